@@ -1,0 +1,82 @@
+// The 10-parameter self-calibration model (Brown / Fraser 1997), correction form, exactly as
+// CONVENTIONS.md "The 10-parameter self-calibration model" defines it.
+//
+// Parameters (block of 10, table units): c [mm], x0 [mm], y0 [mm], K1 [mm^-2], K2 [mm^-4],
+// K3 [mm^-6], P1 [mm^-1], P2 [mm^-1], B1 [1], B2 [1].
+// With xb = x - x0, yb = y - y0 and r2 = xb^2 + yb^2 at the MEASURED photo coordinates (x, y):
+//   dx = xb (K1 r2 + K2 r2^2 + K3 r2^3) + P1 (r2 + 2 xb^2) + 2 P2 xb yb + B1 xb + B2 yb
+//   dy = yb (K1 r2 + K2 r2^2 + K3 r2^3) + 2 P1 xb yb + P2 (r2 + 2 yb^2)
+// The ideal (corrected) coordinates, reduced to the principal point, are (xb + dx, yb + dy);
+// they obey collinearity: xb + dx = -c U / W, yb + dy = -c V / W.
+#pragma once
+
+#include <array>
+#include <string_view>
+
+#include <Eigen/Core>
+
+namespace aerocal::calib {
+
+enum class ParamGroup { kPrincipalDistance, kPrincipalPoint, kRadial, kDecentering, kAffinity };
+
+struct ParamInfo {
+  std::string_view name;
+  std::string_view unit;
+  ParamGroup group;
+};
+
+enum class CameraModelId : int { kBrownFraser10 = 1 };  // values frozen forever
+
+struct BrownFraser10Model {
+  static constexpr CameraModelId kId = CameraModelId::kBrownFraser10;
+  static constexpr std::string_view kName = "brown_fraser_10";
+  enum Index : int { kC, kX0, kY0, kK1, kK2, kK3, kP1, kP2, kB1, kB2, kNumParams };
+  static constexpr std::array<ParamInfo, kNumParams> kParams = {{
+      {"c", "mm", ParamGroup::kPrincipalDistance},
+      {"x0", "mm", ParamGroup::kPrincipalPoint},
+      {"y0", "mm", ParamGroup::kPrincipalPoint},
+      {"K1", "mm^-2", ParamGroup::kRadial},
+      {"K2", "mm^-4", ParamGroup::kRadial},
+      {"K3", "mm^-6", ParamGroup::kRadial},
+      {"P1", "mm^-1", ParamGroup::kDecentering},
+      {"P2", "mm^-1", ParamGroup::kDecentering},
+      {"B1", "1", ParamGroup::kAffinity},
+      {"B2", "1", ParamGroup::kAffinity},
+  }};
+
+  /// Index of a parameter by its table name ("c", "K1", ...); -1 when unknown.
+  static int IndexOf(std::string_view name) {
+    for (int i = 0; i < kNumParams; ++i)
+      if (kParams[i].name == name) return i;
+    return -1;
+  }
+
+  /// Correction (dx, dy) in mm at the principal-point-reduced MEASURED coordinates xb (mm).
+  template <typename T>
+  static void CorrectionReduced(const T* params, const T* xb, T* dxy) {
+    const T r2 = xb[0] * xb[0] + xb[1] * xb[1];
+    const T radial = r2 * (params[kK1] + r2 * (params[kK2] + r2 * params[kK3]));
+    dxy[0] = xb[0] * radial + params[kP1] * (r2 + T(2) * xb[0] * xb[0]) +
+             T(2) * params[kP2] * xb[0] * xb[1] + params[kB1] * xb[0] + params[kB2] * xb[1];
+    dxy[1] = xb[1] * radial + T(2) * params[kP1] * xb[0] * xb[1] +
+             params[kP2] * (r2 + T(2) * xb[1] * xb[1]);
+  }
+
+  /// Ideal coordinates reduced to the principal point, (xb + dx, yb + dy) in mm, from MEASURED
+  /// photo coordinates xy (mm).
+  template <typename T>
+  static void IdealFromMeasured(const T* params, const T* xy_mm, T* ideal_mm) {
+    const T xb[2] = {xy_mm[0] - params[kX0], xy_mm[1] - params[kY0]};
+    T d[2];
+    CorrectionReduced(params, xb, d);
+    ideal_mm[0] = xb[0] + d[0];
+    ideal_mm[1] = xb[1] + d[1];
+  }
+
+  /// Inverse of IdealFromMeasured by Newton iteration: the measured photo coordinates (mm) whose
+  /// ideal reduced coordinates are `ideal_mm`. Converges to |step| < tolerance_mm; false otherwise.
+  static bool MeasuredFromIdeal(const double* params, const Eigen::Vector2d& ideal_mm,
+                                Eigen::Vector2d* measured_mm, double tolerance_mm = 1e-11);
+};
+
+}  // namespace aerocal::calib

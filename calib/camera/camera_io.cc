@@ -1,0 +1,199 @@
+#include "calib/camera/camera_io.h"
+
+#include <set>
+#include <sstream>
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/yaml_util.h"
+
+namespace aerocal::calib {
+namespace {
+
+using Model = BrownFraser10Model;
+
+std::vector<std::string> InteriorKeys() {
+  std::vector<std::string> keys;
+  for (const auto& info : Model::kParams) keys.emplace_back(info.name);
+  return keys;
+}
+
+std::pair<int, int> ReadFormat(const YAML::Node& node, const std::string& file) {
+  if (!node.IsSequence() || node.size() != 2)
+    ThrowInputError(WhereIs(node, file), "format_px must be [width, height]");
+  const int w = YamlInt(node[0], file, "format_px width");
+  const int h = YamlInt(node[1], file, "format_px height");
+  if (w <= 0 || h <= 0)
+    ThrowInputError(WhereIs(node, file), "format_px must be positive (got [" + std::to_string(w) +
+                                             ", " + std::to_string(h) + "])");
+  return {w, h};
+}
+
+SubimageMapping ReadSubimage(const YAML::Node& node, const std::string& file) {
+  RejectUnknownKeys(node, {"id", "format_px", "model", "params"}, file);
+  SubimageMapping s;
+  if (!node["id"]) ThrowInputError(WhereIs(node, file), "sub-image needs an 'id'");
+  s.id = YamlString(node["id"], file, "id");
+  if (!node["format_px"]) ThrowInputError(WhereIs(node, file), "sub-image " + s.id + " needs format_px");
+  std::tie(s.width_px, s.height_px) = ReadFormat(node["format_px"], file);
+  const std::string model_name = node["model"] ? YamlString(node["model"], file, "model") : "affine";
+  const auto model = ParseMappingModel(model_name);
+  if (!model)
+    ThrowInputError(WhereIs(node["model"], file),
+                    "unknown mapping model '" + model_name +
+                        "' (expected translation, conformal, affine or projective)");
+  s.model = *model;
+  if (node["params"]) {
+    const YAML::Node& p = node["params"];
+    if (!p.IsSequence() || static_cast<int>(p.size()) != MappingParamCount(s.model))
+      ThrowInputError(WhereIs(p, file), "sub-image " + s.id + ": model " + model_name + " needs " +
+                                            std::to_string(MappingParamCount(s.model)) +
+                                            " params");
+    for (const auto& v : p) s.params.push_back(YamlDouble(v, file, "params"));
+  } else {
+    s.params = IdentityMappingParams(s.model);
+  }
+  return s;
+}
+
+ReferencePoint ReadReferencePoint(const YAML::Node& node, const std::string& file,
+                                  const Camera& camera) {
+  RejectUnknownKeys(node, {"id", "subimage", "u", "v", "U", "V", "sigma_px"}, file);
+  ReferencePoint r;
+  for (const char* key : {"id", "subimage", "u", "v", "U", "V"})
+    if (!node[key]) ThrowInputError(WhereIs(node, file), std::string("reference point needs '") + key + "'");
+  r.id = YamlString(node["id"], file, "id");
+  r.subimage = YamlString(node["subimage"], file, "subimage");
+  if (camera.SubimageIndex(r.subimage) < 0)
+    ThrowInputError(WhereIs(node["subimage"], file),
+                    "reference point " + r.id + " names unknown sub-image '" + r.subimage + "'");
+  r.u = YamlDouble(node["u"], file, "u");
+  r.v = YamlDouble(node["v"], file, "v");
+  r.U = YamlDouble(node["U"], file, "U");
+  r.V = YamlDouble(node["V"], file, "V");
+  if (node["sigma_px"]) r.sigma_px = YamlDouble(node["sigma_px"], file, "sigma_px");
+  if (!(r.sigma_px > 0))
+    ThrowInputError(WhereIs(node, file), "reference point " + r.id + ": sigma_px must be > 0 (got " +
+                                             FormatNumber(r.sigma_px) + ")");
+  return r;
+}
+
+}  // namespace
+
+Camera ParseCamera(const YAML::Node& root, const std::string& file) {
+  if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
+  RejectUnknownKeys(root, {"name", "pixel_size_mm", "format_px", "interior", "interior_sigma",
+                           "subimages", "reference_points", "model"},
+                    file);
+  Camera camera;
+  if (root["model"] && YamlString(root["model"], file, "model") != Model::kName)
+    ThrowInputError(WhereIs(root["model"], file),
+                    "unknown camera model '" + root["model"].Scalar() + "' (expected " +
+                        std::string(Model::kName) + ")");
+  camera.name = root["name"] ? YamlString(root["name"], file, "name") : "";
+  if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
+  camera.pixel_size_mm = YamlDouble(root["pixel_size_mm"], file, "pixel_size_mm");
+  if (!(camera.pixel_size_mm > 0))
+    ThrowInputError(WhereIs(root["pixel_size_mm"], file),
+                    "pixel_size_mm must be > 0 (got " + root["pixel_size_mm"].Scalar() + ")");
+  if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
+  std::tie(camera.width_px, camera.height_px) = ReadFormat(root["format_px"], file);
+  if (!root["interior"]) ThrowInputError({file, 1}, "missing interior (at least c)");
+  const YAML::Node& interior = root["interior"];
+  RejectUnknownKeys(interior, InteriorKeys(), file);
+  for (int i = 0; i < Model::kNumParams; ++i) {
+    const std::string key(Model::kParams[i].name);
+    if (interior[key]) camera.interior[i] = YamlDouble(interior[key], file, key);
+  }
+  if (!(camera.c_mm() > 0))
+    ThrowInputError(WhereIs(interior, file), "interior.c must be > 0 mm (got " +
+                                                 FormatNumber(camera.c_mm()) + ")");
+  if (root["interior_sigma"]) {
+    const YAML::Node& sig = root["interior_sigma"];
+    RejectUnknownKeys(sig, InteriorKeys(), file);
+    for (int i = 0; i < Model::kNumParams; ++i) {
+      const std::string key(Model::kParams[i].name);
+      if (!sig[key]) continue;
+      const double s = YamlDouble(sig[key], file, key);
+      if (!(s > 0))
+        ThrowInputError(WhereIs(sig[key], file),
+                        "interior_sigma." + key + " must be > 0 (got " + FormatNumber(s) + ")");
+      camera.interior_sigma[i] = s;
+    }
+  }
+  if (root["subimages"]) {
+    if (!root["subimages"].IsSequence())
+      ThrowInputError(WhereIs(root["subimages"], file), "subimages must be a list");
+    std::set<std::string> ids;
+    for (const auto& node : root["subimages"]) {
+      camera.subimages.push_back(ReadSubimage(node, file));
+      if (!ids.insert(camera.subimages.back().id).second)
+        ThrowInputError(WhereIs(node, file), "duplicate sub-image id '" + camera.subimages.back().id + "'");
+    }
+  }
+  if (root["reference_points"]) {
+    if (!root["reference_points"].IsSequence())
+      ThrowInputError(WhereIs(root["reference_points"], file), "reference_points must be a list");
+    for (const auto& node : root["reference_points"])
+      camera.reference_points.push_back(ReadReferencePoint(node, file, camera));
+  }
+  return camera;
+}
+
+Camera ReadCamera(const std::string& path) { return ParseCamera(LoadYamlFile(path), path); }
+
+std::string CameraToYaml(const Camera& camera) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << camera.name;
+  out << YAML::Key << "model" << YAML::Value << std::string(Model::kName);
+  out << YAML::Key << "pixel_size_mm" << YAML::Value << camera.pixel_size_mm;
+  out << YAML::Key << "format_px" << YAML::Value << YAML::Flow << YAML::BeginSeq << camera.width_px
+      << camera.height_px << YAML::EndSeq;
+  out << YAML::Key << "interior" << YAML::Value << YAML::BeginMap;
+  for (int i = 0; i < Model::kNumParams; ++i)
+    out << YAML::Key << std::string(Model::kParams[i].name) << YAML::Value << camera.interior[i];
+  out << YAML::EndMap;
+  bool any_sigma = false;
+  for (const auto& s : camera.interior_sigma) any_sigma |= s.has_value();
+  if (any_sigma) {
+    out << YAML::Key << "interior_sigma" << YAML::Value << YAML::BeginMap;
+    for (int i = 0; i < Model::kNumParams; ++i)
+      if (camera.interior_sigma[i])
+        out << YAML::Key << std::string(Model::kParams[i].name) << YAML::Value
+            << *camera.interior_sigma[i];
+    out << YAML::EndMap;
+  }
+  if (!camera.subimages.empty()) {
+    out << YAML::Key << "subimages" << YAML::Value << YAML::BeginSeq;
+    for (const auto& s : camera.subimages) {
+      out << YAML::BeginMap << YAML::Key << "id" << YAML::Value << s.id;
+      out << YAML::Key << "format_px" << YAML::Value << YAML::Flow << YAML::BeginSeq << s.width_px
+          << s.height_px << YAML::EndSeq;
+      out << YAML::Key << "model" << YAML::Value << std::string(MappingModelName(s.model));
+      out << YAML::Key << "params" << YAML::Value << YAML::Flow << s.params;
+      out << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  if (!camera.reference_points.empty()) {
+    out << YAML::Key << "reference_points" << YAML::Value << YAML::BeginSeq;
+    for (const auto& r : camera.reference_points) {
+      out << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << r.id
+          << YAML::Key << "subimage" << YAML::Value << r.subimage << YAML::Key << "u"
+          << YAML::Value << r.u << YAML::Key << "v" << YAML::Value << r.v << YAML::Key << "U"
+          << YAML::Value << r.U << YAML::Key << "V" << YAML::Value << r.V << YAML::Key
+          << "sigma_px" << YAML::Value << r.sigma_px << YAML::EndMap;
+    }
+    out << YAML::EndSeq;
+  }
+  out << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+void WriteCamera(const std::string& path, const Camera& camera) {
+  WriteFileAtomically(path, CameraToYaml(camera));
+}
+
+}  // namespace aerocal::calib

@@ -1,0 +1,104 @@
+#include "calib/core/csv.h"
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <sstream>
+
+#include "calib/core/atomic_file.h"
+
+namespace aerocal {
+namespace {
+
+std::string Trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t\r");
+  if (begin == std::string::npos) return "";
+  const auto end = s.find_last_not_of(" \t\r");
+  return s.substr(begin, end - begin + 1);
+}
+
+std::vector<std::string> SplitComma(const std::string& line) {
+  std::vector<std::string> out;
+  std::string field;
+  std::istringstream in(line);
+  while (std::getline(in, field, ',')) out.push_back(Trim(field));
+  if (!line.empty() && line.back() == ',') out.emplace_back();
+  return out;
+}
+
+}  // namespace
+
+std::optional<double> ParseDouble(const std::string& text) {
+  if (text.empty()) return std::nullopt;
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  if (end != text.c_str() + text.size() || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
+std::string FormatNumber(double value, int digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*g", digits, value);
+  return buffer;
+}
+
+CsvTable CsvTable::Parse(const std::string& text, const std::string& file) {
+  CsvTable table;
+  table.file_ = file;
+  std::istringstream in(text);
+  std::string line;
+  int line_number = 0;
+  while (std::getline(in, line)) {
+    ++line_number;
+    const std::string trimmed = Trim(line);
+    if (trimmed.empty() || trimmed[0] == '#') continue;
+    std::vector<std::string> fields = SplitComma(trimmed);
+    if (table.header_.empty()) {
+      table.header_ = fields;
+      table.header_line_ = line_number;
+      for (size_t i = 0; i < fields.size(); ++i) {
+        if (fields[i].empty()) ThrowInputError({file, line_number}, "empty column name in header");
+        if (!table.columns_.emplace(fields[i], static_cast<int>(i)).second)
+          ThrowInputError({file, line_number}, "duplicate column '" + fields[i] + "' in header");
+      }
+      continue;
+    }
+    if (fields.size() > table.header_.size())
+      ThrowInputError({file, line_number},
+                      "too many fields (got " + std::to_string(fields.size()) + ", header has " +
+                          std::to_string(table.header_.size()) + ")");
+    fields.resize(table.header_.size());
+    table.rows_.push_back({line_number, std::move(fields)});
+  }
+  if (table.header_.empty()) ThrowInputError({file, 1}, "empty file: a header row is expected");
+  return table;
+}
+
+CsvTable CsvTable::Read(const std::string& path) { return Parse(ReadTextFile(path), path); }
+
+void CsvTable::RequireColumns(const std::vector<std::string>& names) const {
+  for (const auto& name : names)
+    if (!HasColumn(name)) ThrowInputError({file_, header_line_}, "missing column '" + name + "'");
+}
+
+std::string CsvTable::String(const Row& row, const std::string& column) const {
+  const auto it = columns_.find(column);
+  if (it == columns_.end()) return "";
+  return row.fields[it->second];
+}
+
+double CsvTable::Number(const Row& row, const std::string& column) const {
+  const std::string text = String(row, column);
+  const auto value = ParseDouble(text);
+  if (!value)
+    ThrowInputError(Where(row), "column '" + column + "' must be a number (got '" + text + "')");
+  return *value;
+}
+
+std::optional<double> CsvTable::OptionalNumber(const Row& row, const std::string& column) const {
+  const std::string text = String(row, column);
+  if (text.empty()) return std::nullopt;
+  return Number(row, column);
+}
+
+}  // namespace aerocal

@@ -1,0 +1,55 @@
+// CSV tables as FORMATS.md defines them: a header row, comma separators, '#' comment lines,
+// blank lines ignored, fields trimmed. Every value access names FILE:LINE in its error.
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calib/core/error.h"
+
+namespace aerocal {
+
+class CsvTable {
+ public:
+  /// Parses CSV text. `file` is used in messages only.
+  static CsvTable Parse(const std::string& text, const std::string& file);
+  /// Reads and parses a file; throws InputError when it is missing or malformed.
+  static CsvTable Read(const std::string& path);
+
+  struct Row {
+    int line = 0;  // 1-based line number in the file
+    std::vector<std::string> fields;
+  };
+
+  const std::string& file() const { return file_; }
+  const std::vector<std::string>& header() const { return header_; }
+  const std::vector<Row>& rows() const { return rows_; }
+  bool HasColumn(const std::string& name) const { return columns_.count(name) > 0; }
+  /// Throws InputError("FILE:HEADER_LINE: missing column NAME") when absent.
+  void RequireColumns(const std::vector<std::string>& names) const;
+
+  SourceRef Where(const Row& row) const { return {file_, row.line}; }
+  /// Raw string of a column (empty when the column is absent or the field is empty).
+  std::string String(const Row& row, const std::string& column) const;
+  /// Parsed number; throws InputError naming file, line, column and value when not a number.
+  double Number(const Row& row, const std::string& column) const;
+  /// Number when present and non-empty, nullopt otherwise.
+  std::optional<double> OptionalNumber(const Row& row, const std::string& column) const;
+
+ private:
+  std::string file_;
+  int header_line_ = 0;
+  std::vector<std::string> header_;
+  std::map<std::string, int> columns_;
+  std::vector<Row> rows_;
+};
+
+/// Parses a double from the whole of `text`; nullopt when it is not a finite number.
+std::optional<double> ParseDouble(const std::string& text);
+
+/// Formats a double with up to `digits` significant digits, shortest exact form otherwise.
+std::string FormatNumber(double value, int digits = 12);
+
+}  // namespace aerocal

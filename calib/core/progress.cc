@@ -1,0 +1,58 @@
+#include "calib/core/progress.h"
+
+#include <cstdio>
+#include <unistd.h>
+
+namespace aerocal {
+namespace {
+int& EnabledOverride() {
+  static int value = -1;  // -1: decide by isatty
+  return value;
+}
+}  // namespace
+
+void Progress::SetEnabled(bool enabled) { EnabledOverride() = enabled ? 1 : 0; }
+
+Progress::Progress(std::string label, long total)
+    : label_(std::move(label)),
+      total_(total > 0 ? total : 1),
+      start_(std::chrono::steady_clock::now()),
+      last_draw_(start_),
+      enabled_(EnabledOverride() >= 0 ? EnabledOverride() == 1 : ::isatty(STDERR_FILENO) == 1) {
+  if (enabled_) Draw(false);
+}
+
+Progress::~Progress() { Finish(); }
+
+void Progress::Advance(long units) {
+  done_ += units;
+  if (!enabled_) return;
+  const auto now = std::chrono::steady_clock::now();
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (now - last_draw_ < std::chrono::milliseconds(100) && done_ < total_) return;
+  last_draw_ = now;
+  Draw(false);
+}
+
+void Progress::Finish() {
+  std::lock_guard<std::mutex> lock(mutex_);
+  if (finished_) return;
+  finished_ = true;
+  if (enabled_) Draw(true);
+}
+
+void Progress::Draw(bool final_line) {
+  const long done = std::min<long>(done_, total_);
+  const double fraction = static_cast<double>(done) / static_cast<double>(total_);
+  const int width = 30;
+  const int filled = static_cast<int>(fraction * width);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::string bar(filled, '#');
+  bar.resize(width, '.');
+  std::fprintf(stderr, "\r%s [%s] %ld/%ld %5.1f s%s", label_.c_str(), bar.c_str(), done, total_,
+               seconds, final_line ? "\n" : "");
+  std::fflush(stderr);
+}
+
+}  // namespace aerocal

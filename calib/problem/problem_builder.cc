@@ -1,0 +1,565 @@
+#include "calib/problem/problem_builder.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <thread>
+
+#include <Eigen/Dense>
+#include <ceres/ceres.h>
+
+#include "calib/core/error.h"
+#include "calib/problem/scaled_subset_manifold.h"
+
+namespace aerocal::calib {
+
+struct ProblemBuilder::Block {
+  std::string name;
+  double* values = nullptr;
+  int size = 0;
+  BlockKind kind = BlockKind::kOther;
+  std::vector<std::string> entry_names;
+  bool constant = false;
+  std::vector<bool> entry_fixed;
+  std::vector<double> scales;  // per free entry, tangent scaling
+  int num_residuals = 0;       // residual blocks that use it
+
+  std::vector<int> FreeEntries() const {
+    std::vector<int> out;
+    for (int i = 0; i < size; ++i)
+      if (!entry_fixed[i]) out.push_back(i);
+    return out;
+  }
+  int TangentSize() const { return constant ? 0 : static_cast<int>(FreeEntries().size()); }
+};
+
+struct ProblemBuilder::Residual {
+  std::string group, label;
+  ceres::ResidualBlockId id = nullptr;
+  std::vector<BlockId> blocks;
+  int size = 0;
+  bool active = true;
+};
+
+const ResidualGroupStats* SolveReport::Group(const std::string& name) const {
+  for (const auto& g : groups)
+    if (g.name == name) return &g;
+  return nullptr;
+}
+
+Eigen::MatrixXd CovarianceReport::BlockCovariance(BlockId id, int size) const {
+  const int offset = offsets.at(id);
+  return covariance.block(offset, offset, size, size);
+}
+
+Eigen::VectorXd CovarianceReport::BlockSigma(BlockId id, int size) const {
+  return sigma.segment(offsets.at(id), size);
+}
+
+double NormalCriticalValue(double alpha) {
+  // Solve erfc(z / sqrt 2) = alpha by bisection (monotone), to 1e-10.
+  double lo = 0.0, hi = 40.0;
+  for (int i = 0; i < 200; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    if (std::erfc(mid / std::sqrt(2.0)) > alpha)
+      lo = mid;
+    else
+      hi = mid;
+  }
+  return 0.5 * (lo + hi);
+}
+
+ProblemBuilder::ProblemBuilder() {
+  ceres::Problem::Options options;
+  options.enable_fast_removal = true;
+  problem_ = std::make_unique<ceres::Problem>(options);
+}
+
+ProblemBuilder::~ProblemBuilder() = default;
+
+ceres::Problem& ProblemBuilder::problem() { return *problem_; }
+
+BlockId ProblemBuilder::AddBlock(const std::string& name, double* values, int size, BlockKind kind,
+                                 std::vector<std::string> entry_names) {
+  AEROCAL_CHECK(size > 0 && values != nullptr) << "block " << name;
+  AEROCAL_CHECK(block_by_name_.count(name) == 0) << "duplicate block name " << name;
+  AEROCAL_CHECK(block_by_pointer_.count(values) == 0) << "block memory registered twice: " << name;
+  if (entry_names.empty())
+    for (int i = 0; i < size; ++i) entry_names.push_back(std::to_string(i));
+  AEROCAL_CHECK(static_cast<int>(entry_names.size()) == size) << "entry names of " << name;
+  Block block;
+  block.name = name;
+  block.values = values;
+  block.size = size;
+  block.kind = kind;
+  block.entry_names = std::move(entry_names);
+  block.entry_fixed.assign(size, false);
+  block.scales.assign(size, 1.0);
+  const BlockId id = static_cast<BlockId>(blocks_.size());
+  blocks_.push_back(std::move(block));
+  block_by_name_[name] = id;
+  block_by_pointer_[values] = id;
+  problem_->AddParameterBlock(values, size);
+  return id;
+}
+
+BlockId ProblemBuilder::FindBlock(const std::string& name) const {
+  const auto it = block_by_name_.find(name);
+  return it == block_by_name_.end() ? -1 : it->second;
+}
+
+void ProblemBuilder::FixBlock(BlockId id) {
+  blocks_.at(id).constant = true;
+  problem_->SetParameterBlockConstant(blocks_[id].values);
+}
+
+void ProblemBuilder::FreeBlock(BlockId id) {
+  Block& b = blocks_.at(id);
+  b.constant = std::all_of(b.entry_fixed.begin(), b.entry_fixed.end(), [](bool f) { return f; });
+  if (!b.constant) problem_->SetParameterBlockVariable(b.values);
+}
+
+void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
+  Block& b = blocks_.at(id);
+  for (int e : entries) {
+    AEROCAL_CHECK(e >= 0 && e < b.size) << "entry " << e << " of block " << b.name;
+    b.entry_fixed[e] = true;
+  }
+  if (b.FreeEntries().empty()) FixBlock(id);
+}
+
+bool ProblemBuilder::IsBlockFixed(BlockId id) const { return blocks_.at(id).constant; }
+int ProblemBuilder::BlockSize(BlockId id) const { return blocks_.at(id).size; }
+const std::string& ProblemBuilder::BlockName(BlockId id) const { return blocks_.at(id).name; }
+double* ProblemBuilder::BlockValues(BlockId id) const { return blocks_.at(id).values; }
+
+ResidualId ProblemBuilder::AddResidual(const std::string& group,
+                                       std::unique_ptr<ceres::CostFunction> cost,
+                                       const std::vector<BlockId>& blocks, const std::string& label,
+                                       const LossOptions& loss) {
+  AEROCAL_CHECK(cost != nullptr) << "null cost function in group " << group;
+  AEROCAL_CHECK(cost->parameter_block_sizes().size() == blocks.size())
+      << "group " << group << ": cost function expects " << cost->parameter_block_sizes().size()
+      << " blocks, got " << blocks.size();
+  std::vector<double*> pointers;
+  for (size_t i = 0; i < blocks.size(); ++i) {
+    const Block& b = blocks_.at(blocks[i]);
+    AEROCAL_CHECK(cost->parameter_block_sizes()[i] == b.size)
+        << "group " << group << ": block " << b.name << " has size " << b.size << ", functor expects "
+        << cost->parameter_block_sizes()[i];
+    pointers.push_back(b.values);
+  }
+  ceres::LossFunction* loss_function = nullptr;
+  if (loss.kind == LossKind::kHuber) loss_function = new ceres::HuberLoss(loss.scale);
+  if (loss.kind == LossKind::kCauchy) loss_function = new ceres::CauchyLoss(loss.scale);
+  Residual r;
+  r.group = group;
+  r.label = label;
+  r.blocks = blocks;
+  r.size = cost->num_residuals();
+  r.id = problem_->AddResidualBlock(cost.release(), loss_function, pointers);
+  for (BlockId b : blocks) ++blocks_[b].num_residuals;
+  residuals_.push_back(std::move(r));
+  return static_cast<ResidualId>(residuals_.size() - 1);
+}
+
+void ProblemBuilder::RemoveResidual(ResidualId id) {
+  Residual& r = residuals_.at(id);
+  if (!r.active) return;
+  problem_->RemoveResidualBlock(r.id);
+  r.active = false;
+  for (BlockId b : r.blocks) --blocks_[b].num_residuals;
+}
+
+bool ProblemBuilder::IsActive(ResidualId id) const { return residuals_.at(id).active; }
+
+int ProblemBuilder::NumActiveResiduals() const {
+  return static_cast<int>(std::count_if(residuals_.begin(), residuals_.end(),
+                                        [](const Residual& r) { return r.active; }));
+}
+
+const std::string& ProblemBuilder::ResidualGroup(ResidualId id) const {
+  return residuals_.at(id).group;
+}
+const std::string& ProblemBuilder::ResidualLabel(ResidualId id) const {
+  return residuals_.at(id).label;
+}
+
+std::vector<double> ProblemBuilder::EvaluateResidual(ResidualId id) const {
+  const Residual& r = residuals_.at(id);
+  std::vector<double> values(r.size, 0.0);
+  if (!r.active) return values;
+  double cost = 0.0;
+  problem_->EvaluateResidualBlock(r.id, false, &cost, values.data(), nullptr);
+  return values;
+}
+
+std::vector<BlockId> ProblemBuilder::FreeBlocksInOrder() const {
+  std::vector<BlockId> out;
+  for (BlockId i = 0; i < static_cast<BlockId>(blocks_.size()); ++i)
+    if (!blocks_[i].constant && blocks_[i].num_residuals > 0) out.push_back(i);
+  return out;
+}
+
+int ProblemBuilder::NumFreeParameters() const {
+  int n = 0;
+  for (BlockId b : FreeBlocksInOrder()) n += blocks_[b].TangentSize();
+  return n;
+}
+
+int ProblemBuilder::NumObservations() const {
+  int n = 0;
+  for (const auto& r : residuals_)
+    if (r.active) n += r.size;
+  return n;
+}
+
+Eigen::MatrixXd ProblemBuilder::DenseJacobian(const std::vector<BlockId>& blocks,
+                                              std::vector<ResidualId>* row_owner) const {
+  ceres::Problem::EvaluateOptions options;
+  for (BlockId b : blocks) options.parameter_blocks.push_back(blocks_[b].values);
+  std::vector<ResidualId> owners;
+  for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
+    if (!residuals_[i].active) continue;
+    options.residual_blocks.push_back(residuals_[i].id);
+    for (int k = 0; k < residuals_[i].size; ++k) owners.push_back(i);
+  }
+  options.apply_loss_function = false;
+  ceres::CRSMatrix crs;
+  double cost = 0.0;
+  problem_->Evaluate(options, &cost, nullptr, nullptr, &crs);
+  Eigen::MatrixXd dense = Eigen::MatrixXd::Zero(crs.num_rows, crs.num_cols);
+  for (int row = 0; row < crs.num_rows; ++row)
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) dense(row, crs.cols[k]) = crs.values[k];
+  if (row_owner) *row_owner = std::move(owners);
+  return dense;
+}
+
+SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SolveReport report;
+  // Tangent scaling: unit Jacobian columns at the starting point (scaled_subset_manifold.h).
+  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
+  for (BlockId id : free_blocks) {
+    Block& b = blocks_[id];
+    const auto free = b.FreeEntries();
+    problem_->SetManifold(b.values, new ScaledSubsetManifold(b.size, free,
+                                                             std::vector<double>(free.size(), 1.0)));
+  }
+  {
+    ceres::Problem::EvaluateOptions eval;
+    for (BlockId b : free_blocks) eval.parameter_blocks.push_back(blocks_[b].values);
+    eval.apply_loss_function = false;
+    ceres::CRSMatrix crs;
+    double cost = 0;
+    if (!free_blocks.empty() && problem_->Evaluate(eval, &cost, nullptr, nullptr, &crs)) {
+      std::vector<double> norm2(crs.num_cols, 0.0);
+      for (size_t k = 0; k < crs.values.size(); ++k) norm2[crs.cols[k]] += crs.values[k] * crs.values[k];
+      int col = 0;
+      for (BlockId id : free_blocks) {
+        Block& b = blocks_[id];
+        const auto free = b.FreeEntries();
+        std::vector<double> scales;
+        for (size_t k = 0; k < free.size(); ++k, ++col)
+          scales.push_back(norm2[col] > 0 ? 1.0 / std::sqrt(norm2[col]) : 1.0);
+        problem_->SetManifold(b.values, new ScaledSubsetManifold(b.size, free, scales));
+      }
+    } else if (!free_blocks.empty()) {
+      report.diagnostics.push_back(
+          "the residuals cannot be evaluated at the starting values (a point behind a camera?)");
+    }
+  }
+
+  ceres::Solver::Options ceres_options;
+  ceres_options.max_num_iterations = options.max_iterations;
+  ceres_options.function_tolerance = options.function_tolerance;
+  ceres_options.gradient_tolerance = options.gradient_tolerance;
+  ceres_options.parameter_tolerance = options.parameter_tolerance;
+  ceres_options.num_threads =
+      options.num_threads > 0 ? options.num_threads
+                              : std::max(1u, std::thread::hardware_concurrency());
+  ceres_options.minimizer_progress_to_stdout = options.verbose;
+  ceres_options.logging_type = options.verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+
+  int eliminable_params = 0, other_params = 0;
+  std::vector<BlockId> eliminable;
+  for (BlockId id : free_blocks) {
+    const Block& b = blocks_[id];
+    if (b.kind == BlockKind::kGroundPoint || b.kind == BlockKind::kTiePoint2d) {
+      eliminable.push_back(id);
+      eliminable_params += b.TangentSize();
+    } else {
+      other_params += b.TangentSize();
+    }
+  }
+  const bool sparse_available =
+      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
+      ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE);
+  LinearSolverChoice choice = options.linear_solver;
+  if (choice == LinearSolverChoice::kAuto) {
+    if (eliminable_params + other_params <= 300)
+      choice = LinearSolverChoice::kDenseQr;
+    else if (!eliminable.empty() && other_params > 0)
+      choice = other_params <= 800 || !sparse_available ? LinearSolverChoice::kDenseSchur
+                                                        : LinearSolverChoice::kSparseSchur;
+    else
+      choice = sparse_available ? LinearSolverChoice::kSparseNormalCholesky
+                                : LinearSolverChoice::kDenseQr;
+  }
+  switch (choice) {
+    case LinearSolverChoice::kDenseQr:
+    case LinearSolverChoice::kAuto:
+      ceres_options.linear_solver_type = ceres::DENSE_QR;
+      report.linear_solver = "dense_qr";
+      break;
+    case LinearSolverChoice::kDenseSchur:
+      ceres_options.linear_solver_type = ceres::DENSE_SCHUR;
+      report.linear_solver = "dense_schur";
+      break;
+    case LinearSolverChoice::kSparseSchur:
+      ceres_options.linear_solver_type = ceres::SPARSE_SCHUR;
+      report.linear_solver = "sparse_schur";
+      break;
+    case LinearSolverChoice::kSparseNormalCholesky:
+      ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
+      report.linear_solver = "sparse_normal_cholesky";
+      break;
+  }
+  if (ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
+      ceres_options.linear_solver_type == ceres::SPARSE_SCHUR) {
+    if (eliminable.empty() || other_params == 0) {
+      ceres_options.linear_solver_type = ceres::DENSE_QR;
+      report.linear_solver = "dense_qr";
+    } else {
+      auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+      for (BlockId id : free_blocks) {
+        const Block& b = blocks_[id];
+        const bool elim = b.kind == BlockKind::kGroundPoint || b.kind == BlockKind::kTiePoint2d;
+        ordering->AddElementToGroup(b.values, elim ? 0 : 1);
+      }
+      ceres_options.linear_solver_ordering = ordering;
+    }
+  }
+
+  ceres::Solver::Summary summary;
+  if (report.diagnostics.empty()) ceres::Solve(ceres_options, problem_.get(), &summary);
+
+  report.termination = ceres::TerminationTypeToString(summary.termination_type);
+  report.message = summary.message;
+  report.converged = summary.termination_type == ceres::CONVERGENCE;
+  report.usable = summary.IsSolutionUsable();
+  report.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  report.initial_cost = summary.initial_cost;
+  report.final_cost = summary.final_cost;
+
+  // Statistics without the loss function: v^T P v per group and overall.
+  std::map<std::string, ResidualGroupStats> groups;
+  for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
+    const Residual& r = residuals_[i];
+    if (!r.active) continue;
+    auto& g = groups[r.group];
+    g.name = r.group;
+    ++g.n_residual_blocks;
+    g.n_observations += r.size;
+    for (double v : EvaluateResidual(i)) g.vtpv += v * v;
+  }
+  for (auto& [name, g] : groups) {
+    g.rms = g.n_observations > 0 ? std::sqrt(g.vtpv / g.n_observations) : 0.0;
+    report.vtpv += g.vtpv;
+    report.n_observations += g.n_observations;
+    report.groups.push_back(g);
+  }
+  report.n_unknowns = NumFreeParameters();
+  report.redundancy = report.n_observations - report.n_unknowns;
+  if (report.redundancy > 0) {
+    report.sigma0 = std::sqrt(report.vtpv / report.redundancy);
+  } else {
+    report.diagnostics.push_back("no redundancy: " + std::to_string(report.n_observations) +
+                                 " observations for " + std::to_string(report.n_unknowns) +
+                                 " unknowns; sigma0 cannot be estimated");
+  }
+  if (!report.converged)
+    report.diagnostics.push_back("the adjustment did not converge: " + summary.message);
+  for (BlockId id = 0; id < static_cast<BlockId>(blocks_.size()); ++id)
+    if (!blocks_[id].constant && blocks_[id].num_residuals == 0)
+      report.diagnostics.push_back("block " + blocks_[id].name + " has no observations");
+  report.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
+}
+
+std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters) const {
+  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
+  if (NumFreeParameters() > max_parameters) return {};
+  const Eigen::MatrixXd j = DenseJacobian(free_blocks, nullptr);
+  Eigen::MatrixXd n = j.transpose() * j;
+  Eigen::VectorXd d = n.diagonal().cwiseSqrt();
+  for (int i = 0; i < d.size(); ++i) d(i) = d(i) > 0 ? 1.0 / d(i) : 1.0;
+  n = d.asDiagonal() * n * d.asDiagonal();
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(n);
+  const double max_eig = eig.eigenvalues().maxCoeff();
+  std::vector<std::string> names;
+  for (BlockId b : free_blocks)
+    for (int e : blocks_[b].FreeEntries()) names.push_back(blocks_[b].name + "." + blocks_[b].entry_names[e]);
+  std::set<std::string> out;
+  for (int k = 0; k < eig.eigenvalues().size(); ++k) {
+    if (eig.eigenvalues()(k) > 1e-12 * max_eig) break;  // ascending order
+    const Eigen::VectorXd v = eig.eigenvectors().col(k);
+    for (int i = 0; i < v.size(); ++i)
+      if (std::abs(v(i)) > 0.2) out.insert(names[i]);
+  }
+  return {out.begin(), out.end()};
+}
+
+CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& blocks,
+                                                    double sigma0,
+                                                    double correlation_threshold) const {
+  CovarianceReport report;
+  int total = 0;
+  for (BlockId id : blocks) {
+    report.offsets[id] = total;
+    const Block& b = blocks_.at(id);
+    for (int e = 0; e < b.size; ++e) {
+      report.names.push_back(b.name + "." + b.entry_names[e]);
+      report.free.push_back(!b.constant && !b.entry_fixed[e] && b.num_residuals > 0);
+    }
+    total += b.size;
+  }
+  report.covariance = Eigen::MatrixXd::Zero(total, total);
+  std::vector<BlockId> free_requested;
+  for (BlockId id : blocks)
+    if (!blocks_[id].constant && blocks_[id].num_residuals > 0) free_requested.push_back(id);
+
+  ceres::Covariance::Options options;
+  const int n_free = NumFreeParameters();
+  options.algorithm_type = n_free <= 1500 ? ceres::DENSE_SVD : ceres::SPARSE_QR;
+  options.min_reciprocal_condition_number = 1e-14;
+  options.num_threads = std::max(1u, std::thread::hardware_concurrency());
+  options.apply_loss_function = true;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> pairs;
+  for (size_t i = 0; i < free_requested.size(); ++i)
+    for (size_t k = i; k < free_requested.size(); ++k)
+      pairs.emplace_back(blocks_[free_requested[i]].values, blocks_[free_requested[k]].values);
+  const bool computed = pairs.empty() || covariance.Compute(pairs, problem_.get());
+  if (!computed) {
+    report.ok = false;
+    report.undetermined = NullSpaceParameters(3000);
+    report.message = "the normal matrix is singular or badly conditioned: the problem has a "
+                     "datum defect or parameters the observations cannot determine";
+    if (!report.undetermined.empty()) {
+      report.message += " (";
+      for (size_t i = 0; i < report.undetermined.size() && i < 20; ++i)
+        report.message += (i ? ", " : "") + report.undetermined[i];
+      if (report.undetermined.size() > 20) report.message += ", ...";
+      report.message += ")";
+    }
+    report.sigma = Eigen::VectorXd::Zero(total);
+    report.correlation = Eigen::MatrixXd::Identity(total, total);
+    return report;
+  }
+  const double s2 = sigma0 * sigma0;
+  for (size_t i = 0; i < free_requested.size(); ++i) {
+    for (size_t k = i; k < free_requested.size(); ++k) {
+      const Block& a = blocks_[free_requested[i]];
+      const Block& b = blocks_[free_requested[k]];
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(a.size, b.size);
+      covariance.GetCovarianceBlock(a.values, b.values, m.data());
+      const int ra = report.offsets[free_requested[i]], rb = report.offsets[free_requested[k]];
+      report.covariance.block(ra, rb, a.size, b.size) = s2 * m;
+      report.covariance.block(rb, ra, b.size, a.size) = s2 * m.transpose();
+    }
+  }
+  report.ok = true;
+  report.sigma = report.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
+  report.correlation = Eigen::MatrixXd::Identity(total, total);
+  for (int i = 0; i < total; ++i)
+    for (int k = 0; k < total; ++k)
+      if (i != k && report.sigma(i) > 0 && report.sigma(k) > 0)
+        report.correlation(i, k) = report.covariance(i, k) / (report.sigma(i) * report.sigma(k));
+  for (int i = 0; i < total; ++i)
+    for (int k = i + 1; k < total; ++k)
+      if (report.free[i] && report.free[k] &&
+          std::abs(report.correlation(i, k)) > correlation_threshold)
+        report.high_correlations.push_back({report.names[i], report.names[k], report.correlation(i, k)});
+  return report;
+}
+
+std::map<ResidualId, std::vector<double>> ProblemBuilder::RedundancyNumbers(
+    const std::vector<ResidualId>& ids, int max_dense_parameters) const {
+  std::map<ResidualId, std::vector<double>> out;
+  const int n_free = NumFreeParameters();
+  const int n_obs = NumObservations();
+  if (n_free > max_dense_parameters || n_obs <= n_free) {
+    const double mean = n_obs > n_free ? static_cast<double>(n_obs - n_free) / n_obs : 0.0;
+    for (ResidualId id : ids) out[id] = std::vector<double>(residuals_.at(id).size, mean);
+    return out;
+  }
+  std::vector<ResidualId> owner;
+  const Eigen::MatrixXd j = DenseJacobian(FreeBlocksInOrder(), &owner);
+  const Eigen::MatrixXd n = j.transpose() * j;
+  // Pseudo-inverse through the eigen-decomposition, robust to a datum defect.
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(n);
+  const double max_eig = eig.eigenvalues().maxCoeff();
+  Eigen::VectorXd inv = eig.eigenvalues();
+  for (int i = 0; i < inv.size(); ++i) inv(i) = inv(i) > 1e-12 * max_eig ? 1.0 / inv(i) : 0.0;
+  const Eigen::MatrixXd b = j * eig.eigenvectors();  // rows j_i V
+  std::set<ResidualId> wanted(ids.begin(), ids.end());
+  for (int row = 0; row < j.rows(); ++row) {
+    if (!wanted.count(owner[row])) continue;
+    const double h = (b.row(row).array().square() * inv.transpose().array()).sum();
+    out[owner[row]].push_back(std::max(0.0, 1.0 - h));
+  }
+  return out;
+}
+
+SolveReport ProblemBuilder::SolveWithDataSnooping(const SolverOptions& options,
+                                                  const SnoopingOptions& snooping,
+                                                  std::vector<RejectedResidual>* rejected) {
+  SolveReport report = Solve(options);
+  for (int round = 0; round < snooping.max_rejections && report.usable && report.redundancy > 0;
+       ++round) {
+    std::vector<ResidualId> tested;
+    int n_components = 0;
+    for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
+      if (!residuals_[i].active) continue;
+      if (!snooping.groups.empty() &&
+          std::find(snooping.groups.begin(), snooping.groups.end(), residuals_[i].group) ==
+              snooping.groups.end())
+        continue;
+      tested.push_back(i);
+      n_components += residuals_[i].size;
+    }
+    if (tested.empty()) break;
+    const double critical =
+        snooping.critical_value > 0
+            ? snooping.critical_value
+            : std::max(3.29, NormalCriticalValue(0.05 / std::max(1, n_components)));
+    const auto redundancy = RedundancyNumbers(tested, snooping.max_dense_parameters);
+    ResidualId worst = -1;
+    double worst_w = critical;
+    std::vector<double> worst_v;
+    for (ResidualId id : tested) {
+      const std::vector<double> v = EvaluateResidual(id);
+      const std::vector<double>& r = redundancy.at(id);
+      for (size_t k = 0; k < v.size(); ++k) {
+        if (r[k] < 1e-6) continue;  // uncontrolled observation: cannot be tested
+        const double w = std::abs(v[k]) / (report.sigma0 * std::sqrt(r[k]));
+        if (w > worst_w) {
+          worst_w = w;
+          worst = id;
+          worst_v = v;
+        }
+      }
+    }
+    if (worst < 0) break;
+    if (rejected)
+      rejected->push_back({worst, residuals_[worst].group, residuals_[worst].label, worst_w, worst_v});
+    RemoveResidual(worst);
+    report = Solve(options);
+  }
+  return report;
+}
+
+}  // namespace aerocal::calib

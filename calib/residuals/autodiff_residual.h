@@ -1,0 +1,20 @@
+// CRTP base that declares a residual's sizes once and provides Create() (STYLE.md section 5).
+#pragma once
+
+#include <memory>
+#include <utility>
+
+#include <ceres/autodiff_cost_function.h>
+
+namespace aerocal::calib {
+
+template <typename Derived, int kNumResiduals, int... kBlockSizes>
+struct AutoDiffResidual {
+  template <typename... Args>
+  static std::unique_ptr<ceres::CostFunction> Create(Args&&... args) {
+    return std::make_unique<ceres::AutoDiffCostFunction<Derived, kNumResiduals, kBlockSizes...>>(
+        new Derived(std::forward<Args>(args)...));
+  }
+};
+
+}  // namespace aerocal::calib

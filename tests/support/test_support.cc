@@ -1,0 +1,54 @@
+#include "tests/support/test_support.h"
+
+#include <array>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <random>
+#include <sys/wait.h>
+#include <unistd.h>
+
+namespace aerocal::testing {
+
+TempDir::TempDir(const std::string& prefix) {
+  std::random_device device;
+  const auto base = std::filesystem::temp_directory_path();
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const auto candidate =
+        base / (prefix + "_" + std::to_string(::getpid()) + "_" + std::to_string(device()));
+    if (std::filesystem::create_directory(candidate)) {
+      path_ = candidate.string();
+      return;
+    }
+  }
+  path_ = (base / prefix).string();
+  std::filesystem::create_directories(path_);
+}
+
+TempDir::~TempDir() {
+  std::error_code ec;
+  if (!std::getenv("AEROCAL_KEEP_TEST_FILES")) std::filesystem::remove_all(path_, ec);
+}
+
+CommandResult RunCommand(const std::string& command) {
+  CommandResult result;
+  FILE* pipe = ::popen((command + " 2>&1").c_str(), "r");
+  if (!pipe) return result;
+  std::array<char, 4096> buffer;
+  size_t n;
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  const int status = ::pclose(pipe);
+  result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  return result;
+}
+
+CommandResult RunAerocal(const std::string& arguments) {
+  return RunCommand(std::string(AEROCAL_BINARY) + " " + arguments);
+}
+
+std::string SharedDataDir(const std::string& name) {
+  const std::string dir = std::string(AEROCAL_SHARED_DATA_DIR) + "/" + name;
+  return std::filesystem::is_directory(dir) ? dir : "";
+}
+
+}  // namespace aerocal::testing

@@ -1,0 +1,33 @@
+// Helpers shared by the test suites: temporary folders, running the aerocal binary, paths.
+#pragma once
+
+#include <string>
+
+namespace aerocal::testing {
+
+/// A fresh empty folder under the system temp dir, removed at destruction.
+class TempDir {
+ public:
+  explicit TempDir(const std::string& prefix = "aerocal_test");
+  ~TempDir();
+  const std::string& path() const { return path_; }
+  std::string File(const std::string& name) const { return path_ + "/" + name; }
+
+ private:
+  std::string path_;
+};
+
+struct CommandResult {
+  int exit_code = -1;
+  std::string output;  // stdout and stderr together
+};
+
+/// Runs a shell command, capturing stdout+stderr.
+CommandResult RunCommand(const std::string& command);
+/// Runs the aerocal binary with the given arguments.
+CommandResult RunAerocal(const std::string& arguments);
+
+/// Path of a shared real data set, or "" when ../shared/data is absent (tests then GTEST_SKIP).
+std::string SharedDataDir(const std::string& name);
+
+}  // namespace aerocal::testing

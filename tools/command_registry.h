@@ -1,0 +1,42 @@
+// Commands of the `aerocal` executable. Each command lives in tools/cmd_<name>.cc and registers
+// itself with a static AEROCAL_REGISTER_COMMAND, so adding a command edits no other file.
+//
+// A command adds its CLI11 sub-app (options with help texts) in `setup` and returns a callback
+// that runs it and returns the exit code (STYLE.md section 7): 0 converged / done, 2 bad input
+// (nothing written), 3 ran but did not converge or is not determinable, 1 internal error.
+// Throwing aerocal::InputError / ConfigError gives exit 2 with "error: FILE:LINE: ..." on stderr.
+#pragma once
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+namespace aerocal::tools {
+
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitInternal = 1;
+inline constexpr int kExitBadInput = 2;
+inline constexpr int kExitNotConverged = 3;
+
+using CommandRun = std::function<int()>;
+using CommandSetup = std::function<CommandRun(CLI::App& app)>;
+
+struct CommandEntry {
+  std::string name, description;
+  CommandSetup setup;
+};
+
+std::vector<CommandEntry>& CommandRegistry();
+
+struct CommandRegistrar {
+  CommandRegistrar(std::string name, std::string description, CommandSetup setup) {
+    CommandRegistry().push_back({std::move(name), std::move(description), std::move(setup)});
+  }
+};
+
+}  // namespace aerocal::tools
+
+#define AEROCAL_REGISTER_COMMAND(ident, name, description, setup) \
+  static ::aerocal::tools::CommandRegistrar ident##_registrar(name, description, setup)
