@@ -486,11 +486,114 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
   return report;
 }
 
+// Redundancy numbers r_ii = 1 - j_i N^-1 j_i^T with the point blocks (ground points, virtual tie
+// points) eliminated, as the Schur solver does: with N = [A B; B^T C] (A block-diagonal over the
+// point blocks, C over the other parameters) and S = C - B^T A^-1 B, a row j = [a f] touching one
+// point block e gives, with t = a A_e^-1 and q = t B_e:
+//   j N^-1 j^T = t a^T + (q - f) S^+ (q - f)^T.
+// Cost O(rows * n_other^2 + n_other^3) instead of O(n_free^3). Returns false (dense path) when
+// there is no point block, a row touches two point blocks, or S is larger than `max_dense`.
+bool ProblemBuilder::RedundancyNumbersBySchur(const std::vector<ResidualId>& ids, int max_dense,
+                                              std::map<ResidualId, std::vector<double>>* out) const {
+  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
+  std::vector<int> column_block;  // index into free_blocks of every tangent column
+  std::vector<int> local_column;  // column within the point block, or within C
+  std::vector<bool> eliminable(free_blocks.size());
+  int n_other = 0;
+  bool any_point = false;
+  for (size_t i = 0; i < free_blocks.size(); ++i) {
+    const Block& b = blocks_[free_blocks[i]];
+    eliminable[i] = b.kind == BlockKind::kGroundPoint || b.kind == BlockKind::kTiePoint2d;
+    any_point = any_point || eliminable[i];
+    for (int k = 0; k < b.TangentSize(); ++k) {
+      column_block.push_back(static_cast<int>(i));
+      local_column.push_back(eliminable[i] ? k : n_other++);
+    }
+  }
+  if (!any_point || n_other > max_dense) return false;
+  ceres::Problem::EvaluateOptions options;
+  for (BlockId b : free_blocks) options.parameter_blocks.push_back(blocks_[b].values);
+  std::vector<ResidualId> owner;
+  for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
+    if (!residuals_[i].active) continue;
+    options.residual_blocks.push_back(residuals_[i].id);
+    for (int k = 0; k < residuals_[i].size; ++k) owner.push_back(i);
+  }
+  options.apply_loss_function = false;
+  ceres::CRSMatrix crs;
+  double cost = 0.0;
+  if (!problem_->Evaluate(options, &cost, nullptr, nullptr, &crs)) return false;
+  // Split every row into its point part a (one block at most) and its other part f.
+  struct Row {
+    int point = -1;              // index into free_blocks, -1 when none
+    Eigen::VectorXd a, f;
+  };
+  std::vector<Row> rows(crs.num_rows);
+  std::map<int, Eigen::MatrixXd> a_blocks, b_blocks;  // per point block: A_e, B_e
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n_other, n_other);
+  for (int r = 0; r < crs.num_rows; ++r) {
+    Row& row = rows[r];
+    row.f = Eigen::VectorXd::Zero(n_other);
+    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
+      const int col = crs.cols[k], block = column_block[col];
+      if (!eliminable[block]) {
+        row.f(local_column[col]) = crs.values[k];
+        continue;
+      }
+      if (row.point >= 0 && row.point != block) return false;
+      if (row.point < 0) {
+        row.point = block;
+        row.a = Eigen::VectorXd::Zero(blocks_[free_blocks[block]].TangentSize());
+      }
+      row.a(local_column[col]) = crs.values[k];
+    }
+    c.noalias() += row.f * row.f.transpose();
+    if (row.point < 0) continue;
+    const int ne = static_cast<int>(row.a.size());
+    auto [a_it, a_new] = a_blocks.try_emplace(row.point, Eigen::MatrixXd::Zero(ne, ne));
+    auto [b_it, b_new] = b_blocks.try_emplace(row.point, Eigen::MatrixXd::Zero(ne, n_other));
+    a_it->second.noalias() += row.a * row.a.transpose();
+    b_it->second.noalias() += row.a * row.f.transpose();
+  }
+  // A_e^+ (pseudo-inverse: a point seen by too few rows stays undetermined, not infinite).
+  auto pseudo_inverse = [](const Eigen::MatrixXd& m) {
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(m);
+    const double max_eig = eig.eigenvalues().cwiseAbs().maxCoeff();
+    Eigen::VectorXd inv = eig.eigenvalues();
+    for (int i = 0; i < inv.size(); ++i) inv(i) = inv(i) > 1e-12 * max_eig ? 1.0 / inv(i) : 0.0;
+    return Eigen::MatrixXd(eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose());
+  };
+  std::map<int, Eigen::MatrixXd> a_inverse;
+  Eigen::MatrixXd s = c;
+  for (const auto& [block, a] : a_blocks) {
+    a_inverse[block] = pseudo_inverse(a);
+    const Eigen::MatrixXd& b = b_blocks[block];
+    s.noalias() -= b.transpose() * a_inverse[block] * b;
+  }
+  const Eigen::MatrixXd s_inverse = n_other > 0 ? pseudo_inverse(s) : Eigen::MatrixXd();
+  std::set<ResidualId> wanted(ids.begin(), ids.end());
+  for (int r = 0; r < crs.num_rows; ++r) {
+    if (!wanted.count(owner[r])) continue;
+    const Row& row = rows[r];
+    double h = 0.0;
+    Eigen::VectorXd d = -row.f;
+    if (row.point >= 0) {
+      const Eigen::VectorXd t = a_inverse[row.point] * row.a;  // A_e symmetric: (a A_e^-1)^T
+      h += t.dot(row.a);
+      d.noalias() += b_blocks[row.point].transpose() * t;
+    }
+    if (n_other > 0) h += d.dot(s_inverse * d);
+    (*out)[owner[r]].push_back(std::max(0.0, 1.0 - h));
+  }
+  return true;
+}
+
 std::map<ResidualId, std::vector<double>> ProblemBuilder::RedundancyNumbers(
     const std::vector<ResidualId>& ids, int max_dense_parameters) const {
   std::map<ResidualId, std::vector<double>> out;
   const int n_free = NumFreeParameters();
   const int n_obs = NumObservations();
+  if (n_obs > n_free && RedundancyNumbersBySchur(ids, max_dense_parameters, &out)) return out;
   if (n_free > max_dense_parameters || n_obs <= n_free) {
     const double mean = n_obs > n_free ? static_cast<double>(n_obs - n_free) / n_obs : 0.0;
     for (ResidualId id : ids) out[id] = std::vector<double>(residuals_.at(id).size, mean);

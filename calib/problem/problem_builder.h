@@ -191,7 +191,9 @@ class ProblemBuilder {
                                       double correlation_threshold = 0.95) const;
 
   /// Redundancy numbers r_ii of every scalar residual of the listed residuals (whitened problem).
-  /// Exact from the dense normal matrix up to max_dense_parameters free parameters; r/n otherwise.
+  /// Exact: with point blocks (ground / tie points) by their elimination (Schur complement) when
+  /// the other parameters number at most max_dense_parameters; else from the dense normal matrix
+  /// up to max_dense_parameters free parameters; r/n otherwise.
   std::map<ResidualId, std::vector<double>> RedundancyNumbers(const std::vector<ResidualId>& ids,
                                                               int max_dense_parameters) const;
 
@@ -206,6 +208,8 @@ class ProblemBuilder {
   struct Residual;
   std::vector<BlockId> FreeBlocksInOrder() const;
   std::vector<std::string> NullSpaceParameters(int max_parameters) const;
+  bool RedundancyNumbersBySchur(const std::vector<ResidualId>& ids, int max_dense,
+                                std::map<ResidualId, std::vector<double>>* out) const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,
                                 std::vector<ResidualId>* row_owner) const;
 

@@ -1,0 +1,302 @@
+// The shared problem builder on a test-field calibration (known targets, convergent exposures,
+// all 10 interior parameters free): exact recovery without noise, sigma0 and 3-sigma recovery
+// with known Gaussian noise, reported sigmas against the spread of 200 Monte-Carlo repetitions,
+// data snooping of a planted gross error, and the diagnostics of rank-deficient and badly
+// determined problems.
+#include <cmath>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "calib/camera/camera.h"
+#include "calib/problem/problem_builder.h"
+#include "calib/residuals/autodiff_residual.h"
+#include "calib/residuals/collinearity.h"
+
+namespace aerocal::calib {
+namespace {
+
+using Model = BrownFraser10Model;
+
+struct TestField {
+  Camera camera;  // truth
+  std::vector<Eigen::Vector3d> points;
+  std::vector<Eigen::Vector3d> opk, centers;
+  struct Obs {
+    int image, point;
+    Eigen::Vector2d pixel;
+  };
+  std::vector<Obs> observations;  // noise-free
+};
+
+// Exposure looking from `center` at `target`, rotated by `kappa` about the viewing axis.
+Eigen::Vector3d LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target, double kappa) {
+  const Eigen::Vector3d w = (center - target).normalized();  // camera looks along -W
+  Eigen::Vector3d u = Eigen::Vector3d::UnitY().cross(w);
+  if (u.norm() < 1e-6) u = Eigen::Vector3d::UnitX();
+  u.normalize();
+  const Eigen::Vector3d v = w.cross(u);
+  Eigen::Matrix3d r;  // columns: image axes in object space
+  r.col(0) = u;
+  r.col(1) = v;
+  r.col(2) = w;
+  r = r * Eigen::AngleAxisd(kappa, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  return OpkFromRotation(r);
+}
+
+TestField MakeTestField() {
+  TestField f;
+  f.camera.pixel_size_mm = 0.009;
+  f.camera.width_px = 6000;
+  f.camera.height_px = 4000;
+  f.camera.interior = {50.2, 0.031, -0.042, 4e-5, -3e-8, 5e-12, 3e-6, -2e-6, 1e-4, -5e-5};
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  for (int i = 0; i < 150; ++i) f.points.push_back({5.0 * uniform(rng), 5.0 * uniform(rng), 1.5 + 1.5 * uniform(rng)});
+  const Eigen::Vector3d target(0, 0, 1.5);
+  for (int k = 0; k < 8; ++k) {
+    const double a = 2 * M_PI * k / 8;
+    const Eigen::Vector3d c(8.0 * std::cos(a), 8.0 * std::sin(a), 14.0 + (k % 2));
+    f.centers.push_back(c);
+    f.opk.push_back(LookAt(c, target, (k % 4) * M_PI / 2));
+  }
+  f.centers.push_back({0.3, -0.2, 15.0});
+  f.opk.push_back(LookAt(f.centers.back(), target, 0.4));
+  for (size_t i = 0; i < f.centers.size(); ++i)
+    for (size_t p = 0; p < f.points.size(); ++p) {
+      Eigen::Vector2d px;
+      if (!f.camera.ProjectToPixel(f.opk[i], f.centers[i], f.points[p], &px)) continue;
+      if (px.x() < 0 || px.y() < 0 || px.x() > f.camera.width_px - 1 || px.y() > f.camera.height_px - 1) continue;
+      f.observations.push_back({static_cast<int>(i), static_cast<int>(p), px});
+    }
+  return f;
+}
+
+// The adjustment under test: interior (all 10 free), exposures free, targets fixed (known).
+struct Adjustment {
+  InteriorParams interior;
+  std::vector<Eigen::Vector3d> opk, centers, points;
+  ProblemBuilder builder;
+  BlockId interior_block;
+  std::vector<ResidualId> residuals;
+
+  Adjustment(const TestField& f, const std::vector<Eigen::Vector2d>& pixels, double sigma_px,
+             const InteriorParams& start) : interior(start), opk(f.opk), centers(f.centers), points(f.points) {
+    std::vector<std::string> names;
+    for (const auto& info : Model::kParams) names.emplace_back(info.name);
+    interior_block = builder.AddBlock("interior", interior.data(), 10, BlockKind::kInterior, names);
+    std::vector<BlockId> o, c, p;
+    for (size_t i = 0; i < opk.size(); ++i) {
+      o.push_back(builder.AddBlock("opk" + std::to_string(i), opk[i].data(), 3, BlockKind::kRotation));
+      c.push_back(builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter));
+    }
+    for (size_t i = 0; i < points.size(); ++i) {
+      p.push_back(builder.AddBlock("point" + std::to_string(i), points[i].data(), 3, BlockKind::kGroundPoint));
+      builder.FixBlock(p.back());
+    }
+    const PixelFrame frame{f.camera.pixel_size_mm, f.camera.width_px, f.camera.height_px};
+    for (size_t k = 0; k < f.observations.size(); ++k) {
+      const auto& obs = f.observations[k];
+      residuals.push_back(builder.AddResidual(
+          kGroupImage, CollinearityResidual::Create(frame, pixels[k], sigma_px),
+          {interior_block, o[obs.image], c[obs.image], p[obs.point]},
+          "image " + std::to_string(obs.image) + " point " + std::to_string(obs.point)));
+    }
+  }
+};
+
+InteriorParams PerturbedStart(const InteriorParams& truth) {
+  InteriorParams start = truth;
+  start[Model::kC] += 0.3;
+  start[Model::kX0] -= 0.05;
+  start[Model::kY0] += 0.05;
+  for (int i = Model::kK1; i < Model::kNumParams; ++i) start[i] = 0.0;
+  return start;
+}
+
+std::vector<Eigen::Vector2d> NoisyPixels(const TestField& f, double noise_px, std::mt19937_64& rng) {
+  std::normal_distribution<double> normal(0.0, noise_px);
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& obs : f.observations) out.push_back(obs.pixel + Eigen::Vector2d(normal(rng), normal(rng)));
+  return out;
+}
+
+TEST(ProblemBuilder, NoiseFreeDataGiveExactRecovery) {
+  const TestField f = MakeTestField();
+  ASSERT_GT(f.observations.size(), 1000u);
+  std::mt19937_64 rng(1);
+  Adjustment a(f, NoisyPixels(f, 0.0, rng), 0.1, PerturbedStart(f.camera.interior));
+  // Start the exterior orientation off as well.
+  for (auto& c : a.centers) c += Eigen::Vector3d(0.05, -0.05, 0.1);
+  const SolveReport report = a.builder.Solve({});
+  ASSERT_TRUE(report.converged) << report.message;
+  for (int i = 0; i < Model::kNumParams; ++i) {
+    // 1e-9 relative to the parameter, or to its effect of one pixel for the tiny terms.
+    const double truth = f.camera.interior[i];
+    EXPECT_NEAR(a.interior[i], truth, 1e-9 * std::max(std::abs(truth), 1e-12))
+        << Model::kParams[i].name;
+  }
+  EXPECT_LT(report.sigma0, 1e-6);
+}
+
+TEST(ProblemBuilder, GaussianNoiseGivesSigma0AndThreeSigmaRecovery) {
+  const TestField f = MakeTestField();
+  std::mt19937_64 rng(2);
+  const double noise_px = 0.25;
+  Adjustment a(f, NoisyPixels(f, noise_px, rng), noise_px, PerturbedStart(f.camera.interior));
+  const SolveReport report = a.builder.Solve({});
+  ASSERT_TRUE(report.converged);
+  EXPECT_GE(report.n_observations, 1000);
+  EXPECT_NEAR(report.sigma0, 1.0, 0.10) << "sigma0 must match the injected noise within 10 %";
+  EXPECT_EQ(report.redundancy, report.n_observations - (10 + 6 * 9));
+  ASSERT_NE(report.Group(kGroupImage), nullptr);
+  EXPECT_EQ(report.Group(kGroupImage)->n_observations, report.n_observations);
+  const CovarianceReport cov = a.builder.EstimateCovariance({a.interior_block}, report.sigma0);
+  ASSERT_TRUE(cov.ok) << cov.message;
+  for (int i = 0; i < Model::kNumParams; ++i) {
+    EXPECT_GT(cov.sigma(i), 0.0);
+    EXPECT_LT(std::abs(a.interior[i] - f.camera.interior[i]), 3.0 * cov.sigma(i)) << Model::kParams[i].name;
+  }
+  EXPECT_EQ(cov.names[0], "interior.c");
+}
+
+TEST(ProblemBuilder, ReportedSigmasMatchTheMonteCarloSpread) {
+  const TestField f = MakeTestField();
+  const double noise_px = 0.25;
+  const int repetitions = 200;
+  std::mt19937_64 rng(3);
+  std::vector<InteriorParams> estimates;
+  Eigen::VectorXd reported;
+  for (int rep = 0; rep < repetitions; ++rep) {
+    Adjustment a(f, NoisyPixels(f, noise_px, rng), noise_px, f.camera.interior);
+    SolverOptions options;
+    options.num_threads = 1;
+    const SolveReport report = a.builder.Solve(options);
+    ASSERT_TRUE(report.usable);
+    estimates.push_back(a.interior);
+    if (rep == 0) {
+      // A-priori precision (sigma0 = 1: the injected noise is the a-priori sigma).
+      const CovarianceReport cov = a.builder.EstimateCovariance({a.interior_block}, 1.0);
+      ASSERT_TRUE(cov.ok);
+      reported = cov.sigma;
+    }
+  }
+  for (int i = 0; i < Model::kNumParams; ++i) {
+    double mean = 0, sq = 0;
+    for (const auto& e : estimates) mean += e[i];
+    mean /= repetitions;
+    for (const auto& e : estimates) sq += (e[i] - mean) * (e[i] - mean);
+    const double spread = std::sqrt(sq / (repetitions - 1));
+    // 200 repetitions: the empirical sigma itself scatters by ~5 %; 15 % is the stated tolerance.
+    EXPECT_NEAR(spread / reported(i), 1.0, 0.15) << Model::kParams[i].name;
+  }
+}
+
+TEST(ProblemBuilder, DataSnoopingFindsAndListsAPlantedGrossError) {
+  const TestField f = MakeTestField();
+  std::mt19937_64 rng(4);
+  auto pixels = NoisyPixels(f, 0.2, rng);
+  const size_t planted = pixels.size() / 3;
+  pixels[planted].x() += 3.0;  // 15 sigma
+  Adjustment a(f, pixels, 0.2, PerturbedStart(f.camera.interior));
+  std::vector<RejectedResidual> rejected;
+  const SolveReport report = a.builder.SolveWithDataSnooping({}, {}, &rejected);
+  ASSERT_TRUE(report.converged);
+  ASSERT_GE(rejected.size(), 1u);
+  EXPECT_EQ(rejected[0].id, a.residuals[planted]);
+  EXPECT_LE(rejected.size(), 3u) << "no more than a few false alarms at 5 % family-wise";
+  EXPECT_FALSE(a.builder.IsActive(a.residuals[planted]));
+  EXPECT_NEAR(report.sigma0, 1.0, 0.1);
+}
+
+TEST(ProblemBuilder, DatumDefectIsReportedWithTheParametersInvolved) {
+  // A free network: two exposures and free object points, nothing fixing position, attitude and
+  // scale: the covariance cannot be computed and the diagnostics name the exterior orientation.
+  const TestField f = MakeTestField();
+  std::vector<Eigen::Vector3d> opk = {f.opk[0], f.opk[2]}, centers = {f.centers[0], f.centers[2]};
+  std::vector<Eigen::Vector3d> points = f.points;
+  InteriorParams interior = f.camera.interior;
+  ProblemBuilder builder;
+  const BlockId ib = builder.AddBlock("interior", interior.data(), 10, BlockKind::kInterior);
+  builder.FixBlock(ib);
+  const PixelFrame frame{f.camera.pixel_size_mm, f.camera.width_px, f.camera.height_px};
+  std::vector<BlockId> pb(points.size(), -1);
+  BlockId ob[2], cb[2];
+  for (int i = 0; i < 2; ++i) {
+    ob[i] = builder.AddBlock("opk" + std::to_string(i), opk[i].data(), 3, BlockKind::kRotation);
+    cb[i] = builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter);
+  }
+  for (const auto& obs : f.observations) {
+    const int i = obs.image == 0 ? 0 : obs.image == 2 ? 1 : -1;
+    if (i < 0) continue;
+    if (pb[obs.point] < 0)
+      pb[obs.point] = builder.AddBlock("point" + std::to_string(obs.point), points[obs.point].data(), 3, BlockKind::kGroundPoint);
+    builder.AddResidual(kGroupImage, CollinearityResidual::Create(frame, obs.pixel, 0.2), {ib, ob[i], cb[i], pb[obs.point]});
+  }
+  const SolveReport report = builder.Solve({});
+  EXPECT_TRUE(report.usable);
+  const CovarianceReport cov = builder.EstimateCovariance({ob[0], cb[0], ob[1], cb[1]}, 1.0);
+  EXPECT_FALSE(cov.ok);
+  EXPECT_FALSE(cov.undetermined.empty());
+  EXPECT_NE(cov.message.find("datum defect"), std::string::npos);
+  bool names_a_center = false;
+  for (const auto& n : cov.undetermined) names_a_center |= n.rfind("center", 0) == 0;
+  EXPECT_TRUE(names_a_center) << cov.message;
+}
+
+// y = a t + b (t + 1e-3 t^2): a and b are almost indistinguishable.
+struct NearlyCollinearResidual : AutoDiffResidual<NearlyCollinearResidual, 1, 2> {
+  NearlyCollinearResidual(double t, double y) : t_(t), y_(y) {}
+  template <typename T>
+  bool operator()(const T* ab, T* r) const {
+    r[0] = ab[0] * T(t_) + ab[1] * T(t_ + 1e-3 * t_ * t_) - T(y_);
+    return true;
+  }
+  double t_, y_;
+};
+
+TEST(ProblemBuilder, HighCorrelationsAreListed) {
+  double ab[2] = {0.5, 0.5};
+  ProblemBuilder builder;
+  const BlockId b = builder.AddBlock("line", ab, 2, BlockKind::kOther, {"a", "b"});
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  for (int i = 0; i < 100; ++i) {
+    const double t = i * 0.1;
+    builder.AddResidual("samples", NearlyCollinearResidual::Create(t, 2 * t + 1e-3 * t * t + normal(rng)), {b});
+  }
+  const SolveReport report = builder.Solve({});
+  ASSERT_TRUE(report.converged);
+  const CovarianceReport cov = builder.EstimateCovariance({b}, report.sigma0);
+  ASSERT_TRUE(cov.ok) << cov.message;
+  ASSERT_EQ(cov.high_correlations.size(), 1u);
+  EXPECT_EQ(cov.high_correlations[0].a, "line.a");
+  EXPECT_EQ(cov.high_correlations[0].b, "line.b");
+  EXPECT_LT(cov.high_correlations[0].correlation, -0.95);
+}
+
+TEST(ProblemBuilder, FixedEntriesStayAndAreNotCounted) {
+  const TestField f = MakeTestField();
+  std::mt19937_64 rng(6);
+  InteriorParams start = PerturbedStart(f.camera.interior);
+  Adjustment a(f, NoisyPixels(f, 0.2, rng), 0.2, start);
+  a.builder.FixEntries(a.interior_block, {Model::kK3, Model::kB1, Model::kB2});
+  const SolveReport report = a.builder.Solve({});
+  EXPECT_EQ(report.n_unknowns, 7 + 6 * 9);
+  EXPECT_EQ(a.interior[Model::kK3], 0.0);
+  EXPECT_EQ(a.interior[Model::kB1], 0.0);
+  EXPECT_NE(a.interior[Model::kK1], 0.0);
+  const CovarianceReport cov = a.builder.EstimateCovariance({a.interior_block}, report.sigma0);
+  ASSERT_TRUE(cov.ok) << cov.message;
+  EXPECT_EQ(cov.sigma(Model::kK3), 0.0);
+  EXPECT_FALSE(cov.free[Model::kK3]);
+}
+
+TEST(NormalCriticalValue, KnownQuantiles) {
+  EXPECT_NEAR(NormalCriticalValue(0.05), 1.959964, 1e-5);
+  EXPECT_NEAR(NormalCriticalValue(0.001), 3.290527, 1e-5);
+}
+
+}  // namespace
+}  // namespace aerocal::calib

@@ -1,0 +1,75 @@
+// aerocal simulate: writes the deterministic example flight (triangulation/simulation).
+#include <cstdio>
+#include <sstream>
+
+#include "calib/core/error.h"
+#include "tools/command_registry.h"
+#include "triangulation/simulation/flight_simulator.h"
+
+namespace aerocal::tools {
+namespace {
+
+CommandRun SetupSimulate(CLI::App& app) {
+  struct Args {
+    std::string out;
+    std::string layout = "3x2";
+    triangulation::FlightSimulationOptions options;
+    std::uint64_t seed = 1;
+  };
+  auto args = std::make_shared<Args>();
+  auto& o = args->options;
+  app.add_option("--out", args->out, "Output folder (created; files replaced atomically)")->required();
+  app.add_option("--seed", args->seed, "Random seed (the same seed gives the same files)");
+  app.add_option("--exposures", o.exposures, "Number of exposures (spread over the strips)")->check(CLI::Range(2, 1000000));
+  app.add_option("--strips", o.strips, "Number of east-west strips")->check(CLI::Range(1, 10000));
+  app.add_option("--height-m", o.flying_height_m, "Flying height above the mean terrain, m")->check(CLI::PositiveNumber);
+  app.add_option("--forward-overlap", o.forward_overlap, "Forward overlap, 0..1")->check(CLI::Range(0.0, 0.95));
+  app.add_option("--side-overlap", o.side_overlap, "Side overlap, 0..1")->check(CLI::Range(0.0, 0.95));
+  app.add_option("--relief-m", o.terrain_relief_m, "Terrain relief (peak to peak), m")->check(CLI::NonNegativeNumber);
+  app.add_option("--points", o.ground_points, "Surveyed ground points (control + check)")->check(CLI::NonNegativeNumber);
+  app.add_option("--control", o.control_points, "Control points among them (corners and centre first)")->check(CLI::NonNegativeNumber);
+  app.add_option("--tie-points", o.tie_points, "Unsurveyed tie points")->check(CLI::NonNegativeNumber);
+  app.add_option("--image-noise-px", o.image_noise_px, "Image measurement noise (sigma), px")->check(CLI::NonNegativeNumber);
+  app.add_option("--image-sigma-px", o.image_sigma_px, "A-priori image sigma written to the files, px")->check(CLI::PositiveNumber);
+  app.add_option("--stitch-noise-px", o.stitching.noise_px, "Stitching tie-point matching noise, px")->check(CLI::NonNegativeNumber);
+  app.add_option("--stitch-ties", o.stitching.ties_per_frame, "Stitching tie points per exposure")->check(CLI::NonNegativeNumber);
+  app.add_option("--survey-sigma-m", o.survey_sigma_m, "Noise and sigma of control/check coordinates, m")->check(CLI::PositiveNumber);
+  app.add_option("--gnss-sigma-m", o.gnss_sigma_m, "GNSS camera-centre sigma, m (0: no GNSS, approximate centres)")->check(CLI::NonNegativeNumber);
+  app.add_option("--imu-sigma-deg", o.imu_sigma_deg, "IMU attitude sigma, deg (0: no IMU)")->check(CLI::NonNegativeNumber);
+  app.add_option("--start-offset-m", o.start_position_error_m, "Error of approximate centres without GNSS, m")->check(CLI::NonNegativeNumber);
+  app.add_option("--start-offset-deg", o.start_angle_error_deg, "Error of approximate angles without IMU, deg")->check(CLI::NonNegativeNumber);
+  app.add_option("--layout", args->layout, "Sub-image grid ROWSxCOLS of the camera (default 3x2: six CCDs)");
+  return [args]() {
+    auto& o = args->options;
+    o.seed = args->seed;
+    int rows = 0, cols = 0;
+    char x = 0;
+    std::istringstream in(args->layout);
+    if (!(in >> rows >> x >> cols) || x != 'x' || rows < 1 || cols < 1 || rows * cols < 2)
+      throw ConfigError("--layout must be ROWSxCOLS with at least two sub-images (got '" + args->layout + "')");
+    if (rows != o.layout.rows || cols != o.layout.cols) {
+      o.layout.rows = rows;
+      o.layout.cols = cols;
+      // Base CCDs: the one or two sub-images at the centre of the grid.
+      o.layout.base_ids.clear();
+      const int r = (rows - 1) / 2;
+      for (int c = (cols - 1) / 2; c <= cols / 2; ++c)
+        o.layout.base_ids.push_back(stitch::RomanNumeral(r * cols + c + 1));
+    }
+    const auto flight = triangulation::SimulateFlight(o);
+    triangulation::WriteSimulatedFlight(flight, args->out);
+    std::printf("simulated %zu exposures, %zu ground points, %zu image observations, %zu stitching "
+                "measurements -> %s\n",
+                flight.exposures_truth.size(), flight.points_truth.size(), flight.observations.size(),
+                flight.stitching.size(), args->out.c_str());
+    return kExitOk;
+  };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(simulate, "simulate",
+                         "Write a simulated flight of a multi-CCD camera (FORMATS.md files + truth)",
+                         SetupSimulate);
+
+}  // namespace aerocal::tools

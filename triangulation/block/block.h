@@ -1,0 +1,70 @@
+// A block for aerial triangulation as FORMATS.md "Block" defines it: cameras, exposures (approximate
+// or GNSS/IMU-measured exterior orientation), image observations (virtual-image pixels, or raw
+// sub-image pixels of a multi-CCD camera) and ground points with roles control / check / tie.
+// Angles are radians in memory, degrees in files (CONVENTIONS.md "Exterior orientation").
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calib/camera/camera.h"
+
+namespace aerocal::triangulation {
+
+struct Exposure {
+  std::string image, camera;
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();   // X0, Y0, Z0 in the object frame
+  Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();    // omega, phi, kappa
+  std::optional<Eigen::Vector3d> center_sigma_m;        // GNSS prior when present
+  std::optional<Eigen::Vector3d> opk_sigma_rad;         // IMU prior when present
+  int line = 0;                                         // source line in exposures.csv
+};
+
+enum class PointRole { kControl, kCheck, kTie };
+std::string PointRoleName(PointRole role);
+
+struct GroundPoint {
+  std::string id;
+  std::optional<Eigen::Vector3d> xyz_m;  // surveyed (control/check) or approximate (tie)
+  Eigen::Vector3d sigma_m = Eigen::Vector3d::Constant(0.05);  // survey sigma, control/check
+  PointRole role = PointRole::kTie;
+  int line = 0;
+};
+
+struct ImageObservation {
+  std::string image, point;
+  std::string subimage;          // empty: virtual-image pixel (col, row); else raw (u, v)
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
+  double sigma_px = 0.5;
+  int line = 0;
+};
+
+/// The object frame of the project (FORMATS.md `frame:`).
+struct FrameSpec {
+  enum class Kind { kProjected, kLocal, kUtm, kGeodeticToLocal };
+  Kind kind = Kind::kProjected;
+  std::string description = "as given";
+  double lat_deg = 0, lon_deg = 0, h_m = 0;  // local tangent plane origin
+  std::string utm_zone;                      // e.g. "48N"
+};
+
+struct Project {
+  std::string path;  // the project YAML, or the folder
+  std::map<std::string, calib::Camera> cameras;
+  std::map<std::string, std::string> camera_files;
+  std::vector<Exposure> exposures;
+  std::vector<ImageObservation> observations;
+  std::vector<GroundPoint> points;
+  std::string exposures_file, observations_file, points_file;
+  std::string stitching_file;  // optional per-exposure stitching measurements
+  FrameSpec frame;
+
+  const Exposure* FindExposure(const std::string& image) const;
+  const GroundPoint* FindPoint(const std::string& id) const;
+};
+
+}  // namespace aerocal::triangulation

@@ -1,0 +1,275 @@
+#include "triangulation/block/block_io.h"
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <set>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/yaml_util.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+
+std::string Num(double value, int decimals) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
+  return buffer;
+}
+
+std::string ResolvePath(const std::string& base_dir, const std::string& file) {
+  if (file.empty() || std::filesystem::path(file).is_absolute()) return file;
+  return (std::filesystem::path(base_dir) / file).string();
+}
+
+}  // namespace
+
+std::vector<Exposure> ReadExposures(const std::string& path) {
+  const CsvTable t = CsvTable::Read(path);
+  t.RequireColumns({"image", "X", "Y", "Z", "omega", "phi", "kappa"});
+  std::vector<Exposure> out;
+  std::set<std::string> seen;
+  for (const auto& row : t.rows()) {
+    Exposure e;
+    e.line = row.line;
+    e.image = t.String(row, "image");
+    if (e.image.empty()) ThrowInputError(t.Where(row), "image id must not be empty");
+    if (!seen.insert(e.image).second) ThrowInputError(t.Where(row), "duplicate image '" + e.image + "'");
+    e.camera = t.String(row, "camera");
+    e.center_m = {t.Number(row, "X"), t.Number(row, "Y"), t.Number(row, "Z")};
+    e.opk_rad = {t.Number(row, "omega") * kDegToRad, t.Number(row, "phi") * kDegToRad,
+                 t.Number(row, "kappa") * kDegToRad};
+    const auto sx = t.OptionalNumber(row, "sX"), sy = t.OptionalNumber(row, "sY"),
+               sz = t.OptionalNumber(row, "sZ");
+    if (sx || sy || sz) {
+      if (!(sx && sy && sz) || !(*sx > 0 && *sy > 0 && *sz > 0))
+        ThrowInputError(t.Where(row), "sX, sY, sZ must all be given and > 0 (m)");
+      e.center_sigma_m = Eigen::Vector3d(*sx, *sy, *sz);
+    }
+    const auto so = t.OptionalNumber(row, "somega"), sp = t.OptionalNumber(row, "sphi"),
+               sk = t.OptionalNumber(row, "skappa");
+    if (so || sp || sk) {
+      if (!(so && sp && sk) || !(*so > 0 && *sp > 0 && *sk > 0))
+        ThrowInputError(t.Where(row), "somega, sphi, skappa must all be given and > 0 (deg)");
+      e.opk_sigma_rad = Eigen::Vector3d(*so, *sp, *sk) * kDegToRad;
+    }
+    out.push_back(e);
+  }
+  return out;
+}
+
+std::vector<ImageObservation> ReadObservations(const std::string& path, double default_sigma_px) {
+  const CsvTable t = CsvTable::Read(path);
+  const bool sub = t.HasColumn("subimage");
+  if (sub)
+    t.RequireColumns({"image", "subimage", "point", "u", "v"});
+  else
+    t.RequireColumns({"image", "point", "col", "row"});
+  std::vector<ImageObservation> out;
+  out.reserve(t.rows().size());
+  for (const auto& row : t.rows()) {
+    ImageObservation o;
+    o.line = row.line;
+    o.image = t.String(row, "image");
+    o.point = t.String(row, "point");
+    if (o.image.empty() || o.point.empty())
+      ThrowInputError(t.Where(row), "image and point must not be empty");
+    if (sub) {
+      o.subimage = t.String(row, "subimage");
+      if (o.subimage.empty()) ThrowInputError(t.Where(row), "subimage must not be empty");
+      o.pixel = {t.Number(row, "u"), t.Number(row, "v")};
+    } else {
+      o.pixel = {t.Number(row, "col"), t.Number(row, "row")};
+    }
+    o.sigma_px = t.OptionalNumber(row, "sigma_px").value_or(default_sigma_px);
+    if (!(o.sigma_px > 0))
+      ThrowInputError(t.Where(row), "sigma_px must be > 0 (got " + FormatNumber(o.sigma_px) + ")");
+    out.push_back(o);
+  }
+  return out;
+}
+
+std::vector<GroundPoint> ReadPoints(const std::string& path) {
+  const CsvTable t = CsvTable::Read(path);
+  t.RequireColumns({"point", "X", "Y", "Z"});
+  std::vector<GroundPoint> out;
+  std::set<std::string> seen;
+  for (const auto& row : t.rows()) {
+    GroundPoint p;
+    p.line = row.line;
+    p.id = t.String(row, "point");
+    if (p.id.empty()) ThrowInputError(t.Where(row), "point id must not be empty");
+    if (!seen.insert(p.id).second) ThrowInputError(t.Where(row), "duplicate point '" + p.id + "'");
+    const std::string role = t.String(row, "role");
+    if (role == "control")
+      p.role = PointRole::kControl;
+    else if (role == "check")
+      p.role = PointRole::kCheck;
+    else if (role == "tie" || role.empty())
+      p.role = PointRole::kTie;
+    else
+      ThrowInputError(t.Where(row), "role must be control, check or tie (got '" + role + "')");
+    const auto x = t.OptionalNumber(row, "X"), y = t.OptionalNumber(row, "Y"),
+               z = t.OptionalNumber(row, "Z");
+    if (x && y && z) p.xyz_m = Eigen::Vector3d(*x, *y, *z);
+    else if (x || y || z) ThrowInputError(t.Where(row), "give all of X, Y, Z or none");
+    if (p.role != PointRole::kTie && !p.xyz_m)
+      ThrowInputError(t.Where(row), PointRoleName(p.role) + " point '" + p.id + "' needs X, Y, Z");
+    const auto sx = t.OptionalNumber(row, "sX"), sy = t.OptionalNumber(row, "sY"),
+               sz = t.OptionalNumber(row, "sZ");
+    if (sx) p.sigma_m.x() = *sx;
+    if (sy) p.sigma_m.y() = *sy;
+    if (sz) p.sigma_m.z() = *sz;
+    if (p.role == PointRole::kControl && !(p.sigma_m.minCoeff() > 0))
+      ThrowInputError(t.Where(row), "control point '" + p.id + "' needs sX, sY, sZ > 0 (m)");
+    out.push_back(p);
+  }
+  return out;
+}
+
+void ValidateProject(const Project& project) {
+  std::set<std::string> images, points;
+  for (const auto& e : project.exposures) {
+    images.insert(e.image);
+    if (!project.cameras.count(e.camera))
+      ThrowInputError({project.exposures_file, e.line},
+                      "image " + e.image + " uses unknown camera '" + e.camera + "'");
+  }
+  for (const auto& p : project.points) points.insert(p.id);
+  for (const auto& o : project.observations) {
+    if (!images.count(o.image))
+      ThrowInputError({project.observations_file, o.line}, "unknown image '" + o.image + "'");
+    if (!o.subimage.empty()) {
+      const auto& camera = project.cameras.at(project.FindExposure(o.image)->camera);
+      if (camera.SubimageIndex(o.subimage) < 0)
+        ThrowInputError({project.observations_file, o.line},
+                        "camera of image " + o.image + " has no sub-image '" + o.subimage + "'");
+    }
+  }
+}
+
+Project ReadProject(const std::string& path_in, double default_sigma_px) {
+  std::string path = path_in;
+  if (std::filesystem::is_directory(path)) path = (std::filesystem::path(path) / "project.yaml").string();
+  const YAML::Node root = LoadYamlFile(path);
+  RejectUnknownKeys(root, {"cameras", "exposures", "observations", "points", "stitching", "frame", "name"},
+                    path);
+  const std::string dir = std::filesystem::path(path).parent_path().string();
+  Project project;
+  project.path = path;
+  for (const char* key : {"cameras", "exposures", "observations", "points"})
+    if (!root[key]) ThrowInputError({path, 1}, std::string("missing '") + key + "'");
+  if (!root["cameras"].IsMap()) ThrowInputError(WhereIs(root["cameras"], path), "cameras must be a map id: file");
+  for (const auto& entry : root["cameras"]) {
+    const std::string id = entry.first.as<std::string>();
+    const std::string file = ResolvePath(dir, YamlString(entry.second, path, "camera file"));
+    project.camera_files[id] = file;
+    project.cameras[id] = calib::ReadCamera(file);
+  }
+  project.exposures_file = ResolvePath(dir, YamlString(root["exposures"], path, "exposures"));
+  project.observations_file = ResolvePath(dir, YamlString(root["observations"], path, "observations"));
+  project.points_file = ResolvePath(dir, YamlString(root["points"], path, "points"));
+  if (root["stitching"])
+    project.stitching_file = ResolvePath(dir, YamlString(root["stitching"], path, "stitching"));
+  project.exposures = ReadExposures(project.exposures_file);
+  // An exposure without a camera column uses the only camera of the project.
+  for (auto& e : project.exposures)
+    if (e.camera.empty() && project.cameras.size() == 1) e.camera = project.cameras.begin()->first;
+  project.observations = ReadObservations(project.observations_file, default_sigma_px);
+  project.points = ReadPoints(project.points_file);
+  if (root["frame"]) {
+    const YAML::Node& f = root["frame"];
+    RejectUnknownKeys(f, {"local", "utm", "projected", "geodetic"}, path);
+    if (f["local"]) {
+      RejectUnknownKeys(f["local"], {"lat", "lon", "h"}, path);
+      project.frame.kind = FrameSpec::Kind::kLocal;
+      project.frame.lat_deg = YamlDouble(f["local"]["lat"], path, "lat");
+      project.frame.lon_deg = YamlDouble(f["local"]["lon"], path, "lon");
+      project.frame.h_m = f["local"]["h"] ? YamlDouble(f["local"]["h"], path, "h") : 0.0;
+      project.frame.description = "local tangent plane";
+    } else if (f["utm"]) {
+      project.frame.kind = FrameSpec::Kind::kUtm;
+      project.frame.utm_zone = YamlString(f["utm"], path, "utm");
+      project.frame.description = "UTM " + project.frame.utm_zone;
+    } else if (f["projected"]) {
+      project.frame.description = YamlString(f["projected"], path, "projected");
+    }
+  }
+  ValidateProject(project);
+  return project;
+}
+
+void WriteExposures(const std::string& path, const std::vector<Exposure>& exposures) {
+  bool gnss = false, imu = false;
+  for (const auto& e : exposures) {
+    gnss |= e.center_sigma_m.has_value();
+    imu |= e.opk_sigma_rad.has_value();
+  }
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "image,camera,X,Y,Z,omega,phi,kappa";
+    if (gnss) out << ",sX,sY,sZ";
+    if (imu) out << ",somega,sphi,skappa";
+    out << "\n";
+    for (const auto& e : exposures) {
+      out << e.image << "," << e.camera << "," << Num(e.center_m.x(), 4) << ","
+          << Num(e.center_m.y(), 4) << "," << Num(e.center_m.z(), 4) << ","
+          << Num(e.opk_rad.x() / kDegToRad, 8) << "," << Num(e.opk_rad.y() / kDegToRad, 8) << ","
+          << Num(e.opk_rad.z() / kDegToRad, 8);
+      if (gnss) {
+        if (e.center_sigma_m)
+          out << "," << Num(e.center_sigma_m->x(), 4) << "," << Num(e.center_sigma_m->y(), 4) << ","
+              << Num(e.center_sigma_m->z(), 4);
+        else
+          out << ",,,";
+      }
+      if (imu) {
+        if (e.opk_sigma_rad)
+          out << "," << Num(e.opk_sigma_rad->x() / kDegToRad, 6) << ","
+              << Num(e.opk_sigma_rad->y() / kDegToRad, 6) << ","
+              << Num(e.opk_sigma_rad->z() / kDegToRad, 6);
+        else
+          out << ",,,";
+      }
+      out << "\n";
+    }
+  });
+}
+
+void WriteObservations(const std::string& path, const std::vector<ImageObservation>& observations) {
+  bool sub = false;
+  for (const auto& o : observations) sub |= !o.subimage.empty();
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << (sub ? "image,subimage,point,u,v,sigma_px\n" : "image,point,col,row,sigma_px\n");
+    for (const auto& o : observations) {
+      out << o.image << ",";
+      if (sub) out << o.subimage << ",";
+      out << o.point << "," << Num(o.pixel.x(), 4) << "," << Num(o.pixel.y(), 4) << ","
+          << FormatNumber(o.sigma_px, 6) << "\n";
+    }
+  });
+}
+
+void WritePoints(const std::string& path, const std::vector<GroundPoint>& points) {
+  WriteFileAtomically(path, [&](std::ostream& out) {
+    out << "point,X,Y,Z,sX,sY,sZ,role\n";
+    for (const auto& p : points) {
+      out << p.id << ",";
+      if (p.xyz_m)
+        out << Num(p.xyz_m->x(), 4) << "," << Num(p.xyz_m->y(), 4) << "," << Num(p.xyz_m->z(), 4);
+      else
+        out << ",,";
+      if (p.role == PointRole::kTie)
+        out << ",,,";
+      else
+        out << "," << FormatNumber(p.sigma_m.x(), 6) << "," << FormatNumber(p.sigma_m.y(), 6) << ","
+            << FormatNumber(p.sigma_m.z(), 6);
+      out << "," << PointRoleName(p.role) << "\n";
+    }
+  });
+}
+
+}  // namespace aerocal::triangulation

@@ -1,0 +1,258 @@
+#include "triangulation/simulation/flight_simulator.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "triangulation/block/block_io.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+constexpr double kDegToRad = M_PI / 180.0;
+using Model = calib::BrownFraser10Model;
+
+struct Visible {
+  int image;
+  Eigen::Vector2d pixel;
+};
+
+// Images in which `point` projects inside the format (margin in px).
+std::vector<Visible> VisibleIn(const calib::Camera& camera, const std::vector<Exposure>& exposures,
+                               const Eigen::Vector3d& point, double margin_px) {
+  std::vector<Visible> out;
+  for (size_t i = 0; i < exposures.size(); ++i) {
+    Eigen::Vector2d px;
+    if (!camera.ProjectToPixel(exposures[i].opk_rad, exposures[i].center_m, point, &px)) continue;
+    if (px.x() < margin_px || px.y() < margin_px || px.x() > camera.width_px - 1 - margin_px ||
+        px.y() > camera.height_px - 1 - margin_px)
+      continue;
+    out.push_back({static_cast<int>(i), px});
+  }
+  return out;
+}
+
+}  // namespace
+
+stitch::GridLayoutOptions FlightSimulationOptions::DefaultLayout() {
+  stitch::GridLayoutOptions layout;
+  layout.name = "aerocal simulated 2x3-CCD camera";
+  layout.rows = 3;
+  layout.cols = 2;
+  layout.virtual_width_px = 14000;
+  layout.virtual_height_px = 12000;
+  layout.overlap_px = 200;
+  layout.pixel_size_mm = 0.009;
+  layout.c_mm = 170.0;
+  layout.model = calib::MappingModel::kAffine;
+  layout.base_ids = {"III", "IV"};
+  layout.reference_placement = stitch::ReferencePlacement::kBaseCorners;
+  return layout;
+}
+
+stitch::MisplacementOptions FlightSimulationOptions::DefaultMisplacement() {
+  stitch::MisplacementOptions m;
+  m.shift_sigma_px = 3.0;
+  m.rotation_sigma_rad = 5e-5;
+  m.scale_sigma = 5e-5;
+  m.shear = 2e-5;
+  return m;
+}
+
+calib::InteriorParams FlightSimulationOptions::DefaultInteriorCorrection() {
+  calib::InteriorParams d{};
+  d[Model::kC] = 0.038;      // mm
+  d[Model::kX0] = -0.0024;   // mm
+  d[Model::kY0] = 0.0015;    // mm
+  d[Model::kK1] = 3.0e-8;    // 2.3 um at r = 50 mm, 15 um (1.7 px) at the corner (r = 83 mm)
+  d[Model::kK2] = -2.0e-12;
+  d[Model::kK3] = 1.0e-16;
+  d[Model::kP1] = 2.0e-7;
+  d[Model::kP2] = -1.5e-7;
+  d[Model::kB1] = 1.0e-5;
+  d[Model::kB2] = -8.0e-6;
+  return d;
+}
+
+double SimulatedTerrainHeight(const FlightSimulationOptions& o, double x, double y) {
+  const double shape = 0.5 + 0.32 * std::sin(2 * M_PI * x / 9000.0 + 0.3) * std::cos(2 * M_PI * y / 7000.0) +
+                       0.16 * std::sin(2 * M_PI * (x / 3100.0 + y / 4100.0));
+  return o.terrain_base_m + o.terrain_relief_m * std::clamp(shape, 0.0, 1.0);
+}
+
+SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
+  if (o.exposures < 2 || o.strips < 1 || o.exposures < o.strips)
+    throw ConfigError("a flight needs at least 2 exposures and one strip per exposure row");
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+
+  SimulatedFlight f;
+  f.options = o;
+  f.nominal = stitch::MakeGridCamera(o.layout);
+  f.truth = stitch::MakeMisplacedCamera(f.nominal, o.layout.base_ids, o.misplacement, rng);
+  for (int i = 0; i < Model::kNumParams; ++i) f.truth.interior[i] += o.interior_correction[i];
+  f.truth.name = f.nominal.name + " (truth)";
+
+  // Exposures: east-west strips, alternate flight directions (kappa 0 / 180 deg).
+  const double scale = o.flying_height_m / (o.layout.c_mm * 1e-3);
+  const double footprint_x = f.nominal.width_px * f.nominal.pixel_size_mm * 1e-3 * scale;
+  const double footprint_y = f.nominal.height_px * f.nominal.pixel_size_mm * 1e-3 * scale;
+  const double base = (1.0 - o.forward_overlap) * footprint_x;
+  const double spacing = (1.0 - o.side_overlap) * footprint_y;
+  const double mean_terrain = o.terrain_base_m + 0.5 * o.terrain_relief_m;
+  int remaining = o.exposures;
+  for (int s = 0; s < o.strips; ++s) {
+    const int n = (remaining + (o.strips - s) - 1) / (o.strips - s);
+    remaining -= n;
+    for (int k = 0; k < n; ++k) {
+      Exposure e;
+      char id[32];
+      std::snprintf(id, sizeof(id), "%04d", static_cast<int>(f.exposures_truth.size()) + 1);
+      e.image = id;
+      e.camera = "cam1";
+      const int along = s % 2 == 0 ? k : n - 1 - k;
+      e.center_m = {(along - 0.5 * (n - 1)) * base, (s - 0.5 * (o.strips - 1)) * spacing,
+                    mean_terrain + o.flying_height_m};
+      e.opk_rad = {o.attitude_sigma_deg * kDegToRad * normal(rng),
+                   o.attitude_sigma_deg * kDegToRad * normal(rng),
+                   (s % 2 == 0 ? 0.0 : M_PI) + o.attitude_sigma_deg * kDegToRad * normal(rng)};
+      f.exposures_truth.push_back(e);
+    }
+  }
+  for (const auto& t : f.exposures_truth) {
+    Exposure e = t;
+    if (o.gnss_sigma_m > 0) {
+      e.center_m += o.gnss_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      e.center_sigma_m = Eigen::Vector3d::Constant(o.gnss_sigma_m);
+    } else {
+      e.center_m += o.start_position_error_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    }
+    if (o.imu_sigma_deg > 0) {
+      e.opk_rad += o.imu_sigma_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      e.opk_sigma_rad = Eigen::Vector3d::Constant(o.imu_sigma_deg * kDegToRad);
+    } else {
+      e.opk_rad += o.start_angle_error_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    }
+    f.exposures_file.push_back(e);
+  }
+
+  // Ground points: surveyed (control at corners + centre, then check) and tie points, each seen
+  // in at least two images.
+  double x_min = 1e300, x_max = -1e300, y_min = 1e300, y_max = -1e300;
+  for (const auto& e : f.exposures_truth) {
+    x_min = std::min(x_min, e.center_m.x());
+    x_max = std::max(x_max, e.center_m.x());
+    y_min = std::min(y_min, e.center_m.y());
+    y_max = std::max(y_max, e.center_m.y());
+  }
+  x_min -= 0.45 * footprint_x;
+  x_max += 0.45 * footprint_x;
+  y_min -= 0.45 * footprint_y;
+  y_max += 0.45 * footprint_y;
+  const double margin_px = 20.0;
+  auto ground = [&](double x, double y) {
+    return Eigen::Vector3d(x, y, SimulatedTerrainHeight(o, x, y));
+  };
+  auto add_point = [&](const std::string& id, const Eigen::Vector3d& p, PointRole role) {
+    GroundPoint g;
+    g.id = id;
+    g.xyz_m = p;
+    g.role = role;
+    g.sigma_m = Eigen::Vector3d::Constant(o.survey_sigma_m);
+    f.points_truth.push_back(g);
+  };
+  // Control: walk from each target towards the block centre until >= 3 images see it.
+  const Eigen::Vector2d centre(0.5 * (x_min + x_max), 0.5 * (y_min + y_max));
+  std::vector<Eigen::Vector2d> targets = {{x_min, y_min}, {x_max, y_min}, {x_min, y_max},
+                                          {x_max, y_max}, centre};
+  targets.resize(std::min<size_t>(targets.size(), std::max(0, o.control_points)));
+  for (int extra = static_cast<int>(targets.size()); extra < o.control_points; ++extra)
+    targets.push_back({x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min)});
+  int control_id = 0;
+  for (const auto& target : targets) {
+    for (double t = 0.0; t <= 1.0; t += 0.01) {
+      const Eigen::Vector2d xy = target + t * (centre - target);
+      const Eigen::Vector3d p = ground(xy.x(), xy.y());
+      if (VisibleIn(f.truth, f.exposures_truth, p, margin_px).size() >= 3) {
+        add_point("C" + std::to_string(++control_id), p, PointRole::kControl);
+        break;
+      }
+    }
+  }
+  auto sample = [&](int count, const std::string& prefix, PointRole role) {
+    int made = 0;
+    for (int attempt = 0; made < count && attempt < 200 * count + 1000; ++attempt) {
+      const Eigen::Vector3d p =
+          ground(x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min));
+      if (VisibleIn(f.truth, f.exposures_truth, p, margin_px).size() < 2) continue;
+      add_point(prefix + std::to_string(++made), p, role);
+    }
+  };
+  sample(o.ground_points - control_id, "K", PointRole::kCheck);
+  sample(o.tie_points, "T", PointRole::kTie);
+
+  for (const auto& t : f.points_truth) {
+    GroundPoint g = t;
+    if (g.role == PointRole::kTie) {
+      g.xyz_m.reset();
+    } else {
+      *g.xyz_m += o.survey_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    }
+    f.points_file.push_back(g);
+  }
+
+  // Image observations: virtual-image pixels and the same points in raw sub-image pixels.
+  for (const auto& p : f.points_truth) {
+    for (const auto& v : VisibleIn(f.truth, f.exposures_truth, *p.xyz_m, margin_px)) {
+      ImageObservation obs;
+      obs.image = f.exposures_truth[v.image].image;
+      obs.point = p.id;
+      obs.sigma_px = o.image_sigma_px;
+      obs.pixel = v.pixel + o.image_noise_px * Eigen::Vector2d(normal(rng), normal(rng));
+      f.observations.push_back(obs);
+      for (const auto& s : f.truth.subimages) {
+        const Eigen::Vector2d uv = s.SubFromVirtual(v.pixel);
+        if (!s.Contains(uv, -2.0)) continue;
+        ImageObservation sub = obs;
+        sub.subimage = s.id;
+        sub.pixel = uv + o.image_noise_px * Eigen::Vector2d(normal(rng), normal(rng));
+        f.subimage_observations.push_back(sub);
+      }
+    }
+  }
+  // Per-exposure stitching measurements (frame = image id).
+  for (const auto& e : f.exposures_truth) {
+    auto rows = stitch::SimulateFrame(f.truth, e.image, o.stitching, rng);
+    f.stitching.insert(f.stitching.end(), rows.begin(), rows.end());
+  }
+  return f;
+}
+
+void WriteSimulatedFlight(const SimulatedFlight& f, const std::string& folder) {
+  const auto path = [&](const std::string& name) { return folder + "/" + name; };
+  calib::WriteCamera(path("camera_nominal.yaml"), f.nominal);
+  calib::WriteCamera(path("camera_truth.yaml"), f.truth);
+  WriteExposures(path("exposures.csv"), f.exposures_file);
+  WriteObservations(path("observations.csv"), f.observations);
+  WriteObservations(path("observations_subimage.csv"), f.subimage_observations);
+  WritePoints(path("points.csv"), f.points_file);
+  stitch::WriteStitchObservations(path("stitch_obs.csv"), f.stitching);
+  WriteExposures(path("truth/exposures.csv"), f.exposures_truth);
+  WritePoints(path("truth/points.csv"), f.points_truth);
+  const std::string project =
+      "# Simulated flight (aerocal simulate --seed " + std::to_string(f.options.seed) + ")\n"
+      "cameras: {cam1: camera_nominal.yaml}\n"
+      "exposures: exposures.csv\n"
+      "points: points.csv\n"
+      "stitching: stitch_obs.csv\n"
+      "frame: {projected: \"simulated local frame\"}\n";
+  WriteFileAtomically(path("project.yaml"), project + "observations: observations.csv\n");
+  WriteFileAtomically(path("project_subimage.yaml"),
+                      project + "observations: observations_subimage.csv\n");
+}
+
+}  // namespace aerocal::triangulation
