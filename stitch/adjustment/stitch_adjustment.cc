@@ -1,0 +1,273 @@
+#include "stitch/adjustment/stitch_adjustment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "calib/core/error.h"
+#include "calib/residuals/stitching.h"
+
+namespace aerocal::stitch {
+namespace {
+
+using calib::MappingModel;
+
+bool IsBase(const StitchOptions& options, const std::string& id) {
+  return std::find(options.base_ids.begin(), options.base_ids.end(), id) != options.base_ids.end();
+}
+
+/// The model a sub-image is adjusted with: its own (file) model for a base, `model` otherwise.
+MappingModel ModelOf(const calib::SubimageMapping& s, MappingModel model, bool base) {
+  return base ? s.model : model;
+}
+
+/// Rays of a tie that are not excluded.
+std::vector<TieRay> ActiveRays(const calib::Camera& camera, const TieMeasurement& tie,
+                               const std::set<ObservationKey>& excluded) {
+  std::vector<TieRay> rays;
+  for (const TieRay& ray : tie.rays)
+    if (!excluded.count({tie.point, camera.subimages[ray.subimage].id})) rays.push_back(ray);
+  return rays;
+}
+
+/// d(U, V)/d(conditioned params) at conditioned input uv (central differences; exact for the
+/// linear models up to rounding).
+Eigen::MatrixXd VirtualJacobian(MappingModel model, const std::vector<double>& params,
+                                const Eigen::Vector2d& uv_conditioned) {
+  const int n = static_cast<int>(params.size());
+  Eigen::MatrixXd g(2, n);
+  for (int j = 0; j < n; ++j) {
+    const double step = 1e-6 * std::max(1.0, std::abs(params[j]));
+    std::vector<double> plus = params, minus = params;
+    plus[j] += step;
+    minus[j] -= step;
+    Eigen::Vector2d a, b;
+    calib::VisitMappingModel(model, [&](auto m) {
+      decltype(m)::Apply(plus.data(), uv_conditioned.data(), a.data());
+      decltype(m)::Apply(minus.data(), uv_conditioned.data(), b.data());
+    });
+    g.col(j) = (a - b) / (2 * step);
+  }
+  return g;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  const size_t mid = values.size() / 2;
+  std::nth_element(values.begin(), values.begin() + mid, values.end());
+  double m = values[mid];
+  if (values.size() % 2 == 0) m = 0.5 * (m + *std::max_element(values.begin(), values.begin() + mid));
+  return m;
+}
+
+}  // namespace
+
+double CornerPrecision::sigma_px() const { return std::hypot(sigma_U_px, sigma_V_px); }
+
+void StitchOptions::Validate(const calib::Camera& camera) const {
+  for (const auto& id : base_ids)
+    if (camera.SubimageIndex(id) < 0)
+      throw ConfigError("--base: sub-image '" + id + "' is not in the camera");
+  if (!(snooping_alpha > 0 && snooping_alpha < 1))
+    throw ConfigError("snooping alpha must be in (0, 1) (got " + std::to_string(snooping_alpha) + ")");
+}
+
+std::string FindUnderdetermined(const calib::Camera& camera, const FrameMeasurements& frame,
+                                MappingModel model, const StitchOptions& options,
+                                const std::set<ObservationKey>& excluded) {
+  std::vector<int> points(camera.subimages.size(), 0);
+  for (const auto& ref : frame.references)
+    if (!excluded.count({ref.point, camera.subimages[ref.subimage].id})) ++points[ref.subimage];
+  for (const auto& tie : frame.ties) {
+    const auto rays = ActiveRays(camera, tie, excluded);
+    if (rays.size() < 2) continue;
+    for (const TieRay& ray : rays) ++points[ray.subimage];
+  }
+  const int needed = calib::MappingParamCount(model);
+  for (size_t k = 0; k < camera.subimages.size(); ++k) {
+    const auto& s = camera.subimages[k];
+    if (IsBase(options, s.id) || 2 * points[k] >= needed) continue;
+    return "frame " + frame.frame + ", sub-image " + s.id + ": " + std::to_string(points[k]) +
+           " points give " + std::to_string(2 * points[k]) + " equations for the " +
+           std::to_string(needed) + " " + std::string(calib::MappingModelName(model)) +
+           " parameters";
+  }
+  return "";
+}
+
+FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements& frame,
+                            MappingModel model, const StitchOptions& options,
+                            const std::set<ObservationKey>& excluded) {
+  const std::string refusal = FindUnderdetermined(camera, frame, model, options, excluded);
+  if (!refusal.empty()) throw InputError(refusal);
+
+  const size_t n_sub = camera.subimages.size();
+  std::vector<MappingModel> models(n_sub);
+  std::vector<calib::MappingConditioning> conditioning(n_sub);
+  std::vector<std::vector<double>> values(n_sub);  // conditioned parameters, solver memory
+  std::vector<bool> base(n_sub);
+  calib::ProblemBuilder builder;
+  std::vector<calib::BlockId> blocks(n_sub);
+  for (size_t k = 0; k < n_sub; ++k) {
+    const auto& s = camera.subimages[k];
+    base[k] = IsBase(options, s.id);
+    models[k] = ModelOf(s, model, base[k]);
+    conditioning[k] = calib::MappingConditioning::ForSubimage(models[k], s.width_px, s.height_px);
+    // Start (and, for a base, hold) at the camera file's mapping expressed in the model.
+    const std::vector<double> plain = calib::ParamsFromHomography(
+        models[k], calib::HomographyFromParams(s.model, s.params.data()));
+    values[k] = calib::ConditionedFromPlain(models[k], conditioning[k], plain);
+    blocks[k] = builder.AddBlock("mapping " + s.id, values[k].data(),
+                                 static_cast<int>(values[k].size()), calib::BlockKind::kMapping);
+    if (base[k]) builder.FixBlock(blocks[k]);
+  }
+
+  // Residual bookkeeping: what each residual observes.
+  struct Observed {
+    std::string point;
+    int subimage;
+    bool reference;
+    double sigma_px;
+  };
+  std::map<calib::ResidualId, Observed> observed;
+  std::vector<double> sigmas;
+  for (const auto& ref : frame.references) {
+    const auto& s = camera.subimages[ref.subimage];
+    if (excluded.count({ref.point, s.id})) continue;
+    const int k = ref.subimage;
+    auto cost = calib::VisitMappingModel(models[k], [&](auto m) {
+      return calib::StitchReferenceResidual<decltype(m)>::Create(conditioning[k], ref.uv,
+                                                                 ref.virtual_px, ref.sigma_px);
+    });
+    const auto id = builder.AddResidual(calib::kGroupStitchReference, std::move(cost), {blocks[k]},
+                                        "frame " + frame.frame + " reference " + ref.point +
+                                            " sub-image " + s.id);
+    observed[id] = {ref.point, k, true, ref.sigma_px};
+    sigmas.push_back(ref.sigma_px);
+  }
+  std::vector<Eigen::Vector2d> tie_positions;
+  tie_positions.reserve(frame.ties.size());  // block memory must not move
+  int n_ties = 0;
+  for (const auto& tie : frame.ties) {
+    const auto rays = ActiveRays(camera, tie, excluded);
+    if (rays.size() < 2) continue;
+    Eigen::Vector2d start = Eigen::Vector2d::Zero();
+    for (const TieRay& ray : rays) start += camera.subimages[ray.subimage].VirtualFromSub(ray.uv);
+    tie_positions.push_back(start / static_cast<double>(rays.size()));
+    const auto point_block = builder.AddBlock("tie " + tie.point, tie_positions.back().data(), 2,
+                                              calib::BlockKind::kTiePoint2d, {"U", "V"});
+    ++n_ties;
+    for (const TieRay& ray : rays) {
+      const int k = ray.subimage;
+      auto cost = calib::VisitMappingModel(models[k], [&](auto m) {
+        return calib::StitchTieResidual<decltype(m)>::Create(conditioning[k], ray.uv, ray.sigma_px);
+      });
+      const auto id = builder.AddResidual(calib::kGroupStitchTie, std::move(cost),
+                                          {blocks[k], point_block},
+                                          "frame " + frame.frame + " tie " + tie.point +
+                                              " sub-image " + camera.subimages[k].id);
+      observed[id] = {tie.point, k, false, ray.sigma_px};
+      sigmas.push_back(ray.sigma_px);
+    }
+  }
+
+  FrameAdjustment out;
+  out.frame = frame.frame;
+  out.model = model;
+  out.n_ties = n_ties;
+  out.n_references = static_cast<int>(frame.references.size());
+
+  calib::SolveReport report;
+  if (options.data_snooping) {
+    calib::SnoopingOptions snooping;
+    snooping.groups = {calib::kGroupStitchReference, calib::kGroupStitchTie};
+    snooping.critical_value = std::max(
+        3.29, calib::NormalCriticalValue(options.snooping_alpha /
+                                         std::max(1, builder.NumObservations())));
+    std::vector<calib::RejectedResidual> rejected;
+    report = builder.SolveWithDataSnooping(options.solver, snooping, &rejected);
+    for (const auto& r : rejected) {
+      const Observed& o = observed.at(r.id);
+      out.rejected.push_back({o.point, camera.subimages[o.subimage].id, o.reference, r.w,
+                              Eigen::Vector2d(r.whitened_residual[0], r.whitened_residual[1]) *
+                                  o.sigma_px});
+    }
+  } else {
+    report = builder.Solve(options.solver);
+  }
+  out.converged = report.converged;
+  out.iterations = report.iterations;
+  out.sigma0 = report.sigma0;
+  out.vtpv = report.vtpv;
+  out.redundancy = report.redundancy;
+  out.n_observations = report.n_observations;
+  out.n_unknowns = report.n_unknowns;
+  out.diagnostics = report.diagnostics;
+  std::vector<double> active_sigmas;
+  for (const auto& [id, o] : observed)
+    if (builder.IsActive(id)) active_sigmas.push_back(o.sigma_px);
+  out.sigma0_px = out.sigma0 * Median(active_sigmas);
+
+  // Residuals of the clean adjustment, in px: estimated minus observed.
+  for (const auto& [id, o] : observed) {
+    if (!builder.IsActive(id)) continue;
+    const std::vector<double> r = builder.EvaluateResidual(id);
+    out.residuals.push_back({o.point, camera.subimages[o.subimage].id, o.reference,
+                             Eigen::Vector2d(r[0], r[1]) * o.sigma_px, o.sigma_px});
+  }
+
+  // Covariance of the free mappings (scaled by sigma0^2), then plain form and corners.
+  std::vector<calib::BlockId> free_blocks;
+  for (size_t k = 0; k < n_sub; ++k)
+    if (!base[k]) free_blocks.push_back(blocks[k]);
+  const calib::CovarianceReport covariance =
+      builder.EstimateCovariance(free_blocks, std::max(report.sigma0, 0.0));
+  out.covariance_ok = covariance.ok;
+  if (!covariance.ok) out.diagnostics.push_back(covariance.message);
+  for (size_t k = 0; k < n_sub; ++k) {
+    const auto& s = camera.subimages[k];
+    const int n = static_cast<int>(values[k].size());
+    SubimageEstimate e;
+    e.id = s.id;
+    e.model = models[k];
+    e.base = base[k];
+    e.params = calib::PlainFromConditioned(models[k], conditioning[k], values[k]);
+    Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, n);
+    if (!base[k] && covariance.ok) c = covariance.BlockCovariance(blocks[k], n);
+    const Eigen::MatrixXd j = calib::PlainFromConditionedJacobian(models[k], conditioning[k], values[k]);
+    e.covariance = j * c * j.transpose();
+    for (int i = 0; i < n; ++i) e.sigma.push_back(std::sqrt(std::max(0.0, e.covariance(i, i))));
+    const double corner_u[4] = {0.0, s.width_px - 1.0, 0.0, s.width_px - 1.0};
+    const double corner_v[4] = {0.0, 0.0, s.height_px - 1.0, s.height_px - 1.0};
+    calib::SubimageMapping estimated = s;
+    estimated.model = models[k];
+    estimated.params = e.params;
+    for (int i = 0; i < 4; ++i) {
+      CornerPrecision& corner = e.corners[i];
+      corner.uv = {corner_u[i], corner_v[i]};
+      corner.virtual_px = estimated.VirtualFromSub(corner.uv);
+      const Eigen::Vector2d uvc((corner_u[i] - conditioning[k].cu) / conditioning[k].scale,
+                                (corner_v[i] - conditioning[k].cv) / conditioning[k].scale);
+      const Eigen::MatrixXd g = VirtualJacobian(models[k], values[k], uvc);
+      const Eigen::Matrix2d cov_uv = g * c * g.transpose();
+      corner.sigma_U_px = std::sqrt(std::max(0.0, cov_uv(0, 0)));
+      corner.sigma_V_px = std::sqrt(std::max(0.0, cov_uv(1, 1)));
+      e.max_corner_sigma_px = std::max(e.max_corner_sigma_px, corner.sigma_px());
+    }
+    out.max_corner_sigma_px = std::max(out.max_corner_sigma_px, e.max_corner_sigma_px);
+    out.subimages.push_back(std::move(e));
+  }
+  return out;
+}
+
+calib::Camera CameraWithEstimates(const calib::Camera& camera, const FrameAdjustment& adjustment) {
+  calib::Camera out = camera;
+  for (const auto& e : adjustment.subimages) {
+    const int k = out.SubimageIndex(e.id);
+    out.subimages[k].model = e.model;
+    out.subimages[k].params = e.params;
+  }
+  return out;
+}
+
+}  // namespace aerocal::stitch

@@ -1,0 +1,245 @@
+#include "stitch/io/stitch_result_json.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "stitch/adjustment/mapping_param_names.h"
+
+namespace aerocal::stitch {
+namespace {
+
+using nlohmann::json;
+
+std::string ModelName(calib::MappingModel model) {
+  return std::string(calib::MappingModelName(model));
+}
+
+json SubimageToJson(const SubimageEstimate& e) {
+  json corners = json::array();
+  for (const CornerPrecision& c : e.corners)
+    corners.push_back({{"u", c.uv.x()},
+                       {"v", c.uv.y()},
+                       {"U", c.virtual_px.x()},
+                       {"V", c.virtual_px.y()},
+                       {"sigma_U_px", c.sigma_U_px},
+                       {"sigma_V_px", c.sigma_V_px},
+                       {"sigma_px", c.sigma_px()}});
+  return {{"id", e.id},
+          {"model", ModelName(e.model)},
+          {"base", e.base},
+          {"param_names", MappingParamNames(e.model)},
+          {"params", e.params},
+          {"sigma", e.sigma},
+          {"corners", corners},
+          {"max_corner_sigma_px", e.max_corner_sigma_px}};
+}
+
+json CandidateToJson(const ModelCandidate& c) {
+  json j = {{"model", ModelName(c.model)}, {"determinable", c.determinable}};
+  if (!c.determinable) {
+    j["refusal"] = c.refusal;
+    return j;
+  }
+  j["sigma0"] = c.adjustment.sigma0;
+  j["sigma0_px"] = c.adjustment.sigma0_px;
+  j["redundancy"] = c.adjustment.redundancy;
+  j["vtpv"] = c.adjustment.vtpv;
+  j["max_corner_sigma_px"] = c.adjustment.max_corner_sigma_px;
+  if (c.tested)
+    j["test"] = {{"against", c.against},   {"F", c.f},     {"F_critical", c.f_critical},
+                 {"p_value", c.p_value},   {"df1", c.df1}, {"df2", c.df2},
+                 {"significant", c.significant}};
+  return j;
+}
+
+json StabilityToJson(const ModelStability& s) {
+  json parameters = json::array();
+  for (const auto& p : s.parameters)
+    parameters.push_back({{"subimage", p.subimage},
+                          {"name", p.name},
+                          {"mean", p.mean},
+                          {"std", p.std},
+                          {"mean_sigma", p.mean_sigma}});
+  json flagged = json::array();
+  for (const auto& f : s.flagged) flagged.push_back({{"frame", f.frame}, {"reasons", f.reasons}});
+  return {{"model", ModelName(s.model)},       {"n_frames", s.n_frames},
+          {"mean_sigma0", s.mean_sigma0},      {"std_sigma0", s.std_sigma0},
+          {"mean_sigma0_px", s.mean_sigma0_px}, {"std_sigma0_px", s.std_sigma0_px},
+          {"parameters", parameters},          {"flagged", flagged}};
+}
+
+}  // namespace
+
+json FrameResultToJson(const FrameAdjustment& a, const ModelChoice* choice) {
+  json subimages = json::array();
+  for (const auto& e : a.subimages) subimages.push_back(SubimageToJson(e));
+  json residuals = json::array();
+  for (const auto& r : a.residuals)
+    residuals.push_back({{"point", r.point},
+                         {"subimage", r.subimage},
+                         {"kind", r.reference ? "reference" : "tie"},
+                         {"vU_px", r.v_px.x()},
+                         {"vV_px", r.v_px.y()},
+                         {"sigma_px", r.sigma_px}});
+  json rejected = json::array();
+  for (const auto& r : a.rejected)
+    rejected.push_back({{"point", r.point},
+                        {"subimage", r.subimage},
+                        {"kind", r.reference ? "reference" : "tie"},
+                        {"w", r.w},
+                        {"vU_px", r.v_px.x()},
+                        {"vV_px", r.v_px.y()}});
+  json j = {{"kind", "stitch"},
+            {"frame", a.frame},
+            {"sigma0", a.sigma0},
+            {"sigma0_px", a.sigma0_px},
+            {"redundancy", a.redundancy},
+            {"iterations", a.iterations},
+            {"converged", a.converged},
+            {"model", ModelName(a.model)},
+            {"n_observations", a.n_observations},
+            {"n_unknowns", a.n_unknowns},
+            {"n_ties", a.n_ties},
+            {"n_references", a.n_references},
+            {"covariance_ok", a.covariance_ok},
+            {"max_corner_sigma_px", a.max_corner_sigma_px},
+            {"subimages", subimages},
+            {"rejected", rejected},
+            {"residuals", residuals},
+            {"diagnostics", a.diagnostics}};
+  if (choice) {
+    json table = json::array();
+    for (const auto& c : choice->candidates) table.push_back(CandidateToJson(c));
+    j["model_choice"] = {{"test", choice->test},
+                         {"alpha", choice->alpha},
+                         {"chosen", ModelName(choice->chosen)},
+                         {"reason", choice->reason},
+                         {"table", table}};
+  }
+  return j;
+}
+
+json StitchResultToJson(const BatchResult& result, const BatchOptions& options) {
+  AEROCAL_CHECK(!result.frames.empty()) << "stitch result without frames";
+  auto frame_json = [](const FrameRun& run) {
+    return FrameResultToJson(run.adjustment, run.choice ? &*run.choice : nullptr);
+  };
+  if (result.frames.size() == 1) return frame_json(result.frames.front());
+
+  json frames = json::array();
+  double vtpv = 0;
+  int redundancy = 0, iterations = 0;
+  bool converged = true;
+  std::map<calib::MappingModel, int> chosen;
+  for (const FrameRun& run : result.frames) {
+    frames.push_back(frame_json(run));
+    vtpv += run.adjustment.vtpv;
+    redundancy += run.adjustment.redundancy;
+    iterations = std::max(iterations, run.adjustment.iterations);
+    converged = converged && run.adjustment.converged;
+    ++chosen[run.adjustment.model];
+  }
+  calib::MappingModel model = options.model ? *options.model : chosen.begin()->first;
+  for (const auto& [m, n] : chosen)
+    if (n > chosen[model]) model = m;
+  // Frames' median a-priori sigma: sigma0_px / sigma0 of any frame.
+  double scale = 0;
+  for (const FrameRun& run : result.frames)
+    if (run.adjustment.sigma0 > 0) scale = run.adjustment.sigma0_px / run.adjustment.sigma0;
+  const double sigma0 = redundancy > 0 ? std::sqrt(vtpv / redundancy) : 0.0;
+
+  json j = {{"kind", "stitch"},          {"sigma0", sigma0},       {"sigma0_px", sigma0 * scale},
+            {"redundancy", redundancy},  {"iterations", iterations}, {"converged", converged},
+            {"model", ModelName(model)}, {"n_frames", result.frames.size()}};
+  json counts = json::object();
+  for (const auto& [m, n] : chosen) counts[ModelName(m)] = n;
+  j["models_chosen"] = counts;
+
+  // Flight mean mappings of the reported model (base sub-images keep their own).
+  json subimages = json::array();
+  json stability = json::object();
+  json per_model = json::array();
+  for (const ModelStability& s : result.stability) {
+    per_model.push_back(StabilityToJson(s));
+    if (s.model != model) continue;
+    stability["mean_sigma0_px"] = s.mean_sigma0_px;
+    stability["std_sigma0_px"] = s.std_sigma0_px;
+    const FrameAdjustment* first = nullptr;
+    for (const FrameRun& run : result.frames) {
+      if (run.adjustment.model == model) first = &run.adjustment;
+      if (run.choice)
+        for (const auto& c : run.choice->candidates)
+          if (c.model == model && c.determinable) first = &c.adjustment;
+      if (first) break;
+    }
+    for (const SubimageEstimate& e : first->subimages) {
+      json sub = {{"id", e.id}, {"model", ModelName(e.model)}, {"base", e.base}};
+      std::vector<double> params = e.params, sigma(e.params.size(), 0.0);
+      const auto names = MappingParamNames(e.model);
+      for (const auto& p : s.parameters)
+        if (p.subimage == e.id)
+          for (size_t i = 0; i < names.size(); ++i)
+            if (names[i] == p.name) {
+              params[i] = p.mean;
+              sigma[i] = p.std;
+            }
+      sub["param_names"] = names;
+      sub["params"] = params;
+      sub["sigma"] = sigma;
+      subimages.push_back(sub);
+    }
+  }
+  stability["models"] = per_model;
+  j["subimages"] = subimages;
+  j["stability"] = stability;
+  j["frames"] = frames;
+  return j;
+}
+
+calib::Camera ApplyStitchResult(const calib::Camera& camera, const std::string& path,
+                                const std::string& frame) {
+  json doc;
+  try {
+    doc = json::parse(ReadTextFile(path));
+  } catch (const json::exception& e) {
+    throw InputError(path + ": not a JSON document (" + e.what() + ")");
+  }
+  const json* source = &doc;
+  if (!frame.empty()) {
+    source = nullptr;
+    if (doc.value("frame", std::string()) == frame) source = &doc;
+    if (doc.contains("frames"))
+      for (const json& f : doc["frames"])
+        if (f.value("frame", std::string()) == frame) source = &f;
+    if (!source) throw InputError(path + ": no result for frame " + frame);
+  }
+  if (!source->contains("subimages") || !(*source)["subimages"].is_array())
+    throw InputError(path + ": no subimages in the stitch result");
+  calib::Camera out = camera;
+  std::vector<bool> seen(out.subimages.size(), false);
+  try {
+    for (const json& s : (*source)["subimages"]) {
+      const std::string id = s.at("id").get<std::string>();
+      const int k = out.SubimageIndex(id);
+      if (k < 0) throw InputError(path + ": sub-image " + id + " is not in the camera");
+      const auto model = calib::ParseMappingModel(s.at("model").get<std::string>());
+      if (!model) throw InputError(path + ": sub-image " + id + ": unknown model");
+      const auto params = s.at("params").get<std::vector<double>>();
+      if (static_cast<int>(params.size()) != calib::MappingParamCount(*model))
+        throw InputError(path + ": sub-image " + id + ": wrong number of params");
+      out.subimages[k].model = *model;
+      out.subimages[k].params = params;
+      seen[k] = true;
+    }
+  } catch (const json::exception& e) {
+    throw InputError(path + ": malformed sub-image entry (" + e.what() + ")");
+  }
+  for (size_t k = 0; k < seen.size(); ++k)
+    if (!seen[k]) throw InputError(path + ": no mapping for sub-image " + out.subimages[k].id);
+  return out;
+}
+
+}  // namespace aerocal::stitch

@@ -1,0 +1,2 @@
+# Stitching: adjustment, model choice, flight stability, result JSON, resampling, CLI.
+aerocal_add_test(stitch/stitch_adjustment LIBS aerocal::stitch LABELS synthetic)
