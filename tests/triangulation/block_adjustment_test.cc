@@ -1,0 +1,192 @@
+// Self-calibrating bundle block adjustment on the simulated example flight (37 exposures, 2x3-CCD
+// camera, nominal camera off by DMZ-like corrections): the acceptance figures of the adjustment.
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/simulation/flight_simulator.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+using Model = calib::BrownFraser10Model;
+
+Project ProjectFromFlight(const SimulatedFlight& f) {
+  Project p;
+  p.path = "simulated";
+  p.cameras["cam1"] = f.nominal;
+  p.exposures = f.exposures_file;
+  p.observations = f.observations;
+  p.points = f.points_file;
+  p.frame.description = "simulated local frame";
+  return p;
+}
+
+AdjustOptions SelfCalibration() {
+  AdjustOptions o;
+  o.free_interior = ParseSelfCalibration("all");
+  return o;
+}
+
+void ExpectTruthWithinThreeSigma(const CameraEstimate& c, const calib::Camera& truth) {
+  for (int k = 0; k < Model::kNumParams; ++k) {
+    SCOPED_TRACE(std::string(Model::kParams[k].name));
+    ASSERT_GT(c.sigma[k], 0.0);
+    EXPECT_LE(std::abs(c.estimated[k] - truth.interior[k]), 3.0 * c.sigma[k])
+        << "estimate " << c.estimated[k] << " truth " << truth.interior[k] << " sigma " << c.sigma[k];
+  }
+}
+
+bool HasCorrelation(const Determinability& d, const std::string& a, const std::string& b_part) {
+  for (const auto& h : d.high_correlations)
+    if (h.a == a && h.b.find(b_part) != std::string::npos && std::abs(h.correlation) > 0.95) return true;
+  return false;
+}
+
+class SimulatedFlightAdjustment : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    flight_ = std::make_unique<SimulatedFlight>(SimulateFlight(FlightSimulationOptions{}));
+    project_ = std::make_unique<Project>(ProjectFromFlight(*flight_));
+    conventional_ = std::make_unique<AdjustmentResult>(Adjust(*project_, AdjustOptions{}));
+    self_ = std::make_unique<AdjustmentResult>(Adjust(*project_, SelfCalibration()));
+    std::printf("%s\n%s", FormatSummary(*conventional_).c_str(), FormatSummary(*self_).c_str());
+  }
+  static std::unique_ptr<SimulatedFlight> flight_;
+  static std::unique_ptr<Project> project_;
+  static std::unique_ptr<AdjustmentResult> conventional_, self_;
+};
+std::unique_ptr<SimulatedFlight> SimulatedFlightAdjustment::flight_;
+std::unique_ptr<Project> SimulatedFlightAdjustment::project_;
+std::unique_ptr<AdjustmentResult> SimulatedFlightAdjustment::conventional_;
+std::unique_ptr<AdjustmentResult> SimulatedFlightAdjustment::self_;
+
+TEST_F(SimulatedFlightAdjustment, SelfCalibrationRecoversEveryParameterWithinThreeSigma) {
+  ASSERT_TRUE(self_->converged());
+  ASSERT_TRUE(self_->determinability.covariance_ok) << self_->determinability.message;
+  ASSERT_EQ(self_->cameras.size(), 1u);
+  ExpectTruthWithinThreeSigma(self_->cameras[0], flight_->truth);
+}
+
+TEST_F(SimulatedFlightAdjustment, Sigma0MatchesTheInjectedNoise) {
+  // The observations carry N(0, 0.2 px) noise and a-priori sigma 0.2 px: sigma0 ~ 1, 0.2 px.
+  const double noise_px = flight_->options.image_noise_px;
+  EXPECT_NEAR(self_->sigma0_px / noise_px, 1.0, 0.10);
+  EXPECT_NEAR(self_->sigma0_um, self_->sigma0_px * 9.0, 1e-9);
+  // The conventional run absorbs the interior errors into the exterior orientation and points.
+  EXPECT_GT(conventional_->sigma0, self_->sigma0);
+}
+
+TEST_F(SimulatedFlightAdjustment, SelfCalibrationImprovesCheckPointsAtLeastOneAndAHalfTimes) {
+  ASSERT_TRUE(conventional_->converged());
+  ASSERT_GT(self_->check.n, 100);
+  EXPECT_EQ(self_->check.n, conventional_->check.n);
+  const double ratio = conventional_->check.spatial_rmse_m / self_->check.spatial_rmse_m;
+  std::printf("check spatial RMSE: conventional %.3f m, self-calibration %.3f m, ratio %.2f\n",
+              conventional_->check.spatial_rmse_m, self_->check.spatial_rmse_m, ratio);
+  EXPECT_GE(ratio, 1.5);
+}
+
+TEST_F(SimulatedFlightAdjustment, WithoutGnssPrincipalDistanceAndHeightsAreReportedInseparable) {
+  EXPECT_TRUE(HasCorrelation(self_->determinability, "camera cam1.c", "centre.Z"));
+  bool said = false;
+  for (const auto& w : self_->determinability.warnings)
+    said |= w.find("camera cam1.c is not separable") != std::string::npos;
+  EXPECT_TRUE(said);
+  // The JSON says it too.
+  const auto json = AdjustmentToJson(*self_);
+  EXPECT_FALSE(json["determinability"]["high_correlations"].empty());
+}
+
+TEST_F(SimulatedFlightAdjustment, ResultJsonHasTheFormatsKeys) {
+  const auto j = AdjustmentToJson(*self_);
+  for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations",
+                          "converged", "cameras", "control", "check", "exposures", "rejected"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_EQ(j["kind"], "adjust");
+  EXPECT_EQ(j["exposures"].size(), flight_->exposures_truth.size());
+  EXPECT_EQ(j["check"]["rmse_m"].size(), 3u);
+  EXPECT_TRUE(j["cameras"][0]["sigma"].contains("c"));
+  EXPECT_EQ(j["check"]["points"].size(), static_cast<size_t>(self_->check.n));
+}
+
+TEST_F(SimulatedFlightAdjustment, ConvergesToTheSameSolutionFromTheTrueStart) {
+  // Starting values off by 20 m and 1 degree (the default flight) and the true exterior
+  // orientation reach the same minimum.
+  Project from_truth = *project_;
+  from_truth.exposures = flight_->exposures_truth;
+  const AdjustmentResult r = Adjust(from_truth, SelfCalibration());
+  ASSERT_TRUE(r.converged());
+  for (int k = 0; k < Model::kNumParams; ++k)
+    EXPECT_NEAR(r.cameras[0].estimated[k], self_->cameras[0].estimated[k],
+                1e-3 * self_->cameras[0].sigma[k])
+        << Model::kParams[k].name;
+}
+
+TEST(BlockAdjustment, ConvergesFromExteriorOrientationOffByFiftyMetresAndTwoDegrees) {
+  FlightSimulationOptions options;
+  options.seed = 7;
+  options.start_position_error_m = 50.0;
+  options.start_angle_error_deg = 2.0;
+  const SimulatedFlight flight = SimulateFlight(options);
+  const AdjustmentResult r = Adjust(ProjectFromFlight(flight), SelfCalibration());
+  ASSERT_TRUE(r.converged()) << r.solve.message;
+  EXPECT_NEAR(r.sigma0_px / options.image_noise_px, 1.0, 0.10);
+  ExpectTruthWithinThreeSigma(r.cameras[0], flight.truth);
+}
+
+TEST(BlockAdjustment, GnssCentresDeterminePrincipalDistance) {
+  FlightSimulationOptions options;
+  options.gnss_sigma_m = 0.05;
+  const SimulatedFlight flight = SimulateFlight(options);
+  const AdjustmentResult r = Adjust(ProjectFromFlight(flight), SelfCalibration());
+  std::printf("%s", FormatSummary(r).c_str());
+  ASSERT_TRUE(r.converged());
+  const auto& c = r.cameras[0];
+  EXPECT_LE(c.sigma[Model::kC], 0.005);  // mm
+  ExpectTruthWithinThreeSigma(c, flight.truth);
+  EXPECT_FALSE(HasCorrelation(r.determinability, "camera cam1.c", "centre.Z"));
+  const auto* prior = r.solve.Group(calib::kGroupEoPrior);
+  ASSERT_NE(prior, nullptr);
+  EXPECT_EQ(prior->n_observations, 3 * static_cast<int>(flight.exposures_truth.size()));
+}
+
+TEST(BlockAdjustment, PlantedGrossErrorIsFoundListedAndRemoved) {
+  const SimulatedFlight flight = SimulateFlight(FlightSimulationOptions{});
+  const Project clean = ProjectFromFlight(flight);
+  // Plant 5 px in one observation of a point seen in >= 3 images (with two rays both are
+  // equally suspect and the wrong one cannot be told apart).
+  std::map<std::string, int> rays;
+  for (const auto& o : flight.observations) ++rays[o.point];
+  Project planted = clean;
+  size_t index = 0;
+  while (rays[planted.observations[index].point] < 3 || planted.observations[index].point[0] != 'K')
+    ++index;
+  planted.observations[index].pixel.x() += 3.0;
+  planted.observations[index].pixel.y() += 4.0;
+  // "Without it": the same block with that observation left out.
+  Project omitted = clean;
+  omitted.observations.erase(omitted.observations.begin() + index);
+  const AdjustmentResult a = Adjust(omitted, SelfCalibration());
+  const AdjustmentResult b = Adjust(planted, SelfCalibration());
+  bool listed = false;
+  for (const auto& r : b.rejected)
+    if (r.image == planted.observations[index].image && r.point == planted.observations[index].point) {
+      listed = true;
+      EXPECT_GT(r.residual_px.norm(), 1.0);  // part of the 5 px shows in the residual
+    }
+  EXPECT_TRUE(listed) << "image " << planted.observations[index].image << " point "
+                      << planted.observations[index].point;
+  EXPECT_EQ(b.rejected.size(), a.rejected.size() + 1);
+  EXPECT_EQ(AdjustmentToJson(b)["rejected"].size(), b.rejected.size());
+  // After the rejection the adjustment is the one without the observation.
+  EXPECT_EQ(a.check.n, b.check.n);
+  EXPECT_NEAR(b.check.spatial_rmse_m, a.check.spatial_rmse_m, 1e-3 * a.check.spatial_rmse_m);
+  EXPECT_NEAR(b.sigma0, a.sigma0, 1e-6);
+}
+
+}  // namespace
+}  // namespace aerocal::triangulation

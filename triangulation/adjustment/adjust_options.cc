@@ -1,0 +1,63 @@
+#include "triangulation/adjustment/adjust_options.h"
+
+#include <set>
+#include <sstream>
+
+#include "calib/camera/brown_fraser10.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+
+namespace aerocal::triangulation {
+
+using Model = calib::BrownFraser10Model;
+
+void AdjustOptions::Validate() const {
+  std::set<std::string> seen;
+  for (const auto& name : free_interior) {
+    if (Model::IndexOf(name) < 0)
+      throw ConfigError("free_interior: unknown parameter '" + name +
+                        "' (expected c, x0, y0, K1, K2, K3, P1, P2, B1, B2)");
+    if (!seen.insert(name).second)
+      throw ConfigError("free_interior: parameter '" + name + "' listed twice");
+  }
+  if (snooping_critical_value < 0)
+    throw ConfigError("snooping_critical_value must be >= 0 (got " +
+                      FormatNumber(snooping_critical_value) + ")");
+  if (max_rejections < 1)
+    throw ConfigError("max_rejections must be > 0 (got " + std::to_string(max_rejections) + ")");
+  if (!(correlation_threshold > 0 && correlation_threshold < 1))
+    throw ConfigError("correlation_threshold must be in (0, 1) (got " +
+                      FormatNumber(correlation_threshold) + ")");
+  if (max_dense_parameters < 0)
+    throw ConfigError("max_dense_parameters must be >= 0 (got " +
+                      std::to_string(max_dense_parameters) + ")");
+  if (solver.max_iterations < 1)
+    throw ConfigError("solver.max_iterations must be > 0 (got " +
+                      std::to_string(solver.max_iterations) + ")");
+}
+
+std::vector<std::string> ParseSelfCalibration(const std::string& text) {
+  if (text == "none" || text.empty()) return {};
+  std::vector<std::string> names;
+  if (text == "all") {
+    for (const auto& p : Model::kParams) names.emplace_back(p.name);
+    return names;
+  }
+  std::stringstream in(text);
+  std::string name;
+  while (std::getline(in, name, ',')) {
+    const auto begin = name.find_first_not_of(' ');
+    const auto end = name.find_last_not_of(' ');
+    name = begin == std::string::npos ? "" : name.substr(begin, end - begin + 1);
+    if (Model::IndexOf(name) < 0)
+      throw ConfigError("--self-calibration: unknown parameter '" + name +
+                        "' (expected none, all or a list of c, x0, y0, K1, K2, K3, P1, P2, B1, B2)");
+    names.push_back(name);
+  }
+  AdjustOptions probe;
+  probe.free_interior = names;
+  probe.Validate();
+  return names;
+}
+
+}  // namespace aerocal::triangulation

@@ -1,0 +1,41 @@
+// How a block is adjusted (STYLE.md section 6): which interior parameters are free, which weighted
+// observations enter, gross-error detection and the solver. What is adjusted (images, points and
+// their roles, a-priori sigmas) is data from the block files, not options.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/problem/problem_builder.h"
+
+namespace aerocal::triangulation {
+
+struct AdjustOptions {
+  /// Interior parameters estimated per camera, by table name (c, x0, y0, K1, K2, K3, P1, P2, B1,
+  /// B2); empty = conventional adjustment (interior fixed at the camera file's values).
+  std::vector<std::string> free_interior;
+  /// Camera-file `interior_sigma` values enter as weighted observations of the free parameters.
+  bool use_interior_sigma = true;
+  /// The sigma columns of exposures.csv enter as GNSS/IMU weighted observations.
+  bool use_eo_priors = true;
+  /// Baarda data snooping on the image observations; rejected observations are listed.
+  bool data_snooping = true;
+  /// Critical value of the standardized residual |w|; 0: from alpha = 5 % / n_tested (>= 3.29).
+  double snooping_critical_value = 0.0;
+  int max_rejections = 100;  // > 0
+  /// |correlation| above which a pair of parameters is reported as not separable, (0, 1).
+  double correlation_threshold = 0.95;
+  /// Free-parameter limit for the exact redundancy numbers of data snooping (dense reduced
+  /// normal matrix); larger blocks use the mean redundancy r / n.
+  int max_dense_parameters = 4000;
+  calib::SolverOptions solver;
+
+  /// Throws ConfigError naming the field, the value and the rule.
+  void Validate() const;
+};
+
+/// "none" -> {}, "all" -> the 10 names, "c,x0,K1" -> those names (checked against the table).
+/// Throws ConfigError on an unknown name.
+std::vector<std::string> ParseSelfCalibration(const std::string& text);
+
+}  // namespace aerocal::triangulation

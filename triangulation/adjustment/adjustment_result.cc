@@ -1,0 +1,241 @@
+#include "triangulation/adjustment/adjustment_result.h"
+
+#include <cmath>
+#include <cstdarg>
+#include <cstdio>
+
+namespace aerocal::triangulation {
+namespace {
+
+using Model = calib::BrownFraser10Model;
+constexpr double kRadToDeg = 180.0 / M_PI;
+
+nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+nlohmann::json Interior(const calib::InteriorParams& p) {
+  nlohmann::json j = nlohmann::json::object();
+  for (int k = 0; k < Model::kNumParams; ++k) j[std::string(Model::kParams[k].name)] = p[k];
+  return j;
+}
+
+std::string Printf(const char* format, ...) __attribute__((format(printf, 1, 2)));
+std::string Printf(const char* format, ...) {
+  char buffer[1024];
+  va_list args;
+  va_start(args, format);
+  std::vsnprintf(buffer, sizeof(buffer), format, args);
+  va_end(args);
+  return buffer;
+}
+
+std::string StatisticsLine(const char* what, const PointStatistics& s) {
+  return Printf("%-8s n=%3d  RMSE X %.4f  Y %.4f  Z %.4f  plan %.4f  spatial %.4f m\n", what, s.n,
+                s.rmse_m.x(), s.rmse_m.y(), s.rmse_m.z(), s.planimetric_rmse_m, s.spatial_rmse_m);
+}
+
+std::string CalibrationTable(const AdjustmentResult& r) {
+  std::string out;
+  for (const auto& c : r.cameras) {
+    out += "camera " + c.id + "\n";
+    out += Printf("  %-4s %-6s %16s %16s %16s %14s\n", "par", "unit", "initial", "correction",
+                  "estimate", "sigma");
+    for (int k = 0; k < Model::kNumParams; ++k) {
+      const auto& info = Model::kParams[k];
+      out += Printf("  %-4s %-6s %16.8g %16.8g %16.8g %14s\n", std::string(info.name).c_str(),
+                    std::string(info.unit).c_str(), c.initial[k], c.estimated[k] - c.initial[k],
+                    c.estimated[k], c.free[k] ? Printf("%.3g", c.sigma[k]).c_str() : "fixed");
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+PointStatistics ComputePointStatistics(const std::vector<PointDifference>& points) {
+  PointStatistics s;
+  s.n = static_cast<int>(points.size());
+  if (s.n == 0) return s;
+  Eigen::Vector3d sum2 = Eigen::Vector3d::Zero();
+  for (const auto& p : points) {
+    sum2 += p.difference_m.cwiseAbs2();
+    s.mean_m += p.difference_m;
+    s.max_abs_m = s.max_abs_m.cwiseMax(p.difference_m.cwiseAbs());
+  }
+  s.mean_m /= s.n;
+  s.rmse_m = (sum2 / s.n).cwiseSqrt();
+  s.planimetric_rmse_m = s.rmse_m.head<2>().norm();
+  s.spatial_rmse_m = s.rmse_m.norm();
+  return s;
+}
+
+nlohmann::json PointStatisticsToJson(const PointStatistics& s) {
+  return {{"n", s.n},
+          {"rmse_m", Vec(s.rmse_m)},
+          {"mean_m", Vec(s.mean_m)},
+          {"max_abs_m", Vec(s.max_abs_m)},
+          {"planimetric_rmse_m", s.planimetric_rmse_m},
+          {"spatial_rmse_m", s.spatial_rmse_m}};
+}
+
+nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
+  nlohmann::json j;
+  j["kind"] = "adjust";
+  j["sigma0"] = r.sigma0;
+  j["sigma0_px"] = r.sigma0_px;
+  j["sigma0_um"] = r.sigma0_um;
+  j["redundancy"] = r.solve.redundancy;
+  j["iterations"] = r.solve.iterations;
+  j["converged"] = r.solve.converged;
+  j["termination"] = r.solve.termination;
+  j["linear_solver"] = r.solve.linear_solver;
+  j["seconds"] = r.solve.seconds;
+  j["frame"] = r.frame;
+  j["self_calibration"] = r.free_interior;
+  j["n_observations"] = r.solve.n_observations;
+  j["n_unknowns"] = r.solve.n_unknowns;
+  nlohmann::json groups = nlohmann::json::array();
+  for (const auto& g : r.solve.groups)
+    groups.push_back({{"name", g.name}, {"n", g.n_observations}, {"rms_sigma", g.rms}});
+  j["groups"] = groups;
+  j["cameras"] = nlohmann::json::array();
+  for (const auto& c : r.cameras) {
+    nlohmann::json sigma = nlohmann::json::object(), free = nlohmann::json::array();
+    for (int k = 0; k < Model::kNumParams; ++k) {
+      const std::string name(Model::kParams[k].name);
+      if (c.free[k]) {
+        free.push_back(name);
+        sigma[name] = r.determinability.covariance_ok ? nlohmann::json(c.sigma[k]) : nlohmann::json();
+      }
+    }
+    j["cameras"].push_back({{"id", c.id},
+                            {"initial", Interior(c.initial)},
+                            {"estimated", Interior(c.estimated)},
+                            {"sigma", sigma},
+                            {"free", free}});
+  }
+  nlohmann::json control = PointStatisticsToJson(r.control), check = PointStatisticsToJson(r.check);
+  auto table = [](const std::vector<PointDifference>& points) {
+    nlohmann::json t = nlohmann::json::array();
+    for (const auto& p : points)
+      t.push_back({{"point", p.point},
+                   {"surveyed_m", Vec(p.surveyed_m)},
+                   {"adjusted_m", Vec(p.adjusted_m)},
+                   {"difference_m", Vec(p.difference_m)},
+                   {"rays", p.rays}});
+    return t;
+  };
+  control["points"] = table(r.control_points);
+  check["points"] = table(r.check_points);
+  j["control"] = control;
+  j["check"] = check;
+  j["exposures"] = nlohmann::json::array();
+  for (const auto& e : r.exposures) {
+    nlohmann::json x = {{"image", e.image},
+                        {"X", e.center_m.x()},
+                        {"Y", e.center_m.y()},
+                        {"Z", e.center_m.z()},
+                        {"omega", e.opk_rad.x() * kRadToDeg},
+                        {"phi", e.opk_rad.y() * kRadToDeg},
+                        {"kappa", e.opk_rad.z() * kRadToDeg}};
+    nlohmann::json sigma = nlohmann::json::object();
+    if (e.center_sigma_m && e.opk_sigma_rad)
+      sigma = {{"X", e.center_sigma_m->x()},
+               {"Y", e.center_sigma_m->y()},
+               {"Z", e.center_sigma_m->z()},
+               {"omega", e.opk_sigma_rad->x() * kRadToDeg},
+               {"phi", e.opk_sigma_rad->y() * kRadToDeg},
+               {"kappa", e.opk_sigma_rad->z() * kRadToDeg}};
+    x["sigma"] = sigma;
+    j["exposures"].push_back(x);
+  }
+  j["rejected"] = nlohmann::json::array();
+  for (const auto& o : r.rejected)
+    j["rejected"].push_back({{"image", o.image},
+                             {"point", o.point},
+                             {"residual_px", o.residual_px.norm()},
+                             {"residual_col_row_px", {o.residual_px.x(), -o.residual_px.y()}},
+                             {"w", o.w}});
+  nlohmann::json det = {{"determinable", r.determinability.covariance_ok},
+                        {"message", r.determinability.message},
+                        {"undetermined", r.determinability.undetermined},
+                        {"warnings", r.determinability.warnings}};
+  det["high_correlations"] = nlohmann::json::array();
+  for (const auto& h : r.determinability.high_correlations)
+    det["high_correlations"].push_back({{"a", h.a}, {"b", h.b}, {"correlation", h.correlation}});
+  j["determinability"] = det;
+  j["notes"] = r.notes;
+  return j;
+}
+
+std::string FormatSummary(const AdjustmentResult& r) {
+  std::string out = Printf(
+      "%s adjustment: %s after %d iterations, sigma0 %.4f (%.4f px, %.3f um), redundancy %d\n",
+      r.free_interior.empty() ? "conventional" : "self-calibrating",
+      r.solve.converged ? "converged" : "NOT converged", r.solve.iterations, r.sigma0, r.sigma0_px,
+      r.sigma0_um, r.solve.redundancy);
+  out += "frame: " + r.frame + "\n";
+  out += StatisticsLine("control", r.control);
+  out += StatisticsLine("check", r.check);
+  if (!r.free_interior.empty()) out += CalibrationTable(r);
+  for (const auto& o : r.rejected)
+    out += Printf("rejected: image %s point %s, residual %.2f px (w = %.1f)\n", o.image.c_str(),
+                  o.point.c_str(), o.residual_px.norm(), o.w);
+  for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
+  return out;
+}
+
+std::string FormatComparison(const AdjustmentResult& a, const AdjustmentResult& b) {
+  std::string out = Printf("%-26s %16s %16s\n", "", "conventional", "self-calibration");
+  auto row = [&](const char* label, double x, double y) {
+    out += Printf("%-26s %16.4f %16.4f\n", label, x, y);
+  };
+  row("sigma0 [um]", a.sigma0_um, b.sigma0_um);
+  row("sigma0 [px]", a.sigma0_px, b.sigma0_px);
+  const char* axes[] = {"X", "Y", "Z"};
+  for (int k = 0; k < 3; ++k)
+    row(Printf("control RMSE %s [m]", axes[k]).c_str(), a.control.rmse_m(k), b.control.rmse_m(k));
+  for (int k = 0; k < 3; ++k)
+    row(Printf("check RMSE %s [m]", axes[k]).c_str(), a.check.rmse_m(k), b.check.rmse_m(k));
+  row("check RMSE plan. [m]", a.check.planimetric_rmse_m, b.check.planimetric_rmse_m);
+  row("check RMSE spatial [m]", a.check.spatial_rmse_m, b.check.spatial_rmse_m);
+  out += Printf("%-26s %16d %16d\n", "check points", a.check.n, b.check.n);
+  out += Printf("%-26s %16s %16s\n", "converged", a.solve.converged ? "yes" : "no",
+                b.solve.converged ? "yes" : "no");
+  out += "calibration (self-calibrating run):\n" + CalibrationTable(b);
+  for (const auto& w : b.determinability.warnings) out += "warning: " + w + "\n";
+  return out;
+}
+
+nlohmann::json ComparisonToJson(const AdjustmentResult& a, const AdjustmentResult& b) {
+  auto brief = [](const AdjustmentResult& r) {
+    return nlohmann::json{{"sigma0", r.sigma0},
+                          {"sigma0_px", r.sigma0_px},
+                          {"sigma0_um", r.sigma0_um},
+                          {"converged", r.solve.converged},
+                          {"control", PointStatisticsToJson(r.control)},
+                          {"check", PointStatisticsToJson(r.check)}};
+  };
+  nlohmann::json j = {{"conventional", brief(a)}, {"self_calibration", brief(b)}};
+  j["check_spatial_rmse_ratio"] =
+      b.check.spatial_rmse_m > 0 ? a.check.spatial_rmse_m / b.check.spatial_rmse_m : 0.0;
+  nlohmann::json table = nlohmann::json::array();
+  for (const auto& c : b.cameras)
+    for (int k = 0; k < Model::kNumParams; ++k)
+      table.push_back({{"camera", c.id},
+                       {"parameter", std::string(Model::kParams[k].name)},
+                       {"unit", std::string(Model::kParams[k].unit)},
+                       {"initial", c.initial[k]},
+                       {"correction", c.estimated[k] - c.initial[k]},
+                       {"estimate", c.estimated[k]},
+                       {"sigma", c.free[k] ? nlohmann::json(c.sigma[k]) : nlohmann::json()}});
+  j["calibration"] = table;
+  return j;
+}
+
+calib::Camera UpdatedCamera(const calib::Camera& camera, const CameraEstimate& estimate) {
+  calib::Camera out = camera;
+  out.interior = estimate.estimated;
+  return out;
+}
+
+}  // namespace aerocal::triangulation

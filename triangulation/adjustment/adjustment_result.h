@@ -1,0 +1,104 @@
+// What a block adjustment reports (FORMATS.md "Results", kind "adjust"): sigma0 (unitless, px,
+// um), redundancy, convergence, per camera the initial / estimated interior with sigmas, exterior
+// orientations with sigmas, control and check statistics (CONVENTIONS.md "Statistics": RMSE, mean,
+// max |d| per axis, planimetric and spatial RMSE), rejected observations, and the determinability
+// of the free parameters (correlations above the threshold, null-space parameters).
+#pragma once
+
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/camera.h"
+#include "calib/problem/problem_builder.h"
+
+namespace aerocal::triangulation {
+
+/// Adjusted minus surveyed coordinates of one control or check point (m, object frame).
+struct PointDifference {
+  std::string point;
+  Eigen::Vector3d surveyed_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d adjusted_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d difference_m = Eigen::Vector3d::Zero();
+  int rays = 0;
+};
+
+struct PointStatistics {
+  int n = 0;
+  Eigen::Vector3d rmse_m = Eigen::Vector3d::Zero();     // per axis X, Y, Z
+  Eigen::Vector3d mean_m = Eigen::Vector3d::Zero();     // bias
+  Eigen::Vector3d max_abs_m = Eigen::Vector3d::Zero();
+  double planimetric_rmse_m = 0.0;  // sqrt(mX^2 + mY^2)
+  double spatial_rmse_m = 0.0;      // sqrt(mX^2 + mY^2 + mZ^2)
+};
+PointStatistics ComputePointStatistics(const std::vector<PointDifference>& points);
+
+struct CameraEstimate {
+  std::string id;
+  calib::InteriorParams initial{}, estimated{}, sigma{};  // table units; sigma 0 when fixed
+  std::array<bool, calib::BrownFraser10Model::kNumParams> free{};
+};
+
+struct ExposureEstimate {
+  std::string image;
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();
+  std::optional<Eigen::Vector3d> center_sigma_m, opk_sigma_rad;  // when the covariance is known
+};
+
+struct RejectedObservation {
+  std::string image, point;
+  Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // v in (corrected) photo space, px
+  double w = 0.0;                                          // standardized residual
+};
+
+struct Determinability {
+  bool covariance_ok = false;
+  std::string message;
+  /// Pairs with |rho| above the threshold that involve an interior parameter.
+  std::vector<calib::HighCorrelation> high_correlations;
+  std::vector<std::string> undetermined;  // null-space parameters (rank defect)
+  std::vector<std::string> warnings;      // one human sentence per problem found
+  bool determinable() const { return covariance_ok; }
+};
+
+struct AdjustmentResult {
+  calib::SolveReport solve;
+  std::vector<std::string> free_interior;  // names; empty = conventional
+  double sigma0 = 0, sigma0_px = 0, sigma0_um = 0;
+  std::vector<CameraEstimate> cameras;
+  std::vector<ExposureEstimate> exposures;
+  std::vector<PointDifference> control_points, check_points;
+  PointStatistics control, check;
+  std::vector<RejectedObservation> rejected;
+  Determinability determinability;
+  std::map<std::string, Eigen::Vector3d> points_m;  // adjusted coordinates of every point
+  std::vector<std::string> notes;                   // points left out, and why
+  std::string frame;                                // the object frame, stated
+
+  bool converged() const { return solve.converged; }
+};
+
+/// JSON of FORMATS.md (kind "adjust"); angles in degrees, coordinates in the object frame.
+nlohmann::json AdjustmentToJson(const AdjustmentResult& result);
+nlohmann::json PointStatisticsToJson(const PointStatistics& statistics);
+
+/// Side-by-side text of two adjustments of the same block (conventional vs self-calibrating):
+/// control / check RMSE per axis, sigma0 in um and px, and the calibration table (initial,
+/// correction, estimate, sigma) per parameter.
+std::string FormatComparison(const AdjustmentResult& conventional,
+                             const AdjustmentResult& self_calibrating);
+/// The same comparison as JSON: {conventional: {...}, self_calibration: {...}, ratio_check_rmse}.
+nlohmann::json ComparisonToJson(const AdjustmentResult& conventional,
+                                const AdjustmentResult& self_calibrating);
+/// Short text summary of one adjustment (statistics, calibration table, warnings).
+std::string FormatSummary(const AdjustmentResult& result);
+
+/// The camera with its interior replaced by the estimate (sub-images carried along unchanged).
+calib::Camera UpdatedCamera(const calib::Camera& camera, const CameraEstimate& estimate);
+
+}  // namespace aerocal::triangulation

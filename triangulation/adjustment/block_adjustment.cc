@@ -1,0 +1,403 @@
+#include "triangulation/adjustment/block_adjustment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "calib/core/error.h"
+#include "calib/residuals/collinearity.h"
+#include "calib/residuals/prior.h"
+#include "triangulation/adjustment/forward_intersection.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+using Model = calib::BrownFraser10Model;
+using calib::BlockId;
+using calib::BlockKind;
+
+const std::vector<std::string> kCenterNames = {"X", "Y", "Z"};
+const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
+
+std::vector<std::string> InteriorNames() {
+  std::vector<std::string> names;
+  for (const auto& p : Model::kParams) names.emplace_back(p.name);
+  return names;
+}
+
+double Median(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+}  // namespace
+
+struct BlockAdjustment::Storage {
+  struct CameraState {
+    calib::InteriorParams interior{};
+    BlockId block = -1;
+  };
+  struct ExposureState {
+    const Exposure* exposure = nullptr;
+    const calib::Camera* camera = nullptr;
+    Eigen::Vector3d opk = Eigen::Vector3d::Zero(), center = Eigen::Vector3d::Zero();
+    BlockId opk_block = -1, center_block = -1;
+  };
+  struct PointState {
+    Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
+    BlockId block = -1;
+    const GroundPoint* ground = nullptr;  // nullptr: a tie point absent from points.csv
+    int rays = -1;  // virtual-image rays; -1: added by a caller, rays not counted here
+  };
+  // std::map keeps element addresses stable: the builder holds pointers into them.
+  std::map<std::string, CameraState> cameras;
+  std::map<std::string, ExposureState> exposures;
+  std::map<std::string, PointState> points;
+  // Virtual-image observations used in the adjustment (sub-image ones mapped), and their residuals.
+  std::vector<ImageObservation> observations;
+  std::map<calib::ResidualId, size_t> observation_of_residual;
+  std::vector<std::string> notes;
+};
+
+BlockAdjustment::BlockAdjustment(const Project& project, const AdjustOptions& options,
+                                 SubimageObservations subimage)
+    : project_(project), options_(options), storage_(std::make_unique<Storage>()) {
+  options_.Validate();
+  BuildExposures();
+  BuildPoints(subimage);
+  AddImageResiduals();
+  AddPriors();
+}
+
+BlockAdjustment::~BlockAdjustment() = default;
+
+BlockId BlockAdjustment::InteriorBlock(const std::string& camera) const {
+  const auto it = storage_->cameras.find(camera);
+  return it == storage_->cameras.end() ? -1 : it->second.block;
+}
+BlockId BlockAdjustment::RotationBlock(const std::string& image) const {
+  const auto it = storage_->exposures.find(image);
+  return it == storage_->exposures.end() ? -1 : it->second.opk_block;
+}
+BlockId BlockAdjustment::CenterBlock(const std::string& image) const {
+  const auto it = storage_->exposures.find(image);
+  return it == storage_->exposures.end() ? -1 : it->second.center_block;
+}
+BlockId BlockAdjustment::PointBlock(const std::string& point) const {
+  const auto it = storage_->points.find(point);
+  return it == storage_->points.end() ? -1 : it->second.block;
+}
+
+BlockId BlockAdjustment::AddPoint(const std::string& point, const Eigen::Vector3d& start_m) {
+  auto& state = storage_->points[point];
+  if (state.block >= 0) return state.block;
+  state.xyz = start_m;
+  state.ground = project_.FindPoint(point);
+  state.block = builder_.AddBlock("point " + point, state.xyz.data(), 3, BlockKind::kGroundPoint,
+                                  kCenterNames);
+  return state.block;
+}
+
+void BlockAdjustment::BuildExposures() {
+  std::vector<int> fixed;
+  for (int i = 0; i < Model::kNumParams; ++i)
+    if (std::find(options_.free_interior.begin(), options_.free_interior.end(),
+                  std::string(Model::kParams[i].name)) == options_.free_interior.end())
+      fixed.push_back(i);
+  for (const auto& [id, camera] : project_.cameras) {
+    auto& state = storage_->cameras[id];
+    state.interior = camera.interior;
+    state.block = builder_.AddBlock("camera " + id, state.interior.data(), Model::kNumParams,
+                                    BlockKind::kInterior, InteriorNames());
+    builder_.FixEntries(state.block, fixed);
+  }
+  for (const auto& e : project_.exposures) {
+    auto& state = storage_->exposures[e.image];
+    state.exposure = &e;
+    state.camera = &project_.cameras.at(e.camera);
+    state.opk = e.opk_rad;
+    state.center = e.center_m;
+    state.opk_block =
+        builder_.AddBlock("image " + e.image + " angles", state.opk.data(), 3, BlockKind::kRotation, kAngleNames);
+    state.center_block = builder_.AddBlock("image " + e.image + " centre", state.center.data(), 3,
+                                           BlockKind::kCenter, kCenterNames);
+  }
+}
+
+void BlockAdjustment::BuildPoints(SubimageObservations subimage) {
+  // Observations in the virtual image (sub-image ones mapped with the camera file, or skipped).
+  for (const auto& o : project_.observations) {
+    if (o.subimage.empty()) {
+      storage_->observations.push_back(o);
+      continue;
+    }
+    if (subimage == SubimageObservations::kLeaveToCaller) continue;
+    const auto& camera = *storage_->exposures.at(o.image).camera;
+    ImageObservation mapped = o;
+    mapped.pixel = camera.subimages[camera.SubimageIndex(o.subimage)].VirtualFromSub(o.pixel);
+    mapped.subimage.clear();
+    storage_->observations.push_back(mapped);
+  }
+  std::map<std::string, std::vector<ImageRay>> rays;
+  for (const auto& o : storage_->observations) {
+    const auto& e = storage_->exposures.at(o.image);
+    rays[o.point].push_back(RayFromPixel(*e.camera, e.opk, e.center, o.pixel));
+  }
+  // Fallback height for points whose rays do not intersect: mean surveyed height, else 0.
+  double height_sum = 0.0;
+  int height_n = 0;
+  for (const auto& p : project_.points)
+    if (p.xyz_m && p.role != PointRole::kTie) {
+      height_sum += p.xyz_m->z();
+      ++height_n;
+    }
+  const double fallback_height = height_n > 0 ? height_sum / height_n : 0.0;
+  for (const auto& [id, point_rays] : rays) {
+    const GroundPoint* ground = project_.FindPoint(id);
+    const bool control = ground && ground->role == PointRole::kControl;
+    if (point_rays.size() < 2 && !control) {
+      storage_->notes.push_back("point " + id + " is seen in " + std::to_string(point_rays.size()) +
+                                " image only and left out");
+      continue;
+    }
+    Eigen::Vector3d start;
+    if (ground && ground->xyz_m && ground->role != PointRole::kCheck) {
+      start = *ground->xyz_m;  // control survey, or an approximation given for a tie point
+    } else if (auto x = IntersectRays(point_rays)) {
+      start = *x;
+    } else {
+      start = IntersectWithHeight(point_rays, fallback_height);
+    }
+    AddPoint(id, start);
+    storage_->points[id].rays = static_cast<int>(point_rays.size());
+  }
+  for (const auto& p : project_.points)
+    if (p.role != PointRole::kTie && !storage_->points.count(p.id))
+      storage_->notes.push_back(PointRoleName(p.role) + " point " + p.id +
+                                " has too few image observations and is not used");
+}
+
+void BlockAdjustment::AddImageResiduals() {
+  for (size_t i = 0; i < storage_->observations.size(); ++i) {
+    const auto& o = storage_->observations[i];
+    const auto point = storage_->points.find(o.point);
+    if (point == storage_->points.end()) continue;
+    const auto& e = storage_->exposures.at(o.image);
+    const calib::Camera& camera = *e.camera;
+    const calib::PixelFrame frame{camera.pixel_size_mm, camera.width_px, camera.height_px};
+    const auto id = builder_.AddResidual(
+        calib::kGroupImage, calib::CollinearityResidual::Create(frame, o.pixel, o.sigma_px),
+        {storage_->cameras.at(e.exposure->camera).block, e.opk_block, e.center_block, point->second.block},
+        "image " + o.image + " point " + o.point);
+    storage_->observation_of_residual[id] = i;
+  }
+}
+
+void BlockAdjustment::AddPriors() {
+  for (const auto& [id, state] : storage_->points) {
+    if (!state.ground || state.ground->role != PointRole::kControl) continue;
+    const Eigen::Vector3d& xyz = *state.ground->xyz_m;
+    const Eigen::Vector3d& s = state.ground->sigma_m;
+    builder_.AddResidual(calib::kGroupControl,
+                         calib::PriorCostFunction::Create({xyz.x(), xyz.y(), xyz.z()}, {s.x(), s.y(), s.z()}),
+                         {state.block}, "control " + id);
+  }
+  if (options_.use_eo_priors) {
+    for (const auto& [image, state] : storage_->exposures) {
+      const Exposure& e = *state.exposure;
+      if (e.center_sigma_m)
+        builder_.AddResidual(calib::kGroupEoPrior,
+                             calib::PriorCostFunction::Create(
+                                 {e.center_m.x(), e.center_m.y(), e.center_m.z()},
+                                 {e.center_sigma_m->x(), e.center_sigma_m->y(), e.center_sigma_m->z()}),
+                             {state.center_block}, "GNSS " + image);
+      if (e.opk_sigma_rad)
+        builder_.AddResidual(calib::kGroupEoPrior,
+                             calib::PriorCostFunction::Create(
+                                 {e.opk_rad.x(), e.opk_rad.y(), e.opk_rad.z()},
+                                 {e.opk_sigma_rad->x(), e.opk_sigma_rad->y(), e.opk_sigma_rad->z()}),
+                             {state.opk_block}, "IMU " + image);
+    }
+  }
+  if (options_.use_interior_sigma) {
+    for (const auto& [id, state] : storage_->cameras) {
+      const calib::Camera& camera = project_.cameras.at(id);
+      std::vector<int> indices;
+      std::vector<double> values, sigmas;
+      for (const auto& name : options_.free_interior) {
+        const int k = Model::IndexOf(name);
+        if (!camera.interior_sigma[k]) continue;
+        indices.push_back(k);
+        values.push_back(camera.interior[k]);
+        sigmas.push_back(*camera.interior_sigma[k]);
+      }
+      if (!indices.empty())
+        builder_.AddResidual(calib::kGroupInteriorPrior,
+                             std::make_unique<calib::PriorCostFunction>(Model::kNumParams, indices, values, sigmas),
+                             {state.block}, "interior prior " + id);
+    }
+  }
+}
+
+AdjustmentResult BlockAdjustment::Run() {
+  AdjustmentResult result;
+  result.free_interior = options_.free_interior;
+  result.frame = project_.frame.description;
+  result.notes = storage_->notes;
+  std::vector<BlockId> interior_blocks;
+  for (const auto& [id, state] : storage_->cameras) interior_blocks.push_back(state.block);
+
+  // Stage 1 (self-calibration only): exterior orientation and points with the interior fixed.
+  if (!options_.free_interior.empty()) {
+    for (BlockId b : interior_blocks) builder_.FixBlock(b);
+    builder_.Solve(options_.solver);
+    for (BlockId b : interior_blocks) builder_.FreeBlock(b);
+  }
+  std::vector<calib::RejectedResidual> rejected;
+  if (options_.data_snooping) {
+    calib::SnoopingOptions snooping;
+    snooping.groups = {calib::kGroupImage};
+    snooping.critical_value = options_.snooping_critical_value;
+    snooping.max_rejections = options_.max_rejections;
+    snooping.max_dense_parameters = options_.max_dense_parameters;
+    result.solve = builder_.SolveWithDataSnooping(options_.solver, snooping, &rejected);
+  } else {
+    result.solve = builder_.Solve(options_.solver);
+  }
+  // A point left with a single ray after rejections is no longer determined: drop its last
+  // observation (it carried no redundancy) and solve once more for honest statistics.
+  if (!rejected.empty()) {
+    std::map<std::string, std::vector<calib::ResidualId>> active_rays;
+    for (const auto& [id, index] : storage_->observation_of_residual)
+      if (builder_.IsActive(id)) active_rays[storage_->observations[index].point].push_back(id);
+    bool dropped = false;
+    for (auto& [id, state] : storage_->points) {
+      if (state.rays < 0) continue;
+      const auto& ids = active_rays[id];
+      state.rays = static_cast<int>(ids.size());
+      const bool control = state.ground && state.ground->role == PointRole::kControl;
+      if (control || state.rays != 1) continue;
+      builder_.RemoveResidual(ids.front());
+      state.rays = 0;
+      dropped = true;
+      storage_->notes.push_back("point " + id + " keeps one ray after the rejections and is left out");
+    }
+    if (dropped) result.solve = builder_.Solve(options_.solver);
+    result.notes = storage_->notes;
+  }
+  for (const auto& r : rejected) {
+    const auto it = storage_->observation_of_residual.find(r.id);
+    if (it == storage_->observation_of_residual.end()) continue;
+    const auto& o = storage_->observations[it->second];
+    RejectedObservation out;
+    out.image = o.image;
+    out.point = o.point;
+    out.w = r.w;
+    if (r.whitened_residual.size() == 2)
+      out.residual_px = Eigen::Vector2d(r.whitened_residual[0], r.whitened_residual[1]) * o.sigma_px;
+    result.rejected.push_back(out);
+  }
+
+  // Statistics in the units of the image measurements.
+  std::vector<double> image_sigmas;
+  for (const auto& [id, index] : storage_->observation_of_residual)
+    if (builder_.IsActive(id)) image_sigmas.push_back(storage_->observations[index].sigma_px);
+  result.sigma0 = result.solve.sigma0;
+  result.sigma0_px = result.sigma0 * Median(image_sigmas);
+  std::vector<double> pixel_sizes;
+  for (const auto& [id, camera] : project_.cameras) pixel_sizes.push_back(camera.pixel_size_mm);
+  result.sigma0_um = result.sigma0_px * Median(pixel_sizes) * 1000.0;
+
+  // Covariance: interior and exterior orientation (all pairs, so c ~ Z0 and x0 ~ X0/phi show).
+  std::vector<BlockId> cov_blocks = interior_blocks;
+  for (const auto& [image, state] : storage_->exposures) {
+    cov_blocks.push_back(state.opk_block);
+    cov_blocks.push_back(state.center_block);
+  }
+  calib::CovarianceReport cov;
+  if (result.solve.usable && result.solve.redundancy > 0)
+    cov = builder_.EstimateCovariance(cov_blocks, result.sigma0, options_.correlation_threshold);
+  else
+    cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
+  Determinability& det = result.determinability;
+  det.covariance_ok = cov.ok;
+  det.message = cov.message;
+  det.undetermined = cov.undetermined;
+  if (!cov.ok) det.warnings.push_back("the block cannot determine all parameters: " + cov.message);
+
+  for (const auto& [id, state] : storage_->cameras) {
+    CameraEstimate c;
+    c.id = id;
+    c.initial = project_.cameras.at(id).interior;
+    c.estimated = state.interior;
+    for (int k = 0; k < Model::kNumParams; ++k)
+      c.free[k] = std::find(options_.free_interior.begin(), options_.free_interior.end(),
+                            std::string(Model::kParams[k].name)) != options_.free_interior.end();
+    if (cov.ok) {
+      const Eigen::VectorXd s = cov.BlockSigma(state.block, Model::kNumParams);
+      for (int k = 0; k < Model::kNumParams; ++k) c.sigma[k] = c.free[k] ? s(k) : 0.0;
+    }
+    result.cameras.push_back(c);
+  }
+  if (cov.ok) {
+    // Every free interior parameter: its strongest correlation with any other parameter.
+    const std::string prefix = "camera ";
+    for (int i = 0; i < static_cast<int>(cov.names.size()); ++i) {
+      if (cov.names[i].rfind(prefix, 0) != 0 || !cov.free[i]) continue;
+      int partner = -1;
+      double best = 0.0;
+      for (int k = 0; k < static_cast<int>(cov.names.size()); ++k)
+        if (k != i && cov.free[k] && std::abs(cov.correlation(i, k)) > std::abs(best)) {
+          best = cov.correlation(i, k);
+          partner = k;
+        }
+      if (partner >= 0 && std::abs(best) > options_.correlation_threshold) {
+        det.high_correlations.push_back({cov.names[i], cov.names[partner], best});
+        char text[512];
+        std::snprintf(text, sizeof(text),
+                      "%s is not separable from %s (correlation %.4f): the block cannot determine "
+                      "it independently; add GNSS camera centres, control at different heights, "
+                      "cross strips, or an a-priori sigma",
+                      cov.names[i].c_str(), cov.names[partner].c_str(), best);
+        det.warnings.push_back(text);
+      }
+    }
+  }
+
+  for (const auto& [image, state] : storage_->exposures) {
+    ExposureEstimate e;
+    e.image = image;
+    e.center_m = state.center;
+    e.opk_rad = state.opk;
+    if (cov.ok) {
+      e.center_sigma_m = cov.BlockSigma(state.center_block, 3);
+      e.opk_sigma_rad = cov.BlockSigma(state.opk_block, 3);
+    }
+    result.exposures.push_back(e);
+  }
+  for (const auto& [id, state] : storage_->points) {
+    const bool control = state.ground && state.ground->role == PointRole::kControl;
+    if (state.rays >= 0 && state.rays < 2 && !control) continue;
+    result.points_m[id] = state.xyz;
+    if (!state.ground || state.ground->role == PointRole::kTie) continue;
+    PointDifference d;
+    d.point = id;
+    d.surveyed_m = *state.ground->xyz_m;
+    d.adjusted_m = state.xyz;
+    d.difference_m = state.xyz - d.surveyed_m;
+    d.rays = state.rays;
+    (state.ground->role == PointRole::kControl ? result.control_points : result.check_points).push_back(d);
+  }
+  result.control = ComputePointStatistics(result.control_points);
+  result.check = ComputePointStatistics(result.check_points);
+  for (const auto& d : result.solve.diagnostics) result.notes.push_back(d);
+  return result;
+}
+
+AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
+  BlockAdjustment adjustment(project, options);
+  return adjustment.Run();
+}
+
+}  // namespace aerocal::triangulation

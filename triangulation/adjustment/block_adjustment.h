@@ -1,0 +1,83 @@
+// Self-calibrating bundle block adjustment (aerial triangulation) with control and check points.
+//
+// Observations (all whitened, CONVENTIONS.md "Statistics"):
+// - image: collinearity of every virtual-image measurement with the 10-parameter camera
+//   (calib/residuals/collinearity.h), group kGroupImage;
+// - control: the surveyed coordinates of control points as weighted observations of their ground
+//   point block (sigma from points.csv), group kGroupControl;
+// - eo_prior: GNSS centres / IMU angles from the sigma columns of exposures.csv, kGroupEoPrior;
+// - interior_prior: the camera file's `interior_sigma` of free interior parameters.
+// Check points enter only through their image rays (as tie points); their adjusted coordinates are
+// compared with the survey afterwards. Interior parameters are one block per camera; which entries
+// are free is AdjustOptions::free_interior (a SubsetManifold in the builder).
+//
+// Starting values: exposures.csv; control points from their survey; other points from points.csv
+// when given, else by forward intersection (forward_intersection.h). A self-calibrating run first
+// adjusts with the interior fixed, then frees the listed parameters (robust start from exterior
+// orientations off by tens of metres and degrees).
+//
+// Extension (joint stitching + triangulation): build the adjustment with
+// SubimageObservations::kLeaveToCaller, then add SubimageCollinearityResidual<Mapping> residuals
+// (group kGroupSubimage) on mapping blocks of your own and the blocks returned by InteriorBlock,
+// RotationBlock, CenterBlock and PointBlock (create missing points with AddPoint), before Run().
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calib/problem/problem_builder.h"
+#include "triangulation/adjustment/adjust_options.h"
+#include "triangulation/adjustment/adjustment_result.h"
+#include "triangulation/block/block.h"
+
+namespace aerocal::triangulation {
+
+enum class SubimageObservations {
+  kMapWithCameraFile,  // raw sub-image (u, v) -> virtual pixel with the camera file's mapping
+  kLeaveToCaller,      // skipped here: the caller adds them with their mapping blocks
+};
+
+class BlockAdjustment {
+ public:
+  /// Validates the options, computes starting values and builds every residual.
+  /// Throws InputError when the block cannot be started (an exposure without observations is
+  /// only reported; an observation whose ray misses every start is an input error).
+  BlockAdjustment(const Project& project, const AdjustOptions& options,
+                  SubimageObservations subimage = SubimageObservations::kMapWithCameraFile);
+  ~BlockAdjustment();
+  BlockAdjustment(const BlockAdjustment&) = delete;
+  BlockAdjustment& operator=(const BlockAdjustment&) = delete;
+
+  calib::ProblemBuilder& builder() { return builder_; }
+  /// Block ids (-1 when absent).
+  calib::BlockId InteriorBlock(const std::string& camera) const;
+  calib::BlockId RotationBlock(const std::string& image) const;
+  calib::BlockId CenterBlock(const std::string& image) const;
+  calib::BlockId PointBlock(const std::string& point) const;
+  /// Adds (or returns) the ground point block of `point`, starting at `start_m`.
+  calib::BlockId AddPoint(const std::string& point, const Eigen::Vector3d& start_m);
+
+  /// Solves (two stages when self-calibrating), snoops for gross errors, estimates the covariance
+  /// and compares control and check points. Never throws on non-convergence.
+  AdjustmentResult Run();
+
+ private:
+  struct Storage;
+  void BuildExposures();
+  void BuildPoints(SubimageObservations subimage);
+  void AddImageResiduals();
+  void AddPriors();
+
+  const Project& project_;
+  AdjustOptions options_;
+  calib::ProblemBuilder builder_;
+  std::unique_ptr<Storage> storage_;
+};
+
+/// Convenience: build and run.
+AdjustmentResult Adjust(const Project& project, const AdjustOptions& options);
+
+}  // namespace aerocal::triangulation
