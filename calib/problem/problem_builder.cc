@@ -433,7 +433,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
 
   ceres::Covariance::Options options;
   const int n_free = NumFreeParameters();
-  options.algorithm_type = n_free <= 1500 ? ceres::DENSE_SVD : ceres::SPARSE_QR;
+  options.algorithm_type = n_free <= 300 ? ceres::DENSE_SVD : ceres::SPARSE_QR;
   options.min_reciprocal_condition_number = 1e-14;
   options.num_threads = std::max(1u, std::thread::hardware_concurrency());
   options.apply_loss_function = true;
