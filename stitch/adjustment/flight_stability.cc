@@ -4,14 +4,17 @@
 #include <cmath>
 #include <cstdio>
 
+#include <Eigen/Cholesky>
+
 #include "calib/core/progress.h"
+#include "stitch/adjustment/f_test.h"
 #include "stitch/adjustment/mapping_param_names.h"
 
 namespace aerocal::stitch {
 namespace {
 
 struct Spread {
-  double mean = 0, std = 0, median = 0, robust_std = 0;
+  double mean = 0, std = 0, median = 0;
 };
 
 Spread SpreadOf(const std::vector<double>& x) {
@@ -28,9 +31,6 @@ Spread SpreadOf(const std::vector<double>& x) {
     return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
   };
   s.median = median(x);
-  std::vector<double> dev;
-  for (double v : x) dev.push_back(std::abs(v - s.median));
-  s.robust_std = 1.4826 * median(dev);
   return s;
 }
 
@@ -72,19 +72,30 @@ ModelStability ComputeStability(calib::MappingModel model,
       s.values.push_back(f->subimages.at(s.k).params.at(s.i));
       s.sigmas.push_back(f->subimages.at(s.k).sigma.at(s.i));
     }
-  const int n_tests = static_cast<int>(series.size()) + 1;
-  const double k = std::max(3.0, calib::NormalCriticalValue(alpha / (n_tests * frames.size())));
-  std::vector<FlaggedFrame> flags(frames.size());
-  char text[200];
-  auto check = [&](const Spread& spread, double value, size_t frame, const std::string& what) {
-    if (spread.robust_std <= 0) return;
-    const double z = (value - spread.median) / spread.robust_std;
-    if (std::abs(z) <= k) return;
-    std::snprintf(text, sizeof(text), "%s = %.6g is %.1f robust sigma from the flight median %.6g",
-                  what.c_str(), value, z, spread.median);
-    flags[frame].reasons.push_back(text);
-  };
-  for (size_t f = 0; f < frames.size(); ++f) check(sigma0_px, s0px[f], f, "sigma0_px");
+  const size_t n_frames = frames.size();
+  std::vector<FlaggedFrame> flags(n_frames);
+  char text[240];
+  // sigma0 against the pooled sigma0 of the flight.
+  double vtpv = 0, redundancy = 0;
+  for (const FrameAdjustment* f : frames) {
+    vtpv += f->vtpv;
+    redundancy += f->redundancy;
+  }
+  if (redundancy > 0 && vtpv > 0) {
+    const double pooled = vtpv / redundancy;
+    for (size_t f = 0; f < n_frames; ++f) {
+      if (frames[f]->redundancy <= 0) continue;
+      const double ratio = frames[f]->sigma0 * frames[f]->sigma0 / pooled;
+      const double critical =
+          FDistributionQuantile(1.0 - alpha / n_frames, frames[f]->redundancy, redundancy);
+      if (ratio <= critical) continue;
+      std::snprintf(text, sizeof(text),
+                    "sigma0_px = %.4g: F = sigma0^2 / pooled sigma0^2 = %.3g > %.3g", s0px[f],
+                    ratio, critical);
+      flags[f].reasons.push_back(text);
+    }
+  }
+  // Parameter table and the joint test per free sub-image.
   for (Series& s : series) {
     const Spread spread = SpreadOf(s.values);
     ParameterStability p;
@@ -94,8 +105,55 @@ ModelStability ComputeStability(calib::MappingModel model,
     p.std = spread.std;
     for (double v : s.sigmas) p.mean_sigma += v / s.sigmas.size();
     out.parameters.push_back(p);
-    for (size_t f = 0; f < frames.size(); ++f)
-      check(spread, s.values[f], f, "sub-image " + s.subimage + " " + s.name);
+  }
+  int n_free = 0;
+  for (const SubimageEstimate& e : first.subimages) n_free += !e.base;
+  for (size_t k = 0; k < first.subimages.size(); ++k) {
+    const SubimageEstimate& e0 = first.subimages[k];
+    if (e0.base) continue;
+    const int n = static_cast<int>(e0.params.size());
+    const double critical =
+        n * FDistributionQuantile(1.0 - alpha / (n_frames * std::max(1, n_free)), n, 1e7);
+    // d^2 of every frame against the mean of the other frames that are not out of line.
+    auto test = [&](const std::vector<bool>& use, std::vector<double>* d2) {
+      Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
+      int count = 0;
+      for (size_t f = 0; f < n_frames; ++f)
+        if (use[f]) {
+          sum += Eigen::Map<const Eigen::VectorXd>(frames[f]->subimages[k].params.data(), n);
+          ++count;
+        }
+      d2->assign(n_frames, 0.0);
+      for (size_t f = 0; f < n_frames; ++f) {
+        const SubimageEstimate& e = frames[f]->subimages[k];
+        const Eigen::Map<const Eigen::VectorXd> p(e.params.data(), n);
+        const int others = count - (use[f] ? 1 : 0);
+        if (others < 2 || e.covariance.rows() != n || e.covariance.isZero(0.0)) continue;
+        Eigen::VectorXd centre = sum;
+        if (use[f]) centre -= p;
+        centre /= others;
+        // Equilibrated (unit diagonal): plain parameters span 1e-9 (c1, c2) to 1e3 px (a0, b0).
+        const Eigen::VectorXd scale = e.covariance.diagonal().cwiseMax(1e-300).cwiseSqrt();
+        const Eigen::VectorXd dp = (p - centre).cwiseQuotient(scale);
+        const Eigen::MatrixXd correlation =
+            scale.cwiseInverse().asDiagonal() * e.covariance * scale.cwiseInverse().asDiagonal();
+        const Eigen::LDLT<Eigen::MatrixXd> ldlt((1.0 + 1.0 / others) * correlation);
+        if (ldlt.info() == Eigen::Success) (*d2)[f] = dp.dot(ldlt.solve(dp));
+      }
+    };
+    std::vector<bool> use(n_frames, true);
+    std::vector<double> d2;
+    test(use, &d2);
+    for (size_t f = 0; f < n_frames; ++f) use[f] = d2[f] <= critical;
+    test(use, &d2);  // again without the frames out of line in the reference
+    for (size_t f = 0; f < n_frames; ++f) {
+      if (d2[f] <= critical) continue;
+      std::snprintf(text, sizeof(text),
+                    "sub-image %s: mapping differs from the other frames' mean by chi2 = %.3g > "
+                    "%.3g (%d parameters)",
+                    e0.id.c_str(), d2[f], critical, n);
+      flags[f].reasons.push_back(text);
+    }
   }
   for (size_t f = 0; f < frames.size(); ++f)
     if (!flags[f].reasons.empty()) {

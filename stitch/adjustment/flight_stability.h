@@ -3,10 +3,18 @@
 // - mean and standard deviation over frames of sigma0 and sigma0_px;
 // - mean and standard deviation over frames of every mapping parameter, next to the mean of the
 //   per-frame reported sigmas (agreement of the two says the reported precision is realistic);
-// - frames out of line: a frame is flagged when its sigma0_px, or any of its mapping parameters,
-//   lies further than k robust standard deviations (1.4826 * MAD over frames) from the flight's
-//   median, with k = max(3, z(alpha / n_tests)) (Bonferroni over the n_tests values of the
-//   model, so that a stable flight flags a frame with probability about alpha).
+// - frames out of line, with tests whose false-alarm rate over the whole flight is about alpha
+//   (Bonferroni over frames and sub-images):
+//   * sigma0: F = sigma0_f^2 / sigma0_pooled^2 ~ F(r_f, sum r) for a frame like the others;
+//     flagged when F > F(1 - alpha / n_frames; r_f, sum r);
+//   * mapping of a free sub-image: d^2 = dp^T (c C_f)^-1 dp ~ chi^2(n_params), with dp the frame's
+//     plain parameters minus the mean of the other frames, C_f the frame's reported covariance
+//     and c = 1 + 1 / n_others for the mean's own noise; flagged when d^2 exceeds
+//     the chi^2 quantile at 1 - alpha / (n_frames * n_free_subimages). Frames found out of line
+//     in a first pass are left out of the means of a second. The mean, not the per-parameter
+//     median, keeps the centre consistent with strongly correlated parameters. The joint test uses the
+//     correlations: a corner parameter (a0, b0) may have a px-size sigma while a shift of the
+//     sub-image centre by a fraction of that is clearly out of line.
 #pragma once
 
 #include <optional>

@@ -123,17 +123,8 @@ TEST(AdjustFrame, FindsAndListsAPlantedGrossError) {
 TEST(AdjustFrame, RefusesAnUnderdeterminedModelNamingTheSubimage) {
   const auto camera = testing::MakeSimulatedCamera(2, 3, {"II", "V"}, 0.0, 10);
   auto frames = testing::SimulateFrames(camera, 1, 300, 14);
-  const int sub_i = camera.nominal.SubimageIndex("I");
-  // Keep only three ties that touch sub-image I: 6 equations, enough for affine, not projective.
-  std::vector<TieMeasurement> kept;
-  int touching = 0;
-  for (const auto& tie : frames[0].ties) {
-    bool on_i = false;
-    for (const auto& ray : tie.rays) on_i = on_i || ray.subimage == sub_i;
-    if (on_i && ++touching > 3) continue;
-    kept.push_back(tie);
-  }
-  frames[0].ties = kept;
+  // Three points on sub-image I: 6 equations, enough for affine (6), not projective (8).
+  testing::KeepTiesTouching(camera.nominal, "I", 3, &frames[0]);
   StitchOptions options;
   options.base_ids = camera.base;
   EXPECT_EQ(FindUnderdetermined(camera.nominal, frames[0], MappingModel::kAffine, options), "");
