@@ -118,8 +118,8 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
     nlohmann::json t = nlohmann::json::array();
     for (const auto& p : points)
       t.push_back({{"point", p.point},
-                   {"surveyed_m", Vec(p.surveyed_m)},
-                   {"adjusted_m", Vec(p.adjusted_m)},
+                   {"surveyed", Vec(p.surveyed_m)},
+                   {"adjusted", Vec(p.adjusted_m)},
                    {"difference_m", Vec(p.difference_m)},
                    {"rays", p.rays}});
     return t;

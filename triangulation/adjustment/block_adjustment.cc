@@ -352,7 +352,10 @@ AdjustmentResult BlockAdjustment::Run() {
           best = cov.correlation(i, k);
           partner = k;
         }
-      if (partner >= 0 && std::abs(best) > options_.correlation_threshold) {
+      const bool reported =
+          partner >= 0 && std::any_of(det.high_correlations.begin(), det.high_correlations.end(),
+                      [&](const calib::HighCorrelation& h) { return h.a == cov.names[partner] && h.b == cov.names[i]; });
+      if (partner >= 0 && !reported && std::abs(best) > options_.correlation_threshold) {
         det.high_correlations.push_back({cov.names[i], cov.names[partner], best});
         char text[512];
         std::snprintf(text, sizeof(text),

@@ -173,13 +173,19 @@ SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
   for (int extra = static_cast<int>(targets.size()); extra < o.control_points; ++extra)
     targets.push_back({x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min)});
   int control_id = 0;
+  // (The centre itself may lie in a two-fold overlap: look around it along the strip as well.)
+  const double step_x = 0.05 * footprint_x;
   for (const auto& target : targets) {
-    for (double t = 0.0; t <= 1.0; t += 0.01) {
-      const Eigen::Vector2d xy = target + t * (centre - target);
-      const Eigen::Vector3d p = ground(xy.x(), xy.y());
-      if (VisibleIn(f.truth, f.exposures_truth, p, margin_px).size() >= 3) {
-        add_point("C" + std::to_string(++control_id), p, PointRole::kControl);
-        break;
+    bool placed = false;
+    for (double t = 0.0; t <= 1.0 && !placed; t += 0.01) {
+      for (int k = 0; k <= 20 && !placed; ++k) {
+        const double dx = (k % 2 == 0 ? 1 : -1) * ((k + 1) / 2) * step_x;
+        const Eigen::Vector2d xy = target + t * (centre - target) + Eigen::Vector2d(dx, 0.0);
+        const Eigen::Vector3d p = ground(xy.x(), xy.y());
+        if (VisibleIn(f.truth, f.exposures_truth, p, margin_px).size() >= 3) {
+          add_point("C" + std::to_string(++control_id), p, PointRole::kControl);
+          placed = true;
+        }
       }
     }
   }

@@ -1,0 +1,87 @@
+// aerocal adjust on the simulated example flight: exit codes, result keys, --compare,
+// --write-camera (the in-flight calibration loop), bad input with nothing written.
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
+
+namespace aerocal {
+namespace {
+
+using testing::RunAerocal;
+using testing::TempDir;
+
+nlohmann::json ReadJson(const std::string& path) { return nlohmann::json::parse(ReadTextFile(path)); }
+
+class AdjustCommand : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto r = RunAerocal("simulate --out " + dir_.File("flight"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+  }
+  TempDir dir_{"aerocal_adjust_cli"};
+};
+
+TEST_F(AdjustCommand, CompareWritesBothRunsAndTheCamera) {
+  const auto r = RunAerocal("adjust --project " + dir_.File("flight/project.yaml") +
+                            " --compare --write-camera " + dir_.File("next/camera.yaml") +
+                            " --out " + dir_.File("result.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("conventional"), std::string::npos);
+  EXPECT_NE(r.output.find("check RMSE Z"), std::string::npos);
+  EXPECT_NE(r.output.find("is not separable"), std::string::npos);  // c ~ heights, no GNSS
+  const auto j = ReadJson(dir_.File("result.json"));
+  for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations",
+                          "converged", "cameras", "control", "check", "exposures", "rejected",
+                          "comparison", "frame"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  EXPECT_TRUE(j["converged"].get<bool>());
+  const auto& cmp = j["comparison"];
+  EXPECT_GE(cmp["check_spatial_rmse_ratio"].get<double>(), 1.5);
+  EXPECT_EQ(cmp["calibration"].size(), 10u);
+  // The written camera holds the estimate and carries the sub-images along.
+  const calib::Camera camera = calib::ReadCamera(dir_.File("next/camera.yaml"));
+  const calib::Camera nominal = calib::ReadCamera(dir_.File("flight/camera_nominal.yaml"));
+  EXPECT_NEAR(camera.c_mm(), j["cameras"][0]["estimated"]["c"].get<double>(), 1e-9);
+  EXPECT_EQ(camera.subimages.size(), nominal.subimages.size());
+  // Next run from the written camera: the conventional adjustment now fits like the calibrated one.
+  std::string project = ReadTextFile(dir_.File("flight/project.yaml"));
+  project.replace(project.find("camera_nominal.yaml"), 19, dir_.File("next/camera.yaml"));
+  WriteFileAtomically(dir_.File("flight/project_next.yaml"), project);
+  const auto next = RunAerocal("adjust --project " + dir_.File("flight/project_next.yaml") +
+                               " --out " + dir_.File("next.json"));
+  ASSERT_EQ(next.exit_code, 0) << next.output;
+  const auto n = ReadJson(dir_.File("next.json"));
+  EXPECT_NEAR(n["check"]["spatial_rmse_m"].get<double>(),
+              cmp["self_calibration"]["check"]["spatial_rmse_m"].get<double>(), 0.05);
+}
+
+TEST_F(AdjustCommand, BadInputExitsTwoAndWritesNothing) {
+  std::ofstream(dir_.File("flight/exposures.csv"), std::ios::app) << "0099,cam1,1,2,x,0,0,0\n";
+  const auto r = RunAerocal("adjust --project " + dir_.File("flight/project.yaml") +
+                            " --self-calibration all --out " + dir_.File("bad.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("exposures.csv:39"), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_.File("bad.json")));
+  const auto unknown = RunAerocal("adjust --project " + dir_.File("flight/project.yaml") +
+                                  " --self-calibration c,k1 --out " + dir_.File("bad.json"));
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_.File("bad.json")));
+}
+
+TEST_F(AdjustCommand, NotConvergedExitsThreeWithTheResultWritten) {
+  const auto r = RunAerocal("adjust --project " + dir_.File("flight/project.yaml") +
+                            " --self-calibration all --max-iterations 1 --write-camera " +
+                            dir_.File("cam.yaml") + " --out " + dir_.File("r.json"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_FALSE(ReadJson(dir_.File("r.json"))["converged"].get<bool>());
+  EXPECT_FALSE(std::filesystem::exists(dir_.File("cam.yaml")));
+}
+
+}  // namespace
+}  // namespace aerocal

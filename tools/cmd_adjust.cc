@@ -1,0 +1,123 @@
+// aerocal adjust: self-calibrating bundle block adjustment with control and check points
+// (triangulation/adjustment). Parsing, loading, calling the library, writing results.
+#include <cstdio>
+#include <filesystem>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "tools/command_registry.h"
+#include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/block/block_io.h"
+#include "triangulation/georef/object_frame.h"
+
+namespace aerocal::tools {
+namespace {
+
+using triangulation::AdjustmentResult;
+
+// OUT.yaml for a single camera, OUT_<id>.yaml for each of several.
+std::string CameraOutputPath(const std::string& out, const std::string& id, bool several) {
+  if (!several) return out;
+  const std::filesystem::path p(out);
+  return (p.parent_path() / (p.stem().string() + "_" + id + p.extension().string())).string();
+}
+
+CommandRun SetupAdjust(CLI::App& app) {
+  struct Args {
+    std::string project, out, write_camera, self_calibration = "none";
+    bool compare = false, no_snooping = false, no_eo_priors = false, no_interior_sigma = false;
+    double default_sigma_px = 0.5;
+    triangulation::AdjustOptions options;
+  };
+  auto args = std::make_shared<Args>();
+  app.add_option("--project", args->project, "Project YAML (or folder with project.yaml), FORMATS.md")->required();
+  app.add_option("--out", args->out, "Result JSON (written atomically)")->required();
+  app.add_option("--self-calibration", args->self_calibration,
+                 "Interior parameters to estimate: none (conventional, default), all, or a list "
+                 "such as c,x0,y0,K1,K2");
+  app.add_flag("--compare", args->compare,
+               "Run the conventional and the self-calibrating adjustment and compare them "
+               "(self-calibration: the --self-calibration list, or all)");
+  app.add_option("--write-camera", args->write_camera,
+                 "Write the estimated camera file (camera-file YAML) for the next run");
+  app.add_option("--sigma-px", args->default_sigma_px,
+                 "Image sigma where observations.csv has no sigma_px, px")->check(CLI::PositiveNumber);
+  app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
+  app.add_option("--critical-value", args->options.snooping_critical_value,
+                 "Critical |w| of data snooping (0: from alpha = 5 % / n)")->check(CLI::NonNegativeNumber);
+  app.add_flag("--no-eo-priors", args->no_eo_priors,
+               "Ignore the GNSS/IMU sigma columns of exposures.csv (starting values only)");
+  app.add_flag("--no-interior-sigma", args->no_interior_sigma,
+               "Ignore the camera file's interior_sigma (unweighted self-calibration)");
+  app.add_option("--max-iterations", args->options.solver.max_iterations, "Solver iterations")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--correlation-threshold", args->options.correlation_threshold,
+                 "Report parameter pairs correlated above this")->check(CLI::Range(0.0, 1.0));
+  return [args]() {
+    auto options = args->options;
+    options.data_snooping = !args->no_snooping;
+    options.use_eo_priors = !args->no_eo_priors;
+    options.use_interior_sigma = !args->no_interior_sigma;
+    options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
+    options.Validate();
+    if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
+      throw ConfigError("--write-camera needs a self-calibrating run (--self-calibration or --compare)");
+
+    const triangulation::Project input = triangulation::ReadProject(args->project, args->default_sigma_px);
+    const triangulation::ObjectFrame frame(input.frame);
+    const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
+
+    auto run = [&](const std::vector<std::string>& free) {
+      auto o = options;
+      o.free_interior = free;
+      AdjustmentResult r = triangulation::Adjust(project, o);
+      triangulation::ToInputFrame(frame, &r);
+      return r;
+    };
+    nlohmann::json json;
+    AdjustmentResult main;
+    if (args->compare) {
+      const auto self_list =
+          options.free_interior.empty() ? triangulation::ParseSelfCalibration("all") : options.free_interior;
+      const AdjustmentResult conventional = run({});
+      main = run(self_list);
+      std::printf("%s", triangulation::FormatComparison(conventional, main).c_str());
+      json = triangulation::AdjustmentToJson(main);
+      json["comparison"] = triangulation::ComparisonToJson(conventional, main);
+      json["conventional"] = triangulation::AdjustmentToJson(conventional);
+      main.solve.converged = main.solve.converged && conventional.solve.converged;
+    } else {
+      main = run(options.free_interior);
+      std::printf("%s", triangulation::FormatSummary(main).c_str());
+      json = triangulation::AdjustmentToJson(main);
+    }
+    json["project"] = args->project;
+    WriteFileAtomically(args->out, json.dump(2) + "\n");
+    const bool ok = main.solve.converged && main.determinability.covariance_ok;
+    if (!args->write_camera.empty()) {
+      if (!ok) {
+        std::fprintf(stderr, "camera not written: the adjustment %s\n",
+                     main.solve.converged ? "cannot determine every parameter" : "did not converge");
+      } else {
+        for (const auto& estimate : main.cameras) {
+          const std::string path =
+              CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);
+          calib::WriteCamera(path, triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate));
+          std::printf("camera %s -> %s\n", estimate.id.c_str(), path.c_str());
+        }
+      }
+    }
+    std::printf("result -> %s\n", args->out.c_str());
+    return ok ? kExitOk : kExitNotConverged;
+  };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(adjust, "adjust",
+                         "Bundle block adjustment (conventional or self-calibrating) with control and "
+                         "check points",
+                         SetupAdjust);
+
+}  // namespace aerocal::tools
