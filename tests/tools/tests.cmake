@@ -1,1 +1,2 @@
 aerocal_add_test(tools/cli_simulate LIBS aerocal::triangulation LABELS cli)
+aerocal_add_test(tools/cli_flight LIBS aerocal::calib LABELS cli TIMEOUT 600)

@@ -1,0 +1,102 @@
+// `aerocal flight` on a simulated flight: the workflow finishes, result.json has the FORMATS.md
+// keys of every step, the calibrated camera is written, and report.html holds the tables and plots.
+#include <filesystem>
+#include <fstream>
+#include <regex>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
+
+namespace aerocal {
+namespace {
+
+class FlightWorkflow : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new testing::TempDir("aerocal_flight");
+    const auto sim = testing::RunAerocal("simulate --out " + dir_->File("data") +
+                                         " --seed 3 --stitch-ties 200 --gnss-sigma-m 0.05");
+    ASSERT_EQ(sim.exit_code, 0) << sim.output;
+    run_ = new testing::CommandResult(testing::RunAerocal(
+        "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " + dir_->File("data") +
+        " --base III,IV --out " + dir_->File("report")));
+  }
+  static void TearDownTestSuite() {
+    delete run_;
+    delete dir_;
+  }
+  static testing::TempDir* dir_;
+  static testing::CommandResult* run_;
+};
+testing::TempDir* FlightWorkflow::dir_ = nullptr;
+testing::CommandResult* FlightWorkflow::run_ = nullptr;
+
+TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
+  EXPECT_EQ(doc["kind"], "flight");
+  const auto& stitching = doc["stitching"];
+  for (const char* key : {"kind", "sigma0", "sigma0_px", "redundancy", "iterations", "converged", "model",
+                          "subimages", "frames", "stability"})
+    EXPECT_TRUE(stitching.contains(key)) << "stitching." << key;
+  EXPECT_EQ(stitching["frames"].size(), 37u);
+  EXPECT_NEAR(stitching["stability"]["mean_sigma0_px"].get<double>(), 0.1, 0.01);
+  ASSERT_EQ(doc["adjustments"].size(), 3u);
+  const char* names[] = {"conventional", "self_calibration", "joint"};
+  for (int i = 0; i < 3; ++i) {
+    const auto& a = doc["adjustments"][i];
+    EXPECT_EQ(a["name"], names[i]);
+    for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations", "converged",
+                            "cameras", "control", "check", "exposures", "rejected"})
+      EXPECT_TRUE(a.contains(key)) << names[i] << "." << key;
+    EXPECT_EQ(a["kind"], "adjust");
+    EXPECT_TRUE(a["converged"].get<bool>());
+    EXPECT_EQ(a["check"]["rmse_m"].size(), 3u);
+  }
+  // Image sigma 0.2 px injected: sigma0 in px at the noise level for the self-calibrating runs.
+  EXPECT_NEAR(doc["adjustments"][1]["sigma0_px"].get<double>(), 0.2, 0.02);
+  EXPECT_NEAR(doc["adjustments"][2]["sigma0_px"].get<double>(), 0.2, 0.02);
+  EXPECT_TRUE(doc["adjustments"][2].contains("subimages"));
+  // Self-calibration removes the systematic error the conventional run shows in the check points.
+  const auto spatial = [&](int i) {
+    const auto& r = doc["adjustments"][i]["check"]["rmse_m"];
+    return std::sqrt(std::pow(r[0].get<double>(), 2) + std::pow(r[1].get<double>(), 2) + std::pow(r[2].get<double>(), 2));
+  };
+  EXPECT_GT(spatial(0), 1.5 * spatial(1));
+  // The calibrated camera reads back and carries the estimate.
+  const auto camera = calib::ReadCamera(dir_->File("report/camera_calibrated.yaml"));
+  const auto truth = calib::ReadCamera(dir_->File("data/camera_truth.yaml"));
+  EXPECT_NEAR(camera.interior[0], truth.interior[0], 0.01);
+  EXPECT_EQ(camera.subimages.size(), 6u);
+}
+
+TEST_F(FlightWorkflow, ReportHoldsTablesAndPlots) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const std::string html = ReadTextFile(dir_->File("report/report.html"));
+  const std::regex image("<img[^>]+src=\"data:image/png;base64,");
+  const auto images = std::distance(std::sregex_iterator(html.begin(), html.end(), image), std::sregex_iterator());
+  EXPECT_GE(images, 4) << "sigma0 per exposure, residual vectors, distortion curves, check-point map";
+  EXPECT_GE(std::count(html.begin(), html.end(), '<') , 100);
+  for (const char* text : {"<table", "conventional", "self", "joint", "sigma0", "RMSE", "K1", "stability"})
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  EXPECT_EQ(html.find("http://"), std::string::npos) << "the page must not need the network";
+  EXPECT_EQ(html.find("https://"), std::string::npos) << "the page must not need the network";
+}
+
+TEST(FlightWorkflowInput, MissingProjectIsABadInput) {
+  testing::TempDir dir;
+  std::filesystem::create_directories(dir.File("data"));
+  std::ofstream(dir.File("cam.yaml")) << "pixel_size_mm: 0.009\nformat_px: [100, 100]\ninterior: {c: 50}\n";
+  const auto r = testing::RunAerocal("flight --camera " + dir.File("cam.yaml") + " --data " + dir.File("data") +
+                                     " --out " + dir.File("out"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("project.yaml"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("out/result.json")));
+}
+
+}  // namespace
+}  // namespace aerocal

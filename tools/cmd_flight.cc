@@ -1,0 +1,84 @@
+// aerocal flight: the whole calibration workflow of one flight, with a report for people
+// (triangulation/workflow/flight_workflow.h; report by tools/report/aerocal_report.py).
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <sstream>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/progress.h"
+#include "tools/command_registry.h"
+#include "triangulation/workflow/flight_workflow.h"
+
+namespace aerocal::tools {
+namespace {
+
+std::string ShellQuote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+std::vector<std::string> SplitList(const std::string& text) {
+  std::vector<std::string> out;
+  std::stringstream in(text);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+CommandRun SetupFlight(CLI::App& app) {
+  struct Args {
+    triangulation::FlightWorkflowOptions options;
+    std::string out, base, report_script;
+    bool no_report = false;
+  };
+  auto args = std::make_shared<Args>();
+  app.add_option("--camera", args->options.camera_file, "Camera file (YAML) used by every step")->required();
+  app.add_option("--data", args->options.data_folder,
+                 "Flight folder: project.yaml (virtual-image observations), optional project_subimage.yaml "
+                 "(raw sub-image observations) and the stitching measurements the project names")
+      ->required();
+  app.add_option("--out", args->out, "Report folder: result.json, report.html, camera_calibrated.yaml")->required();
+  app.add_option("--base", args->base, "Base sub-images holding the datum of the focal plane (default: reference points)");
+  app.add_option("--stitch-sigma-px", args->options.stitch_sigma_px, "Stitching sigma where the file has none, px")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--no-joint", [args](std::int64_t) { args->options.joint = false; }, "Skip the joint adjustment");
+  app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
+  return [args]() {
+    args->options.base_ids = SplitList(args->base);
+    Progress progress("flight", 5);
+    const auto result = triangulation::RunFlightWorkflow(args->options, &progress);
+    progress.Finish();
+    namespace fs = std::filesystem;
+    const std::string json_path = (fs::path(args->out) / "result.json").string();
+    nlohmann::json document = result.document;
+    document["aerocal_version"] = AEROCAL_VERSION;
+    WriteFileAtomically(json_path, document.dump(2) + "\n");
+    calib::WriteCamera((fs::path(args->out) / "camera_calibrated.yaml").string(), result.calibrated_camera);
+    for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
+    if (!args->no_report) {
+      const char* env = std::getenv("AEROCAL_REPORT_SCRIPT");
+      const std::string script = env ? env : AEROCAL_REPORT_SCRIPT;
+      const std::string html = (fs::path(args->out) / "report.html").string();
+      const std::string command = "python3 " + ShellQuote(script) + " " + ShellQuote(json_path) + " " + ShellQuote(html);
+      if (std::system(command.c_str()) != 0) {
+        std::fprintf(stderr, "error: the report could not be written (%s); result.json is complete\n", command.c_str());
+        return kExitInternal;
+      }
+      std::printf("report: %s\n", html.c_str());
+    }
+    return result.converged ? kExitOk : kExitNotConverged;
+  };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(flight, "flight",
+                         "Calibrate a flight: stitching, conventional / self-calibrating / joint adjustment, report",
+                         SetupFlight);
+
+}  // namespace aerocal::tools

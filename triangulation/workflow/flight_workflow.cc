@@ -1,0 +1,128 @@
+#include "triangulation/workflow/flight_workflow.h"
+
+#include <cstdio>
+#include <filesystem>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/error.h"
+#include "calib/core/progress.h"
+#include "stitch/adjustment/flight_stability.h"
+#include "stitch/adjustment/frame_measurements.h"
+#include "stitch/io/stitch_result_json.h"
+#include "stitch/simulation/stitch_simulator.h"
+#include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/block/block_io.h"
+#include "triangulation/joint/joint_adjustment.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+namespace fs = std::filesystem;
+
+// The project with every exposure using `camera` (a flight of one camera).
+Project WithCamera(Project project, const calib::Camera& camera, const std::string& camera_file) {
+  if (project.cameras.size() != 1)
+    ThrowInputError({project.path, 0}, "the flight workflow takes a block of one camera (found " +
+                                           std::to_string(project.cameras.size()) + ")");
+  const std::string id = project.cameras.begin()->first;
+  project.cameras[id] = camera;
+  project.camera_files[id] = camera_file;
+  return project;
+}
+
+std::string Line(const char* format, double a, double b, double c) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer), format, a, b, c);
+  return buffer;
+}
+
+}  // namespace
+
+FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Progress* progress) {
+  FlightWorkflowResult out;
+  const calib::Camera camera = calib::ReadCamera(options.camera_file);
+  const std::string virtual_project = (fs::path(options.data_folder) / "project.yaml").string();
+  const std::string subimage_project = (fs::path(options.data_folder) / "project_subimage.yaml").string();
+  if (!fs::exists(virtual_project))
+    throw InputError(options.data_folder + ": no project.yaml (the block with virtual-image observations)");
+  const Project project = WithCamera(ReadProject(virtual_project), camera, options.camera_file);
+
+  nlohmann::json& doc = out.document;
+  doc["kind"] = "flight";
+  doc["camera"] = options.camera_file;
+  doc["data"] = options.data_folder;
+  doc["camera_format"] = {{"width_px", camera.width_px},
+                          {"height_px", camera.height_px},
+                          {"pixel_size_mm", camera.pixel_size_mm}};
+  doc["base_subimages"] = options.base_ids;
+
+  // 1. Stitching of every exposure, model chosen per frame by the F test, and stability.
+  if (!project.stitching_file.empty() && !camera.subimages.empty()) {
+    const auto rows = stitch::ReadStitchObservations(project.stitching_file, options.stitch_sigma_px);
+    const auto frames = stitch::GroupByFrame(camera, rows, project.stitching_file);
+    stitch::BatchOptions batch;
+    batch.stitch.base_ids = options.base_ids;
+    const stitch::BatchResult result = stitch::RunStitchBatch(camera, frames, batch, nullptr);
+    doc["stitching"] = stitch::StitchResultToJson(result, batch);
+    char line[256];
+    std::snprintf(line, sizeof(line), "stitching: %zu exposures, sigma0 %.3f px, model %s", frames.size(),
+                  doc["stitching"].value("sigma0_px", 0.0), doc["stitching"].value("model", std::string("?")).c_str());
+    out.summary.push_back(line);
+  } else {
+    out.summary.push_back("stitching: no stitching measurements in the project");
+  }
+  if (progress) progress->Advance();
+
+  // 2. Conventional and self-calibrating triangulation on the virtual-image observations.
+  nlohmann::json adjustments = nlohmann::json::array();
+  AdjustOptions conventional_options;
+  const AdjustmentResult conventional = Adjust(project, conventional_options);
+  if (progress) progress->Advance();
+  AdjustOptions self_options;
+  self_options.free_interior = options.free_interior;
+  const AdjustmentResult self_calibration = Adjust(project, self_options);
+  if (progress) progress->Advance();
+  nlohmann::json a = AdjustmentToJson(conventional);
+  a["name"] = "conventional";
+  adjustments.push_back(a);
+  nlohmann::json b = AdjustmentToJson(self_calibration);
+  b["name"] = "self_calibration";
+  adjustments.push_back(b);
+  doc["comparison"] = ComparisonToJson(conventional, self_calibration);
+  out.converged = conventional.converged() && self_calibration.converged();
+  out.calibrated_camera = UpdatedCamera(camera, self_calibration.cameras.at(0));
+  for (const auto* r : {&conventional, &self_calibration})
+    out.summary.push_back(std::string(r == &conventional ? "conventional" : "self-calibration") +
+                          Line(": sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)", r->sigma0_px,
+                               r->check.spatial_rmse_m, r->check.n));
+
+  // 3. Joint stitching + triangulation on the raw sub-image observations.
+  if (options.joint && fs::exists(subimage_project) && !camera.subimages.empty()) {
+    const Project raw = WithCamera(ReadProject(subimage_project), camera, options.camera_file);
+    JointOptions joint_options;
+    joint_options.adjust = self_options;
+    joint_options.base_ids = options.base_ids;
+    joint_options.stitch_sigma_px = options.stitch_sigma_px;
+    const JointResult joint = AdjustJoint(raw, joint_options);
+    nlohmann::json j = JointResultToJson(joint);
+    j["name"] = "joint";
+    adjustments.push_back(j);
+    out.converged = out.converged && joint.adjustment.converged();
+    out.calibrated_camera = UpdatedCamera(camera, joint.adjustment.cameras.at(0));
+    for (const auto& m : joint.mappings) {
+      if (!m.exposure.empty()) continue;
+      const int k = out.calibrated_camera.SubimageIndex(m.subimage);
+      if (k >= 0) out.calibrated_camera.subimages[k].params = m.params;
+    }
+    out.summary.push_back(Line("joint: sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)",
+                               joint.adjustment.sigma0_px, joint.adjustment.check.spatial_rmse_m,
+                               joint.adjustment.check.n));
+  }
+  if (progress) progress->Advance();
+  doc["adjustments"] = adjustments;
+  doc["converged"] = out.converged;
+  if (progress) progress->Advance();
+  return out;
+}
+
+}  // namespace aerocal::triangulation

@@ -1,0 +1,44 @@
+// The flight workflow a calibration lab runs on one flight of a multi-CCD camera
+// (`aerocal flight`):
+//   1. per-exposure stitching with model comparison (F test) and the flight's stability;
+//   2. conventional triangulation, then self-calibrating triangulation (10 parameters), then the
+//      joint stitching + triangulation adjustment (when raw sub-image observations exist);
+//   3. one result document (kind "flight") holding every step's FORMATS.md result, and the
+//      calibrated camera for the next flight.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/camera.h"
+
+namespace aerocal {
+class Progress;
+}
+
+namespace aerocal::triangulation {
+
+struct FlightWorkflowOptions {
+  std::string camera_file;  // camera for every step (overrides the projects' camera files)
+  std::string data_folder;  // project.yaml (virtual observations), optional project_subimage.yaml
+  std::vector<std::string> base_ids;  // datum of the focal plane; empty: the reference points
+  std::vector<std::string> free_interior = {"c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
+  double stitch_sigma_px = 0.1;  // where stitch_obs.csv has no sigma_px
+  bool joint = true;             // run the joint adjustment when sub-image observations exist
+};
+
+struct FlightWorkflowResult {
+  nlohmann::json document;          // kind "flight"
+  calib::Camera calibrated_camera;  // interior (and mappings, when joint) for the next flight
+  bool converged = true;            // every adjustment converged
+  std::vector<std::string> summary; // one line per step, for the terminal
+};
+
+/// Runs the workflow; `progress` (may be null) advances once per step (5 steps).
+/// Throws InputError for unreadable or inconsistent input.
+FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Progress* progress);
+
+}  // namespace aerocal::triangulation
