@@ -2,5 +2,6 @@
 aerocal_add_test(stitch/stitch_adjustment LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/model_selection LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/flight_stability LIBS aerocal::stitch LABELS synthetic)
-aerocal_add_test(stitch/match_real LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/match_lsm LIBS aerocal::stitch LABELS unit)
+aerocal_add_test(stitch/virtual_image LIBS aerocal::stitch LABELS synthetic)
+aerocal_add_test(stitch/tiff_raster LIBS aerocal::stitch LABELS unit)

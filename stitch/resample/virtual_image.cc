@@ -1,0 +1,261 @@
+#include "stitch/resample/virtual_image.h"
+
+#include <algorithm>
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstring>
+#include <limits>
+
+#include <Eigen/LU>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
+#include "calib/core/error.h"
+
+namespace aerocal::stitch {
+namespace {
+
+// The part of one sub-image a strip needs: a window of samples and the virtual -> window map.
+struct Window {
+  bool used = false;
+  int x0 = 0, y0 = 0, w = 0, h = 0;      // in sub-image pixels
+  int width_px = 0, height_px = 0;       // sub-image format
+  Eigen::Matrix3d sub_from_virtual;      // homogeneous
+  std::vector<std::uint8_t> bytes;
+};
+
+// Keys (1981) cubic convolution weights, a = -0.5, for fractional offset t in [0, 1].
+inline void CubicWeights(float t, float* w) {
+  const float t2 = t * t, t3 = t2 * t;
+  w[0] = -0.5f * t3 + t2 - 0.5f * t;
+  w[1] = 1.5f * t3 - 2.5f * t2 + 1.0f;
+  w[2] = -1.5f * t3 + 2.0f * t2 + 0.5f * t;
+  w[3] = 0.5f * t3 - 0.5f * t2;
+}
+
+// Columns [first, last] of virtual row V whose (u, v) lies inside the sub-image's pixel centres.
+// With [x y w]^T = M [U V 1]^T and w > 0, u >= 0 <=> x >= 0, u <= W-1 <=> (W-1) w - x >= 0, ...:
+// each bound is a U + b >= 0.
+bool CoveredColumns(const Window& win, double V, int virtual_width, int* first, int* last) {
+  const Eigen::Matrix3d& m = win.sub_from_virtual;
+  double lo = 0.0, hi = virtual_width - 1.0;
+  auto bound = [&](double a, double b) {  // a U + b >= 0
+    if (std::abs(a) < 1e-15) {
+      if (b < 0) hi = -1.0;
+      return;
+    }
+    const double root = -b / a;
+    if (a > 0) lo = std::max(lo, root);
+    else hi = std::min(hi, root);
+  };
+  const double W = win.width_px - 1.0, H = win.height_px - 1.0;
+  const double xa = m(0, 0), xb = m(0, 1) * V + m(0, 2);
+  const double ya = m(1, 0), yb = m(1, 1) * V + m(1, 2);
+  const double wa = m(2, 0), wb = m(2, 1) * V + m(2, 2);
+  bound(wa, wb - 1e-12);
+  bound(xa, xb);
+  bound(W * wa - xa, W * wb - xb);
+  bound(ya, yb);
+  bound(H * wa - ya, H * wb - yb);
+  // Rounding at the bounds: keep pixels within 1e-9 px of the edge.
+  *first = static_cast<int>(std::ceil(lo - 1e-9));
+  *last = static_cast<int>(std::floor(hi + 1e-9));
+  *first = std::max(*first, 0);
+  *last = std::min(*last, virtual_width - 1);
+  return *first <= *last;
+}
+
+template <typename T, int kBands>
+void AccumulateRow(const Window& win, Interpolation interpolation, double V, int first, int last,
+                   float* sum, std::uint8_t* count) {
+  const T* data = reinterpret_cast<const T*>(win.bytes.data());
+  const int stride = win.w * kBands;
+  const Eigen::Matrix3d& m = win.sub_from_virtual;
+  double x = m(0, 0) * first + m(0, 1) * V + m(0, 2) - win.x0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
+  double y = m(1, 0) * first + m(1, 1) * V + m(1, 2) - win.y0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
+  double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
+  const double dx = m(0, 0) - win.x0 * m(2, 0), dy = m(1, 0) - win.y0 * m(2, 0), dw = m(2, 0);
+  const float max_u = static_cast<float>(win.w - 1), max_v = static_cast<float>(win.h - 1);
+  for (int c = first; c <= last; ++c, x += dx, y += dy, w += dw) {
+    const float u = std::clamp(static_cast<float>(x / w), 0.0f, max_u);
+    const float v = std::clamp(static_cast<float>(y / w), 0.0f, max_v);
+    float* out = sum + c * kBands;
+    ++count[c];
+    if (interpolation == Interpolation::kBilinear) {
+      const int iu = std::min(static_cast<int>(u), std::max(win.w - 2, 0));
+      const int iv = std::min(static_cast<int>(v), std::max(win.h - 2, 0));
+      const float fu = u - iu, fv = v - iv;
+      const int du = win.w > 1 ? kBands : 0, dv = win.h > 1 ? stride : 0;
+      const T* p = data + iv * stride + iu * kBands;
+      for (int b = 0; b < kBands; ++b) {
+        const float top = p[b] + fu * (static_cast<float>(p[b + du]) - p[b]);
+        const float bottom = p[b + dv] + fu * (static_cast<float>(p[b + dv + du]) - p[b + dv]);
+        out[b] += top + fv * (bottom - top);
+      }
+      continue;
+    }
+    const int iu = static_cast<int>(u), iv = static_cast<int>(v);
+    float wu[4], wv[4];
+    CubicWeights(u - iu, wu);
+    CubicWeights(v - iv, wv);
+    int cols[4], rows[4];
+    for (int k = 0; k < 4; ++k) {
+      cols[k] = std::clamp(iu - 1 + k, 0, win.w - 1) * kBands;
+      rows[k] = std::clamp(iv - 1 + k, 0, win.h - 1) * stride;
+    }
+    for (int b = 0; b < kBands; ++b) {
+      float acc = 0.0f;
+      for (int r = 0; r < 4; ++r) {
+        const T* row = data + rows[r] + b;
+        acc += wv[r] * (wu[0] * row[cols[0]] + wu[1] * row[cols[1]] + wu[2] * row[cols[2]] +
+                        wu[3] * row[cols[3]]);
+      }
+      out[b] += acc;
+    }
+  }
+}
+
+template <typename T, int kBands>
+void ResampleStrip(std::vector<Window>& windows, const ResampleOptions& options, int width,
+                   int y0, int rows, std::vector<std::uint8_t>* strip, std::atomic<long>* covered,
+                   std::atomic<long>* overlap) {
+  const float max_value = static_cast<float>(std::numeric_limits<T>::max());
+  const float fill = std::clamp(static_cast<float>(options.fill), 0.0f, max_value);
+  tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& range) {
+    std::vector<float> sum(static_cast<size_t>(width) * kBands);
+    std::vector<std::uint8_t> count(width);
+    long n_covered = 0, n_overlap = 0;
+    for (int r = range.begin(); r < range.end(); ++r) {
+      std::fill(sum.begin(), sum.end(), 0.0f);
+      std::fill(count.begin(), count.end(), 0);
+      const double V = y0 + r;
+      for (const Window& win : windows) {
+        int first = 0, last = -1;
+        if (!win.used || !CoveredColumns(win, V, width, &first, &last)) continue;
+        AccumulateRow<T, kBands>(win, options.interpolation, V, first, last, sum.data(),
+                                 count.data());
+      }
+      T* out = reinterpret_cast<T*>(strip->data()) + static_cast<size_t>(r) * width * kBands;
+      for (int c = 0; c < width; ++c) {
+        const int n = count[c];
+        n_covered += n > 0;
+        n_overlap += n > 1;
+        const float scale = n > 0 ? 1.0f / n : 0.0f;
+        for (int b = 0; b < kBands; ++b) {
+          const float value = n > 0 ? sum[c * kBands + b] * scale : fill;
+          out[c * kBands + b] = static_cast<T>(std::clamp(value + 0.5f, 0.0f, max_value));
+        }
+      }
+    }
+    *covered += n_covered;
+    *overlap += n_overlap;
+  });
+}
+
+}  // namespace
+
+Interpolation ParseInterpolation(const std::string& name) {
+  if (name == "bilinear") return Interpolation::kBilinear;
+  if (name == "bicubic") return Interpolation::kBicubic;
+  throw ConfigError("interpolation must be bilinear or bicubic (got '" + name + "')");
+}
+
+std::string MappingDescription(const calib::Camera& camera, const std::string& source) {
+  std::string text = "aerocal virtual image " + std::to_string(camera.width_px) + " x " +
+                     std::to_string(camera.height_px) + " px of camera '" + camera.name +
+                     "'; mappings from " + source + "; sub-image model width height params:\n";
+  char number[32];
+  for (const auto& s : camera.subimages) {
+    text += s.id + " " + std::string(calib::MappingModelName(s.model)) + " " +
+            std::to_string(s.width_px) + " " + std::to_string(s.height_px);
+    for (double p : s.params) {
+      std::snprintf(number, sizeof(number), " %.17g", p);
+      text += number;
+    }
+    text += "\n";
+  }
+  return text;
+}
+
+ResampleReport ResampleVirtualImage(const calib::Camera& camera,
+                                    const std::vector<RasterSource*>& sources, RasterSink* sink,
+                                    const ResampleOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  AEROCAL_CHECK(sources.size() == camera.subimages.size())
+      << sources.size() << " sources for " << camera.subimages.size() << " sub-images";
+  AEROCAL_CHECK(options.strip_rows > 0) << options.strip_rows;
+  const RasterInfo first = sources.front()->Info();
+  std::vector<Window> windows(sources.size());
+  for (size_t k = 0; k < sources.size(); ++k) {
+    const auto& s = camera.subimages[k];
+    const RasterInfo info = sources[k]->Info();
+    if (info.width != s.width_px || info.height != s.height_px)
+      throw InputError("sub-image " + s.id + ": image is " + std::to_string(info.width) + " x " +
+                       std::to_string(info.height) + " px, the camera file says " +
+                       std::to_string(s.width_px) + " x " + std::to_string(s.height_px));
+    if (info.bits != first.bits || info.bands != first.bands)
+      throw InputError("sub-image " + s.id + ": " + std::to_string(info.bits) + " bit, " +
+                       std::to_string(info.bands) + " band(s), unlike sub-image " +
+                       camera.subimages[0].id);
+    windows[k].width_px = s.width_px;
+    windows[k].height_px = s.height_px;
+    windows[k].sub_from_virtual = calib::HomographyFromParams(s.model, s.params.data()).inverse();
+  }
+  const int width = camera.width_px, height = camera.height_px;
+  const RasterInfo out_info{width, height, first.bands, first.bits};
+  std::vector<std::uint8_t> strip(out_info.RowBytes() * options.strip_rows);
+  std::atomic<long> covered{0}, overlap{0};
+  tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
+  const int margin = options.interpolation == Interpolation::kBicubic ? 3 : 2;
+  for (int y0 = 0; y0 < height; y0 += options.strip_rows) {
+    const int rows = std::min(options.strip_rows, height - y0);
+    // Window of each sub-image: bounding box of the strip's corners mapped into it, plus margin.
+    for (size_t k = 0; k < windows.size(); ++k) {
+      Window& win = windows[k];
+      double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+      for (double U : {0.0, width - 1.0})
+        for (double V : {static_cast<double>(y0), y0 + rows - 1.0}) {
+          const Eigen::Vector3d p = win.sub_from_virtual * Eigen::Vector3d(U, V, 1.0);
+          u0 = std::min(u0, p.x() / p.z());
+          u1 = std::max(u1, p.x() / p.z());
+          v0 = std::min(v0, p.y() / p.z());
+          v1 = std::max(v1, p.y() / p.z());
+        }
+      const int x0 = std::max(0, static_cast<int>(std::floor(u0)) - margin);
+      const int x1 = std::min(win.width_px - 1, static_cast<int>(std::ceil(u1)) + margin);
+      const int wy0 = std::max(0, static_cast<int>(std::floor(v0)) - margin);
+      const int wy1 = std::min(win.height_px - 1, static_cast<int>(std::ceil(v1)) + margin);
+      win.used = x0 <= x1 && wy0 <= wy1;
+      if (!win.used) continue;
+      win.x0 = x0;
+      win.y0 = wy0;
+      win.w = x1 - x0 + 1;
+      win.h = wy1 - wy0 + 1;
+      win.bytes.resize(static_cast<size_t>(win.w) * win.h * first.bands * first.BytesPerSample());
+      sources[k]->ReadWindow(win.x0, win.y0, win.w, win.h, win.bytes.data());
+    }
+    arena.execute([&] {
+      if (first.bits == 8 && first.bands == 1)
+        ResampleStrip<std::uint8_t, 1>(windows, options, width, y0, rows, &strip, &covered, &overlap);
+      else if (first.bits == 8)
+        ResampleStrip<std::uint8_t, 3>(windows, options, width, y0, rows, &strip, &covered, &overlap);
+      else if (first.bands == 1)
+        ResampleStrip<std::uint16_t, 1>(windows, options, width, y0, rows, &strip, &covered, &overlap);
+      else
+        ResampleStrip<std::uint16_t, 3>(windows, options, width, y0, rows, &strip, &covered, &overlap);
+    });
+    sink->WriteRows(y0, rows, strip.data());
+  }
+  ResampleReport report;
+  report.covered = covered;
+  report.overlap = overlap;
+  report.filled = static_cast<long>(width) * height - report.covered;
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
+}
+
+}  // namespace aerocal::stitch

@@ -1,0 +1,57 @@
+// Resampling the sub-images of a multi-CCD frame into the virtual image
+// (CONVENTIONS.md "Sub-image to virtual image").
+//
+// For every virtual pixel (U, V), each sub-image k gives (u, v) = Map_k^-1(U, V) (the exact
+// inverse of the projectivity). Sub-image k covers the pixel when (u, v) lies within its pixel
+// centres, 0 <= u <= W-1 and 0 <= v <= H-1; its grey value is interpolated there (bilinear, or
+// bicubic convolution with a = -0.5, Keys 1981, edge samples repeated). A pixel covered by no
+// sub-image gets the fill value; a pixel covered by several gets the plain (equal-weight) average
+// of their values: after radiometric equalisation the sub-images agree in the overlaps to the
+// interpolation error, so the average halves the noise there without a weighting ramp.
+//
+// Memory stays bounded: the virtual image is made in strips of `strip_rows` rows; for each strip
+// only the window of each sub-image that the strip needs is read. Rows of a strip are resampled in
+// parallel (TBB). Column ranges covered by a sub-image are solved per row in closed form (each
+// bound u >= 0, u <= W-1, ... is linear in U for a projectivity with positive denominator), so the
+// inner loop has no coverage tests.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/camera/camera.h"
+#include "stitch/resample/raster.h"
+
+namespace aerocal::stitch {
+
+enum class Interpolation { kBilinear, kBicubic };
+
+struct ResampleOptions {
+  Interpolation interpolation = Interpolation::kBilinear;
+  double fill = 0.0;     // value of uncovered pixels, in the output's range
+  int strip_rows = 256;  // rows per strip, > 0 (memory ~ strip_rows x (virtual width + sources))
+  int threads = 0;       // 0: all cores
+};
+
+struct ResampleReport {
+  long covered = 0;   // virtual pixels covered by at least one sub-image
+  long overlap = 0;   // covered by two or more
+  long filled = 0;    // covered by none
+  double seconds = 0;
+};
+
+/// Writes the virtual image of `camera` (format camera.width_px x height_px, mappings of
+/// camera.subimages) from `sources` (one per sub-image, camera order, each of its sub-image's
+/// format; all of one bit depth and band count) to `sink`, with the sources' depth and bands.
+/// Throws InputError naming the sub-image when a source's format, depth or bands do not match.
+ResampleReport ResampleVirtualImage(const calib::Camera& camera,
+                                    const std::vector<RasterSource*>& sources, RasterSink* sink,
+                                    const ResampleOptions& options);
+
+Interpolation ParseInterpolation(const std::string& name);  // ConfigError when unknown
+
+/// Text of the mappings for the output's metadata: a first line naming the format, then one line
+/// per sub-image "ID MODEL W H p1 p2 ..." (plain parameters, FORMATS.md order, 17 digits).
+std::string MappingDescription(const calib::Camera& camera, const std::string& source);
+
+}  // namespace aerocal::stitch
