@@ -1,0 +1,185 @@
+// Acceptance of `aerocal match` on real pixels (issue: tie points to a tenth of a pixel): the
+// Boruszyn scene (match_test_scene.h) written as 8-bit TIFF sub-images plus the NOMINAL camera
+// file; `aerocal match` (SIFT, LSM on and off), the maker reference points measured in the
+// sub-images through the true mappings (noise 0.05 px, their camera-file sigma), then the affine
+// stitching adjustment: sigma0 <= 0.12 px, every sub-image corner within 3 predicted sigmas and
+// 0.25 px of its true virtual position. Also: byte-identical output for identical inputs,
+// appending frames, and bad images named in the error.
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "stitch/adjustment/stitch_adjustment.h"
+#include "tests/stitch/match_test_scene.h"
+
+namespace aerocal::stitch {
+namespace {
+
+using aerocal::testing::RunAerocal;
+using aerocal::testing::TempDir;
+
+class MatchStitch : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    if (!testing::BoruszynScene()) return;
+    const auto& scene = *testing::BoruszynScene();
+    dir_ = new TempDir("aerocal_match");
+    calib::WriteCamera(dir_->File("camera.yaml"), scene.nominal);
+    images_arg_ = new std::string;
+    for (std::size_t k = 0; k < scene.images.size(); ++k) {
+      const std::string& id = scene.nominal.subimages[k].id;
+      WriteGrayImage(dir_->File(id + ".tif"), scene.images[k]);
+      *images_arg_ += (k ? "," : "") + id + "=" + dir_->File(id + ".tif");
+    }
+  }
+  static void TearDownTestSuite() {
+    delete dir_;
+    delete images_arg_;
+  }
+  void SetUp() override {
+    if (!testing::BoruszynScene()) GTEST_SKIP() << "shared data odm_boruszyn_kap_frames absent";
+  }
+  static std::string Match(const std::string& out, const std::string& extra = "") {
+    return "match --camera " + dir_->File("camera.yaml") + " --frame 4880 --images " +
+           *images_arg_ + " --out " + out + " " + extra;
+  }
+  static TempDir* dir_;
+  static std::string* images_arg_;
+};
+TempDir* MatchStitch::dir_ = nullptr;
+std::string* MatchStitch::images_arg_ = nullptr;
+
+// The ties of `obs` plus the reference points measured through the true mappings.
+std::string WithReferences(const std::string& obs, const std::string& out) {
+  const auto& scene = *testing::BoruszynScene();
+  std::vector<StitchObservation> rows = ReadStitchObservations(obs, 0.1);
+  std::mt19937_64 rng(17);
+  std::normal_distribution<double> noise(0.0, 0.05);
+  for (const calib::ReferencePoint& p : scene.nominal.reference_points) {
+    const auto& sub = scene.truth.subimages[scene.truth.SubimageIndex(p.subimage)];
+    const Eigen::Vector2d uv = sub.SubFromVirtual({p.U, p.V});
+    rows.push_back({"4880", p.id, p.subimage, uv.x() + noise(rng), uv.y() + noise(rng), p.sigma_px});
+  }
+  WriteStitchObservations(out, rows);
+  return out;
+}
+
+struct CornerCheck {
+  double sigma0_px = 0, max_error_px = 0, max_error_in_sigmas = 0;
+};
+
+CornerCheck AdjustAndCompare(const std::string& obs) {
+  const auto& scene = *testing::BoruszynScene();
+  const auto frames = GroupByFrame(scene.nominal, ReadStitchObservations(obs, 0.1), obs);
+  EXPECT_EQ(frames.size(), 1u);
+  const FrameAdjustment adj =
+      AdjustFrame(scene.nominal, frames.at(0), calib::MappingModel::kAffine, StitchOptions{});
+  EXPECT_TRUE(adj.converged);
+  EXPECT_TRUE(adj.covariance_ok);
+  CornerCheck check;
+  check.sigma0_px = adj.sigma0_px;
+  for (std::size_t k = 0; k < adj.subimages.size(); ++k) {
+    for (const CornerPrecision& c : adj.subimages[k].corners) {
+      const Eigen::Vector2d d = c.virtual_px - scene.truth.subimages[k].VirtualFromSub(c.uv);
+      check.max_error_px = std::max(check.max_error_px, d.norm());
+      check.max_error_in_sigmas = std::max(
+          {check.max_error_in_sigmas, std::abs(d.x()) / c.sigma_U_px, std::abs(d.y()) / c.sigma_V_px});
+    }
+  }
+  std::printf("  rejected %zu, redundancy %d\n", adj.rejected.size(), adj.redundancy);
+  return check;
+}
+
+TEST_F(MatchStitch, MatchThenAffineStitchRecoversTheTrueCorners) {
+  const std::string on = dir_->File("on.csv"), off = dir_->File("off.csv");
+  ASSERT_EQ(RunAerocal(Match(on)).exit_code, 0);
+  ASSERT_EQ(RunAerocal(Match(off, "--lsm off")).exit_code, 0);
+  const CornerCheck without = AdjustAndCompare(WithReferences(off, dir_->File("off_ref.csv")));
+  std::printf("LSM off: sigma0 %.3f px, corners max error %.3f px = %.2f sigma\n", without.sigma0_px,
+              without.max_error_px, without.max_error_in_sigmas);
+  const CornerCheck with = AdjustAndCompare(WithReferences(on, dir_->File("on_ref.csv")));
+  std::printf("LSM on:  sigma0 %.3f px, corners max error %.3f px = %.2f sigma\n", with.sigma0_px,
+              with.max_error_px, with.max_error_in_sigmas);
+  EXPECT_LE(with.sigma0_px, 0.12);
+  EXPECT_LE(with.max_error_px, 0.25);
+  EXPECT_LE(with.max_error_in_sigmas, 3.0);
+
+  // The stitch command reads the file as written.
+  const auto result = RunAerocal("stitch --camera " + dir_->File("camera.yaml") + " --obs " +
+                                 dir_->File("on_ref.csv") + " --model affine --out " +
+                                 dir_->File("r.json"));
+  ASSERT_EQ(result.exit_code, 0) << result.output;
+  const nlohmann::json doc = nlohmann::json::parse(ReadTextFile(dir_->File("r.json")));
+  EXPECT_LE(doc.at("sigma0_px").get<double>(), 0.12);
+
+  // Same inputs, same file, byte for byte.
+  ASSERT_EQ(RunAerocal(Match(dir_->File("again.csv"))).exit_code, 0);
+  EXPECT_EQ(ReadTextFile(on), ReadTextFile(dir_->File("again.csv")));
+}
+
+TEST_F(MatchStitch, FlightListAppendsFramesAndRefusesDuplicates) {
+  const auto& scene = *testing::BoruszynScene();
+  std::string list = "frame,subimage,image\n";
+  for (const auto& s : scene.nominal.subimages) list += "b," + s.id + "," + s.id + ".tif\n";
+  WriteFileAtomically(dir_->File("list.csv"), list);
+  const std::string out = dir_->File("flight.csv");
+  // Frame "a" first, then frame "b" of the list appended.
+  ASSERT_EQ(RunAerocal("match --camera " + dir_->File("camera.yaml") + " --frame a --images " +
+                       *images_arg_ + " --detector foerstner --out " + out).exit_code, 0);
+  const std::string before = ReadTextFile(out);
+  const std::string list_run =
+      "match --camera " + dir_->File("camera.yaml") + " --list " + dir_->File("list.csv") +
+      " --detector foerstner --append --out " + out;
+  ASSERT_EQ(RunAerocal(list_run).exit_code, 0);
+  const auto rows = ReadStitchObservations(out, 0.1);
+  std::set<std::string> frames;
+  for (const auto& r : rows) frames.insert(r.frame);
+  EXPECT_EQ(frames, (std::set<std::string>{"a", "b"}));
+  EXPECT_EQ(ReadTextFile(out).substr(0, before.size()), before);  // old rows kept as they were
+  // Appending frame b again is refused and leaves the file alone.
+  const std::string after = ReadTextFile(out);
+  const auto again = RunAerocal(list_run);
+  EXPECT_EQ(again.exit_code, 2);
+  EXPECT_NE(again.output.find("frame b is already in the file"), std::string::npos) << again.output;
+  EXPECT_EQ(ReadTextFile(out), after);
+}
+
+TEST_F(MatchStitch, BadImagesAreNamedAndNothingIsWritten) {
+  const std::string cam = dir_->File("camera.yaml"), out = dir_->File("bad.csv");
+  auto images_with = [&](const std::string& second) {
+    std::string arg = *images_arg_;
+    const auto from = arg.find(",II="), to = arg.find(",III=");
+    return arg.substr(0, from) + ",II=" + second + arg.substr(to);
+  };
+  // Missing file.
+  auto r = RunAerocal("match --camera " + cam + " --frame 1 --images " +
+                      images_with(dir_->File("nothing.tif")) + " --out " + out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find(dir_->File("nothing.tif") + ": image file not found"), std::string::npos)
+      << r.output;
+  // Not an image.
+  WriteFileAtomically(dir_->File("text.tif"), "not an image\n");
+  r = RunAerocal("match --camera " + cam + " --frame 1 --images " + images_with(dir_->File("text.tif")) +
+                 " --out " + out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find(dir_->File("text.tif") + ": cannot decode image"), std::string::npos)
+      << r.output;
+  // Wrong format for the camera file.
+  WriteGrayImage(dir_->File("small.tif"), GrayImage::Constant(10, 20, 9.0f));
+  r = RunAerocal("match --camera " + cam + " --frame 1 --images " + images_with(dir_->File("small.tif")) +
+                 " --out " + out);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.output.find(dir_->File("small.tif") + ": image is 20 x 10 px, but sub-image II"),
+            std::string::npos)
+      << r.output;
+  EXPECT_FALSE(std::ifstream(out).good());
+}
+
+}  // namespace
+}  // namespace aerocal::stitch

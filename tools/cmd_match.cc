@@ -1,0 +1,147 @@
+// aerocal match: tie points in the overlap strips of multi-CCD frames, measured on the pixels of
+// the sub-images (stitch/matching/), written as stitch_obs.csv (FORMATS.md) for `aerocal stitch`.
+// One frame (--frame, --images I=a.tif,II=b.tif,...) or a flight (--list: CSV frame,subimage,image
+// with paths relative to the list file).
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <sstream>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/progress.h"
+#include "stitch/image_io/image_io.h"
+#include "stitch/matching/overlap_matcher.h"
+#include "tools/command_registry.h"
+
+namespace aerocal::tools {
+namespace {
+
+struct MatchArgs {
+  std::string camera, frame, images, list, out, detector = "sift", lsm = "on";
+  bool append = false;
+  double sigma_px = 0.3;
+  double cell_px = 100.0;
+};
+
+// frame -> sub-image id -> image path, frames in order of first appearance.
+using FrameImages = std::vector<std::pair<std::string, std::map<std::string, std::string>>>;
+
+FrameImages FromImagesOption(const std::string& frame, const std::string& images) {
+  std::map<std::string, std::string> paths;
+  std::stringstream in(images);
+  std::string item;
+  while (std::getline(in, item, ',')) {
+    const auto eq = item.find('=');
+    if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
+      throw ConfigError("--images: expected ID=PATH, got '" + item + "'");
+    if (!paths.emplace(item.substr(0, eq), item.substr(eq + 1)).second)
+      throw ConfigError("--images: sub-image " + item.substr(0, eq) + " given twice");
+  }
+  return {{frame, paths}};
+}
+
+FrameImages FromList(const std::string& list) {
+  const CsvTable table = CsvTable::Read(list);
+  table.RequireColumns({"frame", "subimage", "image"});
+  const std::filesystem::path dir = std::filesystem::path(list).parent_path();
+  FrameImages frames;
+  std::map<std::string, std::size_t> index;
+  for (const CsvTable::Row& row : table.rows()) {
+    const std::string frame = table.String(row, "frame");
+    const std::string sub = table.String(row, "subimage");
+    std::filesystem::path path = table.String(row, "image");
+    if (frame.empty() || sub.empty() || path.empty())
+      ThrowInputError(table.Where(row), "frame, subimage and image must not be empty");
+    if (path.is_relative()) path = dir / path;
+    if (!index.count(frame)) {
+      index[frame] = frames.size();
+      frames.push_back({frame, {}});
+    }
+    if (!frames[index[frame]].second.emplace(sub, path.string()).second)
+      ThrowInputError(table.Where(row), "sub-image " + sub + " of frame " + frame + " listed twice");
+  }
+  if (frames.empty()) throw InputError(list + ": no frames listed");
+  return frames;
+}
+
+std::vector<stitch::GrayImage> LoadFrame(const calib::Camera& camera, const std::string& frame,
+                                         const std::map<std::string, std::string>& paths) {
+  for (const auto& [id, path] : paths)
+    if (camera.SubimageIndex(id) < 0)
+      throw InputError(path + ": sub-image " + id + " (frame " + frame + ") is not in the camera file");
+  std::vector<stitch::GrayImage> images;
+  for (const calib::SubimageMapping& sub : camera.subimages) {
+    const auto it = paths.find(sub.id);
+    if (it == paths.end()) throw InputError("frame " + frame + ": no image for sub-image " + sub.id);
+    images.push_back(stitch::ReadSubimage(it->second, sub));
+  }
+  return images;
+}
+
+int RunMatch(const MatchArgs& args) {
+  const calib::Camera camera = calib::ReadCamera(args.camera);
+  if (camera.subimages.size() < 2)
+    throw InputError(args.camera + ": matching needs a camera with two or more sub-images");
+  if (args.list.empty() == args.images.empty())
+    throw ConfigError("give either --images (with --frame) or --list");
+  if (!args.images.empty() && args.frame.empty()) throw ConfigError("--images needs --frame");
+  if (args.lsm != "on" && args.lsm != "off") throw ConfigError("--lsm must be on or off");
+  stitch::MatchOptions options;
+  options.detector = stitch::ParseDetector(args.detector);
+  options.use_lsm = args.lsm == "on";
+  options.sigma_px = args.sigma_px;
+  options.cell_px = args.cell_px;
+  options.Validate();
+
+  const FrameImages frames =
+      args.list.empty() ? FromImagesOption(args.frame, args.images) : FromList(args.list);
+  std::vector<stitch::StitchObservation> rows;
+  Progress progress("match", static_cast<long>(frames.size()));
+  std::printf("%-6s %-10s %7s %7s %6s %6s %6s %8s\n", "frame", "strip", "kp_a", "kp_b", "ratio",
+              "ransac", "points", "coverage");
+  for (const auto& [frame, paths] : frames) {
+    const stitch::FrameMatches m =
+        stitch::MatchFrame(camera, LoadFrame(camera, frame, paths), frame, options);
+    rows.insert(rows.end(), m.observations.begin(), m.observations.end());
+    for (const stitch::StripReport& s : m.strips)
+      std::printf("%-6s %-10s %7d %7d %6d %6d %6d %8.2f\n", frame.c_str(), s.name.c_str(),
+                  s.keypoints_a, s.keypoints_b, s.ratio_matches, s.ransac_inliers, s.points,
+                  s.Coverage());
+    progress.Advance();
+  }
+  progress.Finish();
+  stitch::WriteMatchedObservations(args.out, rows, args.append, args.sigma_px);
+  return kExitOk;
+}
+
+CommandRun Setup(CLI::App& app) {
+  auto args = std::make_shared<MatchArgs>();
+  app.add_option("--camera", args->camera, "Camera file (YAML) with nominal sub-image mappings")
+      ->required();
+  app.add_option("--frame", args->frame, "Frame (exposure) id written to the file");
+  app.add_option("--images", args->images, "Sub-image files of the frame: I=a.tif,II=b.tif,...");
+  app.add_option("--list", args->list,
+                 "Flight: CSV frame,subimage,image (paths relative to the list file)");
+  app.add_option("--out", args->out, "stitch_obs.csv to write")->required();
+  app.add_option("--detector", args->detector, "sift | foerstner (on Wallis-filtered strips)")
+      ->capture_default_str();
+  app.add_option("--lsm", args->lsm, "on | off: least-squares matching refinement")
+      ->capture_default_str();
+  app.add_option("--sigma", args->sigma_px,
+                 "sigma_px (px) written without LSM, and for rows of an appended file lacking it")
+      ->capture_default_str();
+  app.add_option("--cell", args->cell_px, "Grid cell along the strips (virtual px): one tie each")
+      ->capture_default_str();
+  app.add_flag("--append", args->append, "Add the frames to an existing --out file");
+  return [args] { return RunMatch(*args); };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(match, "match",
+                         "Tie points in the overlap strips of multi-CCD frames (stitch_obs.csv)",
+                         Setup);
+
+}  // namespace aerocal::tools
