@@ -1,0 +1,318 @@
+"""Tests of the flight report renderer tools/report/aerocal_report.py (python unittest).
+
+Run by ctest as tools/report (tests/tools/report.cmake), or by hand from tests/tools:
+  python3 -m unittest -v report_test
+The fixture tests/data/report/result.json is a flight result: real `aerocal stitch` output for eight
+simulated exposures and three adjustments in the FORMATS.md keys (see tests/data/report/README.md).
+"""
+import base64
+import html.parser
+import json
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+SCRIPT = os.environ.get("AEROCAL_REPORT_SCRIPT",
+                        os.path.join(HERE, "..", "..", "tools", "report", "aerocal_report.py"))
+FIXTURE = os.environ.get("AEROCAL_REPORT_FIXTURE", os.path.join(HERE, "..", "data", "report", "result.json"))
+CHROMIUM = "/usr/bin/chromium"
+PNG_URI = '<img src="data:image/png;base64,'
+# Figures of the fixture: sigma0 per exposure, residual vectors, distortion of camera cam1, check map.
+FIXTURE_FIGURES = 4
+
+
+def run_report(result_path, html_path):
+    return subprocess.run([sys.executable, SCRIPT, result_path, html_path], capture_output=True, text=True,
+                          timeout=120)
+
+
+class Tables(html.parser.HTMLParser):
+    """Collects every element id, and the text of the cells of every table by table id."""
+
+    def __init__(self):
+        super().__init__()
+        self.ids, self.tables, self.headings = set(), {}, []
+        self._table, self._row, self._cell, self._heading = None, None, None, None
+
+    def handle_starttag(self, tag, attrs):
+        attrs = dict(attrs)
+        if "id" in attrs:
+            self.ids.add(attrs["id"])
+        if tag == "table":
+            self._table = self.tables.setdefault(attrs.get("id", ""), [])
+        elif tag == "tr" and self._table is not None:
+            self._row = []
+            self._table.append(self._row)
+        elif tag in ("td", "th") and self._row is not None:
+            self._cell = []
+        elif tag in ("h1", "h2", "h3"):
+            self._heading = []
+
+    def handle_endtag(self, tag):
+        if tag in ("td", "th") and self._cell is not None:
+            self._row.append(" ".join("".join(self._cell).split()))
+            self._cell = None
+        elif tag == "table":
+            self._table, self._row = None, None
+        elif tag in ("h1", "h2", "h3") and self._heading is not None:
+            self.headings.append("".join(self._heading).strip())
+            self._heading = None
+
+    def handle_data(self, data):
+        if self._cell is not None:
+            self._cell.append(data)
+        if self._heading is not None:
+            self._heading.append(data)
+
+    def row(self, table_id, label):
+        """The cells of the first row of table_id whose first cell is label."""
+        for r in self.tables[table_id]:
+            if r and r[0] == label:
+                return r
+        raise AssertionError(f"no row {label!r} in table {table_id!r}")
+
+
+class FixtureReport(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.dir = tempfile.mkdtemp(prefix="aerocal_report_")
+        cls.html_path = os.path.join(cls.dir, "report.html")
+        cls.proc = run_report(FIXTURE, cls.html_path)
+        with open(FIXTURE) as f:
+            cls.doc = json.load(f)
+        cls.html = ""
+        if os.path.exists(cls.html_path):
+            with open(cls.html_path, encoding="utf-8") as f:
+                cls.html = f.read()
+        cls.page = Tables()
+        cls.page.feed(cls.html)
+
+    @classmethod
+    def tearDownClass(cls):
+        shutil.rmtree(cls.dir, ignore_errors=True)
+
+    def adjustment(self, name):
+        return next(a for a in self.doc["adjustments"] if a["name"] == name)
+
+    def test_renders_and_leaves_only_the_report(self):
+        self.assertEqual(self.proc.returncode, 0, self.proc.stderr)
+        self.assertEqual(self.proc.stderr, "")
+        self.assertEqual(os.listdir(self.dir), ["report.html"])
+        self.assertTrue(self.html.startswith("<!DOCTYPE html>"))
+
+    def test_has_the_sections_and_tables(self):
+        for heading in ("1. Summary", "2. Stitching of the sub-images", "2.1 Model comparison", "2.2 Flight stability",
+                        "2.3 sigma0 per exposure", "3. Adjustments", "3.1 Conventional triangulation",
+                        "3.2 Self-calibrating triangulation", "4. Comparison of the adjustments", "5. Calibration",
+                        "5.1 Distortion curves", "6. Image residuals over the format", "7. Check-point errors"):
+            self.assertIn(heading, self.page.headings)
+        for element in ("summary-steps", "stitch-model-comparison", "stitch-model-choice", "stitch-stability",
+                        "stitch-sigma0-plot", "adj-conventional-points", "adj-self-calibration-points",
+                        "adj-joint-points", "adj-joint-subimages", "adj-joint-stitching-sigma0", "comparison-table",
+                        "calib-self-calibration-cam1", "calib-joint-cam1", "distortion-cam1", "residual-plot",
+                        "check-map"):
+            self.assertIn(element, self.page.ids)
+        self.assertNotIn("calib-conventional-cam1", self.page.ids)  # interior held fixed there
+        self.assertNotIn("not available", self.html)
+
+    def test_stitching_tables_show_the_fixture_figures(self):
+        stitching = self.doc["stitching"]
+        models = {m["model"]: m for m in stitching["stability"]["models"]}
+        for model, m in models.items():
+            row = self.page.row("stitch-stability", model)
+            self.assertEqual(row[4], f"{m['mean_sigma0_px']:.4f}")
+            self.assertEqual(row[5], f"{m['std_sigma0_px']:.4f}")
+        # Frame 0001 is flagged by the translation model's stability test in the fixture.
+        self.assertIn("0001:", self.page.row("stitch-stability", "translation")[6])
+        chosen = [f["model_choice"]["chosen"] for f in stitching["frames"]]
+        for model in models:
+            row = self.page.row("stitch-model-comparison", model)
+            self.assertEqual(int(row[2]), chosen.count(model))
+        for f in stitching["frames"]:
+            row = self.page.row("stitch-model-choice", f["frame"])
+            self.assertIn(f["model_choice"]["chosen"], row)
+
+    def test_adjustment_tables_show_the_fixture_figures(self):
+        for name in ("conventional", "self_calibration", "joint"):
+            a = self.adjustment(name)
+            table_id = "adj-" + name.replace("_", "-") + "-points"
+            check = self.page.row(table_id, "check")
+            self.assertEqual(int(check[1]), a["check"]["n"])
+            self.assertEqual(check[2:5], [f"{v:.4f}" for v in a["check"]["rmse_m"]])
+            self.assertEqual(check[5], f"{a['check']['planimetric_rmse_m']:.4f}")
+            self.assertEqual(check[6], f"{a['check']['spatial_rmse_m']:.4f}")
+            self.assertEqual(int(self.page.row(table_id, "control")[1]), a["control"]["n"])
+        names = ["conventional", "self_calibration", "joint"]
+        self.assertEqual(self.page.row("comparison-table", "check RMSE spatial [m]")[1:],
+                         [f"{self.adjustment(n)['check']['spatial_rmse_m']:.4f}" for n in names])
+        self.assertEqual(self.page.row("comparison-table", "sigma0 [um]")[1:],
+                         [f"{self.adjustment(n)['sigma0_um']:.3f}" for n in names])
+
+    def test_calibration_table_is_initial_correction_estimate_sigma(self):
+        cam = self.adjustment("self_calibration")["cameras"][0]
+        c = self.page.row("calib-self-calibration-cam1", "c")
+        self.assertEqual(c[1], "mm")
+        self.assertEqual(c[2:5], [f"{cam['initial']['c']:.5f}", f"{cam['estimated']['c'] - cam['initial']['c']:.5f}",
+                                  f"{cam['estimated']['c']:.5f}"])
+        self.assertEqual(c[5], f"{cam['sigma']['c']:.2e}")
+        k1 = self.page.row("calib-self-calibration-cam1", "K1")
+        self.assertEqual(k1[1], "mm^-2")
+        self.assertEqual(k1[4], f"{cam['estimated']['K1']:.4e}")
+        self.assertEqual(self.page.row("calib-self-calibration-cam1", "B1")[5], "fixed")
+        units = [self.page.row("calib-joint-cam1", p)[1] for p in ("c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2")]
+        self.assertEqual(units, ["mm", "mm", "mm", "mm^-2", "mm^-4", "mm^-6", "mm^-1", "mm^-1", "1", "1"])
+
+    def test_figures_are_embedded_pngs_and_nothing_is_fetched(self):
+        self.assertEqual(self.html.count(PNG_URI), FIXTURE_FIGURES)
+        for chunk in self.html.split(PNG_URI)[1:]:
+            png = base64.b64decode(chunk[:chunk.index('"')])
+            self.assertTrue(png.startswith(b"\x89PNG\r\n\x1a\n"))
+            self.assertGreater(len(png), 10000)
+        self.assertNotIn("<script", self.html)
+        self.assertNotIn("<link", self.html)
+        self.assertNotIn("http://", self.html)
+        self.assertNotIn("https://", self.html)
+
+    def test_figure_captions_state_the_scales(self):
+        self.assertIn("mean residual per cell of a 10 x 9 grid, exaggerated", self.html)
+        self.assertIn("Z error as colour", self.html)
+        self.assertIn("half-diagonal 83.0 mm", self.html)
+
+    @unittest.skipUnless(os.path.exists(CHROMIUM), f"{CHROMIUM} is not installed: headless rendering not checked")
+    def test_renders_in_a_headless_browser(self):
+        try:
+            from PIL import Image  # python3-pil, a dependency of Debian's python3-matplotlib
+        except ImportError:
+            self.skipTest("python3-pil is not installed: the screenshot cannot be inspected")
+        profile = tempfile.mkdtemp(prefix="aerocal_chromium_")
+        shot = os.path.join(self.dir, "screenshot.png")
+        try:
+            proc = subprocess.run(
+                [CHROMIUM, "--headless", "--no-sandbox", "--disable-gpu", "--disable-quic", "--no-first-run",
+                 "--disable-background-networking", "--disable-component-update", "--disable-sync",
+                 f"--user-data-dir={profile}", f"--screenshot={shot}", "--window-size=1200,3000",
+                 "file://" + self.html_path],
+                capture_output=True, text=True, timeout=120, env=dict(os.environ, HOME=profile))
+            self.assertTrue(os.path.exists(shot), proc.stderr[-2000:])
+            with Image.open(shot) as image:
+                self.assertEqual(image.size, (1200, 3000))
+                gray = image.convert("L")
+                histogram = gray.histogram()
+                ink = sum(histogram[:200]) / (1200 * 3000)
+                # A rendered page has text, table rules and the plot: a few percent of dark pixels,
+                # many grey levels; a blank or error page has almost none.
+                self.assertGreater(ink, 0.02)
+                self.assertGreater(sum(1 for n in histogram if n > 0), 100)
+                title = gray.crop((0, 0, 600, 60)).histogram()
+                self.assertGreater(sum(title[:100]), 500)  # the title's glyphs
+        finally:
+            shutil.rmtree(profile, ignore_errors=True)
+            if os.path.exists(shot):
+                os.remove(shot)
+
+
+class BadInput(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="aerocal_report_bad_")
+        self.out = os.path.join(self.dir, "report.html")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def check_refused(self, content, message):
+        path = os.path.join(self.dir, "result.json")
+        with open(path, "w") as f:
+            f.write(content)
+        proc = run_report(path, self.out)
+        self.assertEqual(proc.returncode, 2)
+        self.assertEqual(proc.stderr.count("\n"), 1, proc.stderr)
+        self.assertTrue(proc.stderr.startswith("error: "), proc.stderr)
+        self.assertIn(message, proc.stderr)
+        self.assertEqual(sorted(os.listdir(self.dir)), ["result.json"])
+
+    def test_not_json(self):
+        self.check_refused('{"kind": "flight", "stitching": ', "not a JSON document")
+
+    def test_not_a_flight_result(self):
+        self.check_refused('{"kind": "stitch", "sigma0": 1.0}', 'kind is "stitch", expected "flight"')
+        self.check_refused("[1, 2, 3]", "top level is not an object")
+
+    def test_missing_file(self):
+        proc = run_report(os.path.join(self.dir, "absent.json"), self.out)
+        self.assertEqual(proc.returncode, 2)
+        self.assertIn("cannot read", proc.stderr)
+        self.assertFalse(os.path.exists(self.out))
+
+    def test_usage(self):
+        proc = subprocess.run([sys.executable, SCRIPT], capture_output=True, text=True, timeout=60)
+        self.assertEqual(proc.returncode, 2)
+        self.assertTrue(proc.stderr.startswith("error: usage"))
+
+
+class TolerantInput(unittest.TestCase):
+    def setUp(self):
+        self.dir = tempfile.mkdtemp(prefix="aerocal_report_tolerant_")
+
+    def tearDown(self):
+        shutil.rmtree(self.dir, ignore_errors=True)
+
+    def render(self, doc):
+        path, out = os.path.join(self.dir, "result.json"), os.path.join(self.dir, "report.html")
+        with open(path, "w") as f:
+            json.dump(doc, f)
+        proc = run_report(path, out)
+        self.assertEqual(proc.returncode, 0, proc.stderr)
+        page = Tables()
+        with open(out, encoding="utf-8") as f:
+            text = f.read()
+        page.feed(text)
+        return text, page
+
+    def test_missing_sections_say_not_available(self):
+        text, page = self.render({"kind": "flight"})
+        self.assertIn("Stitching: not available", text)
+        self.assertIn("Adjustments: not available", text)
+        self.assertIn("Check-point errors: not available", text)
+        self.assertEqual(text.count(PNG_URI), 0)
+
+    def test_draft_key_names_are_read(self):
+        # The brief's draft spellings: model_choice.models, stability.per_model with string flags,
+        # check points with X/dX and rmse_planimetric_m / rmse_spatial_m.
+        points = [{"point": f"K{k}", "X": 100.0 * k, "Y": 50.0 * (k % 3), "Z": 10.0, "dX": 0.01 * k, "dY": -0.02,
+                   "dZ": 0.03 * (k % 2)} for k in range(1, 7)]
+        doc = {"kind": "flight", "camera_format": {"width_px": 1000, "height_px": 800, "pixel_size_mm": 0.01},
+               "stitching": {"kind": "stitch", "model": "affine", "sigma0_px": 0.1,
+                             "frames": [{"frame": "0001", "sigma0_px": 0.101, "converged": True,
+                                         "model_choice": {"chosen": "affine", "reason": "because",
+                                                          "models": [{"model": "conformal", "sigma0_px": 0.2,
+                                                                      "redundancy": 40},
+                                                                     {"model": "affine", "sigma0_px": 0.101,
+                                                                      "redundancy": 38, "F": 30.0,
+                                                                      "F_critical": 3.2, "against": "conformal",
+                                                                      "significant": True}]}}],
+                             "stability": {"mean_sigma0_px": 0.101, "std_sigma0_px": 0.0,
+                                           "per_model": [{"model": "affine", "mean_sigma0_px": 0.1234,
+                                                          "std_sigma0_px": 0.0056, "flagged_frames": ["0001"]}]}},
+               "adjustments": [{"name": "conventional", "sigma0": 1.1, "sigma0_px": 0.22, "sigma0_um": 2.2,
+                                "converged": False,
+                                "check": {"n": 6, "rmse_m": [0.1, 0.2, 0.3], "rmse_planimetric_m": 0.2236,
+                                          "rmse_spatial_m": 0.3742, "points": points},
+                                "residuals": [{"image": "1", "point": "T", "col": 100 * k, "row": 80 * k,
+                                               "v_col_px": 0.1, "v_row_px": -0.2} for k in range(1, 9)]}]}
+        text, page = self.render(doc)
+        self.assertEqual(page.row("stitch-stability", "affine")[4], "0.1234")
+        self.assertIn("0001", page.row("stitch-stability", "affine")[6])
+        self.assertIn("F = 30 > 3.2", page.row("stitch-model-choice", "0001")[2])
+        self.assertEqual(page.row("adj-conventional-points", "check")[5:7], ["0.2236", "0.3742"])
+        self.assertIn("did not converge", text)
+        self.assertIn("residual-plot", page.ids)
+        self.assertIn("check-map", page.ids)
+        self.assertEqual(text.count(PNG_URI), 3)  # sigma0, residuals, check map (no interior: no curves)
+
+
+if __name__ == "__main__":
+    unittest.main()

@@ -1,0 +1,219 @@
+"""Tolerant reading of the `aerocal flight` result document (FORMATS.md "Results (JSON)").
+
+Every accessor returns plain Python values or None when a key is absent, so that a missing section
+is shown as "not available" instead of stopping the report. Where two spellings of a key exist
+(the FORMATS.md / C++ writers' name and an older draft name), both are accepted; the first listed
+is the one the writers emit.
+"""
+import json
+import math
+
+# The 10-parameter model's table (CONVENTIONS.md): name, unit.
+INTERIOR_PARAMETERS = [("c", "mm"), ("x0", "mm"), ("y0", "mm"), ("K1", "mm^-2"), ("K2", "mm^-4"),
+                       ("K3", "mm^-6"), ("P1", "mm^-1"), ("P2", "mm^-1"), ("B1", "1"), ("B2", "1")]
+
+ADJUSTMENT_TITLES = {"conventional": "Conventional triangulation",
+                     "self_calibration": "Self-calibrating triangulation",
+                     "joint": "Joint adjustment (stitching and triangulation)"}
+
+
+class InputError(Exception):
+    """The input is not a flight result; the message names the file and the rule."""
+
+
+def load(path):
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError as e:
+        raise InputError(f"{path}: cannot read ({e.strerror})")
+    try:
+        doc = json.loads(text)
+    except ValueError as e:
+        raise InputError(f"{path}: not a JSON document ({e})")
+    if not isinstance(doc, dict):
+        raise InputError(f"{path}: not a flight result (top level is not an object)")
+    if doc.get("kind") != "flight":
+        raise InputError(f"{path}: not a flight result (kind is {json.dumps(doc.get('kind'))}, "
+                         f"expected \"flight\")")
+    return doc
+
+
+def get(obj, *keys):
+    """obj[k] for the first k present (dict), else None."""
+    if not isinstance(obj, dict):
+        return None
+    for k in keys:
+        if k in obj and obj[k] is not None:
+            return obj[k]
+    return None
+
+
+def number(x):
+    """A finite float, or None (JSON null, strings, NaN)."""
+    if isinstance(x, bool) or not isinstance(x, (int, float)):
+        return None
+    return float(x) if math.isfinite(x) else None
+
+
+def listing(x):
+    return x if isinstance(x, list) else []
+
+
+def triple(x):
+    """[X, Y, Z] as three numbers or Nones."""
+    x = listing(x)
+    return [number(x[k]) if k < len(x) else None for k in range(3)]
+
+
+# ---- stitching ------------------------------------------------------------------------------
+
+def frames(stitching):
+    return [f for f in listing(get(stitching, "frames")) if isinstance(f, dict)]
+
+
+def model_choice(frame):
+    return get(frame, "model_choice") or {}
+
+
+def candidates(frame):
+    """Per-model rows of a frame's model comparison: dicts with model, sigma0, sigma0_px,
+    redundancy, determinable, refusal and test (dict: against, F, F_critical, p_value, significant)."""
+    rows = []
+    for c in listing(get(model_choice(frame), "table", "models", "candidates")):
+        if not isinstance(c, dict) or not isinstance(c.get("model"), str):
+            continue
+        test = c.get("test")
+        if not isinstance(test, dict):  # a draft flattened the test into the row
+            test = {"F": c.get("F"), "F_critical": c.get("F_critical"), "against": c.get("against"),
+                    "p_value": c.get("p_value"), "significant": c.get("significant")}
+            if test["F"] is None:
+                test = None
+        rows.append({"model": c["model"], "sigma0": number(c.get("sigma0")),
+                     "sigma0_px": number(c.get("sigma0_px")), "redundancy": number(c.get("redundancy")),
+                     "determinable": c.get("determinable", True) is not False,
+                     "refusal": c.get("refusal"), "test": test})
+    return rows
+
+
+def stability_models(stitching):
+    """Per-model flight stability entries (model, n_frames, mean/std sigma0[_px], flagged, parameters)."""
+    stability = get(stitching, "stability") or {}
+    out = []
+    for m in listing(get(stability, "models", "per_model")):
+        if isinstance(m, dict) and isinstance(m.get("model"), str):
+            out.append(m)
+    return out
+
+
+def flagged(entry):
+    """[(frame, [reasons])] of a stability entry; accepts strings or {frame, reasons}."""
+    out = []
+    for f in listing(get(entry, "flagged", "flagged_frames")):
+        if isinstance(f, dict):
+            reasons = f.get("reasons", f.get("reason", []))
+            out.append((str(f.get("frame", "?")), reasons if isinstance(reasons, list) else [str(reasons)]))
+        else:
+            out.append((str(f), []))
+    return out
+
+
+def flags_by_frame(stitching):
+    """{frame: [models whose stability test flags it]}; a flight-level list without model gives ""."""
+    out = {}
+    for m in stability_models(stitching):
+        for f, _ in flagged(m):
+            out.setdefault(f, []).append(m["model"])
+    for f, _ in flagged(get(stitching, "stability") or {}):
+        out.setdefault(f, []).append("")
+    return out
+
+
+# ---- adjustments ----------------------------------------------------------------------------
+
+def adjustments(doc):
+    out = []
+    for k, a in enumerate(listing(doc.get("adjustments"))):
+        if isinstance(a, dict):
+            a = dict(a)
+            a.setdefault("name", f"adjustment_{k + 1}")
+            out.append(a)
+    return out
+
+
+def title(adjustment):
+    name = str(adjustment.get("name"))
+    return ADJUSTMENT_TITLES.get(name, name.replace("_", " ").capitalize())
+
+
+def point_statistics(adjustment, which):
+    """control/check statistics with all keys normalised; None when absent."""
+    s = get(adjustment, which)
+    if not isinstance(s, dict):
+        return None
+    rmse = triple(s.get("rmse_m"))
+    plan = number(get(s, "planimetric_rmse_m", "rmse_planimetric_m"))
+    spatial = number(get(s, "spatial_rmse_m", "rmse_spatial_m"))
+    if plan is None and None not in rmse[:2]:
+        plan = math.hypot(rmse[0], rmse[1])
+    if spatial is None and None not in rmse:
+        spatial = math.sqrt(sum(v * v for v in rmse))
+    return {"n": number(s.get("n")), "rmse": rmse, "plan": plan, "spatial": spatial,
+            "mean": triple(s.get("mean_m")), "max": triple(s.get("max_abs_m"))}
+
+
+def point_errors(adjustment, which):
+    """[(point, X, Y, Z, dX, dY, dZ)] of control or check points with usable numbers."""
+    out = []
+    for p in listing(get(get(adjustment, which), "points")):
+        if not isinstance(p, dict):
+            continue
+        xyz = triple(p["surveyed_m"]) if "surveyed_m" in p else [number(p.get(k)) for k in "XYZ"]
+        if "difference_m" in p:
+            d = triple(p["difference_m"])
+        else:
+            d = [number(p.get(k)) for k in ("dX", "dY", "dZ")]
+        if None in xyz[:2] or None in d:
+            continue
+        out.append((str(p.get("point", "")), xyz[0], xyz[1], xyz[2], d[0], d[1], d[2]))
+    return out
+
+
+def residuals(adjustment):
+    """[(col, row, v_col_px, v_row_px)] image residuals in the image's pixel frame."""
+    out = []
+    for r in listing(adjustment.get("residuals")):
+        if not isinstance(r, dict):
+            continue
+        v = [number(get(r, "col")), number(get(r, "row")),
+             number(get(r, "v_col_px", "vcol_px")), number(get(r, "v_row_px", "vrow_px"))]
+        if None not in v:
+            out.append(tuple(v))
+    return out
+
+
+def cameras(adjustment):
+    return [c for c in listing(adjustment.get("cameras")) if isinstance(c, dict)]
+
+
+def interior(camera, which):
+    """{name: value} of 'initial' or 'estimated' with numbers only."""
+    block = get(camera, which) or {}
+    return {name: number(block.get(name)) for name, _ in INTERIOR_PARAMETERS if number(block.get(name)) is not None}
+
+
+def estimates_interior(adjustment):
+    """True when the adjustment estimated interior parameters (self-calibration)."""
+    if listing(adjustment.get("self_calibration")):
+        return True
+    return any(listing(c.get("free")) or (isinstance(c.get("sigma"), dict) and c["sigma"])
+               for c in cameras(adjustment))
+
+
+def camera_format(doc):
+    """(width_px, height_px, pixel_size_mm) or None."""
+    f = doc.get("camera_format")
+    values = [number(get(f, "width_px")), number(get(f, "height_px")), number(get(f, "pixel_size_mm"))]
+    if None in values or min(values) <= 0:
+        return None
+    return tuple(values)
