@@ -188,7 +188,7 @@ def check_point_map(panels):
                              edgecolors="#444444", linewidths=0.3, zorder=2)
         q = ax.quiver(c[:, 0], c[:, 1], c[:, 3] * exaggeration, c[:, 4] * exaggeration, angles="xy",
                       scale_units="xy", scale=1, color="black", width=0.0016, headwidth=4,
-                      zorder=3)
+                      headlength=4, headaxislength=3.5, zorder=3)
         ax.quiverkey(q, 0.78, 1.03, key_m * exaggeration, f"{key_m:g} m", labelpos="E",
                      coordinates="axes", fontproperties={"size": 8})
         if control:
