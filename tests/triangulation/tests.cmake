@@ -3,3 +3,4 @@ aerocal_add_test(triangulation/monte_carlo LIBS aerocal::triangulation LABELS sy
 aerocal_add_test(triangulation/forward_intersection LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/adjust_cli LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(triangulation/object_frame LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/real_data LIBS aerocal::triangulation LABELS golden)

@@ -23,6 +23,10 @@ void AdjustOptions::Validate() const {
   if (snooping_critical_value < 0)
     throw ConfigError("snooping_critical_value must be >= 0 (got " +
                       FormatNumber(snooping_critical_value) + ")");
+  if (!(robust_scale_sigma > 0))
+    throw ConfigError("robust_scale_sigma must be > 0 (got " + FormatNumber(robust_scale_sigma) + ")");
+  if (!(robust_reject_sigma > 0))
+    throw ConfigError("robust_reject_sigma must be > 0 (got " + FormatNumber(robust_reject_sigma) + ")");
   if (max_rejections < 1)
     throw ConfigError("max_rejections must be > 0 (got " + std::to_string(max_rejections) + ")");
   if (!(correlation_threshold > 0 && correlation_threshold < 1))

@@ -20,6 +20,17 @@ struct AdjustOptions {
   bool use_eo_priors = true;
   /// Baarda data snooping on the image observations; rejected observations are listed.
   bool data_snooping = true;
+  /// Robust start: adjust first with a Cauchy loss on the image observations (scale
+  /// `robust_scale_sigma` sigmas), then re-adjust without it from that solution, snooping as set.
+  /// For blocks with large gross errors and poor starting values.
+  bool robust_start = false;
+  double robust_scale_sigma = 3.0;  // > 0
+  /// After the robust adjustment, observations whose residual exceeds this many robust scales
+  /// (1.4826 median |v / sigma|) are rejected before the clean re-adjustment, > 0. Only the
+  /// obvious: data snooping (exact redundancy numbers) decides the rest.
+  double robust_reject_sigma = 8.0;
+  /// Estimate the covariance (sigmas, correlations, determinability). Off only for speed.
+  bool estimate_covariance = true;
   /// Critical value of the standardized residual |w|; 0: from alpha = 5 % / n_tested (>= 3.29).
   double snooping_critical_value = 0.0;
   int max_rejections = 100;  // > 0

@@ -152,6 +152,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   for (const auto& o : r.rejected)
     j["rejected"].push_back({{"image", o.image},
                              {"point", o.point},
+                             {"measured_px", {o.measured_px.x(), o.measured_px.y()}},
                              {"residual_px", o.residual_px.norm()},
                              {"residual_col_row_px", {o.residual_px.x(), -o.residual_px.y()}},
                              {"w", o.w}});
@@ -178,8 +179,9 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += StatisticsLine("check", r.check);
   if (!r.free_interior.empty()) out += CalibrationTable(r);
   for (const auto& o : r.rejected)
-    out += Printf("rejected: image %s point %s, residual %.2f px (w = %.1f)\n", o.image.c_str(),
-                  o.point.c_str(), o.residual_px.norm(), o.w);
+    out += Printf("rejected: image %s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
+                  o.image.c_str(), o.point.c_str(), o.measured_px.x(), o.measured_px.y(),
+                  o.residual_px.norm(), o.w);
   for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
   return out;
 }

@@ -52,8 +52,19 @@ struct ExposureEstimate {
 
 struct RejectedObservation {
   std::string image, point;
+  Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();   // the observation (col, row)
   Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // v in (corrected) photo space, px
   double w = 0.0;                                          // standardized residual
+};
+
+/// One image observation after the adjustment: residual v = measured - adjusted, in pixels of
+/// the (corrected) photo space, (col, row) directions.
+struct ObservationResidual {
+  std::string image, point;
+  Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();
+  Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();
+  double sigma_px = 0.0;
+  bool used = true;  // false: rejected as a gross error
 };
 
 struct Determinability {
@@ -75,6 +86,7 @@ struct AdjustmentResult {
   std::vector<PointDifference> control_points, check_points;
   PointStatistics control, check;
   std::vector<RejectedObservation> rejected;
+  std::vector<ObservationResidual> residuals;  // every image observation of the adjustment
   Determinability determinability;
   std::map<std::string, Eigen::Vector3d> points_m;  // adjusted coordinates of every point
   std::vector<std::string> notes;                   // points left out, and why

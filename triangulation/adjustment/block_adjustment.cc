@@ -4,6 +4,7 @@
 #include <cmath>
 #include <set>
 
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
@@ -61,12 +62,12 @@ struct BlockAdjustment::Storage {
 };
 
 BlockAdjustment::BlockAdjustment(const Project& project, const AdjustOptions& options,
-                                 SubimageObservations subimage)
+                                 SubimageObservations subimage, const calib::LossOptions& image_loss)
     : project_(project), options_(options), storage_(std::make_unique<Storage>()) {
   options_.Validate();
   BuildExposures();
   BuildPoints(subimage);
-  AddImageResiduals();
+  AddImageResiduals(image_loss);
   AddPriors();
 }
 
@@ -139,6 +140,39 @@ void BlockAdjustment::BuildPoints(SubimageObservations subimage) {
     mapped.subimage.clear();
     storage_->observations.push_back(mapped);
   }
+  // An exposure seeing fewer than three points (and not held by GNSS and IMU priors) cannot be
+  // oriented; leaving it out can leave a point with one ray, so repeat until nothing changes.
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::map<std::string, std::set<std::string>> points_of_image;
+    std::map<std::string, std::set<std::string>> images_of_point;
+    for (const auto& o : storage_->observations) {
+      points_of_image[o.image].insert(o.point);
+      images_of_point[o.point].insert(o.image);
+    }
+    std::set<std::string> dropped;
+    for (const auto& [image, points] : points_of_image) {
+      const Exposure& e = *storage_->exposures.at(image).exposure;
+      const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
+      if (points.size() >= 3 || held) continue;
+      dropped.insert(image);
+      storage_->notes.push_back("image " + image + " sees " + std::to_string(points.size()) +
+                                " point(s) only: its orientation cannot be determined; left out");
+    }
+    std::set<std::string> single;
+    for (const auto& [point, images] : images_of_point) {
+      const GroundPoint* ground = project_.FindPoint(point);
+      if (images.size() == 1 && !(ground && ground->role == PointRole::kControl)) single.insert(point);
+    }
+    const size_t before = storage_->observations.size();
+    storage_->observations.erase(
+        std::remove_if(storage_->observations.begin(), storage_->observations.end(),
+                       [&](const ImageObservation& o) {
+                         return dropped.count(o.image) || (!dropped.empty() && single.count(o.point));
+                       }),
+        storage_->observations.end());
+    changed = storage_->observations.size() != before;
+  }
   std::map<std::string, std::vector<ImageRay>> rays;
   for (const auto& o : storage_->observations) {
     const auto& e = storage_->exposures.at(o.image);
@@ -178,7 +212,7 @@ void BlockAdjustment::BuildPoints(SubimageObservations subimage) {
                                 " has too few image observations and is not used");
 }
 
-void BlockAdjustment::AddImageResiduals() {
+void BlockAdjustment::AddImageResiduals(const calib::LossOptions& loss) {
   for (size_t i = 0; i < storage_->observations.size(); ++i) {
     const auto& o = storage_->observations[i];
     const auto point = storage_->points.find(o.point);
@@ -189,7 +223,7 @@ void BlockAdjustment::AddImageResiduals() {
     const auto id = builder_.AddResidual(
         calib::kGroupImage, calib::CollinearityResidual::Create(frame, o.pixel, o.sigma_px),
         {storage_->cameras.at(e.exposure->camera).block, e.opk_block, e.center_block, point->second.block},
-        "image " + o.image + " point " + o.point);
+        "image " + o.image + " point " + o.point, loss);
     storage_->observation_of_residual[id] = i;
   }
 }
@@ -293,12 +327,27 @@ AdjustmentResult BlockAdjustment::Run() {
     RejectedObservation out;
     out.image = o.image;
     out.point = o.point;
+    out.measured_px = o.pixel;
     out.w = r.w;
     if (r.whitened_residual.size() == 2)
       out.residual_px = Eigen::Vector2d(r.whitened_residual[0], r.whitened_residual[1]) * o.sigma_px;
     result.rejected.push_back(out);
   }
 
+  // Residuals of every image observation (whitened r = (ideal - projected) / sigma in photo
+  // space, x right and y up; in (col, row) pixels that is (r_x, -r_y) sigma).
+  for (const auto& [id, index] : storage_->observation_of_residual) {
+    const auto& o = storage_->observations[index];
+    ObservationResidual v;
+    v.image = o.image;
+    v.point = o.point;
+    v.measured_px = o.pixel;
+    v.sigma_px = o.sigma_px;
+    v.used = builder_.IsActive(id);
+    const std::vector<double> r = v.used ? builder_.EvaluateResidual(id) : std::vector<double>{};
+    if (r.size() == 2) v.residual_px = Eigen::Vector2d(r[0], -r[1]) * o.sigma_px;
+    result.residuals.push_back(v);
+  }
   // Statistics in the units of the image measurements.
   std::vector<double> image_sigmas;
   for (const auto& [id, index] : storage_->observation_of_residual)
@@ -316,7 +365,9 @@ AdjustmentResult BlockAdjustment::Run() {
     cov_blocks.push_back(state.center_block);
   }
   calib::CovarianceReport cov;
-  if (result.solve.usable && result.solve.redundancy > 0)
+  if (!options_.estimate_covariance)
+    cov.message = "covariance not estimated (option)";
+  else if (result.solve.usable && result.solve.redundancy > 0)
     cov = builder_.EstimateCovariance(cov_blocks, result.sigma0, options_.correlation_threshold);
   else
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
@@ -399,8 +450,68 @@ AdjustmentResult BlockAdjustment::Run() {
 }
 
 AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
-  BlockAdjustment adjustment(project, options);
-  return adjustment.Run();
+  if (!options.robust_start) {
+    BlockAdjustment adjustment(project, options);
+    return adjustment.Run();
+  }
+  AdjustOptions robust = options;
+  robust.data_snooping = false;
+  robust.estimate_covariance = false;
+  calib::LossOptions loss;
+  loss.kind = calib::LossKind::kCauchy;
+  loss.scale = options.robust_scale_sigma;
+  AdjustmentResult start;
+  {
+    BlockAdjustment adjustment(project, robust, SubimageObservations::kMapWithCameraFile, loss);
+    start = adjustment.Run();
+  }
+  // Observations far outside the robust solution's spread are gross errors: a robust scale
+  // (1.4826 median |v / sigma| over all components) and a cut at `robust_reject_sigma` scales.
+  std::vector<double> abs_w;
+  for (const auto& v : start.residuals)
+    if (v.used)
+      for (int k = 0; k < 2; ++k) abs_w.push_back(std::abs(v.residual_px(k)) / v.sigma_px);
+  std::vector<RejectedObservation> pre_rejected;
+  Project next = project;
+  if (!abs_w.empty()) {
+    std::nth_element(abs_w.begin(), abs_w.begin() + abs_w.size() / 2, abs_w.end());
+    const double scale = std::max(1e-12, 1.4826 * abs_w[abs_w.size() / 2]);
+    std::vector<bool> drop(project.observations.size(), false);
+    for (const auto& v : start.residuals) {
+      const double w = v.residual_px.norm() / v.sigma_px / scale;
+      if (!v.used || w <= options.robust_reject_sigma) continue;
+      for (size_t i = 0; i < project.observations.size(); ++i) {
+        const auto& o = project.observations[i];
+        if (!drop[i] && o.image == v.image && o.point == v.point && o.subimage.empty() && o.pixel == v.measured_px) {
+          drop[i] = true;
+          pre_rejected.push_back({v.image, v.point, v.measured_px, Eigen::Vector2d(v.residual_px.x(), -v.residual_px.y()), w});
+          break;
+        }
+      }
+    }
+    next.observations.clear();
+    for (size_t i = 0; i < project.observations.size(); ++i)
+      if (!drop[i]) next.observations.push_back(project.observations[i]);
+  }
+  // The robust solution becomes the starting values; surveyed coordinates stay the survey.
+  for (auto& e : next.exposures)
+    for (const auto& s : start.exposures)
+      if (s.image == e.image) {
+        e.center_m = s.center_m;
+        e.opk_rad = s.opk_rad;
+      }
+  for (const auto& c : start.cameras) next.cameras.at(c.id).interior = c.estimated;
+  for (auto& p : next.points)
+    if (p.role == PointRole::kTie && start.points_m.count(p.id)) p.xyz_m = start.points_m.at(p.id);
+  BlockAdjustment adjustment(next, options);
+  AdjustmentResult result = adjustment.Run();
+  for (auto& c : result.cameras) c.initial = project.cameras.at(c.id).interior;
+  result.rejected.insert(result.rejected.begin(), pre_rejected.begin(), pre_rejected.end());
+  for (const auto& r : pre_rejected)
+    result.residuals.push_back({r.image, r.point, r.measured_px, Eigen::Vector2d::Zero(), 0.0, false});
+  result.notes.push_back("started from a robust (Cauchy, " + FormatNumber(options.robust_scale_sigma, 3) +
+                         " sigma) adjustment");
+  return result;
 }
 
 }  // namespace aerocal::triangulation

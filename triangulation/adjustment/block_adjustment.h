@@ -45,8 +45,10 @@ class BlockAdjustment {
   /// Validates the options, computes starting values and builds every residual.
   /// Throws InputError when the block cannot be started (an exposure without observations is
   /// only reported; an observation whose ray misses every start is an input error).
+  /// `image_loss` is applied to the image observations (robust start); none by default.
   BlockAdjustment(const Project& project, const AdjustOptions& options,
-                  SubimageObservations subimage = SubimageObservations::kMapWithCameraFile);
+                  SubimageObservations subimage = SubimageObservations::kMapWithCameraFile,
+                  const calib::LossOptions& image_loss = {});
   ~BlockAdjustment();
   BlockAdjustment(const BlockAdjustment&) = delete;
   BlockAdjustment& operator=(const BlockAdjustment&) = delete;
@@ -68,7 +70,7 @@ class BlockAdjustment {
   struct Storage;
   void BuildExposures();
   void BuildPoints(SubimageObservations subimage);
-  void AddImageResiduals();
+  void AddImageResiduals(const calib::LossOptions& loss);
   void AddPriors();
 
   const Project& project_;
@@ -77,7 +79,8 @@ class BlockAdjustment {
   std::unique_ptr<Storage> storage_;
 };
 
-/// Convenience: build and run.
+/// Builds and runs; with options.robust_start, first a robust adjustment whose solution starts
+/// the final one (the reported initial interior stays the camera file's).
 AdjustmentResult Adjust(const Project& project, const AdjustOptions& options);
 
 }  // namespace aerocal::triangulation

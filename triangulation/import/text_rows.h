@@ -1,0 +1,23 @@
+// Header-less text tables of other tools (DBAT, PhotoModeler, ODM, COLMAP): lines split on commas
+// and/or blanks, '#' comment lines and blank lines skipped, every value error as FILE:LINE.
+#pragma once
+
+#include <string>
+#include <vector>
+
+namespace aerocal::triangulation::internal {
+
+struct TextRow {
+  int line = 0;  // 1-based
+  std::vector<std::string> fields;
+};
+
+/// Rows of a file; `comma_separates` also splits on commas. InputError when it cannot be read.
+std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates = true);
+
+/// Field k as a number; InputError("FILE:LINE: ...") when absent or not a number.
+double NumberField(const TextRow& row, size_t k, const std::string& file, const char* what);
+/// Field k as a string; InputError when absent.
+const std::string& StringField(const TextRow& row, size_t k, const std::string& file, const char* what);
+
+}  // namespace aerocal::triangulation::internal
