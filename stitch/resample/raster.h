@@ -23,7 +23,8 @@ class RasterSource {
   virtual ~RasterSource() = default;
   virtual RasterInfo Info() const = 0;
   /// Copies the window [x0, x0 + w) x [y0, y0 + h), which lies inside the raster, into `out`
-  /// (w * h * bands samples of the raster's type, rows of w * bands samples). Not thread-safe.
+  /// (w * h * bands samples of the raster's type, rows of w * bands samples). One object is
+  /// not thread-safe; distinct sources may be read concurrently.
   virtual void ReadWindow(int x0, int y0, int w, int h, void* out) = 0;
 };
 

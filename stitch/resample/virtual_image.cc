@@ -69,9 +69,10 @@ bool CoveredColumns(const Window& win, double V, int virtual_width, int* first, 
   return *first <= *last;
 }
 
-template <typename T, int kBands>
-void AccumulateRow(const Window& win, Interpolation interpolation, double V, int first, int last,
-                   float* sum, std::uint8_t* count) {
+// kAffine: the projective row of the map is (0, 0, 1), so w = 1 and no division is needed.
+template <typename T, int kBands, Interpolation kInterpolation, bool kAffine>
+void AccumulateRow(const Window& win, double V, int first, int last, float* sum,
+                   std::uint8_t* count) {
   const T* data = reinterpret_cast<const T*>(win.bytes.data());
   const int stride = win.w * kBands;
   const Eigen::Matrix3d& m = win.sub_from_virtual;
@@ -81,11 +82,11 @@ void AccumulateRow(const Window& win, Interpolation interpolation, double V, int
   const double dx = m(0, 0) - win.x0 * m(2, 0), dy = m(1, 0) - win.y0 * m(2, 0), dw = m(2, 0);
   const float max_u = static_cast<float>(win.w - 1), max_v = static_cast<float>(win.h - 1);
   for (int c = first; c <= last; ++c, x += dx, y += dy, w += dw) {
-    const float u = std::clamp(static_cast<float>(x / w), 0.0f, max_u);
-    const float v = std::clamp(static_cast<float>(y / w), 0.0f, max_v);
+    const float u = std::clamp(static_cast<float>(kAffine ? x : x / w), 0.0f, max_u);
+    const float v = std::clamp(static_cast<float>(kAffine ? y : y / w), 0.0f, max_v);
     float* out = sum + c * kBands;
     ++count[c];
-    if (interpolation == Interpolation::kBilinear) {
+    if constexpr (kInterpolation == Interpolation::kBilinear) {
       const int iu = std::min(static_cast<int>(u), std::max(win.w - 2, 0));
       const int iv = std::min(static_cast<int>(v), std::max(win.h - 2, 0));
       const float fu = u - iu, fv = v - iv;
@@ -96,8 +97,7 @@ void AccumulateRow(const Window& win, Interpolation interpolation, double V, int
         const float bottom = p[b + dv] + fu * (static_cast<float>(p[b + dv + du]) - p[b + dv]);
         out[b] += top + fv * (bottom - top);
       }
-      continue;
-    }
+    } else {
     const int iu = static_cast<int>(u), iv = static_cast<int>(v);
     float wu[4], wv[4];
     CubicWeights(u - iu, wu);
@@ -116,6 +116,21 @@ void AccumulateRow(const Window& win, Interpolation interpolation, double V, int
       }
       out[b] += acc;
     }
+    }
+  }
+}
+
+template <typename T, int kBands>
+void AccumulateRow(const Window& win, Interpolation interpolation, double V, int first, int last,
+                   float* sum, std::uint8_t* count) {
+  const bool affine = win.sub_from_virtual(2, 0) == 0.0 && win.sub_from_virtual(2, 1) == 0.0 &&
+                      win.sub_from_virtual(2, 2) == 1.0;
+  if (interpolation == Interpolation::kBilinear) {
+    if (affine) AccumulateRow<T, kBands, Interpolation::kBilinear, true>(win, V, first, last, sum, count);
+    else AccumulateRow<T, kBands, Interpolation::kBilinear, false>(win, V, first, last, sum, count);
+  } else {
+    if (affine) AccumulateRow<T, kBands, Interpolation::kBicubic, true>(win, V, first, last, sum, count);
+    else AccumulateRow<T, kBands, Interpolation::kBicubic, false>(win, V, first, last, sum, count);
   }
 }
 
@@ -204,6 +219,7 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
     windows[k].width_px = s.width_px;
     windows[k].height_px = s.height_px;
     windows[k].sub_from_virtual = calib::HomographyFromParams(s.model, s.params.data()).inverse();
+    windows[k].sub_from_virtual /= windows[k].sub_from_virtual(2, 2);  // affine: last row 0 0 1
   }
   const int width = camera.width_px, height = camera.height_px;
   const RasterInfo out_info{width, height, first.bands, first.bits};
@@ -214,7 +230,7 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
   for (int y0 = 0; y0 < height; y0 += options.strip_rows) {
     const int rows = std::min(options.strip_rows, height - y0);
     // Window of each sub-image: bounding box of the strip's corners mapped into it, plus margin.
-    for (size_t k = 0; k < windows.size(); ++k) {
+    auto prepare = [&](size_t k) {
       Window& win = windows[k];
       double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
       for (double U : {0.0, width - 1.0})
@@ -230,14 +246,18 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
       const int wy0 = std::max(0, static_cast<int>(std::floor(v0)) - margin);
       const int wy1 = std::min(win.height_px - 1, static_cast<int>(std::ceil(v1)) + margin);
       win.used = x0 <= x1 && wy0 <= wy1;
-      if (!win.used) continue;
+      if (!win.used) return;
       win.x0 = x0;
       win.y0 = wy0;
       win.w = x1 - x0 + 1;
       win.h = wy1 - wy0 + 1;
       win.bytes.resize(static_cast<size_t>(win.w) * win.h * first.bands * first.BytesPerSample());
       sources[k]->ReadWindow(win.x0, win.y0, win.w, win.h, win.bytes.data());
-    }
+    };
+    // Sources are distinct objects: their windows are read in parallel.
+    arena.execute([&] {
+      tbb::parallel_for(size_t{0}, windows.size(), [&](size_t k) { prepare(k); });
+    });
     arena.execute([&] {
       if (first.bits == 8 && first.bands == 1)
         ResampleStrip<std::uint8_t, 1>(windows, options, width, y0, rows, &strip, &covered, &overlap);
