@@ -1,5 +1,6 @@
 # Stitching: adjustment, model choice, flight stability, result JSON, resampling, CLI.
 aerocal_add_test(stitch/stitch_adjustment LIBS aerocal::stitch LABELS synthetic)
+aerocal_add_test(stitch/match_real LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/model_selection LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/flight_stability LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/match_lsm LIBS aerocal::stitch LABELS unit)
