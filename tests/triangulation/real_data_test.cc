@@ -120,3 +120,35 @@ TEST(RealData, OdmUavTargetsBlundersFoundAndCheckPointsCompared) {
 
 }  // namespace
 }  // namespace aerocal::triangulation
+
+namespace aerocal::triangulation {
+namespace {
+
+TEST(RealData, DbatRomaFreeNetworkSelfCalibrationMatchesThePublishedResult) {
+  const std::string dir = testing::SharedDataDir("dbat_roma_canon_eos5d");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/dbat_roma_canon_eos5d is absent";
+  DbatImportOptions in;
+  in.camera_xml = dir + "/cameras/EOS5DMarkII.xml";
+  in.marks = dir + "/measurements/markpts.txt";
+  in.images = dir + "/images/images.txt";
+  in.initial_eo = dir + "/prior/initial_eo.txt";
+  in.default_sigma_px = 1.0;  // DBAT used sxy = 1 px
+  const Project project = ImportDbat(in);
+  ASSERT_EQ(project.observations.size(), 90561u);
+  AdjustOptions options;
+  options.free_interior = ParseSelfCalibration("c,x0,y0,K1,K2");  // DBAT's 5 IO parameters
+  options.data_snooping = false;                                  // as DBAT
+  const AdjustmentResult r = Adjust(project, options);
+  std::printf("%s", FormatSummary(r).c_str());
+  ASSERT_TRUE(r.converged()) << r.solve.message;
+  EXPECT_EQ(r.solve.redundancy, 101801);  // DBAT: 181,122 observations, 79,321 parameters
+  EXPECT_NE(r.datum.find("free network"), std::string::npos);
+  ASSERT_TRUE(r.determinability.covariance_ok) << r.determinability.message;
+  const auto& c = r.cameras[0];
+  // Published: c = 24.5425 mm (sigma 0.00254), sigma0 = 0.582769 px.
+  EXPECT_LE(std::abs(c.estimated[Model::kC] - 24.5425), 3.0 * c.sigma[Model::kC]);
+  EXPECT_NEAR(r.sigma0_px / 0.582769, 1.0, 0.05);
+}
+
+}  // namespace
+}  // namespace aerocal::triangulation

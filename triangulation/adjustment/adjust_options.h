@@ -18,6 +18,11 @@ struct AdjustOptions {
   bool use_interior_sigma = true;
   /// The sigma columns of exposures.csv enter as GNSS/IMU weighted observations.
   bool use_eo_priors = true;
+  /// Without control points and GNSS priors, define the minimal datum of a free network as a
+  /// dependent relative orientation: the first exposure of exposures.csv keeps its starting
+  /// orientation and the exposure farthest from it keeps the coordinate of the largest base
+  /// component (scale). Off: the datum defect is reported as not determinable.
+  bool free_network_datum = true;
   /// Baarda data snooping on the image observations; rejected observations are listed.
   bool data_snooping = true;
   /// Robust start: adjust first with a Cauchy loss on the image observations (scale

@@ -90,6 +90,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["linear_solver"] = r.solve.linear_solver;
   j["seconds"] = r.solve.seconds;
   j["frame"] = r.frame;
+  j["datum"] = r.datum;
   j["self_calibration"] = r.free_interior;
   j["n_observations"] = r.solve.n_observations;
   j["n_unknowns"] = r.solve.n_unknowns;
@@ -175,6 +176,7 @@ std::string FormatSummary(const AdjustmentResult& r) {
       r.solve.converged ? "converged" : "NOT converged", r.solve.iterations, r.sigma0, r.sigma0_px,
       r.sigma0_um, r.solve.redundancy);
   out += "frame: " + r.frame + "\n";
+  out += "datum: " + r.datum + "\n";
   out += StatisticsLine("control", r.control);
   out += StatisticsLine("check", r.check);
   if (!r.free_interior.empty()) out += CalibrationTable(r);

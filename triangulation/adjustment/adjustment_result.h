@@ -91,6 +91,7 @@ struct AdjustmentResult {
   std::map<std::string, Eigen::Vector3d> points_m;  // adjusted coordinates of every point
   std::vector<std::string> notes;                   // points left out, and why
   std::string frame;                                // the object frame, stated
+  std::string datum;                                // how the datum is defined, stated
 
   bool converged() const { return solve.converged; }
 };

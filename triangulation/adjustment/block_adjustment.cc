@@ -59,6 +59,7 @@ struct BlockAdjustment::Storage {
   std::vector<ImageObservation> observations;
   std::map<calib::ResidualId, size_t> observation_of_residual;
   std::vector<std::string> notes;
+  std::string datum;
 };
 
 BlockAdjustment::BlockAdjustment(const Project& project, const AdjustOptions& options,
@@ -69,6 +70,7 @@ BlockAdjustment::BlockAdjustment(const Project& project, const AdjustOptions& op
   BuildPoints(subimage);
   AddImageResiduals(image_loss);
   AddPriors();
+  DefineDatum();
 }
 
 BlockAdjustment::~BlockAdjustment() = default;
@@ -274,10 +276,57 @@ void BlockAdjustment::AddPriors() {
   }
 }
 
+void BlockAdjustment::DefineDatum() {
+  int control = 0;
+  for (const auto& [id, state] : storage_->points)
+    if (state.ground && state.ground->role == PointRole::kControl) ++control;
+  bool gnss = false;
+  for (const auto& [image, state] : storage_->exposures)
+    gnss |= options_.use_eo_priors && state.exposure->center_sigma_m.has_value();
+  if (control > 0 || gnss) {
+    storage_->datum = std::to_string(control) + " control point(s) as weighted observations" +
+                      (gnss ? " and GNSS camera centres" : "");
+    return;
+  }
+  if (!options_.free_network_datum) {
+    storage_->datum = "none: no control points and no GNSS (free network, datum defect)";
+    return;
+  }
+  // Dependent relative orientation: first exposure fixed, one base component of the farthest.
+  std::set<std::string> observed;
+  for (const auto& o : storage_->observations) observed.insert(o.image);
+  const Exposure* first = nullptr;
+  for (const auto& e : project_.exposures)
+    if (observed.count(e.image) && !first) first = &e;
+  if (!first) return;
+  const auto& a = storage_->exposures.at(first->image);
+  const Exposure* far = nullptr;
+  double far_distance = 0.0;
+  for (const auto& e : project_.exposures) {
+    if (!observed.count(e.image)) continue;
+    const double d = (e.center_m - first->center_m).norm();
+    if (d > far_distance) {
+      far_distance = d;
+      far = &e;
+    }
+  }
+  builder_.FixBlock(a.opk_block);
+  builder_.FixBlock(a.center_block);
+  std::string text = "free network: image " + first->image + " fixed at its starting orientation";
+  if (far) {
+    int axis = 0;
+    (far->center_m - first->center_m).cwiseAbs().maxCoeff(&axis);
+    builder_.FixEntries(storage_->exposures.at(far->image).center_block, {axis});
+    text += ", image " + far->image + " centre " + kCenterNames[axis] + " fixed (scale)";
+  }
+  storage_->datum = text;
+}
+
 AdjustmentResult BlockAdjustment::Run() {
   AdjustmentResult result;
   result.free_interior = options_.free_interior;
   result.frame = project_.frame.description;
+  result.datum = storage_->datum;
   result.notes = storage_->notes;
   std::vector<BlockId> interior_blocks;
   for (const auto& [id, state] : storage_->cameras) interior_blocks.push_back(state.block);

@@ -72,6 +72,7 @@ class BlockAdjustment {
   void BuildPoints(SubimageObservations subimage);
   void AddImageResiduals(const calib::LossOptions& loss);
   void AddPriors();
+  void DefineDatum();
 
   const Project& project_;
   AdjustOptions options_;
