@@ -26,7 +26,7 @@ class TiffReader : public RasterSource {
  public:
   explicit TiffReader(const std::string& path) : path_(path) {
     SilenceLibtiff();
-    tiff_ = TIFFOpen(path.c_str(), "r");
+    tiff_ = TIFFOpen(path.c_str(), "rm");  // no memory mapping: windows are read as needed
     if (!tiff_) throw InputError(path + ": cannot open as TIFF");
     uint32_t width = 0, height = 0;
     uint16_t bits = 8, bands = 1, format = SAMPLEFORMAT_UINT, planar = PLANARCONFIG_CONTIG;
