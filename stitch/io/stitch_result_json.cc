@@ -192,6 +192,16 @@ json StitchResultToJson(const BatchResult& result, const BatchOptions& options) 
       subimages.push_back(sub);
     }
   }
+  if (!stability.contains("mean_sigma0_px")) {
+    // The reported model was not adjusted in every frame: the spread of the frames' results.
+    double mean = 0, var = 0;
+    const double n = static_cast<double>(result.frames.size());
+    for (const FrameRun& run : result.frames) mean += run.adjustment.sigma0_px / n;
+    for (const FrameRun& run : result.frames)
+      var += (run.adjustment.sigma0_px - mean) * (run.adjustment.sigma0_px - mean) / (n - 1);
+    stability["mean_sigma0_px"] = mean;
+    stability["std_sigma0_px"] = std::sqrt(var);
+  }
   stability["models"] = per_model;
   j["subimages"] = subimages;
   j["stability"] = stability;
