@@ -8,7 +8,7 @@
 
 namespace aerocal::triangulation::internal {
 
-std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates) {
+std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates, bool keep_blank) {
   const std::string text = ReadTextFile(path);
   std::vector<TextRow> rows;
   std::istringstream in(text);
@@ -18,6 +18,10 @@ std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates)
     ++number;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     const auto first = line.find_first_not_of(" \t");
+    if (first == std::string::npos && keep_blank) {
+      rows.push_back({number, {}});
+      continue;
+    }
     if (first == std::string::npos || line[first] == '#') continue;
     if (comma_separates)
       for (char& ch : line)

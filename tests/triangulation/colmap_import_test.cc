@@ -1,0 +1,112 @@
+// COLMAP text model -> block: pixel (+0.5) and camera-frame conventions, intrinsics fitted to the
+// 10-parameter model; round trip through aerocal's projection.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "calib/core/error.h"
+#include "tests/support/test_support.h"
+#include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/import/colmap_import.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+struct Scene {
+  std::string model;
+  std::vector<double> params;
+};
+
+// Writes a COLMAP model of 6 images looking at 200 points from ~10 m, returns the point truth.
+std::vector<Eigen::Vector3d> WriteModel(const std::string& dir, const Scene& scene) {
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-1, 1);
+  std::vector<Eigen::Vector3d> points;
+  for (int i = 0; i < 200; ++i) points.emplace_back(4 * u(rng), 3 * u(rng), 0.5 * u(rng));
+  std::ofstream cameras(dir + "/cameras.txt"), images(dir + "/images.txt"), pts(dir + "/points3D.txt");
+  cameras << "# Camera list\n1 " << scene.model << " 3000 2000";
+  for (double p : scene.params) cameras << " " << p;
+  cameras << "\n";
+  images << "# Image list with two lines of data per image\n";
+  for (int k = 0; k < 6; ++k) {
+    // Camera above the scene looking down (COLMAP z forward = world -Z), tilted a little.
+    const Eigen::Matrix3d r = (Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()) *
+                               Eigen::AngleAxisd(0.05 * k, Eigen::Vector3d::UnitY()) *
+                               Eigen::AngleAxisd(0.3 * k, Eigen::Vector3d::UnitZ()))
+                                  .toRotationMatrix();
+    const Eigen::Vector3d center(1.0 * k - 2.5, 0.3 * k, 10.0);
+    const Eigen::Vector3d t = -r * center;
+    const Eigen::Quaterniond q(r);
+    images << k + 1 << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << t.x() << " "
+           << t.y() << " " << t.z() << " 1 img" << k + 1 << ".jpg\n";
+    for (size_t i = 0; i < points.size(); ++i) {
+      const Eigen::Vector3d c = r * points[i] + t;
+      const Eigen::Vector2d px = ColmapProject(scene.model, scene.params, c);
+      if (px.x() < 0 || px.y() < 0 || px.x() > 3000 || px.y() > 2000) continue;
+      images << px.x() << " " << px.y() << " " << i + 1 << " ";
+    }
+    images << "\n";
+  }
+  for (size_t i = 0; i < points.size(); ++i)
+    pts << i + 1 << " " << points[i].x() << " " << points[i].y() << " " << points[i].z() << " 0 0 0 0.1\n";
+  return points;
+}
+
+class ColmapImport : public ::testing::TestWithParam<Scene> {};
+
+TEST_P(ColmapImport, ImportedCameraReprojectsColmapPixels) {
+  testing::TempDir dir("aerocal_colmap");
+  const auto truth = WriteModel(dir.path(), GetParam());
+  ColmapImportOptions options;
+  options.folder = dir.path();
+  const auto report = ImportColmapModel(options);
+  const Project& p = report.project;
+  ASSERT_EQ(p.exposures.size(), 6u);
+  ASSERT_GT(p.observations.size(), 600u);
+  std::printf("%s\n", report.notes.front().c_str());
+  double max_error = 0.0;
+  for (const auto& o : p.observations) {
+    const Exposure* e = p.FindExposure(o.image);
+    Eigen::Vector2d px;
+    ASSERT_TRUE(p.cameras.at("1").ProjectToPixel(e->opk_rad, e->center_m, truth[std::stoi(o.point) - 1], &px));
+    max_error = std::max(max_error, (px - o.pixel).norm());
+  }
+  // The forward COLMAP distortion is fitted by the correction model: a few hundredths of a pixel.
+  EXPECT_LT(max_error, 0.05) << GetParam().model;
+  // The imported block adjusts to (nearly) zero residuals in a free-network datum.
+  AdjustOptions adjust;
+  adjust.data_snooping = false;
+  const AdjustmentResult r = Adjust(p, adjust);
+  ASSERT_TRUE(r.converged());
+  EXPECT_LT(r.sigma0_px, 0.02);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Models, ColmapImport,
+    ::testing::Values(Scene{"PINHOLE", {2400, 2410, 1510, 990}},
+                      Scene{"SIMPLE_RADIAL", {2400, 1500, 1000, -0.03}},
+                      Scene{"RADIAL", {2400, 1500, 1000, -0.03, 0.01}},
+                      Scene{"OPENCV", {2400, 2400, 1505, 995, -0.03, 0.01, 2e-4, -1e-4}}),
+    [](const auto& info) { return info.param.model; });
+
+TEST(ColmapImportErrors, UnsupportedModelNamesTheLine) {
+  testing::TempDir dir("aerocal_colmap_bad");
+  std::ofstream(dir.File("cameras.txt")) << "# c\n1 FISHEYE 100 100 1 2 3 4\n";
+  std::ofstream(dir.File("images.txt")) << "";
+  std::ofstream(dir.File("points3D.txt")) << "";
+  ColmapImportOptions options;
+  options.folder = dir.path();
+  try {
+    ImportColmapModel(options);
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cameras.txt:2"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace aerocal::triangulation
