@@ -640,6 +640,10 @@ SolveReport ProblemBuilder::SolveWithDataSnooping(const SolverOptions& options,
             ? snooping.critical_value
             : std::max(3.29, NormalCriticalValue(0.05 / std::max(1, n_components)));
     const auto redundancy = RedundancyNumbers(tested, snooping.max_dense_parameters);
+    // Pope's tau test with the a-posteriori sigma0 when the data are worse than their a-priori
+    // sigmas, Baarda's w test (sigma 1) when they are better: near-noise-free data must not turn
+    // round-off into "gross errors".
+    const double reference_sigma = std::max(report.sigma0, 1.0);
     ResidualId worst = -1;
     double worst_w = critical;
     std::vector<double> worst_v;
@@ -648,7 +652,7 @@ SolveReport ProblemBuilder::SolveWithDataSnooping(const SolverOptions& options,
       const std::vector<double>& r = redundancy.at(id);
       for (size_t k = 0; k < v.size(); ++k) {
         if (r[k] < 1e-6) continue;  // uncontrolled observation: cannot be tested
-        const double w = std::abs(v[k]) / (report.sigma0 * std::sqrt(r[k]));
+        const double w = std::abs(v[k]) / (reference_sigma * std::sqrt(r[k]));
         if (w > worst_w) {
           worst_w = w;
           worst = id;

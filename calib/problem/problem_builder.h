@@ -20,7 +20,8 @@
 //   parameters that span the null space (from an eigen-decomposition of the Jacobi-scaled normal
 //   matrix when the problem is small enough).
 // - SolveWithDataSnooping(): Baarda/Pope data snooping: standardized residuals
-//   w_i = v_i / (sigma0 sqrt(r_ii)) with redundancy numbers r_ii from the normal matrix; the worst
+//   w_i = v_i / (max(sigma0, 1) sqrt(r_ii)) (Pope above, Baarda below the a-priori level) with
+//   redundancy numbers r_ii from the normal matrix; the worst
 //   observation above the critical value is removed and listed, and the problem solved again.
 //
 // How to add a residual family

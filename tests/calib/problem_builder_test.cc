@@ -138,6 +138,10 @@ TEST(ProblemBuilder, NoiseFreeDataGiveExactRecovery) {
         << Model::kParams[i].name;
   }
   EXPECT_LT(report.sigma0, 1e-6);
+  // Snooping noise-free data rejects nothing (round-off is not a gross error).
+  std::vector<RejectedResidual> rejected;
+  a.builder.SolveWithDataSnooping({}, {}, &rejected);
+  EXPECT_TRUE(rejected.empty()) << rejected.size() << " rejected";
 }
 
 TEST(ProblemBuilder, GaussianNoiseGivesSigma0AndThreeSigmaRecovery) {

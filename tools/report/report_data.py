@@ -168,7 +168,8 @@ def point_errors(adjustment, which):
     for p in listing(get(get(adjustment, which), "points")):
         if not isinstance(p, dict):
             continue
-        xyz = triple(p["surveyed_m"]) if "surveyed_m" in p else [number(p.get(k)) for k in "XYZ"]
+        surveyed = p.get("surveyed_m", p.get("surveyed"))
+        xyz = triple(surveyed) if surveyed is not None else [number(p.get(k)) for k in "XYZ"]
         if "difference_m" in p:
             d = triple(p["difference_m"])
         else:
