@@ -44,6 +44,9 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option("--sigma-px", args->default_sigma_px,
                  "Image sigma where observations.csv has no sigma_px, px")->check(CLI::PositiveNumber);
   app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
+  app.add_flag("--robust-start", args->options.robust_start,
+               "Adjust first with a robust (Cauchy) loss, reject the obvious gross errors, then "
+               "re-adjust cleanly (large blunders, rough starting values)");
   app.add_option("--critical-value", args->options.snooping_critical_value,
                  "Critical |w| of data snooping (0: from alpha = 5 % / n)")->check(CLI::NonNegativeNumber);
   app.add_flag("--no-eo-priors", args->no_eo_priors,

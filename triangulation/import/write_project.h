@@ -1,0 +1,15 @@
+// Writes an imported block as FORMATS.md files into a folder: camera_<id>.yaml, exposures.csv,
+// observations.csv, points.csv and project.yaml naming them (with the frame stated), so the
+// conversion is done once and `aerocal adjust --project FOLDER` runs on the result.
+#pragma once
+
+#include <string>
+
+#include "triangulation/block/block.h"
+
+namespace aerocal::triangulation {
+
+/// Every file is written atomically; the folder is created when missing.
+void WriteProjectFolder(const Project& project, const std::string& folder);
+
+}  // namespace aerocal::triangulation
