@@ -414,7 +414,8 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
 
 CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& blocks,
                                                     double sigma0,
-                                                    double correlation_threshold) const {
+                                                    double correlation_threshold,
+                                                    const std::vector<BlockId>& cross_blocks) const {
   CovarianceReport report;
   int total = 0;
   for (BlockId id : blocks) {
@@ -438,10 +439,15 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
   options.num_threads = std::max(1u, std::thread::hardware_concurrency());
   options.apply_loss_function = true;
   ceres::Covariance covariance(options);
+  const std::set<BlockId> cross(cross_blocks.begin(), cross_blocks.end());
+  auto wanted = [&](size_t i, size_t k) {
+    return cross.empty() || i == k || cross.count(free_requested[i]) || cross.count(free_requested[k]);
+  };
   std::vector<std::pair<const double*, const double*>> pairs;
   for (size_t i = 0; i < free_requested.size(); ++i)
     for (size_t k = i; k < free_requested.size(); ++k)
-      pairs.emplace_back(blocks_[free_requested[i]].values, blocks_[free_requested[k]].values);
+      if (wanted(i, k))
+        pairs.emplace_back(blocks_[free_requested[i]].values, blocks_[free_requested[k]].values);
   const bool computed = pairs.empty() || covariance.Compute(pairs, problem_.get());
   if (!computed) {
     report.ok = false;
@@ -462,6 +468,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
   const double s2 = sigma0 * sigma0;
   for (size_t i = 0; i < free_requested.size(); ++i) {
     for (size_t k = i; k < free_requested.size(); ++k) {
+      if (!wanted(i, k)) continue;
       const Block& a = blocks_[free_requested[i]];
       const Block& b = blocks_[free_requested[k]];
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(a.size, b.size);

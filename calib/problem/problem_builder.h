@@ -188,8 +188,12 @@ class ProblemBuilder {
 
   /// Covariance of `blocks` at the current values, scaled by sigma0^2; correlations above
   /// `correlation_threshold` are listed.
+  /// With `cross_blocks` non-empty, only the diagonal blocks and the pairs involving one of
+  /// `cross_blocks` are computed (e.g. interior x every exterior block, for large blocks); the other
+  /// off-diagonal entries stay 0 and their correlations are not examined.
   CovarianceReport EstimateCovariance(const std::vector<BlockId>& blocks, double sigma0,
-                                      double correlation_threshold = 0.95) const;
+                                      double correlation_threshold = 0.95,
+                                      const std::vector<BlockId>& cross_blocks = {}) const;
 
   /// Redundancy numbers r_ii of every scalar residual of the listed residuals (whitened problem).
   /// Exact: with point blocks (ground / tie points) by their elimination (Schur complement) when

@@ -407,7 +407,8 @@ AdjustmentResult BlockAdjustment::Run() {
   for (const auto& [id, camera] : project_.cameras) pixel_sizes.push_back(camera.pixel_size_mm);
   result.sigma0_um = result.sigma0_px * Median(pixel_sizes) * 1000.0;
 
-  // Covariance: interior and exterior orientation (all pairs, so c ~ Z0 and x0 ~ X0/phi show).
+  // Covariance: interior and exterior orientation; interior x everything (so c ~ Z0 and
+  // x0 ~ X0 / phi show), exterior blocks only with themselves (cheap for large blocks).
   std::vector<BlockId> cov_blocks = interior_blocks;
   for (const auto& [image, state] : storage_->exposures) {
     cov_blocks.push_back(state.opk_block);
@@ -417,7 +418,8 @@ AdjustmentResult BlockAdjustment::Run() {
   if (!options_.estimate_covariance)
     cov.message = "covariance not estimated (option)";
   else if (result.solve.usable && result.solve.redundancy > 0)
-    cov = builder_.EstimateCovariance(cov_blocks, result.sigma0, options_.correlation_threshold);
+    cov = builder_.EstimateCovariance(cov_blocks, result.sigma0, options_.correlation_threshold,
+                                      interior_blocks);
   else
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
   Determinability& det = result.determinability;
