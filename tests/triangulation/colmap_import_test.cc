@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
@@ -106,6 +107,54 @@ TEST(ColmapImportErrors, UnsupportedModelNamesTheLine) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("cameras.txt:2"), std::string::npos) << e.what();
   }
+}
+
+}  // namespace
+}  // namespace aerocal::triangulation
+
+#include "triangulation/import/colmap_export.h"
+#include "triangulation/simulation/flight_simulator.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+TEST(ColmapExport, RoundTripKeepsOrientationsAndPixels) {
+  FlightSimulationOptions o;
+  o.ground_points = 30;
+  o.tie_points = 50;
+  const SimulatedFlight f = SimulateFlight(o);
+  Project p;
+  p.cameras["cam1"] = f.truth;
+  p.cameras["cam1"].interior = f.nominal.interior;  // no distortion: exported exactly
+  p.exposures = f.exposures_truth;
+  p.observations = f.observations;
+  std::map<std::string, Eigen::Vector3d> points;
+  for (const auto& g : f.points_truth) points[g.id] = *g.xyz_m;
+  testing::TempDir dir("aerocal_colmap_export");
+  WriteColmapModel(p, points, dir.path());
+  ColmapImportOptions options;
+  options.folder = dir.path();
+  options.pixel_size_mm = f.truth.pixel_size_mm;
+  const Project back = ImportColmapModel(options).project;
+  ASSERT_EQ(back.exposures.size(), p.exposures.size());
+  for (size_t i = 0; i < p.exposures.size(); ++i) {
+    const Exposure* e = back.FindExposure(p.exposures[i].image);
+    ASSERT_NE(e, nullptr);
+    EXPECT_LT((e->center_m - p.exposures[i].center_m).norm(), 1e-6);
+    EXPECT_LT((calib::RotationFromOpk(e->opk_rad) - calib::RotationFromOpk(p.exposures[i].opk_rad)).norm(), 1e-12);
+  }
+  ASSERT_EQ(back.observations.size(), p.observations.size());
+  const auto& camera = back.cameras.begin()->second;
+  EXPECT_NEAR(camera.c_mm(), f.nominal.c_mm(), 1e-9);
+  for (int k = 1; k < calib::BrownFraser10Model::kNumParams; ++k) EXPECT_NEAR(camera.interior[k], 0.0, 1e-12);
+  std::map<std::pair<std::string, std::string>, Eigen::Vector2d> original;
+  for (const auto& ob : p.observations) original[{ob.image, ob.point}] = ob.pixel;
+  // Points are renumbered 1..n in id order; compare by image and coordinates.
+  std::map<std::string, std::string> id_of_number;
+  int n = 0;
+  for (const auto& [id, xyz] : points) id_of_number[std::to_string(++n)] = id;
+  for (const auto& ob : back.observations)
+    EXPECT_LT((ob.pixel - original.at({ob.image, id_of_number.at(ob.point)})).norm(), 1e-9);
 }
 
 }  // namespace
