@@ -12,6 +12,7 @@
 #include "stitch/simulation/stitch_simulator.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/block/block_io.h"
+#include "triangulation/georef/object_frame.h"
 #include "triangulation/joint/joint_adjustment.h"
 
 namespace aerocal::triangulation {
@@ -45,7 +46,15 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   const std::string subimage_project = (fs::path(options.data_folder) / "project_subimage.yaml").string();
   if (!fs::exists(virtual_project))
     throw InputError(options.data_folder + ": no project.yaml (the block with virtual-image observations)");
-  const Project project = WithCamera(ReadProject(virtual_project), camera, options.camera_file);
+  // Geodetic blocks are adjusted in a metric frame and their results written back (georef/).
+  const Project input = WithCamera(ReadProject(virtual_project), camera, options.camera_file);
+  const ObjectFrame object_frame(input.frame);
+  const Project project = ToAdjustmentFrame(input, object_frame);
+  const auto adjust = [&](const AdjustOptions& o) {
+    AdjustmentResult r = Adjust(project, o);
+    ToInputFrame(object_frame, &r);
+    return r;
+  };
 
   nlohmann::json& doc = out.document;
   doc["kind"] = "flight";
@@ -55,6 +64,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
                           {"height_px", camera.height_px},
                           {"pixel_size_mm", camera.pixel_size_mm}};
   doc["base_subimages"] = options.base_ids;
+  doc["frame"] = object_frame.Description();
 
   // 1. Stitching of every exposure, model chosen per frame by the F test, and stability.
   if (!project.stitching_file.empty() && !camera.subimages.empty()) {
@@ -76,11 +86,11 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   // 2. Conventional and self-calibrating triangulation on the virtual-image observations.
   nlohmann::json adjustments = nlohmann::json::array();
   AdjustOptions conventional_options;
-  const AdjustmentResult conventional = Adjust(project, conventional_options);
+  const AdjustmentResult conventional = adjust(conventional_options);
   if (progress) progress->Advance();
   AdjustOptions self_options;
   self_options.free_interior = options.free_interior;
-  const AdjustmentResult self_calibration = Adjust(project, self_options);
+  const AdjustmentResult self_calibration = adjust(self_options);
   if (progress) progress->Advance();
   nlohmann::json a = AdjustmentToJson(conventional);
   a["name"] = "conventional";
@@ -98,12 +108,14 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
 
   // 3. Joint stitching + triangulation on the raw sub-image observations.
   if (options.joint && fs::exists(subimage_project) && !camera.subimages.empty()) {
-    const Project raw = WithCamera(ReadProject(subimage_project), camera, options.camera_file);
+    const Project raw = ToAdjustmentFrame(WithCamera(ReadProject(subimage_project), camera, options.camera_file),
+                                          object_frame);
     JointOptions joint_options;
     joint_options.adjust = self_options;
     joint_options.base_ids = options.base_ids;
     joint_options.stitch_sigma_px = options.stitch_sigma_px;
-    const JointResult joint = AdjustJoint(raw, joint_options);
+    JointResult joint = AdjustJoint(raw, joint_options);
+    ToInputFrame(object_frame, &joint.adjustment);
     nlohmann::json j = JointResultToJson(joint);
     j["name"] = "joint";
     adjustments.push_back(j);
