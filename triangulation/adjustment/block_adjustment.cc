@@ -4,10 +4,10 @@
 #include <cmath>
 #include <set>
 
-#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
+#include "triangulation/adjustment/determinability.h"
 #include "triangulation/adjustment/forward_intersection.h"
 
 namespace aerocal::triangulation {
@@ -422,12 +422,7 @@ AdjustmentResult BlockAdjustment::Run() {
                                       interior_blocks);
   else
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
-  Determinability& det = result.determinability;
-  det.covariance_ok = cov.ok;
-  det.message = cov.message;
-  det.undetermined = cov.undetermined;
-  if (!cov.ok) det.warnings.push_back("the block cannot determine all parameters: " + cov.message);
-
+  result.determinability = AssessDeterminability(cov, "camera ", options_.correlation_threshold);
   for (const auto& [id, state] : storage_->cameras) {
     CameraEstimate c;
     c.id = id;
@@ -442,34 +437,6 @@ AdjustmentResult BlockAdjustment::Run() {
     }
     result.cameras.push_back(c);
   }
-  if (cov.ok) {
-    // Every free interior parameter: its strongest correlation with any other parameter.
-    const std::string prefix = "camera ";
-    for (int i = 0; i < static_cast<int>(cov.names.size()); ++i) {
-      if (cov.names[i].rfind(prefix, 0) != 0 || !cov.free[i]) continue;
-      int partner = -1;
-      double best = 0.0;
-      for (int k = 0; k < static_cast<int>(cov.names.size()); ++k)
-        if (k != i && cov.free[k] && std::abs(cov.correlation(i, k)) > std::abs(best)) {
-          best = cov.correlation(i, k);
-          partner = k;
-        }
-      const bool reported =
-          partner >= 0 && std::any_of(det.high_correlations.begin(), det.high_correlations.end(),
-                      [&](const calib::HighCorrelation& h) { return h.a == cov.names[partner] && h.b == cov.names[i]; });
-      if (partner >= 0 && !reported && std::abs(best) > options_.correlation_threshold) {
-        det.high_correlations.push_back({cov.names[i], cov.names[partner], best});
-        char text[512];
-        std::snprintf(text, sizeof(text),
-                      "%s is not separable from %s (correlation %.4f): the block cannot determine "
-                      "it independently; add GNSS camera centres, control at different heights, "
-                      "cross strips, or an a-priori sigma",
-                      cov.names[i].c_str(), cov.names[partner].c_str(), best);
-        det.warnings.push_back(text);
-      }
-    }
-  }
-
   for (const auto& [image, state] : storage_->exposures) {
     ExposureEstimate e;
     e.image = image;
@@ -497,71 +464,6 @@ AdjustmentResult BlockAdjustment::Run() {
   result.control = ComputePointStatistics(result.control_points);
   result.check = ComputePointStatistics(result.check_points);
   for (const auto& d : result.solve.diagnostics) result.notes.push_back(d);
-  return result;
-}
-
-AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
-  if (!options.robust_start) {
-    BlockAdjustment adjustment(project, options);
-    return adjustment.Run();
-  }
-  AdjustOptions robust = options;
-  robust.data_snooping = false;
-  robust.estimate_covariance = false;
-  calib::LossOptions loss;
-  loss.kind = calib::LossKind::kCauchy;
-  loss.scale = options.robust_scale_sigma;
-  AdjustmentResult start;
-  {
-    BlockAdjustment adjustment(project, robust, SubimageObservations::kMapWithCameraFile, loss);
-    start = adjustment.Run();
-  }
-  // Observations far outside the robust solution's spread are gross errors: a robust scale
-  // (1.4826 median |v / sigma| over all components) and a cut at `robust_reject_sigma` scales.
-  std::vector<double> abs_w;
-  for (const auto& v : start.residuals)
-    if (v.used)
-      for (int k = 0; k < 2; ++k) abs_w.push_back(std::abs(v.residual_px(k)) / v.sigma_px);
-  std::vector<RejectedObservation> pre_rejected;
-  Project next = project;
-  if (!abs_w.empty()) {
-    std::nth_element(abs_w.begin(), abs_w.begin() + abs_w.size() / 2, abs_w.end());
-    const double scale = std::max(1e-12, 1.4826 * abs_w[abs_w.size() / 2]);
-    std::vector<bool> drop(project.observations.size(), false);
-    for (const auto& v : start.residuals) {
-      const double w = v.residual_px.norm() / v.sigma_px / scale;
-      if (!v.used || w <= options.robust_reject_sigma) continue;
-      for (size_t i = 0; i < project.observations.size(); ++i) {
-        const auto& o = project.observations[i];
-        if (!drop[i] && o.image == v.image && o.point == v.point && o.subimage.empty() && o.pixel == v.measured_px) {
-          drop[i] = true;
-          pre_rejected.push_back({v.image, v.point, v.measured_px, Eigen::Vector2d(v.residual_px.x(), -v.residual_px.y()), w});
-          break;
-        }
-      }
-    }
-    next.observations.clear();
-    for (size_t i = 0; i < project.observations.size(); ++i)
-      if (!drop[i]) next.observations.push_back(project.observations[i]);
-  }
-  // The robust solution becomes the starting values; surveyed coordinates stay the survey.
-  for (auto& e : next.exposures)
-    for (const auto& s : start.exposures)
-      if (s.image == e.image) {
-        e.center_m = s.center_m;
-        e.opk_rad = s.opk_rad;
-      }
-  for (const auto& c : start.cameras) next.cameras.at(c.id).interior = c.estimated;
-  for (auto& p : next.points)
-    if (p.role == PointRole::kTie && start.points_m.count(p.id)) p.xyz_m = start.points_m.at(p.id);
-  BlockAdjustment adjustment(next, options);
-  AdjustmentResult result = adjustment.Run();
-  for (auto& c : result.cameras) c.initial = project.cameras.at(c.id).interior;
-  result.rejected.insert(result.rejected.begin(), pre_rejected.begin(), pre_rejected.end());
-  for (const auto& r : pre_rejected)
-    result.residuals.push_back({r.image, r.point, r.measured_px, Eigen::Vector2d::Zero(), 0.0, false});
-  result.notes.push_back("started from a robust (Cauchy, " + FormatNumber(options.robust_scale_sigma, 3) +
-                         " sigma) adjustment");
   return result;
 }
 

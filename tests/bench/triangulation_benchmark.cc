@@ -1,0 +1,174 @@
+// Self-calibrating block adjustment: aerocal vs `colmap bundle_adjuster` (Debian package colmap)
+// on the same data, in the same run. Simulated blocks of 37, 600 and 2400 exposures (seeded
+// example flight scaled up; aerocal with its control points, COLMAP as a free network with
+// intrinsics refined) and the real DBAT Roma block (published answer). Counters:
+//   aerocal_s / colmap_s / ratio      wall time of the whole adjustment (aerocal: with covariance)
+//   aerocal_solve_s                   aerocal without the covariance
+//   c_error_px / colmap_c_error_px    estimated principal distance minus the truth (or published)
+//   aerocal_sigma0_px, colmap_final_rms_px (COLMAP's report), peak_rss_mb
+// Run: build with -DAEROCAL_BUILD_BENCHMARKS=ON, then build/tests/bench/bench_triangulation.
+#include <sys/resource.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include <benchmark/benchmark.h>
+
+#include "tests/support/test_support.h"
+#include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/adjustment/forward_intersection.h"
+#include "triangulation/import/colmap_export.h"
+#include "triangulation/import/dbat_import.h"
+#include "triangulation/simulation/flight_simulator.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using Model = calib::BrownFraser10Model;
+
+double Seconds(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+
+double PeakRssMb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;
+}
+
+// Starting coordinates of every point seen twice (the same start aerocal computes).
+std::map<std::string, Eigen::Vector3d> StartPoints(const Project& p) {
+  std::map<std::string, std::vector<ImageRay>> rays;
+  for (const auto& o : p.observations) {
+    const Exposure* e = p.FindExposure(o.image);
+    rays[o.point].push_back(RayFromPixel(p.cameras.at(e->camera), e->opk_rad, e->center_m, o.pixel));
+  }
+  std::map<std::string, Eigen::Vector3d> out;
+  for (const auto& [id, r] : rays)
+    if (auto x = IntersectRays(r)) out[id] = *x;
+  return out;
+}
+
+struct ColmapRun {
+  bool ok = false;
+  double seconds = 0, f_px = 0, final_rms_px = 0;
+};
+
+ColmapRun RunColmap(const Project& project) {
+  ColmapRun run;
+  if (std::system("command -v colmap > /dev/null 2>&1") != 0) return run;
+  testing::TempDir dir("aerocal_bench_colmap");
+  std::filesystem::create_directories(dir.File("in"));
+  std::filesystem::create_directories(dir.File("out"));
+  WriteColmapModel(project, StartPoints(project), dir.File("in"));
+  const std::string command = "QT_QPA_PLATFORM=offscreen colmap bundle_adjuster --input_path " + dir.File("in") +
+                              " --output_path " + dir.File("out") +
+                              " --BundleAdjustment.refine_focal_length 1 --BundleAdjustment.refine_principal_point 1"
+                              " --BundleAdjustment.refine_extra_params 1 --log_to_stderr 1 > " + dir.File("log.txt") + " 2>&1";
+  const auto start = Clock::now();
+  const int rc = std::system(command.c_str());
+  run.seconds = Seconds(start);
+  if (rc != 0) return run;
+  // Export to text (bundle_adjuster writes the binary format).
+  const std::string convert = "colmap model_converter --input_path " + dir.File("out") + " --output_path " +
+                              dir.File("out") + " --output_type TXT > /dev/null 2>&1";
+  if (std::system(convert.c_str()) != 0) return run;
+  std::ifstream cameras(dir.File("out/cameras.txt"));
+  std::string line;
+  while (std::getline(cameras, line)) {
+    if (line.empty() || line[0] == '#') continue;
+    std::istringstream in(line);
+    std::string id, model;
+    double w, h, fx, fy;
+    in >> id >> model >> w >> h >> fx >> fy;
+    run.f_px = fy;
+    break;
+  }
+  // COLMAP's bundle-adjustment report: "Final cost : X [px]" (RMS reprojection error).
+  std::ifstream log(dir.File("log.txt"));
+  while (std::getline(log, line)) {
+    const auto at = line.find("Final cost");
+    if (at == std::string::npos) continue;
+    std::istringstream in(line.substr(line.find(':', at) + 1));
+    in >> run.final_rms_px;
+  }
+  run.ok = run.f_px > 0;
+  return run;
+}
+
+void Compare(benchmark::State& state, const Project& project, const AdjustOptions& options, double c_truth_mm) {
+  AdjustmentResult r;
+  double seconds = 0;
+  for (auto _ : state) {
+    const auto start = Clock::now();
+    r = Adjust(project, options);
+    seconds = Seconds(start);
+  }
+  const double p = project.cameras.begin()->second.pixel_size_mm;
+  state.counters["aerocal_s"] = seconds;
+  state.counters["aerocal_solve_s"] = r.solve.seconds;
+  state.counters["aerocal_sigma0_px"] = r.sigma0_px;
+  state.counters["c_error_px"] = (r.cameras[0].estimated[Model::kC] - c_truth_mm) / p;
+  state.counters["c_sigma_px"] = r.cameras[0].sigma[Model::kC] / p;
+  state.counters["converged"] = r.converged();
+  state.counters["peak_rss_mb"] = PeakRssMb();
+  const ColmapRun colmap = RunColmap(project);
+  if (colmap.ok) {
+    state.counters["colmap_s"] = colmap.seconds;
+    state.counters["ratio_colmap_over_aerocal"] = colmap.seconds / seconds;
+    state.counters["colmap_c_error_px"] = colmap.f_px - c_truth_mm / p;
+    state.counters["colmap_final_rms_px"] = colmap.final_rms_px;
+  } else {
+    state.SetLabel("colmap not available or failed");
+  }
+}
+
+void BM_SimulatedBlock(benchmark::State& state) {
+  const int exposures = static_cast<int>(state.range(0));
+  FlightSimulationOptions o;
+  o.exposures = exposures;
+  o.strips = std::max(3, static_cast<int>(std::lround(std::sqrt(exposures / 4.0))));
+  o.tie_points = 16 * exposures;
+  o.ground_points = std::max(329, 2 * exposures);
+  o.control_points = std::max(5, exposures / 20);
+  const SimulatedFlight f = SimulateFlight(o);
+  Project project;
+  project.cameras["cam1"] = f.nominal;
+  project.exposures = f.exposures_file;
+  project.observations = f.observations;
+  project.points = f.points_file;
+  AdjustOptions options;
+  options.free_interior = ParseSelfCalibration("all");
+  options.data_snooping = false;  // neither solver tests for gross errors here
+  state.counters["observations"] = static_cast<double>(f.observations.size());
+  Compare(state, project, options, f.truth.c_mm());
+}
+BENCHMARK(BM_SimulatedBlock)->Arg(37)->Arg(600)->Arg(2400)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+void BM_DbatRoma(benchmark::State& state) {
+  const std::string dir = testing::SharedDataDir("dbat_roma_canon_eos5d");
+  if (dir.empty()) {
+    state.SkipWithError("../shared/data/dbat_roma_canon_eos5d is absent");
+    return;
+  }
+  DbatImportOptions in;
+  in.camera_xml = dir + "/cameras/EOS5DMarkII.xml";
+  in.marks = dir + "/measurements/markpts.txt";
+  in.images = dir + "/images/images.txt";
+  in.initial_eo = dir + "/prior/initial_eo.txt";
+  const Project project = ImportDbat(in);
+  AdjustOptions options;
+  options.free_interior = ParseSelfCalibration("c,x0,y0,K1,K2");
+  options.data_snooping = false;
+  Compare(state, project, options, 24.5425);  // published c (DBAT)
+}
+BENCHMARK(BM_DbatRoma)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+
+}  // namespace
+}  // namespace aerocal::triangulation
+
+BENCHMARK_MAIN();

@@ -1,0 +1,20 @@
+// Determinability of the parameters of an adjustment from its covariance: a singular normal
+// matrix (datum defect, parameters the observations cannot reach, with the null-space parameters
+// the builder found), and every parameter of interest whose strongest correlation with any other
+// parameter exceeds the threshold (e.g. c with the exposures' Z without GNSS or relief, x0 with
+// P1). The run reports these; it does not pretend.
+#pragma once
+
+#include <string>
+
+#include "calib/problem/problem_builder.h"
+#include "triangulation/adjustment/adjustment_result.h"
+
+namespace aerocal::triangulation {
+
+/// `prefix` selects the parameters of interest by name ("camera " for interior parameters);
+/// `threshold` in (0, 1). Each inseparable pair is listed once, with a sentence in `warnings`.
+Determinability AssessDeterminability(const calib::CovarianceReport& covariance, const std::string& prefix,
+                                      double threshold);
+
+}  // namespace aerocal::triangulation
