@@ -1,8 +1,5 @@
 // aerocal adjust: self-calibrating bundle block adjustment with control and check points
 // (triangulation/adjustment). Parsing, loading, calling the library, writing results.
-#include <cstdio>
-#include <filesystem>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
@@ -10,6 +7,9 @@
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
+
+#include <cstdio>
+#include <filesystem>
 
 namespace aerocal::tools {
 namespace {
@@ -31,32 +31,46 @@ CommandRun SetupAdjust(CLI::App& app) {
     triangulation::AdjustOptions options;
   };
   auto args = std::make_shared<Args>();
-  app.add_option("--project", args->project, "Project YAML (or folder with project.yaml), FORMATS.md")->required();
+  app.add_option(
+         "--project", args->project, "Project YAML (or folder with project.yaml), FORMATS.md")
+      ->required();
   app.add_option("--out", args->out, "Result JSON (written atomically)")->required();
-  app.add_option("--self-calibration", args->self_calibration,
+  app.add_option("--self-calibration",
+                 args->self_calibration,
                  "Interior parameters to estimate: none (conventional, default), all, or a list "
                  "such as c,x0,y0,K1,K2");
-  app.add_flag("--compare", args->compare,
+  app.add_flag("--compare",
+               args->compare,
                "Run the conventional and the self-calibrating adjustment and compare them "
                "(self-calibration: the --self-calibration list, or all)");
-  app.add_option("--write-camera", args->write_camera,
+  app.add_option("--write-camera",
+                 args->write_camera,
                  "Write the estimated camera file (camera-file YAML) for the next run");
-  app.add_option("--sigma-px", args->default_sigma_px,
-                 "Image sigma where observations.csv has no sigma_px, px")->check(CLI::PositiveNumber);
+  app.add_option("--sigma-px",
+                 args->default_sigma_px,
+                 "Image sigma where observations.csv has no sigma_px, px")
+      ->check(CLI::PositiveNumber);
   app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
-  app.add_flag("--robust-start", args->options.robust_start,
+  app.add_flag("--robust-start",
+               args->options.robust_start,
                "Adjust first with a robust (Cauchy) loss, reject the obvious gross errors, then "
                "re-adjust cleanly (large blunders, rough starting values)");
-  app.add_option("--critical-value", args->options.snooping_critical_value,
-                 "Critical |w| of data snooping (0: from alpha = 5 % / n)")->check(CLI::NonNegativeNumber);
-  app.add_flag("--no-eo-priors", args->no_eo_priors,
+  app.add_option("--critical-value",
+                 args->options.snooping_critical_value,
+                 "Critical |w| of data snooping (0: from alpha = 5 % / n)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_flag("--no-eo-priors",
+               args->no_eo_priors,
                "Ignore the GNSS/IMU sigma columns of exposures.csv (starting values only)");
-  app.add_flag("--no-interior-sigma", args->no_interior_sigma,
+  app.add_flag("--no-interior-sigma",
+               args->no_interior_sigma,
                "Ignore the camera file's interior_sigma (unweighted self-calibration)");
   app.add_option("--max-iterations", args->options.solver.max_iterations, "Solver iterations")
       ->check(CLI::PositiveNumber);
-  app.add_option("--correlation-threshold", args->options.correlation_threshold,
-                 "Report parameter pairs correlated above this")->check(CLI::Range(0.0, 1.0));
+  app.add_option("--correlation-threshold",
+                 args->options.correlation_threshold,
+                 "Report parameter pairs correlated above this")
+      ->check(CLI::Range(0.0, 1.0));
   return [args]() {
     auto options = args->options;
     options.data_snooping = !args->no_snooping;
@@ -65,9 +79,11 @@ CommandRun SetupAdjust(CLI::App& app) {
     options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
     options.Validate();
     if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
-      throw ConfigError("--write-camera needs a self-calibrating run (--self-calibration or --compare)");
+      throw ConfigError(
+          "--write-camera needs a self-calibrating run (--self-calibration or --compare)");
 
-    const triangulation::Project input = triangulation::ReadProject(args->project, args->default_sigma_px);
+    const triangulation::Project input =
+        triangulation::ReadProject(args->project, args->default_sigma_px);
     const triangulation::ObjectFrame frame(input.frame);
     const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
 
@@ -81,8 +97,9 @@ CommandRun SetupAdjust(CLI::App& app) {
     nlohmann::json json;
     AdjustmentResult main;
     if (args->compare) {
-      const auto self_list =
-          options.free_interior.empty() ? triangulation::ParseSelfCalibration("all") : options.free_interior;
+      const auto self_list = options.free_interior.empty()
+                                 ? triangulation::ParseSelfCalibration("all")
+                                 : options.free_interior;
       const AdjustmentResult conventional = run({});
       main = run(self_list);
       std::printf("%s", triangulation::FormatComparison(conventional, main).c_str());
@@ -100,13 +117,16 @@ CommandRun SetupAdjust(CLI::App& app) {
     const bool ok = main.solve.converged && main.determinability.covariance_ok;
     if (!args->write_camera.empty()) {
       if (!ok) {
-        std::fprintf(stderr, "camera not written: the adjustment %s\n",
-                     main.solve.converged ? "cannot determine every parameter" : "did not converge");
+        std::fprintf(
+            stderr,
+            "camera not written: the adjustment %s\n",
+            main.solve.converged ? "cannot determine every parameter" : "did not converge");
       } else {
         for (const auto& estimate : main.cameras) {
           const std::string path =
               CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);
-          calib::WriteCamera(path, triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate));
+          calib::WriteCamera(path,
+                             triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate));
           std::printf("camera %s -> %s\n", estimate.id.c_str(), path.c_str());
         }
       }
@@ -118,9 +138,11 @@ CommandRun SetupAdjust(CLI::App& app) {
 
 }  // namespace
 
-AEROCAL_REGISTER_COMMAND(adjust, "adjust",
-                         "Bundle block adjustment (conventional or self-calibrating) with control and "
-                         "check points",
-                         SetupAdjust);
+AEROCAL_REGISTER_COMMAND(
+    adjust,
+    "adjust",
+    "Bundle block adjustment (conventional or self-calibrating) with control and "
+    "check points",
+    SetupAdjust);
 
 }  // namespace aerocal::tools

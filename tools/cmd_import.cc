@@ -1,8 +1,5 @@
 // aerocal import: converts blocks from other tools (COLMAP text model, DBAT / PhotoModeler marks,
 // OpenDroneMap gcp_list.txt) once into the FORMATS.md block files (triangulation/import).
-#include <cstdio>
-#include <sstream>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
@@ -12,12 +9,18 @@
 #include "triangulation/import/odm_gcp_import.h"
 #include "triangulation/import/write_project.h"
 
+#include <cstdio>
+#include <sstream>
+
 namespace aerocal::tools {
 namespace {
 
 void Report(const triangulation::Project& p, const std::string& out) {
   std::printf("imported %zu exposures, %zu observations, %zu points -> %s/project.yaml\n",
-              p.exposures.size(), p.observations.size(), p.points.size(), out.c_str());
+              p.exposures.size(),
+              p.observations.size(),
+              p.points.size(),
+              out.c_str());
 }
 
 CommandRun SetupImport(CLI::App& app) {
@@ -25,10 +28,12 @@ CommandRun SetupImport(CLI::App& app) {
   auto out = std::make_shared<std::string>();
   auto run = std::make_shared<CommandRun>();
 
-  CLI::App* colmap = app.add_subcommand("colmap", "COLMAP text model (cameras.txt, images.txt, points3D.txt)");
+  CLI::App* colmap =
+      app.add_subcommand("colmap", "COLMAP text model (cameras.txt, images.txt, points3D.txt)");
   auto c = std::make_shared<triangulation::ColmapImportOptions>();
   colmap->add_option("--model", c->folder, "Folder of the text model")->required();
-  colmap->add_option("--pixel-size-mm", c->pixel_size_mm, "Pixel size, mm (COLMAP has none)")->check(CLI::PositiveNumber);
+  colmap->add_option("--pixel-size-mm", c->pixel_size_mm, "Pixel size, mm (COLMAP has none)")
+      ->check(CLI::PositiveNumber);
   colmap->add_option("--sigma-px", c->sigma_px, "Image sigma, px")->check(CLI::PositiveNumber);
   colmap->add_option("--out", *out, "Output folder")->required();
   colmap->callback([=] {
@@ -47,10 +52,15 @@ CommandRun SetupImport(CLI::App& app) {
   dbat->add_option("--marks", d->marks, "markpts.txt: image_id, point_id, x, y[, sxy]")->required();
   dbat->add_option("--images", d->images, "images.txt: id, path")->required();
   dbat->add_option("--control", d->control, "Control points: id, label, X, Y, Z[, sxyz]");
-  dbat->add_option("--initial-eo", d->initial_eo, "Initial EO: id, X, Y, Z, omega, phi, kappa (deg)");
-  dbat->add_option("--photomodeler-export", d->photomodeler_export, "PhotoModeler bundle export (stations)");
-  dbat->add_option("--sigma-px", d->default_sigma_px, "Sigma where the marks have none, px")->check(CLI::PositiveNumber);
-  dbat->add_option("--control-sigma-m", d->control_sigma_m, "Control sigma where the file has none, m")->check(CLI::PositiveNumber);
+  dbat->add_option(
+      "--initial-eo", d->initial_eo, "Initial EO: id, X, Y, Z, omega, phi, kappa (deg)");
+  dbat->add_option(
+      "--photomodeler-export", d->photomodeler_export, "PhotoModeler bundle export (stations)");
+  dbat->add_option("--sigma-px", d->default_sigma_px, "Sigma where the marks have none, px")
+      ->check(CLI::PositiveNumber);
+  dbat->add_option(
+          "--control-sigma-m", d->control_sigma_m, "Control sigma where the file has none, m")
+      ->check(CLI::PositiveNumber);
   dbat->add_option("--out", *out, "Output folder")->required();
   dbat->callback([=] {
     *run = [=] {
@@ -61,18 +71,22 @@ CommandRun SetupImport(CLI::App& app) {
     };
   });
 
-  CLI::App* odm = app.add_subcommand("odm", "OpenDroneMap gcp_list.txt (targets in near-nadir images)");
+  CLI::App* odm =
+      app.add_subcommand("odm", "OpenDroneMap gcp_list.txt (targets in near-nadir images)");
   auto o = std::make_shared<triangulation::OdmImportOptions>();
   auto camera_file = std::make_shared<std::string>();
   auto control = std::make_shared<std::string>();
   odm->add_option("--gcp-list", o->gcp_list, "gcp_list.txt")->required();
   odm->add_option("--camera", *camera_file, "Camera file (YAML) of the images")->required();
-  odm->add_option("--control", *control,
+  odm->add_option("--control",
+                  *control,
                   "Control targets: comma-separated names, or a gcp_list whose targets are control "
                   "(the others become check points; default: all control)");
   odm->add_option("--sigma-px", o->sigma_px, "Image sigma, px")->check(CLI::PositiveNumber);
-  odm->add_option("--target-sigma-m", o->target_sigma_m, "Target survey sigma, m")->check(CLI::PositiveNumber);
-  odm->add_option("--pixel-scale", o->pixel_scale, "Full-format px per listed px")->check(CLI::PositiveNumber);
+  odm->add_option("--target-sigma-m", o->target_sigma_m, "Target survey sigma, m")
+      ->check(CLI::PositiveNumber);
+  odm->add_option("--pixel-scale", o->pixel_scale, "Full-format px per listed px")
+      ->check(CLI::PositiveNumber);
   odm->add_option("--out", *out, "Output folder")->required();
   odm->callback([=] {
     *run = [=] {
@@ -83,7 +97,8 @@ CommandRun SetupImport(CLI::App& app) {
           subset.gcp_list = *control;
           subset.camera = o->camera;
           subset.pixel_scale = o->pixel_scale;
-          for (const auto& p : triangulation::ImportOdmGcpList(subset).points) o->control_ids.insert(p.id);
+          for (const auto& p : triangulation::ImportOdmGcpList(subset).points)
+            o->control_ids.insert(p.id);
         } else {
           std::stringstream in(*control);
           std::string id;
@@ -94,8 +109,9 @@ CommandRun SetupImport(CLI::App& app) {
       project.exposures = triangulation::NadirStartFromControl(project, "cam1");
       triangulation::WriteProjectFolder(project, *out);
       Report(project, *out);
-      std::printf("exposures.csv holds starting values from the targets (near-nadir similarity); "
-                  "adjust with --robust-start when the list may hold gross errors\n");
+      std::printf(
+          "exposures.csv holds starting values from the targets (near-nadir similarity); "
+          "adjust with --robust-start when the list may hold gross errors\n");
       return kExitOk;
     };
   });
@@ -104,7 +120,8 @@ CommandRun SetupImport(CLI::App& app) {
 
 }  // namespace
 
-AEROCAL_REGISTER_COMMAND(import, "import",
+AEROCAL_REGISTER_COMMAND(import,
+                         "import",
                          "Convert a COLMAP model, DBAT/PhotoModeler marks or an ODM gcp_list.txt "
                          "into the block files",
                          SetupImport);

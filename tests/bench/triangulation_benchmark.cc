@@ -7,7 +7,14 @@
 //   c_error_px / colmap_c_error_px    estimated principal distance minus the truth (or published)
 //   aerocal_sigma0_px, colmap_final_rms_px (COLMAP's report), peak_rss_mb
 // Run: build with -DAEROCAL_BUILD_BENCHMARKS=ON, then build/tests/bench/bench_triangulation.
-#include <sys/resource.h>
+#include "tests/support/test_support.h"
+#include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/adjustment/forward_intersection.h"
+#include "triangulation/import/colmap_export.h"
+#include "triangulation/import/dbat_import.h"
+#include "triangulation/simulation/flight_simulator.h"
+
+#include <benchmark/benchmark.h>
 
 #include <chrono>
 #include <cmath>
@@ -16,15 +23,7 @@
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include <benchmark/benchmark.h>
-
-#include "tests/support/test_support.h"
-#include "triangulation/adjustment/block_adjustment.h"
-#include "triangulation/adjustment/forward_intersection.h"
-#include "triangulation/import/colmap_export.h"
-#include "triangulation/import/dbat_import.h"
-#include "triangulation/simulation/flight_simulator.h"
+#include <sys/resource.h>
 
 namespace aerocal::triangulation {
 namespace {
@@ -32,7 +31,9 @@ namespace {
 using Clock = std::chrono::steady_clock;
 using Model = calib::BrownFraser10Model;
 
-double Seconds(Clock::time_point start) { return std::chrono::duration<double>(Clock::now() - start).count(); }
+double Seconds(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 double PeakRssMb() {
   rusage usage{};
@@ -45,7 +46,8 @@ std::map<std::string, Eigen::Vector3d> StartPoints(const Project& p) {
   std::map<std::string, std::vector<ImageRay>> rays;
   for (const auto& o : p.observations) {
     const Exposure* e = p.FindExposure(o.image);
-    rays[o.point].push_back(RayFromPixel(p.cameras.at(e->camera), e->opk_rad, e->center_m, o.pixel));
+    rays[o.point].push_back(
+        RayFromPixel(p.cameras.at(e->camera), e->opk_rad, e->center_m, o.pixel));
   }
   std::map<std::string, Eigen::Vector3d> out;
   for (const auto& [id, r] : rays)
@@ -65,17 +67,20 @@ ColmapRun RunColmap(const Project& project) {
   std::filesystem::create_directories(dir.File("in"));
   std::filesystem::create_directories(dir.File("out"));
   WriteColmapModel(project, StartPoints(project), dir.File("in"));
-  const std::string command = "QT_QPA_PLATFORM=offscreen colmap bundle_adjuster --input_path " + dir.File("in") +
-                              " --output_path " + dir.File("out") +
-                              " --BundleAdjustment.refine_focal_length 1 --BundleAdjustment.refine_principal_point 1"
-                              " --BundleAdjustment.refine_extra_params 1 --log_to_stderr 1 > " + dir.File("log.txt") + " 2>&1";
+  const std::string command =
+      "QT_QPA_PLATFORM=offscreen colmap bundle_adjuster --input_path " + dir.File("in") +
+      " --output_path " + dir.File("out") +
+      " --BundleAdjustment.refine_focal_length 1 --BundleAdjustment.refine_principal_point 1"
+      " --BundleAdjustment.refine_extra_params 1 --log_to_stderr 1 > " +
+      dir.File("log.txt") + " 2>&1";
   const auto start = Clock::now();
   const int rc = std::system(command.c_str());
   run.seconds = Seconds(start);
   if (rc != 0) return run;
   // Export to text (bundle_adjuster writes the binary format).
-  const std::string convert = "colmap model_converter --input_path " + dir.File("out") + " --output_path " +
-                              dir.File("out") + " --output_type TXT > /dev/null 2>&1";
+  const std::string convert = "colmap model_converter --input_path " + dir.File("out") +
+                              " --output_path " + dir.File("out") +
+                              " --output_type TXT > /dev/null 2>&1";
   if (std::system(convert.c_str()) != 0) return run;
   std::ifstream cameras(dir.File("out/cameras.txt"));
   std::string line;
@@ -100,7 +105,10 @@ ColmapRun RunColmap(const Project& project) {
   return run;
 }
 
-void Compare(benchmark::State& state, const Project& project, const AdjustOptions& options, double c_truth_mm) {
+void Compare(benchmark::State& state,
+             const Project& project,
+             const AdjustOptions& options,
+             double c_truth_mm) {
   AdjustmentResult r;
   double seconds = 0;
   for (auto _ : state) {
@@ -147,7 +155,13 @@ void BM_SimulatedBlock(benchmark::State& state) {
   state.counters["observations"] = static_cast<double>(f.observations.size());
   Compare(state, project, options, f.truth.c_mm());
 }
-BENCHMARK(BM_SimulatedBlock)->Arg(37)->Arg(600)->Arg(2400)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_SimulatedBlock)
+    ->Arg(37)
+    ->Arg(600)
+    ->Arg(2400)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime();
 
 void BM_DbatRoma(benchmark::State& state) {
   const std::string dir = testing::SharedDataDir("dbat_roma_canon_eos5d");

@@ -1,14 +1,14 @@
 // aerocal adjust on the simulated example flight: exit codes, result keys, --compare,
 // --write-camera (the in-flight calibration loop), bad input with nothing written.
-#include <filesystem>
-#include <fstream>
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/camera_io.h"
-#include "calib/core/atomic_file.h"
-#include "tests/support/test_support.h"
+#include <filesystem>
+#include <fstream>
 
 namespace aerocal {
 namespace {
@@ -16,7 +16,9 @@ namespace {
 using testing::RunAerocal;
 using testing::TempDir;
 
-nlohmann::json ReadJson(const std::string& path) { return nlohmann::json::parse(ReadTextFile(path)); }
+nlohmann::json ReadJson(const std::string& path) {
+  return nlohmann::json::parse(ReadTextFile(path));
+}
 
 class AdjustCommand : public ::testing::Test {
  protected:
@@ -36,9 +38,20 @@ TEST_F(AdjustCommand, CompareWritesBothRunsAndTheCamera) {
   EXPECT_NE(r.output.find("check RMSE Z"), std::string::npos);
   EXPECT_NE(r.output.find("is not separable"), std::string::npos);  // c ~ heights, no GNSS
   const auto j = ReadJson(dir_.File("result.json"));
-  for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations",
-                          "converged", "cameras", "control", "check", "exposures", "rejected",
-                          "comparison", "frame"})
+  for (const char* key : {"kind",
+                          "sigma0",
+                          "sigma0_px",
+                          "sigma0_um",
+                          "redundancy",
+                          "iterations",
+                          "converged",
+                          "cameras",
+                          "control",
+                          "check",
+                          "exposures",
+                          "rejected",
+                          "comparison",
+                          "frame"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_TRUE(j["converged"].get<bool>());
   const auto& cmp = j["comparison"];
@@ -58,7 +71,8 @@ TEST_F(AdjustCommand, CompareWritesBothRunsAndTheCamera) {
   ASSERT_EQ(next.exit_code, 0) << next.output;
   const auto n = ReadJson(dir_.File("next.json"));
   EXPECT_NEAR(n["check"]["spatial_rmse_m"].get<double>(),
-              cmp["self_calibration"]["check"]["spatial_rmse_m"].get<double>(), 0.05);
+              cmp["self_calibration"]["check"]["spatial_rmse_m"].get<double>(),
+              0.05);
 }
 
 TEST_F(AdjustCommand, BadInputExitsTwoAndWritesNothing) {

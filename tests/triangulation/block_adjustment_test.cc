@@ -1,13 +1,14 @@
 // Self-calibrating bundle block adjustment on the simulated example flight (37 exposures, 2x3-CCD
 // camera, nominal camera off by DMZ-like corrections): the acceptance figures of the adjustment.
-#include <cmath>
-#include <cstdio>
-#include <memory>
+#include "triangulation/adjustment/block_adjustment.h"
+
+#include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
 
-#include "triangulation/adjustment/block_adjustment.h"
-#include "triangulation/simulation/flight_simulator.h"
+#include <cmath>
+#include <cstdio>
+#include <memory>
 
 namespace aerocal::triangulation {
 namespace {
@@ -36,13 +37,15 @@ void ExpectTruthWithinThreeSigma(const CameraEstimate& c, const calib::Camera& t
     SCOPED_TRACE(std::string(Model::kParams[k].name));
     ASSERT_GT(c.sigma[k], 0.0);
     EXPECT_LE(std::abs(c.estimated[k] - truth.interior[k]), 3.0 * c.sigma[k])
-        << "estimate " << c.estimated[k] << " truth " << truth.interior[k] << " sigma " << c.sigma[k];
+        << "estimate " << c.estimated[k] << " truth " << truth.interior[k] << " sigma "
+        << c.sigma[k];
   }
 }
 
 bool HasCorrelation(const Determinability& d, const std::string& a, const std::string& b_part) {
   for (const auto& h : d.high_correlations)
-    if (h.a == a && h.b.find(b_part) != std::string::npos && std::abs(h.correlation) > 0.95) return true;
+    if (h.a == a && h.b.find(b_part) != std::string::npos && std::abs(h.correlation) > 0.95)
+      return true;
   return false;
 }
 
@@ -86,7 +89,9 @@ TEST_F(SimulatedFlightAdjustment, SelfCalibrationImprovesCheckPointsAtLeastOneAn
   EXPECT_EQ(self_->check.n, conventional_->check.n);
   const double ratio = conventional_->check.spatial_rmse_m / self_->check.spatial_rmse_m;
   std::printf("check spatial RMSE: conventional %.3f m, self-calibration %.3f m, ratio %.2f\n",
-              conventional_->check.spatial_rmse_m, self_->check.spatial_rmse_m, ratio);
+              conventional_->check.spatial_rmse_m,
+              self_->check.spatial_rmse_m,
+              ratio);
   EXPECT_GE(ratio, 1.5);
 }
 
@@ -103,8 +108,18 @@ TEST_F(SimulatedFlightAdjustment, WithoutGnssPrincipalDistanceAndHeightsAreRepor
 
 TEST_F(SimulatedFlightAdjustment, ResultJsonHasTheFormatsKeys) {
   const auto j = AdjustmentToJson(*self_);
-  for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations",
-                          "converged", "cameras", "control", "check", "exposures", "rejected"})
+  for (const char* key : {"kind",
+                          "sigma0",
+                          "sigma0_px",
+                          "sigma0_um",
+                          "redundancy",
+                          "iterations",
+                          "converged",
+                          "cameras",
+                          "control",
+                          "check",
+                          "exposures",
+                          "rejected"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_EQ(j["kind"], "adjust");
   EXPECT_EQ(j["exposures"].size(), flight_->exposures_truth.size());
@@ -121,7 +136,8 @@ TEST_F(SimulatedFlightAdjustment, ConvergesToTheSameSolutionFromTheTrueStart) {
   const AdjustmentResult r = Adjust(from_truth, SelfCalibration());
   ASSERT_TRUE(r.converged());
   for (int k = 0; k < Model::kNumParams; ++k)
-    EXPECT_NEAR(r.cameras[0].estimated[k], self_->cameras[0].estimated[k],
+    EXPECT_NEAR(r.cameras[0].estimated[k],
+                self_->cameras[0].estimated[k],
                 1e-3 * self_->cameras[0].sigma[k])
         << Model::kParams[k].name;
 }
@@ -174,7 +190,8 @@ TEST(BlockAdjustment, PlantedGrossErrorIsFoundListedAndRemoved) {
   const AdjustmentResult b = Adjust(planted, SelfCalibration());
   bool listed = false;
   for (const auto& r : b.rejected)
-    if (r.image == planted.observations[index].image && r.point == planted.observations[index].point) {
+    if (r.image == planted.observations[index].image &&
+        r.point == planted.observations[index].point) {
       listed = true;
       EXPECT_GT(r.residual_px.norm(), 1.0);  // part of the 5 px shows in the residual
     }

@@ -1,18 +1,19 @@
 // COLMAP text model -> block: pixel (+0.5) and camera-frame conventions, intrinsics fitted to the
 // 10-parameter model; round trip through aerocal's projection.
-#include <cmath>
-#include <cstdio>
-#include <fstream>
-#include <random>
-
-#include <Eigen/Geometry>
-#include <gtest/gtest.h>
+#include "triangulation/import/colmap_import.h"
 
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
-#include "triangulation/import/colmap_import.h"
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
 
 namespace aerocal::triangulation {
 namespace {
@@ -28,7 +29,8 @@ std::vector<Eigen::Vector3d> WriteModel(const std::string& dir, const Scene& sce
   std::uniform_real_distribution<double> u(-1, 1);
   std::vector<Eigen::Vector3d> points;
   for (int i = 0; i < 200; ++i) points.emplace_back(4 * u(rng), 3 * u(rng), 0.5 * u(rng));
-  std::ofstream cameras(dir + "/cameras.txt"), images(dir + "/images.txt"), pts(dir + "/points3D.txt");
+  std::ofstream cameras(dir + "/cameras.txt"), images(dir + "/images.txt"),
+      pts(dir + "/points3D.txt");
   cameras << "# Camera list\n1 " << scene.model << " 3000 2000";
   for (double p : scene.params) cameras << " " << p;
   cameras << "\n";
@@ -42,8 +44,8 @@ std::vector<Eigen::Vector3d> WriteModel(const std::string& dir, const Scene& sce
     const Eigen::Vector3d center(1.0 * k - 2.5, 0.3 * k, 10.0);
     const Eigen::Vector3d t = -r * center;
     const Eigen::Quaterniond q(r);
-    images << k + 1 << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << t.x() << " "
-           << t.y() << " " << t.z() << " 1 img" << k + 1 << ".jpg\n";
+    images << k + 1 << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << t.x()
+           << " " << t.y() << " " << t.z() << " 1 img" << k + 1 << ".jpg\n";
     for (size_t i = 0; i < points.size(); ++i) {
       const Eigen::Vector3d c = r * points[i] + t;
       const Eigen::Vector2d px = ColmapProject(scene.model, scene.params, c);
@@ -53,7 +55,8 @@ std::vector<Eigen::Vector3d> WriteModel(const std::string& dir, const Scene& sce
     images << "\n";
   }
   for (size_t i = 0; i < points.size(); ++i)
-    pts << i + 1 << " " << points[i].x() << " " << points[i].y() << " " << points[i].z() << " 0 0 0 0.1\n";
+    pts << i + 1 << " " << points[i].x() << " " << points[i].y() << " " << points[i].z()
+        << " 0 0 0 0.1\n";
   return points;
 }
 
@@ -73,7 +76,8 @@ TEST_P(ColmapImport, ImportedCameraReprojectsColmapPixels) {
   for (const auto& o : p.observations) {
     const Exposure* e = p.FindExposure(o.image);
     Eigen::Vector2d px;
-    ASSERT_TRUE(p.cameras.at("1").ProjectToPixel(e->opk_rad, e->center_m, truth[std::stoi(o.point) - 1], &px));
+    ASSERT_TRUE(p.cameras.at("1").ProjectToPixel(
+        e->opk_rad, e->center_m, truth[std::stoi(o.point) - 1], &px));
     max_error = std::max(max_error, (px - o.pixel).norm());
   }
   // The forward COLMAP distortion is fitted by the correction model: a few hundredths of a pixel.
@@ -87,7 +91,8 @@ TEST_P(ColmapImport, ImportedCameraReprojectsColmapPixels) {
 }
 
 INSTANTIATE_TEST_SUITE_P(
-    Models, ColmapImport,
+    Models,
+    ColmapImport,
     ::testing::Values(Scene{"PINHOLE", {2400, 2410, 1510, 990}},
                       Scene{"SIMPLE_RADIAL", {2400, 1500, 1000, -0.03}},
                       Scene{"RADIAL", {2400, 1500, 1000, -0.03, 0.01}},
@@ -141,12 +146,15 @@ TEST(ColmapExport, RoundTripKeepsOrientationsAndPixels) {
     const Exposure* e = back.FindExposure(p.exposures[i].image);
     ASSERT_NE(e, nullptr);
     EXPECT_LT((e->center_m - p.exposures[i].center_m).norm(), 1e-6);
-    EXPECT_LT((calib::RotationFromOpk(e->opk_rad) - calib::RotationFromOpk(p.exposures[i].opk_rad)).norm(), 1e-12);
+    EXPECT_LT((calib::RotationFromOpk(e->opk_rad) - calib::RotationFromOpk(p.exposures[i].opk_rad))
+                  .norm(),
+              1e-12);
   }
   ASSERT_EQ(back.observations.size(), p.observations.size());
   const auto& camera = back.cameras.begin()->second;
   EXPECT_NEAR(camera.c_mm(), f.nominal.c_mm(), 1e-9);
-  for (int k = 1; k < calib::BrownFraser10Model::kNumParams; ++k) EXPECT_NEAR(camera.interior[k], 0.0, 1e-12);
+  for (int k = 1; k < calib::BrownFraser10Model::kNumParams; ++k)
+    EXPECT_NEAR(camera.interior[k], 0.0, 1e-12);
   std::map<std::pair<std::string, std::string>, Eigen::Vector2d> original;
   for (const auto& ob : p.observations) original[{ob.image, ob.point}] = ob.pixel;
   // Points are renumbered 1..n in id order; compare by image and coordinates.

@@ -1,10 +1,11 @@
 // Forward intersection of image rays and the adjustment options.
-#include <gtest/gtest.h>
+#include "triangulation/adjustment/forward_intersection.h"
 
 #include "calib/core/error.h"
 #include "triangulation/adjustment/adjust_options.h"
-#include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/simulation/flight_simulator.h"
+
+#include <gtest/gtest.h>
 
 namespace aerocal::triangulation {
 namespace {

@@ -1,11 +1,11 @@
 // aerocal import (ODM gcp_list.txt, DBAT marks) then aerocal adjust on the written block files.
-#include <fstream>
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "calib/core/atomic_file.h"
-#include "tests/support/test_support.h"
+#include <fstream>
 
 namespace aerocal {
 namespace {
@@ -19,11 +19,13 @@ TEST(ImportCommand, OdmListImportedOnceThenAdjustedWithItsBlundersListed) {
   WriteFileAtomically(tmp.File("sx260.yaml"),
                       "name: Canon PowerShot SX260 HS\npixel_size_mm: 0.00154959\n"
                       "format_px: [4000, 3000]\ninterior: {c: 4.5}\n");
-  auto r = RunAerocal("import odm --gcp-list " + dir + "/odm_gcp_br/gcp_list_floatxy_raw.txt --camera " +
-                      tmp.File("sx260.yaml") + " --control " + dir + "/odm_gcp_br/gcp_list_raw.txt --out " +
-                      tmp.File("block"));
+  auto r =
+      RunAerocal("import odm --gcp-list " + dir + "/odm_gcp_br/gcp_list_floatxy_raw.txt --camera " +
+                 tmp.File("sx260.yaml") + " --control " + dir +
+                 "/odm_gcp_br/gcp_list_raw.txt --out " + tmp.File("block"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = RunAerocal("adjust --project " + tmp.File("block") + " --robust-start --out " + tmp.File("r.json"));
+  r = RunAerocal("adjust --project " + tmp.File("block") + " --robust-start --out " +
+                 tmp.File("r.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = nlohmann::json::parse(ReadTextFile(tmp.File("r.json")));
   int gross = 0;
@@ -35,10 +37,13 @@ TEST(ImportCommand, OdmListImportedOnceThenAdjustedWithItsBlundersListed) {
 
 TEST(ImportCommand, BadGcpLineExitsTwoWithItsLine) {
   testing::TempDir tmp("aerocal_import_bad");
-  WriteFileAtomically(tmp.File("cam.yaml"), "name: c\npixel_size_mm: 0.0015\nformat_px: [4000, 3000]\ninterior: {c: 4.5}\n");
-  WriteFileAtomically(tmp.File("gcp.txt"), "EPSG:32722\n1 2 3 10 10 a.jpg P1\n1 2 x 10 10 b.jpg P1\n");
-  const auto r = RunAerocal("import odm --gcp-list " + tmp.File("gcp.txt") + " --camera " + tmp.File("cam.yaml") +
-                            " --out " + tmp.File("block"));
+  WriteFileAtomically(
+      tmp.File("cam.yaml"),
+      "name: c\npixel_size_mm: 0.0015\nformat_px: [4000, 3000]\ninterior: {c: 4.5}\n");
+  WriteFileAtomically(tmp.File("gcp.txt"),
+                      "EPSG:32722\n1 2 3 10 10 a.jpg P1\n1 2 x 10 10 b.jpg P1\n");
+  const auto r = RunAerocal("import odm --gcp-list " + tmp.File("gcp.txt") + " --camera " +
+                            tmp.File("cam.yaml") + " --out " + tmp.File("block"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("gcp.txt:3"), std::string::npos) << r.output;
 }

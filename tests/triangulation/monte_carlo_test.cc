@@ -1,13 +1,13 @@
 // The reported standard deviations of the interior parameters match the spread of the estimates
 // over many simulated flights. To keep the test fast the block is reduced (fewer surveyed and tie
 // points than the example flight); exposures, camera and noise are those of the example.
-#include <cmath>
-#include <cstdio>
+#include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
 
-#include "triangulation/adjustment/block_adjustment.h"
-#include "triangulation/simulation/flight_simulator.h"
+#include <cmath>
+#include <cstdio>
 
 namespace aerocal::triangulation {
 namespace {
@@ -40,7 +40,8 @@ TEST(BlockAdjustmentMonteCarlo, ReportedSigmasMatchTheSpreadOverFlights) {
     ASSERT_TRUE(r.converged()) << "seed " << options.seed;
     ASSERT_TRUE(r.determinability.covariance_ok) << "seed " << options.seed;
     for (int k = 0; k < Model::kNumParams; ++k) {
-      const double z = (r.cameras[0].estimated[k] - flight.truth.interior[k]) / r.cameras[0].sigma[k];
+      const double z =
+          (r.cameras[0].estimated[k] - flight.truth.interior[k]) / r.cameras[0].sigma[k];
       sum_z2[k] += z * z;
     }
     ++used;
@@ -49,7 +50,8 @@ TEST(BlockAdjustmentMonteCarlo, ReportedSigmasMatchTheSpreadOverFlights) {
     // The truth is known, so the spread is about the truth (n degrees of freedom).
     const double spread_over_sigma = std::sqrt(sum_z2[k] / used);
     std::printf("%-3s empirical spread / reported sigma = %.3f\n",
-                std::string(Model::kParams[k].name).c_str(), spread_over_sigma);
+                std::string(Model::kParams[k].name).c_str(),
+                spread_over_sigma);
     EXPECT_NEAR(spread_over_sigma, 1.0, kTolerance) << Model::kParams[k].name;
   }
 }

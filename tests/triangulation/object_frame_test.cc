@@ -1,12 +1,13 @@
 // Geodetic input converted with GeographicLib (local tangent plane, UTM) and written back.
-#include <cmath>
-
-#include <gtest/gtest.h>
+#include "triangulation/georef/object_frame.h"
 
 #include "calib/core/error.h"
 #include "triangulation/adjustment/block_adjustment.h"
-#include "triangulation/georef/object_frame.h"
 #include "triangulation/simulation/flight_simulator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace aerocal::triangulation {
 namespace {

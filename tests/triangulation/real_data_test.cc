@@ -1,15 +1,15 @@
 // Real data sets from ../shared/data (skipped when absent), imported once with the project's
 // importers and adjusted; published answers from each folder's PROVENANCE.md.
-#include <cmath>
-#include <cstdio>
-
-#include <gtest/gtest.h>
-
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/nadir_start.h"
 #include "triangulation/import/dbat_import.h"
 #include "triangulation/import/odm_gcp_import.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
 
 namespace aerocal::triangulation {
 namespace {
@@ -41,10 +41,16 @@ TEST(RealData, DbatOlympusCalibrationMatchesThePublishedResult) {
   const auto& c = r.cameras[0];
   // Published (DBAT 0.9.2.0): c 7.45700 (0.00105) mm, K1 4.58861e-3, K2 -4.51351e-5,
   // K3 -2.05253e-6, P1 -6.12803e-5, P2 -4.41171e-5, sigma0 0.16148 px.
-  struct Published { int index; double value, sigma; };
-  for (const Published& p : {Published{Model::kC, 7.45700, 0.00105}, {Model::kK1, 4.58861e-3, 2.21e-5},
-                             {Model::kK2, -4.51351e-5, 2.65e-6}, {Model::kK3, -2.05253e-6, 1.01e-7},
-                             {Model::kP1, -6.12803e-5, 3.52e-6}, {Model::kP2, -4.41171e-5, 3.94e-6}}) {
+  struct Published {
+    int index;
+    double value, sigma;
+  };
+  for (const Published& p : {Published{Model::kC, 7.45700, 0.00105},
+                             {Model::kK1, 4.58861e-3, 2.21e-5},
+                             {Model::kK2, -4.51351e-5, 2.65e-6},
+                             {Model::kK3, -2.05253e-6, 1.01e-7},
+                             {Model::kP1, -6.12803e-5, 3.52e-6},
+                             {Model::kP2, -4.41171e-5, 3.94e-6}}) {
     SCOPED_TRACE(std::string(Model::kParams[p.index].name));
     EXPECT_LE(std::abs(c.estimated[p.index] - p.value), 3.0 * c.sigma[p.index])
         << "estimate " << c.estimated[p.index] << " sigma " << c.sigma[p.index];
@@ -114,8 +120,11 @@ TEST(RealData, OdmUavTargetsBlundersFoundAndCheckPointsCompared) {
   // Control / check split: check errors of a few GSD (2.4 cm) per axis.
   EXPECT_GE(r.check.n, 10);
   for (int k = 0; k < 3; ++k) EXPECT_LT(r.check.rmse_m(k), 0.25) << "axis " << k;
-  std::printf("check RMSE X %.3f Y %.3f Z %.3f m over %d points\n", r.check.rmse_m.x(),
-              r.check.rmse_m.y(), r.check.rmse_m.z(), r.check.n);
+  std::printf("check RMSE X %.3f Y %.3f Z %.3f m over %d points\n",
+              r.check.rmse_m.x(),
+              r.check.rmse_m.y(),
+              r.check.rmse_m.z(),
+              r.check.n);
 }
 
 }  // namespace

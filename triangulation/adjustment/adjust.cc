@@ -1,10 +1,10 @@
 // Adjust(): one adjustment, or with a robust start a Cauchy-loss adjustment whose solution and
 // gross-error screening start the clean one (see AdjustOptions::robust_start).
-#include <algorithm>
-#include <cmath>
-
 #include "calib/core/csv.h"
 #include "triangulation/adjustment/block_adjustment.h"
+
+#include <algorithm>
+#include <cmath>
 
 namespace aerocal::triangulation {
 
@@ -41,9 +41,14 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
       if (!v.used || w <= options.robust_reject_sigma) continue;
       for (size_t i = 0; i < project.observations.size(); ++i) {
         const auto& o = project.observations[i];
-        if (!drop[i] && o.image == v.image && o.point == v.point && o.subimage.empty() && o.pixel == v.measured_px) {
+        if (!drop[i] && o.image == v.image && o.point == v.point && o.subimage.empty() &&
+            o.pixel == v.measured_px) {
           drop[i] = true;
-          pre_rejected.push_back({v.image, v.point, v.measured_px, Eigen::Vector2d(v.residual_px.x(), -v.residual_px.y()), w});
+          pre_rejected.push_back({v.image,
+                                  v.point,
+                                  v.measured_px,
+                                  Eigen::Vector2d(v.residual_px.x(), -v.residual_px.y()),
+                                  w});
           break;
         }
       }
@@ -67,9 +72,10 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
   for (auto& c : result.cameras) c.initial = project.cameras.at(c.id).interior;
   result.rejected.insert(result.rejected.begin(), pre_rejected.begin(), pre_rejected.end());
   for (const auto& r : pre_rejected)
-    result.residuals.push_back({r.image, r.point, r.measured_px, Eigen::Vector2d::Zero(), 0.0, false});
-  result.notes.push_back("started from a robust (Cauchy, " + FormatNumber(options.robust_scale_sigma, 3) +
-                         " sigma) adjustment");
+    result.residuals.push_back(
+        {r.image, r.point, r.measured_px, Eigen::Vector2d::Zero(), 0.0, false});
+  result.notes.push_back("started from a robust (Cauchy, " +
+                         FormatNumber(options.robust_scale_sigma, 3) + " sigma) adjustment");
   return result;
 }
 

@@ -1,11 +1,11 @@
 #include "triangulation/adjustment/adjust_options.h"
 
-#include <set>
-#include <sstream>
-
 #include "calib/camera/brown_fraser10.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+
+#include <set>
+#include <sstream>
 
 namespace aerocal::triangulation {
 
@@ -24,9 +24,11 @@ void AdjustOptions::Validate() const {
     throw ConfigError("snooping_critical_value must be >= 0 (got " +
                       FormatNumber(snooping_critical_value) + ")");
   if (!(robust_scale_sigma > 0))
-    throw ConfigError("robust_scale_sigma must be > 0 (got " + FormatNumber(robust_scale_sigma) + ")");
+    throw ConfigError("robust_scale_sigma must be > 0 (got " + FormatNumber(robust_scale_sigma) +
+                      ")");
   if (!(robust_reject_sigma > 0))
-    throw ConfigError("robust_reject_sigma must be > 0 (got " + FormatNumber(robust_reject_sigma) + ")");
+    throw ConfigError("robust_reject_sigma must be > 0 (got " + FormatNumber(robust_reject_sigma) +
+                      ")");
   if (max_rejections < 1)
     throw ConfigError("max_rejections must be > 0 (got " + std::to_string(max_rejections) + ")");
   if (!(correlation_threshold > 0 && correlation_threshold < 1))
@@ -54,8 +56,9 @@ std::vector<std::string> ParseSelfCalibration(const std::string& text) {
     const auto end = name.find_last_not_of(' ');
     name = begin == std::string::npos ? "" : name.substr(begin, end - begin + 1);
     if (Model::IndexOf(name) < 0)
-      throw ConfigError("--self-calibration: unknown parameter '" + name +
-                        "' (expected none, all or a list of c, x0, y0, K1, K2, K3, P1, P2, B1, B2)");
+      throw ConfigError(
+          "--self-calibration: unknown parameter '" + name +
+          "' (expected none, all or a list of c, x0, y0, K1, K2, K3, P1, P2, B1, B2)");
     names.push_back(name);
   }
   AdjustOptions probe;

@@ -3,10 +3,10 @@
 // their roles, a-priori sigmas) is data from the block files, not options.
 #pragma once
 
+#include "calib/problem/problem_builder.h"
+
 #include <string>
 #include <vector>
-
-#include "calib/problem/problem_builder.h"
 
 namespace aerocal::triangulation {
 

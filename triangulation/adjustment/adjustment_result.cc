@@ -29,21 +29,36 @@ std::string Printf(const char* format, ...) {
 }
 
 std::string StatisticsLine(const char* what, const PointStatistics& s) {
-  return Printf("%-8s n=%3d  RMSE X %.4f  Y %.4f  Z %.4f  plan %.4f  spatial %.4f m\n", what, s.n,
-                s.rmse_m.x(), s.rmse_m.y(), s.rmse_m.z(), s.planimetric_rmse_m, s.spatial_rmse_m);
+  return Printf("%-8s n=%3d  RMSE X %.4f  Y %.4f  Z %.4f  plan %.4f  spatial %.4f m\n",
+                what,
+                s.n,
+                s.rmse_m.x(),
+                s.rmse_m.y(),
+                s.rmse_m.z(),
+                s.planimetric_rmse_m,
+                s.spatial_rmse_m);
 }
 
 std::string CalibrationTable(const AdjustmentResult& r) {
   std::string out;
   for (const auto& c : r.cameras) {
     out += "camera " + c.id + "\n";
-    out += Printf("  %-4s %-6s %16s %16s %16s %14s\n", "par", "unit", "initial", "correction",
-                  "estimate", "sigma");
+    out += Printf("  %-4s %-6s %16s %16s %16s %14s\n",
+                  "par",
+                  "unit",
+                  "initial",
+                  "correction",
+                  "estimate",
+                  "sigma");
     for (int k = 0; k < Model::kNumParams; ++k) {
       const auto& info = Model::kParams[k];
-      out += Printf("  %-4s %-6s %16.8g %16.8g %16.8g %14s\n", std::string(info.name).c_str(),
-                    std::string(info.unit).c_str(), c.initial[k], c.estimated[k] - c.initial[k],
-                    c.estimated[k], c.free[k] ? Printf("%.3g", c.sigma[k]).c_str() : "fixed");
+      out += Printf("  %-4s %-6s %16.8g %16.8g %16.8g %14s\n",
+                    std::string(info.name).c_str(),
+                    std::string(info.unit).c_str(),
+                    c.initial[k],
+                    c.estimated[k] - c.initial[k],
+                    c.estimated[k],
+                    c.free[k] ? Printf("%.3g", c.sigma[k]).c_str() : "fixed");
     }
   }
   return out;
@@ -105,7 +120,8 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
       const std::string name(Model::kParams[k].name);
       if (c.free[k]) {
         free.push_back(name);
-        sigma[name] = r.determinability.covariance_ok ? nlohmann::json(c.sigma[k]) : nlohmann::json();
+        sigma[name] =
+            r.determinability.covariance_ok ? nlohmann::json(c.sigma[k]) : nlohmann::json();
       }
     }
     j["cameras"].push_back({{"id", c.id},
@@ -173,8 +189,12 @@ std::string FormatSummary(const AdjustmentResult& r) {
   std::string out = Printf(
       "%s adjustment: %s after %d iterations, sigma0 %.4f (%.4f px, %.3f um), redundancy %d\n",
       r.free_interior.empty() ? "conventional" : "self-calibrating",
-      r.solve.converged ? "converged" : "NOT converged", r.solve.iterations, r.sigma0, r.sigma0_px,
-      r.sigma0_um, r.solve.redundancy);
+      r.solve.converged ? "converged" : "NOT converged",
+      r.solve.iterations,
+      r.sigma0,
+      r.sigma0_px,
+      r.sigma0_um,
+      r.solve.redundancy);
   out += "frame: " + r.frame + "\n";
   out += "datum: " + r.datum + "\n";
   out += StatisticsLine("control", r.control);
@@ -182,8 +202,12 @@ std::string FormatSummary(const AdjustmentResult& r) {
   if (!r.free_interior.empty()) out += CalibrationTable(r);
   for (const auto& o : r.rejected)
     out += Printf("rejected: image %s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
-                  o.image.c_str(), o.point.c_str(), o.measured_px.x(), o.measured_px.y(),
-                  o.residual_px.norm(), o.w);
+                  o.image.c_str(),
+                  o.point.c_str(),
+                  o.measured_px.x(),
+                  o.measured_px.y(),
+                  o.residual_px.norm(),
+                  o.w);
   for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
   return out;
 }
@@ -203,7 +227,9 @@ std::string FormatComparison(const AdjustmentResult& a, const AdjustmentResult& 
   row("check RMSE plan. [m]", a.check.planimetric_rmse_m, b.check.planimetric_rmse_m);
   row("check RMSE spatial [m]", a.check.spatial_rmse_m, b.check.spatial_rmse_m);
   out += Printf("%-26s %16d %16d\n", "check points", a.check.n, b.check.n);
-  out += Printf("%-26s %16s %16s\n", "converged", a.solve.converged ? "yes" : "no",
+  out += Printf("%-26s %16s %16s\n",
+                "converged",
+                a.solve.converged ? "yes" : "no",
                 b.solve.converged ? "yes" : "no");
   out += "calibration (self-calibrating run):\n" + CalibrationTable(b);
   for (const auto& w : b.determinability.warnings) out += "warning: " + w + "\n";

@@ -5,16 +5,16 @@
 // of the free parameters (correlations above the threshold, null-space parameters).
 #pragma once
 
-#include <map>
-#include <optional>
-#include <string>
-#include <vector>
+#include "calib/camera/camera.h"
+#include "calib/problem/problem_builder.h"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/camera.h"
-#include "calib/problem/problem_builder.h"
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 
@@ -29,8 +29,8 @@ struct PointDifference {
 
 struct PointStatistics {
   int n = 0;
-  Eigen::Vector3d rmse_m = Eigen::Vector3d::Zero();     // per axis X, Y, Z
-  Eigen::Vector3d mean_m = Eigen::Vector3d::Zero();     // bias
+  Eigen::Vector3d rmse_m = Eigen::Vector3d::Zero();  // per axis X, Y, Z
+  Eigen::Vector3d mean_m = Eigen::Vector3d::Zero();  // bias
   Eigen::Vector3d max_abs_m = Eigen::Vector3d::Zero();
   double planimetric_rmse_m = 0.0;  // sqrt(mX^2 + mY^2)
   double spatial_rmse_m = 0.0;      // sqrt(mX^2 + mY^2 + mZ^2)
@@ -52,9 +52,9 @@ struct ExposureEstimate {
 
 struct RejectedObservation {
   std::string image, point;
-  Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();   // the observation (col, row)
+  Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();  // the observation (col, row)
   Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // v in (corrected) photo space, px
-  double w = 0.0;                                          // standardized residual
+  double w = 0.0;                                         // standardized residual
 };
 
 /// One image observation after the adjustment: residual v = measured - adjusted, in pixels of

@@ -1,14 +1,14 @@
 #include "triangulation/adjustment/block_adjustment.h"
 
-#include <algorithm>
-#include <cmath>
-#include <set>
-
 #include "calib/core/error.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
 #include "triangulation/adjustment/determinability.h"
 #include "triangulation/adjustment/forward_intersection.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
 
 namespace aerocal::triangulation {
 namespace {
@@ -62,8 +62,10 @@ struct BlockAdjustment::Storage {
   std::string datum;
 };
 
-BlockAdjustment::BlockAdjustment(const Project& project, const AdjustOptions& options,
-                                 SubimageObservations subimage, const calib::LossOptions& image_loss)
+BlockAdjustment::BlockAdjustment(const Project& project,
+                                 const AdjustOptions& options,
+                                 SubimageObservations subimage,
+                                 const calib::LossOptions& image_loss)
     : project_(project), options_(options), storage_(std::make_unique<Storage>()) {
   options_.Validate();
   BuildExposures();
@@ -97,22 +99,26 @@ BlockId BlockAdjustment::AddPoint(const std::string& point, const Eigen::Vector3
   if (state.block >= 0) return state.block;
   state.xyz = start_m;
   state.ground = project_.FindPoint(point);
-  state.block = builder_.AddBlock("point " + point, state.xyz.data(), 3, BlockKind::kGroundPoint,
-                                  kCenterNames);
+  state.block = builder_.AddBlock(
+      "point " + point, state.xyz.data(), 3, BlockKind::kGroundPoint, kCenterNames);
   return state.block;
 }
 
 void BlockAdjustment::BuildExposures() {
   std::vector<int> fixed;
   for (int i = 0; i < Model::kNumParams; ++i)
-    if (std::find(options_.free_interior.begin(), options_.free_interior.end(),
+    if (std::find(options_.free_interior.begin(),
+                  options_.free_interior.end(),
                   std::string(Model::kParams[i].name)) == options_.free_interior.end())
       fixed.push_back(i);
   for (const auto& [id, camera] : project_.cameras) {
     auto& state = storage_->cameras[id];
     state.interior = camera.interior;
-    state.block = builder_.AddBlock("camera " + id, state.interior.data(), Model::kNumParams,
-                                    BlockKind::kInterior, InteriorNames());
+    state.block = builder_.AddBlock("camera " + id,
+                                    state.interior.data(),
+                                    Model::kNumParams,
+                                    BlockKind::kInterior,
+                                    InteriorNames());
     builder_.FixEntries(state.block, fixed);
   }
   for (const auto& e : project_.exposures) {
@@ -121,10 +127,10 @@ void BlockAdjustment::BuildExposures() {
     state.camera = &project_.cameras.at(e.camera);
     state.opk = e.opk_rad;
     state.center = e.center_m;
-    state.opk_block =
-        builder_.AddBlock("image " + e.image + " angles", state.opk.data(), 3, BlockKind::kRotation, kAngleNames);
-    state.center_block = builder_.AddBlock("image " + e.image + " centre", state.center.data(), 3,
-                                           BlockKind::kCenter, kCenterNames);
+    state.opk_block = builder_.AddBlock(
+        "image " + e.image + " angles", state.opk.data(), 3, BlockKind::kRotation, kAngleNames);
+    state.center_block = builder_.AddBlock(
+        "image " + e.image + " centre", state.center.data(), 3, BlockKind::kCenter, kCenterNames);
   }
 }
 
@@ -164,13 +170,16 @@ void BlockAdjustment::BuildPoints(SubimageObservations subimage) {
     std::set<std::string> single;
     for (const auto& [point, images] : images_of_point) {
       const GroundPoint* ground = project_.FindPoint(point);
-      if (images.size() == 1 && !(ground && ground->role == PointRole::kControl)) single.insert(point);
+      if (images.size() == 1 && !(ground && ground->role == PointRole::kControl))
+        single.insert(point);
     }
     const size_t before = storage_->observations.size();
     storage_->observations.erase(
-        std::remove_if(storage_->observations.begin(), storage_->observations.end(),
+        std::remove_if(storage_->observations.begin(),
+                       storage_->observations.end(),
                        [&](const ImageObservation& o) {
-                         return dropped.count(o.image) || (!dropped.empty() && single.count(o.point));
+                         return dropped.count(o.image) ||
+                                (!dropped.empty() && single.count(o.point));
                        }),
         storage_->observations.end());
     changed = storage_->observations.size() != before;
@@ -222,10 +231,15 @@ void BlockAdjustment::AddImageResiduals(const calib::LossOptions& loss) {
     const auto& e = storage_->exposures.at(o.image);
     const calib::Camera& camera = *e.camera;
     const calib::PixelFrame frame{camera.pixel_size_mm, camera.width_px, camera.height_px};
-    const auto id = builder_.AddResidual(
-        calib::kGroupImage, calib::CollinearityResidual::Create(frame, o.pixel, o.sigma_px),
-        {storage_->cameras.at(e.exposure->camera).block, e.opk_block, e.center_block, point->second.block},
-        "image " + o.image + " point " + o.point, loss);
+    const auto id =
+        builder_.AddResidual(calib::kGroupImage,
+                             calib::CollinearityResidual::Create(frame, o.pixel, o.sigma_px),
+                             {storage_->cameras.at(e.exposure->camera).block,
+                              e.opk_block,
+                              e.center_block,
+                              point->second.block},
+                             "image " + o.image + " point " + o.point,
+                             loss);
     storage_->observation_of_residual[id] = i;
   }
 }
@@ -235,25 +249,31 @@ void BlockAdjustment::AddPriors() {
     if (!state.ground || state.ground->role != PointRole::kControl) continue;
     const Eigen::Vector3d& xyz = *state.ground->xyz_m;
     const Eigen::Vector3d& s = state.ground->sigma_m;
-    builder_.AddResidual(calib::kGroupControl,
-                         calib::PriorCostFunction::Create({xyz.x(), xyz.y(), xyz.z()}, {s.x(), s.y(), s.z()}),
-                         {state.block}, "control " + id);
+    builder_.AddResidual(
+        calib::kGroupControl,
+        calib::PriorCostFunction::Create({xyz.x(), xyz.y(), xyz.z()}, {s.x(), s.y(), s.z()}),
+        {state.block},
+        "control " + id);
   }
   if (options_.use_eo_priors) {
     for (const auto& [image, state] : storage_->exposures) {
       const Exposure& e = *state.exposure;
       if (e.center_sigma_m)
-        builder_.AddResidual(calib::kGroupEoPrior,
-                             calib::PriorCostFunction::Create(
-                                 {e.center_m.x(), e.center_m.y(), e.center_m.z()},
-                                 {e.center_sigma_m->x(), e.center_sigma_m->y(), e.center_sigma_m->z()}),
-                             {state.center_block}, "GNSS " + image);
+        builder_.AddResidual(
+            calib::kGroupEoPrior,
+            calib::PriorCostFunction::Create(
+                {e.center_m.x(), e.center_m.y(), e.center_m.z()},
+                {e.center_sigma_m->x(), e.center_sigma_m->y(), e.center_sigma_m->z()}),
+            {state.center_block},
+            "GNSS " + image);
       if (e.opk_sigma_rad)
-        builder_.AddResidual(calib::kGroupEoPrior,
-                             calib::PriorCostFunction::Create(
-                                 {e.opk_rad.x(), e.opk_rad.y(), e.opk_rad.z()},
-                                 {e.opk_sigma_rad->x(), e.opk_sigma_rad->y(), e.opk_sigma_rad->z()}),
-                             {state.opk_block}, "IMU " + image);
+        builder_.AddResidual(
+            calib::kGroupEoPrior,
+            calib::PriorCostFunction::Create(
+                {e.opk_rad.x(), e.opk_rad.y(), e.opk_rad.z()},
+                {e.opk_sigma_rad->x(), e.opk_sigma_rad->y(), e.opk_sigma_rad->z()}),
+            {state.opk_block},
+            "IMU " + image);
     }
   }
   if (options_.use_interior_sigma) {
@@ -269,9 +289,11 @@ void BlockAdjustment::AddPriors() {
         sigmas.push_back(*camera.interior_sigma[k]);
       }
       if (!indices.empty())
-        builder_.AddResidual(calib::kGroupInteriorPrior,
-                             std::make_unique<calib::PriorCostFunction>(Model::kNumParams, indices, values, sigmas),
-                             {state.block}, "interior prior " + id);
+        builder_.AddResidual(
+            calib::kGroupInteriorPrior,
+            std::make_unique<calib::PriorCostFunction>(Model::kNumParams, indices, values, sigmas),
+            {state.block},
+            "interior prior " + id);
     }
   }
 }
@@ -364,7 +386,8 @@ AdjustmentResult BlockAdjustment::Run() {
       builder_.RemoveResidual(ids.front());
       state.rays = 0;
       dropped = true;
-      storage_->notes.push_back("point " + id + " keeps one ray after the rejections and is left out");
+      storage_->notes.push_back("point " + id +
+                                " keeps one ray after the rejections and is left out");
     }
     if (dropped) result.solve = builder_.Solve(options_.solver);
     result.notes = storage_->notes;
@@ -379,7 +402,8 @@ AdjustmentResult BlockAdjustment::Run() {
     out.measured_px = o.pixel;
     out.w = r.w;
     if (r.whitened_residual.size() == 2)
-      out.residual_px = Eigen::Vector2d(r.whitened_residual[0], r.whitened_residual[1]) * o.sigma_px;
+      out.residual_px =
+          Eigen::Vector2d(r.whitened_residual[0], r.whitened_residual[1]) * o.sigma_px;
     result.rejected.push_back(out);
   }
 
@@ -418,8 +442,8 @@ AdjustmentResult BlockAdjustment::Run() {
   if (!options_.estimate_covariance)
     cov.message = "covariance not estimated (option)";
   else if (result.solve.usable && result.solve.redundancy > 0)
-    cov = builder_.EstimateCovariance(cov_blocks, result.sigma0, options_.correlation_threshold,
-                                      interior_blocks);
+    cov = builder_.EstimateCovariance(
+        cov_blocks, result.sigma0, options_.correlation_threshold, interior_blocks);
   else
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
   result.determinability = AssessDeterminability(cov, "camera ", options_.correlation_threshold);
@@ -429,7 +453,8 @@ AdjustmentResult BlockAdjustment::Run() {
     c.initial = project_.cameras.at(id).interior;
     c.estimated = state.interior;
     for (int k = 0; k < Model::kNumParams; ++k)
-      c.free[k] = std::find(options_.free_interior.begin(), options_.free_interior.end(),
+      c.free[k] = std::find(options_.free_interior.begin(),
+                            options_.free_interior.end(),
                             std::string(Model::kParams[k].name)) != options_.free_interior.end();
     if (cov.ok) {
       const Eigen::VectorXd s = cov.BlockSigma(state.block, Model::kNumParams);
@@ -459,7 +484,8 @@ AdjustmentResult BlockAdjustment::Run() {
     d.adjusted_m = state.xyz;
     d.difference_m = state.xyz - d.surveyed_m;
     d.rays = state.rays;
-    (state.ground->role == PointRole::kControl ? result.control_points : result.check_points).push_back(d);
+    (state.ground->role == PointRole::kControl ? result.control_points : result.check_points)
+        .push_back(d);
   }
   result.control = ComputePointStatistics(result.control_points);
   result.check = ComputePointStatistics(result.check_points);

@@ -22,16 +22,16 @@
 // RotationBlock, CenterBlock and PointBlock (create missing points with AddPoint), before Run().
 #pragma once
 
-#include <map>
-#include <string>
-#include <vector>
-
-#include <Eigen/Core>
-
 #include "calib/problem/problem_builder.h"
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
+
+#include <Eigen/Core>
+
+#include <map>
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 
@@ -46,7 +46,8 @@ class BlockAdjustment {
   /// Throws InputError when the block cannot be started (an exposure without observations is
   /// only reported; an observation whose ray misses every start is an input error).
   /// `image_loss` is applied to the image observations (robust start); none by default.
-  BlockAdjustment(const Project& project, const AdjustOptions& options,
+  BlockAdjustment(const Project& project,
+                  const AdjustOptions& options,
                   SubimageObservations subimage = SubimageObservations::kMapWithCameraFile,
                   const calib::LossOptions& image_loss = {});
   ~BlockAdjustment();

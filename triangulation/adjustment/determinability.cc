@@ -6,7 +6,8 @@
 
 namespace aerocal::triangulation {
 
-Determinability AssessDeterminability(const calib::CovarianceReport& cov, const std::string& prefix,
+Determinability AssessDeterminability(const calib::CovarianceReport& cov,
+                                      const std::string& prefix,
                                       double threshold) {
   Determinability det;
   det.covariance_ok = cov.ok;
@@ -27,18 +28,22 @@ Determinability AssessDeterminability(const calib::CovarianceReport& cov, const 
         partner = k;
       }
     if (partner < 0 || !(std::abs(best) > threshold)) continue;
-    const bool listed = std::any_of(det.high_correlations.begin(), det.high_correlations.end(),
+    const bool listed = std::any_of(det.high_correlations.begin(),
+                                    det.high_correlations.end(),
                                     [&](const calib::HighCorrelation& h) {
                                       return h.a == cov.names[partner] && h.b == cov.names[i];
                                     });
     if (listed) continue;
     det.high_correlations.push_back({cov.names[i], cov.names[partner], best});
     char text[512];
-    std::snprintf(text, sizeof(text),
+    std::snprintf(text,
+                  sizeof(text),
                   "%s is not separable from %s (correlation %.4f): the block cannot determine it "
                   "independently; add GNSS camera centres, control at different heights, cross "
                   "strips, or an a-priori sigma",
-                  cov.names[i].c_str(), cov.names[partner].c_str(), best);
+                  cov.names[i].c_str(),
+                  cov.names[partner].c_str(),
+                  best);
     det.warnings.push_back(text);
   }
   return det;

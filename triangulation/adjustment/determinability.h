@@ -5,16 +5,17 @@
 // P1). The run reports these; it does not pretend.
 #pragma once
 
-#include <string>
-
 #include "calib/problem/problem_builder.h"
 #include "triangulation/adjustment/adjustment_result.h"
+
+#include <string>
 
 namespace aerocal::triangulation {
 
 /// `prefix` selects the parameters of interest by name ("camera " for interior parameters);
 /// `threshold` in (0, 1). Each inseparable pair is listed once, with a sentence in `warnings`.
-Determinability AssessDeterminability(const calib::CovarianceReport& covariance, const std::string& prefix,
+Determinability AssessDeterminability(const calib::CovarianceReport& covariance,
+                                      const std::string& prefix,
                                       double threshold);
 
 }  // namespace aerocal::triangulation

@@ -1,15 +1,17 @@
 #include "triangulation/adjustment/forward_intersection.h"
 
-#include <cmath>
+#include "calib/camera/rotation.h"
 
 #include <Eigen/Dense>
 
-#include "calib/camera/rotation.h"
+#include <cmath>
 
 namespace aerocal::triangulation {
 
-ImageRay RayFromPixel(const calib::Camera& camera, const Eigen::Vector3d& opk_rad,
-                      const Eigen::Vector3d& center_m, const Eigen::Vector2d& pixel) {
+ImageRay RayFromPixel(const calib::Camera& camera,
+                      const Eigen::Vector3d& opk_rad,
+                      const Eigen::Vector3d& center_m,
+                      const Eigen::Vector2d& pixel) {
   const Eigen::Vector2d xy = camera.PhotoFromPixel(pixel);
   Eigen::Vector2d ideal;
   calib::BrownFraser10Model::IdealFromMeasured(camera.interior.data(), xy.data(), ideal.data());
@@ -23,12 +25,14 @@ std::optional<Eigen::Vector3d> IntersectRays(const std::vector<ImageRay>& rays,
   double max_angle = 0.0;
   for (size_t i = 0; i < rays.size(); ++i)
     for (size_t k = i + 1; k < rays.size(); ++k)
-      max_angle = std::max(max_angle, std::acos(std::clamp(rays[i].direction.dot(rays[k].direction), -1.0, 1.0)));
+      max_angle = std::max(
+          max_angle, std::acos(std::clamp(rays[i].direction.dot(rays[k].direction), -1.0, 1.0)));
   if (max_angle < min_angle_rad) return std::nullopt;
   Eigen::Matrix3d a = Eigen::Matrix3d::Zero();
   Eigen::Vector3d b = Eigen::Vector3d::Zero();
   for (const auto& ray : rays) {
-    const Eigen::Matrix3d p = Eigen::Matrix3d::Identity() - ray.direction * ray.direction.transpose();
+    const Eigen::Matrix3d p =
+        Eigen::Matrix3d::Identity() - ray.direction * ray.direction.transpose();
     a += p;
     b += p * ray.center_m;
   }

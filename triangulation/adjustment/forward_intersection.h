@@ -7,23 +7,25 @@
 //   sum_i (I - d_i d_i^T) X = sum_i (I - d_i d_i^T) C_i      (d_i unit vectors).
 #pragma once
 
-#include <optional>
-#include <vector>
+#include "calib/camera/camera.h"
 
 #include <Eigen/Core>
 
-#include "calib/camera/camera.h"
+#include <optional>
+#include <vector>
 
 namespace aerocal::triangulation {
 
 struct ImageRay {
-  Eigen::Vector3d center_m;  // projection centre, object frame
+  Eigen::Vector3d center_m;   // projection centre, object frame
   Eigen::Vector3d direction;  // unit vector, object frame
 };
 
 /// Ray of a virtual-image pixel (col, row) seen by `camera` from an exposure (opk rad, centre m).
-ImageRay RayFromPixel(const calib::Camera& camera, const Eigen::Vector3d& opk_rad,
-                      const Eigen::Vector3d& center_m, const Eigen::Vector2d& pixel);
+ImageRay RayFromPixel(const calib::Camera& camera,
+                      const Eigen::Vector3d& opk_rad,
+                      const Eigen::Vector3d& center_m,
+                      const Eigen::Vector2d& pixel);
 
 /// Least-squares intersection of >= 2 rays; nullopt when fewer rays, when the rays are nearly
 /// parallel (intersection angle below `min_angle_rad`) or when the point lies behind a camera.

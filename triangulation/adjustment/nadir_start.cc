@@ -1,10 +1,10 @@
 #include "triangulation/adjustment/nadir_start.h"
 
+#include "calib/core/error.h"
+
 #include <algorithm>
 #include <complex>
 #include <map>
-
-#include "calib/core/error.h"
 
 namespace aerocal::triangulation {
 
@@ -26,7 +26,8 @@ std::vector<Exposure> NadirStartFromControl(const Project& project, const std::s
   std::vector<Exposure> out;
   for (auto& [image, list] : pairs) {
     if (list.size() < 2)
-      throw InputError("image " + image + " sees fewer than two surveyed points: no starting orientation");
+      throw InputError("image " + image +
+                       " sees fewer than two surveyed points: no starting orientation");
     std::complex<double> a, t;
     for (;;) {
       std::complex<double> mp, mg;

@@ -6,9 +6,9 @@
 // five times the median (gross errors), keeping at least three points.
 #pragma once
 
-#include <vector>
-
 #include "triangulation/block/block.h"
+
+#include <vector>
 
 namespace aerocal::triangulation {
 

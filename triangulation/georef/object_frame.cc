@@ -1,12 +1,12 @@
 #include "triangulation/georef/object_frame.h"
 
-#include <cmath>
-#include <cstdio>
+#include "calib/core/error.h"
 
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/UTMUPS.hpp>
 
-#include "calib/core/error.h"
+#include <cmath>
+#include <cstdio>
 
 namespace aerocal::triangulation {
 
@@ -25,8 +25,8 @@ ObjectFrame::ObjectFrame(const FrameSpec& spec) : impl_(std::make_unique<Impl>()
       if (!(std::abs(spec.lat_deg) <= 90.0) || !(spec.lon_deg >= -180.0 && spec.lon_deg <= 360.0))
         throw InputError("frame: local origin lat/lon out of range (got " +
                          std::to_string(spec.lat_deg) + ", " + std::to_string(spec.lon_deg) + ")");
-      impl_->local = std::make_unique<GeographicLib::LocalCartesian>(spec.lat_deg, spec.lon_deg,
-                                                                     spec.h_m);
+      impl_->local =
+          std::make_unique<GeographicLib::LocalCartesian>(spec.lat_deg, spec.lon_deg, spec.h_m);
       break;
     case FrameSpec::Kind::kUtm:
       try {
@@ -58,7 +58,8 @@ Eigen::Vector3d ObjectFrame::ToAdjustment(const Eigen::Vector3d& in) const {
     bool north = true;
     GeographicLib::UTMUPS::Forward(in.y(), in.x(), zone, north, out.x(), out.y(), impl_->zone);
     if (north != impl_->north)  // a point across the equator: keep one false northing
-      out.y() += impl_->north ? -GeographicLib::UTMUPS::UTMShift() : GeographicLib::UTMUPS::UTMShift();
+      out.y() +=
+          impl_->north ? -GeographicLib::UTMUPS::UTMShift() : GeographicLib::UTMUPS::UTMShift();
     out.z() = in.z();
   }
   return out;
@@ -82,17 +83,23 @@ std::string ObjectFrame::Description() const {
   const FrameSpec& s = impl_->spec;
   char text[512];
   if (impl_->local) {
-    std::snprintf(text, sizeof(text),
-                  "local tangent plane (east, north, up; WGS84, GeographicLib LocalCartesian) about "
-                  "lat %.9f, lon %.9f, h %.3f m; input geodetic (X = lon, Y = lat deg, Z = "
-                  "ellipsoidal height m), results written back geodetic, differences in metres",
-                  s.lat_deg, s.lon_deg, s.h_m);
+    std::snprintf(
+        text,
+        sizeof(text),
+        "local tangent plane (east, north, up; WGS84, GeographicLib LocalCartesian) about "
+        "lat %.9f, lon %.9f, h %.3f m; input geodetic (X = lon, Y = lat deg, Z = "
+        "ellipsoidal height m), results written back geodetic, differences in metres",
+        s.lat_deg,
+        s.lon_deg,
+        s.h_m);
   } else if (impl_->zone > 0) {
-    std::snprintf(text, sizeof(text),
+    std::snprintf(text,
+                  sizeof(text),
                   "UTM zone %d%s (WGS84, GeographicLib UTMUPS; ellipsoidal heights, map-projection "
                   "scale and Earth curvature not modelled); input geodetic (X = lon, Y = lat deg, "
                   "Z = ellipsoidal height m), results written back geodetic, differences in metres",
-                  impl_->zone, impl_->north ? "N" : "S");
+                  impl_->zone,
+                  impl_->north ? "N" : "S");
   } else {
     std::snprintf(text, sizeof(text), "projected frame as given (%s)", s.description.c_str());
   }

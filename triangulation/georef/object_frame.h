@@ -16,13 +16,13 @@
 // coordinates are written back in the input frame (geodetic for geodetic input).
 #pragma once
 
-#include <memory>
-#include <string>
+#include "triangulation/adjustment/adjustment_result.h"
+#include "triangulation/block/block.h"
 
 #include <Eigen/Core>
 
-#include "triangulation/adjustment/adjustment_result.h"
-#include "triangulation/block/block.h"
+#include <memory>
+#include <string>
 
 namespace aerocal::triangulation {
 

@@ -1,16 +1,17 @@
 #include "triangulation/import/colmap_export.h"
 
-#include <cstdio>
-#include <sstream>
-
-#include <Eigen/Geometry>
-
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 
+#include <Eigen/Geometry>
+
+#include <cstdio>
+#include <sstream>
+
 namespace aerocal::triangulation {
 
-void WriteColmapModel(const Project& project, const std::map<std::string, Eigen::Vector3d>& points_m,
+void WriteColmapModel(const Project& project,
+                      const std::map<std::string, Eigen::Vector3d>& points_m,
                       const std::string& folder) {
   using Model = calib::BrownFraser10Model;
   std::map<std::string, int> camera_id, image_id, point_id;
@@ -33,7 +34,8 @@ void WriteColmapModel(const Project& project, const std::map<std::string, Eigen:
     if (o.subimage.empty() && point_id.count(o.point)) by_image[o.image].push_back(&o);
   // points3D tracks: (IMAGE_ID, POINT2D_IDX).
   std::map<std::string, std::vector<std::pair<int, int>>> tracks;
-  images << "# IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n# POINTS2D[] as (X, Y, POINT3D_ID)\n";
+  images << "# IMAGE_ID, QW, QX, QY, QZ, TX, TY, TZ, CAMERA_ID, NAME\n# POINTS2D[] as (X, Y, "
+            "POINT3D_ID)\n";
   for (const auto& e : project.exposures) {
     const int n = static_cast<int>(image_id.size()) + 1;
     image_id[e.image] = n;
@@ -41,18 +43,21 @@ void WriteColmapModel(const Project& project, const std::map<std::string, Eigen:
         Eigen::Vector3d(1, -1, -1).asDiagonal() * calib::RotationFromOpk(e.opk_rad).transpose();
     const Eigen::Quaterniond q(camera_from_world);
     const Eigen::Vector3d t = -camera_from_world * e.center_m;
-    images << n << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << t.x() << " " << t.y()
-           << " " << t.z() << " " << camera_id.at(e.camera) << " " << e.image << "\n";
+    images << n << " " << q.w() << " " << q.x() << " " << q.y() << " " << q.z() << " " << t.x()
+           << " " << t.y() << " " << t.z() << " " << camera_id.at(e.camera) << " " << e.image
+           << "\n";
     int k = 0;
     for (const auto* o : by_image[e.image]) {
-      images << (k ? " " : "") << o->pixel.x() + 0.5 << " " << o->pixel.y() + 0.5 << " " << point_id.at(o->point);
+      images << (k ? " " : "") << o->pixel.x() + 0.5 << " " << o->pixel.y() + 0.5 << " "
+             << point_id.at(o->point);
       tracks[o->point].emplace_back(n, k++);
     }
     images << "\n";
   }
   points << "# POINT3D_ID, X, Y, Z, R, G, B, ERROR, TRACK[] as (IMAGE_ID, POINT2D_IDX)\n";
   for (const auto& [id, xyz] : points_m) {
-    points << point_id.at(id) << " " << xyz.x() << " " << xyz.y() << " " << xyz.z() << " 128 128 128 0";
+    points << point_id.at(id) << " " << xyz.x() << " " << xyz.y() << " " << xyz.z()
+           << " 128 128 128 0";
     for (const auto& [image, index] : tracks[id]) points << " " << image << " " << index;
     points << "\n";
   }

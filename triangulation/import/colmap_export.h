@@ -5,17 +5,18 @@
 // Points need coordinates: pass the starting coordinates (e.g. forward intersections).
 #pragma once
 
-#include <map>
-#include <string>
+#include "triangulation/block/block.h"
 
 #include <Eigen/Core>
 
-#include "triangulation/block/block.h"
+#include <map>
+#include <string>
 
 namespace aerocal::triangulation {
 
 /// Observations of points absent from `points_m` are left out. Files written atomically.
-void WriteColmapModel(const Project& project, const std::map<std::string, Eigen::Vector3d>& points_m,
+void WriteColmapModel(const Project& project,
+                      const std::map<std::string, Eigen::Vector3d>& points_m,
                       const std::string& folder);
 
 }  // namespace aerocal::triangulation

@@ -1,16 +1,16 @@
 #include "triangulation/import/colmap_import.h"
 
-#include <cmath>
-#include <filesystem>
-#include <map>
-
-#include <Eigen/Dense>
-#include <Eigen/Geometry>
-
 #include "calib/camera/rotation.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "triangulation/import/text_rows.h"
+
+#include <Eigen/Dense>
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <filesystem>
+#include <map>
 
 namespace aerocal::triangulation {
 namespace {
@@ -24,17 +24,24 @@ struct ModelInfo {
   const char* name;
   size_t num_params;
 };
-constexpr ModelInfo kModels[] = {{"SIMPLE_PINHOLE", 3}, {"PINHOLE", 4}, {"SIMPLE_RADIAL", 4},
-                                 {"RADIAL", 5},         {"OPENCV", 8},  {"FULL_OPENCV", 12}};
+constexpr ModelInfo kModels[] = {{"SIMPLE_PINHOLE", 3},
+                                 {"PINHOLE", 4},
+                                 {"SIMPLE_RADIAL", 4},
+                                 {"RADIAL", 5},
+                                 {"OPENCV", 8},
+                                 {"FULL_OPENCV", 12}};
 
 // fx, fy, cx, cy of any supported model.
 Eigen::Vector4d Pinhole(const std::string& model, const std::vector<double>& p) {
-  if (model == "PINHOLE" || model == "OPENCV" || model == "FULL_OPENCV") return {p[0], p[1], p[2], p[3]};
+  if (model == "PINHOLE" || model == "OPENCV" || model == "FULL_OPENCV")
+    return {p[0], p[1], p[2], p[3]};
   return {p[0], p[0], p[1], p[2]};
 }
 
 // Forward distortion of normalized coordinates (COLMAP's models).
-Eigen::Vector2d Distort(const std::string& model, const std::vector<double>& p, const Eigen::Vector2d& n) {
+Eigen::Vector2d Distort(const std::string& model,
+                        const std::vector<double>& p,
+                        const Eigen::Vector2d& n) {
   const double u = n.x(), v = n.y(), u2 = u * u, v2 = v * v, uv = u * v, r2 = u2 + v2;
   if (model == "SIMPLE_RADIAL") return n * (1 + p[3] * r2);
   if (model == "RADIAL") return n * (1 + p[3] * r2 + p[4] * r2 * r2);
@@ -43,16 +50,22 @@ Eigen::Vector2d Distort(const std::string& model, const std::vector<double>& p, 
     double radial = 1 + k1 * r2 + k2 * r2 * r2;
     if (model == "FULL_OPENCV") {
       const double r6 = r2 * r2 * r2;
-      radial = (1 + k1 * r2 + k2 * r2 * r2 + p[8] * r6) / (1 + p[9] * r2 + p[10] * r2 * r2 + p[11] * r6);
+      radial =
+          (1 + k1 * r2 + k2 * r2 * r2 + p[8] * r6) / (1 + p[9] * r2 + p[10] * r2 * r2 + p[11] * r6);
     }
-    return {u * radial + 2 * p1 * uv + p2 * (r2 + 2 * u2), v * radial + 2 * p2 * uv + p1 * (r2 + 2 * v2)};
+    return {u * radial + 2 * p1 * uv + p2 * (r2 + 2 * u2),
+            v * radial + 2 * p2 * uv + p1 * (r2 + 2 * v2)};
   }
   return n;
 }
 
 // The 10-parameter camera closest to a COLMAP camera; returns the fit RMS in pixels.
-double FitCamera(const std::string& model, const std::vector<double>& p, int width, int height,
-                 double pixel_size_mm, calib::Camera* camera) {
+double FitCamera(const std::string& model,
+                 const std::vector<double>& p,
+                 int width,
+                 int height,
+                 double pixel_size_mm,
+                 calib::Camera* camera) {
   const Eigen::Vector4d k = Pinhole(model, p);
   camera->width_px = width;
   camera->height_px = height;
@@ -74,14 +87,17 @@ double FitCamera(const std::string& model, const std::vector<double>& p, int wid
       Eigen::Vector2d undistorted((pixel.x() - k[2]) / k[0], (pixel.y() - k[3]) / k[1]);
       const Eigen::Vector2d target = undistorted;
       for (int it = 0; it < 100; ++it) undistorted += target - Distort(model, p, undistorted);
-      const Eigen::Vector2d measured = Eigen::Vector2d(k[0], k[1]).cwiseProduct(Distort(model, p, undistorted)) +
-                                       Eigen::Vector2d(k[2], k[3]);
-      const Eigen::Vector2d xb((measured.x() - k[2]) * pixel_size_mm, -(measured.y() - k[3]) * pixel_size_mm);
+      const Eigen::Vector2d measured =
+          Eigen::Vector2d(k[0], k[1]).cwiseProduct(Distort(model, p, undistorted)) +
+          Eigen::Vector2d(k[2], k[3]);
+      const Eigen::Vector2d xb((measured.x() - k[2]) * pixel_size_mm,
+                               -(measured.y() - k[3]) * pixel_size_mm);
       const Eigen::Vector2d ideal(c * undistorted.x(), -c * undistorted.y());
       const double r2 = xb.squaredNorm();
       Eigen::Matrix<double, 2, 7> a;
-      a << xb.x() * r2, xb.x() * r2 * r2, xb.x() * r2 * r2 * r2, r2 + 2 * xb.x() * xb.x(), 2 * xb.x() * xb.y(), xb.x(), xb.y(),
-          xb.y() * r2, xb.y() * r2 * r2, xb.y() * r2 * r2 * r2, 2 * xb.x() * xb.y(), r2 + 2 * xb.y() * xb.y(), 0, 0;
+      a << xb.x() * r2, xb.x() * r2 * r2, xb.x() * r2 * r2 * r2, r2 + 2 * xb.x() * xb.x(),
+          2 * xb.x() * xb.y(), xb.x(), xb.y(), xb.y() * r2, xb.y() * r2 * r2, xb.y() * r2 * r2 * r2,
+          2 * xb.x() * xb.y(), r2 + 2 * xb.y() * xb.y(), 0, 0;
       rows.push_back(a);
       rhs.push_back(ideal - xb);
     }
@@ -93,14 +109,16 @@ double FitCamera(const std::string& model, const std::vector<double>& p, int wid
   }
   // Column scaling: the radial terms span many orders of magnitude.
   const Eigen::VectorXd scale = a.colwise().norm().cwiseMax(1e-300).cwiseInverse();
-  const Eigen::VectorXd x = scale.asDiagonal() * (a * scale.asDiagonal()).colPivHouseholderQr().solve(b);
+  const Eigen::VectorXd x =
+      scale.asDiagonal() * (a * scale.asDiagonal()).colPivHouseholderQr().solve(b);
   for (int i = 0; i < 7; ++i) camera->interior[Model::kK1 + i] = x(i);
   return std::sqrt((a * x - b).squaredNorm() / rows.size()) / pixel_size_mm;
 }
 
 }  // namespace
 
-Eigen::Vector2d ColmapProject(const std::string& model, const std::vector<double>& params,
+Eigen::Vector2d ColmapProject(const std::string& model,
+                              const std::vector<double>& params,
                               const Eigen::Vector3d& q) {
   const Eigen::Vector4d k = Pinhole(model, params);
   const Eigen::Vector2d d = Distort(model, params, q.head<2>() / q.z());
@@ -114,7 +132,8 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
   Project& project = report.project;
   project.path = o.folder;
   project.frame.description = "COLMAP model frame as given";
-  const std::string cameras_file = o.folder + "/cameras.txt", images_file = o.folder + "/images.txt",
+  const std::string cameras_file = o.folder + "/cameras.txt",
+                    images_file = o.folder + "/images.txt",
                     points_file = o.folder + "/points3D.txt";
   std::map<std::string, std::string> camera_model;
   for (const auto& row : internal::ReadTextRows(cameras_file, false)) {
@@ -124,15 +143,18 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     for (const auto& m : kModels)
       if (model == m.name) info = &m;
     if (!info)
-      ThrowInputError({cameras_file, row.line}, "camera model " + model +
-                                                    " is not supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, "
-                                                    "RADIAL, OPENCV, FULL_OPENCV)");
+      ThrowInputError({cameras_file, row.line},
+                      "camera model " + model +
+                          " is not supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, "
+                          "RADIAL, OPENCV, FULL_OPENCV)");
     if (row.fields.size() != 4 + info->num_params)
-      ThrowInputError({cameras_file, row.line}, model + " needs " + std::to_string(info->num_params) + " parameters");
+      ThrowInputError({cameras_file, row.line},
+                      model + " needs " + std::to_string(info->num_params) + " parameters");
     const int width = static_cast<int>(NumberField(row, 2, cameras_file, "WIDTH"));
     const int height = static_cast<int>(NumberField(row, 3, cameras_file, "HEIGHT"));
     std::vector<double> params;
-    for (size_t k = 0; k < info->num_params; ++k) params.push_back(NumberField(row, 4 + k, cameras_file, "PARAMS"));
+    for (size_t k = 0; k < info->num_params; ++k)
+      params.push_back(NumberField(row, 4 + k, cameras_file, "PARAMS"));
     calib::Camera camera;
     camera.name = "COLMAP camera " + id + " (" + model + ")";
     const double rms = FitCamera(model, params, width, height, o.pixel_size_mm, &camera);
@@ -147,15 +169,20 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
   for (size_t i = 0; i < image_rows.size(); i += 2) {
     const TextRow& row = image_rows[i];
     if (row.fields.size() != 10)
-      ThrowInputError({images_file, row.line}, "expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME");
+      ThrowInputError({images_file, row.line},
+                      "expected IMAGE_ID QW QX QY QZ TX TY TZ CAMERA_ID NAME");
     Exposure e;
     e.line = row.line;
     e.image = std::filesystem::path(row.fields[9]).stem().string();
     e.camera = row.fields[8];
-    if (!project.cameras.count(e.camera)) ThrowInputError({images_file, row.line}, "unknown camera " + e.camera);
-    const Eigen::Quaterniond q(NumberField(row, 1, images_file, "QW"), NumberField(row, 2, images_file, "QX"),
-                               NumberField(row, 3, images_file, "QY"), NumberField(row, 4, images_file, "QZ"));
-    const Eigen::Vector3d t(NumberField(row, 5, images_file, "TX"), NumberField(row, 6, images_file, "TY"),
+    if (!project.cameras.count(e.camera))
+      ThrowInputError({images_file, row.line}, "unknown camera " + e.camera);
+    const Eigen::Quaterniond q(NumberField(row, 1, images_file, "QW"),
+                               NumberField(row, 2, images_file, "QX"),
+                               NumberField(row, 3, images_file, "QY"),
+                               NumberField(row, 4, images_file, "QZ"));
+    const Eigen::Vector3d t(NumberField(row, 5, images_file, "TX"),
+                            NumberField(row, 6, images_file, "TY"),
                             NumberField(row, 7, images_file, "TZ"));
     const Eigen::Matrix3d camera_from_world = q.normalized().toRotationMatrix();
     e.center_m = -camera_from_world.transpose() * t;
@@ -173,7 +200,8 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
       obs.line = points.line;
       obs.image = e.image;
       obs.point = points.fields[k + 2];
-      obs.pixel = {NumberField(points, k, images_file, "X") - 0.5, NumberField(points, k + 1, images_file, "Y") - 0.5};
+      obs.pixel = {NumberField(points, k, images_file, "X") - 0.5,
+                   NumberField(points, k + 1, images_file, "Y") - 0.5};
       obs.sigma_px = o.sigma_px;
       project.observations.push_back(obs);
     }
@@ -182,7 +210,8 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     GroundPoint p;
     p.line = row.line;
     p.id = StringField(row, 0, points_file, "POINT3D_ID");
-    p.xyz_m = Eigen::Vector3d(NumberField(row, 1, points_file, "X"), NumberField(row, 2, points_file, "Y"),
+    p.xyz_m = Eigen::Vector3d(NumberField(row, 1, points_file, "X"),
+                              NumberField(row, 2, points_file, "Y"),
                               NumberField(row, 3, points_file, "Z"));
     project.points.push_back(p);
   }

@@ -13,19 +13,19 @@
 //   free-network datum.
 #pragma once
 
-#include <string>
-#include <vector>
+#include "triangulation/block/block.h"
 
 #include <Eigen/Core>
 
-#include "triangulation/block/block.h"
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 
 struct ColmapImportOptions {
-  std::string folder;             // holding cameras.txt, images.txt, points3D.txt
-  double pixel_size_mm = 0.001;   // COLMAP has no pixel size; any value gives the same geometry
-  double sigma_px = 1.0;          // a-priori sigma of the image measurements, > 0
+  std::string folder;            // holding cameras.txt, images.txt, points3D.txt
+  double pixel_size_mm = 0.001;  // COLMAP has no pixel size; any value gives the same geometry
+  double sigma_px = 1.0;         // a-priori sigma of the image measurements, > 0
 };
 
 struct ColmapImportReport {
@@ -37,7 +37,8 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& options);
 
 /// COLMAP's projection of a point in COLMAP camera coordinates to COLMAP pixels (x, y), for the
 /// supported models with their params; the round-trip tests compare it with aerocal's camera.
-Eigen::Vector2d ColmapProject(const std::string& model, const std::vector<double>& params,
+Eigen::Vector2d ColmapProject(const std::string& model,
+                              const std::vector<double>& params,
                               const Eigen::Vector3d& point_in_camera);
 
 }  // namespace aerocal::triangulation

@@ -1,15 +1,15 @@
 #include "triangulation/import/dbat_import.h"
 
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "triangulation/import/text_rows.h"
+
 #include <cmath>
 #include <filesystem>
 #include <map>
 #include <regex>
 #include <set>
-
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
-#include "calib/core/error.h"
-#include "triangulation/import/text_rows.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -32,12 +32,15 @@ std::vector<std::string> XmlList(const std::string& xml, const std::string& tag)
   return out;
 }
 
-std::vector<double> XmlNumbers(const std::string& xml, const std::string& tag, const std::string& path,
+std::vector<double> XmlNumbers(const std::string& xml,
+                               const std::string& tag,
+                               const std::string& path,
                                size_t min_size) {
   std::vector<double> out;
   for (const auto& s : XmlList(xml, tag)) {
     const auto begin = s.find_first_not_of(" \t\n"), end = s.find_last_not_of(" \t\n");
-    const auto v = begin == std::string::npos ? std::nullopt : ParseDouble(s.substr(begin, end - begin + 1));
+    const auto v =
+        begin == std::string::npos ? std::nullopt : ParseDouble(s.substr(begin, end - begin + 1));
     if (!v) ThrowInputError({path, 0}, "<" + tag + "> must hold numbers (got '" + s + "')");
     out.push_back(*v);
   }
@@ -90,7 +93,8 @@ Project ImportDbat(const DbatImportOptions& o) {
   // Image ids -> names (file stems).
   std::map<std::string, std::string> image_name;
   for (const auto& row : ReadTextRows(o.images))
-    image_name[StringField(row, 0, o.images, "image id")] = Stem(StringField(row, 1, o.images, "path"));
+    image_name[StringField(row, 0, o.images, "image id")] =
+        Stem(StringField(row, 1, o.images, "path"));
   auto name_of = [&](const std::string& id, const std::string& file, int line) {
     const auto it = image_name.find(id);
     if (it == image_name.end()) ThrowInputError({file, line}, "unknown image id '" + id + "'");
@@ -121,7 +125,8 @@ Project ImportDbat(const DbatImportOptions& o) {
       e.line = s.line;
       e.image = Stem(rows[i].fields[1]);
       e.camera = "cam1";
-      for (int k = 0; k < 3; ++k) e.center_m[k] = NumberField(s, 1 + k, o.photomodeler_export, "X, Y, Z");
+      for (int k = 0; k < 3; ++k)
+        e.center_m[k] = NumberField(s, 1 + k, o.photomodeler_export, "X, Y, Z");
       e.opk_rad = {NumberField(s, 6, o.photomodeler_export, "omega") * kDegToRad,
                    NumberField(s, 5, o.photomodeler_export, "phi") * kDegToRad,
                    NumberField(s, 4, o.photomodeler_export, "kappa") * kDegToRad};
@@ -156,9 +161,11 @@ Project ImportDbat(const DbatImportOptions& o) {
       p.line = row.line;
       p.id = StringField(row, 0, o.control, "point id");
       p.role = PointRole::kControl;
-      p.xyz_m = Eigen::Vector3d(NumberField(row, 2, o.control, "X"), NumberField(row, 3, o.control, "Y"),
+      p.xyz_m = Eigen::Vector3d(NumberField(row, 2, o.control, "X"),
+                                NumberField(row, 3, o.control, "Y"),
                                 NumberField(row, 4, o.control, "Z"));
-      const double s = row.fields.size() > 5 ? NumberField(row, 5, o.control, "sxyz") : o.control_sigma_m;
+      const double s =
+          row.fields.size() > 5 ? NumberField(row, 5, o.control, "sxyz") : o.control_sigma_m;
       if (!(s > 0)) ThrowInputError({o.control, row.line}, "sxyz must be > 0 m");
       p.sigma_m = Eigen::Vector3d::Constant(s);
       control.insert(p.id);

@@ -18,20 +18,20 @@
 // - Control points `id, label, X, Y, Z[, sxyz]` (m); a missing sigma takes `control_sigma_m`.
 #pragma once
 
-#include <string>
-
 #include "triangulation/block/block.h"
+
+#include <string>
 
 namespace aerocal::triangulation {
 
 struct DbatImportOptions {
-  std::string camera_xml;         // DBAT camera file (initial camera)
-  std::string marks;              // markpts.txt
-  std::string images;             // images.txt: id, path (image ids become file stems)
-  std::string control;            // optional control file
-  std::string initial_eo;         // `id, X, Y, Z, omega, phi, kappa` in degrees, or
+  std::string camera_xml;           // DBAT camera file (initial camera)
+  std::string marks;                // markpts.txt
+  std::string images;               // images.txt: id, path (image ids become file stems)
+  std::string control;              // optional control file
+  std::string initial_eo;           // `id, X, Y, Z, omega, phi, kappa` in degrees, or
   std::string photomodeler_export;  // a PhotoModeler bundle export with the stations
-  double default_sigma_px = 1.0;  // where the marks have no sxy, > 0
+  double default_sigma_px = 1.0;    // where the marks have no sxy, > 0
   double control_sigma_m = 0.001;
 };
 

@@ -1,11 +1,11 @@
 #include "triangulation/import/odm_gcp_import.h"
 
+#include "calib/core/error.h"
+#include "triangulation/import/text_rows.h"
+
 #include <cmath>
 #include <filesystem>
 #include <map>
-
-#include "calib/core/error.h"
-#include "triangulation/import/text_rows.h"
 
 namespace aerocal::triangulation {
 
@@ -16,7 +16,8 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
   if (rows.empty()) ThrowInputError({o.gcp_list, 1}, "empty GCP list (expected a projection line)");
   std::string projection;
   for (const auto& f : rows.front().fields) projection += (projection.empty() ? "" : " ") + f;
-  if (projection.find("longlat") != std::string::npos || projection.find("4326") != std::string::npos)
+  if (projection.find("longlat") != std::string::npos ||
+      projection.find("4326") != std::string::npos)
     ThrowInputError({o.gcp_list, rows.front().line},
                     "geographic GCP coordinates (" + projection +
                         "): give a projected list or a project with frame: {local: ...}");
@@ -29,21 +30,26 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
   for (size_t i = 1; i < rows.size(); ++i) {
     const auto& row = rows[i];
     using internal::NumberField;
-    const Eigen::Vector3d xyz(NumberField(row, 0, o.gcp_list, "geo_x"), NumberField(row, 1, o.gcp_list, "geo_y"),
+    const Eigen::Vector3d xyz(NumberField(row, 0, o.gcp_list, "geo_x"),
+                              NumberField(row, 1, o.gcp_list, "geo_y"),
                               NumberField(row, 2, o.gcp_list, "geo_z"));
     ImageObservation obs;
     obs.line = row.line;
-    obs.pixel = Eigen::Vector2d(NumberField(row, 3, o.gcp_list, "im_x"), NumberField(row, 4, o.gcp_list, "im_y")) *
+    obs.pixel = Eigen::Vector2d(NumberField(row, 3, o.gcp_list, "im_x"),
+                                NumberField(row, 4, o.gcp_list, "im_y")) *
                 o.pixel_scale;
-    obs.image = std::filesystem::path(internal::StringField(row, 5, o.gcp_list, "image_name")).stem().string();
+    obs.image = std::filesystem::path(internal::StringField(row, 5, o.gcp_list, "image_name"))
+                    .stem()
+                    .string();
     // Without a name, the coordinates identify the target.
     obs.point = row.fields.size() > 6 ? row.fields[6]
                                       : row.fields[0] + "_" + row.fields[1] + "_" + row.fields[2];
     obs.sigma_px = o.sigma_px;
     if (obs.pixel.x() < -0.5 || obs.pixel.y() < -0.5 || obs.pixel.x() > o.camera.width_px - 0.5 ||
         obs.pixel.y() > o.camera.height_px - 0.5)
-      ThrowInputError({o.gcp_list, row.line}, "pixel outside the " + std::to_string(o.camera.width_px) + " x " +
-                                                  std::to_string(o.camera.height_px) + " format");
+      ThrowInputError({o.gcp_list, row.line},
+                      "pixel outside the " + std::to_string(o.camera.width_px) + " x " +
+                          std::to_string(o.camera.height_px) + " format");
     auto [it, inserted] = points.try_emplace(obs.point);
     GroundPoint& p = it->second;
     if (inserted) {
@@ -51,10 +57,12 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
       p.line = row.line;
       p.xyz_m = xyz;
       p.sigma_m = Eigen::Vector3d::Constant(o.target_sigma_m);
-      p.role = o.control_ids.empty() || o.control_ids.count(p.id) ? PointRole::kControl : PointRole::kCheck;
+      p.role = o.control_ids.empty() || o.control_ids.count(p.id) ? PointRole::kControl
+                                                                  : PointRole::kCheck;
     } else if ((*p.xyz_m - xyz).norm() > 1e-6) {
-      ThrowInputError({o.gcp_list, row.line}, "target " + p.id + " has other coordinates on line " +
-                                                  std::to_string(p.line));
+      ThrowInputError(
+          {o.gcp_list, row.line},
+          "target " + p.id + " has other coordinates on line " + std::to_string(p.line));
     }
     project.observations.push_back(obs);
   }

@@ -7,10 +7,10 @@
 // (EPSG:4326 / longlat) list is rejected here: convert it with a `frame: {local: ...}` project.
 #pragma once
 
+#include "triangulation/block/block.h"
+
 #include <set>
 #include <string>
-
-#include "triangulation/block/block.h"
 
 namespace aerocal::triangulation {
 

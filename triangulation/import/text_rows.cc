@@ -1,10 +1,10 @@
 #include "triangulation/import/text_rows.h"
 
-#include <sstream>
-
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+
+#include <sstream>
 
 namespace aerocal::triangulation::internal {
 
@@ -38,16 +38,22 @@ std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates,
 
 double NumberField(const TextRow& row, size_t k, const std::string& file, const char* what) {
   if (k >= row.fields.size())
-    ThrowInputError({file, row.line}, std::string("missing ") + what + " (field " + std::to_string(k + 1) + ")");
+    ThrowInputError({file, row.line},
+                    std::string("missing ") + what + " (field " + std::to_string(k + 1) + ")");
   const auto value = ParseDouble(row.fields[k]);
   if (!value)
-    ThrowInputError({file, row.line}, std::string(what) + " must be a number (got '" + row.fields[k] + "')");
+    ThrowInputError({file, row.line},
+                    std::string(what) + " must be a number (got '" + row.fields[k] + "')");
   return *value;
 }
 
-const std::string& StringField(const TextRow& row, size_t k, const std::string& file, const char* what) {
+const std::string& StringField(const TextRow& row,
+                               size_t k,
+                               const std::string& file,
+                               const char* what) {
   if (k >= row.fields.size())
-    ThrowInputError({file, row.line}, std::string("missing ") + what + " (field " + std::to_string(k + 1) + ")");
+    ThrowInputError({file, row.line},
+                    std::string("missing ") + what + " (field " + std::to_string(k + 1) + ")");
   return row.fields[k];
 }
 

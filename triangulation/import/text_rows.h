@@ -14,12 +14,16 @@ struct TextRow {
 
 /// Rows of a file; `comma_separates` also splits on commas; `keep_blank` keeps blank lines as
 /// rows without fields (COLMAP's images.txt). InputError when it cannot be read.
-std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates = true,
+std::vector<TextRow> ReadTextRows(const std::string& path,
+                                  bool comma_separates = true,
                                   bool keep_blank = false);
 
 /// Field k as a number; InputError("FILE:LINE: ...") when absent or not a number.
 double NumberField(const TextRow& row, size_t k, const std::string& file, const char* what);
 /// Field k as a string; InputError when absent.
-const std::string& StringField(const TextRow& row, size_t k, const std::string& file, const char* what);
+const std::string& StringField(const TextRow& row,
+                               size_t k,
+                               const std::string& file,
+                               const char* what);
 
 }  // namespace aerocal::triangulation::internal

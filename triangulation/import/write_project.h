@@ -3,9 +3,9 @@
 // conversion is done once and `aerocal adjust --project FOLDER` runs on the result.
 #pragma once
 
-#include <string>
-
 #include "triangulation/block/block.h"
+
+#include <string>
 
 namespace aerocal::triangulation {
 
