@@ -7,6 +7,8 @@
 #include <thread>
 
 #include <Eigen/Dense>
+#include <Eigen/Sparse>
+#include <Eigen/SparseCholesky>
 #include <ceres/ceres.h>
 
 #include "calib/core/error.h"
@@ -448,7 +450,13 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
     for (size_t k = i; k < free_requested.size(); ++k)
       if (wanted(i, k))
         pairs.emplace_back(blocks_[free_requested[i]].values, blocks_[free_requested[k]].values);
-  const bool computed = pairs.empty() || covariance.Compute(pairs, problem_.get());
+  std::vector<std::pair<BlockId, BlockId>> pair_ids;
+  for (size_t i = 0; i < free_requested.size(); ++i)
+    for (size_t k = i; k < free_requested.size(); ++k)
+      if (wanted(i, k)) pair_ids.emplace_back(free_requested[i], free_requested[k]);
+  std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd> schur;
+  const bool use_schur = n_free > 300 && SchurCovariance(pair_ids, &schur);
+  const bool computed = pairs.empty() || use_schur || covariance.Compute(pairs, problem_.get());
   if (!computed) {
     report.ok = false;
     report.undetermined = NullSpaceParameters(3000);
@@ -472,7 +480,10 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
       const Block& a = blocks_[free_requested[i]];
       const Block& b = blocks_[free_requested[k]];
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(a.size, b.size);
-      covariance.GetCovarianceBlock(a.values, b.values, m.data());
+      if (use_schur)
+        m = schur.at({free_requested[i], free_requested[k]});
+      else
+        covariance.GetCovarianceBlock(a.values, b.values, m.data());
       const int ra = report.offsets[free_requested[i]], rb = report.offsets[free_requested[k]];
       report.covariance.block(ra, rb, a.size, b.size) = s2 * m;
       report.covariance.block(rb, ra, b.size, a.size) = s2 * m.transpose();
@@ -591,6 +602,102 @@ bool ProblemBuilder::RedundancyNumbersBySchur(const std::vector<ResidualId>& ids
     }
     if (n_other > 0) h += d.dot(s_inverse * d);
     (*out)[owner[r]].push_back(std::max(0.0, 1.0 - h));
+  }
+  return true;
+}
+
+bool ProblemBuilder::SchurCovariance(const std::vector<std::pair<BlockId, BlockId>>& pairs,
+                                     std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const {
+  auto eliminable = [&](BlockId id) {
+    return blocks_[id].kind == BlockKind::kGroundPoint || blocks_[id].kind == BlockKind::kTiePoint2d;
+  };
+  for (const auto& [a, b] : pairs)
+    if (eliminable(a) || eliminable(b)) return false;
+  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
+  // Tangent columns: eliminable blocks -> point index space, the others -> reduced space.
+  std::map<BlockId, int> offset;  // in its own space
+  std::vector<int> column_space, column_index, column_block;
+  int n_p = 0, n_r = 0;
+  for (BlockId id : free_blocks) {
+    const int t = blocks_[id].TangentSize();
+    const bool elim = eliminable(id);
+    offset[id] = elim ? n_p : n_r;
+    for (int k = 0; k < t; ++k) {
+      column_space.push_back(elim ? 0 : 1);
+      column_index.push_back(elim ? n_p + k : n_r + k);
+      column_block.push_back(id);
+    }
+    (elim ? n_p : n_r) += t;
+  }
+  if (n_p == 0 || n_r == 0) return false;
+  ceres::Problem::EvaluateOptions eval;
+  for (BlockId id : free_blocks) eval.parameter_blocks.push_back(blocks_[id].values);
+  eval.apply_loss_function = true;
+  ceres::CRSMatrix crs;
+  double cost = 0.0;
+  if (!problem_->Evaluate(eval, &cost, nullptr, nullptr, &crs)) return false;
+  using Sparse = Eigen::SparseMatrix<double>;
+  std::vector<Eigen::Triplet<double>> tp, tr;
+  for (int row = 0; row < crs.num_rows; ++row) {
+    BlockId point = -1;
+    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) {
+      const int col = crs.cols[k];
+      if (column_space[col] == 0) {
+        if (point >= 0 && point != column_block[col]) return false;  // two points in one residual
+        point = column_block[col];
+        tp.emplace_back(row, column_index[col], crs.values[k]);
+      } else {
+        tr.emplace_back(row, column_index[col], crs.values[k]);
+      }
+    }
+  }
+  Sparse jp(crs.num_rows, n_p), jr(crs.num_rows, n_r);
+  jp.setFromTriplets(tp.begin(), tp.end());
+  jr.setFromTriplets(tr.begin(), tr.end());
+  // Block-diagonal N_pp^-1 (one small block per point).
+  const Sparse npp = Sparse(jp.transpose()) * jp;
+  std::vector<Eigen::Triplet<double>> ti;
+  for (BlockId id : free_blocks) {
+    if (!eliminable(id)) continue;
+    const int o = offset[id], t = blocks_[id].TangentSize();
+    Eigen::MatrixXd block = Eigen::MatrixXd(npp.block(o, o, t, t));
+    Eigen::LDLT<Eigen::MatrixXd> ldlt(block);
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return false;
+    const Eigen::MatrixXd inverse = ldlt.solve(Eigen::MatrixXd::Identity(t, t));
+    for (int i = 0; i < t; ++i)
+      for (int k = 0; k < t; ++k) ti.emplace_back(o + i, o + k, inverse(i, k));
+  }
+  Sparse npp_inverse(n_p, n_p);
+  npp_inverse.setFromTriplets(ti.begin(), ti.end());
+  const Sparse npr = Sparse(jp.transpose()) * jr;
+  const Sparse s = Sparse(Sparse(jr.transpose()) * jr) - Sparse(Sparse(npr.transpose()) * npp_inverse) * npr;
+  Eigen::SimplicialLDLT<Sparse> solver(s);
+  if (solver.info() != Eigen::Success || !(solver.vectorD().minCoeff() > 1e-14 * solver.vectorD().maxCoeff()))
+    return false;
+  // Columns of S^-1 for every block that appears in a pair, then the ambient blocks P Q P^T.
+  std::map<BlockId, Eigen::MatrixXd> columns;  // n_r x tangent size
+  for (const auto& [a, b] : pairs)
+    for (BlockId id : {a, b})
+      if (!columns.count(id)) {
+        const int t = blocks_[id].TangentSize();
+        Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_r, t);
+        for (int k = 0; k < t; ++k) rhs(offset[id] + k, k) = 1.0;
+        columns[id] = solver.solve(rhs);
+      }
+  auto plus_jacobian = [&](BlockId id) {
+    const Block& b = blocks_[id];
+    const ceres::Manifold* manifold = problem_->GetManifold(b.values);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> j(b.size, b.TangentSize());
+    if (manifold)
+      manifold->PlusJacobian(b.values, j.data());
+    else
+      j.setIdentity();
+    return Eigen::MatrixXd(j);
+  };
+  for (const auto& [a, b] : pairs) {
+    // Q(a, b): the rows of block a in the solved columns of block b.
+    const Eigen::MatrixXd q_ab = columns[b].middleRows(offset[a], blocks_[a].TangentSize());
+    (*out)[{a, b}] = plus_jacobian(a) * q_ab * plus_jacobian(b).transpose();
   }
   return true;
 }

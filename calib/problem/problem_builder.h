@@ -15,7 +15,9 @@
 //   points can be eliminated, sparse Cholesky otherwise), optional robust loss per residual, and
 //   returns a SolveReport: sigma0 = sqrt(v^T P v / r) with the redundancy r = n_obs - n_unknowns,
 //   iterations, convergence, per-group counts and RMS.
-// - EstimateCovariance(): Ceres' covariance of the chosen blocks, scaled by sigma0^2, with standard
+// - EstimateCovariance(): covariance of the chosen blocks, scaled by sigma0^2 (Ceres' covariance;
+//   for large problems whose requested blocks are not ground points, the points are eliminated
+//   first: Q_rr = S^-1 with the reduced normal matrix S = N_rr - N_rp N_pp^-1 N_pr), with standard
 //   deviations, correlations, the pairs above a threshold, and, for a rank-deficient problem, the
 //   parameters that span the null space (from an eigen-decomposition of the Jacobi-scaled normal
 //   matrix when the problem is small enough).
@@ -217,6 +219,11 @@ class ProblemBuilder {
                                 std::map<ResidualId, std::vector<double>>* out) const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,
                                 std::vector<ResidualId>* row_owner) const;
+  /// Covariance blocks (ambient, unscaled Q) of `pairs` of non-eliminable blocks by eliminating the
+  /// ground points (Schur complement, sparse LDLT); false when not applicable or not positive
+  /// definite (the caller then falls back to Ceres' covariance).
+  bool SchurCovariance(const std::vector<std::pair<BlockId, BlockId>>& pairs,
+                       std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const;
 
   std::unique_ptr<ceres::Problem> problem_;
   std::vector<Block> blocks_;
