@@ -674,30 +674,28 @@ bool ProblemBuilder::SchurCovariance(const std::vector<std::pair<BlockId, BlockI
   Eigen::SimplicialLDLT<Sparse> solver(s);
   if (solver.info() != Eigen::Success || !(solver.vectorD().minCoeff() > 1e-14 * solver.vectorD().maxCoeff()))
     return false;
-  // Columns of S^-1 for every block that appears in a pair, then the ambient blocks P Q P^T.
-  std::map<BlockId, Eigen::MatrixXd> columns;  // n_r x tangent size
-  for (const auto& [a, b] : pairs)
-    for (BlockId id : {a, b})
-      if (!columns.count(id)) {
-        const int t = blocks_[id].TangentSize();
-        Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_r, t);
-        for (int k = 0; k < t; ++k) rhs(offset[id] + k, k) = 1.0;
-        columns[id] = solver.solve(rhs);
-      }
   auto plus_jacobian = [&](BlockId id) {
-    const Block& b = blocks_[id];
-    const ceres::Manifold* manifold = problem_->GetManifold(b.values);
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> j(b.size, b.TangentSize());
+    const Block& block = blocks_[id];
+    const ceres::Manifold* manifold = problem_->GetManifold(block.values);
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> j(block.size, block.TangentSize());
     if (manifold)
-      manifold->PlusJacobian(b.values, j.data());
+      manifold->PlusJacobian(block.values, j.data());
     else
       j.setIdentity();
     return Eigen::MatrixXd(j);
   };
-  for (const auto& [a, b] : pairs) {
-    // Q(a, b): the rows of block a in the solved columns of block b.
-    const Eigen::MatrixXd q_ab = columns[b].middleRows(offset[a], blocks_[a].TangentSize());
-    (*out)[{a, b}] = plus_jacobian(a) * q_ab * plus_jacobian(b).transpose();
+  // Columns of S^-1 one block at a time (memory n_r x block size), then the ambient blocks
+  // P_a Q(a, b) P_b^T of every pair with that block as its column side.
+  std::map<BlockId, std::vector<BlockId>> rows_of_column;
+  for (const auto& [a, b] : pairs) rows_of_column[b].push_back(a);
+  for (const auto& [b, rows] : rows_of_column) {
+    const int t = blocks_[b].TangentSize();
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_r, t);
+    for (int k = 0; k < t; ++k) rhs(offset[b] + k, k) = 1.0;
+    const Eigen::MatrixXd columns = solver.solve(rhs);
+    const Eigen::MatrixXd pb = plus_jacobian(b);
+    for (BlockId a : rows)
+      (*out)[{a, b}] = plus_jacobian(a) * columns.middleRows(offset[a], blocks_[a].TangentSize()) * pb.transpose();
   }
   return true;
 }
