@@ -55,7 +55,21 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
     EXPECT_EQ(a["kind"], "adjust");
     EXPECT_TRUE(a["converged"].get<bool>());
     EXPECT_EQ(a["check"]["rmse_m"].size(), 3u);
+    // Every image observation has its residual (the report's residual plot), at the noise level.
+    const auto& residuals = a["residuals"];
+    ASSERT_GT(residuals.size(), 1000u) << names[i];
+    double sum2 = 0.0;
+    for (const auto& v : residuals)
+      for (const char* key : {"image", "point", "col", "row", "v_col_px", "v_row_px", "used"})
+        ASSERT_TRUE(v.contains(key)) << names[i] << ".residuals[]." << key;
+    for (const auto& v : residuals)
+      sum2 += std::pow(v["v_col_px"].get<double>(), 2) + std::pow(v["v_row_px"].get<double>(), 2);
+    EXPECT_LT(std::sqrt(sum2 / (2.0 * residuals.size())), 0.35) << names[i] << ": RMS residual, px";
+    // Check points are counted with all their rays, virtual or raw sub-image.
+    for (const auto& p : a["check"]["points"]) ASSERT_GE(p["rays"].get<int>(), 2) << names[i];
   }
+  // The joint run measures in raw sub-images: its residuals name the sub-image and its (u, v).
+  EXPECT_TRUE(doc["adjustments"][2]["residuals"][0].contains("subimage"));
   // Image sigma 0.2 px injected: sigma0 in px at the noise level for the self-calibrating runs.
   EXPECT_NEAR(doc["adjustments"][1]["sigma0_px"].get<double>(), 0.2, 0.02);
   EXPECT_NEAR(doc["adjustments"][2]["sigma0_px"].get<double>(), 0.2, 0.02);

@@ -48,7 +48,8 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
                                   v.point,
                                   v.measured_px,
                                   Eigen::Vector2d(v.residual_px.x(), -v.residual_px.y()),
-                                  w});
+                                  w,
+                                  std::string()});
           break;
         }
       }
@@ -73,7 +74,7 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
   result.rejected.insert(result.rejected.begin(), pre_rejected.begin(), pre_rejected.end());
   for (const auto& r : pre_rejected)
     result.residuals.push_back(
-        {r.image, r.point, r.measured_px, Eigen::Vector2d::Zero(), 0.0, false});
+        {r.image, r.point, r.measured_px, Eigen::Vector2d::Zero(), 0.0, false, std::string(), {}});
   result.notes.push_back("started from a robust (Cauchy, " +
                          FormatNumber(options.robust_scale_sigma, 3) + " sigma) adjustment");
   return result;

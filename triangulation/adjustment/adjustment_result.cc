@@ -166,13 +166,35 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
     j["exposures"].push_back(x);
   }
   j["rejected"] = nlohmann::json::array();
-  for (const auto& o : r.rejected)
-    j["rejected"].push_back({{"image", o.image},
-                             {"point", o.point},
-                             {"measured_px", {o.measured_px.x(), o.measured_px.y()}},
-                             {"residual_px", o.residual_px.norm()},
-                             {"residual_col_row_px", {o.residual_px.x(), -o.residual_px.y()}},
-                             {"w", o.w}});
+  for (const auto& o : r.rejected) {
+    nlohmann::json x = {{"image", o.image},
+                        {"point", o.point},
+                        {"measured_px", {o.measured_px.x(), o.measured_px.y()}},
+                        {"residual_px", o.residual_px.norm()},
+                        {"residual_col_row_px", {o.residual_px.x(), -o.residual_px.y()}},
+                        {"w", o.w}};
+    if (!o.subimage.empty()) x["subimage"] = o.subimage;
+    j["rejected"].push_back(x);
+  }
+  // Every image observation: where it was measured (virtual pixels) and its residual, for the
+  // residual plots of the report.
+  j["residuals"] = nlohmann::json::array();
+  for (const auto& o : r.residuals) {
+    nlohmann::json v = {{"image", o.image},
+                        {"point", o.point},
+                        {"col", o.measured_px.x()},
+                        {"row", o.measured_px.y()},
+                        {"v_col_px", o.residual_px.x()},
+                        {"v_row_px", o.residual_px.y()},
+                        {"sigma_px", o.sigma_px},
+                        {"used", o.used}};
+    if (!o.subimage.empty()) {
+      v["subimage"] = o.subimage;
+      v["u"] = o.subimage_px.x();
+      v["v"] = o.subimage_px.y();
+    }
+    j["residuals"].push_back(v);
+  }
   nlohmann::json det = {{"determinable", r.determinability.covariance_ok},
                         {"message", r.determinability.message},
                         {"undetermined", r.determinability.undetermined},

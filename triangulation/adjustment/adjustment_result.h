@@ -52,19 +52,22 @@ struct ExposureEstimate {
 
 struct RejectedObservation {
   std::string image, point;
-  Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();  // the observation (col, row)
+  Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();  // the observation (col, row), or (u, v)
   Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // v in (corrected) photo space, px
   double w = 0.0;                                         // standardized residual
+  std::string subimage;  // non-empty: measured_px is (u, v) in this raw sub-image
 };
 
 /// One image observation after the adjustment: residual v = measured - adjusted, in pixels of
 /// the (corrected) photo space, (col, row) directions.
 struct ObservationResidual {
   std::string image, point;
-  Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();
+  Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();  // virtual-image (col, row)
   Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();
   double sigma_px = 0.0;
   bool used = true;  // false: rejected as a gross error
+  std::string subimage;  // non-empty: measured in this raw sub-image at subimage_px (u, v)
+  Eigen::Vector2d subimage_px = Eigen::Vector2d::Zero();
 };
 
 struct Determinability {

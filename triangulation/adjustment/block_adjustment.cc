@@ -104,6 +104,14 @@ BlockId BlockAdjustment::AddPoint(const std::string& point, const Eigen::Vector3
   return state.block;
 }
 
+void BlockAdjustment::RegisterCallerObservation(calib::ResidualId id,
+                                                const ImageObservation& observation) {
+  storage_->observation_of_residual[id] = storage_->observations.size();
+  storage_->observations.push_back(observation);
+  auto& state = storage_->points.at(observation.point);
+  state.rays = std::max(state.rays, 0) + 1;
+}
+
 void BlockAdjustment::BuildExposures() {
   std::vector<int> fixed;
   for (int i = 0; i < Model::kNumParams; ++i)
@@ -362,7 +370,7 @@ AdjustmentResult BlockAdjustment::Run() {
   std::vector<calib::RejectedResidual> rejected;
   if (options_.data_snooping) {
     calib::SnoopingOptions snooping;
-    snooping.groups = {calib::kGroupImage};
+    snooping.groups = {calib::kGroupImage, calib::kGroupSubimage};
     snooping.critical_value = options_.snooping_critical_value;
     snooping.max_rejections = options_.max_rejections;
     snooping.max_dense_parameters = options_.max_dense_parameters;
@@ -400,6 +408,7 @@ AdjustmentResult BlockAdjustment::Run() {
     out.image = o.image;
     out.point = o.point;
     out.measured_px = o.pixel;
+    out.subimage = o.subimage;
     out.w = r.w;
     if (r.whitened_residual.size() == 2)
       out.residual_px =
@@ -415,6 +424,8 @@ AdjustmentResult BlockAdjustment::Run() {
     v.image = o.image;
     v.point = o.point;
     v.measured_px = o.pixel;
+    v.subimage = o.subimage;
+    if (!o.subimage.empty()) v.subimage_px = o.pixel;
     v.sigma_px = o.sigma_px;
     v.used = builder_.IsActive(id);
     const std::vector<double> r = v.used ? builder_.EvaluateResidual(id) : std::vector<double>{};

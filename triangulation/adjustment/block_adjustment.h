@@ -19,7 +19,9 @@
 // Extension (joint stitching + triangulation): build the adjustment with
 // SubimageObservations::kLeaveToCaller, then add SubimageCollinearityResidual<Mapping> residuals
 // (group kGroupSubimage) on mapping blocks of your own and the blocks returned by InteriorBlock,
-// RotationBlock, CenterBlock and PointBlock (create missing points with AddPoint), before Run().
+// RotationBlock, CenterBlock and PointBlock (create missing points with AddPoint), and register
+// each with RegisterCallerObservation so that it is snooped, counted as a ray and reported, before
+// Run().
 #pragma once
 
 #include "calib/problem/problem_builder.h"
@@ -62,6 +64,11 @@ class BlockAdjustment {
   calib::BlockId PointBlock(const std::string& point) const;
   /// Adds (or returns) the ground point block of `point`, starting at `start_m`.
   calib::BlockId AddPoint(const std::string& point, const Eigen::Vector3d& start_m);
+  /// Declares that residual `id` (group kGroupSubimage, whitened in photo space like the image
+  /// group) measures `observation` (raw sub-image pixels): it takes part in data snooping, counts
+  /// as a ray of its point, and is listed in the result's residuals and rejections with its
+  /// sub-image (u, v). Its virtual-image position is the caller's to fill in after Run().
+  void RegisterCallerObservation(calib::ResidualId id, const ImageObservation& observation);
 
   /// Solves (two stages when self-calibrating), snoops for gross errors, estimates the covariance
   /// and compares control and check points. Never throws on non-convergence.

@@ -167,10 +167,12 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
       return calib::SubimageCollinearityResidual<decltype(model)>::Create(frame, m.conditioning, o.pixel,
                                                                            o.sigma_px);
     });
-    builder.AddResidual(calib::kGroupSubimage, std::move(cost),
-                        {m.block, adjustment.InteriorBlock(e.camera), adjustment.RotationBlock(o.image),
-                         adjustment.CenterBlock(o.image), point},
-                        "image " + o.image + " sub-image " + o.subimage + " point " + o.point);
+    const ResidualId id = builder.AddResidual(
+        calib::kGroupSubimage, std::move(cost),
+        {m.block, adjustment.InteriorBlock(e.camera), adjustment.RotationBlock(o.image),
+         adjustment.CenterBlock(o.image), point},
+        "image " + o.image + " sub-image " + o.subimage + " point " + o.point);
+    adjustment.RegisterCallerObservation(id, o);
   }
 
   // Per-exposure stitching measurements.
@@ -281,6 +283,15 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
       for (int i = 0; i < n; ++i) estimate.sigma[i] = std::sqrt(std::max(0.0, c(i, i)));
     }
     result.mappings.push_back(estimate);
+  }
+  // Residuals of raw sub-image observations, placed in the virtual image by the refined mapping.
+  for (auto& v : result.adjustment.residuals) {
+    if (v.subimage.empty()) continue;
+    const MappingBlock& m = mapping_for(project.FindExposure(v.image)->camera, v.subimage, v.image);
+    calib::SubimageMapping refined;
+    refined.model = m.model;
+    refined.params = calib::PlainFromConditioned(m.model, m.conditioning, m.values);
+    v.measured_px = refined.VirtualFromSub(v.subimage_px);
   }
   for (const auto& h : covariance.high_correlations) {
     const bool a_mapping = h.a.rfind("mapping ", 0) == 0, b_mapping = h.b.rfind("mapping ", 0) == 0;
