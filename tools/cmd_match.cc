@@ -11,6 +11,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
+#include "calib/core/string_printf.h"
 #include "stitch/image_io/image_io.h"
 #include "stitch/matching/overlap_matcher.h"
 #include "tools/command_registry.h"
@@ -99,19 +100,22 @@ int RunMatch(const MatchArgs& args) {
       args.list.empty() ? FromImagesOption(args.frame, args.images) : FromList(args.list);
   std::vector<stitch::StitchObservation> rows;
   Progress progress("match", static_cast<long>(frames.size()));
-  std::printf("%-6s %-10s %7s %7s %6s %6s %6s %8s\n", "frame", "strip", "kp_a", "kp_b", "ratio",
-              "ransac", "points", "coverage");
+  // The per-strip table is printed after the progress bar (stderr) so the two never interleave.
+  std::string table = StringPrintf("%-6s %-10s %7s %7s %6s %6s %7s %7s %7s %6s %8s\n", "frame", "strip", "kp_a",
+                             "kp_b", "ratio", "ransac", "lsm", "lsm_nc", "lsm_low", "points", "coverage");
   for (const auto& [frame, paths] : frames) {
     const stitch::FrameMatches m =
         stitch::MatchFrame(camera, LoadFrame(camera, frame, paths), frame, options);
     rows.insert(rows.end(), m.observations.begin(), m.observations.end());
     for (const stitch::StripReport& s : m.strips)
-      std::printf("%-6s %-10s %7d %7d %6d %6d %6d %8.2f\n", frame.c_str(), s.name.c_str(),
-                  s.keypoints_a, s.keypoints_b, s.ratio_matches, s.ransac_inliers, s.points,
-                  s.Coverage());
+      table += StringPrintf("%-6s %-10s %7d %7d %6d %6d %7d %7d %7d %6d %8.2f\n", frame.c_str(), s.name.c_str(),
+                      s.keypoints_a, s.keypoints_b, s.ratio_matches, s.ransac_inliers, s.lsm_tried,
+                      s.lsm_not_converged, s.lsm_poor_precision, s.points, s.Coverage());
     progress.Advance();
   }
   progress.Finish();
+  std::fputs(table.c_str(), stdout);
+  std::printf("lsm: matches refined; lsm_nc: dropped, not converged; lsm_low: dropped, poor precision\n");
   stitch::WriteMatchedObservations(args.out, rows, args.append, args.sigma_px);
   return kExitOk;
 }

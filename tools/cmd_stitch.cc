@@ -1,5 +1,6 @@
 // aerocal stitch: sub-image mapping adjustment of one frame or a whole flight
 // (stitch/adjustment/, result keys in stitch/io/stitch_result_json.h and stitch/README.md).
+#include <cstdio>
 #include <sstream>
 
 #include "calib/camera/camera_io.h"
@@ -29,6 +30,44 @@ std::vector<std::string> SplitList(const std::string& text) {
   return out;
 }
 
+// What a user must see without opening the JSON: the fit, the gross errors and, above all, the
+// predicted precision of the sub-image corners (a small sigma0 says nothing about a weakly tied
+// outer CCD).
+void PrintSummary(const stitch::BatchResult& result, const std::string& out) {
+  double worst_corner = 0.0;
+  std::string worst_where;
+  int rejected = 0, single = 0, no_precision = 0;
+  for (const auto& run : result.frames) {
+    const auto& a = run.adjustment;
+    rejected += static_cast<int>(a.rejected.size());
+    single += a.n_single_ray_points;
+    if (!a.covariance_ok) ++no_precision;
+    for (const auto& s : a.subimages)
+      if (!s.base && s.max_corner_sigma_px > worst_corner) {
+        worst_corner = s.max_corner_sigma_px;
+        worst_where = "frame " + a.frame + ", sub-image " + s.id;
+      }
+    if (result.frames.size() <= 10)
+      std::printf("frame %s: %s, sigma0 %.3f px, redundancy %d, %d tie points, %zu rejected, "
+                  "largest corner sigma %.2f px%s\n",
+                  a.frame.c_str(), std::string(calib::MappingModelName(a.model)).c_str(), a.sigma0_px,
+                  a.redundancy, a.n_ties, a.rejected.size(), a.max_corner_sigma_px,
+                  a.converged ? "" : " (NOT converged)");
+  }
+  if (result.frames.size() > 10)
+    std::printf("%zu frames, %d observations rejected as gross errors\n", result.frames.size(), rejected);
+  if (!worst_where.empty())
+    std::printf("largest predicted corner sigma: %.2f px (%s)%s\n", worst_corner, worst_where.c_str(),
+                worst_corner > 1.0 ? ": weakly determined, whatever sigma0 says; add reference points or "
+                                     "ties on the outer sub-images"
+                                   : "");
+  if (no_precision > 0)
+    std::printf("warning: %d frame(s) without a precision estimate (see diagnostics)\n", no_precision);
+  if (single > 0)
+    std::printf("%d point(s) measured in one sub-image only carry no equation and were not used\n", single);
+  std::printf("result: %s\n", out.c_str());
+}
+
 int RunStitch(const StitchArgs& args) {
   const calib::Camera camera = calib::ReadCamera(args.camera);
   if (camera.subimages.empty())
@@ -55,6 +94,7 @@ int RunStitch(const StitchArgs& args) {
   progress.Finish();
   const nlohmann::json doc = stitch::StitchResultToJson(result, options);
   WriteFileAtomically(args.out, doc.dump(2) + "\n");
+  PrintSummary(result, args.out);
   return doc.at("converged").get<bool>() ? kExitOk : kExitNotConverged;
 }
 

@@ -2,7 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
+#include <set>
 
 #include "calib/core/error.h"
 #include "calib/residuals/stitching.h"
@@ -92,6 +94,39 @@ std::string FindUnderdetermined(const calib::Camera& camera, const FrameMeasurem
            std::to_string(needed) + " " + std::string(calib::MappingModelName(model)) +
            " parameters";
   }
+  // Enough equations are not enough: a free sub-image must reach the datum (a base sub-image or
+  // a reference point) through tie points, else its mapping floats (a rank defect of the normal
+  // equations that the count above cannot see).
+  const size_t n = camera.subimages.size();
+  std::vector<bool> anchored(n, false);
+  for (size_t k = 0; k < n; ++k) anchored[k] = IsBase(options, camera.subimages[k].id);
+  for (const auto& ref : frame.references)
+    if (!excluded.count({ref.point, camera.subimages[ref.subimage].id})) anchored[ref.subimage] = true;
+  std::vector<std::set<int>> neighbours(n);
+  for (const auto& tie : frame.ties) {
+    const auto rays = ActiveRays(camera, tie, excluded);
+    for (size_t a = 0; a < rays.size(); ++a)
+      for (size_t b = 0; b < rays.size(); ++b)
+        if (rays[a].subimage != rays[b].subimage) neighbours[rays[a].subimage].insert(rays[b].subimage);
+  }
+  std::vector<bool> reached = anchored;
+  std::vector<int> queue;
+  for (size_t k = 0; k < n; ++k)
+    if (anchored[k]) queue.push_back(static_cast<int>(k));
+  while (!queue.empty()) {
+    const int k = queue.back();
+    queue.pop_back();
+    for (int m : neighbours[k])
+      if (!reached[m]) {
+        reached[m] = true;
+        queue.push_back(m);
+      }
+  }
+  for (size_t k = 0; k < n; ++k)
+    if (!reached[k])
+      return "frame " + frame.frame + ", sub-image " + camera.subimages[k].id +
+             ": no chain of tie points connects it to a base sub-image or a reference point, so "
+             "its mapping has no datum (add ties in its overlaps, reference points, or --base)";
   return "";
 }
 
@@ -176,6 +211,7 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
   out.model = model;
   out.n_ties = n_ties;
   out.n_references = static_cast<int>(frame.references.size());
+  out.n_single_ray_points = frame.single_ray_points;
 
   calib::SolveReport report;
   if (options.data_snooping) {
@@ -254,7 +290,16 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
       corner.sigma_V_px = std::sqrt(std::max(0.0, cov_uv(1, 1)));
       e.max_corner_sigma_px = std::max(e.max_corner_sigma_px, corner.sigma_px());
     }
-    out.max_corner_sigma_px = std::max(out.max_corner_sigma_px, e.max_corner_sigma_px);
+    if (!base[k] && !covariance.ok) {
+      // No precision could be computed: say so (null in JSON), never report zero sigmas.
+      constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
+      std::fill(e.sigma.begin(), e.sigma.end(), kUnknown);
+      for (CornerPrecision& corner : e.corners) corner.sigma_U_px = corner.sigma_V_px = kUnknown;
+      e.max_corner_sigma_px = kUnknown;
+      out.max_corner_sigma_px = kUnknown;
+    }
+    if (!std::isnan(out.max_corner_sigma_px))
+      out.max_corner_sigma_px = std::max(out.max_corner_sigma_px, e.max_corner_sigma_px);
     out.subimages.push_back(std::move(e));
   }
   return out;

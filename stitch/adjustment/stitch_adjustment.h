@@ -81,6 +81,7 @@ struct FrameAdjustment {
   double sigma0 = 0, sigma0_px = 0, vtpv = 0;
   int redundancy = 0, n_observations = 0, n_unknowns = 0;
   int n_ties = 0, n_references = 0;
+  int n_single_ray_points = 0;  // points measured in one sub-image only: no equation, not used
   bool covariance_ok = false;
   std::vector<SubimageEstimate> subimages;  // camera order
   std::vector<PointResidual> residuals;

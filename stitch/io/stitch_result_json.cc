@@ -104,6 +104,7 @@ json FrameResultToJson(const FrameAdjustment& a, const ModelChoice* choice) {
             {"n_unknowns", a.n_unknowns},
             {"n_ties", a.n_ties},
             {"n_references", a.n_references},
+            {"n_single_ray_points", a.n_single_ray_points},
             {"covariance_ok", a.covariance_ok},
             {"max_corner_sigma_px", a.max_corner_sigma_px},
             {"subimages", subimages},

@@ -3,6 +3,7 @@
 // CCDs are misplaced by shifts, rotations, scales and an affine part (shear 2e-4).
 #include "stitch/adjustment/stitch_adjustment.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include <gtest/gtest.h>
@@ -117,6 +118,7 @@ TEST(AdjustFrame, FindsAndListsAPlantedGrossError) {
   EXPECT_LE(a.rejected.size(), 3u);  // the family-wise false-alarm rate is 5 %
   EXPECT_NEAR(a.sigma0_px, kNoisePx, 0.1 * kNoisePx);
   // Rejected observations never appear among the residuals of the clean adjustment.
+  ASSERT_FALSE(a.rejected.empty());
   for (const auto& r : a.residuals) EXPECT_FALSE(r.point == tie.point && r.subimage == a.rejected[0].subimage);
 }
 
@@ -137,6 +139,34 @@ TEST(AdjustFrame, RefusesAnUnderdeterminedModelNamingTheSubimage) {
               std::string::npos)
         << e.what();
   }
+}
+
+TEST(AdjustFrame, RefusesSubimagesThatNoTieChainConnectsToTheDatum) {
+  // 2x3 CCDs, base II and V (centre column): keep the ties between I and IV (the left column),
+  // drop every tie linking them to the rest. I and IV have equations enough but no datum.
+  const auto camera = testing::MakeSimulatedCamera(2, 3, {"II", "V"}, 0.0, 17);
+  auto frames = testing::SimulateFrames(camera, 1, 600, 18);
+  const int i = camera.nominal.SubimageIndex("I"), iv = camera.nominal.SubimageIndex("IV");
+  auto& ties = frames[0].ties;
+  ties.erase(std::remove_if(ties.begin(), ties.end(),
+                            [&](const TieMeasurement& t) {
+                              bool left = false, other = false;
+                              for (const auto& r : t.rays) (r.subimage == i || r.subimage == iv ? left : other) = true;
+                              return left && other;
+                            }),
+             ties.end());
+  StitchOptions options;
+  options.base_ids = camera.base;
+  const std::string refusal = FindUnderdetermined(camera.nominal, frames[0], MappingModel::kConformal, options);
+  EXPECT_NE(refusal.find("sub-image I"), std::string::npos) << refusal;
+  EXPECT_NE(refusal.find("no chain of tie points"), std::string::npos) << refusal;
+  EXPECT_THROW(AdjustFrame(camera.nominal, frames[0], MappingModel::kAffine, options), InputError);
+  // With a reference point on I the island has its datum again.
+  frames[0].references.push_back({"R1", i, Eigen::Vector2d(10, 10),
+                                  camera.truth.subimages[i].VirtualFromSub(Eigen::Vector2d(10, 10)), 0.05});
+  frames[0].references.push_back({"R2", iv, Eigen::Vector2d(10, 3000),
+                                  camera.truth.subimages[iv].VirtualFromSub(Eigen::Vector2d(10, 3000)), 0.05});
+  EXPECT_EQ(FindUnderdetermined(camera.nominal, frames[0], MappingModel::kConformal, options), "");
 }
 
 TEST(AdjustFrame, PredictsCornerPrecisionOfATwelveCcdLayout) {

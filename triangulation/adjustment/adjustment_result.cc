@@ -1,8 +1,8 @@
 #include "triangulation/adjustment/adjustment_result.h"
 
+#include "calib/core/string_printf.h"
+
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
 
 namespace aerocal::triangulation {
 namespace {
@@ -18,18 +18,8 @@ nlohmann::json Interior(const calib::InteriorParams& p) {
   return j;
 }
 
-std::string Printf(const char* format, ...) __attribute__((format(printf, 1, 2)));
-std::string Printf(const char* format, ...) {
-  char buffer[1024];
-  va_list args;
-  va_start(args, format);
-  std::vsnprintf(buffer, sizeof(buffer), format, args);
-  va_end(args);
-  return buffer;
-}
-
 std::string StatisticsLine(const char* what, const PointStatistics& s) {
-  return Printf("%-8s n=%3d  RMSE X %.4f  Y %.4f  Z %.4f  plan %.4f  spatial %.4f m\n",
+  return StringPrintf("%-8s n=%3d  RMSE X %.4f  Y %.4f  Z %.4f  plan %.4f  spatial %.4f m\n",
                 what,
                 s.n,
                 s.rmse_m.x(),
@@ -43,7 +33,7 @@ std::string CalibrationTable(const AdjustmentResult& r) {
   std::string out;
   for (const auto& c : r.cameras) {
     out += "camera " + c.id + "\n";
-    out += Printf("  %-4s %-6s %16s %16s %16s %14s\n",
+    out += StringPrintf("  %-4s %-6s %16s %16s %16s %14s\n",
                   "par",
                   "unit",
                   "initial",
@@ -52,13 +42,13 @@ std::string CalibrationTable(const AdjustmentResult& r) {
                   "sigma");
     for (int k = 0; k < Model::kNumParams; ++k) {
       const auto& info = Model::kParams[k];
-      out += Printf("  %-4s %-6s %16.8g %16.8g %16.8g %14s\n",
+      out += StringPrintf("  %-4s %-6s %16.8g %16.8g %16.8g %14s\n",
                     std::string(info.name).c_str(),
                     std::string(info.unit).c_str(),
                     c.initial[k],
                     c.estimated[k] - c.initial[k],
                     c.estimated[k],
-                    c.free[k] ? Printf("%.3g", c.sigma[k]).c_str() : "fixed");
+                    c.free[k] ? StringPrintf("%.3g", c.sigma[k]).c_str() : "fixed");
     }
   }
   return out;
@@ -208,7 +198,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
 }
 
 std::string FormatSummary(const AdjustmentResult& r) {
-  std::string out = Printf(
+  std::string out = StringPrintf(
       "%s adjustment: %s after %d iterations, sigma0 %.4f (%.4f px, %.3f um), redundancy %d\n",
       r.free_interior.empty() ? "conventional" : "self-calibrating",
       r.solve.converged ? "converged" : "NOT converged",
@@ -223,7 +213,7 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += StatisticsLine("check", r.check);
   if (!r.free_interior.empty()) out += CalibrationTable(r);
   for (const auto& o : r.rejected)
-    out += Printf("rejected: image %s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
+    out += StringPrintf("rejected: image %s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
                   o.image.c_str(),
                   o.point.c_str(),
                   o.measured_px.x(),
@@ -235,21 +225,21 @@ std::string FormatSummary(const AdjustmentResult& r) {
 }
 
 std::string FormatComparison(const AdjustmentResult& a, const AdjustmentResult& b) {
-  std::string out = Printf("%-26s %16s %16s\n", "", "conventional", "self-calibration");
+  std::string out = StringPrintf("%-26s %16s %16s\n", "", "conventional", "self-calibration");
   auto row = [&](const char* label, double x, double y) {
-    out += Printf("%-26s %16.4f %16.4f\n", label, x, y);
+    out += StringPrintf("%-26s %16.4f %16.4f\n", label, x, y);
   };
   row("sigma0 [um]", a.sigma0_um, b.sigma0_um);
   row("sigma0 [px]", a.sigma0_px, b.sigma0_px);
   const char* axes[] = {"X", "Y", "Z"};
   for (int k = 0; k < 3; ++k)
-    row(Printf("control RMSE %s [m]", axes[k]).c_str(), a.control.rmse_m(k), b.control.rmse_m(k));
+    row(StringPrintf("control RMSE %s [m]", axes[k]).c_str(), a.control.rmse_m(k), b.control.rmse_m(k));
   for (int k = 0; k < 3; ++k)
-    row(Printf("check RMSE %s [m]", axes[k]).c_str(), a.check.rmse_m(k), b.check.rmse_m(k));
+    row(StringPrintf("check RMSE %s [m]", axes[k]).c_str(), a.check.rmse_m(k), b.check.rmse_m(k));
   row("check RMSE plan. [m]", a.check.planimetric_rmse_m, b.check.planimetric_rmse_m);
   row("check RMSE spatial [m]", a.check.spatial_rmse_m, b.check.spatial_rmse_m);
-  out += Printf("%-26s %16d %16d\n", "check points", a.check.n, b.check.n);
-  out += Printf("%-26s %16s %16s\n",
+  out += StringPrintf("%-26s %16d %16d\n", "check points", a.check.n, b.check.n);
+  out += StringPrintf("%-26s %16s %16s\n",
                 "converged",
                 a.solve.converged ? "yes" : "no",
                 b.solve.converged ? "yes" : "no");
