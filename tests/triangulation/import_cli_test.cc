@@ -2,6 +2,8 @@
 #include "calib/core/atomic_file.h"
 #include "tests/support/test_support.h"
 
+#include <filesystem>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -46,6 +48,22 @@ TEST(ImportCommand, BadGcpLineExitsTwoWithItsLine) {
                             tmp.File("cam.yaml") + " --out " + tmp.File("block"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("gcp.txt:3"), std::string::npos) << r.output;
+}
+
+TEST(ImportCommand, GeographicGcpListIsRefusedWhateverItsSpelling) {
+  testing::TempDir tmp("aerocal_import_geographic");
+  WriteFileAtomically(
+      tmp.File("cam.yaml"),
+      "name: c\npixel_size_mm: 0.0015\nformat_px: [4000, 3000]\ninterior: {c: 4.5}\n");
+  for (const char* projection : {"+proj=longlat +datum=WGS84 +no_defs", "+proj=latlong +ellps=WGS84",
+                                 "EPSG:4326", "WGS84"}) {
+    WriteFileAtomically(tmp.File("gcp.txt"), std::string(projection) + "\n-48.5 -27.6 3 10 10 a.jpg P1\n");
+    const auto r = RunAerocal("import odm --gcp-list " + tmp.File("gcp.txt") + " --camera " +
+                              tmp.File("cam.yaml") + " --out " + tmp.File("block"));
+    EXPECT_EQ(r.exit_code, 2) << projection << ": " << r.output;
+    EXPECT_NE(r.output.find("gcp.txt:1: geographic"), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(tmp.File("block/project.yaml")));
+  }
 }
 
 }  // namespace

@@ -1,13 +1,19 @@
 // Geodetic input converted with GeographicLib (local tangent plane, UTM) and written back.
 #include "triangulation/georef/object_frame.h"
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/block/block_io.h"
+#include "triangulation/import/write_project.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <regex>
 
 namespace aerocal::triangulation {
 namespace {
@@ -81,6 +87,53 @@ TEST(ObjectFrame, GeodeticAndProjectedInputGiveTheSameCheckRmse) {
   EXPECT_NEAR(p.adjusted_m.y(), 47.4, 0.3);  // latitude, deg
   EXPECT_NE(b.frame.find("local tangent plane"), std::string::npos);
   EXPECT_NEAR(b.exposures.front().center_m.x(), 8.5, 0.3);  // longitude, deg
+}
+
+TEST(ObjectFrame, GeodeticFrameWithoutOriginAdjustsAboutTheBlockCentre) {
+  // The simulated block as project folders: once projected, once geodetic with `frame:
+  // {geodetic: WGS84}` (no origin given). Both through `aerocal adjust`: same check RMSE.
+  const SimulatedFlight flight = SimulateFlight(FlightSimulationOptions{});
+  Project projected;
+  projected.cameras["cam1"] = flight.nominal;
+  projected.exposures = flight.exposures_file;
+  projected.observations = flight.observations;
+  projected.points = flight.points_file;
+  projected.frame.description = "simulated local frame";
+  const ObjectFrame frame(LocalFrame());
+  Project geodetic = projected;
+  for (auto& p : geodetic.points)
+    if (p.xyz_m) p.xyz_m = frame.ToInput(*p.xyz_m);
+  for (auto& e : geodetic.exposures) e.center_m = frame.ToInput(e.center_m);
+
+  testing::TempDir dir("aerocal_geodetic");
+  WriteProjectFolder(projected, dir.File("projected"));
+  WriteProjectFolder(geodetic, dir.File("geodetic"));
+  const std::string yaml = ReadTextFile(dir.File("geodetic/project.yaml"));
+  WriteFileAtomically(dir.File("geodetic/project.yaml"),
+                      std::regex_replace(yaml, std::regex("frame: .*"), "frame: {geodetic: WGS84}"));
+
+  const Project read = ReadProject(dir.File("geodetic/project.yaml"));
+  ASSERT_EQ(read.frame.kind, FrameSpec::Kind::kGeodeticToLocal);
+  EXPECT_NEAR(read.frame.lat_deg, 47.3769, 0.1);  // the block lies within a few km of LocalFrame()
+  EXPECT_NEAR(read.frame.lon_deg, 8.5417, 0.1);
+
+  std::vector<nlohmann::json> results;
+  for (const char* name : {"projected", "geodetic"}) {
+    const auto run = testing::RunAerocal("adjust --project " + dir.File(std::string(name) + "/project.yaml") +
+                                         " --self-calibration all --out " + dir.File(std::string(name) + ".json"));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    results.push_back(nlohmann::json::parse(ReadTextFile(dir.File(std::string(name) + ".json"))));
+  }
+  for (const auto& r : results)
+    std::printf("sigma0 %.4f, iterations %d, rejected %zu, converged %d, frame %s\n", r["sigma0"].get<double>(),
+                r["iterations"].get<int>(), r["rejected"].size(), r["converged"].get<bool>(),
+                r["frame"].get<std::string>().c_str());
+  const auto& a = results[0]["check"];
+  const auto& b = results[1]["check"];
+  ASSERT_EQ(a["n"], b["n"]);
+  for (int k = 0; k < 3; ++k)
+    EXPECT_NEAR(a["rmse_m"][k].get<double>(), b["rmse_m"][k].get<double>(), 1e-3) << "axis " << k;
+  EXPECT_NE(results[1]["frame"].get<std::string>().find("local tangent plane"), std::string::npos);
 }
 
 }  // namespace

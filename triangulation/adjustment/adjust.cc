@@ -72,9 +72,15 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
   AdjustmentResult result = adjustment.Run();
   for (auto& c : result.cameras) c.initial = project.cameras.at(c.id).interior;
   result.rejected.insert(result.rejected.begin(), pre_rejected.begin(), pre_rejected.end());
+  // Observations the robust start rejected: listed with their robust residual, not used.
   for (const auto& r : pre_rejected)
-    result.residuals.push_back(
-        {r.image, r.point, r.measured_px, Eigen::Vector2d::Zero(), 0.0, false, std::string(), {}});
+    for (const auto& v : start.residuals)
+      if (v.image == r.image && v.point == r.point && v.measured_px == r.measured_px) {
+        ObservationResidual out = v;
+        out.used = false;
+        result.residuals.push_back(out);
+        break;
+      }
   result.notes.push_back("started from a robust (Cauchy, " +
                          FormatNumber(options.robust_scale_sigma, 3) + " sigma) adjustment");
   return result;

@@ -21,6 +21,10 @@ std::string Num(double value, int decimals) {
   return buffer;
 }
 
+// Object coordinates: 12 significant digits keep 0.1 mm on a UTM northing and 1e-9 deg (0.1 mm)
+// on geodetic longitude/latitude; a fixed number of decimals cannot serve both.
+std::string Coordinate(double value) { return FormatNumber(value, 12); }
+
 std::string ResolvePath(const std::string& base_dir, const std::string& file) {
   if (file.empty() || std::filesystem::path(file).is_absolute()) return file;
   return (std::filesystem::path(base_dir) / file).string();
@@ -197,6 +201,28 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
       project.frame.description = "UTM " + project.frame.utm_zone;
     } else if (f["projected"]) {
       project.frame.description = YamlString(f["projected"], path, "projected");
+    } else if (f["geodetic"]) {
+      // Geodetic input without a stated origin: the local tangent plane about the block's centre
+      // (mean of the surveyed points, else of the exposure centres), so that no curvature is lost.
+      project.frame.kind = FrameSpec::Kind::kGeodeticToLocal;
+      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+      int n = 0;
+      for (const auto& p : project.points)
+        if (p.xyz_m && p.role != PointRole::kTie) {
+          sum += *p.xyz_m;
+          ++n;
+        }
+      if (n == 0)
+        for (const auto& e : project.exposures) {
+          sum += e.center_m;
+          ++n;
+        }
+      if (n == 0) ThrowInputError({path, f.Mark().line + 1}, "frame: geodetic needs surveyed points or exposures");
+      const Eigen::Vector3d origin = sum / n;  // X = longitude, Y = latitude (deg), Z = height (m)
+      project.frame.lon_deg = origin.x();
+      project.frame.lat_deg = origin.y();
+      project.frame.h_m = origin.z();
+      project.frame.description = "local tangent plane about the block centre";
     }
   }
   ValidateProject(project);
@@ -215,8 +241,8 @@ void WriteExposures(const std::string& path, const std::vector<Exposure>& exposu
     if (imu) out << ",somega,sphi,skappa";
     out << "\n";
     for (const auto& e : exposures) {
-      out << e.image << "," << e.camera << "," << Num(e.center_m.x(), 4) << ","
-          << Num(e.center_m.y(), 4) << "," << Num(e.center_m.z(), 4) << ","
+      out << e.image << "," << e.camera << "," << Coordinate(e.center_m.x()) << ","
+          << Coordinate(e.center_m.y()) << "," << Coordinate(e.center_m.z()) << ","
           << Num(e.opk_rad.x() / kDegToRad, 8) << "," << Num(e.opk_rad.y() / kDegToRad, 8) << ","
           << Num(e.opk_rad.z() / kDegToRad, 8);
       if (gnss) {
@@ -259,7 +285,7 @@ void WritePoints(const std::string& path, const std::vector<GroundPoint>& points
     for (const auto& p : points) {
       out << p.id << ",";
       if (p.xyz_m)
-        out << Num(p.xyz_m->x(), 4) << "," << Num(p.xyz_m->y(), 4) << "," << Num(p.xyz_m->z(), 4);
+        out << Coordinate(p.xyz_m->x()) << "," << Coordinate(p.xyz_m->y()) << "," << Coordinate(p.xyz_m->z());
       else
         out << ",,";
       if (p.role == PointRole::kTie)

@@ -3,6 +3,8 @@
 #include "calib/core/error.h"
 #include "triangulation/import/text_rows.h"
 
+#include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -16,8 +18,15 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
   if (rows.empty()) ThrowInputError({o.gcp_list, 1}, "empty GCP list (expected a projection line)");
   std::string projection;
   for (const auto& f : rows.front().fields) projection += (projection.empty() ? "" : " ") + f;
-  if (projection.find("longlat") != std::string::npos ||
-      projection.find("4326") != std::string::npos)
+  // Geographic lists (PROJ "+proj=longlat"/"latlong", EPSG:4326 / 4979, "WGS84" alone) hold
+  // degrees, which the similarity start and the projected frame cannot take.
+  std::string lower = projection;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  const bool geographic = lower.find("longlat") != std::string::npos || lower.find("latlong") != std::string::npos ||
+                          lower.find("lonlat") != std::string::npos || lower.find("latlon") != std::string::npos ||
+                          lower.find("4326") != std::string::npos || lower.find("4979") != std::string::npos ||
+                          lower == "wgs84" || lower == "wgs 84";
+  if (geographic)
     ThrowInputError({o.gcp_list, rows.front().line},
                     "geographic GCP coordinates (" + projection +
                         "): give a projected list or a project with frame: {local: ...}");
