@@ -27,6 +27,28 @@ FrameSpec LocalFrame() {
   return spec;
 }
 
+// The default simulated flight as a projected block, and the same block in geodetic coordinates
+// (the simulated frame taken as the tangent plane of LocalFrame()).
+struct ProjectedAndGeodetic {
+  Project projected, geodetic;
+};
+ProjectedAndGeodetic SimulatedBlocks() {
+  const SimulatedFlight flight = SimulateFlight(FlightSimulationOptions{});
+  ProjectedAndGeodetic out;
+  out.projected.cameras["cam1"] = flight.nominal;
+  out.projected.exposures = flight.exposures_file;
+  out.projected.observations = flight.observations;
+  out.projected.points = flight.points_file;
+  out.projected.frame.description = "simulated local frame";
+  const ObjectFrame frame(LocalFrame());
+  out.geodetic = out.projected;
+  out.geodetic.frame = LocalFrame();
+  for (auto& p : out.geodetic.points)
+    if (p.xyz_m) p.xyz_m = frame.ToInput(*p.xyz_m);
+  for (auto& e : out.geodetic.exposures) e.center_m = frame.ToInput(e.center_m);
+  return out;
+}
+
 TEST(ObjectFrame, GeodeticRoundTripsThroughLocalTangentPlaneAndUtm) {
   FrameSpec utm;
   utm.kind = FrameSpec::Kind::kUtm;
@@ -58,19 +80,8 @@ TEST(ObjectFrame, BadZoneIsAnInputError) {
 }
 
 TEST(ObjectFrame, GeodeticAndProjectedInputGiveTheSameCheckRmse) {
-  const SimulatedFlight flight = SimulateFlight(FlightSimulationOptions{});
-  Project projected;
-  projected.cameras["cam1"] = flight.nominal;
-  projected.exposures = flight.exposures_file;
-  projected.observations = flight.observations;
-  projected.points = flight.points_file;
-  // The same block as geodetic coordinates: the simulated frame is taken as the tangent plane.
+  const auto [projected, geodetic] = SimulatedBlocks();
   const ObjectFrame frame(LocalFrame());
-  Project geodetic = projected;
-  geodetic.frame = LocalFrame();
-  for (auto& p : geodetic.points)
-    if (p.xyz_m) p.xyz_m = frame.ToInput(*p.xyz_m);
-  for (auto& e : geodetic.exposures) e.center_m = frame.ToInput(e.center_m);
   ASSERT_GT(std::abs(geodetic.points.front().xyz_m->y() - 47.3), 0.0);
 
   AdjustOptions options;
@@ -92,19 +103,7 @@ TEST(ObjectFrame, GeodeticAndProjectedInputGiveTheSameCheckRmse) {
 TEST(ObjectFrame, GeodeticFrameWithoutOriginAdjustsAboutTheBlockCentre) {
   // The simulated block as project folders: once projected, once geodetic with `frame:
   // {geodetic: WGS84}` (no origin given). Both through `aerocal adjust`: same check RMSE.
-  const SimulatedFlight flight = SimulateFlight(FlightSimulationOptions{});
-  Project projected;
-  projected.cameras["cam1"] = flight.nominal;
-  projected.exposures = flight.exposures_file;
-  projected.observations = flight.observations;
-  projected.points = flight.points_file;
-  projected.frame.description = "simulated local frame";
-  const ObjectFrame frame(LocalFrame());
-  Project geodetic = projected;
-  for (auto& p : geodetic.points)
-    if (p.xyz_m) p.xyz_m = frame.ToInput(*p.xyz_m);
-  for (auto& e : geodetic.exposures) e.center_m = frame.ToInput(e.center_m);
-
+  const auto [projected, geodetic] = SimulatedBlocks();
   testing::TempDir dir("aerocal_geodetic");
   WriteProjectFolder(projected, dir.File("projected"));
   WriteProjectFolder(geodetic, dir.File("geodetic"));
