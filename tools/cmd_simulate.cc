@@ -56,8 +56,24 @@ CommandRun SetupSimulate(CLI::App& app) {
       for (int c = (cols - 1) / 2; c <= cols / 2; ++c)
         o.layout.base_ids.push_back(stitch::RomanNumeral(r * cols + c + 1));
     }
+    if (o.control_points > o.ground_points)
+      throw ConfigError("--control (" + std::to_string(o.control_points) +
+                        ") must not exceed --points (" + std::to_string(o.ground_points) +
+                        "): control points are among the surveyed points");
     const auto flight = triangulation::SimulateFlight(o);
     triangulation::WriteSimulatedFlight(flight, args->out);
+    // Points are placed only where enough images see them: say when fewer than asked fit.
+    int control = 0, check = 0, tie = 0;
+    for (const auto& p : flight.points_truth)
+      (p.role == triangulation::PointRole::kControl ? control
+       : p.role == triangulation::PointRole::kCheck ? check
+                                                    : tie)++;
+    const int asked_check = o.ground_points - o.control_points;
+    if (control < o.control_points || check < asked_check || tie < o.tie_points)
+      std::fprintf(stderr,
+                   "warning: placed %d of %d control, %d of %d check and %d of %d tie points (the "
+                   "others found no place seen by enough images)\n",
+                   control, o.control_points, check, asked_check, tie, o.tie_points);
     std::printf("simulated %zu exposures, %zu ground points, %zu image observations, %zu stitching "
                 "measurements -> %s\n",
                 flight.exposures_truth.size(), flight.points_truth.size(), flight.observations.size(),

@@ -31,6 +31,7 @@ int main(int argc, char** argv) {
   std::vector<std::pair<CLI::App*, const CommandEntry*>> subs;
   for (const auto& entry : CommandRegistry()) {
     CLI::App* sub = app.add_subcommand(entry.name, entry.description);
+    sub->option_defaults()->always_capture_default();  // --help shows every default
     subs.emplace_back(sub, &entry);
   }
   try {

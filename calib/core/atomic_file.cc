@@ -1,6 +1,8 @@
 #include "calib/core/atomic_file.h"
 
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -16,12 +18,13 @@ void WriteFileAtomically(const std::string& path, const std::function<void(std::
   if (target.has_parent_path()) {
     std::error_code ec;
     fs::create_directories(target.parent_path(), ec);
-    if (ec) throw Error(path + ": cannot create directory: " + ec.message());
+    if (ec) throw InputError(path + ": cannot create the output folder: " + ec.message());
   }
   const std::string temp = path + ".tmp" + std::to_string(::getpid());
   {
     std::ofstream out(temp, std::ios::binary | std::ios::trunc);
-    if (!out) throw Error(path + ": cannot write");
+    // An output path the user cannot write to is a bad input (exit 2), not an internal error.
+    if (!out) throw InputError(path + ": cannot write (" + std::strerror(errno) + ")");
     try {
       write(out);
     } catch (...) {
