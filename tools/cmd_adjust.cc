@@ -5,6 +5,7 @@
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/adjustment/conventional_reference.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
 
@@ -100,8 +101,10 @@ CommandRun SetupAdjust(CLI::App& app) {
       const auto self_list = options.free_interior.empty()
                                  ? triangulation::ParseSelfCalibration("all")
                                  : options.free_interior;
-      const AdjustmentResult conventional = run({});
       main = run(self_list);
+      AdjustmentResult conventional =
+          triangulation::AdjustConventionalReference(project, options, main);
+      triangulation::ToInputFrame(frame, &conventional);
       std::printf("%s", triangulation::FormatComparison(conventional, main).c_str());
       json = triangulation::AdjustmentToJson(main);
       json["comparison"] = triangulation::ComparisonToJson(conventional, main);

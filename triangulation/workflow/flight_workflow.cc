@@ -11,6 +11,7 @@
 #include "stitch/io/stitch_result_json.h"
 #include "stitch/simulation/stitch_simulator.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/adjustment/conventional_reference.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
 #include "triangulation/joint/joint_adjustment.h"
@@ -85,12 +86,13 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
 
   // 2. Conventional and self-calibrating triangulation on the virtual-image observations.
   nlohmann::json adjustments = nlohmann::json::array();
-  AdjustOptions conventional_options;
-  const AdjustmentResult conventional = adjust(conventional_options);
-  if (progress) progress->Advance();
   AdjustOptions self_options;
   self_options.free_interior = options.free_interior;
   const AdjustmentResult self_calibration = adjust(self_options);
+  if (progress) progress->Advance();
+  // The conventional reference: same observations (gross errors decided by the full model).
+  AdjustmentResult conventional = AdjustConventionalReference(project, AdjustOptions{}, self_calibration);
+  ToInputFrame(object_frame, &conventional);
   if (progress) progress->Advance();
   nlohmann::json a = AdjustmentToJson(conventional);
   a["name"] = "conventional";
@@ -101,7 +103,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   doc["comparison"] = ComparisonToJson(conventional, self_calibration);
   out.converged = conventional.converged() && self_calibration.converged();
   out.calibrated_camera = UpdatedCamera(camera, self_calibration.cameras.at(0));
-  for (const auto* r : {&conventional, &self_calibration})
+  for (const AdjustmentResult* r : {static_cast<const AdjustmentResult*>(&conventional), &self_calibration})
     out.summary.push_back(std::string(r == &conventional ? "conventional" : "self-calibration") +
                           Line(": sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)", r->sigma0_px,
                                r->check.spatial_rmse_m, r->check.n));
