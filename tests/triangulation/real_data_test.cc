@@ -117,9 +117,11 @@ TEST(RealData, OdmUavTargetsBlundersFoundAndCheckPointsCompared) {
     if (&o == a || &o == b) continue;
     EXPECT_LT(o.residual_px.norm(), 20.0) << o.image << " " << o.point;
   }
-  // Control / check split: check errors of a few GSD (2.4 cm) per axis.
+  // Control / check split: check errors of a few GSD (2.4 cm) per axis (measured X 0.061, Y 0.087,
+  // Z 0.110 m over 12 points; a camera of 4.5 mm with no distortion model and targets pointed to
+  // ~1 px: 6 GSD is the bound of a working adjustment).
   EXPECT_GE(r.check.n, 10);
-  for (int k = 0; k < 3; ++k) EXPECT_LT(r.check.rmse_m(k), 0.25) << "axis " << k;
+  for (int k = 0; k < 3; ++k) EXPECT_LT(r.check.rmse_m(k), 0.15) << "axis " << k;
   std::printf("check RMSE X %.3f Y %.3f Z %.3f m over %d points\n",
               r.check.rmse_m.x(),
               r.check.rmse_m.y(),

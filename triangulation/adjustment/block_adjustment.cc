@@ -6,6 +6,8 @@
 #include "triangulation/adjustment/determinability.h"
 #include "triangulation/adjustment/forward_intersection.h"
 
+#include <Eigen/Geometry>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
@@ -60,6 +62,7 @@ struct BlockAdjustment::Storage {
   std::map<calib::ResidualId, size_t> observation_of_residual;
   std::vector<std::string> notes;
   std::string datum;
+  bool free_network = false;  // datum by a dependent relative orientation, not by the survey
 };
 
 BlockAdjustment::BlockAdjustment(const Project& project,
@@ -342,6 +345,7 @@ void BlockAdjustment::DefineDatum() {
   }
   builder_.FixBlock(a.opk_block);
   builder_.FixBlock(a.center_block);
+  storage_->free_network = true;
   std::string text = "free network: image " + first->image + " fixed at its starting orientation";
   if (far) {
     int axis = 0;
@@ -497,6 +501,27 @@ AdjustmentResult BlockAdjustment::Run() {
     d.rays = state.rays;
     (state.ground->role == PointRole::kControl ? result.control_points : result.check_points)
         .push_back(d);
+  }
+  // A free network has the arbitrary datum of its starting values: its check points can only
+  // say something about the block's shape, after a 7-parameter similarity (Helmert)
+  // transformation onto their survey (Umeyama's closed form).
+  if (storage_->free_network && result.check_points.size() >= 3) {
+    const int n = static_cast<int>(result.check_points.size());
+    Eigen::Matrix3Xd adjusted(3, n), surveyed(3, n);
+    for (int i = 0; i < n; ++i) {
+      adjusted.col(i) = result.check_points[i].adjusted_m;
+      surveyed.col(i) = result.check_points[i].surveyed_m;
+    }
+    const Eigen::Matrix4d helmert = Eigen::umeyama(adjusted, surveyed, true);
+    for (auto& d : result.check_points) {
+      d.adjusted_m = helmert.topLeftCorner<3, 3>() * d.adjusted_m + helmert.topRightCorner<3, 1>();
+      d.difference_m = d.adjusted_m - d.surveyed_m;
+    }
+    result.notes.push_back(
+        "free network: check points compared after a 7-parameter similarity transformation fitted "
+        "to their " + std::to_string(n) + " surveyed positions (scale " +
+        std::to_string(helmert.topLeftCorner<3, 3>().col(0).norm()) +
+        "); the RMSE measures the block's shape and is optimistic by the 7 fitted parameters");
   }
   result.control = ComputePointStatistics(result.control_points);
   result.check = ComputePointStatistics(result.check_points);
