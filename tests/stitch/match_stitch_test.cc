@@ -123,6 +123,19 @@ TEST_F(MatchStitch, MatchThenAffineStitchRecoversTheTrueCorners) {
   EXPECT_EQ(ReadTextFile(on), ReadTextFile(dir_->File("again.csv")));
 }
 
+TEST_F(MatchStitch, FoerstnerOnWallisFilteredImagesMeetsTheSameBoundsAndRepeats) {
+  const std::string a = dir_->File("foerstner.csv"), b = dir_->File("foerstner_again.csv");
+  ASSERT_EQ(RunAerocal(Match(a, "--detector foerstner")).exit_code, 0);
+  const CornerCheck check = AdjustAndCompare(WithReferences(a, dir_->File("foerstner_ref.csv")));
+  std::printf("Foerstner, LSM on: sigma0 %.3f px, corners max error %.3f px = %.2f sigma\n", check.sigma0_px,
+              check.max_error_px, check.max_error_in_sigmas);
+  EXPECT_LE(check.sigma0_px, 0.12);
+  EXPECT_LE(check.max_error_px, 0.25);
+  EXPECT_LE(check.max_error_in_sigmas, 3.0);
+  ASSERT_EQ(RunAerocal(Match(b, "--detector foerstner")).exit_code, 0);
+  EXPECT_EQ(ReadTextFile(a), ReadTextFile(b));
+}
+
 TEST_F(MatchStitch, FlightListAppendsFramesAndRefusesDuplicates) {
   const auto& scene = *testing::BoruszynScene();
   std::string list = "frame,subimage,image\n";
