@@ -3,6 +3,7 @@
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/conventional_reference.h"
 
+#include "tests/support/simulated_block.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
@@ -16,16 +17,7 @@ namespace {
 
 using Model = calib::BrownFraser10Model;
 
-Project ProjectFromFlight(const SimulatedFlight& f) {
-  Project p;
-  p.path = "simulated";
-  p.cameras["cam1"] = f.nominal;
-  p.exposures = f.exposures_file;
-  p.observations = f.observations;
-  p.points = f.points_file;
-  p.frame.description = "simulated local frame";
-  return p;
-}
+using testing::ProjectFromFlight;
 
 AdjustOptions SelfCalibration() {
   AdjustOptions o;

@@ -3,6 +3,7 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "tests/support/simulated_block.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/block/block_io.h"
@@ -33,13 +34,8 @@ struct ProjectedAndGeodetic {
   Project projected, geodetic;
 };
 ProjectedAndGeodetic SimulatedBlocks() {
-  const SimulatedFlight flight = SimulateFlight(FlightSimulationOptions{});
   ProjectedAndGeodetic out;
-  out.projected.cameras["cam1"] = flight.nominal;
-  out.projected.exposures = flight.exposures_file;
-  out.projected.observations = flight.observations;
-  out.projected.points = flight.points_file;
-  out.projected.frame.description = "simulated local frame";
+  out.projected = testing::ProjectFromFlight(SimulateFlight(FlightSimulationOptions{}));
   const ObjectFrame frame(LocalFrame());
   out.geodetic = out.projected;
   out.geodetic.frame = LocalFrame();

@@ -6,3 +6,4 @@ aerocal_add_test(triangulation/object_frame LIBS aerocal::triangulation LABELS s
 aerocal_add_test(triangulation/real_data LIBS aerocal::triangulation LABELS golden)
 aerocal_add_test(triangulation/colmap_import LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/import_cli LIBS aerocal::triangulation LABELS cli)
+aerocal_add_test(triangulation/block_options LIBS aerocal::triangulation LABELS synthetic)

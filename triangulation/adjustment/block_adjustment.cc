@@ -200,11 +200,12 @@ void BlockAdjustment::BuildPoints(SubimageObservations subimage) {
     const auto& e = storage_->exposures.at(o.image);
     rays[o.point].push_back(RayFromPixel(*e.camera, e.opk, e.center, o.pixel));
   }
-  // Fallback height for points whose rays do not intersect: mean surveyed height, else 0.
+  // Fallback height for points whose rays do not intersect: mean height of the control (and of
+  // approximate tie) points, else 0. Check surveys never enter the adjustment, not even here.
   double height_sum = 0.0;
   int height_n = 0;
   for (const auto& p : project_.points)
-    if (p.xyz_m && p.role != PointRole::kTie) {
+    if (p.xyz_m && p.role != PointRole::kCheck) {  // never the check survey
       height_sum += p.xyz_m->z();
       ++height_n;
     }

@@ -122,7 +122,7 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
   double height_sum = 0.0;
   int height_n = 0;
   for (const auto& p : project.points)
-    if (p.xyz_m && p.role != PointRole::kTie) {
+    if (p.xyz_m && p.role != PointRole::kCheck) {  // never the check survey
       height_sum += p.xyz_m->z();
       ++height_n;
     }
