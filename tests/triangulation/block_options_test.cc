@@ -2,8 +2,8 @@
 // the simulated example flight: check points only through their rays, the camera file's
 // interior_sigma and the GNSS/IMU sigma columns as weighted observations, one interior block per
 // camera id.
-#include "triangulation/adjustment/block_adjustment.h"
 #include "tests/support/simulated_block.h"
+#include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>

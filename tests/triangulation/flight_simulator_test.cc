@@ -1,0 +1,114 @@
+// The simulated example flight (issue: "the embedded default data") has the geometry it promises:
+// a 2x3-CCD camera of 14000 x 12000 px at 9 um with c ~ 170 mm and ~200 px overlaps between
+// neighbouring CCDs, 37 exposures in 3 east-west strips 4500 m above the terrain with 60 % forward
+// and 30 % side overlap, 300 m relief, 329 surveyed points of which 5 control points sit at the
+// block's corners and centre, seen by at least three images; and a nominal camera that differs
+// from the truth by the interior correction.
+#include "triangulation/simulation/flight_simulator.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+
+namespace aerocal::triangulation {
+namespace {
+
+TEST(FlightSimulator, DefaultFlightHasThePromisedGeometry) {
+  const SimulatedFlight f = SimulateFlight(FlightSimulationOptions{});
+  const calib::Camera& cam = f.truth;
+  EXPECT_EQ(cam.width_px, 14000);
+  EXPECT_EQ(cam.height_px, 12000);
+  EXPECT_DOUBLE_EQ(cam.pixel_size_mm, 0.009);
+  EXPECT_NEAR(cam.interior[0], 170.0, 0.1);
+  ASSERT_EQ(cam.subimages.size(), 6u);
+  // Neighbouring CCDs overlap by about 200 px (virtual-image footprints of the sub-images).
+  struct Box {
+    double u0, u1, v0, v1;
+  };
+  std::vector<Box> boxes;
+  for (const auto& s : cam.subimages) {
+    const Eigen::Vector2d a = s.VirtualFromSub({0, 0}),
+                          b = s.VirtualFromSub({s.width_px - 1.0, s.height_px - 1.0});
+    boxes.push_back({std::min(a.x(), b.x()),
+                     std::max(a.x(), b.x()),
+                     std::min(a.y(), b.y()),
+                     std::max(a.y(), b.y())});
+  }
+  int neighbours = 0;
+  for (size_t i = 0; i < boxes.size(); ++i)
+    for (size_t j = i + 1; j < boxes.size(); ++j) {
+      const double du = std::min(boxes[i].u1, boxes[j].u1) - std::max(boxes[i].u0, boxes[j].u0);
+      const double dv = std::min(boxes[i].v1, boxes[j].v1) - std::max(boxes[i].v0, boxes[j].v0);
+      if (du <= 0 || dv <= 0) continue;
+      const double overlap = std::min(du, dv);  // the strip's width
+      if (std::max(du, dv) < 1000) continue;    // a corner where four CCDs meet
+      ++neighbours;
+      EXPECT_NEAR(overlap, 200.0, 20.0) << cam.subimages[i].id << "-" << cam.subimages[j].id;
+    }
+  EXPECT_EQ(neighbours, 7);  // 3 rows x 2 columns: 4 vertical + 3 horizontal neighbours
+
+  // 37 exposures in 3 east-west strips, 4500 m above the mean terrain.
+  ASSERT_EQ(f.exposures_truth.size(), 37u);
+  std::map<long, std::vector<double>> strips;  // rounded Y -> X of its exposures
+  double mean_z = 0;
+  for (const auto& e : f.exposures_truth) {
+    strips[std::lround(e.center_m.y() / 100.0)].push_back(e.center_m.x());
+    mean_z += e.center_m.z() / 37.0;
+  }
+  EXPECT_EQ(strips.size(), 3u);
+  const double terrain_mean = f.options.terrain_base_m + 0.5 * f.options.terrain_relief_m;
+  EXPECT_NEAR(mean_z - terrain_mean, 4500.0, 50.0);
+  // Overlaps from the ground footprint: format / c * height.
+  const double scale = (mean_z - terrain_mean) / cam.interior[0];  // m per mm
+  const double footprint_x = 14000 * 0.009 * scale, footprint_y = 12000 * 0.009 * scale;
+  std::vector<double> xs = strips.begin()->second;
+  std::sort(xs.begin(), xs.end());
+  const double base = (xs.back() - xs.front()) / (xs.size() - 1);
+  EXPECT_NEAR(1.0 - base / footprint_x, 0.60, 0.03);
+  const double spacing = (std::prev(strips.end())->first - strips.begin()->first) * 100.0 / 2.0;
+  EXPECT_NEAR(1.0 - spacing / footprint_y, 0.30, 0.03);
+
+  // 329 surveyed points, 5 of them control at the corners and the centre, seen by >= 3 images.
+  int control = 0, check = 0;
+  double z_min = 1e9, z_max = -1e9;
+  std::map<std::string, std::set<std::string>> images_of;
+  for (const auto& o : f.observations) images_of[o.point].insert(o.image);
+  for (const auto& p : f.points_truth) {
+    z_min = std::min(z_min, p.xyz_m->z());
+    z_max = std::max(z_max, p.xyz_m->z());
+    if (p.role == PointRole::kCheck) ++check;
+    if (p.role != PointRole::kControl) continue;
+    ++control;
+    EXPECT_GE(images_of[p.id].size(), 3u) << p.id;
+  }
+  EXPECT_EQ(control, 5);
+  EXPECT_EQ(control + check, 329);
+  EXPECT_GT(z_max - z_min, 0.7 * f.options.terrain_relief_m);  // the points sample the relief
+  EXPECT_LE(z_max - z_min, f.options.terrain_relief_m + 1.0);
+
+  // The nominal camera differs from the truth by the interior correction; the file has noise-free
+  // truth elsewhere.
+  for (int k = 0; k < calib::BrownFraser10Model::kNumParams; ++k)
+    EXPECT_NEAR(
+        f.truth.interior[k] - f.nominal.interior[k], f.options.interior_correction[k], 1e-12);
+  EXPECT_GT(std::abs(f.options.interior_correction[0]), 0.0);
+  EXPECT_FALSE(f.subimage_observations.empty());
+  EXPECT_FALSE(f.stitching.empty());
+}
+
+TEST(FlightSimulator, TheSameSeedGivesTheSameFlightAndAnotherSeedAnother) {
+  FlightSimulationOptions o;
+  const SimulatedFlight a = SimulateFlight(o), b = SimulateFlight(o);
+  o.seed = 2;
+  const SimulatedFlight c = SimulateFlight(o);
+  ASSERT_EQ(a.observations.size(), b.observations.size());
+  for (size_t i = 0; i < a.observations.size(); ++i)
+    ASSERT_EQ(a.observations[i].pixel, b.observations[i].pixel);
+  EXPECT_NE(a.observations.front().pixel, c.observations.front().pixel);
+}
+
+}  // namespace
+}  // namespace aerocal::triangulation
