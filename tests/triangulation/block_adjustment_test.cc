@@ -1,9 +1,9 @@
 // Self-calibrating bundle block adjustment on the simulated example flight (37 exposures, 2x3-CCD
 // camera, nominal camera off by DMZ-like corrections): the acceptance figures of the adjustment.
 #include "triangulation/adjustment/block_adjustment.h"
-#include "triangulation/adjustment/conventional_reference.h"
 
 #include "tests/support/simulated_block.h"
+#include "triangulation/adjustment/conventional_reference.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
@@ -48,7 +48,8 @@ class SimulatedFlightAdjustment : public ::testing::Test {
     flight_ = std::make_unique<SimulatedFlight>(SimulateFlight(FlightSimulationOptions{}));
     project_ = std::make_unique<Project>(ProjectFromFlight(*flight_));
     self_ = std::make_unique<AdjustmentResult>(Adjust(*project_, SelfCalibration()));
-    conventional_ = std::make_unique<AdjustmentResult>(AdjustConventionalReference(*project_, AdjustOptions{}, *self_));
+    conventional_ = std::make_unique<AdjustmentResult>(
+        AdjustConventionalReference(*project_, AdjustOptions{}, *self_));
     std::printf("%s\n%s", FormatSummary(*conventional_).c_str(), FormatSummary(*self_).c_str());
   }
   static std::unique_ptr<SimulatedFlight> flight_;
@@ -188,8 +189,10 @@ TEST(BlockAdjustment, FreeNetworkChecksTheShapeAfterAHelmertTransformation) {
   bool said = false;
   for (const auto& note : r.notes) said |= note.find("7-parameter similarity") != std::string::npos;
   EXPECT_TRUE(said);
-  std::printf("free network, check RMSE after Helmert: X %.3f Y %.3f Z %.3f m\n", r.check.rmse_m.x(),
-              r.check.rmse_m.y(), r.check.rmse_m.z());
+  std::printf("free network, check RMSE after Helmert: X %.3f Y %.3f Z %.3f m\n",
+              r.check.rmse_m.x(),
+              r.check.rmse_m.y(),
+              r.check.rmse_m.z());
   EXPECT_LT(r.check.spatial_rmse_m, 0.8);
   EXPECT_LT(r.check.mean_m.norm(), 0.05);  // the transformation leaves no bias
 }

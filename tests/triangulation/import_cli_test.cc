@@ -2,11 +2,10 @@
 #include "calib/core/atomic_file.h"
 #include "tests/support/test_support.h"
 
-#include <filesystem>
-
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <filesystem>
 #include <fstream>
 
 namespace aerocal {
@@ -55,9 +54,12 @@ TEST(ImportCommand, GeographicGcpListIsRefusedWhateverItsSpelling) {
   WriteFileAtomically(
       tmp.File("cam.yaml"),
       "name: c\npixel_size_mm: 0.0015\nformat_px: [4000, 3000]\ninterior: {c: 4.5}\n");
-  for (const char* projection : {"+proj=longlat +datum=WGS84 +no_defs", "+proj=latlong +ellps=WGS84",
-                                 "EPSG:4326", "WGS84"}) {
-    WriteFileAtomically(tmp.File("gcp.txt"), std::string(projection) + "\n-48.5 -27.6 3 10 10 a.jpg P1\n");
+  for (const char* projection : {"+proj=longlat +datum=WGS84 +no_defs",
+                                 "+proj=latlong +ellps=WGS84",
+                                 "EPSG:4326",
+                                 "WGS84"}) {
+    WriteFileAtomically(tmp.File("gcp.txt"),
+                        std::string(projection) + "\n-48.5 -27.6 3 10 10 a.jpg P1\n");
     const auto r = RunAerocal("import odm --gcp-list " + tmp.File("gcp.txt") + " --camera " +
                               tmp.File("cam.yaml") + " --out " + tmp.File("block"));
     EXPECT_EQ(r.exit_code, 2) << projection << ": " << r.output;

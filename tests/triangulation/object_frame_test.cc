@@ -104,8 +104,9 @@ TEST(ObjectFrame, GeodeticFrameWithoutOriginAdjustsAboutTheBlockCentre) {
   WriteProjectFolder(projected, dir.File("projected"));
   WriteProjectFolder(geodetic, dir.File("geodetic"));
   const std::string yaml = ReadTextFile(dir.File("geodetic/project.yaml"));
-  WriteFileAtomically(dir.File("geodetic/project.yaml"),
-                      std::regex_replace(yaml, std::regex("frame: .*"), "frame: {geodetic: WGS84}"));
+  WriteFileAtomically(
+      dir.File("geodetic/project.yaml"),
+      std::regex_replace(yaml, std::regex("frame: .*"), "frame: {geodetic: WGS84}"));
 
   const Project read = ReadProject(dir.File("geodetic/project.yaml"));
   ASSERT_EQ(read.frame.kind, FrameSpec::Kind::kGeodeticToLocal);
@@ -114,14 +115,18 @@ TEST(ObjectFrame, GeodeticFrameWithoutOriginAdjustsAboutTheBlockCentre) {
 
   std::vector<nlohmann::json> results;
   for (const char* name : {"projected", "geodetic"}) {
-    const auto run = testing::RunAerocal("adjust --project " + dir.File(std::string(name) + "/project.yaml") +
-                                         " --self-calibration all --out " + dir.File(std::string(name) + ".json"));
+    const auto run = testing::RunAerocal(
+        "adjust --project " + dir.File(std::string(name) + "/project.yaml") +
+        " --self-calibration all --out " + dir.File(std::string(name) + ".json"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
     results.push_back(nlohmann::json::parse(ReadTextFile(dir.File(std::string(name) + ".json"))));
   }
   for (const auto& r : results)
-    std::printf("sigma0 %.4f, iterations %d, rejected %zu, converged %d, frame %s\n", r["sigma0"].get<double>(),
-                r["iterations"].get<int>(), r["rejected"].size(), r["converged"].get<bool>(),
+    std::printf("sigma0 %.4f, iterations %d, rejected %zu, converged %d, frame %s\n",
+                r["sigma0"].get<double>(),
+                r["iterations"].get<int>(),
+                r["rejected"].size(),
+                r["converged"].get<bool>(),
                 r["frame"].get<std::string>().c_str());
   const auto& a = results[0]["check"];
   const auto& b = results[1]["check"];

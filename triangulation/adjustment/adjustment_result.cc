@@ -20,13 +20,13 @@ nlohmann::json Interior(const calib::InteriorParams& p) {
 
 std::string StatisticsLine(const char* what, const PointStatistics& s) {
   return StringPrintf("%-8s n=%3d  RMSE X %.4f  Y %.4f  Z %.4f  plan %.4f  spatial %.4f m\n",
-                what,
-                s.n,
-                s.rmse_m.x(),
-                s.rmse_m.y(),
-                s.rmse_m.z(),
-                s.planimetric_rmse_m,
-                s.spatial_rmse_m);
+                      what,
+                      s.n,
+                      s.rmse_m.x(),
+                      s.rmse_m.y(),
+                      s.rmse_m.z(),
+                      s.planimetric_rmse_m,
+                      s.spatial_rmse_m);
 }
 
 std::string CalibrationTable(const AdjustmentResult& r) {
@@ -34,21 +34,21 @@ std::string CalibrationTable(const AdjustmentResult& r) {
   for (const auto& c : r.cameras) {
     out += "camera " + c.id + "\n";
     out += StringPrintf("  %-4s %-6s %16s %16s %16s %14s\n",
-                  "par",
-                  "unit",
-                  "initial",
-                  "correction",
-                  "estimate",
-                  "sigma");
+                        "par",
+                        "unit",
+                        "initial",
+                        "correction",
+                        "estimate",
+                        "sigma");
     for (int k = 0; k < Model::kNumParams; ++k) {
       const auto& info = Model::kParams[k];
       out += StringPrintf("  %-4s %-6s %16.8g %16.8g %16.8g %14s\n",
-                    std::string(info.name).c_str(),
-                    std::string(info.unit).c_str(),
-                    c.initial[k],
-                    c.estimated[k] - c.initial[k],
-                    c.estimated[k],
-                    c.free[k] ? StringPrintf("%.3g", c.sigma[k]).c_str() : "fixed");
+                          std::string(info.name).c_str(),
+                          std::string(info.unit).c_str(),
+                          c.initial[k],
+                          c.estimated[k] - c.initial[k],
+                          c.estimated[k],
+                          c.free[k] ? StringPrintf("%.3g", c.sigma[k]).c_str() : "fixed");
     }
   }
   return out;
@@ -213,13 +213,14 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += StatisticsLine("check", r.check);
   if (!r.free_interior.empty()) out += CalibrationTable(r);
   for (const auto& o : r.rejected)
-    out += StringPrintf("rejected: image %s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
-                  o.image.c_str(),
-                  o.point.c_str(),
-                  o.measured_px.x(),
-                  o.measured_px.y(),
-                  o.residual_px.norm(),
-                  o.w);
+    out +=
+        StringPrintf("rejected: image %s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
+                     o.image.c_str(),
+                     o.point.c_str(),
+                     o.measured_px.x(),
+                     o.measured_px.y(),
+                     o.residual_px.norm(),
+                     o.w);
   for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
   return out;
 }
@@ -233,16 +234,18 @@ std::string FormatComparison(const AdjustmentResult& a, const AdjustmentResult& 
   row("sigma0 [px]", a.sigma0_px, b.sigma0_px);
   const char* axes[] = {"X", "Y", "Z"};
   for (int k = 0; k < 3; ++k)
-    row(StringPrintf("control RMSE %s [m]", axes[k]).c_str(), a.control.rmse_m(k), b.control.rmse_m(k));
+    row(StringPrintf("control RMSE %s [m]", axes[k]).c_str(),
+        a.control.rmse_m(k),
+        b.control.rmse_m(k));
   for (int k = 0; k < 3; ++k)
     row(StringPrintf("check RMSE %s [m]", axes[k]).c_str(), a.check.rmse_m(k), b.check.rmse_m(k));
   row("check RMSE plan. [m]", a.check.planimetric_rmse_m, b.check.planimetric_rmse_m);
   row("check RMSE spatial [m]", a.check.spatial_rmse_m, b.check.spatial_rmse_m);
   out += StringPrintf("%-26s %16d %16d\n", "check points", a.check.n, b.check.n);
   out += StringPrintf("%-26s %16s %16s\n",
-                "converged",
-                a.solve.converged ? "yes" : "no",
-                b.solve.converged ? "yes" : "no");
+                      "converged",
+                      a.solve.converged ? "yes" : "no",
+                      b.solve.converged ? "yes" : "no");
   out += "calibration (self-calibrating run):\n" + CalibrationTable(b);
   for (const auto& w : b.determinability.warnings) out += "warning: " + w + "\n";
   return out;

@@ -65,7 +65,7 @@ struct ObservationResidual {
   Eigen::Vector2d measured_px = Eigen::Vector2d::Zero();  // virtual-image (col, row)
   Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();
   double sigma_px = 0.0;
-  bool used = true;  // false: rejected as a gross error
+  bool used = true;      // false: rejected as a gross error
   std::string subimage;  // non-empty: measured in this raw sub-image at subimage_px (u, v)
   Eigen::Vector2d subimage_px = Eigen::Vector2d::Zero();
 };

@@ -520,7 +520,8 @@ AdjustmentResult BlockAdjustment::Run() {
     }
     result.notes.push_back(
         "free network: check points compared after a 7-parameter similarity transformation fitted "
-        "to their " + std::to_string(n) + " surveyed positions (scale " +
+        "to their " +
+        std::to_string(n) + " surveyed positions (scale " +
         std::to_string(helmert.topLeftCorner<3, 3>().col(0).norm()) +
         "); the RMSE measures the block's shape and is optimistic by the 7 fitted parameters");
   }

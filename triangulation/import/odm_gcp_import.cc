@@ -21,11 +21,13 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
   // Geographic lists (PROJ "+proj=longlat"/"latlong", EPSG:4326 / 4979, "WGS84" alone) hold
   // degrees, which the similarity start and the projected frame cannot take.
   std::string lower = projection;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  const bool geographic = lower.find("longlat") != std::string::npos || lower.find("latlong") != std::string::npos ||
-                          lower.find("lonlat") != std::string::npos || lower.find("latlon") != std::string::npos ||
-                          lower.find("4326") != std::string::npos || lower.find("4979") != std::string::npos ||
-                          lower == "wgs84" || lower == "wgs 84";
+  std::transform(
+      lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  const bool geographic =
+      lower.find("longlat") != std::string::npos || lower.find("latlong") != std::string::npos ||
+      lower.find("lonlat") != std::string::npos || lower.find("latlon") != std::string::npos ||
+      lower.find("4326") != std::string::npos || lower.find("4979") != std::string::npos ||
+      lower == "wgs84" || lower == "wgs 84";
   if (geographic)
     ThrowInputError({o.gcp_list, rows.front().line},
                     "geographic GCP coordinates (" + projection +
