@@ -391,19 +391,25 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   return report;
 }
 
-std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters) const {
-  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
-  if (NumFreeParameters() > max_parameters) return {};
-  const Eigen::MatrixXd j = DenseJacobian(free_blocks, nullptr);
-  Eigen::MatrixXd n = j.transpose() * j;
+// Normal equations reduced to the non-point parameters: S = N_rr - N_rp N_pp^-1 N_pr.
+struct ProblemBuilder::ReducedSystem {
+  std::vector<BlockId> free_blocks;
+  std::map<BlockId, int> offset;  // tangent offset of a block in its space (points or reduced)
+  int n_p = 0, n_r = 0;
+  Eigen::SparseMatrix<double> s;
+  std::vector<std::string> reduced_names;  // one per reduced column
+  std::vector<BlockId> singular_points;    // point blocks with a singular N_pp block (left out)
+};
+
+namespace {
+// The names of the parameters that the eigenvectors of (scaled) `n` with eigenvalues below
+// 1e-12 of the largest involve (|component| > 0.2).
+std::set<std::string> NullSpaceNames(Eigen::MatrixXd n, const std::vector<std::string>& names) {
   Eigen::VectorXd d = n.diagonal().cwiseSqrt();
   for (int i = 0; i < d.size(); ++i) d(i) = d(i) > 0 ? 1.0 / d(i) : 1.0;
   n = d.asDiagonal() * n * d.asDiagonal();
   Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(n);
   const double max_eig = eig.eigenvalues().maxCoeff();
-  std::vector<std::string> names;
-  for (BlockId b : free_blocks)
-    for (int e : blocks_[b].FreeEntries()) names.push_back(blocks_[b].name + "." + blocks_[b].entry_names[e]);
   std::set<std::string> out;
   for (int k = 0; k < eig.eigenvalues().size(); ++k) {
     if (eig.eigenvalues()(k) > 1e-12 * max_eig) break;  // ascending order
@@ -411,6 +417,26 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
     for (int i = 0; i < v.size(); ++i)
       if (std::abs(v(i)) > 0.2) out.insert(names[i]);
   }
+  return out;
+}
+}  // namespace
+
+std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters) const {
+  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
+  if (NumFreeParameters() > max_parameters) {
+    // Large blocks: the datum defect lives in the exterior / interior parameters; find it in the
+    // reduced system (points eliminated), and name points that are undetermined on their own.
+    ReducedSystem reduced;
+    if (!ReduceNormalEquations(&reduced) || reduced.n_r > max_parameters) return {};
+    std::set<std::string> out = NullSpaceNames(Eigen::MatrixXd(reduced.s), reduced.reduced_names);
+    for (BlockId id : reduced.singular_points) out.insert(blocks_[id].name);
+    return {out.begin(), out.end()};
+  }
+  const Eigen::MatrixXd j = DenseJacobian(free_blocks, nullptr);
+  std::vector<std::string> names;
+  for (BlockId b : free_blocks)
+    for (int e : blocks_[b].FreeEntries()) names.push_back(blocks_[b].name + "." + blocks_[b].entry_names[e]);
+  const std::set<std::string> out = NullSpaceNames(j.transpose() * j, names);
   return {out.begin(), out.end()};
 }
 
@@ -606,32 +632,30 @@ bool ProblemBuilder::RedundancyNumbersBySchur(const std::vector<ResidualId>& ids
   return true;
 }
 
-bool ProblemBuilder::SchurCovariance(const std::vector<std::pair<BlockId, BlockId>>& pairs,
-                                     std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const {
+bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
   auto eliminable = [&](BlockId id) {
     return blocks_[id].kind == BlockKind::kGroundPoint || blocks_[id].kind == BlockKind::kTiePoint2d;
   };
-  for (const auto& [a, b] : pairs)
-    if (eliminable(a) || eliminable(b)) return false;
-  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
+  ReducedSystem& r = *out;
+  r.free_blocks = FreeBlocksInOrder();
   // Tangent columns: eliminable blocks -> point index space, the others -> reduced space.
-  std::map<BlockId, int> offset;  // in its own space
   std::vector<int> column_space, column_index, column_block;
-  int n_p = 0, n_r = 0;
-  for (BlockId id : free_blocks) {
+  for (BlockId id : r.free_blocks) {
     const int t = blocks_[id].TangentSize();
     const bool elim = eliminable(id);
-    offset[id] = elim ? n_p : n_r;
+    r.offset[id] = elim ? r.n_p : r.n_r;
     for (int k = 0; k < t; ++k) {
       column_space.push_back(elim ? 0 : 1);
-      column_index.push_back(elim ? n_p + k : n_r + k);
+      column_index.push_back(elim ? r.n_p + k : r.n_r + k);
       column_block.push_back(id);
     }
-    (elim ? n_p : n_r) += t;
+    if (!elim)
+      for (int e : blocks_[id].FreeEntries()) r.reduced_names.push_back(blocks_[id].name + "." + blocks_[id].entry_names[e]);
+    (elim ? r.n_p : r.n_r) += t;
   }
-  if (n_p == 0 || n_r == 0) return false;
+  if (r.n_p == 0 || r.n_r == 0) return false;
   ceres::Problem::EvaluateOptions eval;
-  for (BlockId id : free_blocks) eval.parameter_blocks.push_back(blocks_[id].values);
+  for (BlockId id : r.free_blocks) eval.parameter_blocks.push_back(blocks_[id].values);
   eval.apply_loss_function = true;
   ceres::CRSMatrix crs;
   double cost = 0.0;
@@ -651,26 +675,45 @@ bool ProblemBuilder::SchurCovariance(const std::vector<std::pair<BlockId, BlockI
       }
     }
   }
-  Sparse jp(crs.num_rows, n_p), jr(crs.num_rows, n_r);
+  Sparse jp(crs.num_rows, r.n_p), jr(crs.num_rows, r.n_r);
   jp.setFromTriplets(tp.begin(), tp.end());
   jr.setFromTriplets(tr.begin(), tr.end());
-  // Block-diagonal N_pp^-1 (one small block per point).
+  // Block-diagonal N_pp^-1 (one small block per point); a singular block is listed and left out.
   const Sparse npp = Sparse(jp.transpose()) * jp;
   std::vector<Eigen::Triplet<double>> ti;
-  for (BlockId id : free_blocks) {
+  for (BlockId id : r.free_blocks) {
     if (!eliminable(id)) continue;
-    const int o = offset[id], t = blocks_[id].TangentSize();
+    const int o = r.offset[id], t = blocks_[id].TangentSize();
     Eigen::MatrixXd block = Eigen::MatrixXd(npp.block(o, o, t, t));
     Eigen::LDLT<Eigen::MatrixXd> ldlt(block);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 0)) return false;
+    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12 * ldlt.vectorD().maxCoeff())) {
+      r.singular_points.push_back(id);
+      continue;
+    }
     const Eigen::MatrixXd inverse = ldlt.solve(Eigen::MatrixXd::Identity(t, t));
     for (int i = 0; i < t; ++i)
       for (int k = 0; k < t; ++k) ti.emplace_back(o + i, o + k, inverse(i, k));
   }
-  Sparse npp_inverse(n_p, n_p);
+  Sparse npp_inverse(r.n_p, r.n_p);
   npp_inverse.setFromTriplets(ti.begin(), ti.end());
   const Sparse npr = Sparse(jp.transpose()) * jr;
-  const Sparse s = Sparse(Sparse(jr.transpose()) * jr) - Sparse(Sparse(npr.transpose()) * npp_inverse) * npr;
+  r.s = Sparse(Sparse(jr.transpose()) * jr) - Sparse(Sparse(npr.transpose()) * npp_inverse) * npr;
+  return true;
+}
+
+bool ProblemBuilder::SchurCovariance(const std::vector<std::pair<BlockId, BlockId>>& pairs,
+                                     std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const {
+  auto eliminable = [&](BlockId id) {
+    return blocks_[id].kind == BlockKind::kGroundPoint || blocks_[id].kind == BlockKind::kTiePoint2d;
+  };
+  for (const auto& [a, b] : pairs)
+    if (eliminable(a) || eliminable(b)) return false;
+  ReducedSystem reduced;
+  if (!ReduceNormalEquations(&reduced) || !reduced.singular_points.empty()) return false;
+  using Sparse = Eigen::SparseMatrix<double>;
+  const Sparse& s = reduced.s;
+  const int n_r = reduced.n_r;
+  std::map<BlockId, int>& offset = reduced.offset;
   Eigen::SimplicialLDLT<Sparse> solver(s);
   if (solver.info() != Eigen::Success || !(solver.vectorD().minCoeff() > 1e-14 * solver.vectorD().maxCoeff()))
     return false;

@@ -214,7 +214,14 @@ class ProblemBuilder {
   struct Block;
   struct Residual;
   std::vector<BlockId> FreeBlocksInOrder() const;
+  /// Names of the parameters in the null space of the normal matrix: from the dense matrix up to
+  /// `max_parameters` free parameters, above that from the normal equations reduced to the
+  /// non-point parameters (points eliminated) while those number at most `max_parameters`.
   std::vector<std::string> NullSpaceParameters(int max_parameters) const;
+  struct ReducedSystem;
+  /// Normal equations with the ground / tie points eliminated (Schur complement); false when no
+  /// point or no other block is free, or a residual observes two points.
+  bool ReduceNormalEquations(ReducedSystem* out) const;
   bool RedundancyNumbersBySchur(const std::vector<ResidualId>& ids, int max_dense,
                                 std::map<ResidualId, std::vector<double>>* out) const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,

@@ -302,5 +302,30 @@ TEST(BlockOptions, ImuPriorsEnterAsWeightedObservations) {
   EXPECT_LT(rms_truth, rms_imu_truth);
 }
 
+TEST(BlockOptions, ADatumDefectIsReportedNotHidden) {
+  // No control, no GNSS and no free-network datum: seven parameters (the similarity of the whole
+  // block) are not determined. The run must say so and name them, not report sigmas.
+  const SimulatedFlight flight = SimulateFlight(FlightSimulationOptions{});
+  Project project = ProjectFromFlight(flight);
+  for (auto& p : project.points)
+    if (p.role == PointRole::kControl) p.role = PointRole::kCheck;
+  AdjustOptions options;
+  options.free_network_datum = false;
+  const AdjustmentResult r = Adjust(project, options);
+  EXPECT_NE(r.datum.find("datum defect"), std::string::npos) << r.datum;
+  EXPECT_FALSE(r.determinability.determinable());
+  EXPECT_FALSE(r.determinability.undetermined.empty());
+  EXPECT_FALSE(r.determinability.warnings.empty());
+  // ~3000 free parameters: found in the reduced system, so the names are exterior parameters (the
+  // 7-parameter similarity moves the projection centres most).
+  for (const auto& name : r.determinability.undetermined)
+    EXPECT_EQ(name.rfind("image ", 0), 0u) << name;
+  std::printf(
+      "datum defect: %zu undetermined parameter(s) named, e.g. %s; %s\n",
+      r.determinability.undetermined.size(),
+      r.determinability.undetermined.empty() ? "-" : r.determinability.undetermined.front().c_str(),
+      r.determinability.message.c_str());
+}
+
 }  // namespace
 }  // namespace aerocal::triangulation

@@ -54,6 +54,22 @@ std::string CalibrationTable(const AdjustmentResult& r) {
   return out;
 }
 
+// One line per observation rejected as a gross error (its sub-image when measured in one).
+std::string RejectedLines(const AdjustmentResult& r) {
+  std::string out;
+  for (const auto& o : r.rejected)
+    out +=
+        StringPrintf("rejected: image %s%s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
+                     o.image.c_str(),
+                     o.subimage.empty() ? "" : (" sub-image " + o.subimage).c_str(),
+                     o.point.c_str(),
+                     o.measured_px.x(),
+                     o.measured_px.y(),
+                     o.residual_px.norm(),
+                     o.w);
+  return out;
+}
+
 }  // namespace
 
 PointStatistics ComputePointStatistics(const std::vector<PointDifference>& points) {
@@ -212,15 +228,7 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += StatisticsLine("control", r.control);
   out += StatisticsLine("check", r.check);
   if (!r.free_interior.empty()) out += CalibrationTable(r);
-  for (const auto& o : r.rejected)
-    out +=
-        StringPrintf("rejected: image %s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
-                     o.image.c_str(),
-                     o.point.c_str(),
-                     o.measured_px.x(),
-                     o.measured_px.y(),
-                     o.residual_px.norm(),
-                     o.w);
+  out += RejectedLines(r);
   for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
   return out;
 }
@@ -247,6 +255,7 @@ std::string FormatComparison(const AdjustmentResult& a, const AdjustmentResult& 
                       a.solve.converged ? "yes" : "no",
                       b.solve.converged ? "yes" : "no");
   out += "calibration (self-calibrating run):\n" + CalibrationTable(b);
+  out += RejectedLines(b);
   for (const auto& w : b.determinability.warnings) out += "warning: " + w + "\n";
   return out;
 }
