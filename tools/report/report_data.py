@@ -168,7 +168,7 @@ def point_errors(adjustment, which):
     for p in listing(get(get(adjustment, which), "points")):
         if not isinstance(p, dict):
             continue
-        surveyed = p.get("surveyed_m", p.get("surveyed"))
+        surveyed = p.get("surveyed", p.get("surveyed_m"))
         xyz = triple(surveyed) if surveyed is not None else [number(p.get(k)) for k in "XYZ"]
         if "difference_m" in p:
             d = triple(p["difference_m"])

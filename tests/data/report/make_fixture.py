@@ -107,8 +107,8 @@ def main():
                 dXYZ = [rng.gauss(0, plan[name]), rng.gauss(0, plan[name]), rng.gauss(0.01, height[name])]
             if pt["role"] == "control":
                 dXYZ = [v * 0.3 for v in dXYZ]
-            row = {"point": pt["point"], "surveyed_m": [X, Y, Z],
-                   "adjusted_m": [round(X + dXYZ[0], 4), round(Y + dXYZ[1], 4), round(Z + dXYZ[2], 4)],
+            row = {"point": pt["point"], "surveyed": [X, Y, Z],
+                   "adjusted": [round(X + dXYZ[0], 4), round(Y + dXYZ[1], 4), round(Z + dXYZ[2], 4)],
                    "difference_m": [round(v, 4) for v in dXYZ], "rays": rng.randint(2, 9)}
             if pt["role"] == "check":
                 check.append(row)
