@@ -147,15 +147,25 @@ TEST(ResampleVirtualImage, RealAerialImageResampledBackWithoutSeams) {
   MemoryRaster back({width, height, 1, 8});
   const ResampleReport report = ResampleVirtualImage(truth, Pointers(subs), &back, {});
   // Interior: 4 px from the border (misplaced CCDs need not reach the very edge).
-  double sum2 = 0, overlap_sum = 0, single_sum = 0, overlap2 = 0, single2 = 0;
-  long n = 0, n_overlap = 0, n_single = 0;
+  double sum2 = 0, overlap_sum = 0, single_sum = 0, overlap2 = 0, single2 = 0, edge_sum = 0, edge2 = 0;
+  long n = 0, n_overlap = 0, n_single = 0, n_edge = 0;
   for (int r = 4; r < height - 4; ++r)
     for (int c = 4; c < width - 4; ++c) {
       const double d = back.At(c, r) - original.At(c, r);
       sum2 += d * d;
       ++n;
       int cover = 0;
-      for (const auto& s : truth.subimages) cover += s.Contains(s.SubFromVirtual({c, r}));
+      bool edge = false;  // within 1.5 px of a sub-image's edge: where a seam would show
+      for (const auto& s : truth.subimages) {
+        const Eigen::Vector2d uv = s.SubFromVirtual({c, r});
+        cover += s.Contains(uv);
+        edge = edge || (s.Contains(uv) && !s.Contains(uv, -1.5));
+      }
+      if (edge) {
+        edge_sum += d;
+        edge2 += d * d;
+        ++n_edge;
+      }
       (cover > 1 ? overlap_sum : single_sum) += d;
       (cover > 1 ? overlap2 : single2) += d * d;
       (cover > 1 ? n_overlap : n_single)++;
@@ -171,6 +181,13 @@ TEST(ResampleVirtualImage, RealAerialImageResampledBackWithoutSeams) {
   // and carry no grey-level step.
   EXPECT_LT(rms_overlap, rms_single * 1.1);
   EXPECT_LT(std::abs(overlap_sum / n_overlap - single_sum / n_single), 0.1);
+  // Nor along the CCD edges themselves, where one sub-image starts or stops contributing.
+  const double rms_edge = std::sqrt(edge2 / n_edge);
+  std::printf("along the sub-image edges (1.5 px band, %ld px): RMS %.3f DN, mean %.3f DN\n", n_edge, rms_edge,
+              edge_sum / n_edge);
+  ASSERT_GT(n_edge, 5000);
+  EXPECT_LT(rms_edge, rms_single * 1.1);
+  EXPECT_LT(std::abs(edge_sum / n_edge - single_sum / n_single), 0.1);
 }
 
 }  // namespace
