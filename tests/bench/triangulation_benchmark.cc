@@ -5,13 +5,17 @@
 //   aerocal_s / colmap_s / ratio      wall time of the whole adjustment (aerocal: with covariance)
 //   aerocal_solve_s                   aerocal without the covariance
 //   c_error_px / colmap_c_error_px    estimated principal distance minus the truth (or published)
-//   aerocal_sigma0_px, colmap_final_rms_px (COLMAP's report), peak_rss_mb
+//   aerocal_sigma0_px, colmap_final_rms_px (COLMAP's report)
+//   peak_rss_mb                       peak of this benchmark process (simulation included)
+//   adjust_cli_peak_rss_mb / _s       `aerocal adjust` alone on the block's files, in a child
+//                                     process (its own ru_maxrss from wait4), and its wall time
 // Run: build with -DAEROCAL_BUILD_BENCHMARKS=ON, then build/tests/bench/bench_triangulation.
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/import/colmap_export.h"
 #include "triangulation/import/dbat_import.h"
+#include "triangulation/import/write_project.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 #include <benchmark/benchmark.h>
@@ -24,6 +28,8 @@
 #include <fstream>
 #include <sstream>
 #include <sys/resource.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 namespace aerocal::triangulation {
 namespace {
@@ -105,9 +111,41 @@ ColmapRun RunColmap(const Project& project) {
   return run;
 }
 
+struct CliRun {
+  bool ok = false;
+  double seconds = 0, peak_rss_mb = 0;
+};
+
+// The adjustment as a user runs it: the block written as FORMATS.md files, `aerocal adjust` in a
+// child process. wait4 reports that child's own peak resident memory, free of what this process
+// holds (the simulation, earlier blocks).
+CliRun RunAerocalAdjust(const Project& project, const std::string& self_calibration) {
+  CliRun run;
+  testing::TempDir dir("aerocal_bench_cli");
+  WriteProjectFolder(project, dir.File("block"));
+  const std::string binary = testing::AerocalBinary(), project_file = dir.File("block/project.yaml"),
+                    out = dir.File("result.json");
+  const auto start = Clock::now();
+  const pid_t pid = fork();
+  if (pid == 0) {
+    if (!std::freopen("/dev/null", "w", stdout)) _exit(126);
+    execl(binary.c_str(), "aerocal", "adjust", "--project", project_file.c_str(), "--self-calibration",
+          self_calibration.c_str(), "--no-snooping", "--out", out.c_str(), static_cast<char*>(nullptr));
+    _exit(127);
+  }
+  int status = 0;
+  rusage usage{};
+  if (pid < 0 || wait4(pid, &status, 0, &usage) != pid) return run;
+  run.seconds = Seconds(start);
+  run.peak_rss_mb = usage.ru_maxrss / 1024.0;
+  run.ok = WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  return run;
+}
+
 void Compare(benchmark::State& state,
              const Project& project,
              const AdjustOptions& options,
+             const std::string& self_calibration,
              double c_truth_mm) {
   AdjustmentResult r;
   double seconds = 0;
@@ -124,6 +162,11 @@ void Compare(benchmark::State& state,
   state.counters["c_sigma_px"] = r.cameras[0].sigma[Model::kC] / p;
   state.counters["converged"] = r.converged();
   state.counters["peak_rss_mb"] = PeakRssMb();
+  const CliRun cli = RunAerocalAdjust(project, self_calibration);
+  if (cli.ok) {
+    state.counters["adjust_cli_s"] = cli.seconds;
+    state.counters["adjust_cli_peak_rss_mb"] = cli.peak_rss_mb;
+  }
   const ColmapRun colmap = RunColmap(project);
   if (colmap.ok) {
     state.counters["colmap_s"] = colmap.seconds;
@@ -153,7 +196,7 @@ void BM_SimulatedBlock(benchmark::State& state) {
   options.free_interior = ParseSelfCalibration("all");
   options.data_snooping = false;  // neither solver tests for gross errors here
   state.counters["observations"] = static_cast<double>(f.observations.size());
-  Compare(state, project, options, f.truth.c_mm());
+  Compare(state, project, options, "all", f.truth.c_mm());
 }
 BENCHMARK(BM_SimulatedBlock)
     ->Arg(37)
@@ -178,7 +221,7 @@ void BM_DbatRoma(benchmark::State& state) {
   AdjustOptions options;
   options.free_interior = ParseSelfCalibration("c,x0,y0,K1,K2");
   options.data_snooping = false;
-  Compare(state, project, options, 24.5425);  // published c (DBAT)
+  Compare(state, project, options, "c,x0,y0,K1,K2", 24.5425);  // published c (DBAT)
 }
 BENCHMARK(BM_DbatRoma)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
 

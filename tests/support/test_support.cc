@@ -42,8 +42,10 @@ CommandResult RunCommand(const std::string& command) {
   return result;
 }
 
+std::string AerocalBinary() { return AEROCAL_BINARY; }
+
 CommandResult RunAerocal(const std::string& arguments) {
-  return RunCommand(std::string(AEROCAL_BINARY) + " " + arguments);
+  return RunCommand(AerocalBinary() + " " + arguments);
 }
 
 std::string SharedDataDir(const std::string& name) {

@@ -24,6 +24,8 @@ struct CommandResult {
 
 /// Runs a shell command, capturing stdout+stderr.
 CommandResult RunCommand(const std::string& command);
+/// Path of the aerocal binary of this build.
+std::string AerocalBinary();
 /// Runs the aerocal binary with the given arguments.
 CommandResult RunAerocal(const std::string& arguments);
 
