@@ -123,14 +123,23 @@ CliRun RunAerocalAdjust(const Project& project, const std::string& self_calibrat
   CliRun run;
   testing::TempDir dir("aerocal_bench_cli");
   WriteProjectFolder(project, dir.File("block"));
-  const std::string binary = testing::AerocalBinary(), project_file = dir.File("block/project.yaml"),
-                    out = dir.File("result.json");
+  const std::string binary = testing::AerocalBinary(),
+                    project_file = dir.File("block/project.yaml"), out = dir.File("result.json");
   const auto start = Clock::now();
   const pid_t pid = fork();
   if (pid == 0) {
     if (!std::freopen("/dev/null", "w", stdout)) _exit(126);
-    execl(binary.c_str(), "aerocal", "adjust", "--project", project_file.c_str(), "--self-calibration",
-          self_calibration.c_str(), "--no-snooping", "--out", out.c_str(), static_cast<char*>(nullptr));
+    execl(binary.c_str(),
+          "aerocal",
+          "adjust",
+          "--project",
+          project_file.c_str(),
+          "--self-calibration",
+          self_calibration.c_str(),
+          "--no-snooping",
+          "--out",
+          out.c_str(),
+          static_cast<char*>(nullptr));
     _exit(127);
   }
   int status = 0;
