@@ -3,6 +3,7 @@
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "calib/core/progress.h"
 #include "tools/command_registry.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/conventional_reference.h"
@@ -88,10 +89,14 @@ CommandRun SetupAdjust(CLI::App& app) {
     const triangulation::ObjectFrame frame(input.frame);
     const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
 
+    // Big blocks take minutes: a progress bar of the adjustment stages (terminal only).
+    const int stages = triangulation::AdjustStages(options) +
+                       (args->compare ? triangulation::BlockAdjustment::kRunStages : 0);
+    Progress progress("adjust", stages);
     auto run = [&](const std::vector<std::string>& free) {
       auto o = options;
       o.free_interior = free;
-      AdjustmentResult r = triangulation::Adjust(project, o);
+      AdjustmentResult r = triangulation::Adjust(project, o, &progress);
       triangulation::ToInputFrame(frame, &r);
       return r;
     };
@@ -103,8 +108,9 @@ CommandRun SetupAdjust(CLI::App& app) {
                                  : options.free_interior;
       main = run(self_list);
       AdjustmentResult conventional =
-          triangulation::AdjustConventionalReference(project, options, main);
+          triangulation::AdjustConventionalReference(project, options, main, &progress);
       triangulation::ToInputFrame(frame, &conventional);
+      progress.Finish();  // before the tables, so the bar never interleaves with them
       std::printf("%s", triangulation::FormatComparison(conventional, main).c_str());
       json = triangulation::AdjustmentToJson(main);
       json["comparison"] = triangulation::ComparisonToJson(conventional, main);
@@ -112,6 +118,7 @@ CommandRun SetupAdjust(CLI::App& app) {
       main.solve.converged = main.solve.converged && conventional.solve.converged;
     } else {
       main = run(options.free_interior);
+      progress.Finish();
       std::printf("%s", triangulation::FormatSummary(main).c_str());
       json = triangulation::AdjustmentToJson(main);
     }

@@ -8,10 +8,14 @@
 
 namespace aerocal::triangulation {
 
-AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
+int AdjustStages(const AdjustOptions& options) {
+  return (options.robust_start ? 2 : 1) * BlockAdjustment::kRunStages;
+}
+
+AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Progress* progress) {
   if (!options.robust_start) {
     BlockAdjustment adjustment(project, options);
-    return adjustment.Run();
+    return adjustment.Run(progress);
   }
   AdjustOptions robust = options;
   robust.data_snooping = false;
@@ -22,7 +26,7 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
   AdjustmentResult start;
   {
     BlockAdjustment adjustment(project, robust, SubimageObservations::kMapWithCameraFile, loss);
-    start = adjustment.Run();
+    start = adjustment.Run(progress);
   }
   // Observations far outside the robust solution's spread are gross errors: a robust scale
   // (1.4826 median |v / sigma| over all components) and a cut at `robust_reject_sigma` scales.
@@ -69,7 +73,7 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options) {
   for (auto& p : next.points)
     if (p.role == PointRole::kTie && start.points_m.count(p.id)) p.xyz_m = start.points_m.at(p.id);
   BlockAdjustment adjustment(next, options);
-  AdjustmentResult result = adjustment.Run();
+  AdjustmentResult result = adjustment.Run(progress);
   for (auto& c : result.cameras) c.initial = project.cameras.at(c.id).interior;
   result.rejected.insert(result.rejected.begin(), pre_rejected.begin(), pre_rejected.end());
   // Observations the robust start rejected: listed with their robust residual, not used.

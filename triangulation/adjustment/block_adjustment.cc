@@ -357,7 +357,10 @@ void BlockAdjustment::DefineDatum() {
   storage_->datum = text;
 }
 
-AdjustmentResult BlockAdjustment::Run() {
+AdjustmentResult BlockAdjustment::Run(Progress* progress) {
+  const auto advance = [&] {
+    if (progress) progress->Advance();
+  };
   AdjustmentResult result;
   result.free_interior = options_.free_interior;
   result.frame = project_.frame.description;
@@ -372,6 +375,7 @@ AdjustmentResult BlockAdjustment::Run() {
     builder_.Solve(options_.solver);
     for (BlockId b : interior_blocks) builder_.FreeBlock(b);
   }
+  advance();
   std::vector<calib::RejectedResidual> rejected;
   if (options_.data_snooping) {
     calib::SnoopingOptions snooping;
@@ -454,6 +458,7 @@ AdjustmentResult BlockAdjustment::Run() {
     cov_blocks.push_back(state.opk_block);
     cov_blocks.push_back(state.center_block);
   }
+  advance();
   calib::CovarianceReport cov;
   if (!options_.estimate_covariance)
     cov.message = "covariance not estimated (option)";
@@ -462,6 +467,7 @@ AdjustmentResult BlockAdjustment::Run() {
         cov_blocks, result.sigma0, options_.correlation_threshold, interior_blocks);
   else
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
+  advance();
   result.determinability = AssessDeterminability(cov, "camera ", options_.correlation_threshold);
   for (const auto& [id, state] : storage_->cameras) {
     CameraEstimate c;

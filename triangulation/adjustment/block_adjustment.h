@@ -24,6 +24,7 @@
 // Run().
 #pragma once
 
+#include "calib/core/progress.h"
 #include "calib/problem/problem_builder.h"
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
@@ -71,8 +72,11 @@ class BlockAdjustment {
   void RegisterCallerObservation(calib::ResidualId id, const ImageObservation& observation);
 
   /// Solves (two stages when self-calibrating), snoops for gross errors, estimates the covariance
-  /// and compares control and check points. Never throws on non-convergence.
-  AdjustmentResult Run();
+  /// and compares control and check points. Never throws on non-convergence. `progress` (may be
+  /// null) advances by kRunStages: the fixed-interior solve, the solve with snooping, the
+  /// covariance.
+  AdjustmentResult Run(Progress* progress = nullptr);
+  static constexpr int kRunStages = 3;
 
  private:
   struct Storage;
@@ -89,7 +93,12 @@ class BlockAdjustment {
 };
 
 /// Builds and runs; with options.robust_start, first a robust adjustment whose solution starts
-/// the final one (the reported initial interior stays the camera file's).
-AdjustmentResult Adjust(const Project& project, const AdjustOptions& options);
+/// the final one (the reported initial interior stays the camera file's). `progress` (may be null)
+/// advances by AdjustStages(options) units of work.
+AdjustmentResult Adjust(const Project& project,
+                        const AdjustOptions& options,
+                        Progress* progress = nullptr);
+/// Units of work of Adjust() with these options, for a Progress bar.
+int AdjustStages(const AdjustOptions& options);
 
 }  // namespace aerocal::triangulation

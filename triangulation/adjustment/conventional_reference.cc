@@ -8,7 +8,8 @@ namespace aerocal::triangulation {
 
 AdjustmentResult AdjustConventionalReference(const Project& project,
                                              const AdjustOptions& options,
-                                             const AdjustmentResult& self_calibration) {
+                                             const AdjustmentResult& self_calibration,
+                                             Progress* progress) {
   // Rejections name the observation by image, point, sub-image and measured pixel.
   auto rejected = [&](const ImageObservation& o) {
     for (const auto& r : self_calibration.rejected)
@@ -27,7 +28,7 @@ AdjustmentResult AdjustConventionalReference(const Project& project,
   conventional.free_interior.clear();
   conventional.data_snooping = false;
   conventional.robust_start = false;
-  AdjustmentResult result = Adjust(clean, conventional);
+  AdjustmentResult result = Adjust(clean, conventional, progress);
   result.rejected = self_calibration.rejected;
   result.notes.push_back(
       std::to_string(left_out) +

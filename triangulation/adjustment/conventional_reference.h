@@ -8,6 +8,7 @@
 // corners and so moves the datum), which inflates the check-point errors the comparison is about.
 #pragma once
 
+#include "calib/core/progress.h"
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
@@ -17,8 +18,10 @@ namespace aerocal::triangulation {
 /// Conventional adjustment of `project` without the observations `self_calibration` rejected
 /// (they are listed in the result's `rejected`, with a note), interior fixed, no snooping, no
 /// robust start. `options` gives everything else (priors, solver, thresholds).
+/// `progress` (may be null) advances by BlockAdjustment::kRunStages.
 AdjustmentResult AdjustConventionalReference(const Project& project,
                                              const AdjustOptions& options,
-                                             const AdjustmentResult& self_calibration);
+                                             const AdjustmentResult& self_calibration,
+                                             Progress* progress = nullptr);
 
 }  // namespace aerocal::triangulation
