@@ -96,7 +96,9 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Scene{"PINHOLE", {2400, 2410, 1510, 990}},
                       Scene{"SIMPLE_RADIAL", {2400, 1500, 1000, -0.03}},
                       Scene{"RADIAL", {2400, 1500, 1000, -0.03, 0.01}},
-                      Scene{"OPENCV", {2400, 2400, 1505, 995, -0.03, 0.01, 2e-4, -1e-4}}),
+                      Scene{"OPENCV", {2400, 2400, 1505, 995, -0.03, 0.01, 2e-4, -1e-4}},
+                      Scene{"FULL_OPENCV",
+                            {2400, 2400, 1505, 995, -0.03, 0.01, 2e-4, -1e-4, 1e-3, 0, 0, 0}}),
     [](const auto& info) { return info.param.model; });
 
 TEST(ColmapImportErrors, UnsupportedModelNamesTheLine) {

@@ -1,6 +1,8 @@
 // aerocal import (ODM gcp_list.txt, DBAT marks) then aerocal adjust on the written block files.
 #include "calib/core/atomic_file.h"
 #include "tests/support/test_support.h"
+#include "triangulation/import/colmap_export.h"
+#include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -66,6 +68,34 @@ TEST(ImportCommand, GeographicGcpListIsRefusedWhateverItsSpelling) {
     EXPECT_NE(r.output.find("gcp.txt:1: geographic"), std::string::npos) << r.output;
     EXPECT_FALSE(std::filesystem::exists(tmp.File("block/project.yaml")));
   }
+}
+
+TEST(ImportCommand, ColmapModelImportedOnceThenAdjusted) {
+  // A simulated block without distortion written as a COLMAP text model (OPENCV camera), imported
+  // by the command and adjusted as a free network: sigma0 at the injected 0.2 px.
+  triangulation::FlightSimulationOptions o;
+  o.interior_correction = {};  // truth = nominal, no distortion: COLMAP's OPENCV holds it exactly
+  o.ground_points = 60;
+  o.tie_points = 300;
+  const triangulation::SimulatedFlight f = triangulation::SimulateFlight(o);
+  triangulation::Project block;
+  block.cameras["cam1"] = f.truth;
+  block.exposures = f.exposures_truth;
+  block.observations = f.observations;
+  std::map<std::string, Eigen::Vector3d> points;
+  for (const auto& g : f.points_truth) points[g.id] = *g.xyz_m;
+  testing::TempDir tmp("aerocal_import_colmap");
+  triangulation::WriteColmapModel(block, points, tmp.File("model"));
+  const auto imported =
+      RunAerocal("import colmap --model " + tmp.File("model") +
+                 " --pixel-size-mm 0.009 --sigma-px 0.2 --out " + tmp.File("block"));
+  ASSERT_EQ(imported.exit_code, 0) << imported.output;
+  const auto adjusted = RunAerocal("adjust --project " + tmp.File("block/project.yaml") +
+                                   " --out " + tmp.File("r.json"));
+  ASSERT_EQ(adjusted.exit_code, 0) << adjusted.output;
+  const auto doc = nlohmann::json::parse(ReadTextFile(tmp.File("r.json")));
+  EXPECT_NE(doc["datum"].get<std::string>().find("free network"), std::string::npos);
+  EXPECT_NEAR(doc["sigma0_px"].get<double>(), 0.2, 0.02);
 }
 
 }  // namespace
