@@ -441,15 +441,20 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     if (r.size() == 2) v.residual_px = Eigen::Vector2d(r[0], -r[1]) * o.sigma_px;
     result.residuals.push_back(v);
   }
-  // Statistics in the units of the image measurements.
-  std::vector<double> image_sigmas;
-  for (const auto& [id, index] : storage_->observation_of_residual)
-    if (builder_.IsActive(id)) image_sigmas.push_back(storage_->observations[index].sigma_px);
+  // Statistics in the units of the image measurements (CONVENTIONS.md "Statistics"), over every
+  // active image observation, virtual or raw: the median a-priori sigma in px, and in um with
+  // each observation's own camera pixel size (blocks may mix cameras).
+  std::vector<double> image_sigmas, image_sigmas_um;
+  for (const auto& [id, index] : storage_->observation_of_residual) {
+    if (!builder_.IsActive(id)) continue;
+    const ImageObservation& o = storage_->observations[index];
+    image_sigmas.push_back(o.sigma_px);
+    image_sigmas_um.push_back(o.sigma_px * storage_->exposures.at(o.image).camera->pixel_size_mm *
+                              1000.0);
+  }
   result.sigma0 = result.solve.sigma0;
   result.sigma0_px = result.sigma0 * Median(image_sigmas);
-  std::vector<double> pixel_sizes;
-  for (const auto& [id, camera] : project_.cameras) pixel_sizes.push_back(camera.pixel_size_mm);
-  result.sigma0_um = result.sigma0_px * Median(pixel_sizes) * 1000.0;
+  result.sigma0_um = result.sigma0 * Median(image_sigmas_um);
 
   // Covariance: interior and exterior orientation; interior x everything (so c ~ Z0 and
   // x0 ~ X0 / phi show), exterior blocks only with themselves (cheap for large blocks).

@@ -239,17 +239,10 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
     }
   }
 
+  // (sigma0 in px and um comes over every image observation, virtual and raw: the raw ones are
+  // registered with the adjustment.)
   result.adjustment = adjustment.Run();
   const double sigma0 = result.adjustment.sigma0;
-  // sigma0 in image units over all image measurements, virtual and raw (CONVENTIONS.md Statistics).
-  {
-    std::vector<double> sigmas;
-    for (const auto& o : project.observations) sigmas.push_back(o.sigma_px);
-    std::vector<double> pixel_sizes;
-    for (const auto& [id, camera] : project.cameras) pixel_sizes.push_back(camera.pixel_size_mm);
-    result.adjustment.sigma0_px = sigma0 * Median(sigmas);
-    result.adjustment.sigma0_um = result.adjustment.sigma0_px * Median(pixel_sizes) * 1000.0;
-  }
   result.datum = options.base_ids.empty()
                      ? "reference points (maker-surveyed virtual positions) fix the focal plane"
                      : "base sub-images keep their camera-file mapping:";
