@@ -482,6 +482,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
       if (wanted(i, k)) pair_ids.emplace_back(free_requested[i], free_requested[k]);
   std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd> schur;
   const bool use_schur = n_free > 300 && SchurCovariance(pair_ids, &schur);
+  report.method = use_schur ? "schur" : n_free <= 300 ? "ceres_dense_svd" : "ceres_sparse_qr";
   const bool computed = pairs.empty() || use_schur || covariance.Compute(pairs, problem_.get());
   if (!computed) {
     report.ok = false;

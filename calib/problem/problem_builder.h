@@ -120,6 +120,9 @@ struct HighCorrelation {
 struct CovarianceReport {
   bool ok = false;
   std::string message;                 // why it failed, when !ok
+  /// How it was computed: "schur" (points eliminated, sparse LDLT), "ceres_dense_svd" or
+  /// "ceres_sparse_qr" (ceres::Covariance).
+  std::string method;
   std::vector<std::string> names;      // "block.entry" per row
   std::vector<bool> free;              // false for fixed entries (sigma 0)
   Eigen::MatrixXd covariance;          // sigma0^2 Q

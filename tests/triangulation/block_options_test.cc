@@ -6,6 +6,7 @@
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/simulation/flight_simulator.h"
 
+#include <ceres/ceres.h>
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -325,6 +326,45 @@ TEST(BlockOptions, ADatumDefectIsReportedNotHidden) {
       r.determinability.undetermined.size(),
       r.determinability.undetermined.empty() ? "-" : r.determinability.undetermined.front().c_str(),
       r.determinability.message.c_str());
+}
+
+TEST(BlockOptions, SchurCovarianceAgreesWithCeresCovariance) {
+  // Above 300 free parameters the builder computes the covariance by eliminating the ground
+  // points (Schur complement, sparse LDLT). Here ~3000 parameters: the sigmas of the interior and
+  // of an exposure centre must be those of Ceres' own covariance (sparse QR) of the same problem.
+  const SimulatedFlight flight = SimulateFlight(FlightSimulationOptions{});
+  const Project project = ProjectFromFlight(flight);
+  AdjustOptions options = SelfCalibration();
+  options.data_snooping = false;
+  BlockAdjustment adjustment(project, options);
+  const AdjustmentResult r = adjustment.Run();
+  ASSERT_TRUE(r.converged());
+  ASSERT_TRUE(r.determinability.covariance_ok);
+  ASSERT_GT(adjustment.builder().NumFreeParameters(), 300);
+  ASSERT_EQ(r.determinability.covariance_method, "schur");
+
+  ceres::Covariance::Options covariance_options;
+  covariance_options.algorithm_type = ceres::SPARSE_QR;
+  ceres::Covariance covariance(covariance_options);
+  double* interior = adjustment.builder().BlockValues(adjustment.InteriorBlock("cam1"));
+  double* centre = adjustment.builder().BlockValues(adjustment.CenterBlock(r.exposures[18].image));
+  const std::vector<std::pair<const double*, const double*>> blocks = {{interior, interior},
+                                                                       {centre, centre}};
+  ASSERT_TRUE(covariance.Compute(blocks, &adjustment.builder().problem()));
+  double q_interior[Model::kNumParams * Model::kNumParams], q_centre[9];
+  ASSERT_TRUE(covariance.GetCovarianceBlock(interior, interior, q_interior));
+  ASSERT_TRUE(covariance.GetCovarianceBlock(centre, centre, q_centre));
+  double worst = 0.0;
+  for (int k = 0; k < Model::kNumParams; ++k) {
+    const double ceres_sigma = r.sigma0 * std::sqrt(q_interior[k * Model::kNumParams + k]);
+    worst = std::max(worst, std::abs(r.cameras[0].sigma[k] / ceres_sigma - 1.0));
+  }
+  for (int k = 0; k < 3; ++k) {
+    const double ceres_sigma = r.sigma0 * std::sqrt(q_centre[4 * k]);
+    worst = std::max(worst, std::abs((*r.exposures[18].center_sigma_m)(k) / ceres_sigma - 1.0));
+  }
+  std::printf("Schur vs Ceres covariance: largest relative sigma difference %.2e\n", worst);
+  EXPECT_LT(worst, 1e-3);  // the same matrix inverted two ways: rounding and conditioning only
 }
 
 }  // namespace

@@ -203,6 +203,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   }
   nlohmann::json det = {{"determinable", r.determinability.covariance_ok},
                         {"message", r.determinability.message},
+                        {"covariance_method", r.determinability.covariance_method},
                         {"undetermined", r.determinability.undetermined},
                         {"warnings", r.determinability.warnings}};
   det["high_correlations"] = nlohmann::json::array();

@@ -73,6 +73,7 @@ struct ObservationResidual {
 struct Determinability {
   bool covariance_ok = false;
   std::string message;
+  std::string covariance_method;  // calib::CovarianceReport::method
   /// Pairs with |rho| above the threshold that involve an interior parameter.
   std::vector<calib::HighCorrelation> high_correlations;
   std::vector<std::string> undetermined;  // null-space parameters (rank defect)

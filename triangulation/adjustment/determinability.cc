@@ -12,6 +12,7 @@ Determinability AssessDeterminability(const calib::CovarianceReport& cov,
   Determinability det;
   det.covariance_ok = cov.ok;
   det.message = cov.message;
+  det.covariance_method = cov.method;
   det.undetermined = cov.undetermined;
   if (!cov.ok) {
     det.warnings.push_back("the block cannot determine all parameters: " + cov.message);
