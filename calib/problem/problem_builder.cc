@@ -1,18 +1,18 @@
 #include "calib/problem/problem_builder.h"
 
-#include <algorithm>
-#include <chrono>
-#include <cmath>
-#include <set>
-#include <thread>
+#include "calib/core/error.h"
+#include "calib/problem/scaled_subset_manifold.h"
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
 #include <Eigen/SparseCholesky>
 #include <ceres/ceres.h>
 
-#include "calib/core/error.h"
-#include "calib/problem/scaled_subset_manifold.h"
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <set>
+#include <thread>
 
 namespace aerocal::calib {
 
@@ -82,7 +82,10 @@ ProblemBuilder::~ProblemBuilder() = default;
 
 ceres::Problem& ProblemBuilder::problem() { return *problem_; }
 
-BlockId ProblemBuilder::AddBlock(const std::string& name, double* values, int size, BlockKind kind,
+BlockId ProblemBuilder::AddBlock(const std::string& name,
+                                 double* values,
+                                 int size,
+                                 BlockKind kind,
                                  std::vector<std::string> entry_names) {
   AEROCAL_CHECK(size > 0 && values != nullptr) << "block " << name;
   AEROCAL_CHECK(block_by_name_.count(name) == 0) << "duplicate block name " << name;
@@ -128,7 +131,13 @@ void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
     AEROCAL_CHECK(e >= 0 && e < b.size) << "entry " << e << " of block " << b.name;
     b.entry_fixed[e] = true;
   }
-  if (b.FreeEntries().empty()) FixBlock(id);
+  const auto free = b.FreeEntries();
+  if (free.empty()) {
+    FixBlock(id);
+    return;
+  }
+  // In force at once, for a covariance or redundancy numbers before the next Solve().
+  UpdateManifolds();
 }
 
 bool ProblemBuilder::IsBlockFixed(BlockId id) const { return blocks_.at(id).constant; }
@@ -138,7 +147,8 @@ double* ProblemBuilder::BlockValues(BlockId id) const { return blocks_.at(id).va
 
 ResidualId ProblemBuilder::AddResidual(const std::string& group,
                                        std::unique_ptr<ceres::CostFunction> cost,
-                                       const std::vector<BlockId>& blocks, const std::string& label,
+                                       const std::vector<BlockId>& blocks,
+                                       const std::string& label,
                                        const LossOptions& loss) {
   AEROCAL_CHECK(cost != nullptr) << "null cost function in group " << group;
   AEROCAL_CHECK(cost->parameter_block_sizes().size() == blocks.size())
@@ -148,8 +158,8 @@ ResidualId ProblemBuilder::AddResidual(const std::string& group,
   for (size_t i = 0; i < blocks.size(); ++i) {
     const Block& b = blocks_.at(blocks[i]);
     AEROCAL_CHECK(cost->parameter_block_sizes()[i] == b.size)
-        << "group " << group << ": block " << b.name << " has size " << b.size << ", functor expects "
-        << cost->parameter_block_sizes()[i];
+        << "group " << group << ": block " << b.name << " has size " << b.size
+        << ", functor expects " << cost->parameter_block_sizes()[i];
     pointers.push_back(b.values);
   }
   ceres::LossFunction* loss_function = nullptr;
@@ -177,8 +187,8 @@ void ProblemBuilder::RemoveResidual(ResidualId id) {
 bool ProblemBuilder::IsActive(ResidualId id) const { return residuals_.at(id).active; }
 
 int ProblemBuilder::NumActiveResiduals() const {
-  return static_cast<int>(std::count_if(residuals_.begin(), residuals_.end(),
-                                        [](const Residual& r) { return r.active; }));
+  return static_cast<int>(std::count_if(
+      residuals_.begin(), residuals_.end(), [](const Residual& r) { return r.active; }));
 }
 
 const std::string& ProblemBuilder::ResidualGroup(ResidualId id) const {
@@ -238,49 +248,53 @@ Eigen::MatrixXd ProblemBuilder::DenseJacobian(const std::vector<BlockId>& blocks
   return dense;
 }
 
-SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  SolveReport report;
-  // Tangent scaling: unit Jacobian columns at the starting point (scaled_subset_manifold.h).
+bool ProblemBuilder::UpdateManifolds() {
+  // Tangent scaling: unit Jacobian columns at the current values (scaled_subset_manifold.h).
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   for (BlockId id : free_blocks) {
     Block& b = blocks_[id];
     const auto free = b.FreeEntries();
-    problem_->SetManifold(b.values, new ScaledSubsetManifold(b.size, free,
-                                                             std::vector<double>(free.size(), 1.0)));
+    problem_->SetManifold(
+        b.values, new ScaledSubsetManifold(b.size, free, std::vector<double>(free.size(), 1.0)));
   }
-  {
-    ceres::Problem::EvaluateOptions eval;
-    for (BlockId b : free_blocks) eval.parameter_blocks.push_back(blocks_[b].values);
-    eval.apply_loss_function = false;
-    ceres::CRSMatrix crs;
-    double cost = 0;
-    if (!free_blocks.empty() && problem_->Evaluate(eval, &cost, nullptr, nullptr, &crs)) {
-      std::vector<double> norm2(crs.num_cols, 0.0);
-      for (size_t k = 0; k < crs.values.size(); ++k) norm2[crs.cols[k]] += crs.values[k] * crs.values[k];
-      int col = 0;
-      for (BlockId id : free_blocks) {
-        Block& b = blocks_[id];
-        const auto free = b.FreeEntries();
-        std::vector<double> scales;
-        for (size_t k = 0; k < free.size(); ++k, ++col)
-          scales.push_back(norm2[col] > 0 ? 1.0 / std::sqrt(norm2[col]) : 1.0);
-        problem_->SetManifold(b.values, new ScaledSubsetManifold(b.size, free, scales));
-      }
-    } else if (!free_blocks.empty()) {
-      report.diagnostics.push_back(
-          "the residuals cannot be evaluated at the starting values (a point behind a camera?)");
-    }
+  if (free_blocks.empty()) return true;
+  ceres::Problem::EvaluateOptions eval;
+  for (BlockId b : free_blocks) eval.parameter_blocks.push_back(blocks_[b].values);
+  eval.apply_loss_function = false;
+  ceres::CRSMatrix crs;
+  double cost = 0;
+  if (!problem_->Evaluate(eval, &cost, nullptr, nullptr, &crs)) return false;
+  std::vector<double> norm2(crs.num_cols, 0.0);
+  for (size_t k = 0; k < crs.values.size(); ++k)
+    norm2[crs.cols[k]] += crs.values[k] * crs.values[k];
+  int col = 0;
+  for (BlockId id : free_blocks) {
+    Block& b = blocks_[id];
+    const auto free = b.FreeEntries();
+    std::vector<double> scales;
+    for (size_t k = 0; k < free.size(); ++k, ++col)
+      scales.push_back(norm2[col] > 0 ? 1.0 / std::sqrt(norm2[col]) : 1.0);
+    problem_->SetManifold(b.values, new ScaledSubsetManifold(b.size, free, scales));
   }
+  return true;
+}
+
+SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  SolveReport report;
+  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
+  if (!UpdateManifolds())
+    report.diagnostics.push_back(
+        "the residuals cannot be evaluated at the starting values (a point behind a camera?)");
 
   ceres::Solver::Options ceres_options;
   ceres_options.max_num_iterations = options.max_iterations;
   ceres_options.function_tolerance = options.function_tolerance;
   ceres_options.gradient_tolerance = options.gradient_tolerance;
   ceres_options.parameter_tolerance = options.parameter_tolerance;
-  ceres_options.num_threads =
-      options.num_threads > 0 ? options.num_threads
-                              : std::max(1u, std::thread::hardware_concurrency());
+  ceres_options.num_threads = options.num_threads > 0
+                                  ? options.num_threads
+                                  : std::max(1u, std::thread::hardware_concurrency());
   ceres_options.minimizer_progress_to_stdout = options.verbose;
   ceres_options.logging_type = options.verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
 
@@ -386,8 +400,7 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   for (BlockId id = 0; id < static_cast<BlockId>(blocks_.size()); ++id)
     if (!blocks_[id].constant && blocks_[id].num_residuals == 0)
       report.diagnostics.push_back("block " + blocks_[id].name + " has no observations");
-  report.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
 }
 
@@ -435,15 +448,17 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
   const Eigen::MatrixXd j = DenseJacobian(free_blocks, nullptr);
   std::vector<std::string> names;
   for (BlockId b : free_blocks)
-    for (int e : blocks_[b].FreeEntries()) names.push_back(blocks_[b].name + "." + blocks_[b].entry_names[e]);
+    for (int e : blocks_[b].FreeEntries())
+      names.push_back(blocks_[b].name + "." + blocks_[b].entry_names[e]);
   const std::set<std::string> out = NullSpaceNames(j.transpose() * j, names);
   return {out.begin(), out.end()};
 }
 
-CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& blocks,
-                                                    double sigma0,
-                                                    double correlation_threshold,
-                                                    const std::vector<BlockId>& cross_blocks) const {
+CovarianceReport ProblemBuilder::EstimateCovariance(
+    const std::vector<BlockId>& blocks,
+    double sigma0,
+    double correlation_threshold,
+    const std::vector<BlockId>& cross_blocks) const {
   CovarianceReport report;
   int total = 0;
   for (BlockId id : blocks) {
@@ -469,7 +484,8 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
   ceres::Covariance covariance(options);
   const std::set<BlockId> cross(cross_blocks.begin(), cross_blocks.end());
   auto wanted = [&](size_t i, size_t k) {
-    return cross.empty() || i == k || cross.count(free_requested[i]) || cross.count(free_requested[k]);
+    return cross.empty() || i == k || cross.count(free_requested[i]) ||
+           cross.count(free_requested[k]);
   };
   std::vector<std::pair<const double*, const double*>> pairs;
   for (size_t i = 0; i < free_requested.size(); ++i)
@@ -487,8 +503,9 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
   if (!computed) {
     report.ok = false;
     report.undetermined = NullSpaceParameters(3000);
-    report.message = "the normal matrix is singular or badly conditioned: the problem has a "
-                     "datum defect or parameters the observations cannot determine";
+    report.message =
+        "the normal matrix is singular or badly conditioned: the problem has a "
+        "datum defect or parameters the observations cannot determine";
     if (!report.undetermined.empty()) {
       report.message += " (";
       for (size_t i = 0; i < report.undetermined.size() && i < 20; ++i)
@@ -527,7 +544,8 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
     for (int k = i + 1; k < total; ++k)
       if (report.free[i] && report.free[k] &&
           std::abs(report.correlation(i, k)) > correlation_threshold)
-        report.high_correlations.push_back({report.names[i], report.names[k], report.correlation(i, k)});
+        report.high_correlations.push_back(
+            {report.names[i], report.names[k], report.correlation(i, k)});
   return report;
 }
 
@@ -538,8 +556,10 @@ CovarianceReport ProblemBuilder::EstimateCovariance(const std::vector<BlockId>& 
 //   j N^-1 j^T = t a^T + (q - f) S^+ (q - f)^T.
 // Cost O(rows * n_other^2 + n_other^3) instead of O(n_free^3). Returns false (dense path) when
 // there is no point block, a row touches two point blocks, or S is larger than `max_dense`.
-bool ProblemBuilder::RedundancyNumbersBySchur(const std::vector<ResidualId>& ids, int max_dense,
-                                              std::map<ResidualId, std::vector<double>>* out) const {
+bool ProblemBuilder::RedundancyNumbersBySchur(
+    const std::vector<ResidualId>& ids,
+    int max_dense,
+    std::map<ResidualId, std::vector<double>>* out) const {
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   std::vector<int> column_block;  // index into free_blocks of every tangent column
   std::vector<int> local_column;  // column within the point block, or within C
@@ -570,7 +590,7 @@ bool ProblemBuilder::RedundancyNumbersBySchur(const std::vector<ResidualId>& ids
   if (!problem_->Evaluate(options, &cost, nullptr, nullptr, &crs)) return false;
   // Split every row into its point part a (one block at most) and its other part f.
   struct Row {
-    int point = -1;              // index into free_blocks, -1 when none
+    int point = -1;  // index into free_blocks, -1 when none
     Eigen::VectorXd a, f;
   };
   std::vector<Row> rows(crs.num_rows);
@@ -635,7 +655,8 @@ bool ProblemBuilder::RedundancyNumbersBySchur(const std::vector<ResidualId>& ids
 
 bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
   auto eliminable = [&](BlockId id) {
-    return blocks_[id].kind == BlockKind::kGroundPoint || blocks_[id].kind == BlockKind::kTiePoint2d;
+    return blocks_[id].kind == BlockKind::kGroundPoint ||
+           blocks_[id].kind == BlockKind::kTiePoint2d;
   };
   ReducedSystem& r = *out;
   r.free_blocks = FreeBlocksInOrder();
@@ -651,7 +672,8 @@ bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
       column_block.push_back(id);
     }
     if (!elim)
-      for (int e : blocks_[id].FreeEntries()) r.reduced_names.push_back(blocks_[id].name + "." + blocks_[id].entry_names[e]);
+      for (int e : blocks_[id].FreeEntries())
+        r.reduced_names.push_back(blocks_[id].name + "." + blocks_[id].entry_names[e]);
     (elim ? r.n_p : r.n_r) += t;
   }
   if (r.n_p == 0 || r.n_r == 0) return false;
@@ -687,7 +709,8 @@ bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
     const int o = r.offset[id], t = blocks_[id].TangentSize();
     Eigen::MatrixXd block = Eigen::MatrixXd(npp.block(o, o, t, t));
     Eigen::LDLT<Eigen::MatrixXd> ldlt(block);
-    if (ldlt.info() != Eigen::Success || !(ldlt.vectorD().minCoeff() > 1e-12 * ldlt.vectorD().maxCoeff())) {
+    if (ldlt.info() != Eigen::Success ||
+        !(ldlt.vectorD().minCoeff() > 1e-12 * ldlt.vectorD().maxCoeff())) {
       r.singular_points.push_back(id);
       continue;
     }
@@ -702,10 +725,12 @@ bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
   return true;
 }
 
-bool ProblemBuilder::SchurCovariance(const std::vector<std::pair<BlockId, BlockId>>& pairs,
-                                     std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const {
+bool ProblemBuilder::SchurCovariance(
+    const std::vector<std::pair<BlockId, BlockId>>& pairs,
+    std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const {
   auto eliminable = [&](BlockId id) {
-    return blocks_[id].kind == BlockKind::kGroundPoint || blocks_[id].kind == BlockKind::kTiePoint2d;
+    return blocks_[id].kind == BlockKind::kGroundPoint ||
+           blocks_[id].kind == BlockKind::kTiePoint2d;
   };
   for (const auto& [a, b] : pairs)
     if (eliminable(a) || eliminable(b)) return false;
@@ -716,12 +741,14 @@ bool ProblemBuilder::SchurCovariance(const std::vector<std::pair<BlockId, BlockI
   const int n_r = reduced.n_r;
   std::map<BlockId, int>& offset = reduced.offset;
   Eigen::SimplicialLDLT<Sparse> solver(s);
-  if (solver.info() != Eigen::Success || !(solver.vectorD().minCoeff() > 1e-14 * solver.vectorD().maxCoeff()))
+  if (solver.info() != Eigen::Success ||
+      !(solver.vectorD().minCoeff() > 1e-14 * solver.vectorD().maxCoeff()))
     return false;
   auto plus_jacobian = [&](BlockId id) {
     const Block& block = blocks_[id];
     const ceres::Manifold* manifold = problem_->GetManifold(block.values);
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> j(block.size, block.TangentSize());
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> j(block.size,
+                                                                             block.TangentSize());
     if (manifold)
       manifold->PlusJacobian(block.values, j.data());
     else
@@ -739,7 +766,8 @@ bool ProblemBuilder::SchurCovariance(const std::vector<std::pair<BlockId, BlockI
     const Eigen::MatrixXd columns = solver.solve(rhs);
     const Eigen::MatrixXd pb = plus_jacobian(b);
     for (BlockId a : rows)
-      (*out)[{a, b}] = plus_jacobian(a) * columns.middleRows(offset[a], blocks_[a].TangentSize()) * pb.transpose();
+      (*out)[{a, b}] = plus_jacobian(a) * columns.middleRows(offset[a], blocks_[a].TangentSize()) *
+                       pb.transpose();
   }
   return true;
 }
@@ -818,7 +846,8 @@ SolveReport ProblemBuilder::SolveWithDataSnooping(const SolverOptions& options,
     }
     if (worst < 0) break;
     if (rejected)
-      rejected->push_back({worst, residuals_[worst].group, residuals_[worst].label, worst_w, worst_v});
+      rejected->push_back(
+          {worst, residuals_[worst].group, residuals_[worst].label, worst_w, worst_v});
     RemoveResidual(worst);
     report = Solve(options);
   }

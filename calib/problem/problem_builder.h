@@ -36,14 +36,14 @@
 //    a new one: statistics appear per group automatically.
 #pragma once
 
+#include <Eigen/Core>
+#include <ceres/cost_function.h>
+
 #include <map>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-#include <ceres/cost_function.h>
 
 namespace ceres {
 class Problem;
@@ -57,10 +57,10 @@ using ResidualId = int;
 enum class BlockKind { kInterior, kMapping, kRotation, kCenter, kGroundPoint, kTiePoint2d, kOther };
 
 // Standard residual group names.
-inline constexpr const char* kGroupImage = "image";                // collinearity, virtual image
-inline constexpr const char* kGroupSubimage = "subimage_image";    // collinearity, raw sub-image
-inline constexpr const char* kGroupControl = "control";            // control-point coordinates
-inline constexpr const char* kGroupEoPrior = "eo_prior";           // GNSS/IMU priors
+inline constexpr const char* kGroupImage = "image";              // collinearity, virtual image
+inline constexpr const char* kGroupSubimage = "subimage_image";  // collinearity, raw sub-image
+inline constexpr const char* kGroupControl = "control";          // control-point coordinates
+inline constexpr const char* kGroupEoPrior = "eo_prior";         // GNSS/IMU priors
 inline constexpr const char* kGroupInteriorPrior = "interior_prior";
 inline constexpr const char* kGroupStitchReference = "stitch_reference";
 inline constexpr const char* kGroupStitchTie = "stitch_tie";
@@ -75,13 +75,13 @@ struct LossOptions {
 enum class LinearSolverChoice { kAuto, kDenseQr, kDenseSchur, kSparseSchur, kSparseNormalCholesky };
 
 struct SolverOptions {
-  int max_iterations = 100;            // Levenberg-Marquardt iterations, > 0
-  double function_tolerance = 1e-12;   // relative cost change to stop
+  int max_iterations = 100;           // Levenberg-Marquardt iterations, > 0
+  double function_tolerance = 1e-12;  // relative cost change to stop
   double gradient_tolerance = 1e-14;
   double parameter_tolerance = 1e-12;  // relative step size to stop
   LinearSolverChoice linear_solver = LinearSolverChoice::kAuto;
-  int num_threads = 0;                 // 0: all cores
-  bool verbose = false;                // Ceres per-iteration log on stdout
+  int num_threads = 0;   // 0: all cores
+  bool verbose = false;  // Ceres per-iteration log on stdout
 };
 
 struct ResidualGroupStats {
@@ -94,17 +94,17 @@ struct ResidualGroupStats {
 
 struct SolveReport {
   bool converged = false;
-  bool usable = false;       // Ceres returned a usable solution (converged or hit iteration limit)
+  bool usable = false;  // Ceres returned a usable solution (converged or hit iteration limit)
   int iterations = 0;
   double initial_cost = 0.0, final_cost = 0.0;  // 0.5 v^T P v
-  std::string termination;   // Ceres' termination type
-  std::string message;       // Ceres' message
+  std::string termination;                      // Ceres' termination type
+  std::string message;                          // Ceres' message
   std::string linear_solver;
-  int n_observations = 0;    // scalar residuals
-  int n_unknowns = 0;        // free parameters (tangent space)
+  int n_observations = 0;  // scalar residuals
+  int n_unknowns = 0;      // free parameters (tangent space)
   int redundancy = 0;
   double vtpv = 0.0;
-  double sigma0 = 0.0;       // unitless, 1 when the a-priori sigmas are right
+  double sigma0 = 0.0;  // unitless, 1 when the a-priori sigmas are right
   double seconds = 0.0;
   std::vector<ResidualGroupStats> groups;
   std::vector<std::string> diagnostics;
@@ -119,14 +119,14 @@ struct HighCorrelation {
 /// Covariance of selected blocks, scaled by sigma0^2 (a-posteriori), in ambient coordinates.
 struct CovarianceReport {
   bool ok = false;
-  std::string message;                 // why it failed, when !ok
+  std::string message;  // why it failed, when !ok
   /// How it was computed: "schur" (points eliminated, sparse LDLT), "ceres_dense_svd" or
   /// "ceres_sparse_qr" (ceres::Covariance).
   std::string method;
-  std::vector<std::string> names;      // "block.entry" per row
-  std::vector<bool> free;              // false for fixed entries (sigma 0)
-  Eigen::MatrixXd covariance;          // sigma0^2 Q
-  Eigen::VectorXd sigma;               // sqrt(diag)
+  std::vector<std::string> names;  // "block.entry" per row
+  std::vector<bool> free;          // false for fixed entries (sigma 0)
+  Eigen::MatrixXd covariance;      // sigma0^2 Q
+  Eigen::VectorXd sigma;           // sqrt(diag)
   Eigen::MatrixXd correlation;
   std::vector<HighCorrelation> high_correlations;  // |rho| above the threshold, free entries only
   std::vector<std::string> undetermined;           // parameters in the null space (rank defect)
@@ -147,7 +147,7 @@ struct SnoopingOptions {
 struct RejectedResidual {
   ResidualId id = -1;
   std::string group, label;
-  double w = 0.0;                       // standardized residual that triggered the rejection
+  double w = 0.0;                         // standardized residual that triggered the rejection
   std::vector<double> whitened_residual;  // v / sigma at rejection time
 };
 
@@ -160,7 +160,10 @@ class ProblemBuilder {
 
   /// Registers `size` doubles at `values` (caller keeps them alive) under a unique name.
   /// `entry_names` name each entry in reports (default "0", "1", ...).
-  BlockId AddBlock(const std::string& name, double* values, int size, BlockKind kind,
+  BlockId AddBlock(const std::string& name,
+                   double* values,
+                   int size,
+                   BlockKind kind,
                    std::vector<std::string> entry_names = {});
   BlockId FindBlock(const std::string& name) const;  // -1 when absent
   void FixBlock(BlockId id);
@@ -173,8 +176,10 @@ class ProblemBuilder {
   double* BlockValues(BlockId id) const;
 
   /// Adds a whitened residual on `blocks` under `group`; `label` names the observation.
-  ResidualId AddResidual(const std::string& group, std::unique_ptr<ceres::CostFunction> cost,
-                         const std::vector<BlockId>& blocks, const std::string& label = "",
+  ResidualId AddResidual(const std::string& group,
+                         std::unique_ptr<ceres::CostFunction> cost,
+                         const std::vector<BlockId>& blocks,
+                         const std::string& label = "",
                          const LossOptions& loss = {});
   /// Removes a residual (e.g. a gross error); its statistics leave the groups.
   void RemoveResidual(ResidualId id);
@@ -188,15 +193,17 @@ class ProblemBuilder {
   SolveReport Solve(const SolverOptions& options);
   /// Solves, then repeatedly removes the worst standardized residual above the critical value and
   /// solves again. The final report is of the clean adjustment; rejections are appended in order.
-  SolveReport SolveWithDataSnooping(const SolverOptions& options, const SnoopingOptions& snooping,
+  SolveReport SolveWithDataSnooping(const SolverOptions& options,
+                                    const SnoopingOptions& snooping,
                                     std::vector<RejectedResidual>* rejected);
 
   /// Covariance of `blocks` at the current values, scaled by sigma0^2; correlations above
   /// `correlation_threshold` are listed.
   /// With `cross_blocks` non-empty, only the diagonal blocks and the pairs involving one of
-  /// `cross_blocks` are computed (e.g. interior x every exterior block, for large blocks); the other
-  /// off-diagonal entries stay 0 and their correlations are not examined.
-  CovarianceReport EstimateCovariance(const std::vector<BlockId>& blocks, double sigma0,
+  /// `cross_blocks` are computed (e.g. interior x every exterior block, for large blocks); the
+  /// other off-diagonal entries stay 0 and their correlations are not examined.
+  CovarianceReport EstimateCovariance(const std::vector<BlockId>& blocks,
+                                      double sigma0,
                                       double correlation_threshold = 0.95,
                                       const std::vector<BlockId>& cross_blocks = {}) const;
 
@@ -217,6 +224,9 @@ class ProblemBuilder {
   struct Block;
   struct Residual;
   std::vector<BlockId> FreeBlocksInOrder() const;
+  /// Subset manifolds of the free entries, columns scaled to unit Jacobian norm at the current
+  /// values; false when the residuals cannot be evaluated there (then the scales are 1).
+  bool UpdateManifolds();
   /// Names of the parameters in the null space of the normal matrix: from the dense matrix up to
   /// `max_parameters` free parameters, above that from the normal equations reduced to the
   /// non-point parameters (points eliminated) while those number at most `max_parameters`.
@@ -225,7 +235,8 @@ class ProblemBuilder {
   /// Normal equations with the ground / tie points eliminated (Schur complement); false when no
   /// point or no other block is free, or a residual observes two points.
   bool ReduceNormalEquations(ReducedSystem* out) const;
-  bool RedundancyNumbersBySchur(const std::vector<ResidualId>& ids, int max_dense,
+  bool RedundancyNumbersBySchur(const std::vector<ResidualId>& ids,
+                                int max_dense,
                                 std::map<ResidualId, std::vector<double>>* out) const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,
                                 std::vector<ResidualId>* row_owner) const;

@@ -3,16 +3,17 @@
 // with known Gaussian noise, reported sigmas against the spread of 200 Monte-Carlo repetitions,
 // data snooping of a planted gross error, and the diagnostics of rank-deficient and badly
 // determined problems.
-#include <cmath>
-#include <random>
+#include "calib/problem/problem_builder.h"
+
+#include "calib/camera/camera.h"
+#include "calib/residuals/autodiff_residual.h"
+#include "calib/residuals/collinearity.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-#include "calib/camera/camera.h"
-#include "calib/problem/problem_builder.h"
-#include "calib/residuals/autodiff_residual.h"
-#include "calib/residuals/collinearity.h"
+#include <cmath>
+#include <random>
 
 namespace aerocal::calib {
 namespace {
@@ -53,7 +54,8 @@ TestField MakeTestField() {
   f.camera.interior = {50.2, 0.031, -0.042, 4e-5, -3e-8, 5e-12, 3e-6, -2e-6, 1e-4, -5e-5};
   std::mt19937_64 rng(7);
   std::uniform_real_distribution<double> uniform(-1.0, 1.0);
-  for (int i = 0; i < 150; ++i) f.points.push_back({5.0 * uniform(rng), 5.0 * uniform(rng), 1.5 + 1.5 * uniform(rng)});
+  for (int i = 0; i < 150; ++i)
+    f.points.push_back({5.0 * uniform(rng), 5.0 * uniform(rng), 1.5 + 1.5 * uniform(rng)});
   const Eigen::Vector3d target(0, 0, 1.5);
   for (int k = 0; k < 8; ++k) {
     const double a = 2 * M_PI * k / 8;
@@ -67,7 +69,9 @@ TestField MakeTestField() {
     for (size_t p = 0; p < f.points.size(); ++p) {
       Eigen::Vector2d px;
       if (!f.camera.ProjectToPixel(f.opk[i], f.centers[i], f.points[p], &px)) continue;
-      if (px.x() < 0 || px.y() < 0 || px.x() > f.camera.width_px - 1 || px.y() > f.camera.height_px - 1) continue;
+      if (px.x() < 0 || px.y() < 0 || px.x() > f.camera.width_px - 1 ||
+          px.y() > f.camera.height_px - 1)
+        continue;
       f.observations.push_back({static_cast<int>(i), static_cast<int>(p), px});
     }
   return f;
@@ -81,25 +85,32 @@ struct Adjustment {
   BlockId interior_block;
   std::vector<ResidualId> residuals;
 
-  Adjustment(const TestField& f, const std::vector<Eigen::Vector2d>& pixels, double sigma_px,
-             const InteriorParams& start) : interior(start), opk(f.opk), centers(f.centers), points(f.points) {
+  Adjustment(const TestField& f,
+             const std::vector<Eigen::Vector2d>& pixels,
+             double sigma_px,
+             const InteriorParams& start)
+      : interior(start), opk(f.opk), centers(f.centers), points(f.points) {
     std::vector<std::string> names;
     for (const auto& info : Model::kParams) names.emplace_back(info.name);
     interior_block = builder.AddBlock("interior", interior.data(), 10, BlockKind::kInterior, names);
     std::vector<BlockId> o, c, p;
     for (size_t i = 0; i < opk.size(); ++i) {
-      o.push_back(builder.AddBlock("opk" + std::to_string(i), opk[i].data(), 3, BlockKind::kRotation));
-      c.push_back(builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter));
+      o.push_back(
+          builder.AddBlock("opk" + std::to_string(i), opk[i].data(), 3, BlockKind::kRotation));
+      c.push_back(
+          builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter));
     }
     for (size_t i = 0; i < points.size(); ++i) {
-      p.push_back(builder.AddBlock("point" + std::to_string(i), points[i].data(), 3, BlockKind::kGroundPoint));
+      p.push_back(builder.AddBlock(
+          "point" + std::to_string(i), points[i].data(), 3, BlockKind::kGroundPoint));
       builder.FixBlock(p.back());
     }
     const PixelFrame frame{f.camera.pixel_size_mm, f.camera.width_px, f.camera.height_px};
     for (size_t k = 0; k < f.observations.size(); ++k) {
       const auto& obs = f.observations[k];
       residuals.push_back(builder.AddResidual(
-          kGroupImage, CollinearityResidual::Create(frame, pixels[k], sigma_px),
+          kGroupImage,
+          CollinearityResidual::Create(frame, pixels[k], sigma_px),
           {interior_block, o[obs.image], c[obs.image], p[obs.point]},
           "image " + std::to_string(obs.image) + " point " + std::to_string(obs.point)));
     }
@@ -115,10 +126,13 @@ InteriorParams PerturbedStart(const InteriorParams& truth) {
   return start;
 }
 
-std::vector<Eigen::Vector2d> NoisyPixels(const TestField& f, double noise_px, std::mt19937_64& rng) {
+std::vector<Eigen::Vector2d> NoisyPixels(const TestField& f,
+                                         double noise_px,
+                                         std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, noise_px);
   std::vector<Eigen::Vector2d> out;
-  for (const auto& obs : f.observations) out.push_back(obs.pixel + Eigen::Vector2d(normal(rng), normal(rng)));
+  for (const auto& obs : f.observations)
+    out.push_back(obs.pixel + Eigen::Vector2d(normal(rng), normal(rng)));
   return out;
 }
 
@@ -160,7 +174,8 @@ TEST(ProblemBuilder, GaussianNoiseGivesSigma0AndThreeSigmaRecovery) {
   ASSERT_TRUE(cov.ok) << cov.message;
   for (int i = 0; i < Model::kNumParams; ++i) {
     EXPECT_GT(cov.sigma(i), 0.0);
-    EXPECT_LT(std::abs(a.interior[i] - f.camera.interior[i]), 3.0 * cov.sigma(i)) << Model::kParams[i].name;
+    EXPECT_LT(std::abs(a.interior[i] - f.camera.interior[i]), 3.0 * cov.sigma(i))
+        << Model::kParams[i].name;
   }
   EXPECT_EQ(cov.names[0], "interior.c");
 }
@@ -229,14 +244,20 @@ TEST(ProblemBuilder, DatumDefectIsReportedWithTheParametersInvolved) {
   BlockId ob[2], cb[2];
   for (int i = 0; i < 2; ++i) {
     ob[i] = builder.AddBlock("opk" + std::to_string(i), opk[i].data(), 3, BlockKind::kRotation);
-    cb[i] = builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter);
+    cb[i] =
+        builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter);
   }
   for (const auto& obs : f.observations) {
     const int i = obs.image == 0 ? 0 : obs.image == 2 ? 1 : -1;
     if (i < 0) continue;
     if (pb[obs.point] < 0)
-      pb[obs.point] = builder.AddBlock("point" + std::to_string(obs.point), points[obs.point].data(), 3, BlockKind::kGroundPoint);
-    builder.AddResidual(kGroupImage, CollinearityResidual::Create(frame, obs.pixel, 0.2), {ib, ob[i], cb[i], pb[obs.point]});
+      pb[obs.point] = builder.AddBlock("point" + std::to_string(obs.point),
+                                       points[obs.point].data(),
+                                       3,
+                                       BlockKind::kGroundPoint);
+    builder.AddResidual(kGroupImage,
+                        CollinearityResidual::Create(frame, obs.pixel, 0.2),
+                        {ib, ob[i], cb[i], pb[obs.point]});
   }
   const SolveReport report = builder.Solve({});
   EXPECT_TRUE(report.usable);
@@ -268,7 +289,8 @@ TEST(ProblemBuilder, HighCorrelationsAreListed) {
   std::normal_distribution<double> normal(0.0, 1.0);
   for (int i = 0; i < 100; ++i) {
     const double t = i * 0.1;
-    builder.AddResidual("samples", NearlyCollinearResidual::Create(t, 2 * t + 1e-3 * t * t + normal(rng)), {b});
+    builder.AddResidual(
+        "samples", NearlyCollinearResidual::Create(t, 2 * t + 1e-3 * t * t + normal(rng)), {b});
   }
   const SolveReport report = builder.Solve({});
   ASSERT_TRUE(report.converged);
@@ -295,6 +317,15 @@ TEST(ProblemBuilder, FixedEntriesStayAndAreNotCounted) {
   ASSERT_TRUE(cov.ok) << cov.message;
   EXPECT_EQ(cov.sigma(Model::kK3), 0.0);
   EXPECT_FALSE(cov.free[Model::kK3]);
+  // Entries fixed after a solve are fixed for the next covariance at once, before any Solve().
+  a.builder.FixEntries(a.interior_block, {Model::kP1, Model::kP2});
+  const CovarianceReport again = a.builder.EstimateCovariance({a.interior_block}, report.sigma0);
+  ASSERT_TRUE(again.ok) << again.message;
+  EXPECT_FALSE(again.free[Model::kP1]);
+  EXPECT_EQ(again.sigma(Model::kP2), 0.0);
+  EXPECT_GT(again.sigma(Model::kK1), 0.0);
+  // Fewer free parameters: K1 is determined at least as well as before.
+  EXPECT_LE(again.sigma(Model::kK1), cov.sigma(Model::kK1) * (1 + 1e-9));
 }
 
 TEST(NormalCriticalValue, KnownQuantiles) {
