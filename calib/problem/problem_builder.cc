@@ -365,7 +365,7 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   report.message = summary.message;
   report.converged = summary.termination_type == ceres::CONVERGENCE;
   report.usable = summary.IsSolutionUsable();
-  report.iterations = static_cast<int>(summary.iterations.size()) - 1;
+  report.iterations = std::max(0, static_cast<int>(summary.iterations.size()) - 1);  // [0] is the start
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
 
