@@ -109,9 +109,12 @@ BlockId BlockAdjustment::AddPoint(const std::string& point, const Eigen::Vector3
 
 void BlockAdjustment::RegisterCallerObservation(calib::ResidualId id,
                                                 const ImageObservation& observation) {
+  const auto point = storage_->points.find(observation.point);
+  AEROCAL_CHECK(point != storage_->points.end())
+      << "point " << observation.point << " observed before AddPoint";
   storage_->observation_of_residual[id] = storage_->observations.size();
   storage_->observations.push_back(observation);
-  auto& state = storage_->points.at(observation.point);
+  auto& state = point->second;
   state.rays = std::max(state.rays, 0) + 1;
 }
 
