@@ -3,6 +3,7 @@
 #include "calib/core/string_printf.h"
 
 #include <cmath>
+#include <limits>
 
 namespace aerocal::triangulation {
 namespace {
@@ -29,27 +30,44 @@ std::string StatisticsLine(const char* what, const PointStatistics& s) {
                       s.spatial_rmse_m);
 }
 
+// |correction| / sigma of a free parameter: above 1.96 the correction is significant at 5 %
+// (the test of additional parameters); NaN when fixed or without a covariance.
+double CorrectionInSigmas(const CameraEstimate& c, int k) {
+  if (!c.free[k] || !(c.sigma[k] > 0)) return std::numeric_limits<double>::quiet_NaN();
+  return std::abs(c.estimated[k] - c.initial[k]) / c.sigma[k];
+}
+
 std::string CalibrationTable(const AdjustmentResult& r) {
   std::string out;
   for (const auto& c : r.cameras) {
     out += "camera " + c.id + "\n";
-    out += StringPrintf("  %-4s %-6s %16s %16s %16s %14s\n",
+    out += StringPrintf("  %-4s %-6s %16s %16s %16s %14s %8s\n",
                         "par",
                         "unit",
                         "initial",
                         "correction",
                         "estimate",
-                        "sigma");
+                        "sigma",
+                        "|t|");
+    std::string insignificant;
     for (int k = 0; k < Model::kNumParams; ++k) {
       const auto& info = Model::kParams[k];
-      out += StringPrintf("  %-4s %-6s %16.8g %16.8g %16.8g %14s\n",
+      const double t = CorrectionInSigmas(c, k);
+      out += StringPrintf("  %-4s %-6s %16.8g %16.8g %16.8g %14s %8s\n",
                           std::string(info.name).c_str(),
                           std::string(info.unit).c_str(),
                           c.initial[k],
                           c.estimated[k] - c.initial[k],
                           c.estimated[k],
-                          c.free[k] ? StringPrintf("%.3g", c.sigma[k]).c_str() : "fixed");
+                          c.free[k] ? StringPrintf("%.3g", c.sigma[k]).c_str() : "fixed",
+                          std::isnan(t) ? "-" : StringPrintf("%.1f", t).c_str());
+      if (t < 1.96) insignificant += (insignificant.empty() ? "" : ", ") + std::string(info.name);
     }
+    if (!insignificant.empty())
+      out +=
+          "  corrections not significant at 5 % (|t| < 1.96, one parameter at a time; correlated "
+          "terms such as K1-K3 may be significant together): " +
+          insignificant + "\n";
   }
   return out;
 }
@@ -276,13 +294,17 @@ nlohmann::json ComparisonToJson(const AdjustmentResult& a, const AdjustmentResul
   nlohmann::json table = nlohmann::json::array();
   for (const auto& c : b.cameras)
     for (int k = 0; k < Model::kNumParams; ++k)
-      table.push_back({{"camera", c.id},
-                       {"parameter", std::string(Model::kParams[k].name)},
-                       {"unit", std::string(Model::kParams[k].unit)},
-                       {"initial", c.initial[k]},
-                       {"correction", c.estimated[k] - c.initial[k]},
-                       {"estimate", c.estimated[k]},
-                       {"sigma", c.free[k] ? nlohmann::json(c.sigma[k]) : nlohmann::json()}});
+      table.push_back(
+          {{"camera", c.id},
+           {"parameter", std::string(Model::kParams[k].name)},
+           {"unit", std::string(Model::kParams[k].unit)},
+           {"initial", c.initial[k]},
+           {"correction", c.estimated[k] - c.initial[k]},
+           {"estimate", c.estimated[k]},
+           {"sigma", c.free[k] ? nlohmann::json(c.sigma[k]) : nlohmann::json()},
+           {"t",
+            std::isnan(CorrectionInSigmas(c, k)) ? nlohmann::json()
+                                                 : nlohmann::json(CorrectionInSigmas(c, k))}});
   j["calibration"] = table;
   return j;
 }
