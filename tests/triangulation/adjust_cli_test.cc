@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -57,6 +58,17 @@ TEST_F(AdjustCommand, CompareWritesBothRunsAndTheCamera) {
   const auto& cmp = j["comparison"];
   EXPECT_GE(cmp["check_spatial_rmse_ratio"].get<double>(), 1.5);
   EXPECT_EQ(cmp["calibration"].size(), 10u);
+  // Each free parameter carries its test statistic |correction| / sigma. Without GNSS, c is
+  // tied to the flying heights (sigma ~0.3 mm): its 0.04 mm correction cannot be significant.
+  for (const auto& row : cmp["calibration"]) {
+    if (row["sigma"].is_null()) continue;
+    EXPECT_NEAR(row["t"].get<double>(),
+                std::abs(row["correction"].get<double>()) / row["sigma"].get<double>(),
+                1e-9 * (1 + row["t"].get<double>()));
+    if (row["parameter"] == "c") {
+      EXPECT_LT(row["t"].get<double>(), 1.96);
+    }
+  }
   // The written camera holds the estimate and carries the sub-images along.
   const calib::Camera camera = calib::ReadCamera(dir_.File("next/camera.yaml"));
   const calib::Camera nominal = calib::ReadCamera(dir_.File("flight/camera_nominal.yaml"));
