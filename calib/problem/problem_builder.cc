@@ -34,6 +34,12 @@ struct ProblemBuilder::Block {
     return out;
   }
   int TangentSize() const { return constant ? 0 : static_cast<int>(FreeEntries().size()); }
+  /// Ground and virtual tie points: the blocks a Schur complement eliminates.
+  bool Eliminable() const {
+    return kind == BlockKind::kGroundPoint || kind == BlockKind::kTiePoint2d;
+  }
+  /// "block.entry", the name of one parameter in reports.
+  std::string EntryName(int e) const { return name + "." + entry_names[e]; }
 };
 
 struct ProblemBuilder::Residual {
@@ -131,8 +137,7 @@ void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
     AEROCAL_CHECK(e >= 0 && e < b.size) << "entry " << e << " of block " << b.name;
     b.entry_fixed[e] = true;
   }
-  const auto free = b.FreeEntries();
-  if (free.empty()) {
+  if (b.FreeEntries().empty()) {
     FixBlock(id);
     return;
   }
@@ -302,7 +307,7 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   std::vector<BlockId> eliminable;
   for (BlockId id : free_blocks) {
     const Block& b = blocks_[id];
-    if (b.kind == BlockKind::kGroundPoint || b.kind == BlockKind::kTiePoint2d) {
+    if (b.Eliminable()) {
       eliminable.push_back(id);
       eliminable_params += b.TangentSize();
     } else {
@@ -351,7 +356,7 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
       for (BlockId id : free_blocks) {
         const Block& b = blocks_[id];
-        const bool elim = b.kind == BlockKind::kGroundPoint || b.kind == BlockKind::kTiePoint2d;
+        const bool elim = b.Eliminable();
         ordering->AddElementToGroup(b.values, elim ? 0 : 1);
       }
       ceres_options.linear_solver_ordering = ordering;
@@ -365,7 +370,8 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   report.message = summary.message;
   report.converged = summary.termination_type == ceres::CONVERGENCE;
   report.usable = summary.IsSolutionUsable();
-  report.iterations = std::max(0, static_cast<int>(summary.iterations.size()) - 1);  // [0] is the start
+  report.iterations =
+      std::max(0, static_cast<int>(summary.iterations.size()) - 1);  // [0] is the start
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
 
@@ -448,8 +454,7 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
   const Eigen::MatrixXd j = DenseJacobian(free_blocks, nullptr);
   std::vector<std::string> names;
   for (BlockId b : free_blocks)
-    for (int e : blocks_[b].FreeEntries())
-      names.push_back(blocks_[b].name + "." + blocks_[b].entry_names[e]);
+    for (int e : blocks_[b].FreeEntries()) names.push_back(blocks_[b].EntryName(e));
   const std::set<std::string> out = NullSpaceNames(j.transpose() * j, names);
   return {out.begin(), out.end()};
 }
@@ -465,7 +470,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     report.offsets[id] = total;
     const Block& b = blocks_.at(id);
     for (int e = 0; e < b.size; ++e) {
-      report.names.push_back(b.name + "." + b.entry_names[e]);
+      report.names.push_back(b.EntryName(e));
       report.free.push_back(!b.constant && !b.entry_fixed[e] && b.num_residuals > 0);
     }
     total += b.size;
@@ -568,7 +573,7 @@ bool ProblemBuilder::RedundancyNumbersBySchur(
   bool any_point = false;
   for (size_t i = 0; i < free_blocks.size(); ++i) {
     const Block& b = blocks_[free_blocks[i]];
-    eliminable[i] = b.kind == BlockKind::kGroundPoint || b.kind == BlockKind::kTiePoint2d;
+    eliminable[i] = b.Eliminable();
     any_point = any_point || eliminable[i];
     for (int k = 0; k < b.TangentSize(); ++k) {
       column_block.push_back(static_cast<int>(i));
@@ -654,17 +659,13 @@ bool ProblemBuilder::RedundancyNumbersBySchur(
 }
 
 bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
-  auto eliminable = [&](BlockId id) {
-    return blocks_[id].kind == BlockKind::kGroundPoint ||
-           blocks_[id].kind == BlockKind::kTiePoint2d;
-  };
   ReducedSystem& r = *out;
   r.free_blocks = FreeBlocksInOrder();
   // Tangent columns: eliminable blocks -> point index space, the others -> reduced space.
   std::vector<int> column_space, column_index, column_block;
   for (BlockId id : r.free_blocks) {
     const int t = blocks_[id].TangentSize();
-    const bool elim = eliminable(id);
+    const bool elim = blocks_[id].Eliminable();
     r.offset[id] = elim ? r.n_p : r.n_r;
     for (int k = 0; k < t; ++k) {
       column_space.push_back(elim ? 0 : 1);
@@ -672,8 +673,7 @@ bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
       column_block.push_back(id);
     }
     if (!elim)
-      for (int e : blocks_[id].FreeEntries())
-        r.reduced_names.push_back(blocks_[id].name + "." + blocks_[id].entry_names[e]);
+      for (int e : blocks_[id].FreeEntries()) r.reduced_names.push_back(blocks_[id].EntryName(e));
     (elim ? r.n_p : r.n_r) += t;
   }
   if (r.n_p == 0 || r.n_r == 0) return false;
@@ -705,7 +705,7 @@ bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
   const Sparse npp = Sparse(jp.transpose()) * jp;
   std::vector<Eigen::Triplet<double>> ti;
   for (BlockId id : r.free_blocks) {
-    if (!eliminable(id)) continue;
+    if (!blocks_[id].Eliminable()) continue;
     const int o = r.offset[id], t = blocks_[id].TangentSize();
     Eigen::MatrixXd block = Eigen::MatrixXd(npp.block(o, o, t, t));
     Eigen::LDLT<Eigen::MatrixXd> ldlt(block);
@@ -728,12 +728,8 @@ bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
 bool ProblemBuilder::SchurCovariance(
     const std::vector<std::pair<BlockId, BlockId>>& pairs,
     std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const {
-  auto eliminable = [&](BlockId id) {
-    return blocks_[id].kind == BlockKind::kGroundPoint ||
-           blocks_[id].kind == BlockKind::kTiePoint2d;
-  };
   for (const auto& [a, b] : pairs)
-    if (eliminable(a) || eliminable(b)) return false;
+    if (blocks_[a].Eliminable() || blocks_[b].Eliminable()) return false;
   ReducedSystem reduced;
   if (!ReduceNormalEquations(&reduced) || !reduced.singular_points.empty()) return false;
   using Sparse = Eigen::SparseMatrix<double>;

@@ -14,6 +14,8 @@ namespace {
 
 using calib::MappingModel;
 
+constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();  // a sigma not computed
+
 bool IsBase(const StitchOptions& options, const std::string& id) {
   return std::find(options.base_ids.begin(), options.base_ids.end(), id) != options.base_ids.end();
 }
@@ -77,16 +79,29 @@ void StitchOptions::Validate(const calib::Camera& camera) const {
 std::string FindUnderdetermined(const calib::Camera& camera, const FrameMeasurements& frame,
                                 MappingModel model, const StitchOptions& options,
                                 const std::set<ObservationKey>& excluded) {
-  std::vector<int> points(camera.subimages.size(), 0);
+  // One pass over the measurements: points per sub-image (equations), and what anchors each
+  // sub-image to the datum (base, reference point) or ties it to its neighbours.
+  const size_t n = camera.subimages.size();
+  std::vector<int> points(n, 0);
+  std::vector<bool> reached(n, false);  // becomes: connected to the datum
+  std::vector<std::set<int>> neighbours(n);
+  for (size_t k = 0; k < n; ++k) reached[k] = IsBase(options, camera.subimages[k].id);
   for (const auto& ref : frame.references)
-    if (!excluded.count({ref.point, camera.subimages[ref.subimage].id})) ++points[ref.subimage];
+    if (!excluded.count({ref.point, camera.subimages[ref.subimage].id})) {
+      ++points[ref.subimage];
+      reached[ref.subimage] = true;
+    }
   for (const auto& tie : frame.ties) {
     const auto rays = ActiveRays(camera, tie, excluded);
     if (rays.size() < 2) continue;
-    for (const TieRay& ray : rays) ++points[ray.subimage];
+    for (const TieRay& ray : rays) {
+      ++points[ray.subimage];
+      for (const TieRay& other : rays)
+        if (other.subimage != ray.subimage) neighbours[ray.subimage].insert(other.subimage);
+    }
   }
   const int needed = calib::MappingParamCount(model);
-  for (size_t k = 0; k < camera.subimages.size(); ++k) {
+  for (size_t k = 0; k < n; ++k) {
     const auto& s = camera.subimages[k];
     if (IsBase(options, s.id) || 2 * points[k] >= needed) continue;
     return "frame " + frame.frame + ", sub-image " + s.id + ": " + std::to_string(points[k]) +
@@ -94,25 +109,11 @@ std::string FindUnderdetermined(const calib::Camera& camera, const FrameMeasurem
            std::to_string(needed) + " " + std::string(calib::MappingModelName(model)) +
            " parameters";
   }
-  // Enough equations are not enough: a free sub-image must reach the datum (a base sub-image or
-  // a reference point) through tie points, else its mapping floats (a rank defect of the normal
-  // equations that the count above cannot see).
-  const size_t n = camera.subimages.size();
-  std::vector<bool> anchored(n, false);
-  for (size_t k = 0; k < n; ++k) anchored[k] = IsBase(options, camera.subimages[k].id);
-  for (const auto& ref : frame.references)
-    if (!excluded.count({ref.point, camera.subimages[ref.subimage].id})) anchored[ref.subimage] = true;
-  std::vector<std::set<int>> neighbours(n);
-  for (const auto& tie : frame.ties) {
-    const auto rays = ActiveRays(camera, tie, excluded);
-    for (size_t a = 0; a < rays.size(); ++a)
-      for (size_t b = 0; b < rays.size(); ++b)
-        if (rays[a].subimage != rays[b].subimage) neighbours[rays[a].subimage].insert(rays[b].subimage);
-  }
-  std::vector<bool> reached = anchored;
+  // Enough equations are not enough: a free sub-image must reach the datum through tie points,
+  // else its mapping floats (a rank defect of the normal equations the count cannot see).
   std::vector<int> queue;
   for (size_t k = 0; k < n; ++k)
-    if (anchored[k]) queue.push_back(static_cast<int>(k));
+    if (reached[k]) queue.push_back(static_cast<int>(k));
   while (!queue.empty()) {
     const int k = queue.back();
     queue.pop_back();
@@ -292,16 +293,14 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
     }
     if (!base[k] && !covariance.ok) {
       // No precision could be computed: say so (null in JSON), never report zero sigmas.
-      constexpr double kUnknown = std::numeric_limits<double>::quiet_NaN();
       std::fill(e.sigma.begin(), e.sigma.end(), kUnknown);
       for (CornerPrecision& corner : e.corners) corner.sigma_U_px = corner.sigma_V_px = kUnknown;
       e.max_corner_sigma_px = kUnknown;
-      out.max_corner_sigma_px = kUnknown;
     }
-    if (!std::isnan(out.max_corner_sigma_px))
-      out.max_corner_sigma_px = std::max(out.max_corner_sigma_px, e.max_corner_sigma_px);
+    out.max_corner_sigma_px = std::max(out.max_corner_sigma_px, e.max_corner_sigma_px);
     out.subimages.push_back(std::move(e));
   }
+  if (!covariance.ok) out.max_corner_sigma_px = kUnknown;
   return out;
 }
 

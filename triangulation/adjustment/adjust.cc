@@ -35,6 +35,7 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
     if (v.used)
       for (int k = 0; k < 2; ++k) abs_w.push_back(std::abs(v.residual_px(k)) / v.sigma_px);
   std::vector<RejectedObservation> pre_rejected;
+  std::vector<ObservationResidual> pre_rejected_residuals;  // listed with their robust residual
   Project next = project;
   if (!abs_w.empty()) {
     std::nth_element(abs_w.begin(), abs_w.begin() + abs_w.size() / 2, abs_w.end());
@@ -54,6 +55,8 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
                                   Eigen::Vector2d(v.residual_px.x(), -v.residual_px.y()),
                                   w,
                                   std::string()});
+          pre_rejected_residuals.push_back(v);
+          pre_rejected_residuals.back().used = false;
           break;
         }
       }
@@ -76,15 +79,8 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   AdjustmentResult result = adjustment.Run(progress);
   for (auto& c : result.cameras) c.initial = project.cameras.at(c.id).interior;
   result.rejected.insert(result.rejected.begin(), pre_rejected.begin(), pre_rejected.end());
-  // Observations the robust start rejected: listed with their robust residual, not used.
-  for (const auto& r : pre_rejected)
-    for (const auto& v : start.residuals)
-      if (v.image == r.image && v.point == r.point && v.measured_px == r.measured_px) {
-        ObservationResidual out = v;
-        out.used = false;
-        result.residuals.push_back(out);
-        break;
-      }
+  result.residuals.insert(
+      result.residuals.end(), pre_rejected_residuals.begin(), pre_rejected_residuals.end());
   result.notes.push_back("started from a robust (Cauchy, " +
                          FormatNumber(options.robust_scale_sigma, 3) + " sigma) adjustment");
   return result;

@@ -293,18 +293,17 @@ nlohmann::json ComparisonToJson(const AdjustmentResult& a, const AdjustmentResul
       b.check.spatial_rmse_m > 0 ? a.check.spatial_rmse_m / b.check.spatial_rmse_m : 0.0;
   nlohmann::json table = nlohmann::json::array();
   for (const auto& c : b.cameras)
-    for (int k = 0; k < Model::kNumParams; ++k)
-      table.push_back(
-          {{"camera", c.id},
-           {"parameter", std::string(Model::kParams[k].name)},
-           {"unit", std::string(Model::kParams[k].unit)},
-           {"initial", c.initial[k]},
-           {"correction", c.estimated[k] - c.initial[k]},
-           {"estimate", c.estimated[k]},
-           {"sigma", c.free[k] ? nlohmann::json(c.sigma[k]) : nlohmann::json()},
-           {"t",
-            std::isnan(CorrectionInSigmas(c, k)) ? nlohmann::json()
-                                                 : nlohmann::json(CorrectionInSigmas(c, k))}});
+    for (int k = 0; k < Model::kNumParams; ++k) {
+      const double t = CorrectionInSigmas(c, k);
+      table.push_back({{"camera", c.id},
+                       {"parameter", std::string(Model::kParams[k].name)},
+                       {"unit", std::string(Model::kParams[k].unit)},
+                       {"initial", c.initial[k]},
+                       {"correction", c.estimated[k] - c.initial[k]},
+                       {"estimate", c.estimated[k]},
+                       {"sigma", c.free[k] ? nlohmann::json(c.sigma[k]) : nlohmann::json()},
+                       {"t", std::isnan(t) ? nlohmann::json() : nlohmann::json(t)}});
+    }
   j["calibration"] = table;
   return j;
 }

@@ -259,6 +259,7 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
   const calib::CovarianceReport covariance =
       builder.EstimateCovariance(blocks, sigma0, options.adjust.correlation_threshold);
   result.mapping_covariance_ok = covariance.ok;
+  std::map<BlockId, calib::SubimageMapping> refined;  // per mapping block, plain form
   for (const auto& m : mappings) {
     MappingEstimate estimate;
     estimate.camera = m.camera;
@@ -275,16 +276,16 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
       const Eigen::MatrixXd c = j * covariance.BlockCovariance(m.block, n) * j.transpose();
       for (int i = 0; i < n; ++i) estimate.sigma[i] = std::sqrt(std::max(0.0, c(i, i)));
     }
+    refined[m.block].model = m.model;
+    refined[m.block].params = estimate.params;
     result.mappings.push_back(estimate);
   }
-  // Residuals of raw sub-image observations, placed in the virtual image by the refined mapping.
+  // Residuals of raw sub-image observations, placed in the virtual image by the refined mapping
+  // (every such observation created its mapping block above).
   for (auto& v : result.adjustment.residuals) {
     if (v.subimage.empty()) continue;
     const MappingBlock& m = mapping_for(project.FindExposure(v.image)->camera, v.subimage, v.image);
-    calib::SubimageMapping refined;
-    refined.model = m.model;
-    refined.params = calib::PlainFromConditioned(m.model, m.conditioning, m.values);
-    v.measured_px = refined.VirtualFromSub(v.subimage_px);
+    v.measured_px = refined.at(m.block).VirtualFromSub(v.subimage_px);
   }
   for (const auto& h : covariance.high_correlations) {
     const bool a_mapping = h.a.rfind("mapping ", 0) == 0, b_mapping = h.b.rfind("mapping ", 0) == 0;
