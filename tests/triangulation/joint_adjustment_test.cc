@@ -45,6 +45,14 @@ AdjustOptions SelfCalibration() {
   return o;
 }
 
+// Joint adjustment with all 10 interior parameters free and the centre CCDs III and IV as datum.
+JointOptions SelfCalibratingJoint() {
+  JointOptions o;
+  o.adjust = SelfCalibration();
+  o.base_ids = {"III", "IV"};
+  return o;
+}
+
 // |estimate - truth| / sigma of every free mapping parameter (plain form).
 std::vector<double> MappingErrors(const JointResult& r, const calib::Camera& truth) {
   std::vector<double> z;
@@ -69,9 +77,7 @@ void ExpectWithinThreeSigma(const std::vector<double>& z) {
 
 TEST(JointAdjustment, RecoversMappingsAndInteriorAndIsNoWorseThanTwoSteps) {
   auto f = MakeFlight(11, 150);
-  JointOptions options;
-  options.adjust = SelfCalibration();
-  options.base_ids = {"III", "IV"};
+  JointOptions options = SelfCalibratingJoint();
   const JointResult joint = AdjustJoint(f->project, options);
   ASSERT_TRUE(joint.adjustment.converged());
   ASSERT_TRUE(joint.mapping_covariance_ok);
@@ -128,9 +134,7 @@ TEST(JointAdjustment, RecoversMappingsHalfAPixelOffWhereTwoStepsCannot) {
   sub.params = calib::ParamsFromHomography(sub.model, h);
   f->project.cameras["cam1"] = camera;
 
-  JointOptions options;
-  options.adjust = SelfCalibration();
-  options.base_ids = {"III", "IV"};
+  JointOptions options = SelfCalibratingJoint();
   options.use_stitching = false;
   const JointResult joint = AdjustJoint(f->project, options);
   ASSERT_TRUE(joint.adjustment.converged());
@@ -152,9 +156,7 @@ TEST(JointAdjustment, PerExposureMappingsAreEstimatedForEveryExposure) {
   // exposure and non-base sub-image, each within 3 sigma of the (flight-constant) truth, with
   // larger sigmas than one mapping for the whole flight, and the same fit.
   auto f = MakeFlight(14, 60);
-  JointOptions options;
-  options.adjust = SelfCalibration();
-  options.base_ids = {"III", "IV"};
+  JointOptions options = SelfCalibratingJoint();
   const JointResult per_flight = AdjustJoint(f->project, options);
   options.scope = MappingScope::kPerExposure;
   const JointResult per_exposure = AdjustJoint(f->project, options);
