@@ -15,44 +15,25 @@
 // Run: build with -DAEROCAL_BUILD_BENCHMARKS=ON, then build/tests/bench/bench_normal_equations
 // (--benchmark_filter=/150 etc. for one size).
 #include "calib/problem/problem_builder.h"
+#include "tests/bench/bench_blocks.h"
+#include "tests/support/simulated_block.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 #include <benchmark/benchmark.h>
 
-#include <chrono>
 #include <cmath>
-#include <sys/resource.h>
 
 namespace aerocal::triangulation {
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-double Seconds(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-double PeakRssMb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;
-}
+using bench::Clock;
+using bench::PeakRssMb;
+using bench::Seconds;
 
 void BM_Statistics(benchmark::State& state) {
   const int exposures = static_cast<int>(state.range(0));
-  FlightSimulationOptions o;
-  o.exposures = exposures;
-  o.strips = std::max(3, static_cast<int>(std::lround(std::sqrt(exposures / 4.0))));
-  o.tie_points = 16 * exposures;
-  o.ground_points = std::max(329, 2 * exposures);
-  o.control_points = std::max(5, exposures / 20);
-  const SimulatedFlight f = SimulateFlight(o);
-  Project project;
-  project.cameras["cam1"] = f.nominal;
-  project.exposures = f.exposures_file;
-  project.observations = f.observations;
-  project.points = f.points_file;
+  const Project project = testing::ProjectFromFlight(bench::SimulateBlock(exposures));
   AdjustOptions options;
   options.free_interior = ParseSelfCalibration("all");
   options.data_snooping = false;

@@ -12,6 +12,8 @@
 // BM_AdjustDefaults: `aerocal adjust` with its default options (snooping on) at 150 / 600 / 2400
 // exposures against COLMAP, with the snooping share and the peak RSS (see there).
 // Run: build with -DAEROCAL_BUILD_BENCHMARKS=ON, then build/tests/bench/bench_triangulation.
+#include "tests/bench/bench_blocks.h"
+#include "tests/support/simulated_block.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/forward_intersection.h"
@@ -36,18 +38,12 @@
 namespace aerocal::triangulation {
 namespace {
 
-using Clock = std::chrono::steady_clock;
+using bench::Clock;
+using bench::PeakRssMb;
+using bench::Seconds;
+using bench::SimulateBlock;
+using testing::ProjectFromFlight;
 using Model = calib::BrownFraser10Model;
-
-double Seconds(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-double PeakRssMb() {
-  rusage usage{};
-  getrusage(RUSAGE_SELF, &usage);
-  return usage.ru_maxrss / 1024.0;
-}
 
 // Starting coordinates of every point seen twice (the same start aerocal computes).
 std::map<std::string, Eigen::Vector3d> StartPoints(const Project& p) {
@@ -189,31 +185,10 @@ void Compare(benchmark::State& state,
   }
 }
 
-// The simulated block of `exposures` exposures: about 4 exposures per strip and strip length, 16
-// tie points per exposure, 2 surveyed points per exposure, one in 20 of them control.
-SimulatedFlight SimulateBlock(int exposures) {
-  FlightSimulationOptions o;
-  o.exposures = exposures;
-  o.strips = std::max(3, static_cast<int>(std::lround(std::sqrt(exposures / 4.0))));
-  o.tie_points = 16 * exposures;
-  o.ground_points = std::max(329, 2 * exposures);
-  o.control_points = std::max(5, exposures / 20);
-  return SimulateFlight(o);
-}
-
-Project ProjectOf(const SimulatedFlight& f) {
-  Project project;
-  project.cameras["cam1"] = f.nominal;
-  project.exposures = f.exposures_file;
-  project.observations = f.observations;
-  project.points = f.points_file;
-  return project;
-}
-
 void BM_SimulatedBlock(benchmark::State& state) {
   const int exposures = static_cast<int>(state.range(0));
   const SimulatedFlight f = SimulateBlock(exposures);
-  const Project project = ProjectOf(f);
+  const Project project = ProjectFromFlight(f);
   AdjustOptions options;
   options.free_interior = ParseSelfCalibration("all");
   options.data_snooping = false;  // neither solver tests for gross errors here
@@ -237,7 +212,7 @@ BENCHMARK(BM_SimulatedBlock)
 //   colmap_s, ratio_aerocal_over_colmap (adjust_s / colmap_s), adjust_exit_code
 void BM_AdjustDefaults(benchmark::State& state) {
   const int exposures = static_cast<int>(state.range(0));
-  const Project project = ProjectOf(SimulateBlock(exposures));
+  const Project project = ProjectFromFlight(SimulateBlock(exposures));
   CliRun with, without;
   for (auto _ : state) {
     with = RunAerocalAdjust(project, {});
