@@ -148,6 +148,10 @@ void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
 bool ProblemBuilder::IsBlockFixed(BlockId id) const { return blocks_.at(id).constant; }
 int ProblemBuilder::BlockSize(BlockId id) const { return blocks_.at(id).size; }
 const std::string& ProblemBuilder::BlockName(BlockId id) const { return blocks_.at(id).name; }
+BlockKind ProblemBuilder::BlockKindOf(BlockId id) const { return blocks_.at(id).kind; }
+const std::vector<BlockId>& ProblemBuilder::ResidualBlocks(ResidualId id) const {
+  return residuals_.at(id).blocks;
+}
 double* ProblemBuilder::BlockValues(BlockId id) const { return blocks_.at(id).values; }
 
 ResidualId ProblemBuilder::AddResidual(const std::string& group,
@@ -190,6 +194,8 @@ void ProblemBuilder::RemoveResidual(ResidualId id) {
 }
 
 bool ProblemBuilder::IsActive(ResidualId id) const { return residuals_.at(id).active; }
+
+int ProblemBuilder::NumResiduals() const { return static_cast<int>(residuals_.size()); }
 
 int ProblemBuilder::NumActiveResiduals() const {
   return static_cast<int>(std::count_if(
@@ -564,7 +570,8 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
 bool ProblemBuilder::RedundancyNumbersBySchur(
     const std::vector<ResidualId>& ids,
     int max_dense,
-    std::map<ResidualId, std::vector<double>>* out) const {
+    std::map<ResidualId, std::vector<double>>* out,
+    std::vector<ResidualCluster>* clusters) const {
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   std::vector<int> column_block;  // index into free_blocks of every tangent column
   std::vector<int> local_column;  // column within the point block, or within C
@@ -642,18 +649,44 @@ bool ProblemBuilder::RedundancyNumbersBySchur(
   }
   const Eigen::MatrixXd s_inverse = n_other > 0 ? pseudo_inverse(s) : Eigen::MatrixXd();
   std::set<ResidualId> wanted(ids.begin(), ids.end());
+  struct ClusterRows {
+    std::vector<ResidualId> residuals;
+    std::vector<Eigen::VectorXd> a, t, d;
+  };
+  std::map<int, ClusterRows> cluster_rows;
   for (int r = 0; r < crs.num_rows; ++r) {
     if (!wanted.count(owner[r])) continue;
     const Row& row = rows[r];
     double h = 0.0;
     Eigen::VectorXd d = -row.f;
+    Eigen::VectorXd t;
     if (row.point >= 0) {
-      const Eigen::VectorXd t = a_inverse[row.point] * row.a;  // A_e symmetric: (a A_e^-1)^T
+      t = a_inverse[row.point] * row.a;  // A_e symmetric: (a A_e^-1)^T
       h += t.dot(row.a);
       d.noalias() += b_blocks[row.point].transpose() * t;
     }
     if (n_other > 0) h += d.dot(s_inverse * d);
     (*out)[owner[r]].push_back(std::max(0.0, 1.0 - h));
+    if (clusters && row.point >= 0) {
+      ClusterRows& c = cluster_rows[row.point];
+      if (c.residuals.empty() || c.residuals.back() != owner[r]) c.residuals.push_back(owner[r]);
+      c.a.push_back(row.a);
+      c.t.push_back(t);
+      c.d.push_back(d);
+    }
+  }
+  for (const auto& [point, c] : cluster_rows) {
+    ResidualCluster cluster;
+    cluster.point = free_blocks[point];
+    cluster.residuals = c.residuals;
+    const int m = static_cast<int>(c.a.size());
+    cluster.qvv = Eigen::MatrixXd::Identity(m, m);
+    for (int i = 0; i < m; ++i) {
+      const Eigen::VectorXd sd = n_other > 0 ? Eigen::VectorXd(s_inverse * c.d[i]) : Eigen::VectorXd();
+      for (int k = 0; k < m; ++k)
+        cluster.qvv(i, k) -= c.t[i].dot(c.a[k]) + (n_other > 0 ? sd.dot(c.d[k]) : 0.0);
+    }
+    clusters->push_back(std::move(cluster));
   }
   return true;
 }
@@ -797,57 +830,21 @@ std::map<ResidualId, std::vector<double>> ProblemBuilder::RedundancyNumbers(
   return out;
 }
 
-SolveReport ProblemBuilder::SolveWithDataSnooping(const SolverOptions& options,
-                                                  const SnoopingOptions& snooping,
-                                                  std::vector<RejectedResidual>* rejected) {
-  SolveReport report = Solve(options);
-  for (int round = 0; round < snooping.max_rejections && report.usable && report.redundancy > 0;
-       ++round) {
-    std::vector<ResidualId> tested;
-    int n_components = 0;
-    for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
-      if (!residuals_[i].active) continue;
-      if (!snooping.groups.empty() &&
-          std::find(snooping.groups.begin(), snooping.groups.end(), residuals_[i].group) ==
-              snooping.groups.end())
-        continue;
-      tested.push_back(i);
-      n_components += residuals_[i].size;
-    }
-    if (tested.empty()) break;
-    const double critical =
-        snooping.critical_value > 0
-            ? snooping.critical_value
-            : std::max(3.29, NormalCriticalValue(0.05 / std::max(1, n_components)));
-    const auto redundancy = RedundancyNumbers(tested, snooping.max_dense_parameters);
-    // Pope's tau test with the a-posteriori sigma0 when the data are worse than their a-priori
-    // sigmas, Baarda's w test (sigma 1) when they are better: near-noise-free data must not turn
-    // round-off into "gross errors".
-    const double reference_sigma = std::max(report.sigma0, 1.0);
-    ResidualId worst = -1;
-    double worst_w = critical;
-    std::vector<double> worst_v;
-    for (ResidualId id : tested) {
-      const std::vector<double> v = EvaluateResidual(id);
-      const std::vector<double>& r = redundancy.at(id);
-      for (size_t k = 0; k < v.size(); ++k) {
-        if (r[k] < 1e-6) continue;  // uncontrolled observation: cannot be tested
-        const double w = std::abs(v[k]) / (reference_sigma * std::sqrt(r[k]));
-        if (w > worst_w) {
-          worst_w = w;
-          worst = id;
-          worst_v = v;
-        }
-      }
-    }
-    if (worst < 0) break;
-    if (rejected)
-      rejected->push_back(
-          {worst, residuals_[worst].group, residuals_[worst].label, worst_w, worst_v});
-    RemoveResidual(worst);
-    report = Solve(options);
+// Interim (until the sparse selected inversion lands): the Schur path of the redundancy numbers,
+// which also gives Q_vv among the rows of one point cluster.
+ObservationCofactors ProblemBuilder::ComputeObservationCofactors(const std::vector<ResidualId>& ids,
+                                                                 bool with_clusters) const {
+  ObservationCofactors out;
+  const int n_free = NumFreeParameters();
+  const int n_obs = NumObservations();
+  if (n_obs > n_free &&
+      RedundancyNumbersBySchur(ids, 1 << 30, &out.redundancy, with_clusters ? &out.clusters : nullptr)) {
+    out.method = "schur_dense_reduced";
+    return out;
   }
-  return report;
+  out.redundancy = RedundancyNumbers(ids, 4000);
+  out.method = n_free > 4000 ? "mean_r_over_n" : "dense_normal_matrix";
+  return out;
 }
 
 }  // namespace aerocal::calib

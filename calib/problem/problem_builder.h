@@ -21,10 +21,7 @@
 //   deviations, correlations, the pairs above a threshold, and, for a rank-deficient problem, the
 //   parameters that span the null space (from an eigen-decomposition of the Jacobi-scaled normal
 //   matrix when the problem is small enough).
-// - SolveWithDataSnooping(): Baarda/Pope data snooping: standardized residuals
-//   w_i = v_i / (max(sigma0, 1) sqrt(r_ii)) (Pope above, Baarda below the a-priori level) with
-//   redundancy numbers r_ii from the normal matrix; the worst
-//   observation above the critical value is removed and listed, and the problem solved again.
+// - Data snooping lives beside it, in data_snooping.h (it only uses this class's public API).
 //
 // How to add a residual family
 // 1. Write a small templated functor (see calib/residuals/*.h): constructor takes the measurement
@@ -136,19 +133,19 @@ struct CovarianceReport {
   Eigen::VectorXd BlockSigma(BlockId id, int size) const;
 };
 
-struct SnoopingOptions {
-  std::vector<std::string> groups;  // groups whose observations are tested; empty = all
-  double critical_value = 0.0;      // of |w|; 0: from alpha = 5 % / n_tested (min 3.29)
-  int max_rejections = 200;
-  /// Above this many free parameters redundancy numbers are approximated by r / n.
-  int max_dense_parameters = 4000;
+/// Whitened Q_vv among the stacked components of the requested residuals observing one point
+/// block (ground or tie point).
+struct ResidualCluster {
+  BlockId point = -1;
+  std::vector<ResidualId> residuals;
+  Eigen::MatrixXd qvv;
 };
-
-struct RejectedResidual {
-  ResidualId id = -1;
-  std::string group, label;
-  double w = 0.0;                         // standardized residual that triggered the rejection
-  std::vector<double> whitened_residual;  // v / sigma at rejection time
+/// Cofactors of the residuals: redundancy numbers r_i = (Q_vv P)_ii per scalar component and,
+/// on request, Q_vv within each point cluster; `method` says how they were computed.
+struct ObservationCofactors {
+  std::string method;
+  std::map<ResidualId, std::vector<double>> redundancy;
+  std::vector<ResidualCluster> clusters;
 };
 
 class ProblemBuilder {
@@ -185,17 +182,18 @@ class ProblemBuilder {
   void RemoveResidual(ResidualId id);
   bool IsActive(ResidualId id) const;
   int NumActiveResiduals() const;
+  /// Residuals ever added (ids 0 .. NumResiduals() - 1, removed ones included).
+  int NumResiduals() const;
   const std::string& ResidualGroup(ResidualId id) const;
   const std::string& ResidualLabel(ResidualId id) const;
   /// Current whitened residual values (loss not applied).
   std::vector<double> EvaluateResidual(ResidualId id) const;
 
+  /// Blocks a residual was added on, in order; the kind of a block.
+  const std::vector<BlockId>& ResidualBlocks(ResidualId id) const;
+  BlockKind BlockKindOf(BlockId id) const;
+
   SolveReport Solve(const SolverOptions& options);
-  /// Solves, then repeatedly removes the worst standardized residual above the critical value and
-  /// solves again. The final report is of the clean adjustment; rejections are appended in order.
-  SolveReport SolveWithDataSnooping(const SolverOptions& options,
-                                    const SnoopingOptions& snooping,
-                                    std::vector<RejectedResidual>* rejected);
 
   /// Covariance of `blocks` at the current values, scaled by sigma0^2; correlations above
   /// `correlation_threshold` are listed.
@@ -213,6 +211,9 @@ class ProblemBuilder {
   /// up to max_dense_parameters free parameters; r/n otherwise.
   std::map<ResidualId, std::vector<double>> RedundancyNumbers(const std::vector<ResidualId>& ids,
                                                               int max_dense_parameters) const;
+  /// Redundancy numbers of `ids` and, with `with_clusters`, Q_vv within each point cluster.
+  ObservationCofactors ComputeObservationCofactors(const std::vector<ResidualId>& ids,
+                                                   bool with_clusters) const;
 
   /// Free parameters (tangent space) and scalar residuals currently in the problem.
   int NumFreeParameters() const;
@@ -237,7 +238,8 @@ class ProblemBuilder {
   bool ReduceNormalEquations(ReducedSystem* out) const;
   bool RedundancyNumbersBySchur(const std::vector<ResidualId>& ids,
                                 int max_dense,
-                                std::map<ResidualId, std::vector<double>>* out) const;
+                                std::map<ResidualId, std::vector<double>>* out,
+                                std::vector<ResidualCluster>* clusters = nullptr) const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,
                                 std::vector<ResidualId>* row_owner) const;
   /// Covariance blocks (ambient, unscaled Q) of `pairs` of non-eliminable blocks by eliminating the

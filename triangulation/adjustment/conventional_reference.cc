@@ -28,6 +28,7 @@ AdjustmentResult AdjustConventionalReference(const Project& project,
   conventional.free_interior.clear();
   conventional.data_snooping = false;
   conventional.robust_start = false;
+  conventional.auto_robust_start = false;  // the self-calibrating run decided the gross errors
   AdjustmentResult result = Adjust(clean, conventional, progress);
   result.rejected = self_calibration.rejected;
   result.notes.push_back(
