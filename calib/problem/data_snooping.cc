@@ -175,51 +175,60 @@ class Snooper {
     return out;
   }
 
-  // The signature of a model error in the first test: the largest w on one point, one image or
-  // the report-only (control) points; or sigma0 far above 1.
-  void DetectModelError(const Test& t) {
+  // The signature of a model error. In the first test: the largest w on the report-only
+  // (control) points, where the survey pins the block and a model error shows most (their rays
+  // are then held). In the final test: sigma0 above the limit, or the candidates left (held,
+  // vetoed, weakly controlled, at the cap) clustering on one point or one image, each correlated
+  // group counted once (one blunder makes its group's w equal, and a rejected blunder is gone).
+  void DetectModelError(const Test& t, bool first) {
     std::vector<const TestedObservation*> top;
     for (const auto& x : t.observations)
-      if (x.w_max > out_.critical_value) top.push_back(&x);
-    std::sort(top.begin(), top.end(), [](auto* a, auto* b) { return a->w_max > b->w_max; });
+      if (std::max(x.w_max, x.w_weak) > out_.critical_value &&
+          x.verdict != SnoopingVerdict::kRejected)
+        top.push_back(&x);
+    const auto w_of = [](const TestedObservation* x) { return std::max(x->w_max, x->w_weak); };
+    std::sort(top.begin(), top.end(), [&](auto* a, auto* b) { return w_of(a) > w_of(b); });
     if (top.size() > static_cast<size_t>(kModelErrorTop)) top.resize(kModelErrorTop);
     const int n = static_cast<int>(top.size());
-    if (out_.report.sigma0 > o_.model_error_sigma0)
-      out_.model_error_evidence.push_back("sigma0 " + Fixed(out_.report.sigma0, 2) + " > " +
-                                          Fixed(o_.model_error_sigma0, 2));
-    if (n >= 2) {
-      std::map<BlockId, int> per_point, per_image;
+    const double limit = o_.model_error_share * n;
+    const std::string of = n == 0 ? std::string()
+                                  : " of the " + std::to_string(n) + " largest w (" +
+                                        Fixed(w_of(top.front()), 1) + " .. " +
+                                        Fixed(w_of(top.back()), 1) + ")";
+    std::vector<std::string> evidence;
+    if (first) {
       int on_report_only = 0;
+      for (const auto* x : top) on_report_only += x->point >= 0 && report_only_points_.count(x->point);
+      if (n >= 2 && on_report_only >= 2 && on_report_only >= limit)
+        evidence.push_back(std::to_string(on_report_only) + of + " on the " +
+                           o_.report_only_groups.front() + " points");
+    } else {
+      if (out_.report.sigma0 > o_.model_error_sigma0)
+        evidence.push_back("sigma0 " + Fixed(out_.report.sigma0, 2) + " > " +
+                           Fixed(o_.model_error_sigma0, 2));
+      std::map<BlockId, std::set<ResidualId>> per_point, per_image;  // groups by first member
       for (const auto* x : top) {
-        if (x->point >= 0) ++per_point[x->point];
+        const ResidualId g = *std::min_element(x->correlated.begin(), x->correlated.end());
+        if (x->point >= 0) per_point[x->point].insert(g);
         const BlockId image = ImageOf(b_, x->id);
-        if (image >= 0) ++per_image[image];
-        if (x->point >= 0 && report_only_points_.count(x->point)) ++on_report_only;
+        if (image >= 0) per_image[image].insert(g);
       }
-      const double limit = o_.model_error_share * n;
-      const std::string of = " of the " + std::to_string(n) + " largest w (" +
-                             Fixed(top.front()->w_max, 1) + " .. " + Fixed(top.back()->w_max, 1) +
-                             ")";
-      for (const auto& [point, k] : per_point)
-        if (k >= 2 && k >= limit)
-          out_.model_error_evidence.push_back(std::to_string(k) + of + " on " +
-                                              b_.BlockName(point));
-      for (const auto& [image, k] : per_image)
-        if (k >= 2 && k >= limit)
-          out_.model_error_evidence.push_back(std::to_string(k) + of + " on " +
-                                              ImageName(b_, image));
-      if (on_report_only >= 2 && on_report_only >= limit)
-        out_.model_error_evidence.push_back(std::to_string(on_report_only) + of +
-                                            " on the " + o_.report_only_groups.front() +
-                                            " points");
+      for (const auto& [point, groups] : per_point)
+        if (groups.size() >= 2 && groups.size() >= limit)
+          evidence.push_back(std::to_string(groups.size()) + " independent" + of + " on " +
+                             b_.BlockName(point));
+      for (const auto& [image, groups] : per_image)
+        if (groups.size() >= 2 && groups.size() >= limit)
+          evidence.push_back(std::to_string(groups.size()) + " independent" + of + " on " +
+                             ImageName(b_, image));
     }
-    out_.model_error_suspected = !out_.model_error_evidence.empty();
-    if (out_.model_error_suspected) {
-      std::string text = "model error suspected, not blunders:";
-      for (size_t i = 0; i < out_.model_error_evidence.size(); ++i)
-        text += (i ? "; " : " ") + out_.model_error_evidence[i];
-      out_.findings.push_back(text);
-    }
+    if (evidence.empty()) return;
+    out_.model_error_suspected = true;
+    out_.model_error_evidence.insert(out_.model_error_evidence.end(), evidence.begin(),
+                                     evidence.end());
+    std::string text = "model error suspected, not blunders:";
+    for (size_t i = 0; i < evidence.size(); ++i) text += (i ? "; " : " ") + evidence[i];
+    out_.findings.push_back(text);
   }
 
   void CollectReportOnlyPoints() {
@@ -239,11 +248,20 @@ class Snooper {
     std::sort(candidates.begin(), candidates.end(), [](auto* a, auto* b) {
       return a->w_max > b->w_max;
     });
-    // The largest of each point (every candidate, decided ones too: the rays of a point whose
-    // survey is suspected stay) and of each image (undecided candidates only).
+    // The largest w of each point, over every tested observation and its weakly controlled
+    // components too (decided ones included: the rays of a point whose survey is suspected, or
+    // whose largest w sits on a weakly controlled component, stay), and of each image
+    // (undecided candidates only).
+    std::map<BlockId, std::pair<double, ResidualId>> point_max;
+    for (const auto& x : t.observations) {
+      if (x.point < 0) continue;
+      const double w = std::max(x.w_max, x.w_weak);
+      auto [it, added] = point_max.try_emplace(x.point, w, x.id);
+      if (!added && w > it->second.first) it->second = {w, x.id};
+    }
     std::map<BlockId, ResidualId> best_of_point, best_of_image;
+    for (const auto& [point, best] : point_max) best_of_point[point] = best.second;
     for (auto* x : candidates) {
-      if (x->point >= 0) best_of_point.try_emplace(x->point, x->id);
       const BlockId image = ImageOf(b_, x->id);
       if (image >= 0 && !decided_.count(x->id)) best_of_image.try_emplace(image, x->id);
     }
@@ -349,7 +367,7 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
   for (int round = 1; out.report.usable && out.report.redundancy > 0; ++round) {
     out.rounds = round;
     Test test = snooper.Run(round);
-    if (round == 1) snooper.DetectModelError(test);
+    if (round == 1) snooper.DetectModelError(test, true);
     if (test.observations.empty()) break;
     const int budget = options.max_rejections - removed_total;
     const int removed = budget > 0 ? snooper.Act(test, round, budget) : 0;
@@ -366,7 +384,8 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
         if (x.verdict == SnoopingVerdict::kAccepted && x.w_max > out.critical_value) {
           if (budget > 0) {  // not the largest of its point / image: a held or vetoed one is
             x.verdict = SnoopingVerdict::kHeld;
-            x.reason = "its point or image holds a larger w that is held or vetoed";
+            x.reason =
+                "its point or image holds a larger w that is held, vetoed or weakly controlled";
             continue;
           }
           x.verdict = SnoopingVerdict::kLeftAboveCritical;
@@ -380,6 +399,7 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
                                " reached: " + std::to_string(out.remaining_above_critical) +
                                " candidate(s) left above the critical value " +
                                Fixed(out.critical_value, 2));
+      snooper.DetectModelError(test, false);
       out.tested = std::move(test.observations);
       break;
     }

@@ -25,10 +25,11 @@
 //   left with < 2 rays, an exposure left under-determined); vetoed candidates are reported.
 // - The cap: after max_rejections removals the run stops, says so and how many candidates were
 //   left above the critical value (SnoopingOutcome::cap_reached).
-// - Model error: when the largest w of the first test cluster on one point, one image or the
-//   report-only (control) points, or sigma0 is above model_error_sigma0, the outcome says "model
-//   error suspected" with the evidence; candidates on report-only points (their rays) are then
-//   held, not rejected (a model error shows most where the survey pins the block).
+// - Model error: when the largest w of the first test sit on the report-only (control) points,
+//   their rays are held, not rejected (a model error shows most where the survey pins the
+//   block); when the final sigma0 is above model_error_sigma0, or the candidates left over
+//   (held, vetoed, weakly controlled, at the cap) cluster on one point or one image (each
+//   correlated group counted once), the outcome says "model error suspected" with the evidence.
 //
 // MDB: the marginal detectable blunder of component k, in sigmas of the observation:
 //   nabla_k = delta0 s / sqrt(r_k), delta0 = k + z(power) (non-centrality for the test's power).
@@ -51,9 +52,9 @@ struct SnoopingOptions {
   double min_redundancy = 0.1;   // r below: weakly controlled, never rejected
   double group_correlation = 0.99;  // |rho| above: the observations cannot be told apart
   int max_rejections = 100;         // removals (group members count one each), > 0
-  double model_error_sigma0 = 1.5;  // sigma0 of the first solve above: model error suspected
+  double model_error_sigma0 = 1.5;  // final sigma0 above: model error suspected
   /// Share of the largest w (at most 10, at least 2) on one point / image / the report-only
-  /// points above which a model error is suspected.
+  /// points from which a model error is suspected.
   double model_error_share = 0.5;
   /// Non-empty reason: removing these residuals (a candidate or its whole group) is refused.
   std::function<std::string(const std::vector<ResidualId>&)> veto;

@@ -49,8 +49,8 @@ struct AdjustOptions {
   double snooping_power = 0.80;         // (0.5, 1)
   double min_redundancy = 0.1;          // [0, 1)
   double group_correlation = 0.99;      // (0, 1]
-  /// sigma0 of the first solve above which a model error is suspected (with the clustering of
-  /// the largest w on one point / image / the control), > 0.
+  /// Final sigma0 above which a model error is suspected (besides the clustering of the largest
+  /// w on one point / image / the control), > 0.
   double model_error_sigma0 = 1.5;
   /// A result whose final sigma0 exceeds this is not valid (exit 3), > 0.
   double max_sigma0 = 3.0;

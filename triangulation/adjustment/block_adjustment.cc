@@ -745,7 +745,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
                       FormatNumber(options_.max_sigma0, 3) + " (max_sigma0)");
   if (options_.estimate_covariance && !cov.ok)
     result.Invalidate("no covariance: " + cov.message);
-  if (!result.determinability.undetermined.empty())
+  else if (!result.determinability.undetermined.empty())
     result.Invalidate("singular: " + std::to_string(result.determinability.undetermined.size()) +
                       " parameter(s) not determinable (" +
                       result.determinability.undetermined.front() + ", ...)");
