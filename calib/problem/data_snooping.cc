@@ -2,6 +2,8 @@
 
 #include "calib/core/error.h"
 
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -46,6 +48,23 @@ std::string ImageName(const ProblemBuilder& b, BlockId block) {
       return name.substr(0, name.size() - s.size());
   }
   return name;
+}
+
+// The two-sided normal value with the tail probability of chi-square(dof) at t (dof 1..3;
+// more: Wilson-Hilferty). Far in the tail (p below 1e-300) sqrt(t), which keeps the order.
+double EquivalentNormal(double t, int dof) {
+  if (dof == 1) return std::sqrt(t);
+  double p = 0.0;
+  if (dof == 2) {
+    p = std::exp(-t / 2);
+  } else if (dof == 3) {
+    p = std::erfc(std::sqrt(t / 2)) + std::sqrt(2 * t / M_PI) * std::exp(-t / 2);
+  } else {
+    const double k = dof, z = (std::cbrt(t / k) - (1 - 2 / (9 * k))) / std::sqrt(2 / (9 * k));
+    p = 0.5 * std::erfc(z / std::sqrt(2.0));
+  }
+  if (!(p > 1e-300)) return std::sqrt(t);
+  return p >= 1.0 ? 0.0 : NormalCriticalValue(p);
 }
 
 std::string Fixed(double value, int digits) {
@@ -127,6 +146,11 @@ class Snooper {
         }
         if (r < o_.min_redundancy) x.w_weak = std::max(x.w_weak, w);
       }
+      // An observation of several correlated components (x, y of an image point) is tested as
+      // a whole: per-component w of another observation can exceed both of the blundered one's,
+      // the joint statistic cannot (its non-centrality is the largest at the blunder).
+      const auto at = t.row_of.find(id);
+      if (x.v.size() > 1 && at != t.row_of.end()) JointTest(t.clusters[at->second.first], at->second.second, s, &x);
       t.index[id] = t.observations.size();
       t.observations.push_back(std::move(x));
     }
@@ -141,6 +165,36 @@ class Snooper {
     out_.seconds_testing +=
         std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return t;
+  }
+
+  // T = v^T Q_ii^+ v / s^2 over the eigen-directions of Q_ii with eigenvalue >= min_redundancy
+  // (chi-square with that many degrees of freedom), as the normal w with the same tail
+  // probability; the weakly controlled directions give w_weak, each its own 1-D test.
+  void JointTest(const ResidualCluster& c, int row, double s, TestedObservation* x) const {
+    const int m = static_cast<int>(x->v.size());
+    const Eigen::MatrixXd q = c.qvv.block(row, row, m, m);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(q);
+    const Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(x->v.data(), m);
+    double t_stat = 0.0, w_weak = 0.0;
+    int dof = 0;
+    for (int k = 0; k < m; ++k) {
+      const double lambda = eig.eigenvalues()(k);
+      if (lambda < kUntestable) continue;
+      const double u = eig.eigenvectors().col(k).dot(v) / s;
+      if (lambda < o_.min_redundancy) {
+        w_weak = std::max(w_weak, std::abs(u) / std::sqrt(lambda));
+        continue;
+      }
+      t_stat += u * u / lambda;
+      ++dof;
+    }
+    x->w_weak = std::max(x->w_weak, w_weak);
+    if (dof == 0) {
+      x->w_max = 0.0;
+      x->component = -1;
+      return;
+    }
+    x->w_max = EquivalentNormal(t_stat, dof);
   }
 
   std::vector<ResidualId> GroupOf(const Test& t, const TestedObservation& x) const {

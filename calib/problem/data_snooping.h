@@ -5,6 +5,10 @@
 // - Solve; for every tested residual component w_k = |v_k| / (s sqrt(r_k)) with the redundancy
 //   number r_k = (Q_vv P)_kk from ProblemBuilder::ComputeObservationCofactors and s = max(sigma0,
 //   1) (Baarda's sigma 1 when the data fit their a-priori sigmas, Pope's sigma0 when worse).
+// - An observation of several components (x, y) is tested jointly: T = v^T Q_ii^+ v / s^2 over
+//   the directions of Q_ii with eigenvalue >= min_redundancy, as the normal w with the same tail
+//   probability (w_max). Per-component w of ANOTHER observation can exceed both components of a
+//   blundered one; the joint statistic's non-centrality is the largest at the blunder.
 // - Candidates: w above the critical value k (from the family-wise alpha: alpha0 = alpha / n over
 //   the n tested components, at least 3.29), on components with r >= min_redundancy.
 // - In one round every candidate that is the largest w of its point (its eliminable block) and
@@ -77,8 +81,11 @@ struct TestedObservation {
   std::vector<double> redundancy;  // r per component
   std::vector<double> w;           // per component; NaN where r < 1e-6 (untestable)
   std::vector<double> mdb_sigma;   // per component, in sigmas; +inf where untestable
-  double w_max = 0.0;              // largest w of the components with r >= min_redundancy
-  int component = -1;              // its component
+  /// The observation's test statistic on the normal scale: for several components (an image
+  /// point's x, y) the joint chi-square test over its controlled directions (Q_ii eigenvalues
+  /// >= min_redundancy) mapped to the normal w of the same tail probability; for one, its w.
+  double w_max = 0.0;
+  int component = -1;              // its largest-w controlled component (for the group)
   double w_weak = 0.0;             // largest w of the weakly controlled components
   std::vector<ResidualId> correlated;  // with itself: observations it cannot be told apart from
   int group_size = 1;
