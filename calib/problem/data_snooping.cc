@@ -109,8 +109,16 @@ class Snooper {
       out_.min_redundancy = o_.min_redundancy;
       out_.group_correlation = o_.group_correlation;
     }
-    ObservationCofactors cof = b_.ComputeObservationCofactors(ids, true);
+    ObservationCofactors cof = b_.ComputeObservationCofactors(ids, true, o_.max_dense_parameters);
     t.method = cof.method;
+    out_.cofactor_method = cof.method;
+    if (!cof.ok) {  // never tested on approximate redundancy numbers
+      out_.cofactors_ok = false;
+      out_.cofactor_message = cof.message;
+      out_.findings.push_back("no test: the redundancy numbers could not be computed (" +
+                              cof.message + ")");
+      return t;
+    }
     t.clusters = std::move(cof.clusters);
     for (size_t c = 0; c < t.clusters.size(); ++c) {
       int row = 0;

@@ -62,6 +62,9 @@ struct SnoopingOptions {
   double model_error_share = 0.5;
   /// Non-empty reason: removing these residuals (a candidate or its whole group) is refused.
   std::function<std::string(const std::vector<ResidualId>&)> veto;
+  /// Passed to ComputeObservationCofactors: a singular reduced matrix larger than this is not
+  /// inverted; then nothing is tested and the outcome says so (cofactors_ok false).
+  int max_dense_parameters = 4000;
 };
 
 enum class SnoopingVerdict {
@@ -101,6 +104,8 @@ struct SnoopingOutcome {
   double min_redundancy = 0.0, group_correlation = 0.0, reference_sigma = 1.0;
   int n_tested_components = 0;
   std::string cofactor_method;
+  bool cofactors_ok = true;  // false: nothing could be tested (cofactor_message says why)
+  std::string cofactor_message;
   int rounds = 0;
   bool cap_reached = false;
   int remaining_above_critical = 0;  // candidates left when the cap was reached

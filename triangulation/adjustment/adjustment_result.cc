@@ -41,6 +41,7 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
                       {"group_correlation", s.group_correlation},
                       {"reference_sigma", s.reference_sigma},
                       {"cofactor_method", s.cofactor_method},
+                      {"cofactors_ok", s.cofactors_ok},
                       {"n_tested_components", s.n_tested_components},
                       {"rounds", s.rounds},
                       {"max_rejections", s.max_rejections},

@@ -94,6 +94,8 @@ struct SnoopingSummary {
   double alpha = 0, alpha0 = 0, critical_value = 0, power = 0, delta0 = 0;
   double min_redundancy = 0, group_correlation = 0, reference_sigma = 1;
   std::string cofactor_method;
+  bool cofactors_ok = true;
+  std::string cofactor_message;
   int n_tested_components = 0, rounds = 0, max_rejections = 0;
   bool cap_reached = false;
   int remaining_above_critical = 0;

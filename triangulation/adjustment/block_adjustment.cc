@@ -461,6 +461,8 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   s.group_correlation = out.group_correlation;
   s.reference_sigma = out.reference_sigma;
   s.cofactor_method = out.cofactor_method;
+  s.cofactors_ok = out.cofactors_ok;
+  s.cofactor_message = out.cofactor_message;
   s.n_tested_components = out.n_tested_components;
   s.rounds = out.rounds;
   s.max_rejections = options_.max_rejections;
@@ -740,6 +742,8 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
                       std::to_string(options_.max_rejections) + " with " +
                       std::to_string(result.snooping.remaining_above_critical) +
                       " candidate(s) left above the critical value");
+  if (options_.data_snooping && result.snooping.run && !result.snooping.cofactors_ok)
+    result.Invalidate("data snooping could not test: " + result.snooping.cofactor_message);
   if (result.sigma0 > options_.max_sigma0)
     result.Invalidate("sigma0 " + FormatNumber(result.sigma0, 3) + " is above the limit " +
                       FormatNumber(options_.max_sigma0, 3) + " (max_sigma0)");
