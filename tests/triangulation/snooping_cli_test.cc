@@ -84,6 +84,27 @@ TEST(SnoopingCommand, RejectionCapIsAWarningAndExitThree) {
       EXPECT_TRUE(o.contains(key)) << key;
 }
 
+TEST(SnoopingCommand, Sigma0AboveTheLimitIsNotValidAndWritesNoCamera) {
+  TempDir dir("aerocal_snoop_sigma0");
+  ASSERT_EQ(RunAerocal("simulate --seed 3 --out " + dir.File("f")).exit_code, 0);
+  // sigma0 is ~1.02 with self-calibration: a limit of 0.5 must fail the run, by name.
+  const auto r = RunAerocal("adjust --project " + dir.File("f/project.yaml") +
+                            " --self-calibration all --max-sigma0 0.5 --min-redundancy 0.2 "
+                            "--write-camera " + dir.File("cam.yaml") + " --out " + dir.File("r.json"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("above the limit 0.5 (max_sigma0)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("camera not written"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("cam.yaml")));
+  const auto j = ReadJson(dir.File("r.json"));
+  EXPECT_FALSE(j["valid"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["snooping"]["min_redundancy"].get<double>(), 0.2);
+  // Bad option values: exit 2, nothing written.
+  const auto bad = RunAerocal("adjust --project " + dir.File("f/project.yaml") +
+                              " --max-rejections 0 --out " + dir.File("bad.json"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("bad.json")));
+}
+
 TEST(SnoopingCommand, FlightOnAnUnsolvableBlockExitsThreeNamesTheStepAndWritesNoCamera) {
   TempDir dir("aerocal_snoop_flight");
   ASSERT_EQ(RunAerocal("simulate --seed 5 --stitch-ties 50 --out " + dir.File("data")).exit_code, 0);
