@@ -70,7 +70,7 @@ def summary(doc):
             warnings.insert(0, (f.get("step", "?"), str(f.get("reason", ""))))
         all_ok = all(c == "" for c in classes) and rd.get(doc, "valid") is not False
         out.append(note("All steps converged and are valid." if all_ok else
-                        '<span class="bad">At least one step failed or is not valid: its figures are not '
+                        '<span class="bad">At least one step did not converge or is not valid: its figures are not '
                         "a valid calibration, and no calibrated camera was written.</span>"))
         if warnings:
             out.append('<ul class="warnings">' + "".join(
