@@ -169,6 +169,11 @@ void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
 bool ProblemBuilder::IsBlockFixed(BlockId id) const { return blocks_.at(id).constant; }
 int ProblemBuilder::BlockSize(BlockId id) const { return blocks_.at(id).size; }
 const std::string& ProblemBuilder::BlockName(BlockId id) const { return blocks_.at(id).name; }
+BlockKind ProblemBuilder::BlockKindOf(BlockId id) const { return blocks_.at(id).kind; }
+const std::vector<BlockId>& ProblemBuilder::ResidualBlocks(ResidualId id) const {
+  return residuals_.at(id).blocks;
+}
+int ProblemBuilder::NumResiduals() const { return static_cast<int>(residuals_.size()); }
 double* ProblemBuilder::BlockValues(BlockId id) const { return blocks_.at(id).values; }
 
 ResidualId ProblemBuilder::AddResidual(const std::string& group,
@@ -820,59 +825,6 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     for (size_t q = 0; q < interior_rows.size(); ++q)
       if (r != q)
         report.interior_correlation(r, q) = report.Correlation(interior_rows[r], interior_rows[q]);
-  }
-  return report;
-}
-
-SolveReport ProblemBuilder::SolveWithDataSnooping(const SolverOptions& options,
-                                                  const SnoopingOptions& snooping,
-                                                  std::vector<RejectedResidual>* rejected) {
-  SolveReport report = Solve(options);
-  for (int round = 0; round < snooping.max_rejections && report.usable && report.redundancy > 0;
-       ++round) {
-    std::vector<ResidualId> tested;
-    int n_components = 0;
-    for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
-      if (!residuals_[i].active) continue;
-      if (!snooping.groups.empty() &&
-          std::find(snooping.groups.begin(), snooping.groups.end(), residuals_[i].group) ==
-              snooping.groups.end())
-        continue;
-      tested.push_back(i);
-      n_components += residuals_[i].size;
-    }
-    if (tested.empty()) break;
-    const double critical =
-        snooping.critical_value > 0
-            ? snooping.critical_value
-            : std::max(3.29, NormalCriticalValue(0.05 / std::max(1, n_components)));
-    const auto redundancy = RedundancyNumbers(tested, snooping.max_dense_parameters);
-    // Pope's tau test with the a-posteriori sigma0 when the data are worse than their a-priori
-    // sigmas, Baarda's w test (sigma 1) when they are better: near-noise-free data must not turn
-    // round-off into "gross errors".
-    const double reference_sigma = std::max(report.sigma0, 1.0);
-    ResidualId worst = -1;
-    double worst_w = critical;
-    std::vector<double> worst_v;
-    for (ResidualId id : tested) {
-      const std::vector<double> v = EvaluateResidual(id);
-      const std::vector<double>& r = redundancy.at(id);
-      for (size_t k = 0; k < v.size(); ++k) {
-        if (r[k] < 1e-6) continue;  // uncontrolled observation: cannot be tested
-        const double w = std::abs(v[k]) / (reference_sigma * std::sqrt(r[k]));
-        if (w > worst_w) {
-          worst_w = w;
-          worst = id;
-          worst_v = v;
-        }
-      }
-    }
-    if (worst < 0) break;
-    if (rejected)
-      rejected->push_back(
-          {worst, residuals_[worst].group, residuals_[worst].label, worst_w, worst_v});
-    RemoveResidual(worst);
-    report = Solve(options);
   }
   return report;
 }

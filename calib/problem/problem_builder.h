@@ -21,10 +21,7 @@
 //   deviations, correlations, the pairs above a threshold, and, for a rank-deficient problem, the
 //   parameters that span the null space (from an eigen-decomposition of the Jacobi-scaled normal
 //   matrix when the problem is small enough).
-// - SolveWithDataSnooping(): Baarda/Pope data snooping: standardized residuals
-//   w_i = v_i / (max(sigma0, 1) sqrt(r_ii)) (Pope above, Baarda below the a-priori level) with
-//   redundancy numbers r_ii from the normal matrix; the worst
-//   observation above the critical value is removed and listed, and the problem solved again.
+// - Data snooping lives beside it, in data_snooping.h (it uses this class's public API only).
 //
 // How to add a residual family
 // 1. Write a small templated functor (see calib/residuals/*.h): constructor takes the measurement
@@ -174,23 +171,6 @@ struct CovarianceReport {
   double Correlation(int i, int k) const;
 };
 
-struct SnoopingOptions {
-  std::vector<std::string> groups;  // groups whose observations are tested; empty = all
-  double critical_value = 0.0;      // of |w|; 0: from alpha = 5 % / n_tested (min 3.29)
-  int max_rejections = 200;
-  /// Redundancy numbers are always exact (ComputeObservationCofactors); a singular reduced normal
-  /// matrix above this many parameters is not inverted densely: its redundancy numbers are
-  /// reported as not computed (NaN) instead.
-  int max_dense_parameters = 4000;
-};
-
-struct RejectedResidual {
-  ResidualId id = -1;
-  std::string group, label;
-  double w = 0.0;                         // standardized residual that triggered the rejection
-  std::vector<double> whitened_residual;  // v / sigma at rejection time
-};
-
 class ProblemBuilder {
  public:
   ProblemBuilder();
@@ -230,12 +210,13 @@ class ProblemBuilder {
   /// Current whitened residual values (loss not applied).
   std::vector<double> EvaluateResidual(ResidualId id) const;
 
+  /// Blocks a residual was added on, in order; the kind of a block.
+  const std::vector<BlockId>& ResidualBlocks(ResidualId id) const;
+  BlockKind BlockKindOf(BlockId id) const;
+  /// Residuals ever added (ids 0 .. NumResiduals() - 1, removed ones included).
+  int NumResiduals() const;
+
   SolveReport Solve(const SolverOptions& options);
-  /// Solves, then repeatedly removes the worst standardized residual above the critical value and
-  /// solves again. The final report is of the clean adjustment; rejections are appended in order.
-  SolveReport SolveWithDataSnooping(const SolverOptions& options,
-                                    const SnoopingOptions& snooping,
-                                    std::vector<RejectedResidual>* rejected);
 
   /// Covariance of `blocks` at the current values, scaled by sigma0^2; correlations above
   /// `correlation_threshold` are listed.

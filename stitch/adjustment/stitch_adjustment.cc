@@ -7,6 +7,7 @@
 #include <set>
 
 #include "calib/core/error.h"
+#include "calib/problem/data_snooping.h"
 #include "calib/residuals/stitching.h"
 
 namespace aerocal::stitch {
@@ -221,13 +222,13 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
     snooping.critical_value = std::max(
         3.29, calib::NormalCriticalValue(options.snooping_alpha /
                                          std::max(1, builder.NumObservations())));
-    std::vector<calib::RejectedResidual> rejected;
-    report = builder.SolveWithDataSnooping(options.solver, snooping, &rejected);
-    for (const auto& r : rejected) {
+    snooping.max_rejections = 200;
+    const calib::SnoopingOutcome snooped = calib::SolveWithDataSnooping(builder, options.solver, snooping);
+    report = snooped.report;
+    for (const auto& r : snooped.rejected) {
       const Observed& o = observed.at(r.id);
-      out.rejected.push_back({o.point, camera.subimages[o.subimage].id, o.reference, r.w,
-                              Eigen::Vector2d(r.whitened_residual[0], r.whitened_residual[1]) *
-                                  o.sigma_px});
+      out.rejected.push_back({o.point, camera.subimages[o.subimage].id, o.reference, r.w_max,
+                              Eigen::Vector2d(r.v[0], r.v[1]) * o.sigma_px});
     }
   } else {
     report = builder.Solve(options.solver);
