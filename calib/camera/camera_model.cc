@@ -10,6 +10,32 @@ std::optional<CameraModelId> CameraModelFromName(std::string_view name) {
   return found;
 }
 
+namespace {
+using ColmapModels = CameraModelList<ColmapSimplePinholeModel, ColmapPinholeModel,
+                                     ColmapSimpleRadialModel, ColmapRadialModel, ColmapOpenCvModel,
+                                     ColmapFullOpenCvModel>;
+}  // namespace
+
+std::optional<CameraModelId> CameraModelFromColmapName(std::string_view colmap_name) {
+  std::optional<CameraModelId> found;
+  internal::ForEachIn(
+      [&](auto model) {
+        if (decltype(model)::kColmapName == colmap_name) found = decltype(model)::kId;
+      },
+      ColmapModels{});
+  return found;
+}
+
+std::string_view ColmapName(CameraModelId id) {
+  std::string_view name;
+  internal::ForEachIn(
+      [&](auto model) {
+        if (decltype(model)::kId == id) name = decltype(model)::kColmapName;
+      },
+      ColmapModels{});
+  return name;
+}
+
 std::string_view CameraModelName(CameraModelId id) {
   return VisitCameraModel(id, [](auto model) { return decltype(model)::kName; });
 }

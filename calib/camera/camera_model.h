@@ -75,6 +75,11 @@ void ForEachCameraModel(Visitor&& visitor) {
   internal::ForEachIn(std::forward<Visitor>(visitor), RegisteredCameraModels{});
 }
 
+/// COLMAP's models (models/colmap.h) by their COLMAP name ("OPENCV", ...); nullopt when the
+/// name is not one of SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV.
+std::optional<CameraModelId> CameraModelFromColmapName(std::string_view colmap_name);
+std::string_view ColmapName(CameraModelId id);  // "" for a model COLMAP does not have
+
 /// The model with this stable name ("brown_fraser_10", "opencv", ...); nullopt when unknown.
 std::optional<CameraModelId> CameraModelFromName(std::string_view name);
 std::string_view CameraModelName(CameraModelId id);
