@@ -119,24 +119,31 @@ TEST(ColmapImportErrors, UnsupportedModelNamesTheLine) {
 }  // namespace
 }  // namespace aerocal::triangulation
 
+#include "calib/camera/convert_camera.h"
 #include "triangulation/import/colmap_export.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 namespace aerocal::triangulation {
 namespace {
 
+// The simulated flight's true block (camera, exposures, observations) and its point truth.
+Project TruthBlock(const SimulatedFlight& f, std::map<std::string, Eigen::Vector3d>* points) {
+  Project p;
+  p.cameras["cam1"] = f.truth;
+  p.exposures = f.exposures_truth;
+  p.observations = f.observations;
+  for (const auto& g : f.points_truth) (*points)[g.id] = *g.xyz_m;
+  return p;
+}
+
 TEST(ColmapExport, RoundTripKeepsOrientationsAndPixels) {
   FlightSimulationOptions o;
   o.ground_points = 30;
   o.tie_points = 50;
   const SimulatedFlight f = SimulateFlight(o);
-  Project p;
-  p.cameras["cam1"] = f.truth;
-  p.cameras["cam1"].interior = f.nominal.interior;  // no distortion: exported exactly
-  p.exposures = f.exposures_truth;
-  p.observations = f.observations;
   std::map<std::string, Eigen::Vector3d> points;
-  for (const auto& g : f.points_truth) points[g.id] = *g.xyz_m;
+  Project p = TruthBlock(f, &points);
+  p.cameras["cam1"].interior = f.nominal.interior;  // no distortion: exported exactly
   testing::TempDir dir("aerocal_colmap_export");
   WriteColmapModel(p, points, dir.path());
   ColmapImportOptions options;
@@ -167,14 +174,6 @@ TEST(ColmapExport, RoundTripKeepsOrientationsAndPixels) {
     EXPECT_LT((ob.pixel - original.at({ob.image, id_of_number.at(ob.point)})).norm(), 1e-9);
 }
 
-}  // namespace
-}  // namespace aerocal::triangulation
-
-#include "calib/camera/convert_camera.h"
-
-namespace aerocal::triangulation {
-namespace {
-
 calib::ModelCamera Registry(const calib::Camera& c) {
   return {calib::CameraModelId::kBrownFraser10, {c.interior.begin(), c.interior.end()}, c.frame()};
 }
@@ -184,12 +183,8 @@ TEST(ColmapExport, DistortionIsFittedIntoOpenCvNotDropped) {
   o.ground_points = 10;
   o.tie_points = 10;
   const SimulatedFlight f = SimulateFlight(o);
-  Project p;
-  p.cameras["cam1"] = f.truth;
-  p.exposures = f.exposures_truth;
-  p.observations = f.observations;
   std::map<std::string, Eigen::Vector3d> points;
-  for (const auto& g : f.points_truth) points[g.id] = *g.xyz_m;
+  const Project p = TruthBlock(f, &points);
   testing::TempDir dir("aerocal_colmap_export_distortion");
   const std::vector<std::string> notes = WriteColmapModel(p, points, dir.path());
   ASSERT_EQ(notes.size(), 1u);
