@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "calib/camera/camera_io.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "stitch/io/stitch_result_json.h"
 #include "stitch/resample/tiff_raster.h"
@@ -41,9 +42,7 @@ int RunResample(const ResampleArgs& args) {
 
   // ID=path pairs; every sub-image needs exactly one image.
   std::vector<std::unique_ptr<stitch::RasterSource>> owned(camera.subimages.size());
-  std::stringstream list(args.images);
-  std::string item;
-  while (std::getline(list, item, ',')) {
+  for (const std::string& item : SplitCommaList(args.images)) {
     const auto eq = item.find('=');
     if (eq == std::string::npos)
       throw ConfigError("--images: expected ID=PATH, got '" + item + "'");
