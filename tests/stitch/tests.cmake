@@ -11,3 +11,4 @@ aerocal_add_test(stitch/stitch_cli LIBS aerocal::stitch LABELS cli)
 # Multi-head rigs: conversion to the virtual image, its error analysis, the rig command.
 aerocal_add_test(stitch/rig_conversion LIBS aerocal::stitch LABELS unit)
 aerocal_add_test(stitch/rig_error_analysis LIBS aerocal::stitch LABELS synthetic)
+aerocal_add_test(stitch/rig_cli LIBS aerocal::stitch LABELS cli)
