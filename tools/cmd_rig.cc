@@ -1,10 +1,12 @@
-// aerocal rig: multi-head rigs (stitch/rig/). `rig error-analysis`: the conversion error analysis
+// aerocal rig: multi-head rigs (stitch/rig/). `rig convert`: the head images of one exposure ->
+// the virtual image (stitch/rig/rig_convert.h). `rig error-analysis`: the conversion error analysis
 // of the virtual image (stitch/rig/error_analysis.h) at one target or over a grid of targets,
 // result.json plus histogram / bound-map CSV files and, through tools/report/rig_error_plots.py
 // (matplotlib), their PNG plots.
 #include <spawn.h>
 #include <sys/wait.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -19,8 +21,11 @@
 #include "calib/core/error.h"
 #include "stitch/rig/error_analysis.h"
 #include "stitch/rig/error_analysis_json.h"
+#include "stitch/resample/tiff_raster.h"
 #include "stitch/rig/rig_conversion.h"
+#include "stitch/rig/rig_convert.h"
 #include "tools/command_registry.h"
+#include "tools/image_sources.h"
 
 extern char** environ;
 
@@ -200,6 +205,70 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   return kExitOk;
 }
 
+struct ConvertArgs {
+  std::string camera, images, opk_deg = "0,0,0", out, interp = "bilinear";
+  double height_m = 0.0;  // 0: the rig file's virtual.height_m
+  double fill = 0.0;
+  double relief_m = 100.0;
+  int strip_rows = 256;
+  bool bigtiff = false;
+};
+
+int RunConvert(const ConvertArgs& args) {
+  const calib::Rig rig = calib::ReadRig(args.camera);
+  const double height_m = args.height_m != 0.0 ? args.height_m
+                          : rig.virtual_camera.height_m ? *rig.virtual_camera.height_m
+                                                        : 0.0;
+  if (!(height_m > 0))
+    throw ConfigError("--height-m: give the relative flying height (> 0 m; the rig file " +
+                      args.camera + " has no virtual.height_m)");
+  stitch::RigExposure exposure;
+  std::stringstream angles(args.opk_deg);
+  std::string item;
+  for (int i = 0; i < 3; ++i) {
+    const auto value = std::getline(angles, item, ',') ? ParseDouble(item) : std::nullopt;
+    if (!value) throw ConfigError("--opk-deg: expected OMEGA,PHI,KAPPA in degrees (got '" + args.opk_deg + "')");
+    exposure.rig_opk_rad[i] = *value * M_PI / 180.0;
+  }
+  stitch::ResampleOptions options;
+  options.interpolation = stitch::ParseInterpolation(args.interp);
+  options.fill = args.fill;
+  options.strip_rows = args.strip_rows;
+  if (options.strip_rows < 1) throw ConfigError("--strip-rows must be > 0");
+  const stitch::RigConverter converter(rig, exposure,
+                                       stitch::MakeRectificationPlane(rig, exposure, height_m));
+  const calib::Camera as_camera = stitch::RigExposureAsSubimageCamera(converter);
+  std::vector<std::string> ids;
+  for (const auto& head : rig.heads) ids.push_back(head.id);
+  const auto owned = OpenImages(args.images, ids, "head", args.camera);
+  std::vector<stitch::RasterSource*> sources;
+  for (const auto& source : owned) sources.push_back(source.get());
+  const stitch::RasterInfo info = sources.front()->Info();
+  if (!(args.fill >= 0 && args.fill <= (info.bits == 8 ? 255.0 : 65535.0)))
+    throw ConfigError("--fill must fit the " + std::to_string(info.bits) + "-bit images");
+  stitch::TiffWriteOptions tiff;
+  tiff.description = stitch::MappingDescription(
+      as_camera, args.camera + " at H = " + FormatNumber(height_m) + " m (plane homographies)");
+  tiff.force_bigtiff = args.bigtiff;
+  stitch::TiffWriter writer(
+      args.out, {as_camera.width_px, as_camera.height_px, info.bands, info.bits}, tiff);
+  const stitch::ResampleReport report =
+      stitch::ResampleVirtualImage(as_camera, sources, &writer, options);
+  writer.Commit();
+  std::printf("virtual image %d x %d px from %zu heads at H = %g m: %ld px covered, %ld in "
+              "overlaps, %ld filled, %.2f s\n",
+              as_camera.width_px, as_camera.height_px, rig.heads.size(), height_m, report.covered,
+              report.overlap, report.filled, report.seconds);
+  // Where the plane is not the terrain: relief displaces points between heads.
+  const int reference = rig.ReferenceIndex();
+  for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k)
+    if (k != reference && args.relief_m < height_m)
+      std::printf("relief of %g m off the plane: %.3f px between heads %s and %s\n", args.relief_m,
+                  stitch::ReliefDisplacementPx(rig, reference, k, height_m, args.relief_m),
+                  rig.reference_head.c_str(), rig.heads[k].id.c_str());
+  return kExitOk;
+}
+
 CommandRun Setup(CLI::App& app) {
   app.require_subcommand(1);
   auto args = std::make_shared<ErrorAnalysisArgs>();
@@ -231,8 +300,27 @@ CommandRun Setup(CLI::App& app) {
   ea->add_option("--out", args->out,
                  "Result JSON; STEM_histogram.csv/.png or STEM_bound_map.csv/.png beside it")
       ->required();
-  return [args, ea] {
+  auto convert = std::make_shared<ConvertArgs>();
+  CLI::App* cv = app.add_subcommand(
+      "convert", "The images of one rig exposure -> the single-centre virtual image (TIFF)");
+  cv->option_defaults()->always_capture_default();
+  cv->add_option("--camera", convert->camera, "Rig camera file (YAML with a rig section)")->required();
+  cv->add_option("--images", convert->images, "Head images: A=a.tif,B=b.tif,...")->required();
+  cv->add_option("--height-m", convert->height_m,
+                 "Relative flying height of the rectification plane, m (default: the rig file's "
+                 "virtual.height_m)");
+  cv->add_option("--opk-deg", convert->opk_deg,
+                 "Rig attitude omega,phi,kappa in degrees (matters for orientation: level)");
+  cv->add_option("--out", convert->out, "Virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
+  cv->add_option("--interp", convert->interp, "bilinear | bicubic");
+  cv->add_option("--fill", convert->fill, "Grey value of pixels no head covers");
+  cv->add_option("--strip-rows", convert->strip_rows, "Rows per processing strip (memory bound)");
+  cv->add_option("--relief-m", convert->relief_m,
+                 "Relief (m off the plane) whose displacement between heads is reported");
+  cv->add_flag("--bigtiff", convert->bigtiff, "Write BigTIFF even when classic TIFF would do");
+  return [args, ea, convert, cv] {
     if (ea->parsed()) return RunErrorAnalysis(*args);
+    if (cv->parsed()) return RunConvert(*convert);
     return kExitInternal;
   };
 }
@@ -240,6 +328,7 @@ CommandRun Setup(CLI::App& app) {
 }  // namespace
 
 AEROCAL_REGISTER_COMMAND(rig, "rig",
-                         "Multi-head rigs: conversion error analysis of the virtual image", Setup);
+                         "Multi-head rigs: conversion to the virtual image and its error analysis",
+                         Setup);
 
 }  // namespace aerocal::tools

@@ -73,6 +73,7 @@ class RigConverter {
   bool InHeadFormat(int head, const Eigen::Vector2d& pixel) const;
 
   const calib::Rig& rig() const { return rig_; }
+  const RectificationPlane& Plane() const { return plane_; }
   /// R_k (head -> object) and O_k of head k for this exposure.
   const Eigen::Matrix3d& ObjectFromHead(int head) const { return object_from_head_[head]; }
   const Eigen::Vector3d& HeadCenter(int head) const { return head_center_[head]; }
