@@ -13,6 +13,7 @@
 #include "calib/core/error.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/rig/rig_convert.h"
+#include "tests/support/cubic_sample.h"
 #include "tests/support/test_support.h"
 
 namespace aerocal::stitch {
@@ -76,24 +77,7 @@ TEST(RigConvert, PlaneHomographyIsTheExactConversion) {
   }
 }
 
-// Keys cubic convolution of the truth at a real position (the test's own, as in
-// virtual_image_test.cc), edge samples repeated.
-double SampleCubic(const MemoryRaster& image, double x, double y) {
-  auto weight = [](double t) {
-    t = std::abs(t);
-    if (t < 1) return 1.5 * t * t * t - 2.5 * t * t + 1;
-    if (t < 2) return -0.5 * t * t * t + 2.5 * t * t - 4 * t + 2;
-    return 0.0;
-  };
-  const int ix = static_cast<int>(std::floor(x)), iy = static_cast<int>(std::floor(y));
-  const RasterInfo info = image.Info();
-  double sum = 0;
-  for (int r = -1; r <= 2; ++r)
-    for (int c = -1; c <= 2; ++c)
-      sum += weight(x - (ix + c)) * weight(y - (iy + r)) *
-             image.At(std::clamp(ix + c, 0, info.width - 1), std::clamp(iy + r, 0, info.height - 1));
-  return sum;
-}
+using testing::SampleCubic;
 
 // The head images of a photograph lying on the rectification plane: the photograph is the
 // virtual image, so head pixel -> virtual pixel (exact conversion) -> the photograph there.
