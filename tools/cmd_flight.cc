@@ -7,6 +7,7 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "tools/command_registry.h"
@@ -19,15 +20,6 @@ std::string ShellQuote(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";
-}
-
-std::vector<std::string> SplitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
 }
 
 CommandRun SetupFlight(CLI::App& app) {
@@ -49,7 +41,7 @@ CommandRun SetupFlight(CLI::App& app) {
   app.add_flag("--no-joint", [args](std::int64_t) { args->options.joint = false; }, "Skip the joint adjustment");
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
   return [args]() {
-    args->options.base_ids = SplitList(args->base);
+    args->options.base_ids = SplitCommaList(args->base);
     Progress progress("flight", 5);
     const auto result = triangulation::RunFlightWorkflow(args->options, &progress);
     progress.Finish();

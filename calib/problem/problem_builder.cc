@@ -474,9 +474,8 @@ std::set<std::string> NullSpaceNames(Eigen::MatrixXd n, const std::vector<std::s
   return out;
 }
 
-// Reduced matrices up to this size are inverted densely (eigen-decomposition): below it a sparse
-// factorisation gains nothing.
-constexpr int kDenseReducedLimit = 300;
+// Up to this many free parameters the covariance is Ceres' (dense SVD).
+constexpr int kCeresCovarianceLimit = 300;
 }  // namespace
 
 std::unique_ptr<internal::SchurComplement> ProblemBuilder::BuildSchurComplement(
@@ -523,7 +522,7 @@ ObservationCofactors ProblemBuilder::ComputeObservationCofactors(
   const auto schur = BuildSchurComplement(false, &free_blocks, &first_row);
   if (!schur) return not_computed("the residuals cannot be evaluated at the current values");
   internal::SelectedInverse inverse;
-  if (!inverse.Compute(schur->s_lower(), kDenseReducedLimit, max_dense_parameters)) {
+  if (!inverse.Compute(schur->s_lower(), dense_inverse_limit_, max_dense_parameters)) {
     std::string why = inverse.message();
     const std::vector<std::string> null_space = NullSpaceParameters(3000);
     for (size_t i = 0; i < null_space.size() && i < 20; ++i)
@@ -722,7 +721,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
   };
   const double s2 = sigma0 * sigma0;
   const int n_free = NumFreeParameters();
-  if (n_free <= kDenseReducedLimit) {
+  if (n_free <= kCeresCovarianceLimit) {
     // Small problems: Ceres' covariance (dense SVD; its rank test is the reference).
     report.method = "ceres_dense_svd";
     ceres::Covariance::Options options;
@@ -748,7 +747,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     const auto schur = BuildSchurComplement(true, &order, &first_row);
     if (!schur) return fail("the residuals cannot be evaluated at the current values");
     internal::SelectedInverse inverse;
-    if (!inverse.Compute(schur->s_lower(), kDenseReducedLimit, 0) || inverse.singular())
+    if (!inverse.Compute(schur->s_lower(), dense_inverse_limit_, 0) || inverse.singular())
       return fail(singular_message);
     std::map<BlockId, int> index;  // block -> index in the Schur system
     for (size_t b = 0; b < order.size(); ++b) index[order[b]] = static_cast<int>(b);

@@ -242,6 +242,11 @@ class ProblemBuilder {
   std::map<ResidualId, std::vector<double>> RedundancyNumbers(const std::vector<ResidualId>& ids,
                                                               int max_dense_parameters) const;
 
+  /// Reduced matrices up to `parameters` (count, >= 0; default 300) are inverted densely by
+  /// ComputeObservationCofactors / EstimateCovariance, larger ones by the sparse selected
+  /// inverse. For tests and benchmarks that compare the two paths on one problem.
+  void SetDenseInverseLimit(int parameters) { dense_inverse_limit_ = parameters; }
+
   /// Free parameters (tangent space) and scalar residuals currently in the problem.
   int NumFreeParameters() const;
   int NumObservations() const;
@@ -273,6 +278,7 @@ class ProblemBuilder {
   std::vector<Residual> residuals_;
   std::map<std::string, BlockId> block_by_name_;
   std::map<const double*, BlockId> block_by_pointer_;
+  int dense_inverse_limit_ = 300;
 };
 
 /// Two-sided standard-normal quantile: z with P(|N(0,1)| > z) = alpha.

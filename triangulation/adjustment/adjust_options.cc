@@ -1,6 +1,6 @@
 #include "triangulation/adjustment/adjust_options.h"
 
-#include "calib/camera/brown_fraser10.h"
+#include "calib/camera/camera.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 
@@ -9,7 +9,7 @@
 
 namespace aerocal::triangulation {
 
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 
 void AdjustOptions::Validate() const {
   std::set<std::string> seen;
@@ -66,12 +66,7 @@ std::vector<std::string> ParseSelfCalibration(const std::string& text) {
     for (const auto& p : Model::kParams) names.emplace_back(p.name);
     return names;
   }
-  std::stringstream in(text);
-  std::string name;
-  while (std::getline(in, name, ',')) {
-    const auto begin = name.find_first_not_of(' ');
-    const auto end = name.find_last_not_of(' ');
-    name = begin == std::string::npos ? "" : name.substr(begin, end - begin + 1);
+  for (const std::string& name : SplitCommaList(text)) {
     if (Model::IndexOf(name) < 0)
       throw ConfigError(
           "--self-calibration: unknown parameter '" + name +

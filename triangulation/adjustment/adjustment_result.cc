@@ -9,7 +9,7 @@
 namespace aerocal::triangulation {
 namespace {
 
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 constexpr double kRadToDeg = 180.0 / M_PI;
 
 nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }

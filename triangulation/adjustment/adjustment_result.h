@@ -40,7 +40,7 @@ PointStatistics ComputePointStatistics(const std::vector<PointDifference>& point
 struct CameraEstimate {
   std::string id;
   calib::InteriorParams initial{}, estimated{}, sigma{};  // table units; sigma 0 when fixed
-  std::array<bool, calib::BrownFraser10Model::kNumParams> free{};
+  std::array<bool, calib::Camera::Model::kNumParams> free{};
 };
 
 struct ExposureEstimate {

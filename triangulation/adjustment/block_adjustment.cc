@@ -1,4 +1,5 @@
 #include "triangulation/adjustment/block_adjustment.h"
+#include "calib/core/median.h"
 
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -16,7 +17,7 @@
 namespace aerocal::triangulation {
 namespace {
 
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 using calib::BlockId;
 using calib::BlockKind;
 
@@ -27,12 +28,6 @@ std::vector<std::string> InteriorNames() {
   std::vector<std::string> names;
   for (const auto& p : Model::kParams) names.emplace_back(p.name);
   return names;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
 }
 
 }  // namespace
