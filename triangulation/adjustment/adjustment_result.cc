@@ -145,9 +145,11 @@ std::string RejectedLines(const AdjustmentResult& r) {
                      o.measured_px.y(),
                      o.residual_px.norm(),
                      o.w,
-                     o.test.tested ? StringPrintf(", r = %.2f, MDB %.2f px, group of %d",
-                                                  o.test.redundancy.minCoeff(),
-                                                  o.test.mdb_px.maxCoeff(),
+                     o.test.tested ? StringPrintf(", r = (%.2f, %.2f), MDB (%.3g, %.3g) px, group of %d",
+                                                  o.test.redundancy.x(),
+                                                  o.test.redundancy.y(),
+                                                  o.test.mdb_px.x(),
+                                                  o.test.mdb_px.y(),
                                                   o.test.group_size).c_str()
                                    : "");
   return out;
