@@ -9,6 +9,7 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/csv.h"
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "calib/core/string_printf.h"
@@ -82,6 +83,7 @@ std::vector<stitch::GrayImage> LoadFrame(const calib::Camera& camera, const std:
 }
 
 int RunMatch(const MatchArgs& args) {
+  CheckOutputFile(args.out, "--out");
   const calib::Camera camera = calib::ReadCamera(args.camera);
   if (camera.subimages.size() < 2)
     throw InputError(args.camera + ": matching needs a camera with two or more sub-images");

@@ -6,6 +6,7 @@
 #include <sstream>
 
 #include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "stitch/io/stitch_result_json.h"
 #include "stitch/resample/tiff_raster.h"
@@ -30,6 +31,7 @@ bool IsTiff(const std::string& path) {
 }
 
 int RunResample(const ResampleArgs& args) {
+  CheckOutputFile(args.out, "--out");
   const calib::Camera nominal = calib::ReadCamera(args.camera);
   if (nominal.subimages.empty()) throw InputError(args.camera + ": the camera has no sub-images");
   const calib::Camera camera = stitch::ApplyStitchResult(nominal, args.mapping, args.frame);

@@ -257,8 +257,23 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
   std::vector<calib::BlockId> free_blocks;
   for (size_t k = 0; k < n_sub; ++k)
     if (!base[k]) free_blocks.push_back(blocks[k]);
-  const calib::CovarianceReport covariance =
-      builder.EstimateCovariance(free_blocks, std::max(report.sigma0, 0.0));
+  // A solution that overflowed (absurd input that passed the readers' bounds) must not reach the
+  // covariance's SVD, which does not survive non-finite or overflowing entries: a named failure
+  // (not converged, exit 3) instead.
+  bool finite = std::isfinite(report.sigma0) && std::abs(report.sigma0) < 1e150;
+  for (const auto& v : values)
+    for (double x : v) finite = finite && std::isfinite(x) && std::abs(x) < 1e150;
+  for (const auto& p : tie_positions) finite = finite && p.allFinite() && p.cwiseAbs().maxCoeff() < 1e150;
+  calib::CovarianceReport covariance;
+  if (finite) {
+    covariance = builder.EstimateCovariance(free_blocks, std::max(report.sigma0, 0.0));
+  } else {
+    out.converged = false;
+    covariance.ok = false;
+    covariance.message = "frame " + frame.frame +
+                         ": numerical failure in the adjustment (non-finite or overflowing "
+                         "values): no covariance, results not usable";
+  }
   out.covariance_ok = covariance.ok;
   if (!covariance.ok) out.diagnostics.push_back(covariance.message);
   for (size_t k = 0; k < n_sub; ++k) {

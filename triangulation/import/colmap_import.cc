@@ -10,7 +10,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <limits>
 #include <map>
+#include <set>
 
 namespace aerocal::triangulation {
 namespace {
@@ -87,6 +89,10 @@ double FitCamera(const std::string& model,
       Eigen::Vector2d undistorted((pixel.x() - k[2]) / k[0], (pixel.y() - k[3]) / k[1]);
       const Eigen::Vector2d target = undistorted;
       for (int it = 0; it < 100; ++it) undistorted += target - Distort(model, p, undistorted);
+      // A distortion that folds over (k1 = -1) or explodes (k1 = 10) within the format has no
+      // inverse there: no 10-parameter camera can stand for it.
+      if (!undistorted.allFinite() || (Distort(model, p, undistorted) - target).norm() * k[1] > 1e-3)
+        return std::numeric_limits<double>::quiet_NaN();
       const Eigen::Vector2d measured =
           Eigen::Vector2d(k[0], k[1]).cwiseProduct(Distort(model, p, undistorted)) +
           Eigen::Vector2d(k[2], k[3]);
@@ -150,14 +156,30 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     if (row.fields.size() != 4 + info->num_params)
       ThrowInputError({cameras_file, row.line},
                       model + " needs " + std::to_string(info->num_params) + " parameters");
-    const int width = static_cast<int>(NumberField(row, 2, cameras_file, "WIDTH"));
-    const int height = static_cast<int>(NumberField(row, 3, cameras_file, "HEIGHT"));
+    if (project.cameras.count(id))
+      ThrowInputError({cameras_file, row.line}, "camera " + id + " defined twice");
+    const int width = internal::IntegerField(row, 2, cameras_file, "WIDTH", 1, 1000000);
+    const int height = internal::IntegerField(row, 3, cameras_file, "HEIGHT", 1, 1000000);
     std::vector<double> params;
     for (size_t k = 0; k < info->num_params; ++k)
-      params.push_back(NumberField(row, 4 + k, cameras_file, "PARAMS"));
+      params.push_back(internal::BoundedField(row, 4 + k, cameras_file, "PARAMS", -1e7, 1e7));
+    const Eigen::Vector4d pinhole = Pinhole(model, params);
+    if (!(pinhole[0] > 0 && pinhole[1] > 0))
+      ThrowInputError({cameras_file, row.line}, "focal length must be > 0 px (got " +
+                                                    FormatNumber(pinhole[0]) + ", " +
+                                                    FormatNumber(pinhole[1]) + ")");
+    if (!(pinhole[0] * o.pixel_size_mm <= 1e4 && pinhole[1] * o.pixel_size_mm <= 1e4))
+      ThrowInputError({cameras_file, row.line}, "focal length beyond 10 m at this pixel size");
     calib::Camera camera;
     camera.name = "COLMAP camera " + id + " (" + model + ")";
     const double rms = FitCamera(model, params, width, height, o.pixel_size_mm, &camera);
+    bool finite = std::isfinite(rms);
+    for (double v : camera.interior) finite = finite && std::isfinite(v);
+    if (!finite)
+      ThrowInputError({cameras_file, row.line},
+                      model + " distortion cannot be inverted over the " + std::to_string(width) +
+                          " x " + std::to_string(height) +
+                          " px image (it folds over or diverges): not a usable camera");
     project.cameras[id] = camera;
     camera_model[id] = model;
     report.notes.push_back("camera " + id + ": " + model + " -> 10-parameter model, fit RMS " +
@@ -165,6 +187,7 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
   }
   // images.txt: per image a pose line, then a points2D line (which may be empty).
   auto image_rows = internal::ReadTextRows(images_file, false, true);
+  std::set<std::string> image_names;
   while (!image_rows.empty() && image_rows.back().fields.empty()) image_rows.pop_back();
   for (size_t i = 0; i < image_rows.size(); i += 2) {
     const TextRow& row = image_rows[i];
@@ -175,6 +198,10 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     e.line = row.line;
     e.image = std::filesystem::path(row.fields[9]).stem().string();
     e.camera = row.fields[8];
+    if (e.image.empty()) ThrowInputError({images_file, row.line}, "empty image name");
+    if (!image_names.insert(e.image).second)
+      ThrowInputError({images_file, row.line},
+                      "image name '" + e.image + "' given twice (two images would merge)");
     if (!project.cameras.count(e.camera))
       ThrowInputError({images_file, row.line}, "unknown camera " + e.camera);
     const Eigen::Quaterniond q(NumberField(row, 1, images_file, "QW"),
@@ -184,6 +211,12 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     const Eigen::Vector3d t(NumberField(row, 5, images_file, "TX"),
                             NumberField(row, 6, images_file, "TY"),
                             NumberField(row, 7, images_file, "TZ"));
+    // COLMAP writes unit quaternions; anything else (0,0,0,0 above all) is no rotation.
+    if (!(std::abs(q.norm() - 1.0) <= 1e-3))
+      ThrowInputError({images_file, row.line}, "QW QX QY QZ is not a unit quaternion (norm " +
+                                                   FormatNumber(q.norm()) + ")");
+    if (!(t.cwiseAbs().maxCoeff() <= 1e8))
+      ThrowInputError({images_file, row.line}, "TX TY TZ beyond 1e8");
     const Eigen::Matrix3d camera_from_world = q.normalized().toRotationMatrix();
     e.center_m = -camera_from_world.transpose() * t;
     const Eigen::Matrix3d object_from_image =
@@ -200,8 +233,8 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
       obs.line = points.line;
       obs.image = e.image;
       obs.point = points.fields[k + 2];
-      obs.pixel = {NumberField(points, k, images_file, "X") - 0.5,
-                   NumberField(points, k + 1, images_file, "Y") - 0.5};
+      obs.pixel = {internal::BoundedField(points, k, images_file, "X", -1e7, 1e7) - 0.5,
+                   internal::BoundedField(points, k + 1, images_file, "Y", -1e7, 1e7) - 0.5};
       obs.sigma_px = o.sigma_px;
       project.observations.push_back(obs);
     }
@@ -210,9 +243,9 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     GroundPoint p;
     p.line = row.line;
     p.id = StringField(row, 0, points_file, "POINT3D_ID");
-    p.xyz_m = Eigen::Vector3d(NumberField(row, 1, points_file, "X"),
-                              NumberField(row, 2, points_file, "Y"),
-                              NumberField(row, 3, points_file, "Z"));
+    p.xyz_m = Eigen::Vector3d(internal::BoundedField(row, 1, points_file, "X", -1e8, 1e8),
+                              internal::BoundedField(row, 2, points_file, "Y", -1e8, 1e8),
+                              internal::BoundedField(row, 3, points_file, "Z", -1e8, 1e8));
     project.points.push_back(p);
   }
   return report;
