@@ -97,7 +97,8 @@ CommandRun Setup(CLI::App& app) {
   app.add_option("--interp", args->interp, "bilinear | bicubic")->capture_default_str();
   app.add_option("--fill", args->fill, "Grey value of pixels no sub-image covers")
       ->capture_default_str();
-  app.add_option("--strip-rows", args->strip_rows, "Rows per processing strip (memory bound)")
+  app.add_option("--strip-rows", args->strip_rows, "Rows per processing strip (memory bound), 1..65536")
+      ->check(CLI::Range(1, 65536))
       ->capture_default_str();
   app.add_flag("--bigtiff", args->bigtiff, "Write BigTIFF even when classic TIFF would do");
   return [args] { return RunResample(*args); };

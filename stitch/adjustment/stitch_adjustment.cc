@@ -150,7 +150,9 @@ std::vector<RejectedObservation> RobustOutliers(const calib::Camera& camera,
   std::vector<RejectedObservation> out;
   if (abs_w.empty()) return out;
   std::nth_element(abs_w.begin(), abs_w.begin() + abs_w.size() / 2, abs_w.end());
-  const double scale = std::max(1e-12, 1.4826 * abs_w[abs_w.size() / 2]);
+  // Only the obvious: the scale is never below the a-priori sigma, so a pessimistic sigma does
+  // not turn the robust cut into a finer test than data snooping (which decides the rest).
+  const double scale = std::max(1.0, 1.4826 * abs_w[abs_w.size() / 2]);
   for (const auto& v : start.residuals) {
     const double w = v.v_px.norm() / v.sigma_px / scale;
     if (!std::isfinite(w) || w > options.robust_reject_sigma)

@@ -36,7 +36,7 @@ struct StitchOptions {
   double snooping_alpha = 0.05;       // family-wise level of the snooping test, (0, 1)
   /// Robust start (with data snooping, as `adjust --robust-start`): first an adjustment with a
   /// Cauchy loss (scale `robust_scale_sigma` sigmas); observations whose residual exceeds
-  /// `robust_reject_sigma` robust scales (1.4826 median |v / sigma|) are gross errors and left out
+  /// `robust_reject_sigma` robust scales (1.4826 median |v / sigma|, at least 1) are gross errors and left out
   /// before the clean adjustment and its snooping, so a decimal slip of 1e4..1e6 px can neither
   /// mask other errors nor pull the model choice (the F test sees clean adjustments).
   bool robust_start = true;

@@ -19,6 +19,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/yaml_util.h"
+#include "stitch/adjustment/stitch_adjustment.h"
 #include "tests/support/test_support.h"
 #include "triangulation/block/block_io.h"
 
@@ -663,6 +664,44 @@ TEST(StitchRobustStart, ADecimalSlipIsTheOnlyRejectionAndLeavesTheModelChoice) {
     ASSERT_FALSE(fb.at("rejected").empty());
     for (const auto& r : fb.at("rejected"))
       EXPECT_EQ(r.at("point").get<std::string>(), f[1]) << fb.at("rejected").dump();
+  }
+}
+
+// Values that overflow (what the readers now refuse at 1e7 px) fed straight to the adjustment:
+// a named numerical failure (not converged, no covariance), never a signal in the SVD.
+TEST(StitchNumericalFailure, OverflowingMeasurementsAreNamedNotACrash) {
+  const calib::Camera camera = calib::ParseCamera(
+      LoadYamlText("pixel_size_mm: 0.009\nformat_px: [14000, 8000]\ninterior: {c: 170}\n"
+                   "subimages:\n  - {id: I, format_px: [7100, 8000], model: affine}\n"
+                   "  - {id: II, format_px: [7100, 8000], model: affine, params: [1, 0, 6900, 0, 1, 0]}\n",
+                   "camera.yaml"),
+      "camera.yaml");
+  stitch::FrameMeasurements frame;
+  frame.frame = "0001";
+  for (int i = 0; i < 12; ++i) {
+    stitch::TieMeasurement tie;
+    tie.point = "t" + std::to_string(i);
+    const double v = 300.0 + 600.0 * i;
+    tie.rays.push_back({0, {7000.0 + (i % 3), v}, 0.1});
+    tie.rays.push_back({1, {100.0 + (i % 3), i == 5 ? 1e200 : v}, 0.1});
+    frame.ties.push_back(tie);
+  }
+  stitch::StitchOptions options;
+  options.base_ids = {"I"};
+  for (const bool snooping : {false, true}) {
+    options.data_snooping = snooping;
+    const auto a = stitch::AdjustFrame(camera, frame, calib::MappingModel::kAffine, options);
+    if (snooping) {  // the robust start removes the overflowing ray: a clean solution
+      EXPECT_TRUE(a.converged);
+      ASSERT_FALSE(a.rejected.empty());
+      EXPECT_EQ(a.rejected.front().point, "t5");
+    } else {
+      EXPECT_FALSE(a.converged);
+      EXPECT_FALSE(a.covariance_ok);
+      bool named = false;
+      for (const auto& d : a.diagnostics) named |= d.find("numerical failure") != std::string::npos;
+      EXPECT_TRUE(named);
+    }
   }
 }
 
