@@ -7,6 +7,7 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "tools/command_registry.h"
@@ -19,15 +20,6 @@ std::string ShellQuote(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";
-}
-
-std::vector<std::string> SplitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
 }
 
 CommandRun SetupFlight(CLI::App& app) {
@@ -50,7 +42,7 @@ CommandRun SetupFlight(CLI::App& app) {
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
   return [args]() {
     CheckOutputFolder(args->out, "--out");
-    args->options.base_ids = SplitList(args->base);
+    args->options.base_ids = SplitCommaList(args->base);
     Progress progress("flight", 5);
     const auto result = triangulation::RunFlightWorkflow(args->options, &progress);
     progress.Finish();
@@ -59,8 +51,19 @@ CommandRun SetupFlight(CLI::App& app) {
     nlohmann::json document = result.document;
     document["aerocal_version"] = AEROCAL_VERSION;
     WriteFileAtomically(json_path, document.dump(2) + "\n");
-    calib::WriteCamera((fs::path(args->out) / "camera_calibrated.yaml").string(), result.calibrated_camera);
+    // A calibrated camera is written only for a valid flight: a file that exists is one the next
+    // flight may use (an old one in the folder is removed, so it cannot pass for this run's).
+    const fs::path camera_path = fs::path(args->out) / "camera_calibrated.yaml";
+    if (result.valid) {
+      calib::WriteCamera(camera_path.string(), result.calibrated_camera);
+    } else {
+      std::error_code ignored;
+      fs::remove(camera_path, ignored);
+    }
     for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
+    for (const auto& [step, reason] : result.failures)
+      std::fprintf(stderr, "flight: step %s failed: %s\n", step.c_str(), reason.c_str());
+    if (!result.valid) std::fprintf(stderr, "flight: no calibrated camera written\n");
     if (!args->no_report) {
       const char* env = std::getenv("AEROCAL_REPORT_SCRIPT");
       const std::string script = env ? env : AEROCAL_REPORT_SCRIPT;
@@ -72,7 +75,7 @@ CommandRun SetupFlight(CLI::App& app) {
       }
       std::printf("report: %s\n", html.c_str());
     }
-    return result.converged ? kExitOk : kExitNotConverged;
+    return result.converged && result.valid ? kExitOk : kExitNotConverged;
   };
 }
 

@@ -2,6 +2,7 @@
 // OpenDroneMap gcp_list.txt) once into the FORMATS.md block files (triangulation/import).
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
 #include "triangulation/adjustment/nadir_start.h"
@@ -106,10 +107,7 @@ CommandRun SetupImport(CLI::App& app) {
             o->control_ids.insert(p.id);
           if (o->control_ids.empty()) throw ConfigError("--control: " + *control + " lists no target");
         } else {
-          std::stringstream in(*control);
-          std::string id;
-          while (std::getline(in, id, ','))
-            if (!id.empty()) o->control_ids.insert(id);
+          for (const std::string& id : SplitCommaList(*control)) o->control_ids.insert(id);
         }
       }
       auto project = triangulation::ImportOdmGcpList(*o);

@@ -5,6 +5,7 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "stitch/adjustment/flight_stability.h"
@@ -20,15 +21,6 @@ struct StitchArgs {
   double alpha = 0.05;
   bool no_snooping = false;
 };
-
-std::vector<std::string> SplitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 // What a user must see without opening the JSON: the fit, the gross errors and, above all, the
 // predicted precision of the sub-image corners (a small sigma0 says nothing about a weakly tied
@@ -81,7 +73,7 @@ int RunStitch(const StitchArgs& args) {
                         "' (expected translation, conformal, affine, projective or auto)");
   }
   options.alpha = args.alpha;
-  options.stitch.base_ids = SplitList(args.base);
+  options.stitch.base_ids = SplitCommaList(args.base);
   options.stitch.data_snooping = !args.no_snooping;
   options.stitch.Validate(camera);
   if (!(args.sigma_px > 0)) throw ConfigError("--sigma must be > 0 px");

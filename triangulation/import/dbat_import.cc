@@ -20,7 +20,7 @@ using internal::BoundedField;
 using internal::NumberField;
 using internal::ReadTextRows;
 using internal::StringField;
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 constexpr double kDegToRad = M_PI / 180.0;
 
 // The DBAT camera XML, read with an XML parser (tinyxml2: comments, CDATA and nesting handled):
@@ -37,15 +37,8 @@ struct XmlCamera {
   // Text of <tag> split on commas, trimmed; empty when the tag is absent.
   std::vector<std::string> List(const char* tag) const {
     const tinyxml2::XMLElement* e = Child(tag);
-    std::vector<std::string> out;
-    if (!e || !e->GetText()) return out;
-    std::stringstream in(e->GetText());
-    std::string item;
-    while (std::getline(in, item, ',')) {
-      const auto begin = item.find_first_not_of(" \t\r\n"), end = item.find_last_not_of(" \t\r\n");
-      out.push_back(begin == std::string::npos ? "" : item.substr(begin, end - begin + 1));
-    }
-    return out;
+    if (!e || !e->GetText()) return {};
+    return SplitCommaList(e->GetText(), {true, true});
   }
   // Numbers of <tag> within [-bound, bound]; at least min_size of them when the tag is required.
   std::vector<double> Numbers(const char* tag, size_t min_size, double bound) const {

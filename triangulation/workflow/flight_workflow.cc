@@ -32,6 +32,14 @@ Project WithCamera(Project project, const calib::Camera& camera, const std::stri
   return project;
 }
 
+// Records every reason why `r` is not a valid result of `step`.
+void CheckStep(const std::string& step, const AdjustmentResult& r, FlightWorkflowResult* out) {
+  for (const auto& reason : r.invalid_reasons) {
+    out->valid = false;
+    out->failures.emplace_back(step, reason);
+  }
+}
+
 std::string Line(const char* format, double a, double b, double c) {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer), format, a, b, c);
@@ -102,6 +110,8 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   adjustments.push_back(b);
   doc["comparison"] = ComparisonToJson(conventional, self_calibration);
   out.converged = conventional.converged() && self_calibration.converged();
+  CheckStep("conventional", conventional, &out);
+  CheckStep("self-calibration", self_calibration, &out);
   out.calibrated_camera = UpdatedCamera(camera, self_calibration.cameras.at(0));
   for (const AdjustmentResult* r : {static_cast<const AdjustmentResult*>(&conventional), &self_calibration})
     out.summary.push_back(std::string(r == &conventional ? "conventional" : "self-calibration") +
@@ -122,6 +132,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     j["name"] = "joint";
     adjustments.push_back(j);
     out.converged = out.converged && joint.adjustment.converged();
+    CheckStep("joint", joint.adjustment, &out);
     out.calibrated_camera = UpdatedCamera(camera, joint.adjustment.cameras.at(0));
     for (const auto& m : joint.mappings) {
       if (!m.exposure.empty()) continue;
@@ -135,6 +146,12 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   if (progress) progress->Advance();
   doc["adjustments"] = adjustments;
   doc["converged"] = out.converged;
+  doc["valid"] = out.valid;
+  doc["failures"] = nlohmann::json::array();
+  for (const auto& [step, reason] : out.failures) {
+    doc["failures"].push_back({{"step", step}, {"reason", reason}});
+    out.summary.push_back("NOT VALID: " + step + ": " + reason);
+  }
   if (progress) progress->Advance();
   return out;
 }
