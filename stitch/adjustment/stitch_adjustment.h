@@ -41,7 +41,7 @@ struct StitchOptions {
   /// mask other errors nor pull the model choice (the F test sees clean adjustments).
   bool robust_start = true;
   double robust_scale_sigma = 3.0;
-  double robust_reject_sigma = 8.0;
+  double robust_reject_sigma = 20.0;  // only the obvious: snooping decides the rest
   calib::LossOptions loss;            // loss on every residual (the robust pass sets Cauchy)
   calib::SolverOptions solver;
   void Validate(const calib::Camera& camera) const;  // ConfigError for unknown base ids

@@ -414,14 +414,14 @@ const std::vector<Case>& Cases() {
          Replace(d.File("model/cameras.txt"), "-0.05 0.01", "-1 0.01");
          return ColmapArgs(d.path());
        },
-       2, "model/cameras.txt:2: OPENCV distortion cannot be inverted", "out"},
+       2, "model/cameras.txt:2: OPENCV distortion cannot be represented", "out"},
       {"colmap_k1_ten",
        [](const TempDir& d) {
          WriteColmap(d.path());
          Replace(d.File("model/cameras.txt"), "-0.05 0.01", "10 0.01");
          return ColmapArgs(d.path());
        },
-       2, "model/cameras.txt:2: OPENCV distortion cannot be inverted", "out"},
+       2, "model/cameras.txt:2: OPENCV distortion cannot be represented", "out"},
       {"colmap_fx_zero",
        [](const TempDir& d) {
          WriteColmap(d.path());

@@ -96,7 +96,11 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     }
     bool finite = std::isfinite(fit.residual.rms_px) && std::isfinite(fit.residual.max_px);
     for (double v : fit.camera.params) finite = finite && std::isfinite(v);
-    if (!finite) ThrowInputError({cameras_file, row.line}, unusable);
+    // A conversion missing by more than 10 px somewhere in the format is no usable camera (the
+    // test cameras convert to 0.016 px; OPENCV k1 = -1 or 10 miss by thousands of pixels).
+    if (!finite || !(fit.residual.max_px <= 10.0))
+      ThrowInputError({cameras_file, row.line}, unusable + " (conversion misses by up to " +
+                                                    FormatNumber(fit.residual.max_px, 3) + " px)");
     calib::Camera camera;
     camera.name = "COLMAP camera " + id + " (" + model + ")";
     camera.width_px = colmap.frame.width_px;
