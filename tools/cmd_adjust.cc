@@ -101,6 +101,8 @@ CommandRun SetupAdjust(CLI::App& app) {
     options.use_interior_sigma = !args->no_interior_sigma;
     options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
     options.Validate();
+    CheckOutputFile(args->out, "--out");
+    if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
     if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
       throw ConfigError(
           "--write-camera needs a self-calibrating run (--self-calibration or --compare)");

@@ -41,6 +41,7 @@ CommandRun SetupFlight(CLI::App& app) {
   app.add_flag("--no-joint", [args](std::int64_t) { args->options.joint = false; }, "Skip the joint adjustment");
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
   return [args]() {
+    CheckOutputFolder(args->out, "--out");
     args->options.base_ids = SplitCommaList(args->base);
     Progress progress("flight", 5);
     const auto result = triangulation::RunFlightWorkflow(args->options, &progress);

@@ -1,6 +1,7 @@
 // aerocal import: converts blocks from other tools (COLMAP text model, DBAT / PhotoModeler marks,
 // OpenDroneMap gcp_list.txt) once into the FORMATS.md block files (triangulation/import).
 #include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
@@ -39,10 +40,12 @@ CommandRun SetupImport(CLI::App& app) {
   colmap->add_option("--out", *out, "Output folder")->required();
   colmap->callback([=] {
     *run = [=] {
+      CheckOutputFolder(*out, "--out");
       const auto report = triangulation::ImportColmapModel(*c);
       for (const auto& note : report.notes) std::printf("%s\n", note.c_str());
-      triangulation::WriteProjectFolder(report.project, *out);
-      Report(report.project, *out);
+      const auto project = triangulation::UsableImportedBlock(report.project, c->folder + "/images.txt");
+      triangulation::WriteProjectFolder(project, *out);
+      Report(project, *out);
       return kExitOk;
     };
   });
@@ -65,7 +68,8 @@ CommandRun SetupImport(CLI::App& app) {
   dbat->add_option("--out", *out, "Output folder")->required();
   dbat->callback([=] {
     *run = [=] {
-      const auto project = triangulation::ImportDbat(*d);
+      CheckOutputFolder(*out, "--out");
+      const auto project = triangulation::UsableImportedBlock(triangulation::ImportDbat(*d), d->marks);
       triangulation::WriteProjectFolder(project, *out);
       Report(project, *out);
       return kExitOk;
@@ -91,6 +95,7 @@ CommandRun SetupImport(CLI::App& app) {
   odm->add_option("--out", *out, "Output folder")->required();
   odm->callback([=] {
     *run = [=] {
+      CheckOutputFolder(*out, "--out");
       o->camera = calib::ReadCamera(*camera_file);
       if (!control->empty()) {
         if (control->find(',') == std::string::npos && control->find('.') != std::string::npos) {
@@ -100,12 +105,20 @@ CommandRun SetupImport(CLI::App& app) {
           subset.pixel_scale = o->pixel_scale;
           for (const auto& p : triangulation::ImportOdmGcpList(subset).points)
             o->control_ids.insert(p.id);
+          if (o->control_ids.empty()) throw ConfigError("--control: " + *control + " lists no target");
         } else {
           for (const std::string& id : SplitCommaList(*control)) o->control_ids.insert(id);
         }
       }
       auto project = triangulation::ImportOdmGcpList(*o);
-      project.exposures = triangulation::NadirStartFromControl(project, "cam1");
+      if (project.observations.empty())
+        throw InputError(o->gcp_list + ": no image sees two or more targets: nothing to import");
+      try {
+        project.exposures = triangulation::NadirStartFromControl(project, "cam1");
+      } catch (const InputError& e) {
+        throw InputError(o->gcp_list + ": " + e.what());
+      }
+      project = triangulation::UsableImportedBlock(project, o->gcp_list);
       triangulation::WriteProjectFolder(project, *out);
       Report(project, *out);
       std::printf(

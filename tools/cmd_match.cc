@@ -9,6 +9,7 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/csv.h"
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "calib/core/string_printf.h"
@@ -41,7 +42,9 @@ FrameImages FromImagesOption(const std::string& frame, const std::string& images
   return {{frame, paths}};
 }
 
-FrameImages FromList(const std::string& list) {
+// The list's rows are checked at their line: a sub-image the camera lacks, an image file that is
+// not a readable regular file, a frame missing a sub-image (errors name list.csv:LINE).
+FrameImages FromList(const std::string& list, const calib::Camera& camera) {
   const CsvTable table = CsvTable::Read(list);
   table.RequireColumns({"frame", "subimage", "image"});
   const std::filesystem::path dir = std::filesystem::path(list).parent_path();
@@ -54,6 +57,14 @@ FrameImages FromList(const std::string& list) {
     if (frame.empty() || sub.empty() || path.empty())
       ThrowInputError(table.Where(row), "frame, subimage and image must not be empty");
     if (path.is_relative()) path = dir / path;
+    if (camera.SubimageIndex(sub) < 0)
+      ThrowInputError(table.Where(row), "sub-image " + sub + " (frame " + frame +
+                                            ") is not in the camera file");
+    try {
+      CheckInputFile(path.string());
+    } catch (const InputError& e) {
+      ThrowInputError(table.Where(row), std::string("image ") + e.what());
+    }
     if (!index.count(frame)) {
       index[frame] = frames.size();
       frames.push_back({frame, {}});
@@ -62,6 +73,10 @@ FrameImages FromList(const std::string& list) {
       ThrowInputError(table.Where(row), "sub-image " + sub + " of frame " + frame + " listed twice");
   }
   if (frames.empty()) throw InputError(list + ": no frames listed");
+  for (const auto& [frame, paths] : frames)
+    for (const calib::SubimageMapping& sub : camera.subimages)
+      if (!paths.count(sub.id))
+        throw InputError(list + ": frame " + frame + ": no image for sub-image " + sub.id);
   return frames;
 }
 
@@ -80,6 +95,7 @@ std::vector<stitch::GrayImage> LoadFrame(const calib::Camera& camera, const std:
 }
 
 int RunMatch(const MatchArgs& args) {
+  CheckOutputFile(args.out, "--out");
   const calib::Camera camera = calib::ReadCamera(args.camera);
   if (camera.subimages.size() < 2)
     throw InputError(args.camera + ": matching needs a camera with two or more sub-images");
@@ -95,7 +111,7 @@ int RunMatch(const MatchArgs& args) {
   options.Validate();
 
   const FrameImages frames =
-      args.list.empty() ? FromImagesOption(args.frame, args.images) : FromList(args.list);
+      args.list.empty() ? FromImagesOption(args.frame, args.images) : FromList(args.list, camera);
   std::vector<stitch::StitchObservation> rows;
   Progress progress("match", static_cast<long>(frames.size()));
   // The per-strip table is printed after the progress bar (stderr) so the two never interleave.

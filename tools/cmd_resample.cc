@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "stitch/io/stitch_result_json.h"
@@ -24,6 +25,7 @@ struct ResampleArgs {
 };
 
 int RunResample(const ResampleArgs& args) {
+  CheckOutputFile(args.out, "--out");
   const calib::Camera nominal = calib::ReadCamera(args.camera);
   if (nominal.subimages.empty()) throw InputError(args.camera + ": the camera has no sub-images");
   const calib::Camera camera = stitch::ApplyStitchResult(nominal, args.mapping, args.frame);
@@ -72,7 +74,8 @@ CommandRun Setup(CLI::App& app) {
   app.add_option("--interp", args->interp, "bilinear | bicubic")->capture_default_str();
   app.add_option("--fill", args->fill, "Grey value of pixels no sub-image covers")
       ->capture_default_str();
-  app.add_option("--strip-rows", args->strip_rows, "Rows per processing strip (memory bound)")
+  app.add_option("--strip-rows", args->strip_rows, "Rows per processing strip (memory bound), 1..65536")
+      ->check(CLI::Range(1, 65536))
       ->capture_default_str();
   app.add_flag("--bigtiff", args->bigtiff, "Write BigTIFF even when classic TIFF would do");
   return [args] { return RunResample(*args); };

@@ -2,6 +2,7 @@
 #include <cstdio>
 #include <sstream>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
 #include "triangulation/simulation/flight_simulator.h"
@@ -20,33 +21,37 @@ CommandRun SetupSimulate(CLI::App& app) {
   auto& o = args->options;
   app.add_option("--out", args->out, "Output folder (created; files replaced atomically)")->required();
   app.add_option("--seed", args->seed, "Random seed (the same seed gives the same files)");
-  app.add_option("--exposures", o.exposures, "Number of exposures (spread over the strips)")->check(CLI::Range(2, 1000000));
-  app.add_option("--strips", o.strips, "Number of east-west strips")->check(CLI::Range(1, 10000));
-  app.add_option("--height-m", o.flying_height_m, "Flying height above the mean terrain, m")->check(CLI::PositiveNumber);
+  app.add_option("--exposures", o.exposures, "Number of exposures (spread over the strips), 2..20000")->check(CLI::Range(2, 20000));
+  app.add_option("--strips", o.strips, "Number of east-west strips, 1..1000")->check(CLI::Range(1, 1000));
+  app.add_option("--height-m", o.flying_height_m, "Flying height above the mean terrain, 1..100000 m")->check(CLI::Range(1.0, 1e5));
   app.add_option("--forward-overlap", o.forward_overlap, "Forward overlap, 0..1")->check(CLI::Range(0.0, 0.95));
   app.add_option("--side-overlap", o.side_overlap, "Side overlap, 0..1")->check(CLI::Range(0.0, 0.95));
-  app.add_option("--relief-m", o.terrain_relief_m, "Terrain relief (peak to peak), m")->check(CLI::NonNegativeNumber);
-  app.add_option("--points", o.ground_points, "Surveyed ground points (control + check)")->check(CLI::NonNegativeNumber);
-  app.add_option("--control", o.control_points, "Control points among them (corners and centre first)")->check(CLI::NonNegativeNumber);
-  app.add_option("--tie-points", o.tie_points, "Unsurveyed tie points")->check(CLI::NonNegativeNumber);
-  app.add_option("--image-noise-px", o.image_noise_px, "Image measurement noise (sigma), px")->check(CLI::NonNegativeNumber);
-  app.add_option("--image-sigma-px", o.image_sigma_px, "A-priori image sigma written to the files, px")->check(CLI::PositiveNumber);
-  app.add_option("--stitch-noise-px", o.stitching.noise_px, "Stitching tie-point matching noise, px")->check(CLI::NonNegativeNumber);
-  app.add_option("--stitch-ties", o.stitching.ties_per_frame, "Stitching tie points per exposure")->check(CLI::NonNegativeNumber);
-  app.add_option("--survey-sigma-m", o.survey_sigma_m, "Noise and sigma of control/check coordinates, m")->check(CLI::PositiveNumber);
-  app.add_option("--gnss-sigma-m", o.gnss_sigma_m, "GNSS camera-centre sigma, m (0: no GNSS, approximate centres)")->check(CLI::NonNegativeNumber);
-  app.add_option("--imu-sigma-deg", o.imu_sigma_deg, "IMU attitude sigma, deg (0: no IMU)")->check(CLI::NonNegativeNumber);
-  app.add_option("--start-offset-m", o.start_position_error_m, "Error of approximate centres without GNSS, m")->check(CLI::NonNegativeNumber);
-  app.add_option("--start-offset-deg", o.start_angle_error_deg, "Error of approximate angles without IMU, deg")->check(CLI::NonNegativeNumber);
-  app.add_option("--layout", args->layout, "Sub-image grid ROWSxCOLS of the camera (default 3x2: six CCDs)");
+  app.add_option("--relief-m", o.terrain_relief_m, "Terrain relief (peak to peak), 0..10000 m")->check(CLI::Range(0.0, 1e4));
+  app.add_option("--points", o.ground_points, "Surveyed ground points (control + check), 0..100000")->check(CLI::Range(0, 100000));
+  app.add_option("--control", o.control_points, "Control points among them (corners and centre first)")->check(CLI::Range(0, 100000));
+  app.add_option("--tie-points", o.tie_points, "Unsurveyed tie points, 0..1000000")->check(CLI::Range(0, 1000000));
+  app.add_option("--image-noise-px", o.image_noise_px, "Image measurement noise (sigma), 0..1000 px")->check(CLI::Range(0.0, 1e3));
+  app.add_option("--image-sigma-px", o.image_sigma_px, "A-priori image sigma written to the files, (0, 1000] px")->check(CLI::PositiveNumber & CLI::Range(0.0, 1e3));
+  app.add_option("--stitch-noise-px", o.stitching.noise_px, "Stitching tie-point matching noise, 0..1000 px")->check(CLI::Range(0.0, 1e3));
+  app.add_option("--stitch-ties", o.stitching.ties_per_frame, "Stitching tie points per exposure, 0..10000")->check(CLI::Range(0, 10000));
+  app.add_option("--survey-sigma-m", o.survey_sigma_m, "Noise and sigma of control/check coordinates, (0, 1000] m")->check(CLI::PositiveNumber & CLI::Range(0.0, 1e3));
+  app.add_option("--gnss-sigma-m", o.gnss_sigma_m, "GNSS camera-centre sigma, 0..1000 m (0: no GNSS, approximate centres)")->check(CLI::Range(0.0, 1e3));
+  app.add_option("--imu-sigma-deg", o.imu_sigma_deg, "IMU attitude sigma, 0..90 deg (0: no IMU)")->check(CLI::Range(0.0, 90.0));
+  app.add_option("--start-offset-m", o.start_position_error_m, "Error of approximate centres without GNSS, 0..100000 m")->check(CLI::Range(0.0, 1e5));
+  app.add_option("--start-offset-deg", o.start_angle_error_deg, "Error of approximate angles without IMU, 0..180 deg")->check(CLI::Range(0.0, 180.0));
+  app.add_option("--layout", args->layout, "Sub-image grid ROWSxCOLS of the camera, 1..10 each (default 3x2: six CCDs)");
   return [args]() {
+    CheckOutputFolder(args->out, "--out");
     auto& o = args->options;
     o.seed = args->seed;
     int rows = 0, cols = 0;
     char x = 0;
     std::istringstream in(args->layout);
-    if (!(in >> rows >> x >> cols) || x != 'x' || rows < 1 || cols < 1 || rows * cols < 2)
-      throw ConfigError("--layout must be ROWSxCOLS with at least two sub-images (got '" + args->layout + "')");
+    std::string rest;
+    if (!(in >> rows >> x >> cols) || x != 'x' || (in >> rest) || rows < 1 || cols < 1 ||
+        rows > 10 || cols > 10 || rows * cols < 2)
+      throw ConfigError("--layout must be ROWSxCOLS, 1..10 each, with at least two sub-images (got '" +
+                        args->layout + "')");
     if (rows != o.layout.rows || cols != o.layout.cols) {
       o.layout.rows = rows;
       o.layout.cols = cols;

@@ -61,6 +61,7 @@ void PrintSummary(const stitch::BatchResult& result, const std::string& out) {
 }
 
 int RunStitch(const StitchArgs& args) {
+  CheckOutputFile(args.out, "--out");
   const calib::Camera camera = calib::ReadCamera(args.camera);
   if (camera.subimages.empty())
     throw InputError(args.camera + ": the camera has no sub-images to stitch");

@@ -1,9 +1,14 @@
 // The aerocal command line: argument parsing and dispatch only; no algorithms live here.
+#include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
+#include <filesystem>
 #include <map>
 
 #include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
 
 #include "calib/core/error.h"
 #include "calib/core/log.h"
@@ -14,6 +19,25 @@ std::vector<CommandEntry>& CommandRegistry() {
   static std::vector<CommandEntry> registry;
   return registry;
 }
+namespace {
+
+// CLI11 converts "nan", "inf" and "1e999" into a double that passes its range checks; no option of
+// aerocal takes a non-finite value, so every floating-point option is checked once here.
+void RejectNonFiniteOptions(const CLI::App& app) {
+  for (const CLI::Option* option : app.get_options()) {
+    const std::string type = option->get_type_name();
+    if (type.find("FLOAT") == std::string::npos && type.find("NUMBER") == std::string::npos) continue;
+    for (const std::string& text : option->results()) {
+      char* end = nullptr;
+      const double value = std::strtod(text.c_str(), &end);
+      if (end != text.c_str() && !std::isfinite(value))
+        throw aerocal::ConfigError(option->get_name() + ": must be a finite number (got '" + text + "')");
+    }
+  }
+  for (const CLI::App* sub : app.get_subcommands()) RejectNonFiniteOptions(*sub);
+}
+
+}  // namespace
 }  // namespace aerocal::tools
 
 int main(int argc, char** argv) {
@@ -44,12 +68,22 @@ int main(int argc, char** argv) {
   if (quiet) aerocal::SetLogLevel(aerocal::LogLevel::kQuiet);
   if (verbose) aerocal::SetLogLevel(aerocal::LogLevel::kInfo);
   try {
+    RejectNonFiniteOptions(app);
     for (auto& [sub, run] : runs)
       if (sub->parsed()) return run();
   } catch (const aerocal::InputError& e) {
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitBadInput;
   } catch (const aerocal::ConfigError& e) {
+    std::fprintf(stderr, "error: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const YAML::Exception& e) {  // a user's YAML the readers did not catch
+    std::fprintf(stderr, "error: YAML input: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const nlohmann::json::exception& e) {  // a user's JSON (stitch result) malformed
+    std::fprintf(stderr, "error: JSON input: %s\n", e.what());
+    return kExitBadInput;
+  } catch (const std::filesystem::filesystem_error& e) {  // a user's path
     std::fprintf(stderr, "error: %s\n", e.what());
     return kExitBadInput;
   } catch (const std::exception& e) {

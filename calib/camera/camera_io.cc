@@ -12,6 +12,17 @@ namespace {
 
 using Model = BrownFraser10Model;
 
+// Physical bounds of the camera file's values (calib/README.md "Camera file bounds").
+constexpr int kMaxFormatPx = 1000000;       // per side, virtual image or sub-image
+constexpr double kMaxPixelSizeMm = 1.0;     // 1 mm pixels
+constexpr double kMinPixelSizeMm = 1e-5;    // 10 nm pixels
+constexpr double kMaxCMm = 10000.0;         // 10 m principal distance
+constexpr double kMaxPpMm = 1e4;            // |x0|, |y0|
+constexpr double kMaxDistortion = 1e4;      // |K1..K3, P1, P2, B1, B2| (overflow-safe only)
+constexpr double kMaxMappingParam = 1e7;    // |sub-image mapping parameter|
+constexpr double kMaxPixelCoordinate = 1e7; // |u|, |v|, |U|, |V| of reference points, px
+constexpr double kMaxSigmaPx = 1e4;
+
 std::vector<std::string> InteriorKeys() {
   std::vector<std::string> keys;
   for (const auto& info : Model::kParams) keys.emplace_back(info.name);
@@ -23,9 +34,10 @@ std::pair<int, int> ReadFormat(const YAML::Node& node, const std::string& file) 
     ThrowInputError(WhereIs(node, file), "format_px must be [width, height]");
   const int w = YamlInt(node[0], file, "format_px width");
   const int h = YamlInt(node[1], file, "format_px height");
-  if (w <= 0 || h <= 0)
-    ThrowInputError(WhereIs(node, file), "format_px must be positive (got [" + std::to_string(w) +
-                                             ", " + std::to_string(h) + "])");
+  if (w <= 0 || h <= 0 || w > kMaxFormatPx || h > kMaxFormatPx)
+    ThrowInputError(WhereIs(node, file), "format_px must be within 1 .. " +
+                                             std::to_string(kMaxFormatPx) + " (got [" +
+                                             std::to_string(w) + ", " + std::to_string(h) + "])");
   return {w, h};
 }
 
@@ -49,7 +61,8 @@ SubimageMapping ReadSubimage(const YAML::Node& node, const std::string& file) {
       ThrowInputError(WhereIs(p, file), "sub-image " + s.id + ": model " + model_name + " needs " +
                                             std::to_string(MappingParamCount(s.model)) +
                                             " params");
-    for (const auto& v : p) s.params.push_back(YamlDouble(v, file, "params"));
+    for (const auto& v : p)
+      s.params.push_back(YamlBounded(v, file, "params", -kMaxMappingParam, kMaxMappingParam));
   } else {
     s.params = IdentityMappingParams(s.model);
   }
@@ -67,11 +80,11 @@ ReferencePoint ReadReferencePoint(const YAML::Node& node, const std::string& fil
   if (camera.SubimageIndex(r.subimage) < 0)
     ThrowInputError(WhereIs(node["subimage"], file),
                     "reference point " + r.id + " names unknown sub-image '" + r.subimage + "'");
-  r.u = YamlDouble(node["u"], file, "u");
-  r.v = YamlDouble(node["v"], file, "v");
-  r.U = YamlDouble(node["U"], file, "U");
-  r.V = YamlDouble(node["V"], file, "V");
-  if (node["sigma_px"]) r.sigma_px = YamlDouble(node["sigma_px"], file, "sigma_px");
+  r.u = YamlBounded(node["u"], file, "u", -kMaxPixelCoordinate, kMaxPixelCoordinate);
+  r.v = YamlBounded(node["v"], file, "v", -kMaxPixelCoordinate, kMaxPixelCoordinate);
+  r.U = YamlBounded(node["U"], file, "U", -kMaxPixelCoordinate, kMaxPixelCoordinate);
+  r.V = YamlBounded(node["V"], file, "V", -kMaxPixelCoordinate, kMaxPixelCoordinate);
+  if (node["sigma_px"]) r.sigma_px = YamlBounded(node["sigma_px"], file, "sigma_px", 0, kMaxSigmaPx);
   if (!(r.sigma_px > 0))
     ThrowInputError(WhereIs(node, file), "reference point " + r.id + ": sigma_px must be > 0 (got " +
                                              FormatNumber(r.sigma_px) + ")");
@@ -97,10 +110,8 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file) {
   }
   camera.name = root["name"] ? YamlString(root["name"], file, "name") : "";
   if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
-  camera.pixel_size_mm = YamlDouble(root["pixel_size_mm"], file, "pixel_size_mm");
-  if (!(camera.pixel_size_mm > 0))
-    ThrowInputError(WhereIs(root["pixel_size_mm"], file),
-                    "pixel_size_mm must be > 0 (got " + root["pixel_size_mm"].Scalar() + ")");
+  camera.pixel_size_mm = YamlBounded(root["pixel_size_mm"], file, "pixel_size_mm", kMinPixelSizeMm,
+                                     kMaxPixelSizeMm);
   if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
   std::tie(camera.width_px, camera.height_px) = ReadFormat(root["format_px"], file);
   if (!root["interior"]) ThrowInputError({file, 1}, "missing interior (at least c)");
@@ -108,7 +119,11 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file) {
   RejectUnknownKeys(interior, InteriorKeys(), file);
   for (int i = 0; i < Model::kNumParams; ++i) {
     const std::string key(Model::kParams[i].name);
-    if (interior[key]) camera.interior[i] = YamlDouble(interior[key], file, key);
+    if (!interior[key]) continue;
+    const double bound = i == Model::kC ? kMaxCMm
+                         : (i == Model::kX0 || i == Model::kY0) ? kMaxPpMm
+                                                                : kMaxDistortion;
+    camera.interior[i] = YamlBounded(interior[key], file, "interior." + key, -bound, bound);
   }
   if (!(camera.c_mm() > 0))
     ThrowInputError(WhereIs(interior, file), "interior.c must be > 0 mm (got " +
@@ -119,7 +134,7 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file) {
     for (int i = 0; i < Model::kNumParams; ++i) {
       const std::string key(Model::kParams[i].name);
       if (!sig[key]) continue;
-      const double s = YamlDouble(sig[key], file, key);
+      const double s = YamlBounded(sig[key], file, "interior_sigma." + key, 0, 1e6);
       if (!(s > 0))
         ThrowInputError(WhereIs(sig[key], file),
                         "interior_sigma." + key + " must be > 0 (got " + FormatNumber(s) + ")");

@@ -1,5 +1,7 @@
 // Results are written atomically: to a temporary file beside the target, then renamed over it,
 // so a failure never leaves a partial or truncated result (DEVELOPERS brief, STYLE.md section 7).
+// Inputs are checked before they are opened: only regular files are read (a FIFO would block, a
+// device never end, a directory is no file), and outputs only ever replace regular files.
 #pragma once
 
 #include <functional>
@@ -8,13 +10,29 @@
 
 namespace aerocal {
 
-/// Writes `contents` to `path` atomically. Creates missing parent directories. Throws Error on failure.
+/// Writes `contents` to `path` atomically. Creates missing parent directories. Throws InputError
+/// when `path` is not a usable output file path (see CheckOutputFile), Error on other failures.
 void WriteFileAtomically(const std::string& path, const std::string& contents);
 
 /// Streams into a temporary file and renames it to `path` once `write` returns without throwing.
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write);
 
-/// Reads a whole text file; throws InputError("PATH: cannot read") when it cannot be opened.
+/// Throws InputError("PATH: what") unless `path` names an existing regular file the process may
+/// read (following symbolic links): a missing path, a directory, a FIFO, a device or socket, a
+/// symbolic-link loop and an unreadable file are refused BEFORE anything is opened.
+void CheckInputFile(const std::string& path);
+
+/// Reads a whole regular text file (CheckInputFile first); a leading UTF-8 byte-order mark is
+/// dropped. Throws InputError("PATH: ...") when it cannot be read.
 std::string ReadTextFile(const std::string& path);
+
+/// Throws InputError("WHAT: ...") unless `path` can become a regular output file: not empty, not an
+/// existing directory, device, FIFO or socket, every name within NAME_MAX and the whole within
+/// PATH_MAX, no existing ancestor that is not a folder, and a writable nearest existing folder.
+/// `what` names the option (e.g. "--out") or is empty to name the path itself. Nothing is created.
+void CheckOutputFile(const std::string& path, const std::string& what = "");
+
+/// As CheckOutputFile, for an output folder (created later): an existing path must be a folder.
+void CheckOutputFolder(const std::string& path, const std::string& what = "");
 
 }  // namespace aerocal

@@ -4,8 +4,10 @@
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
+#include <string_view>
 
 #include "calib/core/atomic_file.h"
+#include "calib/core/log.h"
 
 namespace aerocal {
 namespace {
@@ -18,6 +20,25 @@ std::string Trim(const std::string& s) {
 }
 
 }  // namespace
+
+std::vector<std::string> SplitLines(const std::string& text_in) {
+  std::string_view text(text_in);
+  if (text.substr(0, 3) == "\xEF\xBB\xBF") text.remove_prefix(3);  // UTF-8 byte-order mark
+  std::vector<std::string> lines;
+  std::string line;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char ch = text[i];
+    if (ch == '\n' || ch == '\r') {
+      lines.push_back(std::move(line));
+      line.clear();
+      if (ch == '\r' && i + 1 < text.size() && text[i + 1] == '\n') ++i;  // CRLF
+    } else {
+      line += ch;
+    }
+  }
+  if (!line.empty()) lines.push_back(std::move(line));
+  return lines;
+}
 
 std::vector<std::string> SplitCommaList(const std::string& text, ListSplit how) {
   std::vector<std::string> out;
@@ -51,13 +72,19 @@ std::string FormatNumber(double value, int digits) {
 CsvTable CsvTable::Parse(const std::string& text, const std::string& file) {
   CsvTable table;
   table.file_ = file;
-  std::istringstream in(text);
-  std::string line;
   int line_number = 0;
-  while (std::getline(in, line)) {
+  for (const std::string& line : SplitLines(text)) {
     ++line_number;
     const std::string trimmed = Trim(line);
-    if (trimmed.empty() || trimmed[0] == '#') continue;
+    if (trimmed.empty()) continue;
+    if (line[0] == '#') {  // a comment only where '#' is the line's first character
+      if (!table.header_.empty() && table.header_.size() > 1 &&
+          SplitCommaList(trimmed, {true, true}).size() == table.header_.size())
+        LogWarning(SourceRef{file, line_number}.ToString() +
+                   ": skipped as a comment (the line starts with '#'); an id in the first column "
+                   "cannot start with '#'");
+      continue;
+    }
     std::vector<std::string> fields = SplitCommaList(trimmed, {true, true});
     if (table.header_.empty()) {
       table.header_ = fields;
@@ -76,11 +103,26 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& file) {
     fields.resize(table.header_.size());
     table.rows_.push_back({line_number, std::move(fields)});
   }
-  if (table.header_.empty()) ThrowInputError({file, 1}, "empty file: a header row is expected");
+  if (table.header_.empty())
+    ThrowInputError({file, 0}, "empty file (no header row; expected a header and data rows)");
   return table;
 }
 
 CsvTable CsvTable::Read(const std::string& path) { return Parse(ReadTextFile(path), path); }
+
+double CsvTable::Bounded(const Row& row, const std::string& column, double lo, double hi) const {
+  const double value = Number(row, column);
+  if (!(value >= lo && value <= hi))
+    ThrowInputError(Where(row), "column '" + column + "' out of range (got " + FormatNumber(value) +
+                                    ", expected " + FormatNumber(lo) + " .. " + FormatNumber(hi) + ")");
+  return value;
+}
+
+std::optional<double> CsvTable::OptionalBounded(const Row& row, const std::string& column,
+                                                double lo, double hi) const {
+  if (String(row, column).empty()) return std::nullopt;
+  return Bounded(row, column, lo, hi);
+}
 
 void CsvTable::RequireColumns(const std::vector<std::string>& names) const {
   for (const auto& name : names)

@@ -1,5 +1,6 @@
-// CSV tables as FORMATS.md defines them: a header row, comma separators, '#' comment lines,
-// blank lines ignored, fields trimmed. Every value access names FILE:LINE in its error.
+// CSV tables as FORMATS.md defines them: a header row, comma separators, '#' comment lines (a '#'
+// that is the FIRST character of a line; elsewhere it is data), blank lines ignored, fields
+// trimmed, a UTF-8 byte-order mark and CRLF or CR line ends accepted. Every value access names FILE:LINE in its error.
 #pragma once
 
 #include <map>
@@ -37,6 +38,10 @@ class CsvTable {
   double Number(const Row& row, const std::string& column) const;
   /// Number when present and non-empty, nullopt otherwise.
   std::optional<double> OptionalNumber(const Row& row, const std::string& column) const;
+  /// Number within [lo, hi]; InputError naming the range otherwise.
+  double Bounded(const Row& row, const std::string& column, double lo, double hi) const;
+  std::optional<double> OptionalBounded(const Row& row, const std::string& column, double lo,
+                                        double hi) const;
 
  private:
   std::string file_;
@@ -45,6 +50,9 @@ class CsvTable {
   std::map<std::string, int> columns_;
   std::vector<Row> rows_;
 };
+
+/// Lines of a text: LF, CRLF or CR line ends; a leading UTF-8 byte-order mark is dropped.
+std::vector<std::string> SplitLines(const std::string& text);
 
 /// How SplitCommaList splits `text` at commas: fields trimmed of blanks (space, tab, CR, LF) or
 /// not; empty fields kept (n commas give n + 1 fields: a row or a value list, where an empty field

@@ -11,7 +11,8 @@
 
 namespace aerocal {
 
-/// Parses a YAML file; a syntax error becomes InputError("PATH:LINE: ...").
+/// Parses a YAML file strictly; a syntax error, a duplicate key or a key that is a list or map
+/// becomes InputError("PATH:LINE: ...").
 YAML::Node LoadYamlFile(const std::string& path);
 /// Parses YAML text; `file` is used in messages.
 YAML::Node LoadYamlText(const std::string& text, const std::string& file);
@@ -26,6 +27,9 @@ void RejectUnknownKeys(const YAML::Node& map, const std::vector<std::string>& al
 /// Reads a scalar as double / int / string; InputError at the node's line when it is not one.
 double YamlDouble(const YAML::Node& node, const std::string& file, const std::string& what);
 int YamlInt(const YAML::Node& node, const std::string& file, const std::string& what);
+/// A number within [lo, hi] (the physical bounds FORMATS/READMEs state); InputError otherwise.
+double YamlBounded(const YAML::Node& node, const std::string& file, const std::string& what,
+                   double lo, double hi);
 std::string YamlString(const YAML::Node& node, const std::string& file, const std::string& what);
 
 }  // namespace aerocal

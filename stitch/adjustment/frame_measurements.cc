@@ -30,14 +30,17 @@ std::vector<FrameMeasurements> GroupByFrame(const calib::Camera& camera,
     std::vector<std::string> point_order;
     std::map<std::string, std::vector<const StitchObservation*>> by_point;
     for (const StitchObservation* row : by_frame[frame_id]) {
-      const std::string where = file + ": frame " + frame_id + ", point " + row->point;
+      const std::string where =
+          SourceRef{file, row->line}.ToString() + ": frame " + frame_id + ", point " + row->point;
       const int k = camera.SubimageIndex(row->subimage);
       if (k < 0) throw InputError(where + ": sub-image '" + row->subimage + "' is not in the camera");
       auto [it, inserted] = by_point.try_emplace(row->point);
       if (inserted) point_order.push_back(row->point);
       for (const StitchObservation* other : it->second)
         if (other->subimage == row->subimage)
-          throw InputError(where + ": measured twice in sub-image " + row->subimage);
+          throw InputError(where + ": measured twice in sub-image " + row->subimage +
+                           (other->line > 0 ? " (also on line " + std::to_string(other->line) + ")"
+                                            : std::string()));
       it->second.push_back(row);
     }
     std::set<std::string> measured_references;
@@ -48,7 +51,8 @@ std::vector<FrameMeasurements> GroupByFrame(const calib::Camera& camera,
         const calib::ReferencePoint& rp = camera.reference_points[ref->second];
         for (const StitchObservation* row : obs) {
           if (row->subimage != rp.subimage)
-            throw InputError(file + ": frame " + frame.frame + ", point " + point +
+            throw InputError(SourceRef{file, row->line}.ToString() + ": frame " + frame.frame +
+                             ", point " + point +
                              ": reference point of sub-image " + rp.subimage +
                              " measured in sub-image " + row->subimage);
           frame.references.push_back({point, camera.SubimageIndex(rp.subimage),

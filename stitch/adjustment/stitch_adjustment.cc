@@ -118,11 +118,60 @@ std::string FindUnderdetermined(const calib::Camera& camera, const FrameMeasurem
   return "";
 }
 
+namespace {
+
+// The robust start of AdjustFrame: observations far outside a Cauchy-loss solution.
+std::vector<RejectedObservation> RobustOutliers(const calib::Camera& camera,
+                                                const FrameMeasurements& frame, MappingModel model,
+                                                const StitchOptions& options,
+                                                const std::set<ObservationKey>& excluded) {
+  StitchOptions robust = options;
+  robust.robust_start = false;
+  robust.data_snooping = false;
+  robust.loss.kind = calib::LossKind::kCauchy;
+  robust.loss.scale = options.robust_scale_sigma;
+  const FrameAdjustment start = AdjustFrame(camera, frame, model, robust, excluded);
+  std::vector<double> abs_w;
+  for (const auto& v : start.residuals)
+    for (int k = 0; k < 2; ++k) abs_w.push_back(std::abs(v.v_px(k)) / v.sigma_px);
+  std::vector<RejectedObservation> out;
+  if (abs_w.empty()) return out;
+  std::nth_element(abs_w.begin(), abs_w.begin() + abs_w.size() / 2, abs_w.end());
+  // Only the obvious: the scale is never below the a-priori sigma, so a pessimistic sigma does
+  // not turn the robust cut into a finer test than data snooping (which decides the rest).
+  const double scale = std::max(1.0, 1.4826 * abs_w[abs_w.size() / 2]);
+  for (const auto& v : start.residuals) {
+    const double w = v.v_px.norm() / v.sigma_px / scale;
+    if (!std::isfinite(w) || w > options.robust_reject_sigma)
+      out.push_back({v.point, v.subimage, v.reference, w, v.v_px});
+  }
+  return out;
+}
+
+}  // namespace
+
 FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements& frame,
                             MappingModel model, const StitchOptions& options,
-                            const std::set<ObservationKey>& excluded) {
-  const std::string refusal = FindUnderdetermined(camera, frame, model, options, excluded);
+                            const std::set<ObservationKey>& excluded_in) {
+  const std::string refusal = FindUnderdetermined(camera, frame, model, options, excluded_in);
   if (!refusal.empty()) throw InputError(refusal);
+  std::set<ObservationKey> excluded = excluded_in;
+  std::vector<RejectedObservation> robust_rejected;
+  std::string robust_note;
+  if (options.robust_start && options.data_snooping) {
+    robust_rejected = RobustOutliers(camera, frame, model, options, excluded);
+    std::set<ObservationKey> more = excluded;
+    for (const auto& r : robust_rejected) more.insert({r.point, r.subimage});
+    if (!robust_rejected.empty() && !FindUnderdetermined(camera, frame, model, options, more).empty()) {
+      robust_note = "frame " + frame.frame + ": the robust start found " +
+                    std::to_string(robust_rejected.size()) +
+                    " gross error(s) but leaving them out would under-determine the " +
+                    std::string(calib::MappingModelName(model)) + " model: kept for data snooping";
+      robust_rejected.clear();
+    } else {
+      excluded = std::move(more);
+    }
+  }
 
   const size_t n_sub = camera.subimages.size();
   std::vector<MappingModel> models(n_sub);
@@ -188,7 +237,8 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
       const auto id = builder.AddResidual(calib::kGroupStitchTie, std::move(cost),
                                           {blocks[k], point_block},
                                           "frame " + frame.frame + " tie " + tie.point +
-                                              " sub-image " + camera.subimages[k].id);
+                                              " sub-image " + camera.subimages[k].id,
+                                          options.loss);
       observed[id] = {tie.point, k, false, ray.sigma_px};
       sigmas.push_back(ray.sigma_px);
     }
@@ -219,6 +269,8 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
   } else {
     report = builder.Solve(options.solver);
   }
+  // Gross errors of the robust start first (found before any model was compared).
+  out.rejected.insert(out.rejected.begin(), robust_rejected.begin(), robust_rejected.end());
   out.converged = report.converged;
   out.iterations = report.iterations;
   out.sigma0 = report.sigma0;
@@ -227,6 +279,7 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
   out.n_observations = report.n_observations;
   out.n_unknowns = report.n_unknowns;
   out.diagnostics = report.diagnostics;
+  if (!robust_note.empty()) out.diagnostics.push_back(robust_note);
   std::vector<double> active_sigmas;
   for (const auto& [id, o] : observed)
     if (builder.IsActive(id)) active_sigmas.push_back(o.sigma_px);
@@ -244,8 +297,23 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
   std::vector<calib::BlockId> free_blocks;
   for (size_t k = 0; k < n_sub; ++k)
     if (!base[k]) free_blocks.push_back(blocks[k]);
-  const calib::CovarianceReport covariance =
-      builder.EstimateCovariance(free_blocks, std::max(report.sigma0, 0.0));
+  // A solution that overflowed (absurd input that passed the readers' bounds) must not reach the
+  // covariance's SVD, which does not survive non-finite or overflowing entries: a named failure
+  // (not converged, exit 3) instead.
+  bool finite = std::isfinite(report.sigma0) && std::abs(report.sigma0) < 1e150;
+  for (const auto& v : values)
+    for (double x : v) finite = finite && std::isfinite(x) && std::abs(x) < 1e150;
+  for (const auto& p : tie_positions) finite = finite && p.allFinite() && p.cwiseAbs().maxCoeff() < 1e150;
+  calib::CovarianceReport covariance;
+  if (finite) {
+    covariance = builder.EstimateCovariance(free_blocks, std::max(report.sigma0, 0.0));
+  } else {
+    out.converged = false;
+    covariance.ok = false;
+    covariance.message = "frame " + frame.frame +
+                         ": numerical failure in the adjustment (non-finite or overflowing "
+                         "values): no covariance, results not usable";
+  }
   out.covariance_ok = covariance.ok;
   if (!covariance.ok) out.diagnostics.push_back(covariance.message);
   for (size_t k = 0; k < n_sub; ++k) {

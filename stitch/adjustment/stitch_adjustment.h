@@ -34,6 +34,15 @@ struct StitchOptions {
   std::vector<std::string> base_ids;  // sub-images whose mapping is held at the camera file's
   bool data_snooping = true;          // Baarda data snooping (else no observation is removed)
   double snooping_alpha = 0.05;       // family-wise level of the snooping test, (0, 1)
+  /// Robust start (with data snooping, as `adjust --robust-start`): first an adjustment with a
+  /// Cauchy loss (scale `robust_scale_sigma` sigmas); observations whose residual exceeds
+  /// `robust_reject_sigma` robust scales (1.4826 median |v / sigma|, at least 1) are gross errors and left out
+  /// before the clean adjustment and its snooping, so a decimal slip of 1e4..1e6 px can neither
+  /// mask other errors nor pull the model choice (the F test sees clean adjustments).
+  bool robust_start = true;
+  double robust_scale_sigma = 3.0;
+  double robust_reject_sigma = 20.0;  // only the obvious: snooping decides the rest
+  calib::LossOptions loss;            // loss on every residual (the robust pass sets Cauchy)
   calib::SolverOptions solver;
   void Validate(const calib::Camera& camera) const;  // ConfigError for unknown base ids
 };

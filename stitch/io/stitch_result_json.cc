@@ -4,6 +4,8 @@
 #include <cmath>
 #include <map>
 
+#include <Eigen/LU>
+
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "stitch/adjustment/mapping_param_names.h"
@@ -241,8 +243,24 @@ calib::Camera ApplyStitchResult(const calib::Camera& camera, const std::string& 
       const auto params = s.at("params").get<std::vector<double>>();
       if (static_cast<int>(params.size()) != calib::MappingParamCount(*model))
         throw InputError(path + ": sub-image " + id + ": wrong number of params");
+      for (double p : params)
+        if (!(std::abs(p) <= 1e7))
+          throw InputError(path + ": sub-image " + id + ": a parameter is not finite or beyond 1e7");
       out.subimages[k].model = *model;
       out.subimages[k].params = params;
+      // The mapping must be invertible over the sub-image: its Jacobian at the centre and the
+      // corners (central differences of 1 px) must not be singular (an all-zero affine is).
+      const calib::SubimageMapping& m = out.subimages[k];
+      for (const auto& [cu, cv] : {std::pair{0.5, 0.5}, {0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {1.0, 1.0}}) {
+        const Eigen::Vector2d uv(cu * m.width_px, cv * m.height_px);
+        Eigen::Matrix2d j;
+        j.col(0) = (m.VirtualFromSub(uv + Eigen::Vector2d(0.5, 0)) - m.VirtualFromSub(uv - Eigen::Vector2d(0.5, 0)));
+        j.col(1) = (m.VirtualFromSub(uv + Eigen::Vector2d(0, 0.5)) - m.VirtualFromSub(uv - Eigen::Vector2d(0, 0.5)));
+        const double det = j.determinant();
+        if (!std::isfinite(det) || std::abs(det) < 1e-6)
+          throw InputError(path + ": sub-image " + id + ": the " + std::string(calib::MappingModelName(*model)) +
+                           " mapping is singular (not invertible) over the sub-image");
+      }
       seen[k] = true;
     }
   } catch (const json::exception& e) {

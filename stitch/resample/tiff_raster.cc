@@ -11,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 #include <tiffio.h>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 
 namespace aerocal::stitch {
@@ -26,6 +27,7 @@ class TiffReader : public RasterSource {
  public:
   explicit TiffReader(const std::string& path) : path_(path) {
     SilenceLibtiff();
+    CheckInputFile(path);  // a FIFO or device is refused before libtiff opens it
     tiff_ = TIFFOpen(path.c_str(), "rm");  // no memory mapping: windows are read as needed
     if (!tiff_) throw InputError(path + ": cannot open as TIFF");
     uint32_t width = 0, height = 0;
@@ -204,6 +206,7 @@ bool IsBigTiff(const std::string& path) {
 }
 
 MemoryRaster ReadImageFile(const std::string& path, bool gray) {
+  CheckInputFile(path);
   cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
   if (image.empty()) throw InputError(path + ": cannot read the image");
   if (image.depth() != CV_8U && image.depth() != CV_16U)

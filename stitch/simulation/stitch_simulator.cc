@@ -146,12 +146,14 @@ std::vector<StitchObservation> ReadStitchObservations(const std::string& path,
     obs.subimage = table.String(row, "subimage");
     if (obs.frame.empty() || obs.point.empty() || obs.subimage.empty())
       ThrowInputError(table.Where(row), "frame, point and subimage must not be empty");
-    obs.u = table.Number(row, "u");
-    obs.v = table.Number(row, "v");
+    obs.line = row.line;
+    // Bounds (stitch/README.md): |u|, |v| <= 1e7 px, 0 < sigma_px <= 1e4 px.
+    obs.u = table.Bounded(row, "u", -1e7, 1e7);
+    obs.v = table.Bounded(row, "v", -1e7, 1e7);
     obs.sigma_px = table.OptionalNumber(row, "sigma_px").value_or(default_sigma_px);
-    if (!(obs.sigma_px > 0))
+    if (!(obs.sigma_px > 0 && obs.sigma_px <= 1e4))
       ThrowInputError(table.Where(row),
-                      "sigma_px must be > 0 (got " + FormatNumber(obs.sigma_px) + ")");
+                      "sigma_px must be > 0 and <= 1e4 (got " + FormatNumber(obs.sigma_px) + ")");
     rows.push_back(obs);
   }
   return rows;

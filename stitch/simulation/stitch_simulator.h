@@ -19,6 +19,7 @@ struct StitchObservation {
   std::string frame, point, subimage;
   double u = 0, v = 0;       // sub-image pixel
   double sigma_px = 0.1;     // a-priori sigma
+  int line = 0;              // source line in stitch_obs.csv (0: not read from a file)
 };
 
 struct MisplacementOptions {

@@ -77,7 +77,7 @@ TEST(CameraIo, BadFilesNameFileAndLine) {
   struct Case {
     std::string text, expected;
   } cases[] = {
-      {"pixel_size_mm: -1\nformat_px: [100, 100]\ninterior: {c: 50}\n", ":1: pixel_size_mm must be > 0"},
+      {"pixel_size_mm: -1\nformat_px: [100, 100]\ninterior: {c: 50}\n", ":1: pixel_size_mm out of range (got -1"},
       {base + "colour: red\n", ":5: unknown key 'colour'"},
       {base + "  K9: 1\n", ":5: unknown key 'K9'"},
       {base + "subimages:\n  - id: I\n    format_px: [10, 10]\n    model: affine\n    params: [1, 0, 0]\n",

@@ -50,6 +50,7 @@ struct FrameSpec {
   std::string description = "as given";
   double lat_deg = 0, lon_deg = 0, h_m = 0;  // local tangent plane origin
   std::string utm_zone;                      // e.g. "48N"
+  std::string source;                        // "project.yaml:LINE" of `frame:`, named in errors
 };
 
 struct Project {

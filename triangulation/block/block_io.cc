@@ -15,6 +15,27 @@ namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
+// Physical bounds of the block files' values (triangulation/README.md "Value bounds"): object
+// coordinates within 1e8 m (UTM northings, geocentric metres and degrees fit), angles within one
+// turn either way, pixel coordinates within 1e7 px, sigmas positive and at most 1e6 m / 360 deg /
+// 1e4 px.
+constexpr double kMaxCoordinateM = 1e8;
+constexpr double kMaxAngleDeg = 360.0;
+constexpr double kMaxPixel = 1e7;
+constexpr double kMaxSigmaM = 1e6;
+constexpr double kMaxSigmaDeg = 360.0;
+constexpr double kMaxSigmaPx = 1e4;
+
+// An optional positive sigma column: empty is "not given", otherwise within (0, hi].
+std::optional<double> Sigma(const CsvTable& t, const CsvTable::Row& row, const std::string& column,
+                            double hi) {
+  const auto value = t.OptionalNumber(row, column);
+  if (value && !(*value > 0 && *value <= hi))
+    ThrowInputError(t.Where(row), column + " must be > 0 and <= " + FormatNumber(hi) + " (got " +
+                                      FormatNumber(*value) + ")");
+  return value;
+}
+
 std::string Num(double value, int decimals) {
   char buffer[64];
   std::snprintf(buffer, sizeof(buffer), "%.*f", decimals, value);
@@ -44,21 +65,23 @@ std::vector<Exposure> ReadExposures(const std::string& path) {
     if (e.image.empty()) ThrowInputError(t.Where(row), "image id must not be empty");
     if (!seen.insert(e.image).second) ThrowInputError(t.Where(row), "duplicate image '" + e.image + "'");
     e.camera = t.String(row, "camera");
-    e.center_m = {t.Number(row, "X"), t.Number(row, "Y"), t.Number(row, "Z")};
-    e.opk_rad = {t.Number(row, "omega") * kDegToRad, t.Number(row, "phi") * kDegToRad,
-                 t.Number(row, "kappa") * kDegToRad};
-    const auto sx = t.OptionalNumber(row, "sX"), sy = t.OptionalNumber(row, "sY"),
-               sz = t.OptionalNumber(row, "sZ");
+    e.center_m = {t.Bounded(row, "X", -kMaxCoordinateM, kMaxCoordinateM),
+                  t.Bounded(row, "Y", -kMaxCoordinateM, kMaxCoordinateM),
+                  t.Bounded(row, "Z", -kMaxCoordinateM, kMaxCoordinateM)};
+    e.opk_rad = {t.Bounded(row, "omega", -kMaxAngleDeg, kMaxAngleDeg) * kDegToRad,
+                 t.Bounded(row, "phi", -kMaxAngleDeg, kMaxAngleDeg) * kDegToRad,
+                 t.Bounded(row, "kappa", -kMaxAngleDeg, kMaxAngleDeg) * kDegToRad};
+    const auto sx = Sigma(t, row, "sX", kMaxSigmaM), sy = Sigma(t, row, "sY", kMaxSigmaM),
+               sz = Sigma(t, row, "sZ", kMaxSigmaM);
     if (sx || sy || sz) {
-      if (!(sx && sy && sz) || !(*sx > 0 && *sy > 0 && *sz > 0))
-        ThrowInputError(t.Where(row), "sX, sY, sZ must all be given and > 0 (m)");
+      if (!(sx && sy && sz)) ThrowInputError(t.Where(row), "sX, sY, sZ must all be given or none (m)");
       e.center_sigma_m = Eigen::Vector3d(*sx, *sy, *sz);
     }
-    const auto so = t.OptionalNumber(row, "somega"), sp = t.OptionalNumber(row, "sphi"),
-               sk = t.OptionalNumber(row, "skappa");
+    const auto so = Sigma(t, row, "somega", kMaxSigmaDeg), sp = Sigma(t, row, "sphi", kMaxSigmaDeg),
+               sk = Sigma(t, row, "skappa", kMaxSigmaDeg);
     if (so || sp || sk) {
-      if (!(so && sp && sk) || !(*so > 0 && *sp > 0 && *sk > 0))
-        ThrowInputError(t.Where(row), "somega, sphi, skappa must all be given and > 0 (deg)");
+      if (!(so && sp && sk))
+        ThrowInputError(t.Where(row), "somega, sphi, skappa must all be given or none (deg)");
       e.opk_sigma_rad = Eigen::Vector3d(*so, *sp, *sk) * kDegToRad;
     }
     out.push_back(e);
@@ -85,13 +108,15 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
     if (sub) {
       o.subimage = t.String(row, "subimage");
       if (o.subimage.empty()) ThrowInputError(t.Where(row), "subimage must not be empty");
-      o.pixel = {t.Number(row, "u"), t.Number(row, "v")};
+      o.pixel = {t.Bounded(row, "u", -kMaxPixel, kMaxPixel), t.Bounded(row, "v", -kMaxPixel, kMaxPixel)};
     } else {
-      o.pixel = {t.Number(row, "col"), t.Number(row, "row")};
+      o.pixel = {t.Bounded(row, "col", -kMaxPixel, kMaxPixel),
+                 t.Bounded(row, "row", -kMaxPixel, kMaxPixel)};
     }
-    o.sigma_px = t.OptionalNumber(row, "sigma_px").value_or(default_sigma_px);
-    if (!(o.sigma_px > 0))
-      ThrowInputError(t.Where(row), "sigma_px must be > 0 (got " + FormatNumber(o.sigma_px) + ")");
+    o.sigma_px = Sigma(t, row, "sigma_px", kMaxSigmaPx).value_or(default_sigma_px);
+    if (!(o.sigma_px > 0 && o.sigma_px <= kMaxSigmaPx))
+      ThrowInputError(t.Where(row), "sigma_px must be > 0 and <= " + FormatNumber(kMaxSigmaPx) +
+                                        " (got " + FormatNumber(o.sigma_px) + ")");
     out.push_back(o);
   }
   return out;
@@ -117,19 +142,23 @@ std::vector<GroundPoint> ReadPoints(const std::string& path) {
       p.role = PointRole::kTie;
     else
       ThrowInputError(t.Where(row), "role must be control, check or tie (got '" + role + "')");
-    const auto x = t.OptionalNumber(row, "X"), y = t.OptionalNumber(row, "Y"),
-               z = t.OptionalNumber(row, "Z");
+    const auto x = t.OptionalBounded(row, "X", -kMaxCoordinateM, kMaxCoordinateM),
+               y = t.OptionalBounded(row, "Y", -kMaxCoordinateM, kMaxCoordinateM),
+               z = t.OptionalBounded(row, "Z", -kMaxCoordinateM, kMaxCoordinateM);
     if (x && y && z) p.xyz_m = Eigen::Vector3d(*x, *y, *z);
     else if (x || y || z) ThrowInputError(t.Where(row), "give all of X, Y, Z or none");
     if (p.role != PointRole::kTie && !p.xyz_m)
       ThrowInputError(t.Where(row), PointRoleName(p.role) + " point '" + p.id + "' needs X, Y, Z");
-    const auto sx = t.OptionalNumber(row, "sX"), sy = t.OptionalNumber(row, "sY"),
-               sz = t.OptionalNumber(row, "sZ");
-    if (sx) p.sigma_m.x() = *sx;
-    if (sy) p.sigma_m.y() = *sy;
-    if (sz) p.sigma_m.z() = *sz;
-    if (p.role == PointRole::kControl && !(p.sigma_m.minCoeff() > 0))
-      ThrowInputError(t.Where(row), "control point '" + p.id + "' needs sX, sY, sZ > 0 (m)");
+    // A surveyed point's sigmas weight (control) or judge (check) its survey: they are required,
+    // never a silent default (FORMATS.md: an unknown sigma is never 0 nor made up).
+    const auto sx = Sigma(t, row, "sX", kMaxSigmaM), sy = Sigma(t, row, "sY", kMaxSigmaM),
+               sz = Sigma(t, row, "sZ", kMaxSigmaM);
+    if (p.role != PointRole::kTie) {
+      if (!(sx && sy && sz))
+        ThrowInputError(t.Where(row), PointRoleName(p.role) + " point '" + p.id +
+                                          "' needs sX, sY, sZ > 0 (m): a survey sigma is required");
+      p.sigma_m = Eigen::Vector3d(*sx, *sy, *sz);
+    }
     out.push_back(p);
   }
   return out;
@@ -158,7 +187,8 @@ void ValidateProject(const Project& project) {
 
 Project ReadProject(const std::string& path_in, double default_sigma_px) {
   std::string path = path_in;
-  if (std::filesystem::is_directory(path)) path = (std::filesystem::path(path) / "project.yaml").string();
+  std::error_code ec;  // the error_code form: a symbolic-link loop is then reported by the reader
+  if (std::filesystem::is_directory(path, ec)) path = (std::filesystem::path(path) / "project.yaml").string();
   const YAML::Node root = LoadYamlFile(path);
   RejectUnknownKeys(root, {"cameras", "exposures", "observations", "points", "stitching", "frame", "name"},
                     path);
@@ -166,10 +196,11 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
   Project project;
   project.path = path;
   for (const char* key : {"cameras", "exposures", "observations", "points"})
-    if (!root[key]) ThrowInputError({path, 1}, std::string("missing '") + key + "'");
+    if (!root[key]) ThrowInputError({path, 0}, std::string("missing '") + key + "'");
   if (!root["cameras"].IsMap()) ThrowInputError(WhereIs(root["cameras"], path), "cameras must be a map id: file");
+  if (root["cameras"].size() == 0) ThrowInputError(WhereIs(root["cameras"], path), "no cameras");
   for (const auto& entry : root["cameras"]) {
-    const std::string id = entry.first.as<std::string>();
+    const std::string id = entry.first.Scalar();
     const std::string file = ResolvePath(dir, YamlString(entry.second, path, "camera file"));
     project.camera_files[id] = file;
     project.cameras[id] = calib::ReadCamera(file);
@@ -187,20 +218,31 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
   project.points = ReadPoints(project.points_file);
   if (root["frame"]) {
     const YAML::Node& f = root["frame"];
+    const SourceRef where = WhereIs(f, path);
+    project.frame.source = where.ToString();
+    if (!f.IsMap() || f.size() != 1)
+      ThrowInputError(where, "frame must be one of {local: {lat, lon, h}}, {utm: ZONE}, "
+                             "{projected: TEXT}, {geodetic: ...}");
     RejectUnknownKeys(f, {"local", "utm", "projected", "geodetic"}, path);
     if (f["local"]) {
-      RejectUnknownKeys(f["local"], {"lat", "lon", "h"}, path);
+      const YAML::Node& local = f["local"];
+      if (!local.IsMap())
+        ThrowInputError(WhereIs(local, path), "frame: local needs {lat: DEG, lon: DEG[, h: M]}");
+      RejectUnknownKeys(local, {"lat", "lon", "h"}, path);
+      for (const char* key : {"lat", "lon"})
+        if (!local[key])
+          ThrowInputError(WhereIs(local, path), std::string("frame: local needs '") + key + "' (deg)");
       project.frame.kind = FrameSpec::Kind::kLocal;
-      project.frame.lat_deg = YamlDouble(f["local"]["lat"], path, "lat");
-      project.frame.lon_deg = YamlDouble(f["local"]["lon"], path, "lon");
-      project.frame.h_m = f["local"]["h"] ? YamlDouble(f["local"]["h"], path, "h") : 0.0;
+      project.frame.lat_deg = YamlBounded(local["lat"], path, "frame: local lat", -90, 90);
+      project.frame.lon_deg = YamlBounded(local["lon"], path, "frame: local lon", -180, 360);
+      project.frame.h_m = local["h"] ? YamlBounded(local["h"], path, "frame: local h", -1e5, 1e5) : 0.0;
       project.frame.description = "local tangent plane";
     } else if (f["utm"]) {
       project.frame.kind = FrameSpec::Kind::kUtm;
-      project.frame.utm_zone = YamlString(f["utm"], path, "utm");
+      project.frame.utm_zone = YamlString(f["utm"], path, "frame: utm zone");
       project.frame.description = "UTM " + project.frame.utm_zone;
     } else if (f["projected"]) {
-      project.frame.description = YamlString(f["projected"], path, "projected");
+      project.frame.description = YamlString(f["projected"], path, "frame: projected");
     } else if (f["geodetic"]) {
       // Geodetic input without a stated origin: the local tangent plane about the block's centre
       // (mean of the surveyed points, else of the exposure centres), so that no curvature is lost.
@@ -217,8 +259,14 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
           sum += e.center_m;
           ++n;
         }
-      if (n == 0) ThrowInputError({path, f.Mark().line + 1}, "frame: geodetic needs surveyed points or exposures");
+      if (n == 0) ThrowInputError(where, "frame: geodetic needs surveyed points or exposures");
       const Eigen::Vector3d origin = sum / n;  // X = longitude, Y = latitude (deg), Z = height (m)
+      if (!(std::abs(origin.y()) <= 90 && std::abs(origin.x()) <= 540 && std::abs(origin.z()) <= 1e5))
+        ThrowInputError(where, "frame: geodetic, but the block's mean X, Y, Z (" +
+                                   FormatNumber(origin.x()) + ", " + FormatNumber(origin.y()) + ", " +
+                                   FormatNumber(origin.z()) +
+                                   ") is no longitude/latitude/height: metre coordinates need "
+                                   "frame: {projected: ...}");
       project.frame.lon_deg = origin.x();
       project.frame.lat_deg = origin.y();
       project.frame.h_m = origin.z();

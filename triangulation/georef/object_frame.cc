@@ -2,11 +2,13 @@
 
 #include "calib/core/error.h"
 
+#include <GeographicLib/Constants.hpp>
 #include <GeographicLib/LocalCartesian.hpp>
 #include <GeographicLib/UTMUPS.hpp>
 
 #include <cmath>
 #include <cstdio>
+#include <limits>
 
 namespace aerocal::triangulation {
 
@@ -17,14 +19,26 @@ struct ObjectFrame::Impl {
   bool north = true;
 };
 
+namespace {
+
+// "project.yaml:7: frame: " or "frame: " when the frame has no source.
+std::string FramePrefix(const FrameSpec& spec) {
+  return (spec.source.empty() ? "" : spec.source + ": ") + "frame: ";
+}
+
+}  // namespace
+
 ObjectFrame::ObjectFrame(const FrameSpec& spec) : impl_(std::make_unique<Impl>()) {
   impl_->spec = spec;
   switch (spec.kind) {
     case FrameSpec::Kind::kLocal:
     case FrameSpec::Kind::kGeodeticToLocal:
-      if (!(std::abs(spec.lat_deg) <= 90.0) || !(spec.lon_deg >= -180.0 && spec.lon_deg <= 360.0))
-        throw InputError("frame: local origin lat/lon out of range (got " +
-                         std::to_string(spec.lat_deg) + ", " + std::to_string(spec.lon_deg) + ")");
+      if (!(std::abs(spec.lat_deg) <= 90.0) || !(spec.lon_deg >= -180.0 && spec.lon_deg <= 360.0) ||
+          !(std::abs(spec.h_m) <= 1e5))
+        throw InputError(FramePrefix(spec) + "local origin out of range (got lat " +
+                         std::to_string(spec.lat_deg) + ", lon " + std::to_string(spec.lon_deg) +
+                         ", h " + std::to_string(spec.h_m) +
+                         "; expected |lat| <= 90 deg, lon -180 .. 360 deg, |h| <= 1e5 m)");
       impl_->local =
           std::make_unique<GeographicLib::LocalCartesian>(spec.lat_deg, spec.lon_deg, spec.h_m);
       break;
@@ -32,11 +46,11 @@ ObjectFrame::ObjectFrame(const FrameSpec& spec) : impl_(std::make_unique<Impl>()
       try {
         GeographicLib::UTMUPS::DecodeZone(spec.utm_zone, impl_->zone, impl_->north);
       } catch (const std::exception& e) {
-        throw InputError("frame: utm zone '" + spec.utm_zone + "' is not a UTM zone like 33N (" +
-                         e.what() + ")");
+        throw InputError(FramePrefix(spec) + "utm zone '" + spec.utm_zone +
+                         "' is not a UTM zone like 33N (" + e.what() + ")");
       }
       if (impl_->zone == GeographicLib::UTMUPS::UPS)
-        throw InputError("frame: utm zone '" + spec.utm_zone + "' is a polar (UPS) zone");
+        throw InputError(FramePrefix(spec) + "utm zone '" + spec.utm_zone + "' is a polar (UPS) zone");
       break;
     case FrameSpec::Kind::kProjected:
       break;
@@ -73,7 +87,12 @@ Eigen::Vector3d ObjectFrame::ToInput(const Eigen::Vector3d& a) const {
     out = {lon, lat, h};
   } else if (impl_->zone > 0) {
     double lat = 0, lon = 0;
-    GeographicLib::UTMUPS::Reverse(impl_->zone, impl_->north, a.x(), a.y(), lat, lon);
+    try {
+      GeographicLib::UTMUPS::Reverse(impl_->zone, impl_->north, a.x(), a.y(), lat, lon);
+    } catch (const GeographicLib::GeographicErr&) {
+      // An adjusted point far outside the zone (a diverged solution): no geodetic value.
+      lat = lon = std::numeric_limits<double>::quiet_NaN();
+    }
     out = {lon, lat, a.z()};
   }
   return out;
@@ -109,9 +128,30 @@ std::string ObjectFrame::Description() const {
 Project ToAdjustmentFrame(const Project& project, const ObjectFrame& frame) {
   Project out = project;
   if (!frame.geodetic_input()) return out;
+  const FrameSpec& spec = frame.impl_->spec;
+  // Geodetic input: X = longitude, Y = latitude (deg), Z = height (m). Metre coordinates under a
+  // geodetic frame are an input error at their line, never a NaN or a GeographicLib exception.
+  const auto convert = [&](const Eigen::Vector3d& xyz, const SourceRef& where) {
+    const std::string frame_text =
+        "the frame (" + (spec.source.empty() ? std::string("frame:") : spec.source) +
+        ") takes geodetic X = longitude, Y = latitude (deg), Z = height (m); metre coordinates "
+        "need frame: {projected: ...}";
+    if (!(std::abs(xyz.y()) <= 90.0 && std::abs(xyz.x()) <= 540.0 && std::abs(xyz.z()) <= 1e5))
+      ThrowInputError(where, "not a longitude/latitude/height (got " + std::to_string(xyz.x()) +
+                                 ", " + std::to_string(xyz.y()) + ", " + std::to_string(xyz.z()) +
+                                 "): " + frame_text);
+    try {
+      const Eigen::Vector3d a = frame.ToAdjustment(xyz);
+      if (!a.allFinite()) ThrowInputError(where, "cannot be converted: " + frame_text);
+      return a;
+    } catch (const GeographicLib::GeographicErr& e) {
+      ThrowInputError(where, std::string("cannot be converted to the frame (") +
+                                 (spec.source.empty() ? "frame:" : spec.source) + "): " + e.what());
+    }
+  };
   for (auto& p : out.points)
-    if (p.xyz_m) p.xyz_m = frame.ToAdjustment(*p.xyz_m);
-  for (auto& e : out.exposures) e.center_m = frame.ToAdjustment(e.center_m);
+    if (p.xyz_m) p.xyz_m = convert(*p.xyz_m, {project.points_file, p.line});
+  for (auto& e : out.exposures) e.center_m = convert(e.center_m, {project.exposures_file, e.line});
   out.frame.description = frame.Description();
   return out;
 }

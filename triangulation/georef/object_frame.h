@@ -46,6 +46,7 @@ class ObjectFrame {
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  friend Project ToAdjustmentFrame(const Project& project, const ObjectFrame& frame);
 };
 
 /// The project with points and exposure centres (and their sigmas, unchanged in metres) in the

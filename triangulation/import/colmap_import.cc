@@ -13,6 +13,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
 
 namespace aerocal::triangulation {
 namespace {
@@ -38,10 +39,15 @@ calib::ModelCamera ReadColmapCamera(const TextRow& row, const std::string& file,
   calib::ModelCamera camera;
   camera.model = *model;
   camera.frame.pixel_size_mm = pixel_size_mm;
-  camera.frame.width_px = static_cast<int>(NumberField(row, 2, file, "WIDTH"));
-  camera.frame.height_px = static_cast<int>(NumberField(row, 3, file, "HEIGHT"));
+  camera.frame.width_px = internal::IntegerField(row, 2, file, "WIDTH", 1, 1000000);
+  camera.frame.height_px = internal::IntegerField(row, 3, file, "HEIGHT", 1, 1000000);
   for (size_t k = 0; k < num_params; ++k)
-    camera.params.push_back(NumberField(row, 4 + k, file, "PARAMS"));
+    camera.params.push_back(internal::BoundedField(row, 4 + k, file, "PARAMS", -1e7, 1e7));
+  // Focal lengths (f, or fx and fy) lead every COLMAP model's parameters.
+  const bool two_focals = name == "PINHOLE" || name == "OPENCV" || name == "FULL_OPENCV";
+  if (!(camera.params[0] > 0) || (two_focals && !(camera.params[1] > 0)))
+    ThrowInputError({file, row.line}, "focal length must be > 0 px (got " +
+                                          FormatNumber(camera.params[0]) + ")");
   return camera;
 }
 
@@ -76,7 +82,25 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     const std::string id = StringField(row, 0, cameras_file, "CAMERA_ID");
     const calib::ModelCamera colmap = ReadColmapCamera(row, cameras_file, o.pixel_size_mm);
     const std::string model(calib::ColmapName(colmap.model));
-    const calib::ConversionResult fit = calib::ConvertCamera(colmap, calib::CameraModelId::kBrownFraser10);
+    if (project.cameras.count(id))
+      ThrowInputError({cameras_file, row.line}, "camera " + id + " defined twice");
+    const std::string unusable = model + " distortion cannot be represented over the " +
+                                 std::to_string(colmap.frame.width_px) + " x " +
+                                 std::to_string(colmap.frame.height_px) +
+                                 " px image (it folds over or diverges): not a usable camera";
+    calib::ConversionResult fit;
+    try {
+      fit = calib::ConvertCamera(colmap, calib::CameraModelId::kBrownFraser10);
+    } catch (const LogicError& e) {
+      ThrowInputError({cameras_file, row.line}, unusable + " (" + e.what() + ")");
+    }
+    bool finite = std::isfinite(fit.residual.rms_px) && std::isfinite(fit.residual.max_px);
+    for (double v : fit.camera.params) finite = finite && std::isfinite(v);
+    // A conversion missing by more than 10 px somewhere in the format is no usable camera (the
+    // test cameras convert to 0.016 px; OPENCV k1 = -1 or 10 miss by thousands of pixels).
+    if (!finite || !(fit.residual.max_px <= 10.0))
+      ThrowInputError({cameras_file, row.line}, unusable + " (conversion misses by up to " +
+                                                    FormatNumber(fit.residual.max_px, 3) + " px)");
     calib::Camera camera;
     camera.name = "COLMAP camera " + id + " (" + model + ")";
     camera.width_px = colmap.frame.width_px;
@@ -91,6 +115,7 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
   }
   // images.txt: per image a pose line, then a points2D line (which may be empty).
   auto image_rows = internal::ReadTextRows(images_file, false, true);
+  std::set<std::string> image_names;
   while (!image_rows.empty() && image_rows.back().fields.empty()) image_rows.pop_back();
   for (size_t i = 0; i < image_rows.size(); i += 2) {
     const TextRow& row = image_rows[i];
@@ -101,6 +126,10 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     e.line = row.line;
     e.image = std::filesystem::path(row.fields[9]).stem().string();
     e.camera = row.fields[8];
+    if (e.image.empty()) ThrowInputError({images_file, row.line}, "empty image name");
+    if (!image_names.insert(e.image).second)
+      ThrowInputError({images_file, row.line},
+                      "image name '" + e.image + "' given twice (two images would merge)");
     if (!project.cameras.count(e.camera))
       ThrowInputError({images_file, row.line}, "unknown camera " + e.camera);
     const Eigen::Quaterniond q(NumberField(row, 1, images_file, "QW"),
@@ -110,6 +139,12 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     const Eigen::Vector3d t(NumberField(row, 5, images_file, "TX"),
                             NumberField(row, 6, images_file, "TY"),
                             NumberField(row, 7, images_file, "TZ"));
+    // COLMAP writes unit quaternions; anything else (0,0,0,0 above all) is no rotation.
+    if (!(std::abs(q.norm() - 1.0) <= 1e-3))
+      ThrowInputError({images_file, row.line}, "QW QX QY QZ is not a unit quaternion (norm " +
+                                                   FormatNumber(q.norm()) + ")");
+    if (!(t.cwiseAbs().maxCoeff() <= 1e8))
+      ThrowInputError({images_file, row.line}, "TX TY TZ beyond 1e8");
     const Eigen::Matrix3d camera_from_world = q.normalized().toRotationMatrix();
     e.center_m = -camera_from_world.transpose() * t;
     const Eigen::Matrix3d object_from_image =
@@ -126,8 +161,8 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
       obs.line = points.line;
       obs.image = e.image;
       obs.point = points.fields[k + 2];
-      obs.pixel = {NumberField(points, k, images_file, "X") - 0.5,
-                   NumberField(points, k + 1, images_file, "Y") - 0.5};
+      obs.pixel = {internal::BoundedField(points, k, images_file, "X", -1e7, 1e7) - 0.5,
+                   internal::BoundedField(points, k + 1, images_file, "Y", -1e7, 1e7) - 0.5};
       obs.sigma_px = o.sigma_px;
       project.observations.push_back(obs);
     }
@@ -136,9 +171,9 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     GroundPoint p;
     p.line = row.line;
     p.id = StringField(row, 0, points_file, "POINT3D_ID");
-    p.xyz_m = Eigen::Vector3d(NumberField(row, 1, points_file, "X"),
-                              NumberField(row, 2, points_file, "Y"),
-                              NumberField(row, 3, points_file, "Z"));
+    p.xyz_m = Eigen::Vector3d(internal::BoundedField(row, 1, points_file, "X", -1e8, 1e8),
+                              internal::BoundedField(row, 2, points_file, "Y", -1e8, 1e8),
+                              internal::BoundedField(row, 3, points_file, "Z", -1e8, 1e8));
     project.points.push_back(p);
   }
   return report;

@@ -1,6 +1,7 @@
 #include "triangulation/import/odm_gcp_import.h"
 
 #include "calib/core/error.h"
+#include "calib/core/log.h"
 #include "triangulation/import/text_rows.h"
 
 #include <algorithm>
@@ -8,6 +9,7 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
+#include <set>
 
 namespace aerocal::triangulation {
 
@@ -41,9 +43,10 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
   for (size_t i = 1; i < rows.size(); ++i) {
     const auto& row = rows[i];
     using internal::NumberField;
-    const Eigen::Vector3d xyz(NumberField(row, 0, o.gcp_list, "geo_x"),
-                              NumberField(row, 1, o.gcp_list, "geo_y"),
-                              NumberField(row, 2, o.gcp_list, "geo_z"));
+    using internal::BoundedField;
+    const Eigen::Vector3d xyz(BoundedField(row, 0, o.gcp_list, "geo_x", -1e8, 1e8),
+                              BoundedField(row, 1, o.gcp_list, "geo_y", -1e8, 1e8),
+                              BoundedField(row, 2, o.gcp_list, "geo_z", -1e8, 1e8));
     ImageObservation obs;
     obs.line = row.line;
     obs.pixel = Eigen::Vector2d(NumberField(row, 3, o.gcp_list, "im_x"),
@@ -77,6 +80,23 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
     }
     project.observations.push_back(obs);
   }
+  if (project.observations.empty())
+    ThrowInputError({o.gcp_list, 0}, "no targets listed (only the projection line): nothing to import");
+  for (const auto& id : o.control_ids)
+    if (!points.count(id))
+      throw ConfigError("--control: '" + id + "' is no target of " + o.gcp_list +
+                        " (every control name must match a target)");
+  // An image seeing fewer than two distinct targets gets no starting orientation: left out.
+  std::map<std::string, std::set<std::string>> targets_of_image;
+  for (const auto& obs : project.observations) targets_of_image[obs.image].insert(obs.point);
+  std::vector<ImageObservation> kept;
+  for (const auto& obs : project.observations)
+    if (targets_of_image[obs.image].size() >= 2) kept.push_back(obs);
+  for (const auto& [image, targets] : targets_of_image)
+    if (targets.size() < 2)
+      LogWarning(o.gcp_list + ": image " + image + " sees " + std::to_string(targets.size()) +
+                 " target(s) only: no starting orientation; left out");
+  project.observations = std::move(kept);
   for (auto& [id, p] : points) project.points.push_back(p);
   return project;
 }

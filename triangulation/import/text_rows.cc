@@ -7,30 +7,47 @@
 #include <sstream>
 
 namespace aerocal::triangulation::internal {
+namespace {
+
+std::string Trim(const std::string& s) {
+  const auto begin = s.find_first_not_of(" \t");
+  if (begin == std::string::npos) return "";
+  return s.substr(begin, s.find_last_not_of(" \t") - begin + 1);
+}
+
+}  // namespace
 
 std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates, bool keep_blank) {
-  const std::string text = ReadTextFile(path);
   std::vector<TextRow> rows;
-  std::istringstream in(text);
-  std::string line;
   int number = 0;
-  while (std::getline(in, line)) {
+  for (const std::string& line : SplitLines(ReadTextFile(path))) {
     ++number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
     const auto first = line.find_first_not_of(" \t");
-    if (first == std::string::npos && keep_blank) {
-      rows.push_back({number, {}});
+    if (first == std::string::npos) {
+      if (keep_blank) rows.push_back({number, {}});
       continue;
     }
-    if (first == std::string::npos || line[first] == '#') continue;
-    if (comma_separates)
-      for (char& ch : line)
-        if (ch == ',') ch = ' ';
+    if (line[0] == '#') continue;  // a comment only where '#' is the line's first character
     TextRow row;
     row.line = number;
-    std::istringstream fields(line);
-    std::string field;
-    while (fields >> field) row.fields.push_back(field);
+    if (comma_separates && line.find(',') != std::string::npos) {
+      // Comma-separated: every field must be there; an empty one would shift the columns.
+      std::stringstream in(line);
+      std::string field;
+      while (std::getline(in, field, ',')) {
+        row.fields.push_back(Trim(field));
+        if (row.fields.back().empty())
+          ThrowInputError({path, number},
+                          "empty field " + std::to_string(row.fields.size()) + " (give every value)");
+      }
+      if (line.back() == ',')
+        ThrowInputError({path, number}, "empty field " + std::to_string(row.fields.size() + 1) +
+                                            " (the line ends with a comma)");
+    } else {
+      std::istringstream fields(line);
+      std::string field;
+      while (fields >> field) row.fields.push_back(field);
+    }
     rows.push_back(std::move(row));
   }
   return rows;
@@ -45,6 +62,25 @@ double NumberField(const TextRow& row, size_t k, const std::string& file, const 
     ThrowInputError({file, row.line},
                     std::string(what) + " must be a number (got '" + row.fields[k] + "')");
   return *value;
+}
+
+double BoundedField(const TextRow& row, size_t k, const std::string& file, const char* what,
+                    double lo, double hi) {
+  const double value = NumberField(row, k, file, what);
+  if (!(value >= lo && value <= hi))
+    ThrowInputError({file, row.line}, std::string(what) + " out of range (got " +
+                                          FormatNumber(value) + ", expected " + FormatNumber(lo) +
+                                          " .. " + FormatNumber(hi) + ")");
+  return value;
+}
+
+int IntegerField(const TextRow& row, size_t k, const std::string& file, const char* what, int lo,
+                 int hi) {
+  const double value = BoundedField(row, k, file, what, lo, hi);
+  if (value != static_cast<double>(static_cast<int>(value)))
+    ThrowInputError({file, row.line},
+                    std::string(what) + " must be an integer (got '" + row.fields[k] + "')");
+  return static_cast<int>(value);
 }
 
 const std::string& StringField(const TextRow& row,

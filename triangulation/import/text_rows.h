@@ -1,5 +1,7 @@
-// Header-less text tables of other tools (DBAT, PhotoModeler, ODM, COLMAP): lines split on commas
-// and/or blanks, '#' comment lines and blank lines skipped, every value error as FILE:LINE.
+// Header-less text tables of other tools (DBAT, PhotoModeler, ODM, COLMAP): a line holding a comma
+// is split on commas (an empty field is an error, never a column shift), others on blanks; '#'
+// comment lines ('#' as the first character) and blank lines skipped; BOM, CRLF and CR line ends
+// accepted; every value error as FILE:LINE.
 #pragma once
 
 #include <string>
@@ -20,6 +22,12 @@ std::vector<TextRow> ReadTextRows(const std::string& path,
 
 /// Field k as a number; InputError("FILE:LINE: ...") when absent or not a number.
 double NumberField(const TextRow& row, size_t k, const std::string& file, const char* what);
+/// Field k as a number within [lo, hi]; InputError naming the range otherwise.
+double BoundedField(const TextRow& row, size_t k, const std::string& file, const char* what,
+                    double lo, double hi);
+/// Field k as an integer within [lo, hi].
+int IntegerField(const TextRow& row, size_t k, const std::string& file, const char* what, int lo,
+                 int hi);
 /// Field k as a string; InputError when absent.
 const std::string& StringField(const TextRow& row,
                                size_t k,

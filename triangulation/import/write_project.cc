@@ -2,6 +2,11 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/log.h"
+
+#include <cmath>
+#include <set>
 #include "triangulation/block/block_io.h"
 
 namespace aerocal::triangulation {
@@ -17,6 +22,29 @@ std::string Quoted(const std::string& text) {
 }
 
 }  // namespace
+
+Project UsableImportedBlock(const Project& project, const std::string& source) {
+  Project out = project;
+  std::set<std::string> observed;
+  for (const auto& o : project.observations) observed.insert(o.image);
+  out.exposures.clear();
+  for (const auto& e : project.exposures) {
+    if (observed.count(e.image))
+      out.exposures.push_back(e);
+    else
+      LogWarning(source + ": image " + e.image + " has no usable observation: left out");
+  }
+  if (out.observations.empty())
+    throw InputError(source + ": no image observations: nothing to adjust (no block written)");
+  if (out.exposures.size() < 2)
+    throw InputError(source + ": " + std::to_string(out.exposures.size()) +
+                     " observed exposure(s): a block needs two or more (no block written)");
+  for (const auto& [id, camera] : out.cameras)
+    if (!(camera.width_px > 0 && camera.height_px > 0 && camera.pixel_size_mm > 0 &&
+          camera.c_mm() > 0 && std::isfinite(camera.c_mm())))
+      throw InputError(source + ": camera " + id + " has no usable format or principal distance");
+  return out;
+}
 
 void WriteProjectFolder(const Project& project, const std::string& folder) {
   std::string yaml = "# Imported from " + project.path + "\ncameras:\n";

@@ -9,6 +9,11 @@
 
 namespace aerocal::triangulation {
 
+/// The imported block as `adjust` can take it: an exposure without any observation is left out
+/// with a warning naming it (and `source`); InputError("SOURCE: ...") when no block remains (no
+/// observations, fewer than two observed exposures, a camera without a usable format).
+Project UsableImportedBlock(const Project& project, const std::string& source);
+
 /// Every file is written atomically; the folder is created when missing.
 void WriteProjectFolder(const Project& project, const std::string& folder);
 

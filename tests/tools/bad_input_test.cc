@@ -1,0 +1,709 @@
+// Issue 12: bad input never crashes, hangs or passes quietly. Each case of the mutation campaign
+// is one row: a mutation of a small simulated flight (or a hand-written import file), the command,
+// the exit code (2 bad input, 3 numerical failure) and the FILE:LINE (or option) the message must
+// name; the output must not exist afterwards. Plus the reader rules that must ACCEPT input (BOM,
+// CRLF, CR, '#' inside a row) and the stitching robust start against a 20000 px decimal slip.
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/yaml_util.h"
+#include "stitch/adjustment/stitch_adjustment.h"
+#include "tests/support/test_support.h"
+#include "triangulation/block/block_io.h"
+
+namespace aerocal {
+namespace {
+
+namespace fs = std::filesystem;
+using testing::RunAerocal;
+using testing::RunCommand;
+using testing::TempDir;
+
+std::string Read(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void Write(const std::string& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+std::vector<std::string> Lines(const std::string& path) {
+  std::vector<std::string> lines;
+  std::istringstream in(Read(path));
+  for (std::string line; std::getline(in, line);) lines.push_back(line);
+  return lines;
+}
+
+void WriteLines(const std::string& path, const std::vector<std::string>& lines) {
+  std::string text;
+  for (const auto& l : lines) text += l + "\n";
+  Write(path, text);
+}
+
+// Replaces the first occurrence of `from` in the file; fails the test when absent.
+void Replace(const std::string& path, const std::string& from, const std::string& to) {
+  std::string text = Read(path);
+  const auto at = text.find(from);
+  ASSERT_NE(at, std::string::npos) << from << " not in " << path;
+  text.replace(at, from.size(), to);
+  Write(path, text);
+}
+
+// Sets field `col` (0-based) of 1-based line `line` of a CSV file.
+void SetField(const std::string& path, int line, int col, const std::string& value) {
+  auto lines = Lines(path);
+  std::vector<std::string> f;
+  std::stringstream in(lines[line - 1]);
+  for (std::string x; std::getline(in, x, ',');) f.push_back(x);
+  f.resize(std::max<size_t>(f.size(), col + 1));
+  f[col] = value;
+  std::string joined;
+  for (size_t i = 0; i < f.size(); ++i) joined += (i ? "," : "") + f[i];
+  lines[line - 1] = joined;
+  WriteLines(path, lines);
+}
+
+// The small simulated flight every CLI case starts from (made once).
+const std::string& BaseFlight() {
+  static TempDir* dir = new TempDir("aerocal_bad_input_base");
+  static const bool made = [] {
+    const auto r = RunAerocal("simulate --out " + dir->File("sim") +
+                              " --exposures 6 --strips 1 --points 12 --control 6 --tie-points 40 "
+                              "--stitch-ties 60");
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    return true;
+  }();
+  (void)made;
+  static const std::string path = dir->File("sim");
+  return path;
+}
+
+// A copy of the base flight in a fresh folder `d`/sim.
+std::string Flight(const TempDir& d) {
+  fs::copy(BaseFlight(), d.File("sim"), fs::copy_options::recursive);
+  return d.File("sim");
+}
+
+// Minimal DBAT block: a camera XML, two images, eight marks each, initial EO.
+void WriteDbat(const std::string& dir) {
+  Write(dir + "/cam.xml",
+        "<?xml version=\"1.0\"?>\n<document><cameras><camera>\n<name>test</name>\n"
+        "<sensor>auto,24</sensor>\n<image>6000,4000</image>\n<focal>35</focal>\n<cc>35</cc>\n"
+        "<pp>0,0</pp>\n<K>0,0,0</K>\n<P>0,0</P>\n</camera></cameras></document>\n");
+  Write(dir + "/images.txt", "1, img1.jpg\n2, img2.jpg\n");
+  Write(dir + "/eo.txt", "1, 0, 0, 100, 0, 0, 0\n2, 20, 0, 100, 0, 0, 0\n");
+  std::string marks;
+  for (int image = 1; image <= 2; ++image)
+    for (int p = 1; p <= 8; ++p)
+      marks += std::to_string(image) + ", " + std::to_string(p) + ", " +
+               std::to_string(500 + 500 * p - 1500 * image) + ", " + std::to_string(800 + 300 * p) +
+               "\n";
+  Write(dir + "/marks.txt", marks);
+}
+
+std::string DbatArgs(const std::string& dir, const std::string& marks = "") {
+  return "import dbat --camera-xml " + dir + "/cam.xml --marks " +
+         (marks.empty() ? dir + "/marks.txt" : marks) + " --images " +
+         dir + "/images.txt --initial-eo " + dir + "/eo.txt --out " + dir + "/out";
+}
+
+// Minimal COLMAP text model: one OPENCV camera, two images, four points.
+void WriteColmap(const std::string& dir) {
+  fs::create_directories(dir + "/model");
+  Write(dir + "/model/cameras.txt",
+        "# Camera list\n1 OPENCV 4000 3000 3000 3000 2000 1500 -0.05 0.01 0.001 -0.001\n");
+  std::string images = "# Image list\n";
+  for (int i = 1; i <= 2; ++i) {
+    images += std::to_string(i) + " 1 0 0 0 " + std::to_string(-2 * i) + " 0 10 1 img" +
+              std::to_string(i) + ".jpg\n";
+    for (int p = 1; p <= 4; ++p)
+      images += std::to_string(1000 + 400 * p) + " " + std::to_string(1000 + 200 * p) + " " +
+                std::to_string(p) + " ";
+    images += "\n";
+  }
+  Write(dir + "/model/images.txt", images);
+  std::string points = "# 3D points\n";
+  for (int p = 1; p <= 4; ++p)
+    points += std::to_string(p) + " " + std::to_string(p) + " 1 0 128 128 128 0.5 1 0 2 0\n";
+  Write(dir + "/model/points3D.txt", points);
+}
+
+std::string ColmapArgs(const std::string& dir) {
+  return "import colmap --model " + dir + "/model --pixel-size-mm 0.005 --out " + dir + "/out";
+}
+
+// The ODM list of a 2x... near-nadir block: three targets seen by two images each.
+void WriteOdm(const std::string& dir) {
+  std::string gcp = "+proj=utm +zone=33 +datum=WGS84\n";
+  const double xyz[3][3] = {{100, 100, 10}, {160, 100, 12}, {130, 150, 11}};
+  for (int image = 1; image <= 2; ++image)
+    for (int t = 0; t < 3; ++t)
+      gcp += std::to_string(xyz[t][0]) + " " + std::to_string(xyz[t][1]) + " " +
+             std::to_string(xyz[t][2]) + " " + std::to_string(3000 + 40 * (xyz[t][0] - 130) - 300 * image) +
+             " " + std::to_string(2000 - 40 * (xyz[t][1] - 125)) + " img" + std::to_string(image) +
+             ".jpg T" + std::to_string(t + 1) + "\n";
+  Write(dir + "/gcp.txt", gcp);
+  Write(dir + "/cam.yaml",
+        "pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n");
+}
+
+std::string OdmArgs(const std::string& dir) {
+  return "import odm --gcp-list " + dir + "/gcp.txt --camera " + dir + "/cam.yaml --out " + dir +
+         "/out";
+}
+
+struct Case {
+  const char* name;
+  // Prepares the files in `dir` and returns the aerocal arguments.
+  std::function<std::string(const TempDir& dir)> setup;
+  int exit_code;
+  std::string expect;  // substring of the output; "{DIR}" is the case's folder
+  std::string output;  // path (below {DIR}) that must not exist afterwards; "" for none
+};
+
+std::string StitchArgs(const std::string& sim, const std::string& out = "") {
+  return "stitch --camera " + sim + "/camera_nominal.yaml --obs " + sim +
+         "/stitch_obs.csv --base III,IV --out " + (out.empty() ? sim + "/../s.json" : out);
+}
+
+std::string AdjustArgs(const std::string& sim) {
+  return "adjust --project " + sim + "/project.yaml --out " + sim + "/../a.json";
+}
+
+const std::vector<Case>& Cases() {
+  static const std::vector<Case> cases = {
+      // ---- input files: refused before reading ----
+      {"fifo_as_camera",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         ::mkfifo(d.File("fifo").c_str(), 0600);
+         return "stitch --camera " + d.File("fifo") + " --obs " + sim + "/stitch_obs.csv --out " +
+                d.File("s.json");
+       },
+       2, "{DIR}/fifo: is a FIFO", "s.json"},
+      {"directory_as_obs",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         return "stitch --camera " + sim + "/camera_nominal.yaml --obs " + sim + " --out " +
+                d.File("s.json");
+       },
+       2, "{DIR}/sim: is a directory", "s.json"},
+      {"symlink_loop_project",
+       [](const TempDir& d) {
+         fs::create_symlink(d.File("loop"), d.File("loop"));
+         return "adjust --project " + d.File("loop") + " --out " + d.File("a.json");
+       },
+       2, "{DIR}/loop: symbolic-link loop", "a.json"},
+      {"device_as_dbat_marks",
+       [](const TempDir& d) {
+         WriteDbat(d.path());
+         return DbatArgs(d.path(), "/dev/zero");
+       },
+       2, "/dev/zero: is a device", "out"},
+      {"directory_as_dbat_marks",
+       [](const TempDir& d) {
+         WriteDbat(d.path());
+         return DbatArgs(d.path(), d.path());
+       },
+       2, "is a directory", "out"},
+      {"empty_dbat_marks",
+       [](const TempDir& d) {
+         WriteDbat(d.path());
+         Write(d.File("marks.txt"), "");
+         return DbatArgs(d.path());
+       },
+       2, "{DIR}/marks.txt: no image observations", "out"},
+      // ---- YAML strictly ----
+      {"yaml_duplicate_key",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/camera_nominal.yaml", "format_px: [14000, 12000]",
+                 "format_px: [14000, 12000]\npixel_size_mm: 0.5");
+         return StitchArgs(sim);
+       },
+       2, "camera_nominal.yaml:5: duplicate key 'pixel_size_mm'", "s.json"},
+      {"yaml_key_is_a_sequence",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/project.yaml", "exposures: exposures.csv", "[a, b]: 1\nexposures: exposures.csv");
+         return AdjustArgs(sim);
+       },
+       2, "project.yaml:3: a map key must be a plain name", "a.json"},
+      {"yaml_key_is_a_map",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/camera_nominal.yaml", "interior:", "? {a: 1}\n: 2\ninterior:");
+         return StitchArgs(sim);
+       },
+       2, "camera_nominal.yaml:5: a map key must be a plain name", "s.json"},
+      {"yaml_value_is_a_map",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/camera_nominal.yaml", "pixel_size_mm: 0.0089999999999999993",
+                 "pixel_size_mm: {a: 1}");
+         return StitchArgs(sim);
+       },
+       2, "camera_nominal.yaml:3: pixel_size_mm must be a number", "s.json"},
+      // ---- frames ----
+      {"frame_local_without_lat",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/project.yaml", "frame: {projected: \"simulated local frame\"}",
+                 "frame: {local: {lon: 7}}");
+         return AdjustArgs(sim);
+       },
+       2, "project.yaml:6: frame: local needs 'lat'", "a.json"},
+      {"frame_utm_with_metre_coordinates",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/project.yaml", "frame: {projected: \"simulated local frame\"}",
+                 "frame: {utm: \"33N\"}");
+         return AdjustArgs(sim);
+       },
+       2, "points.csv:2: not a longitude/latitude/height", "a.json"},
+      {"frame_local_with_metre_coordinates",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/project.yaml", "frame: {projected: \"simulated local frame\"}",
+                 "frame: {local: {lat: 47, lon: 8}}");
+         return AdjustArgs(sim);
+       },
+       2, "project.yaml:6) takes geodetic", "a.json"},
+      {"frame_not_a_map",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/project.yaml", "frame: {projected: \"simulated local frame\"}",
+                 "frame: [1, 2]");
+         return AdjustArgs(sim);
+       },
+       2, "project.yaml:6: frame must be one of", "a.json"},
+      // ---- CSV values ----
+      {"control_point_without_sigma",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         SetField(sim + "/points.csv", 2, 4, "");
+         SetField(sim + "/points.csv", 2, 5, "");
+         SetField(sim + "/points.csv", 2, 6, "");
+         return AdjustArgs(sim);
+       },
+       2, "points.csv:2: control point 'C1' needs sX, sY, sZ", "a.json"},
+      {"exposure_angle_out_of_range",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         SetField(sim + "/exposures.csv", 3, 7, "1e300");
+         return AdjustArgs(sim);
+       },
+       2, "exposures.csv:3: column 'kappa' out of range", "a.json"},
+      {"observation_pixel_out_of_range",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         SetField(sim + "/observations.csv", 4, 2, "1e200");
+         return AdjustArgs(sim);
+       },
+       2, "observations.csv:4: column 'col' out of range", "a.json"},
+      // ---- outputs ----
+      {"out_device",
+       [](const TempDir& d) { return StitchArgs(Flight(d), "/dev/null"); }, 2,
+       "--out '/dev/null': exists and is a device", ""},
+      {"out_empty",
+       [](const TempDir& d) { return StitchArgs(Flight(d), "''"); }, 2, "--out: empty path",
+       ""},
+      {"out_directory",
+       [](const TempDir& d) { return StitchArgs(Flight(d), d.path()); }, 2,
+       "exists and is a directory", ""},
+      {"out_below_a_file",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         return StitchArgs(sim, sim + "/points.csv/s.json");
+       },
+       2, "a part of the path is a file", ""},
+      {"out_name_too_long",
+       [](const TempDir& d) { return StitchArgs(Flight(d), d.File(std::string(300, 'a'))); },
+       2, "name too long", ""},
+      {"simulate_out_device",
+       [](const TempDir&) { return std::string("simulate --out /dev/null"); }, 2,
+       "--out '/dev/null': exists and is not a folder", ""},
+      {"resample_out_below_a_file",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         return "resample --camera " + sim + "/camera_nominal.yaml --mapping x.json --images I=a.tif --out " +
+                sim + "/points.csv/v.tif";
+       },
+       2, "--out", ""},
+      {"resample_out_name_too_long",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         return "resample --camera " + sim + "/camera_nominal.yaml --mapping x.json --images I=a.tif --out " +
+                d.File(std::string(300, 'v') + ".tif");
+       },
+       2, "name too long", ""},
+      // ---- options ----
+      {"simulate_height_nan", [](const TempDir& d) { return "simulate --out " + d.File("o") + " --height-m nan"; },
+       2, "--height-m: must be a finite number", "o"},
+      {"simulate_height_inf", [](const TempDir& d) { return "simulate --out " + d.File("o") + " --height-m inf"; },
+       2, "--height-m", "o"},
+      {"simulate_height_huge", [](const TempDir& d) { return "simulate --out " + d.File("o") + " --height-m 1e308"; },
+       2, "--height-m", "o"},
+      {"simulate_layout_unbounded",
+       [](const TempDir& d) { return "simulate --out " + d.File("o") + " --layout 200x200"; }, 2,
+       "--layout must be ROWSxCOLS, 1..10 each", "o"},
+      {"stitch_sigma_nan",
+       [](const TempDir& d) { return StitchArgs(Flight(d)) + " --sigma nan"; }, 2,
+       "--sigma: must be a finite number", "s.json"},
+      // ---- stitching ----
+      {"stitch_u_overflow",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         SetField(sim + "/stitch_obs.csv", 5, 3, "1e300");
+         return StitchArgs(sim);
+       },
+       2, "stitch_obs.csv:5: column 'u' out of range", "s.json"},
+      {"stitch_subimage_params_overflow",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/camera_nominal.yaml", "params: [1, 0, 6900, 0, 1, 0]",
+                 "params: [1, 0, 1e308, 0, 1, 0]");
+         return StitchArgs(sim);
+       },
+       2, "camera_nominal.yaml:24: params out of range", "s.json"},
+      {"stitch_reference_point_overflow",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/camera_nominal.yaml", "U: 30, V: 3963", "U: 1e308, V: 3963");
+         return StitchArgs(sim);
+       },
+       2, "camera_nominal.yaml:42: U out of range", "s.json"},
+      {"stitch_measured_twice",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         auto lines = Lines(sim + "/stitch_obs.csv");
+         lines.insert(lines.begin() + 9, lines[8]);  // line 9 again as line 10
+         WriteLines(sim + "/stitch_obs.csv", lines);
+         return StitchArgs(sim);
+       },
+       2, "stitch_obs.csv:10: frame 0001", "s.json"},
+      {"resample_singular_mapping",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Write(d.File("m.json"),
+               R"({"subimages": [{"id": "I", "model": "affine", "params": [0,0,0,0,0,0]}]})");
+         return "resample --camera " + sim + "/camera_nominal.yaml --mapping " + d.File("m.json") +
+                " --images I=a.tif --out " + d.File("v.tif");
+       },
+       2, "m.json: sub-image I: the affine mapping is singular", "v.tif"},
+      // ---- COLMAP ----
+      {"colmap_k1_minus_one",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Replace(d.File("model/cameras.txt"), "-0.05 0.01", "-1 0.01");
+         return ColmapArgs(d.path());
+       },
+       2, "model/cameras.txt:2: OPENCV distortion cannot be represented", "out"},
+      {"colmap_k1_ten",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Replace(d.File("model/cameras.txt"), "-0.05 0.01", "10 0.01");
+         return ColmapArgs(d.path());
+       },
+       2, "model/cameras.txt:2: OPENCV distortion cannot be represented", "out"},
+      {"colmap_fx_zero",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Replace(d.File("model/cameras.txt"), "3000 3000 2000", "0 3000 2000");
+         return ColmapArgs(d.path());
+       },
+       2, "model/cameras.txt:2: focal length must be > 0", "out"},
+      {"colmap_width_zero",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Replace(d.File("model/cameras.txt"), "OPENCV 4000", "OPENCV 0");
+         return ColmapArgs(d.path());
+       },
+       2, "model/cameras.txt:2: WIDTH out of range", "out"},
+      {"colmap_height_negative",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Replace(d.File("model/cameras.txt"), "4000 3000", "4000 -100");
+         return ColmapArgs(d.path());
+       },
+       2, "model/cameras.txt:2: HEIGHT out of range", "out"},
+      {"colmap_width_2_31",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Replace(d.File("model/cameras.txt"), "OPENCV 4000", "OPENCV 2147483648");
+         return ColmapArgs(d.path());
+       },
+       2, "model/cameras.txt:2: WIDTH out of range", "out"},
+      {"colmap_width_not_integer",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Replace(d.File("model/cameras.txt"), "OPENCV 4000", "OPENCV 14000.5");
+         return ColmapArgs(d.path());
+       },
+       2, "model/cameras.txt:2: WIDTH must be an integer", "out"},
+      {"colmap_zero_quaternion",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Replace(d.File("model/images.txt"), "1 1 0 0 0", "1 0 0 0 0");
+         return ColmapArgs(d.path());
+       },
+       2, "model/images.txt:2: QW QX QY QZ is not a unit quaternion", "out"},
+      {"colmap_empty_images",
+       [](const TempDir& d) {
+         WriteColmap(d.path());
+         Write(d.File("model/images.txt"), "");
+         return ColmapArgs(d.path());
+       },
+       2, "images.txt: no image observations", "out"},
+      // ---- DBAT ----
+      {"dbat_empty_field",
+       [](const TempDir& d) {
+         WriteDbat(d.path());
+         Replace(d.File("marks.txt"), "1, 2, ", "1, 2, , ");
+         return DbatArgs(d.path());
+       },
+       2, "marks.txt:2: empty field 3", "out"},
+      {"dbat_two_ids_one_stem",
+       [](const TempDir& d) {
+         WriteDbat(d.path());
+         Write(d.File("images.txt"), "1, img1.jpg\n2, other/img1.tif\n");
+         return DbatArgs(d.path());
+       },
+       2, "images.txt:2: image 2 has the file name 'img1' of line 1", "out"},
+      {"dbat_image_zero",
+       [](const TempDir& d) {
+         WriteDbat(d.path());
+         Replace(d.File("cam.xml"), "<image>6000,4000</image>", "<image>0,0</image>");
+         return DbatArgs(d.path());
+       },
+       2, "cam.xml:5: <image> must be two positive integers", "out"},
+      {"dbat_xml_malformed",
+       [](const TempDir& d) {
+         WriteDbat(d.path());
+         Replace(d.File("cam.xml"), "<focal>35</focal>", "<focal>35</focl>");
+         return DbatArgs(d.path());
+       },
+       2, "cam.xml:6: invalid XML", "out"},
+      // ---- ODM ----
+      {"odm_projection_line_only",
+       [](const TempDir& d) {
+         WriteOdm(d.path());
+         Write(d.File("gcp.txt"), "+proj=utm +zone=33 +datum=WGS84\n");
+         return OdmArgs(d.path());
+       },
+       2, "gcp.txt: no targets listed", "out"},
+      {"odm_control_matches_no_target",
+       [](const TempDir& d) {
+         WriteOdm(d.path());
+         return OdmArgs(d.path()) + " --control X1,X2";
+       },
+       2, "--control: 'X1' is no target", "out"},
+      {"odm_image_with_one_target_only",
+       [](const TempDir& d) {
+         WriteOdm(d.path());
+         auto lines = Lines(d.File("gcp.txt"));
+         lines.erase(lines.begin() + 5, lines.begin() + 7);  // img2 keeps one target
+         WriteLines(d.File("gcp.txt"), lines);
+         return OdmArgs(d.path());
+       },
+       2, "gcp.txt: 1 observed exposure(s)", "out"},
+      // ---- match --list ----
+      {"match_list_unknown_subimage",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Write(d.File("list.csv"), "frame,subimage,image\n0001,I,a.tif\n0001,XX,b.tif\n");
+         Write(d.File("a.tif"), "x");
+         Write(d.File("b.tif"), "x");
+         return "match --camera " + sim + "/camera_nominal.yaml --list " + d.File("list.csv") +
+                " --out " + d.File("m.csv");
+       },
+       2, "list.csv:3: sub-image XX", "m.csv"},
+  };
+  return cases;
+}
+
+class BadInput : public ::testing::TestWithParam<size_t> {};
+
+TEST_P(BadInput, ExitsWithItsCodeNamesWhereAndWritesNothing) {
+  const Case& c = Cases()[GetParam()];
+  SCOPED_TRACE(c.name);
+  TempDir dir("aerocal_bad_input");
+  const std::string args = c.setup(dir);
+  // `timeout`: a case that would hang (a FIFO) fails instead of blocking the suite.
+  const auto r = RunCommand("timeout 60 " + testing::AerocalBinary() + " " + args);
+  EXPECT_EQ(r.exit_code, c.exit_code) << args << "\n" << r.output;
+  std::string expect = c.expect;
+  const auto at = expect.find("{DIR}");
+  if (at != std::string::npos) expect.replace(at, 5, dir.path());
+  EXPECT_NE(r.output.find(expect), std::string::npos) << "expected '" << expect << "' in\n" << r.output;
+  EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
+  if (!c.output.empty()) EXPECT_FALSE(fs::exists(dir.File(c.output))) << c.output << " was written";
+  struct stat st {};
+  ASSERT_EQ(::stat("/dev/null", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode)) << "/dev/null was replaced";
+}
+
+INSTANTIATE_TEST_SUITE_P(Issue12, BadInput, ::testing::Range<size_t>(0, Cases().size()),
+                         [](const ::testing::TestParamInfo<size_t>& info) {
+                           return std::string(Cases()[info.param].name);
+                         });
+
+// ---- what must be ACCEPTED ----
+
+TEST(ReaderRules, ByteOrderMarkCrlfAndCrLineEndsAreAccepted) {
+  for (const std::string eol : {"\n", "\r\n", "\r"}) {
+    const auto t = CsvTable::Parse("\xEF\xBB\xBFimage,X" + eol + "a,1" + eol + "b,2" + eol, "f.csv");
+    ASSERT_EQ(t.rows().size(), 2u);
+    EXPECT_EQ(t.header()[0], "image");
+    EXPECT_EQ(t.rows()[1].line, 3);
+    EXPECT_EQ(t.Number(t.rows()[1], "X"), 2.0);
+  }
+}
+
+TEST(ReaderRules, HashIsACommentOnlyAsTheFirstCharacterOfALine) {
+  const auto t = CsvTable::Parse("# comment\nimage,point\n#x,p1\n a,#p2\n #b,p3\n", "f.csv");
+  ASSERT_EQ(t.rows().size(), 2u);  // '#x,p1' is a comment (with a warning), the others are data
+  EXPECT_EQ(t.String(t.rows()[0], "point"), "#p2");
+  EXPECT_EQ(t.String(t.rows()[1], "image"), "#b");
+}
+
+TEST(ReaderRules, StrictYamlNamesTheLineOfADuplicateKey) {
+  try {
+    LoadYamlText("a: 1\nb: 2\na: 3\n", "x.yaml");
+    FAIL() << "duplicate key accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("x.yaml:3: duplicate key 'a'"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(LoadYamlText(std::string(100, '[') + std::string(100, ']'), "deep.yaml"), InputError);
+}
+
+TEST(ReaderRules, ADirectoryIsNotAnEmptyFile) {
+  TempDir dir;
+  try {
+    CsvTable::Read(dir.path());
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("is a directory"), std::string::npos) << e.what();
+  }
+}
+
+TEST(ReaderRules, DbatCameraXmlIsParsedNotPatternMatched) {
+  TempDir dir;
+  WriteDbat(dir.path());
+  // A commented-out <cc> and a <pp> inside <std> must not be taken.
+  Replace(dir.File("cam.xml"), "<cc>35</cc>", "<!-- <cc>99</cc> -->\n<cc>35</cc>");
+  Replace(dir.File("cam.xml"), "<pp>0,0</pp>",
+          "<calibration_info><std><pp>1,2</pp></std></calibration_info>\n<pp>12.5,8.5</pp>");
+  const auto r = RunAerocal(DbatArgs(dir.path()));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const calib::Camera camera = calib::ReadCamera(dir.File("out/camera_cam1.yaml"));
+  EXPECT_NEAR(camera.c_mm(), 35.0, 1e-12);
+  const double w_mm = 6000 * 24.0 / 4000;
+  EXPECT_NEAR(camera.interior[1], 12.5 - w_mm / 2, 1e-9);  // x0 from the camera's own <pp>
+  EXPECT_NEAR(camera.interior[2], 12.0 - 8.5, 1e-9);
+}
+
+TEST(ReaderRules, OdmListWithCrOnlyLineEndsImports) {
+  TempDir dir;
+  WriteOdm(dir.path());
+  std::string text = Read(dir.File("gcp.txt"));
+  for (char& ch : text)
+    if (ch == '\n') ch = '\r';
+  Write(dir.File("gcp.txt"), text);
+  const auto r = RunAerocal(OdmArgs(dir.path()));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("imported 2 exposures, 6 observations, 3 points"), std::string::npos)
+      << r.output;
+}
+
+// A decimal slip of 2e4..2e6 px in one stitching tie ray: found by the robust start before the
+// F test, so the model is the clean data's and the slipped tie is the ONLY rejection (without the
+// robust start, a 2e5 px slip masked itself and data snooping rejected four good ties instead).
+TEST(StitchRobustStart, ADecimalSlipIsTheOnlyRejectionAndLeavesTheModelChoice) {
+  TempDir dir;
+  const std::string sim = Flight(dir);
+  const auto clean = RunAerocal(StitchArgs(sim, dir.File("clean.json")));
+  ASSERT_EQ(clean.exit_code, 0) << clean.output;
+  std::ifstream a(dir.File("clean.json"));
+  const nlohmann::json fa = nlohmann::json::parse(a).at("frames").at(0);
+  ASSERT_TRUE(fa.at("rejected").empty()) << fa.at("rejected").dump();
+  // The first tie row of frame 0001 (after the reference points).
+  const auto lines = Lines(sim + "/stitch_obs.csv");
+  int row = 0;
+  for (size_t i = 1; i < lines.size() && !row; ++i)
+    if (lines[i].rfind("0001,t", 0) == 0) row = static_cast<int>(i) + 1;
+  ASSERT_GT(row, 0);
+  std::vector<std::string> f;
+  std::stringstream in(lines[row - 1]);
+  for (std::string x; std::getline(in, x, ',');) f.push_back(x);
+  for (const double slip : {2e4, 2e5, 2e6}) {
+    SCOPED_TRACE(slip);
+    WriteLines(sim + "/stitch_obs.csv", lines);
+    SetField(sim + "/stitch_obs.csv", row, 3, std::to_string(std::stod(f[3]) + slip));
+    const auto slipped = RunAerocal(StitchArgs(sim, dir.File("slip.json")));
+    ASSERT_EQ(slipped.exit_code, 0) << slipped.output;
+    std::ifstream b(dir.File("slip.json"));
+    const nlohmann::json fb = nlohmann::json::parse(b).at("frames").at(0);
+    EXPECT_EQ(fb.at("model"), fa.at("model"));
+    ASSERT_FALSE(fb.at("rejected").empty());
+    for (const auto& r : fb.at("rejected"))
+      EXPECT_EQ(r.at("point").get<std::string>(), f[1]) << fb.at("rejected").dump();
+  }
+}
+
+// Values that overflow (what the readers now refuse at 1e7 px) fed straight to the adjustment:
+// a named numerical failure (not converged, no covariance), never a signal in the SVD.
+TEST(StitchNumericalFailure, OverflowingMeasurementsAreNamedNotACrash) {
+  const calib::Camera camera = calib::ParseCamera(
+      LoadYamlText("pixel_size_mm: 0.009\nformat_px: [14000, 8000]\ninterior: {c: 170}\n"
+                   "subimages:\n  - {id: I, format_px: [7100, 8000], model: affine}\n"
+                   "  - {id: II, format_px: [7100, 8000], model: affine, params: [1, 0, 6900, 0, 1, 0]}\n",
+                   "camera.yaml"),
+      "camera.yaml");
+  stitch::FrameMeasurements frame;
+  frame.frame = "0001";
+  for (int i = 0; i < 12; ++i) {
+    stitch::TieMeasurement tie;
+    tie.point = "t" + std::to_string(i);
+    const double v = 300.0 + 600.0 * i;
+    tie.rays.push_back({0, {7000.0 + (i % 3), v}, 0.1});
+    tie.rays.push_back({1, {100.0 + (i % 3), i == 5 ? 1e200 : v}, 0.1});
+    frame.ties.push_back(tie);
+  }
+  stitch::StitchOptions options;
+  options.base_ids = {"I"};
+  for (const bool snooping : {false, true}) {
+    options.data_snooping = snooping;
+    const auto a = stitch::AdjustFrame(camera, frame, calib::MappingModel::kAffine, options);
+    if (snooping) {  // the robust start removes the overflowing ray: a clean solution
+      EXPECT_TRUE(a.converged);
+      ASSERT_FALSE(a.rejected.empty());
+      EXPECT_EQ(a.rejected.front().point, "t5");
+    } else {
+      EXPECT_FALSE(a.converged);
+      EXPECT_FALSE(a.covariance_ok);
+      bool named = false;
+      for (const auto& d : a.diagnostics) named |= d.find("numerical failure") != std::string::npos;
+      EXPECT_TRUE(named);
+    }
+  }
+}
+
+}  // namespace
+}  // namespace aerocal
