@@ -3,13 +3,14 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <sstream>
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
+#include "tools/cli_lists.h"
 #include "tools/command_registry.h"
+#include "triangulation/joint/joint_adjustment.h"
 #include "triangulation/workflow/flight_workflow.h"
 
 namespace aerocal::tools {
@@ -21,19 +22,10 @@ std::string ShellQuote(const std::string& s) {
   return out + "'";
 }
 
-std::vector<std::string> SplitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 CommandRun SetupFlight(CLI::App& app) {
   struct Args {
     triangulation::FlightWorkflowOptions options;
-    std::string out, base, report_script;
+    std::string out, base, report_script, joint_model = "auto";
     bool no_report = false;
   };
   auto args = std::make_shared<Args>();
@@ -47,9 +39,14 @@ CommandRun SetupFlight(CLI::App& app) {
   app.add_option("--stitch-sigma-px", args->options.stitch_sigma_px, "Stitching sigma where the file has none, px")
       ->check(CLI::PositiveNumber);
   app.add_flag("--no-joint", [args](std::int64_t) { args->options.joint = false; }, "Skip the joint adjustment");
+  app.add_option("--joint-model", args->joint_model,
+                 "Mapping model of the joint adjustment: translation | conformal | affine | projective | auto "
+                 "(the model the flight's stitching F test chose)")
+      ->capture_default_str();
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
   return [args]() {
     args->options.base_ids = SplitList(args->base);
+    args->options.joint_model = triangulation::ParseJointModel(args->joint_model);
     Progress progress("flight", 5);
     const auto result = triangulation::RunFlightWorkflow(args->options, &progress);
     progress.Finish();

@@ -1,7 +1,6 @@
 // aerocal stitch: sub-image mapping adjustment of one frame or a whole flight
 // (stitch/adjustment/, result keys in stitch/io/stitch_result_json.h and stitch/README.md).
 #include <cstdio>
-#include <sstream>
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
@@ -9,6 +8,7 @@
 #include "calib/core/progress.h"
 #include "stitch/adjustment/flight_stability.h"
 #include "stitch/io/stitch_result_json.h"
+#include "tools/cli_lists.h"
 #include "tools/command_registry.h"
 
 namespace aerocal::tools {
@@ -20,15 +20,6 @@ struct StitchArgs {
   double alpha = 0.05;
   bool no_snooping = false;
 };
-
-std::vector<std::string> SplitList(const std::string& text) {
-  std::vector<std::string> out;
-  std::stringstream in(text);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 // What a user must see without opening the JSON: the fit, the gross errors and, above all, the
 // predicted precision of the sub-image corners (a small sigma0 says nothing about a weakly tied

@@ -45,16 +45,26 @@ def summary(doc):
     for a in rd.adjustments(doc):
         check = rd.point_statistics(a, "check")
         key = f"check points: {fmt(check['n'], 'd')}, spatial RMSE {fmt(check['spatial'])} m" if check else ""
+        if a.get("mapping_model"):
+            key += f"; mappings {a.get('mapping_model')}"
+        warnings = rd.listing(a.get("warnings"))
+        if warnings:
+            key += f"; {len(warnings)} warning(s)"
         steps.append([text(rd.title(a)), raw(yes_no(a.get("converged"))), num(rd.number(a.get("sigma0"))),
                       num(rd.number(a.get("sigma0_px"))), text(key)])
-        classes.append("" if a.get("converged") is not False else "flagged")
+        classes.append("" if a.get("converged") is not False and not warnings else "flagged")
     if steps:
         out.append(table("summary-steps", "What ran",
                          ["step", "converged", "sigma0 [1]", "sigma0 [px]", "key figures"], steps, classes))
-        all_ok = all(c == "" for c in classes)
-        out.append(note("All steps converged." if all_ok else
+        converged = all(a.get("converged") is not False for a in rd.adjustments(doc)) and \
+            (not isinstance(stitching, dict) or stitching.get("converged") is not False)
+        out.append(note("All steps converged." if converged else
                         '<span class="bad">At least one step did not converge: its figures are not '
                         "a valid calibration.</span>"))
+        for a in rd.adjustments(doc):
+            for w in rd.listing(a.get("warnings")):
+                message = w.get("message") if isinstance(w, dict) else w
+                out.append(f'<p class="na"><span class="bad">warning ({esc(rd.title(a))})</span>: {esc(message)}</p>')
     else:
         out.append(not_available("Steps of the workflow"))
     return "".join(out)

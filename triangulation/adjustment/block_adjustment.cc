@@ -542,6 +542,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   result.control = ComputePointStatistics(result.control_points);
   result.check = ComputePointStatistics(result.check_points);
   for (const auto& d : result.solve.diagnostics) result.notes.push_back(d);
+  result.warnings = GroupRmsWarnings(result.solve);
   return result;
 }
 
