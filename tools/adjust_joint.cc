@@ -6,8 +6,8 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
-#include "tools/cli_lists.h"
 #include "tools/command_registry.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
@@ -46,7 +46,7 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
   triangulation::JointOptions joint_options;
   joint_options.adjust = options;
   joint_options.scope = triangulation::ParseMappingScope(joint.stitching);
-  joint_options.base_ids = SplitList(joint.base);
+  joint_options.base_ids = SplitCommaList(joint.base);
   joint_options.stitch_sigma_px = joint.stitch_sigma_px;
   const std::optional<calib::MappingModel> forced = triangulation::ParseJointModel(joint.model);
   if (options.robust_start)
@@ -85,11 +85,13 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
   json["project"] = project_path;
   WriteFileAtomically(out, json.dump(2) + "\n");
 
-  const bool ok = result.adjustment.converged() && result.adjustment.determinability.covariance_ok;
+  // As the plain adjustment: exit 3 and no camera when the result is not valid.
+  const bool ok = result.adjustment.valid;
+  for (const auto& reason : result.adjustment.invalid_reasons)
+    std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());
   if (!write_camera.empty()) {
     if (!ok) {
-      std::fprintf(stderr, "camera not written: the adjustment %s\n",
-                   result.adjustment.converged() ? "cannot determine every parameter" : "did not converge");
+      std::fprintf(stderr, "camera not written: the result is not valid\n");
     } else {
       const auto& cameras = result.adjustment.cameras;
       for (const auto& estimate : cameras) {

@@ -27,9 +27,9 @@ std::string CameraOutputPath(const std::string& out, const std::string& id, bool
 void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args);
 
 /// Runs the joint adjustment of `project_path` with `options` (free interior, snooping, priors),
-/// prints the summary, writes the result JSON to `out` and, when `write_camera` is set and the run
-/// converged with a covariance, the camera with the refined interior and per-flight mappings.
-/// Returns the exit code (0, or 3 when not converged / not determinable). ConfigError for
+/// prints the summary, writes the result JSON to `out` and, when `write_camera` is set and the
+/// result is valid, the camera with the refined interior and per-flight mappings. Returns the exit
+/// code (0, or 3 when the result is not valid: AdjustmentResult::valid). ConfigError for
 /// --robust-start, InputError for a project without sub-image observations.
 int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOptions& options,
                    const std::string& project_path, double default_sigma_px, const std::string& out,

@@ -23,6 +23,7 @@ CommandRun SetupAdjust(CLI::App& app) {
   struct Args {
     std::string project, out, write_camera, self_calibration = "none";
     bool compare = false, no_snooping = false, no_eo_priors = false, no_interior_sigma = false;
+    bool no_robust_start = false;
     double default_sigma_px = 0.5;
     triangulation::AdjustOptions options;
     JointAdjustArgs joint;
@@ -52,6 +53,23 @@ CommandRun SetupAdjust(CLI::App& app) {
                args->options.robust_start,
                "Adjust first with a robust (Cauchy) loss, reject the obvious gross errors, then "
                "re-adjust cleanly (large blunders, rough starting values)");
+  app.add_flag("--no-robust-start",
+               args->no_robust_start,
+               "Never start robustly (by default the robust start runs when more than 1 % of the "
+               "image components of the first solve are above 10 sigma)");
+  app.add_option("--max-rejections",
+                 args->options.max_rejections,
+                 "Rejection cap of data snooping; reaching it is a warning and exit 3")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--max-sigma0",
+                 args->options.max_sigma0,
+                 "A result with sigma0 above this is not valid (exit 3)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--min-redundancy",
+                 args->options.min_redundancy,
+                 "Redundancy number below which an observation is weakly controlled: reported, "
+                 "never rejected")
+      ->check(CLI::Range(0.0, 0.999));
   app.add_option("--critical-value",
                  args->options.snooping_critical_value,
                  "Critical |w| of data snooping (0: from alpha = 5 % / n)")
@@ -73,6 +91,9 @@ CommandRun SetupAdjust(CLI::App& app) {
     auto options = args->options;
     options.data_snooping = !args->no_snooping;
     options.use_eo_priors = !args->no_eo_priors;
+    options.auto_robust_start = !args->no_robust_start;
+    if (options.robust_start && args->no_robust_start)
+      throw ConfigError("--robust-start and --no-robust-start exclude each other");
     options.use_interior_sigma = !args->no_interior_sigma;
     options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
     options.Validate();
@@ -118,6 +139,8 @@ CommandRun SetupAdjust(CLI::App& app) {
       json["comparison"] = triangulation::ComparisonToJson(conventional, main);
       json["conventional"] = triangulation::AdjustmentToJson(conventional);
       main.solve.converged = main.solve.converged && conventional.solve.converged;
+      for (const auto& reason : conventional.invalid_reasons)
+        main.Invalidate("conventional run: " + reason);
     } else {
       main = run(options.free_interior);
       progress.Finish();
@@ -125,14 +148,17 @@ CommandRun SetupAdjust(CLI::App& app) {
       json = triangulation::AdjustmentToJson(main);
     }
     json["project"] = args->project;
+    json["valid"] = main.valid;
+    json["invalid_reasons"] = main.invalid_reasons;
     WriteFileAtomically(args->out, json.dump(2) + "\n");
-    const bool ok = main.solve.converged && main.determinability.covariance_ok;
+    // Exit 3 (results written, valid: false) when the run must not be trusted; the camera file
+    // is then not written at all: a file that exists is one the next flight may use.
+    const bool ok = main.valid;
+    for (const auto& reason : main.invalid_reasons)
+      std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());
     if (!args->write_camera.empty()) {
       if (!ok) {
-        std::fprintf(
-            stderr,
-            "camera not written: the adjustment %s\n",
-            main.solve.converged ? "cannot determine every parameter" : "did not converge");
+        std::fprintf(stderr, "camera not written: the result is not valid\n");
       } else {
         for (const auto& estimate : main.cameras) {
           const std::string path =

@@ -6,9 +6,9 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
-#include "tools/cli_lists.h"
 #include "tools/command_registry.h"
 #include "triangulation/joint/joint_adjustment.h"
 #include "triangulation/workflow/flight_workflow.h"
@@ -45,7 +45,7 @@ CommandRun SetupFlight(CLI::App& app) {
       ->capture_default_str();
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
   return [args]() {
-    args->options.base_ids = SplitList(args->base);
+    args->options.base_ids = SplitCommaList(args->base);
     args->options.joint_model = triangulation::ParseJointModel(args->joint_model);
     Progress progress("flight", 5);
     const auto result = triangulation::RunFlightWorkflow(args->options, &progress);
@@ -55,8 +55,19 @@ CommandRun SetupFlight(CLI::App& app) {
     nlohmann::json document = result.document;
     document["aerocal_version"] = AEROCAL_VERSION;
     WriteFileAtomically(json_path, document.dump(2) + "\n");
-    calib::WriteCamera((fs::path(args->out) / "camera_calibrated.yaml").string(), result.calibrated_camera);
+    // A calibrated camera is written only for a valid flight: a file that exists is one the next
+    // flight may use (an old one in the folder is removed, so it cannot pass for this run's).
+    const fs::path camera_path = fs::path(args->out) / "camera_calibrated.yaml";
+    if (result.valid) {
+      calib::WriteCamera(camera_path.string(), result.calibrated_camera);
+    } else {
+      std::error_code ignored;
+      fs::remove(camera_path, ignored);
+    }
     for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
+    for (const auto& [step, reason] : result.failures)
+      std::fprintf(stderr, "flight: step %s failed: %s\n", step.c_str(), reason.c_str());
+    if (!result.valid) std::fprintf(stderr, "flight: no calibrated camera written\n");
     if (!args->no_report) {
       const char* env = std::getenv("AEROCAL_REPORT_SCRIPT");
       const std::string script = env ? env : AEROCAL_REPORT_SCRIPT;
@@ -68,7 +79,7 @@ CommandRun SetupFlight(CLI::App& app) {
       }
       std::printf("report: %s\n", html.c_str());
     }
-    return result.converged ? kExitOk : kExitNotConverged;
+    return result.converged && result.valid ? kExitOk : kExitNotConverged;
   };
 }
 

@@ -1,6 +1,7 @@
 // aerocal import: converts blocks from other tools (COLMAP text model, DBAT / PhotoModeler marks,
 // OpenDroneMap gcp_list.txt) once into the FORMATS.md block files (triangulation/import).
 #include "calib/camera/camera_io.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
 #include "triangulation/adjustment/nadir_start.h"
@@ -100,9 +101,7 @@ CommandRun SetupImport(CLI::App& app) {
           for (const auto& p : triangulation::ImportOdmGcpList(subset).points)
             o->control_ids.insert(p.id);
         } else {
-          std::stringstream in(*control);
-          std::string id;
-          while (std::getline(in, id, ',')) o->control_ids.insert(id);
+          for (const std::string& id : SplitCommaList(*control)) o->control_ids.insert(id);
         }
       }
       auto project = triangulation::ImportOdmGcpList(*o);

@@ -31,9 +31,7 @@ using FrameImages = std::vector<std::pair<std::string, std::map<std::string, std
 
 FrameImages FromImagesOption(const std::string& frame, const std::string& images) {
   std::map<std::string, std::string> paths;
-  std::stringstream in(images);
-  std::string item;
-  while (std::getline(in, item, ',')) {
+  for (const std::string& item : SplitCommaList(images)) {
     const auto eq = item.find('=');
     if (eq == std::string::npos || eq == 0 || eq + 1 == item.size())
       throw ConfigError("--images: expected ID=PATH, got '" + item + "'");

@@ -1,16 +1,17 @@
 // aerocal resample: the virtual image of one frame from its sub-image files and a stitch result
 // (stitch/resample/virtual_image.h).
-#include <cctype>
 #include <cstdio>
 #include <memory>
 #include <sstream>
 
 #include "calib/camera/camera_io.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "stitch/io/stitch_result_json.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/resample/virtual_image.h"
 #include "tools/command_registry.h"
+#include "tools/image_sources.h"
 
 namespace aerocal::tools {
 namespace {
@@ -22,13 +23,6 @@ struct ResampleArgs {
   bool bigtiff = false;
 };
 
-bool IsTiff(const std::string& path) {
-  const auto dot = path.find_last_of('.');
-  std::string ext = dot == std::string::npos ? "" : path.substr(dot + 1);
-  for (char& c : ext) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  return ext == "tif" || ext == "tiff";
-}
-
 int RunResample(const ResampleArgs& args) {
   const calib::Camera nominal = calib::ReadCamera(args.camera);
   if (nominal.subimages.empty()) throw InputError(args.camera + ": the camera has no sub-images");
@@ -39,28 +33,11 @@ int RunResample(const ResampleArgs& args) {
   options.strip_rows = args.strip_rows;
   if (options.strip_rows < 1) throw ConfigError("--strip-rows must be > 0");
 
-  // ID=path pairs; every sub-image needs exactly one image.
-  std::vector<std::unique_ptr<stitch::RasterSource>> owned(camera.subimages.size());
-  std::stringstream list(args.images);
-  std::string item;
-  while (std::getline(list, item, ',')) {
-    const auto eq = item.find('=');
-    if (eq == std::string::npos)
-      throw ConfigError("--images: expected ID=PATH, got '" + item + "'");
-    const std::string id = item.substr(0, eq), path = item.substr(eq + 1);
-    const int k = camera.SubimageIndex(id);
-    if (k < 0) throw ConfigError("--images: sub-image '" + id + "' is not in " + args.camera);
-    if (owned[k]) throw ConfigError("--images: sub-image " + id + " given twice");
-    if (IsTiff(path))
-      owned[k] = stitch::OpenTiff(path);
-    else
-      owned[k] = std::make_unique<stitch::MemoryRaster>(stitch::ReadImageFile(path));
-  }
+  std::vector<std::string> ids;
+  for (const auto& s : camera.subimages) ids.push_back(s.id);
+  const auto owned = OpenImages(args.images, ids, "sub-image", args.camera);
   std::vector<stitch::RasterSource*> sources;
-  for (size_t k = 0; k < owned.size(); ++k) {
-    if (!owned[k]) throw ConfigError("--images: no image for sub-image " + camera.subimages[k].id);
-    sources.push_back(owned[k].get());
-  }
+  for (const auto& source : owned) sources.push_back(source.get());
   const stitch::RasterInfo first = sources.front()->Info();
   const double max_value = first.bits == 8 ? 255.0 : 65535.0;
   if (args.fill < 0 || args.fill > max_value)

@@ -1,14 +1,15 @@
 // aerocal stitch: sub-image mapping adjustment of one frame or a whole flight
 // (stitch/adjustment/, result keys in stitch/io/stitch_result_json.h and stitch/README.md).
 #include <cstdio>
+#include <sstream>
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "stitch/adjustment/flight_stability.h"
 #include "stitch/io/stitch_result_json.h"
-#include "tools/cli_lists.h"
 #include "tools/command_registry.h"
 
 namespace aerocal::tools {
@@ -71,7 +72,7 @@ int RunStitch(const StitchArgs& args) {
                         "' (expected translation, conformal, affine, projective or auto)");
   }
   options.alpha = args.alpha;
-  options.stitch.base_ids = SplitList(args.base);
+  options.stitch.base_ids = SplitCommaList(args.base);
   options.stitch.data_snooping = !args.no_snooping;
   options.stitch.Validate(camera);
   if (!(args.sigma_px > 0)) throw ConfigError("--sigma must be > 0 px");

@@ -1,34 +1,33 @@
 #include "calib/camera/brown_fraser10.h"
 
-#include <cmath>
-
-#include <Eigen/LU>
-#include <ceres/jet.h>
-
 namespace aerocal::calib {
 
 bool BrownFraser10Model::MeasuredFromIdeal(const double* params, const Eigen::Vector2d& ideal_mm,
                                            Eigen::Vector2d* measured_mm, double tolerance_mm) {
-  using Jet2 = ceres::Jet<double, 2>;
-  Jet2 p[kNumParams];
-  for (int i = 0; i < kNumParams; ++i) p[i] = Jet2(params[i]);
-  Eigen::Vector2d xb = ideal_mm;  // start: no distortion
-  for (int iteration = 0; iteration < 50; ++iteration) {
-    const Jet2 x[2] = {Jet2(xb.x(), 0), Jet2(xb.y(), 1)};
-    Jet2 d[2];
-    CorrectionReduced(p, x, d);
-    const Eigen::Vector2d f(xb.x() + d[0].a - ideal_mm.x(), xb.y() + d[1].a - ideal_mm.y());
-    Eigen::Matrix2d jacobian;
-    jacobian << 1.0 + d[0].v[0], d[0].v[1], d[1].v[0], 1.0 + d[1].v[1];
-    const Eigen::Vector2d step = jacobian.partialPivLu().solve(f);
-    if (!step.allFinite()) return false;
-    xb -= step;
-    if (step.norm() < tolerance_mm) {
-      *measured_mm = xb + Eigen::Vector2d(params[kX0], params[kY0]);
-      return true;
-    }
-  }
-  return false;
+  return MeasuredFromIdeal(params, ideal_mm.data(), measured_mm->data(), tolerance_mm);
+}
+
+bool BrownFraser10Model::ToOpenCv(const double* p, const PixelFrame& frame, OpenCvParams* cv) {
+  cv->fill(0.0);
+  const double pixel = frame.pixel_size_mm;
+  (*cv)[0] = p[kC] / ((1.0 + p[kB1]) * pixel);                 // fx
+  (*cv)[1] = p[kC] / pixel;                                    // fy
+  (*cv)[2] = p[kX0] / pixel + 0.5 * (frame.width_px - 1);      // cx
+  (*cv)[3] = -p[kY0] / pixel + 0.5 * (frame.height_px - 1);    // cy
+  return p[kK1] == 0.0 && p[kK2] == 0.0 && p[kK3] == 0.0 && p[kP1] == 0.0 && p[kP2] == 0.0 &&
+         p[kB2] == 0.0;
+}
+
+bool BrownFraser10Model::FromOpenCv(const OpenCvParams& cv, const PixelFrame& frame, double* p) {
+  const double pixel = frame.pixel_size_mm;
+  for (int i = 0; i < kNumParams; ++i) p[i] = 0.0;
+  p[kC] = cv[1] * pixel;
+  p[kX0] = (cv[2] - 0.5 * (frame.width_px - 1)) * pixel;
+  p[kY0] = -(cv[3] - 0.5 * (frame.height_px - 1)) * pixel;
+  p[kB1] = cv[1] / cv[0] - 1.0;
+  for (int i = 4; i < 12; ++i)
+    if (cv[i] != 0.0) return false;
+  return true;
 }
 
 }  // namespace aerocal::calib

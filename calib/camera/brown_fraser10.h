@@ -15,21 +15,14 @@
 
 #include <Eigen/Core>
 
+#include "calib/camera/models/model_common.h"
+
 namespace aerocal::calib {
-
-enum class ParamGroup { kPrincipalDistance, kPrincipalPoint, kRadial, kDecentering, kAffinity };
-
-struct ParamInfo {
-  std::string_view name;
-  std::string_view unit;
-  ParamGroup group;
-};
-
-enum class CameraModelId : int { kBrownFraser10 = 1 };  // values frozen forever
 
 struct BrownFraser10Model {
   static constexpr CameraModelId kId = CameraModelId::kBrownFraser10;
   static constexpr std::string_view kName = "brown_fraser_10";
+  static constexpr bool kCorrectionForm = true;  // closed form measured -> ideal
   enum Index : int { kC, kX0, kY0, kK1, kK2, kK3, kP1, kP2, kB1, kB2, kNumParams };
   static constexpr std::array<ParamInfo, kNumParams> kParams = {{
       {"c", "mm", ParamGroup::kPrincipalDistance},
@@ -45,11 +38,7 @@ struct BrownFraser10Model {
   }};
 
   /// Index of a parameter by its table name ("c", "K1", ...); -1 when unknown.
-  static int IndexOf(std::string_view name) {
-    for (int i = 0; i < kNumParams; ++i)
-      if (kParams[i].name == name) return i;
-    return -1;
-  }
+  static int IndexOf(std::string_view name) { return IndexOfParam(kParams, name); }
 
   /// Correction (dx, dy) in mm at the principal-point-reduced MEASURED coordinates xb (mm).
   template <typename T>
@@ -77,6 +66,39 @@ struct BrownFraser10Model {
   /// ideal reduced coordinates are `ideal_mm`. Converges to |step| < tolerance_mm; false otherwise.
   static bool MeasuredFromIdeal(const double* params, const Eigen::Vector2d& ideal_mm,
                                 Eigen::Vector2d* measured_mm, double tolerance_mm = 1e-11);
+
+  // The uniform interface of the registry (camera_model.h, models/model_common.h).
+  template <typename T>
+  static T PrincipalDistanceMm(const T* params, const PixelFrame&) {
+    return params[kC];
+  }
+  template <typename T>
+  static bool IdealFromMeasured(const T* params, const PixelFrame&, const T* measured_mm,
+                                T* ideal_mm) {
+    IdealFromMeasured(params, measured_mm, ideal_mm);
+    return true;
+  }
+  /// Newton to 1e-10 px (Jet-safe: derivatives of the implicit solution).
+  template <typename T>
+  static bool MeasuredFromIdeal(const T* params, const PixelFrame& frame, const T* ideal_mm,
+                                T* measured_mm) {
+    return MeasuredFromIdeal(params, ideal_mm, measured_mm, 1e-10 * frame.pixel_size_mm);
+  }
+  template <typename T>
+  static bool MeasuredFromIdeal(const T* params, const T* ideal_mm, T* measured_mm,
+                                double tolerance_mm) {
+    const double start[2] = {ValueOf(ideal_mm[0]) + ValueOf(params[kX0]),
+                             ValueOf(ideal_mm[1]) + ValueOf(params[kY0])};
+    const auto ideal = [](const auto* p, const auto* xy, auto* out) {
+      IdealFromMeasured(p, xy, out);
+    };
+    return InvertMap2<kNumParams>(ideal, params, ideal_mm, start, measured_mm, tolerance_mm);
+  }
+  /// Exact OpenCV equivalent when K1 = K2 = K3 = P1 = P2 = B2 = 0 (the affinity B1 becomes
+  /// fx = c / ((1 + B1) p), fy = c / p); otherwise that pinhole part as a starting value.
+  static bool ToOpenCv(const double* params, const PixelFrame& frame, OpenCvParams* cv);
+  /// Exact when OpenCV has no distortion (c = fy p, B1 = fy / fx - 1); else the pinhole part.
+  static bool FromOpenCv(const OpenCvParams& cv, const PixelFrame& frame, double* params);
 };
 
 }  // namespace aerocal::calib

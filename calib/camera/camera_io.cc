@@ -86,10 +86,15 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file) {
                            "subimages", "reference_points", "model"},
                     file);
   Camera camera;
-  if (root["model"] && YamlString(root["model"], file, "model") != Model::kName)
+  if (root["model"] && YamlString(root["model"], file, "model") != Model::kName) {
+    const std::string name = root["model"].Scalar();
     ThrowInputError(WhereIs(root["model"], file),
-                    "unknown camera model '" + root["model"].Scalar() + "' (expected " +
-                        std::string(Model::kName) + ")");
+                    CameraModelFromName(name)
+                        ? "camera model '" + name + "': the adjustment needs " +
+                              std::string(Model::kName) + " (convert it first)"
+                        : "unknown camera model '" + name + "' (expected " +
+                              std::string(Model::kName) + ")");
+  }
   camera.name = root["name"] ? YamlString(root["name"], file, "name") : "";
   if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
   camera.pixel_size_mm = YamlDouble(root["pixel_size_mm"], file, "pixel_size_mm");
@@ -194,6 +199,63 @@ std::string CameraToYaml(const Camera& camera) {
 
 void WriteCamera(const std::string& path, const Camera& camera) {
   WriteFileAtomically(path, CameraToYaml(camera));
+}
+
+ModelCamera ParseModelCamera(const YAML::Node& root, const std::string& file) {
+  if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
+  const std::string name =
+      root["model"] ? YamlString(root["model"], file, "model") : std::string(Model::kName);
+  const auto id = CameraModelFromName(name);
+  if (!id)
+    ThrowInputError(WhereIs(root["model"], file),
+                    "unknown camera model '" + name + "' (expected one of " + CameraModelNames() +
+                        ")");
+  ModelCamera camera;
+  camera.model = *id;
+  if (*id == Model::kId) {
+    const Camera ours = ParseCamera(root, file);
+    camera.params.assign(ours.interior.begin(), ours.interior.end());
+    camera.frame = ours.frame();
+    return camera;
+  }
+  RejectUnknownKeys(root, {"name", "pixel_size_mm", "format_px", "interior", "model"}, file);
+  if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
+  camera.frame.pixel_size_mm = YamlDouble(root["pixel_size_mm"], file, "pixel_size_mm");
+  if (!(camera.frame.pixel_size_mm > 0))
+    ThrowInputError(WhereIs(root["pixel_size_mm"], file), "pixel_size_mm must be > 0");
+  if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
+  std::tie(camera.frame.width_px, camera.frame.height_px) = ReadFormat(root["format_px"], file);
+  if (!root["interior"]) ThrowInputError({file, 1}, "missing interior");
+  const YAML::Node& interior = root["interior"];
+  std::vector<std::string> keys;
+  for (const ParamInfo& info : CameraModelParams(*id)) keys.emplace_back(info.name);
+  RejectUnknownKeys(interior, keys, file);
+  for (const std::string& key : keys)
+    camera.params.push_back(interior[key] ? YamlDouble(interior[key], file, key) : 0.0);
+  if (!(camera.PrincipalDistanceMm() > 0))
+    ThrowInputError(WhereIs(interior, file), name + ": the focal length must be > 0");
+  return camera;
+}
+
+ModelCamera ReadModelCamera(const std::string& path) {
+  return ParseModelCamera(LoadYamlFile(path), path);
+}
+
+std::string ModelCameraToYaml(const ModelCamera& camera, const std::string& name) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << name;
+  out << YAML::Key << "model" << YAML::Value << std::string(CameraModelName(camera.model));
+  out << YAML::Key << "pixel_size_mm" << YAML::Value << camera.frame.pixel_size_mm;
+  out << YAML::Key << "format_px" << YAML::Value << YAML::Flow << YAML::BeginSeq
+      << camera.frame.width_px << camera.frame.height_px << YAML::EndSeq;
+  out << YAML::Key << "interior" << YAML::Value << YAML::BeginMap;
+  const std::vector<ParamInfo> table = CameraModelParams(camera.model);
+  for (size_t i = 0; i < table.size(); ++i)
+    out << YAML::Key << std::string(table[i].name) << YAML::Value << camera.params.at(i);
+  out << YAML::EndMap << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
 }
 
 }  // namespace aerocal::calib

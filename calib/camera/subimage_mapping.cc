@@ -1,4 +1,5 @@
 #include "calib/camera/subimage_mapping.h"
+#include "calib/core/numeric_jacobian.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -93,18 +94,12 @@ std::vector<double> PlainFromConditioned(MappingModel model, const MappingCondit
 
 Eigen::MatrixXd PlainFromConditionedJacobian(MappingModel model, const MappingConditioning& cond,
                                              const std::vector<double>& conditioned) {
-  const int n = MappingParamCount(model);
-  Eigen::MatrixXd jacobian(n, n);
-  for (int j = 0; j < n; ++j) {
-    const double step = 1e-6 * std::max(1.0, std::abs(conditioned[j]));
-    std::vector<double> plus = conditioned, minus = conditioned;
-    plus[j] += step;
-    minus[j] -= step;
-    const auto a = PlainFromConditioned(model, cond, plus);
-    const auto b = PlainFromConditioned(model, cond, minus);
-    for (int i = 0; i < n; ++i) jacobian(i, j) = (a[i] - b[i]) / (2 * step);
-  }
-  return jacobian;
+  return NumericJacobian(
+      [&](const std::vector<double>& x) {
+        const std::vector<double> plain = PlainFromConditioned(model, cond, x);
+        return Eigen::Map<const Eigen::VectorXd>(plain.data(), plain.size()).eval();
+      },
+      conditioned);
 }
 
 Eigen::Vector2d SubimageMapping::VirtualFromSub(const Eigen::Vector2d& uv) const {

@@ -11,22 +11,28 @@ namespace aerocal {
 namespace {
 
 std::string Trim(const std::string& s) {
-  const auto begin = s.find_first_not_of(" \t\r");
+  const auto begin = s.find_first_not_of(" \t\r\n");
   if (begin == std::string::npos) return "";
-  const auto end = s.find_last_not_of(" \t\r");
+  const auto end = s.find_last_not_of(" \t\r\n");
   return s.substr(begin, end - begin + 1);
 }
 
-std::vector<std::string> SplitComma(const std::string& line) {
-  std::vector<std::string> out;
-  std::string field;
-  std::istringstream in(line);
-  while (std::getline(in, field, ',')) out.push_back(Trim(field));
-  if (!line.empty() && line.back() == ',') out.emplace_back();
-  return out;
-}
-
 }  // namespace
+
+std::vector<std::string> SplitCommaList(const std::string& text, ListSplit how) {
+  std::vector<std::string> out;
+  if (text.empty()) return out;
+  size_t begin = 0;
+  while (true) {
+    const size_t comma = text.find(',', begin);
+    std::string field = text.substr(begin, comma == std::string::npos ? std::string::npos
+                                                                      : comma - begin);
+    if (how.trim) field = Trim(field);
+    if (how.keep_empty || !field.empty()) out.push_back(std::move(field));
+    if (comma == std::string::npos) return out;
+    begin = comma + 1;
+  }
+}
 
 std::optional<double> ParseDouble(const std::string& text) {
   if (text.empty()) return std::nullopt;
@@ -52,7 +58,7 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& file) {
     ++line_number;
     const std::string trimmed = Trim(line);
     if (trimmed.empty() || trimmed[0] == '#') continue;
-    std::vector<std::string> fields = SplitComma(trimmed);
+    std::vector<std::string> fields = SplitCommaList(trimmed, {true, true});
     if (table.header_.empty()) {
       table.header_ = fields;
       table.header_line_ = line_number;

@@ -46,6 +46,17 @@ class CsvTable {
   std::vector<Row> rows_;
 };
 
+/// How SplitCommaList splits `text` at commas: fields trimmed of blanks (space, tab, CR, LF) or
+/// not; empty fields kept (n commas give n + 1 fields: a row or a value list, where an empty field
+/// must be seen) or dropped (a list of names or ID=PATH items, where a stray comma means nothing).
+/// An empty text has no fields.
+struct ListSplit {
+  bool trim = true;
+  bool keep_empty = false;
+};
+/// THE comma splitter (CSV rows, command-line lists, lists inside XML tags).
+std::vector<std::string> SplitCommaList(const std::string& text, ListSplit how = {});
+
 /// Parses a double from the whole of `text`; nullopt when it is not a finite number.
 std::optional<double> ParseDouble(const std::string& text);
 

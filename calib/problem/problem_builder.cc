@@ -1,6 +1,7 @@
 #include "calib/problem/problem_builder.h"
 
 #include "calib/core/error.h"
+#include "calib/problem/normal_equations.h"
 #include "calib/problem/scaled_subset_manifold.h"
 
 #include <Eigen/Dense>
@@ -11,6 +12,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <set>
 #include <thread>
 
@@ -24,8 +26,10 @@ struct ProblemBuilder::Block {
   std::vector<std::string> entry_names;
   bool constant = false;
   std::vector<bool> entry_fixed;
-  std::vector<double> scales;  // per free entry, tangent scaling
   int num_residuals = 0;       // residual blocks that use it
+  /// The block's manifold (owned by the ceres::Problem), created once per set of free entries
+  /// and rescaled in place on every UpdateManifolds().
+  ScaledSubsetManifold* manifold = nullptr;
 
   std::vector<int> FreeEntries() const {
     std::vector<int> out;
@@ -57,12 +61,30 @@ const ResidualGroupStats* SolveReport::Group(const std::string& name) const {
 }
 
 Eigen::MatrixXd CovarianceReport::BlockCovariance(BlockId id, int size) const {
-  const int offset = offsets.at(id);
-  return covariance.block(offset, offset, size, size);
+  const auto it = blocks.find({id, id});
+  return it == blocks.end() ? Eigen::MatrixXd::Zero(size, size) : it->second;
 }
 
 Eigen::VectorXd CovarianceReport::BlockSigma(BlockId id, int size) const {
   return sigma.segment(offsets.at(id), size);
+}
+
+bool CovarianceReport::CrossCovariance(BlockId a, BlockId b, Eigen::MatrixXd* out) const {
+  const auto it = blocks.find({std::min(a, b), std::max(a, b)});
+  if (it == blocks.end()) return false;
+  *out = a <= b ? it->second : Eigen::MatrixXd(it->second.transpose());
+  return true;
+}
+
+double CovarianceReport::Correlation(int i, int k) const {
+  if (i == k) return 1.0;
+  if (!(sigma(i) > 0 && sigma(k) > 0)) return 0.0;
+  const BlockId a = entry_block[i], b = entry_block[k];
+  const auto it = blocks.find({std::min(a, b), std::max(a, b)});
+  if (it == blocks.end()) return 0.0;
+  const double c = a <= b ? it->second(entry_local[i], entry_local[k])
+                          : it->second(entry_local[k], entry_local[i]);
+  return c / (sigma(i) * sigma(k));
 }
 
 double NormalCriticalValue(double alpha) {
@@ -106,7 +128,6 @@ BlockId ProblemBuilder::AddBlock(const std::string& name,
   block.kind = kind;
   block.entry_names = std::move(entry_names);
   block.entry_fixed.assign(size, false);
-  block.scales.assign(size, 1.0);
   const BlockId id = static_cast<BlockId>(blocks_.size());
   blocks_.push_back(std::move(block));
   block_by_name_[name] = id;
@@ -148,6 +169,11 @@ void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
 bool ProblemBuilder::IsBlockFixed(BlockId id) const { return blocks_.at(id).constant; }
 int ProblemBuilder::BlockSize(BlockId id) const { return blocks_.at(id).size; }
 const std::string& ProblemBuilder::BlockName(BlockId id) const { return blocks_.at(id).name; }
+BlockKind ProblemBuilder::BlockKindOf(BlockId id) const { return blocks_.at(id).kind; }
+const std::vector<BlockId>& ProblemBuilder::ResidualBlocks(ResidualId id) const {
+  return residuals_.at(id).blocks;
+}
+int ProblemBuilder::NumResiduals() const { return static_cast<int>(residuals_.size()); }
 double* ProblemBuilder::BlockValues(BlockId id) const { return blocks_.at(id).values; }
 
 ResidualId ProblemBuilder::AddResidual(const std::string& group,
@@ -255,12 +281,19 @@ Eigen::MatrixXd ProblemBuilder::DenseJacobian(const std::vector<BlockId>& blocks
 
 bool ProblemBuilder::UpdateManifolds() {
   // Tangent scaling: unit Jacobian columns at the current values (scaled_subset_manifold.h).
+  // One manifold per block: a new one only when its free entries change (Ceres keeps every
+  // manifold it was given until the problem dies), otherwise rescaled in place.
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   for (BlockId id : free_blocks) {
     Block& b = blocks_[id];
     const auto free = b.FreeEntries();
-    problem_->SetManifold(
-        b.values, new ScaledSubsetManifold(b.size, free, std::vector<double>(free.size(), 1.0)));
+    if (b.manifold != nullptr && b.manifold->free_entries() == free) {
+      b.manifold->SetScales(std::vector<double>(free.size(), 1.0));
+      continue;
+    }
+    b.manifold =
+        new ScaledSubsetManifold(b.size, free, std::vector<double>(free.size(), 1.0));
+    problem_->SetManifold(b.values, b.manifold);
   }
   if (free_blocks.empty()) return true;
   ceres::Problem::EvaluateOptions eval;
@@ -275,11 +308,11 @@ bool ProblemBuilder::UpdateManifolds() {
   int col = 0;
   for (BlockId id : free_blocks) {
     Block& b = blocks_[id];
-    const auto free = b.FreeEntries();
+    const size_t n_free = b.manifold->free_entries().size();
     std::vector<double> scales;
-    for (size_t k = 0; k < free.size(); ++k, ++col)
+    for (size_t k = 0; k < n_free; ++k, ++col)
       scales.push_back(norm2[col] > 0 ? 1.0 / std::sqrt(norm2[col]) : 1.0);
-    problem_->SetManifold(b.values, new ScaledSubsetManifold(b.size, free, scales));
+    b.manifold->SetScales(std::move(scales));
   }
   return true;
 }
@@ -297,9 +330,11 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   ceres_options.function_tolerance = options.function_tolerance;
   ceres_options.gradient_tolerance = options.gradient_tolerance;
   ceres_options.parameter_tolerance = options.parameter_tolerance;
-  ceres_options.num_threads = options.num_threads > 0
-                                  ? options.num_threads
-                                  : std::max(1u, std::thread::hardware_concurrency());
+  ceres_options.num_threads =
+      options.deterministic ? 1
+      : options.num_threads > 0
+          ? options.num_threads
+          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
   ceres_options.minimizer_progress_to_stdout = options.verbose;
   ceres_options.logging_type = options.verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
 
@@ -319,11 +354,15 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE);
   LinearSolverChoice choice = options.linear_solver;
   if (choice == LinearSolverChoice::kAuto) {
-    if (eliminable_params + other_params <= 300)
+    if (eliminable_params + other_params <= options.max_dense_qr_parameters)
       choice = LinearSolverChoice::kDenseQr;
     else if (!eliminable.empty() && other_params > 0)
-      choice = other_params <= 800 || !sparse_available ? LinearSolverChoice::kDenseSchur
-                                                        : LinearSolverChoice::kSparseSchur;
+      choice = options.min_iterative_schur_parameters > 0 &&
+                       other_params > options.min_iterative_schur_parameters
+                   ? LinearSolverChoice::kIterativeSchur
+               : other_params <= options.max_dense_schur_parameters || !sparse_available
+                   ? LinearSolverChoice::kDenseSchur
+                   : LinearSolverChoice::kSparseSchur;
     else
       choice = sparse_available ? LinearSolverChoice::kSparseNormalCholesky
                                 : LinearSolverChoice::kDenseQr;
@@ -342,13 +381,19 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       ceres_options.linear_solver_type = ceres::SPARSE_SCHUR;
       report.linear_solver = "sparse_schur";
       break;
+    case LinearSolverChoice::kIterativeSchur:
+      ceres_options.linear_solver_type = ceres::ITERATIVE_SCHUR;
+      ceres_options.preconditioner_type = ceres::SCHUR_JACOBI;
+      report.linear_solver = "iterative_schur";
+      break;
     case LinearSolverChoice::kSparseNormalCholesky:
       ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
       report.linear_solver = "sparse_normal_cholesky";
       break;
   }
   if (ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
-      ceres_options.linear_solver_type == ceres::SPARSE_SCHUR) {
+      ceres_options.linear_solver_type == ceres::SPARSE_SCHUR ||
+      ceres_options.linear_solver_type == ceres::ITERATIVE_SCHUR) {
     if (eliminable.empty() || other_params == 0) {
       ceres_options.linear_solver_type = ceres::DENSE_QR;
       report.linear_solver = "dense_qr";
@@ -410,16 +455,6 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   return report;
 }
 
-// Normal equations reduced to the non-point parameters: S = N_rr - N_rp N_pp^-1 N_pr.
-struct ProblemBuilder::ReducedSystem {
-  std::vector<BlockId> free_blocks;
-  std::map<BlockId, int> offset;  // tangent offset of a block in its space (points or reduced)
-  int n_p = 0, n_r = 0;
-  Eigen::SparseMatrix<double> s;
-  std::vector<std::string> reduced_names;  // one per reduced column
-  std::vector<BlockId> singular_points;    // point blocks with a singular N_pp block (left out)
-};
-
 namespace {
 // The names of the parameters that the eigenvectors of (scaled) `n` with eigenvalues below
 // 1e-12 of the largest involve (|component| > 0.2).
@@ -438,17 +473,180 @@ std::set<std::string> NullSpaceNames(Eigen::MatrixXd n, const std::vector<std::s
   }
   return out;
 }
+
+// Up to this many free parameters the covariance is Ceres' (dense SVD).
+constexpr int kCeresCovarianceLimit = 300;
 }  // namespace
+
+std::unique_ptr<internal::SchurComplement> ProblemBuilder::BuildSchurComplement(
+    bool apply_loss, std::vector<BlockId>* free_blocks, std::vector<int>* first_row) const {
+  *free_blocks = FreeBlocksInOrder();
+  internal::ColumnBlocks columns;
+  ceres::Problem::EvaluateOptions eval;
+  for (BlockId id : *free_blocks) {
+    columns.size.push_back(blocks_[id].TangentSize());
+    columns.eliminable.push_back(blocks_[id].Eliminable());
+    eval.parameter_blocks.push_back(blocks_[id].values);
+  }
+  first_row->assign(residuals_.size(), -1);
+  int row = 0;
+  for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
+    if (!residuals_[i].active) continue;
+    eval.residual_blocks.push_back(residuals_[i].id);
+    (*first_row)[i] = row;
+    row += residuals_[i].size;
+  }
+  eval.apply_loss_function = apply_loss;
+  ceres::CRSMatrix crs;
+  double cost = 0.0;
+  if (!problem_->Evaluate(eval, &cost, nullptr, nullptr, &crs)) return nullptr;
+  return std::make_unique<internal::SchurComplement>(std::move(crs), columns);
+}
+
+ObservationCofactors ProblemBuilder::ComputeObservationCofactors(
+    const std::vector<ResidualId>& ids, bool with_clusters, int max_dense_parameters) const {
+  ObservationCofactors out;
+  auto not_computed = [&](const std::string& why) {
+    out.ok = false;
+    out.method = "not_computed";
+    out.message = why;
+    out.clusters.clear();
+    for (ResidualId id : ids)
+      if (residuals_.at(id).active)
+        out.redundancy[id] = std::vector<double>(residuals_[id].size,
+                                                 std::numeric_limits<double>::quiet_NaN());
+    return out;
+  };
+  std::vector<BlockId> free_blocks;
+  std::vector<int> first_row;
+  const auto schur = BuildSchurComplement(false, &free_blocks, &first_row);
+  if (!schur) return not_computed("the residuals cannot be evaluated at the current values");
+  internal::SelectedInverse inverse;
+  if (!inverse.Compute(schur->s_lower(), dense_inverse_limit_, max_dense_parameters)) {
+    std::string why = inverse.message();
+    const std::vector<std::string> null_space = NullSpaceParameters(3000);
+    for (size_t i = 0; i < null_space.size() && i < 20; ++i)
+      why += (i ? ", " : " (null space: ") + null_space[i];
+    if (!null_space.empty()) why += null_space.size() > 20 ? ", ...)" : ")";
+    return not_computed(why);
+  }
+  bool any_point = false;
+  for (size_t b = 0; b < free_blocks.size(); ++b) any_point |= schur->is_point(static_cast<int>(b));
+  out.ok = true;
+  out.method = std::string(any_point ? "schur_" : "normal_") +
+               (inverse.dense() ? "dense_pseudo_inverse" : "selected_inverse");
+  out.reduced_parameters = schur->num_reduced();
+  out.factor_nonzeros = inverse.factor_nonzeros();
+  if (inverse.singular())
+    out.message = "the normal matrix is singular (datum defect); Q_vv from its pseudo-inverse";
+
+  // Residuals grouped by the point they observe (the block index in the Schur system); the
+  // others one by one. H = J N^- J^T over a group's rows:
+  //   h_ij = a_i A^+ a_j^T + d_i^T S^- d_j,  d_i = B^T A^+ a_i - f_i  (normal_equations.h).
+  std::map<int, std::vector<ResidualId>> by_point;
+  std::vector<ResidualId> pointless;
+  for (ResidualId id : ids) {
+    if (!residuals_.at(id).active) continue;
+    const int point = schur->RowPoint(first_row[id]);
+    if (point >= 0)
+      by_point[point].push_back(id);
+    else
+      pointless.push_back(id);
+  }
+  std::vector<int> cols;
+  std::vector<double> vals;
+  auto reduced_parts = [&](const std::vector<ResidualId>& group,
+                           const std::vector<int>& set_cols,
+                           Eigen::MatrixXd* f) {
+    int m = 0;
+    for (ResidualId id : group) m += residuals_[id].size;
+    *f = Eigen::MatrixXd::Zero(set_cols.size(), m);
+    int c = 0;
+    for (ResidualId id : group)
+      for (int k = 0; k < residuals_[id].size; ++k, ++c) {
+        schur->RowReduced(first_row[id] + k, &cols, &vals);
+        for (size_t q = 0; q < cols.size(); ++q) {
+          const auto at = std::lower_bound(set_cols.begin(), set_cols.end(), cols[q]);
+          (*f)(at - set_cols.begin(), c) = vals[q];
+        }
+      }
+  };
+  auto store = [&](const std::vector<ResidualId>& group, const Eigen::MatrixXd& h, int point) {
+    const Eigen::MatrixXd qvv = Eigen::MatrixXd::Identity(h.rows(), h.cols()) - h;
+    int c = 0;
+    for (ResidualId id : group) {
+      std::vector<double>& r = out.redundancy[id];
+      for (int k = 0; k < residuals_[id].size; ++k, ++c)
+        r.push_back(std::clamp(qvv(c, c), 0.0, 1.0));
+    }
+    if (with_clusters && point >= 0) {
+      ResidualCluster cluster;
+      cluster.point = free_blocks[point];
+      cluster.residuals = group;
+      cluster.qvv = 0.5 * (qvv + qvv.transpose());
+      out.clusters.push_back(std::move(cluster));
+    }
+  };
+  for (const auto& [point, group] : by_point) {
+    const internal::SchurComplement::PointTerms t = schur->Point(point);
+    Eigen::MatrixXd f;
+    reduced_parts(group, t.cols, &f);
+    Eigen::MatrixXd a(t.a_pinv.rows(), f.cols());
+    int c = 0;
+    for (ResidualId id : group)
+      for (int k = 0; k < residuals_[id].size; ++k, ++c)
+        a.col(c) = schur->RowPointPart(first_row[id] + k);
+    const Eigen::MatrixXd ta = t.a_pinv * a;
+    Eigen::MatrixXd h = a.transpose() * ta;
+    if (!t.cols.empty()) {
+      const Eigen::MatrixXd d = t.b.transpose() * ta - f;
+      h.noalias() += d.transpose() * inverse.Gather(t.cols, t.cols) * d;
+    }
+    store(group, h, point);
+  }
+  for (ResidualId id : pointless) {
+    std::vector<int> set_cols;
+    for (int k = 0; k < residuals_[id].size; ++k) {
+      schur->RowReduced(first_row[id] + k, &cols, &vals);
+      set_cols.insert(set_cols.end(), cols.begin(), cols.end());
+    }
+    std::sort(set_cols.begin(), set_cols.end());
+    set_cols.erase(std::unique(set_cols.begin(), set_cols.end()), set_cols.end());
+    Eigen::MatrixXd f;
+    reduced_parts({id}, set_cols, &f);
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(f.cols(), f.cols());
+    if (!set_cols.empty()) h = f.transpose() * inverse.Gather(set_cols, set_cols) * f;
+    store({id}, h, -1);
+  }
+  return out;
+}
+
+std::map<ResidualId, std::vector<double>> ProblemBuilder::RedundancyNumbers(
+    const std::vector<ResidualId>& ids, int max_dense_parameters) const {
+  return ComputeObservationCofactors(ids, false, max_dense_parameters).redundancy;
+}
 
 std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters) const {
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   if (NumFreeParameters() > max_parameters) {
     // Large blocks: the datum defect lives in the exterior / interior parameters; find it in the
     // reduced system (points eliminated), and name points that are undetermined on their own.
-    ReducedSystem reduced;
-    if (!ReduceNormalEquations(&reduced) || reduced.n_r > max_parameters) return {};
-    std::set<std::string> out = NullSpaceNames(Eigen::MatrixXd(reduced.s), reduced.reduced_names);
-    for (BlockId id : reduced.singular_points) out.insert(blocks_[id].name);
+    std::vector<BlockId> blocks;
+    std::vector<int> first_row;
+    const auto schur = BuildSchurComplement(true, &blocks, &first_row);
+    if (!schur || !schur->eliminated() || schur->num_reduced() > max_parameters) return {};
+    std::vector<std::string> names;
+    std::set<std::string> out;
+    for (size_t b = 0; b < blocks.size(); ++b) {
+      if (schur->is_point(static_cast<int>(b))) {
+        if (schur->Point(static_cast<int>(b)).singular) out.insert(blocks_[blocks[b]].name);
+        continue;
+      }
+      for (int e : blocks_[blocks[b]].FreeEntries()) names.push_back(blocks_[blocks[b]].EntryName(e));
+    }
+    const Eigen::MatrixXd s = Eigen::MatrixXd(schur->s_lower()).selfadjointView<Eigen::Lower>();
+    const std::set<std::string> reduced = NullSpaceNames(s, names);
+    out.insert(reduced.begin(), reduced.end());
     return {out.begin(), out.end()};
   }
   const Eigen::MatrixXd j = DenseJacobian(free_blocks, nullptr);
@@ -472,45 +670,31 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     for (int e = 0; e < b.size; ++e) {
       report.names.push_back(b.EntryName(e));
       report.free.push_back(!b.constant && !b.entry_fixed[e] && b.num_residuals > 0);
+      report.entry_block.push_back(id);
+      report.entry_local.push_back(e);
     }
     total += b.size;
   }
-  report.covariance = Eigen::MatrixXd::Zero(total, total);
+  report.sigma = Eigen::VectorXd::Zero(total);
   std::vector<BlockId> free_requested;
   for (BlockId id : blocks)
     if (!blocks_[id].constant && blocks_[id].num_residuals > 0) free_requested.push_back(id);
-
-  ceres::Covariance::Options options;
-  const int n_free = NumFreeParameters();
-  options.algorithm_type = n_free <= 300 ? ceres::DENSE_SVD : ceres::SPARSE_QR;
-  options.min_reciprocal_condition_number = 1e-14;
-  options.num_threads = std::max(1u, std::thread::hardware_concurrency());
-  options.apply_loss_function = true;
-  ceres::Covariance covariance(options);
+  // Pairs: every block with itself, interior x interior, and, with cross_blocks, the pairs with
+  // one of those; without cross_blocks every pair.
   const std::set<BlockId> cross(cross_blocks.begin(), cross_blocks.end());
-  auto wanted = [&](size_t i, size_t k) {
-    return cross.empty() || i == k || cross.count(free_requested[i]) ||
-           cross.count(free_requested[k]);
-  };
-  std::vector<std::pair<const double*, const double*>> pairs;
+  std::vector<std::pair<BlockId, BlockId>> pairs;
   for (size_t i = 0; i < free_requested.size(); ++i)
-    for (size_t k = i; k < free_requested.size(); ++k)
-      if (wanted(i, k))
-        pairs.emplace_back(blocks_[free_requested[i]].values, blocks_[free_requested[k]].values);
-  std::vector<std::pair<BlockId, BlockId>> pair_ids;
-  for (size_t i = 0; i < free_requested.size(); ++i)
-    for (size_t k = i; k < free_requested.size(); ++k)
-      if (wanted(i, k)) pair_ids.emplace_back(free_requested[i], free_requested[k]);
-  std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd> schur;
-  const bool use_schur = n_free > 300 && SchurCovariance(pair_ids, &schur);
-  report.method = use_schur ? "schur" : n_free <= 300 ? "ceres_dense_svd" : "ceres_sparse_qr";
-  const bool computed = pairs.empty() || use_schur || covariance.Compute(pairs, problem_.get());
-  if (!computed) {
+    for (size_t k = i; k < free_requested.size(); ++k) {
+      const BlockId a = free_requested[i], b = free_requested[k];
+      const bool interior_pair =
+          blocks_[a].kind == BlockKind::kInterior && blocks_[b].kind == BlockKind::kInterior;
+      if (cross.empty() || i == k || interior_pair || cross.count(a) || cross.count(b))
+        pairs.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  auto fail = [&](const std::string& why) {
     report.ok = false;
     report.undetermined = NullSpaceParameters(3000);
-    report.message =
-        "the normal matrix is singular or badly conditioned: the problem has a "
-        "datum defect or parameters the observations cannot determine";
+    report.message = why;
     if (!report.undetermined.empty()) {
       report.message += " (";
       for (size_t i = 0; i < report.undetermined.size() && i < 20; ++i)
@@ -518,228 +702,12 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
       if (report.undetermined.size() > 20) report.message += ", ...";
       report.message += ")";
     }
-    report.sigma = Eigen::VectorXd::Zero(total);
-    report.correlation = Eigen::MatrixXd::Identity(total, total);
+    report.blocks.clear();
     return report;
-  }
-  const double s2 = sigma0 * sigma0;
-  for (size_t i = 0; i < free_requested.size(); ++i) {
-    for (size_t k = i; k < free_requested.size(); ++k) {
-      if (!wanted(i, k)) continue;
-      const Block& a = blocks_[free_requested[i]];
-      const Block& b = blocks_[free_requested[k]];
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(a.size, b.size);
-      if (use_schur)
-        m = schur.at({free_requested[i], free_requested[k]});
-      else
-        covariance.GetCovarianceBlock(a.values, b.values, m.data());
-      const int ra = report.offsets[free_requested[i]], rb = report.offsets[free_requested[k]];
-      report.covariance.block(ra, rb, a.size, b.size) = s2 * m;
-      report.covariance.block(rb, ra, b.size, a.size) = s2 * m.transpose();
-    }
-  }
-  report.ok = true;
-  report.sigma = report.covariance.diagonal().cwiseMax(0.0).cwiseSqrt();
-  report.correlation = Eigen::MatrixXd::Identity(total, total);
-  for (int i = 0; i < total; ++i)
-    for (int k = 0; k < total; ++k)
-      if (i != k && report.sigma(i) > 0 && report.sigma(k) > 0)
-        report.correlation(i, k) = report.covariance(i, k) / (report.sigma(i) * report.sigma(k));
-  for (int i = 0; i < total; ++i)
-    for (int k = i + 1; k < total; ++k)
-      if (report.free[i] && report.free[k] &&
-          std::abs(report.correlation(i, k)) > correlation_threshold)
-        report.high_correlations.push_back(
-            {report.names[i], report.names[k], report.correlation(i, k)});
-  return report;
-}
-
-// Redundancy numbers r_ii = 1 - j_i N^-1 j_i^T with the point blocks (ground points, virtual tie
-// points) eliminated, as the Schur solver does: with N = [A B; B^T C] (A block-diagonal over the
-// point blocks, C over the other parameters) and S = C - B^T A^-1 B, a row j = [a f] touching one
-// point block e gives, with t = a A_e^-1 and q = t B_e:
-//   j N^-1 j^T = t a^T + (q - f) S^+ (q - f)^T.
-// Cost O(rows * n_other^2 + n_other^3) instead of O(n_free^3). Returns false (dense path) when
-// there is no point block, a row touches two point blocks, or S is larger than `max_dense`.
-bool ProblemBuilder::RedundancyNumbersBySchur(
-    const std::vector<ResidualId>& ids,
-    int max_dense,
-    std::map<ResidualId, std::vector<double>>* out) const {
-  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
-  std::vector<int> column_block;  // index into free_blocks of every tangent column
-  std::vector<int> local_column;  // column within the point block, or within C
-  std::vector<bool> eliminable(free_blocks.size());
-  int n_other = 0;
-  bool any_point = false;
-  for (size_t i = 0; i < free_blocks.size(); ++i) {
-    const Block& b = blocks_[free_blocks[i]];
-    eliminable[i] = b.Eliminable();
-    any_point = any_point || eliminable[i];
-    for (int k = 0; k < b.TangentSize(); ++k) {
-      column_block.push_back(static_cast<int>(i));
-      local_column.push_back(eliminable[i] ? k : n_other++);
-    }
-  }
-  if (!any_point || n_other > max_dense) return false;
-  ceres::Problem::EvaluateOptions options;
-  for (BlockId b : free_blocks) options.parameter_blocks.push_back(blocks_[b].values);
-  std::vector<ResidualId> owner;
-  for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
-    if (!residuals_[i].active) continue;
-    options.residual_blocks.push_back(residuals_[i].id);
-    for (int k = 0; k < residuals_[i].size; ++k) owner.push_back(i);
-  }
-  options.apply_loss_function = false;
-  ceres::CRSMatrix crs;
-  double cost = 0.0;
-  if (!problem_->Evaluate(options, &cost, nullptr, nullptr, &crs)) return false;
-  // Split every row into its point part a (one block at most) and its other part f.
-  struct Row {
-    int point = -1;  // index into free_blocks, -1 when none
-    Eigen::VectorXd a, f;
   };
-  std::vector<Row> rows(crs.num_rows);
-  std::map<int, Eigen::MatrixXd> a_blocks, b_blocks;  // per point block: A_e, B_e
-  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n_other, n_other);
-  for (int r = 0; r < crs.num_rows; ++r) {
-    Row& row = rows[r];
-    row.f = Eigen::VectorXd::Zero(n_other);
-    for (int k = crs.rows[r]; k < crs.rows[r + 1]; ++k) {
-      const int col = crs.cols[k], block = column_block[col];
-      if (!eliminable[block]) {
-        row.f(local_column[col]) = crs.values[k];
-        continue;
-      }
-      if (row.point >= 0 && row.point != block) return false;
-      if (row.point < 0) {
-        row.point = block;
-        row.a = Eigen::VectorXd::Zero(blocks_[free_blocks[block]].TangentSize());
-      }
-      row.a(local_column[col]) = crs.values[k];
-    }
-    c.noalias() += row.f * row.f.transpose();
-    if (row.point < 0) continue;
-    const int ne = static_cast<int>(row.a.size());
-    auto [a_it, a_new] = a_blocks.try_emplace(row.point, Eigen::MatrixXd::Zero(ne, ne));
-    auto [b_it, b_new] = b_blocks.try_emplace(row.point, Eigen::MatrixXd::Zero(ne, n_other));
-    a_it->second.noalias() += row.a * row.a.transpose();
-    b_it->second.noalias() += row.a * row.f.transpose();
-  }
-  // A_e^+ (pseudo-inverse: a point seen by too few rows stays undetermined, not infinite).
-  auto pseudo_inverse = [](const Eigen::MatrixXd& m) {
-    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(m);
-    const double max_eig = eig.eigenvalues().cwiseAbs().maxCoeff();
-    Eigen::VectorXd inv = eig.eigenvalues();
-    for (int i = 0; i < inv.size(); ++i) inv(i) = inv(i) > 1e-12 * max_eig ? 1.0 / inv(i) : 0.0;
-    return Eigen::MatrixXd(eig.eigenvectors() * inv.asDiagonal() * eig.eigenvectors().transpose());
-  };
-  std::map<int, Eigen::MatrixXd> a_inverse;
-  Eigen::MatrixXd s = c;
-  for (const auto& [block, a] : a_blocks) {
-    a_inverse[block] = pseudo_inverse(a);
-    const Eigen::MatrixXd& b = b_blocks[block];
-    s.noalias() -= b.transpose() * a_inverse[block] * b;
-  }
-  const Eigen::MatrixXd s_inverse = n_other > 0 ? pseudo_inverse(s) : Eigen::MatrixXd();
-  std::set<ResidualId> wanted(ids.begin(), ids.end());
-  for (int r = 0; r < crs.num_rows; ++r) {
-    if (!wanted.count(owner[r])) continue;
-    const Row& row = rows[r];
-    double h = 0.0;
-    Eigen::VectorXd d = -row.f;
-    if (row.point >= 0) {
-      const Eigen::VectorXd t = a_inverse[row.point] * row.a;  // A_e symmetric: (a A_e^-1)^T
-      h += t.dot(row.a);
-      d.noalias() += b_blocks[row.point].transpose() * t;
-    }
-    if (n_other > 0) h += d.dot(s_inverse * d);
-    (*out)[owner[r]].push_back(std::max(0.0, 1.0 - h));
-  }
-  return true;
-}
-
-bool ProblemBuilder::ReduceNormalEquations(ReducedSystem* out) const {
-  ReducedSystem& r = *out;
-  r.free_blocks = FreeBlocksInOrder();
-  // Tangent columns: eliminable blocks -> point index space, the others -> reduced space.
-  std::vector<int> column_space, column_index, column_block;
-  for (BlockId id : r.free_blocks) {
-    const int t = blocks_[id].TangentSize();
-    const bool elim = blocks_[id].Eliminable();
-    r.offset[id] = elim ? r.n_p : r.n_r;
-    for (int k = 0; k < t; ++k) {
-      column_space.push_back(elim ? 0 : 1);
-      column_index.push_back(elim ? r.n_p + k : r.n_r + k);
-      column_block.push_back(id);
-    }
-    if (!elim)
-      for (int e : blocks_[id].FreeEntries()) r.reduced_names.push_back(blocks_[id].EntryName(e));
-    (elim ? r.n_p : r.n_r) += t;
-  }
-  if (r.n_p == 0 || r.n_r == 0) return false;
-  ceres::Problem::EvaluateOptions eval;
-  for (BlockId id : r.free_blocks) eval.parameter_blocks.push_back(blocks_[id].values);
-  eval.apply_loss_function = true;
-  ceres::CRSMatrix crs;
-  double cost = 0.0;
-  if (!problem_->Evaluate(eval, &cost, nullptr, nullptr, &crs)) return false;
-  using Sparse = Eigen::SparseMatrix<double>;
-  std::vector<Eigen::Triplet<double>> tp, tr;
-  for (int row = 0; row < crs.num_rows; ++row) {
-    BlockId point = -1;
-    for (int k = crs.rows[row]; k < crs.rows[row + 1]; ++k) {
-      const int col = crs.cols[k];
-      if (column_space[col] == 0) {
-        if (point >= 0 && point != column_block[col]) return false;  // two points in one residual
-        point = column_block[col];
-        tp.emplace_back(row, column_index[col], crs.values[k]);
-      } else {
-        tr.emplace_back(row, column_index[col], crs.values[k]);
-      }
-    }
-  }
-  Sparse jp(crs.num_rows, r.n_p), jr(crs.num_rows, r.n_r);
-  jp.setFromTriplets(tp.begin(), tp.end());
-  jr.setFromTriplets(tr.begin(), tr.end());
-  // Block-diagonal N_pp^-1 (one small block per point); a singular block is listed and left out.
-  const Sparse npp = Sparse(jp.transpose()) * jp;
-  std::vector<Eigen::Triplet<double>> ti;
-  for (BlockId id : r.free_blocks) {
-    if (!blocks_[id].Eliminable()) continue;
-    const int o = r.offset[id], t = blocks_[id].TangentSize();
-    Eigen::MatrixXd block = Eigen::MatrixXd(npp.block(o, o, t, t));
-    Eigen::LDLT<Eigen::MatrixXd> ldlt(block);
-    if (ldlt.info() != Eigen::Success ||
-        !(ldlt.vectorD().minCoeff() > 1e-12 * ldlt.vectorD().maxCoeff())) {
-      r.singular_points.push_back(id);
-      continue;
-    }
-    const Eigen::MatrixXd inverse = ldlt.solve(Eigen::MatrixXd::Identity(t, t));
-    for (int i = 0; i < t; ++i)
-      for (int k = 0; k < t; ++k) ti.emplace_back(o + i, o + k, inverse(i, k));
-  }
-  Sparse npp_inverse(r.n_p, r.n_p);
-  npp_inverse.setFromTriplets(ti.begin(), ti.end());
-  const Sparse npr = Sparse(jp.transpose()) * jr;
-  r.s = Sparse(Sparse(jr.transpose()) * jr) - Sparse(Sparse(npr.transpose()) * npp_inverse) * npr;
-  return true;
-}
-
-bool ProblemBuilder::SchurCovariance(
-    const std::vector<std::pair<BlockId, BlockId>>& pairs,
-    std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const {
-  for (const auto& [a, b] : pairs)
-    if (blocks_[a].Eliminable() || blocks_[b].Eliminable()) return false;
-  ReducedSystem reduced;
-  if (!ReduceNormalEquations(&reduced) || !reduced.singular_points.empty()) return false;
-  using Sparse = Eigen::SparseMatrix<double>;
-  const Sparse& s = reduced.s;
-  const int n_r = reduced.n_r;
-  std::map<BlockId, int>& offset = reduced.offset;
-  Eigen::SimplicialLDLT<Sparse> solver(s);
-  if (solver.info() != Eigen::Success ||
-      !(solver.vectorD().minCoeff() > 1e-14 * solver.vectorD().maxCoeff()))
-    return false;
+  const std::string singular_message =
+      "the normal matrix is singular or badly conditioned: the problem has a datum defect or "
+      "parameters the observations cannot determine";
   auto plus_jacobian = [&](BlockId id) {
     const Block& block = blocks_[id];
     const ceres::Manifold* manifold = problem_->GetManifold(block.values);
@@ -751,101 +719,112 @@ bool ProblemBuilder::SchurCovariance(
       j.setIdentity();
     return Eigen::MatrixXd(j);
   };
-  // Columns of S^-1 one block at a time (memory n_r x block size), then the ambient blocks
-  // P_a Q(a, b) P_b^T of every pair with that block as its column side.
-  std::map<BlockId, std::vector<BlockId>> rows_of_column;
-  for (const auto& [a, b] : pairs) rows_of_column[b].push_back(a);
-  for (const auto& [b, rows] : rows_of_column) {
-    const int t = blocks_[b].TangentSize();
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n_r, t);
-    for (int k = 0; k < t; ++k) rhs(offset[b] + k, k) = 1.0;
-    const Eigen::MatrixXd columns = solver.solve(rhs);
-    const Eigen::MatrixXd pb = plus_jacobian(b);
-    for (BlockId a : rows)
-      (*out)[{a, b}] = plus_jacobian(a) * columns.middleRows(offset[a], blocks_[a].TangentSize()) *
-                       pb.transpose();
-  }
-  return true;
-}
-
-std::map<ResidualId, std::vector<double>> ProblemBuilder::RedundancyNumbers(
-    const std::vector<ResidualId>& ids, int max_dense_parameters) const {
-  std::map<ResidualId, std::vector<double>> out;
+  const double s2 = sigma0 * sigma0;
   const int n_free = NumFreeParameters();
-  const int n_obs = NumObservations();
-  if (n_obs > n_free && RedundancyNumbersBySchur(ids, max_dense_parameters, &out)) return out;
-  if (n_free > max_dense_parameters || n_obs <= n_free) {
-    const double mean = n_obs > n_free ? static_cast<double>(n_obs - n_free) / n_obs : 0.0;
-    for (ResidualId id : ids) out[id] = std::vector<double>(residuals_.at(id).size, mean);
-    return out;
-  }
-  std::vector<ResidualId> owner;
-  const Eigen::MatrixXd j = DenseJacobian(FreeBlocksInOrder(), &owner);
-  const Eigen::MatrixXd n = j.transpose() * j;
-  // Pseudo-inverse through the eigen-decomposition, robust to a datum defect.
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(n);
-  const double max_eig = eig.eigenvalues().maxCoeff();
-  Eigen::VectorXd inv = eig.eigenvalues();
-  for (int i = 0; i < inv.size(); ++i) inv(i) = inv(i) > 1e-12 * max_eig ? 1.0 / inv(i) : 0.0;
-  const Eigen::MatrixXd b = j * eig.eigenvectors();  // rows j_i V
-  std::set<ResidualId> wanted(ids.begin(), ids.end());
-  for (int row = 0; row < j.rows(); ++row) {
-    if (!wanted.count(owner[row])) continue;
-    const double h = (b.row(row).array().square() * inv.transpose().array()).sum();
-    out[owner[row]].push_back(std::max(0.0, 1.0 - h));
-  }
-  return out;
-}
-
-SolveReport ProblemBuilder::SolveWithDataSnooping(const SolverOptions& options,
-                                                  const SnoopingOptions& snooping,
-                                                  std::vector<RejectedResidual>* rejected) {
-  SolveReport report = Solve(options);
-  for (int round = 0; round < snooping.max_rejections && report.usable && report.redundancy > 0;
-       ++round) {
-    std::vector<ResidualId> tested;
-    int n_components = 0;
-    for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
-      if (!residuals_[i].active) continue;
-      if (!snooping.groups.empty() &&
-          std::find(snooping.groups.begin(), snooping.groups.end(), residuals_[i].group) ==
-              snooping.groups.end())
-        continue;
-      tested.push_back(i);
-      n_components += residuals_[i].size;
+  if (n_free <= kCeresCovarianceLimit) {
+    // Small problems: Ceres' covariance (dense SVD; its rank test is the reference).
+    report.method = "ceres_dense_svd";
+    ceres::Covariance::Options options;
+    options.algorithm_type = ceres::DENSE_SVD;
+    options.min_reciprocal_condition_number = 1e-14;
+    options.num_threads = 1;
+    options.apply_loss_function = true;
+    ceres::Covariance covariance(options);
+    std::vector<std::pair<const double*, const double*>> ceres_pairs;
+    for (const auto& [a, b] : pairs) ceres_pairs.emplace_back(blocks_[a].values, blocks_[b].values);
+    if (!ceres_pairs.empty() && !covariance.Compute(ceres_pairs, problem_.get()))
+      return fail(singular_message);
+    for (const auto& [a, b] : pairs) {
+      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(blocks_[a].size,
+                                                                               blocks_[b].size);
+      covariance.GetCovarianceBlock(blocks_[a].values, blocks_[b].values, m.data());
+      report.blocks[{a, b}] = s2 * Eigen::MatrixXd(m);
     }
-    if (tested.empty()) break;
-    const double critical =
-        snooping.critical_value > 0
-            ? snooping.critical_value
-            : std::max(3.29, NormalCriticalValue(0.05 / std::max(1, n_components)));
-    const auto redundancy = RedundancyNumbers(tested, snooping.max_dense_parameters);
-    // Pope's tau test with the a-posteriori sigma0 when the data are worse than their a-priori
-    // sigmas, Baarda's w test (sigma 1) when they are better: near-noise-free data must not turn
-    // round-off into "gross errors".
-    const double reference_sigma = std::max(report.sigma0, 1.0);
-    ResidualId worst = -1;
-    double worst_w = critical;
-    std::vector<double> worst_v;
-    for (ResidualId id : tested) {
-      const std::vector<double> v = EvaluateResidual(id);
-      const std::vector<double>& r = redundancy.at(id);
-      for (size_t k = 0; k < v.size(); ++k) {
-        if (r[k] < 1e-6) continue;  // uncontrolled observation: cannot be tested
-        const double w = std::abs(v[k]) / (reference_sigma * std::sqrt(r[k]));
-        if (w > worst_w) {
-          worst_w = w;
-          worst = id;
-          worst_v = v;
-        }
+  } else {
+    // Points eliminated, S factorised, S^-1 on the pattern of its factor (normal_equations.h).
+    std::vector<BlockId> order;
+    std::vector<int> first_row;
+    const auto schur = BuildSchurComplement(true, &order, &first_row);
+    if (!schur) return fail("the residuals cannot be evaluated at the current values");
+    internal::SelectedInverse inverse;
+    if (!inverse.Compute(schur->s_lower(), dense_inverse_limit_, 0) || inverse.singular())
+      return fail(singular_message);
+    std::map<BlockId, int> index;  // block -> index in the Schur system
+    for (size_t b = 0; b < order.size(); ++b) index[order[b]] = static_cast<int>(b);
+    bool any_point = false;
+    for (size_t b = 0; b < order.size(); ++b)
+      any_point |= schur->is_point(static_cast<int>(b));
+    report.method = std::string(any_point ? "schur_" : "normal_") +
+                    (inverse.dense() ? "dense_inverse" : "selected_inverse");
+    // Every requested block as a linear function of the reduced parameters s:
+    // x = G s (+ an own term A^+ for a point: p = -A^+ B s + ...).
+    struct Lift {
+      std::vector<int> cols;
+      Eigen::MatrixXd g, own, plus;
+    };
+    std::map<BlockId, Lift> lifts;
+    for (BlockId id : free_requested) {
+      Lift lift;
+      const int b = index.at(id);
+      if (schur->is_point(b)) {
+        const auto t = schur->Point(b);
+        if (t.singular) return fail(singular_message);
+        lift.cols = t.cols;
+        lift.g = -t.a_pinv * t.b;
+        lift.own = t.a_pinv;
+      } else {
+        lift.cols = schur->ReducedColumns({b});
+        lift.g = Eigen::MatrixXd::Identity(lift.cols.size(), lift.cols.size());
       }
+      lift.plus = plus_jacobian(id);
+      lifts[id] = std::move(lift);
     }
-    if (worst < 0) break;
-    if (rejected)
-      rejected->push_back(
-          {worst, residuals_[worst].group, residuals_[worst].label, worst_w, worst_v});
-    RemoveResidual(worst);
-    report = Solve(options);
+    for (const auto& [a, b] : pairs) {
+      const Lift& la = lifts.at(a);
+      const Lift& lb = lifts.at(b);
+      Eigen::MatrixXd q = Eigen::MatrixXd::Zero(la.g.rows(), lb.g.rows());
+      if (!la.cols.empty() && !lb.cols.empty())
+        q = la.g * inverse.Gather(la.cols, lb.cols) * lb.g.transpose();
+      if (a == b && la.own.size() > 0) q += la.own;
+      report.blocks[{a, b}] = s2 * la.plus * q * lb.plus.transpose();
+    }
+  }
+  report.ok = true;
+  for (BlockId id : free_requested) {
+    const Eigen::MatrixXd& c = report.blocks.at({id, id});
+    report.sigma.segment(report.offsets[id], c.rows()) = c.diagonal().cwiseMax(0.0).cwiseSqrt();
+  }
+  // Correlations above the threshold, in the order of the requested entries.
+  struct Pair {
+    int i, k;
+    double rho;
+  };
+  std::vector<Pair> high;
+  for (const auto& [ab, c] : report.blocks) {
+    const int oa = report.offsets.at(ab.first), ob = report.offsets.at(ab.second);
+    for (int r = 0; r < c.rows(); ++r)
+      for (int q = ab.first == ab.second ? r + 1 : 0; q < c.cols(); ++q) {
+        const int i = std::min(oa + r, ob + q), k = std::max(oa + r, ob + q);
+        if (!report.free[i] || !report.free[k]) continue;
+        const double rho = report.Correlation(i, k);
+        if (std::abs(rho) > correlation_threshold) high.push_back({i, k, rho});
+      }
+  }
+  std::sort(high.begin(), high.end(), [](const Pair& x, const Pair& y) {
+    return x.i != y.i ? x.i < y.i : x.k < y.k;
+  });
+  for (const Pair& h : high)
+    report.high_correlations.push_back({report.names[h.i], report.names[h.k], h.rho});
+  // The full correlation matrix of the interior entries.
+  std::vector<int> interior_rows;
+  for (int i = 0; i < total; ++i)
+    if (blocks_[report.entry_block[i]].kind == BlockKind::kInterior) interior_rows.push_back(i);
+  report.interior_correlation = Eigen::MatrixXd::Identity(interior_rows.size(), interior_rows.size());
+  for (size_t r = 0; r < interior_rows.size(); ++r) {
+    report.interior_names.push_back(report.names[interior_rows[r]]);
+    for (size_t q = 0; q < interior_rows.size(); ++q)
+      if (r != q)
+        report.interior_correlation(r, q) = report.Correlation(interior_rows[r], interior_rows[q]);
   }
   return report;
 }

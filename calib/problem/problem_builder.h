@@ -21,10 +21,7 @@
 //   deviations, correlations, the pairs above a threshold, and, for a rank-deficient problem, the
 //   parameters that span the null space (from an eigen-decomposition of the Jacobi-scaled normal
 //   matrix when the problem is small enough).
-// - SolveWithDataSnooping(): Baarda/Pope data snooping: standardized residuals
-//   w_i = v_i / (max(sigma0, 1) sqrt(r_ii)) (Pope above, Baarda below the a-priori level) with
-//   redundancy numbers r_ii from the normal matrix; the worst
-//   observation above the critical value is removed and listed, and the problem solved again.
+// - Data snooping lives beside it, in data_snooping.h (it uses this class's public API only).
 //
 // How to add a residual family
 // 1. Write a small templated functor (see calib/residuals/*.h): constructor takes the measurement
@@ -35,6 +32,8 @@
 //    AddResidual(group, Functor::Create(...), {blocks...}, label). Pick an existing group name or
 //    a new one: statistics appear per group automatically.
 #pragma once
+
+#include "calib/problem/observation_cofactors.h"
 
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
@@ -51,8 +50,10 @@ class Problem;
 
 namespace aerocal::calib {
 
-using BlockId = int;
-using ResidualId = int;
+namespace internal {
+class SchurComplement;
+}
+class ScaledSubsetManifold;
 
 enum class BlockKind { kInterior, kMapping, kRotation, kCenter, kGroundPoint, kTiePoint2d, kOther };
 
@@ -72,7 +73,14 @@ struct LossOptions {
   double scale = 3.0;  // in whitened units (multiples of sigma), > 0
 };
 
-enum class LinearSolverChoice { kAuto, kDenseQr, kDenseSchur, kSparseSchur, kSparseNormalCholesky };
+enum class LinearSolverChoice {
+  kAuto,
+  kDenseQr,
+  kDenseSchur,
+  kSparseSchur,
+  kIterativeSchur,
+  kSparseNormalCholesky
+};
 
 struct SolverOptions {
   int max_iterations = 100;           // Levenberg-Marquardt iterations, > 0
@@ -80,7 +88,19 @@ struct SolverOptions {
   double gradient_tolerance = 1e-14;
   double parameter_tolerance = 1e-12;  // relative step size to stop
   LinearSolverChoice linear_solver = LinearSolverChoice::kAuto;
-  int num_threads = 0;   // 0: all cores
+  /// kAuto: dense QR up to this many free parameters (count, >= 0).
+  int max_dense_qr_parameters = 300;
+  /// kAuto with point blocks: dense Schur while the reduced (non-point) parameters number at most
+  /// this (count, >= 0), sparse Schur (Cholesky of the reduced matrix) above it.
+  int max_dense_schur_parameters = 800;
+  /// kAuto with point blocks: above this many reduced parameters (count, >= 0; 0: never) the
+  /// reduced system is solved iteratively (ITERATIVE_SCHUR, conjugate gradients with the
+  /// SCHUR_JACOBI preconditioner) instead of factorised: memory grows linearly with the block.
+  int min_iterative_schur_parameters = 0;
+  /// Identical inputs give bit-identical results: the solve runs on one thread (Ceres' threaded
+  /// gradient and Schur reductions add in scheduling order). False: `num_threads` threads.
+  bool deterministic = true;
+  int num_threads = 0;   // when !deterministic; 0: all cores
   bool verbose = false;  // Ceres per-iteration log on stdout
 };
 
@@ -117,38 +137,38 @@ struct HighCorrelation {
 };
 
 /// Covariance of selected blocks, scaled by sigma0^2 (a-posteriori), in ambient coordinates.
+/// Only the requested pairs of blocks are held (never a dense matrix of all requested entries).
 struct CovarianceReport {
   bool ok = false;
   std::string message;  // why it failed, when !ok
-  /// How it was computed: "schur" (points eliminated, sparse LDLT), "ceres_dense_svd" or
-  /// "ceres_sparse_qr" (ceres::Covariance).
+  /// How it was computed: "schur_selected_inverse" (points eliminated, sparse LDL^T of the reduced
+  /// matrix, its inverse on the factor's pattern), "normal_selected_inverse" (no point blocks),
+  /// "schur_dense_inverse" / "normal_dense_inverse" (small reduced matrix), or "ceres_dense_svd"
+  /// (ceres::Covariance, up to 300 free parameters). All exact.
   std::string method;
   std::vector<std::string> names;  // "block.entry" per row
   std::vector<bool> free;          // false for fixed entries (sigma 0)
-  Eigen::MatrixXd covariance;      // sigma0^2 Q
   Eigen::VectorXd sigma;           // sqrt(diag)
-  Eigen::MatrixXd correlation;
   std::vector<HighCorrelation> high_correlations;  // |rho| above the threshold, free entries only
   std::vector<std::string> undetermined;           // parameters in the null space (rank defect)
   std::map<BlockId, int> offsets;                  // row of each block's first entry
-  /// Sub-matrix of one block (size x size).
+  /// The computed blocks sigma0^2 Q(a, b) (ambient, size_a x size_b), keyed (a, b) with a <= b.
+  std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd> blocks;
+  /// Full correlation matrix of the interior (BlockKind::kInterior) entries among the requested
+  /// blocks, rows named by interior_names.
+  std::vector<std::string> interior_names;
+  Eigen::MatrixXd interior_correlation;
+  std::vector<BlockId> entry_block;  // block of each row of names
+  std::vector<int> entry_local;      // entry within that block
+
+  /// Sub-matrix of one block (size x size); zero for a fixed block.
   Eigen::MatrixXd BlockCovariance(BlockId id, int size) const;
   Eigen::VectorXd BlockSigma(BlockId id, int size) const;
-};
-
-struct SnoopingOptions {
-  std::vector<std::string> groups;  // groups whose observations are tested; empty = all
-  double critical_value = 0.0;      // of |w|; 0: from alpha = 5 % / n_tested (min 3.29)
-  int max_rejections = 200;
-  /// Above this many free parameters redundancy numbers are approximated by r / n.
-  int max_dense_parameters = 4000;
-};
-
-struct RejectedResidual {
-  ResidualId id = -1;
-  std::string group, label;
-  double w = 0.0;                         // standardized residual that triggered the rejection
-  std::vector<double> whitened_residual;  // v / sigma at rejection time
+  /// Covariance of blocks a and b (size_a x size_b); false when the pair was not computed.
+  bool CrossCovariance(BlockId a, BlockId b, Eigen::MatrixXd* out) const;
+  /// Correlation of rows i and k of names; 0 when their pair of blocks was not computed or one of
+  /// them has no spread.
+  double Correlation(int i, int k) const;
 };
 
 class ProblemBuilder {
@@ -190,12 +210,13 @@ class ProblemBuilder {
   /// Current whitened residual values (loss not applied).
   std::vector<double> EvaluateResidual(ResidualId id) const;
 
+  /// Blocks a residual was added on, in order; the kind of a block.
+  const std::vector<BlockId>& ResidualBlocks(ResidualId id) const;
+  BlockKind BlockKindOf(BlockId id) const;
+  /// Residuals ever added (ids 0 .. NumResiduals() - 1, removed ones included).
+  int NumResiduals() const;
+
   SolveReport Solve(const SolverOptions& options);
-  /// Solves, then repeatedly removes the worst standardized residual above the critical value and
-  /// solves again. The final report is of the clean adjustment; rejections are appended in order.
-  SolveReport SolveWithDataSnooping(const SolverOptions& options,
-                                    const SnoopingOptions& snooping,
-                                    std::vector<RejectedResidual>* rejected);
 
   /// Covariance of `blocks` at the current values, scaled by sigma0^2; correlations above
   /// `correlation_threshold` are listed.
@@ -207,12 +228,24 @@ class ProblemBuilder {
                                       double correlation_threshold = 0.95,
                                       const std::vector<BlockId>& cross_blocks = {}) const;
 
-  /// Redundancy numbers r_ii of every scalar residual of the listed residuals (whitened problem).
-  /// Exact: with point blocks (ground / tie points) by their elimination (Schur complement) when
-  /// the other parameters number at most max_dense_parameters; else from the dense normal matrix
-  /// up to max_dense_parameters free parameters; r/n otherwise.
+  /// Cofactors of the listed (active) residuals at the current values, loss not applied:
+  /// redundancy numbers r_ii of every scalar component and, with `with_clusters`, Q_vv among the
+  /// listed residuals of each point block. Exact at any size (observation_cofactors.h): points
+  /// eliminated, the reduced matrix factorised sparsely and inverted on its pattern only. A
+  /// singular reduced matrix (datum defect) is inverted densely (any generalised inverse gives the
+  /// same Q_vv) up to `max_dense_parameters` reduced parameters; above that the result is not ok.
+  ObservationCofactors ComputeObservationCofactors(const std::vector<ResidualId>& ids,
+                                                   bool with_clusters,
+                                                   int max_dense_parameters = 4000) const;
+  /// r_ii of the listed residuals: ComputeObservationCofactors(ids, false, ...).redundancy
+  /// (NaN components when they cannot be computed; never an approximation).
   std::map<ResidualId, std::vector<double>> RedundancyNumbers(const std::vector<ResidualId>& ids,
                                                               int max_dense_parameters) const;
+
+  /// Reduced matrices up to `parameters` (count, >= 0; default 300) are inverted densely by
+  /// ComputeObservationCofactors / EstimateCovariance, larger ones by the sparse selected
+  /// inverse. For tests and benchmarks that compare the two paths on one problem.
+  void SetDenseInverseLimit(int parameters) { dense_inverse_limit_ = parameters; }
 
   /// Free parameters (tangent space) and scalar residuals currently in the problem.
   int NumFreeParameters() const;
@@ -231,26 +264,21 @@ class ProblemBuilder {
   /// `max_parameters` free parameters, above that from the normal equations reduced to the
   /// non-point parameters (points eliminated) while those number at most `max_parameters`.
   std::vector<std::string> NullSpaceParameters(int max_parameters) const;
-  struct ReducedSystem;
-  /// Normal equations with the ground / tie points eliminated (Schur complement); false when no
-  /// point or no other block is free, or a residual observes two points.
-  bool ReduceNormalEquations(ReducedSystem* out) const;
-  bool RedundancyNumbersBySchur(const std::vector<ResidualId>& ids,
-                                int max_dense,
-                                std::map<ResidualId, std::vector<double>>* out) const;
+  /// Jacobian of all active residuals over the free blocks (tangent space), with the point
+  /// blocks marked for elimination; nullptr when the residuals cannot be evaluated.
+  /// `free_blocks`: the Schur system's block order; `first_row`: per residual, its first row
+  /// (-1 when inactive).
+  std::unique_ptr<internal::SchurComplement> BuildSchurComplement(
+      bool apply_loss, std::vector<BlockId>* free_blocks, std::vector<int>* first_row) const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,
                                 std::vector<ResidualId>* row_owner) const;
-  /// Covariance blocks (ambient, unscaled Q) of `pairs` of non-eliminable blocks by eliminating the
-  /// ground points (Schur complement, sparse LDLT); false when not applicable or not positive
-  /// definite (the caller then falls back to Ceres' covariance).
-  bool SchurCovariance(const std::vector<std::pair<BlockId, BlockId>>& pairs,
-                       std::map<std::pair<BlockId, BlockId>, Eigen::MatrixXd>* out) const;
 
   std::unique_ptr<ceres::Problem> problem_;
   std::vector<Block> blocks_;
   std::vector<Residual> residuals_;
   std::map<std::string, BlockId> block_by_name_;
   std::map<const double*, BlockId> block_by_pointer_;
+  int dense_inverse_limit_ = 300;
 };
 
 /// Two-sided standard-normal quantile: z with P(|N(0,1)| > z) = alpha.

@@ -1,5 +1,7 @@
 #include "calib/problem/scaled_subset_manifold.h"
 
+#include "calib/core/error.h"
+
 #include <algorithm>
 
 namespace aerocal::calib {
@@ -7,6 +9,11 @@ namespace aerocal::calib {
 ScaledSubsetManifold::ScaledSubsetManifold(int size, std::vector<int> free_entries,
                                            std::vector<double> scales)
     : size_(size), free_(std::move(free_entries)), scales_(std::move(scales)) {}
+
+void ScaledSubsetManifold::SetScales(std::vector<double> scales) {
+  AEROCAL_CHECK(scales.size() == free_.size()) << "one scale per free entry";
+  scales_ = std::move(scales);
+}
 
 bool ScaledSubsetManifold::Plus(const double* x, const double* delta, double* x_plus_delta) const {
   std::copy(x, x + size_, x_plus_delta);

@@ -21,6 +21,10 @@ class ScaledSubsetManifold : public ceres::Manifold {
   bool PlusJacobian(const double* x, double* jacobian) const override;
   bool Minus(const double* y, const double* x, double* y_minus_x) const override;
   bool MinusJacobian(const double* x, double* jacobian) const override;
+  /// New scales for the same free entries (the builder keeps one manifold per block and rescales
+  /// it; Ceres re-reads the Plus Jacobian whenever it sets a block's state).
+  void SetScales(std::vector<double> scales);
+  const std::vector<int>& free_entries() const { return free_; }
 
  private:
   int size_;

@@ -7,22 +7,12 @@
 #include <Eigen/Core>
 
 #include "calib/camera/brown_fraser10.h"
+#include "calib/camera/pixel_frame.h"
 #include "calib/camera/rotation.h"
 #include "calib/camera/subimage_mapping.h"
 #include "calib/residuals/autodiff_residual.h"
 
 namespace aerocal::calib {
-
-/// Geometry of the virtual image needed to turn pixels into photo coordinates.
-struct PixelFrame {
-  double pixel_size_mm = 0.009;
-  int width_px = 0, height_px = 0;
-  template <typename T>
-  void PhotoFromPixel(const T* pixel, T* xy_mm) const {
-    xy_mm[0] = (pixel[0] - T(0.5 * (width_px - 1))) * T(pixel_size_mm);
-    xy_mm[1] = -(pixel[1] - T(0.5 * (height_px - 1))) * T(pixel_size_mm);
-  }
-};
 
 namespace internal {
 template <typename T>

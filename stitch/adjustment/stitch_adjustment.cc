@@ -1,4 +1,6 @@
 #include "stitch/adjustment/stitch_adjustment.h"
+#include "calib/core/median.h"
+#include "calib/core/numeric_jacobian.h"
 
 #include <algorithm>
 #include <cmath>
@@ -7,6 +9,7 @@
 #include <set>
 
 #include "calib/core/error.h"
+#include "calib/problem/data_snooping.h"
 #include "calib/residuals/stitching.h"
 
 namespace aerocal::stitch {
@@ -38,30 +41,14 @@ std::vector<TieRay> ActiveRays(const calib::Camera& camera, const TieMeasurement
 /// linear models up to rounding).
 Eigen::MatrixXd VirtualJacobian(MappingModel model, const std::vector<double>& params,
                                 const Eigen::Vector2d& uv_conditioned) {
-  const int n = static_cast<int>(params.size());
-  Eigen::MatrixXd g(2, n);
-  for (int j = 0; j < n; ++j) {
-    const double step = 1e-6 * std::max(1.0, std::abs(params[j]));
-    std::vector<double> plus = params, minus = params;
-    plus[j] += step;
-    minus[j] -= step;
-    Eigen::Vector2d a, b;
-    calib::VisitMappingModel(model, [&](auto m) {
-      decltype(m)::Apply(plus.data(), uv_conditioned.data(), a.data());
-      decltype(m)::Apply(minus.data(), uv_conditioned.data(), b.data());
-    });
-    g.col(j) = (a - b) / (2 * step);
-  }
-  return g;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  const size_t mid = values.size() / 2;
-  std::nth_element(values.begin(), values.begin() + mid, values.end());
-  double m = values[mid];
-  if (values.size() % 2 == 0) m = 0.5 * (m + *std::max_element(values.begin(), values.begin() + mid));
-  return m;
+  return NumericJacobian(
+      [&](const std::vector<double>& p) {
+        Eigen::Vector2d out;
+        calib::VisitMappingModel(
+            model, [&](auto m) { decltype(m)::Apply(p.data(), uv_conditioned.data(), out.data()); });
+        return out;
+      },
+      params);
 }
 
 }  // namespace
@@ -221,13 +208,13 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
     snooping.critical_value = std::max(
         3.29, calib::NormalCriticalValue(options.snooping_alpha /
                                          std::max(1, builder.NumObservations())));
-    std::vector<calib::RejectedResidual> rejected;
-    report = builder.SolveWithDataSnooping(options.solver, snooping, &rejected);
-    for (const auto& r : rejected) {
+    snooping.max_rejections = 200;
+    const calib::SnoopingOutcome snooped = calib::SolveWithDataSnooping(builder, options.solver, snooping);
+    report = snooped.report;
+    for (const auto& r : snooped.rejected) {
       const Observed& o = observed.at(r.id);
-      out.rejected.push_back({o.point, camera.subimages[o.subimage].id, o.reference, r.w,
-                              Eigen::Vector2d(r.whitened_residual[0], r.whitened_residual[1]) *
-                                  o.sigma_px});
+      out.rejected.push_back({o.point, camera.subimages[o.subimage].id, o.reference, r.w_max,
+                              Eigen::Vector2d(r.v[0], r.v[1]) * o.sigma_px});
     }
   } else {
     report = builder.Solve(options.solver);

@@ -35,7 +35,7 @@ calib::Camera MakeGridCamera(const GridLayoutOptions& o) {
   camera.pixel_size_mm = o.pixel_size_mm;
   camera.width_px = o.virtual_width_px;
   camera.height_px = o.virtual_height_px;
-  camera.interior[calib::BrownFraser10Model::kC] = o.c_mm;
+  camera.interior[calib::Camera::Model::kC] = o.c_mm;
   int n = 0;
   for (int r = 0; r < o.rows; ++r) {
     for (int c = 0; c < o.cols; ++c) {

@@ -103,3 +103,49 @@ TEST(CameraIo, BadFilesNameFileAndLine) {
 
 }  // namespace
 }  // namespace aerocal::calib
+
+namespace aerocal::calib {
+namespace {
+
+TEST(ModelCameraFile, EveryRegisteredModelRoundTripsThroughYaml) {
+  ForEachCameraModel([](auto model) {
+    using M = decltype(model);
+    ModelCamera camera;
+    camera.model = M::kId;
+    camera.frame = {0.0039, 6000, 4000};
+    for (int i = 0; i < M::kNumParams; ++i) camera.params.push_back(1000.0 + 0.123456789 * i);
+    const std::string text = ModelCameraToYaml(camera, "cam");
+    const ModelCamera back = ParseModelCamera(YAML::Load(text), "mem.yaml");
+    EXPECT_EQ(back.model, camera.model) << M::kName;
+    EXPECT_EQ(back.params, camera.params) << M::kName;
+    EXPECT_EQ(back.frame.width_px, 6000);
+    EXPECT_EQ(back.frame.pixel_size_mm, 0.0039);
+  });
+}
+
+TEST(ModelCameraFile, BadModelOrParameterNamesTheLine) {
+  const auto expect_error = [](const std::string& text, const std::string& what) {
+    try {
+      ParseModelCamera(YAML::Load(text), "cam.yaml");
+      ADD_FAILURE() << "no error for " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  expect_error("model: opencv_x\npixel_size_mm: 0.004\nformat_px: [10, 10]\ninterior: {fx: 1}\n",
+               "cam.yaml:1: unknown camera model 'opencv_x'");
+  expect_error("model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\ninterior: {K1: 1}\n",
+               "cam.yaml:4");
+  // The 10-parameter reader says what to do with another registered model.
+  try {
+    ParseCamera(YAML::Load("model: metashape_frame\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
+                           "interior: {f: 1}\n"),
+                "cam.yaml");
+    ADD_FAILURE() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("convert it first"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace aerocal::calib

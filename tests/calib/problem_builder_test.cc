@@ -4,6 +4,7 @@
 // data snooping of a planted gross error, and the diagnostics of rank-deficient and badly
 // determined problems.
 #include "calib/problem/problem_builder.h"
+#include "calib/problem/data_snooping.h"
 
 #include "calib/camera/camera.h"
 #include "calib/residuals/autodiff_residual.h"
@@ -153,9 +154,8 @@ TEST(ProblemBuilder, NoiseFreeDataGiveExactRecovery) {
   }
   EXPECT_LT(report.sigma0, 1e-6);
   // Snooping noise-free data rejects nothing (round-off is not a gross error).
-  std::vector<RejectedResidual> rejected;
-  a.builder.SolveWithDataSnooping({}, {}, &rejected);
-  EXPECT_TRUE(rejected.empty()) << rejected.size() << " rejected";
+  const SnoopingOutcome snooped = SolveWithDataSnooping(a.builder, {}, {});
+  EXPECT_TRUE(snooped.rejected.empty()) << snooped.rejected.size() << " rejected";
 }
 
 TEST(ProblemBuilder, GaussianNoiseGivesSigma0AndThreeSigmaRecovery) {
@@ -219,8 +219,9 @@ TEST(ProblemBuilder, DataSnoopingFindsAndListsAPlantedGrossError) {
   const size_t planted = pixels.size() / 3;
   pixels[planted].x() += 3.0;  // 15 sigma
   Adjustment a(f, pixels, 0.2, PerturbedStart(f.camera.interior));
-  std::vector<RejectedResidual> rejected;
-  const SolveReport report = a.builder.SolveWithDataSnooping({}, {}, &rejected);
+  const SnoopingOutcome snooped = SolveWithDataSnooping(a.builder, {}, {});
+  const SolveReport& report = snooped.report;
+  const auto& rejected = snooped.rejected;
   ASSERT_TRUE(report.converged);
   ASSERT_GE(rejected.size(), 1u);
   EXPECT_EQ(rejected[0].id, a.residuals[planted]);

@@ -10,30 +10,13 @@
 #include "stitch/layout/grid_layout.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/simulation/stitch_simulator.h"
+#include "tests/support/cubic_sample.h"
 #include "tests/support/test_support.h"
 
 namespace aerocal::stitch {
 namespace {
 
-// Keys cubic convolution (a = -0.5) of an image at a real position, edge samples repeated; the
-// test's own implementation, independent of the library's.
-double SampleCubic(const MemoryRaster& image, double x, double y, int band) {
-  auto weight = [](double t) {
-    t = std::abs(t);
-    if (t < 1) return 1.5 * t * t * t - 2.5 * t * t + 1;
-    if (t < 2) return -0.5 * t * t * t + 2.5 * t * t - 4 * t + 2;
-    return 0.0;
-  };
-  const int ix = static_cast<int>(std::floor(x)), iy = static_cast<int>(std::floor(y));
-  const RasterInfo info = image.Info();
-  double sum = 0;
-  for (int r = -1; r <= 2; ++r)
-    for (int c = -1; c <= 2; ++c) {
-      const int col = std::clamp(ix + c, 0, info.width - 1), row = std::clamp(iy + r, 0, info.height - 1);
-      sum += weight(x - (ix + c)) * weight(y - (iy + r)) * image.At(col, row, band);
-    }
-  return sum;
-}
+using testing::SampleCubic;
 
 // Sub-images of `truth` cut from `frame`: pixel (u, v) takes the frame at VirtualFromSub(u, v).
 std::vector<MemoryRaster> Cut(const MemoryRaster& frame, const calib::Camera& truth) {

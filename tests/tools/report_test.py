@@ -313,6 +313,23 @@ class TolerantInput(unittest.TestCase):
         self.assertIn("check-map", page.ids)
         self.assertEqual(text.count(PNG_URI), 3)  # sigma0, residuals, check map (no interior: no curves)
 
+    def test_invalid_steps_and_suspected_model_errors_are_shown_in_red(self):
+        doc = {"kind": "flight", "valid": False,
+               "failures": [{"step": "self-calibration", "reason": "sigma0 3.4 is above the limit 3"}],
+               "adjustments": [{"name": "self_calibration", "sigma0": 3.4, "sigma0_px": 0.68, "converged": True,
+                                "valid": False, "invalid_reasons": ["sigma0 3.4 is above the limit 3"],
+                                "snooping": {"model_error_suspected": True,
+                                             "model_error_evidence": ["3 independent of the 5 largest w on point C5"],
+                                             "suggestion": "self-calibration may absorb it",
+                                             "findings": ["point T442: one of these 2 observations holds a gross "
+                                                          "error; they cannot be told apart"]}}]}
+        text, page = self.render(doc)
+        self.assertIn('<span class="bad">self-calibration: sigma0 3.4 is above the limit 3</span>', text)
+        self.assertIn("model error suspected (3 independent of the 5 largest w on point C5)", text)
+        self.assertIn("cannot be told apart", text)
+        self.assertIn("no calibrated camera was written", text)
+        self.assertEqual(page.row("summary-steps", "Self-calibrating triangulation")[2], "no")
+
     def test_warnings_and_the_joint_mapping_model_are_shown(self):
         # A joint adjustment whose translation mappings do not fit: its warnings by name on the
         # summary (step flagged) and in its section, with the mapping model and why.
@@ -327,10 +344,9 @@ class TolerantInput(unittest.TestCase):
         joint = page.tables["summary-steps"][-1]  # the last step that ran
         self.assertIn("mappings translation", joint[-1])
         self.assertIn("1 warning(s)", joint[-1])
-        self.assertIn("All steps converged.", text)
+        self.assertIn("All steps converged and are valid.", text)  # a warning does not invalidate
         self.assertEqual(text.count("residual group stitch_tie: RMS 14.1 sigma"), 2)  # summary and section
         self.assertIn("Mapping model: translation (given by the user).", text)
-        self.assertIn('<tr class="flagged">', text)
 
 
 if __name__ == "__main__":

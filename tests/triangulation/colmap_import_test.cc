@@ -119,24 +119,31 @@ TEST(ColmapImportErrors, UnsupportedModelNamesTheLine) {
 }  // namespace
 }  // namespace aerocal::triangulation
 
+#include "calib/camera/convert_camera.h"
 #include "triangulation/import/colmap_export.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 namespace aerocal::triangulation {
 namespace {
 
+// The simulated flight's true block (camera, exposures, observations) and its point truth.
+Project TruthBlock(const SimulatedFlight& f, std::map<std::string, Eigen::Vector3d>* points) {
+  Project p;
+  p.cameras["cam1"] = f.truth;
+  p.exposures = f.exposures_truth;
+  p.observations = f.observations;
+  for (const auto& g : f.points_truth) (*points)[g.id] = *g.xyz_m;
+  return p;
+}
+
 TEST(ColmapExport, RoundTripKeepsOrientationsAndPixels) {
   FlightSimulationOptions o;
   o.ground_points = 30;
   o.tie_points = 50;
   const SimulatedFlight f = SimulateFlight(o);
-  Project p;
-  p.cameras["cam1"] = f.truth;
-  p.cameras["cam1"].interior = f.nominal.interior;  // no distortion: exported exactly
-  p.exposures = f.exposures_truth;
-  p.observations = f.observations;
   std::map<std::string, Eigen::Vector3d> points;
-  for (const auto& g : f.points_truth) points[g.id] = *g.xyz_m;
+  Project p = TruthBlock(f, &points);
+  p.cameras["cam1"].interior = f.nominal.interior;  // no distortion: exported exactly
   testing::TempDir dir("aerocal_colmap_export");
   WriteColmapModel(p, points, dir.path());
   ColmapImportOptions options;
@@ -165,6 +172,42 @@ TEST(ColmapExport, RoundTripKeepsOrientationsAndPixels) {
   for (const auto& [id, xyz] : points) id_of_number[std::to_string(++n)] = id;
   for (const auto& ob : back.observations)
     EXPECT_LT((ob.pixel - original.at({ob.image, id_of_number.at(ob.point)})).norm(), 1e-9);
+}
+
+calib::ModelCamera Registry(const calib::Camera& c) {
+  return {calib::CameraModelId::kBrownFraser10, {c.interior.begin(), c.interior.end()}, c.frame()};
+}
+
+TEST(ColmapExport, DistortionIsFittedIntoOpenCvNotDropped) {
+  FlightSimulationOptions o;  // the simulated camera: 1.7 px radial distortion at the corner
+  o.ground_points = 10;
+  o.tie_points = 10;
+  const SimulatedFlight f = SimulateFlight(o);
+  std::map<std::string, Eigen::Vector3d> points;
+  const Project p = TruthBlock(f, &points);
+  testing::TempDir dir("aerocal_colmap_export_distortion");
+  const std::vector<std::string> notes = WriteColmapModel(p, points, dir.path());
+  ASSERT_EQ(notes.size(), 1u);
+  std::printf("%s\n", notes[0].c_str());
+  EXPECT_NE(notes[0].find("least-squares fit"), std::string::npos) << notes[0];
+  ColmapImportOptions options;
+  options.folder = dir.path();
+  options.pixel_size_mm = f.truth.pixel_size_mm;
+  const ColmapImportReport back = ImportColmapModel(options);
+  std::printf("%s\n", back.notes.front().c_str());
+  const calib::Camera& imported = back.project.cameras.begin()->second;
+  // Through COLMAP's OPENCV (no K3, no shear B2) and back: within 0.1 px over the format (the
+  // shear's 0.048 px at the top and bottom edge dominates), while dropping the distortion would
+  // leave pixels.
+  const calib::ConversionResidual kept =
+      calib::CompareCameras(Registry(f.truth), Registry(imported), 41);
+  std::printf("ours -> COLMAP OPENCV -> ours: rms %.3g px, max %.3g px\n", kept.rms_px,
+              kept.max_px);
+  EXPECT_LT(kept.max_px, 0.1);
+  calib::Camera dropped = f.truth;
+  for (int k = calib::BrownFraser10Model::kK1; k < calib::BrownFraser10Model::kNumParams; ++k)
+    dropped.interior[k] = 0.0;
+  EXPECT_GT(calib::CompareCameras(Registry(f.truth), Registry(dropped), 41).max_px, 1.0);
 }
 
 }  // namespace

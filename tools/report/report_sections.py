@@ -42,29 +42,47 @@ def summary(doc):
                       num(rd.number(stitching.get("sigma0"))), num(rd.number(stitching.get("sigma0_px"))),
                       text(f"model {stitching.get('model', 'n/a')}, {fmt(n, 'd')} exposures")])
         classes.append("" if stitching.get("converged") is not False else "flagged")
+    warnings = []  # (step, sentence): shown in red under the table
     for a in rd.adjustments(doc):
         check = rd.point_statistics(a, "check")
         key = f"check points: {fmt(check['n'], 'd')}, spatial RMSE {fmt(check['spatial'])} m" if check else ""
         if a.get("mapping_model"):
             key += f"; mappings {a.get('mapping_model')}"
-        warnings = rd.listing(a.get("warnings"))
-        if warnings:
-            key += f"; {len(warnings)} warning(s)"
-        steps.append([text(rd.title(a)), raw(yes_no(a.get("converged"))), num(rd.number(a.get("sigma0"))),
-                      num(rd.number(a.get("sigma0_px"))), text(key)])
-        classes.append("" if a.get("converged") is not False and not warnings else "flagged")
+        named = rd.listing(a.get("warnings"))  # [{name, subject, value, limit, message}]
+        if named:
+            key += f"; {len(named)} warning(s)"
+        for w in named:
+            warnings.append((rd.title(a), "warning: " + str(w.get("message") if isinstance(w, dict) else w)))
+        valid = a.get("valid") is not False and a.get("converged") is not False
+        steps.append([text(rd.title(a)), raw(yes_no(a.get("converged"))), raw(yes_no(valid)),
+                      num(rd.number(a.get("sigma0"))), num(rd.number(a.get("sigma0_px"))), text(key)])
+        classes.append("" if valid else "flagged")
+        for reason in a.get("invalid_reasons") or []:
+            warnings.append((rd.title(a), "not valid: " + str(reason)))
+        snooping = a.get("snooping") or {}
+        if snooping.get("model_error_suspected"):
+            evidence = "; ".join(str(e) for e in snooping.get("model_error_evidence") or [])
+            warnings.append((rd.title(a), f"model error suspected ({evidence}). "
+                                          f"{snooping.get('suggestion', '')}"))
+        for f in snooping.get("findings") or []:
+            if "cannot be told apart" in str(f) or "suspected blunder" in str(f):
+                warnings.append((rd.title(a), str(f)))
     if steps:
+        for v in [stitching] if isinstance(stitching, dict) else []:
+            steps[0].insert(2, raw(yes_no(v.get("converged") is not False)))
         out.append(table("summary-steps", "What ran",
-                         ["step", "converged", "sigma0 [1]", "sigma0 [px]", "key figures"], steps, classes))
-        converged = all(a.get("converged") is not False for a in rd.adjustments(doc)) and \
-            (not isinstance(stitching, dict) or stitching.get("converged") is not False)
-        out.append(note("All steps converged." if converged else
-                        '<span class="bad">At least one step did not converge: its figures are not '
-                        "a valid calibration.</span>"))
-        for a in rd.adjustments(doc):
-            for w in rd.listing(a.get("warnings")):
-                message = w.get("message") if isinstance(w, dict) else w
-                out.append(f'<p class="na"><span class="bad">warning ({esc(rd.title(a))})</span>: {esc(message)}</p>')
+                         ["step", "converged", "valid", "sigma0 [1]", "sigma0 [px]", "key figures"], steps,
+                         classes))
+        for f in rd.get(doc, "failures") or []:
+            warnings.insert(0, (f.get("step", "?"), str(f.get("reason", ""))))
+        all_ok = all(c == "" for c in classes) and rd.get(doc, "valid") is not False
+        out.append(note("All steps converged and are valid." if all_ok else
+                        '<span class="bad">At least one step did not converge or is not valid: its figures are not '
+                        "a valid calibration, and no calibrated camera was written.</span>"))
+        if warnings:
+            out.append('<ul class="warnings">' + "".join(
+                f'<li><span class="bad">{esc(step)}: {esc(sentence)}</span></li>' for step, sentence in warnings)
+                + "</ul>")
     else:
         out.append(not_available("Steps of the workflow"))
     return "".join(out)

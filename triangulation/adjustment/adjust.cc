@@ -1,22 +1,72 @@
 // Adjust(): one adjustment, or with a robust start a Cauchy-loss adjustment whose solution and
-// gross-error screening start the clean one (see AdjustOptions::robust_start).
+// gross-error screening start the clean one (see AdjustOptions::robust_start). The robust start
+// runs when asked, or by default when the first solve's residuals call for it
+// (AdjustOptions::auto_robust_start).
 #include "calib/core/csv.h"
+#include "calib/residuals/collinearity.h"
 #include "triangulation/adjustment/block_adjustment.h"
 
 #include <algorithm>
 #include <cmath>
 
 namespace aerocal::triangulation {
+namespace {
+
+// Whitened residual of `o` at the solution of `r` (adjustment frame); nullopt when its exposure
+// or point is not in that solution or the ray misses.
+std::optional<Eigen::Vector2d> ResidualAt(const Project& project,
+                                          const AdjustmentResult& r,
+                                          const ImageObservation& o) {
+  const Exposure* exposure = nullptr;
+  for (const auto& e : project.exposures)
+    if (e.image == o.image) exposure = &e;
+  const auto point = r.points_m.find(o.point);
+  if (!exposure || point == r.points_m.end()) return std::nullopt;
+  const ExposureEstimate* pose = nullptr;
+  for (const auto& e : r.exposures)
+    if (e.image == o.image && e.used) pose = &e;
+  const CameraEstimate* camera = nullptr;
+  for (const auto& c : r.cameras)
+    if (c.id == exposure->camera) camera = &c;
+  if (!pose || !camera) return std::nullopt;
+  const calib::Camera& cam = project.cameras.at(exposure->camera);
+  const calib::PixelFrame frame{cam.pixel_size_mm, cam.width_px, cam.height_px};
+  const calib::CollinearityResidual residual(frame, o.pixel, o.sigma_px);
+  Eigen::Vector2d v;
+  if (!residual(camera->estimated.data(),
+                pose->opk_rad.data(),
+                pose->center_m.data(),
+                point->second.data(),
+                v.data()))
+    return std::nullopt;
+  return v;
+}
+
+bool SameObservation(const ImageObservation& a, const ImageObservation& b) {
+  return a.image == b.image && a.point == b.point && a.subimage == b.subimage &&
+         a.pixel == b.pixel;
+}
+
+}  // namespace
 
 int AdjustStages(const AdjustOptions& options) {
-  return (options.robust_start ? 2 : 1) * BlockAdjustment::kRunStages;
+  return (options.robust_start ? 3 : 1) * BlockAdjustment::kRunStages;
 }
 
 AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Progress* progress) {
+  std::string reason = "--robust-start";
+  double gross_share = 0.0;
   if (!options.robust_start) {
     BlockAdjustment adjustment(project, options);
-    return adjustment.Run(progress);
+    adjustment.StopWhenRobustStartNeeded(options.auto_robust_start);
+    AdjustmentResult plain = adjustment.Run(progress);
+    if (!plain.robust_start_needed) return plain;
+    gross_share = plain.snooping.gross_share;
+    reason = FormatNumber(100 * gross_share, 3) + " % of the image components above " +
+             FormatNumber(options.robust_trigger_w, 3) + " sigma in the first solve";
   }
+  // 1. Robust (Cauchy) adjustment, then the observations far outside its solution, judged with
+  //    redundancy numbers.
   AdjustOptions robust = options;
   robust.data_snooping = false;
   robust.estimate_covariance = false;
@@ -24,65 +74,108 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   loss.kind = calib::LossKind::kCauchy;
   loss.scale = options.robust_scale_sigma;
   AdjustmentResult start;
+  std::vector<BlockAdjustment::Screened> screened;
   {
     BlockAdjustment adjustment(project, robust, SubimageObservations::kMapWithCameraFile, loss);
     start = adjustment.Run(progress);
+    screened = adjustment.ScreenRobustly(options.robust_reject_sigma);
   }
-  // Observations far outside the robust solution's spread are gross errors: a robust scale
-  // (1.4826 median |v / sigma| over all components) and a cut at `robust_reject_sigma` scales.
-  std::vector<double> abs_w;
-  for (const auto& v : start.residuals)
-    if (v.used)
-      for (int k = 0; k < 2; ++k) abs_w.push_back(std::abs(v.residual_px(k)) / v.sigma_px);
-  std::vector<RejectedObservation> pre_rejected;
-  std::vector<ObservationResidual> pre_rejected_residuals;  // listed with their robust residual
+  auto excluded = [&](const ImageObservation& o) {
+    for (const auto& s : screened)
+      if (SameObservation(s.observation, o)) return true;
+    return false;
+  };
   Project next = project;
-  if (!abs_w.empty()) {
-    std::nth_element(abs_w.begin(), abs_w.begin() + abs_w.size() / 2, abs_w.end());
-    const double scale = std::max(1e-12, 1.4826 * abs_w[abs_w.size() / 2]);
-    std::vector<bool> drop(project.observations.size(), false);
-    for (const auto& v : start.residuals) {
-      const double w = v.residual_px.norm() / v.sigma_px / scale;
-      if (!v.used || w <= options.robust_reject_sigma) continue;
-      for (size_t i = 0; i < project.observations.size(); ++i) {
-        const auto& o = project.observations[i];
-        if (!drop[i] && o.image == v.image && o.point == v.point && o.subimage.empty() &&
-            o.pixel == v.measured_px) {
-          drop[i] = true;
-          pre_rejected.push_back({v.image,
-                                  v.point,
-                                  v.measured_px,
-                                  Eigen::Vector2d(v.residual_px.x(), -v.residual_px.y()),
-                                  w,
-                                  std::string()});
-          pre_rejected_residuals.push_back(v);
-          pre_rejected_residuals.back().used = false;
-          break;
-        }
-      }
-    }
-    next.observations.clear();
-    for (size_t i = 0; i < project.observations.size(); ++i)
-      if (!drop[i]) next.observations.push_back(project.observations[i]);
-  }
+  next.observations.clear();
+  for (const auto& o : project.observations)
+    if (!excluded(o)) next.observations.push_back(o);
   // The robust solution becomes the starting values; surveyed coordinates stay the survey.
   for (auto& e : next.exposures)
     for (const auto& s : start.exposures)
-      if (s.image == e.image) {
+      if (s.image == e.image && s.used) {
         e.center_m = s.center_m;
         e.opk_rad = s.opk_rad;
       }
   for (const auto& c : start.cameras) next.cameras.at(c.id).interior = c.estimated;
   for (auto& p : next.points)
     if (p.role == PointRole::kTie && start.points_m.count(p.id)) p.xyz_m = start.points_m.at(p.id);
-  BlockAdjustment adjustment(next, options);
+
+  // 2. Clean solution without the excluded observations; those that fit it are re-admitted:
+  //    |v| / sigma at a solution they did not influence below the critical value (their
+  //    w would be smaller still: the prediction's variance exceeds sigma^2).
+  AdjustOptions clean_options = options;
+  clean_options.data_snooping = false;
+  clean_options.estimate_covariance = false;
+  AdjustmentResult clean;
+  {
+    BlockAdjustment adjustment(next, clean_options);
+    clean = adjustment.Run(progress);
+  }
+  const int components = 2 * static_cast<int>(next.observations.size());
+  const double critical = options.snooping_critical_value > 0
+                              ? options.snooping_critical_value
+                              : std::max(3.29, calib::NormalCriticalValue(
+                                                   options.snooping_alpha / std::max(1, components)));
+  const double scale = std::max(1.0, clean.sigma0);
+  std::vector<BlockAdjustment::Screened> still_excluded;
+  int readmitted = 0;
+  for (const auto& s : screened) {
+    const auto v = ResidualAt(next, clean, s.observation);
+    if (v && v->cwiseAbs().maxCoeff() / scale < critical) {
+      next.observations.push_back(s.observation);
+      ++readmitted;
+    } else {
+      still_excluded.push_back(s);
+    }
+  }
+  for (auto& e : next.exposures)
+    for (const auto& s : clean.exposures)
+      if (s.image == e.image && s.used) {
+        e.center_m = s.center_m;
+        e.opk_rad = s.opk_rad;
+      }
+  for (const auto& c : clean.cameras) next.cameras.at(c.id).interior = c.estimated;
+  for (auto& p : next.points)
+    if (p.role == PointRole::kTie && clean.points_m.count(p.id)) p.xyz_m = clean.points_m.at(p.id);
+
+  // 3. The final adjustment with snooping and covariance.
+  AdjustOptions final_options = options;
+  final_options.robust_start = false;
+  BlockAdjustment adjustment(next, final_options);
   AdjustmentResult result = adjustment.Run(progress);
   for (auto& c : result.cameras) c.initial = project.cameras.at(c.id).interior;
+  std::vector<RejectedObservation> pre_rejected;
+  for (const auto& s : still_excluded) {
+    RejectedObservation r;
+    r.image = s.observation.image;
+    r.point = s.observation.point;
+    r.measured_px = s.observation.pixel;
+    r.residual_px = s.residual_px;
+    r.w = s.w;
+    r.by = "robust start";
+    r.group = {s.observation.image};
+    pre_rejected.push_back(r);
+    ObservationResidual v;
+    v.image = s.observation.image;
+    v.point = s.observation.point;
+    v.measured_px = s.observation.pixel;
+    v.residual_px = Eigen::Vector2d(s.residual_px.x(), -s.residual_px.y());
+    v.sigma_px = s.observation.sigma_px;
+    v.used = false;
+    result.residuals.push_back(v);
+  }
   result.rejected.insert(result.rejected.begin(), pre_rejected.begin(), pre_rejected.end());
-  result.residuals.insert(
-      result.residuals.end(), pre_rejected_residuals.begin(), pre_rejected_residuals.end());
+  result.snooping.robust_start = true;
+  result.snooping.robust_start_reason = reason;
+  result.snooping.gross_share = gross_share;
+  result.snooping.robust_excluded = static_cast<int>(screened.size());
+  result.snooping.robust_readmitted = readmitted;
   result.notes.push_back("started from a robust (Cauchy, " +
-                         FormatNumber(options.robust_scale_sigma, 3) + " sigma) adjustment");
+                         FormatNumber(options.robust_scale_sigma, 3) + " sigma) adjustment (" +
+                         reason + "): " + std::to_string(screened.size()) +
+                         " observation(s) beyond " + FormatNumber(options.robust_reject_sigma, 3) +
+                         " robust w excluded, " + std::to_string(readmitted) +
+                         " re-admitted because they fit the clean solution");
   return result;
 }
 

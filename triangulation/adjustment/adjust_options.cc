@@ -1,6 +1,6 @@
 #include "triangulation/adjustment/adjust_options.h"
 
-#include "calib/camera/brown_fraser10.h"
+#include "calib/camera/camera.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 
@@ -9,7 +9,7 @@
 
 namespace aerocal::triangulation {
 
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 
 void AdjustOptions::Validate() const {
   std::set<std::string> seen;
@@ -29,14 +29,31 @@ void AdjustOptions::Validate() const {
   if (!(robust_reject_sigma > 0))
     throw ConfigError("robust_reject_sigma must be > 0 (got " + FormatNumber(robust_reject_sigma) +
                       ")");
+  auto in_range = [](const char* name, double value, double lo, double hi, bool lo_open,
+                     bool hi_open) {
+    const bool ok = (lo_open ? value > lo : value >= lo) && (hi_open ? value < hi : value <= hi);
+    if (!ok)
+      throw ConfigError(std::string(name) + " must be in " + (lo_open ? "(" : "[") +
+                        FormatNumber(lo) + ", " + FormatNumber(hi) + (hi_open ? ")" : "]") +
+                        " (got " + FormatNumber(value) + ")");
+  };
+  in_range("snooping_alpha", snooping_alpha, 0, 1, true, true);
+  in_range("snooping_power", snooping_power, 0.5, 1, true, true);
+  in_range("min_redundancy", min_redundancy, 0, 1, false, true);
+  in_range("group_correlation", group_correlation, 0, 1, true, false);
+  in_range("robust_trigger_share", robust_trigger_share, 0, 1, false, true);
+  if (!(robust_trigger_w > 0))
+    throw ConfigError("robust_trigger_w must be > 0 (got " + FormatNumber(robust_trigger_w) + ")");
+  if (!(model_error_sigma0 > 0))
+    throw ConfigError("model_error_sigma0 must be > 0 (got " + FormatNumber(model_error_sigma0) +
+                      ")");
+  if (!(max_sigma0 > 0))
+    throw ConfigError("max_sigma0 must be > 0 (got " + FormatNumber(max_sigma0) + ")");
   if (max_rejections < 1)
     throw ConfigError("max_rejections must be > 0 (got " + std::to_string(max_rejections) + ")");
   if (!(correlation_threshold > 0 && correlation_threshold < 1))
     throw ConfigError("correlation_threshold must be in (0, 1) (got " +
                       FormatNumber(correlation_threshold) + ")");
-  if (max_dense_parameters < 0)
-    throw ConfigError("max_dense_parameters must be >= 0 (got " +
-                      std::to_string(max_dense_parameters) + ")");
   if (solver.max_iterations < 1)
     throw ConfigError("solver.max_iterations must be > 0 (got " +
                       std::to_string(solver.max_iterations) + ")");
@@ -49,12 +66,7 @@ std::vector<std::string> ParseSelfCalibration(const std::string& text) {
     for (const auto& p : Model::kParams) names.emplace_back(p.name);
     return names;
   }
-  std::stringstream in(text);
-  std::string name;
-  while (std::getline(in, name, ',')) {
-    const auto begin = name.find_first_not_of(' ');
-    const auto end = name.find_last_not_of(' ');
-    name = begin == std::string::npos ? "" : name.substr(begin, end - begin + 1);
+  for (const std::string& name : SplitCommaList(text)) {
     if (Model::IndexOf(name) < 0)
       throw ConfigError(
           "--self-calibration: unknown parameter '" + name +

@@ -23,27 +23,45 @@ struct AdjustOptions {
   /// orientation and the exposure farthest from it keeps the coordinate of the largest base
   /// component (scale). Off: the datum defect is reported as not determinable.
   bool free_network_datum = true;
-  /// Baarda data snooping on the image observations; rejected observations are listed.
+  /// Data snooping (calib/problem/data_snooping.h) on the image observations; the control
+  /// coordinates are tested too and named when their survey disagrees, never rejected.
   bool data_snooping = true;
   /// Robust start: adjust first with a Cauchy loss on the image observations (scale
   /// `robust_scale_sigma` sigmas), then re-adjust without it from that solution, snooping as set.
   /// For blocks with large gross errors and poor starting values.
   bool robust_start = false;
+  /// Without robust_start: start robustly anyway when the first adjustment's residuals call for
+  /// it: more than `robust_trigger_share` of the image components above `robust_trigger_w`
+  /// (whitened |v| / sigma).
+  bool auto_robust_start = true;
+  double robust_trigger_share = 0.01;  // [0, 1)
+  double robust_trigger_w = 10.0;      // > 0
   double robust_scale_sigma = 3.0;  // > 0
-  /// After the robust adjustment, observations whose residual exceeds this many robust scales
-  /// (1.4826 median |v / sigma|) are rejected before the clean re-adjustment, > 0. Only the
-  /// obvious: data snooping (exact redundancy numbers) decides the rest.
+  /// After the robust adjustment, observations whose w = |v| / (s sqrt(r)) (redundancy numbers r,
+  /// s = the robust scale of w) exceeds this are excluded from the clean re-adjustment, > 0;
+  /// those that fit the clean solution (|v| / sigma below the snooping critical value) are
+  /// re-admitted. Data snooping decides the rest.
   double robust_reject_sigma = 8.0;
+  /// Snooping policy (data_snooping.h): family-wise alpha, power for the MDB, the redundancy
+  /// below which an observation is weakly controlled (reported, never rejected), the correlation
+  /// above which observations cannot be told apart (acted on as a group).
+  double snooping_alpha = 0.05;         // (0, 1)
+  double snooping_power = 0.80;         // (0.5, 1)
+  double min_redundancy = 0.1;          // [0, 1)
+  double group_correlation = 0.99;      // (0, 1]
+  /// Final sigma0 above which a model error is suspected (besides the clustering of the largest
+  /// w on one point / image / the control), > 0.
+  double model_error_sigma0 = 1.5;
+  /// A result whose final sigma0 exceeds this is not valid (exit 3), > 0.
+  double max_sigma0 = 3.0;
   /// Estimate the covariance (sigmas, correlations, determinability). Off only for speed.
   bool estimate_covariance = true;
   /// Critical value of the standardized residual |w|; 0: from alpha = 5 % / n_tested (>= 3.29).
   double snooping_critical_value = 0.0;
-  int max_rejections = 100;  // > 0
+  /// Rejection cap of data snooping; reaching it makes the result invalid (exit 3), > 0.
+  int max_rejections = 100;
   /// |correlation| above which a pair of parameters is reported as not separable, (0, 1).
   double correlation_threshold = 0.95;
-  /// Free-parameter limit for the exact redundancy numbers of data snooping (dense reduced
-  /// normal matrix); larger blocks use the mean redundancy r / n.
-  int max_dense_parameters = 4000;
   calib::SolverOptions solver;
 
   /// Throws ConfigError naming the field, the value and the rule.

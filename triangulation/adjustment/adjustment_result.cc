@@ -2,16 +2,75 @@
 
 #include "calib/core/string_printf.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
 namespace aerocal::triangulation {
 namespace {
 
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 constexpr double kRadToDeg = 180.0 / M_PI;
 
 nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
+
+// A number, or null when it is not finite (untestable component, unknown sigma).
+nlohmann::json Finite(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
+nlohmann::json Pair(const Eigen::Vector2d& v) { return {Finite(v.x()), Finite(v.y())}; }
+
+// r, w, MDB and group size of one tested observation (FORMATS.md keys are kept beside these).
+void AddTest(const ObservationTest& t, nlohmann::json* j) {
+  if (!t.tested) return;
+  (*j)["r"] = Pair(t.redundancy);
+  (*j)["w_xy"] = Pair(t.w);
+  (*j)["mdb_sigma"] = Pair(t.mdb_sigma);
+  (*j)["mdb_px"] = Pair(t.mdb_px);
+  (*j)["group_size"] = t.group_size;
+  (*j)["verdict"] = t.verdict;
+  if (!t.reason.empty()) (*j)["reason"] = t.reason;
+}
+
+nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
+  nlohmann::json j = {{"run", s.run},
+                      {"alpha", s.alpha},
+                      {"alpha0", s.alpha0},
+                      {"critical_value", s.critical_value},
+                      {"power", s.power},
+                      {"delta0", s.delta0},
+                      {"min_redundancy", s.min_redundancy},
+                      {"group_correlation", s.group_correlation},
+                      {"reference_sigma", s.reference_sigma},
+                      {"cofactor_method", s.cofactor_method},
+                      {"cofactors_ok", s.cofactors_ok},
+                      {"n_tested_components", s.n_tested_components},
+                      {"rounds", s.rounds},
+                      {"max_rejections", s.max_rejections},
+                      {"cap_reached", s.cap_reached},
+                      {"remaining_above_critical", s.remaining_above_critical},
+                      {"n_weakly_controlled", s.n_weakly_controlled},
+                      {"n_untestable", s.n_untestable},
+                      {"n_in_groups", s.n_in_groups},
+                      {"model_error_suspected", s.model_error_suspected},
+                      {"model_error_evidence", s.model_error_evidence},
+                      {"suggestion", s.suggestion},
+                      {"findings", s.findings},
+                      {"seconds_testing", s.seconds_testing},
+                      {"robust_start", s.robust_start},
+                      {"robust_start_reason", s.robust_start_reason},
+                      {"gross_share", s.gross_share},
+                      {"robust_excluded", s.robust_excluded},
+                      {"robust_readmitted", s.robust_readmitted}};
+  j["flagged"] = nlohmann::json::array();
+  for (const auto& f : s.flagged)
+    j["flagged"].push_back({{"observation", f.what},
+                            {"verdict", f.verdict},
+                            {"reason", f.reason},
+                            {"w", Finite(f.w)},
+                            {"r", f.redundancy},
+                            {"mdb_sigma", Finite(f.mdb_sigma)},
+                            {"group_size", f.group_size}});
+  return j;
+}
 
 nlohmann::json Interior(const calib::InteriorParams& p) {
   nlohmann::json j = nlohmann::json::object();
@@ -77,18 +136,62 @@ std::string RejectedLines(const AdjustmentResult& r) {
   std::string out;
   for (const auto& o : r.rejected)
     out +=
-        StringPrintf("rejected: image %s%s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f)\n",
+        StringPrintf("rejected%s: image %s%s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f%s)\n",
+                     o.by == "snooping" ? "" : (" by the " + o.by).c_str(),
                      o.image.c_str(),
                      o.subimage.empty() ? "" : (" sub-image " + o.subimage).c_str(),
                      o.point.c_str(),
                      o.measured_px.x(),
                      o.measured_px.y(),
                      o.residual_px.norm(),
-                     o.w);
+                     o.w,
+                     o.test.tested ? StringPrintf(", r = %.2f, MDB %.2f px, group of %d",
+                                                  o.test.redundancy.minCoeff(),
+                                                  o.test.mdb_px.maxCoeff(),
+                                                  o.test.group_size).c_str()
+                                   : "");
+  return out;
+}
+
+// What snooping could not decide or suspects, one line each.
+std::string SnoopingLines(const AdjustmentResult& r) {
+  const SnoopingSummary& s = r.snooping;
+  std::string out;
+  if (s.robust_start)
+    out += StringPrintf(
+        "robust start (%s): %d observation(s) excluded, %d re-admitted after the clean solution\n",
+        s.robust_start_reason.c_str(), s.robust_excluded, s.robust_readmitted);
+  if (!s.run) return out;
+  out += StringPrintf(
+      "data snooping: %d components tested, critical |w| %.2f (alpha %.3g family-wise), power "
+      "%.0f %% (delta0 %.2f), %d round(s), %zu rejected; %d observation(s) weakly controlled "
+      "(r < %.2f), %d in correlated groups; cofactors: %s\n",
+      s.n_tested_components, s.critical_value, s.alpha, 100 * s.power, s.delta0, s.rounds,
+      r.rejected.size(), s.n_weakly_controlled, s.min_redundancy, s.n_in_groups,
+      s.cofactor_method.c_str());
+  for (const auto& f : s.findings) out += "snooping: " + f + "\n";
+  if (s.model_error_suspected && !s.suggestion.empty())
+    out += "warning: model error suspected: " + s.suggestion + "\n";
+  if (s.cap_reached)
+    out += StringPrintf("warning: rejection cap (%d) reached: %d candidate(s) left above the "
+                        "critical value\n",
+                        s.max_rejections, s.remaining_above_critical);
+  return out;
+}
+
+std::string ValidityLines(const AdjustmentResult& r) {
+  std::string out;
+  for (const auto& reason : r.invalid_reasons) out += "NOT VALID: " + reason + "\n";
   return out;
 }
 
 }  // namespace
+
+void AdjustmentResult::Invalidate(const std::string& reason) {
+  valid = false;
+  if (std::find(invalid_reasons.begin(), invalid_reasons.end(), reason) == invalid_reasons.end())
+    invalid_reasons.push_back(reason);
+}
 
 PointStatistics ComputePointStatistics(const std::vector<PointDifference>& points) {
   PointStatistics s;
@@ -203,7 +306,13 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
                         {"omega", e.opk_rad.x() * kRadToDeg},
                         {"phi", e.opk_rad.y() * kRadToDeg},
                         {"kappa", e.opk_rad.z() * kRadToDeg}};
-    nlohmann::json sigma = nlohmann::json::object();
+    // Unknown (left out, or no covariance): null, never 0.
+    nlohmann::json sigma = {{"X", nullptr},
+                            {"Y", nullptr},
+                            {"Z", nullptr},
+                            {"omega", nullptr},
+                            {"phi", nullptr},
+                            {"kappa", nullptr}};
     if (e.center_sigma_m && e.opk_sigma_rad)
       sigma = {{"X", e.center_sigma_m->x()},
                {"Y", e.center_sigma_m->y()},
@@ -212,6 +321,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
                {"phi", e.opk_sigma_rad->y() * kRadToDeg},
                {"kappa", e.opk_sigma_rad->z() * kRadToDeg}};
     x["sigma"] = sigma;
+    x["used"] = e.used;
     j["exposures"].push_back(x);
   }
   j["rejected"] = nlohmann::json::array();
@@ -221,8 +331,11 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
                         {"measured_px", {o.measured_px.x(), o.measured_px.y()}},
                         {"residual_px", o.residual_px.norm()},
                         {"residual_col_row_px", {o.residual_px.x(), -o.residual_px.y()}},
-                        {"w", o.w}};
+                        {"w", o.w},
+                        {"by", o.by},
+                        {"group", o.group}};
     if (!o.subimage.empty()) x["subimage"] = o.subimage;
+    AddTest(o.test, &x);
     j["rejected"].push_back(x);
   }
   // Every image observation: where it was measured (virtual pixels) and its residual, for the
@@ -242,6 +355,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
       v["u"] = o.subimage_px.x();
       v["v"] = o.subimage_px.y();
     }
+    AddTest(o.test, &v);
     j["residuals"].push_back(v);
   }
   nlohmann::json det = {{"determinable", r.determinability.covariance_ok},
@@ -254,6 +368,9 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
     det["high_correlations"].push_back({{"a", h.a}, {"b", h.b}, {"correlation", h.correlation}});
   j["determinability"] = det;
   j["notes"] = r.notes;
+  j["snooping"] = SnoopingToJson(r.snooping);
+  j["valid"] = r.valid;
+  j["invalid_reasons"] = r.invalid_reasons;
   return j;
 }
 
@@ -273,7 +390,9 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += StatisticsLine("check", r.check);
   if (!r.free_interior.empty()) out += CalibrationTable(r);
   out += RejectedLines(r);
+  out += SnoopingLines(r);
   for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
+  out += ValidityLines(r);
   for (const auto& w : r.warnings) out += "warning: " + w.message + "\n";
   return out;
 }
@@ -301,7 +420,9 @@ std::string FormatComparison(const AdjustmentResult& a, const AdjustmentResult& 
                       b.solve.converged ? "yes" : "no");
   out += "calibration (self-calibrating run):\n" + CalibrationTable(b);
   out += RejectedLines(b);
+  out += SnoopingLines(b);
   for (const auto& w : b.determinability.warnings) out += "warning: " + w + "\n";
+  out += ValidityLines(a) + ValidityLines(b);
   for (const auto& w : a.warnings) out += "warning (conventional): " + w.message + "\n";
   for (const auto& w : b.warnings) out += "warning: " + w.message + "\n";
   return out;

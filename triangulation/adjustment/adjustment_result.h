@@ -40,14 +40,30 @@ PointStatistics ComputePointStatistics(const std::vector<PointDifference>& point
 struct CameraEstimate {
   std::string id;
   calib::InteriorParams initial{}, estimated{}, sigma{};  // table units; sigma 0 when fixed
-  std::array<bool, calib::BrownFraser10Model::kNumParams> free{};
+  std::array<bool, calib::Camera::Model::kNumParams> free{};
 };
 
 struct ExposureEstimate {
   std::string image;
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();
-  std::optional<Eigen::Vector3d> center_sigma_m, opk_sigma_rad;  // when the covariance is known
+  /// When the covariance is known and the exposure took part; null in JSON otherwise.
+  std::optional<Eigen::Vector3d> center_sigma_m, opk_sigma_rad;
+  bool used = true;  // false: left out of the adjustment (too few points)
+};
+
+/// What data snooping found for one image observation (calib/problem/data_snooping.h), per
+/// component (x, y of the photo frame): redundancy number r, standardized residual w (NaN where
+/// r ~ 0: untestable) and the marginal detectable blunder (MDB, +inf where untestable).
+struct ObservationTest {
+  bool tested = false;
+  Eigen::Vector2d redundancy = Eigen::Vector2d::Zero();
+  Eigen::Vector2d w = Eigen::Vector2d::Zero();
+  Eigen::Vector2d mdb_sigma = Eigen::Vector2d::Zero();  // in sigmas of the observation
+  Eigen::Vector2d mdb_px = Eigen::Vector2d::Zero();
+  int group_size = 1;   // observations it cannot be told apart from, itself included
+  std::string verdict;  // calib::VerdictName
+  std::string reason;
 };
 
 struct RejectedObservation {
@@ -56,6 +72,47 @@ struct RejectedObservation {
   Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // v in (corrected) photo space, px
   double w = 0.0;                                         // standardized residual
   std::string subimage;  // non-empty: measured_px is (u, v) in this raw sub-image
+  ObservationTest test;  // at the rejection (robust start: tested == false, w its robust w)
+  std::vector<std::string> group;  // images of the correlated group (same point), with its own
+  std::string by = "snooping";     // "snooping" or "robust start"
+};
+
+/// An observation (or a control point's survey) tested above the critical value and NOT
+/// rejected: vetoed (datum), held (survey, model error), weakly controlled, or left at the cap.
+struct FlaggedObservation {
+  std::string what;  // "image 0012 point T442", "control C5"
+  std::string verdict, reason;
+  double w = 0.0;
+  double redundancy = 0.0;  // of the tested component
+  double mdb_sigma = 0.0;
+  int group_size = 1;
+};
+
+/// How data snooping was run and what it could not decide (data_snooping.h).
+struct SnoopingSummary {
+  bool run = false;
+  double alpha = 0, alpha0 = 0, critical_value = 0, power = 0, delta0 = 0;
+  double min_redundancy = 0, group_correlation = 0, reference_sigma = 1;
+  std::string cofactor_method;
+  bool cofactors_ok = true;
+  std::string cofactor_message;
+  int n_tested_components = 0, rounds = 0, max_rejections = 0;
+  bool cap_reached = false;
+  int remaining_above_critical = 0;
+  int n_weakly_controlled = 0;  // observations with a component r < min_redundancy
+  int n_untestable = 0;         // observations with a component r ~ 0
+  int n_in_groups = 0;          // observations whose correlated group has > 1 member
+  bool model_error_suspected = false;
+  std::vector<std::string> model_error_evidence;
+  std::string suggestion;  // e.g. self-calibration
+  std::vector<std::string> findings;
+  std::vector<FlaggedObservation> flagged;
+  double seconds_testing = 0;
+  // Robust start: why it ran (forced or by the residuals), what it excluded and re-admitted.
+  bool robust_start = false;
+  std::string robust_start_reason;
+  double gross_share = 0;  // of image components above robust_trigger_w in the first solve
+  int robust_excluded = 0, robust_readmitted = 0;
 };
 
 /// One image observation after the adjustment: residual v = measured - adjusted, in pixels of
@@ -68,6 +125,7 @@ struct ObservationResidual {
   bool used = true;      // false: rejected as a gross error
   std::string subimage;  // non-empty: measured in this raw sub-image at subimage_px (u, v)
   Eigen::Vector2d subimage_px = Eigen::Vector2d::Zero();
+  ObservationTest test;  // the final test (or the one at its rejection)
 };
 
 struct Determinability {
@@ -116,8 +174,18 @@ struct AdjustmentResult {
   std::string frame;                                // the object frame, stated
   std::string datum;                                // how the datum is defined, stated
   std::vector<ResultWarning> warnings;              // the result is doubtful: by name
+  SnoopingSummary snooping;
+  /// False when the run must not be trusted: not converged, singular, rejection cap reached,
+  /// sigma0 above AdjustOptions::max_sigma0; `invalid_reasons` says why (exit 3).
+  bool valid = true;
+  std::vector<std::string> invalid_reasons;
+  /// Set by BlockAdjustment::Run when it stopped early because the first solve's residuals call
+  /// for a robust start (only with StopWhenRobustStartNeeded).
+  bool robust_start_needed = false;
 
   bool converged() const { return solve.converged; }
+  /// Marks the result invalid with a reason (kept once).
+  void Invalidate(const std::string& reason);
 };
 
 /// JSON of FORMATS.md (kind "adjust"); angles in degrees, coordinates in the object frame.

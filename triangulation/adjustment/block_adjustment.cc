@@ -1,5 +1,7 @@
 #include "triangulation/adjustment/block_adjustment.h"
+#include "calib/core/median.h"
 
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
@@ -15,7 +17,7 @@
 namespace aerocal::triangulation {
 namespace {
 
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 using calib::BlockId;
 using calib::BlockKind;
 
@@ -26,12 +28,6 @@ std::vector<std::string> InteriorNames() {
   std::vector<std::string> names;
   for (const auto& p : Model::kParams) names.emplace_back(p.name);
   return names;
-}
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return 0.0;
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
 }
 
 }  // namespace
@@ -60,6 +56,7 @@ struct BlockAdjustment::Storage {
   // Virtual-image observations used in the adjustment (sub-image ones mapped), and their residuals.
   std::vector<ImageObservation> observations;
   std::map<calib::ResidualId, size_t> observation_of_residual;
+  std::map<calib::ResidualId, ObservationTest> tests;  // data snooping's last word on each
   std::vector<std::string> notes;
   std::string datum;
   bool free_network = false;  // datum by a dependent relative orientation, not by the survey
@@ -360,6 +357,194 @@ void BlockAdjustment::DefineDatum() {
   storage_->datum = text;
 }
 
+std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double reject) const {
+  std::vector<calib::ResidualId> ids;
+  for (const auto& [id, index] : storage_->observation_of_residual)
+    if (builder_.IsActive(id) && storage_->observations[index].subimage.empty()) ids.push_back(id);
+  const calib::ObservationCofactors cof = builder_.ComputeObservationCofactors(ids, false);
+  std::vector<double> scaled;  // |v| / sqrt(r) of the testable components
+  std::map<calib::ResidualId, std::vector<double>> values;
+  for (calib::ResidualId id : ids) {
+    values[id] = builder_.EvaluateResidual(id);
+    const auto& r = cof.redundancy.at(id);
+    for (size_t k = 0; k < r.size(); ++k)
+      if (r[k] > 1e-6) scaled.push_back(std::abs(values[id][k]) / std::sqrt(r[k]));
+  }
+  std::vector<Screened> out;
+  if (scaled.empty()) return out;
+  const double scale = std::max(1e-12, 1.4826 * Median(scaled));
+  for (calib::ResidualId id : ids) {
+    const auto& r = cof.redundancy.at(id);
+    const auto& v = values.at(id);
+    double w = 0.0;
+    for (size_t k = 0; k < r.size(); ++k)
+      if (r[k] > 1e-6) w = std::max(w, std::abs(v[k]) / (scale * std::sqrt(r[k])));
+    if (w <= reject) continue;
+    const ImageObservation& o = storage_->observations.at(storage_->observation_of_residual.at(id));
+    out.push_back({o, Eigen::Vector2d(v[0], v[1]) * o.sigma_px, w});
+  }
+  return out;
+}
+
+std::string BlockAdjustment::Describe(calib::ResidualId id) const {
+  const auto it = storage_->observation_of_residual.find(id);
+  if (it == storage_->observation_of_residual.end()) return builder_.ResidualLabel(id);
+  const ImageObservation& o = storage_->observations[it->second];
+  return "image " + o.image + (o.subimage.empty() ? "" : " sub-image " + o.subimage) + " point " +
+         o.point;
+}
+
+calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
+  // The datum guard: no control point below two rays, no exposure below three points (unless
+  // GNSS and IMU priors hold it). Counts of the active rays, kept up to date on every approval.
+  std::map<std::string, int> point_rays, image_rays;
+  for (const auto& [id, index] : storage_->observation_of_residual)
+    if (builder_.IsActive(id)) {
+      ++point_rays[storage_->observations[index].point];
+      ++image_rays[storage_->observations[index].image];
+    }
+  calib::SnoopingOptions snooping;
+  snooping.groups = {calib::kGroupImage, calib::kGroupSubimage, calib::kGroupControl};
+  snooping.report_only_groups = {calib::kGroupControl};
+  snooping.alpha = options_.snooping_alpha;
+  snooping.critical_value = options_.snooping_critical_value;
+  snooping.power = options_.snooping_power;
+  snooping.min_redundancy = options_.min_redundancy;
+  snooping.group_correlation = options_.group_correlation;
+  snooping.max_rejections = options_.max_rejections;
+  snooping.model_error_sigma0 = options_.model_error_sigma0;
+  snooping.veto = [&](const std::vector<calib::ResidualId>& ids) -> std::string {
+    std::map<std::string, int> lose_point, lose_image;
+    for (calib::ResidualId id : ids) {
+      const auto it = storage_->observation_of_residual.find(id);
+      if (it == storage_->observation_of_residual.end()) continue;
+      ++lose_point[storage_->observations[it->second].point];
+      ++lose_image[storage_->observations[it->second].image];
+    }
+    for (const auto& [point, n] : lose_point) {
+      const auto& state = storage_->points.at(point);
+      const bool control = state.ground && state.ground->role == PointRole::kControl;
+      if (control && point_rays[point] - n < 2)
+        return "control point " + point + " would keep " + std::to_string(point_rays[point] - n) +
+               " ray(s): its rays are kept, check its measurements";
+    }
+    for (const auto& [image, n] : lose_image) {
+      const Exposure& e = *storage_->exposures.at(image).exposure;
+      const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
+      if (!held && image_rays[image] - n < 3)
+        return "image " + image + " would keep " + std::to_string(image_rays[image] - n) +
+               " point(s) and be under-determined";
+    }
+    for (const auto& [point, n] : lose_point) point_rays[point] -= n;
+    for (const auto& [image, n] : lose_image) image_rays[image] -= n;
+    return "";
+  };
+  const calib::SolveReport first = result->solve;
+  calib::SnoopingOutcome out = calib::SolveWithDataSnooping(builder_, options_.solver, snooping);
+  result->solve = out.report;
+  result->solve.iterations += first.iterations;  // the first solve, before snooping
+  result->solve.initial_cost = first.initial_cost;
+
+  SnoopingSummary& s = result->snooping;
+  s.run = true;
+  s.alpha = out.alpha;
+  s.alpha0 = out.alpha0;
+  s.critical_value = out.critical_value;
+  s.power = out.power;
+  s.delta0 = out.delta0;
+  s.min_redundancy = out.min_redundancy;
+  s.group_correlation = out.group_correlation;
+  s.reference_sigma = out.reference_sigma;
+  s.cofactor_method = out.cofactor_method;
+  s.cofactors_ok = out.cofactors_ok;
+  s.cofactor_message = out.cofactor_message;
+  s.n_tested_components = out.n_tested_components;
+  s.rounds = out.rounds;
+  s.max_rejections = options_.max_rejections;
+  s.cap_reached = out.cap_reached;
+  s.remaining_above_critical = out.remaining_above_critical;
+  s.model_error_suspected = out.model_error_suspected;
+  s.model_error_evidence = out.model_error_evidence;
+  s.findings = out.findings;
+  s.seconds_testing = out.seconds_testing;
+  if (out.model_error_suspected) {
+    int control = 0;
+    for (const auto& [id, state] : storage_->points)
+      control += state.ground && state.ground->role == PointRole::kControl;
+    if (!options_.free_interior.empty())
+      s.suggestion =
+          "the run already self-calibrates: check the camera model, the control survey and the "
+          "a-priori sigmas";
+    else if (storage_->exposures.size() >= 3 && (control >= 3 || !storage_->free_network))
+      s.suggestion =
+          "self-calibration (--self-calibration all, or a subset such as c,x0,y0,K1,K2) may "
+          "absorb it: the block has " +
+          std::to_string(storage_->exposures.size()) + " exposures and " +
+          std::to_string(control) + " control point(s)";
+    else
+      s.suggestion = "the block is too weak to self-calibrate: more control or GNSS is needed";
+  }
+
+  const auto to_test = [&](const calib::TestedObservation& x, double sigma_px) {
+    ObservationTest t;
+    t.tested = true;
+    for (int k = 0; k < 2 && k < static_cast<int>(x.v.size()); ++k) {
+      t.redundancy(k) = x.redundancy[k];
+      t.w(k) = x.w[k];
+      t.mdb_sigma(k) = x.mdb_sigma[k];
+      t.mdb_px(k) = x.mdb_sigma[k] * sigma_px;
+    }
+    t.group_size = x.group_size;
+    t.verdict = calib::VerdictName(x.verdict);
+    t.reason = x.reason;
+    return t;
+  };
+  for (const auto& x : out.tested) {
+    const auto it = storage_->observation_of_residual.find(x.id);
+    const bool image = it != storage_->observation_of_residual.end();
+    if (image) {
+      const ObservationTest t = to_test(x, storage_->observations[it->second].sigma_px);
+      storage_->tests[x.id] = t;
+      s.n_weakly_controlled += t.redundancy.minCoeff() < options_.min_redundancy;
+      s.n_untestable += t.redundancy.minCoeff() < 1e-6;
+      s.n_in_groups += t.group_size > 1;
+    }
+    if (x.verdict == calib::SnoopingVerdict::kAccepted) continue;
+    FlaggedObservation f;
+    f.what = image ? Describe(x.id) : x.label;
+    f.verdict = calib::VerdictName(x.verdict);
+    f.reason = x.reason;
+    f.w = x.verdict == calib::SnoopingVerdict::kWeaklyControlled ? x.w_weak : x.w_max;
+    if (x.component >= 0) {
+      f.redundancy = x.redundancy[x.component];
+      f.mdb_sigma = x.mdb_sigma[x.component];
+    }
+    f.group_size = x.group_size;
+    s.flagged.push_back(f);
+  }
+  for (const auto& x : out.rejected) {
+    const auto it = storage_->observation_of_residual.find(x.id);
+    if (it == storage_->observation_of_residual.end()) continue;
+    const auto& o = storage_->observations[it->second];
+    RejectedObservation r;
+    r.image = o.image;
+    r.point = o.point;
+    r.measured_px = o.pixel;
+    r.subimage = o.subimage;
+    r.w = x.w_max;
+    if (x.v.size() == 2) r.residual_px = Eigen::Vector2d(x.v[0], x.v[1]) * o.sigma_px;
+    r.test = to_test(x, o.sigma_px);
+    for (calib::ResidualId member : x.correlated) {
+      const auto m = storage_->observation_of_residual.find(member);
+      if (m != storage_->observation_of_residual.end())
+        r.group.push_back(storage_->observations[m->second].image);
+    }
+    storage_->tests[x.id] = r.test;
+    result->rejected.push_back(r);
+  }
+  return out;
+}
+
 AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   const auto advance = [&] {
     if (progress) progress->Advance();
@@ -379,20 +564,29 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     for (BlockId b : interior_blocks) builder_.FreeBlock(b);
   }
   advance();
-  std::vector<calib::RejectedResidual> rejected;
-  if (options_.data_snooping) {
-    calib::SnoopingOptions snooping;
-    snooping.groups = {calib::kGroupImage, calib::kGroupSubimage};
-    snooping.critical_value = options_.snooping_critical_value;
-    snooping.max_rejections = options_.max_rejections;
-    snooping.max_dense_parameters = options_.max_dense_parameters;
-    result.solve = builder_.SolveWithDataSnooping(options_.solver, snooping, &rejected);
-  } else {
-    result.solve = builder_.Solve(options_.solver);
+  // The first adjustment's residuals: more than robust_trigger_share of the image components
+  // above robust_trigger_w sigmas are gross errors a least-squares start cannot survive.
+  result.solve = builder_.Solve(options_.solver);
+  {
+    int n = 0, gross = 0;
+    for (const auto& [id, index] : storage_->observation_of_residual)
+      if (builder_.IsActive(id))
+        for (double v : builder_.EvaluateResidual(id)) {
+          ++n;
+          gross += std::abs(v) > options_.robust_trigger_w;
+        }
+    result.snooping.gross_share = n > 0 ? static_cast<double>(gross) / n : 0.0;
+    if (stop_for_robust_start_ && options_.auto_robust_start && !options_.robust_start &&
+        result.snooping.gross_share > options_.robust_trigger_share) {
+      result.robust_start_needed = true;
+      return result;
+    }
   }
+  calib::SnoopingOutcome snooped;
+  if (options_.data_snooping) snooped = Snoop(&result);
   // A point left with a single ray after rejections is no longer determined: drop its last
   // observation (it carried no redundancy) and solve once more for honest statistics.
-  if (!rejected.empty()) {
+  if (!snooped.rejected.empty()) {
     std::map<std::string, std::vector<calib::ResidualId>> active_rays;
     for (const auto& [id, index] : storage_->observation_of_residual)
       if (builder_.IsActive(id)) active_rays[storage_->observations[index].point].push_back(id);
@@ -412,21 +606,6 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     if (dropped) result.solve = builder_.Solve(options_.solver);
     result.notes = storage_->notes;
   }
-  for (const auto& r : rejected) {
-    const auto it = storage_->observation_of_residual.find(r.id);
-    if (it == storage_->observation_of_residual.end()) continue;
-    const auto& o = storage_->observations[it->second];
-    RejectedObservation out;
-    out.image = o.image;
-    out.point = o.point;
-    out.measured_px = o.pixel;
-    out.subimage = o.subimage;
-    out.w = r.w;
-    if (r.whitened_residual.size() == 2)
-      out.residual_px =
-          Eigen::Vector2d(r.whitened_residual[0], r.whitened_residual[1]) * o.sigma_px;
-    result.rejected.push_back(out);
-  }
 
   // Residuals of every image observation (whitened r = (ideal - projected) / sigma in photo
   // space, x right and y up; in (col, row) pixels that is (r_x, -r_y) sigma).
@@ -442,6 +621,8 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     v.used = builder_.IsActive(id);
     const std::vector<double> r = v.used ? builder_.EvaluateResidual(id) : std::vector<double>{};
     if (r.size() == 2) v.residual_px = Eigen::Vector2d(r[0], -r[1]) * o.sigma_px;
+    const auto test = storage_->tests.find(id);
+    if (test != storage_->tests.end()) v.test = test->second;
     result.residuals.push_back(v);
   }
   // Statistics in the units of the image measurements (CONVENTIONS.md "Statistics"), over every
@@ -492,12 +673,18 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     }
     result.cameras.push_back(c);
   }
+  std::set<std::string> used_images;
+  for (const auto& [id, index] : storage_->observation_of_residual)
+    if (builder_.IsActive(id)) used_images.insert(storage_->observations[index].image);
   for (const auto& [image, state] : storage_->exposures) {
     ExposureEstimate e;
     e.image = image;
     e.center_m = state.center;
     e.opk_rad = state.opk;
-    if (cov.ok) {
+    const Exposure& x = *state.exposure;
+    e.used = used_images.count(image) ||
+             (options_.use_eo_priors && x.center_sigma_m && x.opk_sigma_rad);
+    if (cov.ok && e.used) {
       e.center_sigma_m = cov.BlockSigma(state.center_block, 3);
       e.opk_sigma_rad = cov.BlockSigma(state.opk_block, 3);
     }
@@ -542,6 +729,25 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   result.control = ComputePointStatistics(result.control_points);
   result.check = ComputePointStatistics(result.check_points);
   for (const auto& d : result.solve.diagnostics) result.notes.push_back(d);
+  // Honest outcome: what makes this run untrustworthy, by name.
+  if (!result.solve.converged)
+    result.Invalidate("the adjustment did not converge (" + result.solve.termination + ")");
+  if (result.snooping.cap_reached)
+    result.Invalidate("data snooping reached the rejection cap of " +
+                      std::to_string(options_.max_rejections) + " with " +
+                      std::to_string(result.snooping.remaining_above_critical) +
+                      " candidate(s) left above the critical value");
+  if (options_.data_snooping && result.snooping.run && !result.snooping.cofactors_ok)
+    result.Invalidate("data snooping could not test: " + result.snooping.cofactor_message);
+  if (result.sigma0 > options_.max_sigma0)
+    result.Invalidate("sigma0 " + FormatNumber(result.sigma0, 3) + " is above the limit " +
+                      FormatNumber(options_.max_sigma0, 3) + " (max_sigma0)");
+  if (options_.estimate_covariance && !cov.ok)
+    result.Invalidate("no covariance: " + cov.message);
+  else if (!result.determinability.undetermined.empty())
+    result.Invalidate("singular: " + std::to_string(result.determinability.undetermined.size()) +
+                      " parameter(s) not determinable (" +
+                      result.determinability.undetermined.front() + ", ...)");
   result.warnings = GroupRmsWarnings(result.solve);
   return result;
 }

@@ -25,6 +25,7 @@
 #pragma once
 
 #include "calib/core/progress.h"
+#include "calib/problem/data_snooping.h"
 #include "calib/problem/problem_builder.h"
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
@@ -77,6 +78,18 @@ class BlockAdjustment {
   /// covariance.
   AdjustmentResult Run(Progress* progress = nullptr);
   static constexpr int kRunStages = 3;
+  /// After a robust Run(): the virtual-image observations whose standardized residual
+  /// w = |v| / (s sqrt(r)) (redundancy numbers r of the geometry, s the robust scale 1.4826
+  /// median of |v| / sqrt(r) over the testable components) exceeds `reject`, with that w.
+  struct Screened {
+    ImageObservation observation;
+    Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // photo x, y
+    double w = 0.0;
+  };
+  std::vector<Screened> ScreenRobustly(double reject) const;
+  /// With options.auto_robust_start: Run() returns right after the first solve, with
+  /// robust_start_needed set, when its residuals call for a robust start (Adjust() uses it).
+  void StopWhenRobustStartNeeded(bool stop) { stop_for_robust_start_ = stop; }
 
  private:
   struct Storage;
@@ -85,11 +98,16 @@ class BlockAdjustment {
   void AddImageResiduals(const calib::LossOptions& loss);
   void AddPriors();
   void DefineDatum();
+  /// Data snooping with the datum guard; fills result->rejected and result->snooping.
+  calib::SnoopingOutcome Snoop(AdjustmentResult* result);
+  /// Human name of a residual: "image 0012 point T442" or the builder's label.
+  std::string Describe(calib::ResidualId id) const;
 
   const Project& project_;
   AdjustOptions options_;
   calib::ProblemBuilder builder_;
   std::unique_ptr<Storage> storage_;
+  bool stop_for_robust_start_ = false;
 };
 
 /// Builds and runs; with options.robust_start, first a robust adjustment whose solution starts

@@ -2,6 +2,7 @@
 
 #include "triangulation/adjustment/block_adjustment.h"
 
+#include <limits>
 #include <string>
 
 namespace aerocal::triangulation {
@@ -28,6 +29,10 @@ AdjustmentResult AdjustConventionalReference(const Project& project,
   conventional.free_interior.clear();
   conventional.data_snooping = false;
   conventional.robust_start = false;
+  conventional.auto_robust_start = false;  // the self-calibrating run decided the gross errors
+  // Its sigma0 shows the camera error the fixed interior cannot model: that is the finding of the
+  // comparison, not a reason to call the run invalid (non-convergence and singularity still are).
+  conventional.max_sigma0 = std::numeric_limits<double>::infinity();
   AdjustmentResult result = Adjust(clean, conventional, progress);
   result.rejected = self_calibration.rejected;
   result.notes.push_back(

@@ -24,8 +24,8 @@ Determinability AssessDeterminability(const calib::CovarianceReport& cov,
     int partner = -1;
     double best = 0.0;
     for (int k = 0; k < n; ++k)
-      if (k != i && cov.free[k] && std::abs(cov.correlation(i, k)) > std::abs(best)) {
-        best = cov.correlation(i, k);
+      if (k != i && cov.free[k] && std::abs(cov.Correlation(i, k)) > std::abs(best)) {
+        best = cov.Correlation(i, k);
         partner = k;
       }
     if (partner < 0 || !(std::abs(best) > threshold)) continue;

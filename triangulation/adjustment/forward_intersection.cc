@@ -14,7 +14,7 @@ ImageRay RayFromPixel(const calib::Camera& camera,
                       const Eigen::Vector2d& pixel) {
   const Eigen::Vector2d xy = camera.PhotoFromPixel(pixel);
   Eigen::Vector2d ideal;
-  calib::BrownFraser10Model::IdealFromMeasured(camera.interior.data(), xy.data(), ideal.data());
+  calib::Camera::Model::IdealFromMeasured(camera.interior.data(), xy.data(), ideal.data());
   const Eigen::Vector3d in_image(ideal.x(), ideal.y(), -camera.c_mm());
   return {center_m, (calib::RotationFromOpk(opk_rad) * in_image).normalized()};
 }

@@ -1,5 +1,6 @@
 #include "triangulation/import/colmap_export.h"
 
+#include "calib/camera/convert_camera.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 
@@ -10,10 +11,10 @@
 
 namespace aerocal::triangulation {
 
-void WriteColmapModel(const Project& project,
-                      const std::map<std::string, Eigen::Vector3d>& points_m,
-                      const std::string& folder) {
-  using Model = calib::BrownFraser10Model;
+std::vector<std::string> WriteColmapModel(const Project& project,
+                                          const std::map<std::string, Eigen::Vector3d>& points_m,
+                                          const std::string& folder) {
+  std::vector<std::string> notes;
   std::map<std::string, int> camera_id, image_id, point_id;
   std::ostringstream cameras, images, points;
   cameras.precision(17);
@@ -23,10 +24,15 @@ void WriteColmapModel(const Project& project,
   for (const auto& [id, c] : project.cameras) {
     const int n = static_cast<int>(camera_id.size()) + 1;
     camera_id[id] = n;
-    const double f = c.c_mm() / c.pixel_size_mm;
-    cameras << n << " OPENCV " << c.width_px << " " << c.height_px << " " << f << " " << f << " "
-            << c.interior[Model::kX0] / c.pixel_size_mm + 0.5 * c.width_px << " "
-            << -c.interior[Model::kY0] / c.pixel_size_mm + 0.5 * c.height_px << " 0 0 0 0\n";
+    const calib::ModelCamera ours{calib::CameraModelId::kBrownFraser10,
+                                  {c.interior.begin(), c.interior.end()}, c.frame()};
+    const calib::ConversionResult opencv =
+        calib::ConvertCamera(ours, calib::CameraModelId::kColmapOpenCv);
+    cameras << n << " " << calib::ColmapName(opencv.camera.model) << " " << c.width_px << " "
+            << c.height_px;
+    for (double p : opencv.camera.params) cameras << " " << p;
+    cameras << "\n";
+    notes.push_back("camera " + id + " -> COLMAP " + opencv.Summary());
   }
   for (const auto& [id, xyz] : points_m) point_id[id] = static_cast<int>(point_id.size()) + 1;
   std::map<std::string, std::vector<const ImageObservation*>> by_image;
@@ -64,6 +70,7 @@ void WriteColmapModel(const Project& project,
   WriteFileAtomically(folder + "/cameras.txt", cameras.str());
   WriteFileAtomically(folder + "/images.txt", images.str());
   WriteFileAtomically(folder + "/points3D.txt", points.str());
+  return notes;
 }
 
 }  // namespace aerocal::triangulation

@@ -1,7 +1,9 @@
 // Writes a block as a COLMAP text model (the inverse of colmap_import.h, same conventions), so
 // the same data can be adjusted by `colmap bundle_adjuster` for comparison. Cameras become
-// OPENCV (fx = fy = c / p, cx = x0 / p + W / 2, cy = -y0 / p + H / 2, k1 = k2 = p1 = p2 = 0); the
-// 10-parameter distortion terms are not exported (the nominal cameras of a comparison have none).
+// OPENCV through calib::ConvertCamera: exact without distortion (fx = c / ((1 + B1) p), fy = c / p,
+// cx = x0 / p + W / 2, cy = -y0 / p + H / 2, k1 = k2 = p1 = p2 = 0); with distortion k1, k2, p1,
+// p2 (and fx, fy, cx, cy) are fitted over the format and the residual is returned per camera
+// (COLMAP's OPENCV has no K3 term and no shear B2).
 // Points need coordinates: pass the starting coordinates (e.g. forward intersections).
 #pragma once
 
@@ -11,11 +13,13 @@
 
 #include <map>
 #include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 
 /// Observations of points absent from `points_m` are left out. Files written atomically.
-void WriteColmapModel(const Project& project,
+/// Returns one note per camera: exact, or the conversion residual RMS / max in pixels.
+std::vector<std::string> WriteColmapModel(const Project& project,
                       const std::map<std::string, Eigen::Vector3d>& points_m,
                       const std::string& folder);
 

@@ -1,5 +1,6 @@
 #include "triangulation/import/colmap_import.h"
 
+#include "calib/camera/convert_camera.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -8,6 +9,7 @@
 #include <Eigen/Dense>
 #include <Eigen/Geometry>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -18,101 +20,29 @@ namespace {
 using internal::NumberField;
 using internal::StringField;
 using internal::TextRow;
-using Model = calib::BrownFraser10Model;
 
-struct ModelInfo {
-  const char* name;
-  size_t num_params;
-};
-constexpr ModelInfo kModels[] = {{"SIMPLE_PINHOLE", 3},
-                                 {"PINHOLE", 4},
-                                 {"SIMPLE_RADIAL", 4},
-                                 {"RADIAL", 5},
-                                 {"OPENCV", 8},
-                                 {"FULL_OPENCV", 12}};
-
-// fx, fy, cx, cy of any supported model.
-Eigen::Vector4d Pinhole(const std::string& model, const std::vector<double>& p) {
-  if (model == "PINHOLE" || model == "OPENCV" || model == "FULL_OPENCV")
-    return {p[0], p[1], p[2], p[3]};
-  return {p[0], p[0], p[1], p[2]};
-}
-
-// Forward distortion of normalized coordinates (COLMAP's models).
-Eigen::Vector2d Distort(const std::string& model,
-                        const std::vector<double>& p,
-                        const Eigen::Vector2d& n) {
-  const double u = n.x(), v = n.y(), u2 = u * u, v2 = v * v, uv = u * v, r2 = u2 + v2;
-  if (model == "SIMPLE_RADIAL") return n * (1 + p[3] * r2);
-  if (model == "RADIAL") return n * (1 + p[3] * r2 + p[4] * r2 * r2);
-  if (model == "OPENCV" || model == "FULL_OPENCV") {
-    const double k1 = p[4], k2 = p[5], p1 = p[6], p2 = p[7];
-    double radial = 1 + k1 * r2 + k2 * r2 * r2;
-    if (model == "FULL_OPENCV") {
-      const double r6 = r2 * r2 * r2;
-      radial =
-          (1 + k1 * r2 + k2 * r2 * r2 + p[8] * r6) / (1 + p[9] * r2 + p[10] * r2 * r2 + p[11] * r6);
-    }
-    return {u * radial + 2 * p1 * uv + p2 * (r2 + 2 * u2),
-            v * radial + 2 * p2 * uv + p1 * (r2 + 2 * v2)};
-  }
-  return n;
-}
-
-// The 10-parameter camera closest to a COLMAP camera; returns the fit RMS in pixels.
-double FitCamera(const std::string& model,
-                 const std::vector<double>& p,
-                 int width,
-                 int height,
-                 double pixel_size_mm,
-                 calib::Camera* camera) {
-  const Eigen::Vector4d k = Pinhole(model, p);
-  camera->width_px = width;
-  camera->height_px = height;
-  camera->pixel_size_mm = pixel_size_mm;
-  camera->interior.fill(0.0);
-  const double c = k[1] * pixel_size_mm;
-  camera->interior[Model::kC] = c;
-  camera->interior[Model::kX0] = (k[2] - 0.5 * width) * pixel_size_mm;
-  camera->interior[Model::kY0] = -(k[3] - 0.5 * height) * pixel_size_mm;
-  // Grid of ideal directions whose distorted images cover the format; the correction
-  //   ideal - xb = dx(xb) is linear in K1, K2, K3, P1, P2, B1, B2.
-  const int n = 40;
-  std::vector<Eigen::Matrix<double, 2, 7>> rows;
-  std::vector<Eigen::Vector2d> rhs;
-  for (int i = 0; i <= n; ++i)
-    for (int j = 0; j <= n; ++j) {
-      const Eigen::Vector2d pixel(width * double(i) / n, height * double(j) / n);  // COLMAP px
-      // Undistort by fixed-point iteration (COLMAP's own approach).
-      Eigen::Vector2d undistorted((pixel.x() - k[2]) / k[0], (pixel.y() - k[3]) / k[1]);
-      const Eigen::Vector2d target = undistorted;
-      for (int it = 0; it < 100; ++it) undistorted += target - Distort(model, p, undistorted);
-      const Eigen::Vector2d measured =
-          Eigen::Vector2d(k[0], k[1]).cwiseProduct(Distort(model, p, undistorted)) +
-          Eigen::Vector2d(k[2], k[3]);
-      const Eigen::Vector2d xb((measured.x() - k[2]) * pixel_size_mm,
-                               -(measured.y() - k[3]) * pixel_size_mm);
-      const Eigen::Vector2d ideal(c * undistorted.x(), -c * undistorted.y());
-      const double r2 = xb.squaredNorm();
-      Eigen::Matrix<double, 2, 7> a;
-      a << xb.x() * r2, xb.x() * r2 * r2, xb.x() * r2 * r2 * r2, r2 + 2 * xb.x() * xb.x(),
-          2 * xb.x() * xb.y(), xb.x(), xb.y(), xb.y() * r2, xb.y() * r2 * r2, xb.y() * r2 * r2 * r2,
-          2 * xb.x() * xb.y(), r2 + 2 * xb.y() * xb.y(), 0, 0;
-      rows.push_back(a);
-      rhs.push_back(ideal - xb);
-    }
-  Eigen::MatrixXd a(2 * rows.size(), 7);
-  Eigen::VectorXd b(2 * rows.size());
-  for (size_t i = 0; i < rows.size(); ++i) {
-    a.block<2, 7>(2 * i, 0) = rows[i];
-    b.segment<2>(2 * i) = rhs[i];
-  }
-  // Column scaling: the radial terms span many orders of magnitude.
-  const Eigen::VectorXd scale = a.colwise().norm().cwiseMax(1e-300).cwiseInverse();
-  const Eigen::VectorXd x =
-      scale.asDiagonal() * (a * scale.asDiagonal()).colPivHouseholderQr().solve(b);
-  for (int i = 0; i < 7; ++i) camera->interior[Model::kK1 + i] = x(i);
-  return std::sqrt((a * x - b).squaredNorm() / rows.size()) / pixel_size_mm;
+// A COLMAP camera in the registry's COLMAP model (calib/camera/models/colmap.h: OpenCV's formula,
+// COLMAP's pixel origin); the model's parameter count checked against the file.
+calib::ModelCamera ReadColmapCamera(const TextRow& row, const std::string& file,
+                                    double pixel_size_mm) {
+  const std::string name = StringField(row, 1, file, "MODEL");
+  const auto model = calib::CameraModelFromColmapName(name);
+  if (!model)
+    ThrowInputError({file, row.line},
+                    "camera model " + name +
+                        " is not supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, "
+                        "RADIAL, OPENCV, FULL_OPENCV)");
+  const size_t num_params = calib::CameraModelParamCount(*model);
+  if (row.fields.size() != 4 + num_params)
+    ThrowInputError({file, row.line}, name + " needs " + std::to_string(num_params) + " parameters");
+  calib::ModelCamera camera;
+  camera.model = *model;
+  camera.frame.pixel_size_mm = pixel_size_mm;
+  camera.frame.width_px = static_cast<int>(NumberField(row, 2, file, "WIDTH"));
+  camera.frame.height_px = static_cast<int>(NumberField(row, 3, file, "HEIGHT"));
+  for (size_t k = 0; k < num_params; ++k)
+    camera.params.push_back(NumberField(row, 4 + k, file, "PARAMS"));
+  return camera;
 }
 
 }  // namespace
@@ -120,9 +50,16 @@ double FitCamera(const std::string& model,
 Eigen::Vector2d ColmapProject(const std::string& model,
                               const std::vector<double>& params,
                               const Eigen::Vector3d& q) {
-  const Eigen::Vector4d k = Pinhole(model, params);
-  const Eigen::Vector2d d = Distort(model, params, q.head<2>() / q.z());
-  return {k[0] * d.x() + k[2], k[1] * d.y() + k[3]};
+  const auto id = calib::CameraModelFromColmapName(model);
+  AEROCAL_CHECK(id && static_cast<int>(params.size()) == calib::CameraModelParamCount(*id))
+      << model;
+  // Any format serves: COLMAP's parameters are in pixels. COLMAP's camera frame is OpenCV's
+  // (x right, y down, z forward); aerocal's ideal photo coordinates have y up.
+  const calib::ModelCamera camera{*id, params, calib::PixelFrame{1.0, 2, 2}};
+  const double c = camera.PrincipalDistanceMm();
+  Eigen::Vector2d pixel;
+  AEROCAL_CHECK(camera.PixelFromIdeal(Eigen::Vector2d(c * q.x() / q.z(), -c * q.y() / q.z()), &pixel));
+  return pixel + Eigen::Vector2d::Constant(calib::kColmapPixelOffset);  // COLMAP's pixel origin
 }
 
 ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
@@ -135,33 +72,22 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
   const std::string cameras_file = o.folder + "/cameras.txt",
                     images_file = o.folder + "/images.txt",
                     points_file = o.folder + "/points3D.txt";
-  std::map<std::string, std::string> camera_model;
   for (const auto& row : internal::ReadTextRows(cameras_file, false)) {
     const std::string id = StringField(row, 0, cameras_file, "CAMERA_ID");
-    const std::string model = StringField(row, 1, cameras_file, "MODEL");
-    const ModelInfo* info = nullptr;
-    for (const auto& m : kModels)
-      if (model == m.name) info = &m;
-    if (!info)
-      ThrowInputError({cameras_file, row.line},
-                      "camera model " + model +
-                          " is not supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, "
-                          "RADIAL, OPENCV, FULL_OPENCV)");
-    if (row.fields.size() != 4 + info->num_params)
-      ThrowInputError({cameras_file, row.line},
-                      model + " needs " + std::to_string(info->num_params) + " parameters");
-    const int width = static_cast<int>(NumberField(row, 2, cameras_file, "WIDTH"));
-    const int height = static_cast<int>(NumberField(row, 3, cameras_file, "HEIGHT"));
-    std::vector<double> params;
-    for (size_t k = 0; k < info->num_params; ++k)
-      params.push_back(NumberField(row, 4 + k, cameras_file, "PARAMS"));
+    const calib::ModelCamera colmap = ReadColmapCamera(row, cameras_file, o.pixel_size_mm);
+    const std::string model(calib::ColmapName(colmap.model));
+    const calib::ConversionResult fit = calib::ConvertCamera(colmap, calib::CameraModelId::kBrownFraser10);
     calib::Camera camera;
     camera.name = "COLMAP camera " + id + " (" + model + ")";
-    const double rms = FitCamera(model, params, width, height, o.pixel_size_mm, &camera);
+    camera.width_px = colmap.frame.width_px;
+    camera.height_px = colmap.frame.height_px;
+    camera.pixel_size_mm = o.pixel_size_mm;
+    std::copy(fit.camera.params.begin(), fit.camera.params.end(), camera.interior.begin());
     project.cameras[id] = camera;
-    camera_model[id] = model;
     report.notes.push_back("camera " + id + ": " + model + " -> 10-parameter model, fit RMS " +
-                           FormatNumber(rms, 3) + " px");
+                           FormatNumber(fit.residual.rms_px, 3) + " px, max " +
+                           FormatNumber(fit.residual.max_px, 3) + " px" +
+                           (fit.exact ? " (exact)" : ""));
   }
   // images.txt: per image a pose line, then a points2D line (which may be empty).
   auto image_rows = internal::ReadTextRows(images_file, false, true);

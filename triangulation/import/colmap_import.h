@@ -3,11 +3,13 @@
 // - Pixels: COLMAP puts the centre of the top-left pixel at (0.5, 0.5): col = x - 0.5.
 // - Camera frame: COLMAP x right, y down, z forward (x_cam = R X + t); aerocal's image space is
 //   (U, V, W) = (x, -y, -z), so object_from_image = R^T diag(1, -1, -1), centre = -R^T t.
-// - Intrinsics: c = f * pixel_size (fy for two focal lengths), x0 = (cx - W/2) p,
-//   y0 = -(cy - H/2) p. COLMAP's distortion is a FORWARD model (ideal -> distorted) while the
-//   10-parameter model corrects measured coordinates; K1, K2, K3, P1, P2, B1 are fitted by linear
-//   least squares on a dense grid over the format (the fit RMS in pixels is reported), B1 takes
-//   fy / fx - 1. Models: SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV.
+// - Intrinsics: the camera is read into the registry's COLMAP model (calib/camera/models/colmap.h:
+//   SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, RADIAL, OPENCV, FULL_OPENCV as exact subsets of the
+//   OpenCV model, COLMAP's pixel origin converted there) and converted into the 10-parameter model
+//   by calib::ConvertCamera: exact without distortion (c = fy p, x0 = (cx - W/2) p,
+//   y0 = -(cy - H/2) p, B1 = fy / fx - 1), otherwise a least-squares fit of all ten parameters
+//   over the format (COLMAP's distortion is FORWARD, ours a correction); the note per camera gives
+//   the residual RMS and max in pixels.
 // - Points3D become tie points with their coordinates as approximations; COLMAP's frame is kept
 //   (a similarity of the world unless the model was georeferenced), so the adjustment defines a
 //   free-network datum.
@@ -30,7 +32,7 @@ struct ColmapImportOptions {
 
 struct ColmapImportReport {
   Project project;
-  std::vector<std::string> notes;  // one per camera: model and distortion-fit RMS (px)
+  std::vector<std::string> notes;  // one per camera: model and conversion residual RMS / max (px)
 };
 
 ColmapImportReport ImportColmapModel(const ColmapImportOptions& options);

@@ -17,7 +17,7 @@ namespace {
 using internal::NumberField;
 using internal::ReadTextRows;
 using internal::StringField;
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 constexpr double kDegToRad = M_PI / 180.0;
 
 // Text of <tag>...</tag> split on commas; empty when the tag is absent.
@@ -25,11 +25,7 @@ std::vector<std::string> XmlList(const std::string& xml, const std::string& tag)
   const std::regex re("<" + tag + ">([^<]*)</" + tag + ">");
   std::smatch m;
   if (!std::regex_search(xml, m, re)) return {};
-  std::vector<std::string> out;
-  std::stringstream in(m[1].str());
-  std::string item;
-  while (std::getline(in, item, ',')) out.push_back(item);
-  return out;
+  return SplitCommaList(m[1].str(), {false, true});
 }
 
 std::vector<double> XmlNumbers(const std::string& xml,

@@ -1,4 +1,5 @@
 #include "triangulation/joint/joint_adjustment.h"
+#include "calib/core/median.h"
 
 #include <algorithm>
 #include <cmath>
@@ -41,12 +42,6 @@ struct FrameStitchResiduals {
   int ties = 0;
   std::vector<double> sigmas_px;
 };
-
-double Median(std::vector<double> values) {
-  if (values.empty()) return std::numeric_limits<double>::quiet_NaN();
-  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
-  return values[values.size() / 2];
-}
 
 std::vector<std::string> MappingEntryNames(MappingModel model) {
   std::vector<std::string> names;

@@ -13,7 +13,7 @@ namespace aerocal::triangulation {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
-using Model = calib::BrownFraser10Model;
+using Model = calib::Camera::Model;
 
 struct Visible {
   int image;

@@ -32,6 +32,14 @@ Project WithCamera(Project project, const calib::Camera& camera, const std::stri
   return project;
 }
 
+// Records every reason why `r` is not a valid result of `step`.
+void CheckStep(const std::string& step, const AdjustmentResult& r, FlightWorkflowResult* out) {
+  for (const auto& reason : r.invalid_reasons) {
+    out->valid = false;
+    out->failures.emplace_back(step, reason);
+  }
+}
+
 std::string Line(const char* format, double a, double b, double c) {
   char buffer[256];
   std::snprintf(buffer, sizeof(buffer), format, a, b, c);
@@ -106,6 +114,8 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   adjustments.push_back(b);
   doc["comparison"] = ComparisonToJson(conventional, self_calibration);
   out.converged = conventional.converged() && self_calibration.converged();
+  CheckStep("conventional", conventional, &out);
+  CheckStep("self-calibration", self_calibration, &out);
   out.calibrated_camera = UpdatedCamera(camera, self_calibration.cameras.at(0));
   for (const AdjustmentResult* r : {static_cast<const AdjustmentResult*>(&conventional), &self_calibration}) {
     const std::string name = r == &conventional ? "conventional" : "self-calibration";
@@ -138,6 +148,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     j["name"] = "joint";
     adjustments.push_back(j);
     out.converged = out.converged && joint.adjustment.converged();
+    CheckStep("joint", joint.adjustment, &out);
     out.calibrated_camera = JointUpdatedCamera(camera, raw.cameras.begin()->first, joint);
     out.summary.push_back("joint: mappings " + joint.mapping_model + " (" + joint.mapping_model_reason + ")");
     out.summary.push_back(Line("joint: sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)",
@@ -155,6 +166,12 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
       doc["warnings"].push_back(w);
     }
   doc["converged"] = out.converged;
+  doc["valid"] = out.valid;
+  doc["failures"] = nlohmann::json::array();
+  for (const auto& [step, reason] : out.failures) {
+    doc["failures"].push_back({{"step", step}, {"reason", reason}});
+    out.summary.push_back("NOT VALID: " + step + ": " + reason);
+  }
   if (progress) progress->Advance();
   return out;
 }

@@ -10,6 +10,7 @@
 #pragma once
 
 #include <optional>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -44,6 +45,10 @@ struct FlightWorkflowResult {
   nlohmann::json document;          // kind "flight"
   calib::Camera calibrated_camera;  // interior (and mappings, when joint) for the next flight
   bool converged = true;            // every adjustment converged
+  /// Every step converged and is valid (AdjustmentResult::valid); otherwise `failures` names the
+  /// failing steps and calibrated_camera must not be used (aerocal flight does not write it).
+  bool valid = true;
+  std::vector<std::pair<std::string, std::string>> failures;  // (step, reason)
   std::vector<std::string> summary; // one line per step, for the terminal (and each warning)
 };
 

@@ -1,0 +1,208 @@
+#include "calib/camera/rig_io.h"
+
+#include <cmath>
+
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/yaml_util.h"
+
+namespace aerocal::calib {
+namespace {
+
+constexpr double kRadPerDeg = M_PI / 180.0;
+
+// The head keys that belong to the head's camera (read by ParseCamera) and those of the rig.
+const std::vector<std::string> kHeadCameraKeys = {"pixel_size_mm", "format_px", "interior",
+                                                  "interior_sigma", "model"};
+const std::vector<std::string> kHeadRigKeys = {"id", "mount_deg", "lever_arm_m", "mount_sigma_deg",
+                                               "lever_arm_sigma_m"};
+
+Eigen::Vector3d ReadVector3(const YAML::Node& node, const std::string& file,
+                            const std::string& what) {
+  if (!node.IsSequence() || node.size() != 3)
+    ThrowInputError(WhereIs(node, file), what + " must be a list of 3 numbers");
+  return {YamlDouble(node[0], file, what), YamlDouble(node[1], file, what),
+          YamlDouble(node[2], file, what)};
+}
+
+Eigen::Vector3d ReadSigma3(const YAML::Node& node, const std::string& file,
+                           const std::string& what) {
+  const Eigen::Vector3d sigma = ReadVector3(node, file, what);
+  if (!(sigma.minCoeff() > 0))
+    ThrowInputError(WhereIs(node, file), what + " must be > 0 (got [" + FormatNumber(sigma[0]) +
+                                             ", " + FormatNumber(sigma[1]) + ", " +
+                                             FormatNumber(sigma[2]) + "])");
+  return sigma;
+}
+
+double ReadPositive(const YAML::Node& node, const std::string& file, const std::string& what,
+                    const std::string& unit) {
+  const double value = YamlDouble(node, file, what);
+  if (!(value > 0))
+    ThrowInputError(WhereIs(node, file),
+                    what + " must be > 0 " + unit + " (got " + FormatNumber(value) + ")");
+  return value;
+}
+
+RigHead ReadHead(const YAML::Node& node, const std::string& file) {
+  if (!node.IsMap()) ThrowInputError(WhereIs(node, file), "a rig head is a map");
+  std::vector<std::string> allowed = kHeadRigKeys;
+  allowed.insert(allowed.end(), kHeadCameraKeys.begin(), kHeadCameraKeys.end());
+  RejectUnknownKeys(node, allowed, file);
+  RigHead head;
+  if (!node["id"]) ThrowInputError(WhereIs(node, file), "rig head needs an 'id'");
+  head.id = YamlString(node["id"], file, "id");
+  if (head.id.empty()) ThrowInputError(WhereIs(node["id"], file), "head id must not be empty");
+  for (const char* key : {"pixel_size_mm", "format_px", "interior"})
+    if (!node[key]) ThrowInputError(WhereIs(node, file), "head " + head.id + ": missing " + key);
+  // The head's camera keys, as their own camera file: the camera reader checks them (and cites
+  // their lines, which the copied nodes keep).
+  YAML::Node camera_node(YAML::NodeType::Map);
+  for (const std::string& key : kHeadCameraKeys)
+    if (node[key]) camera_node[key] = node[key];
+  head.camera = ParseCamera(camera_node, file);
+  head.camera.name = head.id;
+  if (node["mount_deg"])
+    head.mount_rad = ReadVector3(node["mount_deg"], file, "mount_deg") * kRadPerDeg;
+  if (node["lever_arm_m"]) head.lever_arm_m = ReadVector3(node["lever_arm_m"], file, "lever_arm_m");
+  if (node["mount_sigma_deg"])
+    head.mount_sigma_rad = ReadSigma3(node["mount_sigma_deg"], file, "mount_sigma_deg") * kRadPerDeg;
+  if (node["lever_arm_sigma_m"])
+    head.lever_arm_sigma_m = ReadSigma3(node["lever_arm_sigma_m"], file, "lever_arm_sigma_m");
+  return head;
+}
+
+VirtualCamera ReadVirtual(const YAML::Node& node, const std::string& file) {
+  RejectUnknownKeys(node, {"orientation", "c", "pixel_size_mm", "format_px", "x0", "y0", "height_m"},
+                    file);
+  for (const char* key : {"c", "pixel_size_mm", "format_px"})
+    if (!node[key]) ThrowInputError(WhereIs(node, file), std::string("virtual: missing ") + key);
+  VirtualCamera v;
+  if (node["orientation"]) {
+    const std::string name = YamlString(node["orientation"], file, "orientation");
+    const auto orientation = ParseVirtualOrientation(name);
+    if (!orientation)
+      ThrowInputError(WhereIs(node["orientation"], file),
+                      "virtual.orientation must be rig or level (got '" + name + "')");
+    v.orientation = *orientation;
+  }
+  v.c_mm = ReadPositive(node["c"], file, "virtual.c", "mm");
+  v.pixel_size_mm = ReadPositive(node["pixel_size_mm"], file, "virtual.pixel_size_mm", "mm");
+  const YAML::Node& format = node["format_px"];
+  if (!format.IsSequence() || format.size() != 2)
+    ThrowInputError(WhereIs(format, file), "virtual.format_px must be [width, height]");
+  v.width_px = YamlInt(format[0], file, "virtual.format_px width");
+  v.height_px = YamlInt(format[1], file, "virtual.format_px height");
+  if (v.width_px <= 0 || v.height_px <= 0)
+    ThrowInputError(WhereIs(format, file), "virtual.format_px must be positive");
+  if (node["x0"]) v.x0_mm = YamlDouble(node["x0"], file, "virtual.x0");
+  if (node["y0"]) v.y0_mm = YamlDouble(node["y0"], file, "virtual.y0");
+  if (node["height_m"]) v.height_m = ReadPositive(node["height_m"], file, "virtual.height_m", "m");
+  return v;
+}
+
+void EmitVector3(YAML::Emitter& out, const std::string& key, const Eigen::Vector3d& v) {
+  out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v[0] << v[1] << v[2]
+      << YAML::EndSeq;
+}
+
+}  // namespace
+
+std::string_view VirtualOrientationName(VirtualOrientation orientation) {
+  return orientation == VirtualOrientation::kLevel ? "level" : "rig";
+}
+
+std::optional<VirtualOrientation> ParseVirtualOrientation(std::string_view name) {
+  if (name == "rig") return VirtualOrientation::kRig;
+  if (name == "level") return VirtualOrientation::kLevel;
+  return std::nullopt;
+}
+
+Rig ParseRig(const YAML::Node& root, const std::string& file) {
+  if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
+  if (!root["rig"]) {
+    const Camera camera = ParseCamera(root, file);
+    if (!camera.subimages.empty() || !camera.reference_points.empty())
+      ThrowInputError({file, 1}, "a camera with sub-images is not a rig head (no 'rig' section)");
+    Rig rig = RigFromCamera(camera);
+    rig.Validate(file);
+    return rig;
+  }
+  RejectUnknownKeys(root, {"name", "rig"}, file);
+  Rig rig;
+  rig.name = root["name"] ? YamlString(root["name"], file, "name") : "";
+  const YAML::Node& section = root["rig"];
+  RejectUnknownKeys(section, {"reference_head", "virtual", "heads"}, file);
+  const YAML::Node& heads = section["heads"];
+  if (!heads || !heads.IsSequence() || heads.size() == 0)
+    ThrowInputError(WhereIs(heads ? heads : section, file), "rig.heads must be a non-empty list");
+  for (const auto& node : heads) {
+    RigHead head = ReadHead(node, file);
+    if (rig.HeadIndex(head.id) >= 0)
+      ThrowInputError(WhereIs(node["id"], file), "duplicate head id '" + head.id + "'");
+    rig.heads.push_back(std::move(head));
+  }
+  if (section["reference_head"]) {
+    rig.reference_head = YamlString(section["reference_head"], file, "reference_head");
+    if (rig.HeadIndex(rig.reference_head) < 0)
+      ThrowInputError(WhereIs(section["reference_head"], file),
+                      "reference_head '" + rig.reference_head + "' is not one of the heads");
+  } else if (rig.heads.size() == 1) {
+    rig.reference_head = rig.heads.front().id;
+  } else {
+    ThrowInputError(WhereIs(section, file), "a rig of several heads needs reference_head");
+  }
+  if (section["virtual"]) {
+    rig.virtual_camera = ReadVirtual(section["virtual"], file);
+  } else {
+    const Camera& ref = rig.heads[rig.ReferenceIndex()].camera;
+    rig.virtual_camera = RigFromCamera(ref).virtual_camera;
+  }
+  rig.Validate(file);
+  return rig;
+}
+
+Rig ReadRig(const std::string& path) { return ParseRig(LoadYamlFile(path), path); }
+
+std::string RigToYaml(const Rig& rig) {
+  YAML::Emitter out;
+  out.SetDoublePrecision(17);
+  out << YAML::BeginMap;
+  out << YAML::Key << "name" << YAML::Value << rig.name;
+  out << YAML::Key << "rig" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "reference_head" << YAML::Value << rig.reference_head;
+  const VirtualCamera& v = rig.virtual_camera;
+  out << YAML::Key << "virtual" << YAML::Value << YAML::BeginMap;
+  out << YAML::Key << "orientation" << YAML::Value
+      << std::string(VirtualOrientationName(v.orientation));
+  out << YAML::Key << "c" << YAML::Value << v.c_mm;
+  out << YAML::Key << "pixel_size_mm" << YAML::Value << v.pixel_size_mm;
+  out << YAML::Key << "format_px" << YAML::Value << YAML::Flow << YAML::BeginSeq << v.width_px
+      << v.height_px << YAML::EndSeq;
+  out << YAML::Key << "x0" << YAML::Value << v.x0_mm;
+  out << YAML::Key << "y0" << YAML::Value << v.y0_mm;
+  if (v.height_m) out << YAML::Key << "height_m" << YAML::Value << *v.height_m;
+  out << YAML::EndMap;
+  out << YAML::Key << "heads" << YAML::Value << YAML::BeginSeq;
+  for (const RigHead& head : rig.heads) {
+    out << YAML::BeginMap << YAML::Key << "id" << YAML::Value << head.id;
+    // The head's camera keys as the camera writer writes them.
+    const YAML::Node camera = YAML::Load(CameraToYaml(head.camera));
+    for (const std::string& key : kHeadCameraKeys)
+      if (camera[key]) out << YAML::Key << key << YAML::Value << camera[key];
+    EmitVector3(out, "mount_deg", head.mount_rad / kRadPerDeg);
+    EmitVector3(out, "lever_arm_m", head.lever_arm_m);
+    if (head.mount_sigma_rad) EmitVector3(out, "mount_sigma_deg", *head.mount_sigma_rad / kRadPerDeg);
+    if (head.lever_arm_sigma_m) EmitVector3(out, "lever_arm_sigma_m", *head.lever_arm_sigma_m);
+    out << YAML::EndMap;
+  }
+  out << YAML::EndSeq << YAML::EndMap << YAML::EndMap;
+  return std::string(out.c_str()) + "\n";
+}
+
+void WriteRig(const std::string& path, const Rig& rig) {
+  WriteFileAtomically(path, RigToYaml(rig));
+}
+
+}  // namespace aerocal::calib

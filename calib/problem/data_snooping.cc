@@ -1,0 +1,473 @@
+#include "calib/problem/data_snooping.h"
+
+#include "calib/core/error.h"
+
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <tuple>
+
+namespace aerocal::calib {
+namespace {
+
+constexpr double kUntestable = 1e-6;  // r below: no test can see anything there
+constexpr int kModelErrorTop = 10;    // the largest w examined for a model error
+
+bool Contains(const std::vector<std::string>& list, const std::string& s) {
+  return std::find(list.begin(), list.end(), s) != list.end();
+}
+
+BlockId PointOf(const ProblemBuilder& b, ResidualId id) {
+  for (BlockId block : b.ResidualBlocks(id)) {
+    const BlockKind kind = b.BlockKindOf(block);
+    if (kind == BlockKind::kGroundPoint || kind == BlockKind::kTiePoint2d) return block;
+  }
+  return -1;
+}
+
+BlockId ImageOf(const ProblemBuilder& b, ResidualId id) {
+  BlockId center = -1;
+  for (BlockId block : b.ResidualBlocks(id)) {
+    if (b.BlockKindOf(block) == BlockKind::kRotation) return block;
+    if (b.BlockKindOf(block) == BlockKind::kCenter && center < 0) center = block;
+  }
+  return center;
+}
+
+// Readable name of an image block: "image 0012 angles" -> "image 0012".
+std::string ImageName(const ProblemBuilder& b, BlockId block) {
+  std::string name = b.BlockName(block);
+  for (const char* suffix : {" angles", " centre"}) {
+    const std::string s(suffix);
+    if (name.size() > s.size() && name.compare(name.size() - s.size(), s.size(), s) == 0)
+      return name.substr(0, name.size() - s.size());
+  }
+  return name;
+}
+
+// The two-sided normal value with the tail probability of chi-square(dof) at t (dof 1..3;
+// more: Wilson-Hilferty). Far in the tail (p below 1e-300) sqrt(t), which keeps the order.
+double EquivalentNormal(double t, int dof) {
+  if (dof == 1) return std::sqrt(t);
+  double p = 0.0;
+  if (dof == 2) {
+    p = std::exp(-t / 2);
+  } else if (dof == 3) {
+    p = std::erfc(std::sqrt(t / 2)) + std::sqrt(2 * t / M_PI) * std::exp(-t / 2);
+  } else {
+    const double k = dof, z = (std::cbrt(t / k) - (1 - 2 / (9 * k))) / std::sqrt(2 / (9 * k));
+    p = 0.5 * std::erfc(z / std::sqrt(2.0));
+  }
+  if (!(p > 1e-300)) return std::sqrt(t);
+  return p >= 1.0 ? 0.0 : NormalCriticalValue(p);
+}
+
+std::string Fixed(double value, int digits) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof(buffer), "%.*f", digits, value);
+  return buffer;
+}
+
+struct Test {
+  std::vector<TestedObservation> observations;
+  std::map<ResidualId, size_t> index;
+  std::vector<ResidualCluster> clusters;
+  std::map<ResidualId, std::pair<size_t, int>> row_of;  // residual -> (cluster, first row)
+  std::string method;
+};
+
+class Snooper {
+ public:
+  Snooper(ProblemBuilder& builder, const SnoopingOptions& options, SnoopingOutcome* out)
+      : b_(builder), o_(options), out_(*out) {}
+
+  Test Run(int round) {
+    const auto start = std::chrono::steady_clock::now();
+    Test t;
+    std::vector<ResidualId> ids;
+    int components = 0;
+    for (ResidualId id : AllResiduals()) {
+      if (!b_.IsActive(id)) continue;
+      if (!o_.groups.empty() && !Contains(o_.groups, b_.ResidualGroup(id))) continue;
+      ids.push_back(id);
+      components += static_cast<int>(b_.EvaluateResidual(id).size());
+    }
+    if (round == 1) {
+      out_.n_tested_components = components;
+      out_.alpha = o_.alpha;
+      out_.alpha0 = o_.alpha / std::max(1, components);
+      out_.critical_value = o_.critical_value > 0
+                                ? o_.critical_value
+                                : std::max(3.29, NormalCriticalValue(out_.alpha0));
+      out_.power = o_.power;
+      out_.delta0 = NonCentrality(out_.critical_value, o_.power);
+      out_.min_redundancy = o_.min_redundancy;
+      out_.group_correlation = o_.group_correlation;
+    }
+    ObservationCofactors cof = b_.ComputeObservationCofactors(ids, true, o_.max_dense_parameters);
+    t.method = cof.method;
+    out_.cofactor_method = cof.method;
+    if (!cof.ok) {  // never tested on approximate redundancy numbers
+      out_.cofactors_ok = false;
+      out_.cofactor_message = cof.message;
+      out_.findings.push_back("no test: the redundancy numbers could not be computed (" +
+                              cof.message + ")");
+      return t;
+    }
+    t.clusters = std::move(cof.clusters);
+    for (size_t c = 0; c < t.clusters.size(); ++c) {
+      int row = 0;
+      for (ResidualId id : t.clusters[c].residuals) {
+        t.row_of[id] = {c, row};
+        row += static_cast<int>(b_.EvaluateResidual(id).size());
+      }
+    }
+    const double s = std::max(out_.report.sigma0, 1.0);
+    out_.reference_sigma = s;
+    for (ResidualId id : ids) {
+      TestedObservation x;
+      x.id = id;
+      x.group = b_.ResidualGroup(id);
+      x.label = b_.ResidualLabel(id);
+      x.v = b_.EvaluateResidual(id);
+      x.redundancy = cof.redundancy.at(id);
+      x.point = PointOf(b_, id);
+      x.round = round;
+      for (size_t k = 0; k < x.v.size(); ++k) {
+        const double r = x.redundancy[k];
+        if (r < kUntestable) {
+          x.w.push_back(std::numeric_limits<double>::quiet_NaN());
+          x.mdb_sigma.push_back(std::numeric_limits<double>::infinity());
+          continue;
+        }
+        const double w = std::abs(x.v[k]) / (s * std::sqrt(r));
+        x.w.push_back(w);
+        x.mdb_sigma.push_back(out_.delta0 * s / std::sqrt(r));
+        if (r >= o_.min_redundancy && w > x.w_max) {
+          x.w_max = w;
+          x.component = static_cast<int>(k);
+        }
+        if (r < o_.min_redundancy) x.w_weak = std::max(x.w_weak, w);
+      }
+      // An observation of several correlated components (x, y of an image point) is tested as
+      // a whole: per-component w of another observation can exceed both of the blundered one's,
+      // the joint statistic cannot (its non-centrality is the largest at the blunder).
+      const auto at = t.row_of.find(id);
+      if (x.v.size() > 1 && at != t.row_of.end()) JointTest(t.clusters[at->second.first], at->second.second, s, &x);
+      t.index[id] = t.observations.size();
+      t.observations.push_back(std::move(x));
+    }
+    // Correlated groups of every observation (their sizes go into the report).
+    for (auto& x : t.observations) {
+      x.correlated = GroupOf(t, x);
+      const auto d = decided_.find(x.id);
+      if (d != decided_.end()) std::tie(x.verdict, x.reason) = d->second;
+    }
+    for (auto& x : t.observations) x.group_size = static_cast<int>(x.correlated.size());
+    out_.cofactor_method = t.method;
+    out_.seconds_testing +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return t;
+  }
+
+  // T = v^T Q_ii^+ v / s^2 over the eigen-directions of Q_ii with eigenvalue >= min_redundancy
+  // (chi-square with that many degrees of freedom), as the normal w with the same tail
+  // probability; the weakly controlled directions give w_weak, each its own 1-D test.
+  void JointTest(const ResidualCluster& c, int row, double s, TestedObservation* x) const {
+    const int m = static_cast<int>(x->v.size());
+    const Eigen::MatrixXd q = c.qvv.block(row, row, m, m);
+    Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(q);
+    const Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(x->v.data(), m);
+    double t_stat = 0.0, w_weak = 0.0;
+    int dof = 0;
+    for (int k = 0; k < m; ++k) {
+      const double lambda = eig.eigenvalues()(k);
+      if (lambda < kUntestable) continue;
+      const double u = eig.eigenvectors().col(k).dot(v) / s;
+      if (lambda < o_.min_redundancy) {
+        w_weak = std::max(w_weak, std::abs(u) / std::sqrt(lambda));
+        continue;
+      }
+      t_stat += u * u / lambda;
+      ++dof;
+    }
+    x->w_weak = std::max(x->w_weak, w_weak);
+    if (dof == 0) {
+      x->w_max = 0.0;
+      x->component = -1;
+      return;
+    }
+    x->w_max = EquivalentNormal(t_stat, dof);
+  }
+
+  std::vector<ResidualId> GroupOf(const Test& t, const TestedObservation& x) const {
+    std::vector<ResidualId> group = {x.id};
+    const auto at = t.row_of.find(x.id);
+    if (at == t.row_of.end() || x.component < 0) return group;
+    const ResidualCluster& c = t.clusters[at->second.first];
+    const int i = at->second.second + x.component;
+    const double qii = c.qvv(i, i);
+    if (!(qii > kUntestable)) return group;
+    int row = 0;
+    for (ResidualId other : c.residuals) {
+      const int n = static_cast<int>(t.observations[t.index.at(other)].v.size());
+      if (other != x.id && !Contains(o_.report_only_groups, b_.ResidualGroup(other))) {
+        for (int k = row; k < row + n; ++k) {
+          const double qkk = c.qvv(k, k);
+          if (!(qkk > kUntestable)) continue;
+          if (std::abs(c.qvv(i, k)) / std::sqrt(qii * qkk) > o_.group_correlation) {
+            group.push_back(other);
+            break;
+          }
+        }
+      }
+      row += n;
+    }
+    return group;
+  }
+
+  std::vector<ResidualId> AllResiduals() const {
+    std::vector<ResidualId> out(b_.NumResiduals());
+    for (ResidualId id = 0; id < b_.NumResiduals(); ++id) out[id] = id;
+    return out;
+  }
+
+  // The signature of a model error. In the first test: the largest w on the report-only
+  // (control) points, where the survey pins the block and a model error shows most (their rays
+  // are then held). In the final test: sigma0 above the limit, or the candidates left (held,
+  // vetoed, weakly controlled, at the cap) clustering on one point or one image, each correlated
+  // group counted once (one blunder makes its group's w equal, and a rejected blunder is gone).
+  void DetectModelError(const Test& t, bool first) {
+    std::vector<const TestedObservation*> top;
+    for (const auto& x : t.observations)
+      if (std::max(x.w_max, x.w_weak) > out_.critical_value &&
+          x.verdict != SnoopingVerdict::kRejected)
+        top.push_back(&x);
+    const auto w_of = [](const TestedObservation* x) { return std::max(x->w_max, x->w_weak); };
+    std::sort(top.begin(), top.end(), [&](auto* a, auto* b) { return w_of(a) > w_of(b); });
+    if (top.size() > static_cast<size_t>(kModelErrorTop)) top.resize(kModelErrorTop);
+    const int n = static_cast<int>(top.size());
+    const double limit = o_.model_error_share * n;
+    const std::string of = n == 0 ? std::string()
+                                  : " of the " + std::to_string(n) + " largest w (" +
+                                        Fixed(w_of(top.front()), 1) + " .. " +
+                                        Fixed(w_of(top.back()), 1) + ")";
+    std::vector<std::string> evidence;
+    if (first) {
+      int on_report_only = 0;
+      for (const auto* x : top) on_report_only += x->point >= 0 && report_only_points_.count(x->point);
+      if (n >= 2 && on_report_only >= 2 && on_report_only >= limit)
+        evidence.push_back(std::to_string(on_report_only) + of + " on the " +
+                           o_.report_only_groups.front() + " points");
+    } else {
+      if (out_.report.sigma0 > o_.model_error_sigma0)
+        evidence.push_back("sigma0 " + Fixed(out_.report.sigma0, 2) + " > " +
+                           Fixed(o_.model_error_sigma0, 2));
+      std::map<BlockId, std::set<ResidualId>> per_point, per_image;  // groups by first member
+      for (const auto* x : top) {
+        const ResidualId g = *std::min_element(x->correlated.begin(), x->correlated.end());
+        if (x->point >= 0) per_point[x->point].insert(g);
+        const BlockId image = ImageOf(b_, x->id);
+        if (image >= 0) per_image[image].insert(g);
+      }
+      for (const auto& [point, groups] : per_point)
+        if (groups.size() >= 2 && groups.size() >= limit)
+          evidence.push_back(std::to_string(groups.size()) + " independent" + of + " on " +
+                             b_.BlockName(point));
+      for (const auto& [image, groups] : per_image)
+        if (groups.size() >= 2 && groups.size() >= limit)
+          evidence.push_back(std::to_string(groups.size()) + " independent" + of + " on " +
+                             ImageName(b_, image));
+    }
+    if (evidence.empty()) return;
+    out_.model_error_suspected = true;
+    out_.model_error_evidence.insert(out_.model_error_evidence.end(), evidence.begin(),
+                                     evidence.end());
+    std::string text = "model error suspected, not blunders:";
+    for (size_t i = 0; i < evidence.size(); ++i) text += (i ? "; " : " ") + evidence[i];
+    out_.findings.push_back(text);
+  }
+
+  void CollectReportOnlyPoints() {
+    report_only_points_.clear();
+    for (ResidualId id : AllResiduals())
+      if (b_.IsActive(id) && Contains(o_.report_only_groups, b_.ResidualGroup(id))) {
+        const BlockId p = PointOf(b_, id);
+        if (p >= 0) report_only_points_.insert(p);
+      }
+  }
+
+  // Acts on one round's test; returns the number of removed residuals.
+  int Act(Test& t, int round, int budget) {
+    std::vector<TestedObservation*> candidates;
+    for (auto& x : t.observations)
+      if (x.w_max > out_.critical_value) candidates.push_back(&x);
+    std::sort(candidates.begin(), candidates.end(), [](auto* a, auto* b) {
+      return a->w_max > b->w_max;
+    });
+    // The largest w of each point, over every tested observation and its weakly controlled
+    // components too (decided ones included: the rays of a point whose survey is suspected, or
+    // whose largest w sits on a weakly controlled component, stay), and of each image
+    // (undecided candidates only).
+    std::map<BlockId, std::pair<double, ResidualId>> point_max;
+    for (const auto& x : t.observations) {
+      if (x.point < 0) continue;
+      const double w = std::max(x.w_max, x.w_weak);
+      auto [it, added] = point_max.try_emplace(x.point, w, x.id);
+      if (!added && w > it->second.first) it->second = {w, x.id};
+    }
+    std::map<BlockId, ResidualId> best_of_point, best_of_image;
+    for (const auto& [point, best] : point_max) best_of_point[point] = best.second;
+    for (auto* x : candidates) {
+      const BlockId image = ImageOf(b_, x->id);
+      if (image >= 0 && !decided_.count(x->id)) best_of_image.try_emplace(image, x->id);
+    }
+    int removed = 0;
+    for (auto* x : candidates) {
+      if (x->point >= 0 && best_of_point.at(x->point) != x->id) continue;
+      const BlockId image = ImageOf(b_, x->id);
+      if (image >= 0 && !decided_.count(x->id) && best_of_image.at(image) != x->id) continue;
+      if (decided_.count(x->id)) continue;
+      if (Contains(o_.report_only_groups, x->group)) {
+        Decide(x, SnoopingVerdict::kHeld,
+               "suspected blunder in the " + x->group + " observation " + x->label + " (w = " +
+                   Fixed(x->w_max, 1) + "): check it; it is not rejected");
+        continue;
+      }
+      if (out_.model_error_suspected && x->point >= 0 && report_only_points_.count(x->point)) {
+        Decide(x, SnoopingVerdict::kHeld,
+               "model error suspected: the ray of a " + o_.report_only_groups.front() +
+                   " point is kept");
+        continue;
+      }
+      if (removed >= budget) {
+        x->verdict = SnoopingVerdict::kLeftAboveCritical;
+        x->reason = "rejection cap reached";
+        continue;
+      }
+      const std::string veto = o_.veto ? o_.veto(x->correlated) : std::string();
+      if (!veto.empty()) {
+        Decide(x, SnoopingVerdict::kVetoed, veto);
+        continue;
+      }
+      std::string reason;
+      if (x->correlated.size() > 1) {
+        reason = (x->point >= 0 ? b_.BlockName(x->point) : std::string("observation ")) + ": " +
+                 "one of these " + std::to_string(x->correlated.size()) +
+                 " observations holds a gross error; they cannot be told apart (|rho| > " +
+                 Fixed(o_.group_correlation, 2) + "); all are rejected";
+        out_.findings.push_back(reason + " (w = " + Fixed(x->w_max, 1) + ")");
+      }
+      for (ResidualId member : x->correlated) {
+        TestedObservation r = t.observations[t.index.at(member)];
+        r.correlated = x->correlated;
+        r.group_size = x->group_size;
+        r.verdict = SnoopingVerdict::kRejected;
+        r.round = round;
+        r.reason = reason;
+        out_.rejected.push_back(r);
+        b_.RemoveResidual(member);
+        ++removed;
+      }
+      x->verdict = SnoopingVerdict::kRejected;
+    }
+    return removed;
+  }
+
+  void Decide(TestedObservation* x, SnoopingVerdict verdict, const std::string& reason) {
+    x->verdict = verdict;
+    x->reason = reason;
+    if (decided_.emplace(x->id, std::make_pair(verdict, reason)).second &&
+        verdict != SnoopingVerdict::kLeftAboveCritical)
+      out_.findings.push_back(std::string(VerdictName(verdict)) + ": " + x->label + " (w = " +
+                              Fixed(x->w_max, 1) + "): " + reason);
+  }
+
+ private:
+  ProblemBuilder& b_;
+  const SnoopingOptions& o_;
+  SnoopingOutcome& out_;
+  std::set<BlockId> report_only_points_;
+  std::map<ResidualId, std::pair<SnoopingVerdict, std::string>> decided_;
+};
+
+}  // namespace
+
+const char* VerdictName(SnoopingVerdict verdict) {
+  switch (verdict) {
+    case SnoopingVerdict::kAccepted: return "accepted";
+    case SnoopingVerdict::kRejected: return "rejected";
+    case SnoopingVerdict::kWeaklyControlled: return "weakly controlled";
+    case SnoopingVerdict::kVetoed: return "vetoed";
+    case SnoopingVerdict::kHeld: return "held";
+    case SnoopingVerdict::kLeftAboveCritical: return "left above critical";
+  }
+  return "?";
+}
+
+double NonCentrality(double critical_value, double power) {
+  // z(power): P(N(0,1) > z) = 1 - power, i.e. the two-sided value of 2 (1 - power).
+  return critical_value + NormalCriticalValue(2.0 * (1.0 - power));
+}
+
+SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
+                                      const SolverOptions& solver,
+                                      const SnoopingOptions& options) {
+  AEROCAL_CHECK(options.alpha > 0 && options.alpha < 1) << "snooping alpha " << options.alpha;
+  AEROCAL_CHECK(options.power > 0.5 && options.power < 1) << "snooping power " << options.power;
+  AEROCAL_CHECK(options.max_rejections > 0) << "max_rejections " << options.max_rejections;
+  SnoopingOutcome out;
+  Snooper snooper(builder, options, &out);
+  out.report = builder.Solve(solver);
+  snooper.CollectReportOnlyPoints();
+  int removed_total = 0;
+  for (int round = 1; out.report.usable && out.report.redundancy > 0; ++round) {
+    out.rounds = round;
+    Test test = snooper.Run(round);
+    if (round == 1) snooper.DetectModelError(test, true);
+    if (test.observations.empty()) break;
+    const int budget = options.max_rejections - removed_total;
+    const int removed = budget > 0 ? snooper.Act(test, round, budget) : 0;
+    removed_total += removed;
+    // Weakly controlled observations above the critical value: named, never rejected.
+    for (auto& x : test.observations)
+      if (x.verdict == SnoopingVerdict::kAccepted && x.w_weak > out.critical_value) {
+        x.verdict = SnoopingVerdict::kWeaklyControlled;
+        x.reason = "w " + Fixed(x.w_weak, 1) + " on a component with r < " +
+                   Fixed(options.min_redundancy, 2) + ": a blunder there is barely visible";
+      }
+    if (removed == 0) {
+      for (auto& x : test.observations)
+        if (x.verdict == SnoopingVerdict::kAccepted && x.w_max > out.critical_value) {
+          if (budget > 0) {  // not the largest of its point / image: a held or vetoed one is
+            x.verdict = SnoopingVerdict::kHeld;
+            x.reason =
+                "its point or image holds a larger w that is held, vetoed or weakly controlled";
+            continue;
+          }
+          x.verdict = SnoopingVerdict::kLeftAboveCritical;
+          x.reason = "rejection cap reached";
+        }
+      for (const auto& x : test.observations)
+        if (x.verdict == SnoopingVerdict::kLeftAboveCritical) ++out.remaining_above_critical;
+      out.cap_reached = budget <= 0 && out.remaining_above_critical > 0;
+      if (out.cap_reached)
+        out.findings.push_back("rejection cap of " + std::to_string(options.max_rejections) +
+                               " reached: " + std::to_string(out.remaining_above_critical) +
+                               " candidate(s) left above the critical value " +
+                               Fixed(out.critical_value, 2));
+      snooper.DetectModelError(test, false);
+      out.tested = std::move(test.observations);
+      break;
+    }
+    out.report = builder.Solve(solver);
+  }
+  return out;
+}
+
+}  // namespace aerocal::calib

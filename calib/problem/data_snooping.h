@@ -1,0 +1,129 @@
+// Data snooping (Baarda's w test, Pope's tau test above the a-priori level) on a ProblemBuilder,
+// generic: it knows residual groups and block kinds, nothing about triangulation or stitching.
+//
+// Rounds
+// - Solve; for every tested residual component w_k = |v_k| / (s sqrt(r_k)) with the redundancy
+//   number r_k = (Q_vv P)_kk from ProblemBuilder::ComputeObservationCofactors and s = max(sigma0,
+//   1) (Baarda's sigma 1 when the data fit their a-priori sigmas, Pope's sigma0 when worse).
+// - An observation of several components (x, y) is tested jointly: T = v^T Q_ii^+ v / s^2 over
+//   the directions of Q_ii with eigenvalue >= min_redundancy, as the normal w with the same tail
+//   probability (w_max). Per-component w of ANOTHER observation can exceed both components of a
+//   blundered one; the joint statistic's non-centrality is the largest at the blunder.
+// - Candidates: w above the critical value k (from the family-wise alpha: alpha0 = alpha / n over
+//   the n tested components, at least 3.29), on components with r >= min_redundancy.
+// - In one round every candidate that is the largest w of its point (its eliminable block) and
+//   of its image (its rotation block, else its centre block) is acted on: their tests are nearly
+//   independent. Then the problem is solved again from the current solution.
+// - Components with r < min_redundancy are "weakly controlled": a blunder there barely shows and a
+//   model error looks like one. They are reported with their MDB, never rejected.
+// - Correlated groups: the observations of the candidate's point cluster whose standardized
+//   residuals correlate with the candidate's above group_correlation (|rho| from Q_vv) cannot be
+//   told apart by any test. A group of more than one is reported as a group and acted on as a
+//   whole: all its members are rejected (the blunder is surely removed; the cost is the group's
+//   good observations, which carry no information the test could use to separate them), never
+//   one arbitrary member named as "the" gross error. The caller's veto still applies to the group.
+// - report_only_groups (e.g. surveyed control coordinates) are tested and named when they fail,
+//   never rejected: a survey that disagrees with its rays is a finding for people, and rejecting
+//   the rays instead would hide it.
+// - The veto (caller-supplied) refuses a removal that would destroy the datum (a control point
+//   left with < 2 rays, an exposure left under-determined); vetoed candidates are reported.
+// - The cap: after max_rejections removals the run stops, says so and how many candidates were
+//   left above the critical value (SnoopingOutcome::cap_reached).
+// - Model error: when the largest w of the first test sit on the report-only (control) points,
+//   their rays are held, not rejected (a model error shows most where the survey pins the
+//   block); when the final sigma0 is above model_error_sigma0, or the candidates left over
+//   (held, vetoed, weakly controlled, at the cap) cluster on one point or one image (each
+//   correlated group counted once), the outcome says "model error suspected" with the evidence.
+//
+// MDB: the marginal detectable blunder of component k, in sigmas of the observation:
+//   nabla_k = delta0 s / sqrt(r_k), delta0 = k + z(power) (non-centrality for the test's power).
+#pragma once
+
+#include "calib/problem/problem_builder.h"
+
+#include <functional>
+#include <string>
+#include <vector>
+
+namespace aerocal::calib {
+
+struct SnoopingOptions {
+  std::vector<std::string> groups;              // tested groups; empty = every group
+  std::vector<std::string> report_only_groups;  // tested and reported, never rejected
+  double alpha = 0.05;           // family-wise level over the tested components, (0, 1)
+  double critical_value = 0.0;   // of |w|; 0: from alpha / n_tested (at least 3.29)
+  double power = 0.80;           // of the test, for the MDB, (0.5, 1)
+  double min_redundancy = 0.1;   // r below: weakly controlled, never rejected
+  double group_correlation = 0.99;  // |rho| above: the observations cannot be told apart
+  int max_rejections = 100;         // removals (group members count one each), > 0
+  double model_error_sigma0 = 1.5;  // final sigma0 above: model error suspected
+  /// Share of the largest w (at most 10, at least 2) on one point / image / the report-only
+  /// points from which a model error is suspected.
+  double model_error_share = 0.5;
+  /// Non-empty reason: removing these residuals (a candidate or its whole group) is refused.
+  std::function<std::string(const std::vector<ResidualId>&)> veto;
+  /// Passed to ComputeObservationCofactors: a singular reduced matrix larger than this is not
+  /// inverted; then nothing is tested and the outcome says so (cofactors_ok false).
+  int max_dense_parameters = 4000;
+};
+
+enum class SnoopingVerdict {
+  kAccepted,          // tested, below the critical value
+  kRejected,          // removed as a gross error (alone or with its correlated group)
+  kWeaklyControlled,  // above the critical value on a component with r < min_redundancy
+  kVetoed,            // candidate whose removal the caller refused (datum)
+  kHeld,              // candidate of a report-only group, or held by a suspected model error
+  kLeftAboveCritical  // candidate left when the rejection cap was reached
+};
+const char* VerdictName(SnoopingVerdict verdict);
+
+struct TestedObservation {
+  ResidualId id = -1;
+  std::string group, label;
+  std::vector<double> v;           // whitened residual at the test
+  std::vector<double> redundancy;  // r per component
+  std::vector<double> w;           // per component; NaN where r < 1e-6 (untestable)
+  std::vector<double> mdb_sigma;   // per component, in sigmas; +inf where untestable
+  /// The observation's test statistic on the normal scale: for several components (an image
+  /// point's x, y) the joint chi-square test over its controlled directions (Q_ii eigenvalues
+  /// >= min_redundancy) mapped to the normal w of the same tail probability; for one, its w.
+  double w_max = 0.0;
+  int component = -1;              // its largest-w controlled component (for the group)
+  double w_weak = 0.0;             // largest w of the weakly controlled components
+  std::vector<ResidualId> correlated;  // with itself: observations it cannot be told apart from
+  int group_size = 1;
+  BlockId point = -1;              // its eliminable block, -1 when none
+  SnoopingVerdict verdict = SnoopingVerdict::kAccepted;
+  int round = 0;       // round of the verdict
+  std::string reason;  // for the verdicts other than accepted
+};
+
+struct SnoopingOutcome {
+  SolveReport report;  // of the final adjustment
+  double alpha = 0.0, alpha0 = 0.0, critical_value = 0.0, power = 0.0, delta0 = 0.0;
+  double min_redundancy = 0.0, group_correlation = 0.0, reference_sigma = 1.0;
+  int n_tested_components = 0;
+  std::string cofactor_method;
+  bool cofactors_ok = true;  // false: nothing could be tested (cofactor_message says why)
+  std::string cofactor_message;
+  int rounds = 0;
+  bool cap_reached = false;
+  int remaining_above_critical = 0;  // candidates left when the cap was reached
+  std::vector<TestedObservation> rejected;  // in order, with their test values
+  /// The final test of every active tested residual (and the vetoed / held candidates).
+  std::vector<TestedObservation> tested;
+  bool model_error_suspected = false;
+  std::vector<std::string> model_error_evidence;
+  std::vector<std::string> findings;  // suspected control blunders, groups, vetoes, the cap
+  double seconds_testing = 0.0;       // cofactors and tests (not the solves)
+};
+
+/// Solves, snoops as described above, returns the final report and every verdict.
+SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
+                                      const SolverOptions& solver,
+                                      const SnoopingOptions& options);
+
+/// delta0 = k + z(power): the non-centrality a blunder needs to be found with that power.
+double NonCentrality(double critical_value, double power);
+
+}  // namespace aerocal::calib

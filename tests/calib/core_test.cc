@@ -1,0 +1,45 @@
+// The one Median, the one comma splitter and the one numeric Jacobian of calib/core.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "calib/core/csv.h"
+#include "calib/core/median.h"
+#include "calib/core/numeric_jacobian.h"
+
+namespace aerocal {
+namespace {
+
+TEST(Median, OddEvenAndEmpty) {
+  EXPECT_DOUBLE_EQ(Median({3.0, 1.0, 2.0}), 2.0);
+  EXPECT_DOUBLE_EQ(Median({4.0, 1.0, 3.0, 2.0}), 2.5);  // mean of the two middle values
+  EXPECT_DOUBLE_EQ(Median({0.5, 0.5}), 0.5);
+  EXPECT_DOUBLE_EQ(Median({7.0}), 7.0);
+  EXPECT_TRUE(std::isnan(Median({})));  // unknown, never 0
+}
+
+TEST(SplitCommaList, TrimsAndDropsOrKeepsEmptyFields) {
+  using V = std::vector<std::string>;
+  EXPECT_EQ(SplitCommaList(" c, K1 ,,K2,"), (V{"c", "K1", "K2"}));
+  EXPECT_EQ(SplitCommaList("a, b,", {true, true}), (V{"a", "b", ""}));  // CSV rows
+  EXPECT_EQ(SplitCommaList(" 1,\n2", {false, true}), (V{" 1", "\n2"}));
+  EXPECT_EQ(SplitCommaList("A=x.tif,B=y.tif"), (V{"A=x.tif", "B=y.tif"}));
+  EXPECT_TRUE(SplitCommaList("").empty());
+  EXPECT_TRUE(SplitCommaList(",", {}).empty());
+}
+
+TEST(NumericJacobian, LinearAndQuadraticFunctions) {
+  const auto f = [](const std::vector<double>& x) {
+    return Eigen::Vector2d(2 * x[0] - 3 * x[1], x[0] * x[0]);
+  };
+  const Eigen::MatrixXd j = NumericJacobian(f, {1.5, -2.0});
+  ASSERT_EQ(j.rows(), 2);
+  ASSERT_EQ(j.cols(), 2);
+  EXPECT_NEAR(j(0, 0), 2.0, 1e-9);
+  EXPECT_NEAR(j(0, 1), -3.0, 1e-9);
+  EXPECT_NEAR(j(1, 0), 3.0, 1e-8);
+  EXPECT_NEAR(j(1, 1), 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace aerocal

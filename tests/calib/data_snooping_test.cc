@@ -1,0 +1,165 @@
+// Data snooping (calib/problem/data_snooping.h) on problems whose cofactors are known in closed
+// form: scalar "points" each observed directly n times with weights p_i. Then
+//   r_i = 1 - p_i / P (P = sum of the weights), q_ik = -sqrt(p_i p_k) / P,
+//   a blunder g (in sigmas) on observation i gives whitened v_i = g r_i, w_i = g sqrt(r_i).
+// Two equal observations of one point correlate -1: no test can tell them apart.
+#include "calib/problem/data_snooping.h"
+
+#include "calib/residuals/prior.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <string>
+
+namespace aerocal::calib {
+namespace {
+
+// Points with value 0, observed as listed (sigmas), plus blunders (value in sigmas of that
+// observation). Noise-free otherwise: sigma0 after cleaning is 0 and the test uses sigma 1.
+struct Toy {
+  ProblemBuilder builder;
+  std::deque<double> values;
+  std::vector<std::vector<ResidualId>> rays;  // per point
+  std::vector<BlockId> blocks;
+
+  void AddPoint(const std::vector<double>& sigmas,
+                const std::vector<double>& blunders_sigma = {},
+                const std::string& group = kGroupImage) {
+    values.push_back(0.0);
+    const int p = static_cast<int>(blocks.size());
+    blocks.push_back(builder.AddBlock("point P" + std::to_string(p), &values.back(), 1,
+                                      BlockKind::kGroundPoint));
+    rays.emplace_back();
+    for (size_t i = 0; i < sigmas.size(); ++i) {
+      const double blunder = i < blunders_sigma.size() ? blunders_sigma[i] * sigmas[i] : 0.0;
+      rays.back().push_back(builder.AddResidual(group,
+                                                PriorCostFunction::Create({blunder}, {sigmas[i]}),
+                                                {blocks.back()},
+                                                "P" + std::to_string(p) + " obs " +
+                                                    std::to_string(i)));
+    }
+  }
+};
+
+// Ten four-ray points: the background of every case (critical value from 40+ components).
+void AddBackground(Toy* toy) {
+  for (int i = 0; i < 10; ++i) toy->AddPoint({1, 1, 1, 1});
+}
+
+TEST(DataSnooping, SingleBlunderOnAFourRayPointIsRejectedWithItsExactTestValues) {
+  Toy toy;
+  AddBackground(&toy);
+  toy.AddPoint({1, 1, 1, 1}, {0, 20, 0, 0});
+  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, {});
+  ASSERT_EQ(out.rejected.size(), 1u);
+  const TestedObservation& x = out.rejected[0];
+  EXPECT_EQ(x.id, toy.rays[10][1]);
+  EXPECT_NEAR(x.redundancy[0], 0.75, 1e-9);  // 1 - 1/4
+  // Pope: the reference sigma is sigma0 when above 1: v^T P v = 20^2 0.75, redundancy 44 - 11.
+  const double s = std::sqrt(400 * 0.75 / 33);
+  EXPECT_NEAR(x.w[0], 20 * std::sqrt(0.75) / s, 1e-6);
+  EXPECT_EQ(x.group_size, 1);  // rho = -1/3 with the others
+  EXPECT_NEAR(out.delta0, NonCentrality(out.critical_value, 0.8), 1e-12);
+  EXPECT_NEAR(out.delta0 - out.critical_value, 0.8416, 1e-3);  // z(80 %)
+  EXPECT_NEAR(x.mdb_sigma[0], out.delta0 * s / std::sqrt(0.75), 1e-9);
+  EXPECT_FALSE(out.cap_reached);
+  // The other rays of the point (w = 20/4 / sqrt(0.75) = 5.8, above the critical value before
+  // the rejection) stay: the blunder was the largest of its point.
+  for (int i : {0, 2, 3}) EXPECT_TRUE(toy.builder.IsActive(toy.rays[10][i]));
+  // Critical value from alpha = 5 % over the 44 components: alpha0 = 0.05 / 44, at least 3.29.
+  EXPECT_NEAR(out.alpha0, 0.05 / 44, 1e-12);
+  EXPECT_NEAR(out.critical_value, std::max(3.29, NormalCriticalValue(0.05 / 44)), 1e-9);
+}
+
+TEST(DataSnooping, TwoRayBlunderIsReportedAsAGroupAndBothRaysGo) {
+  Toy toy;
+  AddBackground(&toy);
+  toy.AddPoint({1, 1}, {20, 0});
+  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, {});
+  ASSERT_EQ(out.rejected.size(), 2u);
+  for (const auto& x : out.rejected) {
+    EXPECT_EQ(x.group_size, 2);
+    EXPECT_NEAR(x.redundancy[0], 0.5, 1e-9);
+  }
+  EXPECT_FALSE(toy.builder.IsActive(toy.rays[10][0]));
+  EXPECT_FALSE(toy.builder.IsActive(toy.rays[10][1]));
+  bool said = false;
+  for (const auto& f : out.findings) said |= f.find("cannot be told apart") != std::string::npos;
+  EXPECT_TRUE(said);
+}
+
+TEST(DataSnooping, WeaklyControlledObservationIsReportedNeverRejected) {
+  // Weights 1, 1, 400: r = 0.9975, 0.9975, 0.005. A 100-sigma blunder on the precise one gives
+  // w = 100 sqrt(0.005) / s = 5.7 there (Pope: s = sigma0 = sqrt(100^2 0.005 / 32)) and
+  // 100 * 20 / 402 / sqrt(0.9975) / s = 4.0 on the others: the point's largest w is weakly
+  // controlled, so nothing of it is rejected.
+  Toy toy;
+  AddBackground(&toy);
+  toy.AddPoint({1, 1, 0.05}, {0, 0, 100});
+  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, {});
+  EXPECT_TRUE(out.rejected.empty());
+  bool weak = false;
+  for (const auto& x : out.tested)
+    if (x.id == toy.rays[10][2]) {
+      weak = x.verdict == SnoopingVerdict::kWeaklyControlled;
+      EXPECT_NEAR(x.redundancy[0], 1 - 400.0 / 402.0, 1e-9);
+      const double r = 1 - 400.0 / 402.0;
+      EXPECT_NEAR(x.w[0], 100 * std::sqrt(r) / std::sqrt(100 * 100 * r / 32), 1e-5);  // solver tol.
+    }
+  EXPECT_TRUE(weak);
+}
+
+TEST(DataSnooping, VetoedAndReportOnlyCandidatesAreNamedNotRemoved) {
+  Toy toy;
+  AddBackground(&toy);
+  toy.AddPoint({1, 1, 1, 1}, {0, 20, 0, 0});
+  toy.AddPoint({1, 1, 1, 1}, {30, 0, 0, 0}, kGroupControl);  // a "survey" that disagrees
+  SnoopingOptions options;
+  options.report_only_groups = {kGroupControl};
+  const ResidualId guarded = toy.rays[10][1];
+  options.veto = [&](const std::vector<ResidualId>& ids) {
+    for (ResidualId id : ids)
+      if (id == guarded) return std::string("datum");
+    return std::string();
+  };
+  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, options);
+  EXPECT_TRUE(out.rejected.empty());
+  int vetoed = 0, held = 0;
+  for (const auto& x : out.tested) {
+    vetoed += x.verdict == SnoopingVerdict::kVetoed;
+    held += x.verdict == SnoopingVerdict::kHeld && x.id == toy.rays[11][0];
+  }
+  EXPECT_EQ(vetoed, 1);
+  EXPECT_EQ(held, 1);
+  for (const auto& rays : toy.rays)
+    for (ResidualId id : rays) EXPECT_TRUE(toy.builder.IsActive(id));
+}
+
+TEST(DataSnooping, RejectionCapStopsAndCountsWhatIsLeft) {
+  Toy toy;
+  AddBackground(&toy);
+  for (int i = 0; i < 3; ++i) toy.AddPoint({1, 1, 1, 1}, {25.0 + i, 0, 0, 0});
+  SnoopingOptions options;
+  options.max_rejections = 1;
+  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, options);
+  EXPECT_EQ(out.rejected.size(), 1u);
+  EXPECT_EQ(out.rejected[0].id, toy.rays[12][0]);  // the largest first (27 sigma)
+  EXPECT_TRUE(out.cap_reached);
+  EXPECT_EQ(out.remaining_above_critical, 2);
+}
+
+TEST(DataSnooping, AllIndependentBlundersGoInOneRound) {
+  Toy toy;
+  AddBackground(&toy);
+  for (int i = 0; i < 3; ++i) toy.AddPoint({1, 1, 1, 1}, {0, 0, 20, 0});
+  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, {});
+  EXPECT_EQ(out.rejected.size(), 3u);
+  for (const auto& x : out.rejected) EXPECT_EQ(x.round, 1);
+  EXPECT_EQ(out.rounds, 2);  // the second finds nothing
+}
+
+}  // namespace
+}  // namespace aerocal::calib

@@ -1,0 +1,162 @@
+// Honest outcomes on the command line: the rejection cap of `aerocal adjust` (exit 3 and the
+// warning), `aerocal flight` on a block it cannot solve (exit 3, the failing step named, no
+// calibrated camera), and null sigmas for an exposure left out.
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+namespace aerocal {
+namespace {
+
+using testing::RunAerocal;
+using testing::TempDir;
+
+nlohmann::json ReadJson(const std::string& path) {
+  return nlohmann::json::parse(ReadTextFile(path));
+}
+
+// observations.csv rows: image,point,col,row,sigma_px. Applies `edit` to each data row (return
+// false to drop it) and writes the file back.
+template <typename Edit>
+void EditObservations(const std::string& path, Edit edit) {
+  std::istringstream in(ReadTextFile(path));
+  std::string line, out;
+  std::getline(in, line);
+  out = line + "\n";
+  int index = 0;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) f.push_back(cell);
+    if (edit(index++, &f))
+      out += f[0] + "," + f[1] + "," + f[2] + "," + f[3] + "," + f[4] + "\n";
+  }
+  WriteFileAtomically(path, out);
+}
+
+TEST(SnoopingCommand, RejectionCapIsAWarningAndExitThree) {
+  TempDir dir("aerocal_snoop_cap");
+  ASSERT_EQ(RunAerocal("simulate --seed 3 --out " + dir.File("f")).exit_code, 0);
+  // Three 50-sigma blunders (10 px at 0.2 px) on check-point rays.
+  int planted = 0;
+  std::vector<std::pair<std::string, std::string>> blunders;
+  EditObservations(dir.File("f/observations.csv"), [&](int i, std::vector<std::string>* f) {
+    if ((*f)[1][0] == 'K' && i % 97 == 0 && planted < 3) {
+      (*f)[2] = std::to_string(std::stod((*f)[2]) + 10.0);
+      (*f)[3] = std::to_string(std::stod((*f)[3]) - 10.0);
+      ++planted;
+      blunders.emplace_back((*f)[0], (*f)[1]);
+    }
+    return true;
+  });
+  ASSERT_EQ(planted, 3);
+  const auto r = RunAerocal("adjust --project " + dir.File("f/project.yaml") +
+                            " --self-calibration all --no-robust-start --max-rejections 1 --out " +
+                            dir.File("r.json"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("rejection cap (1) reached"), std::string::npos) << r.output;
+  const auto j = ReadJson(dir.File("r.json"));
+  EXPECT_FALSE(j["valid"].get<bool>());
+  EXPECT_TRUE(j["snooping"]["cap_reached"].get<bool>());
+  EXPECT_GE(j["snooping"]["remaining_above_critical"].get<int>(), 1);
+  EXPECT_EQ(j["rejected"].size(), 1u);
+  // Without the cap all three are found (each a group of one or its correlated group).
+  const auto ok = RunAerocal("adjust --project " + dir.File("f/project.yaml") +
+                             " --self-calibration all --no-robust-start --out " + dir.File("s.json"));
+  EXPECT_EQ(ok.exit_code, 0) << ok.output;
+  const auto s = ReadJson(dir.File("s.json"));
+  EXPECT_TRUE(s["valid"].get<bool>());
+  for (const auto& [image, point] : blunders) {
+    bool found = false;
+    for (const auto& o : s["rejected"]) found |= o["image"] == image && o["point"] == point;
+    EXPECT_TRUE(found) << image << " " << point;
+  }
+  EXPECT_LE(s["rejected"].size(), 5u);  // a blunder in a two-ray pair takes its partner
+  for (const auto& o : s["rejected"])
+    for (const char* key : {"r", "w_xy", "mdb_px", "mdb_sigma", "group_size", "verdict"})
+      EXPECT_TRUE(o.contains(key)) << key;
+}
+
+TEST(SnoopingCommand, Sigma0AboveTheLimitIsNotValidAndWritesNoCamera) {
+  TempDir dir("aerocal_snoop_sigma0");
+  ASSERT_EQ(RunAerocal("simulate --seed 3 --out " + dir.File("f")).exit_code, 0);
+  // sigma0 is ~1.02 with self-calibration: a limit of 0.5 must fail the run, by name.
+  const auto r = RunAerocal("adjust --project " + dir.File("f/project.yaml") +
+                            " --self-calibration all --max-sigma0 0.5 --min-redundancy 0.2 "
+                            "--write-camera " + dir.File("cam.yaml") + " --out " + dir.File("r.json"));
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("above the limit 0.5 (max_sigma0)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("camera not written"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("cam.yaml")));
+  const auto j = ReadJson(dir.File("r.json"));
+  EXPECT_FALSE(j["valid"].get<bool>());
+  EXPECT_DOUBLE_EQ(j["snooping"]["min_redundancy"].get<double>(), 0.2);
+  // Bad option values: exit 2, nothing written.
+  const auto bad = RunAerocal("adjust --project " + dir.File("f/project.yaml") +
+                              " --max-rejections 0 --out " + dir.File("bad.json"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("bad.json")));
+}
+
+TEST(SnoopingCommand, FlightOnAnUnsolvableBlockExitsThreeNamesTheStepAndWritesNoCamera) {
+  TempDir dir("aerocal_snoop_flight");
+  ASSERT_EQ(RunAerocal("simulate --seed 5 --stitch-ties 50 --out " + dir.File("data")).exit_code, 0);
+  // One control point and no GNSS: position, attitude and scale of the block are not determined.
+  std::string points = ReadTextFile(dir.File("data/points.csv"));
+  points = std::regex_replace(points, std::regex("(\\nC[2-9][^\\n]*),control"), "$1,check");
+  WriteFileAtomically(dir.File("data/points.csv"), points);
+  std::filesystem::create_directories(dir.File("report"));
+  WriteFileAtomically(dir.File("report/camera_calibrated.yaml"), "stale: true\n");
+  const auto r = RunAerocal("flight --camera " + dir.File("data/camera_nominal.yaml") + " --data " +
+                            dir.File("data") + " --out " + dir.File("report") +
+                            " --no-joint --no-report");
+  EXPECT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("step self-calibration failed"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("no calibrated camera written"), std::string::npos);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("report/camera_calibrated.yaml")));
+  const auto doc = ReadJson(dir.File("report/result.json"));
+  EXPECT_FALSE(doc["valid"].get<bool>());
+  ASSERT_FALSE(doc["failures"].empty());
+  EXPECT_FALSE(doc["failures"][0]["step"].get<std::string>().empty());
+  for (const auto& a : doc["adjustments"]) {
+    EXPECT_FALSE(a["valid"].get<bool>()) << a["name"];
+    EXPECT_FALSE(a["invalid_reasons"].empty());
+  }
+}
+
+TEST(SnoopingCommand, ExposureLeftOutHasNullSigmasNeverZero) {
+  TempDir dir("aerocal_snoop_null");
+  ASSERT_EQ(RunAerocal("simulate --seed 2 --out " + dir.File("f")).exit_code, 0);
+  // Image 0005 keeps two observations: it cannot be oriented and is left out.
+  int kept = 0;
+  EditObservations(dir.File("f/observations.csv"), [&](int, std::vector<std::string>* f) {
+    if ((*f)[0] != "0005") return true;
+    return kept++ < 2;
+  });
+  const auto r = RunAerocal("adjust --project " + dir.File("f/project.yaml") + " --out " +
+                            dir.File("r.json"));
+  ASSERT_NE(r.exit_code, 2) << r.output;
+  const auto j = ReadJson(dir.File("r.json"));
+  bool seen = false;
+  for (const auto& e : j["exposures"]) {
+    if (e["image"] == "0005") {
+      seen = true;
+      EXPECT_FALSE(e["used"].get<bool>());
+      for (const char* k : {"X", "Y", "Z", "omega", "phi", "kappa"})
+        EXPECT_TRUE(e["sigma"][k].is_null()) << k;
+    } else {
+      EXPECT_GT(e["sigma"]["X"].get<double>(), 0.0) << e["image"];
+    }
+  }
+  EXPECT_TRUE(seen);
+}
+
+}  // namespace
+}  // namespace aerocal

@@ -1,0 +1,334 @@
+// aerocal rig: multi-head rigs (stitch/rig/). `rig convert`: the head images of one exposure ->
+// the virtual image (stitch/rig/rig_convert.h). `rig error-analysis`: the conversion error analysis
+// of the virtual image (stitch/rig/error_analysis.h) at one target or over a grid of targets,
+// result.json plus histogram / bound-map CSV files and, through tools/report/rig_error_plots.py
+// (matplotlib), their PNG plots.
+#include <spawn.h>
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/rig_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "stitch/rig/error_analysis.h"
+#include "stitch/rig/error_analysis_json.h"
+#include "stitch/resample/tiff_raster.h"
+#include "stitch/rig/rig_conversion.h"
+#include "stitch/rig/rig_convert.h"
+#include "tools/command_registry.h"
+#include "tools/image_sources.h"
+
+extern char** environ;
+
+namespace aerocal::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct ErrorAnalysisArgs {
+  std::string camera, limits, target, virtual_px, out;
+  double height_m = 0.0;  // 0: the rig file's virtual.height_m
+  int grid = 0;
+  int samples = 100000;
+  std::uint64_t seed = 1;
+  int bins = 60;
+  double relief_m = 100.0;
+  bool no_plots = false;
+};
+
+// "COL,ROW" -> pixel; ConfigError naming the option otherwise.
+Eigen::Vector2d ParsePixel(const std::string& text, const std::string& option) {
+  const auto comma = text.find(',');
+  const auto col = comma == std::string::npos ? std::nullopt : ParseDouble(text.substr(0, comma));
+  const auto row = comma == std::string::npos ? std::nullopt : ParseDouble(text.substr(comma + 1));
+  if (!col || !row) throw ConfigError(option + ": expected COL,ROW (got '" + text + "')");
+  return {*col, *row};
+}
+
+// Runs python3 SCRIPT ARGS... without a shell; true when it exits with 0.
+bool RunPython(const std::vector<std::string>& args) {
+  std::vector<std::string> argv_strings = {"python3"};
+  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& s : argv_strings) argv.push_back(s.data());
+  argv.push_back(nullptr);
+  pid_t pid = 0;
+  if (posix_spawnp(&pid, "python3", nullptr, nullptr, argv.data(), environ) != 0) return false;
+  int status = 0;
+  if (waitpid(pid, &status, 0) != pid) return false;
+  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+}
+
+std::string PlotScript() {
+  if (const char* env = std::getenv("AEROCAL_RIG_PLOT_SCRIPT")) return env;
+  return (fs::path(AEROCAL_REPORT_SCRIPT).parent_path() / "rig_error_plots.py").string();
+}
+
+int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
+  const calib::Rig rig = calib::ReadRig(args.camera);
+  const stitch::ErrorLimits limits = stitch::ReadErrorLimits(args.limits);
+  if (rig.heads.size() < 2)
+    throw InputError(args.camera + ": a rig of one head is an ordinary camera; it has no "
+                     "conversion error to analyse");
+  double height_m = args.height_m;
+  if (height_m == 0.0) {
+    if (!rig.virtual_camera.height_m)
+      throw ConfigError("--height-m: the rig file " + args.camera +
+                        " has no virtual.height_m; give the relative flying height");
+    height_m = *rig.virtual_camera.height_m;
+  }
+  if (!(height_m > 0)) throw ConfigError("--height-m must be > 0 m");
+  if (!(limits.height_m < height_m))
+    throw InputError(args.limits + ": the height limit (" + FormatNumber(limits.height_m) +
+                     " m) must be below the flying height (" + FormatNumber(height_m) + " m)");
+  const int modes = !args.target.empty() + !args.virtual_px.empty() + (args.grid > 0);
+  if (modes > 1) throw ConfigError("--target, --virtual and --grid exclude each other");
+  if (args.samples < 0) throw ConfigError("--samples must be >= 0");
+  if (args.bins < 1) throw ConfigError("--bins must be >= 1");
+  if (args.grid < 0 || args.grid > 200) throw ConfigError("--grid must be within 1..200");
+  if (!(args.relief_m >= 0)) throw ConfigError("--relief-m must be >= 0");
+
+  const int reference = rig.ReferenceIndex();
+  const stitch::RigExposure nadir;
+  const stitch::RigConverter nominal(rig, nadir,
+                                     stitch::MakeRectificationPlane(rig, nadir, height_m));
+  int head = -1;
+  Eigen::Vector2d virtual_px;
+  if (!args.target.empty()) {
+    const auto colon = args.target.find(':');
+    if (colon == std::string::npos)
+      throw ConfigError("--target: expected HEAD:COL,ROW (got '" + args.target + "')");
+    head = rig.HeadIndex(args.target.substr(0, colon));
+    if (head < 0)
+      throw ConfigError("--target: head '" + args.target.substr(0, colon) + "' is not in " +
+                        args.camera);
+    const auto v = nominal.VirtualFromHead(head, ParsePixel(args.target.substr(colon + 1), "--target"));
+    if (!v) throw ConfigError("--target: the pixel does not reach the rectification plane");
+    virtual_px = *v;
+  } else if (!args.virtual_px.empty()) {
+    virtual_px = ParsePixel(args.virtual_px, "--virtual");
+    for (int k = 0; k < static_cast<int>(rig.heads.size()) && head < 0; ++k) {
+      if (k == reference) continue;
+      const auto p = nominal.HeadFromVirtual(k, virtual_px);
+      if (p && nominal.InHeadFormat(k, *p)) head = k;
+    }
+    if (head < 0)
+      throw ConfigError("--virtual: no non-reference head sees virtual pixel " + args.virtual_px);
+  } else if (args.grid == 0) {
+    // Default: the format centre of the first non-reference head.
+    head = reference == 0 ? 1 : 0;
+    const calib::Camera& camera = rig.heads[head].camera;
+    const auto v = nominal.VirtualFromHead(
+        head, {0.5 * (camera.width_px - 1), 0.5 * (camera.height_px - 1)});
+    if (!v) throw InputError(args.camera + ": the centre of head " + rig.heads[head].id +
+                             " does not reach the rectification plane");
+    virtual_px = *v;
+  }
+  if (head == reference)
+    throw ConfigError("--target: " + rig.reference_head +
+                      " is the reference head, which realises the virtual camera (its conversion "
+                      "error is zero by definition); choose another head");
+
+  const fs::path out(args.out);
+  const std::string stem = out.stem().string();
+  stitch::ErrorAnalysisFiles files;
+  std::unique_ptr<stitch::GridAnalysis> grid;
+  stitch::TargetAnalysis target;
+  if (args.grid > 0) {
+    grid = std::make_unique<stitch::GridAnalysis>(
+        stitch::AnalyseGrid(rig, height_m, limits, args.grid, args.samples, args.seed));
+    if (grid->points.empty())
+      throw InputError(args.camera + ": no grid point is seen by a non-reference head");
+    target = grid->points[grid->worst];
+    files.bound_map_csv = stem + "_bound_map.csv";
+  } else {
+    target = stitch::AnalyseTarget(rig, height_m, limits, head, virtual_px, args.samples, args.seed,
+                                   true);
+    if (target.monte_carlo) files.histogram_csv = stem + "_histogram.csv";
+  }
+  if (!args.no_plots) {
+    if (!files.histogram_csv.empty()) files.histogram_png = stem + "_histogram.png";
+    if (!files.bound_map_csv.empty()) files.bound_map_png = stem + "_bound_map.png";
+  }
+  const nlohmann::json doc = stitch::ErrorAnalysisToJson(rig, height_m, limits, target, grid.get(),
+                                                         args.relief_m, files);
+  const fs::path folder = out.parent_path();
+  if (!files.histogram_csv.empty())
+    WriteFileAtomically((folder / files.histogram_csv).string(),
+                        stitch::HistogramCsv(*target.monte_carlo, args.bins));
+  if (!files.bound_map_csv.empty())
+    WriteFileAtomically((folder / files.bound_map_csv).string(), stitch::BoundMapCsv(rig, *grid));
+  WriteFileAtomically(args.out, doc.dump(2) + "\n");
+
+  // Summary for people.
+  std::printf("conversion error at virtual pixel (%.2f, %.2f) = head %s pixel (%.2f, %.2f), "
+              "H = %g m\n",
+              target.virtual_px.x(), target.virtual_px.y(), rig.heads[target.head].id.c_str(),
+              target.head_px.x(), target.head_px.y(), height_m);
+  std::printf("%-12s %10s %10s %10s %10s   (px, ex = d col, ey = -d row)\n", "source", "+ex",
+              "+ey", "-ex", "-ey");
+  for (const auto& row : target.per_source)
+    std::printf("%-12s %10.4f %10.4f %10.4f %10.4f\n", row.source.c_str(), row.plus_px.x(),
+                row.plus_px.y(), row.minus_px.x(), row.minus_px.y());
+  const auto& all = target.worst_cases.back();
+  std::printf("maximum error (all sources, worst corner): |ex| %.3f |ey| %.3f radial %.3f px\n",
+              all.max_abs_px.x(), all.max_abs_px.y(), all.max_radial_px);
+  std::printf("linear: sigma %.4f %.4f px, 99.75 %% bound %.3f %.3f px, radial %.3f px\n",
+              target.linear.sigma_px.x(), target.linear.sigma_px.y(), target.linear.bound_px.x(),
+              target.linear.bound_px.y(), target.linear.bound_radial_px);
+  if (target.monte_carlo)
+    std::printf("monte-carlo (n %d, seed %llu): sigma %.4f %.4f px, 99.75 %% bound %.3f %.3f px, "
+                "radial %.3f px, largest %.3f px\n",
+                target.monte_carlo->n, static_cast<unsigned long long>(args.seed),
+                target.monte_carlo->sigma_px.x(), target.monte_carlo->sigma_px.y(),
+                target.monte_carlo->bound_px.x(), target.monte_carlo->bound_px.y(),
+                target.monte_carlo->bound_radial_px, target.monte_carlo->max_radial_px);
+  if (grid)
+    std::printf("grid %d x %d: %zu targets, worst shown above; %zu grid points unseen\n", args.grid,
+                args.grid, grid->points.size(), grid->unseen.size());
+  if (args.no_plots || (files.histogram_png.empty() && files.bound_map_png.empty()))
+    return kExitOk;
+  if (!RunPython({PlotScript(), args.out})) {
+    std::fprintf(stderr, "error: the plots could not be drawn (python3 %s %s); %s and the CSV "
+                 "files are complete\n", PlotScript().c_str(), args.out.c_str(), args.out.c_str());
+    return kExitInternal;
+  }
+  return kExitOk;
+}
+
+struct ConvertArgs {
+  std::string camera, images, opk_deg = "0,0,0", out, interp = "bilinear";
+  double height_m = 0.0;  // 0: the rig file's virtual.height_m
+  double fill = 0.0;
+  double relief_m = 100.0;
+  int strip_rows = 256;
+  bool bigtiff = false;
+};
+
+int RunConvert(const ConvertArgs& args) {
+  const calib::Rig rig = calib::ReadRig(args.camera);
+  const double height_m = args.height_m != 0.0 ? args.height_m
+                          : rig.virtual_camera.height_m ? *rig.virtual_camera.height_m
+                                                        : 0.0;
+  if (!(height_m > 0))
+    throw ConfigError("--height-m: give the relative flying height (> 0 m; the rig file " +
+                      args.camera + " has no virtual.height_m)");
+  stitch::RigExposure exposure;
+  std::stringstream angles(args.opk_deg);
+  std::string item;
+  for (int i = 0; i < 3; ++i) {
+    const auto value = std::getline(angles, item, ',') ? ParseDouble(item) : std::nullopt;
+    if (!value) throw ConfigError("--opk-deg: expected OMEGA,PHI,KAPPA in degrees (got '" + args.opk_deg + "')");
+    exposure.rig_opk_rad[i] = *value * M_PI / 180.0;
+  }
+  stitch::ResampleOptions options;
+  options.interpolation = stitch::ParseInterpolation(args.interp);
+  options.fill = args.fill;
+  options.strip_rows = args.strip_rows;
+  if (options.strip_rows < 1) throw ConfigError("--strip-rows must be > 0");
+  const stitch::RigConverter converter(rig, exposure,
+                                       stitch::MakeRectificationPlane(rig, exposure, height_m));
+  const calib::Camera as_camera = stitch::RigExposureAsSubimageCamera(converter);
+  std::vector<std::string> ids;
+  for (const auto& head : rig.heads) ids.push_back(head.id);
+  const auto owned = OpenImages(args.images, ids, "head", args.camera);
+  std::vector<stitch::RasterSource*> sources;
+  for (const auto& source : owned) sources.push_back(source.get());
+  const stitch::RasterInfo info = sources.front()->Info();
+  if (!(args.fill >= 0 && args.fill <= (info.bits == 8 ? 255.0 : 65535.0)))
+    throw ConfigError("--fill must fit the " + std::to_string(info.bits) + "-bit images");
+  stitch::TiffWriteOptions tiff;
+  tiff.description = stitch::MappingDescription(
+      as_camera, args.camera + " at H = " + FormatNumber(height_m) + " m (plane homographies)");
+  tiff.force_bigtiff = args.bigtiff;
+  stitch::TiffWriter writer(
+      args.out, {as_camera.width_px, as_camera.height_px, info.bands, info.bits}, tiff);
+  const stitch::ResampleReport report =
+      stitch::ResampleVirtualImage(as_camera, sources, &writer, options);
+  writer.Commit();
+  std::printf("virtual image %d x %d px from %zu heads at H = %g m: %ld px covered, %ld in "
+              "overlaps, %ld filled, %.2f s\n",
+              as_camera.width_px, as_camera.height_px, rig.heads.size(), height_m, report.covered,
+              report.overlap, report.filled, report.seconds);
+  // Where the plane is not the terrain: relief displaces points between heads.
+  const int reference = rig.ReferenceIndex();
+  for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k)
+    if (k != reference && args.relief_m < height_m)
+      std::printf("relief of %g m off the plane: %.3f px between heads %s and %s\n", args.relief_m,
+                  stitch::ReliefDisplacementPx(rig, reference, k, height_m, args.relief_m),
+                  rig.reference_head.c_str(), rig.heads[k].id.c_str());
+  return kExitOk;
+}
+
+CommandRun Setup(CLI::App& app) {
+  app.require_subcommand(1);
+  auto args = std::make_shared<ErrorAnalysisArgs>();
+  CLI::App* ea = app.add_subcommand(
+      "error-analysis",
+      "Conversion error analysis of the rig's virtual image: maximum error, linear propagation, "
+      "Monte-Carlo, at one target or over a grid");
+  ea->option_defaults()->always_capture_default();
+  ea->add_option("--camera", args->camera, "Rig camera file (YAML with a rig section)")->required();
+  ea->add_option("--limits", args->limits,
+                 "Limits file: limits {principal_point_px, principal_distance_px, angles_arcsec, "
+                 "lever_arm_mm, height_m}, sigmas")
+      ->required();
+  ea->add_option("--height-m", args->height_m,
+                 "Relative flying height of the rectification plane, m (default: the rig file's "
+                 "virtual.height_m)");
+  ea->add_option("--target", args->target,
+                 "HEAD:COL,ROW: a pixel of a non-reference head, carried into the virtual image by "
+                 "the nominal rig (default: the centre of the first non-reference head)");
+  ea->add_option("--virtual", args->virtual_px,
+                 "COL,ROW: a virtual pixel, analysed in the first non-reference head that sees it");
+  ea->add_option("--grid", args->grid, "N: an N x N grid of virtual pixels (bound map)");
+  ea->add_option("--samples", args->samples, "Monte-Carlo samples per target (0: none)");
+  ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)");
+  ea->add_option("--bins", args->bins, "Histogram bins");
+  ea->add_option("--relief-m", args->relief_m,
+                 "Relief (m off the plane) whose displacement between heads is reported");
+  ea->add_flag("--no-plots", args->no_plots, "Write JSON and CSV only (no PNG)");
+  ea->add_option("--out", args->out,
+                 "Result JSON; STEM_histogram.csv/.png or STEM_bound_map.csv/.png beside it")
+      ->required();
+  auto convert = std::make_shared<ConvertArgs>();
+  CLI::App* cv = app.add_subcommand(
+      "convert", "The images of one rig exposure -> the single-centre virtual image (TIFF)");
+  cv->option_defaults()->always_capture_default();
+  cv->add_option("--camera", convert->camera, "Rig camera file (YAML with a rig section)")->required();
+  cv->add_option("--images", convert->images, "Head images: A=a.tif,B=b.tif,...")->required();
+  cv->add_option("--height-m", convert->height_m,
+                 "Relative flying height of the rectification plane, m (default: the rig file's "
+                 "virtual.height_m)");
+  cv->add_option("--opk-deg", convert->opk_deg,
+                 "Rig attitude omega,phi,kappa in degrees (matters for orientation: level)");
+  cv->add_option("--out", convert->out, "Virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
+  cv->add_option("--interp", convert->interp, "bilinear | bicubic");
+  cv->add_option("--fill", convert->fill, "Grey value of pixels no head covers");
+  cv->add_option("--strip-rows", convert->strip_rows, "Rows per processing strip (memory bound)");
+  cv->add_option("--relief-m", convert->relief_m,
+                 "Relief (m off the plane) whose displacement between heads is reported");
+  cv->add_flag("--bigtiff", convert->bigtiff, "Write BigTIFF even when classic TIFF would do");
+  return [args, ea, convert, cv] {
+    if (ea->parsed()) return RunErrorAnalysis(*args);
+    if (cv->parsed()) return RunConvert(*convert);
+    return kExitInternal;
+  };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(rig, "rig",
+                         "Multi-head rigs: conversion to the virtual image and its error analysis",
+                         Setup);
+
+}  // namespace aerocal::tools
