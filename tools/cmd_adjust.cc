@@ -4,6 +4,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
+#include "tools/adjust_joint.h"
 #include "tools/command_registry.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/conventional_reference.h"
@@ -18,13 +19,6 @@ namespace {
 
 using triangulation::AdjustmentResult;
 
-// OUT.yaml for a single camera, OUT_<id>.yaml for each of several.
-std::string CameraOutputPath(const std::string& out, const std::string& id, bool several) {
-  if (!several) return out;
-  const std::filesystem::path p(out);
-  return (p.parent_path() / (p.stem().string() + "_" + id + p.extension().string())).string();
-}
-
 CommandRun SetupAdjust(CLI::App& app) {
   struct Args {
     std::string project, out, write_camera, self_calibration = "none";
@@ -32,6 +26,7 @@ CommandRun SetupAdjust(CLI::App& app) {
     bool no_robust_start = false;
     double default_sigma_px = 0.5;
     triangulation::AdjustOptions options;
+    JointAdjustArgs joint;
   };
   auto args = std::make_shared<Args>();
   app.add_option(
@@ -91,6 +86,7 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->options.correlation_threshold,
                  "Report parameter pairs correlated above this")
       ->check(CLI::Range(0.0, 1.0));
+  AddJointAdjustOptions(app, &args->joint);
   return [args]() {
     auto options = args->options;
     options.data_snooping = !args->no_snooping;
@@ -103,6 +99,12 @@ CommandRun SetupAdjust(CLI::App& app) {
     options.Validate();
     CheckOutputFile(args->out, "--out");
     if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
+    if (args->joint.Requested()) {
+      if (args->compare)
+        throw ConfigError("--compare and --joint-stitching do not combine (`aerocal flight` runs and compares both)");
+      return RunJointAdjust(
+          args->joint, options, args->project, args->default_sigma_px, args->out, args->write_camera);
+    }
     if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
       throw ConfigError(
           "--write-camera needs a self-calibrating run (--self-calibration or --compare)");

@@ -3,7 +3,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
-#include <sstream>
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
@@ -11,6 +10,7 @@
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "tools/command_registry.h"
+#include "triangulation/joint/joint_adjustment.h"
 #include "triangulation/workflow/flight_workflow.h"
 
 namespace aerocal::tools {
@@ -25,7 +25,7 @@ std::string ShellQuote(const std::string& s) {
 CommandRun SetupFlight(CLI::App& app) {
   struct Args {
     triangulation::FlightWorkflowOptions options;
-    std::string out, base, report_script;
+    std::string out, base, report_script, joint_model = "auto";
     bool no_report = false;
   };
   auto args = std::make_shared<Args>();
@@ -39,10 +39,15 @@ CommandRun SetupFlight(CLI::App& app) {
   app.add_option("--stitch-sigma-px", args->options.stitch_sigma_px, "Stitching sigma where the file has none, px")
       ->check(CLI::PositiveNumber);
   app.add_flag("--no-joint", [args](std::int64_t) { args->options.joint = false; }, "Skip the joint adjustment");
+  app.add_option("--joint-model", args->joint_model,
+                 "Mapping model of the joint adjustment: translation | conformal | affine | projective | auto "
+                 "(the model the flight's stitching F test chose)")
+      ->capture_default_str();
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
   return [args]() {
     CheckOutputFolder(args->out, "--out");
     args->options.base_ids = SplitCommaList(args->base);
+    args->options.joint_model = triangulation::ParseJointModel(args->joint_model);
     Progress progress("flight", 5);
     const auto result = triangulation::RunFlightWorkflow(args->options, &progress);
     progress.Finish();

@@ -14,6 +14,7 @@ CommandRun SetupSimulate(CLI::App& app) {
   struct Args {
     std::string out;
     std::string layout = "3x2";
+    std::string nominal_mapping = "affine";
     triangulation::FlightSimulationOptions options;
     std::uint64_t seed = 1;
   };
@@ -40,6 +41,13 @@ CommandRun SetupSimulate(CLI::App& app) {
   app.add_option("--start-offset-m", o.start_position_error_m, "Error of approximate centres without GNSS, 0..100000 m")->check(CLI::Range(0.0, 1e5));
   app.add_option("--start-offset-deg", o.start_angle_error_deg, "Error of approximate angles without IMU, 0..180 deg")->check(CLI::Range(0.0, 180.0));
   app.add_option("--layout", args->layout, "Sub-image grid ROWSxCOLS of the camera, 1..10 each (default 3x2: six CCDs)");
+  app.add_option("--nominal-mapping", args->nominal_mapping,
+                 "Mapping model of the nominal camera's sub-images: translation (a maker's design: nominal "
+                 "offsets only) | conformal | affine | projective; the truth keeps a richer model where its "
+                 "misplacements need one");
+  app.add_option("--ccd-shear", o.misplacement.shear,
+                 "Affine part of the true CCD misplacements (x-scale minus y-scale and skew, each +-this), 0..0.1")
+      ->check(CLI::Range(0.0, 0.1));
   return [args]() {
     CheckOutputFolder(args->out, "--out");
     auto& o = args->options;
@@ -61,6 +69,11 @@ CommandRun SetupSimulate(CLI::App& app) {
       for (int c = (cols - 1) / 2; c <= cols / 2; ++c)
         o.layout.base_ids.push_back(stitch::RomanNumeral(r * cols + c + 1));
     }
+    const auto nominal_mapping = calib::ParseMappingModel(args->nominal_mapping);
+    if (!nominal_mapping)
+      throw ConfigError("--nominal-mapping must be translation, conformal, affine or projective (got '" +
+                        args->nominal_mapping + "')");
+    o.layout.model = *nominal_mapping;
     if (o.control_points > o.ground_points)
       throw ConfigError("--control (" + std::to_string(o.control_points) +
                         ") must not exceed --points (" + std::to_string(o.ground_points) +

@@ -3,9 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 
 #include <Eigen/Cholesky>
 
+#include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "stitch/adjustment/f_test.h"
 #include "stitch/adjustment/mapping_param_names.h"
@@ -192,6 +194,41 @@ BatchResult RunStitchBatch(const calib::Camera& camera, const std::vector<FrameM
       result.stability.push_back(ComputeStability(model, series, options.alpha));
   }
   return result;
+}
+
+calib::MappingModel FlightModel(const BatchResult& result, const BatchOptions& options) {
+  if (options.model) return *options.model;
+  AEROCAL_CHECK(!result.frames.empty()) << "the flight's model of a batch without frames";
+  std::map<calib::MappingModel, int> chosen;
+  for (const FrameRun& run : result.frames) ++chosen[run.adjustment.model];
+  calib::MappingModel model = chosen.begin()->first;
+  for (const auto& [m, n] : chosen)
+    if (n > chosen[model]) model = m;
+  return model;
+}
+
+std::optional<calib::Camera> FlightMeanCamera(const calib::Camera& camera, const BatchResult& result,
+                                              calib::MappingModel model) {
+  const auto stability = std::find_if(result.stability.begin(), result.stability.end(),
+                                      [&](const ModelStability& s) { return s.model == model; });
+  if (stability == result.stability.end()) return std::nullopt;
+  const std::vector<std::string> names = MappingParamNames(model);
+  calib::Camera out = camera;
+  for (calib::SubimageMapping& s : out.subimages) {
+    std::vector<double> params(names.size());
+    size_t found = 0;
+    for (const ParameterStability& p : stability->parameters)
+      if (p.subimage == s.id)
+        for (size_t i = 0; i < names.size(); ++i)
+          if (names[i] == p.name) {
+            params[i] = p.mean;
+            ++found;
+          }
+    if (found != names.size()) continue;  // a base sub-image
+    s.model = model;
+    s.params = params;
+  }
+  return out;
 }
 
 }  // namespace aerocal::stitch

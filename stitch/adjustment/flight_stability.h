@@ -75,4 +75,14 @@ struct BatchResult {
 BatchResult RunStitchBatch(const calib::Camera& camera, const std::vector<FrameMeasurements>& frames,
                            const BatchOptions& options, Progress* progress);
 
+/// The flight's model: the requested one, or with --model auto the one chosen in most frames
+/// (the simpler on a tie). `result` must hold at least one frame.
+calib::MappingModel FlightModel(const BatchResult& result, const BatchOptions& options);
+
+/// `camera` with every free sub-image mapped by the flight mean of its `model` parameters (the
+/// stability of `model`); base sub-images keep the camera's mapping. nullopt when `model` was not
+/// adjusted in every frame.
+std::optional<calib::Camera> FlightMeanCamera(const calib::Camera& camera, const BatchResult& result,
+                                              calib::MappingModel model);
+
 }  // namespace aerocal::stitch

@@ -145,9 +145,7 @@ json StitchResultToJson(const BatchResult& result, const BatchOptions& options) 
     converged = converged && run.adjustment.converged;
     ++chosen[run.adjustment.model];
   }
-  calib::MappingModel model = options.model ? *options.model : chosen.begin()->first;
-  for (const auto& [m, n] : chosen)
-    if (n > chosen[model]) model = m;
+  const calib::MappingModel model = FlightModel(result, options);
   // Frames' median a-priori sigma: sigma0_px / sigma0 of any frame.
   double scale = 0;
   for (const FrameRun& run : result.frames)

@@ -182,6 +182,16 @@ subimages:
   EXPECT_EQ(v.At(399, 10), 7);      // II moved by -0.5 px: the last column is not covered
   const std::string description = ReadTiffDescription(tmp.File("v.tif"));
   EXPECT_NE(description.find("II affine 210 160 1 0 189.5 0 1 0"), std::string::npos) << description;
+  // In strips of 7 rows and as BigTIFF: the same pixels.
+  const auto strips = RunAerocal("resample --camera " + tmp.File("camera.yaml") + " --mapping " +
+                                 tmp.File("r.json") + " --images " + images + " --out " +
+                                 tmp.File("b.tif") + " --fill 7 --interp bicubic --strip-rows 7 --bigtiff");
+  ASSERT_EQ(strips.exit_code, 0) << strips.output;
+  EXPECT_TRUE(IsBigTiff(tmp.File("b.tif")));
+  EXPECT_FALSE(IsBigTiff(tmp.File("v.tif")));
+  MemoryRaster b(source->Info());
+  OpenTiff(tmp.File("b.tif"))->ReadWindow(0, 0, 400, 300, b.bytes().data());
+  EXPECT_EQ(b.bytes(), v.bytes());
   // A sub-image without an image is refused.
   const auto bad = RunAerocal("resample --camera " + tmp.File("camera.yaml") + " --mapping " +
                               tmp.File("r.json") + " --images I=" + tmp.File("I.tif") + " --out " +

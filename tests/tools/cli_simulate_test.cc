@@ -58,6 +58,12 @@ TEST(Cli, BadOptionsExitWithTwoAndWriteNothing) {
   EXPECT_FALSE(std::filesystem::exists(dir.File("x")));
   EXPECT_EQ(testing::RunAerocal("simulate --out " + dir.File("y") + " --exposures -3").exit_code, 2);
   EXPECT_FALSE(std::filesystem::exists(dir.File("y")));
+  const auto model = testing::RunAerocal("simulate --out " + dir.File("z") + " --nominal-mapping shear");
+  EXPECT_EQ(model.exit_code, 2);
+  EXPECT_NE(model.output.find("--nominal-mapping"), std::string::npos) << model.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("z")));
+  EXPECT_EQ(testing::RunAerocal("simulate --out " + dir.File("z") + " --ccd-shear -1").exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("z")));
 }
 
 TEST(Cli, OtherLayoutsSimulate) {

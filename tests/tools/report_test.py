@@ -330,6 +330,24 @@ class TolerantInput(unittest.TestCase):
         self.assertIn("no calibrated camera was written", text)
         self.assertEqual(page.row("summary-steps", "Self-calibrating triangulation")[2], "no")
 
+    def test_warnings_and_the_joint_mapping_model_are_shown(self):
+        # A joint adjustment whose translation mappings do not fit: its warnings by name on the
+        # summary (step flagged) and in its section, with the mapping model and why.
+        warning = {"name": "group_rms", "subject": "stitch_tie", "value": 14.1, "limit": 3,
+                   "message": "residual group stitch_tie: RMS 14.1 sigma over 3678 observations (limit 3)"}
+        doc = {"kind": "flight",
+               "adjustments": [{"name": "self_calibration", "sigma0": 1.0, "converged": True, "warnings": []},
+                               {"name": "joint", "sigma0": 4.7, "converged": True, "mapping_model": "translation",
+                                "mapping_model_reason": "given by the user", "mapping_scope": "per-flight",
+                                "datum": "base sub-images III IV", "warnings": [warning]}]}
+        text, page = self.render(doc)
+        joint = page.tables["summary-steps"][-1]  # the last step that ran
+        self.assertIn("mappings translation", joint[-1])
+        self.assertIn("1 warning(s)", joint[-1])
+        self.assertIn("All steps converged and are valid.", text)  # a warning does not invalidate
+        self.assertEqual(text.count("residual group stitch_tie: RMS 14.1 sigma"), 2)  # summary and section
+        self.assertIn("Mapping model: translation (given by the user).", text)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -26,6 +26,8 @@ def _joint_extras(a, aid):
     scope, datum = a.get("mapping_scope"), a.get("datum")
     if scope or datum:
         out.append(note(f"Mappings estimated {esc(scope or 'n/a')}; datum of the focal plane: {esc(datum or 'n/a')}."))
+    if a.get("mapping_model"):
+        out.append(note(f"Mapping model: {esc(a.get('mapping_model'))} ({esc(a.get('mapping_model_reason') or 'n/a')})."))
     subs = [s for s in rd.listing(a.get("subimages")) if isinstance(s, dict)]
     if subs:
         rows = []
@@ -94,6 +96,9 @@ def adjustment(a, number):
                           for r in rejected]))
     elif "rejected" in a:
         out.append(note("No observation rejected as a gross error."))
+    for w in rd.listing(a.get("warnings")):
+        message = w.get("message") if isinstance(w, dict) else w
+        out.append(f'<p class="na"><span class="bad">warning</span>: {esc(message)}</p>')
     det = a.get("determinability")
     if isinstance(det, dict):
         for w in rd.listing(det.get("warnings")):

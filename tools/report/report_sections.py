@@ -46,6 +46,13 @@ def summary(doc):
     for a in rd.adjustments(doc):
         check = rd.point_statistics(a, "check")
         key = f"check points: {fmt(check['n'], 'd')}, spatial RMSE {fmt(check['spatial'])} m" if check else ""
+        if a.get("mapping_model"):
+            key += f"; mappings {a.get('mapping_model')}"
+        named = rd.listing(a.get("warnings"))  # [{name, subject, value, limit, message}]
+        if named:
+            key += f"; {len(named)} warning(s)"
+        for w in named:
+            warnings.append((rd.title(a), "warning: " + str(w.get("message") if isinstance(w, dict) else w)))
         valid = a.get("valid") is not False and a.get("converged") is not False
         steps.append([text(rd.title(a)), raw(yes_no(a.get("converged"))), raw(yes_no(valid)),
                       num(rd.number(a.get("sigma0"))), num(rd.number(a.get("sigma0_px"))), text(key)])

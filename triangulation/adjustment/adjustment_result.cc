@@ -221,6 +221,24 @@ nlohmann::json PointStatisticsToJson(const PointStatistics& s) {
           {"spatial_rmse_m", s.spatial_rmse_m}};
 }
 
+std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, double limit) {
+  std::vector<ResultWarning> out;
+  for (const auto& g : solve.groups) {
+    if (g.n_observations == 0 || !(g.rms > limit)) continue;
+    out.push_back({kWarningGroupRms,
+                   g.name,
+                   g.rms,
+                   limit,
+                   StringPrintf("residual group %s: RMS %.3g sigma over %d observations (limit %.3g): the "
+                                "model does not fit these observations, or their sigmas are too small",
+                                g.name.c_str(),
+                                g.rms,
+                                g.n_observations,
+                                limit)});
+  }
+  return out;
+}
+
 nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   nlohmann::json j;
   j["kind"] = "adjust";
@@ -242,6 +260,13 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   for (const auto& g : r.solve.groups)
     groups.push_back({{"name", g.name}, {"n", g.n_observations}, {"rms_sigma", g.rms}});
   j["groups"] = groups;
+  j["warnings"] = nlohmann::json::array();
+  for (const auto& w : r.warnings)
+    j["warnings"].push_back({{"name", w.name},
+                             {"subject", w.subject},
+                             {"value", w.value},
+                             {"limit", w.limit},
+                             {"message", w.message}});
   j["cameras"] = nlohmann::json::array();
   for (const auto& c : r.cameras) {
     nlohmann::json sigma = nlohmann::json::object(), free = nlohmann::json::array();
@@ -370,6 +395,7 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += SnoopingLines(r);
   for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
   out += ValidityLines(r);
+  for (const auto& w : r.warnings) out += "warning: " + w.message + "\n";
   return out;
 }
 
@@ -399,6 +425,8 @@ std::string FormatComparison(const AdjustmentResult& a, const AdjustmentResult& 
   out += SnoopingLines(b);
   for (const auto& w : b.determinability.warnings) out += "warning: " + w + "\n";
   out += ValidityLines(a) + ValidityLines(b);
+  for (const auto& w : a.warnings) out += "warning (conventional): " + w.message + "\n";
+  for (const auto& w : b.warnings) out += "warning: " + w.message + "\n";
   return out;
 }
 

@@ -139,6 +139,25 @@ struct Determinability {
   bool determinable() const { return covariance_ok; }
 };
 
+/// A finding that makes a result doubtful, by name, for people and programs (JSON `warnings`:
+/// [{name, subject, value, limit, message}]).
+struct ResultWarning {
+  std::string name;     // kWarningGroupRms, ...
+  std::string subject;  // what it is about (for kWarningGroupRms the residual group)
+  double value = 0, limit = 0;
+  std::string message;  // one sentence for people
+};
+
+/// Name of the warning for a residual group whose RMS in a-priori sigmas exceeds the limit: the
+/// model does not fit those observations (or their sigmas are far too small).
+inline constexpr const char* kWarningGroupRms = "group_rms";
+/// The limit of that RMS, in sigmas: with right sigmas a group's RMS is about 1 (up to the
+/// redundancy share), so 3 is far outside any chance.
+inline constexpr double kGroupRmsLimit = 3.0;
+
+/// One kWarningGroupRms warning per residual group of `solve` whose RMS exceeds `limit`.
+std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, double limit = kGroupRmsLimit);
+
 struct AdjustmentResult {
   calib::SolveReport solve;
   std::vector<std::string> free_interior;  // names; empty = conventional
@@ -154,6 +173,7 @@ struct AdjustmentResult {
   std::vector<std::string> notes;                   // points left out, and why
   std::string frame;                                // the object frame, stated
   std::string datum;                                // how the datum is defined, stated
+  std::vector<ResultWarning> warnings;              // the result is doubtful: by name
   SnoopingSummary snooping;
   /// False when the run must not be trusted: not converged, singular, rejection cap reached,
   /// sigma0 above AdjustOptions::max_sigma0; `invalid_reasons` says why (exit 3).

@@ -748,6 +748,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     result.Invalidate("singular: " + std::to_string(result.determinability.undetermined.size()) +
                       " parameter(s) not determinable (" +
                       result.determinability.undetermined.front() + ", ...)");
+  result.warnings = GroupRmsWarnings(result.solve);
   return result;
 }
 

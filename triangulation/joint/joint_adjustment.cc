@@ -7,7 +7,9 @@
 #include <map>
 #include <set>
 
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/string_printf.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
 #include "calib/residuals/stitching.h"
@@ -47,6 +49,20 @@ std::vector<std::string> MappingEntryNames(MappingModel model) {
   return names;
 }
 
+// The mapping of `s` under `model`, plain form: exact towards a richer model; towards a simpler
+// one the entries `model` has of the homography about the sub-image centre (the centre keeps its
+// place).
+std::vector<double> ConvertedParams(const calib::SubimageMapping& s, MappingModel model) {
+  if (model == s.model) return s.params;
+  Eigen::Matrix3d centre = Eigen::Matrix3d::Identity(), uncentre = Eigen::Matrix3d::Identity();
+  centre(0, 2) = 0.5 * (s.width_px - 1);
+  centre(1, 2) = 0.5 * (s.height_px - 1);
+  uncentre.topRightCorner<2, 1>() = -centre.topRightCorner<2, 1>();
+  const std::vector<double> about_centre =
+      calib::ParamsFromHomography(model, calib::HomographyFromParams(s.model, s.params.data()) * centre);
+  return calib::ParamsFromHomography(model, calib::HomographyFromParams(model, about_centre.data()) * uncentre);
+}
+
 }  // namespace
 
 std::string MappingScopeName(MappingScope scope) {
@@ -57,6 +73,13 @@ MappingScope ParseMappingScope(const std::string& text) {
   if (text == "per-flight") return MappingScope::kPerFlight;
   if (text == "per-exposure") return MappingScope::kPerExposure;
   throw ConfigError("--joint-stitching must be per-flight or per-exposure (got '" + text + "')");
+}
+
+std::optional<calib::MappingModel> ParseJointModel(const std::string& text) {
+  if (text == "auto") return std::nullopt;
+  if (const auto model = calib::ParseMappingModel(text)) return model;
+  throw ConfigError("--joint-model must be translation, conformal, affine, projective or auto (got '" + text +
+                    "')");
 }
 
 void JointOptions::Validate(const Project& project) const {
@@ -99,14 +122,14 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
     m.camera = camera_id;
     m.subimage = subimage;
     m.exposure = exposure;
-    m.model = s.model;
-    m.conditioning = s.Conditioning();
-    m.initial_plain = s.params;
-    m.values = calib::ConditionedFromPlain(s.model, m.conditioning, s.params);
     m.base = std::find(options.base_ids.begin(), options.base_ids.end(), subimage) != options.base_ids.end();
+    m.model = options.model && !m.base ? *options.model : s.model;
+    m.conditioning = calib::MappingConditioning::ForSubimage(m.model, s.width_px, s.height_px);
+    m.initial_plain = ConvertedParams(s, m.model);
+    m.values = calib::ConditionedFromPlain(m.model, m.conditioning, m.initial_plain);
     m.block = builder.AddBlock("mapping " + camera_id + " " + subimage + (exposure.empty() ? "" : " " + exposure),
                                m.values.data(), static_cast<int>(m.values.size()),
-                               calib::BlockKind::kMapping, MappingEntryNames(s.model));
+                               calib::BlockKind::kMapping, MappingEntryNames(m.model));
     if (m.base) builder.FixBlock(m.block);
     mapping_index[key] = &m;
     return m;
@@ -190,15 +213,22 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
       for (const auto& frame : stitch::GroupByFrame(camera, camera_rows, project.stitching_file)) {
         ExposureStitching stats;
         stats.image = frame.frame;
-        // Before: the exposure's own stitching adjustment with the camera file's models.
-        try {
-          MappingModel model = MappingModel::kTranslation;
-          for (const auto& s : camera.subimages)
-            if (static_cast<int>(s.model) > static_cast<int>(model)) model = s.model;
-          const auto alone = stitch::AdjustFrame(camera, frame, model, stitch_options);
-          if (alone.converged) stats.sigma0_before_px = alone.sigma0_px;
-        } catch (const Error&) {
-          // under-determined alone: no "before" figure
+        // Before: the exposure's own stitching adjustment with the joint model (or the camera
+        // file's richest), the caller's when it has it.
+        if (const auto it = options.stitching_sigma0_before_px.find(frame.frame);
+            it != options.stitching_sigma0_before_px.end()) {
+          stats.sigma0_before_px = it->second;
+        } else {
+          try {
+            MappingModel model = MappingModel::kTranslation;
+            for (const auto& s : camera.subimages)
+              if (static_cast<int>(s.model) > static_cast<int>(model)) model = s.model;
+            if (options.model) model = *options.model;
+            const auto alone = stitch::AdjustFrame(camera, frame, model, stitch_options);
+            if (alone.converged) stats.sigma0_before_px = alone.sigma0_px;
+          } catch (const Error&) {
+            // under-determined alone: no "before" figure
+          }
         }
         FrameStitchResiduals& fr = frame_residuals[frame.frame];
         for (const auto& ref : frame.references) {
@@ -242,6 +272,11 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
                      ? "reference points (maker-surveyed virtual positions) fix the focal plane"
                      : "base sub-images keep their camera-file mapping:";
   for (const auto& b : options.base_ids) result.datum += " " + b;
+  result.mapping_model = options.model ? std::string(calib::MappingModelName(*options.model)) : "camera file";
+  result.mapping_model_reason =
+      !options.model_reason.empty() ? options.model_reason
+      : options.model               ? "given by the caller"
+                                    : "each sub-image keeps its camera-file model";
 
   // Mapping estimates with sigmas (plain form) and their correlations with the interior.
   std::vector<BlockId> blocks;
@@ -317,6 +352,8 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
 nlohmann::json JointResultToJson(const JointResult& result) {
   nlohmann::json j = AdjustmentToJson(result.adjustment);
   j["mapping_scope"] = MappingScopeName(result.scope);
+  j["mapping_model"] = result.mapping_model;
+  j["mapping_model_reason"] = result.mapping_model_reason;
   j["datum"] = result.datum;
   j["mapping_covariance_ok"] = result.mapping_covariance_ok;
   nlohmann::json subimages = nlohmann::json::array();
@@ -345,6 +382,104 @@ nlohmann::json JointResultToJson(const JointResult& result) {
     correlations.push_back({{"a", h.a}, {"b", h.b}, {"correlation", h.correlation}});
   j["mapping_interior_correlations"] = correlations;
   return j;
+}
+
+stitch::BatchResult StitchExposures(const Project& project, const stitch::BatchOptions& options,
+                                    double default_sigma_px, Progress* progress) {
+  if (project.stitching_file.empty())
+    ThrowInputError({project.path, 0}, "the project names no stitching measurements (stitching:)");
+  std::string camera_id;
+  for (const auto& [id, camera] : project.cameras) {
+    if (camera.subimages.empty()) continue;
+    if (!camera_id.empty())
+      throw ConfigError(project.path + ": the flight's stitching is run for one camera with sub-images (found " +
+                        camera_id + " and " + id + ")");
+    camera_id = id;
+  }
+  if (camera_id.empty()) ThrowInputError({project.path, 0}, "no camera of the project has sub-images to stitch");
+  const calib::Camera& camera = project.cameras.at(camera_id);
+  std::vector<stitch::StitchObservation> rows;
+  for (const auto& row : stitch::ReadStitchObservations(project.stitching_file, default_sigma_px)) {
+    const Exposure* e = project.FindExposure(row.frame);
+    if (e && e->camera == camera_id) rows.push_back(row);  // the stitching of the block's exposures
+  }
+  const auto frames = stitch::GroupByFrame(camera, rows, project.stitching_file);
+  if (frames.empty())
+    ThrowInputError({project.stitching_file, 0}, "no stitching measurements of the block's exposures");
+  return stitch::RunStitchBatch(camera, frames, options, progress);
+}
+
+calib::Camera JointMappingsFromStitching(const calib::Camera& camera, const stitch::BatchResult* batch,
+                                         const stitch::BatchOptions& batch_options,
+                                         std::optional<calib::MappingModel> forced, JointOptions* options) {
+  options->model = forced;
+  if (!batch || batch->frames.empty()) {
+    options->model_reason = forced ? "given by the user; starting from the camera file's mappings"
+                                   : "each sub-image keeps its camera-file model (no stitching measurements)";
+    return camera;
+  }
+  const MappingModel model = forced ? *forced : stitch::FlightModel(*batch, batch_options);
+  const std::string name(calib::MappingModelName(model));
+  options->model = model;
+  for (const stitch::FrameRun& run : batch->frames) {
+    const stitch::FrameAdjustment* alone = run.adjustment.model == model ? &run.adjustment : nullptr;
+    if (!alone && run.choice)
+      for (const auto& c : run.choice->candidates)
+        if (c.model == model && c.determinable) alone = &c.adjustment;
+    if (alone && alone->converged) options->stitching_sigma0_before_px[alone->frame] = alone->sigma0_px;
+  }
+  std::string reason;
+  if (forced) {
+    reason = "given by the user";
+  } else if (batch_options.model) {
+    reason = "the model the stitching was run with";
+  } else {
+    const auto chosen = std::count_if(batch->frames.begin(), batch->frames.end(),
+                                      [&](const stitch::FrameRun& run) { return run.adjustment.model == model; });
+    reason = "chosen by the stitching F test (alpha " + FormatNumber(batch_options.alpha, 3) + ") in " +
+             std::to_string(chosen) + " of " + std::to_string(batch->frames.size()) + " exposures";
+  }
+  if (auto mean = stitch::FlightMeanCamera(camera, *batch, model)) {
+    options->model_reason = reason + "; starting from the stitching's flight-mean " + name + " mappings";
+    return *mean;
+  }
+  options->model_reason = reason + "; starting from the camera file's mappings (the stitching did not adjust " +
+                          name + " in every exposure)";
+  return camera;
+}
+
+calib::Camera JointUpdatedCamera(const calib::Camera& camera, const std::string& camera_id,
+                                 const JointResult& result) {
+  calib::Camera out = camera;
+  for (const auto& estimate : result.adjustment.cameras)
+    if (estimate.id == camera_id) out = UpdatedCamera(camera, estimate);
+  for (const auto& m : result.mappings) {
+    if (m.camera != camera_id || !m.exposure.empty()) continue;
+    const int k = out.SubimageIndex(m.subimage);
+    if (k < 0) continue;
+    out.subimages[k].model = m.model;
+    out.subimages[k].params = m.params;
+  }
+  return out;
+}
+
+std::string FormatJointSummary(const JointResult& result) {
+  int free = 0;
+  for (const auto& m : result.mappings) free += m.base ? 0 : 1;
+  std::string out = "joint mappings: " + result.mapping_model + ", " + MappingScopeName(result.scope) + ", " +
+                    std::to_string(free) + " free (" + result.mapping_model_reason + ")\n";
+  out += "focal-plane datum: " + result.datum + "\n";
+  std::vector<double> before, after;
+  for (const auto& s : result.stitching) {
+    if (std::isfinite(s.sigma0_before_px)) before.push_back(s.sigma0_before_px);
+    if (std::isfinite(s.sigma0_after_px)) after.push_back(s.sigma0_after_px);
+  }
+  if (!result.stitching.empty())
+    out += StringPrintf("stitching sigma0 per exposure (median of %zu): before %.3f px, after %.3f px\n",
+                        result.stitching.size(), Median(before), Median(after));
+  for (const auto& h : result.mapping_interior_correlations)
+    out += StringPrintf("mapping/interior correlation %.3f: %s ~ %s\n", h.correlation, h.a.c_str(), h.b.c_str());
+  return out;
 }
 
 }  // namespace aerocal::triangulation

@@ -11,9 +11,14 @@
 // (MappingScope), in the conditioned parameterisation (calib/camera/subimage_mapping.h).
 // Datum of the focal plane: the base sub-images keep their camera-file mapping; without base
 // sub-images the reference points carry it. The result states which.
+// Mapping model: each sub-image's camera-file model, or one model for every free sub-image
+// (JointOptions::model), normally the one the flight's stitching chose by the F test
+// (JointMappingsFromStitching), starting from the stitching's flight-mean mappings.
 #pragma once
 
 #include <limits>
+#include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -21,9 +26,14 @@
 
 #include "calib/camera/subimage_mapping.h"
 #include "calib/problem/problem_builder.h"
+#include "stitch/adjustment/flight_stability.h"
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
+
+namespace aerocal {
+class Progress;
+}
 
 namespace aerocal::triangulation {
 
@@ -31,6 +41,9 @@ enum class MappingScope { kPerFlight, kPerExposure };
 std::string MappingScopeName(MappingScope scope);
 /// "per-flight" | "per-exposure"; ConfigError otherwise.
 MappingScope ParseMappingScope(const std::string& text);
+/// --joint-model: "translation" | "conformal" | "affine" | "projective", or "auto" (nullopt: the
+/// model the flight's stitching chooses); ConfigError otherwise.
+std::optional<calib::MappingModel> ParseJointModel(const std::string& text);
 
 struct JointOptions {
   AdjustOptions adjust;
@@ -38,6 +51,15 @@ struct JointOptions {
   std::vector<std::string> base_ids;  // sub-images held at the camera file's mapping (datum)
   bool use_stitching = true;          // the project's stitching file, when it names one
   double stitch_sigma_px = 0.1;       // where stitch_obs.csv has no sigma_px, > 0
+  /// Model of every free sub-image's mapping; nullopt: each its camera-file model. Starting values
+  /// are the camera file's mappings converted (exact towards a richer model, about the sub-image
+  /// centre towards a simpler one). Base sub-images keep their own.
+  std::optional<calib::MappingModel> model;
+  std::string model_reason;  // why that model, in words (written to the result)
+  /// Stitching sigma0 (px) of each exposure's own stitching adjustment, by image: the "before"
+  /// figures when the caller has them (JointMappingsFromStitching); other exposures are adjusted
+  /// alone here.
+  std::map<std::string, double> stitching_sigma0_before_px;
   /// ConfigError for an unknown base sub-image or a project without sub-image observations,
   /// InputError when the focal plane has no datum (no base sub-image and no reference point).
   void Validate(const Project& project) const;
@@ -68,13 +90,43 @@ struct JointResult {
   std::vector<ExposureStitching> stitching;
   std::vector<calib::HighCorrelation> mapping_interior_correlations;  // |rho| above threshold
   bool mapping_covariance_ok = false;
+  std::string mapping_model;         // of the free mappings ("affine"), or "camera file"
+  std::string mapping_model_reason;  // JointOptions::model_reason
 };
 
 JointResult AdjustJoint(const Project& project, const JointOptions& options);
 
+/// Every exposure of `project`'s stitching measurements (`stitching:`) adjusted as
+/// `aerocal stitch` does (`options.model` nullopt: per exposure the model the F test chooses),
+/// for the project's one camera with sub-images. InputError when the project names no stitching
+/// measurements or has no camera with sub-images, ConfigError when it has several.
+stitch::BatchResult StitchExposures(const Project& project, const stitch::BatchOptions& options,
+                                    double default_sigma_px, Progress* progress);
+
+/// Mapping model and starting mappings of the joint adjustment from the flight's stitching
+/// (`batch`, run with `batch_options`; null: no stitching measurements): `forced` when given, else
+/// the flight's model (stitch::FlightModel: with --model auto the one the F test chose in most
+/// exposures), or without stitching the camera file's models. Sets options->model,
+/// options->model_reason and options->stitching_sigma0_before_px (each exposure's stitching with
+/// that model); returns `camera` carrying the starting mappings (the stitching's flight means of
+/// that model, stitch::FlightMeanCamera, when it was adjusted in every exposure).
+calib::Camera JointMappingsFromStitching(const calib::Camera& camera, const stitch::BatchResult* batch,
+                                         const stitch::BatchOptions& batch_options,
+                                         std::optional<calib::MappingModel> forced, JointOptions* options);
+
+/// `camera` with the joint estimate: interior of camera `camera_id` and the flight's mappings
+/// (per-exposure mappings are not carried: the camera keeps its own).
+calib::Camera JointUpdatedCamera(const calib::Camera& camera, const std::string& camera_id,
+                                 const JointResult& result);
+
+/// Terminal lines of the joint part: mapping model and why, every free mapping's largest
+/// |estimate - start| / sigma, stitching sigma0 before/after (median over exposures), the
+/// mapping/interior correlations above the threshold.
+std::string FormatJointSummary(const JointResult& result);
+
 /// AdjustmentToJson plus `subimages` (FORMATS.md: {id, model, params, sigma}, with `exposure` for
-/// per-exposure mappings), `datum`, `mapping_scope`, `stitching_per_exposure` and
-/// `mapping_interior_correlations`.
+/// per-exposure mappings), `datum`, `mapping_scope`, `mapping_model`, `mapping_model_reason`,
+/// `stitching_per_exposure` and `mapping_interior_correlations`.
 nlohmann::json JointResultToJson(const JointResult& result);
 
 }  // namespace aerocal::triangulation

@@ -46,6 +46,11 @@ std::string Line(const char* format, double a, double b, double c) {
   return buffer;
 }
 
+// One terminal line per warning of an adjustment, naming it.
+void AddWarnings(const std::string& name, const AdjustmentResult& result, FlightWorkflowResult* out) {
+  for (const auto& w : result.warnings) out->summary.push_back("warning (" + name + "): " + w.message);
+}
+
 }  // namespace
 
 FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Progress* progress) {
@@ -76,15 +81,14 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   doc["frame"] = object_frame.Description();
 
   // 1. Stitching of every exposure, model chosen per frame by the F test, and stability.
+  stitch::BatchOptions batch;
+  batch.stitch.base_ids = options.base_ids;
+  std::optional<stitch::BatchResult> stitching;
   if (!project.stitching_file.empty() && !camera.subimages.empty()) {
-    const auto rows = stitch::ReadStitchObservations(project.stitching_file, options.stitch_sigma_px);
-    const auto frames = stitch::GroupByFrame(camera, rows, project.stitching_file);
-    stitch::BatchOptions batch;
-    batch.stitch.base_ids = options.base_ids;
-    const stitch::BatchResult result = stitch::RunStitchBatch(camera, frames, batch, nullptr);
-    doc["stitching"] = stitch::StitchResultToJson(result, batch);
+    stitching = StitchExposures(project, batch, options.stitch_sigma_px, nullptr);
+    doc["stitching"] = stitch::StitchResultToJson(*stitching, batch);
     char line[256];
-    std::snprintf(line, sizeof(line), "stitching: %zu exposures, sigma0 %.3f px, model %s", frames.size(),
+    std::snprintf(line, sizeof(line), "stitching: %zu exposures, sigma0 %.3f px, model %s", stitching->frames.size(),
                   doc["stitching"].value("sigma0_px", 0.0), doc["stitching"].value("model", std::string("?")).c_str());
     out.summary.push_back(line);
   } else {
@@ -113,38 +117,54 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   CheckStep("conventional", conventional, &out);
   CheckStep("self-calibration", self_calibration, &out);
   out.calibrated_camera = UpdatedCamera(camera, self_calibration.cameras.at(0));
-  for (const AdjustmentResult* r : {static_cast<const AdjustmentResult*>(&conventional), &self_calibration})
-    out.summary.push_back(std::string(r == &conventional ? "conventional" : "self-calibration") +
-                          Line(": sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)", r->sigma0_px,
-                               r->check.spatial_rmse_m, r->check.n));
+  for (const AdjustmentResult* r : {static_cast<const AdjustmentResult*>(&conventional), &self_calibration}) {
+    const std::string name = r == &conventional ? "conventional" : "self-calibration";
+    out.summary.push_back(name + Line(": sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)", r->sigma0_px,
+                                      r->check.spatial_rmse_m, r->check.n));
+    AddWarnings(name, *r, &out);
+  }
 
   // 3. Joint stitching + triangulation on the raw sub-image observations.
   if (options.joint && fs::exists(subimage_project) && !camera.subimages.empty()) {
-    const Project raw = ToAdjustmentFrame(WithCamera(ReadProject(subimage_project), camera, options.camera_file),
-                                          object_frame);
     JointOptions joint_options;
     joint_options.adjust = self_options;
     joint_options.base_ids = options.base_ids;
     joint_options.stitch_sigma_px = options.stitch_sigma_px;
+    // The mapping model the flight's stitching chose (or the one given), from its flight means.
+    const calib::Camera start = JointMappingsFromStitching(camera, stitching ? &*stitching : nullptr, batch,
+                                                           options.joint_model, &joint_options);
+    const Project raw =
+        ToAdjustmentFrame(WithCamera(ReadProject(subimage_project), start, options.camera_file), object_frame);
     JointResult joint = AdjustJoint(raw, joint_options);
     ToInputFrame(object_frame, &joint.adjustment);
+    const double ratio = joint.adjustment.sigma0 / self_calibration.sigma0;
+    if (ratio > kJointSigma0RatioLimit)
+      joint.adjustment.warnings.push_back(
+          {kWarningJointSigma0Ratio, "joint", ratio, kJointSigma0RatioLimit,
+           Line("sigma0 %.3f px against %.3f px of the self-calibration (ratio %.2f): ", joint.adjustment.sigma0_px,
+                self_calibration.sigma0_px, ratio) +
+               "the joint's mapping model (" + joint.mapping_model + ") does not fit the sub-images"});
     nlohmann::json j = JointResultToJson(joint);
     j["name"] = "joint";
     adjustments.push_back(j);
     out.converged = out.converged && joint.adjustment.converged();
     CheckStep("joint", joint.adjustment, &out);
-    out.calibrated_camera = UpdatedCamera(camera, joint.adjustment.cameras.at(0));
-    for (const auto& m : joint.mappings) {
-      if (!m.exposure.empty()) continue;
-      const int k = out.calibrated_camera.SubimageIndex(m.subimage);
-      if (k >= 0) out.calibrated_camera.subimages[k].params = m.params;
-    }
+    out.calibrated_camera = JointUpdatedCamera(camera, raw.cameras.begin()->first, joint);
+    out.summary.push_back("joint: mappings " + joint.mapping_model + " (" + joint.mapping_model_reason + ")");
     out.summary.push_back(Line("joint: sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)",
                                joint.adjustment.sigma0_px, joint.adjustment.check.spatial_rmse_m,
                                joint.adjustment.check.n));
+    AddWarnings("joint", joint.adjustment, &out);
   }
   if (progress) progress->Advance();
   doc["adjustments"] = adjustments;
+  // Every adjustment's warnings in one list, each naming its adjustment.
+  doc["warnings"] = nlohmann::json::array();
+  for (const auto& a : adjustments)
+    for (auto w : a.value("warnings", nlohmann::json::array())) {
+      w["adjustment"] = a["name"];
+      doc["warnings"].push_back(w);
+    }
   doc["converged"] = out.converged;
   doc["valid"] = out.valid;
   doc["failures"] = nlohmann::json::array();

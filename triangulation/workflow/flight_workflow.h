@@ -2,7 +2,9 @@
 // (`aerocal flight`):
 //   1. per-exposure stitching with model comparison (F test) and the flight's stability;
 //   2. conventional triangulation, then self-calibrating triangulation (10 parameters), then the
-//      joint stitching + triangulation adjustment (when raw sub-image observations exist);
+//      joint stitching + triangulation adjustment (when raw sub-image observations exist) with
+//      the mapping model the flight's stitching chose (or the one given), starting from the
+//      stitching's flight-mean mappings;
 //   3. one result document (kind "flight") holding every step's FORMATS.md result, and the
 //      calibrated camera for the next flight.
 #pragma once
@@ -29,7 +31,15 @@ struct FlightWorkflowOptions {
   std::vector<std::string> free_interior = {"c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
   double stitch_sigma_px = 0.1;  // where stitch_obs.csv has no sigma_px
   bool joint = true;             // run the joint adjustment when sub-image observations exist
+  /// Mapping model of the joint step; nullopt: the one the stitching F test chose for the flight.
+  std::optional<calib::MappingModel> joint_model;
 };
+
+/// Warning name when the joint adjustment's sigma0 exceeds the self-calibration's by more than
+/// kJointSigma0RatioLimit: both fit the same image points (raw or virtual), so with a fitting
+/// mapping model the two agree within about 10 %; far above, the mapping model does not fit.
+inline constexpr const char* kWarningJointSigma0Ratio = "joint_sigma0_ratio";
+inline constexpr double kJointSigma0RatioLimit = 1.5;
 
 struct FlightWorkflowResult {
   nlohmann::json document;          // kind "flight"
@@ -39,7 +49,7 @@ struct FlightWorkflowResult {
   /// failing steps and calibrated_camera must not be used (aerocal flight does not write it).
   bool valid = true;
   std::vector<std::pair<std::string, std::string>> failures;  // (step, reason)
-  std::vector<std::string> summary; // one line per step, for the terminal
+  std::vector<std::string> summary; // one line per step, for the terminal (and each warning)
 };
 
 /// Runs the workflow; `progress` (may be null) advances once per step (5 steps).

@@ -1,0 +1,38 @@
+// `aerocal adjust --joint-stitching per-flight|per-exposure`: the joint stitching + triangulation
+// adjustment (triangulation/joint) of a project measured in raw sub-image pixels. Its options and
+// its run, kept beside cmd_adjust.cc so that the plain adjustment's code stays as it is.
+#pragma once
+
+#include <string>
+
+#include <CLI/CLI.hpp>
+
+#include "triangulation/adjustment/adjust_options.h"
+
+namespace aerocal::tools {
+
+struct JointAdjustArgs {
+  std::string stitching;       // --joint-stitching: per-flight | per-exposure; empty: no joint run
+  std::string model = "auto";  // --joint-model
+  std::string base;            // --base: comma-separated datum sub-images
+  double stitch_sigma_px = 0.1;
+  bool Requested() const { return !stitching.empty(); }
+};
+
+/// OUT.yaml for a single camera, OUT_<id>.yaml for each of several (--write-camera).
+std::string CameraOutputPath(const std::string& out, const std::string& id, bool several);
+
+/// Adds --joint-stitching, --joint-model, --base and --stitch-sigma-px (the last three need the
+/// first).
+void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args);
+
+/// Runs the joint adjustment of `project_path` with `options` (free interior, snooping, priors),
+/// prints the summary, writes the result JSON to `out` and, when `write_camera` is set and the
+/// result is valid, the camera with the refined interior and per-flight mappings. Returns the exit
+/// code (0, or 3 when the result is not valid: AdjustmentResult::valid). ConfigError for
+/// --robust-start, InputError for a project without sub-image observations.
+int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOptions& options,
+                   const std::string& project_path, double default_sigma_px, const std::string& out,
+                   const std::string& write_camera);
+
+}  // namespace aerocal::tools
