@@ -553,7 +553,9 @@ TEST_P(BadInput, ExitsWithItsCodeNamesWhereAndWritesNothing) {
   if (at != std::string::npos) expect.replace(at, 5, dir.path());
   EXPECT_NE(r.output.find(expect), std::string::npos) << "expected '" << expect << "' in\n" << r.output;
   EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
-  if (!c.output.empty()) EXPECT_FALSE(fs::exists(dir.File(c.output))) << c.output << " was written";
+  if (!c.output.empty()) {
+    EXPECT_FALSE(fs::exists(dir.File(c.output))) << c.output << " was written";
+  }
   struct stat st {};
   ASSERT_EQ(::stat("/dev/null", &st), 0);
   EXPECT_TRUE(S_ISCHR(st.st_mode)) << "/dev/null was replaced";

@@ -90,11 +90,12 @@ TEST_F(SnoopingOnTheSimulatedFlight, EveryTestedObservationListsRWMdbAndGroupSiz
       EXPECT_GE(v.test.redundancy(k), 0.0);
       EXPECT_LE(v.test.redundancy(k), 1.0 + 1e-9);
       // MDB = delta0 s / sqrt(r) sigma, in px with the observation's sigma.
-      if (v.test.redundancy(k) > 1e-6)
+      if (v.test.redundancy(k) > 1e-6) {
         EXPECT_NEAR(v.test.mdb_px(k),
                     clean_->snooping.delta0 * clean_->snooping.reference_sigma /
                         std::sqrt(v.test.redundancy(k)) * v.sigma_px,
                     1e-9);
+      }
     }
   }
   EXPECT_GT(tested, 2000);
