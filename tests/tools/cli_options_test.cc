@@ -28,9 +28,8 @@ TEST(CliOptions, StitchModelAutoTestsAtTheGivenAlpha) {
   for (const auto& frame : doc["frames"]) {
     EXPECT_EQ(frame["model_choice"]["alpha"].get<double>(), 0.01);
     EXPECT_NE(frame["model_choice"]["test"].get<std::string>().find("alpha 0.01"), std::string::npos);
-    // The simulated CCDs are affine (--ccd-shear 2e-4 on top of rotation and scale): at 1 % the F
-    // test accepts affine over conformal with 300 ties per frame. (The simulator's default shear,
-    // 2e-5, is below what 300 ties show at 1 %: F = 1.9 and 0.97 against F(0.99) = 2.54.)
+    // CCD shears of 2e-4 (0.7 px across a sub-image): at 1 % the F test still accepts affine over
+    // conformal with 300 ties per frame (with the default 2e-5 it keeps conformal).
     EXPECT_EQ(frame["model"], "affine") << frame["model_choice"]["reason"];
   }
   const auto bad = RunAerocal("stitch --camera " + dir.File("data/camera_nominal.yaml") + " --obs " +
