@@ -1,5 +1,6 @@
 #include "calib/camera/convert_camera.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -52,13 +53,17 @@ int FitParameters(const ModelCamera& from, const ConvertOptions& options,
   const BlockId block = builder.AddBlock("camera", params->data(), Model::kNumParams,
                                          BlockKind::kInterior, names);
   std::vector<int> fixed;
-  for (const auto& name : options.fixed) {
+  std::vector<std::string> held = options.fixed;
+  held.insert(held.end(), options.zero.begin(), options.zero.end());
+  for (const auto& name : held) {
     const int index = IndexOfParam(Model::kParams, name);
     if (index < 0)
       throw ConfigError("ConvertCamera: " + std::string(Model::kName) + " has no parameter '" +
                         name + "'");
     fixed.push_back(index);
   }
+  std::sort(fixed.begin(), fixed.end());
+  fixed.erase(std::unique(fixed.begin(), fixed.end()), fixed.end());
   if (!fixed.empty()) builder.FixEntries(block, fixed);
   const double c_from = from.PrincipalDistanceMm();
   for (const Eigen::Vector2d& pixel : FormatGrid(from.frame, options.fit_grid)) {
@@ -142,6 +147,17 @@ ConversionResult ConvertCamera(const ModelCamera& from, CameraModelId to,
       return decltype(m)::FromOpenCv(cv, from.frame, result.camera.params.data());
     });
     result.exact = exact_out && exact_in;
+  }
+  const std::vector<ParamInfo> table = CameraModelParams(to);
+  for (const std::string& name : options.zero) {
+    int index = -1;
+    for (size_t i = 0; i < table.size(); ++i)
+      if (table[i].name == name) index = static_cast<int>(i);
+    if (index < 0)
+      throw ConfigError("ConvertCamera: " + std::string(CameraModelName(to)) +
+                        " has no parameter '" + name + "'");
+    if (result.camera.params[index] != 0.0) result.exact = false;
+    result.camera.params[index] = 0.0;
   }
   if (!result.exact)
     result.fit_iterations = VisitCameraModel(to, [&](auto m) {

@@ -27,6 +27,9 @@ struct ConvertOptions {
   int check_grid = 101; // residual points per format side (>= 2)
   /// Target parameters (table names) held at their starting values in a fit.
   std::vector<std::string> fixed;
+  /// Target parameters the caller's file format cannot hold: set to 0 and held there (a closed
+  /// form that gives one of them a non-zero value is then not exact and the rest is fitted).
+  std::vector<std::string> zero;
   double max_residual_px = std::numeric_limits<double>::infinity();
 };
 

@@ -1,6 +1,7 @@
 #include "triangulation/import/colmap_import.h"
 
 #include "calib/camera/convert_camera.h"
+#include "calib/camera/formats/camera_formats.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -23,32 +24,10 @@ using internal::StringField;
 using internal::TextRow;
 
 // A COLMAP camera in the registry's COLMAP model (calib/camera/models/colmap.h: OpenCV's formula,
-// COLMAP's pixel origin); the model's parameter count checked against the file.
+// COLMAP's pixel origin): the camera-format reader's row conversion (camera_formats.h).
 calib::ModelCamera ReadColmapCamera(const TextRow& row, const std::string& file,
                                     double pixel_size_mm) {
-  const std::string name = StringField(row, 1, file, "MODEL");
-  const auto model = calib::CameraModelFromColmapName(name);
-  if (!model)
-    ThrowInputError({file, row.line},
-                    "camera model " + name +
-                        " is not supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, "
-                        "RADIAL, OPENCV, FULL_OPENCV)");
-  const size_t num_params = calib::CameraModelParamCount(*model);
-  if (row.fields.size() != 4 + num_params)
-    ThrowInputError({file, row.line}, name + " needs " + std::to_string(num_params) + " parameters");
-  calib::ModelCamera camera;
-  camera.model = *model;
-  camera.frame.pixel_size_mm = pixel_size_mm;
-  camera.frame.width_px = internal::IntegerField(row, 2, file, "WIDTH", 1, 1000000);
-  camera.frame.height_px = internal::IntegerField(row, 3, file, "HEIGHT", 1, 1000000);
-  for (size_t k = 0; k < num_params; ++k)
-    camera.params.push_back(internal::BoundedField(row, 4 + k, file, "PARAMS", -1e7, 1e7));
-  // Focal lengths (f, or fx and fy) lead every COLMAP model's parameters.
-  const bool two_focals = name == "PINHOLE" || name == "OPENCV" || name == "FULL_OPENCV";
-  if (!(camera.params[0] > 0) || (two_focals && !(camera.params[1] > 0)))
-    ThrowInputError({file, row.line}, "focal length must be > 0 px (got " +
-                                          FormatNumber(camera.params[0]) + ")");
-  return camera;
+  return calib::ColmapCameraFromFields(row.fields, {file, row.line}, pixel_size_mm);
 }
 
 }  // namespace

@@ -1,5 +1,6 @@
 #include "triangulation/import/dbat_import.h"
 
+#include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -10,7 +11,6 @@
 #include <map>
 #include <sstream>
 
-#include <tinyxml2.h>
 #include <set>
 
 namespace aerocal::triangulation {
@@ -23,85 +23,18 @@ using internal::StringField;
 using Model = calib::Camera::Model;
 constexpr double kDegToRad = M_PI / 180.0;
 
-// The DBAT camera XML, read with an XML parser (tinyxml2: comments, CDATA and nesting handled):
-// document/cameras/camera, its DIRECT children only (a <pp> inside <std> is a sigma, not the
-// principal point).
-struct XmlCamera {
-  std::string path;
-  const tinyxml2::XMLElement* camera = nullptr;
-
-  const tinyxml2::XMLElement* Child(const char* tag) const { return camera->FirstChildElement(tag); }
-  SourceRef Where(const tinyxml2::XMLElement* e) const {
-    return {path, e ? e->GetLineNum() : camera->GetLineNum()};
-  }
-  // Text of <tag> split on commas, trimmed; empty when the tag is absent.
-  std::vector<std::string> List(const char* tag) const {
-    const tinyxml2::XMLElement* e = Child(tag);
-    if (!e || !e->GetText()) return {};
-    return SplitCommaList(e->GetText(), {true, true});
-  }
-  // Numbers of <tag> within [-bound, bound]; at least min_size of them when the tag is required.
-  std::vector<double> Numbers(const char* tag, size_t min_size, double bound) const {
-    std::vector<double> out;
-    for (const auto& s : List(tag)) {
-      const auto v = ParseDouble(s);
-      if (!v || !(std::abs(*v) <= bound))
-        ThrowInputError(Where(Child(tag)), std::string("<") + tag + "> must hold numbers within +-" +
-                                               FormatNumber(bound) + " (got '" + s + "')");
-      out.push_back(*v);
-    }
-    if (out.size() < min_size)
-      ThrowInputError(Where(Child(tag)), std::string("<") + tag + "> needs " +
-                                             std::to_string(min_size) + " values");
-    return out;
-  }
-};
-
 std::string Stem(const std::string& path) { return std::filesystem::path(path).stem().string(); }
 
 }  // namespace
 
 calib::Camera ReadDbatCamera(const std::string& path) {
-  const std::string text = ReadTextFile(path);
-  tinyxml2::XMLDocument doc;
-  if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS)
-    ThrowInputError({path, doc.ErrorLineNum()},
-                    std::string("invalid XML: ") + doc.ErrorName());
-  const tinyxml2::XMLElement* root = doc.RootElement();
-  const tinyxml2::XMLElement* cameras = root ? root->FirstChildElement("cameras") : nullptr;
-  XmlCamera xml{path, cameras ? cameras->FirstChildElement("camera") : nullptr};
-  if (!xml.camera)
-    ThrowInputError({path, root ? root->GetLineNum() : 0},
-                    "no <document><cameras><camera> element (not a DBAT camera file)");
+  const calib::CameraFile file = calib::ReadDbatCameraXml(path, {});
   calib::Camera camera;
-  const auto name = xml.List("name");
-  camera.name = name.empty() ? Stem(path) : name.front();
-  const auto image = xml.Numbers("image", 2, 1e6);
-  if (!(image[0] >= 1 && image[1] >= 1) || image[0] != std::floor(image[0]) ||
-      image[1] != std::floor(image[1]))
-    ThrowInputError(xml.Where(xml.Child("image")),
-                    "<image> must be two positive integers W,H (px), at most 1e6");
-  camera.width_px = static_cast<int>(image[0]);
-  camera.height_px = static_cast<int>(image[1]);
-  const auto sensor = xml.List("sensor");
-  if (sensor.size() < 2) ThrowInputError(xml.Where(xml.Child("sensor")), "<sensor> must be W,H or auto,H (mm)");
-  const auto height_mm = ParseDouble(sensor[1]);
-  if (!height_mm || !(*height_mm > 0 && *height_mm <= 1000))
-    ThrowInputError(xml.Where(xml.Child("sensor")), "<sensor> height must be > 0 and <= 1000 mm");
-  camera.pixel_size_mm = *height_mm / camera.height_px;  // square pixels; "auto" width
-  const double w_mm = camera.width_px * camera.pixel_size_mm, h_mm = *height_mm;
-  double c = xml.Child("cc") ? xml.Numbers("cc", 1, 1e4)[0] : 0.0;
-  if (c == 0) c = xml.Numbers("focal", 1, 1e4)[0];
-  if (!(c > 0)) ThrowInputError(xml.Where(xml.Child(xml.Child("cc") ? "cc" : "focal")), "<cc>/<focal> must be > 0 mm");
-  auto pp = xml.Child("pp") ? xml.Numbers("pp", 2, 1e4) : std::vector<double>{0, 0};
-  if (pp[0] == 0 && pp[1] == 0) pp = {w_mm / 2, h_mm / 2};
-  camera.interior[Model::kC] = c;
-  camera.interior[Model::kX0] = pp[0] - w_mm / 2;
-  camera.interior[Model::kY0] = h_mm / 2 - pp[1];
-  const auto k = xml.Numbers("K", 0, 1.0);
-  for (size_t i = 0; i < k.size() && i < 3; ++i) camera.interior[Model::kK1 + i] = k[i];
-  const auto p = xml.Numbers("P", 0, 1.0);
-  for (size_t i = 0; i < p.size() && i < 2; ++i) camera.interior[Model::kP1 + i] = p[i];
+  camera.name = file.name;
+  camera.pixel_size_mm = file.camera.frame.pixel_size_mm;
+  camera.width_px = file.camera.frame.width_px;
+  camera.height_px = file.camera.frame.height_px;
+  for (int i = 0; i < Model::kNumParams; ++i) camera.interior[i] = file.camera.params.at(i);
   return camera;
 }
 

@@ -1,0 +1,134 @@
+// Camera files in other tools' languages (issue 15): one reader and one writer per format, each in
+// its own file calib/camera/formats/<format>_format.cc, converting that tool's conventions at this
+// boundary and nowhere else. A format reads into the registry model that IS its model
+// (camera_model.h: a COLMAP camera stays colmap_*, a Metashape one metashape_frame, a DJI or
+// OpenSfM one opencv); nothing is refitted on reading. Writing takes a camera already in the
+// format's model (FormatTarget says which; the `camera convert` command converts first and reports
+// how exactly). The OpenCV FileStorage format lives in tools/ (OpenCV stays out of calib).
+//
+// Conventions per format (sources in the README of this folder, calib/README.md "Camera file
+// formats"):
+// - colmap: cameras.txt `CAMERA_ID MODEL WIDTH HEIGHT PARAMS[]`; pixel origin converted by the
+//   colmap_* models (models/colmap.h). Shared with the COLMAP import (ColmapCameraFromFields).
+// - metashape: <calibration> (projection frame, width, height, f, cx, cy, b1, b2, k1-k4, p1-p4,
+//   optional <covariance><params>names</params><coeffs>row-major</coeffs>) or a project/cameras
+//   XML (<sensor id=...> holding it); models/metashape.h converts.
+// - pix4d: the .cam text file (F, Px, Py mm; K1-K3 (or R1-R3), T1, T2; sensor size in the comment
+//   line); models/pix4d.h converts.
+// - opensfm: cameras.json / reconstruction.json (perspective, simple_radial, radial, brown,
+//   fisheye): focal and principal point normalised by max(W, H), principal point from the image
+//   centre; OpenSfM's normalised coordinates put the top-left pixel centre at
+//   (0.5 - W / 2) / max(W, H), so cx = (W - 1) / 2 + c_x max(W, H) in aerocal/OpenCV pixels.
+// - dji: XMP DewarpData `[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3` (DewarpDataK6 adds k4, k5, k6) with
+//   cx, cy offsets from the image centre: cx_opencv = W / 2 + cx, cy_opencv = H / 2 + cy (the DJI
+//   manuals: "origin point: photo center"; which centre, W / 2 or (W - 1) / 2, they do not say:
+//   the other reading moves the principal point by 0.5 px).
+// - dbat: DBAT camera XML (c, pp mm from the top-left corner, y down, K1-K3, P1, P2): our
+//   correction model (brown_fraser_10 without B1, B2).
+// - kalibr: camchain YAML (camera_model pinhole, distortion_model radtan / equidistant,
+//   intrinsics fu fv pu pv, distortion_coeffs, resolution); pixels as OpenCV.
+#pragma once
+
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calib/camera/camera_model.h"
+#include "calib/camera/convert_camera.h"
+#include "calib/core/error.h"
+
+namespace aerocal::calib {
+
+/// A camera as a file holds it.
+struct CameraFile {
+  std::string name;
+  ModelCamera camera;
+  /// False when neither the file nor the caller gave a pixel size (frame.pixel_size_mm is then a
+  /// placeholder of 0.001 mm: geometry in pixels is unaffected, mm values are meaningless).
+  bool pixel_size_known = true;
+  /// Covariance of camera.params (table order and units) where the file gives it.
+  std::optional<Eigen::MatrixXd> covariance;
+  std::vector<std::string> notes;  // what the reader assumed or left out
+};
+
+/// What the command line adds to a file.
+struct CameraReadOptions {
+  std::string camera_id;     // picks one camera of a file holding several ("" = the only one)
+  int width_px = 0;          // 0 = from the file; given and contradicting the file: InputError
+  int height_px = 0;
+  double pixel_size_mm = 0;  // 0 = from the file (or unknown)
+};
+
+inline constexpr double kPlaceholderPixelSizeMm = 0.001;
+
+/// The registry model a format writes and which of its parameters the format cannot hold (they
+/// must be 0; a conversion fits with them held at 0).
+struct FormatTarget {
+  CameraModelId model;
+  std::vector<std::string> zero_params;
+  bool needs_pixel_size = false;  // the format writes millimetres
+};
+
+/// A camera file expressed in a format's model, with how exactly (result) and, where the source
+/// gives a covariance, the covariance propagated linearly through the conversion's Jacobian.
+struct FileConversion {
+  CameraFile file;
+  ConversionResult result;
+  std::vector<std::string> notes;
+};
+/// ConfigError("--pixel-mm ...") when the target needs a pixel size the source does not give.
+FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& target,
+                                 const ConvertOptions& options = {});
+
+// ---- per format (name: reader, writer) ----
+CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& options);
+void WriteAerocalCamera(const std::string& path, const CameraFile& camera);
+
+CameraFile ReadColmapCameras(const std::string& path, const CameraReadOptions& options);
+void WriteColmapCameras(const std::string& path, const CameraFile& camera);
+/// One cameras.txt row split into fields (CAMERA_ID MODEL WIDTH HEIGHT PARAMS...) -> the
+/// registry's COLMAP model; InputError("FILE:LINE: ...") on a bad row. The COLMAP import uses it.
+ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields, const SourceRef& where,
+                                   double pixel_size_mm);
+
+CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOptions& options);
+void WriteMetashapeCalibration(const std::string& path, const CameraFile& camera);
+
+CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& options);
+void WritePix4dCam(const std::string& path, const CameraFile& camera);
+
+CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options);
+void WriteOpenSfmCameras(const std::string& path, const CameraFile& camera);
+
+CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& options);
+/// The opencv camera of a DewarpData string ("[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" or the 12 values
+/// of DewarpDataK6) for an image of width x height px.
+ModelCamera DjiDewarpDataCamera(const std::string& text, const SourceRef& where, int width_px,
+                                int height_px);
+void WriteDjiDewarpData(const std::string& path, const CameraFile& camera);
+
+CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& options);
+void WriteDbatCameraXml(const std::string& path, const CameraFile& camera);
+
+CameraFile ReadKalibrCamchain(const std::string& path, const CameraReadOptions& options);
+void WriteKalibrCamchain(const std::string& path, const CameraFile& camera);
+
+// ---- shared by the readers ----
+namespace internal {
+/// Applies --width/--height/--pixel-mm to what a file gave (0 = not given): a given value that
+/// contradicts the file is InputError at `where`; a size nobody gave is InputError naming the
+/// options. Marks the pixel size as known or a placeholder.
+void ResolveFormat(CameraFile* file, const CameraReadOptions& options, const SourceRef& where,
+                   int file_width_px, int file_height_px, double file_pixel_size_mm);
+/// A finite number of the whole text within [-bound, bound]; InputError naming `what` otherwise.
+double ParseNumber(const std::string& text, const SourceRef& where, const std::string& what,
+                   double bound = 1e12);
+/// Every parameter in `names` of `camera` is zero (the format can hold the camera).
+void RequireZero(const ModelCamera& camera, const std::vector<std::string>& names,
+                 const std::string& format);
+double Param(const ModelCamera& camera, std::string_view name);
+}  // namespace internal
+
+}  // namespace aerocal::calib

@@ -1,0 +1,157 @@
+// OpenSfM / OpenDroneMap cameras.json (and the "cameras" of a reconstruction.json): a map from
+// camera id to {projection_type, width, height, ...} (opensfm.org/docs/geometry.html "Camera
+// models"). Focal lengths and principal point are normalised by max(W, H); the principal point
+// (c_x, c_y) is measured from the image centre; OpenSfM's normalised image coordinates are
+// ((col + 0.5 - W / 2) / max(W, H), (row + 0.5 - H / 2) / max(W, H)) with (col, row) our pixel
+// (features.normalized_image_coordinates), camera x right, y down, z forward. So in OpenCV pixels
+//   fx = focal_x max(W, H), cx = (W - 1) / 2 + c_x max(W, H) (y alike);
+// perspective (focal, k1, k2), simple_radial (focal, c_x, c_y, k1), radial (focal_x, focal_y,
+// c_x, c_y, k1, k2) and brown (+ p1, p2, k3) use OpenCV's formula: the opencv model, exactly;
+// fisheye (focal, k1, k2: theta_d = theta (1 + k1 theta^2 + k2 theta^4)) is opencv_fisheye.
+#include <algorithm>
+
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+
+namespace aerocal::calib {
+namespace {
+
+using Json = nlohmann::json;
+
+int LineAt(const std::string& text, size_t offset) {
+  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + std::min(offset, text.size()), '\n'));
+}
+// Line of the first `"key"` at or after `from` (the camera's own entry).
+int LineOfKey(const std::string& text, const std::string& key, size_t from) {
+  const size_t at = text.find("\"" + key + "\"", from);
+  return LineAt(text, at == std::string::npos ? from : at);
+}
+
+}  // namespace
+
+CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options) {
+  const std::string text = ReadTextFile(path);
+  Json root;
+  try {
+    root = Json::parse(text);
+  } catch (const Json::parse_error& e) {
+    ThrowInputError({path, LineAt(text, e.byte)}, "invalid JSON");
+  }
+  const Json* cameras = &root;
+  if (root.is_array() && !root.empty() && root[0].is_object() && root[0].contains("cameras"))
+    cameras = &root[0]["cameras"];
+  else if (root.is_object() && root.contains("cameras"))
+    cameras = &root["cameras"];
+  if (!cameras->is_object() || cameras->empty())
+    ThrowInputError({path, 1}, "no cameras (expected {id: {projection_type, width, ...}})");
+  std::string ids;
+  for (auto it = cameras->begin(); it != cameras->end(); ++it) ids += (ids.empty() ? "" : ", ") + it.key();
+  std::string id = options.camera_id;
+  if (id.empty()) {
+    if (cameras->size() > 1)
+      ThrowInputError({path, 1}, "holds " + std::to_string(cameras->size()) +
+                                     " cameras: name one with --camera (" + ids + ")");
+    id = cameras->begin().key();
+  }
+  if (!cameras->contains(id)) ThrowInputError({path, 1}, "no camera '" + id + "' (cameras: " + ids + ")");
+  const Json& c = (*cameras)[id];
+  const size_t from = text.find("\"" + id + "\"");
+  const auto where = [&](const std::string& key) { return SourceRef{path, LineOfKey(text, key, from)}; };
+  if (!c.is_object()) ThrowInputError(where(id), "camera '" + id + "' is not an object");
+  const auto number = [&](const std::string& key, double fallback) {
+    if (!c.contains(key)) return fallback;
+    if (!c[key].is_number()) ThrowInputError(where(key), key + " must be a number");
+    return internal::ParseNumber(FormatNumber(c[key].get<double>(), 17), where(key), key, 1e6);
+  };
+  if (!c.contains("projection_type") || !c["projection_type"].is_string())
+    ThrowInputError(where(id), "missing projection_type");
+  const std::string type = c["projection_type"];
+  const auto size_of = [&](const char* key) {
+    const double v = number(key, 0);
+    if (!(v >= 1 && v <= 1e6) || v != static_cast<int>(v))
+      ThrowInputError(where(key), std::string(key) + " must be an integer within 1 .. 1e6");
+    return static_cast<int>(v);
+  };
+  if (!c.contains("width") || !c.contains("height")) ThrowInputError(where(id), "missing width/height");
+  const int w = size_of("width"), h = size_of("height");
+  const double size = std::max(w, h);
+  const double focal = number("focal", 0);
+  const double focal_x = number("focal_x", focal), focal_y = number("focal_y", focal_x);
+  if (!(focal_x > 0 && focal_y > 0)) ThrowInputError(where(id), "focal length must be > 0");
+  CameraFile file;
+  file.name = id;
+  if (type == "fisheye") {
+    using F = OpenCvFisheyeModel;
+    file.camera.model = F::kId;
+    file.camera.params = {focal_x * size, focal_y * size, 0.5 * (w - 1) + number("c_x", 0) * size,
+                          0.5 * (h - 1) + number("c_y", 0) * size, number("k1", 0), number("k2", 0),
+                          0.0, 0.0};
+  } else if (type == "perspective" || type == "simple_radial" || type == "radial" || type == "brown") {
+    using O = OpenCvModel;
+    file.camera.model = O::kId;
+    file.camera.params.assign(O::kNumParams, 0.0);
+    file.camera.params[O::kFx] = focal_x * size;
+    file.camera.params[O::kFy] = focal_y * size;
+    file.camera.params[O::kCx] = 0.5 * (w - 1) + number("c_x", 0) * size;
+    file.camera.params[O::kCy] = 0.5 * (h - 1) + number("c_y", 0) * size;
+    file.camera.params[O::kK1] = number("k1", 0);
+    file.camera.params[O::kK2] = number("k2", 0);
+    file.camera.params[O::kK3] = number("k3", 0);
+    file.camera.params[O::kP1] = number("p1", 0);
+    file.camera.params[O::kP2] = number("p2", 0);
+  } else {
+    ThrowInputError(where("projection_type"),
+                    "projection_type '" + type +
+                        "' is not supported (perspective, simple_radial, radial, brown, fisheye)");
+  }
+  internal::ResolveFormat(&file, options, where(id), w, h, 0.0);
+  return file;
+}
+
+void WriteOpenSfmCameras(const std::string& path, const CameraFile& file) {
+  const ModelCamera& camera = file.camera;
+  const PixelFrame& f = camera.frame;
+  const double size = std::max(f.width_px, f.height_px);
+  const std::vector<double>& p = camera.params;
+  Json c;
+  c["width"] = f.width_px;
+  c["height"] = f.height_px;
+  const double c_x = (p[2] - 0.5 * (f.width_px - 1)) / size, c_y = (p[3] - 0.5 * (f.height_px - 1)) / size;
+  if (camera.model == OpenCvFisheyeModel::kId) {
+    internal::RequireZero(camera, {"k3", "k4"}, "OpenSfM fisheye");
+    AEROCAL_CHECK(p[0] == p[1] && c_x == 0 && c_y == 0) << "OpenSfM fisheye: fx = fy, centred";
+    c["projection_type"] = "fisheye";
+    c["focal"] = p[0] / size;
+    c["k1"] = p[4];
+    c["k2"] = p[5];
+  } else {
+    using O = OpenCvModel;
+    AEROCAL_CHECK(camera.model == O::kId) << "not opencv";
+    internal::RequireZero(camera, {"k4", "k5", "k6"}, "OpenSfM");
+    const bool perspective = p[O::kFx] == p[O::kFy] && c_x == 0 && c_y == 0 && p[O::kK3] == 0 &&
+                             p[O::kP1] == 0 && p[O::kP2] == 0;
+    if (perspective) {
+      c["projection_type"] = "perspective";
+      c["focal"] = p[O::kFy] / size;
+    } else {
+      c["projection_type"] = "brown";
+      c["focal_x"] = p[O::kFx] / size;
+      c["focal_y"] = p[O::kFy] / size;
+      c["c_x"] = c_x;
+      c["c_y"] = c_y;
+      c["k3"] = p[O::kK3];
+      c["p1"] = p[O::kP1];
+      c["p2"] = p[O::kP2];
+    }
+    c["k1"] = p[O::kK1];
+    c["k2"] = p[O::kK2];
+  }
+  Json root;
+  root[file.name.empty() ? "aerocal" : file.name] = c;
+  WriteFileAtomically(path, root.dump(4) + "\n");
+}
+
+}  // namespace aerocal::calib

@@ -1,0 +1,397 @@
+// Camera files in other tools' formats (calib/camera/formats/, issue 15): every format's writer and
+// reader round-trip a camera of its model exactly; ours -> format -> ours for the simulated aerial
+// camera and a strong drone lens, with the residual each conversion states; the real files of
+// ../shared/data against their published values; the covariance carried through a conversion.
+// (The OpenCV FileStorage format and cv::projectPoints / undistortPoints: tests/tools/.)
+#include "calib/camera/formats/camera_formats.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "calib/core/csv.h"
+#include "tests/support/test_support.h"
+
+namespace aerocal::calib {
+namespace {
+
+using testing::TempDir;
+
+// The simulated flight's aerial camera (as in convert_camera_test): 14000 x 12000 px of 9 um.
+ModelCamera AerialCamera() {
+  return {CameraModelId::kBrownFraser10,
+          {170.038, -0.0024, 0.0015, 3.0e-8, -2.0e-12, 1.0e-16, 2.0e-7, -1.5e-7, 1.0e-5, -8.0e-6},
+          {0.009, 14000, 12000}};
+}
+
+// DJI Phantom 4 RTK record A of ../shared/data/dji_dewarpdata_documented (its published values),
+// 2.41 um pixels (8.8 mm / 3666.67 px design focal length ~ 2.4 um).
+ModelCamera DjiRecordA() {
+  return {CameraModelId::kOpenCv,
+          {3684.48, 3677.57, 2738.24, 1846.05, -0.263482, 0.106788, 3.71107e-5, -3.27247e-4,
+           -0.0300783, 0, 0, 0},
+          {0.0024, 5472, 3648}};
+}
+
+CameraFile File(const ModelCamera& camera, const std::string& name = "cam") {
+  CameraFile file;
+  file.name = name;
+  file.camera = camera;
+  return file;
+}
+
+double MaxDifferencePx(const ModelCamera& a, const ModelCamera& b) {
+  const ConversionResidual r = CompareCameras(a, b, 41);
+  EXPECT_EQ(r.failed_points, 0);
+  return r.max_px;
+}
+
+void ExpectSameParams(const ModelCamera& a, const ModelCamera& b, const char* what) {
+  ASSERT_EQ(a.model, b.model) << what;
+  ASSERT_EQ(a.params.size(), b.params.size()) << what;
+  for (size_t i = 0; i < a.params.size(); ++i)
+    EXPECT_NEAR(a.params[i], b.params[i], 1e-13 * (1 + std::abs(a.params[i]))) << what << " " << i;
+  EXPECT_EQ(a.frame.width_px, b.frame.width_px) << what;
+  EXPECT_EQ(a.frame.height_px, b.frame.height_px) << what;
+}
+
+struct Format {
+  const char* name;
+  std::function<CameraFile(const std::string&, const CameraReadOptions&)> read;
+  std::function<void(const std::string&, const CameraFile&)> write;
+  FormatTarget target;       // for a non-fisheye source
+  bool file_has_size;        // else --width/--height are given to the reader
+  bool file_has_pixel_size;  // else --pixel-mm
+  const char* extension;
+};
+
+std::vector<Format> Formats() {
+  return {
+      {"aerocal", ReadAerocalCamera, WriteAerocalCamera, {CameraModelId::kBrownFraser10, {}, true}, true, true, ".yaml"},
+      {"colmap", ReadColmapCameras, WriteColmapCameras, {CameraModelId::kColmapFullOpenCv, {}}, true, false, ".txt"},
+      {"metashape", ReadMetashapeCalibration, WriteMetashapeCalibration, {CameraModelId::kMetashapeFrame, {}}, true, false, ".xml"},
+      {"pix4d", ReadPix4dCam, WritePix4dCam, {CameraModelId::kPix4dPerspective, {}, true}, false, true, ".cam"},
+      {"opensfm", ReadOpenSfmCameras, WriteOpenSfmCameras, {CameraModelId::kOpenCv, {"k4", "k5", "k6"}}, true, false, ".json"},
+      {"dji", ReadDjiDewarpData, WriteDjiDewarpData, {CameraModelId::kOpenCv, {}}, true, false, ".xmp"},
+      {"dbat", ReadDbatCameraXml, WriteDbatCameraXml, {CameraModelId::kBrownFraser10, {"B1", "B2"}, true}, true, true, ".xml"},
+      {"kalibr", ReadKalibrCamchain, WriteKalibrCamchain, {CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}}, true, false, ".yaml"},
+  };
+}
+
+CameraFile WriteAndRead(const Format& f, const CameraFile& file, const TempDir& dir) {
+  const std::string path = dir.File(std::string(f.name) + f.extension);
+  f.write(path, file);
+  CameraReadOptions options;
+  if (!f.file_has_size) {
+    options.width_px = file.camera.frame.width_px;
+    options.height_px = file.camera.frame.height_px;
+  }
+  if (!f.file_has_pixel_size) options.pixel_size_mm = file.camera.frame.pixel_size_mm;
+  return f.read(path, options);
+}
+
+// ---- every format: its own model written and read back exactly ----
+
+TEST(CameraFormats, EachFormatRoundTripsItsOwnModelExactly) {
+  TempDir dir("aerocal_formats");
+  const ModelCamera dji = DjiRecordA();
+  for (const Format& f : Formats()) {
+    SCOPED_TRACE(f.name);
+    // A camera in the format's model with every term it can hold non-zero: the conversion of the
+    // drone lens (a fit where the format's model differs), then written and read back.
+    const FileConversion in_model = ConvertCameraFile(File(dji), f.target);
+    const CameraFile back = WriteAndRead(f, in_model.file, dir);
+    ExpectSameParams(in_model.file.camera, back.camera, f.name);
+    EXPECT_LT(MaxDifferencePx(in_model.file.camera, back.camera), 1e-9);
+  }
+}
+
+TEST(CameraFormats, TermsOutsideOpenCvSurviveTheirFormat) {
+  TempDir dir("aerocal_formats");
+  // Metashape's b1, b2, k4, p3, p4; DewarpDataK6's k4-k6; a fisheye in OpenSfM and Kalibr.
+  ModelCamera metashape{CameraModelId::kMetashapeFrame,
+                        {3680, 2.2, 22.0, 0.8, -0.3, -0.26, 0.1, -0.03, 0.002, 4e-5, -3e-4, 0.01, -0.002},
+                        {0.0024, 5472, 3648}};
+  const CameraFile m = WriteAndRead(Formats()[2], File(metashape), dir);
+  ExpectSameParams(metashape, m.camera, "metashape");
+  ModelCamera k6 = DjiRecordA();
+  k6.params[OpenCvModel::kK4] = 0.01, k6.params[OpenCvModel::kK5] = -0.002, k6.params[OpenCvModel::kK6] = 1e-4;
+  const CameraFile d = WriteAndRead(Formats()[5], File(k6), dir);
+  ExpectSameParams(k6, d.camera, "DewarpDataK6");
+  const ModelCamera fisheye{CameraModelId::kOpenCvFisheye,
+                            {900, 900, 0.5 * 1279, 0.5 * 959, 0.05, -0.01, 0, 0},
+                            {0.003, 1280, 960}};
+  ExpectSameParams(fisheye, WriteAndRead(Formats()[4], File(fisheye), dir).camera, "opensfm fisheye");
+  ModelCamera equi = fisheye;
+  equi.params[6] = 0.002, equi.params[7] = -4e-4, equi.params[0] = 901;
+  ExpectSameParams(equi, WriteAndRead(Formats()[7], File(equi), dir).camera, "kalibr equidistant");
+  // Our file holds any registry model.
+  ExpectSameParams(metashape, WriteAndRead(Formats()[0], File(metashape), dir).camera, "aerocal metashape_frame");
+}
+
+// ---- ours -> format -> ours ----
+
+struct Trip {
+  bool exact_out;
+  double out_max_px, back_max_px;
+};
+
+Trip OursThroughFormat(const ModelCamera& ours, const Format& f, const TempDir& dir) {
+  const FileConversion out = ConvertCameraFile(File(ours), f.target);
+  const CameraFile read = WriteAndRead(f, out.file, dir);
+  const FileConversion back =
+      ConvertCameraFile(read, {CameraModelId::kBrownFraser10, {}, true});
+  return {out.result.exact, out.result.residual.max_px, MaxDifferencePx(ours, back.file.camera)};
+}
+
+TEST(CameraFormats, OursThroughEveryFormatAndBackStatesItsResidual) {
+  TempDir dir("aerocal_formats");
+  const ModelCamera aerial = AerialCamera();
+  // The drone lens as OUR camera: its refit (13-14 px at the corner, convert_camera_test) is now
+  // the camera every format must carry.
+  const ModelCamera drone = ConvertCamera(DjiRecordA(), CameraModelId::kBrownFraser10).camera;
+  for (const Format& f : Formats()) {
+    const Trip a = OursThroughFormat(aerial, f, dir);
+    const Trip d = OursThroughFormat(drone, f, dir);
+    std::printf("ours -> %-9s -> ours: aerial %s out max %.3g px, back max %.3g px; drone %s out "
+                "max %.3g px, back max %.3g px\n",
+                f.name, a.exact_out ? "exact" : "fit", a.out_max_px, a.back_max_px,
+                d.exact_out ? "exact" : "fit", d.out_max_px, d.back_max_px);
+    const bool ours_model = f.target.model == CameraModelId::kBrownFraser10;
+    if (ours_model && f.target.zero_params.empty()) {  // our own file: exact both ways
+      EXPECT_TRUE(a.exact_out) << f.name;
+      EXPECT_LT(a.back_max_px, 1e-9) << f.name;
+      EXPECT_LT(d.back_max_px, 1e-9) << f.name;
+      continue;
+    }
+    EXPECT_FALSE(a.exact_out) << f.name;  // a correction model is no forward model (or B1/B2 lost)
+    // The way back adds at most the way out's residual again (a fit in each direction); the
+    // aerial camera's shear B2 (8e-6) is what the forward models cannot hold: 0.05-0.06 px.
+    // (Triangle inequality: back <= out + the back fit's own residual, itself <= out.)
+    EXPECT_LT(a.back_max_px, 2.0 * a.out_max_px + 1e-3) << f.name;
+    EXPECT_LT(d.back_max_px, 2.0 * d.out_max_px + 1e-3) << f.name;
+    // The residual each conversion states, measured (2026-11-24) with 20 % margin: the aerial
+    // camera's shear B2 costs 0.05-0.09 px in the forward models (Metashape has b2: 6e-5 px); the
+    // drone lens (our refit of DJI record A) 2-16 px where the target has fewer terms (Kalibr
+    // radtan: k1, k2 only).
+    const std::map<std::string, std::pair<double, double>> stated = {
+        {"colmap", {0.048, 1.95}}, {"metashape", {5.6e-5, 3.46}}, {"pix4d", {0.090, 10.7}},
+        {"opensfm", {0.048, 9.56}}, {"dji", {0.048, 1.95}},       {"dbat", {0.090, 2.61}},
+        {"kalibr", {0.064, 16.3}}};
+    EXPECT_LT(a.out_max_px, 1.2 * stated.at(f.name).first) << f.name;
+    EXPECT_LT(d.out_max_px, 1.2 * stated.at(f.name).second) << f.name;
+  }
+}
+
+// ---- the real files ----
+
+std::string Shared(const std::string& set) { return testing::SharedDataDir(set); }
+
+struct DewarpRecord {
+  std::string id;
+  int width = 0, height = 0;
+  std::string data;
+  int line = 0;
+};
+
+std::vector<DewarpRecord> DewarpRecords(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<DewarpRecord> records;
+  int line_number = 0;
+  for (std::string line; std::getline(in, line);) {
+    ++line_number;
+    if (line.empty() || line[0] == '#') continue;
+    std::vector<std::string> fields;
+    std::stringstream s(line);
+    for (std::string f; std::getline(s, f, '|');) fields.push_back(f);
+    DewarpRecord r;
+    r.id = SplitCommaList(fields.at(0))[0];
+    std::sscanf(fields.at(2).c_str(), " %dx%d", &r.width, &r.height);
+    r.data = fields.at(7);
+    r.line = line_number;
+    records.push_back(r);
+  }
+  return records;
+}
+
+TEST(CameraFormatsRealData, DjiDewarpDataRecordsGiveCentrePlusOffset) {
+  const std::string dir = Shared("dji_dewarpdata_documented");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data absent";
+  const auto records = DewarpRecords(dir + "/dewarpdata_examples.txt");
+  ASSERT_EQ(records.size(), 2u);
+  // PROVENANCE.md "Known values": A (5472 x 3648) centre + (2.24, 22.05) = (2738.24, 1846.05) px;
+  // B (4864 x 3648) offset (-7.71, 45.90).
+  const double expected[2][9] = {
+      {3684.48, 3677.57, 2738.24, 1846.05, -0.263482, 0.106788, 3.71107e-5, -3.27247e-4, -0.0300783},
+      {3659.78, 3653.17, 2432 - 7.71, 1824 + 45.90, -0.269478, 0.115681, -8.75619e-5, -3.06177e-4, -0.0357628}};
+  for (size_t k = 0; k < 2; ++k) {
+    const DewarpRecord& r = records[k];
+    const ModelCamera c = DjiDewarpDataCamera(r.data, {dir, r.line}, r.width, r.height);
+    using O = OpenCvModel;
+    const int order[9] = {O::kFx, O::kFy, O::kCx, O::kCy, O::kK1, O::kK2, O::kP1, O::kP2, O::kK3};
+    for (int i = 0; i < 9; ++i)
+      EXPECT_NEAR(c.params[order[i]], expected[k][i], 1e-9 * (1 + std::abs(expected[k][i])))
+          << r.id << " " << i;
+    // The refit into our 10 parameters: 13-14 px at the corner (the issue's 16-28 px for other
+    // records), never exact; within 80 % of the half-diagonal 2-3 px.
+    ModelCamera with_pixel = c;
+    with_pixel.frame.pixel_size_mm = 0.0024;
+    const ConversionResult ours = ConvertCamera(with_pixel, CameraModelId::kBrownFraser10);
+    std::printf("DJI record %s -> brown_fraser_10: %s\n", r.id.c_str(), ours.Summary().c_str());
+    EXPECT_FALSE(ours.exact);
+    EXPECT_GT(ours.residual.max_px, 5.0);
+    EXPECT_LT(ours.residual.max_px, 30.0);
+    EXPECT_LT(ours.residual.max_inner80_px, 4.0);
+  }
+}
+
+TEST(CameraFormatsRealData, OpenSfmBerlinReconstructionCamera) {
+  const std::string dir = Shared("opensfm_berlin");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data absent";
+  CameraReadOptions options;
+  options.pixel_size_mm = 0.0014;  // iPhone 4S: 1.4 um
+  const CameraFile f = ReadOpenSfmCameras(dir + "/reconstruction_example.json", options);
+  using O = OpenCvModel;
+  // PROVENANCE.md: perspective, focal 0.869666 (x 3264 = 2838.6 px), k1 0.0885146, k2 -0.232443.
+  EXPECT_EQ(f.camera.model, CameraModelId::kOpenCv);
+  EXPECT_NEAR(f.camera.params[O::kFx], 0.8696658484855359 * 3264, 1e-9);
+  EXPECT_NEAR(f.camera.params[O::kFy], 2838.6, 0.05);
+  EXPECT_DOUBLE_EQ(f.camera.params[O::kCx], 0.5 * 3263);
+  EXPECT_DOUBLE_EQ(f.camera.params[O::kCy], 0.5 * 2447);
+  EXPECT_DOUBLE_EQ(f.camera.params[O::kK1], 0.08851464962037196);
+  EXPECT_DOUBLE_EQ(f.camera.params[O::kK2], -0.2324428377906099);
+  // Exact in every forward format (written and read back), and back into OpenSfM.
+  TempDir tmp("aerocal_formats");
+  for (const Format& format : Formats()) {
+    if (format.target.model == CameraModelId::kBrownFraser10) continue;
+    const FileConversion out = ConvertCameraFile(f, format.target);
+    EXPECT_TRUE(out.result.exact) << format.name;
+    EXPECT_LT(out.result.residual.max_px, 1e-9) << format.name;
+    const CameraFile read = WriteAndRead(format, out.file, tmp);
+    const FileConversion back = ConvertCameraFile(read, Formats()[4].target);
+    EXPECT_TRUE(back.result.exact) << format.name;
+    EXPECT_LT(MaxDifferencePx(f.camera, back.file.camera), 1e-9) << format.name;
+  }
+}
+
+TEST(CameraFormatsRealData, OdmCamerasJsonOfTheOrthorityDocs) {
+  // OpenDroneMap's cameras.json of a DJI FC6310R (Phantom 4 Pro), as quoted in the Orthority
+  // documentation (orthority.readthedocs.io, file_formats/opensfm.html): ODM's brown model of the
+  // images resized to 1368 x 912. No cameras.json is among ../shared/data's ODM sets.
+  TempDir tmp("aerocal_formats");
+  const std::string path = tmp.File("cameras.json");
+  std::ofstream(path) << R"({
+    "v2 dji fc6310r 5472 3648 brown 0.6666": {
+        "projection_type": "brown",
+        "width": 1368,
+        "height": 912,
+        "focal_x": 0.6664614123723713,
+        "focal_y": 0.6664614123723713,
+        "c_x": -0.0015460447606643697,
+        "c_y": 0.004751874732641298,
+        "k1": -0.2640629100413887,
+        "k2": 0.10188934223670705,
+        "p1": 0.0007345906274317972,
+        "p2": 0.0002595206713083041,
+        "k3": -0.02581956399353581
+    }
+})";
+  const CameraFile f = ReadOpenSfmCameras(path, {});
+  using O = OpenCvModel;
+  EXPECT_NEAR(f.camera.params[O::kFx], 0.6664614123723713 * 1368, 1e-9);
+  EXPECT_NEAR(f.camera.params[O::kCx], 683.5 - 0.0015460447606643697 * 1368, 1e-9);
+  EXPECT_NEAR(f.camera.params[O::kCy], 455.5 + 0.004751874732641298 * 1368, 1e-9);
+  EXPECT_DOUBLE_EQ(f.camera.params[O::kP1], 0.0007345906274317972);
+  // The same lens class as the DJI DewarpData records: k1 -0.264 against -0.263 (record A).
+  EXPECT_NEAR(f.camera.params[O::kK1], DjiRecordA().params[O::kK1], 0.01);
+  const CameraFile back = WriteAndRead(Formats()[4], f, tmp);
+  ExpectSameParams(f.camera, back.camera, "odm cameras.json");
+}
+
+TEST(CameraFormatsRealData, DbatResultCameraAgainstItsReport) {
+  const std::string dir = Shared("dbat_camcal_olympus_c4040z");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data absent";
+  const CameraFile f = ReadDbatCameraXml(dir + "/result/c4040z.xml", {});
+  using B = BrownFraser10Model;
+  // PROVENANCE.md (DBAT 0.9.2.0 report): c 7.45700 mm, pp (3.61546, 2.61329) mm from the top-left
+  // corner, K1 4.58861e-3, K2 -4.51351e-5, K3 -2.05253e-6, P1 -6.12803e-5, P2 -4.41171e-5.
+  const double p = 5.43764 / 1704;
+  EXPECT_NEAR(f.camera.params[B::kC], 7.45700, 5e-6);
+  EXPECT_NEAR(f.camera.params[B::kX0], 3.61546 - 1136 * p, 5e-6);
+  EXPECT_NEAR(f.camera.params[B::kY0], 852 * p - 2.61329, 5e-6);
+  EXPECT_NEAR(f.camera.params[B::kK1], 4.58861e-3, 5e-9);
+  EXPECT_NEAR(f.camera.params[B::kK2], -4.51351e-5, 5e-11);
+  EXPECT_NEAR(f.camera.params[B::kK3], -2.05253e-6, 5e-12);
+  EXPECT_NEAR(f.camera.params[B::kP1], -6.12803e-5, 5e-11);
+  EXPECT_NEAR(f.camera.params[B::kP2], -4.41171e-5, 5e-11);
+  ASSERT_EQ(f.notes.size(), 1u);  // the aspect 0.99961 is not modelled: said
+  TempDir tmp("aerocal_formats");
+  const CameraFile back = WriteAndRead(Formats()[6], f, tmp);
+  ExpectSameParams(f.camera, back.camera, "dbat");
+  // Into Metashape (a forward model: fitted) and back into DBAT.
+  const FileConversion m = ConvertCameraFile(f, Formats()[2].target);
+  const FileConversion again = ConvertCameraFile(WriteAndRead(Formats()[2], m.file, tmp), Formats()[6].target);
+  std::printf("DBAT c4040z -> metashape: %s; -> DBAT: %.3g px max against the original\n",
+              m.result.Summary().c_str(), MaxDifferencePx(f.camera, again.file.camera));
+  // Measured: 0.057 px at the corner (rms 0.005 px) out, 5e-4 px back.
+  EXPECT_LT(m.result.residual.max_px, 0.07);
+  EXPECT_LT(MaxDifferencePx(f.camera, again.file.camera), 1e-3);
+}
+
+// ---- the covariance carried through ----
+
+TEST(CameraFormats, CovarianceThroughAnExactConversionIsTheLinearMap) {
+  using M = MetashapeFrameModel;
+  using P = Pix4dPerspectiveModel;
+  CameraFile m = File({M::kId, {3680, 2.2, 22.0, 0, 0, -0.26, 0.1, -0.03, 0, 4e-5, -3e-4, 0, 0},
+                       {0.0024, 5472, 3648}});
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(M::kNumParams, M::kNumParams);
+  c(M::kF, M::kF) = 0.5 * 0.5, c(M::kCx, M::kCx) = 0.3 * 0.3, c(M::kF, M::kCx) = 0.05;
+  c(M::kP2, M::kP2) = 1e-5 * 1e-5, c(M::kK1, M::kK1) = 1e-4 * 1e-4;
+  m.covariance = c;
+  const FileConversion p = ConvertCameraFile(m, {P::kId, {}, true});
+  ASSERT_TRUE(p.result.exact);
+  ASSERT_TRUE(p.file.covariance);
+  const Eigen::MatrixXd& q = *p.file.covariance;
+  const double mm = 0.0024;  // F = f p, Px = (cx + W / 2) p, T1 = -P2 (Metashape), R1 = k1
+  EXPECT_NEAR(q(P::kF, P::kF), mm * mm * 0.25, 1e-6 * mm * mm * 0.25);
+  EXPECT_NEAR(q(P::kPx, P::kPx), mm * mm * 0.09, 1e-6 * mm * mm * 0.09);
+  EXPECT_NEAR(q(P::kF, P::kPx), mm * mm * 0.05, 1e-6 * mm * mm * 0.05);
+  EXPECT_NEAR(q(P::kT1, P::kT1), 1e-10, 1e-16);
+  EXPECT_NEAR(q(P::kR1, P::kR1), 1e-8, 1e-14);
+  EXPECT_NEAR(q(P::kPy, P::kPy), 0.0, 1e-18);
+}
+
+TEST(CameraFormats, CovarianceThroughAFitFollowsTheExactScaleAndShift) {
+  // Metashape's skew b2 has no OpenCV term, so Metashape -> ours is a FIT; without distortion ours
+  // holds the camera exactly (B1, B2 are the inverse affinity), and then a change of f scales the
+  // image (our c follows with dc/df = p) and a change of cx shifts it (x0 follows with p):
+  // sigma_c = p sigma_f, sigma_x0 = p sigma_cx, no correlation. (With distortion the fit is not
+  // exact and its c trades with K1 over the format: no such oracle, the propagation is the same
+  // code.)
+  using M = MetashapeFrameModel;
+  using B = BrownFraser10Model;
+  CameraFile m = File({M::kId, {3680, 2.2, 22.0, 0.8, -0.3, 0, 0, 0, 0, 0, 0, 0, 0},
+                       {0.0024, 5472, 3648}});
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(M::kNumParams, M::kNumParams);
+  c(M::kF, M::kF) = 0.8 * 0.8;
+  c(M::kCx, M::kCx) = 0.4 * 0.4;
+  m.covariance = c;
+  const FileConversion ours = ConvertCameraFile(m, {B::kId, {}, true});
+  ASSERT_FALSE(ours.result.exact);
+  EXPECT_LT(ours.result.residual.max_px, 1e-6);
+  ASSERT_TRUE(ours.file.covariance);
+  const Eigen::MatrixXd& q = *ours.file.covariance;
+  const double mm = 0.0024;
+  EXPECT_NEAR(std::sqrt(q(B::kC, B::kC)), mm * 0.8, 1e-4 * mm * 0.8);
+  EXPECT_NEAR(std::sqrt(q(B::kX0, B::kX0)), mm * 0.4, 1e-4 * mm * 0.4);
+  EXPECT_NEAR(q(B::kC, B::kX0), 0.0, 1e-4 * mm * mm * 0.32);
+}
+
+}  // namespace
+}  // namespace aerocal::calib

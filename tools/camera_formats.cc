@@ -1,0 +1,183 @@
+#include "tools/camera_formats.h"
+
+#include <filesystem>
+
+#include <opencv2/core.hpp>
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+
+namespace aerocal::tools {
+namespace {
+
+using calib::CameraFile;
+using calib::CameraModelId;
+using calib::FormatTarget;
+using calib::ModelCamera;
+using calib::OpenCvModel;
+
+calib::OpenCvParams AsOpenCv(const ModelCamera& camera) {
+  calib::OpenCvParams cv;
+  calib::VisitCameraModel(camera.model, [&](auto m) {
+    return decltype(m)::ToOpenCv(camera.params.data(), camera.frame, &cv);
+  });
+  return cv;
+}
+
+bool IsFisheye(const ModelCamera& c) { return c.model == CameraModelId::kOpenCvFisheye; }
+
+FormatTarget ColmapTarget(const ModelCamera& source) {
+  if (!calib::ColmapName(source.model).empty()) return {source.model, {}};
+  const calib::OpenCvParams cv = AsOpenCv(source);
+  const bool full = cv[OpenCvModel::kK3] != 0 || cv[OpenCvModel::kK4] != 0 ||
+                    cv[OpenCvModel::kK5] != 0 || cv[OpenCvModel::kK6] != 0;
+  return {full ? CameraModelId::kColmapFullOpenCv : CameraModelId::kColmapOpenCv, {}};
+}
+
+}  // namespace
+
+const std::vector<CameraFormat>& CameraFormats() {
+  static const std::vector<CameraFormat> formats = {
+      {"aerocal", "our camera YAML (any registry model; a rig file's head by --camera)",
+       calib::ReadAerocalCamera, calib::WriteAerocalCamera,
+       [](const ModelCamera& s) { return FormatTarget{s.model, {}, true}; }},
+      {"opencv", "OpenCV FileStorage YAML/XML/JSON (camera_matrix, distortion_coefficients)",
+       ReadOpenCvCamera, WriteOpenCvCamera,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kOpenCv, {}}; }},
+      {"colmap", "COLMAP cameras.txt (SIMPLE_PINHOLE ... FULL_OPENCV)", calib::ReadColmapCameras,
+       calib::WriteColmapCameras, ColmapTarget},
+      {"metashape", "Agisoft Metashape calibration XML (frame)", calib::ReadMetashapeCalibration,
+       calib::WriteMetashapeCalibration,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kMetashapeFrame, {}}; }},
+      {"pix4d", "Pix4D internal camera parameters (.cam)", calib::ReadPix4dCam, calib::WritePix4dCam,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; }},
+      {"opensfm", "OpenSfM / OpenDroneMap cameras.json", calib::ReadOpenSfmCameras,
+       calib::WriteOpenSfmCameras,
+       [](const ModelCamera& s) {
+         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {"k3", "k4"}}
+                             : FormatTarget{CameraModelId::kOpenCv, {"k4", "k5", "k6"}};
+       }},
+      {"dji", "DJI XMP DewarpData / DewarpDataK6 (a DJI JPEG, an XMP sidecar or the string)",
+       calib::ReadDjiDewarpData, calib::WriteDjiDewarpData,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kOpenCv, {}}; }},
+      {"dbat", "DBAT camera XML (c, pp, K1-K3, P1, P2 in mm)", calib::ReadDbatCameraXml,
+       calib::WriteDbatCameraXml,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
+       }},
+      {"kalibr", "Kalibr camchain YAML (pinhole radtan / equidistant)", calib::ReadKalibrCamchain,
+       calib::WriteKalibrCamchain,
+       [](const ModelCamera& s) {
+         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}}
+                             : FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
+       }},
+  };
+  return formats;
+}
+
+std::string CameraFormatNames() {
+  std::string names;
+  for (const auto& f : CameraFormats()) names += (names.empty() ? "" : ", ") + f.name;
+  return names;
+}
+
+const CameraFormat& FindCameraFormat(const std::string& name, const std::string& option) {
+  for (const auto& f : CameraFormats())
+    if (f.name == name) return f;
+  throw ConfigError(option + ": unknown camera format '" + name + "' (expected " +
+                    CameraFormatNames() + ")");
+}
+
+CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOptions& options) {
+  CheckInputFile(path);
+  cv::FileStorage fs;
+  try {
+    // The text is read by our reader (regular-file checks, BOM) and parsed from memory.
+    const std::string text = ReadTextFile(path);
+    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
+  } catch (const cv::Exception& e) {
+    ThrowInputError({path, 0}, std::string("cv::FileStorage cannot parse it: ") + e.err);
+  }
+  if (!fs.isOpened()) ThrowInputError({path, 1}, "cv::FileStorage cannot parse it");
+  std::string matrix_key = "camera_matrix", dist_key = "distortion_coefficients";
+  if (fs["camera_matrix"].empty()) {
+    const std::string id = options.camera_id.empty() ? "1" : options.camera_id;
+    if (fs["M" + id].empty())
+      ThrowInputError({path, 1}, options.camera_id.empty()
+                                     ? "no camera_matrix (nor a stereo M1/D1)"
+                                     : "no camera M" + id + "/D" + id);
+    if (options.camera_id.empty() && !fs["M2"].empty())
+      ThrowInputError({path, 1}, "a stereo file: name the camera with --camera (1 or 2)");
+    matrix_key = "M" + id;
+    dist_key = "D" + id;
+  }
+  cv::Mat k, d;
+  try {
+    fs[matrix_key] >> k;
+    fs[dist_key] >> d;
+  } catch (const cv::Exception& e) {
+    ThrowInputError({path, 0}, matrix_key + " / " + dist_key + ": " + e.err);
+  }
+  if (k.rows != 3 || k.cols != 3) ThrowInputError({path, 0}, matrix_key + " must be a 3 x 3 matrix");
+  k.convertTo(k, CV_64F);
+  if (!d.empty()) d.convertTo(d, CV_64F);
+  const size_t n = d.total();
+  if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14)
+    ThrowInputError({path, 0}, dist_key + " must hold 4, 5, 8, 12 or 14 values (got " +
+                                   std::to_string(n) + ")");
+  for (size_t i = 8; i < n; ++i)
+    if (d.at<double>(static_cast<int>(i)) != 0.0)
+      ThrowInputError({path, 0}, dist_key + ": the thin-prism s1-s4 and tilt terms are not "
+                                            "modelled (must be 0)");
+  if (k.at<double>(0, 1) != 0.0 || k.at<double>(1, 0) != 0.0 || k.at<double>(2, 0) != 0.0 ||
+      k.at<double>(2, 1) != 0.0 || k.at<double>(2, 2) != 1.0)
+    ThrowInputError({path, 0}, matrix_key + " must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
+                                            "modelled)");
+  CameraFile file;
+  file.name = std::filesystem::path(path).stem().string();
+  file.camera.model = CameraModelId::kOpenCv;
+  file.camera.params.assign(OpenCvModel::kNumParams, 0.0);
+  std::vector<double>& p = file.camera.params;
+  p[OpenCvModel::kFx] = k.at<double>(0, 0);
+  p[OpenCvModel::kFy] = k.at<double>(1, 1);
+  p[OpenCvModel::kCx] = k.at<double>(0, 2);
+  p[OpenCvModel::kCy] = k.at<double>(1, 2);
+  if (!(p[0] > 0 && p[1] > 0)) ThrowInputError({path, 0}, "fx, fy must be > 0 px");
+  static const int kOrder[8] = {OpenCvModel::kK1, OpenCvModel::kK2, OpenCvModel::kP1,
+                                OpenCvModel::kP2, OpenCvModel::kK3, OpenCvModel::kK4,
+                                OpenCvModel::kK5, OpenCvModel::kK6};
+  for (size_t i = 0; i < n && i < 8; ++i) p[kOrder[i]] = d.at<double>(static_cast<int>(i));
+  for (double v : p)
+    if (!std::isfinite(v)) ThrowInputError({path, 0}, "a parameter is not finite");
+  int width = 0, height = 0;
+  if (!fs["image_width"].empty()) width = static_cast<int>(fs["image_width"]);
+  if (!fs["image_height"].empty()) height = static_cast<int>(fs["image_height"]);
+  calib::internal::ResolveFormat(&file, options, {path, 0}, width, height, 0.0);
+  return file;
+}
+
+void WriteOpenCvCamera(const std::string& path, const CameraFile& file) {
+  AEROCAL_CHECK(file.camera.model == CameraModelId::kOpenCv) << "not opencv";
+  const std::vector<double>& p = file.camera.params;
+  const std::string extension = std::filesystem::path(path).extension().string();
+  const std::string memory_name =
+      extension == ".xml" ? ".xml" : extension == ".json" ? ".json" : ".yml";
+  cv::FileStorage fs(memory_name, cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+  fs << "image_width" << file.camera.frame.width_px;
+  fs << "image_height" << file.camera.frame.height_px;
+  const cv::Mat k = (cv::Mat_<double>(3, 3) << p[OpenCvModel::kFx], 0, p[OpenCvModel::kCx], 0,
+                     p[OpenCvModel::kFy], p[OpenCvModel::kCy], 0, 0, 1);
+  fs << "camera_matrix" << k;
+  const bool rational = p[OpenCvModel::kK4] != 0 || p[OpenCvModel::kK5] != 0 || p[OpenCvModel::kK6] != 0;
+  std::vector<double> coefficients = {p[OpenCvModel::kK1], p[OpenCvModel::kK2],
+                                      p[OpenCvModel::kP1], p[OpenCvModel::kP2],
+                                      p[OpenCvModel::kK3]};
+  if (rational)
+    coefficients.insert(coefficients.end(),
+                        {p[OpenCvModel::kK4], p[OpenCvModel::kK5], p[OpenCvModel::kK6]});
+  const cv::Mat d = cv::Mat(coefficients, true);
+  fs << "distortion_coefficients" << d;
+  WriteFileAtomically(path, fs.releaseAndGetString());
+}
+
+}  // namespace aerocal::tools

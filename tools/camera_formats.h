@@ -1,0 +1,37 @@
+// The camera-file formats of `aerocal camera` and `--camera-format` by their command-line names:
+// aerocal, opencv, colmap, metashape, pix4d, opensfm, dji, dbat, kalibr. Each entry is a reader,
+// a writer and the registry model it writes (calib/camera/formats/camera_formats.h has the
+// formats and their conventions; opencv, via cv::FileStorage, lives here because OpenCV stays out
+// of calib).
+#pragma once
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "calib/camera/formats/camera_formats.h"
+
+namespace aerocal::tools {
+
+struct CameraFormat {
+  std::string name;
+  std::string description;
+  std::function<calib::CameraFile(const std::string&, const calib::CameraReadOptions&)> read;
+  std::function<void(const std::string&, const calib::CameraFile&)> write;
+  /// The model (and zero parameters) a source camera is written in by this format.
+  std::function<calib::FormatTarget(const calib::ModelCamera& source)> target;
+};
+
+const std::vector<CameraFormat>& CameraFormats();
+/// ConfigError naming `option` and the format names when unknown.
+const CameraFormat& FindCameraFormat(const std::string& name, const std::string& option);
+std::string CameraFormatNames();
+
+/// OpenCV's calibration file as cv::FileStorage reads and writes it (YAML, XML or JSON by the
+/// extension): camera_matrix 3x3, distortion_coefficients (k1 k2 p1 p2 [k3 [k4 k5 k6]]),
+/// image_width, image_height; or a stereo file's M1/D1, M2/D2 (--camera 1 / 2).
+calib::CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOptions& options);
+void WriteOpenCvCamera(const std::string& path, const calib::CameraFile& camera);
+
+}  // namespace aerocal::tools

@@ -1,0 +1,307 @@
+// aerocal camera: camera files in other tools' languages (issue 15).
+// `camera convert --from F --to G IN OUT`: read IN in format F into that format's own model, express
+// it in G's model (exact where the models are equivalent, else a least-squares fit over the format
+// whose residual is printed and reported), carry a covariance through, write OUT in format G.
+// `camera show --from F IN`: the parameters, a table in our convention (CONVENTIONS.md) and the
+// distortion over the format (a profile table; --plot writes an SVG plot).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+#include <sstream>
+
+#include <nlohmann/json.hpp>
+
+#include "calib/camera/convert_camera.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/log.h"
+#include "tools/camera_formats.h"
+#include "tools/command_registry.h"
+
+namespace aerocal::tools {
+namespace {
+
+using calib::CameraFile;
+
+struct ReadArgs {
+  std::string from, in, camera_id;
+  int width = 0, height = 0;
+  double pixel_mm = 0;
+  void Add(CLI::App* app) {
+    app->add_option("--from", from, "Format of IN: " + CameraFormatNames())->required();
+    app->add_option("--camera", camera_id,
+                    "Which camera of a file holding several (COLMAP id, Metashape sensor id, "
+                    "OpenSfM/Kalibr key, rig head, OpenCV stereo 1/2)");
+    app->add_option("--width", width, "Image width in px where the file has none (checked "
+                                      "against the file where it has one)")
+        ->check(CLI::Range(1, 1000000));
+    app->add_option("--height", height, "Image height in px, as --width")
+        ->check(CLI::Range(1, 1000000));
+    app->add_option("--pixel-mm", pixel_mm, "Pixel size in mm where the file has none")
+        ->check(CLI::Range(1e-5, 1.0));
+  }
+  CameraFile Read() const {
+    const CameraFormat& format = FindCameraFormat(from, "--from");
+    calib::CameraReadOptions options;
+    options.camera_id = camera_id;
+    options.width_px = width;
+    options.height_px = height;
+    options.pixel_size_mm = pixel_mm;
+    return format.read(in, options);
+  }
+};
+
+struct ConvertArgs {
+  ReadArgs read;
+  std::string to, out, model, report;
+  double max_residual_px = std::numeric_limits<double>::infinity();
+};
+
+std::string Describe(const calib::ConversionResult& r) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "residual over the format: rms %.3g px, max %.3g px at pixel (%.0f, %.0f), max "
+                "within 80 %% of the half-diagonal %.3g px",
+                r.residual.rms_px, r.residual.max_px, r.residual.max_at_px.x(),
+                r.residual.max_at_px.y(), r.residual.max_inner80_px);
+  return buffer;
+}
+
+int RunConvert(const ConvertArgs& a) {
+  CheckOutputFile(a.out, "OUT");
+  if (!a.report.empty()) CheckOutputFile(a.report, "--report");
+  const CameraFormat& to = FindCameraFormat(a.to, "--to");
+  const CameraFile source = a.read.Read();
+  calib::FormatTarget target = to.target(source.camera);
+  if (!a.model.empty()) {
+    if (a.to != "aerocal") throw ConfigError("--model: only with --to aerocal (other formats have their model)");
+    const std::string name = a.model == "brown10" ? "brown_fraser_10" : a.model;
+    const auto id = calib::CameraModelFromName(name);
+    if (!id)
+      throw ConfigError("--model: unknown camera model '" + a.model + "' (expected " +
+                        calib::CameraModelNames() + ")");
+    target.model = *id;
+  }
+  calib::ConvertOptions options;
+  options.max_residual_px = a.max_residual_px;
+  const calib::FileConversion conversion = calib::ConvertCameraFile(source, target, options);
+  const calib::ConversionResult& r = conversion.result;
+  std::vector<std::string> notes = source.notes;
+  notes.insert(notes.end(), conversion.notes.begin(), conversion.notes.end());
+  CameraFile written = conversion.file;
+  if (written.covariance) {
+    if (a.to == "aerocal" && written.camera.model == calib::CameraModelId::kBrownFraser10)
+      notes.push_back("covariance written as interior_sigma (our file holds no correlations: "
+                      "dropped)");
+    else if (a.to != "metashape") {
+      notes.push_back("covariance dropped: " + a.to + " (" +
+                      std::string(calib::CameraModelName(written.camera.model)) +
+                      ") holds none");
+      written.covariance.reset();
+    }
+  }
+  const std::string model(calib::CameraModelName(r.camera.model));
+  std::printf("%s (%s, %s) -> %s (%s, %s): %s\n", a.read.in.c_str(), a.read.from.c_str(),
+              std::string(calib::CameraModelName(source.camera.model)).c_str(), a.out.c_str(),
+              a.to.c_str(), model.c_str(),
+              r.exact ? "exact (closed form)" : "least-squares fit over the format");
+  std::printf("%s\n", Describe(r).c_str());
+  for (const auto& note : notes) std::printf("note: %s\n", note.c_str());
+  nlohmann::json report = {
+      {"from", a.read.from},
+      {"to", a.to},
+      {"source_model", std::string(calib::CameraModelName(source.camera.model))},
+      {"model", model},
+      {"exact", r.exact},
+      {"acceptable", r.acceptable},
+      {"fit_iterations", r.fit_iterations},
+      {"residual_px",
+       {{"rms", r.residual.rms_px},
+        {"max", r.residual.max_px},
+        {"max_at", {r.residual.max_at_px.x(), r.residual.max_at_px.y()}},
+        {"max_inner80", r.residual.max_inner80_px},
+        {"points", r.residual.points},
+        {"failed_points", r.residual.failed_points}}},
+      {"notes", notes}};
+  if (!a.report.empty()) WriteFileAtomically(a.report, report.dump(2) + "\n");
+  if (!r.acceptable) {
+    LogWarning("conversion_residual: " + Describe(r) + (r.residual.failed_points ? " (" +
+               std::to_string(r.residual.failed_points) + " points not invertible)" : "") +
+               " exceeds --max-residual-px " + FormatNumber(a.max_residual_px) + "; " + a.out +
+               " not written");
+    return kExitNotConverged;
+  }
+  to.write(a.out, written);
+  return kExitOk;
+}
+
+// ---- show ----
+
+struct ShowArgs {
+  ReadArgs read;
+  std::string plot;
+};
+
+// Distortion at a measured pixel: the pixel minus the pinhole image of the same ray (principal
+// distance, principal point of the model's OpenCV form, no affinity), px.
+Eigen::Vector2d DistortionAt(const calib::ModelCamera& camera, const Eigen::Vector2d& pp,
+                             const Eigen::Vector2d& pixel, bool* ok) {
+  Eigen::Vector2d ideal;
+  *ok = camera.IdealFromPixel(pixel, &ideal);
+  const double p = camera.frame.pixel_size_mm;
+  return pixel - (pp + Eigen::Vector2d(ideal.x() / p, -ideal.y() / p));
+}
+
+std::string Svg(const calib::ModelCamera& camera, const Eigen::Vector2d& pp,
+                const std::vector<std::pair<double, double>>& profile, const std::string& title) {
+  std::ostringstream s;
+  const double W = camera.frame.width_px, H = camera.frame.height_px;
+  double max_d = 1e-12, max_r = 1e-12;
+  for (const auto& [r, d] : profile) max_d = std::max(max_d, d), max_r = std::max(max_r, r);
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"900\" height=\"420\" font-family=\"sans-serif\" font-size=\"12\">\n"
+    << "<text x=\"10\" y=\"18\">" << title << "</text>\n";
+  // Left: |distortion| (px) against the distance from the principal point (px).
+  const double x0 = 60, y0 = 380, w = 340, h = 320;
+  s << "<rect x=\"" << x0 << "\" y=\"" << y0 - h << "\" width=\"" << w << "\" height=\"" << h
+    << "\" fill=\"none\" stroke=\"black\"/>\n<polyline fill=\"none\" stroke=\"blue\" points=\"";
+  for (const auto& [r, d] : profile) s << x0 + w * r / max_r << "," << y0 - h * d / max_d << " ";
+  s << "\"/>\n<text x=\"" << x0 << "\" y=\"" << y0 + 16 << "\">radius 0 .. " << FormatNumber(max_r, 5)
+    << " px (to the farthest corner)</text>\n<text x=\"" << x0 << "\" y=\"" << y0 - h - 6
+    << "\">|distortion| 0 .. " << FormatNumber(max_d, 4) << " px</text>\n";
+  // Right: distortion vectors over the format, scaled so the longest is one cell.
+  const double fx0 = 460, fy0 = 60, fw = 420, fh = fw * H / W;
+  const int nx = 15, ny = std::max(3, static_cast<int>(std::lround(15 * H / W)));
+  s << "<rect x=\"" << fx0 << "\" y=\"" << fy0 << "\" width=\"" << fw << "\" height=\"" << fh
+    << "\" fill=\"none\" stroke=\"black\"/>\n";
+  std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> arrows;
+  double longest = 1e-12;
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Eigen::Vector2d pixel((W - 1) * (i + 0.5) / nx, (H - 1) * (j + 0.5) / ny);
+      bool ok = false;
+      const Eigen::Vector2d d = DistortionAt(camera, pp, pixel, &ok);
+      if (!ok) continue;
+      arrows.emplace_back(pixel, d);
+      longest = std::max(longest, d.norm());
+    }
+  const double cell = fw / nx, scale = cell / longest;
+  for (const auto& [pixel, d] : arrows) {
+    const double ax = fx0 + fw * pixel.x() / W, ay = fy0 + fh * pixel.y() / H;
+    s << "<line x1=\"" << ax << "\" y1=\"" << ay << "\" x2=\"" << ax + d.x() * scale << "\" y2=\""
+      << ay + d.y() * scale << "\" stroke=\"red\"/>\n<circle cx=\"" << ax << "\" cy=\"" << ay
+      << "\" r=\"1.5\"/>\n";
+  }
+  s << "<text x=\"" << fx0 << "\" y=\"" << fy0 + fh + 16 << "\">distortion vectors (longest "
+    << FormatNumber(longest, 4) << " px = one cell)</text>\n</svg>\n";
+  return s.str();
+}
+
+int RunShow(const ShowArgs& a) {
+  if (!a.plot.empty()) CheckOutputFile(a.plot, "--plot");
+  const CameraFile file = a.read.Read();
+  const calib::ModelCamera& camera = file.camera;
+  const calib::PixelFrame& f = camera.frame;
+  const std::string model(calib::CameraModelName(camera.model));
+  std::printf("camera %s: %s, %d x %d px, pixel %s\n", file.name.c_str(), model.c_str(), f.width_px,
+              f.height_px,
+              file.pixel_size_known ? (FormatNumber(f.pixel_size_mm) + " mm").c_str()
+                                    : "unknown (mm values below are in units of 0.001 mm)");
+  const std::vector<calib::ParamInfo> table = calib::CameraModelParams(camera.model);
+  std::printf("%-6s %24s %-6s %s\n", "param", "value", "unit", file.covariance ? "sigma" : "");
+  for (size_t i = 0; i < table.size(); ++i) {
+    std::string sigma;
+    if (file.covariance && (*file.covariance)(i, i) > 0)
+      sigma = FormatNumber(std::sqrt((*file.covariance)(i, i)), 6);
+    std::printf("%-6s %24s %-6s %s\n", std::string(table[i].name).c_str(),
+                FormatNumber(camera.params[i], 15).c_str(), std::string(table[i].unit).c_str(),
+                sigma.c_str());
+  }
+  calib::OpenCvParams cv;
+  calib::VisitCameraModel(camera.model, [&](auto m) {
+    return decltype(m)::ToOpenCv(camera.params.data(), f, &cv);
+  });
+  using O = calib::OpenCvModel;
+  const Eigen::Vector2d pp(cv[O::kCx], cv[O::kCy]);
+  const double p = f.pixel_size_mm;
+  std::printf("our convention (CONVENTIONS.md: photo frame at the format centre, y up):\n");
+  std::printf("  c  = %s mm (%s px)\n", FormatNumber(camera.PrincipalDistanceMm(), 10).c_str(),
+              FormatNumber(camera.PrincipalDistanceMm() / p, 10).c_str());
+  std::printf("  x0 = %s mm (%s px from the centre)\n",
+              FormatNumber((pp.x() - 0.5 * (f.width_px - 1)) * p, 10).c_str(),
+              FormatNumber(pp.x() - 0.5 * (f.width_px - 1), 10).c_str());
+  std::printf("  y0 = %s mm (%s px, y up)\n", FormatNumber(-(pp.y() - 0.5 * (f.height_px - 1)) * p, 10).c_str(),
+              FormatNumber(-(pp.y() - 0.5 * (f.height_px - 1)), 10).c_str());
+  std::printf("  fx / fy - 1 = %s (our B1 after a conversion)\n",
+              FormatNumber(cv[O::kFx] / cv[O::kFy] - 1.0, 6).c_str());
+  // Profile: along the lines from the principal point to the four corners.
+  std::printf("distortion (pixel minus the pinhole image of its ray), max over the 4 corner "
+              "directions:\n  %-8s %12s %12s\n", "r/r_max", "r px", "|d| px");
+  std::vector<std::pair<double, double>> profile;
+  const Eigen::Vector2d corners[4] = {{0, 0}, {f.width_px - 1.0, 0}, {0, f.height_px - 1.0},
+                                      {f.width_px - 1.0, f.height_px - 1.0}};
+  double r_max = 0;
+  for (const auto& c : corners) r_max = std::max(r_max, (c - pp).norm());
+  for (int k = 0; k <= 40; ++k) {
+    const double t = k / 40.0;
+    double d_max = 0;
+    for (const auto& c : corners) {
+      const Eigen::Vector2d dir = (c - pp).normalized();
+      const double r = std::min(t * r_max, (c - pp).norm());
+      bool ok = false;
+      const Eigen::Vector2d d = DistortionAt(camera, pp, pp + r * dir, &ok);
+      if (ok) d_max = std::max(d_max, d.norm());
+    }
+    profile.emplace_back(t * r_max, d_max);
+    if (k % 4 == 0) std::printf("  %-8.2f %12.1f %12.4f\n", t, t * r_max, d_max);
+  }
+  for (const auto& note : file.notes) std::printf("note: %s\n", note.c_str());
+  if (!a.plot.empty()) {
+    WriteFileAtomically(a.plot, Svg(camera, pp, profile, file.name + " (" + model + ")"));
+    std::printf("plot: %s\n", a.plot.c_str());
+  }
+  return kExitOk;
+}
+
+CommandRun Setup(CLI::App& app) {
+  app.require_subcommand(1);
+  auto convert = std::make_shared<ConvertArgs>();
+  CLI::App* cv = app.add_subcommand(
+      "convert", "A camera file in another tool's format: exact where the models are "
+                 "equivalent, else a least-squares fit with its residual");
+  cv->option_defaults()->always_capture_default();
+  convert->read.Add(cv);
+  cv->add_option("--to", convert->to, "Format of OUT: " + CameraFormatNames())->required();
+  cv->add_option("IN", convert->read.in, "Input camera file")->required();
+  cv->add_option("OUT", convert->out, "Output camera file (written atomically)")->required();
+  cv->add_option("--model", convert->model,
+                 "With --to aerocal: the registry model to write (e.g. brown10 = brown_fraser_10, "
+                 "opencv, metashape_frame); default: the source's own model");
+  cv->add_option("--report", convert->report,
+                 "JSON: {exact, acceptable, residual_px: {rms, max, max_at, max_inner80}, notes}");
+  cv->add_option("--max-residual-px", convert->max_residual_px,
+                 "A conversion leaving more (max over the format, px) is an error: exit 3, OUT "
+                 "not written")
+      ->check(CLI::PositiveNumber);
+  auto show = std::make_shared<ShowArgs>();
+  CLI::App* sh = app.add_subcommand(
+      "show", "A camera file as a table in our convention plus its distortion (profile, SVG plot)");
+  sh->option_defaults()->always_capture_default();
+  show->read.Add(sh);
+  sh->add_option("IN", show->read.in, "Camera file")->required();
+  sh->add_option("--plot", show->plot, "SVG plot: distortion profile and vectors over the format");
+  return [convert, cv, show, sh] {
+    if (cv->parsed()) return RunConvert(*convert);
+    if (sh->parsed()) return RunShow(*show);
+    return kExitInternal;
+  };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(camera, "camera",
+                         "Camera files in other tools' formats: convert (with how exact) and show",
+                         Setup);
+
+}  // namespace aerocal::tools
