@@ -534,6 +534,96 @@ const std::vector<Case>& Cases() {
                 " --out " + d.File("m.csv");
        },
        2, "list.csv:3: sub-image XX", "m.csv"},
+      // ---- camera convert / show (issue 15): each format's reader ----
+      {"metashape_calibration_without_f",
+       [](const TempDir& d) {
+         Write(d.File("cal.xml"), "<?xml version=\"1.0\"?>\n<calibration>\n  <projection>frame</projection>\n"
+                                  "  <width>5472</width>\n  <height>3648</height>\n  <cx>2</cx>\n</calibration>\n");
+         return "camera convert --from metashape --to opencv " + d.File("cal.xml") + " " + d.File("o.yml");
+       },
+       2, "cal.xml:2: missing <f>", "o.yml"},
+      {"metashape_covariance_of_the_wrong_size",
+       [](const TempDir& d) {
+         Write(d.File("cal.xml"), "<calibration>\n<width>100</width><height>80</height><f>90</f>\n"
+                                  "<covariance>\n<params>f cx</params>\n<coeffs>1 0 0</coeffs>\n</covariance>\n</calibration>\n");
+         return "camera convert --from metashape --to aerocal " + d.File("cal.xml") + " " + d.File("o.yaml") + " --pixel-mm 0.005";
+       },
+       2, "cal.xml:5: <coeffs> must hold 2^2 = 4 values", "o.yaml"},
+      {"colmap_camera_of_an_unknown_model",
+       [](const TempDir& d) {
+         Write(d.File("cameras.txt"), "# cameras\n1 THIN_PRISM_FISHEYE 4000 3000 1 2 3\n");
+         return "camera convert --from colmap --to opencv " + d.File("cameras.txt") + " " + d.File("o.yml");
+       },
+       2, "cameras.txt:2: camera model THIN_PRISM_FISHEYE", "o.yml"},
+      {"colmap_file_with_two_cameras_and_no_choice",
+       [](const TempDir& d) {
+         Write(d.File("cameras.txt"), "1 PINHOLE 400 300 300 300 200 150\n2 PINHOLE 400 300 300 300 200 150\n");
+         return "camera convert --from colmap --to opencv " + d.File("cameras.txt") + " " + d.File("o.yml");
+       },
+       2, "name one with --camera (1, 2)", "o.yml"},
+      {"dji_dewarpdata_with_eight_values",
+       [](const TempDir& d) {
+         Write(d.File("dji.txt"), "\n2018-09-06;3684.48,3677.57,2.24,22.05,-0.26,0.10,3.7e-5,-3.2e-4\n");
+         return "camera convert --from dji --to opencv " + d.File("dji.txt") + " " + d.File("o.yml") + " --width 5472 --height 3648";
+       },
+       2, "dji.txt:2: DewarpData must hold 9 values", "o.yml"},
+      {"dji_string_without_an_image_size",
+       [](const TempDir& d) {
+         Write(d.File("dji.txt"), "3684.48,3677.57,2.24,22.05,-0.26,0.10,3.7e-5,-3.2e-4,-0.03\n");
+         return "camera convert --from dji --to opencv " + d.File("dji.txt") + " " + d.File("o.yml");
+       },
+       2, "dji.txt:1: the file gives no image size: pass --width", "o.yml"},
+      {"opensfm_width_contradicted_by_the_option",
+       [](const TempDir& d) {
+         Write(d.File("cameras.json"), "{\n  \"c\": {\n    \"projection_type\": \"perspective\",\n"
+                                       "    \"width\": 1368, \"height\": 912, \"focal\": 0.66, \"k1\": 0, \"k2\": 0\n  }\n}\n");
+         return "camera convert --from opensfm --to opencv " + d.File("cameras.json") + " " + d.File("o.yml") + " --width 1000";
+       },
+       2, "cameras.json:2: the file says 1368 px, --width says 1000", "o.yml"},
+      {"pix4d_cam_without_a_pixel_size",
+       [](const TempDir& d) {
+         Write(d.File("p.cam"), "Pix4D camera calibration file 0\nF 8.8\nPx 6.5\nPy 4.4\nK1 -0.1\n");
+         return "camera convert --from pix4d --to opencv " + d.File("p.cam") + " " + d.File("o.yml");
+       },
+       2, "p.cam:1: the pixel size is needed", "o.yml"},
+      {"pix4d_cam_with_an_unknown_parameter",
+       [](const TempDir& d) {
+         Write(d.File("p.cam"), "F 8.8\nPx 6.5\nPy 4.4\nK4 -0.1\n");
+         return "camera convert --from pix4d --to opencv " + d.File("p.cam") + " " + d.File("o.yml") + " --width 100 --height 80 --pixel-mm 0.1";
+       },
+       2, "p.cam:4: unknown parameter 'K4'", "o.yml"},
+      {"kalibr_camchain_of_an_unknown_distortion",
+       [](const TempDir& d) {
+         Write(d.File("chain.yaml"), "cam0:\n  camera_model: pinhole\n  intrinsics: [400, 400, 320, 240]\n"
+                                     "  distortion_model: fov\n  distortion_coeffs: [0.1]\n  resolution: [640, 480]\n");
+         return "camera convert --from kalibr --to opencv " + d.File("chain.yaml") + " " + d.File("o.yml");
+       },
+       2, "chain.yaml:4: distortion_model 'fov'", "o.yml"},
+      {"opencv_file_without_a_camera_matrix",
+       [](const TempDir& d) {
+         Write(d.File("cv.yml"), "%YAML:1.0\n---\nimage_width: 640\nimage_height: 480\n");
+         return "camera show --from opencv " + d.File("cv.yml");
+       },
+       2, "cv.yml:1: no camera_matrix", ""},
+      {"camera_convert_to_an_unknown_format",
+       [](const TempDir& d) {
+         Write(d.File("cam.yaml"), "pixel_size_mm: 0.005\nformat_px: [100, 80]\ninterior: {c: 10}\n");
+         return "camera convert --from aerocal --to agisoft " + d.File("cam.yaml") + " " + d.File("o.xml");
+       },
+       2, "--to: unknown camera format 'agisoft'", "o.xml"},
+      {"camera_convert_into_mm_without_a_pixel_size",
+       [](const TempDir& d) {
+         Write(d.File("cameras.txt"), "1 PINHOLE 400 300 300 300 200 150\n");
+         return "camera convert --from colmap --to dbat " + d.File("cameras.txt") + " " + d.File("o.xml");
+       },
+       2, "--pixel-mm: the target holds millimetres", "o.xml"},
+      {"camera_convert_out_is_a_directory",
+       [](const TempDir& d) {
+         Write(d.File("cameras.txt"), "1 PINHOLE 400 300 300 300 200 150\n");
+         fs::create_directories(d.File("outdir"));
+         return "camera convert --from colmap --to opencv " + d.File("cameras.txt") + " " + d.File("outdir");
+       },
+       2, "OUT", ""},
   };
   return cases;
 }

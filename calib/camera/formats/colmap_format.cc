@@ -37,8 +37,11 @@ ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields, const
   camera.model = *model;
   camera.frame.pixel_size_mm = pixel_size_mm;
   const auto integer = [&](const std::string& text, const char* what) {
-    const double v = internal::ParseNumber(text, where, what, 1e6);
-    if (!(v >= 1) || v != static_cast<int>(v))
+    const double v = internal::ParseNumber(text, where, what, 1e300);
+    if (!(v >= 1 && v <= 1e6))
+      ThrowInputError(where, std::string(what) + " out of range (got " + text +
+                                 ", expected 1 .. 1000000)");
+    if (v != static_cast<int>(v))
       ThrowInputError(where, std::string(what) + " must be an integer within 1 .. 1000000 (got " +
                                  text + ")");
     return static_cast<int>(v);
