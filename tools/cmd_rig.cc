@@ -248,13 +248,19 @@ int RunConvert(const ConvertArgs& args) {
     throw ConfigError("--fill must fit the " + std::to_string(info.bits) + "-bit images");
   stitch::TiffWriteOptions tiff;
   tiff.description = stitch::MappingDescription(
-      as_camera, args.camera + " at H = " + FormatNumber(height_m) + " m (plane homographies)");
+      as_camera, args.camera + " at H = " + FormatNumber(height_m) +
+                       " m (plane homographies; heads with distortion add correction grids)");
   tiff.force_bigtiff = args.bigtiff;
   stitch::TiffWriter writer(
       args.out, {as_camera.width_px, as_camera.height_px, info.bands, info.bits}, tiff);
+  stitch::HeadMapCorrections corrections;
   const stitch::ResampleReport report =
-      stitch::ResampleVirtualImage(as_camera, sources, &writer, options);
+      stitch::ConvertRigExposure(converter, sources, &writer, options, &corrections);
   writer.Commit();
+  if (corrections.finest_step_px > 0)
+    std::printf("heads with distortion: correction grids down to %d px, largest interpolation "
+                "error %.4f px against the exact map\n",
+                corrections.finest_step_px, corrections.max_error_px);
   std::printf("virtual image %d x %d px from %zu heads at H = %g m: %ld px covered, %ld in "
               "overlaps, %ld filled, %.2f s\n",
               as_camera.width_px, as_camera.height_px, rig.heads.size(), height_m, report.covered,

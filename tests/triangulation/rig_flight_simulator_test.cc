@@ -110,6 +110,34 @@ TEST(RigFlightSimulator, FilesReadBackWithHeadsAndVelocity) {
   }
 }
 
+TEST(RigBlockFiles, PartialVelocityAndMixedColumnsAreRefusedByLine) {
+  testing::TempDir dir;
+  WriteFileAtomically(dir.File("exposures.csv"),
+                      "image,camera,X,Y,Z,omega,phi,kappa,vX,vY,vZ\n"
+                      "1,rig1,0,0,1000,0,0,0,50,0,0\n"
+                      "2,rig1,100,0,1000,0,0,0,50,,0\n");
+  try {
+    ReadExposures(dir.File("exposures.csv"));
+    ADD_FAILURE() << "a partial velocity was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("exposures.csv:3: vX, vY, vZ must all be given"),
+              std::string::npos)
+        << e.what();
+  }
+  WriteFileAtomically(dir.File("observations.csv"),
+                      "image,head,subimage,point,u,v\n1,A,I,P,1,2\n");
+  EXPECT_THROW(ReadObservations(dir.File("observations.csv"), 0.5), InputError);
+  WriteFileAtomically(dir.File("observations.csv"), "image,head,point,col,row\n1,,P,1,2\n");
+  try {
+    ReadObservations(dir.File("observations.csv"), 0.5);
+    ADD_FAILURE() << "an empty head was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("observations.csv:2: head must not be empty"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 TEST(RigFlightSimulator, TheSameSeedGivesTheSameFlight) {
   RigFlightSimulationOptions o;
   o.flight.exposures = 6;
