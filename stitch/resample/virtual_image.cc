@@ -70,35 +70,23 @@ bool CoveredColumns(const Window& win, double V, int virtual_width, int* first, 
   return *first <= *last;
 }
 
-// kAffine: the projective row of the map is (0, 0, 1), so w = 1 and no division is needed.
-template <typename T, int kBands, Interpolation kInterpolation, bool kAffine>
-void AccumulateRow(const Window& win, double V, int first, int last, float* sum,
-                   std::uint8_t* count) {
+// Adds the sample of the window at (u, v) (window pixels, inside) to out[0 .. kBands).
+template <typename T, int kBands, Interpolation kInterpolation>
+inline void AddSample(const Window& win, float u, float v, float* out) {
   const T* data = reinterpret_cast<const T*>(win.bytes.data());
   const int stride = win.w * kBands;
-  const Eigen::Matrix3d& m = win.sub_from_virtual;
-  double x = m(0, 0) * first + m(0, 1) * V + m(0, 2) - win.x0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
-  double y = m(1, 0) * first + m(1, 1) * V + m(1, 2) - win.y0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
-  double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
-  const double dx = m(0, 0) - win.x0 * m(2, 0), dy = m(1, 0) - win.y0 * m(2, 0), dw = m(2, 0);
-  const float max_u = static_cast<float>(win.w - 1), max_v = static_cast<float>(win.h - 1);
-  for (int c = first; c <= last; ++c, x += dx, y += dy, w += dw) {
-    const float u = std::clamp(static_cast<float>(kAffine ? x : x / w), 0.0f, max_u);
-    const float v = std::clamp(static_cast<float>(kAffine ? y : y / w), 0.0f, max_v);
-    float* out = sum + c * kBands;
-    ++count[c];
-    if constexpr (kInterpolation == Interpolation::kBilinear) {
-      const int iu = std::min(static_cast<int>(u), std::max(win.w - 2, 0));
-      const int iv = std::min(static_cast<int>(v), std::max(win.h - 2, 0));
-      const float fu = u - iu, fv = v - iv;
-      const int du = win.w > 1 ? kBands : 0, dv = win.h > 1 ? stride : 0;
-      const T* p = data + iv * stride + iu * kBands;
-      for (int b = 0; b < kBands; ++b) {
-        const float top = p[b] + fu * (static_cast<float>(p[b + du]) - p[b]);
-        const float bottom = p[b + dv] + fu * (static_cast<float>(p[b + dv + du]) - p[b + dv]);
-        out[b] += top + fv * (bottom - top);
-      }
-    } else {
+  if constexpr (kInterpolation == Interpolation::kBilinear) {
+    const int iu = std::min(static_cast<int>(u), std::max(win.w - 2, 0));
+    const int iv = std::min(static_cast<int>(v), std::max(win.h - 2, 0));
+    const float fu = u - iu, fv = v - iv;
+    const int du = win.w > 1 ? kBands : 0, dv = win.h > 1 ? stride : 0;
+    const T* p = data + iv * stride + iu * kBands;
+    for (int b = 0; b < kBands; ++b) {
+      const float top = p[b] + fu * (static_cast<float>(p[b + du]) - p[b]);
+      const float bottom = p[b + dv] + fu * (static_cast<float>(p[b + dv + du]) - p[b + dv]);
+      out[b] += top + fv * (bottom - top);
+    }
+  } else {
     const int iu = static_cast<int>(u), iv = static_cast<int>(v);
     float wu[4], wv[4];
     CubicWeights(u - iu, wu);
@@ -117,7 +105,24 @@ void AccumulateRow(const Window& win, double V, int first, int last, float* sum,
       }
       out[b] += acc;
     }
-    }
+  }
+}
+
+// kAffine: the projective row of the map is (0, 0, 1), so w = 1 and no division is needed.
+template <typename T, int kBands, Interpolation kInterpolation, bool kAffine>
+void AccumulateRow(const Window& win, double V, int first, int last, float* sum,
+                   std::uint8_t* count) {
+  const Eigen::Matrix3d& m = win.sub_from_virtual;
+  double x = m(0, 0) * first + m(0, 1) * V + m(0, 2) - win.x0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
+  double y = m(1, 0) * first + m(1, 1) * V + m(1, 2) - win.y0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
+  double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
+  const double dx = m(0, 0) - win.x0 * m(2, 0), dy = m(1, 0) - win.y0 * m(2, 0), dw = m(2, 0);
+  const float max_u = static_cast<float>(win.w - 1), max_v = static_cast<float>(win.h - 1);
+  for (int c = first; c <= last; ++c, x += dx, y += dy, w += dw) {
+    const float u = std::clamp(static_cast<float>(kAffine ? x : x / w), 0.0f, max_u);
+    const float v = std::clamp(static_cast<float>(kAffine ? y : y / w), 0.0f, max_v);
+    ++count[c];
+    AddSample<T, kBands, kInterpolation>(win, u, v, sum + c * kBands);
   }
 }
 
@@ -148,8 +153,6 @@ void AccumulateCorrectedRow(const Window& win, double V, int first, int last, fl
   thread_local std::vector<float> duv;
   duv.resize(2 * static_cast<size_t>(last - first + 1));
   CorrectionAlongRow(*win.correction, V, first, last, duv.data());
-  const T* data = reinterpret_cast<const T*>(win.bytes.data());
-  const int stride = win.w * kBands;
   const Eigen::Matrix3d& m = win.sub_from_virtual;
   double x = m(0, 0) * first + m(0, 1) * V + m(0, 2);
   double y = m(1, 0) * first + m(1, 1) * V + m(1, 2);
@@ -161,39 +164,8 @@ void AccumulateCorrectedRow(const Window& win, double V, int first, int last, fl
     if (!(su >= 0.0f && su <= max_u && sv >= 0.0f && sv <= max_v)) continue;
     const float u = std::clamp(su - win.x0, 0.0f, static_cast<float>(win.w - 1));
     const float v = std::clamp(sv - win.y0, 0.0f, static_cast<float>(win.h - 1));
-    float* out = sum + c * kBands;
     ++count[c];
-    if constexpr (kInterpolation == Interpolation::kBilinear) {
-      const int iu = std::min(static_cast<int>(u), std::max(win.w - 2, 0));
-      const int iv = std::min(static_cast<int>(v), std::max(win.h - 2, 0));
-      const float fu = u - iu, fv = v - iv;
-      const int du = win.w > 1 ? kBands : 0, dv = win.h > 1 ? stride : 0;
-      const T* p = data + iv * stride + iu * kBands;
-      for (int b = 0; b < kBands; ++b) {
-        const float top = p[b] + fu * (static_cast<float>(p[b + du]) - p[b]);
-        const float bottom = p[b + dv] + fu * (static_cast<float>(p[b + dv + du]) - p[b + dv]);
-        out[b] += top + fv * (bottom - top);
-      }
-    } else {
-      const int iu = static_cast<int>(u), iv = static_cast<int>(v);
-      float wu[4], wv[4];
-      CubicWeights(u - iu, wu);
-      CubicWeights(v - iv, wv);
-      int cols[4], rows[4];
-      for (int k = 0; k < 4; ++k) {
-        cols[k] = std::clamp(iu - 1 + k, 0, win.w - 1) * kBands;
-        rows[k] = std::clamp(iv - 1 + k, 0, win.h - 1) * stride;
-      }
-      for (int b = 0; b < kBands; ++b) {
-        float acc = 0.0f;
-        for (int r = 0; r < 4; ++r) {
-          const T* row = data + rows[r] + b;
-          acc += wv[r] * (wu[0] * row[cols[0]] + wu[1] * row[cols[1]] + wu[2] * row[cols[2]] +
-                          wu[3] * row[cols[3]]);
-        }
-        out[b] += acc;
-      }
-    }
+    AddSample<T, kBands, kInterpolation>(win, u, v, sum + c * kBands);
   }
 }
 
