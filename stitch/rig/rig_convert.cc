@@ -77,18 +77,29 @@ bool HasDistortion(const calib::Camera& camera) {
   return false;
 }
 
+// The exact head pixel of a virtual pixel: over the plane, or over the DEM when given.
+std::optional<Eigen::Vector2d> ExactHeadPixel(const RigConverter& converter, const DemGrid* dem,
+                                              int head, const Eigen::Vector2d& virtual_px) {
+  if (!dem) return converter.HeadFromVirtual(head, virtual_px);
+  const auto g = IntersectDem(*dem, converter.VirtualCenter(),
+                              converter.ObjectFromVirtual() *
+                                  converter.rig().virtual_camera.RayFromPixel(virtual_px));
+  if (!g) return converter.HeadFromVirtual(head, virtual_px);
+  return converter.HeadPixelOfPoint(head, *g);
+}
+
 // Exact head pixel minus the homography's at virtual pixel (U, V); zero where the exact map is
 // undefined (the ray misses the plane or the correction does not invert: far outside the head).
-Eigen::Vector2d MapDifference(const RigConverter& converter, int head, const Eigen::Matrix3d& h,
-                              const Eigen::Vector2d& virtual_px) {
-  const auto exact = converter.HeadFromVirtual(head, virtual_px);
+Eigen::Vector2d MapDifference(const RigConverter& converter, const DemGrid* dem, int head,
+                              const Eigen::Matrix3d& h, const Eigen::Vector2d& virtual_px) {
+  const auto exact = ExactHeadPixel(converter, dem, head, virtual_px);
   if (!exact) return Eigen::Vector2d::Zero();
   const Eigen::Vector2d linear = (h * virtual_px.homogeneous()).hnormalized();
   return *exact - linear;
 }
 
-MapCorrectionGrid MakeGrid(const RigConverter& converter, int head, const Eigen::Matrix3d& h,
-                           int step) {
+MapCorrectionGrid MakeGrid(const RigConverter& converter, const DemGrid* dem, int head,
+                           const Eigen::Matrix3d& h, int step) {
   const calib::VirtualCamera& v = converter.rig().virtual_camera;
   MapCorrectionGrid g;
   g.step_px = step;
@@ -98,7 +109,7 @@ MapCorrectionGrid MakeGrid(const RigConverter& converter, int head, const Eigen:
   for (int j = 0; j < g.rows; ++j)
     for (int i = 0; i < g.cols; ++i) {
       const Eigen::Vector2d d =
-          MapDifference(converter, head, h, Eigen::Vector2d(i * step, j * step));
+          MapDifference(converter, dem, head, h, Eigen::Vector2d(i * step, j * step));
       const size_t at = 2 * (static_cast<size_t>(j) * g.cols + i);
       g.duv[at] = static_cast<float>(d.x());
       g.duv[at + 1] = static_cast<float>(d.y());
@@ -109,13 +120,13 @@ MapCorrectionGrid MakeGrid(const RigConverter& converter, int head, const Eigen:
 
 // Largest |interpolated - exact| (px) at the cell centres whose exact head pixel lies inside the
 // head's format.
-double GridError(const RigConverter& converter, int head, const Eigen::Matrix3d& h,
-                 const MapCorrectionGrid& g) {
+double GridError(const RigConverter& converter, const DemGrid* dem, int head,
+                 const Eigen::Matrix3d& h, const MapCorrectionGrid& g) {
   double worst = 0.0;
   for (int j = 0; j + 1 < g.rows; ++j)
     for (int i = 0; i + 1 < g.cols; ++i) {
       const Eigen::Vector2d centre((i + 0.5) * g.step_px, (j + 0.5) * g.step_px);
-      const auto exact = converter.HeadFromVirtual(head, centre);
+      const auto exact = ExactHeadPixel(converter, dem, head, centre);
       if (!exact || !converter.InHeadFormat(head, *exact)) continue;
       Eigen::Vector2d interpolated = Eigen::Vector2d::Zero();
       for (int dj = 0; dj < 2; ++dj)
@@ -131,19 +142,20 @@ double GridError(const RigConverter& converter, int head, const Eigen::Matrix3d&
 
 }  // namespace
 
-HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double tolerance_px) {
+HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double tolerance_px,
+                                          const DemGrid* dem) {
   AEROCAL_CHECK(tolerance_px > 0) << tolerance_px;
   HeadMapCorrections out;
   const calib::Rig& rig = converter.rig();
   out.grids.resize(rig.heads.size());
   for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k) {
-    if (!HasDistortion(rig.heads[k].camera)) continue;
+    if (!dem && !HasDistortion(rig.heads[k].camera)) continue;
     const Eigen::Matrix3d h = HeadFromVirtualHomography(converter, k);
     double error = 0.0;
     int step = 64;
     for (;; step /= 2) {
-      out.grids[k] = MakeGrid(converter, k, h, step);
-      error = GridError(converter, k, h, out.grids[k]);
+      out.grids[k] = MakeGrid(converter, dem, k, h, step);
+      error = GridError(converter, dem, k, h, out.grids[k]);
       if (error <= tolerance_px || step <= 2) break;
     }
     out.max_error_px = std::max(out.max_error_px, error);
@@ -154,8 +166,9 @@ HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double 
 
 ResampleReport ConvertRigExposure(const RigConverter& converter,
                                   const std::vector<RasterSource*>& sources, RasterSink* sink,
-                                  const ResampleOptions& options, HeadMapCorrections* corrections) {
-  HeadMapCorrections grids = MakeHeadMapCorrections(converter);
+                                  const ResampleOptions& options, HeadMapCorrections* corrections,
+                                  const DemGrid* dem) {
+  HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01, dem);
   const ResampleReport report = ResampleVirtualImage(RigExposureAsSubimageCamera(converter),
                                                      sources, sink, options, grids.grids);
   if (corrections) *corrections = std::move(grids);

@@ -21,6 +21,7 @@
 #include "calib/camera/rig.h"
 #include "stitch/resample/raster.h"
 #include "stitch/resample/virtual_image.h"
+#include "stitch/rig/dem_grid.h"
 #include "stitch/rig/rig_conversion.h"
 
 namespace aerocal::stitch {
@@ -42,14 +43,20 @@ struct HeadMapCorrections {
   double max_error_px = 0.0;
   int finest_step_px = 0;  // 0: no head needed a grid
 };
-HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double tolerance_px = 0.01);
+/// With `dem`, the exact map intersects the virtual ray with the DEM (IntersectDem) instead of the
+/// plane, and every head gets a grid (the homography of the converter's plane stays the base:
+/// choose the plane near the DEM's mean height). Virtual pixels whose ray misses the DEM keep the
+/// plane's map.
+HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double tolerance_px = 0.01,
+                                          const DemGrid* dem = nullptr);
 
 /// Converts the head images (`sources`, one per head, rig order) to the virtual image in `sink`.
-/// Heads with distortion go through MakeHeadMapCorrections (its report in `corrections` when
-/// given).
+/// Heads with distortion, and every head over a DEM, go through MakeHeadMapCorrections (its
+/// report in `corrections` when given).
 ResampleReport ConvertRigExposure(const RigConverter& converter,
                                   const std::vector<RasterSource*>& sources, RasterSink* sink,
                                   const ResampleOptions& options,
-                                  HeadMapCorrections* corrections = nullptr);
+                                  HeadMapCorrections* corrections = nullptr,
+                                  const DemGrid* dem = nullptr);
 
 }  // namespace aerocal::stitch
