@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 #include <nlohmann/json.hpp>
@@ -23,6 +24,7 @@
 #include "stitch/rig/error_analysis_json.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/rig/rig_conversion.h"
+#include "stitch/rig/dem_grid.h"
 #include "stitch/rig/rig_convert.h"
 #include "tools/command_registry.h"
 #include "tools/image_sources.h"
@@ -212,6 +214,7 @@ struct ConvertArgs {
   double relief_m = 100.0;
   int strip_rows = 256;
   bool bigtiff = false;
+  std::string dem;  // ESRI ASCII grid: the rectification surface instead of the plane
 };
 
 int RunConvert(const ConvertArgs& args) {
@@ -248,13 +251,22 @@ int RunConvert(const ConvertArgs& args) {
     throw ConfigError("--fill must fit the " + std::to_string(info.bits) + "-bit images");
   stitch::TiffWriteOptions tiff;
   tiff.description = stitch::MappingDescription(
-      as_camera, args.camera + " at H = " + FormatNumber(height_m) + " m (plane homographies)");
+      as_camera, args.camera + " at H = " + FormatNumber(height_m) +
+                       " m (plane homographies; heads with distortion add correction grids)");
   tiff.force_bigtiff = args.bigtiff;
   stitch::TiffWriter writer(
       args.out, {as_camera.width_px, as_camera.height_px, info.bands, info.bits}, tiff);
-  const stitch::ResampleReport report =
-      stitch::ResampleVirtualImage(as_camera, sources, &writer, options);
+  std::optional<stitch::DemGrid> dem;
+  if (!args.dem.empty()) dem = stitch::ReadDemAscii(args.dem);
+  stitch::HeadMapCorrections corrections;
+  const stitch::ResampleReport report = stitch::ConvertRigExposure(
+      converter, sources, &writer, options, &corrections, dem ? &*dem : nullptr);
   writer.Commit();
+  if (corrections.finest_step_px > 0)
+    std::printf("%s: correction grids down to %d px, largest interpolation error %.4f px against "
+                "the exact map\n",
+                dem ? "DEM surface" : "heads with distortion", corrections.finest_step_px,
+                corrections.max_error_px);
   std::printf("virtual image %d x %d px from %zu heads at H = %g m: %ld px covered, %ld in "
               "overlaps, %ld filled, %.2f s\n",
               as_camera.width_px, as_camera.height_px, rig.heads.size(), height_m, report.covered,
@@ -318,6 +330,9 @@ CommandRun Setup(CLI::App& app) {
   cv->add_option("--relief-m", convert->relief_m,
                  "Relief (m off the plane) whose displacement between heads is reported");
   cv->add_flag("--bigtiff", convert->bigtiff, "Write BigTIFF even when classic TIFF would do");
+  cv->add_option("--dem", convert->dem,
+                 "DEM (ESRI ASCII grid, object frame of the exposure) as the rectification surface; "
+                 "the plane at --height-m stays the base of the maps");
   return [args, ea, convert, cv] {
     if (ea->parsed()) return RunErrorAnalysis(*args);
     if (cv->parsed()) return RunConvert(*convert);

@@ -1,4 +1,5 @@
 // aerocal simulate: writes the deterministic example flight (triangulation/simulation).
+#include <cmath>
 #include <cstdio>
 #include <sstream>
 
@@ -6,18 +7,62 @@
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
 #include "triangulation/simulation/flight_simulator.h"
+#include "triangulation/simulation/rig_flight_simulator.h"
 
 namespace aerocal::tools {
 namespace {
 
-CommandRun SetupSimulate(CLI::App& app) {
-  struct Args {
+struct SimulateArgs {
     std::string out;
     std::string layout = "3x2";
     std::string nominal_mapping = "affine";
     triangulation::FlightSimulationOptions options;
     std::uint64_t seed = 1;
-  };
+    std::string rig;
+    double increment_arcsec = 0.0, time_offset_ms = 0.0, speed_mps = 0.0;
+};
+
+using FlightIntOption = std::pair<std::string, int triangulation::FlightSimulationOptions::*>;
+using FlightDoubleOption = std::pair<std::string, double triangulation::FlightSimulationOptions::*>;
+
+// `simulate --rig NAME`: the rig flight, with the flight options the user gave over the rig's
+// defaults; the frame camera's options are refused by name.
+int RunRigSimulation(const CLI::App& app, const SimulateArgs& args,
+                     const std::vector<FlightIntOption>& int_options,
+                     const std::vector<FlightDoubleOption>& double_options) {
+  const auto preset = triangulation::ParseRigPreset(args.rig);
+  if (!preset) throw ConfigError("--rig must be dual-lens or uav4 (got '" + args.rig + "')");
+  for (const char* frame_only :
+       {"--layout", "--nominal-mapping", "--ccd-shear", "--stitch-noise-px", "--stitch-ties"})
+    if (app.get_option(frame_only)->count() > 0)
+      throw ConfigError(std::string(frame_only) + " applies to the frame camera, not to --rig");
+  triangulation::RigFlightSimulationOptions options;
+  options.preset = *preset;
+  for (const auto& [name, member] : int_options)
+    if (app.get_option(name)->count() > 0) options.flight.*member = args.options.*member;
+  for (const auto& [name, member] : double_options)
+    if (app.get_option(name)->count() > 0) options.flight.*member = args.options.*member;
+  options.flight.seed = args.seed;
+  if (options.flight.control_points > options.flight.ground_points)
+    throw ConfigError("--control (" + std::to_string(options.flight.control_points) +
+                      ") must not exceed --points (" + std::to_string(options.flight.ground_points) +
+                      ")");
+  options.increment_sigma_rad = args.increment_arcsec * M_PI / (180.0 * 3600.0);
+  options.time_offset_s = args.time_offset_ms * 1e-3;
+  options.speed_mps = args.speed_mps;
+  if (options.time_offset_s != 0.0 && options.speed_mps == 0.0)
+    std::fprintf(stderr, "warning: --head-time-offset-ms without --speed-mps moves no head\n");
+  const auto flight = triangulation::SimulateRigFlight(options);
+  triangulation::WriteSimulatedRigFlight(flight, args.out);
+  std::printf("simulated rig %s: %zu exposures x %zu heads, %zu ground points, %zu head "
+              "observations -> %s\n",
+              flight.nominal.name.c_str(), flight.exposures_truth.size(), flight.nominal.heads.size(),
+              flight.points_truth.size(), flight.observations.size(), args.out.c_str());
+  return kExitOk;
+}
+
+CommandRun SetupSimulate(CLI::App& app) {
+  using Args = SimulateArgs;
   auto args = std::make_shared<Args>();
   auto& o = args->options;
   app.add_option("--out", args->out, "Output folder (created; files replaced atomically)")->required();
@@ -48,8 +93,46 @@ CommandRun SetupSimulate(CLI::App& app) {
   app.add_option("--ccd-shear", o.misplacement.shear,
                  "Affine part of the true CCD misplacements (x-scale minus y-scale and skew, each +-this), 0..0.1")
       ->check(CLI::Range(0.0, 0.1));
-  return [args]() {
+  app.add_option("--rig", args->rig,
+                 "Simulate a multi-head rig flight instead: dual-lens (configs/rig_dual_lens.yaml; "
+                 "uav4 follows). Flight defaults then: 1200 m, 30 exposures, 100 m relief, 40 "
+                 "surveyed and 300 tie points; the flight options above override them");
+  auto* increment = app.add_option("--head-increment-arcsec", args->increment_arcsec,
+                                   "--rig: sigma of the per-exposure attitude increments E_k of the "
+                                   "non-reference heads, 0..3600 arcsec")
+                        ->check(CLI::Range(0.0, 3600.0));
+  auto* time_offset = app.add_option("--head-time-offset-ms", args->time_offset_ms,
+                                     "--rig: exposure time offset dT_k of the non-reference heads, "
+                                     "-1000..1000 ms (with --speed-mps)")
+                          ->check(CLI::Range(-1000.0, 1000.0));
+  auto* speed = app.add_option("--speed-mps", args->speed_mps,
+                               "--rig: platform speed along the strips, 0..1000 m/s (> 0: "
+                               "exposures.csv carries vX, vY, vZ)")
+                    ->check(CLI::Range(0.0, 1000.0));
+  // Flight options a rig flight takes over when given (the rig's defaults otherwise).
+  using Flight = triangulation::FlightSimulationOptions;
+  const std::vector<std::pair<std::string, int Flight::*>> int_options = {
+      {"--exposures", &Flight::exposures},         {"--strips", &Flight::strips},
+      {"--points", &Flight::ground_points},        {"--control", &Flight::control_points},
+      {"--tie-points", &Flight::tie_points}};
+  const std::vector<std::pair<std::string, double Flight::*>> double_options = {
+      {"--height-m", &Flight::flying_height_m},
+      {"--forward-overlap", &Flight::forward_overlap},
+      {"--side-overlap", &Flight::side_overlap},
+      {"--relief-m", &Flight::terrain_relief_m},
+      {"--image-noise-px", &Flight::image_noise_px},
+      {"--image-sigma-px", &Flight::image_sigma_px},
+      {"--survey-sigma-m", &Flight::survey_sigma_m},
+      {"--gnss-sigma-m", &Flight::gnss_sigma_m},
+      {"--imu-sigma-deg", &Flight::imu_sigma_deg},
+      {"--start-offset-m", &Flight::start_position_error_m},
+      {"--start-offset-deg", &Flight::start_angle_error_deg}};
+  return [args, &app, int_options, double_options, increment, time_offset, speed]() {
     CheckOutputFolder(args->out, "--out");
+    if (!args->rig.empty()) return RunRigSimulation(app, *args, int_options, double_options);
+    for (const CLI::Option* rig_only : {increment, time_offset, speed})
+      if (rig_only->count() > 0)
+        throw ConfigError(rig_only->get_name() + " applies to a rig flight (--rig) only");
     auto& o = args->options;
     o.seed = args->seed;
     int rows = 0, cols = 0;

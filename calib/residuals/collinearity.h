@@ -8,6 +8,7 @@
 
 #include "calib/camera/brown_fraser10.h"
 #include "calib/camera/pixel_frame.h"
+#include "calib/camera/rig.h"
 #include "calib/camera/rotation.h"
 #include "calib/camera/subimage_mapping.h"
 #include "calib/residuals/autodiff_residual.h"
@@ -15,11 +16,12 @@
 namespace aerocal::calib {
 
 namespace internal {
+/// The one collinearity condition of aerocal: an object point already turned into the image-space
+/// frame of its camera or head ([U V W] = R^T (X - X0)) against the measured photo coordinates.
+/// Every collinearity residual (frame camera, sub-image, rig head) ends here.
 template <typename T>
-bool CollinearityError(const T* interior, const T* opk, const T* center, const T* point,
-                       const T* measured_xy_mm, double inverse_sigma_mm, T* residual) {
-  T uvw[3];
-  ImageSpaceFromObject(opk, center, point, uvw);
+bool CollinearityErrorFromImageSpace(const T* interior, const T* uvw, const T* measured_xy_mm,
+                                     double inverse_sigma_mm, T* residual) {
   if (!(uvw[2] < T(0))) return false;  // point on or behind the projection plane
   T ideal[2];
   BrownFraser10Model::IdealFromMeasured(interior, measured_xy_mm, ideal);
@@ -27,6 +29,14 @@ bool CollinearityError(const T* interior, const T* opk, const T* center, const T
   residual[0] = (ideal[0] + c * uvw[0] / uvw[2]) * T(inverse_sigma_mm);
   residual[1] = (ideal[1] + c * uvw[1] / uvw[2]) * T(inverse_sigma_mm);
   return true;
+}
+
+template <typename T>
+bool CollinearityError(const T* interior, const T* opk, const T* center, const T* point,
+                       const T* measured_xy_mm, double inverse_sigma_mm, T* residual) {
+  T uvw[3];
+  ImageSpaceFromObject(opk, center, point, uvw);
+  return CollinearityErrorFromImageSpace(interior, uvw, measured_xy_mm, inverse_sigma_mm, residual);
 }
 }  // namespace internal
 
@@ -73,6 +83,43 @@ struct SubimageCollinearityResidual
   PixelFrame frame_;
   double uv_conditioned_[2];
   double inverse_sigma_mm_;
+};
+
+/// Observation (col, row) in the pixel frame of head k of a rig (CONVENTIONS.md "Multi-head
+/// rigs"): the head's pose is R_k = R M_k E_k, O_k = O + R t_k + v dT_k (calib/camera/rig.h
+/// HeadPose), then the same collinearity as the frame camera with the head's own interior.
+///   r = ((xb + dx, yb + dy) - (-c_k U / W, -c_k V / W)) / sigma_mm,  [U V W] = R_k^T (X - O_k)
+/// blocks: interior[10] (head k, table units), rig_opk[3] (rad), rig_center[3] (m),
+///         mount[3] (M_k omega, phi, kappa, rad), lever_arm[3] (t_k in the rig frame, m),
+///         increment[3] (E_k, rad), dt[1] (dT_k, s), point[3] (m).
+/// The platform velocity v (object frame, m/s) is data of the exposure, held by value.
+/// A rig of one head with identity mount, zero lever arm, zero increment and dT = 0 gives exactly
+/// CollinearityResidual (tests/calib/residuals_test.cc checks it).
+struct RigHeadCollinearityResidual
+    : AutoDiffResidual<RigHeadCollinearityResidual, 2, 10, 3, 3, 3, 3, 3, 1, 3> {
+  RigHeadCollinearityResidual(const PixelFrame& head_frame, const Eigen::Vector2d& pixel,
+                              double sigma_px, const Eigen::Vector3d& velocity_mps)
+      : inverse_sigma_mm_(1.0 / (sigma_px * head_frame.pixel_size_mm)),
+        velocity_mps_{velocity_mps.x(), velocity_mps.y(), velocity_mps.z()} {
+    head_frame.PhotoFromPixel(pixel.data(), xy_mm_);
+  }
+  template <typename T>
+  bool operator()(const T* interior, const T* rig_opk, const T* rig_center, const T* mount,
+                  const T* lever_arm, const T* increment, const T* dt, const T* point,
+                  T* r) const {
+    const T velocity[3] = {T(velocity_mps_[0]), T(velocity_mps_[1]), T(velocity_mps_[2])};
+    T object_from_head[9], head_center[3], uvw[3];
+    HeadPose(rig_opk, rig_center, mount, lever_arm, increment, dt, velocity, object_from_head,
+             head_center);
+    HeadSpaceFromObject(object_from_head, head_center, point, uvw);
+    const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
+    return internal::CollinearityErrorFromImageSpace(interior, uvw, xy, inverse_sigma_mm_, r);
+  }
+
+ private:
+  double xy_mm_[2];
+  double inverse_sigma_mm_;
+  double velocity_mps_[3];
 };
 
 }  // namespace aerocal::calib

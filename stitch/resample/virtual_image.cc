@@ -25,6 +25,7 @@ struct Window {
   int x0 = 0, y0 = 0, w = 0, h = 0;      // in sub-image pixels
   int width_px = 0, height_px = 0;       // sub-image format
   Eigen::Matrix3d sub_from_virtual;      // homogeneous
+  const MapCorrectionGrid* correction = nullptr;  // none: the projectivity alone
   std::vector<std::uint8_t> bytes;
 };
 
@@ -69,35 +70,23 @@ bool CoveredColumns(const Window& win, double V, int virtual_width, int* first, 
   return *first <= *last;
 }
 
-// kAffine: the projective row of the map is (0, 0, 1), so w = 1 and no division is needed.
-template <typename T, int kBands, Interpolation kInterpolation, bool kAffine>
-void AccumulateRow(const Window& win, double V, int first, int last, float* sum,
-                   std::uint8_t* count) {
+// Adds the sample of the window at (u, v) (window pixels, inside) to out[0 .. kBands).
+template <typename T, int kBands, Interpolation kInterpolation>
+inline void AddSample(const Window& win, float u, float v, float* out) {
   const T* data = reinterpret_cast<const T*>(win.bytes.data());
   const int stride = win.w * kBands;
-  const Eigen::Matrix3d& m = win.sub_from_virtual;
-  double x = m(0, 0) * first + m(0, 1) * V + m(0, 2) - win.x0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
-  double y = m(1, 0) * first + m(1, 1) * V + m(1, 2) - win.y0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
-  double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
-  const double dx = m(0, 0) - win.x0 * m(2, 0), dy = m(1, 0) - win.y0 * m(2, 0), dw = m(2, 0);
-  const float max_u = static_cast<float>(win.w - 1), max_v = static_cast<float>(win.h - 1);
-  for (int c = first; c <= last; ++c, x += dx, y += dy, w += dw) {
-    const float u = std::clamp(static_cast<float>(kAffine ? x : x / w), 0.0f, max_u);
-    const float v = std::clamp(static_cast<float>(kAffine ? y : y / w), 0.0f, max_v);
-    float* out = sum + c * kBands;
-    ++count[c];
-    if constexpr (kInterpolation == Interpolation::kBilinear) {
-      const int iu = std::min(static_cast<int>(u), std::max(win.w - 2, 0));
-      const int iv = std::min(static_cast<int>(v), std::max(win.h - 2, 0));
-      const float fu = u - iu, fv = v - iv;
-      const int du = win.w > 1 ? kBands : 0, dv = win.h > 1 ? stride : 0;
-      const T* p = data + iv * stride + iu * kBands;
-      for (int b = 0; b < kBands; ++b) {
-        const float top = p[b] + fu * (static_cast<float>(p[b + du]) - p[b]);
-        const float bottom = p[b + dv] + fu * (static_cast<float>(p[b + dv + du]) - p[b + dv]);
-        out[b] += top + fv * (bottom - top);
-      }
-    } else {
+  if constexpr (kInterpolation == Interpolation::kBilinear) {
+    const int iu = std::min(static_cast<int>(u), std::max(win.w - 2, 0));
+    const int iv = std::min(static_cast<int>(v), std::max(win.h - 2, 0));
+    const float fu = u - iu, fv = v - iv;
+    const int du = win.w > 1 ? kBands : 0, dv = win.h > 1 ? stride : 0;
+    const T* p = data + iv * stride + iu * kBands;
+    for (int b = 0; b < kBands; ++b) {
+      const float top = p[b] + fu * (static_cast<float>(p[b + du]) - p[b]);
+      const float bottom = p[b + dv] + fu * (static_cast<float>(p[b + dv + du]) - p[b + dv]);
+      out[b] += top + fv * (bottom - top);
+    }
+  } else {
     const int iu = static_cast<int>(u), iv = static_cast<int>(v);
     float wu[4], wv[4];
     CubicWeights(u - iu, wu);
@@ -116,13 +105,80 @@ void AccumulateRow(const Window& win, double V, int first, int last, float* sum,
       }
       out[b] += acc;
     }
+  }
+}
+
+// kAffine: the projective row of the map is (0, 0, 1), so w = 1 and no division is needed.
+template <typename T, int kBands, Interpolation kInterpolation, bool kAffine>
+void AccumulateRow(const Window& win, double V, int first, int last, float* sum,
+                   std::uint8_t* count) {
+  const Eigen::Matrix3d& m = win.sub_from_virtual;
+  double x = m(0, 0) * first + m(0, 1) * V + m(0, 2) - win.x0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
+  double y = m(1, 0) * first + m(1, 1) * V + m(1, 2) - win.y0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
+  double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
+  const double dx = m(0, 0) - win.x0 * m(2, 0), dy = m(1, 0) - win.y0 * m(2, 0), dw = m(2, 0);
+  const float max_u = static_cast<float>(win.w - 1), max_v = static_cast<float>(win.h - 1);
+  for (int c = first; c <= last; ++c, x += dx, y += dy, w += dw) {
+    const float u = std::clamp(static_cast<float>(kAffine ? x : x / w), 0.0f, max_u);
+    const float v = std::clamp(static_cast<float>(kAffine ? y : y / w), 0.0f, max_v);
+    ++count[c];
+    AddSample<T, kBands, kInterpolation>(win, u, v, sum + c * kBands);
+  }
+}
+
+// Interpolates the correction grid along virtual row V into per-column (du, dv) for [first, last].
+void CorrectionAlongRow(const MapCorrectionGrid& g, double V, int first, int last, float* duv) {
+  const double gv = V / g.step_px;
+  const int j = std::min(static_cast<int>(gv), g.rows - 2);
+  const float fv = static_cast<float>(gv - j);
+  const float* top = g.duv.data() + 2 * static_cast<size_t>(j) * g.cols;
+  const float* bottom = top + 2 * g.cols;
+  const float inv_step = 1.0f / g.step_px;
+  for (int c = first; c <= last; ++c) {
+    const float gu = c * inv_step;
+    const int i = std::min(static_cast<int>(gu), g.cols - 2);
+    const float fu = gu - i;
+    for (int k = 0; k < 2; ++k) {
+      const float t = top[2 * i + k] + fu * (top[2 * i + 2 + k] - top[2 * i + k]);
+      const float b = bottom[2 * i + k] + fu * (bottom[2 * i + 2 + k] - bottom[2 * i + k]);
+      duv[2 * (c - first) + k] = t + fv * (b - t);
     }
+  }
+}
+
+// With a correction grid: (u, v) = projectivity + interpolated correction, coverage per pixel.
+template <typename T, int kBands, Interpolation kInterpolation>
+void AccumulateCorrectedRow(const Window& win, double V, int first, int last, float* sum,
+                            std::uint8_t* count) {
+  thread_local std::vector<float> duv;
+  duv.resize(2 * static_cast<size_t>(last - first + 1));
+  CorrectionAlongRow(*win.correction, V, first, last, duv.data());
+  const Eigen::Matrix3d& m = win.sub_from_virtual;
+  double x = m(0, 0) * first + m(0, 1) * V + m(0, 2);
+  double y = m(1, 0) * first + m(1, 1) * V + m(1, 2);
+  double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
+  const float max_u = static_cast<float>(win.width_px - 1), max_v = static_cast<float>(win.height_px - 1);
+  for (int c = first; c <= last; ++c, x += m(0, 0), y += m(1, 0), w += m(2, 0)) {
+    const float su = static_cast<float>(x / w) + duv[2 * (c - first)];
+    const float sv = static_cast<float>(y / w) + duv[2 * (c - first) + 1];
+    if (!(su >= 0.0f && su <= max_u && sv >= 0.0f && sv <= max_v)) continue;
+    const float u = std::clamp(su - win.x0, 0.0f, static_cast<float>(win.w - 1));
+    const float v = std::clamp(sv - win.y0, 0.0f, static_cast<float>(win.h - 1));
+    ++count[c];
+    AddSample<T, kBands, kInterpolation>(win, u, v, sum + c * kBands);
   }
 }
 
 template <typename T, int kBands>
 void AccumulateRow(const Window& win, Interpolation interpolation, double V, int first, int last,
                    float* sum, std::uint8_t* count) {
+  if (win.correction) {
+    if (interpolation == Interpolation::kBilinear)
+      AccumulateCorrectedRow<T, kBands, Interpolation::kBilinear>(win, V, first, last, sum, count);
+    else
+      AccumulateCorrectedRow<T, kBands, Interpolation::kBicubic>(win, V, first, last, sum, count);
+    return;
+  }
   const bool affine = win.sub_from_virtual(2, 0) == 0.0 && win.sub_from_virtual(2, 1) == 0.0 &&
                       win.sub_from_virtual(2, 2) == 1.0;
   if (interpolation == Interpolation::kBilinear) {
@@ -150,7 +206,12 @@ void ResampleStrip(std::vector<Window>& windows, const ResampleOptions& options,
       const double V = y0 + r;
       for (const Window& win : windows) {
         int first = 0, last = -1;
-        if (!win.used || !CoveredColumns(win, V, width, &first, &last)) continue;
+        if (!win.used || (!win.correction && !CoveredColumns(win, V, width, &first, &last)))
+          continue;
+        if (win.correction) {  // the corrected map may reach beyond the projectivity's columns
+          first = 0;
+          last = width - 1;
+        }
         AccumulateRow<T, kBands>(win, options.interpolation, V, first, last, sum.data(),
                                  count.data());
       }
@@ -198,8 +259,11 @@ std::string MappingDescription(const calib::Camera& camera, const std::string& s
 
 ResampleReport ResampleVirtualImage(const calib::Camera& camera,
                                     const std::vector<RasterSource*>& sources, RasterSink* sink,
-                                    const ResampleOptions& options) {
+                                    const ResampleOptions& options,
+                                    const std::vector<MapCorrectionGrid>& corrections) {
   const auto start = std::chrono::steady_clock::now();
+  AEROCAL_CHECK(corrections.empty() || corrections.size() == sources.size())
+      << corrections.size() << " correction grids for " << sources.size() << " sources";
   AEROCAL_CHECK(sources.size() == camera.subimages.size())
       << sources.size() << " sources for " << camera.subimages.size() << " sub-images";
   AEROCAL_CHECK(options.strip_rows > 0) << options.strip_rows;
@@ -220,6 +284,14 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
     windows[k].height_px = s.height_px;
     windows[k].sub_from_virtual = calib::HomographyFromParams(s.model, s.params.data()).inverse();
     windows[k].sub_from_virtual /= windows[k].sub_from_virtual(2, 2);  // affine: last row 0 0 1
+    if (!corrections.empty() && corrections[k].step_px > 0) {
+      const MapCorrectionGrid& g = corrections[k];
+      AEROCAL_CHECK(g.cols >= 2 && g.rows >= 2 && (g.cols - 1) * g.step_px >= camera.width_px - 1 &&
+                    (g.rows - 1) * g.step_px >= camera.height_px - 1 &&
+                    g.duv.size() == 2 * static_cast<size_t>(g.cols) * g.rows)
+          << "correction grid of sub-image " << s.id << " does not cover the virtual format";
+      windows[k].correction = &g;
+    }
   }
   const int width = camera.width_px, height = camera.height_px;
   const RasterInfo out_info{width, height, first.bands, first.bits};
@@ -241,10 +313,14 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
           v0 = std::min(v0, p.y() / p.z());
           v1 = std::max(v1, p.y() / p.z());
         }
-      const int x0 = std::max(0, static_cast<int>(std::floor(u0)) - margin);
-      const int x1 = std::min(win.width_px - 1, static_cast<int>(std::ceil(u1)) + margin);
-      const int wy0 = std::max(0, static_cast<int>(std::floor(v0)) - margin);
-      const int wy1 = std::min(win.height_px - 1, static_cast<int>(std::ceil(v1)) + margin);
+      // A correction moves (u, v) by up to max_abs_px; the bounding box of the corners also
+      // misses the bulge of a projectivity's edges only when it is not affine, which the
+      // correction grids' heads (near-nadir rigs) are to far below a pixel per strip.
+      const int extra = win.correction ? static_cast<int>(std::ceil(win.correction->max_abs_px)) + 1 : 0;
+      const int x0 = std::max(0, static_cast<int>(std::floor(u0)) - margin - extra);
+      const int x1 = std::min(win.width_px - 1, static_cast<int>(std::ceil(u1)) + margin + extra);
+      const int wy0 = std::max(0, static_cast<int>(std::floor(v0)) - margin - extra);
+      const int wy1 = std::min(win.height_px - 1, static_cast<int>(std::ceil(v1)) + margin + extra);
       win.used = x0 <= x1 && wy0 <= wy1;
       if (!win.used) return;
       win.x0 = x0;

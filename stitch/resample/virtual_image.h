@@ -40,13 +40,27 @@ struct ResampleReport {
   double seconds = 0;
 };
 
+/// A smooth correction of one source's map beyond its projectivity (lens distortion of a rig
+/// head, relief parallax over a DEM): (du, dv) source pixels added to Map_k^-1(U, V), given on a
+/// grid of virtual pixels (nodes at U = i step, V = j step, i < cols, j < rows; row-major,
+/// interleaved du, dv) and interpolated bilinearly in between (clamped at the last node). With a
+/// correction, coverage is decided per pixel on the corrected (u, v).
+struct MapCorrectionGrid {
+  int step_px = 0;          // > 0
+  int cols = 0, rows = 0;   // nodes; (cols - 1) step >= virtual width - 1, likewise rows
+  std::vector<float> duv;   // 2 cols rows values
+  float max_abs_px = 0.0f;  // largest |du|, |dv| (window margins)
+};
+
 /// Writes the virtual image of `camera` (format camera.width_px x height_px, mappings of
 /// camera.subimages) from `sources` (one per sub-image, camera order, each of its sub-image's
 /// format; all of one bit depth and band count) to `sink`, with the sources' depth and bands.
 /// Throws InputError naming the sub-image when a source's format, depth or bands do not match.
+/// `corrections`: empty, or one per sub-image (a grid with step 0 = none for that sub-image).
 ResampleReport ResampleVirtualImage(const calib::Camera& camera,
                                     const std::vector<RasterSource*>& sources, RasterSink* sink,
-                                    const ResampleOptions& options);
+                                    const ResampleOptions& options,
+                                    const std::vector<MapCorrectionGrid>& corrections = {});
 
 Interpolation ParseInterpolation(const std::string& name);  // ConfigError when unknown
 

@@ -1,7 +1,9 @@
 #include "stitch/rig/rig_convert.h"
 
+#include <algorithm>
 #include <cmath>
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
 
 #include "calib/core/csv.h"
@@ -52,13 +54,6 @@ calib::Camera RigExposureAsSubimageCamera(const RigConverter& converter) {
   camera.interior[calib::BrownFraser10Model::kC] = rig.virtual_camera.c_mm;
   for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k) {
     const calib::RigHead& head = rig.heads[k];
-    for (int i = calib::BrownFraser10Model::kK1; i < calib::BrownFraser10Model::kNumParams; ++i)
-      if (head.camera.interior[i] != 0.0)
-        throw InputError("head " + head.id + ": " +
-                         std::string(calib::BrownFraser10Model::kParams[i].name) + " = " +
-                         FormatNumber(head.camera.interior[i]) +
-                         ": rig convert maps distortion-free heads (the plane homography); "
-                         "correct the head's distortion first");
     Eigen::Matrix3d virtual_from_head = HeadFromVirtualHomography(converter, k).inverse();
     if (!virtual_from_head.allFinite() || std::abs(virtual_from_head(2, 2)) < 1e-300)
       throw InputError("head " + head.id + ": its image does not map onto the rectification plane");
@@ -74,10 +69,110 @@ calib::Camera RigExposureAsSubimageCamera(const RigConverter& converter) {
   return camera;
 }
 
+namespace {
+
+bool HasDistortion(const calib::Camera& camera) {
+  for (int i = calib::BrownFraser10Model::kK1; i < calib::BrownFraser10Model::kNumParams; ++i)
+    if (camera.interior[i] != 0.0) return true;
+  return false;
+}
+
+// The exact head pixel of a virtual pixel: over the plane, or over the DEM when given.
+std::optional<Eigen::Vector2d> ExactHeadPixel(const RigConverter& converter, const DemGrid* dem,
+                                              int head, const Eigen::Vector2d& virtual_px) {
+  if (!dem) return converter.HeadFromVirtual(head, virtual_px);
+  const auto g = IntersectDem(*dem, converter.VirtualCenter(),
+                              converter.ObjectFromVirtual() *
+                                  converter.rig().virtual_camera.RayFromPixel(virtual_px));
+  if (!g) return converter.HeadFromVirtual(head, virtual_px);
+  return converter.HeadPixelOfPoint(head, *g);
+}
+
+// Exact head pixel minus the homography's at virtual pixel (U, V); zero where the exact map is
+// undefined (the ray misses the plane or the correction does not invert: far outside the head).
+Eigen::Vector2d MapDifference(const RigConverter& converter, const DemGrid* dem, int head,
+                              const Eigen::Matrix3d& h, const Eigen::Vector2d& virtual_px) {
+  const auto exact = ExactHeadPixel(converter, dem, head, virtual_px);
+  if (!exact) return Eigen::Vector2d::Zero();
+  const Eigen::Vector2d linear = (h * virtual_px.homogeneous()).hnormalized();
+  return *exact - linear;
+}
+
+MapCorrectionGrid MakeGrid(const RigConverter& converter, const DemGrid* dem, int head,
+                           const Eigen::Matrix3d& h, int step) {
+  const calib::VirtualCamera& v = converter.rig().virtual_camera;
+  MapCorrectionGrid g;
+  g.step_px = step;
+  g.cols = std::max((v.width_px - 1 + step - 1) / step + 1, 2);
+  g.rows = std::max((v.height_px - 1 + step - 1) / step + 1, 2);
+  g.duv.resize(2 * static_cast<size_t>(g.cols) * g.rows);
+  for (int j = 0; j < g.rows; ++j)
+    for (int i = 0; i < g.cols; ++i) {
+      const Eigen::Vector2d d =
+          MapDifference(converter, dem, head, h, Eigen::Vector2d(i * step, j * step));
+      const size_t at = 2 * (static_cast<size_t>(j) * g.cols + i);
+      g.duv[at] = static_cast<float>(d.x());
+      g.duv[at + 1] = static_cast<float>(d.y());
+      g.max_abs_px = std::max(g.max_abs_px, static_cast<float>(d.cwiseAbs().maxCoeff()));
+    }
+  return g;
+}
+
+// Largest |interpolated - exact| (px) at the cell centres whose exact head pixel lies inside the
+// head's format.
+double GridError(const RigConverter& converter, const DemGrid* dem, int head,
+                 const Eigen::Matrix3d& h, const MapCorrectionGrid& g) {
+  double worst = 0.0;
+  for (int j = 0; j + 1 < g.rows; ++j)
+    for (int i = 0; i + 1 < g.cols; ++i) {
+      const Eigen::Vector2d centre((i + 0.5) * g.step_px, (j + 0.5) * g.step_px);
+      const auto exact = ExactHeadPixel(converter, dem, head, centre);
+      if (!exact || !converter.InHeadFormat(head, *exact)) continue;
+      Eigen::Vector2d interpolated = Eigen::Vector2d::Zero();
+      for (int dj = 0; dj < 2; ++dj)
+        for (int di = 0; di < 2; ++di) {
+          const size_t at = 2 * (static_cast<size_t>(j + dj) * g.cols + i + di);
+          interpolated += 0.25 * Eigen::Vector2d(g.duv[at], g.duv[at + 1]);
+        }
+      const Eigen::Vector2d mapped = (h * centre.homogeneous()).hnormalized() + interpolated;
+      worst = std::max(worst, (mapped - *exact).cwiseAbs().maxCoeff());
+    }
+  return worst;
+}
+
+}  // namespace
+
+HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double tolerance_px,
+                                          const DemGrid* dem) {
+  AEROCAL_CHECK(tolerance_px > 0) << tolerance_px;
+  HeadMapCorrections out;
+  const calib::Rig& rig = converter.rig();
+  out.grids.resize(rig.heads.size());
+  for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k) {
+    if (!dem && !HasDistortion(rig.heads[k].camera)) continue;
+    const Eigen::Matrix3d h = HeadFromVirtualHomography(converter, k);
+    double error = 0.0;
+    int step = 64;
+    for (;; step /= 2) {
+      out.grids[k] = MakeGrid(converter, dem, k, h, step);
+      error = GridError(converter, dem, k, h, out.grids[k]);
+      if (error <= tolerance_px || step <= 2) break;
+    }
+    out.max_error_px = std::max(out.max_error_px, error);
+    out.finest_step_px = out.finest_step_px == 0 ? step : std::min(out.finest_step_px, step);
+  }
+  return out;
+}
+
 ResampleReport ConvertRigExposure(const RigConverter& converter,
                                   const std::vector<RasterSource*>& sources, RasterSink* sink,
-                                  const ResampleOptions& options) {
-  return ResampleVirtualImage(RigExposureAsSubimageCamera(converter), sources, sink, options);
+                                  const ResampleOptions& options, HeadMapCorrections* corrections,
+                                  const DemGrid* dem) {
+  HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01, dem);
+  const ResampleReport report = ResampleVirtualImage(RigExposureAsSubimageCamera(converter),
+                                                     sources, sink, options, grids.grids);
+  if (corrections) *corrections = std::move(grids);
+  return report;
 }
 
 }  // namespace aerocal::stitch

@@ -15,6 +15,7 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "tests/bench/discard_sink.h"
 #include "stitch/adjustment/model_selection.h"
 #include "stitch/resample/virtual_image.h"
 #include "tests/stitch/simulated_camera.h"
@@ -64,18 +65,6 @@ const ResampleScene& Scene() {
   return scene;
 }
 
-// Takes the rows and keeps a checksum (no disk in the measurement).
-class DiscardSink : public RasterSink {
- public:
-  explicit DiscardSink(size_t row_bytes) : row_bytes_(row_bytes) {}
-  void WriteRows(int, int rows, const void* data) override {
-    checksum_ += static_cast<const std::uint8_t*>(data)[rows * row_bytes_ / 2];
-  }
-  std::uint64_t checksum_ = 0;
-
- private:
-  size_t row_bytes_;
-};
 
 void BM_Resample(benchmark::State& state) {
   auto& scene = const_cast<ResampleScene&>(Scene());

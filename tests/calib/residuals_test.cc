@@ -90,6 +90,110 @@ void CheckStitchingResiduals() {
   ExpectGradientsMatch(*sub, {p.data(), s.interior, s.opk, s.center, s.point});
 }
 
+// The rig head residual (a head of a two-head rig with mount, lever arm, increment, time offset
+// and velocity): its value against an independent Eigen oracle of the head pose, its gradients
+// against GradientChecker, and its one-head identity case against CollinearityResidual.
+struct RigScene {
+  double interior[10] = {150.02, 0.003, -0.002, 2e-8, -1e-12, 0, 1e-7, -2e-7, 5e-6, -3e-6};
+  double rig_opk[3] = {0.012, -0.007, 0.4};
+  double rig_center[3] = {100.0, -50.0, 1400.0};
+  double mount[3] = {0.002, 0.0175, -0.001};  // about 1 deg convergence in phi
+  double lever[3] = {0.15, 0.01, 0.01};
+  double increment[3] = {1e-5, -2e-5, 3e-5};
+  double dt[1] = {0.002};
+  double point[3] = {220.0, 90.0, 250.0};
+  Eigen::Vector3d velocity{60.0, 5.0, -1.0};
+  PixelFrame frame{0.006, 10000, 10000};
+};
+
+TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
+  RigScene s;
+  // Oracle: R_k = R M_k E_k, O_k = O + R t_k + v dT_k with Eigen matrices (CONVENTIONS.md).
+  const Eigen::Matrix3d r = RotationFromOpk(Eigen::Vector3d(s.rig_opk));
+  const Eigen::Matrix3d rk =
+      r * RotationFromOpk(Eigen::Vector3d(s.mount)) * RotationFromOpk(Eigen::Vector3d(s.increment));
+  const Eigen::Vector3d ok =
+      Eigen::Vector3d(s.rig_center) + r * Eigen::Vector3d(s.lever) + s.velocity * s.dt[0];
+  Camera head;
+  head.pixel_size_mm = s.frame.pixel_size_mm;
+  head.width_px = s.frame.width_px;
+  head.height_px = s.frame.height_px;
+  std::copy(s.interior, s.interior + 10, head.interior.begin());
+  Eigen::Vector2d pixel;
+  ASSERT_TRUE(head.ProjectToPixel(OpkFromRotation(rk), ok, Eigen::Vector3d(s.point), &pixel));
+  auto cost = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.25, s.velocity);
+  double res[2];
+  const double* blocks[] = {s.interior, s.rig_opk, s.rig_center, s.mount,
+                            s.lever,    s.increment, s.dt,        s.point};
+  ASSERT_TRUE(cost->Evaluate(blocks, res, nullptr));
+  EXPECT_NEAR(res[0], 0.0, 1e-6);  // 1e-6 sigma = 2.5e-7 px (the distortion inverse's tolerance)
+  EXPECT_NEAR(res[1], 0.0, 1e-6);
+  // A lever-arm error of 1 mm along the rig's x moves the head centre by R [1e-3 0 0]^T: the
+  // residual is that projection shift in units of sigma (first order; distortion changes it by
+  // < 1e-3 relative).
+  double lever_moved[3] = {s.lever[0] + 1e-3, s.lever[1], s.lever[2]};
+  const double* moved[] = {s.interior, s.rig_opk, s.rig_center, s.mount,
+                           lever_moved, s.increment, s.dt,       s.point};
+  ASSERT_TRUE(cost->Evaluate(moved, res, nullptr));
+  Eigen::Vector2d pixel_moved;
+  ASSERT_TRUE(head.ProjectToPixel(OpkFromRotation(rk), ok + r * Eigen::Vector3d(1e-3, 0, 0),
+                                  Eigen::Vector3d(s.point), &pixel_moved));
+  const double expected = (pixel_moved - pixel).norm() / 0.25;
+  ASSERT_GT(expected, 0.05);  // the shift is seen (0.13 um at 1150 m = 0.02 px)
+  EXPECT_NEAR(std::hypot(res[0], res[1]), expected, 0.02 * expected);
+  ExpectGradientsMatch(*cost, {s.interior, s.rig_opk, s.rig_center, s.mount, s.lever, s.increment,
+                               s.dt, s.point});
+}
+
+TEST(RigHeadCollinearityResidual, TimeOffsetActsAsVelocityTimesOffset) {
+  RigScene s;
+  const Eigen::Vector2d pixel(4200.0, 5300.0);
+  auto cost = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.25, s.velocity);
+  auto still = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.25, Eigen::Vector3d::Zero());
+  double shifted_center[3];
+  for (int i = 0; i < 3; ++i) shifted_center[i] = s.rig_center[i] + s.velocity[i] * s.dt[0];
+  double zero_dt[1] = {0.0};
+  double a[2], b[2];
+  const double* with_dt[] = {s.interior, s.rig_opk, s.rig_center, s.mount,
+                             s.lever,    s.increment, s.dt,        s.point};
+  const double* shifted[] = {s.interior, s.rig_opk, shifted_center, s.mount,
+                             s.lever,    s.increment, zero_dt,       s.point};
+  ASSERT_TRUE(cost->Evaluate(with_dt, a, nullptr));
+  ASSERT_TRUE(still->Evaluate(shifted, b, nullptr));
+  EXPECT_NEAR(a[0], b[0], 1e-9);  // the same head centre, to rounding
+  EXPECT_NEAR(a[1], b[1], 1e-9);
+}
+
+TEST(RigHeadCollinearityResidual, OneHeadRigIsTheFrameCamera) {
+  // Identity mount, zero lever arm, zero increment, dT = 0: the rig head residual and the frame
+  // camera's CollinearityResidual agree in value and in their Jacobians of the shared blocks.
+  Scene s;
+  double zero3a[3] = {0, 0, 0}, zero3b[3] = {0, 0, 0}, zero3c[3] = {0, 0, 0}, dt[1] = {0};
+  const Eigen::Vector2d pixel(6100.5, 5222.25);
+  auto frame_cost = CollinearityResidual::Create(s.frame, pixel, 0.2);
+  auto rig_cost = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.2, Eigen::Vector3d(30, 0, 0));
+  const double* frame_blocks[] = {s.interior, s.opk, s.center, s.point};
+  const double* rig_blocks[] = {s.interior, s.opk, s.center, zero3a, zero3b, zero3c, dt, s.point};
+  double rf[2], rr[2];
+  std::vector<double> jf_int(20), jf_opk(6), jf_c(6), jf_p(6);
+  std::vector<double> jr_int(20), jr_opk(6), jr_c(6), jr_m(6), jr_l(6), jr_e(6), jr_dt(2), jr_p(6);
+  double* jf[] = {jf_int.data(), jf_opk.data(), jf_c.data(), jf_p.data()};
+  double* jr[] = {jr_int.data(), jr_opk.data(), jr_c.data(), jr_m.data(),
+                  jr_l.data(),   jr_e.data(),   jr_dt.data(), jr_p.data()};
+  ASSERT_TRUE(frame_cost->Evaluate(frame_blocks, rf, jf));
+  ASSERT_TRUE(rig_cost->Evaluate(rig_blocks, rr, jr));
+  EXPECT_DOUBLE_EQ(rr[0], rf[0]);
+  EXPECT_DOUBLE_EQ(rr[1], rf[1]);
+  const std::vector<std::pair<const std::vector<double>*, const std::vector<double>*>> pairs = {
+      {&jr_int, &jf_int}, {&jr_opk, &jf_opk}, {&jr_c, &jf_c}, {&jr_p, &jf_p}};
+  for (const auto& [a, b] : pairs)
+    for (size_t i = 0; i < a->size(); ++i)
+      EXPECT_NEAR((*a)[i], (*b)[i], 1e-9 * (1.0 + std::abs((*b)[i])));
+  // dr/d(dT) = dr/dO v with v = (30, 0, 0) m/s.
+  EXPECT_NEAR(jr_dt[0], jr_c[0] * 30.0, 1e-9 * (1.0 + std::abs(jr_c[0] * 30.0)));
+  EXPECT_NEAR(jr_dt[1], jr_c[3] * 30.0, 1e-9 * (1.0 + std::abs(jr_c[3] * 30.0)));
+}
+
 TEST(StitchingResiduals, GradientsMatchForEveryMappingModel) {
   CheckStitchingResiduals<TranslationMapping>();
   CheckStitchingResiduals<ConformalMapping>();

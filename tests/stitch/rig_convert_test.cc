@@ -10,6 +10,8 @@
 #include <gtest/gtest.h>
 
 #include "calib/camera/rig_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/rig/rig_convert.h"
@@ -66,14 +68,128 @@ TEST(RigConvert, PlaneHomographyIsTheExactConversion) {
       }
     }
   }
-  calib::Rig distorted = TwoHeadRig();
-  distorted.heads[1].camera.interior[calib::BrownFraser10Model::kK1] = 1e-5;
-  const RigConverter converter(distorted, {}, MakeRectificationPlane(distorted, {}, kHeight));
+}
+
+// Both heads with radial, decentering and affinity terms of several pixels at the corners.
+calib::Rig DistortedTwoHeadRig() {
+  calib::Rig rig = TwoHeadRig();
+  using Model = calib::BrownFraser10Model;
+  rig.heads[0].camera.interior[Model::kK1] = 1e-4;   // 6 px at the corner (r = 8.5 mm)
+  rig.heads[0].camera.interior[Model::kP1] = 3e-5;
+  rig.heads[1].camera.interior[Model::kK1] = -8e-5;
+  rig.heads[1].camera.interior[Model::kK2] = 5e-7;
+  rig.heads[1].camera.interior[Model::kP2] = -2e-5;
+  rig.heads[1].camera.interior[Model::kB1] = 2e-4;
+  return rig;
+}
+
+// Largest distance (px) between homography + bilinear grid of `base` and the exact conversion of
+// `exact` at pseudo-random virtual pixels inside head k; `checked` counts them.
+double WorstGridError(const RigConverter& base, const RigConverter& exact, int k,
+                      const MapCorrectionGrid& g, int samples, int* checked) {
+  const Eigen::Matrix3d h = HeadFromVirtualHomography(base, k);
+  double worst = 0.0;
+  *checked = 0;
+  for (int i = 0; i < samples; ++i) {
+    const Eigen::Vector2d v(std::fmod(i * 389.17, 1599.0), std::fmod(i * 257.31, 1199.0));
+    const auto p = exact.HeadFromVirtual(k, v);
+    if (!p || !exact.InHeadFormat(k, *p)) continue;
+    const double gu = v.x() / g.step_px, gv = v.y() / g.step_px;
+    const int ci = std::min(static_cast<int>(gu), g.cols - 2), cj = std::min(static_cast<int>(gv), g.rows - 2);
+    const double fu = gu - ci, fv = gv - cj;
+    Eigen::Vector2d d = Eigen::Vector2d::Zero();
+    for (int dj = 0; dj < 2; ++dj)
+      for (int di = 0; di < 2; ++di) {
+        const size_t at = 2 * (static_cast<size_t>(cj + dj) * g.cols + ci + di);
+        d += (di ? fu : 1 - fu) * (dj ? fv : 1 - fv) * Eigen::Vector2d(g.duv[at], g.duv[at + 1]);
+      }
+    worst = std::max(worst, ((h * v.homogeneous()).hnormalized() + d - *p).norm());
+    ++*checked;
+  }
+  return worst;
+}
+
+TEST(RigConvert, CorrectionGridsCarryTheDistortionToTheTolerance) {
+  const calib::Rig rig = DistortedTwoHeadRig();
+  RigExposure exposure;
+  exposure.rig_opk_rad = Eigen::Vector3d(0.01, -0.02, 0.3);
+  const RigConverter converter(rig, exposure, MakeRectificationPlane(rig, exposure, kHeight));
+  const HeadMapCorrections corrections = MakeHeadMapCorrections(converter, 0.01);
+  ASSERT_EQ(corrections.grids.size(), 2u);
+  EXPECT_LE(corrections.max_error_px, 0.01);
+  EXPECT_GT(corrections.finest_step_px, 2);
+  // Independent check at pseudo-random virtual pixels inside each head: homography + bilinear
+  // grid against the exact conversion.
+  for (int k = 0; k < 2; ++k) {
+    const MapCorrectionGrid& g = corrections.grids[k];
+    ASSERT_GT(g.step_px, 0);
+    EXPECT_GT(g.max_abs_px, 2.0f) << "the distortion is several pixels";
+    int checked = 0;
+    const double worst = WorstGridError(converter, converter, k, g, 4000, &checked);
+    EXPECT_GT(checked, 1000);
+    EXPECT_LT(worst, 0.02) << "head " << k;  // 0.01 per axis at cell centres; float storage
+  }
+  // Distortion-free heads need no grid.
+  const RigConverter plain(TwoHeadRig(), exposure, MakeRectificationPlane(TwoHeadRig(), exposure, kHeight));
+  const HeadMapCorrections none = MakeHeadMapCorrections(plain);
+  EXPECT_EQ(none.finest_step_px, 0);
+  EXPECT_EQ(none.grids[0].step_px, 0);
+}
+
+// A DEM of a tilted plane is a tilted rectification plane (bilinear interpolation of a plane is
+// exact): the homography of the level plane plus the DEM grids reproduce the tilted plane's exact
+// conversion; and the reader names the line of a bad DEM.
+std::string TiltedDem(const testing::TempDir& dir) {
+  std::string text = "ncols 61\nnrows 51\nxllcorner -152.5\nyllcorner -127.5\ncellsize 5\n"
+                     "NODATA_value -9999\n";
+  for (int r = 50; r >= 0; --r) {  // north row first
+    for (int c = 0; c <= 60; ++c) {
+      const double x = -150.0 + 5.0 * c, y = -125.0 + 5.0 * r;
+      text += FormatNumber(-100.0 + 0.05 * x - 0.03 * y) + (c < 60 ? " " : "\n");
+    }
+  }
+  WriteFileAtomically(dir.File("tilted.asc"), text);
+  return dir.File("tilted.asc");
+}
+
+TEST(RigConvert, DemOfATiltedPlaneIsThatPlane) {
+  testing::TempDir dir;
+  const DemGrid dem = ReadDemAscii(TiltedDem(dir));
+  ASSERT_EQ(dem.cols, 61);
+  EXPECT_NEAR(*dem.HeightAt(10.0, 20.0), -100.0 + 0.5 - 0.6, 1e-12);
+  const calib::Rig rig = DistortedTwoHeadRig();
+  RigExposure exposure;
+  exposure.rig_opk_rad = Eigen::Vector3d(0.01, -0.02, 0.3);
+  const RigConverter level(rig, exposure, MakeRectificationPlane(rig, exposure, kHeight));
+  RectificationPlane tilted;
+  tilted.normal = Eigen::Vector3d(-0.05, 0.03, 1.0).normalized();
+  tilted.offset = tilted.normal.dot(Eigen::Vector3d(0, 0, -100.0));
+  const RigConverter oracle(rig, exposure, tilted);
+  const HeadMapCorrections corrections = MakeHeadMapCorrections(level, 0.01, &dem);
+  EXPECT_LE(corrections.max_error_px, 0.01);
+  for (int k = 0; k < 2; ++k) {
+    const MapCorrectionGrid& g = corrections.grids[k];
+    ASSERT_GT(g.step_px, 0) << "over a DEM every head has a grid";
+    EXPECT_GT(g.max_abs_px, 1.0f) << "the tilt moves the map by pixels";
+    int checked = 0;
+    const double worst = WorstGridError(level, oracle, k, g, 3000, &checked);
+    EXPECT_GT(checked, 1000);
+    EXPECT_LT(worst, 0.02) << "head " << k;
+  }
+  // Bad DEMs: FILE:LINE.
+  WriteFileAtomically(dir.File("bad.asc"), "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize -1\n1 2 3\n4 5 6\n");
   try {
-    RigExposureAsSubimageCamera(converter);
-    ADD_FAILURE() << "a distorted head was accepted";
+    ReadDemAscii(dir.File("bad.asc"));
+    ADD_FAILURE() << "a negative cell size was read";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("head B: K1"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("bad.asc:5: cellsize must be > 0"), std::string::npos) << e.what();
+  }
+  WriteFileAtomically(dir.File("short.asc"), "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 x 6\n");
+  try {
+    ReadDemAscii(dir.File("short.asc"));
+    ADD_FAILURE() << "a non-numeric height was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("short.asc:7: expected 3 heights, got 1"), std::string::npos) << e.what();
   }
 }
 
@@ -202,6 +318,45 @@ TEST(RigConvert, RealPhotographThroughATwoHeadRigAndBack) {
   EXPECT_NEAR(bad.only_b.Shift().norm(), 0.238, 0.06);
 }
 
+TEST(RigConvert, RealPhotographThroughDistortedHeadsAndBack) {
+  const std::string dir = testing::SharedDataDir("odm_boruszyn_kap_frames");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
+  const MemoryRaster full = ReadImageFile(dir + "/images/img_4880.jpg", /*gray=*/true);
+  const calib::Rig rig = DistortedTwoHeadRig();
+  const int width = rig.virtual_camera.width_px, height = rig.virtual_camera.height_px;
+  const int x_off = (full.Info().width - width) / 2, y_off = (full.Info().height - height) / 2;
+  MemoryRaster truth({width, height, 1, 8});
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c) truth.Set(c, r, 0, full.At(c + x_off, r + y_off));
+  const RigExposure nadir;
+  const RigConverter converter(rig, nadir, MakeRectificationPlane(rig, nadir, kHeight));
+  std::vector<MemoryRaster> heads = Photograph(truth, converter);  // through the distortion
+  std::vector<RasterSource*> sources = {&heads[0], &heads[1]};
+  MemoryRaster back({width, height, 1, 8});
+  HeadMapCorrections corrections;
+  ConvertRigExposure(converter, sources, &back, {}, &corrections);
+  EXPECT_LE(corrections.max_error_px, 0.01);
+  const Comparison cmp = Compare(back, truth, converter);
+  for (const auto& [name, region] : {std::pair<const char*, const Region*>{"A only", &cmp.only_a},
+                                     {"B only", &cmp.only_b},
+                                     {"overlap", &cmp.overlap}}) {
+    const Eigen::Vector2d shift = region->Shift();
+    std::printf("distorted %-8s %7ld px: RMS %.3f DN, shift (%.4f, %.4f) px\n", name, region->n,
+                region->Rms(), shift.x(), shift.y());
+    ASSERT_GT(region->n, 5000) << name;
+    EXPECT_LT(shift.norm(), 0.1) << name;
+  }
+  // Teeth: the homographies alone (distortion ignored) leave pixels of error: a larger grey-level
+  // RMS in every region.
+  MemoryRaster plain({width, height, 1, 8});
+  ResampleVirtualImage(RigExposureAsSubimageCamera(converter), sources, &plain, {});
+  const Comparison bad = Compare(plain, truth, converter);
+  std::printf("without grids: A only RMS %.3f DN, B only RMS %.3f DN\n", bad.only_a.Rms(),
+              bad.only_b.Rms());
+  EXPECT_GT(bad.only_a.Rms(), 1.5 * cmp.only_a.Rms());
+  EXPECT_GT(bad.only_b.Rms(), 1.5 * cmp.only_b.Rms());
+}
+
 TEST(RigConvertCommand, WritesTheVirtualTiffAndRefusesBadInput) {
   testing::TempDir tmp;
   const calib::Rig rig = TwoHeadRig();
@@ -244,6 +399,50 @@ TEST(RigConvertCommand, WritesTheVirtualTiffAndRefusesBadInput) {
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.output.find("--opk-deg"), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(tmp.File("v2.tif")));
+  // Heads with distortion: photographed through it, converted through the correction grids.
+  const calib::Rig distorted = DistortedTwoHeadRig();
+  calib::WriteRig(tmp.File("distorted.yaml"), distorted);
+  const RigConverter through(distorted, nadir, MakeRectificationPlane(distorted, nadir, kHeight));
+  std::vector<MemoryRaster> bent = Photograph(truth, through);
+  for (int k = 0; k < 2; ++k) {
+    TiffWriter writer(tmp.File("d" + distorted.heads[k].id + ".tif"), bent[k].Info(), {});
+    writer.WriteRows(0, bent[k].Info().height, bent[k].bytes().data());
+    writer.Commit();
+  }
+  run = testing::RunAerocal("rig convert --camera " + tmp.File("distorted.yaml") + " --images A=" +
+                            tmp.File("dA.tif") + ",B=" + tmp.File("dB.tif") + " --out " +
+                            tmp.File("dv.tif"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("heads with distortion: correction grids down to"), std::string::npos)
+      << run.output;
+  // --dem: a flat DEM at the plane's height gives the plane's image; a bad DEM exits with 2.
+  std::string flat = "ncols 3\nnrows 3\nxllcenter -200\nyllcenter -200\ncellsize 200\n";
+  for (int r = 0; r < 3; ++r) flat += "-100 -100 -100\n";
+  WriteFileAtomically(tmp.File("flat.asc"), flat);
+  run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + images + " --dem " +
+                            tmp.File("flat.asc") + " --out " + tmp.File("dem.tif"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("DEM surface: correction grids down to 64 px"), std::string::npos) << run.output;
+  const auto on_dem = OpenTiff(tmp.File("dem.tif"));
+  const auto on_plane = OpenTiff(tmp.File("virtual.tif"));
+  std::vector<std::uint8_t> a(1600), b(1600);
+  int differing = 0;
+  for (int r = 0; r < 1200; r += 37) {
+    on_dem->ReadWindow(0, r, 1600, 1, a.data());
+    on_plane->ReadWindow(0, r, 1600, 1, b.data());
+    for (int c = 0; c < 1600; ++c) differing += std::abs(a[c] - b[c]) > 1;
+  }
+  EXPECT_LT(differing, 20) << "grey values off by more than 1 DN";
+  WriteFileAtomically(tmp.File("broken.asc"), "ncols 3\nnrows 3\nxllcenter 0\ncellsize 1\n1 2 3\n");
+  run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + images + " --dem " +
+                            tmp.File("broken.asc") + " --out " + tmp.File("dem2.tif"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find("broken.asc:5: missing header 'yllcorner'"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp.File("dem2.tif")));
+  const auto bent_back = OpenTiff(tmp.File("dv.tif"));
+  bent_back->ReadWindow(0, 620, 1600, 1, row.data());
+  for (const int col : {300, 820, 1300})
+    EXPECT_NEAR(row[col], truth.At(col, 620), 2.0) << col;
 }
 
 }  // namespace

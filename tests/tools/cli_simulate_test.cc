@@ -74,5 +74,48 @@ TEST(Cli, OtherLayoutsSimulate) {
   EXPECT_FALSE(camera.reference_points.empty());
 }
 
+TEST(Cli, SimulateRigDualLensWritesHeadObservationsAndTruth) {
+  testing::TempDir dir;
+  const std::string a = dir.File("a"), b = dir.File("b");
+  const std::string args = " --rig dual-lens --seed 3 --exposures 8 --points 12 --tie-points 40 "
+                           "--gnss-sigma-m 0.05 --imu-sigma-deg 0.005 --speed-mps 60 "
+                           "--head-time-offset-ms 0.5 --head-increment-arcsec 2";
+  const auto run = testing::RunAerocal("simulate --out " + a + args);
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_NE(run.output.find("x 2 heads"), std::string::npos) << run.output;
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + b + args).exit_code, 0);
+  for (const char* f : {"rig_nominal.yaml", "rig_truth.yaml", "exposures.csv", "observations.csv",
+                        "points.csv", "project.yaml", "truth/exposures.csv", "truth/points.csv",
+                        "truth/rig_exposures.csv"}) {
+    ASSERT_TRUE(std::filesystem::exists(a + "/" + f)) << f;
+    EXPECT_EQ(ReadTextFile(a + "/" + f), ReadTextFile(b + "/" + f)) << f << " differs between runs";
+  }
+  EXPECT_EQ(ReadTextFile(a + "/observations.csv").rfind("image,head,point,col,row,sigma_px\n", 0), 0u);
+  const auto exposures = triangulation::ReadExposures(a + "/exposures.csv");
+  ASSERT_EQ(exposures.size(), 8u);  // --exposures overrides the rig default (30)
+  EXPECT_TRUE(exposures[0].velocity_mps && exposures[0].center_sigma_m && exposures[0].opk_sigma_rad);
+  // The rig default flying height (1200 m above a 200..300 m terrain), and --height-m over it.
+  EXPECT_NEAR(triangulation::ReadExposures(a + "/truth/exposures.csv")[0].center_m.z(), 1450.0, 1e-6);
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + b + args + " --height-m 2000").exit_code, 0);
+  EXPECT_NEAR(triangulation::ReadExposures(b + "/truth/exposures.csv")[0].center_m.z(), 2250.0, 1e-6);
+}
+
+TEST(Cli, SimulateRigRefusesUnknownRigsAndFrameOptions) {
+  testing::TempDir dir;
+  const auto unknown = testing::RunAerocal("simulate --out " + dir.File("x") + " --rig triple");
+  EXPECT_EQ(unknown.exit_code, 2);
+  EXPECT_NE(unknown.output.find("--rig"), std::string::npos) << unknown.output;
+  const auto uav4 = testing::RunAerocal("simulate --out " + dir.File("x") + " --rig uav4");
+  EXPECT_EQ(uav4.exit_code, 2);
+  EXPECT_NE(uav4.output.find("issue 14"), std::string::npos) << uav4.output;
+  const auto layout = testing::RunAerocal("simulate --out " + dir.File("x") + " --rig dual-lens --layout 2x2");
+  EXPECT_EQ(layout.exit_code, 2);
+  EXPECT_NE(layout.output.find("--layout"), std::string::npos) << layout.output;
+  const auto speed = testing::RunAerocal("simulate --out " + dir.File("x") + " --speed-mps 50");
+  EXPECT_EQ(speed.exit_code, 2);
+  EXPECT_NE(speed.output.find("--speed-mps"), std::string::npos) << speed.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("x")));
+}
+
 }  // namespace
 }  // namespace aerocal

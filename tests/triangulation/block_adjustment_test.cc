@@ -129,6 +129,35 @@ TEST_F(SimulatedFlightAdjustment, ResultJsonHasTheFormatsKeys) {
   EXPECT_EQ(j["check"]["points"].size(), static_cast<size_t>(self_->check.n));
 }
 
+TEST_F(SimulatedFlightAdjustment, ResultJsonCarriesItsSchemaVersionAndTheModelsParameterTable) {
+  const auto j = AdjustmentToJson(*self_);
+  EXPECT_EQ(j["schema_version"], kResultSchemaVersion);
+  const auto& model = j["camera_model"];
+  EXPECT_EQ(model["name"], std::string(Model::kName));
+  EXPECT_EQ(model["id"], static_cast<int>(Model::kId));
+  ASSERT_EQ(model["parameters"].size(), static_cast<size_t>(Model::kNumParams));
+  const std::vector<std::string> units = {
+      "mm", "mm", "mm", "mm^-2", "mm^-4", "mm^-6", "mm^-1", "mm^-1", "1", "1"};  // CONVENTIONS.md
+  const std::vector<std::string> groups = {"principal_distance",
+                                           "principal_point",
+                                           "principal_point",
+                                           "radial",
+                                           "radial",
+                                           "radial",
+                                           "decentering",
+                                           "decentering",
+                                           "affinity",
+                                           "affinity"};
+  for (int k = 0; k < Model::kNumParams; ++k) {
+    const auto& p = model["parameters"][k];
+    EXPECT_EQ(p["name"], std::string(Model::kParams[k].name));
+    EXPECT_EQ(p["unit"], units[k]) << k;
+    EXPECT_EQ(p["group"], groups[k]) << k;
+    // The reported estimates are keyed by the table's names.
+    EXPECT_TRUE(j["cameras"][0]["sigma"].contains(p["name"].get<std::string>()));
+  }
+}
+
 TEST_F(SimulatedFlightAdjustment, ConvergesToTheSameSolutionFromTheTrueStart) {
   // Starting values off by 20 m and 1 degree (the default flight) and the true exterior
   // orientation reach the same minimum.

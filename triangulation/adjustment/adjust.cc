@@ -47,6 +47,21 @@ bool SameObservation(const ImageObservation& a, const ImageObservation& b) {
          a.pixel == b.pixel;
 }
 
+// The solution of `r` becomes the starting values of `project`: exterior orientation of the
+// exposures it used, interior of every camera, tie point coordinates. Surveyed coordinates stay
+// the survey.
+void StartFromSolution(const AdjustmentResult& r, Project* project) {
+  for (auto& e : project->exposures)
+    for (const auto& s : r.exposures)
+      if (s.image == e.image && s.used) {
+        e.center_m = s.center_m;
+        e.opk_rad = s.opk_rad;
+      }
+  for (const auto& c : r.cameras) project->cameras.at(c.id).interior = c.estimated;
+  for (auto& p : project->points)
+    if (p.role == PointRole::kTie && r.points_m.count(p.id)) p.xyz_m = r.points_m.at(p.id);
+}
+
 }  // namespace
 
 int AdjustStages(const AdjustOptions& options) {
@@ -76,7 +91,7 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   AdjustmentResult start;
   std::vector<BlockAdjustment::Screened> screened;
   {
-    BlockAdjustment adjustment(project, robust, SubimageObservations::kMapWithCameraFile, loss);
+    BlockAdjustment adjustment(project, robust, {}, loss);
     start = adjustment.Run(progress);
     screened = adjustment.ScreenRobustly(options.robust_reject_sigma);
   }
@@ -90,15 +105,7 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   for (const auto& o : project.observations)
     if (!excluded(o)) next.observations.push_back(o);
   // The robust solution becomes the starting values; surveyed coordinates stay the survey.
-  for (auto& e : next.exposures)
-    for (const auto& s : start.exposures)
-      if (s.image == e.image && s.used) {
-        e.center_m = s.center_m;
-        e.opk_rad = s.opk_rad;
-      }
-  for (const auto& c : start.cameras) next.cameras.at(c.id).interior = c.estimated;
-  for (auto& p : next.points)
-    if (p.role == PointRole::kTie && start.points_m.count(p.id)) p.xyz_m = start.points_m.at(p.id);
+  StartFromSolution(start, &next);
 
   // 2. Clean solution without the excluded observations; those that fit it are re-admitted:
   //    |v| / sigma at a solution they did not influence below the critical value (their
@@ -128,15 +135,7 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
       still_excluded.push_back(s);
     }
   }
-  for (auto& e : next.exposures)
-    for (const auto& s : clean.exposures)
-      if (s.image == e.image && s.used) {
-        e.center_m = s.center_m;
-        e.opk_rad = s.opk_rad;
-      }
-  for (const auto& c : clean.cameras) next.cameras.at(c.id).interior = c.estimated;
-  for (auto& p : next.points)
-    if (p.role == PointRole::kTie && clean.points_m.count(p.id)) p.xyz_m = clean.points_m.at(p.id);
+  StartFromSolution(clean, &next);
 
   // 3. The final adjustment with snooping and covariance.
   AdjustOptions final_options = options;

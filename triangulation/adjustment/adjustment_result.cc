@@ -239,9 +239,23 @@ std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, dou
   return out;
 }
 
+nlohmann::json CameraModelTableToJson() {
+  using Model = calib::Camera::Model;
+  nlohmann::json parameters = nlohmann::json::array();
+  for (const calib::ParamInfo& p : Model::kParams)
+    parameters.push_back({{"name", std::string(p.name)},
+                          {"unit", std::string(p.unit)},
+                          {"group", std::string(calib::ParamGroupName(p.group))}});
+  return {{"name", std::string(Model::kName)},
+          {"id", static_cast<int>(Model::kId)},
+          {"parameters", parameters}};
+}
+
 nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   nlohmann::json j;
   j["kind"] = "adjust";
+  j["schema_version"] = kResultSchemaVersion;
+  j["camera_model"] = CameraModelTableToJson();
   j["sigma0"] = r.sigma0;
   j["sigma0_px"] = r.sigma0_px;
   j["sigma0_um"] = r.sigma0_um;

@@ -189,6 +189,12 @@ struct AdjustmentResult {
 };
 
 /// JSON of FORMATS.md (kind "adjust"); angles in degrees, coordinates in the object frame.
+/// Version of the result documents written by AdjustmentToJson (and the writers built on it):
+/// raised when a key changes meaning or disappears; added keys do not raise it.
+inline constexpr int kResultSchemaVersion = 1;
+/// The camera model of the adjustment's cameras with its parameter table:
+/// {name, id, parameters: [{name, unit, group}]} in table order (calib/camera/camera.h).
+nlohmann::json CameraModelTableToJson();
 nlohmann::json AdjustmentToJson(const AdjustmentResult& result);
 nlohmann::json PointStatisticsToJson(const PointStatistics& statistics);
 

@@ -3,10 +3,10 @@
 
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
-#include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
 #include "triangulation/adjustment/determinability.h"
 #include "triangulation/adjustment/forward_intersection.h"
+#include "triangulation/sensor/frame_camera.h"
 
 #include <Eigen/Geometry>
 
@@ -24,24 +24,23 @@ using calib::BlockKind;
 const std::vector<std::string> kCenterNames = {"X", "Y", "Z"};
 const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
 
-std::vector<std::string> InteriorNames() {
-  std::vector<std::string> names;
-  for (const auto& p : Model::kParams) names.emplace_back(p.name);
-  return names;
+// "image 0012 point T442", "image 0012 sub-image A1 point T442": an observation in reports.
+std::string DescribeObservation(const ImageObservation& o) {
+  return "image " + o.image + (o.subimage.empty() ? "" : " sub-image " + o.subimage) + " point " +
+         o.point;
 }
 
 }  // namespace
 
 struct BlockAdjustment::Storage {
-  struct CameraState {
-    calib::InteriorParams interior{};
-    BlockId block = -1;
-  };
+  Storage(const Project& project, const AdjustOptions& options, calib::ProblemBuilder& builder)
+      : index(project), context{project, options, builder, index, poses, frame} {}
   struct ExposureState {
     const Exposure* exposure = nullptr;
     const calib::Camera* camera = nullptr;
     Eigen::Vector3d opk = Eigen::Vector3d::Zero(), center = Eigen::Vector3d::Zero();
     BlockId opk_block = -1, center_block = -1;
+    ExposureIndex index = -1;
   };
   struct PointState {
     Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
@@ -49,12 +48,18 @@ struct BlockAdjustment::Storage {
     const GroundPoint* ground = nullptr;  // nullptr: a tie point absent from points.csv
     int rays = -1;  // virtual-image rays; -1: added by a caller, rays not counted here
   };
+  DenseIndex index;
+  std::vector<PoseBlocks> poses;  // by ExposureIndex
+  FrameCamera frame;
+  std::vector<std::unique_ptr<ImagingModel>> sensors;  // asked first, the frame camera last
+  SensorContext context;
   // std::map keeps element addresses stable: the builder holds pointers into them.
-  std::map<std::string, CameraState> cameras;
   std::map<std::string, ExposureState> exposures;
   std::map<std::string, PointState> points;
-  // Virtual-image observations used in the adjustment (sub-image ones mapped), and their residuals.
+  // Observations used in the adjustment (sub-image ones no kind measures mapped to the virtual
+  // image), the kind that measures each, and their residuals.
   std::vector<ImageObservation> observations;
+  std::vector<ImagingModel*> sensor_of_observation;
   std::map<calib::ResidualId, size_t> observation_of_residual;
   std::map<calib::ResidualId, ObservationTest> tests;  // data snooping's last word on each
   std::vector<std::string> notes;
@@ -64,22 +69,28 @@ struct BlockAdjustment::Storage {
 
 BlockAdjustment::BlockAdjustment(const Project& project,
                                  const AdjustOptions& options,
-                                 SubimageObservations subimage,
+                                 std::vector<std::unique_ptr<ImagingModel>> sensors,
                                  const calib::LossOptions& image_loss)
-    : project_(project), options_(options), storage_(std::make_unique<Storage>()) {
+    : project_(project),
+      options_(options),
+      storage_(std::make_unique<Storage>(project, options_, builder_)) {
   options_.Validate();
+  storage_->sensors = std::move(sensors);
   BuildExposures();
-  BuildPoints(subimage);
+  BuildPoints();
   AddImageResiduals(image_loss);
   AddPriors();
+  for (auto& sensor : storage_->sensors) sensor->AddOwnResiduals(storage_->context);
   DefineDatum();
 }
+
+const SensorContext& BlockAdjustment::context() const { return storage_->context; }
 
 BlockAdjustment::~BlockAdjustment() = default;
 
 BlockId BlockAdjustment::InteriorBlock(const std::string& camera) const {
-  const auto it = storage_->cameras.find(camera);
-  return it == storage_->cameras.end() ? -1 : it->second.block;
+  return project_.cameras.count(camera) ? storage_->frame.InteriorBlock(storage_->index.Camera(camera))
+                                        : -1;
 }
 BlockId BlockAdjustment::RotationBlock(const std::string& image) const {
   const auto it = storage_->exposures.find(image);
@@ -104,37 +115,15 @@ BlockId BlockAdjustment::AddPoint(const std::string& point, const Eigen::Vector3
   return state.block;
 }
 
-void BlockAdjustment::RegisterCallerObservation(calib::ResidualId id,
-                                                const ImageObservation& observation) {
-  const auto point = storage_->points.find(observation.point);
-  AEROCAL_CHECK(point != storage_->points.end())
-      << "point " << observation.point << " observed before AddPoint";
-  storage_->observation_of_residual[id] = storage_->observations.size();
-  storage_->observations.push_back(observation);
-  auto& state = point->second;
-  state.rays = std::max(state.rays, 0) + 1;
-}
-
 void BlockAdjustment::BuildExposures() {
-  std::vector<int> fixed;
-  for (int i = 0; i < Model::kNumParams; ++i)
-    if (std::find(options_.free_interior.begin(),
-                  options_.free_interior.end(),
-                  std::string(Model::kParams[i].name)) == options_.free_interior.end())
-      fixed.push_back(i);
-  for (const auto& [id, camera] : project_.cameras) {
-    auto& state = storage_->cameras[id];
-    state.interior = camera.interior;
-    state.block = builder_.AddBlock("camera " + id,
-                                    state.interior.data(),
-                                    Model::kNumParams,
-                                    BlockKind::kInterior,
-                                    InteriorNames());
-    builder_.FixEntries(state.block, fixed);
-  }
+  // The sensor kinds' own blocks first (the frame camera's interiors), then the platform poses.
+  storage_->frame.RegisterBlocks(storage_->context);
+  for (auto& sensor : storage_->sensors) sensor->RegisterBlocks(storage_->context);
+  storage_->poses.resize(project_.exposures.size());
   for (const auto& e : project_.exposures) {
     auto& state = storage_->exposures[e.image];
     state.exposure = &e;
+    state.index = storage_->index.Exposure(e.image);
     state.camera = &project_.cameras.at(e.camera);
     state.opk = e.opk_rad;
     state.center = e.center_m;
@@ -142,22 +131,29 @@ void BlockAdjustment::BuildExposures() {
         "image " + e.image + " angles", state.opk.data(), 3, BlockKind::kRotation, kAngleNames);
     state.center_block = builder_.AddBlock(
         "image " + e.image + " centre", state.center.data(), 3, BlockKind::kCenter, kCenterNames);
+    storage_->poses[state.index] = {state.opk_block, state.center_block};
   }
 }
 
-void BlockAdjustment::BuildPoints(SubimageObservations subimage) {
-  // Observations in the virtual image (sub-image ones mapped with the camera file, or skipped).
+void BlockAdjustment::BuildPoints() {
+  // Each observation with the sensor kind that measures it; a raw sub-image observation no kind
+  // measures is mapped to the virtual image with the camera file's mapping.
   for (const auto& o : project_.observations) {
-    if (o.subimage.empty()) {
+    ImagingModel* sensor = nullptr;
+    for (auto& s : storage_->sensors)
+      if (!sensor && s->Measures(o)) sensor = s.get();
+    if (!sensor && storage_->frame.Measures(o)) sensor = &storage_->frame;
+    if (sensor) {
       storage_->observations.push_back(o);
+      storage_->sensor_of_observation.push_back(sensor);
       continue;
     }
-    if (subimage == SubimageObservations::kLeaveToCaller) continue;
     const auto& camera = *storage_->exposures.at(o.image).camera;
     ImageObservation mapped = o;
     mapped.pixel = camera.subimages[camera.SubimageIndex(o.subimage)].VirtualFromSub(o.pixel);
     mapped.subimage.clear();
     storage_->observations.push_back(mapped);
+    storage_->sensor_of_observation.push_back(&storage_->frame);
   }
   // An exposure seeing fewer than three points (and not held by GNSS and IMU priors) cannot be
   // oriented; leaving it out can leave a point with one ray, so repeat until nothing changes.
@@ -185,20 +181,22 @@ void BlockAdjustment::BuildPoints(SubimageObservations subimage) {
         single.insert(point);
     }
     const size_t before = storage_->observations.size();
-    storage_->observations.erase(
-        std::remove_if(storage_->observations.begin(),
-                       storage_->observations.end(),
-                       [&](const ImageObservation& o) {
-                         return dropped.count(o.image) ||
-                                (!dropped.empty() && single.count(o.point));
-                       }),
-        storage_->observations.end());
+    std::vector<ImageObservation> kept;
+    std::vector<ImagingModel*> kept_sensors;
+    for (size_t i = 0; i < before; ++i) {
+      const ImageObservation& o = storage_->observations[i];
+      if (dropped.count(o.image) || (!dropped.empty() && single.count(o.point))) continue;
+      kept.push_back(o);
+      kept_sensors.push_back(storage_->sensor_of_observation[i]);
+    }
+    storage_->observations = std::move(kept);
+    storage_->sensor_of_observation = std::move(kept_sensors);
     changed = storage_->observations.size() != before;
   }
   std::map<std::string, std::vector<ImageRay>> rays;
-  for (const auto& o : storage_->observations) {
-    const auto& e = storage_->exposures.at(o.image);
-    rays[o.point].push_back(RayFromPixel(*e.camera, e.opk, e.center, o.pixel));
+  for (size_t i = 0; i < storage_->observations.size(); ++i) {
+    const ImageObservation& o = storage_->observations[i];
+    rays[o.point].push_back(storage_->sensor_of_observation[i]->StartingRay(storage_->context, o));
   }
   // Fallback height for points whose rays do not intersect: mean height of the control (and of
   // approximate tie) points, else 0. Check surveys never enter the adjustment, not even here.
@@ -240,18 +238,10 @@ void BlockAdjustment::AddImageResiduals(const calib::LossOptions& loss) {
     const auto& o = storage_->observations[i];
     const auto point = storage_->points.find(o.point);
     if (point == storage_->points.end()) continue;
-    const auto& e = storage_->exposures.at(o.image);
-    const calib::Camera& camera = *e.camera;
-    const calib::PixelFrame frame{camera.pixel_size_mm, camera.width_px, camera.height_px};
-    const auto id =
-        builder_.AddResidual(calib::kGroupImage,
-                             calib::CollinearityResidual::Create(frame, o.pixel, o.sigma_px),
-                             {storage_->cameras.at(e.exposure->camera).block,
-                              e.opk_block,
-                              e.center_block,
-                              point->second.block},
-                             "image " + o.image + " point " + o.point,
-                             loss);
+    ObservationTerm term =
+        storage_->sensor_of_observation[i]->Observe(storage_->context, o, point->second.block);
+    const auto id = builder_.AddResidual(
+        term.group, std::move(term.cost), term.blocks, DescribeObservation(o), loss);
     storage_->observation_of_residual[id] = i;
   }
 }
@@ -289,7 +279,8 @@ void BlockAdjustment::AddPriors() {
     }
   }
   if (options_.use_interior_sigma) {
-    for (const auto& [id, state] : storage_->cameras) {
+    for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k) {
+      const std::string& id = storage_->index.CameraId(k);
       const calib::Camera& camera = project_.cameras.at(id);
       std::vector<int> indices;
       std::vector<double> values, sigmas;
@@ -304,7 +295,7 @@ void BlockAdjustment::AddPriors() {
         builder_.AddResidual(
             calib::kGroupInteriorPrior,
             std::make_unique<calib::PriorCostFunction>(Model::kNumParams, indices, values, sigmas),
-            {state.block},
+            {storage_->frame.InteriorBlock(k)},
             "interior prior " + id);
     }
   }
@@ -389,9 +380,7 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
 std::string BlockAdjustment::Describe(calib::ResidualId id) const {
   const auto it = storage_->observation_of_residual.find(id);
   if (it == storage_->observation_of_residual.end()) return builder_.ResidualLabel(id);
-  const ImageObservation& o = storage_->observations[it->second];
-  return "image " + o.image + (o.subimage.empty() ? "" : " sub-image " + o.subimage) + " point " +
-         o.point;
+  return DescribeObservation(storage_->observations[it->second]);
 }
 
 calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
@@ -555,7 +544,8 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   result.datum = storage_->datum;
   result.notes = storage_->notes;
   std::vector<BlockId> interior_blocks;
-  for (const auto& [id, state] : storage_->cameras) interior_blocks.push_back(state.block);
+  for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k)
+    interior_blocks.push_back(storage_->frame.InteriorBlock(k));
 
   // Stage 1 (self-calibration only): exterior orientation and points with the interior fixed.
   if (!options_.free_interior.empty()) {
@@ -658,17 +648,18 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
   advance();
   result.determinability = AssessDeterminability(cov, "camera ", options_.correlation_threshold);
-  for (const auto& [id, state] : storage_->cameras) {
+  for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k) {
+    const std::string& id = storage_->index.CameraId(k);
     CameraEstimate c;
     c.id = id;
     c.initial = project_.cameras.at(id).interior;
-    c.estimated = state.interior;
+    c.estimated = storage_->frame.Interior(k);
     for (int k = 0; k < Model::kNumParams; ++k)
       c.free[k] = std::find(options_.free_interior.begin(),
                             options_.free_interior.end(),
                             std::string(Model::kParams[k].name)) != options_.free_interior.end();
     if (cov.ok) {
-      const Eigen::VectorXd s = cov.BlockSigma(state.block, Model::kNumParams);
+      const Eigen::VectorXd s = cov.BlockSigma(storage_->frame.InteriorBlock(k), Model::kNumParams);
       for (int k = 0; k < Model::kNumParams; ++k) c.sigma[k] = c.free[k] ? s(k) : 0.0;
     }
     result.cameras.push_back(c);

@@ -16,12 +16,13 @@
 // adjusts with the interior fixed, then frees the listed parameters (robust start from exterior
 // orientations off by tens of metres and degrees).
 //
-// Extension (joint stitching + triangulation): build the adjustment with
-// SubimageObservations::kLeaveToCaller, then add SubimageCollinearityResidual<Mapping> residuals
-// (group kGroupSubimage) on mapping blocks of your own and the blocks returned by InteriorBlock,
-// RotationBlock, CenterBlock and PointBlock (create missing points with AddPoint), and register
-// each with RegisterCallerObservation so that it is snooped, counted as a ray and reported, before
-// Run().
+// Sensor kinds (triangulation/sensor/imaging_model.h): the frame camera measures virtual-image
+// pixels; other kinds (the sub-image camera of the joint adjustment, ...) are handed to the
+// constructor and asked first. Each registers its own blocks, gives the rays of its observations
+// for the point starting values and builds their residuals; the adjustment keeps the points, the
+// platform poses, the priors, the datum, statistics and data snooping. A raw sub-image
+// observation that no kind measures is mapped to the virtual image with the camera file's mapping
+// and measured by the frame camera.
 #pragma once
 
 #include "calib/core/progress.h"
@@ -30,47 +31,40 @@
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
+#include "triangulation/sensor/imaging_model.h"
 
 #include <Eigen/Core>
 
 #include <map>
+#include <memory>
 #include <string>
 #include <vector>
 
 namespace aerocal::triangulation {
-
-enum class SubimageObservations {
-  kMapWithCameraFile,  // raw sub-image (u, v) -> virtual pixel with the camera file's mapping
-  kLeaveToCaller,      // skipped here: the caller adds them with their mapping blocks
-};
 
 class BlockAdjustment {
  public:
   /// Validates the options, computes starting values and builds every residual.
   /// Throws InputError when the block cannot be started (an exposure without observations is
   /// only reported; an observation whose ray misses every start is an input error).
-  /// `image_loss` is applied to the image observations (robust start); none by default.
+  /// `sensors`: sensor kinds besides the frame camera, asked first which observations they
+  /// measure. `image_loss` is applied to the image observations (robust start); none by default.
   BlockAdjustment(const Project& project,
                   const AdjustOptions& options,
-                  SubimageObservations subimage = SubimageObservations::kMapWithCameraFile,
+                  std::vector<std::unique_ptr<ImagingModel>> sensors = {},
                   const calib::LossOptions& image_loss = {});
   ~BlockAdjustment();
   BlockAdjustment(const BlockAdjustment&) = delete;
   BlockAdjustment& operator=(const BlockAdjustment&) = delete;
 
   calib::ProblemBuilder& builder() { return builder_; }
+  /// What the sensor kinds see (builder, dense indices, poses, the frame camera's interiors).
+  const SensorContext& context() const;
   /// Block ids (-1 when absent).
   calib::BlockId InteriorBlock(const std::string& camera) const;
   calib::BlockId RotationBlock(const std::string& image) const;
   calib::BlockId CenterBlock(const std::string& image) const;
   calib::BlockId PointBlock(const std::string& point) const;
-  /// Adds (or returns) the ground point block of `point`, starting at `start_m`.
-  calib::BlockId AddPoint(const std::string& point, const Eigen::Vector3d& start_m);
-  /// Declares that residual `id` (group kGroupSubimage, whitened in photo space like the image
-  /// group) measures `observation` (raw sub-image pixels): it takes part in data snooping, counts
-  /// as a ray of its point, and is listed in the result's residuals and rejections with its
-  /// sub-image (u, v). Its virtual-image position is the caller's to fill in after Run().
-  void RegisterCallerObservation(calib::ResidualId id, const ImageObservation& observation);
 
   /// Solves (two stages when self-calibrating), snoops for gross errors, estimates the covariance
   /// and compares control and check points. Never throws on non-convergence. `progress` (may be
@@ -94,7 +88,9 @@ class BlockAdjustment {
  private:
   struct Storage;
   void BuildExposures();
-  void BuildPoints(SubimageObservations subimage);
+  void BuildPoints();
+  /// Adds the ground point block of `point`, starting at `start_m`.
+  calib::BlockId AddPoint(const std::string& point, const Eigen::Vector3d& start_m);
   void AddImageResiduals(const calib::LossOptions& loss);
   void AddPriors();
   void DefineDatum();

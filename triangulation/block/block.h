@@ -21,6 +21,7 @@ struct Exposure {
   Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();    // omega, phi, kappa
   std::optional<Eigen::Vector3d> center_sigma_m;        // GNSS prior when present
   std::optional<Eigen::Vector3d> opk_sigma_rad;         // IMU prior when present
+  std::optional<Eigen::Vector3d> velocity_mps;          // platform velocity (rig blocks: vX,vY,vZ)
   int line = 0;                                         // source line in exposures.csv
 };
 
@@ -38,6 +39,7 @@ struct GroundPoint {
 struct ImageObservation {
   std::string image, point;
   std::string subimage;          // empty: virtual-image pixel (col, row); else raw (u, v)
+  std::string head;              // rig head id (observations.csv `head` column); empty: no rig
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
   double sigma_px = 0.5;
   int line = 0;

@@ -25,6 +25,7 @@ constexpr double kMaxPixel = 1e7;
 constexpr double kMaxSigmaM = 1e6;
 constexpr double kMaxSigmaDeg = 360.0;
 constexpr double kMaxSigmaPx = 1e4;
+constexpr double kMaxVelocityMps = 1e4;
 
 // An optional positive sigma column: empty is "not given", otherwise within (0, hi].
 std::optional<double> Sigma(const CsvTable& t, const CsvTable::Row& row, const std::string& column,
@@ -77,6 +78,15 @@ std::vector<Exposure> ReadExposures(const std::string& path) {
       if (!(sx && sy && sz)) ThrowInputError(t.Where(row), "sX, sY, sZ must all be given or none (m)");
       e.center_sigma_m = Eigen::Vector3d(*sx, *sy, *sz);
     }
+    const auto vx = t.OptionalNumber(row, "vX"), vy = t.OptionalNumber(row, "vY"),
+               vz = t.OptionalNumber(row, "vZ");
+    if (vx || vy || vz) {
+      if (!(vx && vy && vz)) ThrowInputError(t.Where(row), "vX, vY, vZ must all be given or none (m/s)");
+      e.velocity_mps = Eigen::Vector3d(*vx, *vy, *vz);
+      if (!(e.velocity_mps->cwiseAbs().maxCoeff() <= kMaxVelocityMps))
+        ThrowInputError(t.Where(row), "vX, vY, vZ must be within +-" + FormatNumber(kMaxVelocityMps) +
+                                          " m/s");
+    }
     const auto so = Sigma(t, row, "somega", kMaxSigmaDeg), sp = Sigma(t, row, "sphi", kMaxSigmaDeg),
                sk = Sigma(t, row, "skappa", kMaxSigmaDeg);
     if (so || sp || sk) {
@@ -92,6 +102,9 @@ std::vector<Exposure> ReadExposures(const std::string& path) {
 std::vector<ImageObservation> ReadObservations(const std::string& path, double default_sigma_px) {
   const CsvTable t = CsvTable::Read(path);
   const bool sub = t.HasColumn("subimage");
+  const bool head = t.HasColumn("head");
+  if (sub && head)
+    ThrowInputError({path, 1}, "an observations table has a subimage or a head column, not both");
   if (sub)
     t.RequireColumns({"image", "subimage", "point", "u", "v"});
   else
@@ -105,6 +118,10 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
     o.point = t.String(row, "point");
     if (o.image.empty() || o.point.empty())
       ThrowInputError(t.Where(row), "image and point must not be empty");
+    if (head) {
+      o.head = t.String(row, "head");
+      if (o.head.empty()) ThrowInputError(t.Where(row), "head must not be empty");
+    }
     if (sub) {
       o.subimage = t.String(row, "subimage");
       if (o.subimage.empty()) ThrowInputError(t.Where(row), "subimage must not be empty");
@@ -176,6 +193,10 @@ void ValidateProject(const Project& project) {
   for (const auto& o : project.observations) {
     if (!images.count(o.image))
       ThrowInputError({project.observations_file, o.line}, "unknown image '" + o.image + "'");
+    if (!o.head.empty())
+      ThrowInputError({project.observations_file, o.line},
+                      "head observations belong to a rig camera file, which the block adjustment "
+                      "does not read yet (issue 13)");
     if (!o.subimage.empty()) {
       const auto& camera = project.cameras.at(project.FindExposure(o.image)->camera);
       if (camera.SubimageIndex(o.subimage) < 0)
@@ -278,15 +299,17 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
 }
 
 void WriteExposures(const std::string& path, const std::vector<Exposure>& exposures) {
-  bool gnss = false, imu = false;
+  bool gnss = false, imu = false, velocity = false;
   for (const auto& e : exposures) {
     gnss |= e.center_sigma_m.has_value();
     imu |= e.opk_sigma_rad.has_value();
+    velocity |= e.velocity_mps.has_value();
   }
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "image,camera,X,Y,Z,omega,phi,kappa";
     if (gnss) out << ",sX,sY,sZ";
     if (imu) out << ",somega,sphi,skappa";
+    if (velocity) out << ",vX,vY,vZ";
     out << "\n";
     for (const auto& e : exposures) {
       out << e.image << "," << e.camera << "," << Coordinate(e.center_m.x()) << ","
@@ -308,19 +331,33 @@ void WriteExposures(const std::string& path, const std::vector<Exposure>& exposu
         else
           out << ",,,";
       }
+      if (velocity) {
+        if (e.velocity_mps)
+          out << "," << Num(e.velocity_mps->x(), 4) << "," << Num(e.velocity_mps->y(), 4) << ","
+              << Num(e.velocity_mps->z(), 4);
+        else
+          out << ",,,";
+      }
       out << "\n";
     }
   });
 }
 
 void WriteObservations(const std::string& path, const std::vector<ImageObservation>& observations) {
-  bool sub = false;
-  for (const auto& o : observations) sub |= !o.subimage.empty();
+  bool sub = false, head = false;
+  for (const auto& o : observations) {
+    sub |= !o.subimage.empty();
+    head |= !o.head.empty();
+  }
+  AEROCAL_CHECK(!(sub && head)) << "observations with both sub-images and rig heads";
   WriteFileAtomically(path, [&](std::ostream& out) {
-    out << (sub ? "image,subimage,point,u,v,sigma_px\n" : "image,point,col,row,sigma_px\n");
+    out << (sub    ? "image,subimage,point,u,v,sigma_px\n"
+            : head ? "image,head,point,col,row,sigma_px\n"
+                   : "image,point,col,row,sigma_px\n");
     for (const auto& o : observations) {
       out << o.image << ",";
       if (sub) out << o.subimage << ",";
+      if (head) out << o.head << ",";
       out << o.point << "," << Num(o.pixel.x(), 4) << "," << Num(o.pixel.y(), 4) << ","
           << FormatNumber(o.sigma_px, 6) << "\n";
     }

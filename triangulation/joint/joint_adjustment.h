@@ -1,12 +1,13 @@
 // Joint adjustment of sub-image stitching and aerial triangulation: the sub-image mappings are
 // refined inside the bundle, so the stitched geometry is checked, and corrected, by ground control.
 //
-// Observations, all in one ProblemBuilder problem (on top of BlockAdjustment's):
+// Not a second adjustment: the block adjustment with the sub-image camera as a sensor kind
+// (triangulation/sensor/subimage_camera.h), whose observations and own residuals are
 // - subimage_image: raw sub-image measurements (u, v) -> mapping of their sub-image -> virtual
 //   pixel -> 10-parameter camera -> collinearity (calib::SubimageCollinearityResidual);
 // - stitch_reference: maker reference points, Map_k(u, v) = (U, V)_surveyed, per exposure;
 // - stitch_tie: stitching tie points of each exposure, Map_k(u, v) = P (unknown virtual P);
-// - plus image / control / GNSS-IMU / interior priors exactly as in BlockAdjustment.
+// - plus image / control / GNSS-IMU / interior priors of BlockAdjustment.
 // Mappings are one block per (camera, sub-image) for the whole flight, or per exposure
 // (MappingScope), in the conditioned parameterisation (calib/camera/subimage_mapping.h).
 // Datum of the focal plane: the base sub-images keep their camera-file mapping; without base
@@ -30,6 +31,7 @@
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
+#include "triangulation/sensor/subimage_camera.h"
 
 namespace aerocal {
 class Progress;
@@ -37,49 +39,18 @@ class Progress;
 
 namespace aerocal::triangulation {
 
-enum class MappingScope { kPerFlight, kPerExposure };
-std::string MappingScopeName(MappingScope scope);
-/// "per-flight" | "per-exposure"; ConfigError otherwise.
-MappingScope ParseMappingScope(const std::string& text);
 /// --joint-model: "translation" | "conformal" | "affine" | "projective", or "auto" (nullopt: the
 /// model the flight's stitching chooses); ConfigError otherwise.
 std::optional<calib::MappingModel> ParseJointModel(const std::string& text);
 
-struct JointOptions {
+/// The sub-image camera's options (scope, base_ids, use_stitching, stitch_sigma_px, model,
+/// stitching_sigma0_before_px: subimage_camera.h) and the adjustment's.
+struct JointOptions : SubimageCameraOptions {
   AdjustOptions adjust;
-  MappingScope scope = MappingScope::kPerFlight;
-  std::vector<std::string> base_ids;  // sub-images held at the camera file's mapping (datum)
-  bool use_stitching = true;          // the project's stitching file, when it names one
-  double stitch_sigma_px = 0.1;       // where stitch_obs.csv has no sigma_px, > 0
-  /// Model of every free sub-image's mapping; nullopt: each its camera-file model. Starting values
-  /// are the camera file's mappings converted (exact towards a richer model, about the sub-image
-  /// centre towards a simpler one). Base sub-images keep their own.
-  std::optional<calib::MappingModel> model;
   std::string model_reason;  // why that model, in words (written to the result)
-  /// Stitching sigma0 (px) of each exposure's own stitching adjustment, by image: the "before"
-  /// figures when the caller has them (JointMappingsFromStitching); other exposures are adjusted
-  /// alone here.
-  std::map<std::string, double> stitching_sigma0_before_px;
   /// ConfigError for an unknown base sub-image or a project without sub-image observations,
   /// InputError when the focal plane has no datum (no base sub-image and no reference point).
   void Validate(const Project& project) const;
-};
-
-struct MappingEstimate {
-  std::string camera, subimage;
-  std::string exposure;  // empty: one mapping for the whole flight
-  calib::MappingModel model = calib::MappingModel::kAffine;
-  bool base = false;
-  std::vector<double> initial, params, sigma;  // plain form (FORMATS.md order)
-};
-
-/// Stitching precision of one exposure, before (the exposure's own stitching adjustment) and after
-/// (its stitching residuals in the joint solution): sqrt(v^T P v / r) times the median sigma, px.
-struct ExposureStitching {
-  std::string image;
-  int n_observations = 0;
-  double sigma0_before_px = std::numeric_limits<double>::quiet_NaN();
-  double sigma0_after_px = std::numeric_limits<double>::quiet_NaN();
 };
 
 struct JointResult {

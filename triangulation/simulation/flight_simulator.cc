@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <random>
 
 #include "calib/camera/camera_io.h"
@@ -13,6 +14,7 @@ namespace aerocal::triangulation {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
+constexpr double kMarginPx = 20.0;  // points are measured at least this far inside the format
 using Model = calib::Camera::Model;
 
 struct Visible {
@@ -36,6 +38,144 @@ std::vector<Visible> VisibleIn(const calib::Camera& camera, const std::vector<Ex
 }
 
 }  // namespace
+
+namespace internal {
+
+std::vector<Exposure> PlanStrips(const FlightSimulationOptions& o, const Eigen::Vector2d& footprint_m,
+                                 const std::string& camera, SimulationRandom& random) {
+  auto& normal = random.normal;
+  auto& rng = random.rng;
+  const double base = (1.0 - o.forward_overlap) * footprint_m.x();
+  const double spacing = (1.0 - o.side_overlap) * footprint_m.y();
+  const double mean_terrain = o.terrain_base_m + 0.5 * o.terrain_relief_m;
+  std::vector<Exposure> truth;
+  int remaining = o.exposures;
+  for (int s = 0; s < o.strips; ++s) {
+    const int n = (remaining + (o.strips - s) - 1) / (o.strips - s);
+    remaining -= n;
+    for (int k = 0; k < n; ++k) {
+      Exposure e;
+      char id[32];
+      std::snprintf(id, sizeof(id), "%04d", static_cast<int>(truth.size()) + 1);
+      e.image = id;
+      e.camera = camera;
+      const int along = s % 2 == 0 ? k : n - 1 - k;
+      e.center_m = {(along - 0.5 * (n - 1)) * base, (s - 0.5 * (o.strips - 1)) * spacing,
+                    mean_terrain + o.flying_height_m};
+      e.opk_rad = {o.attitude_sigma_deg * kDegToRad * normal(rng),
+                   o.attitude_sigma_deg * kDegToRad * normal(rng),
+                   (s % 2 == 0 ? 0.0 : M_PI) + o.attitude_sigma_deg * kDegToRad * normal(rng)};
+      truth.push_back(e);
+    }
+  }
+  return truth;
+}
+
+std::vector<Exposure> ExposuresAsMeasured(const FlightSimulationOptions& o,
+                                          const std::vector<Exposure>& truth,
+                                          SimulationRandom& random) {
+  auto& normal = random.normal;
+  auto& rng = random.rng;
+  std::vector<Exposure> measured;
+  for (const auto& t : truth) {
+    Exposure e = t;
+    if (o.gnss_sigma_m > 0) {
+      e.center_m += o.gnss_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      e.center_sigma_m = Eigen::Vector3d::Constant(o.gnss_sigma_m);
+    } else {
+      e.center_m += o.start_position_error_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    }
+    if (o.imu_sigma_deg > 0) {
+      e.opk_rad += o.imu_sigma_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      e.opk_sigma_rad = Eigen::Vector3d::Constant(o.imu_sigma_deg * kDegToRad);
+    } else {
+      e.opk_rad += o.start_angle_error_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    }
+    measured.push_back(e);
+  }
+  return measured;
+}
+
+void PlacePoints(const FlightSimulationOptions& o, const std::vector<Exposure>& exposures,
+                 const Eigen::Vector2d& footprint_m,
+                 const std::function<int(const Eigen::Vector3d&)>& seen_by, SimulationRandom& random,
+                 std::vector<GroundPoint>* points_truth, std::vector<GroundPoint>* points_file) {
+  auto& normal = random.normal;
+  auto& uniform = random.uniform;
+  auto& rng = random.rng;
+  const double footprint_x = footprint_m.x(), footprint_y = footprint_m.y();
+  // Ground points: surveyed (control at corners + centre, then check) and tie points, each seen
+  // in at least two images.
+  double x_min = 1e300, x_max = -1e300, y_min = 1e300, y_max = -1e300;
+  for (const auto& e : exposures) {
+    x_min = std::min(x_min, e.center_m.x());
+    x_max = std::max(x_max, e.center_m.x());
+    y_min = std::min(y_min, e.center_m.y());
+    y_max = std::max(y_max, e.center_m.y());
+  }
+  x_min -= 0.45 * footprint_x;
+  x_max += 0.45 * footprint_x;
+  y_min -= 0.45 * footprint_y;
+  y_max += 0.45 * footprint_y;
+  auto ground = [&](double x, double y) {
+    return Eigen::Vector3d(x, y, SimulatedTerrainHeight(o, x, y));
+  };
+  auto add_point = [&](const std::string& id, const Eigen::Vector3d& p, PointRole role) {
+    GroundPoint g;
+    g.id = id;
+    g.xyz_m = p;
+    g.role = role;
+    g.sigma_m = Eigen::Vector3d::Constant(o.survey_sigma_m);
+    points_truth->push_back(g);
+  };
+  // Control: walk from each target towards the block centre until >= 3 images see it.
+  const Eigen::Vector2d centre(0.5 * (x_min + x_max), 0.5 * (y_min + y_max));
+  std::vector<Eigen::Vector2d> targets = {{x_min, y_min}, {x_max, y_min}, {x_min, y_max},
+                                          {x_max, y_max}, centre};
+  targets.resize(std::min<size_t>(targets.size(), std::max(0, o.control_points)));
+  for (int extra = static_cast<int>(targets.size()); extra < o.control_points; ++extra)
+    targets.push_back({x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min)});
+  int control_id = 0;
+  // (The centre itself may lie in a two-fold overlap: look around it along the strip as well.)
+  const double step_x = 0.05 * footprint_x;
+  for (const auto& target : targets) {
+    bool placed = false;
+    for (double t = 0.0; t <= 1.0 && !placed; t += 0.01) {
+      for (int k = 0; k <= 20 && !placed; ++k) {
+        const double dx = (k % 2 == 0 ? 1 : -1) * ((k + 1) / 2) * step_x;
+        const Eigen::Vector2d xy = target + t * (centre - target) + Eigen::Vector2d(dx, 0.0);
+        const Eigen::Vector3d p = ground(xy.x(), xy.y());
+        if (seen_by(p) >= 3) {
+          add_point("C" + std::to_string(++control_id), p, PointRole::kControl);
+          placed = true;
+        }
+      }
+    }
+  }
+  auto sample = [&](int count, const std::string& prefix, PointRole role) {
+    int made = 0;
+    for (int attempt = 0; made < count && attempt < 200 * count + 1000; ++attempt) {
+      const Eigen::Vector3d p =
+          ground(x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min));
+      if (seen_by(p) < 2) continue;
+      add_point(prefix + std::to_string(++made), p, role);
+    }
+  };
+  sample(o.ground_points - control_id, "K", PointRole::kCheck);
+  sample(o.tie_points, "T", PointRole::kTie);
+
+  for (const auto& t : *points_truth) {
+    GroundPoint g = t;
+    if (g.role == PointRole::kTie) {
+      g.xyz_m.reset();
+    } else {
+      *g.xyz_m += o.survey_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    }
+    points_file->push_back(g);
+  }
+}
+
+}  // namespace internal
 
 stitch::GridLayoutOptions FlightSimulationOptions::DefaultLayout() {
   stitch::GridLayoutOptions layout;
@@ -86,9 +226,9 @@ double SimulatedTerrainHeight(const FlightSimulationOptions& o, double x, double
 SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
   if (o.exposures < 2 || o.strips < 1 || o.exposures < o.strips)
     throw ConfigError("a flight needs at least 2 exposures and one strip per exposure row");
-  std::mt19937_64 rng(o.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  internal::SimulationRandom random(o.seed);
+  std::mt19937_64& rng = random.rng;
+  std::normal_distribution<double>& normal = random.normal;
 
   SimulatedFlight f;
   f.options = o;
@@ -97,123 +237,20 @@ SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
   for (int i = 0; i < Model::kNumParams; ++i) f.truth.interior[i] += o.interior_correction[i];
   f.truth.name = f.nominal.name + " (truth)";
 
-  // Exposures: east-west strips, alternate flight directions (kappa 0 / 180 deg).
   const double scale = o.flying_height_m / (o.layout.c_mm * 1e-3);
-  const double footprint_x = f.nominal.width_px * f.nominal.pixel_size_mm * 1e-3 * scale;
-  const double footprint_y = f.nominal.height_px * f.nominal.pixel_size_mm * 1e-3 * scale;
-  const double base = (1.0 - o.forward_overlap) * footprint_x;
-  const double spacing = (1.0 - o.side_overlap) * footprint_y;
-  const double mean_terrain = o.terrain_base_m + 0.5 * o.terrain_relief_m;
-  int remaining = o.exposures;
-  for (int s = 0; s < o.strips; ++s) {
-    const int n = (remaining + (o.strips - s) - 1) / (o.strips - s);
-    remaining -= n;
-    for (int k = 0; k < n; ++k) {
-      Exposure e;
-      char id[32];
-      std::snprintf(id, sizeof(id), "%04d", static_cast<int>(f.exposures_truth.size()) + 1);
-      e.image = id;
-      e.camera = "cam1";
-      const int along = s % 2 == 0 ? k : n - 1 - k;
-      e.center_m = {(along - 0.5 * (n - 1)) * base, (s - 0.5 * (o.strips - 1)) * spacing,
-                    mean_terrain + o.flying_height_m};
-      e.opk_rad = {o.attitude_sigma_deg * kDegToRad * normal(rng),
-                   o.attitude_sigma_deg * kDegToRad * normal(rng),
-                   (s % 2 == 0 ? 0.0 : M_PI) + o.attitude_sigma_deg * kDegToRad * normal(rng)};
-      f.exposures_truth.push_back(e);
-    }
-  }
-  for (const auto& t : f.exposures_truth) {
-    Exposure e = t;
-    if (o.gnss_sigma_m > 0) {
-      e.center_m += o.gnss_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-      e.center_sigma_m = Eigen::Vector3d::Constant(o.gnss_sigma_m);
-    } else {
-      e.center_m += o.start_position_error_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-    }
-    if (o.imu_sigma_deg > 0) {
-      e.opk_rad += o.imu_sigma_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-      e.opk_sigma_rad = Eigen::Vector3d::Constant(o.imu_sigma_deg * kDegToRad);
-    } else {
-      e.opk_rad += o.start_angle_error_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-    }
-    f.exposures_file.push_back(e);
-  }
-
-  // Ground points: surveyed (control at corners + centre, then check) and tie points, each seen
-  // in at least two images.
-  double x_min = 1e300, x_max = -1e300, y_min = 1e300, y_max = -1e300;
-  for (const auto& e : f.exposures_truth) {
-    x_min = std::min(x_min, e.center_m.x());
-    x_max = std::max(x_max, e.center_m.x());
-    y_min = std::min(y_min, e.center_m.y());
-    y_max = std::max(y_max, e.center_m.y());
-  }
-  x_min -= 0.45 * footprint_x;
-  x_max += 0.45 * footprint_x;
-  y_min -= 0.45 * footprint_y;
-  y_max += 0.45 * footprint_y;
-  const double margin_px = 20.0;
-  auto ground = [&](double x, double y) {
-    return Eigen::Vector3d(x, y, SimulatedTerrainHeight(o, x, y));
+  const Eigen::Vector2d footprint(f.nominal.width_px * f.nominal.pixel_size_mm * 1e-3 * scale,
+                                  f.nominal.height_px * f.nominal.pixel_size_mm * 1e-3 * scale);
+  f.exposures_truth = internal::PlanStrips(o, footprint, "cam1", random);
+  f.exposures_file = internal::ExposuresAsMeasured(o, f.exposures_truth, random);
+  const auto seen_by = [&](const Eigen::Vector3d& p) {
+    return static_cast<int>(VisibleIn(f.truth, f.exposures_truth, p, kMarginPx).size());
   };
-  auto add_point = [&](const std::string& id, const Eigen::Vector3d& p, PointRole role) {
-    GroundPoint g;
-    g.id = id;
-    g.xyz_m = p;
-    g.role = role;
-    g.sigma_m = Eigen::Vector3d::Constant(o.survey_sigma_m);
-    f.points_truth.push_back(g);
-  };
-  // Control: walk from each target towards the block centre until >= 3 images see it.
-  const Eigen::Vector2d centre(0.5 * (x_min + x_max), 0.5 * (y_min + y_max));
-  std::vector<Eigen::Vector2d> targets = {{x_min, y_min}, {x_max, y_min}, {x_min, y_max},
-                                          {x_max, y_max}, centre};
-  targets.resize(std::min<size_t>(targets.size(), std::max(0, o.control_points)));
-  for (int extra = static_cast<int>(targets.size()); extra < o.control_points; ++extra)
-    targets.push_back({x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min)});
-  int control_id = 0;
-  // (The centre itself may lie in a two-fold overlap: look around it along the strip as well.)
-  const double step_x = 0.05 * footprint_x;
-  for (const auto& target : targets) {
-    bool placed = false;
-    for (double t = 0.0; t <= 1.0 && !placed; t += 0.01) {
-      for (int k = 0; k <= 20 && !placed; ++k) {
-        const double dx = (k % 2 == 0 ? 1 : -1) * ((k + 1) / 2) * step_x;
-        const Eigen::Vector2d xy = target + t * (centre - target) + Eigen::Vector2d(dx, 0.0);
-        const Eigen::Vector3d p = ground(xy.x(), xy.y());
-        if (VisibleIn(f.truth, f.exposures_truth, p, margin_px).size() >= 3) {
-          add_point("C" + std::to_string(++control_id), p, PointRole::kControl);
-          placed = true;
-        }
-      }
-    }
-  }
-  auto sample = [&](int count, const std::string& prefix, PointRole role) {
-    int made = 0;
-    for (int attempt = 0; made < count && attempt < 200 * count + 1000; ++attempt) {
-      const Eigen::Vector3d p =
-          ground(x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min));
-      if (VisibleIn(f.truth, f.exposures_truth, p, margin_px).size() < 2) continue;
-      add_point(prefix + std::to_string(++made), p, role);
-    }
-  };
-  sample(o.ground_points - control_id, "K", PointRole::kCheck);
-  sample(o.tie_points, "T", PointRole::kTie);
-
-  for (const auto& t : f.points_truth) {
-    GroundPoint g = t;
-    if (g.role == PointRole::kTie) {
-      g.xyz_m.reset();
-    } else {
-      *g.xyz_m += o.survey_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-    }
-    f.points_file.push_back(g);
-  }
+  internal::PlacePoints(o, f.exposures_truth, footprint, seen_by, random, &f.points_truth,
+                        &f.points_file);
 
   // Image observations: virtual-image pixels and the same points in raw sub-image pixels.
   for (const auto& p : f.points_truth) {
-    for (const auto& v : VisibleIn(f.truth, f.exposures_truth, *p.xyz_m, margin_px)) {
+    for (const auto& v : VisibleIn(f.truth, f.exposures_truth, *p.xyz_m, kMarginPx)) {
       ImageObservation obs;
       obs.image = f.exposures_truth[v.image].image;
       obs.point = p.id;

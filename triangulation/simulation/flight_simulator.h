@@ -11,6 +11,8 @@
 #pragma once
 
 #include <cstdint>
+#include <functional>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -71,5 +73,41 @@ SimulatedFlight SimulateFlight(const FlightSimulationOptions& options);
 /// project.yaml (virtual observations), project_subimage.yaml (raw sub-image observations), and
 /// truth/exposures.csv, truth/points.csv. Every file is written atomically.
 void WriteSimulatedFlight(const SimulatedFlight& flight, const std::string& folder);
+
+namespace internal {
+
+/// The seeded random streams of one simulation (shared by the frame and rig simulators so both
+/// plan the same flight from the same seed).
+struct SimulationRandom {
+  explicit SimulationRandom(std::uint64_t seed) : rng(seed) {}
+  std::mt19937_64 rng;
+  std::normal_distribution<double> normal{0.0, 1.0};
+  std::uniform_real_distribution<double> uniform{0.0, 1.0};
+};
+
+/// The true exposures: east-west strips with alternate flight directions (kappa 0 / 180 deg),
+/// bases and strip spacing from the overlaps and the ground footprint (m, x along the strip).
+std::vector<Exposure> PlanStrips(const FlightSimulationOptions& options,
+                                 const Eigen::Vector2d& footprint_m,
+                                 const std::string& camera,
+                                 SimulationRandom& random);
+
+/// What exposures.csv holds: GNSS/IMU-measured (with their sigmas) or approximate EO.
+std::vector<Exposure> ExposuresAsMeasured(const FlightSimulationOptions& options,
+                                          const std::vector<Exposure>& truth,
+                                          SimulationRandom& random);
+
+/// Ground points over the block: control walked from the corners and centre inward until
+/// `seen_by` (the number of exposures measuring a point) is >= 3, check and tie points where it
+/// is >= 2; the file copies carry survey noise (control/check) or no coordinates (tie).
+void PlacePoints(const FlightSimulationOptions& options,
+                 const std::vector<Exposure>& exposures,
+                 const Eigen::Vector2d& footprint_m,
+                 const std::function<int(const Eigen::Vector3d&)>& seen_by,
+                 SimulationRandom& random,
+                 std::vector<GroundPoint>* points_truth,
+                 std::vector<GroundPoint>* points_file);
+
+}  // namespace internal
 
 }  // namespace aerocal::triangulation

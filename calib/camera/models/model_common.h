@@ -35,6 +35,19 @@ struct ParamInfo {
   ParamGroup group;
 };
 
+/// The group's name in files and results: principal_distance, principal_point, radial,
+/// decentering, affinity.
+constexpr std::string_view ParamGroupName(ParamGroup group) {
+  switch (group) {
+    case ParamGroup::kPrincipalDistance: return "principal_distance";
+    case ParamGroup::kPrincipalPoint: return "principal_point";
+    case ParamGroup::kRadial: return "radial";
+    case ParamGroup::kDecentering: return "decentering";
+    case ParamGroup::kAffinity: return "affinity";
+  }
+  return "";
+}
+
 /// Registered camera models. The numbers are FROZEN: files and results store them; a removed
 /// model's number is never reused. A new model takes the next free number.
 enum class CameraModelId : int {

@@ -1,0 +1,197 @@
+// Rig conversion speed (issue 13): the dual-lens camera's 10000 x 10000 px head pair (8 bit, a
+// random texture) converted into its 10460 x 10044 px virtual image by ConvertRigExposure, against
+// cv::remap on the same maps (the plane homography plus, for distorted heads, the same correction
+// grids; maps built per strip, their building timed apart in the counter `map_s`), in one run;
+// the end prints the time ratios. Plus the Monte-Carlo of the conversion error analysis with 1e5
+// samples (configs/rig_dual_lens_limits.yaml values).
+//
+// Run: cmake -DAEROCAL_BUILD_BENCHMARKS=ON ...; build/tests/bench/bench_rig
+// Arg 0: distortion-free heads (homographies only); arg 1: K1/P1/B1 of a few px (grids).
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <random>
+
+#include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "stitch/resample/raster.h"
+#include "tests/bench/discard_sink.h"
+#include "stitch/rig/error_analysis.h"
+#include "stitch/rig/rig_convert.h"
+#include "triangulation/simulation/rig_flight_simulator.h"
+
+namespace aerocal::stitch {
+namespace {
+
+calib::Rig BenchRig(bool distorted) {
+  calib::Rig rig = triangulation::MakeNominalRig(triangulation::RigPreset::kDualLens);
+  if (distorted) {
+    using Model = calib::BrownFraser10Model;
+    rig.heads[0].camera.interior[Model::kK1] = 2e-7;   // 3 px at r = 45 mm
+    rig.heads[0].camera.interior[Model::kP1] = 1e-6;
+    rig.heads[1].camera.interior[Model::kK1] = -1.5e-7;
+    rig.heads[1].camera.interior[Model::kB1] = 5e-5;
+  }
+  return rig;
+}
+
+const std::vector<MemoryRaster>& Heads() {
+  static const std::vector<MemoryRaster> heads = [] {
+    std::vector<MemoryRaster> out;
+    std::mt19937 rng(1);
+    for (int k = 0; k < 2; ++k) {
+      MemoryRaster image({10000, 10000, 1, 8});
+      for (auto& b : image.bytes()) b = static_cast<std::uint8_t>(rng());
+      out.push_back(std::move(image));
+    }
+    return out;
+  }();
+  return heads;
+}
+
+
+void BM_RigConvert(benchmark::State& state) {
+  const calib::Rig rig = BenchRig(state.range(0) != 0);
+  const RigExposure nadir;
+  const RigConverter converter(rig, nadir, MakeRectificationPlane(rig, nadir, 1200.0));
+  auto& heads = const_cast<std::vector<MemoryRaster>&>(Heads());
+  std::vector<RasterSource*> sources = {&heads[0], &heads[1]};
+  DiscardSink sink(rig.virtual_camera.width_px);
+  for (auto _ : state) ConvertRigExposure(converter, sources, &sink, {});
+  benchmark::DoNotOptimize(sink.checksum_);
+  const double mpx = rig.virtual_camera.width_px * 1e-6 * rig.virtual_camera.height_px;
+  state.counters["Mpx/s"] = benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_RigConvert)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+// The same conversion with cv::remap: per strip, the maps of each head (homography + the same
+// correction grid, bilinear), remap (bilinear, constant border), coverage from the maps, average.
+void BM_CvRemap(benchmark::State& state) {
+  const calib::Rig rig = BenchRig(state.range(0) != 0);
+  const RigExposure nadir;
+  const RigConverter converter(rig, nadir, MakeRectificationPlane(rig, nadir, 1200.0));
+  const HeadMapCorrections corrections = MakeHeadMapCorrections(converter);
+  const int width = rig.virtual_camera.width_px, height = rig.virtual_camera.height_px;
+  const int strip_rows = 256;
+  std::vector<cv::Mat> sources;
+  std::vector<Eigen::Matrix3d> homographies;
+  for (int k = 0; k < 2; ++k) {
+    sources.emplace_back(10000, 10000, CV_8UC1, const_cast<std::uint8_t*>(Heads()[k].bytes().data()));
+    homographies.push_back(HeadFromVirtualHomography(converter, k));
+  }
+  cv::Mat map_x(strip_rows, width, CV_32FC1), map_y(strip_rows, width, CV_32FC1);
+  cv::Mat warped, in_x, in_y, mask, sum(strip_rows, width, CV_32FC1), count(strip_rows, width, CV_32FC1);
+  cv::Mat mean, out;
+  double map_seconds = 0.0;
+  std::uint64_t checksum = 0;
+  for (auto _ : state) {
+    for (int y0 = 0; y0 < height; y0 += strip_rows) {
+      const int rows = std::min(strip_rows, height - y0);
+      sum.setTo(0);
+      count.setTo(0);
+      for (int k = 0; k < 2; ++k) {
+        const auto start = std::chrono::steady_clock::now();
+        const Eigen::Matrix3d& m = homographies[k];
+        const MapCorrectionGrid& g = corrections.grids[k];
+        for (int r = 0; r < rows; ++r) {
+          float* mx = map_x.ptr<float>(r);
+          float* my = map_y.ptr<float>(r);
+          const double V = y0 + r;
+          for (int c = 0; c < width; ++c) {
+            const double w = m(2, 0) * c + m(2, 1) * V + m(2, 2);
+            mx[c] = static_cast<float>((m(0, 0) * c + m(0, 1) * V + m(0, 2)) / w);
+            my[c] = static_cast<float>((m(1, 0) * c + m(1, 1) * V + m(1, 2)) / w);
+            if (g.step_px > 0) {
+              const double gu = static_cast<double>(c) / g.step_px, gv = V / g.step_px;
+              const int i = std::min(static_cast<int>(gu), g.cols - 2);
+              const int j = std::min(static_cast<int>(gv), g.rows - 2);
+              const float fu = static_cast<float>(gu - i), fv = static_cast<float>(gv - j);
+              const float* t = g.duv.data() + 2 * (static_cast<size_t>(j) * g.cols + i);
+              const float* b = t + 2 * g.cols;
+              for (int a = 0; a < 2; ++a) {
+                const float top = t[a] + fu * (t[2 + a] - t[a]);
+                const float bottom = b[a] + fu * (b[2 + a] - b[a]);
+                (a == 0 ? mx : my)[c] += top + fv * (bottom - top);
+              }
+            }
+          }
+        }
+        map_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        const cv::Rect roi(0, 0, width, rows);
+        cv::remap(sources[k], warped, map_x(roi), map_y(roi), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+        cv::inRange(map_x(roi), 0.0, 9999.0, in_x);
+        cv::inRange(map_y(roi), 0.0, 9999.0, in_y);
+        cv::bitwise_and(in_x, in_y, mask);
+        cv::Mat sum_roi = sum(roi), count_roi = count(roi);
+        cv::accumulate(warped, sum_roi, mask);
+        cv::accumulate(mask / 255, count_roi);
+      }
+      cv::divide(sum, cv::max(count, 1.0f), mean);
+      mean.convertTo(out, CV_8UC1);
+      checksum += out.at<std::uint8_t>(rows / 2, width / 2);
+    }
+  }
+  benchmark::DoNotOptimize(checksum);
+  const double mpx = width * 1e-6 * height;
+  state.counters["Mpx/s"] = benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["map_s"] = map_seconds / state.iterations();
+}
+BENCHMARK(BM_CvRemap)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
+// Monte-Carlo of the conversion error analysis: 1e5 samples at head B's centre pixel, the limits
+// of configs/rig_dual_lens_limits.yaml (0.5 px, 1 px, 10", 1 mm, 150 m; 3 sigma).
+void BM_ErrorAnalysisMonteCarlo(benchmark::State& state) {
+  const calib::Rig rig = BenchRig(false);
+  ErrorLimits limits;
+  limits.principal_point_px = 0.5;
+  limits.principal_distance_px = 1.0;
+  limits.angles_arcsec = 10.0;
+  limits.lever_arm_mm = 1.0;
+  limits.height_m = 150.0;
+  const RigExposure nadir;
+  const RigConverter converter(rig, nadir, MakeRectificationPlane(rig, nadir, 1200.0));
+  const Eigen::Vector2d virtual_px = *converter.VirtualFromHead(1, Eigen::Vector2d(4999.5, 4999.5));
+  const ConversionErrorModel model(rig, 1200.0, MakeErrorSources(rig, limits), 1, virtual_px);
+  for (auto _ : state) {
+    const MonteCarloResult result = RunMonteCarlo(model, 3.0, 100000, 7, false);
+    benchmark::DoNotOptimize(result.sigma_px);
+  }
+}
+BENCHMARK(BM_ErrorAnalysisMonteCarlo)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+// Console output as usual, and the real time per iteration of every run kept for the ratios.
+class RatioReporter : public benchmark::ConsoleReporter {
+ public:
+  void ReportRuns(const std::vector<Run>& runs) override {
+    for (const Run& run : runs)
+      if (run.run_type == Run::RT_Iteration) seconds_[run.benchmark_name()] = run.GetAdjustedRealTime();
+    ConsoleReporter::ReportRuns(runs);
+  }
+  std::map<std::string, double> seconds_;
+};
+
+}  // namespace
+}  // namespace aerocal::stitch
+
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  aerocal::stitch::RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  const auto time_of = [&](const std::string& prefix) {  // "BM_X/0" -> its real time (ms)
+    for (const auto& [name, ms] : reporter.seconds_)
+      if (name.rfind(prefix + "/", 0) == 0 || name == prefix) return ms;
+    return -1.0;
+  };
+  for (const char* arg : {"/0", "/1"}) {
+    const double ours = time_of(std::string("BM_RigConvert") + arg);
+    const double cv = time_of(std::string("BM_CvRemap") + arg);
+    if (ours > 0 && cv > 0)
+      std::printf("rig convert%s: %.1f ms, cv::remap on the same maps: %.1f ms, ratio %.2f\n",
+                  arg[1] == '0' ? " (distortion-free)" : " (distorted, grids)", ours, cv,
+                  ours / cv);
+  }
+  benchmark::Shutdown();
+  return 0;
+}

@@ -1,0 +1,38 @@
+// The frame camera: one image per exposure with the exposure's pose, observations in the virtual
+// image's pixel frame, collinearity with the camera's interior (calib/residuals/collinearity.h,
+// CONVENTIONS.md). It owns one interior block per camera (CameraIndex), whose free entries are
+// AdjustOptions::free_interior (a subset manifold in the builder); other sensor kinds put their
+// geometry in front of these blocks (sub-image mappings, rig mounts).
+#pragma once
+
+#include "calib/camera/camera.h"
+#include "triangulation/sensor/imaging_model.h"
+
+#include <vector>
+
+namespace aerocal::triangulation {
+
+class FrameCamera final : public ImagingModel {
+ public:
+  std::string Kind() const override { return "frame"; }
+  /// Virtual-image pixels (col, row): observations without a sub-image.
+  bool Measures(const ImageObservation& observation) const override;
+  /// One interior block per camera ("camera ID", entries named by the model's table).
+  void RegisterBlocks(const SensorContext& context) override;
+  ImageRay StartingRay(const SensorContext& context,
+                       const ImageObservation& observation) const override;
+  /// Group kGroupImage; blocks interior, rotation, centre, point.
+  ObservationTerm Observe(const SensorContext& context,
+                          const ImageObservation& observation,
+                          calib::BlockId point) override;
+
+  /// The interior block of a camera and its current values (table order).
+  calib::BlockId InteriorBlock(CameraIndex camera) const { return blocks_[camera]; }
+  const calib::InteriorParams& Interior(CameraIndex camera) const { return interior_[camera]; }
+
+ private:
+  std::vector<calib::InteriorParams> interior_;  // sized once: the builder holds their addresses
+  std::vector<calib::BlockId> blocks_;
+};
+
+}  // namespace aerocal::triangulation

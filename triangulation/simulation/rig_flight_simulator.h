@@ -1,0 +1,90 @@
+// Deterministic (seeded) simulation of a flight with a multi-head rig (CONVENTIONS.md "Multi-head
+// rigs", FORMATS.md "Multi-head rig"): the truth behind the rig bundle's synthetic tests and the
+// `aerocal simulate --rig` files.
+//
+// The flight plan, the GNSS/IMU-measured exposures and the ground points are those of the
+// frame-camera simulator (flight_simulator.h, the same options and the same seeded streams); the
+// exposures are the rig's (virtual centre O and rig attitude R), the footprint is the virtual
+// camera's. Each head k of each exposure sees the object through R_k = R M_k E_k,
+// O_k = O + R t_k + v dT_k (calib/camera/rig.h HeadPose) with its own true interior; its
+// measurements are pixels of that head (observations.csv with a `head` column).
+//
+// Presets: `dual-lens` is configs/rig_dual_lens.yaml (two 10000 x 10000 px heads of 6 um,
+// c = 150 mm, head B 0.15 m along x converging by 1 deg). `uav4` (four tilted heads) follows with
+// issue 14: ParseRigPreset knows the name and MakeNominalRig refuses it by name.
+#pragma once
+
+#include <cmath>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calib/camera/rig.h"
+#include "triangulation/block/block.h"
+#include "triangulation/simulation/flight_simulator.h"
+
+namespace aerocal::triangulation {
+
+enum class RigPreset { kDualLens, kUav4 };
+
+/// "dual-lens" | "uav4" -> preset; nullopt for any other name.
+std::optional<RigPreset> ParseRigPreset(const std::string& name);
+
+/// The nominal rig of a preset (a maker's design values). ConfigError for a preset not built yet.
+calib::Rig MakeNominalRig(RigPreset preset);
+
+struct RigFlightSimulationOptions {
+  /// Flight geometry, points, image noise, GNSS/IMU: as the frame simulator. The camera fields
+  /// (layout, misplacement, stitching, interior_correction) are not used.
+  FlightSimulationOptions flight = DefaultRigFlight();
+  RigPreset preset = RigPreset::kDualLens;
+  /// truth - nominal of every non-reference head's mount angles (rad) and lever arm (m)
+  Eigen::Vector3d mount_error_rad = Eigen::Vector3d(15.0, -25.0, 10.0) * M_PI / (180.0 * 3600.0);
+  Eigen::Vector3d lever_arm_error_m = Eigen::Vector3d(1.5e-3, -1.0e-3, 2.0e-3);
+  /// truth - nominal interior of head k (k-th entry; the last one serves the heads beyond)
+  std::vector<calib::InteriorParams> interior_correction = DefaultHeadInteriorCorrections();
+  double increment_sigma_rad = 0.0;  // per-exposure E_k of non-reference heads (sigma), >= 0
+  double time_offset_s = 0.0;        // dT_k of every non-reference head, |dT| <= 1 s
+  double speed_mps = 0.0;            // platform speed along the strips, >= 0; > 0: exposures.csv
+                                     // carries the velocity vX, vY, vZ
+
+  /// The frame simulator's defaults at the dual-lens camera's relative flying height (1200 m)
+  /// with terrain relief of 100 m.
+  static FlightSimulationOptions DefaultRigFlight();
+  static std::vector<calib::InteriorParams> DefaultHeadInteriorCorrections();
+};
+
+/// Truth of one head in one exposure: the attitude increment E_k (rad) and time offset dT_k (s).
+struct RigExposureTruth {
+  std::string image, head;
+  Eigen::Vector3d increment_rad = Eigen::Vector3d::Zero();
+  double dt_s = 0.0;
+};
+
+struct SimulatedRigFlight {
+  RigFlightSimulationOptions options;
+  calib::Rig nominal, truth;
+  std::vector<Exposure> exposures_truth, exposures_file;
+  std::vector<GroundPoint> points_truth, points_file;
+  std::vector<ImageObservation> observations;  // head pixels, `head` set
+  std::vector<RigExposureTruth> rig_exposures;  // every exposure and head
+};
+
+/// The true head pixel of an object point in one exposure; false when it lies behind the head.
+bool ProjectRigHead(const calib::RigHead& head,
+                    const Exposure& exposure,
+                    const RigExposureTruth& increment,
+                    const Eigen::Vector3d& point_m,
+                    Eigen::Vector2d* pixel);
+
+SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options);
+
+/// Writes rig_nominal.yaml, rig_truth.yaml (FORMATS.md "Multi-head rig"), exposures.csv,
+/// observations.csv (`image,head,point,col,row,sigma_px`), points.csv, project.yaml and
+/// truth/exposures.csv, truth/points.csv, truth/rig_exposures.csv
+/// (`image,head,domega,dphi,dkappa,dT_ms`, degrees and ms). Every file is written atomically.
+void WriteSimulatedRigFlight(const SimulatedRigFlight& flight, const std::string& folder);
+
+}  // namespace aerocal::triangulation
