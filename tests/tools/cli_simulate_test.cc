@@ -107,7 +107,7 @@ TEST(Cli, SimulateRigRefusesUnknownRigsAndFrameOptions) {
   EXPECT_NE(unknown.output.find("--rig"), std::string::npos) << unknown.output;
   const auto uav4 = testing::RunAerocal("simulate --out " + dir.File("x") + " --rig uav4");
   EXPECT_EQ(uav4.exit_code, 2);
-  EXPECT_NE(uav4.output.find("issue 14"), std::string::npos) << uav4.output;
+  EXPECT_NE(uav4.output.find("four-head issue, 16"), std::string::npos) << uav4.output;
   const auto layout = testing::RunAerocal("simulate --out " + dir.File("x") + " --rig dual-lens --layout 2x2");
   EXPECT_EQ(layout.exit_code, 2);
   EXPECT_NE(layout.output.find("--layout"), std::string::npos) << layout.output;

@@ -42,7 +42,7 @@ std::optional<RigPreset> ParseRigPreset(const std::string& name) {
 
 calib::Rig MakeNominalRig(RigPreset preset) {
   if (preset != RigPreset::kDualLens)
-    throw ConfigError("--rig uav4: the four-head UAV rig is not built yet (issue 14); use dual-lens");
+    throw ConfigError("--rig uav4: the four-head UAV rig is not built yet (the four-head issue, 16); use dual-lens");
   // configs/rig_dual_lens.yaml (a test checks that both agree).
   calib::Rig rig;
   rig.name = "dual-lens-150";

@@ -11,7 +11,7 @@
 //
 // Presets: `dual-lens` is configs/rig_dual_lens.yaml (two 10000 x 10000 px heads of 6 um,
 // c = 150 mm, head B 0.15 m along x converging by 1 deg). `uav4` (four tilted heads) follows with
-// issue 14: ParseRigPreset knows the name and MakeNominalRig refuses it by name.
+// the four-head issue (16): ParseRigPreset knows the name and MakeNominalRig refuses it by name.
 #pragma once
 
 #include <cmath>
