@@ -89,8 +89,8 @@ double MaxEccentricityPx(const CalibrationRun& run, const Project& project, doub
   const AdjustmentResult& r = run.all.result;
   const double c = r.cameras[0].estimated[Model::kC];
   const double radius_m = radius_mm * 1e-3;
-  // Target normal: that of the plane of the control points when planar, else the ray itself
-  // (targets turned towards the cameras: no eccentricity from the tilt).
+  // Target normal: that of the best-fit plane of the control points (a 3-D field's targets face
+  // the field's main direction).
   std::vector<Eigen::Vector3d> control;
   for (const auto& p : project.points)
     if (p.role == PointRole::kControl && p.xyz_m) control.push_back(*p.xyz_m);
@@ -102,7 +102,7 @@ double MaxEccentricityPx(const CalibrationRun& run, const Project& project, doub
     Eigen::MatrixXd centred(control.size(), 3);
     for (size_t i = 0; i < control.size(); ++i) centred.row(i) = (control[i] - mean).transpose();
     const Eigen::JacobiSVD<Eigen::MatrixXd> svd(centred, Eigen::ComputeFullV);
-    if (svd.singularValues()(2) < 0.02 * svd.singularValues()(0)) normal = svd.matrixV().col(2);
+    normal = svd.matrixV().col(2);
   }
   std::map<std::string, const ExposureEstimate*> exposures;
   for (const auto& e : r.exposures) exposures[e.image] = &e;

@@ -17,7 +17,8 @@
 //   and a run with them 1000 times smaller (nu = inf).
 // - B "target eccentricity": the image offset of a circular target's centre e = c r^2 sin(a)
 //   cos(a) / (D^2 - r^2 sin^2 a) (r target radius, D distance, a viewing angle to the target
-//   normal; Ahn, Warnecke, Kotowski 1999), largest over all observations, rectangular
+//   normal, taken as the normal of the control points' best-fit plane; Ahn, Warnecke, Kotowski
+//   1999), largest over all observations, rectangular
 //   (u_px = e_max / sqrt 3), propagated as an image error: u = u_adjustment u_px / sigma0_px.
 // - B user components (temperature, ...): value with its distribution (normal: divisor 1,
 //   rectangular sqrt 3, triangular sqrt 6), sensitivity coefficient and degrees of freedom.
