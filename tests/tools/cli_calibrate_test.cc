@@ -1,0 +1,196 @@
+// aerocal calibrate and aerocal certificate on real data (skipped when ../shared/data is absent):
+// OpenCV's chessboard images against cv::calibrateCamera on the same corners and the published
+// Bouguet / OpenCV results; the DBAT Olympus test field (started from aerocal's own resections)
+// against DBAT's published calibration, in three image groups; the certificate from it (JSON,
+// HTML, PDF rendered to PNG), deterministic; bad input with exit 2 and nothing written.
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+
+namespace aerocal {
+namespace {
+
+using testing::RunAerocal;
+using testing::RunCommand;
+using testing::SharedDataDir;
+using testing::TempDir;
+
+nlohmann::json ReadJson(const std::string& path) { return nlohmann::json::parse(ReadTextFile(path)); }
+
+void WriteText(const std::string& path, const std::string& text) {
+  std::ofstream(path) << text;
+}
+
+TEST(CalibrateCommand, OpenCvChessboardAgainstCalibrateCameraAndThePublishedResults) {
+  const std::string dir = SharedDataDir("opencv_stereo_chessboard_9x6");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/opencv_stereo_chessboard_9x6 is absent";
+  TempDir tmp("aerocal_calibrate_cv");
+  WriteText(tmp.File("camera.yaml"),
+            "name: left\npixel_size_mm: 0.006\nformat_px: [640, 480]\ninterior: {c: 3.0}\n");
+  const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" + dir +
+                            "/left*.jpg' --board chessboard:9x6:25 --model opencv --write-marks " +
+                            tmp.File("marks") + " --out " + tmp.File("left.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = ReadJson(tmp.File("left.json"));
+  for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations",
+                          "converged", "cameras", "control", "check", "exposures", "rejected", "calibration"})
+    EXPECT_TRUE(j.contains(key)) << key;
+  const auto& cal = j["calibration"];
+  EXPECT_EQ(cal["method"]["detected"].size(), 13u);  // left01..14 without 10
+  EXPECT_EQ(cal["data"]["observations"].get<int>(), 13 * 54);
+  EXPECT_TRUE(std::filesystem::exists(tmp.File("marks/observations.csv")));
+  const auto& est = j["cameras"][0]["estimated"];
+  const double p = 0.006;
+  const double f_px = est["c"].get<double>() / p;
+  const double cx = est["x0"].get<double>() / p + 319.5, cy = -est["y0"].get<double>() / p + 239.5;
+  const auto& cv = cal["opencv"];
+  std::printf("aerocal: f %.3f cx %.3f cy %.3f RMS %.4f px | cv::calibrateCamera: fx %.3f fy %.3f cx %.3f "
+              "cy %.3f RMS %.4f px\n", f_px, cx, cy, cal["rms_px"].get<double>(), cv["fx"].get<double>(),
+              cv["fy"].get<double>(), cv["cx"].get<double>(), cv["cy"].get<double>(), cv["rms_px"].get<double>());
+  // Same corners, different distortion models (correction form vs OpenCV's forward form) and a
+  // common c for fx, fy: the principal distance within 0.2 %, the principal point within 1 px,
+  // the RMS within 10 %.
+  EXPECT_NEAR(f_px / (0.5 * (cv["fx"].get<double>() + cv["fy"].get<double>())), 1.0, 2e-3);
+  EXPECT_NEAR(cx, cv["cx"].get<double>(), 1.0);
+  EXPECT_NEAR(cy, cv["cy"].get<double>(), 1.0);
+  EXPECT_NEAR(cal["rms_px"].get<double>() / cv["rms_px"].get<double>(), 1.0, 0.10);
+  // Published: Bouguet fx 533.00, fy 533.15, cx 341.59, cy 234.26 (14 images, his corners);
+  // OpenCV's sample fx = fy 535.92, cx 342.28, cy 235.57 (fixed aspect, its corners).
+  EXPECT_NEAR(f_px / 533.08, 1.0, 5e-3);
+  EXPECT_NEAR(f_px / 535.92, 1.0, 1e-2);
+  EXPECT_NEAR(cx, 341.59, 2.0);
+  EXPECT_NEAR(cy, 234.26, 2.0);
+  // The budget states c with U and k.
+  bool stated = false;
+  for (const auto& q : cal["uncertainty"])
+    stated = stated || (q["quantity"] == "c" && q["U"].get<double>() > 0 && q["k"].get<double>() >= 2.0);
+  EXPECT_TRUE(stated);
+}
+
+class OlympusCalibration : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = SharedDataDir("dbat_camcal_olympus_c4040z");
+    if (dir_.empty()) GTEST_SKIP() << "../shared/data/dbat_camcal_olympus_c4040z is absent";
+    // The block files from the DBAT marks (the importer needs stations; calibrate ignores them).
+    const auto imp = RunAerocal("import dbat --camera-xml " + dir_ + "/c4040z.xml --marks " + dir_ +
+                                "/measurements/markpts.txt --images " + dir_ + "/images/images.txt --control " +
+                                dir_ + "/reference/camcal-fixed.txt --control-sigma-m 1e-6 --photomodeler-export " +
+                                dir_ + "/photomodeler/camcal-pmexport.txt --out " + tmp_.File("oly"));
+    ASSERT_EQ(imp.exit_code, 0) << imp.output;
+    std::string groups = "image,group\n";
+    for (int i = 21; i <= 41; ++i)
+      groups += "P82500" + std::to_string(i) + ",G" + std::to_string(i % 3 + 1) + "\n";
+    WriteText(tmp_.File("groups.csv"), groups);
+  }
+  std::string Calibrate(const std::string& extra) {
+    return "calibrate --camera " + tmp_.File("oly/camera_cam1.yaml") + " --observations " +
+           tmp_.File("oly/observations.csv") + " --points " + tmp_.File("oly/points.csv") +
+           " --self-calibration c,x0,y0,K1,K2,K3,P1,P2,B1 --no-snooping " + extra;
+  }
+  std::string dir_;
+  TempDir tmp_{"aerocal_calibrate_oly"};
+};
+
+TEST_F(OlympusCalibration, PublishedDbatValuesWithinThreeSigmaAndGroupStability) {
+  const auto r = RunAerocal(Calibrate("--groups " + tmp_.File("groups.csv") + " --out " + tmp_.File("oly.json")));
+  // The three groups of 7 images do not agree within their sigmas (y0, P2, ...): flagged, exit 3.
+  ASSERT_EQ(r.exit_code, 3) << r.output;
+  EXPECT_NE(r.output.find("warning: group_stability"), std::string::npos);
+  const auto j = ReadJson(tmp_.File("oly.json"));
+  const auto& cal = j["calibration"];
+  EXPECT_EQ(cal["start"]["resections"].size(), 21u);
+  EXPECT_EQ(cal["groups"].size(), 3u);
+  EXPECT_EQ(cal["stability"]["rows"].size(), 9u);
+  EXPECT_FALSE(cal["stability"]["agree"].get<bool>());
+  const auto& est = j["cameras"][0]["estimated"];
+  const auto& sig = j["cameras"][0]["sigma"];
+  // DBAT 0.9.2.0 (PROVENANCE.md): c 7.45700, pp 3.61546 / 2.61329 mm from the top-left corner,
+  // K1 4.58861e-3, K2 -4.51351e-5, K3 -2.05253e-6, P1 -6.12803e-5, P2 -4.41171e-5.
+  const double p = 0.0031911032863849768;
+  const std::map<std::string, double> published = {
+      {"c", 7.45700}, {"x0", 3.61546 - 2272 * p / 2}, {"y0", 1704 * p / 2 - 2.61329},
+      {"K1", 4.58861e-3}, {"K2", -4.51351e-5}, {"K3", -2.05253e-6}, {"P1", -6.12803e-5}, {"P2", -4.41171e-5}};
+  for (const auto& [name, value] : published) {
+    SCOPED_TRACE(name);
+    EXPECT_LE(std::abs(est[name].get<double>() - value), 3.0 * sig[name].get<double>())
+        << est[name].get<double>() << " sigma " << sig[name].get<double>();
+  }
+  EXPECT_NEAR(j["sigma0_px"].get<double>() / 0.16148, 1.0, 0.10);
+}
+
+TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
+  const auto r = RunAerocal(Calibrate("--out " + tmp_.File("oly.json")));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  WriteText(tmp_.File("lab.yaml"),
+            "lab: {name: Test Lab, address: 1 Road, accreditation: none}\n"
+            "certificate: {number: T-1, date: 2026-11-24}\n"
+            "camera: {make: Olympus, model: C4040Z, serial: '123'}\n"
+            "signatures: {calibrated_by: A, checked_by: B, approved_by: C}\n");
+  WriteText(tmp_.File("tol.yaml"), "c: 0.001\nx0: 0.001\n");
+  const std::string args = "certificate --result " + tmp_.File("oly.json") + " --lab " + tmp_.File("lab.yaml") +
+                           " --previous " + tmp_.File("oly.json") + " --tolerances " + tmp_.File("tol.yaml");
+  const auto c1 = RunAerocal(args + " --out " + tmp_.File("cert1"));
+  ASSERT_EQ(c1.exit_code, 0) << c1.output;
+  EXPECT_NE(c1.output.find("c = 7.457"), std::string::npos) << c1.output;
+  const auto cert = ReadJson(tmp_.File("cert1/certificate.json"));
+  EXPECT_EQ(cert["kind"], "certificate");
+  EXPECT_TRUE(cert["comparison"]["pass"].get<bool>());  // against itself: differences 0
+  EXPECT_EQ(cert["comparison"]["rows"][0]["criterion"], "|difference| <= tolerance");
+  const std::string html = ReadTextFile(tmp_.File("cert1/certificate.html"));
+  for (const char* text : {"Calibration certificate", "T-1", "Uncertainty budget", "<svg", "Stability over image groups",
+                           "Check points", "Comparison with the previous certificate", "Signatures", "c = 7.457"})
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  // Deterministic: a second run writes the same bytes.
+  const auto c2 = RunAerocal(args + " --out " + tmp_.File("cert2"));
+  ASSERT_EQ(c2.exit_code, 0) << c2.output;
+  for (const char* f : {"certificate.json", "certificate.html", "certificate.pdf"}) {
+    SCOPED_TRACE(f);
+    EXPECT_EQ(ReadTextFile(tmp_.File(std::string("cert1/") + f)), ReadTextFile(tmp_.File(std::string("cert2/") + f)));
+  }
+  // Every PDF page rendered to PNG (poppler's pdftoppm).
+  if (RunCommand("command -v pdftoppm").exit_code != 0)
+    GTEST_SKIP() << "pdftoppm is absent (Debian package poppler-utils): the PDF pages are not rendered";
+  const auto png = RunCommand("pdftoppm -r 40 -png " + tmp_.File("cert1/certificate.pdf") + " " + tmp_.File("page"));
+  ASSERT_EQ(png.exit_code, 0) << png.output;
+  int pages = 0;
+  for (const auto& e : std::filesystem::directory_iterator(tmp_.path()))
+    if (e.path().extension() == ".png" && std::filesystem::file_size(e.path()) > 1000) ++pages;
+  EXPECT_GE(pages, 5);  // identification + results + budget, distortion, residuals, stability .. signatures
+}
+
+TEST(CalibrateCommand, BadInputExitsTwoAndWritesNothing) {
+  TempDir tmp("aerocal_calibrate_bad");
+  WriteText(tmp.File("camera.yaml"), "name: c\npixel_size_mm: 0.006\nformat_px: [640, 480]\ninterior: {c: 3.0}\n");
+  WriteText(tmp.File("points.csv"), "point,X,Y,Z,sX,sY,sZ,role\nA,0,0,0,0.001,0.001,0.001,control\n");
+  WriteText(tmp.File("obs.csv"), "image,point,col,row,sigma_px\ni1,A,10,10,0.5\ni1,B,abc,20,0.5\n");
+  WriteText(tmp.File("few.csv"), "image,point,col,row,sigma_px\ni1,A,10,10,0.5\ni1,B,20,20,0.5\n");
+  auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" + tmp.File("*.jpg") +
+                      "' --board chessboard:9:25 --out " + tmp.File("out.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--board"), std::string::npos) << r.output;
+  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " + tmp.File("obs.csv") +
+                 " --points " + tmp.File("points.csv") + " --out " + tmp.File("out.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("obs.csv:3"), std::string::npos) << r.output;  // col is not a number
+  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " + tmp.File("few.csv") +
+                 " --points " + tmp.File("points.csv") + " --out " + tmp.File("out.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;  // one control point: no resection
+  EXPECT_NE(r.output.find("no starting orientation by resection for i1"), std::string::npos) << r.output;
+  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " + tmp.File("obs.csv") +
+                 " --images x --board chessboard:9x6:25 --out " + tmp.File("out.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  r = RunAerocal("certificate --result " + tmp.File("points.csv") + " --out " + tmp.File("cert"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp.File("out.json")));
+  EXPECT_FALSE(std::filesystem::exists(tmp.File("cert/certificate.json")));
+}
+
+}  // namespace
+}  // namespace aerocal

@@ -1,0 +1,412 @@
+#!/usr/bin/env python3
+"""Renders the calibration certificate of `aerocal certificate`.
+
+Usage: aerocal_certificate.py CERTIFICATE.json OUT_DIR
+Writes OUT_DIR/certificate.html (figures inline as SVG) and OUT_DIR/certificate.pdf (matplotlib's
+PDF backend, A4 pages). Both are deterministic: no dates other than the lab file's, fixed SVG ids,
+no creation date in the PDF. Exit 0 on success, 2 on bad input (nothing written), 1 when
+matplotlib is missing.
+
+The PDF is rendered with matplotlib (python3-matplotlib, already a dependency of the reports),
+not with an HTML engine: weasyprint and chromium are not installed on the target machines and
+would add a large dependency; matplotlib's PDF backend is well kept, deterministic and draws the
+same figures as the HTML page.
+"""
+import html
+import io
+import json
+import math
+import os
+import sys
+
+try:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.backends.backend_pdf import PdfPages
+    import numpy as np
+except ImportError as e:  # pragma: no cover
+    print("error: matplotlib/numpy missing: %s" % e, file=sys.stderr)
+    sys.exit(1)
+
+matplotlib.rcParams["svg.hashsalt"] = "aerocal-certificate"
+matplotlib.rcParams["font.size"] = 8
+A4 = (8.27, 11.69)
+
+
+def fmt(v, digits=6):
+    if v is None:
+        return "-"
+    if isinstance(v, bool):
+        return "yes" if v else "no"
+    if isinstance(v, (int,)):
+        return str(v)
+    if isinstance(v, float):
+        if math.isnan(v):
+            return "-"
+        return "%.*g" % (digits, v)
+    return str(v)
+
+
+def interior_function(name, interior):
+    """Value of a certified distortion quantity (um) from the estimated interior."""
+    k1, k2, k3 = interior.get("K1", 0), interior.get("K2", 0), interior.get("K3", 0)
+    p1, p2 = interior.get("P1", 0), interior.get("P2", 0)
+    def radial(r):
+        r2 = r * r
+        return 1e3 * r * (k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2)
+    def decentring(r):
+        return 1e3 * r * r * math.hypot(p1, p2)
+    return radial, decentring
+
+
+# ---------------------------------------------------------------- tables (lists of rows)
+
+def result_rows(c):
+    rows = [["quantity", "value", "U", "k", "unit", "nu_eff"]]
+    for q in c["results"]:
+        rows.append([q["quantity"], fmt(q["value"], 7), fmt(q["U"], 2), fmt(q["k"], 3), q["unit"],
+                     fmt(q["dof_eff"], 3)])
+    return rows
+
+
+def budget_rows(c):
+    rows = [["quantity", "component", "type", "distribution", "u_i", "nu_i"]]
+    for q in c["results"]:
+        for comp in q["components"]:
+            rows.append([q["quantity"], comp["source"], comp["type"], comp["distribution"],
+                         fmt(comp["u"], 3), fmt(comp["dof"], 3)])
+        rows.append([q["quantity"], "combined u_c / expanded U", "", "k = %s" % fmt(q["k"], 3),
+                     fmt(q["u_c"], 3) + " / " + fmt(q["U"], 2), fmt(q["dof_eff"], 3)])
+    return rows
+
+
+def stability_rows(c):
+    s = c.get("stability") or {}
+    groups = c.get("groups") or []
+    if not groups:
+        return None
+    head = ["parameter"] + [g["group"] for g in groups] + ["mean", "spread", "chi2", "critical", "agree"]
+    rows = [head]
+    for r in s.get("rows", []):
+        rows.append([r["parameter"]] + [fmt(v, 7) + " +- " + fmt(sg, 2) for v, sg in zip(r["values"], r["sigmas"])] +
+                    [fmt(r["mean"], 7), fmt(r["spread"], 2), fmt(r["chi2"], 3), fmt(r["critical"], 3),
+                     "yes" if r["agree"] else "NO"])
+    return rows
+
+
+def check_rows(c):
+    chk = c.get("check") or {}
+    n = chk.get("n", 0)
+    rows = [["quantity", "value", "U (k)", "unit"]]
+    by_name = {q["quantity"]: q for q in c["results"]}
+    for name in ["m_X", "m_Y", "m_Z", "m_0"]:
+        q = by_name.get(name)
+        if q:
+            rows.append([name, fmt(q["value"], 4), "%s (%s)" % (fmt(q["U"], 2), fmt(q["k"], 3)), q["unit"]])
+    rows.append(["check points n", str(n), "", ""])
+    if n:
+        rows.append(["mean X / Y / Z", " / ".join(fmt(1e3 * v, 3) for v in chk["mean_m"]), "", "mm"])
+        rows.append(["max |d| X / Y / Z", " / ".join(fmt(1e3 * v, 3) for v in chk["max_abs_m"]), "", "mm"])
+    return rows
+
+
+def comparison_rows(c):
+    cmp = c.get("comparison")
+    if not cmp:
+        return None
+    rows = [["quantity", "now", "previous", "difference", "tolerance", "E_n", "criterion", "result"]]
+    for r in cmp["rows"]:
+        rows.append([r["quantity"], fmt(r["value"], 7), fmt(r["previous"], 7), fmt(r["difference"], 3),
+                     fmt(r["tolerance"], 3), fmt(r["E_n"], 3), r["criterion"], "pass" if r["pass"] else "FAIL"])
+    return rows
+
+
+def identification_rows(c):
+    lab, cam, cf = c["lab"], c["lab"]["camera"], c["camera_file"]
+    m, d, a = c["method"], c["data"], c["adjustment"]
+    rows = [["field", "value"],
+            ["certificate number", lab["certificate"]["number"]],
+            ["date", lab["certificate"]["date"]],
+            ["laboratory", lab["lab"]["name"]],
+            ["address", lab["lab"]["address"]],
+            ["accreditation", lab["lab"]["accreditation"]],
+            ["customer", lab["customer"]["name"]],
+            ["camera", "%s %s, serial %s" % (cam["make"], cam["model"], cam["serial"])],
+            ["lens", "%s %s" % (cam["lens"], cam["lens_serial"])],
+            ["camera file", "%s: pixel %s mm, format %s x %s px" % (cf["file"], fmt(cf["pixel_size_mm"]),
+                                                                   cf["format_px"][0], cf["format_px"][1])],
+            ["method", method_text(m)],
+            ["data", "%d images, %d observations, %d control, %d check points, %d groups" % (
+                d["images"], d["observations"], d["control_points"], d["check_points"], d["groups"])],
+            ["adjustment", "self-calibrating bundle adjustment (%s); sigma0 %s (%s px, %s um), redundancy %s, RMS %s px" % (
+                ", ".join(a.get("self_calibration") or []) if isinstance(a.get("self_calibration"), list) else fmt(a.get("self_calibration")),
+                fmt(a["sigma0"], 4), fmt(a["sigma0_px"], 4), fmt(a["sigma0_um"], 4), fmt(a["redundancy"]), fmt(a["rms_px"], 4))],
+            ["conditions", ", ".join("%s %s" % (k, v) for k, v in lab["conditions"].items() if v) or "-"],
+            ["valid", "yes" if a["valid"] else "NO: " + "; ".join(a["invalid_reasons"])]]
+    if c.get("opencv"):
+        o = c["opencv"]
+        rows.append(["peer: cv::calibrateCamera", "RMS %s px, fx %s, fy %s, cx %s, cy %s px (c %s, x0 %s, y0 %s mm)" % (
+            fmt(o["rms_px"], 5), fmt(o["fx"], 7), fmt(o["fy"], 7), fmt(o["cx"], 7), fmt(o["cy"], 7),
+            fmt(o["equivalent"]["c"], 6), fmt(o["equivalent"]["x0"], 4), fmt(o["equivalent"]["y0"], 4))])
+    return rows
+
+
+def method_text(m):
+    if m.get("kind") == "planar target":
+        return "planar %s %dx%d, spacing %s mm, %s; %d of %d images detected" % (
+            m["board"], m["columns"], m["rows"], fmt(m["spacing_mm"]), m["detector"], len(m["detected"]),
+            len(m["detected"]) + len(m["not_detected"]))
+    return "test field: %s, %s; starting orientation by resection (aerocal)" % (m.get("observations"), m.get("points"))
+
+
+def warning_lines(c):
+    out = []
+    for w in c["adjustment"].get("warnings") or []:
+        out.append("%s: %s" % (w.get("name"), w.get("message")))
+    for f in (c.get("stability") or {}).get("flagged", []):
+        out.append("group stability: " + f)
+    return out
+
+
+# ---------------------------------------------------------------- figures
+
+def fig_distortion(c):
+    interior = c["interior"]["estimated"]
+    radial, decentring = interior_function("", interior)
+    cf = c["camera_file"]
+    p = cf["pixel_size_mm"]
+    w, h = cf["format_px"]
+    rmax = 0.5 * p * math.hypot(w, h)
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(8, 3.4))
+    r = np.linspace(0, rmax, 200)
+    ax1.plot(r, [radial(x) for x in r], label="radial dr(r)")
+    ax1.plot(r, [decentring(x) for x in r], label="decentring |dt|(r)")
+    by_name = {q["quantity"]: q for q in c["results"]}
+    for rad in c.get("radii_mm", []):
+        for key, color in (("dr@%g" % rad, "C0"), ("dt@%g" % rad, "C1")):
+            q = by_name.get(key)
+            if q and q["U"] is not None:
+                ax1.errorbar([rad], [q["value"]], yerr=[q["U"]], fmt="o", color=color, capsize=3, ms=3)
+    ax1.set_xlabel("radius r (mm)")
+    ax1.set_ylabel("distortion (um)")
+    ax1.set_title("distortion curves (bars: U, k as stated)")
+    ax1.grid(True, lw=0.3)
+    ax1.legend()
+    # Distortion grid over the format (photo frame, mm; vectors exaggerated).
+    x0, y0 = interior.get("x0", 0), interior.get("y0", 0)
+    xs = np.linspace(-0.5 * w * p, 0.5 * w * p, 11)
+    ys = np.linspace(-0.5 * h * p, 0.5 * h * p, 9)
+    gx, gy, dx, dy = [], [], [], []
+    for x in xs:
+        for y in ys:
+            xb, yb = x - x0, y - y0
+            r2 = xb * xb + yb * yb
+            k = interior.get("K1", 0) * r2 + interior.get("K2", 0) * r2 ** 2 + interior.get("K3", 0) * r2 ** 3
+            ddx = xb * k + interior.get("P1", 0) * (r2 + 2 * xb * xb) + 2 * interior.get("P2", 0) * xb * yb + \
+                interior.get("B1", 0) * xb + interior.get("B2", 0) * yb
+            ddy = yb * k + 2 * interior.get("P1", 0) * xb * yb + interior.get("P2", 0) * (r2 + 2 * yb * yb)
+            gx.append(x); gy.append(y); dx.append(ddx * 1e3); dy.append(ddy * 1e3)
+    q = ax2.quiver(gx, gy, dx, dy, angles="xy")
+    longest = max(1e-9, max(math.hypot(a, b) for a, b in zip(dx, dy)))
+    ax2.quiverkey(q, 0.8, 1.04, longest, "%.3g um" % longest, labelpos="E")
+    ax2.set_aspect("equal")
+    ax2.set_xlabel("x (mm)")
+    ax2.set_ylabel("y (mm)")
+    ax2.set_title("correction dx, dy over the format", pad=14)
+    fig.tight_layout()
+    return fig
+
+
+def fig_residuals_correlation(c):
+    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(8, 3.6))
+    cf = c["camera_file"]
+    w, h = cf["format_px"]
+    res = c.get("residuals") or []
+    if res:
+        a = np.array(res, dtype=float)
+        q = ax1.quiver(a[:, 0], a[:, 1], a[:, 2], -a[:, 3], angles="xy", scale_units="xy",
+                       scale=1.0 / (0.08 * w / max(1e-9, np.percentile(np.hypot(a[:, 2], a[:, 3]), 99))))
+        ax1.quiverkey(q, 0.8, 1.04, 1.0, "1 px", labelpos="E")
+    ax1.set_xlim(0, w)
+    ax1.set_ylim(h, 0)
+    ax1.set_aspect("equal")
+    ax1.set_title("image residuals (all images)", pad=14)
+    ax1.set_xlabel("col (px)")
+    ax1.set_ylabel("row (px)")
+    corr = c.get("correlation")
+    if corr and corr.get("correlation"):
+        m = np.array(corr["correlation"])
+        im = ax2.imshow(m, vmin=-1, vmax=1, cmap="RdBu_r")
+        names = corr["names"]
+        ax2.set_xticks(range(len(names)))
+        ax2.set_xticklabels(names, rotation=90)
+        ax2.set_yticks(range(len(names)))
+        ax2.set_yticklabels(names)
+        for i in range(len(names)):
+            for j in range(len(names)):
+                ax2.text(j, i, "%.2f" % m[i, j], ha="center", va="center", fontsize=5)
+        fig.colorbar(im, ax=ax2, shrink=0.8)
+    ax2.set_title("correlation of the interior parameters")
+    fig.tight_layout()
+    return fig
+
+
+def svg_of(fig):
+    buf = io.StringIO()
+    fig.savefig(buf, format="svg", metadata={"Date": None})
+    plt.close(fig)
+    text = buf.getvalue()
+    return text[text.index("<svg"):]
+
+
+# ---------------------------------------------------------------- HTML
+
+def html_table(rows, flag_col=None):
+    out = ["<table><tr>" + "".join("<th>%s</th>" % html.escape(str(x)) for x in rows[0]) + "</tr>"]
+    for r in rows[1:]:
+        cls = ""
+        if flag_col is not None and str(r[flag_col]) in ("NO", "FAIL"):
+            cls = ' class="bad"'
+        out.append("<tr%s>" % cls + "".join("<td>%s</td>" % html.escape(str(x)) for x in r) + "</tr>")
+    out.append("</table>")
+    return "\n".join(out)
+
+
+def write_html(c, path, figures):
+    lab = c["lab"]
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>Calibration certificate %s</title>" %
+             html.escape(lab["certificate"]["number"]),
+             "<style>body{font-family:sans-serif;max-width:60em;margin:auto;font-size:11pt}"
+             "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #999;padding:2px 6px;"
+             "text-align:left;font-size:10pt}.bad{color:#b00;font-weight:bold}.sig td{height:3em;width:14em}"
+             "h1{font-size:18pt}h2{font-size:13pt;border-bottom:1px solid #999}</style></head><body>",
+             "<h1>Calibration certificate</h1>",
+             "<p>%s<br>%s<br>%s</p>" % tuple(html.escape(lab["lab"][k]) for k in ("name", "address", "accreditation")),
+             "<h2>1. Identification, method and data</h2>", html_table(identification_rows(c)),
+             "<h2>2. Results</h2><p>Each value with its expanded uncertainty U = k u_c (ISO GUM / JJF 1059.1), "
+             "coverage probability about 95 %.</p>",
+             "<ul>" + "".join("<li>%s</li>" % html.escape(q["statement"]) for q in c["results"]) + "</ul>",
+             html_table(result_rows(c)),
+             "<h2>3. Uncertainty budget</h2>", html_table(budget_rows(c)),
+             "<h2>4. Distortion</h2>", figures["distortion"],
+             "<h2>5. Residuals and correlations</h2>", figures["residuals"]]
+    st = stability_rows(c)
+    parts.append("<h2>6. Stability over image groups</h2>")
+    parts.append(html_table(st, flag_col=len(st[0]) - 1) if st else "<p>No image groups given.</p>")
+    parts += ["<h2>7. Check points</h2>", html_table(check_rows(c))]
+    cmp = comparison_rows(c)
+    parts.append("<h2>8. Comparison with the previous certificate</h2>")
+    if cmp:
+        parts.append("<p>Previous: %s. Overall: <b>%s</b>.</p>" % (
+            html.escape(c["comparison"]["previous"]), "pass" if c["comparison"]["pass"] else "FAIL"))
+        parts.append(html_table(cmp, flag_col=7))
+    else:
+        parts.append("<p>No previous certificate given.</p>")
+    warnings = warning_lines(c)
+    if warnings:
+        parts.append("<h2>Findings</h2><ul>" + "".join("<li class='bad'>%s</li>" % html.escape(w) for w in warnings) + "</ul>")
+    s = lab["signatures"]
+    parts.append("<h2>Signatures</h2><table class='sig'><tr><th>calibrated by</th><th>checked by</th><th>approved by</th></tr>"
+                 "<tr><td>%s</td><td>%s</td><td>%s</td></tr></table>" % tuple(html.escape(s[k]) for k in ("calibrated_by", "checked_by", "approved_by")))
+    parts.append("<p>%s</p></body></html>" % html.escape(lab["certificate"]["page_note"]))
+    tmp = path + ".tmp"
+    with open(tmp, "w", encoding="utf-8") as f:
+        f.write("\n".join(parts) + "\n")
+    os.replace(tmp, path)
+
+
+# ---------------------------------------------------------------- PDF
+
+def text_pages(title, blocks):
+    """Pages of monospace tables: blocks = [(heading, rows)]."""
+    lines = []
+    for heading, rows in blocks:
+        lines.append(("h", heading))
+        if not rows:
+            lines.append(("t", "-"))
+            continue
+        widths = [max(len(str(r[i])) for r in rows) for i in range(len(rows[0]))]
+        for r in rows:
+            lines.append(("t", "  ".join(str(x).ljust(w) for x, w in zip(r, widths))))
+        lines.append(("t", ""))
+    per_page = 70
+    figs = []
+    for start in range(0, len(lines), per_page):
+        fig = plt.figure(figsize=A4)
+        fig.text(0.05, 0.97, title, fontsize=12, weight="bold")
+        y = 0.945
+        for kind, text in lines[start:start + per_page]:
+            if kind == "h":
+                fig.text(0.05, y, text, fontsize=9, weight="bold")
+            else:
+                fig.text(0.05, y, text, fontsize=5.6, family="monospace")
+            y -= 0.0128
+        figs.append(fig)
+    return figs
+
+
+def write_pdf(c, path):
+    lab = c["lab"]
+    title = "Calibration certificate %s" % lab["certificate"]["number"]
+    tmp = path + ".tmp"
+    with PdfPages(tmp, metadata={"CreationDate": None, "Creator": "aerocal certificate",
+                                 "Producer": "matplotlib"}) as pdf:
+        statements = [["statement"]] + [[q["statement"]] for q in c["results"]]
+        blocks = [("1. Identification, method and data", identification_rows(c)),
+                  ("2. Results (U = k u_c, ISO GUM / JJF 1059.1)", statements),
+                  ("", result_rows(c)),
+                  ("3. Uncertainty budget", budget_rows(c))]
+        for fig in text_pages(title, blocks):
+            pdf.savefig(fig)
+            plt.close(fig)
+        for make in (fig_distortion, fig_residuals_correlation):
+            fig = plt.figure(figsize=A4)
+            fig.text(0.05, 0.97, title, fontsize=12, weight="bold")
+            sub = make(c)
+            buf = io.BytesIO()
+            sub.savefig(buf, format="png", dpi=200)
+            plt.close(sub)
+            buf.seek(0)
+            img = plt.imread(buf)
+            ax = fig.add_axes([0.03, 0.45, 0.94, 0.5])
+            ax.imshow(img)
+            ax.axis("off")
+            pdf.savefig(fig)
+            plt.close(fig)
+        s = lab["signatures"]
+        sig = [["calibrated by", "checked by", "approved by"],
+               [s["calibrated_by"] or "", s["checked_by"] or "", s["approved_by"] or ""],
+               ["signature: ______________", "signature: ______________", "signature: ______________"]]
+        blocks = [("6. Stability over image groups", stability_rows(c) or [["no image groups given"]]),
+                  ("7. Check points", check_rows(c)),
+                  ("8. Comparison with the previous certificate", comparison_rows(c) or [["no previous certificate given"]]),
+                  ("Findings", [[w] for w in warning_lines(c)] or [["none"]]),
+                  ("Signatures", sig)]
+        for fig in text_pages(title, blocks):
+            pdf.savefig(fig)
+            plt.close(fig)
+    os.replace(tmp, path)
+
+
+def main(argv):
+    if len(argv) != 3:
+        print("usage: aerocal_certificate.py CERTIFICATE.json OUT_DIR", file=sys.stderr)
+        return 2
+    try:
+        with open(argv[1], encoding="utf-8") as f:
+            c = json.load(f)
+    except (OSError, ValueError) as e:
+        print("error: %s: %s" % (argv[1], e), file=sys.stderr)
+        return 2
+    if not isinstance(c, dict) or c.get("kind") != "certificate":
+        print("error: %s: not a certificate.json (kind must be \"certificate\")" % argv[1], file=sys.stderr)
+        return 2
+    figures = {"distortion": svg_of(fig_distortion(c)), "residuals": svg_of(fig_residuals_correlation(c))}
+    write_html(c, os.path.join(argv[2], "certificate.html"), figures)
+    write_pdf(c, os.path.join(argv[2], "certificate.pdf"))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv))

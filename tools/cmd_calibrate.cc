@@ -1,0 +1,349 @@
+// aerocal calibrate: camera calibration from a test field (observations.csv + points.csv) or a
+// planar board detected in images, on the existing self-calibrating adjustment
+// (triangulation/calibration). Parsing, loading, detecting, calling the library, writing results.
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/string_printf.h"
+#include "tools/board_detection.h"
+#include "tools/command_registry.h"
+#include "triangulation/block/block_io.h"
+#include "triangulation/calibration/calibration.h"
+#include "triangulation/calibration/uncertainty_budget.h"
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+
+namespace aerocal::tools {
+namespace {
+
+using Model = calib::BrownFraser10Model;
+using triangulation::AdjustmentResult;
+
+// Board points: design coordinates; the default sigma stands for the print / machining accuracy.
+constexpr double kDefaultBoardSigmaMm = 0.01;
+
+std::map<std::string, std::string> ReadGroups(const std::string& path) {
+  const CsvTable table = CsvTable::Read(path);
+  table.RequireColumns({"image", "group"});
+  std::map<std::string, std::string> out;
+  for (const auto& row : table.rows()) {
+    const std::string image = table.String(row, "image"), group = table.String(row, "group");
+    if (image.empty() || group.empty())
+      throw InputError(table.Where(row).ToString() + ": image and group must not be empty");
+    if (!out.emplace(image, group).second)
+      throw InputError(table.Where(row).ToString() + ": image " + image + " listed twice");
+  }
+  return out;
+}
+
+nlohmann::json InteriorJson(const calib::InteriorParams& p) {
+  nlohmann::json j;
+  for (int k = 0; k < Model::kNumParams; ++k) j[std::string(Model::kParams[k].name)] = p[k];
+  return j;
+}
+
+nlohmann::json CovarianceJson(const Eigen::MatrixXd& cov, const triangulation::CameraEstimate& c) {
+  if (cov.rows() != Model::kNumParams) return nullptr;
+  std::vector<int> free;
+  for (int k = 0; k < Model::kNumParams; ++k)
+    if (c.free[k]) free.push_back(k);
+  nlohmann::json names = nlohmann::json::array(), cv = nlohmann::json::array(),
+                 rho = nlohmann::json::array();
+  for (int a : free) {
+    names.push_back(std::string(Model::kParams[a].name));
+    nlohmann::json row = nlohmann::json::array(), rrow = nlohmann::json::array();
+    for (int b : free) {
+      row.push_back(cov(a, b));
+      const double d = std::sqrt(cov(a, a) * cov(b, b));
+      rrow.push_back(d > 0 ? cov(a, b) / d : 0.0);
+    }
+    cv.push_back(row);
+    rho.push_back(rrow);
+  }
+  return {{"names", names}, {"covariance", cv}, {"correlation", rho}};
+}
+
+nlohmann::json GroupJson(const triangulation::GroupCalibration& g) {
+  const AdjustmentResult& r = g.adjustment.result;
+  nlohmann::json j = {{"group", g.group},
+                      {"images", g.images},
+                      {"converged", r.converged()},
+                      {"valid", r.valid},
+                      {"sigma0", r.sigma0},
+                      {"sigma0_px", r.sigma0_px},
+                      {"redundancy", r.solve.redundancy}};
+  if (!r.cameras.empty()) {
+    j["estimated"] = InteriorJson(r.cameras[0].estimated);
+    nlohmann::json s;
+    for (int k = 0; k < Model::kNumParams; ++k)
+      s[std::string(Model::kParams[k].name)] =
+          r.cameras[0].free[k] && r.determinability.covariance_ok ? nlohmann::json(r.cameras[0].sigma[k])
+                                                                  : nlohmann::json();
+    j["sigma"] = s;
+  }
+  j["check"] = triangulation::PointStatisticsToJson(r.check);
+  return j;
+}
+
+nlohmann::json StabilityJson(const triangulation::StabilityReport& s) {
+  nlohmann::json rows = nlohmann::json::array();
+  for (const auto& r : s.rows)
+    rows.push_back({{"parameter", r.parameter},
+                    {"unit", r.unit},
+                    {"values", r.values},
+                    {"sigmas", r.sigmas},
+                    {"mean", r.mean},
+                    {"spread", r.spread},
+                    {"weighted_mean", r.weighted_mean},
+                    {"chi2", std::isfinite(r.chi2) ? nlohmann::json(r.chi2) : nlohmann::json()},
+                    {"critical", r.critical},
+                    {"dof", r.dof},
+                    {"agree", r.agree}});
+  return {{"alpha", s.alpha}, {"agree", s.agree}, {"rows", rows}, {"flagged", s.flagged}};
+}
+
+CommandRun SetupCalibrate(CLI::App& app) {
+  struct Args {
+    std::string camera, observations, points, images, board, groups, budget, out, write_marks;
+    std::string self_calibration = "c,x0,y0,K1,K2,K3,P1,P2";
+    std::string model = "brown10";
+    double sigma_px = 0.5, board_sigma_mm = kDefaultBoardSigmaMm;
+    std::vector<double> radii_mm;
+    bool no_snooping = false, no_closed_form = false;
+  };
+  auto args = std::make_shared<Args>();
+  app.add_option("--camera", args->camera,
+                 "Camera file (FORMATS.md): pixel size, format and an approximate c")
+      ->required();
+  app.add_option("--observations", args->observations,
+                 "Test field / target marks: observations.csv (image,point,col,row[,sigma_px])");
+  app.add_option("--points", args->points,
+                 "Test field / target points: points.csv (role control; check points are not "
+                 "used, only compared)");
+  app.add_option("--images", args->images, "Board images: a glob such as 'data/left*.jpg'");
+  app.add_option("--board", args->board,
+                 "Board of --images: chessboard|circles|acircles:COLSxROWS:SPACING_MM, e.g. "
+                 "chessboard:9x6:25 (inner corners)");
+  app.add_option("--self-calibration", args->self_calibration,
+                 "Interior parameters calibrated: all, or a list such as c,x0,y0,K1,K2,K3,P1,P2 "
+                 "(default)");
+  app.add_option("--model", args->model,
+                 "brown10 (the 10-parameter model); opencv: also cv::calibrateCamera (k1, k2, p1, "
+                 "p2, k3, fx, fy, cx, cy) on the same marks, side by side (needs --images)")
+      ->check(CLI::IsMember({"brown10", "opencv"}));
+  app.add_option("--groups", args->groups,
+                 "Image groups: CSV image,group; each group is calibrated too and the stability "
+                 "over the groups tested (chi-square, 5 %)");
+  app.add_option("--budget", args->budget,
+                 "Uncertainty budget options (YAML: radii_mm, target_radius_mm, components)");
+  app.add_option("--radii-mm", args->radii_mm,
+                 "Radii of the certified distortion values, mm (default: 1/4 .. 4/4 of the half "
+                 "diagonal)")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--sigma-px", args->sigma_px,
+                 "Image sigma where observations.csv has no sigma_px, and of detected marks, px")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--board-sigma-mm", args->board_sigma_mm,
+                 "Sigma of the board's design coordinates (print accuracy), mm")
+      ->check(CLI::PositiveNumber);
+  app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
+  app.add_flag("--no-closed-form", args->no_closed_form,
+               "Planar target: start from the camera file's c, not Zhang's closed form");
+  app.add_option("--write-marks", args->write_marks,
+                 "Write the detected marks as DIR/observations.csv and DIR/points.csv");
+  app.add_option("--out", args->out, "Result JSON (keys of `adjust` plus `calibration`)")
+      ->required();
+  return [args]() {
+    const bool field = !args->observations.empty() || !args->points.empty();
+    const bool board = !args->images.empty() || !args->board.empty();
+    if (field == board)
+      throw ConfigError("give either --observations and --points, or --images and --board");
+    if (field && (args->observations.empty() || args->points.empty()))
+      throw ConfigError("--observations and --points go together");
+    if (board && (args->images.empty() || args->board.empty()))
+      throw ConfigError("--images and --board go together");
+    if (args->model == "opencv" && !board)
+      throw ConfigError("--model opencv needs --images and --board (cv::calibrateCamera on the marks)");
+    triangulation::CalibrateOptions options;
+    options.adjust.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
+    if (options.adjust.free_interior.empty())
+      throw ConfigError("--self-calibration: calibrate needs at least one parameter (got none)");
+    options.adjust.data_snooping = !args->no_snooping;
+    options.closed_form_c = !args->no_closed_form;
+    options.adjust.Validate();
+    CheckOutputFile(args->out, "--out");
+    if (!args->write_marks.empty()) CheckOutputFolder(args->write_marks, "--write-marks");
+    triangulation::BudgetOptions budget;
+    if (!args->budget.empty()) budget = triangulation::ReadBudgetOptions(args->budget);
+    if (!args->radii_mm.empty()) budget.radii_mm = args->radii_mm;
+
+    const calib::Camera camera = calib::ReadCamera(args->camera);
+    triangulation::Project project;
+    const std::string camera_id = camera.name.empty() ? "cam1" : camera.name;
+    project.cameras[camera_id] = camera;
+    project.camera_files[camera_id] = args->camera;
+    nlohmann::json method;
+    DetectedBoards detected;
+    BoardSpec spec;
+    if (board) {
+      spec = ParseBoard(args->board, "--board");
+      detected = DetectBoards(args->images, spec, args->sigma_px, args->board_sigma_mm);
+      if (detected.width_px != camera.width_px || detected.height_px != camera.height_px)
+        throw InputError(StringPrintf("%s: format_px is %d x %d, the images are %d x %d px",
+                                      args->camera.c_str(), camera.width_px, camera.height_px,
+                                      detected.width_px, detected.height_px));
+      project.observations = detected.observations;
+      project.points = detected.points;
+      project.path = project.observations_file = args->images;
+      for (const auto& path : detected.not_detected)
+        std::printf("warning: board not found in %s (image left out)\n", path.c_str());
+      method = {{"kind", "planar target"},
+                {"board", spec.kind},
+                {"columns", spec.columns},
+                {"rows", spec.rows},
+                {"spacing_mm", spec.square_mm},
+                {"board_sigma_mm", args->board_sigma_mm},
+                {"images", args->images},
+                {"detected", detected.image_paths},
+                {"not_detected", detected.not_detected},
+                {"detector", spec.kind == "chessboard"
+                                 ? "cv::findChessboardCorners + cv::cornerSubPix (11 x 11, 1e-4 px)"
+                                 : "cv::findCirclesGrid"}};
+    } else {
+      project.observations = triangulation::ReadObservations(args->observations, args->sigma_px);
+      project.points = triangulation::ReadPoints(args->points);
+      project.path = args->observations;
+      project.observations_file = args->observations;
+      project.points_file = args->points;
+      method = {{"kind", "test field"},
+                {"observations", args->observations},
+                {"points", args->points}};
+    }
+    // Cross-file checks of the block readers, with one exposure per observed image.
+    {
+      triangulation::Project check = project;
+      std::set<std::string> images;
+      for (const auto& o : project.observations) images.insert(o.image);
+      for (const auto& image : images) {
+        triangulation::Exposure e;
+        e.image = image;
+        e.camera = camera_id;
+        check.exposures.push_back(e);
+      }
+      triangulation::ValidateProject(check);
+    }
+    std::map<std::string, std::string> groups;
+    if (!args->groups.empty()) groups = ReadGroups(args->groups);
+    if (budget.radii_mm.empty()) {
+      const double half_diagonal =
+          0.5 * camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
+      for (int i = 1; i <= 4; ++i) budget.radii_mm.push_back(std::round(half_diagonal * i / 4 * 10) / 10);
+    }
+    if (!args->write_marks.empty() && board) {
+      triangulation::WriteObservations(args->write_marks + "/observations.csv", project.observations);
+      triangulation::WritePoints(args->write_marks + "/points.csv", project.points);
+    }
+
+    const triangulation::CalibrationRun run = triangulation::Calibrate(project, options, groups);
+    const auto budget_table = triangulation::UncertaintyBudget(run, run.project, budget);
+    const AdjustmentResult& r = run.all.result;
+    std::printf("%s", triangulation::FormatSummary(r).c_str());
+
+    nlohmann::json json = triangulation::AdjustmentToJson(r);
+    json["command"] = "calibrate";
+    json["valid"] = r.valid;
+    json["invalid_reasons"] = r.invalid_reasons;
+    nlohmann::json cal;
+    cal["method"] = method;
+    cal["camera"] = {{"id", camera_id},
+                     {"file", args->camera},
+                     {"pixel_size_mm", camera.pixel_size_mm},
+                     {"format_px", {camera.width_px, camera.height_px}}};
+    nlohmann::json starts = nlohmann::json::array();
+    for (const auto& s : run.starts)
+      starts.push_back({{"image", s.exposure.image},
+                        {"method", s.method},
+                        {"n_points", s.n_points},
+                        {"rms_px", s.rms_px}});
+    cal["start"] = {{"c_camera_file_mm", camera.interior[Model::kC]},
+                    {"c_closed_form_mm", run.closed_form_c_mm ? nlohmann::json(*run.closed_form_c_mm)
+                                                              : nlohmann::json()},
+                    {"c_start_mm", run.start_c_mm},
+                    {"resections", starts}};
+    int n_control = 0, n_check = 0;
+    for (const auto& p : run.project.points) {
+      n_control += p.role == triangulation::PointRole::kControl;
+      n_check += p.role == triangulation::PointRole::kCheck;
+    }
+    cal["data"] = {{"images", run.starts.size()},
+                   {"observations", run.project.observations.size()},
+                   {"control_points", n_control},
+                   {"check_points", n_check},
+                   {"groups", run.groups.size()}};
+    if (!r.cameras.empty())
+      cal["interior_covariance"] = CovarianceJson(run.all.interior_covariance, r.cameras[0]);
+    cal["groups"] = nlohmann::json::array();
+    for (const auto& g : run.groups) cal["groups"].push_back(GroupJson(g));
+    cal["stability"] = StabilityJson(run.stability);
+    cal["uncertainty"] = triangulation::BudgetToJson(budget_table);
+    cal["radii_mm"] = budget.radii_mm;
+    for (const auto& q : budget_table) std::printf("  %s\n", q.statement.c_str());
+    for (const auto& f : run.stability.flagged) {
+      std::printf("warning: group_stability: %s\n", f.c_str());
+      json["warnings"].push_back({{"name", "group_stability"},
+                                  {"subject", f.substr(0, f.find(':'))},
+                                  {"value", nullptr},
+                                  {"limit", nullptr},
+                                  {"message", f}});
+    }
+    if (args->model == "opencv") {
+      const OpenCvCalibration cv = CalibrateWithOpenCv(detected);
+      const double p = camera.pixel_size_mm;
+      cal["opencv"] = {
+          {"function", "cv::calibrateCamera (flags 0: fx, fy, cx, cy, k1, k2, p1, p2, k3)"},
+          {"rms_px", cv.rms_px},
+          {"seconds", cv.seconds},
+          {"fx", cv.fx},
+          {"fy", cv.fy},
+          {"cx", cv.cx},
+          {"cy", cv.cy},
+          {"k1", cv.distortion[0]},
+          {"k2", cv.distortion[1]},
+          {"p1", cv.distortion[2]},
+          {"p2", cv.distortion[3]},
+          {"k3", cv.distortion[4]},
+          {"equivalent", {{"c", 0.5 * (cv.fx + cv.fy) * p},
+                          {"x0", (cv.cx - 0.5 * (camera.width_px - 1)) * p},
+                          {"y0", -(cv.cy - 0.5 * (camera.height_px - 1)) * p}}}};
+      std::printf("cv::calibrateCamera: RMS %.4f px, fx %.4f fy %.4f cx %.4f cy %.4f (%.3f s)\n",
+                  cv.rms_px, cv.fx, cv.fy, cv.cx, cv.cy, cv.seconds);
+    }
+    double sum2 = 0;
+    int n = 0;
+    for (const auto& o : r.residuals)
+      if (o.used) {
+        sum2 += o.residual_px.squaredNorm();
+        ++n;
+      }
+    cal["rms_px"] = n > 0 ? std::sqrt(sum2 / n) : 0.0;  // per point, as OpenCV's RMS
+    json["calibration"] = cal;
+    WriteFileAtomically(args->out, json.dump(2) + "\n");
+    for (const auto& reason : r.invalid_reasons)
+      std::fprintf(stderr, "calibrate: not valid: %s\n", reason.c_str());
+    std::printf("result -> %s\n", args->out.c_str());
+    return r.valid && run.stability.agree ? kExitOk : kExitNotConverged;
+  };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(calibrate,
+                         "calibrate",
+                         "Camera calibration from a test field or a planar board (resections, "
+                         "self-calibrating adjustment, image-group stability, GUM budget)",
+                         SetupCalibrate);
+
+}  // namespace aerocal::tools

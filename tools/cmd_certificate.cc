@@ -1,0 +1,232 @@
+// aerocal certificate: the calibration certificate of a `calibrate` result (certificate.json for
+// programs; certificate.html and certificate.pdf for people, rendered by
+// tools/certificate/aerocal_certificate.py with matplotlib). This file gathers the data: the lab
+// YAML the user fills, the result, the comparison with a previous certificate or result against
+// tolerances. Deterministic: no clock, no random numbers (the date comes from the lab file).
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/string_printf.h"
+#include "calib/core/yaml_util.h"
+#include "tools/command_registry.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+
+namespace aerocal::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+std::string Quote(const std::string& s) {
+  std::string out = "'";
+  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
+  return out + "'";
+}
+
+nlohmann::json ReadJsonFile(const std::string& path, const std::string& option) {
+  try {
+    return nlohmann::json::parse(ReadTextFile(path));
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": not JSON (" + option + "): " + e.what());
+  }
+}
+
+// The lab file: sections of free-text fields, every key known (typos are errors).
+nlohmann::json ReadLab(const std::string& path) {
+  const std::map<std::string, std::vector<std::string>> sections = {
+      {"lab", {"name", "address", "accreditation", "phone"}},
+      {"certificate", {"number", "date", "page_note"}},
+      {"camera", {"make", "model", "serial", "lens", "lens_serial"}},
+      {"customer", {"name", "address"}},
+      {"conditions", {"temperature", "humidity", "location", "target", "note"}},
+      {"signatures", {"calibrated_by", "checked_by", "approved_by"}}};
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [section, keys] : sections) {
+    out[section] = nlohmann::json::object();
+    for (const auto& k : keys) out[section][k] = "";
+  }
+  if (path.empty()) return out;
+  const YAML::Node root = LoadYamlFile(path);
+  if (!root || root.IsNull()) return out;
+  if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map of sections");
+  std::vector<std::string> names;
+  for (const auto& [section, keys] : sections) names.push_back(section);
+  RejectUnknownKeys(root, names, path);
+  for (const auto& [section, keys] : sections) {
+    const YAML::Node node = root[section];
+    if (!node) continue;
+    if (!node.IsMap()) throw InputError(WhereIs(node, path).ToString() + ": " + section + " must be a map");
+    RejectUnknownKeys(node, keys, path);
+    for (const auto& k : keys)
+      if (node[k]) out[section][k] = YamlString(node[k], path, section + "." + k);
+  }
+  return out;
+}
+
+// Tolerances: {parameter: allowed |change|} in the quantity's unit.
+std::map<std::string, double> ReadTolerances(const std::string& path) {
+  std::map<std::string, double> out;
+  if (path.empty()) return out;
+  const YAML::Node root = LoadYamlFile(path);
+  if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map quantity: tolerance");
+  for (const auto& item : root)
+    out[item.first.as<std::string>()] =
+        YamlBounded(item.second, path, item.first.as<std::string>(), 0, 1e12);
+  return out;
+}
+
+// The uncertainty table of a calibrate result or of a certificate.json.
+const nlohmann::json* Uncertainty(const nlohmann::json& doc) {
+  if (doc.contains("results") && doc["results"].is_array()) return &doc["results"];
+  if (doc.contains("calibration") && doc["calibration"].contains("uncertainty"))
+    return &doc["calibration"]["uncertainty"];
+  return nullptr;
+}
+
+nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous,
+                       const std::map<std::string, double>& tolerances) {
+  nlohmann::json rows = nlohmann::json::array();
+  bool all_pass = true;
+  std::map<std::string, nlohmann::json> old;
+  for (const auto& q : previous) old[q.value("quantity", "")] = q;
+  for (const auto& q : now) {
+    const std::string name = q["quantity"];
+    const auto o = old.find(name);
+    if (o == old.end()) continue;
+    const double v = q["value"], v_old = o->second["value"];
+    const double u = q["U"].is_number() ? q["U"].get<double>() : NAN;
+    const double u_old = o->second["U"].is_number() ? o->second["U"].get<double>() : NAN;
+    const double diff = v - v_old;
+    // E_n = |difference| / sqrt(U^2 + U_prev^2) (ISO/IEC 17043 / ISO 13528): <= 1 consistent.
+    const double en = std::abs(diff) / std::sqrt(u * u + u_old * u_old);
+    nlohmann::json row = {{"quantity", name}, {"unit", q["unit"]},  {"value", v},
+                          {"previous", v_old}, {"difference", diff}, {"U", q["U"]},
+                          {"U_previous", o->second["U"]},
+                          {"E_n", std::isfinite(en) ? nlohmann::json(en) : nlohmann::json()}};
+    const auto t = tolerances.find(name);
+    bool pass;
+    if (t != tolerances.end()) {
+      row["tolerance"] = t->second;
+      row["criterion"] = "|difference| <= tolerance";
+      pass = std::abs(diff) <= t->second;
+    } else {
+      row["tolerance"] = nullptr;
+      row["criterion"] = "E_n <= 1";
+      pass = std::isfinite(en) && en <= 1.0;
+    }
+    row["pass"] = pass;
+    all_pass = all_pass && pass;
+    rows.push_back(row);
+  }
+  return {{"rows", rows}, {"pass", all_pass}};
+}
+
+CommandRun SetupCertificate(CLI::App& app) {
+  struct Args {
+    std::string result, lab, previous, tolerances, out;
+    bool no_render = false;
+  };
+  auto args = std::make_shared<Args>();
+  app.add_option("--result", args->result, "Result JSON of `aerocal calibrate`")->required();
+  app.add_option("--lab", args->lab,
+                 "Lab YAML the user fills: lab, certificate (number, date), camera (make, model, "
+                 "serial, lens), customer, conditions, signatures");
+  app.add_option("--previous", args->previous,
+                 "The previous certificate.json (or calibrate result) to compare with");
+  app.add_option("--tolerances", args->tolerances,
+                 "YAML quantity: allowed |change| (units of the quantity); without one, E_n <= 1");
+  app.add_option("--out", args->out, "Output folder: certificate.json, .html, .pdf")->required();
+  app.add_flag("--no-render", args->no_render, "Write certificate.json only (no HTML / PDF)");
+  return [args]() {
+    CheckOutputFolder(args->out, "--out");
+    if (!args->tolerances.empty() && args->previous.empty())
+      throw ConfigError("--tolerances needs --previous");
+    const nlohmann::json result = ReadJsonFile(args->result, "--result");
+    if (!result.is_object() || result.value("command", "") != "calibrate" ||
+        !result.contains("calibration"))
+      throw InputError(args->result + ": not a result of `aerocal calibrate` (--result)");
+    const nlohmann::json lab = ReadLab(args->lab);
+    const auto tolerances = ReadTolerances(args->tolerances);
+    const nlohmann::json& cal = result["calibration"];
+    nlohmann::json cert;
+    cert["kind"] = "certificate";
+    cert["lab"] = lab;
+    cert["source"] = args->result;
+    cert["method"] = cal["method"];
+    cert["camera_file"] = cal["camera"];
+    cert["data"] = cal["data"];
+    cert["adjustment"] = {{"sigma0", result["sigma0"]},
+                          {"sigma0_px", result["sigma0_px"]},
+                          {"sigma0_um", result["sigma0_um"]},
+                          {"redundancy", result["redundancy"]},
+                          {"converged", result["converged"]},
+                          {"valid", result.value("valid", false)},
+                          {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
+                          {"warnings", result.value("warnings", nlohmann::json::array())},
+                          {"self_calibration", result.value("self_calibration", nlohmann::json())},
+                          {"rms_px", cal["rms_px"]}};
+    cert["results"] = cal["uncertainty"];
+    cert["interior"] = result["cameras"][0];
+    cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
+    cert["groups"] = cal["groups"];
+    cert["stability"] = cal["stability"];
+    cert["check"] = result["check"];
+    cert["control"] = result["control"];
+    cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
+    cert["opencv"] = cal.value("opencv", nlohmann::json());
+    // Residual vectors (image pixels) for the vector field plot.
+    nlohmann::json residuals = nlohmann::json::array();
+    for (const auto& r : result.value("residuals", nlohmann::json::array()))
+      if (r.value("used", true))
+        residuals.push_back({r["col"], r["row"], r["v_col_px"], r["v_row_px"]});
+    cert["residuals"] = residuals;
+    if (!args->previous.empty()) {
+      const nlohmann::json previous = ReadJsonFile(args->previous, "--previous");
+      const nlohmann::json* old = Uncertainty(previous);
+      if (!old) throw InputError(args->previous + ": neither a certificate.json nor a calibrate result (--previous)");
+      cert["comparison"] = Compare(cert["results"], *old, tolerances);
+      cert["comparison"]["previous"] = args->previous;
+      if (previous.contains("lab")) cert["comparison"]["previous_certificate"] = previous["lab"]["certificate"];
+    }
+    fs::create_directories(args->out);
+    const std::string json_path = (fs::path(args->out) / "certificate.json").string();
+    WriteFileAtomically(json_path, cert.dump(2) + "\n");
+    std::printf("certificate data -> %s\n", json_path.c_str());
+    for (const auto& q : cert["results"]) std::printf("  %s\n", q["statement"].get<std::string>().c_str());
+    if (cert.contains("comparison"))
+      std::printf("comparison with %s: %s\n", args->previous.c_str(),
+                  cert["comparison"]["pass"].get<bool>() ? "pass" : "FAIL");
+    if (!args->no_render) {
+      const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
+      const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
+      const char* python_env = std::getenv("AEROCAL_PYTHON");
+      const std::string python =
+          python_env ? python_env : (fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3");
+      const std::string command = Quote(python) + " " + Quote(script) + " " + Quote(json_path) + " " +
+                                  Quote(args->out);
+      if (std::system(command.c_str()) != 0) {
+        std::fprintf(stderr, "error: the certificate could not be rendered (%s); certificate.json is complete\n",
+                     command.c_str());
+        return kExitInternal;
+      }
+      std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", args->out.c_str(),
+                  args->out.c_str());
+    }
+    const bool ok = cert["adjustment"]["valid"].get<bool>() && cal["stability"].value("agree", true) &&
+                    (!cert.contains("comparison") || cert["comparison"]["pass"].get<bool>());
+    return ok ? kExitOk : kExitNotConverged;
+  };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(certificate,
+                         "certificate",
+                         "Calibration certificate (JSON, HTML, PDF) of a `calibrate` result, with "
+                         "the comparison to a previous certificate",
+                         SetupCertificate);
+
+}  // namespace aerocal::tools

@@ -1,0 +1,334 @@
+#include "triangulation/calibration/uncertainty_budget.h"
+
+#include "calib/camera/rotation.h"
+#include "calib/core/error.h"
+#include "calib/core/string_printf.h"
+#include "calib/core/yaml_util.h"
+#include "stitch/adjustment/f_test.h"
+
+#include <Eigen/Dense>
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+
+namespace aerocal::triangulation {
+namespace {
+
+using Model = calib::BrownFraser10Model;
+constexpr double kInf = std::numeric_limits<double>::infinity();
+// Degrees of freedom from which k = 2 is kept (t_95.45(50) = 2.05).
+constexpr double kLargeDof = 50.0;
+
+double Divisor(const std::string& distribution, const std::string& where) {
+  if (distribution == "normal") return 1.0;
+  if (distribution == "rectangular") return std::sqrt(3.0);
+  if (distribution == "triangular") return std::sqrt(6.0);
+  throw ConfigError(where + ": distribution must be normal, rectangular or triangular (got " +
+                    distribution + ")");
+}
+
+// A quantity as a function of the interior parameters: value and gradient (table order).
+struct InteriorFunction {
+  std::string name, unit, description;
+  std::function<double(const calib::InteriorParams&)> f;
+};
+
+Eigen::Matrix<double, Model::kNumParams, 1> Gradient(const InteriorFunction& q,
+                                                     const calib::InteriorParams& p) {
+  Eigen::Matrix<double, Model::kNumParams, 1> g;
+  for (int k = 0; k < Model::kNumParams; ++k) {
+    calib::InteriorParams hi = p, lo = p;
+    const double h = 1e-6 * std::max(1e-6, std::abs(p[k]));
+    hi[k] += h;
+    lo[k] -= h;
+    g(k) = (q.f(hi) - q.f(lo)) / (2 * h);
+  }
+  return g;
+}
+
+double Propagate(const InteriorFunction& q,
+                 const calib::InteriorParams& p,
+                 const Eigen::MatrixXd& covariance) {
+  if (covariance.rows() != Model::kNumParams) return std::nan("");
+  const Eigen::Matrix<double, Model::kNumParams, 1> g = Gradient(q, p);
+  return std::sqrt(std::max(0.0, g.dot(covariance * g)));
+}
+
+void Finish(BudgetQuantity* q) {
+  double sum2 = 0, sum4 = 0;
+  for (const auto& c : q->components) {
+    sum2 += c.u * c.u;
+    if (std::isfinite(c.dof) && c.dof > 0) sum4 += std::pow(c.u, 4) / c.dof;
+  }
+  q->u_c = std::sqrt(sum2);
+  q->dof_eff = sum4 > 0 ? std::pow(q->u_c, 4) / sum4 : kInf;
+  q->k = CoverageFactor(q->dof_eff);
+  q->expanded = q->k * q->u_c;
+  q->statement = CertificateStatement(q->name, q->value, q->expanded, q->k, q->unit);
+}
+
+UncertaintyComponent Component(const std::string& source, const std::string& type, double u,
+                               double dof, const std::string& unit,
+                               const std::string& distribution = "normal") {
+  UncertaintyComponent c;
+  c.source = source;
+  c.type = type;
+  c.distribution = distribution;
+  c.value = u;
+  c.value_unit = unit;
+  c.u = u;
+  c.dof = dof;
+  return c;
+}
+
+// Largest image offset (px) of a circular target's centre over the run's observations.
+double MaxEccentricityPx(const CalibrationRun& run, const Project& project, double radius_mm) {
+  if (radius_mm <= 0) return 0.0;
+  const calib::Camera& camera = project.cameras.at(run.camera);
+  const AdjustmentResult& r = run.all.result;
+  const double c = r.cameras[0].estimated[Model::kC];
+  const double radius_m = radius_mm * 1e-3;
+  // Target normal: that of the best-fit plane of the control points (a 3-D field's targets face
+  // the field's main direction).
+  std::vector<Eigen::Vector3d> control;
+  for (const auto& p : project.points)
+    if (p.role == PointRole::kControl && p.xyz_m) control.push_back(*p.xyz_m);
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  if (control.size() >= 3) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (const auto& p : control) mean += p;
+    mean /= static_cast<double>(control.size());
+    Eigen::MatrixXd centred(control.size(), 3);
+    for (size_t i = 0; i < control.size(); ++i) centred.row(i) = (control[i] - mean).transpose();
+    const Eigen::JacobiSVD<Eigen::MatrixXd> svd(centred, Eigen::ComputeFullV);
+    normal = svd.matrixV().col(2);
+  }
+  std::map<std::string, const ExposureEstimate*> exposures;
+  for (const auto& e : r.exposures) exposures[e.image] = &e;
+  double max_mm = 0;
+  for (const auto& o : project.observations) {
+    const auto e = exposures.find(o.image);
+    const auto p = r.points_m.find(o.point);
+    if (e == exposures.end() || p == r.points_m.end() || normal.isZero()) continue;
+    const Eigen::Vector3d ray = p->second - e->second->center_m;
+    const double d = ray.norm();
+    const double cos_a = std::abs(ray.dot(normal)) / d;
+    const double sin_a = std::sqrt(std::max(0.0, 1 - cos_a * cos_a));
+    const double e_mm = c * radius_m * radius_m * sin_a * cos_a /
+                        (d * d - radius_m * radius_m * sin_a * sin_a);
+    max_mm = std::max(max_mm, e_mm);
+  }
+  return max_mm / camera.pixel_size_mm;
+}
+
+}  // namespace
+
+double CoverageFactor(double dof_eff) {
+  if (!(dof_eff < kLargeDof)) return 2.0;
+  const double t = std::sqrt(stitch::FDistributionQuantile(0.9545, 1.0, std::max(1.0, dof_eff)));
+  return std::round(t * 100.0) / 100.0;
+}
+
+std::string CertificateStatement(const std::string& name, double value, double expanded, double k,
+                                 const std::string& unit) {
+  if (!(expanded > 0) || !std::isfinite(expanded))
+    return StringPrintf("%s = %.6g %s, U unknown", name.c_str(), value, unit.c_str());
+  // Two significant digits of U; the value to the same last decimal.
+  const int exponent = static_cast<int>(std::floor(std::log10(expanded)));
+  const int decimals = std::max(0, 1 - exponent);
+  if (decimals > 8 || std::abs(value) < 1e-3 || std::abs(value) >= 1e6)
+    return StringPrintf("%s = %.4e %s, U = %.2g %s (k = %g)", name.c_str(), value, unit.c_str(),
+                        expanded, unit.c_str(), k);
+  return StringPrintf("%s = %.*f %s, U = %.*f %s (k = %g)", name.c_str(), decimals, value,
+                      unit.c_str(), decimals, expanded, unit.c_str(), k);
+}
+
+BudgetOptions ReadBudgetOptions(const std::string& path) {
+  const YAML::Node root = LoadYamlFile(path);
+  BudgetOptions options;
+  if (!root || root.IsNull()) return options;
+  if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map");
+  RejectUnknownKeys(root, {"radii_mm", "target_radius_mm", "components"}, path);
+  if (root["radii_mm"]) {
+    for (const auto& r : root["radii_mm"])
+      options.radii_mm.push_back(YamlBounded(r, path, "radii_mm", 1e-9, 1e6));
+  }
+  if (root["target_radius_mm"])
+    options.target_radius_mm = YamlBounded(root["target_radius_mm"], path, "target_radius_mm", 0, 1e6);
+  if (root["components"]) {
+    for (const auto& node : root["components"]) {
+      RejectUnknownKeys(
+          node, {"quantity", "source", "value", "unit", "distribution", "sensitivity", "dof"}, path);
+      UserComponent u;
+      const std::string where = WhereIs(node, path).ToString();
+      if (!node["quantity"] || !node["source"] || !node["value"])
+        throw InputError(where + ": a component needs quantity, source and value");
+      u.quantity = YamlString(node["quantity"], path, "quantity");
+      u.source = YamlString(node["source"], path, "source");
+      u.value = YamlBounded(node["value"], path, "value", 0, 1e12);
+      if (node["unit"]) u.unit = YamlString(node["unit"], path, "unit");
+      if (node["distribution"]) u.distribution = YamlString(node["distribution"], path, "distribution");
+      Divisor(u.distribution, WhereIs(node["distribution"] ? node["distribution"] : node, path).ToString());
+      if (node["sensitivity"]) u.sensitivity = YamlDouble(node["sensitivity"], path, "sensitivity");
+      if (node["dof"]) u.dof = YamlBounded(node["dof"], path, "dof", 1, 1e12);
+      options.user.push_back(u);
+    }
+  }
+  return options;
+}
+
+std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
+                                              const Project& project,
+                                              const BudgetOptions& options) {
+  const AdjustmentResult& all = run.all.result;
+  if (all.cameras.empty()) return {};
+  const CameraEstimate& camera = all.cameras[0];
+  const double dof_adjustment = std::max(1, all.solve.redundancy);
+  const double eccentricity_px = MaxEccentricityPx(run, project, options.target_radius_mm);
+
+  std::vector<InteriorFunction> functions;
+  for (int k = 0; k < Model::kNumParams; ++k) {
+    if (!camera.free[k]) continue;
+    functions.push_back({std::string(Model::kParams[k].name), std::string(Model::kParams[k].unit),
+                         "interior parameter",
+                         [k](const calib::InteriorParams& p) { return p[k]; }});
+  }
+  const bool radial = camera.free[Model::kK1] || camera.free[Model::kK2] || camera.free[Model::kK3];
+  const bool decentring = camera.free[Model::kP1] || camera.free[Model::kP2];
+  for (double r : options.radii_mm) {
+    if (radial)
+      functions.push_back({StringPrintf("dr@%g", r), "um",
+                           StringPrintf("radial distortion at r = %g mm", r),
+                           [r](const calib::InteriorParams& p) {
+                             const double r2 = r * r;
+                             return 1e3 * r * (p[Model::kK1] * r2 + p[Model::kK2] * r2 * r2 +
+                                               p[Model::kK3] * r2 * r2 * r2);
+                           }});
+    if (decentring)
+      functions.push_back({StringPrintf("dt@%g", r), "um",
+                           StringPrintf("decentring distortion (magnitude) at r = %g mm", r),
+                           [r](const calib::InteriorParams& p) {
+                             return 1e3 * r * r * std::hypot(p[Model::kP1], p[Model::kP2]);
+                           }});
+  }
+
+  std::vector<BudgetQuantity> out;
+  for (const auto& f : functions) {
+    BudgetQuantity q;
+    q.name = f.name;
+    q.unit = f.unit;
+    q.description = f.description;
+    q.value = f.f(camera.estimated);
+    const double u_a = Propagate(f, camera.estimated, run.all.interior_covariance);
+    q.components.push_back(Component("adjustment (sigma0 sqrt(Qxx))", "A", u_a, dof_adjustment, f.unit));
+    if (run.groups.size() >= 2) {
+      std::vector<double> values;
+      for (const auto& g : run.groups)
+        if (!g.adjustment.result.cameras.empty()) values.push_back(f.f(g.adjustment.result.cameras[0].estimated));
+      const double n = static_cast<double>(values.size());
+      double mean = 0, ss = 0;
+      for (double v : values) mean += v / n;
+      for (double v : values) ss += (v - mean) * (v - mean);
+      const double s2_mean = ss / (n - 1) / n;
+      q.components.push_back(Component(
+          StringPrintf("group reproducibility (%zu groups, excess over the adjustment)", values.size()),
+          "A", std::sqrt(std::max(0.0, s2_mean - u_a * u_a)), n - 1, f.unit));
+    }
+    if (run.control_fixed && run.control_fixed->interior_covariance.rows() == Model::kNumParams) {
+      const double u_fixed = Propagate(f, camera.estimated, run.control_fixed->interior_covariance);
+      q.components.push_back(Component("control / target coordinates (survey sigmas propagated)",
+                                       "B", std::sqrt(std::max(0.0, u_a * u_a - u_fixed * u_fixed)),
+                                       kInf, f.unit));
+    }
+    if (eccentricity_px > 0 && all.sigma0_px > 0) {
+      UncertaintyComponent c = Component("target-centre eccentricity (max " +
+                                             StringPrintf("%.3g", eccentricity_px) + " px)",
+                                         "B", 0, kInf, "px", "rectangular");
+      c.value = eccentricity_px;
+      c.divisor = std::sqrt(3.0);
+      c.sensitivity = u_a / all.sigma0_px;
+      c.u = c.sensitivity * eccentricity_px / c.divisor;
+      q.components.push_back(c);
+    }
+    out.push_back(q);
+  }
+  // Check-point accuracy and m_0.
+  if (all.check.n > 0) {
+    const double n = all.check.n;
+    const char* axes[] = {"m_X", "m_Y", "m_Z"};
+    Eigen::Vector3d survey = Eigen::Vector3d::Zero();
+    int n_survey = 0;
+    for (const auto& d : all.check_points)
+      if (const GroundPoint* p = project.FindPoint(d.point)) {
+        survey += p->sigma_m.cwiseAbs2();
+        ++n_survey;
+      }
+    if (n_survey > 0) survey = (survey / n_survey).cwiseSqrt();
+    for (int a = 0; a < 3; ++a) {
+      BudgetQuantity q;
+      q.name = axes[a];
+      q.unit = "mm";
+      q.description = "check-point RMSE";
+      q.value = 1e3 * all.check.rmse_m(a);
+      q.components.push_back(Component(StringPrintf("sampling of %d check points", all.check.n), "A",
+                                       q.value / std::sqrt(2 * n), std::max(1.0, n - 1), "mm"));
+      q.components.push_back(Component("check-point survey", "B", 1e3 * survey(a), kInf, "mm"));
+      out.push_back(q);
+    }
+  }
+  {
+    BudgetQuantity q;
+    q.name = "m_0";
+    q.unit = "um";
+    q.description = "sigma0 of the image measurements";
+    q.value = all.sigma0_um;
+    q.components.push_back(Component("redundancy " + std::to_string(all.solve.redundancy), "A",
+                                     all.sigma0_um / std::sqrt(2.0 * dof_adjustment), dof_adjustment,
+                                     "um"));
+    out.push_back(q);
+  }
+  for (const auto& u : options.user) {
+    auto q = std::find_if(out.begin(), out.end(), [&](const BudgetQuantity& b) { return b.name == u.quantity; });
+    if (q == out.end())
+      throw ConfigError("budget component '" + u.source + "': unknown quantity " + u.quantity);
+    UncertaintyComponent c;
+    c.source = u.source;
+    c.type = "B";
+    c.distribution = u.distribution;
+    c.value = u.value;
+    c.value_unit = u.unit;
+    c.divisor = Divisor(u.distribution, "budget component " + u.source);
+    c.sensitivity = u.sensitivity;
+    c.u = std::abs(u.sensitivity) * u.value / c.divisor;
+    c.dof = u.dof;
+    q->components.push_back(c);
+  }
+  for (auto& q : out) Finish(&q);
+  return out;
+}
+
+nlohmann::json BudgetToJson(const std::vector<BudgetQuantity>& budget) {
+  auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& q : budget) {
+    nlohmann::json j = {{"quantity", q.name},       {"unit", q.unit},     {"description", q.description},
+                        {"value", q.value},         {"u_c", number(q.u_c)}, {"dof_eff", number(q.dof_eff)},
+                        {"k", q.k},                 {"U", number(q.expanded)}, {"statement", q.statement}};
+    j["components"] = nlohmann::json::array();
+    for (const auto& c : q.components)
+      j["components"].push_back({{"source", c.source},
+                                 {"type", c.type},
+                                 {"distribution", c.distribution},
+                                 {"value", number(c.value)},
+                                 {"value_unit", c.value_unit},
+                                 {"divisor", c.divisor},
+                                 {"sensitivity", number(c.sensitivity)},
+                                 {"u", number(c.u)},
+                                 {"dof", number(c.dof)}});
+    out.push_back(j);
+  }
+  return out;
+}
+
+}  // namespace aerocal::triangulation
