@@ -188,8 +188,14 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
       obs.detector = i + o.image_noise_px * normal(rng);
       obs.line = t + o.image_noise_px * normal(rng);
       obs.sigma_px = o.image_sigma_px;
-      // A measurement beyond the outer detectors' edges cannot exist.
-      if (!(obs.detector >= -0.5 && obs.detector <= sim.truth.detectors - 0.5)) continue;
+      // A measurement lies on one of its sub-camera's detectors (a column of the line image
+      // belongs to one sub-camera): a point that noise carries past the sub-camera's edge would
+      // be read as the neighbour's detector, so it is not measured (and, at the outer edges,
+      // beyond the line).
+      const long column = std::lround(obs.detector);
+      if (!(obs.detector >= -0.5 && column >= sim.truth.subcameras[s].first &&
+            column <= sim.truth.subcameras[s].last))
+        continue;
       seen.push_back(obs);
     }
     if (seen.empty()) continue;
