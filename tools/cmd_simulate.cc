@@ -6,6 +6,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
+#include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/simulation/flight_simulator.h"
 #include "triangulation/simulation/rig_flight_simulator.h"
 
@@ -20,6 +21,8 @@ struct SimulateArgs {
     std::uint64_t seed = 1;
     std::string rig;
     double increment_arcsec = 0.0, time_offset_ms = 0.0, speed_mps = 0.0;
+    bool pushbroom = false;
+    triangulation::LineSimulationOptions line;
 };
 
 using FlightIntOption = std::pair<std::string, int triangulation::FlightSimulationOptions::*>;
@@ -109,6 +112,19 @@ CommandRun SetupSimulate(CLI::App& app) {
                                "--rig: platform speed along the strips, 0..1000 m/s (> 0: "
                                "exposures.csv carries vX, vY, vZ)")
                     ->check(CLI::Range(0.0, 1000.0));
+  // Line camera (pushbroom) flight: its own options; the shared ones above apply when given.
+  auto& l = args->line;
+  app.add_flag("--pushbroom", args->pushbroom,
+               "Simulate a combined line camera (three tilted line cameras) instead: camera files, "
+               "pos.csv, observations, control points and truth (triangulation/pushbroom/README.md)");
+  app.add_option("--detectors", l.detectors_per_camera, "Pushbroom: detectors per line camera, 10..100000")->check(CLI::Range(10, 100000));
+  app.add_option("--lines", l.lines, "Pushbroom: scan lines, 20..10000000")->check(CLI::Range(20, 10000000));
+  app.add_option("--tilt-deg", l.tilt_deg, "Pushbroom: look angle of the outer cameras across track, 0..40 deg")->check(CLI::Range(0.0, 40.0));
+  app.add_option("--pos-error-m", l.pos_error_m, "Pushbroom: sigma of the smooth POS position error, 0..100 m")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--pos-error-deg", l.pos_error_deg, "Pushbroom: sigma of the smooth POS attitude error, 0..10 deg")->check(CLI::Range(0.0, 10.0));
+  app.add_option("--detector-error-px", l.detector_error_px, "Pushbroom: size of the smooth per-detector errors, 0..100 px")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--node-spacing", l.node_spacing_lines, "Pushbroom: node spacing of the POS error spline, lines")->check(CLI::Range(1, 1000000));
+  app.add_option("--control-noise-m", l.control_noise_m, "Pushbroom: control-point coordinate noise, 0..1000 m")->check(CLI::Range(0.0, 1e3));
   // Flight options a rig flight takes over when given (the rig's defaults otherwise).
   using Flight = triangulation::FlightSimulationOptions;
   const std::vector<std::pair<std::string, int Flight::*>> int_options = {
@@ -129,6 +145,28 @@ CommandRun SetupSimulate(CLI::App& app) {
       {"--start-offset-deg", &Flight::start_angle_error_deg}};
   return [args, &app, int_options, double_options, increment, time_offset, speed]() {
     CheckOutputFolder(args->out, "--out");
+    if (args->pushbroom) {
+      if (!args->rig.empty()) throw ConfigError("--pushbroom and --rig: choose one");
+      auto& l = args->line;
+      l.seed = args->seed;
+      auto given = [&](const char* name) { return app.count(name) > 0; };
+      if (given("--height-m")) l.height_m = args->options.flying_height_m;
+      if (given("--relief-m")) l.relief_m = args->options.terrain_relief_m;
+      if (given("--image-noise-px")) l.image_noise_px = args->options.image_noise_px;
+      if (given("--image-sigma-px")) l.image_sigma_px = args->options.image_sigma_px;
+      if (given("--survey-sigma-m")) {
+        l.control_sigma_m = args->options.survey_sigma_m;
+        if (!given("--control-noise-m")) l.control_noise_m = args->options.survey_sigma_m;
+      }
+      if (given("--control")) l.control_points = args->options.control_points;
+      const auto sim = triangulation::SimulateLineFlight(l);
+      triangulation::WriteLineSimulation(sim, args->out);
+      std::printf("simulated a line camera of %d detectors (3 x %d), %d lines, %zu control points, "
+                  "%zu observations -> %s\n",
+                  sim.truth.detectors, l.detectors_per_camera, l.lines, sim.points.size(),
+                  sim.observations.size(), args->out.c_str());
+      return kExitOk;
+    }
     if (!args->rig.empty()) return RunRigSimulation(app, *args, int_options, double_options);
     for (const CLI::Option* rig_only : {increment, time_offset, speed})
       if (rig_only->count() > 0)

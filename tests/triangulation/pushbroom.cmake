@@ -1,0 +1,6 @@
+# Line (pushbroom) cameras (issue 17): the model, file and residual (calib), the POS trajectory,
+# the calibration on simulated flights, the commands; the Monte-Carlo study is labelled `long`.
+aerocal_add_test(calib/line_camera LIBS aerocal::calib LABELS unit)
+aerocal_add_test(triangulation/pushbroom LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/pushbroom_cli LIBS aerocal::triangulation LABELS cli)
+aerocal_add_test(triangulation/pushbroom_study LIBS aerocal::triangulation LABELS long TIMEOUT 3000)

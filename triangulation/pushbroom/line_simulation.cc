@@ -1,0 +1,267 @@
+#include "triangulation/pushbroom/line_simulation.h"
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <sstream>
+
+#include "calib/camera/line_camera_io.h"
+#include "calib/camera/rotation.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/residuals/line_collinearity.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+using Vector6d = Eigen::Matrix<double, 6, 1>;
+
+// Detector position (i, line) of `point` in sub-camera s: Newton on the focal-plane misclosure.
+bool ImageOfPoint(const calib::LineCamera& cam, const PosTrajectory& truth, int s, double t0,
+                  const Eigen::Vector3d& point, double* detector, double* line) {
+  const auto& sub = cam.subcameras[s];
+  Eigen::Vector2d xy;
+  if (!ProjectAtLine(cam, truth, t0, point, &xy)) return false;
+  // Start: the design detector nearest in x.
+  double best = 1e300;
+  double i = sub.first;
+  for (int k = sub.first; k <= sub.last; ++k) {
+    const double d = std::abs(cam.DesignPosition(k).x() - xy.x());
+    if (d < best) best = d, i = k;
+  }
+  double t = t0;
+  auto detector_at = [&](double di) {
+    // The position within sub-camera s (its polynomial, its design), also just beyond its ends.
+    const double clamped = std::max<double>(sub.first, std::min<double>(sub.last, di));
+    const Eigen::Vector2d at_clamped = cam.DetectorPosition(clamped);
+    if (clamped == di) return at_clamped;
+    const double h = di > clamped ? -1e-3 : 1e-3;
+    const Eigen::Vector2d slope = (cam.DetectorPosition(clamped + h) - at_clamped) / h;
+    return Eigen::Vector2d(at_clamped + slope * (di - clamped));
+  };
+  for (int iteration = 0; iteration < 50; ++iteration) {
+    if (!truth.CoversLine(t) || !truth.CoversLine(t + 1e-3) || !truth.CoversLine(t - 1e-3))
+      return false;
+    Eigen::Vector2d p0, pt;
+    if (!ProjectAtLine(cam, truth, t, point, &p0)) return false;
+    const Eigen::Vector2d f = p0 - detector_at(i);
+    if (!ProjectAtLine(cam, truth, t + 1e-3, point, &pt)) return false;
+    Eigen::Matrix2d j;
+    j.col(0) = -(detector_at(i + 1e-3) - detector_at(i - 1e-3)) / 2e-3;
+    j.col(1) = (pt - p0) / 1e-3;
+    const Eigen::Vector2d step = j.fullPivLu().solve(-f);
+    i += step.x();
+    t += step.y();
+    if (step.norm() < 1e-12) break;
+    if (iteration == 49) return false;
+  }
+  if (!(i >= sub.first - 0.5 && i <= sub.last + 0.5)) return false;
+  *detector = i;
+  *line = t;
+  return true;
+}
+
+}  // namespace
+
+void LineSimulationOptions::Validate() const {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw ConfigError(message);
+  };
+  require(detectors_per_camera >= 10 && detectors_per_camera <= 100000,
+          "--detectors must be within 10 .. 100000 per camera");
+  require(tilt_deg >= 0 && tilt_deg <= 40, "--tilt-deg must be within 0 .. 40");
+  require(pitch_mm > 0 && pitch_mm <= 1, "--pitch-mm must be within (0, 1]");
+  require(overlap >= 0 && overlap < 0.5, "--overlap must be within 0 .. 0.5");
+  require(lines >= 20 && lines <= 10000000, "--lines must be within 20 .. 1e7");
+  require(height_m > 0 && speed_m_s > 0 && relief_m >= 0, "--height-m, speed > 0, --relief-m >= 0");
+  require(relief_m < 0.5 * height_m, "--relief-m must be below half the flying height");
+  require(control_points >= 0, "--control must be >= 0");
+  require(image_noise_px >= 0 && image_sigma_px > 0, "--image-noise-px >= 0, --image-sigma-px > 0");
+  require(control_noise_m >= 0 && control_sigma_m > 0, "--control-noise-m >= 0, --control-sigma-m > 0");
+  require(pos_error_m >= 0 && pos_error_deg >= 0, "--pos-error-m and --pos-error-deg must be >= 0");
+  require(node_spacing_lines >= 1, "--node-spacing must be >= 1");
+  require(detector_error_px >= 0, "--detector-error-px must be >= 0");
+}
+
+LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
+  o.Validate();
+  std::mt19937_64 rng(o.seed);
+  std::normal_distribution<double> normal(0.0, 1.0);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  LineSimulation sim;
+
+  // The camera: three sub-cameras, c so that each covers tilt (1 + overlap) across.
+  const int n = o.detectors_per_camera;
+  const double half_field_rad = std::max(0.5 * o.tilt_deg * (1 + o.overlap), 5.0) * kDeg;
+  const double c = 0.5 * n * o.pitch_mm / std::tan(half_field_rad);
+  std::vector<calib::LineSubcamera> subs(3);
+  const char* ids[] = {"L", "N", "R"};
+  for (int k = 0; k < 3; ++k) {
+    subs[k].id = ids[k];
+    subs[k].last = n - 1;
+    subs[k].c_mm = c;
+    subs[k].pitch_mm = o.pitch_mm;
+    // Look angle (k - 1) tilt towards +x: a rotation about y by minus that angle.
+    subs[k].mount_rad = Eigen::Vector3d(0, -(k - 1) * o.tilt_deg * kDeg, 0);
+  }
+  calib::LineCamera cam = calib::CombineLineCameras("pushbroom-sim", subs, c, o.pitch_mm);
+  cam.mount_rad = Eigen::Vector3d(0.1, -0.05, 0.2) * kDeg;  // a known boresight
+  cam.lever_arm_m = Eigen::Vector3d(0.2, 0.1, -0.3);
+  sim.nominal = cam;
+  sim.nominal.name = "pushbroom-sim nominal";
+  sim.reference_subcamera = 1;
+  // Smooth per-detector errors: a cubic in u per sub-camera and axis.
+  const double amp = o.detector_error_px * o.pitch_mm;
+  for (int k = 0; k < 3; ++k) {
+    calib::LinePolynomial p;
+    p.first = cam.subcameras[k].first;
+    p.last = cam.subcameras[k].last;
+    const bool reference = k == sim.reference_subcamera;
+    for (auto* axis : {&p.dx, &p.dy}) {
+      *axis = {reference ? 0.0 : amp * normal(rng), reference ? 0.0 : amp * normal(rng),
+               0.5 * amp * normal(rng), 0.5 * amp * normal(rng)};
+    }
+    cam.calibration.push_back(p);
+  }
+  sim.truth = cam;
+  sim.truth.name = "pushbroom-sim truth";
+
+  // The flight: along +Y, kappa 0 (the line along X, across track).
+  const double spacing_m = o.pitch_mm / c * o.height_m;  // along-track ground spacing of a line
+  const double dt = spacing_m / o.speed_m_s;
+  const double length = o.lines * spacing_m;
+  const double ph[6] = {uniform(rng) * 6.28, uniform(rng) * 6.28, uniform(rng) * 6.28,
+                        uniform(rng) * 6.28, uniform(rng) * 6.28, uniform(rng) * 6.28};
+  const double a = o.attitude_variation_deg * kDeg, q = o.position_variation_m;
+  for (int l = 0; l < o.lines; ++l) {
+    const double s = l / double(o.lines);  // 0 .. 1 along the strip
+    PosRecord r;
+    r.line = l;
+    r.source_line = l + 2;
+    r.time_s = 1000.0 + l * dt;
+    r.center_m = {q * std::sin(2 * M_PI * 1.3 * s + ph[0]), l * spacing_m + 0.3 * q * std::sin(2 * M_PI * 0.7 * s + ph[1]),
+                  o.height_m + q * std::sin(2 * M_PI * 0.9 * s + ph[2])};
+    r.opk_rad = {a * std::sin(2 * M_PI * 2.1 * s + ph[3]), a * std::sin(2 * M_PI * 1.7 * s + ph[4]),
+                 0.5 * a * std::sin(2 * M_PI * 1.1 * s + ph[5])};
+    sim.pos_truth.push_back(r);
+  }
+  // POS error: a cubic B-spline with random node values.
+  const int nodes = calib::SplineNodeCount(o.lines - 1, o.node_spacing_lines);
+  std::vector<Vector6d> error_nodes(nodes);
+  for (auto& e : error_nodes)
+    for (int k = 0; k < 6; ++k) e[k] = (k < 3 ? o.pos_error_m : o.pos_error_deg * kDeg) * normal(rng);
+  for (int l = 0; l < o.lines; ++l) {
+    const calib::SplineSpan span = calib::CubicBSplineWeights(l, o.node_spacing_lines);
+    const int j = std::min(span.first_node, nodes - 4);
+    Vector6d e = Vector6d::Zero();
+    for (int m = 0; m < 4; ++m) e += span.weights[m] * error_nodes[j + m];
+    PosRecord r = sim.pos_truth[l];
+    r.center_m += e.head<3>();
+    r.opk_rad += e.tail<3>();
+    if (o.pos_error_m > 0) r.center_sigma_m = Eigen::Vector3d::Constant(o.pos_error_m);
+    if (o.pos_error_deg > 0) r.opk_sigma_rad = Eigen::Vector3d::Constant(o.pos_error_deg * kDeg);
+    if (!r.center_sigma_m || !r.opk_sigma_rad) r.center_sigma_m.reset(), r.opk_sigma_rad.reset();
+    sim.pos.push_back(r);
+    sim.true_corrections.push_back(-e);
+  }
+  const PosTrajectory truth = PosTrajectory::FromRecords(sim.pos_truth, "pos_truth.csv");
+
+  // Terrain and cloud control points in the swath.
+  const double half_swath = o.height_m * std::tan(1.5 * o.tilt_deg * kDeg + half_field_rad * 0.3);
+  auto terrain = [&](double x, double y) {
+    return 0.5 * o.relief_m * std::sin(x / 170.0 + 0.3) * std::cos(y / 230.0 - 0.2);
+  };
+  int placed = 0;
+  for (int attempt = 0; placed < o.control_points && attempt < 20 * o.control_points + 100; ++attempt) {
+    const double y = (0.02 + 0.96 * uniform(rng)) * length;
+    const double x = (2 * uniform(rng) - 1) * half_swath;
+    const Eigen::Vector3d ground(x, y, terrain(x, y));
+    const double t0 = y / spacing_m;
+    std::vector<LineObservation> seen;
+    for (int s = 0; s < 3; ++s) {
+      double i = 0, t = 0;
+      if (!ImageOfPoint(sim.truth, truth, s, t0, ground, &i, &t)) continue;
+      if (!(t >= 1 && t <= o.lines - 2)) continue;
+      LineObservation obs;
+      obs.detector = i + o.image_noise_px * normal(rng);
+      obs.line = t + o.image_noise_px * normal(rng);
+      obs.sigma_px = o.image_sigma_px;
+      // A measurement lies on one of its sub-camera's detectors (a column of the line image
+      // belongs to one sub-camera): a point that noise carries past the sub-camera's edge would
+      // be read as the neighbour's detector, so it is not measured (and, at the outer edges,
+      // beyond the line).
+      const long column = std::lround(obs.detector);
+      if (!(obs.detector >= -0.5 && column >= sim.truth.subcameras[s].first &&
+            column <= sim.truth.subcameras[s].last))
+        continue;
+      seen.push_back(obs);
+    }
+    if (seen.empty()) continue;
+    GroundPoint g;
+    g.id = "c" + std::to_string(placed + 1);
+    g.role = PointRole::kControl;
+    g.sigma_m = Eigen::Vector3d::Constant(o.control_sigma_m);
+    g.xyz_m = ground;
+    sim.points_truth.push_back(g);
+    g.xyz_m = ground + o.control_noise_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+    sim.points.push_back(g);
+    for (auto& obs : seen) {
+      obs.point = g.id;
+      obs.source_line = int(sim.observations.size()) + 2;
+      sim.observations.push_back(obs);
+    }
+    ++placed;
+  }
+  return sim;
+}
+
+void WriteLineSimulation(const LineSimulation& sim, const std::string& folder) {
+  std::filesystem::create_directories(folder);
+  auto path = [&](const std::string& name) { return (std::filesystem::path(folder) / name).string(); };
+  calib::WriteLineCamera(path("camera_nominal.yaml"), sim.nominal);
+  calib::WriteLineCamera(path("camera_truth.yaml"), sim.truth);
+  WritePos(path("pos.csv"), sim.pos);
+  WritePos(path("pos_truth.csv"), sim.pos_truth);
+  {
+    std::ostringstream out;
+    out << "image,point,col,row,sigma_px\n";
+    for (const auto& o : sim.observations)
+      out << "strip," << o.point << "," << FormatNumber(o.detector, 17) << ","
+          << FormatNumber(o.line, 17) << "," << FormatNumber(o.sigma_px) << "\n";
+    WriteFileAtomically(path("observations.csv"), out.str());
+  }
+  for (int truth = 0; truth < 2; ++truth) {
+    std::ostringstream out;
+    out << "point,X,Y,Z,sX,sY,sZ,role\n";
+    for (const auto& g : truth ? sim.points_truth : sim.points)
+      out << g.id << "," << FormatNumber(g.xyz_m->x(), 17) << "," << FormatNumber(g.xyz_m->y(), 17)
+          << "," << FormatNumber(g.xyz_m->z(), 17) << "," << FormatNumber(g.sigma_m.x()) << ","
+          << FormatNumber(g.sigma_m.y()) << "," << FormatNumber(g.sigma_m.z()) << ",control\n";
+    WriteFileAtomically(path(truth ? "points_truth.csv" : "points.csv"), out.str());
+  }
+  {
+    std::ostringstream out;
+    out << "i,subcamera,dx_mm,dy_mm\n";
+    for (int i = 0; i < sim.truth.detectors; ++i) {
+      const Eigen::Vector2d d = sim.truth.Correction(i);
+      out << i << "," << sim.truth.subcameras[sim.truth.SubcameraOf(i)].id << ","
+          << FormatNumber(d.x(), 17) << "," << FormatNumber(d.y(), 17) << "\n";
+    }
+    WriteFileAtomically(path("truth_detectors.csv"), out.str());
+  }
+  {
+    std::ostringstream out;
+    out << "line,dX,dY,dZ,domega,dphi,dkappa\n";
+    for (size_t l = 0; l < sim.true_corrections.size(); ++l) {
+      out << l;
+      for (int a = 0; a < 6; ++a)
+        out << "," << FormatNumber(sim.true_corrections[l][a] * (a < 3 ? 1.0 : 180.0 / M_PI), 17);
+      out << "\n";
+    }
+    WriteFileAtomically(path("truth_trajectory.csv"), out.str());
+  }
+}
+
+}  // namespace aerocal::triangulation
