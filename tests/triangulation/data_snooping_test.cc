@@ -98,7 +98,9 @@ TEST_F(SnoopingOnTheSimulatedFlight, EveryTestedObservationListsRWMdbAndGroupSiz
         const bool joint =
             std::abs(v.test.mdb_px(k) - clean_->snooping.delta0_joint * unit) < 1e-9;
         joint_mdbs += joint;
-        if (!joint) EXPECT_NEAR(v.test.mdb_px(k), clean_->snooping.delta0 * unit, 1e-9);
+        if (!joint) {
+          EXPECT_NEAR(v.test.mdb_px(k), clean_->snooping.delta0 * unit, 1e-9);
+        }
       }
     }
   }
