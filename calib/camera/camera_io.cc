@@ -23,6 +23,16 @@ constexpr double kMaxMappingParam = 1e7;    // |sub-image mapping parameter|
 constexpr double kMaxPixelCoordinate = 1e7; // |u|, |v|, |U|, |V| of reference points, px
 constexpr double kMaxSigmaPx = 1e4;
 
+// Bound of |value| of a registered model's parameter, from its unit (calib/README.md "Camera file
+// bounds"): pixel and millimetre lengths as for our model, dimensionless and inverse-length
+// coefficients as our distortion terms (overflow-safe only, not physical plausibility).
+double ModelParamBound(const ParamInfo& info) {
+  if (info.unit == "px") return kMaxPixelCoordinate;
+  if (info.unit == "mm")
+    return info.group == ParamGroup::kPrincipalDistance ? kMaxCMm : kMaxPpMm;
+  return kMaxDistortion;
+}
+
 std::vector<std::string> InteriorKeys() {
   std::vector<std::string> keys;
   for (const auto& info : Model::kParams) keys.emplace_back(info.name);
@@ -235,9 +245,8 @@ ModelCamera ParseModelCamera(const YAML::Node& root, const std::string& file) {
   }
   RejectUnknownKeys(root, {"name", "pixel_size_mm", "format_px", "interior", "model"}, file);
   if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
-  camera.frame.pixel_size_mm = YamlDouble(root["pixel_size_mm"], file, "pixel_size_mm");
-  if (!(camera.frame.pixel_size_mm > 0))
-    ThrowInputError(WhereIs(root["pixel_size_mm"], file), "pixel_size_mm must be > 0");
+  camera.frame.pixel_size_mm = YamlBounded(root["pixel_size_mm"], file, "pixel_size_mm",
+                                           kMinPixelSizeMm, kMaxPixelSizeMm);
   if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
   std::tie(camera.frame.width_px, camera.frame.height_px) = ReadFormat(root["format_px"], file);
   if (!root["interior"]) ThrowInputError({file, 1}, "missing interior");
@@ -245,8 +254,14 @@ ModelCamera ParseModelCamera(const YAML::Node& root, const std::string& file) {
   std::vector<std::string> keys;
   for (const ParamInfo& info : CameraModelParams(*id)) keys.emplace_back(info.name);
   RejectUnknownKeys(interior, keys, file);
-  for (const std::string& key : keys)
-    camera.params.push_back(interior[key] ? YamlDouble(interior[key], file, key) : 0.0);
+  const std::vector<ParamInfo> table = CameraModelParams(*id);
+  for (const ParamInfo& info : table) {
+    const std::string key(info.name);
+    const double bound = ModelParamBound(info);
+    camera.params.push_back(interior[key] ? YamlBounded(interior[key], file, "interior." + key,
+                                                        -bound, bound)
+                                          : 0.0);
+  }
   if (!(camera.PrincipalDistanceMm() > 0))
     ThrowInputError(WhereIs(interior, file), name + ": the focal length must be > 0");
   return camera;

@@ -136,6 +136,18 @@ TEST(ModelCameraFile, BadModelOrParameterNamesTheLine) {
                "cam.yaml:1: unknown camera model 'opencv_x'");
   expect_error("model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\ninterior: {K1: 1}\n",
                "cam.yaml:4");
+  // Values outside the unit-derived bounds (calib/README.md "Camera file bounds") name key and line.
+  expect_error("model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
+               "interior:\n  fx: 1000\n  k1: 1e300\n",
+               "cam.yaml:6: interior.k1 out of range");
+  expect_error("model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
+               "interior:\n  fx: 1e308\n",
+               "cam.yaml:5: interior.fx out of range");
+  expect_error("model: metashape_frame\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
+               "interior:\n  f: .nan\n",
+               "cam.yaml:5");
+  expect_error("model: opencv\npixel_size_mm: 1e-30\nformat_px: [10, 10]\ninterior: {fx: 1}\n",
+               "cam.yaml:2: pixel_size_mm out of range");
   // The 10-parameter reader says what to do with another registered model.
   try {
     ParseCamera(YAML::Load("model: metashape_frame\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
