@@ -106,6 +106,7 @@ class Snooper {
                                 : std::max(3.29, NormalCriticalValue(out_.alpha0));
       out_.power = o_.power;
       out_.delta0 = NonCentrality(out_.critical_value, o_.power);
+      out_.delta0_joint = NonCentralityJoint(out_.critical_value, o_.power);
       out_.min_redundancy = o_.min_redundancy;
       out_.group_correlation = o_.group_correlation;
     }
@@ -197,6 +198,9 @@ class Snooper {
       ++dof;
     }
     x->w_weak = std::max(x->w_weak, w_weak);
+    if (dof == 2)  // the MDBs of a joint test of two components
+      for (int k = 0; k < m; ++k)
+        if (std::isfinite(x->mdb_sigma[k])) x->mdb_sigma[k] *= out_.delta0_joint / out_.delta0;
     if (dof == 0) {
       x->w_max = 0.0;
       x->component = -1;
@@ -413,6 +417,32 @@ const char* VerdictName(SnoopingVerdict verdict) {
 double NonCentrality(double critical_value, double power) {
   // z(power): P(N(0,1) > z) = 1 - power, i.e. the two-sided value of 2 (1 - power).
   return critical_value + NormalCriticalValue(2.0 * (1.0 - power));
+}
+
+double NonCentralityJoint(double critical_value, double power) {
+  // P(chi2(2, lambda) > t) = sum_j Poisson(j; lambda / 2) P(chi2(2 + 2j) > t), with
+  // P(chi2(2m) > t) = exp(-t / 2) sum_{i < m} (t / 2)^i / i!; bisection on lambda.
+  const double p = std::erfc(critical_value / std::sqrt(2.0));
+  const double half_t = -std::log(p);  // t / 2
+  const auto tail = [&](double lambda) {
+    const double h = lambda / 2;
+    double sum = 0.0, central = 0.0, term = std::exp(-half_t);  // term: (t/2)^i / i! e^{-t/2}
+    double poisson = std::exp(-h);
+    for (int j = 0; j < 2000; ++j) {
+      central += term;  // P(chi2(2 (j + 1)) > t)
+      sum += poisson * central;
+      term *= half_t / (j + 1);
+      poisson *= h / (j + 1);
+      if (j > h && poisson < 1e-18) break;
+    }
+    return sum;
+  };
+  double lo = 0.0, hi = 4 * (critical_value + 10) * (critical_value + 10);
+  for (int i = 0; i < 100; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (tail(mid) < power ? lo : hi) = mid;
+  }
+  return std::sqrt(0.5 * (lo + hi));
 }
 
 SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,

@@ -35,8 +35,13 @@
 //   (held, vetoed, weakly controlled, at the cap) cluster on one point or one image (each
 //   correlated group counted once), the outcome says "model error suspected" with the evidence.
 //
-// MDB: the marginal detectable blunder of component k, in sigmas of the observation:
-//   nabla_k = delta0 s / sqrt(r_k), delta0 = k + z(power) (non-centrality for the test's power).
+// MDB: the marginal detectable blunder of component k (a blunder along that component), in
+// sigmas of the observation: nabla_k = delta s / sqrt(r_k), with delta the square root of the
+// non-centrality the observation's test needs for the power: for a one-dimensional test
+// delta0 = k + z(power); for the joint test of two controlled components (x, y of an image point)
+// delta0_joint, from chi-square(2) at the critical value T = chi2(2) quantile of the same tail
+// probability (k 4.44, power 0.8: 5.57 instead of 5.28; the one-dimensional delta0 understated
+// those MDBs by 5 %).
 #pragma once
 
 #include "calib/problem/problem_builder.h"
@@ -101,6 +106,7 @@ struct TestedObservation {
 struct SnoopingOutcome {
   SolveReport report;  // of the final adjustment
   double alpha = 0.0, alpha0 = 0.0, critical_value = 0.0, power = 0.0, delta0 = 0.0;
+  double delta0_joint = 0.0;  // for the joint test of two components (see the MDB above)
   double min_redundancy = 0.0, group_correlation = 0.0, reference_sigma = 1.0;
   int n_tested_components = 0;
   std::string cofactor_method;
@@ -125,5 +131,10 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
 
 /// delta0 = k + z(power): the non-centrality a blunder needs to be found with that power.
 double NonCentrality(double critical_value, double power);
+
+/// sqrt(lambda) with P(chi2(2, lambda) > T) = power, T the chi-square(2) value with the tail
+/// probability of |N(0,1)| > critical_value: the non-centrality (as a normal shift) of the joint
+/// test of two components.
+double NonCentralityJoint(double critical_value, double power);
 
 }  // namespace aerocal::calib

@@ -161,5 +161,22 @@ TEST(DataSnooping, AllIndependentBlundersGoInOneRound) {
   EXPECT_EQ(out.rounds, 2);  // the second finds nothing
 }
 
+TEST(DataSnooping, JointNonCentralityGivesThePowerOfTheTwoComponentTest) {
+  // Oracle: the tail of the non-central chi-square(2, lambda) by integrating the Rice density of
+  // R = sqrt(chi2): f(r) = r exp(-(r^2 + lambda) / 2) I0(r sqrt(lambda)), midpoint rule.
+  for (double k : {3.29, 4.44, 5.5}) {
+    const double delta = NonCentralityJoint(k, 0.8);
+    const double t = -2.0 * std::log(std::erfc(k / std::sqrt(2.0)));
+    const double lambda = delta * delta, r0 = std::sqrt(t);
+    double tail = 0.0;
+    const double step = 1e-4;
+    for (double r = r0 + step / 2; r < delta + 12; r += step)
+      tail += step * r * std::exp(-(r * r + lambda) / 2) * std::cyl_bessel_i(0.0, r * delta);
+    EXPECT_NEAR(tail, 0.8, 1e-4) << "k " << k;
+    EXPECT_GT(delta, NonCentrality(k, 0.8));  // two degrees of freedom need more
+  }
+  EXPECT_NEAR(NonCentralityJoint(4.44, 0.8), 5.565, 1e-3);
+}
+
 }  // namespace
 }  // namespace aerocal::calib

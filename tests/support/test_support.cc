@@ -1,5 +1,7 @@
 #include "tests/support/test_support.h"
 
+#include "calib/core/atomic_file.h"
+
 #include <array>
 #include <cstdio>
 #include <cstdlib>
@@ -51,6 +53,10 @@ CommandResult RunAerocal(const std::string& arguments) {
 std::string SharedDataDir(const std::string& name) {
   const std::string dir = std::string(AEROCAL_SHARED_DATA_DIR) + "/" + name;
   return std::filesystem::is_directory(dir) ? dir : "";
+}
+
+nlohmann::json ReadJson(const std::string& path) {
+  return nlohmann::json::parse(ReadTextFile(path));
 }
 
 }  // namespace aerocal::testing

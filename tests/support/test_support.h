@@ -1,6 +1,8 @@
 // Helpers shared by the test suites: temporary folders, running the aerocal binary, paths.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 namespace aerocal::testing {
@@ -28,6 +30,9 @@ CommandResult RunCommand(const std::string& command);
 std::string AerocalBinary();
 /// Runs the aerocal binary with the given arguments.
 CommandResult RunAerocal(const std::string& arguments);
+
+/// The JSON document in `path` (a result the aerocal binary wrote).
+nlohmann::json ReadJson(const std::string& path);
 
 /// Path of a shared real data set, or "" when ../shared/data is absent (tests then GTEST_SKIP).
 std::string SharedDataDir(const std::string& name);

@@ -14,12 +14,9 @@
 namespace aerocal {
 namespace {
 
+using testing::ReadJson;
 using testing::RunAerocal;
 using testing::TempDir;
-
-nlohmann::json ReadJson(const std::string& path) {
-  return nlohmann::json::parse(ReadTextFile(path));
-}
 
 class AdjustCommand : public ::testing::Test {
  protected:

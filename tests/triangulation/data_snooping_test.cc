@@ -80,7 +80,7 @@ TEST_F(SnoopingOnTheSimulatedFlight, ConventionalKeepsTheControlRaysAndSuspectsA
 TEST_F(SnoopingOnTheSimulatedFlight, EveryTestedObservationListsRWMdbAndGroupSize) {
   ASSERT_TRUE(clean_->snooping.run);
   EXPECT_FALSE(clean_->snooping.cofactor_method.empty());
-  int tested = 0, groups = 0;
+  int tested = 0, groups = 0, joint_mdbs = 0;
   for (const auto& v : clean_->residuals) {
     if (!v.used) continue;
     ASSERT_TRUE(v.test.tested) << v.image << " " << v.point;
@@ -89,12 +89,18 @@ TEST_F(SnoopingOnTheSimulatedFlight, EveryTestedObservationListsRWMdbAndGroupSiz
     for (int k = 0; k < 2; ++k) {
       EXPECT_GE(v.test.redundancy(k), 0.0);
       EXPECT_LE(v.test.redundancy(k), 1.0 + 1e-9);
-      // MDB = delta0 s / sqrt(r) sigma, in px with the observation's sigma.
+      // MDB = delta s / sqrt(r) sigma, in px with the observation's sigma: delta = delta0_joint
+      // when both components are tested jointly (two controlled directions of Q_ii), delta0
+      // when one direction is weakly controlled (a one-dimensional test).
       if (v.test.redundancy(k) > 1e-6) {
-        EXPECT_NEAR(v.test.mdb_px(k),
-                    clean_->snooping.delta0 * clean_->snooping.reference_sigma /
-                        std::sqrt(v.test.redundancy(k)) * v.sigma_px,
-                    1e-9);
+        const double unit =
+            clean_->snooping.reference_sigma / std::sqrt(v.test.redundancy(k)) * v.sigma_px;
+        const bool joint =
+            std::abs(v.test.mdb_px(k) - clean_->snooping.delta0_joint * unit) < 1e-9;
+        joint_mdbs += joint;
+        if (!joint) {
+          EXPECT_NEAR(v.test.mdb_px(k), clean_->snooping.delta0 * unit, 1e-9);
+        }
       }
     }
   }
@@ -104,6 +110,9 @@ TEST_F(SnoopingOnTheSimulatedFlight, EveryTestedObservationListsRWMdbAndGroupSiz
   // family-wise level in false rejections (5 %: zero or one here).
   EXPECT_LE(clean_->rejected.size(), 1u);
   EXPECT_NEAR(clean_->snooping.delta0 - clean_->snooping.critical_value, 0.8416, 1e-3);
+  EXPECT_NEAR(clean_->snooping.delta0_joint,
+              calib::NonCentralityJoint(clean_->snooping.critical_value, 0.8), 1e-12);
+  EXPECT_GT(joint_mdbs, tested) << "most image observations are tested jointly in x and y";
 }
 
 TEST_F(SnoopingOnTheSimulatedFlight, PlantedTwentySigmaBlunderOnAPinnedObservationIsFound) {

@@ -1,10 +1,9 @@
 // Real data sets from ../shared/data (skipped when absent), imported once with the project's
 // importers and adjusted; published answers from each folder's PROVENANCE.md.
+#include "tests/support/odm_uav_block.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
-#include "triangulation/adjustment/nadir_start.h"
 #include "triangulation/import/dbat_import.h"
-#include "triangulation/import/odm_gcp_import.h"
 
 #include <gtest/gtest.h>
 
@@ -61,27 +60,11 @@ TEST(RealData, DbatOlympusCalibrationMatchesThePublishedResult) {
 TEST(RealData, OdmUavTargetsBlundersFoundAndCheckPointsCompared) {
   const std::string dir = testing::SharedDataDir("odm_br_uav_gcp_block");
   if (dir.empty()) GTEST_SKIP() << "../shared/data/odm_br_uav_gcp_block is absent";
-  // Canon PowerShot SX260 HS: 4000 x 3000 px, f = 4.5 mm ~ 2904 px (the author's note).
-  OdmImportOptions in;
-  in.gcp_list = dir + "/odm_gcp_br/gcp_list_floatxy_raw.txt";
-  in.camera.name = "Canon PowerShot SX260 HS";
-  in.camera.width_px = 4000;
-  in.camera.height_px = 3000;
-  in.camera.pixel_size_mm = 4.5 / 2904.0;
-  in.camera.interior[Model::kC] = 4.5;
-  // The author's control subset (gcp_list_raw.txt); the other targets are check points.
-  {
-    OdmImportOptions subset;
-    subset.gcp_list = dir + "/odm_gcp_br/gcp_list_raw.txt";
-    subset.camera = in.camera;
-    const Project control = ImportOdmGcpList(subset);
-    for (const auto& p : control.points) in.control_ids.insert(p.id);
-  }
-  Project project = ImportOdmGcpList(in);
+  // The author's control subset; the other targets are check points. Starting values from every
+  // surveyed target (a similarity per near-nadir image).
+  const Project project = testing::ImportOdmUavBlock(dir);
   ASSERT_EQ(project.observations.size(), 82u);
   ASSERT_EQ(project.points.size(), 19u);
-  // Starting values from every surveyed target (a similarity per near-nadir image).
-  project.exposures = NadirStartFromControl(project, "cam1");
   ASSERT_EQ(project.exposures.size(), 10u);
   AdjustOptions options;
   options.robust_start = true;  // gross errors of hundreds of pixels and rough starting values

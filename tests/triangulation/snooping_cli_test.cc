@@ -15,12 +15,9 @@
 namespace aerocal {
 namespace {
 
+using testing::ReadJson;
 using testing::RunAerocal;
 using testing::TempDir;
-
-nlohmann::json ReadJson(const std::string& path) {
-  return nlohmann::json::parse(ReadTextFile(path));
-}
 
 // observations.csv rows: image,point,col,row,sigma_px. Applies `edit` to each data row (return
 // false to drop it) and writes the file back.

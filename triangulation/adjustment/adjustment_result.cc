@@ -37,6 +37,7 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
                       {"critical_value", s.critical_value},
                       {"power", s.power},
                       {"delta0", s.delta0},
+                      {"delta0_joint", s.delta0_joint},
                       {"min_redundancy", s.min_redundancy},
                       {"group_correlation", s.group_correlation},
                       {"reference_sigma", s.reference_sigma},

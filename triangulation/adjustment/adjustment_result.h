@@ -92,6 +92,7 @@ struct FlaggedObservation {
 struct SnoopingSummary {
   bool run = false;
   double alpha = 0, alpha0 = 0, critical_value = 0, power = 0, delta0 = 0;
+  double delta0_joint = 0;  // of the joint x, y test: the MDBs of image observations use it
   double min_redundancy = 0, group_correlation = 0, reference_sigma = 1;
   std::string cofactor_method;
   bool cofactors_ok = true;

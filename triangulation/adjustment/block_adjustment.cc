@@ -441,6 +441,7 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   s.critical_value = out.critical_value;
   s.power = out.power;
   s.delta0 = out.delta0;
+  s.delta0_joint = out.delta0_joint;
   s.min_redundancy = out.min_redundancy;
   s.group_correlation = out.group_correlation;
   s.reference_sigma = out.reference_sigma;
