@@ -136,8 +136,9 @@ TYPED_TEST(CameraModelTest, RoundTripOverTheFormatBelow1e6Px) {
   ASSERT_TRUE(Model::IdealFromMeasured(p.data(), kFrame, corner.data(), distorted.data()));
   ASSERT_TRUE(Model::IdealFromMeasured(p0.data(), kFrame, corner.data(), pinhole.data()));
   if constexpr (Model::kId != CameraModelId::kColmapSimplePinhole &&
-                Model::kId != CameraModelId::kColmapPinhole)
+                Model::kId != CameraModelId::kColmapPinhole) {
     EXPECT_GT((distorted - pinhole).norm() / kFrame.pixel_size_mm, 1.0) << Model::kName;
+  }
 }
 
 // d(out)/d(params) of a uniform function by Jets vs central differences.
