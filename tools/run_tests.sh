@@ -15,7 +15,13 @@ root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="$(nproc)"
 full="${AEROCAL_FULL_CHECKS:-0}"
 
-ctest --test-dir "$root/build" --output-on-failure -j"$jobs"
+# Tests labelled `long` (multi-flight studies) are for benchmarks and local checks, not CI:
+# AEROCAL_LONG=1 runs them too.
+if [ "${AEROCAL_LONG:-0}" = 1 ]; then
+  ctest --test-dir "$root/build" --output-on-failure -j"$jobs"
+else
+  ctest --test-dir "$root/build" --output-on-failure -j"$jobs" -LE long
+fi
 
 if [ "${AEROCAL_FUZZ:-1}" = 1 ]; then
   CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_BUILD_TYPE=Release \
