@@ -2,8 +2,8 @@
 # Runs the whole test suite of an already built tree (tools/setup.sh builds it), then the checking
 # jobs of issue 12, each in its own build dir (configured in place, incremental on a second run):
 #  - fuzz (build-fuzz/, clang libFuzzer with ASan + UBSan): by default the calib readers' targets
-#    (CSV tables, camera YAML) for AEROCAL_FUZZ_SECONDS (20 s) each: they need only aerocal::calib
-#    instrumented (about 2 min to build on 2 cores);
+#    (CSV tables; camera, rig and line-camera YAML; other tools' camera files) for
+#    AEROCAL_FUZZ_SECONDS (20 s) each: they link only aerocal::calib, the one library instrumented;
 #  - AEROCAL_FULL_CHECKS=1 adds every fuzz target (block files, stitching CSV, importers, stitch
 #    result JSON) and the sanitizer job (build-asan/, gcc -fsanitize=address,undefined): the tests
 #    labelled `unit` and the bad-input CLI cases (tools/bad_input runs the sanitized aerocal).
@@ -30,9 +30,9 @@ if [ "${AEROCAL_FUZZ:-1}" = 1 ]; then
     cmake --build "$root/build-fuzz" -j"$jobs"
     ctest --test-dir "$root/build-fuzz" --output-on-failure -j"$jobs" -L fuzz
   else
-    cmake --build "$root/build-fuzz" -j"$jobs" --target fuzz_csv fuzz_camera_yaml
+    cmake --build "$root/build-fuzz" -j"$jobs" --target fuzz_csv fuzz_camera_yaml fuzz_camera_formats
     ctest --test-dir "$root/build-fuzz" --output-on-failure -j"$jobs" -L fuzz \
-      -R '^fuzz/(csv|camera_yaml)$'
+      -R '^fuzz/(csv|camera_yaml|camera_formats)$'
   fi
 fi
 
