@@ -9,23 +9,14 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
+#include "triangulation/block/value_bounds.h"
 
 namespace aerocal::triangulation {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
 
-// Physical bounds of the block files' values (triangulation/README.md "Value bounds"): object
-// coordinates within 1e8 m (UTM northings, geocentric metres and degrees fit), angles within one
-// turn either way, pixel coordinates within 1e7 px, sigmas positive and at most 1e6 m / 360 deg /
-// 1e4 px.
-constexpr double kMaxCoordinateM = 1e8;
-constexpr double kMaxAngleDeg = 360.0;
-constexpr double kMaxPixel = 1e7;
-constexpr double kMaxSigmaM = 1e6;
-constexpr double kMaxSigmaDeg = 360.0;
-constexpr double kMaxSigmaPx = 1e4;
-constexpr double kMaxVelocityMps = 1e4;
+using namespace bounds;  // block/value_bounds.h
 
 // An optional positive sigma column: empty is "not given", otherwise within (0, hi].
 std::optional<double> Sigma(const CsvTable& t, const CsvTable::Row& row, const std::string& column,

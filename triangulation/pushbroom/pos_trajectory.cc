@@ -7,18 +7,16 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "triangulation/block/value_bounds.h"
 
 namespace aerocal::triangulation {
 namespace {
 
 constexpr double kDegToRad = M_PI / 180.0;
-// Bounds as the block files (triangulation/README.md "Value bounds").
-constexpr double kMaxCoordinateM = 1e8;
-constexpr double kMaxAngleDeg = 360.0;
+// Bounds as the block files (block/value_bounds.h), plus the line number and time of a POS row.
+using namespace bounds;
 constexpr double kMaxLine = 1e9;
 constexpr double kMaxTimeS = 1e10;
-constexpr double kMaxSigmaM = 1e6;
-constexpr double kMaxSigmaDeg = 360.0;
 
 std::optional<Eigen::Vector3d> SigmaTriple(const CsvTable& t, const CsvTable::Row& row,
                                            const char* a, const char* b, const char* c, double hi) {
