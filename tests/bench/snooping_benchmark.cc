@@ -79,6 +79,19 @@ bool Rejected(const AdjustmentResult& r, const std::string& image, const std::st
   return false;
 }
 
+// Whether image/point took part in the final adjustment (not rejected, its point not left out).
+bool Used(const AdjustmentResult& r, const std::string& image, const std::string& point) {
+  for (const auto& o : r.residuals)
+    if (o.image == image && o.point == point) return o.used;
+  return false;
+}
+
+std::string RejectedBy(const AdjustmentResult& r, const std::string& image, const std::string& point) {
+  for (const auto& o : r.rejected)
+    if (o.image == image && o.point == point) return o.by;
+  return "";
+}
+
 void BM_ConventionalSeeds(benchmark::State& state) {
   for (auto _ : state) {
     int control_rejected = 0, model_error = 0;
@@ -230,7 +243,8 @@ void BM_ManyBlunders(benchmark::State& state) {
   const double share = state.range(0) / 100.0;
   const bool controlled_only = state.range(1) != 0;
   for (auto _ : state) {
-    int planted = 0, found = 0, good_lost = 0, good = 0, good_lost_beside_blunder = 0;
+    int planted = 0, found = 0, good_lost = 0, good = 0;
+    int good_lost_undetermined = 0, good_lost_in_group = 0, good_lost_other = 0;
     int by_class[4] = {0, 0, 0, 0}, found_by_class[4] = {0, 0, 0, 0};
     double worst_rmse_ratio = 1.0, worst_camera_sigmas = 0.0;
     for (int seed = 1; seed <= 3; ++seed) {
@@ -291,16 +305,32 @@ void BM_ManyBlunders(benchmark::State& state) {
               }
             std::printf("\n");
           }
-      // Good observations lost: those on a point that also holds a blunder (rejected with its
-      // correlated group, or with the point's rays by the robust start) and the others.
-      std::set<std::string> blundered_points;
-      for (const auto& b : blunders) blundered_points.insert(b.second);
+      // Good observations lost, by cause: on a point left with fewer than two good rays (no
+      // method can keep them: without the blunder the point is undetermined), in the blunder's
+      // correlated group of the clean run (no test can tell them from it), and the others.
+      std::map<std::string, int> good_rays;
+      std::map<std::pair<std::string, std::string>, int> group_of;
+      for (const auto& o : p.observations) good_rays[o.point] += !blunders.count({o.image, o.point});
       for (const auto& o : p.observations)
         if (!blunders.count({o.image, o.point})) {
           ++good;
-          const bool lost = Rejected(r, o.image, o.point);
-          good_lost += lost;
-          good_lost_beside_blunder += lost && blundered_points.count(o.point);
+          if (Used(r, o.image, o.point)) continue;
+          ++good_lost;
+          const ObservationResidual* v = clean_test.count({o.image, o.point}) ? clean_test.at({o.image, o.point}) : nullptr;
+          bool beside_grouped_blunder = false;
+          for (const auto& [image, point] : blunders)
+            if (point == o.point && clean_test.count({image, point}) &&
+                clean_test.at({image, point})->test.group_size > 1 && v && v->test.group_size > 1)
+              beside_grouped_blunder = true;
+          if (good_rays[o.point] < 2) {
+            ++good_lost_undetermined;
+          } else if (beside_grouped_blunder) {
+            ++good_lost_in_group;
+          } else {
+            ++good_lost_other;
+            std::printf("  good lost %s/%s (%d good rays of %s, by %s)\n", o.image.c_str(),
+                        o.point.c_str(), good_rays[o.point], o.point.c_str(), Rejected(r, o.image, o.point) ? RejectedBy(r, o.image, o.point).c_str() : "left out");
+          }
         }
       const double ratio = r.check.spatial_rmse_m / s.clean.check.spatial_rmse_m;
       worst_rmse_ratio = std::max(worst_rmse_ratio, ratio);
@@ -310,16 +340,19 @@ void BM_ManyBlunders(benchmark::State& state) {
               worst_camera_sigmas, std::abs(r.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
                                        s.clean.cameras[0].sigma[k]);
       std::printf("seed %d, %.0f %% blunders: %zu planted, robust start %s (%d excluded, %d "
-                  "re-admitted), %zu rejected, valid %s, check RMSE %.3f m (clean %.3f m)\n",
+                  "re-admitted, %d re-tested), %zu rejected, valid %s, check RMSE %.3f m (clean %.3f m)\n",
                   seed, 100 * share, blunders.size(), r.snooping.robust_start ? "yes" : "no",
-                  r.snooping.robust_excluded, r.snooping.robust_readmitted, r.rejected.size(),
+                  r.snooping.robust_excluded, r.snooping.robust_readmitted,
+                  r.snooping.robust_retested, r.rejected.size(),
                   r.valid ? "yes" : "no", r.check.spatial_rmse_m, s.clean.check.spatial_rmse_m);
     }
     state.counters["planted"] = planted;
     state.counters["found_share"] = static_cast<double>(found) / std::max(1, planted);
     state.counters["good_lost_share"] = static_cast<double>(good_lost) / std::max(1, good);
-    state.counters["good_lost_share_elsewhere"] =
-        static_cast<double>(good_lost - good_lost_beside_blunder) / std::max(1, good);
+    state.counters["good_lost_share_undetermined"] =
+        static_cast<double>(good_lost_undetermined) / std::max(1, good);
+    state.counters["good_lost_share_in_group"] = static_cast<double>(good_lost_in_group) / std::max(1, good);
+    state.counters["good_lost_share_other"] = static_cast<double>(good_lost_other) / std::max(1, good);
     state.counters["worst_rmse_ratio"] = worst_rmse_ratio;
     state.counters["worst_camera_offset_sigmas"] = worst_camera_sigmas;
     const char* names[4] = {"weak", "grouped", "controlled", "untested"};

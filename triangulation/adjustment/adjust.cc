@@ -109,7 +109,12 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
 
   // 2. Clean solution without the excluded observations; those that fit it are re-admitted:
   //    |v| / sigma at a solution they did not influence below the critical value (their
-  //    w would be smaller still: the prediction's variance exceeds sigma^2).
+  //    w would be smaller still: the prediction's variance exceeds sigma^2). The excluded rays
+  //    of a point the clean solution does not hold (all or all but one of its rays excluded)
+  //    cannot be judged there: they go back to the final adjustment, whose snooping tests them
+  //    with redundancy numbers and rejects the blunder, or the point's correlated group when no
+  //    test can tell its rays apart (a robust cut would drop the point's good rays with it, or
+  //    name an arbitrary ray of a two-ray point).
   AdjustOptions clean_options = options;
   clean_options.data_snooping = false;
   clean_options.estimate_covariance = false;
@@ -125,12 +130,13 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
                                                    options.snooping_alpha / std::max(1, components)));
   const double scale = std::max(1.0, clean.sigma0);
   std::vector<BlockAdjustment::Screened> still_excluded;
-  int readmitted = 0;
+  int readmitted = 0, retested = 0;
   for (const auto& s : screened) {
+    const bool undetermined = !clean.points_m.count(s.observation.point);
     const auto v = ResidualAt(next, clean, s.observation);
-    if (v && v->cwiseAbs().maxCoeff() / scale < critical) {
+    if (undetermined || (v && v->cwiseAbs().maxCoeff() / scale < critical)) {
       next.observations.push_back(s.observation);
-      ++readmitted;
+      ++(undetermined ? retested : readmitted);
     } else {
       still_excluded.push_back(s);
     }
@@ -169,12 +175,15 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   result.snooping.gross_share = gross_share;
   result.snooping.robust_excluded = static_cast<int>(screened.size());
   result.snooping.robust_readmitted = readmitted;
+  result.snooping.robust_retested = retested;
   result.notes.push_back("started from a robust (Cauchy, " +
                          FormatNumber(options.robust_scale_sigma, 3) + " sigma) adjustment (" +
                          reason + "): " + std::to_string(screened.size()) +
                          " observation(s) beyond " + FormatNumber(options.robust_reject_sigma, 3) +
                          " robust w excluded, " + std::to_string(readmitted) +
-                         " re-admitted because they fit the clean solution");
+                         " re-admitted because they fit the clean solution, " +
+                         std::to_string(retested) +
+                         " on points the clean solution could not hold left to snooping");
   return result;
 }
 

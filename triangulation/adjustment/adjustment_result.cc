@@ -60,7 +60,8 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
                       {"robust_start_reason", s.robust_start_reason},
                       {"gross_share", s.gross_share},
                       {"robust_excluded", s.robust_excluded},
-                      {"robust_readmitted", s.robust_readmitted}};
+                      {"robust_readmitted", s.robust_readmitted},
+                      {"robust_retested", s.robust_retested}};
   j["flagged"] = nlohmann::json::array();
   for (const auto& f : s.flagged)
     j["flagged"].push_back({{"observation", f.what},
@@ -162,8 +163,9 @@ std::string SnoopingLines(const AdjustmentResult& r) {
   std::string out;
   if (s.robust_start)
     out += StringPrintf(
-        "robust start (%s): %d observation(s) excluded, %d re-admitted after the clean solution\n",
-        s.robust_start_reason.c_str(), s.robust_excluded, s.robust_readmitted);
+        "robust start (%s): %d observation(s) excluded, %d re-admitted after the clean solution, "
+        "%d on points it could not hold left to snooping\n",
+        s.robust_start_reason.c_str(), s.robust_excluded, s.robust_readmitted, s.robust_retested);
   if (!s.run) return out;
   out += StringPrintf(
       "data snooping: %d components tested, critical |w| %.2f (alpha %.3g family-wise), power "

@@ -114,6 +114,9 @@ struct SnoopingSummary {
   std::string robust_start_reason;
   double gross_share = 0;  // of image components above robust_trigger_w in the first solve
   int robust_excluded = 0, robust_readmitted = 0;
+  /// Excluded rays of points the clean solution did not hold (all or all but one of their rays
+  /// excluded): handed back to snooping in the final adjustment instead of being dropped.
+  int robust_retested = 0;
 };
 
 /// One image observation after the adjustment: residual v = measured - adjusted, in pixels of
