@@ -13,9 +13,11 @@
 //                             in correlated groups and those reported as a group, good
 //                             observations named as THE gross error (group size 1, not the
 //                             blunder), rejections on other points
-//   BM_ManyBlunders/<percent> seeds 1-3: <percent> % of the observations corrupted by 20-50 sigma:
-//                             found, good ones lost, check RMSE / the clean run's, camera offset
-//                             from the clean run in sigmas (max over the 10 parameters)
+//   BM_ManyBlunders/<percent> seeds 1..AEROCAL_BENCH_MANY_SEEDS (default 3): <percent> % of the
+//                             observations corrupted by 20-50 sigma: found, good ones lost (not
+//                             used at the end) by cause, check RMSE / the clean run's over all
+//                             check points and over the controlled ones (check_controlled),
+//                             camera offset from the clean run in sigmas (max over the 10)
 //   BM_OdmUavBlock            the real UAV block (../shared/data/odm_br_uav_gcp_block), default
 //                             options: the two known gross errors rejected, check RMSE, control
 //                             rays lost
@@ -43,6 +45,12 @@ using Model = calib::BrownFraser10Model;
 int Runs() {
   const char* env = std::getenv("AEROCAL_BENCH_RUNS");
   return env ? std::max(1, std::atoi(env)) : 100;
+}
+
+// BM_ManyBlunders runs over seeds 1..AEROCAL_BENCH_MANY_SEEDS (default 3).
+int ManyBlundersSeeds() {
+  const char* env = std::getenv("AEROCAL_BENCH_MANY_SEEDS");
+  return env ? std::max(1, std::atoi(env)) : 3;
 }
 
 bool IsControl(const std::string& point) { return !point.empty() && point[0] == 'C'; }
@@ -246,8 +254,8 @@ void BM_ManyBlunders(benchmark::State& state) {
     int planted = 0, found = 0, good_lost = 0, good = 0;
     int good_lost_undetermined = 0, good_lost_in_group = 0, good_lost_other = 0;
     int by_class[4] = {0, 0, 0, 0}, found_by_class[4] = {0, 0, 0, 0};
-    double worst_rmse_ratio = 1.0, worst_camera_sigmas = 0.0;
-    for (int seed = 1; seed <= 3; ++seed) {
+    double worst_rmse_ratio = 1.0, worst_rmse_ratio_controlled = 1.0, worst_camera_sigmas = 0.0;
+    for (int seed = 1; seed <= ManyBlundersSeeds(); ++seed) {
       const Seed& s = SeedData(seed);
       std::mt19937_64 rng(seed);
       Project p = s.project;
@@ -334,17 +342,28 @@ void BM_ManyBlunders(benchmark::State& state) {
         }
       const double ratio = r.check.spatial_rmse_m / s.clean.check.spatial_rmse_m;
       worst_rmse_ratio = std::max(worst_rmse_ratio, ratio);
+      // The check points whose rays are all controlled, in this run and in the clean one.
+      const double ratio_controlled =
+          r.check_controlled && s.clean.check_controlled
+              ? r.check_controlled->spatial_rmse_m / s.clean.check_controlled->spatial_rmse_m
+              : 0.0;
+      worst_rmse_ratio_controlled = std::max(worst_rmse_ratio_controlled, ratio_controlled);
       for (int k = 0; k < Model::kNumParams; ++k)
         if (s.clean.cameras[0].sigma[k] > 0)
           worst_camera_sigmas = std::max(
               worst_camera_sigmas, std::abs(r.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
                                        s.clean.cameras[0].sigma[k]);
       std::printf("seed %d, %.0f %% blunders: %zu planted, robust start %s (%d excluded, %d "
-                  "re-admitted, %d re-tested), %zu rejected, valid %s, check RMSE %.3f m (clean %.3f m)\n",
+                  "re-admitted, %d re-tested), %zu rejected, valid %s, check RMSE %.3f m (clean %.3f m), "
+                  "controlled check points %d: %.3f m (clean %d: %.3f m)\n",
                   seed, 100 * share, blunders.size(), r.snooping.robust_start ? "yes" : "no",
                   r.snooping.robust_excluded, r.snooping.robust_readmitted,
                   r.snooping.robust_retested, r.rejected.size(),
-                  r.valid ? "yes" : "no", r.check.spatial_rmse_m, s.clean.check.spatial_rmse_m);
+                  r.valid ? "yes" : "no", r.check.spatial_rmse_m, s.clean.check.spatial_rmse_m,
+                  r.check_controlled ? r.check_controlled->n : 0,
+                  r.check_controlled ? r.check_controlled->spatial_rmse_m : 0.0,
+                  s.clean.check_controlled ? s.clean.check_controlled->n : 0,
+                  s.clean.check_controlled ? s.clean.check_controlled->spatial_rmse_m : 0.0);
     }
     state.counters["planted"] = planted;
     state.counters["found_share"] = static_cast<double>(found) / std::max(1, planted);
@@ -354,6 +373,7 @@ void BM_ManyBlunders(benchmark::State& state) {
     state.counters["good_lost_share_in_group"] = static_cast<double>(good_lost_in_group) / std::max(1, good);
     state.counters["good_lost_share_other"] = static_cast<double>(good_lost_other) / std::max(1, good);
     state.counters["worst_rmse_ratio"] = worst_rmse_ratio;
+    state.counters["worst_rmse_ratio_controlled"] = worst_rmse_ratio_controlled;
     state.counters["worst_camera_offset_sigmas"] = worst_camera_sigmas;
     const char* names[4] = {"weak", "grouped", "controlled", "untested"};
     for (int k = 0; k < 4; ++k) {

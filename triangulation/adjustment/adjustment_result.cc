@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 
 namespace aerocal::triangulation {
 namespace {
@@ -62,6 +63,15 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
                       {"robust_excluded", s.robust_excluded},
                       {"robust_readmitted", s.robust_readmitted},
                       {"robust_retested", s.robust_retested}};
+  j["uncontrolled"] = nlohmann::json::array();
+  for (const auto& u : s.uncontrolled)
+    j["uncontrolled"].push_back({{"image", u.image},
+                                 {"point", u.point},
+                                 {"r", Pair(u.redundancy)},
+                                 {"mdb_px", Pair(u.mdb_px)},
+                                 {"rays", u.rays},
+                                 {"untestable", u.untestable},
+                                 {"reason", u.reason}});
   j["flagged"] = nlohmann::json::array();
   for (const auto& f : s.flagged)
     j["flagged"].push_back({{"observation", f.what},
@@ -175,6 +185,28 @@ std::string SnoopingLines(const AdjustmentResult& r) {
       r.rejected.size(), s.n_weakly_controlled, s.min_redundancy, s.n_in_groups,
       s.cofactor_method.c_str());
   for (const auto& f : s.findings) out += "snooping: " + f + "\n";
+  if (!s.uncontrolled.empty()) {
+    const auto untestable = std::count_if(s.uncontrolled.begin(), s.uncontrolled.end(), [](const auto& u) {
+      return u.untestable;
+    });
+    out += StringPrintf("uncontrolled: %zu observation(s) no test can judge (%d with r = 0, a blunder there "
+                        "is invisible); all in the result's snooping.uncontrolled:\n",
+                        s.uncontrolled.size(),
+                        static_cast<int>(untestable));
+    constexpr size_t kShown = 10;
+    for (size_t i = 0; i < s.uncontrolled.size() && i < kShown; ++i) {
+      const auto& u = s.uncontrolled[i];
+      out += StringPrintf("  image %s point %s (%d rays) r (%.2f, %.2f): %s\n",
+                          u.image.c_str(),
+                          u.point.c_str(),
+                          u.rays,
+                          u.redundancy.x(),
+                          u.redundancy.y(),
+                          u.reason.c_str());
+    }
+    if (s.uncontrolled.size() > kShown)
+      out += StringPrintf("  ... %zu more\n", s.uncontrolled.size() - kShown);
+  }
   if (s.model_error_suspected && !s.suggestion.empty())
     out += "warning: model error suspected: " + s.suggestion + "\n";
   if (s.cap_reached)
@@ -196,6 +228,51 @@ void AdjustmentResult::Invalidate(const std::string& reason) {
   valid = false;
   if (std::find(invalid_reasons.begin(), invalid_reasons.end(), reason) == invalid_reasons.end())
     invalid_reasons.push_back(reason);
+}
+
+void ClassifyUncontrolled(double min_redundancy, AdjustmentResult* result) {
+  constexpr double kUntestable = 1e-6;  // as data_snooping.cc: r below, no test sees anything
+  const char* axis[2] = {"x", "y"};
+  std::map<std::string, int> rays;
+  for (const auto& v : result->residuals) rays[v.point] += v.used;
+  std::map<std::string, std::string> point_reason;  // the first uncontrolled ray of each point
+  SnoopingSummary& s = result->snooping;
+  s.uncontrolled.clear();
+  for (const auto& v : result->residuals) {
+    if (!v.used || !v.test.tested) continue;
+    Eigen::Index k = 0;
+    const double r = v.test.redundancy.minCoeff(&k);
+    if (!(r < min_redundancy)) continue;
+    UncontrolledObservation u;
+    u.image = v.image;
+    u.point = v.point;
+    u.redundancy = v.test.redundancy;
+    u.mdb_px = v.test.mdb_px;
+    u.rays = rays[v.point];
+    u.untestable = r < kUntestable;
+    if (u.untestable && u.rays == 2)
+      u.reason = StringPrintf("r = 0 on photo %s: the component along the base of a two-ray point; no "
+                              "test can see a blunder there",
+                              axis[k]);
+    else if (u.untestable)
+      u.reason = StringPrintf("r = 0 on photo %s: no other observation checks this component", axis[k]);
+    else
+      u.reason = StringPrintf("r = %.3f on photo %s < %.2f: weakly controlled; a blunder below the "
+                              "MDB of %.3g px is not found",
+                              r,
+                              axis[k],
+                              min_redundancy,
+                              v.test.mdb_px(k));
+    point_reason.try_emplace(v.point, "ray " + v.image + ": " + u.reason);
+    s.uncontrolled.push_back(u);
+  }
+  std::vector<PointDifference> controlled;
+  for (auto& d : result->check_points) {
+    const auto it = point_reason.find(d.point);
+    d.uncontrolled = it == point_reason.end() ? std::string() : it->second;
+    if (d.uncontrolled.empty()) controlled.push_back(d);
+  }
+  result->check_controlled = ComputePointStatistics(controlled);
 }
 
 PointStatistics ComputePointStatistics(const std::vector<PointDifference>& points) {
@@ -304,18 +381,31 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   nlohmann::json control = PointStatisticsToJson(r.control), check = PointStatisticsToJson(r.check);
   auto table = [](const std::vector<PointDifference>& points) {
     nlohmann::json t = nlohmann::json::array();
-    for (const auto& p : points)
+    for (const auto& p : points) {
       t.push_back({{"point", p.point},
                    {"surveyed", Vec(p.surveyed_m)},
                    {"adjusted", Vec(p.adjusted_m)},
                    {"difference_m", Vec(p.difference_m)},
                    {"rays", p.rays}});
+      if (!p.uncontrolled.empty()) t.back()["uncontrolled"] = p.uncontrolled;
+    }
     return t;
   };
   control["points"] = table(r.control_points);
   check["points"] = table(r.check_points);
   j["control"] = control;
   j["check"] = check;
+  if (r.check_controlled) {
+    nlohmann::json c = PointStatisticsToJson(*r.check_controlled);
+    c["uncontrolled_points"] = nlohmann::json::array();
+    for (const auto& p : r.check_points)
+      if (!p.uncontrolled.empty())
+        c["uncontrolled_points"].push_back({{"point", p.point},
+                                            {"difference_m", Vec(p.difference_m)},
+                                            {"rays", p.rays},
+                                            {"reason", p.uncontrolled}});
+    j["check_controlled"] = c;
+  }
   j["exposures"] = nlohmann::json::array();
   for (const auto& e : r.exposures) {
     nlohmann::json x = {{"image", e.image},
@@ -407,6 +497,18 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += "datum: " + r.datum + "\n";
   out += StatisticsLine("control", r.control);
   out += StatisticsLine("check", r.check);
+  if (r.check_controlled && r.check_controlled->n < r.check.n) {
+    out += StatisticsLine("check*", *r.check_controlled);
+    out += StringPrintf("  check* = the %d check point(s) whose rays are all controlled; %d rest on rays no test "
+                        "can judge (a blunder there moves the point unseen):",
+                        r.check_controlled->n,
+                        r.check.n - r.check_controlled->n);
+    int shown = 0;
+    for (const auto& p : r.check_points)
+      if (!p.uncontrolled.empty() && shown++ < 10)
+        out += StringPrintf(" %s (%.3f m)", p.point.c_str(), p.difference_m.norm());
+    out += shown > 10 ? StringPrintf(" ... %d more\n", shown - 10) : std::string("\n");
+  }
   if (!r.free_interior.empty()) out += CalibrationTable(r);
   out += RejectedLines(r);
   out += SnoopingLines(r);

@@ -25,6 +25,11 @@ struct PointDifference {
   Eigen::Vector3d adjusted_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d difference_m = Eigen::Vector3d::Zero();
   int rays = 0;
+  /// Check points after snooping: non-empty when the point's estimate rests on a ray component
+  /// no test can judge (r < min_redundancy; r ~ 0 along the base of a two-ray point), with why.
+  /// A blunder there moves the point unseen, so its difference measures the blunder as much as
+  /// the block: such points are listed apart from AdjustmentResult::check_controlled.
+  std::string uncontrolled;
 };
 
 struct PointStatistics {
@@ -88,6 +93,19 @@ struct FlaggedObservation {
   int group_size = 1;
 };
 
+/// An image observation no test can judge (data_snooping.h): a component with a redundancy
+/// number below min_redundancy. With r ~ 0 (untestable: along the base of a two-ray point, or
+/// a component no other ray checks) a blunder moves only its point and no test can see it; a
+/// weakly controlled one is found only above its MDB.
+struct UncontrolledObservation {
+  std::string image, point;
+  Eigen::Vector2d redundancy = Eigen::Vector2d::Zero();  // r per component (photo x, y)
+  Eigen::Vector2d mdb_px = Eigen::Vector2d::Zero();      // +inf (JSON null) where r ~ 0
+  int rays = 0;             // active rays of its point
+  bool untestable = false;  // a component with r ~ 0
+  std::string reason;
+};
+
 /// How data snooping was run and what it could not decide (data_snooping.h).
 struct SnoopingSummary {
   bool run = false;
@@ -108,6 +126,8 @@ struct SnoopingSummary {
   std::string suggestion;  // e.g. self-calibration
   std::vector<std::string> findings;
   std::vector<FlaggedObservation> flagged;
+  /// Every active observation no test can judge, one by one (the counts above summarise them).
+  std::vector<UncontrolledObservation> uncontrolled;
   double seconds_testing = 0;
   // Robust start: why it ran (forced or by the residuals), what it excluded and re-admitted.
   bool robust_start = false;
@@ -170,6 +190,9 @@ struct AdjustmentResult {
   std::vector<ExposureEstimate> exposures;
   std::vector<PointDifference> control_points, check_points;
   PointStatistics control, check;
+  /// After snooping: the check statistics over the check points whose rays are all controlled
+  /// (PointDifference::uncontrolled empty). `check` stays the statistics of every check point.
+  std::optional<PointStatistics> check_controlled;
   std::vector<RejectedObservation> rejected;
   std::vector<ObservationResidual> residuals;  // every image observation of the adjustment
   Determinability determinability;
@@ -191,6 +214,11 @@ struct AdjustmentResult {
   /// Marks the result invalid with a reason (kept once).
   void Invalidate(const std::string& reason);
 };
+
+/// After snooping (result->snooping.run): lists every used observation with a component r <
+/// min_redundancy in snooping.uncontrolled with the reason, marks the check points resting on
+/// such a ray (PointDifference::uncontrolled) and sets check_controlled over the others.
+void ClassifyUncontrolled(double min_redundancy, AdjustmentResult* result);
 
 /// JSON of FORMATS.md (kind "adjust"); angles in degrees, coordinates in the object frame.
 /// Version of the result documents written by AdjustmentToJson (and the writers built on it):

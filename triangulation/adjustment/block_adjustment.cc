@@ -720,6 +720,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   }
   result.control = ComputePointStatistics(result.control_points);
   result.check = ComputePointStatistics(result.check_points);
+  if (result.snooping.run) ClassifyUncontrolled(options_.min_redundancy, &result);
   for (const auto& d : result.solve.diagnostics) result.notes.push_back(d);
   // Honest outcome: what makes this run untrustworthy, by name.
   if (!result.solve.converged)
