@@ -348,6 +348,32 @@ class TolerantInput(unittest.TestCase):
         self.assertEqual(text.count("residual group stitch_tie: RMS 14.1 sigma"), 2)  # summary and section
         self.assertIn("Mapping model: translation (given by the user).", text)
 
+    def test_what_snooping_cannot_judge_is_listed(self):
+        # Check points resting on rays with r = 0 apart from the controlled check RMSE (the check
+        # RMSE of every point kept), and each observation no test can judge with r, MDB and why.
+        doc = {"kind": "flight",
+               "adjustments": [{"name": "self_calibration", "sigma0": 1.0, "converged": True,
+                                "check": {"n": 2, "rmse_m": [0.3, 0.4, 1.2], "spatial_rmse_m": 1.3,
+                                          "planimetric_rmse_m": 0.5},
+                                "check_controlled": {"n": 1, "rmse_m": [0.1, 0.1, 0.2], "spatial_rmse_m": 0.2449,
+                                                     "planimetric_rmse_m": 0.1414,
+                                                     "uncontrolled_points": [{"point": "K10", "rays": 2,
+                                                                              "difference_m": [0.0, 3.0, 4.0],
+                                                                              "reason": "ray 0011: r = 0 on photo x"}]},
+                                "snooping": {"uncontrolled": [{"image": "0011", "point": "K10", "rays": 2,
+                                                               "r": [0.0, 0.48], "mdb_px": [None, 2.1],
+                                                               "untestable": True,
+                                                               "reason": "r = 0 on photo x: the component along "
+                                                                         "the base of a two-ray point"}]}}]}
+        text, page = self.render(doc)
+        self.assertEqual(page.row("adj-self-calibration-points", "check")[6], "1.3000")
+        self.assertEqual(page.row("adj-self-calibration-points", "check, controlled rays only")[1:2], ["1"])
+        self.assertEqual(page.row("adj-self-calibration-uncontrolled-checks", "K10")[2], "5.0000")
+        row = page.row("adj-self-calibration-uncontrolled", "0011")
+        self.assertEqual(row[3:5], ["0.00, 0.48", "n/a, 2.1"])
+        self.assertIn("two-ray point", row[5])
+        self.assertIn("1 with r = 0", text)
+
 
 if __name__ == "__main__":
     unittest.main()

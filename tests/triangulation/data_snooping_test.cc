@@ -12,6 +12,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <memory>
 
 namespace aerocal::triangulation {
@@ -113,6 +114,57 @@ TEST_F(SnoopingOnTheSimulatedFlight, EveryTestedObservationListsRWMdbAndGroupSiz
   EXPECT_NEAR(clean_->snooping.delta0_joint,
               calib::NonCentralityJoint(clean_->snooping.critical_value, 0.8), 1e-12);
   EXPECT_GT(joint_mdbs, tested) << "most image observations are tested jointly in x and y";
+}
+
+TEST_F(SnoopingOnTheSimulatedFlight, ObservationsNoTestCanJudgeAreListedWithTheirReason) {
+  // Each used observation with a component r < min_redundancy is listed once, with its r, MDB
+  // and why; a two-ray point has one ray equation more than its three unknowns need in y only,
+  // so the along-base component of both rays has r = 0: every two-ray check point is listed
+  // apart from the controlled check statistics, which are those of the other check points.
+  const SnoopingSummary& s = clean_->snooping;
+  int weak = 0;
+  std::map<std::string, int> rays;
+  for (const auto& v : clean_->residuals) rays[v.point] += v.used;
+  for (const auto& v : clean_->residuals) weak += v.used && v.test.redundancy.minCoeff() < s.min_redundancy;
+  ASSERT_EQ(static_cast<int>(s.uncontrolled.size()), weak);
+  ASSERT_GT(weak, 0);
+  int two_ray = 0;
+  for (const auto& u : s.uncontrolled) {
+    EXPECT_LT(u.redundancy.minCoeff(), s.min_redundancy) << u.image << " " << u.point;
+    EXPECT_EQ(u.rays, rays[u.point]);
+    EXPECT_EQ(u.untestable, u.redundancy.minCoeff() < 1e-6);
+    if (u.untestable && u.rays == 2) {
+      ++two_ray;
+      EXPECT_NE(u.reason.find("two-ray point"), std::string::npos) << u.reason;
+    }
+    if (!u.untestable) EXPECT_NE(u.reason.find("weakly controlled"), std::string::npos) << u.reason;
+  }
+  EXPECT_GT(two_ray, 0);
+  ASSERT_TRUE(clean_->check_controlled.has_value());
+  std::vector<PointDifference> controlled;
+  int two_ray_checks = 0;
+  for (const auto& d : clean_->check_points) {
+    if (d.rays == 2) {
+      ++two_ray_checks;
+      EXPECT_FALSE(d.uncontrolled.empty()) << d.point << " has two rays: r = 0 along the base";
+    }
+    if (d.uncontrolled.empty()) controlled.push_back(d);
+  }
+  EXPECT_GT(two_ray_checks, 0);
+  EXPECT_EQ(clean_->check_controlled->n, static_cast<int>(controlled.size()));
+  EXPECT_LT(clean_->check_controlled->n, clean_->check.n);
+  EXPECT_NEAR(clean_->check_controlled->spatial_rmse_m, ComputePointStatistics(controlled).spatial_rmse_m, 1e-12);
+  // Listed in the JSON and the terminal summary, beside the unchanged check statistics.
+  const nlohmann::json j = AdjustmentToJson(*clean_);
+  EXPECT_EQ(j["snooping"]["uncontrolled"].size(), s.uncontrolled.size());
+  EXPECT_TRUE(j["snooping"]["uncontrolled"][0]["r"].is_array());
+  EXPECT_EQ(j["check_controlled"]["n"].get<int>(), clean_->check_controlled->n);
+  EXPECT_EQ(j["check_controlled"]["uncontrolled_points"].size(),
+            static_cast<size_t>(clean_->check.n - clean_->check_controlled->n));
+  EXPECT_DOUBLE_EQ(j["check"]["spatial_rmse_m"].get<double>(), clean_->check.spatial_rmse_m);
+  const std::string summary = FormatSummary(*clean_);
+  EXPECT_NE(summary.find("uncontrolled: " + std::to_string(weak) + " observation(s)"), std::string::npos);
+  EXPECT_NE(summary.find("check*"), std::string::npos);
 }
 
 TEST_F(SnoopingOnTheSimulatedFlight, PlantedTwentySigmaBlunderOnAPinnedObservationIsFound) {

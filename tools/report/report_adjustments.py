@@ -9,12 +9,14 @@ AXES = "XYZ"
 
 def _points_table(a, table_id):
     rows = []
-    for which in ("control", "check"):
+    for which in ("control", "check", "check_controlled"):
         s = rd.point_statistics(a, which)
         if s is None:
-            rows.append([text(which)] + [text("n/a")] * 12)
+            if which != "check_controlled":  # only after data snooping
+                rows.append([text(which)] + [text("n/a")] * 12)
             continue
-        rows.append([text(which), num(s["n"], "d")] + [num(v) for v in s["rmse"]] +
+        label = "check, controlled rays only" if which == "check_controlled" else which
+        rows.append([text(label), num(s["n"], "d")] + [num(v) for v in s["rmse"]] +
                     [num(s["plan"]), num(s["spatial"])] + [num(v) for v in s["mean"]] + [num(v) for v in s["max"]])
     headers = (["points", "n"] + [f"RMSE {x} [m]" for x in AXES] + ["RMSE planimetric [m]", "RMSE spatial [m]"] +
                [f"mean {x} [m]" for x in AXES] + [f"max |{x}| [m]" for x in AXES])
@@ -71,6 +73,45 @@ def _joint_extras(a, aid):
     return "".join(out)
 
 
+def _pair(value, spec):
+    values = rd.listing(value)
+    return ", ".join(fmt(rd.number(v), spec) for v in values) if values else "n/a"
+
+
+def _uncontrolled(a, aid):
+    """What data snooping cannot judge: check points resting on such rays, and the observations."""
+    out = []
+    controlled = a.get("check_controlled")
+    points = [p for p in rd.listing(controlled.get("uncontrolled_points"))
+              if isinstance(p, dict)] if isinstance(controlled, dict) else []
+    if points:
+        out.append(table(f"{aid}-uncontrolled-checks", "Check points resting on rays no test can judge (left out of "
+                         "the controlled check RMSE, kept in the check RMSE)",
+                         ["point", "rays", "|difference| [m]", "why"],
+                         [[text(p.get("point", "")), num(rd.number(p.get("rays")), ".0f"),
+                           num(_norm(p.get("difference_m"))), text(p.get("reason", ""))] for p in points],
+                         ["flagged"] * len(points)))
+    snooping = a.get("snooping") if isinstance(a.get("snooping"), dict) else {}
+    obs = [u for u in rd.listing(snooping.get("uncontrolled")) if isinstance(u, dict)]
+    if obs:
+        untestable = sum(1 for u in obs if u.get("untestable"))
+        out.append(f"<details><summary>Observations no test can judge: {len(obs)} ({untestable} with r = 0, "
+                   f"where a blunder is invisible)</summary>")
+        out.append(table(f"{aid}-uncontrolled", "Observations with a redundancy number below the limit (a blunder "
+                         "there is not found, or only above its MDB)",
+                         ["image", "point", "rays", "r (x, y)", "MDB (x, y) [px]", "why"],
+                         [[text(u.get("image", "")), text(u.get("point", "")), num(rd.number(u.get("rays")), ".0f"),
+                           text(_pair(u.get("r"), ".2f")), text(_pair(u.get("mdb_px"), ".3g")),
+                           text(u.get("reason", ""))] for u in obs]))
+        out.append("</details>")
+    return "".join(out)
+
+
+def _norm(values):
+    values = [rd.number(v) for v in rd.listing(values)]
+    return None if not values or None in values else sum(v * v for v in values) ** 0.5
+
+
 def adjustment(a, number):
     aid = "adj-" + anchor(a["name"])
     out = [f'<h3 id="{aid}">3.{number} {esc(rd.title(a))}</h3>']
@@ -96,6 +137,7 @@ def adjustment(a, number):
                           for r in rejected]))
     elif "rejected" in a:
         out.append(note("No observation rejected as a gross error."))
+    out.append(_uncontrolled(a, aid))
     for w in rd.listing(a.get("warnings")):
         message = w.get("message") if isinstance(w, dict) else w
         out.append(f'<p class="na"><span class="bad">warning</span>: {esc(message)}</p>')
