@@ -137,7 +137,9 @@ TEST_F(SnoopingOnTheSimulatedFlight, ObservationsNoTestCanJudgeAreListedWithThei
       ++two_ray;
       EXPECT_NE(u.reason.find("two-ray point"), std::string::npos) << u.reason;
     }
-    if (!u.untestable) EXPECT_NE(u.reason.find("weakly controlled"), std::string::npos) << u.reason;
+    if (!u.untestable) {
+      EXPECT_NE(u.reason.find("weakly controlled"), std::string::npos) << u.reason;
+    }
   }
   EXPECT_GT(two_ray, 0);
   ASSERT_TRUE(clean_->check_controlled.has_value());
