@@ -109,7 +109,8 @@ std::string DescribeConversion(const calib::ConversionResult& r) {
 }
 
 calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib::Camera& camera,
-                                            const std::string& format_name) {
+                                            const std::string& format_name,
+                                            const calib::InteriorParams* posterior_sigma) {
   const CameraFormat& format = FindCameraFormat(format_name, "--camera-format");
   if (format.name == "aerocal") {
     calib::WriteCamera(path, camera);
@@ -118,6 +119,10 @@ calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib
     return same;
   }
   CameraFile source = calib::CameraFileFromCamera(camera);
+  if (posterior_sigma) {
+    const Eigen::Map<const Eigen::VectorXd> sigma(posterior_sigma->data(), posterior_sigma->size());
+    source.covariance = Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal());
+  }
   const bool holds_covariance = format.name == "metashape" || format.name == "australis";
   if (source.covariance && !holds_covariance) {
     source.covariance.reset();

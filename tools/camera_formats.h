@@ -35,11 +35,13 @@ std::string DescribeConversion(const calib::ConversionResult& result);
 /// format named `format_name` (CameraFormats()). `aerocal` writes our YAML exactly as before
 /// (sub-images and reference points included); any other format converts our camera into the
 /// format's model first (exact where equivalent, else a least-squares fit over the format, said
-/// with its residual on stdout), carrying the interior sigmas where the format holds a covariance
-/// (metashape, australis) and saying so where it drops them. Returns the conversion (exact, with
-/// a zero residual, for `aerocal`).
+/// with its residual on stdout), carrying sigmas where the format holds a covariance (metashape,
+/// australis) and saying so where it drops them: `posterior_sigma` (the adjustment's standard
+/// deviations, table order and units, 0 = fixed) when given, else the camera's interior_sigma.
+/// Returns the conversion (exact, with a zero residual, for `aerocal`).
 calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib::Camera& camera,
-                                            const std::string& format_name);
+                                            const std::string& format_name,
+                                            const calib::InteriorParams* posterior_sigma = nullptr);
 
 /// OpenCV's calibration file as cv::FileStorage reads and writes it (YAML, XML or JSON by the
 /// extension): camera_matrix 3x3, distortion_coefficients (k1 k2 p1 p2 [k3 [k4 k5 k6]]),
