@@ -31,14 +31,10 @@ int Runs(int issue_count) {
 }
 
 CalibrationRun CalibrateField(const SimulatedTestField& f) {
-  Project p;
-  p.cameras["cam1"] = f.nominal;
-  p.points = f.points_file;
-  p.observations = f.observations;
-  CalibrateOptions o;
+  CalibrateOptions o;  // as tests/triangulation/test_field_test.cc
   o.adjust.free_interior = ParseSelfCalibration("c,x0,y0,K1,K2,P1,P2");
   o.adjust.data_snooping = false;
-  return Calibrate(p, o, f.group_of_image);
+  return Calibrate(TestFieldProject(f), o, f.group_of_image);
 }
 
 const StabilityRow* Row(const CalibrationRun& run, const std::string& name) {

@@ -16,19 +16,11 @@ namespace {
 
 using Model = calib::BrownFraser10Model;
 
-Project AsProject(const SimulatedTestField& f) {
-  Project p;
-  p.cameras["cam1"] = f.nominal;
-  p.points = f.points_file;
-  p.observations = f.observations;
-  return p;
-}
-
-CalibrateOptions Options() {
-  CalibrateOptions o;
+CalibrationRun CalibrateField(const SimulatedTestField& f, bool groups = true) {
+  CalibrateOptions o;  // the distortion terms the truth has (K3, B1, B2 are 0 there)
   o.adjust.free_interior = ParseSelfCalibration("c,x0,y0,K1,K2,P1,P2");
   o.adjust.data_snooping = false;
-  return o;
+  return Calibrate(TestFieldProject(f), o, groups ? f.group_of_image : std::map<std::string, std::string>{});
 }
 
 TEST(TestFieldSimulator, ThreeGroupsOf24CalibrateToTheTruthAndAgree) {
@@ -37,7 +29,7 @@ TEST(TestFieldSimulator, ThreeGroupsOf24CalibrateToTheTruthAndAgree) {
   const SimulatedTestField f = SimulateTestField(o);
   EXPECT_EQ(f.exposures_truth.size(), 72u);
   EXPECT_EQ(f.group_of_image.size(), 72u);
-  const CalibrationRun run = Calibrate(AsProject(f), Options(), f.group_of_image);
+  const CalibrationRun run = CalibrateField(f);
   const AdjustmentResult& r = run.all.result;
   ASSERT_TRUE(r.valid) << (r.invalid_reasons.empty() ? "" : r.invalid_reasons[0]);
   EXPECT_EQ(run.starts.size(), 72u);  // every image started by resection
@@ -64,7 +56,7 @@ TEST(TestFieldSimulator, OneGroupsCameraChangedByTenSigmaIsFlagged) {
   o.changed_group = 1;
   o.group_camera_change[Model::kC] = 0.02;
   const SimulatedTestField f = SimulateTestField(o);
-  const CalibrationRun run = Calibrate(AsProject(f), Options(), f.group_of_image);
+  const CalibrationRun run = CalibrateField(f);
   EXPECT_FALSE(run.stability.agree);
   ASSERT_FALSE(run.stability.flagged.empty());
   EXPECT_NE(run.stability.flagged[0].find("c:"), std::string::npos) << run.stability.flagged[0];
@@ -78,7 +70,7 @@ TEST(TestFieldSimulator, PlanarFieldStartsFromZhangsClosedForm) {
   o.images_per_group = 16;
   const SimulatedTestField f = SimulateTestField(o);
   for (const auto& p : f.points_truth) ASSERT_EQ(p.xyz_m->y(), 0.0);
-  const CalibrationRun run = Calibrate(AsProject(f), Options(), {});
+  const CalibrationRun run = CalibrateField(f, false);
   ASSERT_TRUE(run.closed_form_c_mm);
   // Zhang's c from the homographies (distortion of up to 12 px left in): within 1 % of the truth.
   EXPECT_NEAR(*run.closed_form_c_mm / f.truth.interior[Model::kC], 1.0, 0.01);

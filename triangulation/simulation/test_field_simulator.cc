@@ -147,6 +147,14 @@ SimulatedTestField SimulateTestField(const TestFieldOptions& o) {
   return f;
 }
 
+Project TestFieldProject(const SimulatedTestField& f) {
+  Project p;
+  p.cameras["cam1"] = f.nominal;
+  p.points = f.points_file;
+  p.observations = f.observations;
+  return p;
+}
+
 void WriteSimulatedTestField(const SimulatedTestField& f, const std::string& folder) {
   const auto path = [&](const std::string& name) { return folder + "/" + name; };
   calib::WriteCamera(path("camera_nominal.yaml"), f.nominal);

@@ -51,6 +51,10 @@ struct SimulatedTestField {
 
 SimulatedTestField SimulateTestField(const TestFieldOptions& options);
 
+/// The field's files as a project for `Calibrate`: the nominal camera (id cam1), the points with
+/// their survey noise, the observations; no exposures (calibrate starts from resections).
+Project TestFieldProject(const SimulatedTestField& field);
+
 /// Writes camera_nominal.yaml, camera_truth.yaml, observations.csv, points.csv, groups.csv and
 /// truth/exposures.csv, truth/points.csv into `folder` (atomically each).
 void WriteSimulatedTestField(const SimulatedTestField& field, const std::string& folder);
