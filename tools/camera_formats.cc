@@ -1,9 +1,11 @@
 #include "tools/camera_formats.h"
 
+#include <cstdio>
 #include <filesystem>
 
 #include <opencv2/core.hpp>
 
+#include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 
@@ -65,6 +67,14 @@ const std::vector<CameraFormat>& CameraFormats() {
        [](const ModelCamera&) {
          return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
        }},
+      {"photomodeler", "PhotoModeler Bundle Soln export's camera (f, pp, format, K1-K3, P1, P2 mm)",
+       calib::ReadPhotoModelerCamera, calib::WritePhotoModelerCamera,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
+       }},
+      {"australis", "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
+       calib::ReadAustralisCamera, calib::WriteAustralisCamera,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kBrownFraser10, {}, true}; }},
       {"kalibr", "Kalibr camchain YAML (pinhole radtan / equidistant)", calib::ReadKalibrCamchain,
        calib::WriteKalibrCamchain,
        [](const ModelCamera& s) {
@@ -86,6 +96,47 @@ const CameraFormat& FindCameraFormat(const std::string& name, const std::string&
     if (f.name == name) return f;
   throw ConfigError(option + ": unknown camera format '" + name + "' (expected " +
                     CameraFormatNames() + ")");
+}
+
+std::string DescribeConversion(const calib::ConversionResult& r) {
+  char buffer[256];
+  std::snprintf(buffer, sizeof(buffer),
+                "residual over the format: rms %.3g px, max %.3g px at pixel (%.0f, %.0f), max "
+                "within 80 %% of the half-diagonal %.3g px",
+                r.residual.rms_px, r.residual.max_px, r.residual.max_at_px.x(),
+                r.residual.max_at_px.y(), r.residual.max_inner80_px);
+  return buffer;
+}
+
+calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib::Camera& camera,
+                                            const std::string& format_name,
+                                            const calib::InteriorParams* posterior_sigma) {
+  const CameraFormat& format = FindCameraFormat(format_name, "--camera-format");
+  if (format.name == "aerocal") {
+    calib::WriteCamera(path, camera);
+    calib::ConversionResult same;
+    same.exact = same.acceptable = true;
+    return same;
+  }
+  CameraFile source = calib::CameraFileFromCamera(camera);
+  if (posterior_sigma) {
+    const Eigen::Map<const Eigen::VectorXd> sigma(posterior_sigma->data(), posterior_sigma->size());
+    source.covariance = Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal());
+  }
+  const bool holds_covariance = format.name == "metashape" || format.name == "australis";
+  if (source.covariance && !holds_covariance) {
+    source.covariance.reset();
+    std::printf("note: interior sigmas not written: %s holds no covariance\n", format.name.c_str());
+  }
+  const calib::FileConversion conversion =
+      calib::ConvertCameraFile(source, format.target(source.camera));
+  format.write(path, conversion.file);
+  const calib::ConversionResult& r = conversion.result;
+  std::printf("camera as %s (%s): %s; %s\n", format.name.c_str(),
+              std::string(calib::CameraModelName(r.camera.model)).c_str(),
+              r.exact ? "exact (closed form)" : "least-squares fit over the format",
+              DescribeConversion(r).c_str());
+  return r;
 }
 
 CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOptions& options) {

@@ -1,5 +1,5 @@
 // The camera-file formats of `aerocal camera` and `--camera-format` by their command-line names:
-// aerocal, opencv, colmap, metashape, pix4d, opensfm, dji, dbat, kalibr. Each entry is a reader,
+// aerocal, opencv, colmap, metashape, pix4d, opensfm, dji, dbat, photomodeler, australis, kalibr. Each entry is a reader,
 // a writer and the registry model it writes (calib/camera/formats/camera_formats.h has the
 // formats and their conventions; opencv, via cv::FileStorage, lives here because OpenCV stays out
 // of calib).
@@ -27,6 +27,21 @@ const std::vector<CameraFormat>& CameraFormats();
 /// ConfigError naming `option` and the format names when unknown.
 const CameraFormat& FindCameraFormat(const std::string& name, const std::string& option);
 std::string CameraFormatNames();
+
+/// One line on how exactly a conversion holds: residual RMS, max and where, max within 80 %.
+std::string DescribeConversion(const calib::ConversionResult& result);
+
+/// `--camera-format` of adjust, calibrate and flight: writes our adjusted camera to `path` in the
+/// format named `format_name` (CameraFormats()). `aerocal` writes our YAML exactly as before
+/// (sub-images and reference points included); any other format converts our camera into the
+/// format's model first (exact where equivalent, else a least-squares fit over the format, said
+/// with its residual on stdout), carrying sigmas where the format holds a covariance (metashape,
+/// australis) and saying so where it drops them: `posterior_sigma` (the adjustment's standard
+/// deviations, table order and units, 0 = fixed) when given, else the camera's interior_sigma.
+/// Returns the conversion (exact, with a zero residual, for `aerocal`).
+calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib::Camera& camera,
+                                            const std::string& format_name,
+                                            const calib::InteriorParams* posterior_sigma = nullptr);
 
 /// OpenCV's calibration file as cv::FileStorage reads and writes it (YAML, XML or JSON by the
 /// extension): camera_matrix 3x3, distortion_coefficients (k1 k2 p1 p2 [k3 [k4 k5 k6]]),

@@ -5,6 +5,7 @@
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "tools/adjust_joint.h"
+#include "tools/camera_formats.h"
 #include "tools/command_registry.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/conventional_reference.h"
@@ -21,7 +22,7 @@ using triangulation::AdjustmentResult;
 
 CommandRun SetupAdjust(CLI::App& app) {
   struct Args {
-    std::string project, out, write_camera, self_calibration = "none";
+    std::string project, out, write_camera, self_calibration = "none", camera_format = "aerocal";
     bool compare = false, no_snooping = false, no_eo_priors = false, no_interior_sigma = false;
     bool no_robust_start = false;
     double default_sigma_px = 0.5;
@@ -44,6 +45,8 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option("--write-camera",
                  args->write_camera,
                  "Write the estimated camera file (camera-file YAML) for the next run");
+  app.add_option("--camera-format", args->camera_format,
+                 "Format of --write-camera: " + CameraFormatNames() + " (converted, with its residual)");
   app.add_option("--sigma-px",
                  args->default_sigma_px,
                  "Image sigma where observations.csv has no sigma_px, px")
@@ -99,6 +102,9 @@ CommandRun SetupAdjust(CLI::App& app) {
     options.Validate();
     CheckOutputFile(args->out, "--out");
     if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
+    FindCameraFormat(args->camera_format, "--camera-format");
+    if (args->joint.Requested() && args->camera_format != "aerocal")
+      throw ConfigError("--camera-format: the joint adjustment writes our camera file only (aerocal)");
     if (args->joint.Requested()) {
       if (args->compare)
         throw ConfigError("--compare and --joint-stitching do not combine (`aerocal flight` runs and compares both)");
@@ -165,8 +171,8 @@ CommandRun SetupAdjust(CLI::App& app) {
         for (const auto& estimate : main.cameras) {
           const std::string path =
               CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);
-          calib::WriteCamera(path,
-                             triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate));
+          WriteCameraInFormat(path, triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate),
+                              args->camera_format, &estimate.sigma);
           std::printf("camera %s -> %s\n", estimate.id.c_str(), path.c_str());
         }
       }

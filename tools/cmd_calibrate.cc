@@ -7,6 +7,7 @@
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 #include "tools/board_detection.h"
+#include "tools/camera_formats.h"
 #include "tools/command_registry.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/calibration/calibration.h"
@@ -35,6 +36,23 @@ std::map<std::string, std::string> ReadGroups(const std::string& path) {
       throw InputError(table.Where(row).ToString() + ": image and group must not be empty");
     if (!out.emplace(image, group).second)
       throw InputError(table.Where(row).ToString() + ": image " + image + " listed twice");
+  }
+  return out;
+}
+
+// The optional `group` column of observations.csv: image -> group (rows with an empty group put
+// nothing); an image given two different groups is an error at the second one's line.
+std::map<std::string, std::string> GroupsFromObservations(const std::string& path) {
+  const CsvTable table = CsvTable::Read(path);
+  std::map<std::string, std::string> out;
+  if (!table.HasColumn("group")) return out;
+  for (const auto& row : table.rows()) {
+    const std::string image = table.String(row, "image"), group = table.String(row, "group");
+    if (group.empty()) continue;
+    const auto [at, added] = out.emplace(image, group);
+    if (!added && at->second != group)
+      throw InputError(table.Where(row).ToString() + ": image " + image + " is in group " +
+                       at->second + " above, here in " + group);
   }
   return out;
 }
@@ -108,6 +126,7 @@ nlohmann::json StabilityJson(const triangulation::StabilityReport& s) {
 CommandRun SetupCalibrate(CLI::App& app) {
   struct Args {
     std::string camera, observations, points, images, board, groups, budget, out, write_marks;
+    std::string write_camera, camera_format = "aerocal";
     std::string self_calibration = "c,x0,y0,K1,K2,K3,P1,P2";
     std::string model = "brown10";
     double sigma_px = 0.5, board_sigma_mm = kDefaultBoardSigmaMm;
@@ -135,8 +154,8 @@ CommandRun SetupCalibrate(CLI::App& app) {
                  "p2, k3, fx, fy, cx, cy) on the same marks, side by side (needs --images)")
       ->check(CLI::IsMember({"brown10", "opencv"}));
   app.add_option("--groups", args->groups,
-                 "Image groups: CSV image,group; each group is calibrated too and the stability "
-                 "over the groups tested (chi-square, 5 %)");
+                 "Image groups: CSV image,group (or a group column in observations.csv); each group "
+                 "is calibrated too and the stability over the groups tested (chi-square, 5 %)");
   app.add_option("--budget", args->budget,
                  "Uncertainty budget options (YAML: radii_mm, target_radius_mm, components)");
   app.add_option("--radii-mm", args->radii_mm,
@@ -156,6 +175,11 @@ CommandRun SetupCalibrate(CLI::App& app) {
                  "Write the detected marks as DIR/observations.csv and DIR/points.csv");
   app.add_option("--out", args->out, "Result JSON (keys of `adjust` plus `calibration`)")
       ->required();
+  app.add_option("--write-camera", args->write_camera,
+                 "Write the calibrated camera (only when the result is valid)");
+  app.add_option("--camera-format", args->camera_format,
+                 "Format of --write-camera: " + CameraFormatNames() +
+                     " (converted into the format's model where it differs, with its residual)");
   return [args]() {
     const bool field = !args->observations.empty() || !args->points.empty();
     const bool board = !args->images.empty() || !args->board.empty();
@@ -176,6 +200,8 @@ CommandRun SetupCalibrate(CLI::App& app) {
     options.adjust.Validate();
     CheckOutputFile(args->out, "--out");
     if (!args->write_marks.empty()) CheckOutputFolder(args->write_marks, "--write-marks");
+    if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
+    FindCameraFormat(args->camera_format, "--camera-format");
     triangulation::BudgetOptions budget;
     if (!args->budget.empty()) budget = triangulation::ReadBudgetOptions(args->budget);
     if (!args->radii_mm.empty()) budget.radii_mm = args->radii_mm;
@@ -237,6 +263,12 @@ CommandRun SetupCalibrate(CLI::App& app) {
     }
     std::map<std::string, std::string> groups;
     if (!args->groups.empty()) groups = ReadGroups(args->groups);
+    if (field) {
+      const auto from_column = GroupsFromObservations(args->observations);
+      if (!from_column.empty() && !args->groups.empty())
+        throw ConfigError("--groups: " + args->observations + " has a group column already (give one)");
+      if (!from_column.empty()) groups = from_column;
+    }
     if (budget.radii_mm.empty()) {
       const double half_diagonal =
           0.5 * camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
@@ -329,6 +361,23 @@ CommandRun SetupCalibrate(CLI::App& app) {
         ++n;
       }
     cal["rms_px"] = n > 0 ? std::sqrt(sum2 / n) : 0.0;  // per point, as OpenCV's RMS
+    // The calibrated camera, in the format asked for; only for a valid result (a file that exists
+    // is one the next run may use).
+    if (!args->write_camera.empty() && r.valid && !r.cameras.empty()) {
+      const calib::ConversionResult written = WriteCameraInFormat(
+          args->write_camera, triangulation::UpdatedCamera(camera, r.cameras[0]), args->camera_format,
+          &r.cameras[0].sigma);
+      cal["camera_written"] = {{"file", args->write_camera},
+                               {"format", args->camera_format},
+                               {"exact", written.exact},
+                               {"residual_px",
+                                {{"rms", written.residual.rms_px},
+                                 {"max", written.residual.max_px},
+                                 {"max_inner80", written.residual.max_inner80_px}}}};
+      std::printf("camera -> %s (%s)\n", args->write_camera.c_str(), args->camera_format.c_str());
+    } else if (!args->write_camera.empty()) {
+      std::fprintf(stderr, "camera not written: the result is not valid\n");
+    }
     json["calibration"] = cal;
     WriteFileAtomically(args->out, json.dump(2) + "\n");
     for (const auto& reason : r.invalid_reasons)

@@ -59,16 +59,6 @@ struct ConvertArgs {
   double max_residual_px = std::numeric_limits<double>::infinity();
 };
 
-std::string Describe(const calib::ConversionResult& r) {
-  char buffer[256];
-  std::snprintf(buffer, sizeof(buffer),
-                "residual over the format: rms %.3g px, max %.3g px at pixel (%.0f, %.0f), max "
-                "within 80 %% of the half-diagonal %.3g px",
-                r.residual.rms_px, r.residual.max_px, r.residual.max_at_px.x(),
-                r.residual.max_at_px.y(), r.residual.max_inner80_px);
-  return buffer;
-}
-
 int RunConvert(const ConvertArgs& a) {
   CheckOutputFile(a.out, "OUT");
   if (!a.report.empty()) CheckOutputFile(a.report, "--report");
@@ -92,9 +82,10 @@ int RunConvert(const ConvertArgs& a) {
   notes.insert(notes.end(), conversion.notes.begin(), conversion.notes.end());
   CameraFile written = conversion.file;
   if (written.covariance) {
-    if (a.to == "aerocal" && written.camera.model == calib::CameraModelId::kBrownFraser10)
-      notes.push_back("covariance written as interior_sigma (our file holds no correlations: "
-                      "dropped)");
+    if ((a.to == "aerocal" || a.to == "australis") &&
+        written.camera.model == calib::CameraModelId::kBrownFraser10)
+      notes.push_back("covariance written as standard deviations (" + a.to +
+                      " holds no correlations: dropped)");
     else if (a.to != "metashape") {
       notes.push_back("covariance dropped: " + a.to + " (" +
                       std::string(calib::CameraModelName(written.camera.model)) +
@@ -107,7 +98,7 @@ int RunConvert(const ConvertArgs& a) {
               std::string(calib::CameraModelName(source.camera.model)).c_str(), a.out.c_str(),
               a.to.c_str(), model.c_str(),
               r.exact ? "exact (closed form)" : "least-squares fit over the format");
-  std::printf("%s\n", Describe(r).c_str());
+  std::printf("%s\n", DescribeConversion(r).c_str());
   for (const auto& note : notes) std::printf("note: %s\n", note.c_str());
   nlohmann::json report = {
       {"from", a.read.from},
@@ -127,7 +118,7 @@ int RunConvert(const ConvertArgs& a) {
       {"notes", notes}};
   if (!a.report.empty()) WriteFileAtomically(a.report, report.dump(2) + "\n");
   if (!r.acceptable) {
-    LogWarning("conversion_residual: " + Describe(r) + (r.residual.failed_points ? " (" +
+    LogWarning("conversion_residual: " + DescribeConversion(r) + (r.residual.failed_points ? " (" +
                std::to_string(r.residual.failed_points) + " points not invertible)" : "") +
                " exceeds --max-residual-px " + FormatNumber(a.max_residual_px) + "; " + a.out +
                " not written");

@@ -8,10 +8,13 @@
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/command_registry.h"
+#include "triangulation/calibration/uncertainty_budget.h"
 
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <limits>
+#include <map>
 #include <cstdlib>
 #include <filesystem>
 
@@ -124,13 +127,100 @@ nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous
   return {{"rows", rows}, {"pass", all_pass}};
 }
 
+// An in-flight calibration (`aerocal flight` result.json) in the form of a `calibrate` result: the
+// adjustment whose camera the flight certifies (the joint one when it ran, else the
+// self-calibration), and an uncertainty budget of type A only: the adjustment's standard deviation
+// of each calibrated parameter (dof = the redundancy, k from it). Type B components (control
+// survey, target eccentricity, conditions) and group reproducibility need a test field and image
+// groups: not evaluated here, said in the method.
+nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::string& path) {
+  const nlohmann::json* chosen = nullptr;
+  if (flight.contains("adjustments") && flight["adjustments"].is_array())
+    for (const auto& a : flight["adjustments"])  // a reference into `flight`, kept below
+      if (a.value("name", "") == "self_calibration" || a.value("name", "") == "joint") chosen = &a;
+  if (!chosen || !chosen->contains("cameras") || (*chosen)["cameras"].empty())
+    throw InputError(path + ": a flight result without a self-calibrating adjustment (--result)");
+  nlohmann::json out = *chosen;
+  out["command"] = "calibrate";
+  out["valid"] = flight.value("valid", false);
+  out["invalid_reasons"] = nlohmann::json::array();
+  for (const auto& f : flight.value("failures", nlohmann::json::array()))
+    out["invalid_reasons"].push_back(f.value("step", "") + ": " + f.value("reason", ""));
+  out["warnings"] = flight.value("warnings", nlohmann::json::array());
+  const nlohmann::json& camera = out["cameras"][0];
+  const double redundancy = out.value("redundancy", 0.0);
+  nlohmann::json budget = nlohmann::json::array();
+  static const std::map<std::string, std::pair<const char*, const char*>> kQuantities = {
+      {"c", {"mm", "principal distance"}}, {"x0", {"mm", "principal point x"}},
+      {"y0", {"mm", "principal point y"}}};
+  std::vector<triangulation::BudgetQuantity> quantities;
+  for (const auto& [name, info] : kQuantities) {
+    const auto& sigma = camera["sigma"][name];
+    if (!sigma.is_number() || !(sigma.get<double>() > 0)) continue;  // fixed or unknown
+    triangulation::BudgetQuantity q;
+    q.name = name;
+    q.unit = info.first;
+    q.description = info.second;
+    q.value = camera["estimated"][name].get<double>();
+    triangulation::UncertaintyComponent a;
+    a.source = "adjustment covariance (in-flight self-calibration)";
+    a.type = "A";
+    a.distribution = "normal";
+    a.value = a.u = sigma.get<double>();
+    a.value_unit = q.unit;
+    a.dof = redundancy > 0 ? redundancy : std::numeric_limits<double>::infinity();
+    q.components.push_back(a);
+    q.u_c = a.u;
+    q.dof_eff = a.dof;
+    q.k = triangulation::CoverageFactor(q.dof_eff);
+    q.expanded = q.k * q.u_c;
+    q.statement = triangulation::CertificateStatement(q.name, q.value, q.expanded, q.k, q.unit);
+    quantities.push_back(q);
+  }
+  double sum2 = 0;
+  int n = 0;
+  for (const auto& r : out.value("residuals", nlohmann::json::array()))
+    if (r.value("used", true) && r.contains("v_col_px")) {
+      sum2 += std::pow(r["v_col_px"].get<double>(), 2) + std::pow(r["v_row_px"].get<double>(), 2);
+      ++n;
+    }
+  const nlohmann::json format = flight.value("camera_format", nlohmann::json::object());
+  out["calibration"] = {
+      {"method",
+       {{"kind", "in-flight calibration"},
+        {"adjustment", chosen->value("name", "")},
+        {"flight_data", flight.value("data", "")},
+        {"budget", "type A only (the adjustment's covariance); type B and group reproducibility "
+                   "are not evaluated for an in-flight calibration"}}},
+      {"camera",
+       {{"id", camera.value("id", "")},
+        {"file", flight.value("camera", "")},
+        {"pixel_size_mm", format.value("pixel_size_mm", 0.0)},
+        {"format_px", {format.value("width_px", 0), format.value("height_px", 0)}}}},
+      {"data",
+       {{"images", out.value("exposures", nlohmann::json::array()).size()},
+        {"observations", n},
+        {"control_points", out["control"].value("n", 0)},
+        {"check_points", out["check"].value("n", 0)},
+        {"groups", 0}}},
+      {"uncertainty", triangulation::BudgetToJson(quantities)},
+      {"groups", nlohmann::json::array()},
+      {"stability", nlohmann::json::object()},
+      {"radii_mm", nlohmann::json::array()},
+      {"rms_px", n > 0 ? std::sqrt(sum2 / n) : 0.0}};
+  return out;
+}
+
 CommandRun SetupCertificate(CLI::App& app) {
   struct Args {
     std::string result, lab, previous, tolerances, out;
     bool no_render = false;
   };
   auto args = std::make_shared<Args>();
-  app.add_option("--result", args->result, "Result JSON of `aerocal calibrate`")->required();
+  app.add_option("--result", args->result,
+                 "Result JSON of `aerocal calibrate`, or an `aerocal flight` result.json (in-flight "
+                 "calibration: type A budget)")
+      ->required();
   app.add_option("--lab", args->lab,
                  "Lab YAML the user fills: lab, certificate (number, date), camera (make, model, "
                  "serial, lens), customer, conditions, signatures");
@@ -144,7 +234,9 @@ CommandRun SetupCertificate(CLI::App& app) {
     CheckOutputFolder(args->out, "--out");
     if (!args->tolerances.empty() && args->previous.empty())
       throw ConfigError("--tolerances needs --previous");
-    const nlohmann::json result = ReadJsonFile(args->result, "--result");
+    nlohmann::json result = ReadJsonFile(args->result, "--result");
+    if (result.is_object() && result.value("kind", "") == "flight")
+      result = CalibrateFormOfFlight(result, args->result);
     if (!result.is_object() || result.value("command", "") != "calibrate" ||
         !result.contains("calibration"))
       throw InputError(args->result + ": not a result of `aerocal calibrate` (--result)");

@@ -9,6 +9,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
+#include "tools/camera_formats.h"
 #include "tools/command_registry.h"
 #include "triangulation/joint/joint_adjustment.h"
 #include "triangulation/workflow/flight_workflow.h"
@@ -25,7 +26,7 @@ std::string ShellQuote(const std::string& s) {
 CommandRun SetupFlight(CLI::App& app) {
   struct Args {
     triangulation::FlightWorkflowOptions options;
-    std::string out, base, report_script, joint_model = "auto";
+    std::string out, base, report_script, joint_model = "auto", camera_format;
     bool no_report = false;
   };
   auto args = std::make_shared<Args>();
@@ -44,8 +45,12 @@ CommandRun SetupFlight(CLI::App& app) {
                  "(the model the flight's stitching F test chose)")
       ->capture_default_str();
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
+  app.add_option("--camera-format", args->camera_format,
+                 "Also write the calibrated camera as camera_calibrated.FORMAT in another tool's format (" +
+                     CameraFormatNames() + "), converted with its residual printed");
   return [args]() {
     CheckOutputFolder(args->out, "--out");
+    if (!args->camera_format.empty()) FindCameraFormat(args->camera_format, "--camera-format");
     args->options.base_ids = SplitCommaList(args->base);
     args->options.joint_model = triangulation::ParseJointModel(args->joint_model);
     Progress progress("flight", 5);
@@ -59,11 +64,15 @@ CommandRun SetupFlight(CLI::App& app) {
     // A calibrated camera is written only for a valid flight: a file that exists is one the next
     // flight may use (an old one in the folder is removed, so it cannot pass for this run's).
     const fs::path camera_path = fs::path(args->out) / "camera_calibrated.yaml";
+    const fs::path format_path = fs::path(args->out) / ("camera_calibrated." + args->camera_format);
     if (result.valid) {
       calib::WriteCamera(camera_path.string(), result.calibrated_camera);
+      if (!args->camera_format.empty())
+        WriteCameraInFormat(format_path.string(), result.calibrated_camera, args->camera_format);
     } else {
       std::error_code ignored;
       fs::remove(camera_path, ignored);
+      if (!args->camera_format.empty()) fs::remove(format_path, ignored);
     }
     for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
     for (const auto& [step, reason] : result.failures)

@@ -9,6 +9,7 @@
 #include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/simulation/flight_simulator.h"
 #include "triangulation/simulation/rig_flight_simulator.h"
+#include "triangulation/simulation/test_field_simulator.h"
 
 namespace aerocal::tools {
 namespace {
@@ -23,7 +24,30 @@ struct SimulateArgs {
     double increment_arcsec = 0.0, time_offset_ms = 0.0, speed_mps = 0.0;
     bool pushbroom = false;
     triangulation::LineSimulationOptions line;
+    bool test_field = false;
+    triangulation::TestFieldOptions field;
 };
+
+// `simulate --test-field`: the calibration test field (triangulation/simulation/
+// test_field_simulator.h); the flight options that mean the same here are taken when given.
+int RunTestFieldSimulation(const CLI::App& app, SimulateArgs& args) {
+  auto& t = args.field;
+  t.seed = args.seed;
+  const auto given = [&](const char* name) { return app.count(name) > 0; };
+  if (given("--survey-sigma-m")) t.survey_sigma_m = args.options.survey_sigma_m;
+  if (given("--image-noise-px")) t.image_noise_px = args.options.image_noise_px;
+  if (given("--image-sigma-px")) t.image_sigma_px = args.options.image_sigma_px;
+  for (const char* flight_only : {"--exposures", "--strips", "--height-m", "--layout", "--rig", "--pushbroom"})
+    if (given(flight_only))
+      throw ConfigError(std::string(flight_only) + " does not apply to --test-field");
+  const auto field = triangulation::SimulateTestField(t);
+  triangulation::WriteSimulatedTestField(field, args.out);
+  std::printf("simulated a %s test field: %zu targets, %zu images in %d groups, %zu image "
+              "observations -> %s\n",
+              t.planar ? "planar" : "3-D", field.points_truth.size(), field.exposures_truth.size(),
+              t.groups, field.observations.size(), args.out.c_str());
+  return kExitOk;
+}
 
 using FlightIntOption = std::pair<std::string, int triangulation::FlightSimulationOptions::*>;
 using FlightDoubleOption = std::pair<std::string, double triangulation::FlightSimulationOptions::*>;
@@ -114,6 +138,15 @@ CommandRun SetupSimulate(CLI::App& app) {
                     ->check(CLI::Range(0.0, 1000.0));
   // Line camera (pushbroom) flight: its own options; the shared ones above apply when given.
   auto& l = args->line;
+  app.add_flag("--test-field", args->test_field,
+               "A camera-calibration test field instead of a flight: targets on a facade with depth "
+               "layers, convergent images in groups (calibrate --observations --points --groups)");
+  app.add_flag("--planar", args->field.planar, "Test field: all targets on one plane");
+  app.add_option("--groups", args->field.groups, "Test field: image groups, 1..26")->check(CLI::Range(1, 26));
+  app.add_option("--images-per-group", args->field.images_per_group, "Test field: images per group, 4..1000")
+      ->check(CLI::Range(4, 1000));
+  app.add_option("--distance-m", args->field.distance_m, "Test field: camera distance from the wall, m")
+      ->check(CLI::Range(1.0, 1000.0));
   app.add_flag("--pushbroom", args->pushbroom,
                "Simulate a combined line camera (three tilted line cameras) instead: camera files, "
                "pos.csv, observations, control points and truth (triangulation/pushbroom/README.md)");
@@ -145,6 +178,10 @@ CommandRun SetupSimulate(CLI::App& app) {
       {"--start-offset-deg", &Flight::start_angle_error_deg}};
   return [args, &app, int_options, double_options, increment, time_offset, speed]() {
     CheckOutputFolder(args->out, "--out");
+    if (args->test_field) return RunTestFieldSimulation(app, *args);
+    for (const char* field_only : {"--planar", "--groups", "--images-per-group", "--distance-m"})
+      if (app.count(field_only) > 0)
+        throw ConfigError(std::string(field_only) + " applies to --test-field only");
     if (args->pushbroom) {
       if (!args->rig.empty()) throw ConfigError("--pushbroom and --rig: choose one");
       auto& l = args->line;

@@ -79,6 +79,8 @@ std::vector<Format> Formats() {
       {"opensfm", ReadOpenSfmCameras, WriteOpenSfmCameras, {CameraModelId::kOpenCv, {"k4", "k5", "k6"}}, true, false, ".json"},
       {"dji", ReadDjiDewarpData, WriteDjiDewarpData, {CameraModelId::kOpenCv, {}}, true, false, ".xmp"},
       {"dbat", ReadDbatCameraXml, WriteDbatCameraXml, {CameraModelId::kBrownFraser10, {"B1", "B2"}, true}, true, true, ".xml"},
+      {"photomodeler", ReadPhotoModelerCamera, WritePhotoModelerCamera, {CameraModelId::kBrownFraser10, {"B1", "B2"}, true}, true, true, ".txt"},
+      {"australis", ReadAustralisCamera, WriteAustralisCamera, {CameraModelId::kBrownFraser10, {}, true}, true, true, ".txt"},
       {"kalibr", ReadKalibrCamchain, WriteKalibrCamchain, {CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}}, true, false, ".yaml"},
   };
 }
@@ -129,7 +131,7 @@ TEST(CameraFormats, TermsOutsideOpenCvSurviveTheirFormat) {
   ExpectSameParams(fisheye, WriteAndRead(Formats()[4], File(fisheye), dir).camera, "opensfm fisheye");
   ModelCamera equi = fisheye;
   equi.params[6] = 0.002, equi.params[7] = -4e-4, equi.params[0] = 901;
-  ExpectSameParams(equi, WriteAndRead(Formats()[7], File(equi), dir).camera, "kalibr equidistant");
+  ExpectSameParams(equi, WriteAndRead(Formats()[9], File(equi), dir).camera, "kalibr equidistant");
   // Our file holds any registry model.
   ExpectSameParams(metashape, WriteAndRead(Formats()[0], File(metashape), dir).camera, "aerocal metashape_frame");
 }
@@ -181,7 +183,7 @@ TEST(CameraFormats, OursThroughEveryFormatAndBackStatesItsResidual) {
     // radtan: k1, k2 only).
     const std::map<std::string, std::pair<double, double>> stated = {
         {"colmap", {0.048, 1.95}}, {"metashape", {5.6e-5, 3.46}}, {"pix4d", {0.090, 10.7}},
-        {"opensfm", {0.048, 9.56}}, {"dji", {0.048, 1.95}},       {"dbat", {0.090, 2.61}},
+        {"opensfm", {0.048, 9.56}}, {"dji", {0.048, 1.95}},       {"dbat", {0.090, 2.61}}, {"photomodeler", {0.090, 2.61}},
         {"kalibr", {0.064, 16.3}}};
     EXPECT_LT(a.out_max_px, 1.2 * stated.at(f.name).first) << f.name;
     EXPECT_LT(d.out_max_px, 1.2 * stated.at(f.name).second) << f.name;
@@ -343,6 +345,94 @@ TEST(CameraFormatsRealData, DbatResultCameraAgainstItsReport) {
   EXPECT_LT(MaxDifferencePx(f.camera, again.file.camera), 1e-3);
 }
 
+TEST(CameraFormatsRealData, PhotoModelerExportOfTheDbatProjectAgreesWithDbat) {
+  // PhotoModeler Scanner 2016's own calibration of the DBAT camcal images (line 4 of its Bundle
+  // Soln export, PROVENANCE.md): f 7.4653, pp (3.6173, 2.6128) mm from the upper-left corner,
+  // format 7.25319 x 5.43764 mm, K1 0.00498, K2 -0.0001, K3 0, P1 -0.00006, P2 -0.00004.
+  const std::string dir = Shared("dbat_camcal_olympus_c4040z");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data absent";
+  const CameraFile pm = ReadPhotoModelerCamera(dir + "/photomodeler/camcal-pmexport.txt", {});
+  using B = BrownFraser10Model;
+  const double p = 5.43764 / 1704;  // square pixels from the format height, as DBAT
+  EXPECT_EQ(pm.camera.frame.width_px, 2272);
+  EXPECT_NEAR(pm.camera.frame.pixel_size_mm, p, 1e-15);
+  EXPECT_NEAR(pm.camera.params[B::kC], 7.4653, 1e-12);
+  EXPECT_NEAR(pm.camera.params[B::kX0], (3.6173 / (7.25319 / 2272) - 1136) * p, 1e-12);
+  EXPECT_NEAR(pm.camera.params[B::kY0], 852 * p - 2.6128, 1e-12);
+  EXPECT_NEAR(pm.camera.params[B::kK1], 0.00498, 1e-15);
+  EXPECT_NEAR(pm.camera.params[B::kP2], -0.00004, 1e-15);
+  // PhotoModeler's format width is 4.1e-4 wider than square pixels give (DBAT estimates the same
+  // aspect, 3.9e-4): said, not modelled.
+  EXPECT_NE(pm.notes.front().find("not modelled"), std::string::npos);
+  // Two programs' calibrations of the same 21 images: the same lens within what their
+  // different c (7.4653 vs 7.4570 mm, 0.11 %) and PhotoModeler's 5-digit print explain. The
+  // distortion curves agree: at r = 4 mm, dr = r^3 K1 + r^5 K2 + r^7 K3.
+  const CameraFile dbat = ReadDbatCameraXml(dir + "/result/c4040z.xml", {});
+  const auto dr = [](const std::vector<double>& q, double r) {
+    return r * r * r * q[B::kK1] + std::pow(r, 5) * q[B::kK2] + std::pow(r, 7) * q[B::kK3];
+  };
+  const double dr_pm = dr(pm.camera.params, 4.0), dr_dbat = dr(dbat.camera.params, 4.0);
+  std::printf("dr(4 mm): PhotoModeler %.5f mm, DBAT %.5f mm\n", dr_pm, dr_dbat);
+  EXPECT_NEAR(dr_pm, dr_dbat, 0.1 * std::abs(dr_dbat));  // 10 %: PM prints K2 to 1e-5 (20 %)
+  EXPECT_NEAR(pm.camera.params[B::kX0], dbat.camera.params[B::kX0], 0.01);  // 3 px
+  EXPECT_NEAR(pm.camera.params[B::kY0], dbat.camera.params[B::kY0], 0.01);
+  // Written and read back exactly.
+  TempDir tmp("aerocal_formats");
+  const Format& f = Formats()[7];
+  ASSERT_STREQ(f.name, "photomodeler");
+  ExpectSameParams(pm.camera, WriteAndRead(f, pm, tmp).camera, "photomodeler");
+}
+
+TEST(CameraFormatsRealData, AustralisReportOfThePublicExample) {
+  // The layout and values of a public Australis report (wiki.cis.rit.edu, WASP-LT camera 3, 2006),
+  // lines as Australis prints them.
+  TempDir tmp("aerocal_formats");
+  const std::string path = tmp.File("camera3-report.txt");
+  std::ofstream(path)
+      << "Australis Bundle Adjustment Results: Camera Parameters\n02 August, 2006 14:11:14\n"
+         "Project: camera3.aus\nAdjustment: Free-Network\nNumber of Points: 145\n"
+         "Results for Camera 1\nWASP-LT Camera 3 Lens\n"
+         "Sensor Size Pixel Size (mm)\nH 648 0.007\nV 494 0.007\n"
+         "Camera Initial Total Final Initial Final\n"
+         "Variable Value Adjustment Value Std. Error Std. Error\n"
+         "C 8.0000 0.30937 8.3094 1.0e+003 6.782e-003 (mm)\n"
+         "XP 0.0000 -0.02804 -0.0280 1.0e+003 6.879e-003 (mm)\n"
+         "YP 0.0000 0.02142 0.0214 1.0e+003 7.204e-003 (mm)\n"
+         "K1 0.00000e+000 1.674e-003 1.67381e-003 1.0e+003 1.238e-004\n"
+         "K2 0.00000e+000 -7.808e-006 -7.80809e-006 1.0e+003 3.066e-005\n"
+         "K3 0.00000e+000 -1.229e-006 -1.22907e-006 1.0e+003 2.327e-006\n"
+         "P1 0.00000e+000 1.752e-005 1.75249e-005 1.0e+003 3.496e-005\n"
+         "P2 0.00000e+000 -8.641e-006 -8.64105e-006 1.0e+003 3.400e-005\n"
+         "B1 0.00000e+000 -4.343e-004 -4.34298e-004 1.0e+003 1.100e-004\n"
+         "B2 0.00000e+000 1.797e-005 1.79692e-005 1.0e+003 1.101e-004\n"
+         "Maximum Observational Radial Distance Encountered: 2.9 mm\n";
+  const CameraFile a = ReadAustralisCamera(path, {});
+  using B = BrownFraser10Model;
+  EXPECT_EQ(a.camera.frame.width_px, 648);
+  EXPECT_EQ(a.camera.frame.height_px, 494);
+  EXPECT_DOUBLE_EQ(a.camera.frame.pixel_size_mm, 0.007);
+  const double expected[B::kNumParams] = {8.3094, -0.0280, 0.0214, 1.67381e-3, -7.80809e-6,
+                                          -1.22907e-6, 1.75249e-5, -8.64105e-6, -4.34298e-4, 1.79692e-5};
+  for (int k = 0; k < B::kNumParams; ++k) EXPECT_DOUBLE_EQ(a.camera.params[k], expected[k]) << k;
+  ASSERT_TRUE(a.covariance);
+  EXPECT_NEAR(std::sqrt((*a.covariance)(B::kC, B::kC)), 6.782e-3, 1e-15);
+  EXPECT_NEAR(std::sqrt((*a.covariance)(B::kB2, B::kB2)), 1.101e-4, 1e-18);
+  EXPECT_EQ((*a.covariance)(B::kC, B::kX0), 0.0);
+  // Written and read back: the same camera and sigmas.
+  const Format& f = Formats()[8];
+  ASSERT_STREQ(f.name, "australis");
+  const CameraFile back = WriteAndRead(f, a, tmp);
+  ExpectSameParams(a.camera, back.camera, "australis");
+  ASSERT_TRUE(back.covariance);
+  EXPECT_NEAR((*back.covariance)(B::kK1, B::kK1), (*a.covariance)(B::kK1, B::kK1), 1e-22);
+  // Into PhotoModeler (no B1, B2: a fit over the format, stated) and DBAT likewise.
+  const FileConversion pm = ConvertCameraFile(a, Formats()[7].target);
+  EXPECT_FALSE(pm.result.exact);
+  std::printf("Australis WASP-LT -> photomodeler: %s\n", pm.result.Summary().c_str());
+  EXPECT_GT(pm.result.residual.max_px, 0.01);  // B1 -4.3e-4 at 2.3 mm: 0.14 px, not nothing
+  EXPECT_LT(pm.result.residual.max_px, 0.5);
+}
+
 // ---- the covariance carried through ----
 
 TEST(CameraFormats, CovarianceThroughAnExactConversionIsTheLinearMap) {
@@ -358,7 +448,7 @@ TEST(CameraFormats, CovarianceThroughAnExactConversionIsTheLinearMap) {
   ASSERT_TRUE(p.result.exact);
   ASSERT_TRUE(p.file.covariance);
   const Eigen::MatrixXd& q = *p.file.covariance;
-  const double mm = 0.0024;  // F = f p, Px = (cx + W / 2) p, T1 = -P2 (Metashape), R1 = k1
+  const double mm = 0.0024;  // F = f p, Px = (cx + W / 2) p, T1 = P2 (Metashape), R1 = k1
   EXPECT_NEAR(q(P::kF, P::kF), mm * mm * 0.25, 1e-6 * mm * mm * 0.25);
   EXPECT_NEAR(q(P::kPx, P::kPx), mm * mm * 0.09, 1e-6 * mm * mm * 0.09);
   EXPECT_NEAR(q(P::kF, P::kPx), mm * mm * 0.05, 1e-6 * mm * mm * 0.05);

@@ -26,6 +26,8 @@ const Format kFormats[] = {
     {"dewarp.txt", aerocal::calib::ReadDjiDewarpData, aerocal::calib::WriteDjiDewarpData},
     {"camera.xml", aerocal::calib::ReadDbatCameraXml, aerocal::calib::WriteDbatCameraXml},
     {"camchain.yaml", aerocal::calib::ReadKalibrCamchain, aerocal::calib::WriteKalibrCamchain},
+    {"pmexport.txt", aerocal::calib::ReadPhotoModelerCamera, aerocal::calib::WritePhotoModelerCamera},
+    {"australis.txt", aerocal::calib::ReadAustralisCamera, aerocal::calib::WriteAustralisCamera},
 };
 
 }  // namespace

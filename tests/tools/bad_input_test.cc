@@ -592,6 +592,26 @@ const std::vector<Case>& Cases() {
          return "camera convert --from pix4d --to opencv " + d.File("p.cam") + " " + d.File("o.yml") + " --width 100 --height 80 --pixel-mm 0.1";
        },
        2, "p.cam:4: unknown parameter 'K4'", "o.yml"},
+      {"photomodeler_export_with_a_short_camera_line",
+       [](const TempDir& d) {
+         Write(d.File("pm.txt"), "Bundle Soln test\n 0.0005 20 2272 1704\n 1 0.1 10 100 100 100 20 20 20\n"
+                                 " 7.4653 3.6173 2.6128 7.25319 5.43764 0.00498\n");
+         return "camera convert --from photomodeler --to opencv " + d.File("pm.txt") + " " + d.File("o.yml");
+       },
+       2, "pm.txt:4: f ppx ppy fw fh K1 K2 K3 P1 P2 needs 10 numbers (got 6)", "o.yml"},
+      {"australis_report_without_a_camera_constant",
+       [](const TempDir& d) {
+         Write(d.File("aus.txt"), "Australis Bundle Adjustment Results: Camera Parameters\nH 648 0.007\n"
+                                  "V 494 0.007\nXP 0 -0.028 -0.028 1000 0.0069 (mm)\n");
+         return "camera convert --from australis --to opencv " + d.File("aus.txt") + " " + d.File("o.yml");
+       },
+       2, "aus.txt:1: no camera constant", "o.yml"},
+      {"adjust_camera_format_unknown",
+       [](const TempDir& d) {
+         return "adjust --project " + d.File("none.yaml") + " --out " + d.File("r.json") +
+                " --self-calibration all --write-camera " + d.File("c.cam") + " --camera-format pix4dd";
+       },
+       2, "--camera-format: unknown camera format 'pix4dd'", "r.json"},
       {"kalibr_camchain_of_an_unknown_distortion",
        [](const TempDir& d) {
          Write(d.File("chain.yaml"), "cam0:\n  camera_model: pinhole\n  intrinsics: [400, 400, 320, 240]\n"

@@ -4,6 +4,7 @@
 // against DBAT's published calibration, in three image groups; the certificate from it (JSON,
 // HTML, PDF rendered to PNG), deterministic; bad input with exit 2 and nothing written.
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -35,7 +36,8 @@ TEST(CalibrateCommand, OpenCvChessboardAgainstCalibrateCameraAndThePublishedResu
             "name: left\npixel_size_mm: 0.006\nformat_px: [640, 480]\ninterior: {c: 3.0}\n");
   const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" + dir +
                             "/left*.jpg' --board chessboard:9x6:25 --model opencv --write-marks " +
-                            tmp.File("marks") + " --out " + tmp.File("left.json"));
+                            tmp.File("marks") + " --out " + tmp.File("left.json") +
+                            " --write-camera " + tmp.File("left_calibrated.yml") + " --camera-format opencv");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = ReadJson(tmp.File("left.json"));
   for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations",
@@ -45,6 +47,13 @@ TEST(CalibrateCommand, OpenCvChessboardAgainstCalibrateCameraAndThePublishedResu
   EXPECT_EQ(cal["method"]["detected"].size(), 13u);  // left01..14 without 10
   EXPECT_EQ(cal["data"]["observations"].get<int>(), 13 * 54);
   EXPECT_TRUE(std::filesystem::exists(tmp.File("marks/observations.csv")));
+  // --camera-format opencv: our calibration written as an OpenCV FileStorage file, a fit of the
+  // OpenCV model to our correction model over the format, its residual in the result.
+  const auto& written = cal["camera_written"];
+  EXPECT_EQ(written["format"].get<std::string>(), "opencv");
+  EXPECT_FALSE(written["exact"].get<bool>());
+  EXPECT_LT(written["residual_px"]["max_inner80"].get<double>(), 0.5);
+  EXPECT_NE(ReadTextFile(tmp.File("left_calibrated.yml")).find("camera_matrix"), std::string::npos);
   const auto& est = j["cameras"][0]["estimated"];
   const double p = 0.006;
   const double f_px = est["c"].get<double>() / p;
@@ -163,6 +172,33 @@ TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
   for (const auto& e : std::filesystem::directory_iterator(tmp_.path()))
     if (e.path().extension() == ".png" && std::filesystem::file_size(e.path()) > 1000) ++pages;
   EXPECT_GE(pages, 5);  // identification + results + budget, distortion, residuals, stability .. signatures
+}
+
+TEST_F(OlympusCalibration, GroupColumnOfTheObservationsGivesTheSameGroups) {
+  // The groups as a `group` column of observations.csv instead of --groups: the same three groups
+  // of 7 images, the same per-group results; both at once is a bad input.
+  const CsvTable obs = CsvTable::Read(tmp_.File("oly/observations.csv"));
+  std::ofstream out(tmp_.File("oly/observations_grouped.csv"));
+  for (size_t i = 0; i < obs.header().size(); ++i) out << (i ? "," : "") << obs.header()[i];
+  out << ",group\n";
+  for (const auto& row : obs.rows()) {
+    for (size_t i = 0; i < obs.header().size(); ++i) out << (i ? "," : "") << obs.String(row, obs.header()[i]);
+    const int number = std::stoi(obs.String(row, "image").substr(6));
+    out << ",G" << number % 3 + 1 << "\n";
+  }
+  out.close();
+  const std::string grouped = "calibrate --camera " + tmp_.File("oly/camera_cam1.yaml") +
+                              " --observations " + tmp_.File("oly/observations_grouped.csv") + " --points " +
+                              tmp_.File("oly/points.csv") + " --self-calibration c,x0,y0,K1,K2,K3,P1,P2,B1 --no-snooping ";
+  const auto r = RunAerocal(grouped + "--out " + tmp_.File("col.json"));
+  ASSERT_EQ(r.exit_code, 3) << r.output;  // the groups disagree, as with --groups
+  const auto a = ReadJson(tmp_.File("col.json"));
+  ASSERT_EQ(a["calibration"]["groups"].size(), 3u);
+  for (const auto& g : a["calibration"]["groups"]) EXPECT_EQ(g["images"].size(), 7u);
+  const auto both = RunAerocal(grouped + "--groups " + tmp_.File("groups.csv") + " --out " + tmp_.File("both.json"));
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  EXPECT_NE(both.output.find("has a group column already"), std::string::npos) << both.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp_.File("both.json")));
 }
 
 TEST(CalibrateCommand, BadInputExitsTwoAndWritesNothing) {

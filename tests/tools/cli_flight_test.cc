@@ -22,7 +22,7 @@ class FlightWorkflow : public ::testing::Test {
     ASSERT_EQ(sim.exit_code, 0) << sim.output;
     run_ = new testing::CommandResult(testing::RunAerocal(
         "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " + dir_->File("data") +
-        " --base III,IV --out " + dir_->File("report")));
+        " --base III,IV --out " + dir_->File("report") + " --camera-format metashape"));
   }
   static void TearDownTestSuite() {
     delete run_;
@@ -85,6 +85,37 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   const auto truth = calib::ReadCamera(dir_->File("data/camera_truth.yaml"));
   EXPECT_NEAR(camera.interior[0], truth.interior[0], 0.01);
   EXPECT_EQ(camera.subimages.size(), 6u);
+  // --camera-format metashape: the same camera for Metashape (a forward model: a fit, its residual
+  // printed), with the interior sigmas as a covariance.
+  const std::string metashape = ReadTextFile(dir_->File("report/camera_calibrated.metashape"));
+  EXPECT_NE(metashape.find("<calibration"), std::string::npos);
+  EXPECT_NE(run_->output.find("camera as metashape (metashape_frame): least-squares fit"), std::string::npos)
+      << run_->output;
+}
+
+TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
+  // `aerocal certificate --result` of a flight result: the certificate form of the in-flight
+  // calibration, a type-A budget from the adjustment (U = k sigma, k from the redundancy).
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const auto r = testing::RunAerocal("certificate --result " + dir_->File("report/result.json") +
+                                     " --no-render --out " + dir_->File("cert"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto cert = nlohmann::json::parse(ReadTextFile(dir_->File("cert/certificate.json")));
+  EXPECT_EQ(cert["method"]["kind"], "in-flight calibration");
+  const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
+  const auto& joint = doc["adjustments"][2];  // the joint adjustment's camera is the certified one
+  ASSERT_EQ(joint["name"], "joint");
+  bool has_c = false;
+  for (const auto& q : cert["results"]) {
+    if (q["quantity"] != "c") continue;
+    has_c = true;
+    const double sigma = joint["cameras"][0]["sigma"]["c"].get<double>();
+    EXPECT_DOUBLE_EQ(q["value"].get<double>(), joint["cameras"][0]["estimated"]["c"].get<double>());
+    EXPECT_NEAR(q["U"].get<double>(), q["k"].get<double>() * sigma, 1e-15);
+    EXPECT_EQ(q["components"][0]["type"], "A");
+    EXPECT_NE(q["statement"].get<std::string>().find("(k = 2)"), std::string::npos) << q["statement"];
+  }
+  EXPECT_TRUE(has_c);
 }
 
 TEST_F(FlightWorkflow, ReportHoldsTablesAndPlots) {

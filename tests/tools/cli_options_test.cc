@@ -2,6 +2,8 @@
 // `import dbat` (then `adjust` on the imported block, against DBAT's published calibration).
 #include <filesystem>
 
+#include <cstdio>
+
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -39,15 +41,20 @@ TEST(CliOptions, StitchModelAutoTestsAtTheGivenAlpha) {
   EXPECT_FALSE(std::filesystem::exists(dir.File("bad.json")));
 }
 
+// The DBAT camcal demo imported as a block (the published run: the four control points fixed, 1 um).
+testing::CommandResult ImportDbatCamcal(const std::string& data, const testing::TempDir& dir) {
+  return RunAerocal("import dbat --camera-xml " + data + "/c4040z.xml --marks " + data +
+                    "/measurements/markpts.txt --images " + data + "/images/images.txt --control " +
+                    data + "/reference/camcal-fixed.txt --control-sigma-m 1e-6 --photomodeler-export " +
+                    data + "/photomodeler/camcal-pmexport.txt --out " + dir.File("block"));
+}
+
 TEST(CliOptions, ImportDbatThenAdjustGivesThePublishedCalibration) {
   const std::string data = testing::SharedDataDir("dbat_camcal_olympus_c4040z");
   if (data.empty()) GTEST_SKIP() << "../shared/data/dbat_camcal_olympus_c4040z is absent";
   testing::TempDir dir("aerocal_cli_dbat");
   // The published run holds the four control points fixed (camcal-fixed.txt): 1 um here.
-  const auto imported = RunAerocal("import dbat --camera-xml " + data + "/c4040z.xml --marks " + data +
-                                   "/measurements/markpts.txt --images " + data + "/images/images.txt --control " +
-                                   data + "/reference/camcal-fixed.txt --control-sigma-m 1e-6 --photomodeler-export " +
-                                   data + "/photomodeler/camcal-pmexport.txt --out " + dir.File("block"));
+  const auto imported = ImportDbatCamcal(data, dir);
   ASSERT_EQ(imported.exit_code, 0) << imported.output;
   const auto adjusted = RunAerocal("adjust --project " + dir.File("block/project.yaml") +
                                    " --self-calibration c,x0,y0,K1,K2,K3,P1,P2,B1 --no-snooping --out " +
@@ -58,6 +65,42 @@ TEST(CliOptions, ImportDbatThenAdjustGivesThePublishedCalibration) {
   const auto& camera = doc["cameras"][0];
   EXPECT_LT(std::abs(camera["estimated"]["c"].get<double>() - 7.45700), 3.0 * camera["sigma"]["c"].get<double>());
   EXPECT_NEAR(doc["sigma0_px"].get<double>() / 0.16148, 1.0, 0.10);
+}
+
+TEST(CliOptions, AdjustWritesTheCameraInAnotherToolsFormat) {
+  // --write-camera with --camera-format: the DBAT test field's self-calibration written as an
+  // Australis report (the same model: exact, the sigmas carried) and as a PhotoModeler camera
+  // (no B1: a fit whose residual is printed), both read back by `camera show`.
+  const std::string data = testing::SharedDataDir("dbat_camcal_olympus_c4040z");
+  if (data.empty()) GTEST_SKIP() << "../shared/data/dbat_camcal_olympus_c4040z is absent";
+  testing::TempDir dir("aerocal_cli_camera_format");
+  const auto imported = ImportDbatCamcal(data, dir);
+  ASSERT_EQ(imported.exit_code, 0) << imported.output;
+  const std::string adjust = "adjust --project " + dir.File("block/project.yaml") +
+                             " --self-calibration c,x0,y0,K1,K2,K3,P1,P2,B1 --no-snooping --out ";
+  auto r = RunAerocal(adjust + dir.File("a.json") + " --write-camera " + dir.File("cam.aus.txt") +
+                      " --camera-format australis");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("camera as australis (brown_fraser_10): exact"), std::string::npos) << r.output;
+  const auto doc = nlohmann::json::parse(ReadTextFile(dir.File("a.json")));
+  const double c = doc["cameras"][0]["estimated"]["c"].get<double>();
+  const double sigma_c = doc["cameras"][0]["sigma"]["c"].get<double>();
+  auto shown = RunAerocal("camera show --from australis " + dir.File("cam.aus.txt"));
+  ASSERT_EQ(shown.exit_code, 0) << shown.output;
+  // The table prints c with 15 digits and its sigma with 6.
+  char c_text[64], sigma_text[64];
+  std::snprintf(c_text, sizeof(c_text), "%.6f", c);
+  std::snprintf(sigma_text, sizeof(sigma_text), "%.4g", sigma_c);
+  EXPECT_NE(shown.output.find(std::string(c_text).substr(0, 7)), std::string::npos) << shown.output;
+  EXPECT_NE(shown.output.find(std::string(sigma_text).substr(0, 5)), std::string::npos) << shown.output;
+  r = RunAerocal(adjust + dir.File("b.json") + " --write-camera " + dir.File("cam.pm.txt") +
+                 " --camera-format photomodeler");
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("least-squares fit over the format"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("interior sigmas not written"), std::string::npos) << r.output;
+  shown = RunAerocal("camera show --from photomodeler " + dir.File("cam.pm.txt"));
+  ASSERT_EQ(shown.exit_code, 0) << shown.output;
+  EXPECT_NE(shown.output.find("2272 x 1704 px"), std::string::npos) << shown.output;
 }
 
 }  // namespace

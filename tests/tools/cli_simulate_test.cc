@@ -1,7 +1,9 @@
 // The command line: help, version, exit codes, determinism of `simulate`, bad options.
+#include <cmath>
 #include <filesystem>
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
@@ -115,6 +117,36 @@ TEST(Cli, SimulateRigRefusesUnknownRigsAndFrameOptions) {
   EXPECT_EQ(speed.exit_code, 2);
   EXPECT_NE(speed.output.find("--speed-mps"), std::string::npos) << speed.output;
   EXPECT_FALSE(std::filesystem::exists(dir.File("x")));
+}
+
+TEST(Cli, SimulateTestFieldThenCalibrateWithItsGroups) {
+  // simulate --test-field: deterministic files that `calibrate` takes as they are (no exposures:
+  // aerocal's own resections), its groups from groups.csv; the c of the truth within 3 sigma.
+  testing::TempDir dir;
+  const std::string sim = "simulate --test-field --groups 2 --images-per-group 8 --seed 4 --out ";
+  ASSERT_EQ(testing::RunAerocal(sim + dir.File("a")).exit_code, 0);
+  ASSERT_EQ(testing::RunAerocal(sim + dir.File("b")).exit_code, 0);
+  for (const char* f : {"camera_nominal.yaml", "camera_truth.yaml", "observations.csv", "points.csv",
+                        "groups.csv", "truth/exposures.csv", "truth/points.csv"}) {
+    ASSERT_TRUE(std::filesystem::exists(dir.File("a/") + f)) << f;
+    EXPECT_EQ(ReadTextFile(dir.File("a/") + f), ReadTextFile(dir.File("b/") + f)) << f;
+  }
+  const std::string a = dir.File("a/");
+  const auto r = testing::RunAerocal("calibrate --camera " + a + "camera_nominal.yaml --observations " + a +
+                                     "observations.csv --points " + a + "points.csv --groups " + a +
+                                     "groups.csv --self-calibration c,x0,y0,K1,K2,P1,P2 --out " +
+                                     dir.File("calib.json"));
+  ASSERT_NE(r.exit_code, 2) << r.output;  // 0, or 3 when the two groups happen to disagree
+  const auto j = nlohmann::json::parse(ReadTextFile(dir.File("calib.json")));
+  EXPECT_EQ(j["calibration"]["groups"].size(), 2u);
+  EXPECT_EQ(j["calibration"]["start"]["resections"].size(), 16u);
+  const double truth = calib::ReadCamera(a + "camera_truth.yaml").interior[0];
+  EXPECT_LE(std::abs(j["cameras"][0]["estimated"]["c"].get<double>() - truth),
+            3.0 * j["cameras"][0]["sigma"]["c"].get<double>());
+  // Test-field options belong to --test-field; flight options do not apply to it.
+  EXPECT_EQ(testing::RunAerocal("simulate --planar --out " + dir.File("c")).exit_code, 2);
+  EXPECT_EQ(testing::RunAerocal("simulate --test-field --strips 3 --out " + dir.File("d")).exit_code, 2);
+  EXPECT_FALSE(std::filesystem::exists(dir.File("d")));
 }
 
 }  // namespace

@@ -153,6 +153,9 @@ def identification_rows(c):
 
 
 def method_text(m):
+    if m.get("kind") == "in-flight calibration":
+        return "in-flight calibration (aerocal flight, %s adjustment) of %s; uncertainty budget: %s" % (
+            m.get("adjustment"), m.get("flight_data"), m.get("budget"))
     if m.get("kind") == "planar target":
         return "planar %s %dx%d, spacing %s mm, %s; %d of %d images detected" % (
             m["board"], m["columns"], m["rows"], fmt(m["spacing_mm"]), m["detector"], len(m["detected"]),

@@ -8,9 +8,8 @@
 #include "calib/core/yaml_util.h"
 
 namespace aerocal::calib {
-namespace {
 
-CameraFile FromOurs(const Camera& ours) {
+CameraFile CameraFileFromCamera(const Camera& ours) {
   CameraFile file;
   file.name = ours.name;
   file.camera.model = CameraModelId::kBrownFraser10;
@@ -30,8 +29,6 @@ CameraFile FromOurs(const Camera& ours) {
   return file;
 }
 
-}  // namespace
-
 CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& options) {
   const YAML::Node root = LoadYamlFile(path);
   CameraFile file;
@@ -49,11 +46,11 @@ CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& o
                       options.camera_id.empty()
                           ? "a rig file: name a head with --camera (" + ids + ")"
                           : "no head '" + options.camera_id + "' (heads: " + ids + ")");
-    file = FromOurs(head->camera);
+    file = CameraFileFromCamera(head->camera);
     file.name = head->id;
   } else if (root.IsMap() && (!root["model"] || root["model"].Scalar() ==
                                                     BrownFraser10Model::kName)) {
-    file = FromOurs(ParseCamera(root, path));
+    file = CameraFileFromCamera(ParseCamera(root, path));
   } else {
     file.camera = ParseModelCamera(root, path);
     file.name = root["name"] ? root["name"].Scalar() : "";

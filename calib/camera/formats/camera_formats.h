@@ -25,6 +25,10 @@
 //   the other reading moves the principal point by 0.5 px).
 // - dbat: DBAT camera XML (c, pp mm from the top-left corner, y down, K1-K3, P1, P2): our
 //   correction model (brown_fraser_10 without B1, B2).
+// - photomodeler: a PhotoModeler "Bundle Soln" export's camera (f, pp mm from the upper-left corner,
+//   format size, K1-K3, P1, P2; photomodeler_format.cc): brown_fraser_10 without B1, B2.
+// - australis: an Australis "Camera Parameters" report (C, XP, YP, K1-K3, P1, P2, B1, B2 with their
+//   standard errors; australis_format.cc): brown_fraser_10, all ten terms, diagonal covariance.
 // - kalibr: camchain YAML (camera_model pinhole, distortion_model radtan / equidistant,
 //   intrinsics fu fv pu pv, distortion_coeffs, resolution); pixels as OpenCV.
 #pragma once
@@ -35,6 +39,7 @@
 
 #include <Eigen/Core>
 
+#include "calib/camera/camera.h"
 #include "calib/camera/camera_model.h"
 #include "calib/camera/convert_camera.h"
 #include "calib/core/error.h"
@@ -82,6 +87,10 @@ struct FileConversion {
 FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& target,
                                  const ConvertOptions& options = {});
 
+/// Our camera (brown_fraser_10) as a camera file: interior_sigma as a diagonal covariance (the
+/// terms without a sigma: 0), said in the notes. Sub-images and reference points are not carried.
+CameraFile CameraFileFromCamera(const Camera& camera);
+
 // ---- per format (name: reader, writer) ----
 CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& options);
 void WriteAerocalCamera(const std::string& path, const CameraFile& camera);
@@ -111,6 +120,12 @@ void WriteDjiDewarpData(const std::string& path, const CameraFile& camera);
 
 CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& options);
 void WriteDbatCameraXml(const std::string& path, const CameraFile& camera);
+
+CameraFile ReadPhotoModelerCamera(const std::string& path, const CameraReadOptions& options);
+void WritePhotoModelerCamera(const std::string& path, const CameraFile& camera);
+
+CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions& options);
+void WriteAustralisCamera(const std::string& path, const CameraFile& camera);
 
 CameraFile ReadKalibrCamchain(const std::string& path, const CameraReadOptions& options);
 void WriteKalibrCamchain(const std::string& path, const CameraFile& camera);

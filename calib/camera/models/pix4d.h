@@ -2,21 +2,31 @@
 // file and the quality report give them: focal length F and principal point (Px, Py) in mm,
 // radial R1-R3, tangential T1-T2), an exact parameter mapping onto OpenCvModel.
 //
-// Source: Pix4D support, "How are the Internal and External Camera Parameters defined?"
-// (support.pix4d.com/hc/en-us/articles/202559089): the camera frame follows the PATB convention
-// (x right, y up, the camera looking along -Z); "the origin of the image coordinate system is at
-// the lower-left corner of the image"; the distorted homogeneous point is
-//   x_hd = x_h (1 + R1 r^2 + R2 r^4 + R3 r^6) + 2 T1 x_h y_h + T2 (r^2 + 2 x_h^2)
-//   y_hd = y_h (1 + R1 r^2 + R2 r^4 + R3 r^6) + T1 (r^2 + 2 y_h^2) + 2 T2 x_h y_h
-// and the image point is F (x_hd, y_hd) + (Px, Py). The page gives its formulas as images; what is
-// written here is our reading of its text (x_h, y_h = the normalised ray in that y-up frame), not
-// yet checked against a file written by Pix4D: a real .cam file with its quality-report pixels is
-// the test that settles it.
+// Sources and what they settle (checked 2026-11-24, issue 15):
+// - Pix4D support, "How are the Internal and External Camera Parameters defined?"
+//   (support.pix4d.com/hc/en-us/articles/202559089): the distorted homogeneous point is
+//     x_hd = x_h (1 + R1 r^2 + R2 r^4 + R3 r^6) + 2 T1 x_h y_h + T2 (r^2 + 2 x_h^2)
+//     y_hd = y_h (1 + R1 r^2 + R2 r^4 + R3 r^6) + T1 (r^2 + 2 y_h^2) + 2 T2 x_h y_h
+//   and the pixel f (x_hd, y_hd) + (cx, cy): OpenCV's form with T1 in p1's place and T2 in p2's.
+//   Its formulas are images; its figure text puts the image origin at the lower-left corner with
+//   y up, which read literally would flip the sign of T1 and measure Py from the bottom.
+// - Pix4D's own code and files do NOT flip: Pix4D's pyopf (github.com/Pix4D/pyopf,
+//   src/pyopf/cameras/sensor_internals.py) defines the perspective internals "as described in"
+//   that article with the "principal point with respect to the top left corner in pixels";
+//   its opf2colmap converter copies (R1, R2, R3, T1, T2) and the principal point unchanged into
+//   COLMAP's OPENCV / FULL_OPENCV (k1, k2, k3, p1, p2, cx, cy), and its undistorter applies T1 as
+//   OpenCV's p1 in a y-down pixel frame. Pix4Dmapper's calibrated_camera_parameters.txt (the same
+//   radial and tangential values as the .cam) states "camera model m = K [R|-Rt] X", a y-down
+//   OpenCV camera matrix (docs.nframes.com, "Pix4D" orientation formats, quotes a real file); and
+//   EasyIDP (a tool that projects into real Pix4D projects' images) applies T1, T2 the same way.
+// So: Px, Py are mm from the top-left CORNER, y down; T1 = p1, T2 = p2. Not settled: whether
+// Pix4D's pixel centres sit at +0.5 (corner origin, COLMAP's convention, as the wording says and
+// as assumed here) or at integers (pyopf's undistorter indexes them so): 0.5 px in cx, cy.
 // Conventions converted HERE (ExpandToOpenCv), nowhere else:
 //   - mm -> px: fx = fy = F / p;
-//   - lower-left CORNER origin, y up -> OpenCV (top-left pixel centre, y down):
-//     cx = Px / p - 0.5,  cy = H - 0.5 - Py / p;
-//   - the y flip changes the sign of the tangential term that pairs with y: p1 = -T1, p2 = T2.
+//   - top-left CORNER origin -> OpenCV (top-left pixel centre at 0): cx = Px / p - 0.5,
+//     cy = Py / p - 0.5;
+//   - tangential terms as OpenCV's: p1 = T1, p2 = T2.
 #pragma once
 
 #include "calib/camera/models/opencv.h"
@@ -46,11 +56,11 @@ struct Pix4dPerspectiveModel : ForwardCameraModel<Pix4dPerspectiveModel> {
     cv[M::kFx] = p[kF] / pixel;
     cv[M::kFy] = p[kF] / pixel;
     cv[M::kCx] = p[kPx] / pixel - T(0.5);
-    cv[M::kCy] = T(frame.height_px - 0.5) - p[kPy] / pixel;
+    cv[M::kCy] = p[kPy] / pixel - T(0.5);
     cv[M::kK1] = p[kR1];
     cv[M::kK2] = p[kR2];
     cv[M::kK3] = p[kR3];
-    cv[M::kP1] = -p[kT1];
+    cv[M::kP1] = p[kT1];
     cv[M::kP2] = p[kT2];
   }
   template <typename T>
@@ -73,11 +83,11 @@ struct Pix4dPerspectiveModel : ForwardCameraModel<Pix4dPerspectiveModel> {
     const double pixel = frame.pixel_size_mm;
     p[kF] = cv[M::kFy] * pixel;
     p[kPx] = (cv[M::kCx] + 0.5) * pixel;
-    p[kPy] = (frame.height_px - 0.5 - cv[M::kCy]) * pixel;
+    p[kPy] = (cv[M::kCy] + 0.5) * pixel;
     p[kR1] = cv[M::kK1];
     p[kR2] = cv[M::kK2];
     p[kR3] = cv[M::kK3];
-    p[kT1] = -cv[M::kP1];
+    p[kT1] = cv[M::kP1];
     p[kT2] = cv[M::kP2];
     return cv[M::kFx] == cv[M::kFy] && cv[M::kK4] == 0.0 && cv[M::kK5] == 0.0 &&
            cv[M::kK6] == 0.0;

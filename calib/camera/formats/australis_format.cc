@@ -1,0 +1,140 @@
+// Australis (Photometrix) camera: the "Camera Parameters" result of an Australis bundle adjustment,
+// as the program prints it (a public example: wiki.cis.rit.edu/pub/LIAS/WaspLTCameraCalibrations/
+// Camera3-2006-report.txt, "Australis Bundle Adjustment Results: Camera Parameters"):
+//   Sensor Size  Pixel Size (mm)
+//   H <width px>  <pixel width mm>
+//   V <height px> <pixel height mm>
+//   Camera Variable | Initial Value | Total Adjustment | Final Value | Initial Std. Error | Final Std. Error
+//   C  ... (mm)   XP ... (mm)   YP ... (mm)   K1 K2 K3 P1 P2 B1 B2
+// Australis's model is Fraser's (1997) 10-parameter correction form, the one ours is
+// (brown_fraser_10, CONVENTIONS.md): c, the principal point offset (xp, yp) from the format centre
+// in mm with y up, K1-K3 (mm^-2, mm^-4, mm^-6), P1, P2 (mm^-1), B1, B2 (1), the correction added to
+// the measured coordinates reduced to the principal point. So x0 = XP, y0 = YP and every term maps
+// one to one (exact). The final standard errors become a diagonal covariance (Australis prints no
+// correlations here); an Initial Std. Error of 1.0e+003 is Australis's "free". The report is read
+// as whitespace-separated tokens (its columns are aligned with spaces, so line breaks do not
+// matter): H and V each followed by pixels and pixel size, then each parameter name followed by
+// its five numbers. H and V pixel sizes that differ are not modelled (square pixels of V's size,
+// said). Written in the same layout, Initial = Final and Total Adjustment 0.
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+
+namespace aerocal::calib {
+namespace {
+
+using Model = BrownFraser10Model;
+
+struct Token {
+  std::string text;
+  int line;
+};
+
+constexpr double kFreeSigma = 1000.0;  // Australis prints 1.0e+003 for a free parameter
+
+// The Australis name of each parameter of our table, in table order.
+constexpr const char* kAustralisNames[Model::kNumParams] = {"C",  "XP", "YP", "K1", "K2",
+                                                            "K3", "P1", "P2", "B1", "B2"};
+
+}  // namespace
+
+CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions& options) {
+  const std::vector<std::string> lines = SplitLines(ReadTextFile(path));
+  std::vector<Token> tokens;
+  for (size_t i = 0; i < lines.size(); ++i) {
+    std::istringstream in(lines[i]);
+    for (std::string t; in >> t;) tokens.push_back({t, static_cast<int>(i + 1)});
+  }
+  bool australis = false;
+  for (const std::string& line : lines) australis |= line.find("Australis") != std::string::npos;
+  if (!australis)
+    ThrowInputError({path, 1}, "not an Australis camera-parameter report (no 'Australis' line)");
+  if (!options.camera_id.empty())
+    ThrowInputError({path, 1}, "--camera: one camera per Australis report is read");
+  // `name` followed by `count` numbers; the first such occurrence. Returns the token index or -1.
+  const auto find = [&](const std::string& name, size_t count, size_t from) -> long {
+    for (size_t i = from; i + count < tokens.size(); ++i) {
+      if (tokens[i].text != name) continue;
+      bool numbers = true;
+      for (size_t k = 1; k <= count; ++k) numbers &= ParseDouble(tokens[i + k].text).has_value();
+      if (numbers) return static_cast<long>(i);
+    }
+    return -1;
+  };
+  const long h = find("H", 2, 0), v = find("V", 2, 0);
+  if (h < 0 || v < 0)
+    ThrowInputError({path, 1}, "no sensor size: lines 'H <pixels> <pixel size mm>' and "
+                               "'V <pixels> <pixel size mm>'");
+  const auto number = [&](long i, const std::string& what, double bound) {
+    return internal::ParseNumber(tokens[i].text, {path, tokens[i].line}, what, bound);
+  };
+  const double width = number(h + 1, "H pixels", 1e6), height = number(v + 1, "V pixels", 1e6);
+  const double pixel_h = number(h + 2, "H pixel size", 1.0), pixel_v = number(v + 2, "V pixel size", 1.0);
+  if (!(width >= 1 && height >= 1 && width == std::floor(width) && height == std::floor(height)))
+    ThrowInputError({path, tokens[h].line}, "H and V pixels must be positive integers");
+  CameraFile file;
+  file.name = std::filesystem::path(path).stem().string();
+  internal::ResolveFormat(&file, options, {path, tokens[v].line}, static_cast<int>(width),
+                          static_cast<int>(height), pixel_v);
+  if (std::abs(pixel_h / pixel_v - 1.0) > 1e-9)
+    file.notes.push_back("Australis H pixel size " + FormatNumber(pixel_h) + " mm differs from V " +
+                         FormatNumber(pixel_v) + " mm: square pixels of V's size (not modelled)");
+  file.camera.model = Model::kId;
+  file.camera.params.assign(Model::kNumParams, 0.0);
+  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(Model::kNumParams, Model::kNumParams);
+  bool any_sigma = false;
+  for (int k = 0; k < Model::kNumParams; ++k) {
+    const long i = find(kAustralisNames[k], 5, static_cast<size_t>(std::max(h, v)));
+    if (i < 0) {
+      if (k == Model::kC)
+        ThrowInputError({path, 1}, "no camera constant: a line 'C <initial> <adjustment> <final> "
+                                   "<initial sigma> <final sigma>'");
+      continue;  // a parameter Australis did not carry: 0
+    }
+    const std::string name = kAustralisNames[k];
+    file.camera.params[k] = number(i + 3, name + " final value", k == Model::kC ? 1e4 : 1e3);
+    const double initial_sigma = number(i + 4, name + " initial std. error", 1e12);
+    const double sigma = number(i + 5, name + " final std. error", 1e12);
+    if (sigma < 0) ThrowInputError({path, tokens[i].line}, name + " std. error must be >= 0");
+    if (sigma > 0 && initial_sigma > 0) {  // 0: fixed (or not given)
+      covariance(k, k) = sigma * sigma;
+      any_sigma = true;
+    }
+  }
+  if (!(file.camera.params[Model::kC] > 0))
+    ThrowInputError({path, 1}, "C must be > 0 mm");
+  if (any_sigma) {
+    file.covariance = covariance;
+    file.notes.push_back("Australis final std. errors read as a diagonal covariance (the report "
+                         "prints no correlations)");
+  }
+  return file;
+}
+
+void WriteAustralisCamera(const std::string& path, const CameraFile& file) {
+  AEROCAL_CHECK(file.camera.model == Model::kId) << "not brown_fraser_10";
+  const PixelFrame& f = file.camera.frame;
+  const std::vector<double>& q = file.camera.params;
+  std::ostringstream out;
+  out.precision(17);
+  out << "Australis Bundle Adjustment Results: Camera Parameters\n"
+      << "(written by aerocal: the camera only)\n\nResults for Camera 1\n"
+      << (file.name.empty() ? "camera" : file.name) << "\n\n"
+      << "Sensor Size  Pixel Size (mm)\nH " << f.width_px << " " << f.pixel_size_mm << "\nV "
+      << f.height_px << " " << f.pixel_size_mm << "\n\n"
+      << "Camera    Initial    Total       Final     Initial     Final\n"
+      << "Variable  Value      Adjustment  Value     Std. Error  Std. Error\n";
+  for (int k = 0; k < Model::kNumParams; ++k) {
+    double sigma = 0;
+    if (file.covariance && (*file.covariance)(k, k) > 0) sigma = std::sqrt((*file.covariance)(k, k));
+    out << kAustralisNames[k] << " " << q[k] << " 0 " << q[k] << " "
+        << (sigma > 0 ? kFreeSigma : 0.0) << " " << sigma << (k < 3 ? " (mm)" : "") << "\n";
+  }
+  WriteFileAtomically(path, out.str());
+}
+
+}  // namespace aerocal::calib
