@@ -5,6 +5,7 @@
 // tolerances. Deterministic: no clock, no random numbers (the date comes from the lab file).
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "calib/core/json_file.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/command_registry.h"
@@ -24,14 +25,6 @@ std::string Quote(const std::string& s) {
   std::string out = "'";
   for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
   return out + "'";
-}
-
-nlohmann::json ReadJsonFile(const std::string& path, const std::string& option) {
-  try {
-    return nlohmann::json::parse(ReadTextFile(path));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path + ": not JSON (" + option + "): " + e.what());
-  }
 }
 
 // The lab file: sections of free-text fields, every key known (typos are errors).
@@ -144,7 +137,7 @@ CommandRun SetupCertificate(CLI::App& app) {
     CheckOutputFolder(args->out, "--out");
     if (!args->tolerances.empty() && args->previous.empty())
       throw ConfigError("--tolerances needs --previous");
-    const nlohmann::json result = ReadJsonFile(args->result, "--result");
+    const nlohmann::json result = ReadJsonFile(args->result);
     if (!result.is_object() || result.value("command", "") != "calibrate" ||
         !result.contains("calibration"))
       throw InputError(args->result + ": not a result of `aerocal calibrate` (--result)");
@@ -184,7 +177,7 @@ CommandRun SetupCertificate(CLI::App& app) {
         residuals.push_back({r["col"], r["row"], r["v_col_px"], r["v_row_px"]});
     cert["residuals"] = residuals;
     if (!args->previous.empty()) {
-      const nlohmann::json previous = ReadJsonFile(args->previous, "--previous");
+      const nlohmann::json previous = ReadJsonFile(args->previous);
       const nlohmann::json* old = Uncertainty(previous);
       if (!old) throw InputError(args->previous + ": neither a certificate.json nor a calibrate result (--previous)");
       cert["comparison"] = Compare(cert["results"], *old, tolerances);
