@@ -9,6 +9,7 @@
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/command_registry.h"
+#include "tools/python_script.h"
 
 #include <nlohmann/json.hpp>
 
@@ -20,12 +21,6 @@ namespace aerocal::tools {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string Quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
 
 // The lab file: sections of free-text fields, every key known (typos are errors).
 nlohmann::json ReadLab(const std::string& path) {
@@ -195,14 +190,9 @@ CommandRun SetupCertificate(CLI::App& app) {
     if (!args->no_render) {
       const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
       const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
-      const char* python_env = std::getenv("AEROCAL_PYTHON");
-      const std::string python =
-          python_env ? python_env : (fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3");
-      const std::string command = Quote(python) + " " + Quote(script) + " " + Quote(json_path) + " " +
-                                  Quote(args->out);
-      if (std::system(command.c_str()) != 0) {
+      if (!RunPythonScript(script, {json_path, args->out})) {
         std::fprintf(stderr, "error: the certificate could not be rendered (%s); certificate.json is complete\n",
-                     command.c_str());
+                     PythonCommandLine(script, {json_path, args->out}).c_str());
         return kExitInternal;
       }
       std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", args->out.c_str(),
