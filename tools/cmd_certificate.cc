@@ -5,9 +5,11 @@
 // tolerances. Deterministic: no clock, no random numbers (the date comes from the lab file).
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "calib/core/json_file.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/command_registry.h"
+#include "tools/python_script.h"
 #include "triangulation/calibration/uncertainty_budget.h"
 
 #include <nlohmann/json.hpp>
@@ -22,20 +24,6 @@ namespace aerocal::tools {
 namespace {
 
 namespace fs = std::filesystem;
-
-std::string Quote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
-nlohmann::json ReadJsonFile(const std::string& path, const std::string& option) {
-  try {
-    return nlohmann::json::parse(ReadTextFile(path));
-  } catch (const nlohmann::json::exception& e) {
-    throw InputError(path + ": not JSON (" + option + "): " + e.what());
-  }
-}
 
 // The lab file: sections of free-text fields, every key known (typos are errors).
 nlohmann::json ReadLab(const std::string& path) {
@@ -234,7 +222,7 @@ CommandRun SetupCertificate(CLI::App& app) {
     CheckOutputFolder(args->out, "--out");
     if (!args->tolerances.empty() && args->previous.empty())
       throw ConfigError("--tolerances needs --previous");
-    nlohmann::json result = ReadJsonFile(args->result, "--result");
+    nlohmann::json result = ReadJsonFile(args->result);
     if (result.is_object() && result.value("kind", "") == "flight")
       result = CalibrateFormOfFlight(result, args->result);
     if (!result.is_object() || result.value("command", "") != "calibrate" ||
@@ -276,7 +264,7 @@ CommandRun SetupCertificate(CLI::App& app) {
         residuals.push_back({r["col"], r["row"], r["v_col_px"], r["v_row_px"]});
     cert["residuals"] = residuals;
     if (!args->previous.empty()) {
-      const nlohmann::json previous = ReadJsonFile(args->previous, "--previous");
+      const nlohmann::json previous = ReadJsonFile(args->previous);
       const nlohmann::json* old = Uncertainty(previous);
       if (!old) throw InputError(args->previous + ": neither a certificate.json nor a calibrate result (--previous)");
       cert["comparison"] = Compare(cert["results"], *old, tolerances);
@@ -294,14 +282,9 @@ CommandRun SetupCertificate(CLI::App& app) {
     if (!args->no_render) {
       const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
       const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
-      const char* python_env = std::getenv("AEROCAL_PYTHON");
-      const std::string python =
-          python_env ? python_env : (fs::exists("/usr/bin/python3") ? "/usr/bin/python3" : "python3");
-      const std::string command = Quote(python) + " " + Quote(script) + " " + Quote(json_path) + " " +
-                                  Quote(args->out);
-      if (std::system(command.c_str()) != 0) {
+      if (!RunPythonScript(script, {json_path, args->out})) {
         std::fprintf(stderr, "error: the certificate could not be rendered (%s); certificate.json is complete\n",
-                     command.c_str());
+                     PythonCommandLine(script, {json_path, args->out}).c_str());
         return kExitInternal;
       }
       std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", args->out.c_str(),

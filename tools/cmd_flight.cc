@@ -11,22 +11,17 @@
 #include "calib/core/progress.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
+#include "tools/python_script.h"
 #include "triangulation/joint/joint_adjustment.h"
 #include "triangulation/workflow/flight_workflow.h"
 
 namespace aerocal::tools {
 namespace {
 
-std::string ShellQuote(const std::string& s) {
-  std::string out = "'";
-  for (char c : s) out += c == '\'' ? std::string("'\\''") : std::string(1, c);
-  return out + "'";
-}
-
 CommandRun SetupFlight(CLI::App& app) {
   struct Args {
     triangulation::FlightWorkflowOptions options;
-    std::string out, base, report_script, joint_model = "auto", camera_format;
+    std::string out, base, joint_model = "auto", camera_format;
     bool no_report = false;
   };
   auto args = std::make_shared<Args>();
@@ -82,9 +77,9 @@ CommandRun SetupFlight(CLI::App& app) {
       const char* env = std::getenv("AEROCAL_REPORT_SCRIPT");
       const std::string script = env ? env : AEROCAL_REPORT_SCRIPT;
       const std::string html = (fs::path(args->out) / "report.html").string();
-      const std::string command = "python3 " + ShellQuote(script) + " " + ShellQuote(json_path) + " " + ShellQuote(html);
-      if (std::system(command.c_str()) != 0) {
-        std::fprintf(stderr, "error: the report could not be written (%s); result.json is complete\n", command.c_str());
+      if (!RunPythonScript(script, {json_path, html})) {
+        std::fprintf(stderr, "error: the report could not be written (%s); result.json is complete\n",
+                     PythonCommandLine(script, {json_path, html}).c_str());
         return kExitInternal;
       }
       std::printf("report: %s\n", html.c_str());

@@ -3,8 +3,6 @@
 // of the virtual image (stitch/rig/error_analysis.h) at one target or over a grid of targets,
 // result.json plus histogram / bound-map CSV files and, through tools/report/rig_error_plots.py
 // (matplotlib), their PNG plots.
-#include <spawn.h>
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdio>
@@ -27,9 +25,9 @@
 #include "stitch/rig/dem_grid.h"
 #include "stitch/rig/rig_convert.h"
 #include "tools/command_registry.h"
+#include "tools/python_script.h"
 #include "tools/image_sources.h"
 
-extern char** environ;
 
 namespace aerocal::tools {
 namespace {
@@ -54,20 +52,6 @@ Eigen::Vector2d ParsePixel(const std::string& text, const std::string& option) {
   const auto row = comma == std::string::npos ? std::nullopt : ParseDouble(text.substr(comma + 1));
   if (!col || !row) throw ConfigError(option + ": expected COL,ROW (got '" + text + "')");
   return {*col, *row};
-}
-
-// Runs python3 SCRIPT ARGS... without a shell; true when it exits with 0.
-bool RunPython(const std::vector<std::string>& args) {
-  std::vector<std::string> argv_strings = {"python3"};
-  argv_strings.insert(argv_strings.end(), args.begin(), args.end());
-  std::vector<char*> argv;
-  for (auto& s : argv_strings) argv.push_back(s.data());
-  argv.push_back(nullptr);
-  pid_t pid = 0;
-  if (posix_spawnp(&pid, "python3", nullptr, nullptr, argv.data(), environ) != 0) return false;
-  int status = 0;
-  if (waitpid(pid, &status, 0) != pid) return false;
-  return WIFEXITED(status) && WEXITSTATUS(status) == 0;
 }
 
 std::string PlotScript() {
@@ -199,9 +183,9 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
                 args.grid, grid->points.size(), grid->unseen.size());
   if (args.no_plots || (files.histogram_png.empty() && files.bound_map_png.empty()))
     return kExitOk;
-  if (!RunPython({PlotScript(), args.out})) {
-    std::fprintf(stderr, "error: the plots could not be drawn (python3 %s %s); %s and the CSV "
-                 "files are complete\n", PlotScript().c_str(), args.out.c_str(), args.out.c_str());
+  if (!RunPythonScript(PlotScript(), {args.out})) {
+    std::fprintf(stderr, "error: the plots could not be drawn (%s); %s and the CSV files are complete\n",
+                 PythonCommandLine(PlotScript(), {args.out}).c_str(), args.out.c_str());
     return kExitInternal;
   }
   return kExitOk;

@@ -1,15 +1,16 @@
 #!/usr/bin/env bash
 # Runs the whole test suite of an already built tree (tools/setup.sh builds it), then the checking
 # jobs of issue 12, each in its own build dir (configured in place, incremental on a second run):
-#  - fuzz (build-fuzz/, clang libFuzzer with ASan + UBSan): by default the calib readers' targets
-#    (CSV tables; camera, rig and line-camera YAML; other tools' camera files) for
-#    AEROCAL_FUZZ_SECONDS (20 s) each: they link only aerocal::calib, the one library instrumented;
+#  - fuzz + sanitizer (build-fuzz/, clang with ASan + UBSan, libFuzzer): by default the calib
+#    readers' fuzz targets (CSV tables; camera, rig and line-camera YAML; other tools' camera
+#    files) for AEROCAL_FUZZ_SECONDS (20 s) each, and the calib `unit` tests under the same
+#    sanitizers: both link only aerocal::calib, the one library instrumented there;
 #  - AEROCAL_FULL_CHECKS=1 adds every fuzz target (block files, stitching CSV, importers, stitch
-#    result JSON) and the sanitizer job (build-asan/, gcc -fsanitize=address,undefined): the tests
-#    labelled `unit` and the bad-input CLI cases (tools/bad_input runs the sanitized aerocal).
-#    The whole instrumented clang build took 12.5 min on 2 cores (the gcc ASan one is of the same
-#    order), too much for the 25-minute CI budget, hence off by default (README "Checking jobs").
-# AEROCAL_FUZZ=0 skips fuzzing. Idempotent: nothing is installed here.
+#    result JSON) and the whole sanitizer job (build-asan/, gcc -fsanitize=address,undefined): every
+#    test labelled `unit` and the bad-input CLI cases (tools/bad_input runs the sanitized aerocal).
+#    That instruments all three libraries (12.5 min on 2 cores for the clang build), too much for
+#    the 25-minute CI budget, hence off by default (README "Checking jobs").
+# AEROCAL_FUZZ=0 skips fuzzing and the calib sanitizer tests. Idempotent: nothing is installed here.
 set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="$(nproc)"
@@ -23,28 +24,35 @@ else
   ctest --test-dir "$root/build" --output-on-failure -j"$jobs" -LE long
 fi
 
+# `ctest -N` names of the tests matching the ctest arguments, as their build targets.
+test_targets() {
+  ctest --test-dir "$1" -N "${@:2}" | sed -n 's/^ *Test *#[0-9]*: *//p' | sed 's|/|_|g'
+}
+
+export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 if [ "${AEROCAL_FUZZ:-1}" = 1 ]; then
   CXX=clang++ cmake -S "$root" -B "$root/build-fuzz" -DCMAKE_BUILD_TYPE=Release \
-    -DAEROCAL_BUILD_FUZZERS=ON -DAEROCAL_BUILD_TESTS=OFF >/dev/null
+    -DAEROCAL_BUILD_FUZZERS=ON -DAEROCAL_BUILD_TESTS=ON >/dev/null
   if [ "$full" = 1 ]; then
-    cmake --build "$root/build-fuzz" -j"$jobs"
+    mapfile -t fuzz < <(test_targets "$root/build-fuzz" -L fuzz)
+    cmake --build "$root/build-fuzz" -j"$jobs" --target "${fuzz[@]}"
     ctest --test-dir "$root/build-fuzz" --output-on-failure -j"$jobs" -L fuzz
   else
     cmake --build "$root/build-fuzz" -j"$jobs" --target fuzz_csv fuzz_camera_yaml fuzz_camera_formats
     ctest --test-dir "$root/build-fuzz" --output-on-failure -j"$jobs" -L fuzz \
       -R '^fuzz/(csv|camera_yaml|camera_formats)$'
   fi
+  # The calib unit tests under ASan + UBSan, on the calib library the fuzz targets instrumented.
+  mapfile -t calib_unit < <(test_targets "$root/build-fuzz" -L unit -R '^calib/' | sed 's/^/test_/')
+  cmake --build "$root/build-fuzz" -j"$jobs" --target "${calib_unit[@]}"
+  ctest --test-dir "$root/build-fuzz" --output-on-failure -j"$jobs" -L unit -R '^calib/'
 fi
 
 if [ "$full" = 1 ]; then
   cmake -S "$root" -B "$root/build-asan" -DCMAKE_BUILD_TYPE=Release -DAEROCAL_SANITIZE=ON >/dev/null
-  targets=(aerocal test_tools_bad_input)
-  while read -r name; do
-    targets+=("test_${name//\//_}")
-  done < <(ctest --test-dir "$root/build-asan" -N -L unit | sed -n 's/^ *Test *#[0-9]*: *//p' |
-           grep -v '^architecture/')
-  cmake --build "$root/build-asan" -j"$jobs" --target "${targets[@]}"
-  export ASAN_OPTIONS=detect_leaks=1 UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+  # (architecture/module_boundaries is a script, no target)
+  mapfile -t targets < <(test_targets "$root/build-asan" -L unit | grep -v '^architecture_' | sed 's/^/test_/')
+  cmake --build "$root/build-asan" -j"$jobs" --target aerocal test_tools_bad_input "${targets[@]}"
   ctest --test-dir "$root/build-asan" --output-on-failure -j"$jobs" -L unit
   ctest --test-dir "$root/build-asan" --output-on-failure -R '^tools/bad_input$'
 fi

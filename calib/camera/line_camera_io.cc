@@ -19,15 +19,6 @@ constexpr double kMaxLeverArmM = 1000.0;
 constexpr double kMaxCorrectionMm = 1000.0;  // |dx|, |dy|, |polynomial coefficient|
 constexpr int kMaxPolynomialTerms = 10;
 
-Eigen::Vector3d ReadVector3(const YAML::Node& node, const std::string& file,
-                            const std::string& what, double bound) {
-  if (!node.IsSequence() || node.size() != 3)
-    ThrowInputError(WhereIs(node, file), what + " must be a list of 3 numbers");
-  return {YamlBounded(node[0], file, what, -bound, bound),
-          YamlBounded(node[1], file, what, -bound, bound),
-          YamlBounded(node[2], file, what, -bound, bound)};
-}
-
 double ReadPositive(const YAML::Node& node, const std::string& file, const std::string& what,
                     double lo, double hi) {
   const double value = YamlDouble(node, file, what);
@@ -81,9 +72,12 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
   camera.pitch_mm = ReadPositive(line["pitch_mm"], file, "line.pitch_mm", kMinPitchMm, kMaxPitchMm);
   camera.c_mm = ReadPositive(line["c"], file, "line.c", 0.0, kMaxCMm);
   if (line["mount_deg"])
-    camera.mount_rad = ReadVector3(line["mount_deg"], file, "line.mount_deg", kMaxAngleDeg) * kRadPerDeg;
+    camera.mount_rad =
+        YamlVector3(line["mount_deg"], file, "line.mount_deg", -kMaxAngleDeg, kMaxAngleDeg) *
+        kRadPerDeg;
   if (line["lever_arm_m"])
-    camera.lever_arm_m = ReadVector3(line["lever_arm_m"], file, "line.lever_arm_m", kMaxLeverArmM);
+    camera.lever_arm_m =
+        YamlVector3(line["lever_arm_m"], file, "line.lever_arm_m", -kMaxLeverArmM, kMaxLeverArmM);
 
   if (const YAML::Node& subs = line["subcameras"]) {
     if (!subs.IsSequence() || subs.size() == 0)
@@ -111,7 +105,10 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
       s.c_mm = ReadPositive(node["c"], file, "sub-camera c", 0.0, kMaxCMm);
       s.pitch_mm = ReadPositive(node["pitch_mm"], file, "sub-camera pitch_mm", kMinPitchMm, kMaxPitchMm);
       if (node["mount_deg"])
-        s.mount_rad = ReadVector3(node["mount_deg"], file, "sub-camera mount_deg", kMaxAngleDeg) * kRadPerDeg;
+        s.mount_rad =
+            YamlVector3(
+                node["mount_deg"], file, "sub-camera mount_deg", -kMaxAngleDeg, kMaxAngleDeg) *
+            kRadPerDeg;
       camera.subcameras.push_back(s);
     }
     if (next != camera.detectors)

@@ -18,17 +18,17 @@ const std::vector<std::string> kHeadCameraKeys = {"pixel_size_mm", "format_px", 
 const std::vector<std::string> kHeadRigKeys = {"id", "mount_deg", "lever_arm_m", "mount_sigma_deg",
                                                "lever_arm_sigma_m"};
 
-Eigen::Vector3d ReadVector3(const YAML::Node& node, const std::string& file,
-                            const std::string& what) {
-  if (!node.IsSequence() || node.size() != 3)
-    ThrowInputError(WhereIs(node, file), what + " must be a list of 3 numbers");
-  return {YamlDouble(node[0], file, what), YamlDouble(node[1], file, what),
-          YamlDouble(node[2], file, what)};
-}
+// Bounds of the rig's relative orientation (as the line camera's, calib/camera/line_camera_io.cc):
+// a mount is an attitude (|angle| <= 360 deg), a lever arm a body offset (|t| <= 1000 m); sigmas of
+// either are positive and below those bounds.
+constexpr double kMaxAngleDeg = 360.0;
+constexpr double kMaxLeverArmM = 1000.0;
 
-Eigen::Vector3d ReadSigma3(const YAML::Node& node, const std::string& file,
-                           const std::string& what) {
-  const Eigen::Vector3d sigma = ReadVector3(node, file, what);
+Eigen::Vector3d ReadSigma3(const YAML::Node& node,
+                           const std::string& file,
+                           const std::string& what,
+                           double bound) {
+  const Eigen::Vector3d sigma = YamlVector3(node, file, what, 0.0, bound);
   if (!(sigma.minCoeff() > 0))
     ThrowInputError(WhereIs(node, file), what + " must be > 0 (got [" + FormatNumber(sigma[0]) +
                                              ", " + FormatNumber(sigma[1]) + ", " +
@@ -64,12 +64,17 @@ RigHead ReadHead(const YAML::Node& node, const std::string& file) {
   head.camera = ParseCamera(camera_node, file);
   head.camera.name = head.id;
   if (node["mount_deg"])
-    head.mount_rad = ReadVector3(node["mount_deg"], file, "mount_deg") * kRadPerDeg;
-  if (node["lever_arm_m"]) head.lever_arm_m = ReadVector3(node["lever_arm_m"], file, "lever_arm_m");
+    head.mount_rad =
+        YamlVector3(node["mount_deg"], file, "mount_deg", -kMaxAngleDeg, kMaxAngleDeg) * kRadPerDeg;
+  if (node["lever_arm_m"])
+    head.lever_arm_m =
+        YamlVector3(node["lever_arm_m"], file, "lever_arm_m", -kMaxLeverArmM, kMaxLeverArmM);
   if (node["mount_sigma_deg"])
-    head.mount_sigma_rad = ReadSigma3(node["mount_sigma_deg"], file, "mount_sigma_deg") * kRadPerDeg;
+    head.mount_sigma_rad =
+        ReadSigma3(node["mount_sigma_deg"], file, "mount_sigma_deg", kMaxAngleDeg) * kRadPerDeg;
   if (node["lever_arm_sigma_m"])
-    head.lever_arm_sigma_m = ReadSigma3(node["lever_arm_sigma_m"], file, "lever_arm_sigma_m");
+    head.lever_arm_sigma_m =
+        ReadSigma3(node["lever_arm_sigma_m"], file, "lever_arm_sigma_m", kMaxLeverArmM);
   return head;
 }
 

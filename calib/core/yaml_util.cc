@@ -98,6 +98,18 @@ double YamlBounded(const YAML::Node& node, const std::string& file, const std::s
   return value;
 }
 
+Eigen::Vector3d YamlVector3(const YAML::Node& node,
+                            const std::string& file,
+                            const std::string& what,
+                            double lo,
+                            double hi) {
+  if (!node.IsSequence() || node.size() != 3)
+    ThrowInputError(WhereIs(node, file), what + " must be a list of 3 numbers");
+  return {YamlBounded(node[0], file, what, lo, hi),
+          YamlBounded(node[1], file, what, lo, hi),
+          YamlBounded(node[2], file, what, lo, hi)};
+}
+
 std::string YamlString(const YAML::Node& node, const std::string& file, const std::string& what) {
   if (!node.IsDefined()) ThrowInputError({file, 0}, "missing " + what);
   if (!node.IsScalar()) ThrowInputError(WhereIs(node, file), what + " must be a string");

@@ -2,12 +2,13 @@
 // errors, missing keys keep defaults, YAML::Node::Mark() is 0-based so +1 for humans).
 #pragma once
 
-#include <string>
-#include <vector>
+#include "calib/core/error.h"
 
+#include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
-#include "calib/core/error.h"
+#include <string>
+#include <vector>
 
 namespace aerocal {
 
@@ -31,5 +32,8 @@ int YamlInt(const YAML::Node& node, const std::string& file, const std::string& 
 double YamlBounded(const YAML::Node& node, const std::string& file, const std::string& what,
                    double lo, double hi);
 std::string YamlString(const YAML::Node& node, const std::string& file, const std::string& what);
+/// A list of exactly 3 numbers, each within [lo, hi]; InputError at the node's line otherwise.
+Eigen::Vector3d YamlVector3(
+    const YAML::Node& node, const std::string& file, const std::string& what, double lo, double hi);
 
 }  // namespace aerocal

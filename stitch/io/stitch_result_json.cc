@@ -8,6 +8,7 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "calib/core/json_file.h"
 #include "stitch/adjustment/mapping_param_names.h"
 
 namespace aerocal::stitch {
@@ -212,12 +213,7 @@ json StitchResultToJson(const BatchResult& result, const BatchOptions& options) 
 
 calib::Camera ApplyStitchResult(const calib::Camera& camera, const std::string& path,
                                 const std::string& frame) {
-  json doc;
-  try {
-    doc = json::parse(ReadTextFile(path));
-  } catch (const json::exception& e) {
-    throw InputError(path + ": not a JSON document (" + e.what() + ")");
-  }
+  const json doc = ReadJsonFile(path);
   const json* source = &doc;
   if (!frame.empty()) {
     source = nullptr;

@@ -87,9 +87,18 @@ DemGrid ReadDemAscii(const std::string& path) {
     if (key != "ncols" && key != "nrows" && key != "cellsize" && key != "xllcorner" &&
         key != "xllcenter" && key != "yllcorner" && key != "yllcenter" && key != "nodata_value")
       throw InputError(where(value.second) + "unknown header '" + key + "'");
+  // Every height takes at least two bytes ("0 "): a header that declares more heights than the
+  // rest of the file can hold is refused before the grid is allocated (1e6 x 1e6 would be 8 TB).
+  in.clear();
+  in.seekg(0, std::ios::end);
+  const double data_bytes = static_cast<double>(in.tellg() - data_start);
+  const double declared = static_cast<double>(dem.cols) * dem.rows;
+  if (declared > data_bytes / 2.0 + 1.0)
+    throw InputError(where(rows_line) + "ncols x nrows = " + FormatNumber(declared) +
+                     " heights, more than the file's " + FormatNumber(data_bytes) +
+                     " bytes of data can hold");
   // Heights: rows north to south in the file, stored south to north.
   dem.height.assign(static_cast<size_t>(dem.cols) * dem.rows, 0.0);
-  in.clear();
   in.seekg(data_start);
   line_no = header_lines;
   int valid = 0;

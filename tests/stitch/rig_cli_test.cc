@@ -24,7 +24,7 @@ std::string Analysis(const std::string& extra) {
   return "rig error-analysis --camera " + kRig + " --limits " + kLimits + " " + extra;
 }
 
-json ReadJson(const std::string& path) { return json::parse(ReadTextFile(path)); }
+using aerocal::testing::ReadJson;
 
 const json& SourceRow(const json& doc, const std::string& name) {
   for (const json& row : doc["per_source"])

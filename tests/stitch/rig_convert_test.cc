@@ -191,6 +191,14 @@ TEST(RigConvert, DemOfATiltedPlaneIsThatPlane) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("short.asc:7: expected 3 heights, got 1"), std::string::npos) << e.what();
   }
+  // A header of 1e6 x 1e6 heights (8 TB) over a few bytes: refused at the header, nothing allocated.
+  WriteFileAtomically(dir.File("huge.asc"), "ncols 1000000\nnrows 1000000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n");
+  try {
+    ReadDemAscii(dir.File("huge.asc"));
+    ADD_FAILURE() << "a 1e12-height header was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("huge.asc:2: ncols x nrows = 1e+12 heights"), std::string::npos) << e.what();
+  }
 }
 
 using testing::SampleCubic;

@@ -44,10 +44,7 @@ calib::Camera WriteFrames(const calib::Camera& camera, const std::vector<std::st
   return truth;
 }
 
-nlohmann::json ReadJson(const std::string& path) {
-  std::ifstream in(path);
-  return nlohmann::json::parse(in);
-}
+using aerocal::testing::ReadJson;
 
 TEST(StitchCommand, AdjustsEveryExampleCameraWithTheFormatsKeys) {
   for (const Example& example : kExamples) {

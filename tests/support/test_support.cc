@@ -1,6 +1,7 @@
 #include "tests/support/test_support.h"
 
 #include "calib/core/atomic_file.h"
+#include "calib/core/json_file.h"
 
 #include <array>
 #include <cstdio>
@@ -56,7 +57,7 @@ std::string SharedDataDir(const std::string& name) {
 }
 
 nlohmann::json ReadJson(const std::string& path) {
-  return nlohmann::json::parse(ReadTextFile(path));
+  return ReadJsonFile(path);
 }
 
 }  // namespace aerocal::testing

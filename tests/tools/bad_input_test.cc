@@ -9,6 +9,7 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <map>
 #include <sstream>
 
 #include <gtest/gtest.h>
@@ -98,6 +99,42 @@ const std::string& BaseFlight() {
 std::string Flight(const TempDir& d) {
   fs::copy(BaseFlight(), d.File("sim"), fs::copy_options::recursive);
   return d.File("sim");
+}
+
+// A copy of a simulated pushbroom flight (`simulate --pushbroom`) or dual-lens rig flight
+// (`simulate --rig dual-lens`), each simulated once, in the fresh folder `d`/`name`.
+std::string SimulatedCopy(const TempDir& d, const std::string& name, const std::string& options) {
+  static TempDir* base = new TempDir("aerocal_bad_input_kinds");
+  static std::map<std::string, bool> made;
+  if (!made[name]) {
+    const auto r = RunAerocal("simulate --out " + base->File(name) + " " + options);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    made[name] = true;
+  }
+  fs::copy(base->File(name), d.File(name), fs::copy_options::recursive);
+  return d.File(name);
+}
+std::string PushbroomFlight(const TempDir& d) { return SimulatedCopy(d, "pb", "--pushbroom"); }
+std::string RigFlight(const TempDir& d) { return SimulatedCopy(d, "rig", "--rig dual-lens"); }
+
+// Replaces the first `from` in the file by `to` (the case's one defect); `from` must be there.
+void ReplaceFirst(const std::string& path, const std::string& from, const std::string& to) {
+  std::string text = Read(path);
+  const size_t at = text.find(from);
+  EXPECT_NE(at, std::string::npos) << from << " not in " << path;
+  if (at != std::string::npos) text.replace(at, from.size(), to);
+  Write(path, text);
+}
+
+std::string PushbroomArgs(const std::string& pb) {
+  return "pushbroom calibrate --camera " + pb + "/camera_nominal.yaml --pos " + pb + "/pos.csv --observations " +
+         pb + "/observations.csv --points " + pb + "/points.csv --out " + pb + "/r.json --write-camera " + pb +
+         "/cam_out.yaml";
+}
+
+std::string RigAnalysisArgs(const std::string& rig) {
+  return "rig error-analysis --camera " + rig + "/rig_nominal.yaml --limits " + std::string(AEROCAL_CONFIGS_DIR) +
+         "/rig_dual_lens_limits.yaml --no-plots --out " + rig + "/ea";
 }
 
 // Minimal DBAT block: a camera XML, two images, eight marks each, initial EO.
@@ -644,6 +681,84 @@ const std::vector<Case>& Cases() {
          return "camera convert --from colmap --to opencv " + d.File("cameras.txt") + " " + d.File("outdir");
        },
        2, "OUT", ""},
+      // ---- line (pushbroom) camera, POS trajectory, rig camera, certificate (issues 13, 14, 17) ----
+      {"line_camera_detectors_do_not_add_up",
+       [](const TempDir& d) {
+         const auto pb = PushbroomFlight(d);
+         ReplaceFirst(pb + "/camera_nominal.yaml", "detectors: 900", "detectors: 901");
+         return PushbroomArgs(pb);
+       },
+       2, "camera_nominal.yaml:9: line.subcameras hold 900 detectors, line.detectors is 901", "pb/r.json"},
+      {"line_camera_mount_out_of_range",
+       [](const TempDir& d) {
+         const auto pb = PushbroomFlight(d);
+         ReplaceFirst(pb + "/camera_nominal.yaml", "mount_deg: [0, 20, 0]", "mount_deg: [0, 2000, 0]");
+         return PushbroomArgs(pb);
+       },
+       2, "camera_nominal.yaml:9: sub-camera mount_deg out of range (got 2000", "pb/r.json"},
+      {"pos_line_not_increasing",
+       [](const TempDir& d) {
+         const auto pb = PushbroomFlight(d);
+         ReplaceFirst(pb + "/pos.csv", "\n4,", "\n2,");
+         return PushbroomArgs(pb);
+       },
+       2, "pos.csv:6: line must increase strictly", "pb/r.json"},
+      {"pos_time_nan",
+       [](const TempDir& d) {
+         const auto pb = PushbroomFlight(d);
+         ReplaceFirst(pb + "/pos.csv", "\n1,1000.0205932272146,", "\n1,nan,");
+         return PushbroomArgs(pb);
+       },
+       2, "pos.csv:3: column 'time_s' must be a number (got 'nan')", "pb/r.json"},
+      {"pushbroom_observation_outside_the_trajectory",
+       [](const TempDir& d) {
+         const auto pb = PushbroomFlight(d);
+         ReplaceFirst(pb + "/observations.csv", "\nstrip,c1,804.94626214520156,393.78854414734786,",
+                      "\nstrip,c1,804.94626214520156,1e6,");
+         return PushbroomArgs(pb);
+       },
+       2, "observations.csv:2: row (scan line) 1000000 is outside the POS trajectory", "pb/cam_out.yaml"},
+      {"rig_reference_head_unknown",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         ReplaceFirst(rig + "/rig_nominal.yaml", "reference_head: A", "reference_head: Q");
+         return RigAnalysisArgs(rig);
+       },
+       2, "rig_nominal.yaml:3: reference_head 'Q' is not one of the heads", "rig/ea"},
+      {"rig_head_id_twice",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         ReplaceFirst(rig + "/rig_nominal.yaml", "- id: B", "- id: A");
+         return RigAnalysisArgs(rig);
+       },
+       2, "rig_nominal.yaml:30: duplicate head id 'A'", "rig/ea"},
+      {"rig_mount_out_of_range",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         ReplaceFirst(rig + "/rig_nominal.yaml", "mount_deg: [0, 0, 0]", "mount_deg: [0, 0, 1e300]");
+         return RigAnalysisArgs(rig);
+       },
+       2, "rig_nominal.yaml:28: mount_deg out of range (got 1e300", "rig/ea"},
+      {"rig_lever_arm_sigma_zero",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         ReplaceFirst(rig + "/rig_nominal.yaml", "lever_arm_m: [0, 0, 0]",
+                      "lever_arm_m: [0, 0, 0]\n      lever_arm_sigma_m: [0.01, 0, 0.01]");
+         return RigAnalysisArgs(rig);
+       },
+       2, "rig_nominal.yaml:30: lever_arm_sigma_m must be > 0", "rig/ea"},
+      {"certificate_of_a_broken_json",
+       [](const TempDir& d) {
+         Write(d.File("r.json"), "{\"schema_version\": 1,\n \"values\": [1, 2\n");
+         return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
+       },
+       2, "r.json:3: invalid JSON", "cert"},
+      {"certificate_of_an_adjust_result",
+       [](const TempDir& d) {
+         Write(d.File("r.json"), "{\"schema_version\": 1, \"kind\": \"self_calibration\"}\n");
+         return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
+       },
+       2, "r.json: not a result of `aerocal calibrate`", "cert"},
   };
   return cases;
 }

@@ -26,7 +26,7 @@ namespace {
 
 using testing::RunAerocal;
 
-nlohmann::json ReadJson(const std::string& path) { return nlohmann::json::parse(ReadTextFile(path)); }
+using testing::ReadJson;
 
 // |estimate - truth| / sigma of every free mapping parameter of a joint result.
 std::vector<double> MappingErrors(const nlohmann::json& joint, const calib::Camera& truth) {

@@ -15,31 +15,24 @@
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+#include "calib/core/json_file.h"
 
 namespace aerocal::calib {
 namespace {
 
 using Json = nlohmann::json;
 
-int LineAt(const std::string& text, size_t offset) {
-  return 1 + static_cast<int>(std::count(text.begin(), text.begin() + std::min(offset, text.size()), '\n'));
-}
 // Line of the first `"key"` at or after `from` (the camera's own entry).
 int LineOfKey(const std::string& text, const std::string& key, size_t from) {
   const size_t at = text.find("\"" + key + "\"", from);
-  return LineAt(text, at == std::string::npos ? from : at);
+  return LineOfOffset(text, at == std::string::npos ? from : at);
 }
 
 }  // namespace
 
 CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options) {
   const std::string text = ReadTextFile(path);
-  Json root;
-  try {
-    root = Json::parse(text);
-  } catch (const Json::parse_error& e) {
-    ThrowInputError({path, LineAt(text, e.byte)}, "invalid JSON");
-  }
+  Json root = ParseJsonText(text, path);
   const Json* cameras = &root;
   if (root.is_array() && !root.empty() && root[0].is_object() && root[0].contains("cameras"))
     cameras = &root[0]["cameras"];

@@ -1,0 +1,32 @@
+#include "calib/core/json_file.h"
+
+#include <algorithm>
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+
+namespace aerocal {
+
+int LineOfOffset(const std::string& text, size_t offset) {
+  const auto end = text.begin() + static_cast<std::ptrdiff_t>(std::min(offset, text.size()));
+  return 1 + static_cast<int>(std::count(text.begin(), end, '\n'));
+}
+
+nlohmann::json ParseJsonText(const std::string& text, const std::string& path) {
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    // e.byte is 1-based and points just past the offending character.
+    const size_t at = e.byte > 0 ? e.byte - 1 : 0;
+    std::string reason = e.what();
+    const size_t colon = reason.find(": ", reason.find("parse error"));
+    if (colon != std::string::npos) reason = reason.substr(colon + 2);
+    ThrowInputError({path, LineOfOffset(text, at)}, "invalid JSON (" + reason + ")");
+  }
+}
+
+nlohmann::json ReadJsonFile(const std::string& path) {
+  return ParseJsonText(ReadTextFile(path), path);
+}
+
+}  // namespace aerocal

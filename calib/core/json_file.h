@@ -1,0 +1,21 @@
+// Reading a JSON document from a file: one place that turns nlohmann's parse error (a byte offset)
+// into the `FILE:LINE: what` every reader reports.
+#pragma once
+
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+namespace aerocal {
+
+/// 1-based line of the byte `offset` in `text` (offsets past the end give the last line).
+int LineOfOffset(const std::string& text, size_t offset);
+
+/// Parses `text` (the contents of `path`); InputError("PATH:LINE: invalid JSON (reason)") when it
+/// is not a JSON document.
+nlohmann::json ParseJsonText(const std::string& text, const std::string& path);
+
+/// ReadTextFile (regular-file checks, BOM dropped) + ParseJsonText.
+nlohmann::json ReadJsonFile(const std::string& path);
+
+}  // namespace aerocal
