@@ -26,8 +26,8 @@ const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
 
 // "image 0012 point T442", "image 0012 sub-image A1 point T442": an observation in reports.
 std::string DescribeObservation(const ImageObservation& o) {
-  return "image " + o.image + (o.subimage.empty() ? "" : " sub-image " + o.subimage) + " point " +
-         o.point;
+  return "image " + o.image + (o.subimage.empty() ? "" : " sub-image " + o.subimage) +
+         (o.head.empty() ? "" : " head " + o.head) + " point " + o.point;
 }
 
 }  // namespace
@@ -521,6 +521,7 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
     r.point = o.point;
     r.measured_px = o.pixel;
     r.subimage = o.subimage;
+    r.head = o.head;
     r.w = x.w_max;
     if (x.v.size() == 2) r.residual_px = Eigen::Vector2d(x.v[0], x.v[1]) * o.sigma_px;
     r.test = to_test(x, o.sigma_px);
@@ -607,6 +608,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     v.point = o.point;
     v.measured_px = o.pixel;
     v.subimage = o.subimage;
+    v.head = o.head;
     if (!o.subimage.empty()) v.subimage_px = o.pixel;
     v.sigma_px = o.sigma_px;
     v.used = builder_.IsActive(id);

@@ -381,7 +381,11 @@ RigAdjustmentResult AdjustRig(const Project& project,
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
   result.determinability = AssessDeterminability(cov, "rig ", options.correlation_threshold);
   rig->Collect(context, cov, &result);
-  if (options.estimate_covariance && !cov.ok)
+  const auto& reasons = result.adjustment.invalid_reasons;
+  const bool said = std::any_of(reasons.begin(), reasons.end(), [&](const std::string& reason) {
+    return reason.find(cov.message) != std::string::npos;
+  });
+  if (options.estimate_covariance && !cov.ok && !said)  // not twice when the block's failed too
     result.adjustment.Invalidate("rig: no covariance of the rig parameters: " + cov.message);
   else if (!result.determinability.undetermined.empty())
     result.adjustment.Invalidate(
@@ -498,7 +502,9 @@ std::string FormatRigSummary(const RigAdjustmentResult& r) {
                          6) +
              "\n";
   }
-  for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
+  // Without a covariance the block's summary has said why already.
+  if (r.determinability.covariance_ok)
+    for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
   return out;
 }
 
