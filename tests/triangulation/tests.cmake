@@ -12,3 +12,4 @@ aerocal_add_test(triangulation/data_snooping LIBS aerocal::triangulation LABELS 
 aerocal_add_test(triangulation/snooping_cli LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(triangulation/rig_flight_simulator LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/calibration LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/wall_pose LIBS aerocal::triangulation LABELS synthetic)
