@@ -336,9 +336,9 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
       sigma = {{"X", e.center_sigma_m->x()},
                {"Y", e.center_sigma_m->y()},
                {"Z", e.center_sigma_m->z()},
-               {"omega", e.opk_sigma_rad->x() * kRadToDeg},
-               {"phi", e.opk_sigma_rad->y() * kRadToDeg},
-               {"kappa", e.opk_sigma_rad->z() * kRadToDeg}};
+               {"omega", Finite(e.opk_sigma_rad->x() * kRadToDeg)},  // null at phi = +-90 deg
+               {"phi", Finite(e.opk_sigma_rad->y() * kRadToDeg)},
+               {"kappa", Finite(e.opk_sigma_rad->z() * kRadToDeg)}};
     x["sigma"] = sigma;
     x["used"] = e.used;
     j["exposures"].push_back(x);
