@@ -9,6 +9,7 @@
 #include "calib/core/error.h"
 #include "tests/support/rig_flight_project.h"
 #include "tests/support/test_support.h"
+#include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/sensor/rig_head_camera.h"
 #include "triangulation/simulation/rig_flight_simulator.h"
@@ -178,6 +179,13 @@ TEST(RigBundle, OptionsAndRigFileRulesAreEnforced) {
   rig = {};
   rig.mounts = RigParameterMode::kWeighted;  // the nominal rig file has no mount sigmas
   EXPECT_THROW(AdjustRig(project, AdjustOptions{}, rig), ConfigError);
+  // The frame camera never takes a head pixel for a virtual-image pixel.
+  try {
+    Adjust(project, AdjustOptions{});
+    ADD_FAILURE() << "a rig project adjusted without the rig bundle";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("rig bundle"), std::string::npos) << e.what();
+  }
 }
 
 TEST(RigBundle, ProjectReaderTakesARigFileAndRejectsMisplacedHeads) {

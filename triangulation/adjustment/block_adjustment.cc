@@ -146,6 +146,11 @@ void BlockAdjustment::BuildPoints() {
     ImagingModel* sensor = nullptr;
     for (auto& s : storage_->sensors)
       if (!sensor && s->Measures(o)) sensor = s.get();
+    if (!sensor && !o.head.empty())  // never a virtual-image pixel: the rig bundle measures it
+      ThrowInputError({project_.observations_file, o.line},
+                      "image " + o.image + " head " + o.head +
+                          ": rig head observations are adjusted by the rig bundle (aerocal "
+                          "adjust without --joint-stitching)");
     if (!sensor && storage_->frame.Measures(o)) sensor = &storage_->frame;
     if (sensor) {
       storage_->observations.push_back(o);
