@@ -1,6 +1,7 @@
 // aerocal adjust: self-calibrating bundle block adjustment with control and check points
 // (triangulation/adjustment). Parsing, loading, calling the library, writing results.
 #include "calib/camera/camera_io.h"
+#include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
@@ -11,7 +12,10 @@
 #include "triangulation/adjustment/conventional_reference.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
+#include "triangulation/sensor/rig_head_camera.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -19,6 +23,62 @@ namespace aerocal::tools {
 namespace {
 
 using triangulation::AdjustmentResult;
+
+// The --rig-* options as given.
+struct RigArgs {
+  std::string mounts = "free", lever_arms = "free", increments = "fixed", time_offsets = "fixed";
+  double increment_sigma_arcsec = 0.0, time_offset_sigma_ms = 0.0;
+};
+
+triangulation::RigParameterMode RigMode(const std::string& option, const std::string& value) {
+  const auto mode = triangulation::ParseRigParameterMode(value);
+  if (!mode) throw ConfigError(option + " must be fixed, free or weighted (got '" + value + "')");
+  return *mode;
+}
+
+// `adjust` of a project with a rig camera file: the rig bundle (rig_head_camera.h).
+int RunRigAdjust(const RigArgs& args,
+                 const triangulation::AdjustOptions& options,
+                 const triangulation::Project& input,
+                 const triangulation::Project& project,
+                 const triangulation::ObjectFrame& frame,
+                 const std::string& project_path,
+                 const std::string& out,
+                 const std::string& write_camera) {
+  triangulation::RigAdjustOptions rig;
+  rig.mounts = RigMode("--rig-mounts", args.mounts);
+  rig.lever_arms = RigMode("--rig-lever-arms", args.lever_arms);
+  rig.increments = RigMode("--rig-increments", args.increments);
+  rig.time_offsets = RigMode("--rig-time-offsets", args.time_offsets);
+  rig.increment_sigma_rad = args.increment_sigma_arcsec * M_PI / (180.0 * 3600.0);
+  rig.time_offset_sigma_s = args.time_offset_sigma_ms * 1e-3;
+  rig.Validate();
+
+  triangulation::RigAdjustmentResult result = triangulation::AdjustRig(project, options, rig);
+  triangulation::ToInputFrame(frame, &result.adjustment);
+  std::printf("%s%s", triangulation::FormatSummary(result.adjustment).c_str(),
+              triangulation::FormatRigSummary(result).c_str());
+  nlohmann::json json = triangulation::AdjustmentToJson(result.adjustment);
+  json.update(triangulation::RigResultToJson(result));
+  json["project"] = project_path;
+  json["valid"] = result.adjustment.valid;
+  json["invalid_reasons"] = result.adjustment.invalid_reasons;
+  WriteFileAtomically(out, json.dump(2) + "\n");
+  // As the frame camera: exit 3 and no rig file when the result is not valid.
+  const bool ok = result.adjustment.valid;
+  for (const auto& reason : result.adjustment.invalid_reasons)
+    std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());
+  if (!write_camera.empty()) {
+    if (!ok) {
+      std::fprintf(stderr, "rig camera not written: the result is not valid\n");
+    } else {
+      calib::WriteRig(write_camera, triangulation::UpdatedRig(input.rigs.at(result.camera), result));
+      std::printf("rig camera %s -> %s\n", result.camera.c_str(), write_camera.c_str());
+    }
+  }
+  std::printf("result -> %s\n", out.c_str());
+  return ok ? kExitOk : kExitNotConverged;
+}
 
 CommandRun SetupAdjust(CLI::App& app) {
   struct Args {
@@ -28,6 +88,7 @@ CommandRun SetupAdjust(CLI::App& app) {
     double default_sigma_px = 0.5;
     triangulation::AdjustOptions options;
     JointAdjustArgs joint;
+    RigArgs rig;
   };
   auto args = std::make_shared<Args>();
   app.add_option(
@@ -90,7 +151,35 @@ CommandRun SetupAdjust(CLI::App& app) {
                  "Report parameter pairs correlated above this")
       ->check(CLI::Range(0.0, 1.0));
   AddJointAdjustOptions(app, &args->joint);
-  return [args]() {
+  // The rig bundle (a project whose camera file has a `rig` section): which rig parameters of the
+  // non-reference heads are estimated.
+  std::vector<CLI::Option*> rig_options = {
+      app.add_option("--rig-mounts",
+                     args->rig.mounts,
+                     "Rig: mount angles of the non-reference heads: fixed | free (default) | "
+                     "weighted (the rig file's mount_sigma_deg)"),
+      app.add_option("--rig-lever-arms",
+                     args->rig.lever_arms,
+                     "Rig: lever arms of the non-reference heads: fixed | free (default) | "
+                     "weighted (the rig file's lever_arm_sigma_m)"),
+      app.add_option("--rig-increments",
+                     args->rig.increments,
+                     "Rig: per-exposure attitude increments E_k of the non-reference heads: fixed "
+                     "(zero, default) | free | weighted (--rig-increment-sigma-arcsec)"),
+      app.add_option("--rig-increment-sigma-arcsec",
+                     args->rig.increment_sigma_arcsec,
+                     "Rig: sigma of weighted increments around zero, arcsec")
+          ->check(CLI::PositiveNumber),
+      app.add_option("--rig-time-offsets",
+                     args->rig.time_offsets,
+                     "Rig: exposure time offset dT_k of each non-reference head: fixed (zero, "
+                     "default) | free | weighted (--rig-time-offset-sigma-ms); needs the velocity "
+                     "columns vX,vY,vZ"),
+      app.add_option("--rig-time-offset-sigma-ms",
+                     args->rig.time_offset_sigma_ms,
+                     "Rig: sigma of weighted time offsets around zero, ms")
+          ->check(CLI::PositiveNumber)};
+  return [args, rig_options]() {
     auto options = args->options;
     options.data_snooping = !args->no_snooping;
     options.use_eo_priors = !args->no_eo_priors;
@@ -111,14 +200,24 @@ CommandRun SetupAdjust(CLI::App& app) {
       return RunJointAdjust(
           args->joint, options, args->project, args->default_sigma_px, args->out, args->write_camera);
     }
-    if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
-      throw ConfigError(
-          "--write-camera needs a self-calibrating run (--self-calibration or --compare)");
-
     const triangulation::Project input =
         triangulation::ReadProject(args->project, args->default_sigma_px);
     const triangulation::ObjectFrame frame(input.frame);
     const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
+    const bool rig_option_given = std::any_of(
+        rig_options.begin(), rig_options.end(), [](const CLI::Option* o) { return o->count() > 0; });
+    if (!input.rigs.empty()) {
+      if (args->compare || options.robust_start)
+        throw ConfigError("--compare and --robust-start are not available for a rig project");
+      return RunRigAdjust(args->rig, options, input, project, frame, args->project, args->out,
+                          args->write_camera);
+    }
+    if (rig_option_given)
+      throw ConfigError(args->project + ": the --rig-* options need a rig camera file (a camera "
+                                        "file with a rig section)");
+    if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
+      throw ConfigError(
+          "--write-camera needs a self-calibrating run (--self-calibration or --compare)");
 
     // Big blocks take minutes: a progress bar of the adjustment stages (terminal only).
     const int stages = triangulation::AdjustStages(options) +

@@ -109,7 +109,8 @@ void MultiplyRotations(const T* a, const T* b, T* c) {
 
 /// Exterior orientation of head k for one exposure: R_k = R M_k E_k (row-major, object_from_head)
 /// and O_k = O + R t_k + v dT_k (m).
-///   rig_opk[3]        rig attitude omega, phi, kappa (rad), R = Rx Ry Rz: rig -> object
+///   object_from_rig[9] rig attitude R (row-major, rig -> object; the rig residual's quaternion
+///                     block through ObjectFromImageRotationOfQuaternion)
 ///   rig_center_m[3]   virtual projection centre O in the object frame (m)
 ///   mount_opk[3]      M_k angles (rad)
 ///   lever_arm_m[3]    t_k in the rig frame (m)
@@ -117,17 +118,17 @@ void MultiplyRotations(const T* a, const T* b, T* c) {
 ///   dt_s[1]           exposure time offset dT_k (s)
 ///   velocity_mps[3]   platform velocity v in the object frame (m/s)
 template <typename T>
-void HeadPose(const T* rig_opk,
-              const T* rig_center_m,
-              const T* mount_opk,
-              const T* lever_arm_m,
-              const T* increment_opk,
-              const T* dt_s,
-              const T* velocity_mps,
-              T* object_from_head,
-              T* head_center_m) {
-  T r[9], m[9], e[9], rm[9];
-  ObjectFromImageRotation(rig_opk, r);
+void HeadPoseOfRotation(const T* object_from_rig,
+                        const T* rig_center_m,
+                        const T* mount_opk,
+                        const T* lever_arm_m,
+                        const T* increment_opk,
+                        const T* dt_s,
+                        const T* velocity_mps,
+                        T* object_from_head,
+                        T* head_center_m) {
+  const T* r = object_from_rig;
+  T m[9], e[9], rm[9];
   ObjectFromImageRotation(mount_opk, m);
   ObjectFromImageRotation(increment_opk, e);
   MultiplyRotations(r, m, rm);
@@ -136,6 +137,15 @@ void HeadPose(const T* rig_opk,
     head_center_m[i] = rig_center_m[i] + r[3 * i] * lever_arm_m[0] +
                        r[3 * i + 1] * lever_arm_m[1] + r[3 * i + 2] * lever_arm_m[2] +
                        velocity_mps[i] * dt_s[0];
+}
+
+/// HeadPose(rig_opk, ...): the same with the rig attitude as rig_opk[3], omega, phi, kappa (rad),
+/// R = Rx Ry Rz; the other arguments as above.
+template <typename T, typename... Rest>
+void HeadPose(const T* rig_opk, Rest... rest) {
+  T object_from_rig[9];
+  ObjectFromImageRotation(rig_opk, object_from_rig);
+  HeadPoseOfRotation(static_cast<const T*>(object_from_rig), rest...);
 }
 
 /// [U V W] = R_k^T (X - O_k): an object point in head k's image-space frame.

@@ -1,7 +1,9 @@
 #include "calib/problem/problem_builder.h"
 
 #include "calib/core/error.h"
+#include "calib/camera/rotation.h"
 #include "calib/problem/normal_equations.h"
+#include "calib/problem/rotation_manifold.h"
 #include "calib/problem/scaled_subset_manifold.h"
 
 #include <Eigen/Dense>
@@ -30,6 +32,10 @@ struct ProblemBuilder::Block {
   /// The block's manifold (owned by the ceres::Problem), created once per set of free entries
   /// and rescaled in place on every UpdateManifolds().
   ScaledSubsetManifold* manifold = nullptr;
+  /// A rotation block (AddRotationBlock): a quaternion of 4 entries with 3 tangent (and 3
+  /// reported, entry_names: omega, phi, kappa) entries, its manifold ScaledRotationManifold.
+  bool rotation = false;
+  ScaledRotationManifold* rotation_manifold = nullptr;
 
   std::vector<int> FreeEntries() const {
     std::vector<int> out;
@@ -37,7 +43,13 @@ struct ProblemBuilder::Block {
       if (!entry_fixed[i]) out.push_back(i);
     return out;
   }
-  int TangentSize() const { return constant ? 0 : static_cast<int>(FreeEntries().size()); }
+  /// Entries of the tangent space (a rotation block: its 3 increment axes).
+  std::vector<int> TangentEntries() const {
+    return rotation ? std::vector<int>{0, 1, 2} : FreeEntries();
+  }
+  int TangentSize() const { return constant ? 0 : static_cast<int>(TangentEntries().size()); }
+  /// Entries in a CovarianceReport: a rotation block reports omega, phi, kappa.
+  int ReportSize() const { return rotation ? 3 : size; }
   /// Ground and virtual tie points: the blocks a Schur complement eliminates.
   bool Eliminable() const {
     return kind == BlockKind::kGroundPoint || kind == BlockKind::kTiePoint2d;
@@ -136,6 +148,21 @@ BlockId ProblemBuilder::AddBlock(const std::string& name,
   return id;
 }
 
+BlockId ProblemBuilder::AddRotationBlock(const std::string& name,
+                                         double* quaternion,
+                                         std::vector<std::string> report_names) {
+  AEROCAL_CHECK(report_names.size() == 3) << "rotation block " << name << " needs 3 names";
+  AEROCAL_CHECK(quaternion != nullptr) << "rotation block " << name;
+  const double norm = std::sqrt(quaternion[0] * quaternion[0] + quaternion[1] * quaternion[1] +
+                                quaternion[2] * quaternion[2] + quaternion[3] * quaternion[3]);
+  AEROCAL_CHECK(std::abs(norm - 1.0) < 1e-9) << "rotation block " << name
+                                             << " is not a unit quaternion (norm " << norm << ")";
+  const BlockId id = AddBlock(name, quaternion, 4, BlockKind::kRotation);
+  blocks_[id].rotation = true;
+  blocks_[id].entry_names = std::move(report_names);
+  return id;
+}
+
 BlockId ProblemBuilder::FindBlock(const std::string& name) const {
   const auto it = block_by_name_.find(name);
   return it == block_by_name_.end() ? -1 : it->second;
@@ -154,6 +181,8 @@ void ProblemBuilder::FreeBlock(BlockId id) {
 
 void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
   Block& b = blocks_.at(id);
+  AEROCAL_CHECK(!b.rotation || entries.empty() || static_cast<int>(entries.size()) == b.size)
+      << "rotation block " << b.name << " is fixed as a whole or not at all";
   for (int e : entries) {
     AEROCAL_CHECK(e >= 0 && e < b.size) << "entry " << e << " of block " << b.name;
     b.entry_fixed[e] = true;
@@ -286,6 +315,15 @@ bool ProblemBuilder::UpdateManifolds() {
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   for (BlockId id : free_blocks) {
     Block& b = blocks_[id];
+    if (b.rotation) {
+      if (b.rotation_manifold != nullptr) {
+        b.rotation_manifold->SetScales({1.0, 1.0, 1.0});
+        continue;
+      }
+      b.rotation_manifold = new ScaledRotationManifold();
+      problem_->SetManifold(b.values, b.rotation_manifold);
+      continue;
+    }
     const auto free = b.FreeEntries();
     if (b.manifold != nullptr && b.manifold->free_entries() == free) {
       b.manifold->SetScales(std::vector<double>(free.size(), 1.0));
@@ -308,11 +346,14 @@ bool ProblemBuilder::UpdateManifolds() {
   int col = 0;
   for (BlockId id : free_blocks) {
     Block& b = blocks_[id];
-    const size_t n_free = b.manifold->free_entries().size();
+    const size_t n_free = b.TangentEntries().size();
     std::vector<double> scales;
     for (size_t k = 0; k < n_free; ++k, ++col)
       scales.push_back(norm2[col] > 0 ? 1.0 / std::sqrt(norm2[col]) : 1.0);
-    b.manifold->SetScales(std::move(scales));
+    if (b.rotation)
+      b.rotation_manifold->SetScales({scales[0], scales[1], scales[2]});
+    else
+      b.manifold->SetScales(std::move(scales));
   }
   return true;
 }
@@ -642,7 +683,8 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
         if (schur->Point(static_cast<int>(b)).singular) out.insert(blocks_[blocks[b]].name);
         continue;
       }
-      for (int e : blocks_[blocks[b]].FreeEntries()) names.push_back(blocks_[blocks[b]].EntryName(e));
+      for (int e : blocks_[blocks[b]].TangentEntries())
+        names.push_back(blocks_[blocks[b]].EntryName(e));
     }
     const Eigen::MatrixXd s = Eigen::MatrixXd(schur->s_lower()).selfadjointView<Eigen::Lower>();
     const std::set<std::string> reduced = NullSpaceNames(s, names);
@@ -652,7 +694,7 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
   const Eigen::MatrixXd j = DenseJacobian(free_blocks, nullptr);
   std::vector<std::string> names;
   for (BlockId b : free_blocks)
-    for (int e : blocks_[b].FreeEntries()) names.push_back(blocks_[b].EntryName(e));
+    for (int e : blocks_[b].TangentEntries()) names.push_back(blocks_[b].EntryName(e));
   const std::set<std::string> out = NullSpaceNames(j.transpose() * j, names);
   return {out.begin(), out.end()};
 }
@@ -667,13 +709,13 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
   for (BlockId id : blocks) {
     report.offsets[id] = total;
     const Block& b = blocks_.at(id);
-    for (int e = 0; e < b.size; ++e) {
+    for (int e = 0; e < b.ReportSize(); ++e) {
       report.names.push_back(b.EntryName(e));
       report.free.push_back(!b.constant && !b.entry_fixed[e] && b.num_residuals > 0);
       report.entry_block.push_back(id);
       report.entry_local.push_back(e);
     }
-    total += b.size;
+    total += b.ReportSize();
   }
   report.sigma = Eigen::VectorXd::Zero(total);
   std::vector<BlockId> free_requested;
@@ -789,10 +831,25 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
       report.blocks[{a, b}] = s2 * la.plus * q * lb.plus.transpose();
     }
   }
+  // Rotation blocks are reported in omega, phi, kappa: C_opk = J C_q J^T with J the conversion's
+  // Jacobian (calib/camera/rotation.h OpkJacobianOfQuaternion; NaN rows for omega and kappa at
+  // phi = +-90 deg, whose sigmas are then unknown).
+  for (auto& [ab, c] : report.blocks) {
+    const Block& a = blocks_[ab.first];
+    const Block& b = blocks_[ab.second];
+    if (!a.rotation && !b.rotation) continue;
+    const auto report_jacobian = [](const Block& block) -> Eigen::MatrixXd {
+      if (!block.rotation) return Eigen::MatrixXd::Identity(block.size, block.size);
+      return OpkJacobianOfQuaternion(Eigen::Map<const Eigen::Vector4d>(block.values));
+    };
+    c = report_jacobian(a) * c * report_jacobian(b).transpose();
+  }
   report.ok = true;
   for (BlockId id : free_requested) {
     const Eigen::MatrixXd& c = report.blocks.at({id, id});
-    report.sigma.segment(report.offsets[id], c.rows()) = c.diagonal().cwiseMax(0.0).cwiseSqrt();
+    for (int e = 0; e < c.rows(); ++e)  // NaN (not separable) stays NaN
+      report.sigma(report.offsets[id] + e) =
+          std::isnan(c(e, e)) ? c(e, e) : std::sqrt(std::max(0.0, c(e, e)));
   }
   // Correlations above the threshold, in the order of the requested entries.
   struct Pair {

@@ -136,7 +136,8 @@ struct HighCorrelation {
   double correlation = 0.0;
 };
 
-/// Covariance of selected blocks, scaled by sigma0^2 (a-posteriori), in ambient coordinates.
+/// Covariance of selected blocks, scaled by sigma0^2 (a-posteriori), in ambient coordinates;
+/// rotation blocks (AddRotationBlock) in omega, phi, kappa (3 entries).
 /// Only the requested pairs of blocks are held (never a dense matrix of all requested entries).
 struct CovarianceReport {
   bool ok = false;
@@ -185,6 +186,15 @@ class ProblemBuilder {
                    int size,
                    BlockKind kind,
                    std::vector<std::string> entry_names = {});
+  /// Registers a rotation (object_from_image) as a unit quaternion [w, x, y, z] at `quaternion`
+  /// (4 doubles, caller keeps them alive; |q| = 1 to 1e-9) under BlockKind::kRotation. Inside the
+  /// solver it moves on the rotation-increment manifold (rotation_manifold.h: 3 tangent entries,
+  /// rotations about the object axes); covariance reports give it as omega, phi, kappa (rad,
+  /// `report_names`, CONVENTIONS.md), propagated through the conversion's Jacobian: at
+  /// phi = +-90 deg the omega and kappa sigmas are NaN (not separable). Fixed only as a whole.
+  BlockId AddRotationBlock(const std::string& name,
+                           double* quaternion,
+                           std::vector<std::string> report_names = {"omega", "phi", "kappa"});
   BlockId FindBlock(const std::string& name) const;  // -1 when absent
   void FixBlock(BlockId id);
   void FreeBlock(BlockId id);

@@ -1,7 +1,9 @@
 // Collinearity residuals with the 10-parameter camera (CONVENTIONS.md). The residual is formed in
 // the corrected (ideal) photo space, no iteration:
 //   r = ((xb + dx, yb + dy) - (-c U / W, -c V / W)) / sigma_mm        [2, unitless]
-// with [U V W] = R^T (X - X0), R = Rx(omega) Ry(phi) Rz(kappa), sigma_mm = sigma_px * pixel_size.
+// with [U V W] = R^T (X - X0), sigma_mm = sigma_px * pixel_size. The exposure rotation R is a unit
+// quaternion block q = [w, x, y, z] (object_from_image, calib/camera/rotation.h), moved by the
+// builder's rotation-increment manifold; R(q) equals Rx(omega) Ry(phi) Rz(kappa) of the files.
 #pragma once
 
 #include <Eigen/Core>
@@ -32,25 +34,26 @@ bool CollinearityErrorFromImageSpace(const T* interior, const T* uvw, const T* m
 }
 
 template <typename T>
-bool CollinearityError(const T* interior, const T* opk, const T* center, const T* point,
+bool CollinearityError(const T* interior, const T* rotation, const T* center, const T* point,
                        const T* measured_xy_mm, double inverse_sigma_mm, T* residual) {
   T uvw[3];
-  ImageSpaceFromObject(opk, center, point, uvw);
+  ImageSpaceFromObjectByQuaternion(rotation, center, point, uvw);
   return CollinearityErrorFromImageSpace(interior, uvw, measured_xy_mm, inverse_sigma_mm, residual);
 }
 }  // namespace internal
 
 /// Observation (col, row) in the virtual image's pixel frame.
-/// blocks: interior[10] (table units), opk[3] (rad), center[3] (m), point[3] (m).
-struct CollinearityResidual : AutoDiffResidual<CollinearityResidual, 2, 10, 3, 3, 3> {
+/// blocks: interior[10] (table units), rotation[4] (quaternion), center[3] (m), point[3] (m).
+struct CollinearityResidual : AutoDiffResidual<CollinearityResidual, 2, 10, 4, 3, 3> {
   CollinearityResidual(const PixelFrame& frame, const Eigen::Vector2d& pixel, double sigma_px)
       : inverse_sigma_mm_(1.0 / (sigma_px * frame.pixel_size_mm)) {
     frame.PhotoFromPixel(pixel.data(), xy_mm_);
   }
   template <typename T>
-  bool operator()(const T* interior, const T* opk, const T* center, const T* point, T* r) const {
+  bool operator()(const T* interior, const T* rotation, const T* center, const T* point,
+                  T* r) const {
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
-    return internal::CollinearityError(interior, opk, center, point, xy, inverse_sigma_mm_, r);
+    return internal::CollinearityError(interior, rotation, center, point, xy, inverse_sigma_mm_, r);
   }
 
  private:
@@ -60,23 +63,24 @@ struct CollinearityResidual : AutoDiffResidual<CollinearityResidual, 2, 10, 3, 3
 
 /// Observation (u, v) in a RAW sub-image; the sub-image mapping (conditioned parameters, see
 /// subimage_mapping.h) takes it to the virtual image, then collinearity as above.
-/// blocks: mapping[Mapping::kNumParams], interior[10], opk[3] (rad), center[3] (m), point[3] (m).
+/// blocks: mapping[Mapping::kNumParams], interior[10], rotation[4] (quaternion), center[3] (m),
+/// point[3] (m).
 template <typename Mapping>
 struct SubimageCollinearityResidual
-    : AutoDiffResidual<SubimageCollinearityResidual<Mapping>, 2, Mapping::kNumParams, 10, 3, 3, 3> {
+    : AutoDiffResidual<SubimageCollinearityResidual<Mapping>, 2, Mapping::kNumParams, 10, 4, 3, 3> {
   SubimageCollinearityResidual(const PixelFrame& frame, const MappingConditioning& cond,
                                const Eigen::Vector2d& uv, double sigma_px)
       : frame_(frame),
         uv_conditioned_{(uv.x() - cond.cu) / cond.scale, (uv.y() - cond.cv) / cond.scale},
         inverse_sigma_mm_(1.0 / (sigma_px * frame.pixel_size_mm)) {}
   template <typename T>
-  bool operator()(const T* mapping, const T* interior, const T* opk, const T* center,
+  bool operator()(const T* mapping, const T* interior, const T* rotation, const T* center,
                   const T* point, T* r) const {
     const T uv[2] = {T(uv_conditioned_[0]), T(uv_conditioned_[1])};
     T virtual_px[2], xy[2];
     Mapping::Apply(mapping, uv, virtual_px);
     frame_.PhotoFromPixel(virtual_px, xy);
-    return internal::CollinearityError(interior, opk, center, point, xy, inverse_sigma_mm_, r);
+    return internal::CollinearityError(interior, rotation, center, point, xy, inverse_sigma_mm_, r);
   }
 
  private:
@@ -89,14 +93,15 @@ struct SubimageCollinearityResidual
 /// rigs"): the head's pose is R_k = R M_k E_k, O_k = O + R t_k + v dT_k (calib/camera/rig.h
 /// HeadPose), then the same collinearity as the frame camera with the head's own interior.
 ///   r = ((xb + dx, yb + dy) - (-c_k U / W, -c_k V / W)) / sigma_mm,  [U V W] = R_k^T (X - O_k)
-/// blocks: interior[10] (head k, table units), rig_opk[3] (rad), rig_center[3] (m),
+/// blocks: interior[10] (head k, table units), rig_rotation[4] (quaternion of R, as the frame
+///         camera's rotation block), rig_center[3] (m),
 ///         mount[3] (M_k omega, phi, kappa, rad), lever_arm[3] (t_k in the rig frame, m),
 ///         increment[3] (E_k, rad), dt[1] (dT_k, s), point[3] (m).
 /// The platform velocity v (object frame, m/s) is data of the exposure, held by value.
 /// A rig of one head with identity mount, zero lever arm, zero increment and dT = 0 gives exactly
 /// CollinearityResidual (tests/calib/residuals_test.cc checks it).
 struct RigHeadCollinearityResidual
-    : AutoDiffResidual<RigHeadCollinearityResidual, 2, 10, 3, 3, 3, 3, 3, 1, 3> {
+    : AutoDiffResidual<RigHeadCollinearityResidual, 2, 10, 4, 3, 3, 3, 3, 1, 3> {
   RigHeadCollinearityResidual(const PixelFrame& head_frame, const Eigen::Vector2d& pixel,
                               double sigma_px, const Eigen::Vector3d& velocity_mps)
       : inverse_sigma_mm_(1.0 / (sigma_px * head_frame.pixel_size_mm)),
@@ -104,13 +109,14 @@ struct RigHeadCollinearityResidual
     head_frame.PhotoFromPixel(pixel.data(), xy_mm_);
   }
   template <typename T>
-  bool operator()(const T* interior, const T* rig_opk, const T* rig_center, const T* mount,
+  bool operator()(const T* interior, const T* rig_rotation, const T* rig_center, const T* mount,
                   const T* lever_arm, const T* increment, const T* dt, const T* point,
                   T* r) const {
     const T velocity[3] = {T(velocity_mps_[0]), T(velocity_mps_[1]), T(velocity_mps_[2])};
-    T object_from_head[9], head_center[3], uvw[3];
-    HeadPose(rig_opk, rig_center, mount, lever_arm, increment, dt, velocity, object_from_head,
-             head_center);
+    T object_from_rig[9], object_from_head[9], head_center[3], uvw[3];
+    ObjectFromImageRotationOfQuaternion(rig_rotation, object_from_rig);
+    HeadPoseOfRotation(object_from_rig, rig_center, mount, lever_arm,
+                       increment, dt, velocity, object_from_head, head_center);
     HeadSpaceFromObject(object_from_head, head_center, point, uvw);
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
     return internal::CollinearityErrorFromImageSpace(interior, uvw, xy, inverse_sigma_mm_, r);

@@ -81,7 +81,8 @@ TestField MakeTestField() {
 // The adjustment under test: interior (all 10 free), exposures free, targets fixed (known).
 struct Adjustment {
   InteriorParams interior;
-  std::vector<Eigen::Vector3d> opk, centers, points;
+  std::vector<Eigen::Vector4d> rotations;  // quaternions of the exposures' opk
+  std::vector<Eigen::Vector3d> centers, points;
   ProblemBuilder builder;
   BlockId interior_block;
   std::vector<ResidualId> residuals;
@@ -90,14 +91,14 @@ struct Adjustment {
              const std::vector<Eigen::Vector2d>& pixels,
              double sigma_px,
              const InteriorParams& start)
-      : interior(start), opk(f.opk), centers(f.centers), points(f.points) {
+      : interior(start), centers(f.centers), points(f.points) {
+    for (const auto& opk : f.opk) rotations.push_back(QuaternionFromOpk(opk));
     std::vector<std::string> names;
     for (const auto& info : Model::kParams) names.emplace_back(info.name);
     interior_block = builder.AddBlock("interior", interior.data(), 10, BlockKind::kInterior, names);
     std::vector<BlockId> o, c, p;
-    for (size_t i = 0; i < opk.size(); ++i) {
-      o.push_back(
-          builder.AddBlock("opk" + std::to_string(i), opk[i].data(), 3, BlockKind::kRotation));
+    for (size_t i = 0; i < rotations.size(); ++i) {
+      o.push_back(builder.AddRotationBlock("opk" + std::to_string(i), rotations[i].data()));
       c.push_back(
           builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter));
     }
@@ -234,7 +235,8 @@ TEST(ProblemBuilder, DatumDefectIsReportedWithTheParametersInvolved) {
   // A free network: two exposures and free object points, nothing fixing position, attitude and
   // scale: the covariance cannot be computed and the diagnostics name the exterior orientation.
   const TestField f = MakeTestField();
-  std::vector<Eigen::Vector3d> opk = {f.opk[0], f.opk[2]}, centers = {f.centers[0], f.centers[2]};
+  std::vector<Eigen::Vector4d> rotations = {QuaternionFromOpk(f.opk[0]), QuaternionFromOpk(f.opk[2])};
+  std::vector<Eigen::Vector3d> centers = {f.centers[0], f.centers[2]};
   std::vector<Eigen::Vector3d> points = f.points;
   InteriorParams interior = f.camera.interior;
   ProblemBuilder builder;
@@ -244,7 +246,7 @@ TEST(ProblemBuilder, DatumDefectIsReportedWithTheParametersInvolved) {
   std::vector<BlockId> pb(points.size(), -1);
   BlockId ob[2], cb[2];
   for (int i = 0; i < 2; ++i) {
-    ob[i] = builder.AddBlock("opk" + std::to_string(i), opk[i].data(), 3, BlockKind::kRotation);
+    ob[i] = builder.AddRotationBlock("opk" + std::to_string(i), rotations[i].data());
     cb[i] =
         builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter);
   }

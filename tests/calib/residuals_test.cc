@@ -6,6 +6,7 @@
 #include "calib/camera/camera.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
+#include "calib/residuals/rotation_prior.h"
 #include "calib/residuals/stitching.h"
 
 namespace aerocal::calib {
@@ -22,6 +23,7 @@ void ExpectGradientsMatch(const ceres::CostFunction& cost, const std::vector<dou
 struct Scene {
   double interior[10] = {170.038, -0.0024, 0.0015, 3e-8, -2e-12, 1e-16, 2e-7, -1.5e-7, 1e-5, -8e-6};
   double opk[3] = {0.01, -0.008, 0.3};
+  Eigen::Vector4d rotation = QuaternionFromOpk(Eigen::Vector3d(opk));  // the solver's block
   double center[3] = {100.0, -50.0, 4700.0};
   double point[3] = {600.0, 300.0, 250.0};
   PixelFrame frame{0.009, 14000, 12000};
@@ -39,7 +41,7 @@ TEST(CollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
                                     Eigen::Vector3d(s.point), &pixel));
   auto cost = CollinearityResidual::Create(s.frame, pixel, 0.2);
   double r[2];
-  const double* blocks[] = {s.interior, s.opk, s.center, s.point};
+  const double* blocks[] = {s.interior, s.rotation.data(), s.center, s.point};
   ASSERT_TRUE(cost->Evaluate(blocks, r, nullptr));
   EXPECT_NEAR(r[0], 0.0, 1e-6);  // 1e-6 sigma = 2e-7 px
   EXPECT_NEAR(r[1], 0.0, 1e-6);
@@ -47,7 +49,7 @@ TEST(CollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
   auto shifted = CollinearityResidual::Create(s.frame, pixel + Eigen::Vector2d(1, 0), 0.2);
   ASSERT_TRUE(shifted->Evaluate(blocks, r, nullptr));
   EXPECT_NEAR(r[0], 5.0, 0.01);
-  ExpectGradientsMatch(*cost, {s.interior, s.opk, s.center, s.point});
+  ExpectGradientsMatch(*cost, {s.interior, s.rotation.data(), s.center, s.point});
 }
 
 TEST(CollinearityResidual, PointBehindTheCameraIsRejected) {
@@ -55,7 +57,7 @@ TEST(CollinearityResidual, PointBehindTheCameraIsRejected) {
   s.point[2] = 9000.0;
   auto cost = CollinearityResidual::Create(s.frame, Eigen::Vector2d(7000, 6000), 0.2);
   double r[2];
-  const double* blocks[] = {s.interior, s.opk, s.center, s.point};
+  const double* blocks[] = {s.interior, s.rotation.data(), s.center, s.point};
   EXPECT_FALSE(cost->Evaluate(blocks, r, nullptr));
 }
 
@@ -87,7 +89,7 @@ void CheckStitchingResiduals() {
   EXPECT_NEAR(r[1], (mapped.y() - point[1]) / 0.1, 1e-6);
   Scene s;
   auto sub = SubimageCollinearityResidual<Mapping>::Create(s.frame, cond, Eigen::Vector2d(3000, 1200), 0.2);
-  ExpectGradientsMatch(*sub, {p.data(), s.interior, s.opk, s.center, s.point});
+  ExpectGradientsMatch(*sub, {p.data(), s.interior, s.rotation.data(), s.center, s.point});
 }
 
 // The rig head residual (a head of a two-head rig with mount, lever arm, increment, time offset
@@ -96,6 +98,7 @@ void CheckStitchingResiduals() {
 struct RigScene {
   double interior[10] = {150.02, 0.003, -0.002, 2e-8, -1e-12, 0, 1e-7, -2e-7, 5e-6, -3e-6};
   double rig_opk[3] = {0.012, -0.007, 0.4};
+  Eigen::Vector4d rig_rotation = QuaternionFromOpk(Eigen::Vector3d(rig_opk));
   double rig_center[3] = {100.0, -50.0, 1400.0};
   double mount[3] = {0.002, 0.0175, -0.001};  // about 1 deg convergence in phi
   double lever[3] = {0.15, 0.01, 0.01};
@@ -123,7 +126,7 @@ TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
   ASSERT_TRUE(head.ProjectToPixel(OpkFromRotation(rk), ok, Eigen::Vector3d(s.point), &pixel));
   auto cost = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.25, s.velocity);
   double res[2];
-  const double* blocks[] = {s.interior, s.rig_opk, s.rig_center, s.mount,
+  const double* blocks[] = {s.interior, s.rig_rotation.data(), s.rig_center, s.mount,
                             s.lever,    s.increment, s.dt,        s.point};
   ASSERT_TRUE(cost->Evaluate(blocks, res, nullptr));
   EXPECT_NEAR(res[0], 0.0, 1e-6);  // 1e-6 sigma = 2.5e-7 px (the distortion inverse's tolerance)
@@ -132,7 +135,7 @@ TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
   // residual is that projection shift in units of sigma (first order; distortion changes it by
   // < 1e-3 relative).
   double lever_moved[3] = {s.lever[0] + 1e-3, s.lever[1], s.lever[2]};
-  const double* moved[] = {s.interior, s.rig_opk, s.rig_center, s.mount,
+  const double* moved[] = {s.interior, s.rig_rotation.data(), s.rig_center, s.mount,
                            lever_moved, s.increment, s.dt,       s.point};
   ASSERT_TRUE(cost->Evaluate(moved, res, nullptr));
   Eigen::Vector2d pixel_moved;
@@ -141,7 +144,7 @@ TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
   const double expected = (pixel_moved - pixel).norm() / 0.25;
   ASSERT_GT(expected, 0.05);  // the shift is seen (0.13 um at 1150 m = 0.02 px)
   EXPECT_NEAR(std::hypot(res[0], res[1]), expected, 0.02 * expected);
-  ExpectGradientsMatch(*cost, {s.interior, s.rig_opk, s.rig_center, s.mount, s.lever, s.increment,
+  ExpectGradientsMatch(*cost, {s.interior, s.rig_rotation.data(), s.rig_center, s.mount, s.lever, s.increment,
                                s.dt, s.point});
 }
 
@@ -154,9 +157,9 @@ TEST(RigHeadCollinearityResidual, TimeOffsetActsAsVelocityTimesOffset) {
   for (int i = 0; i < 3; ++i) shifted_center[i] = s.rig_center[i] + s.velocity[i] * s.dt[0];
   double zero_dt[1] = {0.0};
   double a[2], b[2];
-  const double* with_dt[] = {s.interior, s.rig_opk, s.rig_center, s.mount,
+  const double* with_dt[] = {s.interior, s.rig_rotation.data(), s.rig_center, s.mount,
                              s.lever,    s.increment, s.dt,        s.point};
-  const double* shifted[] = {s.interior, s.rig_opk, shifted_center, s.mount,
+  const double* shifted[] = {s.interior, s.rig_rotation.data(), shifted_center, s.mount,
                              s.lever,    s.increment, zero_dt,       s.point};
   ASSERT_TRUE(cost->Evaluate(with_dt, a, nullptr));
   ASSERT_TRUE(still->Evaluate(shifted, b, nullptr));
@@ -172,11 +175,12 @@ TEST(RigHeadCollinearityResidual, OneHeadRigIsTheFrameCamera) {
   const Eigen::Vector2d pixel(6100.5, 5222.25);
   auto frame_cost = CollinearityResidual::Create(s.frame, pixel, 0.2);
   auto rig_cost = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.2, Eigen::Vector3d(30, 0, 0));
-  const double* frame_blocks[] = {s.interior, s.opk, s.center, s.point};
-  const double* rig_blocks[] = {s.interior, s.opk, s.center, zero3a, zero3b, zero3c, dt, s.point};
+  const double* frame_blocks[] = {s.interior, s.rotation.data(), s.center, s.point};
+  const double* rig_blocks[] = {
+      s.interior, s.rotation.data(), s.center, zero3a, zero3b, zero3c, dt, s.point};
   double rf[2], rr[2];
-  std::vector<double> jf_int(20), jf_opk(6), jf_c(6), jf_p(6);
-  std::vector<double> jr_int(20), jr_opk(6), jr_c(6), jr_m(6), jr_l(6), jr_e(6), jr_dt(2), jr_p(6);
+  std::vector<double> jf_int(20), jf_opk(8), jf_c(6), jf_p(6);
+  std::vector<double> jr_int(20), jr_opk(8), jr_c(6), jr_m(6), jr_l(6), jr_e(6), jr_dt(2), jr_p(6);
   double* jf[] = {jf_int.data(), jf_opk.data(), jf_c.data(), jf_p.data()};
   double* jr[] = {jr_int.data(), jr_opk.data(), jr_c.data(), jr_m.data(),
                   jr_l.data(),   jr_e.data(),   jr_dt.data(), jr_p.data()};
@@ -192,6 +196,26 @@ TEST(RigHeadCollinearityResidual, OneHeadRigIsTheFrameCamera) {
   // dr/d(dT) = dr/dO v with v = (30, 0, 0) m/s.
   EXPECT_NEAR(jr_dt[0], jr_c[0] * 30.0, 1e-9 * (1.0 + std::abs(jr_c[0] * 30.0)));
   EXPECT_NEAR(jr_dt[1], jr_c[3] * 30.0, 1e-9 * (1.0 + std::abs(jr_c[3] * 30.0)));
+}
+
+TEST(OpkPriorResidual, IsTheAngleDifferenceInSigmasAndGradientsMatch) {
+  // The IMU prior on a quaternion block: (opk(q) - opk0) / sigma per angle, kappa wrapped.
+  const Eigen::Vector3d opk(0.02, -0.01, M_PI - 0.001);  // kappa near 180 deg
+  Eigen::Vector4d q = QuaternionFromOpk(opk);
+  const Eigen::Vector3d imu(0.021, -0.0115, -M_PI + 0.0005);  // the same heading, wrapped
+  const Eigen::Vector3d sigma(1e-3, 5e-4, 2e-3);
+  auto cost = OpkPriorResidual::Create(imu, sigma);
+  double r[3];
+  const double* blocks[] = {q.data()};
+  ASSERT_TRUE(cost->Evaluate(blocks, r, nullptr));
+  EXPECT_NEAR(r[0], -1.0, 1e-9);   // (0.020 - 0.021) / 1e-3
+  EXPECT_NEAR(r[1], 3.0, 1e-9);    // (-0.0100 + 0.0115) / 5e-4
+  EXPECT_NEAR(r[2], -0.75, 1e-9);  // (pi - 0.001 - (-pi + 0.0005) - 2 pi) / 2e-3
+  ExpectGradientsMatch(*cost, {q.data()});
+  // Undefined at phi = 90 deg (omega and kappa not separable): refused, not a silent number.
+  Eigen::Vector4d wall = QuaternionFromOpk(Eigen::Vector3d(0.1, M_PI / 2, 0.0));
+  const double* wall_blocks[] = {wall.data()};
+  EXPECT_FALSE(cost->Evaluate(wall_blocks, r, nullptr));
 }
 
 TEST(StitchingResiduals, GradientsMatchForEveryMappingModel) {

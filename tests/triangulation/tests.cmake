@@ -14,3 +14,7 @@ aerocal_add_test(triangulation/rig_flight_simulator LIBS aerocal::triangulation 
 aerocal_add_test(triangulation/calibration LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/test_field LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/test_field_study LIBS aerocal::triangulation LABELS long TIMEOUT 3000)
+aerocal_add_test(triangulation/rig_bundle LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/rig_bundle_study LIBS aerocal::triangulation LABELS long TIMEOUT 1200)
+aerocal_add_test(triangulation/rig_bundle_cli LIBS aerocal::triangulation LABELS cli)
+aerocal_add_test(triangulation/wall_pose LIBS aerocal::triangulation LABELS synthetic)

@@ -32,9 +32,10 @@ std::optional<Eigen::Vector2d> ResidualAt(const Project& project,
   const calib::Camera& cam = project.cameras.at(exposure->camera);
   const calib::PixelFrame frame{cam.pixel_size_mm, cam.width_px, cam.height_px};
   const calib::CollinearityResidual residual(frame, o.pixel, o.sigma_px);
+  const Eigen::Vector4d rotation = calib::QuaternionFromOpk(pose->opk_rad);
   Eigen::Vector2d v;
   if (!residual(camera->estimated.data(),
-                pose->opk_rad.data(),
+                rotation.data(),
                 pose->center_m.data(),
                 point->second.data(),
                 v.data()))

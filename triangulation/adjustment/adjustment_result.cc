@@ -151,7 +151,9 @@ std::string RejectedLines(const AdjustmentResult& r) {
         StringPrintf("rejected%s: image %s%s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f%s)\n",
                      o.by == "snooping" ? "" : (" by the " + o.by).c_str(),
                      o.image.c_str(),
-                     o.subimage.empty() ? "" : (" sub-image " + o.subimage).c_str(),
+                     ((o.subimage.empty() ? "" : " sub-image " + o.subimage) +
+                      (o.head.empty() ? "" : " head " + o.head))
+                         .c_str(),
                      o.point.c_str(),
                      o.measured_px.x(),
                      o.measured_px.y(),
@@ -426,9 +428,9 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
       sigma = {{"X", e.center_sigma_m->x()},
                {"Y", e.center_sigma_m->y()},
                {"Z", e.center_sigma_m->z()},
-               {"omega", e.opk_sigma_rad->x() * kRadToDeg},
-               {"phi", e.opk_sigma_rad->y() * kRadToDeg},
-               {"kappa", e.opk_sigma_rad->z() * kRadToDeg}};
+               {"omega", Finite(e.opk_sigma_rad->x() * kRadToDeg)},  // null at phi = +-90 deg
+               {"phi", Finite(e.opk_sigma_rad->y() * kRadToDeg)},
+               {"kappa", Finite(e.opk_sigma_rad->z() * kRadToDeg)}};
     x["sigma"] = sigma;
     x["used"] = e.used;
     j["exposures"].push_back(x);
@@ -444,6 +446,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
                         {"by", o.by},
                         {"group", o.group}};
     if (!o.subimage.empty()) x["subimage"] = o.subimage;
+    if (!o.head.empty()) x["head"] = o.head;
     AddTest(o.test, &x);
     j["rejected"].push_back(x);
   }
@@ -464,6 +467,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
       v["u"] = o.subimage_px.x();
       v["v"] = o.subimage_px.y();
     }
+    if (!o.head.empty()) v["head"] = o.head;
     AddTest(o.test, &v);
     j["residuals"].push_back(v);
   }

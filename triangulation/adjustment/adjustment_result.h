@@ -77,6 +77,7 @@ struct RejectedObservation {
   Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // v in (corrected) photo space, px
   double w = 0.0;                                         // standardized residual
   std::string subimage;  // non-empty: measured_px is (u, v) in this raw sub-image
+  std::string head;      // non-empty: measured_px is a pixel of this rig head
   ObservationTest test;  // at the rejection (robust start: tested == false, w its robust w)
   std::vector<std::string> group;  // images of the correlated group (same point), with its own
   std::string by = "snooping";     // "snooping" or "robust start"
@@ -149,6 +150,7 @@ struct ObservationResidual {
   bool used = true;      // false: rejected as a gross error
   std::string subimage;  // non-empty: measured in this raw sub-image at subimage_px (u, v)
   Eigen::Vector2d subimage_px = Eigen::Vector2d::Zero();
+  std::string head;      // non-empty: measured_px is a pixel of this rig head
   ObservationTest test;  // the final test (or the one at its rejection)
 };
 

@@ -4,6 +4,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/residuals/prior.h"
+#include "calib/residuals/rotation_prior.h"
 #include "triangulation/adjustment/determinability.h"
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/sensor/frame_camera.h"
@@ -26,8 +27,8 @@ const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
 
 // "image 0012 point T442", "image 0012 sub-image A1 point T442": an observation in reports.
 std::string DescribeObservation(const ImageObservation& o) {
-  return "image " + o.image + (o.subimage.empty() ? "" : " sub-image " + o.subimage) + " point " +
-         o.point;
+  return "image " + o.image + (o.subimage.empty() ? "" : " sub-image " + o.subimage) +
+         (o.head.empty() ? "" : " head " + o.head) + " point " + o.point;
 }
 
 }  // namespace
@@ -38,7 +39,10 @@ struct BlockAdjustment::Storage {
   struct ExposureState {
     const Exposure* exposure = nullptr;
     const calib::Camera* camera = nullptr;
-    Eigen::Vector3d opk = Eigen::Vector3d::Zero(), center = Eigen::Vector3d::Zero();
+    // The rotation as a unit quaternion [w, x, y, z] (the solver's block, calib/camera/rotation.h);
+    // omega-phi-kappa only when read and written.
+    Eigen::Vector4d rotation = Eigen::Vector4d(1, 0, 0, 0);
+    Eigen::Vector3d center = Eigen::Vector3d::Zero();
     BlockId opk_block = -1, center_block = -1;
     ExposureIndex index = -1;
   };
@@ -125,10 +129,10 @@ void BlockAdjustment::BuildExposures() {
     state.exposure = &e;
     state.index = storage_->index.Exposure(e.image);
     state.camera = &project_.cameras.at(e.camera);
-    state.opk = e.opk_rad;
+    state.rotation = calib::QuaternionFromOpk(e.opk_rad);
     state.center = e.center_m;
-    state.opk_block = builder_.AddBlock(
-        "image " + e.image + " angles", state.opk.data(), 3, BlockKind::kRotation, kAngleNames);
+    state.opk_block =
+        builder_.AddRotationBlock("image " + e.image + " angles", state.rotation.data(), kAngleNames);
     state.center_block = builder_.AddBlock(
         "image " + e.image + " centre", state.center.data(), 3, BlockKind::kCenter, kCenterNames);
     storage_->poses[state.index] = {state.opk_block, state.center_block};
@@ -142,6 +146,11 @@ void BlockAdjustment::BuildPoints() {
     ImagingModel* sensor = nullptr;
     for (auto& s : storage_->sensors)
       if (!sensor && s->Measures(o)) sensor = s.get();
+    if (!sensor && !o.head.empty())  // never a virtual-image pixel: the rig bundle measures it
+      ThrowInputError({project_.observations_file, o.line},
+                      "image " + o.image + " head " + o.head +
+                          ": rig head observations are adjusted by the rig bundle (aerocal "
+                          "adjust without --joint-stitching)");
     if (!sensor && storage_->frame.Measures(o)) sensor = &storage_->frame;
     if (sensor) {
       storage_->observations.push_back(o);
@@ -269,13 +278,10 @@ void BlockAdjustment::AddPriors() {
             {state.center_block},
             "GNSS " + image);
       if (e.opk_sigma_rad)
-        builder_.AddResidual(
-            calib::kGroupEoPrior,
-            calib::PriorCostFunction::Create(
-                {e.opk_rad.x(), e.opk_rad.y(), e.opk_rad.z()},
-                {e.opk_sigma_rad->x(), e.opk_sigma_rad->y(), e.opk_sigma_rad->z()}),
-            {state.opk_block},
-            "IMU " + image);
+        builder_.AddResidual(calib::kGroupEoPrior,
+                             calib::OpkPriorResidual::Create(e.opk_rad, *e.opk_sigma_rad),
+                             {state.opk_block},
+                             "IMU " + image);
     }
   }
   if (options_.use_interior_sigma) {
@@ -521,6 +527,7 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
     r.point = o.point;
     r.measured_px = o.pixel;
     r.subimage = o.subimage;
+    r.head = o.head;
     r.w = x.w_max;
     if (x.v.size() == 2) r.residual_px = Eigen::Vector2d(x.v[0], x.v[1]) * o.sigma_px;
     r.test = to_test(x, o.sigma_px);
@@ -607,6 +614,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     v.point = o.point;
     v.measured_px = o.pixel;
     v.subimage = o.subimage;
+    v.head = o.head;
     if (!o.subimage.empty()) v.subimage_px = o.pixel;
     v.sigma_px = o.sigma_px;
     v.used = builder_.IsActive(id);
@@ -672,13 +680,17 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     ExposureEstimate e;
     e.image = image;
     e.center_m = state.center;
-    e.opk_rad = state.opk;
+    e.opk_rad = calib::OpkFromQuaternionNear(state.rotation, state.exposure->opk_rad);
     const Exposure& x = *state.exposure;
     e.used = used_images.count(image) ||
              (options_.use_eo_priors && x.center_sigma_m && x.opk_sigma_rad);
     if (cov.ok && e.used) {
       e.center_sigma_m = cov.BlockSigma(state.center_block, 3);
       e.opk_sigma_rad = cov.BlockSigma(state.opk_block, 3);
+      if (std::isnan(e.opk_sigma_rad->x()))
+        result.notes.push_back("image " + image +
+                               ": phi is 90 deg (gimbal lock), omega and kappa are not separable "
+                               "(only their sum or difference is): their sigmas are unknown (null)");
     }
     result.exposures.push_back(e);
   }

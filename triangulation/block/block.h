@@ -12,6 +12,7 @@
 #include <Eigen/Core>
 
 #include "calib/camera/camera.h"
+#include "calib/camera/rig.h"
 
 namespace aerocal::triangulation {
 
@@ -59,6 +60,10 @@ struct Project {
   std::string path;  // the project YAML, or the folder
   std::map<std::string, calib::Camera> cameras;
   std::map<std::string, std::string> camera_files;
+  /// Cameras whose file has a `rig` section (FORMATS.md "Multi-head rig"), by camera id. Such a
+  /// camera is also in `cameras` as its reference head (the frame camera's interior block of that
+  /// id is the reference head's); its exposures are measured in head pixels (`head` column).
+  std::map<std::string, calib::Rig> rigs;
   std::vector<Exposure> exposures;
   std::vector<ImageObservation> observations;
   std::vector<GroundPoint> points;

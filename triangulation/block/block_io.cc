@@ -6,6 +6,7 @@
 #include <set>
 
 #include "calib/camera/camera_io.h"
+#include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
@@ -184,10 +185,20 @@ void ValidateProject(const Project& project) {
   for (const auto& o : project.observations) {
     if (!images.count(o.image))
       ThrowInputError({project.observations_file, o.line}, "unknown image '" + o.image + "'");
-    if (!o.head.empty())
+    const std::string& camera_id = project.FindExposure(o.image)->camera;
+    const auto rig = project.rigs.find(camera_id);
+    if (!o.head.empty() && rig == project.rigs.end())
       ThrowInputError({project.observations_file, o.line},
-                      "head observations belong to a rig camera file, which the block adjustment "
-                      "does not read yet (issue 13)");
+                      "head '" + o.head + "' of image " + o.image + ": camera '" + camera_id +
+                          "' is not a rig (a head observation needs a camera file with a rig "
+                          "section)");
+    if (rig != project.rigs.end() && o.head.empty())
+      ThrowInputError({project.observations_file, o.line},
+                      "image " + o.image + " is taken by rig '" + camera_id +
+                          "': its observations need a head (observations.csv `head` column)");
+    if (rig != project.rigs.end() && rig->second.HeadIndex(o.head) < 0)
+      ThrowInputError({project.observations_file, o.line},
+                      "rig '" + camera_id + "' has no head '" + o.head + "'");
     if (!o.subimage.empty()) {
       const auto& camera = project.cameras.at(project.FindExposure(o.image)->camera);
       if (camera.SubimageIndex(o.subimage) < 0)
@@ -215,7 +226,15 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
     const std::string id = entry.first.Scalar();
     const std::string file = ResolvePath(dir, YamlString(entry.second, path, "camera file"));
     project.camera_files[id] = file;
-    project.cameras[id] = calib::ReadCamera(file);
+    const YAML::Node camera = LoadYamlFile(file);
+    if (camera.IsMap() && camera["rig"]) {
+      // A rig camera file: the rig, and its reference head as the camera of that id.
+      const calib::Rig rig = calib::ParseRig(camera, file);
+      project.cameras[id] = rig.heads[rig.ReferenceIndex()].camera;
+      project.rigs[id] = rig;
+    } else {
+      project.cameras[id] = calib::ParseCamera(camera, file);
+    }
   }
   project.exposures_file = ResolvePath(dir, YamlString(root["exposures"], path, "exposures"));
   project.observations_file = ResolvePath(dir, YamlString(root["observations"], path, "observations"));

@@ -60,7 +60,9 @@ class DenseIndex {
   std::vector<CameraIndex> camera_of_exposure_;
 };
 
-/// The platform's pose of one exposure: rotation image -> object and projection centre (m).
+/// The platform's pose of one exposure: rotation image -> object (a unit quaternion block
+/// [w, x, y, z], ProblemBuilder::AddRotationBlock; residuals turn it into R with
+/// calib::ObjectFromImageRotationOfQuaternion) and projection centre (m).
 struct PoseBlocks {
   calib::BlockId rotation = -1;
   calib::BlockId center = -1;

@@ -1,0 +1,57 @@
+// IMU attitude prior on a rotation block (a unit quaternion q = [w, x, y, z], object_from_image,
+// calib/camera/rotation.h), in the omega-phi-kappa of the IMU record and its sigmas:
+//   r_k = wrap(opk(q)_k - opk0_k) / sigma_k   [3, unitless],  wrap to (-pi, pi]
+// with phi = atan2(r02, sqrt(r12^2 + r22^2)), omega = atan2(-r12, r22), kappa = atan2(-r01, r00)
+// (CONVENTIONS.md "Exterior orientation"). The prior is the old per-angle prior of the
+// omega-phi-kappa block, so figures are unchanged; at phi = +-90 deg omega and kappa are not
+// defined and neither is this prior (the residual returns false within kGimbalLockCosPhi).
+// blocks: rotation[4].
+#pragma once
+
+#include <cmath>
+
+#include <Eigen/Core>
+#include <ceres/jet.h>
+
+#include "calib/camera/rotation.h"
+#include "calib/residuals/autodiff_residual.h"
+
+namespace aerocal::calib {
+
+namespace internal {
+inline double ScalarPart(double x) { return x; }
+template <typename T, int N>
+double ScalarPart(const ceres::Jet<T, N>& x) {
+  return x.a;
+}
+}  // namespace internal
+
+struct OpkPriorResidual : AutoDiffResidual<OpkPriorResidual, 3, 4> {
+  /// opk_rad: the IMU's omega, phi, kappa (rad); sigma_rad: their sigmas (> 0, rad).
+  OpkPriorResidual(const Eigen::Vector3d& opk_rad, const Eigen::Vector3d& sigma_rad)
+      : opk_{opk_rad.x(), opk_rad.y(), opk_rad.z()},
+        inverse_sigma_{1.0 / sigma_rad.x(), 1.0 / sigma_rad.y(), 1.0 / sigma_rad.z()} {}
+  template <typename T>
+  bool operator()(const T* rotation, T* residual) const {
+    using std::atan2;
+    using std::sqrt;
+    T r[9];
+    ObjectFromImageRotationOfQuaternion(rotation, r);
+    const T cos_phi2 = r[5] * r[5] + r[8] * r[8];
+    if (!(internal::ScalarPart(cos_phi2) > kGimbalLockCosPhi * kGimbalLockCosPhi)) return false;
+    const T opk[3] = {atan2(-r[5], r[8]), atan2(r[2], sqrt(cos_phi2)), atan2(-r[1], r[0])};
+    constexpr double kTwoPi = 2.0 * M_PI;
+    for (int k = 0; k < 3; ++k) {
+      const T d = opk[k] - T(opk_[k]);
+      const double turns = std::round(internal::ScalarPart(d) / kTwoPi);
+      residual[k] = (d - T(turns * kTwoPi)) * T(inverse_sigma_[k]);
+    }
+    return true;
+  }
+
+ private:
+  double opk_[3];
+  double inverse_sigma_[3];
+};
+
+}  // namespace aerocal::calib

@@ -1,0 +1,527 @@
+#include "triangulation/sensor/rig_head_camera.h"
+
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/residuals/collinearity.h"
+#include "calib/residuals/prior.h"
+#include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/adjustment/determinability.h"
+#include "triangulation/sensor/frame_camera.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace aerocal::triangulation {
+namespace {
+
+using Model = calib::Camera::Model;
+using calib::BlockId;
+
+constexpr double kDegPerRad = 180.0 / M_PI;
+
+const std::vector<std::string> kMountNames = {"omega", "phi", "kappa"};
+const std::vector<std::string> kLeverArmNames = {"tx", "ty", "tz"};
+const std::vector<std::string> kIncrementNames = {"domega", "dphi", "dkappa"};
+
+// The one place that knows how the platform's rotation block is parameterised (omega, phi, kappa,
+// calib/camera/rotation.h): the head's residual on the exposure's rotation block, and the
+// exposure's starting rotation. A rotation manifold changes these two functions only.
+std::unique_ptr<ceres::CostFunction> HeadCost(const calib::Camera& head,
+                                              const ImageObservation& observation,
+                                              const Eigen::Vector3d& velocity_mps) {
+  return calib::RigHeadCollinearityResidual::Create(
+      head.frame(), observation.pixel, observation.sigma_px, velocity_mps);
+}
+Eigen::Matrix3d ObjectFromRig(const Exposure& exposure) {
+  return calib::RotationFromOpk(exposure.opk_rad);
+}
+
+std::vector<std::string> InteriorNames() {
+  std::vector<std::string> names;
+  for (const auto& p : Model::kParams) names.emplace_back(p.name);
+  return names;
+}
+
+Eigen::Vector3d VelocityOf(const Exposure& exposure) {
+  return exposure.velocity_mps ? *exposure.velocity_mps : Eigen::Vector3d::Zero();
+}
+
+}  // namespace
+
+std::optional<RigParameterMode> ParseRigParameterMode(std::string_view name) {
+  if (name == "fixed") return RigParameterMode::kFixed;
+  if (name == "free") return RigParameterMode::kFree;
+  if (name == "weighted") return RigParameterMode::kWeighted;
+  return std::nullopt;
+}
+
+std::string_view RigParameterModeName(RigParameterMode mode) {
+  switch (mode) {
+    case RigParameterMode::kFixed: return "fixed";
+    case RigParameterMode::kFree: return "free";
+    case RigParameterMode::kWeighted: return "weighted";
+  }
+  return "fixed";
+}
+
+void RigAdjustOptions::Validate() const {
+  if (increments == RigParameterMode::kWeighted && !(increment_sigma_rad > 0.0))
+    throw ConfigError("weighted rig increments need a sigma > 0 (--rig-increment-sigma-arcsec, "
+                      "got " + FormatNumber(increment_sigma_rad * kDegPerRad * 3600.0) + ")");
+  if (time_offsets == RigParameterMode::kWeighted && !(time_offset_sigma_s > 0.0))
+    throw ConfigError("weighted rig time offsets need a sigma > 0 (--rig-time-offset-sigma-ms, "
+                      "got " + FormatNumber(time_offset_sigma_s * 1e3) + ")");
+}
+
+RigHeadCamera::RigHeadCamera(const RigAdjustOptions& options) : options_(options) {
+  options_.Validate();
+}
+
+bool RigHeadCamera::Measures(const ImageObservation& observation) const {
+  return !observation.head.empty();
+}
+
+void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
+  const Project& project = context.project;
+  if (project.rigs.size() != 1)
+    throw ConfigError(project.path + ": the rig bundle takes a project with one rig camera (got " +
+                      std::to_string(project.rigs.size()) + ")");
+  camera_ = project.rigs.begin()->first;
+  rig_ = &project.rigs.begin()->second;
+  reference_ = rig_->ReferenceIndex();
+  calib::ProblemBuilder& builder = context.builder;
+  const std::string prefix = "rig " + camera_ + " head ";
+
+  // Free interior entries as the frame camera (AdjustOptions::free_interior).
+  std::vector<int> fixed_interior;
+  for (int i = 0; i < Model::kNumParams; ++i) {
+    const auto& free = context.options.free_interior;
+    if (std::find(free.begin(), free.end(), std::string(Model::kParams[i].name)) == free.end())
+      fixed_interior.push_back(i);
+  }
+  const auto apply_mode = [&](BlockId block, RigParameterMode mode) {
+    if (mode == RigParameterMode::kFixed) builder.FixBlock(block);
+  };
+  const int n = static_cast<int>(rig_->heads.size());
+  heads_.assign(n, Head{});
+  for (int k = 0; k < n; ++k) {
+    const calib::RigHead& head = rig_->heads[k];
+    Head& h = heads_[k];
+    h.mount_rad = head.mount_rad;
+    h.lever_arm_m = head.lever_arm_m;
+    const std::string name = prefix + head.id;
+    if (k == reference_) {
+      h.interior_block = context.frame.InteriorBlock(context.index.Camera(camera_));
+    } else {
+      h.interior = head.camera.interior;
+      h.interior_block = builder.AddBlock(name + " interior",
+                                          h.interior.data(),
+                                          Model::kNumParams,
+                                          calib::BlockKind::kInterior,
+                                          InteriorNames());
+      builder.FixEntries(h.interior_block, fixed_interior);
+    }
+    h.mount_block = builder.AddBlock(
+        name + " mount", h.mount_rad.data(), 3, calib::BlockKind::kOther, kMountNames);
+    h.lever_arm_block = builder.AddBlock(
+        name + " lever arm", h.lever_arm_m.data(), 3, calib::BlockKind::kOther, kLeverArmNames);
+    if (k == reference_) {
+      builder.FixBlock(h.mount_block);  // the rig's datum: the reference head
+      builder.FixBlock(h.lever_arm_block);
+      continue;
+    }
+    apply_mode(h.mount_block, options_.mounts);
+    apply_mode(h.lever_arm_block, options_.lever_arms);
+    const auto weighted_needs = [&](bool has, const char* what, const char* key) {
+      if (!has)
+        throw ConfigError(context.project.camera_files.at(camera_) + ": head " + head.id + ": " +
+                          what + " weighted needs the head's " + key);
+    };
+    if (options_.mounts == RigParameterMode::kWeighted)
+      weighted_needs(head.mount_sigma_rad.has_value(), "--rig-mounts", "mount_sigma_deg");
+    if (options_.lever_arms == RigParameterMode::kWeighted)
+      weighted_needs(head.lever_arm_sigma_m.has_value(), "--rig-lever-arms", "lever_arm_sigma_m");
+    if (options_.time_offsets != RigParameterMode::kFixed)
+      h.time_offset_block = builder.AddBlock(
+          name + " time offset", &h.time_offset_s, 1, calib::BlockKind::kOther, {"dT"});
+  }
+  zero_increment_block_ = builder.AddBlock("rig " + camera_ + " zero increment",
+                                           zero_increment_.data(),
+                                           3,
+                                           calib::BlockKind::kOther,
+                                           kIncrementNames);
+  builder.FixBlock(zero_increment_block_);
+  zero_time_offset_block_ = builder.AddBlock(
+      "rig " + camera_ + " zero time offset", &zero_time_offset_, 1, calib::BlockKind::kOther, {"dT"});
+  builder.FixBlock(zero_time_offset_block_);
+
+  // Exposures of the rig: per-head increments; velocity where the time offsets are estimated.
+  for (ExposureIndex e = 0; e < context.index.NumExposures(); ++e) {
+    const Exposure& exposure = project.exposures[e];
+    if (exposure.camera != camera_) continue;
+    if (options_.time_offsets != RigParameterMode::kFixed && n > 1 && !exposure.velocity_mps)
+      ThrowInputError({project.exposures_file, exposure.line},
+                      "image " + exposure.image +
+                          ": estimating rig time offsets needs the platform velocity (columns "
+                          "vX,vY,vZ)");
+    if (options_.increments == RigParameterMode::kFixed) continue;
+    for (int k = 0; k < n; ++k) {
+      if (k == reference_) continue;
+      Increment& increment = increments_[{e, k}];
+      increment.block = builder.AddBlock(
+          "rig " + camera_ + " image " + exposure.image + " head " + rig_->heads[k].id +
+              " increment",
+          increment.rad.data(),
+          3,
+          calib::BlockKind::kOther,
+          kIncrementNames);
+    }
+  }
+}
+
+BlockId RigHeadCamera::IncrementBlock(ExposureIndex exposure, int head) const {
+  const auto it = increments_.find({exposure, head});
+  return it == increments_.end() ? zero_increment_block_ : it->second.block;
+}
+
+std::pair<Eigen::Matrix3d, Eigen::Vector3d> RigHeadCamera::StartingHeadPose(
+    const SensorContext& context, const ObservationSite& site, int head) const {
+  (void)context;
+  const Head& h = heads_[head];
+  const auto increment = increments_.find({site.index, head});
+  const Eigen::Vector3d e =
+      increment == increments_.end() ? Eigen::Vector3d::Zero() : increment->second.rad;
+  const Eigen::Matrix3d r = ObjectFromRig(*site.exposure);
+  const Eigen::Matrix3d object_from_head =
+      r * calib::RotationFromOpk(h.mount_rad) * calib::RotationFromOpk(e);
+  const Eigen::Vector3d center =
+      site.exposure->center_m + r * h.lever_arm_m + VelocityOf(*site.exposure) * h.time_offset_s;
+  return {object_from_head, center};
+}
+
+ImageRay RigHeadCamera::StartingRay(const SensorContext& context,
+                                    const ImageObservation& observation) const {
+  const ObservationSite site = context.Site(observation);
+  const int k = rig_->HeadIndex(observation.head);
+  const auto [object_from_head, center] = StartingHeadPose(context, site, k);
+  return RayFromPixel(rig_->heads[k].camera,
+                      calib::OpkFromRotation(object_from_head),
+                      center,
+                      observation.pixel);
+}
+
+ObservationTerm RigHeadCamera::Observe(const SensorContext& context,
+                                       const ImageObservation& observation,
+                                       BlockId point) {
+  const ObservationSite site = context.Site(observation);
+  const int k = rig_->HeadIndex(observation.head);
+  const Head& h = heads_[k];
+  ObservationTerm term;
+  term.group = calib::kGroupImage;
+  term.cost = HeadCost(rig_->heads[k].camera, observation, VelocityOf(*site.exposure));
+  term.blocks = {h.interior_block,
+                 site.pose.rotation,
+                 site.pose.center,
+                 h.mount_block,
+                 h.lever_arm_block,
+                 IncrementBlock(site.index, k),
+                 h.time_offset_block >= 0 ? h.time_offset_block : zero_time_offset_block_,
+                 point};
+  return term;
+}
+
+void RigHeadCamera::AddOwnResiduals(const SensorContext& context) {
+  calib::ProblemBuilder& builder = context.builder;
+  const auto prior3 = [&](BlockId block,
+                          const Eigen::Vector3d& value,
+                          const Eigen::Vector3d& sigma,
+                          const std::string& label) {
+    builder.AddResidual(
+        kGroupRigPrior,
+        calib::PriorCostFunction::Create({value.x(), value.y(), value.z()},
+                                         {sigma.x(), sigma.y(), sigma.z()}),
+        {block},
+        label);
+  };
+  for (int k = 0; k < static_cast<int>(heads_.size()); ++k) {
+    if (k == reference_) continue;
+    const calib::RigHead& head = rig_->heads[k];
+    const Head& h = heads_[k];
+    const std::string name = "rig prior head " + head.id;
+    if (options_.mounts == RigParameterMode::kWeighted)
+      prior3(h.mount_block, head.mount_rad, *head.mount_sigma_rad, name + " mount");
+    if (options_.lever_arms == RigParameterMode::kWeighted)
+      prior3(h.lever_arm_block, head.lever_arm_m, *head.lever_arm_sigma_m, name + " lever arm");
+    if (options_.time_offsets == RigParameterMode::kWeighted)
+      builder.AddResidual(kGroupRigPrior,
+                          calib::PriorCostFunction::Create({0.0}, {options_.time_offset_sigma_s}),
+                          {h.time_offset_block},
+                          name + " time offset");
+    if (context.options.use_interior_sigma) {
+      std::vector<int> indices;
+      std::vector<double> values, sigmas;
+      for (const auto& free : context.options.free_interior) {
+        const int i = Model::IndexOf(free);
+        if (!head.camera.interior_sigma[i]) continue;
+        indices.push_back(i);
+        values.push_back(head.camera.interior[i]);
+        sigmas.push_back(*head.camera.interior_sigma[i]);
+      }
+      if (!indices.empty())
+        builder.AddResidual(
+            calib::kGroupInteriorPrior,
+            std::make_unique<calib::PriorCostFunction>(Model::kNumParams, indices, values, sigmas),
+            {h.interior_block},
+            "interior prior " + camera_ + " head " + head.id);
+    }
+  }
+  if (options_.increments == RigParameterMode::kWeighted) {
+    const double s = options_.increment_sigma_rad;
+    for (const auto& [key, increment] : increments_)
+      prior3(increment.block,
+             Eigen::Vector3d::Zero(),
+             Eigen::Vector3d::Constant(s),
+             "rig prior image " + context.project.exposures[key.first].image + " head " +
+                 rig_->heads[key.second].id + " increment");
+  }
+}
+
+std::vector<BlockId> RigHeadCamera::Blocks() const {
+  std::vector<BlockId> blocks;
+  for (const Head& h : heads_) {
+    blocks.push_back(h.interior_block);
+    blocks.push_back(h.mount_block);
+    blocks.push_back(h.lever_arm_block);
+    if (h.time_offset_block >= 0) blocks.push_back(h.time_offset_block);
+  }
+  for (const auto& [key, increment] : increments_) blocks.push_back(increment.block);
+  return blocks;
+}
+
+void RigHeadCamera::Collect(const SensorContext& context,
+                            const calib::CovarianceReport& cov,
+                            RigAdjustmentResult* result) const {
+  result->camera = camera_;
+  result->reference_head = rig_->reference_head;
+  result->options = options_;
+  const auto sigma3 = [&](BlockId block) -> std::optional<Eigen::Vector3d> {
+    if (!cov.ok) return std::nullopt;
+    return Eigen::Vector3d(cov.BlockSigma(block, 3));
+  };
+  for (int k = 0; k < static_cast<int>(heads_.size()); ++k) {
+    const Head& h = heads_[k];
+    RigHeadEstimate e;
+    e.id = rig_->heads[k].id;
+    e.reference = k == reference_;
+    e.interior = e.reference ? context.frame.Interior(context.index.Camera(camera_)) : h.interior;
+    if (cov.ok) {
+      const Eigen::VectorXd s = cov.BlockSigma(h.interior_block, Model::kNumParams);
+      for (int i = 0; i < Model::kNumParams; ++i) e.interior_sigma[i] = s(i);
+    }
+    e.mount_rad = h.mount_rad;
+    e.lever_arm_m = h.lever_arm_m;
+    e.mount_sigma_rad = sigma3(h.mount_block);
+    e.lever_arm_sigma_m = sigma3(h.lever_arm_block);
+    e.time_offset_s = h.time_offset_s;
+    if (h.time_offset_block < 0)
+      e.time_offset_sigma_s = 0.0;
+    else if (cov.ok)
+      e.time_offset_sigma_s = cov.BlockSigma(h.time_offset_block, 1)(0);
+    result->heads.push_back(e);
+  }
+  for (ExposureIndex x = 0; x < context.index.NumExposures(); ++x) {
+    const Exposure& exposure = context.project.exposures[x];
+    if (exposure.camera != camera_) continue;
+    for (int k = 0; k < static_cast<int>(heads_.size()); ++k) {
+      if (k == reference_) continue;
+      RigExposureEstimate e;
+      e.image = exposure.image;
+      e.head = rig_->heads[k].id;
+      const auto it = increments_.find({x, k});
+      if (it == increments_.end()) {
+        e.increment_sigma_rad = Eigen::Vector3d::Zero();
+      } else {
+        e.increment_rad = it->second.rad;
+        e.increment_sigma_rad = sigma3(it->second.block);
+      }
+      e.time_offset_s = result->heads[k].time_offset_s;
+      e.time_offset_sigma_s = result->heads[k].time_offset_sigma_s;
+      result->exposures.push_back(e);
+    }
+  }
+}
+
+RigAdjustmentResult AdjustRig(const Project& project,
+                              const AdjustOptions& options,
+                              const RigAdjustOptions& rig_options) {
+  auto sensor = std::make_unique<RigHeadCamera>(rig_options);
+  const RigHeadCamera* rig = sensor.get();
+  std::vector<std::unique_ptr<ImagingModel>> sensors;
+  sensors.push_back(std::move(sensor));
+  BlockAdjustment adjustment(project, options, std::move(sensors));
+  RigAdjustmentResult result;
+  result.adjustment = adjustment.Run();
+
+  // Covariance of the rig's parameters with each other and with every exposure's pose.
+  const SensorContext& context = adjustment.context();
+  const std::vector<BlockId> rig_blocks = rig->Blocks();
+  std::vector<BlockId> blocks = rig_blocks;
+  for (const PoseBlocks& pose : context.poses) {
+    blocks.push_back(pose.rotation);
+    blocks.push_back(pose.center);
+  }
+  calib::CovarianceReport cov;
+  const AdjustmentResult& a = result.adjustment;
+  if (!options.estimate_covariance)
+    cov.message = "covariance not estimated (option)";
+  else if (a.solve.usable && a.solve.redundancy > 0)
+    cov = adjustment.builder().EstimateCovariance(
+        blocks, a.sigma0, options.correlation_threshold, rig_blocks);
+  else
+    cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
+  result.determinability = AssessDeterminability(cov, "rig ", options.correlation_threshold);
+  rig->Collect(context, cov, &result);
+  const auto& reasons = result.adjustment.invalid_reasons;
+  const bool said = std::any_of(reasons.begin(), reasons.end(), [&](const std::string& reason) {
+    return reason.find(cov.message) != std::string::npos;
+  });
+  if (options.estimate_covariance && !cov.ok && !said)  // not twice when the block's failed too
+    result.adjustment.Invalidate("rig: no covariance of the rig parameters: " + cov.message);
+  else if (!result.determinability.undetermined.empty())
+    result.adjustment.Invalidate(
+        "rig: " + std::to_string(result.determinability.undetermined.size()) +
+        " rig parameter(s) not determinable (" + result.determinability.undetermined.front() +
+        ", ...)");
+  return result;
+}
+
+nlohmann::json RigResultToJson(const RigAdjustmentResult& r) {
+  const auto vector3 = [](const Eigen::Vector3d& v, double scale) {
+    return nlohmann::json::array({v.x() * scale, v.y() * scale, v.z() * scale});
+  };
+  const auto sigma3 = [&](const std::optional<Eigen::Vector3d>& s, double scale) {
+    return s ? vector3(*s, scale) : nlohmann::json();
+  };
+  const auto scalar = [](const std::optional<double>& s, double scale) {
+    return s ? nlohmann::json(*s * scale) : nlohmann::json();
+  };
+  nlohmann::json heads = nlohmann::json::array();
+  for (const RigHeadEstimate& h : r.heads) {
+    nlohmann::json interior, interior_sigma;
+    for (int i = 0; i < Model::kNumParams; ++i) {
+      const std::string name(Model::kParams[i].name);
+      interior[name] = h.interior[i];
+      interior_sigma[name] = scalar(h.interior_sigma[i], 1.0);
+    }
+    heads.push_back({{"id", h.id},
+                     {"reference", h.reference},
+                     {"interior", interior},
+                     {"interior_sigma", interior_sigma},
+                     {"mount_deg", vector3(h.mount_rad, kDegPerRad)},
+                     {"mount_sigma_deg", sigma3(h.mount_sigma_rad, kDegPerRad)},
+                     {"lever_arm_m", vector3(h.lever_arm_m, 1.0)},
+                     {"lever_arm_sigma_m", sigma3(h.lever_arm_sigma_m, 1.0)},
+                     {"dT_ms", h.time_offset_s * 1e3},
+                     {"dT_sigma_ms", scalar(h.time_offset_sigma_s, 1e3)}});
+  }
+  const Determinability& d = r.determinability;
+  nlohmann::json correlations = nlohmann::json::array();
+  for (const auto& h : d.high_correlations)
+    correlations.push_back({{"a", h.a}, {"b", h.b}, {"correlation", h.correlation}});
+  const RigAdjustOptions& o = r.options;
+  nlohmann::json rig = {
+      {"camera", r.camera},
+      {"reference_head", r.reference_head},
+      {"options",
+       {{"mounts", RigParameterModeName(o.mounts)},
+        {"lever_arms", RigParameterModeName(o.lever_arms)},
+        {"increments", RigParameterModeName(o.increments)},
+        {"increment_sigma_arcsec",
+         o.increments == RigParameterMode::kWeighted
+             ? nlohmann::json(o.increment_sigma_rad * kDegPerRad * 3600.0)
+             : nlohmann::json()},
+        {"time_offsets", RigParameterModeName(o.time_offsets)},
+        {"time_offset_sigma_ms",
+         o.time_offsets == RigParameterMode::kWeighted ? nlohmann::json(o.time_offset_sigma_s * 1e3)
+                                                       : nlohmann::json()}}},
+      {"heads", heads},
+      {"determinability",
+       {{"determinable", d.covariance_ok && d.undetermined.empty()},
+        {"message", d.message},
+        {"covariance_method", d.covariance_method},
+        {"undetermined", d.undetermined},
+        {"high_correlations", correlations},
+        {"warnings", d.warnings}}}};
+  nlohmann::json exposures = nlohmann::json::array();
+  for (const RigExposureEstimate& e : r.exposures) {
+    const Eigen::Vector3d deg = e.increment_rad * kDegPerRad;
+    nlohmann::json sigma = {{"domega", nullptr}, {"dphi", nullptr}, {"dkappa", nullptr},
+                            {"dT_ms", scalar(e.time_offset_sigma_s, 1e3)}};
+    if (e.increment_sigma_rad) {
+      sigma["domega"] = e.increment_sigma_rad->x() * kDegPerRad;
+      sigma["dphi"] = e.increment_sigma_rad->y() * kDegPerRad;
+      sigma["dkappa"] = e.increment_sigma_rad->z() * kDegPerRad;
+    }
+    exposures.push_back({{"image", e.image},
+                         {"head", e.head},
+                         {"domega", deg.x()},
+                         {"dphi", deg.y()},
+                         {"dkappa", deg.z()},
+                         {"dT_ms", e.time_offset_s * 1e3},
+                         {"sigma", sigma}});
+  }
+  return {{"rig", rig}, {"rig_exposures", exposures}};
+}
+
+std::string FormatRigSummary(const RigAdjustmentResult& r) {
+  std::string out = "rig " + r.camera + " (reference head " + r.reference_head + ")\n";
+  const auto value_sigma = [](double value, const std::optional<double>& sigma, int digits) {
+    return FormatNumber(value, digits) + " +- " + (sigma ? FormatNumber(*sigma, 2) : "?");
+  };
+  for (const RigHeadEstimate& h : r.heads) {
+    if (h.reference) continue;
+    out += "  head " + h.id + " mount (deg):";
+    for (int i = 0; i < 3; ++i)
+      out += " " + value_sigma(h.mount_rad(i) * kDegPerRad,
+                               h.mount_sigma_rad ? std::optional<double>((*h.mount_sigma_rad)(i) *
+                                                                         kDegPerRad)
+                                                 : std::nullopt,
+                               8);
+    out += "\n  head " + h.id + " lever arm (m):";
+    for (int i = 0; i < 3; ++i)
+      out += " " + value_sigma(h.lever_arm_m(i),
+                               h.lever_arm_sigma_m ? std::optional<double>((*h.lever_arm_sigma_m)(i))
+                                                   : std::nullopt,
+                               6);
+    out += "\n";
+    if (r.options.time_offsets != RigParameterMode::kFixed)
+      out += "  head " + h.id + " dT (ms): " +
+             value_sigma(h.time_offset_s * 1e3,
+                         h.time_offset_sigma_s ? std::optional<double>(*h.time_offset_sigma_s * 1e3)
+                                               : std::nullopt,
+                         6) +
+             "\n";
+  }
+  // Without a covariance the block's summary has said why already.
+  if (r.determinability.covariance_ok)
+    for (const auto& w : r.determinability.warnings) out += "warning: " + w + "\n";
+  return out;
+}
+
+calib::Rig UpdatedRig(const calib::Rig& rig, const RigAdjustmentResult& result) {
+  calib::Rig out = rig;
+  for (const RigHeadEstimate& e : result.heads) {
+    calib::RigHead& head = out.heads[out.HeadIndex(e.id)];
+    head.camera.interior = e.interior;
+    head.mount_rad = e.mount_rad;
+    head.lever_arm_m = e.lever_arm_m;
+    if (e.reference) continue;
+    if (result.options.mounts != RigParameterMode::kFixed && e.mount_sigma_rad)
+      head.mount_sigma_rad = e.mount_sigma_rad;
+    if (result.options.lever_arms != RigParameterMode::kFixed && e.lever_arm_sigma_m)
+      head.lever_arm_sigma_m = e.lever_arm_sigma_m;
+  }
+  return out;
+}
+
+}  // namespace aerocal::triangulation
