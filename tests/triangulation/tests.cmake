@@ -13,3 +13,4 @@ aerocal_add_test(triangulation/snooping_cli LIBS aerocal::triangulation LABELS c
 aerocal_add_test(triangulation/rig_flight_simulator LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/calibration LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/wall_pose LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/platform LIBS aerocal::triangulation LABELS synthetic)
