@@ -76,6 +76,9 @@ TEST(PlatformPriors, SurveyedLeverArmDeterminesTheTimeOffset) {
   project.platform.lever_arm_m = o.lever_arm_m + Eigen::Vector3d(0.01, -0.01, 0.01);
   project.platform.lever_arm_sigma_m = 0.02;
   project.platform.time_offset = PlatformParamMode::kFree;
+  // The planted boresight (0.02-0.03 deg, 7-10 IMU sigmas) must be free too: held at zero it
+  // tilts every attitude and biases the lever arm by 0.3 m (measured).
+  project.platform.boresight = PlatformParamMode::kFree;
   const AdjustmentResult r = Adjust(project, AdjustOptions{});
   ASSERT_TRUE(r.solve.converged) << r.solve.message;
   ASSERT_TRUE(r.platform.time_offset_sigma_s && r.platform.lever_arm_sigma_m);
