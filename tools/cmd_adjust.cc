@@ -89,6 +89,11 @@ CommandRun SetupAdjust(CLI::App& app) {
     triangulation::AdjustOptions options;
     JointAdjustArgs joint;
     RigArgs rig;
+    // The GNSS/IMU platform over the project YAML's `platform:` (each given option replaces).
+    std::vector<double> lever_arm_m, boresight_deg;
+    double time_offset_ms = 0.0, lever_arm_sigma_m = 0.0, boresight_sigma_deg = 0.0,
+           time_offset_sigma_ms = 0.0;
+    std::string lever_arm, boresight, time_offset;  // fixed | free | weighted
   };
   auto args = std::make_shared<Args>();
   app.add_option(
@@ -150,6 +155,32 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->options.correlation_threshold,
                  "Report parameter pairs correlated above this")
       ->check(CLI::Range(0.0, 1.0));
+  app.add_option("--lever-arm-m", args->lever_arm_m,
+                 "GNSS lever arm a (projection centre -> antenna, camera frame), m, \"X,Y,Z\": its "
+                 "value (fixed) or start (free, weighted)")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--lever-arm", args->lever_arm, "Lever arm: fixed (default) | free | weighted");
+  app.add_option("--lever-arm-sigma-m", args->lever_arm_sigma_m,
+                 "Lever arm sigma per axis when weighted, m")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--boresight-deg", args->boresight_deg,
+                 "Boresight misalignment M (IMU attitude = R M^T), omega,phi,kappa deg")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--boresight", args->boresight, "Boresight: fixed (default) | free | weighted");
+  app.add_option("--boresight-sigma-deg", args->boresight_sigma_deg,
+                 "Boresight sigma per angle when weighted, deg")
+      ->check(CLI::PositiveNumber);
+  app.add_option("--gnss-time-offset-ms", args->time_offset_ms,
+                 "GNSS time offset dt (GNSS position = antenna at exposure time + dt; needs vX, vY, "
+                 "vZ in exposures.csv), ms")
+      ->check(CLI::Range(-1e4, 1e4));
+  app.add_option("--gnss-time-offset", args->time_offset,
+                 "GNSS time offset: fixed (default) | free | weighted");
+  app.add_option("--gnss-time-offset-sigma-ms", args->time_offset_sigma_ms,
+                 "GNSS time offset sigma when weighted, ms")
+      ->check(CLI::PositiveNumber);
   AddJointAdjustOptions(app, &args->joint);
   // The rig bundle (a project whose camera file has a `rig` section): which rig parameters of the
   // non-reference heads are estimated.
@@ -179,7 +210,41 @@ CommandRun SetupAdjust(CLI::App& app) {
                      args->rig.time_offset_sigma_ms,
                      "Rig: sigma of weighted time offsets around zero, ms")
           ->check(CLI::PositiveNumber)};
-  return [args, rig_options]() {
+  // The command line's platform options over the project's `platform:`.
+  auto apply_platform = [args, &app](triangulation::PlatformSpec* p) -> bool {
+    auto given = [&](const char* name) { return app.count(name) > 0; };
+    auto mode = [](const std::string& text, const char* option) {
+      const auto m = triangulation::ParsePlatformParamMode(text);
+      if (!m)
+        throw ConfigError(std::string(option) + " must be fixed, free or weighted (got '" + text +
+                          "')");
+      return *m;
+    };
+    if (given("--lever-arm-m"))
+      p->lever_arm_m = Eigen::Vector3d(args->lever_arm_m[0], args->lever_arm_m[1], args->lever_arm_m[2]);
+    if (given("--boresight-deg"))
+      p->boresight_rad = Eigen::Vector3d(args->boresight_deg[0], args->boresight_deg[1],
+                                         args->boresight_deg[2]) *
+                         (M_PI / 180.0);
+    if (given("--gnss-time-offset-ms")) p->time_offset_s = args->time_offset_ms * 1e-3;
+    if (given("--lever-arm")) p->lever_arm = mode(args->lever_arm, "--lever-arm");
+    if (given("--boresight")) p->boresight = mode(args->boresight, "--boresight");
+    if (given("--gnss-time-offset"))
+      p->time_offset = mode(args->time_offset, "--gnss-time-offset");
+    if (given("--lever-arm-sigma-m")) p->lever_arm_sigma_m = args->lever_arm_sigma_m;
+    if (given("--boresight-sigma-deg")) p->boresight_sigma_rad = args->boresight_sigma_deg * M_PI / 180.0;
+    if (given("--gnss-time-offset-sigma-ms")) p->time_offset_sigma_s = args->time_offset_sigma_ms * 1e-3;
+    for (const char* name : {"--lever-arm-m", "--lever-arm", "--lever-arm-sigma-m", "--boresight-deg",
+                             "--boresight", "--boresight-sigma-deg", "--gnss-time-offset-ms",
+                             "--gnss-time-offset", "--gnss-time-offset-sigma-ms"})
+      if (given(name)) {
+        p->source = p->source.empty() ? "options" : p->source + " and options";
+        triangulation::ValidatePlatform(*p);
+        return true;
+      }
+    return false;
+  };
+  return [args, rig_options, apply_platform]() {
     auto options = args->options;
     options.data_snooping = !args->no_snooping;
     options.use_eo_priors = !args->no_eo_priors;
@@ -195,13 +260,17 @@ CommandRun SetupAdjust(CLI::App& app) {
     if (args->joint.Requested() && args->camera_format != "aerocal")
       throw ConfigError("--camera-format: the joint adjustment writes our camera file only (aerocal)");
     if (args->joint.Requested()) {
+      triangulation::PlatformSpec unused;
+      if (apply_platform(&unused))
+        throw ConfigError("the platform options (--lever-arm ...) apply to the plain adjustment; "
+                          "the joint adjustment reads `platform:` from the project YAML");
       if (args->compare)
         throw ConfigError("--compare and --joint-stitching do not combine (`aerocal flight` runs and compares both)");
       return RunJointAdjust(
           args->joint, options, args->project, args->default_sigma_px, args->out, args->write_camera);
     }
-    const triangulation::Project input =
-        triangulation::ReadProject(args->project, args->default_sigma_px);
+    triangulation::Project input = triangulation::ReadProject(args->project, args->default_sigma_px);
+    apply_platform(&input.platform);
     const triangulation::ObjectFrame frame(input.frame);
     const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
     const bool rig_option_given = std::any_of(

@@ -22,6 +22,8 @@ struct SimulateArgs {
     std::uint64_t seed = 1;
     std::string rig;
     double increment_arcsec = 0.0, time_offset_ms = 0.0, speed_mps = 0.0;
+    std::vector<double> lever_arm_m, boresight_deg;  // planted platform (frame flight)
+    double gnss_time_offset_ms = 0.0;
     bool pushbroom = false;
     triangulation::LineSimulationOptions line;
     bool test_field = false;
@@ -132,10 +134,24 @@ CommandRun SetupSimulate(CLI::App& app) {
                                      "--rig: exposure time offset dT_k of the non-reference heads, "
                                      "-1000..1000 ms (with --speed-mps)")
                           ->check(CLI::Range(-1000.0, 1000.0));
-  auto* speed = app.add_option("--speed-mps", args->speed_mps,
-                               "--rig: platform speed along the strips, 0..1000 m/s (> 0: "
-                               "exposures.csv carries vX, vY, vZ)")
-                    ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--speed-mps", args->speed_mps,
+                 "Platform speed along the strips, 0..1000 m/s (> 0: exposures.csv carries vX, vY, "
+                 "vZ)")
+      ->check(CLI::Range(0.0, 1000.0));
+  app.add_option("--lever-arm-m", args->lever_arm_m,
+                 "GNSS lever arm a planted in the GNSS centres (X0 + R a), camera frame, m, "
+                 "\"X,Y,Z\" (with --gnss-sigma-m)")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--boresight-deg", args->boresight_deg,
+                 "Boresight misalignment M planted in the IMU angles (R M^T), omega,phi,kappa deg "
+                 "(with --imu-sigma-deg)")
+      ->delimiter(',')
+      ->expected(3);
+  app.add_option("--gnss-time-offset-ms", args->gnss_time_offset_ms,
+                 "GNSS time offset dt planted in the GNSS centres (+ v dt), -10000..10000 ms (with "
+                 "--gnss-sigma-m and --speed-mps)")
+      ->check(CLI::Range(-1e4, 1e4));
   // Line camera (pushbroom) flight: its own options; the shared ones above apply when given.
   auto& l = args->line;
   app.add_flag("--test-field", args->test_field,
@@ -176,7 +192,7 @@ CommandRun SetupSimulate(CLI::App& app) {
       {"--imu-sigma-deg", &Flight::imu_sigma_deg},
       {"--start-offset-m", &Flight::start_position_error_m},
       {"--start-offset-deg", &Flight::start_angle_error_deg}};
-  return [args, &app, int_options, double_options, increment, time_offset, speed]() {
+  return [args, &app, int_options, double_options, increment, time_offset]() {
     CheckOutputFolder(args->out, "--out");
     if (args->test_field) return RunTestFieldSimulation(app, *args);
     for (const char* field_only : {"--planar", "--groups", "--images-per-group", "--distance-m"})
@@ -205,11 +221,29 @@ CommandRun SetupSimulate(CLI::App& app) {
       return kExitOk;
     }
     if (!args->rig.empty()) return RunRigSimulation(app, *args, int_options, double_options);
-    for (const CLI::Option* rig_only : {increment, time_offset, speed})
+    for (const CLI::Option* rig_only : {increment, time_offset})
       if (rig_only->count() > 0)
         throw ConfigError(rig_only->get_name() + " applies to a rig flight (--rig) only");
     auto& o = args->options;
     o.seed = args->seed;
+    o.speed_mps = args->speed_mps;
+    if (!args->lever_arm_m.empty()) {
+      if (o.gnss_sigma_m <= 0) throw ConfigError("--lever-arm-m needs --gnss-sigma-m > 0");
+      for (double v : args->lever_arm_m)
+        if (!(std::abs(v) <= 1000.0)) throw ConfigError("--lever-arm-m must be within +-1000 m");
+      o.lever_arm_m = Eigen::Vector3d(args->lever_arm_m[0], args->lever_arm_m[1], args->lever_arm_m[2]);
+    }
+    if (!args->boresight_deg.empty()) {
+      if (o.imu_sigma_deg <= 0) throw ConfigError("--boresight-deg needs --imu-sigma-deg > 0");
+      for (double v : args->boresight_deg)
+        if (!(std::abs(v) <= 180.0)) throw ConfigError("--boresight-deg must be within +-180 deg");
+      o.boresight_rad =
+          Eigen::Vector3d(args->boresight_deg[0], args->boresight_deg[1], args->boresight_deg[2]) *
+          (M_PI / 180.0);
+    }
+    o.gnss_time_offset_s = args->gnss_time_offset_ms * 1e-3;
+    if (o.gnss_time_offset_s != 0.0 && (o.gnss_sigma_m <= 0 || o.speed_mps <= 0))
+      throw ConfigError("--gnss-time-offset-ms needs --gnss-sigma-m > 0 and --speed-mps > 0");
     int rows = 0, cols = 0;
     char x = 0;
     std::istringstream in(args->layout);

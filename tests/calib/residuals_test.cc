@@ -5,6 +5,7 @@
 
 #include "calib/camera/camera.h"
 #include "calib/residuals/collinearity.h"
+#include "calib/residuals/gnss_prior.h"
 #include "calib/residuals/prior.h"
 #include "calib/residuals/rotation_prior.h"
 #include "calib/residuals/stitching.h"
@@ -206,16 +207,43 @@ TEST(OpkPriorResidual, IsTheAngleDifferenceInSigmasAndGradientsMatch) {
   const Eigen::Vector3d sigma(1e-3, 5e-4, 2e-3);
   auto cost = OpkPriorResidual::Create(imu, sigma);
   double r[3];
-  const double* blocks[] = {q.data()};
+  double no_boresight[3] = {0, 0, 0};
+  const double* blocks[] = {q.data(), no_boresight};
   ASSERT_TRUE(cost->Evaluate(blocks, r, nullptr));
   EXPECT_NEAR(r[0], -1.0, 1e-9);   // (0.020 - 0.021) / 1e-3
   EXPECT_NEAR(r[1], 3.0, 1e-9);    // (-0.0100 + 0.0115) / 5e-4
   EXPECT_NEAR(r[2], -0.75, 1e-9);  // (pi - 0.001 - (-pi + 0.0005) - 2 pi) / 2e-3
-  ExpectGradientsMatch(*cost, {q.data()});
+  ExpectGradientsMatch(*cost, {q.data(), no_boresight});
+  // A boresight M: the IMU records R M^T; the prior of R M^T's own angles is zero.
+  double boresight[3] = {0.003, -0.002, 0.01};
+  const Eigen::Vector3d imu_angles = OpkFromRotation(
+      RotationFromQuaternion(q) * RotationFromOpk(Eigen::Vector3d(boresight)).transpose());
+  auto exact = OpkPriorResidual::Create(imu_angles, sigma);
+  const double* with_boresight[] = {q.data(), boresight};
+  ASSERT_TRUE(exact->Evaluate(with_boresight, r, nullptr));
+  EXPECT_NEAR(std::hypot(r[0], std::hypot(r[1], r[2])), 0.0, 1e-9);
+  ExpectGradientsMatch(*exact, {q.data(), boresight});
   // Undefined at phi = 90 deg (omega and kappa not separable): refused, not a silent number.
   Eigen::Vector4d wall = QuaternionFromOpk(Eigen::Vector3d(0.1, M_PI / 2, 0.0));
-  const double* wall_blocks[] = {wall.data()};
+  const double* wall_blocks[] = {wall.data(), no_boresight};
   EXPECT_FALSE(cost->Evaluate(wall_blocks, r, nullptr));
+}
+
+TEST(GnssPriorResidual, AntennaIsCentrePlusLeverArmPlusVelocityTimesOffset) {
+  Scene s;
+  const Eigen::Vector3d lever(0.2, -0.1, 1.5), velocity(70.0, -3.0, 0.5);
+  const double dt = 0.02;
+  const Eigen::Vector3d antenna = Eigen::Vector3d(s.center) +
+                                  RotationFromQuaternion(s.rotation) * lever + velocity * dt;
+  const Eigen::Vector3d sigma(0.05, 0.05, 0.1);
+  auto cost = GnssPriorResidual::Create(antenna + Eigen::Vector3d(0.05, 0, -0.2), sigma, velocity);
+  double lever_arm[3] = {lever.x(), lever.y(), lever.z()}, offset[1] = {dt}, r[3];
+  const double* blocks[] = {s.rotation.data(), s.center, lever_arm, offset};
+  ASSERT_TRUE(cost->Evaluate(blocks, r, nullptr));
+  EXPECT_NEAR(r[0], -1.0, 1e-9);  // (antenna - recorded) / sigma
+  EXPECT_NEAR(r[1], 0.0, 1e-9);
+  EXPECT_NEAR(r[2], 2.0, 1e-9);
+  ExpectGradientsMatch(*cost, {s.rotation.data(), s.center, lever_arm, offset});
 }
 
 TEST(StitchingResiduals, GradientsMatchForEveryMappingModel) {

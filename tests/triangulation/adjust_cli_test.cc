@@ -106,5 +106,40 @@ TEST_F(AdjustCommand, NotConvergedExitsThreeWithTheResultWritten) {
   EXPECT_FALSE(std::filesystem::exists(dir_.File("cam.yaml")));
 }
 
+// The GNSS/IMU platform: simulate plants a lever arm and a GNSS time offset, adjust estimates
+// them (options over the project YAML) and writes them with sigmas; a bad mode is exit 2.
+TEST(AdjustPlatform, SimulatedLeverArmAndTimeOffsetComeBack) {
+  TempDir dir{"aerocal_adjust_platform"};
+  const auto sim = RunAerocal("simulate --gnss-sigma-m 0.05 --speed-mps 70 --lever-arm-m "
+                              "0.15,-0.25,1.3 --gnss-time-offset-ms 20 --out " +
+                              dir.File("flight"));
+  ASSERT_EQ(sim.exit_code, 0) << sim.output;
+  const auto r = RunAerocal("adjust --project " + dir.File("flight") +
+                            " --self-calibration all --lever-arm free --gnss-time-offset free "
+                            "--out " + dir.File("result.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = ReadJson(dir.File("result.json"));
+  ASSERT_TRUE(j.contains("platform")) << j.dump().substr(0, 400);
+  const auto& lever = j["platform"]["lever_arm_m"];
+  EXPECT_EQ(lever["mode"], "free");
+  const double truth[3] = {0.15, -0.25, 1.3};
+  for (int i = 0; i < 3; ++i)
+    EXPECT_LE(std::abs(lever["value"][i].get<double>() - truth[i]),
+              3.0 * lever["sigma"][i].get<double>()) << i;
+  const auto& dt = j["platform"]["time_offset_ms"];
+  EXPECT_LE(std::abs(dt["value"][0].get<double>() - 20.0), 3.0 * dt["sigma"][0].get<double>());
+  // A mode that is not one of fixed | free | weighted: exit 2, nothing written.
+  const auto bad = RunAerocal("adjust --project " + dir.File("flight") +
+                              " --lever-arm loose --out " + dir.File("bad.json"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--lever-arm"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("bad.json")));
+  // Weighted without a sigma: named, exit 2.
+  const auto no_sigma = RunAerocal("adjust --project " + dir.File("flight") +
+                                   " --gnss-time-offset weighted --out " + dir.File("bad.json"));
+  EXPECT_EQ(no_sigma.exit_code, 2) << no_sigma.output;
+  EXPECT_NE(no_sigma.output.find("time_offset_sigma_ms"), std::string::npos) << no_sigma.output;
+}
+
 }  // namespace
 }  // namespace aerocal

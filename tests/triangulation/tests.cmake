@@ -18,3 +18,4 @@ aerocal_add_test(triangulation/rig_bundle LIBS aerocal::triangulation LABELS syn
 aerocal_add_test(triangulation/rig_bundle_study LIBS aerocal::triangulation LABELS long TIMEOUT 1200)
 aerocal_add_test(triangulation/rig_bundle_cli LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(triangulation/wall_pose LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/platform LIBS aerocal::triangulation LABELS synthetic)

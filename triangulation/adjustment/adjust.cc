@@ -8,27 +8,37 @@
 
 #include <algorithm>
 #include <cmath>
+#include <unordered_map>
 
 namespace aerocal::triangulation {
 namespace {
+
+// The used exposures and the cameras of a result by id, looked up once per run (ids are strings
+// only at this boundary: the result is what the next adjustment starts from).
+struct SolutionIndex {
+  explicit SolutionIndex(const AdjustmentResult& r) {
+    for (const auto& e : r.exposures)
+      if (e.used) exposure[e.image] = &e;
+    for (const auto& c : r.cameras) camera[c.id] = &c;
+  }
+  std::unordered_map<std::string, const ExposureEstimate*> exposure;
+  std::unordered_map<std::string, const CameraEstimate*> camera;
+};
 
 // Whitened residual of `o` at the solution of `r` (adjustment frame); nullopt when its exposure
 // or point is not in that solution or the ray misses.
 std::optional<Eigen::Vector2d> ResidualAt(const Project& project,
                                           const AdjustmentResult& r,
+                                          const SolutionIndex& solution,
                                           const ImageObservation& o) {
-  const Exposure* exposure = nullptr;
-  for (const auto& e : project.exposures)
-    if (e.image == o.image) exposure = &e;
+  const Exposure* exposure = project.FindExposure(o.image);
   const auto point = r.points_m.find(o.point);
   if (!exposure || point == r.points_m.end()) return std::nullopt;
-  const ExposureEstimate* pose = nullptr;
-  for (const auto& e : r.exposures)
-    if (e.image == o.image && e.used) pose = &e;
-  const CameraEstimate* camera = nullptr;
-  for (const auto& c : r.cameras)
-    if (c.id == exposure->camera) camera = &c;
-  if (!pose || !camera) return std::nullopt;
+  const auto pose_it = solution.exposure.find(o.image);
+  const auto camera_it = solution.camera.find(exposure->camera);
+  if (pose_it == solution.exposure.end() || camera_it == solution.camera.end()) return std::nullopt;
+  const ExposureEstimate* pose = pose_it->second;
+  const CameraEstimate* camera = camera_it->second;
   const calib::Camera& cam = project.cameras.at(exposure->camera);
   const calib::PixelFrame frame{cam.pixel_size_mm, cam.width_px, cam.height_px};
   const calib::CollinearityResidual residual(frame, o.pixel, o.sigma_px);
@@ -43,21 +53,17 @@ std::optional<Eigen::Vector2d> ResidualAt(const Project& project,
   return v;
 }
 
-bool SameObservation(const ImageObservation& a, const ImageObservation& b) {
-  return a.image == b.image && a.point == b.point && a.subimage == b.subimage &&
-         a.pixel == b.pixel;
-}
-
 // The solution of `r` becomes the starting values of `project`: exterior orientation of the
 // exposures it used, interior of every camera, tie point coordinates. Surveyed coordinates stay
 // the survey.
 void StartFromSolution(const AdjustmentResult& r, Project* project) {
-  for (auto& e : project->exposures)
-    for (const auto& s : r.exposures)
-      if (s.image == e.image && s.used) {
-        e.center_m = s.center_m;
-        e.opk_rad = s.opk_rad;
-      }
+  const SolutionIndex solution(r);
+  for (auto& e : project->exposures) {
+    const auto s = solution.exposure.find(e.image);
+    if (s == solution.exposure.end()) continue;
+    e.center_m = s->second->center_m;
+    e.opk_rad = s->second->opk_rad;
+  }
   for (const auto& c : r.cameras) project->cameras.at(c.id).interior = c.estimated;
   for (auto& p : project->points)
     if (p.role == PointRole::kTie && r.points_m.count(p.id)) p.xyz_m = r.points_m.at(p.id);
@@ -96,15 +102,12 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
     start = adjustment.Run(progress);
     screened = adjustment.ScreenRobustly(options.robust_reject_sigma);
   }
-  auto excluded = [&](const ImageObservation& o) {
-    for (const auto& s : screened)
-      if (SameObservation(s.observation, o)) return true;
-    return false;
-  };
+  std::vector<bool> excluded(project.observations.size(), false);
+  for (const auto& s : screened) excluded[s.source] = true;
   Project next = project;
   next.observations.clear();
-  for (const auto& o : project.observations)
-    if (!excluded(o)) next.observations.push_back(o);
+  for (size_t i = 0; i < project.observations.size(); ++i)
+    if (!excluded[i]) next.observations.push_back(project.observations[i]);
   // The robust solution becomes the starting values; surveyed coordinates stay the survey.
   StartFromSolution(start, &next);
 
@@ -132,9 +135,10 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   const double scale = std::max(1.0, clean.sigma0);
   std::vector<BlockAdjustment::Screened> still_excluded;
   int readmitted = 0, retested = 0;
+  const SolutionIndex clean_solution(clean);
   for (const auto& s : screened) {
     const bool undetermined = !clean.points_m.count(s.observation.point);
-    const auto v = ResidualAt(next, clean, s.observation);
+    const auto v = ResidualAt(next, clean, clean_solution, s.observation);
     if (undetermined || (v && v->cwiseAbs().maxCoeff() / scale < critical)) {
       next.observations.push_back(s.observation);
       ++(undetermined ? retested : readmitted);

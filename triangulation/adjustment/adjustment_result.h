@@ -7,6 +7,7 @@
 
 #include "calib/camera/camera.h"
 #include "calib/problem/problem_builder.h"
+#include "triangulation/block/block.h"
 
 #include <Eigen/Core>
 #include <nlohmann/json.hpp>
@@ -46,6 +47,19 @@ struct CameraEstimate {
   std::string id;
   calib::InteriorParams initial{}, estimated{}, sigma{};  // table units; sigma 0 when fixed
   std::array<bool, calib::Camera::Model::kNumParams> free{};
+};
+
+/// The GNSS/IMU platform after the adjustment (triangulation/README.md "GNSS/IMU priors on the
+/// platform"): values (the given ones when fixed) and sigmas of the estimated ones.
+struct PlatformEstimate {
+  PlatformSpec spec;   // modes and given values
+  bool gnss = false;   // lever arm and time offset took part (GNSS priors)
+  bool imu = false;    // boresight took part (IMU priors)
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
+  Eigen::Vector3d boresight_rad = Eigen::Vector3d::Zero();
+  double time_offset_s = 0.0;
+  std::optional<Eigen::Vector3d> lever_arm_sigma_m, boresight_sigma_rad;  // free or weighted
+  std::optional<double> time_offset_sigma_s;
 };
 
 struct ExposureEstimate {
@@ -204,6 +218,7 @@ struct AdjustmentResult {
   std::string datum;                                // how the datum is defined, stated
   std::vector<ResultWarning> warnings;              // the result is doubtful: by name
   SnoopingSummary snooping;
+  PlatformEstimate platform;
   /// False when the run must not be trusted: not converged, singular, rejection cap reached,
   /// sigma0 above AdjustOptions::max_sigma0; `invalid_reasons` says why (exit 3).
   bool valid = true;

@@ -3,6 +3,7 @@
 
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/residuals/gnss_prior.h"
 #include "calib/residuals/prior.h"
 #include "calib/residuals/rotation_prior.h"
 #include "triangulation/adjustment/determinability.h"
@@ -24,6 +25,13 @@ using calib::BlockKind;
 
 const std::vector<std::string> kCenterNames = {"X", "Y", "Z"};
 const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
+// Residual group of the weighted platform parameters (lever arm, boresight, GNSS time offset).
+constexpr const char* kGroupPlatformPrior = "platform_prior";
+
+bool PlatformEstimated(const PlatformSpec& p) {
+  return p.lever_arm != PlatformParamMode::kFixed || p.boresight != PlatformParamMode::kFixed ||
+         p.time_offset != PlatformParamMode::kFixed;
+}
 
 // "image 0012 point T442", "image 0012 sub-image A1 point T442": an observation in reports.
 std::string DescribeObservation(const ImageObservation& o) {
@@ -64,9 +72,15 @@ struct BlockAdjustment::Storage {
   // image), the kind that measures each, and their residuals.
   std::vector<ImageObservation> observations;
   std::vector<ImagingModel*> sensor_of_observation;
+  std::vector<int> source_of_observation;  // its index in Project::observations
   std::map<calib::ResidualId, size_t> observation_of_residual;
   std::map<calib::ResidualId, ObservationTest> tests;  // data snooping's last word on each
   std::vector<std::string> notes;
+  // The GNSS/IMU platform (Project::platform): lever arm, GNSS time offset (when exposures carry
+  // GNSS priors) and boresight (with IMU priors); -1 when absent.
+  Eigen::Vector3d lever_arm = Eigen::Vector3d::Zero(), boresight = Eigen::Vector3d::Zero();
+  double time_offset = 0.0;
+  BlockId lever_block = -1, boresight_block = -1, time_block = -1;
   std::string datum;
   bool free_network = false;  // datum by a dependent relative orientation, not by the survey
 };
@@ -104,6 +118,25 @@ BlockId BlockAdjustment::CenterBlock(const std::string& image) const {
   const auto it = storage_->exposures.find(image);
   return it == storage_->exposures.end() ? -1 : it->second.center_block;
 }
+PlatformEstimate BlockAdjustment::PlatformResult(const calib::CovarianceReport& cov) const {
+  const Storage& s = *storage_;
+  PlatformEstimate out;
+  out.spec = project_.platform;
+  out.gnss = s.lever_block >= 0;
+  out.imu = s.boresight_block >= 0;
+  out.lever_arm_m = s.lever_arm;
+  out.boresight_rad = s.boresight;
+  out.time_offset_s = s.time_offset;
+  if (!cov.ok) return out;
+  if (out.gnss && !builder_.IsBlockFixed(s.lever_block))
+    out.lever_arm_sigma_m = cov.BlockSigma(s.lever_block, 3);
+  if (out.gnss && !builder_.IsBlockFixed(s.time_block))
+    out.time_offset_sigma_s = cov.BlockSigma(s.time_block, 1)(0);
+  if (out.imu && !builder_.IsBlockFixed(s.boresight_block))
+    out.boresight_sigma_rad = cov.BlockSigma(s.boresight_block, 3);
+  return out;
+}
+
 BlockId BlockAdjustment::PointBlock(const std::string& point) const {
   const auto it = storage_->points.find(point);
   return it == storage_->points.end() ? -1 : it->second.block;
@@ -142,7 +175,9 @@ void BlockAdjustment::BuildExposures() {
 void BlockAdjustment::BuildPoints() {
   // Each observation with the sensor kind that measures it; a raw sub-image observation no kind
   // measures is mapped to the virtual image with the camera file's mapping.
-  for (const auto& o : project_.observations) {
+  for (size_t source = 0; source < project_.observations.size(); ++source) {
+    const ImageObservation& o = project_.observations[source];
+    storage_->source_of_observation.push_back(static_cast<int>(source));
     ImagingModel* sensor = nullptr;
     for (auto& s : storage_->sensors)
       if (!sensor && s->Measures(o)) sensor = s.get();
@@ -192,14 +227,17 @@ void BlockAdjustment::BuildPoints() {
     const size_t before = storage_->observations.size();
     std::vector<ImageObservation> kept;
     std::vector<ImagingModel*> kept_sensors;
+    std::vector<int> kept_sources;
     for (size_t i = 0; i < before; ++i) {
       const ImageObservation& o = storage_->observations[i];
       if (dropped.count(o.image) || (!dropped.empty() && single.count(o.point))) continue;
       kept.push_back(o);
       kept_sensors.push_back(storage_->sensor_of_observation[i]);
+      kept_sources.push_back(storage_->source_of_observation[i]);
     }
     storage_->observations = std::move(kept);
     storage_->sensor_of_observation = std::move(kept_sensors);
+    storage_->source_of_observation = std::move(kept_sources);
     changed = storage_->observations.size() != before;
   }
   std::map<std::string, std::vector<ImageRay>> rays;
@@ -267,22 +305,26 @@ void BlockAdjustment::AddPriors() {
         "control " + id);
   }
   if (options_.use_eo_priors) {
+    AddPlatformBlocks();
+    Storage& s = *storage_;
     for (const auto& [image, state] : storage_->exposures) {
       const Exposure& e = *state.exposure;
       if (e.center_sigma_m)
-        builder_.AddResidual(
-            calib::kGroupEoPrior,
-            calib::PriorCostFunction::Create(
-                {e.center_m.x(), e.center_m.y(), e.center_m.z()},
-                {e.center_sigma_m->x(), e.center_sigma_m->y(), e.center_sigma_m->z()}),
-            {state.center_block},
-            "GNSS " + image);
+        builder_.AddResidual(calib::kGroupEoPrior,
+                             calib::GnssPriorResidual::Create(
+                                 e.center_m,
+                                 *e.center_sigma_m,
+                                 e.velocity_mps.value_or(Eigen::Vector3d::Zero())),
+                             {state.opk_block, state.center_block, s.lever_block, s.time_block},
+                             "GNSS " + image);
       if (e.opk_sigma_rad)
         builder_.AddResidual(calib::kGroupEoPrior,
                              calib::OpkPriorResidual::Create(e.opk_rad, *e.opk_sigma_rad),
-                             {state.opk_block},
+                             {state.opk_block, s.boresight_block},
                              "IMU " + image);
     }
+  } else if (PlatformEstimated(project_.platform)) {
+    storage_->notes.push_back("platform parameters ignored: the GNSS/IMU priors are off");
   }
   if (options_.use_interior_sigma) {
     for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k) {
@@ -304,6 +346,58 @@ void BlockAdjustment::AddPriors() {
             {storage_->frame.InteriorBlock(k)},
             "interior prior " + id);
     }
+  }
+}
+
+void BlockAdjustment::AddPlatformBlocks() {
+  const PlatformSpec& p = project_.platform;
+  Storage& s = *storage_;
+  bool gnss = false, imu = false;
+  for (const auto& e : project_.exposures) {
+    gnss |= e.center_sigma_m.has_value();
+    imu |= e.opk_sigma_rad.has_value();
+  }
+  const std::string where = p.source.empty() ? "platform" : p.source + ": platform";
+  if (!gnss && (p.lever_arm != PlatformParamMode::kFixed || p.time_offset != PlatformParamMode::kFixed))
+    throw ConfigError(where + ": the lever arm and the GNSS time offset are estimated from GNSS "
+                      "priors, but exposures.csv has no sigma_X/Y/Z columns");
+  if (!imu && p.boresight != PlatformParamMode::kFixed)
+    throw ConfigError(where + ": the boresight is estimated from IMU priors, but exposures.csv has "
+                      "no sigma_omega/phi/kappa columns");
+  // How one platform block enters: held, free, or its value as a weighted observation.
+  auto enter = [&](BlockId block, PlatformParamMode mode, const std::vector<double>& values,
+                   double sigma, const std::string& label) {
+    if (mode == PlatformParamMode::kFixed) builder_.FixBlock(block);
+    if (mode == PlatformParamMode::kWeighted)
+      builder_.AddResidual(kGroupPlatformPrior,
+                           calib::PriorCostFunction::Create(
+                               values, std::vector<double>(values.size(), sigma)),
+                           {block},
+                           label);
+  };
+  if (gnss) {
+    const bool timed = p.time_offset != PlatformParamMode::kFixed || p.time_offset_s != 0.0;
+    for (const auto& e : project_.exposures)
+      if (timed && e.center_sigma_m && !e.velocity_mps)
+        ThrowInputError({project_.exposures_file, e.line},
+                        "image " + e.image + ": the GNSS time offset needs the platform velocity "
+                        "(columns vX, vY, vZ, m/s)");
+    s.lever_arm = p.lever_arm_m;
+    s.time_offset = p.time_offset_s;
+    s.lever_block = builder_.AddBlock(
+        "platform lever_arm", s.lever_arm.data(), 3, BlockKind::kOther, {"x", "y", "z"});
+    s.time_block =
+        builder_.AddBlock("platform time_offset", &s.time_offset, 1, BlockKind::kOther, {"dt"});
+    enter(s.lever_block, p.lever_arm, {s.lever_arm.x(), s.lever_arm.y(), s.lever_arm.z()},
+          p.lever_arm_sigma_m, "lever arm prior");
+    enter(s.time_block, p.time_offset, {s.time_offset}, p.time_offset_sigma_s, "time offset prior");
+  }
+  if (imu) {
+    s.boresight = p.boresight_rad;
+    s.boresight_block = builder_.AddBlock(
+        "platform boresight", s.boresight.data(), 3, BlockKind::kOther, kAngleNames);
+    enter(s.boresight_block, p.boresight, {s.boresight.x(), s.boresight.y(), s.boresight.z()},
+          p.boresight_sigma_rad, "boresight prior");
   }
 }
 
@@ -377,8 +471,10 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
     for (size_t k = 0; k < r.size(); ++k)
       if (r[k] > 1e-6) w = std::max(w, std::abs(v[k]) / (scale * std::sqrt(r[k])));
     if (w <= reject) continue;
-    const ImageObservation& o = storage_->observations.at(storage_->observation_of_residual.at(id));
-    out.push_back({o, Eigen::Vector2d(v[0], v[1]) * o.sigma_px, w});
+    const size_t index = storage_->observation_of_residual.at(id);
+    const ImageObservation& o = storage_->observations.at(index);
+    out.push_back(
+        {o, storage_->source_of_observation[index], Eigen::Vector2d(v[0], v[1]) * o.sigma_px, w});
   }
   return out;
 }
@@ -642,6 +738,13 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   // Covariance: interior and exterior orientation; interior x everything (so c ~ Z0 and
   // x0 ~ X0 / phi show), exterior blocks only with themselves (cheap for large blocks).
   std::vector<BlockId> cov_blocks = interior_blocks;
+  // Interior and the platform parameters x everything (lever arm ~ centres, time offset ~ X0).
+  std::vector<BlockId> cross_blocks = interior_blocks;
+  for (BlockId b : {storage_->lever_block, storage_->time_block, storage_->boresight_block})
+    if (b >= 0) {
+      cov_blocks.push_back(b);
+      if (!builder_.IsBlockFixed(b)) cross_blocks.push_back(b);
+    }
   for (const auto& [image, state] : storage_->exposures) {
     cov_blocks.push_back(state.opk_block);
     cov_blocks.push_back(state.center_block);
@@ -652,11 +755,19 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     cov.message = "covariance not estimated (option)";
   else if (result.solve.usable && result.solve.redundancy > 0)
     cov = builder_.EstimateCovariance(
-        cov_blocks, result.sigma0, options_.correlation_threshold, interior_blocks);
+        cov_blocks, result.sigma0, options_.correlation_threshold, cross_blocks);
   else
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
   advance();
   result.determinability = AssessDeterminability(cov, "camera ", options_.correlation_threshold);
+  if (cov.ok) {  // a free platform parameter the block cannot separate, by name
+    const Determinability platform =
+        AssessDeterminability(cov, "platform ", options_.correlation_threshold);
+    for (const auto& w : platform.warnings) result.determinability.warnings.push_back(w);
+    for (const auto& h : platform.high_correlations)
+      result.determinability.high_correlations.push_back(h);
+  }
+  result.platform = PlatformResult(cov);
   for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k) {
     const std::string& id = storage_->index.CameraId(k);
     CameraEstimate c;

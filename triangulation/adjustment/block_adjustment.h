@@ -77,6 +77,7 @@ class BlockAdjustment {
   /// median of |v| / sqrt(r) over the testable components) exceeds `reject`, with that w.
   struct Screened {
     ImageObservation observation;
+    int source = -1;  // its index in the project's observations (the dense id, no matching)
     Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // photo x, y
     double w = 0.0;
   };
@@ -93,6 +94,10 @@ class BlockAdjustment {
   calib::BlockId AddPoint(const std::string& point, const Eigen::Vector3d& start_m);
   void AddImageResiduals(const calib::LossOptions& loss);
   void AddPriors();
+  /// The platform blocks (lever arm and GNSS time offset with GNSS priors, boresight with IMU
+  /// priors), fixed, free or weighted as Project::platform says.
+  void AddPlatformBlocks();
+  PlatformEstimate PlatformResult(const calib::CovarianceReport& cov) const;
   void DefineDatum();
   /// Data snooping with the datum guard; fills result->rejected and result->snooping.
   calib::SnoopingOutcome Snoop(AdjustmentResult* result);

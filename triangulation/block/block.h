@@ -56,6 +56,29 @@ struct FrameSpec {
   std::string source;                        // "project.yaml:LINE" of `frame:`, named in errors
 };
 
+/// How a platform parameter (lever arm, boresight, GNSS time offset) enters the adjustment:
+/// held at its value, estimated freely, or estimated with its value as a weighted observation.
+enum class PlatformParamMode { kFixed, kFree, kWeighted };
+/// "fixed" | "free" | "weighted" -> the mode; nullopt otherwise.
+std::optional<PlatformParamMode> ParsePlatformParamMode(const std::string& text);
+std::string PlatformParamModeName(PlatformParamMode mode);
+
+/// The GNSS/IMU platform of the block (triangulation/README.md "GNSS/IMU priors on the
+/// platform"): the GNSS antenna records X0 + R a + v dt, the IMU records the attitude R M^T.
+/// From the project YAML's `platform:` (FORMATS.md keys below) or `aerocal adjust` options.
+struct PlatformSpec {
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();   // a: centre -> antenna, camera frame
+  PlatformParamMode lever_arm = PlatformParamMode::kFixed;
+  double lever_arm_sigma_m = 0.0;                           // > 0 when weighted, per axis
+  Eigen::Vector3d boresight_rad = Eigen::Vector3d::Zero();  // M (imu_from_image) omega, phi, kappa
+  PlatformParamMode boresight = PlatformParamMode::kFixed;
+  double boresight_sigma_rad = 0.0;                         // > 0 when weighted, per angle
+  double time_offset_s = 0.0;                               // dt: GNSS time - exposure time
+  PlatformParamMode time_offset = PlatformParamMode::kFixed;
+  double time_offset_sigma_s = 0.0;                         // > 0 when weighted
+  std::string source;  // "project.yaml:LINE" of `platform:` (or the options), named in errors
+};
+
 struct Project {
   std::string path;  // the project YAML, or the folder
   std::map<std::string, calib::Camera> cameras;
@@ -70,6 +93,7 @@ struct Project {
   std::string exposures_file, observations_file, points_file;
   std::string stitching_file;  // optional per-exposure stitching measurements
   FrameSpec frame;
+  PlatformSpec platform;  // lever arm, boresight, GNSS time offset (all fixed at 0 by default)
 
   const Exposure* FindExposure(const std::string& image) const;
   const GroundPoint* FindPoint(const std::string& id) const;

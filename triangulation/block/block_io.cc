@@ -213,8 +213,9 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
   std::error_code ec;  // the error_code form: a symbolic-link loop is then reported by the reader
   if (std::filesystem::is_directory(path, ec)) path = (std::filesystem::path(path) / "project.yaml").string();
   const YAML::Node root = LoadYamlFile(path);
-  RejectUnknownKeys(root, {"cameras", "exposures", "observations", "points", "stitching", "frame", "name"},
-                    path);
+  RejectUnknownKeys(
+      root, {"cameras", "exposures", "observations", "points", "stitching", "frame", "name", "platform"},
+      path);
   const std::string dir = std::filesystem::path(path).parent_path().string();
   Project project;
   project.path = path;
@@ -304,8 +305,68 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
       project.frame.description = "local tangent plane about the block centre";
     }
   }
+  if (root["platform"]) project.platform = ReadPlatform(root["platform"], path);
   ValidateProject(project);
   return project;
+}
+
+PlatformSpec ReadPlatform(const YAML::Node& node, const std::string& path) {
+  const SourceRef where = WhereIs(node, path);
+  if (!node.IsMap())
+    ThrowInputError(where, "platform must be a map (lever_arm_m, lever_arm, boresight_deg, ...)");
+  RejectUnknownKeys(node,
+                    {"lever_arm_m", "lever_arm", "lever_arm_sigma_m", "boresight_deg", "boresight",
+                     "boresight_sigma_deg", "time_offset_ms", "time_offset", "time_offset_sigma_ms"},
+                    path);
+  PlatformSpec p;
+  p.source = where.ToString();
+  auto vector3 = [&](const char* key, double bound) {
+    const YAML::Node& v = node[key];
+    if (!v.IsSequence() || v.size() != 3)
+      ThrowInputError(WhereIs(v, path), std::string("platform: ") + key + " must be [x, y, z]");
+    Eigen::Vector3d out;
+    for (int i = 0; i < 3; ++i)
+      out(i) = YamlBounded(v[i], path, std::string("platform: ") + key, -bound, bound);
+    return out;
+  };
+  auto mode = [&](const char* key, PlatformParamMode* out) {
+    if (!node[key]) return;
+    const std::string text = YamlString(node[key], path, std::string("platform: ") + key);
+    const auto m = ParsePlatformParamMode(text);
+    if (!m)
+      ThrowInputError(WhereIs(node[key], path),
+                      std::string("platform: ") + key + " must be fixed, free or weighted (got '" +
+                          text + "')");
+    *out = *m;
+  };
+  auto sigma = [&](const char* key, double bound, double scale, double* out) {
+    if (node[key])
+      *out = scale * YamlBounded(node[key], path, std::string("platform: ") + key, 0.0, bound);
+  };
+  constexpr double kDegToRad = M_PI / 180.0;
+  if (node["lever_arm_m"]) p.lever_arm_m = vector3("lever_arm_m", 1000.0);
+  if (node["boresight_deg"]) p.boresight_rad = vector3("boresight_deg", 180.0) * kDegToRad;
+  if (node["time_offset_ms"])
+    p.time_offset_s = 1e-3 * YamlBounded(node["time_offset_ms"], path, "platform: time_offset_ms",
+                                         -1e4, 1e4);
+  mode("lever_arm", &p.lever_arm);
+  mode("boresight", &p.boresight);
+  mode("time_offset", &p.time_offset);
+  sigma("lever_arm_sigma_m", 1000.0, 1.0, &p.lever_arm_sigma_m);
+  sigma("boresight_sigma_deg", 180.0, kDegToRad, &p.boresight_sigma_rad);
+  sigma("time_offset_sigma_ms", 1e4, 1e-3, &p.time_offset_sigma_s);
+  ValidatePlatform(p);
+  return p;
+}
+
+void ValidatePlatform(const PlatformSpec& p) {
+  const std::pair<PlatformParamMode, double> weighted[] = {{p.lever_arm, p.lever_arm_sigma_m},
+                                                           {p.boresight, p.boresight_sigma_rad},
+                                                           {p.time_offset, p.time_offset_sigma_s}};
+  const char* names[] = {"lever_arm_sigma_m", "boresight_sigma_deg", "time_offset_sigma_ms"};
+  for (int k = 0; k < 3; ++k)
+    if (weighted[k].first == PlatformParamMode::kWeighted && !(weighted[k].second > 0))
+      throw InputError(p.source + ": platform: weighted needs " + names[k] + " > 0");
 }
 
 void WriteExposures(const std::string& path, const std::vector<Exposure>& exposures) {

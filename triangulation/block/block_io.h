@@ -9,6 +9,8 @@
 
 #include "triangulation/block/block.h"
 
+#include <yaml-cpp/yaml.h>
+
 namespace aerocal::triangulation {
 
 std::vector<Exposure> ReadExposures(const std::string& path);
@@ -17,6 +19,11 @@ std::vector<GroundPoint> ReadPoints(const std::string& path);
 /// Reads a project YAML (or a folder holding project.yaml) and every file it names, validated.
 Project ReadProject(const std::string& path, double default_sigma_px = 0.5);
 void ValidateProject(const Project& project);
+/// The project YAML's `platform:` map (triangulation/README.md "GNSS/IMU priors on the
+/// platform"); InputError with FILE:LINE on a bad key or value.
+PlatformSpec ReadPlatform(const YAML::Node& node, const std::string& path);
+/// A weighted platform parameter needs its sigma > 0 (InputError naming p.source).
+void ValidatePlatform(const PlatformSpec& p);
 
 void WriteExposures(const std::string& path, const std::vector<Exposure>& exposures);
 /// Writes the virtual form, or the sub-image form when any observation has a sub-image.

@@ -7,15 +7,6 @@
 #include <sstream>
 
 namespace aerocal::triangulation::internal {
-namespace {
-
-std::string Trim(const std::string& s) {
-  const auto begin = s.find_first_not_of(" \t");
-  if (begin == std::string::npos) return "";
-  return s.substr(begin, s.find_last_not_of(" \t") - begin + 1);
-}
-
-}  // namespace
 
 std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates, bool keep_blank) {
   std::vector<TextRow> rows;
@@ -32,17 +23,11 @@ std::vector<TextRow> ReadTextRows(const std::string& path, bool comma_separates,
     row.line = number;
     if (comma_separates && line.find(',') != std::string::npos) {
       // Comma-separated: every field must be there; an empty one would shift the columns.
-      std::stringstream in(line);
-      std::string field;
-      while (std::getline(in, field, ',')) {
-        row.fields.push_back(Trim(field));
-        if (row.fields.back().empty())
+      row.fields = SplitCommaList(line, {true, true});
+      for (size_t k = 0; k < row.fields.size(); ++k)
+        if (row.fields[k].empty())
           ThrowInputError({path, number},
-                          "empty field " + std::to_string(row.fields.size()) + " (give every value)");
-      }
-      if (line.back() == ',')
-        ThrowInputError({path, number}, "empty field " + std::to_string(row.fields.size() + 1) +
-                                            " (the line ends with a comma)");
+                          "empty field " + std::to_string(k + 1) + " (give every value)");
     } else {
       std::istringstream fields(line);
       std::string field;

@@ -6,6 +6,7 @@
 #include <random>
 
 #include "calib/camera/camera_io.h"
+#include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "triangulation/block/block_io.h"
@@ -79,13 +80,21 @@ std::vector<Exposure> ExposuresAsMeasured(const FlightSimulationOptions& o,
   std::vector<Exposure> measured;
   for (const auto& t : truth) {
     Exposure e = t;
+    if (o.speed_mps > 0)  // along the strip, in its direction of flight (kappa)
+      e.velocity_mps = Eigen::Vector3d(
+          o.speed_mps * std::cos(t.opk_rad.z()), o.speed_mps * std::sin(t.opk_rad.z()), 0.0);
+    const Eigen::Matrix3d r = calib::RotationFromOpk(t.opk_rad);
     if (o.gnss_sigma_m > 0) {
+      e.center_m += r * o.lever_arm_m +
+                    e.velocity_mps.value_or(Eigen::Vector3d::Zero()) * o.gnss_time_offset_s;
       e.center_m += o.gnss_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
       e.center_sigma_m = Eigen::Vector3d::Constant(o.gnss_sigma_m);
     } else {
       e.center_m += o.start_position_error_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
     }
     if (o.imu_sigma_deg > 0) {
+      if (!o.boresight_rad.isZero())
+        e.opk_rad = calib::OpkFromRotation(r * calib::RotationFromOpk(o.boresight_rad).transpose());
       e.opk_rad += o.imu_sigma_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
       e.opk_sigma_rad = Eigen::Vector3d::Constant(o.imu_sigma_deg * kDegToRad);
     } else {

@@ -43,6 +43,12 @@ struct FlightSimulationOptions {
   double start_angle_error_deg = 1.0;
   double gnss_sigma_m = 0.0;          // > 0: exposures.csv carries GNSS centres with this sigma
   double imu_sigma_deg = 0.0;         // > 0: exposures.csv carries IMU angles with this sigma
+  /// The GNSS/IMU platform (triangulation/README.md "GNSS/IMU priors on the platform"): the GNSS
+  /// records the antenna at X0 + R a + v dt, the IMU the attitude R M^T. Zero by default.
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();   // a, camera frame (m)
+  Eigen::Vector3d boresight_rad = Eigen::Vector3d::Zero();  // M = imu_from_image, omega-phi-kappa
+  double gnss_time_offset_s = 0.0;                          // dt (s), needs speed_mps > 0
+  double speed_mps = 0.0;  // > 0: exposures.csv carries the velocity vX, vY, vZ along the strips
   stitch::GridLayoutOptions layout = DefaultLayout();
   stitch::MisplacementOptions misplacement = DefaultMisplacement();
   stitch::FrameSimulationOptions stitching;  // per-exposure stitching measurements
