@@ -14,3 +14,4 @@ aerocal_add_test(stitch/rig_error_analysis LIBS aerocal::stitch LABELS synthetic
 aerocal_add_test(stitch/rig_cli LIBS aerocal::stitch LABELS cli)
 aerocal_add_test(stitch/rig_convert LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/rig_design LIBS aerocal::stitch LABELS unit)
+aerocal_add_test(stitch/rig_self_calibration LIBS aerocal::triangulation LABELS synthetic)
