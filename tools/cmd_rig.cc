@@ -24,6 +24,7 @@
 #include "stitch/rig/rig_conversion.h"
 #include "stitch/rig/dem_grid.h"
 #include "stitch/rig/rig_convert.h"
+#include "stitch/rig/rig_design.h"
 #include "tools/command_registry.h"
 #include "tools/python_script.h"
 #include "tools/image_sources.h"
@@ -52,6 +53,17 @@ Eigen::Vector2d ParsePixel(const std::string& text, const std::string& option) {
   const auto row = comma == std::string::npos ? std::nullopt : ParseDouble(text.substr(comma + 1));
   if (!col || !row) throw ConfigError(option + ": expected COL,ROW (got '" + text + "')");
   return {*col, *row};
+}
+
+// --height-m when given (!= 0), else the rig file's virtual.height_m; ConfigError unless > 0.
+double FlyingHeight(const calib::Rig& rig, double given_m, const std::string& file) {
+  const double height_m = given_m != 0.0                ? given_m
+                          : rig.virtual_camera.height_m ? *rig.virtual_camera.height_m
+                                                        : 0.0;
+  if (!(height_m > 0))
+    throw ConfigError("--height-m: give the relative flying height (> 0 m; the rig file " + file +
+                      " has no virtual.height_m)");
+  return height_m;
 }
 
 std::string PlotScript() {
@@ -203,12 +215,7 @@ struct ConvertArgs {
 
 int RunConvert(const ConvertArgs& args) {
   const calib::Rig rig = calib::ReadRig(args.camera);
-  const double height_m = args.height_m != 0.0 ? args.height_m
-                          : rig.virtual_camera.height_m ? *rig.virtual_camera.height_m
-                                                        : 0.0;
-  if (!(height_m > 0))
-    throw ConfigError("--height-m: give the relative flying height (> 0 m; the rig file " +
-                      args.camera + " has no virtual.height_m)");
+  const double height_m = FlyingHeight(rig, args.height_m, args.camera);
   stitch::RigExposure exposure;
   std::stringstream angles(args.opk_deg);
   std::string item;
@@ -265,6 +272,90 @@ int RunConvert(const ConvertArgs& args) {
   return kExitOk;
 }
 
+struct DesignArgs {
+  std::string camera, out, svg;
+  double height_m = 0.0;  // 0: the rig file's virtual.height_m
+  int grid_cells = 400;
+};
+
+nlohmann::json PointJson(const Eigen::Vector2d& p) { return {p.x(), p.y()}; }
+
+int RunDesign(const DesignArgs& args) {
+  const calib::Rig rig = calib::ReadRig(args.camera);
+  const double height_m = FlyingHeight(rig, args.height_m, args.camera);
+  if (args.grid_cells < 10 || args.grid_cells > 4000)
+    throw ConfigError("--grid-cells must be within 10..4000 (got " +
+                      std::to_string(args.grid_cells) + ")");
+  const stitch::RigDesign d = stitch::DesignRig(rig, height_m, args.grid_cells);
+  const calib::VirtualCamera& v = rig.virtual_camera;
+  nlohmann::json doc;
+  doc["kind"] = "rig_design";
+  doc["camera"] = args.camera;
+  doc["height_m"] = height_m;
+  doc["virtual_gsd_m"] = d.virtual_gsd_m;
+  for (const stitch::HeadDesign& head : d.heads) {
+    nlohmann::json h = {{"id", head.id}, {"tilt_deg", head.tilt_deg},
+                        {"nadir_gsd_m", head.nadir_gsd_m}};
+    for (const stitch::GsdSample& s : head.samples) {
+      nlohmann::json row = {{"where", s.where},
+                            {"pixel", PointJson(s.pixel)},
+                            {"off_axis_deg", s.off_axis_deg},
+                            {"gsd_ratio", {{"along_tilt", s.ratio.x()}, {"across_tilt", s.ratio.y()}}}};
+      row["closed_form"] = s.on_tilt_line ? nlohmann::json{{"along_tilt", s.closed_form.x()},
+                                                           {"across_tilt", s.closed_form.y()}}
+                                          : nlohmann::json();
+      h["gsd"].push_back(row);
+    }
+    for (const auto& p : head.footprint_m) h["footprint_m"].push_back(PointJson(p));
+    doc["heads"].push_back(h);
+  }
+  const auto rect = [](const stitch::PixelRectangle& r) {
+    return nlohmann::json{{"min_px", PointJson(r.min_px)},
+                          {"max_px", PointJson(r.max_px)},
+                          {"width_px", r.Width()},
+                          {"height_px", r.Height()}};
+  };
+  doc["virtual_format"] = {{"file_px", {v.width_px, v.height_px}},
+                           {"needed", rect(d.covered_box_px)},
+                           {"fits", d.covered_box_px.min_px.x() >= -0.5 &&
+                                        d.covered_box_px.min_px.y() >= -0.5 &&
+                                        d.covered_box_px.max_px.x() <= v.width_px - 0.5 &&
+                                        d.covered_box_px.max_px.y() <= v.height_px - 0.5}};
+  doc["covered_area_m2"] = d.covered_area_m2;
+  doc["effective_format"] = rect(d.effective_px);
+  doc["effective_format"]["width_m"] = d.effective_px.Width() * d.virtual_gsd_m;
+  doc["effective_format"]["height_m"] = d.effective_px.Height() * d.virtual_gsd_m;
+  doc["effective_format"]["area_m2"] = d.effective_area_m2;
+  doc["grid"] = {{"cell_px", d.coverage.cell_px}, {"cols", d.coverage.cols},
+                 {"rows", d.coverage.rows}};
+  for (const auto& [zone, area] : d.zone_area_m2) doc["zones"][zone] = {{"area_m2", area}};
+  for (const auto& s : d.standard_positions)
+    doc["standard_positions"].push_back(
+        {{"name", s.name}, {"zone", s.zone}, {"virtual_px", PointJson(s.virtual_px)}});
+  doc["plot_svg"] = args.svg.empty() ? nlohmann::json() : nlohmann::json(args.svg);
+  if (!args.svg.empty()) WriteFileAtomically(args.svg, stitch::RigDesignSvg(rig, d));
+  if (!args.out.empty()) WriteFileAtomically(args.out, doc.dump(2) + "\n");
+
+  std::printf("rig %s at H = %g m (virtual GSD %.4f m)\n", rig.name.c_str(), height_m,
+              d.virtual_gsd_m);
+  std::printf("%-6s %8s %10s   GSD ratio along / across the tilt: principal point, edges, corners\n",
+              "head", "tilt", "nadir GSD");
+  for (const auto& head : d.heads) {
+    std::printf("%-6s %7.2f° %9.4fm  ", head.id.c_str(), head.tilt_deg, head.nadir_gsd_m);
+    for (const auto& s : head.samples) std::printf(" %.3f/%.3f", s.ratio.x(), s.ratio.y());
+    std::printf("\n");
+  }
+  std::printf("virtual format needed %.0f x %.0f px (file: %d x %d); covered %.0f m^2; effective "
+              "format %.0f x %.0f px (%.1f x %.1f m)\n",
+              d.covered_box_px.Width(), d.covered_box_px.Height(), v.width_px, v.height_px,
+              d.covered_area_m2, d.effective_px.Width(), d.effective_px.Height(),
+              d.effective_px.Width() * d.virtual_gsd_m, d.effective_px.Height() * d.virtual_gsd_m);
+  std::printf("overlap zones:");
+  for (const auto& [zone, area] : d.zone_area_m2) std::printf(" %s %.0f m^2", zone.c_str(), area);
+  std::printf("; %zu standard tie positions\n", d.standard_positions.size());
+  return kExitOk;
+}
+
 CommandRun Setup(CLI::App& app) {
   app.require_subcommand(1);
   auto args = std::make_shared<ErrorAnalysisArgs>();
@@ -317,7 +408,20 @@ CommandRun Setup(CLI::App& app) {
   cv->add_option("--dem", convert->dem,
                  "DEM (ESRI ASCII grid, object frame of the exposure) as the rectification surface; "
                  "the plane at --height-m stays the base of the maps");
-  return [args, ea, convert, cv] {
+  auto design = std::make_shared<DesignArgs>();
+  CLI::App* ds = app.add_subcommand(
+      "design", "Design figures: GSD change ratios of the tilted heads, virtual format, covered "
+                "area, effective format, overlap zones, standard tie positions, footprint plot");
+  ds->option_defaults()->always_capture_default();
+  ds->add_option("--camera", design->camera, "Rig camera file (YAML with a rig section)")->required();
+  ds->add_option("--height-m", design->height_m,
+                 "Relative flying height, m (default: the rig file's virtual.height_m)");
+  ds->add_option("--out", design->out, "Result JSON (optional; the summary is printed)");
+  ds->add_option("--svg", design->svg, "Footprint plot (SVG, ground metres)");
+  ds->add_option("--grid-cells", design->grid_cells,
+                 "Coverage grid cells along the longer side, 10..4000");
+  return [args, ea, convert, cv, design, ds] {
+    if (ds->parsed()) return RunDesign(*design);
     if (ea->parsed()) return RunErrorAnalysis(*args);
     if (cv->parsed()) return RunConvert(*convert);
     return kExitInternal;

@@ -5,6 +5,7 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "stitch/rig/rig_design.h"
 #include "tools/command_registry.h"
 #include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/simulation/flight_simulator.h"
@@ -66,6 +67,8 @@ int RunRigSimulation(const CLI::App& app, const SimulateArgs& args,
     if (app.get_option(frame_only)->count() > 0)
       throw ConfigError(std::string(frame_only) + " applies to the frame camera, not to --rig");
   triangulation::RigFlightSimulationOptions options;
+  if (*preset == triangulation::RigPreset::kUav4)
+    options = triangulation::RigFlightSimulationOptions::DefaultUav4();
   options.preset = *preset;
   for (const auto& [name, member] : int_options)
     if (app.get_option(name)->count() > 0) options.flight.*member = args.options.*member;
@@ -76,9 +79,22 @@ int RunRigSimulation(const CLI::App& app, const SimulateArgs& args,
     throw ConfigError("--control (" + std::to_string(options.flight.control_points) +
                       ") must not exceed --points (" + std::to_string(options.flight.ground_points) +
                       ")");
-  options.increment_sigma_rad = args.increment_arcsec * M_PI / (180.0 * 3600.0);
-  options.time_offset_s = args.time_offset_ms * 1e-3;
-  options.speed_mps = args.speed_mps;
+  const auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
+  if (*preset != triangulation::RigPreset::kUav4 || given("--head-increment-arcsec"))
+    options.increment_sigma_rad = args.increment_arcsec * M_PI / (180.0 * 3600.0);
+  if (*preset != triangulation::RigPreset::kUav4 || given("--head-time-offset-ms")) {
+    options.time_offset_s = args.time_offset_ms * 1e-3;
+    options.head_time_offsets_s.clear();
+  }
+  if (*preset != triangulation::RigPreset::kUav4 || given("--speed-mps"))
+    options.speed_mps = args.speed_mps;
+  if (*preset == triangulation::RigPreset::kUav4) {
+    // The stitching ties around the standard positions of the rig's design (stitch/rig).
+    const stitch::RigDesign design = stitch::DesignRig(triangulation::MakeNominalRig(*preset),
+                                                       options.flight.flying_height_m, 200);
+    for (const auto& s : design.standard_positions)
+      options.stitch_ties.standard_positions.push_back({s.name, s.virtual_px});
+  }
   if (options.time_offset_s != 0.0 && options.speed_mps == 0.0)
     std::fprintf(stderr, "warning: --head-time-offset-ms without --speed-mps moves no head\n");
   const auto flight = triangulation::SimulateRigFlight(options);
@@ -124,8 +140,11 @@ CommandRun SetupSimulate(CLI::App& app) {
       ->check(CLI::Range(0.0, 0.1));
   app.add_option("--rig", args->rig,
                  "Simulate a multi-head rig flight instead: dual-lens (configs/rig_dual_lens.yaml; "
-                 "uav4 follows). Flight defaults then: 1200 m, 30 exposures, 100 m relief, 40 "
-                 "surveyed and 300 tie points; the flight options above override them");
+                 "flight defaults 1200 m, 30 exposures, 100 m relief, 40 surveyed and 300 tie "
+                 "points) | uav4 (configs/rig_uav4.yaml; one line of 8 exposures at 300 m over 30 m "
+                 "relief, 10 m/s, increments 0.025 deg, shutter offsets ~3 ms, stitching ties at "
+                 "the 12 standard positions, dense and check ties per exposure); the flight "
+                 "options above override the defaults");
   auto* increment = app.add_option("--head-increment-arcsec", args->increment_arcsec,
                                    "--rig: sigma of the per-exposure attitude increments E_k of the "
                                    "non-reference heads, 0..3600 arcsec")

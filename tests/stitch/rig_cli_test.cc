@@ -1,6 +1,7 @@
 // 'aerocal rig error-analysis' on the dual-lens example of configs/: the JSON keys, the
 // hand figures through the CLI, Monte-Carlo against linear propagation, byte-identical reruns,
 // exactness with zero limits, the grid and the refusals (exit 2, FILE:LINE, nothing written).
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
 
@@ -180,6 +181,45 @@ TEST(RigErrorAnalysisCommand, RefusesBadInputWithExitTwoAndNothingWritten) {
   std::ofstream(tmp.File("no_height.yaml")) << no_height;
   refused("rig error-analysis --camera " + tmp.File("no_height.yaml") + " --limits " + kLimits,
           "--height-m: the rig file");
+}
+
+
+TEST(RigDesignCommand, Uav4FiguresSvgAndRefusals) {
+  TempDir tmp;
+  const std::string uav4 = std::string(AEROCAL_CONFIGS_DIR) + "/rig_uav4.yaml";
+  auto run = RunAerocal("rig design --camera " + uav4 + " --grid-cells 150 --out " +
+                        tmp.File("d.json") + " --svg " + tmp.File("d.svg"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const json doc = ReadJson(tmp.File("d.json"));
+  EXPECT_EQ(doc["kind"], "rig_design");
+  EXPECT_EQ(doc["height_m"], 300.0) << "the rig file's virtual.height_m";
+  ASSERT_EQ(doc["heads"].size(), 4u);
+  for (const json& head : doc["heads"]) {
+    ASSERT_EQ(head["gsd"].size(), 9u);
+    const json& pp = head["gsd"][0];
+    EXPECT_EQ(pp["where"], "principal_point");
+    EXPECT_NEAR(pp["gsd_ratio"]["along_tilt"].get<double>() / pp["closed_form"]["along_tilt"].get<double>(), 1, 0.005);
+    EXPECT_NEAR(pp["gsd_ratio"]["across_tilt"].get<double>() / pp["closed_form"]["across_tilt"].get<double>(), 1, 0.005);
+    EXPECT_TRUE(head["gsd"][5]["closed_form"].is_null()) << "a corner is off the principal line";
+  }
+  for (const char* key : {"virtual_format", "covered_area_m2", "effective_format", "zones",
+                          "standard_positions", "grid"})
+    EXPECT_TRUE(doc.contains(key)) << key;
+  EXPECT_EQ(doc["standard_positions"].size(), 12u);
+  EXPECT_TRUE(doc["virtual_format"]["fits"].get<bool>());
+  const std::string svg = ReadTextFile(tmp.File("d.svg"));
+  EXPECT_EQ(svg.rfind("<svg", 0), 0u);
+  EXPECT_EQ(std::count(svg.begin(), svg.end(), '\n') > 4, true);
+  EXPECT_NE(svg.find("<polygon"), std::string::npos);
+  // Refusals: exit 2, the option named, nothing written.
+  for (const std::string bad : {"--height-m -5", "--grid-cells 3"}) {
+    run = RunAerocal("rig design --camera " + uav4 + " " + bad + " --out " + tmp.File("x.json") +
+                     " --svg " + tmp.File("x.svg"));
+    EXPECT_EQ(run.exit_code, 2) << bad << run.output;
+    EXPECT_NE(run.output.find(bad.substr(0, bad.find(' '))), std::string::npos) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(tmp.File("x.json")));
+    EXPECT_FALSE(std::filesystem::exists(tmp.File("x.svg")));
+  }
 }
 
 }  // namespace

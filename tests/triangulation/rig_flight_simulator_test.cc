@@ -3,6 +3,7 @@
 // the head pose gives, both heads of one exposure see common points, the files read back, and the
 // time offset moves a head by v dT.
 #include <cmath>
+#include <map>
 #include <set>
 
 #include <gtest/gtest.h>
@@ -10,6 +11,7 @@
 #include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "stitch/rig/rig_design.h"
 #include "tests/support/test_support.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/simulation/rig_flight_simulator.h"
@@ -21,7 +23,9 @@ TEST(RigFlightSimulator, DualLensPresetIsTheExampleRigFile) {
   const calib::Rig file = calib::ReadRig(std::string(AEROCAL_CONFIGS_DIR) + "/rig_dual_lens.yaml");
   const calib::Rig preset = MakeNominalRig(RigPreset::kDualLens);
   EXPECT_EQ(calib::RigToYaml(preset), calib::RigToYaml(file));
-  EXPECT_THROW(MakeNominalRig(RigPreset::kUav4), ConfigError);
+  const calib::Rig uav4 = calib::ReadRig(std::string(AEROCAL_CONFIGS_DIR) + "/rig_uav4.yaml");
+  EXPECT_EQ(calib::RigToYaml(MakeNominalRig(RigPreset::kUav4)), calib::RigToYaml(uav4));
+  EXPECT_EQ(ParseRigPreset("uav4"), RigPreset::kUav4);
   EXPECT_EQ(ParseRigPreset("dual-lens"), RigPreset::kDualLens);
   EXPECT_FALSE(ParseRigPreset("dual_lens").has_value());
 }
@@ -145,6 +149,59 @@ TEST(RigFlightSimulator, TheSameSeedGivesTheSameFlight) {
   for (size_t i = 0; i < a.observations.size(); ++i) EXPECT_EQ(a.observations[i].pixel, b.observations[i].pixel);
   o.flight.seed = 2;
   EXPECT_NE(SimulateRigFlight(o).observations.front().pixel, a.observations.front().pixel);
+}
+
+
+TEST(RigFlightSimulator, Uav4StitchingTiesAreMeasuredInOneExposureAndReadBack) {
+  RigFlightSimulationOptions o = RigFlightSimulationOptions::DefaultUav4();
+  o.flight.exposures = 3;
+  o.flight.image_noise_px = 0.0;
+  for (const auto& s : stitch::DesignRig(MakeNominalRig(RigPreset::kUav4), 300.0, 200).standard_positions)
+    if (s.name == "AB-1" || s.name == "ACD") o.stitch_ties.standard_positions.push_back({s.name, s.virtual_px});
+  const SimulatedRigFlight f = SimulateRigFlight(o);
+  ASSERT_EQ(f.exposures_truth.size(), 3u);
+  // Shutter offsets per head, the reference head's zero.
+  for (size_t i = 0; i < f.rig_exposures.size(); ++i)
+    EXPECT_EQ(f.rig_exposures[i].dt_s, o.head_time_offsets_s[i % 4]) << i;
+  std::map<std::string, std::set<std::string>> images, heads;
+  for (const auto& obs : f.observations) {
+    images[obs.point].insert(obs.image);
+    heads[obs.point].insert(obs.head);
+  }
+  int check = 0, standard = 0;
+  for (const auto& p : f.points_file) {
+    EXPECT_FALSE(p.xyz_m.has_value()) << p.id;
+    EXPECT_EQ(images[p.id].size(), 1u) << p.id << ": a stitching tie belongs to one exposure";
+    EXPECT_GE(heads[p.id].size(), 2u) << p.id;
+    check += p.role == PointRole::kCheck;
+    standard += f.tie_position.count(p.id) > 0;
+  }
+  EXPECT_EQ(check, 3 * o.stitch_ties.check);
+  EXPECT_EQ(standard, 3 * 2 * o.stitch_ties.per_standard_position);
+  EXPECT_EQ(f.points_file.size(), static_cast<size_t>(3 * (6 + 40 + 10)));
+  // Around ACD: seen by A, C and D.
+  for (const auto& [id, position] : f.tie_position)
+    if (position == "ACD") {
+      EXPECT_EQ(heads[id], (std::set<std::string>{"A", "C", "D"})) << id;
+    }
+  // z_ref: the terrain under the image, within the relief.
+  for (const auto& e : f.exposures_file) {
+    ASSERT_TRUE(e.z_ref_m.has_value());
+    EXPECT_GE(*e.z_ref_m, o.flight.terrain_base_m);
+    EXPECT_LE(*e.z_ref_m, o.flight.terrain_base_m + o.flight.terrain_relief_m);
+  }
+  // The files read back: check ties keep their role without coordinates, z_ref its value.
+  aerocal::testing::TempDir tmp;
+  WriteSimulatedRigFlight(f, tmp.path());
+  const auto points = ReadPoints(tmp.File("points.csv"));
+  ASSERT_EQ(points.size(), f.points_file.size());
+  for (size_t i = 0; i < points.size(); ++i) {
+    EXPECT_EQ(points[i].role, f.points_file[i].role);
+    EXPECT_FALSE(points[i].xyz_m.has_value());
+  }
+  const auto exposures = ReadExposures(tmp.File("exposures.csv"));
+  ASSERT_EQ(exposures.size(), 3u);
+  EXPECT_NEAR(*exposures[1].z_ref_m, *f.exposures_file[1].z_ref_m, 1e-6);
 }
 
 }  // namespace

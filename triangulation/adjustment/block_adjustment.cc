@@ -809,7 +809,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     const bool control = state.ground && state.ground->role == PointRole::kControl;
     if (state.rays >= 0 && state.rays < 2 && !control) continue;
     result.points_m[id] = state.xyz;
-    if (!state.ground || state.ground->role == PointRole::kTie) continue;
+    if (!state.ground || state.ground->role == PointRole::kTie || !state.ground->xyz_m) continue;
     PointDifference d;
     d.point = id;
     d.surveyed_m = *state.ground->xyz_m;

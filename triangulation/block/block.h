@@ -23,6 +23,7 @@ struct Exposure {
   std::optional<Eigen::Vector3d> center_sigma_m;        // GNSS prior when present
   std::optional<Eigen::Vector3d> opk_sigma_rad;         // IMU prior when present
   std::optional<Eigen::Vector3d> velocity_mps;          // platform velocity (rig blocks: vX,vY,vZ)
+  std::optional<double> z_ref_m;  // rig blocks: height Z of the rectification plane (z_ref)
   int line = 0;                                         // source line in exposures.csv
 };
 
@@ -31,7 +32,8 @@ std::string PointRoleName(PointRole role);
 
 struct GroundPoint {
   std::string id;
-  std::optional<Eigen::Vector3d> xyz_m;  // surveyed (control/check) or approximate (tie)
+  std::optional<Eigen::Vector3d> xyz_m;  // surveyed (control/check) or approximate (tie);
+                                         // a check point without it is a check tie (rig stitch)
   Eigen::Vector3d sigma_m = Eigen::Vector3d::Constant(0.05);  // survey sigma, control/check
   PointRole role = PointRole::kTie;
   int line = 0;

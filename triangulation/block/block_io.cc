@@ -79,6 +79,8 @@ std::vector<Exposure> ReadExposures(const std::string& path) {
         ThrowInputError(t.Where(row), "vX, vY, vZ must be within +-" + FormatNumber(kMaxVelocityMps) +
                                           " m/s");
     }
+    if (const auto z_ref = t.OptionalBounded(row, "z_ref", -kMaxCoordinateM, kMaxCoordinateM))
+      e.z_ref_m = *z_ref;
     const auto so = Sigma(t, row, "somega", kMaxSigmaDeg), sp = Sigma(t, row, "sphi", kMaxSigmaDeg),
                sk = Sigma(t, row, "skappa", kMaxSigmaDeg);
     if (so || sp || sk) {
@@ -156,13 +158,14 @@ std::vector<GroundPoint> ReadPoints(const std::string& path) {
                z = t.OptionalBounded(row, "Z", -kMaxCoordinateM, kMaxCoordinateM);
     if (x && y && z) p.xyz_m = Eigen::Vector3d(*x, *y, *z);
     else if (x || y || z) ThrowInputError(t.Where(row), "give all of X, Y, Z or none");
-    if (p.role != PointRole::kTie && !p.xyz_m)
+    // A check point without coordinates is a check tie (rig stitch: measured, never adjusted).
+    if (p.role == PointRole::kControl && !p.xyz_m)
       ThrowInputError(t.Where(row), PointRoleName(p.role) + " point '" + p.id + "' needs X, Y, Z");
     // A surveyed point's sigmas weight (control) or judge (check) its survey: they are required,
     // never a silent default (FORMATS.md: an unknown sigma is never 0 nor made up).
     const auto sx = Sigma(t, row, "sX", kMaxSigmaM), sy = Sigma(t, row, "sY", kMaxSigmaM),
                sz = Sigma(t, row, "sZ", kMaxSigmaM);
-    if (p.role != PointRole::kTie) {
+    if (p.role != PointRole::kTie && p.xyz_m) {
       if (!(sx && sy && sz))
         ThrowInputError(t.Where(row), PointRoleName(p.role) + " point '" + p.id +
                                           "' needs sX, sY, sZ > 0 (m): a survey sigma is required");
@@ -370,8 +373,9 @@ void ValidatePlatform(const PlatformSpec& p) {
 }
 
 void WriteExposures(const std::string& path, const std::vector<Exposure>& exposures) {
-  bool gnss = false, imu = false, velocity = false;
+  bool gnss = false, imu = false, velocity = false, z_ref = false;
   for (const auto& e : exposures) {
+    z_ref |= e.z_ref_m.has_value();
     gnss |= e.center_sigma_m.has_value();
     imu |= e.opk_sigma_rad.has_value();
     velocity |= e.velocity_mps.has_value();
@@ -381,6 +385,7 @@ void WriteExposures(const std::string& path, const std::vector<Exposure>& exposu
     if (gnss) out << ",sX,sY,sZ";
     if (imu) out << ",somega,sphi,skappa";
     if (velocity) out << ",vX,vY,vZ";
+    if (z_ref) out << ",z_ref";
     out << "\n";
     for (const auto& e : exposures) {
       out << e.image << "," << e.camera << "," << Coordinate(e.center_m.x()) << ","
@@ -409,6 +414,7 @@ void WriteExposures(const std::string& path, const std::vector<Exposure>& exposu
         else
           out << ",,,";
       }
+      if (z_ref) out << "," << (e.z_ref_m ? Coordinate(*e.z_ref_m) : std::string());
       out << "\n";
     }
   });
@@ -444,7 +450,7 @@ void WritePoints(const std::string& path, const std::vector<GroundPoint>& points
         out << Coordinate(p.xyz_m->x()) << "," << Coordinate(p.xyz_m->y()) << "," << Coordinate(p.xyz_m->z());
       else
         out << ",,";
-      if (p.role == PointRole::kTie)
+      if (p.role == PointRole::kTie || !p.xyz_m)
         out << ",,,";
       else
         out << "," << FormatNumber(p.sigma_m.x(), 6) << "," << FormatNumber(p.sigma_m.y(), 6) << ","

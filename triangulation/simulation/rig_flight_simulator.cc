@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "calib/camera/rig_io.h"
+#include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
@@ -16,20 +17,66 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kMarginPx = 20.0;  // points are measured at least this far inside a head's format
 using Model = calib::Camera::Model;
 
-calib::RigHead DualLensHead(const std::string& id, const Eigen::Vector3d& mount_deg,
-                            const Eigen::Vector3d& lever_arm_m) {
+calib::RigHead MakeHead(const std::string& id, double pixel_size_mm, int width_px, int height_px,
+                        const Eigen::Vector3d& c_x0_y0_mm, const Eigen::Vector3d& mount_deg,
+                        const Eigen::Vector3d& lever_arm_m) {
   calib::RigHead head;
   head.id = id;
   head.camera.name = id;
-  head.camera.pixel_size_mm = 0.006;
-  head.camera.width_px = 10000;
-  head.camera.height_px = 10000;
-  head.camera.interior[Model::kC] = 150.0;
-  head.camera.interior[Model::kX0] = 3.0;
-  head.camera.interior[Model::kY0] = 3.0;
+  head.camera.pixel_size_mm = pixel_size_mm;
+  head.camera.width_px = width_px;
+  head.camera.height_px = height_px;
+  head.camera.interior[Model::kC] = c_x0_y0_mm.x();
+  head.camera.interior[Model::kX0] = c_x0_y0_mm.y();
+  head.camera.interior[Model::kY0] = c_x0_y0_mm.z();
   head.mount_rad = mount_deg * kDegToRad;
   head.lever_arm_m = lever_arm_m;
   return head;
+}
+
+calib::RigHead DualLensHead(const std::string& id, const Eigen::Vector3d& mount_deg,
+                            const Eigen::Vector3d& lever_arm_m) {
+  return MakeHead(id, 0.006, 10000, 10000, {150.0, 3.0, 3.0}, mount_deg, lever_arm_m);
+}
+
+// configs/rig_uav4.yaml (a test checks that both agree).
+calib::Rig Uav4Rig() {
+  calib::Rig rig;
+  rig.name = "uav4-24";
+  rig.reference_head = "A";
+  calib::VirtualCamera& v = rig.virtual_camera;
+  v.orientation = calib::VirtualOrientation::kLevel;
+  v.c_mm = 24.5;
+  v.pixel_size_mm = 0.0082;
+  v.width_px = 8660;
+  v.height_px = 11760;
+  v.height_m = 300.0;
+  const Eigen::Vector3d interior(24.5, 0.0, 0.0);
+  rig.heads.push_back(MakeHead("A", 0.0082, 2912, 4368, interior, {0, -24, 0}, {0.06, 0, 0}));
+  rig.heads.push_back(MakeHead("B", 0.0082, 4368, 2912, interior, {37, 0, 0}, {0, 0.06, 0}));
+  rig.heads.push_back(MakeHead("C", 0.0082, 2912, 4368, interior, {0, 24, 0}, {-0.06, 0, 0}));
+  rig.heads.push_back(MakeHead("D", 0.0082, 4368, 2912, interior, {-37, 0, 0}, {0, -0.06, 0}));
+  return rig;
+}
+
+// The point where the ray through a virtual pixel meets the terrain (bisection between planes
+// below and above the terrain's range); false when the ray does not point down.
+bool TerrainPointOfRay(const FlightSimulationOptions& o, const Eigen::Vector3d& origin,
+                       const Eigen::Vector3d& direction, Eigen::Vector3d* point) {
+  if (!(direction.z() < 0)) return false;
+  const double z_lo = o.terrain_base_m - 1.0, z_hi = o.terrain_base_m + o.terrain_relief_m + 1.0;
+  double s_lo = (origin.z() - z_hi) / -direction.z(), s_hi = (origin.z() - z_lo) / -direction.z();
+  const auto above = [&](double s) {
+    const Eigen::Vector3d p = origin + s * direction;
+    return p.z() > SimulatedTerrainHeight(o, p.x(), p.y());
+  };
+  for (int i = 0; i < 80; ++i) {
+    const double mid = 0.5 * (s_lo + s_hi);
+    (above(mid) ? s_lo : s_hi) = mid;
+  }
+  *point = origin + 0.5 * (s_lo + s_hi) * direction;
+  point->z() = SimulatedTerrainHeight(o, point->x(), point->y());
+  return true;
 }
 
 }  // namespace
@@ -41,8 +88,7 @@ std::optional<RigPreset> ParseRigPreset(const std::string& name) {
 }
 
 calib::Rig MakeNominalRig(RigPreset preset) {
-  if (preset != RigPreset::kDualLens)
-    throw ConfigError("--rig uav4: the four-head UAV rig is not built yet (the four-head issue, 16); use dual-lens");
+  if (preset == RigPreset::kUav4) return Uav4Rig();
   // configs/rig_dual_lens.yaml (a test checks that both agree).
   calib::Rig rig;
   rig.name = "dual-lens-150";
@@ -72,6 +118,30 @@ FlightSimulationOptions RigFlightSimulationOptions::DefaultRigFlight() {
   o.tie_points = 300;
   o.start_position_error_m = 5.0;
   return o;
+}
+
+RigFlightSimulationOptions RigFlightSimulationOptions::DefaultUav4() {
+  RigFlightSimulationOptions r;
+  r.preset = RigPreset::kUav4;
+  FlightSimulationOptions& o = r.flight;
+  o.flying_height_m = 300.0;
+  o.terrain_relief_m = 30.0;
+  o.exposures = 8;
+  o.strips = 1;
+  o.ground_points = 0;
+  o.control_points = 0;
+  o.tie_points = 0;
+  o.image_noise_px = 0.3;
+  o.image_sigma_px = 0.3;
+  o.gnss_sigma_m = 0.05;
+  o.imu_sigma_deg = 0.01;
+  r.increment_sigma_rad = 0.025 * kDegToRad;
+  r.speed_mps = 10.0;
+  r.head_time_offsets_s = {0.0, 0.003, -0.0025, 0.0035};
+  r.stitch_ties.per_standard_position = 3;
+  r.stitch_ties.dense = 40;
+  r.stitch_ties.check = 10;
+  return r;
 }
 
 std::vector<calib::InteriorParams> RigFlightSimulationOptions::DefaultHeadInteriorCorrections() {
@@ -108,6 +178,95 @@ bool ProjectRigHead(const calib::RigHead& head, const Exposure& exposure,
                                     pixel);
 }
 
+namespace {
+
+// z_ref of every exposure and the stitching ties (header comment), drawn after everything else so
+// that the flight, points and observations of a seed do not depend on them.
+void AddStitchingTies(SimulatedRigFlight& f, internal::SimulationRandom& random) {
+  const FlightSimulationOptions& o = f.options.flight;
+  const auto& st = f.options.stitch_ties;
+  auto& rng = random.rng;
+  auto& normal = random.normal;
+  auto& uniform = random.uniform;
+  const calib::VirtualCamera& v = f.nominal.virtual_camera;
+  const size_t heads = f.truth.heads.size();
+  const bool any = st.dense > 0 || st.check > 0 ||
+                   (st.per_standard_position > 0 && !st.standard_positions.empty());
+  for (size_t i = 0; i < f.exposures_truth.size(); ++i) {
+    const Exposure& e = f.exposures_truth[i];
+    // The level virtual camera with the rig's heading (CONVENTIONS.md), at O.
+    const double kappa = calib::OpkFromRotation(calib::RotationFromOpk(e.opk_rad)).z();
+    const Eigen::Matrix3d object_from_virtual = calib::RotationFromOpk({0.0, 0.0, kappa});
+    const auto ground_of = [&](const Eigen::Vector2d& px, Eigen::Vector3d* g) {
+      return TerrainPointOfRay(o, e.center_m, object_from_virtual * v.RayFromPixel(px), g);
+    };
+    // z_ref: the mean terrain height under the virtual image (a 20 x 20 grid).
+    double sum = 0.0;
+    int n = 0;
+    for (int r = 0; r < 20; ++r)
+      for (int c = 0; c < 20; ++c) {
+        Eigen::Vector3d g;
+        if (ground_of({(c + 0.5) * v.width_px / 20.0, (r + 0.5) * v.height_px / 20.0}, &g)) {
+          sum += g.z();
+          ++n;
+        }
+      }
+    if (n > 0) f.exposures_truth[i].z_ref_m = f.exposures_file[i].z_ref_m = sum / n;
+    if (!any) continue;
+    int serial = 0;
+    // A tie at a virtual pixel: measured in every head of this exposure that sees it (>= 2).
+    const auto place = [&](const Eigen::Vector2d& px, PointRole role,
+                           const std::string& position) {
+      Eigen::Vector3d g;
+      if (!ground_of(px, &g)) return false;
+      std::vector<std::pair<int, Eigen::Vector2d>> seen;
+      for (size_t k = 0; k < heads; ++k) {
+        const calib::RigHead& head = f.truth.heads[k];
+        Eigen::Vector2d p;
+        if (!ProjectRigHead(head, e, f.rig_exposures[i * heads + k], g, &p)) continue;
+        if (p.x() < kMarginPx || p.y() < kMarginPx || p.x() > head.camera.width_px - 1 - kMarginPx ||
+            p.y() > head.camera.height_px - 1 - kMarginPx)
+          continue;
+        seen.push_back({static_cast<int>(k), p});
+      }
+      if (seen.size() < 2) return false;
+      GroundPoint truth;
+      truth.id = StringPrintf("%s_%s%03d", e.image.c_str(),
+                              role == PointRole::kCheck ? "c" : "t", serial++);
+      truth.role = role;
+      truth.xyz_m = g;
+      GroundPoint file = truth;
+      file.xyz_m.reset();  // a stitching tie (and a check tie) has no coordinates
+      f.points_truth.push_back(truth);
+      f.points_file.push_back(file);
+      if (!position.empty()) f.tie_position[truth.id] = position;
+      for (const auto& [k, p] : seen) {
+        ImageObservation obs;
+        obs.image = e.image;
+        obs.head = f.truth.heads[k].id;
+        obs.point = truth.id;
+        obs.sigma_px = o.image_sigma_px;
+        obs.pixel = p + o.image_noise_px * Eigen::Vector2d(normal(rng), normal(rng));
+        f.observations.push_back(obs);
+      }
+      return true;
+    };
+    for (const auto& s : st.standard_positions)
+      for (int j = 0, tries = 0; j < st.per_standard_position && tries < 100 * st.per_standard_position + 100; ++tries) {
+        const double radius = st.jitter_px * std::sqrt(uniform(rng)), angle = 2 * M_PI * uniform(rng);
+        j += place(s.virtual_px + radius * Eigen::Vector2d(std::cos(angle), std::sin(angle)),
+                   PointRole::kTie, s.name);
+      }
+    for (PointRole role : {PointRole::kTie, PointRole::kCheck}) {
+      const int wanted = role == PointRole::kTie ? st.dense : st.check;
+      for (int j = 0, tries = 0; j < wanted && tries < 1000 * wanted; ++tries)
+        j += place({uniform(rng) * (v.width_px - 1), uniform(rng) * (v.height_px - 1)}, role, "");
+    }
+  }
+}
+
+}  // namespace
+
 SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) {
   const FlightSimulationOptions& o = options.flight;
   if (o.exposures < 2 || o.strips < 1 || o.exposures < o.strips)
@@ -115,6 +274,11 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
   if (!(options.increment_sigma_rad >= 0) || !(std::abs(options.time_offset_s) <= 1.0) ||
       !(options.speed_mps >= 0))
     throw ConfigError("rig simulation: increment sigma and speed must be >= 0, |dT| <= 1 s");
+  for (double dt : options.head_time_offsets_s)
+    if (!(std::abs(dt) <= 1.0)) throw ConfigError("rig simulation: |dT| of every head <= 1 s");
+  const auto& st = options.stitch_ties;
+  if (st.per_standard_position < 0 || st.dense < 0 || st.check < 0 || !(st.jitter_px >= 0))
+    throw ConfigError("rig simulation: stitching tie counts and jitter must be >= 0");
   internal::SimulationRandom random(o.seed);
   auto& rng = random.rng;
   auto& normal = random.normal;
@@ -155,7 +319,9 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
       if (static_cast<int>(k) != reference) {
         t.increment_rad = options.increment_sigma_rad *
                           Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-        t.dt_s = options.time_offset_s;
+        t.dt_s = options.head_time_offsets_s.empty()
+                     ? options.time_offset_s
+                     : options.head_time_offsets_s[std::min(k, options.head_time_offsets_s.size() - 1)];
       }
       f.rig_exposures.push_back(t);
     }
@@ -203,6 +369,7 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
       }
     }
   }
+  AddStitchingTies(f, random);
   return f;
 }
 

@@ -10,11 +10,19 @@
 // measurements are pixels of that head (observations.csv with a `head` column).
 //
 // Presets: `dual-lens` is configs/rig_dual_lens.yaml (two 10000 x 10000 px heads of 6 um,
-// c = 150 mm, head B 0.15 m along x converging by 1 deg). `uav4` (four tilted heads) follows with
-// the four-head issue (16): ParseRigPreset knows the name and MakeNominalRig refuses it by name.
+// c = 150 mm, head B 0.15 m along x converging by 1 deg). `uav4` is configs/rig_uav4.yaml (four
+// 24.5 mm full-frame heads tilted 24 deg along and 37 deg across track, issue 16).
+//
+// Stitching ties (issue 16): per exposure, ground points on the terrain seen by two or more heads
+// of that ONE exposure and measured there only: around given standard positions of the virtual
+// image (stitch::DesignRig computes them; the caller passes them, triangulation does not use
+// stitch beyond sub-image mappings), at random places of the overlap zones (dense ties), and
+// check ties (points.csv role `check` without coordinates). Each exposure also gets `z_ref`, the
+// mean terrain height under the virtual image.
 #pragma once
 
 #include <cmath>
+#include <map>
 #include <optional>
 #include <string>
 #include <vector>
@@ -49,11 +57,33 @@ struct RigFlightSimulationOptions {
   double time_offset_s = 0.0;        // dT_k of every non-reference head, |dT| <= 1 s
   double speed_mps = 0.0;            // platform speed along the strips, >= 0; > 0: exposures.csv
                                      // carries the velocity vX, vY, vZ
+  /// dT_k per head (s, k-th entry; the reference head's is ignored, |dT| <= 1 s); empty: every
+  /// non-reference head has time_offset_s.
+  std::vector<double> head_time_offsets_s;
+
+  struct StandardPosition {
+    std::string name;               // "AB-1"
+    Eigen::Vector2d virtual_px;     // in the level virtual image of the nadir design
+  };
+  /// Stitching ties per exposure (see the header comment); all zero: none.
+  struct StitchTies {
+    std::vector<StandardPosition> standard_positions;
+    int per_standard_position = 0;  // ties around each standard position, >= 0
+    double jitter_px = 40.0;        // radius around a standard position (virtual px), >= 0
+    int dense = 0;                  // ties at random places seen by >= 2 heads, >= 0
+    int check = 0;                  // check ties, >= 0
+  } stitch_ties;
 
   /// The frame simulator's defaults at the dual-lens camera's relative flying height (1200 m)
   /// with terrain relief of 100 m.
   static FlightSimulationOptions DefaultRigFlight();
   static std::vector<calib::InteriorParams> DefaultHeadInteriorCorrections();
+  /// The four-head stitching flight of issue 16 (preset uav4): one line of 8 exposures at 300 m
+  /// over 30 m of relief, 10 m/s, per-exposure increments of 0.025 deg (sigma per angle), shutter
+  /// offsets B +3, C -2.5, D +3.5 ms, GNSS 0.05 m / IMU 0.01 deg, tie noise 0.3 px, no surveyed
+  /// points; ties: 3 per standard position, 40 dense, 10 check per exposure (the positions are the
+  /// caller's).
+  static RigFlightSimulationOptions DefaultUav4();
 };
 
 /// Truth of one head in one exposure: the attitude increment E_k (rad) and time offset dT_k (s).
@@ -70,6 +100,8 @@ struct SimulatedRigFlight {
   std::vector<GroundPoint> points_truth, points_file;
   std::vector<ImageObservation> observations;  // head pixels, `head` set
   std::vector<RigExposureTruth> rig_exposures;  // every exposure and head
+  /// Stitching tie id -> the standard position it was placed around ("" for dense / check ties).
+  std::map<std::string, std::string> tie_position;
 };
 
 /// The true head pixel of an object point in one exposure; false when it lies behind the head.
