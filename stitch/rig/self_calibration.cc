@@ -6,6 +6,7 @@
 #include <map>
 #include <set>
 
+#include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 #include "calib/problem/data_snooping.h"
@@ -110,6 +111,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   std::vector<std::vector<calib::BlockId>> dt(n_exposures, std::vector<calib::BlockId>(n_heads, -1));
   std::vector<calib::BlockId> line_dt(n_heads, -1);
   std::vector<RigExposure> poses(n_exposures);
+  std::vector<Eigen::Vector4d> rig_quaternion(n_exposures);  // sized once: blocks point into it
   const std::vector<std::string> angle_names = {"domega", "dphi", "dkappa"};
   for (int k = 0; k < n_heads; ++k) {
     if (k == reference || options.mode != RigStitchMode::kLine) continue;
@@ -122,8 +124,9 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     poses[i].increment_rad.assign(n_heads, Eigen::Vector3d::Zero());
     poses[i].dt_s.assign(n_heads, 0.0);
     const std::string& image = exposures[i].image;
-    rig_opk[i] = builder.AddBlock("rig_opk[" + image + "]", poses[i].rig_opk_rad.data(), 3,
-                                  calib::BlockKind::kOther);
+    // The exposure's POS attitude as the quaternion block the head residual takes (held).
+    rig_quaternion[i] = calib::QuaternionFromOpk(poses[i].rig_opk_rad);
+    rig_opk[i] = builder.AddRotationBlock("rig_opk[" + image + "]", rig_quaternion[i].data());
     rig_center[i] = builder.AddBlock("rig_center[" + image + "]", poses[i].rig_center_m.data(), 3,
                                      calib::BlockKind::kOther);
     builder.FixBlock(rig_opk[i]);

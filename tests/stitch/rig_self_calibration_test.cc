@@ -91,7 +91,9 @@ TEST(RigSelfCalibration, NoiseFreeFlatTerrainExactPosRecoversTheIncrements) {
           << r.exposures[i].image << " " << h.head;
       // dT over 3 exposures correlates with an angle beyond the 0.95 threshold, so it may be
       // reported as not determinable; where it is reported it must be right.
-      if (h.dt_s) EXPECT_NEAR(*h.dt_s, truth.dt_s, 1e-7) << h.head;
+      if (h.dt_s) {
+        EXPECT_NEAR(*h.dt_s, truth.dt_s, 1e-7) << h.head;
+      }
     }
   EXPECT_LT(r.after.fit.per_coordinate, 1e-4);
   EXPECT_GT(r.before.fit.per_coordinate, 0.5);

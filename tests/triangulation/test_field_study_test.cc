@@ -83,7 +83,9 @@ TEST(TestFieldStudy, GroupChiSquareAndSigmasAgainstTheSpread) {
     const double sigma = std::sqrt(sigma2[k] / runs);
     std::printf("%s: spread of the error %.3g mm, stated sigma (rms) %.3g mm, ratio %.3f, mean error %.3g\n",
                 std::string(Model::kParams[params[k]].name).c_str(), spread, sigma, spread / sigma, mean);
-    if (runs >= 50) EXPECT_NEAR(spread / sigma, 1.0, 0.25) << Model::kParams[params[k]].name;
+    if (runs >= 50) {
+      EXPECT_NEAR(spread / sigma, 1.0, 0.25) << Model::kParams[params[k]].name;
+    }
   }
   if (runs >= 50) {
     // The test at its 5 % level, per parameter: passes in >= 90 % of the runs.
@@ -119,8 +121,11 @@ TEST(TestFieldStudy, ExpandedUncertaintyCoversTheTruth) {
   std::printf("%d runs (%d valid): U (k from nu_eff) covers the truth: c %d, x0 %d, y0 %d\n", runs,
               valid, covered[0], covered[1], covered[2]);
   EXPECT_EQ(valid, runs);
-  if (runs >= 100)
-    for (int k = 0; k < 3; ++k) EXPECT_GE(covered[k], 93) << names[k];
+  if (runs >= 100) {
+    for (int k = 0; k < 3; ++k) {
+      EXPECT_GE(covered[k], 93) << names[k];
+    }
+  }
 }
 
 }  // namespace
