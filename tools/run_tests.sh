@@ -42,10 +42,12 @@ if [ "${AEROCAL_FUZZ:-1}" = 1 ]; then
     ctest --test-dir "$root/build-fuzz" --output-on-failure -j"$jobs" -L fuzz \
       -R '^fuzz/(csv|camera_yaml|camera_formats)$'
   fi
-  # The calib unit tests under ASan + UBSan, on the calib library the fuzz targets instrumented.
-  mapfile -t calib_unit < <(test_targets "$root/build-fuzz" -L unit -R '^calib/' | sed 's/^/test_/')
+  # The calib unit tests under ASan + UBSan, on the calib library the fuzz targets instrumented
+  # (calib/normal_equations, 1.5-3 min under ASan, only in the full job: CI time budget).
+  sanitized=(-L unit -R '^calib/' -E '^calib/normal_equations$')
+  mapfile -t calib_unit < <(test_targets "$root/build-fuzz" "${sanitized[@]}" | sed 's/^/test_/')
   cmake --build "$root/build-fuzz" -j"$jobs" --target "${calib_unit[@]}"
-  ctest --test-dir "$root/build-fuzz" --output-on-failure -j"$jobs" -L unit -R '^calib/'
+  ctest --test-dir "$root/build-fuzz" --output-on-failure -j"$jobs" "${sanitized[@]}"
 fi
 
 if [ "$full" = 1 ]; then

@@ -378,7 +378,7 @@ TEST(CameraFormatsRealData, PhotoModelerExportOfTheDbatProjectAgreesWithDbat) {
   EXPECT_NEAR(pm.camera.params[B::kY0], dbat.camera.params[B::kY0], 0.01);
   // Written and read back exactly.
   TempDir tmp("aerocal_formats");
-  const Format& f = Formats()[7];
+  const Format f = Formats()[7];  // a copy: Formats() returns a temporary
   ASSERT_STREQ(f.name, "photomodeler");
   ExpectSameParams(pm.camera, WriteAndRead(f, pm, tmp).camera, "photomodeler");
 }
@@ -419,7 +419,7 @@ TEST(CameraFormatsRealData, AustralisReportOfThePublicExample) {
   EXPECT_NEAR(std::sqrt((*a.covariance)(B::kB2, B::kB2)), 1.101e-4, 1e-18);
   EXPECT_EQ((*a.covariance)(B::kC, B::kX0), 0.0);
   // Written and read back: the same camera and sigmas.
-  const Format& f = Formats()[8];
+  const Format f = Formats()[8];  // a copy: Formats() returns a temporary
   ASSERT_STREQ(f.name, "australis");
   const CameraFile back = WriteAndRead(f, a, tmp);
   ExpectSameParams(a.camera, back.camera, "australis");
