@@ -148,19 +148,6 @@ void HeadPose(const T* rig_opk, Rest... rest) {
   HeadPoseOfRotation(static_cast<const T*>(object_from_rig), rest...);
 }
 
-/// [U V W] = R_k^T (X - O_k): an object point in head k's image-space frame.
-template <typename T>
-void HeadSpaceFromObject(const T* object_from_head,
-                         const T* head_center_m,
-                         const T* point_m,
-                         T* uvw) {
-  const T d[3] = {point_m[0] - head_center_m[0], point_m[1] - head_center_m[1],
-                  point_m[2] - head_center_m[2]};
-  for (int i = 0; i < 3; ++i)
-    uvw[i] = object_from_head[i] * d[0] + object_from_head[3 + i] * d[1] +
-             object_from_head[6 + i] * d[2];
-}
-
 /// Ideal photo coordinates reduced to head k's principal point, -c [U V] / W (mm), of an object
 /// point seen in one rig exposure: the projection the rig residual compares with
 /// BrownFraser10Model::IdealFromMeasured of the measured head pixel. Blocks as in HeadPose, plus
@@ -180,7 +167,7 @@ bool ProjectHeadIdeal(const T* interior,
   T rotation[9], center[3], uvw[3];
   HeadPose(rig_opk, rig_center_m, mount_opk, lever_arm_m, increment_opk, dt_s, velocity_mps,
            rotation, center);
-  HeadSpaceFromObject(rotation, center, point_m, uvw);
+  ImageSpaceFromObjectByMatrix(rotation, center, point_m, uvw);  // head k's image space
   if (!(uvw[2] < T(0))) return false;
   const T& c = interior[BrownFraser10Model::kC];
   ideal_mm[0] = -c * uvw[0] / uvw[2];

@@ -117,7 +117,7 @@ struct RigHeadCollinearityResidual
     ObjectFromImageRotationOfQuaternion(rig_rotation, object_from_rig);
     HeadPoseOfRotation(object_from_rig, rig_center, mount, lever_arm,
                        increment, dt, velocity, object_from_head, head_center);
-    HeadSpaceFromObject(object_from_head, head_center, point, uvw);
+    ImageSpaceFromObjectByMatrix(object_from_head, head_center, point, uvw);
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
     return internal::CollinearityErrorFromImageSpace(interior, uvw, xy, inverse_sigma_mm_, r);
   }
