@@ -113,6 +113,23 @@ TEST(CameraFormats, EachFormatRoundTripsItsOwnModelExactly) {
   }
 }
 
+TEST(CameraFormats, AHostileNameNeverBreaksAFile) {
+  // XML markup, quotes and a newline in the camera name: every format still reads back its
+  // parameters exactly; the formats that keep a name keep it on one line, unescaped.
+  TempDir dir("aerocal_formats_name");
+  const std::string hostile = "A&B <lens> \"q\" 'p'\nsecond line";
+  for (const Format& f : Formats()) {
+    SCOPED_TRACE(f.name);
+    FileConversion in_model = ConvertCameraFile(File(DjiRecordA()), f.target);
+    in_model.file.name = hostile;
+    const CameraFile back = WriteAndRead(f, in_model.file, dir);
+    ExpectSameParams(in_model.file.camera, back.camera, f.name);
+    if (std::string(f.name) == "dbat" || std::string(f.name) == "photomodeler") {
+      EXPECT_EQ(back.name, "A&B <lens> \"q\" 'p' second line");
+    }
+  }
+}
+
 TEST(CameraFormats, TermsOutsideOpenCvSurviveTheirFormat) {
   TempDir dir("aerocal_formats");
   // Metashape's b1, b2, k4, p3, p4; DewarpDataK6's k4-k6; a fisheye in OpenSfM and Kalibr.

@@ -144,6 +144,11 @@ double ParseNumber(const std::string& text, const SourceRef& where, const std::s
 void RequireZero(const ModelCamera& camera, const std::vector<std::string>& names,
                  const std::string& format);
 double Param(const ModelCamera& camera, std::string_view name);
+/// A camera name as one line of text (control characters, a newline among them, become spaces):
+/// line-oriented formats put the name on a line of its own.
+std::string OneLine(std::string_view name);
+/// `text` with & < > " ' as XML entities (a camera name in an XML element).
+std::string XmlEscaped(std::string_view text);
 }  // namespace internal
 
 }  // namespace aerocal::calib
