@@ -107,6 +107,10 @@ void WriteMetashapeCalibration(const std::string& path, const CameraFile& camera
 
 CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& options);
 void WritePix4dCam(const std::string& path, const CameraFile& camera);
+/// Pix4D's camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, PerspectiveDistortion)
+/// from a JPEG or an XMP sidecar; the pixel size from exif:FocalPlaneXResolution or --pixel-mm.
+CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& options);
+void WritePix4dXmp(const std::string& path, const CameraFile& camera);
 
 CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options);
 void WriteOpenSfmCameras(const std::string& path, const CameraFile& camera);
