@@ -100,7 +100,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
 
   bool any_velocity = false;
   for (const auto& e : exposures) any_velocity |= e.pose.velocity_mps.norm() > 1e-9;
-  result.dt_held = options.mode == RigStitchMode::kAngles || !any_velocity;
+  result.dt_held = options.mode == RigStitchMode::kAngles || !any_velocity || options.hold_heads;
   if (!any_velocity && options.mode != RigStitchMode::kAngles)
     result.warnings.push_back(
         "no platform velocity in the exposures: the time offsets move no head and are held at 0");
@@ -141,6 +141,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       increment[i][k] = builder.AddBlock("E[" + name + "]",
                                          vectors.emplace_back(Eigen::Vector3d::Zero()).data(), 3,
                                          calib::BlockKind::kOther, angle_names);
+      if (options.hold_heads) builder.FixBlock(increment[i][k]);
       if (options.mode == RigStitchMode::kLine) {
         dt[i][k] = line_dt[k];
       } else {

@@ -87,6 +87,8 @@ struct RigStitchOptions {
   double correlation_threshold = 0.95;  // |rho| of dT with an angle above: not determinable
   double relief_m = 0.0;                // relief off the plane for the displacement figure, >= 0
   double max_sigma0 = 3.0;              // sigma0 above: absurd (a-priori sigmas or model), > 0
+  bool hold_heads = false;  // a reference run: increments and offsets held at the ground
+                            // calibration, only the tie points adjust (benchmark peer)
   calib::SolverOptions solver;
 };
 
