@@ -66,7 +66,7 @@ void ExpectRms(const json& rms, const std::string& where) {
 
 TEST(RigStitchCommand, LineModeOnASimulatedLineWithTheIssueKeys) {
   TempDir dir;
-  const auto run = RunAerocal(Stitch(Line(), "--relief-m 15", dir.File("r.json")));
+  const auto run = RunAerocal(Stitch(Line(), "--relief-m 15 --dt-sigma-ms 20", dir.File("r.json")));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("before -> after"), std::string::npos) << run.output;
   const json doc = ReadJson(dir.File("r.json"));
@@ -127,9 +127,11 @@ TEST(RigStitchCommand, PerExposureNamesTheCorrelationsAndAnglesHoldsTheOffsets) 
     for (const json& h : doc["rig_exposures"]) nulls += h["dT_ms"].is_null();
     EXPECT_GT(nulls, 0) << "no dT value the run cannot determine";
   }
-  run = RunAerocal(Stitch(Line(), "--mode angles", dir.File("a.json")));
+  run = RunAerocal(Stitch(Line(), "--mode angles --increment-sigma-arcsec 600 --alpha 0.01 --sigma-px 0.3",
+                         dir.File("a.json")));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   doc = ReadJson(dir.File("a.json"));
+  EXPECT_EQ(doc["snooping"]["alpha"].get<double>(), 0.01);
   EXPECT_TRUE(doc["time_offsets"]["held"].get<bool>());
   for (const json& h : doc["rig_exposures"]) {
     EXPECT_EQ(h["dT_ms"].get<double>(), 0.0);
