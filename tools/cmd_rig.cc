@@ -1,5 +1,6 @@
-// aerocal rig: multi-head rigs (stitch/rig/). `rig convert`: the head images of one exposure ->
-// the virtual image (stitch/rig/rig_convert.h). `rig error-analysis`: the conversion error analysis
+// aerocal rig: multi-head rigs (stitch/rig/). `rig stitch`: the per-exposure self-calibrating
+// stitching of a rig block (stitch/rig/self_calibration.h) from a project's head observations.
+// `rig convert`: the head images of one exposure -> the virtual image (stitch/rig/rig_convert.h). `rig error-analysis`: the conversion error analysis
 // of the virtual image (stitch/rig/error_analysis.h) at one target or over a grid of targets,
 // result.json plus histogram / bound-map CSV files and, through tools/report/rig_error_plots.py
 // (matplotlib), their PNG plots.
@@ -8,9 +9,9 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <map>
 #include <memory>
 #include <optional>
-#include <sstream>
 
 #include <nlohmann/json.hpp>
 
@@ -25,10 +26,12 @@
 #include "stitch/rig/dem_grid.h"
 #include "stitch/rig/rig_convert.h"
 #include "stitch/rig/rig_design.h"
+#include "stitch/rig/self_calibration.h"
+#include "stitch/rig/self_calibration_json.h"
 #include "tools/command_registry.h"
 #include "tools/python_script.h"
 #include "tools/image_sources.h"
-
+#include "triangulation/block/block_io.h"
 
 namespace aerocal::tools {
 namespace {
@@ -48,9 +51,9 @@ struct ErrorAnalysisArgs {
 
 // "COL,ROW" -> pixel; ConfigError naming the option otherwise.
 Eigen::Vector2d ParsePixel(const std::string& text, const std::string& option) {
-  const auto comma = text.find(',');
-  const auto col = comma == std::string::npos ? std::nullopt : ParseDouble(text.substr(0, comma));
-  const auto row = comma == std::string::npos ? std::nullopt : ParseDouble(text.substr(comma + 1));
+  const std::vector<std::string> fields = SplitCommaList(text, {true, true});
+  const auto col = fields.size() == 2 ? ParseDouble(fields[0]) : std::nullopt;
+  const auto row = fields.size() == 2 ? ParseDouble(fields[1]) : std::nullopt;
   if (!col || !row) throw ConfigError(option + ": expected COL,ROW (got '" + text + "')");
   return {*col, *row};
 }
@@ -217,10 +220,9 @@ int RunConvert(const ConvertArgs& args) {
   const calib::Rig rig = calib::ReadRig(args.camera);
   const double height_m = FlyingHeight(rig, args.height_m, args.camera);
   stitch::RigExposure exposure;
-  std::stringstream angles(args.opk_deg);
-  std::string item;
+  const std::vector<std::string> angles = SplitCommaList(args.opk_deg, {true, true});
   for (int i = 0; i < 3; ++i) {
-    const auto value = std::getline(angles, item, ',') ? ParseDouble(item) : std::nullopt;
+    const auto value = angles.size() == 3 ? ParseDouble(angles[i]) : std::nullopt;
     if (!value) throw ConfigError("--opk-deg: expected OMEGA,PHI,KAPPA in degrees (got '" + args.opk_deg + "')");
     exposure.rig_opk_rad[i] = *value * M_PI / 180.0;
   }
@@ -270,6 +272,128 @@ int RunConvert(const ConvertArgs& args) {
                   stitch::ReliefDisplacementPx(rig, reference, k, height_m, args.relief_m),
                   rig.reference_head.c_str(), rig.heads[k].id.c_str());
   return kExitOk;
+}
+
+struct StitchArgs {
+  std::string camera, project, mode = "line", out;
+  bool no_snooping = false;
+  double alpha = 0.05;
+  double increment_sigma_arcsec = 0.0;  // given only: weighted prior on every increment angle
+  double dt_sigma_ms = 0.0;             // given only: weighted prior on every time offset
+  double relief_m = 0.0;                // given only: relief of the block off the plane
+  double standard_radius_px = 400.0;
+  double max_sigma0 = 3.0;
+  double default_sigma_px = 0.5;
+  CLI::Option* increment_sigma_option = nullptr;
+  CLI::Option* dt_sigma_option = nullptr;
+  CLI::Option* relief_option = nullptr;
+};
+
+// The project's rig block as the library's inputs: every exposure with head observations (z_ref
+// required, velocity optional), the points (role check: a check tie, never adjusted), the head
+// observations with their lines for the snooping's labels.
+struct StitchInputs {
+  std::vector<stitch::RigStitchExposure> exposures;
+  std::vector<stitch::RigStitchTie> ties;
+  std::vector<stitch::RigStitchObservation> observations;
+};
+
+StitchInputs StitchInputsFromProject(const triangulation::Project& project, const calib::Rig& rig,
+                                     const std::string& camera_file) {
+  StitchInputs in;
+  std::map<std::string, int> tie_index, exposure_index;
+  for (const auto& p : project.points) {
+    tie_index[p.id] = static_cast<int>(in.ties.size());
+    in.ties.push_back({p.id, p.role == triangulation::PointRole::kCheck});
+  }
+  for (const auto& o : project.observations) {
+    const SourceRef where{project.observations_file, o.line};
+    if (o.head.empty())
+      ThrowInputError(where, "rig stitch needs head observations (observations.csv `head` column)");
+    const int head = rig.HeadIndex(o.head);
+    if (head < 0) ThrowInputError(where, "head '" + o.head + "' is not a head of " + camera_file);
+    auto [it, added] = exposure_index.try_emplace(o.image, static_cast<int>(in.exposures.size()));
+    if (added) {
+      const triangulation::Exposure& e = *project.FindExposure(o.image);
+      if (!e.z_ref_m)
+        ThrowInputError({project.exposures_file, e.line},
+                        "image " + e.image + " has no z_ref (rig stitch rectifies onto the level "
+                        "plane Z = z_ref of each exposure)");
+      if (!(e.center_m.z() > *e.z_ref_m))
+        ThrowInputError({project.exposures_file, e.line},
+                        "image " + e.image + ": z_ref (" + FormatNumber(*e.z_ref_m) +
+                            " m) must lie below the rig centre Z (" + FormatNumber(e.center_m.z()) +
+                            " m)");
+      stitch::RigStitchExposure x;
+      x.image = e.image;
+      x.pose.rig_opk_rad = e.opk_rad;
+      x.pose.rig_center_m = e.center_m;
+      x.pose.velocity_mps = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
+      x.z_ref_m = *e.z_ref_m;
+      in.exposures.push_back(x);
+    }
+    const std::string label = fs::path(project.observations_file).filename().string() + ":" +
+                              std::to_string(o.line);
+    in.observations.push_back(
+        {it->second, head, tie_index.at(o.point), o.pixel, o.sigma_px, label});
+  }
+  if (in.observations.empty())
+    throw InputError(project.observations_file + ": no head observations to stitch");
+  return in;
+}
+
+int RunStitch(const StitchArgs& args) {
+  const calib::Rig rig = calib::ReadRig(args.camera);
+  if (rig.heads.size() < 2)
+    throw InputError(args.camera + ": a rig of one head has nothing to stitch");
+  if (rig.virtual_camera.orientation != calib::VirtualOrientation::kLevel)
+    throw InputError(args.camera + ": virtual.orientation must be level for rig stitch (the "
+                     "horizontal virtual image of the POS attitude)");
+  stitch::RigStitchOptions options;
+  const auto mode = stitch::ParseRigStitchMode(args.mode);
+  if (!mode) throw ConfigError("--mode must be line, per-exposure or angles (got '" + args.mode + "')");
+  options.mode = *mode;
+  options.snooping = !args.no_snooping;
+  if (!(args.alpha > 0 && args.alpha < 1)) throw ConfigError("--alpha must be within (0, 1)");
+  options.alpha = args.alpha;
+  if (args.increment_sigma_option->count() > 0) {
+    if (!(args.increment_sigma_arcsec > 0)) throw ConfigError("--increment-sigma-arcsec must be > 0");
+    options.increment_sigma_rad = args.increment_sigma_arcsec * M_PI / (180.0 * 3600.0);
+  }
+  if (args.dt_sigma_option->count() > 0) {
+    if (!(args.dt_sigma_ms > 0)) throw ConfigError("--dt-sigma-ms must be > 0");
+    options.dt_sigma_s = args.dt_sigma_ms * 1e-3;
+  }
+  if (!(args.standard_radius_px > 0)) throw ConfigError("--standard-radius-px must be > 0");
+  options.standard_radius_px = args.standard_radius_px;
+  if (!(args.max_sigma0 > 0)) throw ConfigError("--max-sigma0 must be > 0");
+  options.max_sigma0 = args.max_sigma0;
+  if (!(args.default_sigma_px > 0)) throw ConfigError("--sigma-px must be > 0");
+  const triangulation::Project project = triangulation::ReadProject(args.project, args.default_sigma_px);
+  const StitchInputs in = StitchInputsFromProject(project, rig, args.camera);
+  double height_sum = 0.0;
+  for (const auto& e : in.exposures) height_sum += e.pose.rig_center_m.z() - e.z_ref_m;
+  const double height_m = height_sum / in.exposures.size();
+  stitch::RigStitchSources sources{args.camera, args.project, std::nullopt};
+  if (args.relief_option->count() > 0) {
+    if (!(args.relief_m >= 0 && args.relief_m < height_m))
+      throw ConfigError("--relief-m must be within [0, " + FormatNumber(height_m, 6) +
+                        ") m, the mean height above z_ref");
+    options.relief_m = args.relief_m;
+    sources.relief_m = args.relief_m;
+  }
+  // The standard tie positions of the rig's design at the block's mean height.
+  const std::vector<stitch::StandardPosition> positions =
+      stitch::DesignRig(rig, height_m, 200).standard_positions;
+  const stitch::RigStitchResult result = stitch::SelfCalibrateRigStitching(
+      rig, in.exposures, in.ties, in.observations, positions, options);
+  WriteFileAtomically(args.out,
+                      stitch::RigStitchToJson(rig, options, result, sources).dump(2) + "\n");
+  std::fputs(stitch::FormatRigStitchSummary(options, result, sources).c_str(), stdout);
+  if (result.failures.empty()) return kExitOk;
+  for (const auto& f : result.failures) std::fprintf(stderr, "error: %s\n", f.c_str());
+  std::fprintf(stderr, "error: %s written with valid: false\n", args.out.c_str());
+  return kExitNotConverged;
 }
 
 struct DesignArgs {
@@ -420,7 +544,41 @@ CommandRun Setup(CLI::App& app) {
   ds->add_option("--svg", design->svg, "Footprint plot (SVG, ground metres)");
   ds->add_option("--grid-cells", design->grid_cells,
                  "Coverage grid cells along the longer side, 10..4000");
-  return [args, ea, convert, cv, design, ds] {
+  auto stitching = std::make_shared<StitchArgs>();
+  CLI::App* st = app.add_subcommand(
+      "stitch", "Self-calibrating stitching of a rig block: per-exposure attitude increments and "
+                "shutter offsets of the heads from the overlap ties, stitching RMS before/after");
+  st->option_defaults()->always_capture_default();
+  st->add_option("--camera", stitching->camera,
+                 "Rig camera file, the ground calibration (YAML with a rig section, virtual "
+                 "orientation level)")
+      ->required();
+  st->add_option("--project", stitching->project,
+                 "Project YAML (or folder): exposures.csv with z_ref (and vX,vY,vZ), "
+                 "observations.csv with the head column, points.csv (role check: check tie)")
+      ->required();
+  st->add_option("--mode", stitching->mode,
+                 "line (one dT per head for the flight, angles per exposure) | per-exposure "
+                 "(everything per exposure; correlations reported) | angles (dT held at 0)");
+  st->add_option("--out", stitching->out, "Result JSON (kind rig_stitch)")->required();
+  st->add_flag("--no-snooping", stitching->no_snooping, "No data snooping of the tie observations");
+  st->add_option("--alpha", stitching->alpha, "Family-wise level of the snooping, (0, 1)");
+  stitching->increment_sigma_option = st->add_option(
+      "--increment-sigma-arcsec", stitching->increment_sigma_arcsec,
+      "Weighted prior (towards 0) on every increment angle, arcsec > 0 (default: none)");
+  stitching->dt_sigma_option =
+      st->add_option("--dt-sigma-ms", stitching->dt_sigma_ms,
+                     "Weighted prior (towards 0) on every time offset, ms > 0 (default: none)");
+  stitching->relief_option = st->add_option(
+      "--relief-m", stitching->relief_m,
+      "Relief of the block off the plane (m); its displacement between heads is reported");
+  st->add_option("--standard-radius-px", stitching->standard_radius_px,
+                 "A tie this close (virtual px) to a standard position of its zone counts for it");
+  st->add_option("--max-sigma0", stitching->max_sigma0, "sigma0 above: exit 3 (absurd), > 0");
+  st->add_option("--sigma-px", stitching->default_sigma_px,
+                 "Tie sigma (px) where observations.csv gives none");
+  return [args, ea, convert, cv, design, ds, stitching, st] {
+    if (st->parsed()) return RunStitch(*stitching);
     if (ds->parsed()) return RunDesign(*design);
     if (ea->parsed()) return RunErrorAnalysis(*args);
     if (cv->parsed()) return RunConvert(*convert);
@@ -431,7 +589,8 @@ CommandRun Setup(CLI::App& app) {
 }  // namespace
 
 AEROCAL_REGISTER_COMMAND(rig, "rig",
-                         "Multi-head rigs: conversion to the virtual image and its error analysis",
+                         "Multi-head rigs: self-calibrating stitching, conversion to the virtual "
+                         "image, its error analysis, design figures",
                          Setup);
 
 }  // namespace aerocal::tools

@@ -100,7 +100,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
 
   bool any_velocity = false;
   for (const auto& e : exposures) any_velocity |= e.pose.velocity_mps.norm() > 1e-9;
-  result.dt_held = options.mode == RigStitchMode::kAngles || !any_velocity;
+  result.dt_held = options.mode == RigStitchMode::kAngles || !any_velocity || options.hold_heads;
   if (!any_velocity && options.mode != RigStitchMode::kAngles)
     result.warnings.push_back(
         "no platform velocity in the exposures: the time offsets move no head and are held at 0");
@@ -141,6 +141,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       increment[i][k] = builder.AddBlock("E[" + name + "]",
                                          vectors.emplace_back(Eigen::Vector3d::Zero()).data(), 3,
                                          calib::BlockKind::kOther, angle_names);
+      if (options.hold_heads) builder.FixBlock(increment[i][k]);
       if (options.mode == RigStitchMode::kLine) {
         dt[i][k] = line_dt[k];
       } else {
@@ -420,12 +421,32 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   double height_sum = 0.0;
   for (const auto& e : exposures) height_sum += e.pose.rig_center_m.z() - e.z_ref_m;
   const double height_m = n_exposures > 0 ? height_sum / n_exposures : 0.0;
+  result.height_m = height_m;
   if (options.relief_m > 0 && options.relief_m < height_m)
     for (int j = 0; j < n_heads; ++j)
       for (int k = j + 1; k < n_heads; ++k)
         result.relief_displacement_px =
             std::max(result.relief_displacement_px,
                      ReliefDisplacementPx(rig, j, k, height_m, options.relief_m));
+
+  std::vector<double> sigmas;
+  for (const auto& [key, ids] : residuals_of_tie)
+    for (int o : tie_observations[key]) sigmas.push_back(observations[o].sigma_px);
+  if (!sigmas.empty()) {
+    std::nth_element(sigmas.begin(), sigmas.begin() + sigmas.size() / 2, sigmas.end());
+    result.sigma0_px = result.sigma0 * sigmas[sigmas.size() / 2];
+  }
+  // What makes the run untrustworthy, by name.
+  if (!result.report.converged)
+    result.failures.push_back("the adjustment did not converge (" + result.report.termination +
+                              ": " + result.report.message + ")");
+  if (!cov.ok) result.failures.push_back("covariance not computable (singular): " + cov.message);
+  if (!(result.sigma0 <= options.max_sigma0))
+    result.failures.push_back(StringPrintf(
+        "sigma0 %.3g is above %.3g: the tie sigmas or the rig model are wrong", result.sigma0,
+        options.max_sigma0));
+  for (const auto& reason : result.stop_reasons)
+    result.failures.push_back("snooping stopped: " + reason);
   return result;
 }
 

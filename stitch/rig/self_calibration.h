@@ -86,6 +86,9 @@ struct RigStitchOptions {
                                         // counts for it (virtual px), > 0
   double correlation_threshold = 0.95;  // |rho| of dT with an angle above: not determinable
   double relief_m = 0.0;                // relief off the plane for the displacement figure, >= 0
+  double max_sigma0 = 3.0;              // sigma0 above: absurd (a-priori sigmas or model), > 0
+  bool hold_heads = false;  // a reference run: increments and offsets held at the ground
+                            // calibration, only the tie points adjust (benchmark peer)
   calib::SolverOptions solver;
 };
 
@@ -143,7 +146,12 @@ struct RigStitchResult {
   std::vector<StandardPositionCount> standard_positions;
   int dropped_ties = 0;           // fitted ties with fewer than two observations (not used)
   double relief_displacement_px = 0.0;  // largest over the head pairs, at options.relief_m
+  double height_m = 0.0;                // mean relative flying height above z_ref (m)
+  double sigma0_px = 0.0;  // sigma0 x the median a-priori sigma of the fitted tie observations
   std::vector<std::string> warnings;
+  /// Why the run must not be trusted, each by name: not converged, covariance singular, sigma0
+  /// above options.max_sigma0, snooping stopped at a standard position. Empty: a valid run.
+  std::vector<std::string> failures;
 };
 
 /// Runs the self-calibrating stitching. The rig must have a level virtual camera; `positions` are

@@ -1,66 +1,26 @@
 // Self-calibrating stitching of the four-head rig (stitch/rig/self_calibration.h) on lines of the
 // uav4 simulator: noise-free recovery, noisy recovery within 3 sigma, the before/after RMS of the
-// paper's kind, the dT-rotation correlation of the per-exposure mode, a planted wrong tie.
+// paper's kind and its noise floor (why 1.55 x the tie noise), sigmas against the spread over seeds
+// (pooled), the dT-rotation correlation of the per-exposure mode, a planted wrong tie.
 #include <algorithm>
 #include <cmath>
 #include <map>
 
 #include <gtest/gtest.h>
 
-#include "stitch/rig/rig_design.h"
 #include "stitch/rig/self_calibration.h"
-#include "triangulation/simulation/rig_flight_simulator.h"
+#include "tests/stitch/rig_stitch_line.h"
 
 namespace aerocal::stitch {
 namespace {
 
 using triangulation::RigFlightSimulationOptions;
 using triangulation::SimulatedRigFlight;
-
-struct Inputs {
-  std::vector<RigStitchExposure> exposures;
-  std::vector<RigStitchTie> ties;
-  std::vector<RigStitchObservation> observations;
-  std::vector<StandardPosition> positions;
-};
-
-const std::vector<StandardPosition>& Uav4Positions() {
-  static const std::vector<StandardPosition> positions =
-      DesignRig(triangulation::MakeNominalRig(triangulation::RigPreset::kUav4), 300.0, 200)
-          .standard_positions;
-  return positions;
-}
+using Inputs = testing::RigStitchInputs;
+using testing::InputsFromFlight;
 
 RigFlightSimulationOptions Line(std::uint64_t seed, int exposures) {
-  RigFlightSimulationOptions o = RigFlightSimulationOptions::DefaultUav4();
-  o.flight.seed = seed;
-  o.flight.exposures = exposures;
-  for (const auto& s : Uav4Positions()) o.stitch_ties.standard_positions.push_back({s.name, s.virtual_px});
-  return o;
-}
-
-Inputs FromFlight(const SimulatedRigFlight& f) {
-  Inputs in;
-  in.positions = Uav4Positions();
-  std::map<std::string, int> exposure, tie;
-  for (const auto& e : f.exposures_file) {
-    RigStitchExposure x;
-    x.image = e.image;
-    x.pose.rig_opk_rad = e.opk_rad;
-    x.pose.rig_center_m = e.center_m;
-    x.pose.velocity_mps = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
-    x.z_ref_m = *e.z_ref_m;
-    exposure[e.image] = static_cast<int>(in.exposures.size());
-    in.exposures.push_back(x);
-  }
-  for (const auto& p : f.points_file) {
-    tie[p.id] = static_cast<int>(in.ties.size());
-    in.ties.push_back({p.id, p.role == triangulation::PointRole::kCheck});
-  }
-  for (const auto& o : f.observations)
-    in.observations.push_back({exposure.at(o.image), f.truth.HeadIndex(o.head), tie.at(o.point),
-                               o.pixel, o.sigma_px, o.image + "/" + o.head + "/" + o.point});
-  return in;
+  return testing::Uav4Line(seed, exposures);
 }
 
 RigStitchResult Stitch(const SimulatedRigFlight& f, const Inputs& in, RigStitchOptions options = {}) {
@@ -77,7 +37,7 @@ TEST(RigSelfCalibration, NoiseFreeFlatTerrainExactPosRecoversTheIncrements) {
   SimulatedRigFlight f = triangulation::SimulateRigFlight(o);
   f.exposures_file = f.exposures_truth;  // exact POS
   for (auto& e : f.exposures_file) e.z_ref_m = o.flight.terrain_base_m;  // the flat terrain
-  const Inputs in = FromFlight(f);
+  const Inputs in = InputsFromFlight(f);
   RigStitchOptions options;
   options.snooping = false;
   const RigStitchResult r = Stitch(f, in, options);
@@ -101,7 +61,7 @@ TEST(RigSelfCalibration, NoiseFreeFlatTerrainExactPosRecoversTheIncrements) {
 
 TEST(RigSelfCalibration, NoisyLineWithinThreeSigmaAndThePapersBeforeAfter) {
   const SimulatedRigFlight f = triangulation::SimulateRigFlight(Line(11, 8));
-  const Inputs in = FromFlight(f);
+  const Inputs in = InputsFromFlight(f);
   const RigStitchResult r = Stitch(f, in);
   ASSERT_TRUE(r.report.converged) << r.report.message;
   EXPECT_FALSE(r.stopped);
@@ -130,6 +90,49 @@ TEST(RigSelfCalibration, NoisyLineWithinThreeSigmaAndThePapersBeforeAfter) {
   std::printf("before %.3f / %.3f px, after %.3f / %.3f px (fit / check, per coordinate)\n",
               r.before.fit.per_coordinate, r.before.check.per_coordinate, r.after.fit.per_coordinate,
               r.after.check.per_coordinate);
+  // Why "after" is ~1.55 x the 0.3 px tie noise, not the paper's ~1.3 x: the metric. A pair
+  // compares TWO measured rays (sqrt 2) carried into the level virtual image, where a tilted
+  // head's pixel covers more than one virtual pixel. The noise alone, propagated, predicts the
+  // after figure; the true increments give the same floor (relief and POS noise add little).
+  const testing::PairMetricFloor floor = testing::PairFloor(f, in);
+  std::printf("pair metric floor: noise prediction %.3f px (mean scale %.3f virtual px per head "
+              "px), true parameters %.3f px; after / prediction %.3f\n",
+              floor.noise_prediction, floor.mean_scale, floor.truth_parameters,
+              r.after.fit.per_coordinate / floor.noise_prediction);
+  constexpr double kFloorTolerance = 0.10;  // the fit absorbs ~1 % (9 of ~1400 dof per exposure),
+                                            // relief and POS noise add a few %
+  EXPECT_NEAR(r.after.fit.per_coordinate / floor.noise_prediction, 1.0, kFloorTolerance);
+  EXPECT_NEAR(floor.truth_parameters / floor.noise_prediction, 1.0, kFloorTolerance);
+  EXPECT_GT(floor.noise_prediction / 0.3, std::sqrt(2.0)) << "two rays at >= 1 virtual px each";
+}
+
+// The reported sigmas against the spread of the estimates over simulated lines, pooled (the
+// default-suite version of the study in rig_self_calibration_study_test.cc): z = (estimate -
+// truth) / sigma over 8 seeds x 2 exposures x 9 angles; RMS(z) = 1 when the sigmas are right.
+TEST(RigSelfCalibration, SigmasMatchTheSpreadOverSeedsPooled) {
+  double z2 = 0.0;
+  int n = 0;
+  for (std::uint64_t seed = 100; seed < 108; ++seed) {
+    const SimulatedRigFlight f = triangulation::SimulateRigFlight(Line(seed, 2));
+    RigStitchOptions options;
+    options.snooping = false;
+    const RigStitchResult r = Stitch(f, InputsFromFlight(f), options);
+    ASSERT_TRUE(r.report.converged && r.failures.empty()) << seed;
+    for (size_t i = 0; i < r.exposures.size(); ++i)
+      for (size_t k = 1; k < 4; ++k)
+        for (int a = 0; a < 3; ++a, ++n) {
+          const RigStitchHead& h = r.exposures[i].heads[k];
+          const double z = (h.increment_rad[a] - f.rig_exposures[i * 4 + k].increment_rad[a]) /
+                           h.increment_sigma_rad[a];
+          z2 += z * z;
+        }
+  }
+  // 144 values, partly correlated within an exposure: RMS(z) has a spread of ~0.06-0.1; the issue
+  // asks for 25 %.
+  constexpr double kTolerance = 0.25;
+  const double rms_z = std::sqrt(z2 / n);
+  std::printf("RMS of (estimate - truth) / sigma over %d angles: %.3f\n", n, rms_z);
+  EXPECT_NEAR(rms_z, 1.0, kTolerance);
 }
 
 TEST(RigSelfCalibration, PerExposureModeNamesTheDtRotationCorrelation) {
@@ -137,7 +140,7 @@ TEST(RigSelfCalibration, PerExposureModeNamesTheDtRotationCorrelation) {
   RigStitchOptions options;
   options.mode = RigStitchMode::kPerExposure;
   options.snooping = false;
-  const RigStitchResult r = Stitch(f, FromFlight(f), options);
+  const RigStitchResult r = Stitch(f, InputsFromFlight(f), options);
   ASSERT_TRUE(r.report.usable) << r.report.message;
   ASSERT_FALSE(r.dt_correlations.empty());
   double largest = 0.0;
@@ -152,7 +155,7 @@ TEST(RigSelfCalibration, PerExposureModeNamesTheDtRotationCorrelation) {
 
 TEST(RigSelfCalibration, PlantedWrongTieIsRejectedWithoutEmptyingAStandardPosition) {
   SimulatedRigFlight f = triangulation::SimulateRigFlight(Line(7, 2));
-  Inputs in = FromFlight(f);
+  Inputs in = InputsFromFlight(f);
   // A wrong match: 8 px off in head C of a fitted tie seen by three heads (with two, either ray
   // could be the wrong one: no test can tell them apart).
   std::map<int, int> rays;

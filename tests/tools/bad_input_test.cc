@@ -132,6 +132,13 @@ std::string PushbroomArgs(const std::string& pb) {
          "/cam_out.yaml";
 }
 
+// A line of the four-head rig (`simulate --rig uav4`, 2 exposures) and `rig stitch` on it.
+std::string Uav4Line(const TempDir& d) { return SimulatedCopy(d, "uav4", "--rig uav4 --exposures 2"); }
+std::string RigStitchArgs(const std::string& line, const std::string& extra = "") {
+  return "rig stitch --camera " + line + "/rig_truth.yaml --project " + line + " " + extra +
+         " --out " + line + "/stitch.json";
+}
+
 std::string RigAnalysisArgs(const std::string& rig) {
   return "rig error-analysis --camera " + rig + "/rig_nominal.yaml --limits " + std::string(AEROCAL_CONFIGS_DIR) +
          "/rig_dual_lens_limits.yaml --no-plots --out " + rig + "/ea";
@@ -747,6 +754,51 @@ const std::vector<Case>& Cases() {
          return RigAnalysisArgs(rig);
        },
        2, "rig_nominal.yaml:30: lever_arm_sigma_m must be > 0", "rig/ea"},
+      // ---- rig stitch (issue 16) ----
+      {"rig_stitch_exposure_without_z_ref",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         SetField(line + "/exposures.csv", 3, 17, "");
+         return RigStitchArgs(line);
+       },
+       2, "exposures.csv:3: image 0002 has no z_ref", "uav4/stitch.json"},
+      {"rig_stitch_z_ref_above_the_rig",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         SetField(line + "/exposures.csv", 2, 17, "9000");
+         return RigStitchArgs(line);
+       },
+       2, "exposures.csv:2: image 0001: z_ref (9000 m) must lie below the rig centre Z",
+       "uav4/stitch.json"},
+      {"rig_stitch_head_not_in_the_camera",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         ReplaceFirst(line + "/rig_truth.yaml", "- id: D", "- id: E");
+         return RigStitchArgs(line);
+       },
+       2, "observations.csv:27: head 'D' is not a head of", "uav4/stitch.json"},
+      {"rig_stitch_unknown_mode",
+       [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--mode fast"); },
+       2, "--mode must be line, per-exposure or angles (got 'fast')", "uav4/stitch.json"},
+      {"rig_stitch_relief_above_the_height",
+       [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--relief-m 400"); },
+       2, "--relief-m must be within [0, ", "uav4/stitch.json"},
+      {"rig_stitch_increment_sigma_zero",
+       [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--increment-sigma-arcsec 0"); },
+       2, "--increment-sigma-arcsec must be > 0", "uav4/stitch.json"},
+      {"rig_stitch_dt_sigma_negative",
+       [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--dt-sigma-ms -1"); },
+       2, "--dt-sigma-ms must be > 0", "uav4/stitch.json"},
+      {"rig_stitch_alpha_one",
+       [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--alpha 1"); },
+       2, "--alpha must be within (0, 1)", "uav4/stitch.json"},
+      {"rig_stitch_rig_orientation_not_level",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         ReplaceFirst(line + "/rig_truth.yaml", "orientation: level", "orientation: rig");
+         return RigStitchArgs(line);
+       },
+       2, "rig_truth.yaml: virtual.orientation must be level for rig stitch", "uav4/stitch.json"},
       {"certificate_of_a_broken_json",
        [](const TempDir& d) {
          Write(d.File("r.json"), "{\"schema_version\": 1,\n \"values\": [1, 2\n");
