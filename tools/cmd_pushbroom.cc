@@ -1,14 +1,18 @@
 // aerocal pushbroom calibrate: calibration of a line (pushbroom) camera from cloud control points
-// (triangulation/pushbroom/line_calibration.h, module README).
+// (triangulation/pushbroom/line_calibration.h); aerocal pushbroom control: the cloud control points
+// from the line image and oriented reference frame images (cloud_control.h). Module README.
 #include <cstdio>
 #include <filesystem>
 
+#include "calib/camera/camera_io.h"
 #include "calib/camera/line_camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
 #include "triangulation/block/block_io.h"
+#include "stitch/image_io/image_io.h"
+#include "triangulation/pushbroom/cloud_control.h"
 #include "triangulation/pushbroom/line_calibration.h"
 
 namespace aerocal::tools {
@@ -68,6 +72,69 @@ int RunCalibrate(CalibrateArgs& a) {
   return result.valid && result.report.converged ? kExitOk : kExitNotConverged;
 }
 
+struct ControlArgs {
+  std::string camera, pos, line_image, reference_camera, reference_exposures, reference_images, out;
+  bool write_l1 = false;
+  int min_points = 20;
+  triangulation::CloudControlOptions options;
+};
+
+// The image of an exposure in `folder`: the id as a file name, else with .png, .tif, .jpg.
+std::string ReferenceImagePath(const std::string& folder, const triangulation::Exposure& e,
+                               const std::string& exposures_file) {
+  namespace fs = std::filesystem;
+  for (const char* ext : {"", ".png", ".tif", ".tiff", ".jpg"}) {
+    const fs::path p = fs::path(folder) / (e.image + ext);
+    if (fs::is_regular_file(p)) return p.string();
+  }
+  throw InputError(exposures_file + ":" + std::to_string(e.line) + ": no image '" + e.image +
+                   "' (.png, .tif, .jpg) in " + folder);
+}
+
+int RunControl(ControlArgs& a) {
+  CheckOutputFolder(a.out, "--out-dir");
+  a.options.Validate();
+  const calib::LineCamera camera = calib::ReadLineCamera(a.camera);
+  const auto pos = triangulation::PosTrajectory::Read(a.pos);
+  const calib::Camera reference_camera = calib::ReadCamera(a.reference_camera);
+  const auto exposures = triangulation::ReadExposures(a.reference_exposures);
+  std::vector<std::string> image_paths;
+  for (const auto& e : exposures)
+    image_paths.push_back(ReferenceImagePath(a.reference_images, e, a.reference_exposures));
+  const stitch::GrayImage line_image = stitch::ReadGrayImage(a.line_image);
+  std::vector<triangulation::ReferenceFrame> frames;
+  for (size_t k = 0; k < exposures.size(); ++k) {
+    triangulation::ReferenceFrame f;
+    f.id = exposures[k].image;
+    f.center_m = exposures[k].center_m;
+    f.opk_rad = exposures[k].opk_rad;
+    f.image = stitch::ReadGrayImage(image_paths[k]);
+    frames.push_back(std::move(f));
+  }
+  const auto result = triangulation::MakeCloudControl(camera, pos, line_image, reference_camera,
+                                                      frames, a.options);
+  namespace fs = std::filesystem;
+  fs::create_directories(a.out);
+  triangulation::WriteLineObservations((fs::path(a.out) / "observations.csv").string(), result.observations);
+  triangulation::WritePoints((fs::path(a.out) / "points.csv").string(), result.points);
+  WriteFileAtomically((fs::path(a.out) / "control.json").string(),
+                      triangulation::CloudControlToJson(result, a.options));
+  if (a.write_l1) stitch::WriteGrayImage((fs::path(a.out) / "l1.png").string(), result.l1.image);
+  std::printf("cloud control: L1 image %d x %d cells of %.3f m at Z = %.2f m, %d interest points, "
+              "%d matches, %zu control points (dropped: %d fewer than two matches, %d gross errors, "
+              "%d imprecise, %d line outliers; %d single rays removed), median match sigma %.3f px -> %s\n",
+              result.l1.grid.width, result.l1.grid.height, result.l1.grid.gsd_m, result.l1.grid.z_m,
+              result.n_interest, result.n_rays, result.points.size(), result.n_no_match,
+              result.n_gross, result.n_imprecise, result.n_line_outliers, result.n_rays_removed,
+              result.median_match_sigma_px, a.out.c_str());
+  if (int(result.points.size()) < a.min_points) {
+    std::fprintf(stderr, "warning: too_few_control_points: %zu control points (fewer than --min-points %d)\n",
+                 result.points.size(), a.min_points);
+    return kExitNotConverged;
+  }
+  return kExitOk;
+}
+
 CommandRun Setup(CLI::App& app) {
   app.require_subcommand(1);
   auto args = std::make_shared<CalibrateArgs>();
@@ -103,7 +170,49 @@ CommandRun Setup(CLI::App& app) {
   cal->add_option("--pos-sigma-deg", o.pos_sigma_deg, "POS attitude sigma where pos.csv gives none, deg");
   cal->add_option("--min-per-segment", o.min_observations_per_segment,
                   "Fewer observations between two nodes: warning few_points_per_line");
-  return [args, cal] {
+  auto control_args = std::make_shared<ControlArgs>();
+  auto& c = control_args->options;
+  CLI::App* ctl = app.add_subcommand(
+      "control",
+      "Cloud control points from the line image: L1 rectification onto the mean terrain height, "
+      "Foerstner points, matching into oriented reference frame images, forward intersection");
+  ctl->option_defaults()->always_capture_default();
+  ctl->add_option("--camera", control_args->camera, "Nominal line camera file")->required();
+  ctl->add_option("--pos", control_args->pos, "pos.csv of the line image")->required();
+  ctl->add_option("--line-image", control_args->line_image,
+                  "The line image: row = scan line, column = detector")->required();
+  ctl->add_option("--reference-camera", control_args->reference_camera,
+                  "Camera file of the reference frame images")->required();
+  ctl->add_option("--reference-exposures", control_args->reference_exposures,
+                  "exposures.csv with the oriented reference frames (the block result)")->required();
+  ctl->add_option("--reference-images", control_args->reference_images,
+                  "Folder of the reference images (named by their exposure id, .png/.tif/.jpg)")
+      ->required();
+  ctl->add_option("--out-dir", control_args->out,
+                  "Writes observations.csv, points.csv, control.json (and l1.png)")->required();
+  ctl->add_option("--mean-height-m", c.mean_height_m, "Height of the L1 rectification plane, m");
+  ctl->add_option("--gsd-m", c.gsd_m, "L1 cell size, m (0: the POS line spacing)");
+  ctl->add_option("--map-step", c.map_step_px, "Exact L1 inverse every N cells, bilinear between, 1..64");
+  ctl->add_option("--template-half", c.template_half_px, "Half size of the matching template, 3..30 px");
+  ctl->add_option("--search-px", c.search_px, "Correlation search radius, L1 cells, 0..100");
+  ctl->add_option("--min-correlation", c.min_correlation, "Minimum correlation peak, 0..1");
+  ctl->add_option("--max-interest", c.foerstner.max_points, "Strongest Foerstner points kept on the L1 image");
+  ctl->add_option("--interest-spacing", c.foerstner.suppression_px,
+                  "Foerstner non-maximum suppression window (odd), L1 cells");
+  ctl->add_option("--interest-weight", c.foerstner.weight_factor,
+                  "Foerstner threshold: weight above this times the mean weight");
+  ctl->add_option("--min-match-sigma-px", c.min_match_sigma_px, "Floor of the matching sigma, px");
+  ctl->add_option("--line-sigma-px", c.line_sigma_px, "Sigma written for the line-image observations, px");
+  ctl->add_option("--gross-error-alpha", c.gross_error_alpha, "Significance of the misclosure test");
+  ctl->add_option("--max-point-sigma-m", c.max_point_sigma_m, "Drop points less precise than this, m");
+  ctl->add_option("--line-outlier-k", c.line_outlier_k,
+                  "Line-side gross errors: off the smooth misclosure fit by more than k x 1.4826 MAD");
+  ctl->add_option("--line-outlier-min-px", c.line_outlier_min_px, "... and by more than this, px");
+  ctl->add_option("--min-points", control_args->min_points,
+                  "Fewer control points: warning too_few_control_points, exit 3");
+  ctl->add_flag("--write-l1", control_args->write_l1, "Also write the L1 image (l1.png)");
+  return [args, cal, control_args, ctl] {
+    if (ctl->parsed()) return RunControl(*control_args);
     if (cal->parsed()) return RunCalibrate(*args);
     return kExitInternal;
   };

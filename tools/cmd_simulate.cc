@@ -7,6 +7,7 @@
 #include "calib/core/error.h"
 #include "stitch/rig/rig_design.h"
 #include "tools/command_registry.h"
+#include "triangulation/pushbroom/line_images.h"
 #include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/simulation/flight_simulator.h"
 #include "triangulation/simulation/rig_flight_simulator.h"
@@ -27,6 +28,9 @@ struct SimulateArgs {
     double gnss_time_offset_ms = 0.0;
     bool pushbroom = false;
     triangulation::LineSimulationOptions line;
+    bool pushbroom_images = false;
+    std::string reference_size = "2000x1500";
+    triangulation::LineImageOptions line_images;
     bool test_field = false;
     triangulation::TestFieldOptions field;
 };
@@ -193,6 +197,23 @@ CommandRun SetupSimulate(CLI::App& app) {
   app.add_option("--detector-error-px", l.detector_error_px, "Pushbroom: size of the smooth per-detector errors, 0..100 px")->check(CLI::Range(0.0, 100.0));
   app.add_option("--node-spacing", l.node_spacing_lines, "Pushbroom: node spacing of the POS error spline, lines")->check(CLI::Range(1, 1000000));
   app.add_option("--control-noise-m", l.control_noise_m, "Pushbroom: control-point coordinate noise, 0..1000 m")->check(CLI::Range(0.0, 1e3));
+  auto* images = app.add_flag("--images", args->pushbroom_images,
+               "Pushbroom: also render the line image and a reference frame strip of a scene "
+               "textured with --texture (image mode of `pushbroom control`)");
+  app.add_option("--texture", args->line_images.texture_path,
+                 "Pushbroom --images: the photograph laid on the terrain as its texture")
+      ->needs(images);
+  app.add_option("--texture-gsd-m", args->line_images.texture_gsd_m,
+                 "Pushbroom --images: ground size of a texel (2 x 2 photo pixels), m; 0: automatic")
+      ->needs(images)->check(CLI::Range(0.0, 100.0));
+  app.add_option("--reference-size", args->reference_size,
+                 "Pushbroom --images: reference frame format WIDTHxHEIGHT px")->needs(images);
+  app.add_option("--reference-overlap", args->line_images.forward_overlap,
+                 "Pushbroom --images: forward overlap of the reference strip, 0.5..0.9")
+      ->needs(images)->check(CLI::Range(0.5, 0.9));
+  app.add_option("--grey-noise-dn", args->line_images.grey_noise_dn,
+                 "Pushbroom --images: Gaussian grey-value noise of the rendered images, DN")
+      ->needs(images)->check(CLI::Range(0.0, 100.0));
   // Flight options a rig flight takes over when given (the rig's defaults otherwise).
   using Flight = triangulation::FlightSimulationOptions;
   const std::vector<std::pair<std::string, int Flight::*>> int_options = {
@@ -217,6 +238,7 @@ CommandRun SetupSimulate(CLI::App& app) {
     for (const char* field_only : {"--planar", "--groups", "--images-per-group", "--distance-m"})
       if (app.count(field_only) > 0)
         throw ConfigError(std::string(field_only) + " applies to --test-field only");
+    if (args->pushbroom_images && !args->pushbroom) throw ConfigError("--images applies to --pushbroom only");
     if (args->pushbroom) {
       if (!args->rig.empty()) throw ConfigError("--pushbroom and --rig: choose one");
       auto& l = args->line;
@@ -231,8 +253,31 @@ CommandRun SetupSimulate(CLI::App& app) {
         if (!given("--control-noise-m")) l.control_noise_m = args->options.survey_sigma_m;
       }
       if (given("--control")) l.control_points = args->options.control_points;
+      if (args->pushbroom_images && !given("--relief-m")) l.relief_m = 20.0;
+      auto& io = args->line_images;
+      if (args->pushbroom_images) {
+        io.seed = args->seed;
+        char x = 0;
+        std::istringstream in(args->reference_size);
+        std::string rest;
+        if (!(in >> io.reference_width_px >> x >> io.reference_height_px) || x != 'x' || (in >> rest))
+          throw ConfigError("--reference-size must be WIDTHxHEIGHT (got '" + args->reference_size + "')");
+        io.Validate();
+      }
       const auto sim = triangulation::SimulateLineFlight(l);
-      triangulation::WriteLineSimulation(sim, args->out);
+      if (args->pushbroom_images) {
+        // Rendered before anything is written: a bad photograph leaves no partial output.
+        const auto rendered = triangulation::RenderLineImages(sim, l, io);
+        triangulation::WriteLineSimulation(sim, args->out);
+        triangulation::WriteLineImages(rendered, args->out);
+        std::printf("rendered a line image of %d x %zu px and %zu reference frames of %d x %d px "
+                    "(texture %.3f m per texel, mean terrain height %.2f m)\n",
+                    sim.truth.detectors, sim.pos.size(), rendered.reference_images.size(),
+                    io.reference_width_px, io.reference_height_px, rendered.texture_gsd_m,
+                    rendered.mean_height_m);
+      } else {
+        triangulation::WriteLineSimulation(sim, args->out);
+      }
       std::printf("simulated a line camera of %d detectors (3 x %d), %d lines, %zu control points, "
                   "%zu observations -> %s\n",
                   sim.truth.detectors, l.detectors_per_camera, l.lines, sim.points.size(),

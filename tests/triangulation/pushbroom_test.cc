@@ -10,6 +10,7 @@
 #include "calib/core/error.h"
 #include "tests/support/test_support.h"
 #include "triangulation/pushbroom/line_calibration.h"
+#include "triangulation/pushbroom/line_rectification.h"
 #include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
 
@@ -91,6 +92,49 @@ LineCalibrationResult Calibrate(const LineSimulation& sim, const LineCalibration
   const PosTrajectory pos = PosTrajectory::FromRecords(sim.pos, "pos.csv");
   return CalibrateLineCamera(sim.nominal, pos, sim.observations, sim.points, options,
                              "observations.csv");
+}
+
+// The L1 maps (cell -> line-image position) invert the projection: at every cell the point of the
+// plane, projected at the mapped line, falls on the mapped detector. Exact at the nodes (Newton to
+// 1e-10, stored as float), bilinear between them: the curvature of the across-track projection
+// over 8 cells (~ h^2 f''/8 with f'' ~ 2 tan(30 deg) gsd / H per cell) gives ~0.02 px there. The
+// cloud control does not depend on it: an observation is the map value of its L1 cell, whose grey
+// value was resampled from exactly there.
+TEST(L1Rectification, MapsInvertTheProjection) {
+  LineSimulationOptions o = SmallFlight();
+  const LineSimulation sim = SimulateLineFlight(o);
+  const PosTrajectory pos = PosTrajectory::FromRecords(sim.pos, "pos.csv");
+  const L1Grid grid = MakeL1Grid(sim.nominal, pos, 5.0, 0.0);
+  Eigen::MatrixXf detector, line;
+  ComputeL1Maps(sim.nominal, pos, grid, 8, &detector, &line);
+  double worst_node_px = 0, worst_px = 0;
+  int valid = 0;
+  for (int row = 0; row < grid.height; row += 3)
+    for (int col = 0; col < grid.width; col += 3) {
+      if (std::isnan(detector(row, col))) continue;
+      ++valid;
+      Eigen::Vector2d xy;
+      ASSERT_TRUE(ProjectAtLine(sim.nominal, pos, line(row, col), grid.Ground(col, row), &xy));
+      const double e = (xy - sim.nominal.DetectorPosition(detector(row, col))).norm() / sim.nominal.pitch_mm;
+      worst_px = std::max(worst_px, e);
+      if (row % 8 == 0 && col % 8 == 0) worst_node_px = std::max(worst_node_px, e);
+    }
+  EXPECT_GT(valid, grid.width * grid.height / 9 / 2);  // the swath fills most of its bounding box
+  // Nodes: float storage of indices ~1000 and the half-detector extension beyond the outer
+  // detectors (linear in the solver) limit them to a few 1e-4 px.
+  EXPECT_LT(worst_node_px, 1e-3);
+  EXPECT_LT(worst_px, 0.05);
+  // A flat image stays flat; a ramp in the detector index is resampled to the map's values.
+  stitch::GrayImage ramp(int(sim.pos.size()), sim.nominal.detectors);
+  for (int r = 0; r < ramp.rows(); ++r)
+    for (int c = 0; c < ramp.cols(); ++c) ramp(r, c) = float(c);
+  const L1Image l1 = RectifyLineImage(sim.nominal, pos, ramp, 5.0, 0.0, 8);
+  double worst_grey = 0;
+  for (int row = 0; row < l1.grid.height; ++row)
+    for (int col = 0; col < l1.grid.width; ++col)
+      if (l1.Valid(col, row)) worst_grey = std::max(worst_grey, double(std::abs(l1.image(row, col) - l1.detector_map(row, col))));
+  EXPECT_LT(worst_grey, 1e-3);
+  std::printf("L1 maps: %d cells checked, worst %.2e px (nodes %.2e px)\n", valid, worst_px, worst_node_px);
 }
 
 TEST(LineCalibration, NoiseFreeRecoversTheTableAndTheTrajectoryExactly) {

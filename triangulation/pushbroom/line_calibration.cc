@@ -4,12 +4,14 @@
 #include <cmath>
 #include <map>
 #include <set>
+#include <sstream>
 #include <tuple>
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <nlohmann/json.hpp>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
@@ -70,6 +72,15 @@ bool ProjectAtLine(const calib::LineCamera& camera, const PosTrajectory& pos, do
   if (!(v.z() < 0)) return false;
   *xy = Eigen::Vector2d(-camera.c_mm * v.x() / v.z(), -camera.c_mm * v.y() / v.z());
   return true;
+}
+
+void WriteLineObservations(const std::string& path, const std::vector<LineObservation>& observations) {
+  std::ostringstream out;
+  out << "image,point,col,row,sigma_px\n";
+  for (const auto& o : observations)
+    out << "strip," << o.point << "," << FormatNumber(o.detector, 17) << ","
+        << FormatNumber(o.line, 17) << "," << FormatNumber(o.sigma_px) << "\n";
+  WriteFileAtomically(path, out.str());
 }
 
 std::vector<LineObservation> ReadLineObservations(const std::string& path, double default_sigma_px) {

@@ -104,6 +104,9 @@ bool ProjectAtLine(const calib::LineCamera& camera, const PosTrajectory& traject
 /// ignored: one strip): col = detector position, row = scan line.
 std::vector<LineObservation> ReadLineObservations(const std::string& path, double default_sigma_px);
 
+/// Writes observations.csv (`image,point,col,row,sigma_px`, image "strip"; full precision).
+void WriteLineObservations(const std::string& path, const std::vector<LineObservation>& observations);
+
 LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
                                           const PosTrajectory& pos,
                                           const std::vector<LineObservation>& observations,

@@ -11,6 +11,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/residuals/line_collinearity.h"
+#include "triangulation/pushbroom/line_rectification.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -18,52 +19,11 @@ namespace {
 constexpr double kDeg = M_PI / 180.0;
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
-// Detector position (i, line) of `point` in sub-camera s: Newton on the focal-plane misclosure.
-bool ImageOfPoint(const calib::LineCamera& cam, const PosTrajectory& truth, int s, double t0,
-                  const Eigen::Vector3d& point, double* detector, double* line) {
-  const auto& sub = cam.subcameras[s];
-  Eigen::Vector2d xy;
-  if (!ProjectAtLine(cam, truth, t0, point, &xy)) return false;
-  // Start: the design detector nearest in x.
-  double best = 1e300;
-  double i = sub.first;
-  for (int k = sub.first; k <= sub.last; ++k) {
-    const double d = std::abs(cam.DesignPosition(k).x() - xy.x());
-    if (d < best) best = d, i = k;
-  }
-  double t = t0;
-  auto detector_at = [&](double di) {
-    // The position within sub-camera s (its polynomial, its design), also just beyond its ends.
-    const double clamped = std::max<double>(sub.first, std::min<double>(sub.last, di));
-    const Eigen::Vector2d at_clamped = cam.DetectorPosition(clamped);
-    if (clamped == di) return at_clamped;
-    const double h = di > clamped ? -1e-3 : 1e-3;
-    const Eigen::Vector2d slope = (cam.DetectorPosition(clamped + h) - at_clamped) / h;
-    return Eigen::Vector2d(at_clamped + slope * (di - clamped));
-  };
-  for (int iteration = 0; iteration < 50; ++iteration) {
-    if (!truth.CoversLine(t) || !truth.CoversLine(t + 1e-3) || !truth.CoversLine(t - 1e-3))
-      return false;
-    Eigen::Vector2d p0, pt;
-    if (!ProjectAtLine(cam, truth, t, point, &p0)) return false;
-    const Eigen::Vector2d f = p0 - detector_at(i);
-    if (!ProjectAtLine(cam, truth, t + 1e-3, point, &pt)) return false;
-    Eigen::Matrix2d j;
-    j.col(0) = -(detector_at(i + 1e-3) - detector_at(i - 1e-3)) / 2e-3;
-    j.col(1) = (pt - p0) / 1e-3;
-    const Eigen::Vector2d step = j.fullPivLu().solve(-f);
-    i += step.x();
-    t += step.y();
-    if (step.norm() < 1e-12) break;
-    if (iteration == 49) return false;
-  }
-  if (!(i >= sub.first - 0.5 && i <= sub.last + 0.5)) return false;
-  *detector = i;
-  *line = t;
-  return true;
-}
-
 }  // namespace
+
+double SimulatedTerrainHeight(const LineSimulationOptions& o, double x_m, double y_m) {
+  return 0.5 * o.relief_m * std::sin(x_m / 170.0 + 0.3) * std::cos(y_m / 230.0 - 0.2);
+}
 
 void LineSimulationOptions::Validate() const {
   auto require = [](bool ok, const std::string& message) {
@@ -170,9 +130,7 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
 
   // Terrain and cloud control points in the swath.
   const double half_swath = o.height_m * std::tan(1.5 * o.tilt_deg * kDeg + half_field_rad * 0.3);
-  auto terrain = [&](double x, double y) {
-    return 0.5 * o.relief_m * std::sin(x / 170.0 + 0.3) * std::cos(y / 230.0 - 0.2);
-  };
+  auto terrain = [&](double x, double y) { return SimulatedTerrainHeight(o, x, y); };
   int placed = 0;
   for (int attempt = 0; placed < o.control_points && attempt < 20 * o.control_points + 100; ++attempt) {
     const double y = (0.02 + 0.96 * uniform(rng)) * length;
@@ -182,7 +140,7 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     std::vector<LineObservation> seen;
     for (int s = 0; s < 3; ++s) {
       double i = 0, t = 0;
-      if (!ImageOfPoint(sim.truth, truth, s, t0, ground, &i, &t)) continue;
+      if (!SubcameraPixelOfPoint(sim.truth, truth, s, t0, ground, &i, &t)) continue;
       if (!(t >= 1 && t <= o.lines - 2)) continue;
       LineObservation obs;
       obs.detector = i + o.image_noise_px * normal(rng);
@@ -224,14 +182,7 @@ void WriteLineSimulation(const LineSimulation& sim, const std::string& folder) {
   calib::WriteLineCamera(path("camera_truth.yaml"), sim.truth);
   WritePos(path("pos.csv"), sim.pos);
   WritePos(path("pos_truth.csv"), sim.pos_truth);
-  {
-    std::ostringstream out;
-    out << "image,point,col,row,sigma_px\n";
-    for (const auto& o : sim.observations)
-      out << "strip," << o.point << "," << FormatNumber(o.detector, 17) << ","
-          << FormatNumber(o.line, 17) << "," << FormatNumber(o.sigma_px) << "\n";
-    WriteFileAtomically(path("observations.csv"), out.str());
-  }
+  WriteLineObservations(path("observations.csv"), sim.observations);
   for (int truth = 0; truth < 2; ++truth) {
     std::ostringstream out;
     out << "point,X,Y,Z,sX,sY,sZ,role\n";

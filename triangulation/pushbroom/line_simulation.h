@@ -63,6 +63,9 @@ struct LineSimulation {
 
 LineSimulation SimulateLineFlight(const LineSimulationOptions& options);
 
+/// The terrain height (m) of the simulation at (X, Y): a smooth wave of `relief_m` peak to peak.
+double SimulatedTerrainHeight(const LineSimulationOptions& options, double x_m, double y_m);
+
 /// Writes camera_nominal.yaml, camera_truth.yaml, pos.csv, pos_truth.csv, observations.csv,
 /// points.csv, points_truth.csv, truth_detectors.csv (i,subcamera,dx_mm,dy_mm) and
 /// truth_trajectory.csv (line,dX,dY,dZ,domega,dphi,dkappa in m, deg) into `folder`.

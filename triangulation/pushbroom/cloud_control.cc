@@ -1,0 +1,330 @@
+#include "triangulation/pushbroom/cloud_control.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
+#include <nlohmann/json.hpp>
+
+#include "calib/core/error.h"
+#include "triangulation/adjustment/forward_intersection.h"
+#include "triangulation/calibration/calibration.h"
+
+#include <Eigen/QR>
+
+namespace aerocal::triangulation {
+namespace {
+
+struct Ray2 {
+  int frame = 0;
+  Eigen::Vector2d pixel;
+  Eigen::Matrix2d weight;  // inverse covariance, px^-2
+};
+
+// Normalised cross-correlation search: the template of `l1` at p against the reference image
+// resampled through the affine t0 + a0 x; returns the best integer shift (L1 cells) and its
+// correlation.
+bool SearchCorrelation(const stitch::GrayImage& l1, const Eigen::Vector2i& p,
+                       const stitch::GrayImage& b, const Eigen::Vector2d& t0,
+                       const Eigen::Matrix2d& a0, int h, int s, Eigen::Vector2i* shift,
+                       double* best) {
+  const int n = 2 * (h + s) + 1, m = 2 * h + 1;
+  Eigen::MatrixXd window(n, n);
+  for (int v = 0; v < n; ++v)
+    for (int u = 0; u < n; ++u) {
+      const Eigen::Vector2d q = t0 + a0 * Eigen::Vector2d(u - h - s, v - h - s);
+      const float g = SampleBilinear(b, q.x(), q.y());
+      if (std::isnan(g)) return false;
+      window(v, u) = g;
+    }
+  Eigen::MatrixXd tmpl(m, m);
+  for (int y = 0; y < m; ++y)
+    for (int x = 0; x < m; ++x) tmpl(y, x) = l1(p.y() + y - h, p.x() + x - h);
+  tmpl.array() -= tmpl.mean();
+  const double t_norm = tmpl.norm();
+  if (!(t_norm > 0)) return false;
+  *best = -2;
+  for (int sy = 0; sy <= 2 * s; ++sy)
+    for (int sx = 0; sx <= 2 * s; ++sx) {
+      const auto patch = window.block(sy, sx, m, m);
+      const double mean = patch.mean();
+      const double norm = std::sqrt(std::max(0.0, patch.squaredNorm() - m * m * mean * mean));
+      if (!(norm > 0)) continue;
+      const double r = (patch.array() * tmpl.array()).sum() / (norm * t_norm);
+      if (r > *best) *best = r, *shift = Eigen::Vector2i(sx - s, sy - s);
+    }
+  return *best > -2;
+}
+
+// Weighted intersection of the rays (Gauss-Newton on the pixel misclosures from a least-squares
+// ray intersection); returns v^T P v and N^-1 and the per-ray v^T P v.
+bool Intersect(const calib::Camera& camera, const std::vector<ReferenceFrame>& frames,
+               const std::vector<Ray2>& rays, Eigen::Vector3d* point, Eigen::Matrix3d* cov,
+               double* vtpv, std::vector<double>* per_ray) {
+  std::vector<ImageRay> lines;
+  for (const auto& r : rays)
+    lines.push_back(RayFromPixel(camera, frames[r.frame].opk_rad, frames[r.frame].center_m, r.pixel));
+  const auto start = IntersectRays(lines);
+  if (!start) return false;
+  Eigen::Vector3d x = *start;
+  Eigen::Matrix3d n;
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    n.setZero();
+    Eigen::Vector3d rhs = Eigen::Vector3d::Zero();
+    for (const auto& r : rays) {
+      const auto& f = frames[r.frame];
+      Eigen::Vector2d p0;
+      if (!camera.ProjectToPixel(f.opk_rad, f.center_m, x, &p0)) return false;
+      Eigen::Matrix<double, 2, 3> j;
+      for (int a = 0; a < 3; ++a) {
+        Eigen::Vector3d xa = x;
+        xa[a] += 1e-3;
+        Eigen::Vector2d pa;
+        if (!camera.ProjectToPixel(f.opk_rad, f.center_m, xa, &pa)) return false;
+        j.col(a) = (pa - p0) / 1e-3;
+      }
+      n += j.transpose() * r.weight * j;
+      rhs += j.transpose() * r.weight * (r.pixel - p0);
+    }
+    const Eigen::Vector3d dx = n.ldlt().solve(rhs);
+    if (!dx.allFinite()) return false;
+    x += dx;
+    if (dx.norm() < 1e-6) break;
+  }
+  *vtpv = 0;
+  per_ray->clear();
+  for (const auto& r : rays) {
+    const auto& f = frames[r.frame];
+    Eigen::Vector2d p0;
+    if (!camera.ProjectToPixel(f.opk_rad, f.center_m, x, &p0)) return false;
+    const Eigen::Vector2d v = r.pixel - p0;
+    per_ray->push_back(v.dot(r.weight * v));
+    *vtpv += per_ray->back();
+  }
+  *point = x;
+  *cov = n.inverse();
+  return cov->allFinite();
+}
+
+// Gross errors of the line-image side: the misclosure (observation - projection of the point
+// through the nominal camera and the POS, px) is smooth in the detector index (the calibration;
+// the POS error adds ~ its own size), so per sub-camera and axis a degree-5 polynomial in the
+// normalised index is fitted robustly (3 rounds: least squares, then drop |v| > k 1.4826 MAD,
+// at least min_px); returns the indices to keep.
+std::vector<bool> SmoothMisclosureInliers(const calib::LineCamera& camera, const PosTrajectory& pos,
+                                          const std::vector<LineObservation>& obs,
+                                          const std::vector<GroundPoint>& points, double k,
+                                          double min_px, int* rejected) {
+  std::vector<bool> keep(obs.size(), true);
+  std::vector<Eigen::Vector2d> v(obs.size());
+  for (size_t n = 0; n < obs.size(); ++n) {
+    Eigen::Vector2d xy;
+    if (!ProjectAtLine(camera, pos, obs[n].line, *points[n].xyz_m, &xy)) {
+      keep[n] = false;
+      continue;
+    }
+    // Across: focal-plane x against the detector's design x; along: y against 0 (mm -> px).
+    v[n] = (camera.DetectorPosition(obs[n].detector) - xy) / camera.pitch_mm;
+  }
+  const auto ranges = camera.Ranges();
+  for (size_t s = 0; s < ranges.size(); ++s) {
+    const double first = ranges[s].first, last = ranges[s].second;
+    std::vector<size_t> mine;
+    for (size_t n = 0; n < obs.size(); ++n)
+      if (keep[n] && camera.SubcameraOf(obs[n].detector) == int(s)) mine.push_back(n);
+    for (int axis = 0; axis < 2; ++axis)
+      for (int round = 0; round < 3; ++round) {
+        std::vector<size_t> in;
+        for (size_t n : mine)
+          if (keep[n]) in.push_back(n);
+        const int terms = std::min<int>(6, int(in.size()) / 4);
+        if (terms < 1) break;
+        Eigen::MatrixXd a(in.size(), terms);
+        Eigen::VectorXd b(in.size());
+        for (size_t r = 0; r < in.size(); ++r) {
+          const double u = last > first ? (2 * obs[in[r]].detector - first - last) / (last - first) : 0;
+          for (int t = 0; t < terms; ++t) a(r, t) = std::pow(u, t);
+          b[r] = v[in[r]][axis];
+        }
+        const Eigen::VectorXd coef = a.colPivHouseholderQr().solve(b);
+        const Eigen::VectorXd res = b - a * coef;
+        std::vector<double> abs_res(res.size());
+        for (int r = 0; r < res.size(); ++r) abs_res[r] = std::abs(res[r]);
+        std::nth_element(abs_res.begin(), abs_res.begin() + abs_res.size() / 2, abs_res.end());
+        const double limit = std::max(min_px, k * 1.4826 * abs_res[abs_res.size() / 2]);
+        bool changed = false;
+        for (size_t r = 0; r < in.size(); ++r)
+          if (std::abs(res[r]) > limit) keep[in[r]] = false, changed = true, ++*rejected;
+        if (!changed) break;
+      }
+  }
+  return keep;
+}
+
+}  // namespace
+
+void CloudControlOptions::Validate() const {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw ConfigError(message);
+  };
+  require(gsd_m >= 0, "--gsd-m must be >= 0 (0: the line spacing)");
+  require(map_step_px >= 1 && map_step_px <= 64, "--map-step must be within 1 .. 64");
+  require(template_half_px >= 3 && template_half_px <= 30, "--template-half must be within 3 .. 30");
+  require(search_px >= 0 && search_px <= 100, "--search-px must be within 0 .. 100");
+  require(min_correlation >= 0 && min_correlation <= 1, "--min-correlation must be within 0 .. 1");
+  require(min_match_sigma_px > 0, "--min-match-sigma-px must be > 0");
+  require(line_sigma_px > 0, "--line-sigma-px must be > 0");
+  require(gross_error_alpha > 0 && gross_error_alpha < 0.5, "--gross-error-alpha must be within (0, 0.5)");
+  require(max_point_sigma_m > 0, "--max-point-sigma-m must be > 0");
+  require(line_outlier_k > 0 && line_outlier_min_px > 0, "--line-outlier-k and --line-outlier-min-px must be > 0");
+  foerstner.Validate();
+  lsm.Validate();
+}
+
+CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTrajectory& pos,
+                                    const stitch::GrayImage& line_image,
+                                    const calib::Camera& ref_camera,
+                                    const std::vector<ReferenceFrame>& frames,
+                                    const CloudControlOptions& o) {
+  o.Validate();
+  if (line_image.cols() != camera.detectors)
+    throw InputError("the line image has " + std::to_string(line_image.cols()) +
+                     " columns, the camera " + std::to_string(camera.detectors) + " detectors");
+  for (const auto& f : frames)
+    if (f.image.cols() != ref_camera.width_px || f.image.rows() != ref_camera.height_px)
+      throw InputError(f.id + ": image is " + std::to_string(f.image.cols()) + " x " +
+                       std::to_string(f.image.rows()) + " px, the reference camera " +
+                       std::to_string(ref_camera.width_px) + " x " + std::to_string(ref_camera.height_px));
+  CloudControlResult out;
+  out.l1 = RectifyLineImage(camera, pos, line_image, o.mean_height_m, o.gsd_m, o.map_step_px);
+  const L1Image& l1 = out.l1;
+  const auto interest = stitch::DetectFoerstner(l1.image, o.foerstner);
+  const int h = o.template_half_px;
+  stitch::LsmOptions lsm = o.lsm;
+  lsm.half_size_px = h;
+  std::vector<double> match_sigmas;
+  for (const auto& ip : interest) {
+    const Eigen::Vector2i p(int(std::lround(ip.position.x())), int(std::lround(ip.position.y())));
+    // The template and a margin must lie on valid cells.
+    const int r = h + 2;
+    if (p.x() < r || p.y() < r || p.x() >= l1.grid.width - r || p.y() >= l1.grid.height - r) continue;
+    bool valid = true;
+    for (int y = -r; y <= r && valid; ++y)
+      for (int x = -r; x <= r && valid; ++x) valid = l1.Valid(p.x() + x, p.y() + y);
+    if (!valid) continue;
+    ++out.n_interest;
+    const Eigen::Vector3d g0 = l1.grid.Ground(p.x(), p.y());
+    std::vector<Ray2> rays;
+    for (size_t k = 0; k < frames.size(); ++k) {
+      const auto& f = frames[k];
+      Eigen::Vector2d t0, tx, ty;
+      if (!ref_camera.ProjectToPixel(f.opk_rad, f.center_m, g0, &t0) ||
+          !ref_camera.ProjectToPixel(f.opk_rad, f.center_m, g0 + Eigen::Vector3d(l1.grid.gsd_m, 0, 0), &tx) ||
+          !ref_camera.ProjectToPixel(f.opk_rad, f.center_m, g0 + Eigen::Vector3d(0, l1.grid.gsd_m, 0), &ty))
+        continue;
+      Eigen::Matrix2d a0;
+      a0.col(0) = tx - t0;
+      a0.col(1) = ty - t0;
+      const double reach = (h + o.search_px + 3) * a0.cwiseAbs().rowwise().sum().maxCoeff();
+      if (!(t0.x() > reach && t0.y() > reach && t0.x() < f.image.cols() - 1 - reach &&
+            t0.y() < f.image.rows() - 1 - reach))
+        continue;
+      Eigen::Vector2i shift = Eigen::Vector2i::Zero();
+      double ncc = 0;
+      if (!SearchCorrelation(l1.image, p, f.image, t0, a0, h, o.search_px, &shift, &ncc)) continue;
+      if (ncc < o.min_correlation) continue;
+      const auto m = stitch::MatchLeastSquares(l1.image, p, f.image,
+                                               t0 + a0 * shift.cast<double>(), a0, lsm);
+      if (!m.ok()) continue;
+      match_sigmas.push_back(m.SigmaMaxPx());
+      Ray2 ray;
+      ray.frame = int(k);
+      ray.pixel = m.position_in_b;
+      ray.weight = (m.cov_px2 + o.min_match_sigma_px * o.min_match_sigma_px * Eigen::Matrix2d::Identity()).inverse();
+      rays.push_back(ray);
+      ++out.n_rays;
+    }
+    if (rays.size() < 2) {
+      ++out.n_no_match;
+      continue;
+    }
+    Eigen::Vector3d x;
+    Eigen::Matrix3d cov;
+    double vtpv = 0;
+    std::vector<double> per_ray;
+    bool accepted = false;
+    while (rays.size() >= 2) {
+      if (!Intersect(ref_camera, frames, rays, &x, &cov, &vtpv, &per_ray)) break;
+      const int dof = 2 * int(rays.size()) - 3;
+      if (vtpv <= ChiSquareQuantile(1.0 - o.gross_error_alpha, dof)) {
+        accepted = true;
+        break;
+      }
+      rays.erase(rays.begin() + (std::max_element(per_ray.begin(), per_ray.end()) - per_ray.begin()));
+      ++out.n_rays_removed;
+    }
+    if (!accepted) {
+      ++out.n_gross;
+      continue;
+    }
+    const Eigen::Vector3d sigma = cov.diagonal().cwiseSqrt();
+    if (!(sigma.maxCoeff() <= o.max_point_sigma_m)) {
+      ++out.n_imprecise;
+      continue;
+    }
+    GroundPoint point;
+    point.id = "cc" + std::to_string(out.points.size() + 1);
+    point.role = PointRole::kControl;
+    point.xyz_m = x;
+    point.sigma_m = sigma;
+    LineObservation obs;
+    obs.point = point.id;
+    obs.detector = l1.detector_map(p.y(), p.x());
+    obs.line = l1.line_map(p.y(), p.x());
+    obs.sigma_px = o.line_sigma_px;
+    obs.source_line = int(out.observations.size()) + 2;
+    out.points.push_back(point);
+    out.observations.push_back(obs);
+  }
+  {
+    const auto keep = SmoothMisclosureInliers(camera, pos, out.observations, out.points,
+                                              o.line_outlier_k, o.line_outlier_min_px, &out.n_line_outliers);
+    std::vector<LineObservation> observations;
+    std::vector<GroundPoint> points;
+    for (size_t n = 0; n < keep.size(); ++n)
+      if (keep[n]) {
+        observations.push_back(out.observations[n]);
+        points.push_back(out.points[n]);
+      }
+    out.observations = std::move(observations);
+    out.points = std::move(points);
+  }
+  if (!match_sigmas.empty()) {
+    std::nth_element(match_sigmas.begin(), match_sigmas.begin() + match_sigmas.size() / 2, match_sigmas.end());
+    out.median_match_sigma_px = match_sigmas[match_sigmas.size() / 2];
+  }
+  return out;
+}
+
+std::string CloudControlToJson(const CloudControlResult& r, const CloudControlOptions& o) {
+  nlohmann::json j;
+  j["kind"] = "pushbroom_control";
+  j["l1"] = {{"width", r.l1.grid.width}, {"height", r.l1.grid.height}, {"gsd_m", r.l1.grid.gsd_m},
+             {"z_m", r.l1.grid.z_m}, {"x0_m", r.l1.grid.x0_m}, {"y0_m", r.l1.grid.y0_m}};
+  j["n_interest"] = r.n_interest;
+  j["n_rays"] = r.n_rays;
+  j["n_points"] = r.points.size();
+  j["rejected"] = {{"fewer_than_two_matches", r.n_no_match}, {"gross_error", r.n_gross},
+                   {"imprecise", r.n_imprecise}, {"rays_removed", r.n_rays_removed},
+                   {"line_outliers", r.n_line_outliers}};
+  j["median_match_sigma_px"] = r.median_match_sigma_px;
+  j["options"] = {{"mean_height_m", o.mean_height_m}, {"map_step_px", o.map_step_px},
+                  {"template_half_px", o.template_half_px}, {"search_px", o.search_px},
+                  {"min_correlation", o.min_correlation}, {"min_match_sigma_px", o.min_match_sigma_px},
+                  {"line_sigma_px", o.line_sigma_px}, {"gross_error_alpha", o.gross_error_alpha},
+                  {"max_point_sigma_m", o.max_point_sigma_m}};
+  return j.dump(2) + "\n";
+}
+
+}  // namespace aerocal::triangulation

@@ -1,0 +1,170 @@
+#include "triangulation/pushbroom/line_images.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
+
+#include "calib/camera/camera_io.h"
+#include "calib/camera/rotation.h"
+#include "calib/core/error.h"
+#include "stitch/image_io/image_io.h"
+#include "triangulation/adjustment/forward_intersection.h"
+#include "triangulation/block/block_io.h"
+#include "triangulation/pushbroom/line_rectification.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+// The photograph on the ground: texel (u, v) at X = x_c + (u - W/2) gsd, Y = y_c - (v - H/2) gsd,
+// mirrored beyond the edges.
+struct Texture {
+  stitch::GrayImage texels;
+  double x_c = 0, y_c = 0, gsd_m = 1;
+  static double Mirror(double u, int n) {
+    const double period = 2.0 * (n - 1);
+    double m = std::fmod(u, period);
+    if (m < 0) m += period;
+    return m <= n - 1 ? m : period - m;
+  }
+  float At(double x, double y) const {
+    const double u = Mirror((x - x_c) / gsd_m + 0.5 * texels.cols(), int(texels.cols()));
+    const double v = Mirror((y_c - y) / gsd_m + 0.5 * texels.rows(), int(texels.rows()));
+    return SampleBilinear(texels, u, v);
+  }
+};
+
+stitch::GrayImage AverageTwoByTwo(const stitch::GrayImage& photo) {
+  stitch::GrayImage out(photo.rows() / 2, photo.cols() / 2);
+  for (int r = 0; r < out.rows(); ++r)
+    for (int c = 0; c < out.cols(); ++c)
+      out(r, c) = 0.25f * (photo(2 * r, 2 * c) + photo(2 * r, 2 * c + 1) + photo(2 * r + 1, 2 * c) +
+                           photo(2 * r + 1, 2 * c + 1));
+  return out;
+}
+
+}  // namespace
+
+void LineImageOptions::Validate() const {
+  auto require = [](bool ok, const std::string& message) {
+    if (!ok) throw ConfigError(message);
+  };
+  require(!texture_path.empty(), "--texture: the photograph of the scene is required with --images");
+  require(texture_gsd_m >= 0, "--texture-gsd-m must be >= 0");
+  require(reference_width_px >= 100 && reference_width_px <= 20000 && reference_height_px >= 100 &&
+              reference_height_px <= 20000,
+          "the reference image format must be within 100 .. 20000 px");
+  require(reference_pixel_mm > 0 && reference_gsd_m >= 0, "reference pixel > 0, GSD >= 0");
+  require(forward_overlap >= 0.5 && forward_overlap <= 0.9, "--reference-overlap must be within 0.5 .. 0.9");
+  require(grey_noise_dn >= 0, "--grey-noise-dn must be >= 0");
+}
+
+LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimulationOptions& o,
+                                     const LineImageOptions& io) {
+  io.Validate();
+  const auto terrain = [&o](double x, double y) { return SimulatedTerrainHeight(o, x, y); };
+  const PosTrajectory truth = PosTrajectory::FromRecords(sim.pos_truth, "pos_truth.csv");
+  const calib::LineCamera& cam = sim.truth;
+  const int lines = int(sim.pos_truth.size());
+  std::mt19937_64 rng(io.seed * 7919 + 13);
+  std::normal_distribution<double> noise(0.0, 1.0);
+  LineImageSimulation out;
+
+  // Scene extent: the footprint of the first and last lines and of the outer detectors.
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo;
+  double height_sum = 0;
+  int height_n = 0;
+  for (int k = 0; k <= 32; ++k) {
+    const double line = (lines - 1) * k / 32.0;
+    for (double i : {0.0, 0.5 * (cam.detectors - 1), cam.detectors - 1.0}) {
+      const auto g = GroundOfDetector(cam, truth, i, line, terrain);
+      if (!g) throw Error("image mode: a detector ray misses the terrain");
+      lo = lo.cwiseMin(g->head<2>());
+      hi = hi.cwiseMax(g->head<2>());
+      height_sum += g->z(), ++height_n;
+    }
+  }
+  out.mean_height_m = height_sum / height_n;
+  const double line_spacing_m =
+      (sim.pos_truth.back().center_m - sim.pos_truth.front().center_m).head<2>().norm() /
+      std::max(1, lines - 1);
+  const double reference_gsd = io.reference_gsd_m > 0 ? io.reference_gsd_m : 0.6 * line_spacing_m;
+
+  Texture texture;
+  texture.texels = AverageTwoByTwo(stitch::ReadGrayImage(io.texture_path));
+  if (texture.texels.rows() < 16 || texture.texels.cols() < 16)
+    throw InputError(io.texture_path + ": the photograph is too small for a texture (< 32 px)");
+  texture.gsd_m = io.texture_gsd_m > 0 ? io.texture_gsd_m : 0.5 * std::min(line_spacing_m, reference_gsd);
+  texture.x_c = 0.5 * (lo.x() + hi.x());
+  texture.y_c = 0.5 * (lo.y() + hi.y());
+  out.texture_gsd_m = texture.gsd_m;
+  auto grey = [&](const Eigen::Vector3d& g) { return float(texture.At(g.x(), g.y()) + io.grey_noise_dn * noise(rng)); };
+
+  // The line image through the true camera and poses.
+  out.line_image.resize(lines, cam.detectors);
+  std::vector<Eigen::Vector3d> in_camera(cam.detectors);
+  const Eigen::Matrix3d mount = calib::RotationFromOpk(cam.mount_rad);
+  for (int i = 0; i < cam.detectors; ++i) {
+    const Eigen::Vector2d xy = cam.DetectorPosition(i);
+    in_camera[i] = mount * Eigen::Vector3d(xy.x(), xy.y(), -cam.c_mm);
+  }
+  for (int l = 0; l < lines; ++l) {
+    Eigen::Vector3d center, opk;
+    truth.PoseAtLine(l, &center, &opk);
+    const Eigen::Matrix3d body = calib::RotationFromOpk(opk);
+    const Eigen::Vector3d origin = center + body * cam.lever_arm_m;
+    for (int i = 0; i < cam.detectors; ++i) {
+      const auto g = IntersectSurface(origin, body * in_camera[i], terrain);
+      if (!g) throw Error("image mode: a detector ray misses the terrain");
+      out.line_image(l, i) = grey(*g);
+    }
+  }
+
+  // The reference strip: nadir frames along the flight's mean track at the flying height.
+  calib::Camera& ref = out.reference_camera;
+  ref.name = "pushbroom-sim reference frame camera";
+  ref.pixel_size_mm = io.reference_pixel_mm;
+  ref.width_px = io.reference_width_px;
+  ref.height_px = io.reference_height_px;
+  ref.interior.fill(0.0);
+  ref.interior[calib::Camera::Model::kC] = io.reference_pixel_mm * o.height_m / reference_gsd;
+  double x_mean = 0, z_mean = 0;
+  for (const auto& r : sim.pos_truth) x_mean += r.center_m.x(), z_mean += r.center_m.z();
+  x_mean /= lines, z_mean /= lines;
+  const double along_m = io.reference_height_px * reference_gsd;  // image rows along Y
+  const double base_m = (1 - io.forward_overlap) * along_m;
+  int k = 0;
+  for (double y = lo.y() - 0.25 * along_m; y <= hi.y() + 0.25 * along_m + base_m; y += base_m, ++k) {
+    Exposure e;
+    e.image = "ref" + std::to_string(k + 1);
+    e.camera = "reference";
+    e.center_m = Eigen::Vector3d(x_mean + 2.0 * std::sin(0.7 * k), y, z_mean + 1.5 * std::cos(0.9 * k));
+    e.opk_rad = Eigen::Vector3d(0.3 * std::sin(1.3 * k), -0.2 * std::cos(0.8 * k), 0.4 * std::sin(0.5 * k)) *
+                (M_PI / 180.0);
+    e.line = k + 2;
+    out.reference_exposures.push_back(e);
+    stitch::GrayImage image(ref.height_px, ref.width_px);
+    for (int r = 0; r < ref.height_px; ++r)
+      for (int c = 0; c < ref.width_px; ++c) {
+        const ImageRay ray = RayFromPixel(ref, e.opk_rad, e.center_m, Eigen::Vector2d(c, r));
+        const auto g = IntersectSurface(ray.center_m, ray.direction, terrain);
+        image(r, c) = g ? grey(*g) : 0.0f;
+      }
+    out.reference_images.push_back(std::move(image));
+  }
+  return out;
+}
+
+void WriteLineImages(const LineImageSimulation& images, const std::string& folder) {
+  namespace fs = std::filesystem;
+  fs::create_directories(fs::path(folder) / "reference");
+  stitch::WriteGrayImage((fs::path(folder) / "line_image.png").string(), images.line_image);
+  calib::WriteCamera((fs::path(folder) / "reference" / "camera.yaml").string(), images.reference_camera);
+  WriteExposures((fs::path(folder) / "reference" / "exposures.csv").string(), images.reference_exposures);
+  for (size_t k = 0; k < images.reference_images.size(); ++k)
+    stitch::WriteGrayImage(
+        (fs::path(folder) / "reference" / (images.reference_exposures[k].image + ".png")).string(),
+        images.reference_images[k]);
+}
+
+}  // namespace aerocal::triangulation
