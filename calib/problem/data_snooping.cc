@@ -363,6 +363,16 @@ class Snooper {
       for (ResidualId member : x->correlated)
         if (member == x->id || x->t_joint - t.observations[t.index.at(member)].t_joint <= margin)
           acted.push_back(member);
+      // Other candidates of its point the data cannot tell from it either (correlated below
+      // group_correlation, e.g. strip neighbours at 0.95): rejecting the larger alone names the
+      // good one in a share of runs and leaves the blunder on a point too weak to test it.
+      if (x->point >= 0)
+        for (const auto& y : t.observations)
+          if (y.point == x->point && y.id != x->id && y.w_max > out_.critical_value &&
+              x->t_joint - y.t_joint <= margin && !decided_.count(y.id) &&
+              !Contains(o_.report_only_groups, y.group) &&
+              std::find(acted.begin(), acted.end(), y.id) == acted.end())
+            acted.push_back(y.id);
       const std::string veto = o_.veto ? o_.veto(acted) : std::string();
       if (!veto.empty()) {
         Decide(x, SnoopingVerdict::kVetoed, veto);

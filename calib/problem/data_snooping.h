@@ -27,7 +27,10 @@
 //   along-track residuals correlate 1.000): a member whose joint statistic t_joint falls short of
 //   the candidate's by more than k^2 (likelihood ratio of "the blunder is there" below
 //   exp(-k^2 / 2), the test's own tail) is separated by the data and kept; only the members the
-//   residuals cannot separate are rejected with it.
+//   residuals cannot separate are rejected with it. Likewise every other candidate of its point
+//   (w above k) whose t_joint is within k^2 of the candidate's joins the group: correlated
+//   below group_correlation (strip neighbours at ~0.95) they swap order with the noise often
+//   enough that rejecting the larger alone names a good ray and leaves the blunder untestable.
 // - report_only_groups (e.g. surveyed control coordinates) are tested and named when they fail,
 //   never rejected: a survey that disagrees with its rays is a finding for people, and rejecting
 //   the rays instead would hide it.

@@ -261,6 +261,7 @@ void BM_ManyBlunders(benchmark::State& state) {
     int by_class[4] = {0, 0, 0, 0}, found_by_class[4] = {0, 0, 0, 0};
     double worst_rmse_ratio = 1.0, worst_rmse_ratio_controlled = 1.0, worst_camera_sigmas = 0.0;
     int invalid_runs = 0;
+    double worst_oracle_ratio = 1.0, worst_ratio_to_oracle = 1.0;
     std::map<std::string, int> invalid_by_reason;  // by the reason's words before its numbers
     for (int seed = ManyBlundersFirstSeed(); seed <= ManyBlundersSeeds(); ++seed) {
       const Seed& s = SeedData(seed);
@@ -355,6 +356,21 @@ void BM_ManyBlunders(benchmark::State& state) {
         }
       const double ratio = r.check.spatial_rmse_m / s.clean.check.spatial_rmse_m;
       worst_rmse_ratio = std::max(worst_rmse_ratio, ratio);
+      // The oracle: the blundered observations removed by hand, no snooping (what no method can
+      // beat: their information is gone). Its check RMSE over the clean run's says how much of
+      // the ratio above is the lost information, not a fault of the detection.
+      Project without = s.project;
+      without.observations.clear();
+      for (const auto& o : p.observations)
+        if (!blunders.count({o.image, o.point})) without.observations.push_back(o);
+      AdjustOptions oracle_options = SelfCalibration();
+      oracle_options.data_snooping = false;
+      oracle_options.auto_robust_start = false;
+      const AdjustmentResult oracle = Adjust(without, oracle_options);
+      worst_oracle_ratio = std::max(worst_oracle_ratio, oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m);
+      worst_ratio_to_oracle = std::max(worst_ratio_to_oracle, ratio * s.clean.check.spatial_rmse_m / oracle.check.spatial_rmse_m);
+      std::printf("seed %d: check RMSE of the oracle (blunders removed by hand) %.3f m\n", seed,
+                  oracle.check.spatial_rmse_m);
       // The check points whose rays are all controlled, in this run and in the clean one.
       const double ratio_controlled =
           r.check_controlled && s.clean.check_controlled
@@ -384,6 +400,8 @@ void BM_ManyBlunders(benchmark::State& state) {
       invalid_runs += !r.valid;
     }
     state.counters["invalid_runs"] = invalid_runs;
+    state.counters["worst_oracle_rmse_ratio"] = worst_oracle_ratio;        // oracle / clean
+    state.counters["worst_rmse_ratio_to_oracle"] = worst_ratio_to_oracle;  // this run / oracle
     for (const auto& [why, n] : invalid_by_reason) std::printf("invalid %d run(s): %s\n", n, why.c_str());
     state.counters["planted"] = planted;
     state.counters["found_share"] = static_cast<double>(found) / std::max(1, planted);
