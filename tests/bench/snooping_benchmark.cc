@@ -36,6 +36,7 @@
 #include <map>
 #include <random>
 #include <set>
+#include <tuple>
 
 namespace aerocal::triangulation {
 namespace {
@@ -261,7 +262,7 @@ void BM_ManyBlunders(benchmark::State& state) {
     int by_class[4] = {0, 0, 0, 0}, found_by_class[4] = {0, 0, 0, 0};
     double worst_rmse_ratio = 1.0, worst_rmse_ratio_controlled = 1.0, worst_camera_sigmas = 0.0;
     int invalid_runs = 0;
-    double worst_oracle_ratio = 1.0, worst_ratio_to_oracle = 1.0;
+    double worst_oracle_ratio = 1.0, worst_ratio_to_oracle = 1.0, worst_oracle_camera_sigmas = 0.0;
     std::map<std::string, int> invalid_by_reason;  // by the reason's words before its numbers
     for (int seed = ManyBlundersFirstSeed(); seed <= ManyBlundersSeeds(); ++seed) {
       const Seed& s = SeedData(seed);
@@ -377,11 +378,23 @@ void BM_ManyBlunders(benchmark::State& state) {
               ? r.check_controlled->spatial_rmse_m / s.clean.check_controlled->spatial_rmse_m
               : 0.0;
       worst_rmse_ratio_controlled = std::max(worst_rmse_ratio_controlled, ratio_controlled);
+      double camera_sigmas = 0.0, oracle_camera_sigmas = 0.0;
+      int camera_worst = 0;
       for (int k = 0; k < Model::kNumParams; ++k)
-        if (s.clean.cameras[0].sigma[k] > 0)
-          worst_camera_sigmas = std::max(
-              worst_camera_sigmas, std::abs(r.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
-                                       s.clean.cameras[0].sigma[k]);
+        if (s.clean.cameras[0].sigma[k] > 0) {
+          const double d = std::abs(r.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
+                           s.clean.cameras[0].sigma[k];
+          if (d > camera_sigmas) std::tie(camera_sigmas, camera_worst) = std::make_tuple(d, k);
+          oracle_camera_sigmas = std::max(
+              oracle_camera_sigmas,
+              std::abs(oracle.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
+                  s.clean.cameras[0].sigma[k]);
+        }
+      worst_camera_sigmas = std::max(worst_camera_sigmas, camera_sigmas);
+      worst_oracle_camera_sigmas = std::max(worst_oracle_camera_sigmas, oracle_camera_sigmas);
+      std::printf("seed %d: camera %.2f sigma from the clean run (%s); the oracle's %.2f\n", seed,
+                  camera_sigmas, std::string(Model::kParams[camera_worst].name).c_str(),
+                  oracle_camera_sigmas);
       std::printf("seed %d, %.0f %% blunders: %zu planted, robust start %s (%d excluded, %d "
                   "re-admitted, %d re-tested), %zu rejected, valid %s, check RMSE %.3f m (clean %.3f m), "
                   "controlled check points %d: %.3f m (clean %d: %.3f m)\n",
@@ -402,6 +415,7 @@ void BM_ManyBlunders(benchmark::State& state) {
     state.counters["invalid_runs"] = invalid_runs;
     state.counters["worst_oracle_rmse_ratio"] = worst_oracle_ratio;        // oracle / clean
     state.counters["worst_rmse_ratio_to_oracle"] = worst_ratio_to_oracle;  // this run / oracle
+    state.counters["worst_oracle_camera_offset_sigmas"] = worst_oracle_camera_sigmas;
     for (const auto& [why, n] : invalid_by_reason) std::printf("invalid %d run(s): %s\n", n, why.c_str());
     state.counters["planted"] = planted;
     state.counters["found_share"] = static_cast<double>(found) / std::max(1, planted);
