@@ -128,7 +128,8 @@ CommandRun SetupAdjust(CLI::App& app) {
                "image components of the first solve are above 10 sigma)");
   app.add_option("--max-rejections",
                  args->options.max_rejections,
-                 "Rejection cap of data snooping; reaching it is a warning and exit 3")
+                 "Rejection cap of data snooping; reaching it is a warning and exit 3 (default: 10 % of the "
+                 "tested image observations, at least 100)")
       ->check(CLI::PositiveNumber);
   app.add_option("--max-sigma0",
                  args->options.max_sigma0,

@@ -155,6 +155,7 @@ class Snooper {
         }
         if (r < o_.min_redundancy) x.w_weak = std::max(x.w_weak, w);
       }
+      x.t_joint = x.w_max * x.w_max;
       // An observation of several correlated components (x, y of an image point) is tested as
       // a whole: per-component w of another observation can exceed both of the blundered one's,
       // the joint statistic cannot (its non-centrality is the largest at the blunder).
@@ -203,10 +204,12 @@ class Snooper {
         if (std::isfinite(x->mdb_sigma[k])) x->mdb_sigma[k] *= out_.delta0_joint / out_.delta0;
     if (dof == 0) {
       x->w_max = 0.0;
+      x->t_joint = 0.0;
       x->component = -1;
       return;
     }
     x->w_max = EquivalentNormal(t_stat, dof);
+    x->t_joint = t_stat;
   }
 
   std::vector<ResidualId> GroupOf(const Test& t, const TestedObservation& x) const {
@@ -354,23 +357,43 @@ class Snooper {
         x->reason = "rejection cap reached";
         continue;
       }
-      const std::string veto = o_.veto ? o_.veto(x->correlated) : std::string();
+      // The members its other components separate from it stay (see the header).
+      std::vector<ResidualId> acted;
+      const double margin = out_.critical_value * out_.critical_value;
+      for (ResidualId member : x->correlated)
+        if (member == x->id || x->t_joint - t.observations[t.index.at(member)].t_joint <= margin)
+          acted.push_back(member);
+      // Other candidates of its point the data cannot tell from it either (correlated below
+      // group_correlation, e.g. strip neighbours at 0.95): rejecting the larger alone names the
+      // good one in a share of runs and leaves the blunder on a point too weak to test it.
+      if (x->point >= 0)
+        for (const auto& y : t.observations)
+          if (y.point == x->point && y.id != x->id && y.w_max > out_.critical_value &&
+              x->t_joint - y.t_joint <= margin && !decided_.count(y.id) &&
+              !Contains(o_.report_only_groups, y.group) &&
+              std::find(acted.begin(), acted.end(), y.id) == acted.end())
+            acted.push_back(y.id);
+      const std::string veto = o_.veto ? o_.veto(acted) : std::string();
       if (!veto.empty()) {
         Decide(x, SnoopingVerdict::kVetoed, veto);
         continue;
       }
       std::string reason;
-      if (x->correlated.size() > 1) {
+      if (acted.size() > 1) {
         reason = (x->point >= 0 ? b_.BlockName(x->point) : std::string("observation ")) + ": " +
-                 "one of these " + std::to_string(x->correlated.size()) +
+                 "one of these " + std::to_string(acted.size()) +
                  " observations holds a gross error; they cannot be told apart (|rho| > " +
                  Fixed(o_.group_correlation, 2) + "); all are rejected";
         out_.findings.push_back(reason + " (w = " + Fixed(x->w_max, 1) + ")");
+      } else if (x->correlated.size() > 1) {
+        reason = "its correlated group of " + std::to_string(x->correlated.size()) +
+                 " is told apart by its other components (joint statistic larger by more than " +
+                 "k^2): rejected alone";
       }
-      for (ResidualId member : x->correlated) {
+      for (ResidualId member : acted) {
         TestedObservation r = t.observations[t.index.at(member)];
-        r.correlated = x->correlated;
-        r.group_size = x->group_size;
+        r.correlated = acted;
+        r.group_size = static_cast<int>(acted.size());
         r.verdict = SnoopingVerdict::kRejected;
         r.round = round;
         r.reason = reason;

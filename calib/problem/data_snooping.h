@@ -22,6 +22,15 @@
 //   whole: all its members are rejected (the blunder is surely removed; the cost is the group's
 //   good observations, which carry no information the test could use to separate them), never
 //   one arbitrary member named as "the" gross error. The caller's veto still applies to the group.
+//   The group is that of the candidate's largest-w component; its other components can still
+//   tell the members apart (a blunder across the strip on one of three rays of a strip whose
+//   along-track residuals correlate 1.000): a member whose joint statistic t_joint falls short of
+//   the candidate's by more than k^2 (likelihood ratio of "the blunder is there" below
+//   exp(-k^2 / 2), the test's own tail) is separated by the data and kept; only the members the
+//   residuals cannot separate are rejected with it. Likewise every other candidate of its point
+//   (w above k) whose t_joint is within k^2 of the candidate's joins the group: correlated
+//   below group_correlation (strip neighbours at ~0.95) they swap order with the noise often
+//   enough that rejecting the larger alone names a good ray and leaves the blunder untestable.
 // - report_only_groups (e.g. surveyed control coordinates) are tested and named when they fail,
 //   never rejected: a survey that disagrees with its rays is a finding for people, and rejecting
 //   the rays instead would hide it.
@@ -93,6 +102,9 @@ struct TestedObservation {
   /// point's x, y) the joint chi-square test over its controlled directions (Q_ii eigenvalues
   /// >= min_redundancy) mapped to the normal w of the same tail probability; for one, its w.
   double w_max = 0.0;
+  /// The chi-square statistic behind w_max (v^T Q_ii^+ v / s^2 over the controlled directions;
+  /// w_max^2 for one component): members of a correlated group are told apart by it.
+  double t_joint = 0.0;
   int component = -1;              // its largest-w controlled component (for the group)
   double w_weak = 0.0;             // largest w of the weakly controlled components
   std::vector<ResidualId> correlated;  // with itself: observations it cannot be told apart from

@@ -52,8 +52,10 @@ TEST(AdjustOptions, SelfCalibrationListsAreCheckedAgainstTheParameterTable) {
   o.correlation_threshold = 1.5;
   EXPECT_THROW(o.Validate(), ConfigError);
   o = AdjustOptions{};
-  o.max_rejections = 0;
+  o.max_rejections = -1;
   EXPECT_THROW(o.Validate(), ConfigError);
+  o.max_rejections = 0;  // the automatic cap
+  EXPECT_NO_THROW(o.Validate());
 }
 
 }  // namespace

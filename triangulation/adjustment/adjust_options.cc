@@ -49,8 +49,9 @@ void AdjustOptions::Validate() const {
                       ")");
   if (!(max_sigma0 > 0))
     throw ConfigError("max_sigma0 must be > 0 (got " + FormatNumber(max_sigma0) + ")");
-  if (max_rejections < 1)
-    throw ConfigError("max_rejections must be > 0 (got " + std::to_string(max_rejections) + ")");
+  if (max_rejections < 0)
+    throw ConfigError("max_rejections must be >= 0 (0: 10 % of the tested observations, at least "
+                      "100; got " + std::to_string(max_rejections) + ")");
   if (!(correlation_threshold > 0 && correlation_threshold < 1))
     throw ConfigError("correlation_threshold must be in (0, 1) (got " +
                       FormatNumber(correlation_threshold) + ")");

@@ -10,10 +10,12 @@
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/sensor/frame_camera.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <set>
 
 namespace aerocal::triangulation {
@@ -25,6 +27,9 @@ using calib::BlockKind;
 
 const std::vector<std::string> kCenterNames = {"X", "Y", "Z"};
 const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
+// The automatic rejection cap (AdjustOptions::max_rejections 0): 10 % of the tested image
+// observations, at least this many.
+constexpr int kMinAutomaticCap = 100;
 // Residual group of the weighted platform parameters (lever arm, boresight, GNSS time offset).
 constexpr const char* kGroupPlatformPrior = "platform_prior";
 
@@ -448,7 +453,64 @@ void BlockAdjustment::DefineDatum() {
   storage_->datum = text;
 }
 
-std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double reject) const {
+namespace {
+
+// Whitened image residuals of `ids` with the point block (values at `xyz`) set to `at`.
+std::vector<Eigen::VectorXd> ResidualsWithPointAt(const calib::ProblemBuilder& builder,
+                                                  const std::vector<calib::ResidualId>& ids,
+                                                  Eigen::Vector3d* xyz,
+                                                  const Eigen::Vector3d& at) {
+  *xyz = at;
+  std::vector<Eigen::VectorXd> out;
+  for (calib::ResidualId id : ids) {
+    const std::vector<double> v = builder.EvaluateResidual(id);
+    out.push_back(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size())));
+  }
+  return out;
+}
+
+// Least squares of the point alone (the poses and the camera held) on the rays `use` of `ids`,
+// Gauss-Newton from `start` with a central-difference Jacobian; nullopt when the rays do not
+// determine the point.
+std::optional<Eigen::Vector3d> FitPoint(const calib::ProblemBuilder& builder,
+                                        const std::vector<calib::ResidualId>& ids,
+                                        const std::vector<bool>& use,
+                                        Eigen::Vector3d* xyz,
+                                        Eigen::Vector3d start) {
+  constexpr double kStepM = 1e-3;  // central differences of residuals linear at this scale
+  std::vector<calib::ResidualId> rays;
+  for (size_t i = 0; i < ids.size(); ++i)
+    if (use[i]) rays.push_back(ids[i]);
+  for (int iteration = 0; iteration < 8; ++iteration) {
+    const auto at = ResidualsWithPointAt(builder, rays, xyz, start);
+    int m = 0;
+    for (const auto& v : at) m += static_cast<int>(v.size());
+    Eigen::VectorXd r(m);
+    Eigen::MatrixXd j(m, 3);
+    for (int c = 0, row = 0; c < static_cast<int>(at.size()); row += static_cast<int>(at[c].size()), ++c)
+      r.segment(row, at[c].size()) = at[c];
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d plus = start, minus = start;
+      plus(k) += kStepM;
+      minus(k) -= kStepM;
+      const auto vp = ResidualsWithPointAt(builder, rays, xyz, plus);
+      const auto vm = ResidualsWithPointAt(builder, rays, xyz, minus);
+      for (int c = 0, row = 0; c < static_cast<int>(at.size()); row += static_cast<int>(at[c].size()), ++c)
+        j.block(row, k, at[c].size(), 1) = (vp[c] - vm[c]) / (2 * kStepM);
+    }
+    const Eigen::Matrix3d n = j.transpose() * j;
+    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(n);
+    if (!(eig.eigenvalues()(0) > 1e-9 * eig.eigenvalues()(2))) return std::nullopt;
+    const Eigen::Vector3d step = -n.ldlt().solve(j.transpose() * r);
+    start += step;
+    if (step.norm() < 1e-6) break;
+  }
+  return start;
+}
+
+}  // namespace
+
+std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double reject) {
   std::vector<calib::ResidualId> ids;
   for (const auto& [id, index] : storage_->observation_of_residual)
     if (builder_.IsActive(id) && storage_->observations[index].subimage.empty()) ids.push_back(id);
@@ -464,13 +526,85 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
   std::vector<Screened> out;
   if (scaled.empty()) return out;
   const double scale = std::max(1e-12, 1.4826 * Median(scaled));
+  std::map<calib::ResidualId, double> w_of;
+  std::map<std::string, std::vector<calib::ResidualId>> rays_of_point;
   for (calib::ResidualId id : ids) {
     const auto& r = cof.redundancy.at(id);
     const auto& v = values.at(id);
     double w = 0.0;
     for (size_t k = 0; k < r.size(); ++k)
       if (r[k] > 1e-6) w = std::max(w, std::abs(v[k]) / (scale * std::sqrt(r[k])));
+    w_of[id] = w;
+    rays_of_point[storage_->observations[storage_->observation_of_residual.at(id)].point].push_back(id);
+  }
+  // A point of three or more rays with a ray beyond `reject` is judged on its own, the poses and
+  // the camera held at the robust solution: the Cauchy solution can settle a point on its
+  // blunder and one good ray (a local minimum), which makes the good rays look like the gross
+  // errors. The point is fitted to every pair of its rays; the fit that most rays agree with
+  // (|v| / s <= reject on every component; ties by the truncated sum of squares), refitted to
+  // those rays, judges every ray by its residual there. When two fits with different sets of
+  // rays agree equally well, the rays cannot be told apart here: none is excluded, and the final
+  // adjustment's snooping judges them with their correlated group.
+  std::map<calib::ResidualId, double> judged;  // per-point verdicts: the ray's |v| / s there
+  for (const auto& [point, rays] : rays_of_point) {
+    const int n = static_cast<int>(rays.size());
+    auto state = storage_->points.find(point);
+    const bool control = state->second.ground && state->second.ground->role == PointRole::kControl;
+    bool suspect = false;
+    for (calib::ResidualId id : rays) suspect |= w_of.at(id) > reject;
+    if (n < 3 || control || !suspect) continue;
+    Eigen::Vector3d* xyz = &state->second.xyz;
+    const Eigen::Vector3d robust = *xyz;
+    const auto judge = [&](const Eigen::Vector3d& at, std::vector<bool>* agree, double* cost) {
+      const auto v = ResidualsWithPointAt(builder_, rays, xyz, at);
+      int count = 0;
+      *cost = 0.0;
+      for (int i = 0; i < n; ++i) {
+        const double worst = v[i].cwiseAbs().maxCoeff() / scale;
+        (*agree)[i] = worst <= reject;
+        count += (*agree)[i];
+        *cost += std::min(v[i].squaredNorm() / (scale * scale), reject * reject);
+      }
+      return count;
+    };
+    int best_count = -1;
+    double best_cost = 0.0;
+    std::vector<bool> best(n, false), agree(n, false);
+    bool ambiguous = false;
+    const auto consider = [&](const Eigen::Vector3d& at) {
+      double cost = 0.0;
+      const int count = judge(at, &agree, &cost);
+      if (count > best_count || (count == best_count && cost < best_cost)) {
+        ambiguous = count == best_count && agree != best;
+        best_count = count;
+        best_cost = cost;
+        best = agree;
+      } else if (count == best_count && agree != best) {
+        ambiguous = true;
+      }
+    };
+    consider(robust);
+    for (int a = 0; a < n; ++a)
+      for (int b = a + 1; b < n; ++b) {
+        std::vector<bool> pair(n, false);
+        pair[a] = pair[b] = true;
+        if (const auto fit = FitPoint(builder_, rays, pair, xyz, robust)) consider(*fit);
+      }
+    if (!ambiguous && best_count >= 2) {
+      if (const auto fit = FitPoint(builder_, rays, best, xyz, robust)) {
+        const auto v = ResidualsWithPointAt(builder_, rays, xyz, *fit);
+        for (int i = 0; i < n; ++i) judged[rays[i]] = v[i].cwiseAbs().maxCoeff() / scale;
+      }
+    } else {
+      for (calib::ResidualId id : rays) judged[id] = 0.0;  // left to the final snooping
+    }
+    *xyz = robust;
+  }
+  for (calib::ResidualId id : ids) {
+    const auto by_point = judged.find(id);
+    const double w = by_point != judged.end() ? by_point->second : w_of.at(id);
     if (w <= reject) continue;
+    const auto& v = values.at(id);
     const size_t index = storage_->observation_of_residual.at(id);
     const ImageObservation& o = storage_->observations.at(index);
     out.push_back(
@@ -502,7 +636,11 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   snooping.power = options_.snooping_power;
   snooping.min_redundancy = options_.min_redundancy;
   snooping.group_correlation = options_.group_correlation;
-  snooping.max_rejections = options_.max_rejections;
+  int tested_images = 0;
+  for (const auto& [image, n] : image_rays) tested_images += n;
+  snooping.max_rejections = options_.max_rejections > 0
+                                ? options_.max_rejections
+                                : std::max(kMinAutomaticCap, tested_images / 10);
   snooping.model_error_sigma0 = options_.model_error_sigma0;
   snooping.veto = [&](const std::vector<calib::ResidualId>& ids) -> std::string {
     std::map<std::string, int> lose_point, lose_image;
@@ -552,7 +690,7 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   s.cofactor_message = out.cofactor_message;
   s.n_tested_components = out.n_tested_components;
   s.rounds = out.rounds;
-  s.max_rejections = options_.max_rejections;
+  s.max_rejections = snooping.max_rejections;
   s.cap_reached = out.cap_reached;
   s.remaining_above_critical = out.remaining_above_critical;
   s.model_error_suspected = out.model_error_suspected;
@@ -850,7 +988,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     result.Invalidate("the adjustment did not converge (" + result.solve.termination + ")");
   if (result.snooping.cap_reached)
     result.Invalidate("data snooping reached the rejection cap of " +
-                      std::to_string(options_.max_rejections) + " with " +
+                      std::to_string(result.snooping.max_rejections) + " with " +
                       std::to_string(result.snooping.remaining_above_critical) +
                       " candidate(s) left above the critical value");
   if (options_.data_snooping && result.snooping.run && !result.snooping.cofactors_ok)

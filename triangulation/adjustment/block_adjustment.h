@@ -81,7 +81,7 @@ class BlockAdjustment {
     Eigen::Vector2d residual_px = Eigen::Vector2d::Zero();  // photo x, y
     double w = 0.0;
   };
-  std::vector<Screened> ScreenRobustly(double reject) const;
+  std::vector<Screened> ScreenRobustly(double reject);
   /// With options.auto_robust_start: Run() returns right after the first solve, with
   /// robust_start_needed set, when its residuals call for a robust start (Adjust() uses it).
   void StopWhenRobustStartNeeded(bool stop) { stop_for_robust_start_ = stop; }
