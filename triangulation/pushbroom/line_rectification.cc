@@ -12,18 +12,20 @@ namespace aerocal::triangulation {
 
 bool SubcameraPixelOfPoint(const calib::LineCamera& cam, const PosTrajectory& pos, int s,
                            double line_guess, const Eigen::Vector3d& point, double* detector,
-                           double* line) {
+                           double* line, bool strict) {
   const auto ranges = cam.Ranges();
   const int first = ranges[s].first, last = ranges[s].second;
   double t = std::max(pos.first_line(), std::min(pos.last_line(), line_guess));
   Eigen::Vector2d xy;
   if (!ProjectAtLine(cam, pos, t, point, &xy)) return false;
-  // Start: linear in the design x of the sub-camera's ends (monotonic across a sub-camera).
-  const double x_first = cam.DesignPosition(first).x(), x_last = cam.DesignPosition(last).x();
-  double i = last > first && x_last != x_first
-                 ? first + (xy.x() - x_first) / (x_last - x_first) * (last - first)
-                 : first;
-  i = std::max(first - 0.1 * (last - first + 1), std::min(last + 0.1 * (last - first + 1), i));
+  // Start: the design detector nearest in x (design x is monotonic across a sub-camera: bisection).
+  const bool increasing = cam.DesignPosition(last).x() >= cam.DesignPosition(first).x();
+  int lo = first, hi = last;
+  while (hi - lo > 1) {
+    const int mid = (lo + hi) / 2;
+    ((cam.DesignPosition(mid).x() < xy.x()) == increasing ? lo : hi) = mid;
+  }
+  double i = std::abs(cam.DesignPosition(lo).x() - xy.x()) <= std::abs(cam.DesignPosition(hi).x() - xy.x()) ? lo : hi;
   auto detector_at = [&](double di) {
     // The position within the sub-camera (its polynomial, its design), also just beyond its ends.
     const double clamped = std::max<double>(first, std::min<double>(last, di));
@@ -46,8 +48,9 @@ bool SubcameraPixelOfPoint(const calib::LineCamera& cam, const PosTrajectory& po
     if (!step.allFinite()) return false;
     i += step.x();
     t += step.y();
-    if (step.norm() < 1e-10) break;
-    if (iteration == 49) return false;
+    if (step.norm() < 1e-12) break;
+    // Finite-difference noise can keep the last steps above 1e-12 (points of the L1 plane).
+    if (iteration == 49 && (strict || !(step.norm() < 1e-8))) return false;
   }
   *detector = i;
   *line = t;
@@ -59,7 +62,7 @@ bool LinePixelOfPoint(const calib::LineCamera& cam, const PosTrajectory& pos, do
   const auto ranges = cam.Ranges();
   for (size_t s = 0; s < ranges.size(); ++s) {
     double i = 0, t = 0;
-    if (!SubcameraPixelOfPoint(cam, pos, int(s), line_guess, point, &i, &t)) continue;
+    if (!SubcameraPixelOfPoint(cam, pos, int(s), line_guess, point, &i, &t, false)) continue;
     if (i >= ranges[s].first - 0.5 && i <= ranges[s].second + 0.5) {
       *detector = i;
       *line = t;

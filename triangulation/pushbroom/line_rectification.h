@@ -24,12 +24,13 @@ namespace aerocal::triangulation {
 
 /// Detector position and line of `point` in sub-camera `subcamera`, starting the search at
 /// `line_guess`; false when the Newton iteration leaves the trajectory or does not converge. The
-/// detector may lie up to half a detector beyond the sub-camera's range (callers check).
+/// detector may lie up to half a detector beyond the sub-camera's range (callers check). `strict`:
+/// the steps must fall below 1e-12 within 50 iterations; otherwise below 1e-8 is accepted.
 bool SubcameraPixelOfPoint(const calib::LineCamera& camera, const PosTrajectory& pos, int subcamera,
                            double line_guess, const Eigen::Vector3d& point, double* detector,
-                           double* line);
+                           double* line, bool strict = true);
 
-/// The same over the sub-cameras in detector order: the first whose detector lies within its
+/// The same (not strict) over the sub-cameras in detector order: the first whose detector lies within its
 /// range (+- 0.5) wins (overlapping fields: the lower detector index).
 bool LinePixelOfPoint(const calib::LineCamera& camera, const PosTrajectory& pos, double line_guess,
                       const Eigen::Vector3d& point, double* detector, double* line);

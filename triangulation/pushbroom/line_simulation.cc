@@ -141,6 +141,7 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     for (int s = 0; s < 3; ++s) {
       double i = 0, t = 0;
       if (!SubcameraPixelOfPoint(sim.truth, truth, s, t0, ground, &i, &t)) continue;
+      if (!(i >= sim.truth.subcameras[s].first - 0.5 && i <= sim.truth.subcameras[s].last + 0.5)) continue;
       if (!(t >= 1 && t <= o.lines - 2)) continue;
       LineObservation obs;
       obs.detector = i + o.image_noise_px * normal(rng);
