@@ -816,7 +816,7 @@ const std::vector<Case>& Cases() {
          std::vector<std::string> lines;
          for (auto l : Lines(rig + "/observations.csv")) {  // head A's rows, without the head field
            const size_t a = l.find(','), b = l.find(',', a + 1);
-           if (l.substr(a, b - a) == ",B") continue;  // else "measured twice" (by A and B) comes first
+           if (l.substr(a, b - a) == ",B") continue;
            l.erase(a, b - a);
            lines.push_back(l);
          }
@@ -839,15 +839,6 @@ const std::vector<Case>& Cases() {
          return RigAdjustArgs(rig);
        },
        2, "rig_nominal.yaml:30: duplicate head id 'A'", "a.json"},
-      {"rig_project_head_measured_twice",
-       [](const TempDir& d) {
-         const auto rig = RigFlight(d);
-         auto lines = Lines(rig + "/observations.csv");
-         lines.insert(lines.begin() + 2, lines[1]);  // line 2 again as line 3
-         WriteLines(rig + "/observations.csv", lines);
-         return RigAdjustArgs(rig);
-       },
-       2, "observations.csv:3: point C1 is measured twice in image 0001 A (line 2 too)", "a.json"},
       {"rig_project_mount_nan",
        [](const TempDir& d) {
          const auto rig = RigFlight(d);

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
-#include <map>
 #include <set>
 
 #include "calib/camera/camera_io.h"
@@ -106,8 +105,6 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
     t.RequireColumns({"image", "point", "col", "row"});
   std::vector<ImageObservation> out;
   out.reserve(t.rows().size());
-  // One measurement per (image, sub-image or head, point): a second is a copy or a blunder.
-  std::map<std::string, int> measured;
   for (const auto& row : t.rows()) {
     ImageObservation o;
     o.line = row.line;
@@ -127,13 +124,6 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
       o.pixel = {t.Bounded(row, "col", -kMaxPixel, kMaxPixel),
                  t.Bounded(row, "row", -kMaxPixel, kMaxPixel)};
     }
-    const std::string where_in_image = o.subimage.empty() ? o.head : o.subimage;
-    const auto [first, added] =
-        measured.emplace(o.image + '\n' + where_in_image + '\n' + o.point, row.line);
-    if (!added)
-      ThrowInputError(t.Where(row), "point " + o.point + " is measured twice in image " + o.image +
-                                        (where_in_image.empty() ? "" : " " + where_in_image) +
-                                        " (line " + std::to_string(first->second) + " too)");
     o.sigma_px = Sigma(t, row, "sigma_px", kMaxSigmaPx).value_or(default_sigma_px);
     if (!(o.sigma_px > 0 && o.sigma_px <= kMaxSigmaPx))
       ThrowInputError(t.Where(row), "sigma_px must be > 0 and <= " + FormatNumber(kMaxSigmaPx) +
