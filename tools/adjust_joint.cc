@@ -21,6 +21,26 @@ std::string CameraOutputPath(const std::string& out, const std::string& id, bool
   return (p.parent_path() / (p.stem().string() + "_" + id + p.extension().string())).string();
 }
 
+int FinishAdjust(const triangulation::AdjustmentResult& result,
+                 const nlohmann::json& json,
+                 const std::string& out,
+                 const std::string& write_camera,
+                 const std::string& camera_kind,
+                 const std::function<void()>& write_cameras) {
+  WriteFileAtomically(out, json.dump(2) + "\n");
+  const bool ok = result.valid;
+  for (const auto& reason : result.invalid_reasons)
+    std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());
+  if (!write_camera.empty()) {
+    if (ok)
+      write_cameras();
+    else
+      std::fprintf(stderr, "%s not written: the result is not valid\n", camera_kind.c_str());
+  }
+  std::printf("result -> %s\n", out.c_str());
+  return ok ? kExitOk : kExitNotConverged;
+}
+
 void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args) {
   CLI::Option* joint = app.add_option(
       "--joint-stitching", args->stitching,
@@ -52,6 +72,10 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
   if (options.robust_start)
     throw ConfigError("--robust-start is not available with --joint-stitching (start from a plain adjustment)");
 
+  if (!input.rigs.empty())
+    throw ConfigError("--joint-stitching: " + project_path + ": camera '" + input.rigs.begin()->first +
+                      "' is a rig: the joint adjustment estimates the sub-image mappings of a frame "
+                      "camera, a rig's heads have none (adjust the rig without --joint-stitching)");
   const triangulation::ObjectFrame frame(input.frame);
   triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
   joint_options.Validate(project);
@@ -82,29 +106,18 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
               triangulation::FormatJointSummary(result).c_str());
   nlohmann::json json = triangulation::JointResultToJson(result);
   json["project"] = project_path;
-  WriteFileAtomically(out, json.dump(2) + "\n");
-
   // As the plain adjustment: exit 3 and no camera when the result is not valid.
-  const bool ok = result.adjustment.valid;
-  for (const auto& reason : result.adjustment.invalid_reasons)
-    std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());
-  if (!write_camera.empty()) {
-    if (!ok) {
-      std::fprintf(stderr, "camera not written: the result is not valid\n");
-    } else {
-      const auto& cameras = result.adjustment.cameras;
-      for (const auto& estimate : cameras) {
-        const std::string path = CameraOutputPath(write_camera, estimate.id, cameras.size() > 1);
-        calib::WriteCamera(path, triangulation::JointUpdatedCamera(input.cameras.at(estimate.id), estimate.id, result));
-        std::printf("camera %s -> %s%s\n", estimate.id.c_str(), path.c_str(),
-                    joint_options.scope == triangulation::MappingScope::kPerExposure
-                        ? " (interior; the per-exposure mappings are in the result only)"
-                        : "");
-      }
+  return FinishAdjust(result.adjustment, json, out, write_camera, "camera", [&] {
+    const auto& cameras = result.adjustment.cameras;
+    for (const auto& estimate : cameras) {
+      const std::string path = CameraOutputPath(write_camera, estimate.id, cameras.size() > 1);
+      calib::WriteCamera(path, triangulation::JointUpdatedCamera(input.cameras.at(estimate.id), estimate.id, result));
+      std::printf("camera %s -> %s%s\n", estimate.id.c_str(), path.c_str(),
+                  joint_options.scope == triangulation::MappingScope::kPerExposure
+                      ? " (interior; the per-exposure mappings are in the result only)"
+                      : "");
     }
-  }
-  std::printf("result -> %s\n", out.c_str());
-  return ok ? kExitOk : kExitNotConverged;
+  });
 }
 
 }  // namespace aerocal::tools

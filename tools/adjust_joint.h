@@ -3,11 +3,15 @@
 // its run, kept beside cmd_adjust.cc so that the plain adjustment's code stays as it is.
 #pragma once
 
+#include <functional>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include "triangulation/adjustment/adjust_options.h"
+#include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
 
 namespace aerocal::tools {
@@ -22,6 +26,18 @@ struct JointAdjustArgs {
 
 /// OUT.yaml for a single camera, OUT_<id>.yaml for each of several (--write-camera).
 std::string CameraOutputPath(const std::string& out, const std::string& id, bool several);
+
+/// The end of every `adjust` run (plain, joint, rig): writes the result JSON to `out` (atomically,
+/// also when not valid: `valid: false` and its reasons), prints each reason, and calls
+/// `write_cameras` only when `write_camera` is set and the result is valid: a camera file that
+/// exists is one the next flight may use; otherwise says "<camera_kind> not written". Returns the
+/// exit code: 0 valid, 3 not valid (AdjustmentResult::valid).
+int FinishAdjust(const triangulation::AdjustmentResult& result,
+                 const nlohmann::json& json,
+                 const std::string& out,
+                 const std::string& write_camera,
+                 const std::string& camera_kind,
+                 const std::function<void()>& write_cameras);
 
 /// Adds --joint-stitching, --joint-model, --base and --stitch-sigma-px (the last three need the
 /// first).

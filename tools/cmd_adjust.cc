@@ -63,21 +63,11 @@ int RunRigAdjust(const RigArgs& args,
   json["project"] = project_path;
   json["valid"] = result.adjustment.valid;
   json["invalid_reasons"] = result.adjustment.invalid_reasons;
-  WriteFileAtomically(out, json.dump(2) + "\n");
   // As the frame camera: exit 3 and no rig file when the result is not valid.
-  const bool ok = result.adjustment.valid;
-  for (const auto& reason : result.adjustment.invalid_reasons)
-    std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());
-  if (!write_camera.empty()) {
-    if (!ok) {
-      std::fprintf(stderr, "rig camera not written: the result is not valid\n");
-    } else {
-      calib::WriteRig(write_camera, triangulation::UpdatedRig(input.rigs.at(result.camera), result));
-      std::printf("rig camera %s -> %s\n", result.camera.c_str(), write_camera.c_str());
-    }
-  }
-  std::printf("result -> %s\n", out.c_str());
-  return ok ? kExitOk : kExitNotConverged;
+  return FinishAdjust(result.adjustment, json, out, write_camera, "rig camera", [&] {
+    calib::WriteRig(write_camera, triangulation::UpdatedRig(input.rigs.at(result.camera), result));
+    std::printf("rig camera %s -> %s\n", result.camera.c_str(), write_camera.c_str());
+  });
 }
 
 CommandRun SetupAdjust(CLI::App& app) {
@@ -271,8 +261,21 @@ CommandRun SetupAdjust(CLI::App& app) {
     const bool rig_option_given = std::any_of(
         rig_options.begin(), rig_options.end(), [](const CLI::Option* o) { return o->count() > 0; });
     if (!input.rigs.empty()) {
-      if (args->compare || options.robust_start)
-        throw ConfigError("--compare and --robust-start are not available for a rig project");
+      const std::string rig = "rig project (camera '" + input.rigs.begin()->first + "')";
+      if (args->compare)
+        throw ConfigError("--compare: not available for a " + rig + ": its conventional reference "
+                          "run is a frame-camera adjustment (run adjust with and without "
+                          "--self-calibration instead)");
+      if (options.robust_start)
+        throw ConfigError("--robust-start: not available for a " + rig + ": the robust start "
+                          "re-adjusts frame cameras only (reject blunders with data snooping, the "
+                          "default)");
+      if (input.rigs.size() > 1) {
+        std::string names;
+        for (const auto& [id, unused] : input.rigs) names += (names.empty() ? "" : ", ") + id;
+        throw ConfigError(args->project + ": rig cameras " + names + ": the rig bundle takes one "
+                          "rig per project (adjust each rig's exposures in a project of its own)");
+      }
       return RunRigAdjust(args->rig, options, input, project, frame, args->project, args->out,
                           args->write_camera);
     }
@@ -321,27 +324,17 @@ CommandRun SetupAdjust(CLI::App& app) {
     json["project"] = args->project;
     json["valid"] = main.valid;
     json["invalid_reasons"] = main.invalid_reasons;
-    WriteFileAtomically(args->out, json.dump(2) + "\n");
     // Exit 3 (results written, valid: false) when the run must not be trusted; the camera file
-    // is then not written at all: a file that exists is one the next flight may use.
-    const bool ok = main.valid;
-    for (const auto& reason : main.invalid_reasons)
-      std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());
-    if (!args->write_camera.empty()) {
-      if (!ok) {
-        std::fprintf(stderr, "camera not written: the result is not valid\n");
-      } else {
-        for (const auto& estimate : main.cameras) {
-          const std::string path =
-              CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);
-          WriteCameraInFormat(path, triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate),
-                              args->camera_format, &estimate.sigma);
-          std::printf("camera %s -> %s\n", estimate.id.c_str(), path.c_str());
-        }
+    // is then not written at all.
+    return FinishAdjust(main, json, args->out, args->write_camera, "camera", [&] {
+      for (const auto& estimate : main.cameras) {
+        const std::string path =
+            CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);
+        WriteCameraInFormat(path, triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate),
+                            args->camera_format, &estimate.sigma);
+        std::printf("camera %s -> %s\n", estimate.id.c_str(), path.c_str());
       }
-    }
-    std::printf("result -> %s\n", args->out.c_str());
-    return ok ? kExitOk : kExitNotConverged;
+    });
   };
 }
 

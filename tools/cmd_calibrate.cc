@@ -13,6 +13,7 @@
 #include "triangulation/calibration/calibration.h"
 #include "triangulation/calibration/uncertainty_budget.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -26,35 +27,65 @@ using triangulation::AdjustmentResult;
 // Board points: design coordinates; the default sigma stands for the print / machining accuracy.
 constexpr double kDefaultBoardSigmaMm = 0.01;
 
-std::map<std::string, std::string> ReadGroups(const std::string& path) {
+// Image -> (group, the line that put it there), from either source of groups.
+using GroupLines = std::map<std::string, std::pair<std::string, int>>;
+
+// The checks both sources share, at the line that breaks them: every image is observed, each group
+// holds two images or more, and there are two groups or more (the stability test compares groups).
+std::map<std::string, std::string> CheckedGroups(const GroupLines& lines, const std::string& file,
+                                                 const std::set<std::string>& observed) {
+  std::map<std::string, std::pair<int, int>> groups;  // group -> (images, first line)
+  for (const auto& [image, entry] : lines) {
+    if (!observed.count(image))
+      ThrowInputError({file, entry.second}, "image " + image + " has no observations");
+    auto& g = groups.emplace(entry.first, std::make_pair(0, entry.second)).first->second;
+    ++g.first;
+    g.second = std::min(g.second, entry.second);
+  }
+  for (const auto& [group, g] : groups)
+    if (g.first < 2)
+      ThrowInputError({file, g.second}, "group " + group + " has " + std::to_string(g.first) +
+                                            " image (a group needs two or more)");
+  if (groups.size() < 2)
+    ThrowInputError({file, 0}, std::to_string(groups.size()) +
+                                   " group(s): the stability test needs two groups or more");
+  std::map<std::string, std::string> out;
+  for (const auto& [image, entry] : lines) out[image] = entry.first;
+  return out;
+}
+
+std::map<std::string, std::string> ReadGroups(const std::string& path,
+                                              const std::set<std::string>& observed) {
   const CsvTable table = CsvTable::Read(path);
   table.RequireColumns({"image", "group"});
-  std::map<std::string, std::string> out;
+  GroupLines out;
   for (const auto& row : table.rows()) {
     const std::string image = table.String(row, "image"), group = table.String(row, "group");
     if (image.empty() || group.empty())
       throw InputError(table.Where(row).ToString() + ": image and group must not be empty");
-    if (!out.emplace(image, group).second)
+    if (!out.emplace(image, std::make_pair(group, row.line)).second)
       throw InputError(table.Where(row).ToString() + ": image " + image + " listed twice");
   }
-  return out;
+  return CheckedGroups(out, path, observed);
 }
 
 // The optional `group` column of observations.csv: image -> group (rows with an empty group put
 // nothing); an image given two different groups is an error at the second one's line.
-std::map<std::string, std::string> GroupsFromObservations(const std::string& path) {
+std::map<std::string, std::string> GroupsFromObservations(const std::string& path,
+                                                          const std::set<std::string>& observed) {
   const CsvTable table = CsvTable::Read(path);
-  std::map<std::string, std::string> out;
-  if (!table.HasColumn("group")) return out;
+  GroupLines out;
+  if (!table.HasColumn("group")) return {};
   for (const auto& row : table.rows()) {
     const std::string image = table.String(row, "image"), group = table.String(row, "group");
     if (group.empty()) continue;
-    const auto [at, added] = out.emplace(image, group);
-    if (!added && at->second != group)
+    const auto [at, added] = out.emplace(image, std::make_pair(group, row.line));
+    if (!added && at->second.first != group)
       throw InputError(table.Where(row).ToString() + ": image " + image + " is in group " +
-                       at->second + " above, here in " + group);
+                       at->second.first + " above, here in " + group);
   }
-  return out;
+  if (out.empty()) return {};
+  return CheckedGroups(out, path, observed);
 }
 
 nlohmann::json InteriorJson(const calib::InteriorParams& p) {
@@ -261,10 +292,12 @@ CommandRun SetupCalibrate(CLI::App& app) {
       }
       triangulation::ValidateProject(check);
     }
+    std::set<std::string> observed;
+    for (const auto& o : project.observations) observed.insert(o.image);
     std::map<std::string, std::string> groups;
-    if (!args->groups.empty()) groups = ReadGroups(args->groups);
+    if (!args->groups.empty()) groups = ReadGroups(args->groups, observed);
     if (field) {
-      const auto from_column = GroupsFromObservations(args->observations);
+      const auto from_column = GroupsFromObservations(args->observations, observed);
       if (!from_column.empty() && !args->groups.empty())
         throw ConfigError("--groups: " + args->observations + " has a group column already (give one)");
       if (!from_column.empty()) groups = from_column;

@@ -213,10 +213,14 @@ struct ConvertArgs {
   double relief_m = 100.0;
   int strip_rows = 256;
   bool bigtiff = false;
+  int tile_px = 0;  // > 0: tiled TIFF, tiles of tile_px x tile_px
   std::string dem;  // ESRI ASCII grid: the rectification surface instead of the plane
 };
 
 int RunConvert(const ConvertArgs& args) {
+  if (args.tile_px != 0 && !(args.tile_px % 16 == 0 && args.tile_px >= 16 && args.tile_px <= 4096))
+    throw ConfigError("--tile-px must be 0 (strips) or a multiple of 16 in 16..4096 (got " +
+                      std::to_string(args.tile_px) + ")");
   const calib::Rig rig = calib::ReadRig(args.camera);
   const double height_m = FlyingHeight(rig, args.height_m, args.camera);
   stitch::RigExposure exposure;
@@ -247,6 +251,7 @@ int RunConvert(const ConvertArgs& args) {
       as_camera, args.camera + " at H = " + FormatNumber(height_m) +
                        " m (plane homographies; heads with distortion add correction grids)");
   tiff.force_bigtiff = args.bigtiff;
+  tiff.tile_px = args.tile_px;
   stitch::TiffWriter writer(
       args.out, {as_camera.width_px, as_camera.height_px, info.bands, info.bits}, tiff);
   std::optional<stitch::DemGrid> dem;
@@ -529,6 +534,8 @@ CommandRun Setup(CLI::App& app) {
   cv->add_option("--relief-m", convert->relief_m,
                  "Relief (m off the plane) whose displacement between heads is reported");
   cv->add_flag("--bigtiff", convert->bigtiff, "Write BigTIFF even when classic TIFF would do");
+  cv->add_option("--tile-px", convert->tile_px,
+                 "Tiled TIFF: square tiles of N x N px (a multiple of 16, 16..4096); 0: strips");
   cv->add_option("--dem", convert->dem,
                  "DEM (ESRI ASCII grid, object frame of the exposure) as the rectification surface; "
                  "the plane at --height-m stays the base of the maps");

@@ -1,6 +1,7 @@
 // aerocal simulate: writes the deterministic example flight (triangulation/simulation).
 #include <cmath>
 #include <cstdio>
+#include <set>
 #include <sstream>
 
 #include "calib/core/atomic_file.h"
@@ -44,9 +45,13 @@ int RunTestFieldSimulation(const CLI::App& app, SimulateArgs& args) {
   if (given("--survey-sigma-m")) t.survey_sigma_m = args.options.survey_sigma_m;
   if (given("--image-noise-px")) t.image_noise_px = args.options.image_noise_px;
   if (given("--image-sigma-px")) t.image_sigma_px = args.options.image_sigma_px;
-  for (const char* flight_only : {"--exposures", "--strips", "--height-m", "--layout", "--rig", "--pushbroom"})
-    if (given(flight_only))
-      throw ConfigError(std::string(flight_only) + " does not apply to --test-field");
+  // Every other option (flight, rig, pushbroom) is refused by name, never silently ignored.
+  const std::set<std::string> field_options = {
+      "--out", "--seed", "--test-field", "--planar", "--groups", "--images-per-group", "--distance-m",
+      "--survey-sigma-m", "--image-noise-px", "--image-sigma-px", "--help"};
+  for (const CLI::Option* option : app.get_options())
+    if (option->count() > 0 && !field_options.count(option->get_name()))
+      throw ConfigError(option->get_name() + " does not apply to --test-field");
   const auto field = triangulation::SimulateTestField(t);
   triangulation::WriteSimulatedTestField(field, args.out);
   std::printf("simulated a %s test field: %zu targets, %zu images in %d groups, %zu image "

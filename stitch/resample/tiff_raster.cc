@@ -113,9 +113,32 @@ struct TiffWriter::Impl {
   TIFF* tiff = nullptr;
   RasterInfo info;
   int rows_per_strip = 64;
+  int tile_px = 0;                    // > 0: tiled
   int next_row = 0;
-  std::vector<std::uint8_t> pending;  // rows of the current strip
+  std::vector<std::uint8_t> pending;  // rows of the current strip or tile row
+  std::vector<std::uint8_t> tile;     // one tile (tiled only)
   bool committed = false;
+
+  // Writes the block of `rows` rows starting at image row y0 from `src` (rows_per_strip or
+  // tile_px rows, fewer at the bottom): one strip, or one row of tiles.
+  void WriteBlock(int y0, int rows, const std::uint8_t* src) {
+    const size_t row_bytes = info.RowBytes();
+    if (tile_px == 0) {
+      if (TIFFWriteEncodedStrip(tiff, y0 / rows_per_strip, const_cast<std::uint8_t*>(src), rows * row_bytes) < 0)
+        throw Error(path + ": cannot write the TIFF (disk full?)");
+      return;
+    }
+    const size_t pixel_bytes = static_cast<size_t>(info.bands) * info.BytesPerSample();
+    const size_t tile_row_bytes = tile_px * pixel_bytes;
+    for (int x0 = 0; x0 < info.width; x0 += tile_px) {
+      std::fill(tile.begin(), tile.end(), 0);
+      const size_t n = std::min(tile_px, info.width - x0) * pixel_bytes;
+      for (int r = 0; r < rows; ++r)
+        std::memcpy(tile.data() + r * tile_row_bytes, src + r * row_bytes + x0 * pixel_bytes, n);
+      if (TIFFWriteEncodedTile(tiff, TIFFComputeTile(tiff, x0, y0, 0, 0), tile.data(), tile.size()) < 0)
+        throw Error(path + ": cannot write the TIFF (disk full?)");
+    }
+  }
 };
 
 TiffWriter::TiffWriter(const std::string& path, const RasterInfo& info,
@@ -125,11 +148,17 @@ TiffWriter::TiffWriter(const std::string& path, const RasterInfo& info,
   impl_->path = path;
   impl_->info = info;
   impl_->rows_per_strip = std::max(1, options.rows_per_strip);
+  impl_->tile_px = options.tile_px;
+  AEROCAL_CHECK(options.tile_px == 0 ||
+                (options.tile_px % 16 == 0 && options.tile_px >= 16 && options.tile_px <= 4096))
+      << "tile_px must be 0 or a multiple of 16 in 16..4096 (got " << options.tile_px << ")";
   const std::filesystem::path target(path);
   if (target.has_parent_path()) std::filesystem::create_directories(target.parent_path());
   impl_->temp_path = path + ".part";
   // Classic TIFF offsets are 32-bit: beyond ~4 GiB (with room for the tags) BigTIFF is needed.
-  const double bytes = static_cast<double>(info.RowBytes()) * info.height;
+  // (Tiles pad the right and bottom edges.)
+  const auto padded = [&](int n) { return options.tile_px > 0 ? (n + options.tile_px - 1) / options.tile_px * options.tile_px : n; };
+  const double bytes = static_cast<double>(info.RowBytes()) / info.width * padded(info.width) * padded(info.height);
   bigtiff_ = options.force_bigtiff || bytes > 3.9e9;
   impl_->tiff = TIFFOpen(impl_->temp_path.c_str(), bigtiff_ ? "w8" : "w");
   if (!impl_->tiff) throw Error(path + ": cannot create the TIFF");
@@ -142,7 +171,13 @@ TiffWriter::TiffWriter(const std::string& path, const RasterInfo& info,
   TIFFSetField(t, TIFFTAG_PLANARCONFIG, PLANARCONFIG_CONTIG);
   TIFFSetField(t, TIFFTAG_PHOTOMETRIC, info.bands == 3 ? PHOTOMETRIC_RGB : PHOTOMETRIC_MINISBLACK);
   TIFFSetField(t, TIFFTAG_COMPRESSION, COMPRESSION_NONE);
-  TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, static_cast<uint32_t>(impl_->rows_per_strip));
+  if (impl_->tile_px > 0) {
+    TIFFSetField(t, TIFFTAG_TILEWIDTH, static_cast<uint32_t>(impl_->tile_px));
+    TIFFSetField(t, TIFFTAG_TILELENGTH, static_cast<uint32_t>(impl_->tile_px));
+    impl_->tile.resize(static_cast<size_t>(impl_->tile_px) * impl_->tile_px * info.bands * info.BytesPerSample());
+  } else {
+    TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, static_cast<uint32_t>(impl_->rows_per_strip));
+  }
   TIFFSetField(t, TIFFTAG_SOFTWARE, "aerocal");
   if (!options.description.empty())
     TIFFSetField(t, TIFFTAG_IMAGEDESCRIPTION, options.description.c_str());
@@ -159,16 +194,16 @@ void TiffWriter::WriteRows(int y0, int rows, const void* data) {
   const auto* src = static_cast<const std::uint8_t*>(data);
   impl_->pending.insert(impl_->pending.end(), src, src + rows * row_bytes);
   impl_->next_row += rows;
-  // Emit every complete strip (and the last, short one at the end of the image).
-  const size_t strip_bytes = impl_->rows_per_strip * row_bytes;
-  const int written_rows = impl_->next_row - static_cast<int>(impl_->pending.size() / row_bytes);
-  int strip = written_rows / impl_->rows_per_strip;
+  // Emit every complete strip or tile row (and the last, short one at the end of the image).
+  const int block_rows = impl_->tile_px > 0 ? impl_->tile_px : impl_->rows_per_strip;
+  const size_t block_bytes = block_rows * row_bytes;
+  int block_y0 = impl_->next_row - static_cast<int>(impl_->pending.size() / row_bytes);
   size_t offset = 0;
-  while (impl_->pending.size() - offset >= strip_bytes ||
+  while (impl_->pending.size() - offset >= block_bytes ||
          (impl_->next_row == impl_->info.height && offset < impl_->pending.size())) {
-    const size_t n = std::min(strip_bytes, impl_->pending.size() - offset);
-    if (TIFFWriteEncodedStrip(impl_->tiff, strip++, impl_->pending.data() + offset, n) < 0)
-      throw Error(impl_->path + ": cannot write the TIFF (disk full?)");
+    const size_t n = std::min(block_bytes, impl_->pending.size() - offset);
+    impl_->WriteBlock(block_y0, static_cast<int>(n / row_bytes), impl_->pending.data() + offset);
+    block_y0 += block_rows;
     offset += n;
   }
   impl_->pending.erase(impl_->pending.begin(), impl_->pending.begin() + offset);
@@ -203,6 +238,16 @@ bool IsBigTiff(const std::string& path) {
   const bool big = TIFFIsBigTIFF(tiff);
   TIFFClose(tiff);
   return big;
+}
+
+int TiffTileWidth(const std::string& path) {
+  SilenceLibtiff();
+  TIFF* tiff = TIFFOpen(path.c_str(), "r");
+  if (!tiff) throw InputError(path + ": cannot open as TIFF");
+  uint32_t width = 0;
+  if (TIFFIsTiled(tiff)) TIFFGetField(tiff, TIFFTAG_TILEWIDTH, &width);
+  TIFFClose(tiff);
+  return static_cast<int>(width);
 }
 
 MemoryRaster ReadImageFile(const std::string& path, bool gray) {

@@ -397,6 +397,27 @@ TEST(RigConvertCommand, WritesTheVirtualTiffAndRefusesBadInput) {
   out->ReadWindow(0, 620, 1600, 1, row.data());
   for (const int col : {300, 820, 1300})  // inside checker squares: the texture, to interpolation
     EXPECT_NEAR(row[col], truth.At(col, 620), 2.0) << col;
+  // Tiled BigTIFF (--tile-px 256 --bigtiff): the same pixels as the stripped classic TIFF.
+  run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + images +
+                            " --tile-px 256 --bigtiff --out " + tmp.File("tiled.tif"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_EQ(TiffTileWidth(tmp.File("tiled.tif")), 256);
+  EXPECT_TRUE(IsBigTiff(tmp.File("tiled.tif")));
+  EXPECT_EQ(TiffTileWidth(tmp.File("virtual.tif")), 0);
+  {
+    const auto tiled = OpenTiff(tmp.File("tiled.tif"));
+    ASSERT_EQ(tiled->Info().width, 1600);
+    ASSERT_EQ(tiled->Info().height, 1200);
+    std::vector<std::uint8_t> a(1600 * 1200), b(1600 * 1200);
+    tiled->ReadWindow(0, 0, 1600, 1200, a.data());
+    out->ReadWindow(0, 0, 1600, 1200, b.data());
+    EXPECT_TRUE(a == b) << "the tiled image differs from the stripped one";
+  }
+  run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + images +
+                            " --tile-px 100 --out " + tmp.File("v2.tif"));
+  EXPECT_EQ(run.exit_code, 2);
+  EXPECT_NE(run.output.find("--tile-px must be 0 (strips) or a multiple of 16"), std::string::npos)
+      << run.output;
   // Refusals: exit 2, nothing written.
   run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + " --images A=" +
                             tmp.File("A.tif") + " --out " + tmp.File("v2.tif"));

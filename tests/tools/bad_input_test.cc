@@ -116,6 +116,14 @@ std::string SimulatedCopy(const TempDir& d, const std::string& name, const std::
 }
 std::string PushbroomFlight(const TempDir& d) { return SimulatedCopy(d, "pb", "--pushbroom"); }
 std::string RigFlight(const TempDir& d) { return SimulatedCopy(d, "rig", "--rig dual-lens"); }
+// A frame flight whose exposures.csv carries the velocity columns vX, vY, vZ.
+std::string VelocityFlight(const TempDir& d) {
+  return SimulatedCopy(d, "vel", "--exposures 6 --strips 1 --points 12 --control 6 --tie-points 40 --speed-mps 60");
+}
+// A small test field (`simulate --test-field`): 2 groups (A, B) of 4 images, groups.csv lines 2-9.
+std::string TestField(const TempDir& d) {
+  return SimulatedCopy(d, "tf", "--test-field --groups 2 --images-per-group 4");
+}
 
 // Replaces the first `from` in the file by `to` (the case's one defect); `from` must be there.
 void ReplaceFirst(const std::string& path, const std::string& from, const std::string& to) {
@@ -210,6 +218,46 @@ void WriteOdm(const std::string& dir) {
 std::string OdmArgs(const std::string& dir) {
   return "import odm --gcp-list " + dir + "/gcp.txt --camera " + dir + "/cam.yaml --out " + dir +
          "/out";
+}
+
+// Sets the field of column `column` (by its header name) of 1-based line `line` of a CSV file.
+void SetColumn(const std::string& path, int line, const std::string& column, const std::string& value) {
+  const auto header = Lines(path).at(0);
+  std::stringstream in(header);
+  int index = 0;
+  for (std::string name; std::getline(in, name, ','); ++index)
+    if (name == column) return SetField(path, line, index, value);
+  ADD_FAILURE() << column << " not in " << path;
+}
+
+// Appends `text` to the file.
+void Append(const std::string& path, const std::string& text) { Write(path, Read(path) + text); }
+
+// Adjusts the simulated rig project `rig` (RigFlight).
+std::string RigAdjustArgs(const std::string& rig) {
+  return "adjust --project " + rig + "/project.yaml --out " + rig + "/../a.json";
+}
+
+std::string CalibrateArgs(const std::string& tf) {
+  return "calibrate --camera " + tf + "/camera_nominal.yaml --observations " + tf +
+         "/observations.csv --points " + tf + "/points.csv --out " + tf + "/../cal.json";
+}
+
+// The test field's observations with a `group` column from its groups.csv; the image of
+// observation row `odd_row` (1-based line) is put into group `odd_group` instead.
+void AddGroupColumn(const std::string& tf, const std::string& group_of_all = "", int odd_row = 0,
+                    const std::string& odd_group = "") {
+  std::map<std::string, std::string> groups;
+  for (const auto& line : Lines(tf + "/groups.csv")) groups[line.substr(0, line.find(','))] = line.substr(line.find(',') + 1);
+  auto lines = Lines(tf + "/observations.csv");
+  lines[0] += ",group";
+  for (size_t i = 1; i < lines.size(); ++i) {
+    const std::string image = lines[i].substr(0, lines[i].find(','));
+    lines[i] += "," + (static_cast<int>(i) + 1 == odd_row ? odd_group
+                       : group_of_all.empty()             ? groups.at(image)
+                                                          : group_of_all);
+  }
+  WriteLines(tf + "/observations.csv", lines);
 }
 
 struct Case {
@@ -799,6 +847,258 @@ const std::vector<Case>& Cases() {
          return RigStitchArgs(line);
        },
        2, "rig_truth.yaml: virtual.orientation must be level for rig stitch", "uav4/stitch.json"},
+      // ---- the rig in a project (issue 13): rig camera under `cameras:`, head column ----
+      {"rig_project_head_unknown",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         SetColumn(rig + "/observations.csv", 2, "head", "Q");
+         return RigAdjustArgs(rig);
+       },
+       2, "observations.csv:2: rig 'rig1' has no head 'Q'", "a.json"},
+      {"rig_project_head_empty",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         SetColumn(rig + "/observations.csv", 2, "head", "");
+         return RigAdjustArgs(rig);
+       },
+       2, "observations.csv:2: head must not be empty", "a.json"},
+      {"rig_project_without_head_column",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         std::vector<std::string> lines;
+         for (auto l : Lines(rig + "/observations.csv")) {  // head A's rows, without the head field
+           const size_t a = l.find(','), b = l.find(',', a + 1);
+           if (l.substr(a, b - a) == ",B") continue;
+           l.erase(a, b - a);
+           lines.push_back(l);
+         }
+         WriteLines(rig + "/observations.csv", lines);
+         return RigAdjustArgs(rig);
+       },
+       2, "observations.csv:2: image 0001 is taken by rig 'rig1': its observations need a head", "a.json"},
+      {"rig_project_head_on_a_frame_camera",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         Write(rig + "/frame.yaml", "pixel_size_mm: 0.006\nformat_px: [10000, 10000]\ninterior: {c: 150}\n");
+         Replace(rig + "/project.yaml", "{rig1: rig_nominal.yaml}", "{rig1: frame.yaml}");
+         return RigAdjustArgs(rig);
+       },
+       2, "observations.csv:2: head 'A' of image 0001: camera 'rig1' is not a rig", "a.json"},
+      {"rig_project_duplicate_head_id",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         ReplaceFirst(rig + "/rig_nominal.yaml", "- id: B", "- id: A");
+         return RigAdjustArgs(rig);
+       },
+       2, "rig_nominal.yaml:30: duplicate head id 'A'", "a.json"},
+      {"rig_project_mount_nan",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         ReplaceFirst(rig + "/rig_nominal.yaml", "mount_deg: [0, 1, 0]", "mount_deg: [0, .nan, 0]");
+         return RigAdjustArgs(rig);
+       },
+       2, "rig_nominal.yaml:45: mount_deg must be a number (got '.nan')", "a.json"},
+      {"rig_project_lever_arm_inf",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         ReplaceFirst(rig + "/rig_nominal.yaml", "lever_arm_m: [0.14999999999999999", "lever_arm_m: [.inf");
+         return RigAdjustArgs(rig);
+       },
+       2, "rig_nominal.yaml:46: lever_arm_m must be a number (got '.inf')", "a.json"},
+      {"rig_project_platform_nan",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         Append(rig + "/project.yaml", "platform:\n  time_offset_ms: .nan\n");
+         return RigAdjustArgs(rig);
+       },
+       2, "project.yaml:8: platform: time_offset_ms must be a number (got '.nan')", "a.json"},
+      {"rig_project_with_two_rigs",
+       [](const TempDir& d) {
+         const auto rig = RigFlight(d);
+         Replace(rig + "/project.yaml", "{rig1: rig_nominal.yaml}", "{rig1: rig_nominal.yaml, rig2: rig_truth.yaml}");
+         SetColumn(rig + "/exposures.csv", 2, "camera", "rig2");
+         return RigAdjustArgs(rig);
+       },
+       2, "rig cameras rig1, rig2: the rig bundle takes one rig per project", "a.json"},
+      {"rig_adjust_compare",
+       [](const TempDir& d) { return RigAdjustArgs(RigFlight(d)) + " --compare"; },
+       2, "--compare: not available for a rig project (camera 'rig1')", "a.json"},
+      {"rig_adjust_robust_start",
+       [](const TempDir& d) { return RigAdjustArgs(RigFlight(d)) + " --robust-start"; },
+       2, "--robust-start: not available for a rig project (camera 'rig1')", "a.json"},
+      {"rig_adjust_joint_stitching",
+       [](const TempDir& d) { return RigAdjustArgs(RigFlight(d)) + " --joint-stitching per-flight"; },
+       2, "camera 'rig1' is a rig: the joint adjustment", "a.json"},
+      // ---- the project's `platform:` section (lever arm, boresight, GNSS time offset) ----
+#define AEROCAL_PLATFORM_CASE(name, yaml, expect)                          \
+  {name,                                                                  \
+   [](const TempDir& d) {                                                 \
+     const auto sim = Flight(d);                                          \
+     Append(sim + "/project.yaml", std::string("platform:\n") + (yaml));  \
+     return AdjustArgs(sim);                                              \
+   },                                                                     \
+   2, (expect), "a.json"}
+      AEROCAL_PLATFORM_CASE("platform_lever_arm_nan", "  lever_arm_m: [.nan, 0, 0]\n",
+                            "project.yaml:9: platform: lever_arm_m must be a number (got '.nan')"),
+      AEROCAL_PLATFORM_CASE("platform_lever_arm_inf", "  lever_arm_m: [0, -.inf, 0]\n",
+                            "project.yaml:9: platform: lever_arm_m must be a number (got '-.inf')"),
+      AEROCAL_PLATFORM_CASE("platform_lever_arm_out_of_bounds", "  lever_arm_m: [1e9, 0, 0]\n",
+                            "project.yaml:9: platform: lever_arm_m out of range (got 1e9"),
+      AEROCAL_PLATFORM_CASE("platform_lever_arm_not_a_list", "  lever_arm_m: 5\n",
+                            "project.yaml:9: platform: lever_arm_m must be [x, y, z]"),
+      AEROCAL_PLATFORM_CASE("platform_lever_arm_two_values", "  lever_arm_m: [1, 2]\n",
+                            "project.yaml:9: platform: lever_arm_m must be [x, y, z]"),
+      AEROCAL_PLATFORM_CASE("platform_lever_arm_text", "  lever_arm_m: [a, 0, 0]\n",
+                            "project.yaml:9: platform: lever_arm_m must be a number (got 'a')"),
+      AEROCAL_PLATFORM_CASE("platform_boresight_out_of_bounds", "  boresight_deg: [0, 0, 1e300]\n",
+                            "project.yaml:9: platform: boresight_deg out of range (got 1e300"),
+      AEROCAL_PLATFORM_CASE("platform_time_offset_nan", "  time_offset_ms: .nan\n",
+                            "project.yaml:9: platform: time_offset_ms must be a number (got '.nan')"),
+      AEROCAL_PLATFORM_CASE("platform_time_offset_out_of_bounds", "  time_offset_ms: 1e9\n",
+                            "project.yaml:9: platform: time_offset_ms out of range (got 1e9"),
+      AEROCAL_PLATFORM_CASE("platform_time_offset_a_list", "  time_offset_ms: [1]\n",
+                            "project.yaml:9: platform: time_offset_ms must be a number"),
+      AEROCAL_PLATFORM_CASE("platform_mode_a_list", "  lever_arm: [free]\n",
+                            "project.yaml:9: platform: lever_arm must be a string"),
+      AEROCAL_PLATFORM_CASE("platform_mode_unknown", "  boresight: sometimes\n",
+                            "project.yaml:9: platform: boresight must be fixed, free or weighted (got 'sometimes')"),
+      AEROCAL_PLATFORM_CASE("platform_duplicate_key", "  lever_arm_m: [0, 0, 0]\n  lever_arm_m: [1, 1, 1]\n",
+                            "project.yaml:10: duplicate key 'lever_arm_m'"),
+      AEROCAL_PLATFORM_CASE("platform_sigma_zero", "  lever_arm_sigma_m: 0\n",
+                            "project.yaml:9: platform: lever_arm_sigma_m must be > 0"),
+      AEROCAL_PLATFORM_CASE("platform_sigma_negative", "  boresight_sigma_deg: -1\n",
+                            "project.yaml:9: platform: boresight_sigma_deg out of range (got -1"),
+      AEROCAL_PLATFORM_CASE("platform_sigma_nan", "  boresight_sigma_deg: .nan\n",
+                            "project.yaml:9: platform: boresight_sigma_deg must be a number (got '.nan')"),
+      AEROCAL_PLATFORM_CASE("platform_sigma_inf", "  time_offset_sigma_ms: .inf\n",
+                            "project.yaml:9: platform: time_offset_sigma_ms must be a number (got '.inf')"),
+      AEROCAL_PLATFORM_CASE("platform_weighted_without_sigma", "  lever_arm: weighted\n",
+                            "project.yaml:9: platform: weighted needs lever_arm_sigma_m > 0"),
+      AEROCAL_PLATFORM_CASE("platform_unknown_key", "  lever_arm_mm: [0, 0, 0]\n",
+                            "project.yaml:9: unknown key 'lever_arm_mm'"),
+      AEROCAL_PLATFORM_CASE("platform_key_is_a_map", "  {a: 1}: 2\n",
+                            "project.yaml:9: a map key must be a plain name"),
+      AEROCAL_PLATFORM_CASE("platform_not_a_map", "  - 1\n",
+                            "project.yaml:9: platform must be a map"),
+#undef AEROCAL_PLATFORM_CASE
+      // ---- velocity columns vX, vY, vZ of exposures.csv ----
+#define AEROCAL_VELOCITY_CASE(name, value, expect)           \
+  {name,                                                    \
+   [](const TempDir& d) {                                   \
+     const auto sim = VelocityFlight(d);                    \
+     SetColumn(sim + "/exposures.csv", 3, "vX", (value));   \
+     return AdjustArgs(sim);                                \
+   },                                                       \
+   2, (expect), "a.json"}
+      AEROCAL_VELOCITY_CASE("velocity_nan", "nan", "exposures.csv:3: column 'vX' must be a number (got 'nan')"),
+      AEROCAL_VELOCITY_CASE("velocity_inf", "-inf", "exposures.csv:3: column 'vX' must be a number (got '-inf')"),
+      AEROCAL_VELOCITY_CASE("velocity_text", "fast", "exposures.csv:3: column 'vX' must be a number (got 'fast')"),
+      AEROCAL_VELOCITY_CASE("velocity_out_of_bounds", "1e9", "exposures.csv:3: vX, vY, vZ must be within +-10000 m/s"),
+      AEROCAL_VELOCITY_CASE("velocity_partial", "", "exposures.csv:3: vX, vY, vZ must all be given or none (m/s)"),
+#undef AEROCAL_VELOCITY_CASE
+      {"velocity_one_column_only",
+       [](const TempDir& d) {
+         const auto sim = VelocityFlight(d);
+         Replace(sim + "/exposures.csv", ",vX,vY,", ",vX,vY_,");
+         return AdjustArgs(sim);
+       },
+       2, "exposures.csv:2: vX, vY, vZ must all be given or none (m/s)", "a.json"},
+      // ---- simulate --test-field options ----
+#define AEROCAL_TEST_FIELD_CASE(name, options, expect)                                         \
+  {name, [](const TempDir& d) { return "simulate --test-field --out " + d.File("o") + " " + (options); }, \
+   2, (expect), "o"}
+      AEROCAL_TEST_FIELD_CASE("test_field_groups_zero", "--groups 0", "--groups: Value 0 not in range"),
+      AEROCAL_TEST_FIELD_CASE("test_field_groups_27", "--groups 27", "--groups: Value 27 not in range"),
+      AEROCAL_TEST_FIELD_CASE("test_field_groups_not_integer", "--groups 2.5", "--groups"),
+      AEROCAL_TEST_FIELD_CASE("test_field_images_per_group_3", "--images-per-group 3", "--images-per-group: Value 3 not in range"),
+      AEROCAL_TEST_FIELD_CASE("test_field_distance_nan", "--distance-m nan", "--distance-m: must be a finite number"),
+      AEROCAL_TEST_FIELD_CASE("test_field_distance_inf", "--distance-m inf", "--distance-m"),
+      AEROCAL_TEST_FIELD_CASE("test_field_distance_zero", "--distance-m 0", "--distance-m: Value 0 not in range"),
+      AEROCAL_TEST_FIELD_CASE("test_field_survey_sigma_zero", "--survey-sigma-m 0", "--survey-sigma-m"),
+      AEROCAL_TEST_FIELD_CASE("test_field_image_noise_negative", "--image-noise-px -1", "--image-noise-px"),
+      AEROCAL_TEST_FIELD_CASE("test_field_image_sigma_nan", "--image-sigma-px nan", "--image-sigma-px: must be a finite number"),
+      AEROCAL_TEST_FIELD_CASE("test_field_flight_option", "--control 3", "--control does not apply to --test-field"),
+      AEROCAL_TEST_FIELD_CASE("test_field_relief", "--relief-m 5", "--relief-m does not apply to --test-field"),
+      AEROCAL_TEST_FIELD_CASE("test_field_rig_option", "--rig dual-lens", "--rig does not apply to --test-field"),
+      AEROCAL_TEST_FIELD_CASE("test_field_pushbroom_option", "--detectors 20", "--detectors does not apply to --test-field"),
+#undef AEROCAL_TEST_FIELD_CASE
+      {"test_field_option_without_test_field",
+       [](const TempDir& d) { return "simulate --planar --out " + d.File("o"); }, 2,
+       "--planar applies to --test-field only", "o"},
+      // ---- calibrate --groups file and the `group` column of observations.csv ----
+      {"groups_unknown_image",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Append(tf + "/groups.csv", "Z999,A\n");
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "groups.csv:10: image Z999 has no observations", "cal.json"},
+      {"groups_image_twice",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Append(tf + "/groups.csv", "A001,B\n");
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "groups.csv:10: image A001 listed twice", "cal.json"},
+      {"groups_empty_group",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         SetField(tf + "/groups.csv", 2, 1, "");
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "groups.csv:2: image and group must not be empty", "cal.json"},
+      {"groups_missing_column",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Replace(tf + "/groups.csv", "image,group", "image,grp");
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "groups.csv:1: missing column 'group'", "cal.json"},
+      {"groups_group_of_one_image",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         SetField(tf + "/groups.csv", 3, 1, "Z");
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "groups.csv:3: group Z has 1 image (a group needs two or more)", "cal.json"},
+      {"groups_one_group_only",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         for (int line = 6; line <= 9; ++line) SetField(tf + "/groups.csv", line, 1, "A");
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "groups.csv: 1 group(s): the stability test needs two groups or more", "cal.json"},
+      {"groups_header_only",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Write(tf + "/groups.csv", "image,group\n");
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "groups.csv: 0 group(s)", "cal.json"},
+      {"groups_a_directory",
+       [](const TempDir& d) { return CalibrateArgs(TestField(d)) + " --groups " + d.path(); }, 2,
+       "{DIR}: is a directory", "cal.json"},
+      {"group_column_contradicts_itself",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         AddGroupColumn(tf, "", 6, "Q");
+         return CalibrateArgs(tf);
+       },
+       2, "observations.csv:6: image A001 is in group A above, here in Q", "cal.json"},
+      {"group_column_one_group_only",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         AddGroupColumn(tf, "G");
+         return CalibrateArgs(tf);
+       },
+       2, "observations.csv: 1 group(s): the stability test needs two groups or more", "cal.json"},
+      {"group_column_and_groups_option",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         AddGroupColumn(tf);
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "has a group column already", "cal.json"},
       {"certificate_of_a_broken_json",
        [](const TempDir& d) {
          Write(d.File("r.json"), "{\"schema_version\": 1,\n \"values\": [1, 2\n");

@@ -117,7 +117,7 @@ TEST_F(RigAdjustCommand, BadRigOptionsAreExitTwoWithNothingWritten) {
                         Case{"--rig-mounts weighted", "mount_sigma_deg"},
                         Case{"--compare", "not available for a rig"},
                         Case{"--joint-stitching per-flight --joint-model affine",
-                             "raw sub-image pixels"}}) {
+                             "is a rig: the joint adjustment"}}) {
     const auto r = RunAerocal(Adjust(c.options, "bad.json"));
     EXPECT_EQ(r.exit_code, 2) << c.options << "\n" << r.output;
     EXPECT_NE(r.output.find(c.message), std::string::npos) << c.options << "\n" << r.output;

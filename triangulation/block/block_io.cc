@@ -342,9 +342,14 @@ PlatformSpec ReadPlatform(const YAML::Node& node, const std::string& path) {
                           text + "')");
     *out = *m;
   };
+  // A sigma is > 0: an unknown one is left out, never 0 (FORMATS.md).
   auto sigma = [&](const char* key, double bound, double scale, double* out) {
-    if (node[key])
-      *out = scale * YamlBounded(node[key], path, std::string("platform: ") + key, 0.0, bound);
+    if (!node[key]) return;
+    const double value = YamlBounded(node[key], path, std::string("platform: ") + key, 0.0, bound);
+    if (!(value > 0))
+      ThrowInputError(WhereIs(node[key], path), std::string("platform: ") + key +
+                                                    " must be > 0 (got 0; leave it out when unknown)");
+    *out = scale * value;
   };
   constexpr double kDegToRad = M_PI / 180.0;
   if (node["lever_arm_m"]) p.lever_arm_m = vector3("lever_arm_m", 1000.0);
