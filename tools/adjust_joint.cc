@@ -41,8 +41,8 @@ void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args) {
 }
 
 int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOptions& options,
-                   const std::string& project_path, double default_sigma_px, const std::string& out,
-                   const std::string& write_camera) {
+                   const triangulation::Project& input, const std::string& project_path,
+                   const std::string& out, const std::string& write_camera) {
   triangulation::JointOptions joint_options;
   joint_options.adjust = options;
   joint_options.scope = triangulation::ParseMappingScope(joint.stitching);
@@ -52,7 +52,6 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
   if (options.robust_start)
     throw ConfigError("--robust-start is not available with --joint-stitching (start from a plain adjustment)");
 
-  const triangulation::Project input = triangulation::ReadProject(project_path, default_sigma_px);
   const triangulation::ObjectFrame frame(input.frame);
   triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
   joint_options.Validate(project);

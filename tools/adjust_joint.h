@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "triangulation/adjustment/adjust_options.h"
+#include "triangulation/block/block.h"
 
 namespace aerocal::tools {
 
@@ -26,13 +27,14 @@ std::string CameraOutputPath(const std::string& out, const std::string& id, bool
 /// first).
 void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args);
 
-/// Runs the joint adjustment of `project_path` with `options` (free interior, snooping, priors),
+/// Runs the joint adjustment of the project `input` (read from `project_path`, the command line's
+/// platform options applied) with `options` (free interior, snooping, priors),
 /// prints the summary, writes the result JSON to `out` and, when `write_camera` is set and the
 /// result is valid, the camera with the refined interior and per-flight mappings. Returns the exit
 /// code (0, or 3 when the result is not valid: AdjustmentResult::valid). ConfigError for
 /// --robust-start, InputError for a project without sub-image observations.
 int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOptions& options,
-                   const std::string& project_path, double default_sigma_px, const std::string& out,
-                   const std::string& write_camera);
+                   const triangulation::Project& input, const std::string& project_path,
+                   const std::string& out, const std::string& write_camera);
 
 }  // namespace aerocal::tools

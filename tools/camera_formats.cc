@@ -53,6 +53,9 @@ const std::vector<CameraFormat>& CameraFormats() {
        [](const ModelCamera&) { return FormatTarget{CameraModelId::kMetashapeFrame, {}}; }},
       {"pix4d", "Pix4D internal camera parameters (.cam)", calib::ReadPix4dCam, calib::WritePix4dCam,
        [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; }},
+      {"pix4d-xmp", "Pix4D camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, PerspectiveDistortion; a JPEG or an XMP sidecar)",
+       calib::ReadPix4dXmp, calib::WritePix4dXmp,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; }},
       {"opensfm", "OpenSfM / OpenDroneMap cameras.json", calib::ReadOpenSfmCameras,
        calib::WriteOpenSfmCameras,
        [](const ModelCamera& s) {

@@ -277,16 +277,8 @@ CommandRun SetupAdjust(CLI::App& app) {
     FindCameraFormat(args->camera_format, "--camera-format");
     if (args->joint.Requested() && args->camera_format != "aerocal")
       throw ConfigError("--camera-format: the joint adjustment writes our camera file only (aerocal)");
-    if (args->joint.Requested()) {
-      triangulation::PlatformSpec unused;
-      if (apply_platform(&unused))
-        throw ConfigError("the platform options (--lever-arm ...) apply to the plain adjustment; "
-                          "the joint adjustment reads `platform:` from the project YAML");
-      if (args->compare)
-        throw ConfigError("--compare and --joint-stitching do not combine (`aerocal flight` runs and compares both)");
-      return RunJointAdjust(
-          args->joint, options, args->project, args->default_sigma_px, args->out, args->write_camera);
-    }
+    if (args->joint.Requested() && args->compare)
+      throw ConfigError("--compare and --joint-stitching do not combine (`aerocal flight` runs and compares both)");
     triangulation::Project input = triangulation::ReadProject(args->project, args->default_sigma_px);
     const bool self_calibrating = args->compare || (args->self_calibration != "none" &&
                                                     !args->self_calibration.empty());
@@ -297,6 +289,8 @@ CommandRun SetupAdjust(CLI::App& app) {
       options.Validate();
     }
     apply_platform(&input.platform);
+    if (args->joint.Requested())
+      return RunJointAdjust(args->joint, options, input, args->project, args->out, args->write_camera);
     const triangulation::ObjectFrame frame(input.frame);
     const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
     const bool rig_option_given = std::any_of(

@@ -10,6 +10,7 @@
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "tools/camera_formats.h"
+#include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
 #include "tools/python_script.h"
 #include "triangulation/joint/joint_adjustment.h"
@@ -21,8 +22,8 @@ namespace {
 CommandRun SetupFlight(CLI::App& app) {
   struct Args {
     triangulation::FlightWorkflowOptions options;
-    std::string out, base, joint_model = "auto", camera_format;
-    bool no_report = false;
+    std::string out, base, joint_model = "auto", camera_format, lab;
+    bool no_report = false, certificate = false;
   };
   auto args = std::make_shared<Args>();
   app.add_option("--camera", args->options.camera_file, "Camera file (YAML) used by every step")->required();
@@ -43,8 +44,15 @@ CommandRun SetupFlight(CLI::App& app) {
   app.add_option("--camera-format", args->camera_format,
                  "Also write the calibrated camera as camera_calibrated.FORMAT in another tool's format (" +
                      CameraFormatNames() + "), converted with its residual printed");
+  app.add_flag("--certificate", args->certificate,
+               "Also write the certificate of the in-flight calibration (OUT/certificate/: "
+               "certificate.json, .html, .pdf; a type-A budget, as `aerocal certificate` of "
+               "result.json); only for a valid flight");
+  app.add_option("--lab", args->lab, "Lab YAML of the certificate (as `aerocal certificate --lab`)")
+      ->needs("--certificate");
   return [args]() {
     CheckOutputFolder(args->out, "--out");
+    if (args->certificate) ReadCertificateLab(args->lab);  // a bad lab file before the flight runs
     if (!args->camera_format.empty()) FindCameraFormat(args->camera_format, "--camera-format");
     args->options.base_ids = SplitCommaList(args->base);
     args->options.joint_model = triangulation::ParseJointModel(args->joint_model);
@@ -83,6 +91,17 @@ CommandRun SetupFlight(CLI::App& app) {
         return kExitInternal;
       }
       std::printf("report: %s\n", html.c_str());
+    }
+    if (args->certificate && result.valid) {
+      CertificateArgs certificate;
+      certificate.result = json_path;
+      certificate.lab = args->lab;
+      certificate.out = (fs::path(args->out) / "certificate").string();
+      certificate.no_render = args->no_report;
+      const int code = WriteCertificate(certificate);
+      if (code != kExitOk) return code;
+    } else if (args->certificate) {
+      std::fprintf(stderr, "flight: no certificate written (the flight is not valid)\n");
     }
     return result.converged && result.valid ? kExitOk : kExitNotConverged;
   };

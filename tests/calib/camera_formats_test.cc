@@ -10,10 +10,12 @@
 #include <fstream>
 #include <functional>
 #include <map>
+#include <regex>
 #include <sstream>
 
 #include <gtest/gtest.h>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "tests/support/test_support.h"
 
@@ -82,7 +84,14 @@ std::vector<Format> Formats() {
       {"photomodeler", ReadPhotoModelerCamera, WritePhotoModelerCamera, {CameraModelId::kBrownFraser10, {"B1", "B2"}, true}, true, true, ".txt"},
       {"australis", ReadAustralisCamera, WriteAustralisCamera, {CameraModelId::kBrownFraser10, {}, true}, true, true, ".txt"},
       {"kalibr", ReadKalibrCamchain, WriteKalibrCamchain, {CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}}, true, false, ".yaml"},
+      {"pix4d-xmp", ReadPix4dXmp, WritePix4dXmp, {CameraModelId::kPix4dPerspective, {}, true}, true, true, ".xmp"},
   };
+}
+
+Format FormatNamed(const std::string& name) {
+  for (const Format& f : Formats())
+    if (f.name == name) return f;
+  throw std::logic_error("no format " + name);
 }
 
 CameraFile WriteAndRead(const Format& f, const CameraFile& file, const TempDir& dir) {
@@ -113,27 +122,82 @@ TEST(CameraFormats, EachFormatRoundTripsItsOwnModelExactly) {
   }
 }
 
+TEST(CameraFormats, AHostileNameNeverBreaksAFile) {
+  // XML markup, quotes and a newline in the camera name: every format still reads back its
+  // parameters exactly; the formats that keep a name keep it on one line, unescaped.
+  TempDir dir("aerocal_formats_name");
+  const std::string hostile = "A&B <lens> \"q\" 'p'\nsecond line";
+  for (const Format& f : Formats()) {
+    SCOPED_TRACE(f.name);
+    FileConversion in_model = ConvertCameraFile(File(DjiRecordA()), f.target);
+    in_model.file.name = hostile;
+    const CameraFile back = WriteAndRead(f, in_model.file, dir);
+    ExpectSameParams(in_model.file.camera, back.camera, f.name);
+    if (std::string(f.name) == "dbat" || std::string(f.name) == "photomodeler") {
+      EXPECT_EQ(back.name, "A&B <lens> \"q\" 'p' second line");
+    }
+  }
+}
+
+TEST(CameraFormats, Pix4dXmpTagsAreThePix4dCamValues) {
+  // Pix4D's XMP camera tags in element form with the values of Pix4D's specification page
+  // (article 360016450032) and a prefix other than "Camera": the same camera as a .cam with the
+  // same numbers; the fisheye model type is refused by name; without a pixel size: --pixel-mm.
+  TempDir dir("aerocal_pix4d_xmp");
+  const std::string xmp = dir.File("p4d.xmp");
+  const std::string body =
+      "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\"><rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
+      "<rdf:Description xmlns:P4=\"http://pix4d.com/camera/1.0/\">\n"
+      "<P4:ModelType>perspective</P4:ModelType>\n"
+      "<P4:PrincipalPoint>2.42299,1.850154</P4:PrincipalPoint>\n"
+      "<P4:PerspectiveFocalLength>4.569165</P4:PerspectiveFocalLength>\n"
+      "<P4:PerspectiveDistortion>0.201690322, -0.358534038, 0.256185599, 0.004208643, 0.000268361</P4:PerspectiveDistortion>\n"
+      "</rdf:Description></rdf:RDF></x:xmpmeta>\n";
+  WriteFileAtomically(xmp, body);
+  CameraReadOptions options;
+  options.width_px = 4000;
+  options.height_px = 3000;
+  options.pixel_size_mm = 0.00122;
+  const CameraFile a = ReadPix4dXmp(xmp, options);
+  const std::string cam = dir.File("p4d.cam");
+  WriteFileAtomically(cam, "Pix4D camera calibration file 0\nF 4.569165\nPx 2.42299\nPy 1.850154\n"
+                           "K1 0.201690322\nK2 -0.358534038\nK3 0.256185599\nT1 0.004208643\nT2 0.000268361\n");
+  const CameraFile b = ReadPix4dCam(cam, options);
+  EXPECT_EQ(a.camera.params, b.camera.params);
+  EXPECT_EQ(a.camera.frame.pixel_size_mm, b.camera.frame.pixel_size_mm);
+  options.pixel_size_mm = 0;
+  EXPECT_THROW(ReadPix4dXmp(xmp, options), InputError);
+  WriteFileAtomically(xmp, std::regex_replace(body, std::regex(">perspective<"), ">fisheye<"));
+  options.pixel_size_mm = 0.00122;
+  try {
+    ReadPix4dXmp(xmp, options);
+    ADD_FAILURE() << "fisheye accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("p4d.xmp:3: P4:ModelType 'fisheye'"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CameraFormats, TermsOutsideOpenCvSurviveTheirFormat) {
   TempDir dir("aerocal_formats");
   // Metashape's b1, b2, k4, p3, p4; DewarpDataK6's k4-k6; a fisheye in OpenSfM and Kalibr.
   ModelCamera metashape{CameraModelId::kMetashapeFrame,
                         {3680, 2.2, 22.0, 0.8, -0.3, -0.26, 0.1, -0.03, 0.002, 4e-5, -3e-4, 0.01, -0.002},
                         {0.0024, 5472, 3648}};
-  const CameraFile m = WriteAndRead(Formats()[2], File(metashape), dir);
+  const CameraFile m = WriteAndRead(FormatNamed("metashape"), File(metashape), dir);
   ExpectSameParams(metashape, m.camera, "metashape");
   ModelCamera k6 = DjiRecordA();
   k6.params[OpenCvModel::kK4] = 0.01, k6.params[OpenCvModel::kK5] = -0.002, k6.params[OpenCvModel::kK6] = 1e-4;
-  const CameraFile d = WriteAndRead(Formats()[5], File(k6), dir);
+  const CameraFile d = WriteAndRead(FormatNamed("dji"), File(k6), dir);
   ExpectSameParams(k6, d.camera, "DewarpDataK6");
   const ModelCamera fisheye{CameraModelId::kOpenCvFisheye,
                             {900, 900, 0.5 * 1279, 0.5 * 959, 0.05, -0.01, 0, 0},
                             {0.003, 1280, 960}};
-  ExpectSameParams(fisheye, WriteAndRead(Formats()[4], File(fisheye), dir).camera, "opensfm fisheye");
+  ExpectSameParams(fisheye, WriteAndRead(FormatNamed("opensfm"), File(fisheye), dir).camera, "opensfm fisheye");
   ModelCamera equi = fisheye;
   equi.params[6] = 0.002, equi.params[7] = -4e-4, equi.params[0] = 901;
-  ExpectSameParams(equi, WriteAndRead(Formats()[9], File(equi), dir).camera, "kalibr equidistant");
+  ExpectSameParams(equi, WriteAndRead(FormatNamed("kalibr"), File(equi), dir).camera, "kalibr equidistant");
   // Our file holds any registry model.
-  ExpectSameParams(metashape, WriteAndRead(Formats()[0], File(metashape), dir).camera, "aerocal metashape_frame");
+  ExpectSameParams(metashape, WriteAndRead(FormatNamed("aerocal"), File(metashape), dir).camera, "aerocal metashape_frame");
 }
 
 // ---- ours -> format -> ours ----
@@ -182,7 +246,7 @@ TEST(CameraFormats, OursThroughEveryFormatAndBackStatesItsResidual) {
     // drone lens (our refit of DJI record A) 2-16 px where the target has fewer terms (Kalibr
     // radtan: k1, k2 only).
     const std::map<std::string, std::pair<double, double>> stated = {
-        {"colmap", {0.048, 1.95}}, {"metashape", {5.6e-5, 3.46}}, {"pix4d", {0.090, 10.7}},
+        {"colmap", {0.048, 1.95}}, {"metashape", {5.6e-5, 3.46}}, {"pix4d", {0.090, 10.7}}, {"pix4d-xmp", {0.090, 10.7}},
         {"opensfm", {0.048, 9.56}}, {"dji", {0.048, 1.95}},       {"dbat", {0.090, 2.61}}, {"photomodeler", {0.090, 2.61}},
         {"kalibr", {0.064, 16.3}}};
     EXPECT_LT(a.out_max_px, 1.2 * stated.at(f.name).first) << f.name;
@@ -275,7 +339,7 @@ TEST(CameraFormatsRealData, OpenSfmBerlinReconstructionCamera) {
     EXPECT_TRUE(out.result.exact) << format.name;
     EXPECT_LT(out.result.residual.max_px, 1e-9) << format.name;
     const CameraFile read = WriteAndRead(format, out.file, tmp);
-    const FileConversion back = ConvertCameraFile(read, Formats()[4].target);
+    const FileConversion back = ConvertCameraFile(read, FormatNamed("opensfm").target);
     EXPECT_TRUE(back.result.exact) << format.name;
     EXPECT_LT(MaxDifferencePx(f.camera, back.file.camera), 1e-9) << format.name;
   }
@@ -311,7 +375,7 @@ TEST(CameraFormatsRealData, OdmCamerasJsonOfTheOrthorityDocs) {
   EXPECT_DOUBLE_EQ(f.camera.params[O::kP1], 0.0007345906274317972);
   // The same lens class as the DJI DewarpData records: k1 -0.264 against -0.263 (record A).
   EXPECT_NEAR(f.camera.params[O::kK1], DjiRecordA().params[O::kK1], 0.01);
-  const CameraFile back = WriteAndRead(Formats()[4], f, tmp);
+  const CameraFile back = WriteAndRead(FormatNamed("opensfm"), f, tmp);
   ExpectSameParams(f.camera, back.camera, "odm cameras.json");
 }
 
@@ -333,11 +397,11 @@ TEST(CameraFormatsRealData, DbatResultCameraAgainstItsReport) {
   EXPECT_NEAR(f.camera.params[B::kP2], -4.41171e-5, 5e-11);
   ASSERT_EQ(f.notes.size(), 1u);  // the aspect 0.99961 is not modelled: said
   TempDir tmp("aerocal_formats");
-  const CameraFile back = WriteAndRead(Formats()[6], f, tmp);
+  const CameraFile back = WriteAndRead(FormatNamed("dbat"), f, tmp);
   ExpectSameParams(f.camera, back.camera, "dbat");
   // Into Metashape (a forward model: fitted) and back into DBAT.
-  const FileConversion m = ConvertCameraFile(f, Formats()[2].target);
-  const FileConversion again = ConvertCameraFile(WriteAndRead(Formats()[2], m.file, tmp), Formats()[6].target);
+  const FileConversion m = ConvertCameraFile(f, FormatNamed("metashape").target);
+  const FileConversion again = ConvertCameraFile(WriteAndRead(FormatNamed("metashape"), m.file, tmp), FormatNamed("dbat").target);
   std::printf("DBAT c4040z -> metashape: %s; -> DBAT: %.3g px max against the original\n",
               m.result.Summary().c_str(), MaxDifferencePx(f.camera, again.file.camera));
   // Measured: 0.057 px at the corner (rms 0.005 px) out, 5e-4 px back.

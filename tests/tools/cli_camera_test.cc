@@ -78,7 +78,7 @@ TEST(CameraFormatsOpenCv, PublishedChessboardCalibrationThroughEveryFormatProjec
     calib::CameraReadOptions options;
     options.width_px = format.name == "pix4d" ? 640 : 0;
     options.height_px = format.name == "pix4d" ? 480 : 0;
-    const bool holds_pixel = format.name == "pix4d" || format.name == "aerocal" ||
+    const bool holds_pixel = format.name == "pix4d" || format.name == "pix4d-xmp" || format.name == "aerocal" ||
                              format.name == "dbat" || format.name == "photomodeler" ||
                              format.name == "australis";
     options.pixel_size_mm = holds_pixel ? 0 : 0.006;
@@ -196,7 +196,7 @@ TEST(CliCamera, ConvertsOursIntoEveryFormatAndBackWithAReport) {
     if (format.name == "metashape") {
       EXPECT_NE(Read(out).find("<covariance>"), std::string::npos);
     }
-    const bool holds_pixel = format.name == "aerocal" || format.name == "dbat" ||
+    const bool holds_pixel = format.name == "aerocal" || format.name == "dbat" || format.name == "pix4d-xmp" ||
                              format.name == "photomodeler" || format.name == "australis";
     const std::string extra = format.name == "pix4d" ? " --width 14000 --height 12000"
                               : holds_pixel          ? ""

@@ -20,9 +20,12 @@ class FlightWorkflow : public ::testing::Test {
     const auto sim = testing::RunAerocal("simulate --out " + dir_->File("data") +
                                          " --seed 3 --stitch-ties 200 --gnss-sigma-m 0.05");
     ASSERT_EQ(sim.exit_code, 0) << sim.output;
+    WriteFileAtomically(dir_->File("lab.yaml"), "certificate: {number: F-7, date: 2026-11-24}\n"
+                                                "camera: {make: Sim, model: Four-CCD}\n");
     run_ = new testing::CommandResult(testing::RunAerocal(
         "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " + dir_->File("data") +
-        " --base III,IV --out " + dir_->File("report") + " --camera-format metashape"));
+        " --base III,IV --out " + dir_->File("report") + " --camera-format metashape --certificate --lab " +
+        dir_->File("lab.yaml")));
   }
   static void TearDownTestSuite() {
     delete run_;
@@ -94,14 +97,13 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
 }
 
 TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
-  // `aerocal certificate --result` of a flight result: the certificate form of the in-flight
-  // calibration, a type-A budget from the adjustment (U = k sigma, k from the redundancy).
+  // `flight --certificate` writes the certificate form of the in-flight calibration (the joint
+  // adjustment's camera, a type-A budget: U = k sigma, k from the redundancy) as `aerocal
+  // certificate --result result.json` does; HTML and PDF rendered.
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto r = testing::RunAerocal("certificate --result " + dir_->File("report/result.json") +
-                                     " --no-render --out " + dir_->File("cert"));
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto cert = nlohmann::json::parse(ReadTextFile(dir_->File("cert/certificate.json")));
+  const auto cert = nlohmann::json::parse(ReadTextFile(dir_->File("report/certificate/certificate.json")));
   EXPECT_EQ(cert["method"]["kind"], "in-flight calibration");
+  EXPECT_EQ(cert["lab"]["certificate"]["number"], "F-7");
   const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
   const auto& joint = doc["adjustments"][2];  // the joint adjustment's camera is the certified one
   ASSERT_EQ(joint["name"], "joint");
@@ -116,6 +118,42 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
     EXPECT_NE(q["statement"].get<std::string>().find("(k = 2)"), std::string::npos) << q["statement"];
   }
   EXPECT_TRUE(has_c);
+  const std::string html = ReadTextFile(dir_->File("report/certificate/certificate.html"));
+  for (const char* text : {"Calibration certificate", "F-7", "in-flight calibration", "Uncertainty budget"})
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  // The certificate command on the flight's result.json gives the same data (its source apart).
+  const auto r = testing::RunAerocal("certificate --result " + dir_->File("report/result.json") + " --lab " +
+                                     dir_->File("lab.yaml") + " --no-render --out " + dir_->File("cert"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto again = nlohmann::json::parse(ReadTextFile(dir_->File("cert/certificate.json")));
+  auto first = cert;
+  again.erase("source");
+  first.erase("source");
+  EXPECT_EQ(first, again);
+  // Every PDF page rendered to PNG (poppler's pdftoppm).
+  if (testing::RunCommand("command -v pdftoppm").exit_code != 0)
+    GTEST_SKIP() << "pdftoppm is absent (Debian package poppler-utils): the PDF pages are not rendered";
+  const auto png = testing::RunCommand("pdftoppm -r 30 -png " + dir_->File("report/certificate/certificate.pdf") +
+                                       " " + dir_->File("page"));
+  ASSERT_EQ(png.exit_code, 0) << png.output;
+  int pages = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir_->path()))
+    if (e.path().extension() == ".png" && std::filesystem::file_size(e.path()) > 1000) ++pages;
+  EXPECT_GE(pages, 2);
+}
+
+TEST_F(FlightWorkflow, CertificateOptionsAreCheckedBeforeTheFlightRuns) {
+  // A bad lab file: FILE:LINE, exit 2, nothing written; --lab without --certificate: exit 2.
+  WriteFileAtomically(dir_->File("bad_lab.yaml"), "certificate: {numbr: 1}\n");
+  const std::string flight = "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " +
+                             dir_->File("data") + " --base III,IV --out " + dir_->File("bad_report");
+  const auto bad = testing::RunAerocal(flight + " --certificate --lab " + dir_->File("bad_lab.yaml"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("bad_lab.yaml:1"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_->File("bad_report/result.json")));
+  const auto lone = testing::RunAerocal(flight + " --lab " + dir_->File("lab.yaml"));
+  EXPECT_EQ(lone.exit_code, 2) << lone.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_->File("bad_report/result.json")));
 }
 
 TEST_F(FlightWorkflow, ReportHoldsTablesAndPlots) {

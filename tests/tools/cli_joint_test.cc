@@ -244,6 +244,20 @@ TEST_F(ShearedFlight, AdjustJointWithoutStitchingStartsFromTheCameraFileMappings
   ExpectWithinThreeSigma(MappingErrors(j, Truth()));
 }
 
+TEST_F(ShearedFlight, AdjustJointTakesThePlatformOptions) {
+  // The joint adjustment is a sensor kind of the one block adjustment: the command line's
+  // platform options reach it as they reach the plain run. The simulated lever arm is zero.
+  const auto j = AdjustJoint("--joint-stitching per-flight --base III,IV --self-calibration all "
+                             "--lever-arm-m 0,0,0 --lever-arm free", "joint_platform.json");
+  ASSERT_TRUE(j.contains("platform")) << j.dump().substr(0, 400);
+  const auto& lever = j["platform"]["lever_arm_m"];
+  EXPECT_EQ(lever["mode"], "free");
+  for (int i = 0; i < 3; ++i) {
+    ASSERT_TRUE(lever["sigma"][i].is_number()) << i;
+    EXPECT_LE(std::abs(lever["value"][i].get<double>()), 3.0 * lever["sigma"][i].get<double>()) << i;
+  }
+}
+
 TEST_F(StronglyShearedFlight, AModelThatDoesNotFitWarnsByResidualGroup) {
   // Translation mappings cannot follow the shears: the stitching ties (and the image rays) do not
   // fit, and the result says so by group name.

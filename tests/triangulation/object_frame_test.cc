@@ -10,6 +10,7 @@
 #include "triangulation/import/write_project.h"
 #include "triangulation/simulation/flight_simulator.h"
 
+#include <GeographicLib/UTMUPS.hpp>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -66,6 +67,55 @@ TEST(ObjectFrame, GeodeticRoundTripsThroughLocalTangentPlaneAndUtm) {
   const Eigen::Vector3d en = ObjectFrame(utm).ToAdjustment({8.5417, 47.3769, 400.0});
   EXPECT_NEAR(en.x(), 465e3, 2e3);
   EXPECT_NEAR(en.y(), 5247e3, 2e3);
+}
+
+// A velocity of geodetic input is east, north, up (m/s) at the exposure (object_frame.h).
+Eigen::Vector3d VelocityInFrame(const FrameSpec& spec, const Eigen::Vector3d& lon_lat_h,
+                                const Eigen::Vector3d& enu_mps) {
+  Project project;
+  Exposure e;
+  e.center_m = lon_lat_h;
+  e.velocity_mps = enu_mps;
+  project.exposures.push_back(e);
+  return *ToAdjustmentFrame(project, ObjectFrame(spec)).exposures.front().velocity_mps;
+}
+
+TEST(ObjectFrame, VelocitiesTurnWithTheFrame) {
+  const Eigen::Vector3d v(30.0, 55.0, -2.0);
+  // At the origin of the local frame east, north, up are its axes.
+  const FrameSpec local = LocalFrame();
+  const Eigen::Vector3d at_origin(local.lon_deg, local.lat_deg, local.h_m);
+  EXPECT_LT((VelocityInFrame(local, at_origin, v) - v).norm(), 1e-6);
+  // 0.2 deg of longitude east of the origin the local north turns by d_lon sin(lat) about up
+  // (meridian convergence on the tangent plane, to first order): 0.2 deg * 0.7355 = 0.147 deg.
+  const double lat = local.lat_deg * M_PI / 180.0, dlon = 0.2 * M_PI / 180.0;
+  const double turn = dlon * std::sin(lat);
+  const Eigen::Vector3d east_of(local.lon_deg + 0.2, local.lat_deg, local.h_m);
+  const Eigen::Vector3d turned = VelocityInFrame(local, east_of, v);
+  const Eigen::Vector3d expected(v.x() * std::cos(turn) - v.y() * std::sin(turn),
+                                 v.x() * std::sin(turn) + v.y() * std::cos(turn), v.z());
+  EXPECT_LT((turned.head<2>() - expected.head<2>()).norm(), 1e-3 * v.norm());
+  // The exposure's east axis dips below the origin's plane by d_lon cos(lat) = 2.36 mrad.
+  EXPECT_NEAR(turned.z(), v.z() - v.x() * dlon * std::cos(lat), 1e-3);
+  // UTM: grid = k R/(R+h) Rz(gamma) (east, north) with the point scale k and the meridian
+  // convergence gamma of GeographicLib (grid north is gamma clockwise from true north), R/(R+h)
+  // because the grid is the ellipsoid's (centres are converted so: h = 500 m gives 7.8e-5, R
+  // taken as the mean radius, 4e-7 relative off M or N); up unchanged.
+  FrameSpec utm;
+  utm.kind = FrameSpec::Kind::kUtm;
+  utm.utm_zone = "32N";
+  const double lon = 11.2, latd = 47.4;  // 2.2 deg east of the zone's central meridian
+  int zone = 0;
+  bool north = true;
+  double x = 0, y = 0, gamma_deg = 0, k = 0;
+  GeographicLib::UTMUPS::Forward(latd, lon, zone, north, x, y, gamma_deg, k, 32);
+  const double g = gamma_deg * M_PI / 180.0;
+  const Eigen::Vector3d grid = VelocityInFrame(utm, {lon, latd, 500.0}, v);
+  const double scale = k * 6371e3 / (6371e3 + 500.0);
+  EXPECT_NEAR(grid.x(), scale * (v.x() * std::cos(g) - v.y() * std::sin(g)), 1e-4);
+  EXPECT_NEAR(grid.y(), scale * (v.x() * std::sin(g) + v.y() * std::cos(g)), 1e-4);
+  EXPECT_NEAR(grid.z(), v.z(), 1e-6);
+  EXPECT_GT(std::abs(g), 0.02);  // the test would not see a missing rotation otherwise
 }
 
 TEST(ObjectFrame, BadZoneIsAnInputError) {

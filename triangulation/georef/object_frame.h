@@ -50,7 +50,10 @@ class ObjectFrame {
 };
 
 /// The project with points and exposure centres (and their sigmas, unchanged in metres) in the
-/// adjustment frame. Geodetic sigmas are read as metres (sX east, sY north, sZ up).
+/// adjustment frame. Geodetic sigmas are read as metres (sX east, sY north, sZ up). Exposure
+/// velocities of geodetic input are east, north, up (m/s) at the exposure; they are turned into
+/// the adjustment frame's axes (meridian convergence and point scale for UTM, the tangent-plane
+/// rotation for local).
 Project ToAdjustmentFrame(const Project& project, const ObjectFrame& frame);
 
 /// Adjusted coordinates (points, exposure centres, point tables) back into the input frame;

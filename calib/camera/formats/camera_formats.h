@@ -107,6 +107,10 @@ void WriteMetashapeCalibration(const std::string& path, const CameraFile& camera
 
 CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& options);
 void WritePix4dCam(const std::string& path, const CameraFile& camera);
+/// Pix4D's camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, PerspectiveDistortion)
+/// from a JPEG or an XMP sidecar; the pixel size from exif:FocalPlaneXResolution or --pixel-mm.
+CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& options);
+void WritePix4dXmp(const std::string& path, const CameraFile& camera);
 
 CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options);
 void WriteOpenSfmCameras(const std::string& path, const CameraFile& camera);
@@ -144,6 +148,11 @@ double ParseNumber(const std::string& text, const SourceRef& where, const std::s
 void RequireZero(const ModelCamera& camera, const std::vector<std::string>& names,
                  const std::string& format);
 double Param(const ModelCamera& camera, std::string_view name);
+/// A camera name as one line of text (control characters, a newline among them, become spaces):
+/// line-oriented formats put the name on a line of its own.
+std::string OneLine(std::string_view name);
+/// `text` with & < > " ' as XML entities (a camera name in an XML element).
+std::string XmlEscaped(std::string_view text);
 }  // namespace internal
 
 }  // namespace aerocal::calib

@@ -123,7 +123,7 @@ void WriteDbatCameraXml(const std::string& path, const CameraFile& file) {
   std::ostringstream out;
   out.precision(17);
   out << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<document dbat_camera_version=\"1.0\">\n"
-      << "   <cameras>\n      <camera>\n         <id>1</id>\n         <name>" << file.name
+      << "   <cameras>\n      <camera>\n         <id>1</id>\n         <name>" << internal::XmlEscaped(internal::OneLine(file.name))
       << "</name>\n         <unit>mm</unit>\n         <calibrated>yes</calibrated>\n"
       << "         <sensor>" << w_mm << "," << h_mm << "</sensor>\n         <image>" << f.width_px
       << "," << f.height_px << "</image>\n         <aspect>1</aspect>\n         <focal>"

@@ -13,68 +13,19 @@
 #include <sstream>
 
 #include "calib/camera/formats/camera_formats.h"
+#include "calib/camera/formats/xmp_packet.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 
 namespace aerocal::calib {
-namespace {
 
-int LineAt(const std::string& text, size_t offset) {
-  int line = 1;
-  for (size_t i = 0; i < offset && i < text.size(); ++i) line += text[i] == '\n';
-  return line;
-}
-
-// The value of an XMP property written as an attribute (drone-dji:NAME="v") or an element
-// (<drone-dji:NAME>v</drone-dji:NAME>); npos when absent.
-size_t FindXmp(const std::string& text, const std::string& qualified, std::string* value) {
-  const std::string attribute = qualified + "=\"";
-  size_t at = text.find(attribute);
-  if (at != std::string::npos) {
-    const size_t begin = at + attribute.size(), end = text.find('"', begin);
-    if (end == std::string::npos) return std::string::npos;
-    *value = text.substr(begin, end - begin);
-    return begin;
-  }
-  const std::string open = "<" + qualified + ">", close = "</" + qualified + ">";
-  at = text.find(open);
-  if (at == std::string::npos) return std::string::npos;
-  const size_t begin = at + open.size(), end = text.find(close, begin);
-  if (end == std::string::npos) return std::string::npos;
-  *value = text.substr(begin, end - begin);
-  return begin;
-}
-
-// Width and height from a JPEG's SOF marker; false when the bytes are not a JPEG.
-bool JpegSize(const std::string& bytes, int* width, int* height) {
-  const auto byte = [&](size_t i) { return static_cast<unsigned char>(bytes[i]); };
-  if (bytes.size() < 4 || byte(0) != 0xFF || byte(1) != 0xD8) return false;
-  size_t i = 2;
-  while (i + 9 < bytes.size()) {
-    if (byte(i) != 0xFF) return false;
-    const unsigned marker = byte(i + 1);
-    const size_t length = (byte(i + 2) << 8) | byte(i + 3);
-    if (marker >= 0xC0 && marker <= 0xCF && marker != 0xC4 && marker != 0xC8 && marker != 0xCC) {
-      *height = (byte(i + 5) << 8) | byte(i + 6);
-      *width = (byte(i + 7) << 8) | byte(i + 8);
-      return true;
-    }
-    if (marker == 0xDA || length < 2) return false;
-    i += 2 + length;
-  }
-  return false;
-}
-
-std::string Trim(const std::string& s) {
-  const size_t b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
-  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
-}
-
-}  // namespace
-
+using internal::FindXmpValue;
+using internal::JpegSize;
+using internal::LineAt;
+using internal::TrimBlanks;
 ModelCamera DjiDewarpDataCamera(const std::string& text, const SourceRef& where, int width_px,
                                 int height_px) {
-  std::string values = Trim(text);
+  std::string values = TrimBlanks(text);
   const size_t semicolon = values.find(';');
   if (semicolon != std::string::npos) values = values.substr(semicolon + 1);  // the date
   const std::vector<std::string> fields = SplitCommaList(values, {true, true});
@@ -113,8 +64,8 @@ CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& o
   int jpeg_width = 0, jpeg_height = 0;
   const bool jpeg = JpegSize(bytes, &jpeg_width, &jpeg_height);
   std::string data;
-  size_t at = FindXmp(bytes, "drone-dji:DewarpDataK6", &data);
-  if (at == std::string::npos) at = FindXmp(bytes, "drone-dji:DewarpData", &data);
+  size_t at = FindXmpValue(bytes, "drone-dji:DewarpDataK6", &data);
+  if (at == std::string::npos) at = FindXmpValue(bytes, "drone-dji:DewarpData", &data);
   if (at == std::string::npos) {
     if (jpeg || bytes.find("drone-dji") != std::string::npos)
       ThrowInputError({path, jpeg ? 0 : 1}, "no drone-dji:DewarpData in the file's XMP");
@@ -124,10 +75,10 @@ CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& o
   const SourceRef where{path, jpeg ? 0 : LineAt(bytes, at)};
   if (!jpeg) {  // an XMP sidecar may carry the size (tiff:ImageWidth / tiff:ImageLength)
     std::string w, h;
-    if (FindXmp(bytes, "tiff:ImageWidth", &w) != std::string::npos &&
-        FindXmp(bytes, "tiff:ImageLength", &h) != std::string::npos) {
-      jpeg_width = static_cast<int>(internal::ParseNumber(Trim(w), where, "tiff:ImageWidth", 1e6));
-      jpeg_height = static_cast<int>(internal::ParseNumber(Trim(h), where, "tiff:ImageLength", 1e6));
+    if (FindXmpValue(bytes, "tiff:ImageWidth", &w) != std::string::npos &&
+        FindXmpValue(bytes, "tiff:ImageLength", &h) != std::string::npos) {
+      jpeg_width = static_cast<int>(internal::ParseNumber(TrimBlanks(w), where, "tiff:ImageWidth", 1e6));
+      jpeg_height = static_cast<int>(internal::ParseNumber(TrimBlanks(h), where, "tiff:ImageLength", 1e6));
     }
   }
   CameraFile file;
@@ -138,8 +89,8 @@ CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& o
   file.name = "dji";
   for (const char* design : {"CalibratedFocalLength", "CalibratedOpticalCenterX", "CalibratedOpticalCenterY"}) {
     std::string value;
-    if (FindXmp(bytes, std::string("drone-dji:") + design, &value) != std::string::npos)
-      file.notes.push_back(std::string(design) + " = " + Trim(value) + " px (design value, not used)");
+    if (FindXmpValue(bytes, std::string("drone-dji:") + design, &value) != std::string::npos)
+      file.notes.push_back(std::string(design) + " = " + TrimBlanks(value) + " px (design value, not used)");
   }
   return file;
 }

@@ -105,7 +105,7 @@ void WritePhotoModelerCamera(const std::string& path, const CameraFile& file) {
   const double w_mm = f.width_px * f.pixel_size_mm, h_mm = f.height_px * f.pixel_size_mm;
   std::ostringstream out;
   out.precision(17);
-  out << "Bundle Soln " << (file.name.empty() ? "aerocal camera" : file.name) << "\n"
+  out << "Bundle Soln " << (file.name.empty() ? "aerocal camera" : internal::OneLine(file.name)) << "\n"
       << " 0 -1 " << f.width_px << " " << f.height_px << "\n"
       << " 1 0 0 0 0 0 0 0 0\n"
       << " " << q[Model::kC] << " " << q[Model::kX0] + 0.5 * w_mm << " "

@@ -1,0 +1,137 @@
+// Pix4D's camera XMP tags (namespace http://pix4d.com/camera/1.0, Pix4D support article 360016450032
+// "Specifications of XMP Camera Tags"): the "XML form" of Pix4D's internal camera parameters that
+// a camera maker writes into its images for Pix4D to use:
+//   Camera:ModelType              "perspective" (or "fisheye": not read, said)
+//   Camera:PerspectiveFocalLength  F, mm
+//   Camera:PrincipalPoint          "Px,Py", mm
+//   Camera:PerspectiveDistortion   "R1,R2,R3,T1,T2"
+// the same quantities as the .cam file (pix4d_format.cc), in the same conventions
+// (models/pix4d.h: mm from the top-left corner, y down, T1 = p1, T2 = p2). The tags hold no image
+// or pixel size: the image size from a JPEG's SOF marker or a sidecar's tiff:ImageWidth/Length,
+// the pixel size from exif:FocalPlaneXResolution with exif:FocalPlaneResolutionUnit (2 inch,
+// 3 cm, 4 mm), which the writer adds and Pix4D also reads, else --pixel-mm.
+#include <cmath>
+#include <optional>
+#include <sstream>
+
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/camera/formats/xmp_packet.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+
+namespace aerocal::calib {
+namespace {
+
+constexpr const char* kPix4dCameraUri = "http://pix4d.com/camera/1.0";
+
+struct XmpText {
+  std::string value;
+  SourceRef where;
+};
+
+// A number or a rational "a/b" (EXIF rationals in XMP).
+double ParseRational(const XmpText& t, const std::string& what) {
+  const size_t slash = t.value.find('/');
+  if (slash == std::string::npos) return internal::ParseNumber(t.value, t.where, what);
+  const double a = internal::ParseNumber(t.value.substr(0, slash), t.where, what);
+  const double b = internal::ParseNumber(t.value.substr(slash + 1), t.where, what);
+  if (b == 0) ThrowInputError(t.where, what + ": zero denominator");
+  return a / b;
+}
+
+}  // namespace
+
+CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& options) {
+  using M = Pix4dPerspectiveModel;
+  const std::string bytes = ReadTextFile(path);
+  int width = 0, height = 0;
+  const bool jpeg = internal::JpegSize(bytes, &width, &height);
+  const std::string prefix = internal::XmpPrefix(bytes, kPix4dCameraUri, "Camera");
+  const auto find = [&](const std::string& qualified) -> std::optional<XmpText> {
+    std::string value;
+    const size_t at = internal::FindXmpValue(bytes, qualified, &value);
+    if (at == std::string::npos) return std::nullopt;
+    return XmpText{internal::TrimBlanks(value), {path, internal::LineAt(bytes, at)}};
+  };
+  const auto numbers = [&](const XmpText& t, size_t count, const std::string& what) {
+    const std::vector<std::string> fields = SplitCommaList(t.value, {true, true});
+    if (fields.size() != count)
+      ThrowInputError(t.where, what + " must hold " + std::to_string(count) + " comma-separated values (got '" +
+                                   t.value + "')");
+    std::vector<double> v;
+    for (const std::string& f : fields) v.push_back(internal::ParseNumber(f, t.where, what, 1e4));
+    return v;
+  };
+  const auto focal = find(prefix + ":PerspectiveFocalLength");
+  const auto pp = find(prefix + ":PrincipalPoint");
+  if (!focal || !pp) {
+    const auto type = find(prefix + ":ModelType");
+    ThrowInputError({path, type ? type->where.line : 1},
+                    "no " + prefix + ":PerspectiveFocalLength / " + prefix +
+                        ":PrincipalPoint (Pix4D camera XMP, " + kPix4dCameraUri + ")");
+  }
+  if (const auto type = find(prefix + ":ModelType"); type && type->value != "perspective")
+    ThrowInputError(type->where, prefix + ":ModelType '" + type->value +
+                                     "': only the perspective model is read (Pix4D's fisheye "
+                                     "polynomial is not a registry model)");
+  CameraFile file;
+  file.name = "pix4d";
+  file.camera.model = M::kId;
+  file.camera.params.assign(M::kNumParams, 0.0);
+  file.camera.params[M::kF] = numbers(*focal, 1, prefix + ":PerspectiveFocalLength")[0];
+  if (!(file.camera.params[M::kF] > 0)) ThrowInputError(focal->where, "the focal length must be > 0 mm");
+  const std::vector<double> principal = numbers(*pp, 2, prefix + ":PrincipalPoint");
+  file.camera.params[M::kPx] = principal[0];
+  file.camera.params[M::kPy] = principal[1];
+  if (const auto d = find(prefix + ":PerspectiveDistortion")) {
+    const std::vector<double> v = numbers(*d, 5, prefix + ":PerspectiveDistortion (R1,R2,R3,T1,T2)");
+    for (int i = 0; i < 5; ++i) file.camera.params[M::kR1 + i] = v[i];
+  }
+  const SourceRef where{path, focal->where.line};
+  if (!jpeg) {
+    const auto w = find("tiff:ImageWidth"), h = find("tiff:ImageLength");
+    if (w && h) {
+      width = static_cast<int>(internal::ParseNumber(w->value, w->where, "tiff:ImageWidth", 1e6));
+      height = static_cast<int>(internal::ParseNumber(h->value, h->where, "tiff:ImageLength", 1e6));
+    }
+  }
+  double pixel_mm = 0.0;
+  if (const auto res = find("exif:FocalPlaneXResolution")) {
+    const auto unit = find("exif:FocalPlaneResolutionUnit");
+    const int u = unit ? static_cast<int>(internal::ParseNumber(unit->value, unit->where, "exif:FocalPlaneResolutionUnit", 10)) : 2;
+    const double mm_per_unit = u == 2 ? 25.4 : u == 3 ? 10.0 : u == 4 ? 1.0 : 0.0;
+    if (mm_per_unit == 0)
+      ThrowInputError(unit->where, "exif:FocalPlaneResolutionUnit must be 2 (inch), 3 (cm) or 4 (mm)");
+    const double per_unit = ParseRational(*res, "exif:FocalPlaneXResolution");
+    if (!(per_unit > 0)) ThrowInputError(res->where, "exif:FocalPlaneXResolution must be > 0");
+    pixel_mm = mm_per_unit / per_unit;
+  }
+  internal::ResolveFormat(&file, options, where, width, height, pixel_mm);
+  if (!file.pixel_size_known)
+    ThrowInputError(where, "the pixel size is needed (the tags are mm): the file has no "
+                           "exif:FocalPlaneXResolution; pass --pixel-mm");
+  return file;
+}
+
+void WritePix4dXmp(const std::string& path, const CameraFile& file) {
+  using M = Pix4dPerspectiveModel;
+  AEROCAL_CHECK(file.camera.model == M::kId) << "not pix4d_perspective";
+  const PixelFrame& f = file.camera.frame;
+  const std::vector<double>& p = file.camera.params;
+  std::ostringstream out;
+  out.precision(17);
+  out << "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n <rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
+      << "  <rdf:Description xmlns:Camera=\"" << kPix4dCameraUri << "/\"\n"
+      << "    xmlns:tiff=\"http://ns.adobe.com/tiff/1.0/\" xmlns:exif=\"http://ns.adobe.com/exif/1.0/\"\n"
+      << "    tiff:ImageWidth=\"" << f.width_px << "\" tiff:ImageLength=\"" << f.height_px << "\"\n"
+      << "    exif:FocalPlaneXResolution=\"" << 1.0 / f.pixel_size_mm << "\" exif:FocalPlaneYResolution=\""
+      << 1.0 / f.pixel_size_mm << "\" exif:FocalPlaneResolutionUnit=\"4\"\n"
+      << "    Camera:ModelType=\"perspective\"\n"
+      << "    Camera:PerspectiveFocalLength=\"" << p[M::kF] << "\"\n"
+      << "    Camera:PrincipalPoint=\"" << p[M::kPx] << "," << p[M::kPy] << "\"\n"
+      << "    Camera:PerspectiveDistortion=\"" << p[M::kR1] << "," << p[M::kR2] << "," << p[M::kR3]
+      << "," << p[M::kT1] << "," << p[M::kT2] << "\"/>\n </rdf:RDF>\n</x:xmpmeta>\n";
+  WriteFileAtomically(path, out.str());
+}
+
+}  // namespace aerocal::calib

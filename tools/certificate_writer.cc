@@ -1,0 +1,282 @@
+// The calibration certificate of a `calibrate` or `flight` result (certificate.json for programs;
+// certificate.html and certificate.pdf for people, rendered by
+// tools/certificate/aerocal_certificate.py with matplotlib). This file gathers the data: the lab
+// YAML the user fills, the result, the comparison with a previous certificate or result against
+// tolerances. Deterministic: no clock, no random numbers (the date comes from the lab file).
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/json_file.h"
+#include "calib/core/string_printf.h"
+#include "calib/core/yaml_util.h"
+#include "tools/certificate_writer.h"
+#include "tools/command_registry.h"
+#include "tools/python_script.h"
+#include "triangulation/calibration/uncertainty_budget.h"
+
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <cstdlib>
+#include <filesystem>
+
+namespace aerocal::tools {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Tolerances: {parameter: allowed |change|} in the quantity's unit.
+std::map<std::string, double> ReadTolerances(const std::string& path) {
+  std::map<std::string, double> out;
+  if (path.empty()) return out;
+  const YAML::Node root = LoadYamlFile(path);
+  if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map quantity: tolerance");
+  for (const auto& item : root)
+    out[item.first.as<std::string>()] =
+        YamlBounded(item.second, path, item.first.as<std::string>(), 0, 1e12);
+  return out;
+}
+
+// The uncertainty table of a calibrate result or of a certificate.json.
+const nlohmann::json* Uncertainty(const nlohmann::json& doc) {
+  if (doc.contains("results") && doc["results"].is_array()) return &doc["results"];
+  if (doc.contains("calibration") && doc["calibration"].contains("uncertainty"))
+    return &doc["calibration"]["uncertainty"];
+  return nullptr;
+}
+
+nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous,
+                       const std::map<std::string, double>& tolerances) {
+  nlohmann::json rows = nlohmann::json::array();
+  bool all_pass = true;
+  std::map<std::string, nlohmann::json> old;
+  for (const auto& q : previous) old[q.value("quantity", "")] = q;
+  for (const auto& q : now) {
+    const std::string name = q["quantity"];
+    const auto o = old.find(name);
+    if (o == old.end()) continue;
+    const double v = q["value"], v_old = o->second["value"];
+    const double u = q["U"].is_number() ? q["U"].get<double>() : NAN;
+    const double u_old = o->second["U"].is_number() ? o->second["U"].get<double>() : NAN;
+    const double diff = v - v_old;
+    // E_n = |difference| / sqrt(U^2 + U_prev^2) (ISO/IEC 17043 / ISO 13528): <= 1 consistent.
+    const double en = std::abs(diff) / std::sqrt(u * u + u_old * u_old);
+    nlohmann::json row = {{"quantity", name}, {"unit", q["unit"]},  {"value", v},
+                          {"previous", v_old}, {"difference", diff}, {"U", q["U"]},
+                          {"U_previous", o->second["U"]},
+                          {"E_n", std::isfinite(en) ? nlohmann::json(en) : nlohmann::json()}};
+    const auto t = tolerances.find(name);
+    bool pass;
+    if (t != tolerances.end()) {
+      row["tolerance"] = t->second;
+      row["criterion"] = "|difference| <= tolerance";
+      pass = std::abs(diff) <= t->second;
+    } else {
+      row["tolerance"] = nullptr;
+      row["criterion"] = "E_n <= 1";
+      pass = std::isfinite(en) && en <= 1.0;
+    }
+    row["pass"] = pass;
+    all_pass = all_pass && pass;
+    rows.push_back(row);
+  }
+  return {{"rows", rows}, {"pass", all_pass}};
+}
+
+// An in-flight calibration (`aerocal flight` result.json) in the form of a `calibrate` result: the
+// adjustment whose camera the flight certifies (the joint one when it ran, else the
+// self-calibration), and an uncertainty budget of type A only: the adjustment's standard deviation
+// of each calibrated parameter (dof = the redundancy, k from it). Type B components (control
+// survey, target eccentricity, conditions) and group reproducibility need a test field and image
+// groups: not evaluated here, said in the method.
+nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::string& path) {
+  const nlohmann::json* chosen = nullptr;
+  if (flight.contains("adjustments") && flight["adjustments"].is_array())
+    for (const auto& a : flight["adjustments"])  // a reference into `flight`, kept below
+      if (a.value("name", "") == "self_calibration" || a.value("name", "") == "joint") chosen = &a;
+  if (!chosen || !chosen->contains("cameras") || (*chosen)["cameras"].empty())
+    throw InputError(path + ": a flight result without a self-calibrating adjustment (--result)");
+  nlohmann::json out = *chosen;
+  out["command"] = "calibrate";
+  out["valid"] = flight.value("valid", false);
+  out["invalid_reasons"] = nlohmann::json::array();
+  for (const auto& f : flight.value("failures", nlohmann::json::array()))
+    out["invalid_reasons"].push_back(f.value("step", "") + ": " + f.value("reason", ""));
+  out["warnings"] = flight.value("warnings", nlohmann::json::array());
+  const nlohmann::json& camera = out["cameras"][0];
+  const double redundancy = out.value("redundancy", 0.0);
+  nlohmann::json budget = nlohmann::json::array();
+  static const std::map<std::string, std::pair<const char*, const char*>> kQuantities = {
+      {"c", {"mm", "principal distance"}}, {"x0", {"mm", "principal point x"}},
+      {"y0", {"mm", "principal point y"}}};
+  std::vector<triangulation::BudgetQuantity> quantities;
+  for (const auto& [name, info] : kQuantities) {
+    const auto& sigma = camera["sigma"][name];
+    if (!sigma.is_number() || !(sigma.get<double>() > 0)) continue;  // fixed or unknown
+    triangulation::BudgetQuantity q;
+    q.name = name;
+    q.unit = info.first;
+    q.description = info.second;
+    q.value = camera["estimated"][name].get<double>();
+    triangulation::UncertaintyComponent a;
+    a.source = "adjustment covariance (in-flight self-calibration)";
+    a.type = "A";
+    a.distribution = "normal";
+    a.value = a.u = sigma.get<double>();
+    a.value_unit = q.unit;
+    a.dof = redundancy > 0 ? redundancy : std::numeric_limits<double>::infinity();
+    q.components.push_back(a);
+    q.u_c = a.u;
+    q.dof_eff = a.dof;
+    q.k = triangulation::CoverageFactor(q.dof_eff);
+    q.expanded = q.k * q.u_c;
+    q.statement = triangulation::CertificateStatement(q.name, q.value, q.expanded, q.k, q.unit);
+    quantities.push_back(q);
+  }
+  double sum2 = 0;
+  int n = 0;
+  for (const auto& r : out.value("residuals", nlohmann::json::array()))
+    if (r.value("used", true) && r.contains("v_col_px")) {
+      sum2 += std::pow(r["v_col_px"].get<double>(), 2) + std::pow(r["v_row_px"].get<double>(), 2);
+      ++n;
+    }
+  const nlohmann::json format = flight.value("camera_format", nlohmann::json::object());
+  out["calibration"] = {
+      {"method",
+       {{"kind", "in-flight calibration"},
+        {"adjustment", chosen->value("name", "")},
+        {"flight_data", flight.value("data", "")},
+        {"budget", "type A only (the adjustment's covariance); type B and group reproducibility "
+                   "are not evaluated for an in-flight calibration"}}},
+      {"camera",
+       {{"id", camera.value("id", "")},
+        {"file", flight.value("camera", "")},
+        {"pixel_size_mm", format.value("pixel_size_mm", 0.0)},
+        {"format_px", {format.value("width_px", 0), format.value("height_px", 0)}}}},
+      {"data",
+       {{"images", out.value("exposures", nlohmann::json::array()).size()},
+        {"observations", n},
+        {"control_points", out["control"].value("n", 0)},
+        {"check_points", out["check"].value("n", 0)},
+        {"groups", 0}}},
+      {"uncertainty", triangulation::BudgetToJson(quantities)},
+      {"groups", nlohmann::json::array()},
+      {"stability", nlohmann::json::object()},
+      {"radii_mm", nlohmann::json::array()},
+      {"rms_px", n > 0 ? std::sqrt(sum2 / n) : 0.0}};
+  return out;
+}
+
+}  // namespace
+
+// The lab file: sections of free-text fields, every key known (typos are errors).
+nlohmann::json ReadCertificateLab(const std::string& path) {
+  const std::map<std::string, std::vector<std::string>> sections = {
+      {"lab", {"name", "address", "accreditation", "phone"}},
+      {"certificate", {"number", "date", "page_note"}},
+      {"camera", {"make", "model", "serial", "lens", "lens_serial"}},
+      {"customer", {"name", "address"}},
+      {"conditions", {"temperature", "humidity", "location", "target", "note"}},
+      {"signatures", {"calibrated_by", "checked_by", "approved_by"}}};
+  nlohmann::json out = nlohmann::json::object();
+  for (const auto& [section, keys] : sections) {
+    out[section] = nlohmann::json::object();
+    for (const auto& k : keys) out[section][k] = "";
+  }
+  if (path.empty()) return out;
+  const YAML::Node root = LoadYamlFile(path);
+  if (!root || root.IsNull()) return out;
+  if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map of sections");
+  std::vector<std::string> names;
+  for (const auto& [section, keys] : sections) names.push_back(section);
+  RejectUnknownKeys(root, names, path);
+  for (const auto& [section, keys] : sections) {
+    const YAML::Node node = root[section];
+    if (!node) continue;
+    if (!node.IsMap()) throw InputError(WhereIs(node, path).ToString() + ": " + section + " must be a map");
+    RejectUnknownKeys(node, keys, path);
+    for (const auto& k : keys)
+      if (node[k]) out[section][k] = YamlString(node[k], path, section + "." + k);
+  }
+  return out;
+}
+
+int WriteCertificate(const CertificateArgs& args) {
+  CheckOutputFolder(args.out, "--out");
+  if (!args.tolerances.empty() && args.previous.empty())
+    throw ConfigError("--tolerances needs --previous");
+  nlohmann::json result = ReadJsonFile(args.result);
+  if (result.is_object() && result.value("kind", "") == "flight")
+    result = CalibrateFormOfFlight(result, args.result);
+  if (!result.is_object() || result.value("command", "") != "calibrate" ||
+      !result.contains("calibration"))
+    throw InputError(args.result + ": not a result of `aerocal calibrate` (--result)");
+  const nlohmann::json lab = ReadCertificateLab(args.lab);
+  const auto tolerances = ReadTolerances(args.tolerances);
+  const nlohmann::json& cal = result["calibration"];
+  nlohmann::json cert;
+  cert["kind"] = "certificate";
+  cert["lab"] = lab;
+  cert["source"] = args.result;
+  cert["method"] = cal["method"];
+  cert["camera_file"] = cal["camera"];
+  cert["data"] = cal["data"];
+  cert["adjustment"] = {{"sigma0", result["sigma0"]},
+                        {"sigma0_px", result["sigma0_px"]},
+                        {"sigma0_um", result["sigma0_um"]},
+                        {"redundancy", result["redundancy"]},
+                        {"converged", result["converged"]},
+                        {"valid", result.value("valid", false)},
+                        {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
+                        {"warnings", result.value("warnings", nlohmann::json::array())},
+                        {"self_calibration", result.value("self_calibration", nlohmann::json())},
+                        {"rms_px", cal["rms_px"]}};
+  cert["results"] = cal["uncertainty"];
+  cert["interior"] = result["cameras"][0];
+  cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
+  cert["groups"] = cal["groups"];
+  cert["stability"] = cal["stability"];
+  cert["check"] = result["check"];
+  cert["control"] = result["control"];
+  cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
+  cert["opencv"] = cal.value("opencv", nlohmann::json());
+  // Residual vectors (image pixels) for the vector field plot.
+  nlohmann::json residuals = nlohmann::json::array();
+  for (const auto& r : result.value("residuals", nlohmann::json::array()))
+    if (r.value("used", true))
+      residuals.push_back({r["col"], r["row"], r["v_col_px"], r["v_row_px"]});
+  cert["residuals"] = residuals;
+  if (!args.previous.empty()) {
+    const nlohmann::json previous = ReadJsonFile(args.previous);
+    const nlohmann::json* old = Uncertainty(previous);
+    if (!old) throw InputError(args.previous + ": neither a certificate.json nor a calibrate result (--previous)");
+    cert["comparison"] = Compare(cert["results"], *old, tolerances);
+    cert["comparison"]["previous"] = args.previous;
+    if (previous.contains("lab")) cert["comparison"]["previous_certificate"] = previous["lab"]["certificate"];
+  }
+  fs::create_directories(args.out);
+  const std::string json_path = (fs::path(args.out) / "certificate.json").string();
+  WriteFileAtomically(json_path, cert.dump(2) + "\n");
+  std::printf("certificate data -> %s\n", json_path.c_str());
+  for (const auto& q : cert["results"]) std::printf("  %s\n", q["statement"].get<std::string>().c_str());
+  if (cert.contains("comparison"))
+    std::printf("comparison with %s: %s\n", args.previous.c_str(),
+                cert["comparison"]["pass"].get<bool>() ? "pass" : "FAIL");
+  if (!args.no_render) {
+    const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
+    const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
+    if (!RunPythonScript(script, {json_path, args.out})) {
+      std::fprintf(stderr, "error: the certificate could not be rendered (%s); certificate.json is complete\n",
+                   PythonCommandLine(script, {json_path, args.out}).c_str());
+      return kExitInternal;
+    }
+    std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", args.out.c_str(),
+                args.out.c_str());
+  }
+  const bool ok = cert["adjustment"]["valid"].get<bool>() && cal["stability"].value("agree", true) &&
+                  (!cert.contains("comparison") || cert["comparison"]["pass"].get<bool>());
+  return ok ? kExitOk : kExitNotConverged;
+}
+
+}  // namespace aerocal::tools
