@@ -77,12 +77,12 @@ std::vector<std::string> ParseSelfCalibration(const std::string& text, calib::Ca
   for (const std::string& name : SplitCommaList(text)) {
     if (std::none_of(table.begin(), table.end(), [&](const auto& p) { return p.name == name; }))
       throw ConfigError("--self-calibration: unknown parameter '" + name +
-                        "' (expected none, all or a list of " + calib::JoinParamNames(table) +
-                        (model == Model::kId
-                             ? ""
-                             : ", the parameters of model " +
-                                   std::string(calib::CameraModelName(model))) +
-                        ")");
+                        "' (expected none, all or a list of " +
+                        (model == Model::kId ? std::string()
+                                             : "the parameters of model " +
+                                                   std::string(calib::CameraModelName(model)) +
+                                                   ": ") +
+                        calib::JoinParamNames(table) + ")");
     names.push_back(name);
   }
   AdjustOptions probe;
