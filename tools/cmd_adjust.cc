@@ -70,6 +70,19 @@ int RunRigAdjust(const RigArgs& args,
   });
 }
 
+// The camera model of the project's cameras, whose table names --self-calibration's parameters
+// (a camera file may be in any registered model: the adjustment works in it).
+calib::CameraModelId CamerasModel(const triangulation::Project& project) {
+  const calib::CameraModelId model = project.cameras.begin()->second.model;
+  for (const auto& [id, camera] : project.cameras)
+    if (camera.model != model)
+      throw ConfigError("--self-calibration: the project's cameras are in different models (" +
+                        std::string(calib::CameraModelName(model)) + ", " + id + " in " +
+                        std::string(calib::CameraModelName(camera.model)) +
+                        "): self-calibrate them in separate projects");
+  return model;
+}
+
 CommandRun SetupAdjust(CLI::App& app) {
   struct Args {
     std::string project, out, write_camera, self_calibration = "none", camera_format = "aerocal";
@@ -93,7 +106,8 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option("--self-calibration",
                  args->self_calibration,
                  "Interior parameters to estimate: none (conventional, default), all, or a list "
-                 "such as c,x0,y0,K1,K2");
+                 "such as c,x0,y0,K1,K2 (the names of the camera file's model, e.g. "
+                 "f,cx,cy,k1,k2 for metashape_frame)");
   app.add_flag("--compare",
                args->compare,
                "Run the conventional and the self-calibrating adjustment and compare them "
@@ -243,7 +257,11 @@ CommandRun SetupAdjust(CLI::App& app) {
     if (options.robust_start && args->no_robust_start)
       throw ConfigError("--robust-start and --no-robust-start exclude each other");
     options.use_interior_sigma = !args->no_interior_sigma;
-    options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
+    // The names of the 10-parameter model here (the joint adjustment needs it); the plain
+    // adjustment reads them again in the model of the project's cameras below.
+    const bool other_model_names = !args->joint.Requested();
+    if (!other_model_names)
+      options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
     options.Validate();
     CheckOutputFile(args->out, "--out");
     if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
@@ -253,6 +271,14 @@ CommandRun SetupAdjust(CLI::App& app) {
     if (args->joint.Requested() && args->compare)
       throw ConfigError("--compare and --joint-stitching do not combine (`aerocal flight` runs and compares both)");
     triangulation::Project input = triangulation::ReadProject(args->project, args->default_sigma_px);
+    const bool self_calibrating = args->compare || (args->self_calibration != "none" &&
+                                                    !args->self_calibration.empty());
+    const calib::CameraModelId model =
+        self_calibrating ? CamerasModel(input) : calib::Camera::Model::kId;
+    if (other_model_names) {
+      options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration, model);
+      options.Validate();
+    }
     apply_platform(&input.platform);
     if (args->joint.Requested())
       return RunJointAdjust(args->joint, options, input, args->project, args->out, args->write_camera);
@@ -301,7 +327,7 @@ CommandRun SetupAdjust(CLI::App& app) {
     AdjustmentResult main;
     if (args->compare) {
       const auto self_list = options.free_interior.empty()
-                                 ? triangulation::ParseSelfCalibration("all")
+                                 ? triangulation::ParseSelfCalibration("all", model)
                                  : options.free_interior;
       main = run(self_list);
       AdjustmentResult conventional =

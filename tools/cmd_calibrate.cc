@@ -2,6 +2,7 @@
 // planar board detected in images, on the existing self-calibrating adjustment
 // (triangulation/calibration). Parsing, loading, detecting, calling the library, writing results.
 #include "calib/camera/camera_io.h"
+#include "calib/camera/convert_camera.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -21,7 +22,6 @@
 namespace aerocal::tools {
 namespace {
 
-using Model = calib::BrownFraser10Model;
 using triangulation::AdjustmentResult;
 
 // Board points: design coordinates; the default sigma stands for the print / machining accuracy.
@@ -88,21 +88,30 @@ std::map<std::string, std::string> GroupsFromObservations(const std::string& pat
   return CheckedGroups(out, path, observed);
 }
 
-nlohmann::json InteriorJson(const calib::InteriorParams& p) {
+// The model's parameter names (its table) of a camera estimate.
+std::vector<std::string> ParamNames(const triangulation::CameraEstimate& c) {
+  std::vector<std::string> names;
+  for (const calib::ParamInfo& info : calib::CameraModelParams(c.model)) names.emplace_back(info.name);
+  return names;
+}
+
+nlohmann::json InteriorJson(const triangulation::CameraEstimate& c, const calib::InteriorParams& p) {
   nlohmann::json j;
-  for (int k = 0; k < Model::kNumParams; ++k) j[std::string(Model::kParams[k].name)] = p[k];
+  const std::vector<std::string> names = ParamNames(c);
+  for (size_t k = 0; k < names.size(); ++k) j[names[k]] = p[k];
   return j;
 }
 
 nlohmann::json CovarianceJson(const Eigen::MatrixXd& cov, const triangulation::CameraEstimate& c) {
-  if (cov.rows() != Model::kNumParams) return nullptr;
+  if (cov.rows() != c.estimated.size()) return nullptr;
+  const std::vector<std::string> table = ParamNames(c);
   std::vector<int> free;
-  for (int k = 0; k < Model::kNumParams; ++k)
+  for (int k = 0; k < c.estimated.size(); ++k)
     if (c.free[k]) free.push_back(k);
   nlohmann::json names = nlohmann::json::array(), cv = nlohmann::json::array(),
                  rho = nlohmann::json::array();
   for (int a : free) {
-    names.push_back(std::string(Model::kParams[a].name));
+    names.push_back(table[a]);
     nlohmann::json row = nlohmann::json::array(), rrow = nlohmann::json::array();
     for (int b : free) {
       row.push_back(cov(a, b));
@@ -115,25 +124,32 @@ nlohmann::json CovarianceJson(const Eigen::MatrixXd& cov, const triangulation::C
   return {{"names", names}, {"covariance", cv}, {"correlation", rho}};
 }
 
-nlohmann::json GroupJson(const triangulation::GroupCalibration& g) {
-  const AdjustmentResult& r = g.adjustment.result;
-  nlohmann::json j = {{"group", g.group},
-                      {"images", g.images},
-                      {"converged", r.converged()},
+// One calibration run: its statistics, the estimated interior in its model and the sigmas (null
+// when fixed or not determinable), the check points.
+nlohmann::json RunJson(const AdjustmentResult& r) {
+  nlohmann::json j = {{"converged", r.converged()},
                       {"valid", r.valid},
                       {"sigma0", r.sigma0},
                       {"sigma0_px", r.sigma0_px},
                       {"redundancy", r.solve.redundancy}};
   if (!r.cameras.empty()) {
-    j["estimated"] = InteriorJson(r.cameras[0].estimated);
+    const triangulation::CameraEstimate& c = r.cameras[0];
+    j["estimated"] = InteriorJson(c, c.estimated);
     nlohmann::json s;
-    for (int k = 0; k < Model::kNumParams; ++k)
-      s[std::string(Model::kParams[k].name)] =
-          r.cameras[0].free[k] && r.determinability.covariance_ok ? nlohmann::json(r.cameras[0].sigma[k])
-                                                                  : nlohmann::json();
+    const std::vector<std::string> names = ParamNames(c);
+    for (size_t k = 0; k < names.size(); ++k)
+      s[names[k]] = c.free[k] && r.determinability.covariance_ok ? nlohmann::json(c.sigma[k])
+                                                                 : nlohmann::json();
     j["sigma"] = s;
   }
   j["check"] = triangulation::PointStatisticsToJson(r.check);
+  return j;
+}
+
+nlohmann::json GroupJson(const triangulation::GroupCalibration& g) {
+  nlohmann::json j = RunJson(g.adjustment.result);
+  j["group"] = g.group;
+  j["images"] = g.images;
   return j;
 }
 
@@ -154,12 +170,58 @@ nlohmann::json StabilityJson(const triangulation::StabilityReport& s) {
   return {{"alpha", s.alpha}, {"agree", s.agree}, {"rows", rows}, {"flagged", s.flagged}};
 }
 
+// The RMS image residual per point (sqrt of the mean squared residual vector), as OpenCV's RMS.
+double RmsPx(const AdjustmentResult& r) {
+  double sum2 = 0;
+  int n = 0;
+  for (const auto& o : r.residuals)
+    if (o.used) {
+      sum2 += o.residual_px.squaredNorm();
+      ++n;
+    }
+  return n > 0 ? std::sqrt(sum2 / n) : 0.0;
+}
+
+// --model: brown10 (our 10-parameter model's short name) or a registered model name.
+calib::CameraModelId ModelOfOption(const std::string& name) {
+  const auto model = calib::CameraModelFromName(name == "brown10" ? "brown_fraser_10" : name);
+  if (!model)
+    throw ConfigError("--model: unknown camera model '" + name + "' (expected brown10, " +
+                      calib::CameraModelNames() + ")");
+  return *model;
+}
+
+// The parameters calibrated by default: those of the 10-parameter model but the affinity, and
+// OpenCV's of cv::calibrateCamera's default flags (k4-k6 fixed at 0); every one otherwise.
+std::string DefaultSelfCalibration(calib::CameraModelId model) {
+  if (model == calib::BrownFraser10Model::kId) return "c,x0,y0,K1,K2,K3,P1,P2";
+  if (model == calib::OpenCvModel::kId) return "fx,fy,cx,cy,k1,k2,p1,p2,k3";
+  return "all";
+}
+
+// The camera file's camera in `model`: converted (calib/camera/convert_camera.h; the
+// parameters not calibrated are held at 0 in the fit, as a start they would stay there).
+calib::Camera StartInModel(const calib::Camera& camera, calib::CameraModelId model,
+                           const std::vector<std::string>& free) {
+  calib::ConvertOptions convert;
+  for (const calib::ParamInfo& info : calib::CameraModelParams(model))
+    if (std::find(free.begin(), free.end(), info.name) == free.end())
+      if (info.group != calib::ParamGroup::kPrincipalDistance &&
+          info.group != calib::ParamGroup::kPrincipalPoint)
+        convert.zero.emplace_back(info.name);
+  const calib::ConversionResult start = calib::ConvertCamera(camera.AsModelCamera(), model, convert);
+  std::printf("start: the camera file's %s camera as %s: %s\n",
+              std::string(calib::CameraModelName(camera.model)).c_str(),
+              std::string(calib::CameraModelName(model)).c_str(), start.Summary().c_str());
+  return camera.WithModelCamera(start.camera);
+}
+
 CommandRun SetupCalibrate(CLI::App& app) {
   struct Args {
     std::string camera, observations, points, images, board, groups, budget, out, write_marks;
     std::string write_camera, camera_format = "aerocal";
-    std::string self_calibration = "c,x0,y0,K1,K2,K3,P1,P2";
-    std::string model = "brown10";
+    std::string self_calibration;  // default: the model's (DefaultSelfCalibration)
+    std::string model;             // default: the camera file's
     double sigma_px = 0.5, board_sigma_mm = kDefaultBoardSigmaMm;
     std::vector<double> radii_mm;
     bool no_snooping = false, no_closed_form = false;
@@ -178,12 +240,15 @@ CommandRun SetupCalibrate(CLI::App& app) {
                  "Board of --images: chessboard|circles|acircles:COLSxROWS:SPACING_MM, e.g. "
                  "chessboard:9x6:25 (inner corners)");
   app.add_option("--self-calibration", args->self_calibration,
-                 "Interior parameters calibrated: all, or a list such as c,x0,y0,K1,K2,K3,P1,P2 "
-                 "(default)");
+                 "Interior parameters calibrated, names of the camera file's model: all, or a "
+                 "list such as c,x0,y0,K1,K2,K3,P1,P2 (default of brown_fraser_10; opencv: "
+                 "fx,fy,cx,cy,k1,k2,p1,p2,k3; another model: all)");
   app.add_option("--model", args->model,
-                 "brown10 (the 10-parameter model); opencv: also cv::calibrateCamera (k1, k2, p1, "
-                 "p2, k3, fx, fy, cx, cy) on the same marks, side by side (needs --images)")
-      ->check(CLI::IsMember({"brown10", "opencv"}));
+                 "The camera is calibrated in the camera file's model (any registered model); "
+                 "--model also calibrates it in this model, in the same bundle adjustment, side by "
+                 "side: brown10 (the 10-parameter model), opencv (fx, fy, cx, cy, k1, k2, p1, p2, "
+                 "k3; with --images also cv::calibrateCamera on the same marks) or a registered "
+                 "name (" + calib::CameraModelNames() + ")");
   app.add_option("--groups", args->groups,
                  "Image groups: CSV image,group (or a group column in observations.csv); each group "
                  "is calibrated too and the stability over the groups tested (chi-square, 5 %)");
@@ -220,10 +285,14 @@ CommandRun SetupCalibrate(CLI::App& app) {
       throw ConfigError("--observations and --points go together");
     if (board && (args->images.empty() || args->board.empty()))
       throw ConfigError("--images and --board go together");
-    if (args->model == "opencv" && !board)
-      throw ConfigError("--model opencv needs --images and --board (cv::calibrateCamera on the marks)");
+    const calib::Camera file_camera = calib::ReadCamera(args->camera, calib::CameraModels::kAny);
+    const calib::CameraModelId model = file_camera.model;
+    const calib::CameraModelId beside_model =
+        args->model.empty() ? model : ModelOfOption(args->model);
     triangulation::CalibrateOptions options;
-    options.adjust.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
+    options.adjust.free_interior = triangulation::ParseSelfCalibration(
+        args->self_calibration.empty() ? DefaultSelfCalibration(model) : args->self_calibration,
+        model);
     if (options.adjust.free_interior.empty())
       throw ConfigError("--self-calibration: calibrate needs at least one parameter (got none)");
     options.adjust.data_snooping = !args->no_snooping;
@@ -237,7 +306,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
     if (!args->budget.empty()) budget = triangulation::ReadBudgetOptions(args->budget);
     if (!args->radii_mm.empty()) budget.radii_mm = args->radii_mm;
 
-    const calib::Camera camera = calib::ReadCamera(args->camera);
+    const calib::Camera& camera = file_camera;
     triangulation::Project project;
     const std::string camera_id = camera.name.empty() ? "cam1" : camera.name;
     project.cameras[camera_id] = camera;
@@ -333,7 +402,8 @@ CommandRun SetupCalibrate(CLI::App& app) {
                         {"method", s.method},
                         {"n_points", s.n_points},
                         {"rms_px", s.rms_px}});
-    cal["start"] = {{"c_camera_file_mm", camera.interior[Model::kC]},
+    cal["model"] = std::string(calib::CameraModelName(model));
+    cal["start"] = {{"c_camera_file_mm", file_camera.c_mm()},
                     {"c_closed_form_mm", run.closed_form_c_mm ? nlohmann::json(*run.closed_form_c_mm)
                                                               : nlohmann::json()},
                     {"c_start_mm", run.start_c_mm},
@@ -364,7 +434,28 @@ CommandRun SetupCalibrate(CLI::App& app) {
                                   {"limit", nullptr},
                                   {"message", f}});
     }
-    if (args->model == "opencv") {
+    if (beside_model != model) {
+      // The same marks calibrated in --model, started from the camera file's values converted.
+      triangulation::CalibrateOptions beside = options;
+      beside.adjust.free_interior = triangulation::ParseSelfCalibration(
+          DefaultSelfCalibration(beside_model), beside_model);
+      beside.control_propagation = false;
+      triangulation::Project in_model = project;
+      in_model.cameras[camera_id] =
+          StartInModel(camera, beside_model, beside.adjust.free_interior);
+      const triangulation::CalibrationRun other = triangulation::Calibrate(in_model, beside, {});
+      const AdjustmentResult& o = other.all.result;
+      nlohmann::json b = RunJson(o);
+      b["model"] = std::string(calib::CameraModelName(beside_model));
+      b["self_calibration"] = beside.adjust.free_interior;
+      b["rms_px"] = RmsPx(o);
+      b["seconds"] = o.solve.seconds;
+      std::printf("beside, in model %s: sigma0 %.4f, RMS %.4f px%s\n",
+                  std::string(calib::CameraModelName(beside_model)).c_str(), o.sigma0, RmsPx(o),
+                  o.valid ? "" : " (not valid)");
+      cal["beside"] = b;
+    }
+    if (beside_model == calib::OpenCvModel::kId && board) {
       const OpenCvCalibration cv = CalibrateWithOpenCv(detected);
       const double p = camera.pixel_size_mm;
       cal["opencv"] = {
@@ -386,14 +477,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
       std::printf("cv::calibrateCamera: RMS %.4f px, fx %.4f fy %.4f cx %.4f cy %.4f (%.3f s)\n",
                   cv.rms_px, cv.fx, cv.fy, cv.cx, cv.cy, cv.seconds);
     }
-    double sum2 = 0;
-    int n = 0;
-    for (const auto& o : r.residuals)
-      if (o.used) {
-        sum2 += o.residual_px.squaredNorm();
-        ++n;
-      }
-    cal["rms_px"] = n > 0 ? std::sqrt(sum2 / n) : 0.0;  // per point, as OpenCV's RMS
+    cal["rms_px"] = RmsPx(r);
     // The calibrated camera, in the format asked for; only for a valid result (a file that exists
     // is one the next run may use).
     if (!args->write_camera.empty() && r.valid && !r.cameras.empty()) {

@@ -1,21 +1,82 @@
 #include "calib/camera/camera.h"
 
 #include "calib/camera/rotation.h"
+#include "calib/core/error.h"
 
 namespace aerocal::calib {
+
+Camera Camera::OfModel(CameraModelId model) {
+  Camera camera;
+  camera.model = model;
+  camera.interior = InteriorParams::ForModel(model);
+  camera.interior_sigma = InteriorSigmas::ForModel(model);
+  return camera;
+}
+
+int Camera::ParamIndex(std::string_view name) const {
+  return VisitCameraModel(model, [&](auto m) { return IndexOfParam(decltype(m)::kParams, name); });
+}
+
+double Camera::c_mm() const {
+  return VisitCameraModel(
+      model, [&](auto m) { return decltype(m)::PrincipalDistanceMm(interior.data(), frame()); });
+}
+
+void Camera::SetPrincipalDistanceMm(double c) {
+  const double scale = c / c_mm();
+  const std::vector<ParamInfo> table = Params();
+  for (size_t i = 0; i < table.size(); ++i)
+    if (table[i].group == ParamGroup::kPrincipalDistance)
+      interior[i] = table[i].unit == "mm" ? c : interior[i] * scale;
+}
+
+Eigen::Vector2d Camera::PrincipalPointMm() const {
+  const double ideal[2] = {0.0, 0.0};
+  Eigen::Vector2d xy = Eigen::Vector2d::Zero();
+  const bool ok = VisitCameraModel(model, [&](auto m) {
+    return decltype(m)::MeasuredFromIdeal(interior.data(), frame(), ideal, xy.data());
+  });
+  AEROCAL_CHECK(ok) << "principal point of camera " << name << " not found";
+  return xy;
+}
+
+bool Camera::IdealFromPixel(const Eigen::Vector2d& pixel, Eigen::Vector2d* ideal_mm) const {
+  const Eigen::Vector2d xy = PhotoFromPixel(pixel);
+  return VisitCameraModel(model, [&](auto m) {
+    return decltype(m)::IdealFromMeasured(interior.data(), frame(), xy.data(), ideal_mm->data());
+  });
+}
+
+ModelCamera Camera::AsModelCamera() const { return {model, interior.values(), frame()}; }
+
+Camera Camera::WithModelCamera(const ModelCamera& camera) const {
+  AEROCAL_CHECK(static_cast<int>(camera.params.size()) == CameraModelParamCount(camera.model))
+      << "camera " << name << ": " << camera.params.size() << " parameters for model "
+      << CameraModelName(camera.model);
+  Camera out = *this;
+  if (camera.model != model) out.interior_sigma = InteriorSigmas::ForModel(camera.model);
+  out.model = camera.model;
+  out.interior = InteriorParams(camera.params);
+  out.pixel_size_mm = camera.frame.pixel_size_mm;
+  out.width_px = camera.frame.width_px;
+  out.height_px = camera.frame.height_px;
+  return out;
+}
 
 bool Camera::ProjectToPixel(const Eigen::Vector3d& opk_rad, const Eigen::Vector3d& center_m,
                             const Eigen::Vector3d& point_m, Eigen::Vector2d* pixel) const {
   double uvw[3];
   ImageSpaceFromObject(opk_rad.data(), center_m.data(), point_m.data(), uvw);
   if (!(uvw[2] < 0)) return false;  // the camera looks along -W
-  const double c = interior[Model::kC];
-  const Eigen::Vector2d ideal(-c * uvw[0] / uvw[2], -c * uvw[1] / uvw[2]);
+  const double c = c_mm();
+  const double ideal[2] = {-c * uvw[0] / uvw[2], -c * uvw[1] / uvw[2]};
   Eigen::Vector2d measured;
-  // 1e-6 px in photo units, with margin: iterate to 1e-4 of that.
-  if (!Model::MeasuredFromIdeal(interior.data(), ideal, &measured,
-                                             1e-10 * pixel_size_mm))
-    return false;
+  // The models' inversions converge to 1e-10 px (brown_fraser_10) or 1e-13 in normalised
+  // coordinates (forward models: closed form).
+  const bool ok = VisitCameraModel(model, [&](auto m) {
+    return decltype(m)::MeasuredFromIdeal(interior.data(), frame(), ideal, measured.data());
+  });
+  if (!ok) return false;
   *pixel = PixelFromPhoto(measured);
   return true;
 }

@@ -33,12 +33,6 @@ double ModelParamBound(const ParamInfo& info) {
   return kMaxDistortion;
 }
 
-std::vector<std::string> InteriorKeys() {
-  std::vector<std::string> keys;
-  for (const auto& info : Model::kParams) keys.emplace_back(info.name);
-  return keys;
-}
-
 std::pair<int, int> ReadFormat(const YAML::Node& node, const std::string& file) {
   if (!node.IsSequence() || node.size() != 2)
     ThrowInputError(WhereIs(node, file), "format_px must be [width, height]");
@@ -103,46 +97,58 @@ ReferencePoint ReadReferencePoint(const YAML::Node& node, const std::string& fil
 
 }  // namespace
 
-Camera ParseCamera(const YAML::Node& root, const std::string& file) {
+Camera ParseCamera(const YAML::Node& root, const std::string& file, CameraModels models) {
   if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
   RejectUnknownKeys(root, {"name", "pixel_size_mm", "format_px", "interior", "interior_sigma",
                            "subimages", "reference_points", "model"},
                     file);
-  Camera camera;
-  if (root["model"] && YamlString(root["model"], file, "model") != Model::kName) {
-    const std::string name = root["model"].Scalar();
+  const std::string model_name =
+      root["model"] ? YamlString(root["model"], file, "model") : std::string(Model::kName);
+  const std::optional<CameraModelId> id = CameraModelFromName(model_name);
+  if (!id)
     ThrowInputError(WhereIs(root["model"], file),
-                    CameraModelFromName(name)
-                        ? "camera model '" + name + "': the adjustment needs " +
-                              std::string(Model::kName) + " (convert it first)"
-                        : "unknown camera model '" + name + "' (expected " +
-                              std::string(Model::kName) + ")");
-  }
+                    "unknown camera model '" + model_name + "' (expected one of " +
+                        CameraModelNames() + ")");
+  if (*id != Model::kId && models == CameraModels::kBrownFraser10Only)
+    ThrowInputError(WhereIs(root["model"], file),
+                    "camera model '" + model_name + "': this command needs " +
+                        std::string(Model::kName) + " (convert it first: aerocal camera convert "
+                        "--to aerocal --model " + std::string(Model::kName) + ")");
+  if (*id != Model::kId && (root["subimages"] || root["reference_points"]))
+    ThrowInputError(WhereIs(root["model"], file),
+                    "camera model '" + model_name + "': sub-image mappings and reference points "
+                    "need " + std::string(Model::kName) + " (convert the camera first)");
+  Camera camera = Camera::OfModel(*id);
   camera.name = root["name"] ? YamlString(root["name"], file, "name") : "";
   if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
   camera.pixel_size_mm = YamlBounded(root["pixel_size_mm"], file, "pixel_size_mm", kMinPixelSizeMm,
                                      kMaxPixelSizeMm);
   if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
   std::tie(camera.width_px, camera.height_px) = ReadFormat(root["format_px"], file);
-  if (!root["interior"]) ThrowInputError({file, 1}, "missing interior (at least c)");
+  // The interior and its sigmas are keyed by the model's parameter table: a new model needs
+  // nothing here.
+  const std::vector<ParamInfo> table = camera.Params();
+  std::vector<std::string> keys;
+  for (const ParamInfo& info : table) keys.emplace_back(info.name);
+  if (!root["interior"])
+    ThrowInputError({file, 1}, "missing interior (at least " + keys.front() + ")");
   const YAML::Node& interior = root["interior"];
-  RejectUnknownKeys(interior, InteriorKeys(), file);
-  for (int i = 0; i < Model::kNumParams; ++i) {
-    const std::string key(Model::kParams[i].name);
-    if (!interior[key]) continue;
-    const double bound = i == Model::kC ? kMaxCMm
-                         : (i == Model::kX0 || i == Model::kY0) ? kMaxPpMm
-                                                                : kMaxDistortion;
-    camera.interior[i] = YamlBounded(interior[key], file, "interior." + key, -bound, bound);
+  RejectUnknownKeys(interior, keys, file);
+  for (size_t i = 0; i < table.size(); ++i) {
+    if (!interior[keys[i]]) continue;
+    const double bound = ModelParamBound(table[i]);
+    camera.interior[i] = YamlBounded(interior[keys[i]], file, "interior." + keys[i], -bound, bound);
   }
-  if (!(camera.c_mm() > 0))
-    ThrowInputError(WhereIs(interior, file), "interior.c must be > 0 mm (got " +
-                                                 FormatNumber(camera.c_mm()) + ")");
+  for (size_t i = 0; i < table.size(); ++i)
+    if (table[i].group == ParamGroup::kPrincipalDistance && !(camera.interior[i] > 0))
+      ThrowInputError(WhereIs(interior, file),
+                      "interior." + keys[i] + " must be > 0 " + std::string(table[i].unit) +
+                          " (got " + FormatNumber(camera.interior[i]) + ")");
   if (root["interior_sigma"]) {
     const YAML::Node& sig = root["interior_sigma"];
-    RejectUnknownKeys(sig, InteriorKeys(), file);
-    for (int i = 0; i < Model::kNumParams; ++i) {
-      const std::string key(Model::kParams[i].name);
+    RejectUnknownKeys(sig, keys, file);
+    for (size_t i = 0; i < table.size(); ++i) {
+      const std::string& key = keys[i];
       if (!sig[key]) continue;
       const double s = YamlBounded(sig[key], file, "interior_sigma." + key, 0, 1e6);
       if (!(s > 0))
@@ -170,28 +176,31 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file) {
   return camera;
 }
 
-Camera ReadCamera(const std::string& path) { return ParseCamera(LoadYamlFile(path), path); }
+Camera ReadCamera(const std::string& path, CameraModels models) {
+  return ParseCamera(LoadYamlFile(path), path, models);
+}
 
 std::string CameraToYaml(const Camera& camera) {
   YAML::Emitter out;
   out.SetDoublePrecision(17);
   out << YAML::BeginMap;
   out << YAML::Key << "name" << YAML::Value << camera.name;
-  out << YAML::Key << "model" << YAML::Value << std::string(Model::kName);
+  out << YAML::Key << "model" << YAML::Value << std::string(CameraModelName(camera.model));
   out << YAML::Key << "pixel_size_mm" << YAML::Value << camera.pixel_size_mm;
   out << YAML::Key << "format_px" << YAML::Value << YAML::Flow << YAML::BeginSeq << camera.width_px
       << camera.height_px << YAML::EndSeq;
+  const std::vector<ParamInfo> table = camera.Params();
   out << YAML::Key << "interior" << YAML::Value << YAML::BeginMap;
-  for (int i = 0; i < Model::kNumParams; ++i)
-    out << YAML::Key << std::string(Model::kParams[i].name) << YAML::Value << camera.interior[i];
+  for (size_t i = 0; i < table.size(); ++i)
+    out << YAML::Key << std::string(table[i].name) << YAML::Value << camera.interior[i];
   out << YAML::EndMap;
   bool any_sigma = false;
   for (const auto& s : camera.interior_sigma) any_sigma |= s.has_value();
   if (any_sigma) {
     out << YAML::Key << "interior_sigma" << YAML::Value << YAML::BeginMap;
-    for (int i = 0; i < Model::kNumParams; ++i)
+    for (size_t i = 0; i < table.size(); ++i)
       if (camera.interior_sigma[i])
-        out << YAML::Key << std::string(Model::kParams[i].name) << YAML::Value
+        out << YAML::Key << std::string(table[i].name) << YAML::Value
             << *camera.interior_sigma[i];
     out << YAML::EndMap;
   }
@@ -227,44 +236,7 @@ void WriteCamera(const std::string& path, const Camera& camera) {
 }
 
 ModelCamera ParseModelCamera(const YAML::Node& root, const std::string& file) {
-  if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
-  const std::string name =
-      root["model"] ? YamlString(root["model"], file, "model") : std::string(Model::kName);
-  const auto id = CameraModelFromName(name);
-  if (!id)
-    ThrowInputError(WhereIs(root["model"], file),
-                    "unknown camera model '" + name + "' (expected one of " + CameraModelNames() +
-                        ")");
-  ModelCamera camera;
-  camera.model = *id;
-  if (*id == Model::kId) {
-    const Camera ours = ParseCamera(root, file);
-    camera.params.assign(ours.interior.begin(), ours.interior.end());
-    camera.frame = ours.frame();
-    return camera;
-  }
-  RejectUnknownKeys(root, {"name", "pixel_size_mm", "format_px", "interior", "model"}, file);
-  if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
-  camera.frame.pixel_size_mm = YamlBounded(root["pixel_size_mm"], file, "pixel_size_mm",
-                                           kMinPixelSizeMm, kMaxPixelSizeMm);
-  if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
-  std::tie(camera.frame.width_px, camera.frame.height_px) = ReadFormat(root["format_px"], file);
-  if (!root["interior"]) ThrowInputError({file, 1}, "missing interior");
-  const YAML::Node& interior = root["interior"];
-  std::vector<std::string> keys;
-  for (const ParamInfo& info : CameraModelParams(*id)) keys.emplace_back(info.name);
-  RejectUnknownKeys(interior, keys, file);
-  const std::vector<ParamInfo> table = CameraModelParams(*id);
-  for (const ParamInfo& info : table) {
-    const std::string key(info.name);
-    const double bound = ModelParamBound(info);
-    camera.params.push_back(interior[key] ? YamlBounded(interior[key], file, "interior." + key,
-                                                        -bound, bound)
-                                          : 0.0);
-  }
-  if (!(camera.PrincipalDistanceMm() > 0))
-    ThrowInputError(WhereIs(interior, file), name + ": the focal length must be > 0");
-  return camera;
+  return ParseCamera(root, file, CameraModels::kAny).AsModelCamera();
 }
 
 ModelCamera ReadModelCamera(const std::string& path) {

@@ -12,18 +12,26 @@
 
 namespace aerocal::calib {
 
-Camera ReadCamera(const std::string& path);
-Camera ParseCamera(const YAML::Node& root, const std::string& file);
+/// Which camera models a reader accepts: the commands whose sensor kinds need the 10-parameter
+/// model (sub-image mappings, rig heads, stitching) read with the default and refuse another
+/// model with "convert it first"; the adjustment's frame cameras and `calibrate` take any model.
+enum class CameraModels { kBrownFraser10Only, kAny };
+
+/// `model:` one of the registry's names (default brown_fraser_10); `interior:` and
+/// `interior_sigma:` keyed by that model's parameter names (absent = 0 / not weighted), the
+/// principal-distance parameters > 0; sub-images and reference points only with brown_fraser_10.
+Camera ReadCamera(const std::string& path, CameraModels models = CameraModels::kBrownFraser10Only);
+Camera ParseCamera(const YAML::Node& root,
+                   const std::string& file,
+                   CameraModels models = CameraModels::kBrownFraser10Only);
 /// YAML text of a camera (full precision, every interior term written).
 std::string CameraToYaml(const Camera& camera);
 /// Writes atomically.
 void WriteCamera(const std::string& path, const Camera& camera);
 
-/// A camera file in ANY registered model (camera_model.h): the same keys as above, `model:` one of
-/// the registry's names (default brown_fraser_10), `interior:` keyed by that model's parameter
-/// names (absent = 0). A brown_fraser_10 file is read by ParseCamera (everything checked as
-/// there; sub-images and sigmas are not part of a ModelCamera). The mapping is the parameter
-/// table: a new model needs nothing here.
+/// A camera file in ANY registered model as a ModelCamera (ParseCamera with CameraModels::kAny;
+/// sub-images and sigmas are not part of a ModelCamera). The mapping is the parameter table: a new
+/// model needs nothing here.
 ModelCamera ParseModelCamera(const YAML::Node& root, const std::string& file);
 ModelCamera ReadModelCamera(const std::string& path);
 std::string ModelCameraToYaml(const ModelCamera& camera, const std::string& name);

@@ -59,6 +59,12 @@ std::vector<ParamInfo> CameraModelParams(CameraModelId id) {
   });
 }
 
+std::string JoinParamNames(const std::vector<ParamInfo>& table) {
+  std::string names;
+  for (const ParamInfo& info : table) names += (names.empty() ? "" : ", ") + std::string(info.name);
+  return names;
+}
+
 bool ModelCamera::IdealFromPixel(const Eigen::Vector2d& pixel, Eigen::Vector2d* ideal_mm) const {
   AEROCAL_CHECK(static_cast<int>(params.size()) == CameraModelParamCount(model));
   const Eigen::Vector2d xy = frame.PhotoFromPixel(pixel);

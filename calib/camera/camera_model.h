@@ -87,6 +87,8 @@ std::string_view CameraModelName(CameraModelId id);
 std::string CameraModelNames();
 int CameraModelParamCount(CameraModelId id);
 std::vector<ParamInfo> CameraModelParams(CameraModelId id);
+/// The names of a parameter table, comma separated (for messages).
+std::string JoinParamNames(const std::vector<ParamInfo>& table);
 
 /// A camera in any registered model: the model, its parameters in table order and units, and the
 /// image format the parameters refer to.

@@ -1,14 +1,24 @@
-// Collinearity residuals with the 10-parameter camera (CONVENTIONS.md). The residual is formed in
-// the corrected (ideal) photo space, no iteration:
-//   r = ((xb + dx, yb + dy) - (-c U / W, -c V / W)) / sigma_mm        [2, unitless]
-// with [U V W] = R^T (X - X0), sigma_mm = sigma_px * pixel_size. The exposure rotation R is a unit
-// quaternion block q = [w, x, y, z] (object_from_image, calib/camera/rotation.h), moved by the
-// builder's rotation-increment manifold; R(q) equals Rx(omega) Ry(phi) Rz(kappa) of the files.
+// Collinearity residuals (CONVENTIONS.md) for a camera in ANY registered model (camera_model.h),
+// with [U V W] = R^T (X - X0), ideal = -c (U, V) / W, c = the model's PrincipalDistanceMm:
+// - a model in correction form (kCorrectionForm, the 10-parameter model) is compared in the
+//   corrected (ideal) photo space, no iteration:
+//     r = (IdealFromMeasured(xy) - ideal) / sigma_mm
+// - a forward model (OpenCV, COLMAP, Metashape, Pix4D: distortion from ideal to measured) is
+//   compared where it is measured, as those tools do (reprojection error):
+//     r = (xy - MeasuredFromIdeal(ideal)) / sigma_mm
+// [2, unitless], sigma_mm = sigma_px * pixel_size, xy the measured photo coordinates (mm). The
+// exposure rotation R is a unit quaternion block q = [w, x, y, z] (object_from_image,
+// calib/camera/rotation.h), moved by the builder's rotation-increment manifold; R(q) equals
+// Rx(omega) Ry(phi) Rz(kappa) of the files. MakeCollinearityResidual is THE factory: the residual
+// of a camera's model by its id (VisitCameraModel); a new model needs nothing here.
 #pragma once
+
+#include <memory>
 
 #include <Eigen/Core>
 
 #include "calib/camera/brown_fraser10.h"
+#include "calib/camera/camera_model.h"
 #include "calib/camera/pixel_frame.h"
 #include "calib/camera/rig.h"
 #include "calib/camera/rotation.h"
@@ -19,47 +29,81 @@ namespace aerocal::calib {
 
 namespace internal {
 /// The one collinearity condition of aerocal: an object point already turned into the image-space
-/// frame of its camera or head ([U V W] = R^T (X - X0)) against the measured photo coordinates.
-/// Every collinearity residual (frame camera, sub-image, rig head) ends here.
-template <typename T>
-bool CollinearityErrorFromImageSpace(const T* interior, const T* uvw, const T* measured_xy_mm,
-                                     double inverse_sigma_mm, T* residual) {
+/// frame of its camera or head ([U V W] = R^T (X - X0)) against the measured photo coordinates,
+/// in the camera model `Model` (header comment). Every collinearity residual (frame camera,
+/// sub-image, rig head) ends here. False behind the projection plane or where the model's
+/// inversion does not converge.
+template <typename Model, typename T>
+bool CollinearityErrorFromImageSpace(const T* interior, const PixelFrame& frame, const T* uvw,
+                                     const T* measured_xy_mm, double inverse_sigma_mm,
+                                     T* residual) {
   if (!(uvw[2] < T(0))) return false;  // point on or behind the projection plane
-  T ideal[2];
-  BrownFraser10Model::IdealFromMeasured(interior, measured_xy_mm, ideal);
-  const T c = interior[BrownFraser10Model::kC];
-  residual[0] = (ideal[0] + c * uvw[0] / uvw[2]) * T(inverse_sigma_mm);
-  residual[1] = (ideal[1] + c * uvw[1] / uvw[2]) * T(inverse_sigma_mm);
+  const T c = Model::PrincipalDistanceMm(interior, frame);
+  const T projected[2] = {-c * uvw[0] / uvw[2], -c * uvw[1] / uvw[2]};
+  if constexpr (Model::kCorrectionForm) {
+    T ideal[2];
+    if (!Model::IdealFromMeasured(interior, frame, measured_xy_mm, ideal)) return false;
+    residual[0] = (ideal[0] - projected[0]) * T(inverse_sigma_mm);
+    residual[1] = (ideal[1] - projected[1]) * T(inverse_sigma_mm);
+  } else {
+    T measured[2];
+    if (!Model::MeasuredFromIdeal(interior, frame, projected, measured)) return false;
+    residual[0] = (measured_xy_mm[0] - measured[0]) * T(inverse_sigma_mm);
+    residual[1] = (measured_xy_mm[1] - measured[1]) * T(inverse_sigma_mm);
+  }
   return true;
 }
 
-template <typename T>
-bool CollinearityError(const T* interior, const T* rotation, const T* center, const T* point,
-                       const T* measured_xy_mm, double inverse_sigma_mm, T* residual) {
+template <typename Model, typename T>
+bool CollinearityError(const T* interior, const PixelFrame& frame, const T* rotation,
+                       const T* center, const T* point, const T* measured_xy_mm,
+                       double inverse_sigma_mm, T* residual) {
   T uvw[3];
   ImageSpaceFromObjectByQuaternion(rotation, center, point, uvw);
-  return CollinearityErrorFromImageSpace(interior, uvw, measured_xy_mm, inverse_sigma_mm, residual);
+  return CollinearityErrorFromImageSpace<Model>(interior, frame, uvw, measured_xy_mm,
+                                                inverse_sigma_mm, residual);
 }
 }  // namespace internal
 
-/// Observation (col, row) in the virtual image's pixel frame.
-/// blocks: interior[10] (table units), rotation[4] (quaternion), center[3] (m), point[3] (m).
-struct CollinearityResidual : AutoDiffResidual<CollinearityResidual, 2, 10, 4, 3, 3> {
-  CollinearityResidual(const PixelFrame& frame, const Eigen::Vector2d& pixel, double sigma_px)
-      : inverse_sigma_mm_(1.0 / (sigma_px * frame.pixel_size_mm)) {
+/// Observation (col, row) in the virtual image's pixel frame, camera in `Model`.
+/// blocks: interior[Model::kNumParams] (table units), rotation[4] (quaternion), center[3] (m),
+/// point[3] (m).
+template <typename Model>
+struct ModelCollinearityResidual
+    : AutoDiffResidual<ModelCollinearityResidual<Model>, 2, Model::kNumParams, 4, 3, 3> {
+  ModelCollinearityResidual(const PixelFrame& frame, const Eigen::Vector2d& pixel, double sigma_px)
+      : frame_(frame), inverse_sigma_mm_(1.0 / (sigma_px * frame.pixel_size_mm)) {
     frame.PhotoFromPixel(pixel.data(), xy_mm_);
   }
   template <typename T>
   bool operator()(const T* interior, const T* rotation, const T* center, const T* point,
                   T* r) const {
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
-    return internal::CollinearityError(interior, rotation, center, point, xy, inverse_sigma_mm_, r);
+    return internal::CollinearityError<Model>(interior, frame_, rotation, center, point, xy,
+                                              inverse_sigma_mm_, r);
   }
 
  private:
+  PixelFrame frame_;
   double xy_mm_[2];
   double inverse_sigma_mm_;
 };
+
+/// The frame residual of the 10-parameter model (blocks interior[10], rotation[4], center[3],
+/// point[3]).
+using CollinearityResidual = ModelCollinearityResidual<BrownFraser10Model>;
+
+/// THE residual factory: the collinearity residual of an observation (col, row) of a camera in
+/// model `model` (blocks interior[CameraModelParamCount(model)], rotation[4], center[3],
+/// point[3]).
+inline std::unique_ptr<ceres::CostFunction> MakeCollinearityResidual(CameraModelId model,
+                                                                     const PixelFrame& frame,
+                                                                     const Eigen::Vector2d& pixel,
+                                                                     double sigma_px) {
+  return VisitCameraModel(model, [&](auto m) {
+    return ModelCollinearityResidual<decltype(m)>::Create(frame, pixel, sigma_px);
+  });
+}
 
 /// Observation (u, v) in a RAW sub-image; the sub-image mapping (conditioned parameters, see
 /// subimage_mapping.h) takes it to the virtual image, then collinearity as above.
@@ -80,7 +124,8 @@ struct SubimageCollinearityResidual
     T virtual_px[2], xy[2];
     Mapping::Apply(mapping, uv, virtual_px);
     frame_.PhotoFromPixel(virtual_px, xy);
-    return internal::CollinearityError(interior, rotation, center, point, xy, inverse_sigma_mm_, r);
+    return internal::CollinearityError<BrownFraser10Model>(interior, frame_, rotation, center,
+                                                           point, xy, inverse_sigma_mm_, r);
   }
 
  private:
@@ -104,7 +149,8 @@ struct RigHeadCollinearityResidual
     : AutoDiffResidual<RigHeadCollinearityResidual, 2, 10, 4, 3, 3, 3, 3, 1, 3> {
   RigHeadCollinearityResidual(const PixelFrame& head_frame, const Eigen::Vector2d& pixel,
                               double sigma_px, const Eigen::Vector3d& velocity_mps)
-      : inverse_sigma_mm_(1.0 / (sigma_px * head_frame.pixel_size_mm)),
+      : frame_(head_frame),
+        inverse_sigma_mm_(1.0 / (sigma_px * head_frame.pixel_size_mm)),
         velocity_mps_{velocity_mps.x(), velocity_mps.y(), velocity_mps.z()} {
     head_frame.PhotoFromPixel(pixel.data(), xy_mm_);
   }
@@ -119,10 +165,12 @@ struct RigHeadCollinearityResidual
                        increment, dt, velocity, object_from_head, head_center);
     ImageSpaceFromObjectByMatrix(object_from_head, head_center, point, uvw);
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
-    return internal::CollinearityErrorFromImageSpace(interior, uvw, xy, inverse_sigma_mm_, r);
+    return internal::CollinearityErrorFromImageSpace<BrownFraser10Model>(
+        interior, frame_, uvw, xy, inverse_sigma_mm_, r);
   }
 
  private:
+  PixelFrame frame_;
   double xy_mm_[2];
   double inverse_sigma_mm_;
   double velocity_mps_[3];

@@ -4,6 +4,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 
+#include <algorithm>
 #include <set>
 #include <sstream>
 
@@ -14,9 +15,15 @@ using Model = calib::Camera::Model;
 void AdjustOptions::Validate() const {
   std::set<std::string> seen;
   for (const auto& name : free_interior) {
-    if (Model::IndexOf(name) < 0)
+    // The names of any registered model; the frame camera checks them against each camera's own
+    // model when the adjustment starts.
+    bool known = false;
+    calib::ForEachCameraModel(
+        [&](auto model) { known = known || calib::IndexOfParam(decltype(model)::kParams, name) >= 0; });
+    if (!known)
       throw ConfigError("free_interior: unknown parameter '" + name +
-                        "' (expected c, x0, y0, K1, K2, K3, P1, P2, B1, B2)");
+                        "' (expected c, x0, y0, K1, K2, K3, P1, P2, B1, B2 or a parameter of the "
+                        "camera's model)");
     if (!seen.insert(name).second)
       throw ConfigError("free_interior: parameter '" + name + "' listed twice");
   }
@@ -60,18 +67,23 @@ void AdjustOptions::Validate() const {
                       std::to_string(solver.max_iterations) + ")");
 }
 
-std::vector<std::string> ParseSelfCalibration(const std::string& text) {
+std::vector<std::string> ParseSelfCalibration(const std::string& text, calib::CameraModelId model) {
   if (text == "none" || text.empty()) return {};
   std::vector<std::string> names;
+  const std::vector<calib::ParamInfo> table = calib::CameraModelParams(model);
   if (text == "all") {
-    for (const auto& p : Model::kParams) names.emplace_back(p.name);
+    for (const auto& p : table) names.emplace_back(p.name);
     return names;
   }
   for (const std::string& name : SplitCommaList(text)) {
-    if (Model::IndexOf(name) < 0)
-      throw ConfigError(
-          "--self-calibration: unknown parameter '" + name +
-          "' (expected none, all or a list of c, x0, y0, K1, K2, K3, P1, P2, B1, B2)");
+    if (std::none_of(table.begin(), table.end(), [&](const auto& p) { return p.name == name; }))
+      throw ConfigError("--self-calibration: unknown parameter '" + name +
+                        "' (expected none, all or a list of " +
+                        (model == Model::kId ? std::string()
+                                             : "the parameters of model " +
+                                                   std::string(calib::CameraModelName(model)) +
+                                                   ": ") +
+                        calib::JoinParamNames(table) + ")");
     names.push_back(name);
   }
   AdjustOptions probe;

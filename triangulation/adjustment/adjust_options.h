@@ -3,6 +3,7 @@
 // their roles, a-priori sigmas) is data from the block files, not options.
 #pragma once
 
+#include "calib/camera/camera_model.h"
 #include "calib/problem/problem_builder.h"
 
 #include <string>
@@ -11,8 +12,9 @@
 namespace aerocal::triangulation {
 
 struct AdjustOptions {
-  /// Interior parameters estimated per camera, by table name (c, x0, y0, K1, K2, K3, P1, P2, B1,
-  /// B2); empty = conventional adjustment (interior fixed at the camera file's values).
+  /// Interior parameters estimated per camera, by the names of the camera's model's table
+  /// (brown_fraser_10: c, x0, y0, K1, K2, K3, P1, P2, B1, B2; opencv: fx, fy, cx, cy, k1, ...);
+  /// empty = conventional adjustment (interior fixed at the camera file's values).
   std::vector<std::string> free_interior;
   /// Camera-file `interior_sigma` values enter as weighted observations of the free parameters.
   bool use_interior_sigma = true;
@@ -71,8 +73,9 @@ struct AdjustOptions {
   void Validate() const;
 };
 
-/// "none" -> {}, "all" -> the 10 names, "c,x0,K1" -> those names (checked against the table).
-/// Throws ConfigError on an unknown name.
-std::vector<std::string> ParseSelfCalibration(const std::string& text);
+/// "none" -> {}, "all" -> every name of `model`'s table (the 10 of brown_fraser_10),
+/// "c,x0,K1" -> those names (checked against that table). Throws ConfigError on an unknown name.
+std::vector<std::string> ParseSelfCalibration(
+    const std::string& text, calib::CameraModelId model = calib::CameraModelId::kBrownFraser10);
 
 }  // namespace aerocal::triangulation

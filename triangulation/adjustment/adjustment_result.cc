@@ -1,5 +1,6 @@
 #include "triangulation/adjustment/adjustment_result.h"
 
+#include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 
 #include <algorithm>
@@ -118,9 +119,10 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
   return j;
 }
 
-nlohmann::json Interior(const calib::InteriorParams& p) {
+nlohmann::json Interior(calib::CameraModelId model, const calib::InteriorParams& p) {
   nlohmann::json j = nlohmann::json::object();
-  for (int k = 0; k < Model::kNumParams; ++k) j[std::string(Model::kParams[k].name)] = p[k];
+  const std::vector<calib::ParamInfo> table = calib::CameraModelParams(model);
+  for (size_t k = 0; k < table.size(); ++k) j[std::string(table[k].name)] = p[k];
   return j;
 }
 
@@ -155,8 +157,9 @@ std::string CalibrationTable(const AdjustmentResult& r) {
                         "sigma",
                         "|t|");
     std::string insignificant;
-    for (int k = 0; k < Model::kNumParams; ++k) {
-      const auto& info = Model::kParams[k];
+    const std::vector<calib::ParamInfo> table = calib::CameraModelParams(c.model);
+    for (int k = 0; k < static_cast<int>(table.size()); ++k) {
+      const auto& info = table[k];
       const double t = CorrectionInSigmas(c, k);
       out += StringPrintf("  %-4s %-6s %16.8g %16.8g %16.8g %14s %8s\n",
                           std::string(info.name).c_str(),
@@ -355,15 +358,14 @@ std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, dou
   return out;
 }
 
-nlohmann::json CameraModelTableToJson() {
-  using Model = calib::Camera::Model;
+nlohmann::json CameraModelTableToJson(calib::CameraModelId model) {
   nlohmann::json parameters = nlohmann::json::array();
-  for (const calib::ParamInfo& p : Model::kParams)
+  for (const calib::ParamInfo& p : calib::CameraModelParams(model))
     parameters.push_back({{"name", std::string(p.name)},
                           {"unit", std::string(p.unit)},
                           {"group", std::string(calib::ParamGroupName(p.group))}});
-  return {{"name", std::string(Model::kName)},
-          {"id", static_cast<int>(Model::kId)},
+  return {{"name", std::string(calib::CameraModelName(model))},
+          {"id", static_cast<int>(model)},
           {"parameters", parameters}};
 }
 
@@ -371,7 +373,9 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   nlohmann::json j;
   j["kind"] = "adjust";
   j["schema_version"] = kResultSchemaVersion;
-  j["camera_model"] = CameraModelTableToJson();
+  // The model of the cameras (the first camera's when they differ; each camera names its own).
+  j["camera_model"] =
+      CameraModelTableToJson(r.cameras.empty() ? Model::kId : r.cameras.front().model);
   j["sigma0"] = r.sigma0;
   j["sigma0_px"] = r.sigma0_px;
   j["sigma0_um"] = r.sigma0_um;
@@ -400,8 +404,9 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["cameras"] = nlohmann::json::array();
   for (const auto& c : r.cameras) {
     nlohmann::json sigma = nlohmann::json::object(), free = nlohmann::json::array();
-    for (int k = 0; k < Model::kNumParams; ++k) {
-      const std::string name(Model::kParams[k].name);
+    const std::vector<calib::ParamInfo> table = calib::CameraModelParams(c.model);
+    for (int k = 0; k < static_cast<int>(table.size()); ++k) {
+      const std::string name(table[k].name);
       if (c.free[k]) {
         free.push_back(name);
         sigma[name] =
@@ -409,8 +414,9 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
       }
     }
     j["cameras"].push_back({{"id", c.id},
-                            {"initial", Interior(c.initial)},
-                            {"estimated", Interior(c.estimated)},
+                            {"model", std::string(calib::CameraModelName(c.model))},
+                            {"initial", Interior(c.model, c.initial)},
+                            {"estimated", Interior(c.model, c.estimated)},
                             {"sigma", sigma},
                             {"free", free}});
   }
@@ -601,23 +607,28 @@ nlohmann::json ComparisonToJson(const AdjustmentResult& a, const AdjustmentResul
   j["check_spatial_rmse_ratio"] =
       b.check.spatial_rmse_m > 0 ? a.check.spatial_rmse_m / b.check.spatial_rmse_m : 0.0;
   nlohmann::json table = nlohmann::json::array();
-  for (const auto& c : b.cameras)
-    for (int k = 0; k < Model::kNumParams; ++k) {
+  for (const auto& c : b.cameras) {
+    const std::vector<calib::ParamInfo> params = calib::CameraModelParams(c.model);
+    for (int k = 0; k < static_cast<int>(params.size()); ++k) {
       const double t = CorrectionInSigmas(c, k);
       table.push_back({{"camera", c.id},
-                       {"parameter", std::string(Model::kParams[k].name)},
-                       {"unit", std::string(Model::kParams[k].unit)},
+                       {"parameter", std::string(params[k].name)},
+                       {"unit", std::string(params[k].unit)},
                        {"initial", c.initial[k]},
                        {"correction", c.estimated[k] - c.initial[k]},
                        {"estimate", c.estimated[k]},
                        {"sigma", c.free[k] ? nlohmann::json(c.sigma[k]) : nlohmann::json()},
                        {"t", std::isnan(t) ? nlohmann::json() : nlohmann::json(t)}});
     }
+  }
   j["calibration"] = table;
   return j;
 }
 
 calib::Camera UpdatedCamera(const calib::Camera& camera, const CameraEstimate& estimate) {
+  AEROCAL_CHECK(estimate.model == camera.model)
+      << "camera " << camera.name << ": estimate in model " << calib::CameraModelName(estimate.model)
+      << ", camera in " << calib::CameraModelName(camera.model);
   calib::Camera out = camera;
   out.interior = estimate.estimated;
   return out;

@@ -43,10 +43,13 @@ struct PointStatistics {
 };
 PointStatistics ComputePointStatistics(const std::vector<PointDifference>& points);
 
+/// One camera's interior after the adjustment, in the camera's own model (its table order and
+/// units; default-constructed: the 10-parameter model).
 struct CameraEstimate {
   std::string id;
+  calib::CameraModelId model = calib::Camera::Model::kId;
   calib::InteriorParams initial{}, estimated{}, sigma{};  // table units; sigma 0 when fixed
-  std::array<bool, calib::Camera::Model::kNumParams> free{};
+  calib::ParamVector<bool> free{};
 };
 
 /// The GNSS/IMU platform after the adjustment (triangulation/README.md "GNSS/IMU priors on the
@@ -241,9 +244,10 @@ void ClassifyUncontrolled(double min_redundancy, AdjustmentResult* result);
 /// Version of the result documents written by AdjustmentToJson (and the writers built on it):
 /// raised when a key changes meaning or disappears; added keys do not raise it.
 inline constexpr int kResultSchemaVersion = 1;
-/// The camera model of the adjustment's cameras with its parameter table:
-/// {name, id, parameters: [{name, unit, group}]} in table order (calib/camera/camera.h).
-nlohmann::json CameraModelTableToJson();
+/// A camera model with its parameter table: {name, id, parameters: [{name, unit, group}]} in
+/// table order (calib/camera/camera_model.h). The result's `camera_model` is that of its cameras
+/// (the first camera's when they differ: each camera entry names its `model`).
+nlohmann::json CameraModelTableToJson(calib::CameraModelId model = calib::Camera::Model::kId);
 nlohmann::json AdjustmentToJson(const AdjustmentResult& result);
 nlohmann::json PointStatisticsToJson(const PointStatistics& statistics);
 

@@ -21,7 +21,6 @@
 namespace aerocal::triangulation {
 namespace {
 
-using Model = calib::Camera::Model;
 using calib::BlockId;
 using calib::BlockKind;
 
@@ -338,16 +337,17 @@ void BlockAdjustment::AddPriors() {
       std::vector<int> indices;
       std::vector<double> values, sigmas;
       for (const auto& name : options_.free_interior) {
-        const int k = Model::IndexOf(name);
-        if (!camera.interior_sigma[k]) continue;
-        indices.push_back(k);
-        values.push_back(camera.interior[k]);
-        sigmas.push_back(*camera.interior_sigma[k]);
+        const int i = camera.ParamIndex(name);  // >= 0: the frame camera checked the names
+        if (!camera.interior_sigma[i]) continue;
+        indices.push_back(i);
+        values.push_back(camera.interior[i]);
+        sigmas.push_back(*camera.interior_sigma[i]);
       }
       if (!indices.empty())
         builder_.AddResidual(
             calib::kGroupInteriorPrior,
-            std::make_unique<calib::PriorCostFunction>(Model::kNumParams, indices, values, sigmas),
+            std::make_unique<calib::PriorCostFunction>(camera.interior.size(), indices, values,
+                                                       sigmas),
             {storage_->frame.InteriorBlock(k)},
             "interior prior " + id);
     }
@@ -908,17 +908,23 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   result.platform = PlatformResult(cov);
   for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k) {
     const std::string& id = storage_->index.CameraId(k);
+    const calib::Camera& camera = project_.cameras.at(id);
+    const std::vector<calib::ParamInfo> table = camera.Params();
+    const int n = static_cast<int>(table.size());
     CameraEstimate c;
     c.id = id;
-    c.initial = project_.cameras.at(id).interior;
+    c.model = camera.model;
+    c.initial = camera.interior;
     c.estimated = storage_->frame.Interior(k);
-    for (int k = 0; k < Model::kNumParams; ++k)
-      c.free[k] = std::find(options_.free_interior.begin(),
+    c.sigma = calib::InteriorParams::ForModel(camera.model);
+    c.free = calib::ParamVector<bool>::ForModel(camera.model);
+    for (int i = 0; i < n; ++i)
+      c.free[i] = std::find(options_.free_interior.begin(),
                             options_.free_interior.end(),
-                            std::string(Model::kParams[k].name)) != options_.free_interior.end();
+                            std::string(table[i].name)) != options_.free_interior.end();
     if (cov.ok) {
-      const Eigen::VectorXd s = cov.BlockSigma(storage_->frame.InteriorBlock(k), Model::kNumParams);
-      for (int k = 0; k < Model::kNumParams; ++k) c.sigma[k] = c.free[k] ? s(k) : 0.0;
+      const Eigen::VectorXd s = cov.BlockSigma(storage_->frame.InteriorBlock(k), n);
+      for (int i = 0; i < n; ++i) c.sigma[i] = c.free[i] ? s(i) : 0.0;
     }
     result.cameras.push_back(c);
   }

@@ -12,9 +12,11 @@ ImageRay RayFromPixel(const calib::Camera& camera,
                       const Eigen::Vector3d& opk_rad,
                       const Eigen::Vector3d& center_m,
                       const Eigen::Vector2d& pixel) {
-  const Eigen::Vector2d xy = camera.PhotoFromPixel(pixel);
+  // In the camera's own model; where a forward model's inversion does not converge (far outside
+  // its format), the pinhole ray is a starting value good enough.
   Eigen::Vector2d ideal;
-  calib::Camera::Model::IdealFromMeasured(camera.interior.data(), xy.data(), ideal.data());
+  if (!camera.IdealFromPixel(pixel, &ideal))
+    ideal = camera.PhotoFromPixel(pixel) - camera.PrincipalPointMm();
   const Eigen::Vector3d in_image(ideal.x(), ideal.y(), -camera.c_mm());
   return {center_m, (calib::RotationFromOpk(opk_rad) * in_image).normalized()};
 }

@@ -15,11 +15,12 @@ std::vector<Exposure> NadirStartFromControl(const Project& project, const std::s
     double z;
   };
   std::map<std::string, std::vector<Pair>> pairs;
+  const Eigen::Vector2d principal_point = camera.PrincipalPointMm();
   for (const auto& o : project.observations) {
     const GroundPoint* p = project.FindPoint(o.point);
     if (!p || !p->xyz_m) continue;
-    const Eigen::Vector2d xy = camera.PhotoFromPixel(o.pixel);
-    pairs[o.image].push_back({{xy.x() - camera.interior[1], xy.y() - camera.interior[2]},
+    const Eigen::Vector2d xy = camera.PhotoFromPixel(o.pixel) - principal_point;
+    pairs[o.image].push_back({{xy.x(), xy.y()},
                               {p->xyz_m->x(), p->xyz_m->y()},
                               p->xyz_m->z()});
   }

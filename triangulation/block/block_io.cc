@@ -237,7 +237,7 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
       project.cameras[id] = rig.heads[rig.ReferenceIndex()].camera;
       project.rigs[id] = rig;
     } else {
-      project.cameras[id] = calib::ParseCamera(camera, file);
+      project.cameras[id] = calib::ParseCamera(camera, file, calib::CameraModels::kAny);
     }
   }
   project.exposures_file = ResolvePath(dir, YamlString(root["exposures"], path, "exposures"));

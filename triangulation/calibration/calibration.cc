@@ -54,7 +54,9 @@ CalibrationAdjustment RunCalibrationAdjustment(const Project& project, const Adj
       out.result.determinability.covariance_ok) {
     const calib::CovarianceReport cov =
         adjustment.builder().EstimateCovariance({block}, out.result.sigma0);
-    if (cov.ok) out.interior_covariance = cov.BlockCovariance(block, Model::kNumParams);
+    if (cov.ok)
+      out.interior_covariance =
+          cov.BlockCovariance(block, project.cameras.begin()->second.interior.size());
   }
   return out;
 }
@@ -64,8 +66,12 @@ StabilityReport GroupStability(const std::vector<GroupCalibration>& groups, doub
   report.alpha = alpha;
   if (groups.size() < 2) return report;
   const int n_groups = static_cast<int>(groups.size());
+  const calib::CameraModelId model = groups.front().adjustment.result.cameras.empty()
+                                         ? Model::kId
+                                         : groups.front().adjustment.result.cameras[0].model;
+  const std::vector<calib::ParamInfo> table = calib::CameraModelParams(model);
   std::vector<int> free;
-  for (int k = 0; k < Model::kNumParams; ++k) {
+  for (int k = 0; k < static_cast<int>(table.size()); ++k) {
     bool all = true;
     for (const auto& g : groups)
       all = all && !g.adjustment.result.cameras.empty() && g.adjustment.result.cameras[0].free[k];
@@ -76,8 +82,8 @@ StabilityReport GroupStability(const std::vector<GroupCalibration>& groups, doub
                    : ChiSquareQuantile(1.0 - alpha / static_cast<double>(free.size()), n_groups - 1);
   for (int k : free) {
     StabilityRow row;
-    row.parameter = std::string(Model::kParams[k].name);
-    row.unit = std::string(Model::kParams[k].unit);
+    row.parameter = std::string(table[k].name);
+    row.unit = std::string(table[k].unit);
     double sum = 0, sum_w = 0, sum_wv = 0;
     bool sigmas_known = true;
     for (const auto& g : groups) {
@@ -133,12 +139,12 @@ CalibrationRun Calibrate(const Project& input,
   calib::Camera& camera = project.cameras.begin()->second;
   if (options.closed_form_c) {
     run.closed_form_c_mm = ClosedFormPrincipalDistance(project, run.camera);
-    const double c_file = camera.interior[Model::kC];
+    const double c_file = camera.c_mm();
     if (run.closed_form_c_mm && *run.closed_form_c_mm < kClosedFormFactor * c_file &&
         *run.closed_form_c_mm > c_file / kClosedFormFactor)
-      camera.interior[Model::kC] = *run.closed_form_c_mm;
+      camera.SetPrincipalDistanceMm(*run.closed_form_c_mm);
   }
-  run.start_c_mm = camera.interior[Model::kC];
+  run.start_c_mm = camera.c_mm();
   run.starts = StartFromResections(project, run.camera);
   project.exposures.clear();
   for (const auto& s : run.starts) project.exposures.push_back(s.exposure);

@@ -94,9 +94,10 @@ PlaneFrame FitPlane(const std::vector<Eigen::Vector3d>& points) {
 }
 
 Eigen::Vector2d Normalised(const calib::Camera& camera, const Eigen::Vector2d& pixel) {
-  const Eigen::Vector2d xy = camera.PhotoFromPixel(pixel);
-  const double c = camera.interior[0];
-  return {(xy.x() - camera.interior[1]) / c, -(xy.y() - camera.interior[2]) / c};
+  // The pinhole part of the camera's model (principal point and distance), distortion ignored.
+  const Eigen::Vector2d xy = camera.PhotoFromPixel(pixel) - camera.PrincipalPointMm();
+  const double c = camera.c_mm();
+  return {xy.x() / c, -xy.y() / c};
 }
 
 Exposure ExposureFromForward(const Eigen::Matrix3d& forward_from_object,
@@ -255,13 +256,13 @@ std::optional<double> ClosedFormPrincipalDistance(const Project& project,
   const PlaneFrame plane = FitPlane(all);
   if (plane.extent(2) > kPlanarRatio * plane.extent(0)) return std::nullopt;
   std::map<std::string, std::pair<std::vector<Eigen::Vector2d>, std::vector<Eigen::Vector2d>>> views;
+  const Eigen::Vector2d principal_point = camera.PrincipalPointMm();
   for (const auto& o : project.observations) {
     const auto k = control.find(o.point);
     if (k == control.end()) continue;
-    const Eigen::Vector2d xy = camera.PhotoFromPixel(o.pixel);
+    const Eigen::Vector2d xy = camera.PhotoFromPixel(o.pixel) - principal_point;
     views[o.image].first.push_back((plane.axes.transpose() * (k->second - plane.centroid)).head<2>());
-    views[o.image].second.push_back(
-        {xy.x() - camera.interior[1], -(xy.y() - camera.interior[2])});
+    views[o.image].second.push_back({xy.x(), -xy.y()});
   }
   double ata = 0, atb = 0;
   for (const auto& [image, view] : views) {

@@ -34,10 +34,9 @@ struct InteriorFunction {
   std::function<double(const calib::InteriorParams&)> f;
 };
 
-Eigen::Matrix<double, Model::kNumParams, 1> Gradient(const InteriorFunction& q,
-                                                     const calib::InteriorParams& p) {
-  Eigen::Matrix<double, Model::kNumParams, 1> g;
-  for (int k = 0; k < Model::kNumParams; ++k) {
+Eigen::VectorXd Gradient(const InteriorFunction& q, const calib::InteriorParams& p) {
+  Eigen::VectorXd g(p.size());
+  for (int k = 0; k < p.size(); ++k) {
     calib::InteriorParams hi = p, lo = p;
     const double h = 1e-6 * std::max(1e-6, std::abs(p[k]));
     hi[k] += h;
@@ -50,8 +49,8 @@ Eigen::Matrix<double, Model::kNumParams, 1> Gradient(const InteriorFunction& q,
 double Propagate(const InteriorFunction& q,
                  const calib::InteriorParams& p,
                  const Eigen::MatrixXd& covariance) {
-  if (covariance.rows() != Model::kNumParams) return std::nan("");
-  const Eigen::Matrix<double, Model::kNumParams, 1> g = Gradient(q, p);
+  if (covariance.rows() != p.size()) return std::nan("");
+  const Eigen::VectorXd g = Gradient(q, p);
   return std::sqrt(std::max(0.0, g.dot(covariance * g)));
 }
 
@@ -87,7 +86,9 @@ double MaxEccentricityPx(const CalibrationRun& run, const Project& project, doub
   if (radius_mm <= 0) return 0.0;
   const calib::Camera& camera = project.cameras.at(run.camera);
   const AdjustmentResult& r = run.all.result;
-  const double c = r.cameras[0].estimated[Model::kC];
+  calib::Camera estimated = camera;
+  estimated.interior = r.cameras[0].estimated;
+  const double c = estimated.c_mm();
   const double radius_m = radius_mm * 1e-3;
   // Target normal: that of the best-fit plane of the control points (a 3-D field's targets face
   // the field's main direction).
@@ -188,14 +189,19 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
   const double eccentricity_px = MaxEccentricityPx(run, project, options.target_radius_mm);
 
   std::vector<InteriorFunction> functions;
-  for (int k = 0; k < Model::kNumParams; ++k) {
+  const std::vector<calib::ParamInfo> table = calib::CameraModelParams(camera.model);
+  for (int k = 0; k < static_cast<int>(table.size()); ++k) {
     if (!camera.free[k]) continue;
-    functions.push_back({std::string(Model::kParams[k].name), std::string(Model::kParams[k].unit),
+    functions.push_back({std::string(table[k].name), std::string(table[k].unit),
                          "interior parameter",
                          [k](const calib::InteriorParams& p) { return p[k]; }});
   }
-  const bool radial = camera.free[Model::kK1] || camera.free[Model::kK2] || camera.free[Model::kK3];
-  const bool decentring = camera.free[Model::kP1] || camera.free[Model::kP2];
+  // The distortion values at radii are the 10-parameter model's correction terms (header); a
+  // camera in another model certifies its parameters.
+  const bool ours = camera.model == Model::kId;
+  const bool radial =
+      ours && (camera.free[Model::kK1] || camera.free[Model::kK2] || camera.free[Model::kK3]);
+  const bool decentring = ours && (camera.free[Model::kP1] || camera.free[Model::kP2]);
   for (double r : options.radii_mm) {
     if (radial)
       functions.push_back({StringPrintf("dr@%g", r), "um",
@@ -235,7 +241,8 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
           StringPrintf("group reproducibility (%zu groups, excess over the adjustment)", values.size()),
           "A", std::sqrt(std::max(0.0, s2_mean - u_a * u_a)), n - 1, f.unit));
     }
-    if (run.control_fixed && run.control_fixed->interior_covariance.rows() == Model::kNumParams) {
+    if (run.control_fixed &&
+        run.control_fixed->interior_covariance.rows() == camera.estimated.size()) {
       const double u_fixed = Propagate(f, camera.estimated, run.control_fixed->interior_covariance);
       q.components.push_back(Component("control / target coordinates (survey sigmas propagated)",
                                        "B", std::sqrt(std::max(0.0, u_a * u_a - u_fixed * u_fixed)),

@@ -24,10 +24,8 @@ std::vector<std::string> WriteColmapModel(const Project& project,
   for (const auto& [id, c] : project.cameras) {
     const int n = static_cast<int>(camera_id.size()) + 1;
     camera_id[id] = n;
-    const calib::ModelCamera ours{calib::CameraModelId::kBrownFraser10,
-                                  {c.interior.begin(), c.interior.end()}, c.frame()};
     const calib::ConversionResult opencv =
-        calib::ConvertCamera(ours, calib::CameraModelId::kColmapOpenCv);
+        calib::ConvertCamera(c.AsModelCamera(), calib::CameraModelId::kColmapOpenCv);
     cameras << n << " " << calib::ColmapName(opencv.camera.model) << " " << c.width_px << " "
             << c.height_px;
     for (double p : opencv.camera.params) cameras << " " << p;

@@ -1,35 +1,39 @@
 #include "triangulation/sensor/frame_camera.h"
 
+#include "calib/core/error.h"
 #include "calib/residuals/collinearity.h"
 
 #include <algorithm>
 
 namespace aerocal::triangulation {
-namespace {
-using Model = calib::Camera::Model;
-}  // namespace
-
 bool FrameCamera::Measures(const ImageObservation& observation) const {
   return observation.subimage.empty();
 }
 
 void FrameCamera::RegisterBlocks(const SensorContext& context) {
-  std::vector<int> fixed;
-  std::vector<std::string> names;
-  for (int i = 0; i < Model::kNumParams; ++i) {
-    const std::string name(Model::kParams[i].name);
-    names.push_back(name);
-    const auto& free = context.options.free_interior;
-    if (std::find(free.begin(), free.end(), name) == free.end()) fixed.push_back(i);
-  }
   const int n = context.index.NumCameras();
   interior_.resize(n);
   blocks_.assign(n, -1);
+  const auto& free = context.options.free_interior;
   for (CameraIndex k = 0; k < n; ++k) {
     const std::string& id = context.index.CameraId(k);
-    interior_[k] = context.project.cameras.at(id).interior;
-    blocks_[k] = context.builder.AddBlock(
-        "camera " + id, interior_[k].data(), Model::kNumParams, calib::BlockKind::kInterior, names);
+    const calib::Camera& camera = context.project.cameras.at(id);
+    // Free entries by the names of the camera's own model (AdjustOptions::free_interior).
+    const std::vector<calib::ParamInfo> table = camera.Params();
+    std::vector<std::string> names;
+    std::vector<int> fixed;
+    for (int i = 0; i < static_cast<int>(table.size()); ++i) {
+      names.emplace_back(table[i].name);
+      if (std::find(free.begin(), free.end(), names.back()) == free.end()) fixed.push_back(i);
+    }
+    for (const std::string& name : free)
+      if (camera.ParamIndex(name) < 0)
+        throw ConfigError("free_interior: '" + name + "' is not a parameter of camera " + id +
+                          " in model " + std::string(calib::CameraModelName(camera.model)) +
+                          " (its parameters: " + calib::JoinParamNames(table) + ")");
+    interior_[k] = camera.interior;
+    blocks_[k] = context.builder.AddBlock("camera " + id, interior_[k].data(), interior_[k].size(),
+                                          calib::BlockKind::kInterior, names);
     context.builder.FixEntries(blocks_[k], fixed);
   }
 }
@@ -47,8 +51,8 @@ ObservationTerm FrameCamera::Observe(const SensorContext& context,
   const ObservationSite site = context.Site(observation);
   ObservationTerm term;
   term.group = calib::kGroupImage;
-  term.cost = calib::CollinearityResidual::Create(
-      site.camera->frame(), observation.pixel, observation.sigma_px);
+  term.cost = calib::MakeCollinearityResidual(
+      site.camera->model, site.camera->frame(), observation.pixel, observation.sigma_px);
   term.blocks = {blocks_[site.camera_index], site.pose.rotation, site.pose.center, point};
   return term;
 }

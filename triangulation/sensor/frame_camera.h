@@ -1,8 +1,11 @@
 // The frame camera: one image per exposure with the exposure's pose, observations in the virtual
-// image's pixel frame, collinearity with the camera's interior (calib/residuals/collinearity.h,
-// CONVENTIONS.md). It owns one interior block per camera (CameraIndex), whose free entries are
-// AdjustOptions::free_interior (a subset manifold in the builder); other sensor kinds put their
-// geometry in front of these blocks (sub-image mappings, rig mounts).
+// image's pixel frame, collinearity with the camera's interior in the camera's OWN model (any
+// registered model: the residual comes from calib::MakeCollinearityResidual, the one factory,
+// calib/residuals/collinearity.h; CONVENTIONS.md). It owns one interior block per camera
+// (CameraIndex, sized by the camera's model), whose free entries are AdjustOptions::free_interior
+// named by that model's table (a subset manifold in the builder; a name the model does not have is
+// a ConfigError); other sensor kinds put their geometry in front of these blocks (sub-image
+// mappings, rig mounts: those need the 10-parameter model).
 #pragma once
 
 #include "calib/camera/camera.h"
@@ -17,7 +20,7 @@ class FrameCamera final : public ImagingModel {
   std::string Kind() const override { return "frame"; }
   /// Virtual-image pixels (col, row): observations without a sub-image.
   bool Measures(const ImageObservation& observation) const override;
-  /// One interior block per camera ("camera ID", entries named by the model's table).
+  /// One interior block per camera ("camera ID", entries named by its model's table).
   void RegisterBlocks(const SensorContext& context) override;
   ImageRay StartingRay(const SensorContext& context,
                        const ImageObservation& observation) const override;

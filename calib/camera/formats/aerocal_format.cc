@@ -12,12 +12,11 @@ namespace aerocal::calib {
 CameraFile CameraFileFromCamera(const Camera& ours) {
   CameraFile file;
   file.name = ours.name;
-  file.camera.model = CameraModelId::kBrownFraser10;
-  file.camera.params.assign(ours.interior.begin(), ours.interior.end());
-  file.camera.frame = ours.frame();
+  file.camera = ours.AsModelCamera();
   bool any = false;
-  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(10, 10);
-  for (int i = 0; i < 10; ++i)
+  const int n = ours.interior.size();
+  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < n; ++i)
     if (ours.interior_sigma[i]) {
       any = true;
       covariance(i, i) = *ours.interior_sigma[i] * *ours.interior_sigma[i];
@@ -48,12 +47,8 @@ CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& o
                           : "no head '" + options.camera_id + "' (heads: " + ids + ")");
     file = CameraFileFromCamera(head->camera);
     file.name = head->id;
-  } else if (root.IsMap() && (!root["model"] || root["model"].Scalar() ==
-                                                    BrownFraser10Model::kName)) {
-    file = CameraFileFromCamera(ParseCamera(root, path));
   } else {
-    file.camera = ParseModelCamera(root, path);
-    file.name = root["name"] ? root["name"].Scalar() : "";
+    file = CameraFileFromCamera(ParseCamera(root, path, CameraModels::kAny));
   }
   const PixelFrame frame = file.camera.frame;
   internal::ResolveFormat(&file, options, {path, 1}, frame.width_px, frame.height_px,
@@ -62,18 +57,10 @@ CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& o
 }
 
 void WriteAerocalCamera(const std::string& path, const CameraFile& file) {
-  if (file.camera.model != CameraModelId::kBrownFraser10) {
-    WriteFileAtomically(path, ModelCameraToYaml(file.camera, file.name));
-    return;
-  }
-  Camera ours;
+  Camera ours = Camera::OfModel(file.camera.model).WithModelCamera(file.camera);
   ours.name = file.name;
-  ours.pixel_size_mm = file.camera.frame.pixel_size_mm;
-  ours.width_px = file.camera.frame.width_px;
-  ours.height_px = file.camera.frame.height_px;
-  for (int i = 0; i < 10; ++i) ours.interior[i] = file.camera.params.at(i);
   if (file.covariance)
-    for (int i = 0; i < 10; ++i) {
+    for (int i = 0; i < ours.interior.size(); ++i) {
       const double variance = (*file.covariance)(i, i);
       if (variance > 0 && std::isfinite(variance)) ours.interior_sigma[i] = std::sqrt(variance);
     }

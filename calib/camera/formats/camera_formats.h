@@ -87,7 +87,7 @@ struct FileConversion {
 FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& target,
                                  const ConvertOptions& options = {});
 
-/// Our camera (brown_fraser_10) as a camera file: interior_sigma as a diagonal covariance (the
+/// Our camera (in its own model) as a camera file: interior_sigma as a diagonal covariance (the
 /// terms without a sigma: 0), said in the notes. Sub-images and reference points are not carried.
 CameraFile CameraFileFromCamera(const Camera& camera);
 
