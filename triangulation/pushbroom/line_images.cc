@@ -126,7 +126,7 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimula
   ref.pixel_size_mm = io.reference_pixel_mm;
   ref.width_px = io.reference_width_px;
   ref.height_px = io.reference_height_px;
-  ref.interior.fill(0.0);
+  std::fill(ref.interior.begin(), ref.interior.end(), 0.0);
   ref.interior[calib::Camera::Model::kC] = io.reference_pixel_mm * o.height_m / reference_gsd;
   double x_mean = 0, z_mean = 0;
   for (const auto& r : sim.pos_truth) x_mean += r.center_m.x(), z_mean += r.center_m.z();
