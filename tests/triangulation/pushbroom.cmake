@@ -7,3 +7,4 @@ aerocal_add_test(triangulation/pushbroom_study LIBS aerocal::triangulation LABEL
 # pushbroom_images: the image-mode acceptance (1.5 x the geometry-only error) does NOT hold yet
 # (README "Measured"), so it is kept out of the default suite until it does.
 aerocal_add_test(triangulation/pushbroom_images LIBS aerocal::triangulation LABELS long)
+aerocal_add_test(triangulation/pushbroom_control_cli LIBS aerocal::triangulation LABELS cli)

@@ -102,28 +102,5 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
   EXPECT_LE(image.y(), 1.5 * geometry.y());
 }
 
-TEST(PushbroomImageMode, BadInputIsRefused) {
-  TempDir tmp("aerocal_pushbroom_images_bad");
-  // --images needs the photograph.
-  const auto no_texture = RunAerocal("simulate --pushbroom --images --out " + tmp.File("a"));
-  EXPECT_EQ(no_texture.exit_code, 2) << no_texture.output;
-  EXPECT_NE(no_texture.output.find("--texture"), std::string::npos) << no_texture.output;
-  EXPECT_FALSE(std::filesystem::exists(tmp.File("a")));
-  // A reference image missing: exposures.csv:LINE names it, nothing written.
-  const std::string sim = tmp.File("sim");
-  ASSERT_EQ(RunAerocal("simulate --pushbroom --detectors 60 --lines 200 --control 50 --out " + sim).exit_code, 0);
-  std::filesystem::create_directories(sim + "/reference");
-  std::ofstream(sim + "/line_image.png");  // never read: the reference images are found first
-  std::ofstream(sim + "/reference/camera.yaml")
-      << "name: ref\nmodel: brown_fraser_10\npixel_size_mm: 0.006\nformat_px: [1000, 800]\n"
-         "interior: {c: 10}\n";
-  std::ofstream(sim + "/reference/exposures.csv")
-      << "image,camera,X,Y,Z,omega,phi,kappa\nref9,reference,0,0,1000,0,0,0\n";
-  const auto missing = RunAerocal(Control(sim, tmp.File("out")));
-  EXPECT_EQ(missing.exit_code, 2) << missing.output;
-  EXPECT_NE(missing.output.find("ref9"), std::string::npos) << missing.output;
-  EXPECT_FALSE(std::filesystem::exists(tmp.File("out")));
-}
-
 }  // namespace
 }  // namespace aerocal::triangulation
