@@ -179,7 +179,10 @@ std::vector<StandardPosition> StandardTiePositions(const calib::Rig& rig,
     return pa != pb ? pa < pb : ZoneName(rig, a.first) < ZoneName(rig, b.first);
   });
   std::vector<StandardPosition> positions;
-  for (const auto& [mask, points] : zones) {
+  for (const auto& zone_cells : zones) {
+    // (named copies: a lambda may not capture a structured binding in C++17; clang refuses it)
+    const unsigned mask = zone_cells.first;
+    const std::vector<Eigen::Vector2d>& points = zone_cells.second;
     const std::string zone = ZoneName(rig, mask);
     Eigen::Vector2d mean = Eigen::Vector2d::Zero();
     for (const auto& p : points) mean += p;
