@@ -396,7 +396,9 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       }
       RigStitchExposureResult& er = result.exposures[i];
       (phase == 0 ? er.before : er.after) = sums.Finish();
-      for (const auto& [zone, s] : exposure_zones) {
+      for (const auto& zone_rms : exposure_zones) {
+        const std::string& zone = zone_rms.first;  // (a lambda may not capture a binding, C++17)
+        const RmsSums& s = zone_rms.second;
         auto z = std::find_if(er.zones.begin(), er.zones.end(),
                               [&](const ZoneStitchRms& r) { return r.zone == zone; });
         if (z == er.zones.end()) z = er.zones.insert(er.zones.end(), ZoneStitchRms{zone, {}, {}});
