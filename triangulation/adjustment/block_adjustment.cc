@@ -546,7 +546,9 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
   // rays agree equally well, the rays cannot be told apart here: none is excluded, and the final
   // adjustment's snooping judges them with their correlated group.
   std::map<calib::ResidualId, double> judged;  // per-point verdicts: the ray's |v| / s there
-  for (const auto& [point, rays] : rays_of_point) {
+  for (const auto& point_rays : rays_of_point) {
+    const auto& point = point_rays.first;  // (a lambda may not capture a binding in C++17)
+    const auto& rays = point_rays.second;
     const int n = static_cast<int>(rays.size());
     auto state = storage_->points.find(point);
     const bool control = state->second.ground && state->second.ground->role == PointRole::kControl;
