@@ -11,6 +11,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
   const int kind = data[0] % 2;
   const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
+  // (outside the macro: a comma between braces would split its argument)
+  static constexpr double kFractions[] = {0.0, 0.5, 1.0};
   AEROCAL_FUZZ_EXPECTED_ERRORS({
     if (kind == 0) {
       (void)stitch::ParseErrorLimits(LoadYamlText(text, "limits.yaml"), "limits.yaml");
@@ -18,8 +20,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
       const stitch::DemGrid dem = stitch::ReadDemAscii(fuzz::WriteScratch("dem.asc", text));
       (void)dem.MeanHeight();
       const double w = dem.cell_m * (dem.cols - 1), h = dem.cell_m * (dem.rows - 1);
-      for (const double fx : {0.0, 0.5, 1.0})
-        for (const double fy : {0.0, 0.5, 1.0}) (void)dem.HeightAt(dem.x0_m + fx * w, dem.y0_m + fy * h);
+      for (const double fx : kFractions)
+        for (const double fy : kFractions) (void)dem.HeightAt(dem.x0_m + fx * w, dem.y0_m + fy * h);
     }
   });
   return 0;
