@@ -19,7 +19,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     } else {
       const stitch::DemGrid dem = stitch::ReadDemAscii(fuzz::WriteScratch("dem.asc", text));
       (void)dem.MeanHeight();
-      const double w = dem.cell_m * (dem.cols - 1), h = dem.cell_m * (dem.rows - 1);
+      const double w = dem.cell_m * (dem.cols - 1);
+      const double h = dem.cell_m * (dem.rows - 1);
       for (const double fx : kFractions)
         for (const double fy : kFractions) (void)dem.HeightAt(dem.x0_m + fx * w, dem.y0_m + fy * h);
     }
