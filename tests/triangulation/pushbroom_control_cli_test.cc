@@ -13,6 +13,7 @@
 
 #include "calib/core/csv.h"
 #include "tests/support/test_support.h"
+#include "tests/triangulation/pushbroom_commands.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -20,13 +21,6 @@ namespace {
 using aerocal::testing::RunAerocal;
 using aerocal::testing::TempDir;
 using nlohmann::json;
-
-std::string Control(const std::string& dir, const std::string& out) {
-  return "pushbroom control --camera " + dir + "/camera_nominal.yaml --pos " + dir +
-         "/pos.csv --line-image " + dir + "/line_image.png --reference-camera " + dir +
-         "/reference/camera.yaml --reference-exposures " + dir +
-         "/reference/exposures.csv --reference-images " + dir + "/reference --out-dir " + out;
-}
 
 TEST(PushbroomControl, MatchedControlCalibratesTheDetectors) {
   const std::string photo = testing::SharedDataDir("odm_boruszyn_kap_frames");
@@ -36,7 +30,7 @@ TEST(PushbroomControl, MatchedControlCalibratesTheDetectors) {
   const auto s = RunAerocal("simulate --pushbroom --images --texture " + photo +
                             "/images/img_4880.jpg --detectors 100 --lines 300 --out " + sim);
   ASSERT_EQ(s.exit_code, 0) << s.output;
-  const auto c = RunAerocal(Control(sim, tmp.File("control")));
+  const auto c = RunAerocal(PushbroomControlCommand(sim, tmp.File("control")));
   ASSERT_EQ(c.exit_code, 0) << c.output;
   const json control = testing::ReadJson(tmp.File("control/control.json"));
   EXPECT_GE(control["n_points"].get<int>(), 100);
@@ -48,9 +42,8 @@ TEST(PushbroomControl, MatchedControlCalibratesTheDetectors) {
   for (const auto& row : points.rows())
     for (const char* sigma : {"sX", "sY", "sZ"}) EXPECT_GT(points.Number(row, sigma), 0.0) << sigma;
 
-  const auto cal = RunAerocal("pushbroom calibrate --camera " + sim + "/camera_nominal.yaml --pos " + sim +
-                              "/pos.csv --observations " + tmp.File("control/observations.csv") + " --points " +
-                              tmp.File("control/points.csv") + " --out " + tmp.File("cal.json"));
+  const auto cal = RunAerocal(PushbroomCalibrateCommand(sim, tmp.File("control/observations.csv"),
+                                                        tmp.File("control/points.csv"), tmp.File("cal.json")));
   ASSERT_EQ(cal.exit_code, 0) << cal.output;
   const json j = testing::ReadJson(tmp.File("cal.json"));
   // The fit reaches the matching precision in every sub-camera (2 x: the intersection's own
@@ -94,7 +87,7 @@ TEST(PushbroomImageMode, BadInputIsRefused) {
          "interior: {c: 10}\n";
   std::ofstream(sim + "/reference/exposures.csv")
       << "image,camera,X,Y,Z,omega,phi,kappa\nref9,reference,0,0,1000,0,0,0\n";
-  const auto missing = RunAerocal(Control(sim, tmp.File("out")));
+  const auto missing = RunAerocal(PushbroomControlCommand(sim, tmp.File("out")));
   EXPECT_EQ(missing.exit_code, 2) << missing.output;
   EXPECT_NE(missing.output.find("ref9"), std::string::npos) << missing.output;
   EXPECT_FALSE(std::filesystem::exists(tmp.File("out")));

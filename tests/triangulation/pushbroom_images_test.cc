@@ -18,6 +18,7 @@
 
 #include "calib/core/csv.h"
 #include "tests/support/test_support.h"
+#include "tests/triangulation/pushbroom_commands.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -41,19 +42,6 @@ Eigen::Vector2d TableRmsPx(const std::string& dir, const json& result, double pi
   return (sum / double(result["detectors"].size())).cwiseSqrt() / pitch_mm;
 }
 
-std::string Control(const std::string& dir, const std::string& out) {
-  return "pushbroom control --camera " + dir + "/camera_nominal.yaml --pos " + dir +
-         "/pos.csv --line-image " + dir + "/line_image.png --reference-camera " + dir +
-         "/reference/camera.yaml --reference-exposures " + dir +
-         "/reference/exposures.csv --reference-images " + dir + "/reference --out-dir " + out;
-}
-
-std::string Calibrate(const std::string& dir, const std::string& obs, const std::string& points,
-                      const std::string& out) {
-  return "pushbroom calibrate --camera " + dir + "/camera_nominal.yaml --pos " + dir +
-         "/pos.csv --observations " + obs + " --points " + points + " --out " + out;
-}
-
 TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGeometryError) {
   const std::string data = testing::SharedDataDir("odm_boruszyn_kap_frames");
   if (data.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
@@ -67,7 +55,7 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
     EXPECT_TRUE(std::filesystem::exists(sim + "/" + f)) << f;
 
   const std::string control = tmp.File("control");
-  const auto c = RunAerocal(Control(sim, control) + " --write-l1");
+  const auto c = RunAerocal(PushbroomControlCommand(sim, control) + " --write-l1");
   ASSERT_EQ(c.exit_code, 0) << c.output;
   const json cj = testing::ReadJson(control + "/control.json");
   EXPECT_EQ(cj["kind"], "pushbroom_control");
@@ -89,9 +77,9 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
   }
   EXPECT_LT(std::sqrt(sum / n), 1.5);
 
-  const auto g = RunAerocal(Calibrate(sim, sim + "/observations.csv", sim + "/points.csv", tmp.File("geometry.json")));
+  const auto g = RunAerocal(PushbroomCalibrateCommand(sim, sim + "/observations.csv", sim + "/points.csv", tmp.File("geometry.json")));
   ASSERT_EQ(g.exit_code, 0) << g.output;
-  const auto i = RunAerocal(Calibrate(sim, control + "/observations.csv", control + "/points.csv", tmp.File("image.json")));
+  const auto i = RunAerocal(PushbroomCalibrateCommand(sim, control + "/observations.csv", control + "/points.csv", tmp.File("image.json")));
   ASSERT_EQ(i.exit_code, 0) << i.output;
   const json gj = testing::ReadJson(tmp.File("geometry.json")), ij = testing::ReadJson(tmp.File("image.json"));
   ASSERT_TRUE(ij["valid"].get<bool>()) << i.output;
