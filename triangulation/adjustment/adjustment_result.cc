@@ -385,6 +385,11 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["termination"] = r.solve.termination;
   j["linear_solver"] = r.solve.linear_solver;
   j["seconds"] = r.solve.seconds;
+  j["timing"] = {{"solve_s", r.timing.solve_s},
+                 {"snooping_s", r.timing.snooping_s},
+                 {"testing_s", r.timing.testing_s},
+                 {"covariance_s", r.timing.covariance_s},
+                 {"total_s", r.timing.total_s}};
   j["frame"] = r.frame;
   j["datum"] = r.datum;
   j["self_calibration"] = r.free_interior;

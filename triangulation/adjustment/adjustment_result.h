@@ -201,8 +201,19 @@ inline constexpr double kGroupRmsLimit = 3.0;
 /// One kWarningGroupRms warning per residual group of `solve` whose RMS exceeds `limit`.
 std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, double limit = kGroupRmsLimit);
 
+/// Wall time of the stages of one BlockAdjustment::Run, s (JSON `timing`; for benchmarks and
+/// profiling, not statistics).
+struct AdjustmentTiming {
+  double solve_s = 0;       // the solves before snooping (stage 1 of a self-calibration included)
+  double snooping_s = 0;    // data snooping: its re-solves, cofactors and tests
+  double testing_s = 0;     // of which the cofactors (selected inverse) and tests
+  double covariance_s = 0;  // the covariance of the requested blocks
+  double total_s = 0;       // the whole run (results and statistics included)
+};
+
 struct AdjustmentResult {
   calib::SolveReport solve;
+  AdjustmentTiming timing;
   std::vector<std::string> free_interior;  // names; empty = conventional
   double sigma0 = 0, sigma0_px = 0, sigma0_um = 0;
   std::vector<CameraEstimate> cameras;

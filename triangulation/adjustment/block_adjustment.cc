@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <optional>
 #include <set>
@@ -671,10 +672,13 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
     return "";
   };
   const calib::SolveReport first = result->solve;
-  calib::SnoopingOutcome out = calib::SolveWithDataSnooping(builder_, options_.solver, snooping);
+  calib::SnoopingOutcome out =
+      calib::SolveWithDataSnooping(builder_, options_.solver, snooping, &first);
   result->solve = out.report;
-  result->solve.iterations += first.iterations;  // the first solve, before snooping
-  result->solve.initial_cost = first.initial_cost;
+  if (out.solves > 0) {
+    result->solve.iterations += first.iterations;  // the first solve, before snooping
+    result->solve.initial_cost = first.initial_cost;
+  }
 
   SnoopingSummary& s = result->snooping;
   s.run = true;
@@ -783,6 +787,11 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     if (progress) progress->Advance();
   };
   AdjustmentResult result;
+  using Clock = std::chrono::steady_clock;
+  const auto seconds_since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  const Clock::time_point run_start = Clock::now();
   result.free_interior = options_.free_interior;
   result.frame = project_.frame.description;
   result.datum = storage_->datum;
@@ -816,8 +825,12 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
       return result;
     }
   }
+  result.timing.solve_s = seconds_since(run_start);
   calib::SnoopingOutcome snooped;
+  const Clock::time_point snooping_start = Clock::now();
   if (options_.data_snooping) snooped = Snoop(&result);
+  result.timing.snooping_s = seconds_since(snooping_start);
+  result.timing.testing_s = snooped.seconds_testing;
   // A point left with a single ray after rejections is no longer determined: drop its last
   // observation (it carried no redundancy) and solve once more for honest statistics.
   if (!snooped.rejected.empty()) {
@@ -891,6 +904,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   }
   advance();
   calib::CovarianceReport cov;
+  const Clock::time_point covariance_start = Clock::now();
   if (!options_.estimate_covariance)
     cov.message = "covariance not estimated (option)";
   else if (result.solve.usable && result.solve.redundancy > 0)
@@ -898,6 +912,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
         cov_blocks, result.sigma0, options_.correlation_threshold, cross_blocks);
   else
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
+  result.timing.covariance_s = seconds_since(covariance_start);
   advance();
   result.determinability = AssessDeterminability(cov, "camera ", options_.correlation_threshold);
   if (cov.ok) {  // a free platform parameter the block cannot separate, by name
@@ -1011,6 +1026,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
                       " parameter(s) not determinable (" +
                       result.determinability.undetermined.front() + ", ...)");
   result.warnings = GroupRmsWarnings(result.solve);
+  result.timing.total_s = seconds_since(run_start);
   return result;
 }
 
