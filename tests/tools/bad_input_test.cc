@@ -1064,6 +1064,22 @@ const std::vector<Case>& Cases() {
          return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
        },
        2, "groups.csv:1: unknown column 'groupe'", "cal.json"},
+      // ---- calibrate --budget: its lists are lists (a scalar read as no radii; a map threw
+      // yaml-cpp's "invalid node" without FILE:LINE) ----
+      {"budget_radii_not_a_list",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Write(d.File("budget.yaml"), "target_radius_mm: 0.5\nradii_mm: 5\n");
+         return CalibrateArgs(tf) + " --budget " + d.File("budget.yaml");
+       },
+       2, "budget.yaml:2: radii_mm must be a list", "cal.json"},
+      {"budget_components_a_map",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Write(d.File("budget.yaml"), "components: {quantity: c, source: temperature, value: 0.002}\n");
+         return CalibrateArgs(tf) + " --budget " + d.File("budget.yaml");
+       },
+       2, "budget.yaml:1: components must be a list", "cal.json"},
       // ---- a random seed is an unsigned 64-bit integer (CLI11 wraps -1 into 2^64 - 1) ----
       {"simulate_seed_minus_one", [](const TempDir& d) { return "simulate --out " + d.File("o") + " --seed -1"; },
        2, "--seed: must be an integer within 0 .. 18446744073709551615 (got '-1')", "o"},
