@@ -17,32 +17,39 @@
 #include "triangulation/pushbroom/line_calibration.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
 
-extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+namespace {
+
+// One reader on `text` (kind as in the header comment); outside the macro, whose argument a
+// top-level comma would split.
+void ReadOne(int kind, const std::string& text) {
   using namespace aerocal;
-  if (size < 1) return 0;
-  const int kind = data[0] % 4;
-  const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
-  AEROCAL_FUZZ_EXPECTED_ERRORS({
-    if (kind == 0) {
-      const auto pos = triangulation::PosTrajectory::Read(fuzz::WriteScratch("pos.csv", text));
-      const double first = pos.first_line(), last = pos.last_line();
-      for (const double line : {first - 0.5, first, 0.5 * (first + last), last, last + 0.5}) {
-        if (!pos.CoversLine(line)) continue;
-        Eigen::Vector3d center_m, opk_rad;
-        pos.PoseAtLine(line, &center_m, &opk_rad);
-      }
-      (void)pos.MedianCenterSigma();
-      (void)pos.MedianOpkSigma();
-    } else if (kind == 1) {
-      (void)triangulation::ReadLineObservations(fuzz::WriteScratch("observations.csv", text), 0.3);
-    } else if (kind == 2) {
-      const calib::LineCamera camera = calib::ReadLineCamera(fuzz::WriteScratch("line.yaml", text));
-      const std::string copy = fuzz::ScratchDir() + "/line_copy.yaml";
-      calib::WriteLineCamera(copy, camera);
-      (void)calib::ReadLineCamera(copy);
-    } else {
-      (void)triangulation::ReadBudgetOptions(fuzz::WriteScratch("budget.yaml", text));
+  if (kind == 0) {
+    const auto pos = triangulation::PosTrajectory::Read(fuzz::WriteScratch("pos.csv", text));
+    const double first = pos.first_line(), last = pos.last_line();
+    for (const double line : {first - 0.5, first, 0.5 * (first + last), last, last + 0.5}) {
+      if (!pos.CoversLine(line)) continue;
+      Eigen::Vector3d center_m, opk_rad;
+      pos.PoseAtLine(line, &center_m, &opk_rad);
     }
-  });
+    (void)pos.MedianCenterSigma();
+    (void)pos.MedianOpkSigma();
+  } else if (kind == 1) {
+    (void)triangulation::ReadLineObservations(fuzz::WriteScratch("observations.csv", text), 0.3);
+  } else if (kind == 2) {
+    const calib::LineCamera camera = calib::ReadLineCamera(fuzz::WriteScratch("line.yaml", text));
+    const std::string copy = fuzz::ScratchDir() + "/line_copy.yaml";
+    calib::WriteLineCamera(copy, camera);
+    (void)calib::ReadLineCamera(copy);
+  } else {
+    (void)triangulation::ReadBudgetOptions(fuzz::WriteScratch("budget.yaml", text));
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
+  if (size < 1) return 0;
+  const std::string text(reinterpret_cast<const char*>(data + 1), size - 1);
+  AEROCAL_FUZZ_EXPECTED_ERRORS(ReadOne(data[0] % 4, text));
   return 0;
 }
