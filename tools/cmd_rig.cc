@@ -508,7 +508,7 @@ CommandRun Setup(CLI::App& app) {
                  "COL,ROW: a virtual pixel, analysed in the first non-reference head that sees it");
   ea->add_option("--grid", args->grid, "N: an N x N grid of virtual pixels (bound map)");
   ea->add_option("--samples", args->samples, "Monte-Carlo samples per target (0: none)");
-  ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)");
+  ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)")->check(SeedCheck());
   ea->add_option("--bins", args->bins, "Histogram bins");
   ea->add_option("--relief-m", args->relief_m,
                  "Relief (m off the plane) whose displacement between heads is reported");
