@@ -79,6 +79,7 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
   EXPECT_STREQ(root->Name(), "svg");
   std::set<std::string> panels;
   for (const auto* g = root->FirstChildElement("g"); g; g = g->NextSiblingElement("g")) {
+    ASSERT_TRUE(g->Attribute("data-subcamera") && g->Attribute("data-axis"));
     const std::string id = g->Attribute("data-subcamera"), axis = g->Attribute("data-axis");
     EXPECT_TRUE(panels.insert(id + "/" + axis).second) << id << " " << axis;
     int fits = 0, bands = 0, dots = 0;
@@ -162,9 +163,10 @@ TEST(PushbroomCommands, PatentLineAxisGivesTheSameCalibration) {
   calib::WriteLineCamera(dir.File("camera_y.yaml"), camera);
   const std::string text = ReadTextFile(dir.File("camera_y.yaml"));
   EXPECT_NE(text.find("line_axis: y"), std::string::npos) << text;
-  // The file holds the other frame: the virtual camera's mount becomes kappa = -90 deg.
+  // The file holds the other frame: the virtual camera's mount (a boresight of 0.1 / -0.05 / 0.2
+  // deg in ours) turns by 90 deg in kappa.
   const YAML::Node y_file = YAML::LoadFile(dir.File("camera_y.yaml"));
-  EXPECT_NEAR(std::abs(y_file["line"]["mount_deg"][2].as<double>()), 90.0, 1e-9) << text;
+  EXPECT_NEAR(std::abs(y_file["line"]["mount_deg"][2].as<double>()), 90.0, 0.5) << text;
   const calib::LineCamera back = calib::ReadLineCamera(dir.File("camera_y.yaml"));
   EXPECT_TRUE(back.file_line_along_y);
   for (int i = 0; i < camera.detectors; ++i)
