@@ -6,6 +6,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
+#include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/certificate_writer.h"
@@ -206,8 +207,9 @@ int WriteCertificate(const CertificateArgs& args) {
   CheckOutputFolder(args.out, "--out");
   if (!args.tolerances.empty() && args.previous.empty())
     throw ConfigError("--tolerances needs --previous");
-  nlohmann::json result = ReadJsonFile(args.result);
-  if (result.is_object() && result.value("kind", "") == "flight")
+  // The result of `aerocal calibrate` (kind "adjust", command "calibrate") or of `aerocal flight`.
+  nlohmann::json result = ReadResult(args.result, {"adjust", "flight"}, "`aerocal calibrate`");
+  if (result.value("kind", "") == "flight")
     result = CalibrateFormOfFlight(result, args.result);
   if (!result.is_object() || result.value("command", "") != "calibrate" ||
       !result.contains("calibration"))
@@ -234,6 +236,7 @@ int WriteCertificate(const CertificateArgs& args) {
                         {"rms_px", cal["rms_px"]}};
   cert["results"] = cal["uncertainty"];
   cert["interior"] = result["cameras"][0];
+  cert["camera_model"] = result.value("camera_model", nlohmann::json());
   cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
   cert["groups"] = cal["groups"];
   cert["stability"] = cal["stability"];
@@ -248,7 +251,8 @@ int WriteCertificate(const CertificateArgs& args) {
       residuals.push_back({r["col"], r["row"], r["v_col_px"], r["v_row_px"]});
   cert["residuals"] = residuals;
   if (!args.previous.empty()) {
-    const nlohmann::json previous = ReadJsonFile(args.previous);
+    const nlohmann::json previous = ReadResult(args.previous, {"certificate", "adjust"},
+                                               "`aerocal certificate` or `aerocal calibrate`");
     const nlohmann::json* old = Uncertainty(previous);
     if (!old) throw InputError(args.previous + ": neither a certificate.json nor a calibrate result (--previous)");
     cert["comparison"] = Compare(cert["results"], *old, tolerances);
@@ -257,7 +261,7 @@ int WriteCertificate(const CertificateArgs& args) {
   }
   fs::create_directories(args.out);
   const std::string json_path = (fs::path(args.out) / "certificate.json").string();
-  WriteFileAtomically(json_path, cert.dump(2) + "\n");
+  WriteResult(json_path, "certificate", cert);
   std::printf("certificate data -> %s\n", json_path.c_str());
   for (const auto& q : cert["results"]) std::printf("  %s\n", q["statement"].get<std::string>().c_str());
   if (cert.contains("comparison"))
