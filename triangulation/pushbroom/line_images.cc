@@ -12,38 +12,9 @@
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/pushbroom/line_rectification.h"
+#include "triangulation/simulation/textured_ground.h"
 
 namespace aerocal::triangulation {
-namespace {
-
-// The photograph on the ground: texel (u, v) at X = x_c + (u - W/2) gsd, Y = y_c - (v - H/2) gsd,
-// mirrored beyond the edges.
-struct Texture {
-  stitch::GrayImage texels;
-  double x_c = 0, y_c = 0, gsd_m = 1;
-  static double Mirror(double u, int n) {
-    const double period = 2.0 * (n - 1);
-    double m = std::fmod(u, period);
-    if (m < 0) m += period;
-    return m <= n - 1 ? m : period - m;
-  }
-  float At(double x, double y) const {
-    const double u = Mirror((x - x_c) / gsd_m + 0.5 * texels.cols(), int(texels.cols()));
-    const double v = Mirror((y_c - y) / gsd_m + 0.5 * texels.rows(), int(texels.rows()));
-    return SampleBilinear(texels, u, v);
-  }
-};
-
-stitch::GrayImage AverageTwoByTwo(const stitch::GrayImage& photo) {
-  stitch::GrayImage out(photo.rows() / 2, photo.cols() / 2);
-  for (int r = 0; r < out.rows(); ++r)
-    for (int c = 0; c < out.cols(); ++c)
-      out(r, c) = 0.25f * (photo(2 * r, 2 * c) + photo(2 * r, 2 * c + 1) + photo(2 * r + 1, 2 * c) +
-                           photo(2 * r + 1, 2 * c + 1));
-  return out;
-}
-
-}  // namespace
 
 void LineImageOptions::Validate() const {
   auto require = [](bool ok, const std::string& message) {
@@ -90,10 +61,8 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimula
       std::max(1, lines - 1);
   const double reference_gsd = io.reference_gsd_m > 0 ? io.reference_gsd_m : 0.6 * line_spacing_m;
 
-  Texture texture;
-  texture.texels = AverageTwoByTwo(stitch::ReadGrayImage(io.texture_path));
-  if (texture.texels.rows() < 16 || texture.texels.cols() < 16)
-    throw InputError(io.texture_path + ": the photograph is too small for a texture (< 32 px)");
+  TexturedGround texture;
+  ReadGroundTexture(io.texture_path, &texture);
   texture.gsd_m = io.texture_gsd_m > 0 ? io.texture_gsd_m : 0.5 * std::min(line_spacing_m, reference_gsd);
   texture.x_c = 0.5 * (lo.x() + hi.x());
   texture.y_c = 0.5 * (lo.y() + hi.y());
