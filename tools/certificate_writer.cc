@@ -6,6 +6,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
+#include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/certificate_writer.h"
@@ -222,7 +223,8 @@ int WriteCertificate(const CertificateArgs& args) {
     throw ConfigError("--tolerances needs --previous");
   const nlohmann::json lab = ReadCertificateLab(args.lab);
   const auto tolerances = ReadTolerances(args.tolerances);
-  nlohmann::json result = ReadJsonFile(args.result);
+  // The result of `aerocal calibrate` (kind "adjust", command "calibrate") or of `aerocal flight`.
+  nlohmann::json result = ReadResult(args.result, {"adjust", "flight"}, "`aerocal calibrate`");
   nlohmann::json cert;
   std::vector<std::string> statements;  // checked before anything is written
   const bool valid = ReadTyped(args.result, "--result", [&] {
@@ -250,6 +252,7 @@ int WriteCertificate(const CertificateArgs& args) {
                           {"rms_px", cal.at("rms_px")}};
     cert["results"] = cal.at("uncertainty");
     cert["interior"] = result["cameras"][0];
+    cert["camera_model"] = result.value("camera_model", nlohmann::json());
     cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
     cert["groups"] = cal.at("groups");
     cert["stability"] = cal.at("stability");
@@ -268,7 +271,8 @@ int WriteCertificate(const CertificateArgs& args) {
   });
   bool comparison_pass = true;
   if (!args.previous.empty()) {
-    const nlohmann::json previous = ReadJsonFile(args.previous);
+    const nlohmann::json previous = ReadResult(args.previous, {"certificate", "adjust"},
+                                               "`aerocal certificate` or `aerocal calibrate`");
     comparison_pass = ReadTyped(args.previous, "--previous", [&] {
       const nlohmann::json* old = Uncertainty(previous);
       if (!old)
@@ -282,7 +286,7 @@ int WriteCertificate(const CertificateArgs& args) {
   }
   fs::create_directories(args.out);
   const std::string json_path = (fs::path(args.out) / "certificate.json").string();
-  WriteFileAtomically(json_path, cert.dump(2) + "\n");
+  WriteResult(json_path, "certificate", cert);
   std::printf("certificate data -> %s\n", json_path.c_str());
   for (const auto& statement : statements) std::printf("  %s\n", statement.c_str());
   if (cert.contains("comparison"))

@@ -7,6 +7,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/csv_columns.h"
 #include "calib/core/error.h"
+#include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
 #include "tools/board_detection.h"
 #include "tools/camera_formats.h"
@@ -498,7 +499,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
       std::fprintf(stderr, "camera not written: the result is not valid\n");
     }
     json["calibration"] = cal;
-    WriteFileAtomically(args->out, json.dump(2) + "\n");
+    WriteResult(args->out, "adjust", json);
     for (const auto& reason : r.invalid_reasons)
       std::fprintf(stderr, "calibrate: not valid: %s\n", reason.c_str());
     std::printf("result -> %s\n", args->out.c_str());

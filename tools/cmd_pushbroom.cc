@@ -9,6 +9,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/result_file.h"
 #include "tools/command_registry.h"
 #include "triangulation/block/block_io.h"
 #include "stitch/image_io/image_io.h"
@@ -52,7 +53,7 @@ int RunCalibrate(CalibrateArgs& a) {
   const auto points = triangulation::ReadPoints(a.points);
   const auto result =
       triangulation::CalibrateLineCamera(camera, pos, observations, points, o, a.observations);
-  WriteFileAtomically(a.out, triangulation::LineCalibrationToJson(result));
+  WriteResult(a.out, "pushbroom", triangulation::LineCalibrationToJson(result), 1);
   if (!a.lines_csv.empty()) WriteFileAtomically(a.lines_csv, triangulation::LineCorrectionsToCsv(result));
   if (!a.plot.empty())
     WriteFileAtomically(a.plot, triangulation::LineCalibrationSvg(result, camera.name + " (" + a.observations + ")"));
@@ -121,8 +122,9 @@ int RunControl(ControlArgs& a) {
   fs::create_directories(a.out);
   triangulation::WriteLineObservations((fs::path(a.out) / "observations.csv").string(), result.observations);
   triangulation::WritePoints((fs::path(a.out) / "points.csv").string(), result.points);
-  WriteFileAtomically((fs::path(a.out) / "control.json").string(),
-                      triangulation::CloudControlToJson(result, a.options));
+  WriteResult((fs::path(a.out) / "control.json").string(),
+              "pushbroom_control",
+              triangulation::CloudControlToJson(result, a.options));
   if (a.write_l1) stitch::WriteGrayImage((fs::path(a.out) / "l1.png").string(), result.l1.image);
   std::printf("cloud control: L1 image %d x %d cells of %.3f m at Z = %.2f m, %d interest points, "
               "%d matches, %zu control points (dropped: %d fewer than two matches, %d gross errors, "

@@ -503,7 +503,8 @@ const std::vector<Case>& Cases() {
        [](const TempDir& d) {
          const auto sim = Flight(d);
          Write(d.File("m.json"),
-               R"({"subimages": [{"id": "I", "model": "affine", "params": [0,0,0,0,0,0]}]})");
+               R"({"kind": "stitch", "schema_version": 1,
+                   "subimages": [{"id": "I", "model": "affine", "params": [0,0,0,0,0,0]}]})");
          return "resample --camera " + sim + "/camera_nominal.yaml --mapping " + d.File("m.json") +
                 " --images I=a.tif --out " + d.File("v.tif");
        },

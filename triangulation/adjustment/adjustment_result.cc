@@ -358,24 +358,13 @@ std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, dou
   return out;
 }
 
-nlohmann::json CameraModelTableToJson(calib::CameraModelId model) {
-  nlohmann::json parameters = nlohmann::json::array();
-  for (const calib::ParamInfo& p : calib::CameraModelParams(model))
-    parameters.push_back({{"name", std::string(p.name)},
-                          {"unit", std::string(p.unit)},
-                          {"group", std::string(calib::ParamGroupName(p.group))}});
-  return {{"name", std::string(calib::CameraModelName(model))},
-          {"id", static_cast<int>(model)},
-          {"parameters", parameters}};
-}
-
 nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   nlohmann::json j;
   j["kind"] = "adjust";
   j["schema_version"] = kResultSchemaVersion;
   // The model of the cameras (the first camera's when they differ; each camera names its own).
   j["camera_model"] =
-      CameraModelTableToJson(r.cameras.empty() ? Model::kId : r.cameras.front().model);
+      calib::CameraModelTableToJson(r.cameras.empty() ? Model::kId : r.cameras.front().model);
   j["sigma0"] = r.sigma0;
   j["sigma0_px"] = r.sigma0_px;
   j["sigma0_um"] = r.sigma0_um;

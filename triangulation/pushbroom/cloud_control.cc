@@ -341,7 +341,7 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
   return out;
 }
 
-std::string CloudControlToJson(const CloudControlResult& r, const CloudControlOptions& o) {
+nlohmann::json CloudControlToJson(const CloudControlResult& r, const CloudControlOptions& o) {
   nlohmann::json j;
   j["kind"] = "pushbroom_control";
   j["l1"] = {{"width", r.l1.grid.width}, {"height", r.l1.grid.height}, {"gsd_m", r.l1.grid.gsd_m},
@@ -358,7 +358,7 @@ std::string CloudControlToJson(const CloudControlResult& r, const CloudControlOp
                   {"min_correlation", o.min_correlation}, {"min_match_sigma_px", o.min_match_sigma_px},
                   {"line_sigma_px", o.line_sigma_px}, {"gross_error_alpha", o.gross_error_alpha},
                   {"max_point_sigma_m", o.max_point_sigma_m}};
-  return j.dump(2) + "\n";
+  return j;
 }
 
 }  // namespace aerocal::triangulation

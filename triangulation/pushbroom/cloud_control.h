@@ -89,7 +89,7 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
                                     const std::vector<ReferenceFrame>& references,
                                     const CloudControlOptions& options);
 
-/// control.json text: the counts above, the L1 grid and the options used.
-std::string CloudControlToJson(const CloudControlResult& result, const CloudControlOptions& options);
+/// control.json (kind "pushbroom_control", written by WriteResult): the counts above, the L1 grid and the options used.
+nlohmann::json CloudControlToJson(const CloudControlResult& result, const CloudControlOptions& options);
 
 }  // namespace aerocal::triangulation

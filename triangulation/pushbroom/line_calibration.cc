@@ -658,7 +658,7 @@ std::string LineCorrectionsToCsv(const LineCalibrationResult& r) {
   return out;
 }
 
-std::string LineCalibrationToJson(const LineCalibrationResult& r) {
+nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
   using nlohmann::json;
   auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
   json j;
@@ -725,7 +725,7 @@ std::string LineCalibrationToJson(const LineCalibrationResult& r) {
   for (const auto& g : r.report.groups)
     groups.push_back({{"name", g.name}, {"n", g.n_observations}, {"rms", g.rms}});
   j["groups"] = groups;
-  return j.dump(1) + "\n";
+  return j;
 }
 
 }  // namespace aerocal::triangulation

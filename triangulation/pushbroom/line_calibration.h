@@ -21,6 +21,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
 #include "calib/camera/line_camera.h"
 #include "calib/problem/problem_builder.h"
@@ -126,7 +127,8 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
 /// Per-line corrections as CSV: line,dX,dY,dZ,domega,dphi,dkappa + sigmas (m, deg).
 std::string LineCorrectionsToCsv(const LineCalibrationResult& result);
 
-/// result.json text (FORMATS.md "Results": kind "pushbroom" plus the keys of the module README).
-std::string LineCalibrationToJson(const LineCalibrationResult& result);
+/// result.json (FORMATS.md "Results": kind "pushbroom" plus the keys of the module README; written
+/// by WriteResult of calib/core/result_file.h with its schema_version).
+nlohmann::json LineCalibrationToJson(const LineCalibrationResult& result);
 
 }  // namespace aerocal::triangulation
