@@ -263,7 +263,8 @@ void AddGroupColumn(const std::string& tf, const std::string& group_of_all = "",
 // A minimal calibrate result for `certificate`: one uncertainty row, with or without the
 // calibration's stability table.
 std::string CertificateResult(const std::string& uncertainty_row, bool stability = true) {
-  return "{\"command\": \"calibrate\", \"valid\": true, \"cameras\": [{}],\n"
+  return "{\"kind\": \"adjust\", \"schema_version\": 1, \"command\": \"calibrate\",\n"
+         " \"valid\": true, \"cameras\": [{}],\n"
          " \"calibration\": {\"method\": {}, \"camera\": {}, \"data\": {}, \"rms_px\": 0.1,"
          " \"groups\": [],\n  \"uncertainty\": [" + uncertainty_row + "]" +
          (stability ? ", \"stability\": {}" : "") + "}}\n";
@@ -1214,7 +1215,8 @@ const std::vector<Case>& Cases() {
       {"certificate_previous_value_not_a_number",
        [](const TempDir& d) {
          Write(d.File("r.json"), CertificateResult("{\"quantity\": \"c\", \"value\": 1, \"statement\": \"c = 1\"}"));
-         Write(d.File("p.json"), "{\"results\": [{\"quantity\": \"c\", \"value\": \"1.0\"}]}\n");
+         Write(d.File("p.json"), "{\"kind\": \"certificate\", \"schema_version\": 1,\n"
+                                 " \"results\": [{\"quantity\": \"c\", \"value\": \"1.0\"}]}\n");
          return "certificate --result " + d.File("r.json") + " --previous " + d.File("p.json") +
                 " --no-render --out " + d.File("cert");
        },
