@@ -5,7 +5,6 @@
 #include "calib/camera/convert_camera.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
-#include "calib/core/csv_columns.h"
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
@@ -60,7 +59,7 @@ std::map<std::string, std::string> ReadGroups(const std::string& path,
                                               const std::set<std::string>& observed) {
   const CsvTable table = CsvTable::Read(path);
   table.RequireColumns({"image", "group"});
-  RejectUnknownColumns(table, {"image", "group"});
+  table.RejectUnknownColumns({"image", "group"});
   GroupLines out;
   for (const auto& row : table.rows()) {
     const std::string image = table.String(row, "image"), group = table.String(row, "group");

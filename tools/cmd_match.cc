@@ -9,7 +9,6 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/csv.h"
-#include "calib/core/csv_columns.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
@@ -48,7 +47,7 @@ FrameImages FromImagesOption(const std::string& frame, const std::string& images
 FrameImages FromList(const std::string& list, const calib::Camera& camera) {
   const CsvTable table = CsvTable::Read(list);
   table.RequireColumns({"frame", "subimage", "image"});
-  RejectUnknownColumns(table, {"frame", "subimage", "image"});
+  table.RejectUnknownColumns({"frame", "subimage", "image"});
   const std::filesystem::path dir = std::filesystem::path(list).parent_path();
   FrameImages frames;
   std::map<std::string, std::size_t> index;

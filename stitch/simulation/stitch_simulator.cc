@@ -7,7 +7,6 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
-#include "calib/core/csv_columns.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -138,7 +137,7 @@ std::vector<StitchObservation> ReadStitchObservations(const std::string& path,
                                                       double default_sigma_px) {
   const CsvTable table = CsvTable::Read(path);
   table.RequireColumns({"frame", "point", "subimage", "u", "v"});
-  RejectUnknownColumns(table, {"frame", "point", "subimage", "u", "v", "sigma_px"});
+  table.RejectUnknownColumns({"frame", "point", "subimage", "u", "v", "sigma_px"});
   std::vector<StitchObservation> rows;
   rows.reserve(table.rows().size());
   for (const auto& row : table.rows()) {

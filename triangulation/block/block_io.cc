@@ -9,7 +9,6 @@
 #include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
-#include "calib/core/csv_columns.h"
 #include "calib/core/yaml_util.h"
 #include "triangulation/block/value_bounds.h"
 
@@ -50,8 +49,8 @@ std::string ResolvePath(const std::string& base_dir, const std::string& file) {
 std::vector<Exposure> ReadExposures(const std::string& path) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"image", "X", "Y", "Z", "omega", "phi", "kappa"});
-  RejectUnknownColumns(t, {"image", "camera", "X", "Y", "Z", "omega", "phi", "kappa", "sX", "sY", "sZ",
-                          "somega", "sphi", "skappa", "vX", "vY", "vZ", "z_ref"});
+  t.RejectUnknownColumns({"image", "camera", "X", "Y", "Z", "omega", "phi", "kappa", "sX", "sY", "sZ",
+                         "somega", "sphi", "skappa", "vX", "vY", "vZ", "z_ref"});
   std::vector<Exposure> out;
   std::set<std::string> seen;
   for (const auto& row : t.rows()) {
@@ -105,10 +104,10 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
   // (`group`: the test-field groups of `calibrate`, read by tools/cmd_calibrate.cc)
   if (sub) {
     t.RequireColumns({"image", "subimage", "point", "u", "v"});
-    RejectUnknownColumns(t, {"image", "subimage", "point", "u", "v", "sigma_px", "group"});
+    t.RejectUnknownColumns({"image", "subimage", "point", "u", "v", "sigma_px", "group"});
   } else {
     t.RequireColumns({"image", "point", "col", "row"});
-    RejectUnknownColumns(t, {"image", "head", "point", "col", "row", "sigma_px", "group"});
+    t.RejectUnknownColumns({"image", "head", "point", "col", "row", "sigma_px", "group"});
   }
   std::vector<ImageObservation> out;
   out.reserve(t.rows().size());
@@ -143,7 +142,7 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
 std::vector<GroundPoint> ReadPoints(const std::string& path) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"point", "X", "Y", "Z"});
-  RejectUnknownColumns(t, {"point", "X", "Y", "Z", "sX", "sY", "sZ", "role"});
+  t.RejectUnknownColumns({"point", "X", "Y", "Z", "sX", "sY", "sZ", "role"});
   std::vector<GroundPoint> out;
   std::set<std::string> seen;
   for (const auto& row : t.rows()) {

@@ -13,7 +13,6 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
-#include "calib/core/csv_columns.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/residuals/line_collinearity.h"
@@ -89,7 +88,7 @@ void WriteLineObservations(const std::string& path, const std::vector<LineObserv
 std::vector<LineObservation> ReadLineObservations(const std::string& path, double default_sigma_px) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"point", "col", "row"});
-  RejectUnknownColumns(t, {"image", "point", "col", "row", "sigma_px"});
+  t.RejectUnknownColumns({"image", "point", "col", "row", "sigma_px"});
   std::vector<LineObservation> out;
   for (const auto& row : t.rows()) {
     LineObservation o;

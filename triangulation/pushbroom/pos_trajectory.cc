@@ -6,7 +6,6 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
-#include "calib/core/csv_columns.h"
 #include "calib/core/error.h"
 #include "triangulation/block/value_bounds.h"
 
@@ -51,8 +50,8 @@ std::optional<Eigen::Vector3d> Median3(const std::vector<PosRecord>& records, bo
 PosTrajectory PosTrajectory::Read(const std::string& path) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"line", "time_s", "X", "Y", "Z", "omega", "phi", "kappa"});
-  RejectUnknownColumns(t, {"line", "time_s", "X", "Y", "Z", "omega", "phi", "kappa", "sX", "sY", "sZ",
-                          "somega", "sphi", "skappa"});
+  t.RejectUnknownColumns({"line", "time_s", "X", "Y", "Z", "omega", "phi", "kappa", "sX", "sY", "sZ",
+                         "somega", "sphi", "skappa"});
   std::vector<PosRecord> records;
   for (const auto& row : t.rows()) {
     PosRecord r;
