@@ -13,6 +13,7 @@
 #include "tools/command_registry.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/calibration/calibration.h"
+#include "triangulation/calibration/calibration_json.h"
 #include "triangulation/calibration/uncertainty_budget.h"
 
 #include <algorithm>
@@ -88,95 +89,6 @@ std::map<std::string, std::string> GroupsFromObservations(const std::string& pat
   }
   if (out.empty()) return {};
   return CheckedGroups(out, path, observed);
-}
-
-// The model's parameter names (its table) of a camera estimate.
-std::vector<std::string> ParamNames(const triangulation::CameraEstimate& c) {
-  std::vector<std::string> names;
-  for (const calib::ParamInfo& info : calib::CameraModelParams(c.model)) names.emplace_back(info.name);
-  return names;
-}
-
-nlohmann::json InteriorJson(const triangulation::CameraEstimate& c, const calib::InteriorParams& p) {
-  nlohmann::json j;
-  const std::vector<std::string> names = ParamNames(c);
-  for (size_t k = 0; k < names.size(); ++k) j[names[k]] = p[k];
-  return j;
-}
-
-nlohmann::json CovarianceJson(const Eigen::MatrixXd& cov, const triangulation::CameraEstimate& c) {
-  if (cov.rows() != c.estimated.size()) return nullptr;
-  const std::vector<std::string> table = ParamNames(c);
-  std::vector<int> free;
-  for (int k = 0; k < c.estimated.size(); ++k)
-    if (c.free[k]) free.push_back(k);
-  nlohmann::json names = nlohmann::json::array(), cv = nlohmann::json::array(),
-                 rho = nlohmann::json::array();
-  for (int a : free) {
-    names.push_back(table[a]);
-    nlohmann::json row = nlohmann::json::array(), rrow = nlohmann::json::array();
-    for (int b : free) {
-      row.push_back(cov(a, b));
-      const double d = std::sqrt(cov(a, a) * cov(b, b));
-      rrow.push_back(d > 0 ? cov(a, b) / d : 0.0);
-    }
-    cv.push_back(row);
-    rho.push_back(rrow);
-  }
-  return {{"names", names}, {"covariance", cv}, {"correlation", rho}};
-}
-
-// One calibration run: its statistics, the estimated interior in its model and the sigmas (null
-// when fixed or not determinable), the check points.
-nlohmann::json RunJson(const AdjustmentResult& r) {
-  nlohmann::json j = {{"converged", r.converged()},
-                      {"valid", r.valid},
-                      {"sigma0", r.sigma0},
-                      {"sigma0_px", r.sigma0_px},
-                      {"redundancy", r.solve.redundancy}};
-  if (!r.cameras.empty()) {
-    const triangulation::CameraEstimate& c = r.cameras[0];
-    j["estimated"] = InteriorJson(c, c.estimated);
-    nlohmann::json s;
-    const std::vector<std::string> names = ParamNames(c);
-    for (size_t k = 0; k < names.size(); ++k)
-      s[names[k]] = c.free[k] && r.determinability.covariance_ok ? nlohmann::json(c.sigma[k])
-                                                                 : nlohmann::json();
-    j["sigma"] = s;
-  }
-  j["check"] = triangulation::PointStatisticsToJson(r.check);
-  return j;
-}
-
-nlohmann::json GroupJson(const triangulation::GroupCalibration& g) {
-  nlohmann::json j = RunJson(g.adjustment.result);
-  j["group"] = g.group;
-  j["images"] = g.images;
-  return j;
-}
-
-nlohmann::json StabilityJson(const triangulation::StabilityReport& s) {
-  nlohmann::json rows = nlohmann::json::array();
-  for (const auto& r : s.rows)
-    rows.push_back({{"parameter", r.parameter},
-                    {"unit", r.unit},
-                    {"values", r.values},
-                    {"sigmas", r.sigmas},
-                    {"detectable_change", r.detectable_change.empty()
-                                              ? nlohmann::json()
-                                              : nlohmann::json(r.detectable_change)},
-                    {"mean", r.mean},
-                    {"spread", r.spread},
-                    {"weighted_mean", r.weighted_mean},
-                    {"chi2", std::isfinite(r.chi2) ? nlohmann::json(r.chi2) : nlohmann::json()},
-                    {"critical", r.critical},
-                    {"dof", r.dof},
-                    {"agree", r.agree}});
-  return {{"alpha", s.alpha},
-          {"power", s.power},
-          {"agree", s.agree},
-          {"rows", rows},
-          {"flagged", s.flagged}};
 }
 
 // The RMS image residual per point (sqrt of the mean squared residual vector), as OpenCV's RMS.
@@ -399,41 +311,14 @@ CommandRun SetupCalibrate(CLI::App& app) {
     json["command"] = "calibrate";
     json["valid"] = r.valid;
     json["invalid_reasons"] = r.invalid_reasons;
-    nlohmann::json cal;
+    nlohmann::json cal = triangulation::CalibrationToJson(run, budget_table, budget.radii_mm,
+                                                          file_camera.c_mm());
     cal["method"] = method;
     cal["camera"] = {{"id", camera_id},
                      {"file", args->camera},
                      {"pixel_size_mm", camera.pixel_size_mm},
                      {"format_px", {camera.width_px, camera.height_px}}};
-    nlohmann::json starts = nlohmann::json::array();
-    for (const auto& s : run.starts)
-      starts.push_back({{"image", s.exposure.image},
-                        {"method", s.method},
-                        {"n_points", s.n_points},
-                        {"rms_px", s.rms_px}});
     cal["model"] = std::string(calib::CameraModelName(model));
-    cal["start"] = {{"c_camera_file_mm", file_camera.c_mm()},
-                    {"c_closed_form_mm", run.closed_form_c_mm ? nlohmann::json(*run.closed_form_c_mm)
-                                                              : nlohmann::json()},
-                    {"c_start_mm", run.start_c_mm},
-                    {"resections", starts}};
-    int n_control = 0, n_check = 0;
-    for (const auto& p : run.project.points) {
-      n_control += p.role == triangulation::PointRole::kControl;
-      n_check += p.role == triangulation::PointRole::kCheck;
-    }
-    cal["data"] = {{"images", run.starts.size()},
-                   {"observations", run.project.observations.size()},
-                   {"control_points", n_control},
-                   {"check_points", n_check},
-                   {"groups", run.groups.size()}};
-    if (!r.cameras.empty())
-      cal["interior_covariance"] = CovarianceJson(run.all.interior_covariance, r.cameras[0]);
-    cal["groups"] = nlohmann::json::array();
-    for (const auto& g : run.groups) cal["groups"].push_back(GroupJson(g));
-    cal["stability"] = StabilityJson(run.stability);
-    cal["uncertainty"] = triangulation::BudgetToJson(budget_table);
-    cal["radii_mm"] = budget.radii_mm;
     for (const auto& q : budget_table) std::printf("  %s\n", q.statement.c_str());
     for (const auto& f : run.stability.flagged) {
       std::printf("warning: group_stability: %s\n", f.c_str());
@@ -454,7 +339,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
           StartInModel(camera, beside_model, beside.adjust.free_interior);
       const triangulation::CalibrationRun other = triangulation::Calibrate(in_model, beside, {});
       const AdjustmentResult& o = other.all.result;
-      nlohmann::json b = RunJson(o);
+      nlohmann::json b = triangulation::CalibrationRunToJson(o);
       b["model"] = std::string(calib::CameraModelName(beside_model));
       b["self_calibration"] = beside.adjust.free_interior;
       b["rms_px"] = RmsPx(o);
