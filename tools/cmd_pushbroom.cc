@@ -1,6 +1,7 @@
 // aerocal pushbroom calibrate: calibration of a line (pushbroom) camera from cloud control points
 // (triangulation/pushbroom/line_calibration.h); aerocal pushbroom control: the cloud control points
 // from the line image and oriented reference frame images (cloud_control.h). Module README.
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -26,6 +27,8 @@ struct CalibrateArgs {
   std::string degree = "auto";
   std::string datum = "reference";
   std::string pos_prior = "on";
+  std::string boresight = "fixed", lever_arm = "fixed";  // fixed | free | weighted
+  double boresight_sigma_deg = 0.0;
   triangulation::LineCalibrationOptions options;
 };
 
@@ -46,6 +49,14 @@ int RunCalibrate(CalibrateArgs& a) {
   if (a.pos_prior != "on" && a.pos_prior != "off")
     throw ConfigError("--pos-prior must be on or off (got '" + a.pos_prior + "')");
   o.pos_prior = a.pos_prior == "on";
+  auto mode = [](const std::string& text, const char* option) {
+    const auto m = triangulation::ParsePlatformParamMode(text);
+    if (!m) throw ConfigError(std::string(option) + " must be fixed, free or weighted (got '" + text + "')");
+    return *m;
+  };
+  o.boresight = mode(a.boresight, "--boresight");
+  o.lever_arm = mode(a.lever_arm, "--lever-arm");
+  o.boresight_sigma_rad = a.boresight_sigma_deg * M_PI / 180.0;
   o.Validate();
   const calib::LineCamera camera = calib::ReadLineCamera(a.camera);
   const auto pos = triangulation::PosTrajectory::Read(a.pos);
@@ -67,6 +78,21 @@ int RunCalibrate(CalibrateArgs& a) {
                 "along %.3f -> %.3f px\n",
                 s.id.c_str(), s.first, s.last, s.n, s.degree_x, s.degree_y, s.across_before_px,
                 s.across_after_px, s.along_before_px, s.along_after_px);
+  const double deg = 180.0 / M_PI;
+  if (result.boresight != triangulation::PlatformParamMode::kFixed) {
+    const Eigen::Vector3d v = result.boresight_rad * deg;
+    const Eigen::Vector3d s = result.boresight_sigma_rad.value_or(Eigen::Vector3d::Constant(NAN)) * deg;
+    std::printf("  boresight (%s): omega %.5f +- %.5f, phi %.5f +- %.5f, kappa %.5f +- %.5f deg\n",
+                triangulation::PlatformParamModeName(result.boresight).c_str(), v.x(), s.x(), v.y(),
+                s.y(), v.z(), s.z());
+  }
+  if (result.lever_arm != triangulation::PlatformParamMode::kFixed) {
+    const Eigen::Vector3d& v = result.lever_arm_m;
+    const Eigen::Vector3d s = result.lever_arm_sigma_m.value_or(Eigen::Vector3d::Constant(NAN));
+    std::printf("  lever arm (%s): x %.4f +- %.4f, y %.4f +- %.4f, z %.4f +- %.4f m\n",
+                triangulation::PlatformParamModeName(result.lever_arm).c_str(), v.x(), s.x(), v.y(),
+                s.y(), v.z(), s.z());
+  }
   for (const auto& [name, rho] : result.correlations)
     std::printf("  correlation %s: %.4f\n", name.c_str(), rho);
   for (const auto& w : result.warnings)
@@ -177,6 +203,16 @@ CommandRun Setup(CLI::App& app) {
   cal->add_option("--pos-prior", args->pos_prior, "on | off: the POS sigmas as priors on the spline nodes");
   cal->add_option("--pos-sigma-m", o.pos_sigma_m, "POS position sigma where pos.csv gives none, m");
   cal->add_option("--pos-sigma-deg", o.pos_sigma_deg, "POS attitude sigma where pos.csv gives none, deg");
+  cal->add_option("--boresight", args->boresight,
+                  "Boresight (the camera file's mount): fixed (default) | free | weighted (around "
+                  "the file's values by --boresight-sigma-deg)");
+  cal->add_option("--boresight-sigma-deg", args->boresight_sigma_deg,
+                  "Sigma of each weighted boresight angle, deg, > 0");
+  cal->add_option("--lever-arm", args->lever_arm,
+                  "Lever arm (the camera file's, body frame): fixed (default) | free | weighted "
+                  "(around the file's values by --lever-arm-sigma-m)");
+  cal->add_option("--lever-arm-sigma-m", o.lever_arm_sigma_m,
+                  "Sigma of each weighted lever-arm component, m, > 0");
   cal->add_option("--min-per-segment", o.min_observations_per_segment,
                   "Fewer observations between two nodes: warning few_points_per_line");
   auto control_args = std::make_shared<ControlArgs>();

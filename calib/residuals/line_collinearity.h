@@ -13,6 +13,8 @@
 // its sub-camera in the normalised index u (line_camera.h):
 //   x = x_design + sum_k a_k u^k,   y = y_design + sum_k b_k u^k
 //   r = ((x - (-c U / W)) / sigma_x_mm, (y - (-c V / W)) / sigma_y_mm)            [2, unitless]
+// computed by the one collinearity condition of aerocal (internal::CollinearityErrorFromImageSpace
+// with LineFocalPlaneModel, unit sigma) and then whitened per axis.
 // sigma_x_mm = sigma_px |d x_design / d i| (the local detector spacing in the virtual focal plane:
 // up to 1 / cos^2 of the look angle times the pitch for a tilted sub-camera), sigma_y_mm =
 // sigma_px |d y / d t| (the image motion of one scan line), so that a measurement's sigma in
@@ -31,6 +33,7 @@
 #include "calib/camera/line_camera.h"
 #include "calib/camera/rotation.h"
 #include "calib/residuals/autodiff_residual.h"
+#include "calib/residuals/collinearity.h"
 
 namespace aerocal::calib {
 
@@ -59,6 +62,24 @@ inline SplineSpan CubicBSplineWeights(double t, int spacing) {
 inline int SplineNodeCount(double last_line, int spacing) {
   return int(std::floor(last_line / spacing)) + 4;
 }
+
+/// The line camera's focal plane as a camera model of the one collinearity condition
+/// (internal::CollinearityErrorFromImageSpace, collinearity.h): interior [c] (mm); the detector's
+/// calibrated focal-plane position (design + polynomial) is the ideal position itself (the
+/// detector calibration sits in the residual's detector block, not in a distortion model).
+struct LineFocalPlaneModel {
+  static constexpr bool kCorrectionForm = true;
+  template <typename T>
+  static T PrincipalDistanceMm(const T* c, const PixelFrame&) {
+    return c[0];
+  }
+  template <typename T>
+  static bool IdealFromMeasured(const T*, const PixelFrame&, const T* measured_mm, T* ideal_mm) {
+    ideal_mm[0] = measured_mm[0];
+    ideal_mm[1] = measured_mm[1];
+    return true;
+  }
+};
 
 struct LineCollinearityResidual
     : AutoDiffResidual<LineCollinearityResidual, 2, kLineNodeSize, kLineNodeSize, kLineNodeSize,
@@ -100,12 +121,16 @@ struct LineCollinearityResidual
     T b[3], v[3];
     for (int a = 0; a < 3; ++a) b[a] = body[a] * d[0] + body[3 + a] * d[1] + body[6 + a] * d[2];
     for (int a = 0; a < 3; ++a) v[a] = cam[a] * b[0] + cam[3 + a] * b[1] + cam[6 + a] * b[2];
-    if (!(v[2] < T(0))) return false;
     const T u(u_);
-    const T x = T(design_[0]) + EvaluatePolynomial(detector, kLineMaxTerms, u);
-    const T y = T(design_[1]) + EvaluatePolynomial(detector + kLineMaxTerms, kLineMaxTerms, u);
-    r[0] = (x + c[0] * v[0] / v[2]) * T(inverse_sigma_mm_[0]);
-    r[1] = (y + c[0] * v[1] / v[2]) * T(inverse_sigma_mm_[1]);
+    const T xy[2] = {T(design_[0]) + EvaluatePolynomial(detector, kLineMaxTerms, u),
+                     T(design_[1]) + EvaluatePolynomial(detector + kLineMaxTerms, kLineMaxTerms, u)};
+    // The one collinearity condition (unit sigma), then the per-axis whitening.
+    T unit[2];
+    if (!internal::CollinearityErrorFromImageSpace<LineFocalPlaneModel>(
+            c, PixelFrame{}, v, xy, 1.0, unit))
+      return false;
+    r[0] = unit[0] * T(inverse_sigma_mm_[0]);
+    r[1] = unit[1] * T(inverse_sigma_mm_[1]);
     return true;
   }
 

@@ -784,6 +784,17 @@ const std::vector<Case>& Cases() {
          return PushbroomArgs(pb);
        },
        2, "observations.csv:2: row (scan line) 1000000 is outside the POS trajectory", "pb/cam_out.yaml"},
+      {"pushbroom_boresight_mode_unknown",
+       [](const TempDir& d) { return PushbroomArgs(PushbroomFlight(d)) + " --boresight loose"; },
+       2, "--boresight must be fixed, free or weighted (got 'loose')", "pb/r.json"},
+      {"pushbroom_lever_arm_weighted_without_sigma",
+       [](const TempDir& d) { return PushbroomArgs(PushbroomFlight(d)) + " --lever-arm weighted"; },
+       2, "--lever-arm-sigma-m must be > 0 when --lever-arm is weighted (got 0)", "pb/r.json"},
+      {"pushbroom_boresight_sigma_negative",
+       [](const TempDir& d) {
+         return PushbroomArgs(PushbroomFlight(d)) + " --boresight weighted --boresight-sigma-deg -0.01";
+       },
+       2, "--boresight-sigma-deg must be > 0 when --boresight is weighted (got -0.01)", "pb/r.json"},
       {"rig_reference_head_unknown",
        [](const TempDir& d) {
          const auto rig = RigFlight(d);

@@ -15,8 +15,8 @@
 #include "calib/core/csv.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
-#include "calib/residuals/line_collinearity.h"
 #include "calib/residuals/prior.h"
+#include "triangulation/sensor/frame_camera.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -28,23 +28,12 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 constexpr double kMaxPixel = 1e7;
 constexpr double kMaxSigmaPx = 1e4;
-constexpr char kGroupLineImage[] = "line_image";
-constexpr char kGroupPosPrior[] = "pos_prior";
 
 struct Problem {
   calib::ProblemBuilder builder;
-  std::vector<BlockId> node_blocks, detector_blocks;
-  BlockId c_block = -1, mount_block = -1, lever_block = -1;
-  std::vector<Vector6d> nodes;
-  std::vector<std::array<double, 2 * kLineMaxTerms>> detector;
-  double c = 0;
-  Eigen::Vector3d mount, lever;
   std::vector<Eigen::Vector3d> point_values;
-  std::vector<calib::ResidualId> image_residuals;
-  std::vector<int> residual_subcamera;
-  std::vector<double> residual_detector, residual_u;   // per image residual: plots
-  std::vector<Eigen::Vector2d> residual_sigma_mm;
-  std::vector<std::set<int>> fixed_entries;  // per detector block
+  std::vector<calib::ResidualId> image_residuals;  // in the order of the kind's Terms()
+  std::vector<std::set<int>> fixed_entries;        // per detector block
 };
 
 }  // namespace
@@ -62,18 +51,12 @@ void LineCalibrationOptions::Validate() const {
     throw ConfigError("--pos-sigma-m and --pos-sigma-deg must be > 0");
   if (min_observations_per_segment < 0)
     throw ConfigError("--min-per-segment must be >= 0");
-}
-
-bool ProjectAtLine(const calib::LineCamera& camera, const PosTrajectory& pos, double line,
-                    const Eigen::Vector3d& point, Eigen::Vector2d* xy) {
-  Eigen::Vector3d center, opk;
-  pos.PoseAtLine(line, &center, &opk);
-  const Eigen::Matrix3d body = calib::RotationFromOpk(opk);
-  const Eigen::Vector3d v = calib::RotationFromOpk(camera.mount_rad).transpose() *
-                            body.transpose() * (point - center - body * camera.lever_arm_m);
-  if (!(v.z() < 0)) return false;
-  *xy = Eigen::Vector2d(-camera.c_mm * v.x() / v.z(), -camera.c_mm * v.y() / v.z());
-  return true;
+  if (boresight == PlatformParamMode::kWeighted && !(boresight_sigma_rad > 0))
+    throw ConfigError("--boresight-sigma-deg must be > 0 when --boresight is weighted (got " +
+                      FormatNumber(boresight_sigma_rad * 180.0 / M_PI) + ")");
+  if (lever_arm == PlatformParamMode::kWeighted && !(lever_arm_sigma_m > 0))
+    throw ConfigError("--lever-arm-sigma-m must be > 0 when --lever-arm is weighted (got " +
+                      FormatNumber(lever_arm_sigma_m) + ")");
 }
 
 void WriteLineObservations(const std::string& path, const std::vector<LineObservation>& observations) {
@@ -131,14 +114,35 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   const int spacing = options.node_spacing_lines;
   const int n_nodes = calib::SplineNodeCount(last_line - first_line, spacing);
 
+  // The line camera as a sensor kind (triangulation/sensor/line_scan_camera.h): it owns the
+  // spline nodes, detector polynomials, c, mount and lever arm, and builds the residual of every
+  // observation; the calibration owns the control points, the datum, the degree test and the
+  // report. A line strip is not a block of frame exposures: its SensorContext has an empty
+  // project (the observations file named in errors) and no exposure poses.
+  LineScanOptions line_options;
+  line_options.node_spacing_lines = spacing;
+  line_options.free_c = options.free_c;
+  line_options.pos_prior = options.pos_prior;
+  line_options.pos_sigma_center_m =
+      pos.MedianCenterSigma().value_or(Eigen::Vector3d::Constant(options.pos_sigma_m));
+  line_options.pos_sigma_opk_rad = pos.MedianOpkSigma().value_or(
+      Eigen::Vector3d::Constant(options.pos_sigma_deg * M_PI / 180.0));
+  line_options.boresight = options.boresight;
+  line_options.boresight_sigma_rad = options.boresight_sigma_rad;
+  line_options.lever_arm = options.lever_arm;
+  line_options.lever_arm_sigma_m = options.lever_arm_sigma_m;
+  LineScanCamera sensor(camera, pos, line_options);
   Problem p;
-  p.nodes.assign(n_nodes, Vector6d::Zero());
-  p.detector.assign(n_sub, {});
-  for (auto& d : p.detector) d.fill(0.0);
   p.fixed_entries.assign(n_sub, {});
-  p.c = camera.c_mm;
-  p.mount = camera.mount_rad;
-  p.lever = camera.lever_arm_m;
+  Project strip;
+  strip.observations_file = observations_file;
+  const AdjustOptions adjust_options{};
+  const DenseIndex dense_index(strip);
+  const std::vector<PoseBlocks> no_poses;
+  const FrameCamera no_frame{};
+  const SensorContext context{strip, adjust_options, p.builder, dense_index, no_poses, no_frame};
+  auto& b = p.builder;
+  sensor.RegisterBlocks(context);
 
   // Control points: weighted ground points. Other roles cannot be used by a single line camera
   // (one ray per point): their observations are ignored and counted.
@@ -152,26 +156,6 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   p.point_values.resize(control.size());
   for (size_t k = 0; k < control.size(); ++k) p.point_values[k] = *control[k]->xyz_m;
 
-  auto& b = p.builder;
-  const char* entry_names[] = {"dX", "dY", "dZ", "domega", "dphi", "dkappa"};
-  for (int j = 0; j < n_nodes; ++j)
-    p.node_blocks.push_back(b.AddBlock("node" + std::to_string(j), p.nodes[j].data(), kLineNodeSize,
-                                       calib::BlockKind::kOther,
-                                       {entry_names, entry_names + 6}));
-  for (int s = 0; s < n_sub; ++s) {
-    std::vector<std::string> names;
-    for (int k = 0; k < kLineMaxTerms; ++k) names.push_back("dx" + std::to_string(k));
-    for (int k = 0; k < kLineMaxTerms; ++k) names.push_back("dy" + std::to_string(k));
-    p.detector_blocks.push_back(b.AddBlock("detector_" + sub_ids[s], p.detector[s].data(),
-                                           2 * kLineMaxTerms, calib::BlockKind::kInterior, names));
-  }
-  p.c_block = b.AddBlock("c", &p.c, 1, calib::BlockKind::kInterior, {"c"});
-  p.mount_block = b.AddBlock("mount", p.mount.data(), 3, calib::BlockKind::kOther, {"omega", "phi", "kappa"});
-  p.lever_block = b.AddBlock("lever_arm", p.lever.data(), 3, calib::BlockKind::kOther, {"x", "y", "z"});
-  if (!options.free_c) b.FixBlock(p.c_block);
-  b.FixBlock(p.mount_block);
-  b.FixBlock(p.lever_block);
-
   std::vector<BlockId> point_blocks(control.size());
   for (size_t k = 0; k < control.size(); ++k) {
     point_blocks[k] = b.AddBlock("point_" + control[k]->id, p.point_values[k].data(), 3,
@@ -183,7 +167,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
                   {point_blocks[k]}, "control " + control[k]->id);
   }
 
-  // Image observations.
+  // Image observations: each built by the kind (through the interface), added under its group.
   std::vector<int> per_segment(n_nodes, 0);
   std::vector<int> per_node(n_nodes, 0);
   for (const auto& o : observations) {
@@ -193,61 +177,18 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
       ++result.n_ignored;
       continue;
     }
-    if (!(o.detector >= -0.5 && o.detector <= camera.detectors - 0.5))
-      ThrowInputError(where, "col (detector) must be within -0.5 .. " +
-                                 FormatNumber(camera.detectors - 0.5) + " (got " +
-                                 FormatNumber(o.detector) + ")");
-    if (!pos.CoversLine(o.line))
-      ThrowInputError(where, "row (scan line) " + FormatNumber(o.line) +
-                                 " is outside the POS trajectory (lines " + FormatNumber(first_line) +
-                                 " .. " + FormatNumber(last_line) + ")");
-    int s = 0;
-    const long nearest = std::lround(std::max(0.0, std::min<double>(o.detector, camera.detectors - 1)));
-    for (int r = 0; r < n_sub; ++r)
-      if (nearest >= ranges[r].first && nearest <= ranges[r].second) s = r;
-    const double u = ranges[s].second > ranges[s].first
-                         ? (2.0 * o.detector - ranges[s].first - ranges[s].second) /
-                               double(ranges[s].second - ranges[s].first)
-                         : 0.0;
-    Eigen::Vector3d pos_center, pos_opk;
-    pos.PoseAtLine(o.line, &pos_center, &pos_opk);
-    // Whitening in detectors and lines: the local detector spacing in the virtual focal plane and
-    // the image motion of one line (at the POS pose and the file's camera).
-    const double h = 0.01;
-    const double ic = std::max(ranges[s].first + h, std::min(ranges[s].second - h, o.detector));
-    const double dx_di =
-        ranges[s].second > ranges[s].first
-            ? std::abs(camera.DesignPosition(ic + h).x() - camera.DesignPosition(ic - h).x()) / (2 * h)
-            : camera.pitch_mm;
-    double dy_dt = 0;
-    {
-      const double t0 = pos.CoversLine(o.line - 0.5) ? o.line - 0.5 : o.line;
-      const double t1 = pos.CoversLine(o.line + 0.5) ? o.line + 0.5 : o.line;
-      Eigen::Vector2d y0, y1;
-      if (t1 > t0 && ProjectAtLine(camera, pos, t0, *control[it->second]->xyz_m, &y0) &&
-          ProjectAtLine(camera, pos, t1, *control[it->second]->xyz_m, &y1))
-        dy_dt = std::abs(y1.y() - y0.y()) / (t1 - t0);
-    }
-    if (!(dy_dt > 1e-3 * camera.pitch_mm)) dy_dt = camera.pitch_mm;
-    const Eigen::Vector2d sigma_xy_mm(o.sigma_px * std::max(dx_di, 1e-3 * camera.pitch_mm),
-                                      o.sigma_px * dy_dt);
-    const double t = std::max(0.0, o.line - first_line);
-    const calib::SplineSpan span = calib::CubicBSplineWeights(t, spacing);
-    const int j = std::min(span.first_node, n_nodes - 4);
+    ImageObservation observation;
+    observation.image = kLineStripImage;
+    observation.point = o.point;
+    observation.pixel = Eigen::Vector2d(o.detector, o.line);
+    observation.sigma_px = o.sigma_px;
+    observation.line = o.source_line;
+    ObservationTerm term = sensor.Observe(context, observation, point_blocks[it->second]);
+    const int j = sensor.Terms().back().segment;
     ++per_segment[j];
     for (int m = 0; m < 4; ++m) ++per_node[j + m];
-    const auto id = b.AddResidual(
-        kGroupLineImage,
-        calib::LineCollinearityResidual::Create(camera.DetectorPosition(o.detector), u, span,
-                                                pos_opk, pos_center, sigma_xy_mm),
-        {p.node_blocks[j], p.node_blocks[j + 1], p.node_blocks[j + 2], p.node_blocks[j + 3],
-         p.detector_blocks[s], p.c_block, p.mount_block, p.lever_block, point_blocks[it->second]},
-        "point " + o.point);
+    const auto id = b.AddResidual(term.group, std::move(term.cost), term.blocks, "point " + o.point);
     p.image_residuals.push_back(id);
-    p.residual_subcamera.push_back(s);
-    p.residual_detector.push_back(o.detector);
-    p.residual_u.push_back(u);
-    p.residual_sigma_mm.push_back(sigma_xy_mm);
     // The start must be a valid geometry (the point in front of the camera).
     if (b.EvaluateResidual(id).empty())
       ThrowInputError(where, "point " + o.point + " lies behind the camera at line " +
@@ -259,19 +200,8 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     throw InputError(observations_file + ": no observation of a control point (" +
                      std::to_string(result.n_ignored) + " observations of other points ignored)");
 
-  // POS priors on the node values.
-  const Eigen::Vector3d sigma_center =
-      pos.MedianCenterSigma().value_or(Eigen::Vector3d::Constant(options.pos_sigma_m));
-  const Eigen::Vector3d sigma_opk = pos.MedianOpkSigma().value_or(
-      Eigen::Vector3d::Constant(options.pos_sigma_deg * M_PI / 180.0));
-  if (options.pos_prior)
-    for (int j = 0; j < n_nodes; ++j)
-      b.AddResidual(kGroupPosPrior,
-                    calib::PriorCostFunction::Create(
-                        {0, 0, 0, 0, 0, 0},
-                        {sigma_center.x(), sigma_center.y(), sigma_center.z(), sigma_opk.x(),
-                         sigma_opk.y(), sigma_opk.z()}),
-                    {p.node_blocks[j]}, "pos node " + std::to_string(j));
+  // The kind's own residuals: POS priors on the node values, weighted boresight / lever arm.
+  sensor.AddOwnResiduals(context);
 
   // Too few points per line: per spline segment; a node no observation reaches is undetermined
   // without the POS prior (it is then fixed at 0 and the result is not valid).
@@ -288,7 +218,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   }
   for (int j = 0; j < n_nodes; ++j)
     if (per_node[j] == 0 && !options.pos_prior) {
-      b.FixBlock(p.node_blocks[j]);
+      b.FixBlock(sensor.NodeBlocks()[j]);
       result.valid = false;
       result.warnings.push_back({"few_points_per_line", "node " + std::to_string(j), 0, 1,
                                  "no observation reaches spline node " + std::to_string(j) +
@@ -299,10 +229,8 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   const int start_degree = options.degree.value_or(options.max_degree);
   auto apply_fixed = [&]() {
     for (int s = 0; s < n_sub; ++s) {
-      std::vector<int> fixed(p.fixed_entries[s].begin(), p.fixed_entries[s].end());
-      for (int e : fixed) p.detector[s][e] = 0.0;
-      b.FreeBlock(p.detector_blocks[s]);
-      if (!fixed.empty()) b.FixEntries(p.detector_blocks[s], fixed);
+      sensor.SetFixedDetectorEntries(
+          b, s, std::vector<int>(p.fixed_entries[s].begin(), p.fixed_entries[s].end()));
     }
   };
   for (int s = 0; s < n_sub; ++s) {
@@ -322,7 +250,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     for (size_t k = 0; k < p.image_residuals.size(); ++k) {
       const auto r = b.EvaluateResidual(p.image_residuals[k]);
       if (r.size() != 2) continue;
-      const int s = p.residual_subcamera[k];
+      const int s = sensor.Terms()[k].subcamera;
       sx[s] += r[0] * r[0];
       sy[s] += r[1] * r[1];
       ++n[s];
@@ -341,9 +269,11 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   };
   rms_by_subcamera(false);
 
-  std::vector<BlockId> cov_blocks = p.node_blocks;
-  cov_blocks.insert(cov_blocks.end(), p.detector_blocks.begin(), p.detector_blocks.end());
-  cov_blocks.push_back(p.c_block);
+  std::vector<BlockId> cov_blocks = sensor.NodeBlocks();
+  cov_blocks.insert(cov_blocks.end(), sensor.DetectorBlocks().begin(), sensor.DetectorBlocks().end());
+  cov_blocks.push_back(sensor.CBlock());
+  if (options.boresight != PlatformParamMode::kFixed) cov_blocks.push_back(sensor.MountBlock());
+  if (options.lever_arm != PlatformParamMode::kFixed) cov_blocks.push_back(sensor.LeverArmBlock());
 
   result.report = b.Solve(options.solver);
   calib::CovarianceReport cov;
@@ -356,7 +286,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     for (int s = 0; s < n_sub; ++s)
       for (int axis = 0; axis < 2; ++axis) {
         const int base = axis * kLineMaxTerms;
-        const Eigen::MatrixXd q = cov.BlockCovariance(p.detector_blocks[s], 2 * kLineMaxTerms);
+        const Eigen::MatrixXd q = cov.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms);
         // Top-down: drop the highest free coefficient while it is insignificant (Wald, one
         // degree of freedom) in the model without the terms already dropped. The estimate and
         // variance of that reduced model come from this fit's covariance (restricted least
@@ -367,14 +297,14 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         for (; chosen >= 0; --chosen) {
           const int e = base + chosen;
           if (p.fixed_entries[s].count(e)) continue;  // fixed (datum): does not decide
-          double beta = p.detector[s][e], var = q(e, e);
+          double beta = sensor.Detectors()[s][e], var = q(e, e);
           if (!dropped.empty()) {
             const int nb = int(dropped.size());
             Eigen::MatrixXd qbb(nb, nb);
             Eigen::VectorXd qeb(nb), bb(nb);
             for (int k = 0; k < nb; ++k) {
               qeb[k] = q(e, dropped[k]);
-              bb[k] = p.detector[s][dropped[k]];
+              bb[k] = sensor.Detectors()[s][dropped[k]];
               for (int m = 0; m < nb; ++m) qbb(k, m) = q(dropped[k], dropped[m]);
             }
             const Eigen::LDLT<Eigen::MatrixXd> ldlt(qbb);
@@ -447,11 +377,11 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   };
   for (int s = 0; s < n_sub; ++s) {
     auto& out = result.subcameras[s];
-    out.dx_coefficients_mm.assign(p.detector[s].begin(), p.detector[s].begin() + kLineMaxTerms);
-    out.dy_coefficients_mm.assign(p.detector[s].begin() + kLineMaxTerms, p.detector[s].end());
+    out.dx_coefficients_mm.assign(sensor.Detectors()[s].begin(), sensor.Detectors()[s].begin() + kLineMaxTerms);
+    out.dy_coefficients_mm.assign(sensor.Detectors()[s].begin() + kLineMaxTerms, sensor.Detectors()[s].end());
     for (int k = 0; k < kLineMaxTerms; ++k) {
-      out.dx_sigma_mm.push_back(entry_sigma(p.detector_blocks[s], k));
-      out.dy_sigma_mm.push_back(entry_sigma(p.detector_blocks[s], kLineMaxTerms + k));
+      out.dx_sigma_mm.push_back(entry_sigma(sensor.DetectorBlocks()[s], k));
+      out.dy_sigma_mm.push_back(entry_sigma(sensor.DetectorBlocks()[s], kLineMaxTerms + k));
     }
   }
   result.dx_mm.resize(camera.detectors);
@@ -460,15 +390,15 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   result.dy_sigma_mm.resize(camera.detectors);
   for (int s = 0; s < n_sub; ++s) {
     const Eigen::MatrixXd q =
-        cov.ok ? cov.BlockCovariance(p.detector_blocks[s], 2 * kLineMaxTerms) : Eigen::MatrixXd();
+        cov.ok ? cov.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms) : Eigen::MatrixXd();
     for (int i = ranges[s].first; i <= ranges[s].second; ++i) {
       const double u = ranges[s].second > ranges[s].first
                            ? (2.0 * i - ranges[s].first - ranges[s].second) /
                                  double(ranges[s].second - ranges[s].first)
                            : 0.0;
       const Eigen::Vector2d base = camera.Correction(i);
-      result.dx_mm[i] = base.x() + calib::EvaluatePolynomial(p.detector[s].data(), kLineMaxTerms, u);
-      result.dy_mm[i] = base.y() + calib::EvaluatePolynomial(p.detector[s].data() + kLineMaxTerms,
+      result.dx_mm[i] = base.x() + calib::EvaluatePolynomial(sensor.Detectors()[s].data(), kLineMaxTerms, u);
+      result.dy_mm[i] = base.y() + calib::EvaluatePolynomial(sensor.Detectors()[s].data() + kLineMaxTerms,
                                                              kLineMaxTerms, u);
       if (cov.ok)
         for (int axis = 0; axis < 2; ++axis) {
@@ -486,24 +416,24 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   for (size_t k = 0; k < p.image_residuals.size(); ++k) {
     const auto r = b.EvaluateResidual(p.image_residuals[k]);
     if (r.size() != 2) continue;
-    const int s = p.residual_subcamera[k];
-    const double u = p.residual_u[k];
-    const Eigen::Vector2d base = camera.Correction(p.residual_detector[k]);
-    const double dx = base.x() + calib::EvaluatePolynomial(p.detector[s].data(), kLineMaxTerms, u);
+    const int s = sensor.Terms()[k].subcamera;
+    const double u = sensor.Terms()[k].u;
+    const Eigen::Vector2d base = camera.Correction(sensor.Terms()[k].detector);
+    const double dx = base.x() + calib::EvaluatePolynomial(sensor.Detectors()[s].data(), kLineMaxTerms, u);
     const double dy =
-        base.y() + calib::EvaluatePolynomial(p.detector[s].data() + kLineMaxTerms, kLineMaxTerms, u);
-    result.error_samples.push_back({p.residual_detector[k], s,
-                                    (dx - r[0] * p.residual_sigma_mm[k].x()) / camera.pitch_mm,
-                                    (dy - r[1] * p.residual_sigma_mm[k].y()) / camera.pitch_mm});
+        base.y() + calib::EvaluatePolynomial(sensor.Detectors()[s].data() + kLineMaxTerms, kLineMaxTerms, u);
+    result.error_samples.push_back({sensor.Terms()[k].detector, s,
+                                    (dx - r[0] * sensor.Terms()[k].sigma_mm.x()) / camera.pitch_mm,
+                                    (dy - r[1] * sensor.Terms()[k].sigma_mm.y()) / camera.pitch_mm});
   }
 
   // Spline nodes and per-line corrections with sigmas.
   for (int j = 0; j < n_nodes; ++j) {
     result.node_line.push_back(first_line + (j - 1) * double(spacing));
-    result.node_values.push_back(p.nodes[j]);
+    result.node_values.push_back(sensor.Nodes()[j]);
     Vector6d sigma = Vector6d::Zero();
     if (cov.ok)
-      for (int e = 0; e < 6; ++e) sigma[e] = entry_sigma(p.node_blocks[j], e).value_or(0.0);
+      for (int e = 0; e < 6; ++e) sigma[e] = entry_sigma(sensor.NodeBlocks()[j], e).value_or(0.0);
     result.node_sigma.push_back(sigma);
   }
   for (double line = first_line; line <= last_line + 1e-9; line += 1.0) {
@@ -512,11 +442,11 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     Vector6d value = Vector6d::Zero();
     Eigen::Matrix<double, 6, 6> var = Eigen::Matrix<double, 6, 6>::Zero();
     for (int m = 0; m < 4; ++m) {
-      value += span.weights[m] * p.nodes[j + m];
+      value += span.weights[m] * sensor.Nodes()[j + m];
       if (!cov.ok) continue;
       for (int n = 0; n < 4; ++n) {
         Eigen::MatrixXd cross;
-        if (cov.CrossCovariance(p.node_blocks[j + m], p.node_blocks[j + n], &cross))
+        if (cov.CrossCovariance(sensor.NodeBlocks()[j + m], sensor.NodeBlocks()[j + n], &cross))
           var += span.weights[m] * span.weights[n] * cross;
       }
     }
@@ -524,8 +454,26 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     result.line_corrections.push_back(value);
     result.line_sigma.push_back(var.diagonal().cwiseMax(0.0).cwiseSqrt());
   }
-  result.c_mm = p.c;
-  if (options.free_c) result.c_sigma_mm = entry_sigma(p.c_block, 0);
+  result.c_mm = sensor.CMm();
+  if (options.free_c) result.c_sigma_mm = entry_sigma(sensor.CBlock(), 0);
+  // Boresight and lever arm: values, sigmas (null when fixed or not determined).
+  result.boresight = options.boresight;
+  result.lever_arm = options.lever_arm;
+  result.boresight_rad = sensor.MountRad();
+  result.lever_arm_m = sensor.LeverArmM();
+  auto block_sigma = [&](BlockId block) -> std::optional<Eigen::Vector3d> {
+    Eigen::Vector3d sigma;
+    for (int e = 0; e < 3; ++e) {
+      const auto s = entry_sigma(block, e);
+      if (!s) return std::nullopt;
+      sigma[e] = *s;
+    }
+    return sigma;
+  };
+  if (options.boresight != PlatformParamMode::kFixed)
+    result.boresight_sigma_rad = block_sigma(sensor.MountBlock());
+  if (options.lever_arm != PlatformParamMode::kFixed)
+    result.lever_arm_sigma_m = block_sigma(sensor.LeverArmBlock());
 
   // Named correlations: a detector polynomial's constant across-track term against the mean roll
   // correction of the strip (offset_vs_roll), its constant along-track term against the mean pitch
@@ -577,32 +525,84 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         if (entry_sigma(block, entry)) c.emplace_back(block, entry, 1.0);
       return c;
     };
-    const double offset_roll = multiple(mean_free(p.detector_blocks, 0), all_free(p.node_blocks, roll));
+    const double offset_roll = multiple(mean_free(sensor.DetectorBlocks(), 0), all_free(sensor.NodeBlocks(), roll));
     const double offset_pitch =
-        multiple(mean_free(p.detector_blocks, kLineMaxTerms), all_free(p.node_blocks, pitch));
+        multiple(mean_free(sensor.DetectorBlocks(), kLineMaxTerms), all_free(sensor.NodeBlocks(), pitch));
     double scale_c = -1;
-    if (options.free_c && entry_sigma(p.c_block, 0)) {
-      Combination set = all_free(p.detector_blocks, 1);
-      const Combination dz = all_free(p.node_blocks, 2);
+    if (options.free_c && entry_sigma(sensor.CBlock(), 0)) {
+      Combination set = all_free(sensor.DetectorBlocks(), 1);
+      const Combination dz = all_free(sensor.NodeBlocks(), 2);
       set.insert(set.end(), dz.begin(), dz.end());
-      scale_c = multiple({{p.c_block, 0, 1.0}}, set);
+      scale_c = multiple({{sensor.CBlock(), 0, 1.0}}, set);
     }
-    const std::pair<const char*, double> named[] = {
-        {"offset_vs_roll", offset_roll}, {"offset_vs_pitch", offset_pitch}, {"scale_vs_c", scale_c}};
-    for (const auto& [name, rho] : named) {
+    struct Named {
+      std::string name;
+      double rho;
+      std::string meaning;
+    };
+    std::vector<Named> named = {
+        {"offset_vs_roll", offset_roll,
+         "a constant across-track offset of the detectors is a roll of the strip"},
+        {"offset_vs_pitch", offset_pitch,
+         "a constant along-track offset of the detectors is a pitch of the strip"},
+        {"scale_vs_c", scale_c, "c and the detectors' linear term (or the height) are one scale"}};
+    // The boresight and lever arm when estimated: multiple correlation of each entry with what
+    // can take it over. The camera's x axis is the line (across track): the boresight phi (about
+    // y) is its roll, omega its pitch.
+    const BlockId mount = sensor.MountBlock(), lever = sensor.LeverArmBlock();
+    if (entry_sigma(mount, 0)) {
+      const char* angle[] = {"omega", "phi", "kappa"};
+      for (int a = 0; a < 3; ++a)
+        named.push_back({std::string("boresight_") + angle[a] + "_vs_attitude",
+                         multiple({{mount, a, 1.0}}, all_free(sensor.NodeBlocks(), 3 + a)),
+                         "a constant boresight angle is a constant attitude correction of the "
+                         "trajectory (only the POS prior tells them apart)"});
+      named.push_back({"boresight_roll_vs_offset",
+                       multiple({{mount, 1, 1.0}}, all_free(sensor.DetectorBlocks(), 0)),
+                       "the boresight roll (phi) is a constant across-track offset of the detectors"});
+      named.push_back({"boresight_pitch_vs_offset",
+                       multiple({{mount, 0, 1.0}}, all_free(sensor.DetectorBlocks(), kLineMaxTerms)),
+                       "the boresight pitch (omega) is a constant along-track offset of the detectors"});
+    }
+    if (entry_sigma(lever, 0)) {
+      Combination positions;
+      for (int e = 0; e < 3; ++e) {
+        const Combination c = all_free(sensor.NodeBlocks(), e);
+        positions.insert(positions.end(), c.begin(), c.end());
+      }
+      const char* axis[] = {"x", "y", "z"};
+      for (int a = 0; a < 3; ++a)
+        named.push_back({std::string("lever_arm_") + axis[a] + "_vs_position",
+                         multiple({{lever, a, 1.0}}, positions),
+                         "a constant lever arm is a constant position correction of the trajectory "
+                         "(along track it is also what a POS time offset does; only the POS prior "
+                         "tells them apart)"});
+      // With the boresight free too: a lever arm across (along) track seen from the height H is
+      // nearly a roll (pitch) of lever / H; only the relief tells them apart.
+      const Combination boresight = all_free({mount}, 0), phi = all_free({mount}, 1),
+                        kappa = all_free({mount}, 2);
+      Combination angles = boresight;
+      angles.insert(angles.end(), phi.begin(), phi.end());
+      angles.insert(angles.end(), kappa.begin(), kappa.end());
+      if (!angles.empty())
+        for (int a = 0; a < 3; ++a)
+          named.push_back({std::string("lever_arm_") + axis[a] + "_vs_boresight",
+                           multiple({{lever, a, 1.0}}, angles),
+                           "a lever arm across or along track is nearly a boresight roll or pitch "
+                           "(lever / flying height); only the relief tells them apart"});
+    }
+    for (const auto& [name, rho, meaning] : named) {
       if (rho < 0) continue;
       result.correlations.emplace_back(name, rho);
       if (rho > options.correlation_warn) {
         const bool fail = rho > options.correlation_fail;
         if (fail) result.valid = false;
+        const bool own = name.rfind("boresight", 0) == 0 || name.rfind("lever_arm", 0) == 0;
         result.warnings.push_back(
-            {name, "detector polynomials", rho, fail ? options.correlation_fail : options.correlation_warn,
+            {name, own ? "boresight / lever arm" : "detector polynomials", rho,
+             fail ? options.correlation_fail : options.correlation_warn,
              std::string(fail ? "ill-posed: " : "") + "correlation " + FormatNumber(rho, 6) +
-                 (std::string(name) == "scale_vs_c"
-                      ? ": c and the detectors' linear term (or the height) are one scale"
-                      : std::string(name) == "offset_vs_roll"
-                            ? ": a constant across-track offset of the detectors is a roll of the strip"
-                            : ": a constant along-track offset of the detectors is a pitch of the strip")});
+                 ": " + meaning});
       }
     }
   }
@@ -610,7 +610,9 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   // The updated camera: design + the estimated calibration (polynomials when the file had none
   // or had polynomials over the same ranges, else the table).
   result.camera = camera;
-  result.camera.c_mm = p.c;
+  result.camera.c_mm = sensor.CMm();
+  result.camera.mount_rad = sensor.MountRad();
+  result.camera.lever_arm_m = sensor.LeverArmM();
   bool same_ranges = camera.dx_mm.empty();
   if (!camera.calibration.empty()) {
     same_ranges = int(camera.calibration.size()) == n_sub;
@@ -625,8 +627,8 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     for (int s = 0; s < n_sub; ++s) {
       polys[s].first = ranges[s].first;
       polys[s].last = ranges[s].second;
-      polys[s].dx.assign(p.detector[s].begin(), p.detector[s].begin() + kLineMaxTerms);
-      polys[s].dy.assign(p.detector[s].begin() + kLineMaxTerms, p.detector[s].end());
+      polys[s].dx.assign(sensor.Detectors()[s].begin(), sensor.Detectors()[s].begin() + kLineMaxTerms);
+      polys[s].dy.assign(sensor.Detectors()[s].begin() + kLineMaxTerms, sensor.Detectors()[s].end());
       if (!camera.calibration.empty()) {
         for (size_t k = 0; k < camera.calibration[s].dx.size(); ++k) polys[s].dx[k] += camera.calibration[s].dx[k];
         for (size_t k = 0; k < camera.calibration[s].dy.size(); ++k) polys[s].dy[k] += camera.calibration[s].dy[k];
@@ -673,6 +675,16 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
   j["n_ignored_observations"] = r.n_ignored;
   j["c_mm"] = r.c_mm;
   j["c_sigma_mm"] = opt(r.c_sigma_mm);
+  const double deg = 180.0 / M_PI;
+  auto vector3 = [](const Eigen::Vector3d& v, double scale) {
+    return json::array({v.x() * scale, v.y() * scale, v.z() * scale});
+  };
+  j["boresight"] = {{"mode", PlatformParamModeName(r.boresight)},
+                    {"opk_deg", vector3(r.boresight_rad, deg)},
+                    {"sigma_deg", r.boresight_sigma_rad ? vector3(*r.boresight_sigma_rad, deg) : json(nullptr)}};
+  j["lever_arm"] = {{"mode", PlatformParamModeName(r.lever_arm)},
+                    {"xyz_m", vector3(r.lever_arm_m, 1.0)},
+                    {"sigma_m", r.lever_arm_sigma_m ? vector3(*r.lever_arm_sigma_m, 1.0) : json(nullptr)}};
   json subs = json::array();
   for (const auto& s : r.subcameras) {
     json js;
@@ -700,7 +712,6 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
                    {"sigma_dx_mm", opt(r.dx_sigma_mm[i])}, {"sigma_dy_mm", opt(r.dy_sigma_mm[i])}});
   j["detectors"] = det;
   json nodes = json::array();
-  const double deg = 180.0 / M_PI;
   for (size_t k = 0; k < r.node_values.size(); ++k) {
     const auto& v = r.node_values[k];
     const auto& s = r.node_sigma[k];

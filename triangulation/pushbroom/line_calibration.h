@@ -27,6 +27,7 @@
 #include "calib/problem/problem_builder.h"
 #include "triangulation/block/block.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
+#include "triangulation/sensor/line_scan_camera.h"
 
 namespace aerocal::triangulation {
 
@@ -45,6 +46,12 @@ struct LineCalibrationOptions {
   double correlation_warn = 0.95;     // |rho| above: warning by name
   double correlation_fail = 0.999;    // |rho| above: the result cannot be trusted (valid = false)
   double max_sigma0 = 3.0;            // sigma0 above: valid = false (absurd a-priori sigmas)
+  // Boresight (the camera file's mount M) and lever arm: fixed at the file's values (default),
+  // free, or weighted around them with these sigmas (as PlatformSpec of a frame block).
+  PlatformParamMode boresight = PlatformParamMode::kFixed;
+  double boresight_sigma_rad = 0.0;   // weighted: per angle, rad, > 0
+  PlatformParamMode lever_arm = PlatformParamMode::kFixed;
+  double lever_arm_sigma_m = 0.0;     // weighted: per axis, m, > 0
   calib::SolverOptions solver;
   void Validate() const;              // ConfigError naming the option
 };
@@ -99,17 +106,17 @@ struct LineCalibrationResult {
   std::vector<Eigen::Matrix<double, 6, 1>> line_corrections, line_sigma;
   double c_mm = 0.0;
   std::optional<double> c_sigma_mm;
+  /// Boresight (the camera's mount M, omega phi kappa) and lever arm (body frame): how they were
+  /// estimated, their values and sigmas (null when fixed or not determined).
+  PlatformParamMode boresight = PlatformParamMode::kFixed, lever_arm = PlatformParamMode::kFixed;
+  Eigen::Vector3d boresight_rad = Eigen::Vector3d::Zero(), lever_arm_m = Eigen::Vector3d::Zero();
+  std::optional<Eigen::Vector3d> boresight_sigma_rad, lever_arm_sigma_m;
   /// Named correlations (max |rho| over the pairs of that kind; absent when not computed).
   std::vector<std::pair<std::string, double>> correlations;
   calib::LineCamera camera;  // the updated camera (polynomial calibration)
   int n_observations = 0, n_control = 0, n_ignored = 0;
   std::vector<std::string> undetermined;
 };
-
-/// Focal-plane position (mm) of `point` seen from the pose of `trajectory` at (fractional) `line`
-/// through `camera`'s mount and lever arm; false when it lies on or behind the camera.
-bool ProjectAtLine(const calib::LineCamera& camera, const PosTrajectory& trajectory, double line,
-                   const Eigen::Vector3d& point, Eigen::Vector2d* xy);
 
 /// Reads observations.csv of a line camera (`point,col,row[,sigma_px]`; `image` optional and
 /// ignored: one strip): col = detector position, row = scan line.
