@@ -142,6 +142,21 @@ TEST_F(OlympusCalibration, PublishedDbatValuesWithinThreeSigmaAndGroupStability)
   EXPECT_EQ(cal["groups"].size(), 3u);
   EXPECT_EQ(cal["stability"]["rows"].size(), 9u);
   EXPECT_FALSE(cal["stability"]["agree"].get<bool>());
+  // The test's sensitivity per group: the change detected with 80 % power, more than twice the
+  // group's own sigma, largest for the least precise group (group_change_power.h).
+  EXPECT_EQ(cal["stability"]["power"].get<double>(), 0.8);
+  for (const auto& row : cal["stability"]["rows"]) {
+    const auto& d = row["detectable_change"];
+    const auto& s = row["sigmas"];
+    ASSERT_EQ(d.size(), 3u) << row["parameter"];
+    int least_precise = 0, largest_change = 0;
+    for (int g = 0; g < 3; ++g) {
+      EXPECT_GT(d[g].get<double>(), 2 * s[g].get<double>()) << row["parameter"];
+      if (s[g].get<double>() > s[least_precise].get<double>()) least_precise = g;
+      if (d[g].get<double>() > d[largest_change].get<double>()) largest_change = g;
+    }
+    EXPECT_EQ(largest_change, least_precise) << row["parameter"];
+  }
   const auto& est = j["cameras"][0]["estimated"];
   const auto& sig = j["cameras"][0]["sigma"];
   // DBAT 0.9.2.0 (PROVENANCE.md): c 7.45700, pp 3.61546 / 2.61329 mm from the top-left corner,

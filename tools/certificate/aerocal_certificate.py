@@ -86,11 +86,16 @@ def stability_rows(c):
     groups = c.get("groups") or []
     if not groups:
         return None
-    head = ["parameter"] + [g["group"] for g in groups] + ["mean", "spread", "chi2", "critical", "agree"]
+    # The change of one group alone the test flags with probability `power` (per group).
+    power = s.get("power")
+    detect = "detectable change (%s)" % ("%.0f %%" % (100 * power) if power else "-")
+    head = ["parameter"] + [g["group"] for g in groups] + ["mean", "spread", "chi2", "critical", detect, "agree"]
     rows = [head]
     for r in s.get("rows", []):
+        d = r.get("detectable_change")
         rows.append([r["parameter"]] + [fmt(v, 7) + " +- " + fmt(sg, 2) for v, sg in zip(r["values"], r["sigmas"])] +
                     [fmt(r["mean"], 7), fmt(r["spread"], 2), fmt(r["chi2"], 3), fmt(r["critical"], 3),
+                     " / ".join(fmt(x, 2) for x in d) if d else "-",
                      "yes" if r["agree"] else "NO"])
     return rows
 
