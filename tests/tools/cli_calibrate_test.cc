@@ -50,6 +50,19 @@ TEST(CalibrateCommand, OpenCvModelOnTheChessboardEqualsCalibrateCamera) {
   for (const char* p : {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"})
     EXPECT_NEAR(ours[p].get<double>(), cv[p].get<double>(), 1e-4 * std::abs(cv[p].get<double>())) << p;
   EXPECT_NEAR(j["calibration"]["rms_px"].get<double>(), cv["rms_px"].get<double>(), 1e-4 * cv["rms_px"].get<double>());
+
+  // Its certificate draws the OpenCV camera's own distortion (computed in its model, not restated
+  // by the renderer): this lens's strong barrel distortion (k1 ~ -0.28) is a large outward
+  // correction at the corners, not the flat zero curve a 10-parameter formula would draw.
+  const auto c = RunAerocal("certificate --result " + tmp.File("cv.json") + " --out " + tmp.File("cert"));
+  ASSERT_LE(c.exit_code, 3) << c.output;
+  const auto cert = ReadJson(tmp.File("cert/certificate.json"));
+  const auto& d = cert["distortion"];
+  ASSERT_TRUE(d.is_object()) << cert.dump().substr(0, 400);
+  EXPECT_EQ(d["profile_kind"], "mean over directions");
+  EXPECT_EQ(d["grid"].size(), 99u);
+  EXPECT_GT(d["profile"].back()[1].get<double>(), 50.0);  // um at the half diagonal
+  EXPECT_TRUE(std::filesystem::exists(tmp.File("cert/certificate.pdf")));
 }
 
 TEST(CalibrateCommand, OpenCvChessboardAgainstCalibrateCameraAndThePublishedResults) {
