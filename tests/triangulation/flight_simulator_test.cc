@@ -110,5 +110,38 @@ TEST(FlightSimulator, TheSameSeedGivesTheSameFlightAndAnotherSeedAnother) {
   EXPECT_NE(a.observations.front().pixel, c.observations.front().pixel);
 }
 
+// The simulator asks only the exposures near a point whether they see it (a grid of ground discs,
+// flight_simulator.cc): every (point, image) pair whose true projection falls inside the format
+// (20 px margin) must still be observed, and no other, here with tilts of several degrees and a
+// low flight over high relief, where the discs are widest relative to the block.
+TEST(FlightSimulator, ObservesEveryPointInEveryImageThatSeesIt) {
+  FlightSimulationOptions o;
+  o.seed = 4;
+  o.exposures = 24;
+  o.strips = 3;
+  o.attitude_sigma_deg = 6.0;
+  o.flying_height_m = 1500.0;
+  o.terrain_relief_m = 900.0;
+  o.tie_points = 400;
+  const SimulatedFlight f = SimulateFlight(o);
+  std::set<std::pair<std::string, std::string>> observed;
+  for (const auto& obs : f.observations) observed.insert({obs.point, obs.image});
+  constexpr double kMarginPx = 20.0;
+  size_t expected = 0;
+  for (const auto& p : f.points_truth) {
+    for (const auto& e : f.exposures_truth) {
+      Eigen::Vector2d px;
+      const bool inside =
+          f.truth.ProjectToPixel(e.opk_rad, e.center_m, *p.xyz_m, &px) && px.x() >= kMarginPx &&
+          px.y() >= kMarginPx && px.x() <= f.truth.width_px - 1 - kMarginPx &&
+          px.y() <= f.truth.height_px - 1 - kMarginPx;
+      expected += inside;
+      EXPECT_EQ(observed.count({p.id, e.image}), inside ? 1u : 0u) << p.id << " in " << e.image;
+    }
+  }
+  EXPECT_EQ(f.observations.size(), expected);
+  EXPECT_GT(expected, 2000u);  // 2525 with seed 4
+}
+
 }  // namespace
 }  // namespace aerocal::triangulation

@@ -18,6 +18,8 @@
 #include <cmath>
 #include <optional>
 #include <set>
+#include <string_view>
+#include <unordered_map>
 
 namespace aerocal::triangulation {
 namespace {
@@ -239,8 +241,13 @@ void BlockAdjustment::BuildPoints() {
   std::sort(s.point_ids.begin(), s.point_ids.end());
   s.point_ids.erase(std::unique(s.point_ids.begin(), s.point_ids.end()), s.point_ids.end());
   s.points.resize(s.point_ids.size());  // once: the builder keeps pointers into the states
-  for (PointIndex p = 0; p < static_cast<PointIndex>(s.points.size()); ++p)
-    s.points[p].ground = project_.FindPoint(s.point_ids[p]);
+  // Project::FindPoint's first match, without its linear search (quadratic at 180,000 points).
+  std::unordered_map<std::string_view, const GroundPoint*> ground_of_id;
+  for (const auto& g : project_.points) ground_of_id.emplace(g.id, &g);
+  for (PointIndex p = 0; p < static_cast<PointIndex>(s.points.size()); ++p) {
+    const auto ground = ground_of_id.find(s.point_ids[p]);
+    s.points[p].ground = ground == ground_of_id.end() ? nullptr : ground->second;
+  }
   for (const auto& o : s.observations) s.point_of_observation.push_back(s.FindPoint(o.point));
   const int n_exposures = s.index.NumExposures();
   const int n_points = static_cast<int>(s.points.size());

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <map>
 #include <set>
 
 #include "calib/camera/camera_io.h"
@@ -185,8 +186,10 @@ std::vector<GroundPoint> ReadPoints(const std::string& path) {
 
 void ValidateProject(const Project& project) {
   std::set<std::string> images, points;
+  std::map<std::string, std::string> camera_of_image;  // Project::FindExposure's first match
   for (const auto& e : project.exposures) {
     images.insert(e.image);
+    camera_of_image.emplace(e.image, e.camera);
     if (!project.cameras.count(e.camera))
       ThrowInputError({project.exposures_file, e.line},
                       "image " + e.image + " uses unknown camera '" + e.camera + "'");
@@ -195,7 +198,7 @@ void ValidateProject(const Project& project) {
   for (const auto& o : project.observations) {
     if (!images.count(o.image))
       ThrowInputError({project.observations_file, o.line}, "unknown image '" + o.image + "'");
-    const std::string& camera_id = project.FindExposure(o.image)->camera;
+    const std::string& camera_id = camera_of_image.at(o.image);
     const auto rig = project.rigs.find(camera_id);
     if (!o.head.empty() && rig == project.rigs.end())
       ThrowInputError({project.observations_file, o.line},
@@ -210,7 +213,7 @@ void ValidateProject(const Project& project) {
       ThrowInputError({project.observations_file, o.line},
                       "rig '" + camera_id + "' has no head '" + o.head + "'");
     if (!o.subimage.empty()) {
-      const auto& camera = project.cameras.at(project.FindExposure(o.image)->camera);
+      const auto& camera = project.cameras.at(camera_id);
       if (camera.SubimageIndex(o.subimage) < 0)
         ThrowInputError({project.observations_file, o.line},
                         "camera of image " + o.image + " has no sub-image '" + o.subimage + "'");
