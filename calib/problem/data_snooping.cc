@@ -17,6 +17,17 @@ namespace {
 
 constexpr double kUntestable = 1e-6;  // r below: no test can see anything there
 constexpr int kModelErrorTop = 10;    // the largest w examined for a model error
+// A survey is left out only when the block then fits its a-priori sigmas: sigma0 within
+// 1 + kFitBand / sqrt(2 redundancy) (the chi-square band of sigma0, 3 of its sigmas). A model
+// error (a camera the adjustment does not model) leaves sigma0 above it, and then a survey that
+// disagrees cannot be told from the model error: leaving the worst one out would bend the
+// block at that point (the centre point C5 of the conventional simulated flight: 6.6 m).
+constexpr double kFitBand = 3.0;
+// A survey with a direction of redundancy below this alone holds the block there (without it the
+// block is 1 / sqrt(1e-4) = 100 survey sigmas loose at that point): never left out, named. The
+// centre control point of the self-calibrating simulated flight (height r 1.6e-5: c absorbs the
+// block's height there) moved by 10 m when its survey was left out for a wrong X.
+constexpr double kHoldsTheBlock = 1e-4;
 
 bool Contains(const std::vector<std::string>& list, const std::string& s) {
   return std::find(list.begin(), list.end(), s) != list.end();
@@ -97,7 +108,8 @@ class Snooper {
       ids.push_back(id);
       components += static_cast<int>(b_.EvaluateResidual(id).size());
     }
-    if (round == 1) {
+    if (round == 1 && !initialized_) {
+      initialized_ = true;
       out_.n_tested_components = components;
       out_.alpha = o_.alpha;
       out_.alpha0 = o_.alpha / std::max(1, components);
@@ -154,7 +166,9 @@ class Snooper {
           x.component = static_cast<int>(k);
         }
         if (r < o_.min_redundancy) x.w_weak = std::max(x.w_weak, w);
+        x.w_full = std::max(x.w_full, w);
       }
+      x.t_full = x.w_full * x.w_full;
       x.t_joint = x.w_max * x.w_max;
       // An observation of several correlated components (x, y of an image point) is tested as
       // a whole: per-component w of another observation can exceed both of the blundered one's,
@@ -185,12 +199,14 @@ class Snooper {
     const Eigen::MatrixXd q = c.qvv.block(row, row, m, m);
     Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(q);
     const Eigen::VectorXd v = Eigen::Map<const Eigen::VectorXd>(x->v.data(), m);
-    double t_stat = 0.0, w_weak = 0.0;
-    int dof = 0;
+    double t_stat = 0.0, w_weak = 0.0, t_full = 0.0;
+    int dof = 0, dof_full = 0;
     for (int k = 0; k < m; ++k) {
       const double lambda = eig.eigenvalues()(k);
       if (lambda < kUntestable) continue;
       const double u = eig.eigenvectors().col(k).dot(v) / s;
+      t_full += u * u / lambda;
+      ++dof_full;
       if (lambda < o_.min_redundancy) {
         w_weak = std::max(w_weak, std::abs(u) / std::sqrt(lambda));
         continue;
@@ -199,6 +215,8 @@ class Snooper {
       ++dof;
     }
     x->w_weak = std::max(x->w_weak, w_weak);
+    x->w_full = dof_full > 0 ? EquivalentNormal(t_full, dof_full) : 0.0;
+    x->t_full = t_full;
     if (dof == 2)  // the MDBs of a joint test of two components
       for (int k = 0; k < m; ++k)
         if (std::isfinite(x->mdb_sigma[k])) x->mdb_sigma[k] *= out_.delta0_joint / out_.delta0;
@@ -406,6 +424,110 @@ class Snooper {
     return removed;
   }
 
+  // The smallest eigenvalue of Q_ii of `x` (its least redundant direction).
+  static double SmallestCofactor(const Test& t, const TestedObservation& x) {
+    const auto at = t.row_of.find(x.id);
+    if (at == t.row_of.end()) return 0.0;
+    const int m = static_cast<int>(x.v.size());
+    const Eigen::MatrixXd q = t.clusters[at->second.first].qvv.block(at->second.second, at->second.second, m, m);
+    return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(q).eigenvalues()(0);
+  }
+
+  // Surveys first (see the header): leaves out the worst failing report-only observation while
+  // the data single it out and that is what makes the others pass; restores them all when not.
+  void TestSurveys(const SolverOptions& solver) {
+    int n_surveys = 0;
+    for (ResidualId id : AllResiduals())
+      n_surveys += b_.IsActive(id) && Contains(o_.report_only_groups, b_.ResidualGroup(id));
+    const int limit = o_.max_left_out > 0 ? o_.max_left_out : std::max(1, n_surveys / 3);
+    std::vector<TestedObservation> left;
+    std::string stopped;  // why no (further) survey is left out although one fails
+    for (;;) {
+      Test t = Run(1);
+      if (!out_.cofactors_ok) return;
+      const double k = out_.critical_value, s = out_.reference_sigma;
+      std::vector<const TestedObservation*> failing;  // worst first
+      for (const auto& x : t.observations)
+        if (Contains(o_.report_only_groups, x.group) && x.w_full > k) failing.push_back(&x);
+      std::sort(failing.begin(), failing.end(), [](auto* a, auto* b) { return a->t_full > b->t_full; });
+      if (failing.empty()) {  // every remaining survey passes; does the block fit its sigmas?
+        const double band = 1 + kFitBand / std::sqrt(2.0 * std::max(1, out_.report.redundancy));
+        if (!left.empty() && out_.report.sigma0 > band)
+          stopped = "sigma0 " + Fixed(out_.report.sigma0, 3) + " without it is above " +
+                    Fixed(band, 3) + " = 1 + 3 / sqrt(2 r): a model error remains";
+        break;
+      }
+      const TestedObservation& worst = *failing.front();
+      // Surveys the test cannot tell from the worst: chi-square within k^2 (the likelihood ratio
+      // of the two explanations above exp(-k^2 / 2), the test's own tail).
+      std::string group;
+      int together = 0;
+      for (const auto* x : failing)
+        if (worst.t_full - x->t_full <= k * k) {
+          group += (together++ ? ", " : "") + x->label + " (w = " + Fixed(x->w_full, 1) + ")";
+        }
+      double largest_v = 0.0;  // the survey's own residual, in sigmas
+      for (double v : worst.v) largest_v = std::max(largest_v, std::abs(v) / s);
+      const double holds = SmallestCofactor(t, worst);
+      if (together > 1) {
+        stopped = "the surveys " + group +
+                  " fail and the test cannot tell them apart (their chi-square statistics lie "
+                  "within k^2 = " + Fixed(k * k, 1) + "): one of them may be off";
+      } else if (largest_v <= k) {
+        stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
+                  " over all its components) but its residual is " + Fixed(largest_v, 1) +
+                  " sigma, within the critical value: the disagreement lies in a direction the "
+                  "block bends to fit (r < " + Fixed(o_.min_redundancy, 2) +
+                  "), where a model error looks the same";
+      } else if (holds < kHoldsTheBlock) {
+        stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
+                  ") but it alone holds the block in one direction (redundancy " +
+                  Fixed(holds, 6) + "): without it the block would be loose there";
+      } else if (static_cast<int>(left.size()) >= limit) {
+        stopped = worst.label + " still fails (w = " + Fixed(worst.w_full, 1) + "); at most " +
+                  std::to_string(limit) + " of the " + std::to_string(n_surveys) +
+                  " surveys are left out";
+      } else if (const std::string veto = o_.veto ? o_.veto({worst.id}) : std::string();
+                 !veto.empty()) {
+        stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) + "); " + veto;
+      }
+      if (!stopped.empty()) break;
+      left.push_back(worst);
+      b_.RemoveResidual(worst.id);
+      out_.report = b_.Solve(solver);
+      ++out_.solves;
+      if (!out_.report.usable) {
+        stopped = "the block without " + worst.label + " cannot be solved";
+        break;
+      }
+    }
+    if (!stopped.empty()) {  // not a survey blunder the data single out: every survey stays
+      std::string names;
+      for (const auto& x : left) names += (names.empty() ? "" : ", ") + x.label;
+      if (!left.empty()) {
+        for (const auto& x : left) b_.RestoreResidual(x.id);
+        out_.report = b_.Solve(solver);
+        ++out_.solves;
+      }
+      out_.findings.push_back(
+          "surveys tested first: " + stopped +
+          (left.empty() ? std::string()
+                        : "; leaving out " + names + " (w = " + Fixed(left.front().w_full, 1) +
+                              ") did not make the block fit") +
+          ": every survey kept (a survey blunder, or a model error)");
+      return;
+    }
+    for (auto& x : left) {
+      x.verdict = SnoopingVerdict::kLeftOut;
+      x.reason = "suspected blunder in the " + x.group + " observation " + x.label +
+                 " (w = " + Fixed(x.w_full, 1) +
+                 " over all its components): it disagrees with its rays and every other survey "
+                 "passes without it; left out of the adjustment, its rays kept";
+      out_.findings.push_back("left out: " + x.reason);
+      out_.left_out.push_back(x);
+    }
+  }
+
   void Decide(TestedObservation* x, SnoopingVerdict verdict, const std::string& reason) {
     x->verdict = verdict;
     x->reason = reason;
@@ -421,6 +543,7 @@ class Snooper {
   SnoopingOutcome& out_;
   std::set<BlockId> report_only_points_;
   std::map<ResidualId, std::pair<SnoopingVerdict, std::string>> decided_;
+  bool initialized_ = false;  // the critical value is fixed by the first test
 };
 
 }  // namespace
@@ -433,6 +556,7 @@ const char* VerdictName(SnoopingVerdict verdict) {
     case SnoopingVerdict::kVetoed: return "vetoed";
     case SnoopingVerdict::kHeld: return "held";
     case SnoopingVerdict::kLeftAboveCritical: return "left above critical";
+    case SnoopingVerdict::kLeftOut: return "left out";
   }
   return "?";
 }
@@ -483,6 +607,9 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
     out.report = builder.Solve(solver);
     ++out.solves;
   }
+  if (options.leave_out_report_only && !options.report_only_groups.empty() &&
+      out.report.usable && out.report.redundancy > 0)
+    snooper.TestSurveys(solver);
   snooper.CollectReportOnlyPoints();
   int removed_total = 0;
   for (int round = 1; out.report.usable && out.report.redundancy > 0; ++round) {

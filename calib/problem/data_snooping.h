@@ -32,8 +32,29 @@
 //   below group_correlation (strip neighbours at ~0.95) they swap order with the noise often
 //   enough that rejecting the larger alone names a good ray and leaves the blunder untestable.
 // - report_only_groups (e.g. surveyed control coordinates) are tested and named when they fail,
-//   never rejected: a survey that disagrees with its rays is a finding for people, and rejecting
-//   the rays instead would hide it.
+//   never rejected as gross errors of the rays: a survey that disagrees with its rays is a
+//   finding for people, and rejecting the rays instead would hide it.
+// - Surveys first (leave_out_report_only): before the rays are snooped, every report-only
+//   observation is tested over ALL its directions (w_full: the joint chi-square t_full over every
+//   eigen-direction of Q_ii above 1e-6, weakly controlled ones included, as the normal w of the
+//   same tail). A wrong survey pulls the block and large residuals land on the other surveys and
+//   the rays (a corner control point's coordinate has r ~ 0.02 in the direction the block can
+//   bend: 10 m on C1 of the self-calibrating simulated flight gave w 40 on C1, 40 on C4, 32 on
+//   C5, and the per-direction test named C5), but the joint statistic of the wrong one has the
+//   largest non-centrality. The worst failing survey is left out, the block re-solved and the
+//   others re-tested, when the data single it out:
+//   - no other failing survey has t_full within k^2 of it (else the test cannot tell them apart:
+//     the group is named, e.g. opposite corners C1 and C4, or the four corners' heights);
+//   - its own residual exceeds k sigmas (else the disagreement lies in a direction the block
+//     bends to fit, where a model error looks the same: the conventional flight's C5, w 15 from a
+//     residual of 0.8 sigma at r 0.003);
+//   - no direction of it has r < 1e-4 (else it alone holds the block there);
+//   - at most max_left_out are left out, and the caller's veto (datum) agrees.
+//   When every remaining survey then passes and sigma0 lies within 1 + 3 / sqrt(2 r) (a model
+//   error would keep it above), those left out are "suspected control blunders"
+//   (SnoopingOutcome::left_out, verdict "left out"): out of the adjustment, their rays kept and
+//   tested as tie rays. Otherwise every survey is restored (RestoreResidual), the finding names
+//   the worst or the group and why, and the run goes on as below (held, model error suspected).
 // - The veto (caller-supplied) refuses a removal that would destroy the datum (a control point
 //   left with < 2 rays, an exposure left under-determined); vetoed candidates are reported.
 // - The cap: after max_rejections removals the run stops, says so and how many candidates were
@@ -70,6 +91,11 @@ struct SnoopingOptions {
   double min_redundancy = 0.1;   // r below: weakly controlled, never rejected
   double group_correlation = 0.99;  // |rho| above: the observations cannot be told apart
   int max_rejections = 100;         // removals (group members count one each), > 0
+  /// Test the report-only observations first and leave out the failing ones when that makes the
+  /// others pass (see the header); off: they are only named and held.
+  bool leave_out_report_only = false;
+  /// At most this many report-only observations left out; 0: a third of them (at least 1).
+  int max_left_out = 0;
   double model_error_sigma0 = 1.5;  // final sigma0 above: model error suspected
   /// Share of the largest w (at most 10, at least 2) on one point / image / the report-only
   /// points from which a model error is suspected.
@@ -87,7 +113,8 @@ enum class SnoopingVerdict {
   kWeaklyControlled,  // above the critical value on a component with r < min_redundancy
   kVetoed,            // candidate whose removal the caller refused (datum)
   kHeld,              // candidate of a report-only group, or held by a suspected model error
-  kLeftAboveCritical  // candidate left when the rejection cap was reached
+  kLeftAboveCritical, // candidate left when the rejection cap was reached
+  kLeftOut            // report-only observation left out: the others pass without it
 };
 const char* VerdictName(SnoopingVerdict verdict);
 
@@ -107,6 +134,10 @@ struct TestedObservation {
   double t_joint = 0.0;
   int component = -1;              // its largest-w controlled component (for the group)
   double w_weak = 0.0;             // largest w of the weakly controlled components
+  /// The joint statistic over every testable direction (eigenvalue of Q_ii >= 1e-6, weakly
+  /// controlled ones included) as a normal w: the test of a survey (leave_out_report_only).
+  double w_full = 0.0;
+  double t_full = 0.0;  // the chi-square statistic behind w_full
   std::vector<ResidualId> correlated;  // with itself: observations it cannot be told apart from
   int group_size = 1;
   BlockId point = -1;              // its eliminable block, -1 when none
@@ -129,6 +160,8 @@ struct SnoopingOutcome {
   bool cap_reached = false;
   int remaining_above_critical = 0;  // candidates left when the cap was reached
   std::vector<TestedObservation> rejected;  // in order, with their test values
+  /// Report-only observations left out (suspected survey blunders), with the test that failed.
+  std::vector<TestedObservation> left_out;
   /// The final test of every active tested residual (and the vetoed / held candidates).
   std::vector<TestedObservation> tested;
   bool model_error_suspected = false;

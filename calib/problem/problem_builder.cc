@@ -61,6 +61,9 @@ struct ProblemBuilder::Block {
 struct ProblemBuilder::Residual {
   std::string group, label;
   ceres::ResidualBlockId id = nullptr;
+  // Owned here, not by the ceres::Problem, so that a removed residual can be restored.
+  std::unique_ptr<ceres::CostFunction> cost;
+  std::unique_ptr<ceres::LossFunction> loss;
   std::vector<BlockId> blocks;
   int size = 0;
   bool active = true;
@@ -128,10 +131,12 @@ double NormalCriticalValue(double alpha) {
 ProblemBuilder::ProblemBuilder() {
   ceres::Problem::Options options;
   options.enable_fast_removal = true;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   problem_ = std::make_unique<ceres::Problem>(options);
 }
 
-ProblemBuilder::~ProblemBuilder() = default;
+ProblemBuilder::~ProblemBuilder() { problem_.reset(); }  // before the residuals it points to
 
 std::vector<double> ProblemBuilder::ValuesSnapshot() const {
   std::vector<double> out;
@@ -282,7 +287,9 @@ ResidualId ProblemBuilder::AddResidual(const std::string& group,
   r.blocks = blocks;
   r.size = cost->num_residuals();
   r.has_loss = loss_function != nullptr;
-  r.id = problem_->AddResidualBlock(cost.release(), loss_function, pointers);
+  r.cost = std::move(cost);
+  r.loss.reset(loss_function);
+  r.id = problem_->AddResidualBlock(r.cost.get(), loss_function, pointers);
   ++structure_version_;
   for (BlockId b : blocks) ++blocks_[b].num_residuals;
   residuals_.push_back(std::move(r));
@@ -296,6 +303,17 @@ void ProblemBuilder::RemoveResidual(ResidualId id) {
   r.active = false;
   ++structure_version_;
   for (BlockId b : r.blocks) --blocks_[b].num_residuals;
+}
+
+void ProblemBuilder::RestoreResidual(ResidualId id) {
+  Residual& r = residuals_.at(id);
+  if (r.active) return;
+  std::vector<double*> pointers;
+  for (BlockId b : r.blocks) pointers.push_back(blocks_.at(b).values);
+  r.id = problem_->AddResidualBlock(r.cost.get(), r.loss.get(), pointers);
+  r.active = true;
+  ++structure_version_;
+  for (BlockId b : r.blocks) ++blocks_[b].num_residuals;
 }
 
 bool ProblemBuilder::IsActive(ResidualId id) const { return residuals_.at(id).active; }

@@ -213,6 +213,8 @@ class ProblemBuilder {
                          const LossOptions& loss = {});
   /// Removes a residual (e.g. a gross error); its statistics leave the groups.
   void RemoveResidual(ResidualId id);
+  /// Puts a removed residual back (same id, cost and loss): a trial removal undone.
+  void RestoreResidual(ResidualId id);
   bool IsActive(ResidualId id) const;
   int NumActiveResiduals() const;
   const std::string& ResidualGroup(ResidualId id) const;

@@ -424,6 +424,19 @@ void BM_ManyBlunders(benchmark::State& state) {
         static_cast<double>(good_lost_undetermined) / std::max(1, good);
     state.counters["good_lost_share_in_group"] = static_cast<double>(good_lost_in_group) / std::max(1, good);
     state.counters["good_lost_share_other"] = static_cast<double>(good_lost_other) / std::max(1, good);
+    // Issue 18's "good observations lost", both ways: every good observation not used at the end,
+    // and the avoidable ones. Not avoidable: the single good ray of a point whose other rays are
+    // all blunders (one ray of an unknown point has no redundancy: it determines nothing else,
+    // with or without it the other parameters are the same), and the good members of a group
+    // with a blunder whose standardised residuals no test can separate (keeping them keeps the
+    // blunder). A point with 2 good rays and 1 blunder is NOT in the first class.
+    state.counters["good_lost_share_avoidable"] = state.counters["good_lost_share_other"];
+    std::printf("good observations lost: all %.2f %% (%d of %d), avoidable %.2f %% (%d); on points "
+                "left with < 2 good rays %.2f %%, in an inseparable group with a blunder %.2f %%\n",
+                100.0 * good_lost / std::max(1, good), good_lost, good,
+                100.0 * good_lost_other / std::max(1, good), good_lost_other,
+                100.0 * good_lost_undetermined / std::max(1, good),
+                100.0 * good_lost_in_group / std::max(1, good));
     state.counters["worst_rmse_ratio"] = worst_rmse_ratio;
     state.counters["worst_rmse_ratio_controlled"] = worst_rmse_ratio_controlled;
     state.counters["worst_camera_offset_sigmas"] = worst_camera_sigmas;

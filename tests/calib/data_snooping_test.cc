@@ -178,5 +178,73 @@ TEST(DataSnooping, JointNonCentralityGivesThePowerOfTheTwoComponentTest) {
   EXPECT_NEAR(NonCentralityJoint(4.44, 0.8), 5.565, 1e-3);
 }
 
+// A hundred four-ray points (sigma 1; points 0-99) and four more (100-103) that also carry a
+// "survey" of sigma 0.16 (weight 39.06: r = 4 / 43.06 = 0.093, below min_redundancy, as the
+// corner control of a block: a survey blunder there shows mostly on the rays), off by
+// `blunders_m` (value units).
+std::vector<ResidualId> AddSurveyedPoints(Toy* toy, const std::vector<double>& blunders_m) {
+  for (int i = 0; i < 100; ++i) toy->AddPoint({1, 1, 1, 1});
+  std::vector<ResidualId> surveys;
+  for (int i = 0; i < 4; ++i) {
+    toy->AddPoint({1, 1, 1, 1});
+    const double blunder = i < static_cast<int>(blunders_m.size()) ? blunders_m[i] : 0.0;
+    surveys.push_back(toy->builder.AddResidual(kGroupControl,
+                                               PriorCostFunction::Create({blunder}, {0.16}),
+                                               {toy->blocks.back()},
+                                               "survey P" + std::to_string(100 + i)));
+  }
+  return surveys;
+}
+
+TEST(DataSnooping, FailingSurveyIsLeftOutWhenTheOthersFitWithoutIt) {
+  // 80 survey sigmas on P100: its residual 0.093 * 80 = 7.4 a-priori sigmas, 5.4 of s = sigma0
+  // 1.37, is above the critical value (the block cannot bend to fit it), w = 80 sqrt(0.093) / s
+  // = 17.8; the per-direction test called it
+  // weakly controlled (r < 0.1). The survey test leaves it out and its rays stay.
+  Toy toy;
+  const std::vector<ResidualId> surveys = AddSurveyedPoints(&toy, {80 * 0.16});
+  SnoopingOptions options;
+  options.report_only_groups = {kGroupControl};
+  options.leave_out_report_only = true;
+  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, options);
+  ASSERT_EQ(out.left_out.size(), 1u);
+  EXPECT_EQ(out.left_out[0].id, surveys[0]);
+  EXPECT_EQ(out.left_out[0].verdict, SnoopingVerdict::kLeftOut);
+  const double r = 4 / (4 + 1 / (0.16 * 0.16));
+  EXPECT_NEAR(out.left_out[0].redundancy[0], r, 1e-9);
+  // Pope: s = sigma0 = sqrt(80^2 r / 316) (420 observations, 104 unknowns).
+  EXPECT_NEAR(out.left_out[0].w_full, 80 * std::sqrt(r) / std::sqrt(6400 * r / 316), 1e-4);
+  EXPECT_FALSE(toy.builder.IsActive(surveys[0]));
+  for (int k = 1; k < 4; ++k) EXPECT_TRUE(toy.builder.IsActive(surveys[k]));
+  for (const auto& rays : toy.rays)
+    for (ResidualId id : rays) EXPECT_TRUE(toy.builder.IsActive(id));
+  EXPECT_TRUE(out.rejected.empty());
+  EXPECT_NEAR(toy.values[100], 0.0, 1e-9);  // where its rays say, not at the survey
+}
+
+TEST(DataSnooping, SurveysThatDoNotFitWithoutTheWorstAreAllRestored) {
+  // Two surveys off (as a model error moves several): leaving out the worst (at most one of
+  // four, the default third) leaves the other failing, so both are put back, named, and the
+  // rays of their points are not rejected.
+  Toy toy;
+  const std::vector<ResidualId> surveys = AddSurveyedPoints(&toy, {100 * 0.16, -60 * 0.16});
+  SnoopingOptions options;
+  options.report_only_groups = {kGroupControl};
+  options.leave_out_report_only = true;
+  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, options);
+  EXPECT_TRUE(out.left_out.empty());
+  for (ResidualId id : surveys) EXPECT_TRUE(toy.builder.IsActive(id));
+  for (const auto& rays : toy.rays)
+    for (ResidualId id : rays) EXPECT_TRUE(toy.builder.IsActive(id));
+  bool said = false;
+  for (const auto& f : out.findings)
+    said |= f.find("leaving out survey P100") != std::string::npos &&
+            f.find("every survey kept") != std::string::npos;
+  EXPECT_TRUE(said);
+  // Restored: the solution with every survey (P100 pulled to 16 * 39.06 / 43.06).
+  const double p = 1 / (0.16 * 0.16);
+  EXPECT_NEAR(toy.values[100], 16.0 * p / (4 + p), 1e-6);
+}
+
 }  // namespace
 }  // namespace aerocal::calib

@@ -128,6 +128,114 @@ TEST(SnoopingCommand, FlightOnAnUnsolvableBlockExitsThreeNamesTheStepAndWritesNo
   }
 }
 
+// points.csv rows: point,X,Y,Z,sX,sY,sZ,role. Adds `offset_m` to column `column` (1 X, 3 Z) of
+// `point`.
+void ShiftSurvey(const std::string& path, const std::string& point, int column, double offset_m) {
+  std::istringstream in(ReadTextFile(path));
+  std::string line, out;
+  while (std::getline(in, line)) {
+    std::vector<std::string> f;
+    std::stringstream row(line);
+    for (std::string cell; std::getline(row, cell, ',');) f.push_back(cell);
+    if (!f.empty() && f[0] == point) {
+      char value[64];
+      std::snprintf(value, sizeof(value), "%.9f", std::stod(f[column]) + offset_m);
+      f[column] = value;
+    }
+    for (size_t k = 0; k < f.size(); ++k) out += (k ? "," : "") + f[k];
+    out += "\n";
+  }
+  WriteFileAtomically(path, out);
+}
+
+bool RejectedRayOf(const nlohmann::json& result, const std::string& point) {
+  for (const auto& o : result["rejected"])
+    if (o["point"] == point) return true;
+  return false;
+}
+
+bool Said(const nlohmann::json& result, const std::vector<std::string>& words) {
+  for (const auto& f : result["snooping"]["findings"]) {
+    bool all = true;
+    for (const auto& w : words) all &= f.get<std::string>().find(w) != std::string::npos;
+    if (all) return true;
+  }
+  return false;
+}
+
+TEST(SnoopingCommand, ControlSurveyOffIsNamedAndLeftOutNotItsRays) {
+  // Issue 12: a control point whose survey disagrees with its rays is named as a suspected
+  // control blunder, not hidden by rejecting its rays. C1 is a corner of the 5 control points of
+  // the simulated flight: with self-calibration its survey has r 0.02 in X and 0.001 in Z (the
+  // block bends to fit it), so the old per-direction test called it weakly controlled and named
+  // the centre point C5 instead.
+  TempDir dir("aerocal_snoop_control");
+  ASSERT_EQ(RunAerocal("simulate --seed 3 --out " + dir.File("f")).exit_code, 0);
+  const std::string self_calibration = " --self-calibration all";
+  // The oracle: C1's survey removed by hand (C1 a tie point, its rays kept).
+  std::filesystem::copy(dir.File("f"), dir.File("o"));
+  {
+    std::string points = ReadTextFile(dir.File("o/points.csv"));
+    points = std::regex_replace(points, std::regex("\nC1,[^\n]*"), "");
+    WriteFileAtomically(dir.File("o/points.csv"), points);
+  }
+  ASSERT_EQ(RunAerocal("adjust --project " + dir.File("o/project.yaml") + self_calibration +
+                       " --out " + dir.File("oracle.json")).exit_code, 0);
+  const double oracle_rmse_m = ReadJson(dir.File("oracle.json"))["check"]["spatial_rmse_m"];
+  const auto run = [&](int column, double offset_m, const std::string& options) {
+    std::filesystem::remove_all(dir.File("g"));
+    std::filesystem::copy(dir.File("f"), dir.File("g"));
+    ShiftSurvey(dir.File("g/points.csv"), "C1", column, offset_m);
+    return RunAerocal("adjust --project " + dir.File("g/project.yaml") + options + " --out " +
+                      dir.File("r.json"));
+  };
+  {  // 10 m in X: the data single C1 out; its survey leaves the adjustment, its rays stay.
+    const auto r = run(1, 10.0, self_calibration);
+    EXPECT_EQ(r.exit_code, 0) << r.output;  // a named warning; the other surveys fit
+    EXPECT_NE(r.output.find("warning: suspected control blunder: the survey of control point C1"),
+              std::string::npos)
+        << r.output;
+    EXPECT_NE(r.output.find("control C1 LEFT OUT"), std::string::npos) << r.output;
+    const auto j = ReadJson(dir.File("r.json"));
+    ASSERT_EQ(j["control_left_out"].size(), 1u) << r.output;
+    EXPECT_EQ(j["control_left_out"][0]["point"], "C1");
+    // The block without the survey puts C1 where its rays say: the offset comes back to the
+    // block's precision at a corner without its survey (0.5 m; measured 9.77 m).
+    EXPECT_NEAR(-j["control_left_out"][0]["difference_m"][0].get<double>(), 10.0, 0.5);
+    EXPECT_EQ(j["control"]["n"].get<int>(), 4);
+    bool warned = false;
+    for (const auto& w : j["warnings"]) warned |= w["name"] == "control_blunder" && w["subject"] == "C1";
+    EXPECT_TRUE(warned);
+    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+    // The block is the oracle's (measured ratio 1.000; the clean run with C1's right survey has
+    // 0.259 m against 0.369 m: a corner survey the block needs is gone).
+    EXPECT_NEAR(j["check"]["spatial_rmse_m"].get<double>() / oracle_rmse_m, 1.0, 0.05);
+  }
+  {  // 1 m in X: C1 and the opposite corner C4 fail alike; named as a pair, both kept.
+    const auto r = run(1, 1.0, self_calibration);
+    EXPECT_EQ(r.exit_code, 0) << r.output;
+    const auto j = ReadJson(dir.File("r.json"));
+    EXPECT_TRUE(j["control_left_out"].empty());
+    EXPECT_TRUE(Said(j, {"control C1", "control C4", "cannot tell them apart"})) << r.output;
+    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+  }
+  {  // 10 m in Z: the four corners' heights have r 0.001 and fail alike: named as a group.
+    const auto r = run(3, 10.0, self_calibration);
+    const auto j = ReadJson(dir.File("r.json"));
+    EXPECT_TRUE(j["control_left_out"].empty());
+    EXPECT_TRUE(Said(j, {"control C1", "cannot tell them apart"})) << r.output;
+    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+  }
+  {  // Conventional (the simulated camera error is not modelled): C1 is named as the worst, but
+     // without it the other surveys still fail (a model error): every survey is kept.
+    const auto r = run(1, 10.0, "");
+    const auto j = ReadJson(dir.File("r.json"));
+    EXPECT_TRUE(j["control_left_out"].empty());
+    EXPECT_TRUE(Said(j, {"leaving out control C1", "every survey kept"})) << r.output;
+    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+  }
+}
+
 TEST(SnoopingCommand, ExposureLeftOutHasNullSigmasNeverZero) {
   TempDir dir("aerocal_snoop_null");
   ASSERT_EQ(RunAerocal("simulate --seed 2 --out " + dir.File("f")).exit_code, 0);

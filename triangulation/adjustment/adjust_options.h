@@ -28,6 +28,11 @@ struct AdjustOptions {
   /// Data snooping (calib/problem/data_snooping.h) on the image observations; the control
   /// coordinates are tested too and named when their survey disagrees, never rejected.
   bool data_snooping = true;
+  /// With data_snooping: the control surveys are tested first over all their components; the
+  /// worst failing ones are left out (a suspected control blunder, named; its rays kept) when
+  /// that makes every other survey fit, up to a third of them, never below 3 control points
+  /// without GNSS centres. Off: a failing survey is only named and held.
+  bool leave_out_failing_control = true;
   /// Robust start: adjust first with a Cauchy loss on the image observations (scale
   /// `robust_scale_sigma` sigmas), then re-adjust without it from that solution, snooping as set.
   /// For blocks with large gross errors and poor starting values.

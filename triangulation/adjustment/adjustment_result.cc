@@ -431,6 +431,17 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   check["points"] = table(r.check_points);
   j["control"] = control;
   j["check"] = check;
+  j["control_left_out"] = nlohmann::json::array();
+  for (const auto& p : r.control_left_out) {
+    const auto w = r.control_left_out_w.find(p.point);
+    j["control_left_out"].push_back(
+        {{"point", p.point},
+         {"surveyed_m", Vec(p.surveyed_m)},
+         {"adjusted_m", Vec(p.adjusted_m)},
+         {"difference_m", Vec(p.difference_m)},
+         {"rays", p.rays},
+         {"w", w != r.control_left_out_w.end() ? nlohmann::json(w->second) : nlohmann::json()}});
+  }
   if (r.check_controlled) {
     nlohmann::json c = PointStatisticsToJson(*r.check_controlled);
     c["uncontrolled_points"] = nlohmann::json::array();
@@ -535,6 +546,14 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += "frame: " + r.frame + "\n";
   out += "datum: " + r.datum + "\n";
   out += StatisticsLine("control", r.control);
+  for (const auto& p : r.control_left_out)
+    out += StringPrintf("control %s LEFT OUT (suspected control blunder): survey - block without it "
+                        "X %.3f  Y %.3f  Z %.3f m, %d rays kept\n",
+                        p.point.c_str(),
+                        -p.difference_m.x(),
+                        -p.difference_m.y(),
+                        -p.difference_m.z(),
+                        p.rays);
   out += StatisticsLine("check", r.check);
   if (r.check_controlled && r.check_controlled->n < r.check.n) {
     out += StatisticsLine("check*", *r.check_controlled);

@@ -199,6 +199,10 @@ inline constexpr const char* kWarningGroupRms = "group_rms";
 /// The limit of that RMS, in sigmas: with right sigmas a group's RMS is about 1 (up to the
 /// redundancy share), so 3 is far outside any chance.
 inline constexpr double kGroupRmsLimit = 3.0;
+/// Name of the warning for a control point whose survey data snooping left out as a suspected
+/// control blunder (subject: the point id; value: w of its survey test; limit: the critical
+/// value).
+inline constexpr const char* kWarningControlBlunder = "control_blunder";
 
 /// One kWarningGroupRms warning per residual group of `solve` whose RMS exceeds `limit`.
 std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, double limit = kGroupRmsLimit);
@@ -222,6 +226,12 @@ struct AdjustmentResult {
   std::vector<ExposureEstimate> exposures;
   std::vector<PointDifference> control_points, check_points;
   PointStatistics control, check;
+  /// Control points whose survey data snooping left out as a suspected control blunder (it
+  /// disagrees with the point's rays, every other survey fits without it; the rays stay): their
+  /// survey against the position the block gives them without it (not in `control`). JSON
+  /// `control_left_out: [{point, surveyed_m, adjusted_m, difference_m, rays, w}]`.
+  std::vector<PointDifference> control_left_out;
+  std::map<std::string, double> control_left_out_w;  // by point: w of the failed survey test
   /// After snooping: the check statistics over the check points whose rays are all controlled
   /// (PointDifference::uncontrolled empty). `check` stays the statistics of every check point.
   std::optional<PointStatistics> check_controlled;

@@ -3,6 +3,7 @@
 
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/string_printf.h"
 #include "calib/residuals/gnss_prior.h"
 #include "calib/residuals/prior.h"
 #include "calib/residuals/rotation_prior.h"
@@ -95,6 +96,8 @@ struct BlockAdjustment::Storage {
   std::vector<ExposureIndex> exposure_of_observation;
   std::vector<PointIndex> point_of_observation;
   std::map<calib::ResidualId, size_t> observation_of_residual;
+  std::map<calib::ResidualId, PointIndex> control_of_residual;  // surveyed coordinates
+  std::map<PointIndex, double> survey_left_out;  // snooping left it out: w of its test
   std::map<calib::ResidualId, ObservationTest> tests;  // data snooping's last word on each
   std::vector<std::string> notes;
   // The GNSS/IMU platform (Project::platform): lever arm, GNSS time offset (when exposures carry
@@ -360,11 +363,12 @@ void BlockAdjustment::AddPriors() {
     if (state.block < 0 || !state.Control()) continue;
     const Eigen::Vector3d& xyz = *state.ground->xyz_m;
     const Eigen::Vector3d& s = state.ground->sigma_m;
-    builder_.AddResidual(
+    const calib::ResidualId id = builder_.AddResidual(
         calib::kGroupControl,
         calib::PriorCostFunction::Create({xyz.x(), xyz.y(), xyz.z()}, {s.x(), s.y(), s.z()}),
         {state.block},
         "control " + storage_->point_ids[p]);
+    storage_->control_of_residual[id] = p;
   }
   if (options_.use_eo_priors) {
     AddPlatformBlocks();
@@ -606,7 +610,10 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
   // (|v| / s <= reject on every component; ties by the truncated sum of squares), refitted to
   // those rays, judges every ray by its residual there. When two fits with different sets of
   // rays agree equally well, the rays cannot be told apart here: none is excluded, and the final
-  // adjustment's snooping judges them with their correlated group.
+  // adjustment's snooping judges them with their correlated group. A control point keeps the
+  // one-pass cut, except when every one of its rays is beyond it: then its survey is the suspect
+  // (a wrong survey makes all its good rays look like gross errors), and the rays go to the final
+  // adjustment, which tests the survey first.
   std::map<calib::ResidualId, double> judged;  // per-point verdicts: the ray's |v| / s there
   for (const auto& point_rays : rays_of_point) {
     // (a lambda may not capture a structured binding in C++17)
@@ -616,7 +623,15 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
     const bool control = state.Control();
     bool suspect = false;
     for (calib::ResidualId id : rays) suspect |= w_of.at(id) > reject;
-    if (n < 3 || control || !suspect) continue;
+    if (!suspect) continue;
+    if (control) {  // every ray beyond the cut: its survey is suspect, not its rays
+      bool all = n >= 2;
+      for (calib::ResidualId id : rays) all &= w_of.at(id) > reject;
+      if (all)
+        for (calib::ResidualId id : rays) judged[id] = 0.0;  // the final adjustment tests both
+      continue;
+    }
+    if (n < 3) continue;
     Eigen::Vector3d* xyz = &state.xyz;
     const Eigen::Vector3d robust = *xyz;
     const auto judge = [&](const Eigen::Vector3d& at, std::vector<bool>* agree, double* cost) {
@@ -707,7 +722,19 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
                                 ? options_.max_rejections
                                 : std::max(kMinAutomaticCap, tested_images / 10);
   snooping.model_error_sigma0 = options_.model_error_sigma0;
+  snooping.leave_out_report_only = options_.leave_out_failing_control;
+  // Without GNSS centres the surveys hold the datum: at least three control points stay.
+  bool gnss = false;
+  for (const auto& state : st.exposures) gnss |= options_.use_eo_priors && state.exposure->center_sigma_m.has_value();
   snooping.veto = [&](const std::vector<calib::ResidualId>& ids) -> std::string {
+    int surveys = 0, leaving = 0;
+    for (const auto& [id, point] : st.control_of_residual) {
+      surveys += builder_.IsActive(id);
+      leaving += std::find(ids.begin(), ids.end(), id) != ids.end();
+    }
+    if (leaving > 0 && !gnss && surveys - leaving < 3)
+      return "leaving out the survey would leave " + std::to_string(surveys - leaving) +
+             " control point(s) and no GNSS centres: the datum needs 3";
     // Keyed by point index (id order) and by exposure rank (image id order): the first veto
     // found is the one named.
     std::map<PointIndex, int> lose_point;
@@ -739,6 +766,10 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   const calib::SolveReport first = result->solve;
   calib::SnoopingOutcome out =
       calib::SolveWithDataSnooping(builder_, options_.solver, snooping, &first);
+  for (const auto& x : out.left_out) {
+    const auto it = st.control_of_residual.find(x.id);
+    if (it != st.control_of_residual.end()) st.survey_left_out[it->second] = x.w_full;
+  }
   result->solve = out.report;
   if (out.solves > 0) {
     result->solve.iterations += first.iterations;  // the first solve, before snooping
@@ -1047,6 +1078,12 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     d.adjusted_m = state.xyz;
     d.difference_m = state.xyz - d.surveyed_m;
     d.rays = state.rays;
+    const auto left_out = storage_->survey_left_out.find(p);
+    if (left_out != storage_->survey_left_out.end()) {
+      result.control_left_out.push_back(d);
+      result.control_left_out_w[id] = left_out->second;
+      continue;
+    }
     (state.ground->role == PointRole::kControl ? result.control_points : result.check_points)
         .push_back(d);
   }
@@ -1096,6 +1133,25 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
                       " parameter(s) not determinable (" +
                       result.determinability.undetermined.front() + ", ...)");
   result.warnings = GroupRmsWarnings(result.solve);
+  for (const auto& d : result.control_left_out) {
+    const double w = result.control_left_out_w.at(d.point);
+    result.warnings.push_back(
+        {kWarningControlBlunder,
+         d.point,
+         w,
+         result.snooping.critical_value,
+         StringPrintf("suspected control blunder: the survey of control point %s disagrees with its "
+                      "%d rays (w = %.1f > %.2f; survey - block X %.3f Y %.3f Z %.3f m) and every "
+                      "other survey fits without it: its survey is left out of the adjustment, its "
+                      "rays are kept; check its survey",
+                      d.point.c_str(),
+                      d.rays,
+                      w,
+                      result.snooping.critical_value,
+                      -d.difference_m.x(),
+                      -d.difference_m.y(),
+                      -d.difference_m.z())});
+  }
   result.timing.total_s = seconds_since(run_start);
   return result;
 }
