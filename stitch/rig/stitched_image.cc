@@ -97,9 +97,21 @@ StitchedImageReport MakeStitchedImage(const RigConverter& converter,
     std::fill(ones.bytes().begin(), ones.bytes().end(), 0xFF);
     MemoryRaster covered({width, height, 1, 16});
     ResampleVirtualImage(one, {&ones}, &covered, resample, grid);
+    // The projectivity also maps virtual pixels whose ray lies BEHIND the head into its format
+    // (negative depth: far corners of the level image, e.g. a spurious "BD" zone of the uav4
+    // rig); those pixels are not seen by the head. Depth sign: that of the head's centre.
+    const Eigen::Matrix3d homography = HeadFromVirtualHomography(converter, k);
+    const calib::Camera& head_camera = rig.heads[k].camera;
+    const auto centre = converter.VirtualFromHead(
+        k, Eigen::Vector2d(0.5 * (head_camera.width_px - 1), 0.5 * (head_camera.height_px - 1)));
+    const double front =
+        centre ? homography.row(2).dot(Eigen::RowVector3d(centre->x(), centre->y(), 1.0)) : 1.0;
     cv::Mat inside(height, width, CV_8UC1);
     for (int r = 0; r < height; ++r)
-      for (int c = 0; c < width; ++c) inside.at<std::uint8_t>(r, c) = covered.At(c, r) > 32767 ? 255 : 0;
+      for (int c = 0; c < width; ++c) {
+        const double depth = homography.row(2).dot(Eigen::RowVector3d(c, r, 1.0));
+        inside.at<std::uint8_t>(r, c) = covered.At(c, r) > 32767 && depth * front > 0 ? 255 : 0;
+      }
     cv::Mat distance;
     cv::distanceTransform(inside, distance, cv::DIST_L2, 3);
     on[k].value.resize(pixels);
