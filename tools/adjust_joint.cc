@@ -8,6 +8,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/result_file.h"
 #include "tools/command_registry.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
@@ -27,7 +28,7 @@ int FinishAdjust(const triangulation::AdjustmentResult& result,
                  const std::string& write_camera,
                  const std::string& camera_kind,
                  const std::function<void()>& write_cameras) {
-  WriteFileAtomically(out, json.dump(2) + "\n");
+  WriteResult(out, "adjust", json);
   const bool ok = result.valid;
   for (const auto& reason : result.invalid_reasons)
     std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());

@@ -6,6 +6,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
+#include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/certificate_writer.h"
@@ -20,6 +21,7 @@
 #include <map>
 #include <cstdlib>
 #include <filesystem>
+#include <vector>
 
 namespace aerocal::tools {
 namespace {
@@ -53,18 +55,20 @@ nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous
   std::map<std::string, nlohmann::json> old;
   for (const auto& q : previous) old[q.value("quantity", "")] = q;
   for (const auto& q : now) {
-    const std::string name = q["quantity"];
+    const std::string name = q.at("quantity");
     const auto o = old.find(name);
     if (o == old.end()) continue;
-    const double v = q["value"], v_old = o->second["value"];
-    const double u = q["U"].is_number() ? q["U"].get<double>() : NAN;
-    const double u_old = o->second["U"].is_number() ? o->second["U"].get<double>() : NAN;
+    const double v = q.at("value"), v_old = o->second.at("value");
+    const nlohmann::json big_u = q.value("U", nlohmann::json()),
+                         big_u_old = o->second.value("U", nlohmann::json());
+    const double u = big_u.is_number() ? big_u.get<double>() : NAN;
+    const double u_old = big_u_old.is_number() ? big_u_old.get<double>() : NAN;
     const double diff = v - v_old;
     // E_n = |difference| / sqrt(U^2 + U_prev^2) (ISO/IEC 17043 / ISO 13528): <= 1 consistent.
     const double en = std::abs(diff) / std::sqrt(u * u + u_old * u_old);
-    nlohmann::json row = {{"quantity", name}, {"unit", q["unit"]},  {"value", v},
-                          {"previous", v_old}, {"difference", diff}, {"U", q["U"]},
-                          {"U_previous", o->second["U"]},
+    nlohmann::json row = {{"quantity", name}, {"unit", q.value("unit", nlohmann::json())},  {"value", v},
+                          {"previous", v_old}, {"difference", diff}, {"U", big_u},
+                          {"U_previous", big_u_old},
                           {"E_n", std::isfinite(en) ? nlohmann::json(en) : nlohmann::json()}};
     const auto t = tolerances.find(name);
     bool pass;
@@ -112,13 +116,13 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
       {"y0", {"mm", "principal point y"}}};
   std::vector<triangulation::BudgetQuantity> quantities;
   for (const auto& [name, info] : kQuantities) {
-    const auto& sigma = camera["sigma"][name];
+    const nlohmann::json sigma = camera.at("sigma").value(name, nlohmann::json());
     if (!sigma.is_number() || !(sigma.get<double>() > 0)) continue;  // fixed or unknown
     triangulation::BudgetQuantity q;
     q.name = name;
     q.unit = info.first;
     q.description = info.second;
-    q.value = camera["estimated"][name].get<double>();
+    q.value = camera.at("estimated").at(name).get<double>();
     triangulation::UncertaintyComponent a;
     a.source = "adjustment covariance (in-flight self-calibration)";
     a.type = "A";
@@ -138,7 +142,7 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
   int n = 0;
   for (const auto& r : out.value("residuals", nlohmann::json::array()))
     if (r.value("used", true) && r.contains("v_col_px")) {
-      sum2 += std::pow(r["v_col_px"].get<double>(), 2) + std::pow(r["v_row_px"].get<double>(), 2);
+      sum2 += std::pow(r.at("v_col_px").get<double>(), 2) + std::pow(r.at("v_row_px").get<double>(), 2);
       ++n;
     }
   const nlohmann::json format = flight.value("camera_format", nlohmann::json::object());
@@ -202,67 +206,91 @@ nlohmann::json ReadCertificateLab(const std::string& path) {
   return out;
 }
 
+// Runs `read` (typed access into a JSON document); a value of the wrong JSON type or a missing
+// table (nlohmann's exception) is bad input naming the file and option (exit 2, nothing written).
+template <typename Read>
+auto ReadTyped(const std::string& path, const char* option, Read&& read) -> decltype(read()) {
+  try {
+    return read();
+  } catch (const nlohmann::json::exception& e) {
+    throw InputError(path + ": not a result written by aerocal (" + option + "): " + e.what());
+  }
+}
+
 int WriteCertificate(const CertificateArgs& args) {
   CheckOutputFolder(args.out, "--out");
   if (!args.tolerances.empty() && args.previous.empty())
     throw ConfigError("--tolerances needs --previous");
-  nlohmann::json result = ReadJsonFile(args.result);
-  if (result.is_object() && result.value("kind", "") == "flight")
-    result = CalibrateFormOfFlight(result, args.result);
-  if (!result.is_object() || result.value("command", "") != "calibrate" ||
-      !result.contains("calibration"))
-    throw InputError(args.result + ": not a result of `aerocal calibrate` (--result)");
   const nlohmann::json lab = ReadCertificateLab(args.lab);
   const auto tolerances = ReadTolerances(args.tolerances);
-  const nlohmann::json& cal = result["calibration"];
+  // The result of `aerocal calibrate` (kind "adjust", command "calibrate") or of `aerocal flight`.
+  nlohmann::json result = ReadResult(args.result, {"adjust", "flight"}, "`aerocal calibrate`");
   nlohmann::json cert;
-  cert["kind"] = "certificate";
-  cert["lab"] = lab;
-  cert["source"] = args.result;
-  cert["method"] = cal["method"];
-  cert["camera_file"] = cal["camera"];
-  cert["data"] = cal["data"];
-  cert["adjustment"] = {{"sigma0", result["sigma0"]},
-                        {"sigma0_px", result["sigma0_px"]},
-                        {"sigma0_um", result["sigma0_um"]},
-                        {"redundancy", result["redundancy"]},
-                        {"converged", result["converged"]},
-                        {"valid", result.value("valid", false)},
-                        {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
-                        {"warnings", result.value("warnings", nlohmann::json::array())},
-                        {"self_calibration", result.value("self_calibration", nlohmann::json())},
-                        {"rms_px", cal["rms_px"]}};
-  cert["results"] = cal["uncertainty"];
-  cert["interior"] = result["cameras"][0];
-  cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
-  cert["groups"] = cal["groups"];
-  cert["stability"] = cal["stability"];
-  cert["check"] = result["check"];
-  cert["control"] = result["control"];
-  cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
-  cert["opencv"] = cal.value("opencv", nlohmann::json());
-  // Residual vectors (image pixels) for the vector field plot.
-  nlohmann::json residuals = nlohmann::json::array();
-  for (const auto& r : result.value("residuals", nlohmann::json::array()))
-    if (r.value("used", true))
-      residuals.push_back({r["col"], r["row"], r["v_col_px"], r["v_row_px"]});
-  cert["residuals"] = residuals;
+  std::vector<std::string> statements;  // checked before anything is written
+  const bool valid = ReadTyped(args.result, "--result", [&] {
+    if (result.is_object() && result.value("kind", "") == "flight")
+      result = CalibrateFormOfFlight(result, args.result);
+    if (!result.is_object() || result.value("command", "") != "calibrate" ||
+        !result.contains("calibration"))
+      throw InputError(args.result + ": not a result of `aerocal calibrate` (--result)");
+    const nlohmann::json& cal = result["calibration"];
+    cert["kind"] = "certificate";
+    cert["lab"] = lab;
+    cert["source"] = args.result;
+    cert["method"] = cal.at("method");
+    cert["camera_file"] = cal.at("camera");
+    cert["data"] = cal.at("data");
+    cert["adjustment"] = {{"sigma0", result["sigma0"]},
+                          {"sigma0_px", result["sigma0_px"]},
+                          {"sigma0_um", result["sigma0_um"]},
+                          {"redundancy", result["redundancy"]},
+                          {"converged", result["converged"]},
+                          {"valid", result.value("valid", false)},
+                          {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
+                          {"warnings", result.value("warnings", nlohmann::json::array())},
+                          {"self_calibration", result.value("self_calibration", nlohmann::json())},
+                          {"rms_px", cal.at("rms_px")}};
+    cert["results"] = cal.at("uncertainty");
+    cert["interior"] = result["cameras"][0];
+    cert["camera_model"] = result.value("camera_model", nlohmann::json());
+    cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
+    cert["groups"] = cal.at("groups");
+    cert["stability"] = cal.at("stability");
+    cert["check"] = result["check"];
+    cert["control"] = result["control"];
+    cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
+    cert["opencv"] = cal.value("opencv", nlohmann::json());
+    // Residual vectors (image pixels) for the vector field plot.
+    nlohmann::json residuals = nlohmann::json::array();
+    for (const auto& r : result.value("residuals", nlohmann::json::array()))
+      if (r.value("used", true))
+        residuals.push_back({r.at("col"), r.at("row"), r.at("v_col_px"), r.at("v_row_px")});
+    cert["residuals"] = residuals;
+    for (const auto& q : cert["results"]) statements.push_back(q.at("statement").get<std::string>());
+    return cert["adjustment"]["valid"].get<bool>() && cal.at("stability").value("agree", true);
+  });
+  bool comparison_pass = true;
   if (!args.previous.empty()) {
-    const nlohmann::json previous = ReadJsonFile(args.previous);
-    const nlohmann::json* old = Uncertainty(previous);
-    if (!old) throw InputError(args.previous + ": neither a certificate.json nor a calibrate result (--previous)");
-    cert["comparison"] = Compare(cert["results"], *old, tolerances);
-    cert["comparison"]["previous"] = args.previous;
-    if (previous.contains("lab")) cert["comparison"]["previous_certificate"] = previous["lab"]["certificate"];
+    const nlohmann::json previous = ReadResult(args.previous, {"certificate", "adjust"},
+                                               "`aerocal certificate` or `aerocal calibrate`");
+    comparison_pass = ReadTyped(args.previous, "--previous", [&] {
+      const nlohmann::json* old = Uncertainty(previous);
+      if (!old)
+        throw InputError(args.previous + ": neither a certificate.json nor a calibrate result (--previous)");
+      cert["comparison"] = Compare(cert["results"], *old, tolerances);
+      cert["comparison"]["previous"] = args.previous;
+      if (previous.contains("lab"))
+        cert["comparison"]["previous_certificate"] = previous["lab"].at("certificate");
+      return cert["comparison"]["pass"].get<bool>();
+    });
   }
   fs::create_directories(args.out);
   const std::string json_path = (fs::path(args.out) / "certificate.json").string();
-  WriteFileAtomically(json_path, cert.dump(2) + "\n");
+  WriteResult(json_path, "certificate", cert);
   std::printf("certificate data -> %s\n", json_path.c_str());
-  for (const auto& q : cert["results"]) std::printf("  %s\n", q["statement"].get<std::string>().c_str());
+  for (const auto& statement : statements) std::printf("  %s\n", statement.c_str());
   if (cert.contains("comparison"))
-    std::printf("comparison with %s: %s\n", args.previous.c_str(),
-                cert["comparison"]["pass"].get<bool>() ? "pass" : "FAIL");
+    std::printf("comparison with %s: %s\n", args.previous.c_str(), comparison_pass ? "pass" : "FAIL");
   if (!args.no_render) {
     const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
     const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
@@ -274,8 +302,7 @@ int WriteCertificate(const CertificateArgs& args) {
     std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", args.out.c_str(),
                 args.out.c_str());
   }
-  const bool ok = cert["adjustment"]["valid"].get<bool>() && cal["stability"].value("agree", true) &&
-                  (!cert.contains("comparison") || cert["comparison"]["pass"].get<bool>());
+  const bool ok = valid && comparison_pass;
   return ok ? kExitOk : kExitNotConverged;
 }
 

@@ -6,6 +6,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
 #include "tools/board_detection.h"
 #include "tools/camera_formats.h"
@@ -58,6 +59,7 @@ std::map<std::string, std::string> ReadGroups(const std::string& path,
                                               const std::set<std::string>& observed) {
   const CsvTable table = CsvTable::Read(path);
   table.RequireColumns({"image", "group"});
+  table.RejectUnknownColumns({"image", "group"});
   GroupLines out;
   for (const auto& row : table.rows()) {
     const std::string image = table.String(row, "image"), group = table.String(row, "group");
@@ -496,7 +498,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
       std::fprintf(stderr, "camera not written: the result is not valid\n");
     }
     json["calibration"] = cal;
-    WriteFileAtomically(args->out, json.dump(2) + "\n");
+    WriteResult(args->out, "adjust", json);
     for (const auto& reason : r.invalid_reasons)
       std::fprintf(stderr, "calibrate: not valid: %s\n", reason.c_str());
     std::printf("result -> %s\n", args->out.c_str());

@@ -12,11 +12,13 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calib/camera/camera_model_json.h"
 #include "calib/camera/convert_camera.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/log.h"
+#include "calib/core/result_file.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
 
@@ -115,8 +117,10 @@ int RunConvert(const ConvertArgs& a) {
         {"max_inner80", r.residual.max_inner80_px},
         {"points", r.residual.points},
         {"failed_points", r.residual.failed_points}}},
-      {"notes", notes}};
-  if (!a.report.empty()) WriteFileAtomically(a.report, report.dump(2) + "\n");
+      {"notes", notes},
+      {"source_camera_model", calib::CameraModelTableToJson(source.camera.model)},
+      {"camera_model", calib::CameraModelTableToJson(r.camera.model)}};
+  if (!a.report.empty()) WriteResult(a.report, "camera_conversion", report);
   if (!r.acceptable) {
     LogWarning("conversion_residual: " + DescribeConversion(r) + (r.residual.failed_points ? " (" +
                std::to_string(r.residual.failed_points) + " points not invertible)" : "") +

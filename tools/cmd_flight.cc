@@ -9,6 +9,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
+#include "calib/core/result_file.h"
 #include "tools/camera_formats.h"
 #include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
@@ -63,7 +64,7 @@ CommandRun SetupFlight(CLI::App& app) {
     const std::string json_path = (fs::path(args->out) / "result.json").string();
     nlohmann::json document = result.document;
     document["aerocal_version"] = AEROCAL_VERSION;
-    WriteFileAtomically(json_path, document.dump(2) + "\n");
+    WriteResult(json_path, "flight", document);
     // A calibrated camera is written only for a valid flight: a file that exists is one the next
     // flight may use (an old one in the folder is removed, so it cannot pass for this run's).
     const fs::path camera_path = fs::path(args->out) / "camera_calibrated.yaml";

@@ -47,6 +47,7 @@ FrameImages FromImagesOption(const std::string& frame, const std::string& images
 FrameImages FromList(const std::string& list, const calib::Camera& camera) {
   const CsvTable table = CsvTable::Read(list);
   table.RequireColumns({"frame", "subimage", "image"});
+  table.RejectUnknownColumns({"frame", "subimage", "image"});
   const std::filesystem::path dir = std::filesystem::path(list).parent_path();
   FrameImages frames;
   std::map<std::string, std::size_t> index;

@@ -9,17 +9,19 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/result_file.h"
 #include "tools/command_registry.h"
 #include "triangulation/block/block_io.h"
 #include "stitch/image_io/image_io.h"
 #include "triangulation/pushbroom/cloud_control.h"
 #include "triangulation/pushbroom/line_calibration.h"
+#include "triangulation/pushbroom/line_plots.h"
 
 namespace aerocal::tools {
 namespace {
 
 struct CalibrateArgs {
-  std::string camera, pos, observations, points, out, write_camera, lines_csv;
+  std::string camera, pos, observations, points, out, write_camera, lines_csv, plot;
   double sigma_px = 0.3;
   std::string degree = "auto";
   std::string datum = "reference";
@@ -31,6 +33,7 @@ int RunCalibrate(CalibrateArgs& a) {
   CheckOutputFile(a.out, "--out");
   if (!a.write_camera.empty()) CheckOutputFile(a.write_camera, "--write-camera");
   if (!a.lines_csv.empty()) CheckOutputFile(a.lines_csv, "--lines");
+  if (!a.plot.empty()) CheckOutputFile(a.plot, "--plot");
   auto& o = a.options;
   if (a.degree != "auto") {
     const auto d = ParseDouble(a.degree);
@@ -50,8 +53,10 @@ int RunCalibrate(CalibrateArgs& a) {
   const auto points = triangulation::ReadPoints(a.points);
   const auto result =
       triangulation::CalibrateLineCamera(camera, pos, observations, points, o, a.observations);
-  WriteFileAtomically(a.out, triangulation::LineCalibrationToJson(result));
+  WriteResult(a.out, "pushbroom", triangulation::LineCalibrationToJson(result), 1);
   if (!a.lines_csv.empty()) WriteFileAtomically(a.lines_csv, triangulation::LineCorrectionsToCsv(result));
+  if (!a.plot.empty())
+    WriteFileAtomically(a.plot, triangulation::LineCalibrationSvg(result, camera.name + " (" + a.observations + ")"));
   if (!a.write_camera.empty() && result.valid) calib::WriteLineCamera(a.write_camera, result.camera);
   std::printf("pushbroom calibration: %d observations of %d control points, sigma0 %.3f (%.3f px), "
               "redundancy %d, %s\n",
@@ -117,8 +122,9 @@ int RunControl(ControlArgs& a) {
   fs::create_directories(a.out);
   triangulation::WriteLineObservations((fs::path(a.out) / "observations.csv").string(), result.observations);
   triangulation::WritePoints((fs::path(a.out) / "points.csv").string(), result.points);
-  WriteFileAtomically((fs::path(a.out) / "control.json").string(),
-                      triangulation::CloudControlToJson(result, a.options));
+  WriteResult((fs::path(a.out) / "control.json").string(),
+              "pushbroom_control",
+              triangulation::CloudControlToJson(result, a.options));
   if (a.write_l1) stitch::WriteGrayImage((fs::path(a.out) / "l1.png").string(), result.l1.image);
   std::printf("cloud control: L1 image %d x %d cells of %.3f m at Z = %.2f m, %d interest points, "
               "%d matches, %zu control points (dropped: %d fewer than two matches, %d gross errors, "
@@ -155,6 +161,9 @@ CommandRun Setup(CLI::App& app) {
   cal->add_option("--write-camera", args->write_camera,
                   "The updated camera file (written only when the result is valid)");
   cal->add_option("--lines", args->lines_csv, "Per-line corrections with sigmas (CSV)");
+  cal->add_option("--plot", args->plot,
+                  "SVG: per sub-camera the errors along and across track against the detector with "
+                  "the fitted polynomial and its sigma band");
   cal->add_option("--sigma-px", args->sigma_px, "Image sigma where observations.csv gives none, px");
   cal->add_option("--node-spacing", o.node_spacing_lines, "Spline nodes every N lines, >= 1");
   cal->add_option("--degree", args->degree, "Detector polynomial degree: auto (Wald test) or 0 .. 5");

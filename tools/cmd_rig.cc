@@ -16,10 +16,12 @@
 
 #include <nlohmann/json.hpp>
 
+#include "calib/camera/camera_model_json.h"
 #include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/result_file.h"
 #include "stitch/rig/error_analysis.h"
 #include "stitch/rig/error_analysis_json.h"
 #include "stitch/resample/tiff_raster.h"
@@ -74,6 +76,14 @@ double FlyingHeight(const calib::Rig& rig, double given_m, const std::string& fi
 std::string PlotScript() {
   if (const char* env = std::getenv("AEROCAL_RIG_PLOT_SCRIPT")) return env;
   return (fs::path(AEROCAL_REPORT_SCRIPT).parent_path() / "rig_error_plots.py").string();
+}
+
+// The camera model of each head with its parameter table, keyed by head id (`camera_models` of
+// the rig result documents).
+nlohmann::json HeadCameraModels(const calib::Rig& rig) {
+  nlohmann::json models = nlohmann::json::object();
+  for (const auto& head : rig.heads) models[head.id] = calib::CameraModelTableToJson(head.camera.model);
+  return models;
 }
 
 int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
@@ -162,15 +172,16 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
     if (!files.histogram_csv.empty()) files.histogram_png = stem + "_histogram.png";
     if (!files.bound_map_csv.empty()) files.bound_map_png = stem + "_bound_map.png";
   }
-  const nlohmann::json doc = stitch::ErrorAnalysisToJson(rig, height_m, limits, target, grid.get(),
-                                                         args.relief_m, files);
+  nlohmann::json doc = stitch::ErrorAnalysisToJson(rig, height_m, limits, target, grid.get(),
+                                                   args.relief_m, files);
+  doc["camera_models"] = HeadCameraModels(rig);
   const fs::path folder = out.parent_path();
   if (!files.histogram_csv.empty())
     WriteFileAtomically((folder / files.histogram_csv).string(),
                         stitch::HistogramCsv(*target.monte_carlo, args.bins));
   if (!files.bound_map_csv.empty())
     WriteFileAtomically((folder / files.bound_map_csv).string(), stitch::BoundMapCsv(rig, *grid));
-  WriteFileAtomically(args.out, doc.dump(2) + "\n");
+  WriteResult(args.out, "rig_error_analysis", doc);
 
   // Summary for people.
   std::printf("conversion error at virtual pixel (%.2f, %.2f) = head %s pixel (%.2f, %.2f), "
@@ -508,6 +519,7 @@ int RunStitch(const StitchArgs& args) {
   const stitch::RigStitchResult result = stitch::SelfCalibrateRigStitching(
       rig, in.exposures, in.ties, in.observations, positions, options);
   nlohmann::json json = stitch::RigStitchToJson(rig, options, result, sources);
+  json["camera_models"] = HeadCameraModels(rig);
   std::fputs(stitch::FormatRigStitchSummary(options, result, sources).c_str(), stdout);
   if (!args.images.empty()) {
     if (result.failures.empty())
@@ -515,7 +527,7 @@ int RunStitch(const StitchArgs& args) {
     else
       std::fprintf(stderr, "error: no stitched images: the self-calibration is not valid\n");
   }
-  WriteFileAtomically(args.out, json.dump(2) + "\n");
+  WriteResult(args.out, "rig_stitch", json);
   if (result.failures.empty()) return kExitOk;
   for (const auto& f : result.failures) std::fprintf(stderr, "error: %s\n", f.c_str());
   std::fprintf(stderr, "error: %s written with valid: false\n", args.out.c_str());
@@ -540,6 +552,7 @@ int RunDesign(const DesignArgs& args) {
   const calib::VirtualCamera& v = rig.virtual_camera;
   nlohmann::json doc;
   doc["kind"] = "rig_design";
+  doc["camera_models"] = HeadCameraModels(rig);
   doc["camera"] = args.camera;
   doc["height_m"] = height_m;
   doc["virtual_gsd_m"] = d.virtual_gsd_m;
@@ -584,7 +597,7 @@ int RunDesign(const DesignArgs& args) {
         {{"name", s.name}, {"zone", s.zone}, {"virtual_px", PointJson(s.virtual_px)}});
   doc["plot_svg"] = args.svg.empty() ? nlohmann::json() : nlohmann::json(args.svg);
   if (!args.svg.empty()) WriteFileAtomically(args.svg, stitch::RigDesignSvg(rig, d));
-  if (!args.out.empty()) WriteFileAtomically(args.out, doc.dump(2) + "\n");
+  if (!args.out.empty()) WriteResult(args.out, "rig_design", doc);
 
   std::printf("rig %s at H = %g m (virtual GSD %.4f m)\n", rig.name.c_str(), height_m,
               d.virtual_gsd_m);
@@ -629,7 +642,7 @@ CommandRun Setup(CLI::App& app) {
                  "COL,ROW: a virtual pixel, analysed in the first non-reference head that sees it");
   ea->add_option("--grid", args->grid, "N: an N x N grid of virtual pixels (bound map)");
   ea->add_option("--samples", args->samples, "Monte-Carlo samples per target (0: none)");
-  ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)");
+  ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)")->check(SeedCheck());
   ea->add_option("--bins", args->bins, "Histogram bins");
   ea->add_option("--relief-m", args->relief_m,
                  "Relief (m off the plane) whose displacement between heads is reported");

@@ -139,7 +139,7 @@ CommandRun SetupSimulate(CLI::App& app) {
   auto args = std::make_shared<Args>();
   auto& o = args->options;
   app.add_option("--out", args->out, "Output folder (created; files replaced atomically)")->required();
-  app.add_option("--seed", args->seed, "Random seed (the same seed gives the same files)");
+  app.add_option("--seed", args->seed, "Random seed (the same seed gives the same files)")->check(SeedCheck());
   app.add_option("--exposures", o.exposures, "Number of exposures (spread over the strips), 2..20000")->check(CLI::Range(2, 20000));
   app.add_option("--strips", o.strips, "Number of east-west strips, 1..1000")->check(CLI::Range(1, 1000));
   app.add_option("--height-m", o.flying_height_m, "Flying height above the mean terrain, 1..100000 m")->check(CLI::Range(1.0, 1e5));

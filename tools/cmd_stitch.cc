@@ -8,6 +8,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
+#include "calib/core/result_file.h"
 #include "stitch/adjustment/flight_stability.h"
 #include "stitch/io/stitch_result_json.h"
 #include "tools/command_registry.h"
@@ -86,7 +87,7 @@ int RunStitch(const StitchArgs& args) {
   const stitch::BatchResult result = stitch::RunStitchBatch(camera, frames, options, &progress);
   progress.Finish();
   const nlohmann::json doc = stitch::StitchResultToJson(result, options);
-  WriteFileAtomically(args.out, doc.dump(2) + "\n");
+  WriteResult(args.out, "stitch", doc);
   PrintSummary(result, args.out);
   return doc.at("converged").get<bool>() ? kExitOk : kExitNotConverged;
 }

@@ -7,6 +7,8 @@
 // Throwing aerocal::InputError / ConfigError gives exit 2 with "error: FILE:LINE: ..." on stderr.
 #pragma once
 
+#include <cerrno>
+#include <cstdlib>
 #include <functional>
 #include <string>
 #include <vector>
@@ -19,6 +21,20 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitInternal = 1;
 inline constexpr int kExitBadInput = 2;
 inline constexpr int kExitNotConverged = 3;
+
+/// Check of a random seed option: decimal digits only, within 0 .. 2^64 - 1 (CLI11 itself turns
+/// "-1" into 2^64 - 1 and accepts a value past 2^64).
+inline CLI::Validator SeedCheck() {
+  return CLI::Validator(
+      [](std::string& text) -> std::string {
+        errno = 0;
+        if (text.empty() || text.find_first_not_of("0123456789") != std::string::npos ||
+            (std::strtoull(text.c_str(), nullptr, 10), errno == ERANGE))
+          return "must be an integer within 0 .. 18446744073709551615 (got '" + text + "')";
+        return "";
+      },
+      "UINT64");
+}
 
 using CommandRun = std::function<int()>;
 using CommandSetup = std::function<CommandRun(CLI::App& app)>;

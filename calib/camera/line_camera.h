@@ -60,6 +60,9 @@ struct LineCamera {
   /// Calibration: a table (size N each, or both empty) or polynomials (one per range).
   std::vector<double> dx_mm, dy_mm;
   std::vector<LinePolynomial> calibration;
+  /// The file wrote the line along its camera y axis (`line_axis: y`, the patent's convention);
+  /// the values above are converted to ours at the reader and back at the writer.
+  bool file_line_along_y = false;
 
   /// Index of the sub-camera (or polynomial range) holding detector position i (rounded to the
   /// nearest detector); -1 when outside 0 .. N-1. Without sub-cameras: 0.

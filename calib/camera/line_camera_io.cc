@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
@@ -42,6 +43,30 @@ std::vector<double> ReadNumbers(const YAML::Node& node, const std::string& file,
   return values;
 }
 
+// The patent's line camera frame (line along its y axis) from ours (line along x): a rotation
+// by +90 deg about z, x_file = -y, y_file = x (a proper rotation: z and the focal plane stay).
+Eigen::Matrix3d FileFromOurs() {
+  Eigen::Matrix3d r;
+  r << 0, -1, 0, 1, 0, 0, 0, 0, 1;
+  return r;
+}
+
+// Converts the camera between the file's frame (line along y) and ours: `to_ours` true at the
+// reader. Mount: camera -> body, so M_ours = M_file R; a sub-camera's mount maps its frame into
+// the virtual camera's, both rotated: R^T M R. Calibration: dx = dy_file, dy = -dx_file.
+void ConvertLineAxis(LineCamera* camera, bool to_ours) {
+  const Eigen::Matrix3d r = to_ours ? FileFromOurs() : Eigen::Matrix3d(FileFromOurs().transpose());
+  camera->mount_rad = OpkFromRotation(RotationFromOpk(camera->mount_rad) * r);
+  for (auto& s : camera->subcameras)
+    s.mount_rad = OpkFromRotation(r.transpose() * RotationFromOpk(s.mount_rad) * r);
+  const auto swap = [to_ours](std::vector<double>* x, std::vector<double>* y) {
+    std::swap(*x, *y);                      // to ours: x = y_file, y = x_file ...
+    for (double& v : to_ours ? *y : *x) v = -v;  // ... then y = -x_file (back: x_file = -y)
+  };
+  swap(&camera->dx_mm, &camera->dy_mm);
+  for (auto& p : camera->calibration) swap(&p.dx, &p.dy);
+}
+
 void EmitVector3(YAML::Emitter& out, const std::string& key, const Eigen::Vector3d& v) {
   out << YAML::Key << key << YAML::Value << YAML::Flow << YAML::BeginSeq << v[0] << v[1] << v[2]
       << YAML::EndSeq;
@@ -58,7 +83,7 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
   if (!line || !line.IsMap())
     ThrowInputError(WhereIs(line ? line : root, file), "a line-camera file needs a 'line' map");
   RejectUnknownKeys(line, {"detectors", "pitch_mm", "c", "mount_deg", "lever_arm_m", "subcameras",
-                           "dx_mm", "dy_mm", "calibration"},
+                           "dx_mm", "dy_mm", "calibration", "line_axis"},
                     file);
   for (const char* key : {"detectors", "pitch_mm", "c"})
     if (!line[key]) ThrowInputError(WhereIs(line, file), std::string("line: missing ") + key);
@@ -166,6 +191,13 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
                                               std::to_string(next - 1) + ", expected " +
                                               std::to_string(camera.detectors - 1));
   }
+  if (const YAML::Node& axis = line["line_axis"]) {
+    const std::string value = YamlString(axis, file, "line.line_axis");
+    if (value != "x" && value != "y")
+      ThrowInputError(WhereIs(axis, file), "line.line_axis must be x or y (got " + value + ")");
+    camera.file_line_along_y = value == "y";
+    if (camera.file_line_along_y) ConvertLineAxis(&camera, true);
+  }
   camera.Validate(file);  // the design geometry (every detector looks forward)
   return camera;
 }
@@ -174,7 +206,9 @@ LineCamera ReadLineCamera(const std::string& path) {
   return ParseLineCamera(LoadYamlFile(path), path);
 }
 
-std::string LineCameraToYaml(const LineCamera& camera) {
+std::string LineCameraToYaml(const LineCamera& ours) {
+  LineCamera camera = ours;
+  if (camera.file_line_along_y) ConvertLineAxis(&camera, false);
   const double deg = 180.0 / M_PI;
   YAML::Emitter out;
   out.SetDoublePrecision(17);
@@ -184,6 +218,7 @@ std::string LineCameraToYaml(const LineCamera& camera) {
   out << YAML::Key << "detectors" << YAML::Value << camera.detectors;
   out << YAML::Key << "pitch_mm" << YAML::Value << camera.pitch_mm;
   out << YAML::Key << "c" << YAML::Value << camera.c_mm;
+  if (camera.file_line_along_y) out << YAML::Key << "line_axis" << YAML::Value << "y";
   EmitVector3(out, "mount_deg", camera.mount_rad * deg);
   EmitVector3(out, "lever_arm_m", camera.lever_arm_m);
   if (!camera.subcameras.empty()) {

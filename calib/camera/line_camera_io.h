@@ -5,6 +5,9 @@
 //     detectors: 900            # N, 1 .. 1e6
 //     pitch_mm: 0.01            # 1e-5 .. 1
 //     c: 8.5                    # principal distance, (0, 1e4] mm
+//     line_axis: x              # optional: y = the values below are written with the line along
+//                               # the camera's y axis (the patent's convention; converted to ours
+//                               # at the reader: x = y_file, y = -x_file, and back at the writer)
 //     mount_deg: [0, 0, 0]      # camera -> body, omega phi kappa, |.| <= 360
 //     lever_arm_m: [0, 0, 0]    # camera centre in the body frame, |.| <= 1000
 //     subcameras:               # optional (ours): the physical line cameras, in detector order

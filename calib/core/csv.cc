@@ -1,5 +1,6 @@
 #include "calib/core/csv.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -127,6 +128,15 @@ std::optional<double> CsvTable::OptionalBounded(const Row& row, const std::strin
 void CsvTable::RequireColumns(const std::vector<std::string>& names) const {
   for (const auto& name : names)
     if (!HasColumn(name)) ThrowInputError({file_, header_line_}, "missing column '" + name + "'");
+}
+
+void CsvTable::RejectUnknownColumns(const std::vector<std::string>& known) const {
+  for (const std::string& name : header_) {
+    if (std::find(known.begin(), known.end(), name) != known.end()) continue;
+    std::string list;
+    for (const std::string& k : known) list += (list.empty() ? "" : ", ") + k;
+    ThrowInputError({file_, header_line_}, "unknown column '" + name + "' (known: " + list + ")");
+  }
 }
 
 std::string CsvTable::String(const Row& row, const std::string& column) const {

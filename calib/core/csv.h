@@ -30,6 +30,10 @@ class CsvTable {
   bool HasColumn(const std::string& name) const { return columns_.count(name) > 0; }
   /// Throws InputError("FILE:HEADER_LINE: missing column NAME") when absent.
   void RequireColumns(const std::vector<std::string>& names) const;
+  /// Throws InputError("FILE:HEADER_LINE: unknown column 'NAME' (known: ...)") for a header column
+  /// not in `known` (issue 12: a misspelt optional column, `vY_` for `vY`, is refused by name,
+  /// never read as an absent one).
+  void RejectUnknownColumns(const std::vector<std::string>& known) const;
 
   SourceRef Where(const Row& row) const { return {file_, row.line}; }
   /// Raw string of a column (empty when the column is absent or the field is empty).

@@ -470,13 +470,19 @@ double NonCentralityJoint(double critical_value, double power) {
 
 SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
                                       const SolverOptions& solver,
-                                      const SnoopingOptions& options) {
+                                      const SnoopingOptions& options,
+                                      const SolveReport* solved) {
   AEROCAL_CHECK(options.alpha > 0 && options.alpha < 1) << "snooping alpha " << options.alpha;
   AEROCAL_CHECK(options.power > 0.5 && options.power < 1) << "snooping power " << options.power;
   AEROCAL_CHECK(options.max_rejections > 0) << "max_rejections " << options.max_rejections;
   SnoopingOutcome out;
   Snooper snooper(builder, options, &out);
-  out.report = builder.Solve(solver);
+  if (solved) {
+    out.report = *solved;
+  } else {
+    out.report = builder.Solve(solver);
+    ++out.solves;
+  }
   snooper.CollectReportOnlyPoints();
   int removed_total = 0;
   for (int round = 1; out.report.usable && out.report.redundancy > 0; ++round) {
@@ -519,6 +525,7 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
       break;
     }
     out.report = builder.Solve(solver);
+    ++out.solves;
   }
   return out;
 }

@@ -125,6 +125,7 @@ struct SnoopingOutcome {
   bool cofactors_ok = true;  // false: nothing could be tested (cofactor_message says why)
   std::string cofactor_message;
   int rounds = 0;
+  int solves = 0;  // solves made by snooping (0: `report` is the caller's `solved`)
   bool cap_reached = false;
   int remaining_above_critical = 0;  // candidates left when the cap was reached
   std::vector<TestedObservation> rejected;  // in order, with their test values
@@ -137,9 +138,13 @@ struct SnoopingOutcome {
 };
 
 /// Solves, snoops as described above, returns the final report and every verdict.
+/// `solved`: the report of a solve the caller just made on `builder` at its current values (the
+/// first solve is then skipped; re-solving a converged problem costs a factorisation and moves
+/// nothing beyond the solver tolerance); null: solve first.
 SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
                                       const SolverOptions& solver,
-                                      const SnoopingOptions& options);
+                                      const SnoopingOptions& options,
+                                      const SolveReport* solved = nullptr);
 
 /// delta0 = k + z(power): the non-centrality a blunder needs to be found with that power.
 double NonCentrality(double critical_value, double power);

@@ -64,6 +64,19 @@ struct ProblemBuilder::Residual {
   std::vector<BlockId> blocks;
   int size = 0;
   bool active = true;
+  bool has_loss = false;
+};
+
+struct ProblemBuilder::Factorized {
+  long long structure_version = -1;
+  bool loss_applied = false;  // a loss function was applied to the Jacobian
+  int max_dense = 0;          // max_dense_parameters of the inverse
+  std::vector<double> values;
+  std::vector<BlockId> free_blocks;
+  std::vector<int> first_row;
+  std::unique_ptr<internal::SchurComplement> schur;
+  internal::SelectedInverse inverse;
+  bool inverse_ok = false;
 };
 
 const ResidualGroupStats* SolveReport::Group(const std::string& name) const {
@@ -120,6 +133,40 @@ ProblemBuilder::ProblemBuilder() {
 
 ProblemBuilder::~ProblemBuilder() = default;
 
+std::vector<double> ProblemBuilder::ValuesSnapshot() const {
+  std::vector<double> out;
+  for (const Block& b : blocks_) out.insert(out.end(), b.values, b.values + b.size);
+  return out;
+}
+
+void ProblemBuilder::ReleaseFactorized() const { factorized_.reset(); }
+
+const ProblemBuilder::Factorized* ProblemBuilder::Factorize(bool apply_loss,
+                                                            int max_dense_parameters) const {
+  // With no loss function on an active residual, applying the loss changes nothing.
+  bool any_loss = false;
+  for (const Residual& r : residuals_) any_loss = any_loss || (r.active && r.has_loss);
+  const bool loss_applied = apply_loss && any_loss;
+  std::vector<double> values = ValuesSnapshot();
+  if (factorized_ && factorized_->structure_version == structure_version_ &&
+      factorized_->loss_applied == loss_applied && factorized_->values == values &&
+      ((factorized_->inverse_ok && !factorized_->inverse.singular()) ||
+       factorized_->max_dense == max_dense_parameters))
+    return factorized_.get();
+  factorized_.reset();
+  auto f = std::make_unique<Factorized>();
+  f->schur = BuildSchurComplement(loss_applied, &f->free_blocks, &f->first_row);
+  if (!f->schur) return nullptr;
+  f->structure_version = structure_version_;
+  f->loss_applied = loss_applied;
+  f->max_dense = max_dense_parameters;
+  f->values = std::move(values);
+  f->inverse_ok =
+      f->inverse.Compute(f->schur->s_lower(), dense_inverse_limit_, max_dense_parameters);
+  factorized_ = std::move(f);
+  return factorized_.get();
+}
+
 ceres::Problem& ProblemBuilder::problem() { return *problem_; }
 
 BlockId ProblemBuilder::AddBlock(const std::string& name,
@@ -145,6 +192,7 @@ BlockId ProblemBuilder::AddBlock(const std::string& name,
   block_by_name_[name] = id;
   block_by_pointer_[values] = id;
   problem_->AddParameterBlock(values, size);
+  ++structure_version_;
   return id;
 }
 
@@ -169,17 +217,20 @@ BlockId ProblemBuilder::FindBlock(const std::string& name) const {
 }
 
 void ProblemBuilder::FixBlock(BlockId id) {
+  ++structure_version_;
   blocks_.at(id).constant = true;
   problem_->SetParameterBlockConstant(blocks_[id].values);
 }
 
 void ProblemBuilder::FreeBlock(BlockId id) {
+  ++structure_version_;
   Block& b = blocks_.at(id);
   b.constant = std::all_of(b.entry_fixed.begin(), b.entry_fixed.end(), [](bool f) { return f; });
   if (!b.constant) problem_->SetParameterBlockVariable(b.values);
 }
 
 void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
+  ++structure_version_;
   Block& b = blocks_.at(id);
   AEROCAL_CHECK(!b.rotation || entries.empty() || static_cast<int>(entries.size()) == b.size)
       << "rotation block " << b.name << " is fixed as a whole or not at all";
@@ -230,7 +281,9 @@ ResidualId ProblemBuilder::AddResidual(const std::string& group,
   r.label = label;
   r.blocks = blocks;
   r.size = cost->num_residuals();
+  r.has_loss = loss_function != nullptr;
   r.id = problem_->AddResidualBlock(cost.release(), loss_function, pointers);
+  ++structure_version_;
   for (BlockId b : blocks) ++blocks_[b].num_residuals;
   residuals_.push_back(std::move(r));
   return static_cast<ResidualId>(residuals_.size() - 1);
@@ -241,6 +294,7 @@ void ProblemBuilder::RemoveResidual(ResidualId id) {
   if (!r.active) return;
   problem_->RemoveResidualBlock(r.id);
   r.active = false;
+  ++structure_version_;
   for (BlockId b : r.blocks) --blocks_[b].num_residuals;
 }
 
@@ -312,6 +366,7 @@ bool ProblemBuilder::UpdateManifolds() {
   // Tangent scaling: unit Jacobian columns at the current values (scaled_subset_manifold.h).
   // One manifold per block: a new one only when its free entries change (Ceres keeps every
   // manifold it was given until the problem dies), otherwise rescaled in place.
+  ++structure_version_;  // the scales change the tangent space of a kept factorisation
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   for (BlockId id : free_blocks) {
     Block& b = blocks_[id];
@@ -360,6 +415,7 @@ bool ProblemBuilder::UpdateManifolds() {
 
 SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
+  ReleaseFactorized();  // stale after the solve; its memory is the solver's now
   SolveReport report;
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   if (!UpdateManifolds())
@@ -558,13 +614,15 @@ ObservationCofactors ProblemBuilder::ComputeObservationCofactors(
                                                  std::numeric_limits<double>::quiet_NaN());
     return out;
   };
-  std::vector<BlockId> free_blocks;
-  std::vector<int> first_row;
-  const auto schur = BuildSchurComplement(false, &free_blocks, &first_row);
-  if (!schur) return not_computed("the residuals cannot be evaluated at the current values");
-  internal::SelectedInverse inverse;
-  if (!inverse.Compute(schur->s_lower(), dense_inverse_limit_, max_dense_parameters)) {
+  const Factorized* factorized = Factorize(false, max_dense_parameters);
+  if (!factorized) return not_computed("the residuals cannot be evaluated at the current values");
+  const std::vector<BlockId>& free_blocks = factorized->free_blocks;
+  const std::vector<int>& first_row = factorized->first_row;
+  const internal::SchurComplement* schur = factorized->schur.get();
+  const internal::SelectedInverse& inverse = factorized->inverse;
+  if (!factorized->inverse_ok) {
     std::string why = inverse.message();
+    ReleaseFactorized();  // before the null-space search builds its own system
     const std::vector<std::string> null_space = NullSpaceParameters(3000);
     for (size_t i = 0; i < null_space.size() && i < 20; ++i)
       why += (i ? ", " : " (null space: ") + null_space[i];
@@ -734,6 +792,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
         pairs.emplace_back(std::min(a, b), std::max(a, b));
     }
   auto fail = [&](const std::string& why) {
+    ReleaseFactorized();
     report.ok = false;
     report.undetermined = NullSpaceParameters(3000);
     report.message = why;
@@ -784,13 +843,14 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     }
   } else {
     // Points eliminated, S factorised, S^-1 on the pattern of its factor (normal_equations.h).
-    std::vector<BlockId> order;
-    std::vector<int> first_row;
-    const auto schur = BuildSchurComplement(true, &order, &first_row);
-    if (!schur) return fail("the residuals cannot be evaluated at the current values");
-    internal::SelectedInverse inverse;
-    if (!inverse.Compute(schur->s_lower(), dense_inverse_limit_, 0) || inverse.singular())
-      return fail(singular_message);
+    // The factorisation of the last redundancy numbers when nothing changed since (snooping's
+    // final test): one factorisation and selected inversion for both. Released at the end.
+    const Factorized* factorized = Factorize(true, 0);
+    if (!factorized) return fail("the residuals cannot be evaluated at the current values");
+    const std::vector<BlockId>& order = factorized->free_blocks;
+    const internal::SchurComplement* schur = factorized->schur.get();
+    const internal::SelectedInverse& inverse = factorized->inverse;
+    if (!factorized->inverse_ok || inverse.singular()) return fail(singular_message);
     std::map<BlockId, int> index;  // block -> index in the Schur system
     for (size_t b = 0; b < order.size(); ++b) index[order[b]] = static_cast<int>(b);
     bool any_point = false;
@@ -830,6 +890,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
       if (a == b && la.own.size() > 0) q += la.own;
       report.blocks[{a, b}] = s2 * la.plus * q * lb.plus.transpose();
     }
+    ReleaseFactorized();
   }
   // Rotation blocks are reported in omega, phi, kappa: C_opk = J C_q J^T with J the conversion's
   // Jacobian (calib/camera/rotation.h OpkJacobianOfQuaternion; NaN rows for omega and kappa at

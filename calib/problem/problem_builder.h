@@ -255,7 +255,10 @@ class ProblemBuilder {
   /// Reduced matrices up to `parameters` (count, >= 0; default 300) are inverted densely by
   /// ComputeObservationCofactors / EstimateCovariance, larger ones by the sparse selected
   /// inverse. For tests and benchmarks that compare the two paths on one problem.
-  void SetDenseInverseLimit(int parameters) { dense_inverse_limit_ = parameters; }
+  void SetDenseInverseLimit(int parameters) {
+    dense_inverse_limit_ = parameters;
+    ++structure_version_;
+  }
 
   /// Free parameters (tangent space) and scalar residuals currently in the problem.
   int NumFreeParameters() const;
@@ -280,6 +283,17 @@ class ProblemBuilder {
   /// (-1 when inactive).
   std::unique_ptr<internal::SchurComplement> BuildSchurComplement(
       bool apply_loss, std::vector<BlockId>* free_blocks, std::vector<int>* first_row) const;
+  /// The reduced system with its selected inverse at the current state (values, free entries,
+  /// active residuals, manifold scales). The last one is kept: ComputeObservationCofactors and
+  /// EstimateCovariance at the same state (snooping's final test, then the covariance) share one
+  /// factorisation and selected inversion. A stale one is released before a new one is built,
+  /// so at most one is in memory. nullptr when the residuals cannot be evaluated.
+  struct Factorized;
+  const Factorized* Factorize(bool apply_loss, int max_dense_parameters) const;
+  /// Drops the kept factorisation (its memory).
+  void ReleaseFactorized() const;
+  /// Every parameter value, block after block (the state a kept factorisation belongs to).
+  std::vector<double> ValuesSnapshot() const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,
                                 std::vector<ResidualId>* row_owner) const;
 
@@ -289,6 +303,10 @@ class ProblemBuilder {
   std::map<std::string, BlockId> block_by_name_;
   std::map<const double*, BlockId> block_by_pointer_;
   int dense_inverse_limit_ = 300;
+  /// Bumped by every change of the problem other than parameter values (blocks, residuals,
+  /// fixing, manifold scales at each Solve): part of a kept factorisation's state.
+  long long structure_version_ = 0;
+  mutable std::unique_ptr<Factorized> factorized_;
 };
 
 /// Two-sided standard-normal quantile: z with P(|N(0,1)| > z) = alpha.

@@ -9,6 +9,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
+#include "calib/core/result_file.h"
 #include "stitch/adjustment/mapping_param_names.h"
 
 namespace aerocal::stitch {
@@ -213,7 +214,7 @@ json StitchResultToJson(const BatchResult& result, const BatchOptions& options) 
 
 calib::Camera ApplyStitchResult(const calib::Camera& camera, const std::string& path,
                                 const std::string& frame) {
-  const json doc = ReadJsonFile(path);
+  const json doc = ReadResult(path, {"stitch"}, "`aerocal stitch`");
   const json* source = &doc;
   if (!frame.empty()) {
     source = nullptr;

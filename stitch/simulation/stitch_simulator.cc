@@ -137,6 +137,7 @@ std::vector<StitchObservation> ReadStitchObservations(const std::string& path,
                                                       double default_sigma_px) {
   const CsvTable table = CsvTable::Read(path);
   table.RequireColumns({"frame", "point", "subimage", "u", "v"});
+  table.RejectUnknownColumns({"frame", "point", "subimage", "u", "v", "sigma_px"});
   std::vector<StitchObservation> rows;
   rows.reserve(table.rows().size());
   for (const auto& row : table.rows()) {

@@ -18,6 +18,7 @@
 
 #include "stitch/resample/raster.h"
 #include "tests/bench/discard_sink.h"
+#include "tests/bench/ratio_reporter.h"
 #include "stitch/rig/error_analysis.h"
 #include "stitch/rig/rig_convert.h"
 #include "stitch/rig/self_calibration.h"
@@ -309,29 +310,14 @@ void BM_StitchedPeerRemap(benchmark::State& state) {
 }
 BENCHMARK(BM_StitchedPeerRemap)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 
-// Console output as usual, and the real time per iteration of every run kept for the ratios.
-class RatioReporter : public benchmark::ConsoleReporter {
- public:
-  void ReportRuns(const std::vector<Run>& runs) override {
-    for (const Run& run : runs)
-      if (run.run_type == Run::RT_Iteration) seconds_[run.benchmark_name()] = run.GetAdjustedRealTime();
-    ConsoleReporter::ReportRuns(runs);
-  }
-  std::map<std::string, double> seconds_;
-};
-
 }  // namespace
 }  // namespace aerocal::stitch
 
 int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
-  aerocal::stitch::RatioReporter reporter;
+  aerocal::testing::RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  const auto time_of = [&](const std::string& prefix) {  // "BM_X/0" -> its real time (ms)
-    for (const auto& [name, ms] : reporter.seconds_)
-      if (name.rfind(prefix + "/", 0) == 0 || name == prefix) return ms;
-    return -1.0;
-  };
+  const auto time_of = [&](const std::string& prefix) { return reporter.TimeOf(prefix); };  // ms
   for (const char* arg : {"/0", "/1"}) {
     const double ours = time_of(std::string("BM_RigConvert") + arg);
     const double cv = time_of(std::string("BM_CvRemap") + arg);

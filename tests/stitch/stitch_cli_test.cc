@@ -7,6 +7,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calib/camera/camera_io.h"
+#include "calib/core/result_file.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/simulation/stitch_simulator.h"
 #include "tests/support/test_support.h"
@@ -143,7 +144,8 @@ subimages:
   std::ofstream(tmp.File("camera.yaml")) << yaml;
   const calib::Camera camera = calib::ReadCamera(tmp.File("camera.yaml"));
   // Stitch result: the nominal mappings, II shifted left by half a pixel.
-  nlohmann::json result = {{"kind", "stitch"}, {"subimages", nlohmann::json::array()}};
+  nlohmann::json result = {
+      {"kind", "stitch"}, {"schema_version", aerocal::kResultSchemaVersion}, {"subimages", nlohmann::json::array()}};
   for (const auto& s : camera.subimages) {
     std::vector<double> p = s.params;
     if (s.id == "II") p[2] -= 0.5;

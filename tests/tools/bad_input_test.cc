@@ -260,6 +260,16 @@ void AddGroupColumn(const std::string& tf, const std::string& group_of_all = "",
   WriteLines(tf + "/observations.csv", lines);
 }
 
+// A minimal calibrate result for `certificate`: one uncertainty row, with or without the
+// calibration's stability table.
+std::string CertificateResult(const std::string& uncertainty_row, bool stability = true) {
+  return "{\"kind\": \"adjust\", \"schema_version\": 1, \"command\": \"calibrate\",\n"
+         " \"valid\": true, \"cameras\": [{}],\n"
+         " \"calibration\": {\"method\": {}, \"camera\": {}, \"data\": {}, \"rms_px\": 0.1,"
+         " \"groups\": [],\n  \"uncertainty\": [" + uncertainty_row + "]" +
+         (stability ? ", \"stability\": {}" : "") + "}}\n";
+}
+
 struct Case {
   const char* name;
   // Prepares the files in `dir` and returns the aerocal arguments.
@@ -494,7 +504,8 @@ const std::vector<Case>& Cases() {
        [](const TempDir& d) {
          const auto sim = Flight(d);
          Write(d.File("m.json"),
-               R"({"subimages": [{"id": "I", "model": "affine", "params": [0,0,0,0,0,0]}]})");
+               R"({"kind": "stitch", "schema_version": 1,
+                   "subimages": [{"id": "I", "model": "affine", "params": [0,0,0,0,0,0]}]})");
          return "resample --camera " + sim + "/camera_nominal.yaml --mapping " + d.File("m.json") +
                 " --images I=a.tif --out " + d.File("v.tif");
        },
@@ -1057,7 +1068,81 @@ const std::vector<Case>& Cases() {
          Replace(sim + "/exposures.csv", ",vX,vY,", ",vX,vY_,");
          return AdjustArgs(sim);
        },
-       2, "exposures.csv:2: vX, vY, vZ must all be given or none (m/s)", "a.json"},
+       2, "exposures.csv:1: unknown column 'vY_'", "a.json"},
+      // ---- a misspelt optional column is refused by name at the header's line (never read as
+      // absent: issue 12), in every CSV table a user writes ----
+      {"unknown_column_in_exposures",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/exposures.csv", "kappa\n", "kappa,sx\n");
+         return AdjustArgs(sim);
+       },
+       2, "exposures.csv:1: unknown column 'sx' (known: image, camera,", "a.json"},
+      {"unknown_column_after_comment_lines",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/points.csv", "role\n", "role,note\n");
+         Write(sim + "/points.csv", "# surveyed 2026\n\n" + Read(sim + "/points.csv"));
+         return AdjustArgs(sim);
+       },
+       2, "points.csv:3: unknown column 'note'", "a.json"},
+      {"unknown_column_in_observations",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/observations.csv", ",sigma_px\n", ",sigma\n");
+         return AdjustArgs(sim);
+       },
+       2, "observations.csv:1: unknown column 'sigma'", "a.json"},
+      {"unknown_column_in_stitch_obs",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Replace(sim + "/stitch_obs.csv", ",sigma_px\n", ",sigma_pix\n");
+         return StitchArgs(sim);
+       },
+       2, "stitch_obs.csv:1: unknown column 'sigma_pix'", "s.json"},
+      {"unknown_column_in_pos",
+       [](const TempDir& d) {
+         const auto pb = PushbroomFlight(d);
+         ReplaceFirst(pb + "/pos.csv", ",skappa\n", ",s_kappa\n");
+         return PushbroomArgs(pb);
+       },
+       2, "pos.csv:1: unknown column 's_kappa'", "pb/r.json"},
+      {"unknown_column_in_line_observations",
+       [](const TempDir& d) {
+         const auto pb = PushbroomFlight(d);
+         ReplaceFirst(pb + "/observations.csv", ",sigma_px\n", ",sigmapx\n");
+         return PushbroomArgs(pb);
+       },
+       2, "observations.csv:1: unknown column 'sigmapx'", "pb/r.json"},
+      {"unknown_column_in_groups",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Replace(tf + "/groups.csv", "image,group", "image,group,groupe");
+         return CalibrateArgs(tf) + " --groups " + tf + "/groups.csv";
+       },
+       2, "groups.csv:1: unknown column 'groupe'", "cal.json"},
+      // ---- calibrate --budget: its lists are lists (a scalar read as no radii; a map threw
+      // yaml-cpp's "invalid node" without FILE:LINE) ----
+      {"budget_radii_not_a_list",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Write(d.File("budget.yaml"), "target_radius_mm: 0.5\nradii_mm: 5\n");
+         return CalibrateArgs(tf) + " --budget " + d.File("budget.yaml");
+       },
+       2, "budget.yaml:2: radii_mm must be a list", "cal.json"},
+      {"budget_components_a_map",
+       [](const TempDir& d) {
+         const auto tf = TestField(d);
+         Write(d.File("budget.yaml"), "components: {quantity: c, source: temperature, value: 0.002}\n");
+         return CalibrateArgs(tf) + " --budget " + d.File("budget.yaml");
+       },
+       2, "budget.yaml:1: components must be a list", "cal.json"},
+      // ---- a random seed is an unsigned 64-bit integer (CLI11 wraps -1 into 2^64 - 1) ----
+      {"simulate_seed_minus_one", [](const TempDir& d) { return "simulate --out " + d.File("o") + " --seed -1"; },
+       2, "--seed: must be an integer within 0 .. 18446744073709551615 (got '-1')", "o"},
+      {"simulate_seed_past_2_64",
+       [](const TempDir& d) { return "simulate --out " + d.File("o") + " --seed 18446744073709551616"; },
+       2, "--seed: must be an integer within 0 .. 18446744073709551615", "o"},
       // ---- simulate --test-field options ----
 #define AEROCAL_TEST_FIELD_CASE(name, options, expect)                                         \
   {name, [](const TempDir& d) { return "simulate --test-field --out " + d.File("o") + " " + (options); }, \
@@ -1166,6 +1251,31 @@ const std::vector<Case>& Cases() {
          return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
        },
        2, "r.json: not a result of `aerocal calibrate`", "cert"},
+      // The typed reading of a result (fuzz target `cli`): a table missing or of the wrong JSON
+      // type names the file and option, before anything is written (a missing key was read
+      // through nlohmann's const operator[], undefined behaviour; a statement that is not text
+      // threw after certificate.json was written).
+      {"certificate_calibration_without_stability",
+       [](const TempDir& d) {
+         Write(d.File("r.json"), CertificateResult("{\"quantity\": \"c\", \"value\": 1, \"statement\": \"c = 1\"}", false));
+         return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
+       },
+       2, "r.json: not a result written by aerocal (--result): [json.exception.out_of_range.403] key 'stability' not found", "cert"},
+      {"certificate_statement_not_text",
+       [](const TempDir& d) {
+         Write(d.File("r.json"), CertificateResult("{\"quantity\": \"c\", \"value\": 1, \"statement\": 5}"));
+         return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
+       },
+       2, "r.json: not a result written by aerocal (--result)", "cert"},
+      {"certificate_previous_value_not_a_number",
+       [](const TempDir& d) {
+         Write(d.File("r.json"), CertificateResult("{\"quantity\": \"c\", \"value\": 1, \"statement\": \"c = 1\"}"));
+         Write(d.File("p.json"), "{\"kind\": \"certificate\", \"schema_version\": 1,\n"
+                                 " \"results\": [{\"quantity\": \"c\", \"value\": \"1.0\"}]}\n");
+         return "certificate --result " + d.File("r.json") + " --previous " + d.File("p.json") +
+                " --no-render --out " + d.File("cert");
+       },
+       2, "p.json: not a result written by aerocal (--previous)", "cert"},
   };
   return cases;
 }

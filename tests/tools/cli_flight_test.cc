@@ -8,6 +8,7 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/result_file.h"
 #include "tests/support/test_support.h"
 
 namespace aerocal {
@@ -41,6 +42,8 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
   const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
   EXPECT_EQ(doc["kind"], "flight");
+  EXPECT_EQ(doc["schema_version"], kResultSchemaVersion);
+  EXPECT_EQ(doc["camera_model"]["name"], "brown_fraser_10");
   const auto& stitching = doc["stitching"];
   for (const char* key : {"kind", "sigma0", "sigma0_px", "redundancy", "iterations", "converged", "model",
                           "subimages", "frames", "stability"})

@@ -14,6 +14,7 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+#include "calib/core/result_file.h"
 #include "tests/support/test_support.h"
 
 namespace aerocal {
@@ -71,6 +72,8 @@ TEST(RigStitchCommand, LineModeOnASimulatedLineWithTheIssueKeys) {
   EXPECT_NE(run.output.find("before -> after"), std::string::npos) << run.output;
   const json doc = ReadJson(dir.File("r.json"));
   EXPECT_EQ(doc["kind"], "rig_stitch");
+  EXPECT_EQ(doc["schema_version"], kResultSchemaVersion);
+  EXPECT_FALSE(doc["camera_models"].empty());
   EXPECT_EQ(doc["mode"], "line");
   EXPECT_TRUE(doc["converged"].get<bool>());
   EXPECT_TRUE(doc["valid"].get<bool>());

@@ -241,6 +241,11 @@ class BadInput(unittest.TestCase):
         self.check_refused('{"kind": "stitch", "sigma0": 1.0}', 'kind is "stitch", expected "flight"')
         self.check_refused("[1, 2, 3]", "top level is not an object")
 
+    def test_wrong_schema_version(self):
+        self.check_refused('{"kind": "flight", "schema_version": 2}',
+                           'schema_version is 2, expected 1 (kind "flight")')
+        self.check_refused('{"kind": "flight"}', 'schema_version is null, expected 1 (kind "flight")')
+
     def test_missing_file(self):
         proc = run_report(os.path.join(self.dir, "absent.json"), self.out)
         self.assertEqual(proc.returncode, 2)
@@ -273,7 +278,7 @@ class TolerantInput(unittest.TestCase):
         return text, page
 
     def test_missing_sections_say_not_available(self):
-        text, page = self.render({"kind": "flight"})
+        text, page = self.render({"kind": "flight", "schema_version": 1})
         self.assertIn("Stitching: not available", text)
         self.assertIn("Adjustments: not available", text)
         self.assertIn("Check-point errors: not available", text)
@@ -284,7 +289,7 @@ class TolerantInput(unittest.TestCase):
         # check points with X/dX and rmse_planimetric_m / rmse_spatial_m.
         points = [{"point": f"K{k}", "X": 100.0 * k, "Y": 50.0 * (k % 3), "Z": 10.0, "dX": 0.01 * k, "dY": -0.02,
                    "dZ": 0.03 * (k % 2)} for k in range(1, 7)]
-        doc = {"kind": "flight", "camera_format": {"width_px": 1000, "height_px": 800, "pixel_size_mm": 0.01},
+        doc = {"kind": "flight", "schema_version": 1, "camera_format": {"width_px": 1000, "height_px": 800, "pixel_size_mm": 0.01},
                "stitching": {"kind": "stitch", "model": "affine", "sigma0_px": 0.1,
                              "frames": [{"frame": "0001", "sigma0_px": 0.101, "converged": True,
                                          "model_choice": {"chosen": "affine", "reason": "because",
@@ -314,7 +319,7 @@ class TolerantInput(unittest.TestCase):
         self.assertEqual(text.count(PNG_URI), 3)  # sigma0, residuals, check map (no interior: no curves)
 
     def test_invalid_steps_and_suspected_model_errors_are_shown_in_red(self):
-        doc = {"kind": "flight", "valid": False,
+        doc = {"kind": "flight", "schema_version": 1, "valid": False,
                "failures": [{"step": "self-calibration", "reason": "sigma0 3.4 is above the limit 3"}],
                "adjustments": [{"name": "self_calibration", "sigma0": 3.4, "sigma0_px": 0.68, "converged": True,
                                 "valid": False, "invalid_reasons": ["sigma0 3.4 is above the limit 3"],
@@ -335,7 +340,7 @@ class TolerantInput(unittest.TestCase):
         # summary (step flagged) and in its section, with the mapping model and why.
         warning = {"name": "group_rms", "subject": "stitch_tie", "value": 14.1, "limit": 3,
                    "message": "residual group stitch_tie: RMS 14.1 sigma over 3678 observations (limit 3)"}
-        doc = {"kind": "flight",
+        doc = {"kind": "flight", "schema_version": 1,
                "adjustments": [{"name": "self_calibration", "sigma0": 1.0, "converged": True, "warnings": []},
                                {"name": "joint", "sigma0": 4.7, "converged": True, "mapping_model": "translation",
                                 "mapping_model_reason": "given by the user", "mapping_scope": "per-flight",
@@ -351,7 +356,7 @@ class TolerantInput(unittest.TestCase):
     def test_what_snooping_cannot_judge_is_listed(self):
         # Check points resting on rays with r = 0 apart from the controlled check RMSE (the check
         # RMSE of every point kept), and each observation no test can judge with r, MDB and why.
-        doc = {"kind": "flight",
+        doc = {"kind": "flight", "schema_version": 1,
                "adjustments": [{"name": "self_calibration", "sigma0": 1.0, "converged": True,
                                 "check": {"n": 2, "rmse_m": [0.3, 0.4, 1.2], "spatial_rmse_m": 1.3,
                                           "planimetric_rmse_m": 0.5},

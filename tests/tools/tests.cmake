@@ -12,4 +12,6 @@ aerocal_add_test(tools/cli_camera LIBS aerocal::calib ${OpenCV_LIBS} LABELS cli)
 target_sources(test_tools_cli_camera PRIVATE ${PROJECT_SOURCE_DIR}/tools/camera_formats.cc)
 target_include_directories(test_tools_cli_camera PRIVATE ${OpenCV_INCLUDE_DIRS})
 aerocal_add_test(tools/cli_calibrate LIBS aerocal::calib LABELS cli)
+# Result documents: kind and schema_version of every command, readers refusing others.
+aerocal_add_test(tools/cli_results LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/cli_camera_models LIBS aerocal::calib LABELS cli)

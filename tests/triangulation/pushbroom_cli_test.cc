@@ -4,9 +4,12 @@
 // nothing written). Also the example camera of configs/.
 #include <filesystem>
 #include <fstream>
+#include <set>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
+#include <tinyxml2.h>
+#include <yaml-cpp/yaml.h>
 
 #include "calib/camera/line_camera_io.h"
 #include "calib/core/atomic_file.h"
@@ -42,6 +45,7 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
   auto run = RunAerocal(Calibrate(dir.path(),
                                   "--out " + dir.File("result.json") + " --write-camera " +
                                       dir.File("calibrated.yaml") + " --lines " + dir.File("lines.csv") +
+                                      " --plot " + dir.File("plot.svg") +
                                       " --node-spacing 50 --degree auto --max-degree 4 --degree-alpha 0.05"
                                       " --datum reference --reference -1 --pos-prior on"
                                       " --pos-sigma-m 0.05 --pos-sigma-deg 0.005 --sigma-px 0.25"
@@ -65,6 +69,36 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
   const calib::LineCamera cam = calib::ReadLineCamera(dir.File("calibrated.yaml"));
   EXPECT_EQ(cam.calibration.size(), 3u);
   EXPECT_TRUE(std::filesystem::exists(dir.File("lines.csv")));
+
+  // The plot: valid XML, per sub-camera and axis one group with one fitted curve over every
+  // detector of the sub-camera, its sigma band, and (nearly) every observation as a dot.
+  tinyxml2::XMLDocument svg;
+  ASSERT_EQ(svg.LoadFile(dir.File("plot.svg").c_str()), tinyxml2::XML_SUCCESS) << svg.ErrorStr();
+  const tinyxml2::XMLElement* root = svg.RootElement();
+  ASSERT_NE(root, nullptr);
+  EXPECT_STREQ(root->Name(), "svg");
+  std::set<std::string> panels;
+  for (const auto* g = root->FirstChildElement("g"); g; g = g->NextSiblingElement("g")) {
+    ASSERT_TRUE(g->Attribute("data-subcamera") && g->Attribute("data-axis"));
+    const std::string id = g->Attribute("data-subcamera"), axis = g->Attribute("data-axis");
+    EXPECT_TRUE(panels.insert(id + "/" + axis).second) << id << " " << axis;
+    int fits = 0, bands = 0, dots = 0;
+    for (const auto* e = g->FirstChildElement(); e; e = e->NextSiblingElement()) {
+      const char* cls = e->Attribute("class");
+      if (std::string(e->Name()) == "polyline" && cls && std::string(cls) == "fit") {
+        ++fits;
+        const std::string points = e->Attribute("points");
+        EXPECT_EQ(std::count(points.begin(), points.end(), ','), 60) << "one vertex per detector";
+      }
+      if (std::string(e->Name()) == "polygon" && cls && std::string(cls) == "band") ++bands;
+      if (std::string(e->Name()) == "circle") ++dots;
+    }
+    EXPECT_EQ(fits, 1) << id << " " << axis;
+    EXPECT_EQ(bands, 1) << id << " " << axis;
+    for (const json& s : doc["subcameras"])
+      if (s["id"] == id) EXPECT_GE(dots, 0.95 * s["n"].get<int>()) << id << " " << axis;
+  }
+  EXPECT_EQ(panels.size(), 6u);
 
   // A fixed degree and c free: the scale is named; exit 3 only when ill-posed beyond 0.999.
   auto c_run = RunAerocal(Calibrate(dir.path(), "--out " + dir.File("c.json") + " --free-c --degree 3"));
@@ -99,6 +133,11 @@ TEST(PushbroomCommands, BadInputIsRefusedWithFileAndLine) {
             std::string::npos)
       << run.output;
   EXPECT_FALSE(std::filesystem::exists(dir.File("r.json")));
+  // A plot below a file (not a folder): refused by option name, nothing written.
+  run = RunAerocal(Calibrate(dir.path(), "--out " + dir.File("r.json") + " --plot " + dir.File("points.csv/p.svg")));
+  EXPECT_EQ(run.exit_code, 2) << run.output;
+  EXPECT_NE(run.output.find("--plot"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("r.json")));
   // A bad option.
   run = RunAerocal(Calibrate(dir.path(), "--out " + dir.File("r.json") + " --degree 7"));
   EXPECT_EQ(run.exit_code, 2) << run.output;
@@ -110,6 +149,63 @@ TEST(PushbroomCommands, BadInputIsRefusedWithFileAndLine) {
                    " --points " + dir.File("points.csv") + " --out " + dir.File("r.json"));
   EXPECT_EQ(run.exit_code, 2) << run.output;
   EXPECT_NE(run.output.find("cam.yaml:4: line.c must be within"), std::string::npos) << run.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("r.json")));
+}
+
+// The patent writes the line along the camera's y axis (CONVENTIONS "Line (pushbroom) cameras"):
+// a camera file with `line_axis: y` is converted at the reader, so the same camera written either
+// way calibrates identically, and the updated camera is written back in the file's convention.
+TEST(PushbroomCommands, PatentLineAxisGivesTheSameCalibration) {
+  TempDir dir;
+  ASSERT_EQ(RunAerocal("simulate --pushbroom --out " + dir.path() + kSmall).exit_code, 0);
+  calib::LineCamera camera = calib::ReadLineCamera(dir.File("camera_nominal.yaml"));
+  camera.file_line_along_y = true;
+  calib::WriteLineCamera(dir.File("camera_y.yaml"), camera);
+  const std::string text = ReadTextFile(dir.File("camera_y.yaml"));
+  EXPECT_NE(text.find("line_axis: y"), std::string::npos) << text;
+  // The file holds the other frame: the virtual camera's mount (a boresight of 0.1 / -0.05 / 0.2
+  // deg in ours) turns by 90 deg in kappa.
+  const YAML::Node y_file = YAML::LoadFile(dir.File("camera_y.yaml"));
+  EXPECT_NEAR(std::abs(y_file["line"]["mount_deg"][2].as<double>()), 90.0, 0.5) << text;
+  const calib::LineCamera back = calib::ReadLineCamera(dir.File("camera_y.yaml"));
+  EXPECT_TRUE(back.file_line_along_y);
+  for (int i = 0; i < camera.detectors; ++i)
+    EXPECT_LT((back.DetectorPosition(i) - camera.DetectorPosition(i)).norm(), 1e-12) << i;
+  EXPECT_LT((back.mount_rad - camera.mount_rad).norm(), 1e-12);
+  for (size_t k = 0; k < camera.subcameras.size(); ++k)
+    EXPECT_LT((back.subcameras[k].mount_rad - camera.subcameras[k].mount_rad).norm(), 1e-12) << k;
+
+  const auto calibrate = [&](const std::string& cam, const std::string& name) {
+    return RunAerocal("pushbroom calibrate --camera " + cam + " --pos " + dir.File("pos.csv") +
+                      " --observations " + dir.File("observations.csv") + " --points " +
+                      dir.File("points.csv") + " --out " + dir.File(name + ".json") +
+                      " --write-camera " + dir.File(name + ".yaml"));
+  };
+  const auto x_run = calibrate(dir.File("camera_nominal.yaml"), "x");
+  const auto y_run = calibrate(dir.File("camera_y.yaml"), "y");
+  ASSERT_EQ(x_run.exit_code, 0) << x_run.output;
+  ASSERT_EQ(y_run.exit_code, 0) << y_run.output;
+  const json x = json::parse(ReadTextFile(dir.File("x.json")));
+  const json y = json::parse(ReadTextFile(dir.File("y.json")));
+  ASSERT_EQ(x["detectors"].size(), y["detectors"].size());
+  for (size_t i = 0; i < x["detectors"].size(); ++i)
+    for (const char* key : {"dx_mm", "dy_mm", "sigma_dx_mm", "sigma_dy_mm"})
+      EXPECT_NEAR(x["detectors"][i][key].get<double>(), y["detectors"][i][key].get<double>(), 1e-10)
+          << i << " " << key;
+  EXPECT_NEAR(x["sigma0"].get<double>(), y["sigma0"].get<double>(), 1e-9);
+  // The updated camera comes back in the file's convention and means the same detectors.
+  EXPECT_NE(ReadTextFile(dir.File("y.yaml")).find("line_axis: y"), std::string::npos);
+  const calib::LineCamera x_cam = calib::ReadLineCamera(dir.File("x.yaml"));
+  const calib::LineCamera y_cam = calib::ReadLineCamera(dir.File("y.yaml"));
+  for (int i = 0; i < x_cam.detectors; ++i)
+    EXPECT_LT((x_cam.DetectorPosition(i) - y_cam.DetectorPosition(i)).norm(), 1e-10) << i;
+  // A bad value: FILE:LINE and the key.
+  std::ofstream(dir.File("bad.yaml")) << "line:\n  detectors: 180\n  pitch_mm: 0.01\n  c: 3\n  line_axis: z\n";
+  const auto bad = RunAerocal("pushbroom calibrate --camera " + dir.File("bad.yaml") + " --pos " +
+                              dir.File("pos.csv") + " --observations " + dir.File("observations.csv") +
+                              " --points " + dir.File("points.csv") + " --out " + dir.File("r.json"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("bad.yaml:5: line.line_axis must be x or y"), std::string::npos) << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir.File("r.json")));
 }
 

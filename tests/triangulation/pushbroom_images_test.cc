@@ -4,9 +4,10 @@
 // intersects the cloud control on those pixels, and `aerocal pushbroom calibrate` from that control
 // recovers the detector table within 1.5 x the error of the geometry-only run of the same flight
 // (the acceptance). Bad input: exit 2 with the file and line, nothing written.
-// The flight: 3 x 200 detectors (1.85 m nadir sampling), 800 lines. NOT met yet at 3 x 150 detectors
-// (2.5 m): the across-track table error is 2.4 x the geometry run's there, a smooth bias of the
-// image-mode observations (module README "Measured"), so this test pins the measured case.
+// The flight: 3 x 200 detectors (1.85 m nadir sampling), 800 lines. The per-detector 3-sigma check
+// does NOT hold in image mode (a residual across-track bias of ~0.015 px, module README
+// "Measured"), so it is printed, not asserted; the test stays labelled `long`.
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -17,6 +18,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calib/core/csv.h"
+#include "calib/core/result_file.h"
 #include "tests/support/test_support.h"
 #include "tests/triangulation/pushbroom_commands.h"
 
@@ -27,19 +29,38 @@ using aerocal::testing::RunAerocal;
 using aerocal::testing::TempDir;
 using nlohmann::json;
 
-// RMS error (px) of the calibrated table against truth_detectors.csv, across (x) and along (y).
-Eigen::Vector2d TableRmsPx(const std::string& dir, const json& result, double pitch_mm) {
+// truth_detectors.csv of the flight in `dir`: detector -> (dx, dy) mm.
+std::map<int, Eigen::Vector2d> TruthTable(const std::string& dir) {
   const CsvTable truth = CsvTable::Read(dir + "/truth_detectors.csv");
   std::map<int, Eigen::Vector2d> by_detector;
   for (const auto& row : truth.rows())
     by_detector[int(truth.Number(row, "i"))] =
         Eigen::Vector2d(truth.Number(row, "dx_mm"), truth.Number(row, "dy_mm"));
+  return by_detector;
+}
+
+// RMS error (px) of the calibrated table against truth_detectors.csv, across (x) and along (y).
+Eigen::Vector2d TableRmsPx(const std::string& dir, const json& result, double pitch_mm) {
+  const std::map<int, Eigen::Vector2d> by_detector = TruthTable(dir);
   Eigen::Vector2d sum = Eigen::Vector2d::Zero();
   for (const auto& d : result["detectors"]) {
     const Eigen::Vector2d e(d["dx_mm"].get<double>(), d["dy_mm"].get<double>());
     sum += (e - by_detector.at(d["i"].get<int>())).cwiseAbs2();
   }
   return (sum / double(result["detectors"].size())).cwiseSqrt() / pitch_mm;
+}
+
+// Worst |table error| / predicted sigma over the detectors, across and along.
+Eigen::Vector2d WorstNormalisedError(const std::string& dir, const json& result) {
+  const std::map<int, Eigen::Vector2d> by_detector = TruthTable(dir);
+  Eigen::Vector2d worst = Eigen::Vector2d::Zero();
+  for (const auto& d : result["detectors"]) {
+    const Eigen::Vector2d e = Eigen::Vector2d(d["dx_mm"].get<double>(), d["dy_mm"].get<double>()) -
+                              by_detector.at(d["i"].get<int>());
+    if (d["sigma_dx_mm"].is_number()) worst.x() = std::max(worst.x(), std::abs(e.x()) / d["sigma_dx_mm"].get<double>());
+    if (d["sigma_dy_mm"].is_number()) worst.y() = std::max(worst.y(), std::abs(e.y()) / d["sigma_dy_mm"].get<double>());
+  }
+  return worst;
 }
 
 TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGeometryError) {
@@ -59,6 +80,7 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
   ASSERT_EQ(c.exit_code, 0) << c.output;
   const json cj = testing::ReadJson(control + "/control.json");
   EXPECT_EQ(cj["kind"], "pushbroom_control");
+  EXPECT_EQ(cj["schema_version"], kResultSchemaVersion);
   EXPECT_GE(cj["n_points"].get<int>(), 250) << c.output;
   // Gross errors are few on clean synthetic pixels: below 5 % of the points.
   EXPECT_LT(cj["rejected"]["gross_error"].get<int>(), cj["n_points"].get<int>() / 20 + 1);
@@ -86,6 +108,9 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
   const Eigen::Vector2d geometry = TableRmsPx(sim, gj, 0.01), image = TableRmsPx(sim, ij, 0.01);
   std::printf("table RMS error across / along: geometry %.4f / %.4f px, image mode %.4f / %.4f px\n",
               geometry.x(), geometry.y(), image.x(), image.y());
+  const Eigen::Vector2d worst = WorstNormalisedError(sim, ij);
+  std::printf("image mode: worst |error| / sigma over the detectors across / along: %.2f / %.2f\n",
+              worst.x(), worst.y());
   EXPECT_LE(image.x(), 1.5 * geometry.x());
   EXPECT_LE(image.y(), 1.5 * geometry.y());
 }

@@ -405,6 +405,11 @@ def main(argv):
     if not isinstance(c, dict) or c.get("kind") != "certificate":
         print("error: %s: not a certificate.json (kind must be \"certificate\")" % argv[1], file=sys.stderr)
         return 2
+    # kResultSchemaVersion of calib/core/result_file.h
+    if c.get("schema_version") != 1 or isinstance(c.get("schema_version"), bool):
+        print("error: %s: schema_version is %s, expected 1 (kind \"certificate\")"
+              % (argv[1], json.dumps(c.get("schema_version"))), file=sys.stderr)
+        return 2
     figures = {"distortion": svg_of(fig_distortion(c)), "residuals": svg_of(fig_residuals_correlation(c))}
     write_html(c, os.path.join(argv[2], "certificate.html"), figures)
     write_pdf(c, os.path.join(argv[2], "certificate.pdf"))

@@ -17,6 +17,10 @@ ADJUSTMENT_TITLES = {"conventional": "Conventional triangulation",
                      "joint": "Joint adjustment (stitching and triangulation)"}
 
 
+# kResultSchemaVersion of calib/core/result_file.h: the result version this reader understands.
+SCHEMA_VERSION = 1
+
+
 class InputError(Exception):
     """The input is not a flight result; the message names the file and the rule."""
 
@@ -36,6 +40,9 @@ def load(path):
     if doc.get("kind") != "flight":
         raise InputError(f"{path}: not a flight result (kind is {json.dumps(doc.get('kind'))}, "
                          f"expected \"flight\")")
+    if doc.get("schema_version") != SCHEMA_VERSION or isinstance(doc.get("schema_version"), bool):
+        raise InputError(f"{path}: schema_version is {json.dumps(doc.get('schema_version'))}, "
+                         f"expected {SCHEMA_VERSION} (kind \"flight\")")
     return doc
 
 

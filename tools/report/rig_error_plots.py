@@ -80,6 +80,10 @@ def main(argv):
         _fail(f"{argv[1]}: {e}", 2)
     if not isinstance(doc, dict) or doc.get("kind") != "rig_error_analysis":
         _fail(f"{argv[1]}: not a rig error analysis (kind must be 'rig_error_analysis')", 2)
+    # kResultSchemaVersion of calib/core/result_file.h
+    if doc.get("schema_version") != 1 or isinstance(doc.get("schema_version"), bool):
+        _fail(f"{argv[1]}: schema_version is {json.dumps(doc.get('schema_version'))}, expected 1 "
+              f"(kind \"rig_error_analysis\")", 2)
     try:
         import matplotlib
         matplotlib.use("Agg")

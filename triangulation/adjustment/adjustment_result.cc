@@ -358,24 +358,13 @@ std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, dou
   return out;
 }
 
-nlohmann::json CameraModelTableToJson(calib::CameraModelId model) {
-  nlohmann::json parameters = nlohmann::json::array();
-  for (const calib::ParamInfo& p : calib::CameraModelParams(model))
-    parameters.push_back({{"name", std::string(p.name)},
-                          {"unit", std::string(p.unit)},
-                          {"group", std::string(calib::ParamGroupName(p.group))}});
-  return {{"name", std::string(calib::CameraModelName(model))},
-          {"id", static_cast<int>(model)},
-          {"parameters", parameters}};
-}
-
 nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   nlohmann::json j;
   j["kind"] = "adjust";
   j["schema_version"] = kResultSchemaVersion;
   // The model of the cameras (the first camera's when they differ; each camera names its own).
   j["camera_model"] =
-      CameraModelTableToJson(r.cameras.empty() ? Model::kId : r.cameras.front().model);
+      calib::CameraModelTableToJson(r.cameras.empty() ? Model::kId : r.cameras.front().model);
   j["sigma0"] = r.sigma0;
   j["sigma0_px"] = r.sigma0_px;
   j["sigma0_um"] = r.sigma0_um;
@@ -385,6 +374,11 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["termination"] = r.solve.termination;
   j["linear_solver"] = r.solve.linear_solver;
   j["seconds"] = r.solve.seconds;
+  j["timing"] = {{"solve_s", r.timing.solve_s},
+                 {"snooping_s", r.timing.snooping_s},
+                 {"testing_s", r.timing.testing_s},
+                 {"covariance_s", r.timing.covariance_s},
+                 {"total_s", r.timing.total_s}};
   j["frame"] = r.frame;
   j["datum"] = r.datum;
   j["self_calibration"] = r.free_interior;

@@ -6,6 +6,8 @@
 #pragma once
 
 #include "calib/camera/camera.h"
+#include "calib/camera/camera_model_json.h"
+#include "calib/core/result_file.h"
 #include "calib/problem/problem_builder.h"
 #include "triangulation/block/block.h"
 
@@ -201,8 +203,19 @@ inline constexpr double kGroupRmsLimit = 3.0;
 /// One kWarningGroupRms warning per residual group of `solve` whose RMS exceeds `limit`.
 std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, double limit = kGroupRmsLimit);
 
+/// Wall time of the stages of one BlockAdjustment::Run, s (JSON `timing`; for benchmarks and
+/// profiling, not statistics).
+struct AdjustmentTiming {
+  double solve_s = 0;       // the solves before snooping (stage 1 of a self-calibration included)
+  double snooping_s = 0;    // data snooping: its re-solves, cofactors and tests
+  double testing_s = 0;     // of which the cofactors (selected inverse) and tests
+  double covariance_s = 0;  // the covariance of the requested blocks
+  double total_s = 0;       // the whole run (results and statistics included)
+};
+
 struct AdjustmentResult {
   calib::SolveReport solve;
+  AdjustmentTiming timing;
   std::vector<std::string> free_interior;  // names; empty = conventional
   double sigma0 = 0, sigma0_px = 0, sigma0_um = 0;
   std::vector<CameraEstimate> cameras;
@@ -240,14 +253,11 @@ struct AdjustmentResult {
 /// such a ray (PointDifference::uncontrolled) and sets check_controlled over the others.
 void ClassifyUncontrolled(double min_redundancy, AdjustmentResult* result);
 
-/// JSON of FORMATS.md (kind "adjust"); angles in degrees, coordinates in the object frame.
-/// Version of the result documents written by AdjustmentToJson (and the writers built on it):
-/// raised when a key changes meaning or disappears; added keys do not raise it.
-inline constexpr int kResultSchemaVersion = 1;
-/// A camera model with its parameter table: {name, id, parameters: [{name, unit, group}]} in
-/// table order (calib/camera/camera_model.h). The result's `camera_model` is that of its cameras
-/// (the first camera's when they differ: each camera entry names its `model`).
-nlohmann::json CameraModelTableToJson(calib::CameraModelId model = calib::Camera::Model::kId);
+/// JSON of FORMATS.md (kind "adjust", schema_version kResultSchemaVersion of
+/// calib/core/result_file.h, written by WriteResult); angles in degrees, coordinates in the object
+/// frame. `camera_model` is the model of its cameras with its parameter table
+/// (calib::CameraModelTableToJson; the first camera's when they differ: each camera entry names
+/// its `model`).
 nlohmann::json AdjustmentToJson(const AdjustmentResult& result);
 nlohmann::json PointStatisticsToJson(const PointStatistics& statistics);
 

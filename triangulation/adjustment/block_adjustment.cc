@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <optional>
 #include <set>
@@ -60,23 +61,37 @@ struct BlockAdjustment::Storage {
   };
   struct PointState {
     Eigen::Vector3d xyz = Eigen::Vector3d::Zero();
-    BlockId block = -1;
+    BlockId block = -1;                   // -1: not in the adjustment (too few rays)
     const GroundPoint* ground = nullptr;  // nullptr: a tie point absent from points.csv
-    int rays = -1;  // virtual-image rays; -1: added by a caller, rays not counted here
+    int rays = 0;                         // virtual-image rays
+    bool Control() const { return ground && ground->role == PointRole::kControl; }
   };
+  /// The point of `id`, -1 when no observation names it (strings only at the boundary).
+  PointIndex FindPoint(const std::string& id) const {
+    const auto it = std::lower_bound(point_ids.begin(), point_ids.end(), id);
+    return it != point_ids.end() && *it == id ? static_cast<PointIndex>(it - point_ids.begin())
+                                              : -1;
+  }
   DenseIndex index;
   std::vector<PoseBlocks> poses;  // by ExposureIndex
   FrameCamera frame;
   std::vector<std::unique_ptr<ImagingModel>> sensors;  // asked first, the frame camera last
   SensorContext context;
-  // std::map keeps element addresses stable: the builder holds pointers into them.
-  std::map<std::string, ExposureState> exposures;
-  std::map<std::string, PointState> points;
+  // Dense indices, assigned once when the block is built; ids are strings only when read and in
+  // reports. Both vectors are sized once and never grow afterwards: the builder holds pointers
+  // into their elements.
+  std::vector<ExposureState> exposures;       // by ExposureIndex (Project::exposures order)
+  std::vector<ExposureIndex> exposure_order;  // by image id: the order of priors and reports
+  std::vector<int> exposure_rank;             // by ExposureIndex: position in exposure_order
+  std::vector<std::string> point_ids;         // by PointIndex: the observed points, sorted ids
+  std::vector<PointState> points;             // by PointIndex
   // Observations used in the adjustment (sub-image ones no kind measures mapped to the virtual
-  // image), the kind that measures each, and their residuals.
+  // image), the kind that measures each, their exposure and point, and their residuals.
   std::vector<ImageObservation> observations;
   std::vector<ImagingModel*> sensor_of_observation;
   std::vector<int> source_of_observation;  // its index in Project::observations
+  std::vector<ExposureIndex> exposure_of_observation;
+  std::vector<PointIndex> point_of_observation;
   std::map<calib::ResidualId, size_t> observation_of_residual;
   std::map<calib::ResidualId, ObservationTest> tests;  // data snooping's last word on each
   std::vector<std::string> notes;
@@ -115,12 +130,12 @@ BlockId BlockAdjustment::InteriorBlock(const std::string& camera) const {
                                         : -1;
 }
 BlockId BlockAdjustment::RotationBlock(const std::string& image) const {
-  const auto it = storage_->exposures.find(image);
-  return it == storage_->exposures.end() ? -1 : it->second.opk_block;
+  const ExposureIndex e = storage_->index.FindExposure(image);
+  return e < 0 ? -1 : storage_->exposures[e].opk_block;
 }
 BlockId BlockAdjustment::CenterBlock(const std::string& image) const {
-  const auto it = storage_->exposures.find(image);
-  return it == storage_->exposures.end() ? -1 : it->second.center_block;
+  const ExposureIndex e = storage_->index.FindExposure(image);
+  return e < 0 ? -1 : storage_->exposures[e].center_block;
 }
 PlatformEstimate BlockAdjustment::PlatformResult(const calib::CovarianceReport& cov) const {
   const Storage& s = *storage_;
@@ -142,17 +157,19 @@ PlatformEstimate BlockAdjustment::PlatformResult(const calib::CovarianceReport& 
 }
 
 BlockId BlockAdjustment::PointBlock(const std::string& point) const {
-  const auto it = storage_->points.find(point);
-  return it == storage_->points.end() ? -1 : it->second.block;
+  const PointIndex p = storage_->FindPoint(point);
+  return p < 0 ? -1 : storage_->points[p].block;
 }
 
-BlockId BlockAdjustment::AddPoint(const std::string& point, const Eigen::Vector3d& start_m) {
+BlockId BlockAdjustment::AddPoint(PointIndex point, const Eigen::Vector3d& start_m) {
   auto& state = storage_->points[point];
   if (state.block >= 0) return state.block;
   state.xyz = start_m;
-  state.ground = project_.FindPoint(point);
-  state.block = builder_.AddBlock(
-      "point " + point, state.xyz.data(), 3, BlockKind::kGroundPoint, kCenterNames);
+  state.block = builder_.AddBlock("point " + storage_->point_ids[point],
+                                  state.xyz.data(),
+                                  3,
+                                  BlockKind::kGroundPoint,
+                                  kCenterNames);
   return state.block;
 }
 
@@ -160,11 +177,22 @@ void BlockAdjustment::BuildExposures() {
   // The sensor kinds' own blocks first (the frame camera's interiors), then the platform poses.
   storage_->frame.RegisterBlocks(storage_->context);
   for (auto& sensor : storage_->sensors) sensor->RegisterBlocks(storage_->context);
-  storage_->poses.resize(project_.exposures.size());
+  Storage& s = *storage_;
+  const int n = s.index.NumExposures();
+  s.poses.resize(n);
+  s.exposures.resize(n);  // once: the builder keeps pointers into the states
+  s.exposure_order.resize(n);
+  for (ExposureIndex k = 0; k < n; ++k) s.exposure_order[k] = k;
+  std::sort(s.exposure_order.begin(), s.exposure_order.end(), [&](ExposureIndex a, ExposureIndex b) {
+    return project_.exposures[a].image < project_.exposures[b].image;
+  });
+  s.exposure_rank.resize(n);
+  for (int rank = 0; rank < n; ++rank) s.exposure_rank[s.exposure_order[rank]] = rank;
   for (const auto& e : project_.exposures) {
-    auto& state = storage_->exposures[e.image];
+    const ExposureIndex index = s.index.Exposure(e.image);
+    auto& state = s.exposures[index];
     state.exposure = &e;
-    state.index = storage_->index.Exposure(e.image);
+    state.index = index;
     state.camera = &project_.cameras.at(e.camera);
     state.rotation = calib::QuaternionFromOpk(e.opk_rad);
     state.center = e.center_m;
@@ -191,64 +219,83 @@ void BlockAdjustment::BuildPoints() {
                           ": rig head observations are adjusted by the rig bundle (aerocal "
                           "adjust without --joint-stitching)");
     if (!sensor && storage_->frame.Measures(o)) sensor = &storage_->frame;
+    const ExposureIndex exposure = storage_->index.Exposure(o.image);
+    storage_->exposure_of_observation.push_back(exposure);
     if (sensor) {
       storage_->observations.push_back(o);
       storage_->sensor_of_observation.push_back(sensor);
       continue;
     }
-    const auto& camera = *storage_->exposures.at(o.image).camera;
+    const auto& camera = *storage_->exposures[exposure].camera;
     ImageObservation mapped = o;
     mapped.pixel = camera.subimages[camera.SubimageIndex(o.subimage)].VirtualFromSub(o.pixel);
     mapped.subimage.clear();
     storage_->observations.push_back(mapped);
     storage_->sensor_of_observation.push_back(&storage_->frame);
   }
+  // The points: a dense index per observed point id (sorted ids), assigned once.
+  Storage& s = *storage_;
+  for (const auto& o : s.observations) s.point_ids.push_back(o.point);
+  std::sort(s.point_ids.begin(), s.point_ids.end());
+  s.point_ids.erase(std::unique(s.point_ids.begin(), s.point_ids.end()), s.point_ids.end());
+  s.points.resize(s.point_ids.size());  // once: the builder keeps pointers into the states
+  for (PointIndex p = 0; p < static_cast<PointIndex>(s.points.size()); ++p)
+    s.points[p].ground = project_.FindPoint(s.point_ids[p]);
+  for (const auto& o : s.observations) s.point_of_observation.push_back(s.FindPoint(o.point));
+  const int n_exposures = s.index.NumExposures();
+  const int n_points = static_cast<int>(s.points.size());
   // An exposure seeing fewer than three points (and not held by GNSS and IMU priors) cannot be
   // oriented; leaving it out can leave a point with one ray, so repeat until nothing changes.
   for (bool changed = true; changed;) {
     changed = false;
-    std::map<std::string, std::set<std::string>> points_of_image;
-    std::map<std::string, std::set<std::string>> images_of_point;
-    for (const auto& o : storage_->observations) {
-      points_of_image[o.image].insert(o.point);
-      images_of_point[o.point].insert(o.image);
+    std::vector<std::set<PointIndex>> points_of_image(n_exposures);
+    std::vector<std::set<ExposureIndex>> images_of_point(n_points);
+    for (size_t i = 0; i < s.observations.size(); ++i) {
+      points_of_image[s.exposure_of_observation[i]].insert(s.point_of_observation[i]);
+      images_of_point[s.point_of_observation[i]].insert(s.exposure_of_observation[i]);
     }
-    std::set<std::string> dropped;
-    for (const auto& [image, points] : points_of_image) {
-      const Exposure& e = *storage_->exposures.at(image).exposure;
+    std::vector<bool> dropped(n_exposures, false);
+    bool any_dropped = false;
+    for (ExposureIndex k : s.exposure_order) {
+      const std::set<PointIndex>& points = points_of_image[k];
+      if (points.empty()) continue;  // not observed
+      const Exposure& e = *s.exposures[k].exposure;
       const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
       if (points.size() >= 3 || held) continue;
-      dropped.insert(image);
-      storage_->notes.push_back("image " + image + " sees " + std::to_string(points.size()) +
-                                " point(s) only: its orientation cannot be determined; left out");
+      dropped[k] = any_dropped = true;
+      s.notes.push_back("image " + e.image + " sees " + std::to_string(points.size()) +
+                        " point(s) only: its orientation cannot be determined; left out");
     }
-    std::set<std::string> single;
-    for (const auto& [point, images] : images_of_point) {
-      const GroundPoint* ground = project_.FindPoint(point);
-      if (images.size() == 1 && !(ground && ground->role == PointRole::kControl))
-        single.insert(point);
-    }
-    const size_t before = storage_->observations.size();
+    std::vector<bool> single(n_points, false);
+    for (PointIndex p = 0; p < n_points; ++p)
+      single[p] = images_of_point[p].size() == 1 && !s.points[p].Control();
+    const size_t before = s.observations.size();
     std::vector<ImageObservation> kept;
     std::vector<ImagingModel*> kept_sensors;
     std::vector<int> kept_sources;
+    std::vector<ExposureIndex> kept_exposures;
+    std::vector<PointIndex> kept_points;
     for (size_t i = 0; i < before; ++i) {
-      const ImageObservation& o = storage_->observations[i];
-      if (dropped.count(o.image) || (!dropped.empty() && single.count(o.point))) continue;
-      kept.push_back(o);
-      kept_sensors.push_back(storage_->sensor_of_observation[i]);
-      kept_sources.push_back(storage_->source_of_observation[i]);
+      const ExposureIndex e = s.exposure_of_observation[i];
+      const PointIndex p = s.point_of_observation[i];
+      if (dropped[e] || (any_dropped && single[p])) continue;
+      kept.push_back(s.observations[i]);
+      kept_sensors.push_back(s.sensor_of_observation[i]);
+      kept_sources.push_back(s.source_of_observation[i]);
+      kept_exposures.push_back(e);
+      kept_points.push_back(p);
     }
-    storage_->observations = std::move(kept);
-    storage_->sensor_of_observation = std::move(kept_sensors);
-    storage_->source_of_observation = std::move(kept_sources);
-    changed = storage_->observations.size() != before;
+    s.observations = std::move(kept);
+    s.sensor_of_observation = std::move(kept_sensors);
+    s.source_of_observation = std::move(kept_sources);
+    s.exposure_of_observation = std::move(kept_exposures);
+    s.point_of_observation = std::move(kept_points);
+    changed = s.observations.size() != before;
   }
-  std::map<std::string, std::vector<ImageRay>> rays;
-  for (size_t i = 0; i < storage_->observations.size(); ++i) {
-    const ImageObservation& o = storage_->observations[i];
-    rays[o.point].push_back(storage_->sensor_of_observation[i]->StartingRay(storage_->context, o));
-  }
+  std::vector<std::vector<ImageRay>> rays(n_points);
+  for (size_t i = 0; i < s.observations.size(); ++i)
+    rays[s.point_of_observation[i]].push_back(
+        s.sensor_of_observation[i]->StartingRay(s.context, s.observations[i]));
   // Fallback height for points whose rays do not intersect: mean height of the control (and of
   // approximate tie) points, else 0. Check surveys never enter the adjustment, not even here.
   double height_sum = 0.0;
@@ -259,9 +306,12 @@ void BlockAdjustment::BuildPoints() {
       ++height_n;
     }
   const double fallback_height = height_n > 0 ? height_sum / height_n : 0.0;
-  for (const auto& [id, point_rays] : rays) {
-    const GroundPoint* ground = project_.FindPoint(id);
-    const bool control = ground && ground->role == PointRole::kControl;
+  for (PointIndex p = 0; p < n_points; ++p) {
+    const std::vector<ImageRay>& point_rays = rays[p];
+    if (point_rays.empty()) continue;  // its observations were left out
+    const std::string& id = s.point_ids[p];
+    const GroundPoint* ground = s.points[p].ground;
+    const bool control = s.points[p].Control();
     if (point_rays.size() < 2 && !control) {
       storage_->notes.push_back("point " + id + " is seen in " + std::to_string(point_rays.size()) +
                                 " image only and left out");
@@ -275,11 +325,12 @@ void BlockAdjustment::BuildPoints() {
     } else {
       start = IntersectWithHeight(point_rays, fallback_height);
     }
-    AddPoint(id, start);
-    storage_->points[id].rays = static_cast<int>(point_rays.size());
+    AddPoint(p, start);
+    s.points[p].rays = static_cast<int>(point_rays.size());
   }
   for (const auto& p : project_.points)
-    if (p.role != PointRole::kTie && !storage_->points.count(p.id))
+    if (p.role != PointRole::kTie &&
+        (s.FindPoint(p.id) < 0 || s.points[s.FindPoint(p.id)].block < 0))
       storage_->notes.push_back(PointRoleName(p.role) + " point " + p.id +
                                 " has too few image observations and is not used");
 }
@@ -287,10 +338,9 @@ void BlockAdjustment::BuildPoints() {
 void BlockAdjustment::AddImageResiduals(const calib::LossOptions& loss) {
   for (size_t i = 0; i < storage_->observations.size(); ++i) {
     const auto& o = storage_->observations[i];
-    const auto point = storage_->points.find(o.point);
-    if (point == storage_->points.end()) continue;
-    ObservationTerm term =
-        storage_->sensor_of_observation[i]->Observe(storage_->context, o, point->second.block);
+    const BlockId point = storage_->points[storage_->point_of_observation[i]].block;
+    if (point < 0) continue;
+    ObservationTerm term = storage_->sensor_of_observation[i]->Observe(storage_->context, o, point);
     const auto id = builder_.AddResidual(
         term.group, std::move(term.cost), term.blocks, DescribeObservation(o), loss);
     storage_->observation_of_residual[id] = i;
@@ -298,21 +348,24 @@ void BlockAdjustment::AddImageResiduals(const calib::LossOptions& loss) {
 }
 
 void BlockAdjustment::AddPriors() {
-  for (const auto& [id, state] : storage_->points) {
-    if (!state.ground || state.ground->role != PointRole::kControl) continue;
+  for (PointIndex p = 0; p < static_cast<PointIndex>(storage_->points.size()); ++p) {
+    const auto& state = storage_->points[p];
+    if (state.block < 0 || !state.Control()) continue;
     const Eigen::Vector3d& xyz = *state.ground->xyz_m;
     const Eigen::Vector3d& s = state.ground->sigma_m;
     builder_.AddResidual(
         calib::kGroupControl,
         calib::PriorCostFunction::Create({xyz.x(), xyz.y(), xyz.z()}, {s.x(), s.y(), s.z()}),
         {state.block},
-        "control " + id);
+        "control " + storage_->point_ids[p]);
   }
   if (options_.use_eo_priors) {
     AddPlatformBlocks();
     Storage& s = *storage_;
-    for (const auto& [image, state] : storage_->exposures) {
+    for (ExposureIndex k : s.exposure_order) {
+      const auto& state = s.exposures[k];
       const Exposure& e = *state.exposure;
+      const std::string& image = e.image;
       if (e.center_sigma_m)
         builder_.AddResidual(calib::kGroupEoPrior,
                              calib::GnssPriorResidual::Create(
@@ -408,10 +461,9 @@ void BlockAdjustment::AddPlatformBlocks() {
 
 void BlockAdjustment::DefineDatum() {
   int control = 0;
-  for (const auto& [id, state] : storage_->points)
-    if (state.ground && state.ground->role == PointRole::kControl) ++control;
+  for (const auto& state : storage_->points) control += state.block >= 0 && state.Control();
   bool gnss = false;
-  for (const auto& [image, state] : storage_->exposures)
+  for (const auto& state : storage_->exposures)
     gnss |= options_.use_eo_priors && state.exposure->center_sigma_m.has_value();
   if (control > 0 || gnss) {
     storage_->datum = std::to_string(control) + " control point(s) as weighted observations" +
@@ -423,21 +475,24 @@ void BlockAdjustment::DefineDatum() {
     return;
   }
   // Dependent relative orientation: first exposure fixed, one base component of the farthest.
-  std::set<std::string> observed;
-  for (const auto& o : storage_->observations) observed.insert(o.image);
+  std::vector<bool> observed(storage_->exposures.size(), false);
+  for (ExposureIndex e : storage_->exposure_of_observation) observed[e] = true;
   const Exposure* first = nullptr;
-  for (const auto& e : project_.exposures)
-    if (observed.count(e.image) && !first) first = &e;
+  for (ExposureIndex k = 0; k < static_cast<ExposureIndex>(observed.size()) && !first; ++k)
+    if (observed[k]) first = &project_.exposures[k];
   if (!first) return;
-  const auto& a = storage_->exposures.at(first->image);
+  const auto& a = storage_->exposures[storage_->index.Exposure(first->image)];
   const Exposure* far = nullptr;
+  ExposureIndex far_index = -1;
   double far_distance = 0.0;
-  for (const auto& e : project_.exposures) {
-    if (!observed.count(e.image)) continue;
+  for (ExposureIndex k = 0; k < static_cast<ExposureIndex>(observed.size()); ++k) {
+    if (!observed[k]) continue;
+    const Exposure& e = project_.exposures[k];
     const double d = (e.center_m - first->center_m).norm();
     if (d > far_distance) {
       far_distance = d;
       far = &e;
+      far_index = k;
     }
   }
   builder_.FixBlock(a.opk_block);
@@ -447,7 +502,7 @@ void BlockAdjustment::DefineDatum() {
   if (far) {
     int axis = 0;
     (far->center_m - first->center_m).cwiseAbs().maxCoeff(&axis);
-    builder_.FixEntries(storage_->exposures.at(far->image).center_block, {axis});
+    builder_.FixEntries(storage_->exposures[far_index].center_block, {axis});
     text += ", image " + far->image + " centre " + kCenterNames[axis] + " fixed (scale)";
   }
   storage_->datum = text;
@@ -527,7 +582,7 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
   if (scaled.empty()) return out;
   const double scale = std::max(1e-12, 1.4826 * Median(scaled));
   std::map<calib::ResidualId, double> w_of;
-  std::map<std::string, std::vector<calib::ResidualId>> rays_of_point;
+  std::map<PointIndex, std::vector<calib::ResidualId>> rays_of_point;  // by point (id order)
   for (calib::ResidualId id : ids) {
     const auto& r = cof.redundancy.at(id);
     const auto& v = values.at(id);
@@ -535,7 +590,7 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
     for (size_t k = 0; k < r.size(); ++k)
       if (r[k] > 1e-6) w = std::max(w, std::abs(v[k]) / (scale * std::sqrt(r[k])));
     w_of[id] = w;
-    rays_of_point[storage_->observations[storage_->observation_of_residual.at(id)].point].push_back(id);
+    rays_of_point[storage_->point_of_observation[storage_->observation_of_residual.at(id)]].push_back(id);
   }
   // A point of three or more rays with a ray beyond `reject` is judged on its own, the poses and
   // the camera held at the robust solution: the Cauchy solution can settle a point on its
@@ -547,15 +602,15 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
   // adjustment's snooping judges them with their correlated group.
   std::map<calib::ResidualId, double> judged;  // per-point verdicts: the ray's |v| / s there
   for (const auto& point_rays : rays_of_point) {
-    const auto& point = point_rays.first;  // (a lambda may not capture a binding in C++17)
+    // (a lambda may not capture a structured binding in C++17)
+    Storage::PointState& state = storage_->points[point_rays.first];
     const auto& rays = point_rays.second;
     const int n = static_cast<int>(rays.size());
-    auto state = storage_->points.find(point);
-    const bool control = state->second.ground && state->second.ground->role == PointRole::kControl;
+    const bool control = state.Control();
     bool suspect = false;
     for (calib::ResidualId id : rays) suspect |= w_of.at(id) > reject;
     if (n < 3 || control || !suspect) continue;
-    Eigen::Vector3d* xyz = &state->second.xyz;
+    Eigen::Vector3d* xyz = &state.xyz;
     const Eigen::Vector3d robust = *xyz;
     const auto judge = [&](const Eigen::Vector3d& at, std::vector<bool>* agree, double* cost) {
       const auto v = ResidualsWithPointAt(builder_, rays, xyz, at);
@@ -624,11 +679,12 @@ std::string BlockAdjustment::Describe(calib::ResidualId id) const {
 calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   // The datum guard: no control point below two rays, no exposure below three points (unless
   // GNSS and IMU priors hold it). Counts of the active rays, kept up to date on every approval.
-  std::map<std::string, int> point_rays, image_rays;
-  for (const auto& [id, index] : storage_->observation_of_residual)
+  Storage& st = *storage_;
+  std::vector<int> point_rays(st.points.size(), 0), image_rays(st.exposures.size(), 0);
+  for (const auto& [id, index] : st.observation_of_residual)
     if (builder_.IsActive(id)) {
-      ++point_rays[storage_->observations[index].point];
-      ++image_rays[storage_->observations[index].image];
+      ++point_rays[st.point_of_observation[index]];
+      ++image_rays[st.exposure_of_observation[index]];
     }
   calib::SnoopingOptions snooping;
   snooping.groups = {calib::kGroupImage, calib::kGroupSubimage, calib::kGroupControl};
@@ -639,42 +695,48 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   snooping.min_redundancy = options_.min_redundancy;
   snooping.group_correlation = options_.group_correlation;
   int tested_images = 0;
-  for (const auto& [image, n] : image_rays) tested_images += n;
+  for (int n : image_rays) tested_images += n;
   snooping.max_rejections = options_.max_rejections > 0
                                 ? options_.max_rejections
                                 : std::max(kMinAutomaticCap, tested_images / 10);
   snooping.model_error_sigma0 = options_.model_error_sigma0;
   snooping.veto = [&](const std::vector<calib::ResidualId>& ids) -> std::string {
-    std::map<std::string, int> lose_point, lose_image;
+    // Keyed by point index (id order) and by exposure rank (image id order): the first veto
+    // found is the one named.
+    std::map<PointIndex, int> lose_point;
+    std::map<int, int> lose_image;
     for (calib::ResidualId id : ids) {
-      const auto it = storage_->observation_of_residual.find(id);
-      if (it == storage_->observation_of_residual.end()) continue;
-      ++lose_point[storage_->observations[it->second].point];
-      ++lose_image[storage_->observations[it->second].image];
+      const auto it = st.observation_of_residual.find(id);
+      if (it == st.observation_of_residual.end()) continue;
+      ++lose_point[st.point_of_observation[it->second]];
+      ++lose_image[st.exposure_rank[st.exposure_of_observation[it->second]]];
     }
     for (const auto& [point, n] : lose_point) {
-      const auto& state = storage_->points.at(point);
-      const bool control = state.ground && state.ground->role == PointRole::kControl;
-      if (control && point_rays[point] - n < 2)
-        return "control point " + point + " would keep " + std::to_string(point_rays[point] - n) +
+      if (st.points[point].Control() && point_rays[point] - n < 2)
+        return "control point " + st.point_ids[point] + " would keep " +
+               std::to_string(point_rays[point] - n) +
                " ray(s): its rays are kept, check its measurements";
     }
-    for (const auto& [image, n] : lose_image) {
-      const Exposure& e = *storage_->exposures.at(image).exposure;
+    for (const auto& [rank, n] : lose_image) {
+      const ExposureIndex image = st.exposure_order[rank];
+      const Exposure& e = *st.exposures[image].exposure;
       const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
       if (!held && image_rays[image] - n < 3)
-        return "image " + image + " would keep " + std::to_string(image_rays[image] - n) +
+        return "image " + e.image + " would keep " + std::to_string(image_rays[image] - n) +
                " point(s) and be under-determined";
     }
     for (const auto& [point, n] : lose_point) point_rays[point] -= n;
-    for (const auto& [image, n] : lose_image) image_rays[image] -= n;
+    for (const auto& [rank, n] : lose_image) image_rays[st.exposure_order[rank]] -= n;
     return "";
   };
   const calib::SolveReport first = result->solve;
-  calib::SnoopingOutcome out = calib::SolveWithDataSnooping(builder_, options_.solver, snooping);
+  calib::SnoopingOutcome out =
+      calib::SolveWithDataSnooping(builder_, options_.solver, snooping, &first);
   result->solve = out.report;
-  result->solve.iterations += first.iterations;  // the first solve, before snooping
-  result->solve.initial_cost = first.initial_cost;
+  if (out.solves > 0) {
+    result->solve.iterations += first.iterations;  // the first solve, before snooping
+    result->solve.initial_cost = first.initial_cost;
+  }
 
   SnoopingSummary& s = result->snooping;
   s.run = true;
@@ -701,8 +763,7 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   s.seconds_testing = out.seconds_testing;
   if (out.model_error_suspected) {
     int control = 0;
-    for (const auto& [id, state] : storage_->points)
-      control += state.ground && state.ground->role == PointRole::kControl;
+    for (const auto& state : storage_->points) control += state.block >= 0 && state.Control();
     if (!options_.free_interior.empty())
       s.suggestion =
           "the run already self-calibrates: check the camera model, the control survey and the "
@@ -783,6 +844,11 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     if (progress) progress->Advance();
   };
   AdjustmentResult result;
+  using Clock = std::chrono::steady_clock;
+  const auto seconds_since = [](Clock::time_point t) {
+    return std::chrono::duration<double>(Clock::now() - t).count();
+  };
+  const Clock::time_point run_start = Clock::now();
   result.free_interior = options_.free_interior;
   result.frame = project_.frame.description;
   result.datum = storage_->datum;
@@ -816,21 +882,26 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
       return result;
     }
   }
+  result.timing.solve_s = seconds_since(run_start);
   calib::SnoopingOutcome snooped;
+  const Clock::time_point snooping_start = Clock::now();
   if (options_.data_snooping) snooped = Snoop(&result);
+  result.timing.snooping_s = seconds_since(snooping_start);
+  result.timing.testing_s = snooped.seconds_testing;
   // A point left with a single ray after rejections is no longer determined: drop its last
   // observation (it carried no redundancy) and solve once more for honest statistics.
   if (!snooped.rejected.empty()) {
-    std::map<std::string, std::vector<calib::ResidualId>> active_rays;
+    std::vector<std::vector<calib::ResidualId>> active_rays(storage_->points.size());
     for (const auto& [id, index] : storage_->observation_of_residual)
-      if (builder_.IsActive(id)) active_rays[storage_->observations[index].point].push_back(id);
+      if (builder_.IsActive(id)) active_rays[storage_->point_of_observation[index]].push_back(id);
     bool dropped = false;
-    for (auto& [id, state] : storage_->points) {
-      if (state.rays < 0) continue;
-      const auto& ids = active_rays[id];
+    for (PointIndex p = 0; p < static_cast<PointIndex>(storage_->points.size()); ++p) {
+      auto& state = storage_->points[p];
+      if (state.block < 0) continue;
+      const std::string& id = storage_->point_ids[p];
+      const auto& ids = active_rays[p];
       state.rays = static_cast<int>(ids.size());
-      const bool control = state.ground && state.ground->role == PointRole::kControl;
-      if (control || state.rays != 1) continue;
+      if (state.Control() || state.rays != 1) continue;
       builder_.RemoveResidual(ids.front());
       state.rays = 0;
       dropped = true;
@@ -868,8 +939,9 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     if (!builder_.IsActive(id)) continue;
     const ImageObservation& o = storage_->observations[index];
     image_sigmas.push_back(o.sigma_px);
-    image_sigmas_um.push_back(o.sigma_px * storage_->exposures.at(o.image).camera->pixel_size_mm *
-                              1000.0);
+    image_sigmas_um.push_back(
+        o.sigma_px * storage_->exposures[storage_->exposure_of_observation[index]].camera->pixel_size_mm *
+        1000.0);
   }
   result.sigma0 = result.solve.sigma0;
   result.sigma0_px = result.sigma0 * Median(image_sigmas);
@@ -885,12 +957,13 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
       cov_blocks.push_back(b);
       if (!builder_.IsBlockFixed(b)) cross_blocks.push_back(b);
     }
-  for (const auto& [image, state] : storage_->exposures) {
-    cov_blocks.push_back(state.opk_block);
-    cov_blocks.push_back(state.center_block);
+  for (ExposureIndex k : storage_->exposure_order) {
+    cov_blocks.push_back(storage_->exposures[k].opk_block);
+    cov_blocks.push_back(storage_->exposures[k].center_block);
   }
   advance();
   calib::CovarianceReport cov;
+  const Clock::time_point covariance_start = Clock::now();
   if (!options_.estimate_covariance)
     cov.message = "covariance not estimated (option)";
   else if (result.solve.usable && result.solve.redundancy > 0)
@@ -898,6 +971,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
         cov_blocks, result.sigma0, options_.correlation_threshold, cross_blocks);
   else
     cov.message = "no covariance: the adjustment has no usable solution or no redundancy";
+  result.timing.covariance_s = seconds_since(covariance_start);
   advance();
   result.determinability = AssessDeterminability(cov, "camera ", options_.correlation_threshold);
   if (cov.ok) {  // a free platform parameter the block cannot separate, by name
@@ -930,16 +1004,18 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     }
     result.cameras.push_back(c);
   }
-  std::set<std::string> used_images;
+  std::vector<bool> used_images(storage_->exposures.size(), false);
   for (const auto& [id, index] : storage_->observation_of_residual)
-    if (builder_.IsActive(id)) used_images.insert(storage_->observations[index].image);
-  for (const auto& [image, state] : storage_->exposures) {
+    if (builder_.IsActive(id)) used_images[storage_->exposure_of_observation[index]] = true;
+  for (ExposureIndex k : storage_->exposure_order) {
+    const auto& state = storage_->exposures[k];
+    const std::string& image = state.exposure->image;
     ExposureEstimate e;
     e.image = image;
     e.center_m = state.center;
     e.opk_rad = calib::OpkFromQuaternionNear(state.rotation, state.exposure->opk_rad);
     const Exposure& x = *state.exposure;
-    e.used = used_images.count(image) ||
+    e.used = used_images[k] ||
              (options_.use_eo_priors && x.center_sigma_m && x.opk_sigma_rad);
     if (cov.ok && e.used) {
       e.center_sigma_m = cov.BlockSigma(state.center_block, 3);
@@ -951,9 +1027,11 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     }
     result.exposures.push_back(e);
   }
-  for (const auto& [id, state] : storage_->points) {
-    const bool control = state.ground && state.ground->role == PointRole::kControl;
-    if (state.rays >= 0 && state.rays < 2 && !control) continue;
+  for (PointIndex p = 0; p < static_cast<PointIndex>(storage_->points.size()); ++p) {
+    const auto& state = storage_->points[p];
+    const std::string& id = storage_->point_ids[p];
+    const bool control = state.Control();
+    if (state.block < 0 || (state.rays < 2 && !control)) continue;
     result.points_m[id] = state.xyz;
     if (!state.ground || state.ground->role == PointRole::kTie || !state.ground->xyz_m) continue;
     PointDifference d;
@@ -1011,6 +1089,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
                       " parameter(s) not determinable (" +
                       result.determinability.undetermined.front() + ", ...)");
   result.warnings = GroupRmsWarnings(result.solve);
+  result.timing.total_s = seconds_since(run_start);
   return result;
 }
 

@@ -23,6 +23,12 @@
 // platform poses, the priors, the datum, statistics and data snooping. A raw sub-image
 // observation that no kind measures is mapped to the virtual image with the camera file's mapping
 // and measured by the frame camera.
+//
+// Identities: exposures (ExposureIndex, Project::exposures order) and ground points (PointIndex,
+// the observed point ids sorted) are dense indices assigned once when the block is built; every
+// loop, the snooping bookkeeping and the datum guard work on them. Ids are strings only when read
+// (the public *Block(id) lookups) and in labels and results; loops that decide an order (priors,
+// notes, covariance blocks, results) go by sorted id, so results do not depend on the indices.
 #pragma once
 
 #include "calib/core/progress.h"
@@ -90,8 +96,9 @@ class BlockAdjustment {
   struct Storage;
   void BuildExposures();
   void BuildPoints();
-  /// Adds the ground point block of `point`, starting at `start_m`.
-  calib::BlockId AddPoint(const std::string& point, const Eigen::Vector3d& start_m);
+  /// Adds the ground point block of `point` (a dense index of the observed points), starting at
+  /// `start_m`; its block when it has one already.
+  calib::BlockId AddPoint(PointIndex point, const Eigen::Vector3d& start_m);
   void AddImageResiduals(const calib::LossOptions& loss);
   void AddPriors();
   /// The platform blocks (lever arm and GNSS time offset with GNSS priors, boresight with IMU

@@ -49,6 +49,8 @@ std::string ResolvePath(const std::string& base_dir, const std::string& file) {
 std::vector<Exposure> ReadExposures(const std::string& path) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"image", "X", "Y", "Z", "omega", "phi", "kappa"});
+  t.RejectUnknownColumns({"image", "camera", "X", "Y", "Z", "omega", "phi", "kappa", "sX", "sY", "sZ",
+                         "somega", "sphi", "skappa", "vX", "vY", "vZ", "z_ref"});
   std::vector<Exposure> out;
   std::set<std::string> seen;
   for (const auto& row : t.rows()) {
@@ -99,10 +101,14 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
   const bool head = t.HasColumn("head");
   if (sub && head)
     ThrowInputError({path, 1}, "an observations table has a subimage or a head column, not both");
-  if (sub)
+  // (`group`: the test-field groups of `calibrate`, read by tools/cmd_calibrate.cc)
+  if (sub) {
     t.RequireColumns({"image", "subimage", "point", "u", "v"});
-  else
+    t.RejectUnknownColumns({"image", "subimage", "point", "u", "v", "sigma_px", "group"});
+  } else {
     t.RequireColumns({"image", "point", "col", "row"});
+    t.RejectUnknownColumns({"image", "head", "point", "col", "row", "sigma_px", "group"});
+  }
   std::vector<ImageObservation> out;
   out.reserve(t.rows().size());
   for (const auto& row : t.rows()) {
@@ -136,6 +142,7 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
 std::vector<GroundPoint> ReadPoints(const std::string& path) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"point", "X", "Y", "Z"});
+  t.RejectUnknownColumns({"point", "X", "Y", "Z", "sX", "sY", "sZ", "role"});
   std::vector<GroundPoint> out;
   std::set<std::string> seen;
   for (const auto& row : t.rows()) {

@@ -151,6 +151,9 @@ BudgetOptions ReadBudgetOptions(const std::string& path) {
   if (!root || root.IsNull()) return options;
   if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map");
   RejectUnknownKeys(root, {"radii_mm", "target_radius_mm", "components"}, path);
+  for (const char* list : {"radii_mm", "components"})  // a map or a scalar there is no list
+    if (root[list] && !root[list].IsSequence())
+      throw InputError(WhereIs(root[list], path).ToString() + ": " + list + " must be a list");
   if (root["radii_mm"]) {
     for (const auto& r : root["radii_mm"])
       options.radii_mm.push_back(YamlBounded(r, path, "radii_mm", 1e-9, 1e6));

@@ -204,6 +204,8 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
   stitch::LsmOptions lsm = o.lsm;
   lsm.half_size_px = h;
   std::vector<double> match_sigmas;
+  const auto ranges = camera.Ranges();
+  const auto plane = [&o](double, double) { return o.mean_height_m; };
   for (const auto& ip : interest) {
     const Eigen::Vector2i p(int(std::lround(ip.position.x())), int(std::lround(ip.position.y())));
     // The template and a margin must lie on valid cells.
@@ -213,6 +215,19 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
     for (int y = -r; y <= r && valid; ++y)
       for (int x = -r; x <= r && valid; ++x) valid = l1.Valid(p.x() + x, p.y() + y);
     if (!valid) continue;
+    // The line-image template: centred on the integer pixel q nearest to the cell's line-image
+    // position, moved inside the cell's sub-camera (the template must not cross a seam). The
+    // observation is q itself, so no interpolated grey value of the line image enters it.
+    const Eigen::Vector2d cell_in_line(l1.detector_map(p.y(), p.x()), l1.line_map(p.y(), p.x()));
+    const auto [first, last] = ranges[camera.SubcameraOf(cell_in_line.x())];
+    if (last - first < 2 * h + 2) continue;
+    const Eigen::Vector2i q(std::clamp<int>(int(std::lround(cell_in_line.x())), first + h + 1, last - h - 1),
+                            int(std::lround(cell_in_line.y())));
+    if (q.y() < h + 1 || q.y() > line_image.rows() - h - 2) continue;
+    const auto q_ground = GroundOfDetector(camera, pos, q.x(), q.y(), plane);
+    const auto qx_ground = GroundOfDetector(camera, pos, q.x() + 1, q.y(), plane);
+    const auto qy_ground = GroundOfDetector(camera, pos, q.x(), q.y() + 1, plane);
+    if (!q_ground || !qx_ground || !qy_ground) continue;
     ++out.n_interest;
     const Eigen::Vector3d g0 = l1.grid.Ground(p.x(), p.y());
     std::vector<Ray2> rays;
@@ -234,8 +249,27 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
       double ncc = 0;
       if (!SearchCorrelation(l1.image, p, f.image, t0, a0, h, o.search_px, &shift, &ncc)) continue;
       if (ncc < o.min_correlation) continue;
-      const auto m = stitch::MatchLeastSquares(l1.image, p, f.image,
-                                               t0 + a0 * shift.cast<double>(), a0, lsm);
+      const auto m_l1 = stitch::MatchLeastSquares(l1.image, p, f.image,
+                                                  t0 + a0 * shift.cast<double>(), a0, lsm);
+      if (!m_l1.ok()) continue;
+      // Refined from the line image itself: the L1 grey values are interpolated at fractional
+      // line-image positions whose fraction drifts slowly over the L1 grid (its cells are not
+      // the detectors), and interpolation shifts fine texture towards the nearest sample: a
+      // smooth bias of the L1 position (module README "Cloud control").
+      Eigen::Vector2d pq, pqx, pqy;
+      if (!ref_camera.ProjectToPixel(f.opk_rad, f.center_m, *q_ground, &pq) ||
+          !ref_camera.ProjectToPixel(f.opk_rad, f.center_m, *qx_ground, &pqx) ||
+          !ref_camera.ProjectToPixel(f.opk_rad, f.center_m, *qy_ground, &pqy))
+        continue;
+      Eigen::Matrix2d a_line;
+      a_line.col(0) = pqx - pq;
+      a_line.col(1) = pqy - pq;
+      const Eigen::Vector2d start = m_l1.position_in_b + a_line * (q.cast<double>() - cell_in_line);
+      const double margin = (h + 3) * a_line.cwiseAbs().rowwise().sum().maxCoeff();
+      if (!(start.x() > margin && start.y() > margin && start.x() < f.image.cols() - 1 - margin &&
+            start.y() < f.image.rows() - 1 - margin))
+        continue;
+      const auto m = stitch::MatchLeastSquares(line_image, q, f.image, start, a_line, lsm);
       if (!m.ok()) continue;
       match_sigmas.push_back(m.SigmaMaxPx());
       Ray2 ray;
@@ -280,8 +314,8 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
     point.sigma_m = sigma;
     LineObservation obs;
     obs.point = point.id;
-    obs.detector = l1.detector_map(p.y(), p.x());
-    obs.line = l1.line_map(p.y(), p.x());
+    obs.detector = q.x();
+    obs.line = q.y();
     obs.sigma_px = o.line_sigma_px;
     obs.source_line = int(out.observations.size()) + 2;
     out.points.push_back(point);
@@ -307,7 +341,7 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
   return out;
 }
 
-std::string CloudControlToJson(const CloudControlResult& r, const CloudControlOptions& o) {
+nlohmann::json CloudControlToJson(const CloudControlResult& r, const CloudControlOptions& o) {
   nlohmann::json j;
   j["kind"] = "pushbroom_control";
   j["l1"] = {{"width", r.l1.grid.width}, {"height", r.l1.grid.height}, {"gsd_m", r.l1.grid.gsd_m},
@@ -324,7 +358,7 @@ std::string CloudControlToJson(const CloudControlResult& r, const CloudControlOp
                   {"min_correlation", o.min_correlation}, {"min_match_sigma_px", o.min_match_sigma_px},
                   {"line_sigma_px", o.line_sigma_px}, {"gross_error_alpha", o.gross_error_alpha},
                   {"max_point_sigma_m", o.max_point_sigma_m}};
-  return j.dump(2) + "\n";
+  return j;
 }
 
 }  // namespace aerocal::triangulation

@@ -15,8 +15,15 @@
 //    line-image side, the misclosure against the nominal camera and the POS is smooth in the
 //    detector index (calibration, POS error): per sub-camera and axis a robust degree-5 fit drops
 //    points off it by more than line_outlier_k x 1.4826 MAD (and line_outlier_min_px).
-// The line-image observation of a point is the line-image position of its L1 cell (the L1 maps),
-// exact by construction: the L1 grey value at that cell was resampled from there.
+// 3b. the match is then refined from the line image itself: the template centred on the integer
+//    line-image pixel q nearest to the L1 cell's position (moved inside its sub-camera so that it
+//    does not cross a seam) is matched by least squares into the reference image, starting from
+//    the L1 match, with the local affine line pixel -> plane -> reference pixel. The line-image
+//    observation of the point is q itself (no interpolated line-image grey value enters it).
+//    Why: an L1 grey value is interpolated at a fractional line-image position whose fraction
+//    drifts slowly over the L1 grid (L1 cells are not the detectors), and interpolation shifts
+//    fine texture towards the nearest sample, so the L1 template's content is off its map position
+//    by a smooth function of the detector: measured, a 0.08 px across-track table bias.
 #pragma once
 
 #include <string>
@@ -82,7 +89,7 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
                                     const std::vector<ReferenceFrame>& references,
                                     const CloudControlOptions& options);
 
-/// control.json text: the counts above, the L1 grid and the options used.
-std::string CloudControlToJson(const CloudControlResult& result, const CloudControlOptions& options);
+/// control.json (kind "pushbroom_control", written by WriteResult): the counts above, the L1 grid and the options used.
+nlohmann::json CloudControlToJson(const CloudControlResult& result, const CloudControlOptions& options);
 
 }  // namespace aerocal::triangulation

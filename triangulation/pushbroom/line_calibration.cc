@@ -42,6 +42,8 @@ struct Problem {
   std::vector<Eigen::Vector3d> point_values;
   std::vector<calib::ResidualId> image_residuals;
   std::vector<int> residual_subcamera;
+  std::vector<double> residual_detector, residual_u;   // per image residual: plots
+  std::vector<Eigen::Vector2d> residual_sigma_mm;
   std::vector<std::set<int>> fixed_entries;  // per detector block
 };
 
@@ -86,6 +88,7 @@ void WriteLineObservations(const std::string& path, const std::vector<LineObserv
 std::vector<LineObservation> ReadLineObservations(const std::string& path, double default_sigma_px) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"point", "col", "row"});
+  t.RejectUnknownColumns({"image", "point", "col", "row", "sigma_px"});
   std::vector<LineObservation> out;
   for (const auto& row : t.rows()) {
     LineObservation o;
@@ -242,6 +245,9 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         "point " + o.point);
     p.image_residuals.push_back(id);
     p.residual_subcamera.push_back(s);
+    p.residual_detector.push_back(o.detector);
+    p.residual_u.push_back(u);
+    p.residual_sigma_mm.push_back(sigma_xy_mm);
     // The start must be a valid geometry (the point in front of the camera).
     if (b.EvaluateResidual(id).empty())
       ThrowInputError(where, "point " + o.point + " lies behind the camera at line " +
@@ -475,6 +481,22 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     }
   }
 
+  // Error samples (plots): the fitted correction at the measured position minus the residual,
+  // i.e. what remains without the detector calibration, in pitches.
+  for (size_t k = 0; k < p.image_residuals.size(); ++k) {
+    const auto r = b.EvaluateResidual(p.image_residuals[k]);
+    if (r.size() != 2) continue;
+    const int s = p.residual_subcamera[k];
+    const double u = p.residual_u[k];
+    const Eigen::Vector2d base = camera.Correction(p.residual_detector[k]);
+    const double dx = base.x() + calib::EvaluatePolynomial(p.detector[s].data(), kLineMaxTerms, u);
+    const double dy =
+        base.y() + calib::EvaluatePolynomial(p.detector[s].data() + kLineMaxTerms, kLineMaxTerms, u);
+    result.error_samples.push_back({p.residual_detector[k], s,
+                                    (dx - r[0] * p.residual_sigma_mm[k].x()) / camera.pitch_mm,
+                                    (dy - r[1] * p.residual_sigma_mm[k].y()) / camera.pitch_mm});
+  }
+
   // Spline nodes and per-line corrections with sigmas.
   for (int j = 0; j < n_nodes; ++j) {
     result.node_line.push_back(first_line + (j - 1) * double(spacing));
@@ -635,7 +657,7 @@ std::string LineCorrectionsToCsv(const LineCalibrationResult& r) {
   return out;
 }
 
-std::string LineCalibrationToJson(const LineCalibrationResult& r) {
+nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
   using nlohmann::json;
   auto opt = [](const std::optional<double>& v) { return v ? json(*v) : json(nullptr); };
   json j;
@@ -702,7 +724,7 @@ std::string LineCalibrationToJson(const LineCalibrationResult& r) {
   for (const auto& g : r.report.groups)
     groups.push_back({{"name", g.name}, {"n", g.n_observations}, {"rms", g.rms}});
   j["groups"] = groups;
-  return j.dump(1) + "\n";
+  return j;
 }
 
 }  // namespace aerocal::triangulation

@@ -21,6 +21,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <nlohmann/json.hpp>
 
 #include "calib/camera/line_camera.h"
 #include "calib/problem/problem_builder.h"
@@ -71,6 +72,15 @@ struct SubcameraRms {
   std::vector<std::optional<double>> dx_sigma_mm, dy_sigma_mm; // null: fixed (datum / degree)
 };
 
+/// One observation's reprojection error without the detector calibration, at the adjusted
+/// trajectory (the points the detector polynomial fits; plots): focal-plane error in pitches
+/// (px), across (x) and along (y) track.
+struct LineErrorSample {
+  double detector = 0.0;
+  int subcamera = 0;
+  double across_px = 0.0, along_px = 0.0;
+};
+
 struct LineCalibrationResult {
   calib::SolveReport report;
   bool valid = true;               // false: cannot be trusted (warnings say why)
@@ -80,6 +90,7 @@ struct LineCalibrationResult {
   /// Per detector: the estimated calibration (mm) and its sigma (mm, null when not determined).
   std::vector<double> dx_mm, dy_mm;
   std::vector<std::optional<double>> dx_sigma_mm, dy_sigma_mm;
+  std::vector<LineErrorSample> error_samples;  // one per image observation used
   /// Spline nodes: line of each node's centre, values [dX dY dZ m, domega dphi dkappa rad], sigmas.
   std::vector<double> node_line;
   std::vector<Eigen::Matrix<double, 6, 1>> node_values, node_sigma;
@@ -116,7 +127,8 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
 /// Per-line corrections as CSV: line,dX,dY,dZ,domega,dphi,dkappa + sigmas (m, deg).
 std::string LineCorrectionsToCsv(const LineCalibrationResult& result);
 
-/// result.json text (FORMATS.md "Results": kind "pushbroom" plus the keys of the module README).
-std::string LineCalibrationToJson(const LineCalibrationResult& result);
+/// result.json (FORMATS.md "Results": kind "pushbroom" plus the keys of the module README; written
+/// by WriteResult of calib/core/result_file.h with its schema_version).
+nlohmann::json LineCalibrationToJson(const LineCalibrationResult& result);
 
 }  // namespace aerocal::triangulation

@@ -50,6 +50,8 @@ std::optional<Eigen::Vector3d> Median3(const std::vector<PosRecord>& records, bo
 PosTrajectory PosTrajectory::Read(const std::string& path) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"line", "time_s", "X", "Y", "Z", "omega", "phi", "kappa"});
+  t.RejectUnknownColumns({"line", "time_s", "X", "Y", "Z", "omega", "phi", "kappa", "sX", "sY", "sZ",
+                         "somega", "sphi", "skappa"});
   std::vector<PosRecord> records;
   for (const auto& row : t.rows()) {
     PosRecord r;

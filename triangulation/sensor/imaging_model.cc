@@ -28,6 +28,11 @@ ExposureIndex DenseIndex::Exposure(const std::string& image) const {
   return it->second;
 }
 
+ExposureIndex DenseIndex::FindExposure(const std::string& image) const {
+  const auto it = exposure_by_image_.find(image);
+  return it == exposure_by_image_.end() ? -1 : it->second;
+}
+
 ObservationSite SensorContext::Site(const ImageObservation& observation) const {
   ObservationSite site;
   site.index = index.Exposure(observation.image);

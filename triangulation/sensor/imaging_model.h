@@ -37,6 +37,8 @@ namespace aerocal::triangulation {
 
 using CameraIndex = int;    // position of a camera in DenseIndex::camera_ids (sorted ids)
 using ExposureIndex = int;  // position of an exposure in Project::exposures
+using PointIndex = int;     // position of a ground point among the adjustment's observed points
+                            // (sorted ids; BlockAdjustment assigns them once)
 
 /// Dense indices of the project's cameras and exposures. AEROCAL_CHECK (LogicError) on an unknown
 /// id: the readers have validated every reference before an adjustment starts.
@@ -45,6 +47,8 @@ class DenseIndex {
   explicit DenseIndex(const Project& project);
   CameraIndex Camera(const std::string& id) const;
   ExposureIndex Exposure(const std::string& image) const;
+  /// As Exposure, -1 when `image` is not an exposure of the project.
+  ExposureIndex FindExposure(const std::string& image) const;
   /// The camera of an exposure.
   CameraIndex CameraOfExposure(ExposureIndex exposure) const {
     return camera_of_exposure_[exposure];

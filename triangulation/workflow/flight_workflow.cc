@@ -4,6 +4,7 @@
 #include <filesystem>
 
 #include "calib/camera/camera_io.h"
+#include "calib/camera/camera_model_json.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
 #include "stitch/adjustment/flight_stability.h"
@@ -73,6 +74,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   nlohmann::json& doc = out.document;
   doc["kind"] = "flight";
   doc["camera"] = options.camera_file;
+  doc["camera_model"] = calib::CameraModelTableToJson(camera.model);
   doc["data"] = options.data_folder;
   doc["camera_format"] = {{"width_px", camera.width_px},
                           {"height_px", camera.height_px},

@@ -1,0 +1,55 @@
+#include "calib/core/result_file.h"
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/json_file.h"
+
+namespace aerocal {
+
+std::string ResultText(std::string_view kind, nlohmann::json document, int indent) {
+  AEROCAL_CHECK(document.is_object()) << "a result document is a JSON object";
+  if (document.contains("kind"))
+    AEROCAL_CHECK(document["kind"] == std::string(kind))
+        << "result of kind " << document["kind"].dump() << " written as " << kind;
+  document["kind"] = std::string(kind);
+  document["schema_version"] = kResultSchemaVersion;
+  return document.dump(indent) + "\n";
+}
+
+void WriteResult(const std::string& path,
+                 std::string_view kind,
+                 nlohmann::json document,
+                 int indent) {
+  WriteFileAtomically(path, ResultText(kind, std::move(document), indent));
+}
+
+void CheckResult(const nlohmann::json& document,
+                 const std::string& path,
+                 std::initializer_list<std::string_view> kinds,
+                 std::string_view what) {
+  std::string expected;
+  for (std::string_view k : kinds)
+    expected += (expected.empty() ? "\"" : " or \"") + std::string(k) + "\"";
+  const nlohmann::json kind =
+      document.is_object() && document.contains("kind") ? document["kind"] : nlohmann::json();
+  bool known = false;
+  for (std::string_view k : kinds) known = known || (kind.is_string() && kind == std::string(k));
+  if (!known)
+    throw InputError(path + ": not a result of " + std::string(what) + " (kind is " + kind.dump() +
+                     ", expected " + expected + ")");
+  const nlohmann::json version =
+      document.contains("schema_version") ? document["schema_version"] : nlohmann::json();
+  if (!version.is_number_integer() || version.get<long long>() != kResultSchemaVersion)
+    throw InputError(path + ": schema_version is " + version.dump() + ", expected " +
+                     std::to_string(kResultSchemaVersion) + " (kind " + kind.dump() + ")");
+}
+
+nlohmann::json ReadResult(const std::string& path,
+                          std::initializer_list<std::string_view> kinds,
+                          std::string_view what) {
+  nlohmann::json document = ReadJsonFile(path);
+  CheckResult(document, path, kinds, what);
+  return document;
+}
+
+}  // namespace aerocal

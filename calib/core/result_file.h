@@ -1,0 +1,48 @@
+// Result documents of the commands (JSON): ONE writer and ONE reader check for all of them.
+// Every result carries `kind` (which command wrote it: "adjust", "calibrate", "flight", "stitch",
+// "rig_stitch", "rig_error_analysis", "rig_design", "pushbroom", "pushbroom_control",
+// "camera_conversion", "certificate") and `schema_version` (kResultSchemaVersion), and is written
+// atomically (calib/core/atomic_file.h). A reader of a result (the certificate, the report, a
+// stitch result applied to a camera) checks both and refuses any other document with
+// `FILE: what` (an InputError: exit 2). The keys of each kind are in the README of the module that
+// builds it (calib/README.md "Result documents" lists them).
+#pragma once
+
+#include <initializer_list>
+#include <string>
+#include <string_view>
+
+#include <nlohmann/json.hpp>
+
+namespace aerocal {
+
+/// Version of every result document; raised when a key changes meaning or is removed (adding a
+/// key does not raise it). Readers accept exactly this version.
+inline constexpr int kResultSchemaVersion = 1;
+
+/// `document` (a JSON object) stamped with `kind` and `schema_version`, as text (`indent` spaces,
+/// newline at the end). Throws LogicError when `document` is not an object or already names
+/// another kind.
+std::string ResultText(std::string_view kind, nlohmann::json document, int indent = 2);
+
+/// Writes ResultText(kind, document, indent) to `path` atomically (nothing partial on failure).
+void WriteResult(const std::string& path,
+                 std::string_view kind,
+                 nlohmann::json document,
+                 int indent = 2);
+
+/// Throws InputError("PATH: not a result of WHAT (kind is K, expected A or B)") unless `document`
+/// is an object whose `kind` is one of `kinds`, and InputError("PATH: schema_version is V, expected
+/// N (kind K)") unless its `schema_version` is kResultSchemaVersion. `what` names the
+/// command for people ("`aerocal calibrate`").
+void CheckResult(const nlohmann::json& document,
+                 const std::string& path,
+                 std::initializer_list<std::string_view> kinds,
+                 std::string_view what);
+
+/// ReadJsonFile(path) (FILE:LINE on invalid JSON) + CheckResult.
+nlohmann::json ReadResult(const std::string& path,
+                          std::initializer_list<std::string_view> kinds,
+                          std::string_view what);
+
+}  // namespace aerocal
