@@ -31,7 +31,9 @@
 #include "stitch/rig/rig_design.h"
 #include "stitch/rig/self_calibration.h"
 #include "stitch/rig/self_calibration_json.h"
+#include "stitch/rig/rig_tie_matching.h"
 #include "stitch/rig/stitched_image.h"
+#include "stitch/image_io/image_io.h"
 #include "tools/command_registry.h"
 #include "tools/python_script.h"
 #include "tools/image_sources.h"
@@ -311,6 +313,7 @@ struct StitchArgs {
   int tile_px = 256;
   bool bigtiff = false, no_balance = false;
   int feather_px = 64;
+  bool match_ties = false;  // ties matched on the head images instead of observations.csv
   CLI::Option* increment_sigma_option = nullptr;
   CLI::Option* dt_sigma_option = nullptr;
   CLI::Option* relief_option = nullptr;
@@ -324,6 +327,28 @@ struct StitchInputs {
   std::vector<stitch::RigStitchTie> ties;
   std::vector<stitch::RigStitchObservation> observations;
 };
+
+// An exposure of the project as the library's: POS, velocity (optional) and z_ref (required,
+// below the rig centre; FILE:LINE otherwise).
+stitch::RigStitchExposure StitchExposure(const triangulation::Project& project,
+                                         const triangulation::Exposure& e) {
+  if (!e.z_ref_m)
+    ThrowInputError({project.exposures_file, e.line},
+                    "image " + e.image + " has no z_ref (rig stitch rectifies onto the level "
+                    "plane Z = z_ref of each exposure)");
+  if (!(e.center_m.z() > *e.z_ref_m))
+    ThrowInputError({project.exposures_file, e.line},
+                    "image " + e.image + ": z_ref (" + FormatNumber(*e.z_ref_m) +
+                        " m) must lie below the rig centre Z (" + FormatNumber(e.center_m.z()) +
+                        " m)");
+  stitch::RigStitchExposure x;
+  x.image = e.image;
+  x.pose.rig_opk_rad = e.opk_rad;
+  x.pose.rig_center_m = e.center_m;
+  x.pose.velocity_mps = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
+  x.z_ref_m = *e.z_ref_m;
+  return x;
+}
 
 StitchInputs StitchInputsFromProject(const triangulation::Project& project, const calib::Rig& rig,
                                      const std::string& camera_file) {
@@ -340,25 +365,7 @@ StitchInputs StitchInputsFromProject(const triangulation::Project& project, cons
     const int head = rig.HeadIndex(o.head);
     if (head < 0) ThrowInputError(where, "head '" + o.head + "' is not a head of " + camera_file);
     auto [it, added] = exposure_index.try_emplace(o.image, static_cast<int>(in.exposures.size()));
-    if (added) {
-      const triangulation::Exposure& e = *project.FindExposure(o.image);
-      if (!e.z_ref_m)
-        ThrowInputError({project.exposures_file, e.line},
-                        "image " + e.image + " has no z_ref (rig stitch rectifies onto the level "
-                        "plane Z = z_ref of each exposure)");
-      if (!(e.center_m.z() > *e.z_ref_m))
-        ThrowInputError({project.exposures_file, e.line},
-                        "image " + e.image + ": z_ref (" + FormatNumber(*e.z_ref_m) +
-                            " m) must lie below the rig centre Z (" + FormatNumber(e.center_m.z()) +
-                            " m)");
-      stitch::RigStitchExposure x;
-      x.image = e.image;
-      x.pose.rig_opk_rad = e.opk_rad;
-      x.pose.rig_center_m = e.center_m;
-      x.pose.velocity_mps = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
-      x.z_ref_m = *e.z_ref_m;
-      in.exposures.push_back(x);
-    }
+    if (added) in.exposures.push_back(StitchExposure(project, *project.FindExposure(o.image)));
     const std::string label = fs::path(project.observations_file).filename().string() + ":" +
                               std::to_string(o.line);
     in.observations.push_back(
@@ -385,6 +392,41 @@ std::unique_ptr<stitch::RasterSource> OpenHeadImage(const std::string& path) {
   return std::make_unique<stitch::MemoryRaster>(stitch::ReadImageFile(path, true));
 }
 
+// --match-ties: every exposure of the project, its ties matched on the head images under --images
+// (stitch/rig/rig_tie_matching.h); observations.csv must have no rows. The zones' counts in
+// `zones`.
+StitchInputs MatchedStitchInputs(const triangulation::Project& project, const calib::Rig& rig,
+                                 const std::string& images,
+                                 std::vector<stitch::RigZoneMatchReport>* zones) {
+  if (!project.observations.empty())
+    ThrowInputError({project.observations_file, project.observations.front().line},
+                    "--match-ties measures the ties on the head images: observations.csv must have "
+                    "no rows (got " + std::to_string(project.observations.size()) + ")");
+  StitchInputs in;
+  for (const auto& e : project.exposures) in.exposures.push_back(StitchExposure(project, e));
+  if (in.exposures.empty()) throw InputError(project.exposures_file + ": no exposures");
+  for (const auto& e : in.exposures)  // every head image present before anything is computed
+    for (const auto& head : rig.heads) HeadImagePath(images, e.image, head.id);
+  stitch::RigTieMatches matches;
+  for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i) {
+    std::vector<stitch::GrayImage> heads;
+    for (const auto& head : rig.heads) {
+      const std::string path = HeadImagePath(images, in.exposures[i].image, head.id);
+      heads.push_back(stitch::ReadGrayImage(path));
+      if (heads.back().cols() != head.camera.width_px || heads.back().rows() != head.camera.height_px)
+        throw InputError(path + ": " + std::to_string(heads.back().cols()) + " x " +
+                         std::to_string(heads.back().rows()) + " px, head " + head.id + " is " +
+                         std::to_string(head.camera.width_px) + " x " +
+                         std::to_string(head.camera.height_px) + " px");
+    }
+    stitch::MatchRigExposureTies(rig, in.exposures[i], i, heads, {}, &matches);
+  }
+  in.ties = std::move(matches.ties);
+  in.observations = std::move(matches.observations);
+  *zones = std::move(matches.zones);
+  return in;
+}
+
 // The stitched image of every exposure with the refined increments and offsets (stitch/rig/
 // stitched_image.h): <image>.tif and <image>_mask.tif under --stitched-out; the figures as JSON.
 nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig,
@@ -405,7 +447,7 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
     for (const auto& h : refined->heads) {
       const int k = rig.HeadIndex(h.head);
       pose.increment_rad[k] = h.increment_rad;
-      pose.dt_s[k] = h.dt_s.value_or(0.0);  // not determinable (per-exposure mode): none applied
+      pose.dt_s[k] = h.dt_fitted_s;  // also where not determinable on its own: the fitted geometry
     }
     const stitch::RigConverter converter(
         rig, pose, stitch::MakeRectificationPlane(rig, pose, e.pose.rig_center_m.z() - e.z_ref_m));
@@ -463,9 +505,12 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
 }
 
 int RunStitch(const StitchArgs& args) {
-  if (args.images.empty() != args.stitched_out.empty())
-    throw ConfigError("--images and --stitched-out go together (the head images and the folder of "
-                      "the stitched images)");
+  if (args.images.empty() && (!args.stitched_out.empty() || args.match_ties))
+    throw ConfigError(std::string(args.match_ties ? "--match-ties" : "--stitched-out") +
+                      " needs --images (the folder of the head images)");
+  if (!args.images.empty() && args.stitched_out.empty() && !args.match_ties)
+    throw ConfigError("--images needs --stitched-out or --match-ties (what to do with the head "
+                      "images)");
   CheckTilePx(args.tile_px);
   if (!(args.feather_px >= 1 && args.feather_px <= 255))
     throw ConfigError("--feather-px must be within 1..255 (got " + std::to_string(args.feather_px) + ")");
@@ -498,7 +543,10 @@ int RunStitch(const StitchArgs& args) {
   options.max_sigma0 = args.max_sigma0;
   if (!(args.default_sigma_px > 0)) throw ConfigError("--sigma-px must be > 0");
   const triangulation::Project project = triangulation::ReadProject(args.project, args.default_sigma_px);
-  const StitchInputs in = StitchInputsFromProject(project, rig, args.camera);
+  std::vector<stitch::RigZoneMatchReport> matched_zones;
+  const StitchInputs in = args.match_ties
+                              ? MatchedStitchInputs(project, rig, args.images, &matched_zones)
+                              : StitchInputsFromProject(project, rig, args.camera);
   double height_sum = 0.0;
   for (const auto& e : in.exposures) height_sum += e.pose.rig_center_m.z() - e.z_ref_m;
   const double height_m = height_sum / in.exposures.size();
@@ -513,15 +561,28 @@ int RunStitch(const StitchArgs& args) {
   // The standard tie positions of the rig's design at the block's mean height.
   const std::vector<stitch::StandardPosition> positions =
       stitch::DesignRig(rig, height_m, 200).standard_positions;
-  if (!args.images.empty())  // every head image present before anything is computed or written
+  if (!args.stitched_out.empty())  // every head image present before anything is computed or written
     for (const auto& e : in.exposures)
       for (const auto& head : rig.heads) HeadImagePath(args.images, e.image, head.id);
   const stitch::RigStitchResult result = stitch::SelfCalibrateRigStitching(
       rig, in.exposures, in.ties, in.observations, positions, options);
   nlohmann::json json = stitch::RigStitchToJson(rig, options, result, sources);
   json["camera_models"] = HeadCameraModels(rig);
+  if (args.match_ties) {
+    nlohmann::json zones = nlohmann::json::array();
+    for (const auto& z : matched_zones) {
+      zones.push_back({{"image", z.image}, {"zone", z.zone}, {"pixels", z.pixels},
+                       {"cells", z.cells}, {"lsm_tried", z.lsm_tried},
+                       {"lsm_failed", z.lsm_failed}, {"ties", z.ties}});
+      std::printf("matched %s zone %s: %d ties (%d cells, LSM %d tried, %d failed)\n",
+                  z.image.c_str(), z.zone.c_str(), z.ties, z.cells, z.lsm_tried, z.lsm_failed);
+    }
+    json["tie_matching"] = {{"ties", in.ties.size()},
+                            {"observations", in.observations.size()},
+                            {"zones", zones}};
+  }
   std::fputs(stitch::FormatRigStitchSummary(options, result, sources).c_str(), stdout);
-  if (!args.images.empty()) {
+  if (!args.stitched_out.empty()) {
     if (result.failures.empty())
       json["stitched_images"] = WriteStitchedImages(args, rig, in.exposures, result);
     else
@@ -725,6 +786,10 @@ CommandRun Setup(CLI::App& app) {
                  "Folder for the stitched level image of every exposure (<image>.tif, resampled "
                  "once with the refined increments and offsets, balanced, blended) and its "
                  "valid-area mask (<image>_mask.tif)");
+  st->add_flag("--match-ties", stitching->match_ties,
+               "Match the ties on the head images under --images (Foerstner + least-squares "
+               "matching per overlap zone, on the level plane of the ground calibration and the "
+               "POS) instead of reading them from observations.csv (which must have no rows)");
   st->add_option("--tile-px", stitching->tile_px,
                  "Stitched images: square TIFF tiles of this size (multiple of 16, 16..4096; 0: strips)");
   st->add_flag("--bigtiff", stitching->bigtiff, "Stitched images: BigTIFF even when classic TIFF would do");

@@ -56,6 +56,28 @@ MemoryRaster AsSixteenBit(RasterSource* source, double scale) {
 
 }  // namespace
 
+HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter, int head,
+                                      const MapCorrectionGrid& grid, RasterSource* source,
+                                      const ResampleOptions& resample) {
+  const calib::Camera all = RigExposureAsSubimageCamera(converter);
+  const int width = all.width_px, height = all.height_px;
+  calib::Camera one = all;
+  one.subimages = {all.subimages[head]};
+  const std::vector<MapCorrectionGrid> grids = {grid};
+  const RasterInfo info = source->Info();
+  HeadProjection out{MemoryRaster({width, height, 1, info.bits}), {}};
+  ResampleVirtualImage(one, {source}, &out.values, resample, grids);
+  MemoryRaster ones({info.width, info.height, 1, 8});
+  std::fill(ones.bytes().begin(), ones.bytes().end(), 0xFF);
+  MemoryRaster covered({width, height, 1, 8});
+  ResampleOptions coverage = resample;
+  coverage.fill = 0.0;
+  ResampleVirtualImage(one, {&ones}, &covered, coverage, grids);
+  out.covered.resize(static_cast<size_t>(width) * height);
+  for (size_t i = 0; i < out.covered.size(); ++i) out.covered[i] = covered.bytes()[i] > 127 ? 255 : 0;
+  return out;
+}
+
 StitchedImageReport MakeStitchedImage(const RigConverter& converter,
                                       const std::vector<RasterSource*>& sources,
                                       const StitchedImageOptions& options, RasterSink* image,
@@ -83,35 +105,13 @@ StitchedImageReport MakeStitchedImage(const RigConverter& converter,
   resample.fill = 0.0;
   resample.strip_rows = options.strip_rows;
 
-  // Each head resampled once, alone, onto the virtual grid; its coverage from a constant image
-  // through the same map (the resampler's own coverage rule).
+  // Each head resampled once, alone, onto the virtual grid, with its coverage.
   std::vector<HeadOnVirtual> on(heads);
   for (int k = 0; k < heads; ++k) {
-    calib::Camera one = all;
-    one.subimages = {all.subimages[k]};
-    const std::vector<MapCorrectionGrid> grid = {grids.grids[k]};
     MemoryRaster source = AsSixteenBit(sources[k], scale);
-    MemoryRaster values({width, height, 1, 16});
-    ResampleVirtualImage(one, {&source}, &values, resample, grid);
-    MemoryRaster ones(source.Info());
-    std::fill(ones.bytes().begin(), ones.bytes().end(), 0xFF);
-    MemoryRaster covered({width, height, 1, 16});
-    ResampleVirtualImage(one, {&ones}, &covered, resample, grid);
-    // The projectivity also maps virtual pixels whose ray lies BEHIND the head into its format
-    // (negative depth: far corners of the level image, e.g. a spurious "BD" zone of the uav4
-    // rig); those pixels are not seen by the head. Depth sign: that of the head's centre.
-    const Eigen::Matrix3d homography = HeadFromVirtualHomography(converter, k);
-    const calib::Camera& head_camera = rig.heads[k].camera;
-    const auto centre = converter.VirtualFromHead(
-        k, Eigen::Vector2d(0.5 * (head_camera.width_px - 1), 0.5 * (head_camera.height_px - 1)));
-    const double front =
-        centre ? homography.row(2).dot(Eigen::RowVector3d(centre->x(), centre->y(), 1.0)) : 1.0;
-    cv::Mat inside(height, width, CV_8UC1);
-    for (int r = 0; r < height; ++r)
-      for (int c = 0; c < width; ++c) {
-        const double depth = homography.row(2).dot(Eigen::RowVector3d(c, r, 1.0));
-        inside.at<std::uint8_t>(r, c) = covered.At(c, r) > 32767 && depth * front > 0 ? 255 : 0;
-      }
+    const HeadProjection projection = ProjectHeadOntoVirtual(converter, k, grids.grids[k], &source, resample);
+    const MemoryRaster& values = projection.values;
+    cv::Mat inside(height, width, CV_8UC1, const_cast<std::uint8_t*>(projection.covered.data()));
     cv::Mat distance;
     cv::distanceTransform(inside, distance, cv::DIST_L2, 3);
     on[k].value.resize(pixels);

@@ -24,6 +24,7 @@
 // output strip.
 #pragma once
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -63,6 +64,19 @@ struct StitchedImageReport {
   OverlapDisagreement overall;             // zone "all"
   std::vector<std::string> warnings;       // e.g. a head without overlap (held)
 };
+
+/// One head's pixels resampled alone onto the converter's virtual grid through the `rig convert`
+/// map (plane homography plus `grid`, stitch/rig/rig_convert.h): `values` (virtual format, one
+/// band, the source's depth) and `covered` (row-major virtual format: 255 where the resampler puts
+/// the virtual pixel inside the head's format, 0 elsewhere; its own rule, from a constant image
+/// through the same map). Shared by the stitched image and the tie matching (rig_tie_matching.h).
+struct HeadProjection {
+  MemoryRaster values;
+  std::vector<std::uint8_t> covered;
+};
+HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter, int head,
+                                      const MapCorrectionGrid& grid, RasterSource* source,
+                                      const ResampleOptions& resample = {});
 
 /// Makes the stitched image of the converter's exposure from `sources` (one per head, rig order,
 /// each of its head's format, one band, 8 or 16 bit) into `image` (virtual format, one band, the

@@ -22,6 +22,7 @@
 #include "stitch/rig/error_analysis.h"
 #include "stitch/rig/rig_convert.h"
 #include "stitch/rig/self_calibration.h"
+#include "stitch/rig/rig_tie_matching.h"
 #include "stitch/rig/stitched_image.h"
 #include "tests/stitch/rig_stitch_line.h"
 #include "tests/support/test_support.h"
@@ -195,11 +196,12 @@ void BM_RigSelfCalibrationExposure(benchmark::State& state) {
 }
 BENCHMARK(BM_RigSelfCalibrationExposure)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
 
-// One exposure's self-calibration WITH the stitched image (issue 16 item 6): the uav4 line at
-// half its formats (heads 1456 x 2184 px, virtual 4330 x 5880 px), its head images rendered on the
-// kite photograph (../shared/data; skipped without it) once outside the measurement; per
-// iteration SelfCalibrateRigStitching on exposure 0001's ties (observations.csv kind: no
-// matching) and MakeStitchedImage from the raw heads with the refined increments (each head
+// One exposure's self-calibration WITH tie matching and the stitched image (issue 16 items 2, 6):
+// the uav4 line at half its formats (heads 1456 x 2184 px, virtual 4330 x 5880 px), its head
+// images rendered on the kite photograph (../shared/data; skipped without it) once outside the
+// measurement; per iteration MatchRigExposureTies on exposure 0001's head images (projection onto
+// the level plane, Foerstner + LSM per zone), SelfCalibrateRigStitching on those ties, and
+// MakeStitchedImage from the raw heads with the refined increments (each head
 // resampled once, coverage, balance, blending) into discard sinks. The peer in the same run
 // (BM_StitchedPeerRemap): cv::remap (bilinear) of the four heads onto the same virtual format
 // through their plane homographies, maps precomputed (only the remaps timed).
@@ -207,6 +209,7 @@ struct StitchedScene {
   triangulation::SimulatedRigFlight flight;
   testing::RigStitchInputs in;
   std::vector<MemoryRaster> heads;
+  std::vector<GrayImage> gray;  // the same head images for the matcher
   bool ok = false;
 };
 const StitchedScene& Scene() {
@@ -235,6 +238,7 @@ const StitchedScene& Scene() {
     const triangulation::TexturedGround ground = triangulation::MakeRigGroundTexture(s.flight, render);
     for (int k = 0; k < 4; ++k) {
       const GrayImage image = triangulation::RenderRigHeadImage(s.flight, ground, render, 0, k);
+      s.gray.push_back(image);
       MemoryRaster raster({static_cast<int>(image.cols()), static_cast<int>(image.rows()), 1, 8});
       for (int r = 0; r < image.rows(); ++r)
         for (int c = 0; c < image.cols(); ++c) raster.Set(c, r, 0, image(r, c));
@@ -258,14 +262,16 @@ void BM_StitchedExposure(benchmark::State& state) {
   RigStitchOptions options;
   options.standard_radius_px *= 0.5;
   for (auto _ : state) {
-    const RigStitchResult r = SelfCalibrateRigStitching(s.flight.truth, s.in.exposures, s.in.ties,
-                                                        s.in.observations, s.in.positions, options);
+    RigTieMatches matches;
+    MatchRigExposureTies(s.flight.truth, s.in.exposures[0], 0, s.gray, {}, &matches);
+    const RigStitchResult r = SelfCalibrateRigStitching(s.flight.truth, s.in.exposures, matches.ties,
+                                                        matches.observations, s.in.positions, options);
     RigExposure pose = s.in.exposures[0].pose;
     pose.increment_rad.assign(4, Eigen::Vector3d::Zero());
     pose.dt_s.assign(4, 0.0);
     for (const auto& h : r.exposures[0].heads) {
       pose.increment_rad[s.flight.truth.HeadIndex(h.head)] = h.increment_rad;
-      pose.dt_s[s.flight.truth.HeadIndex(h.head)] = h.dt_s.value_or(0.0);
+      pose.dt_s[s.flight.truth.HeadIndex(h.head)] = h.dt_fitted_s;
     }
     const RigConverter converter(s.flight.truth, pose,
                                  {Eigen::Vector3d::UnitZ(), s.in.exposures[0].z_ref_m});
@@ -274,6 +280,7 @@ void BM_StitchedExposure(benchmark::State& state) {
     DiscardSink image(v.width_px), mask(v.width_px);
     const StitchedImageReport report = MakeStitchedImage(converter, sources, {}, &image, &mask);
     benchmark::DoNotOptimize(report.overall.rms_dn);
+    state.counters["ties"] = static_cast<double>(matches.ties.size());
   }
   state.counters["virtual_mpx"] = v.width_px * 1e-6 * v.height_px;
 }
@@ -335,7 +342,7 @@ int main(int argc, char** argv) {
   const double stitched = time_of("BM_StitchedExposure");
   const double remap = time_of("BM_StitchedPeerRemap");
   if (stitched > 0 && remap > 0)
-    std::printf("one exposure's self-calibration + stitched image (half formats): %.1f ms, "
+    std::printf("one exposure's tie matching + self-calibration + stitched image (half formats): %.1f ms, "
                 "cv::remap of the four heads onto the same format: %.1f ms, ratio %.2f\n",
                 stitched, remap, stitched / remap);
   benchmark::Shutdown();

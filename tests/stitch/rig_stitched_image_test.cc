@@ -10,6 +10,7 @@
 // The scene: the uav4 line at 0.2 x its formats (same geometry, 582 x 874 px heads), textured
 // with a real photograph (../shared/data/odm_boruszyn_kap_frames).
 #include <cmath>
+#include <map>
 #include <memory>
 
 #include <gtest/gtest.h>
@@ -18,6 +19,7 @@
 #include "stitch/rig/rig_conversion.h"
 #include "stitch/rig/self_calibration.h"
 #include "stitch/rig/stitched_image.h"
+#include "stitch/rig/rig_tie_matching.h"
 #include "tests/stitch/rig_stitch_line.h"
 #include "tests/support/test_support.h"
 #include "triangulation/simulation/rig_flight_simulator.h"
@@ -150,7 +152,7 @@ TEST(RigStitchedImage, SeamlessWithTheRefinedIncrementsAndBalancesAPlantedGain) 
   refined.dt_s.assign(4, 0.0);
   for (const auto& h : result.exposures[0].heads) {
     refined.increment_rad[f.truth.HeadIndex(h.head)] = h.increment_rad;
-    refined.dt_s[f.truth.HeadIndex(h.head)] = h.dt_s.value_or(0.0);
+    refined.dt_s[f.truth.HeadIndex(h.head)] = h.dt_fitted_s;
   }
   const StitchedImageReport with_truth = Stitch(f, Pose(f, 0, true), z_ref, heads);
   const StitchedImageReport with_refined = Stitch(f, refined, z_ref, heads);
@@ -184,6 +186,84 @@ TEST(RigStitchedImage, SeamlessWithTheRefinedIncrementsAndBalancesAPlantedGain) 
   EXPECT_NEAR(planted.heads[1].gain, 1.25, 0.01);
   EXPECT_NEAR(planted.heads[1].offset_dn, -15.0, 1.0);
   EXPECT_LT(planted.overall.rms_dn, 1.15 * floor);
+}
+
+
+// Tie matching on the rendered head images (issue 16 item 2; stitch/rig/rig_tie_matching.h): the
+// heads projected onto the level plane with the ground calibration and the POS, Foerstner + LSM per
+// zone, measured back in raw head pixels; the self-calibration on those ties alone (line mode,
+// flat terrain). Asserted: ties in every zone and none between B and D; a valid run; the fitted
+// stitching RMS after the adjustment at the matching noise (the LSM sigmas scaled by the sigma0
+// reached: at most 1.5 x that); the increments recovered to better than half their size (RMS over
+// the 18 angles). NOT met (printed, see stitch/README.md): the issue's "within 3 sigma of the
+// truth" -- errors up to 7.4 sigma, sigma0 2.06: the matched ties carry a systematic error of a
+// few hundredths of a pixel that the LSM sigmas do not describe (not diagnosed yet).
+TEST(RigTieMatching, MatchedTiesStitchAtTheMatchingNoise) {
+  if (Photo().empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
+  const SimulatedRigFlight f = triangulation::SimulateRigFlight(SmallLine(0.0));
+  testing::RigStitchInputs in = testing::InputsFromFlight(f);
+  in.positions = DesignRig(f.nominal, f.options.flight.flying_height_m, 200).standard_positions;
+  triangulation::RigImageOptions render;
+  render.texture_path = Photo();
+  render.grey_noise_dn = 1.0;
+  // texels of 1 m (head GSD 0.5 m at nadir at this format scale): the rendering samples the
+  // texture at one point per head pixel, so finer texels alias differently in each head
+  render.texture_gsd_m = 1.0;
+  const triangulation::TexturedGround ground = triangulation::MakeRigGroundTexture(f, render);
+  RigTieMatches matches;
+  RigTieMatchOptions match_options;
+  for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i) {
+    std::vector<GrayImage> heads;
+    for (int k = 0; k < 4; ++k) heads.push_back(triangulation::RenderRigHeadImage(f, ground, render, i, k));
+    MatchRigExposureTies(f.truth, in.exposures[i], i, heads, match_options, &matches);
+  }
+  std::map<std::string, int> ties_per_zone;
+  for (const auto& z : matches.zones) {
+    std::printf("  %s %s: %ld px, %d cells, LSM %d tried %d failed, %d ties\n", z.image.c_str(),
+                z.zone.c_str(), z.pixels, z.cells, z.lsm_tried, z.lsm_failed, z.ties);
+    ties_per_zone[z.zone] += z.ties;
+  }
+  // AC is small (the corners between A and C beyond B and D's footprints)
+  for (const char* zone : {"AB", "AC", "AD", "BC", "CD"}) EXPECT_GE(ties_per_zone[zone], 4) << zone;
+  EXPECT_EQ(ties_per_zone.count("BD"), 0u);  // B and D see no common ground
+  double sum2 = 0.0;
+  for (double s : matches.lsm_sigma_px) sum2 += s * s;
+  const double lsm_rms = std::sqrt(sum2 / matches.lsm_sigma_px.size());
+
+  RigStitchOptions options;
+  options.standard_radius_px *= kScale;
+  const RigStitchResult result = SelfCalibrateRigStitching(f.truth, in.exposures, matches.ties,
+                                                           matches.observations, in.positions, options);
+  ASSERT_TRUE(result.failures.empty()) << result.failures.front();
+  std::printf("matched: %zu ties, %zu observations, LSM sigma RMS %.4f px; sigma0 %.3f, fit "
+              "stitching RMS per coordinate %.4f -> %.4f px, %zu rejected\n",
+              matches.ties.size(), matches.observations.size(), lsm_rms, result.sigma0,
+              result.before.fit.per_coordinate, result.after.fit.per_coordinate,
+              result.rejected.size());
+  int compared = 0;
+  double error2 = 0.0, truth2 = 0.0;
+  for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i)
+    for (const auto& h : result.exposures[i].heads) {
+      if (h.reference) continue;
+      const int k = f.truth.HeadIndex(h.head);
+      const Eigen::Vector3d truth = f.rig_exposures[i * f.truth.heads.size() + k].increment_rad;
+      for (int a = 0; a < 3; ++a) {
+        const double z = (h.increment_rad[a] - truth[a]) / h.increment_sigma_rad[a];
+        std::printf("  exposure %d head %s angle %d: (estimate - truth) / sigma = %.2f (sigma %.2e "
+                    "rad)\n", i, h.head.c_str(), a, z, h.increment_sigma_rad[a]);
+        error2 += std::pow(h.increment_rad[a] - truth[a], 2);
+        truth2 += truth[a] * truth[a];
+        ++compared;
+      }
+    }
+  EXPECT_EQ(compared, 18);
+  std::printf("increments: RMS(estimate - truth) %.3g rad, RMS(truth) %.3g rad\n",
+              std::sqrt(error2 / compared), std::sqrt(truth2 / compared));
+  EXPECT_LT(error2, 0.25 * truth2);  // the ground calibration alone (E = 0) gives error2 = truth2
+  // At the matching noise: the LSM sigmas scaled by the sigma0 the fit reaches; the pair
+  // differences of the fitted ties at most that noise x 1.5.
+  EXPECT_LT(result.after.fit.per_coordinate, 1.5 * result.sigma0 * lsm_rms);
+  EXPECT_GT(result.before.fit.per_coordinate, 3.0 * result.after.fit.per_coordinate);
 }
 
 }  // namespace

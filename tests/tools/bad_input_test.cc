@@ -861,7 +861,17 @@ const std::vector<Case>& Cases() {
       // ---- rig stitch --images / --stitched-out, simulate --rig --images (issue 16) ----
       {"rig_stitch_images_without_stitched_out",
        [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--images " + d.File("uav4")); },
-       2, "--images and --stitched-out go together", "uav4/stitch.json"},
+       2, "--images needs --stitched-out or --match-ties", "uav4/stitch.json"},
+      {"rig_stitch_match_ties_without_images",
+       [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--match-ties"); },
+       2, "--match-ties needs --images", "uav4/stitch.json"},
+      {"rig_stitch_match_ties_with_observations",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         return RigStitchArgs(line, "--images " + line + " --match-ties");
+       },
+       2, "observations.csv:2: --match-ties measures the ties on the head images: observations.csv "
+          "must have no rows", "uav4/stitch.json"},
       {"rig_stitch_images_not_a_folder",
        [](const TempDir& d) {
          const auto line = Uav4Line(d);
