@@ -12,6 +12,7 @@
 #include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
 #include "tools/python_script.h"
+#include "triangulation/calibration/distortion_figure.h"
 #include "triangulation/calibration/uncertainty_budget.h"
 
 #include <nlohmann/json.hpp>
@@ -217,6 +218,35 @@ auto ReadTyped(const std::string& path, const char* option, Read&& read) -> decl
   }
 }
 
+// The samples of the distortion figure (distortion_figure.h) from the certified camera: its model
+// (the result's parameter table, else the 10-parameter model), estimated parameters by name and the
+// camera file's format. Null when one of them is missing (the figure then says so).
+nlohmann::json DistortionJson(const nlohmann::json& cert) {
+  const nlohmann::json& table = cert["camera_model"];
+  const auto model = calib::CameraModelFromName(
+      table.is_object() ? table.value("name", "") : std::string(calib::BrownFraser10Model::kName));
+  const nlohmann::json& estimated = cert["interior"].value("estimated", nlohmann::json::object());
+  const nlohmann::json& file = cert["camera_file"];
+  if (!model || !file.contains("format_px") || !file.contains("pixel_size_mm")) return nullptr;
+  calib::ModelCamera camera;
+  camera.model = *model;
+  for (const auto& info : calib::CameraModelParams(*model)) {
+    const std::string name(info.name);
+    if (!estimated.contains(name) || !estimated[name].is_number()) return nullptr;
+    camera.params.push_back(estimated[name].get<double>());
+  }
+  camera.frame.pixel_size_mm = file["pixel_size_mm"].get<double>();
+  camera.frame.width_px = file["format_px"][0].get<int>();
+  camera.frame.height_px = file["format_px"][1].get<int>();
+  if (!(camera.frame.pixel_size_mm > 0) || camera.frame.width_px < 2 || camera.frame.height_px < 2)
+    return nullptr;
+  const triangulation::DistortionFigure figure = triangulation::DistortionOverFormat(camera);
+  if (figure.profile.empty()) return nullptr;
+  return {{"profile_kind", figure.profile_kind},
+          {"profile", figure.profile},
+          {"grid", figure.grid}};
+}
+
 int WriteCertificate(const CertificateArgs& args) {
   CheckOutputFolder(args.out, "--out");
   if (!args.tolerances.empty() && args.previous.empty())
@@ -260,6 +290,7 @@ int WriteCertificate(const CertificateArgs& args) {
     cert["control"] = result["control"];
     cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
     cert["opencv"] = cal.value("opencv", nlohmann::json());
+    cert["distortion"] = DistortionJson(cert);
     // Residual vectors (image pixels) for the vector field plot.
     nlohmann::json residuals = nlohmann::json::array();
     for (const auto& r : result.value("residuals", nlohmann::json::array()))

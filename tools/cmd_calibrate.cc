@@ -162,6 +162,9 @@ nlohmann::json StabilityJson(const triangulation::StabilityReport& s) {
                     {"unit", r.unit},
                     {"values", r.values},
                     {"sigmas", r.sigmas},
+                    {"detectable_change", r.detectable_change.empty()
+                                              ? nlohmann::json()
+                                              : nlohmann::json(r.detectable_change)},
                     {"mean", r.mean},
                     {"spread", r.spread},
                     {"weighted_mean", r.weighted_mean},
@@ -169,7 +172,11 @@ nlohmann::json StabilityJson(const triangulation::StabilityReport& s) {
                     {"critical", r.critical},
                     {"dof", r.dof},
                     {"agree", r.agree}});
-  return {{"alpha", s.alpha}, {"agree", s.agree}, {"rows", rows}, {"flagged", s.flagged}};
+  return {{"alpha", s.alpha},
+          {"power", s.power},
+          {"agree", s.agree},
+          {"rows", rows},
+          {"flagged", s.flagged}};
 }
 
 // The RMS image residual per point (sqrt of the mean squared residual vector), as OpenCV's RMS.

@@ -50,6 +50,19 @@ TEST(CalibrateCommand, OpenCvModelOnTheChessboardEqualsCalibrateCamera) {
   for (const char* p : {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"})
     EXPECT_NEAR(ours[p].get<double>(), cv[p].get<double>(), 1e-4 * std::abs(cv[p].get<double>())) << p;
   EXPECT_NEAR(j["calibration"]["rms_px"].get<double>(), cv["rms_px"].get<double>(), 1e-4 * cv["rms_px"].get<double>());
+
+  // Its certificate draws the OpenCV camera's own distortion (computed in its model, not restated
+  // by the renderer): this lens's strong barrel distortion (k1 ~ -0.28) is a large outward
+  // correction at the corners, not the flat zero curve a 10-parameter formula would draw.
+  const auto c = RunAerocal("certificate --result " + tmp.File("cv.json") + " --out " + tmp.File("cert"));
+  ASSERT_LE(c.exit_code, 3) << c.output;
+  const auto cert = ReadJson(tmp.File("cert/certificate.json"));
+  const auto& d = cert["distortion"];
+  ASSERT_TRUE(d.is_object()) << cert.dump().substr(0, 400);
+  EXPECT_EQ(d["profile_kind"], "mean over directions");
+  EXPECT_EQ(d["grid"].size(), 99u);
+  EXPECT_GT(d["profile"].back()[1].get<double>(), 50.0);  // um at the half diagonal
+  EXPECT_TRUE(std::filesystem::exists(tmp.File("cert/certificate.pdf")));
 }
 
 TEST(CalibrateCommand, OpenCvChessboardAgainstCalibrateCameraAndThePublishedResults) {
@@ -142,6 +155,21 @@ TEST_F(OlympusCalibration, PublishedDbatValuesWithinThreeSigmaAndGroupStability)
   EXPECT_EQ(cal["groups"].size(), 3u);
   EXPECT_EQ(cal["stability"]["rows"].size(), 9u);
   EXPECT_FALSE(cal["stability"]["agree"].get<bool>());
+  // The test's sensitivity per group: the change detected with 80 % power, more than twice the
+  // group's own sigma, largest for the least precise group (group_change_power.h).
+  EXPECT_EQ(cal["stability"]["power"].get<double>(), 0.8);
+  for (const auto& row : cal["stability"]["rows"]) {
+    const auto& d = row["detectable_change"];
+    const auto& s = row["sigmas"];
+    ASSERT_EQ(d.size(), 3u) << row["parameter"];
+    int least_precise = 0, largest_change = 0;
+    for (int g = 0; g < 3; ++g) {
+      EXPECT_GT(d[g].get<double>(), 2 * s[g].get<double>()) << row["parameter"];
+      if (s[g].get<double>() > s[least_precise].get<double>()) least_precise = g;
+      if (d[g].get<double>() > d[largest_change].get<double>()) largest_change = g;
+    }
+    EXPECT_EQ(largest_change, least_precise) << row["parameter"];
+  }
   const auto& est = j["cameras"][0]["estimated"];
   const auto& sig = j["cameras"][0]["sigma"];
   // DBAT 0.9.2.0 (PROVENANCE.md): c 7.45700, pp 3.61546 / 2.61329 mm from the top-left corner,

@@ -318,6 +318,25 @@ class TolerantInput(unittest.TestCase):
         self.assertIn("check-map", page.ids)
         self.assertEqual(text.count(PNG_URI), 3)  # sigma0, residuals, check map (no interior: no curves)
 
+    def test_calibration_table_follows_the_results_camera_model(self):
+        # A camera in another registered model: its table's names and units (the result's
+        # camera_model), and no 10-parameter distortion curves drawn from absent K1..P2.
+        table = [{"name": n, "unit": u, "group": "g"} for n, u in (("fx", "px"), ("fy", "px"), ("k1", "1"))]
+        camera = {"id": "cam1", "model": "opencv", "initial": {"fx": 4000.0, "fy": 4000.0, "k1": 0.0},
+                  "estimated": {"fx": 4012.5, "fy": 4011.0, "k1": -0.05}, "sigma": {"fx": 0.5, "fy": 0.5, "k1": 0.001}}
+        doc = {"kind": "flight", "schema_version": 1,
+               "camera_format": {"width_px": 1000, "height_px": 800, "pixel_size_mm": 0.01},
+               "camera_model": {"name": "opencv", "id": 2, "parameters": table},
+               "adjustments": [{"name": "self_calibration", "sigma0": 1.0, "converged": True,
+                                "self_calibration": ["fx", "fy", "k1"], "cameras": [camera]}]}
+        text, page = self.render(doc)
+        row = page.row("calib-self-calibration-cam1", "fx")
+        self.assertEqual(row[1], "px")
+        self.assertEqual(row[4], "4012.50000")
+        self.assertEqual(page.row("calib-self-calibration-cam1", "k1")[1], "1")
+        self.assertNotIn("distortion-cam1", page.ids)
+        self.assertIn("the camera is in the model opencv", text)
+
     def test_invalid_steps_and_suspected_model_errors_are_shown_in_red(self):
         doc = {"kind": "flight", "schema_version": 1, "valid": False,
                "failures": [{"step": "self-calibration", "reason": "sigma0 3.4 is above the limit 3"}],

@@ -12,6 +12,8 @@ aerocal_add_test(triangulation/data_snooping LIBS aerocal::triangulation LABELS 
 aerocal_add_test(triangulation/snooping_cli LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(triangulation/rig_flight_simulator LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/calibration LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/group_change_power LIBS aerocal::triangulation LABELS unit)
+aerocal_add_test(triangulation/distortion_figure LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/test_field LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/camera_model_calibration LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/test_field_study LIBS aerocal::triangulation LABELS long TIMEOUT 3000)

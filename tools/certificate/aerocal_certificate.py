@@ -48,18 +48,6 @@ def fmt(v, digits=6):
     return str(v)
 
 
-def interior_function(name, interior):
-    """Value of a certified distortion quantity (um) from the estimated interior."""
-    k1, k2, k3 = interior.get("K1", 0), interior.get("K2", 0), interior.get("K3", 0)
-    p1, p2 = interior.get("P1", 0), interior.get("P2", 0)
-    def radial(r):
-        r2 = r * r
-        return 1e3 * r * (k1 * r2 + k2 * r2 * r2 + k3 * r2 * r2 * r2)
-    def decentring(r):
-        return 1e3 * r * r * math.hypot(p1, p2)
-    return radial, decentring
-
-
 # ---------------------------------------------------------------- tables (lists of rows)
 
 def result_rows(c):
@@ -86,11 +74,16 @@ def stability_rows(c):
     groups = c.get("groups") or []
     if not groups:
         return None
-    head = ["parameter"] + [g["group"] for g in groups] + ["mean", "spread", "chi2", "critical", "agree"]
+    # The change of one group alone the test flags with probability `power` (per group).
+    power = s.get("power")
+    detect = "detectable change (%s)" % ("%.0f %%" % (100 * power) if power else "-")
+    head = ["parameter"] + [g["group"] for g in groups] + ["mean", "spread", "chi2", "critical", detect, "agree"]
     rows = [head]
     for r in s.get("rows", []):
+        d = r.get("detectable_change")
         rows.append([r["parameter"]] + [fmt(v, 7) + " +- " + fmt(sg, 2) for v, sg in zip(r["values"], r["sigmas"])] +
                     [fmt(r["mean"], 7), fmt(r["spread"], 2), fmt(r["chi2"], 3), fmt(r["critical"], 3),
+                     " / ".join(fmt(x, 2) for x in d) if d else "-",
                      "yes" if r["agree"] else "NO"])
     return rows
 
@@ -175,16 +168,19 @@ def warning_lines(c):
 # ---------------------------------------------------------------- figures
 
 def fig_distortion(c):
-    interior = c["interior"]["estimated"]
-    radial, decentring = interior_function("", interior)
-    cf = c["camera_file"]
-    p = cf["pixel_size_mm"]
-    w, h = cf["format_px"]
-    rmax = 0.5 * p * math.hypot(w, h)
+    """The camera's correction as aerocal computed it in its model (certificate.json `distortion`:
+    triangulation/calibration/distortion_figure.h); this script restates no camera model."""
+    d = c.get("distortion")
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(8, 3.4))
-    r = np.linspace(0, rmax, 200)
-    ax1.plot(r, [radial(x) for x in r], label="radial dr(r)")
-    ax1.plot(r, [decentring(x) for x in r], label="decentring |dt|(r)")
+    if not d:
+        for ax in (ax1, ax2):
+            ax.axis("off")
+        ax1.text(0, 0.5, "no distortion samples in certificate.json", fontsize=9)
+        return fig
+    r, dr, dt = zip(*d["profile"])
+    terms = d["profile_kind"] == "10-parameter terms"
+    ax1.plot(r, dr, label="radial dr(r)" if terms else "radial dr(r), mean over directions")
+    ax1.plot(r, dt, label="decentring |dt|(r)" if terms else "tangential, RMS over directions")
     by_name = {q["quantity"]: q for q in c["results"]}
     for rad in c.get("radii_mm", []):
         for key, color in (("dr@%g" % rad, "C0"), ("dt@%g" % rad, "C1")):
@@ -197,21 +193,9 @@ def fig_distortion(c):
     ax1.grid(True, lw=0.3)
     ax1.legend()
     # Distortion grid over the format (photo frame, mm; vectors exaggerated).
-    x0, y0 = interior.get("x0", 0), interior.get("y0", 0)
-    xs = np.linspace(-0.5 * w * p, 0.5 * w * p, 11)
-    ys = np.linspace(-0.5 * h * p, 0.5 * h * p, 9)
-    gx, gy, dx, dy = [], [], [], []
-    for x in xs:
-        for y in ys:
-            xb, yb = x - x0, y - y0
-            r2 = xb * xb + yb * yb
-            k = interior.get("K1", 0) * r2 + interior.get("K2", 0) * r2 ** 2 + interior.get("K3", 0) * r2 ** 3
-            ddx = xb * k + interior.get("P1", 0) * (r2 + 2 * xb * xb) + 2 * interior.get("P2", 0) * xb * yb + \
-                interior.get("B1", 0) * xb + interior.get("B2", 0) * yb
-            ddy = yb * k + 2 * interior.get("P1", 0) * xb * yb + interior.get("P2", 0) * (r2 + 2 * yb * yb)
-            gx.append(x); gy.append(y); dx.append(ddx * 1e3); dy.append(ddy * 1e3)
+    gx, gy, dx, dy = zip(*d["grid"]) if d["grid"] else ([], [], [], [])
     q = ax2.quiver(gx, gy, dx, dy, angles="xy")
-    longest = max(1e-9, max(math.hypot(a, b) for a, b in zip(dx, dy)))
+    longest = max([1e-9] + [math.hypot(a, b) for a, b in zip(dx, dy)])
     ax2.quiverkey(q, 0.8, 1.04, longest, "%.3g um" % longest, labelpos="E")
     ax2.set_aspect("equal")
     ax2.set_xlabel("x (mm)")

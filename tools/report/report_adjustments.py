@@ -201,17 +201,18 @@ def comparison(doc):
     return "".join(out)
 
 
-def _calibration_table(a, camera, table_id):
+def _calibration_table(a, camera, table_id, parameters):
     initial, estimated = rd.interior(camera, "initial"), rd.interior(camera, "estimated")
     sigma = camera.get("sigma") if isinstance(camera.get("sigma"), dict) else {}
     rows = []
-    for name, unit in rd.INTERIOR_PARAMETERS:
-        spec = ".5f" if unit == "mm" else ".4e"
+    for name, unit in parameters:
+        length = unit in ("mm", "px")  # lengths in fixed point, coefficients in exponent form
+        spec = ".5f" if length else ".4e"
         v0, v = initial.get(name), estimated.get(name)
         corr = v - v0 if None not in (v0, v) else None
         s = rd.number(sigma.get(name))
         free = name in sigma
-        rows.append([text(name), text(unit), num(v0, spec), num(corr, spec if unit == "mm" else ".3e"), num(v, spec),
+        rows.append([text(name), text(unit), num(v0, spec), num(corr, spec if length else ".3e"), num(v, spec),
                      num(s, ".2e") if free else text("fixed"),
                      num(abs(corr) / s if corr is not None and s else None, ".1f")])
     return table(table_id, f"Camera {camera.get('id', '?')}: interior orientation ({rd.title(a)})",
@@ -227,13 +228,20 @@ def calibration(doc):
         out.append(note(f"{esc(', '.join(fixed))}: interior orientation held at the camera file's values."))
     if not estimating:
         return "".join(out) + not_available("Calibration (no adjustment estimated interior parameters)")
-    out.append(note("correction = estimated - initial. c, x0, y0 in mm; K1 mm^-2, K2 mm^-4, K3 mm^-6; "
-                    "P1, P2 mm^-1; B1, B2 unitless (CONVENTIONS.md). Parameters held fixed show 'fixed'."))
+    model = rd.camera_model_name(doc)
+    out.append(note(f"correction = estimated - initial. Parameters and units of the camera model {esc(model)} "
+                    "(the result's camera_model table; CONVENTIONS.md). Parameters held fixed show 'fixed'."))
+    parameters = rd.interior_parameters(doc)
     for a in estimating:
         for cam in rd.cameras(a):
-            out.append(_calibration_table(a, cam, f"calib-{anchor(a['name'])}-{anchor(cam.get('id', 'camera'))}"))
+            out.append(_calibration_table(a, cam, f"calib-{anchor(a['name'])}-{anchor(cam.get('id', 'camera'))}",
+                                          parameters))
     out.append('<h3 id="distortion">5.1 Distortion curves</h3>')
-    out.append(_distortion(doc, adjs, estimating))
+    if model != "brown_fraser_10":
+        out.append(not_available(f"Distortion curves (drawn for the 10-parameter model's terms; the camera is "
+                                 f"in the model {model})"))
+    else:
+        out.append(_distortion(doc, adjs, estimating))
     return "".join(out)
 
 

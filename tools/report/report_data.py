@@ -204,10 +204,25 @@ def cameras(adjustment):
     return [c for c in listing(adjustment.get("cameras")) if isinstance(c, dict)]
 
 
+def interior_parameters(doc):
+    """[(name, unit)] of the camera model's parameter table in the result (`camera_model`,
+    calib/README "Result documents"); the 10-parameter table when the result has none."""
+    table = [p for p in listing(get(doc.get("camera_model"), "parameters")) if isinstance(p, dict)]
+    named = [(str(p.get("name")), str(p.get("unit", ""))) for p in table if p.get("name") is not None]
+    return named or INTERIOR_PARAMETERS
+
+
+def camera_model_name(doc):
+    """The camera model's name ("brown_fraser_10" when the result names none)."""
+    return str(get(doc.get("camera_model"), "name") or "brown_fraser_10")
+
+
 def interior(camera, which):
     """{name: value} of 'initial' or 'estimated' with numbers only."""
     block = get(camera, which) or {}
-    return {name: number(block.get(name)) for name, _ in INTERIOR_PARAMETERS if number(block.get(name)) is not None}
+    if not isinstance(block, dict):
+        return {}
+    return {name: number(v) for name, v in block.items() if number(v) is not None}
 
 
 def estimates_interior(adjustment):

@@ -4,6 +4,7 @@
 #include "calib/core/string_printf.h"
 #include "stitch/adjustment/f_test.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/calibration/group_change_power.h"
 
 #include <algorithm>
 #include <cmath>
@@ -108,6 +109,9 @@ StabilityReport GroupStability(const std::vector<GroupCalibration>& groups, doub
       for (int g = 0; g < n_groups; ++g)
         row.chi2 += std::pow((row.values[g] - row.weighted_mean) / row.sigmas[g], 2);
       row.agree = row.chi2 <= critical;
+      for (int g = 0; g < n_groups; ++g)
+        row.detectable_change.push_back(
+            DetectableGroupChange(row.sigmas, g, critical, report.power));
     } else {
       row.weighted_mean = row.mean;
       row.chi2 = std::nan("");

@@ -8,7 +8,9 @@
 // m = sum(v_g / s_g^2) / sum(1 / s_g^2) and chi2 = sum((v_g - m)^2 / s_g^2) ~ chi^2(G - 1) when the
 // groups measure the same camera with their stated precision. The groups agree when every
 // parameter's chi2 stays below the (1 - alpha / n_free) quantile (Bonferroni: the family of tests
-// keeps the level alpha); a parameter above it is flagged by name.
+// keeps the level alpha); a parameter above it is flagged by name. The test's sensitivity is
+// stated with it: per group the change of that group alone detected with probability
+// `StabilityReport::power` (group_change_power.h), the analogue of the MDB of data snooping.
 #pragma once
 
 #include "triangulation/adjustment/adjust_options.h"
@@ -52,6 +54,9 @@ struct GroupCalibration {
 struct StabilityRow {
   std::string parameter, unit;
   std::vector<double> values, sigmas;  // per group, in the order of CalibrationRun::groups
+  /// Per group: the change of that group's value alone which the test flags with probability
+  /// StabilityReport::power (empty when a sigma is unknown).
+  std::vector<double> detectable_change;
   double mean = 0, spread = 0, weighted_mean = 0, chi2 = 0, critical = 0;
   int dof = 0;
   bool agree = true;
@@ -59,6 +64,7 @@ struct StabilityRow {
 
 struct StabilityReport {
   double alpha = 0.05;
+  double power = 0.8;  // of the detectable changes
   bool agree = true;
   std::vector<StabilityRow> rows;
   std::vector<std::string> flagged;  // one sentence per parameter out of agreement

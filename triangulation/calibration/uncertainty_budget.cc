@@ -5,6 +5,7 @@
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "stitch/adjustment/f_test.h"
+#include "triangulation/calibration/distortion_figure.h"
 
 #include <Eigen/Dense>
 
@@ -209,17 +210,11 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
     if (radial)
       functions.push_back({StringPrintf("dr@%g", r), "um",
                            StringPrintf("radial distortion at r = %g mm", r),
-                           [r](const calib::InteriorParams& p) {
-                             const double r2 = r * r;
-                             return 1e3 * r * (p[Model::kK1] * r2 + p[Model::kK2] * r2 * r2 +
-                                               p[Model::kK3] * r2 * r2 * r2);
-                           }});
+                           [r](const calib::InteriorParams& p) { return RadialDistortionUm(p, r); }});
     if (decentring)
       functions.push_back({StringPrintf("dt@%g", r), "um",
                            StringPrintf("decentring distortion (magnitude) at r = %g mm", r),
-                           [r](const calib::InteriorParams& p) {
-                             return 1e3 * r * r * std::hypot(p[Model::kP1], p[Model::kP2]);
-                           }});
+                           [r](const calib::InteriorParams& p) { return DecentringDistortionUm(p, r); }});
   }
 
   std::vector<BudgetQuantity> out;
