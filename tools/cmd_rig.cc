@@ -5,6 +5,7 @@
 // result.json plus histogram / bound-map CSV files and, through tools/report/rig_error_plots.py
 // (matplotlib), their PNG plots.
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -30,6 +31,9 @@
 #include "stitch/rig/rig_design.h"
 #include "stitch/rig/self_calibration.h"
 #include "stitch/rig/self_calibration_json.h"
+#include "stitch/rig/rig_tie_matching.h"
+#include "stitch/rig/stitched_image.h"
+#include "stitch/image_io/image_io.h"
 #include "tools/command_registry.h"
 #include "tools/python_script.h"
 #include "tools/image_sources.h"
@@ -217,6 +221,13 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   return kExitOk;
 }
 
+// --tile-px of the TIFF outputs: 0 (strips) or the TIFF tile rule.
+void CheckTilePx(int tile_px) {
+  if (tile_px != 0 && !(tile_px % 16 == 0 && tile_px >= 16 && tile_px <= 4096))
+    throw ConfigError("--tile-px must be 0 (strips) or a multiple of 16 in 16..4096 (got " +
+                      std::to_string(tile_px) + ")");
+}
+
 struct ConvertArgs {
   std::string camera, images, opk_deg = "0,0,0", out, interp = "bilinear";
   double height_m = 0.0;  // 0: the rig file's virtual.height_m
@@ -229,9 +240,7 @@ struct ConvertArgs {
 };
 
 int RunConvert(const ConvertArgs& args) {
-  if (args.tile_px != 0 && !(args.tile_px % 16 == 0 && args.tile_px >= 16 && args.tile_px <= 4096))
-    throw ConfigError("--tile-px must be 0 (strips) or a multiple of 16 in 16..4096 (got " +
-                      std::to_string(args.tile_px) + ")");
+  CheckTilePx(args.tile_px);
   const calib::Rig rig = calib::ReadRig(args.camera);
   const double height_m = FlyingHeight(rig, args.height_m, args.camera);
   stitch::RigExposure exposure;
@@ -300,6 +309,11 @@ struct StitchArgs {
   double standard_radius_px = 400.0;
   double max_sigma0 = 3.0;
   double default_sigma_px = 0.5;
+  std::string images, stitched_out;  // head images <image>_<head>.tif; stitched images folder
+  int tile_px = 256;
+  bool bigtiff = false, no_balance = false;
+  int feather_px = 64;
+  bool match_ties = false;  // ties matched on the head images instead of observations.csv
   CLI::Option* increment_sigma_option = nullptr;
   CLI::Option* dt_sigma_option = nullptr;
   CLI::Option* relief_option = nullptr;
@@ -313,6 +327,28 @@ struct StitchInputs {
   std::vector<stitch::RigStitchTie> ties;
   std::vector<stitch::RigStitchObservation> observations;
 };
+
+// An exposure of the project as the library's: POS, velocity (optional) and z_ref (required,
+// below the rig centre; FILE:LINE otherwise).
+stitch::RigStitchExposure StitchExposure(const triangulation::Project& project,
+                                         const triangulation::Exposure& e) {
+  if (!e.z_ref_m)
+    ThrowInputError({project.exposures_file, e.line},
+                    "image " + e.image + " has no z_ref (rig stitch rectifies onto the level "
+                    "plane Z = z_ref of each exposure)");
+  if (!(e.center_m.z() > *e.z_ref_m))
+    ThrowInputError({project.exposures_file, e.line},
+                    "image " + e.image + ": z_ref (" + FormatNumber(*e.z_ref_m) +
+                        " m) must lie below the rig centre Z (" + FormatNumber(e.center_m.z()) +
+                        " m)");
+  stitch::RigStitchExposure x;
+  x.image = e.image;
+  x.pose.rig_opk_rad = e.opk_rad;
+  x.pose.rig_center_m = e.center_m;
+  x.pose.velocity_mps = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
+  x.z_ref_m = *e.z_ref_m;
+  return x;
+}
 
 StitchInputs StitchInputsFromProject(const triangulation::Project& project, const calib::Rig& rig,
                                      const std::string& camera_file) {
@@ -329,25 +365,7 @@ StitchInputs StitchInputsFromProject(const triangulation::Project& project, cons
     const int head = rig.HeadIndex(o.head);
     if (head < 0) ThrowInputError(where, "head '" + o.head + "' is not a head of " + camera_file);
     auto [it, added] = exposure_index.try_emplace(o.image, static_cast<int>(in.exposures.size()));
-    if (added) {
-      const triangulation::Exposure& e = *project.FindExposure(o.image);
-      if (!e.z_ref_m)
-        ThrowInputError({project.exposures_file, e.line},
-                        "image " + e.image + " has no z_ref (rig stitch rectifies onto the level "
-                        "plane Z = z_ref of each exposure)");
-      if (!(e.center_m.z() > *e.z_ref_m))
-        ThrowInputError({project.exposures_file, e.line},
-                        "image " + e.image + ": z_ref (" + FormatNumber(*e.z_ref_m) +
-                            " m) must lie below the rig centre Z (" + FormatNumber(e.center_m.z()) +
-                            " m)");
-      stitch::RigStitchExposure x;
-      x.image = e.image;
-      x.pose.rig_opk_rad = e.opk_rad;
-      x.pose.rig_center_m = e.center_m;
-      x.pose.velocity_mps = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
-      x.z_ref_m = *e.z_ref_m;
-      in.exposures.push_back(x);
-    }
+    if (added) in.exposures.push_back(StitchExposure(project, *project.FindExposure(o.image)));
     const std::string label = fs::path(project.observations_file).filename().string() + ":" +
                               std::to_string(o.line);
     in.observations.push_back(
@@ -358,7 +376,146 @@ StitchInputs StitchInputsFromProject(const triangulation::Project& project, cons
   return in;
 }
 
+// The head image of an exposure under --images: <image>_<head>.tif (or .png, .jpg).
+std::string HeadImagePath(const std::string& folder, const std::string& image, const std::string& head) {
+  for (const char* ext : {".tif", ".tiff", ".png", ".jpg"}) {
+    const std::string path = folder + "/" + image + "_" + head + ext;
+    if (fs::exists(path)) return path;
+  }
+  throw InputError("--images: " + folder + "/" + image + "_" + head +
+                   ".tif not found (the head images are <image>_<head>.tif)");
+}
+
+std::unique_ptr<stitch::RasterSource> OpenHeadImage(const std::string& path) {
+  if (fs::path(path).extension() == ".tif" || fs::path(path).extension() == ".tiff")
+    return stitch::OpenTiff(path);
+  return std::make_unique<stitch::MemoryRaster>(stitch::ReadImageFile(path, true));
+}
+
+// --match-ties: every exposure of the project, its ties matched on the head images under --images
+// (stitch/rig/rig_tie_matching.h); observations.csv must have no rows. The zones' counts in
+// `zones`.
+StitchInputs MatchedStitchInputs(const triangulation::Project& project, const calib::Rig& rig,
+                                 const std::string& images,
+                                 std::vector<stitch::RigZoneMatchReport>* zones) {
+  if (!project.observations.empty())
+    ThrowInputError({project.observations_file, project.observations.front().line},
+                    "--match-ties measures the ties on the head images: observations.csv must have "
+                    "no rows (got " + std::to_string(project.observations.size()) + ")");
+  StitchInputs in;
+  for (const auto& e : project.exposures) in.exposures.push_back(StitchExposure(project, e));
+  if (in.exposures.empty()) throw InputError(project.exposures_file + ": no exposures");
+  for (const auto& e : in.exposures)  // every head image present before anything is computed
+    for (const auto& head : rig.heads) HeadImagePath(images, e.image, head.id);
+  stitch::RigTieMatches matches;
+  for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i) {
+    std::vector<stitch::GrayImage> heads;
+    for (const auto& head : rig.heads) {
+      const std::string path = HeadImagePath(images, in.exposures[i].image, head.id);
+      heads.push_back(stitch::ReadGrayImage(path));
+      if (heads.back().cols() != head.camera.width_px || heads.back().rows() != head.camera.height_px)
+        throw InputError(path + ": " + std::to_string(heads.back().cols()) + " x " +
+                         std::to_string(heads.back().rows()) + " px, head " + head.id + " is " +
+                         std::to_string(head.camera.width_px) + " x " +
+                         std::to_string(head.camera.height_px) + " px");
+    }
+    stitch::MatchRigExposureTies(rig, in.exposures[i], i, heads, {}, &matches);
+  }
+  in.ties = std::move(matches.ties);
+  in.observations = std::move(matches.observations);
+  *zones = std::move(matches.zones);
+  return in;
+}
+
+// The stitched image of every exposure with the refined increments and offsets (stitch/rig/
+// stitched_image.h): <image>.tif and <image>_mask.tif under --stitched-out; the figures as JSON.
+nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig,
+                                   const std::vector<stitch::RigStitchExposure>& exposures,
+                                   const stitch::RigStitchResult& result) {
+  fs::create_directories(args.stitched_out);
+  stitch::StitchedImageOptions options;
+  options.balance = !args.no_balance;
+  options.feather_px = args.feather_px;
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& e : exposures) {
+    const auto refined = std::find_if(result.exposures.begin(), result.exposures.end(),
+                                      [&](const auto& r) { return r.image == e.image; });
+    if (refined == result.exposures.end()) continue;
+    stitch::RigExposure pose = e.pose;
+    pose.increment_rad.assign(rig.heads.size(), Eigen::Vector3d::Zero());
+    pose.dt_s.assign(rig.heads.size(), 0.0);
+    for (const auto& h : refined->heads) {
+      const int k = rig.HeadIndex(h.head);
+      pose.increment_rad[k] = h.increment_rad;
+      pose.dt_s[k] = h.dt_fitted_s;  // also where not determinable on its own: the fitted geometry
+    }
+    const stitch::RigConverter converter(
+        rig, pose, stitch::MakeRectificationPlane(rig, pose, e.pose.rig_center_m.z() - e.z_ref_m));
+    std::vector<std::unique_ptr<stitch::RasterSource>> owned;
+    std::vector<stitch::RasterSource*> sources;
+    for (const auto& head : rig.heads) {
+      owned.push_back(OpenHeadImage(HeadImagePath(args.images, e.image, head.id)));
+      sources.push_back(owned.back().get());
+    }
+    const stitch::RasterInfo info = sources.front()->Info();
+    const calib::VirtualCamera& v = rig.virtual_camera;
+    stitch::TiffWriteOptions tiff;
+    tiff.tile_px = args.tile_px;
+    tiff.force_bigtiff = args.bigtiff;
+    tiff.description = "aerocal rig stitch: stitched level virtual image of " + e.image + " (" +
+                       args.camera + ", refined increments and offsets, z_ref " +
+                       FormatNumber(e.z_ref_m) + " m)";
+    const std::string image_path = args.stitched_out + "/" + e.image + ".tif";
+    const std::string mask_path = args.stitched_out + "/" + e.image + "_mask.tif";
+    stitch::TiffWriter image(image_path, {v.width_px, v.height_px, 1, info.bits}, tiff);
+    tiff.description = "aerocal rig stitch: valid-area mask of " + e.image + " (255 valid)";
+    stitch::TiffWriter mask(mask_path, {v.width_px, v.height_px, 1, 8}, tiff);
+    const stitch::StitchedImageReport r =
+        stitch::MakeStitchedImage(converter, sources, options, &image, &mask);
+    image.Commit();
+    mask.Commit();
+    nlohmann::json heads = nlohmann::json::array(), zones = nlohmann::json::array();
+    for (const auto& h : r.heads)
+      heads.push_back({{"head", h.head}, {"gain", h.gain}, {"offset_dn", h.offset_dn},
+                       {"samples", h.samples}, {"reference", h.reference}});
+    const auto zone_json = [](const stitch::OverlapDisagreement& z) {
+      return nlohmann::json{{"zone", z.zone}, {"pixels", z.pixels}, {"rms_dn", z.rms_dn},
+                            {"mean_dn", z.mean_dn}};
+    };
+    for (const auto& z : r.zones) zones.push_back(zone_json(z));
+    out.push_back({{"image", e.image},
+                   {"file", image_path},
+                   {"mask", mask_path},
+                   {"width_px", r.width_px},
+                   {"height_px", r.height_px},
+                   {"bits", r.bits},
+                   {"bigtiff", image.bigtiff()},
+                   {"tile_px", args.tile_px},
+                   {"valid_pixels", r.valid_pixels},
+                   {"radiometry", heads},
+                   {"overlap_disagreement_dn", {{"all", zone_json(r.overall)}, {"zones", zones}}},
+                   {"warnings", r.warnings}});
+    std::printf("stitched %s: %d x %d px, %ld valid, overlap disagreement %.3f DN RMS (head "
+                "against head before blending, %ld px) -> %s\n",
+                e.image.c_str(), r.width_px, r.height_px, r.valid_pixels, r.overall.rms_dn,
+                r.overall.pixels, image_path.c_str());
+    for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", e.image.c_str(), w.c_str());
+  }
+  return out;
+}
+
 int RunStitch(const StitchArgs& args) {
+  if (args.images.empty() && (!args.stitched_out.empty() || args.match_ties))
+    throw ConfigError(std::string(args.match_ties ? "--match-ties" : "--stitched-out") +
+                      " needs --images (the folder of the head images)");
+  if (!args.images.empty() && args.stitched_out.empty() && !args.match_ties)
+    throw ConfigError("--images needs --stitched-out or --match-ties (what to do with the head "
+                      "images)");
+  CheckTilePx(args.tile_px);
+  if (!(args.feather_px >= 1 && args.feather_px <= 255))
+    throw ConfigError("--feather-px must be within 1..255 (got " + std::to_string(args.feather_px) + ")");
+  if (!args.images.empty() && !fs::is_directory(args.images))
+    throw ConfigError("--images must be a folder of head images (got '" + args.images + "')");
   const calib::Rig rig = calib::ReadRig(args.camera);
   if (rig.heads.size() < 2)
     throw InputError(args.camera + ": a rig of one head has nothing to stitch");
@@ -386,7 +543,10 @@ int RunStitch(const StitchArgs& args) {
   options.max_sigma0 = args.max_sigma0;
   if (!(args.default_sigma_px > 0)) throw ConfigError("--sigma-px must be > 0");
   const triangulation::Project project = triangulation::ReadProject(args.project, args.default_sigma_px);
-  const StitchInputs in = StitchInputsFromProject(project, rig, args.camera);
+  std::vector<stitch::RigZoneMatchReport> matched_zones;
+  const StitchInputs in = args.match_ties
+                              ? MatchedStitchInputs(project, rig, args.images, &matched_zones)
+                              : StitchInputsFromProject(project, rig, args.camera);
   double height_sum = 0.0;
   for (const auto& e : in.exposures) height_sum += e.pose.rig_center_m.z() - e.z_ref_m;
   const double height_m = height_sum / in.exposures.size();
@@ -401,12 +561,34 @@ int RunStitch(const StitchArgs& args) {
   // The standard tie positions of the rig's design at the block's mean height.
   const std::vector<stitch::StandardPosition> positions =
       stitch::DesignRig(rig, height_m, 200).standard_positions;
+  if (!args.stitched_out.empty())  // every head image present before anything is computed or written
+    for (const auto& e : in.exposures)
+      for (const auto& head : rig.heads) HeadImagePath(args.images, e.image, head.id);
   const stitch::RigStitchResult result = stitch::SelfCalibrateRigStitching(
       rig, in.exposures, in.ties, in.observations, positions, options);
-  nlohmann::json doc = stitch::RigStitchToJson(rig, options, result, sources);
-  doc["camera_models"] = HeadCameraModels(rig);
-  WriteResult(args.out, "rig_stitch", doc);
+  nlohmann::json json = stitch::RigStitchToJson(rig, options, result, sources);
+  json["camera_models"] = HeadCameraModels(rig);
+  if (args.match_ties) {
+    nlohmann::json zones = nlohmann::json::array();
+    for (const auto& z : matched_zones) {
+      zones.push_back({{"image", z.image}, {"zone", z.zone}, {"pixels", z.pixels},
+                       {"cells", z.cells}, {"lsm_tried", z.lsm_tried},
+                       {"lsm_failed", z.lsm_failed}, {"ties", z.ties}});
+      std::printf("matched %s zone %s: %d ties (%d cells, LSM %d tried, %d failed)\n",
+                  z.image.c_str(), z.zone.c_str(), z.ties, z.cells, z.lsm_tried, z.lsm_failed);
+    }
+    json["tie_matching"] = {{"ties", in.ties.size()},
+                            {"observations", in.observations.size()},
+                            {"zones", zones}};
+  }
   std::fputs(stitch::FormatRigStitchSummary(options, result, sources).c_str(), stdout);
+  if (!args.stitched_out.empty()) {
+    if (result.failures.empty())
+      json["stitched_images"] = WriteStitchedImages(args, rig, in.exposures, result);
+    else
+      std::fprintf(stderr, "error: no stitched images: the self-calibration is not valid\n");
+  }
+  WriteResult(args.out, "rig_stitch", json);
   if (result.failures.empty()) return kExitOk;
   for (const auto& f : result.failures) std::fprintf(stderr, "error: %s\n", f.c_str());
   std::fprintf(stderr, "error: %s written with valid: false\n", args.out.c_str());
@@ -597,6 +779,24 @@ CommandRun Setup(CLI::App& app) {
   st->add_option("--max-sigma0", stitching->max_sigma0, "sigma0 above: exit 3 (absurd), > 0");
   st->add_option("--sigma-px", stitching->default_sigma_px,
                  "Tie sigma (px) where observations.csv gives none");
+  st->add_option("--images", stitching->images,
+                 "Folder of the head images <image>_<head>.tif (simulate --rig --images writes "
+                 "them under images/); with --stitched-out");
+  st->add_option("--stitched-out", stitching->stitched_out,
+                 "Folder for the stitched level image of every exposure (<image>.tif, resampled "
+                 "once with the refined increments and offsets, balanced, blended) and its "
+                 "valid-area mask (<image>_mask.tif)");
+  st->add_flag("--match-ties", stitching->match_ties,
+               "Match the ties on the head images under --images (Foerstner + least-squares "
+               "matching per overlap zone, on the level plane of the ground calibration and the "
+               "POS) instead of reading them from observations.csv (which must have no rows)");
+  st->add_option("--tile-px", stitching->tile_px,
+                 "Stitched images: square TIFF tiles of this size (multiple of 16, 16..4096; 0: strips)");
+  st->add_flag("--bigtiff", stitching->bigtiff, "Stitched images: BigTIFF even when classic TIFF would do");
+  st->add_flag("--no-balance", stitching->no_balance,
+               "Stitched images: no radiometric balance (every head gain 1, offset 0)");
+  st->add_option("--feather-px", stitching->feather_px,
+                 "Stitched images: width of the blending ramp at each head's border, 1..255 px");
   return [args, ea, convert, cv, design, ds, stitching, st] {
     if (st->parsed()) return RunStitch(*stitching);
     if (ds->parsed()) return RunDesign(*design);

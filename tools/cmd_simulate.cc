@@ -24,7 +24,7 @@ struct SimulateArgs {
     triangulation::FlightSimulationOptions options;
     std::uint64_t seed = 1;
     std::string rig;
-    double increment_arcsec = 0.0, time_offset_ms = 0.0, speed_mps = 0.0;
+    double increment_arcsec = 0.0, time_offset_ms = 0.0, speed_mps = 0.0, format_scale = 1.0;
     std::vector<double> lever_arm_m, boresight_deg;  // planted platform (frame flight)
     double gnss_time_offset_ms = 0.0;
     bool pushbroom = false;
@@ -99,15 +99,34 @@ int RunRigSimulation(const CLI::App& app, const SimulateArgs& args,
     options.speed_mps = args.speed_mps;
   if (*preset == triangulation::RigPreset::kUav4) {
     // The stitching ties around the standard positions of the rig's design (stitch/rig).
-    const stitch::RigDesign design = stitch::DesignRig(triangulation::MakeNominalRig(*preset),
-                                                       options.flight.flying_height_m, 200);
+    const stitch::RigDesign design = stitch::DesignRig(
+        triangulation::ScaleRigFormats(triangulation::MakeNominalRig(*preset), args.format_scale),
+        options.flight.flying_height_m, 200);
     for (const auto& s : design.standard_positions)
       options.stitch_ties.standard_positions.push_back({s.name, s.virtual_px});
+    options.stitch_ties.jitter_px *= args.format_scale;  // the same ground radius
   }
   if (options.time_offset_s != 0.0 && options.speed_mps == 0.0)
     std::fprintf(stderr, "warning: --head-time-offset-ms without --speed-mps moves no head\n");
+  options.format_scale = args.format_scale;
+  for (const char* pushbroom_only : {"--reference-size", "--reference-overlap"})
+    if (app.get_option(pushbroom_only)->count() > 0)
+      throw ConfigError(std::string(pushbroom_only) + " applies to --pushbroom --images only");
+  triangulation::RigImageOptions image_options;
+  image_options.texture_path = args.line_images.texture_path;
+  image_options.texture_gsd_m = args.line_images.texture_gsd_m;
+  image_options.grey_noise_dn = args.line_images.grey_noise_dn;
+  image_options.seed = args.seed;
+  if (args.pushbroom_images) image_options.Validate();
   const auto flight = triangulation::SimulateRigFlight(options);
+  // The photograph is read before anything is written: a bad one leaves no partial output.
+  if (args.pushbroom_images) triangulation::MakeRigGroundTexture(flight, image_options);
   triangulation::WriteSimulatedRigFlight(flight, args.out);
+  if (args.pushbroom_images) {
+    const double gsd = triangulation::WriteRigHeadImages(flight, image_options, args.out);
+    std::printf("rendered %zu head images (texture %.3f m per texel) -> %s/images\n",
+                flight.exposures_truth.size() * flight.truth.heads.size(), gsd, args.out.c_str());
+  }
   std::printf("simulated rig %s: %zu exposures x %zu heads, %zu ground points, %zu head "
               "observations -> %s\n",
               flight.nominal.name.c_str(), flight.exposures_truth.size(), flight.nominal.heads.size(),
@@ -162,6 +181,10 @@ CommandRun SetupSimulate(CLI::App& app) {
                                      "--rig: exposure time offset dT_k of the non-reference heads, "
                                      "-1000..1000 ms (with --speed-mps)")
                           ->check(CLI::Range(-1000.0, 1000.0));
+  auto* format_scale = app.add_option(
+      "--format-scale", args->format_scale,
+      "--rig: every format (heads, virtual image) x this, pixel sizes / this: the same geometry in "
+      "fewer pixels (small rendered images), (0, 1]");
   app.add_option("--speed-mps", args->speed_mps,
                  "Platform speed along the strips, 0..1000 m/s (> 0: exposures.csv carries vX, vY, "
                  "vZ)")
@@ -204,12 +227,13 @@ CommandRun SetupSimulate(CLI::App& app) {
   app.add_option("--control-noise-m", l.control_noise_m, "Pushbroom: control-point coordinate noise, 0..1000 m")->check(CLI::Range(0.0, 1e3));
   auto* images = app.add_flag("--images", args->pushbroom_images,
                "Pushbroom: also render the line image and a reference frame strip of a scene "
-               "textured with --texture (image mode of `pushbroom control`)");
+               "textured with --texture (image mode of `pushbroom control`); --rig: render every "
+               "head image of every exposure (images/<image>_<head>.tif)");
   app.add_option("--texture", args->line_images.texture_path,
-                 "Pushbroom --images: the photograph laid on the terrain as its texture")
+                 "--images: the photograph laid on the terrain as its texture")
       ->needs(images);
   app.add_option("--texture-gsd-m", args->line_images.texture_gsd_m,
-                 "Pushbroom --images: ground size of a texel (2 x 2 photo pixels), m; 0: automatic")
+                 "--images: ground size of a texel (2 x 2 photo pixels), m; 0: automatic")
       ->needs(images)->check(CLI::Range(0.0, 100.0));
   app.add_option("--reference-size", args->reference_size,
                  "Pushbroom --images: reference frame format WIDTHxHEIGHT px")->needs(images);
@@ -217,7 +241,7 @@ CommandRun SetupSimulate(CLI::App& app) {
                  "Pushbroom --images: forward overlap of the reference strip, 0.5..0.9")
       ->needs(images)->check(CLI::Range(0.5, 0.9));
   app.add_option("--grey-noise-dn", args->line_images.grey_noise_dn,
-                 "Pushbroom --images: Gaussian grey-value noise of the rendered images, DN")
+                 "--images: Gaussian grey-value noise of the rendered images, DN")
       ->needs(images)->check(CLI::Range(0.0, 100.0));
   // Flight options a rig flight takes over when given (the rig's defaults otherwise).
   using Flight = triangulation::FlightSimulationOptions;
@@ -237,15 +261,17 @@ CommandRun SetupSimulate(CLI::App& app) {
       {"--imu-sigma-deg", &Flight::imu_sigma_deg},
       {"--start-offset-m", &Flight::start_position_error_m},
       {"--start-offset-deg", &Flight::start_angle_error_deg}};
-  return [args, &app, int_options, double_options, increment, time_offset]() {
+  return [args, &app, int_options, double_options, increment, time_offset, format_scale]() {
     CheckOutputFolder(args->out, "--out");
     if (args->test_field) return RunTestFieldSimulation(app, *args);
     for (const char* field_only : {"--planar", "--groups", "--images-per-group", "--distance-m"})
       if (app.count(field_only) > 0)
         throw ConfigError(std::string(field_only) + " applies to --test-field only");
-    if (args->pushbroom_images && !args->pushbroom) throw ConfigError("--images applies to --pushbroom only");
+    if (args->pushbroom_images && !args->pushbroom && args->rig.empty())
+      throw ConfigError("--images applies to --pushbroom or --rig only");
     if (args->pushbroom) {
       if (!args->rig.empty()) throw ConfigError("--pushbroom and --rig: choose one");
+      if (format_scale->count() > 0) throw ConfigError("--format-scale applies to --rig only");
       auto& l = args->line;
       l.seed = args->seed;
       auto given = [&](const char* name) { return app.count(name) > 0; };
@@ -290,7 +316,7 @@ CommandRun SetupSimulate(CLI::App& app) {
       return kExitOk;
     }
     if (!args->rig.empty()) return RunRigSimulation(app, *args, int_options, double_options);
-    for (const CLI::Option* rig_only : {increment, time_offset})
+    for (const CLI::Option* rig_only : {increment, time_offset, format_scale})
       if (rig_only->count() > 0)
         throw ConfigError(rig_only->get_name() + " applies to a rig flight (--rig) only");
     auto& o = args->options;

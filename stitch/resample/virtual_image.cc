@@ -283,7 +283,11 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
     windows[k].width_px = s.width_px;
     windows[k].height_px = s.height_px;
     windows[k].sub_from_virtual = calib::HomographyFromParams(s.model, s.params.data()).inverse();
-    windows[k].sub_from_virtual /= windows[k].sub_from_virtual(2, 2);  // affine: last row 0 0 1
+    // Scaled so that w > 0 where the virtual ray lies in front of the sub-image (its pixel (0, 0)
+    // maps to w = 1 through the inverse); CoveredColumns relies on it. A negative (2, 2) (virtual
+    // pixel (0, 0) behind the sub-image's camera, e.g. a head tilted away from that corner) must
+    // not flip the sign. Affine: the last row stays 0 0 1.
+    windows[k].sub_from_virtual /= std::abs(windows[k].sub_from_virtual(2, 2));
     if (!corrections.empty() && corrections[k].step_px > 0) {
       const MapCorrectionGrid& g = corrections[k];
       AEROCAL_CHECK(g.cols >= 2 && g.rows >= 2 && (g.cols - 1) * g.step_px >= camera.width_px - 1 &&

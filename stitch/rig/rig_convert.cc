@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <optional>
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -88,12 +90,24 @@ std::optional<Eigen::Vector2d> ExactHeadPixel(const RigConverter& converter, con
   return converter.HeadPixelOfPoint(head, *g);
 }
 
-// Exact head pixel minus the homography's at virtual pixel (U, V); zero where the exact map is
-// undefined (the ray misses the plane or the correction does not invert: far outside the head).
-Eigen::Vector2d MapDifference(const RigConverter& converter, const DemGrid* dem, int head,
-                              const Eigen::Matrix3d& h, const Eigen::Vector2d& virtual_px) {
+// Exact head pixel minus the homography's at virtual pixel (U, V), where the correction grid is
+// defined: the exact map exists (the ray meets the plane or DEM, the point lies in front of the
+// head, the correction inverts) and lands inside the head's format widened by half its larger
+// side on every side. Elsewhere nullopt: beyond the head's horizon (a tilted head, e.g. B and D of
+// the uav4 rig, sees the far side of the level virtual image only at grazing angles) the map
+// diverges and changes sign, so a grid node there holds values that are no correction at all,
+// and bilinear interpolation between such a node and its neighbour can land a virtual pixel far
+// outside the head inside its format (a spurious overlap zone).
+std::optional<Eigen::Vector2d> MapDifference(const RigConverter& converter, const DemGrid* dem,
+                                             int head, const Eigen::Matrix3d& h,
+                                             const Eigen::Vector2d& virtual_px) {
   const auto exact = ExactHeadPixel(converter, dem, head, virtual_px);
-  if (!exact) return Eigen::Vector2d::Zero();
+  if (!exact) return std::nullopt;
+  const calib::Camera& camera = converter.rig().heads[head].camera;
+  const double margin = 0.5 * std::max(camera.width_px, camera.height_px);
+  if (exact->x() < -margin || exact->y() < -margin || exact->x() > camera.width_px - 1 + margin ||
+      exact->y() > camera.height_px - 1 + margin)
+    return std::nullopt;
   const Eigen::Vector2d linear = (h * virtual_px.homogeneous()).hnormalized();
   return *exact - linear;
 }
@@ -108,12 +122,13 @@ MapCorrectionGrid MakeGrid(const RigConverter& converter, const DemGrid* dem, in
   g.duv.resize(2 * static_cast<size_t>(g.cols) * g.rows);
   for (int j = 0; j < g.rows; ++j)
     for (int i = 0; i < g.cols; ++i) {
-      const Eigen::Vector2d d =
-          MapDifference(converter, dem, head, h, Eigen::Vector2d(i * step, j * step));
+      // Outside the defined region the node holds NaN: the interpolated (u, v) of every virtual
+      // pixel of its cells is NaN, which the resampler's per-pixel format test rejects.
+      const auto d = MapDifference(converter, dem, head, h, Eigen::Vector2d(i * step, j * step));
       const size_t at = 2 * (static_cast<size_t>(j) * g.cols + i);
-      g.duv[at] = static_cast<float>(d.x());
-      g.duv[at + 1] = static_cast<float>(d.y());
-      g.max_abs_px = std::max(g.max_abs_px, static_cast<float>(d.cwiseAbs().maxCoeff()));
+      g.duv[at] = d ? static_cast<float>(d->x()) : std::numeric_limits<float>::quiet_NaN();
+      g.duv[at + 1] = d ? static_cast<float>(d->y()) : std::numeric_limits<float>::quiet_NaN();
+      if (d) g.max_abs_px = std::max(g.max_abs_px, static_cast<float>(d->cwiseAbs().maxCoeff()));
     }
   return g;
 }
@@ -135,6 +150,8 @@ double GridError(const RigConverter& converter, const DemGrid* dem, int head,
           interpolated += 0.25 * Eigen::Vector2d(g.duv[at], g.duv[at + 1]);
         }
       const Eigen::Vector2d mapped = (h * centre.homogeneous()).hnormalized() + interpolated;
+      // A cell inside the head that touches an undefined node: refine (NaN would pass std::max).
+      if (!mapped.allFinite()) return std::numeric_limits<double>::infinity();
       worst = std::max(worst, (mapped - *exact).cwiseAbs().maxCoeff());
     }
   return worst;

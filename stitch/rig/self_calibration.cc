@@ -338,6 +338,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       const double* e = builder.BlockValues(increment[i][k]);
       h.increment_rad = Eigen::Vector3d(e[0], e[1], e[2]);
       const double dt_value = *builder.BlockValues(dt[i][k]);
+      h.dt_fitted_s = dt_value;
       refined[i].increment_rad[k] = h.increment_rad;
       refined[i].dt_s[k] = dt_value;
       if (!h.reference && cov.ok) h.increment_sigma_rad = cov.BlockSigma(increment[i][k], 3);

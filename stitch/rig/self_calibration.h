@@ -110,6 +110,9 @@ struct RigStitchHead {
   Eigen::Vector3d increment_sigma_rad = Eigen::Vector3d::Zero();  // 0 for the reference head
   std::optional<double> dt_s;        // nullopt: not determinable (per-exposure mode, correlation)
   std::optional<double> dt_sigma_s;  // nullopt: held or not determinable
+  double dt_fitted_s = 0.0;  // the adjusted dT (s), also where it is not determinable on its own:
+                             // with the increments, the geometry of the "after" figures and of
+                             // the stitched image (the pair is determined, its split is not)
   bool reference = false;
 };
 

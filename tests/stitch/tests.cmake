@@ -16,3 +16,6 @@ aerocal_add_test(stitch/rig_convert LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/rig_design LIBS aerocal::stitch LABELS unit)
 aerocal_add_test(stitch/rig_self_calibration LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(stitch/rig_self_calibration_study LIBS aerocal::triangulation LABELS long TIMEOUT 1200)
+# Rendered head images and the stitched level image of a rig exposure (issue 16 items 1 and 6).
+aerocal_add_test(stitch/rig_stitched_image LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(stitch/rig_images_cli LIBS aerocal::stitch LABELS cli)

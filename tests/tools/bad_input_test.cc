@@ -869,6 +869,71 @@ const std::vector<Case>& Cases() {
          return RigStitchArgs(line);
        },
        2, "rig_truth.yaml: virtual.orientation must be level for rig stitch", "uav4/stitch.json"},
+      // ---- rig stitch --images / --stitched-out, simulate --rig --images (issue 16) ----
+      {"rig_stitch_images_without_stitched_out",
+       [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--images " + d.File("uav4")); },
+       2, "--images needs --stitched-out or --match-ties", "uav4/stitch.json"},
+      {"rig_stitch_match_ties_without_images",
+       [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--match-ties"); },
+       2, "--match-ties needs --images", "uav4/stitch.json"},
+      {"rig_stitch_match_ties_with_observations",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         return RigStitchArgs(line, "--images " + line + " --match-ties");
+       },
+       2, "observations.csv:2: --match-ties measures the ties on the head images: observations.csv "
+          "must have no rows", "uav4/stitch.json"},
+      {"rig_stitch_images_not_a_folder",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         return RigStitchArgs(line, "--images " + line + "/nothing --stitched-out " + line + "/st");
+       },
+       2, "--images must be a folder of head images", "uav4/stitch.json"},
+      {"rig_stitch_head_image_missing",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         return RigStitchArgs(line, "--images " + line + "/truth --stitched-out " + line + "/st");
+       },
+       2, "/truth/0001_A.tif not found", "uav4/st"},
+      {"rig_stitch_tile_not_a_multiple_of_16",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         return RigStitchArgs(line, "--images " + line + " --stitched-out " + line + "/st --tile-px 100");
+       },
+       2, "--tile-px must be 0 (strips) or a multiple of 16 in 16..4096 (got 100)", "uav4/st"},
+      {"rig_stitch_feather_zero",
+       [](const TempDir& d) {
+         const auto line = Uav4Line(d);
+         return RigStitchArgs(line, "--images " + line + " --stitched-out " + line + "/st --feather-px 0");
+       },
+       2, "--feather-px must be within 1..255 (got 0)", "uav4/st"},
+      {"simulate_rig_format_scale_zero",
+       [](const TempDir& d) { return "simulate --rig uav4 --format-scale 0 --out " + d.File("o"); },
+       2, "--format-scale must be within (0, 1]", "o"},
+      {"simulate_rig_format_scale_above_one",
+       [](const TempDir& d) { return "simulate --rig uav4 --format-scale 1.5 --out " + d.File("o"); },
+       2, "--format-scale must be within (0, 1]", "o"},
+      {"simulate_format_scale_without_rig",
+       [](const TempDir& d) { return "simulate --format-scale 0.5 --out " + d.File("o"); },
+       2, "--format-scale applies to a rig flight (--rig) only", "o"},
+      {"simulate_rig_images_without_texture",
+       [](const TempDir& d) { return "simulate --rig uav4 --images --out " + d.File("o"); },
+       2, "--texture: the photograph of the scene is required with --images", "o"},
+      {"simulate_rig_images_texture_missing",
+       [](const TempDir& d) {
+         return "simulate --rig uav4 --images --texture " + d.File("none.jpg") + " --out " + d.File("o");
+       },
+       2, "none.jpg", "o"},
+      {"simulate_rig_images_reference_size",
+       [](const TempDir& d) {
+         return "simulate --rig uav4 --images --texture x.jpg --reference-size 200x200 --out " + d.File("o");
+       },
+       2, "--reference-size applies to --pushbroom --images only", "o"},
+      {"simulate_rig_grey_noise_negative",
+       [](const TempDir& d) {
+         return "simulate --rig uav4 --images --texture x.jpg --grey-noise-dn -1 --out " + d.File("o");
+       },
+       2, "--grey-noise-dn", "o"},
       // ---- the rig in a project (issue 13): rig camera under `cameras:`, head column ----
       {"rig_project_head_unknown",
        [](const TempDir& d) {

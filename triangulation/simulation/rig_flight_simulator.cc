@@ -2,12 +2,16 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
+#include <random>
 
 #include "calib/camera/rig_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
+#include "stitch/image_io/image_io.h"
+#include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/block/block_io.h"
 
 namespace aerocal::triangulation {
@@ -62,7 +66,8 @@ calib::Rig Uav4Rig() {
 // The point where the ray through a virtual pixel meets the terrain (bisection between planes
 // below and above the terrain's range); false when the ray does not point down.
 bool TerrainPointOfRay(const FlightSimulationOptions& o, const Eigen::Vector3d& origin,
-                       const Eigen::Vector3d& direction, Eigen::Vector3d* point) {
+                       const Eigen::Vector3d& direction, Eigen::Vector3d* point,
+                       int iterations = 80) {
   if (!(direction.z() < 0)) return false;
   const double z_lo = o.terrain_base_m - 1.0, z_hi = o.terrain_base_m + o.terrain_relief_m + 1.0;
   double s_lo = (origin.z() - z_hi) / -direction.z(), s_hi = (origin.z() - z_lo) / -direction.z();
@@ -70,7 +75,7 @@ bool TerrainPointOfRay(const FlightSimulationOptions& o, const Eigen::Vector3d& 
     const Eigen::Vector3d p = origin + s * direction;
     return p.z() > SimulatedTerrainHeight(o, p.x(), p.y());
   };
-  for (int i = 0; i < 80; ++i) {
+  for (int i = 0; i < iterations; ++i) {
     const double mid = 0.5 * (s_lo + s_hi);
     (above(mid) ? s_lo : s_hi) = mid;
   }
@@ -285,7 +290,7 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
 
   SimulatedRigFlight f;
   f.options = options;
-  f.nominal = MakeNominalRig(options.preset);
+  f.nominal = ScaleRigFormats(MakeNominalRig(options.preset), options.format_scale);
   f.truth = f.nominal;
   f.truth.name = f.nominal.name + " (truth)";
   const int reference = f.truth.ReferenceIndex();
@@ -371,6 +376,96 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
   }
   AddStitchingTies(f, random);
   return f;
+}
+
+calib::Rig ScaleRigFormats(const calib::Rig& rig, double scale) {
+  if (!(scale > 0 && scale <= 1))
+    throw ConfigError("--format-scale must be within (0, 1] (got " + std::to_string(scale) + ")");
+  calib::Rig out = rig;
+  if (scale == 1.0) return out;
+  const auto scaled = [scale](int px) { return std::max(16, static_cast<int>(std::lround(px * scale))); };
+  for (calib::RigHead& head : out.heads) {
+    head.camera.width_px = scaled(head.camera.width_px);
+    head.camera.height_px = scaled(head.camera.height_px);
+    head.camera.pixel_size_mm /= scale;
+  }
+  out.virtual_camera.width_px = scaled(out.virtual_camera.width_px);
+  out.virtual_camera.height_px = scaled(out.virtual_camera.height_px);
+  out.virtual_camera.pixel_size_mm /= scale;
+  return out;
+}
+
+void RigImageOptions::Validate() const {
+  if (texture_path.empty())
+    throw ConfigError("--texture: the photograph of the scene is required with --images");
+  if (!(texture_gsd_m >= 0)) throw ConfigError("--texture-gsd-m must be >= 0");
+  if (!(grey_noise_dn >= 0)) throw ConfigError("--grey-noise-dn must be >= 0");
+}
+
+TexturedGround MakeRigGroundTexture(const SimulatedRigFlight& f, const RigImageOptions& options) {
+  options.Validate();
+  TexturedGround ground;
+  ReadGroundTexture(options.texture_path, &ground);
+  const calib::VirtualCamera& v = f.nominal.virtual_camera;
+  ground.gsd_m = options.texture_gsd_m > 0
+                     ? options.texture_gsd_m
+                     : 0.5 * v.pixel_size_mm * f.options.flight.flying_height_m / v.c_mm;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  for (const Exposure& e : f.exposures_truth) centre += e.center_m.head<2>();
+  centre /= static_cast<double>(f.exposures_truth.size());
+  ground.x_c = centre.x();
+  ground.y_c = centre.y();
+  return ground;
+}
+
+stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f, const TexturedGround& ground,
+                                     const RigImageOptions& options, int exposure, int head) {
+  const size_t heads = f.truth.heads.size();
+  AEROCAL_CHECK(exposure >= 0 && exposure < static_cast<int>(f.exposures_truth.size()) &&
+                head >= 0 && head < static_cast<int>(heads))
+      << exposure << " " << head;
+  const calib::RigHead& h = f.truth.heads[head];
+  const Exposure& e = f.exposures_truth[exposure];
+  const RigExposureTruth& t = f.rig_exposures[exposure * heads + head];
+  const Eigen::Vector3d velocity = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
+  double rotation[9], center[3];
+  calib::HeadPose(e.opk_rad.data(), e.center_m.data(), h.mount_rad.data(), h.lever_arm_m.data(),
+                  t.increment_rad.data(), &t.dt_s, velocity.data(), rotation, center);
+  const Eigen::Vector3d opk = calib::OpkFromRotation(
+      Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation));
+  const Eigen::Vector3d origin(center[0], center[1], center[2]);
+  std::mt19937_64 rng(options.seed * 7919 + 13 + 1009 * static_cast<std::uint64_t>(exposure) +
+                      static_cast<std::uint64_t>(head));
+  std::normal_distribution<double> noise(0.0, 1.0);
+  stitch::GrayImage image(h.camera.height_px, h.camera.width_px);
+  for (int r = 0; r < image.rows(); ++r)
+    for (int c = 0; c < image.cols(); ++c) {
+      const ImageRay ray = RayFromPixel(h.camera, opk, origin, Eigen::Vector2d(c, r));
+      Eigen::Vector3d g;
+      // 40 halvings of the terrain's height range: far below 1e-6 m.
+      if (!TerrainPointOfRay(f.options.flight, ray.center_m, ray.direction, &g, 40))
+        throw Error("image mode: a ray of head " + h.id + " in " + e.image +
+                    " does not point down");
+      image(r, c) = static_cast<float>(ground.At(g.x(), g.y()) + options.grey_noise_dn * noise(rng));
+    }
+  return image;
+}
+
+std::string RigHeadImagePath(const std::string& folder, const std::string& image,
+                             const std::string& head) {
+  return folder + "/images/" + image + "_" + head + ".tif";
+}
+
+double WriteRigHeadImages(const SimulatedRigFlight& f, const RigImageOptions& options,
+                          const std::string& folder) {
+  const TexturedGround ground = MakeRigGroundTexture(f, options);
+  std::filesystem::create_directories(folder + "/images");
+  for (size_t i = 0; i < f.exposures_truth.size(); ++i)
+    for (size_t k = 0; k < f.truth.heads.size(); ++k)
+      stitch::WriteGrayImage(
+          RigHeadImagePath(folder, f.exposures_truth[i].image, f.truth.heads[k].id),
+          RenderRigHeadImage(f, ground, options, static_cast<int>(i), static_cast<int>(k)));
+  return ground.gsd_m;
 }
 
 void WriteSimulatedRigFlight(const SimulatedRigFlight& f, const std::string& folder) {

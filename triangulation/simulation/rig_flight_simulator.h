@@ -19,9 +19,19 @@
 // stitch beyond sub-image mappings), at random places of the overlap zones (dense ties), and
 // check ties (points.csv role `check` without coordinates). Each exposure also gets `z_ref`, the
 // mean terrain height under the virtual image.
+//
+// Image mode (`simulate --rig uav4 --images --texture PHOTO`): every head image of every exposure
+// rendered through the TRUE head pose of that exposure (ground calibration + increments E_k +
+// offsets dT_k with the velocity; calib::HeadPose) and the head's true interior onto the terrain
+// textured with a real photograph (textured_ground.h), plus Gaussian grey-value noise. Each pixel
+// centre's ray is intersected with the terrain exactly (bisection to 1e-10 m); its grey value is
+// the texture's there (point sampling: the texture is finer than the head pixels, 2 texels per
+// nadir pixel by default). `format_scale` shrinks every format (pixel size grown by the same
+// factor, same field of view) so that tests render small images of the same geometry.
 #pragma once
 
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
@@ -30,8 +40,10 @@
 #include <Eigen/Core>
 
 #include "calib/camera/rig.h"
+#include "stitch/image_io/gray_image.h"
 #include "triangulation/block/block.h"
 #include "triangulation/simulation/flight_simulator.h"
+#include "triangulation/simulation/textured_ground.h"
 
 namespace aerocal::triangulation {
 
@@ -57,6 +69,9 @@ struct RigFlightSimulationOptions {
   double time_offset_s = 0.0;        // dT_k of every non-reference head, |dT| <= 1 s
   double speed_mps = 0.0;            // platform speed along the strips, >= 0; > 0: exposures.csv
                                      // carries the velocity vX, vY, vZ
+  /// Every head's and the virtual camera's format x format_scale (rounded), pixel sizes / scale:
+  /// the same geometry in fewer pixels (rendered images for tests), (0, 1].
+  double format_scale = 1.0;
   /// dT_k per head (s, k-th entry; the reference head's is ignored, |dT| <= 1 s); empty: every
   /// non-reference head has time_offset_s.
   std::vector<double> head_time_offsets_s;
@@ -112,6 +127,40 @@ bool ProjectRigHead(const calib::RigHead& head,
                     Eigen::Vector2d* pixel);
 
 SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options);
+
+/// The rig with every format (heads and virtual image) x `scale` (rounded, >= 16 px) and every
+/// pixel size / scale (the principal distances and the fields of view stay). ConfigError unless
+/// 0 < scale <= 1.
+calib::Rig ScaleRigFormats(const calib::Rig& rig, double scale);
+
+/// Image mode (header comment).
+struct RigImageOptions {
+  std::string texture_path;    // the photograph (any format ReadGrayImage reads), required
+  double texture_gsd_m = 0.0;  // ground size of a texel (2 x 2 photo pixels); 0: half the
+                               // virtual image's nadir GSD at the flying height, >= 0
+  double grey_noise_dn = 1.0;  // Gaussian noise added to every rendered grey value (DN), >= 0
+  std::uint64_t seed = 1;
+  void Validate() const;       // ConfigError naming the option
+};
+
+/// The photograph laid on the ground under the flight (centred on the mean exposure centre) with
+/// the options' texel size.
+TexturedGround MakeRigGroundTexture(const SimulatedRigFlight& flight, const RigImageOptions& options);
+
+/// The image of head `head` in exposure `exposure` (indices into the flight) through its true
+/// pose and interior, grey values of `ground` plus the options' noise (seeded by options.seed,
+/// exposure and head). Error when a pixel's ray does not point down.
+stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& flight, const TexturedGround& ground,
+                                     const RigImageOptions& options, int exposure, int head);
+
+/// The file of one head image under a folder: `images/<image>_<head>.tif` (8 bit).
+std::string RigHeadImagePath(const std::string& folder, const std::string& image,
+                             const std::string& head);
+
+/// Renders and writes every head image of every exposure (RigHeadImagePath, 8 bit, rounded and
+/// clamped); returns the texel size used (m).
+double WriteRigHeadImages(const SimulatedRigFlight& flight, const RigImageOptions& options,
+                          const std::string& folder);
 
 /// Writes rig_nominal.yaml, rig_truth.yaml (FORMATS.md "Multi-head rig"), exposures.csv,
 /// observations.csv (`image,head,point,col,row,sigma_px`), points.csv, project.yaml and

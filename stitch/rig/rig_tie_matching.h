@@ -1,0 +1,67 @@
+// Tie points of a rig exposure matched on the head images (issue 16 item 2; `aerocal rig stitch
+// --match-ties`): with the ground calibration and the POS (no increments, no offsets) every head
+// is resampled once onto the level virtual image of the exposure (plane Z = z_ref, the stitched
+// image's projection: stitch/rig/stitched_image.h ProjectHeadOntoVirtual); on the virtual grid
+// the overlap zones are the pixels covered by the same set of two or more heads ("AB", ...,
+// triple zones "ABC"), each shrunk by the LSM template and search margin. The matcher of
+// `aerocal match` (stitch/matching) then works per zone:
+//  1. Foerstner points (interest_operators.h) on the Wallis-filtered projection of the zone's
+//     first head (rig order), the strongest one per square cell of `cell_px` virtual px;
+//  2. least-squares matching (least_squares_matching.h) of its template into the projection of
+//     each other head of the zone, starting at the same virtual pixel (the ground calibration
+//     leaves ~2 px; LSM's shift bound `lsm.max_shift_px`);
+//  3. measured back in RAW head pixels through the exact conversion (RigConverter::HeadFromVirtual:
+//     plane, the head's full interior model inverted): the first head's point and every matched
+//     position; a tie keeps the heads whose match converged (at least two heads).
+// Sigma of each observation row: the LSM position sigma (larger axis) / sqrt(2), not below
+// `min_sigma_px`, in virtual px, times the head's local scale (head px per virtual px, the larger
+// singular value of the conversion's Jacobian); the first head's row takes the largest LSM sigma
+// of its tie. Deterministic (fixed order, no random sampling).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "calib/camera/rig.h"
+#include "stitch/image_io/gray_image.h"
+#include "stitch/matching/interest_operators.h"
+#include "stitch/matching/least_squares_matching.h"
+#include "stitch/rig/rig_conversion.h"
+#include "stitch/rig/self_calibration.h"
+
+namespace aerocal::stitch {
+
+struct RigTieMatchOptions {
+  double cell_px = 40.0;       // one tie per cell of this side per zone, virtual px, >= 8
+  double min_sigma_px = 0.02;  // floor of the LSM sigma written, virtual px, > 0
+  LsmOptions lsm;
+  WallisOptions wallis;
+  FoerstnerOptions foerstner;
+  void Validate() const;  // ConfigError naming the field
+};
+
+/// Counts of one zone of one exposure.
+struct RigZoneMatchReport {
+  std::string image, zone;  // "AB", "ABC"
+  long pixels = 0;          // zone pixels (after the margin)
+  int cells = 0;            // cells with a Foerstner point in the zone
+  int lsm_tried = 0, lsm_failed = 0;
+  int ties = 0;             // ties written (two or more heads)
+};
+
+struct RigTieMatches {
+  std::vector<RigStitchTie> ties;                  // ids "<image>/<zone>-<n>", fitted ties
+  std::vector<RigStitchObservation> observations;  // indices into `ties`, the exposures, the heads
+  std::vector<double> lsm_sigma_px;  // per tie: its largest LSM position sigma (larger axis),
+                                     // virtual px: the matching noise of the tie's differences
+  std::vector<RigZoneMatchReport> zones;
+};
+
+/// Matches the ties of exposure `exposure_index` (`exposure`: its POS and z_ref) on `heads` (one
+/// image per head of `rig`, rig order, each of its head's format; LogicError otherwise) and
+/// appends them to `out` (tie indices continue from out->ties.size()).
+void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposure,
+                          int exposure_index, const std::vector<GrayImage>& heads,
+                          const RigTieMatchOptions& options, RigTieMatches* out);
+
+}  // namespace aerocal::stitch
