@@ -235,9 +235,9 @@ nlohmann::json DistortionJson(const nlohmann::json& cert) {
     if (!estimated.contains(name) || !estimated[name].is_number()) return nullptr;
     camera.params.push_back(estimated[name].get<double>());
   }
-  camera.frame.pixel_size_mm = file["pixel_size_mm"].get<double>();
-  camera.frame.width_px = file["format_px"][0].get<int>();
-  camera.frame.height_px = file["format_px"][1].get<int>();
+  camera.frame.pixel_size_mm = file.at("pixel_size_mm").get<double>();
+  camera.frame.width_px = file.at("format_px").at(0).get<int>();  // at(): a short list is bad input
+  camera.frame.height_px = file.at("format_px").at(1).get<int>();
   if (!(camera.frame.pixel_size_mm > 0) || camera.frame.width_px < 2 || camera.frame.height_px < 2)
     return nullptr;
   const triangulation::DistortionFigure figure = triangulation::DistortionOverFormat(camera);
