@@ -1282,6 +1282,20 @@ const std::vector<Case>& Cases() {
          return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
        },
        2, "r.json: not a result written by aerocal (--result): [json.exception.out_of_range.403] key 'stability' not found", "cert"},
+      // The distortion samples read the certified camera's format (a list shorter than two was
+      // undefined behaviour through const operator[]).
+      {"certificate_format_px_too_short",
+       [](const TempDir& d) {
+         std::string r = CertificateResult("{\"quantity\": \"c\", \"value\": 1, \"statement\": \"c = 1\"}");
+         const std::string cameras = "\"cameras\": [{}]", camera = "\"camera\": {}";
+         r.replace(r.find(cameras), cameras.size(),
+                   "\"cameras\": [{\"estimated\": {\"c\": 24, \"x0\": 0, \"y0\": 0, \"K1\": 0, \"K2\": 0,"
+                   " \"K3\": 0, \"P1\": 0, \"P2\": 0, \"B1\": 0, \"B2\": 0}}]");
+         r.replace(r.find(camera), camera.size(), "\"camera\": {\"pixel_size_mm\": 0.006, \"format_px\": [640]}");
+         Write(d.File("r.json"), r);
+         return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
+       },
+       2, "r.json: not a result written by aerocal (--result): [json.exception.out_of_range.401] array index 1 is out of range", "cert"},
       {"certificate_statement_not_text",
        [](const TempDir& d) {
          Write(d.File("r.json"), CertificateResult("{\"quantity\": \"c\", \"value\": 1, \"statement\": 5}"));
