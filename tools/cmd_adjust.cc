@@ -218,13 +218,6 @@ CommandRun SetupAdjust(CLI::App& app) {
   // The command line's platform options over the project's `platform:`.
   auto apply_platform = [args, &app](triangulation::PlatformSpec* p) -> bool {
     auto given = [&](const char* name) { return app.count(name) > 0; };
-    auto mode = [](const std::string& text, const char* option) {
-      const auto m = triangulation::ParsePlatformParamMode(text);
-      if (!m)
-        throw ConfigError(std::string(option) + " must be fixed, free or weighted (got '" + text +
-                          "')");
-      return *m;
-    };
     if (given("--lever-arm-m"))
       p->lever_arm_m = Eigen::Vector3d(args->lever_arm_m[0], args->lever_arm_m[1], args->lever_arm_m[2]);
     if (given("--boresight-deg"))
@@ -232,10 +225,10 @@ CommandRun SetupAdjust(CLI::App& app) {
                                          args->boresight_deg[2]) *
                          (M_PI / 180.0);
     if (given("--gnss-time-offset-ms")) p->time_offset_s = args->time_offset_ms * 1e-3;
-    if (given("--lever-arm")) p->lever_arm = mode(args->lever_arm, "--lever-arm");
-    if (given("--boresight")) p->boresight = mode(args->boresight, "--boresight");
+    if (given("--lever-arm")) p->lever_arm = triangulation::PlatformParamModeOption(args->lever_arm, "--lever-arm");
+    if (given("--boresight")) p->boresight = triangulation::PlatformParamModeOption(args->boresight, "--boresight");
     if (given("--gnss-time-offset"))
-      p->time_offset = mode(args->time_offset, "--gnss-time-offset");
+      p->time_offset = triangulation::PlatformParamModeOption(args->time_offset, "--gnss-time-offset");
     if (given("--lever-arm-sigma-m")) p->lever_arm_sigma_m = args->lever_arm_sigma_m;
     if (given("--boresight-sigma-deg")) p->boresight_sigma_rad = args->boresight_sigma_deg * M_PI / 180.0;
     if (given("--gnss-time-offset-sigma-ms")) p->time_offset_sigma_s = args->time_offset_sigma_ms * 1e-3;

@@ -49,13 +49,8 @@ int RunCalibrate(CalibrateArgs& a) {
   if (a.pos_prior != "on" && a.pos_prior != "off")
     throw ConfigError("--pos-prior must be on or off (got '" + a.pos_prior + "')");
   o.pos_prior = a.pos_prior == "on";
-  auto mode = [](const std::string& text, const char* option) {
-    const auto m = triangulation::ParsePlatformParamMode(text);
-    if (!m) throw ConfigError(std::string(option) + " must be fixed, free or weighted (got '" + text + "')");
-    return *m;
-  };
-  o.boresight = mode(a.boresight, "--boresight");
-  o.lever_arm = mode(a.lever_arm, "--lever-arm");
+  o.boresight = triangulation::PlatformParamModeOption(a.boresight, "--boresight");
+  o.lever_arm = triangulation::PlatformParamModeOption(a.lever_arm, "--lever-arm");
   o.boresight_sigma_rad = a.boresight_sigma_deg * M_PI / 180.0;
   o.Validate();
   const calib::LineCamera camera = calib::ReadLineCamera(a.camera);

@@ -1,5 +1,7 @@
 #include "triangulation/block/block.h"
 
+#include "calib/core/error.h"
+
 namespace aerocal::triangulation {
 
 std::string PointRoleName(PointRole role) {
@@ -19,6 +21,12 @@ std::optional<PlatformParamMode> ParsePlatformParamMode(const std::string& text)
   if (text == "free") return PlatformParamMode::kFree;
   if (text == "weighted") return PlatformParamMode::kWeighted;
   return std::nullopt;
+}
+
+PlatformParamMode PlatformParamModeOption(const std::string& text, const std::string& option) {
+  const auto mode = ParsePlatformParamMode(text);
+  if (!mode) throw ConfigError(option + " must be fixed, free or weighted (got '" + text + "')");
+  return *mode;
 }
 
 std::string PlatformParamModeName(PlatformParamMode mode) {

@@ -63,6 +63,8 @@ struct FrameSpec {
 enum class PlatformParamMode { kFixed, kFree, kWeighted };
 /// "fixed" | "free" | "weighted" -> the mode; nullopt otherwise.
 std::optional<PlatformParamMode> ParsePlatformParamMode(const std::string& text);
+/// The mode given to a command-line `option`; ConfigError naming the option otherwise (exit 2).
+PlatformParamMode PlatformParamModeOption(const std::string& text, const std::string& option);
 std::string PlatformParamModeName(PlatformParamMode mode);
 
 /// The GNSS/IMU platform of the block (triangulation/README.md "GNSS/IMU priors on the
