@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
 #include "calib/core/error.h"
@@ -245,6 +246,44 @@ TEST(LineCalibration, WithNoiseEveryDetectorIsWithinThreeSigma) {
   std::printf("noise: worst |e|/sigma %.2f, table RMS error %.4f px vs predicted %.4f px, sigma0 %.3f\n",
               worst_z, std::sqrt(sum_e2 / (2 * sim.truth.detectors)) / pitch,
               std::sqrt(sum_s2 / (2 * sim.truth.detectors)) / pitch, r.report.sigma0);
+}
+
+// The datum's Legendre mean and slope: 1 -> (1, 0), u -> (0, 1), u^2 -> (1/3, 0), u^3 -> (0, 3/5);
+// P2 = (3u^2 - 1)/2, P3 = (5u^3 - 3u)/2, P4, P5 -> (0, 0): adding or dropping them leaves the datum.
+// The residual is their whitened value per axis; its Jacobian matches numeric differentiation.
+TEST(LineDatumResidual, HoldsTheLegendreMeanAndSlopeOnly) {
+  auto moments = [](std::vector<double> a) {
+    a.resize(calib::kLineMaxTerms, 0.0);
+    double mean = 0, slope = 0;
+    LegendreMeanAndSlope(a.data(), calib::kLineMaxTerms, &mean, &slope);
+    return Eigen::Vector2d(mean, slope);
+  };
+  EXPECT_LT((moments({1}) - Eigen::Vector2d(1, 0)).norm(), 1e-15);
+  EXPECT_LT((moments({0, 1}) - Eigen::Vector2d(0, 1)).norm(), 1e-15);
+  EXPECT_LT((moments({0, 0, 1}) - Eigen::Vector2d(1.0 / 3, 0)).norm(), 1e-15);
+  EXPECT_LT((moments({0, 0, 0, 1}) - Eigen::Vector2d(0, 0.6)).norm(), 1e-15);
+  EXPECT_LT(moments({-0.5, 0, 1.5}).norm(), 1e-15);                       // P2
+  EXPECT_LT(moments({0, -1.5, 0, 2.5}).norm(), 1e-15);                    // P3
+  EXPECT_LT(moments({3.0 / 8, 0, -30.0 / 8, 0, 35.0 / 8}).norm(), 1e-15);  // P4
+  EXPECT_LT(moments({0, 15.0 / 8, 0, -70.0 / 8, 0, 63.0 / 8}).norm(), 1e-14);  // P5
+  const auto cost = LineDatumResidual::Create(1e-6);
+  std::array<double, 2 * calib::kLineMaxTerms> block;
+  for (int k = 0; k < 2 * calib::kLineMaxTerms; ++k) block[k] = 1e-3 * std::sin(1.0 + k);
+  std::vector<double*> parameters = {block.data()};
+  const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(cost.get(), no_manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  EXPECT_TRUE(checker.Probe(parameters.data(), 1e-8, &results)) << results.error_log;
+  double r[4];
+  const double* values = block.data();
+  ASSERT_TRUE(cost->Evaluate(&values, r, nullptr));
+  const Eigen::Vector2d x = moments({block.begin(), block.begin() + 6}) / 1e-6;
+  const Eigen::Vector2d y = moments({block.begin() + 6, block.end()}) / 1e-6;
+  EXPECT_NEAR(r[0], x[0], 1e-9);
+  EXPECT_NEAR(r[1], x[1], 1e-9);
+  EXPECT_NEAR(r[2], y[0], 1e-9);
+  EXPECT_NEAR(r[3], y[1], 1e-9);
 }
 
 TEST(LineCalibration, WithoutTheDatumTheOffsetsAreReportedIllPosed) {

@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include <Eigen/Cholesky>
-#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
 #include <nlohmann/json.hpp>
 
@@ -56,27 +55,6 @@ bool SearchCorrelation(const stitch::GrayImage& l1, const Eigen::Vector2i& p,
       if (r > *best) *best = r, *shift = Eigen::Vector2i(sx - s, sy - s);
     }
   return *best > -2;
-}
-
-// Bicubic convolution (Keys 1981, a = -0.5) of `image` at (col, row); NaN within 2 px of an edge.
-float SampleBicubic(const stitch::GrayImage& image, double col, double row) {
-  const int c0 = int(std::floor(col)), r0 = int(std::floor(row));
-  if (c0 < 1 || r0 < 1 || c0 + 2 >= image.cols() || r0 + 2 >= image.rows()) return std::nanf("");
-  auto weights = [](double t, double* w) {
-    const double a = -0.5;
-    for (int k = -1; k <= 2; ++k) {
-      const double x = std::abs(t - k);
-      w[k + 1] = x <= 1 ? ((a + 2) * x - (a + 3)) * x * x + 1
-                        : x < 2 ? ((a * x - 5 * a) * x + 8 * a) * x - 4 * a : 0.0;
-    }
-  };
-  double wc[4], wr[4];
-  weights(col - c0, wc);
-  weights(row - r0, wr);
-  double sum = 0;
-  for (int j = 0; j < 4; ++j)
-    for (int i = 0; i < 4; ++i) sum += wr[j] * wc[i] * image(r0 - 1 + j, c0 - 1 + i);
-  return float(sum);
 }
 
 // Weighted intersection of the rays (Gauss-Newton on the pixel misclosures from a least-squares
@@ -291,51 +269,30 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
       if (!(start.x() > margin && start.y() > margin && start.x() < f.image.cols() - 1 - margin &&
             start.y() < f.image.rows() - 1 - margin))
         continue;
-      // The reference image resampled onto the line image's pixel grid around q through the
-      // exact mapping (line pixel -> plane point -> reference pixel, shifted by the L1 match's
-      // displacement), so the least-squares affine only absorbs what the plane does not model.
-      // An affine over the template of a tilted sub-camera misses the perspective's curvature
-      // (ground sampling ~ sec^2 of the look angle): the fit moves the centre by ~ k h^2 / 3
-      // (k = tan(look) pitch / c per px), a smooth across-track bias in the detector index
-      // (measured: 0.013-0.019 px table error, 7-11 sigma; module README "Measured").
-      const Eigen::Vector2d shift_px = start - pq;
-      const int margin_px = int(std::ceil(lsm.max_shift_px)) + 3, half = h + margin_px;
-      auto reference_of = [&](const Eigen::Vector2d& offset, Eigen::Vector2d* pixel) {
-        const auto g = GroundOfDetector(camera, pos, q.x() + offset.x(), q.y() + offset.y(), plane);
-        if (!g || !ref_camera.ProjectToPixel(f.opk_rad, f.center_m, *g, pixel)) return false;
-        *pixel += shift_px;
-        return true;
-      };
-      stitch::GrayImage patch(2 * half + 1, 2 * half + 1);
-      bool inside = q.x() - half >= 0 && q.x() + half < line_image.cols() && q.y() - half >= 0 &&
-                    q.y() + half < line_image.rows();
-      for (int y = -half; y <= half && inside; ++y)
-        for (int x = -half; x <= half && inside; ++x) {
-          Eigen::Vector2d pixel;
-          inside = reference_of(Eigen::Vector2d(x, y), &pixel);
-          if (inside) patch(y + half, x + half) = SampleBicubic(f.image, pixel.x(), pixel.y());
-          inside = inside && !std::isnan(patch(y + half, x + half));
-        }
-      if (!inside) continue;
-      const auto m = stitch::MatchLeastSquares(line_image, q, patch, Eigen::Vector2d(half, half),
-                                               Eigen::Matrix2d::Identity(), lsm);
+      const auto m = stitch::MatchLeastSquares(line_image, q, f.image, start, a_line, lsm);
       if (!m.ok()) continue;
-      // Back through the exact mapping: the matched offset (line px) -> reference pixel, its
-      // covariance by the mapping's Jacobian there.
-      const Eigen::Vector2d offset = m.position_in_b - Eigen::Vector2d(half, half);
-      Eigen::Vector2d matched, along_col, along_row;
-      if (!reference_of(offset, &matched) || !reference_of(offset + Eigen::Vector2d(1e-3, 0), &along_col) ||
-          !reference_of(offset + Eigen::Vector2d(0, 1e-3), &along_row))
-        continue;
-      Eigen::Matrix2d jacobian;
-      jacobian.col(0) = (along_col - matched) / 1e-3;
-      jacobian.col(1) = (along_row - matched) / 1e-3;
-      const Eigen::Matrix2d cov_px2 = jacobian * m.cov_px2 * jacobian.transpose();
-      match_sigmas.push_back(std::sqrt(Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(cov_px2).eigenvalues().maxCoeff()));
+      // The affine of the match stands for the exact mapping line pixel -> plane point ->
+      // reference pixel, which a tilted sub-camera's perspective curves (ground sampling ~ sec^2
+      // of the look angle). Over the symmetric template the least-squares affine's centre is the
+      // template's MEAN mapped position, not the centre's: off by mean_o F(o) - F(0) ~ k h^2 / 3
+      // (k = tan(look) pitch / c per px), a smooth across-track bias in the detector index
+      // (measured: 0.013-0.019 px table error, 7-11 sigma; module README "Measured"). Removed.
+      Eigen::Vector2d mean_mapped = Eigen::Vector2d::Zero();
+      bool mapped = true;
+      for (int y = -h; y <= h && mapped; ++y)
+        for (int x = -h; x <= h && mapped; ++x) {
+          const auto g = GroundOfDetector(camera, pos, q.x() + x, q.y() + y, plane);
+          Eigen::Vector2d pixel;
+          mapped = g && ref_camera.ProjectToPixel(f.opk_rad, f.center_m, *g, &pixel);
+          if (mapped) mean_mapped += pixel;
+        }
+      if (!mapped) continue;
+      mean_mapped /= double((2 * h + 1) * (2 * h + 1));
+      match_sigmas.push_back(m.SigmaMaxPx());
       Ray2 ray;
       ray.frame = int(k);
-      ray.pixel = matched;
-      ray.weight = (cov_px2 + o.min_match_sigma_px * o.min_match_sigma_px * Eigen::Matrix2d::Identity()).inverse();
+      ray.pixel = m.position_in_b - (mean_mapped - pq);
+      ray.weight = (m.cov_px2 + o.min_match_sigma_px * o.min_match_sigma_px * Eigen::Matrix2d::Identity()).inverse();
       rays.push_back(ray);
       ++out.n_rays;
     }

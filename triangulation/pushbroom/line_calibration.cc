@@ -375,6 +375,14 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     result.valid = false;
     result.warnings.push_back({"covariance", "adjustment", 0, 0,
                                "no covariance (singular normal matrix?): " + cov.message});
+    // Without the datum the singular direction is known: a constant along-track offset of all
+    // detectors IS a pitch of the strip (exactly, for a line at y = 0); without a covariance its
+    // correlation cannot be computed, so it is named with the value it has in the model.
+    if (!options.reference_datum)
+      result.warnings.push_back({"offset_vs_pitch", "detector polynomials", 1.0,
+                                 options.correlation_fail,
+                                 "ill-posed: no datum and a singular normal matrix: a constant "
+                                 "along-track offset of the detectors is a pitch of the strip"});
   }
   result.undetermined = cov.undetermined;
   if (!cov.undetermined.empty()) {
