@@ -16,7 +16,8 @@
 //   "detector_ID"     per sub-camera ID: a_0..a_5, b_0..b_5 (mm), the calibration polynomials in
 //                     the sub-camera's normalised index (calib/camera/line_camera.h); start 0 (on
 //                     top of the file's calibration); which entries are fixed is the caller's
-//                     (degree, datum: SetFixedDetectorEntries)
+//                     (degree: SetFixedDetectorEntries); the datum is the caller's too
+//                     (LineDatumResidual below, on the reference sub-camera's block)
 //   "c"               principal distance (mm), fixed unless `free_c`
 //   "mount"           boresight M omega, phi, kappa (rad), camera -> body; fixed | free | weighted
 //   "lever_arm"       camera centre in the body frame (m); fixed | free | weighted
