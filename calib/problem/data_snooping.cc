@@ -507,14 +507,13 @@ class Snooper {
       ++out_.solves;
       if (!out_.report.usable) {
         stopped = "the block without " + worst.label + " cannot be solved";
-        suspects.push_back(worst);
-        unsolvable = true;
+        unsolvable = true;  // it is in `left`: a suspect with those left out before it
         break;
       }
     }
-    if (!suspects.empty()) {  // the test names suspects it cannot leave out: not a fit
+    if (!suspects.empty() || unsolvable) {  // suspects it cannot leave out: not a fit
       out_.unresolved_reason = stopped;
-      if (inseparable && !unsolvable && !left.empty()) {
+      if (inseparable && !left.empty()) {
         // Those singled out before a group the test cannot tell apart stay out (each failed
         // alone, beyond k sigmas; putting it back would bend the block by its blunder too):
         // both are named, and the caller's run is not a fit.
