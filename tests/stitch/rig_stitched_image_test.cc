@@ -2,11 +2,14 @@
 // horizontal stitched image of an exposure (stitch/rig/stitched_image.h, issue 16 item 6):
 // - every rendered pixel shows the ground point its TRUE head ray meets (ground calibration,
 //   increments and shutter offsets with the velocity), checked against the stitch module's own
-//   converter on flat terrain;
+//   converter on flat terrain (point sampling), and the default renderer integrates the texture
+//   over each pixel's footprint;
 // - the stitched image from the raw heads with the increments and offsets of the self-calibration
 //   on the simulated ties agrees head against head (overlaps, before blending) at the level of
 //   the true parameters, clearly better than with the ground calibration alone;
-// - a gain and offset planted in one head are recovered by the radiometric balance.
+// - a gain and offset planted in one head are recovered by the radiometric balance;
+// - ties matched on the rendered heads (rig_tie_matching.h) against the simulator's truth, and
+//   the increments self-calibrated from them within their sigmas.
 // The scene: the uav4 line at 0.2 x its formats (same geometry, 582 x 874 px heads), textured
 // with a real photograph (../shared/data/odm_boruszyn_kap_frames).
 #include <cmath>
@@ -124,8 +127,9 @@ TEST(RigHeadImages, EveryPixelShowsTheGroundItsTrueRayMeets) {
       }
     // float grey values; the two ray intersections agree to ~1e-9 m
     EXPECT_LT(worst, 1e-3) << f.truth.heads[k].id;
-    if (k != f.truth.ReferenceIndex())  // the increments move the head's ground by ~0.1 m
+    if (k != f.truth.ReferenceIndex()) {  // the increments move the head's ground by ~0.1 m
       EXPECT_GT(worst_ground_only, 1.0) << f.truth.heads[k].id;
+    }
   }
 }
 
@@ -445,8 +449,11 @@ TEST(RigTieMatching, MatchedTiesGiveIncrementsWithinTheirSigmas) {
     ++n;
     sum += m.error_px[o];
   }
-  for (const auto& [key, v] : mean)
-    if (v.first >= 100) EXPECT_LT((v.second / v.first).cwiseAbs().maxCoeff(), 0.015) << key;
+  for (const auto& [key, v] : mean) {
+    if (v.first >= 100) {
+      EXPECT_LT((v.second / v.first).cwiseAbs().maxCoeff(), 0.015) << key;
+    }
+  }
 
   const IncrementCheck c = SelfCalibrateOnMatches(f, in, m.matches);
   ASSERT_TRUE(c.result.failures.empty()) << c.result.failures.front();
