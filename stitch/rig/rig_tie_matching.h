@@ -15,7 +15,7 @@
 //     has a variance that depends on the sub-pixel phase, which pulls the LSM optimum towards
 //     certain phases; the phase follows the ~2 px misregistration smoothly over a zone, so the
 //     pull is a systematic error per zone (0.02-0.08 px without the prefilter, measured against
-//     the simulator's truth; below 0.01 px with it: stitch/README.md);
+//     the simulator's truth; about 0.01 px and below with 1.5 px: stitch/README.md);
 //  3. measured back in RAW head pixels through the exact conversion (RigConverter::HeadFromVirtual:
 //     plane, the head's full interior model inverted): the first head's point and every matched
 //     position; a tie keeps the heads whose match converged (at least two heads).

@@ -461,8 +461,9 @@ stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f, const Textured
   // points of its four corners are exact ray intersections, the points inside bilinear in them
   // (the mapping is smooth over one pixel); n x n samples at the centres of n x n equal
   // sub-squares, n = ceil(the footprint's longer diagonal / texel) within [2, kMaxSamples], so
-  // that the samples are at most a texel apart and the bilinear texture is integrated over the
-  // footprint (a box filter: the sensor's pixel area).
+  // that the samples are at most a texel apart (for footprints up to 8 texels across; the default
+  // texel, half the nadir GSD, gives about 3 at nadir) and the bilinear texture is integrated
+  // over the footprint (a box filter: the sensor's pixel area).
   constexpr int kMaxSamples = 8;
   std::vector<Eigen::Vector2d> top(cols + 1), bottom(cols + 1);
   for (int c = 0; c <= cols; ++c) top[c] = ground_of(c - 0.5, -0.5);
