@@ -99,8 +99,11 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
     }
     EXPECT_EQ(fits, 1) << id << " " << axis;
     EXPECT_EQ(bands, 1) << id << " " << axis;
-    for (const json& s : doc["subcameras"])
-      if (s["id"] == id) EXPECT_GE(dots, 0.95 * s["n"].get<int>()) << id << " " << axis;
+    for (const json& s : doc["subcameras"]) {
+      if (s["id"] == id) {
+        EXPECT_GE(dots, 0.95 * s["n"].get<int>()) << id << " " << axis;
+      }
+    }
   }
   EXPECT_EQ(panels.size(), 6u);
 
