@@ -229,12 +229,36 @@ TEST_F(SnoopingOnTheSimulatedFlight, FivePercentOfFiftySigmaBlundersRecoverTheCl
   EXPECT_GE(r.snooping.max_rejections, 100);
   EXPECT_FALSE(r.snooping.cap_reached);
   EXPECT_TRUE(r.valid) << (r.invalid_reasons.empty() ? "" : r.invalid_reasons.front());
+  // The oracle: the blundered observations removed by hand, no snooping. Its camera differs from
+  // the clean one by the information of the blundered observations, which no method gets back
+  // (over seeds 1-30 of tests/bench/snooping_benchmark.cc it is itself up to 1.55 clean sigmas
+  // off); the method's own share is this run against the oracle.
+  Project without = p;
+  without.observations.clear();
+  for (const auto& o : p.observations)
+    if (!blunders.count({o.image, o.point})) without.observations.push_back(o);
+  AdjustOptions by_hand = SelfCalibration();
+  by_hand.data_snooping = false;
+  by_hand.auto_robust_start = false;
+  by_hand.estimate_covariance = false;
+  const AdjustmentResult oracle = Adjust(without, by_hand);
+  // The method's share (blunders kept on r ~ 0 components, good rays lost): over seeds 1-30 of
+  // the benchmark's 5 % case this run was at most 0.44 clean sigmas from the oracle in any
+  // parameter (0.23 here); 0.5 is that with a margin, half of the 1 sigma.
+  constexpr double kMethodShareSigmas = 0.5;
   // The clean camera within 1 of its sigmas, every free parameter.
   for (int k = 0; k < calib::BrownFraser10Model::kNumParams; ++k) {
     const double sigma = clean_->cameras[0].sigma[k];
     if (!(sigma > 0)) continue;
     EXPECT_LE(std::abs(r.cameras[0].estimated[k] - clean_->cameras[0].estimated[k]), sigma)
         << calib::BrownFraser10Model::kParams[k].name;
+    EXPECT_LE(std::abs(r.cameras[0].estimated[k] - oracle.cameras[0].estimated[k]),
+              kMethodShareSigmas * sigma)
+        << calib::BrownFraser10Model::kParams[k].name;
+    std::printf("%s: this run %+.2f, the oracle %+.2f clean sigmas from the clean camera\n",
+                std::string(calib::BrownFraser10Model::kParams[k].name).c_str(),
+                (r.cameras[0].estimated[k] - clean_->cameras[0].estimated[k]) / sigma,
+                (oracle.cameras[0].estimated[k] - clean_->cameras[0].estimated[k]) / sigma);
   }
   // Good rays lost: only on points left with fewer than two good rays (no method can use them)
   // or rejected in a group with a blunder the test could not separate from them. The robust
@@ -262,9 +286,11 @@ TEST_F(SnoopingOnTheSimulatedFlight, FivePercentOfFiftySigmaBlundersRecoverTheCl
   // Every blunder still used is listed as one no test can judge (r below min_redundancy).
   std::set<std::pair<std::string, std::string>> uncontrolled;
   for (const auto& u : r.snooping.uncontrolled) uncontrolled.insert({u.image, u.point});
-  for (const auto& v : r.residuals)
-    if (v.used && blunders.count({v.image, v.point}))
+  for (const auto& v : r.residuals) {
+    if (v.used && blunders.count({v.image, v.point})) {
       EXPECT_TRUE(uncontrolled.count({v.image, v.point})) << v.image << " " << v.point;
+    }
+  }
 }
 
 }  // namespace
