@@ -394,10 +394,11 @@ std::unique_ptr<stitch::RasterSource> OpenHeadImage(const std::string& path) {
 
 // --match-ties: every exposure of the project, its ties matched on the head images under --images
 // (stitch/rig/rig_tie_matching.h); observations.csv must have no rows. The zones' counts in
-// `zones`.
+// `zones`, the RMS of the ties' LSM sigmas (virtual px) in `lsm_sigma_rms_px`.
 StitchInputs MatchedStitchInputs(const triangulation::Project& project, const calib::Rig& rig,
                                  const std::string& images,
-                                 std::vector<stitch::RigZoneMatchReport>* zones) {
+                                 std::vector<stitch::RigZoneMatchReport>* zones,
+                                 double* lsm_sigma_rms_px) {
   if (!project.observations.empty())
     ThrowInputError({project.observations_file, project.observations.front().line},
                     "--match-ties measures the ties on the head images: observations.csv must have "
@@ -421,6 +422,9 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
     }
     stitch::MatchRigExposureTies(rig, in.exposures[i], i, heads, {}, &matches);
   }
+  double sum2 = 0.0;
+  for (double sigma : matches.lsm_sigma_px) sum2 += sigma * sigma;
+  *lsm_sigma_rms_px = matches.lsm_sigma_px.empty() ? 0.0 : std::sqrt(sum2 / matches.lsm_sigma_px.size());
   in.ties = std::move(matches.ties);
   in.observations = std::move(matches.observations);
   *zones = std::move(matches.zones);
@@ -544,8 +548,10 @@ int RunStitch(const StitchArgs& args) {
   if (!(args.default_sigma_px > 0)) throw ConfigError("--sigma-px must be > 0");
   const triangulation::Project project = triangulation::ReadProject(args.project, args.default_sigma_px);
   std::vector<stitch::RigZoneMatchReport> matched_zones;
+  double lsm_sigma_rms_px = 0.0;
   const StitchInputs in = args.match_ties
-                              ? MatchedStitchInputs(project, rig, args.images, &matched_zones)
+                              ? MatchedStitchInputs(project, rig, args.images, &matched_zones,
+                                                    &lsm_sigma_rms_px)
                               : StitchInputsFromProject(project, rig, args.camera);
   double height_sum = 0.0;
   for (const auto& e : in.exposures) height_sum += e.pose.rig_center_m.z() - e.z_ref_m;
@@ -579,7 +585,15 @@ int RunStitch(const StitchArgs& args) {
     }
     json["tie_matching"] = {{"ties", in.ties.size()},
                             {"observations", in.observations.size()},
+                            {"prefilter_sigma_px", stitch::RigTieMatchOptions{}.prefilter_sigma_px},
+                            {"lsm_sigma_rms_px", lsm_sigma_rms_px},
                             {"zones", zones}};
+    // The LSM sigmas take the template's residuals as independent; sigma0 says by how much they
+    // are too small here, and the increments' sigmas are scaled by it (a-posteriori).
+    std::printf("matched ties: LSM sigma RMS %.4f virtual px; sigma0 %.2f: the LSM sigmas are %.2f x "
+                "too %s, the increments' sigmas are scaled by sigma0\n",
+                lsm_sigma_rms_px, result.sigma0, result.sigma0 >= 1 ? result.sigma0 : 1 / result.sigma0,
+                result.sigma0 >= 1 ? "small" : "large");
   }
   std::fputs(stitch::FormatRigStitchSummary(options, result, sources).c_str(), stdout);
   if (!args.stitched_out.empty()) {

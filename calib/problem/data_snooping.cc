@@ -499,6 +499,9 @@ class Snooper {
     const int limit = o_.max_left_out > 0 ? o_.max_left_out : std::max(1, n_surveys / 3);
     std::vector<TestedObservation> left;
     std::string stopped;  // why no (further) survey is left out although one fails
+    std::vector<TestedObservation> suspects;  // failing, singled out, but not left out
+    bool inseparable = false;  // the suspects are a group the test cannot tell apart
+    bool unsolvable = false;   // the block without the last one left out cannot be solved
     for (;;) {
       Test t = Run(1);
       if (!out_.cofactors_ok) return;
@@ -530,6 +533,9 @@ class Snooper {
         stopped = "the surveys " + group +
                   " fail and the test cannot tell them apart (their chi-square statistics lie "
                   "within k^2 = " + Fixed(k * k, 1) + "): one of them may be off";
+        for (const auto* x : failing)
+          if (worst.t_full - x->t_full <= k * k) suspects.push_back(*x);
+        inseparable = true;
       } else if (largest_v <= k) {
         stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
                   " over all its components) but its residual is " + Fixed(largest_v, 1) +
@@ -548,15 +554,33 @@ class Snooper {
                  !veto.empty()) {
         stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) + "); " + veto;
       }
-      if (!stopped.empty()) break;
+      if (!stopped.empty()) {
+        if (suspects.empty() && largest_v > k) suspects.push_back(worst);
+        break;
+      }
       left.push_back(worst);
       b_.RemoveResidual(worst.id);
       out_.report = b_.Solve(solver);
       ++out_.solves;
       if (!out_.report.usable) {
         stopped = "the block without " + worst.label + " cannot be solved";
+        unsolvable = true;  // it is in `left`: a suspect with those left out before it
         break;
       }
+    }
+    if (!suspects.empty() || unsolvable) {  // suspects it cannot leave out: not a fit
+      out_.unresolved_reason = stopped;
+      if (inseparable && !left.empty()) {
+        // Those singled out before a group the test cannot tell apart stay out (each failed
+        // alone, beyond k sigmas; putting it back would bend the block by its blunder too):
+        // both are named, and the caller's run is not a fit.
+        out_.findings.push_back("surveys tested first: " + stopped +
+                                ": these surveys are kept, named as unresolved");
+        stopped.clear();
+      } else {  // every survey is restored below: those left out before are suspects as well
+        suspects.insert(suspects.begin(), left.begin(), left.end());
+      }
+      out_.unresolved = std::move(suspects);
     }
     if (!stopped.empty()) {  // not a survey blunder the data single out: every survey stays
       std::string names;
@@ -578,8 +602,10 @@ class Snooper {
       x.verdict = SnoopingVerdict::kLeftOut;
       x.reason = "suspected blunder in the " + x.group + " observation " + x.label +
                  " (w = " + Fixed(x.w_full, 1) +
-                 " over all its components): it disagrees with its rays and every other survey "
-                 "passes without it; left out of the adjustment, its rays kept";
+                 " over all its components): it disagrees with its rays and " +
+                 (out_.unresolved.empty() ? "every other survey passes without it"
+                                          : "it fails alone (the unresolved surveys apart)") +
+                 "; left out of the adjustment, its rays kept";
       out_.findings.push_back("left out: " + x.reason);
       out_.left_out.push_back(x);
     }

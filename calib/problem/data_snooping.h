@@ -50,6 +50,17 @@
 //     residual of 0.8 sigma at r 0.003);
 //   - no direction of it has r < 1e-4 (else it alone holds the block there);
 //   - at most max_left_out are left out, and the caller's veto (datum) agrees.
+//   A group, a survey that holds the block, the cap or the veto leave failing surveys that the
+//   test names as suspects but cannot leave out: SnoopingOutcome::unresolved holds them (the
+//   caller's run is then not a fit: a blunder somewhere in the datum) and they stay in the
+//   adjustment. The surveys singled out and left out before a group stay out (left_out); before
+//   the other stops they are restored and named with the suspects. A
+//   failing survey whose residual is within k sigmas is not a suspect (a model error looks the
+//   same: the conventional flight's C5 height on clean data).
+//   An observation of several components is one test; a caller that wants components judged
+//   separately (a survey's plan and height: their redundancy differs by orders of magnitude,
+//   0.02 and 0.001 at a corner of the self-calibrating simulated flight) adds them as separate
+//   residuals.
 //   When every remaining survey then passes and sigma0 lies within 1 + 3 / sqrt(2 r) (a model
 //   error would keep it above), those left out are "suspected control blunders"
 //   (SnoopingOutcome::left_out, verdict "left out"): out of the adjustment, their rays kept and
@@ -168,6 +179,14 @@ struct SnoopingOutcome {
   std::vector<TestedObservation> rejected;  // in order, with their test values
   /// Report-only observations left out (suspected survey blunders), with the test that failed.
   std::vector<TestedObservation> left_out;
+  /// Report-only observations that fail the surveys-first test when none of them can be left out:
+  /// the test cannot tell them apart (a group), or the worst alone holds the block in a direction,
+  /// or the veto / max_left_out keep it. Every survey is kept and these are named: one of them is
+  /// off (or the model does not fit them). Empty when nothing fails, when the failing survey's
+  /// residual is within the critical value (a model error looks the same) and when a model error
+  /// remains after leaving out the worst (sigma0 above the band).
+  std::vector<TestedObservation> unresolved;
+  std::string unresolved_reason;  // why none of `unresolved` could be left out
   /// The final test of every active tested residual (and the vetoed / held candidates).
   std::vector<TestedObservation> tested;
   bool model_error_suspected = false;

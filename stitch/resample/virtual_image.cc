@@ -161,9 +161,11 @@ void AccumulateCorrectedRow(const Window& win, double V, int first, int last, fl
   for (int c = first; c <= last; ++c, x += m(0, 0), y += m(1, 0), w += m(2, 0)) {
     const float su = static_cast<float>(x / w) + duv[2 * (c - first)];
     const float sv = static_cast<float>(y / w) + duv[2 * (c - first) + 1];
-    if (!(su >= 0.0f && su <= max_u && sv >= 0.0f && sv <= max_v)) continue;
-    const float u = std::clamp(su - win.x0, 0.0f, static_cast<float>(win.w - 1));
-    const float v = std::clamp(sv - win.y0, 0.0f, static_cast<float>(win.h - 1));
+    if (!(w > 0 && su >= 0.0f && su <= max_u && sv >= 0.0f && sv <= max_v)) continue;
+    // The strip's window holds every such sample (ResampleVirtualImage); one outside it is
+    // dropped, never clamped to the window's edge (that would be another pixel's value).
+    const float u = su - win.x0, v = sv - win.y0;
+    if (!(u >= 0.0f && u <= win.w - 1 && v >= 0.0f && v <= win.h - 1)) continue;
     ++count[c];
     AddSample<T, kBands, kInterpolation>(win, u, v, sum + c * kBands);
   }
@@ -308,18 +310,27 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
     // Window of each sub-image: bounding box of the strip's corners mapped into it, plus margin.
     auto prepare = [&](size_t k) {
       Window& win = windows[k];
+      // A projectivity maps the strip's rectangle onto the quadrilateral of its corners when w > 0
+      // at all four (w is affine in (U, V), so then positive over the whole strip, and straight
+      // lines stay straight): the corners' bounding box is exact. A corner at or behind the
+      // sub-image's horizon (w <= 0, a tilted head under a wide virtual image) makes the image
+      // of the strip unbounded and the corners' box meaningless: then the whole format. A
+      // correction moves (u, v) by up to max_abs_px.
       double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
       for (double U : {0.0, width - 1.0})
         for (double V : {static_cast<double>(y0), y0 + rows - 1.0}) {
           const Eigen::Vector3d p = win.sub_from_virtual * Eigen::Vector3d(U, V, 1.0);
+          if (!(p.z() > 0)) {
+            u0 = v0 = -1e300;
+            u1 = v1 = 1e300;
+            break;
+          }
           u0 = std::min(u0, p.x() / p.z());
           u1 = std::max(u1, p.x() / p.z());
           v0 = std::min(v0, p.y() / p.z());
           v1 = std::max(v1, p.y() / p.z());
         }
-      // A correction moves (u, v) by up to max_abs_px; the bounding box of the corners also
-      // misses the bulge of a projectivity's edges only when it is not affine, which the
-      // correction grids' heads (near-nadir rigs) are to far below a pixel per strip.
+      u0 = std::max(u0, -1e9), v0 = std::max(v0, -1e9), u1 = std::min(u1, 1e9), v1 = std::min(v1, 1e9);
       const int extra = win.correction ? static_cast<int>(std::ceil(win.correction->max_abs_px)) + 1 : 0;
       const int x0 = std::max(0, static_cast<int>(std::floor(u0)) - margin - extra);
       const int x1 = std::min(win.width_px - 1, static_cast<int>(std::ceil(u1)) + margin + extra);

@@ -17,6 +17,9 @@ namespace aerocal::stitch {
 void RigTieMatchOptions::Validate() const {
   if (!(cell_px >= 8)) throw ConfigError("tie matching: cell_px must be >= 8 (got " + std::to_string(cell_px) + ")");
   if (!(min_sigma_px > 0)) throw ConfigError("tie matching: min_sigma_px must be > 0");
+  if (!(prefilter_sigma_px == 0 || (prefilter_sigma_px >= 0.3 && prefilter_sigma_px <= 5)))
+    throw ConfigError("tie matching: prefilter_sigma_px must be 0 or within 0.3..5 (got " +
+                      std::to_string(prefilter_sigma_px) + ")");
   lsm.Validate();
   wallis.Validate();
   foerstner.Validate();
@@ -63,7 +66,7 @@ void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposu
   // Every head once on the virtual grid (float grey values) with its coverage shrunk by the
   // template half size plus the LSM shift bound and 2 px (the interpolation support).
   const int margin = options.lsm.half_size_px + static_cast<int>(std::ceil(options.lsm.max_shift_px)) + 2;
-  std::vector<GrayImage> projected(n_heads);
+  std::vector<GrayImage> projected(n_heads), smoothed(n_heads);
   cv::Mat zone_mask(height, width, CV_8UC1, cv::Scalar(0));
   for (int k = 0; k < n_heads; ++k) {
     float top = 0.0f;
@@ -82,6 +85,22 @@ void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposu
         projected[k](r, c) = static_cast<float>(p.values.At(c, r) / scale);
         inside.at<std::uint8_t>(r, c) = p.covered[static_cast<size_t>(r) * width + c];
       }
+    // The low-pass copy for LSM: a normalised convolution over the head's coverage (blur of the
+    // covered values / blur of the coverage), so the fill outside does not leak in at the border.
+    smoothed[k] = projected[k];
+    if (options.prefilter_sigma_px > 0) {
+      cv::Mat weight;
+      inside.convertTo(weight, CV_32F, 1.0 / 255.0);
+      cv::Mat values = cv::Mat(height, width, CV_32F, projected[k].data()).mul(weight);
+      cv::GaussianBlur(values, values, cv::Size(0, 0), options.prefilter_sigma_px);
+      cv::GaussianBlur(weight, weight, cv::Size(0, 0), options.prefilter_sigma_px);
+      cv::Mat out(height, width, CV_32F, smoothed[k].data());
+      for (int r = 0; r < height; ++r)
+        for (int c = 0; c < width; ++c) {
+          const float w = weight.at<float>(r, c);
+          out.at<float>(r, c) = w > 1e-3f ? values.at<float>(r, c) / w : 0.0f;
+        }
+    }
     cv::Mat distance;
     cv::distanceTransform(inside, distance, cv::DIST_L2, 3);
     for (int r = 0; r < height; ++r)
@@ -134,7 +153,7 @@ void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposu
       for (size_t m = 1; m < members.size(); ++m) {
         const int k = members[m];
         ++report.lsm_tried;
-        const LsmResult lsm = MatchLeastSquares(projected[first], at, projected[k], p,
+        const LsmResult lsm = MatchLeastSquares(smoothed[first], at, smoothed[k], p,
                                                 Eigen::Matrix2d::Identity(), options.lsm);
         const auto raw = lsm.ok() ? converter.HeadFromVirtual(k, lsm.position_in_b) : std::nullopt;
         if (!raw || !converter.InHeadFormat(k, *raw)) {

@@ -196,6 +196,14 @@ std::vector<ResidualId> AddSurveyedPoints(Toy* toy, const std::vector<double>& b
   return surveys;
 }
 
+// Snooping with the control group report-only and tested first (leave_out_report_only).
+SnoopingOutcome SnoopSurveysFirst(Toy* toy) {
+  SnoopingOptions options;
+  options.report_only_groups = {kGroupControl};
+  options.leave_out_report_only = true;
+  return SolveWithDataSnooping(toy->builder, {}, options);
+}
+
 TEST(DataSnooping, FailingSurveyIsLeftOutWhenTheOthersFitWithoutIt) {
   // 80 survey sigmas on P100: its residual 0.093 * 80 = 7.4 a-priori sigmas, 5.4 of s = sigma0
   // 1.37, is above the critical value (the block cannot bend to fit it), w = 80 sqrt(0.093) / s
@@ -203,10 +211,7 @@ TEST(DataSnooping, FailingSurveyIsLeftOutWhenTheOthersFitWithoutIt) {
   // weakly controlled (r < 0.1). The survey test leaves it out and its rays stay.
   Toy toy;
   const std::vector<ResidualId> surveys = AddSurveyedPoints(&toy, {80 * 0.16});
-  SnoopingOptions options;
-  options.report_only_groups = {kGroupControl};
-  options.leave_out_report_only = true;
-  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, options);
+  const SnoopingOutcome out = SnoopSurveysFirst(&toy);
   ASSERT_EQ(out.left_out.size(), 1u);
   EXPECT_EQ(out.left_out[0].id, surveys[0]);
   EXPECT_EQ(out.left_out[0].verdict, SnoopingVerdict::kLeftOut);
@@ -228,10 +233,7 @@ TEST(DataSnooping, SurveysThatDoNotFitWithoutTheWorstAreAllRestored) {
   // rays of their points are not rejected.
   Toy toy;
   const std::vector<ResidualId> surveys = AddSurveyedPoints(&toy, {100 * 0.16, -60 * 0.16});
-  SnoopingOptions options;
-  options.report_only_groups = {kGroupControl};
-  options.leave_out_report_only = true;
-  const SnoopingOutcome out = SolveWithDataSnooping(toy.builder, {}, options);
+  const SnoopingOutcome out = SnoopSurveysFirst(&toy);
   EXPECT_TRUE(out.left_out.empty());
   for (ResidualId id : surveys) EXPECT_TRUE(toy.builder.IsActive(id));
   for (const auto& rays : toy.rays)
@@ -241,9 +243,64 @@ TEST(DataSnooping, SurveysThatDoNotFitWithoutTheWorstAreAllRestored) {
     said |= f.find("leaving out survey P100") != std::string::npos &&
             f.find("every survey kept") != std::string::npos;
   EXPECT_TRUE(said);
+  // Both are named as unresolved: P100 left out first, then P101 at the cap of one.
+  ASSERT_EQ(out.unresolved.size(), 2u);
+  EXPECT_EQ(out.unresolved[0].id, surveys[0]);
+  EXPECT_EQ(out.unresolved[1].id, surveys[1]);
   // Restored: the solution with every survey (P100 pulled to 16 * 39.06 / 43.06).
   const double p = 1 / (0.16 * 0.16);
   EXPECT_NEAR(toy.values[100], 16.0 * p / (4 + p), 1e-6);
+}
+
+// Two surveys of one point that has no rays (a height only the surveys hold): their residuals
+// correlate -1 (r = 0.5 each), so a blunder on either gives both the same w.
+std::vector<ResidualId> AddSurveyPair(Toy* toy, double blunder_sigma) {
+  toy->AddPoint({});
+  std::vector<ResidualId> pair;
+  for (int i = 0; i < 2; ++i)
+    pair.push_back(toy->builder.AddResidual(
+        kGroupControl,
+        PriorCostFunction::Create({i == 0 ? blunder_sigma * 0.16 : 0.0}, {0.16}),
+        {toy->blocks.back()},
+        "survey Q" + std::to_string(i)));
+  return pair;
+}
+
+TEST(DataSnooping, SurveysTheTestCannotTellApartAreNamedUnresolvedAndKept) {
+  // 40 sigmas on Q0: v = -20, +20 sigmas, w equal on both (the test cannot say which is off).
+  // Neither is left out, neither's point loses anything, and both are named as unresolved.
+  Toy toy;
+  AddSurveyedPoints(&toy, {});
+  const std::vector<ResidualId> pair = AddSurveyPair(&toy, 40);
+  const SnoopingOutcome out = SnoopSurveysFirst(&toy);
+  EXPECT_TRUE(out.left_out.empty());
+  ASSERT_EQ(out.unresolved.size(), 2u);
+  for (const auto& x : out.unresolved) {
+    EXPECT_TRUE(x.id == pair[0] || x.id == pair[1]);
+    EXPECT_NEAR(x.redundancy[0], 0.5, 1e-9);
+    EXPECT_NEAR(std::abs(x.v[0]), 20.0, 1e-6);
+  }
+  EXPECT_NEAR(out.unresolved[0].w_full, out.unresolved[1].w_full, 1e-6);
+  EXPECT_NE(out.unresolved_reason.find("cannot tell them apart"), std::string::npos);
+  for (ResidualId id : pair) EXPECT_TRUE(toy.builder.IsActive(id));
+  EXPECT_TRUE(out.rejected.empty());
+}
+
+TEST(DataSnooping, SurveySingledOutStaysOutBesideAnUnresolvedPair) {
+  // P100 off by 80 survey sigmas fails alone (the largest statistic) and is left out; the pair
+  // (20 sigmas on Q0) then fails as a pair: named unresolved and kept, and P100 stays out (putting
+  // it back would bend the block by its blunder as well).
+  Toy toy;
+  const std::vector<ResidualId> surveys = AddSurveyedPoints(&toy, {80 * 0.16});
+  const std::vector<ResidualId> pair = AddSurveyPair(&toy, 20);
+  const SnoopingOutcome out = SnoopSurveysFirst(&toy);
+  ASSERT_EQ(out.left_out.size(), 1u);
+  EXPECT_EQ(out.left_out[0].id, surveys[0]);
+  EXPECT_FALSE(toy.builder.IsActive(surveys[0]));
+  EXPECT_NEAR(toy.values[100], 0.0, 1e-6);  // where its rays say (solver tolerance)
+  ASSERT_EQ(out.unresolved.size(), 2u);
+  for (ResidualId id : pair) EXPECT_TRUE(toy.builder.IsActive(id));
+  EXPECT_NEAR(toy.values[104], 10 * 0.16, 1e-6);  // the mean of the pair's two surveys
 }
 
 }  // namespace

@@ -4,6 +4,7 @@
 // (< 0.1 px where the plane is exact; a 5 % wrong height is seen), no seam (measured as
 // tests/stitch/virtual_image_test.cc does), and the command on TIFF files.
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <filesystem>
 
@@ -146,20 +147,33 @@ TEST(RigConvert, CorrectionGridsCarryTheDistortionToTheTolerance) {
 // correction grid interpolated between nodes on either side of a head's horizon, where the map
 // diverges (distorted heads). Checked on every 3rd virtual pixel at 1/10 of the formats, with and
 // without distortion.
+// configs/rig_uav4.yaml at 0.1 x its formats (pixels 10 x larger), with K1 = 2e-5 in every head
+// (~2.5 px at the corner: correction grids) when `distorted`.
+calib::Rig SmallUav4Rig(bool distorted) {
+  calib::Rig rig = calib::ReadRig(std::string(AEROCAL_CONFIGS_DIR) + "/rig_uav4.yaml");
+  const auto scale = [](int& width, int& height, double& pixel_mm) {
+    width /= 10, height /= 10, pixel_mm *= 10;
+  };
+  scale(rig.virtual_camera.width_px, rig.virtual_camera.height_px, rig.virtual_camera.pixel_size_mm);
+  for (auto& head : rig.heads) {
+    scale(head.camera.width_px, head.camera.height_px, head.camera.pixel_size_mm);
+    if (distorted) head.camera.interior[calib::BrownFraser10Model::kK1] = 2e-5;
+  }
+  return rig;
+}
+
+// A slightly tilted, turned exposure 100 m above the rectification plane.
+RigExposure TurnedExposure() {
+  RigExposure exposure;
+  exposure.rig_opk_rad = Eigen::Vector3d(0.002, -0.001, 0.3);
+  exposure.rig_center_m = Eigen::Vector3d(0, 0, 400);
+  return exposure;
+}
+
 TEST(RigConvert, TiltedHeadsCoverExactlyTheVirtualPixelsTheySee) {
   for (const bool distorted : {false, true}) {
-    calib::Rig rig = calib::ReadRig(std::string(AEROCAL_CONFIGS_DIR) + "/rig_uav4.yaml");
-    const auto scale = [](int& width, int& height, double& pixel_mm) {
-      width /= 10, height /= 10, pixel_mm *= 10;
-    };
-    scale(rig.virtual_camera.width_px, rig.virtual_camera.height_px, rig.virtual_camera.pixel_size_mm);
-    for (auto& head : rig.heads) {
-      scale(head.camera.width_px, head.camera.height_px, head.camera.pixel_size_mm);
-      if (distorted) head.camera.interior[calib::BrownFraser10Model::kK1] = 2e-5;  // ~2.5 px at the corner
-    }
-    RigExposure exposure;
-    exposure.rig_opk_rad = Eigen::Vector3d(0.002, -0.001, 0.3);
-    exposure.rig_center_m = Eigen::Vector3d(0, 0, 400);
+    const calib::Rig rig = SmallUav4Rig(distorted);
+    const RigExposure exposure = TurnedExposure();
     const RigConverter converter(rig, exposure, MakeRectificationPlane(rig, exposure, 300.0));
     const calib::Camera all = RigExposureAsSubimageCamera(converter);
     const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
@@ -199,6 +213,65 @@ TEST(RigConvert, TiltedHeadsCoverExactlyTheVirtualPixelsTheySee) {
     }
     EXPECT_EQ(b_and_d, 0) << (distorted ? "distorted" : "distortion-free");
   }
+}
+
+// Every covered virtual pixel takes its value from the head pixel its exact map gives, with a
+// correction grid too: the head images are ramps (16 bit, 16 x the head column, or row), so the
+// resampled value / 16 is the sampled head position (bilinear and bicubic interpolation of a ramp
+// are exact inside the format). A sample outside the strip's source window must never be clamped
+// to the window's edge (a wrong value); short strips (16 rows), the default (256) and one strip
+// for the whole image (4096 rows: a strip that reaches beyond a tilted head's horizon).
+TEST(RigConvert, TiltedHeadsSampleTheExactHeadPixelInEveryStrip) {
+  const calib::Rig rig = SmallUav4Rig(/*distorted=*/true);
+  const RigExposure exposure = TurnedExposure();
+  const RigConverter converter(rig, exposure, MakeRectificationPlane(rig, exposure, 300.0));
+  const calib::Camera all = RigExposureAsSubimageCamera(converter);
+  const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
+  const int width = all.width_px, height = all.height_px;
+  // The grid's tolerance (0.01 px), the 16-bit rounding (1/32 px) and float rounding.
+  constexpr double kTolerancePx = 0.05;
+  for (const int strip_rows : {16, 256, 4096})
+    for (const Interpolation interpolation : {Interpolation::kBilinear, Interpolation::kBicubic})
+      for (int k = 0; k < 4; ++k) {
+        calib::Camera one = all;
+        one.subimages = {all.subimages[k]};
+        const calib::Camera& camera = rig.heads[k].camera;
+        std::array<MemoryRaster, 2> ramp{MemoryRaster({camera.width_px, camera.height_px, 1, 16}),
+                                         MemoryRaster({camera.width_px, camera.height_px, 1, 16})};
+        for (int r = 0; r < camera.height_px; ++r)
+          for (int c = 0; c < camera.width_px; ++c) {
+            ramp[0].Set(c, r, 0, 16.0 * c);
+            ramp[1].Set(c, r, 0, 16.0 * r);
+          }
+        ResampleOptions options;
+        options.fill = 0.0;
+        options.strip_rows = strip_rows;
+        options.interpolation = interpolation;
+        std::array<MemoryRaster, 2> out{MemoryRaster({width, height, 1, 16}),
+                                        MemoryRaster({width, height, 1, 16})};
+        for (int a = 0; a < 2; ++a)
+          ResampleVirtualImage(one, {&ramp[a]}, &out[a], options,
+                               std::vector<MapCorrectionGrid>{grids.grids[k]});
+        long checked = 0, wrong = 0;
+        double worst = 0.0;
+        for (int r = 0; r < height; ++r)
+          for (int c = 0; c < width; ++c) {
+            const auto exact = converter.HeadFromVirtual(k, Eigen::Vector2d(c, r));
+            // 1 px inside the format: the bicubic support and the coverage rule stay out of it
+            if (!exact || exact->x() < 1 || exact->y() < 1 || exact->x() > camera.width_px - 2 ||
+                exact->y() > camera.height_px - 2)
+              continue;
+            const Eigen::Vector2d sampled(out[0].At(c, r) / 16.0, out[1].At(c, r) / 16.0);
+            const double error = (sampled - *exact).cwiseAbs().maxCoeff();
+            worst = std::max(worst, error);
+            ++checked;
+            wrong += error > kTolerancePx;
+          }
+        EXPECT_GT(checked, 10000) << rig.heads[k].id;
+        EXPECT_EQ(wrong, 0) << rig.heads[k].id << ", strips of " << strip_rows << " rows, "
+                            << (interpolation == Interpolation::kBilinear ? "bilinear" : "bicubic")
+                            << ": worst " << worst << " px";
+      }
 }
 
 // A DEM of a tilted plane is a tilted rectification plane (bilinear interpolation of a plane is

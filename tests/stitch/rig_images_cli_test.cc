@@ -110,8 +110,13 @@ TEST(RigImagesCommand, RendersTheHeadsAndStitchesEveryExposure) {
                             tmp.File("m.json"));
   ASSERT_EQ(m.exit_code, 0) << m.output;
   EXPECT_NE(m.output.find("matched 0001 zone AB:"), std::string::npos) << m.output;
+  EXPECT_NE(m.output.find("the increments' sigmas are scaled by sigma0"), std::string::npos) << m.output;
   const json matched = ReadJson(tmp.File("m.json"));
   ASSERT_TRUE(matched.contains("tie_matching"));
+  EXPECT_EQ(matched["tie_matching"]["prefilter_sigma_px"].get<double>(), 1.5);
+  // LSM sigmas of a few hundredths of a virtual pixel (floor 0.02 sqrt 2)
+  EXPECT_GT(matched["tie_matching"]["lsm_sigma_rms_px"].get<double>(), 0.028);
+  EXPECT_LT(matched["tie_matching"]["lsm_sigma_rms_px"].get<double>(), 0.2);
   std::map<std::string, int> ties;
   for (const json& z : matched["tie_matching"]["zones"]) ties[z["zone"].get<std::string>()] += z["ties"].get<int>();
   for (const char* zone : {"AB", "AC", "AD", "BC", "CD"}) EXPECT_GE(ties[zone], 4) << zone;

@@ -4,9 +4,11 @@
 // intersects the cloud control on those pixels, and `aerocal pushbroom calibrate` from that control
 // recovers the detector table within 1.5 x the error of the geometry-only run of the same flight
 // (the acceptance). Bad input: exit 2 with the file and line, nothing written.
-// The flight: 3 x 200 detectors (1.85 m nadir sampling), 800 lines. The per-detector 3-sigma check
-// does NOT hold in image mode (a residual across-track bias of ~0.015 px, module README
-// "Measured"), so it is printed, not asserted; the test stays labelled `long`.
+// The flight: 3 x 200 detectors (1.85 m nadir sampling), 800 lines (33 s: labelled `long`).
+// Measured: geometry 0.0305 / 0.0179 px, image mode 0.0103 / 0.0057 px (over 10 seeds at 3 x 150
+// the ratio is 0.07-0.42, module README "Measured"). The per-detector 3-sigma check does NOT hold
+// in image mode (worst 7.8 sigma across here: a smaller smooth error remains), so it is printed,
+// not asserted.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>

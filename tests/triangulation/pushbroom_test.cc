@@ -7,6 +7,7 @@
 #include <map>
 #include <set>
 
+#include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
 #include "calib/core/error.h"
@@ -177,15 +178,41 @@ TEST(LineCalibration, NoiseFreeRecoversTheTableAndTheTrajectoryExactly) {
   }
   // Along-track position and pitch (and across-track position and roll) differ only through the
   // relief (100 m at 1000 m): the ~1e-8 m by which the interpolated POS error spline differs from
-  // the spline itself comes back amplified, as 3e-6 m against 3e-9 rad x 1000 m.
-  EXPECT_LT(worst_m, 1e-5);
-  EXPECT_LT(worst_rad, 1e-8);
+  // the spline itself comes back amplified, as 3e-6 m against 3e-9 rad x 1000 m. An observation
+  // just beyond a sub-camera's last detector is simulated with the polynomial extended linearly
+  // (SubcameraPixelOfPoint), the model continues the polynomial: a ray off by up to 1.4e-5 m on
+  // this flight (LineScanCamera.StartingRayPassesThroughTheTruePoint), 1.2e-5 m / 1.2e-8 rad here.
+  EXPECT_LT(worst_m, 3e-5);
+  EXPECT_LT(worst_rad, 3e-8);
   std::printf("noise-free: table %.2e px, trajectory %.2e m %.2e rad\n", worst_px, worst_m, worst_rad);
 }
 
+// The 3-sigma oracle at the truth's degree (3). The automatic degree (the default) is a pre-test:
+// a real term below its threshold is dropped and the reduced model's sigmas do not show that bias.
+// On this flight it drops the along-track cubic of L (truth 2.2 sigma of its estimate) and the
+// table's end detector is then 6.3 sigma off (module README "Degree test"): printed below, not
+// asserted; its sigma0 and RMS after are.
 TEST(LineCalibration, WithNoiseEveryDetectorIsWithinThreeSigma) {
   const LineSimulation sim = SimulateLineFlight(SmallFlight());
+  {
+    const LineCalibrationResult automatic = Calibrate(sim, LineCalibrationOptions{});
+    ASSERT_TRUE(automatic.report.converged) << automatic.report.message;
+    EXPECT_NEAR(automatic.report.sigma0, 1.0, 3.0 / std::sqrt(2.0 * automatic.report.redundancy));
+    double worst = 0;
+    for (int i = 0; i < sim.truth.detectors; ++i) {
+      const Eigen::Vector2d e = Eigen::Vector2d(automatic.dx_mm[i], automatic.dy_mm[i]) - sim.truth.Correction(i);
+      if (*automatic.dx_sigma_mm[i] > 0) worst = std::max(worst, std::abs(e.x()) / *automatic.dx_sigma_mm[i]);
+      if (*automatic.dy_sigma_mm[i] > 0) worst = std::max(worst, std::abs(e.y()) / *automatic.dy_sigma_mm[i]);
+    }
+    for (const auto& s : automatic.subcameras) {
+      EXPECT_LT(s.across_after_px, 0.25 * 1.3) << s.id;
+      EXPECT_LT(s.along_after_px, 0.25 * 1.3) << s.id;
+      std::printf("automatic degree: sub-camera %s degree x %d y %d\n", s.id.c_str(), s.degree_x, s.degree_y);
+    }
+    std::printf("automatic degree: worst |e|/sigma %.2f\n", worst);
+  }
   LineCalibrationOptions options;
+  options.degree = 3;
   const LineCalibrationResult r = Calibrate(sim, options);
   ASSERT_TRUE(r.report.converged) << r.report.message;
   EXPECT_TRUE(r.valid);
@@ -221,6 +248,44 @@ TEST(LineCalibration, WithNoiseEveryDetectorIsWithinThreeSigma) {
               std::sqrt(sum_s2 / (2 * sim.truth.detectors)) / pitch, r.report.sigma0);
 }
 
+// The datum's Legendre mean and slope: 1 -> (1, 0), u -> (0, 1), u^2 -> (1/3, 0), u^3 -> (0, 3/5);
+// P2 = (3u^2 - 1)/2, P3 = (5u^3 - 3u)/2, P4, P5 -> (0, 0): adding or dropping them leaves the datum.
+// The residual is their whitened value per axis; its Jacobian matches numeric differentiation.
+TEST(LineDatumResidual, HoldsTheLegendreMeanAndSlopeOnly) {
+  auto moments = [](std::vector<double> a) {
+    a.resize(calib::kLineMaxTerms, 0.0);
+    double mean = 0, slope = 0;
+    LegendreMeanAndSlope(a.data(), calib::kLineMaxTerms, &mean, &slope);
+    return Eigen::Vector2d(mean, slope);
+  };
+  EXPECT_LT((moments({1}) - Eigen::Vector2d(1, 0)).norm(), 1e-15);
+  EXPECT_LT((moments({0, 1}) - Eigen::Vector2d(0, 1)).norm(), 1e-15);
+  EXPECT_LT((moments({0, 0, 1}) - Eigen::Vector2d(1.0 / 3, 0)).norm(), 1e-15);
+  EXPECT_LT((moments({0, 0, 0, 1}) - Eigen::Vector2d(0, 0.6)).norm(), 1e-15);
+  EXPECT_LT(moments({-0.5, 0, 1.5}).norm(), 1e-15);                       // P2
+  EXPECT_LT(moments({0, -1.5, 0, 2.5}).norm(), 1e-15);                    // P3
+  EXPECT_LT(moments({3.0 / 8, 0, -30.0 / 8, 0, 35.0 / 8}).norm(), 1e-15);  // P4
+  EXPECT_LT(moments({0, 15.0 / 8, 0, -70.0 / 8, 0, 63.0 / 8}).norm(), 1e-14);  // P5
+  const auto cost = LineDatumResidual::Create(1e-6);
+  std::array<double, 2 * calib::kLineMaxTerms> block;
+  for (int k = 0; k < 2 * calib::kLineMaxTerms; ++k) block[k] = 1e-3 * std::sin(1.0 + k);
+  std::vector<double*> parameters = {block.data()};
+  const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
+  ceres::NumericDiffOptions options;
+  ceres::GradientChecker checker(cost.get(), no_manifolds, options);
+  ceres::GradientChecker::ProbeResults results;
+  EXPECT_TRUE(checker.Probe(parameters.data(), 1e-8, &results)) << results.error_log;
+  double r[4];
+  const double* values = block.data();
+  ASSERT_TRUE(cost->Evaluate(&values, r, nullptr));
+  const Eigen::Vector2d x = moments({block.begin(), block.begin() + 6}) / 1e-6;
+  const Eigen::Vector2d y = moments({block.begin() + 6, block.end()}) / 1e-6;
+  EXPECT_NEAR(r[0], x[0], 1e-9);
+  EXPECT_NEAR(r[1], x[1], 1e-9);
+  EXPECT_NEAR(r[2], y[0], 1e-9);
+  EXPECT_NEAR(r[3], y[1], 1e-9);
+}
+
 TEST(LineCalibration, WithoutTheDatumTheOffsetsAreReportedIllPosed) {
   const LineSimulation sim = SimulateLineFlight(SmallFlight());
   LineCalibrationOptions options;
@@ -236,18 +301,26 @@ TEST(LineCalibration, WithoutTheDatumTheOffsetsAreReportedIllPosed) {
   EXPECT_TRUE(named);
 }
 
+// With the datum holding the reference sub-camera's Legendre slope, c (a scale of the focal plane,
+// a slope in the reference) is determined by that datum and the control: reported with its
+// correlation against the free linear terms and the nodes' dZ, within 3 sigma of the truth. (The
+// earlier datum, a_1 = 0 beside a free u^3, let the reference's cubic take part of the scale:
+// scale_vs_c was above 0.9 then, 0.50 now.)
 TEST(LineCalibration, FreeCIsReportedAgainstTheScale) {
   const LineSimulation sim = SimulateLineFlight(SmallFlight());
   LineCalibrationOptions options;
   options.free_c = true;
+  options.degree = 3;
   const LineCalibrationResult r = Calibrate(sim, options);
   double rho = -1;
   for (const auto& [name, value] : r.correlations)
     if (name == "scale_vs_c") rho = value;
-  EXPECT_GT(rho, 0.9);
-  bool warned = false;
-  for (const auto& w : r.warnings) warned |= w.name == "scale_vs_c";
-  EXPECT_TRUE(warned);
+  std::printf("scale_vs_c %.4f, c %.6f +- %.6f mm (truth %.6f)\n", rho, r.c_mm, r.c_sigma_mm.value_or(-1),
+              sim.truth.c_mm);
+  EXPECT_GE(rho, 0.0);
+  EXPECT_LE(rho, 1.0);
+  ASSERT_TRUE(r.c_sigma_mm.has_value());
+  EXPECT_LT(std::abs(r.c_mm - sim.truth.c_mm), 3 * *r.c_sigma_mm);
 }
 
 TEST(LineCalibration, FewPointsPerLineAreNamed) {
@@ -291,10 +364,13 @@ TEST(LineScanCamera, StartingRayPassesThroughTheTruePoint) {
     observation.pixel = Eigen::Vector2d(o.detector, o.line);
     const ImageRay ray = line.StartingRay(context, observation);
     const Eigen::Vector3d d = truth.at(o.point) - ray.center_m;
-    worst_m = std::max(worst_m, (d - d.dot(ray.direction) * ray.direction).norm());
+    const double miss = (d - d.dot(ray.direction) * ray.direction).norm();
+    worst_m = std::max(worst_m, miss);
   }
-  // 1000 m range; the simulation solves the image position to ~1e-9 px.
-  EXPECT_LT(worst_m, 1e-5);
+  // 1000 m range; the simulation solves the image position to ~1e-9 px, but beyond a sub-camera's
+  // last detector (measured: 1.4e-5 m at detector 239.19, the reference's end + 0.19) it extends the
+  // polynomial linearly (SubcameraPixelOfPoint) where DetectorPosition continues it.
+  EXPECT_LT(worst_m, 3e-5);
 
   calib::LineCamera mounted = sim.nominal;  // no calibration: DetectorPosition is the design
   mounted.mount_rad = Eigen::Vector3d(0.5, -1.0, 2.0) * kDeg;
@@ -331,15 +407,17 @@ TEST(LineCalibration, BoresightAndLeverArmAreRecoveredWithinThreeSigma) {
     LineSimulation planted = sim;
     if (boresight) planted.nominal.mount_rad = planted_mount;
     if (lever) planted.nominal.lever_arm_m = planted_lever;
+    // The default path: the automatic degree test. It never changes the reference sub-camera
+    // (the datum): a weak cubic term dropped there leaked into the fixed linear term, the only
+    // datum of the boresight kappa (a kappa is a linear along-track term), and put kappa 4 sigma
+    // off the truth on this flight before (module README "Datum").
     LineCalibrationOptions options;
-    // The truth's detector errors are cubics: the degree test may drop a weak cubic term of the
-    // reference sub-camera, whose fixed linear term is the only datum of the boresight kappa
-    // (a kappa is a linear along-track term): measured, 4 sigma of bias in kappa. Degree 3 fixed.
-    options.degree = 3;
     if (boresight) options.boresight = PlatformParamMode::kFree;
     if (lever) options.lever_arm = PlatformParamMode::kFree;
     const LineCalibrationResult r = Calibrate(planted, options);
     EXPECT_TRUE(r.report.converged) << r.report.message;
+    for (const auto& s : r.subcameras)
+      std::printf("  sub-camera %s: degree %d / %d\n", s.id.c_str(), s.degree_x, s.degree_y);
     for (const auto& [name, rho] : r.correlations) std::printf("  %s %.4f\n", name.c_str(), rho);
     for (int a = 0; a < 3; ++a) {
       if (boresight) {

@@ -163,76 +163,170 @@ bool Said(const nlohmann::json& result, const std::vector<std::string>& words) {
   return false;
 }
 
+// points.csv: the plan survey of `point` removed by hand (sX = sY = 1000 m: a weight 2.5e9 times
+// below the 2 cm survey; its height survey stays).
+void RemovePlanSurvey(const std::string& path, const std::string& point) {
+  std::string points = ReadTextFile(path);
+  points = std::regex_replace(points,
+                              std::regex("\n(" + point + ",[^,]*,[^,]*,[^,]*),[^,]*,[^,]*,"),
+                              "\n$1,1000,1000,");
+  WriteFileAtomically(path, points);
+}
+
+bool Warned(const nlohmann::json& result, const std::string& name, const std::string& subject) {
+  for (const auto& w : result["warnings"])
+    if (w["name"] == name && w["subject"].get<std::string>().find(subject) != std::string::npos)
+      return true;
+  return false;
+}
+
+// `point` is the only control point left out, and only its plan, 10 m off in X: the block without
+// the plan survey puts it where its rays say (to 0.5 m, the block's precision at a corner without
+// plan control) while its height survey still holds it (to 5 cm, 2.5 survey sigmas).
+void ExpectOnlyPlanLeftOut(const nlohmann::json& result, const std::string& point) {
+  const auto& left_out = result["control_left_out"];
+  ASSERT_EQ(left_out.size(), 1u) << left_out;
+  EXPECT_EQ(left_out[0]["point"], point);
+  EXPECT_EQ(left_out[0]["components"].size(), 1u);
+  EXPECT_TRUE(left_out[0]["components"].contains("plan"));
+  EXPECT_NEAR(-left_out[0]["difference_m"][0].get<double>(), 10.0, 0.5);
+  EXPECT_LT(std::abs(left_out[0]["difference_m"][2].get<double>()), 0.05);
+}
+
+// Adjusts the simulated flight of seed 3 with self-calibration after `edit` on a copy of its
+// points.csv; returns the exit code and the result.
+struct SurveyRun {
+  int exit_code = 0;
+  std::string output;
+  nlohmann::json result;
+};
+template <typename Edit>
+SurveyRun AdjustWithSurvey(const TempDir& dir, const std::string& options, Edit edit) {
+  std::filesystem::remove_all(dir.File("g"));
+  std::filesystem::copy(dir.File("f"), dir.File("g"));
+  edit(dir.File("g/points.csv"));
+  const auto r = RunAerocal("adjust --project " + dir.File("g/project.yaml") + options + " --out " +
+                            dir.File("r.json"));
+  return {r.exit_code, r.output, ReadJson(dir.File("r.json"))};
+}
+
 TEST(SnoopingCommand, ControlSurveyOffIsNamedAndLeftOutNotItsRays) {
   // Issue 12: a control point whose survey disagrees with its rays is named as a suspected
   // control blunder, not hidden by rejecting its rays. C1 is a corner of the 5 control points of
-  // the simulated flight: with self-calibration its survey has r 0.02 in X and 0.001 in Z (the
-  // block bends to fit it), so the old per-direction test called it weakly controlled and named
-  // the centre point C5 instead.
+  // the simulated flight; its plan and its height are tested apart (self-calibration: r 0.02 in
+  // X, 0.001 in Z), and only the failing one is left out.
   TempDir dir("aerocal_snoop_control");
   ASSERT_EQ(RunAerocal("simulate --seed 3 --out " + dir.File("f")).exit_code, 0);
   const std::string self_calibration = " --self-calibration all";
-  // The oracle: C1's survey removed by hand (C1 a tie point, its rays kept).
-  std::filesystem::copy(dir.File("f"), dir.File("o"));
-  {
-    std::string points = ReadTextFile(dir.File("o/points.csv"));
-    points = std::regex_replace(points, std::regex("\nC1,[^\n]*"), "");
-    WriteFileAtomically(dir.File("o/points.csv"), points);
-  }
-  ASSERT_EQ(RunAerocal("adjust --project " + dir.File("o/project.yaml") + self_calibration +
-                       " --out " + dir.File("oracle.json")).exit_code, 0);
-  const double oracle_rmse_m = ReadJson(dir.File("oracle.json"))["check"]["spatial_rmse_m"];
-  const auto run = [&](int column, double offset_m, const std::string& options) {
-    std::filesystem::remove_all(dir.File("g"));
-    std::filesystem::copy(dir.File("f"), dir.File("g"));
-    ShiftSurvey(dir.File("g/points.csv"), "C1", column, offset_m);
-    return RunAerocal("adjust --project " + dir.File("g/project.yaml") + options + " --out " +
-                      dir.File("r.json"));
+  // The oracle: C1's plan survey removed by hand (its height survey and its rays kept).
+  const SurveyRun oracle = AdjustWithSurvey(dir, self_calibration, [](const std::string& points) {
+    RemovePlanSurvey(points, "C1");
+  });
+  ASSERT_EQ(oracle.exit_code, 0) << oracle.output;
+  const double oracle_rmse_m = oracle.result["check"]["spatial_rmse_m"];
+  const auto shift = [](int column, double offset_m) {
+    return [=](const std::string& points) { ShiftSurvey(points, "C1", column, offset_m); };
   };
-  {  // 10 m in X: the data single C1 out; its survey leaves the adjustment, its rays stay.
-    const auto r = run(1, 10.0, self_calibration);
+  {  // 10 m in X: the data single C1's plan out; it leaves the adjustment, its height and rays stay.
+    const SurveyRun r = AdjustWithSurvey(dir, self_calibration, shift(1, 10.0));
     EXPECT_EQ(r.exit_code, 0) << r.output;  // a named warning; the other surveys fit
-    EXPECT_NE(r.output.find("warning: suspected control blunder: the survey of control point C1"),
+    EXPECT_NE(r.output.find("warning: suspected control blunder: the survey of control point C1 "
+                            "(its plan)"),
               std::string::npos)
         << r.output;
-    EXPECT_NE(r.output.find("control C1 LEFT OUT"), std::string::npos) << r.output;
-    const auto j = ReadJson(dir.File("r.json"));
-    ASSERT_EQ(j["control_left_out"].size(), 1u) << r.output;
-    EXPECT_EQ(j["control_left_out"][0]["point"], "C1");
-    // The block without the survey puts C1 where its rays say: the offset comes back to the
-    // block's precision at a corner without its survey (0.5 m; measured 9.77 m).
-    EXPECT_NEAR(-j["control_left_out"][0]["difference_m"][0].get<double>(), 10.0, 0.5);
+    EXPECT_NE(r.output.find("control C1 LEFT OUT (plan survey"), std::string::npos) << r.output;
+    const auto& j = r.result;
+    ExpectOnlyPlanLeftOut(j, "C1");  // measured X 9.76 m, Z 0.001 m
     EXPECT_EQ(j["control"]["n"].get<int>(), 4);
-    bool warned = false;
-    for (const auto& w : j["warnings"]) warned |= w["name"] == "control_blunder" && w["subject"] == "C1";
-    EXPECT_TRUE(warned);
+    EXPECT_TRUE(Warned(j, "control_blunder", "C1"));
     EXPECT_FALSE(RejectedRayOf(j, "C1"));
-    // The block is the oracle's (measured ratio 1.000; the clean run with C1's right survey has
-    // 0.259 m against 0.369 m: a corner survey the block needs is gone).
+    // The block is the oracle's (measured 0.261 m against 0.261 m; 0.259 m with C1's right
+    // survey).
     EXPECT_NEAR(j["check"]["spatial_rmse_m"].get<double>() / oracle_rmse_m, 1.0, 0.05);
   }
-  {  // 1 m in X: C1 and the opposite corner C4 fail alike; named as a pair, both kept.
-    const auto r = run(1, 1.0, self_calibration);
+  {  // 1 m in X: C1 and the opposite corner C4 fail alike (w 4.9 and 4.7): named as a pair, both
+     // kept, and the run is not valid (a survey blunder the test cannot place).
+    const SurveyRun r = AdjustWithSurvey(dir, self_calibration, shift(1, 1.0));
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    const auto& j = r.result;
+    EXPECT_TRUE(j["control_left_out"].empty());
+    EXPECT_TRUE(Said(j, {"control C1 plan", "control C4 plan", "cannot tell them apart"})) << r.output;
+    EXPECT_TRUE(Warned(j, "control_blunder_unresolved", "control C1 plan"));
+    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+  }
+  {  // Conventional (the simulated camera error is not modelled): C1's plan is named as the worst,
+     // but without it C5's height still fails (a model error): every survey is kept.
+    const SurveyRun r = AdjustWithSurvey(dir, "", shift(1, 10.0));
+    const auto& j = r.result;
+    EXPECT_TRUE(j["control_left_out"].empty());
+    EXPECT_TRUE(Said(j, {"leaving out control C1 plan", "every survey kept"})) << r.output;
+    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+  }
+}
+
+TEST(SnoopingCommand, HeightBlunderAtACornerIsAnUnresolvedGroupAndAPlanBlunderAtTheCentreIsLeftOut) {
+  // The self-calibrating simulated flight (seed 3, 5 control points, survey sigma 2 cm): the four
+  // corners' heights share one redundant direction, the block's twist (their residuals correlate
+  // |rho| 0.997-1.000; r 0.0012-0.0015 each): a height blunder on any corner gives all four the
+  // same w (10 m: 15.0, 15.0, 14.9, 14.9), so no test can say which is off. The honest outcome is
+  // the group named and exit 3. C5's plan (r 0.1) is separable: 10 m there is left out, its
+  // height (r 3e-5, c absorbs it) stays.
+  TempDir dir("aerocal_snoop_height");
+  ASSERT_EQ(RunAerocal("simulate --seed 3 --out " + dir.File("f")).exit_code, 0);
+  const std::string self_calibration = " --self-calibration all";
+  {  // Z +10 m on C1: the four corners' heights named as a group, every survey kept, exit 3.
+    const SurveyRun r = AdjustWithSurvey(dir, self_calibration, [](const std::string& points) {
+      ShiftSurvey(points, "C1", 3, 10.0);
+    });
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    const auto& j = r.result;
+    EXPECT_FALSE(j["valid"].get<bool>());
+    EXPECT_TRUE(j["control_left_out"].empty());
+    EXPECT_EQ(j["control"]["n"].get<int>(), 5);
+    const auto& unresolved = j["snooping"]["unresolved_surveys"];
+    ASSERT_EQ(unresolved.size(), 4u) << r.output;
+    for (const auto& u : unresolved) {
+      EXPECT_NE(u["survey"].get<std::string>().find(" height"), std::string::npos) << u;
+      EXPECT_EQ(u["survey"].get<std::string>().find("C5"), std::string::npos) << u;
+      EXPECT_GT(u["w"].get<double>(), j["snooping"]["critical_value"].get<double>());
+      EXPECT_LT(u["r"].get<double>(), 0.01);  // measured 0.0012-0.0015
+    }
+    EXPECT_TRUE(Warned(j, "control_blunder_unresolved", "control C1 height"));
+    EXPECT_NE(r.output.find("control survey blunder not resolved"), std::string::npos) << r.output;
+    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+  }
+  // The oracle of C5: its plan survey removed by hand.
+  const SurveyRun oracle = AdjustWithSurvey(dir, self_calibration, [](const std::string& points) {
+    RemovePlanSurvey(points, "C5");
+  });
+  ASSERT_EQ(oracle.exit_code, 0) << oracle.output;
+  const double oracle_rmse_m = oracle.result["check"]["spatial_rmse_m"];
+  {  // X +10 m on C5: its plan left out, its height kept, no ray of it rejected.
+    const SurveyRun r = AdjustWithSurvey(dir, self_calibration, [](const std::string& points) {
+      ShiftSurvey(points, "C5", 1, 10.0);
+    });
     EXPECT_EQ(r.exit_code, 0) << r.output;
-    const auto j = ReadJson(dir.File("r.json"));
-    EXPECT_TRUE(j["control_left_out"].empty());
-    EXPECT_TRUE(Said(j, {"control C1", "control C4", "cannot tell them apart"})) << r.output;
-    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+    const auto& j = r.result;
+    ExpectOnlyPlanLeftOut(j, "C5");  // measured X 10.05 m, Z 0.000 m
+    EXPECT_TRUE(j["snooping"]["unresolved_surveys"].empty());
+    EXPECT_FALSE(RejectedRayOf(j, "C5"));
+    // measured 0.256 m against 0.256 m (0.259 m with C5's right survey)
+    EXPECT_NEAR(j["check"]["spatial_rmse_m"].get<double>() / oracle_rmse_m, 1.0, 0.05);
   }
-  {  // 10 m in Z: the four corners' heights have r 0.001 and fail alike: named as a group.
-    const auto r = run(3, 10.0, self_calibration);
-    const auto j = ReadJson(dir.File("r.json"));
-    EXPECT_TRUE(j["control_left_out"].empty());
-    EXPECT_TRUE(Said(j, {"control C1", "cannot tell them apart"})) << r.output;
+  {  // Both: C5's plan (w 48) is singled out and stays out; the corners' heights are the group.
+    const SurveyRun r = AdjustWithSurvey(dir, self_calibration, [](const std::string& points) {
+      ShiftSurvey(points, "C1", 3, 10.0);
+      ShiftSurvey(points, "C5", 1, 10.0);
+    });
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    const auto& j = r.result;
+    ASSERT_EQ(j["control_left_out"].size(), 1u) << r.output;
+    EXPECT_EQ(j["control_left_out"][0]["point"], "C5");
+    EXPECT_EQ(j["snooping"]["unresolved_surveys"].size(), 4u) << r.output;
+    EXPECT_TRUE(Warned(j, "control_blunder", "C5"));
+    EXPECT_TRUE(Warned(j, "control_blunder_unresolved", "control C1 height"));
     EXPECT_FALSE(RejectedRayOf(j, "C1"));
-  }
-  {  // Conventional (the simulated camera error is not modelled): C1 is named as the worst, but
-     // without it the other surveys still fail (a model error): every survey is kept.
-    const auto r = run(1, 10.0, "");
-    const auto j = ReadJson(dir.File("r.json"));
-    EXPECT_TRUE(j["control_left_out"].empty());
-    EXPECT_TRUE(Said(j, {"leaving out control C1", "every survey kept"})) << r.output;
-    EXPECT_FALSE(RejectedRayOf(j, "C1"));
+    EXPECT_FALSE(RejectedRayOf(j, "C5"));
   }
 }
 

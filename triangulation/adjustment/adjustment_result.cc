@@ -97,7 +97,14 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
                       {"gross_share", s.gross_share},
                       {"robust_excluded", s.robust_excluded},
                       {"robust_readmitted", s.robust_readmitted},
-                      {"robust_retested", s.robust_retested}};
+                      {"robust_retested", s.robust_retested},
+                      {"unresolved_reason", s.unresolved_reason}};
+  j["unresolved_surveys"] = nlohmann::json::array();
+  for (const auto& u : s.unresolved_surveys)
+    j["unresolved_surveys"].push_back({{"survey", u.survey},
+                                       {"w", u.w},
+                                       {"r", u.redundancy},
+                                       {"residual_sigma", u.residual_sigma}});
   j["uncontrolled"] = nlohmann::json::array();
   for (const auto& u : s.uncontrolled)
     j["uncontrolled"].push_back({{"image", u.image},
@@ -433,14 +440,20 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["check"] = check;
   j["control_left_out"] = nlohmann::json::array();
   for (const auto& p : r.control_left_out) {
-    const auto w = r.control_left_out_w.find(p.point);
-    j["control_left_out"].push_back(
-        {{"point", p.point},
-         {"surveyed_m", Vec(p.surveyed_m)},
-         {"adjusted_m", Vec(p.adjusted_m)},
-         {"difference_m", Vec(p.difference_m)},
-         {"rays", p.rays},
-         {"w", w != r.control_left_out_w.end() ? nlohmann::json(w->second) : nlohmann::json()}});
+    const auto parts = r.control_left_out_w.find(p.point);
+    nlohmann::json w, components = nlohmann::json::object();
+    if (parts != r.control_left_out_w.end())
+      for (const auto& [component, w_component] : parts->second) {
+        components[component] = w_component;
+        if (w.is_null() || w_component > w.get<double>()) w = w_component;
+      }
+    j["control_left_out"].push_back({{"point", p.point},
+                                     {"surveyed_m", Vec(p.surveyed_m)},
+                                     {"adjusted_m", Vec(p.adjusted_m)},
+                                     {"difference_m", Vec(p.difference_m)},
+                                     {"rays", p.rays},
+                                     {"w", w},
+                                     {"components", components}});
   }
   if (r.check_controlled) {
     nlohmann::json c = PointStatisticsToJson(*r.check_controlled);
@@ -546,14 +559,20 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += "frame: " + r.frame + "\n";
   out += "datum: " + r.datum + "\n";
   out += StatisticsLine("control", r.control);
-  for (const auto& p : r.control_left_out)
-    out += StringPrintf("control %s LEFT OUT (suspected control blunder): survey - block without it "
-                        "X %.3f  Y %.3f  Z %.3f m, %d rays kept\n",
+  for (const auto& p : r.control_left_out) {
+    std::string parts;
+    const auto left = r.control_left_out_w.find(p.point);
+    if (left != r.control_left_out_w.end())
+      for (const auto& part : left->second) parts += (parts.empty() ? "" : " and ") + part.first;
+    out += StringPrintf("control %s LEFT OUT (%s survey; suspected control blunder): survey - block "
+                        "without it X %.3f  Y %.3f  Z %.3f m, %d rays kept\n",
                         p.point.c_str(),
+                        parts.c_str(),
                         -p.difference_m.x(),
                         -p.difference_m.y(),
                         -p.difference_m.z(),
                         p.rays);
+  }
   out += StatisticsLine("check", r.check);
   if (r.check_controlled && r.check_controlled->n < r.check.n) {
     out += StatisticsLine("check*", *r.check_controlled);

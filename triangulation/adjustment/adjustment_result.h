@@ -126,6 +126,15 @@ struct UncontrolledObservation {
   std::string reason;
 };
 
+/// A control survey (its plan or its height) that fails the surveys-first test but could not be
+/// left out (calib::SnoopingOutcome::unresolved).
+struct UnresolvedSurvey {
+  std::string survey;            // "control C1 height"
+  double w = 0;                  // its test over all its components
+  double redundancy = 0;         // of its least redundant component
+  double residual_sigma = 0;     // its largest residual, in a-priori sigmas
+};
+
 /// How data snooping was run and what it could not decide (data_snooping.h).
 struct SnoopingSummary {
   bool run = false;
@@ -145,6 +154,9 @@ struct SnoopingSummary {
   std::vector<std::string> model_error_evidence;
   std::string suggestion;  // e.g. self-calibration
   std::vector<std::string> findings;
+  /// Failing control surveys none of which could be left out (kWarningControlBlunderUnresolved).
+  std::vector<UnresolvedSurvey> unresolved_surveys;
+  std::string unresolved_reason;
   std::vector<FlaggedObservation> flagged;
   /// Every active observation no test can judge, one by one (the counts above summarise them).
   std::vector<UncontrolledObservation> uncontrolled;
@@ -203,6 +215,12 @@ inline constexpr double kGroupRmsLimit = 3.0;
 /// control blunder (subject: the point id; value: w of its survey test; limit: the critical
 /// value).
 inline constexpr const char* kWarningControlBlunder = "control_blunder";
+/// Name of the warning for failing control surveys that data snooping cannot resolve: the surveys
+/// named (subject: their labels, e.g. "control C1 height, control C2 height") fail their test but
+/// none can be singled out and left out (the test cannot tell them apart, or the block needs the
+/// worst); value: the largest w; limit: the critical value. The result is not valid (exit 3): a
+/// survey blunder somewhere in the datum is a model that does not fit.
+inline constexpr const char* kWarningControlBlunderUnresolved = "control_blunder_unresolved";
 
 /// One kWarningGroupRms warning per residual group of `solve` whose RMS exceeds `limit`.
 std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, double limit = kGroupRmsLimit);
@@ -226,12 +244,15 @@ struct AdjustmentResult {
   std::vector<ExposureEstimate> exposures;
   std::vector<PointDifference> control_points, check_points;
   PointStatistics control, check;
-  /// Control points whose survey data snooping left out as a suspected control blunder (it
-  /// disagrees with the point's rays, every other survey fits without it; the rays stay): their
-  /// survey against the position the block gives them without it (not in `control`). JSON
-  /// `control_left_out: [{point, surveyed_m, adjusted_m, difference_m, rays, w}]`.
+  /// Control points whose survey data snooping left out, in whole or in part, as a suspected
+  /// control blunder (it disagrees with the point's rays, every other survey fits without it; the
+  /// rays stay): their survey against the position the block gives them (not in `control`). The
+  /// plan (X, Y) and the height (Z) of a survey are tested and left out separately. JSON
+  /// `control_left_out: [{point, surveyed_m, adjusted_m, difference_m, rays, w, components}]`
+  /// (`components`: {"plan": w, "height": w} of the parts left out; `w` the largest).
   std::vector<PointDifference> control_left_out;
-  std::map<std::string, double> control_left_out_w;  // by point: w of the failed survey test
+  /// By point: the components left out ("plan", "height") with the w of their failed test.
+  std::map<std::string, std::vector<std::pair<std::string, double>>> control_left_out_w;
   /// After snooping: the check statistics over the check points whose rays are all controlled
   /// (PointDifference::uncontrolled empty). `check` stays the statistics of every check point.
   std::optional<PointStatistics> check_controlled;

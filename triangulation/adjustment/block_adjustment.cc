@@ -35,6 +35,9 @@ const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
 constexpr int kMinAutomaticCap = 100;
 // Residual group of the weighted platform parameters (lever arm, boresight, GNSS time offset).
 constexpr const char* kGroupPlatformPrior = "platform_prior";
+// The two survey observations of a control point (labels "control <id> plan" / "... height").
+constexpr const char* kSurveyPlan = "plan";
+constexpr const char* kSurveyHeight = "height";
 
 bool PlatformEstimated(const PlatformSpec& p) {
   return p.lever_arm != PlatformParamMode::kFixed || p.boresight != PlatformParamMode::kFixed ||
@@ -96,8 +99,10 @@ struct BlockAdjustment::Storage {
   std::vector<ExposureIndex> exposure_of_observation;
   std::vector<PointIndex> point_of_observation;
   std::map<calib::ResidualId, size_t> observation_of_residual;
-  std::map<calib::ResidualId, PointIndex> control_of_residual;  // surveyed coordinates
-  std::map<PointIndex, double> survey_left_out;  // snooping left it out: w of its test
+  // Surveyed coordinates: two residuals per control point, its plan (X, Y) and its height (Z).
+  std::map<calib::ResidualId, std::pair<PointIndex, const char*>> control_of_residual;
+  // Snooping left them out: the components ("plan", "height") with the w of their test.
+  std::map<PointIndex, std::vector<std::pair<std::string, double>>> survey_left_out;
   std::map<calib::ResidualId, ObservationTest> tests;  // data snooping's last word on each
   std::vector<std::string> notes;
   // The GNSS/IMU platform (Project::platform): lever arm, GNSS time offset (when exposures carry
@@ -363,12 +368,24 @@ void BlockAdjustment::AddPriors() {
     if (state.block < 0 || !state.Control()) continue;
     const Eigen::Vector3d& xyz = *state.ground->xyz_m;
     const Eigen::Vector3d& s = state.ground->sigma_m;
-    const calib::ResidualId id = builder_.AddResidual(
+    // Plan and height are two observations: snooping tests each with its own redundancy and
+    // leaves out only the failing one (a wrong height must not take a good plan survey along).
+    const calib::ResidualId plan = builder_.AddResidual(
         calib::kGroupControl,
-        calib::PriorCostFunction::Create({xyz.x(), xyz.y(), xyz.z()}, {s.x(), s.y(), s.z()}),
+        std::make_unique<calib::PriorCostFunction>(3, std::vector<int>{0, 1},
+                                                   std::vector<double>{xyz.x(), xyz.y()},
+                                                   std::vector<double>{s.x(), s.y()}),
         {state.block},
-        "control " + storage_->point_ids[p]);
-    storage_->control_of_residual[id] = p;
+        "control " + storage_->point_ids[p] + " plan");
+    const calib::ResidualId height = builder_.AddResidual(
+        calib::kGroupControl,
+        std::make_unique<calib::PriorCostFunction>(3, std::vector<int>{2},
+                                                   std::vector<double>{xyz.z()},
+                                                   std::vector<double>{s.z()}),
+        {state.block},
+        "control " + storage_->point_ids[p] + " height");
+    storage_->control_of_residual[plan] = {p, kSurveyPlan};
+    storage_->control_of_residual[height] = {p, kSurveyHeight};
   }
   if (options_.use_eo_priors) {
     AddPlatformBlocks();
@@ -723,18 +740,22 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
                                 : std::max(kMinAutomaticCap, tested_images / 10);
   snooping.model_error_sigma0 = options_.model_error_sigma0;
   snooping.leave_out_report_only = options_.leave_out_failing_control;
-  // Without GNSS centres the surveys hold the datum: at least three control points stay.
+  // Without GNSS centres the surveys hold the datum: at least three plan and three height
+  // surveys stay.
   bool gnss = false;
   for (const auto& state : st.exposures) gnss |= options_.use_eo_priors && state.exposure->center_sigma_m.has_value();
   snooping.veto = [&](const std::vector<calib::ResidualId>& ids) -> std::string {
-    int surveys = 0, leaving = 0;
-    for (const auto& [id, point] : st.control_of_residual) {
+    std::map<std::string, std::pair<int, int>> kept_leaving;  // by component: active, leaving
+    for (const auto& [id, survey] : st.control_of_residual) {
+      auto& [surveys, leaving] = kept_leaving[survey.second];
       surveys += builder_.IsActive(id);
       leaving += std::find(ids.begin(), ids.end(), id) != ids.end();
     }
-    if (leaving > 0 && !gnss && surveys - leaving < 3)
-      return "leaving out the survey would leave " + std::to_string(surveys - leaving) +
-             " control point(s) and no GNSS centres: the datum needs 3";
+    for (const auto& [component, count] : kept_leaving)
+      if (count.second > 0 && !gnss && count.first - count.second < 3)
+        return "leaving out the survey would leave " + std::to_string(count.first - count.second) +
+               " control point(s) with a " + component +
+               " survey and no GNSS centres: the datum needs 3";
     // Keyed by point index (id order) and by exposure rank (image id order): the first veto
     // found is the one named.
     std::map<PointIndex, int> lose_point;
@@ -768,7 +789,8 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
       calib::SolveWithDataSnooping(builder_, options_.solver, snooping, &first);
   for (const auto& x : out.left_out) {
     const auto it = st.control_of_residual.find(x.id);
-    if (it != st.control_of_residual.end()) st.survey_left_out[it->second] = x.w_full;
+    if (it != st.control_of_residual.end())
+      st.survey_left_out[it->second.first].emplace_back(it->second.second, x.w_full);
   }
   result->solve = out.report;
   if (out.solves > 0) {
@@ -798,6 +820,15 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   s.model_error_suspected = out.model_error_suspected;
   s.model_error_evidence = out.model_error_evidence;
   s.findings = out.findings;
+  s.unresolved_reason = out.unresolved_reason;
+  for (const auto& x : out.unresolved) {
+    UnresolvedSurvey u;
+    u.survey = x.label;
+    u.w = x.w_full;
+    u.redundancy = *std::min_element(x.redundancy.begin(), x.redundancy.end());
+    for (double v : x.v) u.residual_sigma = std::max(u.residual_sigma, std::abs(v));
+    s.unresolved_surveys.push_back(u);
+  }
   s.seconds_testing = out.seconds_testing;
   if (out.model_error_suspected) {
     int control = 0;
@@ -1134,23 +1165,45 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
                       result.determinability.undetermined.front() + ", ...)");
   result.warnings = GroupRmsWarnings(result.solve);
   for (const auto& d : result.control_left_out) {
-    const double w = result.control_left_out_w.at(d.point);
+    double w = 0.0;
+    std::string parts;
+    for (const auto& [component, w_component] : result.control_left_out_w.at(d.point)) {
+      w = std::max(w, w_component);
+      parts += (parts.empty() ? "" : " and ") + component;
+    }
     result.warnings.push_back(
         {kWarningControlBlunder,
          d.point,
          w,
          result.snooping.critical_value,
-         StringPrintf("suspected control blunder: the survey of control point %s disagrees with its "
-                      "%d rays (w = %.1f > %.2f; survey - block X %.3f Y %.3f Z %.3f m) and every "
-                      "other survey fits without it: its survey is left out of the adjustment, its "
+         StringPrintf("suspected control blunder: the survey of control point %s (its %s) disagrees "
+                      "with its %d rays (w = %.1f > %.2f; survey - block X %.3f Y %.3f Z %.3f m) "
+                      "and every other survey fits without it: it is left out of the adjustment, its "
                       "rays are kept; check its survey",
                       d.point.c_str(),
+                      parts.c_str(),
                       d.rays,
                       w,
                       result.snooping.critical_value,
                       -d.difference_m.x(),
                       -d.difference_m.y(),
                       -d.difference_m.z())});
+  }
+  if (!result.snooping.unresolved_surveys.empty()) {
+    std::string names;
+    double w = 0.0;
+    for (const auto& u : result.snooping.unresolved_surveys) {
+      names += (names.empty() ? "" : ", ") + u.survey;
+      w = std::max(w, u.w);
+    }
+    const std::string message =
+        "control survey blunder not resolved: " + names + " fail the survey test (w up to " +
+        FormatNumber(w, 3) + " > " + FormatNumber(result.snooping.critical_value, 3) +
+        ") and none can be left out: " + result.snooping.unresolved_reason +
+        "; every survey is kept, the block is bent to fit them: check these surveys";
+    result.warnings.push_back(
+        {kWarningControlBlunderUnresolved, names, w, result.snooping.critical_value, message});
+    result.Invalidate(message);
   }
   result.timing.total_s = seconds_since(run_start);
   return result;

@@ -4,7 +4,9 @@
 // - image: collinearity of every virtual-image measurement with the 10-parameter camera
 //   (calib/residuals/collinearity.h), group kGroupImage;
 // - control: the surveyed coordinates of control points as weighted observations of their ground
-//   point block (sigma from points.csv), group kGroupControl;
+//   point block (sigma from points.csv), group kGroupControl: two residuals per point, its plan
+//   (X, Y; label "control <id> plan") and its height (Z; "control <id> height"), which data
+//   snooping tests and leaves out each on its own (a wrong height keeps a good plan survey);
 // - eo_prior: GNSS centres / IMU angles from the sigma columns of exposures.csv, kGroupEoPrior;
 // - interior_prior: the camera file's `interior_sigma` of free interior parameters.
 // Check points enter only through their image rays (as tie points); their adjusted coordinates are

@@ -28,12 +28,16 @@ using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 constexpr double kMaxPixel = 1e7;
 constexpr double kMaxSigmaPx = 1e4;
+// Sigma of the datum pseudo-observations (LineDatumResidual), px: tight against a table sigma of
+// ~1e-3 .. 1e-2 px, loose enough for the normal matrix (its weight ~ that of an angle).
+constexpr double kDatumSigmaPx = 1e-4;
 
 struct Problem {
   calib::ProblemBuilder builder;
   std::vector<Eigen::Vector3d> point_values;
   std::vector<calib::ResidualId> image_residuals;  // in the order of the kind's Terms()
   std::vector<std::set<int>> fixed_entries;        // per detector block
+  std::vector<std::set<int>> datum_entries;        // per detector block: held by the datum
 };
 
 }  // namespace
@@ -134,6 +138,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   LineScanCamera sensor(camera, pos, line_options);
   Problem p;
   p.fixed_entries.assign(n_sub, {});
+  p.datum_entries.assign(n_sub, {});
   Project strip;
   strip.observations_file = observations_file;
   const AdjustOptions adjust_options{};
@@ -225,7 +230,10 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
                                      " and there is no POS prior: its correction is not determined"});
     }
 
-  // Fixed detector entries: above the degree, and the datum.
+  // Fixed detector entries: above the degree. The datum (module README "Datum"): the reference
+  // sub-camera's Legendre mean and slope per axis are zero (LineDatumResidual), which holds the
+  // same whatever degree the test leaves; its constant and linear entries follow the higher
+  // terms (a_0 = -a_2/3 - a_4/5, a_1 = -3 a_3/5 - 3 a_5/7) and do not enter the test.
   const int start_degree = options.degree.value_or(options.max_degree);
   auto apply_fixed = [&]() {
     for (int s = 0; s < n_sub; ++s) {
@@ -239,9 +247,12 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
       p.fixed_entries[s].insert(kLineMaxTerms + k);
     }
     if (options.reference_datum && s == reference)
-      for (int e : {0, 1, kLineMaxTerms, kLineMaxTerms + 1}) p.fixed_entries[s].insert(e);
+      p.datum_entries[s] = {0, 1, kLineMaxTerms, kLineMaxTerms + 1};
   }
   apply_fixed();
+  if (options.reference_datum)
+    b.AddResidual(kGroupLineDatum, LineDatumResidual::Create(kDatumSigmaPx * camera.pitch_mm),
+                  {sensor.DetectorBlocks()[reference]}, "datum " + sub_ids[reference]);
 
   // Reprojection before: at the POS and the file's camera.
   auto rms_by_subcamera = [&](bool after) {
@@ -285,6 +296,13 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     bool changed = false;
     for (int s = 0; s < n_sub; ++s)
       for (int axis = 0; axis < 2; ++axis) {
+        // The datum sub-camera keeps the start degree: a term dropped there (insignificant, yet
+        // real) is a bias the sigmas do not show, and the datum pins its correction where the
+        // Legendre terms kept vanish (degree 2: u = +-1/sqrt(3), sigma ~0 there).
+        if (options.reference_datum && s == reference) {
+          (axis == 0 ? result.subcameras[s].degree_x : result.subcameras[s].degree_y) = start_degree;
+          continue;
+        }
         const int base = axis * kLineMaxTerms;
         const Eigen::MatrixXd q = cov.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms);
         // Top-down: drop the highest free coefficient while it is insignificant (Wald, one
@@ -296,7 +314,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         int chosen = start_degree;
         for (; chosen >= 0; --chosen) {
           const int e = base + chosen;
-          if (p.fixed_entries[s].count(e)) continue;  // fixed (datum): does not decide
+          if (p.fixed_entries[s].count(e) || p.datum_entries[s].count(e)) continue;  // does not decide
           double beta = sensor.Detectors()[s][e], var = q(e, e);
           if (!dropped.empty()) {
             const int nb = int(dropped.size());
@@ -357,6 +375,14 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     result.valid = false;
     result.warnings.push_back({"covariance", "adjustment", 0, 0,
                                "no covariance (singular normal matrix?): " + cov.message});
+    // Without the datum the singular direction is known: a constant along-track offset of all
+    // detectors IS a pitch of the strip (exactly, for a line at y = 0); without a covariance its
+    // correlation cannot be computed, so it is named with the value it has in the model.
+    if (!options.reference_datum)
+      result.warnings.push_back({"offset_vs_pitch", "detector polynomials", 1.0,
+                                 options.correlation_fail,
+                                 "ill-posed: no datum and a singular normal matrix: a constant "
+                                 "along-track offset of the detectors is a pitch of the strip"});
   }
   result.undetermined = cov.undetermined;
   if (!cov.undetermined.empty()) {
@@ -402,6 +428,17 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
                                                              kLineMaxTerms, u);
       if (cov.ok)
         for (int axis = 0; axis < 2; ++axis) {
+          // No free term beyond the datum's: the correction is fixed (sigma 0), not the datum
+          // pseudo-observations' own ~1e-4 px.
+          bool estimated = false;
+          for (int k = 0; k < kLineMaxTerms; ++k) {
+            const int e = axis * kLineMaxTerms + k;
+            estimated |= !p.fixed_entries[s].count(e) && !p.datum_entries[s].count(e);
+          }
+          if (!estimated) {
+            (axis == 0 ? result.dx_sigma_mm : result.dy_sigma_mm)[i] = 0.0;
+            continue;
+          }
           Eigen::VectorXd g = Eigen::VectorXd::Zero(2 * kLineMaxTerms);
           double power = 1.0;
           for (int k = 0; k < kLineMaxTerms; ++k, power *= u) g[axis * kLineMaxTerms + k] = power;
@@ -496,10 +533,16 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
           if (cov.CrossCovariance(bx, by, &cross)) sum += wx * wy * cross(ex, ey);
       return sum;
     };
+    // Free and not held by the datum (its entries follow the higher terms).
+    auto decides = [&](BlockId block, int entry) {
+      for (int s = 0; s < n_sub; ++s)
+        if (sensor.DetectorBlocks()[s] == block && p.datum_entries[s].count(entry)) return false;
+      return entry_sigma(block, entry).has_value();
+    };
     auto mean_free = [&](const std::vector<BlockId>& blocks, int entry) {
       Combination c;
       for (BlockId block : blocks)
-        if (entry_sigma(block, entry)) c.emplace_back(block, entry, 1.0);
+        if (decides(block, entry)) c.emplace_back(block, entry, 1.0);
       for (auto& [block, e, w] : c) w = 1.0 / double(c.size());
       return c;
     };
@@ -522,7 +565,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     auto all_free = [&](const std::vector<BlockId>& blocks, int entry) {
       Combination c;
       for (BlockId block : blocks)
-        if (entry_sigma(block, entry)) c.emplace_back(block, entry, 1.0);
+        if (decides(block, entry)) c.emplace_back(block, entry, 1.0);
       return c;
     };
     const double offset_roll = multiple(mean_free(sensor.DetectorBlocks(), 0), all_free(sensor.NodeBlocks(), roll));

@@ -6,12 +6,14 @@
 //   values (the POS error is modelled as smooth; white POS noise stays in the residuals);
 // - the detector calibration: a polynomial per sub-camera and axis in the normalised index
 //   (degree <= 5, jumps allowed at the seams), its degree chosen top-down by a Wald test of the
-//   highest coefficient (alpha 5 %), giving dx_i, dy_i with sigmas for every detector;
+//   highest coefficient (alpha 5 %; not for the datum's sub-camera), giving dx_i, dy_i with
+//   sigmas for every detector;
 // - the control points as weighted ground points (their survey sigmas);
 // - optionally the principal distance c (`free_c`; it is nearly a scale of the table).
-// Datum (module README "Datum"): the reference sub-camera's constant and linear terms in x and y
-// are fixed at their file values: the common along-track offset is exactly a pitch, the common
-// across-track offset nearly a roll, the linear terms nearly kappa and the scale; the trajectory
+// Datum (module README "Datum"): the reference sub-camera's correction (on top of the file's) has
+// zero Legendre mean and slope in x and y (LineDatumResidual), whatever its degree; it keeps the
+// start degree (the degree test leaves it). The common along-track offset is exactly a pitch, the
+// common across-track offset nearly a roll, the slopes nearly kappa and the scale; the trajectory
 // corrections take them. `reference_datum = false` frees them: the result is then reported
 // ill-posed by name (offset_vs_roll, offset_vs_pitch, scale_vs_c) with the correlations.
 #pragma once
@@ -36,7 +38,7 @@ struct LineCalibrationOptions {
   int max_degree = 5;                 // highest polynomial degree tried, 0 .. 5
   std::optional<int> degree;          // a fixed degree (0 .. 5) instead of the test
   double degree_test_alpha = 0.05;    // significance of the top-down Wald test, (0, 0.5)
-  bool reference_datum = true;        // fix the reference sub-camera's constant + linear terms
+  bool reference_datum = true;        // the reference sub-camera's Legendre mean + slope = 0
   int reference_subcamera = -1;       // index; -1: the middle one
   bool free_c = false;                // estimate c (nearly a scale of the table: scale_vs_c)
   bool pos_prior = true;              // the POS sigmas as priors on the node values
@@ -76,7 +78,7 @@ struct SubcameraRms {
   double across_before_px = 0, along_before_px = 0, across_after_px = 0, along_after_px = 0;
   int degree_x = 0, degree_y = 0;
   std::vector<double> dx_coefficients_mm, dy_coefficients_mm;  // estimated polynomial (all terms)
-  std::vector<std::optional<double>> dx_sigma_mm, dy_sigma_mm; // null: fixed (datum / degree)
+  std::vector<std::optional<double>> dx_sigma_mm, dy_sigma_mm; // null: fixed (degree)
 };
 
 /// One observation's reprojection error without the detector calibration, at the adjusted

@@ -15,6 +15,57 @@
 #include "triangulation/simulation/textured_ground.h"
 
 namespace aerocal::triangulation {
+namespace {
+
+// Sub-samples per pixel side of the area integration (kPixelSamples^2 per pixel).
+constexpr int kPixelSamples = 4;
+
+// Grey values of an image whose pixel (r, c) sees the ground point ground(r, c) (NaN: no
+// ground), each the mean of the texture over the pixel's footprint, as a real detector
+// integrates over its pixel: kPixelSamples^2 samples on a regular grid over the square
+// [-1/2, 1/2]^2 pixel, mapped onto the ground by the local Jacobian (central differences of the
+// neighbouring pixels' ground points; one-sided at an edge). Point sampling at the pixel centre
+// instead aliases the texture (0.3 line spacings per texel) and biased the image-mode
+// calibration smoothly in the detector index (module README "Measured").
+template <typename Noise>
+stitch::GrayImage IntegrateOverPixels(const TexturedGround& texture,
+                                      const Eigen::MatrixXd& ground_x,
+                                      const Eigen::MatrixXd& ground_y,
+                                      Noise&& noise) {
+  const int rows = int(ground_x.rows()), cols = int(ground_x.cols());
+  stitch::GrayImage image(rows, cols);
+  auto valid = [&](int r, int c) { return r >= 0 && c >= 0 && r < rows && c < cols && !std::isnan(ground_x(r, c)); };
+  // d ground / d (pixel step) along one image axis at (r, c): central, else one-sided, else 0.
+  auto derivative = [&](int r, int c, int dr, int dc) -> Eigen::Vector2d {
+    const bool ahead = valid(r + dr, c + dc), behind = valid(r - dr, c - dc);
+    if (!ahead && !behind) return Eigen::Vector2d(0, 0);
+    const int r1 = ahead ? r + dr : r, c1 = ahead ? c + dc : c;
+    const int r0 = behind ? r - dr : r, c0 = behind ? c - dc : c;
+    const double steps = (ahead ? 1.0 : 0.0) + (behind ? 1.0 : 0.0);
+    return Eigen::Vector2d(ground_x(r1, c1) - ground_x(r0, c0), ground_y(r1, c1) - ground_y(r0, c0)) /
+           steps;
+  };
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      if (!valid(r, c)) {
+        image(r, c) = 0.0f;
+        continue;
+      }
+      const Eigen::Vector2d g(ground_x(r, c), ground_y(r, c));
+      const Eigen::Vector2d along_c = derivative(r, c, 0, 1), along_r = derivative(r, c, 1, 0);
+      double sum = 0;
+      for (int a = 0; a < kPixelSamples; ++a)
+        for (int b = 0; b < kPixelSamples; ++b) {
+          const double fc = (b + 0.5) / kPixelSamples - 0.5, fr = (a + 0.5) / kPixelSamples - 0.5;
+          const Eigen::Vector2d q = g + fc * along_c + fr * along_r;
+          sum += texture.At(q.x(), q.y());
+        }
+      image(r, c) = float(sum / (kPixelSamples * kPixelSamples) + noise());
+    }
+  return image;
+}
+
+}  // namespace
 
 void LineImageOptions::Validate() const {
   auto require = [](bool ok, const std::string& message) {
@@ -67,10 +118,11 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimula
   texture.x_c = 0.5 * (lo.x() + hi.x());
   texture.y_c = 0.5 * (lo.y() + hi.y());
   out.texture_gsd_m = texture.gsd_m;
-  auto grey = [&](const Eigen::Vector3d& g) { return float(texture.At(g.x(), g.y()) + io.grey_noise_dn * noise(rng)); };
+  auto grey_noise = [&]() { return io.grey_noise_dn * noise(rng); };
 
-  // The line image through the true camera and poses.
-  out.line_image.resize(lines, cam.detectors);
+  // The line image through the true camera and poses: the ground point of every pixel, then the
+  // texture integrated over each pixel's footprint (one line period along track).
+  Eigen::MatrixXd ground_x(lines, cam.detectors), ground_y(lines, cam.detectors);
   std::vector<Eigen::Vector3d> in_camera(cam.detectors);
   const Eigen::Matrix3d mount = calib::RotationFromOpk(cam.mount_rad);
   for (int i = 0; i < cam.detectors; ++i) {
@@ -85,9 +137,11 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimula
     for (int i = 0; i < cam.detectors; ++i) {
       const auto g = IntersectSurface(origin, body * in_camera[i], terrain);
       if (!g) throw Error("image mode: a detector ray misses the terrain");
-      out.line_image(l, i) = grey(*g);
+      ground_x(l, i) = g->x();
+      ground_y(l, i) = g->y();
     }
   }
+  out.line_image = IntegrateOverPixels(texture, ground_x, ground_y, grey_noise);
 
   // The reference strip: nadir frames along the flight's mean track at the flying height.
   calib::Camera& ref = out.reference_camera;
@@ -112,14 +166,15 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimula
                 (M_PI / 180.0);
     e.line = k + 2;
     out.reference_exposures.push_back(e);
-    stitch::GrayImage image(ref.height_px, ref.width_px);
+    Eigen::MatrixXd frame_x(ref.height_px, ref.width_px), frame_y(ref.height_px, ref.width_px);
     for (int r = 0; r < ref.height_px; ++r)
       for (int c = 0; c < ref.width_px; ++c) {
         const ImageRay ray = RayFromPixel(ref, e.opk_rad, e.center_m, Eigen::Vector2d(c, r));
         const auto g = IntersectSurface(ray.center_m, ray.direction, terrain);
-        image(r, c) = g ? grey(*g) : 0.0f;
+        frame_x(r, c) = g ? g->x() : std::nan("");
+        frame_y(r, c) = g ? g->y() : std::nan("");
       }
-    out.reference_images.push_back(std::move(image));
+    out.reference_images.push_back(IntegrateOverPixels(texture, frame_x, frame_y, grey_noise));
   }
   return out;
 }

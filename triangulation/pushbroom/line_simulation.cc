@@ -12,6 +12,7 @@
 #include "calib/core/error.h"
 #include "calib/residuals/line_collinearity.h"
 #include "triangulation/pushbroom/line_rectification.h"
+#include "triangulation/sensor/line_scan_camera.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -82,6 +83,14 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     for (auto* axis : {&p.dx, &p.dy}) {
       *axis = {reference ? 0.0 : amp * normal(rng), reference ? 0.0 : amp * normal(rng),
                0.5 * amp * normal(rng), 0.5 * amp * normal(rng)};
+      // The reference's errors satisfy the calibration's datum (zero Legendre mean and slope,
+      // LineDatumResidual): a_0 = -a_2 / 3, a_1 = -3 a_3 / 5.
+      if (reference) {
+        double mean = 0, slope = 0;
+        LegendreMeanAndSlope(axis->data(), int(axis->size()), &mean, &slope);
+        (*axis)[0] -= mean;
+        (*axis)[1] -= slope;
+      }
     }
     cam.calibration.push_back(p);
   }

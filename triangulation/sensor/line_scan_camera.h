@@ -16,7 +16,8 @@
 //   "detector_ID"     per sub-camera ID: a_0..a_5, b_0..b_5 (mm), the calibration polynomials in
 //                     the sub-camera's normalised index (calib/camera/line_camera.h); start 0 (on
 //                     top of the file's calibration); which entries are fixed is the caller's
-//                     (degree, datum: SetFixedDetectorEntries)
+//                     (degree: SetFixedDetectorEntries); the datum is the caller's too
+//                     (LineDatumResidual below, on the reference sub-camera's block)
 //   "c"               principal distance (mm), fixed unless `free_c`
 //   "mount"           boresight M omega, phi, kappa (rad), camera -> body; fixed | free | weighted
 //   "lever_arm"       camera centre in the body frame (m); fixed | free | weighted
@@ -35,6 +36,7 @@
 #include <Eigen/Core>
 
 #include "calib/camera/line_camera.h"
+#include "calib/residuals/autodiff_residual.h"
 #include "calib/residuals/line_collinearity.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
 #include "triangulation/sensor/imaging_model.h"
@@ -45,6 +47,44 @@ inline constexpr const char* kGroupLineImage = "line_image";
 inline constexpr const char* kGroupPosPrior = "pos_prior";
 inline constexpr const char* kGroupLinePrior = "line_prior";  // boresight / lever-arm priors
 inline constexpr const char* kLineStripImage = "strip";       // the image id of a line strip
+inline constexpr const char* kGroupLineDatum = "line_datum";  // the reference sub-camera's datum
+
+/// The Legendre constant and linear components over u in [-1, 1] of the polynomial
+/// sum_k a[k] u^k (n terms): mean = sum over even k of a_k / (k + 1) (P0 = 1), slope = sum over
+/// odd k of 3 a_k / (k + 2) (P1 = u, (3/2) int u p(u) du). They do not change when a higher
+/// Legendre term is added or dropped: the datum of the reference sub-camera (module README
+/// "Datum") fixes them, so it does not depend on the polynomial degree.
+template <typename T>
+void LegendreMeanAndSlope(const T* a, int n, T* mean, T* slope) {
+  *mean = T(0.0);
+  *slope = T(0.0);
+  for (int k = 0; k < n; ++k)
+    if (k % 2 == 0)
+      *mean += a[k] / double(k + 1);
+    else
+      *slope += a[k] * (3.0 / double(k + 2));
+}
+
+/// The datum of the reference sub-camera: its correction's Legendre mean and slope are zero, per
+/// axis (r = [mean_x, slope_x, mean_y, slope_y] / sigma_mm, [4, unitless]; block: the detector
+/// polynomials a_0..a_5, b_0..b_5, mm). A pseudo-observation as tight as the datum must be
+/// (`sigma_mm` ~ 1e-4 px: its own variance is ~1e-3 of a table's); it replaces the four fixed
+/// entries of the earlier datum (a_0 = a_1 = b_0 = b_1 = 0), so the redundancy is the same.
+struct LineDatumResidual
+    : calib::AutoDiffResidual<LineDatumResidual, 4, 2 * calib::kLineMaxTerms> {
+  explicit LineDatumResidual(double sigma_mm) : inverse_sigma_(1.0 / sigma_mm) {}
+  template <typename T>
+  bool operator()(const T* coefficients, T* r) const {
+    for (int axis = 0; axis < 2; ++axis) {
+      LegendreMeanAndSlope(coefficients + axis * calib::kLineMaxTerms, calib::kLineMaxTerms,
+                           &r[2 * axis], &r[2 * axis + 1]);
+      r[2 * axis] *= inverse_sigma_;
+      r[2 * axis + 1] *= inverse_sigma_;
+    }
+    return true;
+  }
+  double inverse_sigma_;
+};
 
 /// Focal-plane position (mm) of `point` seen from the pose of `trajectory` at (fractional) `line`
 /// through `camera`'s mount and lever arm (no spline corrections); false when it lies on or behind

@@ -1,5 +1,6 @@
 #include "triangulation/simulation/rig_flight_simulator.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -437,17 +438,58 @@ stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f, const Textured
   std::mt19937_64 rng(options.seed * 7919 + 13 + 1009 * static_cast<std::uint64_t>(exposure) +
                       static_cast<std::uint64_t>(head));
   std::normal_distribution<double> noise(0.0, 1.0);
-  stitch::GrayImage image(h.camera.height_px, h.camera.width_px);
-  for (int r = 0; r < image.rows(); ++r)
-    for (int c = 0; c < image.cols(); ++c) {
-      const ImageRay ray = RayFromPixel(h.camera, opk, origin, Eigen::Vector2d(c, r));
-      Eigen::Vector3d g;
-      // 40 halvings of the terrain's height range: far below 1e-6 m.
-      if (!TerrainPointOfRay(f.options.flight, ray.center_m, ray.direction, &g, 40))
-        throw Error("image mode: a ray of head " + h.id + " in " + e.image +
-                    " does not point down");
-      image(r, c) = static_cast<float>(ground.At(g.x(), g.y()) + options.grey_noise_dn * noise(rng));
+  // The ground point of the ray through head pixel (c, r): 40 halvings of the terrain's height
+  // range, far below 1e-6 m.
+  const auto ground_of = [&](double c, double r) {
+    const ImageRay ray = RayFromPixel(h.camera, opk, origin, Eigen::Vector2d(c, r));
+    Eigen::Vector3d g;
+    if (!TerrainPointOfRay(f.options.flight, ray.center_m, ray.direction, &g, 40))
+      throw Error("image mode: a ray of head " + h.id + " in " + e.image + " does not point down");
+    return Eigen::Vector2d(g.x(), g.y());
+  };
+  const int cols = h.camera.width_px, rows = h.camera.height_px;
+  stitch::GrayImage image(rows, cols);
+  if (options.point_sampling) {
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) {
+        const Eigen::Vector2d g = ground_of(c, r);
+        image(r, c) = static_cast<float>(ground.At(g.x(), g.y()) + options.grey_noise_dn * noise(rng));
+      }
+    return image;
+  }
+  // Area integration: pixel (c, r) covers [c - 1/2, c + 1/2] x [r - 1/2, r + 1/2]; the ground
+  // points of its four corners are exact ray intersections, the points inside bilinear in them
+  // (the mapping is smooth over one pixel); n x n samples at the centres of n x n equal
+  // sub-squares, n = ceil(the footprint's longer diagonal / texel) within [2, kMaxSamples], so
+  // that the samples are at most a texel apart (for footprints up to 8 texels across; the default
+  // texel, half the nadir GSD, gives about 3 at nadir) and the bilinear texture is integrated
+  // over the footprint (a box filter: the sensor's pixel area).
+  constexpr int kMaxSamples = 8;
+  std::vector<Eigen::Vector2d> top(cols + 1), bottom(cols + 1);
+  for (int c = 0; c <= cols; ++c) top[c] = ground_of(c - 0.5, -0.5);
+  for (int r = 0; r < rows; ++r) {
+    for (int c = 0; c <= cols; ++c) bottom[c] = ground_of(c - 0.5, r + 0.5);
+    for (int c = 0; c < cols; ++c) {
+      const Eigen::Vector2d& g00 = top[c];
+      const Eigen::Vector2d& g10 = top[c + 1];
+      const Eigen::Vector2d& g01 = bottom[c];
+      const Eigen::Vector2d& g11 = bottom[c + 1];
+      const double diagonal_m = std::max((g11 - g00).norm(), (g10 - g01).norm());
+      const int n = std::clamp(static_cast<int>(std::ceil(diagonal_m / ground.gsd_m)), 2, kMaxSamples);
+      double sum = 0.0;
+      for (int j = 0; j < n; ++j) {
+        const double v = (j + 0.5) / n;
+        const Eigen::Vector2d left = (1.0 - v) * g00 + v * g01, right = (1.0 - v) * g10 + v * g11;
+        for (int i = 0; i < n; ++i) {
+          const double u = (i + 0.5) / n;
+          const Eigen::Vector2d g = (1.0 - u) * left + u * right;
+          sum += ground.At(g.x(), g.y());
+        }
+      }
+      image(r, c) = static_cast<float>(sum / (n * n) + options.grey_noise_dn * noise(rng));
     }
+    std::swap(top, bottom);
+  }
   return image;
 }
 

@@ -24,10 +24,15 @@
 // rendered through the TRUE head pose of that exposure (ground calibration + increments E_k +
 // offsets dT_k with the velocity; calib::HeadPose) and the head's true interior onto the terrain
 // textured with a real photograph (textured_ground.h), plus Gaussian grey-value noise. Each pixel
-// centre's ray is intersected with the terrain exactly (bisection to 1e-10 m); its grey value is
-// the texture's there (point sampling: the texture is finer than the head pixels, 2 texels per
-// nadir pixel by default). `format_scale` shrinks every format (pixel size grown by the same
-// factor, same field of view) so that tests render small images of the same geometry.
+// integrates the texture over its footprint, as a sensor integrates over its pixel area: the rays
+// through the pixel's four corners are intersected with the terrain exactly (bisection to
+// 1e-10 m), the points inside bilinear in them, n x n samples (n = the footprint's longer
+// diagonal in texels, rounded up, within 2..8) averaged with equal weights (a box filter). The
+// texture is finer than the head pixels (2 texels per nadir pixel by default), so one sample per
+// pixel (`point_sampling`, the former renderer) aliases it differently in heads of different GSD:
+// tests/stitch/rig_stitched_image_test.cc measures both. `format_scale` shrinks every format (pixel
+// size grown by the same factor, same field of view) so that tests render small images of the
+// same geometry.
 #pragma once
 
 #include <cmath>
@@ -140,6 +145,9 @@ struct RigImageOptions {
                                // virtual image's nadir GSD at the flying height, >= 0
   double grey_noise_dn = 1.0;  // Gaussian noise added to every rendered grey value (DN), >= 0
   std::uint64_t seed = 1;
+  bool point_sampling = false;  // true: one texture sample at each pixel centre (the renderer
+                                // before area integration; kept for the comparison in
+                                // tests/stitch/rig_stitched_image_test.cc)
   void Validate() const;       // ConfigError naming the option
 };
 
