@@ -318,6 +318,63 @@ class Snooper {
     out_.findings.push_back(text);
   }
 
+  // A blunder on one control ray looks like a model error in the first test: the largest w sit
+  // on that control point's rays (the blunder pulls the point, its other rays follow). Before
+  // they are held, the largest-w ray of a control point is removed alone (a group of one, the
+  // veto agreeing) and the block re-solved: when no ray of a control point is then above the
+  // critical value and sigma0 lies within 1 + kFitBand / sqrt(2 r), it was a blunder: rejected,
+  // the suspicion withdrawn, `t` the test without it. Otherwise (a model error leaves the other
+  // control rays above k and sigma0 above the band: the conventional flight's C5) it is restored
+  // and the rays are held. Returns whether the ray was rejected.
+  bool TryControlRayBlunder(Test* t, int round, const SolverOptions& solver,
+                            size_t evidence_before, size_t findings_before) {
+    const TestedObservation* worst = nullptr;
+    for (const auto& x : t->observations)
+      if (x.point >= 0 && report_only_points_.count(x.point) &&
+          !Contains(o_.report_only_groups, x.group) && x.w_max > out_.critical_value &&
+          (!worst || x.w_max > worst->w_max))
+        worst = &x;
+    if (!worst || worst->correlated.size() > 1) return false;
+    if (o_.veto && !o_.veto({worst->id}).empty()) return false;
+    TestedObservation ray = *worst;
+    const double reference_sigma = out_.reference_sigma;
+    b_.RemoveResidual(ray.id);
+    out_.report = b_.Solve(solver);
+    ++out_.solves;
+    bool fits = out_.report.usable && out_.report.redundancy > 0;
+    Test next;
+    if (fits) {
+      next = Run(round);
+      const double band = 1 + kFitBand / std::sqrt(2.0 * std::max(1, out_.report.redundancy));
+      fits = out_.cofactors_ok && out_.report.sigma0 <= band;
+      for (const auto& x : next.observations)
+        fits &= !(x.point >= 0 && report_only_points_.count(x.point) &&
+                  std::max(x.w_max, x.w_weak) > out_.critical_value);
+    }
+    if (!fits) {
+      b_.RestoreResidual(ray.id);
+      out_.report = b_.Solve(solver);
+      ++out_.solves;
+      out_.reference_sigma = reference_sigma;  // `t` stands: the solution is back
+      return false;
+    }
+    out_.model_error_suspected = false;
+    out_.model_error_evidence.resize(evidence_before);
+    out_.findings.resize(findings_before);
+    ray.verdict = SnoopingVerdict::kRejected;
+    ray.round = round;
+    ray.correlated = {ray.id};
+    ray.group_size = 1;
+    ray.reason = "the largest w sat on this control point's rays, as a model error would show; "
+                 "without this ray every control ray passes and sigma0 " +
+                 Fixed(out_.report.sigma0, 3) + " is within the band: a blunder";
+    out_.findings.push_back("rejected: " + ray.label + " (w = " + Fixed(ray.w_max, 1) + "): " +
+                            ray.reason);
+    out_.rejected.push_back(ray);
+    *t = std::move(next);
+    return true;
+  }
+
   void CollectReportOnlyPoints() {
     report_only_points_.clear();
     for (ResidualId id : AllResiduals())
@@ -641,7 +698,13 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
   for (int round = 1; out.report.usable && out.report.redundancy > 0; ++round) {
     out.rounds = round;
     Test test = snooper.Run(round);
-    if (round == 1) snooper.DetectModelError(test, true);
+    if (round == 1) {
+      const size_t evidence = out.model_error_evidence.size(), findings = out.findings.size();
+      snooper.DetectModelError(test, true);
+      if (out.model_error_evidence.size() > evidence &&
+          snooper.TryControlRayBlunder(&test, round, solver, evidence, findings))
+        ++removed_total;
+    }
     if (test.observations.empty()) break;
     const int budget = options.max_rejections - removed_total;
     const int removed = budget > 0 ? snooper.Act(test, round, budget) : 0;

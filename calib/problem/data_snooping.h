@@ -72,9 +72,15 @@
 //   left above the critical value (SnoopingOutcome::cap_reached).
 // - Model error: when the largest w of the first test sit on the report-only (control) points,
 //   their rays are held, not rejected (a model error shows most where the survey pins the
-//   block); when the final sigma0 is above model_error_sigma0, or the candidates left over
-//   (held, vetoed, weakly controlled, at the cap) cluster on one point or one image (each
-//   correlated group counted once), the outcome says "model error suspected" with the evidence.
+//   block), unless one ray explains them: a blunder on one control ray pulls its point and the
+//   point's other rays follow, which looks the same. So first the largest-w ray of a control
+//   point (a group of one, the veto agreeing) is removed alone and the block re-solved; when
+//   every control ray then passes and sigma0 lies within 1 + 3 / sqrt(2 r), that ray is rejected
+//   as a blunder and the suspicion withdrawn; otherwise it is restored and the rays are held (a
+//   model error leaves the other control rays above k and sigma0 above the band). When the
+//   final sigma0 is above model_error_sigma0, or the candidates left over (held, vetoed, weakly
+//   controlled, at the cap) cluster on one point or one image (each correlated group counted
+//   once), the outcome says "model error suspected" with the evidence.
 //
 // MDB: the marginal detectable blunder of component k (a blunder along that component), in
 // sigmas of the observation: nabla_k = delta s / sqrt(r_k), with delta the square root of the

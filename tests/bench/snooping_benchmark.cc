@@ -3,7 +3,8 @@
 //   BM_ConventionalSeeds      seeds 1-10, conventional: control rays rejected (must be 0), check
 //                             RMSE / the --no-snooping run's, runs saying "model error suspected"
 //   BM_FalseRejections        RUNS clean flights (seeds 1..RUNS), self-calibration all: runs with
-//                             a rejection (the family-wise level is 5 %)
+//                             a rejection (the family-wise level is 5 %), Clopper-Pearson 95 %
+//                             interval
 //   BM_SingleBlunder/<sigma>  RUNS runs (env AEROCAL_BENCH_RUNS, default 100) over seeds 1-10: one
 //                             blunder of <sigma> sigmas in a random direction on a random
 //                             observation with r >= 0.2 on both components; detected (it, or its
@@ -12,12 +13,21 @@
 //                             the linear response, s Pope's factor; see the function), blunders
 //                             in correlated groups and those reported as a group, good
 //                             observations named as THE gross error (group size 1, not the
-//                             blunder), rejections on other points
+//                             blunder), rejections on other points, the detection rate's
+//                             Clopper-Pearson 95 % interval
 //   BM_ManyBlunders/<percent> seeds 1..AEROCAL_BENCH_MANY_SEEDS (default 3): <percent> % of the
 //                             observations corrupted by 20-50 sigma: found, good ones lost (not
 //                             used at the end) by cause, check RMSE / the clean run's over all
 //                             check points and over the controlled ones (check_controlled),
-//                             camera offset from the clean run in sigmas (max over the 10)
+//                             camera offset from the clean run in sigmas (max over the 10);
+//                             beside them the oracles: the blunders removed by hand (no snooping),
+//                             also with the good rays the run lost removed (the camera offset
+//                             split into lost information, good rays lost, blunders kept), the
+//                             oracle's offset in its expected spread sqrt(q_oracle^2 - q_clean^2)
+//                             (z), the check RMSE over the check points none of whose rays held a
+//                             blunder, and (/1/1 only) oracles with only the blunders on check
+//                             (K), control (C) or tie (T) rays removed. AEROCAL_BENCH_DEBUG_SIGMA
+//                             set: every camera parameter of the clean run, oracle and run
 //   BM_OdmUavBlock            the real UAV block (../shared/data/odm_br_uav_gcp_block), default
 //                             options: the two known gross errors rejected, check RMSE, control
 //                             rays lost
@@ -100,6 +110,65 @@ bool Used(const AdjustmentResult& r, const std::string& image, const std::string
   return false;
 }
 
+// Check RMSE (sqrt of the mean squared 3D difference, as PointStatistics::spatial_rmse_m) over the
+// check points of r whose id is in `only`, or over all when `only` is null.
+double CheckRmse(const AdjustmentResult& r, const std::set<std::string>* only) {
+  double sum = 0.0;
+  int n = 0;
+  for (const auto& c : r.check_points)
+    if (!only || only->count(c.point)) {
+      sum += c.difference_m.squaredNorm();
+      ++n;
+    }
+  return n > 0 ? std::sqrt(sum / n) : 0.0;
+}
+
+// The block of `project` without the observations in `drop`, adjusted without snooping (an
+// oracle: the observations removed by hand).
+AdjustmentResult AdjustWithout(const Project& project,
+                               const std::set<std::pair<std::string, std::string>>& drop) {
+  Project without = project;
+  without.observations.clear();
+  for (const auto& o : project.observations)
+    if (!drop.count({o.image, o.point})) without.observations.push_back(o);
+  AdjustOptions options = SelfCalibration();
+  options.data_snooping = false;
+  options.auto_robust_start = false;
+  return Adjust(without, options);
+}
+
+// The sigma of oracle - clean for camera parameter k, in the clean run's sigmas: least squares
+// on nested observation sets, so the difference has the cofactor Q_oracle - Q_clean; the
+// cofactors are the sigmas over each run's sigma0 (the covariance is scaled by sigma0^2).
+double OracleSpread(const AdjustmentResult& clean, const AdjustmentResult& oracle, int k) {
+  const double qc = clean.cameras[0].sigma[k] / clean.sigma0;
+  const double qo = oracle.cameras[0].sigma[k] / oracle.sigma0;
+  return std::sqrt(std::max(1e-6, qo * qo / (qc * qc) - 1.0));
+}
+
+// Clopper-Pearson 95 % interval of a binomial proportion k / n (by bisection on the binomial
+// tails, exact enough for n <= a few hundred).
+double BinomialTail(int k, int n, double p, bool upper) {  // P(X >= k) or P(X <= k)
+  double sum = 0.0;
+  for (int i = upper ? k : 0; i <= (upper ? n : k); ++i)
+    sum += std::exp(std::lgamma(n + 1.0) - std::lgamma(i + 1.0) - std::lgamma(n - i + 1.0) +
+                    (i > 0 ? i * std::log(p) : 0.0) + (n - i > 0 ? (n - i) * std::log1p(-p) : 0.0));
+  return sum;
+}
+std::pair<double, double> ClopperPearson95(int k, int n) {
+  const auto solve = [&](bool lower) {
+    double a = 0.0, b = 1.0;
+    for (int i = 0; i < 60; ++i) {
+      const double m = 0.5 * (a + b);
+      // lower bound: P(X >= k | p) = 0.025; upper: P(X <= k | p) = 0.025
+      const double tail = lower ? BinomialTail(k, n, m, true) : BinomialTail(k, n, m, false);
+      if (lower == (tail < 0.025)) a = m; else b = m;
+    }
+    return 0.5 * (a + b);
+  };
+  return {k == 0 ? 0.0 : solve(true), k == n ? 1.0 : solve(false)};
+}
+
 std::string RejectedBy(const AdjustmentResult& r, const std::string& image, const std::string& point) {
   for (const auto& o : r.rejected)
     if (o.image == image && o.point == point) return o.by;
@@ -151,6 +220,12 @@ void BM_FalseRejections(benchmark::State& state) {
     state.counters["runs_with_rejection"] = runs_with_rejection;
     state.counters["false_rejection_rate"] = static_cast<double>(runs_with_rejection) / runs;
     state.counters["rejected"] = rejected;
+    const auto ci = ClopperPearson95(runs_with_rejection, runs);
+    state.counters["false_rejection_ci95_high"] = ci.second;
+    std::printf("clean flights: %d of %d runs with a rejection (%.3f, 95 %% interval %.3f-%.3f) "
+                "against the family-wise alpha 0.05; %d observations rejected\n",
+                runs_with_rejection, runs, static_cast<double>(runs_with_rejection) / runs,
+                ci.first, ci.second, rejected);
   }
 }
 BENCHMARK(BM_FalseRejections)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
@@ -243,6 +318,14 @@ void BM_SingleBlunder(benchmark::State& state) {
     }
     state.counters["runs"] = runs;
     state.counters["detection_rate"] = static_cast<double>(detected) / runs;
+    const auto ci = ClopperPearson95(detected, runs);
+    state.counters["detection_ci95_low"] = ci.first;
+    state.counters["detection_ci95_high"] = ci.second;
+    std::printf("%.0f sigma: found %d of %d (%.3f, 95 %% interval %.3f-%.3f), predicted power "
+                "%.3f (%s the interval)\n",
+                g, detected, runs, static_cast<double>(detected) / runs, ci.first, ci.second,
+                predicted / runs,
+                predicted / runs >= ci.first && predicted / runs <= ci.second ? "inside" : "OUTSIDE");
     state.counters["predicted_power"] = predicted / runs;
     state.counters["predicted_power_diagonal"] = predicted_diagonal / runs;
     state.counters["blunders_in_groups"] = in_group;
@@ -264,6 +347,12 @@ void BM_ManyBlunders(benchmark::State& state) {
     int invalid_runs = 0;
     double worst_oracle_ratio = 1.0, worst_ratio_to_oracle = 1.0, worst_oracle_camera_sigmas = 0.0;
     std::map<std::string, int> invalid_by_reason;  // by the reason's words before its numbers
+    double worst_oracle_lost_camera_sigmas = 0.0, worst_kept_camera_sigmas = 0.0;
+    double worst_oracle_z = 0.0, worst_run_vs_oracle = 0.0;
+    double worst_ratio_untouched = 0.0, worst_oracle_untouched = 0.0, sum_ratio = 0.0;
+    double sum_oracle_ratio = 0.0, sum_kind_ratio[3] = {0, 0, 0}, worst_kind_ratio[3] = {1, 1, 1};
+    int runs_within_2_clean = 0, runs_within_2_oracle = 0, runs_within_2_untouched = 0;
+    int seeds_run = 0, planted_by_kind[3] = {0, 0, 0};
     for (int seed = ManyBlundersFirstSeed(); seed <= ManyBlundersSeeds(); ++seed) {
       const Seed& s = SeedData(seed);
       std::mt19937_64 rng(seed);
@@ -360,14 +449,7 @@ void BM_ManyBlunders(benchmark::State& state) {
       // The oracle: the blundered observations removed by hand, no snooping (what no method can
       // beat: their information is gone). Its check RMSE over the clean run's says how much of
       // the ratio above is the lost information, not a fault of the detection.
-      Project without = s.project;
-      without.observations.clear();
-      for (const auto& o : p.observations)
-        if (!blunders.count({o.image, o.point})) without.observations.push_back(o);
-      AdjustOptions oracle_options = SelfCalibration();
-      oracle_options.data_snooping = false;
-      oracle_options.auto_robust_start = false;
-      const AdjustmentResult oracle = Adjust(without, oracle_options);
+      const AdjustmentResult oracle = AdjustWithout(p, blunders);
       worst_oracle_ratio = std::max(worst_oracle_ratio, oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m);
       worst_ratio_to_oracle = std::max(worst_ratio_to_oracle, ratio * s.clean.check.spatial_rmse_m / oracle.check.spatial_rmse_m);
       std::printf("seed %d: check RMSE of the oracle (blunders removed by hand) %.3f m\n", seed,
@@ -391,6 +473,125 @@ void BM_ManyBlunders(benchmark::State& state) {
                   s.clean.cameras[0].sigma[k]);
         }
       worst_camera_sigmas = std::max(worst_camera_sigmas, camera_sigmas);
+      // Why the camera moved: the oracle with the good rays this run lost removed too. The run
+      // against it is the effect of the blunders the run kept (its final set is that one plus
+      // them); it against the oracle the effect of the good rays lost; the oracle against the
+      // clean run the information of the blundered observations, which no method gets back.
+      std::set<std::pair<std::string, std::string>> used_final, drop_lost = blunders;
+      for (const auto& o : r.residuals)
+        if (o.used) used_final.insert({o.image, o.point});
+      int kept = 0;
+      for (const auto& o : p.observations) {
+        const std::pair<std::string, std::string> key{o.image, o.point};
+        if (!blunders.count(key) && !used_final.count(key)) drop_lost.insert(key);
+        kept += blunders.count(key) && used_final.count(key);
+      }
+      const AdjustmentResult oracle_lost = AdjustWithout(p, drop_lost);
+      double lost_sigmas = 0.0, kept_sigmas = 0.0;
+      for (int k = 0; k < Model::kNumParams; ++k)
+        if (s.clean.cameras[0].sigma[k] > 0) {
+          const double sigma = s.clean.cameras[0].sigma[k];
+          lost_sigmas = std::max(lost_sigmas, std::abs(oracle_lost.cameras[0].estimated[k] -
+                                                       s.clean.cameras[0].estimated[k]) / sigma);
+          kept_sigmas = std::max(kept_sigmas, std::abs(r.cameras[0].estimated[k] -
+                                                       oracle_lost.cameras[0].estimated[k]) / sigma);
+        }
+      // The oracle's own spread: nested least squares, so oracle - clean has the covariance
+      // Q_oracle - Q_clean; per parameter its sigma is sqrt(sigma_oracle^2 - sigma_clean^2).
+      // z = (oracle - clean) / that: what the lost information alone predicts (|z| <= 3 but for
+      // chance). And this run against the oracle: the method's own share.
+      double oracle_z = 0.0, run_vs_oracle = 0.0, worst_spread = 0.0;
+      for (int k = 0; k < Model::kNumParams; ++k)
+        if (s.clean.cameras[0].sigma[k] > 0) {
+          const double sc = s.clean.cameras[0].sigma[k], so = oracle.cameras[0].sigma[k];
+          const double spread = sc * OracleSpread(s.clean, oracle, k);
+          oracle_z = std::max(oracle_z, std::abs(oracle.cameras[0].estimated[k] -
+                                                 s.clean.cameras[0].estimated[k]) / spread);
+          worst_spread = std::max(worst_spread, spread / sc);
+          if (std::getenv("AEROCAL_BENCH_DEBUG_SIGMA"))
+            std::printf("  %s: clean %.6g +- %.4g, oracle %.6g +- %.4g, run %.6g +- %.4g\n",
+                        std::string(Model::kParams[k].name).c_str(),
+                        s.clean.cameras[0].estimated[k], sc, oracle.cameras[0].estimated[k], so,
+                        r.cameras[0].estimated[k], r.cameras[0].sigma[k]);
+          run_vs_oracle = std::max(run_vs_oracle, std::abs(r.cameras[0].estimated[k] -
+                                                           oracle.cameras[0].estimated[k]) / sc);
+        }
+      worst_oracle_z = std::max(worst_oracle_z, oracle_z);
+      worst_run_vs_oracle = std::max(worst_run_vs_oracle, run_vs_oracle);
+      {
+        const int k = camera_worst;
+        const double sc = s.clean.cameras[0].sigma[k], so = oracle.cameras[0].sigma[k];
+        const double spread = OracleSpread(s.clean, oracle, k);
+        std::printf("seed %d: camera %s: sigma clean %.4g, oracle %.4g, this run %.4g; the oracle's "
+                    "expected spread about the clean camera sqrt(so^2 - sc^2) = %.2f clean sigmas, "
+                    "its offset %.2f of them; over all parameters: oracle |z| max %.2f, spread max "
+                    "%.2f clean sigmas, this run against the oracle max %.2f clean sigmas\n",
+                    seed, std::string(Model::kParams[k].name).c_str(), sc, so,
+                    r.cameras[0].sigma[k], spread,
+                    (oracle.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
+                        (sc * spread),
+                    oracle_z, worst_spread, run_vs_oracle);
+      }
+      worst_oracle_lost_camera_sigmas = std::max(worst_oracle_lost_camera_sigmas, lost_sigmas);
+      worst_kept_camera_sigmas = std::max(worst_kept_camera_sigmas, kept_sigmas);
+      {
+        const int k = camera_worst;
+        const double sigma = s.clean.cameras[0].sigma[k], clean_k = s.clean.cameras[0].estimated[k];
+        std::printf("seed %d: camera %s from the clean run, signed, in sigmas: this run %+.2f, the "
+                    "oracle %+.2f, the oracle without the %zu good rays lost too %+.2f; this run "
+                    "against the latter (the %d blunders kept) %+.2f; over all parameters: "
+                    "oracle+lost %.2f, kept blunders %.2f\n",
+                    seed, std::string(Model::kParams[k].name).c_str(),
+                    (r.cameras[0].estimated[k] - clean_k) / sigma,
+                    (oracle.cameras[0].estimated[k] - clean_k) / sigma,
+                    drop_lost.size() - blunders.size(),
+                    (oracle_lost.cameras[0].estimated[k] - clean_k) / sigma, kept,
+                    (r.cameras[0].estimated[k] - oracle_lost.cameras[0].estimated[k]) / sigma,
+                    lost_sigmas, kept_sigmas);
+      }
+      // Issue 9's check RMSE within 2 % of the clean run: by where the blunders fell. The check
+      // points none of whose rays held a blunder keep their intersection whole; a check point
+      // that lost a ray is intersected from fewer rays in every method (the oracle too).
+      std::set<std::string> touched, untouched;
+      for (const auto& key : blunders)
+        if (!key.second.empty() && key.second[0] == 'K') touched.insert(key.second);
+      for (const auto& c : s.clean.check_points)
+        if (!touched.count(c.point)) untouched.insert(c.point);
+      const double clean_untouched = CheckRmse(s.clean, &untouched);
+      const double ratio_untouched = CheckRmse(r, &untouched) / clean_untouched;
+      const double oracle_untouched = CheckRmse(oracle, &untouched) / clean_untouched;
+      worst_ratio_untouched = std::max(worst_ratio_untouched, ratio_untouched);
+      worst_oracle_untouched = std::max(worst_oracle_untouched, oracle_untouched);
+      const double to_oracle = r.check.spatial_rmse_m / oracle.check.spatial_rmse_m;
+      runs_within_2_clean += ratio <= 1.02;
+      runs_within_2_oracle += to_oracle <= 1.02;
+      runs_within_2_untouched += ratio_untouched <= 1.02;
+      sum_ratio += ratio;
+      sum_oracle_ratio += oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m;
+      ++seeds_run;
+      std::printf("seed %d: check RMSE / clean run %.3f (the acceptance's figure), / the oracle %.3f, "
+                  "oracle / clean %.3f; over the %zu check points whose rays held no blunder (%zu "
+                  "touched): this run / clean %.3f, oracle / clean %.3f\n",
+                  seed, ratio, to_oracle, oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m,
+                  untouched.size(), touched.size(), ratio_untouched, oracle_untouched);
+      if (controlled_only) {  // partial oracles: only the blunders of one kind removed
+        const char kinds[3] = {'K', 'C', 'T'};
+        std::printf("seed %d: oracle / clean with only the blunders on", seed);
+        for (int k = 0; k < 3; ++k) {
+          std::set<std::pair<std::string, std::string>> of_kind;
+          for (const auto& key : blunders)
+            if (!key.second.empty() && key.second[0] == kinds[k]) of_kind.insert(key);
+          planted_by_kind[k] += static_cast<int>(of_kind.size());
+          const double kind_ratio =
+              of_kind.empty() ? 1.0
+                              : AdjustWithout(s.project, of_kind).check.spatial_rmse_m /
+                                    s.clean.check.spatial_rmse_m;
+          sum_kind_ratio[k] += kind_ratio;
+          worst_kind_ratio[k] = std::max(worst_kind_ratio[k], kind_ratio);
+          std::printf(" %c rays (%zu) removed %.3f;", kinds[k], of_kind.size(), kind_ratio);
+        }
+        std::printf("\n");
+      }
       worst_oracle_camera_sigmas = std::max(worst_oracle_camera_sigmas, oracle_camera_sigmas);
       std::printf("seed %d: camera %.2f sigma from the clean run (%s); the oracle's %.2f\n", seed,
                   camera_sigmas, std::string(Model::kParams[camera_worst].name).c_str(),
@@ -413,6 +614,38 @@ void BM_ManyBlunders(benchmark::State& state) {
       invalid_runs += !r.valid;
     }
     state.counters["invalid_runs"] = invalid_runs;
+    state.counters["worst_oracle_lost_camera_offset_sigmas"] = worst_oracle_lost_camera_sigmas;
+    state.counters["worst_kept_blunders_camera_sigmas"] = worst_kept_camera_sigmas;
+    state.counters["worst_oracle_camera_z"] = worst_oracle_z;
+    state.counters["worst_camera_against_oracle_sigmas"] = worst_run_vs_oracle;
+    state.counters["worst_rmse_ratio_untouched"] = worst_ratio_untouched;
+    state.counters["worst_oracle_rmse_ratio_untouched"] = worst_oracle_untouched;
+    state.counters["runs_within_2pct_of_clean"] = runs_within_2_clean;
+    state.counters["runs_within_2pct_of_oracle"] = runs_within_2_oracle;
+    state.counters["runs_within_2pct_of_clean_untouched"] = runs_within_2_untouched;
+    std::printf("over %d seeds: check RMSE / clean run mean %.3f, worst %.3f, within 2 %% in %d; "
+                "/ the oracle worst %.3f, within 2 %% in %d; oracle / clean mean %.3f, worst %.3f; "
+                "over the check points whose rays held no blunder: this run / clean worst %.3f, "
+                "within 2 %% in %d, oracle / clean worst %.3f\n",
+                seeds_run, sum_ratio / std::max(1, seeds_run), worst_rmse_ratio, runs_within_2_clean,
+                worst_ratio_to_oracle, runs_within_2_oracle,
+                sum_oracle_ratio / std::max(1, seeds_run), worst_oracle_ratio,
+                worst_ratio_untouched, runs_within_2_untouched, worst_oracle_untouched);
+    if (controlled_only)
+      for (int k = 0; k < 3; ++k) {
+        const char kinds[3] = {'K', 'C', 'T'};
+        std::printf("blunders on %c rays: %d planted; oracle / clean with only them removed: mean "
+                    "%.3f, worst %.3f\n",
+                    kinds[k], planted_by_kind[k], sum_kind_ratio[k] / std::max(1, seeds_run),
+                    worst_kind_ratio[k]);
+        state.counters[std::string("oracle_ratio_only_") + kinds[k]] = worst_kind_ratio[k];
+      }
+    std::printf("camera: this run worst %.2f sigma from the clean run; the oracle %.2f; the oracle "
+                "without the good rays lost too %.2f; this run against the latter (kept blunders) "
+                "%.2f; this run against the oracle %.2f; the oracle's offset in its expected spread (z) "
+                "%.2f\n",
+                worst_camera_sigmas, worst_oracle_camera_sigmas, worst_oracle_lost_camera_sigmas,
+                worst_kept_camera_sigmas, worst_run_vs_oracle, worst_oracle_z);
     state.counters["worst_oracle_rmse_ratio"] = worst_oracle_ratio;        // oracle / clean
     state.counters["worst_rmse_ratio_to_oracle"] = worst_ratio_to_oracle;  // this run / oracle
     state.counters["worst_oracle_camera_offset_sigmas"] = worst_oracle_camera_sigmas;

@@ -1,7 +1,9 @@
 // Data snooping in the block adjustment (data_snooping.h through BlockAdjustment) on the
 // simulated flight of seed 3: a conventional run keeps every control ray and says "model error
 // suspected"; a planted 20-sigma blunder on a pinned-down observation is found; a blunder in a
-// two-ray pair is reported and acted on as a group; every observation carries r, w, MDB and its
+// two-ray pair is reported and acted on as a group; a 20-sigma blunder on a control ray, which
+// looks like a model error in the first test, is rejected and the check RMSE is the oracle's (the
+// ray removed by hand); every observation carries r, w, MDB and its
 // group size; with 5 % of the observations at 50 sigma the default run (robust start, snooping)
 // recovers the clean camera, loses no good ray a method could keep and lists every blunder it
 // keeps as one no test can judge.
@@ -31,6 +33,20 @@ AdjustOptions SelfCalibration() {
 }
 
 bool IsControl(const std::string& point) { return !point.empty() && point[0] == 'C'; }
+
+// The oracle: `p` without the observations in `drop` (removed by hand), adjusted without
+// snooping or robust start.
+AdjustmentResult Oracle(const Project& p, const std::set<std::pair<std::string, std::string>>& drop) {
+  Project without = p;
+  without.observations.clear();
+  for (const auto& o : p.observations)
+    if (!drop.count({o.image, o.point})) without.observations.push_back(o);
+  AdjustOptions by_hand = SelfCalibration();
+  by_hand.data_snooping = false;
+  by_hand.auto_robust_start = false;
+  by_hand.estimate_covariance = false;
+  return Adjust(without, by_hand);
+}
 
 class SnoopingOnTheSimulatedFlight : public ::testing::Test {
  protected:
@@ -211,6 +227,40 @@ TEST_F(SnoopingOnTheSimulatedFlight, BlunderInATwoRayPairIsReportedAsTheGroup) {
   EXPECT_TRUE(said);
 }
 
+TEST_F(SnoopingOnTheSimulatedFlight, BlunderOnAControlRayGoesAndTheCheckRmseIsTheOracles) {
+  // Issue 9's "check RMSE within 2 % of the clean solution": a blunder on a control ray takes that
+  // ray's information with it (5 control points, one ray fewer weakens the datum), so the target
+  // is the oracle, the ray removed by hand; the clean run's figure is printed beside it.
+  const ObservationResidual* v = nullptr;
+  std::map<std::string, int> rays;
+  for (const auto& o : clean_->residuals) rays[o.point] += o.used;
+  for (const auto& o : clean_->residuals)
+    if (!v && o.used && o.test.tested && o.test.group_size == 1 && IsControl(o.point) &&
+        rays[o.point] >= 3 && o.test.redundancy.minCoeff() >= 0.2)
+      v = &o;
+  ASSERT_NE(v, nullptr);
+  const double g = 20 * v->sigma_px / std::sqrt(2.0);  // 20 sigma, diagonal
+  const AdjustmentResult r = Adjust(Planted(*v, g, g), SelfCalibration());
+  bool found = false;
+  for (const auto& o : r.rejected) found |= o.image == v->image && o.point == v->point;
+  EXPECT_TRUE(found) << v->image << " " << v->point;
+  // It looked like a model error (the largest w on one control point's rays); without the ray
+  // every control ray passes, so the suspicion is withdrawn and no other ray is rejected.
+  EXPECT_FALSE(r.snooping.model_error_suspected);
+  EXPECT_EQ(r.rejected.size(), 1u);
+  for (const auto& f : r.snooping.findings) std::printf("finding: %s\n", f.c_str());
+  EXPECT_TRUE(r.valid);
+  const AdjustmentResult oracle = Oracle(*project_, {{v->image, v->point}});
+  // 2 %: the issue's figure, now against the oracle (bench: within 1.8 % in 40 of 40 seeds).
+  constexpr double kCheckRmseTolerance = 0.02;
+  EXPECT_NEAR(r.check.spatial_rmse_m / oracle.check.spatial_rmse_m, 1.0, kCheckRmseTolerance);
+  std::printf("control ray %s/%s (r %.2f, %.2f): check RMSE %.4f m, the oracle %.4f m, the clean "
+              "run %.4f m (/ clean %.3f)\n",
+              v->image.c_str(), v->point.c_str(), v->test.redundancy.x(), v->test.redundancy.y(),
+              r.check.spatial_rmse_m, oracle.check.spatial_rmse_m, clean_->check.spatial_rmse_m,
+              r.check.spatial_rmse_m / clean_->check.spatial_rmse_m);
+}
+
 TEST_F(SnoopingOnTheSimulatedFlight, FivePercentOfFiftySigmaBlundersRecoverTheCleanCamera) {
   // Issue 18: 5 % of the observations moved by 50 sigma in a random direction (seeded).
   Project p = *project_;
@@ -229,12 +279,28 @@ TEST_F(SnoopingOnTheSimulatedFlight, FivePercentOfFiftySigmaBlundersRecoverTheCl
   EXPECT_GE(r.snooping.max_rejections, 100);
   EXPECT_FALSE(r.snooping.cap_reached);
   EXPECT_TRUE(r.valid) << (r.invalid_reasons.empty() ? "" : r.invalid_reasons.front());
+  // The oracle: the blundered observations removed by hand, no snooping. Its camera differs from
+  // the clean one by the information of the blundered observations, which no method gets back
+  // (over seeds 1-30 of tests/bench/snooping_benchmark.cc it is itself up to 1.55 clean sigmas
+  // off); the method's own share is this run against the oracle.
+  const AdjustmentResult oracle = Oracle(p, blunders);
+  // The method's share (blunders kept on r ~ 0 components, good rays lost): over seeds 1-30 of
+  // the benchmark's 5 % case this run was at most 0.44 clean sigmas from the oracle in any
+  // parameter (0.23 here); 0.5 is that with a margin, half of the issue's 1 sigma.
+  constexpr double kMethodShareSigmas = 0.5;
   // The clean camera within 1 of its sigmas, every free parameter.
   for (int k = 0; k < calib::BrownFraser10Model::kNumParams; ++k) {
     const double sigma = clean_->cameras[0].sigma[k];
     if (!(sigma > 0)) continue;
     EXPECT_LE(std::abs(r.cameras[0].estimated[k] - clean_->cameras[0].estimated[k]), sigma)
         << calib::BrownFraser10Model::kParams[k].name;
+    EXPECT_LE(std::abs(r.cameras[0].estimated[k] - oracle.cameras[0].estimated[k]),
+              kMethodShareSigmas * sigma)
+        << calib::BrownFraser10Model::kParams[k].name;
+    std::printf("%s: this run %+.2f, the oracle %+.2f clean sigmas from the clean camera\n",
+                std::string(calib::BrownFraser10Model::kParams[k].name).c_str(),
+                (r.cameras[0].estimated[k] - clean_->cameras[0].estimated[k]) / sigma,
+                (oracle.cameras[0].estimated[k] - clean_->cameras[0].estimated[k]) / sigma);
   }
   // Good rays lost: only on points left with fewer than two good rays (no method can use them)
   // or rejected in a group with a blunder the test could not separate from them. The robust
@@ -262,9 +328,11 @@ TEST_F(SnoopingOnTheSimulatedFlight, FivePercentOfFiftySigmaBlundersRecoverTheCl
   // Every blunder still used is listed as one no test can judge (r below min_redundancy).
   std::set<std::pair<std::string, std::string>> uncontrolled;
   for (const auto& u : r.snooping.uncontrolled) uncontrolled.insert({u.image, u.point});
-  for (const auto& v : r.residuals)
-    if (v.used && blunders.count({v.image, v.point}))
+  for (const auto& v : r.residuals) {
+    if (v.used && blunders.count({v.image, v.point})) {
       EXPECT_TRUE(uncontrolled.count({v.image, v.point})) << v.image << " " << v.point;
+    }
+  }
 }
 
 }  // namespace
