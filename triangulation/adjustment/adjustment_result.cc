@@ -270,6 +270,19 @@ std::string ValidityLines(const AdjustmentResult& r) {
 
 }  // namespace
 
+std::optional<double> LeftOutControl::LargestW() const {
+  std::optional<double> w;
+  for (const auto& component : components)
+    if (!w || component.second > *w) w = component.second;
+  return w;
+}
+
+std::string LeftOutControl::ComponentNames() const {
+  std::string names;
+  for (const auto& component : components) names += (names.empty() ? "" : " and ") + component.first;
+  return names;
+}
+
 void AdjustmentResult::Invalidate(const std::string& reason) {
   valid = false;
   if (std::find(invalid_reasons.begin(), invalid_reasons.end(), reason) == invalid_reasons.end())
@@ -439,14 +452,12 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["control"] = control;
   j["check"] = check;
   j["control_left_out"] = nlohmann::json::array();
-  for (const auto& p : r.control_left_out) {
-    const auto parts = r.control_left_out_w.find(p.point);
-    nlohmann::json w, components = nlohmann::json::object();
-    if (parts != r.control_left_out_w.end())
-      for (const auto& [component, w_component] : parts->second) {
-        components[component] = w_component;
-        if (w.is_null() || w_component > w.get<double>()) w = w_component;
-      }
+  for (const auto& left : r.control_left_out) {
+    const PointDifference& p = left.difference;
+    nlohmann::json components = nlohmann::json::object();
+    for (const auto& [component, w_component] : left.components) components[component] = w_component;
+    const std::optional<double> largest = left.LargestW();
+    const nlohmann::json w = largest ? nlohmann::json(*largest) : nlohmann::json();
     j["control_left_out"].push_back({{"point", p.point},
                                      {"surveyed_m", Vec(p.surveyed_m)},
                                      {"adjusted_m", Vec(p.adjusted_m)},
@@ -559,15 +570,12 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += "frame: " + r.frame + "\n";
   out += "datum: " + r.datum + "\n";
   out += StatisticsLine("control", r.control);
-  for (const auto& p : r.control_left_out) {
-    std::string parts;
-    const auto left = r.control_left_out_w.find(p.point);
-    if (left != r.control_left_out_w.end())
-      for (const auto& part : left->second) parts += (parts.empty() ? "" : " and ") + part.first;
+  for (const auto& left : r.control_left_out) {
+    const PointDifference& p = left.difference;
     out += StringPrintf("control %s LEFT OUT (%s survey; suspected control blunder): survey - block "
                         "without it X %.3f  Y %.3f  Z %.3f m, %d rays kept\n",
                         p.point.c_str(),
-                        parts.c_str(),
+                        left.ComponentNames().c_str(),
                         -p.difference_m.x(),
                         -p.difference_m.y(),
                         -p.difference_m.z(),

@@ -35,6 +35,18 @@ struct PointDifference {
   std::string uncontrolled;
 };
 
+/// A control point whose survey data snooping left out, in whole or in part
+/// (AdjustmentResult::control_left_out).
+struct LeftOutControl {
+  PointDifference difference;  // the survey against the position the block gives the point
+  /// The components left out ("plan", "height") with the w of their failed test.
+  std::vector<std::pair<std::string, double>> components;
+  /// The largest w of the components (nullopt: none recorded).
+  std::optional<double> LargestW() const;
+  /// The components' names joined by " and " ("plan", "plan and height").
+  std::string ComponentNames() const;
+};
+
 struct PointStatistics {
   int n = 0;
   Eigen::Vector3d rmse_m = Eigen::Vector3d::Zero();  // per axis X, Y, Z
@@ -250,9 +262,7 @@ struct AdjustmentResult {
   /// plan (X, Y) and the height (Z) of a survey are tested and left out separately. JSON
   /// `control_left_out: [{point, surveyed_m, adjusted_m, difference_m, rays, w, components}]`
   /// (`components`: {"plan": w, "height": w} of the parts left out; `w` the largest).
-  std::vector<PointDifference> control_left_out;
-  /// By point: the components left out ("plan", "height") with the w of their failed test.
-  std::map<std::string, std::vector<std::pair<std::string, double>>> control_left_out_w;
+  std::vector<LeftOutControl> control_left_out;
   /// After snooping: the check statistics over the check points whose rays are all controlled
   /// (PointDifference::uncontrolled empty). `check` stays the statistics of every check point.
   std::optional<PointStatistics> check_controlled;

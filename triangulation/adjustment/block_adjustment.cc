@@ -1111,8 +1111,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     d.rays = state.rays;
     const auto left_out = storage_->survey_left_out.find(p);
     if (left_out != storage_->survey_left_out.end()) {
-      result.control_left_out.push_back(d);
-      result.control_left_out_w[id] = left_out->second;
+      result.control_left_out.push_back({d, left_out->second});
       continue;
     }
     (state.ground->role == PointRole::kControl ? result.control_points : result.check_points)
@@ -1164,13 +1163,10 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
                       " parameter(s) not determinable (" +
                       result.determinability.undetermined.front() + ", ...)");
   result.warnings = GroupRmsWarnings(result.solve);
-  for (const auto& d : result.control_left_out) {
-    double w = 0.0;
-    std::string parts;
-    for (const auto& [component, w_component] : result.control_left_out_w.at(d.point)) {
-      w = std::max(w, w_component);
-      parts += (parts.empty() ? "" : " and ") + component;
-    }
+  for (const auto& left : result.control_left_out) {
+    const PointDifference& d = left.difference;
+    const double w = std::max(0.0, left.LargestW().value_or(0.0));
+    const std::string parts = left.ComponentNames();
     result.warnings.push_back(
         {kWarningControlBlunder,
          d.point,
