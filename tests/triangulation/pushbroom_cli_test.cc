@@ -70,6 +70,16 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
     EXPECT_LE(s["degree_x"].get<int>(), 4);
   }
   EXPECT_EQ(doc["detectors"].size(), 180u);
+  // The degree test ran from the start degree; a table's sigma is never below its fit's (a
+  // reduced table: at least the start-degree fit's, line_degree_test.h).
+  EXPECT_TRUE(doc["degree_test"]["applied"].get<bool>());
+  EXPECT_EQ(doc["degree_test"]["start_degree"], 4);
+  EXPECT_DOUBLE_EQ(doc["degree_test"]["alpha"].get<double>(), 0.05);
+  EXPECT_EQ(doc["degree_test"]["table_sigma"], doc["degree_test"]["reduced"].get<bool>() ? "selected" : "fit");
+  for (const json& d : doc["detectors"])
+    for (const char* axis : {"dx", "dy"})
+      EXPECT_GE(d[std::string("sigma_") + axis + "_mm"].get<double>(),
+                d[std::string("sigma_") + axis + "_fit_mm"].get<double>());
   const calib::LineCamera cam = calib::ReadLineCamera(dir.File("calibrated.yaml"));
   EXPECT_EQ(cam.calibration.size(), 3u);
   EXPECT_TRUE(std::filesystem::exists(dir.File("lines.csv")));

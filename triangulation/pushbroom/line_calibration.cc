@@ -16,6 +16,7 @@
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/residuals/prior.h"
+#include "triangulation/pushbroom/line_degree_test.h"
 #include "triangulation/sensor/frame_camera.h"
 
 namespace aerocal::triangulation {
@@ -31,6 +32,11 @@ constexpr double kMaxSigmaPx = 1e4;
 // Sigma of the datum pseudo-observations (LineDatumResidual), px: tight against a table sigma of
 // ~1e-3 .. 1e-2 px, loose enough for the normal matrix (its weight ~ that of an angle).
 constexpr double kDatumSigmaPx = 1e-4;
+
+// u in [-1, 1] of detector i in its sub-camera's range (module README "The model").
+double NormalisedIndex(const std::pair<int, int>& range, int i) {
+  return calib::LinePolynomial{range.first, range.second, {}, {}}.Normalised(i);
+}
 
 struct Problem {
   calib::ProblemBuilder builder;
@@ -290,54 +296,50 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   calib::CovarianceReport cov;
   if (result.report.usable) cov = b.EstimateCovariance(cov_blocks, result.report.sigma0);
 
-  // Degree test (Wald, from the top): the smallest degree whose higher free coefficients are
-  // jointly insignificant. Not applicable when sigma0 is ~0 (noise-free data): the start degree.
+  // The per-detector table (values and variances, axis-major) at the current solution.
+  auto detector_table = [&](const calib::CovarianceReport& c) {
+    std::vector<TableValue> table(2 * size_t(camera.detectors));
+    for (int s = 0; s < n_sub; ++s) {
+      const Eigen::MatrixXd q =
+          c.ok ? c.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms) : Eigen::MatrixXd();
+      for (int i = ranges[s].first; i <= ranges[s].second; ++i)
+        for (int axis = 0; axis < 2; ++axis)
+          table[axis * size_t(camera.detectors) + i] =
+              EvaluateDetectorPolynomial(sensor.Detectors()[s].data(), q, axis, NormalisedIndex(ranges[s], i));
+    }
+    return table;
+  };
+
+  // Degree test (line_degree_test.h), per sub-camera and axis. Not applicable when sigma0 is ~0
+  // (noise-free data): the start degree. The start-degree table is kept for the sigmas of the
+  // selected one (SelectedTableSigma).
+  std::vector<TableValue> start_table;
+  result.degree_test.start_degree = start_degree;
+  result.degree_test.alpha = options.degree_test_alpha;
   if (!options.degree && cov.ok && result.report.sigma0 > 1e-9) {
+    result.degree_test.applied = true;
     bool changed = false;
     for (int s = 0; s < n_sub; ++s)
       for (int axis = 0; axis < 2; ++axis) {
+        int& degree = axis == 0 ? result.subcameras[s].degree_x : result.subcameras[s].degree_y;
         // The datum sub-camera keeps the start degree: a term dropped there (insignificant, yet
         // real) is a bias the sigmas do not show, and the datum pins its correction where the
         // Legendre terms kept vanish (degree 2: u = +-1/sqrt(3), sigma ~0 there).
         if (options.reference_datum && s == reference) {
-          (axis == 0 ? result.subcameras[s].degree_x : result.subcameras[s].degree_y) = start_degree;
+          degree = start_degree;
           continue;
         }
-        const int base = axis * kLineMaxTerms;
-        const Eigen::MatrixXd q = cov.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms);
-        // Top-down: drop the highest free coefficient while it is insignificant (Wald, one
-        // degree of freedom) in the model without the terms already dropped. The estimate and
-        // variance of that reduced model come from this fit's covariance (restricted least
-        // squares: b_e - Q_eB Q_BB^-1 b_B, Q_ee - Q_eB Q_BB^-1 Q_Be), so one solve serves every step.
-        const double z = calib::NormalCriticalValue(options.degree_test_alpha);
-        std::vector<int> dropped;
-        int chosen = start_degree;
-        for (; chosen >= 0; --chosen) {
-          const int e = base + chosen;
-          if (p.fixed_entries[s].count(e) || p.datum_entries[s].count(e)) continue;  // does not decide
-          double beta = sensor.Detectors()[s][e], var = q(e, e);
-          if (!dropped.empty()) {
-            const int nb = int(dropped.size());
-            Eigen::MatrixXd qbb(nb, nb);
-            Eigen::VectorXd qeb(nb), bb(nb);
-            for (int k = 0; k < nb; ++k) {
-              qeb[k] = q(e, dropped[k]);
-              bb[k] = sensor.Detectors()[s][dropped[k]];
-              for (int m = 0; m < nb; ++m) qbb(k, m) = q(dropped[k], dropped[m]);
-            }
-            const Eigen::LDLT<Eigen::MatrixXd> ldlt(qbb);
-            beta -= qeb.dot(ldlt.solve(bb));
-            var -= qeb.dot(ldlt.solve(qeb));
-          }
-          if (!(var > 0) || !(beta * beta / var < z * z)) break;
-          dropped.push_back(e);
-        }
-        // chosen: the highest kept term; -1 when every free term was dropped (no correction).
-        for (int k = chosen + 1; k <= start_degree; ++k)
-          if (p.fixed_entries[s].insert(base + k).second) changed = true;
-        (axis == 0 ? result.subcameras[s].degree_x : result.subcameras[s].degree_y) = chosen;
+        std::set<int> held = p.fixed_entries[s];
+        held.insert(p.datum_entries[s].begin(), p.datum_entries[s].end());
+        degree = TopDownWaldDegree(sensor.Detectors()[s].data(),
+                                   cov.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms),
+                                   axis, start_degree, held, options.degree_test_alpha);
+        for (int k = degree + 1; k <= start_degree; ++k)
+          if (p.fixed_entries[s].insert(axis * kLineMaxTerms + k).second) changed = true;
       }
     if (changed) {
+      result.degree_test.reduced = true;
+      start_table = detector_table(cov);
       apply_fixed();
       result.report = b.Solve(options.solver);
       cov = result.report.usable ? b.EstimateCovariance(cov_blocks, result.report.sigma0)
@@ -414,37 +416,29 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   result.dy_mm.resize(camera.detectors);
   result.dx_sigma_mm.resize(camera.detectors);
   result.dy_sigma_mm.resize(camera.detectors);
+  result.dx_fit_sigma_mm.resize(camera.detectors);
+  result.dy_fit_sigma_mm.resize(camera.detectors);
+  const std::vector<TableValue> table = detector_table(cov);
   for (int s = 0; s < n_sub; ++s) {
-    const Eigen::MatrixXd q =
-        cov.ok ? cov.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms) : Eigen::MatrixXd();
-    for (int i = ranges[s].first; i <= ranges[s].second; ++i) {
-      const double u = ranges[s].second > ranges[s].first
-                           ? (2.0 * i - ranges[s].first - ranges[s].second) /
-                                 double(ranges[s].second - ranges[s].first)
-                           : 0.0;
-      const Eigen::Vector2d base = camera.Correction(i);
-      result.dx_mm[i] = base.x() + calib::EvaluatePolynomial(sensor.Detectors()[s].data(), kLineMaxTerms, u);
-      result.dy_mm[i] = base.y() + calib::EvaluatePolynomial(sensor.Detectors()[s].data() + kLineMaxTerms,
-                                                             kLineMaxTerms, u);
-      if (cov.ok)
-        for (int axis = 0; axis < 2; ++axis) {
-          // No free term beyond the datum's: the correction is fixed (sigma 0), not the datum
-          // pseudo-observations' own ~1e-4 px.
-          bool estimated = false;
-          for (int k = 0; k < kLineMaxTerms; ++k) {
-            const int e = axis * kLineMaxTerms + k;
-            estimated |= !p.fixed_entries[s].count(e) && !p.datum_entries[s].count(e);
-          }
-          if (!estimated) {
-            (axis == 0 ? result.dx_sigma_mm : result.dy_sigma_mm)[i] = 0.0;
-            continue;
-          }
-          Eigen::VectorXd g = Eigen::VectorXd::Zero(2 * kLineMaxTerms);
-          double power = 1.0;
-          for (int k = 0; k < kLineMaxTerms; ++k, power *= u) g[axis * kLineMaxTerms + k] = power;
-          const double var = g.dot(q * g);
-          (axis == 0 ? result.dx_sigma_mm : result.dy_sigma_mm)[i] = std::sqrt(std::max(0.0, var));
-        }
+    for (int axis = 0; axis < 2; ++axis) {
+      // No free term beyond the datum's: the correction is fixed (sigma 0), not the datum
+      // pseudo-observations' own ~1e-4 px.
+      bool estimated = false;
+      for (int k = 0; k < kLineMaxTerms; ++k) {
+        const int e = axis * kLineMaxTerms + k;
+        estimated |= !p.fixed_entries[s].count(e) && !p.datum_entries[s].count(e);
+      }
+      for (int i = ranges[s].first; i <= ranges[s].second; ++i) {
+        const size_t j = axis * size_t(camera.detectors) + i;
+        const Eigen::Vector2d base = camera.Correction(i);
+        (axis == 0 ? result.dx_mm : result.dy_mm)[i] = base[axis] + table[j].value;
+        if (!cov.ok) continue;
+        auto& sigma = (axis == 0 ? result.dx_sigma_mm : result.dy_sigma_mm)[i];
+        auto& fit_sigma = (axis == 0 ? result.dx_fit_sigma_mm : result.dy_fit_sigma_mm)[i];
+        fit_sigma = estimated ? std::sqrt(table[j].variance) : 0.0;
+        // After a degree test: at least the start-degree fit's sigma (line_degree_test.h).
+        sigma = start_table.empty() ? *fit_sigma : SelectedTableSigma(table[j], start_table[j]);
+      }
     }
   }
 
@@ -749,10 +743,16 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
     subs.push_back(js);
   }
   j["subcameras"] = subs;
+  j["degree_test"] = {{"applied", r.degree_test.applied},
+                      {"reduced", r.degree_test.reduced},
+                      {"start_degree", r.degree_test.start_degree},
+                      {"alpha", r.degree_test.alpha},
+                      {"table_sigma", r.degree_test.reduced ? "selected" : "fit"}};
   json det = json::array();
   for (size_t i = 0; i < r.dx_mm.size(); ++i)
     det.push_back({{"i", i}, {"dx_mm", r.dx_mm[i]}, {"dy_mm", r.dy_mm[i]},
-                   {"sigma_dx_mm", opt(r.dx_sigma_mm[i])}, {"sigma_dy_mm", opt(r.dy_sigma_mm[i])}});
+                   {"sigma_dx_mm", opt(r.dx_sigma_mm[i])}, {"sigma_dy_mm", opt(r.dy_sigma_mm[i])},
+                   {"sigma_dx_fit_mm", opt(r.dx_fit_sigma_mm[i])}, {"sigma_dy_fit_mm", opt(r.dy_fit_sigma_mm[i])}});
   j["detectors"] = det;
   json nodes = json::array();
   for (size_t k = 0; k < r.node_values.size(); ++k) {

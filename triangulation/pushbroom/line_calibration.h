@@ -6,8 +6,9 @@
 //   values (the POS error is modelled as smooth; white POS noise stays in the residuals);
 // - the detector calibration: a polynomial per sub-camera and axis in the normalised index
 //   (degree <= 5, jumps allowed at the seams), its degree chosen top-down by a Wald test of the
-//   highest coefficient (alpha 5 %; not for the datum's sub-camera), giving dx_i, dy_i with
-//   sigmas for every detector;
+//   highest coefficient (alpha 5 %; not for the datum's sub-camera; line_degree_test.h), giving
+//   dx_i, dy_i with sigmas for every detector (after a reduction: SelectedTableSigma, which
+//   accounts for the selection);
 // - the control points as weighted ground points (their survey sigmas);
 // - optionally the principal distance c (`free_c`; it is nearly a scale of the table).
 // Datum (module README "Datum"): the reference sub-camera's correction (on top of the file's) has
@@ -97,8 +98,19 @@ struct LineCalibrationResult {
   double sigma0_px = 0.0;
   std::vector<SubcameraRms> subcameras;
   /// Per detector: the estimated calibration (mm) and its sigma (mm, null when not determined).
+  /// After a degree test the sigma is SelectedTableSigma (line_degree_test.h): at least the
+  /// start-degree fit's; the selected polynomial's own propagated sigma is the fit sigma.
   std::vector<double> dx_mm, dy_mm;
   std::vector<std::optional<double>> dx_sigma_mm, dy_sigma_mm;
+  std::vector<std::optional<double>> dx_fit_sigma_mm, dy_fit_sigma_mm;
+  /// The degree test: whether it ran (not with --degree, nor on noise-free data), at which
+  /// start degree and alpha, and whether it dropped a term (the table sigmas then follow
+  /// SelectedTableSigma).
+  struct DegreeTest {
+    bool applied = false, reduced = false;
+    int start_degree = 0;
+    double alpha = 0.0;
+  } degree_test;
   std::vector<LineErrorSample> error_samples;  // one per image observation used
   /// Spline nodes: line of each node's centre, values [dX dY dZ m, domega dphi dkappa rad], sigmas.
   std::vector<double> node_line;
