@@ -7,8 +7,8 @@
 // The flight: 3 x 200 detectors (1.85 m nadir sampling), 800 lines (33 s: labelled `long`).
 // Measured: geometry 0.0305 / 0.0179 px, image mode 0.0103 / 0.0057 px (over 10 seeds at 3 x 150
 // the ratio is 0.07-0.42, module README "Measured"). The per-detector 3-sigma check does NOT hold
-// in image mode (worst 7.8 sigma across here: a smaller smooth error remains), so it is printed,
-// not asserted.
+// in image mode (worst 7.8 sigma across here with the fit's own sigmas: a smaller smooth error of
+// unknown cause remains, module README "Measured"), so it is printed, not asserted.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
