@@ -15,6 +15,7 @@
 #include "triangulation/block/block_io.h"
 #include "stitch/image_io/image_io.h"
 #include "triangulation/pushbroom/cloud_control.h"
+#include "triangulation/pushbroom/reference_frames.h"
 #include "triangulation/pushbroom/line_calibration.h"
 #include "triangulation/pushbroom/line_plots.h"
 
@@ -99,34 +100,47 @@ int RunCalibrate(CalibrateArgs& a) {
 }
 
 struct ControlArgs {
-  std::string camera, pos, line_image, reference_camera, reference_exposures, reference_images, out;
+  std::string camera, pos, line_image, reference_camera, reference_exposures, reference_result,
+      reference_images, out;
   bool write_l1 = false;
   int min_points = 20;
   triangulation::CloudControlOptions options;
 };
 
-// The image of an exposure in `folder`: the id as a file name, else with .png, .tif, .jpg.
+// The image of an exposure in `folder`: the id as a file name, else with .png, .tif, .jpg;
+// `where` names the exposure's source in the error.
 std::string ReferenceImagePath(const std::string& folder, const triangulation::Exposure& e,
-                               const std::string& exposures_file) {
+                               const std::string& where) {
   namespace fs = std::filesystem;
   for (const char* ext : {"", ".png", ".tif", ".tiff", ".jpg"}) {
     const fs::path p = fs::path(folder) / (e.image + ext);
     if (fs::is_regular_file(p)) return p.string();
   }
-  throw InputError(exposures_file + ":" + std::to_string(e.line) + ": no image '" + e.image +
-                   "' (.png, .tif, .jpg) in " + folder);
+  throw InputError(where + ": no image '" + e.image + "' (.png, .tif, .jpg) in " + folder);
 }
 
 int RunControl(ControlArgs& a) {
+  if (a.reference_exposures.empty() == a.reference_result.empty())
+    throw ConfigError("give one of --reference-exposures and --reference-result");
   CheckOutputFolder(a.out, "--out-dir");
   a.options.Validate();
   const calib::LineCamera camera = calib::ReadLineCamera(a.camera);
   const auto pos = triangulation::PosTrajectory::Read(a.pos);
   const calib::Camera reference_camera = calib::ReadCamera(a.reference_camera);
-  const auto exposures = triangulation::ReadExposures(a.reference_exposures);
+  // The orientations: exposures.csv, or the block result of `aerocal adjust` (its used exposures).
+  int skipped = 0;
+  const auto exposures = a.reference_result.empty()
+                             ? triangulation::ReadExposures(a.reference_exposures)
+                             : triangulation::ReadAdjustedExposures(a.reference_result, &skipped);
+  if (skipped > 0)
+    std::printf("reference: %zu adjusted exposures of %s (%d not used by the adjustment, skipped)\n",
+                exposures.size(), a.reference_result.c_str(), skipped);
   std::vector<std::string> image_paths;
   for (const auto& e : exposures)
-    image_paths.push_back(ReferenceImagePath(a.reference_images, e, a.reference_exposures));
+    image_paths.push_back(ReferenceImagePath(
+        a.reference_images, e,
+        a.reference_result.empty() ? a.reference_exposures + ":" + std::to_string(e.line)
+                                   : a.reference_result + ": exposures[" + std::to_string(e.line - 1) + "]"));
   const stitch::GrayImage line_image = stitch::ReadGrayImage(a.line_image);
   std::vector<triangulation::ReferenceFrame> frames;
   for (size_t k = 0; k < exposures.size(); ++k) {
@@ -223,8 +237,13 @@ CommandRun Setup(CLI::App& app) {
                   "The line image: row = scan line, column = detector")->required();
   ctl->add_option("--reference-camera", control_args->reference_camera,
                   "Camera file of the reference frame images")->required();
-  ctl->add_option("--reference-exposures", control_args->reference_exposures,
-                  "exposures.csv with the oriented reference frames (the block result)")->required();
+  auto* ref_csv = ctl->add_option("--reference-exposures", control_args->reference_exposures,
+                                  "exposures.csv with the oriented reference frames (the block result)");
+  auto* ref_result = ctl->add_option(
+      "--reference-result", control_args->reference_result,
+      "result.json of `aerocal adjust` with the oriented reference frames (instead of "
+      "--reference-exposures; its used exposures)");
+  ref_csv->excludes(ref_result);
   ctl->add_option("--reference-images", control_args->reference_images,
                   "Folder of the reference images (named by their exposure id, .png/.tif/.jpg)")
       ->required();

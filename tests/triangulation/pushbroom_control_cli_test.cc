@@ -11,7 +11,9 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+#include "calib/core/result_file.h"
 #include "tests/support/test_support.h"
 #include "tests/triangulation/pushbroom_commands.h"
 
@@ -68,6 +70,67 @@ TEST(PushbroomControl, MatchedControlCalibratesTheDetectors) {
   }
   EXPECT_LT(std::sqrt(e2[0] / n2[0]), 0.25) << "across track";
   EXPECT_LT(std::sqrt(e2[1] / n2[1]), 0.25) << "along track";
+}
+
+// The reference orientation straight from `aerocal adjust`'s result.json (--reference-result):
+// the simulated strip's exposures.csv written as the adjustment's `exposures` (deg), plus one
+// exposure the adjustment did not use, must give the very control of --reference-exposures.
+// Another kind, `valid: false`, a missing angle and both options are refused (exit 2), nothing
+// written.
+TEST(PushbroomControl, ReferenceOrientationFromTheBlockResult) {
+  const std::string photo = testing::SharedDataDir("odm_boruszyn_kap_frames");
+  if (photo.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent (the scene's texture)";
+  TempDir tmp("aerocal_pushbroom_reference_result");
+  const std::string sim = tmp.File("sim");
+  ASSERT_EQ(RunAerocal("simulate --pushbroom --images --texture " + photo +
+                       "/images/img_4880.jpg --detectors 60 --lines 200 --out " + sim).exit_code, 0);
+  const CsvTable csv = CsvTable::Read(sim + "/reference/exposures.csv");
+  json exposures = json::array();
+  for (const auto& row : csv.rows()) {
+    json e = {{"image", csv.String(row, "image")}, {"used", true}};
+    for (const char* key : {"X", "Y", "Z", "omega", "phi", "kappa"}) e[key] = csv.Number(row, key);
+    exposures.push_back(e);
+  }
+  exposures.push_back({{"image", "not_oriented"}, {"X", nullptr}, {"used", false}});
+  auto write = [&](const std::string& path, const json& doc) { std::ofstream(path) << doc.dump(1); };
+  const json result = {{"kind", "adjust"}, {"schema_version", kResultSchemaVersion}, {"valid", true},
+                       {"exposures", exposures}};
+  write(tmp.File("result.json"), result);
+  const std::string common = "pushbroom control --camera " + sim + "/camera_nominal.yaml --pos " + sim +
+                             "/pos.csv --line-image " + sim + "/line_image.png --reference-camera " + sim +
+                             "/reference/camera.yaml --reference-images " + sim + "/reference" +
+                             " --line-outlier-k 5 --line-outlier-min-px 0.25";
+  const auto from_csv = RunAerocal(common + " --reference-exposures " + sim + "/reference/exposures.csv --out-dir " + tmp.File("a"));
+  ASSERT_EQ(from_csv.exit_code, 0) << from_csv.output;
+  const auto from_result = RunAerocal(common + " --reference-result " + tmp.File("result.json") + " --out-dir " + tmp.File("b"));
+  ASSERT_EQ(from_result.exit_code, 0) << from_result.output;
+  EXPECT_NE(from_result.output.find("1 not used by the adjustment"), std::string::npos) << from_result.output;
+  EXPECT_EQ(ReadTextFile(tmp.File("a/points.csv")), ReadTextFile(tmp.File("b/points.csv")));
+  EXPECT_EQ(ReadTextFile(tmp.File("a/observations.csv")), ReadTextFile(tmp.File("b/observations.csv")));
+
+  auto refused = [&](const json& doc, const std::string& expected) {
+    write(tmp.File("bad.json"), doc);
+    const auto run = RunAerocal(common + " --reference-result " + tmp.File("bad.json") + " --out-dir " + tmp.File("c"));
+    EXPECT_EQ(run.exit_code, 2) << run.output;
+    EXPECT_NE(run.output.find(expected), std::string::npos) << run.output;
+    EXPECT_FALSE(std::filesystem::exists(tmp.File("c")));
+  };
+  json other = result;
+  other["kind"] = "pushbroom";
+  refused(other, "bad.json: not a result of `aerocal adjust`");
+  json invalid = result;
+  invalid["valid"] = false;
+  refused(invalid, "valid: false");
+  json no_kappa = result;
+  no_kappa["exposures"][1].erase("kappa");
+  refused(no_kappa, "bad.json: exposures[1] (" + csv.String(csv.rows()[1], "image") + "): kappa must be a finite number");
+  const auto both = RunAerocal(common + " --reference-result " + tmp.File("result.json") + " --reference-exposures " +
+                               sim + "/reference/exposures.csv --out-dir " + tmp.File("c"));
+  EXPECT_EQ(both.exit_code, 2) << both.output;
+  const auto neither = RunAerocal(common + " --out-dir " + tmp.File("c"));
+  EXPECT_EQ(neither.exit_code, 2) << neither.output;
+  EXPECT_NE(neither.output.find("--reference-result"), std::string::npos) << neither.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp.File("c")));
 }
 
 TEST(PushbroomImageMode, BadInputIsRefused) {
