@@ -96,10 +96,7 @@ TEST(PushbroomControl, ReferenceOrientationFromTheBlockResult) {
   const json result = {{"kind", "adjust"}, {"schema_version", kResultSchemaVersion}, {"valid", true},
                        {"exposures", exposures}};
   write(tmp.File("result.json"), result);
-  const std::string common = "pushbroom control --camera " + sim + "/camera_nominal.yaml --pos " + sim +
-                             "/pos.csv --line-image " + sim + "/line_image.png --reference-camera " + sim +
-                             "/reference/camera.yaml --reference-images " + sim + "/reference" +
-                             " --line-outlier-k 5 --line-outlier-min-px 0.25";
+  const std::string common = PushbroomControlInputs(sim) + " --line-outlier-k 5 --line-outlier-min-px 0.25";
   const auto from_csv = RunAerocal(common + " --reference-exposures " + sim + "/reference/exposures.csv --out-dir " + tmp.File("a"));
   ASSERT_EQ(from_csv.exit_code, 0) << from_csv.output;
   const auto from_result = RunAerocal(common + " --reference-result " + tmp.File("result.json") + " --out-dir " + tmp.File("b"));
