@@ -8,8 +8,10 @@
 #include "tools/adjust_joint.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
+#include "tools/suspect_effect_option.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/conventional_reference.h"
+#include "triangulation/adjustment/self_calibration_choice.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
 #include "triangulation/sensor/rig_head_camera.h"
@@ -105,9 +107,10 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option("--out", args->out, "Result JSON (written atomically)")->required();
   app.add_option("--self-calibration",
                  args->self_calibration,
-                 "Interior parameters to estimate: none (conventional, default), all, or a list "
-                 "such as c,x0,y0,K1,K2 (the names of the camera file's model, e.g. "
-                 "f,cx,cy,k1,k2 for metashape_frame)");
+                 "Interior parameters to estimate: none (conventional, default), auto (those of "
+                 "the model that this block determines and that are significant: held one by one "
+                 "with the reason, self_calibration_choice), all, or a list such as c,x0,y0,K1,K2 "
+                 "(the names of the camera file's model, e.g. f,cx,cy,k1,k2 for metashape_frame)");
   app.add_flag("--compare",
                args->compare,
                "Run the conventional and the self-calibrating adjustment and compare them "
@@ -139,6 +142,7 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->options.max_sigma0,
                  "A result with sigma0 above this is not valid (exit 3)")
       ->check(CLI::PositiveNumber);
+  AddSuspectEffectOption(app, &args->options.suspect_effect_limit);
   app.add_option("--min-redundancy",
                  args->options.min_redundancy,
                  "Redundancy number below which an observation is weakly controlled: reported, "
@@ -253,8 +257,13 @@ CommandRun SetupAdjust(CLI::App& app) {
     // The names of the 10-parameter model here (the joint adjustment needs it); the plain
     // adjustment reads them again in the model of the project's cameras below.
     const bool other_model_names = !args->joint.Requested();
+    const bool auto_free = args->self_calibration == "auto";
+    if (auto_free && args->joint.Requested())
+      throw ConfigError("--self-calibration auto: not with --joint-stitching (give the list, e.g. "
+                        "the `self_calibration_choice.chosen` of an auto run)");
+    const std::string free_text = auto_free ? "all" : args->self_calibration;
     if (!other_model_names)
-      options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
+      options.free_interior = triangulation::ParseSelfCalibration(free_text);
     options.Validate();
     CheckOutputFile(args->out, "--out");
     if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
@@ -269,7 +278,7 @@ CommandRun SetupAdjust(CLI::App& app) {
     const calib::CameraModelId model =
         self_calibrating ? CamerasModel(input) : calib::Camera::Model::kId;
     if (other_model_names) {
-      options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration, model);
+      options.free_interior = triangulation::ParseSelfCalibration(free_text, model);
       options.Validate();
     }
     apply_platform(&input.platform);
@@ -285,6 +294,9 @@ CommandRun SetupAdjust(CLI::App& app) {
         throw ConfigError("--compare: not available for a " + rig + ": its conventional reference "
                           "run is a frame-camera adjustment (run adjust with and without "
                           "--self-calibration instead)");
+      if (auto_free)
+        throw ConfigError("--self-calibration auto: not available for a " + rig + " (give the "
+                          "parameters to calibrate)");
       if (options.robust_start)
         throw ConfigError("--robust-start: not available for a " + rig + ": the robust start "
                           "re-adjusts frame cameras only (reject blunders with data snooping, the "
@@ -312,7 +324,9 @@ CommandRun SetupAdjust(CLI::App& app) {
     auto run = [&](const std::vector<std::string>& free) {
       auto o = options;
       o.free_interior = free;
-      AdjustmentResult r = triangulation::Adjust(project, o, &progress);
+      AdjustmentResult r = auto_free && !free.empty()
+                               ? triangulation::AdjustWithChosenFreeSet(project, o, {}, nullptr)
+                               : triangulation::Adjust(project, o, &progress);
       triangulation::ToInputFrame(frame, &r);
       return r;
     };

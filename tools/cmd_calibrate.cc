@@ -11,6 +11,7 @@
 #include "tools/board_detection.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
+#include "tools/suspect_effect_option.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/calibration/calibration.h"
 #include "triangulation/calibration/calibration_json.h"
@@ -146,6 +147,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
     double sigma_px = 0.5, board_sigma_mm = kDefaultBoardSigmaMm;
     std::vector<double> radii_mm;
     bool no_snooping = false, no_closed_form = false;
+    double suspect_effect_limit = triangulation::AdjustOptions{}.suspect_effect_limit;
   };
   auto args = std::make_shared<Args>();
   app.add_option("--camera", args->camera,
@@ -186,6 +188,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
                  "Sigma of the board's design coordinates (print accuracy), mm")
       ->check(CLI::PositiveNumber);
   app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
+  AddSuspectEffectOption(app, &args->suspect_effect_limit);
   app.add_flag("--no-closed-form", args->no_closed_form,
                "Planar target: start from the camera file's c, not Zhang's closed form");
   app.add_option("--write-marks", args->write_marks,
@@ -217,6 +220,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
     if (options.adjust.free_interior.empty())
       throw ConfigError("--self-calibration: calibrate needs at least one parameter (got none)");
     options.adjust.data_snooping = !args->no_snooping;
+    options.adjust.suspect_effect_limit = args->suspect_effect_limit;
     options.closed_form_c = !args->no_closed_form;
     options.adjust.Validate();
     CheckOutputFile(args->out, "--out");

@@ -13,7 +13,9 @@
 #include "tools/camera_formats.h"
 #include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
+#include "tools/suspect_effect_option.h"
 #include "tools/python_script.h"
+#include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/joint/joint_adjustment.h"
 #include "triangulation/workflow/flight_workflow.h"
 
@@ -23,7 +25,7 @@ namespace {
 CommandRun SetupFlight(CLI::App& app) {
   struct Args {
     triangulation::FlightWorkflowOptions options;
-    std::string out, base, joint_model = "auto", camera_format, lab;
+    std::string out, base, joint_model = "auto", camera_format, lab, self_calibration = "auto";
     bool no_report = false, certificate = false;
   };
   auto args = std::make_shared<Args>();
@@ -41,6 +43,13 @@ CommandRun SetupFlight(CLI::App& app) {
                  "Mapping model of the joint adjustment: translation | conformal | affine | projective | auto "
                  "(the model the flight's stitching F test chose)")
       ->capture_default_str();
+  app.add_option("--self-calibration", args->self_calibration,
+                 "Interior parameters of the self-calibration: auto (default: those of the "
+                 "10-parameter model that this block determines and that are significant, each "
+                 "held one named with the reason, self_calibration_choice), all, or a list such "
+                 "as c,x0,y0,K1,K2")
+      ->capture_default_str();
+  AddSuspectEffectOption(app, &args->options.suspect_effect_limit);
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
   app.add_option("--camera-format", args->camera_format,
                  "Also write the calibrated camera as camera_calibrated.FORMAT in another tool's format (" +
@@ -57,6 +66,13 @@ CommandRun SetupFlight(CLI::App& app) {
     if (!args->camera_format.empty()) FindCameraFormat(args->camera_format, "--camera-format");
     args->options.base_ids = SplitCommaList(args->base);
     args->options.joint_model = triangulation::ParseJointModel(args->joint_model);
+    args->options.choose_free_set = args->self_calibration == "auto";
+    if (!args->options.choose_free_set) {
+      args->options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
+      if (args->options.free_interior.empty())
+        throw ConfigError("--self-calibration none: flight calibrates the camera (use `aerocal "
+                          "adjust` for a conventional run alone)");
+    }
     Progress progress("flight", 5);
     const auto result = triangulation::RunFlightWorkflow(args->options, &progress);
     progress.Finish();

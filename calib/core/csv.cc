@@ -8,7 +8,6 @@
 #include <string_view>
 
 #include "calib/core/atomic_file.h"
-#include "calib/core/log.h"
 
 namespace aerocal {
 namespace {
@@ -78,12 +77,13 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& file) {
     ++line_number;
     const std::string trimmed = Trim(line);
     if (trimmed.empty()) continue;
-    if (line[0] == '#') {  // a comment only where '#' is the line's first character
-      if (!table.header_.empty() && table.header_.size() > 1 &&
-          SplitCommaList(trimmed, {true, true}).size() == table.header_.size())
-        LogWarning(SourceRef{file, line_number}.ToString() +
-                   ": skipped as a comment (the line starts with '#'); an id in the first column "
-                   "cannot start with '#'");
+    // A comment: before the header, any line whose first non-blank character is '#'; after it,
+    // only such a line that cannot be a row (not the header's number of fields). A row whose
+    // first field starts with '#' (an image id "#101") is data (issue 28: it was once dropped).
+    if (trimmed[0] == '#' &&
+        (table.header_.empty() ||
+         SplitCommaList(trimmed, {true, true}).size() != table.header_.size())) {
+      if (!table.header_.empty()) table.comment_lines_.push_back(line_number);
       continue;
     }
     std::vector<std::string> fields = SplitCommaList(trimmed, {true, true});

@@ -1,6 +1,11 @@
-// CSV tables as FORMATS.md defines them: a header row, comma separators, '#' comment lines (a '#'
-// that is the FIRST character of a line; elsewhere it is data), blank lines ignored, fields
-// trimmed, a UTF-8 byte-order mark and CRLF or CR line ends accepted. Every value access names FILE:LINE in its error.
+// CSV tables as FORMATS.md defines them: a header row, comma separators, '#' comment lines, blank
+// lines ignored, fields trimmed, a UTF-8 byte-order mark and CRLF or CR line ends accepted. Every
+// value access names FILE:LINE in its error.
+// Comments (issue 28): before the header, every line whose first non-blank character is '#';
+// after the header, such a line only when it does not have the header's number of fields. A line
+// that does is a row whose first field starts with '#' (an id "#101" is an id, never a comment).
+// The comment lines after the header are kept by number (comment_lines) so that a reader can
+// name them.
 #pragma once
 
 #include <map>
@@ -27,6 +32,8 @@ class CsvTable {
   const std::string& file() const { return file_; }
   const std::vector<std::string>& header() const { return header_; }
   const std::vector<Row>& rows() const { return rows_; }
+  /// Line numbers of the comment lines after the header (those before it are the file's preamble).
+  const std::vector<int>& comment_lines() const { return comment_lines_; }
   bool HasColumn(const std::string& name) const { return columns_.count(name) > 0; }
   /// Throws InputError("FILE:HEADER_LINE: missing column NAME") when absent.
   void RequireColumns(const std::vector<std::string>& names) const;
@@ -53,6 +60,7 @@ class CsvTable {
   std::vector<std::string> header_;
   std::map<std::string, int> columns_;
   std::vector<Row> rows_;
+  std::vector<int> comment_lines_;
 };
 
 /// Lines of a text: LF, CRLF or CR line ends; a leading UTF-8 byte-order mark is dropped.

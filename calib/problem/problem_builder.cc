@@ -148,6 +148,17 @@ std::vector<double> ProblemBuilder::ValuesSnapshot() const {
   return out;
 }
 
+void ProblemBuilder::RestoreValues(const std::vector<double>& snapshot) {
+  size_t at = 0;
+  for (const Block& b : blocks_) {
+    const size_t size = static_cast<size_t>(b.size);
+    AEROCAL_CHECK(at + size <= snapshot.size()) << "RestoreValues: snapshot of another builder";
+    std::copy(snapshot.begin() + at, snapshot.begin() + at + size, b.values);
+    at += size;
+  }
+  AEROCAL_CHECK(at == snapshot.size()) << "RestoreValues: snapshot of another builder";
+}
+
 void ProblemBuilder::ReleaseFactorized() const { factorized_.reset(); }
 
 const ProblemBuilder::Factorized* ProblemBuilder::Factorize(bool apply_loss,

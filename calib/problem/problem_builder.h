@@ -219,6 +219,11 @@ class ProblemBuilder {
   int NumActiveResiduals() const;
   const std::string& ResidualGroup(ResidualId id) const;
   const std::string& ResidualLabel(ResidualId id) const;
+  /// Every parameter value, block after block: the state a kept factorisation belongs to, and a
+  /// state to return to after a trial solve (RestoreValues).
+  std::vector<double> ValuesSnapshot() const;
+  /// Puts back every parameter value of a ValuesSnapshot of this builder (the same blocks).
+  void RestoreValues(const std::vector<double>& snapshot);
   /// Current whitened residual values (loss not applied).
   std::vector<double> EvaluateResidual(ResidualId id) const;
 
@@ -294,8 +299,6 @@ class ProblemBuilder {
   const Factorized* Factorize(bool apply_loss, int max_dense_parameters) const;
   /// Drops the kept factorisation (its memory).
   void ReleaseFactorized() const;
-  /// Every parameter value, block after block (the state a kept factorisation belongs to).
-  std::vector<double> ValuesSnapshot() const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,
                                 std::vector<ResidualId>* row_owner) const;
 

@@ -1355,11 +1355,18 @@ TEST(ReaderRules, ByteOrderMarkCrlfAndCrLineEndsAreAccepted) {
   }
 }
 
-TEST(ReaderRules, HashIsACommentOnlyAsTheFirstCharacterOfALine) {
-  const auto t = CsvTable::Parse("# comment\nimage,point\n#x,p1\n a,#p2\n #b,p3\n", "f.csv");
-  ASSERT_EQ(t.rows().size(), 2u);  // '#x,p1' is a comment (with a warning), the others are data
-  EXPECT_EQ(t.String(t.rows()[0], "point"), "#p2");
-  EXPECT_EQ(t.String(t.rows()[1], "image"), "#b");
+TEST(ReaderRules, AnIdStartingWithHashIsAnIdAndACommentIsNamedByLine) {
+  // Issue 28: '#101,p1' was read as a comment and the exposure vanished. After the header a '#'
+  // line with the header's number of fields is a row; one that cannot be a row is a comment,
+  // counted by line.
+  const auto t = CsvTable::Parse(
+      "# comment\n  # indented comment\nimage,point\n#101,p1\n a,#p2\n #b,p3\n# note\n", "f.csv");
+  ASSERT_EQ(t.rows().size(), 3u);
+  EXPECT_EQ(t.String(t.rows()[0], "image"), "#101");
+  EXPECT_EQ(t.rows()[0].line, 4);
+  EXPECT_EQ(t.String(t.rows()[1], "point"), "#p2");
+  EXPECT_EQ(t.String(t.rows()[2], "image"), "#b");
+  EXPECT_EQ(t.comment_lines(), std::vector<int>{7});
 }
 
 TEST(ReaderRules, StrictYamlNamesTheLineOfADuplicateKey) {

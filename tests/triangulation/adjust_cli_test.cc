@@ -106,6 +106,47 @@ TEST_F(AdjustCommand, NotConvergedExitsThreeWithTheResultWritten) {
   EXPECT_FALSE(std::filesystem::exists(dir_.File("cam.yaml")));
 }
 
+// Issue 28: an image id that starts with '#' ('#0001') was read as a comment, and the exposure and
+// its observations vanished with exit 0. It is an id: the exposure is adjusted under its name. An
+// exposure no observation names is named in the notes, never silently unused.
+TEST_F(AdjustCommand, AnImageIdStartingWithHashIsAdjustedAndAnUnobservedImageIsNamed) {
+  auto rename = [&](const std::string& file) {
+    std::string text = ReadTextFile(dir_.File("flight/" + file));
+    std::string out;
+    size_t begin = 0;
+    while (begin < text.size()) {  // every line that starts with the id 0001
+      const size_t end = text.find('\n', begin);
+      std::string line = text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+      if (line.rfind("0001,", 0) == 0) line = "#" + line;
+      out += line + "\n";
+      if (end == std::string::npos) break;
+      begin = end + 1;
+    }
+    WriteFileAtomically(dir_.File("flight/" + file), out);
+  };
+  rename("exposures.csv");
+  rename("observations.csv");
+  // One more exposure that no observation names.
+  std::string exposures = ReadTextFile(dir_.File("flight/exposures.csv"));
+  const size_t first_row = exposures.find("#0001,");
+  ASSERT_NE(first_row, std::string::npos);
+  const std::string row = exposures.substr(first_row, exposures.find('\n', first_row) - first_row);
+  exposures += "9999" + row.substr(5) + "\n";
+  WriteFileAtomically(dir_.File("flight/exposures.csv"), exposures);
+  const auto r = RunAerocal("adjust --project " + dir_.File("flight/project.yaml") + " --out " +
+                            dir_.File("result.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = ReadJson(dir_.File("result.json"));
+  bool hash_used = false;
+  for (const auto& e : j["exposures"])
+    if (e["image"] == "#0001") hash_used = e["used"].get<bool>();
+  EXPECT_TRUE(hash_used) << "exposure #0001 not adjusted";
+  bool named = false;
+  for (const auto& note : j["notes"])
+    named = named || note.get<std::string>().find("image 9999") != std::string::npos;
+  EXPECT_TRUE(named) << j["notes"].dump();
+}
+
 // The GNSS/IMU platform: simulate plants a lever arm and a GNSS time offset, adjust estimates
 // them (options over the project YAML) and writes them with sigmas; a bad mode is exit 2.
 TEST(AdjustPlatform, SimulatedLeverArmAndTimeOffsetComeBack) {

@@ -22,3 +22,6 @@ aerocal_add_test(triangulation/rig_bundle_study LIBS aerocal::triangulation LABE
 aerocal_add_test(triangulation/rig_bundle_cli LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(triangulation/wall_pose LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/platform LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/robust_start_models LIBS aerocal::triangulation LABELS unit)
+aerocal_add_test(triangulation/suspect_effect LIBS aerocal::triangulation LABELS unit)
+aerocal_add_test(triangulation/self_calibration_choice LIBS aerocal::triangulation LABELS golden)

@@ -3,7 +3,6 @@
 // runs when asked, or by default when the first solve's residuals call for it
 // (AdjustOptions::auto_robust_start).
 #include "calib/core/csv.h"
-#include "calib/residuals/collinearity.h"
 #include "triangulation/adjustment/block_adjustment.h"
 
 #include <algorithm>
@@ -25,32 +24,16 @@ struct SolutionIndex {
   std::unordered_map<std::string, const CameraEstimate*> camera;
 };
 
-// Whitened residual of `o` at the solution of `r` (adjustment frame); nullopt when its exposure
-// or point is not in that solution or the ray misses.
-std::optional<Eigen::Vector2d> ResidualAt(const Project& project,
+// Whitened residual of `o` at the solution of `r`, the result of `adjustment` (issue 28: built by
+// the sensor kind and the camera's own model, as the solve builds it, never the 10-parameter
+// functor on another model's block); nullopt when its exposure was not used there, its point is
+// not in that solution or the ray misses.
+std::optional<Eigen::Vector2d> ResidualAt(BlockAdjustment& adjustment,
                                           const AdjustmentResult& r,
                                           const SolutionIndex& solution,
                                           const ImageObservation& o) {
-  const Exposure* exposure = project.FindExposure(o.image);
-  const auto point = r.points_m.find(o.point);
-  if (!exposure || point == r.points_m.end()) return std::nullopt;
-  const auto pose_it = solution.exposure.find(o.image);
-  const auto camera_it = solution.camera.find(exposure->camera);
-  if (pose_it == solution.exposure.end() || camera_it == solution.camera.end()) return std::nullopt;
-  const ExposureEstimate* pose = pose_it->second;
-  const CameraEstimate* camera = camera_it->second;
-  const calib::Camera& cam = project.cameras.at(exposure->camera);
-  const calib::PixelFrame frame{cam.pixel_size_mm, cam.width_px, cam.height_px};
-  const calib::CollinearityResidual residual(frame, o.pixel, o.sigma_px);
-  const Eigen::Vector4d rotation = calib::QuaternionFromOpk(pose->opk_rad);
-  Eigen::Vector2d v;
-  if (!residual(camera->estimated.data(),
-                rotation.data(),
-                pose->center_m.data(),
-                point->second.data(),
-                v.data()))
-    return std::nullopt;
-  return v;
+  if (!solution.exposure.count(o.image) || !r.points_m.count(o.point)) return std::nullopt;
+  return adjustment.ResidualAtCurrentValues(o);
 }
 
 // The solution of `r` becomes the starting values of `project`: exterior orientation of the
@@ -122,11 +105,8 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   AdjustOptions clean_options = options;
   clean_options.data_snooping = false;
   clean_options.estimate_covariance = false;
-  AdjustmentResult clean;
-  {
-    BlockAdjustment adjustment(next, clean_options);
-    clean = adjustment.Run(progress);
-  }
+  BlockAdjustment clean_adjustment(next, clean_options);
+  const AdjustmentResult clean = clean_adjustment.Run(progress);
   const int components = 2 * static_cast<int>(next.observations.size());
   const double critical = options.snooping_critical_value > 0
                               ? options.snooping_critical_value
@@ -136,16 +116,18 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   std::vector<BlockAdjustment::Screened> still_excluded;
   int readmitted = 0, retested = 0;
   const SolutionIndex clean_solution(clean);
+  std::vector<ImageObservation> back;  // into `next` only once clean_adjustment is done with it
   for (const auto& s : screened) {
     const bool undetermined = !clean.points_m.count(s.observation.point);
-    const auto v = ResidualAt(next, clean, clean_solution, s.observation);
+    const auto v = ResidualAt(clean_adjustment, clean, clean_solution, s.observation);
     if (undetermined || (v && v->cwiseAbs().maxCoeff() / scale < critical)) {
-      next.observations.push_back(s.observation);
+      back.push_back(s.observation);
       ++(undetermined ? retested : readmitted);
     } else {
       still_excluded.push_back(s);
     }
   }
+  next.observations.insert(next.observations.end(), back.begin(), back.end());
   StartFromSolution(clean, &next);
 
   // 3. The final adjustment with snooping and covariance.

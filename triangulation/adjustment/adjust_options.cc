@@ -56,6 +56,9 @@ void AdjustOptions::Validate() const {
                       ")");
   if (!(max_sigma0 > 0))
     throw ConfigError("max_sigma0 must be > 0 (got " + FormatNumber(max_sigma0) + ")");
+  if (!(suspect_effect_limit > 0 && suspect_effect_limit <= 1e3))
+    throw ConfigError("suspect_effect_limit must be in (0, 1000] sigmas (got " +
+                      FormatNumber(suspect_effect_limit) + ")");
   if (max_rejections < 0)
     throw ConfigError("max_rejections must be >= 0 (0: 10 % of the tested observations, at least "
                       "100; got " + std::to_string(max_rejections) + ")");

@@ -61,6 +61,12 @@ struct AdjustOptions {
   double model_error_sigma0 = 1.5;
   /// A result whose final sigma0 exceeds this is not valid (exit 3), > 0.
   double max_sigma0 = 3.0;
+  /// Failing control surveys that snooping cannot leave out (a group it cannot tell apart) are
+  /// judged by their effect (SuspectEffect): the block re-solved without them; when no parameter
+  /// with a sigma (free interior, platform, exterior orientation) moves by more than this many of
+  /// its sigmas, the result stays valid with a warning naming them, else it is not valid (exit 3).
+  /// (0, 1e3]; 0 is refused: a limit of zero sigmas would call every suspicion decisive.
+  double suspect_effect_limit = 1.0;
   /// Estimate the covariance (sigmas, correlations, determinability). Off only for speed.
   bool estimate_covariance = true;
   /// Critical value of the standardized residual |w|; 0: from alpha = 5 % / n_tested (>= 3.29).

@@ -66,6 +66,45 @@ void AddTest(const ObservationTest& t, nlohmann::json* j) {
   if (!t.reason.empty()) (*j)["reason"] = t.reason;
 }
 
+// "unresolved_effect": the suspects' effect on the results (SuspectEffect); null where unknown.
+nlohmann::json SuspectEffectJson(const SuspectEffect& e) {
+  nlohmann::json j = {{"computed", e.computed},
+                      {"limit_sigmas", e.limit_sigmas},
+                      {"max_sigmas", e.computed ? Finite(e.max_sigmas) : nlohmann::json()},
+                      {"parameter", e.parameter},
+                      {"max_all_sigmas", e.computed ? Finite(e.max_all_sigmas) : nlohmann::json()},
+                      {"parameter_all", e.parameter_all},
+                      {"matters", e.Matters()}};
+  if (!e.message.empty()) j["message"] = e.message;
+  j["calibrated"] = nlohmann::json::array();
+  for (const auto& c : e.calibrated)
+    j["calibrated"].push_back({{"parameter", c.parameter},
+                               {"change", c.change},
+                               {"sigma", Finite(c.sigma)},
+                               {"sigmas", c.sigma > 0 ? Finite(std::abs(c.change) / c.sigma)
+                                                      : nlohmann::json()}});
+  return j;
+}
+
+// "self_calibration_choice" (`--self-calibration auto`): candidates, chosen, each held parameter.
+nlohmann::json FreeSetChoiceJson(const FreeSetChoice& c) {
+  nlohmann::json j = {{"candidates", c.candidates},
+                      {"chosen", c.chosen},
+                      {"significance_t", c.significance_t},
+                      {"correlation_limit", c.correlation_limit},
+                      {"rounds", c.rounds}};
+  j["held"] = nlohmann::json::array();
+  for (const auto& h : c.held) {
+    nlohmann::json e = {{"parameter", h.parameter},
+                        {"reason", h.reason},
+                        {"statistic", Finite(h.statistic)},
+                        {"round", h.round}};
+    if (!h.with.empty()) e["with"] = h.with;
+    j["held"].push_back(e);
+  }
+  return j;
+}
+
 nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
   nlohmann::json j = {{"run", s.run},
                       {"alpha", s.alpha},
@@ -105,6 +144,7 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
                                        {"w", u.w},
                                        {"r", u.redundancy},
                                        {"residual_sigma", u.residual_sigma}});
+  if (!s.unresolved_surveys.empty()) j["unresolved_effect"] = SuspectEffectJson(s.unresolved_effect);
   j["uncontrolled"] = nlohmann::json::array();
   for (const auto& u : s.uncontrolled)
     j["uncontrolled"].push_back({{"image", u.image},
@@ -551,6 +591,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["determinability"] = det;
   if (r.platform.gnss || r.platform.imu) j["platform"] = PlatformToJson(r.platform);
   j["notes"] = r.notes;
+  if (r.free_set_choice) j["self_calibration_choice"] = FreeSetChoiceJson(*r.free_set_choice);
   j["snooping"] = SnoopingToJson(r.snooping);
   j["valid"] = r.valid;
   j["invalid_reasons"] = r.invalid_reasons;

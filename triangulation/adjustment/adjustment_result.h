@@ -147,6 +147,30 @@ struct UnresolvedSurvey {
   double residual_sigma = 0;     // its largest residual, in a-priori sigmas
 };
 
+/// The effect of an unresolved suspicion on the results (issue 28: a calibration is invalid when a
+/// suspicion matters, not whenever a test fires): the block re-solved with the suspects left out,
+/// the change of every parameter whose sigma the covariance gives (free interior and platform
+/// parameters, exterior orientations), in that parameter's sigmas. The result keeps the solution
+/// with every survey; the effect on what the run calibrates decides whether it is valid
+/// (AdjustOptions::suspect_effect_limit).
+struct SuspectEffect {
+  bool computed = false;
+  std::string message;  // why it could not be computed (no covariance, the re-solve failed)
+  double limit_sigmas = 0;
+  /// The decision: the largest |change| / sigma over the calibrated parameters (free interior and
+  /// platform), over every parameter when the run calibrates none (conventional).
+  double max_sigmas = 0;
+  std::string parameter;  // where it is largest ("camera cam1.c", "image 0012 centre.Z")
+  double max_all_sigmas = 0;   // the largest over every parameter, exterior orientations included
+  std::string parameter_all;
+  struct Change {
+    std::string parameter;
+    double change = 0, sigma = 0;  // the parameter's units (table units, m, rad)
+  };
+  std::vector<Change> calibrated;  // every free interior and platform parameter
+  bool Matters() const { return !computed || max_sigmas > limit_sigmas; }
+};
+
 /// How data snooping was run and what it could not decide (data_snooping.h).
 struct SnoopingSummary {
   bool run = false;
@@ -169,6 +193,7 @@ struct SnoopingSummary {
   /// Failing control surveys none of which could be left out (kWarningControlBlunderUnresolved).
   std::vector<UnresolvedSurvey> unresolved_surveys;
   std::string unresolved_reason;
+  SuspectEffect unresolved_effect;  // computed when unresolved_surveys is not empty
   std::vector<FlaggedObservation> flagged;
   /// Every active observation no test can judge, one by one (the counts above summarise them).
   std::vector<UncontrolledObservation> uncontrolled;
@@ -247,6 +272,22 @@ struct AdjustmentTiming {
   double total_s = 0;       // the whole run (results and statistics included)
 };
 
+/// `--self-calibration auto` (self_calibration_choice.h): the candidates, the parameters held and
+/// why, the free set chosen.
+struct FreeSetChoice {
+  std::vector<std::string> candidates, chosen;
+  struct Held {
+    std::string parameter;
+    std::string reason;        // "not determinable" | "not significant"
+    double statistic = 0;      // |rho| with `with`, or t
+    std::string with;          // the parameter it is traded against (not determinable)
+    int round = 0;
+  };
+  std::vector<Held> held;
+  double significance_t = 0, correlation_limit = 0;
+  int rounds = 0;
+};
+
 struct AdjustmentResult {
   calib::SolveReport solve;
   AdjustmentTiming timing;
@@ -276,6 +317,7 @@ struct AdjustmentResult {
   std::vector<ResultWarning> warnings;              // the result is doubtful: by name
   SnoopingSummary snooping;
   PlatformEstimate platform;
+  std::optional<FreeSetChoice> free_set_choice;  // `--self-calibration auto` only
   /// False when the run must not be trusted: not converged, singular, rejection cap reached,
   /// sigma0 above AdjustOptions::max_sigma0; `invalid_reasons` says why (exit 3).
   bool valid = true;

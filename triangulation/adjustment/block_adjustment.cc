@@ -1,4 +1,6 @@
 #include "triangulation/adjustment/block_adjustment.h"
+
+#include "triangulation/adjustment/suspect_effect.h"
 #include "calib/core/median.h"
 
 #include "calib/core/csv.h"
@@ -112,6 +114,7 @@ struct BlockAdjustment::Storage {
   BlockId lever_block = -1, boresight_block = -1, time_block = -1;
   std::string datum;
   bool free_network = false;  // datum by a dependent relative orientation, not by the survey
+  std::vector<calib::ResidualId> unresolved_ids;  // failing surveys snooping could not leave out
 };
 
 BlockAdjustment::BlockAdjustment(const Project& project,
@@ -214,34 +217,49 @@ void BlockAdjustment::BuildExposures() {
   }
 }
 
+std::pair<ImagingModel*, ImageObservation> BlockAdjustment::SensorOf(
+    const ImageObservation& o) const {
+  for (auto& s : storage_->sensors)
+    if (s->Measures(o)) return {s.get(), o};
+  if (!o.head.empty())  // never a virtual-image pixel: the rig bundle measures it
+    ThrowInputError({project_.observations_file, o.line},
+                    "image " + o.image + " head " + o.head +
+                        ": rig head observations are adjusted by the rig bundle (aerocal "
+                        "adjust without --joint-stitching)");
+  if (storage_->frame.Measures(o)) return {&storage_->frame, o};
+  const ExposureIndex exposure = storage_->index.Exposure(o.image);
+  const auto& camera = *storage_->exposures[exposure].camera;
+  ImageObservation mapped = o;
+  mapped.pixel = camera.subimages[camera.SubimageIndex(o.subimage)].VirtualFromSub(o.pixel);
+  mapped.subimage.clear();
+  return {&storage_->frame, mapped};
+}
+
+std::optional<Eigen::Vector2d> BlockAdjustment::ResidualAtCurrentValues(
+    const ImageObservation& observation) {
+  const ExposureIndex exposure = storage_->index.FindExposure(observation.image);
+  const BlockId point = PointBlock(observation.point);
+  if (exposure < 0 || point < 0 || storage_->exposures[exposure].opk_block < 0) return std::nullopt;
+  auto [sensor, measured] = SensorOf(observation);
+  const ObservationTerm term = sensor->Observe(storage_->context, measured, point);
+  std::vector<const double*> values;
+  for (BlockId b : term.blocks) values.push_back(builder_.BlockValues(b));
+  if (term.cost->num_residuals() != 2) return std::nullopt;
+  Eigen::Vector2d v;
+  if (!term.cost->Evaluate(values.data(), v.data(), nullptr) || !v.allFinite()) return std::nullopt;
+  return v;
+}
+
 void BlockAdjustment::BuildPoints() {
   // Each observation with the sensor kind that measures it; a raw sub-image observation no kind
   // measures is mapped to the virtual image with the camera file's mapping.
   for (size_t source = 0; source < project_.observations.size(); ++source) {
     const ImageObservation& o = project_.observations[source];
     storage_->source_of_observation.push_back(static_cast<int>(source));
-    ImagingModel* sensor = nullptr;
-    for (auto& s : storage_->sensors)
-      if (!sensor && s->Measures(o)) sensor = s.get();
-    if (!sensor && !o.head.empty())  // never a virtual-image pixel: the rig bundle measures it
-      ThrowInputError({project_.observations_file, o.line},
-                      "image " + o.image + " head " + o.head +
-                          ": rig head observations are adjusted by the rig bundle (aerocal "
-                          "adjust without --joint-stitching)");
-    if (!sensor && storage_->frame.Measures(o)) sensor = &storage_->frame;
-    const ExposureIndex exposure = storage_->index.Exposure(o.image);
-    storage_->exposure_of_observation.push_back(exposure);
-    if (sensor) {
-      storage_->observations.push_back(o);
-      storage_->sensor_of_observation.push_back(sensor);
-      continue;
-    }
-    const auto& camera = *storage_->exposures[exposure].camera;
-    ImageObservation mapped = o;
-    mapped.pixel = camera.subimages[camera.SubimageIndex(o.subimage)].VirtualFromSub(o.pixel);
-    mapped.subimage.clear();
-    storage_->observations.push_back(mapped);
-    storage_->sensor_of_observation.push_back(&storage_->frame);
+    storage_->exposure_of_observation.push_back(storage_->index.Exposure(o.image));
+    auto [sensor, measured] = SensorOf(o);
+    storage_->observations.push_back(std::move(measured));
+    storage_->sensor_of_observation.push_back(sensor);
   }
   // The points: a dense index per observed point id (sorted ids), assigned once.
   Storage& s = *storage_;
@@ -259,6 +277,20 @@ void BlockAdjustment::BuildPoints() {
   for (const auto& o : s.observations) s.point_of_observation.push_back(s.FindPoint(o.point));
   const int n_exposures = s.index.NumExposures();
   const int n_points = static_cast<int>(s.points.size());
+  // An exposure that no observation names is named, never silently unused (issue 28).
+  std::vector<bool> observed(n_exposures, false);
+  for (ExposureIndex e : s.exposure_of_observation) observed[e] = true;
+  for (ExposureIndex k : s.exposure_order) {
+    if (observed[k]) continue;
+    const Exposure& e = *s.exposures[k].exposure;
+    const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
+    const std::string where = project_.exposures_file.empty()
+                                  ? ""
+                                  : " (" + SourceRef{project_.exposures_file, e.line}.ToString() + ")";
+    s.notes.push_back("image " + e.image + where + " has no image observation: " +
+                      (held ? "its orientation is its GNSS/IMU priors only"
+                            : "not adjusted, no orientation written"));
+  }
   // An exposure seeing fewer than three points (and not held by GNSS and IMU priors) cannot be
   // oriented; leaving it out can leave a point with one ray, so repeat until nothing changes.
   for (bool changed = true; changed;) {
@@ -822,6 +854,7 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   s.findings = out.findings;
   s.unresolved_reason = out.unresolved_reason;
   for (const auto& x : out.unresolved) {
+    storage_->unresolved_ids.push_back(x.id);
     UnresolvedSurvey u;
     u.survey = x.label;
     u.w = x.w_full;
@@ -839,8 +872,9 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
           "a-priori sigmas";
     else if (storage_->exposures.size() >= 3 && (control >= 3 || !storage_->free_network))
       s.suggestion =
-          "self-calibration (--self-calibration all, or a subset such as c,x0,y0,K1,K2) may "
-          "absorb it: the block has " +
+          "self-calibration with --self-calibration auto (it frees only what this block "
+          "determines and what is significant, and names what it holds) may absorb it: the "
+          "block has " +
           std::to_string(storage_->exposures.size()) + " exposures and " +
           std::to_string(control) + " control point(s)";
     else
@@ -1186,20 +1220,33 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
                       -d.difference_m.z())});
   }
   if (!result.snooping.unresolved_surveys.empty()) {
+    // Judged by its effect (issue 28): invalid only when leaving the suspects out moves a
+    // parameter by more than the limit in its sigmas.
+    SuspectEffect& effect = result.snooping.unresolved_effect;
+    effect = EffectOfLeavingOut(builder_, storage_->unresolved_ids, cov, cov_blocks, cross_blocks,
+                                options_.solver, options_.suspect_effect_limit);
     std::string names;
     double w = 0.0;
     for (const auto& u : result.snooping.unresolved_surveys) {
       names += (names.empty() ? "" : ", ") + u.survey;
       w = std::max(w, u.w);
     }
+    const std::string impact =
+        effect.computed
+            ? "leaving them out moves " + effect.parameter + " by " +
+                  FormatNumber(effect.max_sigmas, 2) + " of its sigmas (limit " +
+                  FormatNumber(effect.limit_sigmas, 3) + ", --suspect-effect-limit)"
+            : "their effect cannot be judged: " + effect.message;
     const std::string message =
         "control survey blunder not resolved: " + names + " fail the survey test (w up to " +
         FormatNumber(w, 3) + " > " + FormatNumber(result.snooping.critical_value, 3) +
-        ") and none can be left out: " + result.snooping.unresolved_reason +
-        "; every survey is kept, the block is bent to fit them: check these surveys";
+        ") and none can be left out: " + result.snooping.unresolved_reason + "; " + impact +
+        (effect.Matters() ? "; every survey is kept, the block is bent to fit them: check these "
+                            "surveys"
+                          : "; every survey is kept and the result stands: check these surveys");
     result.warnings.push_back(
         {kWarningControlBlunderUnresolved, names, w, result.snooping.critical_value, message});
-    result.Invalidate(message);
+    if (effect.Matters()) result.Invalidate(message);
   }
   result.timing.total_s = seconds_since(run_start);
   return result;

@@ -45,7 +45,9 @@
 
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace aerocal::triangulation {
@@ -90,12 +92,23 @@ class BlockAdjustment {
     double w = 0.0;
   };
   std::vector<Screened> ScreenRobustly(double reject);
+  /// The whitened residual (photo x, y) of `observation`, which need not be one of the
+  /// adjustment's, at the blocks' current values (after Run(): the solution): its term built by
+  /// the sensor kind that measures it, exactly as the solve builds the terms it adds (the camera's
+  /// own model through the registry). nullopt when its exposure or point has no block here, or
+  /// the ray misses (behind the camera, the model's inversion fails).
+  std::optional<Eigen::Vector2d> ResidualAtCurrentValues(const ImageObservation& observation);
   /// With options.auto_robust_start: Run() returns right after the first solve, with
   /// robust_start_needed set, when its residuals call for a robust start (Adjust() uses it).
   void StopWhenRobustStartNeeded(bool stop) { stop_for_robust_start_ = stop; }
 
  private:
   struct Storage;
+  /// The sensor kind that measures `o` (the kinds given first, the frame camera last) and the
+  /// observation as it measures it: a raw sub-image observation no kind measures is mapped to the
+  /// virtual image with the camera file's mapping. InputError for a rig head observation no kind
+  /// measures.
+  std::pair<ImagingModel*, ImageObservation> SensorOf(const ImageObservation& o) const;
   void BuildExposures();
   void BuildPoints();
   /// Adds the ground point block of `point` (a dense index of the observed points), starting at

@@ -13,6 +13,7 @@
 #include "stitch/simulation/stitch_simulator.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/conventional_reference.h"
+#include "triangulation/adjustment/self_calibration_choice.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
 #include "triangulation/joint/joint_adjustment.h"
@@ -66,7 +67,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   const ObjectFrame object_frame(input.frame);
   const Project project = ToAdjustmentFrame(input, object_frame);
   const auto adjust = [&](const AdjustOptions& o) {
-    AdjustmentResult r = Adjust(project, o);
+    AdjustmentResult r = options.choose_free_set ? AdjustWithChosenFreeSet(project, o) : Adjust(project, o);
     ToInputFrame(object_frame, &r);
     return r;
   };
@@ -102,12 +103,26 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   nlohmann::json adjustments = nlohmann::json::array();
   AdjustOptions self_options;
   self_options.free_interior = options.free_interior;
-  const AdjustmentResult self_calibration = adjust(self_options);
+  self_options.suspect_effect_limit = options.suspect_effect_limit;
+  AdjustmentResult self_calibration = adjust(self_options);
+  self_options.free_interior = self_calibration.free_interior;  // the chosen set, for the joint
   if (progress) progress->Advance();
   // The conventional reference: same observations (gross errors decided by the full model).
-  AdjustmentResult conventional = AdjustConventionalReference(project, AdjustOptions{}, self_calibration);
+  AdjustOptions conventional_options;
+  conventional_options.suspect_effect_limit = options.suspect_effect_limit;
+  AdjustmentResult conventional =
+      AdjustConventionalReference(project, conventional_options, self_calibration);
   ToInputFrame(object_frame, &conventional);
   if (progress) progress->Advance();
+  // A self-calibrated camera that makes the check points significantly worse is not a calibration
+  // (self_calibration_choice.h): not written, the result not valid, with the test.
+  const CheckPointComparison check_test = CompareCheckPoints(conventional, self_calibration);
+  doc["check_point_test"] = {{"tested", check_test.tested}, {"n", check_test.n},
+                             {"f", check_test.f}, {"f_critical", check_test.f_critical},
+                             {"alpha", check_test.alpha}, {"worse", check_test.worse},
+                             {"message", check_test.message}};
+  if (check_test.worse) self_calibration.Invalidate(check_test.message);
+  out.summary.push_back(check_test.message);
   nlohmann::json a = AdjustmentToJson(conventional);
   a["name"] = "conventional";
   adjustments.push_back(a);
@@ -119,7 +134,10 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   CheckStep("conventional", conventional, &out);
   CheckStep("self-calibration", self_calibration, &out);
   out.calibrated_camera = UpdatedCamera(camera, self_calibration.cameras.at(0));
-  for (const AdjustmentResult* r : {static_cast<const AdjustmentResult*>(&conventional), &self_calibration}) {
+  out.camera_from = "self_calibration";
+  out.camera_from_reason = "the self-calibrating adjustment of the virtual-image observations";
+  for (const AdjustmentResult* r : {static_cast<const AdjustmentResult*>(&conventional),
+                                    static_cast<const AdjustmentResult*>(&self_calibration)}) {
     const std::string name = r == &conventional ? "conventional" : "self-calibration";
     out.summary.push_back(name + Line(": sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)", r->sigma0_px,
                                       r->check.spatial_rmse_m, r->check.n));
@@ -152,6 +170,10 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     out.converged = out.converged && joint.adjustment.converged();
     CheckStep("joint", joint.adjustment, &out);
     out.calibrated_camera = JointUpdatedCamera(camera, raw.cameras.begin()->first, joint);
+    out.camera_from = "joint";
+    out.camera_from_reason =
+        "the joint stitching + triangulation adjustment (interior and the sub-image mappings "
+        "refined together)";
     out.summary.push_back("joint: mappings " + joint.mapping_model + " (" + joint.mapping_model_reason + ")");
     out.summary.push_back(Line("joint: sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)",
                                joint.adjustment.sigma0_px, joint.adjustment.check.spatial_rmse_m,
@@ -169,6 +191,10 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     }
   doc["converged"] = out.converged;
   doc["valid"] = out.valid;
+  // Which adjustment the written camera comes from; null when none is written (not valid).
+  doc["camera_written_from"] = out.valid ? nlohmann::json{{"adjustment", out.camera_from},
+                                                          {"reason", out.camera_from_reason}}
+                                         : nlohmann::json();
   doc["failures"] = nlohmann::json::array();
   for (const auto& [step, reason] : out.failures) {
     doc["failures"].push_back({{"step", step}, {"reason", reason}});

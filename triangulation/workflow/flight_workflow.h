@@ -28,7 +28,12 @@ struct FlightWorkflowOptions {
   std::string camera_file;  // camera for every step (overrides the projects' camera files)
   std::string data_folder;  // project.yaml (virtual observations), optional project_subimage.yaml
   std::vector<std::string> base_ids;  // datum of the focal plane; empty: the reference points
+  /// The self-calibration's parameters; with choose_free_set the candidates of
+  /// AdjustWithChosenFreeSet (self_calibration_choice.h: only what the block determines and what
+  /// is significant), else calibrated as they are (`--self-calibration all` or a list).
   std::vector<std::string> free_interior = {"c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
+  bool choose_free_set = true;  // `--self-calibration auto`, the default
+  double suspect_effect_limit = 1.0;  // AdjustOptions::suspect_effect_limit
   double stitch_sigma_px = 0.1;  // where stitch_obs.csv has no sigma_px
   bool joint = true;             // run the joint adjustment when sub-image observations exist
   /// Mapping model of the joint step; nullopt: the one the stitching F test chose for the flight.
@@ -50,6 +55,8 @@ struct FlightWorkflowResult {
   bool valid = true;
   std::vector<std::pair<std::string, std::string>> failures;  // (step, reason)
   std::vector<std::string> summary; // one line per step, for the terminal (and each warning)
+  /// Which adjustment calibrated_camera comes from ("self_calibration" or "joint") and why.
+  std::string camera_from, camera_from_reason;
 };
 
 /// Runs the workflow; `progress` (may be null) advances once per step (5 steps).
