@@ -274,6 +274,13 @@ TEST(CalibrateCommand, BadInputExitsTwoAndWritesNothing) {
   r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " + tmp.File("obs.csv") +
                  " --images x --board chessboard:9x6:25 --out " + tmp.File("out.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
+  for (const char* bad : {"0", "-1", "nan", "2e3"}) {  // issue 28: the effect limit, by name
+    r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " +
+                   tmp.File("few.csv") + " --points " + tmp.File("points.csv") +
+                   " --suspect-effect-limit " + bad + " --out " + tmp.File("out.json"));
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+    EXPECT_NE(r.output.find("suspect"), std::string::npos) << r.output;
+  }
   r = RunAerocal("certificate --result " + tmp.File("points.csv") + " --out " + tmp.File("cert"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_FALSE(std::filesystem::exists(tmp.File("out.json")));

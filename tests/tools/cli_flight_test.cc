@@ -174,6 +174,28 @@ TEST_F(FlightWorkflow, ReportHoldsTablesAndPlots) {
   EXPECT_EQ(html.find("https://"), std::string::npos) << "the page must not need the network";
 }
 
+// Issue 28: flight's self-calibration is `auto` by default (held parameters named), the
+// check-point test and the origin of the written camera are in result.json; `none` is refused
+// (flight calibrates), and so is a bad --suspect-effect-limit, each by name with exit 2.
+TEST_F(FlightWorkflow, AutoSelfCalibrationCheckPointTestAndCameraOrigin) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
+  const auto& self = doc["adjustments"][1];
+  ASSERT_TRUE(self.contains("self_calibration_choice"));
+  EXPECT_EQ(self["self_calibration_choice"]["candidates"].size(), 10u);
+  ASSERT_TRUE(doc["check_point_test"]["tested"].get<bool>());
+  EXPECT_FALSE(doc["check_point_test"]["worse"].get<bool>());
+  EXPECT_EQ(doc["camera_written_from"]["adjustment"], "joint");
+  for (const std::string bad : {"--self-calibration none", "--self-calibration Q7",
+                                "--suspect-effect-limit -1"}) {
+    const auto r = testing::RunAerocal("flight --camera " + dir_->File("data/camera_nominal.yaml") +
+                                       " --data " + dir_->File("data") + " --out " +
+                                       dir_->File("bad") + " " + bad);
+    EXPECT_EQ(r.exit_code, 2) << bad << ": " << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir_->File("bad/result.json"))) << bad;
+  }
+}
+
 TEST(FlightWorkflowInput, MissingProjectIsABadInput) {
   testing::TempDir dir;
   std::filesystem::create_directories(dir.File("data"));

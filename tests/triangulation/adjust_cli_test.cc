@@ -147,6 +147,32 @@ TEST_F(AdjustCommand, AnImageIdStartingWithHashIsAdjustedAndAnUnobservedImageIsN
   EXPECT_TRUE(named) << j["notes"].dump();
 }
 
+// Issue 28: --self-calibration auto names what it holds and why; --suspect-effect-limit is
+// range-checked by name (NaN, zero, negative and huge values refused with exit 2, nothing written).
+TEST_F(AdjustCommand, SelfCalibrationAutoAndTheSuspectEffectLimit) {
+  const auto r = RunAerocal("adjust --project " + dir_.File("flight/project.yaml") +
+                            " --self-calibration auto --suspect-effect-limit 2 --out " +
+                            dir_.File("auto.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto j = ReadJson(dir_.File("auto.json"));
+  ASSERT_TRUE(j.contains("self_calibration_choice")) << j.dump().substr(0, 300);
+  const auto& choice = j["self_calibration_choice"];
+  EXPECT_EQ(choice["candidates"].size(), 10u);
+  EXPECT_EQ(choice["chosen"].size() + choice["held"].size(), 10u);
+  for (const auto& h : choice["held"]) EXPECT_FALSE(h["reason"].get<std::string>().empty());
+  // Without GNSS the simulated flight cannot separate c from the flying heights.
+  bool c_held = false;
+  for (const auto& h : choice["held"]) c_held = c_held || h["parameter"] == "c";
+  EXPECT_TRUE(c_held) << choice.dump();
+  for (const char* bad : {"0", "-1", "nan", "inf", "1e9"}) {
+    const auto b = RunAerocal("adjust --project " + dir_.File("flight/project.yaml") +
+                              " --suspect-effect-limit " + bad + " --out " + dir_.File("bad.json"));
+    EXPECT_EQ(b.exit_code, 2) << bad << ": " << b.output;
+    EXPECT_NE(b.output.find("suspect"), std::string::npos) << b.output;
+    EXPECT_FALSE(std::filesystem::exists(dir_.File("bad.json")));
+  }
+}
+
 // The GNSS/IMU platform: simulate plants a lever arm and a GNSS time offset, adjust estimates
 // them (options over the project YAML) and writes them with sigmas; a bad mode is exit 2.
 TEST(AdjustPlatform, SimulatedLeverArmAndTimeOffsetComeBack) {

@@ -13,7 +13,9 @@
 #include "tests/support/simulated_block.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/import/write_project.h"
 #include "triangulation/simulation/flight_simulator.h"
+#include "triangulation/workflow/flight_workflow.h"
 
 #include <gtest/gtest.h>
 
@@ -101,6 +103,28 @@ TEST(ChosenFreeSet, OdmUavBlockHoldsCAndKeepsTheCheckPoints) {
   EXPECT_FALSE(with_chosen.worse) << with_chosen.message;
   EXPECT_TRUE(Holds(chosen, "c", "not determinable"));
   EXPECT_EQ(chosen.cameras[0].estimated[0], project.cameras.begin()->second.interior[0]);
+}
+
+TEST(ChosenFreeSet, OdmUavBlockThroughTheFlightWorkflow) {
+  // `aerocal flight` on the ODM block as a user runs it (the imported project folder, its camera
+  // file): the camera it writes must not make the check points significantly worse than the
+  // conventional run, and the result says which adjustment it comes from.
+  const std::string dir = testing::SharedDataDir("odm_br_uav_gcp_block");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/odm_br_uav_gcp_block is absent";
+  testing::TempDir tmp("aerocal_odm_flight");
+  WriteProjectFolder(testing::ImportOdmUavBlock(dir), tmp.path());
+  FlightWorkflowOptions options;
+  options.camera_file = tmp.File("camera_cam1.yaml");
+  options.data_folder = tmp.path();
+  const FlightWorkflowResult flight = RunFlightWorkflow(options, nullptr);
+  for (const auto& line : flight.summary) std::printf("%s\n", line.c_str());
+  const auto& test = flight.document["check_point_test"];
+  ASSERT_TRUE(test["tested"].get<bool>());
+  EXPECT_FALSE(test["worse"].get<bool>()) << test["message"];
+  EXPECT_TRUE(flight.valid);
+  EXPECT_EQ(flight.document["camera_written_from"]["adjustment"], "self_calibration");
+  // c stays the camera file's: this block cannot calibrate it.
+  EXPECT_EQ(flight.calibrated_camera.c_mm(), 4.5);
 }
 
 TEST(ChosenFreeSet, OneStripOverFlatGroundHoldsCWithItsReason) {
