@@ -76,12 +76,9 @@ TEST(CameraFormatsOpenCv, PublishedChessboardCalibrationThroughEveryFormatProjec
     const std::string path = tmp.File("left." + format.name);
     format.write(path, out.file);
     calib::CameraReadOptions options;
-    options.width_px = format.name == "pix4d" ? 640 : 0;
-    options.height_px = format.name == "pix4d" ? 480 : 0;
-    const bool holds_pixel = format.name == "pix4d" || format.name == "pix4d-xmp" || format.name == "aerocal" ||
-                             format.name == "dbat" || format.name == "photomodeler" ||
-                             format.name == "australis";
-    options.pixel_size_mm = holds_pixel ? 0 : 0.006;
+    options.width_px = format.writes_size ? 0 : 640;
+    options.height_px = format.writes_size ? 0 : 480;
+    options.pixel_size_mm = format.writes_pixel_size ? 0 : 0.006;
     const CameraFile read = format.read(path, options);
     const calib::FileConversion back =
         calib::ConvertCameraFile(read, {CameraModelId::kOpenCv, {}});
@@ -196,14 +193,15 @@ TEST(CliCamera, ConvertsOursIntoEveryFormatAndBackWithAReport) {
     if (format.name == "metashape") {
       EXPECT_NE(Read(out).find("<covariance>"), std::string::npos);
     }
-    const bool holds_pixel = format.name == "aerocal" || format.name == "dbat" || format.name == "pix4d-xmp" ||
-                             format.name == "photomodeler" || format.name == "australis";
-    const std::string extra = format.name == "pix4d" ? " --width 14000 --height 12000"
-                              : holds_pixel          ? ""
-                                                     : " --pixel-mm 0.009";
-    r = RunAerocal("camera convert --from " + format.name + " --to aerocal --model brown10 " + out +
-                   " " + tmp.File("back_" + format.name + ".yaml") + extra);
+    const std::string extra = !format.writes_size          ? " --width 14000 --height 12000"
+                              : format.writes_pixel_size ? ""
+                                                         : " --pixel-mm 0.009";
+    // Back with --from auto: every file we write is detected as its own format.
+    r = RunAerocal("camera convert --from auto --to aerocal --model brown10 " + out + " " +
+                   tmp.File("back_" + format.name + ".yaml") + extra);
     ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("read as " + format.name + " (--from auto)"), std::string::npos)
+        << r.output;
   }
 }
 
