@@ -77,17 +77,47 @@ calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib
   return r;
 }
 
+namespace {
+
+bool OpenStorage(const std::string& text, cv::FileStorage* fs) {
+  try {
+    return fs->open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY) && fs->isOpened();
+  } catch (const cv::Exception&) {
+    return false;
+  }
+}
+
+// A YAML file cut short (the first lines of a calibration output): the longest prefix that ends
+// before a top-level key and parses; 0 when there is none.
+size_t ReadablePrefixLines(const std::vector<std::string>& lines, cv::FileStorage* fs) {
+  for (size_t cut = lines.size(); cut-- > 1;) {
+    const std::string& line = lines[cut];
+    if (line.empty() || line[0] == ' ' || line[0] == '-' || line[0] == '#' ||
+        line.find(':') == std::string::npos)
+      continue;
+    std::string text;
+    for (size_t i = 0; i < cut; ++i) text += lines[i] + "\n";
+    if (OpenStorage(text, fs)) return cut;
+  }
+  return 0;
+}
+
+}  // namespace
+
 CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOptions& options) {
   CheckInputFile(path);
   cv::FileStorage fs;
-  try {
-    // The text is read by our reader (regular-file checks, BOM) and parsed from memory.
-    const std::string text = ReadTextFile(path);
-    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
-  } catch (const cv::Exception& e) {
-    ThrowInputError({path, 0}, std::string("cv::FileStorage cannot parse it: ") + e.err);
+  std::vector<std::string> notes;
+  // The text is read by our reader (regular-file checks, BOM) and parsed from memory.
+  const std::string text = ReadTextFile(path);
+  if (!OpenStorage(text, &fs)) {
+    const std::vector<std::string> lines = SplitLines(text);
+    const size_t kept = text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, &fs) : 0;
+    if (kept == 0) ThrowInputError({path, 1}, "cv::FileStorage cannot parse it");
+    notes.push_back("the file is cut short: lines 1-" + std::to_string(kept) +
+                    " read (the entry from line " + std::to_string(kept + 1) +
+                    " on is incomplete)");
   }
-  if (!fs.isOpened()) ThrowInputError({path, 1}, "cv::FileStorage cannot parse it");
   std::string matrix_key = "camera_matrix", dist_key = "distortion_coefficients";
   if (fs["camera_matrix"].empty()) {
     const std::string id = options.camera_id.empty() ? "1" : options.camera_id;
@@ -123,6 +153,7 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
     ThrowInputError({path, 0}, matrix_key + " must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
                                             "modelled)");
   CameraFile file;
+  file.notes = notes;
   file.name = std::filesystem::path(path).stem().string();
   file.camera.model = CameraModelId::kOpenCv;
   file.camera.params.assign(OpenCvModel::kNumParams, 0.0);

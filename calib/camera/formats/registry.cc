@@ -75,7 +75,9 @@ std::vector<CameraFormat>& Registry() {
        [](const ModelCamera&) { return FormatTarget{CameraModelId::kMetashapeFrame, {}}; },
        [](const std::string& h, const std::string&) {
          // A calibration export, a cameras export, a .psx project, a .psz / .zip project archive.
-         return Has(h, "<calibration") || Has(h, "<sensor ") || Has(h, "<sensors") ||
+         if (Has(h, "<opencv_storage>")) return false;  // OpenCV's <calibration_time>
+         return Has(h, "<calibration>") || Has(h, "<calibration ") || Has(h, "<sensor ") ||
+                Has(h, "<sensors") ||
                 (Has(h, "<document") && Has(h, "<chunks")) ||
                 (internal::LooksLikeZip(h) && Has(h, "doc.xml"));
        },
