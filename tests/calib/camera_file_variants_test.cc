@@ -502,5 +502,41 @@ TEST(CameraFileVariants, ColmapIdsFromZeroAndTheBinaryFile) {
             std::string::npos);
 }
 
+// ---- DBAT ----
+
+// A DBAT camera XML fragment (a <camera> without <document>), the c4040z result camera of DBAT's
+// camcal demo (../shared/data/dbat_camcal_olympus_c4040z/result/c4040z.xml, DBAT 0.9.2.0), and a
+// <cameras> list of two (the second the same camera under id 2): --camera picks.
+TEST(CameraFileVariants, DbatFragmentsAndTheAspectAsB1) {
+  TempDir dir("aerocal_variants");
+  const std::string camera =
+      "<camera>\n<id>1</id>\n<name>Olympus Camedia C4040Z</name>\n<unit>mm</unit>\n"
+      "<calibrated>yes</calibrated>\n<sensor>7.25301132255482273,5.43764000000000003</sensor>\n"
+      "<image>2272,1704</image>\n<aspect>0.999610402322309577</aspect>\n<focal>7.5</focal>\n"
+      "<model>3</model>\n<nK>3</nK>\n<nP>2</nP>\n<cc>7.45699532273933752</cc>\n"
+      "<pp>3.61546239970888994,2.61329279848268081</pp>\n<skew>0</skew>\n"
+      "<K>0.00458860662755811253,-4.51350997187018702e-05,-2.05253370760761127e-06</K>\n"
+      "<P>-6.12803065099492536e-05,-4.41170561685059337e-05</P>\n</camera>\n";
+  const std::string one = Write(dir, "camera.xml", camera);
+  EXPECT_EQ(DetectCameraFormats(one), std::vector<std::string>{"dbat"});
+  const CameraFile f = ReadCameraFileAs("auto", one, {});
+  EXPECT_EQ(f.name, "Olympus Camedia C4040Z");
+  EXPECT_NEAR(P(f, "B1"), 1.0 - 0.999610402322309577, 1e-9);  // as = 1 - aspect
+  EXPECT_TRUE(HasNote(f, "not exact"));
+  std::string second = camera;
+  second.replace(second.find("<id>1</id>"), 10, "<id>2</id>");
+  const std::string two = Write(dir, "cameras.xml", "<cameras>\n" + camera + second + "</cameras>\n");
+  EXPECT_NE(ReadError("auto", two).find("name one with --camera (1, 2)"), std::string::npos);
+  CameraReadOptions options;
+  options.camera_id = "2";
+  EXPECT_EQ(ReadCameraFileAs("auto", two, options).camera.params, f.camera.params);
+  // Written back with the aspect and read again: the same camera.
+  const std::string out = dir.File("back.xml");
+  WriteDbatCameraXml(out, f);
+  const CameraFile back = ReadDbatCameraXml(out, {});
+  for (size_t i = 0; i < f.camera.params.size(); ++i)
+    EXPECT_NEAR(back.camera.params[i], f.camera.params[i], 1e-14 * (1 + std::abs(f.camera.params[i])));
+}
+
 }  // namespace
 }  // namespace aerocal::calib

@@ -243,7 +243,7 @@ TEST(CameraFormats, OursThroughEveryFormatAndBackStatesItsResidual) {
         // for the drone; the 8-coefficient rational form gave 1.95 px with k1 = +2.33 for a lens
         // whose k1 is about -0.28, which every 5-coefficient reader misreads.
         {"colmap", {0.048, 9.56}}, {"metashape", {5.6e-5, 3.46}}, {"pix4d", {0.090, 10.7}}, {"pix4d-xmp", {0.090, 10.7}},
-        {"opensfm", {0.048, 9.56}}, {"dji", {0.048, 9.56}},       {"dbat", {0.090, 2.61}}, {"photomodeler", {0.090, 2.61}},
+        {"opensfm", {0.048, 9.56}}, {"dji", {0.048, 9.56}},       {"dbat", {0.048, 0.013}} /* B1 as the aspect */, {"photomodeler", {0.090, 2.61}},
         {"kalibr", {0.064, 16.3}}, {"ros", {0.048, 9.56}}, {"camodocal", {0.064, 16.3}}};
     EXPECT_LT(a.out_max_px, 1.2 * stated.at(f.name).first) << f.name;
     EXPECT_LT(d.out_max_px, 1.2 * stated.at(f.name).second) << f.name;
@@ -384,14 +384,22 @@ TEST(CameraFormatsRealData, DbatResultCameraAgainstItsReport) {
   // corner, K1 4.58861e-3, K2 -4.51351e-5, K3 -2.05253e-6, P1 -6.12803e-5, P2 -4.41171e-5.
   const double p = 5.43764 / 1704;
   EXPECT_NEAR(f.camera.params[B::kC], 7.45700, 5e-6);
-  EXPECT_NEAR(f.camera.params[B::kX0], 3.61546 - 1136 * p, 5e-6);
+  // DBAT's pixel aspect (report: as 3.89598e-4, the XML's aspect 1 - as; pixel width 0.00319235
+  // mm, height 0.0031911 mm) scales DBAT's x: B1 = s - 1 = as, x0 = px / s - W p / 2 (0.44 px
+  // from ignoring it).
+  const double s = (7.25301132255482273 / 2272) / p;
+  EXPECT_NEAR(s, 1.0 + 3.89598e-4, 1e-9);  // pixel width = pixel height (1 + as)
+  EXPECT_NEAR(f.camera.params[B::kB1], s - 1.0, 1e-15);
+  EXPECT_NEAR(f.camera.params[B::kX0], 3.61546 / s - 1136 * p, 5e-6);
   EXPECT_NEAR(f.camera.params[B::kY0], 852 * p - 2.61329, 5e-6);
   EXPECT_NEAR(f.camera.params[B::kK1], 4.58861e-3, 5e-9);
   EXPECT_NEAR(f.camera.params[B::kK2], -4.51351e-5, 5e-11);
   EXPECT_NEAR(f.camera.params[B::kK3], -2.05253e-6, 5e-12);
   EXPECT_NEAR(f.camera.params[B::kP1], -6.12803e-5, 5e-11);
   EXPECT_NEAR(f.camera.params[B::kP2], -4.41171e-5, 5e-11);
-  ASSERT_EQ(f.notes.size(), 1u);  // the aspect 0.99961 is not modelled: said
+  ASSERT_EQ(f.notes.size(), 1u);  // the aspect as B1, not exact: said with its size
+  std::printf("DBAT c4040z: %s\n", f.notes[0].c_str());
+  EXPECT_NE(f.notes[0].find("not exact"), std::string::npos);
   TempDir tmp("aerocal_formats");
   const CameraFile back = WriteAndRead(FormatNamed("dbat"), f, tmp);
   ExpectSameParams(f.camera, back.camera, "dbat");
@@ -484,7 +492,7 @@ TEST(CameraFormatsRealData, AustralisReportOfThePublicExample) {
   ASSERT_TRUE(back.covariance);
   EXPECT_NEAR((*back.covariance)(B::kK1, B::kK1), (*a.covariance)(B::kK1, B::kK1), 1e-22);
   // Into PhotoModeler (no B1, B2: a fit over the format, stated) and DBAT likewise.
-  const FileConversion pm = ConvertCameraFile(a, Formats()[7].target);
+  const FileConversion pm = ConvertCameraFile(a, FormatNamed("photomodeler").target);
   EXPECT_FALSE(pm.result.exact);
   std::printf("Australis WASP-LT -> photomodeler: %s\n", pm.result.Summary().c_str());
   EXPECT_GT(pm.result.residual.max_px, 0.01);  // B1 -4.3e-4 at 2.3 mm: 0.14 px, not nothing

@@ -112,13 +112,11 @@ std::vector<CameraFormat>& Registry() {
          return std::regex_match(h.substr(0, h.find('\n')), kRecord);
        },
        ".xmp"},
-      {"dbat", "DBAT camera XML (c, pp, K1-K3, P1, P2 in mm)", ReadDbatCameraXml,
-       WriteDbatCameraXml,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
-       },
+      {"dbat", "DBAT camera XML, whole or a <cameras> / <camera> fragment (c, pp, aspect, K1-K3, P1, P2 in mm)",
+       ReadDbatCameraXml, WriteDbatCameraXml,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kBrownFraser10, {"B2"}, true}; },
        [](const std::string& h, const std::string&) {
-         return Has(h, "<camera>") && (Has(h, "<cc>") || Has(h, "<pp>"));
+         return (Has(h, "<camera>") || Has(h, "<camera ")) && (Has(h, "<cc>") || Has(h, "<pp>"));
        },
        ".xml", true, true},
       {"photomodeler", "PhotoModeler Bundle Soln export's camera (f, pp, format, K1-K3, P1, P2 mm)",
