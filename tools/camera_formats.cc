@@ -18,88 +18,22 @@ using calib::FormatTarget;
 using calib::ModelCamera;
 using calib::OpenCvModel;
 
-calib::OpenCvParams AsOpenCv(const ModelCamera& camera) {
-  calib::OpenCvParams cv;
-  calib::VisitCameraModel(camera.model, [&](auto m) {
-    return decltype(m)::ToOpenCv(camera.params.data(), camera.frame, &cv);
-  });
-  return cv;
+bool LooksLikeOpenCv(const std::string& head, const std::string&) {
+  // cv::FileStorage tags every matrix (YAML !!opencv-matrix, XML and JSON type_id).
+  return head.find("opencv-matrix") != std::string::npos ||
+         head.find("<opencv_storage>") != std::string::npos;
 }
 
-bool IsFisheye(const ModelCamera& c) { return c.model == CameraModelId::kOpenCvFisheye; }
-
-FormatTarget ColmapTarget(const ModelCamera& source) {
-  if (!calib::ColmapName(source.model).empty()) return {source.model, {}};
-  const calib::OpenCvParams cv = AsOpenCv(source);
-  const bool full = cv[OpenCvModel::kK3] != 0 || cv[OpenCvModel::kK4] != 0 ||
-                    cv[OpenCvModel::kK5] != 0 || cv[OpenCvModel::kK6] != 0;
-  return {full ? CameraModelId::kColmapFullOpenCv : CameraModelId::kColmapOpenCv, {}};
-}
-
-}  // namespace
-
-const std::vector<CameraFormat>& CameraFormats() {
-  static const std::vector<CameraFormat> formats = {
-      {"aerocal", "our camera YAML (any registry model; a rig file's head by --camera)",
-       calib::ReadAerocalCamera, calib::WriteAerocalCamera,
-       [](const ModelCamera& s) { return FormatTarget{s.model, {}, true}; }},
+// The opencv row of calib's registry (OpenCV stays out of calib).
+const bool kOpenCvRegistered = [] {
+  calib::RegisterCameraFormat(
       {"opencv", "OpenCV FileStorage YAML/XML/JSON (camera_matrix, distortion_coefficients)",
        ReadOpenCvCamera, WriteOpenCvCamera,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kOpenCv, {}}; }},
-      {"colmap", "COLMAP cameras.txt (SIMPLE_PINHOLE ... FULL_OPENCV)", calib::ReadColmapCameras,
-       calib::WriteColmapCameras, ColmapTarget},
-      {"metashape", "Agisoft Metashape calibration XML (frame)", calib::ReadMetashapeCalibration,
-       calib::WriteMetashapeCalibration,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kMetashapeFrame, {}}; }},
-      {"pix4d", "Pix4D internal camera parameters (.cam)", calib::ReadPix4dCam, calib::WritePix4dCam,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; }},
-      {"pix4d-xmp", "Pix4D camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, PerspectiveDistortion; a JPEG or an XMP sidecar)",
-       calib::ReadPix4dXmp, calib::WritePix4dXmp,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; }},
-      {"opensfm", "OpenSfM / OpenDroneMap cameras.json", calib::ReadOpenSfmCameras,
-       calib::WriteOpenSfmCameras,
-       [](const ModelCamera& s) {
-         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {"k3", "k4"}}
-                             : FormatTarget{CameraModelId::kOpenCv, {"k4", "k5", "k6"}};
-       }},
-      {"dji", "DJI XMP DewarpData / DewarpDataK6 (a DJI JPEG, an XMP sidecar or the string)",
-       calib::ReadDjiDewarpData, calib::WriteDjiDewarpData,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kOpenCv, {}}; }},
-      {"dbat", "DBAT camera XML (c, pp, K1-K3, P1, P2 in mm)", calib::ReadDbatCameraXml,
-       calib::WriteDbatCameraXml,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
-       }},
-      {"photomodeler", "PhotoModeler Bundle Soln export's camera (f, pp, format, K1-K3, P1, P2 mm)",
-       calib::ReadPhotoModelerCamera, calib::WritePhotoModelerCamera,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
-       }},
-      {"australis", "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
-       calib::ReadAustralisCamera, calib::WriteAustralisCamera,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kBrownFraser10, {}, true}; }},
-      {"kalibr", "Kalibr camchain YAML (pinhole radtan / equidistant)", calib::ReadKalibrCamchain,
-       calib::WriteKalibrCamchain,
-       [](const ModelCamera& s) {
-         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}}
-                             : FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
-       }},
-  };
-  return formats;
-}
+       calib::OpenCvTarget, LooksLikeOpenCv, ".yml"});
+  return true;
+}();
 
-std::string CameraFormatNames() {
-  std::string names;
-  for (const auto& f : CameraFormats()) names += (names.empty() ? "" : ", ") + f.name;
-  return names;
-}
-
-const CameraFormat& FindCameraFormat(const std::string& name, const std::string& option) {
-  for (const auto& f : CameraFormats())
-    if (f.name == name) return f;
-  throw ConfigError(option + ": unknown camera format '" + name + "' (expected " +
-                    CameraFormatNames() + ")");
-}
+}  // namespace
 
 std::string DescribeConversion(const calib::ConversionResult& r) {
   char buffer[256];
@@ -126,14 +60,15 @@ calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib
     const Eigen::Map<const Eigen::VectorXd> sigma(posterior_sigma->data(), posterior_sigma->size());
     source.covariance = Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal());
   }
-  const bool holds_covariance = format.name == "metashape" || format.name == "australis";
-  if (source.covariance && !holds_covariance) {
+  if (source.covariance && !format.holds_covariance) {
     source.covariance.reset();
     std::printf("note: interior sigmas not written: %s holds no covariance\n", format.name.c_str());
   }
-  const calib::FileConversion conversion =
-      calib::ConvertCameraFile(source, format.target(source.camera));
-  format.write(path, conversion.file);
+  std::vector<std::string> tried;
+  const calib::FileConversion conversion = calib::ConvertCameraFileSimplest(
+      source, format.target(source.camera), {}, kDefaultMaxCoefficients, &tried);
+  for (const std::string& line : tried) std::printf("  %s\n", line.c_str());
+  calib::WriteCameraFileVerified(format, path, conversion.file);
   const calib::ConversionResult& r = conversion.result;
   std::printf("camera as %s (%s): %s; %s\n", format.name.c_str(),
               std::string(calib::CameraModelName(r.camera.model)).c_str(),
@@ -142,17 +77,47 @@ calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib
   return r;
 }
 
+namespace {
+
+bool OpenStorage(const std::string& text, cv::FileStorage* fs) {
+  try {
+    return fs->open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY) && fs->isOpened();
+  } catch (const cv::Exception&) {
+    return false;
+  }
+}
+
+// A YAML file cut short (the first lines of a calibration output): the longest prefix that ends
+// before a top-level key and parses; 0 when there is none.
+size_t ReadablePrefixLines(const std::vector<std::string>& lines, cv::FileStorage* fs) {
+  for (size_t cut = lines.size(); cut-- > 1;) {
+    const std::string& line = lines[cut];
+    if (line.empty() || line[0] == ' ' || line[0] == '-' || line[0] == '#' ||
+        line.find(':') == std::string::npos)
+      continue;
+    std::string text;
+    for (size_t i = 0; i < cut; ++i) text += lines[i] + "\n";
+    if (OpenStorage(text, fs)) return cut;
+  }
+  return 0;
+}
+
+}  // namespace
+
 CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOptions& options) {
   CheckInputFile(path);
   cv::FileStorage fs;
-  try {
-    // The text is read by our reader (regular-file checks, BOM) and parsed from memory.
-    const std::string text = ReadTextFile(path);
-    fs.open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY);
-  } catch (const cv::Exception& e) {
-    ThrowInputError({path, 0}, std::string("cv::FileStorage cannot parse it: ") + e.err);
+  std::vector<std::string> notes;
+  // The text is read by our reader (regular-file checks, BOM) and parsed from memory.
+  const std::string text = ReadTextFile(path);
+  if (!OpenStorage(text, &fs)) {
+    const std::vector<std::string> lines = SplitLines(text);
+    const size_t kept = text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, &fs) : 0;
+    if (kept == 0) ThrowInputError({path, 1}, "cv::FileStorage cannot parse it");
+    notes.push_back("the file is cut short: lines 1-" + std::to_string(kept) +
+                    " read (the entry from line " + std::to_string(kept + 1) +
+                    " on is incomplete)");
   }
-  if (!fs.isOpened()) ThrowInputError({path, 1}, "cv::FileStorage cannot parse it");
   std::string matrix_key = "camera_matrix", dist_key = "distortion_coefficients";
   if (fs["camera_matrix"].empty()) {
     const std::string id = options.camera_id.empty() ? "1" : options.camera_id;
@@ -188,6 +153,7 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
     ThrowInputError({path, 0}, matrix_key + " must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
                                             "modelled)");
   CameraFile file;
+  file.notes = notes;
   file.name = std::filesystem::path(path).stem().string();
   file.camera.model = CameraModelId::kOpenCv;
   file.camera.params.assign(OpenCvModel::kNumParams, 0.0);

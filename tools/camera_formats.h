@@ -1,8 +1,6 @@
-// The camera-file formats of `aerocal camera` and `--camera-format` by their command-line names:
-// aerocal, opencv, colmap, metashape, pix4d, opensfm, dji, dbat, photomodeler, australis, kalibr. Each entry is a reader,
-// a writer and the registry model it writes (calib/camera/formats/camera_formats.h has the
-// formats and their conventions; opencv, via cv::FileStorage, lives here because OpenCV stays out
-// of calib).
+// The camera-file formats of `aerocal camera` and `--camera-format`: calib's registry
+// (calib/camera/formats/camera_formats.h CameraFormats(), the formats and their conventions) plus
+// the opencv row registered here, because cv::FileStorage and OpenCV stay out of calib.
 #pragma once
 
 #include <functional>
@@ -14,19 +12,14 @@
 
 namespace aerocal::tools {
 
-struct CameraFormat {
-  std::string name;
-  std::string description;
-  std::function<calib::CameraFile(const std::string&, const calib::CameraReadOptions&)> read;
-  std::function<void(const std::string&, const calib::CameraFile&)> write;
-  /// The model (and zero parameters) a source camera is written in by this format.
-  std::function<calib::FormatTarget(const calib::ModelCamera& source)> target;
-};
+// The registry lives in calib (camera_formats.h); this layer adds the OpenCV FileStorage row.
+using calib::CameraFormat;
+using calib::CameraFormatNames;
+using calib::CameraFormats;
+using calib::FindCameraFormat;
 
-const std::vector<CameraFormat>& CameraFormats();
-/// ConfigError naming `option` and the format names when unknown.
-const CameraFormat& FindCameraFormat(const std::string& name, const std::string& option);
-std::string CameraFormatNames();
+/// Distortion coefficients written by default into OpenCV-form files (k1 k2 p1 p2 k3).
+inline constexpr int kDefaultMaxCoefficients = 5;
 
 /// One line on how exactly a conversion holds: residual RMS, max and where, max within 80 %.
 std::string DescribeConversion(const calib::ConversionResult& result);

@@ -29,10 +29,14 @@ using calib::CameraFile;
 
 struct ReadArgs {
   std::string from, in, camera_id;
+  mutable std::string used;  // the format read (--from, or what auto detected)
   int width = 0, height = 0;
   double pixel_mm = 0;
   void Add(CLI::App* app) {
-    app->add_option("--from", from, "Format of IN: " + CameraFormatNames())->required();
+    app->add_option("--from", from,
+                    "Format of IN: " + CameraFormatNames() +
+                        ", or auto (the one format the content looks like)")
+        ->required();
     app->add_option("--camera", camera_id,
                     "Which camera of a file holding several (COLMAP id, Metashape sensor id, "
                     "OpenSfM/Kalibr key, rig head, OpenCV stereo 1/2)");
@@ -45,13 +49,14 @@ struct ReadArgs {
         ->check(CLI::Range(1e-5, 1.0));
   }
   CameraFile Read() const {
-    const CameraFormat& format = FindCameraFormat(from, "--from");
     calib::CameraReadOptions options;
     options.camera_id = camera_id;
     options.width_px = width;
     options.height_px = height;
     options.pixel_size_mm = pixel_mm;
-    return format.read(in, options);
+    CameraFile file = calib::ReadCameraFileAs(from, in, options, &used);
+    if (from == "auto") std::printf("%s: read as %s (--from auto)\n", in.c_str(), used.c_str());
+    return file;
   }
 };
 
@@ -59,6 +64,7 @@ struct ConvertArgs {
   ReadArgs read;
   std::string to, out, model, report;
   double max_residual_px = std::numeric_limits<double>::infinity();
+  int max_coefficients = kDefaultMaxCoefficients;
 };
 
 int RunConvert(const ConvertArgs& a) {
@@ -78,8 +84,11 @@ int RunConvert(const ConvertArgs& a) {
   }
   calib::ConvertOptions options;
   options.max_residual_px = a.max_residual_px;
-  const calib::FileConversion conversion = calib::ConvertCameraFile(source, target, options);
+  std::vector<std::string> tried;
+  const calib::FileConversion conversion =
+      calib::ConvertCameraFileSimplest(source, target, options, a.max_coefficients, &tried);
   const calib::ConversionResult& r = conversion.result;
+  for (const std::string& line : tried) std::printf("  %s\n", line.c_str());
   std::vector<std::string> notes = source.notes;
   notes.insert(notes.end(), conversion.notes.begin(), conversion.notes.end());
   CameraFile written = conversion.file;
@@ -96,14 +105,14 @@ int RunConvert(const ConvertArgs& a) {
     }
   }
   const std::string model(calib::CameraModelName(r.camera.model));
-  std::printf("%s (%s, %s) -> %s (%s, %s): %s\n", a.read.in.c_str(), a.read.from.c_str(),
+  std::printf("%s (%s, %s) -> %s (%s, %s): %s\n", a.read.in.c_str(), a.read.used.c_str(),
               std::string(calib::CameraModelName(source.camera.model)).c_str(), a.out.c_str(),
               a.to.c_str(), model.c_str(),
               r.exact ? "exact (closed form)" : "least-squares fit over the format");
   std::printf("%s\n", DescribeConversion(r).c_str());
   for (const auto& note : notes) std::printf("note: %s\n", note.c_str());
   nlohmann::json report = {
-      {"from", a.read.from},
+      {"from", a.read.used},
       {"to", a.to},
       {"source_model", std::string(calib::CameraModelName(source.camera.model))},
       {"model", model},
@@ -118,6 +127,7 @@ int RunConvert(const ConvertArgs& a) {
         {"points", r.residual.points},
         {"failed_points", r.residual.failed_points}}},
       {"notes", notes},
+      {"coefficient_choices", tried},
       {"source_camera_model", calib::CameraModelTableToJson(source.camera.model)},
       {"camera_model", calib::CameraModelTableToJson(r.camera.model)}};
   if (!a.report.empty()) WriteResult(a.report, "camera_conversion", report);
@@ -128,7 +138,7 @@ int RunConvert(const ConvertArgs& a) {
                " not written");
     return kExitNotConverged;
   }
-  to.write(a.out, written);
+  calib::WriteCameraFileVerified(to, a.out, written);
   return kExitOk;
 }
 
@@ -279,6 +289,11 @@ CommandRun Setup(CLI::App& app) {
                  "A conversion leaving more (max over the format, px) is an error: exit 3, OUT "
                  "not written")
       ->check(CLI::PositiveNumber);
+  cv->add_option("--max-coefficients", convert->max_coefficients,
+                 "OpenCV-form targets (opencv, ros, dji, colmap) reached by a fit: at most this "
+                 "many distortion coefficients, 4 (k1 k2 p1 p2), 5 (+ k3) or 8 (+ k4-k6); the "
+                 "fewest meeting --max-residual-px are written, each choice's residual printed")
+      ->check(CLI::IsMember({4, 5, 8}));
   auto show = std::make_shared<ShowArgs>();
   CLI::App* sh = app.add_subcommand(
       "show", "A camera file as a table in our convention plus its distortion (profile, SVG plot)");

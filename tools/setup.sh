@@ -8,7 +8,7 @@ build_dir="${1:-build}"
 
 packages=(cmake make g++ pkg-config
   libceres-dev libeigen3-dev libopencv-dev libgeographiclib-dev libyaml-cpp-dev libcli11-dev
-  nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libtiff-dev libtinyxml2-dev clang libclang-rt-dev
+  nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libtiff-dev libtinyxml2-dev zlib1g-dev clang libclang-rt-dev
   python3 python3-matplotlib python3-numpy poppler-utils)
 missing=()
 for p in "${packages[@]}"; do

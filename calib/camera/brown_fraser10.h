@@ -92,7 +92,9 @@ struct BrownFraser10Model {
     const auto ideal = [](const auto* p, const auto* xy, auto* out) {
       IdealFromMeasured(p, xy, out);
     };
-    return InvertMap2<kNumParams>(ideal, params, ideal_mm, start, measured_mm, tolerance_mm);
+    const double centre[2] = {ValueOf(params[kX0]), ValueOf(params[kY0])};
+    return InvertMap2<kNumParams>(ideal, params, ideal_mm, start, measured_mm, tolerance_mm, 50,
+                                  centre);
   }
   /// Exact OpenCV equivalent when K1 = K2 = K3 = P1 = P2 = B2 = 0 (the affinity B1 becomes
   /// fx = c / ((1 + B1) p), fy = c / p); otherwise that pinhole part as a starting value.

@@ -43,6 +43,50 @@ cv::Point2d Project(const ModelCamera& camera, const cv::Point3d& q) {
   return {pixel.x(), pixel.y()};
 }
 
+// OpenCV's calibration sample output (samples/cpp/calibration.cpp saveCameraParams: calibration_time,
+// nframes, image_width, image_height, board size, flags, camera_matrix, distortion_coefficients,
+// avg_reprojection_error, per_view_reprojection_errors, extrinsic_parameters, image_points) as
+// cv::FileStorage writes it in XML and JSON, and the published YAML output cut short (its first
+// 30 lines: a copy that stops inside per_view_reprojection_errors' data).
+TEST(CameraFormatsOpenCv, SampleOutputAsXmlJsonAndCutShort) {
+  TempDir tmp("aerocal_cli_camera");
+  const cv::Mat k = (cv::Mat_<double>(3, 3) << 535.9157, 0, 342.2832, 0, 535.9157, 235.5708, 0, 0, 1);
+  const cv::Mat d = (cv::Mat_<double>(5, 1) << -0.266373, -0.0385889, 0.00178319, -0.000281221, 0.238392);
+  for (const char* extension : {".xml", ".json"}) {
+    SCOPED_TRACE(extension);
+    const std::string path = tmp.File(std::string("out_camera_data") + extension);
+    {
+      cv::FileStorage fs(path, cv::FileStorage::WRITE);
+      fs << "calibration_time" << "Fri Nov 27 10:00:00 2026" << "nframes" << 13
+         << "image_width" << 640 << "image_height" << 480 << "board_width" << 9
+         << "board_height" << 6 << "square_size" << 0.025 << "flags" << 0 << "camera_matrix" << k
+         << "distortion_coefficients" << d << "avg_reprojection_error" << 0.3926
+         << "extrinsic_parameters" << cv::Mat(13, 6, CV_64F, cv::Scalar(0.1))
+         << "image_points" << cv::Mat(13, 54, CV_32FC2, cv::Scalar(1, 2));
+    }
+    EXPECT_EQ(calib::DetectCameraFormats(path), std::vector<std::string>{"opencv"});
+    const CameraFile f = calib::ReadCameraFileAs("auto", path, {});
+    EXPECT_EQ(f.camera.params[OpenCvModel::kFx], 535.9157);
+    EXPECT_EQ(f.camera.params[OpenCvModel::kK3], 0.238392);
+    EXPECT_EQ(f.camera.frame.height_px, 480);
+  }
+  const std::string dir = testing::SharedDataDir("opencv_stereo_chessboard_9x6");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data absent: the cut-short file is not tried";
+  const std::string full = Read(dir + "/left_intrinsics.yml");
+  std::string cut;
+  std::istringstream in(full);
+  int n = 0;
+  for (std::string line; n < 30 && std::getline(in, line); ++n) cut += line + "\n";
+  const std::string path = tmp.File("left_cut.yml");
+  std::ofstream(path) << cut;
+  EXPECT_EQ(calib::DetectCameraFormats(path), std::vector<std::string>{"opencv"});
+  const CameraFile f = calib::ReadCameraFileAs("auto", path, {});
+  const CameraFile whole = tools::ReadOpenCvCamera(dir + "/left_intrinsics.yml", {});
+  EXPECT_EQ(f.camera.params, whole.camera.params);
+  ASSERT_FALSE(f.notes.empty());
+  EXPECT_NE(f.notes[0].find("cut short"), std::string::npos) << f.notes[0];
+}
+
 TEST(CameraFormatsOpenCv, PublishedChessboardCalibrationThroughEveryFormatProjectsLikeOpenCv) {
   const std::string dir = testing::SharedDataDir("opencv_stereo_chessboard_9x6");
   if (dir.empty()) GTEST_SKIP() << "../shared/data absent";
@@ -76,12 +120,9 @@ TEST(CameraFormatsOpenCv, PublishedChessboardCalibrationThroughEveryFormatProjec
     const std::string path = tmp.File("left." + format.name);
     format.write(path, out.file);
     calib::CameraReadOptions options;
-    options.width_px = format.name == "pix4d" ? 640 : 0;
-    options.height_px = format.name == "pix4d" ? 480 : 0;
-    const bool holds_pixel = format.name == "pix4d" || format.name == "pix4d-xmp" || format.name == "aerocal" ||
-                             format.name == "dbat" || format.name == "photomodeler" ||
-                             format.name == "australis";
-    options.pixel_size_mm = holds_pixel ? 0 : 0.006;
+    options.width_px = format.writes_size ? 0 : 640;
+    options.height_px = format.writes_size ? 0 : 480;
+    options.pixel_size_mm = format.writes_pixel_size ? 0 : 0.006;
     const CameraFile read = format.read(path, options);
     const calib::FileConversion back =
         calib::ConvertCameraFile(read, {CameraModelId::kOpenCv, {}});
@@ -196,14 +237,15 @@ TEST(CliCamera, ConvertsOursIntoEveryFormatAndBackWithAReport) {
     if (format.name == "metashape") {
       EXPECT_NE(Read(out).find("<covariance>"), std::string::npos);
     }
-    const bool holds_pixel = format.name == "aerocal" || format.name == "dbat" || format.name == "pix4d-xmp" ||
-                             format.name == "photomodeler" || format.name == "australis";
-    const std::string extra = format.name == "pix4d" ? " --width 14000 --height 12000"
-                              : holds_pixel          ? ""
-                                                     : " --pixel-mm 0.009";
-    r = RunAerocal("camera convert --from " + format.name + " --to aerocal --model brown10 " + out +
-                   " " + tmp.File("back_" + format.name + ".yaml") + extra);
+    const std::string extra = !format.writes_size          ? " --width 14000 --height 12000"
+                              : format.writes_pixel_size ? ""
+                                                         : " --pixel-mm 0.009";
+    // Back with --from auto: every file we write is detected as its own format.
+    r = RunAerocal("camera convert --from auto --to aerocal --model brown10 " + out + " " +
+                   tmp.File("back_" + format.name + ".yaml") + extra);
     ASSERT_EQ(r.exit_code, 0) << r.output;
+    EXPECT_NE(r.output.find("read as " + format.name + " (--from auto)"), std::string::npos)
+        << r.output;
   }
 }
 

@@ -33,11 +33,13 @@
 //   intrinsics fu fv pu pv, distortion_coeffs, resolution); pixels as OpenCV.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
+#include <yaml-cpp/yaml.h>
 
 #include "calib/camera/camera.h"
 #include "calib/camera/camera_model.h"
@@ -74,6 +76,10 @@ struct FormatTarget {
   CameraModelId model;
   std::vector<std::string> zero_params;
   bool needs_pixel_size = false;  // the format writes millimetres
+  /// The target is OpenCV's distortion (opencv, colmap_opencv / full_opencv) reached by a fit:
+  /// ConvertCameraFileSimplest may try 4 (k1 k2 p1 p2), 5 (+ k3) or 8 (+ k4-k6) coefficients.
+  /// The registry's default is 5 (zero_params k4-k6).
+  bool coefficient_choice = false;
 };
 
 /// A camera file expressed in a format's model, with how exactly (result) and, where the source
@@ -87,15 +93,76 @@ struct FileConversion {
 FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& target,
                                  const ConvertOptions& options = {});
 
+/// The target of the formats written in OpenCV's model (opencv, ros, dji): the source itself when
+/// it is an opencv camera (exact), else a fit with 5 coefficients (coefficient_choice).
+FormatTarget OpenCvTarget(const ModelCamera& source);
+
+/// ConvertCameraFile in the simplest form of the format (issue 29): where target.coefficient_choice,
+/// the conversions with 4, 5 and 8 distortion coefficients up to `max_coefficients` (>= 4), one
+/// line each in `tried` ("5 coefficients (k1 k2 p1 p2 k3): residual max ... px, rms ... px"); the
+/// first whose max residual meets options.max_residual_px, or without that gate the first within
+/// 0.01 px of the best tried. Otherwise ConvertCameraFile.
+FileConversion ConvertCameraFileSimplest(const CameraFile& from, const FormatTarget& target,
+                                         const ConvertOptions& options, int max_coefficients,
+                                         std::vector<std::string>* tried);
+
 /// Our camera (in its own model) as a camera file: interior_sigma as a diagonal covariance (the
 /// terms without a sigma: 0), said in the notes. Sub-images and reference points are not carried.
 CameraFile CameraFileFromCamera(const Camera& camera);
+
+// ---- the registry (issue 30 item 7): the CLI, the tests and the fuzzers iterate it ----
+
+/// One camera-file format: a new format is its file plus one row in registry.cc (or, for the
+/// OpenCV FileStorage entry that needs OpenCV, a RegisterCameraFormat call in the tool layer).
+struct CameraFormat {
+  std::string name;         // the command-line name (--from, --to, --camera-format)
+  std::string description;  // one line for --help
+  std::function<CameraFile(const std::string& path, const CameraReadOptions&)> read;
+  std::function<void(const std::string& path, const CameraFile&)> write;
+  /// The model (and zero parameters) a source camera is written in by this format.
+  std::function<FormatTarget(const ModelCamera& source)> target;
+  /// True when a file whose first bytes (up to kDetectBytes) are `head` and whose path is `path`
+  /// is of this format (`--from auto`, and what a wrong --from names). Content first: the path
+  /// only where the content cannot tell (cameras.bin).
+  std::function<bool(const std::string& head, const std::string& path)> looks_like;
+  std::string extension;           // a file name ending the writer uses (tests, fuzzers)
+  bool writes_size = true;         // a written file holds the image size (else --width/--height)
+  bool writes_pixel_size = false;  // ... and the pixel size (else --pixel-mm)
+  bool holds_covariance = false;   // the writer keeps CameraFile::covariance
+};
+
+inline constexpr size_t kDetectBytes = 1 << 16;
+
+/// Every registered format, in registration order (calib's, then the tool layer's).
+const std::vector<CameraFormat>& CameraFormats();
+/// Adds a format (the tool layer's OpenCV entry); LogicError on a duplicate name.
+void RegisterCameraFormat(CameraFormat format);
+/// ConfigError naming `option` and the format names when unknown.
+const CameraFormat& FindCameraFormat(const std::string& name, const std::string& option);
+std::string CameraFormatNames();
+/// The names of the formats whose looks_like accepts the file (empty: none).
+std::vector<std::string> DetectCameraFormats(const std::string& path);
+/// Writes `file` with `format` to `path` only after the format's own reader has read it back as
+/// the same camera (model, size, every pixel within 1e-6 px over a 21 x 21 grid): the writer runs
+/// on a scratch file beside `path`, which is renamed onto `path` when it reads back; else the
+/// scratch is removed and Error names what differs (nothing is written).
+void WriteCameraFileVerified(const CameraFormat& format, const std::string& path,
+                             const CameraFile& file);
+/// Reads `path` as format `name`, or, with name "auto", as the one format it looks like
+/// (InputError naming the candidates when none or several). A reader's InputError on a file that
+/// looks like another format says so ("... (the file looks like kalibr: --from kalibr)").
+/// `*used` (optional) receives the format read.
+CameraFile ReadCameraFileAs(const std::string& name, const std::string& path,
+                            const CameraReadOptions& options, std::string* used = nullptr);
 
 // ---- per format (name: reader, writer) ----
 CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& options);
 void WriteAerocalCamera(const std::string& path, const CameraFile& camera);
 
+/// cameras.txt, or cameras.bin by the .bin extension (written so too).
 CameraFile ReadColmapCameras(const std::string& path, const CameraReadOptions& options);
+/// True when `path` ends in .bin and `head` starts as a cameras.bin does.
+bool LooksLikeColmapBinary(const std::string& head, const std::string& path);
 void WriteColmapCameras(const std::string& path, const CameraFile& camera);
 /// One cameras.txt row split into fields (CAMERA_ID MODEL WIDTH HEIGHT PARAMS...) -> the
 /// registry's COLMAP model; InputError("FILE:LINE: ...") on a bad row. The COLMAP import uses it.
@@ -105,7 +172,10 @@ ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields, const
 CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOptions& options);
 void WriteMetashapeCalibration(const std::string& path, const CameraFile& camera);
 
+/// The .cam, or a project's calibrated_camera_parameters.txt (--camera IMAGE, else the first).
 CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& options);
+/// True when `head` starts as Pix4D's calibrated_camera_parameters.txt does.
+bool IsPix4dCalibratedParameters(const std::string& head);
 void WritePix4dCam(const std::string& path, const CameraFile& camera);
 /// Pix4D's camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, PerspectiveDistortion)
 /// from a JPEG or an XMP sidecar; the pixel size from exif:FocalPlaneXResolution or --pixel-mm.
@@ -131,6 +201,14 @@ void WritePhotoModelerCamera(const std::string& path, const CameraFile& camera);
 CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions& options);
 void WriteAustralisCamera(const std::string& path, const CameraFile& camera);
 
+/// ROS camera_info YAML (plumb_bob, rational_polynomial, equidistant; ros_format.cc).
+CameraFile ReadRosCameraInfo(const std::string& path, const CameraReadOptions& options);
+void WriteRosCameraInfo(const std::string& path, const CameraFile& camera);
+
+/// camodocal / VINS PINHOLE camera YAML (camodocal_format.cc).
+CameraFile ReadCamodocalCamera(const std::string& path, const CameraReadOptions& options);
+void WriteCamodocalCamera(const std::string& path, const CameraFile& camera);
+
 CameraFile ReadKalibrCamchain(const std::string& path, const CameraReadOptions& options);
 void WriteKalibrCamchain(const std::string& path, const CameraFile& camera);
 
@@ -151,6 +229,15 @@ double Param(const ModelCamera& camera, std::string_view name);
 /// A camera name as one line of text (control characters, a newline among them, become spaces):
 /// line-oriented formats put the name on a line of its own.
 std::string OneLine(std::string_view name);
+/// The shortest decimal text that reads back to the same double (std::to_chars): 0.009, not
+/// 0.0089999999999999993.
+std::string ShortestNumber(double value);
+/// `text` for a double-quoted YAML scalar (backslash and quote escaped).
+std::string YamlQuoted(std::string_view text);
+/// A YAML camera file, strict (calib/core/yaml_util.h LoadYamlText: duplicate keys are errors);
+/// OpenCV's `%YAML:1.0` first line (cv::FileStorage's, not a YAML 1.x directive) is read as a
+/// comment, so line numbers stay those of the file.
+YAML::Node LoadCameraYaml(const std::string& path);
 /// `text` with & < > " ' as XML entities (a camera name in an XML element).
 std::string XmlEscaped(std::string_view text);
 }  // namespace internal

@@ -4,8 +4,12 @@
 // <pp> mm from the top-left CORNER with y DOWN, <K>, <P>, <aspect>, <skew>. DBAT's backward model
 // 3 is our correction form, so it maps onto brown_fraser_10 exactly:
 //   x0 = px - W p / 2, y0 = H p / 2 - py (photo frame: format centre, y up), K and P unchanged.
-// `cc` or `pp` of 0 mean "not known": the focal length and the format centre are used. <aspect>
-// (DBAT's affinity) is not modelled: an aspect other than 1 is reported as a note. Read with an
+// `cc` or `pp` of 0 mean "not known": the focal length and the format centre are used (said).
+// DBAT's pixel aspect (the sensor width over the image width against the pixel height, or
+// 2 - <aspect> with an "auto" width; the report's `as` = 1 - aspect) scales DBAT's x: read as
+// B1 = s - 1 with x0 = px / s - W p / 2; not exact (DBAT's K, P act on the scaled x), the
+// difference measured over the format and said. A fragment (<cameras> or <camera> without
+// <document>) is read too; several cameras need --camera ID. Read with an
 // XML parser (comments, CDATA and nesting handled), the camera's DIRECT children only (a <pp>
 // inside <std> is a sigma, not the principal point).
 #include <cmath>
@@ -56,22 +60,61 @@ struct XmlCamera {
 
 }  // namespace
 
+namespace {
+
+// The largest difference (px) over the format between DBAT's correction, which acts on x scaled
+// by the pixel aspect s (x_dbat = s xb), and ours with that scale as B1 = s - 1.
+double AspectAsB1ResidualPx(const ModelCamera& ours, double s) {
+  using Model = BrownFraser10Model;
+  const PixelFrame& f = ours.frame;
+  std::vector<double> dbat = ours.params;
+  dbat[Model::kX0] = dbat[Model::kY0] = dbat[Model::kB1] = dbat[Model::kB2] = 0.0;
+  double worst = 0.0;
+  for (int j = 0; j <= 20; ++j)
+    for (int i = 0; i <= 20; ++i) {
+      const double xy[2] = {(i / 20.0 - 0.5) * f.width_px * f.pixel_size_mm,
+                            (0.5 - j / 20.0) * f.height_px * f.pixel_size_mm};
+      const double xy_dbat[2] = {s * (xy[0] - ours.params[Model::kX0]),
+                                 xy[1] - ours.params[Model::kY0]};
+      double a[2], b[2];
+      Model::IdealFromMeasured(ours.params.data(), xy, a);
+      Model::IdealFromMeasured(dbat.data(), xy_dbat, b);
+      worst = std::max(worst, std::hypot(a[0] - b[0], a[1] - b[1]) / f.pixel_size_mm);
+    }
+  return worst;
+}
+
+}  // namespace
+
 CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& options) {
   const std::string text = ReadTextFile(path);
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS)
     ThrowInputError({path, doc.ErrorLineNum()}, std::string("invalid XML: ") + doc.ErrorName());
   const tinyxml2::XMLElement* root = doc.RootElement();
-  const tinyxml2::XMLElement* cameras = root ? root->FirstChildElement("cameras") : nullptr;
-  XmlCamera xml{path, cameras ? cameras->FirstChildElement("camera") : nullptr};
-  if (!options.camera_id.empty())
+  // A whole file (<document><cameras><camera>) or a fragment (<cameras> or one <camera>).
+  const std::string root_name = root ? root->Name() : "";
+  const tinyxml2::XMLElement* cameras =
+      root_name == "cameras" ? root : root ? root->FirstChildElement("cameras") : nullptr;
+  XmlCamera xml{path, root_name == "camera" ? root
+                      : cameras             ? cameras->FirstChildElement("camera")
+                                            : nullptr};
+  std::string ids;
+  int count = 0;
+  for (XmlCamera c = xml; c.camera; c.camera = c.camera->NextSiblingElement("camera"), ++count)
+    ids += (ids.empty() ? "" : ", ") + (c.List("id").empty() ? std::string("?") : c.List("id")[0]);
+  if (!options.camera_id.empty()) {
     while (xml.camera && !(xml.List("id").size() == 1 && xml.List("id")[0] == options.camera_id))
       xml.camera = xml.camera->NextSiblingElement("camera");
+  } else if (count > 1) {
+    ThrowInputError({path, root->GetLineNum()}, "holds " + std::to_string(count) +
+                                                    " cameras: name one with --camera (" + ids + ")");
+  }
   if (!xml.camera)
     ThrowInputError({path, root ? root->GetLineNum() : 0},
                     options.camera_id.empty()
                         ? "no <document><cameras><camera> element (not a DBAT camera file)"
-                        : "no camera with <id>" + options.camera_id + "</id>");
+                        : "no camera with <id>" + options.camera_id + "</id> (cameras: " + ids + ")");
   CameraFile file;
   const auto name = xml.List("name");
   file.name = name.empty() ? std::filesystem::path(path).stem().string() : name.front();
@@ -82,56 +125,81 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
                     "<image> must be two positive integers W,H (px), at most 1e6");
   const int width = static_cast<int>(image[0]), height = static_cast<int>(image[1]);
   const auto sensor = xml.List("sensor");
-  if (sensor.size() < 2)
+  if (sensor.size() != 2)
     ThrowInputError(xml.Where(xml.Child("sensor")), "<sensor> must be W,H or auto,H (mm)");
   const auto height_mm = ParseDouble(sensor[1]);
   if (!height_mm || !(*height_mm > 0 && *height_mm <= 1000))
     ThrowInputError(xml.Where(xml.Child("sensor")), "<sensor> height must be > 0 and <= 1000 mm");
-  const double pixel = *height_mm / height;  // square pixels; "auto" width
+  const double pixel = *height_mm / height;  // our pixel: the pixel height
   internal::ResolveFormat(&file, options, xml.Where(xml.Child("image")), width, height, pixel);
   const double w_mm = width * pixel, h_mm = *height_mm;
+  // DBAT's pixel aspect: the sensor width over the image width against the pixel height, or
+  // 1 + as = 2 - <aspect> where the width is "auto" (DBAT's report: pixel width = pixel height
+  // (1 + as), the XML's aspect = 1 - as). It scales DBAT's x: held as B1 = s - 1.
+  double s = 1.0;
+  if (sensor[0] != "auto") {
+    const auto sensor_w = ParseDouble(sensor[0]);
+    if (!sensor_w || !(*sensor_w > 0 && *sensor_w <= 1000))
+      ThrowInputError(xml.Where(xml.Child("sensor")), "<sensor> width must be > 0 and <= 1000 mm (or auto)");
+    s = (*sensor_w / width) / pixel;
+  }
+  if (xml.Child("aspect")) {
+    const double aspect = xml.Numbers("aspect", 1, 10)[0];
+    if (!(aspect > 0)) ThrowInputError(xml.Where(xml.Child("aspect")), "<aspect> must be > 0");
+    if (sensor[0] == "auto") s = 2.0 - aspect;
+    else if (std::abs(s - (2.0 - aspect)) > 1e-6)
+      ThrowInputError(xml.Where(xml.Child("aspect")),
+                      "<aspect> " + FormatNumber(aspect) + " contradicts the sensor width (pixel "
+                      "width / height " + FormatNumber(s) + ")");
+  }
   double c = xml.Child("cc") ? xml.Numbers("cc", 1, 1e4)[0] : 0.0;
   if (c == 0) c = xml.Numbers("focal", 1, 1e4)[0];
   if (!(c > 0))
     ThrowInputError(xml.Where(xml.Child(xml.Child("cc") ? "cc" : "focal")), "<cc>/<focal> must be > 0 mm");
   auto pp = xml.Child("pp") ? xml.Numbers("pp", 2, 1e4) : std::vector<double>{0, 0};
-  if (pp[0] == 0 && pp[1] == 0) pp = {w_mm / 2, h_mm / 2};
+  if (pp[0] == 0 && pp[1] == 0) {
+    pp = {s * w_mm / 2, h_mm / 2};
+    file.notes.push_back("<pp> 0,0 (DBAT: not known): the format centre");
+  }
   file.camera.model = Model::kId;
   file.camera.params.assign(Model::kNumParams, 0.0);
   file.camera.params[Model::kC] = c;
-  file.camera.params[Model::kX0] = pp[0] - w_mm / 2;
+  file.camera.params[Model::kX0] = pp[0] / s - w_mm / 2;
   file.camera.params[Model::kY0] = h_mm / 2 - pp[1];
+  file.camera.params[Model::kB1] = s - 1.0;
   const auto k = xml.Numbers("K", 0, 1.0);
   for (size_t i = 0; i < k.size() && i < 3; ++i) file.camera.params[Model::kK1 + i] = k[i];
   const auto p = xml.Numbers("P", 0, 1.0);
   for (size_t i = 0; i < p.size() && i < 2; ++i) file.camera.params[Model::kP1 + i] = p[i];
-  if (xml.Child("aspect")) {
-    const double aspect = xml.Numbers("aspect", 1, 10)[0];
-    if (aspect != 1.0)
-      file.notes.push_back("DBAT aspect " + FormatNumber(aspect) +
-                           " not modelled (square pixels from the sensor height)");
-  }
+  if (s != 1.0)
+    file.notes.push_back("DBAT pixel aspect (width / height " + FormatNumber(s) + ") read as B1 = " +
+                         FormatNumber(s - 1.0) + ": not exact, " +
+                         FormatNumber(AspectAsB1ResidualPx(file.camera, s), 3) +
+                         " px max over the format (DBAT's K, P act on the scaled x)");
   return file;
 }
 
 void WriteDbatCameraXml(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == Model::kId) << "not brown_fraser_10";
-  internal::RequireZero(file.camera, {"B1", "B2"}, "DBAT");
+  internal::RequireZero(file.camera, {"B2"}, "DBAT");
   const PixelFrame& f = file.camera.frame;
   const std::vector<double>& q = file.camera.params;
-  const double w_mm = f.width_px * f.pixel_size_mm, h_mm = f.height_px * f.pixel_size_mm;
+  // B1 as DBAT's pixel aspect (the reader's rule backwards): sensor width and pp x scaled.
+  const double s = 1.0 + q[Model::kB1];
+  const double w_mm = f.width_px * f.pixel_size_mm * s, h_mm = f.height_px * f.pixel_size_mm;
+  const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out.precision(17);
   out << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<document dbat_camera_version=\"1.0\">\n"
       << "   <cameras>\n      <camera>\n         <id>1</id>\n         <name>" << internal::XmlEscaped(internal::OneLine(file.name))
       << "</name>\n         <unit>mm</unit>\n         <calibrated>yes</calibrated>\n"
-      << "         <sensor>" << w_mm << "," << h_mm << "</sensor>\n         <image>" << f.width_px
-      << "," << f.height_px << "</image>\n         <aspect>1</aspect>\n         <focal>"
-      << q[Model::kC] << "</focal>\n         <model>3</model>\n         <nK>3</nK>\n"
-      << "         <nP>2</nP>\n         <cc>" << q[Model::kC] << "</cc>\n         <pp>"
-      << q[Model::kX0] + w_mm / 2 << "," << h_mm / 2 - q[Model::kY0] << "</pp>\n"
-      << "         <skew>0</skew>\n         <K>" << q[Model::kK1] << "," << q[Model::kK2] << ","
-      << q[Model::kK3] << "</K>\n         <P>" << q[Model::kP1] << "," << q[Model::kP2]
+      << "         <sensor>" << n(w_mm) << "," << n(h_mm) << "</sensor>\n         <image>"
+      << f.width_px << "," << f.height_px << "</image>\n         <aspect>" << n(2.0 - s)
+      << "</aspect>\n         <focal>" << n(q[Model::kC]) << "</focal>\n         <model>3</model>\n"
+      << "         <nK>3</nK>\n         <nP>2</nP>\n         <cc>" << n(q[Model::kC])
+      << "</cc>\n         <pp>" << n(s * (q[Model::kX0] + f.width_px * f.pixel_size_mm / 2)) << ","
+      << n(h_mm / 2 - q[Model::kY0]) << "</pp>\n         <skew>0</skew>\n         <K>"
+      << n(q[Model::kK1]) << "," << n(q[Model::kK2]) << "," << n(q[Model::kK3])
+      << "</K>\n         <P>" << n(q[Model::kP1]) << "," << n(q[Model::kP2])
       << "</P>\n      </camera>\n   </cameras>\n</document>\n";
   WriteFileAtomically(path, out.str());
 }

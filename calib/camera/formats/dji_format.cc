@@ -8,8 +8,13 @@
 // (W - 1) / 2 would move it by 0.5 px). Input: a DJI JPEG (the XMP packet is found in the file;
 // the size from its SOF marker), an XMP sidecar, or a text file holding the string (then
 // --width/--height). CalibratedFocalLength and CalibratedOpticalCenterX/Y (design values) are
-// reported as notes.
+// reported as notes. A text file may hold several records as exiftool prints them (default print
+// names "Dewarp Data : ...", -s tag names, -G group prefixes, "======== FILE" blocks with their
+// Image Width / Height) or bare lines; --camera picks one by file, date or number, identical
+// records are one camera (said). The date of the record is the camera's name and is written back.
+#include <cctype>
 #include <cmath>
+#include <regex>
 #include <sstream>
 
 #include "calib/camera/formats/camera_formats.h"
@@ -59,39 +64,149 @@ ModelCamera DjiDewarpDataCamera(const std::string& text, const SourceRef& where,
   return camera;
 }
 
+namespace {
+
+// One DewarpData record of a text file, with what the same block printed beside it.
+struct DewarpRecord {
+  std::string file;  // exiftool's "======== NAME" block, else ""
+  std::string data;  // the value, "[date;]fx,..."
+  int line = 0, width = 0, height = 0;
+  std::vector<std::string> design;  // CalibratedFocalLength / OpticalCenterX / Y, as notes
+};
+
+std::string Date(const std::string& data) {
+  const size_t semicolon = data.find(';');
+  return semicolon == std::string::npos ? "" : TrimBlanks(data.substr(0, semicolon));
+}
+
+// exiftool's print name or tag name, or a bare key: "Dewarp Data" / "DewarpData" -> "dewarpdata".
+std::string KeyOf(const std::string& key) {
+  std::string out;
+  for (char c : key)
+    if (c != ' ' && c != '\t') out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (!out.empty() && out[0] == '[' && out.find(']') != std::string::npos)  // -G: "[XMP] "
+    out = out.substr(out.find(']') + 1);
+  return out;
+}
+
+// The records of a text file as exiftool (default, -s, -G, several files) or DJI's tools print
+// them, or bare "[date;]fx,..." lines. Unknown "key : value" lines are other tags (skipped); a
+// line that is neither a tag nor a record is an error.
+std::vector<DewarpRecord> TextRecords(const std::string& path, const std::string& text) {
+  const std::vector<std::string> lines = SplitLines(text);
+  std::vector<DewarpRecord> records;
+  std::string file;
+  int width = 0, height = 0;
+  std::vector<std::string> design;
+  const auto flush_block = [&] {  // sizes and design values printed after the record
+    for (DewarpRecord& r : records)
+      if (r.file == file) {
+        if (r.width == 0) r.width = width, r.height = height;
+        if (r.design.empty()) r.design = design;
+      }
+  };
+  for (size_t i = 0; i < lines.size(); ++i) {
+    const SourceRef where{path, static_cast<int>(i + 1)};
+    const std::string line = TrimBlanks(lines[i]);
+    if (line.empty() || line[0] == '#') continue;
+    if (line.rfind("========", 0) == 0) {
+      flush_block();
+      file = TrimBlanks(line.substr(8));
+      width = height = 0;
+      design.clear();
+      continue;
+    }
+    static const std::regex kSummary(R"(\d+ (image |directories |)files? .*|\d+ directories scanned)");
+    if (std::regex_match(line, kSummary)) continue;  // exiftool's "2 image files read"
+    const size_t colon = line.find(':');
+    const size_t semicolon = line.find(';');
+    const bool tag = colon != std::string::npos && (semicolon == std::string::npos || colon < semicolon);
+    const std::string key = tag ? KeyOf(line.substr(0, colon)) : "dewarpdata";
+    const std::string value = tag ? TrimBlanks(line.substr(colon + 1)) : line;
+    if (!tag && line.find(',') == std::string::npos)
+      ThrowInputError(where, "neither a DewarpData record nor an exiftool 'Tag : value' line");
+    if (key == "dewarpdata" || key == "dewarpdatak6") {
+      records.push_back({file, value, where.line, 0, 0, {}});
+    } else if (key == "imagewidth" || key == "exifimagewidth") {
+      width = static_cast<int>(internal::ParseNumber(value, where, "image width", 1e6));
+    } else if (key == "imageheight" || key == "exifimageheight" || key == "imagelength") {
+      height = static_cast<int>(internal::ParseNumber(value, where, "image height", 1e6));
+    } else if (key == "calibratedfocallength" || key == "calibratedopticalcenterx" ||
+               key == "calibratedopticalcentery") {
+      design.push_back(TrimBlanks(line.substr(0, colon)) + " = " + value +
+                       " px (design value, not used)");
+    }
+  }
+  flush_block();
+  return records;
+}
+
+}  // namespace
+
 CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& options) {
   const std::string bytes = ReadTextFile(path);
-  int jpeg_width = 0, jpeg_height = 0;
-  const bool jpeg = JpegSize(bytes, &jpeg_width, &jpeg_height);
+  int file_width = 0, file_height = 0;
+  const bool jpeg = JpegSize(bytes, &file_width, &file_height);
+  std::vector<DewarpRecord> records;
   std::string data;
   size_t at = FindXmpValue(bytes, "drone-dji:DewarpDataK6", &data);
   if (at == std::string::npos) at = FindXmpValue(bytes, "drone-dji:DewarpData", &data);
-  if (at == std::string::npos) {
-    if (jpeg || bytes.find("drone-dji") != std::string::npos)
-      ThrowInputError({path, jpeg ? 0 : 1}, "no drone-dji:DewarpData in the file's XMP");
-    data = bytes;  // a text file holding the string
-    at = bytes.find_first_not_of(" \t\r\n");
-  }
-  const SourceRef where{path, jpeg ? 0 : LineAt(bytes, at)};
-  if (!jpeg) {  // an XMP sidecar may carry the size (tiff:ImageWidth / tiff:ImageLength)
-    std::string w, h;
-    if (FindXmpValue(bytes, "tiff:ImageWidth", &w) != std::string::npos &&
-        FindXmpValue(bytes, "tiff:ImageLength", &h) != std::string::npos) {
-      jpeg_width = static_cast<int>(internal::ParseNumber(TrimBlanks(w), where, "tiff:ImageWidth", 1e6));
-      jpeg_height = static_cast<int>(internal::ParseNumber(TrimBlanks(h), where, "tiff:ImageLength", 1e6));
+  if (at != std::string::npos) {  // a JPEG's XMP packet or a sidecar
+    DewarpRecord r{"", TrimBlanks(data), jpeg ? 0 : LineAt(bytes, at), 0, 0, {}};
+    for (const char* design : {"CalibratedFocalLength", "CalibratedOpticalCenterX", "CalibratedOpticalCenterY"}) {
+      std::string value;
+      if (FindXmpValue(bytes, std::string("drone-dji:") + design, &value) != std::string::npos)
+        r.design.push_back(std::string(design) + " = " + TrimBlanks(value) + " px (design value, not used)");
     }
+    std::string w, h;
+    if (!jpeg && FindXmpValue(bytes, "tiff:ImageWidth", &w) != std::string::npos &&
+        FindXmpValue(bytes, "tiff:ImageLength", &h) != std::string::npos) {
+      const SourceRef where{path, r.line};
+      file_width = static_cast<int>(internal::ParseNumber(TrimBlanks(w), where, "tiff:ImageWidth", 1e6));
+      file_height = static_cast<int>(internal::ParseNumber(TrimBlanks(h), where, "tiff:ImageLength", 1e6));
+    }
+    r.width = file_width, r.height = file_height;
+    records.push_back(r);
+  } else if (jpeg || bytes.find("drone-dji") != std::string::npos) {
+    ThrowInputError({path, jpeg ? 0 : 1}, "no drone-dji:DewarpData in the file's XMP");
+  } else {
+    records = TextRecords(path, bytes);
+    if (records.empty()) ThrowInputError({path, 1}, "no DewarpData record");
   }
+  // Several records: --camera names one (its exiftool file name, its date or its 1-based number);
+  // without it, records that are all the same are one camera (said), else the list is an error.
+  const DewarpRecord* picked = &records.front();
+  std::string ids;
+  for (size_t k = 0; k < records.size(); ++k) {
+    const DewarpRecord& r = records[k];
+    const std::string id = !r.file.empty() ? r.file : !Date(r.data).empty() ? Date(r.data) : std::to_string(k + 1);
+    ids += (ids.empty() ? "" : ", ") + std::to_string(k + 1) + " (" + id + ")";
+  }
+  if (!options.camera_id.empty()) {
+    picked = nullptr;
+    for (size_t k = 0; k < records.size() && !picked; ++k)
+      if (records[k].file == options.camera_id || Date(records[k].data) == options.camera_id ||
+          std::to_string(k + 1) == options.camera_id)
+        picked = &records[k];
+    if (!picked) ThrowInputError({path, 1}, "no DewarpData record " + options.camera_id + " (records: " + ids + ")");
+  } else if (records.size() > 1) {
+    for (const DewarpRecord& r : records)
+      if (r.data != records.front().data)
+        ThrowInputError({path, r.line}, "holds " + std::to_string(records.size()) +
+                                            " different DewarpData records: name one with --camera (" + ids + ")");
+  }
+  const SourceRef where{path, picked->line};
   CameraFile file;
-  internal::ResolveFormat(&file, options, where, jpeg_width, jpeg_height, 0.0);
+  if (picked->width == 0 && picked->height == 0 && (options.width_px == 0 || options.height_px == 0))
+    ThrowInputError(where, "the file gives no image size: pass --width and --height");
+  internal::ResolveFormat(&file, options, where, picked->width, picked->height, 0.0);
   const PixelFrame frame = file.camera.frame;
-  file.camera = DjiDewarpDataCamera(data, where, frame.width_px, frame.height_px);
+  file.camera = DjiDewarpDataCamera(picked->data, where, frame.width_px, frame.height_px);
   file.camera.frame = frame;
-  file.name = "dji";
-  for (const char* design : {"CalibratedFocalLength", "CalibratedOpticalCenterX", "CalibratedOpticalCenterY"}) {
-    std::string value;
-    if (FindXmpValue(bytes, std::string("drone-dji:") + design, &value) != std::string::npos)
-      file.notes.push_back(std::string(design) + " = " + TrimBlanks(value) + " px (design value, not used)");
-  }
+  file.name = !Date(picked->data).empty() ? Date(picked->data) : "dji";
+  file.notes = picked->design;
+  if (records.size() > 1 && options.camera_id.empty())
+    file.notes.push_back(std::to_string(records.size()) + " DewarpData records, all the same: one camera");
   return file;
 }
 
@@ -101,12 +216,14 @@ void WriteDjiDewarpData(const std::string& path, const CameraFile& file) {
   const std::vector<double>& p = file.camera.params;
   const PixelFrame& f = file.camera.frame;
   const bool k6 = p[O::kK4] != 0 || p[O::kK5] != 0 || p[O::kK6] != 0;
+  const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out.precision(17);
-  out << p[O::kFx] << "," << p[O::kFy] << "," << p[O::kCx] - 0.5 * f.width_px << ","
-      << p[O::kCy] - 0.5 * f.height_px << "," << p[O::kK1] << "," << p[O::kK2] << "," << p[O::kP1]
-      << "," << p[O::kP2] << "," << p[O::kK3];
-  if (k6) out << "," << p[O::kK4] << "," << p[O::kK5] << "," << p[O::kK6];
+  // The record's date survives (our name for a DJI camera is its date).
+  if (std::regex_match(file.name, std::regex(R"(\d{4}-\d{2}-\d{2})"))) out << file.name << ";";
+  out << n(p[O::kFx]) << "," << n(p[O::kFy]) << "," << n(p[O::kCx] - 0.5 * f.width_px) << ","
+      << n(p[O::kCy] - 0.5 * f.height_px) << "," << n(p[O::kK1]) << "," << n(p[O::kK2]) << ","
+      << n(p[O::kP1]) << "," << n(p[O::kP2]) << "," << n(p[O::kK3]);
+  if (k6) out << "," << n(p[O::kK4]) << "," << n(p[O::kK5]) << "," << n(p[O::kK6]);
   // An XMP sidecar: what a DJI JPEG carries, readable by this reader and by XMP tools.
   WriteFileAtomically(path, std::string("<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n <rdf:RDF "
                                         "xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"

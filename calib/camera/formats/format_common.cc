@@ -1,8 +1,11 @@
 // What the camera-format readers share (camera_formats.h).
+#include <charconv>
 #include <cmath>
 
 #include "calib/camera/formats/camera_formats.h"
+#include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+#include "calib/core/yaml_util.h"
 
 namespace aerocal::calib::internal {
 
@@ -63,6 +66,27 @@ std::string OneLine(std::string_view name) {
   for (char& c : out)
     if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) c = ' ';
   return out;
+}
+
+std::string ShortestNumber(double value) {
+  char buffer[64];
+  const auto result = std::to_chars(buffer, buffer + sizeof(buffer), value);
+  return std::string(buffer, result.ptr);
+}
+
+std::string YamlQuoted(std::string_view text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '\\' || c == '"') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
+YAML::Node LoadCameraYaml(const std::string& path) {
+  std::string text = ReadTextFile(path);
+  if (text.rfind("%YAML:", 0) == 0) text[0] = '#';
+  return LoadYamlText(text, path);
 }
 
 std::string XmlEscaped(std::string_view text) {

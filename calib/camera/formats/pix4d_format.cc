@@ -9,6 +9,17 @@
 // registry model (models/pix4d.h, which converts the conventions) calls them R1-R3; both names are
 // read. The pixel size is the sensor width of the comment line over the image width in pixels,
 // which the file does not hold: --width/--height (or --pixel-mm, which gives the size).
+//
+// Also read: a project's <project>_calibrated_camera_parameters.txt (Pix4Dmapper's params folder;
+// the layout as EasyIDP's Pix4D reader documents it and as files quoted in public code show it):
+//   7 header lines (fileName imageWidth imageHeight / camera matrix K [3x3] / radial distortion
+//   [3x1] / tangential distortion [2x1] / camera position t [3x1] / camera rotation R [3x3] /
+//   camera model m = K [R|-Rt] X), then per image: NAME W H, K (3 rows), R1 R2 R3, T1 T2,
+//   position (3), rotation (3 rows); blank lines anywhere.
+// K is in pixels with the .cam's corner origin (cx = Px / p), one focal length. Without a pixel
+// size the camera is read with a placeholder one (pixels exact, mm meaningless, said).
+// `--camera IMAGE` picks an image, else the first; images whose K or distortion differ from the
+// picked one are said (they are another camera, or a per-image calibration).
 #include <cmath>
 #include <map>
 #include <sstream>
@@ -19,9 +30,112 @@
 
 namespace aerocal::calib {
 
+namespace {
+
+constexpr char kCalibratedHeader[] = "fileName imageWidth imageHeight";
+
+// One image of calibrated_camera_parameters.txt: its name, size and the 14 numbers of K,
+// radial and tangential distortion (position and rotation are checked, not kept).
+struct CalibratedImage {
+  std::string name;
+  int line = 0, width = 0, height = 0;
+  std::vector<double> intrinsics;  // K (9), R1-R3, T1, T2
+};
+
+std::vector<CalibratedImage> ReadCalibratedImages(const std::string& path,
+                                                  const std::vector<std::string>& lines) {
+  struct Token {
+    std::string text;
+    int line;
+  };
+  std::vector<Token> tokens;
+  for (size_t i = 7; i < lines.size(); ++i) {
+    std::istringstream in(lines[i]);
+    for (std::string t; in >> t;) tokens.push_back({t, static_cast<int>(i + 1)});
+  }
+  constexpr size_t kPerImage = 3 + 9 + 3 + 2 + 3 + 9;
+  std::vector<CalibratedImage> images;
+  for (size_t at = 0; at < tokens.size(); at += kPerImage) {
+    if (tokens.size() - at < kPerImage)
+      ThrowInputError({path, tokens[at].line},
+                      "image " + tokens[at].text + ": a record is NAME W H, K (9), radial (3), "
+                      "tangential (2), position (3), rotation (9): the file ends after " +
+                          std::to_string(tokens.size() - at) + " of its 29 values");
+    CalibratedImage image;
+    image.name = tokens[at].text;
+    image.line = tokens[at].line;
+    for (int k = 1; k <= 2; ++k) {
+      const SourceRef where{path, tokens[at + k].line};
+      const double v = internal::ParseNumber(tokens[at + k].text, where, "image size", 1e6);
+      if (!(v >= 1) || v != std::floor(v)) ThrowInputError(where, "image size must be a positive integer");
+      (k == 1 ? image.width : image.height) = static_cast<int>(v);
+    }
+    for (size_t k = 3; k < kPerImage; ++k) {
+      const double v = internal::ParseNumber(tokens[at + k].text, {path, tokens[at + k].line},
+                                             "image " + image.name + " value", 1e9);
+      if (k < 3 + 9 + 3 + 2) image.intrinsics.push_back(v);
+    }
+    images.push_back(image);
+  }
+  if (images.empty()) ThrowInputError({path, 8}, "no image record after the 7 header lines");
+  return images;
+}
+
+CameraFile ReadPix4dCalibratedParameters(const std::string& path,
+                                         const std::vector<std::string>& lines,
+                                         const CameraReadOptions& options) {
+  using M = Pix4dPerspectiveModel;
+  const std::vector<CalibratedImage> images = ReadCalibratedImages(path, lines);
+  const CalibratedImage* picked = &images.front();
+  if (!options.camera_id.empty()) {
+    picked = nullptr;
+    std::string names;
+    for (const CalibratedImage& image : images) {
+      names += (names.empty() ? "" : ", ") + image.name;
+      if (image.name == options.camera_id) picked = &image;
+    }
+    if (!picked) ThrowInputError({path, 1}, "no image " + options.camera_id + " (images: " + names + ")");
+  }
+  const std::vector<double>& k = picked->intrinsics;
+  const SourceRef where{path, picked->line};
+  if (k[1] != 0 || k[3] != 0 || k[6] != 0 || k[7] != 0 || k[8] != 1)
+    ThrowInputError(where, "K must be [f 0 cx; 0 f cy; 0 0 1]");
+  if (!(k[0] > 0) || k[4] != k[0])
+    ThrowInputError(where, "K must hold one focal length > 0 px (Pix4D's F; got " +
+                               FormatNumber(k[0]) + " and " + FormatNumber(k[4]) + ")");
+  CameraFile file;
+  file.name = picked->name;
+  std::vector<std::string> differ;
+  for (const CalibratedImage& image : images)
+    if (image.intrinsics != k || image.width != picked->width || image.height != picked->height)
+      differ.push_back(image.name);
+  if (!differ.empty())
+    file.notes.push_back(std::to_string(differ.size()) + " of " + std::to_string(images.size()) +
+                         " images have another K, distortion or size than " + picked->name +
+                         " (first: " + differ.front() + "): " + picked->name + " read");
+  else if (images.size() > 1)
+    file.notes.push_back("all " + std::to_string(images.size()) +
+                         " images share K and distortion: " + picked->name + " read");
+  internal::ResolveFormat(&file, options, where, picked->width, picked->height, 0.0);
+  if (!file.pixel_size_known)
+    file.notes.push_back("no pixel size (pass --pixel-mm): F, Px, Py in units of the placeholder");
+  const double p = file.camera.frame.pixel_size_mm;
+  file.camera.model = M::kId;
+  file.camera.params = {k[0] * p, k[2] * p, k[5] * p, k[9], k[10], k[11], k[12], k[13]};
+  return file;
+}
+
+}  // namespace
+
+bool IsPix4dCalibratedParameters(const std::string& head) {
+  return head.rfind(kCalibratedHeader, 0) == 0;
+}
+
 CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& options) {
   using M = Pix4dPerspectiveModel;
   const std::vector<std::string> lines = SplitLines(ReadTextFile(path));
+  if (!lines.empty() && IsPix4dCalibratedParameters(lines[0]))
+    return ReadPix4dCalibratedParameters(path, lines, options);
   std::map<std::string, std::pair<double, int>> values;
   double sensor_w = 0, sensor_h = 0;
   int sensor_line = 1;
@@ -90,14 +204,15 @@ void WritePix4dCam(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == M::kId) << "not pix4d_perspective";
   const PixelFrame& f = file.camera.frame;
   const std::vector<double>& p = file.camera.params;
+  const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out.precision(17);
   out << "Pix4D camera calibration file 0\n#Focal Length mm assuming a sensor width of "
-      << f.width_px * f.pixel_size_mm << "x" << f.height_px * f.pixel_size_mm << "mm\n"
-      << "F " << p[M::kF] << "\n#Principal Point mm\nPx " << p[M::kPx] << "\nPy " << p[M::kPy]
-      << "\n#Symmetrical Lens Distortion Coeffs\nK1 " << p[M::kR1] << "\nK2 " << p[M::kR2]
-      << "\nK3 " << p[M::kR3] << "\n#Tangential Lens Distortion Coeffs\nT1 " << p[M::kT1]
-      << "\nT2 " << p[M::kT2] << "\n";
+      << n(f.width_px * f.pixel_size_mm) << "x" << n(f.height_px * f.pixel_size_mm) << "mm\n"
+      << "F " << n(p[M::kF]) << "\n#Principal Point mm\nPx " << n(p[M::kPx]) << "\nPy "
+      << n(p[M::kPy]) << "\n#Symmetrical Lens Distortion Coeffs\nK1 " << n(p[M::kR1])
+      << "\nK2 " << n(p[M::kR2]) << "\nK3 " << n(p[M::kR3])
+      << "\n#Tangential Lens Distortion Coeffs\nT1 " << n(p[M::kT1]) << "\nT2 " << n(p[M::kT2])
+      << "\n";
   WriteFileAtomically(path, out.str());
 }
 

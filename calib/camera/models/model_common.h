@@ -82,35 +82,63 @@ double ValueOf(const ceres::Jet<U, K>& j) {
 /// Solves f(params, x) = target for x (2D) by Newton from `start`. `f` is a generic callable
 /// f(const S* params, const S* x, S* y) for any scalar S (double, Jet). The iteration runs on the
 /// values; a final Newton step in T gives `out` the derivatives of the implicit solution with
-/// respect to params and target. False when it does not converge to |step| < tolerance.
+/// respect to params and target. The solution must lie on the branch of the map that holds
+/// `centre` (where the map is the identity-like part of a lens: the principal point): a Newton
+/// run from `start` that does not converge, or converges where the map is folded (det J <= 0, the
+/// far side of a turning point of the distortion polynomial), is redone by continuation from
+/// `centre` (the target moved there from f(centre) in steps). False when neither reaches the
+/// target to |step| < tolerance on that branch (the target lies beyond the fold: not invertible).
 template <int kNumParams, typename T, typename F>
 bool InvertMap2(const F& f, const T* params, const T* target, const double* start, T* out,
-                double tolerance, int max_iterations = 50) {
+                double tolerance, int max_iterations = 50, const double* centre = nullptr) {
   using J = ceres::Jet<double, 2>;
   J pj[kNumParams];
   for (int i = 0; i < kNumParams; ++i) pj[i] = J(ValueOf(params[i]));
   const Eigen::Vector2d goal(ValueOf(target[0]), ValueOf(target[1]));
-  Eigen::Vector2d x(start[0], start[1]);
   Eigen::Matrix2d jacobian;
-  bool converged = false;
-  for (int iteration = 0; iteration < max_iterations && !converged; ++iteration) {
+  // f and its Jacobian at x.
+  const auto evaluate = [&](const Eigen::Vector2d& x) {
     const J xj[2] = {J(x.x(), 0), J(x.y(), 1)};
     J y[2];
     f(pj, xj, y);
     jacobian << y[0].v[0], y[0].v[1], y[1].v[0], y[1].v[1];
-    const Eigen::Vector2d step =
-        jacobian.partialPivLu().solve(Eigen::Vector2d(y[0].a, y[1].a) - goal);
-    if (!step.allFinite()) return false;
-    x -= step;
-    converged = step.norm() < tolerance;
+    return Eigen::Vector2d(y[0].a, y[1].a);
+  };
+  // Newton towards `aim` from *x; true when it converged on the unfolded branch.
+  const auto newton = [&](const Eigen::Vector2d& aim, Eigen::Vector2d* x, int iterations) {
+    for (int iteration = 0; iteration < iterations; ++iteration) {
+      const Eigen::Vector2d error = evaluate(*x) - aim;  // sets `jacobian` at *x
+      const Eigen::Vector2d step = jacobian.partialPivLu().solve(error);
+      if (!step.allFinite()) return false;
+      *x -= step;
+      if (step.norm() < tolerance) {
+        evaluate(*x);
+        return jacobian.determinant() > 0;
+      }
+    }
+    return false;
+  };
+  const Eigen::Vector2d middle = centre ? Eigen::Vector2d(centre[0], centre[1]) : Eigen::Vector2d::Zero();
+  // The branch of `centre`: no fold (det J <= 0) on the segment from it to the solution.
+  const auto on_centre_branch = [&](const Eigen::Vector2d& x) {
+    for (int k = 1; k < 8; ++k) {
+      evaluate(middle + (x - middle) * (k / 8.0));
+      if (!(jacobian.determinant() > 0)) return false;
+    }
+    return true;
+  };
+  Eigen::Vector2d x(start[0], start[1]);
+  if (!newton(goal, &x, max_iterations) || !on_centre_branch(x)) {
+    x = middle;
+    const Eigen::Vector2d from = evaluate(x);
+    if (!from.allFinite() || !(jacobian.determinant() > 0)) return false;
+    constexpr int kSteps = 32;
+    for (int k = 1; k <= kSteps; ++k) {
+      const Eigen::Vector2d aim = from + (goal - from) * (double(k) / kSteps);
+      if (!newton(aim, &x, k == kSteps ? max_iterations : 20)) return false;
+    }
   }
-  if (!converged) return false;
-  {
-    const J xj[2] = {J(x.x(), 0), J(x.y(), 1)};
-    J y[2];
-    f(pj, xj, y);
-    jacobian << y[0].v[0], y[0].v[1], y[1].v[0], y[1].v[1];
-  }
+  evaluate(x);
   const Eigen::Matrix2d inverse = jacobian.inverse();
   const T xt[2] = {T(x.x()), T(x.y())};
   T y[2];

@@ -1,0 +1,285 @@
+// The camera-format registry (camera_formats.h CameraFormat): one row per format, with what its
+// files look like for `--from auto`. The OpenCV FileStorage row is added by the tool layer
+// (tools/camera_formats.cc, OpenCV staying out of calib).
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/camera/formats/zip_archive.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+
+namespace aerocal::calib {
+namespace {
+
+bool Has(const std::string& head, const char* marker) {
+  return head.find(marker) != std::string::npos;
+}
+
+bool IsFisheye(const ModelCamera& c) { return c.model == CameraModelId::kOpenCvFisheye; }
+
+// A fit into OpenCV's distortion: 5 coefficients (k1 k2 p1 p2 k3) unless the caller chooses
+// (ConvertCameraFileSimplest).
+FormatTarget OpenCvFit(CameraModelId model) {
+  FormatTarget t{model, {"k4", "k5", "k6"}};
+  t.coefficient_choice = true;
+  return t;
+}
+
+// COLMAP cameras.txt: its comment header or a first data line `ID MODEL W H PARAMS...`.
+bool LooksLikeColmapText(const std::string& head) {
+  if (Has(head, "# Camera list with one line of data per camera")) return true;
+  std::istringstream in(head);
+  static const std::regex kRow(
+      R"(^\s*\S+\s+(SIMPLE_PINHOLE|PINHOLE|SIMPLE_RADIAL|RADIAL|OPENCV|FULL_OPENCV|OPENCV_FISHEYE|SIMPLE_RADIAL_FISHEYE|RADIAL_FISHEYE|THIN_PRISM_FISHEYE|FOV)\s+\d+\s+\d+(\s+\S+)+\s*$)");
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') continue;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    return std::regex_match(line, kRow);
+  }
+  return false;
+}
+
+std::vector<CameraFormat>& Registry() {
+  static std::vector<CameraFormat> formats = {
+      {"aerocal", "our camera YAML (any registry model; a rig file's head by --camera)",
+       ReadAerocalCamera, WriteAerocalCamera,
+       [](const ModelCamera& s) { return FormatTarget{s.model, {}, true}; },
+       [](const std::string& h, const std::string&) {
+         return Has(h, "format_px:") && Has(h, "pixel_size_mm:");
+       },
+       ".yaml", true, true, true},
+      {"colmap", "COLMAP cameras.txt or cameras.bin (SIMPLE_PINHOLE ... FULL_OPENCV; --camera ID)", ReadColmapCameras,
+       WriteColmapCameras,
+       [](const ModelCamera& source) {
+         if (!ColmapName(source.model).empty()) return FormatTarget{source.model, {}};
+         if (source.model == CameraModelId::kOpenCv) {  // exact: OPENCV when k3-k6 are 0
+           const bool full = source.params[OpenCvModel::kK3] != 0 ||
+                             source.params[OpenCvModel::kK4] != 0 ||
+                             source.params[OpenCvModel::kK5] != 0 ||
+                             source.params[OpenCvModel::kK6] != 0;
+           return FormatTarget{full ? CameraModelId::kColmapFullOpenCv : CameraModelId::kColmapOpenCv,
+                               {}};
+         }
+         return OpenCvFit(CameraModelId::kColmapFullOpenCv);
+       },
+       [](const std::string& h, const std::string& path) {
+         return LooksLikeColmapText(h) || LooksLikeColmapBinary(h, path);
+       },
+       ".txt"},
+      {"metashape", "Agisoft Metashape / PhotoScan calibration XML, cameras XML, .psx / .psz project (--camera sensor id)",
+       ReadMetashapeCalibration, WriteMetashapeCalibration,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kMetashapeFrame, {}}; },
+       [](const std::string& h, const std::string&) {
+         // A calibration export, a cameras export, a .psx project, a .psz / .zip project archive.
+         if (Has(h, "<opencv_storage>")) return false;  // OpenCV's <calibration_time>
+         return Has(h, "<calibration>") || Has(h, "<calibration ") || Has(h, "<sensor ") ||
+                Has(h, "<sensors") ||
+                (Has(h, "<document") && Has(h, "<chunks")) ||
+                (internal::LooksLikeZip(h) && Has(h, "doc.xml"));
+       },
+       ".xml", true, false, true},
+      {"pix4d", "Pix4D internal camera parameters (.cam), a project's calibrated_camera_parameters.txt (--camera IMAGE)", ReadPix4dCam, WritePix4dCam,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; },
+       [](const std::string& h, const std::string&) {
+         return Has(h, "Pix4D camera calibration file") || IsPix4dCalibratedParameters(h);
+       },
+       ".cam", false, true},
+      {"pix4d-xmp",
+       "Pix4D camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, "
+       "PerspectiveDistortion; a JPEG or an XMP sidecar)",
+       ReadPix4dXmp, WritePix4dXmp,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; },
+       [](const std::string& h, const std::string&) { return Has(h, "PerspectiveFocalLength"); },
+       ".xmp", true, true},
+      {"opensfm", "OpenSfM / OpenDroneMap cameras.json", ReadOpenSfmCameras, WriteOpenSfmCameras,
+       [](const ModelCamera& s) {
+         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {"k3", "k4"}}
+                             : FormatTarget{CameraModelId::kOpenCv, {"k4", "k5", "k6"}};
+       },
+       [](const std::string& h, const std::string&) { return Has(h, "\"projection_type\""); },
+       ".json"},
+      {"dji", "DJI XMP DewarpData / DewarpDataK6 (a DJI JPEG, an XMP sidecar or the string)",
+       ReadDjiDewarpData, WriteDjiDewarpData, OpenCvTarget,
+       [](const std::string& h, const std::string&) {
+         if (Has(h, "DewarpData") || Has(h, "Dewarp Data")) return true;
+         // The bare string: "[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" on its first line.
+         static const std::regex kRecord(
+             R"(^\s*([0-9-]+;)?\s*[-+0-9.eE]+(\s*,\s*[-+0-9.eE]+){8}([-+0-9.eE,\s]*)$)");
+         return std::regex_match(h.substr(0, h.find('\n')), kRecord);
+       },
+       ".xmp"},
+      {"dbat", "DBAT camera XML, whole or a <cameras> / <camera> fragment (c, pp, aspect, K1-K3, P1, P2 in mm)",
+       ReadDbatCameraXml, WriteDbatCameraXml,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kBrownFraser10, {"B2"}, true}; },
+       [](const std::string& h, const std::string&) {
+         return (Has(h, "<camera>") || Has(h, "<camera ")) && (Has(h, "<cc>") || Has(h, "<pp>"));
+       },
+       ".xml", true, true},
+      {"photomodeler", "PhotoModeler Bundle Soln export's camera (f, pp, format, K1-K3, P1, P2 mm)",
+       ReadPhotoModelerCamera, WritePhotoModelerCamera,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
+       },
+       [](const std::string& h, const std::string&) { return h.rfind("Bundle Soln", 0) == 0; },
+       ".txt", true, true},
+      {"australis", "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
+       ReadAustralisCamera, WriteAustralisCamera,
+       [](const ModelCamera&) { return FormatTarget{CameraModelId::kBrownFraser10, {}, true}; },
+       [](const std::string& h, const std::string&) {
+         return Has(h, "Australis") && Has(h, "Camera Parameters");
+       },
+       ".txt", true, true, true},
+      {"ros", "ROS camera_info YAML (camera_matrix/distortion_coefficients {rows, cols, data}; "
+              "plumb_bob, rational_polynomial, equidistant)",
+       ReadRosCameraInfo, WriteRosCameraInfo,
+       [](const ModelCamera& s) {
+         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}} : OpenCvTarget(s);
+       },
+       [](const std::string& h, const std::string&) {
+         return Has(h, "camera_matrix:") && Has(h, "rows:") && !Has(h, "opencv-matrix") &&
+                !Has(h, "model_type:");
+       },
+       ".yaml"},
+      {"camodocal", "camodocal / VINS-Mono / VINS-Fusion PINHOLE camera YAML",
+       ReadCamodocalCamera, WriteCamodocalCamera,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
+       },
+       [](const std::string& h, const std::string&) {
+         return Has(h, "model_type:") && Has(h, "projection_parameters");
+       },
+       ".yaml"},
+      {"kalibr", "Kalibr camchain YAML (pinhole radtan / equidistant)", ReadKalibrCamchain,
+       WriteKalibrCamchain,
+       [](const ModelCamera& s) {
+         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}}
+                             : FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
+       },
+       [](const std::string& h, const std::string&) {
+         return Has(h, "camera_model:") && Has(h, "intrinsics:");
+       },
+       ".yaml"},
+  };
+  return formats;
+}
+
+std::string Head(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  std::string head(kDetectBytes, '\0');
+  if (!in) return {};
+  in.read(&head[0], static_cast<std::streamsize>(head.size()));
+  head.resize(static_cast<size_t>(in.gcount()));
+  return head;
+}
+
+std::string Joined(const std::vector<std::string>& names) {
+  std::string out;
+  for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+  return out;
+}
+
+}  // namespace
+
+FormatTarget OpenCvTarget(const ModelCamera& source) {
+  if (source.model == CameraModelId::kOpenCv) return {CameraModelId::kOpenCv, {}};
+  return OpenCvFit(CameraModelId::kOpenCv);
+}
+
+const std::vector<CameraFormat>& CameraFormats() { return Registry(); }
+
+void RegisterCameraFormat(CameraFormat format) {
+  for (const CameraFormat& f : Registry())
+    AEROCAL_CHECK(f.name != format.name) << "camera format " << format.name << " registered twice";
+  Registry().push_back(std::move(format));
+}
+
+std::string CameraFormatNames() {
+  std::vector<std::string> names;
+  for (const CameraFormat& f : Registry()) names.push_back(f.name);
+  return Joined(names);
+}
+
+const CameraFormat& FindCameraFormat(const std::string& name, const std::string& option) {
+  for (const CameraFormat& f : Registry())
+    if (f.name == name) return f;
+  throw ConfigError(option + ": unknown camera format '" + name + "' (expected " +
+                    CameraFormatNames() + (option == "--from" ? ", or auto" : "") + ")");
+}
+
+std::vector<std::string> DetectCameraFormats(const std::string& path) {
+  const std::string head = Head(path);
+  std::vector<std::string> names;
+  for (const CameraFormat& f : Registry())
+    if (f.looks_like && f.looks_like(head, path)) names.push_back(f.name);
+  return names;
+}
+
+void WriteCameraFileVerified(const CameraFormat& format, const std::string& path,
+                             const CameraFile& file) {
+  namespace fs = std::filesystem;
+  const fs::path target(path);
+  const fs::path scratch = target.parent_path() / (".aerocal_check_" + target.filename().string());
+  format.write(scratch.string(), file);
+  std::string problem;
+  try {
+    CameraReadOptions options;
+    if (!format.writes_size) {
+      options.width_px = file.camera.frame.width_px;
+      options.height_px = file.camera.frame.height_px;
+    }
+    if (!format.writes_pixel_size && file.pixel_size_known)
+      options.pixel_size_mm = file.camera.frame.pixel_size_mm;
+    const CameraFile back = format.read(scratch.string(), options);
+    const PixelFrame &a = file.camera.frame, &b = back.camera.frame;
+    if (back.camera.model != file.camera.model)
+      problem = "reads back as " + std::string(CameraModelName(back.camera.model));
+    else if (a.width_px != b.width_px || a.height_px != b.height_px)
+      problem = "reads back as " + std::to_string(b.width_px) + " x " + std::to_string(b.height_px) + " px";
+    else if (const ConversionResidual r = CompareCameras(file.camera, back.camera, 21);
+             r.failed_points > 0 || !(r.max_px <= 1e-6))
+      problem = "reads back " + FormatNumber(r.max_px) + " px away";
+  } catch (const Error& e) {
+    problem = std::string("does not read back: ") + e.what();
+  }
+  std::error_code ignored;
+  if (!problem.empty()) {
+    fs::remove(scratch, ignored);
+    throw Error(path + ": not written: the " + format.name + " file " + problem);
+  }
+  fs::rename(scratch, target);
+}
+
+CameraFile ReadCameraFileAs(const std::string& name, const std::string& path,
+                            const CameraReadOptions& options, std::string* used) {
+  std::string chosen = name;
+  if (name == "auto") {
+    CheckInputFile(path);
+    const std::vector<std::string> candidates = DetectCameraFormats(path);
+    if (candidates.empty())
+      ThrowInputError({path, 1}, "--from auto: the file looks like none of the camera formats (" +
+                                     CameraFormatNames() + "): name one with --from");
+    if (candidates.size() > 1)
+      ThrowInputError({path, 1}, "--from auto: the file looks like several formats (" +
+                                     Joined(candidates) + "): name one with --from");
+    chosen = candidates.front();
+  }
+  const CameraFormat& format = FindCameraFormat(chosen, "--from");
+  if (used) *used = chosen;
+  try {
+    return format.read(path, options);
+  } catch (const InputError& e) {
+    if (name == "auto") throw;
+    const std::vector<std::string> candidates = DetectCameraFormats(path);
+    if (candidates.empty() ||
+        std::find(candidates.begin(), candidates.end(), chosen) != candidates.end())
+      throw;
+    throw InputError(std::string(e.what()) + " (the file looks like " + Joined(candidates) +
+                     ": --from " + candidates.front() + ")");
+  }
+}
+
+}  // namespace aerocal::calib
