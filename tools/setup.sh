@@ -9,7 +9,8 @@ build_dir="${1:-build}"
 packages=(cmake make g++ pkg-config
   libceres-dev libeigen3-dev libopencv-dev libgeographiclib-dev libyaml-cpp-dev libcli11-dev
   nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libtiff-dev libtinyxml2-dev zlib1g-dev clang libclang-rt-dev
-  python3 python3-matplotlib python3-numpy poppler-utils)
+  python3 python3-matplotlib python3-numpy poppler-utils
+  python3-dev pybind11-dev python3-pytest)
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -24,3 +25,10 @@ fi
 
 cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build "$build_dir" -j"$(nproc)"
+# `import aerocal` for Debian's python3 (tools/python/README.md): the package of this build,
+# installed under /usr/local (the interpreter's dist-packages there); idempotent.
+if [ -f "$build_dir/python/aerocal/__init__.py" ]; then
+  install_cmd=""
+  [ "$(id -u)" -ne 0 ] && install_cmd="sudo"
+  $install_cmd cmake --install "$build_dir" --component python >/dev/null
+fi

@@ -528,11 +528,18 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       ceres_options.linear_solver_type = ceres::DENSE_QR;
       report.linear_solver = "dense_qr";
     } else {
+      // Ceres orders the blocks of one group by their memory address (a std::set<double*>), so
+      // with all non-eliminated blocks in one group the reduced system's layout, and its rounding,
+      // depended on where the owners' vectors happened to be allocated: a second adjustment in the
+      // same process (flight, the Python module) differed from a fresh one in the last digits.
+      // Each non-eliminated block gets its own group, in BlockId (registration) order; the
+      // eliminated points share group 0 (Ceres eliminates the first group only), each owner's in
+      // one vector, so their address order is their index order.
       auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
+      int group = 0;
       for (BlockId id : free_blocks) {
         const Block& b = blocks_[id];
-        const bool elim = b.Eliminable();
-        ordering->AddElementToGroup(b.values, elim ? 0 : 1);
+        ordering->AddElementToGroup(b.values, b.Eliminable() ? 0 : ++group);
       }
       ceres_options.linear_solver_ordering = ordering;
     }

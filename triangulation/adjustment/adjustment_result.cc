@@ -585,6 +585,15 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
                         {"covariance_method", r.determinability.covariance_method},
                         {"undetermined", r.determinability.undetermined},
                         {"warnings", r.determinability.warnings}};
+  nlohmann::json correlation = {{"names", r.interior_correlation_names},
+                                 {"matrix", nlohmann::json::array()}};
+  for (int i = 0; i < r.interior_correlation.rows(); ++i) {
+    nlohmann::json row = nlohmann::json::array();
+    for (int k = 0; k < r.interior_correlation.cols(); ++k)
+      row.push_back(Finite(r.interior_correlation(i, k)));
+    correlation["matrix"].push_back(row);
+  }
+  j["interior_correlation"] = correlation;
   det["high_correlations"] = nlohmann::json::array();
   for (const auto& h : r.determinability.high_correlations)
     det["high_correlations"].push_back({{"a", h.a}, {"b", h.b}, {"correlation", h.correlation}});

@@ -310,6 +310,11 @@ struct AdjustmentResult {
   std::vector<RejectedObservation> rejected;
   std::vector<ObservationResidual> residuals;  // every image observation of the adjustment
   Determinability determinability;
+  /// Correlation matrix of the interior parameters of every camera (free and fixed entries; a
+  /// fixed one has a zero row), rows named "camera ID.NAME"; empty without a covariance. JSON
+  /// `interior_correlation: {names, matrix}`.
+  std::vector<std::string> interior_correlation_names;
+  Eigen::MatrixXd interior_correlation;
   std::map<std::string, Eigen::Vector3d> points_m;  // adjusted coordinates of every point
   std::vector<std::string> notes;                   // points left out, and why
   std::string frame;                                // the object frame, stated

@@ -1077,6 +1077,10 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   result.timing.covariance_s = seconds_since(covariance_start);
   advance();
   result.determinability = AssessDeterminability(cov, "camera ", options_.correlation_threshold);
+  if (cov.ok) {
+    result.interior_correlation_names = cov.interior_names;
+    result.interior_correlation = cov.interior_correlation;
+  }
   if (cov.ok) {  // a free platform parameter the block cannot separate, by name
     const Determinability platform =
         AssessDeterminability(cov, "platform ", options_.correlation_threshold);

@@ -1,0 +1,168 @@
+"""The Python module against the command line on the same inputs (issue 32).
+
+Run by ctest (tests/python/python.cmake) with PYTHONPATH at the build tree's package and
+AEROCAL_BINARY at the command; the simulated flight is made by `aerocal simulate`, so nothing here
+is a second implementation: every number compared comes from both sides of the same library.
+"""
+
+import json
+import math
+import os
+import subprocess
+import tempfile
+
+import numpy as np
+import pytest
+
+import aerocal
+
+BINARY = os.environ["AEROCAL_BINARY"]
+SOURCE = os.environ["AEROCAL_SOURCE_DIR"]
+SHARED = os.path.join(SOURCE, "..", "shared", "data")
+
+
+def run(*args):
+    done = subprocess.run([BINARY, *args], capture_output=True, text=True)
+    return done.returncode, done.stdout + done.stderr
+
+
+@pytest.fixture(scope="module")
+def flight():
+    with tempfile.TemporaryDirectory(prefix="aerocal_py_") as tmp:
+        code, out = run("simulate", "--out", os.path.join(tmp, "flight"))
+        assert code == 0, out
+        yield tmp
+
+
+def test_the_calls_of_the_issue_work_exactly_so(flight):
+    p = os.path.join(flight, "flight", "project.yaml")
+    b = aerocal.Block.read(p)
+    r = aerocal.adjust(b, self_calibration="all")
+    assert r.sigma0 > 0 and isinstance(r.valid, bool)
+    assert r.check_rmse_m.shape == (3,)
+    c = r.cameras[0].estimated["c"]
+    s = r.cameras[0].sigma["c"]
+    assert c > 0 and s > 0
+    assert r.correlation.shape == (10, 10)
+    np.testing.assert_allclose(np.diag(r.correlation), 1.0, atol=1e-12)
+    cam = aerocal.Camera.read(os.path.join(flight, "flight", "camera_nominal.yaml"), format="auto")
+    c2, res = aerocal.convert_camera(cam, model="brown_fraser_10")
+    assert res["exact"] and res["max_px"] < 1e-9
+    rays = cam.image_to_ray(np.array([[0.0, 0.0]]))
+    assert rays.shape == (1, 2)
+
+
+def test_adjust_equals_the_command_to_the_last_digit(flight):
+    p = os.path.join(flight, "flight", "project.yaml")
+    out = os.path.join(flight, "cli.json")
+    code, text = run("adjust", "--project", p, "--self-calibration", "all", "--out", out)
+    assert code == 0, text
+    r = aerocal.adjust(aerocal.Block.read(p), self_calibration="all")
+    with open(out) as f:
+        cli = f.read()
+    # The same document (timings aside: they are the clock's, not the adjustment's).
+    a, b = json.loads(cli), json.loads(r.to_json())
+    for doc in (a, b):
+        doc.pop("timing", None)
+        doc.pop("seconds", None)
+        doc["snooping"].pop("seconds_testing", None)
+    assert a == b
+    assert b["cameras"][0]["estimated"]["c"] == r.cameras[0].estimated["c"]
+
+
+def test_residuals_and_redundancy_are_arrays(flight):
+    r = aerocal.adjust(aerocal.Block.read(os.path.join(flight, "flight")), self_calibration="all")
+    res = r.residuals
+    n = len(res["image"])
+    assert res["residual_px"].shape == (n, 2) and res["used"].shape == (n,)
+    used = res["used"]
+    # The image residuals of a consistent adjustment: RMS at the simulated 0.2 px noise.
+    rms = math.sqrt(np.mean(res["residual_px"][used] ** 2))
+    assert 0.1 < rms < 0.3
+    assert np.nanmax(res["redundancy"]) <= 1.0
+
+
+def test_image_to_ray_and_back_are_inverse(flight):
+    cam = aerocal.Camera.read(os.path.join(flight, "flight", "camera_truth.yaml"))
+    cam.set_param("K1", -5e-6)
+    cols, rows = np.meshgrid(np.linspace(0, cam.width - 1, 7), np.linspace(0, cam.height - 1, 5))
+    pixels = np.column_stack([cols.ravel(), rows.ravel()])
+    back = cam.ray_to_image(cam.image_to_ray(pixels))
+    np.testing.assert_allclose(back, pixels, atol=1e-6)
+    # The principal point's ray is the axis.
+    assert cam.params["x0"] != 0 or cam.params["y0"] != 0
+
+
+def test_block_from_arrays_equals_the_files(flight):
+    folder = os.path.join(flight, "flight")
+    files = aerocal.Block.read(os.path.join(folder, "project.yaml"))
+    cam = aerocal.Camera.read(os.path.join(folder, "camera_nominal.yaml"))
+    e, o, p = files.exposures, files.observations, files.points
+    exposures = {"image": e["image"], "camera": e["camera"],
+                 "X": e["center_m"][:, 0], "Y": e["center_m"][:, 1], "Z": e["center_m"][:, 2],
+                 "omega": e["opk_deg"][:, 0], "phi": e["opk_deg"][:, 1], "kappa": e["opk_deg"][:, 2]}
+    import csv
+    with open(os.path.join(folder, "points.csv")) as f:
+        rows = [r for r in csv.DictReader(line for line in f if not line.startswith("#"))]
+    def number(text):
+        return float(text) if text.strip() else float("nan")  # an empty field: absent
+    points = {k: [number(r[k]) if k not in ("point", "role") else r[k] for r in rows]
+              for k in ("point", "X", "Y", "Z", "sX", "sY", "sZ", "role")}
+    observations = {"image": o["image"], "point": o["point"], "col": o["pixel"][:, 0],
+                    "row": o["pixel"][:, 1], "sigma_px": o["sigma_px"]}
+    arrays = aerocal.Block.from_arrays({"cam1": cam}, exposures, points, observations)
+    a = aerocal.adjust(arrays)
+    b = aerocal.adjust(files)
+    assert a.sigma0 == pytest.approx(b.sigma0, rel=1e-9)
+    np.testing.assert_allclose(a.check_rmse_m, b.check_rmse_m, rtol=1e-9)
+
+
+def test_errors_are_value_errors_with_file_and_line(flight):
+    bad = os.path.join(flight, "bad.csv")
+    with open(bad, "w") as f:
+        f.write("not a camera\n")
+    with pytest.raises(ValueError):
+        aerocal.Camera.read(bad, format="colmap")
+    proj = os.path.join(flight, "flight")
+    with open(os.path.join(proj, "points.csv")) as f:
+        text = f.read()
+    broken = os.path.join(flight, "broken")
+    subprocess.run(["cp", "-r", proj, broken], check=True)
+    with open(os.path.join(broken, "points.csv"), "w") as f:
+        f.write(text.replace("control", "kontrol", 1))
+    with pytest.raises(aerocal.InputError, match=r"points\.csv:\d+:"):
+        aerocal.Block.read(broken)
+    with pytest.raises(TypeError, match="unknown option"):
+        aerocal.adjust(aerocal.Block.read(proj), no_such_option=1)
+
+
+def test_convert_a_dji_camera_from_the_documented_records(tmp_path):
+    # Record A of the documented DewarpData examples (a Phantom 4 RTK, 5472 x 3648), written as
+    # exiftool prints the value: the date, then fx,fy,cx,cy,k1,k2,p1,p2,k3 on one line.
+    path = os.path.join(SHARED, "dji_dewarpdata_documented", "dewarpdata_examples.txt")
+    if not os.path.exists(path):
+        pytest.skip("../shared/data/dji_dewarpdata_documented is absent")
+    with open(path) as f:
+        record = next(line for line in f if line.startswith("A |"))
+    value = record.rsplit("|", 1)[1].strip()
+    dewarp = tmp_path / "dewarp.txt"
+    dewarp.write_text(value + "\n")
+    names = aerocal.formats()
+    assert "dji" in names and "opencv" in names
+    cam = aerocal.Camera.read(str(dewarp), format="dji", width=5472, height=3648)
+    fx = float(value.split(";")[1].split(",")[0])
+    assert cam.width == 5472 and cam.height == 3648
+    ours, res = aerocal.convert_camera(cam, model="brown_fraser_10")
+    assert ours.model == "brown_fraser_10"
+    # k1 = -0.26 on a 1-inch sensor: the 10-parameter model fits it to about a pixel inside 80 % of
+    # the half-diagonal (14 px at the extreme corner, where the two models' series part).
+    assert res["rms_px"] < 2.0 and res["max_inner80_px"] < 3.0, res["summary"]
+    # The principal distance survives the conversion within 1 % (the fit trades c against K1).
+    assert ours.principal_distance_mm == pytest.approx(cam.principal_distance_mm, rel=1e-2)
+    assert fx > 3000
+
+
+def test_help_names_every_area():
+    text = aerocal.__doc__
+    for word in ("Camera.read", "convert_camera", "Block.read", "adjust(", "InputError"):
+        assert word in text

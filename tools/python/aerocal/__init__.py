@@ -1,0 +1,49 @@
+"""aerocal: calibration of large-format and multi-head aerial cameras, from Python.
+
+The C++ library behind the `aerocal` command line, with its objects in Python and numpy arrays
+(nothing is implemented twice: every number comes from the same code as the command's).
+
+Cameras
+    Camera.read(path, format="auto")  a camera file of any format in formats()
+    camera.params / camera.units / camera.sigma   parameters by the model's names
+    camera.image_to_ray(pixels) / camera.ray_to_image(rays)   arrays of shape (N, 2)
+    convert_camera(camera, model=...) -> (Camera, residual)   into any of models()
+    camera.write(path, format=...)
+
+Blocks and the adjustment
+    Block.read(project)  or  Block.from_arrays(cameras, exposures, points, observations)
+    adjust(block, self_calibration="all", **options) -> AdjustmentResult
+    result.sigma0, result.valid, result.check_rmse_m, result.cameras[0].estimated["c"],
+    result.cameras[0].sigma["c"], result.correlation, result.residuals, result.to_json()
+
+Conventions: pixels (col, row) with the top-left pixel centre at (0, 0); photo coordinates x
+right, y up (mm); rays (x / c, y / c) with the camera looking along -z; angles in degrees in
+tables, as in the files. Bad input raises InputError (a ValueError) with FILE:LINE; a result that
+did not converge or is not valid comes back with valid=False, as the command writes it.
+"""
+
+from ._aerocal import (
+    AdjustmentResult,
+    Block,
+    Camera,
+    CameraEstimate,
+    ConfigError,
+    InputError,
+    adjust,
+    convert_camera,
+    formats,
+    models,
+)
+
+__all__ = [
+    "AdjustmentResult",
+    "Block",
+    "Camera",
+    "CameraEstimate",
+    "ConfigError",
+    "InputError",
+    "adjust",
+    "convert_camera",
+    "formats",
+    "models",
+]

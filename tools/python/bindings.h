@@ -1,0 +1,15 @@
+// The Python module `aerocal` (issue 32): the library's objects with numpy arrays, no second
+// implementation of anything. Each Bind* adds one area's classes and functions to the module;
+// tools/python/aerocal/__init__.py is the package around it (docstrings, help(aerocal)).
+#pragma once
+
+#include <pybind11/pybind11.h>
+
+namespace aerocal::python {
+
+/// Camera: read/write in any registered format, parameters by name, image <-> ray, conversion.
+void BindCamera(pybind11::module_& m);
+/// Block.read and Block from arrays, adjust(block, **options) -> AdjustmentResult.
+void BindAdjust(pybind11::module_& m);
+
+}  // namespace aerocal::python
