@@ -26,7 +26,7 @@ struct CalibrateArgs {
   std::string camera, pos, observations, points, out, write_camera, lines_csv, plot;
   double sigma_px = 0.3;
   std::string degree = "auto";
-  std::string datum = "reference";
+  std::string datum = "gauge";
   std::string pos_prior = "on";
   std::string boresight = "fixed", lever_arm = "fixed";  // fixed | free | weighted
   double boresight_sigma_deg = 0.0;
@@ -44,9 +44,14 @@ int RunCalibrate(CalibrateArgs& a) {
     if (!d || *d != std::floor(*d)) throw ConfigError("--degree must be auto or 0 .. 5 (got '" + a.degree + "')");
     o.degree = int(*d);
   }
-  if (a.datum != "reference" && a.datum != "none")
-    throw ConfigError("--datum must be reference or none (got '" + a.datum + "')");
-  o.reference_datum = a.datum == "reference";
+  if (a.datum == "gauge")
+    o.datum = triangulation::LineDatum::kGauge;
+  else if (a.datum == "reference")
+    o.datum = triangulation::LineDatum::kReference;
+  else if (a.datum == "none")
+    o.datum = triangulation::LineDatum::kNone;
+  else
+    throw ConfigError("--datum must be gauge, reference or none (got '" + a.datum + "')");
   if (a.pos_prior != "on" && a.pos_prior != "off")
     throw ConfigError("--pos-prior must be on or off (got '" + a.pos_prior + "')");
   o.pos_prior = a.pos_prior == "on";
@@ -69,6 +74,21 @@ int RunCalibrate(CalibrateArgs& a) {
               "redundancy %d, %s\n",
               result.n_observations, result.n_control, result.report.sigma0, result.sigma0_px,
               result.report.redundancy, result.report.converged ? "converged" : "NOT converged");
+  {
+    const auto& d = result.datum;
+    std::string names;
+    for (const auto& g : d.directions) names += (names.empty() ? "" : ", ") + g.name;
+    std::printf("  datum %s: rank defect %s without it, %d constraints%s%s%s\n",
+                triangulation::LineDatumName(d.mode),
+                d.null_space_computed ? std::to_string(d.rank_defect).c_str() : "not computed",
+                d.n_constraints, d.n_constraints ? " on " : "",
+                d.n_constraints ? d.blocks.front().c_str() : "",
+                names.empty() ? "" : (" (gauge: " + names + ")").c_str());
+  }
+  if (result.time_offset_estimated)
+    std::printf("  time offset: %.6f +- %s s\n", result.time_offset_s,
+                result.time_offset_sigma_s ? FormatNumber(*result.time_offset_sigma_s, 3).c_str()
+                                           : "(not determined)");
   for (const auto& s : result.subcameras)
     std::printf("  %-4s detectors %d..%d: %d obs, degree x %d y %d, RMS across %.3f -> %.3f px, "
                 "along %.3f -> %.3f px\n",
@@ -205,9 +225,17 @@ CommandRun Setup(CLI::App& app) {
   cal->add_option("--max-degree", o.max_degree, "Highest degree the test starts from, 0 .. 5");
   cal->add_option("--degree-alpha", o.degree_test_alpha, "Significance of the degree test, (0, 0.5)");
   cal->add_option("--datum", args->datum,
-                  "reference: the reference sub-camera's constant and linear terms are fixed "
-                  "(trajectory takes them) | none: all free (reported ill-posed)");
-  cal->add_option("--reference", o.reference_subcamera, "Reference sub-camera index (-1: the middle one)");
+                  "gauge (default): exactly the rank defect of the problem as configured, on the "
+                  "gauge directions of its null space (none with the POS priors on and the "
+                  "boresight and lever arm fixed) | reference: the earlier datum, the reference "
+                  "sub-camera's Legendre mean and slope per axis held at zero (4 constraints: "
+                  "over-constrains, e.g. holds the scale the control determines) | none: no "
+                  "datum (an undetermined problem is reported ill-posed)");
+  cal->add_option("--reference", o.reference_subcamera,
+                  "Sub-camera index carrying the datum (-1: the middle one)");
+  cal->add_option("--gauge-threshold", o.gauge_threshold,
+                  "Relative eigenvalue of the scaled normal matrix below which a direction is a "
+                  "gauge freedom, (0, 1e-3]");
   cal->add_flag("--free-c", o.free_c, "Estimate the principal distance (nearly a scale of the table)");
   cal->add_option("--pos-prior", args->pos_prior, "on | off: the POS sigmas as priors on the spline nodes");
   cal->add_option("--pos-sigma-m", o.pos_sigma_m, "POS position sigma where pos.csv gives none, m");
@@ -222,6 +250,10 @@ CommandRun Setup(CLI::App& app) {
                   "(around the file's values by --lever-arm-sigma-m)");
   cal->add_option("--lever-arm-sigma-m", o.lever_arm_sigma_m,
                   "Sigma of each weighted lever-arm component, m, > 0");
+  cal->add_flag("--time-offset", o.time_offset,
+                "Estimate a time offset of the line camera against the POS (shutter / POS "
+                "latency, s); determinable only through the POS priors "
+                "(time_offset_vs_along_track)");
   cal->add_option("--min-per-segment", o.min_observations_per_segment,
                   "Fewer observations between two nodes: warning few_points_per_line");
   auto control_args = std::make_shared<ControlArgs>();

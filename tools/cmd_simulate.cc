@@ -223,6 +223,19 @@ CommandRun SetupSimulate(CLI::App& app) {
   app.add_option("--pos-error-m", l.pos_error_m, "Pushbroom: sigma of the smooth POS position error, 0..100 m")->check(CLI::Range(0.0, 100.0));
   app.add_option("--pos-error-deg", l.pos_error_deg, "Pushbroom: sigma of the smooth POS attitude error, 0..10 deg")->check(CLI::Range(0.0, 10.0));
   app.add_option("--detector-error-px", l.detector_error_px, "Pushbroom: size of the smooth per-detector errors, 0..100 px")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--subcamera-error-px", l.subcamera_error_px,
+                 "Pushbroom: sigma of every sub-camera's own offset, scale, rotation and curvature "
+                 "errors (the reference's too), 0..100 px")->check(CLI::Range(0.0, 100.0));
+  app.add_flag("--linear-layout", l.linear_layout,
+               "Pushbroom: the sub-cameras stitched onto one straight virtual CCD (the camera "
+               "file's calibration ranges, no subcameras section)");
+  app.add_option("--pos-bias-m", l.pos_bias_m, "Pushbroom: sigma of a constant POS position error, 0..100 m")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--pos-bias-deg", l.pos_bias_deg, "Pushbroom: sigma of a constant POS attitude error, 0..10 deg")->check(CLI::Range(0.0, 10.0));
+  app.add_option("--pos-drift-m", l.pos_drift_m, "Pushbroom: sigma of a linear POS position drift (at the end), 0..100 m")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--pos-drift-deg", l.pos_drift_deg, "Pushbroom: sigma of a linear POS attitude drift (at the end), 0..10 deg")->check(CLI::Range(0.0, 10.0));
+  app.add_option("--time-offset-s", l.time_offset_s,
+                 "Pushbroom: shutter / POS latency, s: each line exposed this long after its "
+                 "pos.csv time stamp, -1..1")->check(CLI::Range(-1.0, 1.0));
   app.add_option("--node-spacing", l.node_spacing_lines, "Pushbroom: node spacing of the POS error spline, lines")->check(CLI::Range(1, 1000000));
   app.add_option("--control-noise-m", l.control_noise_m, "Pushbroom: control-point coordinate noise, 0..1000 m")->check(CLI::Range(0.0, 1e3));
   auto* images = app.add_flag("--images", args->pushbroom_images,

@@ -797,6 +797,81 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
   return {out.begin(), out.end()};
 }
 
+Eigen::MatrixXd ProblemBuilder::PlusJacobianOf(BlockId id) const {
+  const Block& block = blocks_[id];
+  const ceres::Manifold* manifold = problem_->GetManifold(block.values);
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> j(block.size,
+                                                                           block.TangentSize());
+  if (manifold)
+    manifold->PlusJacobian(block.values, j.data());
+  else
+    j.setIdentity();
+  return Eigen::MatrixXd(j);
+}
+
+NullSpaceReport ProblemBuilder::NullSpace(double relative_threshold, int max_parameters) const {
+  NullSpaceReport report;
+  report.threshold = relative_threshold;
+  std::vector<BlockId> free_blocks;
+  std::vector<int> first_row;
+  const auto schur = BuildSchurComplement(false, &free_blocks, &first_row);
+  if (!schur) {
+    report.message = "the residuals cannot be evaluated at the current values";
+    return report;
+  }
+  const int n = schur->num_reduced();
+  report.reduced_parameters = n;
+  if (n > max_parameters) {
+    report.message = std::to_string(n) + " reduced parameters, above the dense limit " +
+                     std::to_string(max_parameters);
+    return report;
+  }
+  if (n == 0) {
+    report.ok = true;
+    return report;
+  }
+  Eigen::MatrixXd s = Eigen::MatrixXd(schur->s_lower()).selfadjointView<Eigen::Lower>();
+  Eigen::VectorXd d = s.diagonal().cwiseSqrt();
+  for (int i = 0; i < n; ++i) d(i) = d(i) > 0 ? 1.0 / d(i) : 1.0;
+  s = d.asDiagonal() * s * d.asDiagonal();
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(s);
+  const double max_eig = eig.eigenvalues().maxCoeff();
+  if (!(max_eig > 0)) {
+    report.message = "the normal matrix is zero";
+    return report;
+  }
+  for (int k = 0; k < n && k < 16; ++k)
+    report.smallest_relative_eigenvalues.push_back(eig.eigenvalues()(k) / max_eig);
+  while (report.rank_defect < n &&
+         eig.eigenvalues()(report.rank_defect) <= relative_threshold * max_eig)
+    ++report.rank_defect;
+  const Eigen::MatrixXd w = eig.eigenvectors().leftCols(report.rank_defect);
+  for (size_t b = 0; b < free_blocks.size(); ++b) {
+    if (schur->is_point(static_cast<int>(b))) continue;
+    const BlockId id = free_blocks[b];
+    const Block& block = blocks_[id];
+    const int offset = schur->reduced_offset(static_cast<int>(b));
+    const int size = block.TangentSize();
+    report.vectors[id] = PlusJacobianOf(id) * d.segment(offset, size).asDiagonal() *
+                         w.middleRows(offset, size);
+    if (block.rotation) continue;
+    // A subset (or no) manifold: tangent entry t is ambient entry free[t], scaled by s_t, so the
+    // Jacobi-scaled coordinate sqrt(S_ee) x_e of the ambient entry is the eigenvector's.
+    const std::vector<int> free = block.TangentEntries();
+    Eigen::MatrixXd scaled = Eigen::MatrixXd::Zero(block.size, report.rank_defect);
+    Eigen::VectorXd scale = Eigen::VectorXd::Zero(block.size);
+    const Eigen::MatrixXd plus = PlusJacobianOf(id);
+    for (int t = 0; t < size; ++t) {
+      scaled.row(free[t]) = w.row(offset + t);
+      scale(free[t]) = 1.0 / (d(offset + t) * plus(free[t], t));
+    }
+    report.scaled[id] = scaled;
+    report.scale[id] = scale;
+  }
+  report.ok = true;
+  return report;
+}
+
 CovarianceReport ProblemBuilder::EstimateCovariance(
     const std::vector<BlockId>& blocks,
     double sigma0,
@@ -849,17 +924,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
   const std::string singular_message =
       "the normal matrix is singular or badly conditioned: the problem has a datum defect or "
       "parameters the observations cannot determine";
-  auto plus_jacobian = [&](BlockId id) {
-    const Block& block = blocks_[id];
-    const ceres::Manifold* manifold = problem_->GetManifold(block.values);
-    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> j(block.size,
-                                                                             block.TangentSize());
-    if (manifold)
-      manifold->PlusJacobian(block.values, j.data());
-    else
-      j.setIdentity();
-    return Eigen::MatrixXd(j);
-  };
+  auto plus_jacobian = [&](BlockId id) { return PlusJacobianOf(id); };
   const double s2 = sigma0 * sigma0;
   const int n_free = NumFreeParameters();
   if (n_free <= kCeresCovarianceLimit) {

@@ -172,6 +172,31 @@ struct CovarianceReport {
   double Correlation(int i, int k) const;
 };
 
+/// The null space of the normal matrix N = J^T J at the current values (loss not applied), the
+/// ground points eliminated (Schur complement; a point block is never part of a null vector here:
+/// a weighted point is determined once the other parameters are). From the eigen-decomposition of
+/// the Jacobi-scaled reduced matrix D S D (D = diag(S)^-1/2): the eigenvectors whose eigenvalue is
+/// below `relative_threshold` x the largest, mapped back to AMBIENT block entries (d = D w through
+/// each block's manifold). Used to derive a minimal datum (e.g. triangulation/pushbroom).
+struct NullSpaceReport {
+  bool ok = false;
+  std::string message;           // why it was not computed, when !ok
+  int reduced_parameters = 0;    // size of S
+  double threshold = 0.0;        // the relative eigenvalue threshold used
+  /// Ascending eigenvalues of D S D divided by the largest (the smallest ones, up to 16): the
+  /// rank defect is the count below the threshold; the next one shows the gap.
+  std::vector<double> smallest_relative_eigenvalues;
+  int rank_defect = 0;
+  /// Ambient components of the null vectors (size x rank_defect) per free non-point block;
+  /// fixed entries are 0. The columns span the null space (any basis of it).
+  std::map<BlockId, Eigen::MatrixXd> vectors;
+  /// The same null vectors in Jacobi-scaled coordinates z_e = scale_e x_e (unitless; the columns
+  /// over all blocks are orthonormal), and scale_e = sqrt(S_ee) in 1 / (the entry's unit), 0 for
+  /// fixed entries. Not for rotation blocks (their ambient entries are a quaternion).
+  std::map<BlockId, Eigen::MatrixXd> scaled;
+  std::map<BlockId, Eigen::VectorXd> scale;
+};
+
 class ProblemBuilder {
  public:
   ProblemBuilder();
@@ -245,6 +270,10 @@ class ProblemBuilder {
                                       double correlation_threshold = 0.95,
                                       const std::vector<BlockId>& cross_blocks = {}) const;
 
+  /// The null space of the normal matrix at the current state (NullSpaceReport); not computed
+  /// (ok false) above `max_parameters` reduced parameters (dense eigen-decomposition).
+  NullSpaceReport NullSpace(double relative_threshold, int max_parameters = 3000) const;
+
   /// Cofactors of the listed (active) residuals at the current values, loss not applied:
   /// redundancy numbers r_ii of every scalar component and, with `with_clusters`, Q_vv among the
   /// listed residuals of each point block. Exact at any size (observation_cofactors.h): points
@@ -299,6 +328,8 @@ class ProblemBuilder {
   const Factorized* Factorize(bool apply_loss, int max_dense_parameters) const;
   /// Drops the kept factorisation (its memory).
   void ReleaseFactorized() const;
+  /// d(ambient)/d(tangent) of a block at its current values (identity without a manifold).
+  Eigen::MatrixXd PlusJacobianOf(BlockId id) const;
   Eigen::MatrixXd DenseJacobian(const std::vector<BlockId>& blocks,
                                 std::vector<ResidualId>* row_owner) const;
 

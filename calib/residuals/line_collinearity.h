@@ -5,8 +5,10 @@
 // is the POS pose interpolated to t (constant here: opk_pos, O_pos) plus a smooth correction: a
 // uniform cubic B-spline in the line index with nodes every N lines (CubicBSplineWeights), whose
 // four node blocks hold [dX, dY, dZ (m), domega, dphi, dkappa (rad)], added to the position and
-// the angles:
-//   opk(t) = opk_pos + sum_m w_m node_m[3..5],   O(t) = O_pos + sum_m w_m node_m[0..2]
+// the angles, and a time offset dt (s; the line's true time minus its pos.csv time: shutter / POS
+// latency) to first order through the POS velocity and attitude rate at the line:
+//   opk(t) = opk_pos + dt opk_rate + sum_m w_m node_m[3..5],
+//   O(t) = O_pos + dt velocity + sum_m w_m node_m[0..2]
 //   R = Rx Ry Rz(opk(t))   (body -> object),   camera centre C = O(t) + R t_lever
 //   [U V W]^T = M^T R^T (X - C),   M = Rx Ry Rz(mount) (camera -> body)
 // The detector's focal-plane position is its design position plus the calibration polynomial of
@@ -21,7 +23,7 @@
 // detectors and lines is whitened correctly for every sub-camera.
 //
 // blocks: node0..node3 [6] (m, rad), detector [2 kLineMaxTerms] = a_0..a_5, b_0..b_5 (mm),
-//         c [1] (mm), mount [3] (rad), lever_arm [3] (m), point [3] (m).
+//         c [1] (mm), mount [3] (rad), lever_arm [3] (m), time_offset [1] (s), point [3] (m).
 // Returns false when the point is on or behind the camera (W >= 0).
 #pragma once
 
@@ -83,28 +85,35 @@ struct LineFocalPlaneModel {
 
 struct LineCollinearityResidual
     : AutoDiffResidual<LineCollinearityResidual, 2, kLineNodeSize, kLineNodeSize, kLineNodeSize,
-                       kLineNodeSize, 2 * kLineMaxTerms, 1, 3, 3, 3> {
+                       kLineNodeSize, 2 * kLineMaxTerms, 1, 3, 3, 1, 3> {
   /// design_xy_mm: design focal-plane position of the measured detector position; u: its
   /// normalised index in its sub-camera; span: spline weights of its line; pos_opk_rad,
-  /// pos_center_m: the POS pose interpolated to its line; sigma_xy_mm > 0 (see above).
+  /// pos_center_m: the POS pose interpolated to its line; sigma_xy_mm > 0 (see above);
+  /// pos_velocity_m_s, pos_opk_rate_rad_s: the POS's time derivatives at the line (the time
+  /// offset's lever).
   LineCollinearityResidual(const Eigen::Vector2d& design_xy_mm, double u, const SplineSpan& span,
                            const Eigen::Vector3d& pos_opk_rad, const Eigen::Vector3d& pos_center_m,
-                           const Eigen::Vector2d& sigma_xy_mm)
+                           const Eigen::Vector2d& sigma_xy_mm,
+                           const Eigen::Vector3d& pos_velocity_m_s = Eigen::Vector3d::Zero(),
+                           const Eigen::Vector3d& pos_opk_rate_rad_s = Eigen::Vector3d::Zero())
       : design_{design_xy_mm.x(), design_xy_mm.y()},
         u_(u),
         weights_(span.weights),
         opk_{pos_opk_rad.x(), pos_opk_rad.y(), pos_opk_rad.z()},
         center_{pos_center_m.x(), pos_center_m.y(), pos_center_m.z()},
+        velocity_{pos_velocity_m_s.x(), pos_velocity_m_s.y(), pos_velocity_m_s.z()},
+        opk_rate_{pos_opk_rate_rad_s.x(), pos_opk_rate_rad_s.y(), pos_opk_rate_rad_s.z()},
         inverse_sigma_mm_{1.0 / sigma_xy_mm.x(), 1.0 / sigma_xy_mm.y()} {}
 
   template <typename T>
   bool operator()(const T* n0, const T* n1, const T* n2, const T* n3, const T* detector,
-                  const T* c, const T* mount, const T* lever, const T* point, T* r) const {
+                  const T* c, const T* mount, const T* lever, const T* time_offset,
+                  const T* point, T* r) const {
     const T* nodes[4] = {n0, n1, n2, n3};
     T opk[3], center[3];
     for (int a = 0; a < 3; ++a) {
-      opk[a] = T(opk_[a]);
-      center[a] = T(center_[a]);
+      opk[a] = T(opk_[a]) + time_offset[0] * opk_rate_[a];
+      center[a] = T(center_[a]) + time_offset[0] * velocity_[a];
       for (int m = 0; m < 4; ++m) {
         center[a] += T(weights_[m]) * nodes[m][a];
         opk[a] += T(weights_[m]) * nodes[m][3 + a];
@@ -139,6 +148,7 @@ struct LineCollinearityResidual
   double u_;
   std::array<double, 4> weights_;
   double opk_[3], center_[3];
+  double velocity_[3], opk_rate_[3];
   double inverse_sigma_mm_[2];
 };
 

@@ -40,4 +40,34 @@ std::unique_ptr<ceres::CostFunction> PriorCostFunction::Create(const std::vector
                                              sigmas);
 }
 
+LinearConstraintCostFunction::LinearConstraintCostFunction(std::vector<Eigen::MatrixXd> weights,
+                                                           std::vector<Eigen::VectorXd> origins,
+                                                           double sigma)
+    : weights_(std::move(weights)), origins_(std::move(origins)) {
+  AEROCAL_CHECK(!weights_.empty() && weights_.size() == origins_.size()) << "constraint blocks";
+  AEROCAL_CHECK(sigma > 0) << "constraint sigma must be > 0, got " << sigma;
+  for (size_t b = 0; b < weights_.size(); ++b) {
+    AEROCAL_CHECK(weights_[b].rows() == weights_[0].rows() &&
+                  weights_[b].cols() == origins_[b].size())
+        << "constraint block " << b << " sizes";
+    weights_[b] /= sigma;
+    mutable_parameter_block_sizes()->push_back(static_cast<int>(origins_[b].size()));
+  }
+  set_num_residuals(static_cast<int>(weights_[0].rows()));
+}
+
+bool LinearConstraintCostFunction::Evaluate(double const* const* parameters, double* residuals,
+                                            double** jacobians) const {
+  Eigen::Map<Eigen::VectorXd> r(residuals, num_residuals());
+  r.setZero();
+  for (size_t b = 0; b < weights_.size(); ++b) {
+    const Eigen::Map<const Eigen::VectorXd> x(parameters[b], origins_[b].size());
+    r += weights_[b] * (x - origins_[b]);
+    if (jacobians && jacobians[b])
+      Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+          jacobians[b], weights_[b].rows(), weights_[b].cols()) = weights_[b];
+  }
+  return true;
+}
+
 }  // namespace aerocal::calib

@@ -7,6 +7,7 @@
 #include <memory>
 #include <vector>
 
+#include <Eigen/Core>
 #include <ceres/cost_function.h>
 
 namespace aerocal::calib {
@@ -27,6 +28,25 @@ class PriorCostFunction : public ceres::CostFunction {
   int block_size_;
   std::vector<int> indices_;
   std::vector<double> values_, inverse_sigmas_;
+};
+
+/// Linear constraints on several blocks, as pseudo-observations (a datum):
+///   r = sum_b W_b (x_b - x0_b) / sigma   [unitless; W_b: rows x size_b, in the blocks' units].
+/// Linear, so the Jacobian (W_b / sigma) is written analytically; GradientChecker test in
+/// tests/calib/residuals_test.cc.
+class LinearConstraintCostFunction : public ceres::CostFunction {
+ public:
+  /// `weights[b]` (rows x size of block b) and `origins[b]` (size of block b); equal row counts;
+  /// sigma > 0.
+  LinearConstraintCostFunction(std::vector<Eigen::MatrixXd> weights,
+                               std::vector<Eigen::VectorXd> origins,
+                               double sigma);
+  bool Evaluate(double const* const* parameters, double* residuals,
+                double** jacobians) const override;
+
+ private:
+  std::vector<Eigen::MatrixXd> weights_;  // already divided by sigma
+  std::vector<Eigen::VectorXd> origins_;
 };
 
 }  // namespace aerocal::calib

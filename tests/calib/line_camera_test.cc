@@ -210,9 +210,12 @@ TEST(LineCollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
   const Eigen::Vector3d point = cam_center + ray * (1000.0 / -ray.z());  // 1000 m below
   std::copy(point.data(), point.data() + 3, s.point);
 
-  auto cost = LineCollinearityResidual::Create(design, u, span, pos_opk, pos_center, Eigen::Vector2d(0.003, 0.003));
+  // A time offset (here 0) moves the pose along the POS velocity and attitude rate.
+  auto cost = LineCollinearityResidual::Create(design, u, span, pos_opk, pos_center, Eigen::Vector2d(0.003, 0.003),
+                                               Eigen::Vector3d(1, 60, -0.5), Eigen::Vector3d(0.01, -0.02, 0.005));
+  double time_offset = 0.0;
   const double* blocks[] = {s.nodes[0], s.nodes[1], s.nodes[2], s.nodes[3], s.detector,
-                            &s.c,       s.mount,    s.lever,    s.point};
+                            &s.c,       s.mount,    s.lever,    &time_offset, s.point};
   double r[2];
   ASSERT_TRUE(cost->Evaluate(blocks, r, nullptr));
   EXPECT_NEAR(r[0], 0.0, 1e-9);
@@ -227,8 +230,9 @@ TEST(LineCollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
   const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
   ceres::GradientChecker checker(cost.get(), no_manifolds, options);
   ceres::GradientChecker::ProbeResults results;
+  time_offset = 0.003;
   std::vector<double*> mutable_blocks = {s.nodes[0], s.nodes[1], s.nodes[2], s.nodes[3], s.detector,
-                                         &s.c,       s.mount,    s.lever,    s.point};
+                                         &s.c,       s.mount,    s.lever,    &time_offset, s.point};
   EXPECT_TRUE(checker.Probe(mutable_blocks.data(), 1e-6, &results)) << results.error_log;
 }
 
@@ -238,8 +242,9 @@ TEST(LineCollinearityResidual, RefusesAPointBehindTheCamera) {
   auto cost = LineCollinearityResidual::Create(Eigen::Vector2d(0, 0), 0.0, CubicBSplineWeights(0, 10),
                                                Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1000),
                                                Eigen::Vector2d(0.003, 0.003));
+  double time_offset = 0.0;
   const double* blocks[] = {s.nodes[0], s.nodes[1], s.nodes[2], s.nodes[3], s.detector,
-                            &s.c,       s.mount,    s.lever,    s.point};
+                            &s.c,       s.mount,    s.lever,    &time_offset, s.point};
   double r[2];
   EXPECT_FALSE(cost->Evaluate(blocks, r, nullptr));
 }

@@ -268,6 +268,20 @@ TEST(ProblemBuilder, DatumDefectIsReportedWithTheParametersInvolved) {
   EXPECT_FALSE(cov.ok);
   EXPECT_FALSE(cov.undetermined.empty());
   EXPECT_NE(cov.message.find("datum defect"), std::string::npos);
+  // The null space of the reduced normal matrix (points eliminated): the 7 parameters of a
+  // similarity transform of the network, exact (the cost is invariant under it), far below the
+  // first determined direction; every exterior block takes part.
+  const NullSpaceReport null_space = builder.NullSpace(1e-10);
+  ASSERT_TRUE(null_space.ok) << null_space.message;
+  EXPECT_EQ(null_space.rank_defect, 7);
+  EXPECT_GT(null_space.smallest_relative_eigenvalues[7], 1e4 * null_space.smallest_relative_eigenvalues[6]);
+  for (const BlockId b : {ob[0], cb[0], ob[1], cb[1]}) {
+    ASSERT_TRUE(null_space.vectors.count(b));
+    EXPECT_EQ(null_space.vectors.at(b).cols(), 7);
+  }
+  EXPECT_EQ(null_space.scaled.count(ob[0]), 0u);  // a rotation block: ambient is a quaternion
+  ASSERT_TRUE(null_space.scaled.count(cb[0]));
+  EXPECT_EQ(null_space.scaled.at(cb[0]).rows(), 3);
   bool names_a_center = false;
   for (const auto& n : cov.undetermined) names_a_center |= n.rfind("center", 0) == 0;
   EXPECT_TRUE(names_a_center) << cov.message;

@@ -264,5 +264,19 @@ TEST(PriorCostFunction, WhitenedDifferenceOnSelectedEntries) {
   ExpectGradientsMatch(prior, {x});
 }
 
+TEST(LinearConstraintCostFunction, WhitenedSumOverBlocks) {
+  Eigen::MatrixXd w0(2, 3), w1(2, 2);
+  w0 << 1, 2, 3, 0, -1, 0.5;
+  w1 << 4, 0, 0, 1;
+  const LinearConstraintCostFunction constraint({w0, w1}, {Eigen::Vector3d(1, 0, 0), Eigen::Vector2d(0, 2)}, 0.5);
+  double x0[3] = {2.0, 1.0, -1.0}, x1[2] = {1.0, 3.0};
+  const double* blocks[] = {x0, x1};
+  double r[2];
+  ASSERT_TRUE(constraint.Evaluate(blocks, r, nullptr));
+  EXPECT_DOUBLE_EQ(r[0], (1 + 2 - 3 + 4) / 0.5);       // w0 (1, 1, -1) + w1 (1, 1)
+  EXPECT_DOUBLE_EQ(r[1], (0 - 1 - 0.5 + 1) / 0.5);
+  ExpectGradientsMatch(constraint, {x0, x1});
+}
+
 }  // namespace
 }  // namespace aerocal::calib

@@ -9,3 +9,6 @@ aerocal_add_test(triangulation/pushbroom_study LIBS aerocal::triangulation LABEL
 # "Measured") on a 3 x 200 flight: 33 s, too long for the default suite.
 aerocal_add_test(triangulation/pushbroom_images LIBS aerocal::triangulation LABELS long)
 aerocal_add_test(triangulation/pushbroom_control_cli LIBS aerocal::triangulation LABELS cli)
+# pushbroom_datum: the datum from the null space (issue 28): rank defect = constraints per
+# configuration, reference choices equal modulo the gauge, the default against --datum none.
+aerocal_add_test(triangulation/pushbroom_datum LIBS aerocal::triangulation LABELS synthetic)

@@ -9,6 +9,7 @@
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
+#include <Eigen/SVD>
 #include <nlohmann/json.hpp>
 
 #include "calib/core/atomic_file.h"
@@ -46,7 +47,166 @@ struct Problem {
   std::vector<std::set<int>> datum_entries;        // per detector block: held by the datum
 };
 
+// Singular values of a constraint's restriction to the null space (Jacobi-scaled, the null
+// vectors orthonormal) above this: the constraint holds every gauge direction firmly.
+constexpr double kDatumReach = 1e-3;
+
+// The gauge functions of the detector table at the current detector positions (x_i, y_i) and c
+// (first order): a rotation of the camera frame about x (pitch), y (roll), z (yaw) and a scale of
+// the focal plane; 2N values, dx of every detector then dy, mm per unit.
+struct GaugeFunction {
+  const char* name;
+  const char* meaning;
+  Eigen::VectorXd values;
+};
+std::vector<GaugeFunction> TableGaugeFunctions(const calib::LineCamera& camera,
+                                               const LineScanCamera& sensor,
+                                               const std::vector<std::pair<int, int>>& ranges) {
+  const int n = camera.detectors;
+  const double c = sensor.CMm();
+  std::vector<GaugeFunction> out = {
+      {"pitch", "a rotation about the line (camera x): dy = c + y^2/c, a constant along track",
+       Eigen::VectorXd::Zero(2 * n)},
+      {"roll", "a rotation about the flight direction (camera y): dx = -(c + x^2/c), the across-"
+               "track shift 1 + x^2/c^2 together",
+       Eigen::VectorXd::Zero(2 * n)},
+      {"yaw", "a rotation about the camera axis (z): dx = -y, dy = x, a slope along track",
+       Eigen::VectorXd::Zero(2 * n)},
+      {"scale", "a scale of the focal plane (dx = x, dy = y), which c and the heights may fix",
+       Eigen::VectorXd::Zero(2 * n)}};
+  for (size_t s = 0; s < ranges.size(); ++s)
+    for (int i = ranges[s].first; i <= ranges[s].second; ++i) {
+      const double u = NormalisedIndex(ranges[s], i);
+      const double* a = sensor.Detectors()[s].data();
+      const Eigen::Vector2d xy =
+          camera.DetectorPosition(i) +
+          Eigen::Vector2d(calib::EvaluatePolynomial(a, kLineMaxTerms, u),
+                          calib::EvaluatePolynomial(a + kLineMaxTerms, kLineMaxTerms, u));
+      const double x = xy.x(), y = xy.y();
+      out[0].values(i) = x * y / c;
+      out[0].values(n + i) = c + y * y / c;
+      out[1].values(i) = -(c + x * x / c);
+      out[1].values(n + i) = -x * y / c;
+      out[2].values(i) = -y;
+      out[2].values(n + i) = x;
+      out[3].values(i) = x;
+      out[3].values(n + i) = y;
+    }
+  return out;
+}
+
+// The detector-table part of the null vectors (2N x k, mm): each sub-camera's polynomial
+// components evaluated at its detectors.
+Eigen::MatrixXd NullSpaceInTable(const calib::NullSpaceReport& null_space,
+                                 const LineScanCamera& sensor,
+                                 const std::vector<std::pair<int, int>>& ranges,
+                                 int detectors) {
+  Eigen::MatrixXd f = Eigen::MatrixXd::Zero(2 * detectors, null_space.rank_defect);
+  for (size_t s = 0; s < ranges.size(); ++s) {
+    const auto it = null_space.vectors.find(sensor.DetectorBlocks()[s]);
+    if (it == null_space.vectors.end()) continue;
+    for (int j = 0; j < null_space.rank_defect; ++j)
+      for (int i = ranges[s].first; i <= ranges[s].second; ++i) {
+        const double u = NormalisedIndex(ranges[s], i);
+        const Eigen::VectorXd v = it->second.col(j);
+        f(i, j) = calib::EvaluatePolynomial(v.data(), kLineMaxTerms, u);
+        f(detectors + i, j) = calib::EvaluatePolynomial(v.data() + kLineMaxTerms, kLineMaxTerms, u);
+      }
+  }
+  return f;
+}
+
+// Names the gauge functions the null space holds (LineDatumReport::directions, in_table).
+void NameGaugeDirections(const calib::NullSpaceReport& null_space,
+                         const calib::LineCamera& camera,
+                         const LineScanCamera& sensor,
+                         const std::vector<std::pair<int, int>>& ranges,
+                         LineDatumReport* report) {
+  report->directions.clear();
+  report->in_table = 0;
+  if (null_space.rank_defect == 0) return;
+  const Eigen::MatrixXd f = NullSpaceInTable(null_space, sensor, ranges, camera.detectors);
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(f, Eigen::ComputeThinU);
+  const Eigen::VectorXd sv = svd.singularValues();
+  int rank = 0;
+  while (rank < sv.size() && sv(rank) > 1e-6 * sv(0) && sv(0) > 0) ++rank;
+  report->in_table = rank;
+  const Eigen::MatrixXd basis = svd.matrixU().leftCols(rank);
+  for (const auto& g : TableGaugeFunctions(camera, sensor, ranges)) {
+    const double norm = g.values.norm();
+    if (!(norm > 0) || rank == 0) continue;
+    const double fraction = (basis * (basis.transpose() * g.values)).norm() / norm;
+    if (fraction > 0.999) report->directions.push_back({g.name, fraction, g.meaning});
+  }
+}
+
+// The minimal datum of the gauge mode: exactly k = rank defect constraints, on the first of
+// `candidates` (in order) that together reach every null direction (the singular values of the
+// null vectors restricted to them, Jacobi-scaled, above kDatumReach): the projection of those
+// parameters onto the null space's span there is held at its current value. Unit sigma in the
+// Jacobi-scaled coordinates (the constraint does not compete with the data: it acts on the null
+// space only). Returns the residual id, -1 when k = 0 or the candidates do not reach it.
+calib::ResidualId AddGaugeDatum(calib::ProblemBuilder& builder,
+                                const calib::NullSpaceReport& null_space,
+                                const std::vector<BlockId>& candidates,
+                                const std::string& label,
+                                LineDatumReport* report) {
+  const int k = null_space.rank_defect;
+  report->n_constraints = 0;
+  report->blocks.clear();
+  if (k == 0) return -1;
+  std::vector<BlockId> used;
+  Eigen::MatrixXd w(0, k);
+  bool reached = false;
+  for (BlockId block : candidates) {
+    const auto it = null_space.scaled.find(block);
+    if (it == null_space.scaled.end() || it->second.cwiseAbs().maxCoeff() == 0.0) continue;
+    used.push_back(block);
+    Eigen::MatrixXd grown(w.rows() + it->second.rows(), k);
+    grown.topRows(w.rows()) = w;
+    grown.bottomRows(it->second.rows()) = it->second;
+    w = grown;
+    if (w.rows() >= k) {
+      Eigen::JacobiSVD<Eigen::MatrixXd> svd(w);
+      if (svd.singularValues()(k - 1) > kDatumReach) {
+        reached = true;
+        break;
+      }
+    }
+  }
+  if (!reached) {
+    report->message = "the gauge directions are not reached by the datum's candidate blocks";
+    return -1;
+  }
+  Eigen::JacobiSVD<Eigen::MatrixXd> svd(w, Eigen::ComputeThinU);
+  const Eigen::MatrixXd u = svd.matrixU().leftCols(k);
+  std::vector<Eigen::MatrixXd> weights;
+  std::vector<Eigen::VectorXd> origins;
+  int row = 0;
+  for (BlockId block : used) {
+    const int size = builder.BlockSize(block);
+    weights.push_back(u.middleRows(row, size).transpose() *
+                      null_space.scale.at(block).asDiagonal());
+    origins.push_back(Eigen::Map<const Eigen::VectorXd>(builder.BlockValues(block), size));
+    report->blocks.push_back(builder.BlockName(block));
+    row += size;
+  }
+  report->n_constraints = k;
+  return builder.AddResidual(
+      kGroupLineDatum,
+      std::make_unique<calib::LinearConstraintCostFunction>(weights, origins, 1.0), used, label);
+}
+
 }  // namespace
+
+const char* LineDatumName(LineDatum datum) {
+  switch (datum) {
+    case LineDatum::kGauge: return "gauge";
+    case LineDatum::kReference: return "reference";
+    case LineDatum::kNone: return "none";
+  }
+  return "";
+}
 
 void LineCalibrationOptions::Validate() const {
   if (node_spacing_lines < 1)
@@ -59,6 +219,8 @@ void LineCalibrationOptions::Validate() const {
     throw ConfigError("--degree-alpha must be within (0, 0.5) (got " + FormatNumber(degree_test_alpha) + ")");
   if (!(pos_sigma_m > 0) || !(pos_sigma_deg > 0))
     throw ConfigError("--pos-sigma-m and --pos-sigma-deg must be > 0");
+  if (!(gauge_threshold > 0 && gauge_threshold <= 1e-3))
+    throw ConfigError("--gauge-threshold must be within (0, 1e-3] (got " + FormatNumber(gauge_threshold) + ")");
   if (min_observations_per_segment < 0)
     throw ConfigError("--min-per-segment must be >= 0");
   if (boresight == PlatformParamMode::kWeighted && !(boresight_sigma_rad > 0))
@@ -141,6 +303,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   line_options.boresight_sigma_rad = options.boresight_sigma_rad;
   line_options.lever_arm = options.lever_arm;
   line_options.lever_arm_sigma_m = options.lever_arm_sigma_m;
+  line_options.time_offset = options.time_offset;
   LineScanCamera sensor(camera, pos, line_options);
   Problem p;
   p.fixed_entries.assign(n_sub, {});
@@ -252,13 +415,63 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
       p.fixed_entries[s].insert(k);
       p.fixed_entries[s].insert(kLineMaxTerms + k);
     }
-    if (options.reference_datum && s == reference)
+    if (options.datum == LineDatum::kReference && s == reference)
       p.datum_entries[s] = {0, 1, kLineMaxTerms, kLineMaxTerms + 1};
   }
   apply_fixed();
-  if (options.reference_datum)
-    b.AddResidual(kGroupLineDatum, LineDatumResidual::Create(kDatumSigmaPx * camera.pitch_mm),
-                  {sensor.DetectorBlocks()[reference]}, "datum " + sub_ids[reference]);
+  // The datum (module README "Datum"): the null space of the problem as configured, without a
+  // datum, is always computed and reported; the gauge mode constrains exactly its directions.
+  result.datum.mode = options.datum;
+  result.datum.subcamera = sub_ids[reference];
+  calib::ResidualId datum_residual = -1;
+  bool time_offset_in_null_space = false;
+  std::vector<BlockId> datum_candidates = {sensor.DetectorBlocks()[reference], sensor.MountBlock(),
+                                           sensor.LeverArmBlock(), sensor.CBlock()};
+  datum_candidates.insert(datum_candidates.end(), sensor.NodeBlocks().begin(), sensor.NodeBlocks().end());
+  auto derive_datum = [&]() {
+    if (datum_residual >= 0) b.RemoveResidual(datum_residual);
+    datum_residual = -1;
+    const calib::NullSpaceReport null_space = b.NullSpace(options.gauge_threshold);
+    auto& d = result.datum;
+    d.null_space_computed = null_space.ok;
+    d.message = null_space.message;
+    d.threshold = options.gauge_threshold;
+    d.rank_defect = null_space.rank_defect;
+    d.smallest_relative_eigenvalues = null_space.smallest_relative_eigenvalues;
+    NameGaugeDirections(null_space, camera, sensor, ranges, &d);
+    // A parameter the user asked to estimate that lies in the null space is not determined by
+    // the data (a datum only sets it by convention): named, the result is not valid. E.g. the
+    // time offset or the lever arm without POS priors (a constant along-track shift / position
+    // of the trajectory), c (the focal plane's scale), the boresight (a rotation of the table).
+    auto in_null_space = [&](BlockId block) {
+      const auto it = null_space.scaled.find(block);
+      return it != null_space.scaled.end() && it->second.rows() > 0 && it->second.cols() > 0 &&
+             Eigen::JacobiSVD<Eigen::MatrixXd>(it->second).singularValues()(0) > kDatumReach;
+    };
+    time_offset_in_null_space = in_null_space(sensor.TimeOffsetBlock());
+    d.parameters_in_null_space.clear();
+    const std::pair<BlockId, const char*> own[] = {{sensor.CBlock(), "c"},
+                                                   {sensor.MountBlock(), "boresight"},
+                                                   {sensor.LeverArmBlock(), "lever_arm"}};
+    for (const auto& [block, name] : own)
+      if (in_null_space(block)) d.parameters_in_null_space.push_back(name);
+    if (time_offset_in_null_space) d.parameters_in_null_space.push_back("time_offset");
+    if (options.datum == LineDatum::kGauge && null_space.ok)
+      datum_residual = AddGaugeDatum(b, null_space, datum_candidates, "datum " + sub_ids[reference], &d);
+    if (options.datum == LineDatum::kReference) {
+      d.n_constraints = 4;
+      d.blocks = {b.BlockName(sensor.DetectorBlocks()[reference])};
+      datum_residual =
+          b.AddResidual(kGroupLineDatum, LineDatumResidual::Create(kDatumSigmaPx * camera.pitch_mm),
+                        {sensor.DetectorBlocks()[reference]}, "datum " + sub_ids[reference]);
+    }
+  };
+  derive_datum();
+  // The sub-camera carrying the constraints keeps the start degree (the degree test leaves it).
+  auto datum_on_reference = [&]() {
+    return std::find(result.datum.blocks.begin(), result.datum.blocks.end(),
+                     b.BlockName(sensor.DetectorBlocks()[reference])) != result.datum.blocks.end();
+  };
 
   // Reprojection before: at the POS and the file's camera.
   auto rms_by_subcamera = [&](bool after) {
@@ -291,6 +504,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   cov_blocks.push_back(sensor.CBlock());
   if (options.boresight != PlatformParamMode::kFixed) cov_blocks.push_back(sensor.MountBlock());
   if (options.lever_arm != PlatformParamMode::kFixed) cov_blocks.push_back(sensor.LeverArmBlock());
+  if (options.time_offset) cov_blocks.push_back(sensor.TimeOffsetBlock());
 
   result.report = b.Solve(options.solver);
   calib::CovarianceReport cov;
@@ -325,7 +539,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         // The datum sub-camera keeps the start degree: a term dropped there (insignificant, yet
         // real) is a bias the sigmas do not show, and the datum pins its correction where the
         // Legendre terms kept vanish (degree 2: u = +-1/sqrt(3), sigma ~0 there).
-        if (options.reference_datum && s == reference) {
+        if (s == reference && datum_on_reference()) {
           degree = start_degree;
           continue;
         }
@@ -341,6 +555,9 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
       result.degree_test.reduced = true;
       start_table = detector_table(cov);
       apply_fixed();
+      // Fewer terms can remove a gauge direction (e.g. a roll needs x^2 in every sub-camera):
+      // the datum follows the reduced problem's null space.
+      derive_datum();
       result.report = b.Solve(options.solver);
       cov = result.report.usable ? b.EstimateCovariance(cov_blocks, result.report.sigma0)
                                  : calib::CovarianceReport{};
@@ -380,7 +597,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     // Without the datum the singular direction is known: a constant along-track offset of all
     // detectors IS a pitch of the strip (exactly, for a line at y = 0); without a covariance its
     // correlation cannot be computed, so it is named with the value it has in the model.
-    if (!options.reference_datum)
+    if (options.datum == LineDatum::kNone)
       result.warnings.push_back({"offset_vs_pitch", "detector polynomials", 1.0,
                                  options.correlation_fail,
                                  "ill-posed: no datum and a singular normal matrix: a constant "
@@ -505,6 +722,29 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     result.boresight_sigma_rad = block_sigma(sensor.MountBlock());
   if (options.lever_arm != PlatformParamMode::kFixed)
     result.lever_arm_sigma_m = block_sigma(sensor.LeverArmBlock());
+  // Requested parameters in the null space (derive_datum): not determined by the data.
+  if (options.datum != LineDatum::kReference)
+    for (const std::string& name : result.datum.parameters_in_null_space) {
+      if (name == "time_offset") continue;  // below, with its own message
+      result.valid = false;
+      result.warnings.push_back({name + "_not_determinable", name, 1.0, options.correlation_fail,
+                                 "ill-posed: " + name + " lies in the null space of the problem "
+                                 "(a gauge direction: its value is the datum's convention, not "
+                                 "the data's; datum.gauge_directions says which)"});
+    }
+  result.time_offset_estimated = options.time_offset;
+  result.time_offset_s = sensor.TimeOffsetS();
+  if (options.time_offset && (!time_offset_in_null_space || options.datum == LineDatum::kReference))
+    result.time_offset_sigma_s = entry_sigma(sensor.TimeOffsetBlock(), 0);
+  if (time_offset_in_null_space && options.datum != LineDatum::kReference) {
+    result.valid = false;
+    result.time_offset_sigma_s.reset();
+    result.warnings.push_back({"time_offset_not_determinable", "time offset", 1.0,
+                               options.correlation_fail,
+                               "ill-posed: the time offset lies in the null space (an along-track "
+                               "shift v dt the trajectory takes over entirely; the POS priors are "
+                               "off)"});
+  }
 
   // Named correlations: a detector polynomial's constant across-track term against the mean roll
   // correction of the strip (offset_vs_roll), its constant along-track term against the mean pitch
@@ -601,6 +841,24 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
                        multiple({{mount, 0, 1.0}}, all_free(sensor.DetectorBlocks(), kLineMaxTerms)),
                        "the boresight pitch (omega) is a constant along-track offset of the detectors"});
     }
+    // The time offset: v dt is an along-track shift (the nodes' along-track position, its
+    // drift included) and, seen from the height, a pitch; only the POS priors separate them.
+    if (options.time_offset && !time_offset_in_null_space && entry_sigma(sensor.TimeOffsetBlock(), 0)) {
+      Combination along = all_free(sensor.NodeBlocks(), line_along_x ? 1 : 0);
+      const Combination pitches = all_free(sensor.NodeBlocks(), pitch);
+      along.insert(along.end(), pitches.begin(), pitches.end());
+      named.push_back({"time_offset_vs_along_track",
+                       multiple({{sensor.TimeOffsetBlock(), 0, 1.0}}, along),
+                       "a time offset is an along-track shift v dt (and the attitude change over "
+                       "dt): the trajectory's along-track and pitch corrections take it; only the "
+                       "POS priors tell them apart"});
+      named.push_back({"time_offset_vs_offset",
+                       multiple({{sensor.TimeOffsetBlock(), 0, 1.0}},
+                                all_free(sensor.DetectorBlocks(), kLineMaxTerms)),
+                       "a time offset seen from the height is nearly a constant along-track offset "
+                       "of the detectors (a pitch of the camera); only the relief tells them "
+                       "apart"});
+    }
     if (entry_sigma(lever, 0)) {
       Combination positions;
       for (int e = 0; e < 3; ++e) {
@@ -635,8 +893,9 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         const bool fail = rho > options.correlation_fail;
         if (fail) result.valid = false;
         const bool own = name.rfind("boresight", 0) == 0 || name.rfind("lever_arm", 0) == 0;
+        const bool time = name.rfind("time_offset", 0) == 0;
         result.warnings.push_back(
-            {name, own ? "boresight / lever arm" : "detector polynomials", rho,
+            {name, time ? "time offset" : own ? "boresight / lever arm" : "detector polynomials", rho,
              fail ? options.correlation_fail : options.correlation_warn,
              std::string(fail ? "ill-posed: " : "") + "correlation " + FormatNumber(rho, 6) +
                  ": " + meaning});
@@ -710,6 +969,27 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
   j["n_observations"] = r.n_observations;
   j["n_control"] = r.n_control;
   j["n_ignored_observations"] = r.n_ignored;
+  {
+    const auto& d = r.datum;
+    json directions = json::array();
+    for (const auto& g : d.directions)
+      directions.push_back({{"name", g.name}, {"fraction", g.fraction}, {"meaning", g.meaning}});
+    j["datum"] = {{"mode", LineDatumName(d.mode)},
+                  {"null_space_computed", d.null_space_computed},
+                  {"rank_defect", d.null_space_computed ? json(d.rank_defect) : json(nullptr)},
+                  {"threshold", d.threshold},
+                  {"smallest_relative_eigenvalues", d.smallest_relative_eigenvalues},
+                  {"n_constraints", d.n_constraints},
+                  {"subcamera", d.subcamera},
+                  {"blocks", d.blocks},
+                  {"gauge_directions", directions},
+                  {"gauge_directions_in_table", d.in_table},
+                  {"parameters_in_null_space", d.parameters_in_null_space},
+                  {"message", d.message}};
+  }
+  j["time_offset"] = {{"estimated", r.time_offset_estimated},
+                      {"dt_s", r.time_offset_s},
+                      {"sigma_s", r.time_offset_sigma_s ? json(*r.time_offset_sigma_s) : json(nullptr)}};
   j["c_mm"] = r.c_mm;
   j["c_sigma_mm"] = opt(r.c_sigma_mm);
   const double deg = 180.0 / M_PI;

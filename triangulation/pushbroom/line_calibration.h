@@ -11,12 +11,22 @@
 //   accounts for the selection);
 // - the control points as weighted ground points (their survey sigmas);
 // - optionally the principal distance c (`free_c`; it is nearly a scale of the table).
-// Datum (module README "Datum"): the reference sub-camera's correction (on top of the file's) has
-// zero Legendre mean and slope in x and y (LineDatumResidual), whatever its degree; it keeps the
-// start degree (the degree test leaves it). The common along-track offset is exactly a pitch, the
-// common across-track offset nearly a roll, the slopes nearly kappa and the scale; the trajectory
-// corrections take them. `reference_datum = false` frees them: the result is then reported
-// ill-posed by name (offset_vs_roll, offset_vs_pitch, scale_vs_c) with the correlations.
+// Datum (module README "Datum"), `datum`:
+// - kGauge (default): derived from the null space of the problem as configured (c fixed or free,
+//   boresight and lever-arm modes, POS priors on or off): the rank defect k of the reduced normal
+//   matrix without a datum (ProblemBuilder::NullSpace) is counted, and exactly k constraints are
+//   put on the reference sub-camera's polynomial block (then, only if the gauge does not reach it
+//   fully, on the mount, lever arm, c and the spline nodes): the projection of the parameters
+//   onto the null space's components there is held at its start value (C V nonsingular, so the
+//   fit, sigma0 and every gauge-invariant quantity equal those of the datum-free problem). With
+//   the POS priors on and the boresight and lever arm fixed the defect is 0: nothing is held.
+//   The gauge functions found (pitch, roll, yaw, scale in the table) are named in the result.
+// - kReference: the earlier datum, kept for an explicit request only: the reference sub-camera's
+//   Legendre mean and slope per axis are zero (LineDatumResidual, 4 constraints whatever the
+//   null space): it over-constrains (holds the scale and the mean roll, which the control and the
+//   POS determine) unless the defect is exactly those four functions.
+// - kNone: no datum; an undetermined problem is reported ill-posed by name.
+// The sub-camera that carries the constraints (gauge, reference) keeps the start degree.
 #pragma once
 
 #include <optional>
@@ -34,13 +44,21 @@
 
 namespace aerocal::triangulation {
 
+enum class LineDatum { kGauge, kReference, kNone };
+/// "gauge", "reference", "none" (the --datum values).
+const char* LineDatumName(LineDatum datum);
+
 struct LineCalibrationOptions {
   int node_spacing_lines = 100;       // spline node spacing N, lines, >= 1
   int max_degree = 5;                 // highest polynomial degree tried, 0 .. 5
   std::optional<int> degree;          // a fixed degree (0 .. 5) instead of the test
   double degree_test_alpha = 0.05;    // significance of the top-down Wald test, (0, 0.5)
-  bool reference_datum = true;        // the reference sub-camera's Legendre mean + slope = 0
-  int reference_subcamera = -1;       // index; -1: the middle one
+  LineDatum datum = LineDatum::kGauge;  // the datum (header comment)
+  int reference_subcamera = -1;       // the sub-camera carrying the datum; -1: the middle one
+  // Relative eigenvalue (of the Jacobi-scaled reduced normal matrix) below which a direction is
+  // a gauge freedom, (0, 1e-3]: exact gauges sit at ~1e-16, determined directions above 1e-9 on
+  // the flights measured (module README "Datum").
+  double gauge_threshold = 1e-5;
   bool free_c = false;                // estimate c (nearly a scale of the table: scale_vs_c)
   bool pos_prior = true;              // the POS sigmas as priors on the node values
   double pos_sigma_m = 0.05;          // used when pos.csv gives no sigmas, > 0
@@ -55,6 +73,11 @@ struct LineCalibrationOptions {
   double boresight_sigma_rad = 0.0;   // weighted: per angle, rad, > 0
   PlatformParamMode lever_arm = PlatformParamMode::kFixed;
   double lever_arm_sigma_m = 0.0;     // weighted: per axis, m, > 0
+  // Estimate a time offset dt (s) of the line camera against the POS (shutter / POS latency;
+  // LineScanCamera "time_offset"). It is an along-track shift v dt plus the attitude change over
+  // dt: only the POS priors tell it from the trajectory's along-track and pitch corrections
+  // (named time_offset_vs_along_track); without them it is not determinable (named, invalid).
+  bool time_offset = false;
   calib::SolverOptions solver;
   void Validate() const;              // ConfigError naming the option
 };
@@ -91,8 +114,38 @@ struct LineErrorSample {
   double across_px = 0.0, along_px = 0.0;
 };
 
+/// The datum as derived and applied (result.json "datum").
+struct LineDatumReport {
+  LineDatum mode = LineDatum::kGauge;
+  bool null_space_computed = false;
+  std::string message;                          // why the null space was not computed
+  int rank_defect = 0;                          // of the normal matrix WITHOUT a datum
+  double threshold = 0.0;                       // relative eigenvalue threshold
+  std::vector<double> smallest_relative_eigenvalues;  // ascending, without the datum
+  int n_constraints = 0;                        // constraints the datum adds
+  std::string subcamera;                        // the reference sub-camera's id
+  std::vector<std::string> blocks;              // the blocks the constraints act on
+  /// Gauge functions of the detector table found in the null space: name (pitch: a constant
+  /// along-track shift c + y^2/c; roll: the across-track c + x^2/c; yaw: (-y, x); scale: (x, y)),
+  /// the fraction of its norm over the table that the null space holds (1: a gauge freedom) and
+  /// what it means. `in_table` of the defect: the directions the table takes part in; the rest
+  /// (e.g. a free boresight against a trajectory without POS priors) lie outside it.
+  struct Direction {
+    std::string name;
+    double fraction = 0.0;
+    std::string meaning;
+  };
+  std::vector<Direction> directions;
+  int in_table = 0;
+  /// Parameters asked for (c, boresight, lever_arm, time_offset) that the null space reaches:
+  /// not determined by the data (named warnings, the result is not valid unless the datum is
+  /// the explicit `reference` convention).
+  std::vector<std::string> parameters_in_null_space;
+};
+
 struct LineCalibrationResult {
   calib::SolveReport report;
+  LineDatumReport datum;
   bool valid = true;               // false: cannot be trusted (warnings say why)
   std::vector<LineWarning> warnings;
   double sigma0_px = 0.0;
@@ -125,6 +178,10 @@ struct LineCalibrationResult {
   PlatformParamMode boresight = PlatformParamMode::kFixed, lever_arm = PlatformParamMode::kFixed;
   Eigen::Vector3d boresight_rad = Eigen::Vector3d::Zero(), lever_arm_m = Eigen::Vector3d::Zero();
   std::optional<Eigen::Vector3d> boresight_sigma_rad, lever_arm_sigma_m;
+  /// The time offset (s) when estimated, and its sigma (null when not estimated or determined).
+  bool time_offset_estimated = false;
+  double time_offset_s = 0.0;
+  std::optional<double> time_offset_sigma_s;
   /// Named correlations (max |rho| over the pairs of that kind; absent when not computed).
   std::vector<std::pair<std::string, double>> correlations;
   calib::LineCamera camera;  // the updated camera (polynomial calibration)

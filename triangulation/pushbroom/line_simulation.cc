@@ -44,6 +44,10 @@ void LineSimulationOptions::Validate() const {
   require(pos_error_m >= 0 && pos_error_deg >= 0, "--pos-error-m and --pos-error-deg must be >= 0");
   require(node_spacing_lines >= 1, "--node-spacing must be >= 1");
   require(detector_error_px >= 0, "--detector-error-px must be >= 0");
+  require(subcamera_error_px >= 0, "--subcamera-error-px must be >= 0");
+  require(std::abs(time_offset_s) <= 1.0, "--time-offset-s must be within -1 .. 1 s");
+  require(pos_bias_m >= 0 && pos_bias_deg >= 0 && pos_drift_m >= 0 && pos_drift_deg >= 0,
+          "--pos-bias-m, --pos-bias-deg, --pos-drift-m and --pos-drift-deg must be >= 0");
 }
 
 LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
@@ -68,6 +72,11 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     subs[k].mount_rad = Eigen::Vector3d(0, -(k - 1) * o.tilt_deg * kDeg, 0);
   }
   calib::LineCamera cam = calib::CombineLineCameras("pushbroom-sim", subs, c, o.pitch_mm);
+  if (o.linear_layout) {
+    // One straight virtual CCD; the sub-cameras are its polynomial ranges.
+    cam.subcameras.clear();
+    for (int k = 0; k < 3; ++k) cam.calibration.push_back({k * n, k * n + n - 1, {}, {}});
+  }
   cam.mount_rad = Eigen::Vector3d(0.1, -0.05, 0.2) * kDeg;  // a known boresight
   cam.lever_arm_m = Eigen::Vector3d(0.2, 0.1, -0.3);
   sim.nominal = cam;
@@ -75,11 +84,13 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
   sim.reference_subcamera = 1;
   // Smooth per-detector errors: a cubic in u per sub-camera and axis.
   const double amp = o.detector_error_px * o.pitch_mm;
+  const double sub_amp = o.subcamera_error_px * o.pitch_mm;
+  std::vector<calib::LinePolynomial> truth_polynomials;
   for (int k = 0; k < 3; ++k) {
     calib::LinePolynomial p;
-    p.first = cam.subcameras[k].first;
-    p.last = cam.subcameras[k].last;
-    const bool reference = k == sim.reference_subcamera;
+    p.first = k * n;
+    p.last = k * n + n - 1;
+    const bool reference = k == sim.reference_subcamera && sub_amp == 0;
     for (auto* axis : {&p.dx, &p.dy}) {
       *axis = {reference ? 0.0 : amp * normal(rng), reference ? 0.0 : amp * normal(rng),
                0.5 * amp * normal(rng), 0.5 * amp * normal(rng)};
@@ -92,8 +103,16 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
         (*axis)[1] -= slope;
       }
     }
-    cam.calibration.push_back(p);
+    if (sub_amp > 0) {
+      p.dx[0] += sub_amp * normal(rng);  // offset across
+      p.dy[0] += sub_amp * normal(rng);  // offset along
+      p.dx[1] += sub_amp * normal(rng);  // scale
+      p.dy[1] += sub_amp * normal(rng);  // rotation in the focal plane
+      p.dy[2] += sub_amp * normal(rng);  // curvature of the line
+    }
+    truth_polynomials.push_back(p);
   }
+  cam.calibration = truth_polynomials;
   sim.truth = cam;
   sim.truth.name = "pushbroom-sim truth";
 
@@ -104,29 +123,49 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
   const double ph[6] = {uniform(rng) * 6.28, uniform(rng) * 6.28, uniform(rng) * 6.28,
                         uniform(rng) * 6.28, uniform(rng) * 6.28, uniform(rng) * 6.28};
   const double a = o.attitude_variation_deg * kDeg, q = o.position_variation_m;
-  for (int l = 0; l < o.lines; ++l) {
+  // The body's trajectory at a (fractional) line index.
+  auto trajectory = [&](double l, PosRecord* r) {
     const double s = l / double(o.lines);  // 0 .. 1 along the strip
+    r->center_m = {q * std::sin(2 * M_PI * 1.3 * s + ph[0]), l * spacing_m + 0.3 * q * std::sin(2 * M_PI * 0.7 * s + ph[1]),
+                   o.height_m + q * std::sin(2 * M_PI * 0.9 * s + ph[2])};
+    r->opk_rad = {a * std::sin(2 * M_PI * 2.1 * s + ph[3]), a * std::sin(2 * M_PI * 1.7 * s + ph[4]),
+                  0.5 * a * std::sin(2 * M_PI * 1.1 * s + ph[5])};
+  };
+  // A time offset: line l is exposed at its time stamp plus time_offset_s, so its true pose is
+  // the trajectory there, while the POS row of line l is the trajectory at the stamp.
+  std::vector<PosRecord> pos_rows;
+  for (int l = 0; l < o.lines; ++l) {
     PosRecord r;
     r.line = l;
     r.source_line = l + 2;
     r.time_s = 1000.0 + l * dt;
-    r.center_m = {q * std::sin(2 * M_PI * 1.3 * s + ph[0]), l * spacing_m + 0.3 * q * std::sin(2 * M_PI * 0.7 * s + ph[1]),
-                  o.height_m + q * std::sin(2 * M_PI * 0.9 * s + ph[2])};
-    r.opk_rad = {a * std::sin(2 * M_PI * 2.1 * s + ph[3]), a * std::sin(2 * M_PI * 1.7 * s + ph[4]),
-                 0.5 * a * std::sin(2 * M_PI * 1.1 * s + ph[5])};
+    trajectory(l + o.time_offset_s / dt, &r);
     sim.pos_truth.push_back(r);
+    trajectory(l, &r);
+    pos_rows.push_back(r);
   }
   // POS error: a cubic B-spline with random node values.
   const int nodes = calib::SplineNodeCount(o.lines - 1, o.node_spacing_lines);
   std::vector<Vector6d> error_nodes(nodes);
   for (auto& e : error_nodes)
     for (int k = 0; k < 6; ++k) e[k] = (k < 3 ? o.pos_error_m : o.pos_error_deg * kDeg) * normal(rng);
+  // Bias and drift: constant and linear in the line index, which the cubic B-spline holds exactly
+  // (node j is centred on line (j - 1) spacing).
+  if (o.pos_bias_m > 0 || o.pos_bias_deg > 0 || o.pos_drift_m > 0 || o.pos_drift_deg > 0) {
+    Vector6d bias, drift;
+    for (int k = 0; k < 6; ++k) {
+      bias[k] = (k < 3 ? o.pos_bias_m : o.pos_bias_deg * kDeg) * normal(rng);
+      drift[k] = (k < 3 ? o.pos_drift_m : o.pos_drift_deg * kDeg) * normal(rng);
+    }
+    for (int j = 0; j < nodes; ++j)
+      error_nodes[j] += bias + drift * ((j - 1) * double(o.node_spacing_lines) / (o.lines - 1));
+  }
   for (int l = 0; l < o.lines; ++l) {
     const calib::SplineSpan span = calib::CubicBSplineWeights(l, o.node_spacing_lines);
     const int j = std::min(span.first_node, nodes - 4);
     Vector6d e = Vector6d::Zero();
     for (int m = 0; m < 4; ++m) e += span.weights[m] * error_nodes[j + m];
-    PosRecord r = sim.pos_truth[l];
+    PosRecord r = pos_rows[l];
     r.center_m += e.head<3>();
     r.opk_rad += e.tail<3>();
     if (o.pos_error_m > 0) r.center_sigma_m = Eigen::Vector3d::Constant(o.pos_error_m);
@@ -149,8 +188,9 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     std::vector<LineObservation> seen;
     for (int s = 0; s < 3; ++s) {
       double i = 0, t = 0;
+      const int first = s * n, last = s * n + n - 1;
       if (!SubcameraPixelOfPoint(sim.truth, truth, s, t0, ground, &i, &t)) continue;
-      if (!(i >= sim.truth.subcameras[s].first - 0.5 && i <= sim.truth.subcameras[s].last + 0.5)) continue;
+      if (!(i >= first - 0.5 && i <= last + 0.5)) continue;
       if (!(t >= 1 && t <= o.lines - 2)) continue;
       LineObservation obs;
       obs.detector = i + o.image_noise_px * normal(rng);
@@ -161,8 +201,7 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
       // be read as the neighbour's detector, so it is not measured (and, at the outer edges,
       // beyond the line).
       const long column = std::lround(obs.detector);
-      if (!(obs.detector >= -0.5 && column >= sim.truth.subcameras[s].first &&
-            column <= sim.truth.subcameras[s].last))
+      if (!(obs.detector >= -0.5 && column >= first && column <= last))
         continue;
       seen.push_back(obs);
     }
@@ -207,7 +246,8 @@ void WriteLineSimulation(const LineSimulation& sim, const std::string& folder) {
     out << "i,subcamera,dx_mm,dy_mm\n";
     for (int i = 0; i < sim.truth.detectors; ++i) {
       const Eigen::Vector2d d = sim.truth.Correction(i);
-      out << i << "," << sim.truth.subcameras[sim.truth.SubcameraOf(i)].id << ","
+      const int k = sim.truth.SubcameraOf(i);
+      out << i << "," << (sim.truth.subcameras.empty() ? std::to_string(k) : sim.truth.subcameras[k].id) << ","
           << FormatNumber(d.x(), 17) << "," << FormatNumber(d.y(), 17) << "\n";
     }
     WriteFileAtomically(path("truth_detectors.csv"), out.str());

@@ -9,8 +9,9 @@
 // Truth, exactly as the calibration models it (module README "Simulation"):
 // - the true body pose at a fractional line is the POS interpolation (pos_trajectory.h) of the
 //   true per-line poses; the POS rows are the true rows plus the spline error at each line;
-// - the reference (middle) sub-camera's true errors have no constant and no linear term (the
-//   calibration's datum: those are trajectory corrections).
+// - without `subcamera_error_px` the reference (middle) sub-camera's true errors have zero
+//   Legendre mean and slope (the earlier datum, --datum reference); with it every sub-camera has
+//   its own offset, scale, rotation and curvature error.
 #pragma once
 
 #include <cstdint>
@@ -44,6 +45,21 @@ struct LineSimulationOptions {
   double pos_error_deg = 0.005;     // sigma of the POS error spline nodes (attitude), >= 0
   int node_spacing_lines = 100;     // of the POS error spline, >= 1
   double detector_error_px = 0.5;   // size of the smooth per-detector errors, >= 0
+  // Per sub-camera errors of EVERY sub-camera (the reference too; issue 28): an offset (dx, dy),
+  // a scale (dx ~ u), a rotation of the line in the focal plane (dy ~ u) and a curvature
+  // (dy ~ u^2), each drawn with this sigma at the sub-camera's ends, px; 0: none (then the
+  // reference's cubic errors satisfy the earlier Legendre datum, as before), >= 0.
+  double subcamera_error_px = 0.0;
+  // The sub-cameras stitched by their design onto ONE straight virtual CCD: the nominal camera has
+  // no `subcameras` section, the sub-cameras are the calibration's polynomial ranges (zero in the
+  // nominal camera); the truth's polynomials carry the errors.
+  bool linear_layout = false;
+  // POS error beyond the spline's random nodes: a constant (bias) and a linear drift over the
+  // flight (its value at the end), each component drawn with these sigmas (m, deg), >= 0.
+  double pos_bias_m = 0.0, pos_bias_deg = 0.0, pos_drift_m = 0.0, pos_drift_deg = 0.0;
+  // Shutter / POS latency: line l is exposed time_offset_s after its pos.csv time stamp (the
+  // calibration's --time-offset estimates it), s, |.| <= 1.
+  double time_offset_s = 0.0;
   double attitude_variation_deg = 0.5;  // amplitude of the smooth attitude variation
   double position_variation_m = 3.0;    // amplitude of the smooth position variation
   std::uint64_t seed = 1;

@@ -64,6 +64,9 @@ void LineScanCamera::RegisterBlocks(const SensorContext& context) {
   mount_block_ =
       b.AddBlock("mount", mount_.data(), 3, calib::BlockKind::kOther, {"omega", "phi", "kappa"});
   lever_block_ = b.AddBlock("lever_arm", lever_.data(), 3, calib::BlockKind::kOther, {"x", "y", "z"});
+  time_offset_s_ = 0.0;
+  time_block_ = b.AddBlock("time_offset", &time_offset_s_, 1, calib::BlockKind::kOther, {"dt"});
+  if (!options_.time_offset) b.FixBlock(time_block_);
   if (!options_.free_c) b.FixBlock(c_block_);
   if (options_.boresight == PlatformParamMode::kFixed) b.FixBlock(mount_block_);
   if (options_.lever_arm == PlatformParamMode::kFixed) b.FixBlock(lever_block_);
@@ -159,10 +162,19 @@ ObservationTerm LineScanCamera::Observe(const SensorContext& context,
   terms_.push_back({s, detector, site.u, sigma_xy_mm, j});
   ObservationTerm term;
   term.group = kGroupLineImage;
+  // The POS velocity and attitude rate at the line (the time offset's lever): central
+  // differences of the interpolated POS over +- 1 ms.
+  const double time = pos_.LineTime(line);
+  const double t0 = std::max(pos_.records().front().time_s, time - 1e-3);
+  const double t1 = std::min(pos_.records().back().time_s, time + 1e-3);
+  Eigen::Vector3d c0, c1, o0, o1;
+  pos_.PoseAtTime(t0, &c0, &o0);
+  pos_.PoseAtTime(t1, &c1, &o1);
   term.cost = calib::LineCollinearityResidual::Create(
-      camera_.DetectorPosition(detector), site.u, span, pos_opk, pos_center, sigma_xy_mm);
+      camera_.DetectorPosition(detector), site.u, span, pos_opk, pos_center, sigma_xy_mm,
+      Eigen::Vector3d((c1 - c0) / (t1 - t0)), Eigen::Vector3d((o1 - o0) / (t1 - t0)));
   term.blocks = {node_blocks_[j], node_blocks_[j + 1], node_blocks_[j + 2], node_blocks_[j + 3],
-                 detector_blocks_[s], c_block_, mount_block_, lever_block_, point};
+                 detector_blocks_[s], c_block_, mount_block_, lever_block_, time_block_, point};
   return term;
 }
 

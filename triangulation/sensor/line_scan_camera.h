@@ -21,9 +21,12 @@
 //   "c"               principal distance (mm), fixed unless `free_c`
 //   "mount"           boresight M omega, phi, kappa (rad), camera -> body; fixed | free | weighted
 //   "lever_arm"       camera centre in the body frame (m); fixed | free | weighted
+//   "time_offset"     dt (s): the line's true time minus its pos.csv time (shutter / POS latency),
+//                     to first order through the POS velocity and attitude rate; fixed at 0
+//                     unless `time_offset`
 // Residual of an observation: calib::LineCollinearityResidual (group kGroupLineImage), which ends
 // in the one collinearity condition of aerocal (calib/residuals/collinearity.h); blocks node J ..
-// J+3, detector, c, mount, lever_arm, point.
+// J+3, detector, c, mount, lever_arm, time_offset, point.
 // Own residuals (AddOwnResiduals): the POS prior on every node (group kGroupPosPrior, around 0 with
 // the POS sigmas) when `pos_prior`; the weighted boresight and lever arm around the file's values
 // (group kGroupLinePrior).
@@ -103,6 +106,7 @@ struct LineScanOptions {
   double boresight_sigma_rad = 0.0;                         // weighted: per angle, > 0
   PlatformParamMode lever_arm = PlatformParamMode::kFixed;  // the camera file's lever arm
   double lever_arm_sigma_m = 0.0;                           // weighted: per axis, > 0
+  bool time_offset = false;                                 // estimate the time offset dt
 };
 
 /// Where a detector position lies: its sub-camera and normalised index u in [-1, 1].
@@ -161,6 +165,8 @@ class LineScanCamera final : public ImagingModel {
   calib::BlockId CBlock() const { return c_block_; }
   calib::BlockId MountBlock() const { return mount_block_; }
   calib::BlockId LeverArmBlock() const { return lever_block_; }
+  calib::BlockId TimeOffsetBlock() const { return time_block_; }
+  double TimeOffsetS() const { return time_offset_s_; }
   double CMm() const { return c_; }
   const Eigen::Vector3d& MountRad() const { return mount_; }
   const Eigen::Vector3d& LeverArmM() const { return lever_; }
@@ -178,8 +184,9 @@ class LineScanCamera final : public ImagingModel {
   std::vector<DetectorValues> detector_;
   double c_ = 0.0;
   Eigen::Vector3d mount_ = Eigen::Vector3d::Zero(), lever_ = Eigen::Vector3d::Zero();
+  double time_offset_s_ = 0.0;
   std::vector<calib::BlockId> node_blocks_, detector_blocks_;
-  calib::BlockId c_block_ = -1, mount_block_ = -1, lever_block_ = -1;
+  calib::BlockId c_block_ = -1, mount_block_ = -1, lever_block_ = -1, time_block_ = -1;
   std::vector<LineTerm> terms_;
 };
 

@@ -1,0 +1,367 @@
+// The pushbroom datum from the null space (issue 28 part 1; module README "Datum"): on flights
+// whose every sub-camera has its own offset, scale, rotation and curvature error, for both layouts
+// (the `subcameras` design, and the sub-cameras as polynomial ranges of one straight virtual CCD):
+// - the rank defect of the normal matrix without a datum equals the number of constraints the
+//   gauge datum adds, per configuration, and the constrained problem has full rank with the same
+//   fit (v^T P v) as the datum-free one;
+// - the tables of any two valid datum choices (reference 0, 1, 2) are equal modulo the gauge (a
+//   rotation of the camera frame, and with c free its scale) to 1e-6 px;
+// - the default datum equals `--datum none` with POS priors (no defect: nothing is held), and is
+//   within a few sigma of the truth; the earlier reference datum fits worse (it holds functions
+//   the data determine).
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <string>
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include "calib/camera/rotation.h"
+#include "triangulation/pushbroom/line_calibration.h"
+#include "triangulation/pushbroom/line_simulation.h"
+#include "triangulation/pushbroom/pos_trajectory.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+// A flight as in the issue: every sub-camera with its own errors (1 px), POS with bias and drift,
+// control 0.1 m, image sigma 0.25 px.
+LineSimulationOptions DatumFlight(bool linear_layout, std::uint64_t seed) {
+  LineSimulationOptions o;
+  o.detectors_per_camera = 120;
+  o.lines = 800;
+  o.control_points = 700;
+  o.node_spacing_lines = 100;
+  o.subcamera_error_px = 1.0;
+  o.linear_layout = linear_layout;
+  o.pos_bias_m = 0.05;
+  o.pos_bias_deg = 0.005;
+  o.pos_drift_m = 0.05;
+  o.pos_drift_deg = 0.005;
+  o.seed = seed;
+  return o;
+}
+
+LineCalibrationResult Calibrate(const LineSimulation& sim, const LineCalibrationOptions& options) {
+  const PosTrajectory pos = PosTrajectory::FromRecords(sim.pos, "pos.csv");
+  return CalibrateLineCamera(sim.nominal, pos, sim.observations, sim.points, options,
+                             "observations.csv");
+}
+
+// Detector directions of a calibrated table: (x_i, y_i, -c) with x_i, y_i = design + table (mm).
+struct Table {
+  std::vector<Eigen::Vector3d> ray;
+  double c = 0;
+};
+Table TableOf(const calib::LineCamera& design, const std::vector<double>& dx,
+              const std::vector<double>& dy, double c) {
+  Table t;
+  t.c = c;
+  for (int i = 0; i < design.detectors; ++i) {
+    const Eigen::Vector2d p = design.DesignPosition(i);
+    t.ray.emplace_back(p.x() + dx[i], p.y() + dy[i], -c);
+  }
+  return t;
+}
+Table TableOf(const LineCalibrationResult& r, const calib::LineCamera& design) {
+  return TableOf(design, r.dx_mm, r.dy_mm, r.c_mm);
+}
+Table TruthTable(const LineSimulation& sim) {
+  std::vector<double> dx, dy;
+  for (int i = 0; i < sim.truth.detectors; ++i) {
+    dx.push_back(sim.truth.Correction(i).x());
+    dy.push_back(sim.truth.Correction(i).y());
+  }
+  return TableOf(sim.nominal, dx, dy, sim.truth.c_mm);
+}
+
+// b's detector rays turned by the camera rotation R(angles) and projected into a's focal plane
+// (principal distance a.c), minus a's positions, px (x then y per detector).
+Eigen::VectorXd RotatedDifference(const Table& a, const Table& b, const Eigen::Vector3d& angles,
+                                  double pitch_mm) {
+  const Eigen::Matrix3d r = calib::RotationFromOpk(angles);
+  Eigen::VectorXd out(2 * a.ray.size());
+  for (size_t i = 0; i < a.ray.size(); ++i) {
+    const Eigen::Vector3d d = r * b.ray[i];
+    out(2 * i) = (-a.c * d.x() / d.z() - a.ray[i].x()) / pitch_mm;
+    out(2 * i + 1) = (-a.c * d.y() / d.z() - a.ray[i].y()) / pitch_mm;
+  }
+  return out;
+}
+
+// The difference of two tables modulo the gauge: the camera rotation that maps b onto a best
+// (Gauss-Newton, the exact rotation, not its first order), and the scale through each table's c.
+// Returns the remaining difference, px.
+Eigen::VectorXd ModuloGauge(const Table& a, const Table& b, double pitch_mm,
+                            Eigen::Vector3d* angles_out = nullptr) {
+  Eigen::Vector3d angles = Eigen::Vector3d::Zero();
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    const Eigen::VectorXd f = RotatedDifference(a, b, angles, pitch_mm);
+    Eigen::MatrixXd j(f.size(), 3);
+    for (int k = 0; k < 3; ++k) {
+      Eigen::Vector3d h = angles;
+      h[k] += 1e-7;
+      j.col(k) = (RotatedDifference(a, b, h, pitch_mm) - f) / 1e-7;
+    }
+    angles -= j.colPivHouseholderQr().solve(f);
+  }
+  if (angles_out) *angles_out = angles;
+  return RotatedDifference(a, b, angles, pitch_mm);
+}
+
+struct Config {
+  const char* name;
+  bool pos_prior, free_c;
+  PlatformParamMode boresight, lever_arm;
+  int expected_defect;  // from the math (module README "Datum"); -1: measured only
+};
+
+// Exact gauges on the linear layout (its gauge functions are polynomials of degree <= 2 in u):
+// with the POS priors every node is anchored, so only what the camera itself can trade is free:
+// c against the focal plane's scale (1), a free boresight against the table's rotations (3).
+// Without the priors the trajectory's constant attitude is a rotation of the camera too: measured.
+const Config kConfigs[] = {
+    {"priors", true, false, PlatformParamMode::kFixed, PlatformParamMode::kFixed, 0},
+    {"priors, c free", true, true, PlatformParamMode::kFixed, PlatformParamMode::kFixed, 1},
+    {"priors, boresight free", true, false, PlatformParamMode::kFree, PlatformParamMode::kFixed, 3},
+    {"priors, boresight and c free", true, true, PlatformParamMode::kFree, PlatformParamMode::kFixed, 4},
+    {"priors, lever arm free", true, false, PlatformParamMode::kFixed, PlatformParamMode::kFree, 0},
+    {"no priors", false, false, PlatformParamMode::kFixed, PlatformParamMode::kFixed, -1},
+    {"no priors, c free", false, true, PlatformParamMode::kFixed, PlatformParamMode::kFixed, -1},
+    {"no priors, boresight free", false, false, PlatformParamMode::kFree, PlatformParamMode::kFixed, -1},
+};
+
+LineCalibrationOptions OptionsOf(const Config& config) {
+  LineCalibrationOptions options;
+  options.pos_prior = config.pos_prior;
+  options.free_c = config.free_c;
+  options.boresight = config.boresight;
+  options.lever_arm = config.lever_arm;
+  options.degree = 3;  // the truth's degree; no test, so every datum fits the same model
+  return options;
+}
+
+void PrintDatum(const char* what, const LineCalibrationResult& r) {
+  std::printf("%s: defect %d, constraints %d, in table %d, eigenvalues", what, r.datum.rank_defect,
+              r.datum.n_constraints, r.datum.in_table);
+  for (size_t k = 0; k < r.datum.smallest_relative_eigenvalues.size() && k < 10; ++k)
+    std::printf(" %.1e", r.datum.smallest_relative_eigenvalues[k]);
+  std::printf(", gauge:");
+  for (const auto& d : r.datum.directions) std::printf(" %s (%.9f)", d.name.c_str(), d.fraction);
+  std::printf(", sigma0 %.6f, vtpv %.6f\n", r.report.sigma0, r.report.vtpv);
+}
+
+class GaugeDatum : public ::testing::TestWithParam<bool> {};
+
+// The gauge directions are null directions of the model (the table functions of a camera rotation
+// or scale); the focal-plane residual makes them null only up to a term of the residuals' size
+// (a rotation by b changes a focal-plane residual e by about 2 b x e / c): measured relative
+// eigenvalues 5e-9 .. 2.4e-6 with the POS priors, against >= 1.9e-2 for every determined
+// direction with the boresight and lever arm fixed, but only 4.5e-5 for the lever arm free (its
+// vertical component is nearly a scale of the table, told apart by the relief). So the default
+// threshold 1e-5 separates them by a factor of 4 on either side, no more. Without the priors the
+// trajectory's constant attitude is a near-gauge too and the spectrum has no gap (1e-9 .. 2e-5):
+// the count then depends on the threshold; it is printed, not asserted.
+constexpr double kMargin = 4.0;  // eigenvalue ratio to the threshold on either side, at least
+
+TEST_P(GaugeDatum, RankDefectEqualsTheConstraintsPerConfiguration) {
+  const bool linear = GetParam();
+  const LineSimulation sim = SimulateLineFlight(DatumFlight(linear, 11));
+  for (const Config& config : kConfigs) {
+    LineCalibrationOptions options = OptionsOf(config);
+    options.datum = LineDatum::kNone;
+    const LineCalibrationResult none = Calibrate(sim, options);
+    options.datum = LineDatum::kGauge;
+    const LineCalibrationResult gauge = Calibrate(sim, options);
+    std::printf("%s layout, %s\n", linear ? "linear" : "subcameras", config.name);
+    PrintDatum("  none ", none);
+    PrintDatum("  gauge", gauge);
+    ASSERT_TRUE(none.datum.null_space_computed) << config.name;
+    EXPECT_TRUE(gauge.report.converged) << config.name;
+    const int k = none.datum.rank_defect;
+    if (config.expected_defect >= 0) {
+      EXPECT_EQ(k, config.expected_defect) << config.name;
+      const auto& e = none.datum.smallest_relative_eigenvalues;
+      EXPECT_GT(e[k], kMargin * none.datum.threshold) << config.name;
+      if (k > 0) EXPECT_LT(e[k - 1], none.datum.threshold / kMargin) << config.name;
+    }
+    // The datum adds exactly the defect, and the problem with it has full rank: a covariance
+    // without undetermined parameters; the pseudo-observations count in the redundancy.
+    EXPECT_EQ(gauge.datum.n_constraints, k) << config.name;
+    EXPECT_TRUE(gauge.undetermined.empty()) << config.name;
+    for (const auto& w : gauge.warnings) EXPECT_NE(w.name, "covariance") << config.name;
+    EXPECT_EQ(gauge.report.redundancy, none.report.redundancy + k);
+    // No defect: nothing is held, the problem is the datum-free one.
+    if (k == 0) EXPECT_DOUBLE_EQ(gauge.report.vtpv, none.report.vtpv) << config.name;
+    // The gauge functions named are those of the configuration (with the priors: scale with c,
+    // the three rotations with the boresight).
+    if (config.pos_prior && k > 0) {
+      std::set<std::string> names;
+      for (const auto& d : gauge.datum.directions) names.insert(d.name);
+      EXPECT_EQ(names.count("scale"), config.free_c ? 1u : 0u) << config.name;
+      const size_t rotation = config.boresight == PlatformParamMode::kFree ? 1u : 0u;
+      EXPECT_EQ(names.count("pitch"), rotation) << config.name;
+      EXPECT_EQ(names.count("roll"), rotation) << config.name;
+      EXPECT_EQ(names.count("yaw"), rotation) << config.name;
+    }
+  }
+}
+
+// Any two valid choices of the sub-camera that carries the datum: with the POS priors and the
+// boresight fixed (the default) there is no defect and the tables are identical. With a defect
+// (boresight and c free: 4 gauge directions) the tables agree modulo the gauge to 1e-6 px on
+// data without any error (image, control, POS: the residuals vanish, so does the residual-size
+// term that makes the gauge inexact); with noise they differ by what that term moves (printed;
+// module README "Datum": the issue's 1e-6 px is not met there).
+TEST_P(GaugeDatum, ReferenceChoicesAgreeModuloTheGauge) {
+  const bool linear = GetParam();
+  for (const bool noise : {false, true}) {
+    LineSimulationOptions o = DatumFlight(linear, 12);
+    if (!noise) {  // no residual at all: the POS is exact too, so the priors hold the truth
+      o.image_noise_px = o.control_noise_m = 0;
+      o.pos_error_m = o.pos_error_deg = o.pos_bias_m = o.pos_bias_deg = 0;
+      o.pos_drift_m = o.pos_drift_deg = 0;
+    }
+    const LineSimulation sim = SimulateLineFlight(o);
+    const double pitch = sim.nominal.pitch_mm;
+    for (const Config& config : {kConfigs[0], kConfigs[3]}) {
+      std::vector<Table> tables;
+      for (int reference = 0; reference < 3; ++reference) {
+        LineCalibrationOptions options = OptionsOf(config);
+        options.degree = 5;  // a finite rotation of the table is a polynomial to 1e-9 px at 5
+        options.reference_subcamera = reference;
+        options.solver.function_tolerance = 1e-16;
+        options.solver.parameter_tolerance = 1e-16;
+        options.solver.gradient_tolerance = 1e-20;
+        const LineCalibrationResult r = Calibrate(sim, options);
+        ASSERT_TRUE(r.report.usable) << r.report.message;
+        EXPECT_EQ(r.datum.n_constraints, config.expected_defect) << config.name;
+        tables.push_back(TableOf(r, sim.nominal));
+      }
+      for (int a = 0; a < 3; ++a)
+        for (int b = a + 1; b < 3; ++b) {
+          Eigen::Vector3d angles;
+          const Eigen::VectorXd plain =
+              RotatedDifference(tables[a], tables[b], Eigen::Vector3d::Zero(), pitch);
+          const Eigen::VectorXd d = ModuloGauge(tables[a], tables[b], pitch, &angles);
+          std::printf("%s layout, %s, %s: reference %d vs %d: max difference %.2e px, modulo "
+                      "the gauge %.2e px (rotation %.2e %.2e %.2e rad)\n",
+                      linear ? "linear" : "subcameras", noise ? "noise" : "noise-free",
+                      config.name, a, b, plain.cwiseAbs().maxCoeff(), d.cwiseAbs().maxCoeff(),
+                      angles.x(), angles.y(), angles.z());
+          // No defect: the same problem; it differs in the last bits only (the Schur ordering
+          // follows block addresses; 100 iterations near a zero residual amplify them).
+          if (config.expected_defect == 0) EXPECT_LT(plain.cwiseAbs().maxCoeff(), 1e-9);
+          if (!noise) EXPECT_LT(d.cwiseAbs().maxCoeff(), 1e-6) << config.name << " " << a << " " << b;
+        }
+    }
+  }
+}
+
+// The default datum on the issue's flight: the POS priors leave no defect, so nothing is held and
+// the result is the datum-free one; the table is within a few sigma of the truth. The earlier
+// reference datum (4 constraints whatever the null space) fits worse.
+TEST_P(GaugeDatum, DefaultEqualsNoDatumWithPriorsAndTheTruth) {
+  const bool linear = GetParam();
+  const LineSimulation sim = SimulateLineFlight(DatumFlight(linear, 13));
+  const double pitch = sim.nominal.pitch_mm;
+  LineCalibrationOptions options;
+  options.degree = 3;
+  const LineCalibrationResult gauge = Calibrate(sim, options);
+  options.datum = LineDatum::kNone;
+  const LineCalibrationResult none = Calibrate(sim, options);
+  options.datum = LineDatum::kReference;
+  const LineCalibrationResult reference = Calibrate(sim, options);
+  ASSERT_TRUE(gauge.report.converged);
+  EXPECT_TRUE(gauge.valid);
+  EXPECT_EQ(gauge.datum.rank_defect, 0);
+  EXPECT_EQ(gauge.datum.n_constraints, 0);
+  double worst_px = 0;
+  for (int i = 0; i < sim.truth.detectors; ++i)
+    worst_px = std::max({worst_px, std::abs(gauge.dx_mm[i] - none.dx_mm[i]) / pitch,
+                         std::abs(gauge.dy_mm[i] - none.dy_mm[i]) / pitch});
+  EXPECT_LT(worst_px, 1e-9);
+  EXPECT_DOUBLE_EQ(gauge.report.sigma0, none.report.sigma0);
+  // Adding constraints that are not in the null space can only raise v^T P v.
+  EXPECT_GT(reference.report.vtpv, gauge.report.vtpv);
+  // Against the truth: per detector within the 1 % band of 4 free coefficients (Scheffe:
+  // sqrt(chi2_4(1 %)) = 3.64), and the table error per axis.
+  auto table_error = [&](const LineCalibrationResult& r, double* worst_z) -> Eigen::Vector2d {
+    double ex = 0, ey = 0;
+    *worst_z = 0;
+    for (int i = 0; i < sim.truth.detectors; ++i) {
+      const Eigen::Vector2d e = Eigen::Vector2d(r.dx_mm[i], r.dy_mm[i]) - sim.truth.Correction(i);
+      ex += e.x() * e.x();
+      ey += e.y() * e.y();
+      if (r.dx_sigma_mm[i] && *r.dx_sigma_mm[i] > 0) *worst_z = std::max(*worst_z, std::abs(e.x()) / *r.dx_sigma_mm[i]);
+      if (r.dy_sigma_mm[i] && *r.dy_sigma_mm[i] > 0) *worst_z = std::max(*worst_z, std::abs(e.y()) / *r.dy_sigma_mm[i]);
+    }
+    return Eigen::Vector2d(std::sqrt(ex / sim.truth.detectors), std::sqrt(ey / sim.truth.detectors)) / pitch;
+  };
+  double z_gauge = 0, z_reference = 0;
+  const Eigen::Vector2d e_gauge = table_error(gauge, &z_gauge);
+  const Eigen::Vector2d e_reference = table_error(reference, &z_reference);
+  const Eigen::VectorXd modulo = ModuloGauge(TruthTable(sim), TableOf(gauge, sim.nominal), pitch);
+  std::printf("%s layout: table error across / along: gauge (default) %.4f / %.4f px (worst %.2f "
+              "sigma, modulo the gauge RMS %.4f px), sigma0 %.4f; reference datum %.4f / %.4f px "
+              "(worst %.1f sigma), sigma0 %.4f\n",
+              linear ? "linear" : "subcameras", e_gauge.x(), e_gauge.y(), z_gauge,
+              std::sqrt(modulo.squaredNorm() / double(modulo.size())), gauge.report.sigma0,
+              e_reference.x(), e_reference.y(), z_reference, reference.report.sigma0);
+  EXPECT_LT(z_gauge, 3.64);
+  EXPECT_NEAR(gauge.report.sigma0, 1.0, 3.0 / std::sqrt(2.0 * gauge.report.redundancy));
+}
+
+// A shutter / POS latency of 5 ms (0.3 m along track at 60 m/s): recovered within 3 sigma when
+// estimated with the POS priors (its correlation with the trajectory's along-track and pitch
+// corrections named); without the priors it lies in the null space: named, invalid.
+TEST(TimeOffset, RecoveredWithPosPriorsAndNamedWithout) {
+  LineSimulationOptions o = DatumFlight(false, 14);
+  o.time_offset_s = 0.005;
+  const LineSimulation sim = SimulateLineFlight(o);
+  LineCalibrationOptions options;
+  options.degree = 3;
+  options.time_offset = true;
+  const LineCalibrationResult r = Calibrate(sim, options);
+  ASSERT_TRUE(r.report.converged);
+  ASSERT_TRUE(r.time_offset_sigma_s.has_value());
+  double rho = -1, rho_offset = -1;
+  for (const auto& [name, value] : r.correlations) {
+    if (name == "time_offset_vs_along_track") rho = value;
+    if (name == "time_offset_vs_offset") rho_offset = value;
+  }
+  std::printf("time offset %.6f +- %.6f s (truth 0.005), time_offset_vs_along_track %.4f, "
+              "time_offset_vs_offset %.4f, sigma0 %.4f, defect %d\n",
+              r.time_offset_s, *r.time_offset_sigma_s, rho, rho_offset, r.report.sigma0,
+              r.datum.rank_defect);
+  EXPECT_GT(rho_offset, 0.0);
+  EXPECT_LT(rho_offset, 1.0);
+  EXPECT_LT(std::abs(r.time_offset_s - 0.005), 3 * *r.time_offset_sigma_s);
+  EXPECT_GT(rho, 0.0);
+  EXPECT_LT(rho, 1.0);
+  EXPECT_EQ(r.datum.rank_defect, 0);
+  EXPECT_NEAR(r.report.sigma0, 1.0, 3.0 / std::sqrt(2.0 * r.report.redundancy));
+  // Not estimated: the trajectory's corrections take the shift against their priors.
+  options.time_offset = false;
+  const LineCalibrationResult without = Calibrate(sim, options);
+  std::printf("without the time offset: sigma0 %.4f, along-track node corrections take it\n",
+              without.report.sigma0);
+  // Without the POS priors: not determinable, named.
+  options.time_offset = true;
+  options.pos_prior = false;
+  const LineCalibrationResult free = Calibrate(sim, options);
+  bool named = false;
+  for (const auto& w : free.warnings) named |= w.name == "time_offset_not_determinable";
+  EXPECT_TRUE(named);
+  EXPECT_FALSE(free.valid);
+  EXPECT_FALSE(free.time_offset_sigma_s.has_value());
+}
+
+INSTANTIATE_TEST_SUITE_P(Layouts, GaugeDatum, ::testing::Values(false, true),
+                         [](const ::testing::TestParamInfo<bool>& info) {
+                           return info.param ? "LinearVirtualCcd" : "Subcameras";
+                         });
+
+}  // namespace
+}  // namespace aerocal::triangulation
