@@ -19,3 +19,5 @@ aerocal_add_test(stitch/rig_self_calibration_study LIBS aerocal::triangulation L
 # Rendered head images and the stitched level image of a rig exposure (issue 16 items 1 and 6).
 aerocal_add_test(stitch/rig_stitched_image LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(stitch/rig_images_cli LIBS aerocal::stitch LABELS cli)
+# Image quality (issue 36): slanted-edge e-SFR on exactly rendered edges.
+aerocal_add_test(stitch/slanted_edge LIBS aerocal::stitch LABELS synthetic)
