@@ -21,3 +21,5 @@ aerocal_add_test(stitch/rig_stitched_image LIBS aerocal::triangulation LABELS sy
 aerocal_add_test(stitch/rig_images_cli LIBS aerocal::stitch LABELS cli)
 # Image quality (issue 36): slanted-edge e-SFR on exactly rendered edges.
 aerocal_add_test(stitch/slanted_edge LIBS aerocal::stitch LABELS synthetic)
+# Bar targets: contrast transfer per frequency and the limiting frequency (issue 36 item 2).
+aerocal_add_test(stitch/bar_target LIBS aerocal::stitch LABELS synthetic)
