@@ -22,3 +22,5 @@ aerocal_add_test(triangulation/rig_bundle_study LIBS aerocal::triangulation LABE
 aerocal_add_test(triangulation/rig_bundle_cli LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(triangulation/wall_pose LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/platform LIBS aerocal::triangulation LABELS synthetic)
+# Laboratory calibration from directions: collimator array and goniometer (issue 36 item 6).
+aerocal_add_test(triangulation/direction_calibration LIBS aerocal::triangulation LABELS synthetic)
