@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <complex>
+#include <functional>
 #include <limits>
 #include <random>
 
@@ -203,23 +204,9 @@ double MtfAt(const Lsf& lsf, double f) {
   return std::abs(sum) / std::abs(lsf.dc) / correction;
 }
 
-// First frequency (cycles/px) where the MTF falls to `level`: a scan in steps of 1/256, then
-// bisection to 1e-7. NaN when it does not fall so far below kMaxFrequency.
 double CrossingFrequency(const Lsf& lsf, double level) {
   if (lsf.x.empty() || lsf.dc == 0.0) return kNaN;
-  constexpr double kScanStep = 1.0 / 256.0;
-  double f0 = 0.0;
-  for (double f1 = kScanStep; f1 <= kMaxFrequency + 1e-12; f1 += kScanStep) {
-    if (MtfAt(lsf, f1) <= level) {
-      for (int i = 0; i < 40 && f1 - f0 > 1e-7; ++i) {
-        const double mid = 0.5 * (f0 + f1);
-        (MtfAt(lsf, mid) > level ? f0 : f1) = mid;
-      }
-      return 0.5 * (f0 + f1);
-    }
-    f0 = f1;
-  }
-  return kNaN;
+  return FirstCrossingFrequency([&lsf](double f) { return MtfAt(lsf, f); }, level);
 }
 
 double Mtf50(const Esf& esf) { return CrossingFrequency(MakeLsf(esf, esf.value), 0.5); }
@@ -317,6 +304,29 @@ void ComputeBudget(const Matrix& m,
 }
 
 }  // namespace
+
+double FirstCrossingFrequency(const std::function<double(double)>& mtf, double level) {
+  constexpr double kScanStep = 1.0 / 256.0;
+  double f0 = 0.0;
+  for (double f1 = kScanStep; f1 <= kMaxFrequency + 1e-12; f1 += kScanStep) {
+    if (mtf(f1) <= level) {
+      for (int i = 0; i < 40 && f1 - f0 > 1e-7; ++i) {
+        const double mid = 0.5 * (f0 + f1);
+        (mtf(mid) > level ? f0 : f1) = mid;
+      }
+      return 0.5 * (f0 + f1);
+    }
+    f0 = f1;
+  }
+  return kNaN;
+}
+
+double EdgeMtfAt(const SlantedEdgeResult& edge, double f_cy_px) {
+  Esf esf;
+  esf.x = edge.esf_distance_px;
+  esf.bin_px = esf.x.size() > 1 ? esf.x[1] - esf.x[0] : 0.25;
+  return MtfAt(MakeLsf(esf, edge.esf), f_cy_px);
+}
 
 std::string_view MtfAxisName(MtfAxis axis) { return axis == MtfAxis::kX ? "x" : "y"; }
 

@@ -29,6 +29,7 @@
 // Frames: pixel (col, row) of CONVENTIONS.md; frequencies in cycles per pixel (Nyquist 0.5).
 #pragma once
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -92,6 +93,14 @@ struct SlantedEdgeResult {
 SlantedEdgeResult MeasureSlantedEdge(const GrayImage& image,
                                      const PixelRegion& region,
                                      const SlantedEdgeOptions& options = {});
+
+/// MTF of a measured edge at any frequency (cycles/px along its normal), from its ESF: the same
+/// LSF, window and corrections as its curve.
+double EdgeMtfAt(const SlantedEdgeResult& edge, double f_cy_px);
+
+/// First frequency in (0, 1] cycles/px where `mtf` falls to `level`: a scan in steps of 1/256, then
+/// bisection to 1e-7 cycles/px. NaN when it does not fall so far.
+double FirstCrossingFrequency(const std::function<double(double)>& mtf, double level);
 
 /// The MTF50 of repeated edges combined.
 struct EdgeMtfCombination {

@@ -26,3 +26,5 @@ aerocal_add_test(stitch/bar_target LIBS aerocal::stitch LABELS synthetic)
 # On images we did not make (tests/data/quality/PROVENANCE.md): a third-party synthetic edge and a
 # real satellite image of the Baotou edge target with a published MTF50.
 aerocal_add_test(stitch/slanted_edge_real LIBS aerocal::stitch LABELS golden)
+# The virtual image's MTF after resampling against the raw sub-image's (issue 36 item 3).
+aerocal_add_test(stitch/resampling_mtf LIBS aerocal::stitch LABELS synthetic)
