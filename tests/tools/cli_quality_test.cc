@@ -1,7 +1,7 @@
 // `aerocal quality mtf` on exactly rendered slanted edges (tests/support/rendered_targets.h) written
 // as 8-bit PNG and 16-bit TIFF files: MTF50 against the analytic value, the units through the pixel
 // size and the GSD, the per-axis combination of repeated edges, and bad options (exit 2 naming the
-// option, nothing written).
+// option, nothing written). `aerocal quality bars` on rendered bar groups: the limiting frequency.
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -94,6 +94,52 @@ TEST(CliQuality, BadOptionsExitTwoNamingTheOption) {
                                dir.File("r.json"));
   EXPECT_EQ(flat.exit_code, 2) << flat.output;
   EXPECT_NE(flat.output.find("--roi 0,0,64,64"), std::string::npos) << flat.output;
+}
+
+// Bar groups of vertical bars, one block of 24 rows each, then a bright and a dark block (16 bit).
+TEST(CliQuality, BarsGiveTheLimitingFrequencyAndGroundUnits) {
+  testing::TempDir dir("aerocal_cli_quality_bars");
+  const double frequencies[] = {0.1, 0.14, 0.2, 0.28, 0.4};
+  const double s = 1.0;
+  stitch::GrayImage image(7 * 24, 160);
+  std::string groups;
+  for (int g = 0; g < 5; ++g) {
+    for (int c = 0; c < 160; ++c)
+      image.block(g * 24, c, 24, 1).setConstant(
+          static_cast<float>(256.0 * (30.0 + 190.0 * testing::BarPixelFraction(c, 1.0 / frequencies[g], 0.3, s))));
+    groups += " --group " + std::to_string(frequencies[g]) + ",4," + std::to_string(g * 24 + 2) + ",152,20,x";
+  }
+  image.block(5 * 24, 0, 24, 160).setConstant(256.0f * 220.0f);
+  image.block(6 * 24, 0, 24, 160).setConstant(256.0f * 30.0f);
+  stitch::WriteGrayImage(dir.File("bars.tif"), image, 16);
+  const std::string base = "quality bars --image " + dir.File("bars.tif") + groups;
+  const auto run = RunAerocal(base + " --bright 4,122,152,20 --dark 4,146,152,20 --pixel-mm 0.005 --gsd-m 0.1 --out " +
+                              dir.File("bars.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json doc = testing::ReadJson(dir.File("bars.json"));
+  EXPECT_EQ(doc["kind"], "quality_bars");
+  ASSERT_EQ(doc["groups"].size(), 5u);
+  const double limit = doc["limiting_frequency_cy_px"].get<double>();
+  const double truth = testing::FirstCrossing([&](double f) { return testing::RenderedBarContrast(f, s); }, 0.1);
+  // Within one step of this target (0.28 -> 0.4, a factor 1.43).
+  EXPECT_LE(std::abs(std::log(limit / truth)), std::log(0.4 / 0.28)) << limit << " vs " << truth;
+  EXPECT_TRUE(doc["limit_in_range"].get<bool>());
+  EXPECT_NEAR(doc["limiting_lp_per_mm"].get<double>(), limit / 0.005, 1e-9);
+  EXPECT_NEAR(doc["limiting_resolved_distance_m"].get<double>(), 0.1 / (2.0 * limit), 1e-12);
+  EXPECT_FALSE(doc.contains("limiting_resolved_distance_expanded_m"));  // no U for bars yet
+  EXPECT_NEAR(doc["groups"][0]["contrast_transfer"].get<double>(), testing::RenderedBarContrast(0.1, s), 0.03);
+  const std::pair<std::string, std::string> bad[] = {
+      {" --bright 4,122,152,20 --dark 4,146,152,20 --group 0.7,4,2,152,20", "--group"},
+      {" --bright 4,122,152 --dark 4,146,152,20", "--bright"},
+      {" --bright 4,122,152,20 --dark 4,146,152,20 --threshold 1.5", "--threshold"},
+      {" --bright 4,146,152,20 --dark 4,122,152,20", "--bright"},  // swapped: no contrast
+  };
+  for (const auto& [options, name] : bad) {
+    const auto r = RunAerocal(base + options + " --out " + dir.File("bad.json"));
+    EXPECT_EQ(r.exit_code, 2) << options << "\n" << r.output;
+    EXPECT_NE(r.output.find(name), std::string::npos) << options << "\n" << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.File("bad.json"))) << options;
+  }
 }
 
 }  // namespace
