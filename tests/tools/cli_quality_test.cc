@@ -9,6 +9,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "calib/core/atomic_file.h"
 #include "stitch/image_io/image_io.h"
 #include "tests/support/rendered_targets.h"
 #include "tests/support/test_support.h"
@@ -96,25 +97,30 @@ TEST(CliQuality, BadOptionsExitTwoNamingTheOption) {
   EXPECT_NE(flat.output.find("--roi 0,0,64,64"), std::string::npos) << flat.output;
 }
 
-// Bar groups of vertical bars, one block of 24 rows each, then a bright and a dark block (16 bit).
-TEST(CliQuality, BarsGiveTheLimitingFrequencyAndGroundUnits) {
-  testing::TempDir dir("aerocal_cli_quality_bars");
-  const double frequencies[] = {0.1, 0.14, 0.2, 0.28, 0.4};
-  const double s = 1.0;
+// Bar groups of vertical bars (blur s px), one block of 24 rows each, then a bright and a dark block
+// (16 bit), written to `path`; returns the --group options.
+const double kBarFrequencies[] = {0.1, 0.14, 0.2, 0.28, 0.4};
+std::string WriteBarTarget(const std::string& path, double s) {
   stitch::GrayImage image(7 * 24, 160);
   std::string groups;
   for (int g = 0; g < 5; ++g) {
     for (int c = 0; c < 160; ++c)
       image.block(g * 24, c, 24, 1).setConstant(
-          static_cast<float>(256.0 * (30.0 + 190.0 * testing::BarPixelFraction(c, 1.0 / frequencies[g], 0.3, s))));
-    groups += " --group " + std::to_string(frequencies[g]) + ",4," + std::to_string(g * 24 + 2) + ",152,20,x";
+          static_cast<float>(256.0 * (30.0 + 190.0 * testing::BarPixelFraction(c, 1.0 / kBarFrequencies[g], 0.3, s))));
+    groups += " --group " + std::to_string(kBarFrequencies[g]) + ",4," + std::to_string(g * 24 + 2) + ",152,20,x";
   }
   image.block(5 * 24, 0, 24, 160).setConstant(256.0f * 220.0f);
   image.block(6 * 24, 0, 24, 160).setConstant(256.0f * 30.0f);
-  stitch::WriteGrayImage(dir.File("bars.tif"), image, 16);
-  const std::string base = "quality bars --image " + dir.File("bars.tif") + groups;
-  const auto run = RunAerocal(base + " --bright 4,122,152,20 --dark 4,146,152,20 --pixel-mm 0.005 --gsd-m 0.1 --out " +
-                              dir.File("bars.json"));
+  stitch::WriteGrayImage(path, image, 16);
+  return groups;
+}
+const std::string kBarReferences = " --bright 4,122,152,20 --dark 4,146,152,20";
+
+TEST(CliQuality, BarsGiveTheLimitingFrequencyAndGroundUnits) {
+  testing::TempDir dir("aerocal_cli_quality_bars");
+  const double s = 1.0;
+  const std::string base = "quality bars --image " + dir.File("bars.tif") + WriteBarTarget(dir.File("bars.tif"), s);
+  const auto run = RunAerocal(base + kBarReferences + " --pixel-mm 0.005 --gsd-m 0.1 --out " + dir.File("bars.json"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json doc = testing::ReadJson(dir.File("bars.json"));
   EXPECT_EQ(doc["kind"], "quality_bars");
@@ -140,6 +146,54 @@ TEST(CliQuality, BarsGiveTheLimitingFrequencyAndGroundUnits) {
     EXPECT_NE(r.output.find(name), std::string::npos) << options << "\n" << r.output;
     EXPECT_FALSE(std::filesystem::exists(dir.File("bad.json"))) << options;
   }
+}
+
+// The certificate of a test-field calibration with the "dynamic image resolution" section from a
+// quality mtf and a quality bars result: the values copied, rendered into the HTML and the PDF.
+TEST(CliQuality, CertificateGainsTheDynamicImageResolutionSection) {
+  testing::TempDir dir("aerocal_cli_quality_cert");
+  ASSERT_EQ(RunAerocal("simulate --test-field --groups 2 --images-per-group 4 --out " + dir.File("tf")).exit_code, 0);
+  const auto cal = RunAerocal("calibrate --camera " + dir.File("tf/camera_nominal.yaml") + " --observations " +
+                              dir.File("tf/observations.csv") + " --points " + dir.File("tf/points.csv") +
+                              " --out " + dir.File("cal.json"));
+  ASSERT_LE(cal.exit_code, 3) << cal.output;  // 3: written, the group stability may disagree
+  std::mt19937_64 rng(12);
+  stitch::WriteGrayImage(dir.File("edges.png"), TwoEdges(1.0, 1.0, &rng), 8);
+  ASSERT_EQ(RunAerocal("quality mtf --image " + dir.File("edges.png") +
+                       " --roi 0,0,128,128 --roi 128,0,128,128 --flight-axis y --gsd-m 0.05 --out " + dir.File("q.json"))
+                .exit_code,
+            0);
+  const std::string groups = WriteBarTarget(dir.File("bars.tif"), 1.0);
+  ASSERT_EQ(RunAerocal("quality bars --image " + dir.File("bars.tif") + groups + kBarReferences + " --gsd-m 0.05 --out " +
+                       dir.File("bars.json"))
+                .exit_code,
+            0);
+  const auto run = RunAerocal("certificate --result " + dir.File("cal.json") + " --quality " + dir.File("q.json") +
+                              " --quality " + dir.File("bars.json") + " --out " + dir.File("cert"));
+  ASSERT_LE(run.exit_code, 3) << run.output;
+  const nlohmann::json cert = testing::ReadJson(dir.File("cert/certificate.json"));
+  ASSERT_TRUE(cert.contains("dynamic_image_resolution")) << run.output;
+  const auto& d = cert["dynamic_image_resolution"];
+  const nlohmann::json q = testing::ReadJson(dir.File("q.json"));
+  ASSERT_EQ(d["edges"].size(), 2u);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(d["edges"][i]["mtf50_cy_px"], q["edges"][i]["mtf50_cy_px"]);
+    EXPECT_EQ(d["edges"][i]["mtf50_expanded_cy_px"], q["edges"][i]["mtf50_expanded_cy_px"]);
+    EXPECT_EQ(d["edges"][i]["direction"], "across_track");
+  }
+  ASSERT_EQ(d["axes"].size(), 1u);
+  EXPECT_EQ(d["axes"][0]["mtf50_cy_px"], q["axes"]["x"]["mtf50_cy_px"]);
+  ASSERT_EQ(d["bars"].size(), 1u);
+  EXPECT_EQ(d["bars"][0]["limiting_frequency_cy_px"], testing::ReadJson(dir.File("bars.json"))["limiting_frequency_cy_px"]);
+  const std::string html = ReadTextFile(dir.File("cert/certificate.html"));
+  EXPECT_NE(html.find("9. Dynamic image resolution"), std::string::npos);
+  EXPECT_TRUE(std::filesystem::exists(dir.File("cert/certificate.pdf")));
+  // Another kind of result is refused, naming the file; nothing written.
+  const auto bad = RunAerocal("certificate --result " + dir.File("cal.json") + " --quality " + dir.File("cal.json") +
+                              " --no-render --out " + dir.File("cert2"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("not a result of `aerocal quality`"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir.File("cert2/certificate.json")));
 }
 
 }  // namespace
