@@ -28,3 +28,5 @@ aerocal_add_test(stitch/bar_target LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/slanted_edge_real LIBS aerocal::stitch LABELS golden)
 # The virtual image's MTF after resampling against the raw sub-image's (issue 36 item 3).
 aerocal_add_test(stitch/resampling_mtf LIBS aerocal::stitch LABELS synthetic)
+# Edge targets on the ground found in the image from the orientation (issue 36 item 1).
+aerocal_add_test(stitch/edge_targets LIBS aerocal::stitch LABELS unit)
