@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <nlohmann/json.hpp>
 
@@ -17,6 +18,9 @@ struct CertificateArgs {
   std::string tolerances;  // YAML quantity: allowed |change| (needs previous)
   std::string out;         // output folder
   bool no_render = false;  // certificate.json only
+  /// Results of `aerocal quality mtf` / `quality bars` (kinds quality_mtf, quality_bars): the
+  /// certificate's "dynamic image resolution" section (optional).
+  std::vector<std::string> quality;
 };
 
 /// The lab YAML (sections lab, certificate, camera, customer, conditions, signatures of free-text

@@ -23,6 +23,9 @@ CommandRun SetupCertificate(CLI::App& app) {
                  "YAML quantity: allowed |change| (units of the quantity); without one, E_n <= 1");
   app.add_option("--out", args->out, "Output folder: certificate.json, .html, .pdf")->required();
   app.add_flag("--no-render", args->no_render, "Write certificate.json only (no HTML / PDF)");
+  app.add_option("--quality", args->quality,
+                 "Result of `aerocal quality mtf` or `quality bars` (repeatable): the section "
+                 "\"dynamic image resolution\" (MTF50 with U, limiting resolution, MTF curves)");
   return [args]() { return WriteCertificate(*args); };
 }
 

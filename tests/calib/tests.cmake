@@ -13,3 +13,5 @@ aerocal_add_test(calib/rig LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/camera_formats LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/camera_file_variants LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/rotation LIBS aerocal::calib LABELS unit)
+# Direction observations of a laboratory calibration (collimator, goniometer; issue 36 item 6).
+aerocal_add_test(calib/direction_residual LIBS aerocal::calib LABELS unit)

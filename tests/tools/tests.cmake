@@ -15,3 +15,5 @@ aerocal_add_test(tools/cli_calibrate LIBS aerocal::calib LABELS cli)
 # Result documents: kind and schema_version of every command, readers refusing others.
 aerocal_add_test(tools/cli_results LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/cli_camera_models LIBS aerocal::calib LABELS cli)
+# `aerocal quality mtf` (issue 36) on rendered edges written as 8- and 16-bit images.
+aerocal_add_test(tools/cli_quality LIBS aerocal::stitch LABELS cli)

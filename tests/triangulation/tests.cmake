@@ -25,3 +25,5 @@ aerocal_add_test(triangulation/platform LIBS aerocal::triangulation LABELS synth
 aerocal_add_test(triangulation/robust_start_models LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/suspect_effect LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/self_calibration_choice LIBS aerocal::triangulation LABELS golden)
+# Laboratory calibration from directions: collimator array and goniometer (issue 36 item 6).
+aerocal_add_test(triangulation/direction_calibration LIBS aerocal::triangulation LABELS synthetic)

@@ -145,6 +145,71 @@ def identification_rows(c):
     return rows
 
 
+def resolution_edge_rows(c):
+    """Section 9 (dynamic image resolution): one row per slanted edge (`aerocal quality mtf`)."""
+    d = c.get("dynamic_image_resolution") or {}
+    rows = [["edge", "roi col,row,w,h", "axis", "direction", "slant deg", "MTF50 cy/px", "U", "lp/mm", "U",
+             "GRD m", "U", "MTF Nyquist"]]
+    for i, e in enumerate(d.get("edges", [])):
+        rows.append([i + 1, ",".join(str(v) for v in e.get("roi", [])), e.get("axis", "-"), e.get("direction", "-"),
+                     fmt(e.get("angle_deg"), 3), fmt(e.get("mtf50_cy_px"), 4), fmt(e.get("mtf50_expanded_cy_px"), 2),
+                     fmt(e.get("mtf50_lp_per_mm"), 4), fmt(e.get("mtf50_lp_per_mm_expanded"), 2),
+                     fmt(e.get("mtf50_resolved_distance_m"), 4), fmt(e.get("mtf50_resolved_distance_expanded_m"), 2),
+                     fmt(e.get("mtf_nyquist"), 3)])
+    return rows if len(rows) > 1 else []
+
+
+def resolution_axis_rows(c):
+    """Repeated edges of one axis combined: type A from their scatter, type B the systematic part."""
+    d = c.get("dynamic_image_resolution") or {}
+    rows = [["axis", "direction", "edges", "MTF50 cy/px", "u_A", "u_B", "U (k=2)", "lp/mm", "U", "GRD m", "U"]]
+    for a in d.get("axes", []):
+        rows.append([a.get("axis"), a.get("direction", "-"), a.get("count"), fmt(a.get("mtf50_cy_px"), 4),
+                     fmt(a.get("type_a_u_cy_px"), 2), fmt(a.get("type_b_u_cy_px"), 2),
+                     fmt(a.get("mtf50_expanded_cy_px"), 2), fmt(a.get("mtf50_lp_per_mm"), 4),
+                     fmt(a.get("mtf50_lp_per_mm_expanded"), 2), fmt(a.get("mtf50_resolved_distance_m"), 4),
+                     fmt(a.get("mtf50_resolved_distance_expanded_m"), 2)])
+    return rows if len(rows) > 1 else []
+
+
+def resolution_bar_rows(c):
+    """Bar targets (`aerocal quality bars`): the limiting frequency at the threshold."""
+    d = c.get("dynamic_image_resolution") or {}
+    rows = [["bar target", "threshold", "groups", "limiting cy/px", "lp/mm", "GRD m", "within the target"]]
+    for i, b in enumerate(d.get("bars", [])):
+        rows.append([i + 1, fmt((b.get("options") or {}).get("threshold"), 3), len(b.get("groups", [])),
+                     fmt(b.get("limiting_frequency_cy_px"), 4), fmt(b.get("limiting_lp_per_mm"), 4),
+                     fmt(b.get("limiting_resolved_distance_m"), 4), fmt(b.get("limit_in_range"))])
+    return rows if len(rows) > 1 else []
+
+
+def fig_mtf(c):
+    """MTF curves of the edges and contrast transfer of the bar groups, cycles/px."""
+    d = c.get("dynamic_image_resolution") or {}
+    fig, ax = plt.subplots(figsize=(7.0, 3.6))
+    for i, e in enumerate(d.get("edges", [])):
+        curve = e.get("curve") or {}
+        f, m = curve.get("frequency_cy_px", []), curve.get("mtf", [])
+        pts = [(x, y) for x, y in zip(f, m) if x is not None and y is not None and x <= 0.75]
+        if pts:
+            ax.plot([p[0] for p in pts], [p[1] for p in pts], "-",
+                    label="edge %d (%s)" % (i + 1, e.get("direction", e.get("axis", ""))))
+    for i, b in enumerate(d.get("bars", [])):
+        g = b.get("groups", [])
+        ax.plot([x["frequency_cy_px"] for x in g], [x["contrast_transfer"] for x in g], "o--",
+                label="bar target %d (contrast transfer)" % (i + 1))
+    ax.axhline(0.5, color="#999", lw=0.6)
+    ax.axvline(0.5, color="#999", lw=0.6, ls=":")
+    ax.set_xlabel("frequency (cycles/px); Nyquist 0.5")
+    ax.set_ylabel("MTF / contrast transfer")
+    ax.set_xlim(0, 0.75)
+    ax.set_ylim(0, 1.05)
+    if ax.lines:
+        ax.legend(fontsize=6)
+    fig.tight_layout()
+    return fig
+
+
 def method_text(m):
     if m.get("kind") == "in-flight calibration":
         return "in-flight calibration (aerocal flight, %s adjustment) of %s; uncertainty budget: %s" % (
@@ -290,6 +355,15 @@ def write_html(c, path, figures):
         parts.append(html_table(cmp, flag_col=7))
     else:
         parts.append("<p>No previous certificate given.</p>")
+    if c.get("dynamic_image_resolution"):
+        d = c["dynamic_image_resolution"]
+        parts.append("<h2>9. Dynamic image resolution</h2><p>%s; MTF50 with U = k u_c (k = 2); GRD = GSD / "
+                     "(2 f), one bar width. Sources: %s.</p>" % (
+                         html.escape(d.get("method", "bar targets")), html.escape(", ".join(d.get("sources", [])))))
+        for rows in (resolution_edge_rows(c), resolution_axis_rows(c), resolution_bar_rows(c)):
+            if rows:
+                parts.append(html_table(rows))
+        parts.append(figures["mtf"])
     warnings = warning_lines(c)
     if warnings:
         parts.append("<h2>Findings</h2><ul>" + "".join("<li class='bad'>%s</li>" % html.escape(w) for w in warnings) + "</ul>")
@@ -367,10 +441,20 @@ def write_pdf(c, path):
                ["signature: ______________", "signature: ______________", "signature: ______________"]]
         blocks = [("6. Stability over image groups", stability_rows(c) or [["no image groups given"]]),
                   ("7. Check points", check_rows(c)),
-                  ("8. Comparison with the previous certificate", comparison_rows(c) or [["no previous certificate given"]]),
-                  ("Findings", [[w] for w in warning_lines(c)] or [["none"]]),
-                  ("Signatures", sig)]
+                  ("8. Comparison with the previous certificate", comparison_rows(c) or [["no previous certificate given"]])]
+        if c.get("dynamic_image_resolution"):
+            blocks += [("9. Dynamic image resolution (MTF50, U = k u_c, k = 2)", resolution_edge_rows(c) or [["no edges"]]),
+                       ("", resolution_axis_rows(c) or [["no repeated edges of one axis"]]),
+                       ("", resolution_bar_rows(c) or [["no bar targets"]])]
+        blocks += [("Findings", [[w] for w in warning_lines(c)] or [["none"]]),
+                   ("Signatures", sig)]
         for fig in text_pages(title, blocks):
+            pdf.savefig(fig)
+            plt.close(fig)
+        if c.get("dynamic_image_resolution"):
+            fig = fig_mtf(c)
+            fig.suptitle("9. Dynamic image resolution: MTF curves and bar contrast transfer")
+            fig.tight_layout(rect=(0, 0, 1, 0.93))
             pdf.savefig(fig)
             plt.close(fig)
     os.replace(tmp, path)
@@ -395,6 +479,8 @@ def main(argv):
               % (argv[1], json.dumps(c.get("schema_version"))), file=sys.stderr)
         return 2
     figures = {"distortion": svg_of(fig_distortion(c)), "residuals": svg_of(fig_residuals_correlation(c))}
+    if c.get("dynamic_image_resolution"):
+        figures["mtf"] = svg_of(fig_mtf(c))
     write_html(c, os.path.join(argv[2], "certificate.html"), figures)
     write_pdf(c, os.path.join(argv[2], "certificate.pdf"))
     return 0

@@ -1,0 +1,50 @@
+// Edge targets on the ground (issue 36 item 1): where a target's edge lies in an image, from the
+// adjusted orientation of the exposure and the target's ground coordinates, so that the slanted
+// edge is measured in a region found rather than given.
+//
+// A target's edge is the segment between two ground points (object frame, m). Both ends are
+// projected into the (virtual) image with the camera and the exposure's orientation
+// (calib::Camera::ProjectToPixel: collinearity and the camera's distortion). The region spans the
+// central `used_fraction` of the projected edge along it and `half_width_px` to both sides across
+// it, as a pixel-axis rectangle; the local GSD is the edge's ground length over its image length.
+#pragma once
+
+#include <string>
+
+#include <Eigen/Core>
+
+#include "calib/camera/camera.h"
+#include "stitch/quality/slanted_edge.h"
+
+namespace aerocal::stitch {
+
+struct EdgeTarget {
+  std::string id;
+  Eigen::Vector3d start_m = Eigen::Vector3d::Zero();  // one end of the edge, object frame (m)
+  Eigen::Vector3d end_m = Eigen::Vector3d::Zero();    // the other end
+};
+
+struct EdgeTargetRegionOptions {
+  double half_width_px = 32.0;   // across the edge, each side (>= 8)
+  double used_fraction = 0.8;    // of the edge's length, centred (0 < f <= 1; the ends are corners)
+};
+
+struct EdgeTargetRegion {
+  std::string id;
+  bool usable = false;       // both ends project in front of the camera and the region is inside
+  std::string reason;        // why not, when !usable
+  PixelRegion region;
+  Eigen::Vector2d start_px = Eigen::Vector2d::Zero(), end_px = Eigen::Vector2d::Zero();
+  MtfAxis axis = MtfAxis::kX;  // the image axis nearer the edge normal
+  double slant_deg = 0.0;      // the edge's angle to the nearer pixel axis (unsigned)
+  double gsd_m = 0.0;          // ground length per image pixel along the edge
+};
+
+/// The region of `target` in the image of `camera` seen from (opk_rad, center_m).
+EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
+                                    const Eigen::Vector3d& opk_rad,
+                                    const Eigen::Vector3d& center_m,
+                                    const EdgeTarget& target,
+                                    const EdgeTargetRegionOptions& options = {});
+
+}  // namespace aerocal::stitch

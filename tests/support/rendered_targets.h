@@ -1,0 +1,112 @@
+// Resolution targets rendered exactly: a straight edge or a bar pattern blurred by a Gaussian PSF
+// of sigma s px and integrated over each pixel's area in closed form, so the rendering adds no
+// error to what a measurement of it is compared with. With Phi the standard normal CDF and phi its
+// density, F1(u) = u Phi(u) + phi(u) and F2(u) = ((u^2 + 1) Phi(u) + u phi(u)) / 2 are its first
+// and second antiderivatives; the area integral of Phi((n . p - o) / s) over the pixel square is
+// s^2 / (nx ny) times the second difference of F2 over the square's corners.
+//
+// The rendered image's MTF along the edge normal n = (cos t, sin t) is that of the PSF times the
+// pixel square's projection onto n: exp(-2 pi^2 s^2 f^2) sinc(f cos t) sinc(f sin t).
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace aerocal::testing {
+
+using RenderedImage = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+inline constexpr double kRenderPi = 3.14159265358979323846;
+
+inline double NormalCdf(double u) { return 0.5 * std::erfc(-u / std::sqrt(2.0)); }
+inline double NormalPdf(double u) { return std::exp(-0.5 * u * u) / std::sqrt(2.0 * kRenderPi); }
+inline double NormalCdfIntegral(double u) { return u * NormalCdf(u) + NormalPdf(u); }  // F1
+inline double NormalCdfIntegral2(double u) {                                              // F2
+  return 0.5 * ((u * u + 1.0) * NormalCdf(u) + u * NormalPdf(u));
+}
+inline double Sinc(double x) {
+  return std::abs(x) < 1e-12 ? 1.0 : std::sin(kRenderPi * x) / (kRenderPi * x);
+}
+
+/// Fraction (0..1) of the bright side in pixel (col, row) for the blurred edge n . p = offset,
+/// n = (cos t, sin t) the unit normal pointing to the bright side, p = (col, row) px.
+inline double EdgePixelFraction(double col, double row, double angle_rad, double offset_px, double s_px) {
+  const double nx = std::cos(angle_rad), ny = std::sin(angle_rad);
+  auto u = [&](double x, double y) { return (nx * x + ny * y - offset_px) / s_px; };
+  const double x0 = col - 0.5, x1 = col + 0.5, y0 = row - 0.5, y1 = row + 0.5;
+  const double corners[4] = {u(x0, y0), u(x1, y0), u(x0, y1), u(x1, y1)};
+  if (*std::min_element(corners, corners + 4) > 9.0) return 1.0;
+  if (*std::max_element(corners, corners + 4) < -9.0) return 0.0;
+  if (std::abs(ny) < 1e-9)  // an axis-aligned edge: one antiderivative, along x
+    return s_px / nx * (NormalCdfIntegral(u(x1, 0.0)) - NormalCdfIntegral(u(x0, 0.0)));
+  if (std::abs(nx) < 1e-9)
+    return s_px / ny * (NormalCdfIntegral(u(0.0, y1)) - NormalCdfIntegral(u(0.0, y0)));
+  return s_px * s_px / (nx * ny) *
+         (NormalCdfIntegral2(corners[3]) - NormalCdfIntegral2(corners[2]) -
+          NormalCdfIntegral2(corners[1]) + NormalCdfIntegral2(corners[0]));
+}
+
+/// A width x height image of an edge through the image centre shifted by `offset_px`, its normal
+/// at `angle_rad` from +x, dark `low` and bright `high` (floating point, no noise).
+inline RenderedImage RenderEdge(int width, int height, double angle_rad, double s_px, double low,
+                                double high, double offset_px = 0.0) {
+  RenderedImage image(height, width);
+  const double nx = std::cos(angle_rad), ny = std::sin(angle_rad);
+  const double centre = nx * 0.5 * (width - 1) + ny * 0.5 * (height - 1) + offset_px;
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c)
+      image(r, c) = static_cast<float>(low + (high - low) * EdgePixelFraction(c, r, angle_rad, centre, s_px));
+  return image;
+}
+
+/// Vertical bars (grey value a function of the column): bright on [x0 + k P, x0 + k P + P/2) for
+/// every integer k, period P px, blurred by s and integrated over each pixel's column extent.
+inline double BarPixelFraction(double col, double period_px, double x0_px, double s_px) {
+  double fraction = 0.0;
+  const int k_first = static_cast<int>(std::floor((col - 0.5 - 10.0 * s_px - x0_px) / period_px)) - 1;
+  const int k_last = static_cast<int>(std::ceil((col + 0.5 + 10.0 * s_px - x0_px) / period_px)) + 1;
+  for (int k = k_first; k <= k_last; ++k) {
+    const double a = x0_px + k * period_px, b = a + 0.5 * period_px;  // one bright bar [a, b)
+    auto bar = [&](double x) {  // integral of Phi((x - a)/s) - Phi((x - b)/s) dx
+      return s_px * (NormalCdfIntegral((x - a) / s_px) - NormalCdfIntegral((x - b) / s_px));
+    };
+    fraction += bar(col + 0.5) - bar(col - 0.5);
+  }
+  return fraction;
+}
+
+/// MTF of the rendered edge along its normal: PSF times the projected pixel square.
+inline double RenderedEdgeMtf(double f, double s_px, double angle_rad) {
+  return std::exp(-2.0 * kRenderPi * kRenderPi * s_px * s_px * f * f) * Sinc(f * std::cos(angle_rad)) *
+         Sinc(f * std::sin(angle_rad));
+}
+
+/// Coltman's square-wave response of vertical bars of frequency f (cycles/px) through the PSF and
+/// the pixel's column extent: (4/pi) sum over odd k of (-1)^((k-1)/2) M(k f) / k.
+inline double RenderedBarContrast(double f, double s_px) {
+  double sum = 0.0;
+  for (int k = 1; k < 200; k += 2) sum += ((k / 2) % 2 == 0 ? 1.0 : -1.0) * RenderedEdgeMtf(k * f, s_px, 0.0) / k;
+  return 4.0 / kRenderPi * sum;
+}
+
+/// First f in (0, 1] where `curve(f)` falls to `level` (scan then bisection); NaN if none.
+template <typename Curve>
+double FirstCrossing(const Curve& curve, double level) {
+  double f0 = 0.0;
+  for (double f1 = 1.0 / 512; f1 <= 1.0; f1 += 1.0 / 512) {
+    if (curve(f1) <= level) {
+      for (int i = 0; i < 60; ++i) {
+        const double mid = 0.5 * (f0 + f1);
+        (curve(mid) > level ? f0 : f1) = mid;
+      }
+      return 0.5 * (f0 + f1);
+    }
+    f0 = f1;
+  }
+  return std::nan("");
+}
+
+}  // namespace aerocal::testing

@@ -1,0 +1,276 @@
+// aerocal quality: dynamic image resolution. `quality mtf` measures slanted edges (ISO 12233
+// e-SFR, stitch/quality/slanted_edge.h) in regions of one image and writes their MTF, MTF50 with
+// its GUM budget, and the same in lp/mm and as a ground resolved distance; `quality bars` the
+// contrast transfer of bar groups and the limiting frequency at a threshold
+// (stitch/quality/bar_target.h). stitch/quality/README.md.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/result_file.h"
+#include "stitch/image_io/image_io.h"
+#include "stitch/quality/bar_target.h"
+#include "stitch/quality/quality_json.h"
+#include "stitch/quality/slanted_edge.h"
+#include "tools/command_registry.h"
+
+namespace aerocal::tools {
+namespace {
+
+// The units of the report, for the options every `quality` command shares.
+struct GroundArgs {
+  double gsd_m = 0.0, gsd_sigma_m = 0.0, pixel_mm = 0.0;
+  void Add(CLI::App* app) {
+    app->add_option("--pixel-mm", pixel_mm, "Pixel size (mm): frequencies also in line pairs per mm")
+        ->check(CLI::PositiveNumber);
+    app->add_option("--gsd-m", gsd_m, "Ground sample distance (m): frequencies as a ground resolved distance")
+        ->check(CLI::PositiveNumber);
+    app->add_option("--gsd-sigma-m", gsd_sigma_m, "Standard uncertainty of the GSD (m), from the adjustment")
+        ->check(CLI::NonNegativeNumber);
+  }
+  void Check() const {
+    if (gsd_sigma_m > 0.0 && gsd_m <= 0.0) throw ConfigError("--gsd-sigma-m needs --gsd-m");
+  }
+  void Write(nlohmann::json* doc) const {
+    if (pixel_mm > 0.0) (*doc)["pixel_size_mm"] = pixel_mm;
+    if (gsd_m > 0.0) (*doc)["gsd_m"] = gsd_m, (*doc)["gsd_sigma_m"] = gsd_sigma_m;
+  }
+};
+
+struct MtfArgs {
+  std::string image, out, flight_axis;
+  std::vector<std::string> rois;
+  double gamma = 1.0;
+  int oversampling = 4;
+  GroundArgs ground;
+};
+
+struct BarsArgs {
+  std::string image, out, bright, dark;
+  std::vector<std::string> groups;
+  double gamma = 1.0, threshold = 0.1;
+  GroundArgs ground;
+};
+
+// "col,row,width,height" in px; ConfigError naming `option` otherwise.
+stitch::PixelRegion ParseRegion(const std::string& text, const std::string& option = "--roi") {
+  stitch::PixelRegion region;
+  std::istringstream in(text);
+  char c1 = 0, c2 = 0, c3 = 0;
+  std::string rest;
+  if (!(in >> region.col >> c1 >> region.row >> c2 >> region.width >> c3 >> region.height) || c1 != ',' ||
+      c2 != ',' || c3 != ',' || (in >> rest))
+    throw ConfigError(option + ": expected col,row,width,height in px (got '" + text + "')");
+  return region;
+}
+
+// "frequency,col,row,width,height[,x|y]": a bar group (frequency in cycles/px, axis across the
+// bars, x by default); ConfigError naming --group otherwise.
+stitch::BarGroup ParseGroup(const std::string& text) {
+  const size_t comma = text.find(',');
+  stitch::BarGroup group;
+  std::string rest = comma == std::string::npos ? "" : text.substr(comma + 1);
+  char* end = nullptr;
+  group.frequency_cy_px = std::strtod(text.c_str(), &end);
+  if (comma == std::string::npos || end != text.c_str() + comma || !(group.frequency_cy_px > 0.0) ||
+      group.frequency_cy_px > 0.5)
+    throw ConfigError("--group: expected frequency (0 < f <= 0.5 cycles/px),col,row,width,height[,x|y] (got '" +
+                      text + "')");
+  if (rest.size() > 2 && (rest.substr(rest.size() - 2) == ",x" || rest.substr(rest.size() - 2) == ",y")) {
+    group.axis = rest.back() == 'x' ? stitch::MtfAxis::kX : stitch::MtfAxis::kY;
+    rest.resize(rest.size() - 2);
+  }
+  group.region = ParseRegion(rest, "--group " + text);
+  return group;
+}
+
+// The flight direction's image axis names an edge's direction: an MTF along it is along track.
+std::string Direction(stitch::MtfAxis axis, const std::string& flight_axis) {
+  if (flight_axis.empty()) return "";
+  return std::string(stitch::MtfAxisName(axis)) == flight_axis ? "along_track" : "across_track";
+}
+
+
+// `prefix`_lp_per_mm and `prefix`_resolved_distance_m of frequency f (cycles/px); with `u` (the
+// frequency's standard uncertainty, >= 0) also their U (k = 2); without (u < 0) none.
+void AddGround(const GroundArgs& args, double f, double u, const std::string& prefix, nlohmann::json* json) {
+  if (!std::isfinite(f) || f <= 0.0) return;
+  const stitch::GroundResolution g =
+      stitch::ToGroundResolution(f, std::max(u, 0.0), args.pixel_mm, args.gsd_m, args.gsd_sigma_m);
+  if (args.pixel_mm > 0.0) {
+    (*json)[prefix + "_lp_per_mm"] = g.lp_per_mm;
+    if (u >= 0.0) (*json)[prefix + "_lp_per_mm_expanded"] = 2.0 * g.lp_per_mm_u;
+  }
+  if (args.gsd_m > 0.0) {
+    (*json)[prefix + "_resolved_distance_m"] = g.resolved_distance_m;
+    if (u >= 0.0) (*json)[prefix + "_resolved_distance_expanded_m"] = 2.0 * g.resolved_distance_u_m;
+  }
+}
+
+int RunMtf(const MtfArgs& args) {
+  CheckOutputFile(args.out, "--out");
+  std::vector<stitch::PixelRegion> regions;
+  for (const auto& text : args.rois) regions.push_back(ParseRegion(text));
+  args.ground.Check();
+  stitch::SlantedEdgeOptions options;
+  options.gamma = args.gamma;
+  options.oversampling = args.oversampling;
+  const stitch::GrayImage image = stitch::ReadGrayImage(args.image);
+
+  nlohmann::json edges = nlohmann::json::array();
+  std::vector<stitch::SlantedEdgeResult> per_axis[2];
+  bool determined = true;
+  for (size_t i = 0; i < regions.size(); ++i) {
+    stitch::SlantedEdgeResult r;
+    try {
+      r = stitch::MeasureSlantedEdge(image, regions[i], options);
+    } catch (const InputError& e) {
+      throw InputError("--roi " + args.rois[i] + ": " + args.image + ": " + e.what());
+    }
+    nlohmann::json edge = stitch::SlantedEdgeToJson(r);
+    edge["roi"] = {regions[i].col, regions[i].row, regions[i].width, regions[i].height};
+    const std::string direction = Direction(r.axis, args.flight_axis);
+    if (!direction.empty()) edge["direction"] = direction;
+    AddGround(args.ground, r.mtf50_cy_px, r.mtf50_u_cy_px, "mtf50", &edge);
+    edges.push_back(edge);
+    determined = determined && std::isfinite(r.mtf50_cy_px);
+    if (std::isfinite(r.mtf50_cy_px)) per_axis[r.axis == stitch::MtfAxis::kX ? 0 : 1].push_back(r);
+    std::printf("roi %s: MTF along %s, slant %.2f deg, MTF50 %.4f +- %.4f cycles/px (U, k = 2), "
+                "MTF at Nyquist %.3f\n",
+                args.rois[i].c_str(), std::string(stitch::MtfAxisName(r.axis)).c_str(), r.angle_deg,
+                r.mtf50_cy_px, r.mtf50_expanded_cy_px, r.mtf_nyquist);
+  }
+  nlohmann::json axes = nlohmann::json::object();
+  for (int a = 0; a < 2; ++a) {
+    if (per_axis[a].size() < 2) continue;
+    const stitch::MtfAxis axis = a == 0 ? stitch::MtfAxis::kX : stitch::MtfAxis::kY;
+    const stitch::EdgeMtfCombination c = stitch::CombineEdgeMeasurements(per_axis[a]);
+    nlohmann::json combined = stitch::EdgeCombinationToJson(c);
+    const std::string direction = Direction(axis, args.flight_axis);
+    if (!direction.empty()) combined["direction"] = direction;
+    AddGround(args.ground, c.mtf50_cy_px, c.mtf50_u_cy_px, "mtf50", &combined);
+    axes[std::string(stitch::MtfAxisName(axis))] = combined;
+  }
+  nlohmann::json doc = {{"image", args.image},
+                        {"width_px", image.cols()},
+                        {"height_px", image.rows()},
+                        {"method", "ISO 12233:2017 e-SFR (slanted edge)"},
+                        {"options", {{"gamma", args.gamma}, {"oversampling", args.oversampling}}},
+                        {"edges", edges},
+                        {"axes", axes},
+                        {"determined", determined}};
+  args.ground.Write(&doc);
+  if (!args.flight_axis.empty()) doc["flight_axis"] = args.flight_axis;
+  WriteResult(args.out, "quality_mtf", doc);
+  return determined ? kExitOk : kExitNotConverged;
+}
+
+int RunBars(const BarsArgs& args) {
+  CheckOutputFile(args.out, "--out");
+  std::vector<stitch::BarGroup> groups;
+  for (const auto& text : args.groups) groups.push_back(ParseGroup(text));
+  const stitch::PixelRegion bright = ParseRegion(args.bright, "--bright");
+  const stitch::PixelRegion dark = ParseRegion(args.dark, "--dark");
+  args.ground.Check();
+  stitch::BarTargetOptions options;
+  options.gamma = args.gamma;
+  options.threshold = args.threshold;
+  const stitch::GrayImage image = stitch::ReadGrayImage(args.image);
+  stitch::BarTargetResult r;
+  try {
+    r = stitch::MeasureBarTarget(image, groups, bright, dark, options);
+  } catch (const InputError& e) {
+    throw InputError("--group/--bright/--dark: " + args.image + ": " + e.what());
+  }
+  nlohmann::json out_groups = nlohmann::json::array();
+  for (const auto& g : r.groups) {
+    nlohmann::json j = {{"frequency_cy_px", g.frequency_cy_px},
+                        {"modulation", g.modulation},
+                        {"contrast_transfer", g.contrast_transfer}};
+    AddGround(args.ground, g.frequency_cy_px, -1.0, "frequency", &j);
+    out_groups.push_back(j);
+    std::printf("bars at %.4f cycles/px: modulation %.4f, contrast transfer %.4f\n", g.frequency_cy_px,
+                g.modulation, g.contrast_transfer);
+  }
+  const bool determined = std::isfinite(r.limiting_frequency_cy_px);
+  nlohmann::json doc = {{"image", args.image},
+                        {"method", "bar target contrast transfer, limit at a threshold"},
+                        {"options", {{"gamma", args.gamma}, {"threshold", args.threshold}}},
+                        {"reference_modulation", r.reference_modulation},
+                        {"groups", out_groups},
+                        {"limit_in_range", r.limit_in_range},
+                        {"determined", determined}};
+  doc["limiting_frequency_cy_px"] = determined ? nlohmann::json(r.limiting_frequency_cy_px) : nlohmann::json();
+  if (determined) AddGround(args.ground, r.limiting_frequency_cy_px, -1.0, "limiting", &doc);  // no U yet
+  args.ground.Write(&doc);
+  WriteResult(args.out, "quality_bars", doc);
+  if (determined)
+    std::printf("limiting frequency at %.0f %% contrast transfer: %.4f cycles/px%s\n", 100.0 * args.threshold,
+                r.limiting_frequency_cy_px, r.limit_in_range ? "" : " (or higher: every group resolved)");
+  else
+    std::printf("no group reaches %.0f %% contrast transfer\n", 100.0 * args.threshold);
+  return determined ? kExitOk : kExitNotConverged;
+}
+
+CommandRun Setup(CLI::App& app) {
+  app.require_subcommand(1);
+  auto mtf = std::make_shared<MtfArgs>();
+  CLI::App* m = app.add_subcommand(
+      "mtf", "Slanted-edge MTF (ISO 12233 e-SFR) of edge regions: MTF50, MTF at Nyquist, U (k = 2)");
+  m->option_defaults()->always_capture_default();
+  m->add_option("--image", mtf->image, "Grey-value image (8 or 16 bit; colour is converted to grey)")
+      ->required();
+  m->add_option("--roi", mtf->rois,
+                "Edge region col,row,width,height (px, at least 16 x 16), one edge slanted by 1..35 "
+                "deg; repeat for more edges")
+      ->required();
+  m->add_option("--gamma", mtf->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
+      ->check(CLI::Range(1e-6, 10.0))
+      ->capture_default_str();
+  m->add_option("--oversampling", mtf->oversampling, "ESF bins per pixel (ISO 12233: 4)")
+      ->check(CLI::Range(2, 16))
+      ->capture_default_str();
+  mtf->ground.Add(m);
+  m->add_option("--flight-axis", mtf->flight_axis, "Image axis of the flight direction (x or y): names "
+                "each MTF along or across track")
+      ->check(CLI::IsMember({"x", "y"}));
+  m->add_option("--out", mtf->out, "Result JSON (kind quality_mtf, written atomically)")->required();
+  auto bars = std::make_shared<BarsArgs>();
+  CLI::App* b = app.add_subcommand(
+      "bars", "Bar targets: contrast transfer per bar group and the limiting frequency at a threshold");
+  b->option_defaults()->always_capture_default();
+  b->add_option("--image", bars->image, "Grey-value image (8 or 16 bit)")->required();
+  b->add_option("--group", bars->groups,
+                "Bar group frequency,col,row,width,height[,x|y]: its frequency in this image (cycles/px, "
+                "<= 0.5), its region (two periods or more across the bars) and the axis across the bars "
+                "(x: vertical bars, the default); repeat per group")
+      ->required();
+  b->add_option("--bright", bars->bright, "Large bright reference area col,row,width,height")->required();
+  b->add_option("--dark", bars->dark, "Large dark reference area col,row,width,height")->required();
+  b->add_option("--threshold", bars->threshold, "Contrast transfer defining the limiting frequency, 0 < T < 1")
+      ->check(CLI::Range(1e-6, 1.0 - 1e-6))
+      ->capture_default_str();
+  b->add_option("--gamma", bars->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
+      ->check(CLI::Range(1e-6, 10.0))
+      ->capture_default_str();
+  bars->ground.Add(b);
+  b->add_option("--out", bars->out, "Result JSON (kind quality_bars, written atomically)")->required();
+  return [mtf, m, bars, b] {
+    if (m->parsed()) return RunMtf(*mtf);
+    if (b->parsed()) return RunBars(*bars);
+    return kExitInternal;
+  };
+}
+
+}  // namespace
+
+AEROCAL_REGISTER_COMMAND(quality, "quality",
+                         "Dynamic image resolution: slanted-edge MTF (ISO 12233 e-SFR) with GUM uncertainty, bar targets",
+                         Setup);
+
+}  // namespace aerocal::tools

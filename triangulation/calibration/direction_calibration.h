@@ -1,0 +1,69 @@
+// Laboratory geometric calibration from known directions (issue 36 item 6): a collimator array
+// (every target's direction known in the instrument frame, each cross measured in the image) or a
+// goniometer (the camera turned by known instrument rotations G_k, one fixed target of unknown
+// direction measured at every setting). The unknowns are the camera's rotation to the instrument
+// and the interior orientation and distortion in the camera file's model; no position, no scale.
+// The residual is calib/residuals/direction.h; the problem is built by calib/problem's builder
+// (residual group "direction").
+//
+// A direction's angular sigma (a collimator's direction or a goniometer setting) is folded into
+// its observation's focal-plane covariance (DirectionCovarianceMm2 at the start camera's c): each
+// observation has its own direction error, so this is the rigorous weighting; a target seen in
+// several images would need its angles as weighted unknowns instead (not done).
+#pragma once
+
+#include <map>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "calib/camera/camera.h"
+#include "calib/problem/problem_builder.h"
+
+namespace aerocal::triangulation {
+
+inline constexpr const char* kGroupDirection = "direction";
+
+struct DirectionTarget {
+  std::string id;
+  Eigen::Vector2d angles_rad = Eigen::Vector2d::Zero();  // azimuth, elevation (direction.h); start value when !known
+  bool known = true;  // a collimator: known (fixed); a goniometer's target: estimated
+};
+
+struct DirectionObservation {
+  std::string target;   // id of a DirectionTarget
+  std::string setting;  // names the instrument setting in labels ("" for a collimator array)
+  Eigen::Matrix3d instrument_rotation = Eigen::Matrix3d::Identity();  // G of direction.h
+  Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // measured (col, row), camera pixel frame
+  double sigma_px = 0.1;   // image measurement sigma, > 0
+  double sigma_rad = 0.0;  // angular sigma of the direction (collimator or setting), >= 0
+};
+
+struct DirectionCalibrationOptions {
+  std::vector<std::string> free_interior = {"c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
+  calib::SolverOptions solver;
+};
+
+struct DirectionCalibration {
+  calib::SolveReport report;
+  calib::Camera camera;                   // the start camera with the estimated interior
+  std::vector<double> interior_sigma;     // a-posteriori, table order (0 for fixed entries)
+  Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();        // R (instrument_from_camera) as omega, phi, kappa
+  Eigen::Vector3d opk_sigma_rad = Eigen::Vector3d::Zero();
+  std::map<std::string, Eigen::Vector2d> target_angles_rad;  // estimated (unknown) targets
+  std::map<std::string, Eigen::Vector2d> target_sigma_rad;
+  std::string method;  // "collimator array" (every target known) or "goniometer"
+  bool covariance_ok = false;
+};
+
+/// Adjusts `observations` of `targets` starting from `start` (interior, format, model) and the
+/// rotation `start_opk_rad`. Throws InputError naming the observation for an unknown target id, a
+/// sigma out of range or a parameter name not in the model's table.
+DirectionCalibration CalibrateFromDirections(const calib::Camera& start,
+                                             const Eigen::Vector3d& start_opk_rad,
+                                             const std::vector<DirectionTarget>& targets,
+                                             const std::vector<DirectionObservation>& observations,
+                                             const DirectionCalibrationOptions& options = {});
+
+}  // namespace aerocal::triangulation
