@@ -92,11 +92,15 @@ void ExpectHonest(const StudyFigures& f, double lowest = 0.7) {
 // default: cubics at their detection limit, the pre-test's worst case) and 2 px (strong terms).
 // With errors of 0 the test drops every term of most curves: their table is zero and exact, while
 // its sigma stays the start-degree fit's (the data cannot tell the curve from zero any better):
-// 0.66 over 30 flights, conservative by design (line_degree_test.h), not optimistic.
+// 0.66 over 30 flights, conservative by design (line_degree_test.h), not optimistic. Since the
+// datum comes from the null space (issue 28), the reference sub-camera's curves are tested and
+// dropped like the others (the reference datum pinned them): 0.477 over the same 30 flights, and
+// the floor of this case 0.45 (a floor against gross over-statement; every value below 1 is
+// conservative).
 class LineCalibrationStudy : public ::testing::TestWithParam<double> {};
 
 TEST_P(LineCalibrationStudy, AutomaticDegreeTableErrorMatchesItsPredictedSigma) {
-  ExpectHonest(Study(GetParam(), LineCalibrationOptions{}, "automatic degree"), GetParam() == 0.0 ? 0.5 : 0.7);
+  ExpectHonest(Study(GetParam(), LineCalibrationOptions{}, "automatic degree"), GetParam() == 0.0 ? 0.45 : 0.7);
 }
 
 // The oracle: the truth's degree (3) given, no test; the study measures the sigmas alone.
