@@ -20,6 +20,9 @@
 // the upper-left corner: x0 = ppx - W p / 2, y0 = H p / 2 - ppy. The pixel size is the format
 // height over the image height (square pixels, as DBAT reads it); a format width that disagrees
 // (PhotoModeler's x scale, what DBAT calls the aspect) is reported as a note, not modelled.
+// Also read: a PhotoModeler calibration / project status report's camera block ("Camera1: ...",
+// then "Focal Length", "Xp - principal point x", "Yp", "Fw - format width", "Fh", "K1"-"P2" title
+// lines with "Value: X mm" and "Deviation: Name: Y mm"; report_camera.cc), the same conventions.
 // Writing gives lines 1-5 with no photos: the camera as PhotoModeler's export holds it; that
 // PhotoModeler imports such a file is not verified (no PhotoModeler here).
 #include <cmath>
@@ -51,8 +54,15 @@ std::vector<double> Numbers(const std::vector<std::string>& lines, int index, si
 
 }  // namespace
 
+bool IsPhotoModelerReport(const std::string& head) {
+  return head.find("Xp - principal point x") != std::string::npos &&
+         head.find("Focal Length") != std::string::npos;
+}
+
 CameraFile ReadPhotoModelerCamera(const std::string& path, const CameraReadOptions& options) {
-  const std::vector<std::string> lines = SplitLines(ReadTextFile(path));
+  const std::string text = ReadTextFile(path);
+  const std::vector<std::string> lines = SplitLines(text);
+  if (IsPhotoModelerReport(text)) return internal::ReadReportCamera(path, lines, options, "PhotoModeler");
   if (lines.empty() || lines[0].rfind("Bundle Soln", 0) != 0)
     ThrowInputError({path, 1}, "not a PhotoModeler Bundle Soln export (line 1 must start with "
                                "'Bundle Soln')");
