@@ -460,6 +460,14 @@ TEST(CameraFileVariants, KalibrCamchainImucamOfEuroc) {
   EXPECT_EQ(f.camera.params[0], 459.6820431465863);
   EXPECT_EQ(f.camera.params[7], -0.010717188529046507);
   EXPECT_EQ(f.camera.frame.width_px, 752);
+  // Written back under its key, every number in its shortest exact form.
+  const std::string out = dir.File("back.yaml");
+  WriteKalibrCamchain(out, f);
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.rfind("cam1:\n", 0), 0u) << text;
+  EXPECT_NE(text.find("-0.010717188529046507]"), std::string::npos) << text;
+  EXPECT_EQ(ReadKalibrCamchain(out, {}).camera.params, f.camera.params);
 }
 
 // ---- COLMAP ----

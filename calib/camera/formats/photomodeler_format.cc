@@ -113,15 +113,15 @@ void WritePhotoModelerCamera(const std::string& path, const CameraFile& file) {
   const PixelFrame& f = file.camera.frame;
   const std::vector<double>& q = file.camera.params;
   const double w_mm = f.width_px * f.pixel_size_mm, h_mm = f.height_px * f.pixel_size_mm;
+  const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out.precision(17);
   out << "Bundle Soln " << (file.name.empty() ? "aerocal camera" : internal::OneLine(file.name)) << "\n"
       << " 0 -1 " << f.width_px << " " << f.height_px << "\n"
       << " 1 0 0 0 0 0 0 0 0\n"
-      << " " << q[Model::kC] << " " << q[Model::kX0] + 0.5 * w_mm << " "
-      << 0.5 * h_mm - q[Model::kY0] << " " << w_mm << " " << h_mm << " " << q[Model::kK1] << " "
-      << q[Model::kK2] << " " << q[Model::kK3] << " " << q[Model::kP1] << " " << q[Model::kP2]
-      << "\n 0 0 0 0 0 0 0 0 0 0\n";
+      << " " << n(q[Model::kC]) << " " << n(q[Model::kX0] + 0.5 * w_mm) << " "
+      << n(0.5 * h_mm - q[Model::kY0]) << " " << n(w_mm) << " " << n(h_mm) << " "
+      << n(q[Model::kK1]) << " " << n(q[Model::kK2]) << " " << n(q[Model::kK3]) << " "
+      << n(q[Model::kP1]) << " " << n(q[Model::kP2]) << "\n 0 0 0 0 0 0 0 0 0 0\n";
   WriteFileAtomically(path, out.str());
 }
 
