@@ -179,25 +179,40 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
 void WriteOpenCvCamera(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == CameraModelId::kOpenCv) << "not opencv";
   const std::vector<double>& p = file.camera.params;
-  const std::string extension = std::filesystem::path(path).extension().string();
-  const std::string memory_name =
-      extension == ".xml" ? ".xml" : extension == ".json" ? ".json" : ".yml";
-  cv::FileStorage fs(memory_name, cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
-  fs << "image_width" << file.camera.frame.width_px;
-  fs << "image_height" << file.camera.frame.height_px;
-  const cv::Mat k = (cv::Mat_<double>(3, 3) << p[OpenCvModel::kFx], 0, p[OpenCvModel::kCx], 0,
-                     p[OpenCvModel::kFy], p[OpenCvModel::kCy], 0, 0, 1);
-  fs << "camera_matrix" << k;
+  // The simplest form that holds the camera: k1 k2 p1 p2 [k3 [k4 k5 k6]].
   const bool rational = p[OpenCvModel::kK4] != 0 || p[OpenCvModel::kK5] != 0 || p[OpenCvModel::kK6] != 0;
   std::vector<double> coefficients = {p[OpenCvModel::kK1], p[OpenCvModel::kK2],
-                                      p[OpenCvModel::kP1], p[OpenCvModel::kP2],
-                                      p[OpenCvModel::kK3]};
+                                      p[OpenCvModel::kP1], p[OpenCvModel::kP2]};
+  if (rational || p[OpenCvModel::kK3] != 0) coefficients.push_back(p[OpenCvModel::kK3]);
   if (rational)
     coefficients.insert(coefficients.end(),
                         {p[OpenCvModel::kK4], p[OpenCvModel::kK5], p[OpenCvModel::kK6]});
-  const cv::Mat d = cv::Mat(coefficients, true);
-  fs << "distortion_coefficients" << d;
-  WriteFileAtomically(path, fs.releaseAndGetString());
+  const std::vector<double> k = {p[OpenCvModel::kFx], 0, p[OpenCvModel::kCx], 0,
+                                 p[OpenCvModel::kFy], p[OpenCvModel::kCy], 0, 0, 1};
+  const std::string extension = std::filesystem::path(path).extension().string();
+  if (extension == ".xml" || extension == ".json") {
+    cv::FileStorage fs(extension, cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
+    fs << "image_width" << file.camera.frame.width_px;
+    fs << "image_height" << file.camera.frame.height_px;
+    fs << "camera_matrix" << cv::Mat(k, true).reshape(1, 3);
+    fs << "distortion_coefficients" << cv::Mat(coefficients, true);
+    WriteFileAtomically(path, fs.releaseAndGetString());
+    return;
+  }
+  // YAML in cv::FileStorage's own layout, the numbers in the shortest form that reads back to
+  // the same double (cv::FileStorage prints %.16e: 0.009 as 8.9999999999999997e-03).
+  const auto matrix = [](const std::vector<double>& values, int rows, int cols) {
+    std::string text = " !!opencv-matrix\n   rows: " + std::to_string(rows) +
+                       "\n   cols: " + std::to_string(cols) + "\n   dt: d\n   data: [ ";
+    for (size_t i = 0; i < values.size(); ++i)
+      text += (i ? ", " : "") + calib::internal::ShortestNumber(values[i]);
+    return text + " ]\n";
+  };
+  WriteFileAtomically(path, "%YAML:1.0\n---\nimage_width: " +
+                                std::to_string(file.camera.frame.width_px) + "\nimage_height: " +
+                                std::to_string(file.camera.frame.height_px) + "\ncamera_matrix:" +
+                                matrix(k, 3, 3) + "distortion_coefficients:" +
+                                matrix(coefficients, static_cast<int>(coefficients.size()), 1));
 }
 
 }  // namespace aerocal::tools

@@ -20,6 +20,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <optional>
 #include <set>
 
 namespace aerocal::tools {
@@ -332,6 +333,9 @@ CommandRun SetupCalibrate(CLI::App& app) {
                                   {"limit", nullptr},
                                   {"message", f}});
     }
+    // The --model estimate of this run: what --write-camera writes when --model is given.
+    std::optional<calib::Camera> beside_camera;
+    std::optional<triangulation::CameraEstimate> beside_estimate;
     if (beside_model != model) {
       // The same marks calibrated in --model, started from the camera file's values converted.
       triangulation::CalibrateOptions beside = options;
@@ -352,6 +356,10 @@ CommandRun SetupCalibrate(CLI::App& app) {
                   std::string(calib::CameraModelName(beside_model)).c_str(), o.sigma0, RmsPx(o),
                   o.valid ? "" : " (not valid)");
       cal["beside"] = b;
+      if (o.valid && !o.cameras.empty()) {
+        beside_camera = triangulation::UpdatedCamera(in_model.cameras[camera_id], o.cameras[0]);
+        beside_estimate = o.cameras[0];
+      }
     }
     if (beside_model == calib::OpenCvModel::kId && board) {
       const OpenCvCalibration cv = CalibrateWithOpenCv(detected);
@@ -378,7 +386,24 @@ CommandRun SetupCalibrate(CLI::App& app) {
     cal["rms_px"] = RmsPx(r);
     // The calibrated camera, in the format asked for; only for a valid result (a file that exists
     // is one the next run may use).
-    if (!args->write_camera.empty() && r.valid && !r.cameras.empty()) {
+    // With --model the model-M estimate of this run is written (issue 29), not a refit of ours.
+    if (!args->write_camera.empty() && beside_model != model && beside_camera) {
+      const calib::ConversionResult written = WriteCameraInFormat(
+          args->write_camera, *beside_camera, args->camera_format, &beside_estimate->sigma);
+      cal["camera_written"] = {{"file", args->write_camera},
+                               {"format", args->camera_format},
+                               {"model", std::string(calib::CameraModelName(beside_model))},
+                               {"exact", written.exact},
+                               {"residual_px",
+                                {{"rms", written.residual.rms_px},
+                                 {"max", written.residual.max_px},
+                                 {"max_inner80", written.residual.max_inner80_px}}}};
+      std::printf("camera (the %s estimate) -> %s (%s)\n",
+                  std::string(calib::CameraModelName(beside_model)).c_str(),
+                  args->write_camera.c_str(), args->camera_format.c_str());
+    } else if (!args->write_camera.empty() && beside_model != model) {
+      std::fprintf(stderr, "camera not written: the --model result is not valid\n");
+    } else if (!args->write_camera.empty() && r.valid && !r.cameras.empty()) {
       const calib::ConversionResult written = WriteCameraInFormat(
           args->write_camera, triangulation::UpdatedCamera(camera, r.cameras[0]), args->camera_format,
           &r.cameras[0].sigma);

@@ -39,7 +39,8 @@ struct ReadArgs {
         ->required();
     app->add_option("--camera", camera_id,
                     "Which camera of a file holding several (COLMAP id, Metashape sensor id, "
-                    "OpenSfM/Kalibr key, rig head, OpenCV stereo 1/2)");
+                    "OpenSfM/Kalibr key, rig head, OpenCV stereo 1/2, Pix4D image, DJI record "
+                    "file/date/number, DBAT id or report CameraN)");
     app->add_option("--width", width, "Image width in px where the file has none (checked "
                                       "against the file where it has one)")
         ->check(CLI::Range(1, 1000000));

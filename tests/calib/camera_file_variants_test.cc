@@ -2,6 +2,8 @@
 // in the exact layout of that tool (small numeric records; where each layout comes from is said at
 // each test), plus the registry's detection (`--from auto`) and what a wrong --from says.
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <string>
 
@@ -458,6 +460,14 @@ TEST(CameraFileVariants, KalibrCamchainImucamOfEuroc) {
   EXPECT_EQ(f.camera.params[0], 459.6820431465863);
   EXPECT_EQ(f.camera.params[7], -0.010717188529046507);
   EXPECT_EQ(f.camera.frame.width_px, 752);
+  // Written back under its key, every number in its shortest exact form.
+  const std::string out = dir.File("back.yaml");
+  WriteKalibrCamchain(out, f);
+  std::ifstream in(out);
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  EXPECT_EQ(text.rfind("cam1:\n", 0), 0u) << text;
+  EXPECT_NE(text.find("-0.010717188529046507]"), std::string::npos) << text;
+  EXPECT_EQ(ReadKalibrCamchain(out, {}).camera.params, f.camera.params);
 }
 
 // ---- COLMAP ----
@@ -536,6 +546,124 @@ TEST(CameraFileVariants, DbatFragmentsAndTheAspectAsB1) {
   const CameraFile back = ReadDbatCameraXml(out, {});
   for (size_t i = 0; i < f.camera.params.size(); ++i)
     EXPECT_NEAR(back.camera.params[i], f.camera.params[i], 1e-14 * (1 + std::abs(f.camera.params[i])));
+}
+
+// DBAT's text report (DBAT 0.9.2.0 report.txt of its camcal demo and of the Roma EOS 5D project,
+// ../shared/data/dbat_*/result/report.txt): the same camera as the XML DBAT wrote beside it, to the
+// report's 6 significant digits, with the deviations as sigmas.
+TEST(CameraFileVariants, DbatTextReportAgainstItsXml) {
+  const std::string dir = testing::SharedDataDir("dbat_camcal_olympus_c4040z");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data absent";
+  const std::string report = dir + "/result/report.txt";
+  EXPECT_EQ(DetectCameraFormats(report), std::vector<std::string>{"dbat"});
+  const CameraFile r = ReadCameraFileAs("auto", report, {});
+  const CameraFile x = ReadDbatCameraXml(dir + "/result/c4040z.xml", {});
+  EXPECT_EQ(r.name, "Camera1");
+  for (size_t i = 0; i < x.camera.params.size(); ++i)
+    EXPECT_NEAR(r.camera.params[i], x.camera.params[i],
+                6e-6 * std::abs(x.camera.params[i]) + (i == 1 || i == 2 ? 5e-6 : 1e-9))
+        << i;  // x0, y0: px, py printed to 5e-6 mm
+  EXPECT_LT(CompareCameras(x.camera, r.camera, 21).max_px, 0.05);  // 6 digits printed
+  ASSERT_TRUE(r.covariance.has_value());
+  EXPECT_NEAR(std::sqrt((*r.covariance)(0, 0)), 0.00105, 1e-12);  // c
+  const std::string roma = testing::SharedDataDir("dbat_roma_canon_eos5d");
+  if (roma.empty()) return;
+  const CameraFile e = ReadCameraFileAs("dbat", roma + "/result/report.txt", {});
+  EXPECT_EQ(e.camera.frame.width_px, 5616);
+  EXPECT_EQ(P(e, "c"), 24.5425);
+  EXPECT_EQ(P(e, "K2"), -1.86985e-07);
+  EXPECT_EQ(P(e, "B1"), 0.0);
+}
+
+// ---- PhotoModeler ----
+
+// A PhotoModeler report's camera block: the heading and value lines of PhotoModeler's project
+// status report (../shared/data/dbat_camcal_olympus_c4040z/photomodeler/
+// weighted-with-orient-pmreport.txt: "Camera1: <name>", indented title lines, "Value: X unit",
+// "Deviation: Name: Y unit", CRLF line ends) with the calibration headings of PhotoModeler's
+// calibration report as DBAT's PhotoModeler-style report writer lists them ("Focal Length",
+// "Xp - principal point x", ..., "Iw - image width"). No PhotoModeler calibration report itself
+// was available: the values are PhotoModeler's own calibration of the same images, line 4 of its
+// Bundle Soln export (camcal-pmexport.txt), which must read as the same camera.
+TEST(CameraFileVariants, PhotoModelerReportBlockIsItsBundleSolnCamera) {
+  const std::string dir = testing::SharedDataDir("dbat_camcal_olympus_c4040z");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data absent";
+  TempDir tmp("aerocal_variants");
+  const auto entry = [](const std::string& title, const std::string& name, const std::string& value,
+                        const std::string& deviation, const std::string& unit) {
+    return "            " + title + "\r\n                 Value: " + value + " " + unit +
+           "\r\n                 Deviation: " + name + ": " + deviation + " " + unit + "\r\n";
+  };
+  const std::string report =
+      "\r\nStatus Report Tree\r\n   Project Name: camcal.pmr\r\n"
+      "      Camera Calibration Standard Deviations\r\n"
+      "         Camera1: Olympus C4040Z 2272x1704 inf focus\r\n" +
+      entry("Focal Length", "Focal", "7.4653", "0.0011", "mm") +
+      entry("Xp - principal point x", "Xp", "3.6173", "0.0008", "mm") +
+      entry("Yp - principal point y", "Yp", "2.6128", "0.0009", "mm") +
+      "            Fw - format width\r\n                 Value: 7.25319 mm\r\n"
+      "            Fh - format height\r\n                 Value: 5.43764 mm\r\n" +
+      entry("K1 - radial distortion 1", "K1", "0.00498", "2.2e-005", "mm^-2") +
+      entry("K2 - radial distortion 2", "K2", "-0.00010", "2.7e-006", "mm^-4") +
+      entry("K3 - radial distortion 3", "K3", "0.00000", "0", "mm^-6") +
+      entry("P1 - decentering distortion 1", "P1", "-0.00006", "3.5e-006", "mm^-1") +
+      entry("P2 - decentering distortion 2", "P2", "-0.00004", "3.9e-006", "mm^-1") +
+      "            Iw - image width\r\n                 Value: 2272 px\r\n"
+      "            Ih - image height\r\n                 Value: 1704 px\r\n"
+      "      Cameras\r\n         Camera1: Olympus C4040Z 2272x1704 inf focus\r\n"
+      "            Calibration: yes\r\n            Number of photos using camera: 21\r\n";
+  const std::string path = Write(tmp, "camcal-report.txt", report);
+  EXPECT_EQ(DetectCameraFormats(path), std::vector<std::string>{"photomodeler"});
+  const CameraFile r = ReadCameraFileAs("auto", path, {});
+  const CameraFile b = ReadPhotoModelerCamera(dir + "/photomodeler/camcal-pmexport.txt", {});
+  EXPECT_EQ(r.name, "Camera1");
+  for (size_t i = 0; i < b.camera.params.size(); ++i)
+    EXPECT_NEAR(r.camera.params[i], b.camera.params[i], 1e-12) << i;
+  EXPECT_EQ(r.camera.frame.width_px, 2272);
+  ASSERT_TRUE(r.covariance.has_value());
+  EXPECT_NEAR(std::sqrt((*r.covariance)(0, 0)), 0.0011, 1e-15);
+  EXPECT_TRUE(HasNote(r, "Format width"));  // 7.25319 mm against 2272 square pixels: said
+  EXPECT_EQ(P(r, "B1"), 0.0);               // not modelled, as in the Bundle Soln reader
+}
+
+// ---- every reader on damaged files (what the camera_formats fuzzer does, in the unit build) ----
+
+// Each seed of the fuzzer and the project archives, cut at 8 lengths and with bytes overwritten at 4 places,
+// through every reader of the registry: a camera or an aerocal::Error, nothing else (a crash or
+// another exception fails the test).
+TEST(CameraFileRegistry, EveryReaderRefusesDamagedFilesWithAnError) {
+  namespace fs = std::filesystem;
+  TempDir dir("aerocal_variants");
+  std::vector<std::string> inputs;
+  const fs::path seeds = fs::path(AEROCAL_TEST_DATA_DIR) / ".." / "fuzz" / "seeds" / "camera_formats";
+  for (const auto& entry : fs::directory_iterator(seeds)) inputs.push_back(entry.path().string());
+  inputs.push_back(Data("photoscan12_project.psz"));
+  inputs.push_back(Data("metashape_project.files/0/chunk.zip"));
+  int reads = 0, errors = 0;
+  for (const std::string& input : inputs) {
+    std::ifstream in(input, std::ios::binary);
+    const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    std::vector<std::string> damaged;
+    for (int k = 0; k < 8; ++k) damaged.push_back(bytes.substr(0, bytes.size() * k / 8));
+    for (int k = 1; k < 5; ++k) {
+      std::string flipped = bytes;
+      for (size_t i = flipped.size() * k / 5; i < flipped.size() && i < flipped.size() * k / 5 + 3; ++i)
+        flipped[i] = static_cast<char>(flipped[i] ^ 0x5a);
+      damaged.push_back(flipped);
+    }
+    for (const std::string& text : damaged)
+      for (const CameraFormat& f : CameraFormats()) {
+        const std::string path = Write(dir, "damaged_" + f.name + f.extension, text);
+        try {
+          f.read(path, {});
+          ++reads;
+        } catch (const aerocal::Error&) {
+          ++errors;
+        }
+      }
+  }
+  std::printf("damaged inputs: %d read, %d refused with an error\n", reads, errors);
+  EXPECT_GT(errors, 0);
 }
 
 }  // namespace

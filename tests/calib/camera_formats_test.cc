@@ -373,6 +373,12 @@ TEST(CameraFormatsRealData, OdmCamerasJsonOfTheOrthorityDocs) {
   EXPECT_NEAR(f.camera.params[O::kK1], DjiRecordA().params[O::kK1], 0.01);
   const CameraFile back = WriteAndRead(FormatNamed("opensfm"), f, tmp);
   ExpectSameParams(f.camera, back.camera, "odm cameras.json");
+  // The key, spaces and all, is the camera's name and survives (issue 29); --camera takes it.
+  EXPECT_EQ(f.name, "v2 dji fc6310r 5472 3648 brown 0.6666");
+  EXPECT_EQ(back.name, f.name);
+  CameraReadOptions options;
+  options.camera_id = "v2 dji fc6310r 5472 3648 brown 0.6666";
+  EXPECT_EQ(ReadCameraFileAs("auto", path, options).camera.params, f.camera.params);
 }
 
 TEST(CameraFormatsRealData, DbatResultCameraAgainstItsReport) {

@@ -119,20 +119,20 @@ void WriteAustralisCamera(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == Model::kId) << "not brown_fraser_10";
   const PixelFrame& f = file.camera.frame;
   const std::vector<double>& q = file.camera.params;
+  const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out.precision(17);
   out << "Australis Bundle Adjustment Results: Camera Parameters\n"
       << "(written by aerocal: the camera only)\n\nResults for Camera 1\n"
       << (file.name.empty() ? "camera" : file.name) << "\n\n"
-      << "Sensor Size  Pixel Size (mm)\nH " << f.width_px << " " << f.pixel_size_mm << "\nV "
-      << f.height_px << " " << f.pixel_size_mm << "\n\n"
+      << "Sensor Size  Pixel Size (mm)\nH " << f.width_px << " " << n(f.pixel_size_mm) << "\nV "
+      << f.height_px << " " << n(f.pixel_size_mm) << "\n\n"
       << "Camera    Initial    Total       Final     Initial     Final\n"
       << "Variable  Value      Adjustment  Value     Std. Error  Std. Error\n";
   for (int k = 0; k < Model::kNumParams; ++k) {
     double sigma = 0;
     if (file.covariance && (*file.covariance)(k, k) > 0) sigma = std::sqrt((*file.covariance)(k, k));
-    out << kAustralisNames[k] << " " << q[k] << " 0 " << q[k] << " "
-        << (sigma > 0 ? kFreeSigma : 0.0) << " " << sigma << (k < 3 ? " (mm)" : "") << "\n";
+    out << kAustralisNames[k] << " " << n(q[k]) << " 0 " << n(q[k]) << " "
+        << n(sigma > 0 ? kFreeSigma : 0.0) << " " << n(sigma) << (k < 3 ? " (mm)" : "") << "\n";
   }
   WriteFileAtomically(path, out.str());
 }

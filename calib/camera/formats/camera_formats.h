@@ -192,10 +192,16 @@ ModelCamera DjiDewarpDataCamera(const std::string& text, const SourceRef& where,
                                 int height_px);
 void WriteDjiDewarpData(const std::string& path, const CameraFile& camera);
 
+/// DBAT camera XML (whole or a fragment) or DBAT's text report (--camera CameraN).
 CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& options);
+/// True when `head` is (the start of) a DBAT text report with a camera block.
+bool IsDbatReport(const std::string& head);
 void WriteDbatCameraXml(const std::string& path, const CameraFile& camera);
 
+/// A Bundle Soln export, or a calibration / status report's camera block (--camera CameraN).
 CameraFile ReadPhotoModelerCamera(const std::string& path, const CameraReadOptions& options);
+/// True when `head` holds a PhotoModeler-style report camera block (Focal Length, Xp - ...).
+bool IsPhotoModelerReport(const std::string& head);
 void WritePhotoModelerCamera(const std::string& path, const CameraFile& camera);
 
 CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions& options);
@@ -238,6 +244,13 @@ std::string YamlQuoted(std::string_view text);
 /// OpenCV's `%YAML:1.0` first line (cv::FileStorage's, not a YAML 1.x directive) is read as a
 /// comment, so line numbers stay those of the file.
 YAML::Node LoadCameraYaml(const std::string& path);
+/// The camera of a DBAT or PhotoModeler text report (report_camera.cc): `tool` names it in
+/// messages; --camera CameraN picks one of several.
+CameraFile ReadReportCamera(const std::string& path, const std::vector<std::string>& lines,
+                            const CameraReadOptions& options, const std::string& tool);
+/// The largest difference (px) over the format between a correction acting on x scaled by the
+/// pixel aspect s (DBAT's x = s xb) and ours with that scale as B1 = s - 1 (`ours` holds it).
+double AspectAsB1ResidualPx(const ModelCamera& ours, double s);
 /// `text` with & < > " ' as XML entities (a camera name in an XML element).
 std::string XmlEscaped(std::string_view text);
 }  // namespace internal

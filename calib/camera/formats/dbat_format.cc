@@ -9,7 +9,12 @@
 // 2 - <aspect> with an "auto" width; the report's `as` = 1 - aspect) scales DBAT's x: read as
 // B1 = s - 1 with x0 = px / s - W p / 2; not exact (DBAT's K, P act on the scaled x), the
 // difference measured over the format and said. A fragment (<cameras> or <camera> without
-// <document>) is read too; several cameras need --camera ID. Read with an
+// <document>) is read too; several cameras need --camera ID.
+// Also DBAT's text report (report.txt: "Cameras:" ... "Camera1 (simple)", then per parameter a
+// title line and "Value:" / "Deviation:" lines: Camera Constant, px, py, Format width/height, K1-K3,
+// P1, P2, as (off-unit aspect: pixel width = pixel height (1 + as)), sk, Image width/height): the
+// same mapping, 6 significant digits as printed, the deviations as a diagonal covariance; a
+// non-zero skew is an error (not modelled). --camera CameraN picks one of several. Read with an
 // XML parser (comments, CDATA and nesting handled), the camera's DIRECT children only (a <pp>
 // inside <std> is a sigma, not the principal point).
 #include <cmath>
@@ -60,34 +65,14 @@ struct XmlCamera {
 
 }  // namespace
 
-namespace {
-
-// The largest difference (px) over the format between DBAT's correction, which acts on x scaled
-// by the pixel aspect s (x_dbat = s xb), and ours with that scale as B1 = s - 1.
-double AspectAsB1ResidualPx(const ModelCamera& ours, double s) {
-  using Model = BrownFraser10Model;
-  const PixelFrame& f = ours.frame;
-  std::vector<double> dbat = ours.params;
-  dbat[Model::kX0] = dbat[Model::kY0] = dbat[Model::kB1] = dbat[Model::kB2] = 0.0;
-  double worst = 0.0;
-  for (int j = 0; j <= 20; ++j)
-    for (int i = 0; i <= 20; ++i) {
-      const double xy[2] = {(i / 20.0 - 0.5) * f.width_px * f.pixel_size_mm,
-                            (0.5 - j / 20.0) * f.height_px * f.pixel_size_mm};
-      const double xy_dbat[2] = {s * (xy[0] - ours.params[Model::kX0]),
-                                 xy[1] - ours.params[Model::kY0]};
-      double a[2], b[2];
-      Model::IdealFromMeasured(ours.params.data(), xy, a);
-      Model::IdealFromMeasured(dbat.data(), xy_dbat, b);
-      worst = std::max(worst, std::hypot(a[0] - b[0], a[1] - b[1]) / f.pixel_size_mm);
-    }
-  return worst;
+bool IsDbatReport(const std::string& head) {
+  return head.find("Camera Constant:") != std::string::npos &&
+         head.find("px - principal point x:") != std::string::npos;
 }
-
-}  // namespace
 
 CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& options) {
   const std::string text = ReadTextFile(path);
+  if (IsDbatReport(text)) return internal::ReadReportCamera(path, SplitLines(text), options, "DBAT");
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS)
     ThrowInputError({path, doc.ErrorLineNum()}, std::string("invalid XML: ") + doc.ErrorName());
@@ -174,7 +159,7 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
   if (s != 1.0)
     file.notes.push_back("DBAT pixel aspect (width / height " + FormatNumber(s) + ") read as B1 = " +
                          FormatNumber(s - 1.0) + ": not exact, " +
-                         FormatNumber(AspectAsB1ResidualPx(file.camera, s), 3) +
+                         FormatNumber(internal::AspectAsB1ResidualPx(file.camera, s), 3) +
                          " px max over the format (DBAT's K, P act on the scaled x)");
   return file;
 }

@@ -4,6 +4,7 @@
 // OpenCV fisheye), resolution [W, H]; other keys (T_cam_imu, rostopic, cam_overlaps, ...) are
 // kept out. Pixels as OpenCV (pixel centres at integer coordinates), so the opencv /
 // opencv_fisheye models hold a Kalibr camera exactly.
+#include <regex>
 #include <sstream>
 
 #include "calib/camera/formats/camera_formats.h"
@@ -67,18 +68,20 @@ CameraFile ReadKalibrCamchain(const std::string& path, const CameraReadOptions& 
 
 void WriteKalibrCamchain(const std::string& path, const CameraFile& file) {
   const std::vector<double>& p = file.camera.params;
+  const auto n = [](double v) { return internal::ShortestNumber(v); };
+  // The camera's key survives (cam1 of a camchain); another name is written as cam0.
+  const std::string key = std::regex_match(file.name, std::regex("cam[0-9]{1,3}")) ? file.name : "cam0";
   std::ostringstream out;
-  out.precision(17);
-  out << "cam0:\n  camera_model: pinhole\n  intrinsics: [" << p[0] << ", " << p[1] << ", " << p[2]
-      << ", " << p[3] << "]\n";
+  out << key << ":\n  camera_model: pinhole\n  intrinsics: [" << n(p[0]) << ", " << n(p[1]) << ", "
+      << n(p[2]) << ", " << n(p[3]) << "]\n";
   if (file.camera.model == OpenCvFisheyeModel::kId) {
-    out << "  distortion_model: equidistant\n  distortion_coeffs: [" << p[4] << ", " << p[5]
-        << ", " << p[6] << ", " << p[7] << "]\n";
+    out << "  distortion_model: equidistant\n  distortion_coeffs: [" << n(p[4]) << ", " << n(p[5])
+        << ", " << n(p[6]) << ", " << n(p[7]) << "]\n";
   } else {
     AEROCAL_CHECK(file.camera.model == OpenCvModel::kId) << "not opencv";
     internal::RequireZero(file.camera, {"k3", "k4", "k5", "k6"}, "Kalibr radtan");
-    out << "  distortion_model: radtan\n  distortion_coeffs: [" << p[4] << ", " << p[5] << ", "
-        << p[6] << ", " << p[7] << "]\n";
+    out << "  distortion_model: radtan\n  distortion_coeffs: [" << n(p[4]) << ", " << n(p[5])
+        << ", " << n(p[6]) << ", " << n(p[7]) << "]\n";
   }
   out << "  resolution: [" << file.camera.frame.width_px << ", " << file.camera.frame.height_px
       << "]\n";

@@ -20,6 +20,9 @@
 // the upper-left corner: x0 = ppx - W p / 2, y0 = H p / 2 - ppy. The pixel size is the format
 // height over the image height (square pixels, as DBAT reads it); a format width that disagrees
 // (PhotoModeler's x scale, what DBAT calls the aspect) is reported as a note, not modelled.
+// Also read: a PhotoModeler calibration / project status report's camera block ("Camera1: ...",
+// then "Focal Length", "Xp - principal point x", "Yp", "Fw - format width", "Fh", "K1"-"P2" title
+// lines with "Value: X mm" and "Deviation: Name: Y mm"; report_camera.cc), the same conventions.
 // Writing gives lines 1-5 with no photos: the camera as PhotoModeler's export holds it; that
 // PhotoModeler imports such a file is not verified (no PhotoModeler here).
 #include <cmath>
@@ -51,8 +54,15 @@ std::vector<double> Numbers(const std::vector<std::string>& lines, int index, si
 
 }  // namespace
 
+bool IsPhotoModelerReport(const std::string& head) {
+  return head.find("Xp - principal point x") != std::string::npos &&
+         head.find("Focal Length") != std::string::npos;
+}
+
 CameraFile ReadPhotoModelerCamera(const std::string& path, const CameraReadOptions& options) {
-  const std::vector<std::string> lines = SplitLines(ReadTextFile(path));
+  const std::string text = ReadTextFile(path);
+  const std::vector<std::string> lines = SplitLines(text);
+  if (IsPhotoModelerReport(text)) return internal::ReadReportCamera(path, lines, options, "PhotoModeler");
   if (lines.empty() || lines[0].rfind("Bundle Soln", 0) != 0)
     ThrowInputError({path, 1}, "not a PhotoModeler Bundle Soln export (line 1 must start with "
                                "'Bundle Soln')");
@@ -103,15 +113,15 @@ void WritePhotoModelerCamera(const std::string& path, const CameraFile& file) {
   const PixelFrame& f = file.camera.frame;
   const std::vector<double>& q = file.camera.params;
   const double w_mm = f.width_px * f.pixel_size_mm, h_mm = f.height_px * f.pixel_size_mm;
+  const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out.precision(17);
   out << "Bundle Soln " << (file.name.empty() ? "aerocal camera" : internal::OneLine(file.name)) << "\n"
       << " 0 -1 " << f.width_px << " " << f.height_px << "\n"
       << " 1 0 0 0 0 0 0 0 0\n"
-      << " " << q[Model::kC] << " " << q[Model::kX0] + 0.5 * w_mm << " "
-      << 0.5 * h_mm - q[Model::kY0] << " " << w_mm << " " << h_mm << " " << q[Model::kK1] << " "
-      << q[Model::kK2] << " " << q[Model::kK3] << " " << q[Model::kP1] << " " << q[Model::kP2]
-      << "\n 0 0 0 0 0 0 0 0 0 0\n";
+      << " " << n(q[Model::kC]) << " " << n(q[Model::kX0] + 0.5 * w_mm) << " "
+      << n(0.5 * h_mm - q[Model::kY0]) << " " << n(w_mm) << " " << n(h_mm) << " "
+      << n(q[Model::kK1]) << " " << n(q[Model::kK2]) << " " << n(q[Model::kK3]) << " "
+      << n(q[Model::kP1]) << " " << n(q[Model::kP2]) << "\n 0 0 0 0 0 0 0 0 0 0\n";
   WriteFileAtomically(path, out.str());
 }
 

@@ -118,19 +118,19 @@ void WritePix4dXmp(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == M::kId) << "not pix4d_perspective";
   const PixelFrame& f = file.camera.frame;
   const std::vector<double>& p = file.camera.params;
+  const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out.precision(17);
   out << "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n <rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
       << "  <rdf:Description xmlns:Camera=\"" << kPix4dCameraUri << "/\"\n"
       << "    xmlns:tiff=\"http://ns.adobe.com/tiff/1.0/\" xmlns:exif=\"http://ns.adobe.com/exif/1.0/\"\n"
       << "    tiff:ImageWidth=\"" << f.width_px << "\" tiff:ImageLength=\"" << f.height_px << "\"\n"
-      << "    exif:FocalPlaneXResolution=\"" << 1.0 / f.pixel_size_mm << "\" exif:FocalPlaneYResolution=\""
-      << 1.0 / f.pixel_size_mm << "\" exif:FocalPlaneResolutionUnit=\"4\"\n"
+      << "    exif:FocalPlaneXResolution=\"" << n(1.0 / f.pixel_size_mm) << "\" exif:FocalPlaneYResolution=\""
+      << n(1.0 / f.pixel_size_mm) << "\" exif:FocalPlaneResolutionUnit=\"4\"\n"
       << "    Camera:ModelType=\"perspective\"\n"
-      << "    Camera:PerspectiveFocalLength=\"" << p[M::kF] << "\"\n"
-      << "    Camera:PrincipalPoint=\"" << p[M::kPx] << "," << p[M::kPy] << "\"\n"
-      << "    Camera:PerspectiveDistortion=\"" << p[M::kR1] << "," << p[M::kR2] << "," << p[M::kR3]
-      << "," << p[M::kT1] << "," << p[M::kT2] << "\"/>\n </rdf:RDF>\n</x:xmpmeta>\n";
+      << "    Camera:PerspectiveFocalLength=\"" << n(p[M::kF]) << "\"\n"
+      << "    Camera:PrincipalPoint=\"" << n(p[M::kPx]) << "," << n(p[M::kPy]) << "\"\n"
+      << "    Camera:PerspectiveDistortion=\"" << n(p[M::kR1]) << "," << n(p[M::kR2]) << ","
+      << n(p[M::kR3]) << "," << n(p[M::kT1]) << "," << n(p[M::kT2]) << "\"/>\n </rdf:RDF>\n</x:xmpmeta>\n";
   WriteFileAtomically(path, out.str());
 }
 

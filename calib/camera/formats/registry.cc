@@ -38,7 +38,7 @@ bool LooksLikeColmapText(const std::string& head) {
   for (std::string line; std::getline(in, line);) {
     if (line.empty() || line[0] == '#') continue;
     if (!line.empty() && line.back() == '\r') line.pop_back();
-    return std::regex_match(line, kRow);
+    return line.size() < 4000 && std::regex_match(line, kRow);
   }
   return false;
 }
@@ -109,22 +109,26 @@ std::vector<CameraFormat>& Registry() {
          // The bare string: "[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" on its first line.
          static const std::regex kRecord(
              R"(^\s*([0-9-]+;)?\s*[-+0-9.eE]+(\s*,\s*[-+0-9.eE]+){8}([-+0-9.eE,\s]*)$)");
-         return std::regex_match(h.substr(0, h.find('\n')), kRecord);
+         const std::string first = h.substr(0, h.find('\n'));
+         return first.size() < 1000 && std::regex_match(first, kRecord);
        },
        ".xmp"},
-      {"dbat", "DBAT camera XML, whole or a <cameras> / <camera> fragment (c, pp, aspect, K1-K3, P1, P2 in mm)",
+      {"dbat", "DBAT camera XML, whole or a <cameras> / <camera> fragment, or DBAT's text report (c, pp, aspect, K1-K3, P1, P2 in mm)",
        ReadDbatCameraXml, WriteDbatCameraXml,
        [](const ModelCamera&) { return FormatTarget{CameraModelId::kBrownFraser10, {"B2"}, true}; },
        [](const std::string& h, const std::string&) {
-         return (Has(h, "<camera>") || Has(h, "<camera ")) && (Has(h, "<cc>") || Has(h, "<pp>"));
+         return ((Has(h, "<camera>") || Has(h, "<camera ")) && (Has(h, "<cc>") || Has(h, "<pp>"))) ||
+                IsDbatReport(h);
        },
        ".xml", true, true},
-      {"photomodeler", "PhotoModeler Bundle Soln export's camera (f, pp, format, K1-K3, P1, P2 mm)",
+      {"photomodeler", "PhotoModeler Bundle Soln export's camera or a calibration report's camera block (f, pp, format, K1-K3, P1, P2 mm)",
        ReadPhotoModelerCamera, WritePhotoModelerCamera,
        [](const ModelCamera&) {
          return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
        },
-       [](const std::string& h, const std::string&) { return h.rfind("Bundle Soln", 0) == 0; },
+       [](const std::string& h, const std::string&) {
+         return h.rfind("Bundle Soln", 0) == 0 || IsPhotoModelerReport(h);
+       },
        ".txt", true, true},
       {"australis", "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
        ReadAustralisCamera, WriteAustralisCamera,

@@ -86,6 +86,11 @@ std::string ReadZipMember(const std::string& b, const std::string& name, const s
   if (data > b.size() || b.size() - data < found->compressed)
     throw InputError(what + ": data runs past the end of the archive");
   if (found->size > kMaxMemberBytes) throw InputError(what + ": larger than 256 MiB");
+  // Deflate expands at most about 1032:1: a larger stated size is a damaged header.
+  if (found->size > uint64_t{found->compressed} * 1100 + 1024)
+    throw InputError(what + ": stated size " + std::to_string(found->size) +
+                     " bytes does not fit its " + std::to_string(found->compressed) +
+                     " compressed bytes");
   if (found->method == 0) {
     if (found->compressed != found->size) throw InputError(what + ": stored sizes disagree");
     return b.substr(data, found->size);
