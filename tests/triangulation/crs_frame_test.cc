@@ -11,11 +11,13 @@
 #include "tests/support/odm_uav_block.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/import/write_project.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
 #include <sstream>
 #include <tuple>
@@ -249,6 +251,95 @@ TEST(CrsFrame, ImportOdmTakesAWgs84GcpList) {
     EXPECT_NEAR(results[0]["check"]["rmse_m"][k].get<double>(),
                 results[1]["check"]["rmse_m"][k].get<double>(), 1e-3);
   EXPECT_NE(results[1]["frame"].get<std::string>().find("X = longitude"), std::string::npos);
+}
+
+// A GTX geoid grid (PROJ's vgridshift format: big-endian header lat0, lon0, dlat, dlon (deg),
+// rows, columns, then float32 undulations row by row from the south) over the ODM block with
+// N = 10 + 1 m per 0.5 deg north + 0.5 m per 0.5 deg east (bilinear interpolation is exact).
+void WriteGtx(const std::string& path) {
+  std::string bytes;
+  const auto put = [&](const void* data, size_t n) {
+    const char* c = static_cast<const char*>(data);
+    for (size_t i = n; i-- > 0;) bytes += c[i];  // little-endian host -> big-endian file
+  };
+  for (double v : {-27.0, -51.0, 0.5, 0.5}) put(&v, 8);
+  for (int32_t v : {8, 8}) put(&v, 4);
+  for (int row = 0; row < 8; ++row)
+    for (int col = 0; col < 8; ++col) {
+      const float n = 10.0f + 1.0f * row + 0.5f * col;
+      put(&n, 4);
+    }
+  WriteFileAtomically(path, bytes);
+}
+
+// Orthometric heights through the geoid PROJ finds (EGM96, installed) or a grid file the user
+// names give the same adjustment as ellipsoidal heights; a grid that is not installed is exit 2
+// naming it, never a silent ellipsoidal height.
+TEST(CrsFrame, OrthometricHeightsGiveTheEllipsoidalResult) {
+  const std::string dir = testing::SharedDataDir("odm_br_uav_gcp_block");
+  if (dir.empty()) GTEST_SKIP() << "../shared/data/odm_br_uav_gcp_block is absent";
+  testing::TempDir tmp("aerocal_crs_geoid");
+  Project utm = testing::ImportOdmUavBlock(dir);
+  utm.frame = FrameSpec{};
+  utm.frame.kind = FrameSpec::Kind::kCrs;
+  utm.frame.crs = "EPSG:32722";
+  const ObjectFrame utm_frame(utm.frame);
+  utm_frame.FixOrigin(utm);
+  const Project local = ToAdjustmentFrame(utm, utm_frame);
+  WriteGtx(tmp.File("geoid.gtx"));
+
+  FrameSpec ellipsoidal, egm96, user_grid;
+  ellipsoidal.crs = "EPSG:32722";
+  egm96.crs = "EPSG:32722+5773";
+  user_grid.crs = "EPSG:32722";
+  user_grid.geoid_grid = tmp.File("geoid.gtx");
+  std::vector<nlohmann::json> results;
+  std::vector<double> first_height;
+  for (const auto& [name, spec] : std::vector<std::pair<std::string, FrameSpec>>{
+           {"ellipsoidal", ellipsoidal}, {"egm96", egm96}, {"user_grid", user_grid}}) {
+    const Project block = InFrame(local, utm_frame, spec);
+    first_height.push_back(block.points.front().xyz_m->z());
+    WriteProjectFolder(block, tmp.File(name));
+    const auto run = testing::RunAerocal("adjust --project " + tmp.File(name + "/project.yaml") +
+                                         " --robust-start --out " + tmp.File(name + ".json"));
+    ASSERT_EQ(run.exit_code, 0) << run.output;
+    results.push_back(nlohmann::json::parse(ReadTextFile(tmp.File(name + ".json"))));
+    std::printf("%s: height of %s %.4f m, check RMSE %s, c %.6f\n  frame: %s\n", name.c_str(),
+                block.points.front().id.c_str(), first_height.back(),
+                results.back()["check"]["rmse_m"].dump().c_str(),
+                results.back()["cameras"][0]["estimated"]["c"].get<double>(),
+                results.back()["frame"].get<std::string>().c_str());
+  }
+  // The heights in the files differ by the undulation (EGM96 ~4 m; the user grid 10 + ...).
+  EXPECT_NEAR(first_height[0] - first_height[1], 4.0, 1.0);
+  EXPECT_NEAR(first_height[0] - first_height[2], 10.0 + 2.8 + 1.6, 0.5);
+  for (size_t k = 1; k < results.size(); ++k) {
+    for (int i = 0; i < 3; ++i)
+      EXPECT_NEAR(results[0]["check"]["rmse_m"][i].get<double>(),
+                  results[k]["check"]["rmse_m"][i].get<double>(), 1e-6);
+    const double c0 = results[0]["cameras"][0]["estimated"]["c"].get<double>();
+    EXPECT_NEAR(results[k]["cameras"][0]["estimated"]["c"].get<double>(), c0, 1e-6 * c0);
+  }
+  EXPECT_NE(results[1]["frame"].get<std::string>().find("geoid undulation at the origin N = 4.0"),
+            std::string::npos);
+  EXPECT_NE(results[2]["frame"].get<std::string>().find("geoid.gtx"), std::string::npos);
+
+  // EGM2008 heights: us_nga_egm08_25.tif is not in Debian's proj-data.
+  const std::string yaml = ReadTextFile(tmp.File("egm96/project.yaml"));
+  const size_t at = yaml.find("EPSG:32722+5773");
+  ASSERT_NE(at, std::string::npos);
+  WriteFileAtomically(tmp.File("egm96/project.yaml"),
+                      yaml.substr(0, at) + "EPSG:32722+3855" + yaml.substr(at + 15));
+  const auto missing = testing::RunAerocal("adjust --project " + tmp.File("egm96/project.yaml") +
+                                           " --out " + tmp.File("missing.json"));
+  EXPECT_EQ(missing.exit_code, 2) << missing.output;
+  EXPECT_NE(missing.output.find("us_nga_egm08_25.tif"), std::string::npos) << missing.output;
+  // A user grid that is not there.
+  std::remove(tmp.File("geoid.gtx").c_str());
+  const auto gone = testing::RunAerocal("adjust --project " + tmp.File("user_grid/project.yaml") +
+                                        " --out " + tmp.File("gone.json"));
+  EXPECT_EQ(gone.exit_code, 2) << gone.output;
+  EXPECT_NE(gone.output.find("geoid.gtx"), std::string::npos) << gone.output;
 }
 
 }  // namespace
