@@ -7,6 +7,7 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "tests/support/odm_uav_block.h"
 #include "tests/support/test_support.h"
@@ -251,6 +252,32 @@ TEST(CrsFrame, ImportOdmTakesAWgs84GcpList) {
     EXPECT_NEAR(results[0]["check"]["rmse_m"][k].get<double>(),
                 results[1]["check"]["rmse_m"][k].get<double>(), 1e-3);
   EXPECT_NE(results[1]["frame"].get<std::string>().find("X = longitude"), std::string::npos);
+
+  // `aerocal export --write-crs EPSG:4326` of the UTM result gives the WGS84 result's exposures
+  // (centres to 1e-8 deg ~ 1 mm, attitudes relative to east/north/up to 1e-4 deg) and a GeoJSON
+  // of the check-point errors.
+  const auto exported = testing::RunAerocal(
+      "export --project " + tmp.File("utm/project.yaml") + " --result " + tmp.File("utm.json") +
+      " --write-crs EPSG:4326 --out " + tmp.File("export"));
+  ASSERT_EQ(exported.exit_code, 0) << exported.output;
+  const CsvTable table = CsvTable::Read(tmp.File("export/exposures.csv"));
+  ASSERT_EQ(table.rows().size(), results[1]["exposures"].size());
+  for (const auto& row : table.rows()) {
+    const std::string image = table.String(row, "image");
+    for (const auto& e : results[1]["exposures"])
+      if (e["image"] == image) {
+        EXPECT_NEAR(table.Number(row, "X"), e["X"].get<double>(), 1e-8) << image;
+        EXPECT_NEAR(table.Number(row, "Y"), e["Y"].get<double>(), 1e-8) << image;
+        EXPECT_NEAR(table.Number(row, "Z"), e["Z"].get<double>(), 1e-3) << image;
+        for (const char* angle : {"omega", "phi", "kappa"})
+          EXPECT_NEAR(table.Number(row, angle), e[angle].get<double>(), 1e-4) << image << angle;
+      }
+  }
+  const nlohmann::json geojson =
+      nlohmann::json::parse(ReadTextFile(tmp.File("export/check_errors.geojson")));
+  EXPECT_EQ(geojson["type"], "FeatureCollection");
+  EXPECT_EQ(geojson["features"].size(), results[0]["check"]["points"].size());
+  EXPECT_NEAR(geojson["features"][0]["geometry"]["coordinates"][0].get<double>(), -49.42, 0.01);
 }
 
 // A GTX geoid grid (PROJ's vgridshift format: big-endian header lat0, lon0, dlat, dlon (deg),
