@@ -36,6 +36,9 @@ CommandRun SetupImport(CLI::App& app) {
   colmap->add_option("--pixel-size-mm", c->pixel_size_mm, "Pixel size, mm (COLMAP has none)")
       ->check(CLI::PositiveNumber);
   colmap->add_option("--sigma-px", c->sigma_px, "Image sigma, px")->check(CLI::PositiveNumber);
+  colmap->add_option("--crs", c->crs,
+                     "CRS of a georeferenced model (EPSG:4978 after model_aligner, or a "
+                     "projected CRS): the project gets frame: {crs: ...}");
   colmap->add_option("--out", *out, "Output folder")->required();
   colmap->callback([=] {
     *run = [=] {

@@ -12,7 +12,9 @@
 #include "tests/support/odm_uav_block.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/import/colmap_export.h"
 #include "triangulation/import/write_project.h"
+#include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -20,6 +22,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
+#include <map>
 #include <sstream>
 #include <tuple>
 
@@ -367,6 +370,53 @@ TEST(CrsFrame, OrthometricHeightsGiveTheEllipsoidalResult) {
                                         " --out " + tmp.File("gone.json"));
   EXPECT_EQ(gone.exit_code, 2) << gone.output;
   EXPECT_NE(gone.output.find("geoid.gtx"), std::string::npos) << gone.output;
+}
+
+// `import colmap --crs`: a model georeferenced in ECEF (as COLMAP's model_aligner writes it)
+// imports with frame: {crs: EPSG:4978} and adjusts in the tangent plane; a geographic CRS is
+// refused (a COLMAP model is Cartesian).
+TEST(CrsFrame, ImportColmapTakesAGeocentricModel) {
+  FlightSimulationOptions o;
+  o.interior_correction = {};
+  o.ground_points = 60;
+  o.tie_points = 300;
+  const SimulatedFlight f = SimulateFlight(o);
+  Project local;
+  local.cameras["cam1"] = f.truth;
+  local.exposures = f.exposures_truth;
+  local.observations = f.observations;
+  for (const auto& g : f.points_truth) local.points.push_back(g);
+  FrameSpec ecef;
+  ecef.kind = FrameSpec::Kind::kCrs;
+  ecef.crs = "EPSG:4978";
+  ecef.has_origin = true;
+  ecef.lat_deg = 47.3769;
+  ecef.lon_deg = 8.5417;
+  ecef.h_m = 400.0;
+  const Project model = FromAdjustmentFrame(local, ObjectFrame(ecef));
+  std::map<std::string, Eigen::Vector3d> points;
+  for (const auto& g : model.points) points[g.id] = *g.xyz_m;
+  testing::TempDir tmp("aerocal_crs_colmap");
+  WriteColmapModel(model, points, tmp.File("model"));
+  const auto refused = testing::RunAerocal("import colmap --model " + tmp.File("model") +
+                                           " --pixel-size-mm 0.009 --crs EPSG:4326 --out " +
+                                           tmp.File("refused"));
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  const auto imported = testing::RunAerocal("import colmap --model " + tmp.File("model") +
+                                            " --pixel-size-mm 0.009 --sigma-px 0.2 --crs EPSG:4978 "
+                                            "--out " + tmp.File("block"));
+  ASSERT_EQ(imported.exit_code, 0) << imported.output;
+  const auto adjusted = testing::RunAerocal("adjust --project " + tmp.File("block/project.yaml") +
+                                            " --out " + tmp.File("r.json"));
+  ASSERT_EQ(adjusted.exit_code, 0) << adjusted.output;
+  const auto doc = nlohmann::json::parse(ReadTextFile(tmp.File("r.json")));
+  EXPECT_NEAR(doc["sigma0_px"].get<double>(), 0.2, 0.02);
+  EXPECT_NE(doc["frame"].get<std::string>().find("X, Y, Z geocentric"), std::string::npos);
+  // The adjusted centres are written back geocentric (|X| ~ Earth radius).
+  EXPECT_NEAR(Eigen::Vector3d(doc["exposures"][0]["X"].get<double>(),
+                              doc["exposures"][0]["Y"].get<double>(),
+                              doc["exposures"][0]["Z"].get<double>()).norm(),
+              6.37e6, 2e4);
 }
 
 }  // namespace
