@@ -10,6 +10,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "tests/support/odm_uav_block.h"
+#include "tests/support/simulated_block.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/import/colmap_export.h"
@@ -381,11 +382,9 @@ TEST(CrsFrame, ImportColmapTakesAGeocentricModel) {
   o.ground_points = 60;
   o.tie_points = 300;
   const SimulatedFlight f = SimulateFlight(o);
-  Project local;
-  local.cameras["cam1"] = f.truth;
+  Project local = testing::ProjectFromFlight(f);  // nominal = truth (no correction)
   local.exposures = f.exposures_truth;
-  local.observations = f.observations;
-  for (const auto& g : f.points_truth) local.points.push_back(g);
+  local.points = f.points_truth;
   FrameSpec ecef;
   ecef.kind = FrameSpec::Kind::kCrs;
   ecef.crs = "EPSG:4978";
