@@ -59,6 +59,17 @@ TEST(Crs, AxisOrderIsEastingOrLongitudeFirst) {
   EXPECT_LT((ecef.ToPivot(xyz) - g).cwiseProduct(Eigen::Vector3d(1e5, 1e5, 1)).norm(), 1e-4);
 }
 
+TEST(Crs, ProjStringsAndWktAreCrsDefinitions) {
+  const CrsConverter utm = Crs("EPSG:32722");
+  // The ODM list's projection line (no +type=crs) and the WKT of the pivot.
+  const CrsConverter proj_string = Crs("+proj=utm +zone=22 +south +datum=WGS84 +units=m +no_defs");
+  EXPECT_LT((proj_string.ToPivot(kUtm22s) - utm.ToPivot(kUtm22s)).norm(), 1e-9);
+  const CrsConverter wkt = Crs(utm.PivotDefinition());
+  EXPECT_EQ(wkt.axes(), CrsConverter::Axes::kGeographic);
+  const Eigen::Vector3d g = utm.ToPivot(kUtm22s);
+  EXPECT_LT((wkt.ToPivot(g) - g).norm(), 1e-12);
+}
+
 TEST(Crs, CompoundWithInstalledGeoidAndSeparateVertical) {
   // EGM96 (egm96_15.gtx ships with Debian's proj-data, PROJ names it us_nga_egm96_15.tif):
   // N is about +4 m at the block.

@@ -61,7 +61,12 @@ CrsConverter::CrsConverter(const CrsOptions& o, const std::string& pivot_definit
   proj_log_level(m.ctx, PJ_LOG_NONE);
   m.definition = o.definition;
   if (o.definition.empty()) fail("no CRS given (an EPSG code, WKT or PROJ string)");
-  m.source.reset(proj_create(m.ctx, o.definition.c_str()));
+  // A PROJ string as ODM's gcp_list.txt writes it ("+proj=utm +zone=22 +south ...") is a CRS
+  // only with +type=crs.
+  std::string definition = o.definition;
+  if (definition.rfind("+proj=", 0) == 0 && definition.find("+type=crs") == std::string::npos)
+    definition += " +type=crs";
+  m.source.reset(proj_create(m.ctx, definition.c_str()));
   if (!m.source || !proj_is_crs(m.source.get()))
     fail("PROJ cannot read '" + o.definition + "' as a CRS (" + m.LastError() + ")");
   if (!o.vertical.empty()) {
