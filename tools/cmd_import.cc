@@ -5,7 +5,6 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
-#include "triangulation/adjustment/nadir_start.h"
 #include "triangulation/import/colmap_import.h"
 #include "triangulation/import/dbat_import.h"
 #include "triangulation/import/odm_gcp_import.h"
@@ -37,6 +36,9 @@ CommandRun SetupImport(CLI::App& app) {
   colmap->add_option("--pixel-size-mm", c->pixel_size_mm, "Pixel size, mm (COLMAP has none)")
       ->check(CLI::PositiveNumber);
   colmap->add_option("--sigma-px", c->sigma_px, "Image sigma, px")->check(CLI::PositiveNumber);
+  colmap->add_option("--crs", c->crs,
+                     "CRS of a georeferenced model (EPSG:4978 after model_aligner, or a "
+                     "projected CRS): the project gets frame: {crs: ...}");
   colmap->add_option("--out", *out, "Output folder")->required();
   colmap->callback([=] {
     *run = [=] {
@@ -92,6 +94,10 @@ CommandRun SetupImport(CLI::App& app) {
       ->check(CLI::PositiveNumber);
   odm->add_option("--pixel-scale", o->pixel_scale, "Full-format px per listed px")
       ->check(CLI::PositiveNumber);
+  odm->add_option("--crs", o->crs,
+                  "CRS of the list's coordinates (EPSG code, compound EPSG:A+B, WKT or PROJ "
+                  "string; longitude / easting first), e.g. EPSG:4326 for a WGS84 list: the "
+                  "project gets frame: {crs: ...} (default: projected, used as given)");
   odm->add_option("--out", *out, "Output folder")->required();
   odm->callback([=] {
     *run = [=] {
@@ -103,6 +109,7 @@ CommandRun SetupImport(CLI::App& app) {
           subset.gcp_list = *control;
           subset.camera = o->camera;
           subset.pixel_scale = o->pixel_scale;
+          subset.crs = o->crs;
           for (const auto& p : triangulation::ImportOdmGcpList(subset).points)
             o->control_ids.insert(p.id);
           if (o->control_ids.empty()) throw ConfigError("--control: " + *control + " lists no target");
@@ -114,7 +121,7 @@ CommandRun SetupImport(CLI::App& app) {
       if (project.observations.empty())
         throw InputError(o->gcp_list + ": no image sees two or more targets: nothing to import");
       try {
-        project.exposures = triangulation::NadirStartFromControl(project, "cam1");
+        project = triangulation::WithNadirStart(project, "cam1");
       } catch (const InputError& e) {
         throw InputError(o->gcp_list + ": " + e.what());
       }

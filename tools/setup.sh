@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 build_dir="${1:-build}"
 
 packages=(cmake make g++ pkg-config
-  libceres-dev libeigen3-dev libopencv-dev libgeographiclib-dev libyaml-cpp-dev libcli11-dev
+  libceres-dev libeigen3-dev libopencv-dev libgeographiclib-dev libproj-dev libyaml-cpp-dev libcli11-dev
   nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libtiff-dev libtinyxml2-dev zlib1g-dev clang libclang-rt-dev
   python3 python3-matplotlib python3-numpy poppler-utils
   python3-dev pybind11-dev python3-pytest)

@@ -3,6 +3,7 @@ aerocal_add_test(triangulation/monte_carlo LIBS aerocal::triangulation LABELS sy
 aerocal_add_test(triangulation/forward_intersection LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/adjust_cli LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(triangulation/object_frame LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/crs_frame LIBS aerocal::triangulation LABELS golden)
 aerocal_add_test(triangulation/real_data LIBS aerocal::triangulation LABELS golden)
 aerocal_add_test(triangulation/colmap_import LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/import_cli LIBS aerocal::triangulation LABELS cli)

@@ -48,14 +48,24 @@ struct ImageObservation {
   int line = 0;
 };
 
-/// The object frame of the project (FORMATS.md `frame:`).
+/// The object frame of the project (FORMATS.md `frame:`). kCrs: the files' coordinates are in a
+/// CRS PROJ reads (triangulation/georef/crs.h); the adjustment runs in the local tangent plane
+/// about `origin` (lat_deg, lon_deg, h_m on the datum of `crs`) or, without one, about the block
+/// centre. The legacy kinds keep their meaning (triangulation/README.md "Frames").
 struct FrameSpec {
-  enum class Kind { kProjected, kLocal, kUtm, kGeodeticToLocal };
+  enum class Kind { kProjected, kLocal, kUtm, kGeodeticToLocal, kCrs };
   Kind kind = Kind::kProjected;
   std::string description = "as given";
   double lat_deg = 0, lon_deg = 0, h_m = 0;  // local tangent plane origin
   std::string utm_zone;                      // e.g. "48N"
   std::string source;                        // "project.yaml:LINE" of `frame:`, named in errors
+  // kCrs only:
+  std::string crs;            // EPSG code, compound "EPSG:2056+5728", WKT or PROJ string
+  std::string vertical;       // optional separate vertical CRS ("EPSG:5783")
+  std::string geoid_grid;     // optional grid file: heights orthometric above it (h = H + N)
+  std::string points_crs;     // optional: points.csv in another CRS than `crs`
+  std::string exposures_crs;  // optional: exposures.csv in another CRS than `crs`
+  bool has_origin = false;    // lat_deg, lon_deg, h_m given (`origin:`)
 };
 
 /// How a platform parameter (lever arm, boresight, GNSS time offset) enters the adjustment:

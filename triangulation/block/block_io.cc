@@ -265,10 +265,36 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
     const YAML::Node& f = root["frame"];
     const SourceRef where = WhereIs(f, path);
     project.frame.source = where.ToString();
-    if (!f.IsMap() || f.size() != 1)
-      ThrowInputError(where, "frame must be one of {local: {lat, lon, h}}, {utm: ZONE}, "
-                             "{projected: TEXT}, {geodetic: ...}");
-    RejectUnknownKeys(f, {"local", "utm", "projected", "geodetic"}, path);
+    if (f.IsMap() && f["crs"]) {
+      // A CRS through PROJ (triangulation/georef/crs.h), optionally per file, with heights.
+      RejectUnknownKeys(
+          f, {"crs", "vertical", "geoid_grid", "points_crs", "exposures_crs", "origin"}, path);
+      FrameSpec& s = project.frame;
+      s.kind = FrameSpec::Kind::kCrs;
+      s.crs = YamlString(f["crs"], path, "frame: crs");
+      if (f["vertical"]) s.vertical = YamlString(f["vertical"], path, "frame: vertical");
+      if (f["geoid_grid"])
+        s.geoid_grid = ResolvePath(dir, YamlString(f["geoid_grid"], path, "frame: geoid_grid"));
+      if (f["points_crs"]) s.points_crs = YamlString(f["points_crs"], path, "frame: points_crs");
+      if (f["exposures_crs"])
+        s.exposures_crs = YamlString(f["exposures_crs"], path, "frame: exposures_crs");
+      if (f["origin"]) {
+        const YAML::Node& origin = f["origin"];
+        if (!origin.IsMap() || !origin["lat"] || !origin["lon"])
+          ThrowInputError(WhereIs(origin, path), "frame: origin needs {lat: DEG, lon: DEG[, h: M]}");
+        RejectUnknownKeys(origin, {"lat", "lon", "h"}, path);
+        s.lat_deg = YamlBounded(origin["lat"], path, "frame: origin lat", -90, 90);
+        s.lon_deg = YamlBounded(origin["lon"], path, "frame: origin lon", -180, 360);
+        s.h_m = origin["h"] ? YamlBounded(origin["h"], path, "frame: origin h", -1e5, 1e5) : 0.0;
+        s.has_origin = true;
+      }
+      s.description = "crs " + s.crs;
+    } else {
+      if (!f.IsMap() || f.size() != 1)
+        ThrowInputError(where, "frame must be one of {crs: CRS, ...}, {local: {lat, lon, h}}, "
+                               "{utm: ZONE}, {projected: TEXT}, {geodetic: ...}");
+      RejectUnknownKeys(f, {"local", "utm", "projected", "geodetic"}, path);
+    }
     if (f["local"]) {
       const YAML::Node& local = f["local"];
       if (!local.IsMap())

@@ -5,6 +5,7 @@
 #include "calib/camera/rotation.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "triangulation/georef/crs.h"
 #include "triangulation/import/text_rows.h"
 
 #include <Eigen/Dense>
@@ -54,6 +55,16 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
   Project& project = report.project;
   project.path = o.folder;
   project.frame.description = "COLMAP model frame as given";
+  if (!o.crs.empty()) {
+    const CrsConverter crs(CrsOptions{o.crs, "", "", "--crs"});
+    if (crs.axes() == CrsConverter::Axes::kGeographic)
+      throw InputError("--crs " + o.crs + ": a COLMAP model is Cartesian; give its geocentric (e.g. "
+                       "EPSG:4978 after model_aligner --ref_is_gps) or projected CRS");
+    project.frame.kind = FrameSpec::Kind::kCrs;
+    project.frame.crs = o.crs;
+    project.frame.description = "crs " + o.crs;
+    project.frame.source = "--crs";
+  }
   const std::string cameras_file = o.folder + "/cameras.txt",
                     images_file = o.folder + "/images.txt",
                     points_file = o.folder + "/points3D.txt";

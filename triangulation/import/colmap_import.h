@@ -28,6 +28,10 @@ struct ColmapImportOptions {
   std::string folder;            // holding cameras.txt, images.txt, points3D.txt
   double pixel_size_mm = 0.001;  // COLMAP has no pixel size; any value gives the same geometry
   double sigma_px = 1.0;         // a-priori sigma of the image measurements, > 0
+  /// CRS of a georeferenced model (model_aligner: ECEF "EPSG:4978", or a projected CRS); the
+  /// project gets frame: {crs: ...} and attitudes are relative to that CRS's axes. A geographic
+  /// CRS is refused (a COLMAP model is Cartesian). Empty: the model frame as given.
+  std::string crs;
 };
 
 struct ColmapImportReport {

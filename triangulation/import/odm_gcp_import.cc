@@ -2,6 +2,8 @@
 
 #include "calib/core/error.h"
 #include "calib/core/log.h"
+#include "triangulation/adjustment/nadir_start.h"
+#include "triangulation/georef/object_frame.h"
 #include "triangulation/import/text_rows.h"
 
 #include <algorithm>
@@ -30,15 +32,22 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
       lower.find("lonlat") != std::string::npos || lower.find("latlon") != std::string::npos ||
       lower.find("4326") != std::string::npos || lower.find("4979") != std::string::npos ||
       lower == "wgs84" || lower == "wgs 84";
-  if (geographic)
+  if (geographic && o.crs.empty())
     ThrowInputError({o.gcp_list, rows.front().line},
                     "geographic GCP coordinates (" + projection +
-                        "): give a projected list or a project with frame: {local: ...}");
+                        "): give their CRS (--crs EPSG:4326, longitude first) or a projected list");
   Project project;
   project.path = o.gcp_list;
   project.cameras["cam1"] = o.camera;
   project.frame.kind = FrameSpec::Kind::kProjected;
   project.frame.description = projection;
+  if (!o.crs.empty()) {
+    project.frame.kind = FrameSpec::Kind::kCrs;
+    project.frame.crs = o.crs;
+    project.frame.description = "crs " + o.crs;
+    project.frame.source = "--crs";
+    (void)ObjectFrame(project.frame);  // an unknown CRS or a missing grid: exit 2 here
+  }
   std::map<std::string, GroundPoint> points;
   for (size_t i = 1; i < rows.size(); ++i) {
     const auto& row = rows[i];
@@ -99,6 +108,23 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
   project.observations = std::move(kept);
   for (auto& [id, p] : points) project.points.push_back(p);
   return project;
+}
+
+Project WithNadirStart(const Project& project, const std::string& camera) {
+  if (project.frame.kind != FrameSpec::Kind::kCrs) {
+    Project out = project;
+    out.exposures = NadirStartFromControl(project, camera);
+    return out;
+  }
+  const ObjectFrame frame(project.frame);
+  Project local = ToAdjustmentFrame(project, frame);
+  local.exposures = NadirStartFromControl(local, camera);
+  // Only the new exposures are converted back: the points stay exactly as listed.
+  const Project converted = FromAdjustmentFrame(local, frame);
+  Project out = project;
+  out.exposures = converted.exposures;
+  out.frame = converted.frame;  // with the origin fixed at the block centre
+  return out;
 }
 
 }  // namespace aerocal::triangulation

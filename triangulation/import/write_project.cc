@@ -2,6 +2,7 @@
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/log.h"
 
@@ -22,6 +23,19 @@ std::string Quoted(const std::string& text) {
 }
 
 }  // namespace
+
+std::string FrameYaml(const FrameSpec& f) {
+  if (f.kind != FrameSpec::Kind::kCrs) return "frame: {projected: " + Quoted(f.description) + "}";
+  std::string yaml = "frame: {crs: " + Quoted(f.crs);
+  if (!f.vertical.empty()) yaml += ", vertical: " + Quoted(f.vertical);
+  if (!f.geoid_grid.empty()) yaml += ", geoid_grid: " + Quoted(f.geoid_grid);
+  if (!f.points_crs.empty()) yaml += ", points_crs: " + Quoted(f.points_crs);
+  if (!f.exposures_crs.empty()) yaml += ", exposures_crs: " + Quoted(f.exposures_crs);
+  if (f.has_origin)
+    yaml += ", origin: {lat: " + FormatNumber(f.lat_deg, 15) + ", lon: " +
+            FormatNumber(f.lon_deg, 15) + ", h: " + FormatNumber(f.h_m, 10) + "}";
+  return yaml + "}";
+}
 
 Project UsableImportedBlock(const Project& project, const std::string& source) {
   Project out = project;
@@ -57,7 +71,7 @@ void WriteProjectFolder(const Project& project, const std::string& folder) {
   WriteObservations(folder + "/observations.csv", project.observations);
   WritePoints(folder + "/points.csv", project.points);
   yaml += "exposures: exposures.csv\nobservations: observations.csv\npoints: points.csv\n";
-  yaml += "frame: {projected: " + Quoted(project.frame.description) + "}\n";
+  yaml += FrameYaml(project.frame) + "\n";
   WriteFileAtomically(folder + "/project.yaml", yaml);
 }
 

@@ -14,6 +14,9 @@ namespace aerocal::triangulation {
 /// observations, fewer than two observed exposures, a camera without a usable format).
 Project UsableImportedBlock(const Project& project, const std::string& source);
 
+/// The `frame:` line of project.yaml for the frame (crs: with its keys; else projected: TEXT).
+std::string FrameYaml(const FrameSpec& frame);
+
 /// Every file is written atomically; the folder is created when missing.
 void WriteProjectFolder(const Project& project, const std::string& folder);
 
