@@ -151,8 +151,8 @@ CommandRun SetupAdjust(CLI::App& app) {
       ->check(FiniteRange(0.0, 0.999));
   app.add_option("--critical-value",
                  args->options.snooping_critical_value,
-                 "Critical |w| of data snooping (0: from alpha = 5 % / n)")
-      ->check(FiniteRange(0, 1000));
+                 "Critical |w| of data snooping (0: from alpha = 5 % / n; 1e6: never reject)")
+      ->check(FiniteRange(0, 1e9));
   app.add_flag("--no-eo-priors",
                args->no_eo_priors,
                "Ignore the GNSS/IMU sigma columns of exposures.csv (starting values only)");

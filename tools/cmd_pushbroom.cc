@@ -143,7 +143,13 @@ int RunControl(ControlArgs& a) {
   // The L1 image's size comes from --mean-height-m and --gsd-m: bounded before anything is allocated
   // (a plane far from the terrain gave a footprint of millions of cells per side).
   {
-    const auto grid = triangulation::MakeL1Grid(camera, pos, a.options.mean_height_m, a.options.gsd_m);
+    triangulation::L1Grid grid;
+    try {
+      grid = triangulation::MakeL1Grid(camera, pos, a.options.mean_height_m, a.options.gsd_m);
+    } catch (const InputError& e) {  // its messages say "pos.csv" for any POS file: name the inputs
+      throw InputError(std::string(e.what()) + " (--pos " + a.pos + ", --camera " + a.camera +
+                       ", --mean-height-m " + FormatNumber(a.options.mean_height_m) + ")");
+    }
     const double cells = double(grid.width) * double(grid.height);
     if (!(cells <= kMaxL1Cells))
       throw ConfigError("--mean-height-m / --gsd-m: the L1 image would have " + std::to_string(grid.width) + " x " +

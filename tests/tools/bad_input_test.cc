@@ -780,7 +780,7 @@ const std::vector<Case>& Cases() {
        [](const TempDir& d) {
          return PushbroomArgs(PushbroomFlight(d)) + " --boresight weighted --boresight-sigma-deg -0.01";
        },
-       2, "--boresight-sigma-deg must be > 0 when --boresight is weighted (got -0.01)", "pb/r.json"},
+       2, "--boresight-sigma-deg: must be in (0, 180] (got -0.01)", "pb/r.json"},
       {"rig_reference_head_unknown",
        [](const TempDir& d) {
          const auto rig = RigFlight(d);
@@ -841,10 +841,10 @@ const std::vector<Case>& Cases() {
        2, "--relief-m must be within [0, ", "uav4/stitch.json"},
       {"rig_stitch_increment_sigma_zero",
        [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--increment-sigma-arcsec 0"); },
-       2, "--increment-sigma-arcsec must be > 0", "uav4/stitch.json"},
+       2, "--increment-sigma-arcsec: must be in (0, 36000] (got 0)", "uav4/stitch.json"},
       {"rig_stitch_dt_sigma_negative",
        [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--dt-sigma-ms -1"); },
-       2, "--dt-sigma-ms must be > 0", "uav4/stitch.json"},
+       2, "--dt-sigma-ms: must be in (0, 10000] (got -1)", "uav4/stitch.json"},
       {"rig_stitch_alpha_one",
        [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--alpha 1"); },
        2, "--alpha must be within (0, 1)", "uav4/stitch.json"},
@@ -892,13 +892,13 @@ const std::vector<Case>& Cases() {
          const auto line = Uav4Line(d);
          return RigStitchArgs(line, "--images " + line + " --stitched-out " + line + "/st --feather-px 0");
        },
-       2, "--feather-px must be within 1..255 (got 0)", "uav4/st"},
+       2, "--feather-px: must be in [1, 255] (got 0)", "uav4/st"},
       {"simulate_rig_format_scale_zero",
        [](const TempDir& d) { return "simulate --rig uav4 --format-scale 0 --out " + d.File("o"); },
-       2, "--format-scale must be within (0, 1]", "o"},
+       2, "--format-scale: must be in (0, 1]", "o"},
       {"simulate_rig_format_scale_above_one",
        [](const TempDir& d) { return "simulate --rig uav4 --format-scale 1.5 --out " + d.File("o"); },
-       2, "--format-scale must be within (0, 1]", "o"},
+       2, "--format-scale: must be in (0, 1]", "o"},
       {"simulate_format_scale_without_rig",
        [](const TempDir& d) { return "simulate --format-scale 0.5 --out " + d.File("o"); },
        2, "--format-scale applies to a rig flight (--rig) only", "o"},
@@ -1154,13 +1154,13 @@ const std::vector<Case>& Cases() {
 #define AEROCAL_TEST_FIELD_CASE(name, options, expect)                                         \
   {name, [](const TempDir& d) { return "simulate --test-field --out " + d.File("o") + " " + (options); }, \
    2, (expect), "o"}
-      AEROCAL_TEST_FIELD_CASE("test_field_groups_zero", "--groups 0", "--groups: Value 0 not in range"),
-      AEROCAL_TEST_FIELD_CASE("test_field_groups_27", "--groups 27", "--groups: Value 27 not in range"),
+      AEROCAL_TEST_FIELD_CASE("test_field_groups_zero", "--groups 0", "--groups: must be in [1, 26] (got 0)"),
+      AEROCAL_TEST_FIELD_CASE("test_field_groups_27", "--groups 27", "--groups: must be in [1, 26] (got 27)"),
       AEROCAL_TEST_FIELD_CASE("test_field_groups_not_integer", "--groups 2.5", "--groups"),
-      AEROCAL_TEST_FIELD_CASE("test_field_images_per_group_3", "--images-per-group 3", "--images-per-group: Value 3 not in range"),
+      AEROCAL_TEST_FIELD_CASE("test_field_images_per_group_3", "--images-per-group 3", "--images-per-group: must be in [4, 1000] (got 3)"),
       AEROCAL_TEST_FIELD_CASE("test_field_distance_nan", "--distance-m nan", "--distance-m: must be a finite number"),
       AEROCAL_TEST_FIELD_CASE("test_field_distance_inf", "--distance-m inf", "--distance-m"),
-      AEROCAL_TEST_FIELD_CASE("test_field_distance_zero", "--distance-m 0", "--distance-m: Value 0 not in range"),
+      AEROCAL_TEST_FIELD_CASE("test_field_distance_zero", "--distance-m 0", "--distance-m: must be in [1, 1000] (got 0)"),
       AEROCAL_TEST_FIELD_CASE("test_field_survey_sigma_zero", "--survey-sigma-m 0", "--survey-sigma-m"),
       AEROCAL_TEST_FIELD_CASE("test_field_image_noise_negative", "--image-noise-px -1", "--image-noise-px"),
       AEROCAL_TEST_FIELD_CASE("test_field_image_sigma_nan", "--image-sigma-px nan", "--image-sigma-px: must be a finite number"),
