@@ -267,6 +267,14 @@ const std::vector<Case>& Cases() {
                 pb + "/observations.csv --points " + pb + "/points.csv --reference -2 --out " + d.File("r.json");
        },
        2, "--reference", "r.json"},
+      {"pushbroom_empty_subcamera_id",
+       [](const TempDir& d) {
+         const std::string pb = PushbroomFlight(d);
+         ReplaceFirst(pb + "/camera_nominal.yaml", "{id: L,", "{id: '',");
+         return "pushbroom calibrate --camera " + pb + "/camera_nominal.yaml --pos " + pb + "/pos.csv --observations " +
+                pb + "/observations.csv --points " + pb + "/points.csv --out " + d.File("r.json");
+       },
+       2, "camera_nominal.yaml:9: sub-camera id must not be empty", "r.json"},
       {"pushbroom_sigma_negative",
        [](const TempDir& d) {
          const std::string pb = PushbroomFlight(d);
