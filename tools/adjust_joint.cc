@@ -10,6 +10,7 @@
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
 #include "triangulation/joint/joint_adjustment.h"
@@ -57,7 +58,7 @@ void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args) {
       ->needs(joint);
   app.add_option("--stitch-sigma-px", args->stitch_sigma_px,
                  "Joint adjustment: stitching sigma where the stitching file has none, px")
-      ->check(CLI::PositiveNumber)
+      ->check(PositiveUpTo(100))
       ->needs(joint);
 }
 

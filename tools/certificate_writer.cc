@@ -4,13 +4,16 @@
 // YAML the user fills, the result, the comparison with a previous certificate or result against
 // tolerances. Deterministic: no clock, no random numbers (the date comes from the lab file).
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
+#include "calib/core/json_schema.h"
 #include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
+#include "tools/output_set.h"
 #include "tools/python_script.h"
 #include "triangulation/calibration/distortion_figure.h"
 #include "triangulation/calibration/uncertainty_budget.h"
@@ -41,6 +44,36 @@ std::map<std::string, double> ReadTolerances(const std::string& path) {
   return out;
 }
 
+// The schema of the certificate's inputs (docs/schema/certificate_inputs.schema.json) rooted at
+// one of its definitions.
+nlohmann::json InputSchema(const std::string& definition) {
+  static const nlohmann::json schema =
+      ReadJsonSchema(std::string(AEROCAL_SCHEMA_DIR) + "/certificate_inputs.schema.json");
+  return {{"$ref", "#/definitions/" + definition}, {"definitions", schema.at("definitions")}};
+}
+
+// Every row of an uncertainty table (validated by the schema) must state what its numbers say:
+// the statement is the one CertificateStatement gives for value, U, k and unit, and U = k u_c. A
+// row whose statement quotes other numbers than its value and U is refused, never printed.
+void CheckStatements(const nlohmann::json& rows, const std::string& file, const std::string& path) {
+  for (size_t i = 0; i < rows.size(); ++i) {
+    const nlohmann::json& q = rows[i];
+    const std::string at = file + ": " + path + "[" + std::to_string(i) + "]";
+    const double big_u = q["U"].is_number() ? q["U"].get<double>() : NAN;
+    const std::string expected = triangulation::CertificateStatement(
+        q["quantity"].get<std::string>(), q["value"].get<double>(), big_u, q["k"].get<double>(),
+        q["unit"].get<std::string>());
+    if (q["statement"].get<std::string>() != expected)
+      throw InputError(at + ".statement: '" + q["statement"].get<std::string>() +
+                       "' does not state the row's value, U, k and unit ('" + expected + "')");
+    if (q.contains("u_c") && q["u_c"].is_number() && std::isfinite(big_u)) {
+      const double k_u_c = q["k"].get<double>() * q["u_c"].get<double>();
+      if (!(std::abs(big_u - k_u_c) <= 1e-9 * std::max(1e-300, big_u)))
+        throw InputError(at + ".U: " + FormatNumber(big_u) + " is not k u_c = " + FormatNumber(k_u_c));
+    }
+  }
+}
+
 // The uncertainty table of a calibrate result or of a certificate.json.
 const nlohmann::json* Uncertainty(const nlohmann::json& doc) {
   if (doc.contains("results") && doc["results"].is_array()) return &doc["results"];
@@ -50,7 +83,7 @@ const nlohmann::json* Uncertainty(const nlohmann::json& doc) {
 }
 
 nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous,
-                       const std::map<std::string, double>& tolerances) {
+                       const std::map<std::string, double>& tolerances, const std::string& previous_file) {
   nlohmann::json rows = nlohmann::json::array();
   bool all_pass = true;
   std::map<std::string, nlohmann::json> old;
@@ -59,6 +92,9 @@ nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous
     const std::string name = q.at("quantity");
     const auto o = old.find(name);
     if (o == old.end()) continue;
+    if (q.value("unit", "") != o->second.value("unit", ""))
+      throw InputError(previous_file + ": quantity " + name + " is in " + o->second.value("unit", "") +
+                       ", the result's in " + q.value("unit", "") + " (--previous)");
     const double v = q.at("value"), v_old = o->second.at("value");
     const nlohmann::json big_u = q.value("U", nlohmann::json()),
                          big_u_old = o->second.value("U", nlohmann::json());
@@ -306,6 +342,9 @@ int WriteCertificate(const CertificateArgs& args) {
     if (!result.is_object() || result.value("command", "") != "calibrate" ||
         !result.contains("calibration"))
       throw InputError(args.result + ": not a result of `aerocal calibrate` (--result)");
+    // Through its schema (key path in the message), and every statement against its numbers.
+    ValidateJson(result, InputSchema("calibrate_result"), args.result);
+    CheckStatements(result["calibration"]["uncertainty"], args.result, "calibration.uncertainty");
     const nlohmann::json& cal = result["calibration"];
     cert["kind"] = "certificate";
     cert["lab"] = lab;
@@ -352,31 +391,42 @@ int WriteCertificate(const CertificateArgs& args) {
       const nlohmann::json* old = Uncertainty(previous);
       if (!old)
         throw InputError(args.previous + ": neither a certificate.json nor a calibrate result (--previous)");
-      cert["comparison"] = Compare(cert["results"], *old, tolerances);
+      ValidateJson(previous, InputSchema("previous"), args.previous);
+      CheckStatements(*old, args.previous, previous.contains("results") ? "results" : "calibration.uncertainty");
+      cert["comparison"] = Compare(cert["results"], *old, tolerances, args.previous);
       cert["comparison"]["previous"] = args.previous;
       if (previous.contains("lab"))
         cert["comparison"]["previous_certificate"] = previous["lab"].at("certificate");
       return cert["comparison"]["pass"].get<bool>();
     });
   }
-  fs::create_directories(args.out);
-  const std::string json_path = (fs::path(args.out) / "certificate.json").string();
+  // certificate.json, .html and .pdf are one set (tools/output_set.h): all are written into a
+  // staging folder and moved into args.out only when every part was written, so a failing
+  // renderer replaces nothing of the previous certificate.
+  OutputSet set(args.out);
+  const std::string json_path = set.Staged("certificate.json");
   WriteResult(json_path, "certificate", cert);
-  std::printf("certificate data -> %s\n", json_path.c_str());
-  for (const auto& statement : statements) std::printf("  %s\n", statement.c_str());
-  if (cert.contains("comparison"))
-    std::printf("comparison with %s: %s\n", args.previous.c_str(), comparison_pass ? "pass" : "FAIL");
   if (!args.no_render) {
     const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
     const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
-    if (!RunPythonScript(script, {json_path, args.out})) {
-      std::fprintf(stderr, "error: the certificate could not be rendered (%s); certificate.json is complete\n",
-                   PythonCommandLine(script, {json_path, args.out}).c_str());
+    if (!RunPythonScript(script, {json_path, set.staging()})) {
+      std::fprintf(stderr, "error: the certificate could not be rendered (%s); nothing written, the "
+                   "previous certificate in %s is left as it was\n",
+                   PythonCommandLine(script, {json_path, set.staging()}).c_str(), args.out.c_str());
       return kExitInternal;
     }
+    set.Commit({"certificate.json", "certificate.html", "certificate.pdf"});
+  } else {
+    // certificate.json alone: an .html / .pdf of a previous certificate would not describe it.
+    set.Commit({"certificate.json"}, {"certificate.html", "certificate.pdf"});
+  }
+  std::printf("certificate data -> %s\n", set.Final("certificate.json").c_str());
+  for (const auto& statement : statements) std::printf("  %s\n", statement.c_str());
+  if (cert.contains("comparison"))
+    std::printf("comparison with %s: %s\n", args.previous.c_str(), comparison_pass ? "pass" : "FAIL");
+  if (!args.no_render)
     std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", args.out.c_str(),
                 args.out.c_str());
-  }
   const bool ok = valid && comparison_pass;
   return ok ? kExitOk : kExitNotConverged;
 }

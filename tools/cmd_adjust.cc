@@ -8,6 +8,7 @@
 #include "tools/adjust_joint.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 #include "tools/suspect_effect_option.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/conventional_reference.h"
@@ -123,7 +124,7 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option("--sigma-px",
                  args->default_sigma_px,
                  "Image sigma where observations.csv has no sigma_px, px")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(100));
   app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
   app.add_flag("--robust-start",
                args->options.robust_start,
@@ -137,21 +138,21 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->options.max_rejections,
                  "Rejection cap of data snooping; reaching it is a warning and exit 3 (default: 10 % of the "
                  "tested image observations, at least 100)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1e7));
   app.add_option("--max-sigma0",
                  args->options.max_sigma0,
                  "A result with sigma0 above this is not valid (exit 3)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1e6));
   AddSuspectEffectOption(app, &args->options.suspect_effect_limit);
   app.add_option("--min-redundancy",
                  args->options.min_redundancy,
                  "Redundancy number below which an observation is weakly controlled: reported, "
                  "never rejected")
-      ->check(CLI::Range(0.0, 0.999));
+      ->check(FiniteRange(0.0, 0.999));
   app.add_option("--critical-value",
                  args->options.snooping_critical_value,
-                 "Critical |w| of data snooping (0: from alpha = 5 % / n)")
-      ->check(CLI::NonNegativeNumber);
+                 "Critical |w| of data snooping (0: from alpha = 5 % / n; 1e6: never reject)")
+      ->check(FiniteRange(0, 1e9));
   app.add_flag("--no-eo-priors",
                args->no_eo_priors,
                "Ignore the GNSS/IMU sigma columns of exposures.csv (starting values only)");
@@ -159,37 +160,37 @@ CommandRun SetupAdjust(CLI::App& app) {
                args->no_interior_sigma,
                "Ignore the camera file's interior_sigma (unweighted self-calibration)");
   app.add_option("--max-iterations", args->options.solver.max_iterations, "Solver iterations")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1e5));
   app.add_option("--correlation-threshold",
                  args->options.correlation_threshold,
                  "Report parameter pairs correlated above this")
-      ->check(CLI::Range(0.0, 1.0));
+      ->check(FiniteRange(0.0, 1.0));
   app.add_option("--lever-arm-m", args->lever_arm_m,
                  "GNSS lever arm a (projection centre -> antenna, camera frame), m, \"X,Y,Z\": its "
-                 "value (fixed) or start (free, weighted)")
+                 "value (fixed) or start (free, weighted)")->check(FiniteRange(-1000, 1000))
       ->delimiter(',')
       ->expected(3);
   app.add_option("--lever-arm", args->lever_arm, "Lever arm: fixed (default) | free | weighted");
   app.add_option("--lever-arm-sigma-m", args->lever_arm_sigma_m,
                  "Lever arm sigma per axis when weighted, m")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1000));
   app.add_option("--boresight-deg", args->boresight_deg,
-                 "Boresight misalignment M (IMU attitude = R M^T), omega,phi,kappa deg")
+                 "Boresight misalignment M (IMU attitude = R M^T), omega,phi,kappa deg")->check(FiniteRange(-360, 360))
       ->delimiter(',')
       ->expected(3);
   app.add_option("--boresight", args->boresight, "Boresight: fixed (default) | free | weighted");
   app.add_option("--boresight-sigma-deg", args->boresight_sigma_deg,
                  "Boresight sigma per angle when weighted, deg")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(180));
   app.add_option("--gnss-time-offset-ms", args->time_offset_ms,
                  "GNSS time offset dt (GNSS position = antenna at exposure time + dt; needs vX, vY, "
                  "vZ in exposures.csv), ms")
-      ->check(CLI::Range(-1e4, 1e4));
+      ->check(FiniteRange(-1e4, 1e4));
   app.add_option("--gnss-time-offset", args->time_offset,
                  "GNSS time offset: fixed (default) | free | weighted");
   app.add_option("--gnss-time-offset-sigma-ms", args->time_offset_sigma_ms,
                  "GNSS time offset sigma when weighted, ms")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1e4));
   AddJointAdjustOptions(app, &args->joint);
   // The rig bundle (a project whose camera file has a `rig` section): which rig parameters of the
   // non-reference heads are estimated.
@@ -209,7 +210,7 @@ CommandRun SetupAdjust(CLI::App& app) {
       app.add_option("--rig-increment-sigma-arcsec",
                      args->rig.increment_sigma_arcsec,
                      "Rig: sigma of weighted increments around zero, arcsec")
-          ->check(CLI::PositiveNumber),
+          ->check(PositiveUpTo(36000)),
       app.add_option("--rig-time-offsets",
                      args->rig.time_offsets,
                      "Rig: exposure time offset dT_k of each non-reference head: fixed (zero, "
@@ -218,7 +219,7 @@ CommandRun SetupAdjust(CLI::App& app) {
       app.add_option("--rig-time-offset-sigma-ms",
                      args->rig.time_offset_sigma_ms,
                      "Rig: sigma of weighted time offsets around zero, ms")
-          ->check(CLI::PositiveNumber)};
+          ->check(PositiveUpTo(1e4))};
   // The command line's platform options over the project's `platform:`.
   auto apply_platform = [args, &app](triangulation::PlatformSpec* p) -> bool {
     auto given = [&](const char* name) { return app.count(name) > 0; };

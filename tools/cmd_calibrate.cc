@@ -11,6 +11,7 @@
 #include "tools/board_detection.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 #include "tools/suspect_effect_option.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/calibration/calibration.h"
@@ -181,13 +182,13 @@ CommandRun SetupCalibrate(CLI::App& app) {
   app.add_option("--radii-mm", args->radii_mm,
                  "Radii of the certified distortion values, mm (default: 1/4 .. 4/4 of the half "
                  "diagonal)")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1e4));
   app.add_option("--sigma-px", args->sigma_px,
                  "Image sigma where observations.csv has no sigma_px, and of detected marks, px")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(100));
   app.add_option("--board-sigma-mm", args->board_sigma_mm,
                  "Sigma of the board's design coordinates (print accuracy), mm")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(100));
   app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
   AddSuspectEffectOption(app, &args->suspect_effect_limit);
   app.add_flag("--no-closed-form", args->no_closed_form,

@@ -1,5 +1,6 @@
 // aerocal flight: the whole calibration workflow of one flight, with a report for people
 // (triangulation/workflow/flight_workflow.h; report by tools/report/aerocal_report.py).
+#include <algorithm>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -13,6 +14,7 @@
 #include "tools/camera_formats.h"
 #include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 #include "tools/suspect_effect_option.h"
 #include "tools/python_script.h"
 #include "triangulation/adjustment/adjust_options.h"
@@ -37,7 +39,7 @@ CommandRun SetupFlight(CLI::App& app) {
   app.add_option("--out", args->out, "Report folder: result.json, report.html, camera_calibrated.yaml")->required();
   app.add_option("--base", args->base, "Base sub-images holding the datum of the focal plane (default: reference points)");
   app.add_option("--stitch-sigma-px", args->options.stitch_sigma_px, "Stitching sigma where the file has none, px")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(100));
   app.add_flag("--no-joint", [args](std::int64_t) { args->options.joint = false; }, "Skip the joint adjustment");
   app.add_option("--joint-model", args->joint_model,
                  "Mapping model of the joint adjustment: translation | conformal | affine | projective | auto "
@@ -65,6 +67,18 @@ CommandRun SetupFlight(CLI::App& app) {
     if (args->certificate) ReadCertificateLab(args->lab);  // a bad lab file before the flight runs
     if (!args->camera_format.empty()) FindCameraFormat(args->camera_format, "--camera-format");
     args->options.base_ids = SplitCommaList(args->base);
+    // Every --base id names a sub-image of the camera (the stitching step would otherwise fail
+    // inside the workflow and the flight go on without it).
+    if (!args->options.base_ids.empty()) {
+      const calib::Camera camera = calib::ReadCamera(args->options.camera_file);
+      std::string known;
+      for (const auto& s : camera.subimages) known += (known.empty() ? "" : ", ") + s.id;
+      for (const auto& id : args->options.base_ids)
+        if (std::none_of(camera.subimages.begin(), camera.subimages.end(),
+                         [&](const calib::SubimageMapping& s) { return s.id == id; }))
+          throw ConfigError("--base: sub-image '" + id + "' is not in " + args->options.camera_file +
+                            " (sub-images: " + (known.empty() ? "none" : known) + ")");
+    }
     args->options.joint_model = triangulation::ParseJointModel(args->joint_model);
     args->options.choose_free_set = args->self_calibration == "auto";
     if (!args->options.choose_free_set) {

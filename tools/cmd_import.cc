@@ -5,6 +5,8 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
+#include "triangulation/adjustment/nadir_start.h"
 #include "triangulation/import/colmap_import.h"
 #include "triangulation/import/dbat_import.h"
 #include "triangulation/import/odm_gcp_import.h"
@@ -34,8 +36,8 @@ CommandRun SetupImport(CLI::App& app) {
   auto c = std::make_shared<triangulation::ColmapImportOptions>();
   colmap->add_option("--model", c->folder, "Folder of the text model")->required();
   colmap->add_option("--pixel-size-mm", c->pixel_size_mm, "Pixel size, mm (COLMAP has none)")
-      ->check(CLI::PositiveNumber);
-  colmap->add_option("--sigma-px", c->sigma_px, "Image sigma, px")->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1));
+  colmap->add_option("--sigma-px", c->sigma_px, "Image sigma, px")->check(PositiveUpTo(100));
   colmap->add_option("--crs", c->crs,
                      "CRS of a georeferenced model (EPSG:4978 after model_aligner, or a "
                      "projected CRS): the project gets frame: {crs: ...}");
@@ -63,10 +65,10 @@ CommandRun SetupImport(CLI::App& app) {
   dbat->add_option(
       "--photomodeler-export", d->photomodeler_export, "PhotoModeler bundle export (stations)");
   dbat->add_option("--sigma-px", d->default_sigma_px, "Sigma where the marks have none, px")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(100));
   dbat->add_option(
           "--control-sigma-m", d->control_sigma_m, "Control sigma where the file has none, m")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1000));
   dbat->add_option("--out", *out, "Output folder")->required();
   dbat->callback([=] {
     *run = [=] {
@@ -89,11 +91,11 @@ CommandRun SetupImport(CLI::App& app) {
                   *control,
                   "Control targets: comma-separated names, or a gcp_list whose targets are control "
                   "(the others become check points; default: all control)");
-  odm->add_option("--sigma-px", o->sigma_px, "Image sigma, px")->check(CLI::PositiveNumber);
+  odm->add_option("--sigma-px", o->sigma_px, "Image sigma, px")->check(PositiveUpTo(100));
   odm->add_option("--target-sigma-m", o->target_sigma_m, "Target survey sigma, m")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1000));
   odm->add_option("--pixel-scale", o->pixel_scale, "Full-format px per listed px")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1e6));
   odm->add_option("--crs", o->crs,
                   "CRS of the list's coordinates (EPSG code, compound EPSG:A+B, WKT or PROJ "
                   "string; longitude / easting first), e.g. EPSG:4326 for a WGS84 list: the "

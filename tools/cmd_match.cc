@@ -16,6 +16,7 @@
 #include "stitch/image_io/image_io.h"
 #include "stitch/matching/overlap_matcher.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 
 namespace aerocal::tools {
 namespace {
@@ -149,9 +150,9 @@ CommandRun Setup(CLI::App& app) {
   app.add_option("--lsm", args->lsm, "on | off: least-squares matching refinement")
       ->capture_default_str();
   app.add_option("--sigma", args->sigma_px,
-                 "sigma_px (px) written without LSM, and for rows of an appended file lacking it")
+                 "sigma_px (px) written without LSM, and for rows of an appended file lacking it")->check(PositiveUpTo(100))
       ->capture_default_str();
-  app.add_option("--cell", args->cell_px, "Grid cell along the strips (virtual px): one tie each")
+  app.add_option("--cell", args->cell_px, "Grid cell along the strips (virtual px): one tie each")->check(FiniteRange(1, 1e5))
       ->capture_default_str();
   app.add_flag("--append", args->append, "Add the frames to an existing --out file");
   return [args] { return RunMatch(*args); };

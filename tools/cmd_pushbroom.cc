@@ -12,6 +12,7 @@
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 #include "triangulation/block/block_io.h"
 #include "stitch/image_io/image_io.h"
 #include "triangulation/pushbroom/cloud_control.h"
@@ -119,6 +120,9 @@ int RunCalibrate(CalibrateArgs& a) {
   return result.valid && result.report.converged ? kExitOk : kExitNotConverged;
 }
 
+// Most cells of the L1 image of `pushbroom control` (two float maps and the image: about 1.2 GB).
+constexpr double kMaxL1Cells = 1e8;
+
 struct ControlArgs {
   std::string camera, pos, line_image, reference_camera, reference_exposures, reference_result,
       reference_images, out;
@@ -152,6 +156,26 @@ int RunControl(ControlArgs& a) {
   const auto exposures = a.reference_result.empty()
                              ? triangulation::ReadExposures(a.reference_exposures)
                              : triangulation::ReadAdjustedExposures(a.reference_result, &skipped);
+  // A list without a reference exposure (a header only) is bad input, not a failed control (exit 2).
+  if (exposures.empty())
+    throw InputError(a.reference_result.empty() ? a.reference_exposures + ":1: no reference exposure (a header only)"
+                                                : a.reference_result + ": no used reference exposure");
+  // The L1 image's size comes from --mean-height-m and --gsd-m: bounded before anything is allocated
+  // (a plane far from the terrain gave a footprint of millions of cells per side).
+  {
+    triangulation::L1Grid grid;
+    try {
+      grid = triangulation::MakeL1Grid(camera, pos, a.options.mean_height_m, a.options.gsd_m);
+    } catch (const InputError& e) {  // its messages say "pos.csv" for any POS file: name the inputs
+      throw InputError(std::string(e.what()) + " (--pos " + a.pos + ", --camera " + a.camera +
+                       ", --mean-height-m " + FormatNumber(a.options.mean_height_m) + ")");
+    }
+    const double cells = double(grid.width) * double(grid.height);
+    if (!(cells <= kMaxL1Cells))
+      throw ConfigError("--mean-height-m / --gsd-m: the L1 image would have " + std::to_string(grid.width) + " x " +
+                        std::to_string(grid.height) + " cells, at most " + FormatNumber(kMaxL1Cells) +
+                        " (the plane Z = " + FormatNumber(a.options.mean_height_m) + " m is far from the line footprint)");
+  }
   if (skipped > 0)
     std::printf("reference: %zu adjusted exposures of %s (%d not used by the adjustment, skipped)\n",
                 exposures.size(), a.reference_result.c_str(), skipped);
@@ -219,11 +243,11 @@ CommandRun Setup(CLI::App& app) {
   cal->add_option("--plot", args->plot,
                   "SVG: per sub-camera the errors along and across track against the detector with "
                   "the fitted polynomial and its sigma band");
-  cal->add_option("--sigma-px", args->sigma_px, "Image sigma where observations.csv gives none, px");
-  cal->add_option("--node-spacing", o.node_spacing_lines, "Spline nodes every N lines, >= 1");
+  cal->add_option("--sigma-px", args->sigma_px, "Image sigma where observations.csv gives none, px")->check(PositiveUpTo(100));
+  cal->add_option("--node-spacing", o.node_spacing_lines, "Spline nodes every N lines, >= 1")->check(FiniteRange(1, 1e6));
   cal->add_option("--degree", args->degree, "Detector polynomial degree: auto (Wald test) or 0 .. 5");
-  cal->add_option("--max-degree", o.max_degree, "Highest degree the test starts from, 0 .. 5");
-  cal->add_option("--degree-alpha", o.degree_test_alpha, "Significance of the degree test, (0, 0.5)");
+  cal->add_option("--max-degree", o.max_degree, "Highest degree the test starts from, 0 .. 5")->check(FiniteRange(0, 5));
+  cal->add_option("--degree-alpha", o.degree_test_alpha, "Significance of the degree test, (0, 0.5)")->check(FiniteRange(0, 0.5, true));
   cal->add_option("--datum", args->datum,
                   "gauge (default): exactly the rank defect of the problem as configured, on the "
                   "gauge directions of its null space (none with the POS priors on and the "
@@ -232,30 +256,32 @@ CommandRun Setup(CLI::App& app) {
                   "over-constrains, e.g. holds the scale the control determines) | none: no "
                   "datum (an undetermined problem is reported ill-posed)");
   cal->add_option("--reference", o.reference_subcamera,
-                  "Sub-camera index carrying the datum (-1: the middle one)");
+                  "Sub-camera index carrying the datum (-1: the middle one)")
+      ->check(FiniteRange(-1, 1000));
   cal->add_option("--gauge-threshold", o.gauge_threshold,
                   "Relative eigenvalue of the scaled normal matrix below which a direction is a "
-                  "gauge freedom, (0, 1e-3]");
+                  "gauge freedom, (0, 1e-3]")
+      ->check(FiniteRange(0, 1e-3, true));
   cal->add_flag("--free-c", o.free_c, "Estimate the principal distance (nearly a scale of the table)");
   cal->add_option("--pos-prior", args->pos_prior, "on | off: the POS sigmas as priors on the spline nodes");
-  cal->add_option("--pos-sigma-m", o.pos_sigma_m, "POS position sigma where pos.csv gives none, m");
-  cal->add_option("--pos-sigma-deg", o.pos_sigma_deg, "POS attitude sigma where pos.csv gives none, deg");
+  cal->add_option("--pos-sigma-m", o.pos_sigma_m, "POS position sigma where pos.csv gives none, m")->check(PositiveUpTo(1000));
+  cal->add_option("--pos-sigma-deg", o.pos_sigma_deg, "POS attitude sigma where pos.csv gives none, deg")->check(PositiveUpTo(180));
   cal->add_option("--boresight", args->boresight,
                   "Boresight (the camera file's mount): fixed (default) | free | weighted (around "
                   "the file's values by --boresight-sigma-deg)");
   cal->add_option("--boresight-sigma-deg", args->boresight_sigma_deg,
-                  "Sigma of each weighted boresight angle, deg, > 0");
+                  "Sigma of each weighted boresight angle, deg, > 0")->check(PositiveUpTo(180));
   cal->add_option("--lever-arm", args->lever_arm,
                   "Lever arm (the camera file's, body frame): fixed (default) | free | weighted "
                   "(around the file's values by --lever-arm-sigma-m)");
   cal->add_option("--lever-arm-sigma-m", o.lever_arm_sigma_m,
-                  "Sigma of each weighted lever-arm component, m, > 0");
+                  "Sigma of each weighted lever-arm component, m, > 0")->check(PositiveUpTo(1000));
   cal->add_flag("--time-offset", o.time_offset,
                 "Estimate a time offset of the line camera against the POS (shutter / POS "
                 "latency, s); determinable only through the POS priors "
                 "(time_offset_vs_along_track)");
   cal->add_option("--min-per-segment", o.min_observations_per_segment,
-                  "Fewer observations between two nodes: warning few_points_per_line");
+                  "Fewer observations between two nodes: warning few_points_per_line")->check(FiniteRange(0, 1e6));
   auto control_args = std::make_shared<ControlArgs>();
   auto& c = control_args->options;
   CLI::App* ctl = app.add_subcommand(
@@ -281,26 +307,26 @@ CommandRun Setup(CLI::App& app) {
       ->required();
   ctl->add_option("--out-dir", control_args->out,
                   "Writes observations.csv, points.csv, control.json (and l1.png)")->required();
-  ctl->add_option("--mean-height-m", c.mean_height_m, "Height of the L1 rectification plane, m");
-  ctl->add_option("--gsd-m", c.gsd_m, "L1 cell size, m (0: the POS line spacing)");
-  ctl->add_option("--map-step", c.map_step_px, "Exact L1 inverse every N cells, bilinear between, 1..64");
-  ctl->add_option("--template-half", c.template_half_px, "Half size of the matching template, 3..30 px");
-  ctl->add_option("--search-px", c.search_px, "Correlation search radius, L1 cells, 0..100");
-  ctl->add_option("--min-correlation", c.min_correlation, "Minimum correlation peak, 0..1");
-  ctl->add_option("--max-interest", c.foerstner.max_points, "Strongest Foerstner points kept on the L1 image");
+  ctl->add_option("--mean-height-m", c.mean_height_m, "Height of the L1 rectification plane, m")->check(FiniteRange(-500, 10000));
+  ctl->add_option("--gsd-m", c.gsd_m, "L1 cell size, m (0: the POS line spacing)")->check(FiniteRange(0, 1e4));
+  ctl->add_option("--map-step", c.map_step_px, "Exact L1 inverse every N cells, bilinear between, 1..64")->check(FiniteRange(1, 64));
+  ctl->add_option("--template-half", c.template_half_px, "Half size of the matching template, 3..30 px")->check(FiniteRange(3, 30));
+  ctl->add_option("--search-px", c.search_px, "Correlation search radius, L1 cells, 0..100")->check(FiniteRange(0, 100));
+  ctl->add_option("--min-correlation", c.min_correlation, "Minimum correlation peak, 0..1")->check(FiniteRange(0, 1));
+  ctl->add_option("--max-interest", c.foerstner.max_points, "Strongest Foerstner points kept on the L1 image")->check(FiniteRange(1, 1e6));
   ctl->add_option("--interest-spacing", c.foerstner.suppression_px,
-                  "Foerstner non-maximum suppression window (odd), L1 cells");
+                  "Foerstner non-maximum suppression window (odd), L1 cells")->check(FiniteRange(1, 101));
   ctl->add_option("--interest-weight", c.foerstner.weight_factor,
-                  "Foerstner threshold: weight above this times the mean weight");
-  ctl->add_option("--min-match-sigma-px", c.min_match_sigma_px, "Floor of the matching sigma, px");
-  ctl->add_option("--line-sigma-px", c.line_sigma_px, "Sigma written for the line-image observations, px");
-  ctl->add_option("--gross-error-alpha", c.gross_error_alpha, "Significance of the misclosure test");
-  ctl->add_option("--max-point-sigma-m", c.max_point_sigma_m, "Drop points less precise than this, m");
+                  "Foerstner threshold: weight above this times the mean weight")->check(FiniteRange(0, 1000));
+  ctl->add_option("--min-match-sigma-px", c.min_match_sigma_px, "Floor of the matching sigma, px")->check(PositiveUpTo(100));
+  ctl->add_option("--line-sigma-px", c.line_sigma_px, "Sigma written for the line-image observations, px")->check(PositiveUpTo(100));
+  ctl->add_option("--gross-error-alpha", c.gross_error_alpha, "Significance of the misclosure test")->check(FiniteRange(0, 0.5, true));
+  ctl->add_option("--max-point-sigma-m", c.max_point_sigma_m, "Drop points less precise than this, m")->check(PositiveUpTo(1e4));
   ctl->add_option("--line-outlier-k", c.line_outlier_k,
-                  "Line-side gross errors: off the smooth misclosure fit by more than k x 1.4826 MAD");
-  ctl->add_option("--line-outlier-min-px", c.line_outlier_min_px, "... and by more than this, px");
+                  "Line-side gross errors: off the smooth misclosure fit by more than k x 1.4826 MAD")->check(PositiveUpTo(1000));
+  ctl->add_option("--line-outlier-min-px", c.line_outlier_min_px, "... and by more than this, px")->check(PositiveUpTo(1e4));
   ctl->add_option("--min-points", control_args->min_points,
-                  "Fewer control points: warning too_few_control_points, exit 3");
+                  "Fewer control points: warning too_few_control_points, exit 3")->check(FiniteRange(0, 1e6));
   ctl->add_flag("--write-l1", control_args->write_l1, "Also write the L1 image (l1.png)");
   return [args, cal, control_args, ctl] {
     if (ctl->parsed()) return RunControl(*control_args);

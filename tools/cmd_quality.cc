@@ -18,6 +18,7 @@
 #include "stitch/quality/quality_json.h"
 #include "stitch/quality/slanted_edge.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 
 namespace aerocal::tools {
 namespace {
@@ -27,11 +28,11 @@ struct GroundArgs {
   double gsd_m = 0.0, gsd_sigma_m = 0.0, pixel_mm = 0.0;
   void Add(CLI::App* app) {
     app->add_option("--pixel-mm", pixel_mm, "Pixel size (mm): frequencies also in line pairs per mm")
-        ->check(CLI::PositiveNumber);
+        ->check(PositiveUpTo(1));
     app->add_option("--gsd-m", gsd_m, "Ground sample distance (m): frequencies as a ground resolved distance")
-        ->check(CLI::PositiveNumber);
+        ->check(PositiveUpTo(1e4));
     app->add_option("--gsd-sigma-m", gsd_sigma_m, "Standard uncertainty of the GSD (m), from the adjustment")
-        ->check(CLI::NonNegativeNumber);
+        ->check(FiniteRange(0, 1e4));
   }
   void Check() const {
     if (gsd_sigma_m > 0.0 && gsd_m <= 0.0) throw ConfigError("--gsd-sigma-m needs --gsd-m");
@@ -230,10 +231,10 @@ CommandRun Setup(CLI::App& app) {
                 "deg; repeat for more edges")
       ->required();
   m->add_option("--gamma", mtf->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
-      ->check(CLI::Range(1e-6, 10.0))
+      ->check(FiniteRange(1e-6, 10.0))
       ->capture_default_str();
   m->add_option("--oversampling", mtf->oversampling, "ESF bins per pixel (ISO 12233: 4)")
-      ->check(CLI::Range(2, 16))
+      ->check(FiniteRange(2, 16))
       ->capture_default_str();
   mtf->ground.Add(m);
   m->add_option("--flight-axis", mtf->flight_axis, "Image axis of the flight direction (x or y): names "
@@ -253,10 +254,10 @@ CommandRun Setup(CLI::App& app) {
   b->add_option("--bright", bars->bright, "Large bright reference area col,row,width,height")->required();
   b->add_option("--dark", bars->dark, "Large dark reference area col,row,width,height")->required();
   b->add_option("--threshold", bars->threshold, "Contrast transfer defining the limiting frequency, 0 < T < 1")
-      ->check(CLI::Range(1e-6, 1.0 - 1e-6))
+      ->check(FiniteRange(1e-6, 1.0 - 1e-6))
       ->capture_default_str();
   b->add_option("--gamma", bars->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
-      ->check(CLI::Range(1e-6, 10.0))
+      ->check(FiniteRange(1e-6, 10.0))
       ->capture_default_str();
   bars->ground.Add(b);
   b->add_option("--out", bars->out, "Result JSON (kind quality_bars, written atomically)")->required();

@@ -12,6 +12,7 @@
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/resample/virtual_image.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 #include "tools/image_sources.h"
 
 namespace aerocal::tools {
@@ -72,10 +73,10 @@ CommandRun Setup(CLI::App& app) {
   app.add_option("--images", args->images, "Sub-image files: I=a.tif,II=b.tif,...")->required();
   app.add_option("--out", args->out, "Virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
   app.add_option("--interp", args->interp, "bilinear | bicubic")->capture_default_str();
-  app.add_option("--fill", args->fill, "Grey value of pixels no sub-image covers")
+  app.add_option("--fill", args->fill, "Grey value of pixels no sub-image covers")->check(FiniteRange(0, 65535))
       ->capture_default_str();
   app.add_option("--strip-rows", args->strip_rows, "Rows per processing strip (memory bound), 1..65536")
-      ->check(CLI::Range(1, 65536))
+      ->check(FiniteRange(1, 65536))
       ->capture_default_str();
   app.add_flag("--bigtiff", args->bigtiff, "Write BigTIFF even when classic TIFF would do");
   return [args] { return RunResample(*args); };

@@ -35,6 +35,8 @@
 #include "stitch/rig/stitched_image.h"
 #include "stitch/image_io/image_io.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
+#include "tools/output_set.h"
 #include "tools/python_script.h"
 #include "tools/image_sources.h"
 #include "triangulation/block/block_io.h"
@@ -72,6 +74,8 @@ double FlyingHeight(const calib::Rig& rig, double given_m, const std::string& fi
   if (!(height_m > 0))
     throw ConfigError("--height-m: give the relative flying height (> 0 m; the rig file " + file +
                       " has no virtual.height_m)");
+  if (!(height_m >= 1 && height_m <= 1e5))
+    throw ConfigError("--height-m must be within 1 .. 100000 m (got " + FormatNumber(height_m) + ")");
   return height_m;
 }
 
@@ -89,6 +93,7 @@ nlohmann::json HeadCameraModels(const calib::Rig& rig) {
 }
 
 int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
+  CheckOutputFile(args.out, "--out");
   const calib::Rig rig = calib::ReadRig(args.camera);
   const stitch::ErrorLimits limits = stitch::ReadErrorLimits(args.limits);
   if (rig.heads.size() < 2)
@@ -101,7 +106,8 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
                         " has no virtual.height_m; give the relative flying height");
     height_m = *rig.virtual_camera.height_m;
   }
-  if (!(height_m > 0)) throw ConfigError("--height-m must be > 0 m");
+  if (!(height_m >= 1 && height_m <= 1e5))
+    throw ConfigError("--height-m must be within 1 .. 100000 m (got " + FormatNumber(height_m) + ")");
   if (!(limits.height_m < height_m))
     throw InputError(args.limits + ": the height limit (" + FormatNumber(limits.height_m) +
                      " m) must be below the flying height (" + FormatNumber(height_m) + " m)");
@@ -111,6 +117,9 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   if (args.bins < 1) throw ConfigError("--bins must be >= 1");
   if (args.grid < 0 || args.grid > 200) throw ConfigError("--grid must be within 1..200");
   if (!(args.relief_m >= 0)) throw ConfigError("--relief-m must be >= 0");
+  if (!(args.relief_m < height_m))
+    throw ConfigError("--relief-m: " + FormatNumber(args.relief_m) + " m of relief reaches the flying height (" +
+                      FormatNumber(height_m) + " m)");
 
   const int reference = rig.ReferenceIndex();
   const stitch::RigExposure nadir;
@@ -158,16 +167,31 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   stitch::ErrorAnalysisFiles files;
   std::unique_ptr<stitch::GridAnalysis> grid;
   stitch::TargetAnalysis target;
+  // A limit that breaks the conversion is a value of the limits file: the message names it.
+  const auto named = [&](const InputError& e) {
+    const std::string what = e.what();
+    return what.find("breaks the conversion") == std::string::npos
+               ? e
+               : InputError(args.limits + ": " + what + " (rig " + args.camera + ", H = " + FormatNumber(height_m) +
+                            " m)");
+  };
   if (args.grid > 0) {
-    grid = std::make_unique<stitch::GridAnalysis>(
-        stitch::AnalyseGrid(rig, height_m, limits, args.grid, args.samples, args.seed));
+    try {
+      grid = std::make_unique<stitch::GridAnalysis>(
+          stitch::AnalyseGrid(rig, height_m, limits, args.grid, args.samples, args.seed));
+    } catch (const InputError& e) {
+      throw named(e);
+    }
     if (grid->points.empty())
       throw InputError(args.camera + ": no grid point is seen by a non-reference head");
     target = grid->points[grid->worst];
     files.bound_map_csv = stem + "_bound_map.csv";
   } else {
-    target = stitch::AnalyseTarget(rig, height_m, limits, head, virtual_px, args.samples, args.seed,
-                                   true);
+    try {
+      target = stitch::AnalyseTarget(rig, height_m, limits, head, virtual_px, args.samples, args.seed, true);
+    } catch (const InputError& e) {
+      throw named(e);
+    }
     if (target.monte_carlo) files.histogram_csv = stem + "_histogram.csv";
   }
   if (!args.no_plots) {
@@ -177,13 +201,26 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   nlohmann::json doc = stitch::ErrorAnalysisToJson(rig, height_m, limits, target, grid.get(),
                                                    args.relief_m, files);
   doc["camera_models"] = HeadCameraModels(rig);
-  const fs::path folder = out.parent_path();
+  // The JSON, its CSV files and plots are one set (tools/output_set.h): staged, then moved into
+  // place together; a failing plot replaces nothing of an earlier analysis.
+  OutputSet set(out.parent_path().empty() ? "." : out.parent_path().string());
+  std::vector<std::string> parts = {out.filename().string()};
+  for (const std::string& name : {files.histogram_csv, files.bound_map_csv, files.histogram_png, files.bound_map_png})
+    if (!name.empty()) parts.push_back(name);
   if (!files.histogram_csv.empty())
-    WriteFileAtomically((folder / files.histogram_csv).string(),
-                        stitch::HistogramCsv(*target.monte_carlo, args.bins));
+    WriteFileAtomically(set.Staged(files.histogram_csv), stitch::HistogramCsv(*target.monte_carlo, args.bins));
   if (!files.bound_map_csv.empty())
-    WriteFileAtomically((folder / files.bound_map_csv).string(), stitch::BoundMapCsv(rig, *grid));
-  WriteResult(args.out, "rig_error_analysis", doc);
+    WriteFileAtomically(set.Staged(files.bound_map_csv), stitch::BoundMapCsv(rig, *grid));
+  const std::string staged_json = set.Staged(out.filename().string());
+  WriteResult(staged_json, "rig_error_analysis", doc);
+  const bool plots = !args.no_plots && !(files.histogram_png.empty() && files.bound_map_png.empty());
+  if (plots && !RunPythonScript(PlotScript(), {staged_json})) {
+    std::fprintf(stderr, "error: the plots could not be drawn (%s); nothing written, an earlier "
+                 "analysis in the folder is left as it was\n",
+                 PythonCommandLine(PlotScript(), {args.out}).c_str());
+    return kExitInternal;
+  }
+  set.Commit(parts);
 
   // Summary for people.
   std::printf("conversion error at virtual pixel (%.2f, %.2f) = head %s pixel (%.2f, %.2f), "
@@ -211,13 +248,6 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   if (grid)
     std::printf("grid %d x %d: %zu targets, worst shown above; %zu grid points unseen\n", args.grid,
                 args.grid, grid->points.size(), grid->unseen.size());
-  if (args.no_plots || (files.histogram_png.empty() && files.bound_map_png.empty()))
-    return kExitOk;
-  if (!RunPythonScript(PlotScript(), {args.out})) {
-    std::fprintf(stderr, "error: the plots could not be drawn (%s); %s and the CSV files are complete\n",
-                 PythonCommandLine(PlotScript(), {args.out}).c_str(), args.out.c_str());
-    return kExitInternal;
-  }
   return kExitOk;
 }
 
@@ -709,18 +739,18 @@ CommandRun Setup(CLI::App& app) {
       ->required();
   ea->add_option("--height-m", args->height_m,
                  "Relative flying height of the rectification plane, m (default: the rig file's "
-                 "virtual.height_m)");
+                 "virtual.height_m)")->check(FiniteRange(0, 1e5));
   ea->add_option("--target", args->target,
                  "HEAD:COL,ROW: a pixel of a non-reference head, carried into the virtual image by "
                  "the nominal rig (default: the centre of the first non-reference head)");
   ea->add_option("--virtual", args->virtual_px,
                  "COL,ROW: a virtual pixel, analysed in the first non-reference head that sees it");
-  ea->add_option("--grid", args->grid, "N: an N x N grid of virtual pixels (bound map)");
-  ea->add_option("--samples", args->samples, "Monte-Carlo samples per target (0: none)");
+  ea->add_option("--grid", args->grid, "N: an N x N grid of virtual pixels (bound map)")->check(FiniteRange(0, 200));
+  ea->add_option("--samples", args->samples, "Monte-Carlo samples per target (0: none)")->check(FiniteRange(0, 1e7));
   ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)")->check(SeedCheck());
-  ea->add_option("--bins", args->bins, "Histogram bins");
+  ea->add_option("--bins", args->bins, "Histogram bins")->check(FiniteRange(1, 10000));
   ea->add_option("--relief-m", args->relief_m,
-                 "Relief (m off the plane) whose displacement between heads is reported");
+                 "Relief (m off the plane) whose displacement between heads is reported")->check(FiniteRange(0, 1e4));
   ea->add_flag("--no-plots", args->no_plots, "Write JSON and CSV only (no PNG)");
   ea->add_option("--out", args->out,
                  "Result JSON; STEM_histogram.csv/.png or STEM_bound_map.csv/.png beside it")
@@ -733,18 +763,18 @@ CommandRun Setup(CLI::App& app) {
   cv->add_option("--images", convert->images, "Head images: A=a.tif,B=b.tif,...")->required();
   cv->add_option("--height-m", convert->height_m,
                  "Relative flying height of the rectification plane, m (default: the rig file's "
-                 "virtual.height_m)");
+                 "virtual.height_m)")->check(FiniteRange(0, 1e5));
   cv->add_option("--opk-deg", convert->opk_deg,
                  "Rig attitude omega,phi,kappa in degrees (matters for orientation: level)");
   cv->add_option("--out", convert->out, "Virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
   cv->add_option("--interp", convert->interp, "bilinear | bicubic");
-  cv->add_option("--fill", convert->fill, "Grey value of pixels no head covers");
-  cv->add_option("--strip-rows", convert->strip_rows, "Rows per processing strip (memory bound)");
+  cv->add_option("--fill", convert->fill, "Grey value of pixels no head covers")->check(FiniteRange(0, 65535));
+  cv->add_option("--strip-rows", convert->strip_rows, "Rows per processing strip (memory bound)")->check(FiniteRange(1, 65536));
   cv->add_option("--relief-m", convert->relief_m,
-                 "Relief (m off the plane) whose displacement between heads is reported");
+                 "Relief (m off the plane) whose displacement between heads is reported")->check(FiniteRange(0, 1e4));
   cv->add_flag("--bigtiff", convert->bigtiff, "Write BigTIFF even when classic TIFF would do");
   cv->add_option("--tile-px", convert->tile_px,
-                 "Tiled TIFF: square tiles of N x N px (a multiple of 16, 16..4096); 0: strips");
+                 "Tiled TIFF: square tiles of N x N px (a multiple of 16, 16..4096); 0: strips")->check(FiniteRange(0, 4096));
   cv->add_option("--dem", convert->dem,
                  "DEM (ESRI ASCII grid, object frame of the exposure) as the rectification surface; "
                  "the plane at --height-m stays the base of the maps");
@@ -755,11 +785,11 @@ CommandRun Setup(CLI::App& app) {
   ds->option_defaults()->always_capture_default();
   ds->add_option("--camera", design->camera, "Rig camera file (YAML with a rig section)")->required();
   ds->add_option("--height-m", design->height_m,
-                 "Relative flying height, m (default: the rig file's virtual.height_m)");
+                 "Relative flying height, m (default: the rig file's virtual.height_m)")->check(FiniteRange(0, 1e5));
   ds->add_option("--out", design->out, "Result JSON (optional; the summary is printed)");
   ds->add_option("--svg", design->svg, "Footprint plot (SVG, ground metres)");
   ds->add_option("--grid-cells", design->grid_cells,
-                 "Coverage grid cells along the longer side, 10..4000");
+                 "Coverage grid cells along the longer side, 10..4000")->check(FiniteRange(10, 4000));
   auto stitching = std::make_shared<StitchArgs>();
   CLI::App* st = app.add_subcommand(
       "stitch", "Self-calibrating stitching of a rig block: per-exposure attitude increments and "
@@ -778,21 +808,21 @@ CommandRun Setup(CLI::App& app) {
                  "(everything per exposure; correlations reported) | angles (dT held at 0)");
   st->add_option("--out", stitching->out, "Result JSON (kind rig_stitch)")->required();
   st->add_flag("--no-snooping", stitching->no_snooping, "No data snooping of the tie observations");
-  st->add_option("--alpha", stitching->alpha, "Family-wise level of the snooping, (0, 1)");
+  st->add_option("--alpha", stitching->alpha, "Family-wise level of the snooping, (0, 1)")->check(FiniteRange(0, 1, true));
   stitching->increment_sigma_option = st->add_option(
       "--increment-sigma-arcsec", stitching->increment_sigma_arcsec,
-      "Weighted prior (towards 0) on every increment angle, arcsec > 0 (default: none)");
+      "Weighted prior (towards 0) on every increment angle, arcsec > 0 (default: none)")->check(PositiveUpTo(36000));
   stitching->dt_sigma_option =
       st->add_option("--dt-sigma-ms", stitching->dt_sigma_ms,
-                     "Weighted prior (towards 0) on every time offset, ms > 0 (default: none)");
+                     "Weighted prior (towards 0) on every time offset, ms > 0 (default: none)")->check(PositiveUpTo(1e4));
   stitching->relief_option = st->add_option(
       "--relief-m", stitching->relief_m,
-      "Relief of the block off the plane (m); its displacement between heads is reported");
+      "Relief of the block off the plane (m); its displacement between heads is reported")->check(FiniteRange(-1e4, 1e4));
   st->add_option("--standard-radius-px", stitching->standard_radius_px,
-                 "A tie this close (virtual px) to a standard position of its zone counts for it");
-  st->add_option("--max-sigma0", stitching->max_sigma0, "sigma0 above: exit 3 (absurd), > 0");
+                 "A tie this close (virtual px) to a standard position of its zone counts for it")->check(PositiveUpTo(1e5));
+  st->add_option("--max-sigma0", stitching->max_sigma0, "sigma0 above: exit 3 (absurd), > 0")->check(PositiveUpTo(1e6));
   st->add_option("--sigma-px", stitching->default_sigma_px,
-                 "Tie sigma (px) where observations.csv gives none");
+                 "Tie sigma (px) where observations.csv gives none")->check(PositiveUpTo(100));
   st->add_option("--images", stitching->images,
                  "Folder of the head images <image>_<head>.tif (simulate --rig --images writes "
                  "them under images/); with --stitched-out");
@@ -805,12 +835,12 @@ CommandRun Setup(CLI::App& app) {
                "matching per overlap zone, on the level plane of the ground calibration and the "
                "POS) instead of reading them from observations.csv (which must have no rows)");
   st->add_option("--tile-px", stitching->tile_px,
-                 "Stitched images: square TIFF tiles of this size (multiple of 16, 16..4096; 0: strips)");
+                 "Stitched images: square TIFF tiles of this size (multiple of 16, 16..4096; 0: strips)")->check(FiniteRange(0, 4096));
   st->add_flag("--bigtiff", stitching->bigtiff, "Stitched images: BigTIFF even when classic TIFF would do");
   st->add_flag("--no-balance", stitching->no_balance,
                "Stitched images: no radiometric balance (every head gain 1, offset 0)");
   st->add_option("--feather-px", stitching->feather_px,
-                 "Stitched images: width of the blending ramp at each head's border, 1..255 px");
+                 "Stitched images: width of the blending ramp at each head's border, 1..255 px")->check(FiniteRange(1, 255));
   return [args, ea, convert, cv, design, ds, stitching, st] {
     if (st->parsed()) return RunStitch(*stitching);
     if (ds->parsed()) return RunDesign(*design);

@@ -8,6 +8,7 @@
 #include "calib/core/error.h"
 #include "stitch/rig/rig_design.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 #include "triangulation/pushbroom/line_images.h"
 #include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/simulation/flight_simulator.h"
@@ -140,24 +141,24 @@ CommandRun SetupSimulate(CLI::App& app) {
   auto& o = args->options;
   app.add_option("--out", args->out, "Output folder (created; files replaced atomically)")->required();
   app.add_option("--seed", args->seed, "Random seed (the same seed gives the same files)")->check(SeedCheck());
-  app.add_option("--exposures", o.exposures, "Number of exposures (spread over the strips), 2..20000")->check(CLI::Range(2, 20000));
-  app.add_option("--strips", o.strips, "Number of east-west strips, 1..1000")->check(CLI::Range(1, 1000));
-  app.add_option("--height-m", o.flying_height_m, "Flying height above the mean terrain, 1..100000 m")->check(CLI::Range(1.0, 1e5));
-  app.add_option("--forward-overlap", o.forward_overlap, "Forward overlap, 0..1")->check(CLI::Range(0.0, 0.95));
-  app.add_option("--side-overlap", o.side_overlap, "Side overlap, 0..1")->check(CLI::Range(0.0, 0.95));
-  app.add_option("--relief-m", o.terrain_relief_m, "Terrain relief (peak to peak), 0..10000 m")->check(CLI::Range(0.0, 1e4));
-  app.add_option("--points", o.ground_points, "Surveyed ground points (control + check), 0..100000")->check(CLI::Range(0, 100000));
-  app.add_option("--control", o.control_points, "Control points among them (corners and centre first)")->check(CLI::Range(0, 100000));
-  app.add_option("--tie-points", o.tie_points, "Unsurveyed tie points, 0..1000000")->check(CLI::Range(0, 1000000));
-  app.add_option("--image-noise-px", o.image_noise_px, "Image measurement noise (sigma), 0..1000 px")->check(CLI::Range(0.0, 1e3));
-  app.add_option("--image-sigma-px", o.image_sigma_px, "A-priori image sigma written to the files, (0, 1000] px")->check(CLI::PositiveNumber & CLI::Range(0.0, 1e3));
-  app.add_option("--stitch-noise-px", o.stitching.noise_px, "Stitching tie-point matching noise, 0..1000 px")->check(CLI::Range(0.0, 1e3));
-  app.add_option("--stitch-ties", o.stitching.ties_per_frame, "Stitching tie points per exposure, 0..10000")->check(CLI::Range(0, 10000));
-  app.add_option("--survey-sigma-m", o.survey_sigma_m, "Noise and sigma of control/check coordinates, (0, 1000] m")->check(CLI::PositiveNumber & CLI::Range(0.0, 1e3));
-  app.add_option("--gnss-sigma-m", o.gnss_sigma_m, "GNSS camera-centre sigma, 0..1000 m (0: no GNSS, approximate centres)")->check(CLI::Range(0.0, 1e3));
-  app.add_option("--imu-sigma-deg", o.imu_sigma_deg, "IMU attitude sigma, 0..90 deg (0: no IMU)")->check(CLI::Range(0.0, 90.0));
-  app.add_option("--start-offset-m", o.start_position_error_m, "Error of approximate centres without GNSS, 0..100000 m")->check(CLI::Range(0.0, 1e5));
-  app.add_option("--start-offset-deg", o.start_angle_error_deg, "Error of approximate angles without IMU, 0..180 deg")->check(CLI::Range(0.0, 180.0));
+  app.add_option("--exposures", o.exposures, "Number of exposures (spread over the strips), 2..20000")->check(FiniteRange(2, 20000));
+  app.add_option("--strips", o.strips, "Number of east-west strips, 1..1000")->check(FiniteRange(1, 1000));
+  app.add_option("--height-m", o.flying_height_m, "Flying height above the mean terrain, 1..100000 m")->check(FiniteRange(1.0, 1e5));
+  app.add_option("--forward-overlap", o.forward_overlap, "Forward overlap, 0..1")->check(FiniteRange(0.0, 0.95));
+  app.add_option("--side-overlap", o.side_overlap, "Side overlap, 0..1")->check(FiniteRange(0.0, 0.95));
+  app.add_option("--relief-m", o.terrain_relief_m, "Terrain relief (peak to peak), 0..10000 m")->check(FiniteRange(0.0, 1e4));
+  app.add_option("--points", o.ground_points, "Surveyed ground points (control + check), 0..100000")->check(FiniteRange(0, 100000));
+  app.add_option("--control", o.control_points, "Control points among them (corners and centre first)")->check(FiniteRange(0, 100000));
+  app.add_option("--tie-points", o.tie_points, "Unsurveyed tie points, 0..1000000")->check(FiniteRange(0, 1000000));
+  app.add_option("--image-noise-px", o.image_noise_px, "Image measurement noise (sigma), 0..1000 px")->check(FiniteRange(0.0, 1e3));
+  app.add_option("--image-sigma-px", o.image_sigma_px, "A-priori image sigma written to the files, (0, 1000] px")->check(PositiveUpTo(1e3));
+  app.add_option("--stitch-noise-px", o.stitching.noise_px, "Stitching tie-point matching noise, 0..1000 px")->check(FiniteRange(0.0, 1e3));
+  app.add_option("--stitch-ties", o.stitching.ties_per_frame, "Stitching tie points per exposure, 0..10000")->check(FiniteRange(0, 10000));
+  app.add_option("--survey-sigma-m", o.survey_sigma_m, "Noise and sigma of control/check coordinates, (0, 1000] m")->check(PositiveUpTo(1e3));
+  app.add_option("--gnss-sigma-m", o.gnss_sigma_m, "GNSS camera-centre sigma, 0..1000 m (0: no GNSS, approximate centres)")->check(FiniteRange(0.0, 1e3));
+  app.add_option("--imu-sigma-deg", o.imu_sigma_deg, "IMU attitude sigma, 0..90 deg (0: no IMU)")->check(FiniteRange(0.0, 90.0));
+  app.add_option("--start-offset-m", o.start_position_error_m, "Error of approximate centres without GNSS, 0..100000 m")->check(FiniteRange(0.0, 1e5));
+  app.add_option("--start-offset-deg", o.start_angle_error_deg, "Error of approximate angles without IMU, 0..180 deg")->check(FiniteRange(0.0, 180.0));
   app.add_option("--layout", args->layout, "Sub-image grid ROWSxCOLS of the camera, 1..10 each (default 3x2: six CCDs)");
   app.add_option("--nominal-mapping", args->nominal_mapping,
                  "Mapping model of the nominal camera's sub-images: translation (a maker's design: nominal "
@@ -165,7 +166,7 @@ CommandRun SetupSimulate(CLI::App& app) {
                  "misplacements need one");
   app.add_option("--ccd-shear", o.misplacement.shear,
                  "Affine part of the true CCD misplacements (x-scale minus y-scale and skew, each +-this), 0..0.1")
-      ->check(CLI::Range(0.0, 0.1));
+      ->check(FiniteRange(0.0, 0.1));
   app.add_option("--rig", args->rig,
                  "Simulate a multi-head rig flight instead: dual-lens (configs/rig_dual_lens.yaml; "
                  "flight defaults 1200 m, 30 exposures, 100 m relief, 40 surveyed and 300 tie "
@@ -176,68 +177,68 @@ CommandRun SetupSimulate(CLI::App& app) {
   auto* increment = app.add_option("--head-increment-arcsec", args->increment_arcsec,
                                    "--rig: sigma of the per-exposure attitude increments E_k of the "
                                    "non-reference heads, 0..3600 arcsec")
-                        ->check(CLI::Range(0.0, 3600.0));
+                        ->check(FiniteRange(0.0, 3600.0));
   auto* time_offset = app.add_option("--head-time-offset-ms", args->time_offset_ms,
                                      "--rig: exposure time offset dT_k of the non-reference heads, "
                                      "-1000..1000 ms (with --speed-mps)")
-                          ->check(CLI::Range(-1000.0, 1000.0));
+                          ->check(FiniteRange(-1000.0, 1000.0));
   auto* format_scale = app.add_option(
       "--format-scale", args->format_scale,
       "--rig: every format (heads, virtual image) x this, pixel sizes / this: the same geometry in "
-      "fewer pixels (small rendered images), (0, 1]");
+      "fewer pixels (small rendered images), (0, 1]")->check(FiniteRange(0, 1, true));
   app.add_option("--speed-mps", args->speed_mps,
                  "Platform speed along the strips, 0..1000 m/s (> 0: exposures.csv carries vX, vY, "
                  "vZ)")
-      ->check(CLI::Range(0.0, 1000.0));
+      ->check(FiniteRange(0.0, 1000.0));
   app.add_option("--lever-arm-m", args->lever_arm_m,
                  "GNSS lever arm a planted in the GNSS centres (X0 + R a), camera frame, m, "
-                 "\"X,Y,Z\" (with --gnss-sigma-m)")
+                 "\"X,Y,Z\" (with --gnss-sigma-m)")->check(FiniteRange(-1000, 1000))
       ->delimiter(',')
       ->expected(3);
   app.add_option("--boresight-deg", args->boresight_deg,
                  "Boresight misalignment M planted in the IMU angles (R M^T), omega,phi,kappa deg "
-                 "(with --imu-sigma-deg)")
+                 "(with --imu-sigma-deg)")->check(FiniteRange(-360, 360))
       ->delimiter(',')
       ->expected(3);
   app.add_option("--gnss-time-offset-ms", args->gnss_time_offset_ms,
                  "GNSS time offset dt planted in the GNSS centres (+ v dt), -10000..10000 ms (with "
                  "--gnss-sigma-m and --speed-mps)")
-      ->check(CLI::Range(-1e4, 1e4));
+      ->check(FiniteRange(-1e4, 1e4));
   // Line camera (pushbroom) flight: its own options; the shared ones above apply when given.
   auto& l = args->line;
   app.add_flag("--test-field", args->test_field,
                "A camera-calibration test field instead of a flight: targets on a facade with depth "
                "layers, convergent images in groups (calibrate --observations --points --groups)");
   app.add_flag("--planar", args->field.planar, "Test field: all targets on one plane");
-  app.add_option("--groups", args->field.groups, "Test field: image groups, 1..26")->check(CLI::Range(1, 26));
+  app.add_option("--groups", args->field.groups, "Test field: image groups, 1..26")->check(FiniteRange(1, 26));
   app.add_option("--images-per-group", args->field.images_per_group, "Test field: images per group, 4..1000")
-      ->check(CLI::Range(4, 1000));
+      ->check(FiniteRange(4, 1000));
   app.add_option("--distance-m", args->field.distance_m, "Test field: camera distance from the wall, m")
-      ->check(CLI::Range(1.0, 1000.0));
+      ->check(FiniteRange(1.0, 1000.0));
   app.add_flag("--pushbroom", args->pushbroom,
                "Simulate a combined line camera (three tilted line cameras) instead: camera files, "
                "pos.csv, observations, control points and truth (triangulation/pushbroom/README.md)");
-  app.add_option("--detectors", l.detectors_per_camera, "Pushbroom: detectors per line camera, 10..100000")->check(CLI::Range(10, 100000));
-  app.add_option("--lines", l.lines, "Pushbroom: scan lines, 20..10000000")->check(CLI::Range(20, 10000000));
-  app.add_option("--tilt-deg", l.tilt_deg, "Pushbroom: look angle of the outer cameras across track, 0..40 deg")->check(CLI::Range(0.0, 40.0));
-  app.add_option("--pos-error-m", l.pos_error_m, "Pushbroom: sigma of the smooth POS position error, 0..100 m")->check(CLI::Range(0.0, 100.0));
-  app.add_option("--pos-error-deg", l.pos_error_deg, "Pushbroom: sigma of the smooth POS attitude error, 0..10 deg")->check(CLI::Range(0.0, 10.0));
-  app.add_option("--detector-error-px", l.detector_error_px, "Pushbroom: size of the smooth per-detector errors, 0..100 px")->check(CLI::Range(0.0, 100.0));
+  app.add_option("--detectors", l.detectors_per_camera, "Pushbroom: detectors per line camera, 10..100000")->check(FiniteRange(10, 100000));
+  app.add_option("--lines", l.lines, "Pushbroom: scan lines, 20..10000000")->check(FiniteRange(20, 10000000));
+  app.add_option("--tilt-deg", l.tilt_deg, "Pushbroom: look angle of the outer cameras across track, 0..40 deg")->check(FiniteRange(0.0, 40.0));
+  app.add_option("--pos-error-m", l.pos_error_m, "Pushbroom: sigma of the smooth POS position error, 0..100 m")->check(FiniteRange(0.0, 100.0));
+  app.add_option("--pos-error-deg", l.pos_error_deg, "Pushbroom: sigma of the smooth POS attitude error, 0..10 deg")->check(FiniteRange(0.0, 10.0));
+  app.add_option("--detector-error-px", l.detector_error_px, "Pushbroom: size of the smooth per-detector errors, 0..100 px")->check(FiniteRange(0.0, 100.0));
   app.add_option("--subcamera-error-px", l.subcamera_error_px,
                  "Pushbroom: sigma of every sub-camera's own offset, scale, rotation and curvature "
-                 "errors (the reference's too), 0..100 px")->check(CLI::Range(0.0, 100.0));
+                 "errors (the reference's too), 0..100 px")->check(FiniteRange(0.0, 100.0));
   app.add_flag("--linear-layout", l.linear_layout,
                "Pushbroom: the sub-cameras stitched onto one straight virtual CCD (the camera "
                "file's calibration ranges, no subcameras section)");
-  app.add_option("--pos-bias-m", l.pos_bias_m, "Pushbroom: sigma of a constant POS position error, 0..100 m")->check(CLI::Range(0.0, 100.0));
-  app.add_option("--pos-bias-deg", l.pos_bias_deg, "Pushbroom: sigma of a constant POS attitude error, 0..10 deg")->check(CLI::Range(0.0, 10.0));
-  app.add_option("--pos-drift-m", l.pos_drift_m, "Pushbroom: sigma of a linear POS position drift (at the end), 0..100 m")->check(CLI::Range(0.0, 100.0));
-  app.add_option("--pos-drift-deg", l.pos_drift_deg, "Pushbroom: sigma of a linear POS attitude drift (at the end), 0..10 deg")->check(CLI::Range(0.0, 10.0));
+  app.add_option("--pos-bias-m", l.pos_bias_m, "Pushbroom: sigma of a constant POS position error, 0..100 m")->check(FiniteRange(0.0, 100.0));
+  app.add_option("--pos-bias-deg", l.pos_bias_deg, "Pushbroom: sigma of a constant POS attitude error, 0..10 deg")->check(FiniteRange(0.0, 10.0));
+  app.add_option("--pos-drift-m", l.pos_drift_m, "Pushbroom: sigma of a linear POS position drift (at the end), 0..100 m")->check(FiniteRange(0.0, 100.0));
+  app.add_option("--pos-drift-deg", l.pos_drift_deg, "Pushbroom: sigma of a linear POS attitude drift (at the end), 0..10 deg")->check(FiniteRange(0.0, 10.0));
   app.add_option("--time-offset-s", l.time_offset_s,
                  "Pushbroom: shutter / POS latency, s: each line exposed this long after its "
-                 "pos.csv time stamp, -1..1")->check(CLI::Range(-1.0, 1.0));
-  app.add_option("--node-spacing", l.node_spacing_lines, "Pushbroom: node spacing of the POS error spline, lines")->check(CLI::Range(1, 1000000));
-  app.add_option("--control-noise-m", l.control_noise_m, "Pushbroom: control-point coordinate noise, 0..1000 m")->check(CLI::Range(0.0, 1e3));
+                 "pos.csv time stamp, -1..1")->check(FiniteRange(-1.0, 1.0));
+  app.add_option("--node-spacing", l.node_spacing_lines, "Pushbroom: node spacing of the POS error spline, lines")->check(FiniteRange(1, 1000000));
+  app.add_option("--control-noise-m", l.control_noise_m, "Pushbroom: control-point coordinate noise, 0..1000 m")->check(FiniteRange(0.0, 1e3));
   auto* images = app.add_flag("--images", args->pushbroom_images,
                "Pushbroom: also render the line image and a reference frame strip of a scene "
                "textured with --texture (image mode of `pushbroom control`); --rig: render every "
@@ -247,15 +248,15 @@ CommandRun SetupSimulate(CLI::App& app) {
       ->needs(images);
   app.add_option("--texture-gsd-m", args->line_images.texture_gsd_m,
                  "--images: ground size of a texel (2 x 2 photo pixels), m; 0: automatic")
-      ->needs(images)->check(CLI::Range(0.0, 100.0));
+      ->needs(images)->check(FiniteRange(0.0, 100.0));
   app.add_option("--reference-size", args->reference_size,
                  "Pushbroom --images: reference frame format WIDTHxHEIGHT px")->needs(images);
   app.add_option("--reference-overlap", args->line_images.forward_overlap,
                  "Pushbroom --images: forward overlap of the reference strip, 0.5..0.9")
-      ->needs(images)->check(CLI::Range(0.5, 0.9));
+      ->needs(images)->check(FiniteRange(0.5, 0.9));
   app.add_option("--grey-noise-dn", args->line_images.grey_noise_dn,
                  "--images: Gaussian grey-value noise of the rendered images, DN")
-      ->needs(images)->check(CLI::Range(0.0, 100.0));
+      ->needs(images)->check(FiniteRange(0.0, 100.0));
   // Flight options a rig flight takes over when given (the rig's defaults otherwise).
   using Flight = triangulation::FlightSimulationOptions;
   const std::vector<std::pair<std::string, int Flight::*>> int_options = {

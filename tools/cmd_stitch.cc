@@ -12,6 +12,7 @@
 #include "stitch/adjustment/flight_stability.h"
 #include "stitch/io/stitch_result_json.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 
 namespace aerocal::tools {
 namespace {
@@ -101,9 +102,9 @@ CommandRun Setup(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--base", args->base,
                  "Comma-separated sub-images that keep the camera file's mapping (the datum)");
-  app.add_option("--sigma", args->sigma_px, "A-priori sigma (px) of rows without sigma_px")
+  app.add_option("--sigma", args->sigma_px, "A-priori sigma (px) of rows without sigma_px")->check(PositiveUpTo(100))
       ->capture_default_str();
-  app.add_option("--alpha", args->alpha, "Level of the model-choice F test and stability flags")
+  app.add_option("--alpha", args->alpha, "Level of the model-choice F test and stability flags")->check(FiniteRange(0, 1, true))
       ->capture_default_str();
   app.add_flag("--no-snooping", args->no_snooping, "Do not search gross errors");
   app.add_option("--out", args->out, "Result JSON")->required();

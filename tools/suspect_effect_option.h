@@ -4,6 +4,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "tools/option_ranges.h"
+
 namespace aerocal::tools {
 
 inline CLI::Option* AddSuspectEffectOption(CLI::App& app, double* limit_sigmas) {
@@ -14,7 +16,7 @@ inline CLI::Option* AddSuspectEffectOption(CLI::App& app, double* limit_sigmas) 
                   "their effect: the block re-solved without them; a parameter moving by more "
                   "than this many of its sigmas makes the result not valid (exit 3), else a "
                   "warning names them. (0, 1000], default 1")
-      ->check(CLI::Range(1e-9, 1e3));
+      ->check(PositiveUpTo(1e3));
 }
 
 }  // namespace aerocal::tools

@@ -17,6 +17,7 @@ constexpr int kMaxFormatPx = 1000000;       // per side, virtual image or sub-im
 constexpr double kMaxPixelSizeMm = 1.0;     // 1 mm pixels
 constexpr double kMinPixelSizeMm = 1e-5;    // 10 nm pixels
 constexpr double kMaxCMm = 10000.0;         // 10 m principal distance
+constexpr double kMinPrincipalDistancePx = 100.0;  // c / pixel size (a fisheye has about 400)
 constexpr double kMaxPpMm = 1e4;            // |x0|, |y0|
 constexpr double kMaxDistortion = 1e4;      // |K1..K3, P1, P2, B1, B2| (overflow-safe only)
 constexpr double kMaxMappingParam = 1e7;    // |sub-image mapping parameter|
@@ -97,11 +98,13 @@ ReferencePoint ReadReferencePoint(const YAML::Node& node, const std::string& fil
 
 }  // namespace
 
-Camera ParseCamera(const YAML::Node& root, const std::string& file, CameraModels models) {
+Camera ParseCamera(const YAML::Node& root, const std::string& file, CameraModels models,
+                   const std::vector<std::string>& record_keys) {
   if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
-  RejectUnknownKeys(root, {"name", "pixel_size_mm", "format_px", "interior", "interior_sigma",
-                           "subimages", "reference_points", "model"},
-                    file);
+  std::vector<std::string> allowed = {"name", "pixel_size_mm", "format_px", "interior", "interior_sigma",
+                                      "subimages", "reference_points", "model"};
+  allowed.insert(allowed.end(), record_keys.begin(), record_keys.end());
+  RejectUnknownKeys(root, allowed, file);
   const std::string model_name =
       root["model"] ? YamlString(root["model"], file, "model") : std::string(Model::kName);
   const std::optional<CameraModelId> id = CameraModelFromName(model_name);
@@ -139,11 +142,21 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file, CameraModels
     const double bound = ModelParamBound(table[i]);
     camera.interior[i] = YamlBounded(interior[keys[i]], file, "interior." + keys[i], -bound, bound);
   }
-  for (size_t i = 0; i < table.size(); ++i)
-    if (table[i].group == ParamGroup::kPrincipalDistance && !(camera.interior[i] > 0))
+  for (size_t i = 0; i < table.size(); ++i) {
+    if (table[i].group != ParamGroup::kPrincipalDistance) continue;
+    if (!(camera.interior[i] > 0))
       ThrowInputError(WhereIs(interior, file),
                       "interior." + keys[i] + " must be > 0 " + std::string(table[i].unit) +
                           " (got " + FormatNumber(camera.interior[i]) + ")");
+    // At least kMinPrincipalDistancePx pixels: a principal distance of 1e-9 mm is no lens (every
+    // ray leaves the format at once) and passed as one.
+    const double c_px = table[i].unit == "px" ? camera.interior[i] : camera.interior[i] / camera.pixel_size_mm;
+    if (table[i].unit != "1" && !(c_px >= kMinPrincipalDistancePx))
+      ThrowInputError(WhereIs(interior[keys[i]] ? interior[keys[i]] : interior, file),
+                      "interior." + keys[i] + " must be at least " + FormatNumber(kMinPrincipalDistancePx) +
+                          " pixels (got " + FormatNumber(camera.interior[i]) + " " +
+                          std::string(table[i].unit) + " = " + FormatNumber(c_px) + " px)");
+  }
   if (root["interior_sigma"]) {
     const YAML::Node& sig = root["interior_sigma"];
     RejectUnknownKeys(sig, keys, file);

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <string>
+#include <vector>
 
 #include <yaml-cpp/yaml.h>
 
@@ -21,9 +22,13 @@ enum class CameraModels { kBrownFraser10Only, kAny };
 /// `interior_sigma:` keyed by that model's parameter names (absent = 0 / not weighted), the
 /// principal-distance parameters > 0; sub-images and reference points only with brown_fraser_10.
 Camera ReadCamera(const std::string& path, CameraModels models = CameraModels::kBrownFraser10Only);
+/// `record_keys`: further keys of `root` that its caller reads (a rig head's id, mount...), not
+/// refused as unknown (reading the camera keys in place: a copy of them into a new node merged the
+/// whole document's memory per head in yaml-cpp, which made rig files quadratic).
 Camera ParseCamera(const YAML::Node& root,
                    const std::string& file,
-                   CameraModels models = CameraModels::kBrownFraser10Only);
+                   CameraModels models = CameraModels::kBrownFraser10Only,
+                   const std::vector<std::string>& record_keys = {});
 /// YAML text of a camera (full precision, every interior term written).
 std::string CameraToYaml(const Camera& camera);
 /// Writes atomically.

@@ -115,6 +115,7 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
         if (!node[key]) ThrowInputError(WhereIs(node, file), std::string("sub-camera: missing ") + key);
       LineSubcamera s;
       s.id = YamlString(node["id"], file, "id");
+      if (s.id.empty()) ThrowInputError(WhereIs(node["id"], file), "sub-camera id must not be empty");
       for (const auto& other : camera.subcameras)
         if (other.id == s.id)
           ThrowInputError(WhereIs(node["id"], file), "duplicate sub-camera id '" + s.id + "'");

@@ -45,6 +45,8 @@ int Rig::ReferenceIndex() const {
 void Rig::Validate(const std::string& where) const {
   const SourceRef at{where, 0};
   if (heads.empty()) ThrowInputError(at, "a rig needs at least one head");
+  if (heads.size() > kMaxRigHeads)
+    ThrowInputError(at, std::to_string(heads.size()) + " rig heads, at most " + std::to_string(kMaxRigHeads));
   std::set<std::string> ids;
   for (const RigHead& head : heads) {
     if (head.id.empty()) ThrowInputError(at, "every rig head needs a non-empty id");

@@ -71,6 +71,10 @@ struct VirtualCamera {
   bool PixelFromRay(const Eigen::Vector3d& ray, Eigen::Vector2d* pixel) const;
 };
 
+/// Most heads a rig may have: the coverage of the rig design and the error analysis is a bit mask
+/// per ground cell (stitch/rig/rig_design.cc). The rig reader refuses more with FILE:LINE.
+inline constexpr size_t kMaxRigHeads = 32;
+
 struct Rig {
   std::string name;
   std::string reference_head;  // id of the head the others are relative to

@@ -1,8 +1,11 @@
 #include "calib/camera/rig_io.h"
 
+#include <algorithm>
 #include <cmath>
+#include <set>
 
 #include "calib/camera/camera_io.h"
+#include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
@@ -23,6 +26,9 @@ const std::vector<std::string> kHeadRigKeys = {"id", "mount_deg", "lever_arm_m",
 // either are positive and below those bounds.
 constexpr double kMaxAngleDeg = 360.0;
 constexpr double kMaxLeverArmM = 1000.0;
+constexpr double kMaxHeadTiltDeg = 80.0;  // a head's axis off the virtual camera's axis
+// Relative flying height of the virtual camera: 1 m .. 100 km.
+constexpr double kMinHeightM = 1.0, kMaxHeightM = 1e5;
 
 Eigen::Vector3d ReadSigma3(const YAML::Node& node,
                            const std::string& file,
@@ -56,16 +62,24 @@ RigHead ReadHead(const YAML::Node& node, const std::string& file) {
   if (head.id.empty()) ThrowInputError(WhereIs(node["id"], file), "head id must not be empty");
   for (const char* key : {"pixel_size_mm", "format_px", "interior"})
     if (!node[key]) ThrowInputError(WhereIs(node, file), "head " + head.id + ": missing " + key);
-  // The head's camera keys, as their own camera file: the camera reader checks them (and cites
-  // their lines, which the copied nodes keep).
-  YAML::Node camera_node(YAML::NodeType::Map);
-  for (const std::string& key : kHeadCameraKeys)
-    if (node[key]) camera_node[key] = node[key];
-  head.camera = ParseCamera(camera_node, file);
+  // The head's camera keys, read in place by the camera reader (it cites their lines). Copying them
+  // into a new node merged the whole document into that node's memory (yaml-cpp), once per head:
+  // reading was quadratic in the number of heads (1000 heads took about 20 s).
+  head.camera = ParseCamera(node, file, CameraModels::kBrownFraser10Only, kHeadRigKeys);
   head.camera.name = head.id;
-  if (node["mount_deg"])
+  if (node["mount_deg"]) {
     head.mount_rad =
         YamlVector3(node["mount_deg"], file, "mount_deg", -kMaxAngleDeg, kMaxAngleDeg) * kRadPerDeg;
+    // The head's viewing axis (-z of the head) in the rig frame must look down, at most
+    // kMaxHeadTiltDeg off the virtual camera's axis: a head looking up or sideways sees no point
+    // of the rectification plane (its ratios were NaN downstream).
+    const Eigen::Vector3d axis = RotationFromOpk(head.mount_rad) * Eigen::Vector3d(0, 0, -1);
+    const double tilt_deg = std::acos(std::clamp(-axis.z(), -1.0, 1.0)) / kRadPerDeg;
+    if (!(tilt_deg <= kMaxHeadTiltDeg))
+      ThrowInputError(WhereIs(node["mount_deg"], file),
+                      "head " + head.id + ": mount_deg turns the head's axis " + FormatNumber(tilt_deg, 4) +
+                          " deg off the rig's nadir (at most " + FormatNumber(kMaxHeadTiltDeg) + " deg)");
+  }
   if (node["lever_arm_m"])
     head.lever_arm_m =
         YamlVector3(node["lever_arm_m"], file, "lever_arm_m", -kMaxLeverArmM, kMaxLeverArmM);
@@ -103,7 +117,8 @@ VirtualCamera ReadVirtual(const YAML::Node& node, const std::string& file) {
     ThrowInputError(WhereIs(format, file), "virtual.format_px must be positive");
   if (node["x0"]) v.x0_mm = YamlDouble(node["x0"], file, "virtual.x0");
   if (node["y0"]) v.y0_mm = YamlDouble(node["y0"], file, "virtual.y0");
-  if (node["height_m"]) v.height_m = ReadPositive(node["height_m"], file, "virtual.height_m", "m");
+  if (node["height_m"])
+    v.height_m = YamlBounded(node["height_m"], file, "virtual.height_m", kMinHeightM, kMaxHeightM);
   return v;
 }
 
@@ -142,9 +157,14 @@ Rig ParseRig(const YAML::Node& root, const std::string& file) {
   const YAML::Node& heads = section["heads"];
   if (!heads || !heads.IsSequence() || heads.size() == 0)
     ThrowInputError(WhereIs(heads ? heads : section, file), "rig.heads must be a non-empty list");
+  // Checked before any head is read: the rig's coverage and design work on a bit per head.
+  if (heads.size() > kMaxRigHeads)
+    ThrowInputError(WhereIs(heads, file), "rig.heads: " + std::to_string(heads.size()) +
+                                              " heads, at most " + std::to_string(kMaxRigHeads));
+  std::set<std::string> ids;
   for (const auto& node : heads) {
     RigHead head = ReadHead(node, file);
-    if (rig.HeadIndex(head.id) >= 0)
+    if (!ids.insert(head.id).second)
       ThrowInputError(WhereIs(node["id"], file), "duplicate head id '" + head.id + "'");
     rig.heads.push_back(std::move(head));
   }

@@ -140,7 +140,7 @@ std::string ZoneName(const calib::Rig& rig, unsigned mask) {
 }
 
 RigCoverage ComputeRigCoverage(const calib::Rig& rig, double height_m, double cell_px) {
-  AEROCAL_CHECK(cell_px > 0 && rig.heads.size() <= 32) << "cell size > 0, at most 32 heads";
+  AEROCAL_CHECK(cell_px > 0 && rig.heads.size() <= calib::kMaxRigHeads) << "cell size > 0, at most 32 heads";
   const RigConverter converter = NadirConverter(rig, height_m);
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo;
   for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k)

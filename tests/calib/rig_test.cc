@@ -267,7 +267,7 @@ TEST(RigFile, BadFilesNameFileAndLine) {
        ":3: virtual.orientation must be rig or level"},
       {"rig:\n  reference_head: A\n  virtual: {c: 150, pixel_size_mm: 0.006, format_px: [120, 100], "
        "height_m: -3}\n  heads:\n" + head_a,
-       ":3: virtual.height_m must be > 0 m"},
+       ":3: virtual.height_m out of range (got -3, expected 1 .. 100000)"},
       {"rig:\n  reference_head: A\n  virtual: {c: 150, format_px: [120, 100]}\n  heads:\n" + head_a,
        ":3: virtual: missing pixel_size_mm"},
       {"rig:\n  heads: []\n", ":2: rig.heads must be a non-empty list"},

@@ -31,6 +31,13 @@ except ImportError as e:  # pragma: no cover
 
 matplotlib.rcParams["svg.hashsalt"] = "aerocal-certificate"
 matplotlib.rcParams["font.size"] = 8
+# Every text drawn is the user's or ours, never mathtext: a `$...$` in a lab field crashed the
+# renderer (issue 37). matplotlib >= 3.6 has the switch; older ones get every `$` escaped (plain()).
+try:
+    matplotlib.rcParams["text.parse_math"] = False
+    MATH_OFF = True
+except KeyError:  # pragma: no cover
+    MATH_OFF = False
 A4 = (8.27, 11.69)
 
 
@@ -372,15 +379,25 @@ def write_html(c, path, figures):
                  "<tr><td>%s</td><td>%s</td><td>%s</td></tr></table>" % tuple(html.escape(s[k]) for k in ("calibrated_by", "checked_by", "approved_by")))
     parts.append("<p>%s</p></body></html>" % html.escape(lab["certificate"]["page_note"]))
     tmp = path + ".tmp"
-    with open(tmp, "w", encoding="utf-8") as f:
-        f.write("\n".join(parts) + "\n")
-    os.replace(tmp, path)
+    try:
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write("\n".join(parts) + "\n")
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
 
 
 # ---------------------------------------------------------------- PDF
 
+def plain(text):
+    """`text` drawn as it is by matplotlib: with mathtext off as it is; else every `$` escaped
+    (matplotlib shows an escaped `\\$` as `$`)."""
+    return str(text) if MATH_OFF else str(text).replace("$", r"\$")
+
+
 def text_pages(title, blocks):
-    """Pages of monospace tables: blocks = [(heading, rows)]."""
+    """Pages of monospace tables: blocks = [(heading, rows)]. Every text is user text: plain()."""
     lines = []
     for heading, rows in blocks:
         lines.append(("h", heading))
@@ -395,13 +412,13 @@ def text_pages(title, blocks):
     figs = []
     for start in range(0, len(lines), per_page):
         fig = plt.figure(figsize=A4)
-        fig.text(0.05, 0.97, title, fontsize=12, weight="bold")
+        fig.text(0.05, 0.97, plain(title), fontsize=12, weight="bold")
         y = 0.945
         for kind, text in lines[start:start + per_page]:
             if kind == "h":
-                fig.text(0.05, y, text, fontsize=9, weight="bold")
+                fig.text(0.05, y, plain(text), fontsize=9, weight="bold")
             else:
-                fig.text(0.05, y, text, fontsize=5.6, family="monospace")
+                fig.text(0.05, y, plain(text), fontsize=5.6, family="monospace")
             y -= 0.0128
         figs.append(fig)
     return figs
@@ -411,6 +428,16 @@ def write_pdf(c, path):
     lab = c["lab"]
     title = "Calibration certificate %s" % lab["certificate"]["number"]
     tmp = path + ".tmp"
+    try:
+        write_pdf_pages(c, tmp, title)
+        os.replace(tmp, path)
+    finally:
+        if os.path.exists(tmp):
+            os.remove(tmp)
+
+
+def write_pdf_pages(c, tmp, title):
+    lab = c["lab"]
     with PdfPages(tmp, metadata={"CreationDate": None, "Creator": "aerocal certificate",
                                  "Producer": "matplotlib"}) as pdf:
         statements = [["statement"]] + [[q["statement"]] for q in c["results"]]
@@ -423,7 +450,7 @@ def write_pdf(c, path):
             plt.close(fig)
         for make in (fig_distortion, fig_residuals_correlation):
             fig = plt.figure(figsize=A4)
-            fig.text(0.05, 0.97, title, fontsize=12, weight="bold")
+            fig.text(0.05, 0.97, plain(title), fontsize=12, weight="bold")
             sub = make(c)
             buf = io.BytesIO()
             sub.savefig(buf, format="png", dpi=200)
@@ -457,7 +484,6 @@ def write_pdf(c, path):
             fig.tight_layout(rect=(0, 0, 1, 0.93))
             pdf.savefig(fig)
             plt.close(fig)
-    os.replace(tmp, path)
 
 
 def main(argv):

@@ -11,6 +11,13 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402  (after the backend is chosen)
+
+# Ids from the user's files (exposures, cameras, sub-images) are drawn as text, never as mathtext:
+# an id with `$...$` crashed the renderer (issue 37). matplotlib < 3.6 lacks the switch.
+try:
+    matplotlib.rcParams["text.parse_math"] = False
+except KeyError:  # pragma: no cover
+    pass
 import numpy as np  # noqa: E402
 
 DPI = 100

@@ -88,6 +88,8 @@ def main(argv):
         import matplotlib
         matplotlib.use("Agg")
         import matplotlib.pyplot as plt
+        if "text.parse_math" in matplotlib.rcParams:  # ids are text, never mathtext (issue 37)
+            matplotlib.rcParams["text.parse_math"] = False
     except ImportError:
         # A python3 earlier in PATH (pyenv, virtualenv) may lack Debian's matplotlib: use Debian's.
         debian = "/usr/bin/python3"

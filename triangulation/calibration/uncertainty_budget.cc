@@ -1,6 +1,7 @@
 #include "triangulation/calibration/uncertainty_budget.h"
 
 #include "calib/camera/rotation.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
@@ -146,10 +147,41 @@ std::string CertificateStatement(const std::string& name, double value, double e
                       unit.c_str(), decimals, expanded, unit.c_str(), k);
 }
 
+namespace {
+
+// A unit of a budget component: its kind and its size in the kind's base unit.
+struct BudgetUnit {
+  const char* name;
+  const char* kind;
+  double scale;
+};
+constexpr BudgetUnit kBudgetUnits[] = {
+    {"m", "length", 1.0},         {"mm", "length", 1e-3},     {"um", "length", 1e-6},
+    {"nm", "length", 1e-9},       {"px", "image", 1.0},       {"rad", "angle", 1.0},
+    {"mrad", "angle", 1e-3},      {"deg", "angle", M_PI / 180}, {"arcmin", "angle", M_PI / 10800},
+    {"arcsec", "angle", M_PI / 648000}, {"K", "temperature", 1.0}, {"degC", "temperature", 1.0},
+    {"1", "ratio", 1.0},          {"%", "ratio", 1e-2},       {"ppm", "ratio", 1e-6}};
+
+const BudgetUnit* FindBudgetUnit(const std::string& name) {
+  for (const auto& u : kBudgetUnits)
+    if (name == u.name) return &u;
+  return nullptr;
+}
+
+}  // namespace
+
+std::string BudgetUnits() {
+  std::string names;
+  for (const auto& u : kBudgetUnits) names += (names.empty() ? "" : ", ") + std::string(u.name);
+  return names;
+}
+
 BudgetOptions ReadBudgetOptions(const std::string& path) {
   const YAML::Node root = LoadYamlFile(path);
   BudgetOptions options;
-  if (!root || root.IsNull()) return options;
+  // An empty budget file is a mistake (a wrong file, a failed export), not "no options".
+  if (!root || root.IsNull() || (root.IsMap() && root.size() == 0))
+    throw InputError(path + ":1: an empty budget file (expected radii_mm, target_radius_mm or components)");
   if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map");
   RejectUnknownKeys(root, {"radii_mm", "target_radius_mm", "components"}, path);
   for (const char* list : {"radii_mm", "components"})  // a map or a scalar there is no list
@@ -172,10 +204,19 @@ BudgetOptions ReadBudgetOptions(const std::string& path) {
       u.quantity = YamlString(node["quantity"], path, "quantity");
       u.source = YamlString(node["source"], path, "source");
       u.value = YamlBounded(node["value"], path, "value", 0, 1e12);
-      if (node["unit"]) u.unit = YamlString(node["unit"], path, "unit");
+      u.where = where;
+      if (node["unit"]) {
+        u.unit = YamlString(node["unit"], path, "unit");
+        if (!FindBudgetUnit(u.unit))
+          throw InputError(WhereIs(node["unit"], path).ToString() + ": unknown unit '" + u.unit +
+                           "' (expected one of " + BudgetUnits() + ")");
+      }
       if (node["distribution"]) u.distribution = YamlString(node["distribution"], path, "distribution");
       Divisor(u.distribution, WhereIs(node["distribution"] ? node["distribution"] : node, path).ToString());
-      if (node["sensitivity"]) u.sensitivity = YamlDouble(node["sensitivity"], path, "sensitivity");
+      if (node["sensitivity"]) {
+        u.sensitivity = YamlBounded(node["sensitivity"], path, "sensitivity", -1e6, 1e6);
+        u.sensitivity_given = true;
+      }
       if (node["dof"]) u.dof = YamlBounded(node["dof"], path, "dof", 1, 1e12);
       options.user.push_back(u);
     }
@@ -296,7 +337,8 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
   for (const auto& u : options.user) {
     auto q = std::find_if(out.begin(), out.end(), [&](const BudgetQuantity& b) { return b.name == u.quantity; });
     if (q == out.end())
-      throw ConfigError("budget component '" + u.source + "': unknown quantity " + u.quantity);
+      throw ConfigError(u.where + ": budget component '" + u.source + "': unknown quantity " + u.quantity +
+                        " (not certified by this calibration)");
     UncertaintyComponent c;
     c.source = u.source;
     c.type = "B";
@@ -304,12 +346,37 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
     c.value = u.value;
     c.value_unit = u.unit;
     c.divisor = Divisor(u.distribution, "budget component " + u.source);
-    c.sensitivity = u.sensitivity;
-    c.u = std::abs(u.sensitivity) * u.value / c.divisor;
+    // Units: a value in the quantity's own kind is converted to the quantity's unit (0.002 um for
+    // a quantity in mm is 2e-6 mm); another kind needs the sensitivity that converts it.
+    const std::string who = u.where + ": budget component '" + u.source + "' of " + u.quantity;
+    const BudgetUnit* from = u.unit.empty() ? nullptr : FindBudgetUnit(u.unit);
+    const BudgetUnit* to = FindBudgetUnit(q->unit);
+    double factor = 1.0;
+    if (from && u.unit != q->unit) {
+      if (to && std::string(to->kind) == from->kind)
+        factor = from->scale / to->scale;
+      else if (!u.sensitivity_given)
+        throw ConfigError(who + ": unit " + u.unit + " is no " + (to ? to->kind : q->unit) +
+                          "; give its sensitivity (" + q->unit + " per " + u.unit + ")");
+    }
+    c.sensitivity = u.sensitivity * factor;
+    c.u = std::abs(c.sensitivity) * u.value / c.divisor;
+    if (!std::isfinite(c.u))
+      throw ConfigError(who + ": the standard uncertainty is not finite (value " + FormatNumber(u.value) +
+                        " " + u.unit + ", sensitivity " + FormatNumber(u.sensitivity) + ")");
     c.dof = u.dof;
     q->components.push_back(c);
   }
-  for (auto& q : out) Finish(&q);
+  for (auto& q : out) {
+    Finish(&q);
+    // A non-finite intermediate (a distortion at an absurd radius, an overflowing component) is
+    // refused, never printed as a certified value.
+    const bool at_radius = q.name.find('@') != std::string::npos;
+    if (std::isinf(q.value) || std::isinf(q.u_c) || (at_radius && !std::isfinite(q.value)))
+      throw ConfigError("budget: " + q.name + " (" + q.description + ") is not finite (value " +
+                        FormatNumber(q.value) + " " + q.unit + ", u_c " + FormatNumber(q.u_c) +
+                        "); check radii_mm / --radii-mm and the components");
+  }
   return out;
 }
 

@@ -61,11 +61,20 @@ struct UserComponent {
   std::string quantity;  // name of a certified quantity (c, x0, ..., dr@2.0, m_X, ...)
   std::string source;
   double value = 0;  // half-width (rectangular, triangular) or standard uncertainty (normal)
-  std::string unit;
+  std::string unit;  // one of BudgetUnits(); empty: the quantity's unit
   std::string distribution = "normal";
-  double sensitivity = 1;
+  double sensitivity = 1;  // quantity unit per `unit` (after converting `unit` when both are of
+                           // one kind: a length in um for a quantity in mm is divided by 1000)
+  bool sensitivity_given = false;
   double dof = std::numeric_limits<double>::infinity();
+  std::string where;  // FILE:LINE of the component, for messages
 };
+
+/// The units a budget component's `unit` may name, by kind: length m, mm, um, nm; image px;
+/// angle rad, mrad, deg, arcmin, arcsec; temperature K, degC; ratio 1, %, ppm. A value in a unit
+/// of the quantity's kind is converted to the quantity's unit; another kind needs an explicit
+/// sensitivity (quantity unit per component unit).
+std::string BudgetUnits();
 
 struct BudgetOptions {
   std::vector<double> radii_mm;     // radii of the distortion values, mm, > 0
