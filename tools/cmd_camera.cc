@@ -14,6 +14,7 @@
 
 #include "calib/camera/camera_model_json.h"
 #include "calib/camera/convert_camera.h"
+#include "calib/camera/distortion_folding.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -224,6 +225,10 @@ int RunShow(const ShowArgs& a) {
                 FormatNumber(camera.params[i], 15).c_str(), std::string(table[i].unit).c_str(),
                 sigma.c_str());
   }
+  // A lens whose distortion folds inside its format maps two image points to one ray: the table
+  // below would jump there without a word (issue 37 class 6).
+  const std::string folding = calib::DistortionFoldingWarning(calib::FindDistortionFolding(camera));
+  if (!folding.empty()) std::fprintf(stderr, "warning: %s\n", folding.c_str());
   calib::OpenCvParams cv;
   calib::VisitCameraModel(camera.model, [&](auto m) {
     return decltype(m)::ToOpenCv(camera.params.data(), f, &cv);
@@ -231,7 +236,7 @@ int RunShow(const ShowArgs& a) {
   using O = calib::OpenCvModel;
   const Eigen::Vector2d pp(cv[O::kCx], cv[O::kCy]);
   const double p = f.pixel_size_mm;
-  std::printf("our convention (CONVENTIONS.md: photo frame at the format centre, y up):\n");
+  std::printf("our convention (docs/conventions.md: photo frame at the format centre, y up):\n");
   std::printf("  c  = %s mm (%s px)\n", FormatNumber(camera.PrincipalDistanceMm(), 10).c_str(),
               FormatNumber(camera.PrincipalDistanceMm() / p, 10).c_str());
   std::printf("  x0 = %s mm (%s px from the centre)\n",

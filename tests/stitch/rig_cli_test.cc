@@ -173,7 +173,7 @@ TEST(RigErrorAnalysisCommand, RefusesBadInputWithExitTwoAndNothingWritten) {
   refused(Analysis("--target B:100,100 --grid 3"), "exclude each other");
   refused(Analysis("--height-m 100"), "must be below the flying height");
   refused(Analysis("--virtual 20000,5000"), "no non-reference head sees");
-  refused(Analysis("--samples -5"), "--samples must be >= 0");
+  refused(Analysis("--samples -5"), "--samples: must be in [0, ");
   std::string no_height = ReadTextFile(kRig);
   const auto at = no_height.find(", height_m: 1200.0");
   ASSERT_NE(at, std::string::npos);

@@ -92,50 +92,42 @@ void SetParam(CameraFile& c, const std::string& name, double value) {
 
 using Points = py::array_t<double, py::array::c_style | py::array::forcecast>;
 
-void CheckPoints(const Points& a, const char* what) {
-  if (a.ndim() != 2 || a.shape(1) != 2)
+// Maps every row of a (N, 2) array through `map` (false: the row is NaN), the GIL released.
+template <typename Map>
+Points MapRows(const Points& points, const char* what, Map map) {
+  if (points.ndim() != 2 || points.shape(1) != 2)
     throw ConfigError(std::string(what) + " must be an array of shape (N, 2)");
+  const auto n = points.shape(0);
+  Points out({n, static_cast<py::ssize_t>(2)});
+  auto in = points.unchecked<2>();
+  auto o = out.mutable_unchecked<2>();
+  py::gil_scoped_release release;
+  for (py::ssize_t i = 0; i < n; ++i) {
+    Eigen::Vector2d to;
+    const bool ok = map(Eigen::Vector2d(in(i, 0), in(i, 1)), &to);
+    o(i, 0) = ok ? to.x() : std::numeric_limits<double>::quiet_NaN();
+    o(i, 1) = ok ? to.y() : std::numeric_limits<double>::quiet_NaN();
+  }
+  return out;
 }
 
 // Pixels (col, row) -> normalised rays (x / c, y / c): the ray (x / c, y / c, -1) in the camera
 // frame (photo x right, y up, looking along -z); NaN where the model's inversion fails.
 Points ImageToRay(const CameraFile& c, const Points& pixels) {
-  CheckPoints(pixels, "pixels");
-  const auto n = pixels.shape(0);
-  Points out({n, static_cast<py::ssize_t>(2)});
-  auto in = pixels.unchecked<2>();
-  auto o = out.mutable_unchecked<2>();
   const double cmm = c.camera.PrincipalDistanceMm();
-  {
-    py::gil_scoped_release release;
-    for (py::ssize_t i = 0; i < n; ++i) {
-      Eigen::Vector2d ideal;
-      const bool ok = c.camera.IdealFromPixel({in(i, 0), in(i, 1)}, &ideal);
-      o(i, 0) = ok ? ideal.x() / cmm : std::numeric_limits<double>::quiet_NaN();
-      o(i, 1) = ok ? ideal.y() / cmm : std::numeric_limits<double>::quiet_NaN();
-    }
-  }
-  return out;
+  return MapRows(pixels, "pixels", [&](const Eigen::Vector2d& pixel, Eigen::Vector2d* ray) {
+    const bool ok = c.camera.IdealFromPixel(pixel, ray);
+    *ray /= cmm;
+    return ok;
+  });
 }
 
 // Normalised rays (x / c, y / c) -> measured pixels (col, row); NaN where the inversion fails.
 Points RayToImage(const CameraFile& c, const Points& rays) {
-  CheckPoints(rays, "rays");
-  const auto n = rays.shape(0);
-  Points out({n, static_cast<py::ssize_t>(2)});
-  auto in = rays.unchecked<2>();
-  auto o = out.mutable_unchecked<2>();
   const double cmm = c.camera.PrincipalDistanceMm();
-  {
-    py::gil_scoped_release release;
-    for (py::ssize_t i = 0; i < n; ++i) {
-      Eigen::Vector2d pixel;
-      const bool ok = c.camera.PixelFromIdeal({in(i, 0) * cmm, in(i, 1) * cmm}, &pixel);
-      o(i, 0) = ok ? pixel.x() : std::numeric_limits<double>::quiet_NaN();
-      o(i, 1) = ok ? pixel.y() : std::numeric_limits<double>::quiet_NaN();
-    }
-  }
-  return out;
+  return MapRows(rays, "rays", [&](const Eigen::Vector2d& ray, Eigen::Vector2d* pixel) {
+    return c.camera.PixelFromIdeal(ray * cmm, pixel);
+  });
 }
 
 py::dict ResidualDict(const calib::ConversionResult& r) {
