@@ -8,9 +8,10 @@ namespace aerocal {
 
 std::string ResultText(std::string_view kind, nlohmann::json document, int indent) {
   AEROCAL_CHECK(document.is_object()) << "a result document is a JSON object";
-  if (document.contains("kind"))
+  if (document.contains("kind")) {
     AEROCAL_CHECK(document["kind"] == std::string(kind))
         << "result of kind " << document["kind"].dump() << " written as " << kind;
+  }
   document["kind"] = std::string(kind);
   document["schema_version"] = kResultSchemaVersion;
   return document.dump(indent) + "\n";

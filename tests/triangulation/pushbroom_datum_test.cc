@@ -184,7 +184,9 @@ TEST_P(GaugeDatum, RankDefectEqualsTheConstraintsPerConfiguration) {
       EXPECT_EQ(k, config.expected_defect) << config.name;
       const auto& e = none.datum.smallest_relative_eigenvalues;
       EXPECT_GT(e[k], kMargin * none.datum.threshold) << config.name;
-      if (k > 0) EXPECT_LT(e[k - 1], none.datum.threshold / kMargin) << config.name;
+      if (k > 0) {
+        EXPECT_LT(e[k - 1], none.datum.threshold / kMargin) << config.name;
+      }
     }
     // The datum adds exactly the defect, and the problem with it has full rank: a covariance
     // without undetermined parameters; the pseudo-observations count in the redundancy.
@@ -193,7 +195,9 @@ TEST_P(GaugeDatum, RankDefectEqualsTheConstraintsPerConfiguration) {
     for (const auto& w : gauge.warnings) EXPECT_NE(w.name, "covariance") << config.name;
     EXPECT_EQ(gauge.report.redundancy, none.report.redundancy + k);
     // No defect: nothing is held, the problem is the datum-free one.
-    if (k == 0) EXPECT_DOUBLE_EQ(gauge.report.vtpv, none.report.vtpv) << config.name;
+    if (k == 0) {
+      EXPECT_DOUBLE_EQ(gauge.report.vtpv, none.report.vtpv) << config.name;
+    }
     // The gauge functions named are those of the configuration (with the priors: scale with c,
     // the three rotations with the boresight).
     if (config.pos_prior && k > 0) {
@@ -252,8 +256,12 @@ TEST_P(GaugeDatum, ReferenceChoicesAgreeModuloTheGauge) {
                       angles.x(), angles.y(), angles.z());
           // No defect: the same problem; it differs in the last bits only (the Schur ordering
           // follows block addresses; 100 iterations near a zero residual amplify them).
-          if (config.expected_defect == 0) EXPECT_LT(plain.cwiseAbs().maxCoeff(), 1e-9);
-          if (!noise) EXPECT_LT(d.cwiseAbs().maxCoeff(), 1e-6) << config.name << " " << a << " " << b;
+          if (config.expected_defect == 0) {
+            EXPECT_LT(plain.cwiseAbs().maxCoeff(), 1e-9);
+          }
+          if (!noise) {
+            EXPECT_LT(d.cwiseAbs().maxCoeff(), 1e-6) << config.name << " " << a << " " << b;
+          }
         }
     }
   }
