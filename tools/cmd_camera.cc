@@ -22,6 +22,7 @@
 #include "calib/core/result_file.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
+#include "tools/option_ranges.h"
 
 namespace aerocal::tools {
 namespace {
@@ -299,6 +300,7 @@ CommandRun Setup(CLI::App& app) {
                  "OpenCV-form targets (opencv, ros, dji, colmap) reached by a fit: at most this "
                  "many distortion coefficients, 4 (k1 k2 p1 p2), 5 (+ k3) or 8 (+ k4-k6); the "
                  "fewest meeting --max-residual-px are written, each choice's residual printed")
+      ->check(FiniteRange(4, 8))
       ->check(CLI::IsMember({4, 5, 8}));
   auto show = std::make_shared<ShowArgs>();
   CLI::App* sh = app.add_subcommand(
