@@ -209,9 +209,7 @@ py::dict PointTable(const Project& p) {
 }
 
 // The keyword options of adjust(): the command's options, `-` -> `_` (tools/cmd_adjust.cc).
-triangulation::AdjustOptions OptionsFromKeywords(const py::kwargs& kw,
-                                                 bool* auto_free,
-                                                 std::string* self_calibration) {
+triangulation::AdjustOptions OptionsFromKeywords(const py::kwargs& kw) {
   triangulation::AdjustOptions o;
   static const std::set<std::string> known = {"no_snooping",
                                               "robust_start",
@@ -251,13 +249,12 @@ triangulation::AdjustOptions OptionsFromKeywords(const py::kwargs& kw,
   number("critical_value", &o.snooping_critical_value);
   number("correlation_threshold", &o.correlation_threshold);
   number("suspect_effect_limit", &o.suspect_effect_limit);
-  *auto_free = *self_calibration == "auto";
   return o;
 }
 
-Result Adjust(const Block& block, std::string self_calibration, const py::kwargs& kw) {
-  bool auto_free = false;
-  triangulation::AdjustOptions options = OptionsFromKeywords(kw, &auto_free, &self_calibration);
+Result Adjust(const Block& block, const std::string& self_calibration, const py::kwargs& kw) {
+  const bool auto_free = self_calibration == "auto";
+  triangulation::AdjustOptions options = OptionsFromKeywords(kw);
   const calib::CameraModelId model = block.project.cameras.begin()->second.model;
   for (const auto& [id, camera] : block.project.cameras)
     if (camera.model != model && self_calibration != "none")
