@@ -1,5 +1,6 @@
 #!/usr/bin/env bash
-# Runs the whole test suite of an already built tree (tools/setup.sh builds it), then the checking
+# Builds the rest of the tree tools/setup.sh configured (tests, studies, benchmarks: setup.sh builds
+# only the program and the Python module the demo needs), runs the whole test suite, then the checking
 # jobs of issue 12, each in its own build dir (configured in place, incremental on a second run):
 #  - fuzz + sanitizer (build-fuzz/, clang with ASan + UBSan, libFuzzer): by default the calib
 #    readers' fuzz targets (CSV tables; camera, rig and line-camera YAML; other tools' camera
@@ -17,6 +18,8 @@ set -euo pipefail
 root="$(cd "$(dirname "$0")/.." && pwd)"
 jobs="$(nproc)"
 full="${AEROCAL_FULL_CHECKS:-0}"
+
+cmake --build "$root/build" -j"$jobs"
 
 # Tests labelled `long` (multi-flight studies) are for benchmarks and local checks, not CI:
 # AEROCAL_LONG=1 runs them too.

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Installs the Debian packages aerocal needs (only those missing) and builds it in Release.
-# Idempotent: a second run installs nothing and rebuilds only what changed.
+# Installs the Debian packages aerocal needs (only those missing) and builds, in Release, what the
+# demo needs: the `aerocal` program and the Python module (tools/run_tests.sh builds the tests,
+# studies and benchmarks). Idempotent: a second run installs nothing and rebuilds only what changed.
+# ccache is used when installed (it is in the package list): a rebuild in another clone is quick.
 # Usage: bash tools/setup.sh [build-dir]   (default: build)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -8,7 +10,7 @@ build_dir="${1:-build}"
 
 packages=(cmake make g++ pkg-config
   libceres-dev libeigen3-dev libopencv-dev libgeographiclib-dev libproj-dev libyaml-cpp-dev libcli11-dev
-  nlohmann-json3-dev libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libtiff-dev libtinyxml2-dev zlib1g-dev clang libclang-rt-dev
+  nlohmann-json3-dev ccache libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libtiff-dev libtinyxml2-dev zlib1g-dev clang libclang-rt-dev
   python3 python3-matplotlib python3-numpy poppler-utils
   python3-dev pybind11-dev python3-pytest)
 missing=()
@@ -23,8 +25,13 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $sudo_cmd apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build_dir" -j"$(nproc)"
+launcher=()
+command -v ccache >/dev/null && launcher=(-DCMAKE_CXX_COMPILER_LAUNCHER=ccache)
+cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release "${launcher[@]}" >/dev/null
+demo_targets=(aerocal)
+help="$(cmake --build "$build_dir" --target help)"
+grep -q "^\.\.\. aerocal_python$" <<<"$help" && demo_targets+=(aerocal_python)
+cmake --build "$build_dir" -j"$(nproc)" --target "${demo_targets[@]}"
 # `import aerocal` for Debian's python3 (tools/python/README.md): the package of this build,
 # installed under /usr/local (the interpreter's dist-packages there); idempotent.
 if [ -f "$build_dir/python/aerocal/__init__.py" ]; then
