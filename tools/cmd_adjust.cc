@@ -319,14 +319,16 @@ CommandRun SetupAdjust(CLI::App& app) {
           "--write-camera needs a self-calibrating run (--self-calibration or --compare)");
 
     // Big blocks take minutes: a progress bar of the adjustment stages (terminal only).
-    const int stages = triangulation::AdjustStages(options) +
+    const int stages = (auto_free && !options.free_interior.empty()
+                            ? triangulation::AutoFreeSetRounds(options)
+                            : triangulation::AdjustStages(options)) +
                        (args->compare ? triangulation::BlockAdjustment::kRunStages : 0);
     Progress progress("adjust", stages);
     auto run = [&](const std::vector<std::string>& free) {
       auto o = options;
       o.free_interior = free;
       AdjustmentResult r = auto_free && !free.empty()
-                               ? triangulation::AdjustWithChosenFreeSet(project, o, {}, nullptr)
+                               ? triangulation::AdjustWithChosenFreeSet(project, o, {}, &progress)
                                : triangulation::Adjust(project, o, &progress);
       triangulation::ToInputFrame(frame, &r);
       return r;

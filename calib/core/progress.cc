@@ -1,5 +1,6 @@
 #include "calib/core/progress.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <unistd.h>
 
@@ -25,7 +26,8 @@ Progress::Progress(std::string label, long total)
 Progress::~Progress() { Finish(); }
 
 void Progress::Advance(long units) {
-  done_ += units;
+  const long done = done_ += units;
+  if (observer_) observer_(std::min(done, total_), total_);
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
   std::lock_guard<std::mutex> lock(mutex_);

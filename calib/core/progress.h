@@ -5,6 +5,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <functional>
 #include <mutex>
 #include <string>
 
@@ -19,6 +20,10 @@ class Progress {
   void Finish();
   /// Force-enable or disable drawing (default: whether stderr is a terminal).
   static void SetEnabled(bool enabled);
+  /// Called after every Advance with (done, total) on the advancing thread, whether or not the
+  /// line is drawn (the Python module's progress callback). It may throw: the work stops there.
+  using Observer = std::function<void(long done, long total)>;
+  void SetObserver(Observer observer) { observer_ = std::move(observer); }
 
  private:
   void Draw(bool final_line);
@@ -29,6 +34,7 @@ class Progress {
   std::chrono::steady_clock::time_point start_, last_draw_;
   bool finished_ = false;
   bool enabled_;
+  Observer observer_;
 };
 
 }  // namespace aerocal

@@ -97,7 +97,8 @@ AdjustmentResult AdjustWithChosenFreeSet(const Project& project,
         held = LeastSignificant(r, o.free_interior, choice.significance_t);
     }
     if (!held) {
-      if (progress) progress->Advance();
+      // The rounds left unused (at most one per candidate, plus the last): the bar completes.
+      if (progress) progress->Advance(AutoFreeSetRounds(options) - round + 1);
       choice.chosen = o.free_interior;
       std::string list;
       for (const auto& h : choice.held) list += (list.empty() ? "" : ", ") + h.parameter;
@@ -114,6 +115,7 @@ AdjustmentResult AdjustWithChosenFreeSet(const Project& project,
             " held (" + held->reason + ", " + FormatNumber(held->statistic, 3) +
             (held->with.empty() ? "" : " with " + held->with) + ")");
     choice.held.push_back(*held);
+    if (progress) progress->Advance();
     o.free_interior.erase(
         std::find(o.free_interior.begin(), o.free_interior.end(), held->parameter));
   }

@@ -41,11 +41,16 @@ struct FreeSetChoiceOptions {
 
 /// Adjusts `project` with options.free_interior as the candidates, holding parameters as the
 /// header says until every free one is determinable and significant. The returned result is the
-/// adjustment with the chosen set; its `free_set_choice` says what was held and why.
+/// adjustment with the chosen set; its `free_set_choice` says what was held and why. `progress`
+/// (may be null) advances by AutoFreeSetRounds(options) units: one per round, the rest at the end.
 AdjustmentResult AdjustWithChosenFreeSet(const Project& project,
                                          const AdjustOptions& options,
                                          const FreeSetChoiceOptions& choice = {},
                                          Progress* progress = nullptr);
+/// The most rounds AdjustWithChosenFreeSet can take: one per candidate held, plus the final one.
+inline int AutoFreeSetRounds(const AdjustOptions& options) {
+  return static_cast<int>(options.free_interior.size()) + 1;
+}
 
 /// The check-point test of the header: `worse` when the self-calibrated run's check errors are
 /// significantly larger (alpha one-sided) than the conventional run's on their common points.
