@@ -10,6 +10,7 @@
 #include "calib/core/progress.h"
 #include "calib/core/result_file.h"
 #include "stitch/adjustment/flight_stability.h"
+#include "stitch/io/stitch_from_files.h"
 #include "stitch/io/stitch_result_json.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
@@ -65,25 +66,9 @@ void PrintSummary(const stitch::BatchResult& result, const std::string& out) {
 int RunStitch(const StitchArgs& args) {
   CheckOutputFile(args.out, "--out");
   const calib::Camera camera = calib::ReadCamera(args.camera);
-  if (camera.subimages.empty())
-    throw InputError(args.camera + ": the camera has no sub-images to stitch");
-  stitch::BatchOptions options;
-  if (args.model != "auto") {
-    options.model = calib::ParseMappingModel(args.model);
-    if (!options.model)
-      throw ConfigError("--model: unknown model '" + args.model +
-                        "' (expected translation, conformal, affine, projective or auto)");
-  }
-  options.alpha = args.alpha;
-  options.stitch.base_ids = SplitCommaList(args.base);
-  options.stitch.data_snooping = !args.no_snooping;
-  options.stitch.Validate(camera);
-  if (!(args.sigma_px > 0)) throw ConfigError("--sigma must be > 0 px");
-  if (!(args.alpha > 0 && args.alpha < 1)) throw ConfigError("--alpha must be in (0, 1)");
-
-  const auto rows = stitch::ReadStitchObservations(args.obs, args.sigma_px);
-  const auto frames = stitch::GroupByFrame(camera, rows, args.obs);
-  if (frames.empty()) throw InputError(args.obs + ": no measurements");
+  const stitch::BatchOptions options = stitch::BatchOptionsFromText(
+      camera, args.model, args.base, args.alpha, !args.no_snooping);
+  const auto frames = stitch::ReadStitchFrames(camera, args.camera, args.obs, args.sigma_px);
   Progress progress("stitch", static_cast<long>(frames.size()));
   const stitch::BatchResult result = stitch::RunStitchBatch(camera, frames, options, &progress);
   progress.Finish();
