@@ -166,3 +166,78 @@ def test_help_names_every_area():
     text = aerocal.__doc__
     for word in ("Camera.read", "convert_camera", "Block.read", "adjust(", "InputError"):
         assert word in text
+
+
+def test_progress_callback_counts_the_stages_and_can_stop_the_work(flight):
+    p = os.path.join(flight, "flight", "project.yaml")
+    seen = []
+    r = aerocal.adjust(aerocal.Block.read(p), self_calibration="all",
+                       progress=lambda done, total: seen.append((done, total)))
+    assert r.converged and seen
+    done = [d for d, _ in seen]
+    assert done == sorted(done) and len({t for _, t in seen}) == 1
+    assert done[-1] == seen[-1][1]  # the bar completes
+
+    class Stop(Exception):
+        pass
+
+    def stop(done, total):
+        raise Stop(f"{done}/{total}")
+
+    with pytest.raises(Stop):
+        aerocal.adjust(aerocal.Block.read(p), self_calibration="all", progress=stop)
+    with pytest.raises(TypeError):
+        aerocal.adjust(aerocal.Block.read(p), progress=3)
+    seen_auto = []
+    aerocal.adjust(aerocal.Block.read(p), self_calibration="auto",
+                   progress=lambda d, t: seen_auto.append((d, t)))
+    assert seen_auto[-1][0] == seen_auto[-1][1] == 11  # ten candidates + the final round
+
+
+def test_covariance_is_the_sigmas_around_the_correlation(flight):
+    r = aerocal.adjust(aerocal.Block.read(os.path.join(flight, "flight")), self_calibration="all")
+    names = r.correlation_names
+    cov = r.covariance(["camera cam1"])
+    assert cov.shape == (10, 10)
+    s = np.array([r.cameras[0].sigma[n.split(".", 1)[1]] for n in names])
+    np.testing.assert_allclose(np.diag(cov), s ** 2, rtol=1e-12)
+    np.testing.assert_allclose(cov / np.outer(s, s), r.correlation, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(cov, cov.T, rtol=0, atol=0)
+    # A covariance matrix is positive semi-definite (relative to its scale, per entry).
+    scaled = cov / np.outer(s, s)
+    assert np.linalg.eigvalsh(scaled).min() > -1e-9
+    sub = r.covariance(["camera cam1.K1", "camera cam1.c"])
+    assert sub[0, 0] == cov[3, 3] and sub[1, 1] == cov[0, 0] and sub[0, 1] == cov[3, 0]
+    with pytest.raises(ValueError, match="camera nope"):
+        r.covariance(["camera nope"])
+
+
+def test_stitch_equals_the_command_and_types_its_result(flight):
+    camera = os.path.join(flight, "flight", "camera_nominal.yaml")
+    obs = os.path.join(flight, "flight", "stitch_obs.csv")
+    out = os.path.join(flight, "stitch.json")
+    code, text = run("stitch", "--camera", camera, "--obs", obs, "--base", "III,IV", "--out", out)
+    assert code == 0, text
+    seen = []
+    r = aerocal.stitch(camera, obs, base="III,IV", progress=lambda d, t: seen.append((d, t)))
+    with open(out) as f:
+        cli = json.load(f)
+    doc = json.loads(r.to_json())
+    for d in (cli, doc):
+        d.pop("seconds", None)
+        d.pop("timing", None)
+    assert doc == cli
+    assert r.converged and len(r.frames) == cli["n_frames"] == seen[-1][1] == seen[-1][0]
+    frame = r.frames[0]
+    for sid in ("III", "IV"):  # the datum: held, so no sigma (None, never 0)
+        assert frame["subimages"][sid]["base"] and frame["subimages"][sid]["sigma"] is None
+    free = [s for s in frame["subimages"].values() if not s["base"]]
+    assert free
+    for s in free:
+        n = s["params"].shape[0]
+        assert s["covariance"].shape == (n, n)
+        np.testing.assert_allclose(np.sqrt(np.diag(s["covariance"])), s["sigma"], rtol=1e-9)
+    with pytest.raises(ValueError, match="model"):
+        aerocal.stitch(camera, obs, model="bilinear")
+    with pytest.raises(ValueError, match="nope.csv"):
+        aerocal.stitch(camera, os.path.join(flight, "nope.csv"))

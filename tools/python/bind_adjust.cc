@@ -7,11 +7,13 @@
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
 #include "tools/python/bindings.h"
+#include "tools/python/progress_callback.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/self_calibration_choice.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
 
+#include <algorithm>
 #include <cmath>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
@@ -252,7 +254,10 @@ triangulation::AdjustOptions OptionsFromKeywords(const py::kwargs& kw) {
   return o;
 }
 
-Result Adjust(const Block& block, const std::string& self_calibration, const py::kwargs& kw) {
+Result Adjust(const Block& block,
+              const std::string& self_calibration,
+              const py::object& progress_callback,
+              const py::kwargs& kw) {
   const bool auto_free = self_calibration == "auto";
   triangulation::AdjustOptions options = OptionsFromKeywords(kw);
   const calib::CameraModelId model = block.project.cameras.begin()->second.model;
@@ -264,14 +269,19 @@ Result Adjust(const Block& block, const std::string& self_calibration, const py:
   options.Validate();
   if (!block.project.rigs.empty())
     throw ConfigError("a rig block: adjust it with the command line (`aerocal adjust`) for now");
+  const auto progress = CallbackProgress(
+      progress_callback,
+      "adjust",
+      auto_free && !options.free_interior.empty() ? triangulation::AutoFreeSetRounds(options)
+                                                  : triangulation::AdjustStages(options));
   Result out;
   {
     py::gil_scoped_release release;
     const triangulation::ObjectFrame frame(block.project.frame);
     const Project project = triangulation::ToAdjustmentFrame(block.project, frame);
     out.result = auto_free && !options.free_interior.empty()
-                     ? triangulation::AdjustWithChosenFreeSet(project, options)
-                     : triangulation::Adjust(project, options);
+                     ? triangulation::AdjustWithChosenFreeSet(project, options, {}, progress.get())
+                     : triangulation::Adjust(project, options, progress.get());
     triangulation::ToInputFrame(frame, &out.result);
   }
   nlohmann::json json = triangulation::AdjustmentToJson(out.result);
@@ -322,6 +332,48 @@ py::dict ResidualTable(const AdjustmentResult& r) {
   d["w"] = w;
   d["redundancy"] = redundancy;
   return d;
+}
+
+// sigma0^2 Q of the named interior entries, Sigma = S R S with S = diag(sigma): the result's
+// a-posteriori sigmas and its correlation matrix R (both from the same covariance estimate; a
+// fixed entry has a zero row). `names`: entries "camera ID.NAME" or whole cameras
+// "camera ID" (expanded in the model's parameter order). Exterior blocks are not kept by the
+// result (their sigmas are), so they cannot be named here.
+Eigen::MatrixXd InteriorCovariance(const AdjustmentResult& r, const std::vector<std::string>& names) {
+  if (r.interior_correlation_names.empty())
+    throw ConfigError("covariance: the adjustment has no covariance (see invalid_reasons)");
+  std::map<std::string, int> row;
+  for (size_t i = 0; i < r.interior_correlation_names.size(); ++i)
+    row[r.interior_correlation_names[i]] = static_cast<int>(i);
+  std::map<std::string, double> sigma;
+  for (const auto& c : r.cameras) {
+    const auto table = calib::CameraModelParams(c.model);
+    for (size_t k = 0; k < table.size(); ++k)
+      sigma["camera " + c.id + "." + std::string(table[k].name)] = c.free[k] ? c.sigma[k] : 0.0;
+  }
+  std::vector<int> rows;
+  std::vector<double> s;
+  for (const auto& name : names) {
+    const size_t before = rows.size();
+    for (size_t i = 0; i < r.interior_correlation_names.size(); ++i) {
+      const std::string& entry = r.interior_correlation_names[i];
+      if (entry == name || entry.rfind(name + ".", 0) == 0) {
+        rows.push_back(static_cast<int>(i));
+        s.push_back(sigma.count(entry) ? sigma.at(entry) : 0.0);
+      }
+    }
+    if (rows.size() == before)
+      throw ConfigError("covariance: '" + name + "' names no interior entry (correlation_names)");
+  }
+  Eigen::MatrixXd out(rows.size(), rows.size());
+  for (size_t i = 0; i < rows.size(); ++i)
+    for (size_t k = 0; k < rows.size(); ++k)
+      // One triangle of R: the matrix is exactly symmetric, as a covariance must be.
+      out(i, k) = (i == k ? 1.0
+                          : r.interior_correlation(std::min(rows[i], rows[k]),
+                                                   std::max(rows[i], rows[k]))) *
+                  (s[i] * s[k]);
+  return out;
 }
 
 }  // namespace
@@ -419,6 +471,15 @@ arrays (exposures, points, observations).)doc")
           "Correlation matrix of the interior parameters (rows: correlation_names)")
       .def_property_readonly("correlation_names",
                              [](const Result& r) { return r.result.interior_correlation_names; })
+      .def(
+          "covariance",
+          [](const Result& r, const std::vector<std::string>& names) {
+            return InteriorCovariance(r.result, names);
+          },
+          py::arg("names"),
+          "sigma0^2 Q of the named interior entries ('camera ID.NAME') or whole cameras "
+          "('camera ID', in the model's order), in the parameters' table units; fixed entries "
+          "have zero rows. Raises ValueError for a name the result does not hold.")
       .def_property_readonly(
           "residuals",
           [](const Result& r) { return ResidualTable(r.result); },
@@ -433,8 +494,11 @@ arrays (exposures, points, observations).)doc")
         &Adjust,
         py::arg("block"),
         py::arg("self_calibration") = "none",
+        py::arg("progress") = py::none(),
         "Bundle block adjustment as `aerocal adjust`: self_calibration none | auto | all | "
-        "'c,x0,y0,K1' ...; every other option of the command as a keyword (no_snooping, "
+        "'c,x0,y0,K1' ...; progress: None or a callable(done, total) called after each stage "
+        "(solve, data-snooping round, covariance; with auto, each round of the free-set choice); "
+        "every other option of the command as a keyword (no_snooping, "
         "robust_start, no_robust_start, max_rejections, max_sigma0, min_redundancy, "
         "critical_value, no_eo_priors, no_interior_sigma, max_iterations, "
         "correlation_threshold, suspect_effect_limit). The GIL is released while solving. A "

@@ -209,6 +209,13 @@ photo frame (x right, y up), the camera looking along -z.)doc")
       .def_property_readonly("principal_distance_mm",
                              [](const CameraFile& c) { return c.camera.PrincipalDistanceMm(); })
       .def_property_readonly(
+          "principal_distance_px",
+          [](const CameraFile& c) {
+            return c.camera.PrincipalDistanceMm() / c.camera.frame.pixel_size_mm;
+          },
+          "The principal distance in pixels: known even where the file gives no pixel size "
+          "(a camera in pixel units)")
+      .def_property_readonly(
           "notes",
           [](const CameraFile& c) { return c.notes; },
           "What the reader assumed or left out")

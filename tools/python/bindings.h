@@ -11,5 +11,7 @@ namespace aerocal::python {
 void BindCamera(pybind11::module_& m);
 /// Block.read and Block from arrays, adjust(block, **options) -> AdjustmentResult.
 void BindAdjust(pybind11::module_& m);
+/// stitch(camera, observations, **options) -> StitchResult: `aerocal stitch` from Python.
+void BindStitch(pybind11::module_& m);
 
 }  // namespace aerocal::python

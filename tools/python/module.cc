@@ -21,4 +21,5 @@ PYBIND11_MODULE(_aerocal, m) {
   });
   aerocal::python::BindCamera(m);
   aerocal::python::BindAdjust(m);
+  aerocal::python::BindStitch(m);
 }

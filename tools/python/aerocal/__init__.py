@@ -15,6 +15,11 @@ Blocks and the adjustment
     adjust(block, self_calibration="all", **options) -> AdjustmentResult
     result.sigma0, result.valid, result.check_rmse_m, result.cameras[0].estimated["c"],
     result.cameras[0].sigma["c"], result.correlation, result.residuals, result.to_json()
+    result.covariance(["camera cam1"]); adjust(..., progress=lambda done, total: ...)
+
+Sub-image stitching (multi-CCD cameras)
+    stitch(camera_file, stitch_obs_csv, model="auto") -> StitchResult
+    result.frames[i]["subimages"]["II"]["params"], result.stability, result.to_json()
 
 Conventions: pixels (col, row) with the top-left pixel centre at (0, 0); photo coordinates x
 right, y up (mm); rays (x / c, y / c) with the camera looking along -z; angles in degrees in
@@ -29,10 +34,12 @@ from ._aerocal import (
     CameraEstimate,
     ConfigError,
     InputError,
+    StitchResult,
     adjust,
     convert_camera,
     formats,
     models,
+    stitch,
 )
 
 __all__ = [
@@ -42,8 +49,10 @@ __all__ = [
     "CameraEstimate",
     "ConfigError",
     "InputError",
+    "StitchResult",
     "adjust",
     "convert_camera",
     "formats",
     "models",
+    "stitch",
 ]
