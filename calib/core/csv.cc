@@ -88,6 +88,15 @@ CsvTable CsvTable::Parse(const std::string& text, const std::string& file) {
     }
     std::vector<std::string> fields = SplitCommaList(trimmed, {true, true});
     if (table.header_.empty()) {
+      // A spreadsheet's export in a comma-decimal locale separates by ';' (or a tab): said
+      // before any column is looked for, instead of "missing column 'a;b;c'".
+      for (const char separator : {';', '\t'})
+        if (fields.size() == 1 && fields[0].find(separator) != std::string::npos)
+          ThrowInputError({file, line_number},
+                          std::string("the fields are separated by '") +
+                              (separator == ';' ? ";" : "\\t") +
+                              "', aerocal reads ',' (and '.' as the decimal mark): export the "
+                              "table as comma-separated values");
       table.header_ = fields;
       table.header_line_ = line_number;
       for (size_t i = 0; i < fields.size(); ++i) {
