@@ -3,6 +3,7 @@
 #include <set>
 #include <sstream>
 
+#include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
@@ -190,7 +191,11 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file, CameraModels
 }
 
 Camera ReadCamera(const std::string& path, CameraModels models) {
-  return ParseCamera(LoadYamlFile(path), path, models);
+  try {
+    return ParseCamera(LoadYamlFile(path), path, models);
+  } catch (const InputError& e) {
+    throw InputError(e.what() + ForeignCameraHint(path));  // another tool's file: say which
+  }
 }
 
 std::string CameraToYaml(const Camera& camera) {

@@ -142,6 +142,10 @@ const CameraFormat& FindCameraFormat(const std::string& name, const std::string&
 std::string CameraFormatNames();
 /// The names of the formats whose looks_like accepts the file (empty: none).
 std::vector<std::string> DetectCameraFormats(const std::string& path);
+/// Where aerocal's own camera file is expected: " (the file looks like a F camera file ...: convert
+/// it with `aerocal camera convert --from F ...`)" when `path` looks like another tool's file and
+/// not like ours, else "". Appended to the reader's error by ReadCamera and ReadProject.
+std::string ForeignCameraHint(const std::string& path);
 /// Writes `file` with `format` to `path` only after the format's own reader has read it back as
 /// the same camera (model, size, every pixel within 1e-6 px over a 21 x 21 grid): the writer runs
 /// on a scratch file beside `path`, which is renamed onto `path` when it reads back; else the

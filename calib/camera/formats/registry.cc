@@ -222,6 +222,22 @@ std::vector<std::string> DetectCameraFormats(const std::string& path) {
   return names;
 }
 
+std::string ForeignCameraHint(const std::string& path) {
+  // Only a regular file is looked into (a FIFO or a device would block or never end).
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(path, ec)) return "";
+  std::vector<std::string> names;
+  try {
+    names = DetectCameraFormats(path);
+  } catch (const Error&) {
+    return "";  // unreadable: the reader's own message says so
+  }
+  if (names.empty() || std::find(names.begin(), names.end(), "aerocal") != names.end()) return "";
+  return " (the file looks like a " + names.front() +
+         " camera file, not aerocal's: convert it with `aerocal camera convert --from " +
+         names.front() + " --to aerocal " + path + " camera.yaml`)";
+}
+
 void WriteCameraFileVerified(const CameraFormat& format, const std::string& path,
                              const CameraFile& file) {
   namespace fs = std::filesystem;
