@@ -1,16 +1,17 @@
 #include "triangulation/adjustment/block_adjustment.h"
 
-#include "triangulation/adjustment/suspect_effect.h"
-#include "calib/core/median.h"
-
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/log.h"
+#include "calib/core/median.h"
 #include "calib/core/string_printf.h"
 #include "calib/residuals/gnss_prior.h"
 #include "calib/residuals/prior.h"
 #include "calib/residuals/rotation_prior.h"
 #include "triangulation/adjustment/determinability.h"
 #include "triangulation/adjustment/forward_intersection.h"
+#include "triangulation/adjustment/plausibility.h"
+#include "triangulation/adjustment/suspect_effect.h"
 #include "triangulation/sensor/frame_camera.h"
 
 #include <Eigen/Eigenvalues>
@@ -956,6 +957,9 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   result.frame = project_.frame.description;
   result.datum = storage_->datum;
   result.notes = storage_->notes;
+  // Said before the solve as well (a long run should not hide a unit mistake until its end).
+  for (const ResultWarning& w : PlausibilityWarnings(project_))
+    LogWarning(w.name + ": " + w.subject + ": " + w.message);
   std::vector<BlockId> interior_blocks;
   for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k)
     interior_blocks.push_back(storage_->frame.InteriorBlock(k));
@@ -1200,7 +1204,8 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     result.Invalidate("singular: " + std::to_string(result.determinability.undetermined.size()) +
                       " parameter(s) not determinable (" +
                       result.determinability.undetermined.front() + ", ...)");
-  result.warnings = GroupRmsWarnings(result.solve);
+  result.warnings = PlausibilityWarnings(project_);  // likely unit mistakes of the inputs
+  for (auto& w : GroupRmsWarnings(result.solve)) result.warnings.push_back(std::move(w));
   for (const auto& left : result.control_left_out) {
     const PointDifference& d = left.difference;
     const double w = std::max(0.0, left.LargestW().value_or(0.0));

@@ -1,5 +1,6 @@
 #include "triangulation/block/block_io.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -7,9 +8,12 @@
 #include <set>
 
 #include "calib/camera/camera_io.h"
+#include "calib/camera/formats/camera_formats.h"
 #include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+#include "calib/core/log.h"
+#include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "triangulation/block/value_bounds.h"
 
@@ -184,6 +188,33 @@ std::vector<GroundPoint> ReadPoints(const std::string& path) {
   return out;
 }
 
+namespace {
+
+// An image observation lies on its format: pixel centres 0 .. W-1, 0 .. H-1, half a pixel to the
+// edge, plus a pixel of measuring tolerance. Coordinates beyond are no measurement of that
+// camera; the usual cause is a list measured on a resized copy of the images.
+void CheckOnFormat(const Project& project,
+                   const ImageObservation& o,
+                   const std::string& camera_id,
+                   int width_px,
+                   int height_px,
+                   const std::string& what) {
+  constexpr double kTolerancePx = 1.5;
+  if (width_px <= 0 || height_px <= 0) return;  // a format the camera file does not give
+  const double outside = std::max({-o.pixel.x(), o.pixel.x() - (width_px - 1),
+                                   -o.pixel.y(), o.pixel.y() - (height_px - 1)});
+  if (outside <= kTolerancePx) return;
+  ThrowInputError({project.observations_file, o.line},
+                  StringPrintf("image %s point %s at pixel (%.2f, %.2f) lies %.1f px outside "
+                               "the %d x %d px format of %s of camera '%s': measured on a "
+                               "resized copy of the images? (`import odm --pixel-scale` scales "
+                               "such a list)",
+                               o.image.c_str(), o.point.c_str(), o.pixel.x(), o.pixel.y(),
+                               outside, width_px, height_px, what.c_str(), camera_id.c_str()));
+}
+
+}  // namespace
+
 void ValidateProject(const Project& project) {
   std::set<std::string> images, points;
   std::map<std::string, std::string> camera_of_image;  // Project::FindExposure's first match
@@ -212,11 +243,19 @@ void ValidateProject(const Project& project) {
     if (rig != project.rigs.end() && rig->second.HeadIndex(o.head) < 0)
       ThrowInputError({project.observations_file, o.line},
                       "rig '" + camera_id + "' has no head '" + o.head + "'");
+    const auto& camera = project.cameras.at(camera_id);
     if (!o.subimage.empty()) {
-      const auto& camera = project.cameras.at(camera_id);
-      if (camera.SubimageIndex(o.subimage) < 0)
+      const int k = camera.SubimageIndex(o.subimage);
+      if (k < 0)
         ThrowInputError({project.observations_file, o.line},
                         "camera of image " + o.image + " has no sub-image '" + o.subimage + "'");
+      const auto& sub = camera.subimages[k];
+      CheckOnFormat(project, o, camera_id, sub.width_px, sub.height_px, "sub-image " + sub.id);
+    } else if (rig != project.rigs.end()) {
+      const auto& head = rig->second.heads[rig->second.HeadIndex(o.head)].camera;
+      CheckOnFormat(project, o, camera_id, head.width_px, head.height_px, "head " + o.head);
+    } else {
+      CheckOnFormat(project, o, camera_id, camera.width_px, camera.height_px, "the image");
     }
   }
 }
@@ -240,14 +279,18 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
     const std::string id = entry.first.Scalar();
     const std::string file = ResolvePath(dir, YamlString(entry.second, path, "camera file"));
     project.camera_files[id] = file;
-    const YAML::Node camera = LoadYamlFile(file);
-    if (camera.IsMap() && camera["rig"]) {
-      // A rig camera file: the rig, and its reference head as the camera of that id.
-      const calib::Rig rig = calib::ParseRig(camera, file);
-      project.cameras[id] = rig.heads[rig.ReferenceIndex()].camera;
-      project.rigs[id] = rig;
-    } else {
-      project.cameras[id] = calib::ParseCamera(camera, file, calib::CameraModels::kAny);
+    try {
+      const YAML::Node camera = LoadYamlFile(file);
+      if (camera.IsMap() && camera["rig"]) {
+        // A rig camera file: the rig, and its reference head as the camera of that id.
+        const calib::Rig rig = calib::ParseRig(camera, file);
+        project.cameras[id] = rig.heads[rig.ReferenceIndex()].camera;
+        project.rigs[id] = rig;
+      } else {
+        project.cameras[id] = calib::ParseCamera(camera, file, calib::CameraModels::kAny);
+      }
+    } catch (const InputError& e) {
+      throw InputError(e.what() + calib::ForeignCameraHint(file));  // another tool's file
     }
   }
   project.exposures_file = ResolvePath(dir, YamlString(root["exposures"], path, "exposures"));
@@ -346,6 +389,13 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
   }
   if (root["platform"]) project.platform = ReadPlatform(root["platform"], path);
   ValidateProject(project);
+  // What was read (--verbose): a wrong file named in the project shows here first.
+  LogInfo(StringPrintf("read %s: %zu camera(s), %zu exposures (%s), %zu points (%s), "
+                       "%zu image observations (%s), frame: %s",
+                       path.c_str(), project.cameras.size(), project.exposures.size(),
+                       project.exposures_file.c_str(), project.points.size(),
+                       project.points_file.c_str(), project.observations.size(),
+                       project.observations_file.c_str(), project.frame.description.c_str()));
   return project;
 }
 
