@@ -56,6 +56,7 @@ int main(int argc, char** argv) {
   for (const auto& entry : CommandRegistry()) {
     CLI::App* sub = app.add_subcommand(entry.name, entry.description);
     sub->option_defaults()->always_capture_default();  // --help shows every default
+    sub->fallthrough();  // the global --verbose / --quiet also after the command's name
     subs.emplace_back(sub, &entry);
   }
   try {

@@ -1,6 +1,7 @@
 #include "calib/problem/problem_builder.h"
 
 #include "calib/core/error.h"
+#include "calib/core/log.h"
 #include "calib/camera/rotation.h"
 #include "calib/problem/normal_equations.h"
 #include "calib/problem/rotation_manifold.h"
@@ -465,8 +466,10 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       : options.num_threads > 0
           ? options.num_threads
           : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
-  ceres_options.minimizer_progress_to_stdout = options.verbose;
-  ceres_options.logging_type = options.verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
+  // The solver's iterations: asked for by the caller, or by the command line's --verbose.
+  const bool verbose = options.verbose || GetLogLevel() == LogLevel::kInfo;
+  ceres_options.minimizer_progress_to_stdout = verbose;
+  ceres_options.logging_type = verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
 
   int eliminable_params = 0, other_params = 0;
   std::vector<BlockId> eliminable;
