@@ -20,3 +20,6 @@ aerocal_add_test(tools/cli_quality LIBS aerocal::stitch LABELS cli)
 # Issue 37 (bad input, part 2): schema-checked certificate inputs, budget units, absurd geometry,
 # bounded sizes, the renderer's text and output sets, the ranges of every numeric option.
 aerocal_add_test(tools/bad_input2 LIBS aerocal::triangulation LABELS cli TIMEOUT 900)
+# Plausibility before solving (issue 33 item 5): ';' CSVs, another tool's camera file, pixels off
+# the format, c given in pixels; the global --verbose / --quiet after the command (item 4).
+aerocal_add_test(tools/cli_plausibility LIBS aerocal::calib LABELS cli)
