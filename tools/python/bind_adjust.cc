@@ -342,9 +342,6 @@ py::dict ResidualTable(const AdjustmentResult& r) {
 Eigen::MatrixXd InteriorCovariance(const AdjustmentResult& r, const std::vector<std::string>& names) {
   if (r.interior_correlation_names.empty())
     throw ConfigError("covariance: the adjustment has no covariance (see invalid_reasons)");
-  std::map<std::string, int> row;
-  for (size_t i = 0; i < r.interior_correlation_names.size(); ++i)
-    row[r.interior_correlation_names[i]] = static_cast<int>(i);
   std::map<std::string, double> sigma;
   for (const auto& c : r.cameras) {
     const auto table = calib::CameraModelParams(c.model);
