@@ -1,5 +1,6 @@
 #include "tools/camera_formats.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -94,13 +95,17 @@ bool OpenStorage(const std::string& text, cv::FileStorage* fs, std::string* erro
 }
 
 // A YAML file cut short (the first lines of a calibration output): the longest prefix that ends
-// before a top-level key and parses; 0 when there is none.
-size_t ReadablePrefixLines(const std::vector<std::string>& lines, cv::FileStorage* fs) {
-  for (size_t cut = lines.size(); cut-- > 1;) {
+// before a top-level key at or above the line cv::FileStorage stopped at (`error_line`) and
+// parses; 0 when there is none. At most a few prefixes are parsed, so a long file with an error
+// is not parsed once per line (readers stay linear, issue 37 class 7).
+size_t ReadablePrefixLines(const std::vector<std::string>& lines, size_t error_line, cv::FileStorage* fs) {
+  int attempts = 0;
+  for (size_t cut = std::min(error_line, lines.size()); cut-- > 1 && attempts < 4;) {
     const std::string& line = lines[cut];
     if (line.empty() || line[0] == ' ' || line[0] == '-' || line[0] == '#' ||
         line.find(':') == std::string::npos)
       continue;
+    ++attempts;
     std::string text;
     for (size_t i = 0; i < cut; ++i) text += lines[i] + "\n";
     if (OpenStorage(text, fs)) return cut;
@@ -151,11 +156,17 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
   };
   if (!OpenStorage(text, &fs, &error)) {
     const std::vector<std::string> lines = SplitLines(text);
-    const size_t kept = text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, &fs) : 0;
+    const size_t error_line = static_cast<size_t>(OpenCvParseErrorLine(error).first);
+    const size_t kept = text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, error_line, &fs) : 0;
     if (kept == 0) unparsable();
     notes.push_back("the file is cut short: lines 1-" + std::to_string(kept) +
                     " read (the entry from line " + std::to_string(kept + 1) +
                     " on is incomplete)");
+  }
+  // Keys are looked up in a map: cv::FileStorage asserts (cv::Exception) on any other top level.
+  if (!fs.root().isMap()) {
+    if (!error.empty()) unparsable();
+    ThrowInputError({path, 1}, "the top level is not a map of keys (camera_matrix, distortion_coefficients, ...)");
   }
   std::string matrix_key = "camera_matrix", dist_key = "distortion_coefficients";
   bool stereo = false;

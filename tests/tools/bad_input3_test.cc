@@ -155,6 +155,9 @@ TEST(OpenCvStorage, EveryErrorIsFileLineWithoutOpenCvInternals) {
       {"k1_inf", ".xml", Replaced(kGoodXml, "-0.1 0.01", ".Inf 0.01"), 11, "not finite"},
       {"distortion_6", ".yml", Replaced(Replaced(kGoodYaml, "rows: 5", "rows: 6"), "0., 0., 0. ]", "0., 0., 0., 0. ]"),
        10, "must hold 4, 5, 8, 12 or 14 values"},
+      // A top level that is no map (found by fuzz/camera_formats: cv::FileStorage asserted).
+      {"yaml_root_sequence", ".yml", "%YAML:1.0\n- camera_matrix\n- 3\n", 1, "the top level is not a map"},
+      {"json_root_array", ".json", "[ 1, 2 ]\n", 1, "cv::FileStorage cannot parse"},
       // Syntax cv::FileStorage cannot parse: its line, not line 1.
       {"yaml_syntax", ".yml", Replaced(kGoodYaml, "image_height: 480\n", "image_height: 480\n  : : [\n"), 5, "parse"},
       {"xml_syntax", ".xml", Replaced(kGoodXml, "<cols>3</cols>", "<cols>3</rows>"), 7, "parse"},
