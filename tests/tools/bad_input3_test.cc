@@ -265,6 +265,18 @@ TEST(CameraConvertOutputs, OutAndReportInTwoFoldersAreOneSet) {
   ExpectNoLeftovers(d.path());
 }
 
+TEST(RigConvertOutputs, AnOutNamingTheDemIsRefusedBeforeAnythingIsRead) {
+  TempDir d("aerocal_bad_input3_rig_convert");
+  Write(d.File("dem.asc"), "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n");
+  const std::string before = Read(d.File("dem.asc"));
+  const auto r = RunAerocal("rig convert --camera " + std::string(AEROCAL_CONFIGS_DIR) + "/rig_dual_lens.yaml --images A=" +
+                            d.File("a.tif") + ",B=" + d.File("b.tif") + " --out " + d.File("dem.asc") + " --dem " +
+                            d.File("./dem.asc"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("--out: '" + d.File("dem.asc") + "' is --dem"), std::string::npos) << r.output;
+  EXPECT_EQ(Read(d.File("dem.asc")), before);
+}
+
 // ---- class 7: size products of options, bounded before allocation ----
 
 TEST(SizeProducts, AreRefusedByNameBeforeAnythingIsAllocated) {
