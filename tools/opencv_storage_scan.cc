@@ -1,5 +1,6 @@
 #include "tools/opencv_storage_scan.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <regex>
@@ -203,6 +204,12 @@ int OpenCvStorageScan::Line(const std::string& key) const {
 }
 
 OpenCvStorageScan ScanOpenCvStorage(const std::string& text, const std::string& path) {
+  // cv::FileStorage reads a memory buffer as a C string: a NUL byte cuts it short, and in an XML
+  // declaration that made OpenCV 4.6 dereference a null pointer (found by fuzz/camera_formats).
+  const size_t nul = text.find('\0');
+  if (nul != std::string::npos)
+    ThrowInputError({path, 1 + static_cast<int>(std::count(text.begin(), text.begin() + nul, '\n'))},
+                    "a NUL byte: not a text file (an OpenCV FileStorage file is YAML, XML or JSON text)");
   OpenCvStorageScan scan;
   Scanner scanner(text, path);
   const Syntax syntax = SyntaxOf(text);

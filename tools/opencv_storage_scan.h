@@ -6,7 +6,9 @@
 //    >= 1, a known element type of 1..4 channels, and rows x cols x channels at most the number
 //    of characters in the text (every element needs at least one), so nothing cv::FileStorage
 //    then allocates is larger than a small multiple of the file;
-//  - refuses a top-level key that occurs twice (cv::FileStorage would take one silently);
+//  - refuses a NUL byte (cv::FileStorage reads memory as a C string; a NUL in an XML declaration
+//    crashed OpenCV 4.6) and a top-level key that occurs twice (cv::FileStorage would take one
+//    silently);
 //  - keeps the line of every top-level key, for the reader's FILE:LINE messages.
 // Errors are InputError "FILE:LINE: what".
 #pragma once

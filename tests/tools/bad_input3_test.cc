@@ -158,6 +158,9 @@ TEST(OpenCvStorage, EveryErrorIsFileLineWithoutOpenCvInternals) {
       // A top level that is no map (found by fuzz/camera_formats: cv::FileStorage asserted).
       {"yaml_root_sequence", ".yml", "%YAML:1.0\n- camera_matrix\n- 3\n", 1, "the top level is not a map"},
       {"json_root_array", ".json", "[ 1, 2 ]\n", 1, "cv::FileStorage cannot parse"},
+      // A NUL byte (found by fuzz/camera_formats: in the XML declaration it crashed OpenCV 4.6).
+      {"xml_nul", ".xml", Replaced(kGoodXml, "version=\"1.0\"", std::string("version=\0\1.0\"", 13)), 1, "a NUL byte"},
+      {"yaml_nul", ".yml", Replaced(kGoodYaml, "cols: 1", std::string("cols: 1\0", 8)), 12, "a NUL byte"},
       // Syntax cv::FileStorage cannot parse: its line, not line 1.
       {"yaml_syntax", ".yml", Replaced(kGoodYaml, "image_height: 480\n", "image_height: 480\n  : : [\n"), 5, "parse"},
       {"xml_syntax", ".xml", Replaced(kGoodXml, "<cols>3</cols>", "<cols>3</rows>"), 7, "parse"},
@@ -290,6 +293,9 @@ TEST(SizeProducts, AreRefusedByNameBeforeAnythingIsAllocated) {
                 " --lines 1000000 --detectors 100000 --out " + d.File("pb"),
             "--lines x --detectors"},
            {"simulate --pushbroom --lines 2000000 --out " + d.File("pb"), "--lines"},
+           {"simulate --exposures 20000 --stitch-ties 10000 --out " + d.File("pb"), "--exposures x --stitch-ties"},
+           {"simulate --exposures 20000 --tie-points 1000000 --out " + d.File("pb"),
+            "--exposures x (--points + --tie-points)"},
            {"simulate --pushbroom --images --texture " + d.File("photo.pgm") +
                 " --reference-size 20000x20000 --out " + d.File("pb"),
             "--reference-size"},
