@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdlib>
+#include <cctype>
 #include <regex>
 #include <sstream>
 
@@ -25,6 +26,9 @@ Syntax SyntaxOf(const std::string& text) {
 struct Header {
   double rows = -1, cols = -1, channels = 1;
 };
+
+constexpr int kMaxNesting = 64;       // collections inside collections
+constexpr int kMaxIndentation = 256;  // YAML block nesting: columns of indentation
 
 class Scanner {
  public:
@@ -51,6 +55,18 @@ class Scanner {
       Throw(line, "a matrix of " + FormatNumber(header_.rows) + " x " + FormatNumber(header_.cols) +
                       (header_.channels > 1 ? " x " + FormatNumber(header_.channels) : "") +
                       " elements cannot be held by a file of " + FormatNumber(limit_) + " characters");
+  }
+
+  // cv::FileStorage parses nested collections recursively, without a limit: 200000 '[' overflowed
+  // its stack. Nesting is bounded before it reads anything.
+  void Nesting(int depth, int line, const char* what) const {
+    if (depth > kMaxNesting)
+      Throw(line, std::string(what) + " nested deeper than " + std::to_string(kMaxNesting) + " levels");
+  }
+  void Indentation(size_t columns, int line) const {
+    if (columns > static_cast<size_t>(kMaxIndentation))
+      Throw(line, "indented " + std::to_string(columns) + " columns: YAML nested deeper than " +
+                      std::to_string(kMaxIndentation) + " columns");
   }
 
   void Key(const std::string& key, int line, OpenCvStorageScan* scan) const {
@@ -107,54 +123,122 @@ std::string Unquoted(std::string value) {
   return value;
 }
 
+// The scan is hand-written, not std::regex: libstdc++'s regex recurses once per character and
+// overflows the stack on a long line, and every step here is linear in the line.
+bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
+bool IsNameChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-' || c == ':'; }
+
+size_t SkipSpaces(const std::string& line, size_t i) {
+  while (i < line.size() && IsSpace(line[i])) ++i;
+  return i;
+}
+
+// A field's value cut to a length no valid value exceeds (the check then refuses it).
+std::string Bounded(const std::string& value) { return value.size() > 64 ? value.substr(0, 65) : value; }
+
+constexpr const char* kFieldNames[] = {"rows", "cols", "dt", "sizes", "data"};
+
 // YAML and JSON: `rows: 3`, `"rows": 3`, in block or flow style (several fields on a line).
 void ScanFieldsYamlJson(const std::string& line, int number, Scanner* scanner) {
-  static const std::regex kField(R"re((?:^|[\s{,])"?(rows|cols|dt|sizes|data)"?\s*:\s*(\[[^\]]*\]?|"[^"]*"|[^,}\s]*))re");
-  for (auto it = std::sregex_iterator(line.begin(), line.end(), kField); it != std::sregex_iterator(); ++it)
-    scanner->Field((*it)[1], Unquoted((*it)[2]), number);
+  for (const char* name : kFieldNames) {
+    const std::string key(name);
+    for (size_t at = line.find(key); at != std::string::npos; at = line.find(key, at + 1)) {
+      size_t begin = at;
+      if (begin > 0 && line[begin - 1] == '"') --begin;
+      if (begin > 0 && !(IsSpace(line[begin - 1]) || line[begin - 1] == '{' || line[begin - 1] == ',')) continue;
+      size_t i = at + key.size();
+      if (i < line.size() && line[i] == '"') ++i;
+      i = SkipSpaces(line, i);
+      if (i >= line.size() || line[i] != ':') continue;
+      i = SkipSpaces(line, i + 1);
+      size_t end = i;
+      if (i < line.size() && line[i] == '[') {
+        end = line.find(']', i);
+        end = end == std::string::npos ? line.size() : end + 1;
+      } else if (i < line.size() && line[i] == '"') {
+        end = line.find('"', i + 1);
+        end = end == std::string::npos ? line.size() : end + 1;
+      } else {
+        while (end < line.size() && line[end] != ',' && line[end] != '}' && !IsSpace(line[end])) ++end;
+      }
+      scanner->Field(key, Bounded(Unquoted(line.substr(i, end - i))), number);
+    }
+  }
 }
 
+// XML: <rows>3</rows>; the value is the text up to the next tag (XML quotes dt too: <dt>"2f"</dt>).
 void ScanFieldsXml(const std::string& line, int number, Scanner* scanner) {
-  static const std::regex kField(R"(<(rows|cols|dt|sizes|data)>\s*([^<]*?)\s*(</|$))");
-  for (auto it = std::sregex_iterator(line.begin(), line.end(), kField); it != std::sregex_iterator(); ++it)
-    scanner->Field((*it)[1], Unquoted((*it)[2]), number);  // XML quotes dt too: <dt>"2f"</dt>
+  for (const char* name : kFieldNames) {
+    const std::string tag = "<" + std::string(name) + ">";
+    for (size_t at = line.find(tag); at != std::string::npos; at = line.find(tag, at + 1)) {
+      const size_t i = SkipSpaces(line, at + tag.size());
+      size_t end = line.find('<', i);
+      if (end == std::string::npos) end = line.size();
+      while (end > i && IsSpace(line[end - 1])) --end;
+      scanner->Field(name, Bounded(Unquoted(line.substr(i, end - i))), number);
+    }
+  }
 }
 
-// YAML: a key at column 0 is a top-level key.
+// YAML: a key at column 0 (a name, or a quoted one, then ':' and a space or the line's end) is a
+// top-level key.
 void ScanKeyYaml(const std::string& line, int number, const Scanner& scanner, OpenCvStorageScan* scan) {
-  static const std::regex kKey(R"re(^([A-Za-z_][A-Za-z0-9_.-]*|"[^"]*")\s*:(\s.*)?$)re");
-  std::smatch m;
-  if (std::regex_match(line, m, kKey)) scanner.Key(Unquoted(m[1]), number, scan);
+  if (line.empty()) return;
+  size_t end = 0;
+  if (line[0] == '"') {
+    end = line.find('"', 1);
+    if (end == std::string::npos) return;
+    ++end;
+  } else if (std::isalpha(static_cast<unsigned char>(line[0])) || line[0] == '_') {
+    while (end < line.size() && IsNameChar(line[end]) && line[end] != ':') ++end;
+  } else {
+    return;
+  }
+  const size_t colon = SkipSpaces(line, end);
+  if (colon >= line.size() || line[colon] != ':') return;
+  if (colon + 1 < line.size() && !IsSpace(line[colon + 1])) return;
+  scanner.Key(Unquoted(line.substr(0, end)), number, scan);
 }
 
 // XML: the elements directly inside the root (<opencv_storage>); comments and declarations skipped.
 class XmlKeys {
  public:
   void Line(const std::string& line, int number, const Scanner& scanner, OpenCvStorageScan* scan) {
-    static const std::regex kTag(R"(<(/?)([A-Za-z_][A-Za-z0-9_.:-]*)[^>]*?(/?)>)");
-    std::string rest = line;
-    std::string visible;  // the line without comments
-    while (!rest.empty()) {
+    size_t i = 0;
+    while (i < line.size()) {
       if (in_comment_) {
-        const size_t end = rest.find("-->");
+        const size_t end = line.find("-->", i);
         if (end == std::string::npos) return;
-        rest = rest.substr(end + 3);
+        i = end + 3;
         in_comment_ = false;
+        continue;
       }
-      const size_t start = rest.find("<!--");
-      visible += rest.substr(0, start);
-      if (start == std::string::npos) break;
-      rest = rest.substr(start + 4);
-      in_comment_ = true;
-    }
-    for (auto it = std::sregex_iterator(visible.begin(), visible.end(), kTag); it != std::sregex_iterator(); ++it) {
-      const auto& m = *it;
-      if (m[1].length()) {
+      const size_t open = line.find('<', i);
+      if (open == std::string::npos) return;
+      if (line.compare(open, 4, "<!--") == 0) {
+        in_comment_ = true;
+        i = open + 4;
+        continue;
+      }
+      size_t j = open + 1;
+      const bool closing = j < line.size() && line[j] == '/';
+      if (closing) ++j;
+      const size_t name_begin = j;
+      while (j < line.size() && IsNameChar(line[j])) ++j;
+      const size_t close = line.find('>', j);
+      if (j == name_begin || !(std::isalpha(static_cast<unsigned char>(line[name_begin])) || line[name_begin] == '_')) {
+        i = open + 1;  // a declaration (<?xml ...?>), text, or a tag cut by the line's end
+        continue;
+      }
+      if (closing) {
         --depth_;
       } else {
-        if (depth_ == 1) scanner.Key(m[2], number, scan);
-        if (!m[3].length()) ++depth_;
+        if (depth_ == 1) scanner.Key(line.substr(name_begin, j - name_begin), number, scan);
+        const bool self_closing = close != std::string::npos && close > j && line[close - 1] == '/';
+        if (!self_closing) scanner.Nesting(++depth_, number, "elements");
       }
+      if (close == std::string::npos) return;
+      i = close + 1;
     }
   }
 
@@ -178,7 +262,7 @@ class JsonKeys {
         }
         i = end;
       } else if (c == '{' || c == '[') {
-        ++depth_;
+        scanner.Nesting(++depth_, number, "objects and arrays");
       } else if (c == '}' || c == ']') {
         --depth_;
       }
@@ -194,6 +278,37 @@ class JsonKeys {
     return line.size();
   }
   int depth_ = 0;
+};
+
+// YAML: block nesting by indentation (leading spaces and "- " items), flow nesting by [ and {
+// outside quoted strings, carried from line to line.
+class YamlNesting {
+ public:
+  void Line(const std::string& line, int number, const Scanner& scanner) {
+    size_t indent = 0;
+    while (indent < line.size() && (line[indent] == ' ' || (line[indent] == '-' && indent + 1 < line.size() &&
+                                                             line[indent + 1] == ' ')))
+      ++indent;
+    scanner.Indentation(indent, number);
+    char quote = 0;
+    for (size_t i = indent; i < line.size(); ++i) {
+      const char c = line[i];
+      if (quote) {
+        if (c == quote) quote = 0;
+      } else if (c == '"' || c == '\'') {
+        quote = c;
+      } else if (c == '#' && (i == 0 || IsSpace(line[i - 1]))) {
+        return;  // a comment
+      } else if (c == '[' || c == '{') {
+        scanner.Nesting(++flow_depth_, number, "flow collections");
+      } else if ((c == ']' || c == '}') && flow_depth_ > 0) {
+        --flow_depth_;
+      }
+    }
+  }
+
+ private:
+  int flow_depth_ = 0;
 };
 
 }  // namespace
@@ -215,6 +330,7 @@ OpenCvStorageScan ScanOpenCvStorage(const std::string& text, const std::string& 
   const Syntax syntax = SyntaxOf(text);
   XmlKeys xml;
   JsonKeys json;
+  YamlNesting yaml;
   std::istringstream in(text);
   int number = 0;
   for (std::string line; std::getline(in, line);) {
@@ -231,6 +347,7 @@ OpenCvStorageScan ScanOpenCvStorage(const std::string& text, const std::string& 
         break;
       case Syntax::kYaml:
         if (line.rfind('#', 0) == 0) break;
+        yaml.Line(line, number, scanner);
         ScanKeyYaml(line, number, scanner, &scan);
         ScanFieldsYamlJson(line, number, &scanner);
         break;

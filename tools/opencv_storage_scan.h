@@ -9,6 +9,8 @@
 //  - refuses a NUL byte (cv::FileStorage reads memory as a C string; a NUL in an XML declaration
 //    crashed OpenCV 4.6) and a top-level key that occurs twice (cv::FileStorage would take one
 //    silently);
+//  - bounds nesting (64 levels of collections or elements, YAML indentation within 256 columns):
+//    cv::FileStorage parses recursively without a limit (200000 '[' overflowed its stack);
 //  - keeps the line of every top-level key, for the reader's FILE:LINE messages.
 // Errors are InputError "FILE:LINE: what".
 #pragma once

@@ -161,6 +161,23 @@ TEST(OpenCvStorage, EveryErrorIsFileLineWithoutOpenCvInternals) {
       // A NUL byte (found by fuzz/camera_formats: in the XML declaration it crashed OpenCV 4.6).
       {"xml_nul", ".xml", Replaced(kGoodXml, "version=\"1.0\"", std::string("version=\0\1.0\"", 13)), 1, "a NUL byte"},
       {"yaml_nul", ".yml", Replaced(kGoodYaml, "cols: 1", std::string("cols: 1\0", 8)), 12, "a NUL byte"},
+      // Nesting cv::FileStorage would parse recursively until its stack overflows (exit 139 before).
+      {"yaml_deep_flow", ".yml", std::string(kGoodYaml) + "deep: " + std::string(200000, '[') + "\n", 15,
+       "flow collections nested deeper than 64"},
+      {"yaml_deep_block", ".yml", std::string(kGoodYaml) + "deep:\n" + std::string(300, ' ') + "- 1\n", 16,
+       "indented 302 columns"},
+      {"yaml_deep_dashes", ".yml", std::string(kGoodYaml) + "deep:\n" + [] {
+         std::string dashes;
+         for (int i = 0; i < 100000; ++i) dashes += "- ";
+         return dashes + "1\n";
+       }(), 16, "indented 200000 columns"},
+      {"json_deep", ".json", Replaced(kGoodJson, "\"image_width\": 640,", "\"deep\": " + std::string(200000, '[') + ","), 2,
+       "objects and arrays nested deeper than 64"},
+      {"xml_deep", ".xml", Replaced(kGoodXml, "<image_width>640</image_width>", [] {
+         std::string tags;
+         for (int i = 0; i < 200000; ++i) tags += "<a>";
+         return tags;
+       }()), 3, "elements nested deeper than 64"},
       // Syntax cv::FileStorage cannot parse: its line, not line 1.
       {"yaml_syntax", ".yml", Replaced(kGoodYaml, "image_height: 480\n", "image_height: 480\n  : : [\n"), 5, "parse"},
       {"xml_syntax", ".xml", Replaced(kGoodXml, "<cols>3</cols>", "<cols>3</rows>"), 7, "parse"},
