@@ -311,7 +311,7 @@ TEST(SizeProducts, AreRefusedByNameBeforeAnythingIsAllocated) {
             "--lines x --detectors"},
            {"simulate --pushbroom --lines 2000000 --out " + d.File("pb"), "--lines"},
            {"simulate --exposures 20000 --stitch-ties 10000 --out " + d.File("pb"), "--exposures x --stitch-ties"},
-           {"simulate --exposures 20000 --tie-points 1000000 --out " + d.File("pb"),
+           {"simulate --exposures 20000 --stitch-ties 0 --tie-points 1000000 --out " + d.File("pb"),
             "--exposures x (--points + --tie-points)"},
            {"simulate --pushbroom --images --texture " + d.File("photo.pgm") +
                 " --reference-size 20000x20000 --out " + d.File("pb"),

@@ -341,7 +341,7 @@ SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
   const double ties = double(o.exposures) * o.stitching.ties_per_frame;
   if (ties > kMaxSimulatedStitchTies)
     throw ConfigError("--exposures x --stitch-ties: " + FormatNumber(ties) + " stitching ties are more than " +
-                      FormatNumber(kMaxSimulatedStitchTies));
+                      FormatNumber(kMaxSimulatedStitchTies) + " (fewer --stitch-ties, default 900 a frame)");
   const double pairs = double(o.exposures) * (double(o.ground_points) + o.tie_points);
   if (pairs > kMaxSimulatedPointExposurePairs)
     throw ConfigError("--exposures x (--points + --tie-points): " + FormatNumber(pairs) +
