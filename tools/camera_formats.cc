@@ -1,5 +1,7 @@
 #include "tools/camera_formats.h"
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 
@@ -8,6 +10,7 @@
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+#include "tools/opencv_storage_scan.h"
 
 namespace aerocal::tools {
 namespace {
@@ -79,27 +82,60 @@ calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib
 
 namespace {
 
-bool OpenStorage(const std::string& text, cv::FileStorage* fs) {
+// Opens `text` from memory; on failure `*error` (optional) receives cv::FileStorage's message.
+bool OpenStorage(const std::string& text, cv::FileStorage* fs, std::string* error = nullptr) {
   try {
     return fs->open(text, cv::FileStorage::READ | cv::FileStorage::MEMORY) && fs->isOpened();
-  } catch (const cv::Exception&) {
+  } catch (const cv::Exception& e) {
+    // OpenCV 4's parse errors carry "(LINE): message" in `func` and the function's name in `err`
+    // (the two arguments are swapped in FileStorage::Impl::parseError): both are kept.
+    if (error) *error = e.err + "\n" + e.func;
     return false;
   }
 }
 
 // A YAML file cut short (the first lines of a calibration output): the longest prefix that ends
-// before a top-level key and parses; 0 when there is none.
-size_t ReadablePrefixLines(const std::vector<std::string>& lines, cv::FileStorage* fs) {
-  for (size_t cut = lines.size(); cut-- > 1;) {
+// before a top-level key at or above the line cv::FileStorage stopped at (`error_line`) and
+// parses; 0 when there is none. At most a few prefixes are parsed, so a long file with an error
+// is not parsed once per line (readers stay linear, issue 37 class 7).
+size_t ReadablePrefixLines(const std::vector<std::string>& lines, size_t error_line, cv::FileStorage* fs) {
+  int attempts = 0;
+  for (size_t cut = std::min(error_line, lines.size()); cut-- > 1 && attempts < 4;) {
     const std::string& line = lines[cut];
     if (line.empty() || line[0] == ' ' || line[0] == '-' || line[0] == '#' ||
         line.find(':') == std::string::npos)
       continue;
+    ++attempts;
     std::string text;
     for (size_t i = 0; i < cut; ++i) text += lines[i] + "\n";
     if (OpenStorage(text, fs)) return cut;
   }
   return 0;
+}
+
+// A matrix of the file, read by cv::FileStorage after the scan bounded its header; what cv
+// refuses is said with the key's line, not in cv's words.
+cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& key, const SourceRef& where) {
+  cv::Mat m;
+  try {
+    fs[key] >> m;
+  } catch (const cv::Exception&) {
+    ThrowInputError(where, key + ": not a matrix cv::FileStorage reads (an opencv-matrix whose data "
+                                 "holds rows x cols values of its dt)");
+  }
+  if (!m.empty() && m.channels() != 1) ThrowInputError(where, key + " must have one channel (dt d or f)");
+  if (!m.empty()) m.convertTo(m, CV_64F);
+  return m;
+}
+
+// image_width / image_height: absent (0), else a whole number of pixels.
+int ImageSize(const cv::FileStorage& fs, const std::string& key, const SourceRef& where) {
+  const cv::FileNode node = fs[key];
+  if (node.empty()) return 0;
+  const double v = node.isInt() || node.isReal() ? node.real() : -1.0;
+  if (!(v >= 1 && v <= 1e6 && v == std::floor(v)))
+    ThrowInputError(where, key + " must be a whole number of pixels within 1 .. 1000000");
+  return static_cast<int>(v);
 }
 
 }  // namespace
@@ -108,53 +144,64 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
   CheckInputFile(path);
   cv::FileStorage fs;
   std::vector<std::string> notes;
-  // The text is read by our reader (regular-file checks, BOM) and parsed from memory.
+  // The text is read by our reader (regular-file checks, BOM), scanned for its lines and matrix
+  // sizes (tools/opencv_storage_scan.h: nothing huge reaches cv::FileStorage) and parsed from memory.
   const std::string text = ReadTextFile(path);
-  if (!OpenStorage(text, &fs)) {
+  const OpenCvStorageScan scan = ScanOpenCvStorage(text, path);
+  const auto at = [&](const std::string& key) { return SourceRef{path, scan.Line(key)}; };
+  std::string error;
+  const auto unparsable = [&]() {
+    const auto [line, what] = OpenCvParseErrorLine(error);
+    ThrowInputError({path, line}, "cv::FileStorage cannot parse the file here (" + what + ")");
+  };
+  if (!OpenStorage(text, &fs, &error)) {
     const std::vector<std::string> lines = SplitLines(text);
-    const size_t kept = text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, &fs) : 0;
-    if (kept == 0) ThrowInputError({path, 1}, "cv::FileStorage cannot parse it");
+    const size_t error_line = static_cast<size_t>(OpenCvParseErrorLine(error).first);
+    const size_t kept = text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, error_line, &fs) : 0;
+    if (kept == 0) unparsable();
     notes.push_back("the file is cut short: lines 1-" + std::to_string(kept) +
                     " read (the entry from line " + std::to_string(kept + 1) +
                     " on is incomplete)");
   }
+  // Keys are looked up in a map: cv::FileStorage asserts (cv::Exception) on any other top level.
+  if (!fs.root().isMap()) {
+    if (!error.empty()) unparsable();
+    ThrowInputError({path, 1}, "the top level is not a map of keys (camera_matrix, distortion_coefficients, ...)");
+  }
   std::string matrix_key = "camera_matrix", dist_key = "distortion_coefficients";
+  bool stereo = false;
   if (fs["camera_matrix"].empty()) {
     const std::string id = options.camera_id.empty() ? "1" : options.camera_id;
+    if (fs["M" + id].empty() && !error.empty()) unparsable();  // a prefix read without the camera
     if (fs["M" + id].empty())
       ThrowInputError({path, 1}, options.camera_id.empty()
                                      ? "no camera_matrix (nor a stereo M1/D1)"
                                      : "no camera M" + id + "/D" + id);
     if (options.camera_id.empty() && !fs["M2"].empty())
-      ThrowInputError({path, 1}, "a stereo file: name the camera with --camera (1 or 2)");
+      ThrowInputError(at("M2"), "a stereo file: name the camera with --camera (1 or 2)");
     matrix_key = "M" + id;
     dist_key = "D" + id;
+    stereo = true;
   }
-  cv::Mat k, d;
-  try {
-    fs[matrix_key] >> k;
-    fs[dist_key] >> d;
-  } catch (const cv::Exception& e) {
-    ThrowInputError({path, 0}, matrix_key + " / " + dist_key + ": " + e.err);
-  }
-  if (k.rows != 3 || k.cols != 3) ThrowInputError({path, 0}, matrix_key + " must be a 3 x 3 matrix");
-  k.convertTo(k, CV_64F);
-  if (!d.empty()) d.convertTo(d, CV_64F);
+  const cv::Mat k = ReadMatrix(fs, matrix_key, at(matrix_key));
+  const cv::Mat d = ReadMatrix(fs, dist_key, at(dist_key));
+  if (k.rows != 3 || k.cols != 3) ThrowInputError(at(matrix_key), matrix_key + " must be a 3 x 3 matrix");
   const size_t n = d.total();
   if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14)
-    ThrowInputError({path, 0}, dist_key + " must hold 4, 5, 8, 12 or 14 values (got " +
-                                   std::to_string(n) + ")");
+    ThrowInputError(at(dist_key), dist_key + " must hold 4, 5, 8, 12 or 14 values (got " +
+                                      std::to_string(n) + ")");
   for (size_t i = 8; i < n; ++i)
     if (d.at<double>(static_cast<int>(i)) != 0.0)
-      ThrowInputError({path, 0}, dist_key + ": the thin-prism s1-s4 and tilt terms are not "
-                                            "modelled (must be 0)");
+      ThrowInputError(at(dist_key), dist_key + ": the thin-prism s1-s4 and tilt terms are not "
+                                               "modelled (must be 0)");
   if (k.at<double>(0, 1) != 0.0 || k.at<double>(1, 0) != 0.0 || k.at<double>(2, 0) != 0.0 ||
       k.at<double>(2, 1) != 0.0 || k.at<double>(2, 2) != 1.0)
-    ThrowInputError({path, 0}, matrix_key + " must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
-                                            "modelled)");
+    ThrowInputError(at(matrix_key), matrix_key + " must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
+                                                 "modelled)");
   CameraFile file;
   file.notes = notes;
   file.name = std::filesystem::path(path).stem().string();
+  file.chosen_by_camera_id = stereo && !options.camera_id.empty();
   file.camera.model = CameraModelId::kOpenCv;
   file.camera.params.assign(OpenCvModel::kNumParams, 0.0);
   std::vector<double>& p = file.camera.params;
@@ -162,17 +209,18 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
   p[OpenCvModel::kFy] = k.at<double>(1, 1);
   p[OpenCvModel::kCx] = k.at<double>(0, 2);
   p[OpenCvModel::kCy] = k.at<double>(1, 2);
-  if (!(p[0] > 0 && p[1] > 0)) ThrowInputError({path, 0}, "fx, fy must be > 0 px");
   static const int kOrder[8] = {OpenCvModel::kK1, OpenCvModel::kK2, OpenCvModel::kP1,
                                 OpenCvModel::kP2, OpenCvModel::kK3, OpenCvModel::kK4,
                                 OpenCvModel::kK5, OpenCvModel::kK6};
   for (size_t i = 0; i < n && i < 8; ++i) p[kOrder[i]] = d.at<double>(static_cast<int>(i));
-  for (double v : p)
-    if (!std::isfinite(v)) ThrowInputError({path, 0}, "a parameter is not finite");
-  int width = 0, height = 0;
-  if (!fs["image_width"].empty()) width = static_cast<int>(fs["image_width"]);
-  if (!fs["image_height"].empty()) height = static_cast<int>(fs["image_height"]);
-  calib::internal::ResolveFormat(&file, options, {path, 0}, width, height, 0.0);
+  for (int i : {OpenCvModel::kFx, OpenCvModel::kFy, OpenCvModel::kCx, OpenCvModel::kCy})
+    if (!std::isfinite(p[i])) ThrowInputError(at(matrix_key), matrix_key + ": a value is not finite");
+  for (size_t i = 0; i < n && i < 8; ++i)
+    if (!std::isfinite(p[kOrder[i]])) ThrowInputError(at(dist_key), dist_key + ": a value is not finite");
+  if (!(p[OpenCvModel::kFx] > 0 && p[OpenCvModel::kFy] > 0)) ThrowInputError(at(matrix_key), "fx, fy must be > 0 px");
+  const int width = ImageSize(fs, "image_width", at("image_width"));
+  const int height = ImageSize(fs, "image_height", at("image_height"));
+  calib::internal::ResolveFormat(&file, options, at(matrix_key), width, height, 0.0);
   return file;
 }
 

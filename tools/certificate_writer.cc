@@ -348,7 +348,7 @@ int WriteCertificate(const CertificateArgs& args) {
     const nlohmann::json& cal = result["calibration"];
     cert["kind"] = "certificate";
     cert["lab"] = lab;
-    cert["source"] = args.result;
+    cert["source"] = args.result_name.empty() ? args.result : args.result_name;
     cert["method"] = cal.at("method");
     cert["camera_file"] = cal.at("camera");
     cert["data"] = cal.at("data");
@@ -420,13 +420,13 @@ int WriteCertificate(const CertificateArgs& args) {
     // certificate.json alone: an .html / .pdf of a previous certificate would not describe it.
     set.Commit({"certificate.json"}, {"certificate.html", "certificate.pdf"});
   }
-  std::printf("certificate data -> %s\n", set.Final("certificate.json").c_str());
+  const std::string shown = args.out_name.empty() ? args.out : args.out_name;
+  std::printf("certificate data -> %s/certificate.json\n", shown.c_str());
   for (const auto& statement : statements) std::printf("  %s\n", statement.c_str());
   if (cert.contains("comparison"))
     std::printf("comparison with %s: %s\n", args.previous.c_str(), comparison_pass ? "pass" : "FAIL");
   if (!args.no_render)
-    std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", args.out.c_str(),
-                args.out.c_str());
+    std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", shown.c_str(), shown.c_str());
   const bool ok = valid && comparison_pass;
   return ok ? kExitOk : kExitNotConverged;
 }

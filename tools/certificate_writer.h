@@ -18,6 +18,9 @@ struct CertificateArgs {
   std::string tolerances;  // YAML quantity: allowed |change| (needs previous)
   std::string out;         // output folder
   bool no_render = false;  // certificate.json only
+  /// Where `result` and `out` end when the caller stages them (flight writes its outputs as one
+  /// set, tools/output_set.h): the paths recorded and printed ("" = result, out themselves).
+  std::string result_name, out_name;
   /// Results of `aerocal quality mtf` / `quality bars` (kinds quality_mtf, quality_bars): the
   /// certificate's "dynamic image resolution" section (optional).
   std::vector<std::string> quality;

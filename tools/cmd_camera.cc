@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <memory>
 #include <sstream>
 
@@ -23,6 +24,7 @@
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
+#include "tools/output_set.h"
 
 namespace aerocal::tools {
 namespace {
@@ -45,11 +47,11 @@ struct ReadArgs {
                     "file/date/number, DBAT id or report CameraN)");
     app->add_option("--width", width, "Image width in px where the file has none (checked "
                                       "against the file where it has one)")
-        ->check(CLI::Range(1, 1000000));
+        ->check(FiniteRange(1, 1000000));
     app->add_option("--height", height, "Image height in px, as --width")
-        ->check(CLI::Range(1, 1000000));
+        ->check(FiniteRange(1, 1000000));
     app->add_option("--pixel-mm", pixel_mm, "Pixel size in mm where the file has none")
-        ->check(CLI::Range(1e-5, 1.0));
+        ->check(FiniteRange(1e-5, 1.0));
   }
   CameraFile Read() const {
     calib::CameraReadOptions options;
@@ -72,7 +74,12 @@ struct ConvertArgs {
 
 int RunConvert(const ConvertArgs& a) {
   CheckOutputFile(a.out, "OUT");
-  if (!a.report.empty()) CheckOutputFile(a.report, "--report");
+  CheckDistinctPath(a.out, "OUT", a.read.in, "IN");
+  if (!a.report.empty()) {
+    CheckOutputFile(a.report, "--report");
+    CheckDistinctPath(a.report, "--report", a.out, "OUT");
+    CheckDistinctPath(a.report, "--report", a.read.in, "IN");
+  }
   const CameraFormat& to = FindCameraFormat(a.to, "--to");
   const CameraFile source = a.read.Read();
   calib::FormatTarget target = to.target(source.camera);
@@ -133,15 +140,21 @@ int RunConvert(const ConvertArgs& a) {
       {"coefficient_choices", tried},
       {"source_camera_model", calib::CameraModelTableToJson(source.camera.model)},
       {"camera_model", calib::CameraModelTableToJson(r.camera.model)}};
-  if (!a.report.empty()) WriteResult(a.report, "camera_conversion", report);
+  // OUT and the report are one set (tools/output_set.h): neither replaces its previous file
+  // unless both were written. A conversion that is not acceptable writes the report alone (it
+  // says why OUT was not written).
+  OutputSet set(std::filesystem::path(a.out).parent_path().string());
+  if (!a.report.empty()) WriteResult(set.StagePath(a.report), "camera_conversion", report);
   if (!r.acceptable) {
+    if (!a.report.empty()) set.Commit({});
     LogWarning("conversion_residual: " + DescribeConversion(r) + (r.residual.failed_points ? " (" +
                std::to_string(r.residual.failed_points) + " points not invertible)" : "") +
                " exceeds --max-residual-px " + FormatNumber(a.max_residual_px) + "; " + a.out +
                " not written");
     return kExitNotConverged;
   }
-  calib::WriteCameraFileVerified(to, a.out, written);
+  calib::WriteCameraFileVerified(to, set.StagePath(a.out), written);
+  set.Commit({});
   return kExitOk;
 }
 
@@ -295,7 +308,7 @@ CommandRun Setup(CLI::App& app) {
   cv->add_option("--max-residual-px", convert->max_residual_px,
                  "A conversion leaving more (max over the format, px) is an error: exit 3, OUT "
                  "not written")
-      ->check(CLI::PositiveNumber);
+      ->check(PositiveUpTo(1e6));
   cv->add_option("--max-coefficients", convert->max_coefficients,
                  "OpenCV-form targets (opencv, ros, dji, colmap) reached by a fit: at most this "
                  "many distortion coefficients, 4 (k1 k2 p1 p2), 5 (+ k3) or 8 (+ k4-k6); the "

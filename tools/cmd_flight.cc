@@ -15,6 +15,7 @@
 #include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
+#include "tools/output_set.h"
 #include "tools/suspect_effect_option.h"
 #include "tools/python_script.h"
 #include "triangulation/adjustment/adjust_options.h"
@@ -91,49 +92,68 @@ CommandRun SetupFlight(CLI::App& app) {
     const auto result = triangulation::RunFlightWorkflow(args->options, &progress);
     progress.Finish();
     namespace fs = std::filesystem;
-    const std::string json_path = (fs::path(args->out) / "result.json").string();
+    for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
+    for (const auto& [step, reason] : result.failures)
+      std::fprintf(stderr, "flight: step %s failed: %s\n", step.c_str(), reason.c_str());
+    if (!result.valid) std::fprintf(stderr, "flight: no calibrated camera written\n");
+    // result.json, the calibrated camera(s), report.html and certificate/ are one set
+    // (tools/output_set.h): staged in OUT, moved into place only when every part was written, so
+    // a failing report or certificate replaces nothing of the previous flight in OUT.
+    OutputSet set(args->out);
+    const std::string camera_name = "camera_calibrated.yaml";
+    const std::string format_name = "camera_calibrated." + args->camera_format;
+    std::vector<std::string> parts = {"result.json"}, obsolete;
+    const std::string json_path = set.Staged("result.json");
     nlohmann::json document = result.document;
     document["aerocal_version"] = AEROCAL_VERSION;
     WriteResult(json_path, "flight", document);
     // A calibrated camera is written only for a valid flight: a file that exists is one the next
     // flight may use (an old one in the folder is removed, so it cannot pass for this run's).
-    const fs::path camera_path = fs::path(args->out) / "camera_calibrated.yaml";
-    const fs::path format_path = fs::path(args->out) / ("camera_calibrated." + args->camera_format);
-    if (result.valid) {
-      calib::WriteCamera(camera_path.string(), result.calibrated_camera);
-      if (!args->camera_format.empty())
-        WriteCameraInFormat(format_path.string(), result.calibrated_camera, args->camera_format);
-    } else {
-      std::error_code ignored;
-      fs::remove(camera_path, ignored);
-      if (!args->camera_format.empty()) fs::remove(format_path, ignored);
+    (result.valid ? parts : obsolete).push_back(camera_name);
+    if (result.valid) calib::WriteCamera(set.Staged(camera_name), result.calibrated_camera);
+    if (!args->camera_format.empty()) {
+      (result.valid ? parts : obsolete).push_back(format_name);
+      if (result.valid)
+        WriteCameraInFormat(set.Staged(format_name), result.calibrated_camera, args->camera_format);
     }
-    for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
-    for (const auto& [step, reason] : result.failures)
-      std::fprintf(stderr, "flight: step %s failed: %s\n", step.c_str(), reason.c_str());
-    if (!result.valid) std::fprintf(stderr, "flight: no calibrated camera written\n");
+    // A report or certificate of an earlier flight left beside this result.json would not
+    // describe it: parts this run does not write are removed with the commit.
+    if (args->no_report) obsolete.push_back("report.html");
     if (!args->no_report) {
       const char* env = std::getenv("AEROCAL_REPORT_SCRIPT");
       const std::string script = env ? env : AEROCAL_REPORT_SCRIPT;
-      const std::string html = (fs::path(args->out) / "report.html").string();
+      const std::string html = set.Staged("report.html");
       if (!RunPythonScript(script, {json_path, html})) {
-        std::fprintf(stderr, "error: the report could not be written (%s); result.json is complete\n",
-                     PythonCommandLine(script, {json_path, html}).c_str());
+        std::fprintf(stderr, "error: the report could not be written (%s); nothing written, the "
+                     "previous flight in %s is left as it was\n",
+                     PythonCommandLine(script, {json_path, html}).c_str(), args->out.c_str());
         return kExitInternal;
       }
-      std::printf("report: %s\n", html.c_str());
+      parts.push_back("report.html");
     }
+    int certificate_code = kExitOk;
     if (args->certificate && result.valid) {
       CertificateArgs certificate;
       certificate.result = json_path;
       certificate.lab = args->lab;
-      certificate.out = (fs::path(args->out) / "certificate").string();
+      certificate.out = set.Staged("certificate");
+      certificate.result_name = set.Final("result.json");
+      certificate.out_name = set.Final("certificate");
       certificate.no_render = args->no_report;
-      const int code = WriteCertificate(certificate);
-      if (code != kExitOk) return code;
-    } else if (args->certificate) {
-      std::fprintf(stderr, "flight: no certificate written (the flight is not valid)\n");
+      certificate_code = WriteCertificate(certificate);
+      if (certificate_code == kExitInternal) {
+        std::fprintf(stderr, "error: nothing written, the previous flight in %s is left as it was\n",
+                     args->out.c_str());
+        return certificate_code;
+      }
+      parts.push_back("certificate");
+    } else {
+      if (args->certificate) std::fprintf(stderr, "flight: no certificate written (the flight is not valid)\n");
+      obsolete.push_back("certificate");
     }
+    set.Commit(parts, obsolete);
+    if (!args->no_report) std::printf("report: %s\n", set.Final("report.html").c_str());
+    if (certificate_code != kExitOk) return certificate_code;
     return result.converged && result.valid ? kExitOk : kExitNotConverged;
   };
 }

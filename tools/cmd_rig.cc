@@ -46,6 +46,9 @@ namespace {
 
 namespace fs = std::filesystem;
 
+// Monte-Carlo samples of a whole --grid analysis (about 20 min at ~1 us a sample).
+constexpr double kMaxGridSamples = 1e9;
+
 struct ErrorAnalysisArgs {
   std::string camera, limits, target, virtual_px, out;
   double height_m = 0.0;  // 0: the rig file's virtual.height_m
@@ -116,6 +119,11 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   if (args.samples < 0) throw ConfigError("--samples must be >= 0");
   if (args.bins < 1) throw ConfigError("--bins must be >= 1");
   if (args.grid < 0 || args.grid > 200) throw ConfigError("--grid must be within 1..200");
+  // Every grid target runs its own Monte-Carlo: the work is grid x grid x samples (x heads).
+  if (double(args.grid) * args.grid * args.samples > kMaxGridSamples)
+    throw ConfigError("--grid x --grid x --samples: " + std::to_string(args.grid) + " x " + std::to_string(args.grid) +
+                      " x " + std::to_string(args.samples) + " Monte-Carlo samples are more than 1e9 (fewer "
+                      "--samples or a coarser --grid)");
   if (!(args.relief_m >= 0)) throw ConfigError("--relief-m must be >= 0");
   if (!(args.relief_m < height_m))
     throw ConfigError("--relief-m: " + FormatNumber(args.relief_m) + " m of relief reaches the flying height (" +
@@ -203,7 +211,7 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   doc["camera_models"] = HeadCameraModels(rig);
   // The JSON, its CSV files and plots are one set (tools/output_set.h): staged, then moved into
   // place together; a failing plot replaces nothing of an earlier analysis.
-  OutputSet set(out.parent_path().empty() ? "." : out.parent_path().string());
+  OutputSet set(out.parent_path().string());
   std::vector<std::string> parts = {out.filename().string()};
   for (const std::string& name : {files.histogram_csv, files.bound_map_csv, files.histogram_png, files.bound_map_png})
     if (!name.empty()) parts.push_back(name);
@@ -270,6 +278,10 @@ struct ConvertArgs {
 };
 
 int RunConvert(const ConvertArgs& args) {
+  // One output, the TIFF: written to a temporary file beside --out and renamed when complete
+  // (stitch::TiffWriter), so a failure replaces nothing and leaves no temporary file.
+  CheckOutputFile(args.out, "--out");
+  CheckDistinctPath(args.out, "--out", args.dem, "--dem");
   CheckTilePx(args.tile_px);
   const calib::Rig rig = calib::ReadRig(args.camera);
   const double height_m = FlyingHeight(rig, args.height_m, args.camera);
@@ -302,10 +314,10 @@ int RunConvert(const ConvertArgs& args) {
                        " m (plane homographies; heads with distortion add correction grids)");
   tiff.force_bigtiff = args.bigtiff;
   tiff.tile_px = args.tile_px;
+  std::optional<stitch::DemGrid> dem;  // read before the writer opens --out
+  if (!args.dem.empty()) dem = stitch::ReadDemAscii(args.dem);
   stitch::TiffWriter writer(
       args.out, {as_camera.width_px, as_camera.height_px, info.bands, info.bits}, tiff);
-  std::optional<stitch::DemGrid> dem;
-  if (!args.dem.empty()) dem = stitch::ReadDemAscii(args.dem);
   stitch::HeadMapCorrections corrections;
   const stitch::ResampleReport report = stitch::ConvertRigExposure(
       converter, sources, &writer, options, &corrections, dem ? &*dem : nullptr);
@@ -465,8 +477,7 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
 // stitched_image.h): <image>.tif and <image>_mask.tif under --stitched-out; the figures as JSON.
 nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig,
                                    const std::vector<stitch::RigStitchExposure>& exposures,
-                                   const stitch::RigStitchResult& result) {
-  fs::create_directories(args.stitched_out);
+                                   const stitch::RigStitchResult& result, OutputSet* set) {
   stitch::StitchedImageOptions options;
   options.balance = !args.no_balance;
   options.feather_px = args.feather_px;
@@ -501,9 +512,9 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
                        FormatNumber(e.z_ref_m) + " m)";
     const std::string image_path = args.stitched_out + "/" + e.image + ".tif";
     const std::string mask_path = args.stitched_out + "/" + e.image + "_mask.tif";
-    stitch::TiffWriter image(image_path, {v.width_px, v.height_px, 1, info.bits}, tiff);
+    stitch::TiffWriter image(set->StagePath(image_path), {v.width_px, v.height_px, 1, info.bits}, tiff);
     tiff.description = "aerocal rig stitch: valid-area mask of " + e.image + " (255 valid)";
-    stitch::TiffWriter mask(mask_path, {v.width_px, v.height_px, 1, 8}, tiff);
+    stitch::TiffWriter mask(set->StagePath(mask_path), {v.width_px, v.height_px, 1, 8}, tiff);
     const stitch::StitchedImageReport r =
         stitch::MakeStitchedImage(converter, sources, options, &image, &mask);
     image.Commit();
@@ -539,6 +550,8 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
 }
 
 int RunStitch(const StitchArgs& args) {
+  CheckOutputFile(args.out, "--out");
+  if (!args.stitched_out.empty()) CheckOutputFolder(args.stitched_out, "--stitched-out");
   if (args.images.empty() && (!args.stitched_out.empty() || args.match_ties))
     throw ConfigError(std::string(args.match_ties ? "--match-ties" : "--stitched-out") +
                       " needs --images (the folder of the head images)");
@@ -626,13 +639,18 @@ int RunStitch(const StitchArgs& args) {
                 result.sigma0 >= 1 ? "small" : "large");
   }
   std::fputs(stitch::FormatRigStitchSummary(options, result, sources).c_str(), stdout);
+  // The JSON and the stitched images are one set (tools/output_set.h): a stitched image that
+  // fails replaces neither the previous JSON nor any previous image.
+  const fs::path out(args.out);
+  OutputSet set(out.parent_path().string());
   if (!args.stitched_out.empty()) {
     if (result.failures.empty())
-      json["stitched_images"] = WriteStitchedImages(args, rig, in.exposures, result);
+      json["stitched_images"] = WriteStitchedImages(args, rig, in.exposures, result, &set);
     else
       std::fprintf(stderr, "error: no stitched images: the self-calibration is not valid\n");
   }
-  WriteResult(args.out, "rig_stitch", json);
+  WriteResult(set.Staged(out.filename().string()), "rig_stitch", json);
+  set.Commit({out.filename().string()});
   if (result.failures.empty()) return kExitOk;
   for (const auto& f : result.failures) std::fprintf(stderr, "error: %s\n", f.c_str());
   std::fprintf(stderr, "error: %s written with valid: false\n", args.out.c_str());

@@ -219,7 +219,7 @@ CommandRun SetupSimulate(CLI::App& app) {
                "Simulate a combined line camera (three tilted line cameras) instead: camera files, "
                "pos.csv, observations, control points and truth (triangulation/pushbroom/README.md)");
   app.add_option("--detectors", l.detectors_per_camera, "Pushbroom: detectors per line camera, 10..100000")->check(FiniteRange(10, 100000));
-  app.add_option("--lines", l.lines, "Pushbroom: scan lines, 20..10000000")->check(FiniteRange(20, 10000000));
+  app.add_option("--lines", l.lines, "Pushbroom: scan lines, 20..1000000 (with --images: lines x 3 x detectors at most 5e7 px)")->check(FiniteRange(20, 1000000));
   app.add_option("--tilt-deg", l.tilt_deg, "Pushbroom: look angle of the outer cameras across track, 0..40 deg")->check(FiniteRange(0.0, 40.0));
   app.add_option("--pos-error-m", l.pos_error_m, "Pushbroom: sigma of the smooth POS position error, 0..100 m")->check(FiniteRange(0.0, 100.0));
   app.add_option("--pos-error-deg", l.pos_error_deg, "Pushbroom: sigma of the smooth POS attitude error, 0..10 deg")->check(FiniteRange(0.0, 10.0));
@@ -308,6 +308,13 @@ CommandRun SetupSimulate(CLI::App& app) {
         if (!(in >> io.reference_width_px >> x >> io.reference_height_px) || x != 'x' || (in >> rest))
           throw ConfigError("--reference-size must be WIDTHxHEIGHT (got '" + args->reference_size + "')");
         io.Validate();
+        // The line image is rendered through two double grids of lines x all detectors: the
+        // product is bounded before anything is allocated.
+        const double pixels = double(l.lines) * 3 * l.detectors_per_camera;
+        if (pixels > triangulation::kMaxLineImagePixels)
+          throw ConfigError("--lines x --detectors: a line image of " + std::to_string(l.lines) + " lines x 3 x " +
+                            std::to_string(l.detectors_per_camera) + " detectors is " + FormatNumber(pixels) +
+                            " px, more than the 5e7 px --images renders");
       }
       const auto sim = triangulation::SimulateLineFlight(l);
       if (args->pushbroom_images) {

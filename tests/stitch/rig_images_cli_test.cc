@@ -12,6 +12,7 @@
 
 #include "stitch/image_io/image_io.h"
 #include "stitch/resample/tiff_raster.h"
+#include "tests/support/bad_input_case.h"
 #include "tests/support/test_support.h"
 
 namespace aerocal::stitch {
@@ -70,6 +71,29 @@ TEST(RigImagesCommand, RendersTheHeadsAndStitchesEveryExposure) {
     // the true parameters and 2.17 DN with the refined ones.
     EXPECT_LT(e["overlap_disagreement_dn"]["all"]["rms_dn"].get<double>(), 3.5);
   }
+
+  // The JSON and the stitched images are one set (issue 37 class 8): a head image of the second
+  // exposure that cannot be read replaces nothing of the run above (whose images were tiled: the
+  // first exposure's strips would differ) and leaves no staging folder behind.
+  const auto snapshot = [&]() {
+    std::map<std::string, std::string> files;
+    for (const std::string& folder : {tmp.path(), out})
+      for (const auto& e : fs::directory_iterator(folder))
+        if (e.is_regular_file() || e.is_directory())
+          files[e.path().string()] = e.is_regular_file() ? testing::ReadFileText(e.path().string()) : "(folder)";
+    return files;
+  };
+  const auto before = snapshot();
+  const std::string bad_images = tmp.File("images_bad");
+  fs::copy(sim + "/images", bad_images);
+  testing::WriteFileText(bad_images + "/0002_D.tif", "not a TIFF\n");
+  const auto failed = RunAerocal("rig stitch --camera " + sim + "/rig_truth.yaml --project " + sim +
+                                 " --standard-radius-px 80 --images " + bad_images + " --stitched-out " + out +
+                                 " --tile-px 0 --out " + tmp.File("r.json"));
+  EXPECT_EQ(failed.exit_code, 2) << failed.output;
+  EXPECT_NE(failed.output.find("0002_D.tif"), std::string::npos) << failed.output;
+  fs::remove_all(bad_images);
+  EXPECT_EQ(snapshot(), before);
 
   // Strips, BigTIFF forced, no balance (every gain 1, offset 0), a short ramp.
   const std::string out2 = tmp.File("stitched2");

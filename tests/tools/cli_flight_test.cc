@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <map>
 #include <functional>
 #include <fstream>
 
@@ -110,6 +111,8 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   const auto cert = nlohmann::json::parse(ReadTextFile(dir_->File("report/certificate/certificate.json")));
   EXPECT_EQ(cert["method"]["kind"], "in-flight calibration");
   EXPECT_EQ(cert["lab"]["certificate"]["number"], "F-7");
+  // The certificate names the flight's result.json where it ends, not where it was staged.
+  EXPECT_EQ(cert["source"], dir_->File("report/result.json"));
   const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
   const auto& joint = doc["adjustments"][2];  // the joint adjustment's camera is the certified one
   ASSERT_EQ(joint["name"], "joint");
@@ -146,6 +149,36 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   for (const auto& e : std::filesystem::directory_iterator(dir_->path()))
     if (e.path().extension() == ".png" && std::filesystem::file_size(e.path()) > 1000) ++pages;
   EXPECT_GE(pages, 2);
+}
+
+// Every file under `folder` (relative path -> content).
+std::map<std::string, std::string> Snapshot(const std::string& folder) {
+  std::map<std::string, std::string> files;
+  for (const auto& e : std::filesystem::recursive_directory_iterator(folder))
+    if (e.is_regular_file())
+      files[std::filesystem::relative(e.path(), folder).string()] = ReadTextFile(e.path().string());
+  return files;
+}
+
+TEST_F(FlightWorkflow, AFailingLastPartReplacesNothingOfThePreviousFlight) {
+  // result.json, camera_calibrated.yaml / .xml, report.html and certificate/ are one set (issue 37
+  // class 8): the certificate renderer, the last part, fails; the previous flight stays as it was.
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const std::string out = dir_->File("report_set");
+  std::filesystem::copy(dir_->File("report"), out, std::filesystem::copy_options::recursive);
+  const auto before = Snapshot(out);
+  ASSERT_GE(before.size(), 6u);
+  WriteFileAtomically(dir_->File("fail.py"), "import sys\nsys.exit(1)\n");
+  // The same flight from a copy of the camera file: result.json (which names it) would differ.
+  std::filesystem::copy_file(dir_->File("data/camera_nominal.yaml"), dir_->File("camera_copy.yaml"),
+                             std::filesystem::copy_options::overwrite_existing);
+  const auto r = testing::RunCommand(
+      "AEROCAL_CERTIFICATE_SCRIPT=" + dir_->File("fail.py") + " " + testing::AerocalBinary() + " flight --camera " +
+      dir_->File("camera_copy.yaml") + " --data " + dir_->File("data") + " --base III,IV --out " + out +
+      " --camera-format metashape --certificate --lab " + dir_->File("lab.yaml"));
+  EXPECT_EQ(r.exit_code, 1) << r.output;
+  EXPECT_NE(r.output.find("nothing written"), std::string::npos) << r.output;
+  EXPECT_EQ(Snapshot(out), before);  // no file replaced, added (no staging folder) or removed
 }
 
 TEST_F(FlightWorkflow, CertificateOptionsAreCheckedBeforeTheFlightRuns) {

@@ -9,7 +9,8 @@ aerocal_add_test(tools/cli_options LIBS aerocal::calib LABELS cli)
 # Camera files in other tools' formats (issue 15): the CLI, plus the OpenCV FileStorage format
 # (tools/camera_formats.cc) against cv::projectPoints and cv::undistortPoints.
 aerocal_add_test(tools/cli_camera LIBS aerocal::calib ${OpenCV_LIBS} LABELS cli)
-target_sources(test_tools_cli_camera PRIVATE ${PROJECT_SOURCE_DIR}/tools/camera_formats.cc)
+target_sources(test_tools_cli_camera PRIVATE ${PROJECT_SOURCE_DIR}/tools/camera_formats.cc
+  ${PROJECT_SOURCE_DIR}/tools/opencv_storage_scan.cc)
 target_include_directories(test_tools_cli_camera PRIVATE ${OpenCV_INCLUDE_DIRS})
 aerocal_add_test(tools/cli_calibrate LIBS aerocal::calib LABELS cli)
 # Result documents: kind and schema_version of every command, readers refusing others.
@@ -23,3 +24,8 @@ aerocal_add_test(tools/bad_input2 LIBS aerocal::triangulation LABELS cli TIMEOUT
 # Plausibility before solving (issue 33 item 5): ';' CSVs, another tool's camera file, pixels off
 # the format, c given in pixels; the global --verbose / --quiet after the command (item 4).
 aerocal_add_test(tools/cli_plausibility LIBS aerocal::calib LABELS cli)
+# Issue 37, part 3: OpenCV FileStorage bounds and lines, --camera on files of one camera, camera
+# convert's outputs as a set, size products of options.
+aerocal_add_test(tools/bad_input3 LIBS aerocal::calib LABELS cli)
+aerocal_add_test(tools/output_set LIBS aerocal::calib LABELS unit)
+target_sources(test_tools_output_set PRIVATE ${PROJECT_SOURCE_DIR}/tools/output_set.cc)

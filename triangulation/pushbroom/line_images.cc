@@ -76,6 +76,10 @@ void LineImageOptions::Validate() const {
   require(reference_width_px >= 100 && reference_width_px <= 20000 && reference_height_px >= 100 &&
               reference_height_px <= 20000,
           "the reference image format must be within 100 .. 20000 px");
+  // Each reference frame holds two double grids of its format (16 bytes a pixel) while rendered.
+  require(double(reference_width_px) * reference_height_px <= kMaxReferencePixels,
+          "--reference-size: " + std::to_string(reference_width_px) + "x" + std::to_string(reference_height_px) +
+              " px is more than the 2.5e7 px a reference frame may have");
   require(reference_pixel_mm > 0 && reference_gsd_m >= 0, "reference pixel > 0, GSD >= 0");
   require(forward_overlap >= 0.5 && forward_overlap <= 0.9, "--reference-overlap must be within 0.5 .. 0.9");
   require(grey_noise_dn >= 0, "--grey-noise-dn must be >= 0");

@@ -22,10 +22,16 @@
 
 namespace aerocal::triangulation {
 
+/// Bounds of the rendered sizes (issue 37 class 7), checked before anything is allocated: a
+/// reference frame (two double grids of its format while rendered) and the line image (two
+/// double grids of lines x all detectors).
+inline constexpr double kMaxReferencePixels = 2.5e7;
+inline constexpr double kMaxLineImagePixels = 5e7;
+
 struct LineImageOptions {
   std::string texture_path;          // the photograph (any format ReadGrayImage reads), required
   double texture_gsd_m = 0.0;        // ground size of a texel (2 x 2 photo pixels); 0: automatic
-  int reference_width_px = 2000;     // frame image format, 100 .. 20000
+  int reference_width_px = 2000;     // frame image format, 100 .. 20000, at most kMaxReferencePixels
   int reference_height_px = 1500;
   double reference_pixel_mm = 0.006; // > 0
   double reference_gsd_m = 0.0;      // nadir ground sampling of the frames; 0: 0.6 x line spacing

@@ -35,7 +35,8 @@ void LineSimulationOptions::Validate() const {
   require(tilt_deg >= 0 && tilt_deg <= 40, "--tilt-deg must be within 0 .. 40");
   require(pitch_mm > 0 && pitch_mm <= 1, "--pitch-mm must be within (0, 1]");
   require(overlap >= 0 && overlap < 0.5, "--overlap must be within 0 .. 0.5");
-  require(lines >= 20 && lines <= 10000000, "--lines must be within 20 .. 1e7");
+  // pos.csv and its truth hold two records of ~140 bytes a line: 1e6 lines is ~0.3 GB.
+  require(lines >= 20 && lines <= 1000000, "--lines must be within 20 .. 1e6");
   require(height_m > 0 && speed_m_s > 0 && relief_m >= 0, "--height-m, speed > 0, --relief-m >= 0");
   require(relief_m < 0.5 * height_m, "--relief-m must be below half the flying height");
   require(control_points >= 0, "--control must be >= 0");

@@ -32,7 +32,7 @@ struct LineSimulationOptions {
   double tilt_deg = 20.0;           // across-track look angle of the outer cameras, 0 .. 40
   double pitch_mm = 0.01;           // detector pitch, > 0
   double overlap = 0.05;            // fraction of a sub-camera's field shared with its neighbour
-  int lines = 2000;                 // scan lines, >= 20
+  int lines = 2000;                 // scan lines, 20 .. 1e6
   double height_m = 1000.0;         // flying height above the mean terrain, > 0
   double speed_m_s = 60.0;          // ground speed, > 0
   double relief_m = 100.0;          // terrain relief peak to peak, >= 0

@@ -8,6 +8,7 @@
 #include "calib/camera/camera_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "triangulation/block/block_io.h"
 
@@ -334,6 +335,17 @@ double SimulatedTerrainHeight(const FlightSimulationOptions& o, double x, double
 SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
   if (o.exposures < 2 || o.strips < 1 || o.exposures < o.strips)
     throw ConfigError("a flight needs at least 2 exposures and one strip per exposure row");
+  // Sizes that are products of options, bounded before anything is made (issue 37 class 7): every
+  // stitching tie of every exposure is kept (~0.5 kB with its observations), and every ground
+  // point is projected into every exposure.
+  const double ties = double(o.exposures) * o.stitching.ties_per_frame;
+  if (ties > kMaxSimulatedStitchTies)
+    throw ConfigError("--exposures x --stitch-ties: " + FormatNumber(ties) + " stitching ties are more than " +
+                      FormatNumber(kMaxSimulatedStitchTies) + " (fewer --stitch-ties, default 900 a frame)");
+  const double pairs = double(o.exposures) * (double(o.ground_points) + o.tie_points);
+  if (pairs > kMaxSimulatedPointExposurePairs)
+    throw ConfigError("--exposures x (--points + --tie-points): " + FormatNumber(pairs) +
+                      " point-exposure pairs are more than " + FormatNumber(kMaxSimulatedPointExposurePairs));
   internal::SimulationRandom random(o.seed);
   std::mt19937_64& rng = random.rng;
   std::normal_distribution<double>& normal = random.normal;

@@ -23,6 +23,11 @@
 
 namespace aerocal::triangulation {
 
+/// Bounds of option products checked by SimulateFlight (ConfigError naming the options):
+/// exposures x stitching ties per exposure, and exposures x (ground points + tie points).
+inline constexpr double kMaxSimulatedStitchTies = 2e6;
+inline constexpr double kMaxSimulatedPointExposurePairs = 1e9;
+
 struct FlightSimulationOptions {
   std::uint64_t seed = 1;
   int exposures = 37;                 // total, spread evenly over the strips

@@ -47,6 +47,7 @@ CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& o
                           : "no head '" + options.camera_id + "' (heads: " + ids + ")");
     file = CameraFileFromCamera(head->camera);
     file.name = head->id;
+    file.chosen_by_camera_id = !options.camera_id.empty();
   } else {
     file = CameraFileFromCamera(ParseCamera(root, path, CameraModels::kAny));
   }

@@ -58,6 +58,9 @@ struct CameraFile {
   /// Covariance of camera.params (table order and units) where the file gives it.
   std::optional<Eigen::MatrixXd> covariance;
   std::vector<std::string> notes;  // what the reader assumed or left out
+  /// True when the reader picked this camera among the file's by CameraReadOptions::camera_id.
+  /// A --camera the reader did not use names no camera of the file: ReadCameraFileAs refuses it.
+  bool chosen_by_camera_id = false;
 };
 
 /// What the command line adds to a file.

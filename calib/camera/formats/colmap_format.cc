@@ -163,6 +163,7 @@ CameraFile ReadColmapCameras(const std::string& path, const CameraReadOptions& o
                                    " cameras: name one with --camera (" + ids + ")");
   CameraFile file;
   file.name = found->first[0];
+  file.chosen_by_camera_id = !options.camera_id.empty();
   file.camera = ColmapCameraFromFields(found->first, where_of(found->second), kPlaceholderPixelSizeMm);
   const PixelFrame frame = file.camera.frame;
   internal::ResolveFormat(&file, options, where_of(found->second), frame.width_px, frame.height_px,

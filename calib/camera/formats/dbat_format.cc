@@ -103,6 +103,7 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
   CameraFile file;
   const auto name = xml.List("name");
   file.name = name.empty() ? std::filesystem::path(path).stem().string() : name.front();
+  file.chosen_by_camera_id = !options.camera_id.empty();
   const auto image = xml.Numbers("image", 2, 1e6);
   if (!(image[0] >= 1 && image[1] >= 1) || image[0] != std::floor(image[0]) ||
       image[1] != std::floor(image[1]))

@@ -204,6 +204,7 @@ CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& o
   file.camera = DjiDewarpDataCamera(picked->data, where, frame.width_px, frame.height_px);
   file.camera.frame = frame;
   file.name = !Date(picked->data).empty() ? Date(picked->data) : "dji";
+  file.chosen_by_camera_id = !options.camera_id.empty();
   file.notes = picked->design;
   if (records.size() > 1 && options.camera_id.empty())
     file.notes.push_back(std::to_string(records.size()) + " DewarpData records, all the same: one camera");

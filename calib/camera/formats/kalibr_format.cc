@@ -47,6 +47,7 @@ CameraFile ReadKalibrCamchain(const std::string& path, const CameraReadOptions& 
   const std::string distortion = YamlString(cam["distortion_model"], path, "distortion_model");
   CameraFile file;
   file.name = id;
+  file.chosen_by_camera_id = !options.camera_id.empty();
   if (distortion == "radtan") {
     const std::vector<double> d = list("distortion_coeffs", 4);
     file.camera.model = OpenCvModel::kId;

@@ -205,6 +205,7 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
   const XMLElement* calibration =
       sensor ? ChooseCalibration(s, sensor, &file.notes) : chosen.calibration;
   if (sensor && sensor->Attribute("label")) file.name = sensor->Attribute("label");
+  file.chosen_by_camera_id = sensor && !options.camera_id.empty();
   const auto number = [&](const XMLElement* e, const std::string& what, double bound) {
     return internal::ParseNumber(e->GetText() ? e->GetText() : "", s.At(e), what, bound);
   };

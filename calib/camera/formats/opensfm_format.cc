@@ -76,6 +76,7 @@ CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& 
   if (!(focal_x > 0 && focal_y > 0)) ThrowInputError(where(id), "focal length must be > 0");
   CameraFile file;
   file.name = id;
+  file.chosen_by_camera_id = !options.camera_id.empty();
   if (type == "fisheye") {
     using F = OpenCvFisheyeModel;
     file.camera.model = F::kId;

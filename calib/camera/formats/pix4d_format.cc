@@ -105,6 +105,7 @@ CameraFile ReadPix4dCalibratedParameters(const std::string& path,
                                FormatNumber(k[0]) + " and " + FormatNumber(k[4]) + ")");
   CameraFile file;
   file.name = picked->name;
+  file.chosen_by_camera_id = !options.camera_id.empty();
   std::vector<std::string> differ;
   for (const CalibratedImage& image : images)
     if (image.intrinsics != k || image.width != picked->width || image.height != picked->height)

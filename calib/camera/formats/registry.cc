@@ -290,7 +290,13 @@ CameraFile ReadCameraFileAs(const std::string& name, const std::string& path,
   const CameraFormat& format = FindCameraFormat(chosen, "--from");
   if (used) *used = chosen;
   try {
-    return format.read(path, options);
+    CameraFile file = format.read(path, options);
+    // A --camera on a file of one camera without ids (a single-camera format, a camera YAML
+    // that is no rig, an OpenCV file without M1/M2) names no camera in it (issue 37 class 9).
+    if (!options.camera_id.empty() && !file.chosen_by_camera_id)
+      ThrowInputError({path, 1}, "--camera " + options.camera_id + ": the file holds one " + chosen +
+                                     " camera and names no cameras (drop --camera)");
+    return file;
   } catch (const InputError& e) {
     if (name == "auto") throw;
     const std::vector<std::string> candidates = DetectCameraFormats(path);

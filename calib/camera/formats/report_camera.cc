@@ -141,6 +141,7 @@ CameraFile ReadReportCamera(const std::string& path, const std::vector<std::stri
                                            " (skew / aspect-ratio form) is not modelled");
   CameraFile file;
   file.name = name;
+  file.chosen_by_camera_id = !options.camera_id.empty();
   const auto integer = [&](const ReportEntry& e, const char* what) {
     if (e.line == 0) return 0;  // not printed: --width / --height
     if (!(e.value >= 1 && e.value <= 1e6) || e.value != std::floor(e.value))
