@@ -17,6 +17,8 @@ aerocal_add_test(tools/cli_results LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/cli_camera_models LIBS aerocal::calib LABELS cli)
 # `aerocal quality mtf` (issue 36) on rendered edges written as 8- and 16-bit images.
 aerocal_add_test(tools/cli_quality LIBS aerocal::stitch LABELS cli)
+# Issue 36 item 6: calibrate --directions (collimator array, goniometer, groups, bad rows).
+aerocal_add_test(tools/cli_directions LIBS aerocal::triangulation LABELS cli)
 # Issue 37 (bad input, part 2): schema-checked certificate inputs, budget units, absurd geometry,
 # bounded sizes, the renderer's text and output sets, the ranges of every numeric option.
 aerocal_add_test(tools/bad_input2 LIBS aerocal::triangulation LABELS cli TIMEOUT 900)
