@@ -18,8 +18,8 @@ struct CertificateArgs {
   std::string tolerances;  // YAML quantity: allowed |change| (needs previous)
   std::string out;         // output folder
   bool no_render = false;  // certificate.json only
-  /// Results of `aerocal quality mtf` / `quality bars` (kinds quality_mtf, quality_bars): the
-  /// certificate's "dynamic image resolution" section (optional).
+  /// Results of `aerocal quality mtf` / `bars` / `star` (kinds quality_mtf, quality_bars,
+  /// quality_star): the certificate's "dynamic image resolution" section (optional).
   std::vector<std::string> quality;
 };
 

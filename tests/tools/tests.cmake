@@ -1,7 +1,7 @@
 aerocal_add_test(tools/cli_simulate LIBS aerocal::triangulation LABELS cli)
 # `aerocal rig stitch` (issue 16) on a simulated uav4 line.
 aerocal_add_test(tools/cli_rig_stitch LIBS aerocal::calib LABELS cli)
-aerocal_add_test(tools/cli_flight LIBS aerocal::calib LABELS cli TIMEOUT 600)
+aerocal_add_test(tools/cli_flight LIBS aerocal::stitch LABELS cli TIMEOUT 600)
 include(${CMAKE_CURRENT_SOURCE_DIR}/tools/report.cmake)
 aerocal_add_test(tools/bad_input LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(tools/cli_joint LIBS aerocal::calib LABELS cli TIMEOUT 600)
