@@ -256,19 +256,29 @@ auto ReadTyped(const std::string& path, const char* option, Read&& read) -> decl
 
 // The "dynamic image resolution" section from `aerocal quality` results: per edge the slanted-edge
 // MTF50 with U (and its units), MTF at Nyquist and the curve; per axis the repeated edges combined;
-// per bar target the limiting frequency. Values are copied, nothing is recomputed.
+// per bar target and per Siemens star the limiting frequency. Values are copied, nothing is
+// recomputed.
 nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
   nlohmann::json section = {{"sources", paths},
                             {"edges", nlohmann::json::array()},
                             {"axes", nlohmann::json::array()},
-                            {"bars", nlohmann::json::array()}};
+                            {"bars", nlohmann::json::array()},
+                            {"stars", nlohmann::json::array()}};
   const auto copy = [](const nlohmann::json& from, nlohmann::json* to, std::initializer_list<const char*> keys) {
     for (const char* key : keys)
       if (from.contains(key)) (*to)[key] = from[key];
   };
   for (const std::string& path : paths) {
-    const nlohmann::json doc = ReadResult(path, {"quality_mtf", "quality_bars"}, "`aerocal quality`");
+    const nlohmann::json doc =
+        ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality`");
     ReadTyped(path, "--quality", [&] {
+      if (doc.at("kind") == "quality_star") {
+        nlohmann::json star = {{"source", path}};
+        copy(doc, &star, {"method", "star", "options", "reference_modulation", "rings", "limiting_frequency_cy_px",
+                          "limit_in_range", "limiting_radius_px", "limiting_lp_per_mm", "limiting_resolved_distance_m"});
+        section["stars"].push_back(star);
+        return 0;
+      }
       if (doc.at("kind") == "quality_bars") {
         nlohmann::json bars = {{"source", path}};
         copy(doc, &bars, {"method", "options", "reference_modulation", "groups", "limiting_frequency_cy_px",

@@ -21,8 +21,8 @@ struct CertificateArgs {
   /// Where `result` and `out` end when the caller stages them (flight writes its outputs as one
   /// set, tools/output_set.h): the paths recorded and printed ("" = result, out themselves).
   std::string result_name, out_name;
-  /// Results of `aerocal quality mtf` / `quality bars` (kinds quality_mtf, quality_bars): the
-  /// certificate's "dynamic image resolution" section (optional).
+  /// Results of `aerocal quality mtf` / `bars` / `star` (kinds quality_mtf, quality_bars,
+  /// quality_star): the certificate's "dynamic image resolution" section (optional).
   std::vector<std::string> quality;
 };
 

@@ -1,6 +1,7 @@
 // aerocal calibrate: camera calibration from a test field (observations.csv + points.csv) or a
 // planar board detected in images, on the existing self-calibrating adjustment
-// (triangulation/calibration). Parsing, loading, detecting, calling the library, writing results.
+// (triangulation/calibration); or from known directions (--directions: calibrate_directions.cc).
+// Parsing, loading, detecting, calling the library, writing results.
 #include "calib/camera/camera_io.h"
 #include "calib/camera/convert_camera.h"
 #include "calib/core/atomic_file.h"
@@ -9,6 +10,8 @@
 #include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
 #include "tools/board_detection.h"
+#include "tools/calibrate_directions.h"
+#include "tools/calibrate_models.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
@@ -94,55 +97,9 @@ std::map<std::string, std::string> GroupsFromObservations(const std::string& pat
   return CheckedGroups(out, path, observed);
 }
 
-// The RMS image residual per point (sqrt of the mean squared residual vector), as OpenCV's RMS.
-double RmsPx(const AdjustmentResult& r) {
-  double sum2 = 0;
-  int n = 0;
-  for (const auto& o : r.residuals)
-    if (o.used) {
-      sum2 += o.residual_px.squaredNorm();
-      ++n;
-    }
-  return n > 0 ? std::sqrt(sum2 / n) : 0.0;
-}
-
-// --model: brown10 (our 10-parameter model's short name) or a registered model name.
-calib::CameraModelId ModelOfOption(const std::string& name) {
-  const auto model = calib::CameraModelFromName(name == "brown10" ? "brown_fraser_10" : name);
-  if (!model)
-    throw ConfigError("--model: unknown camera model '" + name + "' (expected brown10, " +
-                      calib::CameraModelNames() + ")");
-  return *model;
-}
-
-// The parameters calibrated by default: those of the 10-parameter model but the affinity, and
-// OpenCV's of cv::calibrateCamera's default flags (k4-k6 fixed at 0); every one otherwise.
-std::string DefaultSelfCalibration(calib::CameraModelId model) {
-  if (model == calib::BrownFraser10Model::kId) return "c,x0,y0,K1,K2,K3,P1,P2";
-  if (model == calib::OpenCvModel::kId) return "fx,fy,cx,cy,k1,k2,p1,p2,k3";
-  return "all";
-}
-
-// The camera file's camera in `model`: converted (calib/camera/convert_camera.h; the
-// parameters not calibrated are held at 0 in the fit, as a start they would stay there).
-calib::Camera StartInModel(const calib::Camera& camera, calib::CameraModelId model,
-                           const std::vector<std::string>& free) {
-  calib::ConvertOptions convert;
-  for (const calib::ParamInfo& info : calib::CameraModelParams(model))
-    if (std::find(free.begin(), free.end(), info.name) == free.end())
-      if (info.group != calib::ParamGroup::kPrincipalDistance &&
-          info.group != calib::ParamGroup::kPrincipalPoint)
-        convert.zero.emplace_back(info.name);
-  const calib::ConversionResult start = calib::ConvertCamera(camera.AsModelCamera(), model, convert);
-  std::printf("start: the camera file's %s camera as %s: %s\n",
-              std::string(calib::CameraModelName(camera.model)).c_str(),
-              std::string(calib::CameraModelName(model)).c_str(), start.Summary().c_str());
-  return camera.WithModelCamera(start.camera);
-}
-
 CommandRun SetupCalibrate(CLI::App& app) {
   struct Args {
-    std::string camera, observations, points, images, board, groups, budget, out, write_marks;
+    std::string camera, observations, points, images, board, directions, groups, budget, out, write_marks;
     std::string write_camera, camera_format = "aerocal";
     std::string self_calibration;  // default: the model's (DefaultSelfCalibration)
     std::string model;             // default: the camera file's
@@ -164,6 +121,9 @@ CommandRun SetupCalibrate(CLI::App& app) {
   app.add_option("--board", args->board,
                  "Board of --images: chessboard|circles|acircles:COLSxROWS:SPACING_MM, e.g. "
                  "chessboard:9x6:25 (inner corners)");
+  app.add_option("--directions", args->directions,
+                 "Laboratory calibration from known directions: a collimator array or a goniometer "
+                 "sequence (CSV target,col,row,... of docs/formats.md 'Directions file')");
   app.add_option("--self-calibration", args->self_calibration,
                  "Interior parameters calibrated, names of the camera file's model: all, or a "
                  "list such as c,x0,y0,K1,K2,K3,P1,P2 (default of brown_fraser_10; opencv: "
@@ -184,17 +144,21 @@ CommandRun SetupCalibrate(CLI::App& app) {
                  "diagonal)")
       ->check(PositiveUpTo(1e4));
   app.add_option("--sigma-px", args->sigma_px,
-                 "Image sigma where observations.csv has no sigma_px, and of detected marks, px")
+                 "Image sigma where observations.csv or the directions file has no sigma_px, and of "
+                 "detected marks, px")
       ->check(PositiveUpTo(100));
-  app.add_option("--board-sigma-mm", args->board_sigma_mm,
-                 "Sigma of the board's design coordinates (print accuracy), mm")
-      ->check(PositiveUpTo(100));
-  app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
+  // Options of the test field / board only: refused by name with --directions.
+  std::vector<CLI::Option*> field_only = {app.get_option("--groups")};
+  field_only.push_back(app.add_option("--board-sigma-mm", args->board_sigma_mm,
+                                      "Sigma of the board's design coordinates (print accuracy), mm")
+                           ->check(PositiveUpTo(100)));
+  field_only.push_back(app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors"));
   AddSuspectEffectOption(app, &args->suspect_effect_limit);
-  app.add_flag("--no-closed-form", args->no_closed_form,
-               "Planar target: start from the camera file's c, not Zhang's closed form");
-  app.add_option("--write-marks", args->write_marks,
-                 "Write the detected marks as DIR/observations.csv and DIR/points.csv");
+  field_only.push_back(app.get_option("--suspect-effect-limit"));
+  field_only.push_back(app.add_flag("--no-closed-form", args->no_closed_form,
+                                    "Planar target: start from the camera file's c, not Zhang's closed form"));
+  field_only.push_back(app.add_option("--write-marks", args->write_marks,
+                                      "Write the detected marks as DIR/observations.csv and DIR/points.csv"));
   app.add_option("--out", args->out, "Result JSON (keys of `adjust` plus `calibration`)")
       ->required();
   app.add_option("--write-camera", args->write_camera,
@@ -202,11 +166,22 @@ CommandRun SetupCalibrate(CLI::App& app) {
   app.add_option("--camera-format", args->camera_format,
                  "Format of --write-camera: " + CameraFormatNames() +
                      " (converted into the format's model where it differs, with its residual)");
-  return [args]() {
+  return [args, field_only]() {
     const bool field = !args->observations.empty() || !args->points.empty();
     const bool board = !args->images.empty() || !args->board.empty();
+    if (!args->directions.empty()) {
+      if (field || board)
+        throw ConfigError("--directions: give either --directions, or --observations and --points, or "
+                          "--images and --board");
+      for (const CLI::Option* o : field_only)
+        if (o->count() > 0)
+          throw ConfigError(o->get_name() + ": not an option of a direction calibration (--directions)");
+      return CalibrateFromDirectionsFile({args->camera, args->directions, args->budget, args->out,
+                                          args->write_camera, args->camera_format, args->self_calibration,
+                                          args->model, args->sigma_px, args->radii_mm});
+    }
     if (field == board)
-      throw ConfigError("give either --observations and --points, or --images and --board");
+      throw ConfigError("give either --observations and --points, or --images and --board, or --directions");
     if (field && (args->observations.empty() || args->points.empty()))
       throw ConfigError("--observations and --points go together");
     if (board && (args->images.empty() || args->board.empty()))
@@ -326,14 +301,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
                      {"format_px", {camera.width_px, camera.height_px}}};
     cal["model"] = std::string(calib::CameraModelName(model));
     for (const auto& q : budget_table) std::printf("  %s\n", q.statement.c_str());
-    for (const auto& f : run.stability.flagged) {
-      std::printf("warning: group_stability: %s\n", f.c_str());
-      json["warnings"].push_back({{"name", "group_stability"},
-                                  {"subject", f.substr(0, f.find(':'))},
-                                  {"value", nullptr},
-                                  {"limit", nullptr},
-                                  {"message", f}});
-    }
+    AddStabilityWarnings(run.stability, &json);
     // The --model estimate of this run: what --write-camera writes when --model is given.
     std::optional<calib::Camera> beside_camera;
     std::optional<triangulation::CameraEstimate> beside_estimate;
@@ -432,8 +400,8 @@ CommandRun SetupCalibrate(CLI::App& app) {
 
 AEROCAL_REGISTER_COMMAND(calibrate,
                          "calibrate",
-                         "Camera calibration from a test field or a planar board (resections, "
-                         "self-calibrating adjustment, image-group stability, GUM budget)",
+                         "Camera calibration from a test field, a planar board or known directions "
+                         "(collimator array, goniometer); image-group stability, GUM budget",
                          SetupCalibrate);
 
 }  // namespace aerocal::tools

@@ -29,6 +29,7 @@ CommandRun SetupFlight(CLI::App& app) {
   struct Args {
     triangulation::FlightWorkflowOptions options;
     std::string out, base, joint_model = "auto", camera_format, lab, self_calibration = "auto";
+    std::vector<std::string> quality;
     bool no_report = false, certificate = false;
   };
   auto args = std::make_shared<Args>();
@@ -63,9 +64,15 @@ CommandRun SetupFlight(CLI::App& app) {
                "result.json); only for a valid flight");
   app.add_option("--lab", args->lab, "Lab YAML of the certificate (as `aerocal certificate --lab`)")
       ->needs("--certificate");
+  app.add_option("--quality", args->quality,
+                 "Results of `aerocal quality mtf|bars|star` on this flight's images: the certificate's "
+                 "dynamic image resolution section (as `aerocal certificate --quality`); repeatable")
+      ->needs("--certificate");
   return [args]() {
     CheckOutputFolder(args->out, "--out");
     if (args->certificate) ReadCertificateLab(args->lab);  // a bad lab file before the flight runs
+    for (const auto& path : args->quality)  // and a file that is no quality result
+      ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality` (--quality)");
     if (!args->camera_format.empty()) FindCameraFormat(args->camera_format, "--camera-format");
     args->options.base_ids = SplitCommaList(args->base);
     // Every --base id names a sub-image of the camera (the stitching step would otherwise fail
@@ -140,6 +147,7 @@ CommandRun SetupFlight(CLI::App& app) {
       certificate.result_name = set.Final("result.json");
       certificate.out_name = set.Final("certificate");
       certificate.no_render = args->no_report;
+      certificate.quality = args->quality;
       certificate_code = WriteCertificate(certificate);
       if (certificate_code == kExitInternal) {
         std::fprintf(stderr, "error: nothing written, the previous flight in %s is left as it was\n",

@@ -2,7 +2,8 @@
 // e-SFR, stitch/quality/slanted_edge.h) in regions of one image and writes their MTF, MTF50 with
 // its GUM budget, and the same in lp/mm and as a ground resolved distance; `quality bars` the
 // contrast transfer of bar groups and the limiting frequency at a threshold
-// (stitch/quality/bar_target.h). stitch/quality/README.md.
+// (stitch/quality/bar_target.h); `quality star` the same per radius of a Siemens star
+// (stitch/quality/siemens_star.h). stitch/quality/README.md.
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -16,6 +17,7 @@
 #include "stitch/image_io/image_io.h"
 #include "stitch/quality/bar_target.h"
 #include "stitch/quality/quality_json.h"
+#include "stitch/quality/siemens_star.h"
 #include "stitch/quality/slanted_edge.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
@@ -48,6 +50,13 @@ struct MtfArgs {
   std::vector<std::string> rois;
   double gamma = 1.0;
   int oversampling = 4;
+  GroundArgs ground;
+};
+
+struct StarArgs {
+  std::string image, out, centre;
+  int cycles = 0, steps_per_octave = 12;
+  double outer_radius_px = 0.0, inner_radius_px = 0.0, gamma = 1.0, threshold = 0.1;
   GroundArgs ground;
 };
 
@@ -218,6 +227,105 @@ int RunBars(const BarsArgs& args) {
   return determined ? kExitOk : kExitNotConverged;
 }
 
+// "col,row" in px (sub-pixel); ConfigError naming --centre otherwise.
+Eigen::Vector2d ParseCentre(const std::string& text) {
+  std::istringstream in(text);
+  double col = 0, row = 0;
+  char comma = 0;
+  std::string rest;
+  if (!(in >> col >> comma >> row) || comma != ',' || (in >> rest) || !std::isfinite(col) || !std::isfinite(row))
+    throw ConfigError("--centre: expected col,row in px (got '" + text + "')");
+  return {col, row};
+}
+
+int RunStar(const StarArgs& args) {
+  CheckOutputFile(args.out, "--out");
+  args.ground.Check();
+  stitch::SiemensStar star;
+  star.centre_px = ParseCentre(args.centre);
+  star.cycles = args.cycles;
+  star.outer_radius_px = args.outer_radius_px;
+  star.inner_radius_px = args.inner_radius_px;
+  stitch::SiemensStarOptions options;
+  options.gamma = args.gamma;
+  options.threshold = args.threshold;
+  options.steps_per_octave = args.steps_per_octave;
+  const stitch::GrayImage image = stitch::ReadGrayImage(args.image);
+  stitch::SiemensStarResult r;
+  try {
+    r = stitch::MeasureSiemensStar(image, star, options);
+  } catch (const InputError& e) {
+    throw InputError("--centre/--cycles/--outer-radius-px: " + args.image + ": " + e.what());
+  }
+  nlohmann::json rings = nlohmann::json::array();
+  for (const auto& ring : r.rings) {
+    nlohmann::json j = {{"radius_px", ring.radius_px},
+                        {"frequency_cy_px", ring.frequency_cy_px},
+                        {"modulation", ring.modulation},
+                        {"contrast_transfer", ring.contrast_transfer},
+                        {"pixels", ring.pixels}};
+    AddGround(args.ground, ring.frequency_cy_px, -1.0, "frequency", &j);
+    rings.push_back(j);
+  }
+  const bool determined = std::isfinite(r.limiting_frequency_cy_px);
+  nlohmann::json doc = {{"image", args.image},
+                        {"method", "Siemens star: fundamental modulation per ring, limit at a threshold"},
+                        {"star", {{"centre_px", {star.centre_px.x(), star.centre_px.y()}},
+                                  {"cycles", star.cycles},
+                                  {"outer_radius_px", star.outer_radius_px},
+                                  {"inner_radius_px", star.inner_radius_px}}},
+                        {"options", {{"gamma", args.gamma}, {"threshold", args.threshold},
+                                     {"steps_per_octave", args.steps_per_octave}}},
+                        {"reference_modulation", r.reference_modulation},
+                        {"step_ratio", r.step_ratio},
+                        {"rings", rings},
+                        {"limit_in_range", r.limit_in_range},
+                        {"determined", determined}};
+  doc["limiting_frequency_cy_px"] = determined ? nlohmann::json(r.limiting_frequency_cy_px) : nlohmann::json();
+  if (determined) {
+    AddGround(args.ground, r.limiting_frequency_cy_px, -1.0, "limiting", &doc);
+    doc["limiting_radius_px"] = star.cycles / (2.0 * M_PI * r.limiting_frequency_cy_px);
+  }
+  args.ground.Write(&doc);
+  WriteResult(args.out, "quality_star", doc);
+  if (determined)
+    std::printf("limiting frequency at %.0f %% modulation transfer: %.4f cycles/px (radius %.1f px)%s\n",
+                100.0 * args.threshold, r.limiting_frequency_cy_px,
+                star.cycles / (2.0 * M_PI * r.limiting_frequency_cy_px),
+                r.limit_in_range ? "" : " (or higher: every ring resolved)");
+  else
+    std::printf("no ring reaches %.0f %% modulation transfer\n", 100.0 * args.threshold);
+  return determined ? kExitOk : kExitNotConverged;
+}
+
+// `quality star`'s options.
+CLI::App* AddStar(CLI::App& app, StarArgs* star) {
+  CLI::App* s = app.add_subcommand(
+      "star", "Siemens star: modulation transfer per radius (frequency) and the limiting frequency at a threshold");
+  s->option_defaults()->always_capture_default();
+  s->add_option("--image", star->image, "Grey-value image (8 or 16 bit)")->required();
+  s->add_option("--centre", star->centre, "The star's centre col,row (px, sub-pixel)")->required();
+  s->add_option("--cycles", star->cycles, "Bright + dark sector pairs round the star")
+      ->check(FiniteRange(4, 10000))
+      ->required();
+  s->add_option("--outer-radius-px", star->outer_radius_px,
+                "Largest radius measured, inside the star (px; 12 px or more per sector there)")
+      ->check(PositiveUpTo(1e5))
+      ->required();
+  s->add_option("--inner-radius-px", star->inner_radius_px,
+                "Smallest radius measured (px; 0: down to 0.5 cycles/px)")
+      ->check(FiniteRange(0, 1e5));
+  s->add_option("--steps-per-octave", star->steps_per_octave, "Radii per halving of the radius")
+      ->check(FiniteRange(2, 96));
+  s->add_option("--threshold", star->threshold, "Modulation transfer defining the limiting frequency, 0 < T < 1")
+      ->check(FiniteRange(1e-6, 1.0 - 1e-6));
+  s->add_option("--gamma", star->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
+      ->check(FiniteRange(1e-6, 10.0));
+  star->ground.Add(s);
+  s->add_option("--out", star->out, "Result JSON (kind quality_star, written atomically)")->required();
+  return s;
+}
+
 CommandRun Setup(CLI::App& app) {
   app.require_subcommand(1);
   auto mtf = std::make_shared<MtfArgs>();
@@ -261,9 +369,12 @@ CommandRun Setup(CLI::App& app) {
       ->capture_default_str();
   bars->ground.Add(b);
   b->add_option("--out", bars->out, "Result JSON (kind quality_bars, written atomically)")->required();
-  return [mtf, m, bars, b] {
+  auto star = std::make_shared<StarArgs>();
+  CLI::App* s = AddStar(app, star.get());
+  return [mtf, m, bars, b, star, s] {
     if (m->parsed()) return RunMtf(*mtf);
     if (b->parsed()) return RunBars(*bars);
+    if (s->parsed()) return RunStar(*star);
     return kExitInternal;
   };
 }
@@ -271,7 +382,8 @@ CommandRun Setup(CLI::App& app) {
 }  // namespace
 
 AEROCAL_REGISTER_COMMAND(quality, "quality",
-                         "Dynamic image resolution: slanted-edge MTF (ISO 12233 e-SFR) with GUM uncertainty, bar targets",
+                         "Dynamic image resolution: slanted-edge MTF (ISO 12233 e-SFR) with GUM uncertainty, bar "
+                         "targets, Siemens stars",
                          Setup);
 
 }  // namespace aerocal::tools

@@ -2,9 +2,9 @@
 
 #include <algorithm>
 #include <cmath>
-#include <limits>
 
 #include "calib/core/error.h"
+#include "stitch/quality/limiting_frequency.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -96,22 +96,9 @@ BarTargetResult MeasureBarTarget(const GrayImage& image,
   std::sort(result.groups.begin(), result.groups.end(),
             [](const auto& a, const auto& b) { return a.frequency_cy_px < b.frequency_cy_px; });
 
-  const double t = options.threshold;
-  result.limiting_frequency_cy_px = std::numeric_limits<double>::quiet_NaN();
-  for (size_t i = 0; i < result.groups.size(); ++i) {
-    if (result.groups[i].contrast_transfer >= t) continue;
-    if (i == 0) return result;  // nothing resolved
-    const auto& a = result.groups[i - 1];
-    const auto& c = result.groups[i];
-    const double w = (a.contrast_transfer - t) / (a.contrast_transfer - c.contrast_transfer);
-    result.limiting_frequency_cy_px =
-        std::exp(std::log(a.frequency_cy_px) + w * (std::log(c.frequency_cy_px) - std::log(a.frequency_cy_px)));
-    return result;
-  }
-  if (!result.groups.empty()) {
-    result.limiting_frequency_cy_px = result.groups.back().frequency_cy_px;
-    result.limit_in_range = false;
-  }
+  const LimitingFrequency limit = FindLimitingFrequencyOf(result.groups, options.threshold);
+  result.limiting_frequency_cy_px = limit.frequency_cy_px;
+  result.limit_in_range = limit.in_range;
   return result;
 }
 

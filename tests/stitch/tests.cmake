@@ -23,6 +23,7 @@ aerocal_add_test(stitch/rig_images_cli LIBS aerocal::stitch LABELS cli)
 aerocal_add_test(stitch/slanted_edge LIBS aerocal::stitch LABELS synthetic)
 # Bar targets: contrast transfer per frequency and the limiting frequency (issue 36 item 2).
 aerocal_add_test(stitch/bar_target LIBS aerocal::stitch LABELS synthetic)
+aerocal_add_test(stitch/siemens_star LIBS aerocal::stitch LABELS synthetic)
 # On images we did not make (tests/data/quality/PROVENANCE.md): a third-party synthetic edge and a
 # real satellite image of the Baotou edge target with a published MTF50.
 aerocal_add_test(stitch/slanted_edge_real LIBS aerocal::stitch LABELS golden)

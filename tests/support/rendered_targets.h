@@ -109,4 +109,64 @@ double FirstCrossing(const Curve& curve, double level) {
   return std::nan("");
 }
 
+/// One pass of a Gaussian of sigma `s` (samples) over an n x n row-major array, along rows
+/// (`along_rows`) or columns, the border value repeated.
+inline void GaussianPass(std::vector<float>* image, int n, double s, bool along_rows) {
+  const int radius = static_cast<int>(std::ceil(4 * s));
+  std::vector<double> kernel(2 * radius + 1);
+  double sum = 0;
+  for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (s * s));
+  for (double& k : kernel) k /= sum;
+  std::vector<float> out(image->size());
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      double v = 0;
+      for (int k = -radius; k <= radius; ++k) {
+        const int jj = std::clamp(j + k, 0, n - 1);
+        v += kernel[k + radius] * (*image)[along_rows ? i * n + jj : jj * n + i];
+      }
+      out[along_rows ? i * n + j : j * n + i] = static_cast<float>(v);
+    }
+  *image = std::move(out);
+}
+
+/// A size x size Siemens star of `cycles` bright / dark sector pairs (bright where
+/// cos(cycles theta + phase) >= 0) centred at `centre` (px), blurred by a Gaussian of s px: the
+/// binary star at the centres of 4 x 4 sub-pixels, blurred there, averaged over each pixel (no
+/// noise). Its modulation transfer is RenderedStarTransfer.
+inline RenderedImage RenderSiemensStar(int size, int cycles, const Eigen::Vector2d& centre, double phase,
+                                       double s_px, double low, double high) {
+  constexpr int kSuper = 4;
+  const int n = size * kSuper;
+  std::vector<float> fine(static_cast<size_t>(n) * n);
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j) {
+      const double x = (j + 0.5) / kSuper - 0.5 - centre.x(), y = (i + 0.5) / kSuper - 0.5 - centre.y();
+      fine[static_cast<size_t>(i) * n + j] = static_cast<float>(std::cos(cycles * std::atan2(y, x) + phase) >= 0 ? high : low);
+    }
+  GaussianPass(&fine, n, s_px * kSuper, true);
+  GaussianPass(&fine, n, s_px * kSuper, false);
+  RenderedImage image(size, size);
+  for (int r = 0; r < size; ++r)
+    for (int c = 0; c < size; ++c) {
+      double sum = 0;
+      for (int a = 0; a < kSuper; ++a)
+        for (int b = 0; b < kSuper; ++b) sum += fine[static_cast<size_t>(r * kSuper + a) * n + c * kSuper + b];
+      image(r, c) = static_cast<float>(sum / (kSuper * kSuper));
+    }
+  return image;
+}
+
+/// The rendered star's modulation transfer at f (cycles/px): the PSF times the pixel's box
+/// averaged over the tangential directions round the circle, mean_t sinc(f cos t) sinc(f sin t).
+inline double RenderedStarTransfer(double f, double s_px) {
+  constexpr int kAngles = 360;
+  double box = 0;
+  for (int k = 0; k < kAngles; ++k) {
+    const double t = 2 * kRenderPi * (k + 0.5) / kAngles;
+    box += Sinc(f * std::cos(t)) * Sinc(f * std::sin(t)) / kAngles;
+  }
+  return std::exp(-2.0 * kRenderPi * kRenderPi * s_px * s_px * f * f) * box;
+}
+
 }  // namespace aerocal::testing

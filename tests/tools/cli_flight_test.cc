@@ -13,6 +13,8 @@
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/result_file.h"
+#include "stitch/image_io/image_io.h"
+#include "tests/support/rendered_targets.h"
 #include "tests/support/test_support.h"
 
 namespace aerocal {
@@ -27,10 +29,17 @@ class FlightWorkflow : public ::testing::Test {
     ASSERT_EQ(sim.exit_code, 0) << sim.output;
     WriteFileAtomically(dir_->File("lab.yaml"), "certificate: {number: F-7, date: 2026-11-24}\n"
                                                 "camera: {make: Sim, model: Four-CCD}\n");
+    // A Siemens star's reading (`quality star`) for the certificate's resolution section.
+    stitch::WriteGrayImage(dir_->File("star.png"),
+                           testing::RenderSiemensStar(220, 12, {109.5, 109.5}, 0.0, 1.0, 30.0, 220.0), 8);
+    const auto star = testing::RunAerocal("quality star --image " + dir_->File("star.png") +
+                                          " --centre 109.5,109.5 --cycles 12 --outer-radius-px 100 --gsd-m 0.05 "
+                                          "--out " + dir_->File("star.json"));
+    ASSERT_EQ(star.exit_code, 0) << star.output;
     run_ = new testing::CommandResult(testing::RunAerocal(
         "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " + dir_->File("data") +
         " --base III,IV --out " + dir_->File("report") + " --camera-format metashape --certificate --lab " +
-        dir_->File("lab.yaml")));
+        dir_->File("lab.yaml") + " --quality " + dir_->File("star.json")));
   }
   static void TearDownTestSuite() {
     delete run_;
@@ -127,12 +136,18 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
     EXPECT_NE(q["statement"].get<std::string>().find("(k = 2)"), std::string::npos) << q["statement"];
   }
   EXPECT_TRUE(has_c);
+  // --quality: the dynamic image resolution section from the star's reading.
+  ASSERT_EQ(cert["dynamic_image_resolution"]["stars"].size(), 1u);
+  EXPECT_EQ(cert["dynamic_image_resolution"]["stars"][0]["limiting_frequency_cy_px"],
+            nlohmann::json::parse(ReadTextFile(dir_->File("star.json")))["limiting_frequency_cy_px"]);
   const std::string html = ReadTextFile(dir_->File("report/certificate/certificate.html"));
-  for (const char* text : {"Calibration certificate", "F-7", "in-flight calibration", "Uncertainty budget"})
+  for (const char* text : {"Calibration certificate", "F-7", "in-flight calibration", "Uncertainty budget",
+                           "9. Dynamic image resolution", "Siemens star"})
     EXPECT_NE(html.find(text), std::string::npos) << text;
   // The certificate command on the flight's result.json gives the same data (its source apart).
   const auto r = testing::RunAerocal("certificate --result " + dir_->File("report/result.json") + " --lab " +
-                                     dir_->File("lab.yaml") + " --no-render --out " + dir_->File("cert"));
+                                     dir_->File("lab.yaml") + " --quality " + dir_->File("star.json") +
+                                     " --no-render --out " + dir_->File("cert"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   auto again = nlohmann::json::parse(ReadTextFile(dir_->File("cert/certificate.json")));
   auto first = cert;
@@ -192,6 +207,11 @@ TEST_F(FlightWorkflow, CertificateOptionsAreCheckedBeforeTheFlightRuns) {
   EXPECT_FALSE(std::filesystem::exists(dir_->File("bad_report/result.json")));
   const auto lone = testing::RunAerocal(flight + " --lab " + dir_->File("lab.yaml"));
   EXPECT_EQ(lone.exit_code, 2) << lone.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_->File("bad_report/result.json")));
+  // --quality with a file that is no quality result: exit 2 naming it, before the flight runs.
+  const auto quality = testing::RunAerocal(flight + " --certificate --quality " + dir_->File("lab.yaml"));
+  EXPECT_EQ(quality.exit_code, 2) << quality.output;
+  EXPECT_NE(quality.output.find("lab.yaml"), std::string::npos) << quality.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("bad_report/result.json")));
 }
 

@@ -1,7 +1,8 @@
 // `aerocal quality mtf` on exactly rendered slanted edges (tests/support/rendered_targets.h) written
 // as 8-bit PNG and 16-bit TIFF files: MTF50 against the analytic value, the units through the pixel
 // size and the GSD, the per-axis combination of repeated edges, and bad options (exit 2 naming the
-// option, nothing written). `aerocal quality bars` on rendered bar groups: the limiting frequency.
+// option, nothing written). `aerocal quality bars` on rendered bar groups and `aerocal quality star`
+// on a rendered Siemens star: the limiting frequency.
 #include <cmath>
 #include <filesystem>
 #include <random>
@@ -150,6 +151,49 @@ TEST(CliQuality, BarsGiveTheLimitingFrequencyAndGroundUnits) {
 
 // The certificate of a test-field calibration with the "dynamic image resolution" section from a
 // quality mtf and a quality bars result: the values copied, rendered into the HTML and the PDF.
+// A Siemens star of 24 cycles (blur s px) in a 420 x 420 8-bit PNG at `path`; returns its options.
+std::string WriteStar(const std::string& path, double s) {
+  stitch::WriteGrayImage(path, testing::RenderSiemensStar(420, 24, {209.5, 209.5}, 0.4, s, 30.0, 220.0), 8);
+  return " --centre 209.5,209.5 --cycles 24 --outer-radius-px 200";
+}
+
+TEST(CliQuality, StarGivesTheLimitingFrequencyAndGroundUnits) {
+  testing::TempDir dir("aerocal_cli_quality_star");
+  const double s = 1.2;
+  const std::string base = "quality star --image " + dir.File("star.png") + WriteStar(dir.File("star.png"), s);
+  const auto run = RunAerocal(base + " --pixel-mm 0.005 --gsd-m 0.1 --out " + dir.File("star.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json doc = testing::ReadJson(dir.File("star.json"));
+  EXPECT_EQ(doc["kind"], "quality_star");
+  const double limit = doc["limiting_frequency_cy_px"].get<double>();
+  const double truth = testing::FirstCrossing([&](double f) { return testing::RenderedStarTransfer(f, s); }, 0.1);
+  EXPECT_LE(std::abs(std::log(limit / truth)), std::log(doc["step_ratio"].get<double>())) << limit << " vs " << truth;
+  EXPECT_TRUE(doc["limit_in_range"].get<bool>());
+  EXPECT_NEAR(doc["limiting_lp_per_mm"].get<double>(), limit / 0.005, 1e-9);
+  EXPECT_NEAR(doc["limiting_resolved_distance_m"].get<double>(), 0.1 / (2.0 * limit), 1e-12);
+  EXPECT_NEAR(doc["limiting_radius_px"].get<double>(), 24 / (2 * 3.14159265358979323846 * limit), 1e-9);
+  // --inner-radius-px and --steps-per-octave: the rings stop at the inner radius, a step 2^(1/6) apart.
+  const auto coarse = RunAerocal(base + " --inner-radius-px 30 --steps-per-octave 6 --gamma 1 --out " +
+                                 dir.File("coarse.json"));
+  ASSERT_EQ(coarse.exit_code, 0) << coarse.output;
+  const nlohmann::json c = testing::ReadJson(dir.File("coarse.json"));
+  EXPECT_NEAR(c["step_ratio"].get<double>(), std::pow(2.0, 1.0 / 6.0), 1e-12);
+  EXPECT_GE(c["rings"].back()["radius_px"].get<double>(), 30.0 * (1 - 1e-9));
+  EXPECT_LT(c["rings"].back()["radius_px"].get<double>(), 30.0 * std::pow(2.0, 1.0 / 6.0));
+  const std::pair<std::string, std::string> bad[] = {
+      {" --centre 209.5 --cycles 24 --outer-radius-px 200", "--centre"},
+      {" --centre 209.5,209.5 --cycles 24 --outer-radius-px 260", "--outer-radius-px"},  // leaves the image
+      {" --centre 209.5,209.5 --cycles 2 --outer-radius-px 200", "--cycles"},
+      {" --centre 209.5,209.5 --cycles 24 --outer-radius-px 200 --threshold 1.5", "--threshold"},
+  };
+  for (const auto& [options, name] : bad) {
+    const auto r = RunAerocal("quality star --image " + dir.File("star.png") + options + " --out " + dir.File("bad.json"));
+    EXPECT_EQ(r.exit_code, 2) << options << "\n" << r.output;
+    EXPECT_NE(r.output.find(name), std::string::npos) << options << "\n" << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir.File("bad.json"))) << options;
+  }
+}
+
 TEST(CliQuality, CertificateGainsTheDynamicImageResolutionSection) {
   testing::TempDir dir("aerocal_cli_quality_cert");
   ASSERT_EQ(RunAerocal("simulate --test-field --groups 2 --images-per-group 4 --out " + dir.File("tf")).exit_code, 0);
@@ -168,8 +212,13 @@ TEST(CliQuality, CertificateGainsTheDynamicImageResolutionSection) {
                        dir.File("bars.json"))
                 .exit_code,
             0);
+  ASSERT_EQ(RunAerocal("quality star --image " + dir.File("star.png") + WriteStar(dir.File("star.png"), 1.0) +
+                       " --gsd-m 0.05 --out " + dir.File("star.json"))
+                .exit_code,
+            0);
   const auto run = RunAerocal("certificate --result " + dir.File("cal.json") + " --quality " + dir.File("q.json") +
-                              " --quality " + dir.File("bars.json") + " --out " + dir.File("cert"));
+                              " --quality " + dir.File("bars.json") + " --quality " + dir.File("star.json") +
+                              " --out " + dir.File("cert"));
   ASSERT_LE(run.exit_code, 3) << run.output;
   const nlohmann::json cert = testing::ReadJson(dir.File("cert/certificate.json"));
   ASSERT_TRUE(cert.contains("dynamic_image_resolution")) << run.output;
@@ -185,8 +234,11 @@ TEST(CliQuality, CertificateGainsTheDynamicImageResolutionSection) {
   EXPECT_EQ(d["axes"][0]["mtf50_cy_px"], q["axes"]["x"]["mtf50_cy_px"]);
   ASSERT_EQ(d["bars"].size(), 1u);
   EXPECT_EQ(d["bars"][0]["limiting_frequency_cy_px"], testing::ReadJson(dir.File("bars.json"))["limiting_frequency_cy_px"]);
+  ASSERT_EQ(d["stars"].size(), 1u);
+  EXPECT_EQ(d["stars"][0]["limiting_frequency_cy_px"], testing::ReadJson(dir.File("star.json"))["limiting_frequency_cy_px"]);
   const std::string html = ReadTextFile(dir.File("cert/certificate.html"));
   EXPECT_NE(html.find("9. Dynamic image resolution"), std::string::npos);
+  EXPECT_NE(html.find("Siemens star"), std::string::npos);
   EXPECT_TRUE(std::filesystem::exists(dir.File("cert/certificate.pdf")));
   // Another kind of result is refused, naming the file; nothing written.
   const auto bad = RunAerocal("certificate --result " + dir.File("cal.json") + " --quality " + dir.File("cal.json") +

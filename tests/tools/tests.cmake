@@ -1,7 +1,7 @@
 aerocal_add_test(tools/cli_simulate LIBS aerocal::triangulation LABELS cli)
 # `aerocal rig stitch` (issue 16) on a simulated uav4 line.
 aerocal_add_test(tools/cli_rig_stitch LIBS aerocal::calib LABELS cli)
-aerocal_add_test(tools/cli_flight LIBS aerocal::calib LABELS cli TIMEOUT 600)
+aerocal_add_test(tools/cli_flight LIBS aerocal::stitch LABELS cli TIMEOUT 600)
 include(${CMAKE_CURRENT_SOURCE_DIR}/tools/report.cmake)
 aerocal_add_test(tools/bad_input LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(tools/cli_joint LIBS aerocal::calib LABELS cli TIMEOUT 600)
@@ -18,6 +18,8 @@ aerocal_add_test(tools/cli_results LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/cli_camera_models LIBS aerocal::calib LABELS cli)
 # `aerocal quality mtf` (issue 36) on rendered edges written as 8- and 16-bit images.
 aerocal_add_test(tools/cli_quality LIBS aerocal::stitch LABELS cli)
+# Issue 36 item 6: calibrate --directions (collimator array, goniometer, groups, bad rows).
+aerocal_add_test(tools/cli_directions LIBS aerocal::triangulation LABELS cli)
 # Issue 37 (bad input, part 2): schema-checked certificate inputs, budget units, absurd geometry,
 # bounded sizes, the renderer's text and output sets, the ranges of every numeric option.
 aerocal_add_test(tools/bad_input2 LIBS aerocal::triangulation LABELS cli TIMEOUT 900)

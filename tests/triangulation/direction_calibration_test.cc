@@ -13,6 +13,7 @@
 #include "calib/camera/brown_fraser10.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
+#include "tests/support/simulated_directions.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -40,27 +41,18 @@ calib::Camera Truth() {
 
 const Eigen::Vector3d kTrueOpk(0.2 * kDeg, -0.3 * kDeg, 0.4 * kDeg);
 
-Eigen::Vector3d Direction(double azimuth, double elevation) {
-  return {std::sin(azimuth) * std::cos(elevation), std::sin(elevation), -std::cos(azimuth) * std::cos(elevation)};
-}
+Eigen::Vector3d Direction(double azimuth, double elevation) { return testing::InstrumentDirection(azimuth, elevation); }
 
 // The measured pixel of direction t (instrument frame) seen through G: exact, then image noise.
 Eigen::Vector2d Observe(const calib::Camera& truth, const Eigen::Matrix3d& g, const Eigen::Vector3d& t,
                         std::mt19937_64* rng) {
-  const Eigen::Vector3d uvw = calib::RotationFromOpk(kTrueOpk).transpose() * g.transpose() * t;
-  const double c = truth.interior[0];
-  const Eigen::Vector2d ideal(-c * uvw.x() / uvw.z(), -c * uvw.y() / uvw.z());
-  Eigen::Vector2d measured;
-  EXPECT_TRUE(calib::BrownFraser10Model::MeasuredFromIdeal(truth.interior.data(), ideal, &measured));
-  std::normal_distribution<double> noise(0.0, kSigmaPx);
-  return truth.frame().PixelFromPhoto(measured) + Eigen::Vector2d(noise(*rng), noise(*rng));
+  const Eigen::Vector2d px = testing::ObserveDirection(truth, kTrueOpk, g, t, kSigmaPx, rng);
+  EXPECT_TRUE(px.allFinite());
+  return px;
 }
 
 // A small random rotation of kSigmaRad per axis (a direction's or a setting's error).
-Eigen::Matrix3d AngularError(std::mt19937_64* rng) {
-  std::normal_distribution<double> n(0.0, kSigmaRad);
-  return calib::RotationFromOpk(Eigen::Vector3d(n(*rng), n(*rng), n(*rng)));
-}
+Eigen::Matrix3d AngularError(std::mt19937_64* rng) { return testing::RandomSmallRotation(kSigmaRad, rng); }
 
 void ExpectWithinThreeSigma(const DirectionCalibration& r, const calib::Camera& truth) {
   ASSERT_TRUE(r.report.converged) << r.report.message;
@@ -101,7 +93,7 @@ DirectionCalibration SimulateCollimatorArray(std::mt19937_64* rng) {
       // The collimator's true direction differs from its calibrated one by its 0.5" error.
       const Eigen::Vector3d t = AngularError(rng) * Direction(angles.x(), angles.y());
       observations.push_back({id, "", Eigen::Matrix3d::Identity(), Observe(truth, Eigen::Matrix3d::Identity(), t, rng),
-                              kSigmaPx, kSigmaRad});
+                              kSigmaPx, kSigmaRad, ""});
     }
   return CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations);
 }
@@ -120,7 +112,7 @@ DirectionCalibration SimulateGoniometer(std::mt19937_64* rng) {
       const Eigen::Matrix3d true_g = g * AngularError(rng);  // the setting's 0.5" error
       observations.push_back({"cross", "a" + std::to_string(i) + "e" + std::to_string(j), g,
                               Observe(truth, true_g, Direction(kTargetAngles.x(), kTargetAngles.y()), rng),
-                              kSigmaPx, kSigmaRad});
+                              kSigmaPx, kSigmaRad, ""});
     }
   return CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations);
 }
@@ -170,7 +162,7 @@ TEST(DirectionCalibration, ReportedSigmasMatchTheScatterOverSeeds) {
 
 TEST(DirectionCalibration, RefusesUnknownTargetsAndBadSigmas) {
   std::vector<DirectionTarget> targets = {{"a", Eigen::Vector2d::Zero(), true}};
-  std::vector<DirectionObservation> observations = {{"b", "", Eigen::Matrix3d::Identity(), {3000, 2000}, 0.1, 0}};
+  std::vector<DirectionObservation> observations = {{"b", "", Eigen::Matrix3d::Identity(), {3000, 2000}, 0.1, 0, ""}};
   EXPECT_THROW(CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations), InputError);
   observations[0].target = "a";
   observations[0].sigma_px = 0.0;

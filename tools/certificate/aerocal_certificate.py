@@ -137,9 +137,8 @@ def identification_rows(c):
             ["camera file", "%s: pixel %s mm, format %s x %s px" % (cf["file"], fmt(cf["pixel_size_mm"]),
                                                                    cf["format_px"][0], cf["format_px"][1])],
             ["method", method_text(m)],
-            ["data", "%d images, %d observations, %d control, %d check points, %d groups" % (
-                d["images"], d["observations"], d["control_points"], d["check_points"], d["groups"])],
-            ["adjustment", "self-calibrating bundle adjustment (%s); sigma0 %s (%s px, %s um), redundancy %s, RMS %s px" % (
+            ["data", data_text(m, d)],
+            ["adjustment", adjustment_kind(m) + " (%s); sigma0 %s (%s px, %s um), redundancy %s, RMS %s px" % (
                 ", ".join(a.get("self_calibration") or []) if isinstance(a.get("self_calibration"), list) else fmt(a.get("self_calibration")),
                 fmt(a["sigma0"], 4), fmt(a["sigma0_px"], 4), fmt(a["sigma0_um"], 4), fmt(a["redundancy"]), fmt(a["rms_px"], 4))],
             ["conditions", ", ".join("%s %s" % (k, v) for k, v in lab["conditions"].items() if v) or "-"],
@@ -190,8 +189,21 @@ def resolution_bar_rows(c):
     return rows if len(rows) > 1 else []
 
 
+def resolution_star_rows(c):
+    """Siemens stars (`aerocal quality star`): the limiting frequency at the threshold."""
+    d = c.get("dynamic_image_resolution") or {}
+    rows = [["Siemens star", "cycles", "threshold", "limiting cy/px", "radius px", "lp/mm", "GRD m",
+             "within the star"]]
+    for i, s in enumerate(d.get("stars", [])):
+        rows.append([i + 1, (s.get("star") or {}).get("cycles", "-"), fmt((s.get("options") or {}).get("threshold"), 3),
+                     fmt(s.get("limiting_frequency_cy_px"), 4), fmt(s.get("limiting_radius_px"), 4),
+                     fmt(s.get("limiting_lp_per_mm"), 4), fmt(s.get("limiting_resolved_distance_m"), 4),
+                     fmt(s.get("limit_in_range"))])
+    return rows if len(rows) > 1 else []
+
+
 def fig_mtf(c):
-    """MTF curves of the edges and contrast transfer of the bar groups, cycles/px."""
+    """MTF curves of the edges, contrast transfer of the bar groups and of the stars' rings, cycles/px."""
     d = c.get("dynamic_image_resolution") or {}
     fig, ax = plt.subplots(figsize=(7.0, 3.6))
     for i, e in enumerate(d.get("edges", [])):
@@ -205,6 +217,10 @@ def fig_mtf(c):
         g = b.get("groups", [])
         ax.plot([x["frequency_cy_px"] for x in g], [x["contrast_transfer"] for x in g], "o--",
                 label="bar target %d (contrast transfer)" % (i + 1))
+    for i, s in enumerate(d.get("stars", [])):
+        r = s.get("rings", [])
+        ax.plot([x["frequency_cy_px"] for x in r], [x["contrast_transfer"] for x in r], ".:",
+                label="Siemens star %d (modulation transfer)" % (i + 1))
     ax.axhline(0.5, color="#999", lw=0.6)
     ax.axvline(0.5, color="#999", lw=0.6, ls=":")
     ax.set_xlabel("frequency (cycles/px); Nyquist 0.5")
@@ -217,10 +233,30 @@ def fig_mtf(c):
     return fig
 
 
+def data_text(m, d):
+    """The data row: images and points, or for a direction calibration targets and settings."""
+    if m.get("kind") in ("collimator array", "goniometer"):
+        return "%d observations of %d targets (%d of known direction), %d settings, %d groups" % (
+            d["observations"], d.get("targets", 0), d["control_points"], d.get("settings", 0), d["groups"])
+    return "%d images, %d observations, %d control, %d check points, %d groups" % (
+        d["images"], d["observations"], d["control_points"], d["check_points"], d["groups"])
+
+
+def adjustment_kind(m):
+    """The adjustment the method ran: directions (no positions) or a bundle adjustment."""
+    if m.get("kind") in ("collimator array", "goniometer"):
+        return "direction adjustment"
+    return "self-calibrating bundle adjustment"
+
+
 def method_text(m):
     if m.get("kind") == "in-flight calibration":
         return "in-flight calibration (aerocal flight, %s adjustment) of %s; uncertainty budget: %s" % (
             m.get("adjustment"), m.get("flight_data"), m.get("budget"))
+    if m.get("kind") in ("collimator array", "goniometer"):
+        return "%s (laboratory, known directions): %s; %d targets (%d of known direction), %d settings; %s" % (
+            m["kind"], m.get("directions"), m.get("targets", 0), m.get("known_targets", 0), m.get("settings", 0),
+            m.get("adjustment", ""))
     if m.get("kind") == "planar target":
         return "planar %s %dx%d, spacing %s mm, %s; %d of %d images detected" % (
             m["board"], m["columns"], m["rows"], fmt(m["spacing_mm"]), m["detector"], len(m["detected"]),
@@ -367,7 +403,8 @@ def write_html(c, path, figures):
         parts.append("<h2>9. Dynamic image resolution</h2><p>%s; MTF50 with U = k u_c (k = 2); GRD = GSD / "
                      "(2 f), one bar width. Sources: %s.</p>" % (
                          html.escape(d.get("method", "bar targets")), html.escape(", ".join(d.get("sources", [])))))
-        for rows in (resolution_edge_rows(c), resolution_axis_rows(c), resolution_bar_rows(c)):
+        for rows in (resolution_edge_rows(c), resolution_axis_rows(c), resolution_bar_rows(c),
+                     resolution_star_rows(c)):
             if rows:
                 parts.append(html_table(rows))
         parts.append(figures["mtf"])
@@ -472,7 +509,8 @@ def write_pdf_pages(c, tmp, title):
         if c.get("dynamic_image_resolution"):
             blocks += [("9. Dynamic image resolution (MTF50, U = k u_c, k = 2)", resolution_edge_rows(c) or [["no edges"]]),
                        ("", resolution_axis_rows(c) or [["no repeated edges of one axis"]]),
-                       ("", resolution_bar_rows(c) or [["no bar targets"]])]
+                       ("", resolution_bar_rows(c) or [["no bar targets"]]),
+                       ("", resolution_star_rows(c) or [["no Siemens stars"]])]
         blocks += [("Findings", [[w] for w in warning_lines(c)] or [["none"]]),
                    ("Signatures", sig)]
         for fig in text_pages(title, blocks):

@@ -38,6 +38,7 @@ struct DirectionObservation {
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // measured (col, row), camera pixel frame
   double sigma_px = 0.1;   // image measurement sigma, > 0
   double sigma_rad = 0.0;  // angular sigma of the direction (collimator or setting), >= 0
+  std::string where;       // FILE:LINE of the observation for messages ("" : its number)
 };
 
 struct DirectionCalibrationOptions {
@@ -49,6 +50,16 @@ struct DirectionCalibration {
   calib::SolveReport report;
   calib::Camera camera;                   // the start camera with the estimated interior
   std::vector<double> interior_sigma;     // a-posteriori, table order (0 for fixed entries)
+  /// A-posteriori covariance of the interior, table order and units (zero rows and columns for
+  /// fixed entries); empty when !covariance_ok.
+  Eigen::MatrixXd interior_covariance;
+  std::vector<calib::HighCorrelation> high_correlations;  // |rho| > 0.95 of free parameters
+  std::vector<std::string> undetermined;                 // null-space parameters (rank defect)
+  /// Per observation: v = measured - adjusted in the (corrected) photo space, (col, row) px; and
+  /// its a-priori sigma sqrt(trace(C) / 2) / pixel size (C of DirectionCovarianceMm2: the image
+  /// measurement and the direction's angular sigma), px.
+  std::vector<Eigen::Vector2d> residual_px;
+  std::vector<double> apriori_sigma_px;
   Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();        // R (instrument_from_camera) as omega, phi, kappa
   Eigen::Vector3d opk_sigma_rad = Eigen::Vector3d::Zero();
   std::map<std::string, Eigen::Vector2d> target_angles_rad;  // estimated (unknown) targets
@@ -65,5 +76,20 @@ DirectionCalibration CalibrateFromDirections(const calib::Camera& start,
                                              const std::vector<DirectionTarget>& targets,
                                              const std::vector<DirectionObservation>& observations,
                                              const DirectionCalibrationOptions& options = {});
+
+/// A start of R (instrument_from_camera, as omega, phi, kappa) from the known targets: the rotation
+/// that best turns the start camera's rays u (principal distance and point, no distortion) into
+/// the known directions turned back by their settings, G^T t = R u (Wahba's problem, solved by the
+/// SVD of sum (G^T t) u^T). Zero when fewer than two distinct known targets are observed.
+Eigen::Vector3d StartRotationFromDirections(const calib::Camera& start,
+                                            const std::vector<DirectionTarget>& targets,
+                                            const std::vector<DirectionObservation>& observations);
+
+/// Start angles of the targets not known: the first observation's ray of the start camera turned
+/// into the instrument frame, t = G R u (the azimuth and elevation of t).
+void StartUnknownTargets(const calib::Camera& start,
+                         const Eigen::Vector3d& start_opk_rad,
+                         const std::vector<DirectionObservation>& observations,
+                         std::vector<DirectionTarget>* targets);
 
 }  // namespace aerocal::triangulation

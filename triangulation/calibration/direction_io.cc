@@ -1,0 +1,106 @@
+#include "triangulation/calibration/direction_io.h"
+
+#include <cmath>
+#include <map>
+#include <optional>
+#include <set>
+#include <tuple>
+
+#include "calib/camera/rotation.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/string_printf.h"
+
+namespace aerocal::triangulation {
+namespace {
+
+constexpr double kDeg = M_PI / 180.0;
+constexpr double kArcSecond = kDeg / 3600.0;
+// Largest angular sigma accepted: a degree is no calibrated direction.
+constexpr double kMaxSigmaArcsec = 3600.0;
+// Two values of one target's / setting's angles on different rows must agree to this, deg.
+constexpr double kSameAngleDeg = 1e-9;
+
+// A target's direction (both columns, or none) on a row.
+std::optional<Eigen::Vector2d> RowAngles(const CsvTable& table, const CsvTable::Row& row) {
+  const auto a = table.OptionalBounded(row, "azimuth_deg", -180.0, 180.0);
+  const auto e = table.OptionalBounded(row, "elevation_deg", -89.0, 89.0);
+  if (a.has_value() != e.has_value())
+    ThrowInputError(table.Where(row), "azimuth_deg and elevation_deg go together (one is empty)");
+  if (!a) return std::nullopt;
+  return Eigen::Vector2d(*a, *e);
+}
+
+bool SameAngles(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  return (a - b).cwiseAbs().maxCoeff() <= kSameAngleDeg;
+}
+
+// A row's goniometer setting: its name and (turn, tilt) in degrees.
+std::pair<std::string, Eigen::Vector2d> RowSetting(const CsvTable& table, const CsvTable::Row& row) {
+  const Eigen::Vector2d angles(table.OptionalBounded(row, "turn_deg", -180.0, 180.0).value_or(0.0),
+                               table.OptionalBounded(row, "tilt_deg", -180.0, 180.0).value_or(0.0));
+  std::string name = table.String(row, "setting");
+  const bool has_angles = table.HasColumn("turn_deg") || table.HasColumn("tilt_deg");
+  if (name.empty() && has_angles) name = StringPrintf("turn %.6g tilt %.6g", angles.x(), angles.y());
+  return {name, angles};
+}
+
+}  // namespace
+
+DirectionData ReadDirections(const std::string& path, const calib::Camera& camera, double default_sigma_px) {
+  const CsvTable table = CsvTable::Read(path);
+  table.RequireColumns({"target", "col", "row"});
+  table.RejectUnknownColumns({"target", "col", "row", "sigma_px", "azimuth_deg", "elevation_deg", "sigma_arcsec",
+                              "setting", "turn_deg", "tilt_deg", "group"});
+  if (table.HasColumn("azimuth_deg") != table.HasColumn("elevation_deg"))
+    ThrowInputError({path, 0}, "azimuth_deg and elevation_deg go together (one column is missing)");
+  if (table.rows().empty()) ThrowInputError({path, 0}, "no rows (a directions file needs observations)");
+  DirectionData out;
+  std::map<std::string, std::pair<std::optional<Eigen::Vector2d>, int>> target_angles;  // -> (angles, line)
+  std::map<std::string, std::pair<Eigen::Vector2d, int>> settings;                      // -> (turn, tilt; line)
+  std::set<std::tuple<std::string, std::string, std::string>> seen;                     // target, setting, group
+  for (const auto& row : table.rows()) {
+    const SourceRef where = table.Where(row);
+    DirectionObservation o;
+    o.where = where.ToString();
+    o.target = table.String(row, "target");
+    if (o.target.empty()) ThrowInputError(where, "target must not be empty");
+    o.pixel = Eigen::Vector2d(table.Bounded(row, "col", -0.5, camera.width_px - 0.5),
+                              table.Bounded(row, "row", -0.5, camera.height_px - 0.5));
+    o.sigma_px = table.OptionalBounded(row, "sigma_px", 0.0, 100.0).value_or(default_sigma_px);
+    if (!(o.sigma_px > 0)) ThrowInputError(where, "sigma_px must be > 0 (got 0)");
+    o.sigma_rad = table.OptionalBounded(row, "sigma_arcsec", 0.0, kMaxSigmaArcsec).value_or(0.0) * kArcSecond;
+    const auto [setting, turn_tilt] = RowSetting(table, row);
+    o.setting = setting;
+    o.instrument_rotation = calib::RotationFromOpk(Eigen::Vector3d(turn_tilt.y() * kDeg, turn_tilt.x() * kDeg, 0.0));
+    if (!setting.empty()) {
+      const auto [at, added] = settings.emplace(setting, std::make_pair(turn_tilt, row.line));
+      if (!added && !SameAngles(at->second.first, turn_tilt))
+        ThrowInputError(where, StringPrintf("setting %s has turn %.9g, tilt %.9g deg here and %.9g, %.9g at line %d",
+                                            setting.c_str(), turn_tilt.x(), turn_tilt.y(), at->second.first.x(),
+                                            at->second.first.y(), at->second.second));
+    }
+    const std::optional<Eigen::Vector2d> angles = RowAngles(table, row);
+    const auto [at, added] = target_angles.emplace(o.target, std::make_pair(angles, row.line));
+    if (added) {
+      const Eigen::Vector2d start_rad = angles ? Eigen::Vector2d(*angles * kDeg) : Eigen::Vector2d(0.0, 0.0);
+      out.targets.push_back({o.target, start_rad, angles.has_value()});
+    } else if (at->second.first.has_value() != angles.has_value() ||
+               (angles && !SameAngles(*angles, *at->second.first))) {
+      ThrowInputError(where, "target " + o.target + ": its azimuth_deg, elevation_deg differ from line " +
+                                 std::to_string(at->second.second) +
+                                 " (a known target gives the same direction on every row; an estimated one none)");
+    }
+    const std::string group = table.String(row, "group");
+    if (!seen.emplace(o.target, o.setting, group).second)
+      ThrowInputError(where, "target " + o.target + (o.setting.empty() ? "" : " at setting " + o.setting) +
+                                 (group.empty() ? "" : " in group " + group) +
+                                 " is observed twice (a repeated series goes into its own group)");
+    if (table.HasColumn("group")) out.groups.push_back(group);
+    out.observations.push_back(o);
+  }
+  out.settings = static_cast<int>(settings.size());
+  return out;
+}
+
+}  // namespace aerocal::triangulation

@@ -1,0 +1,62 @@
+// A laboratory calibration from directions (direction_calibration.h) in the form of a test-field
+// calibration run (calibration.h): the adjustment of all observations, one per observation group
+// and the stability of the groups (GroupStability), so that the uncertainty budget
+// (uncertainty_budget.h), the `calibration` JSON section and the certificate are the test
+// field's, not a second copy.
+//
+// The directions' angular sigmas (collimators, goniometer settings) are part of each
+// observation's a-priori covariance (DirectionCovarianceMm2), so the adjustment's covariance, the
+// budget's component "adjustment (sigma0 sqrt(Qxx))", already holds them; no `control_fixed` run is
+// made. (A run with the angular sigmas made small and its covariance subtracted would count them
+// twice, and its a-posteriori scaling by its own, larger sigma0 puts them back: measured, the
+// difference was 0 for c.)
+//
+// What a direction run puts into the AdjustmentResult of each run: the solve report, sigma0 (and
+// in px: sigma0 times the RMS of the observations' a-priori focal-plane sigmas, which include the
+// directions' angular sigmas), the camera estimate with sigmas, one residual per observation
+// (image = the setting, or "collimator"; point = the target), the determinability and the
+// validity (not converged, no covariance, a rank defect or sigma0 above max_sigma0: not valid).
+// No exposures, control or check points: a direction calibration has no positions.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include "triangulation/calibration/calibration.h"
+#include "triangulation/calibration/direction_calibration.h"
+
+namespace aerocal::triangulation {
+
+struct DirectionRunOptions {
+  DirectionCalibrationOptions calibration;
+  double stability_alpha = 0.05;  // level of the group agreement test, (0, 1)
+  double max_sigma0 = 3.0;        // above it a run is not valid (AdjustOptions::max_sigma0), > 0
+};
+
+struct DirectionRun {
+  CalibrationRun run;        // all, groups, stability (no control_fixed: see the header comment)
+  DirectionCalibration all;  // the rotation, the estimated targets, the residuals
+  Eigen::Vector3d start_opk_rad = Eigen::Vector3d::Zero();  // StartRotationFromDirections
+};
+
+/// Calibrates `start` (model, format, start interior; its id `camera_id`) from `observations` of
+/// `targets`; `group_of_observation` is empty or names each observation's group ("": none; groups
+/// need two or more and each determines its unknowns). The rotation starts from the known
+/// targets (StartRotationFromDirections), unknown targets from their first ray. Throws
+/// InputError for a group that cannot be adjusted alone (fewer observations than unknowns).
+DirectionRun RunDirectionCalibration(const std::string& camera_id,
+                                     const calib::Camera& start,
+                                     std::vector<DirectionTarget> targets,
+                                     const std::vector<DirectionObservation>& observations,
+                                     const std::vector<std::string>& group_of_observation,
+                                     const DirectionRunOptions& options = {});
+
+/// One direction calibration as a calibration adjustment (see the header comment).
+CalibrationAdjustment AdjustmentOfDirections(const std::string& camera_id,
+                                             const calib::Camera& start,
+                                             const DirectionCalibration& calibration,
+                                             const std::vector<DirectionObservation>& observations,
+                                             const std::vector<std::string>& free_interior,
+                                             double max_sigma0);
+
+}  // namespace aerocal::triangulation
