@@ -448,7 +448,8 @@ bool ProblemBuilder::UpdateManifolds() {
 }
 
 std::unique_ptr<ceres::Problem> ProblemBuilder::EliminableInOrder(std::vector<double>* buffer,
-                                                                   std::vector<double*>* pointers) const {
+                                                                   std::vector<double*>* pointers,
+                                                                   bool all) const {
   ceres::Problem::Options options;
   options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -456,14 +457,14 @@ std::unique_ptr<ceres::Problem> ProblemBuilder::EliminableInOrder(std::vector<do
   auto mirror = std::make_unique<ceres::Problem>(options);
   size_t total = 0;
   for (const Block& b : blocks_)
-    if (b.Eliminable()) total += b.size;
+    if (all || b.Eliminable()) total += b.size;
   buffer->assign(total, 0.0);  // never resized below: the pointers into it stay valid
   pointers->assign(blocks_.size(), nullptr);
   size_t offset = 0;
   for (size_t id = 0; id < blocks_.size(); ++id) {
     const Block& b = blocks_[id];
     double* values = b.values;
-    if (b.Eliminable()) {
+    if (all || b.Eliminable()) {
       values = buffer->data() + offset;
       std::copy(b.values, b.values + b.size, values);
       offset += b.size;
@@ -984,14 +985,18 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     options.num_threads = 1;
     options.apply_loss_function = true;
     ceres::Covariance covariance(options);
+    // On a copy in BlockId order: Ceres orders the Jacobian's columns by block address.
+    std::vector<double> buffer;
+    std::vector<double*> in_order;
+    const std::unique_ptr<ceres::Problem> mirror = EliminableInOrder(&buffer, &in_order, true);
     std::vector<std::pair<const double*, const double*>> ceres_pairs;
-    for (const auto& [a, b] : pairs) ceres_pairs.emplace_back(blocks_[a].values, blocks_[b].values);
-    if (!ceres_pairs.empty() && !covariance.Compute(ceres_pairs, problem_.get()))
+    for (const auto& [a, b] : pairs) ceres_pairs.emplace_back(in_order[a], in_order[b]);
+    if (!ceres_pairs.empty() && !covariance.Compute(ceres_pairs, mirror.get()))
       return fail(singular_message);
     for (const auto& [a, b] : pairs) {
       Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(blocks_[a].size,
                                                                                blocks_[b].size);
-      covariance.GetCovarianceBlock(blocks_[a].values, blocks_[b].values, m.data());
+      covariance.GetCovarianceBlock(in_order[a], in_order[b], m.data());
       report.blocks[{a, b}] = s2 * Eigen::MatrixXd(m);
     }
   } else {

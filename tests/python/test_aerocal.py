@@ -241,3 +241,33 @@ def test_stitch_equals_the_command_and_types_its_result(flight):
         aerocal.stitch(camera, obs, model="bilinear")
     with pytest.raises(ValueError, match="nope.csv"):
         aerocal.stitch(camera, os.path.join(flight, "nope.csv"))
+
+
+def test_a_real_block_equals_the_command_to_the_last_digit(tmp_path):
+    """The ODM UAV block (10 real images, GCPs surveyed by GNSS): the module's result file is the
+    command's, with the options a user of that block needs (robust start: two gross blunders)."""
+    data = os.path.join(SHARED, "odm_br_uav_gcp_block", "odm_gcp_br")
+    if not os.path.isdir(data):
+        pytest.skip("../shared/data/odm_br_uav_gcp_block is absent")
+    camera = tmp_path / "sx260.yaml"
+    camera.write_text("name: Canon PowerShot SX260 HS\npixel_size_mm: 0.00154959\n"
+                      "format_px: [4000, 3000]\ninterior: {c: 4.5}\n")
+    block = str(tmp_path / "block")
+    code, text = run("import", "odm", "--gcp-list", os.path.join(data, "gcp_list_floatxy_raw.txt"),
+                     "--camera", str(camera), "--control", os.path.join(data, "gcp_list_raw.txt"),
+                     "--out", block)
+    assert code == 0, text
+    out = str(tmp_path / "cli.json")
+    code, text = run("adjust", "--project", block, "--robust-start", "--self-calibration", "auto",
+                     "--out", out)
+    assert code in (0, 3), text
+    r = aerocal.adjust(aerocal.Block.read(block), self_calibration="auto", robust_start=True)
+    with open(out) as f:
+        cli = json.load(f)
+    doc = json.loads(r.to_json())
+    for d in (cli, doc):
+        d.pop("timing", None)
+        d.pop("seconds", None)
+        d["snooping"].pop("seconds_testing", None)
+    assert doc == cli
+    assert (code == 0) == r.valid
