@@ -1,5 +1,5 @@
 // aerocal import: converts blocks from other tools (COLMAP text model, DBAT / PhotoModeler marks,
-// OpenDroneMap gcp_list.txt) once into the FORMATS.md block files (triangulation/import).
+// OpenDroneMap gcp_list.txt, a drone flight's images) once into the FORMATS.md block files (triangulation/import).
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
@@ -9,6 +9,7 @@
 #include "triangulation/adjustment/nadir_start.h"
 #include "triangulation/import/colmap_import.h"
 #include "triangulation/import/dbat_import.h"
+#include "triangulation/import/image_import.h"
 #include "triangulation/import/odm_gcp_import.h"
 #include "triangulation/import/write_project.h"
 
@@ -24,6 +25,58 @@ void Report(const triangulation::Project& p, const std::string& out) {
               p.observations.size(),
               p.points.size(),
               out.c_str());
+}
+
+void SetupImportImages(CLI::App& app, const std::shared_ptr<std::string>& out,
+                       const std::shared_ptr<CommandRun>& run) {
+  CLI::App* images = app.add_subcommand(
+      "images", "A drone flight's JPEG/TIFF images: exposures and cameras from their EXIF and XMP");
+  auto o = std::make_shared<triangulation::ImageImportOptions>();
+  auto gnss = std::make_shared<std::vector<double>>();
+  auto attitude = std::make_shared<double>(0.0);
+  images->add_option("dir", o->folder, "Folder of the images (files directly in it)")->required();
+  images->add_option("--crs", o->crs,
+                     "CRS of the written exposures (EPSG code, compound EPSG:A+B, WKT, PROJ string; "
+                     "default: the images' own, EPSG:4326+5773 or EPSG:4979 by --heights)");
+  images->add_option("--heights", o->heights,
+                     "What the images' altitudes are: egm96 (EXIF: above sea level; default) or "
+                     "ellipsoidal (WGS84)")
+      ->check(CLI::IsMember({"egm96", "ellipsoidal"}));
+  images->add_option("--gnss-sigma-m", *gnss,
+                     "Horizontal and vertical sigma (m) of centres without RTK standard deviations "
+                     "(default: none, the centre is not weighted)")
+      ->expected(2)
+      ->delimiter(',')
+      ->check(PositiveUpTo(1e6));
+  images->add_option("--attitude-sigma-deg", *attitude,
+                     "Sigma (deg) of the attitude from the gimbal angles (default: none)")
+      ->check(PositiveUpTo(360));
+  images->add_option("--pixel-size-mm", o->pixel_size_mm,
+                     "Pixel size, mm (default: EXIF FocalPlaneXResolution, else the 35 mm "
+                     "equivalent focal length)")
+      ->check(PositiveUpTo(1));
+  images->add_option("--out", *out, "Output folder")->required();
+  images->callback([=] {
+    *run = [=] {
+      CheckOutputFolder(*out, "--out");
+      if (!gnss->empty()) o->gnss_sigma_m = Eigen::Vector2d((*gnss)[0], (*gnss)[1]);
+      if (*attitude > 0) o->attitude_sigma_deg = *attitude;
+      const triangulation::ImageImportReport report = triangulation::ImportImages(*o);
+      triangulation::WriteImageImport(report, *out);
+      for (const std::string& note : report.notes) std::printf("note: %s\n", note.c_str());
+      std::printf("imported %zu exposures, %zu cameras from %s -> %s/project.yaml (tags.csv: the "
+                  "tag of every value)\n",
+                  report.project.exposures.size(),
+                  report.project.cameras.size(),
+                  o->folder.c_str(),
+                  out->c_str());
+      std::printf("%zu files not used (images_not_used.csv)", report.not_used.size());
+      for (size_t i = 0; i < report.not_used.size(); ++i)
+        std::printf("%s%s", i == 0 ? ": " : ", ", report.not_used[i].first.c_str());
+      std::printf("\n");
+      return kExitOk;
+    };
+  });
 }
 
 CommandRun SetupImport(CLI::App& app) {
@@ -136,6 +189,7 @@ CommandRun SetupImport(CLI::App& app) {
       return kExitOk;
     };
   });
+  SetupImportImages(app, out, run);
   return [run]() { return (*run)(); };
 }
 
@@ -143,8 +197,8 @@ CommandRun SetupImport(CLI::App& app) {
 
 AEROCAL_REGISTER_COMMAND(import,
                          "import",
-                         "Convert a COLMAP model, DBAT/PhotoModeler marks or an ODM gcp_list.txt "
-                         "into the block files",
+                         "Convert a COLMAP model, DBAT/PhotoModeler marks, an ODM gcp_list.txt or a "
+                         "drone flight's images into the block files",
                          SetupImport);
 
 }  // namespace aerocal::tools

@@ -15,3 +15,5 @@ aerocal_add_test(calib/camera_file_variants LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/rotation LIBS aerocal::calib LABELS unit)
 # Direction observations of a laboratory calibration (collimator, goniometer; issue 36 item 6).
 aerocal_add_test(calib/direction_residual LIBS aerocal::calib LABELS unit)
+# Image metadata: JPEG / TIFF / EXIF / XMP by namespace URI (issues 34, 37).
+aerocal_add_test(calib/image_metadata LIBS aerocal::calib LABELS unit)

@@ -28,3 +28,6 @@ aerocal_add_test(triangulation/suspect_effect LIBS aerocal::triangulation LABELS
 aerocal_add_test(triangulation/self_calibration_choice LIBS aerocal::triangulation LABELS golden)
 # Laboratory calibration from directions: collimator array and goniometer (issue 36 item 6).
 aerocal_add_test(triangulation/direction_calibration LIBS aerocal::triangulation LABELS synthetic)
+# import images (issue 34 item 3): the gimbal convention and the command on metadata-only JPEGs.
+aerocal_add_test(triangulation/gimbal_attitude LIBS aerocal::triangulation LABELS unit)
+aerocal_add_test(triangulation/import_images_cli LIBS aerocal::triangulation LABELS cli)

@@ -6,7 +6,8 @@
 // read as OpenCV's (distCoeffs order), as Metashape's and Pix4D's DJI imports do. The principal
 // point: cx_opencv = W / 2 + cx, cy_opencv = H / 2 + cy (which centre is meant is not stated;
 // (W - 1) / 2 would move it by 0.5 px). Input: a DJI JPEG (the XMP packet is found in the file;
-// the size from its SOF marker), an XMP sidecar, or a text file holding the string (then
+// the size from its SOF marker; calib/metadata/image_metadata.h: the properties are matched by
+// namespace URI, whatever prefix the file binds), an XMP sidecar, or a text file holding the string (then
 // --width/--height). CalibratedFocalLength and CalibratedOpticalCenterX/Y (design values) are
 // reported as notes. A text file may hold several records as exiftool prints them (default print
 // names "Dewarp Data : ...", -s tag names, -G group prefixes, "======== FILE" blocks with their
@@ -18,16 +19,21 @@
 #include <sstream>
 
 #include "calib/camera/formats/camera_formats.h"
-#include "calib/camera/formats/xmp_packet.h"
+#include "calib/metadata/image_metadata.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 
 namespace aerocal::calib {
 
-using internal::FindXmpValue;
-using internal::JpegSize;
-using internal::LineAt;
-using internal::TrimBlanks;
+namespace {
+
+std::string TrimBlanks(const std::string& s) {
+  const size_t b = s.find_first_not_of(" \t\r\n"), e = s.find_last_not_of(" \t\r\n");
+  return b == std::string::npos ? "" : s.substr(b, e - b + 1);
+}
+
+}  // namespace
+
 ModelCamera DjiDewarpDataCamera(const std::string& text, const SourceRef& where, int width_px,
                                 int height_px) {
   std::string values = TrimBlanks(text);
@@ -146,29 +152,27 @@ std::vector<DewarpRecord> TextRecords(const std::string& path, const std::string
 CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& options) {
   const std::string bytes = ReadTextFile(path);
   int file_width = 0, file_height = 0;
-  const bool jpeg = JpegSize(bytes, &file_width, &file_height);
+  const bool image = IsJpegOrTiff(bytes);
   std::vector<DewarpRecord> records;
-  std::string data;
-  size_t at = FindXmpValue(bytes, "drone-dji:DewarpDataK6", &data);
-  if (at == std::string::npos) at = FindXmpValue(bytes, "drone-dji:DewarpData", &data);
-  if (at != std::string::npos) {  // a JPEG's XMP packet or a sidecar
-    DewarpRecord r{"", TrimBlanks(data), jpeg ? 0 : LineAt(bytes, at), 0, 0, {}};
-    for (const char* design : {"CalibratedFocalLength", "CalibratedOpticalCenterX", "CalibratedOpticalCenterY"}) {
-      std::string value;
-      if (FindXmpValue(bytes, std::string("drone-dji:") + design, &value) != std::string::npos)
-        r.design.push_back(std::string(design) + " = " + TrimBlanks(value) + " px (design value, not used)");
-    }
-    std::string w, h;
-    if (!jpeg && FindXmpValue(bytes, "tiff:ImageWidth", &w) != std::string::npos &&
-        FindXmpValue(bytes, "tiff:ImageLength", &h) != std::string::npos) {
-      const SourceRef where{path, r.line};
-      file_width = static_cast<int>(internal::ParseNumber(TrimBlanks(w), where, "tiff:ImageWidth", 1e6));
-      file_height = static_cast<int>(internal::ParseNumber(TrimBlanks(h), where, "tiff:ImageLength", 1e6));
+  if (const std::optional<XmpPacket> xmp = XmpOfCameraFile(bytes, path, &file_width, &file_height)) {
+    // A JPEG's or TIFF's XMP packet, or a sidecar: properties by namespace URI, not by prefix.
+    const XmpProperty* data = xmp->Find(xmp_ns::kDji, "DewarpDataK6");
+    if (!data) data = xmp->Find(xmp_ns::kDji, "DewarpData");
+    if (!data)
+      ThrowInputError({path, image ? 0 : 1}, std::string("no DewarpData of namespace ") + xmp_ns::kDji +
+                                                 " in the file's XMP");
+    DewarpRecord r{"", data->value, image ? 0 : data->where.line, 0, 0, {}};
+    for (const char* design : {"CalibratedFocalLength", "CalibratedOpticalCenterX", "CalibratedOpticalCenterY"})
+      if (const XmpProperty* p = xmp->Find(xmp_ns::kDji, design))
+        r.design.push_back(std::string(design) + " = " + p->value + " px (design value, not used)");
+    const XmpProperty* w = xmp->Find(xmp_ns::kTiff, "ImageWidth");
+    const XmpProperty* h = xmp->Find(xmp_ns::kTiff, "ImageLength");
+    if (!image && w && h) {
+      file_width = static_cast<int>(internal::ParseNumber(w->value, w->where, w->qualified, 1e6));
+      file_height = static_cast<int>(internal::ParseNumber(h->value, h->where, h->qualified, 1e6));
     }
     r.width = file_width, r.height = file_height;
     records.push_back(r);
-  } else if (jpeg || bytes.find("drone-dji") != std::string::npos) {
-    ThrowInputError({path, jpeg ? 0 : 1}, "no drone-dji:DewarpData in the file's XMP");
   } else {
     records = TextRecords(path, bytes);
     if (records.empty()) ThrowInputError({path, 1}, "no DewarpData record");

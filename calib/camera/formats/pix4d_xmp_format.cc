@@ -15,18 +15,19 @@
 #include <sstream>
 
 #include "calib/camera/formats/camera_formats.h"
-#include "calib/camera/formats/xmp_packet.h"
+#include "calib/metadata/image_metadata.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 
 namespace aerocal::calib {
 namespace {
 
-constexpr const char* kPix4dCameraUri = "http://pix4d.com/camera/1.0";
+constexpr const char* kPix4dCameraUri = xmp_ns::kPix4dCamera;
 
 struct XmpText {
   std::string value;
   SourceRef where;
+  std::string name;  // as written: "Camera:PrincipalPoint"
 };
 
 // A number or a rational "a/b" (EXIF rationals in XMP).
@@ -45,64 +46,68 @@ CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& option
   using M = Pix4dPerspectiveModel;
   const std::string bytes = ReadTextFile(path);
   int width = 0, height = 0;
-  const bool jpeg = internal::JpegSize(bytes, &width, &height);
-  const std::string prefix = internal::XmpPrefix(bytes, kPix4dCameraUri, "Camera");
-  const auto find = [&](const std::string& qualified) -> std::optional<XmpText> {
-    std::string value;
-    const size_t at = internal::FindXmpValue(bytes, qualified, &value);
-    if (at == std::string::npos) return std::nullopt;
-    return XmpText{internal::TrimBlanks(value), {path, internal::LineAt(bytes, at)}};
+  const bool image = IsJpegOrTiff(bytes);
+  const std::optional<XmpPacket> xmp = XmpOfCameraFile(bytes, path, &width, &height);
+  if (!xmp) ThrowInputError({path, 1}, "neither an image nor an XMP packet (x:xmpmeta / rdf:RDF)");
+  // Properties by namespace URI (kPix4dCameraUri, with or without its trailing '/'): the prefix is
+  // whatever the file binds ("Camera", "P4", ...); messages quote it as written.
+  const auto find = [&](const char* uri, const std::string& name) -> std::optional<XmpText> {
+    const XmpProperty* p = xmp->Find(uri, name);
+    if (!p) return std::nullopt;
+    if (p->structured) ThrowInputError(p->where, p->qualified + " must be a simple value");
+    return XmpText{p->value, p->where, p->qualified};
   };
-  const auto numbers = [&](const XmpText& t, size_t count, const std::string& what) {
+  const auto camera = [&](const std::string& name) { return find(kPix4dCameraUri, name); };
+  const auto numbers = [&](const XmpText& t, size_t count) {
     const std::vector<std::string> fields = SplitCommaList(t.value, {true, true});
     if (fields.size() != count)
-      ThrowInputError(t.where, what + " must hold " + std::to_string(count) + " comma-separated values (got '" +
+      ThrowInputError(t.where, t.name + " must hold " + std::to_string(count) + " comma-separated values (got '" +
                                    t.value + "')");
     std::vector<double> v;
-    for (const std::string& f : fields) v.push_back(internal::ParseNumber(f, t.where, what, 1e4));
+    for (const std::string& f : fields) v.push_back(internal::ParseNumber(f, t.where, t.name, 1e4));
     return v;
   };
-  const auto focal = find(prefix + ":PerspectiveFocalLength");
-  const auto pp = find(prefix + ":PrincipalPoint");
+  const auto focal = camera("PerspectiveFocalLength");
+  const auto pp = camera("PrincipalPoint");
   if (!focal || !pp) {
-    const auto type = find(prefix + ":ModelType");
-    ThrowInputError({path, type ? type->where.line : 1},
-                    "no " + prefix + ":PerspectiveFocalLength / " + prefix +
-                        ":PrincipalPoint (Pix4D camera XMP, " + kPix4dCameraUri + ")");
+    const auto type = camera("ModelType");
+    ThrowInputError(type ? type->where : SourceRef{path, image ? 0 : 1},
+                    std::string("no PerspectiveFocalLength / PrincipalPoint of namespace ") + kPix4dCameraUri +
+                        " (Pix4D camera XMP)");
   }
-  if (const auto type = find(prefix + ":ModelType"); type && type->value != "perspective")
-    ThrowInputError(type->where, prefix + ":ModelType '" + type->value +
+  if (const auto type = camera("ModelType"); type && type->value != "perspective")
+    ThrowInputError(type->where, type->name + " '" + type->value +
                                      "': only the perspective model is read (Pix4D's fisheye "
                                      "polynomial is not a registry model)");
   CameraFile file;
   file.name = "pix4d";
   file.camera.model = M::kId;
   file.camera.params.assign(M::kNumParams, 0.0);
-  file.camera.params[M::kF] = numbers(*focal, 1, prefix + ":PerspectiveFocalLength")[0];
+  file.camera.params[M::kF] = numbers(*focal, 1)[0];
   if (!(file.camera.params[M::kF] > 0)) ThrowInputError(focal->where, "the focal length must be > 0 mm");
-  const std::vector<double> principal = numbers(*pp, 2, prefix + ":PrincipalPoint");
+  const std::vector<double> principal = numbers(*pp, 2);
   file.camera.params[M::kPx] = principal[0];
   file.camera.params[M::kPy] = principal[1];
-  if (const auto d = find(prefix + ":PerspectiveDistortion")) {
-    const std::vector<double> v = numbers(*d, 5, prefix + ":PerspectiveDistortion (R1,R2,R3,T1,T2)");
+  if (const auto d = camera("PerspectiveDistortion")) {
+    const std::vector<double> v = numbers(*d, 5);  // R1, R2, R3, T1, T2
     for (int i = 0; i < 5; ++i) file.camera.params[M::kR1 + i] = v[i];
   }
   const SourceRef where{path, focal->where.line};
-  if (!jpeg) {
-    const auto w = find("tiff:ImageWidth"), h = find("tiff:ImageLength");
+  if (!image) {
+    const auto w = find(xmp_ns::kTiff, "ImageWidth"), h = find(xmp_ns::kTiff, "ImageLength");
     if (w && h) {
-      width = static_cast<int>(internal::ParseNumber(w->value, w->where, "tiff:ImageWidth", 1e6));
-      height = static_cast<int>(internal::ParseNumber(h->value, h->where, "tiff:ImageLength", 1e6));
+      width = static_cast<int>(internal::ParseNumber(w->value, w->where, w->name, 1e6));
+      height = static_cast<int>(internal::ParseNumber(h->value, h->where, h->name, 1e6));
     }
   }
   double pixel_mm = 0.0;
-  if (const auto res = find("exif:FocalPlaneXResolution")) {
-    const auto unit = find("exif:FocalPlaneResolutionUnit");
-    const int u = unit ? static_cast<int>(internal::ParseNumber(unit->value, unit->where, "exif:FocalPlaneResolutionUnit", 10)) : 2;
+  if (const auto res = find(xmp_ns::kExif, "FocalPlaneXResolution")) {
+    const auto unit = find(xmp_ns::kExif, "FocalPlaneResolutionUnit");
+    const int u = unit ? static_cast<int>(internal::ParseNumber(unit->value, unit->where, unit->name, 10)) : 2;
     const double mm_per_unit = u == 2 ? 25.4 : u == 3 ? 10.0 : u == 4 ? 1.0 : 0.0;
     if (mm_per_unit == 0)
       ThrowInputError(unit->where, "exif:FocalPlaneResolutionUnit must be 2 (inch), 3 (cm) or 4 (mm)");
-    const double per_unit = ParseRational(*res, "exif:FocalPlaneXResolution");
+    const double per_unit = ParseRational(*res, res->name);
     if (!(per_unit > 0)) ThrowInputError(res->where, "exif:FocalPlaneXResolution must be > 0");
     pixel_mm = mm_per_unit / per_unit;
   }
