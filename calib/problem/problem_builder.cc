@@ -446,6 +446,41 @@ bool ProblemBuilder::UpdateManifolds() {
   return true;
 }
 
+std::unique_ptr<ceres::Problem> ProblemBuilder::EliminableInOrder(std::vector<double>* buffer,
+                                                                   std::vector<double*>* pointers) const {
+  ceres::Problem::Options options;
+  options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
+  options.manifold_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;  // problem_ owns them
+  auto mirror = std::make_unique<ceres::Problem>(options);
+  size_t total = 0;
+  for (const Block& b : blocks_)
+    if (b.Eliminable()) total += b.size;
+  buffer->assign(total, 0.0);  // never resized below: the pointers into it stay valid
+  pointers->assign(blocks_.size(), nullptr);
+  size_t offset = 0;
+  for (size_t id = 0; id < blocks_.size(); ++id) {
+    const Block& b = blocks_[id];
+    double* values = b.values;
+    if (b.Eliminable()) {
+      values = buffer->data() + offset;
+      std::copy(b.values, b.values + b.size, values);
+      offset += b.size;
+    }
+    (*pointers)[id] = values;
+    mirror->AddParameterBlock(values, b.size,
+                              const_cast<ceres::Manifold*>(problem_->GetManifold(b.values)));
+    if (problem_->IsParameterBlockConstant(b.values)) mirror->SetParameterBlockConstant(values);
+  }
+  for (const Residual& r : residuals_) {
+    if (!r.active) continue;
+    std::vector<double*> blocks;
+    for (BlockId id : r.blocks) blocks.push_back((*pointers)[id]);
+    mirror->AddResidualBlock(r.cost.get(), r.loss.get(), blocks);
+  }
+  return mirror;
+}
+
 SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   const auto start = std::chrono::steady_clock::now();
   ReleaseFactorized();  // stale after the solve; its memory is the solver's now
@@ -468,6 +503,9 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   ceres_options.minimizer_progress_to_stdout = options.verbose;
   ceres_options.logging_type = options.verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
 
+  std::unique_ptr<ceres::Problem> mirror;  // the Schur solve's problem (see the ordering below)
+  std::vector<double> mirror_buffer;
+  std::vector<double*> mirror_pointers;
   int eliminable_params = 0, other_params = 0;
   std::vector<BlockId> eliminable;
   for (BlockId id : free_blocks) {
@@ -532,21 +570,28 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       // with all non-eliminated blocks in one group the reduced system's layout, and its rounding,
       // depended on where the owners' vectors happened to be allocated: a second adjustment in the
       // same process (flight, the Python module) differed from a fresh one in the last digits.
-      // Each non-eliminated block gets its own group, in BlockId (registration) order; the
-      // eliminated points share group 0 (Ceres eliminates the first group only), each owner's in
-      // one vector, so their address order is their index order.
+      // Each non-eliminated block gets its own group, in BlockId (registration) order. The
+      // eliminated points share group 0 (Ceres eliminates the first group only) and are summed
+      // into the reduced system in their address order: with several owners (the block's ground
+      // points, a sub-image camera's virtual tie points in a deque) that order followed the heap's
+      // history, and `aerocal batch merge` differed from `aerocal flight` in the joint step's last
+      // digits. So the solve runs on a copy whose eliminated blocks lie in one buffer in BlockId
+      // order (EliminableInOrder), and the solution is copied back.
+      mirror = EliminableInOrder(&mirror_buffer, &mirror_pointers);
       auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
       int group = 0;
-      for (BlockId id : free_blocks) {
-        const Block& b = blocks_[id];
-        ordering->AddElementToGroup(b.values, b.Eliminable() ? 0 : ++group);
-      }
+      for (BlockId id : free_blocks)
+        ordering->AddElementToGroup(mirror_pointers[id], blocks_[id].Eliminable() ? 0 : ++group);
       ceres_options.linear_solver_ordering = ordering;
     }
   }
 
   ceres::Solver::Summary summary;
-  if (report.diagnostics.empty()) ceres::Solve(ceres_options, problem_.get(), &summary);
+  if (report.diagnostics.empty()) ceres::Solve(ceres_options, mirror ? mirror.get() : problem_.get(), &summary);
+  if (mirror)
+    for (BlockId id = 0; id < static_cast<BlockId>(blocks_.size()); ++id)
+      if (mirror_pointers[id] != blocks_[id].values)
+        std::copy(mirror_pointers[id], mirror_pointers[id] + blocks_[id].size, blocks_[id].values);
 
   report.termination = ceres::TerminationTypeToString(summary.termination_type);
   report.message = summary.message;

@@ -309,6 +309,11 @@ class ProblemBuilder {
   /// Subset manifolds of the free entries, columns scaled to unit Jacobian norm at the current
   /// values; false when the residuals cannot be evaluated there (then the scales are 1).
   bool UpdateManifolds();
+  /// The problem as Ceres must see it for a Schur solve: the eliminable blocks copied into one
+  /// buffer in BlockId order (`buffer`; `pointers[id]` is where block id lives in the copy, the
+  /// owner's memory for the others), the same residuals, manifolds and fixed blocks.
+  std::unique_ptr<ceres::Problem> EliminableInOrder(std::vector<double>* buffer,
+                                                    std::vector<double*>* pointers) const;
   /// Names of the parameters in the null space of the normal matrix: from the dense matrix up to
   /// `max_parameters` free parameters, above that from the normal equations reduced to the
   /// non-point parameters (points eliminated) while those number at most `max_parameters`.
