@@ -20,3 +20,10 @@ aerocal_add_test(tools/cli_quality LIBS aerocal::stitch LABELS cli)
 # Issue 37 (bad input, part 2): schema-checked certificate inputs, budget units, absurd geometry,
 # bounded sizes, the renderer's text and output sets, the ranges of every numeric option.
 aerocal_add_test(tools/bad_input2 LIBS aerocal::triangulation LABELS cli TIMEOUT 900)
+# `aerocal batch` (issue 35): plan / run --shard / status / merge against `flight`, a killed run,
+# changed and failing units, GNU Parallel (skipped without it), the Slurm scripts.
+aerocal_add_test(tools/cli_batch LIBS aerocal::calib LABELS cli)
+# The same for real under Slurm: munged, slurmctld and slurmd started on this machine
+# (tests/tools/slurm_localhost.sh), a 4-task job array and the dependent merge. Skipped with the
+# reason without slurm-wlm and munge (not in tools/setup.sh); label long: it starts daemons.
+aerocal_add_test(tools/cli_batch_slurm LIBS aerocal::calib LABELS long TIMEOUT 900)
