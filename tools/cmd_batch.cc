@@ -35,11 +35,13 @@ std::string UnitId(const std::string& frame, size_t index, const std::map<std::s
 }
 
 // Memory of one frame's stitching (four candidate models, dense normal equations of the mapping
-// and tie unknowns), from its rows: an estimate for the scheduler. Measured peak resident memory
-// (/usr/bin/time): 65 MB for a 6-CCD frame of 430 rows, nearly all of it the executable and its
-// libraries; the merge (the whole flight in one process) 134 MB for 5,195 rows.
+// and tie unknowns) and of the merge (the flight's adjustments in one process), from the rows of
+// stitching measurements: estimates for the scheduler, above the measured peak resident memory
+// (/usr/bin/time, tools/README.md "Batch"): a unit of 430 rows 65 MB, of 1,900 rows 76 MB (nearly
+// all of it the executable and its libraries); the merge of 5,195 rows 134 MB, of 70,300 rows
+// 381 MB (the default simulated flight).
 int UnitMemoryMb(size_t rows) { return 96 + static_cast<int>(rows / 100); }
-int MergeMemoryMb(size_t rows) { return 256 + static_cast<int>(rows / 20); }
+int MergeMemoryMb(size_t rows) { return 512 + static_cast<int>(rows / 200); }
 
 int Plan(const std::string& work, const std::vector<std::string>& flight_arguments) {
   CheckOutputFolder(work, "--work");
