@@ -84,9 +84,8 @@ std::string UnitInputHash(const UnitContext& context, const BatchManifest& manif
 }
 
 bool RunUnit(const UnitContext& context, const BatchManifest& manifest, const BatchUnit& unit,
-             std::string* error, bool* input_error) {
+             const std::string& hash, std::string* error, bool* input_error) {
   const double started = Now();
-  const std::string hash = UnitInputHash(context, manifest, unit);
   LogUnit(manifest, unit, "start (input hash " + hash + ")");
   try {
     RemoveLeftovers(manifest.Output(unit));

@@ -33,10 +33,11 @@ UnitContext MakeUnitContext(const FlightArgs& flight);
 /// Hash of everything a unit's output depends on: the shared part and its input file.
 std::string UnitInputHash(const UnitContext& context, const BatchManifest& manifest, const BatchUnit& unit);
 
-/// Runs `unit` (its output and done record written atomically; on failure a failed record and the
-/// log, nothing else). Returns false on failure with the message in `error`; `input_error` tells
-/// a bad input (exit 2) from an internal error (exit 1).
+/// Runs `unit` whose inputs hash to `input_hash` (UnitInputHash): its output and done record
+/// written atomically; on failure a failed record and the log, nothing else. Returns false on
+/// failure with the message in `error`; `input_error` tells a bad input (exit 2) from an internal
+/// error (exit 1).
 bool RunUnit(const UnitContext& context, const BatchManifest& manifest, const BatchUnit& unit,
-             std::string* error, bool* input_error);
+             const std::string& input_hash, std::string* error, bool* input_error);
 
 }  // namespace aerocal::tools

@@ -123,7 +123,7 @@ int Run(const RunArgs& args) {
     } else {
       std::string error;
       bool input_error = false;
-      if (RunUnit(context, m, *unit, &error, &input_error)) {
+      if (RunUnit(context, m, *unit, hash, &error, &input_error)) {
         ++ran;
       } else {
         ++failed;
