@@ -52,8 +52,15 @@ void Progress::Draw(bool final_line) {
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
   std::string bar(filled, '#');
   bar.resize(width, '.');
-  std::fprintf(stderr, "\r%s [%s] %ld/%ld %5.1f s%s", label_.c_str(), bar.c_str(), done, total_,
-               seconds, final_line ? "\n" : "");
+  // Rate and the time left at that rate, once a unit is done (the first says nothing of the rest
+  // before it finishes); blanks at the end clear a longer previous line.
+  char rate[64] = "";
+  if (done > 0 && seconds > 0) {
+    const double per_second = done / seconds;
+    std::snprintf(rate, sizeof(rate), ", %.3g/s, ETA %.0f s", per_second, (total_ - done) / per_second);
+  }
+  std::fprintf(stderr, "\r%s [%s] %ld/%ld %5.1f s%s   %s", label_.c_str(), bar.c_str(), done, total_,
+               seconds, rate, final_line ? "\n" : "");
   std::fflush(stderr);
 }
 

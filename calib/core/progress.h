@@ -1,4 +1,5 @@
-// Progress on a terminal for long work (batch stitching, matching, resampling, big adjustments).
+// Progress on a terminal for long work (batch stitching, matching, resampling, big adjustments,
+// `aerocal batch run`): units done / total, elapsed time, rate and ETA at that rate.
 // Draws a single updating line on stderr when stderr is a terminal; prints nothing otherwise, so
 // logs and CI output stay clean. Thread-safe Advance().
 #pragma once

@@ -165,20 +165,20 @@ ModelStability ComputeStability(calib::MappingModel model,
   return out;
 }
 
-BatchResult RunStitchBatch(const calib::Camera& camera, const std::vector<FrameMeasurements>& frames,
-                           const BatchOptions& options, Progress* progress) {
-  BatchResult result;
-  for (const FrameMeasurements& frame : frames) {
-    FrameRun run;
-    if (options.model) {
-      run.adjustment = AdjustFrame(camera, frame, *options.model, options.stitch);
-    } else {
-      run.choice = ChooseModel(camera, frame, options.stitch, options.alpha);
-      run.adjustment = run.choice->Chosen();
-    }
-    result.frames.push_back(std::move(run));
-    if (progress) progress->Advance();
+FrameRun StitchFrame(const calib::Camera& camera, const FrameMeasurements& frame, const BatchOptions& options) {
+  FrameRun run;
+  if (options.model) {
+    run.adjustment = AdjustFrame(camera, frame, *options.model, options.stitch);
+  } else {
+    run.choice = ChooseModel(camera, frame, options.stitch, options.alpha);
+    run.adjustment = run.choice->Chosen();
   }
+  return run;
+}
+
+BatchResult CollectBatch(std::vector<FrameRun> frames, const BatchOptions& options) {
+  BatchResult result;
+  result.frames = std::move(frames);
   // Stability of every model adjusted in all frames.
   for (calib::MappingModel model : calib::kAllMappingModels) {
     std::vector<const FrameAdjustment*> series;
@@ -194,6 +194,16 @@ BatchResult RunStitchBatch(const calib::Camera& camera, const std::vector<FrameM
       result.stability.push_back(ComputeStability(model, series, options.alpha));
   }
   return result;
+}
+
+BatchResult RunStitchBatch(const calib::Camera& camera, const std::vector<FrameMeasurements>& frames,
+                           const BatchOptions& options, Progress* progress) {
+  std::vector<FrameRun> runs;
+  for (const FrameMeasurements& frame : frames) {
+    runs.push_back(StitchFrame(camera, frame, options));
+    if (progress) progress->Advance();
+  }
+  return CollectBatch(std::move(runs), options);
 }
 
 calib::MappingModel FlightModel(const BatchResult& result, const BatchOptions& options) {

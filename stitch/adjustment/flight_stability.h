@@ -70,6 +70,14 @@ struct BatchResult {
   std::vector<ModelStability> stability;  // per model adjusted in every frame, simplest first
 };
 
+/// One frame of a batch: adjusted with the requested model, or with the model its F test chooses.
+/// A unit of `aerocal batch`: frames are independent until CollectBatch.
+FrameRun StitchFrame(const calib::Camera& camera, const FrameMeasurements& frame, const BatchOptions& options);
+
+/// The batch of already adjusted `frames` (in flight order) with the stability of every model
+/// adjusted in all of them; RunStitchBatch = StitchFrame per frame, then this.
+BatchResult CollectBatch(std::vector<FrameRun> frames, const BatchOptions& options);
+
 /// Adjusts every frame (InputError when a requested model is under-determined in a frame);
 /// `progress` (may be null) advances by one per frame.
 BatchResult RunStitchBatch(const calib::Camera& camera, const std::vector<FrameMeasurements>& frames,

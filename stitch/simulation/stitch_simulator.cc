@@ -121,14 +121,15 @@ std::vector<StitchObservation> SimulateFrame(const calib::Camera& truth, const s
   return rows;
 }
 
-void WriteStitchObservations(const std::string& path, const std::vector<StitchObservation>& rows) {
+void WriteStitchObservations(const std::string& path, const std::vector<StitchObservation>& rows,
+                             bool exact) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "frame,point,subimage,u,v,sigma_px\n";
-    char line[256];
+    const char* format = exact ? "%.17g,%.17g,%.17g\n" : "%.4f,%.4f,%.4g\n";
+    char numbers[128];
     for (const auto& r : rows) {
-      std::snprintf(line, sizeof(line), "%s,%s,%s,%.4f,%.4f,%.4g\n", r.frame.c_str(),
-                    r.point.c_str(), r.subimage.c_str(), r.u, r.v, r.sigma_px);
-      out << line;
+      std::snprintf(numbers, sizeof(numbers), format, r.u, r.v, r.sigma_px);
+      out << r.frame << ',' << r.point << ',' << r.subimage << ',' << numbers;
     }
   });
 }

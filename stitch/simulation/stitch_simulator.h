@@ -49,8 +49,11 @@ std::vector<StitchObservation> SimulateFrame(const calib::Camera& truth, const s
                                              const FrameSimulationOptions& options,
                                              std::mt19937_64& rng);
 
-/// Writes rows as stitch_obs.csv (header frame,point,subimage,u,v,sigma_px), atomically.
-void WriteStitchObservations(const std::string& path, const std::vector<StitchObservation>& rows);
+/// Writes rows as stitch_obs.csv (header frame,point,subimage,u,v,sigma_px), atomically: u, v to
+/// 1e-4 px and sigma_px to 4 digits, or with `exact` every number in the shortest text that reads
+/// back to the same double (a file handed between processes that must agree to the last bit).
+void WriteStitchObservations(const std::string& path, const std::vector<StitchObservation>& rows,
+                             bool exact = false);
 /// Reads stitch_obs.csv; `default_sigma_px` where the column is missing or empty.
 std::vector<StitchObservation> ReadStitchObservations(const std::string& path,
                                                       double default_sigma_px);

@@ -31,3 +31,5 @@ aerocal_add_test(stitch/slanted_edge_real LIBS aerocal::stitch LABELS golden)
 aerocal_add_test(stitch/resampling_mtf LIBS aerocal::stitch LABELS synthetic)
 # Edge targets on the ground found in the image from the orientation (issue 36 item 1).
 aerocal_add_test(stitch/edge_targets LIBS aerocal::stitch LABELS unit)
+# A frame's run as lossless JSON (`aerocal batch` units to the merge, issue 35).
+aerocal_add_test(stitch/frame_run_json LIBS aerocal::stitch LABELS unit)

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <random>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -58,6 +59,20 @@ std::string SharedDataDir(const std::string& name) {
 
 nlohmann::json ReadJson(const std::string& path) {
   return ReadJsonFile(path);
+}
+
+std::string ResultWithoutClock(const std::string& path) {
+  std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& j) {
+    if (j.is_object()) {
+      for (const char* clock : {"seconds", "timing", "seconds_testing"}) j.erase(clock);
+      for (auto& [key, value] : j.items()) strip(value);
+    } else if (j.is_array()) {
+      for (auto& value : j) strip(value);
+    }
+  };
+  nlohmann::json document = ReadJsonFile(path);
+  strip(document);
+  return document.dump(1);
 }
 
 }  // namespace aerocal::testing

@@ -34,6 +34,12 @@ CommandResult RunAerocal(const std::string& arguments);
 /// The JSON document in `path` (a result the aerocal binary wrote).
 nlohmann::json ReadJson(const std::string& path);
 
+/// The result document in `path` without the clock's keys (`seconds`, `timing`,
+/// `seconds_testing`, at any depth), as text: two runs' texts are equal byte for byte exactly
+/// when every other value is equal to the last bit (doubles are written in the shortest text that
+/// reads back to the same bits).
+std::string ResultWithoutClock(const std::string& path);
+
 /// Path of a shared real data set, or "" when ../shared/data is absent (tests then GTEST_SKIP).
 std::string SharedDataDir(const std::string& name);
 

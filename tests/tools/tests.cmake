@@ -31,3 +31,10 @@ aerocal_add_test(tools/cli_plausibility LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/bad_input3 LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/output_set LIBS aerocal::calib LABELS unit)
 target_sources(test_tools_output_set PRIVATE ${PROJECT_SOURCE_DIR}/tools/output_set.cc)
+# `aerocal batch` (issue 35): plan / run --shard / status / merge against `flight`, a killed run,
+# changed and failing units, GNU Parallel (skipped without it), the Slurm scripts.
+aerocal_add_test(tools/cli_batch LIBS aerocal::calib LABELS cli)
+# The same for real under Slurm: munged, slurmctld and slurmd started on this machine
+# (tests/tools/slurm_localhost.sh), a 4-task job array and the dependent merge. Skipped with the
+# reason without slurm-wlm and munge (not in tools/setup.sh); label long: it starts daemons.
+aerocal_add_test(tools/cli_batch_slurm LIBS aerocal::calib LABELS long TIMEOUT 900)

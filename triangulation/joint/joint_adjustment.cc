@@ -111,8 +111,7 @@ nlohmann::json JointResultToJson(const JointResult& result) {
   return j;
 }
 
-stitch::BatchResult StitchExposures(const Project& project, const stitch::BatchOptions& options,
-                                    double default_sigma_px, Progress* progress) {
+ExposureMeasurements ReadExposureMeasurements(const Project& project, double default_sigma_px) {
   if (project.stitching_file.empty())
     ThrowInputError({project.path, 0}, "the project names no stitching measurements (stitching:)");
   std::string camera_id;
@@ -124,16 +123,22 @@ stitch::BatchResult StitchExposures(const Project& project, const stitch::BatchO
     camera_id = id;
   }
   if (camera_id.empty()) ThrowInputError({project.path, 0}, "no camera of the project has sub-images to stitch");
-  const calib::Camera& camera = project.cameras.at(camera_id);
-  std::vector<stitch::StitchObservation> rows;
+  ExposureMeasurements out;
+  out.camera = project.cameras.at(camera_id);
   for (const auto& row : stitch::ReadStitchObservations(project.stitching_file, default_sigma_px)) {
     const Exposure* e = project.FindExposure(row.frame);
-    if (e && e->camera == camera_id) rows.push_back(row);  // the stitching of the block's exposures
+    if (e && e->camera == camera_id) out.rows.push_back(row);  // the stitching of the block's exposures
   }
-  const auto frames = stitch::GroupByFrame(camera, rows, project.stitching_file);
-  if (frames.empty())
+  out.frames = stitch::GroupByFrame(out.camera, out.rows, project.stitching_file);
+  if (out.frames.empty())
     ThrowInputError({project.stitching_file, 0}, "no stitching measurements of the block's exposures");
-  return stitch::RunStitchBatch(camera, frames, options, progress);
+  return out;
+}
+
+stitch::BatchResult StitchExposures(const Project& project, const stitch::BatchOptions& options,
+                                    double default_sigma_px, Progress* progress) {
+  const ExposureMeasurements m = ReadExposureMeasurements(project, default_sigma_px);
+  return stitch::RunStitchBatch(m.camera, m.frames, options, progress);
 }
 
 calib::Camera JointMappingsFromStitching(const calib::Camera& camera, const stitch::BatchResult* batch,

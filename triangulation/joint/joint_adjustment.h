@@ -67,6 +67,17 @@ struct JointResult {
 
 JointResult AdjustJoint(const Project& project, const JointOptions& options);
 
+/// The stitching measurements of `project`'s exposures of its one camera with sub-images, as
+/// StitchExposures adjusts them: the rows (sigma_px filled with `default_sigma_px` where the file
+/// has none) and the frames they make (stitch::GroupByFrame, in order of first appearance).
+/// Errors as StitchExposures.
+struct ExposureMeasurements {
+  calib::Camera camera;
+  std::vector<stitch::StitchObservation> rows;
+  std::vector<stitch::FrameMeasurements> frames;
+};
+ExposureMeasurements ReadExposureMeasurements(const Project& project, double default_sigma_px);
+
 /// Every exposure of `project`'s stitching measurements (`stitching:`) adjusted as
 /// `aerocal stitch` does (`options.model` nullopt: per exposure the model the F test chooses),
 /// for the project's one camera with sub-images. InputError when the project names no stitching

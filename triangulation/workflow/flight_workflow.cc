@@ -53,15 +53,56 @@ void AddWarnings(const std::string& name, const AdjustmentResult& result, Flight
   for (const auto& w : result.warnings) out->summary.push_back("warning (" + name + "): " + w.message);
 }
 
+std::string VirtualProjectPath(const FlightWorkflowOptions& options) {
+  const std::string path = (fs::path(options.data_folder) / "project.yaml").string();
+  if (!fs::exists(path))
+    throw InputError(options.data_folder + ": no project.yaml (the block with virtual-image observations)");
+  return path;
+}
+
+bool HasStitching(const Project& project, const calib::Camera& camera) {
+  return !project.stitching_file.empty() && !camera.subimages.empty();
+}
+
+// Step 1 from the frames adjusted elsewhere, checked against the measurements they must come from.
+stitch::BatchResult CollectStitchedFrames(const Project& project, const FlightWorkflowOptions& options,
+                                          const stitch::BatchOptions& batch) {
+  const ExposureMeasurements m = ReadExposureMeasurements(project, options.stitch_sigma_px);
+  const std::vector<stitch::FrameRun>& runs = *options.stitched_frames;
+  bool same = runs.size() == m.frames.size();
+  for (size_t i = 0; same && i < runs.size(); ++i) same = runs[i].adjustment.frame == m.frames[i].frame;
+  if (!same)
+    throw InputError(project.stitching_file + ": the frames adjusted apart (" + std::to_string(runs.size()) +
+                     ") are not the flight's " + std::to_string(m.frames.size()) + " frames in order");
+  return stitch::CollectBatch(runs, batch);
+}
+
 }  // namespace
+
+stitch::BatchOptions FlightStitchingOptions(const FlightWorkflowOptions& options) {
+  stitch::BatchOptions batch;
+  batch.stitch.base_ids = options.base_ids;
+  return batch;
+}
+
+FlightStitching ReadFlightStitching(const FlightWorkflowOptions& options) {
+  FlightStitching out;
+  out.options = FlightStitchingOptions(options);
+  const calib::Camera camera = calib::ReadCamera(options.camera_file);
+  const Project project = WithCamera(ReadProject(VirtualProjectPath(options)), camera, options.camera_file);
+  if (!HasStitching(project, camera)) return out;
+  ExposureMeasurements m = ReadExposureMeasurements(project, options.stitch_sigma_px);
+  out.camera = std::move(m.camera);
+  out.rows = std::move(m.rows);
+  out.frames = std::move(m.frames);
+  return out;
+}
 
 FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Progress* progress) {
   FlightWorkflowResult out;
   const calib::Camera camera = calib::ReadCamera(options.camera_file);
-  const std::string virtual_project = (fs::path(options.data_folder) / "project.yaml").string();
+  const std::string virtual_project = VirtualProjectPath(options);
   const std::string subimage_project = (fs::path(options.data_folder) / "project_subimage.yaml").string();
-  if (!fs::exists(virtual_project))
-    throw InputError(options.data_folder + ": no project.yaml (the block with virtual-image observations)");
   // Geodetic blocks are adjusted in a metric frame and their results written back (georef/).
   const Project input = WithCamera(ReadProject(virtual_project), camera, options.camera_file);
   const ObjectFrame object_frame(input.frame);
@@ -84,11 +125,11 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   doc["frame"] = object_frame.Description();
 
   // 1. Stitching of every exposure, model chosen per frame by the F test, and stability.
-  stitch::BatchOptions batch;
-  batch.stitch.base_ids = options.base_ids;
+  const stitch::BatchOptions batch = FlightStitchingOptions(options);
   std::optional<stitch::BatchResult> stitching;
-  if (!project.stitching_file.empty() && !camera.subimages.empty()) {
-    stitching = StitchExposures(project, batch, options.stitch_sigma_px, nullptr);
+  if (HasStitching(project, camera)) {
+    stitching = options.stitched_frames ? CollectStitchedFrames(project, options, batch)
+                                        : StitchExposures(project, batch, options.stitch_sigma_px, nullptr);
     doc["stitching"] = stitch::StitchResultToJson(*stitching, batch);
     char line[256];
     std::snprintf(line, sizeof(line), "stitching: %zu exposures, sigma0 %.3f px, model %s", stitching->frames.size(),

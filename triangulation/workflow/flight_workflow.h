@@ -17,6 +17,7 @@
 #include <nlohmann/json.hpp>
 
 #include "calib/camera/camera.h"
+#include "stitch/adjustment/flight_stability.h"
 
 namespace aerocal {
 class Progress;
@@ -38,7 +39,24 @@ struct FlightWorkflowOptions {
   bool joint = true;             // run the joint adjustment when sub-image observations exist
   /// Mapping model of the joint step; nullopt: the one the stitching F test chose for the flight.
   std::optional<calib::MappingModel> joint_model;
+  /// Step 1 already done frame by frame (`aerocal batch`): one run per frame of FlightStitching,
+  /// in its order; null: the workflow adjusts the frames itself. Either way the same numbers.
+  const std::vector<stitch::FrameRun>* stitched_frames = nullptr;
 };
+
+/// Step 1's work, frame by frame: the stitching options of the flight and the measurements of
+/// every exposure, exactly as RunFlightWorkflow adjusts them (stitch::StitchFrame of each frame
+/// with `options`). No frames: the flight has no stitching step. InputError as the workflow.
+struct FlightStitching {
+  stitch::BatchOptions options;
+  calib::Camera camera;
+  std::vector<stitch::StitchObservation> rows;
+  std::vector<stitch::FrameMeasurements> frames;
+};
+FlightStitching ReadFlightStitching(const FlightWorkflowOptions& options);
+
+/// The stitching options of step 1 (FlightStitching::options) without reading the flight.
+stitch::BatchOptions FlightStitchingOptions(const FlightWorkflowOptions& options);
 
 /// Warning name when the joint adjustment's sigma0 exceeds the self-calibration's by more than
 /// kJointSigma0RatioLimit: both fit the same image points (raw or virtual), so with a fitting
