@@ -280,6 +280,39 @@ class JsonKeys {
   int depth_ = 0;
 };
 
+// XML: every attribute's '=' is followed by a quoted value. OpenCV 4.6's XML parser dereferences
+// null when the text ends after an '=' (found by fuzz/camera_formats: `<?xml version=` and CRs).
+void CheckXmlAttributes(const std::string& text, const std::string& path) {
+  int line = 1;
+  bool in_tag = false;
+  char quote = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') ++line;
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (!in_tag) {
+      if (c == '<' && text.compare(i, 4, "<!--") == 0) {
+        const size_t end = text.find("-->", i + 4);
+        const size_t stop = end == std::string::npos ? text.size() : end + 3;
+        line += static_cast<int>(std::count(text.begin() + i, text.begin() + stop, '\n'));
+        i = stop - 1;
+      } else if (c == '<') {
+        in_tag = true;
+      }
+    } else if (c == '>') {
+      in_tag = false;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '=') {
+      size_t j = i + 1;
+      while (j < text.size() && std::isspace(static_cast<unsigned char>(text[j]))) ++j;
+      if (j >= text.size() || (text[j] != '"' && text[j] != '\''))
+        ThrowInputError({path, line}, "an XML attribute without a quoted value after '='");
+    }
+  }
+}
+
 // YAML: block nesting by indentation (leading spaces and "- " items), flow nesting by [ and {
 // outside quoted strings, carried from line to line.
 class YamlNesting {
@@ -328,6 +361,7 @@ OpenCvStorageScan ScanOpenCvStorage(const std::string& text, const std::string& 
   OpenCvStorageScan scan;
   Scanner scanner(text, path);
   const Syntax syntax = SyntaxOf(text);
+  if (syntax == Syntax::kXml) CheckXmlAttributes(text, path);
   XmlKeys xml;
   JsonKeys json;
   YamlNesting yaml;

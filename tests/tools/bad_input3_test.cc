@@ -161,6 +161,11 @@ TEST(OpenCvStorage, EveryErrorIsFileLineWithoutOpenCvInternals) {
       // A NUL byte (found by fuzz/camera_formats: in the XML declaration it crashed OpenCV 4.6).
       {"xml_nul", ".xml", Replaced(kGoodXml, "version=\"1.0\"", std::string("version=\0\1.0\"", 13)), 1, "a NUL byte"},
       {"yaml_nul", ".yml", Replaced(kGoodYaml, "cols: 1", std::string("cols: 1\0", 8)), 12, "a NUL byte"},
+      // An attribute's '=' at the end of the text (found by fuzz/camera_formats: OpenCV 4.6 crashed).
+      {"xml_declaration_cut", ".xml", "<?xml version=\r\r\r", 1, "without a quoted value"},
+      {"xml_attribute_cut", ".xml", std::string(kGoodXml) + "<a x=", 18, "without a quoted value"},
+      {"xml_attribute_unquoted", ".xml", Replaced(kGoodXml, "type_id=\"opencv-matrix\"", "type_id=opencv-matrix"), 5,
+       "without a quoted value"},
       // Nesting cv::FileStorage would parse recursively until its stack overflows (exit 139 before).
       {"yaml_deep_flow", ".yml", std::string(kGoodYaml) + "deep: " + std::string(200000, '[') + "\n", 15,
        "flow collections nested deeper than 64"},
