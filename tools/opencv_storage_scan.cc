@@ -63,6 +63,7 @@ class Scanner {
     if (depth > kMaxNesting)
       Throw(line, std::string(what) + " nested deeper than " + std::to_string(kMaxNesting) + " levels");
   }
+  void EmptyKey(int line) const { Throw(line, "a key is empty (nothing before ':')"); }
   void Indentation(size_t columns, int line) const {
     if (columns > static_cast<size_t>(kMaxIndentation))
       Throw(line, "indented " + std::to_string(columns) + " columns: YAML nested deeper than " +
@@ -323,6 +324,10 @@ class YamlNesting {
                                                              line[indent + 1] == ' ')))
       ++indent;
     scanner.Indentation(indent, number);
+    // An empty key (`   : 460.4`): OpenCV 4.6's YAML parser then asks std::string for a negative
+    // length (std::length_error, found by fuzz/camera_formats).
+    if (indent < line.size() && line[indent] == ':' && (indent + 1 == line.size() || IsSpace(line[indent + 1])))
+      scanner.EmptyKey(number);
     char quote = 0;
     for (size_t i = indent; i < line.size(); ++i) {
       const char c = line[i];

@@ -166,6 +166,8 @@ TEST(OpenCvStorage, EveryErrorIsFileLineWithoutOpenCvInternals) {
       {"xml_attribute_cut", ".xml", std::string(kGoodXml) + "<a x=", 18, "without a quoted value"},
       {"xml_attribute_unquoted", ".xml", Replaced(kGoodXml, "type_id=\"opencv-matrix\"", "type_id=opencv-matrix"), 5,
        "without a quoted value"},
+      // An empty key (found by fuzz/camera_formats: std::length_error escaped OpenCV 4.6).
+      {"yaml_empty_key", ".yml", Replaced(kGoodYaml, "   dt: d\n", "   : 460.4\n"), 8, "a key is empty"},
       // Nesting cv::FileStorage would parse recursively until its stack overflows (exit 139 before).
       {"yaml_deep_flow", ".yml", std::string(kGoodYaml) + "deep: " + std::string(200000, '[') + "\n", 15,
        "flow collections nested deeper than 64"},
