@@ -186,7 +186,7 @@ TEST(OpenCvStorage, EveryErrorIsFileLineWithoutOpenCvInternals) {
          return tags;
        }()), 3, "elements nested deeper than 64"},
       // Syntax cv::FileStorage cannot parse: its line, not line 1.
-      {"yaml_syntax", ".yml", Replaced(kGoodYaml, "image_height: 480\n", "image_height: 480\n  : : [\n"), 5, "parse"},
+      {"yaml_syntax", ".yml", Replaced(kGoodYaml, "image_height: 480\n", "image_height: 480\n  : : [\n"), 5, "a key is empty"},
       {"xml_syntax", ".xml", Replaced(kGoodXml, "<cols>3</cols>", "<cols>3</rows>"), 7, "parse"},
   };
   TempDir d("aerocal_bad_input3_cv");
