@@ -91,6 +91,11 @@ bool OpenStorage(const std::string& text, cv::FileStorage* fs, std::string* erro
     // (the two arguments are swapped in FileStorage::Impl::parseError): both are kept.
     if (error) *error = e.err + "\n" + e.func;
     return false;
+  } catch (const std::exception&) {
+    // The parser failing outside cv::Exception (std::length_error, std::bad_alloc) on input the
+    // scan let through: a parse failure too, said without the library's words.
+    if (error) *error = "the parser failed";
+    return false;
   }
 }
 

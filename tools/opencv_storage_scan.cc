@@ -63,6 +63,7 @@ class Scanner {
     if (depth > kMaxNesting)
       Throw(line, std::string(what) + " nested deeper than " + std::to_string(kMaxNesting) + " levels");
   }
+  void EmptyKey(int line) const { Throw(line, "a key is empty (nothing before ':')"); }
   void Indentation(size_t columns, int line) const {
     if (columns > static_cast<size_t>(kMaxIndentation))
       Throw(line, "indented " + std::to_string(columns) + " columns: YAML nested deeper than " +
@@ -280,6 +281,39 @@ class JsonKeys {
   int depth_ = 0;
 };
 
+// XML: every attribute's '=' is followed by a quoted value. OpenCV 4.6's XML parser dereferences
+// null when the text ends after an '=' (found by fuzz/camera_formats: `<?xml version=` and CRs).
+void CheckXmlAttributes(const std::string& text, const std::string& path) {
+  int line = 1;
+  bool in_tag = false;
+  char quote = 0;
+  for (size_t i = 0; i < text.size(); ++i) {
+    const char c = text[i];
+    if (c == '\n') ++line;
+    if (quote) {
+      if (c == quote) quote = 0;
+    } else if (!in_tag) {
+      if (c == '<' && text.compare(i, 4, "<!--") == 0) {
+        const size_t end = text.find("-->", i + 4);
+        const size_t stop = end == std::string::npos ? text.size() : end + 3;
+        line += static_cast<int>(std::count(text.begin() + i, text.begin() + stop, '\n'));
+        i = stop - 1;
+      } else if (c == '<') {
+        in_tag = true;
+      }
+    } else if (c == '>') {
+      in_tag = false;
+    } else if (c == '"' || c == '\'') {
+      quote = c;
+    } else if (c == '=') {
+      size_t j = i + 1;
+      while (j < text.size() && std::isspace(static_cast<unsigned char>(text[j]))) ++j;
+      if (j >= text.size() || (text[j] != '"' && text[j] != '\''))
+        ThrowInputError({path, line}, "an XML attribute without a quoted value after '='");
+    }
+  }
+}
+
 // YAML: block nesting by indentation (leading spaces and "- " items), flow nesting by [ and {
 // outside quoted strings, carried from line to line.
 class YamlNesting {
@@ -290,6 +324,10 @@ class YamlNesting {
                                                              line[indent + 1] == ' ')))
       ++indent;
     scanner.Indentation(indent, number);
+    // An empty key (`   : 460.4`): OpenCV 4.6's YAML parser then asks std::string for a negative
+    // length (std::length_error, found by fuzz/camera_formats).
+    if (indent < line.size() && line[indent] == ':' && (indent + 1 == line.size() || IsSpace(line[indent + 1])))
+      scanner.EmptyKey(number);
     char quote = 0;
     for (size_t i = indent; i < line.size(); ++i) {
       const char c = line[i];
@@ -328,6 +366,7 @@ OpenCvStorageScan ScanOpenCvStorage(const std::string& text, const std::string& 
   OpenCvStorageScan scan;
   Scanner scanner(text, path);
   const Syntax syntax = SyntaxOf(text);
+  if (syntax == Syntax::kXml) CheckXmlAttributes(text, path);
   XmlKeys xml;
   JsonKeys json;
   YamlNesting yaml;

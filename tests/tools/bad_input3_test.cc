@@ -161,6 +161,13 @@ TEST(OpenCvStorage, EveryErrorIsFileLineWithoutOpenCvInternals) {
       // A NUL byte (found by fuzz/camera_formats: in the XML declaration it crashed OpenCV 4.6).
       {"xml_nul", ".xml", Replaced(kGoodXml, "version=\"1.0\"", std::string("version=\0\1.0\"", 13)), 1, "a NUL byte"},
       {"yaml_nul", ".yml", Replaced(kGoodYaml, "cols: 1", std::string("cols: 1\0", 8)), 12, "a NUL byte"},
+      // An attribute's '=' at the end of the text (found by fuzz/camera_formats: OpenCV 4.6 crashed).
+      {"xml_declaration_cut", ".xml", "<?xml version=\r\r\r", 1, "without a quoted value"},
+      {"xml_attribute_cut", ".xml", std::string(kGoodXml) + "<a x=", 18, "without a quoted value"},
+      {"xml_attribute_unquoted", ".xml", Replaced(kGoodXml, "type_id=\"opencv-matrix\"", "type_id=opencv-matrix"), 5,
+       "without a quoted value"},
+      // An empty key (found by fuzz/camera_formats: std::length_error escaped OpenCV 4.6).
+      {"yaml_empty_key", ".yml", Replaced(kGoodYaml, "   dt: d\n", "   : 460.4\n"), 8, "a key is empty"},
       // Nesting cv::FileStorage would parse recursively until its stack overflows (exit 139 before).
       {"yaml_deep_flow", ".yml", std::string(kGoodYaml) + "deep: " + std::string(200000, '[') + "\n", 15,
        "flow collections nested deeper than 64"},
@@ -179,7 +186,7 @@ TEST(OpenCvStorage, EveryErrorIsFileLineWithoutOpenCvInternals) {
          return tags;
        }()), 3, "elements nested deeper than 64"},
       // Syntax cv::FileStorage cannot parse: its line, not line 1.
-      {"yaml_syntax", ".yml", Replaced(kGoodYaml, "image_height: 480\n", "image_height: 480\n  : : [\n"), 5, "parse"},
+      {"yaml_syntax", ".yml", Replaced(kGoodYaml, "image_height: 480\n", "image_height: 480\n  : : [\n"), 5, "a key is empty"},
       {"xml_syntax", ".xml", Replaced(kGoodXml, "<cols>3</cols>", "<cols>3</rows>"), 7, "parse"},
   };
   TempDir d("aerocal_bad_input3_cv");
