@@ -22,6 +22,9 @@ nlohmann::json ParseJsonText(const std::string& text, const std::string& path) {
     const size_t colon = reason.find(": ", reason.find("parse error"));
     if (colon != std::string::npos) reason = reason.substr(colon + 2);
     ThrowInputError({path, LineOfOffset(text, at)}, "invalid JSON (" + reason + ")");
+  } catch (const nlohmann::json::exception& e) {
+    // Thrown while parsing, without a position: a number beyond the double range (1e999).
+    ThrowInputError({path, 0}, std::string("invalid JSON (") + e.what() + ")");
   }
 }
 

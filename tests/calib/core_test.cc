@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/json_file.h"
 #include "calib/core/median.h"
 #include "calib/core/numeric_jacobian.h"
 
@@ -39,6 +41,24 @@ TEST(NumericJacobian, LinearAndQuadraticFunctions) {
   EXPECT_NEAR(j(0, 1), -3.0, 1e-9);
   EXPECT_NEAR(j(1, 0), 3.0, 1e-8);
   EXPECT_NEAR(j(1, 1), 0.0, 1e-12);
+}
+
+}  // namespace
+}  // namespace aerocal
+
+namespace aerocal {
+namespace {
+
+// A number beyond the double range is no parse_error in nlohmann's parser (out_of_range, thrown
+// from the parse): found by fuzz/camera_formats through the OpenSfM reader. It is bad input.
+TEST(ParseJsonText, NumberOverflowIsAnInputErrorNamingTheFile) {
+  try {
+    ParseJsonText("{\"data\": [-2.9e999]}", "cameras.json");
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("cameras.json"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("invalid JSON"), std::string::npos) << e.what();
+  }
 }
 
 }  // namespace
