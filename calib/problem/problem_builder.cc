@@ -447,9 +447,9 @@ bool ProblemBuilder::UpdateManifolds() {
   return true;
 }
 
-std::unique_ptr<ceres::Problem> ProblemBuilder::EliminableInOrder(std::vector<double>* buffer,
-                                                                   std::vector<double*>* pointers,
-                                                                   bool all) const {
+std::unique_ptr<ceres::Problem> ProblemBuilder::CopyInBlockOrder(std::vector<double>* buffer,
+                                                                  std::vector<double*>* pointers,
+                                                                  bool all) const {
   ceres::Problem::Options options;
   options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -580,8 +580,8 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       // points, a sub-image camera's virtual tie points in a deque) that order followed the heap's
       // history, and `aerocal batch merge` differed from `aerocal flight` in the joint step's last
       // digits. So the solve runs on a copy whose eliminated blocks lie in one buffer in BlockId
-      // order (EliminableInOrder), and the solution is copied back.
-      mirror = EliminableInOrder(&mirror_buffer, &mirror_pointers);
+      // order (CopyInBlockOrder), and the solution is copied back.
+      mirror = CopyInBlockOrder(&mirror_buffer, &mirror_pointers);
       auto ordering = std::make_shared<ceres::ParameterBlockOrdering>();
       int group = 0;
       for (BlockId id : free_blocks)
@@ -988,7 +988,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     // On a copy in BlockId order: Ceres orders the Jacobian's columns by block address.
     std::vector<double> buffer;
     std::vector<double*> in_order;
-    const std::unique_ptr<ceres::Problem> mirror = EliminableInOrder(&buffer, &in_order, true);
+    const std::unique_ptr<ceres::Problem> mirror = CopyInBlockOrder(&buffer, &in_order, true);
     std::vector<std::pair<const double*, const double*>> ceres_pairs;
     for (const auto& [a, b] : pairs) ceres_pairs.emplace_back(in_order[a], in_order[b]);
     if (!ceres_pairs.empty() && !covariance.Compute(ceres_pairs, mirror.get()))

@@ -314,9 +314,9 @@ class ProblemBuilder {
   /// columns by address) copied into one buffer in BlockId order (`buffer`; `pointers[id]` is
   /// where block id lives in the copy, the owner's memory for the others), the same residuals,
   /// manifolds and fixed blocks. Without it the last digits followed the heap's history.
-  std::unique_ptr<ceres::Problem> EliminableInOrder(std::vector<double>* buffer,
-                                                    std::vector<double*>* pointers,
-                                                    bool all = false) const;
+  std::unique_ptr<ceres::Problem> CopyInBlockOrder(std::vector<double>* buffer,
+                                                   std::vector<double*>* pointers,
+                                                   bool all = false) const;
   /// Names of the parameters in the null space of the normal matrix: from the dense matrix up to
   /// `max_parameters` free parameters, above that from the normal equations reduced to the
   /// non-point parameters (points eliminated) while those number at most `max_parameters`.

@@ -957,8 +957,10 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   result.frame = project_.frame.description;
   result.datum = storage_->datum;
   result.notes = storage_->notes;
-  // Said before the solve as well (a long run should not hide a unit mistake until its end).
-  for (const ResultWarning& w : PlausibilityWarnings(project_))
+  // Likely unit mistakes of the inputs: said before the solve (a long run should not hide one
+  // until its end) and listed first among the result's warnings.
+  const std::vector<ResultWarning> plausibility = PlausibilityWarnings(project_);
+  for (const ResultWarning& w : plausibility)
     LogWarning(w.name + ": " + w.subject + ": " + w.message);
   std::vector<BlockId> interior_blocks;
   for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k)
@@ -1204,7 +1206,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     result.Invalidate("singular: " + std::to_string(result.determinability.undetermined.size()) +
                       " parameter(s) not determinable (" +
                       result.determinability.undetermined.front() + ", ...)");
-  result.warnings = PlausibilityWarnings(project_);  // likely unit mistakes of the inputs
+  result.warnings = plausibility;
   for (auto& w : GroupRmsWarnings(result.solve)) result.warnings.push_back(std::move(w));
   for (const auto& left : result.control_left_out) {
     const PointDifference& d = left.difference;
