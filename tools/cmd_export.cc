@@ -27,7 +27,7 @@ CommandRun SetupExport(CLI::App& app) {
   app.add_option("--write-crs", args->write_crs,
                  "CRS to write (EPSG code, compound EPSG:A+B, WKT or PROJ string)")
       ->required();
-  app.add_option("--out", args->out, "Output folder")->required();
+  app.add_option("--out", args->out, "Output folder: exposures, points and check-point errors in --write-crs")->required();
   return [args]() {
     CheckOutputFolder(args->out, "--out");
     const triangulation::Project project = triangulation::ReadProject(args->project);
