@@ -37,6 +37,7 @@
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
 #include "tools/output_set.h"
+#include "tools/suspect_effect_option.h"
 #include "tools/python_script.h"
 #include "tools/image_sources.h"
 #include "triangulation/block/block_io.h"
@@ -350,6 +351,7 @@ struct StitchArgs {
   double relief_m = 0.0;                // given only: relief of the block off the plane
   double standard_radius_px = 400.0;
   double max_sigma0 = 3.0;
+  double suspect_effect_limit = 1.0;
   double default_sigma_px = 0.5;
   std::string images, stitched_out;  // head images <image>_<head>.tif; stitched images folder
   int tile_px = 256;
@@ -588,6 +590,7 @@ int RunStitch(const StitchArgs& args) {
   options.standard_radius_px = args.standard_radius_px;
   if (!(args.max_sigma0 > 0)) throw ConfigError("--max-sigma0 must be > 0");
   options.max_sigma0 = args.max_sigma0;
+  options.suspect_effect_limit = args.suspect_effect_limit;
   if (!(args.default_sigma_px > 0)) throw ConfigError("--sigma-px must be > 0");
   const triangulation::Project project = triangulation::ReadProject(args.project, args.default_sigma_px);
   std::vector<stitch::RigZoneMatchReport> matched_zones;
@@ -839,6 +842,7 @@ CommandRun Setup(CLI::App& app) {
   st->add_option("--standard-radius-px", stitching->standard_radius_px,
                  "A tie this close (virtual px) to a standard position of its zone counts for it")->check(PositiveUpTo(1e5));
   st->add_option("--max-sigma0", stitching->max_sigma0, "sigma0 above: exit 3 (absurd), > 0")->check(PositiveUpTo(1e6));
+  AddSuspectEffectOption(*st, &stitching->suspect_effect_limit);
   st->add_option("--sigma-px", stitching->default_sigma_px,
                  "Tie sigma (px) where observations.csv gives none")->check(PositiveUpTo(100));
   st->add_option("--images", stitching->images,
