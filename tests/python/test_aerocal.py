@@ -271,3 +271,54 @@ def test_a_real_block_equals_the_command_to_the_last_digit(tmp_path):
         d["snooping"].pop("seconds_testing", None)
     assert doc == cli
     assert (code == 0) == r.valid
+
+
+SMALL_CAMERA = """name: small
+pixel_size_mm: 0.009
+format_px: [400, 300]
+interior: {c: 50}
+subimages:
+  - {id: I, format_px: [210, 160], model: affine, params: [1, 0, 0, 0, 1, 0]}
+  - {id: II, format_px: [210, 160], model: affine, params: [1, 0, 190, 0, 1, 0]}
+  - {id: III, format_px: [210, 160], model: affine, params: [1, 0, 0, 0, 1, 140]}
+  - {id: IV, format_px: [210, 160], model: affine, params: [1, 0, 190, 0, 1, 140]}
+"""
+
+
+def test_resample_equals_the_command(tmp_path):
+    from PIL import Image  # Debian's python3-pil (a dependency of python3-matplotlib)
+    camera = tmp_path / "camera.yaml"
+    camera.write_text(SMALL_CAMERA)
+    # The nominal mappings, II turned by 1 mrad and shifted by sub-pixel amounts: bilinear
+    # interpolation between textured pixels everywhere in II.
+    subimages = []
+    for sid, (e, f) in {"I": (0, 0), "II": (190, 0), "III": (0, 140), "IV": (190, 140)}.items():
+        p = [1, 0, e, 0, 1, f]
+        if sid == "II":
+            p = [1, -1e-3, e - 0.37, 1e-3, 1, f + 0.21]
+        subimages.append({"id": sid, "model": "affine", "params": p})
+    mapping = tmp_path / "r.json"
+    mapping.write_text(json.dumps({"kind": "stitch", "schema_version": 1, "subimages": subimages}))
+    rng = np.random.default_rng(3)
+    images = {}
+    for sid in ("I", "II", "III", "IV"):
+        path = tmp_path / f"{sid}.png"
+        Image.fromarray(rng.integers(0, 256, size=(160, 210), dtype=np.uint8)).save(path)
+        images[sid] = str(path)
+    text = ",".join(f"{k}={v}" for k, v in images.items())
+    cli = tmp_path / "cli.tif"
+    code, out = run("resample", "--camera", str(camera), "--mapping", str(mapping), "--images", text,
+                    "--fill", "7", "--out", str(cli))
+    assert code == 0, out
+    py_tif = tmp_path / "py.tif"
+    pixels = aerocal.resample(str(camera), str(mapping), images, fill=7, out=str(py_tif))
+    assert pixels.dtype == np.uint8 and pixels.shape == (300, 400)
+    assert py_tif.read_bytes() == cli.read_bytes()  # the command's file, byte for byte
+    np.testing.assert_array_equal(pixels, np.asarray(Image.open(cli)))
+    # The option's text gives the same image; the corner II leaves uncovered holds the fill.
+    np.testing.assert_array_equal(aerocal.resample(str(camera), str(mapping), text, fill=7), pixels)
+    assert pixels[0, 399] == 7
+    with pytest.raises(ValueError, match="no image for sub-image II"):
+        aerocal.resample(str(camera), str(mapping), {"I": images["I"]})
+    with pytest.raises(ValueError, match="--fill"):
+        aerocal.resample(str(camera), str(mapping), images, fill=300)

@@ -13,5 +13,7 @@ void BindCamera(pybind11::module_& m);
 void BindAdjust(pybind11::module_& m);
 /// stitch(camera, observations, **options) -> StitchResult: `aerocal stitch` from Python.
 void BindStitch(pybind11::module_& m);
+/// resample(camera, mapping, images, ...) -> numpy array: `aerocal resample` from Python.
+void BindResample(pybind11::module_& m);
 
 }  // namespace aerocal::python

@@ -22,4 +22,5 @@ PYBIND11_MODULE(_aerocal, m) {
   aerocal::python::BindCamera(m);
   aerocal::python::BindAdjust(m);
   aerocal::python::BindStitch(m);
+  aerocal::python::BindResample(m);
 }

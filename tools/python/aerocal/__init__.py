@@ -21,6 +21,10 @@ Sub-image stitching (multi-CCD cameras)
     stitch(camera_file, stitch_obs_csv, model="auto") -> StitchResult
     result.frames[i]["subimages"]["II"]["params"], result.stability, result.to_json()
 
+The virtual image (resampling the sub-images of one frame)
+    resample(camera_file, stitch_json, {"I": "I.tif", ...}, frame="", interpolation="bilinear",
+             fill=0, out="") -> numpy array (rows, cols[, bands]), uint8 or uint16
+
 Conventions: pixels (col, row) with the top-left pixel centre at (0, 0); photo coordinates x
 right, y up (mm); rays (x / c, y / c) with the camera looking along -z; angles in degrees in
 tables, as in the files. Bad input raises InputError (a ValueError) with FILE:LINE; a result that
@@ -39,6 +43,7 @@ from ._aerocal import (
     convert_camera,
     formats,
     models,
+    resample,
     stitch,
 )
 
@@ -54,5 +59,6 @@ __all__ = [
     "convert_camera",
     "formats",
     "models",
+    "resample",
     "stitch",
 ]

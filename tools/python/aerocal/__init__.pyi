@@ -1,5 +1,5 @@
 # Type stubs of the aerocal module (tools/python/bind_*.cc).
-from typing import Any, Callable, Dict, List, Optional, Sequence, Tuple
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -116,3 +116,7 @@ class StitchResult:
 def stitch(camera: str, observations: str, model: str = "auto", base: str = "",
            sigma_px: float = 0.1, alpha: float = 0.05, no_snooping: bool = False,
            progress: Optional[Callable[[int, int], None]] = None) -> StitchResult: ...
+
+def resample(camera: str, mapping: str, images: Union[Mapping[str, str], str], frame: str = "",
+             interpolation: str = "bilinear", fill: float = 0.0,
+             out: str = "") -> npt.NDArray[Any]: ...
