@@ -322,3 +322,45 @@ def test_resample_equals_the_command(tmp_path):
         aerocal.resample(str(camera), str(mapping), {"I": images["I"]})
     with pytest.raises(ValueError, match="--fill"):
         aerocal.resample(str(camera), str(mapping), images, fill=300)
+
+
+def _without_clock(doc):
+    """The document without the clock's keys (seconds, timing, seconds_testing), at any depth."""
+    if isinstance(doc, dict):
+        return {k: _without_clock(v) for k, v in doc.items() if k not in ("seconds", "timing", "seconds_testing")}
+    if isinstance(doc, list):
+        return [_without_clock(v) for v in doc]
+    return doc
+
+
+def test_calibrate_equals_the_command(tmp_path):
+    field = tmp_path / "tf"
+    code, out = run("simulate", "--test-field", "--groups", "2", "--images-per-group", "4",
+                    "--seed", "3", "--out", str(field))
+    assert code == 0, out
+    camera, obs, points, groups = (str(field / f) for f in
+                                   ("camera_nominal.yaml", "observations.csv", "points.csv", "groups.csv"))
+    cli = tmp_path / "cli.json"
+    code, out = run("calibrate", "--camera", camera, "--observations", obs, "--points", points,
+                    "--groups", groups, "--write-camera", str(tmp_path / "cli.yaml"), "--out", str(cli))
+    assert code in (0, 3), out
+    r = aerocal.calibrate(camera, observations=obs, points=points, groups=groups,
+                          write_camera=str(tmp_path / "py.yaml"), out=str(tmp_path / "py.json"))
+    assert r.valid == (code == 0)
+    with open(cli) as f:
+        expected = json.load(f)
+    doc = json.loads(r.to_json())
+    written = doc["calibration"].pop("camera_written", None), expected["calibration"].pop("camera_written", None)
+    assert _without_clock(doc) == _without_clock(expected)
+    assert (written[0] is None) == (written[1] is None)
+    if written[0] is not None:  # the same camera file under another name
+        assert (tmp_path / "py.yaml").read_text() == (tmp_path / "cli.yaml").read_text()
+    assert r.sigma0 == expected["sigma0"]
+    assert r.calibration["method"]["kind"] == "test field"
+    on_disk = json.loads((tmp_path / "py.json").read_text())  # out=: the file to_json() gives
+    on_disk["calibration"].pop("camera_written", None)
+    assert _without_clock(on_disk) == _without_clock(doc)
+    with pytest.raises(ValueError, match="--observations and --points go together"):
+        aerocal.calibrate(camera, observations=obs)
+    with pytest.raises(ValueError, match="sigma_px"):
+        aerocal.calibrate(camera, observations=obs, points=points, sigma_px=-1)

@@ -15,5 +15,7 @@ void BindAdjust(pybind11::module_& m);
 void BindStitch(pybind11::module_& m);
 /// resample(camera, mapping, images, ...) -> numpy array: `aerocal resample` from Python.
 void BindResample(pybind11::module_& m);
+/// calibrate(camera, observations=..., points=... | images=..., board=...) -> CalibrationResult.
+void BindCalibrate(pybind11::module_& m);
 
 }  // namespace aerocal::python

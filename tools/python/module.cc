@@ -23,4 +23,5 @@ PYBIND11_MODULE(_aerocal, m) {
   aerocal::python::BindAdjust(m);
   aerocal::python::BindStitch(m);
   aerocal::python::BindResample(m);
+  aerocal::python::BindCalibrate(m);
 }

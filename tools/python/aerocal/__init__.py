@@ -21,6 +21,10 @@ Sub-image stitching (multi-CCD cameras)
     stitch(camera_file, stitch_obs_csv, model="auto") -> StitchResult
     result.frames[i]["subimages"]["II"]["params"], result.stability, result.to_json()
 
+Camera calibration (test field or planar board)
+    calibrate(camera_file, observations=..., points=...) or (camera_file, images="b*.jpg",
+              board="chessboard:9x6:25") -> CalibrationResult: valid, sigma0, calibration, to_json()
+
 The virtual image (resampling the sub-images of one frame)
     resample(camera_file, stitch_json, {"I": "I.tif", ...}, frame="", interpolation="bilinear",
              fill=0, out="") -> numpy array (rows, cols[, bands]), uint8 or uint16
@@ -39,7 +43,9 @@ from ._aerocal import (
     ConfigError,
     InputError,
     StitchResult,
+    CalibrationResult,
     adjust,
+    calibrate,
     convert_camera,
     formats,
     models,
@@ -55,7 +61,9 @@ __all__ = [
     "ConfigError",
     "InputError",
     "StitchResult",
+    "CalibrationResult",
     "adjust",
+    "calibrate",
     "convert_camera",
     "formats",
     "models",

@@ -120,3 +120,24 @@ def stitch(camera: str, observations: str, model: str = "auto", base: str = "",
 def resample(camera: str, mapping: str, images: Union[Mapping[str, str], str], frame: str = "",
              interpolation: str = "bilinear", fill: float = 0.0,
              out: str = "") -> npt.NDArray[Any]: ...
+
+class CalibrationResult:
+    @property
+    def valid(self) -> bool: ...
+    @property
+    def sigma0(self) -> float: ...
+    @property
+    def calibration(self) -> Dict[str, Any]: ...
+    @property
+    def printed(self) -> str: ...
+    def to_json(self) -> str: ...
+
+def calibrate(camera: str, observations: Optional[str] = None, points: Optional[str] = None,
+              images: Optional[str] = None, board: Optional[str] = None,
+              groups: Optional[str] = None, budget: Optional[str] = None,
+              self_calibration: Optional[str] = None, model: Optional[str] = None,
+              sigma_px: float = 0.5, board_sigma_mm: float = 0.01,
+              radii_mm: Sequence[float] = (), no_snooping: bool = False,
+              no_closed_form: bool = False, suspect_effect_limit: float = 1.0,
+              write_camera: Optional[str] = None, camera_format: str = "aerocal",
+              write_marks: Optional[str] = None, out: Optional[str] = None) -> CalibrationResult: ...

@@ -1,0 +1,100 @@
+// aerocal.calibrate: camera calibration from a test field or a planar board as `aerocal calibrate`
+// runs it (tools/calibrate_request.h: the same request, the same outcome), with the result
+// document as the command writes it.
+#include "calib/core/error.h"
+#include "calib/core/result_file.h"
+#include "tools/calibrate_request.h"
+#include "tools/python/bindings.h"
+
+#include <pybind11/stl.h>
+
+namespace aerocal::python {
+namespace {
+
+namespace py = pybind11;
+
+struct CalibrationResult {
+  tools::CalibrateOutcome outcome;
+  std::string json;  // as `aerocal calibrate --out` writes it
+};
+
+std::string Text(const py::object& value) { return value.is_none() ? "" : py::str(value).cast<std::string>(); }
+
+CalibrationResult Calibrate(const std::string& camera, const py::object& observations, const py::object& points,
+                            const py::object& images, const py::object& board, const py::object& groups,
+                            const py::object& budget, const py::object& self_calibration,
+                            const py::object& model, double sigma_px, double board_sigma_mm,
+                            const std::vector<double>& radii_mm, bool no_snooping, bool no_closed_form,
+                            double suspect_effect_limit, const py::object& write_camera,
+                            const std::string& camera_format, const py::object& write_marks,
+                            const py::object& out) {
+  if (!(sigma_px > 0 && sigma_px <= 100)) throw ConfigError("sigma_px: must be in (0, 100]");
+  if (!(board_sigma_mm > 0 && board_sigma_mm <= 100)) throw ConfigError("board_sigma_mm: must be in (0, 100]");
+  if (!(suspect_effect_limit > 0 && suspect_effect_limit <= 1e3))
+    throw ConfigError("suspect_effect_limit: must be in (0, 1000]");
+  for (const double r : radii_mm)
+    if (!(r > 0 && r <= 1e4)) throw ConfigError("radii_mm: each must be in (0, 10000]");
+  tools::CalibrateRequest request;
+  request.camera = camera;
+  request.observations = Text(observations);
+  request.points = Text(points);
+  request.images = Text(images);
+  request.board = Text(board);
+  request.groups = Text(groups);
+  request.budget = Text(budget);
+  request.self_calibration = Text(self_calibration);
+  request.model = Text(model);
+  request.sigma_px = sigma_px;
+  request.board_sigma_mm = board_sigma_mm;
+  request.radii_mm = radii_mm;
+  request.no_snooping = no_snooping;
+  request.no_closed_form = no_closed_form;
+  request.suspect_effect_limit = suspect_effect_limit;
+  request.write_camera = Text(write_camera);
+  request.camera_format = camera_format;
+  request.write_marks = Text(write_marks);
+  request.out = Text(out);
+  CalibrationResult result;
+  {
+    py::gil_scoped_release release;
+    result.outcome = tools::RunCalibration(request);
+  }
+  result.json = ResultText("adjust", result.outcome.doc);
+  if (!request.out.empty()) WriteResult(request.out, "adjust", result.outcome.doc);
+  return result;
+}
+
+}  // namespace
+
+void BindCalibrate(py::module_& m) {
+  py::class_<CalibrationResult>(m, "CalibrationResult",
+                                "The result of calibrate(): as `aerocal calibrate` writes it")
+      .def_property_readonly("valid", [](const CalibrationResult& r) { return r.outcome.valid; },
+                             "The calibration is valid and its image groups agree (exit 0 of the command)")
+      .def_property_readonly("sigma0", [](const CalibrationResult& r) { return r.outcome.doc.at("sigma0").get<double>(); })
+      .def_property_readonly("calibration",
+                             [](const CalibrationResult& r) {
+                               return py::module_::import("json").attr("loads")(r.outcome.doc.at("calibration").dump());
+                             },
+                             "The result's `calibration` section as a dict (values with U, budget, "
+                             "groups, stability, method)")
+      .def_property_readonly("printed", [](const CalibrationResult& r) { return r.outcome.printed; },
+                             "What the command prints")
+      .def("to_json", [](const CalibrationResult& r) { return r.json; },
+           "The result file's text, identical to `aerocal calibrate --out`");
+  m.def("calibrate", &Calibrate, py::arg("camera"), py::arg("observations") = py::none(),
+        py::arg("points") = py::none(), py::arg("images") = py::none(), py::arg("board") = py::none(),
+        py::arg("groups") = py::none(), py::arg("budget") = py::none(),
+        py::arg("self_calibration") = py::none(), py::arg("model") = py::none(),
+        py::arg("sigma_px") = 0.5, py::arg("board_sigma_mm") = tools::kDefaultBoardSigmaMm,
+        py::arg("radii_mm") = std::vector<double>{}, py::arg("no_snooping") = false,
+        py::arg("no_closed_form") = false, py::arg("suspect_effect_limit") = 1.0,
+        py::arg("write_camera") = py::none(), py::arg("camera_format") = "aerocal",
+        py::arg("write_marks") = py::none(), py::arg("out") = py::none(),
+        "Camera calibration as `aerocal calibrate`: a test field (observations, points: the CSV "
+        "files) or a planar board (images: a glob, board: 'chessboard:9x6:25'); groups, budget, "
+        "self_calibration, model, ... as the command's options (`-` -> `_`). A result that is not "
+        "valid comes back with valid=False. The GIL is released while calibrating.");
+}
+
+}  // namespace aerocal::python
