@@ -39,6 +39,7 @@
 #include "tools/output_set.h"
 #include "tools/suspect_effect_option.h"
 #include "tools/python_script.h"
+#include "tools/rig_stitch_run.h"
 #include "tools/image_sources.h"
 #include "triangulation/block/block_io.h"
 
@@ -86,14 +87,6 @@ double FlyingHeight(const calib::Rig& rig, double given_m, const std::string& fi
 std::string PlotScript() {
   if (const char* env = std::getenv("AEROCAL_RIG_PLOT_SCRIPT")) return env;
   return (fs::path(AEROCAL_REPORT_SCRIPT).parent_path() / "rig_error_plots.py").string();
-}
-
-// The camera model of each head with its parameter table, keyed by head id (`camera_models` of
-// the rig result documents).
-nlohmann::json HeadCameraModels(const calib::Rig& rig) {
-  nlohmann::json models = nlohmann::json::object();
-  for (const auto& head : rig.heads) models[head.id] = calib::CameraModelTableToJson(head.camera.model);
-  return models;
 }
 
 int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
@@ -363,116 +356,11 @@ struct StitchArgs {
   CLI::Option* relief_option = nullptr;
 };
 
-// The project's rig block as the library's inputs: every exposure with head observations (z_ref
-// required, velocity optional), the points (role check: a check tie, never adjusted), the head
-// observations with their lines for the snooping's labels.
-struct StitchInputs {
-  std::vector<stitch::RigStitchExposure> exposures;
-  std::vector<stitch::RigStitchTie> ties;
-  std::vector<stitch::RigStitchObservation> observations;
-};
-
-// An exposure of the project as the library's: POS, velocity (optional) and z_ref (required,
-// below the rig centre; FILE:LINE otherwise).
-stitch::RigStitchExposure StitchExposure(const triangulation::Project& project,
-                                         const triangulation::Exposure& e) {
-  if (!e.z_ref_m)
-    ThrowInputError({project.exposures_file, e.line},
-                    "image " + e.image + " has no z_ref (rig stitch rectifies onto the level "
-                    "plane Z = z_ref of each exposure)");
-  if (!(e.center_m.z() > *e.z_ref_m))
-    ThrowInputError({project.exposures_file, e.line},
-                    "image " + e.image + ": z_ref (" + FormatNumber(*e.z_ref_m) +
-                        " m) must lie below the rig centre Z (" + FormatNumber(e.center_m.z()) +
-                        " m)");
-  stitch::RigStitchExposure x;
-  x.image = e.image;
-  x.pose.rig_opk_rad = e.opk_rad;
-  x.pose.rig_center_m = e.center_m;
-  x.pose.velocity_mps = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
-  x.z_ref_m = *e.z_ref_m;
-  return x;
-}
-
-StitchInputs StitchInputsFromProject(const triangulation::Project& project, const calib::Rig& rig,
-                                     const std::string& camera_file) {
-  StitchInputs in;
-  std::map<std::string, int> tie_index, exposure_index;
-  for (const auto& p : project.points) {
-    tie_index[p.id] = static_cast<int>(in.ties.size());
-    in.ties.push_back({p.id, p.role == triangulation::PointRole::kCheck});
-  }
-  for (const auto& o : project.observations) {
-    const SourceRef where{project.observations_file, o.line};
-    if (o.head.empty())
-      ThrowInputError(where, "rig stitch needs head observations (observations.csv `head` column)");
-    const int head = rig.HeadIndex(o.head);
-    if (head < 0) ThrowInputError(where, "head '" + o.head + "' is not a head of " + camera_file);
-    auto [it, added] = exposure_index.try_emplace(o.image, static_cast<int>(in.exposures.size()));
-    if (added) in.exposures.push_back(StitchExposure(project, *project.FindExposure(o.image)));
-    const std::string label = fs::path(project.observations_file).filename().string() + ":" +
-                              std::to_string(o.line);
-    in.observations.push_back(
-        {it->second, head, tie_index.at(o.point), o.pixel, o.sigma_px, label});
-  }
-  if (in.observations.empty())
-    throw InputError(project.observations_file + ": no head observations to stitch");
-  return in;
-}
-
-// The head image of an exposure under --images: <image>_<head>.tif (or .png, .jpg).
-std::string HeadImagePath(const std::string& folder, const std::string& image, const std::string& head) {
-  for (const char* ext : {".tif", ".tiff", ".png", ".jpg"}) {
-    const std::string path = folder + "/" + image + "_" + head + ext;
-    if (fs::exists(path)) return path;
-  }
-  throw InputError("--images: " + folder + "/" + image + "_" + head +
-                   ".tif not found (the head images are <image>_<head>.tif)");
-}
 
 std::unique_ptr<stitch::RasterSource> OpenHeadImage(const std::string& path) {
   if (fs::path(path).extension() == ".tif" || fs::path(path).extension() == ".tiff")
     return stitch::OpenTiff(path);
   return std::make_unique<stitch::MemoryRaster>(stitch::ReadImageFile(path, true));
-}
-
-// --match-ties: every exposure of the project, its ties matched on the head images under --images
-// (stitch/rig/rig_tie_matching.h); observations.csv must have no rows. The zones' counts in
-// `zones`, the RMS of the ties' LSM sigmas (virtual px) in `lsm_sigma_rms_px`.
-StitchInputs MatchedStitchInputs(const triangulation::Project& project, const calib::Rig& rig,
-                                 const std::string& images,
-                                 std::vector<stitch::RigZoneMatchReport>* zones,
-                                 double* lsm_sigma_rms_px) {
-  if (!project.observations.empty())
-    ThrowInputError({project.observations_file, project.observations.front().line},
-                    "--match-ties measures the ties on the head images: observations.csv must have "
-                    "no rows (got " + std::to_string(project.observations.size()) + ")");
-  StitchInputs in;
-  for (const auto& e : project.exposures) in.exposures.push_back(StitchExposure(project, e));
-  if (in.exposures.empty()) throw InputError(project.exposures_file + ": no exposures");
-  for (const auto& e : in.exposures)  // every head image present before anything is computed
-    for (const auto& head : rig.heads) HeadImagePath(images, e.image, head.id);
-  stitch::RigTieMatches matches;
-  for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i) {
-    std::vector<stitch::GrayImage> heads;
-    for (const auto& head : rig.heads) {
-      const std::string path = HeadImagePath(images, in.exposures[i].image, head.id);
-      heads.push_back(stitch::ReadGrayImage(path));
-      if (heads.back().cols() != head.camera.width_px || heads.back().rows() != head.camera.height_px)
-        throw InputError(path + ": " + std::to_string(heads.back().cols()) + " x " +
-                         std::to_string(heads.back().rows()) + " px, head " + head.id + " is " +
-                         std::to_string(head.camera.width_px) + " x " +
-                         std::to_string(head.camera.height_px) + " px");
-    }
-    stitch::MatchRigExposureTies(rig, in.exposures[i], i, heads, {}, &matches);
-  }
-  double sum2 = 0.0;
-  for (double sigma : matches.lsm_sigma_px) sum2 += sigma * sigma;
-  *lsm_sigma_rms_px = matches.lsm_sigma_px.empty() ? 0.0 : std::sqrt(sum2 / matches.lsm_sigma_px.size());
-  in.ties = std::move(matches.ties);
-  in.observations = std::move(matches.observations);
-  *zones = std::move(matches.zones);
-  return in;
 }
 
 // The stitched image of every exposure with the refined increments and offsets (stitch/rig/
@@ -565,90 +453,33 @@ int RunStitch(const StitchArgs& args) {
     throw ConfigError("--feather-px must be within 1..255 (got " + std::to_string(args.feather_px) + ")");
   if (!args.images.empty() && !fs::is_directory(args.images))
     throw ConfigError("--images must be a folder of head images (got '" + args.images + "')");
-  const calib::Rig rig = calib::ReadRig(args.camera);
-  if (rig.heads.size() < 2)
-    throw InputError(args.camera + ": a rig of one head has nothing to stitch");
-  if (rig.virtual_camera.orientation != calib::VirtualOrientation::kLevel)
-    throw InputError(args.camera + ": virtual.orientation must be level for rig stitch (the "
-                     "horizontal virtual image of the POS attitude)");
-  stitch::RigStitchOptions options;
-  const auto mode = stitch::ParseRigStitchMode(args.mode);
-  if (!mode) throw ConfigError("--mode must be line, per-exposure or angles (got '" + args.mode + "')");
-  options.mode = *mode;
-  options.snooping = !args.no_snooping;
-  if (!(args.alpha > 0 && args.alpha < 1)) throw ConfigError("--alpha must be within (0, 1)");
-  options.alpha = args.alpha;
-  if (args.increment_sigma_option->count() > 0) {
-    if (!(args.increment_sigma_arcsec > 0)) throw ConfigError("--increment-sigma-arcsec must be > 0");
-    options.increment_sigma_rad = args.increment_sigma_arcsec * M_PI / (180.0 * 3600.0);
-  }
-  if (args.dt_sigma_option->count() > 0) {
-    if (!(args.dt_sigma_ms > 0)) throw ConfigError("--dt-sigma-ms must be > 0");
-    options.dt_sigma_s = args.dt_sigma_ms * 1e-3;
-  }
-  if (!(args.standard_radius_px > 0)) throw ConfigError("--standard-radius-px must be > 0");
-  options.standard_radius_px = args.standard_radius_px;
-  if (!(args.max_sigma0 > 0)) throw ConfigError("--max-sigma0 must be > 0");
-  options.max_sigma0 = args.max_sigma0;
-  options.suspect_effect_limit = args.suspect_effect_limit;
-  if (!(args.default_sigma_px > 0)) throw ConfigError("--sigma-px must be > 0");
-  const triangulation::Project project = triangulation::ReadProject(args.project, args.default_sigma_px);
-  std::vector<stitch::RigZoneMatchReport> matched_zones;
-  double lsm_sigma_rms_px = 0.0;
-  const StitchInputs in = args.match_ties
-                              ? MatchedStitchInputs(project, rig, args.images, &matched_zones,
-                                                    &lsm_sigma_rms_px)
-                              : StitchInputsFromProject(project, rig, args.camera);
-  double height_sum = 0.0;
-  for (const auto& e : in.exposures) height_sum += e.pose.rig_center_m.z() - e.z_ref_m;
-  const double height_m = height_sum / in.exposures.size();
-  stitch::RigStitchSources sources{args.camera, args.project, std::nullopt};
-  if (args.relief_option->count() > 0) {
-    if (!(args.relief_m >= 0 && args.relief_m < height_m))
-      throw ConfigError("--relief-m must be within [0, " + FormatNumber(height_m, 6) +
-                        ") m, the mean height above z_ref");
-    options.relief_m = args.relief_m;
-    sources.relief_m = args.relief_m;
-  }
-  // The standard tie positions of the rig's design at the block's mean height.
-  const std::vector<stitch::StandardPosition> positions =
-      stitch::DesignRig(rig, height_m, 200).standard_positions;
-  if (!args.stitched_out.empty())  // every head image present before anything is computed or written
-    for (const auto& e : in.exposures)
-      for (const auto& head : rig.heads) HeadImagePath(args.images, e.image, head.id);
-  const stitch::RigStitchResult result = stitch::SelfCalibrateRigStitching(
-      rig, in.exposures, in.ties, in.observations, positions, options);
-  nlohmann::json json = stitch::RigStitchToJson(rig, options, result, sources);
-  json["camera_models"] = HeadCameraModels(rig);
-  if (args.match_ties) {
-    nlohmann::json zones = nlohmann::json::array();
-    for (const auto& z : matched_zones) {
-      zones.push_back({{"image", z.image}, {"zone", z.zone}, {"pixels", z.pixels},
-                       {"cells", z.cells}, {"lsm_tried", z.lsm_tried},
-                       {"lsm_failed", z.lsm_failed}, {"ties", z.ties}});
-      std::printf("matched %s zone %s: %d ties (%d cells, LSM %d tried, %d failed)\n",
-                  z.image.c_str(), z.zone.c_str(), z.ties, z.cells, z.lsm_tried, z.lsm_failed);
-    }
-    json["tie_matching"] = {{"ties", in.ties.size()},
-                            {"observations", in.observations.size()},
-                            {"prefilter_sigma_px", stitch::RigTieMatchOptions{}.prefilter_sigma_px},
-                            {"lsm_sigma_rms_px", lsm_sigma_rms_px},
-                            {"zones", zones}};
-    // The LSM sigmas take the template's residuals as independent; sigma0 says by how much they
-    // are too small here, and the increments' sigmas are scaled by it (a-posteriori).
-    std::printf("matched ties: LSM sigma RMS %.4f virtual px; sigma0 %.2f: the LSM sigmas are %.2f x "
-                "too %s, the increments' sigmas are scaled by sigma0\n",
-                lsm_sigma_rms_px, result.sigma0, result.sigma0 >= 1 ? result.sigma0 : 1 / result.sigma0,
-                result.sigma0 >= 1 ? "small" : "large");
-  }
-  std::fputs(stitch::FormatRigStitchSummary(options, result, sources).c_str(), stdout);
+  RigStitchRequest request;
+  request.camera = args.camera;
+  request.project = args.project;
+  request.mode = args.mode;
+  request.no_snooping = args.no_snooping;
+  request.alpha = args.alpha;
+  if (args.increment_sigma_option->count() > 0) request.increment_sigma_arcsec = args.increment_sigma_arcsec;
+  if (args.dt_sigma_option->count() > 0) request.dt_sigma_ms = args.dt_sigma_ms;
+  if (args.relief_option->count() > 0) request.relief_m = args.relief_m;
+  request.standard_radius_px = args.standard_radius_px;
+  request.max_sigma0 = args.max_sigma0;
+  request.suspect_effect_limit = args.suspect_effect_limit;
+  request.default_sigma_px = args.default_sigma_px;
+  request.images = args.images;
+  request.match_ties = args.match_ties;
+  request.need_head_images = !args.stitched_out.empty();
+  RigStitchRun run = RunRigStitch(request);
+  const stitch::RigStitchResult& result = run.result;
+  nlohmann::json& json = run.json;
+  std::fputs(run.printed.c_str(), stdout);
   // The JSON and the stitched images are one set (tools/output_set.h): a stitched image that
   // fails replaces neither the previous JSON nor any previous image.
   const fs::path out(args.out);
   OutputSet set(out.parent_path().string());
   if (!args.stitched_out.empty()) {
     if (result.failures.empty())
-      json["stitched_images"] = WriteStitchedImages(args, rig, in.exposures, result, &set);
+      json["stitched_images"] = WriteStitchedImages(args, run.rig, run.exposures, result, &set);
     else
       std::fprintf(stderr, "error: no stitched images: the self-calibration is not valid\n");
   }

@@ -364,3 +364,23 @@ def test_calibrate_equals_the_command(tmp_path):
         aerocal.calibrate(camera, observations=obs)
     with pytest.raises(ValueError, match="sigma_px"):
         aerocal.calibrate(camera, observations=obs, points=points, sigma_px=-1)
+
+
+def test_rig_stitch_equals_the_command(tmp_path):
+    line = tmp_path / "uav4"
+    code, out = run("simulate", "--rig", "uav4", "--exposures", "3", "--seed", "5", "--out", str(line))
+    assert code == 0, out
+    camera = str(line / "rig_truth.yaml")
+    cli = tmp_path / "cli.json"
+    code, out = run("rig", "stitch", "--camera", camera, "--project", str(line), "--dt-sigma-ms", "50",
+                    "--out", str(cli))
+    assert code == 0, out
+    r = aerocal.rig_stitch(camera, str(line), dt_sigma_ms=50)
+    with open(cli) as f:
+        expected = json.load(f)
+    assert _without_clock(json.loads(r.to_json())) == _without_clock(expected)
+    assert r.valid and not r.failures and r.sigma0 == expected["sigma0"]
+    assert len(r.rig_exposures) == len(expected["rig_exposures"])
+    assert r.snooping["stopped"] is False
+    with pytest.raises(ValueError, match="--mode must be line, per-exposure or angles"):
+        aerocal.rig_stitch(camera, str(line), mode="spline")

@@ -17,5 +17,7 @@ void BindStitch(pybind11::module_& m);
 void BindResample(pybind11::module_& m);
 /// calibrate(camera, observations=..., points=... | images=..., board=...) -> CalibrationResult.
 void BindCalibrate(pybind11::module_& m);
+/// rig_stitch(camera, project, ...) -> RigStitchResult: `aerocal rig stitch` from Python.
+void BindRig(pybind11::module_& m);
 
 }  // namespace aerocal::python

@@ -24,4 +24,5 @@ PYBIND11_MODULE(_aerocal, m) {
   aerocal::python::BindStitch(m);
   aerocal::python::BindResample(m);
   aerocal::python::BindCalibrate(m);
+  aerocal::python::BindRig(m);
 }

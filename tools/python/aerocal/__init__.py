@@ -25,6 +25,10 @@ Camera calibration (test field or planar board)
     calibrate(camera_file, observations=..., points=...) or (camera_file, images="b*.jpg",
               board="chessboard:9x6:25") -> CalibrationResult: valid, sigma0, calibration, to_json()
 
+Multi-head rigs
+    rig_stitch(rig_camera_file, project, mode="line") -> RigStitchResult: valid, failures,
+               rig_exposures, snooping, to_json()
+
 The virtual image (resampling the sub-images of one frame)
     resample(camera_file, stitch_json, {"I": "I.tif", ...}, frame="", interpolation="bilinear",
              fill=0, out="") -> numpy array (rows, cols[, bands]), uint8 or uint16
@@ -42,6 +46,7 @@ from ._aerocal import (
     CameraEstimate,
     ConfigError,
     InputError,
+    RigStitchResult,
     StitchResult,
     CalibrationResult,
     adjust,
@@ -50,6 +55,7 @@ from ._aerocal import (
     formats,
     models,
     resample,
+    rig_stitch,
     stitch,
 )
 
@@ -60,6 +66,7 @@ __all__ = [
     "CameraEstimate",
     "ConfigError",
     "InputError",
+    "RigStitchResult",
     "StitchResult",
     "CalibrationResult",
     "adjust",
@@ -68,5 +75,6 @@ __all__ = [
     "formats",
     "models",
     "resample",
+    "rig_stitch",
     "stitch",
 ]

@@ -1,0 +1,89 @@
+// aerocal.rig_stitch: the self-calibrating stitching of a rig block as `aerocal rig stitch` runs it
+// (tools/rig_stitch_run.h: the same request and run), with the result document as the command
+// writes it (the stitched images stay with the command).
+#include "calib/core/error.h"
+#include "calib/core/result_file.h"
+#include "tools/python/bindings.h"
+#include "tools/rig_stitch_run.h"
+
+#include <pybind11/stl.h>
+
+namespace aerocal::python {
+namespace {
+
+namespace py = pybind11;
+
+struct RigStitchResult {
+  tools::RigStitchRun run;
+  std::string json;  // as `aerocal rig stitch --out` writes it
+};
+
+RigStitchResult RigStitch(const std::string& camera, const std::string& project, const std::string& mode,
+                          bool no_snooping, double alpha, std::optional<double> increment_sigma_arcsec,
+                          std::optional<double> dt_sigma_ms, std::optional<double> relief_m,
+                          double standard_radius_px, double max_sigma0, double suspect_effect_limit,
+                          double sigma_px, const std::string& images, bool match_ties) {
+  for (const auto& [name, value] : {std::make_pair("standard_radius_px", standard_radius_px),
+                                    std::make_pair("max_sigma0", max_sigma0),
+                                    std::make_pair("suspect_effect_limit", suspect_effect_limit),
+                                    std::make_pair("sigma_px", sigma_px)})
+    if (!(std::isfinite(value) && value > 0)) throw ConfigError(std::string(name) + ": must be a finite number > 0");
+  tools::RigStitchRequest request;
+  request.camera = camera;
+  request.project = project;
+  request.mode = mode;
+  request.no_snooping = no_snooping;
+  request.alpha = alpha;
+  request.increment_sigma_arcsec = increment_sigma_arcsec;
+  request.dt_sigma_ms = dt_sigma_ms;
+  request.relief_m = relief_m;
+  request.standard_radius_px = standard_radius_px;
+  request.max_sigma0 = max_sigma0;
+  request.suspect_effect_limit = suspect_effect_limit;
+  request.default_sigma_px = sigma_px;
+  request.images = images;
+  request.match_ties = match_ties;
+  if (match_ties && images.empty()) throw ConfigError("match_ties needs images (the folder of the head images)");
+  RigStitchResult out;
+  {
+    py::gil_scoped_release release;
+    out.run = tools::RunRigStitch(request);
+  }
+  out.json = ResultText("rig_stitch", out.run.json);
+  return out;
+}
+
+py::object JsonValue(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
+
+}  // namespace
+
+void BindRig(py::module_& m) {
+  py::class_<RigStitchResult>(m, "RigStitchResult", "The result of rig_stitch(): as `aerocal rig stitch` writes it")
+      .def_property_readonly("valid", [](const RigStitchResult& r) { return r.run.result.failures.empty(); },
+                             "No failure (the command's exit 0)")
+      .def_property_readonly("failures", [](const RigStitchResult& r) { return r.run.result.failures; })
+      .def_property_readonly("warnings", [](const RigStitchResult& r) { return r.run.result.warnings; })
+      .def_property_readonly("sigma0", [](const RigStitchResult& r) { return r.run.result.sigma0; })
+      .def_property_readonly("rig_exposures", [](const RigStitchResult& r) { return JsonValue(r.run.json.at("rig_exposures")); },
+                             "Per exposure and head: domega, dphi, dkappa (deg), dT_ms and their sigmas "
+                             "(None where held or not computable)")
+      .def_property_readonly("snooping", [](const RigStitchResult& r) { return JsonValue(r.run.json.at("snooping")); })
+      .def_property_readonly("printed", [](const RigStitchResult& r) { return r.run.printed; },
+                             "What the command prints")
+      .def("to_json", [](const RigStitchResult& r) { return r.json; },
+           "The result file's text, identical to `aerocal rig stitch --out`");
+  m.def("rig_stitch", &RigStitch, py::arg("camera"), py::arg("project"), py::arg("mode") = "line",
+        py::arg("no_snooping") = false, py::arg("alpha") = 0.05,
+        py::arg("increment_sigma_arcsec") = py::none(), py::arg("dt_sigma_ms") = py::none(),
+        py::arg("relief_m") = py::none(), py::arg("standard_radius_px") = 400.0,
+        py::arg("max_sigma0") = 3.0, py::arg("suspect_effect_limit") = 1.0, py::arg("sigma_px") = 0.5,
+        py::arg("images") = "", py::arg("match_ties") = false,
+        "The self-calibrating stitching of a rig block as `aerocal rig stitch --camera CAMERA "
+        "--project PROJECT`: mode line | per-exposure | angles, the command's other options as "
+        "keywords (`-` -> `_`; sigma_px is --sigma-px); match_ties with images (the head images' "
+        "folder) matches the ties on the images. The stitched images are the command's "
+        "(--stitched-out). A result that is not valid comes back with valid=False. The GIL is "
+        "released while adjusting.");
+}
+
+}  // namespace aerocal::python
