@@ -13,6 +13,7 @@
 #include "calib/core/result_file.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
+#include "tools/pushbroom_calibrate_run.h"
 #include "triangulation/block/block_io.h"
 #include "stitch/image_io/image_io.h"
 #include "triangulation/pushbroom/cloud_control.h"
@@ -23,15 +24,8 @@
 namespace aerocal::tools {
 namespace {
 
-struct CalibrateArgs {
-  std::string camera, pos, observations, points, out, write_camera, lines_csv, plot;
-  double sigma_px = 0.3;
-  std::string degree = "auto";
-  std::string datum = "gauge";
-  std::string pos_prior = "on";
-  std::string boresight = "fixed", lever_arm = "fixed";  // fixed | free | weighted
-  double boresight_sigma_deg = 0.0;
-  triangulation::LineCalibrationOptions options;
+struct CalibrateArgs : LineCalibrationRequest {
+  std::string out, write_camera, lines_csv, plot;
 };
 
 int RunCalibrate(CalibrateArgs& a) {
@@ -39,85 +33,19 @@ int RunCalibrate(CalibrateArgs& a) {
   if (!a.write_camera.empty()) CheckOutputFile(a.write_camera, "--write-camera");
   if (!a.lines_csv.empty()) CheckOutputFile(a.lines_csv, "--lines");
   if (!a.plot.empty()) CheckOutputFile(a.plot, "--plot");
-  auto& o = a.options;
-  if (a.degree != "auto") {
-    const auto d = ParseDouble(a.degree);
-    if (!d || *d != std::floor(*d)) throw ConfigError("--degree must be auto or 0 .. 5 (got '" + a.degree + "')");
-    o.degree = int(*d);
-  }
-  if (a.datum == "gauge")
-    o.datum = triangulation::LineDatum::kGauge;
-  else if (a.datum == "reference")
-    o.datum = triangulation::LineDatum::kReference;
-  else if (a.datum == "none")
-    o.datum = triangulation::LineDatum::kNone;
-  else
-    throw ConfigError("--datum must be gauge, reference or none (got '" + a.datum + "')");
-  if (a.pos_prior != "on" && a.pos_prior != "off")
-    throw ConfigError("--pos-prior must be on or off (got '" + a.pos_prior + "')");
-  o.pos_prior = a.pos_prior == "on";
-  o.boresight = triangulation::PlatformParamModeOption(a.boresight, "--boresight");
-  o.lever_arm = triangulation::PlatformParamModeOption(a.lever_arm, "--lever-arm");
-  o.boresight_sigma_rad = a.boresight_sigma_deg * M_PI / 180.0;
-  o.Validate();
-  const calib::LineCamera camera = calib::ReadLineCamera(a.camera);
-  const auto pos = triangulation::PosTrajectory::Read(a.pos);
-  const auto observations = triangulation::ReadLineObservations(a.observations, a.sigma_px);
-  const auto points = triangulation::ReadPoints(a.points);
-  const auto result =
-      triangulation::CalibrateLineCamera(camera, pos, observations, points, o, a.observations);
-  WriteResult(a.out, "pushbroom", triangulation::LineCalibrationToJson(result), 1);
+  const LineCalibrationRun run = RunLineCalibration(a);
+  const auto& result = run.result;
+  WriteResult(a.out, "pushbroom", run.json, 1);
   if (!a.lines_csv.empty()) WriteFileAtomically(a.lines_csv, triangulation::LineCorrectionsToCsv(result));
   if (!a.plot.empty())
-    WriteFileAtomically(a.plot, triangulation::LineCalibrationSvg(result, camera.name + " (" + a.observations + ")"));
+    WriteFileAtomically(a.plot, triangulation::LineCalibrationSvg(result, run.camera.name + " (" + a.observations + ")"));
   if (!a.write_camera.empty() && result.valid) calib::WriteLineCamera(a.write_camera, result.camera);
-  std::printf("pushbroom calibration: %d observations of %d control points, sigma0 %.3f (%.3f px), "
-              "redundancy %d, %s\n",
-              result.n_observations, result.n_control, result.report.sigma0, result.sigma0_px,
-              result.report.redundancy, result.report.converged ? "converged" : "NOT converged");
-  {
-    const auto& d = result.datum;
-    std::string names;
-    for (const auto& g : d.directions) names += (names.empty() ? "" : ", ") + g.name;
-    std::printf("  datum %s: rank defect %s without it, %d constraints%s%s%s\n",
-                triangulation::LineDatumName(d.mode),
-                d.null_space_computed ? std::to_string(d.rank_defect).c_str() : "not computed",
-                d.n_constraints, d.n_constraints ? " on " : "",
-                d.n_constraints ? d.blocks.front().c_str() : "",
-                names.empty() ? "" : (" (gauge: " + names + ")").c_str());
-  }
-  if (result.time_offset_estimated)
-    std::printf("  time offset: %.6f +- %s s\n", result.time_offset_s,
-                result.time_offset_sigma_s ? FormatNumber(*result.time_offset_sigma_s, 3).c_str()
-                                           : "(not determined)");
-  for (const auto& s : result.subcameras)
-    std::printf("  %-4s detectors %d..%d: %d obs, degree x %d y %d, RMS across %.3f -> %.3f px, "
-                "along %.3f -> %.3f px\n",
-                s.id.c_str(), s.first, s.last, s.n, s.degree_x, s.degree_y, s.across_before_px,
-                s.across_after_px, s.along_before_px, s.along_after_px);
-  const double deg = 180.0 / M_PI;
-  if (result.boresight != triangulation::PlatformParamMode::kFixed) {
-    const Eigen::Vector3d v = result.boresight_rad * deg;
-    const Eigen::Vector3d s = result.boresight_sigma_rad.value_or(Eigen::Vector3d::Constant(NAN)) * deg;
-    std::printf("  boresight (%s): omega %.5f +- %.5f, phi %.5f +- %.5f, kappa %.5f +- %.5f deg\n",
-                triangulation::PlatformParamModeName(result.boresight).c_str(), v.x(), s.x(), v.y(),
-                s.y(), v.z(), s.z());
-  }
-  if (result.lever_arm != triangulation::PlatformParamMode::kFixed) {
-    const Eigen::Vector3d& v = result.lever_arm_m;
-    const Eigen::Vector3d s = result.lever_arm_sigma_m.value_or(Eigen::Vector3d::Constant(NAN));
-    std::printf("  lever arm (%s): x %.4f +- %.4f, y %.4f +- %.4f, z %.4f +- %.4f m\n",
-                triangulation::PlatformParamModeName(result.lever_arm).c_str(), v.x(), s.x(), v.y(),
-                s.y(), v.z(), s.z());
-  }
-  for (const auto& [name, rho] : result.correlations)
-    std::printf("  correlation %s: %.4f\n", name.c_str(), rho);
-  for (const auto& w : result.warnings)
-    std::fprintf(stderr, "warning: %s (%s): %s\n", w.name.c_str(), w.subject.c_str(), w.message.c_str());
+  std::fputs(run.printed.c_str(), stdout);
+  std::fputs(run.errors.c_str(), stderr);
   if (!a.write_camera.empty() && !result.valid)
     std::fprintf(stderr, "warning: no camera written to %s: the result cannot be trusted\n",
                  a.write_camera.c_str());
-  return result.valid && result.report.converged ? kExitOk : kExitNotConverged;
+  return run.Ok() ? kExitOk : kExitNotConverged;
 }
 
 // Most cells of the L1 image of `pushbroom control` (two float maps and the image: about 1.2 GB).

@@ -384,3 +384,26 @@ def test_rig_stitch_equals_the_command(tmp_path):
     assert r.snooping["stopped"] is False
     with pytest.raises(ValueError, match="--mode must be line, per-exposure or angles"):
         aerocal.rig_stitch(camera, str(line), mode="spline")
+
+
+def test_pushbroom_calibrate_equals_the_command(tmp_path):
+    sim = tmp_path / "pb"
+    code, out = run("simulate", "--pushbroom", "--out", str(sim))
+    assert code == 0, out
+    files = [str(sim / f) for f in ("camera_nominal.yaml", "pos.csv", "observations.csv", "points.csv")]
+    cli = tmp_path / "cli.json"
+    code, out = run("pushbroom", "calibrate", "--camera", files[0], "--pos", files[1], "--observations",
+                    files[2], "--points", files[3], "--degree", "3", "--out", str(cli))
+    assert code in (0, 3), out
+    r = aerocal.pushbroom_calibrate(*files, degree=3)
+    assert r.valid == (code == 0)
+    with open(cli) as f:
+        expected = json.load(f)
+    assert _without_clock(json.loads(r.to_json())) == _without_clock(expected)
+    body = {k: v for k, v in expected.items() if k != "schema_version"}  # the file's envelope
+    assert _without_clock(r.document) == _without_clock(body)
+    assert r.printed.splitlines()[0] in out
+    with pytest.raises(TypeError, match="unknown option 'degre'"):
+        aerocal.pushbroom_calibrate(*files, degre=3)
+    with pytest.raises(ValueError, match="--datum must be gauge, reference or none"):
+        aerocal.pushbroom_calibrate(*files, datum="middle")

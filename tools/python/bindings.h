@@ -19,5 +19,7 @@ void BindResample(pybind11::module_& m);
 void BindCalibrate(pybind11::module_& m);
 /// rig_stitch(camera, project, ...) -> RigStitchResult: `aerocal rig stitch` from Python.
 void BindRig(pybind11::module_& m);
+/// pushbroom_calibrate(camera, pos, observations, points, **options) -> LineCalibrationResult.
+void BindPushbroom(pybind11::module_& m);
 
 }  // namespace aerocal::python

@@ -25,4 +25,5 @@ PYBIND11_MODULE(_aerocal, m) {
   aerocal::python::BindResample(m);
   aerocal::python::BindCalibrate(m);
   aerocal::python::BindRig(m);
+  aerocal::python::BindPushbroom(m);
 }

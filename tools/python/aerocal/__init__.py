@@ -29,6 +29,10 @@ Multi-head rigs
     rig_stitch(rig_camera_file, project, mode="line") -> RigStitchResult: valid, failures,
                rig_exposures, snooping, to_json()
 
+Pushbroom line cameras
+    pushbroom_calibrate(line_camera_file, pos_csv, observations_csv, points_csv, **options)
+        -> LineCalibrationResult: valid, sigma0, document, to_json()
+
 The virtual image (resampling the sub-images of one frame)
     resample(camera_file, stitch_json, {"I": "I.tif", ...}, frame="", interpolation="bilinear",
              fill=0, out="") -> numpy array (rows, cols[, bands]), uint8 or uint16
@@ -46,6 +50,7 @@ from ._aerocal import (
     CameraEstimate,
     ConfigError,
     InputError,
+    LineCalibrationResult,
     RigStitchResult,
     StitchResult,
     CalibrationResult,
@@ -54,6 +59,7 @@ from ._aerocal import (
     convert_camera,
     formats,
     models,
+    pushbroom_calibrate,
     resample,
     rig_stitch,
     stitch,
@@ -66,6 +72,7 @@ __all__ = [
     "CameraEstimate",
     "ConfigError",
     "InputError",
+    "LineCalibrationResult",
     "RigStitchResult",
     "StitchResult",
     "CalibrationResult",
@@ -74,6 +81,7 @@ __all__ = [
     "convert_camera",
     "formats",
     "models",
+    "pushbroom_calibrate",
     "resample",
     "rig_stitch",
     "stitch",
