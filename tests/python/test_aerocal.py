@@ -407,3 +407,17 @@ def test_pushbroom_calibrate_equals_the_command(tmp_path):
         aerocal.pushbroom_calibrate(*files, degre=3)
     with pytest.raises(ValueError, match="--datum must be gauge, reference or none"):
         aerocal.pushbroom_calibrate(*files, datum="middle")
+
+
+def test_rig_design_equals_the_command(tmp_path):
+    camera = os.path.join(SOURCE, "configs", "rig_uav4.yaml")
+    out = tmp_path / "design.json"
+    code, text = run("rig", "design", "--camera", camera, "--height-m", "300", "--out", str(out))
+    assert code == 0, text
+    with open(out) as f:
+        expected = json.load(f)
+    doc = aerocal.rig_design(camera, height_m=300)
+    assert doc == expected
+    assert doc["height_m"] == 300 and len(doc["heads"]) == 4 and doc["standard_positions"]
+    with pytest.raises(ValueError, match="grid_cells"):
+        aerocal.rig_design(camera, height_m=300, grid_cells=5)

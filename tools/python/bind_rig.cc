@@ -3,7 +3,9 @@
 // writes it (the stitched images stay with the command).
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
+#include "calib/camera/rig_io.h"
 #include "tools/python/bindings.h"
+#include "tools/rig_design_document.h"
 #include "tools/rig_stitch_run.h"
 
 #include <pybind11/stl.h>
@@ -55,6 +57,20 @@ RigStitchResult RigStitch(const std::string& camera, const std::string& project,
 
 py::object JsonValue(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
+// `aerocal rig design`: the design document as a dict (the command's --out file's content).
+py::object RigDesign(const std::string& camera, double height_m, int grid_cells) {
+  const calib::Rig rig = calib::ReadRig(camera);
+  const double height = tools::FlyingHeight(rig, height_m, camera);
+  if (grid_cells < 10 || grid_cells > 4000)
+    throw ConfigError("grid_cells must be within 10..4000 (got " + std::to_string(grid_cells) + ")");
+  stitch::RigDesign design;
+  {
+    py::gil_scoped_release release;
+    design = stitch::DesignRig(rig, height, grid_cells);
+  }
+  return JsonValue(nlohmann::json::parse(ResultText("rig_design", tools::RigDesignDocument(rig, camera, height, design, ""))));
+}
+
 }  // namespace
 
 void BindRig(py::module_& m) {
@@ -72,6 +88,11 @@ void BindRig(py::module_& m) {
                              "What the command prints")
       .def("to_json", [](const RigStitchResult& r) { return r.json; },
            "The result file's text, identical to `aerocal rig stitch --out`");
+  m.def("rig_design", &RigDesign, py::arg("camera"), py::arg("height_m") = 0.0, py::arg("grid_cells") = 400,
+        "The design figures of a multi-head rig as `aerocal rig design --camera CAMERA --out F` "
+        "writes them, as a dict: GSD change ratios of each head against the closed form, the "
+        "virtual format needed, covered area, effective format, overlap zones, standard tie "
+        "positions (height_m 0: the rig file's virtual.height_m).");
   m.def("rig_stitch", &RigStitch, py::arg("camera"), py::arg("project"), py::arg("mode") = "line",
         py::arg("no_snooping") = false, py::arg("alpha") = 0.05,
         py::arg("increment_sigma_arcsec") = py::none(), py::arg("dt_sigma_ms") = py::none(),

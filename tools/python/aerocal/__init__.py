@@ -26,6 +26,7 @@ Camera calibration (test field or planar board)
               board="chessboard:9x6:25") -> CalibrationResult: valid, sigma0, calibration, to_json()
 
 Multi-head rigs
+    rig_design(rig_camera_file, height_m=0) -> dict (GSD ratios, formats, zones, tie positions)
     rig_stitch(rig_camera_file, project, mode="line") -> RigStitchResult: valid, failures,
                rig_exposures, snooping, to_json()
 
@@ -61,6 +62,7 @@ from ._aerocal import (
     models,
     pushbroom_calibrate,
     resample,
+    rig_design,
     rig_stitch,
     stitch,
 )
@@ -83,6 +85,7 @@ __all__ = [
     "models",
     "pushbroom_calibrate",
     "resample",
+    "rig_design",
     "rig_stitch",
     "stitch",
 ]
