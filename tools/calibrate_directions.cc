@@ -12,6 +12,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
+#include "calib/core/string_printf.h"
 #include "tools/calibrate_models.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
@@ -74,11 +75,11 @@ nlohmann::json MethodJson(const triangulation::DirectionRun& d, const triangulat
 }
 
 // The camera file written in the requested format: the --model run's camera when it was given.
-nlohmann::json WriteCamera(const DirectionsArgs& args, const calib::Camera& camera,
+nlohmann::json WriteCamera(const DirectionsArgs& args, std::string* printed, const calib::Camera& camera,
                            const triangulation::CameraEstimate& estimate) {
   const calib::ConversionResult written = WriteCameraInFormat(
       args.write_camera, triangulation::UpdatedCamera(camera, estimate), args.camera_format, &estimate.sigma);
-  std::printf("camera (%s) -> %s (%s)\n", std::string(calib::CameraModelName(estimate.model)).c_str(),
+  *printed += StringPrintf("camera (%s) -> %s (%s)\n", std::string(calib::CameraModelName(estimate.model)).c_str(),
               args.write_camera.c_str(), args.camera_format.c_str());
   return {{"file", args.write_camera},
           {"format", args.camera_format},
@@ -92,7 +93,8 @@ nlohmann::json WriteCamera(const DirectionsArgs& args, const calib::Camera& came
 
 }  // namespace
 
-int CalibrateFromDirectionsFile(const DirectionsArgs& args) {
+CalibrateOutcome CalibrateFromDirections(const DirectionsArgs& args) {
+  CalibrateOutcome outcome;
   const calib::Camera camera = calib::ReadCamera(args.camera, calib::CameraModels::kAny);
   const calib::CameraModelId beside_model = args.model.empty() ? camera.model : ModelOfOption(args.model);
   triangulation::DirectionRunOptions options;
@@ -100,7 +102,7 @@ int CalibrateFromDirectionsFile(const DirectionsArgs& args) {
       args.self_calibration.empty() ? DefaultSelfCalibration(camera.model) : args.self_calibration, camera.model);
   if (options.calibration.free_interior.empty())
     throw ConfigError("--self-calibration: calibrate needs at least one parameter (got none)");
-  CheckOutputFile(args.out, "--out");
+  if (!args.out.empty()) CheckOutputFile(args.out, "--out");
   if (!args.write_camera.empty()) CheckOutputFile(args.write_camera, "--write-camera");
   FindCameraFormat(args.camera_format, "--camera-format");
   triangulation::BudgetOptions budget;
@@ -122,7 +124,7 @@ int CalibrateFromDirectionsFile(const DirectionsArgs& args) {
   const triangulation::CalibrationRun& run = d.run;
   const auto budget_table = triangulation::UncertaintyBudget(run, run.project, budget);
   const triangulation::AdjustmentResult& r = run.all.result;
-  std::printf("%s (%s): %s", d.all.method.c_str(), args.directions.c_str(), triangulation::FormatSummary(r).c_str());
+  outcome.printed += StringPrintf("%s (%s): %s", d.all.method.c_str(), args.directions.c_str(), triangulation::FormatSummary(r).c_str());
 
   nlohmann::json json = triangulation::AdjustmentToJson(r);
   json["command"] = "calibrate";
@@ -150,7 +152,7 @@ int CalibrateFromDirectionsFile(const DirectionsArgs& args) {
                    {"format_px", {camera.width_px, camera.height_px}}};
   cal["model"] = std::string(calib::CameraModelName(camera.model));
   cal["rms_px"] = RmsPx(r);
-  for (const auto& q : budget_table) std::printf("  %s\n", q.statement.c_str());
+  for (const auto& q : budget_table) outcome.printed += StringPrintf("  %s\n", q.statement.c_str());
   AddStabilityWarnings(run.stability, &json);
   // --model: the same directions calibrated in that model (its camera is what --write-camera writes).
   std::optional<calib::Camera> beside_start;
@@ -167,7 +169,7 @@ int CalibrateFromDirectionsFile(const DirectionsArgs& args) {
     b["model"] = std::string(calib::CameraModelName(beside_model));
     b["self_calibration"] = in_model.calibration.free_interior;
     b["rms_px"] = RmsPx(o);
-    std::printf("beside, in model %s: sigma0 %.4f, RMS %.4f px%s\n",
+    outcome.printed += StringPrintf("beside, in model %s: sigma0 %.4f, RMS %.4f px%s\n",
                 std::string(calib::CameraModelName(beside_model)).c_str(), o.sigma0, RmsPx(o),
                 o.valid ? "" : " (not valid)");
     cal["beside"] = b;
@@ -176,17 +178,26 @@ int CalibrateFromDirectionsFile(const DirectionsArgs& args) {
   // Only a valid result is written as a camera file (a file that exists is one the next run may use).
   if (!args.write_camera.empty()) {
     if (beside_start && beside)
-      cal["camera_written"] = WriteCamera(args, *beside_start, *beside);
+      cal["camera_written"] = WriteCamera(args, &outcome.printed, *beside_start, *beside);
     else if (!beside_start && r.valid)
-      cal["camera_written"] = WriteCamera(args, camera, r.cameras[0]);
+      cal["camera_written"] = WriteCamera(args, &outcome.printed, camera, r.cameras[0]);
     else
-      std::fprintf(stderr, "camera not written: the %sresult is not valid\n", beside_start ? "--model " : "");
+      outcome.errors += StringPrintf("camera not written: the %sresult is not valid\n", beside_start ? "--model " : "");
   }
   json["calibration"] = cal;
-  WriteResult(args.out, "adjust", json);
-  for (const auto& reason : r.invalid_reasons) std::fprintf(stderr, "calibrate: not valid: %s\n", reason.c_str());
+  for (const auto& reason : r.invalid_reasons) outcome.errors += "calibrate: not valid: " + reason + "\n";
+  outcome.doc = std::move(json);
+  outcome.valid = r.valid && run.stability.agree;
+  return outcome;
+}
+
+int CalibrateFromDirectionsFile(const DirectionsArgs& args) {
+  const CalibrateOutcome outcome = CalibrateFromDirections(args);
+  std::fputs(outcome.printed.c_str(), stdout);
+  std::fputs(outcome.errors.c_str(), stderr);
+  WriteResult(args.out, "adjust", outcome.doc);
   std::printf("result -> %s\n", args.out.c_str());
-  return r.valid && run.stability.agree ? kExitOk : kExitNotConverged;
+  return outcome.valid ? kExitOk : kExitNotConverged;
 }
 
 }  // namespace aerocal::tools

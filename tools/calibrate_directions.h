@@ -8,6 +8,8 @@
 #include <string>
 #include <vector>
 
+#include "tools/calibrate_request.h"
+
 namespace aerocal::tools {
 
 struct DirectionsArgs {
@@ -18,8 +20,12 @@ struct DirectionsArgs {
   std::vector<double> radii_mm;  // certified distortion radii (default: 1/4 .. 4/4 of the half diagonal)
 };
 
-/// Runs the calibration; the exit code (0 valid and the groups agree, 3 otherwise). Throws
-/// InputError / ConfigError on bad input before anything is written.
+/// Runs the calibration and writes --write-camera (not the result file; `out` is checked when
+/// given). Throws InputError / ConfigError on bad input before anything is written.
+CalibrateOutcome CalibrateFromDirections(const DirectionsArgs& args);
+
+/// The command: CalibrateFromDirections, its lines printed, the result file written; the exit
+/// code (0 valid and the groups agree, 3 otherwise).
 int CalibrateFromDirectionsFile(const DirectionsArgs& args);
 
 }  // namespace aerocal::tools

@@ -421,3 +421,30 @@ def test_rig_design_equals_the_command(tmp_path):
     assert doc["height_m"] == 300 and len(doc["heads"]) == 4 and doc["standard_positions"]
     with pytest.raises(ValueError, match="grid_cells"):
         aerocal.rig_design(camera, height_m=300, grid_cells=5)
+
+
+def test_calibrate_from_directions_equals_the_command(tmp_path):
+    camera = tmp_path / "camera.yaml"
+    camera.write_text("name: lab\npixel_size_mm: 0.006\nformat_px: [6000, 4000]\ninterior: {c: 50.0}\n")
+    # A 9 x 9 collimator array: t = (sin a cos e, sin e, -cos a cos e) (docs/formats.md), measured
+    # through the camera file's own camera with 0.05 px noise.
+    a, e = np.meshgrid(np.radians(np.linspace(-17, 17, 9)), np.radians(np.linspace(-11, 11, 9)))
+    t = np.stack([np.sin(a) * np.cos(e), np.sin(e), -np.cos(a) * np.cos(e)], axis=-1).reshape(-1, 3)
+    pixels = aerocal.Camera.read(str(camera)).ray_to_image(t[:, :2] / -t[:, 2:3])
+    pixels += np.random.default_rng(5).normal(0.0, 0.05, pixels.shape)
+    rows = ["target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec"]
+    for k, (p, ak, ek) in enumerate(zip(pixels, np.degrees(a).ravel(), np.degrees(e).ravel())):
+        rows.append(f"C{k},{p[0]:.5f},{p[1]:.5f},0.05,{ak:.6f},{ek:.6f},0.5")
+    directions = tmp_path / "directions.csv"
+    directions.write_text("\n".join(rows) + "\n")
+    cli = tmp_path / "cli.json"
+    code, out = run("calibrate", "--camera", str(camera), "--directions", str(directions), "--out", str(cli))
+    assert code in (0, 3), out
+    r = aerocal.calibrate(str(camera), directions=str(directions))
+    assert r.valid == (code == 0)
+    with open(cli) as f:
+        expected = json.load(f)
+    assert _without_clock(json.loads(r.to_json())) == _without_clock(expected)
+    assert r.calibration["method"] == expected["calibration"]["method"]
+    with pytest.raises(ValueError, match="give either directions"):
+        aerocal.calibrate(str(camera), directions=str(directions), observations=str(directions))

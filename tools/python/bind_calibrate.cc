@@ -3,6 +3,7 @@
 // document as the command writes it.
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
+#include "tools/calibrate_directions.h"
 #include "tools/calibrate_request.h"
 #include "tools/python/bindings.h"
 
@@ -20,7 +21,8 @@ struct CalibrationResult {
 
 std::string Text(const py::object& value) { return value.is_none() ? "" : py::str(value).cast<std::string>(); }
 
-CalibrationResult Calibrate(const std::string& camera, const py::object& observations, const py::object& points,
+CalibrationResult Calibrate(const std::string& camera, const py::object& directions,
+                            const py::object& observations, const py::object& points,
                             const py::object& images, const py::object& board, const py::object& groups,
                             const py::object& budget, const py::object& self_calibration,
                             const py::object& model, double sigma_px, double board_sigma_mm,
@@ -34,6 +36,31 @@ CalibrationResult Calibrate(const std::string& camera, const py::object& observa
     throw ConfigError("suspect_effect_limit: must be in (0, 1000]");
   for (const double r : radii_mm)
     if (!(r > 0 && r <= 1e4)) throw ConfigError("radii_mm: each must be in (0, 10000]");
+  if (!directions.is_none()) {  // a collimator array or a goniometer sequence
+    if (!observations.is_none() || !points.is_none() || !images.is_none() || !board.is_none())
+      throw ConfigError("directions: give either directions, or observations and points, or images and board");
+    if (!groups.is_none() || !write_marks.is_none() || no_snooping || no_closed_form)
+      throw ConfigError("groups, write_marks, no_snooping, no_closed_form: not options of a direction calibration");
+    tools::DirectionsArgs args;
+    args.camera = camera;
+    args.directions = Text(directions);
+    args.budget = Text(budget);
+    args.out = Text(out);
+    args.write_camera = Text(write_camera);
+    args.camera_format = camera_format;
+    args.self_calibration = Text(self_calibration);
+    args.model = Text(model);
+    args.sigma_px = sigma_px;
+    args.radii_mm = radii_mm;
+    CalibrationResult result;
+    {
+      py::gil_scoped_release release;
+      result.outcome = tools::CalibrateFromDirections(args);
+    }
+    result.json = ResultText("adjust", result.outcome.doc);
+    if (!args.out.empty()) WriteResult(args.out, "adjust", result.outcome.doc);
+    return result;
+  }
   tools::CalibrateRequest request;
   request.camera = camera;
   request.observations = Text(observations);
@@ -82,7 +109,8 @@ void BindCalibrate(py::module_& m) {
                              "What the command prints")
       .def("to_json", [](const CalibrationResult& r) { return r.json; },
            "The result file's text, identical to `aerocal calibrate --out`");
-  m.def("calibrate", &Calibrate, py::arg("camera"), py::arg("observations") = py::none(),
+  m.def("calibrate", &Calibrate, py::arg("camera"), py::arg("directions") = py::none(),
+        py::arg("observations") = py::none(),
         py::arg("points") = py::none(), py::arg("images") = py::none(), py::arg("board") = py::none(),
         py::arg("groups") = py::none(), py::arg("budget") = py::none(),
         py::arg("self_calibration") = py::none(), py::arg("model") = py::none(),
@@ -92,7 +120,8 @@ void BindCalibrate(py::module_& m) {
         py::arg("write_camera") = py::none(), py::arg("camera_format") = "aerocal",
         py::arg("write_marks") = py::none(), py::arg("out") = py::none(),
         "Camera calibration as `aerocal calibrate`: a test field (observations, points: the CSV "
-        "files) or a planar board (images: a glob, board: 'chessboard:9x6:25'); groups, budget, "
+        "files), a planar board (images: a glob, board: 'chessboard:9x6:25') or known directions "
+        "(directions: a collimator array or goniometer file); groups, budget, "
         "self_calibration, model, ... as the command's options (`-` -> `_`). A result that is not "
         "valid comes back with valid=False. The GIL is released while calibrating.");
 }

@@ -132,7 +132,7 @@ class CalibrationResult:
     def printed(self) -> str: ...
     def to_json(self) -> str: ...
 
-def calibrate(camera: str, observations: Optional[str] = None, points: Optional[str] = None,
+def calibrate(camera: str, directions: Optional[str] = None, observations: Optional[str] = None, points: Optional[str] = None,
               images: Optional[str] = None, board: Optional[str] = None,
               groups: Optional[str] = None, budget: Optional[str] = None,
               self_calibration: Optional[str] = None, model: Optional[str] = None,
