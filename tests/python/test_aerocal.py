@@ -448,3 +448,45 @@ def test_calibrate_from_directions_equals_the_command(tmp_path):
     assert r.calibration["method"] == expected["calibration"]["method"]
     with pytest.raises(ValueError, match="give either directions"):
         aerocal.calibrate(str(camera), directions=str(directions), observations=str(directions))
+
+
+MATCH_CAMERA = """name: small
+pixel_size_mm: 0.009
+format_px: [600, 400]
+interior: {c: 50}
+subimages:
+  - {id: I, format_px: [340, 240], model: affine, params: [1, 0, 0, 0, 1, 0]}
+  - {id: II, format_px: [340, 240], model: affine, params: [1, 0, 260, 0, 1, 0]}
+  - {id: III, format_px: [340, 240], model: affine, params: [1, 0, 0, 0, 1, 160]}
+  - {id: IV, format_px: [340, 240], model: affine, params: [1, 0, 260, 0, 1, 160]}
+"""
+
+
+def test_match_equals_the_command(tmp_path):
+    from PIL import Image
+    camera = tmp_path / "camera.yaml"
+    camera.write_text(MATCH_CAMERA)
+    # One scene of the 600 x 400 virtual format (white noise low-passed by a Gaussian of 2 px),
+    # cut along the nominal mappings into four 340 x 240 sub-images with 80 px overlaps.
+    noise = np.random.default_rng(7).normal(size=(400, 600))
+    fy, fx = np.fft.fftfreq(400)[:, None], np.fft.fftfreq(600)[None, :]
+    scene = np.real(np.fft.ifft2(np.fft.fft2(noise) * np.exp(-2 * np.pi ** 2 * 4.0 * (fx ** 2 + fy ** 2))))
+    scene = (255 * (scene - scene.min()) / (scene.max() - scene.min())).astype(np.uint8)
+    images = {}
+    for sid, (e, f) in {"I": (0, 0), "II": (260, 0), "III": (0, 160), "IV": (260, 160)}.items():
+        path = tmp_path / f"{sid}.png"
+        Image.fromarray(scene[f:f + 240, e:e + 340]).save(path)
+        images[sid] = str(path)
+    text = ",".join(f"{k}={v}" for k, v in images.items())
+    cli = tmp_path / "cli.csv"
+    code, out = run("match", "--camera", str(camera), "--frame", "1", "--images", text, "--out", str(cli))
+    assert code == 0, out
+    py_csv = tmp_path / "py.csv"
+    r = aerocal.match(str(camera), images, frame="1", out=str(py_csv))
+    assert py_csv.read_text() == cli.read_text()  # the command's file, byte for byte
+    n = len(r["point"])
+    assert n > 0 and r["pixel"].shape == (n, 2) and r["sigma_px"].shape == (n,)
+    assert set(r["subimage"]) <= set(images) and set(r["frame"]) == {"1"}
+    assert r["table"].splitlines()[0].split()[:2] == ["frame", "strip"]
+    with pytest.raises(ValueError, match="--images needs --frame"):
+        aerocal.match(str(camera), images)

@@ -16,16 +16,6 @@ namespace {
 
 namespace py = pybind11;
 
-// "I=a.tif,II=b.tif": the --images text of a {id: path} dict, or the text itself.
-std::string ImagesText(const py::object& images) {
-  if (py::isinstance<py::str>(images)) return images.cast<std::string>();
-  std::string text;
-  for (const auto& [id, path] : images.cast<py::dict>())
-    text += (text.empty() ? "" : ",") + py::str(id).cast<std::string>() + "=" +
-            py::str(path).cast<std::string>();
-  return text;
-}
-
 template <typename T>
 py::array Pixels(const stitch::MemoryRaster& raster) {
   const stitch::RasterInfo info = raster.Info();
@@ -48,7 +38,7 @@ py::array Resample(const std::string& camera,
   request.camera = camera;
   request.mapping = mapping;
   request.frame = frame;
-  request.images = ImagesText(images);
+  request.images = ImagesOptionText(images);
   request.interpolation = interpolation;
   request.fill = fill;
   tools::PreparedResample p = tools::PrepareResample(request);
@@ -68,6 +58,15 @@ py::array Resample(const std::string& camera,
 }
 
 }  // namespace
+
+std::string ImagesOptionText(const py::object& images) {
+  if (images.is_none()) return "";
+  if (py::isinstance<py::str>(images)) return images.cast<std::string>();
+  std::string text;
+  for (const auto& [id, path] : images.cast<py::dict>())
+    text += (text.empty() ? "" : ",") + py::str(id).cast<std::string>() + "=" + py::str(path).cast<std::string>();
+  return text;
+}
 
 void BindResample(py::module_& m) {
   m.def("resample",

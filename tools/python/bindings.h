@@ -5,7 +5,13 @@
 
 #include <pybind11/pybind11.h>
 
+#include <string>
+
 namespace aerocal::python {
+
+/// The `--images` text "I=a.tif,II=b.tif" of a {sub-image id: file} dict, the text itself, or ""
+/// for None (resample, match).
+std::string ImagesOptionText(const pybind11::object& images);
 
 /// Camera: read/write in any registered format, parameters by name, image <-> ray, conversion.
 void BindCamera(pybind11::module_& m);
@@ -21,5 +27,7 @@ void BindCalibrate(pybind11::module_& m);
 void BindRig(pybind11::module_& m);
 /// pushbroom_calibrate(camera, pos, observations, points, **options) -> LineCalibrationResult.
 void BindPushbroom(pybind11::module_& m);
+/// match(camera, images, frame, ...) -> dict of numpy columns: `aerocal match` from Python.
+void BindMatch(pybind11::module_& m);
 
 }  // namespace aerocal::python

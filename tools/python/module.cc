@@ -26,4 +26,5 @@ PYBIND11_MODULE(_aerocal, m) {
   aerocal::python::BindCalibrate(m);
   aerocal::python::BindRig(m);
   aerocal::python::BindPushbroom(m);
+  aerocal::python::BindMatch(m);
 }

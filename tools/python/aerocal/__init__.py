@@ -18,6 +18,7 @@ Blocks and the adjustment
     result.covariance(["camera cam1"]); adjust(..., progress=lambda done, total: ...)
 
 Sub-image stitching (multi-CCD cameras)
+    match(camera_file, {"I": "I.tif", ...}, frame="1") -> {frame, point, subimage, pixel, sigma_px}
     stitch(camera_file, stitch_obs_csv, model="auto") -> StitchResult
     result.frames[i]["subimages"]["II"]["params"], result.stability, result.to_json()
 
@@ -59,6 +60,7 @@ from ._aerocal import (
     calibrate,
     convert_camera,
     formats,
+    match,
     models,
     pushbroom_calibrate,
     resample,
@@ -82,6 +84,7 @@ __all__ = [
     "calibrate",
     "convert_camera",
     "formats",
+    "match",
     "models",
     "pushbroom_calibrate",
     "resample",

@@ -183,3 +183,7 @@ class LineCalibrationResult:
 
 def pushbroom_calibrate(camera: str, pos: str, observations: str, points: str,
                         **options: Any) -> LineCalibrationResult: ...
+
+def match(camera: str, images: Union[Mapping[str, str], str, None] = None, frame: str = "",
+          list: Optional[str] = None, detector: str = "sift", lsm: bool = True,
+          sigma_px: float = 0.3, cell_px: float = 100.0, out: str = "") -> Dict[str, Any]: ...
