@@ -17,7 +17,7 @@ from report_html import Cell, esc, fmt, note, num, table, text
 
 NEW_STRIP_TURN_DEG = 45.0   # heading change that starts a new strip
 NEW_STRIP_STEP_RATIO = 2.5  # a step this many times the median step starts a new strip
-NADIR_LIMIT_DEG = 10.0      # omega and phi below this: a vertical (aerial) image
+NADIR_LIMIT_DEG = 15.0      # omega and phi below this: a near-vertical (aerial, UAV) image
 
 
 def _used_exposures(adjustment):
