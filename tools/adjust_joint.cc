@@ -8,6 +8,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/file_digest.h"
 #include "calib/core/result_file.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
@@ -21,6 +22,17 @@ std::string CameraOutputPath(const std::string& out, const std::string& id, bool
   if (!several) return out;
   const std::filesystem::path p(out);
   return (p.parent_path() / (p.stem().string() + "_" + id + p.extension().string())).string();
+}
+
+void AddProjectFacts(const triangulation::Project& input, nlohmann::json* json) {
+  (*json)["aerocal_version"] = AEROCAL_VERSION;
+  (*json)["inputs"] = InputFilesToJson(triangulation::ProjectFiles(input));
+  const calib::Camera& camera = input.cameras.begin()->second;
+  (*json)["camera_format"] = {{"width_px", camera.width_px},
+                              {"height_px", camera.height_px},
+                              {"pixel_size_mm", camera.pixel_size_mm}};
+  (*json)["camera_names"] = nlohmann::json::object();
+  for (const auto& [id, c] : input.cameras) (*json)["camera_names"][id] = c.name;
 }
 
 int FinishAdjust(const triangulation::AdjustmentResult& result,
@@ -108,6 +120,7 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
               triangulation::FormatJointSummary(result).c_str());
   nlohmann::json json = triangulation::JointResultToJson(result);
   json["project"] = project_path;
+  AddProjectFacts(input, &json);
   // As the plain adjustment: exit 3 and no camera when the result is not valid.
   return FinishAdjust(result.adjustment, json, out, write_camera, "camera", [&] {
     const auto& cameras = result.adjustment.cameras;

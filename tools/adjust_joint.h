@@ -39,6 +39,13 @@ int FinishAdjust(const triangulation::AdjustmentResult& result,
                  const std::string& camera_kind,
                  const std::function<void()>& write_cameras);
 
+/// The facts of the project an `adjust` result describes, for its report (tools/report):
+/// `aerocal_version`, `inputs`
+/// (every file read, with its size and SHA-256, calib/core/file_digest.h), `camera_format` (the
+/// first camera's width_px, height_px, pixel_size_mm) and `camera_names` ({id: the camera file's
+/// `name`}). Throws InputError when a file cannot be read again.
+void AddProjectFacts(const triangulation::Project& input, nlohmann::json* json);
+
 /// Adds --joint-stitching, --joint-model, --base and --stitch-sigma-px (the last three need the
 /// first).
 void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args);
