@@ -21,6 +21,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/progress.h"
 #include "calib/core/result_file.h"
 #include "stitch/rig/error_analysis.h"
 #include "stitch/rig/error_analysis_json.h"
@@ -451,6 +452,7 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
   for (const auto& e : in.exposures)  // every head image present before anything is computed
     for (const auto& head : rig.heads) HeadImagePath(images, e.image, head.id);
   stitch::RigTieMatches matches;
+  Progress progress("rig tie matching", static_cast<long>(in.exposures.size()));
   for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i) {
     std::vector<stitch::GrayImage> heads;
     for (const auto& head : rig.heads) {
@@ -463,6 +465,7 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
                          std::to_string(head.camera.height_px) + " px");
     }
     stitch::MatchRigExposureTies(rig, in.exposures[i], i, heads, {}, &matches);
+    progress.Advance();
   }
   double sum2 = 0.0;
   for (double sigma : matches.lsm_sigma_px) sum2 += sigma * sigma;
@@ -482,7 +485,9 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
   options.balance = !args.no_balance;
   options.feather_px = args.feather_px;
   nlohmann::json out = nlohmann::json::array();
+  Progress progress("stitched images", static_cast<long>(exposures.size()));
   for (const auto& e : exposures) {
+    progress.Stage(e.image);
     const auto refined = std::find_if(result.exposures.begin(), result.exposures.end(),
                                       [&](const auto& r) { return r.image == e.image; });
     if (refined == result.exposures.end()) continue;
@@ -545,6 +550,7 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
                 e.image.c_str(), r.width_px, r.height_px, r.valid_pixels, r.overall.rms_dn,
                 r.overall.pixels, image_path.c_str());
     for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", e.image.c_str(), w.c_str());
+    progress.Advance();
   }
   return out;
 }
