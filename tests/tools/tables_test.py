@@ -82,6 +82,23 @@ class FlightTables(unittest.TestCase):
             self.assertGreater(len(frame.columns), 1, name)
 
 
+class BadInput(unittest.TestCase):
+    def test_a_result_of_another_kind_is_exit_2_and_writes_nothing(self):
+        with tempfile.TemporaryDirectory() as tmp:
+            other = os.path.join(tmp, "stitch.json")
+            with open(other, "w") as f:
+                json.dump({"kind": "stitch", "schema_version": 1}, f)
+            out = os.path.join(tmp, "tables")
+            r = runs.aerocal("export", "--result", other, "--tables", out, ok=(2,))
+            self.assertIn("stitch.json", r.stderr)
+            self.assertFalse(os.path.exists(out) and os.listdir(out))
+
+    def test_tables_and_write_crs_exclude_each_other(self):
+        r = runs.aerocal("export", "--result", runs.FIXTURE, "--tables", "t", "--write-crs", "EPSG:4326", "--out", "o",
+                         ok=(2,))
+        self.assertIn("--tables", r.stderr + r.stdout)
+
+
 class OdmTables(unittest.TestCase):
     """The real ODM block in WGS 84 / UTM 22S: the GeoJSON in the project's CRS."""
 
