@@ -8,7 +8,6 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
-#include "calib/core/file_digest.h"
 #include "calib/core/result_file.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
@@ -22,17 +21,6 @@ std::string CameraOutputPath(const std::string& out, const std::string& id, bool
   if (!several) return out;
   const std::filesystem::path p(out);
   return (p.parent_path() / (p.stem().string() + "_" + id + p.extension().string())).string();
-}
-
-void AddProjectFacts(const triangulation::Project& input, nlohmann::json* json) {
-  (*json)["aerocal_version"] = AEROCAL_VERSION;
-  (*json)["inputs"] = InputFilesToJson(triangulation::ProjectFiles(input));
-  const calib::Camera& camera = input.cameras.begin()->second;
-  (*json)["camera_format"] = {{"width_px", camera.width_px},
-                              {"height_px", camera.height_px},
-                              {"pixel_size_mm", camera.pixel_size_mm}};
-  (*json)["camera_names"] = nlohmann::json::object();
-  for (const auto& [id, c] : input.cameras) (*json)["camera_names"][id] = c.name;
 }
 
 int FinishAdjust(const triangulation::AdjustmentResult& result,

@@ -13,6 +13,7 @@
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
+#include "tools/project_facts.h"
 
 namespace aerocal::tools {
 
@@ -38,13 +39,6 @@ int FinishAdjust(const triangulation::AdjustmentResult& result,
                  const std::string& write_camera,
                  const std::string& camera_kind,
                  const std::function<void()>& write_cameras);
-
-/// The facts of the project an `adjust` result describes, for its report (tools/report):
-/// `aerocal_version`, `inputs`
-/// (every file read, with its size and SHA-256, calib/core/file_digest.h), `camera_format` (the
-/// first camera's width_px, height_px, pixel_size_mm) and `camera_names` ({id: the camera file's
-/// `name`}). Throws InputError when a file cannot be read again.
-void AddProjectFacts(const triangulation::Project& input, nlohmann::json* json);
 
 /// Adds --joint-stitching, --joint-model, --base and --stitch-sigma-px (the last three need the
 /// first).
