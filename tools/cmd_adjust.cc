@@ -106,7 +106,7 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option(
          "--project", args->project, "Project YAML (or folder with project.yaml), FORMATS.md")
       ->required();
-  app.add_option("--out", args->out, "Result JSON (written atomically)")->required();
+  app.add_option("--out", args->out, "Output file: the result JSON (written atomically)")->required();
   app.add_option("--self-calibration",
                  args->self_calibration,
                  "Interior parameters to estimate: none (conventional, default), auto (those of "

@@ -222,7 +222,7 @@ std::function<int()> AddSlurm(CLI::App& batch) {
   s->add_option("--time", o->time_limit, "Time limit of a task, Slurm's format (e.g. 01:00:00)");
   s->add_option("--account", o->account, "Slurm account");
   s->add_option("--aerocal", o->aerocal, "The aerocal the jobs run (default: this one)");
-  s->add_option("--out", o->out, "Folder of units.sbatch, merge.sbatch, submit.sh")->required();
+  s->add_option("--out", o->out, "Output folder: units.sbatch, merge.sbatch, submit.sh")->required();
   return [manifest, o] {
     CheckOutputFolder(o->out, "--out");
     if (o->aerocal.empty()) o->aerocal = ThisExecutable();

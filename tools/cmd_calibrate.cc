@@ -159,7 +159,7 @@ CommandRun SetupCalibrate(CLI::App& app) {
                                     "Planar target: start from the camera file's c, not Zhang's closed form"));
   field_only.push_back(app.add_option("--write-marks", args->write_marks,
                                       "Write the detected marks as DIR/observations.csv and DIR/points.csv"));
-  app.add_option("--out", args->out, "Result JSON (keys of `adjust` plus `calibration`)")
+  app.add_option("--out", args->out, "Output file: the result JSON (keys of `adjust` plus `calibration`)")
       ->required();
   app.add_option("--write-camera", args->write_camera,
                  "Write the calibrated camera (only when the result is valid)");

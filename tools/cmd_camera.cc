@@ -50,7 +50,7 @@ struct ReadArgs {
         ->check(FiniteRange(1, 1000000));
     app->add_option("--height", height, "Image height in px, as --width")
         ->check(FiniteRange(1, 1000000));
-    app->add_option("--pixel-mm", pixel_mm, "Pixel size in mm where the file has none")
+    app->add_option("--pixel-size-mm", pixel_mm, "Pixel size in mm where the file has none")
         ->check(FiniteRange(1e-5, 1.0));
   }
   CameraFile Read() const {

@@ -52,7 +52,8 @@ CommandRun SetupExport(CLI::App& app) {
       ->required();
   auto* write_crs = app.add_option("--write-crs", args->write_crs,
                                    "CRS to write (EPSG code, compound EPSG:A+B, WKT or PROJ string)");
-  auto* out = app.add_option("--out", args->out, "Output folder of --write-crs");
+  auto* out = app.add_option("--out", args->out,
+                             "Output folder: exposures, points and check-point errors in --write-crs");
   auto* tables = app.add_option(
       "--tables", args->tables,
       "Output folder: every table of the result as CSV (exposures, points, point errors, "

@@ -87,7 +87,7 @@ CommandRun SetupImport(CLI::App& app) {
   CLI::App* colmap =
       app.add_subcommand("colmap", "COLMAP text model (cameras.txt, images.txt, points3D.txt)");
   auto c = std::make_shared<triangulation::ColmapImportOptions>();
-  colmap->add_option("--model", c->folder, "Folder of the text model")->required();
+  colmap->add_option("--colmap-model", c->folder, "Folder of the COLMAP text model (cameras.txt, images.txt, points3D.txt)")->required();
   colmap->add_option("--pixel-size-mm", c->pixel_size_mm, "Pixel size, mm (COLMAP has none)")
       ->check(PositiveUpTo(1));
   colmap->add_option("--sigma-px", c->sigma_px, "Image sigma, px")->check(PositiveUpTo(100));

@@ -144,12 +144,12 @@ CommandRun Setup(CLI::App& app) {
   app.add_option("--images", args->images, "Sub-image files of the frame: I=a.tif,II=b.tif,...");
   app.add_option("--list", args->list,
                  "Flight: CSV frame,subimage,image (paths relative to the list file)");
-  app.add_option("--out", args->out, "stitch_obs.csv to write")->required();
+  app.add_option("--out", args->out, "Output file: the stitching observations (stitch_obs.csv)")->required();
   app.add_option("--detector", args->detector, "sift | foerstner (on Wallis-filtered strips)")
       ->capture_default_str();
   app.add_option("--lsm", args->lsm, "on | off: least-squares matching refinement")
       ->capture_default_str();
-  app.add_option("--sigma", args->sigma_px,
+  app.add_option("--sigma-px", args->sigma_px,
                  "sigma_px (px) written without LSM, and for rows of an appended file lacking it")->check(PositiveUpTo(100))
       ->capture_default_str();
   app.add_option("--cell", args->cell_px, "Grid cell along the strips (virtual px): one tie each")->check(FiniteRange(1, 1e5))

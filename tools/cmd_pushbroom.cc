@@ -146,7 +146,7 @@ std::string ReferenceImagePath(const std::string& folder, const triangulation::E
 int RunControl(ControlArgs& a) {
   if (a.reference_exposures.empty() == a.reference_result.empty())
     throw ConfigError("give one of --reference-exposures and --reference-result");
-  CheckOutputFolder(a.out, "--out-dir");
+  CheckOutputFolder(a.out, "--out");
   a.options.Validate();
   const calib::LineCamera camera = calib::ReadLineCamera(a.camera);
   const auto pos = triangulation::PosTrajectory::Read(a.pos);
@@ -236,7 +236,7 @@ CommandRun Setup(CLI::App& app) {
       ->required();
   cal->add_option("--points", args->points, "points.csv: control points with sX,sY,sZ (others ignored)")
       ->required();
-  cal->add_option("--out", args->out, "result.json")->required();
+  cal->add_option("--out", args->out, "Output file: the result JSON")->required();
   cal->add_option("--write-camera", args->write_camera,
                   "The updated camera file (written only when the result is valid)");
   cal->add_option("--lines", args->lines_csv, "Per-line corrections with sigmas (CSV)");
@@ -305,8 +305,8 @@ CommandRun Setup(CLI::App& app) {
   ctl->add_option("--reference-images", control_args->reference_images,
                   "Folder of the reference images (named by their exposure id, .png/.tif/.jpg)")
       ->required();
-  ctl->add_option("--out-dir", control_args->out,
-                  "Writes observations.csv, points.csv, control.json (and l1.png)")->required();
+  ctl->add_option("--out", control_args->out,
+                  "Output folder: observations.csv, points.csv, control.json (and l1.png)")->required();
   ctl->add_option("--mean-height-m", c.mean_height_m, "Height of the L1 rectification plane, m")->check(FiniteRange(-500, 10000));
   ctl->add_option("--gsd-m", c.gsd_m, "L1 cell size, m (0: the POS line spacing)")->check(FiniteRange(0, 1e4));
   ctl->add_option("--map-step", c.map_step_px, "Exact L1 inverse every N cells, bilinear between, 1..64")->check(FiniteRange(1, 64));

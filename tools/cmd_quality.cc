@@ -29,7 +29,7 @@ namespace {
 struct GroundArgs {
   double gsd_m = 0.0, gsd_sigma_m = 0.0, pixel_mm = 0.0;
   void Add(CLI::App* app) {
-    app->add_option("--pixel-mm", pixel_mm, "Pixel size (mm): frequencies also in line pairs per mm")
+    app->add_option("--pixel-size-mm", pixel_mm, "Pixel size (mm): frequencies also in line pairs per mm")
         ->check(PositiveUpTo(1));
     app->add_option("--gsd-m", gsd_m, "Ground sample distance (m): frequencies as a ground resolved distance")
         ->check(PositiveUpTo(1e4));
@@ -322,7 +322,7 @@ CLI::App* AddStar(CLI::App& app, StarArgs* star) {
   s->add_option("--gamma", star->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
       ->check(FiniteRange(1e-6, 10.0));
   star->ground.Add(s);
-  s->add_option("--out", star->out, "Result JSON (kind quality_star, written atomically)")->required();
+  s->add_option("--out", star->out, "Output file: the result JSON (kind quality_star, written atomically)")->required();
   return s;
 }
 
@@ -348,7 +348,7 @@ CommandRun Setup(CLI::App& app) {
   m->add_option("--flight-axis", mtf->flight_axis, "Image axis of the flight direction (x or y): names "
                 "each MTF along or across track")
       ->check(CLI::IsMember({"x", "y"}));
-  m->add_option("--out", mtf->out, "Result JSON (kind quality_mtf, written atomically)")->required();
+  m->add_option("--out", mtf->out, "Output file: the result JSON (kind quality_mtf, written atomically)")->required();
   auto bars = std::make_shared<BarsArgs>();
   CLI::App* b = app.add_subcommand(
       "bars", "Bar targets: contrast transfer per bar group and the limiting frequency at a threshold");
@@ -368,7 +368,7 @@ CommandRun Setup(CLI::App& app) {
       ->check(FiniteRange(1e-6, 10.0))
       ->capture_default_str();
   bars->ground.Add(b);
-  b->add_option("--out", bars->out, "Result JSON (kind quality_bars, written atomically)")->required();
+  b->add_option("--out", bars->out, "Output file: the result JSON (kind quality_bars, written atomically)")->required();
   auto star = std::make_shared<StarArgs>();
   CLI::App* s = AddStar(app, star.get());
   return [mtf, m, bars, b, star, s] {

@@ -71,7 +71,7 @@ CommandRun Setup(CLI::App& app) {
   app.add_option("--mapping", args->mapping, "Stitch result JSON (aerocal stitch)")->required();
   app.add_option("--frame", args->frame, "Frame whose mappings are used (default: the top level)");
   app.add_option("--images", args->images, "Sub-image files: I=a.tif,II=b.tif,...")->required();
-  app.add_option("--out", args->out, "Virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
+  app.add_option("--out", args->out, "Output file: the virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
   app.add_option("--interp", args->interp, "bilinear | bicubic")->capture_default_str();
   app.add_option("--fill", args->fill, "Grey value of pixels no sub-image covers")->check(FiniteRange(0, 65535))
       ->capture_default_str();

@@ -38,6 +38,7 @@
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
 #include "tools/output_set.h"
+#include "tools/suspect_effect_option.h"
 #include "tools/python_script.h"
 #include "tools/image_sources.h"
 #include "triangulation/block/block_io.h"
@@ -351,6 +352,7 @@ struct StitchArgs {
   double relief_m = 0.0;                // given only: relief of the block off the plane
   double standard_radius_px = 400.0;
   double max_sigma0 = 3.0;
+  double suspect_effect_limit = 1.0;
   double default_sigma_px = 0.5;
   std::string images, stitched_out;  // head images <image>_<head>.tif; stitched images folder
   int tile_px = 256;
@@ -594,6 +596,7 @@ int RunStitch(const StitchArgs& args) {
   options.standard_radius_px = args.standard_radius_px;
   if (!(args.max_sigma0 > 0)) throw ConfigError("--max-sigma0 must be > 0");
   options.max_sigma0 = args.max_sigma0;
+  options.suspect_effect_limit = args.suspect_effect_limit;
   if (!(args.default_sigma_px > 0)) throw ConfigError("--sigma-px must be > 0");
   const triangulation::Project project = triangulation::ReadProject(args.project, args.default_sigma_px);
   std::vector<stitch::RigZoneMatchReport> matched_zones;
@@ -777,7 +780,7 @@ CommandRun Setup(CLI::App& app) {
                  "Relief (m off the plane) whose displacement between heads is reported")->check(FiniteRange(0, 1e4));
   ea->add_flag("--no-plots", args->no_plots, "Write JSON and CSV only (no PNG)");
   ea->add_option("--out", args->out,
-                 "Result JSON; STEM_histogram.csv/.png or STEM_bound_map.csv/.png beside it")
+                 "Output file: the result JSON; STEM_histogram.csv/.png or STEM_bound_map.csv/.png beside it")
       ->required();
   auto convert = std::make_shared<ConvertArgs>();
   CLI::App* cv = app.add_subcommand(
@@ -790,7 +793,7 @@ CommandRun Setup(CLI::App& app) {
                  "virtual.height_m)")->check(FiniteRange(0, 1e5));
   cv->add_option("--opk-deg", convert->opk_deg,
                  "Rig attitude omega,phi,kappa in degrees (matters for orientation: level)");
-  cv->add_option("--out", convert->out, "Virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
+  cv->add_option("--out", convert->out, "Output file: the virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
   cv->add_option("--interp", convert->interp, "bilinear | bicubic");
   cv->add_option("--fill", convert->fill, "Grey value of pixels no head covers")->check(FiniteRange(0, 65535));
   cv->add_option("--strip-rows", convert->strip_rows, "Rows per processing strip (memory bound)")->check(FiniteRange(1, 65536));
@@ -810,7 +813,7 @@ CommandRun Setup(CLI::App& app) {
   ds->add_option("--camera", design->camera, "Rig camera file (YAML with a rig section)")->required();
   ds->add_option("--height-m", design->height_m,
                  "Relative flying height, m (default: the rig file's virtual.height_m)")->check(FiniteRange(0, 1e5));
-  ds->add_option("--out", design->out, "Result JSON (optional; the summary is printed)");
+  ds->add_option("--out", design->out, "Output file: the result JSON (optional; the summary is printed)");
   ds->add_option("--svg", design->svg, "Footprint plot (SVG, ground metres)");
   ds->add_option("--grid-cells", design->grid_cells,
                  "Coverage grid cells along the longer side, 10..4000")->check(FiniteRange(10, 4000));
@@ -830,7 +833,7 @@ CommandRun Setup(CLI::App& app) {
   st->add_option("--mode", stitching->mode,
                  "line (one dT per head for the flight, angles per exposure) | per-exposure "
                  "(everything per exposure; correlations reported) | angles (dT held at 0)");
-  st->add_option("--out", stitching->out, "Result JSON (kind rig_stitch)")->required();
+  st->add_option("--out", stitching->out, "Output file: the result JSON (kind rig_stitch)")->required();
   st->add_flag("--no-snooping", stitching->no_snooping, "No data snooping of the tie observations");
   st->add_option("--alpha", stitching->alpha, "Family-wise level of the snooping, (0, 1)")->check(FiniteRange(0, 1, true));
   stitching->increment_sigma_option = st->add_option(
@@ -845,10 +848,11 @@ CommandRun Setup(CLI::App& app) {
   st->add_option("--standard-radius-px", stitching->standard_radius_px,
                  "A tie this close (virtual px) to a standard position of its zone counts for it")->check(PositiveUpTo(1e5));
   st->add_option("--max-sigma0", stitching->max_sigma0, "sigma0 above: exit 3 (absurd), > 0")->check(PositiveUpTo(1e6));
+  AddSuspectEffectOption(*st, &stitching->suspect_effect_limit);
   st->add_option("--sigma-px", stitching->default_sigma_px,
                  "Tie sigma (px) where observations.csv gives none")->check(PositiveUpTo(100));
   st->add_option("--images", stitching->images,
-                 "Folder of the head images <image>_<head>.tif (simulate --rig --images writes "
+                 "Folder of the head images <image>_<head>.tif (simulate --rig --render-images writes "
                  "them under images/); with --stitched-out");
   st->add_option("--stitched-out", stitching->stitched_out,
                  "Folder for the stitched level image of every exposure (<image>.tif, resampled "

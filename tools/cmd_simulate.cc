@@ -87,7 +87,7 @@ int RunRigSimulation(const CLI::App& app, const SimulateArgs& args,
   options.flight.seed = args.seed;
   if (options.flight.control_points > options.flight.ground_points)
     throw ConfigError("--control (" + std::to_string(options.flight.control_points) +
-                      ") must not exceed --points (" + std::to_string(options.flight.ground_points) +
+                      ") must not exceed --surveyed-points (" + std::to_string(options.flight.ground_points) +
                       ")");
   const auto given = [&](const char* name) { return app.get_option(name)->count() > 0; };
   if (*preset != triangulation::RigPreset::kUav4 || given("--head-increment-arcsec"))
@@ -112,7 +112,7 @@ int RunRigSimulation(const CLI::App& app, const SimulateArgs& args,
   options.format_scale = args.format_scale;
   for (const char* pushbroom_only : {"--reference-size", "--reference-overlap"})
     if (app.get_option(pushbroom_only)->count() > 0)
-      throw ConfigError(std::string(pushbroom_only) + " applies to --pushbroom --images only");
+      throw ConfigError(std::string(pushbroom_only) + " applies to --pushbroom --render-images only");
   triangulation::RigImageOptions image_options;
   image_options.texture_path = args.line_images.texture_path;
   image_options.texture_gsd_m = args.line_images.texture_gsd_m;
@@ -135,6 +135,33 @@ int RunRigSimulation(const CLI::App& app, const SimulateArgs& args,
   return kExitOk;
 }
 
+// `simulate --help` grouped by mode (issue 33 item 4): the options each mode adds, under its
+// name; the flight options (the default mode) are shared by the others where they say so.
+void GroupOptionsByMode(CLI::App& app) {
+  const std::vector<std::pair<std::string, std::set<std::string>>> groups = {
+      {"Output", {"--out", "--seed"}},
+      {"Multi-head rig flight (--rig)",
+       {"--rig", "--head-increment-arcsec", "--head-time-offset-ms", "--format-scale"}},
+      {"Calibration test field (--test-field)",
+       {"--test-field", "--planar", "--groups", "--images-per-group", "--distance-m"}},
+      {"Pushbroom line camera (--pushbroom)",
+       {"--pushbroom", "--detectors", "--lines", "--tilt-deg", "--pos-error-m", "--pos-error-deg",
+        "--detector-error-px", "--subcamera-error-px", "--linear-layout", "--pos-bias-m",
+        "--pos-bias-deg", "--pos-drift-m", "--pos-drift-deg", "--time-offset-s", "--node-spacing",
+        "--control-noise-m"}},
+      {"Rendered images (--render-images, with --rig or --pushbroom)",
+       {"--render-images", "--texture", "--texture-gsd-m", "--reference-size", "--reference-overlap",
+        "--grey-noise-dn"}}};
+  for (CLI::Option* option : app.get_options()) {
+    if (option->get_name() == "--help") continue;
+    std::string group = "Frame-camera flight (the default; --rig, --pushbroom and --test-field take "
+                        "those they name)";
+    for (const auto& [name, members] : groups)
+      if (members.count(option->get_name())) group = name;
+    option->group(group);
+  }
+}
+
 CommandRun SetupSimulate(CLI::App& app) {
   using Args = SimulateArgs;
   auto args = std::make_shared<Args>();
@@ -147,7 +174,7 @@ CommandRun SetupSimulate(CLI::App& app) {
   app.add_option("--forward-overlap", o.forward_overlap, "Forward overlap, 0..1")->check(FiniteRange(0.0, 0.95));
   app.add_option("--side-overlap", o.side_overlap, "Side overlap, 0..1")->check(FiniteRange(0.0, 0.95));
   app.add_option("--relief-m", o.terrain_relief_m, "Terrain relief (peak to peak), 0..10000 m")->check(FiniteRange(0.0, 1e4));
-  app.add_option("--points", o.ground_points, "Surveyed ground points (control + check), 0..100000")->check(FiniteRange(0, 100000));
+  app.add_option("--surveyed-points", o.ground_points, "Surveyed ground points (control + check), 0..100000")->check(FiniteRange(0, 100000));
   app.add_option("--control", o.control_points, "Control points among them (corners and centre first)")->check(FiniteRange(0, 100000));
   app.add_option("--tie-points", o.tie_points, "Unsurveyed tie points, 0..1000000")->check(FiniteRange(0, 1000000));
   app.add_option("--image-noise-px", o.image_noise_px, "Image measurement noise (sigma), 0..1000 px")->check(FiniteRange(0.0, 1e3));
@@ -219,7 +246,7 @@ CommandRun SetupSimulate(CLI::App& app) {
                "Simulate a combined line camera (three tilted line cameras) instead: camera files, "
                "pos.csv, observations, control points and truth (triangulation/pushbroom/README.md)");
   app.add_option("--detectors", l.detectors_per_camera, "Pushbroom: detectors per line camera, 10..100000")->check(FiniteRange(10, 100000));
-  app.add_option("--lines", l.lines, "Pushbroom: scan lines, 20..1000000 (with --images: lines x 3 x detectors at most 5e7 px)")->check(FiniteRange(20, 1000000));
+  app.add_option("--lines", l.lines, "Pushbroom: scan lines, 20..1000000 (with --render-images: lines x 3 x detectors at most 5e7 px)")->check(FiniteRange(20, 1000000));
   app.add_option("--tilt-deg", l.tilt_deg, "Pushbroom: look angle of the outer cameras across track, 0..40 deg")->check(FiniteRange(0.0, 40.0));
   app.add_option("--pos-error-m", l.pos_error_m, "Pushbroom: sigma of the smooth POS position error, 0..100 m")->check(FiniteRange(0.0, 100.0));
   app.add_option("--pos-error-deg", l.pos_error_deg, "Pushbroom: sigma of the smooth POS attitude error, 0..10 deg")->check(FiniteRange(0.0, 10.0));
@@ -239,29 +266,29 @@ CommandRun SetupSimulate(CLI::App& app) {
                  "pos.csv time stamp, -1..1")->check(FiniteRange(-1.0, 1.0));
   app.add_option("--node-spacing", l.node_spacing_lines, "Pushbroom: node spacing of the POS error spline, lines")->check(FiniteRange(1, 1000000));
   app.add_option("--control-noise-m", l.control_noise_m, "Pushbroom: control-point coordinate noise, 0..1000 m")->check(FiniteRange(0.0, 1e3));
-  auto* images = app.add_flag("--images", args->pushbroom_images,
+  auto* images = app.add_flag("--render-images", args->pushbroom_images,
                "Pushbroom: also render the line image and a reference frame strip of a scene "
                "textured with --texture (image mode of `pushbroom control`); --rig: render every "
                "head image of every exposure (images/<image>_<head>.tif)");
   app.add_option("--texture", args->line_images.texture_path,
-                 "--images: the photograph laid on the terrain as its texture")
+                 "--render-images: the photograph laid on the terrain as its texture")
       ->needs(images);
   app.add_option("--texture-gsd-m", args->line_images.texture_gsd_m,
-                 "--images: ground size of a texel (2 x 2 photo pixels), m; 0: automatic")
+                 "--render-images: ground size of a texel (2 x 2 photo pixels), m; 0: automatic")
       ->needs(images)->check(FiniteRange(0.0, 100.0));
   app.add_option("--reference-size", args->reference_size,
-                 "Pushbroom --images: reference frame format WIDTHxHEIGHT px")->needs(images);
+                 "Pushbroom --render-images: reference frame format WIDTHxHEIGHT px")->needs(images);
   app.add_option("--reference-overlap", args->line_images.forward_overlap,
-                 "Pushbroom --images: forward overlap of the reference strip, 0.5..0.9")
+                 "Pushbroom --render-images: forward overlap of the reference strip, 0.5..0.9")
       ->needs(images)->check(FiniteRange(0.5, 0.9));
   app.add_option("--grey-noise-dn", args->line_images.grey_noise_dn,
-                 "--images: Gaussian grey-value noise of the rendered images, DN")
+                 "--render-images: Gaussian grey-value noise of the rendered images, DN")
       ->needs(images)->check(FiniteRange(0.0, 100.0));
   // Flight options a rig flight takes over when given (the rig's defaults otherwise).
   using Flight = triangulation::FlightSimulationOptions;
   const std::vector<std::pair<std::string, int Flight::*>> int_options = {
       {"--exposures", &Flight::exposures},         {"--strips", &Flight::strips},
-      {"--points", &Flight::ground_points},        {"--control", &Flight::control_points},
+      {"--surveyed-points", &Flight::ground_points},        {"--control", &Flight::control_points},
       {"--tie-points", &Flight::tie_points}};
   const std::vector<std::pair<std::string, double Flight::*>> double_options = {
       {"--height-m", &Flight::flying_height_m},
@@ -275,6 +302,7 @@ CommandRun SetupSimulate(CLI::App& app) {
       {"--imu-sigma-deg", &Flight::imu_sigma_deg},
       {"--start-offset-m", &Flight::start_position_error_m},
       {"--start-offset-deg", &Flight::start_angle_error_deg}};
+  GroupOptionsByMode(app);
   return [args, &app, int_options, double_options, increment, time_offset, format_scale]() {
     CheckOutputFolder(args->out, "--out");
     if (args->test_field) return RunTestFieldSimulation(app, *args);
@@ -282,7 +310,7 @@ CommandRun SetupSimulate(CLI::App& app) {
       if (app.count(field_only) > 0)
         throw ConfigError(std::string(field_only) + " applies to --test-field only");
     if (args->pushbroom_images && !args->pushbroom && args->rig.empty())
-      throw ConfigError("--images applies to --pushbroom or --rig only");
+      throw ConfigError("--render-images applies to --pushbroom or --rig only");
     if (args->pushbroom) {
       if (!args->rig.empty()) throw ConfigError("--pushbroom and --rig: choose one");
       if (format_scale->count() > 0) throw ConfigError("--format-scale applies to --rig only");
@@ -314,7 +342,7 @@ CommandRun SetupSimulate(CLI::App& app) {
         if (pixels > triangulation::kMaxLineImagePixels)
           throw ConfigError("--lines x --detectors: a line image of " + std::to_string(l.lines) + " lines x 3 x " +
                             std::to_string(l.detectors_per_camera) + " detectors is " + FormatNumber(pixels) +
-                            " px, more than the 5e7 px --images renders");
+                            " px, more than the 5e7 px --render-images renders");
       }
       const auto sim = triangulation::SimulateLineFlight(l);
       if (args->pushbroom_images) {
@@ -384,7 +412,7 @@ CommandRun SetupSimulate(CLI::App& app) {
     o.layout.model = *nominal_mapping;
     if (o.control_points > o.ground_points)
       throw ConfigError("--control (" + std::to_string(o.control_points) +
-                        ") must not exceed --points (" + std::to_string(o.ground_points) +
+                        ") must not exceed --surveyed-points (" + std::to_string(o.ground_points) +
                         "): control points are among the surveyed points");
     const auto flight = triangulation::SimulateFlight(o);
     triangulation::WriteSimulatedFlight(flight, args->out);

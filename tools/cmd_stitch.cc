@@ -87,12 +87,12 @@ CommandRun Setup(CLI::App& app) {
       ->capture_default_str();
   app.add_option("--base", args->base,
                  "Comma-separated sub-images that keep the camera file's mapping (the datum)");
-  app.add_option("--sigma", args->sigma_px, "A-priori sigma (px) of rows without sigma_px")->check(PositiveUpTo(100))
+  app.add_option("--sigma-px", args->sigma_px, "A-priori sigma (px) of rows without sigma_px")->check(PositiveUpTo(100))
       ->capture_default_str();
   app.add_option("--alpha", args->alpha, "Level of the model-choice F test and stability flags")->check(FiniteRange(0, 1, true))
       ->capture_default_str();
   app.add_flag("--no-snooping", args->no_snooping, "Do not search gross errors");
-  app.add_option("--out", args->out, "Result JSON")->required();
+  app.add_option("--out", args->out, "Output file: the result JSON")->required();
   return [args] { return RunStitch(*args); };
 }
 

@@ -30,7 +30,7 @@ void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
                  "Flight folder: project.yaml (virtual-image observations), optional project_subimage.yaml "
                  "(raw sub-image observations) and the stitching measurements the project names")
       ->required();
-  app.add_option("--out", args->out, "Report folder: result.json, report.html, camera_calibrated.yaml")->required();
+  app.add_option("--out", args->out, "Output folder: result.json, report.html, camera_calibrated.yaml")->required();
   app.add_option("--base", args->base, "Base sub-images holding the datum of the focal plane (default: reference points)");
   app.add_option("--stitch-sigma-px", args->options.stitch_sigma_px, "Stitching sigma where the file has none, px")
       ->check(PositiveUpTo(100));

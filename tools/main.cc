@@ -10,9 +10,11 @@
 #include <nlohmann/json.hpp>
 #include <yaml-cpp/yaml.h>
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/log.h"
 #include "tools/command_registry.h"
+#include "tools/deprecated_options.h"
 
 namespace aerocal::tools {
 std::vector<CommandEntry>& CommandRegistry() {
@@ -48,9 +50,10 @@ int main(int argc, char** argv) {
       "control/check-point statistics and calibration reports."};
   app.set_version_flag("--version", std::string("aerocal ") + AEROCAL_VERSION);
   app.require_subcommand(1);
-  bool quiet = false, verbose = false;
+  bool quiet = false, verbose = false, mkdir = false;
   app.add_flag("--quiet", quiet, "Print no warnings");
   app.add_flag("--verbose", verbose, "Print solver progress and extra information");
+  app.add_flag("--mkdir", mkdir, "Create missing parent folders of output paths (else an error)");
   std::map<CLI::App*, CommandRun> runs;
   std::vector<std::pair<CLI::App*, const CommandEntry*>> subs;
   for (const auto& entry : CommandRegistry()) {
@@ -59,15 +62,21 @@ int main(int argc, char** argv) {
     sub->fallthrough();  // the global --verbose / --quiet also after the command's name
     subs.emplace_back(sub, &entry);
   }
+  std::vector<std::string> args(argv, argv + argc);
+  const std::vector<std::string> deprecations = RewriteDeprecatedOptions(args);
+  std::vector<char*> rewritten;
+  for (std::string& arg : args) rewritten.push_back(arg.data());
   try {
     for (auto& [sub, entry] : subs) runs[sub] = entry->setup(*sub);
-    app.parse(argc, argv);
+    app.parse(static_cast<int>(rewritten.size()), rewritten.data());
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
     return code == 0 ? kExitOk : kExitBadInput;
   }
   if (quiet) aerocal::SetLogLevel(aerocal::LogLevel::kQuiet);
   if (verbose) aerocal::SetLogLevel(aerocal::LogLevel::kInfo);
+  aerocal::SetCreateMissingFolders(mkdir);
+  for (const std::string& warning : deprecations) aerocal::LogWarning(warning);
   try {
     RejectNonFiniteOptions(app);
     for (auto& [sub, run] : runs)

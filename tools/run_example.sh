@@ -6,6 +6,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 aerocal=build/tools/aerocal
-$aerocal simulate --out out/example/data --seed 1 --gnss-sigma-m 0.05
+$aerocal --mkdir simulate --out out/example/data --seed 1 --gnss-sigma-m 0.05
 $aerocal flight --camera out/example/data/camera_nominal.yaml --data out/example/data --base III,IV \
   --out out/example/report

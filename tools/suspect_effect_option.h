@@ -1,5 +1,5 @@
-// `--suspect-effect-limit` of the commands that adjust a block (adjust, calibrate, flight): one
-// option, one meaning (triangulation::AdjustOptions::suspect_effect_limit).
+// `--suspect-effect-limit` of the commands that snoop (adjust, calibrate, flight, rig stitch): one
+// option, one meaning (calib/problem/suspect_effect.h).
 #pragma once
 
 #include <CLI/CLI.hpp>
@@ -12,10 +12,11 @@ inline CLI::Option* AddSuspectEffectOption(CLI::App& app, double* limit_sigmas) 
   return app
       .add_option("--suspect-effect-limit",
                   *limit_sigmas,
-                  "Failing control surveys that data snooping cannot tell apart are judged by "
-                  "their effect: the block re-solved without them; a parameter moving by more "
-                  "than this many of its sigmas makes the result not valid (exit 3), else a "
-                  "warning names them. (0, 1000], default 1")
+                  "Suspects that data snooping cannot resolve (failing control surveys it cannot "
+                  "tell apart; rig stitch: failing ties kept for their standard position) are "
+                  "judged by their effect: the problem re-solved without them; a calibrated "
+                  "parameter moving by more than this many of its sigmas makes the result not "
+                  "valid (exit 3), else a warning names them. (0, 1000], default 1")
       ->check(PositiveUpTo(1e3));
 }
 

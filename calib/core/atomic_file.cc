@@ -25,8 +25,11 @@ std::string KindOf(mode_t mode) {
   return "not a regular file";
 }
 
-// Shared by the output checks: `is_folder` says what the target itself must become.
-void CheckOutputPath(const std::string& path, const std::string& what, bool is_folder) {
+bool create_missing_folders = true;
+
+// Shared by the output checks: `is_folder` says what the target itself must become; a path the
+// user named (`user_path`) may lack its parent folders only when SetCreateMissingFolders allows it.
+void CheckOutputPath(const std::string& path, const std::string& what, bool is_folder, bool user_path) {
   const std::string who = what.empty() ? "'" + path + "'" : what + " '" + path + "'";
   if (path.empty()) throw InputError((what.empty() ? std::string("output path") : what) + ": empty path");
   if (path.size() >= PATH_MAX) throw InputError(who + ": path too long");
@@ -51,7 +54,9 @@ void CheckOutputPath(const std::string& path, const std::string& what, bool is_f
   std::filesystem::path dir = std::filesystem::path(path).parent_path();
   if (is_folder && ::stat(path.c_str(), &st) == 0) dir = path;
   if (dir.empty()) dir = ".";
+  std::filesystem::path first_missing;
   while (::stat(dir.c_str(), &st) != 0) {
+    first_missing = dir;
     if (errno == ENOTDIR) throw InputError(who + ": a part of the path is a file, not a folder");
     if (errno == ELOOP) throw InputError(who + ": symbolic-link loop");
     if (!dir.has_parent_path() || dir.parent_path() == dir) break;
@@ -63,21 +68,26 @@ void CheckOutputPath(const std::string& path, const std::string& what, bool is_f
     if (::access(dir.c_str(), W_OK) != 0)
       throw InputError(who + ": folder '" + dir.string() + "' is not writable");
   }
+  if (user_path && !create_missing_folders && !first_missing.empty())
+    throw InputError(who + ": folder '" + first_missing.string() +
+                     "' does not exist (create it, or give --mkdir to have it created)");
 }
 
 }  // namespace
 
+void SetCreateMissingFolders(bool create) { create_missing_folders = create; }
+
 void CheckOutputFile(const std::string& path, const std::string& what) {
-  CheckOutputPath(path, what, false);
+  CheckOutputPath(path, what, false, true);
 }
 
 void CheckOutputFolder(const std::string& path, const std::string& what) {
-  CheckOutputPath(path, what, true);
+  CheckOutputPath(path, what, true, true);
 }
 
 void WriteFileAtomically(const std::string& path, const std::function<void(std::ostream&)>& write) {
   namespace fs = std::filesystem;
-  CheckOutputFile(path);
+  CheckOutputPath(path, "", false, false);  // the program's own sub-folders are created
   const fs::path target(path);
   if (target.has_parent_path()) {
     std::error_code ec;

@@ -28,11 +28,18 @@ std::string ReadTextFile(const std::string& path);
 
 /// Throws InputError("WHAT: ...") unless `path` can become a regular output file: not empty, not an
 /// existing directory, device, FIFO or socket, every name within NAME_MAX and the whole within
-/// PATH_MAX, no existing ancestor that is not a folder, and a writable nearest existing folder.
+/// PATH_MAX, no existing ancestor that is not a folder, a writable nearest existing folder, and
+/// (see SetCreateMissingFolders) an existing parent folder.
 /// `what` names the option (e.g. "--out") or is empty to name the path itself. Nothing is created.
 void CheckOutputFile(const std::string& path, const std::string& what = "");
 
 /// As CheckOutputFile, for an output folder (created later): an existing path must be a folder.
 void CheckOutputFolder(const std::string& path, const std::string& what = "");
+
+/// Whether CheckOutputFile / CheckOutputFolder accept a path whose parent folders do not exist yet
+/// (they are created when written). The library's default is yes; the command line says no unless
+/// `--mkdir` is given (issue 33 item 5: a mistyped folder is an error, not a new folder tree). An
+/// output folder itself (CheckOutputFolder) is always created; only its parents must exist.
+void SetCreateMissingFolders(bool create);
 
 }  // namespace aerocal

@@ -268,6 +268,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     return "";
   };
 
+  std::vector<calib::ResidualId> kept_against_test;  // vetoed removals: the stop's suspects
   if (options.snooping) {
     calib::SnoopingOptions snooping;
     snooping.groups = {kGroupRigStitchTie};
@@ -278,7 +279,10 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     result.report = outcome.report;
     for (const auto& r : outcome.rejected) result.rejected.push_back(r.label);
     for (const auto& t : outcome.tested)
-      if (t.verdict == calib::SnoopingVerdict::kVetoed) result.stopped = true;
+      if (t.verdict == calib::SnoopingVerdict::kVetoed) {
+        result.stopped = true;
+        kept_against_test.push_back(t.id);
+      }
     for (const auto& f : outcome.findings) result.warnings.push_back(f);
   } else {
     result.report = builder.Solve(options.solver);
@@ -302,6 +306,9 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   const calib::CovarianceReport cov = builder.EstimateCovariance(
       wanted, std::max(result.sigma0, 1e-300), options.correlation_threshold);
   if (!cov.ok) result.warnings.push_back("covariance: " + cov.message);
+  if (result.stopped)  // what the rig's calibration becomes without the ties kept against the test
+    result.stop_effect = calib::EffectOfLeavingOut(builder, kept_against_test, cov, wanted, wanted,
+                                                   options.solver, options.suspect_effect_limit);
   // The largest |rho| of each free dT with an angle of its head (each exposure for line mode).
   std::map<calib::BlockId, DtCorrelation> worst;
   std::set<calib::BlockId> undetermined_dt;
@@ -448,8 +455,12 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     result.failures.push_back(StringPrintf(
         "sigma0 %.3g is above %.3g: the tie sigmas or the rig model are wrong", result.sigma0,
         options.max_sigma0));
-  for (const auto& reason : result.stop_reasons)
-    result.failures.push_back("snooping stopped: " + reason);
+  // A stop is judged by its effect: invalid when it matters, else a warning (issue 28 part 2).
+  for (const auto& reason : result.stop_reasons) {
+    const std::string message = "snooping stopped: " + reason + "; " + result.stop_effect.Describe();
+    if (result.stop_effect.Matters()) result.failures.push_back(message);
+    else result.warnings.push_back(message + "; the tie is kept and the result stands: check it");
+  }
   return result;
 }
 

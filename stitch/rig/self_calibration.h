@@ -25,7 +25,9 @@
 // Gross errors: data snooping (calib/problem/data_snooping.h) on the tie observations, with a
 // veto: a removal that would leave a standard position of an exposure (rig_design.h: two per
 // two-fold zone, one per triple zone) without any tie is refused; the run then STOPS at that
-// point and says so (the paper's rule against over-rejection), `stopped` with the reason.
+// point and says so (the paper's rule against over-rejection), `stopped` with the reason. The
+// stop is judged by its effect (issue 28 part 2): the ties kept against the test are left out, the
+// increments and offsets re-estimated, and their change in their sigmas decides (stop_effect).
 //
 // Stitching RMS (virtual pixels of the level virtual image): each tie's head pixels are carried
 // to the virtual image (RigConverter, plane Z = z_ref) and compared pairwise: per_coordinate =
@@ -43,6 +45,7 @@
 
 #include "calib/camera/rig.h"
 #include "calib/problem/problem_builder.h"
+#include "calib/problem/suspect_effect.h"
 #include "stitch/rig/rig_conversion.h"
 #include "stitch/rig/rig_design.h"
 
@@ -87,6 +90,10 @@ struct RigStitchOptions {
   double correlation_threshold = 0.95;  // |rho| of dT with an angle above: not determinable
   double relief_m = 0.0;                // relief off the plane for the displacement figure, >= 0
   double max_sigma0 = 3.0;              // sigma0 above: absurd (a-priori sigmas or model), > 0
+  /// A stop (a failing tie kept to hold its standard position) is judged by its effect
+  /// (calib/problem/suspect_effect.h): the increments and offsets re-estimated without the kept
+  /// ties; the run is not valid only when one moves by more than this many of its sigmas, > 0.
+  double suspect_effect_limit = 1.0;
   bool hold_heads = false;  // a reference run: increments and offsets held at the ground
                             // calibration, only the tie points adjust (benchmark peer)
   calib::SolverOptions solver;
@@ -146,6 +153,7 @@ struct RigStitchResult {
   std::vector<std::string> rejected;  // labels of the observations snooping removed
   bool stopped = false;               // snooping refused to empty a standard position
   std::vector<std::string> stop_reasons;
+  calib::SuspectEffect stop_effect;   // of the kept failing ties, when stopped
   std::vector<StandardPositionCount> standard_positions;
   int dropped_ties = 0;           // fitted ties with fewer than two observations (not used)
   double relief_displacement_px = 0.0;  // largest over the head pairs, at options.relief_m
@@ -153,7 +161,8 @@ struct RigStitchResult {
   double sigma0_px = 0.0;  // sigma0 x the median a-priori sigma of the fitted tie observations
   std::vector<std::string> warnings;
   /// Why the run must not be trusted, each by name: not converged, covariance singular, sigma0
-  /// above options.max_sigma0, snooping stopped at a standard position. Empty: a valid run.
+  /// above options.max_sigma0, snooping stopped at a standard position with an effect that
+  /// matters (else a warning). Empty: a valid run.
   std::vector<std::string> failures;
 };
 

@@ -118,6 +118,8 @@ nlohmann::json RigStitchToJson(const calib::Rig& rig, const RigStitchOptions& op
                      {"rejected", result.rejected},
                      {"stopped", result.stopped},
                      {"stop_reasons", result.stop_reasons},
+                     {"stop_effect", result.stopped ? calib::SuspectEffectJson(result.stop_effect)
+                                                    : nlohmann::json()},
                      {"standard_positions", positions}};
   doc["dropped_ties"] = result.dropped_ties;
   doc["relief_displacement"] = {

@@ -286,7 +286,7 @@ void BM_AdjustLargeSimulated(benchmark::State& state) {
   const std::string simulate =
       testing::AerocalBinary() + " simulate --exposures " + std::to_string(exposures) +
       " --strips " + std::to_string(strips) + " --tie-points " + std::to_string(16 * exposures) +
-      " --points " + std::to_string(2 * exposures) + " --control " +
+      " --surveyed-points " + std::to_string(2 * exposures) + " --control " +
       std::to_string(exposures / 20) + " --stitch-ties 0 --out " + dir.File("block") +
       " > /dev/null";
   if (std::system(simulate.c_str()) != 0) {

@@ -68,7 +68,7 @@ struct Format {
   std::function<void(const std::string&, const CameraFile&)> write;
   FormatTarget target;       // for a non-fisheye source
   bool file_has_size;        // else --width/--height are given to the reader
-  bool file_has_pixel_size;  // else --pixel-mm
+  bool file_has_pixel_size;  // else --pixel-size-mm
   std::string extension;
 };
 
@@ -135,7 +135,7 @@ TEST(CameraFormats, AHostileNameNeverBreaksAFile) {
 TEST(CameraFormats, Pix4dXmpTagsAreThePix4dCamValues) {
   // Pix4D's XMP camera tags in element form with the values of Pix4D's specification page
   // (article 360016450032) and a prefix other than "Camera": the same camera as a .cam with the
-  // same numbers; the fisheye model type is refused by name; without a pixel size: --pixel-mm.
+  // same numbers; the fisheye model type is refused by name; without a pixel size: --pixel-size-mm.
   TempDir dir("aerocal_pix4d_xmp");
   const std::string xmp = dir.File("p4d.xmp");
   const std::string body =

@@ -117,7 +117,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
                 WriteScratch("pos.csv", parts[1]), "--line-image", fixed + "/line.png",
                 "--reference-camera", fixed + "/camera.yaml", "--reference-exposures",
                 WriteScratch("reference.csv", parts[2]), "--reference-images", fixed + "/images",
-                "--out-dir", out});
+                "--out", out});
   }
   if (code == 1) {
     std::fprintf(stderr, "fuzz_cli: exit 1 (internal error) on command kind %d\n", kind);

@@ -1,4 +1,4 @@
-// `aerocal simulate --rig uav4 --images --texture PHOTO` (rendered head images, issue 16) and
+// `aerocal simulate --rig uav4 --render-images --texture PHOTO` (rendered head images, issue 16) and
 // `aerocal rig stitch --images DIR --stitched-out DIR` (the stitched level image of every exposure,
 // issue 16 item 6) on a small line (formats x 0.2): the files, the formats, the tiled TIFF, the
 // valid-area mask and the JSON figures (radiometry per head, overlap disagreement per head pair).
@@ -29,7 +29,7 @@ TEST(RigImagesCommand, RendersTheHeadsAndStitchesEveryExposure) {
   if (data.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
   TempDir tmp("aerocal_rig_images");
   const std::string sim = tmp.File("sim");
-  const auto s = RunAerocal("simulate --rig uav4 --exposures 2 --format-scale 0.2 --seed 3 --images "
+  const auto s = RunAerocal("simulate --rig uav4 --exposures 2 --format-scale 0.2 --seed 3 --render-images "
                             "--texture " + data + "/images/img_4880.jpg --texture-gsd-m 0.25 "
                             "--grey-noise-dn 1 --out " + sim);
   ASSERT_EQ(s.exit_code, 0) << s.output;

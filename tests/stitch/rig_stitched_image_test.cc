@@ -1,4 +1,4 @@
-// Rendered head images of the four-head rig (`simulate --rig uav4 --images`, issue 16) and the
+// Rendered head images of the four-head rig (`simulate --rig uav4 --render-images`, issue 16) and the
 // horizontal stitched image of an exposure (stitch/rig/stitched_image.h, issue 16 item 6):
 // - every rendered pixel shows the ground point its TRUE head ray meets (ground calibration,
 //   increments and shutter offsets with the velocity), checked against the stitch module's own

@@ -56,7 +56,7 @@ std::string Simulated(const TempDir& d, const std::string& name, const std::stri
   return d.File(name);
 }
 std::string Flight(const TempDir& d) {
-  return Simulated(d, "sim", "--exposures 6 --strips 1 --points 12 --control 6 --tie-points 40 --stitch-ties 60");
+  return Simulated(d, "sim", "--exposures 6 --strips 1 --surveyed-points 12 --control 6 --tie-points 40 --stitch-ties 60");
 }
 std::string RigFlight(const TempDir& d) { return Simulated(d, "rig", "--rig dual-lens"); }
 std::string PushbroomFlight(const TempDir& d) { return Simulated(d, "pb", "--pushbroom"); }
@@ -114,7 +114,7 @@ std::string ControlArgs(const TempDir& d, const std::string& extra = "") {
   const std::string pb = PushbroomFlight(d), sim = Flight(d);
   return "pushbroom control --camera " + pb + "/camera_nominal.yaml --pos " + pb + "/pos.csv --line-image " +
          d.File("line.png") + " --reference-camera " + sim + "/camera_nominal.yaml --reference-exposures " +
-         d.File("exposures.csv") + " --reference-images " + d.path() + " --out-dir " + d.File("control") + " " + extra;
+         d.File("exposures.csv") + " --reference-images " + d.path() + " --out " + d.File("control") + " " + extra;
 }
 
 const std::vector<Case>& Cases() {
@@ -249,7 +249,7 @@ const std::vector<Case>& Cases() {
        [](const TempDir& d) {
          const std::string rig = RigFlight(d);
          return "rig error-analysis --camera " + rig + "/rig_nominal.yaml --limits " +
-                std::string(AEROCAL_CONFIGS_DIR) + "/rig_dual_lens_limits.yaml --relief-m 5000 --no-plots --out " +
+                std::string(AEROCAL_CONFIGS_DIR) + "/rig_dual_lens_limits.yaml --relief-m 5000 --no-plots --mkdir --out " +
                 rig + "/ea/ea.json";
        },
        2, "--relief-m: 5000 m of relief reaches the flying height (1200 m)", "rig/ea"},

@@ -271,7 +271,7 @@ TEST(CameraConvertOutputs, OutAndReportInTwoFoldersAreOneSet) {
   TempDir d("aerocal_bad_input3_convert_set");
   Write(d.File("cv.yml"), kGoodYaml);
   const std::string convert = "camera convert --from opencv --to dji " + d.File("cv.yml") + " " +
-                              d.File("a/out.txt") + " --report " + d.File("b/report.json");
+                              d.File("a/out.txt") + " --report " + d.File("b/report.json") + " --mkdir";
   const auto r = RunAerocal(convert);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_TRUE(fs::exists(d.File("a/out.txt")));
@@ -282,7 +282,7 @@ TEST(CameraConvertOutputs, OutAndReportInTwoFoldersAreOneSet) {
   Write(d.File("cv.yml"), Replaced(kGoodYaml, "[ -0.1, 0.01, 0., 0., 0. ]", "[ -0.3, 0.2, 0., 0., 0. ]"));
   const auto fit = RunAerocal("camera convert --from opencv --to pix4d " + d.File("cv.yml") + " " +
                               d.File("a/out.txt") + " --report " + d.File("b/report.json") +
-                              " --pixel-mm 0.005 --max-residual-px 1e-9");
+                              " --pixel-size-mm 0.005 --max-residual-px 1e-9");
   if (fit.exit_code == 3) {
     EXPECT_EQ(Read(d.File("a/out.txt")), previous);
     EXPECT_FALSE(nlohmann::json::parse(Read(d.File("b/report.json")))["acceptable"].get<bool>());
@@ -313,18 +313,18 @@ TEST(SizeProducts, AreRefusedByNameBeforeAnythingIsAllocated) {
     std::string args, words;
   };
   for (const Case& c : std::vector<Case>{
-           {"simulate --pushbroom --images --texture " + d.File("photo.pgm") +
+           {"simulate --pushbroom --render-images --texture " + d.File("photo.pgm") +
                 " --lines 1000000 --detectors 100000 --out " + d.File("pb"),
             "--lines x --detectors"},
            {"simulate --pushbroom --lines 2000000 --out " + d.File("pb"), "--lines"},
            {"simulate --exposures 20000 --stitch-ties 10000 --out " + d.File("pb"), "--exposures x --stitch-ties"},
            {"simulate --exposures 20000 --stitch-ties 0 --tie-points 1000000 --out " + d.File("pb"),
-            "--exposures x (--points + --tie-points)"},
-           {"simulate --pushbroom --images --texture " + d.File("photo.pgm") +
+            "--exposures x (--surveyed-points + --tie-points)"},
+           {"simulate --pushbroom --render-images --texture " + d.File("photo.pgm") +
                 " --reference-size 20000x20000 --out " + d.File("pb"),
             "--reference-size"},
            {"rig error-analysis --camera " + std::string(AEROCAL_CONFIGS_DIR) + "/rig_dual_lens.yaml --limits " +
-                std::string(AEROCAL_CONFIGS_DIR) + "/rig_dual_lens_limits.yaml --grid 200 --samples 1000000 --out " +
+                std::string(AEROCAL_CONFIGS_DIR) + "/rig_dual_lens_limits.yaml --grid 200 --samples 1000000 --mkdir --out " +
                 d.File("pb/ea.json"),
             "--grid x --grid x --samples"},
        }) {

@@ -77,7 +77,7 @@ const std::string& BaseFlight() {
   static TempDir* dir = new TempDir("aerocal_bad_input_base");
   static const bool made = [] {
     const auto r = RunAerocal("simulate --out " + dir->File("sim") +
-                              " --exposures 6 --strips 1 --points 12 --control 6 --tie-points 40 "
+                              " --exposures 6 --strips 1 --surveyed-points 12 --control 6 --tie-points 40 "
                               "--stitch-ties 60");
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return true;
@@ -110,7 +110,7 @@ std::string PushbroomFlight(const TempDir& d) { return SimulatedCopy(d, "pb", "-
 std::string RigFlight(const TempDir& d) { return SimulatedCopy(d, "rig", "--rig dual-lens"); }
 // A frame flight whose exposures.csv carries the velocity columns vX, vY, vZ.
 std::string VelocityFlight(const TempDir& d) {
-  return SimulatedCopy(d, "vel", "--exposures 6 --strips 1 --points 12 --control 6 --tie-points 40 --speed-mps 60");
+  return SimulatedCopy(d, "vel", "--exposures 6 --strips 1 --surveyed-points 12 --control 6 --tie-points 40 --speed-mps 60");
 }
 // A small test field (`simulate --test-field`): 2 groups (A, B) of 4 images, groups.csv lines 2-9.
 std::string TestField(const TempDir& d) {
@@ -185,7 +185,7 @@ void WriteColmap(const std::string& dir) {
 }
 
 std::string ColmapArgs(const std::string& dir) {
-  return "import colmap --model " + dir + "/model --pixel-size-mm 0.005 --out " + dir + "/out";
+  return "import colmap --colmap-model " + dir + "/model --pixel-size-mm 0.005 --out " + dir + "/out";
 }
 
 // The ODM list of a 2x... near-nadir block: three targets seen by two images each.
@@ -452,8 +452,8 @@ const std::vector<Case>& Cases() {
        [](const TempDir& d) { return "simulate --out " + d.File("o") + " --layout 200x200"; }, 2,
        "--layout must be ROWSxCOLS, 1..10 each", "o"},
       {"stitch_sigma_nan",
-       [](const TempDir& d) { return StitchArgs(Flight(d)) + " --sigma nan"; }, 2,
-       "--sigma: must be a finite number", "s.json"},
+       [](const TempDir& d) { return StitchArgs(Flight(d)) + " --sigma-px nan"; }, 2,
+       "--sigma-px: must be a finite number", "s.json"},
       // ---- stitching ----
       {"stitch_u_overflow",
        [](const TempDir& d) {
@@ -635,7 +635,7 @@ const std::vector<Case>& Cases() {
        [](const TempDir& d) {
          Write(d.File("cal.xml"), "<calibration>\n<width>100</width><height>80</height><f>90</f>\n"
                                   "<covariance>\n<params>f cx</params>\n<coeffs>1 0 0</coeffs>\n</covariance>\n</calibration>\n");
-         return "camera convert --from metashape --to aerocal " + d.File("cal.xml") + " " + d.File("o.yaml") + " --pixel-mm 0.005";
+         return "camera convert --from metashape --to aerocal " + d.File("cal.xml") + " " + d.File("o.yaml") + " --pixel-size-mm 0.005";
        },
        2, "cal.xml:5: <coeffs> must hold 2^2 = 4 values", "o.yaml"},
       {"colmap_camera_of_an_unknown_model",
@@ -678,7 +678,7 @@ const std::vector<Case>& Cases() {
       {"pix4d_cam_with_an_unknown_parameter",
        [](const TempDir& d) {
          Write(d.File("p.cam"), "F 8.8\nPx 6.5\nPy 4.4\nK4 -0.1\n");
-         return "camera convert --from pix4d --to opencv " + d.File("p.cam") + " " + d.File("o.yml") + " --width 100 --height 80 --pixel-mm 0.1";
+         return "camera convert --from pix4d --to opencv " + d.File("p.cam") + " " + d.File("o.yml") + " --width 100 --height 80 --pixel-size-mm 0.1";
        },
        2, "p.cam:4: unknown parameter 'K4'", "o.yml"},
       {"photomodeler_export_with_a_short_camera_line",
@@ -725,7 +725,7 @@ const std::vector<Case>& Cases() {
          Write(d.File("cameras.txt"), "1 PINHOLE 400 300 300 300 200 150\n");
          return "camera convert --from colmap --to dbat " + d.File("cameras.txt") + " " + d.File("o.xml");
        },
-       2, "--pixel-mm: the target holds millimetres", "o.xml"},
+       2, "--pixel-size-mm: the target holds millimetres", "o.xml"},
       {"camera_convert_out_is_a_directory",
        [](const TempDir& d) {
          Write(d.File("cameras.txt"), "1 PINHOLE 400 300 300 300 200 150\n");
@@ -855,7 +855,7 @@ const std::vector<Case>& Cases() {
          return RigStitchArgs(line);
        },
        2, "rig_truth.yaml: virtual.orientation must be level for rig stitch", "uav4/stitch.json"},
-      // ---- rig stitch --images / --stitched-out, simulate --rig --images (issue 16) ----
+      // ---- rig stitch --render-images / --stitched-out, simulate --rig --render-images (issue 16) ----
       {"rig_stitch_images_without_stitched_out",
        [](const TempDir& d) { return RigStitchArgs(Uav4Line(d), "--images " + d.File("uav4")); },
        2, "--images needs --stitched-out or --match-ties", "uav4/stitch.json"},
@@ -903,21 +903,21 @@ const std::vector<Case>& Cases() {
        [](const TempDir& d) { return "simulate --format-scale 0.5 --out " + d.File("o"); },
        2, "--format-scale applies to a rig flight (--rig) only", "o"},
       {"simulate_rig_images_without_texture",
-       [](const TempDir& d) { return "simulate --rig uav4 --images --out " + d.File("o"); },
-       2, "--texture: the photograph of the scene is required with --images", "o"},
+       [](const TempDir& d) { return "simulate --rig uav4 --render-images --out " + d.File("o"); },
+       2, "--texture: the photograph of the scene is required with --render-images", "o"},
       {"simulate_rig_images_texture_missing",
        [](const TempDir& d) {
-         return "simulate --rig uav4 --images --texture " + d.File("none.jpg") + " --out " + d.File("o");
+         return "simulate --rig uav4 --render-images --texture " + d.File("none.jpg") + " --out " + d.File("o");
        },
        2, "none.jpg", "o"},
       {"simulate_rig_images_reference_size",
        [](const TempDir& d) {
-         return "simulate --rig uav4 --images --texture x.jpg --reference-size 200x200 --out " + d.File("o");
+         return "simulate --rig uav4 --render-images --texture x.jpg --reference-size 200x200 --out " + d.File("o");
        },
-       2, "--reference-size applies to --pushbroom --images only", "o"},
+       2, "--reference-size applies to --pushbroom --render-images only", "o"},
       {"simulate_rig_grey_noise_negative",
        [](const TempDir& d) {
-         return "simulate --rig uav4 --images --texture x.jpg --grey-noise-dn -1 --out " + d.File("o");
+         return "simulate --rig uav4 --render-images --texture x.jpg --grey-noise-dn -1 --out " + d.File("o");
        },
        2, "--grey-noise-dn", "o"},
       // ---- the rig in a project (issue 13): rig camera under `cameras:`, head column ----

@@ -239,7 +239,7 @@ TEST(CliCamera, ConvertsOursIntoEveryFormatAndBackWithAReport) {
     }
     const std::string extra = !format.writes_size          ? " --width 14000 --height 12000"
                               : format.writes_pixel_size ? ""
-                                                         : " --pixel-mm 0.009";
+                                                         : " --pixel-size-mm 0.009";
     // Back with --from auto: every file we write is detected as its own format.
     r = RunAerocal("camera convert --from auto --to aerocal --model brown10 " + out + " " +
                    tmp.File("back_" + format.name + ".yaml") + extra);
@@ -255,7 +255,7 @@ TEST(CliCamera, ShowPrintsOurConventionAndWritesThePlot) {
   std::ofstream(dji) << "2018-09-06;3684.48,3677.57,2.24,22.05,-0.263482,0.106788,3.71107e-5,"
                         "-3.27247e-4,-0.0300783\n";
   const auto r = RunAerocal("camera show --from dji " + dji + " --width 5472 --height 3648 "
-                            "--pixel-mm 0.0024 --plot " + tmp.File("d.svg"));
+                            "--pixel-size-mm 0.0024 --plot " + tmp.File("d.svg"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("our convention"), std::string::npos) << r.output;
   // x0 = (2738.24 - 2735.5) px = 2.74 px from the centre.
@@ -276,7 +276,7 @@ TEST(CliCamera, MaxResidualTurnsABadFitIntoExit3AndWritesNothing) {
   const std::string dji = tmp.File("dji.txt");
   std::ofstream(dji) << "3684.48,3677.57,2.24,22.05,-0.263482,0.106788,3.71107e-5,-3.27247e-4,-0.0300783\n";
   const auto r = RunAerocal("camera convert --from dji --to aerocal --model brown10 " + dji + " " +
-                            tmp.File("ours.yaml") + " --width 5472 --height 3648 --pixel-mm 0.0024 "
+                            tmp.File("ours.yaml") + " --width 5472 --height 3648 --pixel-size-mm 0.0024 "
                             "--max-residual-px 5 --report " + tmp.File("r.json"));
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("conversion_residual"), std::string::npos) << r.output;
@@ -286,7 +286,7 @@ TEST(CliCamera, MaxResidualTurnsABadFitIntoExit3AndWritesNothing) {
   EXPECT_GT(json["residual_px"]["max"].get<double>(), 5.0);
   // Kept in its own model (no --model) it is exact.
   const auto exact = RunAerocal("camera convert --from dji --to aerocal " + dji + " " +
-                                tmp.File("dji.yaml") + " --width 5472 --height 3648 --pixel-mm 0.0024");
+                                tmp.File("dji.yaml") + " --width 5472 --height 3648 --pixel-size-mm 0.0024");
   EXPECT_EQ(exact.exit_code, 0) << exact.output;
   EXPECT_NE(exact.output.find("exact (closed form)"), std::string::npos) << exact.output;
   EXPECT_NE(Read(tmp.File("dji.yaml")).find("model: opencv"), std::string::npos);

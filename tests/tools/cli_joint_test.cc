@@ -86,7 +86,7 @@ using ShearedFlight = SimulatedFlight<Sheared>;
 // A small flight (9 exposures) with CCD shears of 2e-3 (7 px across a sub-image).
 struct StronglySheared {
   static constexpr const char* kOptions =
-      "--seed 4 --exposures 9 --points 60 --tie-points 150 --stitch-ties 100 --gnss-sigma-m 0.05 "
+      "--seed 4 --exposures 9 --surveyed-points 60 --tie-points 150 --stitch-ties 100 --gnss-sigma-m 0.05 "
       "--nominal-mapping translation --ccd-shear 2e-3";
 };
 using StronglyShearedFlight = SimulatedFlight<StronglySheared>;

@@ -25,7 +25,7 @@ using testing::RunAerocal;
 TEST(CliOptions, StitchModelAutoTestsAtTheGivenAlpha) {
   testing::TempDir dir("aerocal_cli_options");
   ASSERT_EQ(RunAerocal("simulate --out " + dir.File("data") +
-                       " --exposures 2 --strips 1 --points 20 --tie-points 30 --stitch-ties 300 --ccd-shear 2e-4")
+                       " --exposures 2 --strips 1 --surveyed-points 20 --tie-points 30 --stitch-ties 300 --ccd-shear 2e-4")
                 .exit_code,
             0);
   const auto run = RunAerocal("stitch --camera " + dir.File("data/camera_nominal.yaml") + " --obs " +

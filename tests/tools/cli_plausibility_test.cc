@@ -146,7 +146,7 @@ TEST_F(Plausibility, APrincipalDistanceInPixelsIsWarnedBeforeTheSolveAndInTheRes
 TEST(Vocabulary, GlobalOptionsAfterTheCommandAndWhatVerbosePrints) {
   TempDir dir("aerocal_cli_vocabulary");
   ASSERT_EQ(RunAerocal("simulate --out " + dir.File("f") +
-                       " --exposures 3 --strips 1 --points 20 --tie-points 30 --quiet")
+                       " --exposures 3 --strips 1 --surveyed-points 20 --tie-points 30 --quiet")
                 .exit_code,
             0);
   const std::string project = dir.File("f/project.yaml");

@@ -44,7 +44,7 @@ TEST(CliQuality, MtfOfEightAndSixteenBitEdgesWithGroundUnits) {
   stitch::WriteGrayImage(dir.File("edges16.tif"), TwoEdges(256.0, 256.0, &rng), 16);
   for (const std::string name : {"edges8.png", "edges16.tif"}) {
     const auto run = RunAerocal("quality mtf --image " + dir.File(name) +
-                                " --roi 0,0,128,128 --roi 128,0,128,128 --pixel-mm 0.006 --gsd-m 0.08 "
+                                " --roi 0,0,128,128 --roi 128,0,128,128 --pixel-size-mm 0.006 --gsd-m 0.08 "
                                 "--gsd-sigma-m 0.001 --flight-axis y --out " + dir.File("r.json"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
     const nlohmann::json doc = testing::ReadJson(dir.File("r.json"));
@@ -121,7 +121,7 @@ TEST(CliQuality, BarsGiveTheLimitingFrequencyAndGroundUnits) {
   testing::TempDir dir("aerocal_cli_quality_bars");
   const double s = 1.0;
   const std::string base = "quality bars --image " + dir.File("bars.tif") + WriteBarTarget(dir.File("bars.tif"), s);
-  const auto run = RunAerocal(base + kBarReferences + " --pixel-mm 0.005 --gsd-m 0.1 --out " + dir.File("bars.json"));
+  const auto run = RunAerocal(base + kBarReferences + " --pixel-size-mm 0.005 --gsd-m 0.1 --out " + dir.File("bars.json"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json doc = testing::ReadJson(dir.File("bars.json"));
   EXPECT_EQ(doc["kind"], "quality_bars");
@@ -161,7 +161,7 @@ TEST(CliQuality, StarGivesTheLimitingFrequencyAndGroundUnits) {
   testing::TempDir dir("aerocal_cli_quality_star");
   const double s = 1.2;
   const std::string base = "quality star --image " + dir.File("star.png") + WriteStar(dir.File("star.png"), s);
-  const auto run = RunAerocal(base + " --pixel-mm 0.005 --gsd-m 0.1 --out " + dir.File("star.json"));
+  const auto run = RunAerocal(base + " --pixel-size-mm 0.005 --gsd-m 0.1 --out " + dir.File("star.json"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const nlohmann::json doc = testing::ReadJson(dir.File("star.json"));
   EXPECT_EQ(doc["kind"], "quality_star");

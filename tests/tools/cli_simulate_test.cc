@@ -30,8 +30,8 @@ TEST(Cli, HelpListsTheCommandsAndVersionPrints) {
 TEST(Cli, SimulateIsDeterministicAndWritesTheFormatsFiles) {
   testing::TempDir dir;
   const std::string a = dir.File("a"), b = dir.File("b");
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + a + " --seed 5 --exposures 9 --points 60 --tie-points 50").exit_code, 0);
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + b + " --seed 5 --exposures 9 --points 60 --tie-points 50").exit_code, 0);
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + a + " --seed 5 --exposures 9 --surveyed-points 60 --tie-points 50").exit_code, 0);
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + b + " --seed 5 --exposures 9 --surveyed-points 60 --tie-points 50").exit_code, 0);
   for (const char* f : {"camera_nominal.yaml", "camera_truth.yaml", "exposures.csv", "observations.csv",
                         "observations_subimage.csv", "points.csv", "stitch_obs.csv", "project.yaml",
                         "project_subimage.yaml", "truth/exposures.csv", "truth/points.csv"}) {
@@ -48,7 +48,7 @@ TEST(Cli, SimulateIsDeterministicAndWritesTheFormatsFiles) {
   EXPECT_EQ(camera.subimages.size(), 6u);
   EXPECT_EQ(camera.width_px, 14000);
   // Another seed gives other data.
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + b + " --seed 6 --exposures 9 --points 60 --tie-points 50").exit_code, 0);
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + b + " --seed 6 --exposures 9 --surveyed-points 60 --tie-points 50").exit_code, 0);
   EXPECT_NE(ReadTextFile(a + "/observations.csv"), ReadTextFile(b + "/observations.csv"));
 }
 
@@ -70,7 +70,7 @@ TEST(Cli, BadOptionsExitWithTwoAndWriteNothing) {
 
 TEST(Cli, OtherLayoutsSimulate) {
   testing::TempDir dir;
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + dir.path() + " --layout 3x4 --exposures 6 --points 30 --tie-points 20").exit_code, 0);
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + dir.path() + " --layout 3x4 --exposures 6 --surveyed-points 30 --tie-points 20").exit_code, 0);
   const auto camera = calib::ReadCamera(dir.File("camera_nominal.yaml"));
   EXPECT_EQ(camera.subimages.size(), 12u);
   EXPECT_FALSE(camera.reference_points.empty());
@@ -79,7 +79,7 @@ TEST(Cli, OtherLayoutsSimulate) {
 TEST(Cli, SimulateRigDualLensWritesHeadObservationsAndTruth) {
   testing::TempDir dir;
   const std::string a = dir.File("a"), b = dir.File("b");
-  const std::string args = " --rig dual-lens --seed 3 --exposures 8 --points 12 --tie-points 40 "
+  const std::string args = " --rig dual-lens --seed 3 --exposures 8 --surveyed-points 12 --tie-points 40 "
                            "--gnss-sigma-m 0.05 --imu-sigma-deg 0.005 --speed-mps 60 "
                            "--head-time-offset-ms 0.5 --head-increment-arcsec 2";
   const auto run = testing::RunAerocal("simulate --out " + a + args);

@@ -39,3 +39,5 @@ aerocal_add_test(tools/cli_batch LIBS aerocal::calib LABELS cli)
 # (tests/tools/slurm_localhost.sh), a 4-task job array and the dependent merge. Skipped with the
 # reason without slurm-wlm and munge (not in tools/setup.sh); label long: it starts daemons.
 aerocal_add_test(tools/cli_batch_slurm LIBS aerocal::calib LABELS long TIMEOUT 900)
+aerocal_add_test(tools/cli_vocabulary LABELS cli)
+target_compile_definitions(test_tools_cli_vocabulary PRIVATE AEROCAL_SOURCE_DIR="${PROJECT_SOURCE_DIR}")

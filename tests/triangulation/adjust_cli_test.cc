@@ -29,7 +29,7 @@ class AdjustCommand : public ::testing::Test {
 
 TEST_F(AdjustCommand, CompareWritesBothRunsAndTheCamera) {
   const auto r = RunAerocal("adjust --project " + dir_.File("flight/project.yaml") +
-                            " --compare --write-camera " + dir_.File("next/camera.yaml") +
+                            " --mkdir --compare --write-camera " + dir_.File("next/camera.yaml") +
                             " --out " + dir_.File("result.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("conventional"), std::string::npos);

@@ -412,11 +412,11 @@ TEST(CrsFrame, ImportColmapTakesAGeocentricModel) {
   for (const auto& g : model.points) points[g.id] = *g.xyz_m;
   testing::TempDir tmp("aerocal_crs_colmap");
   WriteColmapModel(model, points, tmp.File("model"));
-  const auto refused = testing::RunAerocal("import colmap --model " + tmp.File("model") +
+  const auto refused = testing::RunAerocal("import colmap --colmap-model " + tmp.File("model") +
                                            " --pixel-size-mm 0.009 --crs EPSG:4326 --out " +
                                            tmp.File("refused"));
   EXPECT_EQ(refused.exit_code, 2) << refused.output;
-  const auto imported = testing::RunAerocal("import colmap --model " + tmp.File("model") +
+  const auto imported = testing::RunAerocal("import colmap --colmap-model " + tmp.File("model") +
                                             " --pixel-size-mm 0.009 --sigma-px 0.2 --crs EPSG:4978 "
                                             "--out " + tmp.File("block"));
   ASSERT_EQ(imported.exit_code, 0) << imported.output;

@@ -87,7 +87,7 @@ TEST(ImportCommand, ColmapModelImportedOnceThenAdjusted) {
   testing::TempDir tmp("aerocal_import_colmap");
   triangulation::WriteColmapModel(block, points, tmp.File("model"));
   const auto imported =
-      RunAerocal("import colmap --model " + tmp.File("model") +
+      RunAerocal("import colmap --colmap-model " + tmp.File("model") +
                  " --pixel-size-mm 0.009 --sigma-px 0.2 --out " + tmp.File("block"));
   ASSERT_EQ(imported.exit_code, 0) << imported.output;
   const auto adjusted = RunAerocal("adjust --project " + tmp.File("block/project.yaml") +

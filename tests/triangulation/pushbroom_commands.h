@@ -17,7 +17,7 @@ inline std::string PushbroomControlInputs(const std::string& dir) {
 /// `pushbroom control` on the flight in `dir`, oriented by its exposures.csv, into `out`.
 inline std::string PushbroomControlCommand(const std::string& dir, const std::string& out) {
   return PushbroomControlInputs(dir) + " --reference-exposures " + dir +
-         "/reference/exposures.csv --out-dir " + out;
+         "/reference/exposures.csv --out " + out;
 }
 
 /// `pushbroom calibrate` of the flight's nominal camera and POS from control `obs` and `points`.

@@ -29,7 +29,7 @@ TEST(PushbroomControl, MatchedControlCalibratesTheDetectors) {
   if (photo.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent (the scene's texture)";
   TempDir tmp("aerocal_pushbroom_control");
   const std::string sim = tmp.File("sim");
-  const auto s = RunAerocal("simulate --pushbroom --images --texture " + photo +
+  const auto s = RunAerocal("simulate --pushbroom --render-images --texture " + photo +
                             "/images/img_4880.jpg --detectors 100 --lines 300 --out " + sim);
   ASSERT_EQ(s.exit_code, 0) << s.output;
   const auto c = RunAerocal(PushbroomControlCommand(sim, tmp.File("control")));
@@ -82,7 +82,7 @@ TEST(PushbroomControl, ReferenceOrientationFromTheBlockResult) {
   if (photo.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent (the scene's texture)";
   TempDir tmp("aerocal_pushbroom_reference_result");
   const std::string sim = tmp.File("sim");
-  ASSERT_EQ(RunAerocal("simulate --pushbroom --images --texture " + photo +
+  ASSERT_EQ(RunAerocal("simulate --pushbroom --render-images --texture " + photo +
                        "/images/img_4880.jpg --detectors 60 --lines 200 --out " + sim).exit_code, 0);
   const CsvTable csv = CsvTable::Read(sim + "/reference/exposures.csv");
   json exposures = json::array();
@@ -97,9 +97,9 @@ TEST(PushbroomControl, ReferenceOrientationFromTheBlockResult) {
                        {"exposures", exposures}};
   write(tmp.File("result.json"), result);
   const std::string common = PushbroomControlInputs(sim) + " --line-outlier-k 5 --line-outlier-min-px 0.25";
-  const auto from_csv = RunAerocal(common + " --reference-exposures " + sim + "/reference/exposures.csv --out-dir " + tmp.File("a"));
+  const auto from_csv = RunAerocal(common + " --reference-exposures " + sim + "/reference/exposures.csv --out " + tmp.File("a"));
   ASSERT_EQ(from_csv.exit_code, 0) << from_csv.output;
-  const auto from_result = RunAerocal(common + " --reference-result " + tmp.File("result.json") + " --out-dir " + tmp.File("b"));
+  const auto from_result = RunAerocal(common + " --reference-result " + tmp.File("result.json") + " --out " + tmp.File("b"));
   ASSERT_EQ(from_result.exit_code, 0) << from_result.output;
   EXPECT_NE(from_result.output.find("1 not used by the adjustment"), std::string::npos) << from_result.output;
   EXPECT_EQ(ReadTextFile(tmp.File("a/points.csv")), ReadTextFile(tmp.File("b/points.csv")));
@@ -107,7 +107,7 @@ TEST(PushbroomControl, ReferenceOrientationFromTheBlockResult) {
 
   auto refused = [&](const json& doc, const std::string& expected) {
     write(tmp.File("bad.json"), doc);
-    const auto run = RunAerocal(common + " --reference-result " + tmp.File("bad.json") + " --out-dir " + tmp.File("c"));
+    const auto run = RunAerocal(common + " --reference-result " + tmp.File("bad.json") + " --out " + tmp.File("c"));
     EXPECT_EQ(run.exit_code, 2) << run.output;
     EXPECT_NE(run.output.find(expected), std::string::npos) << run.output;
     EXPECT_FALSE(std::filesystem::exists(tmp.File("c")));
@@ -122,9 +122,9 @@ TEST(PushbroomControl, ReferenceOrientationFromTheBlockResult) {
   no_kappa["exposures"][1].erase("kappa");
   refused(no_kappa, "bad.json: exposures[1] (" + csv.String(csv.rows()[1], "image") + "): kappa must be a finite number");
   const auto both = RunAerocal(common + " --reference-result " + tmp.File("result.json") + " --reference-exposures " +
-                               sim + "/reference/exposures.csv --out-dir " + tmp.File("c"));
+                               sim + "/reference/exposures.csv --out " + tmp.File("c"));
   EXPECT_EQ(both.exit_code, 2) << both.output;
-  const auto neither = RunAerocal(common + " --out-dir " + tmp.File("c"));
+  const auto neither = RunAerocal(common + " --out " + tmp.File("c"));
   EXPECT_EQ(neither.exit_code, 2) << neither.output;
   EXPECT_NE(neither.output.find("--reference-result"), std::string::npos) << neither.output;
   EXPECT_FALSE(std::filesystem::exists(tmp.File("c")));
@@ -132,8 +132,8 @@ TEST(PushbroomControl, ReferenceOrientationFromTheBlockResult) {
 
 TEST(PushbroomImageMode, BadInputIsRefused) {
   TempDir tmp("aerocal_pushbroom_images_bad");
-  // --images needs the photograph.
-  const auto no_texture = RunAerocal("simulate --pushbroom --images --out " + tmp.File("a"));
+  // --render-images needs the photograph.
+  const auto no_texture = RunAerocal("simulate --pushbroom --render-images --out " + tmp.File("a"));
   EXPECT_EQ(no_texture.exit_code, 2) << no_texture.output;
   EXPECT_NE(no_texture.output.find("--texture"), std::string::npos) << no_texture.output;
   EXPECT_FALSE(std::filesystem::exists(tmp.File("a")));

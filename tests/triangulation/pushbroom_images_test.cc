@@ -1,4 +1,4 @@
-// Image mode of the pushbroom commands (issue 17): `aerocal simulate --pushbroom --images` renders
+// Image mode of the pushbroom commands (issue 17): `aerocal simulate --pushbroom --render-images` renders
 // the line image and a reference frame strip of a scene textured with a real photograph
 // (../shared/data/odm_boruszyn_kap_frames), `aerocal pushbroom control` rectifies, matches and
 // intersects the cloud control on those pixels, and `aerocal pushbroom calibrate` from that control
@@ -70,7 +70,7 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
   if (data.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
   TempDir tmp("aerocal_pushbroom_images");
   const std::string sim = tmp.File("sim");
-  const auto s = RunAerocal("simulate --pushbroom --images --texture " + data +
+  const auto s = RunAerocal("simulate --pushbroom --render-images --texture " + data +
                             "/images/img_4880.jpg --detectors 200 --lines 800 --seed 1 --out " + sim);
   ASSERT_EQ(s.exit_code, 0) << s.output;
   for (const char* f : {"line_image.png", "reference/camera.yaml", "reference/exposures.csv",

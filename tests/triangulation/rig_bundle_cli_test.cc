@@ -30,7 +30,7 @@ class RigAdjustCommand : public ::testing::Test {
 };
 
 TEST_F(RigAdjustCommand, WritesTheRigResultAndTheRigFile) {
-  const auto r = RunAerocal(Adjust("--write-camera " + dir_.File("next/rig.yaml"), "result.json"));
+  const auto r = RunAerocal(Adjust("--mkdir --write-camera " + dir_.File("next/rig.yaml"), "result.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("head B mount (deg)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("is not separable"), std::string::npos);  // lever arm ~ mount at 1200 m

@@ -8,7 +8,7 @@
 //   (left out, or unresolved with an effect within the limit); the same with the limit at 1e-6
 //   sigmas is not valid when they are unresolved; one corner off by 20 survey sigmas is left out,
 //   or the run is not valid, as before.
-#include "triangulation/adjustment/suspect_effect.h"
+#include "calib/problem/suspect_effect.h"
 
 #include "calib/residuals/prior.h"
 #include "triangulation/calibration/calibration.h"
@@ -43,7 +43,7 @@ TEST(EffectOfLeavingOut, TheMeanOfNObservationsMovesAsTheClosedFormSays) {
   ASSERT_NEAR(cov.BlockSigma(b, 1)(0), sigma_mean, 1e-9);
   const double before = mean;
   const SuspectEffect e =
-      EffectOfLeavingOut(builder, {ids.back()}, cov, {b}, {b}, calib::SolverOptions{}, 1.0);
+      calib::EffectOfLeavingOut(builder, {ids.back()}, cov, {b}, {b}, calib::SolverOptions{}, 1.0);
   ASSERT_TRUE(e.computed) << e.message;
   const double change = (sum / n - x.back()) / (n - 1);
   ASSERT_EQ(e.calibrated.size(), 1u);
@@ -57,11 +57,11 @@ TEST(EffectOfLeavingOut, TheMeanOfNObservationsMovesAsTheClosedFormSays) {
   for (calib::ResidualId id : ids) EXPECT_TRUE(builder.IsActive(id));
   // A suspect within the crowd hardly moves it.
   const SuspectEffect small =
-      EffectOfLeavingOut(builder, {ids[3]}, cov, {b}, {b}, calib::SolverOptions{}, 1.0);
+      calib::EffectOfLeavingOut(builder, {ids[3]}, cov, {b}, {b}, calib::SolverOptions{}, 1.0);
   EXPECT_NEAR(small.max_sigmas, std::abs((sum / n - x[3]) / (n - 1)) / sigma_mean, 1e-4);
   EXPECT_FALSE(small.Matters());
   // Without a covariance the effect is unknown, and an unknown effect matters.
-  const SuspectEffect unknown = EffectOfLeavingOut(
+  const SuspectEffect unknown = calib::EffectOfLeavingOut(
       builder, {ids[3]}, calib::CovarianceReport{}, {b}, {b}, calib::SolverOptions{}, 1.0);
   EXPECT_FALSE(unknown.computed);
   EXPECT_TRUE(unknown.Matters());

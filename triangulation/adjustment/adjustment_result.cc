@@ -66,26 +66,6 @@ void AddTest(const ObservationTest& t, nlohmann::json* j) {
   if (!t.reason.empty()) (*j)["reason"] = t.reason;
 }
 
-// "unresolved_effect": the suspects' effect on the results (SuspectEffect); null where unknown.
-nlohmann::json SuspectEffectJson(const SuspectEffect& e) {
-  nlohmann::json j = {{"computed", e.computed},
-                      {"limit_sigmas", e.limit_sigmas},
-                      {"max_sigmas", e.computed ? Finite(e.max_sigmas) : nlohmann::json()},
-                      {"parameter", e.parameter},
-                      {"max_all_sigmas", e.computed ? Finite(e.max_all_sigmas) : nlohmann::json()},
-                      {"parameter_all", e.parameter_all},
-                      {"matters", e.Matters()}};
-  if (!e.message.empty()) j["message"] = e.message;
-  j["calibrated"] = nlohmann::json::array();
-  for (const auto& c : e.calibrated)
-    j["calibrated"].push_back({{"parameter", c.parameter},
-                               {"change", c.change},
-                               {"sigma", Finite(c.sigma)},
-                               {"sigmas", c.sigma > 0 ? Finite(std::abs(c.change) / c.sigma)
-                                                      : nlohmann::json()}});
-  return j;
-}
-
 // "self_calibration_choice" (`--self-calibration auto`): candidates, chosen, each held parameter.
 nlohmann::json FreeSetChoiceJson(const FreeSetChoice& c) {
   nlohmann::json j = {{"candidates", c.candidates},
@@ -144,7 +124,7 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
                                        {"w", u.w},
                                        {"r", u.redundancy},
                                        {"residual_sigma", u.residual_sigma}});
-  if (!s.unresolved_surveys.empty()) j["unresolved_effect"] = SuspectEffectJson(s.unresolved_effect);
+  if (!s.unresolved_surveys.empty()) j["unresolved_effect"] = calib::SuspectEffectJson(s.unresolved_effect);
   j["uncontrolled"] = nlohmann::json::array();
   for (const auto& u : s.uncontrolled)
     j["uncontrolled"].push_back({{"image", u.image},

@@ -9,6 +9,7 @@
 #include "calib/camera/camera_model_json.h"
 #include "calib/core/result_file.h"
 #include "calib/problem/problem_builder.h"
+#include "calib/problem/suspect_effect.h"
 #include "triangulation/block/block.h"
 
 #include <Eigen/Core>
@@ -147,29 +148,9 @@ struct UnresolvedSurvey {
   double residual_sigma = 0;     // its largest residual, in a-priori sigmas
 };
 
-/// The effect of an unresolved suspicion on the results (issue 28: a calibration is invalid when a
-/// suspicion matters, not whenever a test fires): the block re-solved with the suspects left out,
-/// the change of every parameter whose sigma the covariance gives (free interior and platform
-/// parameters, exterior orientations), in that parameter's sigmas. The result keeps the solution
-/// with every survey; the effect on what the run calibrates decides whether it is valid
-/// (AdjustOptions::suspect_effect_limit).
-struct SuspectEffect {
-  bool computed = false;
-  std::string message;  // why it could not be computed (no covariance, the re-solve failed)
-  double limit_sigmas = 0;
-  /// The decision: the largest |change| / sigma over the calibrated parameters (free interior and
-  /// platform), over every parameter when the run calibrates none (conventional).
-  double max_sigmas = 0;
-  std::string parameter;  // where it is largest ("camera cam1.c", "image 0012 centre.Z")
-  double max_all_sigmas = 0;   // the largest over every parameter, exterior orientations included
-  std::string parameter_all;
-  struct Change {
-    std::string parameter;
-    double change = 0, sigma = 0;  // the parameter's units (table units, m, rad)
-  };
-  std::vector<Change> calibrated;  // every free interior and platform parameter
-  bool Matters() const { return !computed || max_sigmas > limit_sigmas; }
-};
+/// The effect of the unresolved suspects on the results (issue 28 part 2: a calibration is invalid
+/// when a suspicion matters, not whenever a test fires).
+using calib::SuspectEffect;  // calib/problem/suspect_effect.h
 
 /// How data snooping was run and what it could not decide (data_snooping.h).
 struct SnoopingSummary {

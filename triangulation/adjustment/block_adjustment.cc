@@ -11,7 +11,7 @@
 #include "triangulation/adjustment/determinability.h"
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/adjustment/plausibility.h"
-#include "triangulation/adjustment/suspect_effect.h"
+#include "calib/problem/suspect_effect.h"
 #include "triangulation/sensor/frame_camera.h"
 
 #include <Eigen/Eigenvalues>
@@ -1234,7 +1234,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     // Judged by its effect (issue 28): invalid only when leaving the suspects out moves a
     // parameter by more than the limit in its sigmas.
     SuspectEffect& effect = result.snooping.unresolved_effect;
-    effect = EffectOfLeavingOut(builder_, storage_->unresolved_ids, cov, cov_blocks, cross_blocks,
+    effect = calib::EffectOfLeavingOut(builder_, storage_->unresolved_ids, cov, cov_blocks, cross_blocks,
                                 options_.solver, options_.suspect_effect_limit);
     std::string names;
     double w = 0.0;
@@ -1242,12 +1242,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
       names += (names.empty() ? "" : ", ") + u.survey;
       w = std::max(w, u.w);
     }
-    const std::string impact =
-        effect.computed
-            ? "leaving them out moves " + effect.parameter + " by " +
-                  FormatNumber(effect.max_sigmas, 2) + " of its sigmas (limit " +
-                  FormatNumber(effect.limit_sigmas, 3) + ", --suspect-effect-limit)"
-            : "their effect cannot be judged: " + effect.message;
+    const std::string impact = effect.Describe();
     const std::string message =
         "control survey blunder not resolved: " + names + " fail the survey test (w up to " +
         FormatNumber(w, 3) + " > " + FormatNumber(result.snooping.critical_value, 3) +

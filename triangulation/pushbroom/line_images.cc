@@ -71,7 +71,7 @@ void LineImageOptions::Validate() const {
   auto require = [](bool ok, const std::string& message) {
     if (!ok) throw ConfigError(message);
   };
-  require(!texture_path.empty(), "--texture: the photograph of the scene is required with --images");
+  require(!texture_path.empty(), "--texture: the photograph of the scene is required with --render-images");
   require(texture_gsd_m >= 0, "--texture-gsd-m must be >= 0");
   require(reference_width_px >= 100 && reference_width_px <= 20000 && reference_height_px >= 100 &&
               reference_height_px <= 20000,

@@ -1,4 +1,4 @@
-// Image mode of `aerocal simulate --pushbroom --images` (issue 17, module README "Image mode"): the
+// Image mode of `aerocal simulate --pushbroom --render-images` (issue 17, module README "Image mode"): the
 // scene of the simulated flight (line_simulation.h: its terrain) textured with a real photograph,
 // rendered
 // - through the TRUE line camera and the TRUE per-line poses into the line image (row r = scan

@@ -344,7 +344,7 @@ SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
                       FormatNumber(kMaxSimulatedStitchTies) + " (fewer --stitch-ties, default 900 a frame)");
   const double pairs = double(o.exposures) * (double(o.ground_points) + o.tie_points);
   if (pairs > kMaxSimulatedPointExposurePairs)
-    throw ConfigError("--exposures x (--points + --tie-points): " + FormatNumber(pairs) +
+    throw ConfigError("--exposures x (--surveyed-points + --tie-points): " + FormatNumber(pairs) +
                       " point-exposure pairs are more than " + FormatNumber(kMaxSimulatedPointExposurePairs));
   internal::SimulationRandom random(o.seed);
   std::mt19937_64& rng = random.rng;

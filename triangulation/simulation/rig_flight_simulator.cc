@@ -398,7 +398,7 @@ calib::Rig ScaleRigFormats(const calib::Rig& rig, double scale) {
 
 void RigImageOptions::Validate() const {
   if (texture_path.empty())
-    throw ConfigError("--texture: the photograph of the scene is required with --images");
+    throw ConfigError("--texture: the photograph of the scene is required with --render-images");
   if (!(texture_gsd_m >= 0)) throw ConfigError("--texture-gsd-m must be >= 0");
   if (!(grey_noise_dn >= 0)) throw ConfigError("--grey-noise-dn must be >= 0");
 }

@@ -20,7 +20,7 @@
 // check ties (points.csv role `check` without coordinates). Each exposure also gets `z_ref`, the
 // mean terrain height under the virtual image.
 //
-// Image mode (`simulate --rig uav4 --images --texture PHOTO`): every head image of every exposure
+// Image mode (`simulate --rig uav4 --render-images --texture PHOTO`): every head image of every exposure
 // rendered through the TRUE head pose of that exposure (ground calibration + increments E_k +
 // offsets dT_k with the velocity; calib::HeadPose) and the head's true interior onto the terrain
 // textured with a real photograph (textured_ground.h), plus Gaussian grey-value noise. Each pixel

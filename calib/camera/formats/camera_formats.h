@@ -92,7 +92,7 @@ struct FileConversion {
   ConversionResult result;
   std::vector<std::string> notes;
 };
-/// ConfigError("--pixel-mm ...") when the target needs a pixel size the source does not give.
+/// ConfigError("--pixel-size-mm ...") when the target needs a pixel size the source does not give.
 FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& target,
                                  const ConvertOptions& options = {});
 
@@ -130,7 +130,7 @@ struct CameraFormat {
   std::function<bool(const std::string& head, const std::string& path)> looks_like;
   std::string extension;           // a file name ending the writer uses (tests, fuzzers)
   bool writes_size = true;         // a written file holds the image size (else --width/--height)
-  bool writes_pixel_size = false;  // ... and the pixel size (else --pixel-mm)
+  bool writes_pixel_size = false;  // ... and the pixel size (else --pixel-size-mm)
   bool holds_covariance = false;   // the writer keeps CameraFile::covariance
 };
 
@@ -185,7 +185,7 @@ CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& option
 bool IsPix4dCalibratedParameters(const std::string& head);
 void WritePix4dCam(const std::string& path, const CameraFile& camera);
 /// Pix4D's camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, PerspectiveDistortion)
-/// from a JPEG or an XMP sidecar; the pixel size from exif:FocalPlaneXResolution or --pixel-mm.
+/// from a JPEG or an XMP sidecar; the pixel size from exif:FocalPlaneXResolution or --pixel-size-mm.
 CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& options);
 void WritePix4dXmp(const std::string& path, const CameraFile& camera);
 
@@ -227,7 +227,7 @@ void WriteKalibrCamchain(const std::string& path, const CameraFile& camera);
 
 // ---- shared by the readers ----
 namespace internal {
-/// Applies --width/--height/--pixel-mm to what a file gave (0 = not given): a given value that
+/// Applies --width/--height/--pixel-size-mm to what a file gave (0 = not given): a given value that
 /// contradicts the file is InputError at `where`; a size nobody gave is InputError naming the
 /// options. Marks the pixel size as known or a placeholder.
 void ResolveFormat(CameraFile* file, const CameraReadOptions& options, const SourceRef& where,

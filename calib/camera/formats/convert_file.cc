@@ -13,7 +13,7 @@ namespace aerocal::calib {
 FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& target,
                                  const ConvertOptions& options) {
   if (target.needs_pixel_size && !from.pixel_size_known)
-    throw ConfigError("--pixel-mm: the target holds millimetres and the source gives no pixel "
+    throw ConfigError("--pixel-size-mm: the target holds millimetres and the source gives no pixel "
                       "size");
   FileConversion out;
   ConvertOptions o = options;

@@ -27,7 +27,7 @@ void ResolveFormat(CameraFile* file, const CameraReadOptions& options, const Sou
   if (file_pixel_size_mm > 0 && options.pixel_size_mm > 0 &&
       std::abs(file_pixel_size_mm - options.pixel_size_mm) > 1e-9 * file_pixel_size_mm)
     ThrowInputError(where, "the file's pixel size " + FormatNumber(file_pixel_size_mm) +
-                               " mm contradicts --pixel-mm " + FormatNumber(options.pixel_size_mm));
+                               " mm contradicts --pixel-size-mm " + FormatNumber(options.pixel_size_mm));
   const double p = file_pixel_size_mm > 0 ? file_pixel_size_mm : options.pixel_size_mm;
   file->pixel_size_known = p > 0;
   frame.pixel_size_mm = p > 0 ? p : kPlaceholderPixelSizeMm;

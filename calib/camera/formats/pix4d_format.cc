@@ -8,7 +8,7 @@
 // one `NAME value` per line ('#' comment lines). The .cam calls the radial terms K1-K3; the
 // registry model (models/pix4d.h, which converts the conventions) calls them R1-R3; both names are
 // read. The pixel size is the sensor width of the comment line over the image width in pixels,
-// which the file does not hold: --width/--height (or --pixel-mm, which gives the size).
+// which the file does not hold: --width/--height (or --pixel-size-mm, which gives the size).
 //
 // Also read: a project's <project>_calibrated_camera_parameters.txt (Pix4Dmapper's params folder;
 // the layout as EasyIDP's Pix4D reader documents it and as files quoted in public code show it):
@@ -119,7 +119,7 @@ CameraFile ReadPix4dCalibratedParameters(const std::string& path,
                          " images share K and distortion: " + picked->name + " read");
   internal::ResolveFormat(&file, options, where, picked->width, picked->height, 0.0);
   if (!file.pixel_size_known)
-    file.notes.push_back("no pixel size (pass --pixel-mm): F, Px, Py in units of the placeholder");
+    file.notes.push_back("no pixel size (pass --pixel-size-mm): F, Px, Py in units of the placeholder");
   const double p = file.camera.frame.pixel_size_mm;
   file.camera.model = M::kId;
   file.camera.params = {k[0] * p, k[2] * p, k[5] * p, k[9], k[10], k[11], k[12], k[13]};
@@ -194,7 +194,7 @@ CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& option
   }
   if (!(pixel > 0))
     ThrowInputError(where, "the pixel size is needed (F, Px, Py are mm): pass --width/--height "
-                           "with the sensor-size line, or --pixel-mm");
+                           "with the sensor-size line, or --pixel-size-mm");
   CameraReadOptions derived;
   internal::ResolveFormat(&file, derived, where, width, height, pixel);
   return file;

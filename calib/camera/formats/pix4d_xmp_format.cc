@@ -9,7 +9,7 @@
 // (models/pix4d.h: mm from the top-left corner, y down, T1 = p1, T2 = p2). The tags hold no image
 // or pixel size: the image size from a JPEG's SOF marker or a sidecar's tiff:ImageWidth/Length,
 // the pixel size from exif:FocalPlaneXResolution with exif:FocalPlaneResolutionUnit (2 inch,
-// 3 cm, 4 mm), which the writer adds and Pix4D also reads, else --pixel-mm.
+// 3 cm, 4 mm), which the writer adds and Pix4D also reads, else --pixel-size-mm.
 #include <cmath>
 #include <optional>
 #include <sstream>
@@ -114,7 +114,7 @@ CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& option
   internal::ResolveFormat(&file, options, where, width, height, pixel_mm);
   if (!file.pixel_size_known)
     ThrowInputError(where, "the pixel size is needed (the tags are mm): the file has no "
-                           "exif:FocalPlaneXResolution; pass --pixel-mm");
+                           "exif:FocalPlaneXResolution; pass --pixel-size-mm");
   return file;
 }
 

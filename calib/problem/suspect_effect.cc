@@ -1,32 +1,61 @@
-#include "triangulation/adjustment/suspect_effect.h"
+#include "calib/problem/suspect_effect.h"
 
 #include "calib/camera/rotation.h"
+
+#include "calib/core/csv.h"
 
 #include <algorithm>
 #include <cmath>
 
-namespace aerocal::triangulation {
+namespace aerocal::calib {
 namespace {
 
 // A block's values as the covariance reports them: omega, phi, kappa (rad) for a rotation
 // quaternion, near `near` (its values before), else the values themselves.
-Eigen::VectorXd ReportedValues(const calib::ProblemBuilder& builder,
-                               calib::BlockId b,
+Eigen::VectorXd ReportedValues(const ProblemBuilder& builder,
+                               BlockId b,
                                const Eigen::Vector3d& near) {
   const double* v = builder.BlockValues(b);
-  if (builder.BlockKindOf(b) == calib::BlockKind::kRotation)
-    return calib::OpkFromQuaternionNear(Eigen::Vector4d(v[0], v[1], v[2], v[3]), near);
+  if (builder.BlockKindOf(b) == BlockKind::kRotation)
+    return OpkFromQuaternionNear(Eigen::Vector4d(v[0], v[1], v[2], v[3]), near);
   return Eigen::Map<const Eigen::VectorXd>(v, builder.BlockSize(b));
 }
 
+nlohmann::json Finite(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
+
 }  // namespace
 
-SuspectEffect EffectOfLeavingOut(calib::ProblemBuilder& builder,
-                                 const std::vector<calib::ResidualId>& suspects,
-                                 const calib::CovarianceReport& cov,
-                                 const std::vector<calib::BlockId>& blocks,
-                                 const std::vector<calib::BlockId>& calibrated,
-                                 const calib::SolverOptions& solver,
+std::string SuspectEffect::Describe() const {
+  if (!computed) return "their effect cannot be judged: " + message;
+  return "leaving them out moves " + parameter + " by " + FormatNumber(max_sigmas, 2) +
+         " of its sigmas (limit " + FormatNumber(limit_sigmas, 3) + ", --suspect-effect-limit)";
+}
+
+nlohmann::json SuspectEffectJson(const SuspectEffect& e) {
+  nlohmann::json j = {{"computed", e.computed},
+                      {"limit_sigmas", e.limit_sigmas},
+                      {"max_sigmas", e.computed ? Finite(e.max_sigmas) : nlohmann::json()},
+                      {"parameter", e.parameter},
+                      {"max_all_sigmas", e.computed ? Finite(e.max_all_sigmas) : nlohmann::json()},
+                      {"parameter_all", e.parameter_all},
+                      {"matters", e.Matters()}};
+  if (!e.message.empty()) j["message"] = e.message;
+  j["calibrated"] = nlohmann::json::array();
+  for (const auto& c : e.calibrated)
+    j["calibrated"].push_back({{"parameter", c.parameter},
+                               {"change", c.change},
+                               {"sigma", Finite(c.sigma)},
+                               {"sigmas", c.sigma > 0 ? Finite(std::abs(c.change) / c.sigma)
+                                                      : nlohmann::json()}});
+  return j;
+}
+
+SuspectEffect EffectOfLeavingOut(ProblemBuilder& builder,
+                                 const std::vector<ResidualId>& suspects,
+                                 const CovarianceReport& cov,
+                                 const std::vector<BlockId>& blocks,
+                                 const std::vector<BlockId>& calibrated,
+                                 const SolverOptions& solver,
                                  double limit_sigmas) {
   SuspectEffect effect;
   effect.limit_sigmas = limit_sigmas;
@@ -35,20 +64,20 @@ SuspectEffect EffectOfLeavingOut(calib::ProblemBuilder& builder,
     return effect;
   }
   std::vector<Eigen::VectorXd> before;
-  for (calib::BlockId b : blocks)
+  for (BlockId b : blocks)
     before.push_back(ReportedValues(builder, b, Eigen::Vector3d::Zero()));
   const std::vector<double> state = builder.ValuesSnapshot();
-  for (calib::ResidualId id : suspects) builder.RemoveResidual(id);
-  const calib::SolveReport without = builder.Solve(solver);
+  for (ResidualId id : suspects) builder.RemoveResidual(id);
+  const SolveReport without = builder.Solve(solver);
   std::vector<Eigen::VectorXd> after;
   for (size_t i = 0; i < blocks.size(); ++i) {
-    const bool rotation = builder.BlockKindOf(blocks[i]) == calib::BlockKind::kRotation;
+    const bool rotation = builder.BlockKindOf(blocks[i]) == BlockKind::kRotation;
     after.push_back(
         ReportedValues(builder,
                        blocks[i],
                        rotation ? Eigen::Vector3d(before[i].head<3>()) : Eigen::Vector3d::Zero()));
   }
-  for (calib::ResidualId id : suspects) builder.RestoreResidual(id);
+  for (ResidualId id : suspects) builder.RestoreResidual(id);
   builder.RestoreValues(state);
   if (!without.usable) {
     effect.message =
@@ -59,7 +88,7 @@ SuspectEffect EffectOfLeavingOut(calib::ProblemBuilder& builder,
   SuspectEffect::Change all_worst;
   double all_max = -1.0;
   for (size_t i = 0; i < blocks.size(); ++i) {
-    const calib::BlockId b = blocks[i];
+    const BlockId b = blocks[i];
     if (builder.IsBlockFixed(b) || !cov.offsets.count(b)) continue;
     const Eigen::VectorXd sigma = cov.BlockSigma(b, static_cast<int>(before[i].size()));
     const bool listed = std::find(calibrated.begin(), calibrated.end(), b) != calibrated.end();
@@ -91,4 +120,4 @@ SuspectEffect EffectOfLeavingOut(calib::ProblemBuilder& builder,
   return effect;
 }
 
-}  // namespace aerocal::triangulation
+}  // namespace aerocal::calib
