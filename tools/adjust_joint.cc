@@ -108,6 +108,7 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
               triangulation::FormatJointSummary(result).c_str());
   nlohmann::json json = triangulation::JointResultToJson(result);
   json["project"] = project_path;
+  AddProjectFacts(input, &json);
   // As the plain adjustment: exit 3 and no camera when the result is not valid.
   return FinishAdjust(result.adjustment, json, out, write_camera, "camera", [&] {
     const auto& cameras = result.adjustment.cameras;

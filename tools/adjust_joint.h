@@ -13,6 +13,7 @@
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
+#include "tools/project_facts.h"
 
 namespace aerocal::tools {
 

@@ -1,6 +1,7 @@
 #include "tools/board_detection.h"
 
 #include "calib/core/error.h"
+#include "calib/core/progress.h"
 #include "calib/core/string_printf.h"
 
 #include <opencv2/calib3d.hpp>
@@ -62,7 +63,13 @@ DetectedBoards DetectBoards(const std::string& glob,
   const std::vector<std::string> files = Glob(glob);
   if (files.empty()) throw InputError("--images: no file matches '" + glob + "'");
   const cv::Size pattern(board.columns, board.rows);
+  Progress progress("board detection", static_cast<long>(files.size()));
+  struct Tick {  // one unit per image, also for the images skipped with `continue`
+    Progress& progress;
+    ~Tick() { progress.Advance(); }
+  };
   for (const auto& path : files) {
+    const Tick tick{progress};
     const cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
     if (gray.empty()) throw InputError(path + ": not an image OpenCV can read");
     if (out.width_px == 0) {

@@ -64,6 +64,7 @@ int RunRigAdjust(const RigArgs& args,
   nlohmann::json json = triangulation::AdjustmentToJson(result.adjustment);
   json.update(triangulation::RigResultToJson(result));
   json["project"] = project_path;
+  AddProjectFacts(input, &json);
   json["valid"] = result.adjustment.valid;
   json["invalid_reasons"] = result.adjustment.invalid_reasons;
   // As the frame camera: exit 3 and no rig file when the result is not valid.
@@ -358,6 +359,15 @@ CommandRun SetupAdjust(CLI::App& app) {
       json = triangulation::AdjustmentToJson(main);
     }
     json["project"] = args->project;
+    AddProjectFacts(input, &json);
+    // Which adjustment a written camera comes from (as flight's camera_written_from).
+    if (!args->write_camera.empty() && main.valid)
+      json["camera_written_from"] = {
+          {"adjustment", main.free_interior.empty() ? "conventional" : "self_calibration"},
+          {"reason", main.free_interior.empty()
+                         ? "the adjustment run (no interior parameter estimated: the camera file's "
+                           "interior with the adjustment's frame)"
+                         : "the self-calibrating adjustment (--self-calibration)"}};
     json["valid"] = main.valid;
     json["invalid_reasons"] = main.invalid_reasons;
     // Exit 3 (results written, valid: false) when the run must not be trusted; the camera file

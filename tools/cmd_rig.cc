@@ -21,6 +21,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/progress.h"
 #include "calib/core/result_file.h"
 #include "stitch/rig/error_analysis.h"
 #include "stitch/rig/error_analysis_json.h"
@@ -362,7 +363,9 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
   options.balance = !args.no_balance;
   options.feather_px = args.feather_px;
   nlohmann::json out = nlohmann::json::array();
+  Progress progress("stitched images", static_cast<long>(exposures.size()));
   for (const auto& e : exposures) {
+    progress.Stage(e.image);
     const auto refined = std::find_if(result.exposures.begin(), result.exposures.end(),
                                       [&](const auto& r) { return r.image == e.image; });
     if (refined == result.exposures.end()) continue;
@@ -425,6 +428,7 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
                 e.image.c_str(), r.width_px, r.height_px, r.valid_pixels, r.overall.rms_dn,
                 r.overall.pixels, image_path.c_str());
     for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", e.image.c_str(), w.c_str());
+    progress.Advance();
   }
   return out;
 }

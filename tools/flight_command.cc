@@ -92,9 +92,9 @@ void PrepareFlight(FlightArgs* args) {
 }
 
 int RunFlight(const FlightArgs& args) {
-  Progress progress("flight", 5);
+  // The workflow's five steps, then the report (its figures take tens of seconds on a big flight).
+  Progress progress("flight", args.no_report ? 5 : 6);
   const auto result = triangulation::RunFlightWorkflow(args.options, &progress);
-  progress.Finish();
   namespace fs = std::filesystem;
   for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
   for (const auto& [step, reason] : result.failures)
@@ -122,18 +122,22 @@ int RunFlight(const FlightArgs& args) {
   }
   // A report or certificate of an earlier flight left beside this result.json would not
   // describe it: parts this run does not write are removed with the commit.
-  if (args.no_report) obsolete.push_back("report.html");
+  if (args.no_report) obsolete.insert(obsolete.end(), {"report.html", "report.pdf"});
   if (!args.no_report) {
     const char* env = std::getenv("AEROCAL_REPORT_SCRIPT");
     const std::string script = env ? env : AEROCAL_REPORT_SCRIPT;
-    const std::string html = set.Staged("report.html");
-    if (!RunPythonScript(script, {json_path, html})) {
+    const std::string html = set.Staged("report.html"), pdf = set.Staged("report.pdf");
+    progress.Stage("report");
+    if (!RunPythonScript(script, {json_path, html, pdf})) {
       std::fprintf(stderr, "error: the report could not be written (%s); nothing written, the "
                    "previous flight in %s is left as it was\n",
-                   PythonCommandLine(script, {json_path, html}).c_str(), args.out.c_str());
+                   PythonCommandLine(script, {json_path, html, pdf}).c_str(), args.out.c_str());
       return kExitInternal;
     }
+    progress.Advance();
     parts.push_back("report.html");
+    // report.pdf: the same page typeset, where weasyprint is installed (tools/report/README.md).
+    (std::filesystem::exists(pdf) ? parts : obsolete).push_back("report.pdf");
   }
   int certificate_code = kExitOk;
   if (args.certificate && result.valid) {

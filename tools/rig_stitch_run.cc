@@ -8,6 +8,7 @@
 #include "calib/camera/rig_io.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/progress.h"
 #include "calib/core/string_printf.h"
 #include "stitch/image_io/image_io.h"
 #include "stitch/rig/rig_design.h"
@@ -110,6 +111,7 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
   for (const auto& e : in.exposures)  // every head image present before anything is computed
     for (const auto& head : rig.heads) HeadImagePath(images, e.image, head.id);
   stitch::RigTieMatches matches;
+  Progress progress("rig tie matching", static_cast<long>(in.exposures.size()));
   for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i) {
     std::vector<stitch::GrayImage> heads;
     for (const auto& head : rig.heads) {
@@ -122,6 +124,7 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
                          std::to_string(head.camera.height_px) + " px");
     }
     stitch::MatchRigExposureTies(rig, in.exposures[i], i, heads, {}, &matches);
+    progress.Advance();
   }
   double sum2 = 0.0;
   for (double sigma : matches.lsm_sigma_px) sum2 += sigma * sigma;

@@ -13,6 +13,7 @@ packages=(cmake make g++ pkg-config
   nlohmann-json3-dev ccache libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libtiff-dev libtinyxml2-dev zlib1g-dev clang libclang-rt-dev
   python3 python3-matplotlib python3-numpy poppler-utils
   python3-dev pybind11-dev python3-pytest
+  weasyprint  # report.pdf: the HTML report typeset for A4 (tools/report/README.md)
   parallel)  # GNU Parallel (2.9 MB installed, with sysstat 1.8 MB): `aerocal batch` shards, tests/tools/cli_batch
 missing=()
 for p in "${packages[@]}"; do

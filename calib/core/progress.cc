@@ -1,5 +1,7 @@
 #include "calib/core/progress.h"
 
+#include "calib/core/log.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <unistd.h>
@@ -19,8 +21,27 @@ Progress::Progress(std::string label, long total)
       total_(total > 0 ? total : 1),
       start_(std::chrono::steady_clock::now()),
       last_draw_(start_),
-      enabled_(EnabledOverride() >= 0 ? EnabledOverride() == 1 : ::isatty(STDERR_FILENO) == 1) {
+      enabled_(EnabledOverride() >= 0 ? EnabledOverride() == 1 : ::isatty(STDERR_FILENO) == 1),
+      logged_(!enabled_ && EnabledOverride() != 0 && GetLogLevel() != LogLevel::kQuiet) {
   if (enabled_) Draw(false);
+}
+
+void Progress::Stage(const std::string& name) {
+  std::lock_guard<std::mutex> lock(mutex_);
+  stage_ = name;
+  if (enabled_) Draw(false);
+}
+
+// A line when `done` reaches the next tenth of the work (every unit up to 20 units).
+void Progress::LogLine(long done) {
+  const long step = total_ <= 20 ? 1 : (total_ + 9) / 10;
+  if (done < total_ && done / step == last_logged_ / step) return;
+  last_logged_ = done;
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
+  std::fprintf(stderr, "%s: %ld/%ld%s%s (%.1f s)\n", label_.c_str(), done, total_, stage_.empty() ? "" : " ",
+               stage_.c_str(), seconds);
+  std::fflush(stderr);
 }
 
 Progress::~Progress() { Finish(); }
@@ -28,6 +49,10 @@ Progress::~Progress() { Finish(); }
 void Progress::Advance(long units) {
   const long done = done_ += units;
   if (observer_) observer_(std::min(done, total_), total_);
+  if (logged_) {
+    std::lock_guard<std::mutex> lock(mutex_);
+    LogLine(std::min(done, total_));
+  }
   if (!enabled_) return;
   const auto now = std::chrono::steady_clock::now();
   std::lock_guard<std::mutex> lock(mutex_);
@@ -59,8 +84,8 @@ void Progress::Draw(bool final_line) {
     const double per_second = done / seconds;
     std::snprintf(rate, sizeof(rate), ", %.3g/s, ETA %.0f s", per_second, (total_ - done) / per_second);
   }
-  std::fprintf(stderr, "\r%s [%s] %ld/%ld %5.1f s%s   %s", label_.c_str(), bar.c_str(), done, total_,
-               seconds, rate, final_line ? "\n" : "");
+  std::fprintf(stderr, "\r%s [%s] %ld/%ld %5.1f s%s%s%s   %s", label_.c_str(), bar.c_str(), done, total_,
+               seconds, rate, stage_.empty() ? "" : " ", stage_.c_str(), final_line ? "\n" : "");
   std::fflush(stderr);
 }
 

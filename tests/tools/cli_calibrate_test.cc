@@ -57,6 +57,12 @@ TEST(CalibrateCommand, OpenCvModelOnTheChessboardEqualsCalibrateCamera) {
   const auto c = RunAerocal("certificate --result " + tmp.File("cv.json") + " --out " + tmp.File("cert"));
   ASSERT_LE(c.exit_code, 3) << c.output;
   const auto cert = ReadJson(tmp.File("cert/certificate.json"));
+  // No lab file: a draft, not called a certificate (issue 33 item 2).
+  const std::string draft = ReadTextFile(tmp.File("cert/certificate.html"));
+  EXPECT_NE(draft.find("<h1>DRAFT calibration report (no laboratory file: not a certificate)</h1>"),
+            std::string::npos);
+  EXPECT_EQ(draft.find("Calibration certificate"), std::string::npos);
+  EXPECT_EQ(draft.find("Signatures"), std::string::npos);
   const auto& d = cert["distortion"];
   ASSERT_TRUE(d.is_object()) << cert.dump().substr(0, 400);
   EXPECT_EQ(d["profile_kind"], "mean over directions");
@@ -205,6 +211,11 @@ TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
   EXPECT_EQ(cert["kind"], "certificate");
   EXPECT_TRUE(cert["comparison"]["pass"].get<bool>());  // against itself: differences 0
   EXPECT_EQ(cert["comparison"]["rows"][0]["criterion"], "|difference| <= tolerance");
+  // The comparison judges the camera; sigma0 (m_0) and the check RMSEs are the run's, not judged.
+  for (const auto& row : cert["comparison"]["rows"]) {
+    const std::string q = row["quantity"];
+    EXPECT_EQ(row["judged"].get<bool>(), q != "m_0" && q != "m_X" && q != "m_Y" && q != "m_Z") << q;
+  }
   const std::string html = ReadTextFile(tmp_.File("cert1/certificate.html"));
   for (const char* text : {"Calibration certificate", "T-1", "Uncertainty budget", "<svg", "Stability over image groups",
                            "Check points", "Comparison with the previous certificate", "Signatures", "c = 7.457"})

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <map>
 #include <functional>
 #include <fstream>
@@ -57,6 +58,20 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   EXPECT_EQ(doc["kind"], "flight");
   EXPECT_EQ(doc["schema_version"], kResultSchemaVersion);
   EXPECT_EQ(doc["camera_model"]["name"], "brown_fraser_10");
+  // Every file read, with its SHA-256 (issue 33 item 1): the virtual project's and the joint
+  // step's sub-image project's, each once.
+  std::set<std::string> roles, paths;
+  for (const auto& f : doc["inputs"]) {
+    roles.insert(f["role"].get<std::string>());
+    EXPECT_TRUE(paths.insert(f["path"].get<std::string>()).second) << f.dump();
+    EXPECT_EQ(f["sha256"].get<std::string>().size(), 64u);
+    EXPECT_EQ(f["bytes"].get<std::uintmax_t>(), std::filesystem::file_size(f["path"].get<std::string>()));
+  }
+  for (const char* role : {"project", "exposures", "observations", "points", "stitching"})
+    EXPECT_EQ(roles.count(role), 1u) << role;
+  // Not a terminal: one progress line per stage (issue 33 item 6), the report the last.
+  for (const char* line : {"flight: 1/6 stitching (", "flight: 5/6 result (", "flight: 6/6 report ("})
+    EXPECT_NE(run_->output.find(line), std::string::npos) << line << "\n" << run_->output;
   const auto& stitching = doc["stitching"];
   for (const char* key : {"kind", "sigma0", "sigma0_px", "redundancy", "iterations", "converged", "model",
                           "subimages", "frames", "stability"})

@@ -105,10 +105,12 @@ class FixtureReport(unittest.TestCase):
         self.assertTrue(self.html.startswith("<!DOCTYPE html>"))
 
     def test_has_the_sections_and_tables(self):
-        for heading in ("1. Summary", "2. Stitching of the sub-images", "2.1 Model comparison", "2.2 Flight stability",
-                        "2.3 sigma0 per exposure", "3. Adjustments", "3.1 Conventional triangulation",
-                        "3.2 Self-calibrating triangulation", "4. Comparison of the adjustments", "5. Calibration",
-                        "5.1 Distortion curves", "6. Image residuals over the format", "7. Check-point errors"):
+        for heading in ("1. Summary", "2. Project", "3. Stitching of the sub-images", "3.1 Model comparison",
+                        "3.2 Flight stability", "3.3 sigma0 per exposure", "4. Adjustments",
+                        "4.1 Conventional triangulation", "4.2 Self-calibrating triangulation",
+                        "5. Left out: images, points and observations the adjustments did not use",
+                        "6. Comparison of the adjustments", "7. Calibration", "7.1 Distortion curves",
+                        "8. Image residuals over the format", "9. Check-point errors"):
             self.assertIn(heading, self.page.headings)
         for element in ("summary-steps", "stitch-model-comparison", "stitch-model-choice", "stitch-stability",
                         "stitch-sigma0-plot", "adj-conventional-points", "adj-self-calibration-points",
@@ -368,8 +370,10 @@ class TolerantInput(unittest.TestCase):
         joint = page.tables["summary-steps"][-1]  # the last step that ran
         self.assertIn("mappings translation", joint[-1])
         self.assertIn("1 warning(s)", joint[-1])
-        self.assertIn("All steps converged and are valid.", text)  # a warning does not invalidate
-        self.assertEqual(text.count("residual group stitch_tie: RMS 14.1 sigma"), 2)  # summary and section
+        # A warning does not invalidate, and the verdict line says the warning (never a plain "valid").
+        self.assertIn("Verdict: converged, with 1 warning(s)", text)
+        self.assertNotIn("Verdict: valid", text)
+        self.assertEqual(text.count("residual group stitch_tie: RMS 14.1 sigma"), 3)  # verdict, summary, section
         self.assertIn("Mapping model: translation (given by the user).", text)
 
     def test_what_snooping_cannot_judge_is_listed(self):
@@ -397,6 +401,111 @@ class TolerantInput(unittest.TestCase):
         self.assertEqual(row[3:5], ["0.00, 0.48", "n/a, 2.1"])
         self.assertIn("two-ray point", row[5])
         self.assertIn("1 with r = 0", text)
+
+
+def adjust_result(**extra):
+    """A small `aerocal adjust --compare` result: one blunder rejected (1200 px, w 768), one image
+    left out, a control survey left out, two weakly controlled observations."""
+    residuals = [{"image": "A", "point": "P1", "col": 100.0, "row": 200.0, "v_col_px": 0.5, "v_row_px": -0.5,
+                  "used": True, "r": [0.4, 0.5], "w_xy": [0.7, 0.8]},
+                 {"image": "B", "point": "P1", "col": 300.0, "row": 100.0, "v_col_px": -0.3, "v_row_px": 0.4,
+                  "used": True, "r": [0.3, 0.4], "w_xy": [0.5, 0.6]},
+                 {"image": "B", "point": "P2", "col": 900.0, "row": 500.0, "v_col_px": 1000.0,
+                  "v_row_px": -663.3, "used": False}]
+    own = {"name": "ignored", "sigma0": 1.1, "sigma0_px": 1.1, "converged": True, "valid": True,
+           "self_calibration": ["c"], "residuals": residuals,
+           "rejected": [{"image": "B", "point": "P2", "by": "robust start", "residual_px": 1200.0, "w": 768.4,
+                         "measured_px": [900.0, 500.0]}],
+           "exposures": [{"image": "A", "X": 0.0, "Y": 0.0, "Z": 100.0, "omega": 0.1, "phi": 0.2, "kappa": 90.0,
+                          "sigma": {"X": 0.01, "Y": 0.01, "Z": 0.02, "omega": 0.001, "phi": 0.001, "kappa": 0.001},
+                          "used": True},
+                         {"image": "C", "X": 5.0, "Y": 0.0, "Z": 100.0, "omega": 0.0, "phi": 0.0, "kappa": 90.0,
+                          "sigma": {k: None for k in ("X", "Y", "Z", "omega", "phi", "kappa")}, "used": False}],
+           "notes": ["image C sees 2 point(s) only: its orientation cannot be determined; left out"],
+           "control": {"n": 1, "rmse_m": [0.01, 0.01, 0.01], "points": [
+               {"point": "P1", "rays": 2, "surveyed": [0, 0, 0], "adjusted": [0.01, 0, 0],
+                "difference_m": [0.01, 0.0, 0.0]}]},
+           "control_left_out": [{"point": "P9", "rays": 3, "difference_m": [0.5, 0.0, 0.0], "w": 6.2,
+                                 "components": {"plan": 6.2}}],
+           "check": {"n": 1, "rmse_m": [0.02, 0.02, 0.02], "points": [
+               {"point": "K1", "rays": 2, "surveyed": [1, 1, 0], "adjusted": [1.02, 1, 0],
+                "difference_m": [0.02, 0.0, 0.0], "uncontrolled": "ray B: r = 0 on photo y"}]},
+           "snooping": {"min_redundancy": 0.1, "uncontrolled": [
+               {"image": "A", "point": "K1", "rays": 2, "r": [0.2, 0.0], "untestable": True, "reason": "r = 0"},
+               {"image": "B", "point": "K1", "rays": 2, "r": [0.3, 0.05], "reason": "weak"}]},
+           "warnings": []}
+    doc = dict(own, kind="adjust", schema_version=1, project="p",
+               camera_format={"width_px": 1000, "height_px": 800, "pixel_size_mm": 0.01},
+               conventional=dict(own, self_calibration=[], name="x"))
+    doc.update(extra)
+    return doc
+
+
+class WhatPeopleRead(unittest.TestCase):
+    """Issue 33 item 1: per-point tables, rejected apart, left-out named, one consistent verdict."""
+    setUp, tearDown, render = TolerantInput.setUp, TolerantInput.tearDown, TolerantInput.render
+
+    def test_adjust_result_is_reported_with_its_conventional_reference(self):
+        text, page = self.render(adjust_result())
+        self.assertIn("aerocal block adjustment report", text)
+        self.assertIn("4.1 Conventional triangulation", page.headings)
+        self.assertIn("4.2 Self-calibrating triangulation", page.headings)
+
+    def test_residuals_plotted_are_the_used_ones_and_the_blunder_is_listed_with_w(self):
+        sys.path.insert(0, os.path.dirname(SCRIPT))
+        import report_data
+        doc = report_data.as_flight_document(adjust_result())
+        self.assertEqual(len(report_data.residuals(doc["adjustments"][1])), 2)  # the 1200 px one is out
+        text, page = self.render(adjust_result())
+        row = page.row("adj-self-calibration-rejected", "B")
+        self.assertEqual(row[3:6], ["1200.00", "768.4", "robust start"])
+        self.assertIn("the 2 rejected are listed apart", text)  # one per adjustment panel
+
+    def test_points_exposures_and_left_out_are_named_with_the_reason(self):
+        text, page = self.render(adjust_result())
+        check = page.row("adj-self-calibration-check-points", "K1")
+        self.assertEqual(check[8:10], ["used, untestable rays", "ray B: r = 0 on photo y"])
+        control = page.row("adj-self-calibration-control-points", "P9")
+        self.assertEqual(control[7:9], ["6.2", "rejected"])
+        exposure = page.row("adj-self-calibration-exposures", "C")
+        self.assertEqual(exposure[-1], "no: left out")
+        left = {(r[1], r[2]): r for r in page.tables["left-out-table"][1:]}
+        self.assertIn("Conventional triangulation, Self-calibrating triangulation", left[("image", "C")][0])
+        self.assertIn("w = 768.4", left[("observation", "image B point P2")][3])
+        self.assertIn("w = 6.2", left[("control survey", "P9")][3])
+
+    def test_weakly_controlled_rows_are_summarised_and_folded(self):
+        text, _ = self.render(adjust_result())
+        self.assertIn("2 observation(s) weakly controlled", text)
+        self.assertIn("worst: image A point K1 (r = 0.000)", text)
+        self.assertIn("<details><summary>Full list (2)</summary>", text)
+
+    def test_the_verdict_follows_the_worst_finding(self):
+        text, _ = self.render(adjust_result())
+        self.assertIn('class="verdict ok"', text)
+        suspect = adjust_result(snooping={"model_error_suspected": True, "model_error_evidence": ["sigma0 2 > 1.5"],
+                                          "suggestion": "check the camera model"})
+        text, _ = self.render(suspect)
+        self.assertIn('class="verdict warn"', text)
+        self.assertNotIn('class="verdict ok"', text)
+        invalid = adjust_result(valid=False, invalid_reasons=["c not determinable"])
+        text, _ = self.render(invalid)
+        self.assertIn("Verdict: NOT VALID: Self-calibrating triangulation: c not determinable", text)
+
+    def test_advice_depends_on_the_case(self):
+        sys.path.insert(0, os.path.dirname(SCRIPT))
+        import report_data
+        import report_facts
+        held = {"held": [{"parameter": "c", "reason": "not determinable (traded against the orientation)"}]}
+        doc = report_data.as_flight_document(adjust_result(self_calibration_choice=held))
+        advice = " ".join(report_facts.advice(doc))
+        self.assertIn("Re-measure or remove the 1 rejected", advice)
+        self.assertIn("Images left out (C)", advice)
+        self.assertIn("Points seen in two images only (K1)", advice)
+        # Two exposures are no aerial block: close-range advice, nothing about strips or GNSS.
+        self.assertNotIn("GNSS", advice)
+        self.assertNotIn("strips", advice)
+        self.assertIn("convergent and rolled", advice)
 
 
 if __name__ == "__main__":

@@ -18,6 +18,7 @@ import json
 import math
 import os
 import sys
+import textwrap
 
 try:
     import matplotlib
@@ -55,12 +56,38 @@ def fmt(v, digits=6):
     return str(v)
 
 
+def fmt_u(v):
+    """An expanded uncertainty with two significant digits, trailing zeros kept (0.60, 1.0e-06)."""
+    if not isinstance(v, (int, float)) or isinstance(v, bool) or not math.isfinite(v) or v <= 0:
+        return "-"
+    text = "%#.2g" % v
+    return text[:-1] if text.endswith(".") else text
+
+
+def unit_of(unit):
+    """A table unit for people: the dimensionless "1" is written as "-" (never `unit 1`)."""
+    return "-" if unit in ("1", "", None) else unit
+
+
+def is_draft(c):
+    """No laboratory file: no lab name and no certificate number. Such a document is a draft and
+    is not called a certificate (ISO/IEC 17025 7.8.2: a certificate names the laboratory)."""
+    lab = c.get("lab") or {}
+    return not (lab.get("lab") or {}).get("name") and not (lab.get("certificate") or {}).get("number")
+
+
+def title_of(c):
+    if is_draft(c):
+        return "DRAFT calibration report (no laboratory file: not a certificate)"
+    return "Calibration certificate %s" % c["lab"]["certificate"]["number"]
+
+
 # ---------------------------------------------------------------- tables (lists of rows)
 
 def result_rows(c):
     rows = [["quantity", "value", "U", "k", "unit", "nu_eff"]]
     for q in c["results"]:
-        rows.append([q["quantity"], fmt(q["value"], 7), fmt(q["U"], 2), fmt(q["k"], 3), q["unit"],
+        rows.append([q["quantity"], fmt(q["value"], 7), fmt_u(q["U"]), fmt(q["k"], 3), unit_of(q["unit"]),
                      fmt(q["dof_eff"], 3)])
     return rows
 
@@ -72,7 +99,7 @@ def budget_rows(c):
             rows.append([q["quantity"], comp["source"], comp["type"], comp["distribution"],
                          fmt(comp["u"], 3), fmt(comp["dof"], 3)])
         rows.append([q["quantity"], "combined u_c / expanded U", "", "k = %s" % fmt(q["k"], 3),
-                     fmt(q["u_c"], 3) + " / " + fmt(q["U"], 2), fmt(q["dof_eff"], 3)])
+                     fmt(q["u_c"], 3) + " / " + fmt_u(q["U"]), fmt(q["dof_eff"], 3)])
     return rows
 
 
@@ -103,7 +130,7 @@ def check_rows(c):
     for name in ["m_X", "m_Y", "m_Z", "m_0"]:
         q = by_name.get(name)
         if q:
-            rows.append([name, fmt(q["value"], 4), "%s (%s)" % (fmt(q["U"], 2), fmt(q["k"], 3)), q["unit"]])
+            rows.append([name, fmt(q["value"], 4), "%s (%s)" % (fmt_u(q["U"]), fmt(q["k"], 3)), unit_of(q["unit"])])
     rows.append(["check points n", str(n), "", ""])
     if n:
         rows.append(["mean X / Y / Z", " / ".join(fmt(1e3 * v, 3) for v in chk["mean_m"]), "", "mm"])
@@ -117,23 +144,33 @@ def comparison_rows(c):
         return None
     rows = [["quantity", "now", "previous", "difference", "tolerance", "E_n", "criterion", "result"]]
     for r in cmp["rows"]:
+        judged = r.get("judged", True)
+        verdict = ("pass" if r["pass"] else "FAIL") if judged else \
+            "not judged (%s)" % ("consistent" if r["pass"] else "differs")
         rows.append([r["quantity"], fmt(r["value"], 7), fmt(r["previous"], 7), fmt(r["difference"], 3),
-                     fmt(r["tolerance"], 3), fmt(r["E_n"], 3), r["criterion"], "pass" if r["pass"] else "FAIL"])
+                     fmt(r["tolerance"], 3), fmt(r["E_n"], 3), r["criterion"], verdict])
     return rows
+
+
+COMPARISON_NOTE = ("The comparison judges the camera: its parameters and distortion values. sigma0 (m_0) "
+                   "and the check-point RMSEs (m_X, m_Y, m_Z) are properties of the run (images, targets, "
+                   "pointing), listed for information and not counted in the overall result.")
 
 
 def identification_rows(c):
     lab, cam, cf = c["lab"], c["lab"]["camera"], c["camera_file"]
     m, d, a = c["method"], c["data"], c["adjustment"]
-    rows = [["field", "value"],
-            ["certificate number", lab["certificate"]["number"]],
-            ["date", lab["certificate"]["date"]],
-            ["laboratory", lab["lab"]["name"]],
-            ["address", lab["lab"]["address"]],
-            ["accreditation", lab["lab"]["accreditation"]],
-            ["customer", lab["customer"]["name"]],
-            ["camera", "%s %s, serial %s" % (cam["make"], cam["model"], cam["serial"])],
-            ["lens", "%s %s" % (cam["lens"], cam["lens_serial"])],
+    rows = [["field", "value"]]
+    if not is_draft(c):
+        rows += [["certificate number", lab["certificate"]["number"]],
+                 ["date", lab["certificate"]["date"]],
+                 ["laboratory", lab["lab"]["name"]],
+                 ["address", lab["lab"]["address"]],
+                 ["accreditation", lab["lab"]["accreditation"]],
+                 ["customer", lab["customer"]["name"]]]
+    camera = " ".join(x for x in (cam["make"], cam["model"]) if x) or c.get("interior", {}).get("id") or "-"
+    rows += [["camera", camera + (", serial %s" % cam["serial"] if cam["serial"] else ", serial not given")],
+             ["lens", " ".join(x for x in (cam["lens"], cam["lens_serial"]) if x) or "-"],
             ["camera file", "%s: pixel %s mm, format %s x %s px" % (cf["file"], fmt(cf["pixel_size_mm"]),
                                                                    cf["format_px"][0], cf["format_px"][1])],
             ["method", method_text(m)],
@@ -142,13 +179,62 @@ def identification_rows(c):
                 ", ".join(a.get("self_calibration") or []) if isinstance(a.get("self_calibration"), list) else fmt(a.get("self_calibration")),
                 fmt(a["sigma0"], 4), fmt(a["sigma0_px"], 4), fmt(a["sigma0_um"], 4), fmt(a["redundancy"]), fmt(a["rms_px"], 4))],
             ["conditions", ", ".join("%s %s" % (k, v) for k, v in lab["conditions"].items() if v) or "-"],
-            ["valid", "yes" if a["valid"] else "NO: " + "; ".join(a["invalid_reasons"])]]
+            ["valid", validity(c)]]
     if c.get("opencv"):
         o = c["opencv"]
         rows.append(["peer: cv::calibrateCamera", "RMS %s px, fx %s, fy %s, cx %s, cy %s px (c %s, x0 %s, y0 %s mm)" % (
             fmt(o["rms_px"], 5), fmt(o["fx"], 7), fmt(o["fy"], 7), fmt(o["cx"], 7), fmt(o["cy"], 7),
             fmt(o["equivalent"]["c"], 6), fmt(o["equivalent"]["x0"], 4), fmt(o["equivalent"]["y0"], 4))])
     return rows
+
+
+def validity(c):
+    """"yes" only when the adjustment is valid AND every test passed: group stability and the
+    comparison with a previous certificate (a failed test is never "valid yes")."""
+    reasons = list(c["adjustment"].get("invalid_reasons") or []) if not c["adjustment"]["valid"] else []
+    stability = c.get("stability") or {}
+    if c.get("groups") and stability.get("agree") is False:
+        disagree = [r["parameter"] for r in stability.get("rows", []) if not r.get("agree")]
+        reasons.append("the image groups disagree (%s)" % ", ".join(disagree))
+    if c.get("comparison") and not c["comparison"].get("pass"):
+        reasons.append("the camera differs from the previous certificate")
+    return "yes" if not reasons else "NO: " + "; ".join(reasons)
+
+
+def model_rows(c):
+    """The camera model written out: which parameters were estimated and which held."""
+    interior = c.get("interior") or {}
+    free = set(interior.get("free") or [])
+    rows = [["parameter", "unit", "meaning", "this calibration"]]
+    meaning = {"c": "principal distance", "x0": "principal point x (photo frame, from the format centre)",
+               "y0": "principal point y (photo frame, y up)", "K1": "radial", "K2": "radial", "K3": "radial",
+               "P1": "decentring", "P2": "decentring", "B1": "affinity (scale of x)", "B2": "shear"}
+    for p in (c.get("camera_model") or {}).get("parameters", []):
+        held = interior.get("estimated", {}).get(p["name"])
+        rows.append([p["name"], unit_of(p["unit"]), meaning.get(p["name"], p.get("group", "").replace("_", " ")),
+                     "estimated" if p["name"] in free else "held at %s" % fmt(held)])
+    return rows
+
+
+MODEL_TEXT_BROWN_FRASER = (
+    "Photo frame: origin at the centre of the image format, x to the right, y up, in mm; pixel (col, row) "
+    "-> x = (col - (W - 1)/2) p, y = -(row - (H - 1)/2) p, p the pixel size. The principal point (x0, y0) "
+    "is the foot of the perpendicular from the projection centre, in that frame (positive x0: right of "
+    "the format centre; positive y0: above it). Correction form (Brown / Fraser 1997), evaluated at the "
+    "measured (x, y): with xb = x - x0, yb = y - y0, r^2 = xb^2 + yb^2, "
+    "dx = xb (K1 r^2 + K2 r^4 + K3 r^6) + P1 (r^2 + 2 xb^2) + 2 P2 xb yb + B1 xb + B2 yb, "
+    "dy = yb (K1 r^2 + K2 r^4 + K3 r^6) + 2 P1 xb yb + P2 (r^2 + 2 yb^2); the ideal point is "
+    "(xb + dx, yb + dy) = -c (U, V) / W (collinearity). dr@R is the radial correction "
+    "R (K1 R^2 + K2 R^4 + K3 R^6) at the radius R mm from the principal point, dt@R the magnitude of the "
+    "decentring correction sqrt(P1^2 + P2^2) R^2 there, both in um.")
+
+
+def model_text(c):
+    name = (c.get("camera_model") or {}).get("name", "brown_fraser_10")
+    if name == "brown_fraser_10":
+        return MODEL_TEXT_BROWN_FRASER
+    return ("Camera model %s in the photo frame of aerocal (origin at the format centre, x right, y up, mm); "
+            "its parameters and equations: docs/conventions.md section 3 of aerocal." % name)
 
 
 def resolution_edge_rows(c):
@@ -265,12 +351,32 @@ def method_text(m):
 
 
 def warning_lines(c):
+    """Every finding once: the adjustment's warnings, then the flagged groups unless a warning of
+    the adjustment already states the group test."""
     out = []
     for w in c["adjustment"].get("warnings") or []:
-        out.append("%s: %s" % (w.get("name"), w.get("message")))
+        line = "%s: %s" % (w.get("name"), w.get("message"))
+        if line not in out:
+            out.append(line)
+    stated = any(w.get("name") == "group_stability" for w in c["adjustment"].get("warnings") or [])
     for f in (c.get("stability") or {}).get("flagged", []):
-        out.append("group stability: " + f)
+        line = "group stability: " + f
+        if not stated and line not in out:
+            out.append(line)
     return out
+
+
+def type_a_note(c):
+    """What is type A only, said in the document (not only in the JSON)."""
+    kinds = {comp["type"] for q in c["results"] for comp in q["components"]
+             if comp.get("u") and comp["u"] > 0}
+    if kinds == {"A"}:
+        return ("This budget holds type A components only (the adjustment's statistics): no type B "
+                "component is known for this calibration (give a budget file: aerocal calibrate --budget).")
+    zero_b = sorted({comp["source"] for q in c["results"] for comp in q["components"]
+                     if comp["type"] == "B" and not comp.get("u")})
+    return ("Type B components of zero size (their source gave no uncertainty): %s." % "; ".join(zero_b)
+            if zero_b else "")
 
 
 # ---------------------------------------------------------------- figures
@@ -370,20 +476,31 @@ def html_table(rows, flag_col=None):
 
 def write_html(c, path, figures):
     lab = c["lab"]
-    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>Calibration certificate %s</title>" %
-             html.escape(lab["certificate"]["number"]),
+    draft = is_draft(c)
+    parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>%s</title>" % html.escape(title_of(c)),
              "<style>body{font-family:sans-serif;max-width:60em;margin:auto;font-size:11pt}"
              "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #999;padding:2px 6px;"
              "text-align:left;font-size:10pt}.bad{color:#b00;font-weight:bold}.sig td{height:3em;width:14em}"
-             "h1{font-size:18pt}h2{font-size:13pt;border-bottom:1px solid #999}</style></head><body>",
-             "<h1>Calibration certificate</h1>",
-             "<p>%s<br>%s<br>%s</p>" % tuple(html.escape(lab["lab"][k]) for k in ("name", "address", "accreditation")),
-             "<h2>1. Identification, method and data</h2>", html_table(identification_rows(c)),
-             "<h2>2. Results</h2><p>Each value with its expanded uncertainty U = k u_c (ISO GUM / JJF 1059.1), "
-             "coverage probability about 95 %.</p>",
-             "<ul>" + "".join("<li>%s</li>" % html.escape(q["statement"]) for q in c["results"]) + "</ul>",
-             html_table(result_rows(c)),
-             "<h2>3. Uncertainty budget</h2>", html_table(budget_rows(c)),
+             ".draft{color:#b00;border:2px solid #b00;padding:4px 8px;font-weight:bold}"
+             "h1{font-size:18pt}h2{font-size:13pt;border-bottom:1px solid #999}"
+             "@page{size:A4;margin:16mm 14mm;@bottom-right{content:'page ' counter(page) ' of ' counter(pages);"
+             "font-size:8pt}}@media print{body{max-width:none;font-size:9pt}td,th{font-size:7.5pt}"
+             "svg{max-width:100%;height:auto}h2{break-after:avoid}}</style></head><body>",
+             "<h1>%s</h1>" % html.escape(title_of(c))]
+    if draft:
+        parts.append("<p class='draft'>DRAFT: no laboratory file (--lab) was given. This document states "
+                     "aerocal's results and their budget; it is not a calibration certificate (ISO/IEC 17025 "
+                     "7.8: a certificate names the laboratory, its number and date, and is signed).</p>")
+    else:
+        parts.append("<p>%s<br>%s<br>%s</p>" % tuple(html.escape(lab["lab"][k])
+                                                   for k in ("name", "address", "accreditation")))
+    parts += ["<h2>1. Identification, method and data</h2>", html_table(identification_rows(c)),
+              "<h3>Camera model</h3><p>%s</p>" % html.escape(model_text(c)), html_table(model_rows(c)),
+              "<h2>2. Results</h2><p>Each value with its expanded uncertainty U = k u_c (ISO GUM / JJF 1059.1), "
+              "coverage probability about 95 %; U with two significant digits.</p>",
+              "<ul>" + "".join("<li>%s</li>" % html.escape(q["statement"]) for q in c["results"]) + "</ul>",
+              html_table(result_rows(c)),
+              "<h2>3. Uncertainty budget</h2>", "<p>%s</p>" % html.escape(type_a_note(c)), html_table(budget_rows(c)),
              "<h2>4. Distortion</h2>", figures["distortion"],
              "<h2>5. Residuals and correlations</h2>", figures["residuals"]]
     st = stability_rows(c)
@@ -393,8 +510,9 @@ def write_html(c, path, figures):
     cmp = comparison_rows(c)
     parts.append("<h2>8. Comparison with the previous certificate</h2>")
     if cmp:
-        parts.append("<p>Previous: %s. Overall: <b>%s</b>.</p>" % (
-            html.escape(c["comparison"]["previous"]), "pass" if c["comparison"]["pass"] else "FAIL"))
+        parts.append("<p>Previous: %s. Overall (the camera's parameters): <b>%s</b>. %s</p>" % (
+            html.escape(c["comparison"]["previous"]), "pass" if c["comparison"]["pass"] else "FAIL",
+            html.escape(COMPARISON_NOTE)))
         parts.append(html_table(cmp, flag_col=7))
     else:
         parts.append("<p>No previous certificate given.</p>")
@@ -412,8 +530,10 @@ def write_html(c, path, figures):
     if warnings:
         parts.append("<h2>Findings</h2><ul>" + "".join("<li class='bad'>%s</li>" % html.escape(w) for w in warnings) + "</ul>")
     s = lab["signatures"]
-    parts.append("<h2>Signatures</h2><table class='sig'><tr><th>calibrated by</th><th>checked by</th><th>approved by</th></tr>"
-                 "<tr><td>%s</td><td>%s</td><td>%s</td></tr></table>" % tuple(html.escape(s[k]) for k in ("calibrated_by", "checked_by", "approved_by")))
+    if not draft:
+        parts.append("<h2>Signatures</h2><table class='sig'><tr><th>calibrated by</th><th>checked by</th>"
+                     "<th>approved by</th></tr><tr><td>%s</td><td>%s</td><td>%s</td></tr></table>"
+                     % tuple(html.escape(s[k]) for k in ("calibrated_by", "checked_by", "approved_by")))
     parts.append("<p>%s</p></body></html>" % html.escape(lab["certificate"]["page_note"]))
     tmp = path + ".tmp"
     try:
@@ -445,25 +565,24 @@ def text_pages(title, blocks):
         for r in rows:
             lines.append(("t", "  ".join(str(x).ljust(w) for x, w in zip(r, widths))))
         lines.append(("t", ""))
-    per_page = 70
+    per_page = 66  # lines from y = 0.925 down to 0.08 (24 mm above the bottom edge)
     figs = []
     for start in range(0, len(lines), per_page):
         fig = plt.figure(figsize=A4)
-        fig.text(0.05, 0.97, plain(title), fontsize=12, weight="bold")
-        y = 0.945
+        fig.text(0.07, 0.948, plain(title), fontsize=12, weight="bold")
+        y = 0.925
         for kind, text in lines[start:start + per_page]:
             if kind == "h":
-                fig.text(0.05, y, plain(text), fontsize=9, weight="bold")
+                fig.text(0.07, y, plain(text), fontsize=9, weight="bold")
             else:
-                fig.text(0.05, y, plain(text), fontsize=5.6, family="monospace")
+                fig.text(0.07, y, plain(text), fontsize=5.6, family="monospace")
             y -= 0.0128
         figs.append(fig)
     return figs
 
 
 def write_pdf(c, path):
-    lab = c["lab"]
-    title = "Calibration certificate %s" % lab["certificate"]["number"]
+    title = title_of(c)
     tmp = path + ".tmp"
     try:
         write_pdf_pages(c, tmp, title)
@@ -478,23 +597,28 @@ def write_pdf_pages(c, tmp, title):
     with PdfPages(tmp, metadata={"CreationDate": None, "Creator": "aerocal certificate",
                                  "Producer": "matplotlib"}) as pdf:
         statements = [["statement"]] + [[q["statement"]] for q in c["results"]]
+        wrapped = [[line] for line in textwrap.wrap(model_text(c), 150)]
         blocks = [("1. Identification, method and data", identification_rows(c)),
+                  ("Camera model", wrapped), ("", model_rows(c)),
                   ("2. Results (U = k u_c, ISO GUM / JJF 1059.1)", statements),
                   ("", result_rows(c)),
-                  ("3. Uncertainty budget", budget_rows(c))]
+                  ("3. Uncertainty budget", [[line] for line in textwrap.wrap(type_a_note(c), 150)] or [[""]]),
+                  ("", budget_rows(c))]
+        if is_draft(c):
+            blocks.insert(0, ("DRAFT: no laboratory file (--lab): not a calibration certificate", [[""]]))
         for fig in text_pages(title, blocks):
             pdf.savefig(fig)
             plt.close(fig)
         for make in (fig_distortion, fig_residuals_correlation):
             fig = plt.figure(figsize=A4)
-            fig.text(0.05, 0.97, plain(title), fontsize=12, weight="bold")
+            fig.text(0.07, 0.948, plain(title), fontsize=12, weight="bold")
             sub = make(c)
             buf = io.BytesIO()
             sub.savefig(buf, format="png", dpi=200)
             plt.close(sub)
             buf.seek(0)
             img = plt.imread(buf)
-            ax = fig.add_axes([0.03, 0.45, 0.94, 0.5])
+            ax = fig.add_axes([0.08, 0.45, 0.84, 0.5])  # 17 mm margins on A4
             ax.imshow(img)
             ax.axis("off")
             pdf.savefig(fig)
@@ -506,13 +630,16 @@ def write_pdf_pages(c, tmp, title):
         blocks = [("6. Stability over image groups", stability_rows(c) or [["no image groups given"]]),
                   ("7. Check points", check_rows(c)),
                   ("8. Comparison with the previous certificate", comparison_rows(c) or [["no previous certificate given"]])]
+        if comparison_rows(c):
+            blocks.append(("", [[line] for line in textwrap.wrap(COMPARISON_NOTE, 150)]))
         if c.get("dynamic_image_resolution"):
             blocks += [("9. Dynamic image resolution (MTF50, U = k u_c, k = 2)", resolution_edge_rows(c) or [["no edges"]]),
                        ("", resolution_axis_rows(c) or [["no repeated edges of one axis"]]),
                        ("", resolution_bar_rows(c) or [["no bar targets"]]),
                        ("", resolution_star_rows(c) or [["no Siemens stars"]])]
-        blocks += [("Findings", [[w] for w in warning_lines(c)] or [["none"]]),
-                   ("Signatures", sig)]
+        blocks += [("Findings", [[w] for w in warning_lines(c)] or [["none"]])]
+        if not is_draft(c):
+            blocks.append(("Signatures", sig))
         for fig in text_pages(title, blocks):
             pdf.savefig(fig)
             plt.close(fig)

@@ -7,6 +7,7 @@
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
 #include "tools/python/bindings.h"
+#include "tools/project_facts.h"
 #include "tools/python/progress_callback.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/self_calibration_choice.h"
@@ -286,6 +287,7 @@ Result Adjust(const Block& block,
   }
   nlohmann::json json = triangulation::AdjustmentToJson(out.result);
   json["project"] = block.path;
+  if (!block.path.empty()) tools::AddProjectFacts(block.project, &json);  // read from files
   json["valid"] = out.result.valid;
   json["invalid_reasons"] = out.result.invalid_reasons;
   out.json = ResultText("adjust", json);

@@ -1,6 +1,9 @@
 """Report sections of the adjustments: statistics, comparison, calibration, residual and check maps."""
 import report_data as rd
+import report_facts as rf
 import report_plots as plots
+import report_points as points
+from report_points import folded as points_folded
 from report_html import Cell, esc, figure, fmt, not_available, note, num, raw, table, text, yes_no
 from report_sections import anchor
 
@@ -79,31 +82,20 @@ def _pair(value, spec):
 
 
 def _uncontrolled(a, aid):
-    """What data snooping cannot judge: check points resting on such rays, and the observations."""
+    """Check points resting on rays data snooping cannot judge (the observations: weak_summary)."""
     out = []
     controlled = a.get("check_controlled")
     points = [p for p in rd.listing(controlled.get("uncontrolled_points"))
               if isinstance(p, dict)] if isinstance(controlled, dict) else []
     if points:
-        out.append(table(f"{aid}-uncontrolled-checks", "Check points resting on rays no test can judge (left out of "
-                         "the controlled check RMSE, kept in the check RMSE)",
-                         ["point", "rays", "|difference| [m]", "why"],
-                         [[text(p.get("point", "")), num(rd.number(p.get("rays")), ".0f"),
-                           num(_norm(p.get("difference_m"))), text(p.get("reason", ""))] for p in points],
-                         ["flagged"] * len(points)))
-    snooping = a.get("snooping") if isinstance(a.get("snooping"), dict) else {}
-    obs = [u for u in rd.listing(snooping.get("uncontrolled")) if isinstance(u, dict)]
-    if obs:
-        untestable = sum(1 for u in obs if u.get("untestable"))
-        out.append(f"<details><summary>Observations no test can judge: {len(obs)} ({untestable} with r = 0, "
-                   f"where a blunder is invisible)</summary>")
-        out.append(table(f"{aid}-uncontrolled", "Observations with a redundancy number below the limit (a blunder "
-                         "there is not found, or only above its MDB)",
-                         ["image", "point", "rays", "r (x, y)", "MDB (x, y) [px]", "why"],
-                         [[text(u.get("image", "")), text(u.get("point", "")), num(rd.number(u.get("rays")), ".0f"),
-                           text(_pair(u.get("r"), ".2f")), text(_pair(u.get("mdb_px"), ".3g")),
-                           text(u.get("reason", ""))] for u in obs]))
-        out.append("</details>")
+        body = table(f"{aid}-uncontrolled-checks", "Check points resting on rays no test can judge (left out of "
+                     "the controlled check RMSE, kept in the check RMSE)",
+                     ["point", "rays", "|difference| [m]", "why"],
+                     [[text(p.get("point", "")), num(rd.number(p.get("rays")), ".0f"),
+                       num(_norm(p.get("difference_m"))), text(p.get("reason", ""))] for p in points],
+                     ["flagged"] * len(points))
+        out.append(points_folded(f"Check points resting on rays no test can judge: {len(points)}", body,
+                                 len(points)))
     return "".join(out)
 
 
@@ -112,9 +104,9 @@ def _norm(values):
     return None if not values or None in values else sum(v * v for v in values) ** 0.5
 
 
-def adjustment(a, number):
+def adjustment(a, number, doc=None):
     aid = "adj-" + anchor(a["name"])
-    out = [f'<h3 id="{aid}">3.{number} {esc(rd.title(a))}</h3>']
+    out = [f'<h3 id="{aid}">4.{number} {esc(rd.title(a))}</h3>']
     free = rd.listing(a.get("self_calibration"))
     rows = [["converged", raw(yes_no(a.get("converged")))],
             ["iterations", num(rd.number(a.get("iterations")), ".0f")],
@@ -128,16 +120,13 @@ def adjustment(a, number):
             rows.append([label, num(rd.number(a.get(key)), ".0f")])
     out.append(table(f"{aid}-summary", "Adjustment", ["item", "value"], rows))
     out.append(_points_table(a, f"{aid}-points"))
-    rejected = [r for r in rd.listing(a.get("rejected")) if isinstance(r, dict)]
-    if rejected:
-        out.append(table(f"{aid}-rejected", "Observations rejected as gross errors",
-                         ["image", "point", "residual [px]", "standardised residual w"],
-                         [[text(r.get("image", "")), text(r.get("point", "")),
-                           num(rd.number(r.get("residual_px")), ".2f"), num(rd.number(r.get("w")), ".1f")]
-                          for r in rejected]))
-    elif "rejected" in a:
-        out.append(note("No observation rejected as a gross error."))
+    out.append(points.points_tables(a, aid))
+    geo = rf.geometry(doc, a) if doc else None
+    strip_of = {image: str(k) for k, strip in enumerate(geo["strips"] if geo else [], 1) for image in strip}
+    out.append(points.exposures_table(a, aid, strip_of))
+    out.append(points.rejected_table(a, aid))
     out.append(_uncontrolled(a, aid))
+    out.append(points.weak_summary(a, aid))
     for w in rd.listing(a.get("warnings")):
         message = w.get("message") if isinstance(w, dict) else w
         out.append(f'<p class="na"><span class="bad">warning</span>: {esc(message)}</p>')
@@ -154,20 +143,30 @@ def adjustment(a, number):
 
 
 def adjustments(doc):
-    out = ['<h2 id="adjustments">3. Adjustments</h2>']
+    out = ['<h2 id="adjustments">4. Adjustments</h2>']
     adjs = rd.adjustments(doc)
     if not adjs:
         return out[0] + not_available("Adjustments")
     for k, a in enumerate(adjs, 1):
         try:
-            out.append(adjustment(a, k))
+            out.append(adjustment(a, k, doc))
         except (KeyError, TypeError, ValueError, IndexError, AttributeError) as e:
             out.append(not_available(f"{rd.title(a)} (unreadable: {e})"))
     return "".join(out)
 
 
+def left_out(doc):
+    out = ['<h2 id="left-out">5. Left out: images, points and observations the adjustments did not use</h2>']
+    rows = points.left_out(doc)
+    if not rows:
+        return out[0] + note("Nothing was left out: every image, point and observation was used.")
+    out.append(table("left-out-table", "Left out, each with the reason", ["adjustments", "kind", "what", "why"],
+                     [[text(t), text(k), text(w), Cell(esc(r), "text-small")] for t, k, w, r in rows]))
+    return "".join(out)
+
+
 def comparison(doc):
-    out = ['<h2 id="comparison">4. Comparison of the adjustments</h2>']
+    out = ['<h2 id="comparison">6. Comparison of the adjustments</h2>']
     adjs = rd.adjustments(doc)
     if not adjs:
         return out[0] + not_available("Comparison")
@@ -220,7 +219,7 @@ def _calibration_table(a, camera, table_id, parameters):
 
 
 def calibration(doc):
-    out = ['<h2 id="calibration">5. Calibration</h2>']
+    out = ['<h2 id="calibration">7. Calibration</h2>']
     adjs = rd.adjustments(doc)
     estimating = [a for a in adjs if rd.estimates_interior(a)]
     fixed = [rd.title(a) for a in adjs if not rd.estimates_interior(a)]
@@ -236,7 +235,7 @@ def calibration(doc):
         for cam in rd.cameras(a):
             out.append(_calibration_table(a, cam, f"calib-{anchor(a['name'])}-{anchor(cam.get('id', 'camera'))}",
                                           parameters))
-    out.append('<h3 id="distortion">5.1 Distortion curves</h3>')
+    out.append('<h3 id="distortion">7.1 Distortion curves</h3>')
     if model != "brown_fraser_10":
         out.append(not_available(f"Distortion curves (drawn for the 10-parameter model's terms; the camera is "
                                  f"in the model {model})"))
@@ -277,9 +276,12 @@ def _distortion(doc, adjs, estimating):
 
 
 def residual_plot(doc):
-    out = ['<h2 id="residuals">6. Image residuals over the format</h2>']
+    out = ['<h2 id="residuals">8. Image residuals over the format</h2>']
     fmt_info = rd.camera_format(doc)
-    panels = [(rd.title(a), rd.residuals(a)) for a in rd.adjustments(doc)]
+    adjs = rd.adjustments(doc)
+    panels = [(rd.title(a), rd.residuals(a)) for a in adjs]
+    n_rejected = sum(1 for a in adjs for r in rd.listing(a.get("residuals"))
+                     if isinstance(r, dict) and r.get("used") is False)
     panels = [(t, r) for t, r in panels if r]
     if not fmt_info or not panels:
         return out[0] + not_available("Image residuals" if fmt_info else "Image residuals (image format unknown)")
@@ -290,13 +292,15 @@ def residual_plot(doc):
     out.append(figure("residual-plot", png, "residual vectors over the image format",
                       f"Image residuals in photo coordinates (x right, y up, mm; the grey frame is the image "
                       f"format): {how}, exaggerated {facts['exaggeration']:g} times (the key arrow is "
-                      f"{facts['key_px']:g} px); the same scale in every panel. A systematic pattern means the "
+                      f"{facts['key_px']:g} px); the same scale in every panel. Only the observations each "
+                      f"adjustment used are drawn: the {n_rejected} rejected are listed apart with their w (section 4, "
+                      f"'Observations rejected'), so a blunder never sets the scale. A systematic pattern means the "
                       f"camera model leaves distortion unmodelled."))
     return "".join(out)
 
 
 def check_map(doc):
-    out = ['<h2 id="check-map">7. Check-point errors</h2>']
+    out = ['<h2 id="check-map">9. Check-point errors</h2>']
     panels = [(rd.title(a), rd.point_errors(a, "check"), rd.point_errors(a, "control")) for a in rd.adjustments(doc)]
     panels = [p for p in panels if p[1]]
     if not panels:

@@ -37,13 +37,34 @@ def load(path):
         raise InputError(f"{path}: not a JSON document ({e})")
     if not isinstance(doc, dict):
         raise InputError(f"{path}: not a flight result (top level is not an object)")
-    if doc.get("kind") != "flight":
-        raise InputError(f"{path}: not a flight result (kind is {json.dumps(doc.get('kind'))}, "
-                         f"expected \"flight\")")
+    if doc.get("kind") not in ("flight", "adjust"):
+        raise InputError(f"{path}: not a flight or adjust result (kind is {json.dumps(doc.get('kind'))}, "
+                         f"expected \"flight\" or \"adjust\")")
     if doc.get("schema_version") != SCHEMA_VERSION or isinstance(doc.get("schema_version"), bool):
         raise InputError(f"{path}: schema_version is {json.dumps(doc.get('schema_version'))}, "
-                         f"expected {SCHEMA_VERSION} (kind \"flight\")")
-    return doc
+                         f"expected {SCHEMA_VERSION} (kind {json.dumps(doc.get('kind'))})")
+    return as_flight_document(doc) if doc["kind"] == "adjust" else doc
+
+
+def as_flight_document(doc):
+    """An `aerocal adjust` result in the flight document's layout: its adjustment (and with
+    --compare the conventional reference run, `conventional`) as `adjustments`, the project facts
+    (`inputs`, `camera_format`, `camera_names`, `frame`, `camera_written_from`) at the top."""
+    own = dict(doc)
+    own["name"] = "self_calibration" if listing(doc.get("self_calibration")) else "conventional"
+    adjustments = []
+    if isinstance(doc.get("conventional"), dict):
+        reference = dict(doc["conventional"])
+        reference["name"] = "conventional"
+        adjustments.append(reference)
+        own.pop("conventional")
+    adjustments.append(own)
+    out = {k: doc.get(k) for k in ("kind", "schema_version", "aerocal_version", "inputs", "camera_format",
+                                   "camera_names", "frame", "camera_written_from", "project", "valid",
+                                   "camera_model") if k in doc}
+    out["adjustments"] = adjustments
+    out["warnings"] = [dict(w, adjustment=own["name"]) for w in listing(doc.get("warnings")) if isinstance(w, dict)]
+    return out
 
 
 def get(obj, *keys):
@@ -188,10 +209,11 @@ def point_errors(adjustment, which):
 
 
 def residuals(adjustment):
-    """[(col, row, v_col_px, v_row_px)] image residuals in the image's pixel frame."""
+    """[(col, row, v_col_px, v_row_px)] image residuals in the image's pixel frame, of the
+    observations the adjustment USED (a rejected blunder is listed apart, never plotted)."""
     out = []
     for r in listing(adjustment.get("residuals")):
-        if not isinstance(r, dict):
+        if not isinstance(r, dict) or r.get("used") is False:
             continue
         v = [number(get(r, "col")), number(get(r, "row")),
              number(get(r, "v_col_px", "vcol_px")), number(get(r, "v_row_px", "vrow_px"))]

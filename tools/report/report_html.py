@@ -28,9 +28,32 @@ tr.chosen td { background: #e9f6e9; }
 tr.flagged td { background: #fdeaea; }
 span.ok { color: #1d7a1d; font-weight: bold; }
 span.bad { color: #b21f1f; font-weight: bold; }
+p.verdict { font-size: 16px; font-weight: bold; padding: 6px 10px; border-left: 5px solid; }
+p.verdict.ok { color: #1d7a1d; background: #e9f6e9; }
+p.verdict.warn { color: #8a5a00; background: #fff6e0; }
+p.verdict.bad { color: #b21f1f; background: #fdeaea; }
+td.hash { font-family: "DejaVu Sans Mono", monospace; font-size: 10px; word-break: break-all; max-width: 260px; }
+td.text-small { word-break: break-word; }
+details > summary { cursor: pointer; font-weight: 600; margin: 6px 0; }
 figure { margin: 10px 0 18px; }
 figure img { max-width: 100%; border: 1px solid #d5dbe3; }
 figcaption { font-size: 13px; color: #4a5563; margin-top: 3px; }
+@page { size: A4; margin: 14mm 12mm 16mm 12mm;
+        @bottom-right { content: "page " counter(page) " of " counter(pages); font-size: 8pt; color: #4a5563; } }
+@media print {
+  body { max-width: none; padding: 0; font-size: 9pt; }
+  h2 { break-after: avoid; } caption { break-after: avoid; }
+  table { font-size: 7pt; max-width: 100%; } td.num { font-size: 7pt; } td.hash { font-size: 6pt; max-width: 60mm; }
+  th, td { padding: 1px 3px; }
+  td.text-small { font-size: 6.5pt; max-width: none; } td details { display: none; }
+  /* A folded list stays folded on paper: its summary line is printed, the rows are in the HTML
+     report and in `aerocal export --tables`. */
+  details:not([open]) > :not(summary) { display: none; }
+  details:not([open]) > summary::after { content: " (full list: HTML report, aerocal export --tables)";
+                                          font-weight: normal; color: #4a5563; }
+  figure { break-inside: avoid; } figure img { max-width: 100%; }
+  nav { display: none; }
+}
 """
 
 

@@ -6,6 +6,8 @@ import re
 import statistics
 
 import report_data as rd
+import report_facts as rf
+from report_points import folded
 import report_plots as plots
 from report_html import (Cell, esc, figure, fmt, not_available, note, num, raw, table, text,
                          yes_no)
@@ -20,19 +22,7 @@ def _mean(values):
 # ---- summary --------------------------------------------------------------------------------
 
 def summary(doc):
-    out = ['<h2 id="summary">1. Summary</h2>']
-    fmt_info = rd.camera_format(doc)
-    if fmt_info:
-        w, h, p = fmt_info
-        fmt_text = (f"{int(w)} x {int(h)} px, pixel {p * 1000:g} um, "
-                    f"{w * p:.1f} x {h * p:.1f} mm")
-    else:
-        fmt_text = "not available"
-    rows = [["Camera file", text(rd.get(doc, "camera") or "not available")],
-            ["Data folder", text(rd.get(doc, "data") or "not available")],
-            ["Image format", text(fmt_text)],
-            ["aerocal version", text(rd.get(doc, "aerocal_version") or "not available")]]
-    out.append(table("summary-inputs", "Inputs", ["item", "value"], rows))
+    out = ['<h2 id="summary">1. Summary</h2>', rf.verdict(doc)]
 
     steps, classes = [], []
     stitching = rd.get(doc, "stitching")
@@ -76,16 +66,33 @@ def summary(doc):
         for f in rd.get(doc, "failures") or []:
             warnings.insert(0, (f.get("step", "?"), str(f.get("reason", ""))))
         all_ok = all(c == "" for c in classes) and rd.get(doc, "valid") is not False
-        out.append(note("All steps converged and are valid." if all_ok else
-                        '<span class="bad">At least one step did not converge or is not valid: its figures are not '
-                        "a valid calibration, and no calibrated camera was written.</span>"))
+        if not all_ok:
+            out.append(note('<span class="bad">At least one step did not converge or is not valid: its figures '
+                            "are not a valid calibration, and no calibrated camera was written.</span>"))
         if warnings:
             out.append('<ul class="warnings">' + "".join(
                 f'<li><span class="bad">{esc(step)}: {esc(sentence)}</span></li>' for step, sentence in warnings)
                 + "</ul>")
     else:
         out.append(not_available("Steps of the workflow"))
+    out.append(_camera_written(doc))
+    tips = rf.advice(doc)
+    out.append('<h3 id="advice">Advice for this block</h3>' + (
+        '<ul class="advice">' + "".join(f"<li>{esc(t)}</li>" for t in tips) + "</ul>" if tips else
+        note("Nothing to add: the block is controlled, checked and free of rejected observations.")))
     return "".join(out)
+
+
+def _camera_written(doc):
+    written = doc.get("camera_written_from")
+    if isinstance(written, dict) and written.get("adjustment"):
+        names = {a.get("name"): rd.title(a) for a in rd.adjustments(doc)}
+        return note(f"<b>The written camera</b> comes from the {esc(names.get(written['adjustment'], written['adjustment']))}: "
+                    f"{esc(written.get('reason', ''))}.")
+    if "camera_written_from" in doc:
+        return note("<b>No camera was written</b>: the result is not valid.")
+    return note("Which adjustment a written camera comes from: not stated in this result.")
+
 
 # ---- stitching ------------------------------------------------------------------------------
 
@@ -186,8 +193,10 @@ def _model_choice_per_frame(frames, order, flags_by_frame, reported):
         classes.append("flagged" if reported in under or "" in under else "")
     headers = ["exposure"] + [f"{m}: sigma0 [px]" for m in order] + ["chosen", "converged", "why",
                                                                      "flagged under"]
-    return (table("stitch-model-choice", "Model choice per exposure (sigma0 in px, redundancy r, "
-                  "F test against the next simpler model; chosen model in bold)", headers, rows, classes) +
+    return (folded(f"Model choice per exposure: {len(rows)} exposures",
+                   table("stitch-model-choice", "Model choice per exposure (sigma0 in px, redundancy r, "
+                         "F test against the next simpler model; chosen model in bold)", headers, rows, classes),
+                   len(rows)) +
             note(f"'flagged under': models whose stability test flags the exposure (next table); rows in red "
                  f"are flagged under the flight's model ({esc(reported)})."))
 
@@ -257,8 +266,11 @@ def _sigma0_plot(stitching, frames, order, flagged):
                   "flight's model; the dashed line is the flight mean of that model.")
 
 def stitching(doc):
-    out = ['<h2 id="stitching">2. Stitching of the sub-images</h2>']
+    out = ['<h2 id="stitching">3. Stitching of the sub-images</h2>']
     s = rd.get(doc, "stitching")
+    if doc.get("kind") == "adjust":
+        return out[0] + note("An adjust run has no stitching step (its observations are in the virtual image, "
+                             "or the joint adjustment refines the mappings: section 4).")
     if not isinstance(s, dict):
         return out[0] + not_available("Stitching")
     frames = rd.frames(s)
@@ -270,14 +282,14 @@ def stitching(doc):
     order = _model_order(frames)
     flags_by_frame = rd.flags_by_frame(s)
     flagged = {f for f, models in flags_by_frame.items() if s.get("model") in models or "" in models}
-    out.append('<h3 id="stitch-models">2.1 Model comparison</h3>')
+    out.append('<h3 id="stitch-models">3.1 Model comparison</h3>')
     if order:
         out.append(_model_comparison(s, frames, order))
         out.append(_model_choice_per_frame(frames, order, flags_by_frame, s.get("model")))
     else:
         out.append(not_available("Model comparison"))
-    out.append('<h3 id="stitch-flight-stability">2.2 Flight stability</h3>')
+    out.append('<h3 id="stitch-flight-stability">3.2 Flight stability</h3>')
     out.append(_stability(s, frames))
-    out.append('<h3 id="stitch-sigma0">2.3 sigma0 per exposure</h3>')
+    out.append('<h3 id="stitch-sigma0">3.3 sigma0 per exposure</h3>')
     out.append(_sigma0_plot(s, frames, order, flagged))
     return "".join(out)

@@ -260,6 +260,16 @@ void ValidateProject(const Project& project) {
   }
 }
 
+std::vector<std::pair<std::string, std::string>> ProjectFiles(const Project& project) {
+  std::vector<std::pair<std::string, std::string>> files = {{"project", project.path}};
+  for (const auto& [id, file] : project.camera_files) files.push_back({"camera " + id, file});
+  files.push_back({"exposures", project.exposures_file});
+  files.push_back({"observations", project.observations_file});
+  files.push_back({"points", project.points_file});
+  if (!project.stitching_file.empty()) files.push_back({"stitching", project.stitching_file});
+  return files;
+}
+
 Project ReadProject(const std::string& path_in, double default_sigma_px) {
   std::string path = path_in;
   std::error_code ec;  // the error_code form: a symbolic-link loop is then reported by the reader

@@ -5,6 +5,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "triangulation/block/block.h"
@@ -19,6 +20,10 @@ std::vector<GroundPoint> ReadPoints(const std::string& path);
 /// Reads a project YAML (or a folder holding project.yaml) and every file it names, validated.
 Project ReadProject(const std::string& path, double default_sigma_px = 0.5);
 void ValidateProject(const Project& project);
+/// The files a project was read from as (role, path) pairs: the project YAML, each camera file,
+/// exposures, observations, points and the stitching measurements when named (for the result's
+/// `inputs` with their checksums, calib/core/file_digest.h).
+std::vector<std::pair<std::string, std::string>> ProjectFiles(const Project& project);
 /// The project YAML's `platform:` map (triangulation/README.md "GNSS/IMU priors on the
 /// platform"); InputError with FILE:LINE on a bad key or value.
 PlatformSpec ReadPlatform(const YAML::Node& node, const std::string& path);

@@ -135,16 +135,19 @@ double CoverageFactor(double dof_eff) {
 
 std::string CertificateStatement(const std::string& name, double value, double expanded, double k,
                                  const std::string& unit) {
+  // A dimensionless quantity (table unit "1", e.g. B1) is written without a unit.
+  const std::string u = unit == "1" || unit.empty() ? "" : " " + unit;
   if (!(expanded > 0) || !std::isfinite(expanded))
-    return StringPrintf("%s = %.6g %s, U unknown", name.c_str(), value, unit.c_str());
-  // Two significant digits of U; the value to the same last decimal.
+    return StringPrintf("%s = %.6g%s, U unknown", name.c_str(), value, u.c_str());
+  // Two significant digits of U (trailing zeros kept: 1.0e-06, 0.60); the value to the same
+  // last decimal.
   const int exponent = static_cast<int>(std::floor(std::log10(expanded)));
   const int decimals = std::max(0, 1 - exponent);
   if (decimals > 8 || std::abs(value) < 1e-3 || std::abs(value) >= 1e6)
-    return StringPrintf("%s = %.4e %s, U = %.2g %s (k = %g)", name.c_str(), value, unit.c_str(),
-                        expanded, unit.c_str(), k);
-  return StringPrintf("%s = %.*f %s, U = %.*f %s (k = %g)", name.c_str(), decimals, value,
-                      unit.c_str(), decimals, expanded, unit.c_str(), k);
+    return StringPrintf("%s = %.4e%s, U = %#.2g%s (k = %g)", name.c_str(), value, u.c_str(), expanded,
+                        u.c_str(), k);
+  return StringPrintf("%s = %.*f%s, U = %.*f%s (k = %g)", name.c_str(), decimals, value, u.c_str(),
+                      decimals, expanded, u.c_str(), k);
 }
 
 namespace {

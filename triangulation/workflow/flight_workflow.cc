@@ -1,11 +1,13 @@
 #include "triangulation/workflow/flight_workflow.h"
 
+#include <algorithm>
 #include <cstdio>
 #include <filesystem>
 
 #include "calib/camera/camera_io.h"
 #include "calib/camera/camera_model_json.h"
 #include "calib/core/error.h"
+#include "calib/core/file_digest.h"
 #include "calib/core/progress.h"
 #include "stitch/adjustment/flight_stability.h"
 #include "stitch/adjustment/frame_measurements.h"
@@ -116,6 +118,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   nlohmann::json& doc = out.document;
   doc["kind"] = "flight";
   doc["camera"] = options.camera_file;
+  doc["camera_name"] = camera.name;
   doc["camera_model"] = calib::CameraModelTableToJson(camera.model);
   doc["data"] = options.data_folder;
   doc["camera_format"] = {{"width_px", camera.width_px},
@@ -123,8 +126,15 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
                           {"pixel_size_mm", camera.pixel_size_mm}};
   doc["base_subimages"] = options.base_ids;
   doc["frame"] = object_frame.Description();
+  // The files read, with their checksums: a lab verifies a re-run read the same data.
+  // (The joint step adds the sub-image project's files.)
+  doc["inputs"] = InputFilesToJson(ProjectFiles(input));
 
   // 1. Stitching of every exposure, model chosen per frame by the F test, and stability.
+  const auto stage = [&](const char* name) {
+    if (progress) progress->Stage(name);
+  };
+  stage("stitching");
   const stitch::BatchOptions batch = FlightStitchingOptions(options);
   std::optional<stitch::BatchResult> stitching;
   if (HasStitching(project, camera)) {
@@ -139,6 +149,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     out.summary.push_back("stitching: no stitching measurements in the project");
   }
   if (progress) progress->Advance();
+  stage("self-calibration");
 
   // 2. Conventional and self-calibrating triangulation on the virtual-image observations.
   nlohmann::json adjustments = nlohmann::json::array();
@@ -148,6 +159,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   AdjustmentResult self_calibration = adjust(self_options);
   self_options.free_interior = self_calibration.free_interior;  // the chosen set, for the joint
   if (progress) progress->Advance();
+  stage("conventional");
   // The conventional reference: same observations (gross errors decided by the full model).
   AdjustOptions conventional_options;
   conventional_options.suspect_effect_limit = options.suspect_effect_limit;
@@ -155,6 +167,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
       AdjustConventionalReference(project, conventional_options, self_calibration);
   ToInputFrame(object_frame, &conventional);
   if (progress) progress->Advance();
+  stage("joint");
   // A self-calibrated camera that makes the check points significantly worse is not a calibration
   // (self_calibration_choice.h): not written, the result not valid, with the test.
   const CheckPointComparison check_test = CompareCheckPoints(conventional, self_calibration);
@@ -196,6 +209,10 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
                                                            options.joint_model, &joint_options);
     const Project raw =
         ToAdjustmentFrame(WithCamera(ReadProject(subimage_project), start, options.camera_file), object_frame);
+    for (const auto& file : InputFilesToJson(ProjectFiles(raw)))
+      if (std::none_of(doc["inputs"].begin(), doc["inputs"].end(),
+                       [&](const nlohmann::json& f) { return f["path"] == file["path"]; }))
+        doc["inputs"].push_back(file);
     JointResult joint = AdjustJoint(raw, joint_options);
     ToInputFrame(object_frame, &joint.adjustment);
     const double ratio = joint.adjustment.sigma0 / self_calibration.sigma0;
@@ -222,6 +239,7 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     AddWarnings("joint", joint.adjustment, &out);
   }
   if (progress) progress->Advance();
+  stage("result");
   doc["adjustments"] = adjustments;
   // Every adjustment's warnings in one list, each naming its adjustment.
   doc["warnings"] = nlohmann::json::array();

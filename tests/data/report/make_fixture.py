@@ -145,6 +145,8 @@ def main():
     doc = {"kind": "flight", "schema_version": 1, "aerocal_version": "0.1.0", "camera": "data/camera_nominal.yaml", "data": "data",
            "camera_format": {"width_px": W, "height_px": H, "pixel_size_mm": p},
            "stitching": stitch, "adjustments": adjustments}
+    # The project facts of the flight result (tools/report/report_facts.py), as the writer states them.
+    doc.update({"camera_name": "6-CCD camera, 2 x 3 sub-images (simulated)", "frame": "projected frame, used as given (simulated block)", "camera_written_from": {"adjustment": "joint", "reason": "the joint stitching + triangulation adjustment (interior and the sub-image mappings refined together)"}, "inputs": [{"role": "project", "path": "data/project.yaml", "bytes": 231, "sha256": "0000000000000000000000000000000000000000000000000000000000000000"}]})
     with open(out, "w") as f:
         json.dump(doc, f, separators=(",", ":"))
 
