@@ -26,6 +26,9 @@ class RasterSource {
   /// (w * h * bands samples of the raster's type, rows of w * bands samples). One object is
   /// not thread-safe; distinct sources may be read concurrently.
   virtual void ReadWindow(int x0, int y0, int w, int h, void* out) = 0;
+  /// The whole raster when it is held in memory (rows of Info().RowBytes() bytes), which the
+  /// resampling then reads in place instead of copying windows; null otherwise.
+  virtual const std::uint8_t* Samples() const { return nullptr; }
 };
 
 class RasterSink {
@@ -42,6 +45,7 @@ class MemoryRaster : public RasterSource, public RasterSink {
   explicit MemoryRaster(const RasterInfo& info);
   RasterInfo Info() const override { return info_; }
   void ReadWindow(int x0, int y0, int w, int h, void* out) override;
+  const std::uint8_t* Samples() const override { return bytes_.data(); }
   void WriteRows(int y0, int rows, const void* data) override;
   /// Sample of band `band` at (col, row), as a number.
   double At(int col, int row, int band = 0) const;

@@ -15,19 +15,14 @@
 #include <tbb/task_arena.h>
 
 #include "calib/core/error.h"
+#include "stitch/resample/fast_strip.h"
+#include "stitch/resample/resample_window.h"
 
 namespace aerocal::stitch {
 namespace {
 
-// The part of one sub-image a strip needs: a window of samples and the virtual -> window map.
-struct Window {
-  bool used = false;
-  int x0 = 0, y0 = 0, w = 0, h = 0;      // in sub-image pixels
-  int width_px = 0, height_px = 0;       // sub-image format
-  Eigen::Matrix3d sub_from_virtual;      // homogeneous
-  const MapCorrectionGrid* correction = nullptr;  // none: the projectivity alone
-  std::vector<std::uint8_t> bytes;
-};
+using internal::CoveredColumns;
+using internal::Window;
 
 // Keys (1981) cubic convolution weights, a = -0.5, for fractional offset t in [0, 1].
 inline void CubicWeights(float t, float* w) {
@@ -36,38 +31,6 @@ inline void CubicWeights(float t, float* w) {
   w[1] = 1.5f * t3 - 2.5f * t2 + 1.0f;
   w[2] = -1.5f * t3 + 2.0f * t2 + 0.5f * t;
   w[3] = 0.5f * t3 - 0.5f * t2;
-}
-
-// Columns [first, last] of virtual row V whose (u, v) lies inside the sub-image's pixel centres.
-// With [x y w]^T = M [U V 1]^T and w > 0, u >= 0 <=> x >= 0, u <= W-1 <=> (W-1) w - x >= 0, ...:
-// each bound is a U + b >= 0.
-bool CoveredColumns(const Window& win, double V, int virtual_width, int* first, int* last) {
-  const Eigen::Matrix3d& m = win.sub_from_virtual;
-  double lo = 0.0, hi = virtual_width - 1.0;
-  auto bound = [&](double a, double b) {  // a U + b >= 0
-    if (std::abs(a) < 1e-15) {
-      if (b < 0) hi = -1.0;
-      return;
-    }
-    const double root = -b / a;
-    if (a > 0) lo = std::max(lo, root);
-    else hi = std::min(hi, root);
-  };
-  const double W = win.width_px - 1.0, H = win.height_px - 1.0;
-  const double xa = m(0, 0), xb = m(0, 1) * V + m(0, 2);
-  const double ya = m(1, 0), yb = m(1, 1) * V + m(1, 2);
-  const double wa = m(2, 0), wb = m(2, 1) * V + m(2, 2);
-  bound(wa, wb - 1e-12);
-  bound(xa, xb);
-  bound(W * wa - xa, W * wb - xb);
-  bound(ya, yb);
-  bound(H * wa - ya, H * wb - yb);
-  // Rounding at the bounds: keep pixels within 1e-9 px of the edge.
-  *first = static_cast<int>(std::ceil(lo - 1e-9));
-  *last = static_cast<int>(std::floor(hi + 1e-9));
-  *first = std::max(*first, 0);
-  *last = std::min(*last, virtual_width - 1);
-  return *first <= *last;
 }
 
 // Adds the sample of the window at (u, v) (window pixels, inside) to out[0 .. kBands).
@@ -305,6 +268,11 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
   std::atomic<long> covered{0}, overlap{0};
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   const int margin = options.interpolation == Interpolation::kBicubic ? 3 : 2;
+  // The fast path (fast_strip.h): bilinear, one band, no correction grid.
+  const bool fast = !options.reference && options.interpolation == Interpolation::kBilinear &&
+                    first.bands == 1 &&
+                    std::none_of(windows.begin(), windows.end(), [](const Window& w) { return w.correction; });
+  const float fill = std::clamp(static_cast<float>(options.fill), 0.0f, first.bits == 8 ? 255.0f : 65535.0f);
   for (int y0 = 0; y0 < height; y0 += options.strip_rows) {
     const int rows = std::min(options.strip_rows, height - y0);
     // Window of each sub-image: bounding box of the strip's corners mapped into it, plus margin.
@@ -342,15 +310,30 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
       win.y0 = wy0;
       win.w = x1 - x0 + 1;
       win.h = wy1 - wy0 + 1;
-      win.bytes.resize(static_cast<size_t>(win.w) * win.h * first.bands * first.BytesPerSample());
+      // Plus a row and two samples of padding: the fast path reads the last column's and row's
+      // right and lower neighbours with weight 0.
+      const int sample_bytes = first.bands * first.BytesPerSample();
+      if (fast && sources[k]->Samples() && wy1 + 2 < win.height_px) {
+        // In place: the padding the fast path reads (the next row and its next sample) exists.
+        win.samples = sources[k]->Samples() + (static_cast<size_t>(wy0) * win.width_px + x0) * sample_bytes;
+        win.stride = win.width_px;
+        return;
+      }
+      win.bytes.resize(static_cast<size_t>(win.w) * (win.h + 1) * sample_bytes + 2 * sample_bytes);
       sources[k]->ReadWindow(win.x0, win.y0, win.w, win.h, win.bytes.data());
+      win.samples = win.bytes.data();
+      win.stride = win.w;
     };
     // Sources are distinct objects: their windows are read in parallel.
     arena.execute([&] {
       tbb::parallel_for(size_t{0}, windows.size(), [&](size_t k) { prepare(k); });
     });
     arena.execute([&] {
-      if (first.bits == 8 && first.bands == 1)
+      if (fast && first.bits == 8)
+        internal::ResampleStripFast<std::uint8_t>(windows, fill, width, y0, rows, strip.data(), &covered, &overlap);
+      else if (fast)
+        internal::ResampleStripFast<std::uint16_t>(windows, fill, width, y0, rows, strip.data(), &covered, &overlap);
+      else if (first.bits == 8 && first.bands == 1)
         ResampleStrip<std::uint8_t, 1>(windows, options, width, y0, rows, &strip, &covered, &overlap);
       else if (first.bits == 8)
         ResampleStrip<std::uint8_t, 3>(windows, options, width, y0, rows, &strip, &covered, &overlap);

@@ -14,6 +14,18 @@
 // parallel (TBB). Column ranges covered by a sub-image are solved per row in closed form (each
 // bound u >= 0, u <= W-1, ... is linear in U for a projectivity with positive denominator), so the
 // inner loop has no coverage tests.
+//
+// Two paths give the same coverage and the same values to well below 0.5 DN (tested):
+// - fast (fast_strip.h; bilinear, one band, no correction grid, the default there): each row is
+//   cut into intervals seen by the same sub-images, single coverage is written straight to the
+//   output and only overlap bands are averaged; positions are 32.32 fixed point stepped along the
+//   row (exact for an affine mapping, chords within 1e-5 px of a projectivity) and a sub-image at
+//   about the virtual scale is interpolated 16 columns at a time by a vectorised loop
+//   (bilinear_run.h); a source held in memory (RasterSource::Samples) is read in place;
+// - reference (everything else, or ResampleOptions::reference): per pixel, (u, v) from the exact
+//   projectivity in double, then float; bicubic, 3 bands and correction grids go this way.
+// The fast path's output is bit-identical whatever the thread count and strip height (tested),
+// the reference path's whatever the thread count.
 #pragma once
 
 #include <string>
@@ -31,6 +43,7 @@ struct ResampleOptions {
   double fill = 0.0;     // value of uncovered pixels, in the output's range
   int strip_rows = 256;  // rows per strip, > 0 (memory ~ strip_rows x (virtual width + sources))
   int threads = 0;       // 0: all cores
+  bool reference = false;  // true: the per-pixel reference path even where the fast one applies
 };
 
 struct ResampleReport {

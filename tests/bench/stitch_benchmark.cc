@@ -1,21 +1,27 @@
 // Stitching benchmarks (issue "sub-image stitching"):
 // (a) BM_AdjustFrame: one 6-CCD frame (2 x 3, 14000 x 12000 px, base II and V) with 900 tie points
 //     adjusted, affine with data snooping, and with the model chosen by the F test (all 4 models).
-// (b) BM_Resample / BM_OpenCvWarpAffine: the 14000 x 12000 16-bit virtual image from 6 sub-images
-//     (sub-pixel affine misplacements), bilinear, overlaps averaged; ours strip-wise with TBB,
-//     OpenCV's cv::warpAffine doing the same six warps (plus a coverage warp each) into the same
-//     strips and the same averaging. Counter "Mpx/s" is virtual-image Mpx per second.
+// (b) BM_Resample / BM_OpenCvWarpAffine / BM_Copy: the 14000 x 12000 16-bit virtual image from 6
+//     sub-images (sub-pixel affine misplacements), bilinear, overlaps averaged, ON ONE CORE (one TBB
+//     thread, cv::setNumThreads(1)); ours strip-wise, OpenCV's cv::warpAffine doing the same six
+//     warps (plus a coverage warp each) into the same strips and the same averaging, and a plain
+//     copy (std::memcpy) of as many bytes as the virtual image has, from one buffer to another,
+//     both far larger than the caches: the machine's memory bandwidth for this amount of output.
+//     Arg 0 of BM_Resample is the fast path, arg 1 the reference (per-pixel double) path.
+//     Counter "Mpx/s" is virtual-image Mpx per second; the program ends by printing the ratios.
 // Run: cmake -DAEROCAL_BUILD_BENCHMARKS=ON ...; build/tests/bench/bench_stitch
 #include <benchmark/benchmark.h>
 
 #include <cstring>
 #include <random>
+#include <string>
 
 #include <Eigen/LU>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "tests/bench/discard_sink.h"
+#include "tests/bench/ratio_reporter.h"
 #include "stitch/adjustment/model_selection.h"
 #include "stitch/resample/virtual_image.h"
 #include "tests/stitch/simulated_camera.h"
@@ -72,14 +78,17 @@ void BM_Resample(benchmark::State& state) {
   for (auto& image : scene.images) sources.push_back(&image);
   ResampleOptions options;
   options.strip_rows = 256;
+  options.threads = 1;
   DiscardSink sink(static_cast<size_t>(scene.truth.width_px) * 2);
+  options.reference = state.range(0) == 1;
   for (auto _ : state) ResampleVirtualImage(scene.truth, sources, &sink, options);
   const double mpx = scene.truth.width_px * 1e-6 * scene.truth.height_px;
   state.counters["Mpx/s"] = benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_Resample)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
+BENCHMARK(BM_Resample)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
 void BM_OpenCvWarpAffine(benchmark::State& state) {
+  cv::setNumThreads(1);
   const ResampleScene& scene = Scene();
   const int width = scene.truth.width_px, height = scene.truth.height_px, strip_rows = 256;
   std::vector<cv::Mat> sources;
@@ -133,7 +142,44 @@ void BM_OpenCvWarpAffine(benchmark::State& state) {
 }
 BENCHMARK(BM_OpenCvWarpAffine)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
+// The memory-bandwidth peer: the virtual image's bytes copied from one buffer to another.
+void BM_Copy(benchmark::State& state) {
+  const ResampleScene& scene = Scene();
+  const size_t bytes = static_cast<size_t>(scene.truth.width_px) * scene.truth.height_px * 2;
+  std::vector<std::uint8_t> from(bytes, 1), to(bytes, 0);
+  for (auto _ : state) {
+    std::memcpy(to.data(), from.data(), bytes);
+    benchmark::DoNotOptimize(to.data());
+    benchmark::ClobberMemory();
+  }
+  state.counters["GB/s"] = benchmark::Counter(2e-9 * bytes * state.iterations(), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_Copy)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+
 }  // namespace
 }  // namespace aerocal::stitch
 
-BENCHMARK_MAIN();
+int main(int argc, char** argv) {
+  benchmark::Initialize(&argc, argv);
+  aerocal::testing::RatioReporter reporter;
+  benchmark::RunSpecifiedBenchmarks(&reporter);
+  // Wall time (the reporter's) and CPU time: all three run on one thread, so on a machine shared
+  // with other jobs the CPU time is the work and the wall time adds the waits for a core.
+  for (const bool cpu : {false, true}) {
+    const auto time_of = [&](const std::string& name) {
+      return cpu ? reporter.CpuTimeOf(name) : reporter.TimeOf(name);
+    };
+    const double warp = time_of("BM_OpenCvWarpAffine"), copy = time_of("BM_Copy");
+    for (const std::string name : {"BM_Resample/0", "BM_Resample/1"}) {
+      const double ours = time_of(name);
+      if (ours <= 0) continue;
+      std::printf("%s %s (%s): %.1f ms", cpu ? "CPU " : "wall", name.c_str(),
+                  name.back() == '0' ? "fast" : "reference", ours);
+      if (warp > 0) std::printf(", cv::warpAffine %.1f ms: %.2fx as fast", warp, warp / ours);
+      if (copy > 0) std::printf(", copy %.1f ms: %.1f %% of the copy's bandwidth", copy, 100 * copy / ours);
+      std::printf("\n");
+    }
+  }
+  benchmark::Shutdown();
+  return 0;
+}

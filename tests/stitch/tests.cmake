@@ -33,3 +33,4 @@ aerocal_add_test(stitch/resampling_mtf LIBS aerocal::stitch LABELS synthetic)
 aerocal_add_test(stitch/edge_targets LIBS aerocal::stitch LABELS unit)
 # A frame's run as lossless JSON (`aerocal batch` units to the merge, issue 35).
 aerocal_add_test(stitch/frame_run_json LIBS aerocal::stitch LABELS unit)
+aerocal_add_test(stitch/fast_resample LIBS aerocal::stitch LABELS synthetic)
