@@ -38,7 +38,7 @@ TEST(ImportImagesMatch, ColmapTiesLetTheFlightBeAdjusted) {
   std::map<std::string, int> per_image, rays;
   for (const triangulation::ImageObservation& o : p.observations) ++per_image[o.image], ++rays[o.point];
   for (const triangulation::Exposure& e : p.exposures) EXPECT_GE(per_image[e.image], 50) << e.image;
-  EXPECT_GE(p.points.size(), 300u);  // 630 with COLMAP 3.8
+  EXPECT_GE(p.points.size(), 300u);  // 628 to 630 with COLMAP 3.8 (its threads vary a little)
   for (const auto& [id, n] : rays) ASSERT_GE(n, 2) << id;
   // A nadir flight: every tie point lies below every centre and within 100 m of the flight's
   // centre horizontally (the model placed by the GNSS centres alone, through ECEF and back).
@@ -58,7 +58,7 @@ TEST(ImportImagesMatch, ColmapTiesLetTheFlightBeAdjusted) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = testing::ReadJson(tmp.File("r.json"));
   EXPECT_TRUE(j["converged"].get<bool>());
-  // SIFT keypoints on 640 x 360 px images: about 0.3 px against the a-priori 1 px.
+  // SIFT keypoints on 640 x 360 px images: 0.31 to 0.33 px against the a-priori 1 px.
   EXPECT_GT(j["sigma0"].get<double>(), 0.1);
   EXPECT_LT(j["sigma0"].get<double>(), 1.0);
   std::map<std::string, const triangulation::Exposure*> imported;
@@ -77,7 +77,7 @@ TEST(ImportImagesMatch, ColmapTiesLetTheFlightBeAdjusted) {
   }
   // The GNSS centres agree with the photogrammetric geometry to well under their 5 m sigma: the
   // decoded positions (degrees, minutes, seconds, W negative) are the ones the images were taken
-  // at (measured: 0.3 m RMS).
+  // at (measured: 0.34 m RMS).
   EXPECT_LT(std::sqrt(shift2), 1.5);
   std::printf("tie points %zu, observations %zu, sigma0 %.3f, GNSS shift RMS %.2f m\n", p.points.size(),
               p.observations.size(), j["sigma0"].get<double>(), std::sqrt(shift2));
