@@ -46,7 +46,7 @@ void AddMatchOptions(CLI::App* images, const std::shared_ptr<MatchArgs>& m) {
       ->check(CLI::IsMember({"exhaustive", "spatial"}));
   images->add_option("--colmap-max-image-px", m->colmap.max_image_px,
                      "SIFT on images downscaled to this longer side, px (default 3200)")
-      ->check(CLI::Range(100, 100000));
+      ->check(FiniteRange(100, 100000));
   images->add_option("--colmap-align-error-m", m->colmap.align_error_m,
                      "Inlier bound of the model's alignment to the GNSS centres, m (default 10)")
       ->check(PositiveUpTo(1e6));
