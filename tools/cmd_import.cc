@@ -4,10 +4,12 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "tools/colmap_matching.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
 #include "triangulation/adjustment/nadir_start.h"
 #include "triangulation/import/colmap_import.h"
+#include "triangulation/import/colmap_ties.h"
 #include "triangulation/import/dbat_import.h"
 #include "triangulation/import/image_import.h"
 #include "triangulation/import/odm_gcp_import.h"
@@ -25,6 +27,46 @@ void Report(const triangulation::Project& p, const std::string& out) {
               p.observations.size(),
               p.points.size(),
               out.c_str());
+}
+
+struct MatchArgs {
+  std::string match = "none";  // none | colmap
+  double sigma_px = 1.0;       // a-priori sigma of the tie observations, px
+  ColmapMatchingOptions colmap;
+};
+
+void AddMatchOptions(CLI::App* images, const std::shared_ptr<MatchArgs>& m) {
+  images->add_option("--match", m->match,
+                     "Tie points after the import: none (default) or colmap (COLMAP's SIFT "
+                     "extraction, matching and mapper, aligned to the GNSS centres; files in OUT/colmap)")
+      ->check(CLI::IsMember({"none", "colmap"}));
+  images->add_option("--colmap", m->colmap.program, "COLMAP executable (default: colmap on PATH)");
+  images->add_option("--colmap-matcher", m->colmap.matcher,
+                     "exhaustive (every pair; default) or spatial (pairs near in the EXIF GPS; large flights)")
+      ->check(CLI::IsMember({"exhaustive", "spatial"}));
+  images->add_option("--colmap-max-image-px", m->colmap.max_image_px,
+                     "SIFT on images downscaled to this longer side, px (default 3200)")
+      ->check(FiniteRange(100, 100000));
+  images->add_option("--colmap-align-error-m", m->colmap.align_error_m,
+                     "Inlier bound of the model's alignment to the GNSS centres, m (default 10)")
+      ->check(PositiveUpTo(1e6));
+  images->add_option("--sigma-px", m->sigma_px, "Sigma of the tie observations, px (default 1)")
+      ->check(PositiveUpTo(100));
+}
+
+// --match colmap: COLMAP's tie points added to the imported exposures (colmap_ties.h).
+triangulation::Project MatchWithColmap(const triangulation::ImageImportReport& report,
+                                       const std::string& images_dir, MatchArgs m, const std::string& out) {
+  m.colmap.work_dir = out + "/colmap";
+  const std::string text = RunColmapMatching(images_dir, triangulation::EcefCentres(report.project), m.colmap);
+  triangulation::ColmapImportOptions c;
+  c.folder = text;
+  c.sigma_px = m.sigma_px;
+  c.crs = "EPSG:4978";
+  const triangulation::ColmapImportReport model = triangulation::ImportColmapModel(c);
+  triangulation::ColmapTiesReport ties = triangulation::AddColmapTies(report.project, model.project);
+  for (const std::string& note : ties.notes) std::printf("note: %s\n", note.c_str());
+  return ties.project;
 }
 
 void SetupImportImages(CLI::App& app, const std::shared_ptr<std::string>& out,
@@ -56,20 +98,28 @@ void SetupImportImages(CLI::App& app, const std::shared_ptr<std::string>& out,
                      "equivalent focal length)")
       ->check(PositiveUpTo(1));
   images->add_option("--out", *out, "Output folder")->required();
+  auto match = std::make_shared<MatchArgs>();
+  AddMatchOptions(images, match);
   images->callback([=] {
     *run = [=] {
       CheckOutputFolder(*out, "--out");
       if (!gnss->empty()) o->gnss_sigma_m = Eigen::Vector2d((*gnss)[0], (*gnss)[1]);
       if (*attitude > 0) o->attitude_sigma_deg = *attitude;
-      const triangulation::ImageImportReport report = triangulation::ImportImages(*o);
-      triangulation::WriteImageImport(report, *out);
+      triangulation::ImageImportReport report = triangulation::ImportImages(*o);
       for (const std::string& note : report.notes) std::printf("note: %s\n", note.c_str());
+      if (match->match == "colmap") report.project = MatchWithColmap(report, o->folder, *match, *out);
+      triangulation::WriteImageImport(report, *out);
       std::printf("imported %zu exposures, %zu cameras from %s -> %s/project.yaml (tags.csv: the "
                   "tag of every value)\n",
                   report.project.exposures.size(),
                   report.project.cameras.size(),
                   o->folder.c_str(),
                   out->c_str());
+      if (match->match == "colmap")
+        std::printf("COLMAP: %zu tie points, %zu image observations in %zu exposures\n",
+                    report.project.points.size(),
+                    report.project.observations.size(),
+                    report.project.exposures.size());
       std::printf("%zu files not used (images_not_used.csv)", report.not_used.size());
       for (size_t i = 0; i < report.not_used.size(); ++i)
         std::printf("%s%s", i == 0 ? ": " : ", ", report.not_used[i].first.c_str());

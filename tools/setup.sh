@@ -14,7 +14,8 @@ packages=(cmake make g++ pkg-config
   python3 python3-matplotlib python3-numpy poppler-utils
   python3-dev pybind11-dev python3-pytest
   weasyprint  # report.pdf: the HTML report typeset for A4 (tools/report/README.md)
-  parallel)  # GNU Parallel (2.9 MB installed, with sysstat 1.8 MB): `aerocal batch` shards, tests/tools/cli_batch
+  parallel  # GNU Parallel (2.9 MB installed, with sysstat 1.8 MB): `aerocal batch` shards, tests/tools/cli_batch
+  colmap)   # COLMAP 3.8 (16.5 MB more here, no recommends): `import images --match colmap`, import_images_match_test
 missing=()
 for p in "${packages[@]}"; do
   dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

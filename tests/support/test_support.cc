@@ -4,11 +4,13 @@
 #include "calib/core/json_file.h"
 
 #include <array>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <random>
+#include <regex>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -50,6 +52,12 @@ std::string AerocalBinary() { return AEROCAL_BINARY; }
 
 CommandResult RunAerocal(const std::string& arguments) {
   return RunCommand(AerocalBinary() + " " + arguments);
+}
+
+double XmpAttribute(const std::string& bytes, const std::string& name) {
+  std::smatch m;
+  if (!std::regex_search(bytes, m, std::regex(":" + name + "=\"([^\"]+)\""))) return NAN;
+  return std::stod(m[1].str());
 }
 
 std::string SharedDataDir(const std::string& name) {

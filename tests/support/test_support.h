@@ -40,6 +40,10 @@ nlohmann::json ReadJson(const std::string& path);
 /// reads back to the same bits).
 std::string ResultWithoutClock(const std::string& path);
 
+/// The number in NAME="..." of an XMP text (a regular expression on ":NAME=", whatever the prefix;
+/// NaN when absent): the tests' reading of image metadata, independent of calib/metadata.
+double XmpAttribute(const std::string& bytes, const std::string& name);
+
 /// Path of a shared real data set, or "" when ../shared/data is absent (tests then GTEST_SKIP).
 std::string SharedDataDir(const std::string& name);
 

@@ -13,7 +13,6 @@
 
 #include <cmath>
 #include <filesystem>
-#include <regex>
 
 namespace aerocal {
 namespace {
@@ -24,12 +23,7 @@ constexpr double kDeg = M_PI / 180.0;
 
 const std::string kImages = std::string(AEROCAL_TEST_DATA_DIR) + "/images";
 
-// The value of NAME="..." in the text (independent of the reader: a regular expression).
-double XmpValue(const std::string& bytes, const std::string& name) {
-  std::smatch m;
-  if (!std::regex_search(bytes, m, std::regex(":" + name + "=\"([^\"]+)\""))) return NAN;
-  return std::stod(m[1].str());
-}
+double XmpValue(const std::string& bytes, const std::string& name) { return testing::XmpAttribute(bytes, name); }
 
 // The fixture with its XMP text passed through `edit` (the APP1 length rewritten).
 std::string WithXmp(const std::string& jpeg, const std::function<std::string(std::string)>& edit) {

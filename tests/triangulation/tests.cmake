@@ -31,3 +31,6 @@ aerocal_add_test(triangulation/direction_calibration LIBS aerocal::triangulation
 # import images (issue 34 item 3): the gimbal convention and the command on metadata-only JPEGs.
 aerocal_add_test(triangulation/gimbal_attitude LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/import_images_cli LIBS aerocal::triangulation LABELS cli)
+# ... on real DJI JPEGs (metadata unaltered), and matched by COLMAP then adjusted (item 3).
+aerocal_add_test(triangulation/import_images_real LIBS aerocal::triangulation LABELS cli)
+aerocal_add_test(triangulation/import_images_match LIBS aerocal::triangulation LABELS cli)
