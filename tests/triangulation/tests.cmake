@@ -31,3 +31,6 @@ aerocal_add_test(triangulation/direction_calibration LIBS aerocal::triangulation
 # import images (issue 34 item 3): the gimbal convention and the command on metadata-only JPEGs.
 aerocal_add_test(triangulation/gimbal_attitude LIBS aerocal::triangulation LABELS unit)
 aerocal_add_test(triangulation/import_images_cli LIBS aerocal::triangulation LABELS cli)
+# The budget YAML and directions file readers called directly (issue 37: `unit`, so the sanitizer
+# job runs them; their CLI tests are `cli`).
+aerocal_add_test(triangulation/calibration_readers LIBS aerocal::triangulation LABELS unit)
