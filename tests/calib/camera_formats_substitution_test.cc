@@ -99,6 +99,63 @@ TEST(CameraFormatsNoSubstitution, ANanOrAnEmptyNumberIsRefusedOrUnused) {
   for (const std::string& s : substituted) ADD_FAILURE() << s;
 }
 
+// A line holding a number given twice, the copy with another number (1, or 2 where it was 1),
+// before and after the original: the reader refuses it or does not use that number. A reader that
+// takes the first (or the last) of two values reads another camera. Not for two files whose lines
+// mean nothing alone: a PhotoModeler export is positional (lines 1-5, the photos after them not
+// read), and a copy of the XMP attribute line ending in "/>" leaves the original as character data
+// outside the element (two attributes of one name are refused: not well-formed XML).
+TEST(CameraFormatsNoSubstitution, ALineGivenTwiceIsRefusedOrUnused) {
+  testing::TempDir dir("aerocal_formats_substitution");
+  const fs::path seeds = fs::path(AEROCAL_TEST_DATA_DIR) / ".." / "fuzz" / "seeds" / "camera_formats";
+  const std::regex number(R"((^|[^A-Za-z0-9_.+-])([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)(?![A-Za-z0-9_.]))");
+  int mutations = 0, refused = 0;
+  std::vector<std::string> taken;
+  for (const auto& entry : fs::directory_iterator(seeds)) {
+    const std::string seed = entry.path().string();
+    const std::string name = entry.path().filename().string();
+    if (name == "photomodeler.txt" || name == "dewarp.txt") continue;
+    const CameraReadOptions options = OptionsFor(seed);
+    std::string format;
+    CameraFile original;
+    try {
+      original = ReadCameraFileAs("auto", seed, options, &format);
+    } catch (const Error&) {
+      continue;
+    }
+    const CameraFormat& reader = FindCameraFormat(format, "--from");
+    const std::string text = testing::ReadFileText(seed);
+    size_t begin = 0;
+    for (int line = 1; begin < text.size(); ++line) {
+      const size_t end = std::min(text.find('\n', begin), text.size());
+      const std::string row = text.substr(begin, end - begin);
+      std::smatch m;
+      if (std::regex_search(row, m, number)) {
+        std::string copy = row;
+        copy.replace(static_cast<size_t>(m.position(2)), static_cast<size_t>(m.length(2)), m.str(2) == "1" ? "2" : "1");
+        for (const bool before : {true, false}) {
+          std::string mutated = text;
+          mutated.insert(before ? begin : end, before ? copy + "\n" : "\n" + copy);
+          const std::string path = dir.File("twice" + entry.path().extension().string());
+          testing::WriteFileText(path, mutated);
+          ++mutations;
+          try {
+            if (!SameCamera(original, reader.read(path, options)))
+              taken.push_back(format + " " + entry.path().filename().string() + ":" + std::to_string(line) +
+                              ": a copy " + (before ? "before" : "after") + " it with '" + m.str(2) +
+                              "' changed is read");
+          } catch (const Error&) {
+            ++refused;
+          }
+        }
+      }
+      begin = end + 1;
+    }
+  }
+  std::printf("%d duplicated lines: %d refused, %zu read as another camera\n", mutations, refused, taken.size());
+  for (const std::string& t : taken) ADD_FAILURE() << t;
+}
+
 // What the mutations above found in the Australis reader: it took the first name followed by five
 // numbers, so a damaged row was skipped and its parameter read as 0 (and a second row ignored).
 TEST(CameraFormatsNoSubstitution, AustralisRowsAreOneLineEachWithFiveNumbers) {
@@ -133,6 +190,37 @@ TEST(CameraFormatsNoSubstitution, AustralisRowsAreOneLineEachWithFiveNumbers) {
   const CameraFile b = ReadAustralisCamera(dir.File("b.txt"), {});
   EXPECT_EQ(b.camera.params[BrownFraser10Model::kK1], 0.0);
   EXPECT_NE(std::find(b.notes.begin(), b.notes.end(), "K1: no line in the report, 0"), b.notes.end());
+}
+
+// What the duplicated lines found: each reader now names the second value (or the empty element).
+TEST(CameraFormatsNoSubstitution, DbatDjiAndOpenSfmNameTheSecondValue) {
+  testing::TempDir dir("aerocal_formats_substitution");
+  const auto error = [&](const std::string& format, const std::string& name, const std::string& text) {
+    testing::WriteFileText(dir.File(name), text);
+    try {
+      ReadCameraFileAs(format, dir.File(name), {});
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(read)");
+  };
+  const std::string dbat = "<cameras><camera><sensor>auto,24</sensor><image>6000,4000</image>\n<cc>35</cc>\n";
+  EXPECT_NE(error("dbat", "a.xml", dbat + "<cc>36</cc>\n</camera></cameras>\n")
+                .find("a.xml:3: <cc> occurs twice in <camera> (first on line 2)"),
+            std::string::npos);
+  EXPECT_NE(error("dbat", "b.xml", dbat + "<K></K>\n</camera></cameras>\n").find("b.xml:3: <K> is empty"),
+            std::string::npos);
+  const std::string exif = "======== A.JPG\nImage Width : 5472\nExif Image Width : 5472\nImage Height : 3648\n"
+                           "Dewarp Data : 3684.48,3677.57,2.24,22.05,-0.26,0.1,3e-05,-3e-04,-0.03\n";
+  EXPECT_EQ(error("dji", "c.txt", exif), "(read)");  // the same width twice, as exiftool prints it
+  EXPECT_NE(error("dji", "d.txt", exif + "Exif Image Height : 3000\n")
+                .find("d.txt:6: image height 3000 contradicts 3648 on line 4"),
+            std::string::npos);
+  EXPECT_NE(error("opensfm", "e.json",
+                  "{\"cam\": {\"projection_type\": \"perspective\", \"width\": 640, \"height\": 480,\n"
+                  "\"focal\": 0.9, \"focal\": 1.0, \"k1\": 0, \"k2\": 0}}\n")
+                .find("e.json: cam: key \"focal\" occurs twice in one object"),
+            std::string::npos);
 }
 
 }  // namespace
