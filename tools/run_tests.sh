@@ -7,8 +7,9 @@
 #    files) for AEROCAL_FUZZ_SECONDS (20 s) each, and the calib `unit` tests under the same
 #    sanitizers: both link only aerocal::calib, the one library instrumented there;
 #  - AEROCAL_FULL_CHECKS=1 adds every fuzz target (block files, stitching CSV, importers, stitch
-#    result JSON, rig project and rig inputs, pushbroom inputs and the budget YAML, the readers inside
-#    the command line: --groups, certificate files, rig stitch, pushbroom control) and the whole
+#    result JSON, rig project and rig inputs, pushbroom inputs, the budget YAML and the directions
+#    file, the readers inside the command line: --groups, certificate files, rig stitch, pushbroom
+#    control, the batch manifest) and the whole
 #    sanitizer job (build-asan/, gcc -fsanitize=address,undefined): every
 #    test labelled `unit` and the bad-input CLI cases (tools/bad_input runs the sanitized aerocal).
 #    That instruments all three libraries (12.5 min on 2 cores for the clang build), too much for

@@ -1,6 +1,8 @@
 #include "calib/core/json_file.h"
 
 #include <algorithm>
+#include <set>
+#include <vector>
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
@@ -26,6 +28,30 @@ nlohmann::json ParseJsonText(const std::string& text, const std::string& path) {
     // Thrown while parsing, without a position: a number beyond the double range (1e999).
     ThrowInputError({path, 0}, std::string("invalid JSON (") + e.what() + ")");
   }
+}
+
+void RejectDuplicateJsonKeys(const std::string& text, const std::string& path) {
+  struct Object {
+    std::set<std::string> keys;
+    std::string key;  // the key being read (names the objects below it)
+  };
+  std::vector<Object> objects;
+  using Event = nlohmann::json::parse_event_t;
+  const nlohmann::json::parser_callback_t check = [&](int, Event event, nlohmann::json& parsed) {
+    if (event == Event::object_start) objects.emplace_back();
+    if (event == Event::object_end && !objects.empty()) objects.pop_back();
+    if (event != Event::key || objects.empty()) return true;
+    const std::string key = parsed.get<std::string>();
+    if (!objects.back().keys.insert(key).second) {
+      std::string where;
+      for (size_t i = 0; i + 1 < objects.size(); ++i) where += (i ? " / " : "") + objects[i].key;
+      throw InputError(path + ": " + (where.empty() ? "" : where + ": ") + "key \"" + key +
+                       "\" occurs twice in one object");
+    }
+    objects.back().key = key;
+    return true;
+  };
+  (void)nlohmann::json::parse(text, check);
 }
 
 nlohmann::json ReadJsonFile(const std::string& path) {

@@ -15,6 +15,11 @@ int LineOfOffset(const std::string& text, size_t offset);
 /// is not a JSON document.
 nlohmann::json ParseJsonText(const std::string& text, const std::string& path);
 
+/// InputError("PATH: a / b: key \"k\" occurs twice in one object") when an object of `text` (a
+/// JSON document ParseJsonText accepted) holds a key twice: nlohmann keeps the last, a reader of
+/// another tool's file must not choose (issue 37 class 4). The path names the object's keys.
+void RejectDuplicateJsonKeys(const std::string& text, const std::string& path);
+
 /// ReadTextFile (regular-file checks, BOM dropped) + ParseJsonText.
 nlohmann::json ReadJsonFile(const std::string& path);
 

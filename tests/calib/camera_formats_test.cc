@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <map>
@@ -129,6 +130,25 @@ TEST(CameraFormats, AHostileNameNeverBreaksAFile) {
     if (std::string(f.name) == "dbat" || std::string(f.name) == "photomodeler") {
       EXPECT_EQ(back.name, "A&B <lens> \"q\" 'p' second line");
     }
+  }
+}
+
+// Issue 37 class 3: a writer never leaves a file its own reader refuses. A camera whose principal
+// distance is 1e9 times the DJI record's (3.7e12 px) is written by every format through
+// WriteCameraFileVerified: an Error naming the file, and neither the file nor its scratch copy.
+TEST(CameraFormats, AVerifiedWriteTheReaderRefusesLeavesNoFile) {
+  namespace fs = std::filesystem;
+  TempDir dir("aerocal_formats_verified");
+  for (const CameraFormat& f : CameraFormats()) {
+    SCOPED_TRACE(f.name);
+    CameraFile file = ConvertCameraFile(File(DjiRecordA()), f.target(DjiRecordA())).file;
+    const std::vector<ParamInfo> table = CameraModelParams(file.camera.model);
+    for (size_t i = 0; i < table.size(); ++i)
+      if (table[i].group == ParamGroup::kPrincipalDistance) file.camera.params[i] *= 1e9;
+    const std::string path = dir.File("huge" + f.extension);
+    EXPECT_THROW(WriteCameraFileVerified(f, path, file), Error);
+    EXPECT_FALSE(fs::exists(path));
+    for (const auto& entry : fs::directory_iterator(dir.path())) ADD_FAILURE() << "left " << entry.path();
   }
 }
 

@@ -13,6 +13,10 @@ aerocal_add_test(calib/file_digest LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/rig LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/camera_formats LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/camera_file_variants LIBS aerocal::calib LABELS unit)
+# Issue 37 class 4: a nan or an empty number in any reader's example is refused or unused.
+aerocal_add_test(calib/camera_formats_substitution LIBS aerocal::calib LABELS unit)
+# Issue 37 class 5: names and ids with line breaks and punctuation through our YAML writers.
+aerocal_add_test(calib/hostile_text LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/rotation LIBS aerocal::calib LABELS unit)
 # Direction observations of a laboratory calibration (collimator, goniometer; issue 36 item 6).
 aerocal_add_test(calib/direction_residual LIBS aerocal::calib LABELS unit)

@@ -1,7 +1,8 @@
 // libFuzzer target of the readers that live in the command line (issue 12): the `aerocal`
 // commands run in process (tools/main.cc compiled with main renamed AerocalMain, tests/fuzz/
 // CMakeLists.txt), so the fuzzed files go through the same reading and checking as for a user.
-// The first byte picks the command; the rest is split at "\n%%\n" into the files it reads:
+// The first byte picks the command (a seed's first character '0'..'5' names kind 0..5); the rest
+// is split at "\n%%\n" into the files it reads:
 //   0: certificate --result R --lab L --previous P --tolerances T (the typed reading of a
 //      calibrate result.json and of a previous certificate, the lab YAML, the tolerances YAML);
 //   1: calibrate --groups G on a simulated test field (2 groups of 4 images);
@@ -9,7 +10,10 @@
 //   3: rig stitch --project with the fuzzed project.yaml, exposures, observations and points of a
 //      simulated four-head rig line (its rig file as given);
 //   4: pushbroom control with the fuzzed line camera, pos.csv and reference exposures.csv (the
-//      reference camera, line image and reference images fixed, small).
+//      reference camera, line image and reference images fixed, small);
+//   5: batch status --manifest M with the fuzzed manifest.json and unit u1's done and failed
+//      records (docs/formats.md "Batch manifest"); run from the scratch folder, which holds a
+//      simulated flight in sim_flight/ (a seed's "directory" and relative flight arguments).
 // Exit 2 (bad input) and 3 (did not converge) are answers; exit 1 ("internal error": an exception
 // the command did not turn into FILE:LINE) is a finding, as is any crash, leak or UB report.
 #include <cstdint>
@@ -57,6 +61,8 @@ const std::string& Simulated(const std::string& name, const std::vector<std::str
   return made.emplace(name, dir).first->second;
 }
 
+constexpr int kKinds = 6;
+
 const std::string& TestField() {
   return Simulated("tf", {"--test-field", "--groups", "2", "--images-per-group", "4"});
 }
@@ -84,7 +90,7 @@ const std::string& PushbroomFixed() {
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   if (size < 1) return 0;
-  const int kind = data[0] % 5;
+  const int kind = (data[0] - '0' + 256 * kKinds) % kKinds;  // '0' -> 0, ..., '5' -> 5
   const auto parts = Parts(data + 1, size - 1, 4);
   const std::string out = ScratchDir() + "/out";
   fs::remove_all(out);
@@ -111,13 +117,24 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     WriteScratch("rig/points.csv", parts[3]);
     code = Run({"rig", "stitch", "--camera", dir + "/rig_truth.yaml", "--project",
                 dir + "/project.yaml", "--out", out});
-  } else {
+  } else if (kind == 4) {
     const std::string& fixed = PushbroomFixed();
     code = Run({"pushbroom", "control", "--camera", WriteScratch("line.yaml", parts[0]), "--pos",
                 WriteScratch("pos.csv", parts[1]), "--line-image", fixed + "/line.png",
                 "--reference-camera", fixed + "/camera.yaml", "--reference-exposures",
                 WriteScratch("reference.csv", parts[2]), "--reference-images", fixed + "/images",
                 "--out", out});
+  } else {
+    Simulated("flight", {"--exposures", "2", "--strips", "1"});
+    fs::remove_all(ScratchDir() + "/batch");
+    fs::create_directories(ScratchDir() + "/batch/done");
+    fs::create_directories(ScratchDir() + "/batch/failed");
+    WriteScratch("batch/done/u1.json", parts[1]);
+    WriteScratch("batch/failed/u1.json", parts[2]);
+    const fs::path cwd = fs::current_path();  // the command enters the manifest's "directory"
+    fs::current_path(ScratchDir());
+    code = Run({"batch", "status", "--list", "--manifest", WriteScratch("batch/manifest.json", parts[0])});
+    fs::current_path(cwd);
   }
   if (code == 1) {
     std::fprintf(stderr, "fuzz_cli: exit 1 (internal error) on command kind %d\n", kind);

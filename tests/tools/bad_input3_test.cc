@@ -292,6 +292,23 @@ TEST(CameraConvertOutputs, OutAndReportInTwoFoldersAreOneSet) {
   ExpectNoLeftovers(d.path());
 }
 
+// Class 3: without --max-residual-px a fit that leaves part of the format unmapped (a drone lens
+// whose strong k1 = -0.5, k2 = +0.3 folds inside the format; the ten-parameter model cannot follow
+// it and is not invertible there) is exit 3 in every format it is fitted for, nothing written.
+TEST(CameraConvertOutputs, AFitNotInvertibleOverTheFormatIsExit3WithoutAGate) {
+  TempDir d("aerocal_bad_input3_convert_fit");
+  Write(d.File("dji.txt"), "3684.48,3677.57,2.24,22.05,-0.5,0.3,3.71107e-3,-3.27247e-3,-0.0300783\n");
+  for (const std::string to : {"aerocal --model brown10", "australis", "dbat"}) {
+    SCOPED_TRACE(to);
+    const auto r = RunAerocal("camera convert --from dji --to " + to + " " + d.File("dji.txt") + " " +
+                              d.File("out.cam") + " --width 5472 --height 3648 --pixel-mm 0.0024");
+    EXPECT_EQ(r.exit_code, 3) << r.output;
+    EXPECT_NE(r.output.find("points not invertible"), std::string::npos) << r.output;
+    EXPECT_FALSE(fs::exists(d.File("out.cam")));
+  }
+  ExpectNoLeftovers(d.path());
+}
+
 TEST(RigConvertOutputs, AnOutNamingTheDemIsRefusedBeforeAnythingIsRead) {
   TempDir d("aerocal_bad_input3_rig_convert");
   Write(d.File("dem.asc"), "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n");

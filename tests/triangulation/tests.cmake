@@ -34,3 +34,6 @@ aerocal_add_test(triangulation/import_images_cli LIBS aerocal::triangulation LAB
 # ... on real DJI JPEGs (metadata unaltered), and matched by COLMAP then adjusted (item 3).
 aerocal_add_test(triangulation/import_images_real LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(triangulation/import_images_match LIBS aerocal::triangulation LABELS cli)
+# The budget YAML and directions file readers called directly (issue 37: `unit`, so the sanitizer
+# job runs them; their CLI tests are `cli`).
+aerocal_add_test(triangulation/calibration_readers LIBS aerocal::triangulation LABELS unit)

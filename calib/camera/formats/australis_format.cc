@@ -12,9 +12,12 @@
 // the measured coordinates reduced to the principal point. So x0 = XP, y0 = YP and every term maps
 // one to one (exact). The final standard errors become a diagonal covariance (Australis prints no
 // correlations here); an Initial Std. Error of 1.0e+003 is Australis's "free". The report is read
-// as whitespace-separated tokens (its columns are aligned with spaces, so line breaks do not
-// matter): H and V each followed by pixels and pixel size, then each parameter name followed by
-// its five numbers. H and V pixel sizes that differ are not modelled (square pixels of V's size,
+// as whitespace-separated tokens (its columns are aligned with spaces): the line that starts with
+// H and the one that starts with V, each followed by pixels and pixel size, then the line of each
+// parameter, its name followed by its five numbers. Each of these lines is given once (a second
+// one is an error, not the first one taken) and its numbers must read (a `nan` or a missing
+// number is an error at its line, never a 0); a parameter without a line is 0, said in the notes
+// (C is required). H and V pixel sizes that differ are not modelled (square pixels of V's size,
 // said). Written in the same layout, Initial = Final and Total Adjustment 0.
 #include <cmath>
 #include <filesystem>
@@ -55,25 +58,30 @@ CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions&
     ThrowInputError({path, 1}, "not an Australis camera-parameter report (no 'Australis' line)");
   if (!options.camera_id.empty())
     ThrowInputError({path, 1}, "--camera: one camera per Australis report is read");
-  // `name` followed by `count` numbers; the first such occurrence. Returns the token index or -1.
-  const auto find = [&](const std::string& name, size_t count, size_t from) -> long {
-    for (size_t i = from; i + count < tokens.size(); ++i) {
-      if (tokens[i].text != name) continue;
-      bool numbers = true;
-      for (size_t k = 1; k <= count; ++k) numbers &= ParseDouble(tokens[i + k].text).has_value();
-      if (numbers) return static_cast<long>(i);
+  // The token index of the one line at or after token `from` that starts with `name` (-1: none).
+  const auto row = [&](const std::string& name, size_t from) -> long {
+    long found = -1;
+    for (size_t i = from; i < tokens.size(); ++i) {
+      if (tokens[i].text != name || (i > 0 && tokens[i - 1].line == tokens[i].line)) continue;
+      if (found >= 0)
+        ThrowInputError({path, tokens[i].line}, "a second '" + name + "' line (the first is line " +
+                                                    std::to_string(tokens[found].line) + ")");
+      found = static_cast<long>(i);
     }
-    return -1;
+    return found;
   };
-  const long h = find("H", 2, 0), v = find("V", 2, 0);
+  const long h = row("H", 0), v = row("V", 0);
   if (h < 0 || v < 0)
     ThrowInputError({path, 1}, "no sensor size: lines 'H <pixels> <pixel size mm>' and "
                                "'V <pixels> <pixel size mm>'");
-  const auto number = [&](long i, const std::string& what, double bound) {
-    return internal::ParseNumber(tokens[i].text, {path, tokens[i].line}, what, bound);
+  // The k-th number after the name at token `i`.
+  const auto number = [&](long i, long k, const std::string& what, double bound) {
+    const size_t at = static_cast<size_t>(i + k);
+    if (at >= tokens.size()) ThrowInputError({path, tokens[i].line}, what + " is missing");
+    return internal::ParseNumber(tokens[at].text, {path, tokens[at].line}, what, bound);
   };
-  const double width = number(h + 1, "H pixels", 1e6), height = number(v + 1, "V pixels", 1e6);
-  const double pixel_h = number(h + 2, "H pixel size", 1.0), pixel_v = number(v + 2, "V pixel size", 1.0);
+  const double width = number(h, 1, "H pixels", 1e6), height = number(v, 1, "V pixels", 1e6);
+  const double pixel_h = number(h, 2, "H pixel size", 1.0), pixel_v = number(v, 2, "V pixel size", 1.0);
   if (!(width >= 1 && height >= 1 && width == std::floor(width) && height == std::floor(height)))
     ThrowInputError({path, tokens[h].line}, "H and V pixels must be positive integers");
   CameraFile file;
@@ -88,17 +96,20 @@ CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions&
   Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(Model::kNumParams, Model::kNumParams);
   bool any_sigma = false;
   for (int k = 0; k < Model::kNumParams; ++k) {
-    const long i = find(kAustralisNames[k], 5, static_cast<size_t>(std::max(h, v)));
+    const std::string name = kAustralisNames[k];
+    const long i = row(name, static_cast<size_t>(std::max(h, v)) + 1);
     if (i < 0) {
       if (k == Model::kC)
         ThrowInputError({path, 1}, "no camera constant: a line 'C <initial> <adjustment> <final> "
                                    "<initial sigma> <final sigma>'");
-      continue;  // a parameter Australis did not carry: 0
+      file.notes.push_back(name + ": no line in the report, 0");
+      continue;
     }
-    const std::string name = kAustralisNames[k];
-    file.camera.params[k] = number(i + 3, name + " final value", k == Model::kC ? 1e4 : 1e3);
-    const double initial_sigma = number(i + 4, name + " initial std. error", 1e12);
-    const double sigma = number(i + 5, name + " final std. error", 1e12);
+    number(i, 1, name + " initial value", 1e12);
+    number(i, 2, name + " total adjustment", 1e12);
+    file.camera.params[k] = number(i, 3, name + " final value", k == Model::kC ? 1e4 : 1e3);
+    const double initial_sigma = number(i, 4, name + " initial std. error", 1e12);
+    const double sigma = number(i, 5, name + " final std. error", 1e12);
     if (sigma < 0) ThrowInputError({path, tokens[i].line}, name + " std. error must be >= 0");
     if (sigma > 0 && initial_sigma > 0) {  // 0: fixed (or not given)
       covariance(k, k) = sigma * sigma;

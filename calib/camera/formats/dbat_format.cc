@@ -36,14 +36,23 @@ struct XmlCamera {
   std::string path;
   const tinyxml2::XMLElement* camera = nullptr;
 
-  const tinyxml2::XMLElement* Child(const char* tag) const { return camera->FirstChildElement(tag); }
   SourceRef Where(const tinyxml2::XMLElement* e) const {
     return {path, e ? e->GetLineNum() : camera->GetLineNum()};
   }
-  // Text of <tag> split on commas, trimmed; empty when the tag is absent.
+  // The one <tag> of the camera (nullptr: none); a second one is an error, not the first taken.
+  const tinyxml2::XMLElement* Child(const char* tag) const {
+    const tinyxml2::XMLElement* e = camera->FirstChildElement(tag);
+    if (const tinyxml2::XMLElement* again = e ? e->NextSiblingElement(tag) : nullptr)
+      ThrowInputError(Where(again), std::string("<") + tag + "> occurs twice in <camera> (first on line " +
+                                        std::to_string(e->GetLineNum()) + ")");
+    return e;
+  }
+  // Text of <tag> split on commas, trimmed; empty when the tag is absent. A tag present but empty
+  // is an error (not "no values": an empty <K> is no statement of zero distortion).
   std::vector<std::string> List(const char* tag) const {
     const tinyxml2::XMLElement* e = Child(tag);
-    if (!e || !e->GetText()) return {};
+    if (!e) return {};
+    if (!e->GetText()) ThrowInputError(Where(e), std::string("<") + tag + "> is empty");
     return SplitCommaList(e->GetText(), {true, true});
   }
   // Numbers of <tag> within [-bound, bound]; at least min_size of them when the tag is required.

@@ -102,8 +102,19 @@ std::vector<DewarpRecord> TextRecords(const std::string& path, const std::string
   const std::vector<std::string> lines = SplitLines(text);
   std::vector<DewarpRecord> records;
   std::string file;
-  int width = 0, height = 0;
+  int width = 0, height = 0, width_line = 0, height_line = 0;
   std::vector<std::string> design;
+  // A block's width or height given again (exiftool prints Image Width and Exif Image Width) must
+  // agree with the first: two values are an error, not the last one taken.
+  const auto size = [&](const std::string& value, const SourceRef& where, const char* what, int* slot,
+                        int* slot_line) {
+    const int v = static_cast<int>(internal::ParseNumber(value, where, what, 1e6));
+    if (*slot != 0 && v != *slot)
+      ThrowInputError(where, std::string(what) + " " + std::to_string(v) + " contradicts " +
+                                 std::to_string(*slot) + " on line " + std::to_string(*slot_line));
+    *slot = v;
+    *slot_line = where.line;
+  };
   const auto flush_block = [&] {  // sizes and design values printed after the record
     for (DewarpRecord& r : records)
       if (r.file == file) {
@@ -118,7 +129,7 @@ std::vector<DewarpRecord> TextRecords(const std::string& path, const std::string
     if (line.rfind("========", 0) == 0) {
       flush_block();
       file = TrimBlanks(line.substr(8));
-      width = height = 0;
+      width = height = width_line = height_line = 0;
       design.clear();
       continue;
     }
@@ -134,9 +145,9 @@ std::vector<DewarpRecord> TextRecords(const std::string& path, const std::string
     if (key == "dewarpdata" || key == "dewarpdatak6") {
       records.push_back({file, value, where.line, 0, 0, {}});
     } else if (key == "imagewidth" || key == "exifimagewidth") {
-      width = static_cast<int>(internal::ParseNumber(value, where, "image width", 1e6));
+      size(value, where, "image width", &width, &width_line);
     } else if (key == "imageheight" || key == "exifimageheight" || key == "imagelength") {
-      height = static_cast<int>(internal::ParseNumber(value, where, "image height", 1e6));
+      size(value, where, "image height", &height, &height_line);
     } else if (key == "calibratedfocallength" || key == "calibratedopticalcenterx" ||
                key == "calibratedopticalcentery") {
       design.push_back(TrimBlanks(line.substr(0, colon)) + " = " + value +
