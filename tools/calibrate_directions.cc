@@ -111,10 +111,7 @@ CalibrateOutcome CalibrateFromDirections(const DirectionsArgs& args) {
     throw ConfigError(args.budget + ": target_radius_mm is the eccentricity of test-field targets; a direction "
                       "calibration has none (--directions)");
   if (!args.radii_mm.empty()) budget.radii_mm = args.radii_mm;
-  if (budget.radii_mm.empty()) {
-    const double half_diagonal = 0.5 * camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
-    for (int i = 1; i <= 4; ++i) budget.radii_mm.push_back(std::round(half_diagonal * i / 4 * 10) / 10);
-  }
+  if (budget.radii_mm.empty()) budget.radii_mm = DefaultCertifiedRadiiMm(camera);
   const triangulation::DirectionData data = triangulation::ReadDirections(args.directions, camera, args.sigma_px);
   CheckGroups(data, args.directions);
 

@@ -60,4 +60,11 @@ void AddStabilityWarnings(const triangulation::StabilityReport& stability, nlohm
   }
 }
 
+std::vector<double> DefaultCertifiedRadiiMm(const calib::Camera& camera) {
+  const double half_diagonal = 0.5 * camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
+  std::vector<double> radii;
+  for (int i = 1; i <= 4; ++i) radii.push_back(std::round(half_diagonal * i / 4 * 10) / 10);
+  return radii;
+}
+
 }  // namespace aerocal::tools

@@ -37,4 +37,8 @@ void AddStabilityWarnings(const triangulation::StabilityReport& stability, nlohm
 /// The RMS image residual per point (sqrt of the mean squared residual vector), as OpenCV's RMS, px.
 double RmsPx(const triangulation::AdjustmentResult& r);
 
+/// The default radii of the certified distortion values: 1/4 .. 4/4 of the format's half diagonal,
+/// mm, rounded to 0.1 mm (--radii-mm overrides them).
+std::vector<double> DefaultCertifiedRadiiMm(const calib::Camera& camera);
+
 }  // namespace aerocal::tools

@@ -272,10 +272,7 @@ CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
   const nlohmann::json method = LoadMarks(r, camera, &detected, &project, &outcome.printed);
   ValidateMarks(project, camera_id);
   const std::map<std::string, std::string> groups = GroupsOf(r, project);
-  if (budget.radii_mm.empty()) {  // 1/4 .. 4/4 of the half diagonal
-    const double half_diagonal = 0.5 * camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
-    for (int i = 1; i <= 4; ++i) budget.radii_mm.push_back(std::round(half_diagonal * i / 4 * 10) / 10);
-  }
+  if (budget.radii_mm.empty()) budget.radii_mm = DefaultCertifiedRadiiMm(camera);
   if (!r.write_marks.empty() && !r.images.empty()) {
     triangulation::WriteObservations(r.write_marks + "/observations.csv", project.observations);
     triangulation::WritePoints(r.write_marks + "/points.csv", project.points);

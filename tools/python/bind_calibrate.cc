@@ -101,7 +101,7 @@ void BindCalibrate(py::module_& m) {
       .def_property_readonly("sigma0", [](const CalibrationResult& r) { return r.outcome.doc.at("sigma0").get<double>(); })
       .def_property_readonly("calibration",
                              [](const CalibrationResult& r) {
-                               return py::module_::import("json").attr("loads")(r.outcome.doc.at("calibration").dump());
+                               return JsonToPython(r.outcome.doc.at("calibration").dump());
                              },
                              "The result's `calibration` section as a dict (values with U, budget, "
                              "groups, stability, method)")

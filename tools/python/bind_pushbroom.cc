@@ -75,7 +75,7 @@ void BindPushbroom(py::module_& m) {
       .def_property_readonly("sigma0_px", [](const LineCalibrationResult& r) { return r.run.result.sigma0_px; })
       .def_property_readonly("document",
                              [](const LineCalibrationResult& r) {
-                               return py::module_::import("json").attr("loads")(r.run.json.dump());
+                               return JsonToPython(r.run.json.dump());
                              },
                              "The result document as a dict (detector table, datum, per-line corrections, warnings)")
       .def_property_readonly("printed", [](const LineCalibrationResult& r) { return r.run.printed + r.run.errors; },

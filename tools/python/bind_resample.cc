@@ -68,6 +68,8 @@ std::string ImagesOptionText(const py::object& images) {
   return text;
 }
 
+py::object JsonToPython(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
+
 void BindResample(py::module_& m) {
   m.def("resample",
         &Resample,

@@ -55,7 +55,6 @@ RigStitchResult RigStitch(const std::string& camera, const std::string& project,
   return out;
 }
 
-py::object JsonValue(const nlohmann::json& j) { return py::module_::import("json").attr("loads")(j.dump()); }
 
 // `aerocal rig design`: the design document as a dict (the command's --out file's content).
 py::object RigDesign(const std::string& camera, double height_m, int grid_cells) {
@@ -68,7 +67,7 @@ py::object RigDesign(const std::string& camera, double height_m, int grid_cells)
     py::gil_scoped_release release;
     design = stitch::DesignRig(rig, height, grid_cells);
   }
-  return JsonValue(nlohmann::json::parse(ResultText("rig_design", tools::RigDesignDocument(rig, camera, height, design, ""))));
+  return JsonToPython(ResultText("rig_design", tools::RigDesignDocument(rig, camera, height, design, "")));
 }
 
 }  // namespace
@@ -80,10 +79,10 @@ void BindRig(py::module_& m) {
       .def_property_readonly("failures", [](const RigStitchResult& r) { return r.run.result.failures; })
       .def_property_readonly("warnings", [](const RigStitchResult& r) { return r.run.result.warnings; })
       .def_property_readonly("sigma0", [](const RigStitchResult& r) { return r.run.result.sigma0; })
-      .def_property_readonly("rig_exposures", [](const RigStitchResult& r) { return JsonValue(r.run.json.at("rig_exposures")); },
+      .def_property_readonly("rig_exposures", [](const RigStitchResult& r) { return JsonToPython(r.run.json.at("rig_exposures").dump()); },
                              "Per exposure and head: domega, dphi, dkappa (deg), dT_ms and their sigmas "
                              "(None where held or not computable)")
-      .def_property_readonly("snooping", [](const RigStitchResult& r) { return JsonValue(r.run.json.at("snooping")); })
+      .def_property_readonly("snooping", [](const RigStitchResult& r) { return JsonToPython(r.run.json.at("snooping").dump()); })
       .def_property_readonly("printed", [](const RigStitchResult& r) { return r.run.printed; },
                              "What the command prints")
       .def("to_json", [](const RigStitchResult& r) { return r.json; },

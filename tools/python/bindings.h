@@ -13,6 +13,9 @@ namespace aerocal::python {
 /// for None (resample, match).
 std::string ImagesOptionText(const pybind11::object& images);
 
+/// A JSON text as the Python object json.loads makes of it (the result documents' sections).
+pybind11::object JsonToPython(const std::string& text);
+
 /// Camera: read/write in any registered format, parameters by name, image <-> ray, conversion.
 void BindCamera(pybind11::module_& m);
 /// Block.read and Block from arrays, adjust(block, **options) -> AdjustmentResult.
