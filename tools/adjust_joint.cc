@@ -1,9 +1,5 @@
 #include "tools/adjust_joint.h"
 
-#include <cstdio>
-#include <filesystem>
-#include <optional>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
@@ -14,6 +10,10 @@
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
 #include "triangulation/joint/joint_adjustment.h"
+
+#include <cstdio>
+#include <filesystem>
+#include <optional>
 
 namespace aerocal::tools {
 
@@ -45,26 +45,36 @@ int FinishAdjust(const triangulation::AdjustmentResult& result,
 
 void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args) {
   CLI::Option* joint = app.add_option(
-      "--joint-stitching", args->stitching,
+      "--joint-stitching",
+      args->stitching,
       "Joint stitching + triangulation adjustment of a project measured in raw sub-image pixels: "
       "per-flight (one mapping per sub-image) or per-exposure");
-  app.add_option("--joint-model", args->model,
-                 "Mapping model of the joint adjustment: translation | conformal | affine | projective | auto "
-                 "(the model the stitching F test chooses for the flight, as `aerocal stitch --model auto`)")
+  app.add_option("--joint-model",
+                 args->model,
+                 "Mapping model of the joint adjustment: translation | conformal | affine | "
+                 "projective | auto "
+                 "(the model the stitching F test chooses for the flight, as `aerocal stitch "
+                 "--model auto`)")
       ->needs(joint);
-  app.add_option("--base", args->base,
-                 "Joint adjustment: comma-separated sub-images keeping the camera file's mapping (the focal "
+  app.add_option("--base",
+                 args->base,
+                 "Joint adjustment: comma-separated sub-images keeping the camera file's mapping "
+                 "(the focal "
                  "plane's datum; default: the camera's reference points)")
       ->needs(joint);
-  app.add_option("--stitch-sigma-px", args->stitch_sigma_px,
+  app.add_option("--stitch-sigma-px",
+                 args->stitch_sigma_px,
                  "Joint adjustment: stitching sigma where the stitching file has none, px")
       ->check(PositiveUpTo(100))
       ->needs(joint);
 }
 
-int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOptions& options,
-                   const triangulation::Project& input, const std::string& project_path,
-                   const std::string& out, const std::string& write_camera) {
+int RunJointAdjust(const JointAdjustArgs& joint,
+                   const triangulation::AdjustOptions& options,
+                   const triangulation::Project& input,
+                   const std::string& project_path,
+                   const std::string& out,
+                   const std::string& write_camera) {
   triangulation::JointOptions joint_options;
   joint_options.adjust = options;
   joint_options.scope = triangulation::ParseMappingScope(joint.stitching);
@@ -72,19 +82,22 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
   joint_options.stitch_sigma_px = joint.stitch_sigma_px;
   const std::optional<calib::MappingModel> forced = triangulation::ParseJointModel(joint.model);
   if (options.robust_start)
-    throw ConfigError("--robust-start is not available with --joint-stitching (start from a plain adjustment)");
+    throw ConfigError(
+        "--robust-start is not available with --joint-stitching (start from a plain adjustment)");
 
   if (!input.rigs.empty())
-    throw ConfigError("--joint-stitching: " + project_path + ": camera '" + input.rigs.begin()->first +
-                      "' is a rig: the joint adjustment estimates the sub-image mappings of a frame "
-                      "camera, a rig's heads have none (adjust the rig without --joint-stitching)");
+    throw ConfigError(
+        "--joint-stitching: " + project_path + ": camera '" + input.rigs.begin()->first +
+        "' is a rig: the joint adjustment estimates the sub-image mappings of a frame "
+        "camera, a rig's heads have none (adjust the rig without --joint-stitching)");
   const triangulation::ObjectFrame frame(input.frame);
   triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
   joint_options.Validate(project);
   if (!forced && project.stitching_file.empty())
-    throw ConfigError(project_path +
-                      ": --joint-model auto needs the project's stitching measurements (stitching:) to choose "
-                      "the model; name them or give the model");
+    throw ConfigError(
+        project_path +
+        ": --joint-model auto needs the project's stitching measurements (stitching:) to choose "
+        "the model; name them or give the model");
 
   // The flight's stitching: the model (F test per exposure, the flight's choice) and the starting
   // mappings (its flight means).
@@ -97,14 +110,16 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
         triangulation::StitchExposures(project, batch, joint_options.stitch_sigma_px, nullptr);
     for (auto& [id, camera] : project.cameras)
       if (!camera.subimages.empty())
-        camera = triangulation::JointMappingsFromStitching(camera, &stitching, batch, forced, &joint_options);
+        camera = triangulation::JointMappingsFromStitching(
+            camera, &stitching, batch, forced, &joint_options);
   } else {
     triangulation::JointMappingsFromStitching(calib::Camera{}, nullptr, {}, forced, &joint_options);
   }
 
   triangulation::JointResult result = triangulation::AdjustJoint(project, joint_options);
   triangulation::ToInputFrame(frame, &result.adjustment);
-  std::printf("%s%s", triangulation::FormatSummary(result.adjustment).c_str(),
+  std::printf("%s%s",
+              triangulation::FormatSummary(result.adjustment).c_str(),
               triangulation::FormatJointSummary(result).c_str());
   nlohmann::json json = triangulation::JointResultToJson(result);
   json["project"] = project_path;
@@ -114,8 +129,12 @@ int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOpti
     const auto& cameras = result.adjustment.cameras;
     for (const auto& estimate : cameras) {
       const std::string path = CameraOutputPath(write_camera, estimate.id, cameras.size() > 1);
-      calib::WriteCamera(path, triangulation::JointUpdatedCamera(input.cameras.at(estimate.id), estimate.id, result));
-      std::printf("camera %s -> %s%s\n", estimate.id.c_str(), path.c_str(),
+      calib::WriteCamera(
+          path,
+          triangulation::JointUpdatedCamera(input.cameras.at(estimate.id), estimate.id, result));
+      std::printf("camera %s -> %s%s\n",
+                  estimate.id.c_str(),
+                  path.c_str(),
                   joint_options.scope == triangulation::MappingScope::kPerExposure
                       ? " (interior; the per-exposure mappings are in the result only)"
                       : "");

@@ -3,17 +3,16 @@
 // its run, kept beside cmd_adjust.cc so that the plain adjustment's code stays as it is.
 #pragma once
 
-#include <functional>
-#include <string>
-
-#include <CLI/CLI.hpp>
-
-#include <nlohmann/json.hpp>
-
+#include "tools/project_facts.h"
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
-#include "tools/project_facts.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <string>
 
 namespace aerocal::tools {
 
@@ -50,8 +49,11 @@ void AddJointAdjustOptions(CLI::App& app, JointAdjustArgs* args);
 /// result is valid, the camera with the refined interior and per-flight mappings. Returns the exit
 /// code (0, or 3 when the result is not valid: AdjustmentResult::valid). ConfigError for
 /// --robust-start, InputError for a project without sub-image observations.
-int RunJointAdjust(const JointAdjustArgs& joint, const triangulation::AdjustOptions& options,
-                   const triangulation::Project& input, const std::string& project_path,
-                   const std::string& out, const std::string& write_camera);
+int RunJointAdjust(const JointAdjustArgs& joint,
+                   const triangulation::AdjustOptions& options,
+                   const triangulation::Project& input,
+                   const std::string& project_path,
+                   const std::string& out,
+                   const std::string& write_camera);
 
 }  // namespace aerocal::tools

@@ -1,6 +1,11 @@
 #include "tools/batch_manifest.h"
 
-#include <unistd.h>
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/json_schema.h"
+#include "calib/core/result_file.h"
+
+#include <nlohmann/json.hpp>
 
 #include <chrono>
 #include <cstdint>
@@ -8,13 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <set>
-
-#include <nlohmann/json.hpp>
-
-#include "calib/core/atomic_file.h"
-#include "calib/core/error.h"
-#include "calib/core/json_schema.h"
-#include "calib/core/result_file.h"
+#include <unistd.h>
 
 namespace aerocal::tools {
 namespace {
@@ -42,13 +41,21 @@ double Now() {
   return std::chrono::duration<double>(std::chrono::system_clock::now().time_since_epoch()).count();
 }
 
-std::string BatchManifest::Input(const BatchUnit& u) const { return Join(work, "units/" + u.id + "/input.csv"); }
+std::string BatchManifest::Input(const BatchUnit& u) const {
+  return Join(work, "units/" + u.id + "/input.csv");
+}
 std::string BatchManifest::Output(const BatchUnit& u) const {
   return Join(work, "units/" + u.id + "/frame_run.json");
 }
-std::string BatchManifest::Done(const BatchUnit& u) const { return Join(work, "done/" + u.id + ".json"); }
-std::string BatchManifest::Failed(const BatchUnit& u) const { return Join(work, "failed/" + u.id + ".json"); }
-std::string BatchManifest::Log(const BatchUnit& u) const { return Join(work, "logs/" + u.id + ".log"); }
+std::string BatchManifest::Done(const BatchUnit& u) const {
+  return Join(work, "done/" + u.id + ".json");
+}
+std::string BatchManifest::Failed(const BatchUnit& u) const {
+  return Join(work, "failed/" + u.id + ".json");
+}
+std::string BatchManifest::Log(const BatchUnit& u) const {
+  return Join(work, "logs/" + u.id + ".log");
+}
 
 const BatchUnit& BatchManifest::Find(const std::string& id) const {
   for (const BatchUnit& u : units)
@@ -65,17 +72,19 @@ void WriteManifest(const BatchManifest& m) {
                      {"input", "units/" + u.id + "/input.csv"},
                      {"output", "units/" + u.id + "/frame_run.json"},
                      {"resources", {{"cpus", 1}, {"memory_mb", u.memory_mb}}}});
-  const nlohmann::json doc = {{"aerocal_version", m.version},
-                              {"directory", m.directory},
-                              {"flight_arguments", m.flight_arguments},
-                              {"units", units},
-                              {"merge", {{"resources", {{"cpus", 1}, {"memory_mb", m.merge_memory_mb}}}}}};
+  const nlohmann::json doc = {
+      {"aerocal_version", m.version},
+      {"directory", m.directory},
+      {"flight_arguments", m.flight_arguments},
+      {"units", units},
+      {"merge", {{"resources", {{"cpus", 1}, {"memory_mb", m.merge_memory_mb}}}}}};
   WriteResult(Join(m.work, "manifest.json"), "batch_manifest", doc);
 }
 
 BatchManifest ReadManifest(const std::string& path) {
   const nlohmann::json doc = ReadResult(path, {"batch_manifest"}, "`aerocal batch plan`");
-  ValidateJson(doc, ReadJsonSchema(std::string(AEROCAL_SCHEMA_DIR) + "/batch_manifest.schema.json"), path);
+  ValidateJson(
+      doc, ReadJsonSchema(std::string(AEROCAL_SCHEMA_DIR) + "/batch_manifest.schema.json"), path);
   BatchManifest m;
   try {
     m.work = fs::absolute(fs::path(path)).parent_path().string();
@@ -84,7 +93,8 @@ BatchManifest ReadManifest(const std::string& path) {
     m.flight_arguments = doc.at("flight_arguments").get<std::vector<std::string>>();
     m.merge_memory_mb = doc.at("merge").at("resources").at("memory_mb").get<int>();
     for (const auto& u : doc.at("units"))
-      m.units.push_back({u.at("id").get<std::string>(), u.at("frame").get<std::string>(),
+      m.units.push_back({u.at("id").get<std::string>(),
+                         u.at("frame").get<std::string>(),
                          u.at("resources").at("memory_mb").get<int>()});
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not a batch manifest (" + e.what() + ")");
@@ -93,12 +103,15 @@ BatchManifest ReadManifest(const std::string& path) {
   std::set<std::string> ids;
   for (size_t i = 0; i < m.units.size(); ++i) {
     const std::string& id = m.units[i].id;
-    const bool plain = !id.empty() && id != "." && id != ".." &&
-                       id.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-") ==
-                           std::string::npos;
+    const bool plain =
+        !id.empty() && id != "." && id != ".." &&
+        id.find_first_not_of("ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789._-") ==
+            std::string::npos;
     if (!plain || !ids.insert(id).second)
-      throw InputError(path + ": units[" + std::to_string(i) + "].id: expected a unique name of letters, digits, "
-                       "'.', '_', '-' (got '" + id + "')");
+      throw InputError(path + ": units[" + std::to_string(i) +
+                       "].id: expected a unique name of letters, digits, "
+                       "'.', '_', '-' (got '" +
+                       id + "')");
   }
   return m;
 }
@@ -113,15 +126,21 @@ std::string HashText(const std::string& text) {
 
 const char* UnitStateName(UnitState state) {
   switch (state) {
-    case UnitState::kDone: return "done";
-    case UnitState::kChanged: return "changed";
-    case UnitState::kFailed: return "failed";
-    case UnitState::kMissing: return "missing";
+    case UnitState::kDone:
+      return "done";
+    case UnitState::kChanged:
+      return "changed";
+    case UnitState::kFailed:
+      return "failed";
+    case UnitState::kMissing:
+      return "missing";
   }
   return "?";
 }
 
-UnitRecord ReadUnitRecord(const BatchManifest& m, const BatchUnit& unit, const std::string& input_hash) {
+UnitRecord ReadUnitRecord(const BatchManifest& m,
+                          const BatchUnit& unit,
+                          const std::string& input_hash) {
   UnitRecord r;
   std::error_code ec;
   if (fs::is_regular_file(m.Done(unit), ec)) {
@@ -137,7 +156,8 @@ UnitRecord ReadUnitRecord(const BatchManifest& m, const BatchUnit& unit, const s
     r.state = UnitState::kChanged;
   }
   if (fs::is_regular_file(m.Failed(unit), ec)) {
-    const nlohmann::json failed = nlohmann::json::parse(ReadTextFile(m.Failed(unit)), nullptr, false);
+    const nlohmann::json failed =
+        nlohmann::json::parse(ReadTextFile(m.Failed(unit)), nullptr, false);
     if (!failed.is_discarded() && failed.value("input_hash", "") == input_hash) {
       r.state = UnitState::kFailed;
       r.error = failed.value("error", "");
@@ -152,7 +172,10 @@ void LogUnit(const BatchManifest& m, const BatchUnit& unit, const std::string& t
   log << TimeText(Now()) << ' ' << HostName() << " pid " << ::getpid() << ": " << text << '\n';
 }
 
-void RecordDone(const BatchManifest& m, const BatchUnit& unit, const std::string& input_hash, double started,
+void RecordDone(const BatchManifest& m,
+                const BatchUnit& unit,
+                const std::string& input_hash,
+                double started,
                 double finished) {
   const nlohmann::json done = {{"unit", unit.id},
                                {"input_hash", input_hash},
@@ -169,7 +192,10 @@ void RecordDone(const BatchManifest& m, const BatchUnit& unit, const std::string
   LogUnit(m, unit, line);
 }
 
-void RecordFailure(const BatchManifest& m, const BatchUnit& unit, const std::string& input_hash, double started,
+void RecordFailure(const BatchManifest& m,
+                   const BatchUnit& unit,
+                   const std::string& input_hash,
+                   double started,
                    const std::string& error) {
   const nlohmann::json failed = {{"unit", unit.id},
                                  {"input_hash", input_hash},

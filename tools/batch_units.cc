@@ -1,15 +1,15 @@
 #include "tools/batch_units.h"
 
-#include <filesystem>
-
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "stitch/adjustment/frame_measurements.h"
 #include "stitch/io/frame_run_json.h"
 #include "stitch/simulation/stitch_simulator.h"
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
 
 namespace aerocal::tools {
 namespace {
@@ -18,14 +18,15 @@ namespace fs = std::filesystem;
 
 // The options a frame's stitching depends on, as text (part of every unit's hash).
 std::string OptionsText(const stitch::BatchOptions& o) {
-  const nlohmann::json j = {{"model", o.model ? std::string(calib::MappingModelName(*o.model)) : "auto"},
-                            {"alpha", o.alpha},
-                            {"base", o.stitch.base_ids},
-                            {"data_snooping", o.stitch.data_snooping},
-                            {"snooping_alpha", o.stitch.snooping_alpha},
-                            {"robust_start", o.stitch.robust_start},
-                            {"robust_scale_sigma", o.stitch.robust_scale_sigma},
-                            {"robust_reject_sigma", o.stitch.robust_reject_sigma}};
+  const nlohmann::json j = {
+      {"model", o.model ? std::string(calib::MappingModelName(*o.model)) : "auto"},
+      {"alpha", o.alpha},
+      {"base", o.stitch.base_ids},
+      {"data_snooping", o.stitch.data_snooping},
+      {"snooping_alpha", o.stitch.snooping_alpha},
+      {"robust_start", o.stitch.robust_start},
+      {"robust_scale_sigma", o.stitch.robust_scale_sigma},
+      {"robust_reject_sigma", o.stitch.robust_reject_sigma}};
   return j.dump();
 }
 
@@ -46,7 +47,8 @@ std::shared_ptr<FlightArgs> ParseFlightArguments(const std::vector<std::string>&
   auto args = std::make_shared<FlightArgs>();
   CLI::App app("flight");
   AddFlightOptions(app, args);
-  std::vector<std::string> reversed(arguments.rbegin(), arguments.rend());  // CLI11 parses from the back
+  std::vector<std::string> reversed(arguments.rbegin(),
+                                    arguments.rend());  // CLI11 parses from the back
   try {
     app.parse(reversed);
   } catch (const CLI::ParseError& e) {
@@ -68,12 +70,15 @@ UnitContext MakeUnitContext(const FlightArgs& flight) {
   UnitContext c;
   c.camera = calib::ReadCamera(flight.options.camera_file);
   c.options = triangulation::FlightStitchingOptions(flight.options);
-  c.shared_hash = HashText(std::string("aerocal ") + AEROCAL_VERSION + "\n" +
-                           HashText(ReadTextFile(flight.options.camera_file)) + "\n" + OptionsText(c.options));
+  c.shared_hash =
+      HashText(std::string("aerocal ") + AEROCAL_VERSION + "\n" +
+               HashText(ReadTextFile(flight.options.camera_file)) + "\n" + OptionsText(c.options));
   return c;
 }
 
-std::string UnitInputHash(const UnitContext& context, const BatchManifest& manifest, const BatchUnit& unit) {
+std::string UnitInputHash(const UnitContext& context,
+                          const BatchManifest& manifest,
+                          const BatchUnit& unit) {
   std::string input;
   try {
     input = ReadTextFile(manifest.Input(unit));
@@ -83,8 +88,12 @@ std::string UnitInputHash(const UnitContext& context, const BatchManifest& manif
   return HashText(context.shared_hash + "\n" + HashText(input));
 }
 
-bool RunUnit(const UnitContext& context, const BatchManifest& manifest, const BatchUnit& unit,
-             const std::string& hash, std::string* error, bool* input_error) {
+bool RunUnit(const UnitContext& context,
+             const BatchManifest& manifest,
+             const BatchUnit& unit,
+             const std::string& hash,
+             std::string* error,
+             bool* input_error) {
   const double started = Now();
   LogUnit(manifest, unit, "start (input hash " + hash + ")");
   try {

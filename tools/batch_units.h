@@ -3,14 +3,14 @@
 // `aerocal flight` adjusts it in step 1), written atomically with its done record.
 #pragma once
 
-#include <memory>
-#include <string>
-#include <vector>
-
 #include "calib/camera/camera.h"
 #include "stitch/adjustment/flight_stability.h"
 #include "tools/batch_manifest.h"
 #include "tools/flight_command.h"
+
+#include <memory>
+#include <string>
+#include <vector>
 
 namespace aerocal::tools {
 
@@ -31,13 +31,19 @@ struct UnitContext {
 UnitContext MakeUnitContext(const FlightArgs& flight);
 
 /// Hash of everything a unit's output depends on: the shared part and its input file.
-std::string UnitInputHash(const UnitContext& context, const BatchManifest& manifest, const BatchUnit& unit);
+std::string UnitInputHash(const UnitContext& context,
+                          const BatchManifest& manifest,
+                          const BatchUnit& unit);
 
 /// Runs `unit` whose inputs hash to `input_hash` (UnitInputHash): its output and done record
 /// written atomically; on failure a failed record and the log, nothing else. Returns false on
 /// failure with the message in `error`; `input_error` tells a bad input (exit 2) from an internal
 /// error (exit 1).
-bool RunUnit(const UnitContext& context, const BatchManifest& manifest, const BatchUnit& unit,
-             const std::string& input_hash, std::string* error, bool* input_error);
+bool RunUnit(const UnitContext& context,
+             const BatchManifest& manifest,
+             const BatchUnit& unit,
+             const std::string& input_hash,
+             std::string* error,
+             bool* input_error);
 
 }  // namespace aerocal::tools

@@ -8,10 +8,9 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include <glob.h>
-
 #include <chrono>
 #include <filesystem>
+#include <glob.h>
 #include <map>
 #include <sstream>
 
@@ -49,8 +48,10 @@ BoardSpec ParseBoard(const std::string& text, const std::string& option) {
   char* end = nullptr;
   b.square_mm = std::strtod(square.c_str(), &end);
   if (!ok || square.empty() || *end != '\0' || !(b.square_mm > 0))
-    throw ConfigError(option + ": expected chessboard|circles|acircles:COLSxROWS:SPACING_MM "
-                      "(e.g. chessboard:9x6:25), got '" + text + "'");
+    throw ConfigError(option +
+                      ": expected chessboard|circles|acircles:COLSxROWS:SPACING_MM "
+                      "(e.g. chessboard:9x6:25), got '" +
+                      text + "'");
   b.kind = kind;
   return b;
 }
@@ -76,21 +77,31 @@ DetectedBoards DetectBoards(const std::string& glob,
       out.width_px = gray.cols;
       out.height_px = gray.rows;
     } else if (gray.cols != out.width_px || gray.rows != out.height_px) {
-      throw InputError(StringPrintf("%s: %d x %d px, the first image is %d x %d px", path.c_str(),
-                                    gray.cols, gray.rows, out.width_px, out.height_px));
+      throw InputError(StringPrintf("%s: %d x %d px, the first image is %d x %d px",
+                                    path.c_str(),
+                                    gray.cols,
+                                    gray.rows,
+                                    out.width_px,
+                                    out.height_px));
     }
     std::vector<cv::Point2f> marks;
     bool found = false;
     if (board.kind == "chessboard") {
-      found = cv::findChessboardCorners(gray, pattern, marks,
-                                        cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
+      found = cv::findChessboardCorners(
+          gray, pattern, marks, cv::CALIB_CB_ADAPTIVE_THRESH | cv::CALIB_CB_NORMALIZE_IMAGE);
       if (found)
-        cv::cornerSubPix(gray, marks, cv::Size(kSubPixWindow, kSubPixWindow), cv::Size(-1, -1),
-                         cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 1e-4));
+        cv::cornerSubPix(
+            gray,
+            marks,
+            cv::Size(kSubPixWindow, kSubPixWindow),
+            cv::Size(-1, -1),
+            cv::TermCriteria(cv::TermCriteria::EPS + cv::TermCriteria::COUNT, 30, 1e-4));
     } else {
-      found = cv::findCirclesGrid(gray, pattern, marks,
-                                  board.kind == "acircles" ? cv::CALIB_CB_ASYMMETRIC_GRID
-                                                           : cv::CALIB_CB_SYMMETRIC_GRID);
+      found = cv::findCirclesGrid(
+          gray,
+          pattern,
+          marks,
+          board.kind == "acircles" ? cv::CALIB_CB_ASYMMETRIC_GRID : cv::CALIB_CB_SYMMETRIC_GRID);
     }
     if (!found || static_cast<int>(marks.size()) != board.columns * board.rows) {
       out.not_detected.push_back(path);
@@ -110,16 +121,22 @@ DetectedBoards DetectBoards(const std::string& glob,
       }
   }
   if (out.images.size() < 3)
-    throw InputError(StringPrintf("--images: the board %s:%dx%d was found in %zu of %zu images "
-                                  "(needs 3)",
-                                  board.kind.c_str(), board.columns, board.rows, out.images.size(),
-                                  files.size()));
+    throw InputError(
+        StringPrintf("--images: the board %s:%dx%d was found in %zu of %zu images "
+                     "(needs 3)",
+                     board.kind.c_str(),
+                     board.columns,
+                     board.rows,
+                     out.images.size(),
+                     files.size()));
   for (int r = 0; r < board.rows; ++r)
     for (int c = 0; c < board.columns; ++c) {
       triangulation::GroundPoint p;
       p.id = StringPrintf("r%dc%d", r, c);
-      p.xyz_m = Eigen::Vector3d((board.kind == "acircles" ? 2 * c + r % 2 : c) * board.square_mm * 1e-3,
-                                r * board.square_mm * 1e-3, 0.0);
+      p.xyz_m =
+          Eigen::Vector3d((board.kind == "acircles" ? 2 * c + r % 2 : c) * board.square_mm * 1e-3,
+                          r * board.square_mm * 1e-3,
+                          0.0);
       p.sigma_m = Eigen::Vector3d::Constant(point_sigma_mm * 1e-3);
       p.role = triangulation::PointRole::kControl;
       out.points.push_back(p);
@@ -130,7 +147,8 @@ DetectedBoards DetectBoards(const std::string& glob,
 OpenCvCalibration CalibrateWithOpenCv(const DetectedBoards& boards) {
   std::map<std::string, cv::Point3f> board;
   for (const auto& p : boards.points)
-    board[p.id] = cv::Point3f(static_cast<float>(p.xyz_m->x()), static_cast<float>(p.xyz_m->y()), 0.0f);
+    board[p.id] =
+        cv::Point3f(static_cast<float>(p.xyz_m->x()), static_cast<float>(p.xyz_m->y()), 0.0f);
   std::vector<std::vector<cv::Point3f>> object(boards.images.size());
   std::vector<std::vector<cv::Point2f>> image(boards.images.size());
   std::map<std::string, size_t> index;
@@ -146,8 +164,16 @@ OpenCvCalibration CalibrateWithOpenCv(const DetectedBoards& boards) {
   out.iterations_limit = kOpenCvIterations;
   const auto t0 = std::chrono::steady_clock::now();
   out.rms_px = cv::calibrateCamera(
-      object, image, cv::Size(boards.width_px, boards.height_px), k, d, rvecs, tvecs, 0,
-      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, kOpenCvIterations, DBL_EPSILON));
+      object,
+      image,
+      cv::Size(boards.width_px, boards.height_px),
+      k,
+      d,
+      rvecs,
+      tvecs,
+      0,
+      cv::TermCriteria(
+          cv::TermCriteria::COUNT + cv::TermCriteria::EPS, kOpenCvIterations, DBL_EPSILON));
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   out.fx = k.at<double>(0, 0);
   out.fy = k.at<double>(1, 1);

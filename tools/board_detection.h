@@ -1,6 +1,6 @@
-// Planar calibration boards detected with OpenCV for `aerocal calibrate --images GLOB --board SPEC`:
-// chessboards (inner corners, cv::findChessboardCorners refined by cv::cornerSubPix with an 11 x 11
-// window to 1e-4 px, as OpenCV's calibration sample) and circle grids (cv::findCirclesGrid,
+// Planar calibration boards detected with OpenCV for `aerocal calibrate --images GLOB --board
+// SPEC`: chessboards (inner corners, cv::findChessboardCorners refined by cv::cornerSubPix with an
+// 11 x 11 window to 1e-4 px, as OpenCV's calibration sample) and circle grids (cv::findCirclesGrid,
 // symmetric or asymmetric; blob centres). The marks become block observations (pixel frame of
 // CONVENTIONS.md = OpenCV's: the centre of the top-left pixel is (0, 0)) and the board points
 // control points on the plane Z = 0 (metres), row-major: point "r{row}c{col}" at
@@ -16,7 +16,7 @@
 namespace aerocal::tools {
 
 struct BoardSpec {
-  std::string kind;  // chessboard | circles | acircles
+  std::string kind;           // chessboard | circles | acircles
   int columns = 0, rows = 0;  // inner corners / circles per row and per column
   double square_mm = 0;       // corner or circle spacing, mm
 };

@@ -1,13 +1,5 @@
 #include "tools/calibrate_directions.h"
 
-#include <cmath>
-#include <cstdio>
-#include <map>
-#include <optional>
-#include <set>
-
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
@@ -21,6 +13,14 @@
 #include "triangulation/calibration/direction_run.h"
 #include "triangulation/calibration/uncertainty_budget.h"
 
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <optional>
+#include <set>
+
 namespace aerocal::tools {
 namespace {
 
@@ -33,23 +33,30 @@ void CheckGroups(const triangulation::DirectionData& data, const std::string& pa
   for (const auto& g : data.groups)
     if (!g.empty()) names.insert(g);
   if (names.size() == 1)
-    ThrowInputError({path, 0}, "1 group (" + *names.begin() + "): the stability test needs two groups or more");
+    ThrowInputError(
+        {path, 0}, "1 group (" + *names.begin() + "): the stability test needs two groups or more");
 }
 
-nlohmann::json Arcsec(const Eigen::Vector2d& rad) { return {rad.x() / kArcSecond, rad.y() / kArcSecond}; }
-nlohmann::json Degrees(const Eigen::Vector3d& rad) { return {rad.x() / kDeg, rad.y() / kDeg, rad.z() / kDeg}; }
+nlohmann::json Arcsec(const Eigen::Vector2d& rad) {
+  return {rad.x() / kArcSecond, rad.y() / kArcSecond};
+}
+nlohmann::json Degrees(const Eigen::Vector3d& rad) {
+  return {rad.x() / kDeg, rad.y() / kDeg, rad.z() / kDeg};
+}
 
 // The method: the instrument, the file, what was estimated besides the interior.
-nlohmann::json MethodJson(const triangulation::DirectionRun& d, const triangulation::DirectionData& data,
+nlohmann::json MethodJson(const triangulation::DirectionRun& d,
+                          const triangulation::DirectionData& data,
                           const std::string& path) {
   int known = 0;
   for (const auto& t : data.targets) known += t.known;
   nlohmann::json targets = nlohmann::json::object();
   for (const auto& [id, angles] : d.all.target_angles_rad) {
     const auto s = d.all.target_sigma_rad.find(id);
-    targets[id] = {{"azimuth_deg", angles.x() / kDeg},
-                   {"elevation_deg", angles.y() / kDeg},
-                   {"sigma_arcsec", s == d.all.target_sigma_rad.end() ? nlohmann::json() : Arcsec(s->second)}};
+    targets[id] = {
+        {"azimuth_deg", angles.x() / kDeg},
+        {"elevation_deg", angles.y() / kDeg},
+        {"sigma_arcsec", s == d.all.target_sigma_rad.end() ? nlohmann::json() : Arcsec(s->second)}};
   }
   return {{"kind", d.all.method},
           {"directions", path},
@@ -57,10 +64,12 @@ nlohmann::json MethodJson(const triangulation::DirectionRun& d, const triangulat
           {"known_targets", known},
           {"settings", data.settings},
           {"adjustment",
-           "direction adjustment (calib/residuals/direction.h): the interior and the camera's rotation to the "
+           "direction adjustment (calib/residuals/direction.h): the interior and the camera's "
+           "rotation to the "
            "instrument; no position, no scale; no data snooping"},
           {"budget",
-           "the directions' angular sigmas are part of each observation's a-priori covariance: the adjustment's "
+           "the directions' angular sigmas are part of each observation's a-priori covariance: the "
+           "adjustment's "
            "component holds them (no separate type-B component of the directions)"},
           {"instrument_from_camera_opk_deg", Degrees(d.all.opk_rad)},
           {"instrument_from_camera_sigma_arcsec",
@@ -70,17 +79,25 @@ nlohmann::json MethodJson(const triangulation::DirectionRun& d, const triangulat
                                : nlohmann::json()},
           {"start_opk_deg", Degrees(d.start_opk_rad)},
           {"estimated_targets", targets},
-          {"sub_images", "one camera (one frame) per run: the sub-images of a multi-CCD camera or a rig's heads "
-                         "are calibrated one run each"}};
+          {"sub_images",
+           "one camera (one frame) per run: the sub-images of a multi-CCD camera or a rig's heads "
+           "are calibrated one run each"}};
 }
 
 // The camera file written in the requested format: the --model run's camera when it was given.
-nlohmann::json WriteCamera(const DirectionsArgs& args, std::string* printed, const calib::Camera& camera,
+nlohmann::json WriteCamera(const DirectionsArgs& args,
+                           std::string* printed,
+                           const calib::Camera& camera,
                            const triangulation::CameraEstimate& estimate) {
-  const calib::ConversionResult written = WriteCameraInFormat(
-      args.write_camera, triangulation::UpdatedCamera(camera, estimate), args.camera_format, &estimate.sigma);
-  *printed += StringPrintf("camera (%s) -> %s (%s)\n", std::string(calib::CameraModelName(estimate.model)).c_str(),
-              args.write_camera.c_str(), args.camera_format.c_str());
+  const calib::ConversionResult written =
+      WriteCameraInFormat(args.write_camera,
+                          triangulation::UpdatedCamera(camera, estimate),
+                          args.camera_format,
+                          &estimate.sigma);
+  *printed += StringPrintf("camera (%s) -> %s (%s)\n",
+                           std::string(calib::CameraModelName(estimate.model)).c_str(),
+                           args.write_camera.c_str(),
+                           args.camera_format.c_str());
   return {{"file", args.write_camera},
           {"format", args.camera_format},
           {"model", std::string(calib::CameraModelName(estimate.model))},
@@ -96,10 +113,12 @@ nlohmann::json WriteCamera(const DirectionsArgs& args, std::string* printed, con
 CalibrateOutcome CalibrateFromDirections(const DirectionsArgs& args) {
   CalibrateOutcome outcome;
   const calib::Camera camera = calib::ReadCamera(args.camera, calib::CameraModels::kAny);
-  const calib::CameraModelId beside_model = args.model.empty() ? camera.model : ModelOfOption(args.model);
+  const calib::CameraModelId beside_model =
+      args.model.empty() ? camera.model : ModelOfOption(args.model);
   triangulation::DirectionRunOptions options;
   options.calibration.free_interior = triangulation::ParseSelfCalibration(
-      args.self_calibration.empty() ? DefaultSelfCalibration(camera.model) : args.self_calibration, camera.model);
+      args.self_calibration.empty() ? DefaultSelfCalibration(camera.model) : args.self_calibration,
+      camera.model);
   if (options.calibration.free_interior.empty())
     throw ConfigError("--self-calibration: calibrate needs at least one parameter (got none)");
   if (!args.out.empty()) CheckOutputFile(args.out, "--out");
@@ -108,34 +127,41 @@ CalibrateOutcome CalibrateFromDirections(const DirectionsArgs& args) {
   triangulation::BudgetOptions budget;
   if (!args.budget.empty()) budget = triangulation::ReadBudgetOptions(args.budget);
   if (budget.target_radius_mm > 0)
-    throw ConfigError(args.budget + ": target_radius_mm is the eccentricity of test-field targets; a direction "
+    throw ConfigError(args.budget +
+                      ": target_radius_mm is the eccentricity of test-field targets; a direction "
                       "calibration has none (--directions)");
   if (!args.radii_mm.empty()) budget.radii_mm = args.radii_mm;
   if (budget.radii_mm.empty()) budget.radii_mm = DefaultCertifiedRadiiMm(camera);
-  const triangulation::DirectionData data = triangulation::ReadDirections(args.directions, camera, args.sigma_px);
+  const triangulation::DirectionData data =
+      triangulation::ReadDirections(args.directions, camera, args.sigma_px);
   CheckGroups(data, args.directions);
 
   const std::string camera_id = camera.name.empty() ? "cam1" : camera.name;
-  const triangulation::DirectionRun d =
-      triangulation::RunDirectionCalibration(camera_id, camera, data.targets, data.observations, data.groups, options);
+  const triangulation::DirectionRun d = triangulation::RunDirectionCalibration(
+      camera_id, camera, data.targets, data.observations, data.groups, options);
   const triangulation::CalibrationRun& run = d.run;
   const auto budget_table = triangulation::UncertaintyBudget(run, run.project, budget);
   const triangulation::AdjustmentResult& r = run.all.result;
-  outcome.printed += StringPrintf("%s (%s): %s", d.all.method.c_str(), args.directions.c_str(), triangulation::FormatSummary(r).c_str());
+  outcome.printed += StringPrintf("%s (%s): %s",
+                                  d.all.method.c_str(),
+                                  args.directions.c_str(),
+                                  triangulation::FormatSummary(r).c_str());
 
   nlohmann::json json = triangulation::AdjustmentToJson(r);
   json["command"] = "calibrate";
   json["valid"] = r.valid;
   json["invalid_reasons"] = r.invalid_reasons;
   json["self_calibration"] = options.calibration.free_interior;
-  nlohmann::json cal = triangulation::CalibrationToJson(run, budget_table, budget.radii_mm, camera.c_mm());
+  nlohmann::json cal =
+      triangulation::CalibrationToJson(run, budget_table, budget.radii_mm, camera.c_mm());
   int known = 0;
   for (const auto& t : data.targets) known += t.known;
   cal["method"] = MethodJson(d, data, args.directions);
-  cal["start"] = {{"c_camera_file_mm", camera.c_mm()},
-                  {"c_start_mm", camera.c_mm()},
-                  {"opk_deg", Degrees(d.start_opk_rad)},
-                  {"rotation", known >= 2 ? "Wahba's problem (SVD) on the known directions" : "zero"}};
+  cal["start"] = {
+      {"c_camera_file_mm", camera.c_mm()},
+      {"c_start_mm", camera.c_mm()},
+      {"opk_deg", Degrees(d.start_opk_rad)},
+      {"rotation", known >= 2 ? "Wahba's problem (SVD) on the known directions" : "zero"}};
   cal["data"] = {{"images", std::max(1, data.settings)},
                  {"observations", data.observations.size()},
                  {"control_points", known},
@@ -151,7 +177,8 @@ CalibrateOutcome CalibrateFromDirections(const DirectionsArgs& args) {
   cal["rms_px"] = RmsPx(r);
   for (const auto& q : budget_table) outcome.printed += StringPrintf("  %s\n", q.statement.c_str());
   AddStabilityWarnings(run.stability, &json);
-  // --model: the same directions calibrated in that model (its camera is what --write-camera writes).
+  // --model: the same directions calibrated in that model (its camera is what --write-camera
+  // writes).
   std::optional<calib::Camera> beside_start;
   std::optional<triangulation::CameraEstimate> beside;
   if (beside_model != camera.model) {
@@ -159,30 +186,35 @@ CalibrateOutcome CalibrateFromDirections(const DirectionsArgs& args) {
     in_model.calibration.free_interior =
         triangulation::ParseSelfCalibration(DefaultSelfCalibration(beside_model), beside_model);
     beside_start = StartInModel(camera, beside_model, in_model.calibration.free_interior);
-    const triangulation::DirectionRun other =
-        triangulation::RunDirectionCalibration(camera_id, *beside_start, data.targets, data.observations, {}, in_model);
+    const triangulation::DirectionRun other = triangulation::RunDirectionCalibration(
+        camera_id, *beside_start, data.targets, data.observations, {}, in_model);
     const triangulation::AdjustmentResult& o = other.run.all.result;
     nlohmann::json b = triangulation::CalibrationRunToJson(o);
     b["model"] = std::string(calib::CameraModelName(beside_model));
     b["self_calibration"] = in_model.calibration.free_interior;
     b["rms_px"] = RmsPx(o);
     outcome.printed += StringPrintf("beside, in model %s: sigma0 %.4f, RMS %.4f px%s\n",
-                std::string(calib::CameraModelName(beside_model)).c_str(), o.sigma0, RmsPx(o),
-                o.valid ? "" : " (not valid)");
+                                    std::string(calib::CameraModelName(beside_model)).c_str(),
+                                    o.sigma0,
+                                    RmsPx(o),
+                                    o.valid ? "" : " (not valid)");
     cal["beside"] = b;
     if (o.valid) beside = o.cameras[0];
   }
-  // Only a valid result is written as a camera file (a file that exists is one the next run may use).
+  // Only a valid result is written as a camera file (a file that exists is one the next run may
+  // use).
   if (!args.write_camera.empty()) {
     if (beside_start && beside)
       cal["camera_written"] = WriteCamera(args, &outcome.printed, *beside_start, *beside);
     else if (!beside_start && r.valid)
       cal["camera_written"] = WriteCamera(args, &outcome.printed, camera, r.cameras[0]);
     else
-      outcome.errors += StringPrintf("camera not written: the %sresult is not valid\n", beside_start ? "--model " : "");
+      outcome.errors += StringPrintf("camera not written: the %sresult is not valid\n",
+                                     beside_start ? "--model " : "");
   }
   json["calibration"] = cal;
-  for (const auto& reason : r.invalid_reasons) outcome.errors += "calibrate: not valid: " + reason + "\n";
+  for (const auto& reason : r.invalid_reasons)
+    outcome.errors += "calibrate: not valid: " + reason + "\n";
   outcome.doc = std::move(json);
   outcome.valid = r.valid && run.stability.agree;
   return outcome;

@@ -5,10 +5,10 @@
 // inputs; the method states the instrument) and the camera file in the requested model / format.
 #pragma once
 
+#include "tools/calibrate_request.h"
+
 #include <string>
 #include <vector>
-
-#include "tools/calibrate_request.h"
 
 namespace aerocal::tools {
 
@@ -17,7 +17,8 @@ struct DirectionsArgs {
   std::string self_calibration;  // default: the model's (DefaultSelfCalibration)
   std::string model;             // default: the camera file's
   double sigma_px = 0.5;         // image sigma of rows without sigma_px, px
-  std::vector<double> radii_mm;  // certified distortion radii (default: 1/4 .. 4/4 of the half diagonal)
+  std::vector<double>
+      radii_mm;  // certified distortion radii (default: 1/4 .. 4/4 of the half diagonal)
 };
 
 /// Runs the calibration and writes --write-camera (not the result file; `out` is checked when

@@ -1,11 +1,11 @@
 #include "tools/calibrate_models.h"
 
+#include "calib/camera/convert_camera.h"
+#include "calib/core/error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-
-#include "calib/camera/convert_camera.h"
-#include "calib/core/error.h"
 
 namespace aerocal::tools {
 
@@ -34,7 +34,8 @@ std::string DefaultSelfCalibration(calib::CameraModelId model) {
   return "all";
 }
 
-calib::Camera StartInModel(const calib::Camera& camera, calib::CameraModelId model,
+calib::Camera StartInModel(const calib::Camera& camera,
+                           calib::CameraModelId model,
                            const std::vector<std::string>& free) {
   calib::ConvertOptions convert;
   for (const calib::ParamInfo& info : calib::CameraModelParams(model))
@@ -42,10 +43,12 @@ calib::Camera StartInModel(const calib::Camera& camera, calib::CameraModelId mod
       if (info.group != calib::ParamGroup::kPrincipalDistance &&
           info.group != calib::ParamGroup::kPrincipalPoint)
         convert.zero.emplace_back(info.name);
-  const calib::ConversionResult start = calib::ConvertCamera(camera.AsModelCamera(), model, convert);
+  const calib::ConversionResult start =
+      calib::ConvertCamera(camera.AsModelCamera(), model, convert);
   std::printf("start: the camera file's %s camera as %s: %s\n",
               std::string(calib::CameraModelName(camera.model)).c_str(),
-              std::string(calib::CameraModelName(model)).c_str(), start.Summary().c_str());
+              std::string(calib::CameraModelName(model)).c_str(),
+              start.Summary().c_str());
   return camera.WithModelCamera(start.camera);
 }
 
@@ -61,7 +64,8 @@ void AddStabilityWarnings(const triangulation::StabilityReport& stability, nlohm
 }
 
 std::vector<double> DefaultCertifiedRadiiMm(const calib::Camera& camera) {
-  const double half_diagonal = 0.5 * camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
+  const double half_diagonal =
+      0.5 * camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
   std::vector<double> radii;
   for (int i = 1; i <= 4; ++i) radii.push_back(std::round(half_diagonal * i / 4 * 10) / 10);
   return radii;

@@ -4,14 +4,14 @@
 // stability warnings and the RMS image residual.
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include "calib/camera/camera.h"
-#include <nlohmann/json.hpp>
-
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/calibration/calibration.h"
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
 
 namespace aerocal::tools {
 
@@ -34,7 +34,8 @@ calib::Camera StartInModel(const calib::Camera& camera,
 /// `warnings` (printed too).
 void AddStabilityWarnings(const triangulation::StabilityReport& stability, nlohmann::json* json);
 
-/// The RMS image residual per point (sqrt of the mean squared residual vector), as OpenCV's RMS, px.
+/// The RMS image residual per point (sqrt of the mean squared residual vector), as OpenCV's RMS,
+/// px.
 double RmsPx(const triangulation::AdjustmentResult& r);
 
 /// The default radii of the certified distortion values: 1/4 .. 4/4 of the format's half diagonal,

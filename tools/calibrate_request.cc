@@ -29,7 +29,8 @@ using GroupLines = std::map<std::string, std::pair<std::string, int>>;
 
 // The checks both sources share, at the line that breaks them: every image is observed, each group
 // holds two images or more, and there are two groups or more (the stability test compares groups).
-std::map<std::string, std::string> CheckedGroups(const GroupLines& lines, const std::string& file,
+std::map<std::string, std::string> CheckedGroups(const GroupLines& lines,
+                                                 const std::string& file,
                                                  const std::set<std::string>& observed) {
   std::map<std::string, std::pair<int, int>> groups;  // group -> (images, first line)
   for (const auto& [image, entry] : lines) {
@@ -41,11 +42,13 @@ std::map<std::string, std::string> CheckedGroups(const GroupLines& lines, const 
   }
   for (const auto& [group, g] : groups)
     if (g.first < 2)
-      ThrowInputError({file, g.second}, "group " + group + " has " + std::to_string(g.first) +
-                                            " image (a group needs two or more)");
+      ThrowInputError({file, g.second},
+                      "group " + group + " has " + std::to_string(g.first) +
+                          " image (a group needs two or more)");
   if (groups.size() < 2)
-    ThrowInputError({file, 0}, std::to_string(groups.size()) +
-                                   " group(s): the stability test needs two groups or more");
+    ThrowInputError(
+        {file, 0},
+        std::to_string(groups.size()) + " group(s): the stability test needs two groups or more");
   std::map<std::string, std::string> out;
   for (const auto& [image, entry] : lines) out[image] = entry.first;
   return out;
@@ -88,8 +91,11 @@ std::map<std::string, std::string> GroupsFromObservations(const std::string& pat
 
 // The marks of the request in `project` (a test field's files, or the board detected in the
 // images), and the method's description for the result.
-nlohmann::json LoadMarks(const CalibrateRequest& r, const calib::Camera& camera, DetectedBoards* detected,
-                         triangulation::Project* project, std::string* printed) {
+nlohmann::json LoadMarks(const CalibrateRequest& r,
+                         const calib::Camera& camera,
+                         DetectedBoards* detected,
+                         triangulation::Project* project,
+                         std::string* printed) {
   if (r.images.empty()) {
     project->observations = triangulation::ReadObservations(r.observations, r.sigma_px);
     project->points = triangulation::ReadPoints(r.points);
@@ -101,25 +107,29 @@ nlohmann::json LoadMarks(const CalibrateRequest& r, const calib::Camera& camera,
   *detected = DetectBoards(r.images, spec, r.sigma_px, r.board_sigma_mm);
   if (detected->width_px != camera.width_px || detected->height_px != camera.height_px)
     throw InputError(StringPrintf("%s: format_px is %d x %d, the images are %d x %d px",
-                                  r.camera.c_str(), camera.width_px, camera.height_px,
-                                  detected->width_px, detected->height_px));
+                                  r.camera.c_str(),
+                                  camera.width_px,
+                                  camera.height_px,
+                                  detected->width_px,
+                                  detected->height_px));
   project->observations = detected->observations;
   project->points = detected->points;
   project->path = project->observations_file = r.images;
   for (const auto& path : detected->not_detected)
     *printed += "warning: board not found in " + path + " (image left out)\n";
-  return {{"kind", "planar target"},
-          {"board", spec.kind},
-          {"columns", spec.columns},
-          {"rows", spec.rows},
-          {"spacing_mm", spec.square_mm},
-          {"board_sigma_mm", r.board_sigma_mm},
-          {"images", r.images},
-          {"detected", detected->image_paths},
-          {"not_detected", detected->not_detected},
-          {"detector", spec.kind == "chessboard"
-                           ? "cv::findChessboardCorners + cv::cornerSubPix (11 x 11, 1e-4 px)"
-                           : "cv::findCirclesGrid"}};
+  return {
+      {"kind", "planar target"},
+      {"board", spec.kind},
+      {"columns", spec.columns},
+      {"rows", spec.rows},
+      {"spacing_mm", spec.square_mm},
+      {"board_sigma_mm", r.board_sigma_mm},
+      {"images", r.images},
+      {"detected", detected->image_paths},
+      {"not_detected", detected->not_detected},
+      {"detector",
+       spec.kind == "chessboard" ? "cv::findChessboardCorners + cv::cornerSubPix (11 x 11, 1e-4 px)"
+                                 : "cv::findCirclesGrid"}};
 }
 
 // The cross-file checks of the block readers, with one exposure per observed image.
@@ -137,7 +147,8 @@ void ValidateMarks(const triangulation::Project& project, const std::string& cam
 }
 
 // The image groups: --groups, or the group column of a test field's observations.csv.
-std::map<std::string, std::string> GroupsOf(const CalibrateRequest& r, const triangulation::Project& project) {
+std::map<std::string, std::string> GroupsOf(const CalibrateRequest& r,
+                                            const triangulation::Project& project) {
   std::set<std::string> observed;
   for (const auto& o : project.observations) observed.insert(o.image);
   std::map<std::string, std::string> groups;
@@ -158,9 +169,12 @@ struct BesideRun {  // the same marks calibrated in --model
 };
 
 // The same marks calibrated in --model, started from the camera file's values converted.
-BesideRun CalibrateBeside(const triangulation::Project& project, const std::string& camera_id,
-                          const calib::Camera& camera, calib::CameraModelId beside_model,
-                          const triangulation::CalibrateOptions& options, std::string* printed) {
+BesideRun CalibrateBeside(const triangulation::Project& project,
+                          const std::string& camera_id,
+                          const calib::Camera& camera,
+                          calib::CameraModelId beside_model,
+                          const triangulation::CalibrateOptions& options,
+                          std::string* printed) {
   triangulation::CalibrateOptions beside = options;
   beside.adjust.free_interior =
       triangulation::ParseSelfCalibration(DefaultSelfCalibration(beside_model), beside_model);
@@ -176,8 +190,10 @@ BesideRun CalibrateBeside(const triangulation::Project& project, const std::stri
   run.json["rms_px"] = RmsPx(o);
   run.json["seconds"] = o.solve.seconds;
   *printed += StringPrintf("beside, in model %s: sigma0 %.4f, RMS %.4f px%s\n",
-                           std::string(calib::CameraModelName(beside_model)).c_str(), o.sigma0,
-                           RmsPx(o), o.valid ? "" : " (not valid)");
+                           std::string(calib::CameraModelName(beside_model)).c_str(),
+                           o.sigma0,
+                           RmsPx(o),
+                           o.valid ? "" : " (not valid)");
   if (o.valid && !o.cameras.empty()) {
     run.camera = triangulation::UpdatedCamera(in_model.cameras[camera_id], o.cameras[0]);
     run.estimate = o.cameras[0];
@@ -186,11 +202,19 @@ BesideRun CalibrateBeside(const triangulation::Project& project, const std::stri
 }
 
 // cv::calibrateCamera on the detected marks, for comparison (--model opencv with --images).
-nlohmann::json OpenCvBeside(const DetectedBoards& detected, const calib::Camera& camera, std::string* printed) {
+nlohmann::json OpenCvBeside(const DetectedBoards& detected,
+                            const calib::Camera& camera,
+                            std::string* printed) {
   const OpenCvCalibration cv = CalibrateWithOpenCv(detected);
   const double p = camera.pixel_size_mm;
-  *printed += StringPrintf("cv::calibrateCamera: RMS %.4f px, fx %.4f fy %.4f cx %.4f cy %.4f (%.3f s)\n",
-                           cv.rms_px, cv.fx, cv.fy, cv.cx, cv.cy, cv.seconds);
+  *printed +=
+      StringPrintf("cv::calibrateCamera: RMS %.4f px, fx %.4f fy %.4f cx %.4f cy %.4f (%.3f s)\n",
+                   cv.rms_px,
+                   cv.fx,
+                   cv.fy,
+                   cv.cx,
+                   cv.cy,
+                   cv.seconds);
   return {{"function", "cv::calibrateCamera (flags 0: fx, fy, cx, cy, k1, k2, p1, p2, k3)"},
           {"rms_px", cv.rms_px},
           {"seconds", cv.seconds},
@@ -203,16 +227,19 @@ nlohmann::json OpenCvBeside(const DetectedBoards& detected, const calib::Camera&
           {"p1", cv.distortion[2]},
           {"p2", cv.distortion[3]},
           {"k3", cv.distortion[4]},
-          {"equivalent", {{"c", 0.5 * (cv.fx + cv.fy) * p},
-                          {"x0", (cv.cx - 0.5 * (camera.width_px - 1)) * p},
-                          {"y0", -(cv.cy - 0.5 * (camera.height_px - 1)) * p}}}};
+          {"equivalent",
+           {{"c", 0.5 * (cv.fx + cv.fy) * p},
+            {"x0", (cv.cx - 0.5 * (camera.width_px - 1)) * p},
+            {"y0", -(cv.cy - 0.5 * (camera.height_px - 1)) * p}}}};
 }
 
 // --write-camera: the calibrated camera in the format asked for, only from a valid estimate (a
 // file that exists is one the next run may use); "camera_written" for the result, or "" with the
 // reason in `errors`.
-nlohmann::json WriteCalibratedCamera(const CalibrateRequest& r, const calib::Camera& camera,
-                                     const triangulation::CameraEstimate& estimate, const std::string& model_name,
+nlohmann::json WriteCalibratedCamera(const CalibrateRequest& r,
+                                     const calib::Camera& camera,
+                                     const triangulation::CameraEstimate& estimate,
+                                     const std::string& model_name,
                                      std::string* printed) {
   const calib::ConversionResult written =
       WriteCameraInFormat(r.write_camera, camera, r.camera_format, &estimate.sigma);
@@ -222,10 +249,13 @@ nlohmann::json WriteCalibratedCamera(const CalibrateRequest& r, const calib::Cam
   j["residual_px"] = {{"rms", written.residual.rms_px},
                       {"max", written.residual.max_px},
                       {"max_inner80", written.residual.max_inner80_px}};
-  *printed += model_name.empty()
-                  ? StringPrintf("camera -> %s (%s)\n", r.write_camera.c_str(), r.camera_format.c_str())
-                  : StringPrintf("camera (the %s estimate) -> %s (%s)\n", model_name.c_str(),
-                                 r.write_camera.c_str(), r.camera_format.c_str());
+  *printed +=
+      model_name.empty()
+          ? StringPrintf("camera -> %s (%s)\n", r.write_camera.c_str(), r.camera_format.c_str())
+          : StringPrintf("camera (the %s estimate) -> %s (%s)\n",
+                         model_name.c_str(),
+                         r.write_camera.c_str(),
+                         r.camera_format.c_str());
   return j;
 }
 
@@ -233,10 +263,12 @@ void CheckRequest(const CalibrateRequest& r) {
   const bool field = !r.observations.empty() || !r.points.empty();
   const bool board = !r.images.empty() || !r.board.empty();
   if (field == board)
-    throw ConfigError("give either --observations and --points, or --images and --board, or --directions");
+    throw ConfigError(
+        "give either --observations and --points, or --images and --board, or --directions");
   if (field && (r.observations.empty() || r.points.empty()))
     throw ConfigError("--observations and --points go together");
-  if (board && (r.images.empty() || r.board.empty())) throw ConfigError("--images and --board go together");
+  if (board && (r.images.empty() || r.board.empty()))
+    throw ConfigError("--images and --board go together");
 }
 
 }  // namespace
@@ -286,7 +318,8 @@ CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
   json["command"] = "calibrate";
   json["valid"] = result.valid;
   json["invalid_reasons"] = result.invalid_reasons;
-  nlohmann::json cal = triangulation::CalibrationToJson(run, budget_table, budget.radii_mm, camera.c_mm());
+  nlohmann::json cal =
+      triangulation::CalibrationToJson(run, budget_table, budget.radii_mm, camera.c_mm());
   cal["method"] = method;
   cal["camera"] = {{"id", camera_id},
                    {"file", r.camera},
@@ -305,17 +338,25 @@ CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
   cal["rms_px"] = RmsPx(result);
   // With --model the model-M estimate of this run is written (issue 29), not a refit of ours.
   if (!r.write_camera.empty() && beside_model != model && beside.camera)
-    cal["camera_written"] = WriteCalibratedCamera(
-        r, *beside.camera, *beside.estimate, std::string(calib::CameraModelName(beside_model)), &outcome.printed);
+    cal["camera_written"] = WriteCalibratedCamera(r,
+                                                  *beside.camera,
+                                                  *beside.estimate,
+                                                  std::string(calib::CameraModelName(beside_model)),
+                                                  &outcome.printed);
   else if (!r.write_camera.empty() && beside_model != model)
     outcome.errors += "camera not written: the --model result is not valid\n";
   else if (!r.write_camera.empty() && result.valid && !result.cameras.empty())
-    cal["camera_written"] = WriteCalibratedCamera(
-        r, triangulation::UpdatedCamera(camera, result.cameras[0]), result.cameras[0], "", &outcome.printed);
+    cal["camera_written"] =
+        WriteCalibratedCamera(r,
+                              triangulation::UpdatedCamera(camera, result.cameras[0]),
+                              result.cameras[0],
+                              "",
+                              &outcome.printed);
   else if (!r.write_camera.empty())
     outcome.errors += "camera not written: the result is not valid\n";
   json["calibration"] = cal;
-  for (const auto& reason : result.invalid_reasons) outcome.errors += "calibrate: not valid: " + reason + "\n";
+  for (const auto& reason : result.invalid_reasons)
+    outcome.errors += "calibrate: not valid: " + reason + "\n";
   outcome.doc = std::move(json);
   outcome.valid = result.valid && run.stability.agree;
   return outcome;

@@ -1,13 +1,14 @@
 // `aerocal calibrate` from a test field or a planar board, as one request (the command's options)
 // and one outcome (the result document, what the command prints, its exit code): shared by the
-// command (tools/cmd_calibrate.cc) and Python's `aerocal.calibrate` (tools/python/bind_calibrate.cc).
-// The direction calibration (--directions) is tools/calibrate_directions.h.
+// command (tools/cmd_calibrate.cc) and Python's `aerocal.calibrate`
+// (tools/python/bind_calibrate.cc). The direction calibration (--directions) is
+// tools/calibrate_directions.h.
 #pragma once
+
+#include <nlohmann/json.hpp>
 
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace aerocal::tools {
 
@@ -15,9 +16,9 @@ namespace aerocal::tools {
 inline constexpr double kDefaultBoardSigmaMm = 0.01;
 
 struct CalibrateRequest {
-  std::string camera;                      // camera file: pixel size, format, an approximate c
-  std::string observations, points;        // a test field (together) ...
-  std::string images, board;               // ... or a planar board: glob and "chessboard:9x6:25"
+  std::string camera;                // camera file: pixel size, format, an approximate c
+  std::string observations, points;  // a test field (together) ...
+  std::string images, board;         // ... or a planar board: glob and "chessboard:9x6:25"
   std::string groups, budget, write_marks, write_camera, camera_format = "aerocal";
   std::string self_calibration;  // default: the model's (DefaultSelfCalibration)
   std::string model;             // default: the camera file's

@@ -1,16 +1,16 @@
 #include "tools/camera_formats.h"
 
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
-
-#include <opencv2/core.hpp>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "tools/opencv_storage_scan.h"
+
+#include <opencv2/core.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
 
 namespace aerocal::tools {
 namespace {
@@ -30,9 +30,13 @@ bool LooksLikeOpenCv(const std::string& head, const std::string&) {
 // The opencv row of calib's registry (OpenCV stays out of calib).
 const bool kOpenCvRegistered = [] {
   calib::RegisterCameraFormat(
-      {"opencv", "OpenCV FileStorage YAML/XML/JSON (camera_matrix, distortion_coefficients)",
-       ReadOpenCvCamera, WriteOpenCvCamera,
-       calib::OpenCvTarget, LooksLikeOpenCv, ".yml"});
+      {"opencv",
+       "OpenCV FileStorage YAML/XML/JSON (camera_matrix, distortion_coefficients)",
+       ReadOpenCvCamera,
+       WriteOpenCvCamera,
+       calib::OpenCvTarget,
+       LooksLikeOpenCv,
+       ".yml"});
   return true;
 }();
 
@@ -40,15 +44,20 @@ const bool kOpenCvRegistered = [] {
 
 std::string DescribeConversion(const calib::ConversionResult& r) {
   char buffer[256];
-  std::snprintf(buffer, sizeof(buffer),
+  std::snprintf(buffer,
+                sizeof(buffer),
                 "residual over the format: rms %.3g px, max %.3g px at pixel (%.0f, %.0f), max "
                 "within 80 %% of the half-diagonal %.3g px",
-                r.residual.rms_px, r.residual.max_px, r.residual.max_at_px.x(),
-                r.residual.max_at_px.y(), r.residual.max_inner80_px);
+                r.residual.rms_px,
+                r.residual.max_px,
+                r.residual.max_at_px.x(),
+                r.residual.max_at_px.y(),
+                r.residual.max_inner80_px);
   return buffer;
 }
 
-calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib::Camera& camera,
+calib::ConversionResult WriteCameraInFormat(const std::string& path,
+                                            const calib::Camera& camera,
                                             const std::string& format_name,
                                             const calib::InteriorParams* posterior_sigma) {
   const CameraFormat& format = FindCameraFormat(format_name, "--camera-format");
@@ -73,7 +82,8 @@ calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib
   for (const std::string& line : tried) std::printf("  %s\n", line.c_str());
   calib::WriteCameraFileVerified(format, path, conversion.file);
   const calib::ConversionResult& r = conversion.result;
-  std::printf("camera as %s (%s): %s; %s\n", format.name.c_str(),
+  std::printf("camera as %s (%s): %s; %s\n",
+              format.name.c_str(),
               std::string(calib::CameraModelName(r.camera.model)).c_str(),
               r.exact ? "exact (closed form)" : "least-squares fit over the format",
               DescribeConversion(r).c_str());
@@ -103,7 +113,9 @@ bool OpenStorage(const std::string& text, cv::FileStorage* fs, std::string* erro
 // before a top-level key at or above the line cv::FileStorage stopped at (`error_line`) and
 // parses; 0 when there is none. At most a few prefixes are parsed, so a long file with an error
 // is not parsed once per line (readers stay linear, issue 37 class 7).
-size_t ReadablePrefixLines(const std::vector<std::string>& lines, size_t error_line, cv::FileStorage* fs) {
+size_t ReadablePrefixLines(const std::vector<std::string>& lines,
+                           size_t error_line,
+                           cv::FileStorage* fs) {
   int attempts = 0;
   for (size_t cut = std::min(error_line, lines.size()); cut-- > 1 && attempts < 4;) {
     const std::string& line = lines[cut];
@@ -125,10 +137,13 @@ cv::Mat ReadMatrix(const cv::FileStorage& fs, const std::string& key, const Sour
   try {
     fs[key] >> m;
   } catch (const cv::Exception&) {
-    ThrowInputError(where, key + ": not a matrix cv::FileStorage reads (an opencv-matrix whose data "
-                                 "holds rows x cols values of its dt)");
+    ThrowInputError(where,
+                    key +
+                        ": not a matrix cv::FileStorage reads (an opencv-matrix whose data "
+                        "holds rows x cols values of its dt)");
   }
-  if (!m.empty() && m.channels() != 1) ThrowInputError(where, key + " must have one channel (dt d or f)");
+  if (!m.empty() && m.channels() != 1)
+    ThrowInputError(where, key + " must have one channel (dt d or f)");
   if (!m.empty()) m.convertTo(m, CV_64F);
   return m;
 }
@@ -150,7 +165,8 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
   cv::FileStorage fs;
   std::vector<std::string> notes;
   // The text is read by our reader (regular-file checks, BOM), scanned for its lines and matrix
-  // sizes (tools/opencv_storage_scan.h: nothing huge reaches cv::FileStorage) and parsed from memory.
+  // sizes (tools/opencv_storage_scan.h: nothing huge reaches cv::FileStorage) and parsed from
+  // memory.
   const std::string text = ReadTextFile(path);
   const OpenCvStorageScan scan = ScanOpenCvStorage(text, path);
   const auto at = [&](const std::string& key) { return SourceRef{path, scan.Line(key)}; };
@@ -162,7 +178,8 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
   if (!OpenStorage(text, &fs, &error)) {
     const std::vector<std::string> lines = SplitLines(text);
     const size_t error_line = static_cast<size_t>(OpenCvParseErrorLine(error).first);
-    const size_t kept = text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, error_line, &fs) : 0;
+    const size_t kept =
+        text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, error_line, &fs) : 0;
     if (kept == 0) unparsable();
     notes.push_back("the file is cut short: lines 1-" + std::to_string(kept) +
                     " read (the entry from line " + std::to_string(kept + 1) +
@@ -171,7 +188,9 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
   // Keys are looked up in a map: cv::FileStorage asserts (cv::Exception) on any other top level.
   if (!fs.root().isMap()) {
     if (!error.empty()) unparsable();
-    ThrowInputError({path, 1}, "the top level is not a map of keys (camera_matrix, distortion_coefficients, ...)");
+    ThrowInputError(
+        {path, 1},
+        "the top level is not a map of keys (camera_matrix, distortion_coefficients, ...)");
   }
   std::string matrix_key = "camera_matrix", dist_key = "distortion_coefficients";
   bool stereo = false;
@@ -179,9 +198,9 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
     const std::string id = options.camera_id.empty() ? "1" : options.camera_id;
     if (fs["M" + id].empty() && !error.empty()) unparsable();  // a prefix read without the camera
     if (fs["M" + id].empty())
-      ThrowInputError({path, 1}, options.camera_id.empty()
-                                     ? "no camera_matrix (nor a stereo M1/D1)"
-                                     : "no camera M" + id + "/D" + id);
+      ThrowInputError({path, 1},
+                      options.camera_id.empty() ? "no camera_matrix (nor a stereo M1/D1)"
+                                                : "no camera M" + id + "/D" + id);
     if (options.camera_id.empty() && !fs["M2"].empty())
       ThrowInputError(at("M2"), "a stereo file: name the camera with --camera (1 or 2)");
     matrix_key = "M" + id;
@@ -190,19 +209,25 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
   }
   const cv::Mat k = ReadMatrix(fs, matrix_key, at(matrix_key));
   const cv::Mat d = ReadMatrix(fs, dist_key, at(dist_key));
-  if (k.rows != 3 || k.cols != 3) ThrowInputError(at(matrix_key), matrix_key + " must be a 3 x 3 matrix");
+  if (k.rows != 3 || k.cols != 3)
+    ThrowInputError(at(matrix_key), matrix_key + " must be a 3 x 3 matrix");
   const size_t n = d.total();
   if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14)
-    ThrowInputError(at(dist_key), dist_key + " must hold 4, 5, 8, 12 or 14 values (got " +
-                                      std::to_string(n) + ")");
+    ThrowInputError(
+        at(dist_key),
+        dist_key + " must hold 4, 5, 8, 12 or 14 values (got " + std::to_string(n) + ")");
   for (size_t i = 8; i < n; ++i)
     if (d.at<double>(static_cast<int>(i)) != 0.0)
-      ThrowInputError(at(dist_key), dist_key + ": the thin-prism s1-s4 and tilt terms are not "
-                                               "modelled (must be 0)");
+      ThrowInputError(at(dist_key),
+                      dist_key +
+                          ": the thin-prism s1-s4 and tilt terms are not "
+                          "modelled (must be 0)");
   if (k.at<double>(0, 1) != 0.0 || k.at<double>(1, 0) != 0.0 || k.at<double>(2, 0) != 0.0 ||
       k.at<double>(2, 1) != 0.0 || k.at<double>(2, 2) != 1.0)
-    ThrowInputError(at(matrix_key), matrix_key + " must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
-                                                 "modelled)");
+    ThrowInputError(at(matrix_key),
+                    matrix_key +
+                        " must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
+                        "modelled)");
   CameraFile file;
   file.notes = notes;
   file.name = std::filesystem::path(path).stem().string();
@@ -214,15 +239,23 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
   p[OpenCvModel::kFy] = k.at<double>(1, 1);
   p[OpenCvModel::kCx] = k.at<double>(0, 2);
   p[OpenCvModel::kCy] = k.at<double>(1, 2);
-  static const int kOrder[8] = {OpenCvModel::kK1, OpenCvModel::kK2, OpenCvModel::kP1,
-                                OpenCvModel::kP2, OpenCvModel::kK3, OpenCvModel::kK4,
-                                OpenCvModel::kK5, OpenCvModel::kK6};
+  static const int kOrder[8] = {OpenCvModel::kK1,
+                                OpenCvModel::kK2,
+                                OpenCvModel::kP1,
+                                OpenCvModel::kP2,
+                                OpenCvModel::kK3,
+                                OpenCvModel::kK4,
+                                OpenCvModel::kK5,
+                                OpenCvModel::kK6};
   for (size_t i = 0; i < n && i < 8; ++i) p[kOrder[i]] = d.at<double>(static_cast<int>(i));
   for (int i : {OpenCvModel::kFx, OpenCvModel::kFy, OpenCvModel::kCx, OpenCvModel::kCy})
-    if (!std::isfinite(p[i])) ThrowInputError(at(matrix_key), matrix_key + ": a value is not finite");
+    if (!std::isfinite(p[i]))
+      ThrowInputError(at(matrix_key), matrix_key + ": a value is not finite");
   for (size_t i = 0; i < n && i < 8; ++i)
-    if (!std::isfinite(p[kOrder[i]])) ThrowInputError(at(dist_key), dist_key + ": a value is not finite");
-  if (!(p[OpenCvModel::kFx] > 0 && p[OpenCvModel::kFy] > 0)) ThrowInputError(at(matrix_key), "fx, fy must be > 0 px");
+    if (!std::isfinite(p[kOrder[i]]))
+      ThrowInputError(at(dist_key), dist_key + ": a value is not finite");
+  if (!(p[OpenCvModel::kFx] > 0 && p[OpenCvModel::kFy] > 0))
+    ThrowInputError(at(matrix_key), "fx, fy must be > 0 px");
   const int width = ImageSize(fs, "image_width", at("image_width"));
   const int height = ImageSize(fs, "image_height", at("image_height"));
   calib::internal::ResolveFormat(&file, options, at(matrix_key), width, height, 0.0);
@@ -233,15 +266,23 @@ void WriteOpenCvCamera(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == CameraModelId::kOpenCv) << "not opencv";
   const std::vector<double>& p = file.camera.params;
   // The simplest form that holds the camera: k1 k2 p1 p2 [k3 [k4 k5 k6]].
-  const bool rational = p[OpenCvModel::kK4] != 0 || p[OpenCvModel::kK5] != 0 || p[OpenCvModel::kK6] != 0;
-  std::vector<double> coefficients = {p[OpenCvModel::kK1], p[OpenCvModel::kK2],
-                                      p[OpenCvModel::kP1], p[OpenCvModel::kP2]};
+  const bool rational =
+      p[OpenCvModel::kK4] != 0 || p[OpenCvModel::kK5] != 0 || p[OpenCvModel::kK6] != 0;
+  std::vector<double> coefficients = {
+      p[OpenCvModel::kK1], p[OpenCvModel::kK2], p[OpenCvModel::kP1], p[OpenCvModel::kP2]};
   if (rational || p[OpenCvModel::kK3] != 0) coefficients.push_back(p[OpenCvModel::kK3]);
   if (rational)
     coefficients.insert(coefficients.end(),
                         {p[OpenCvModel::kK4], p[OpenCvModel::kK5], p[OpenCvModel::kK6]});
-  const std::vector<double> k = {p[OpenCvModel::kFx], 0, p[OpenCvModel::kCx], 0,
-                                 p[OpenCvModel::kFy], p[OpenCvModel::kCy], 0, 0, 1};
+  const std::vector<double> k = {p[OpenCvModel::kFx],
+                                 0,
+                                 p[OpenCvModel::kCx],
+                                 0,
+                                 p[OpenCvModel::kFy],
+                                 p[OpenCvModel::kCy],
+                                 0,
+                                 0,
+                                 1};
   const std::string extension = std::filesystem::path(path).extension().string();
   if (extension == ".xml" || extension == ".json") {
     cv::FileStorage fs(extension, cv::FileStorage::WRITE | cv::FileStorage::MEMORY);
@@ -261,11 +302,11 @@ void WriteOpenCvCamera(const std::string& path, const CameraFile& file) {
       text += (i ? ", " : "") + calib::internal::ShortestNumber(values[i]);
     return text + " ]\n";
   };
-  WriteFileAtomically(path, "%YAML:1.0\n---\nimage_width: " +
-                                std::to_string(file.camera.frame.width_px) + "\nimage_height: " +
-                                std::to_string(file.camera.frame.height_px) + "\ncamera_matrix:" +
-                                matrix(k, 3, 3) + "distortion_coefficients:" +
-                                matrix(coefficients, static_cast<int>(coefficients.size()), 1));
+  WriteFileAtomically(path,
+                      "%YAML:1.0\n---\nimage_width: " + std::to_string(file.camera.frame.width_px) +
+                          "\nimage_height: " + std::to_string(file.camera.frame.height_px) +
+                          "\ncamera_matrix:" + matrix(k, 3, 3) + "distortion_coefficients:" +
+                          matrix(coefficients, static_cast<int>(coefficients.size()), 1));
 }
 
 }  // namespace aerocal::tools

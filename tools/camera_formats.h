@@ -3,12 +3,12 @@
 // the opencv row registered here, because cv::FileStorage and OpenCV stay out of calib.
 #pragma once
 
+#include "calib/camera/formats/camera_formats.h"
+
 #include <functional>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include "calib/camera/formats/camera_formats.h"
 
 namespace aerocal::tools {
 
@@ -32,14 +32,16 @@ std::string DescribeConversion(const calib::ConversionResult& result);
 /// australis) and saying so where it drops them: `posterior_sigma` (the adjustment's standard
 /// deviations, table order and units, 0 = fixed) when given, else the camera's interior_sigma.
 /// Returns the conversion (exact, with a zero residual, for `aerocal`).
-calib::ConversionResult WriteCameraInFormat(const std::string& path, const calib::Camera& camera,
+calib::ConversionResult WriteCameraInFormat(const std::string& path,
+                                            const calib::Camera& camera,
                                             const std::string& format_name,
                                             const calib::InteriorParams* posterior_sigma = nullptr);
 
 /// OpenCV's calibration file as cv::FileStorage reads and writes it (YAML, XML or JSON by the
 /// extension): camera_matrix 3x3, distortion_coefficients (k1 k2 p1 p2 [k3 [k4 k5 k6]]),
 /// image_width, image_height; or a stereo file's M1/D1, M2/D2 (--camera 1 / 2).
-calib::CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOptions& options);
+calib::CameraFile ReadOpenCvCamera(const std::string& path,
+                                   const calib::CameraReadOptions& options);
 void WriteOpenCvCamera(const std::string& path, const calib::CameraFile& camera);
 
 }  // namespace aerocal::tools

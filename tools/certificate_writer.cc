@@ -3,6 +3,8 @@
 // tools/certificate/aerocal_certificate.py with matplotlib). This file gathers the data: the lab
 // YAML the user fills, the result, the comparison with a previous certificate or result against
 // tolerances. Deterministic: no clock, no random numbers (the date comes from the lab file).
+#include "tools/certificate_writer.h"
+
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -11,7 +13,6 @@
 #include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
-#include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
 #include "tools/output_set.h"
 #include "tools/python_script.h"
@@ -21,10 +22,10 @@
 #include <nlohmann/json.hpp>
 
 #include <cmath>
-#include <limits>
-#include <map>
 #include <cstdlib>
 #include <filesystem>
+#include <limits>
+#include <map>
 #include <vector>
 
 namespace aerocal::tools {
@@ -37,7 +38,8 @@ std::map<std::string, double> ReadTolerances(const std::string& path) {
   std::map<std::string, double> out;
   if (path.empty()) return out;
   const YAML::Node root = LoadYamlFile(path);
-  if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map quantity: tolerance");
+  if (!root.IsMap())
+    throw InputError(WhereIs(root, path).ToString() + ": expected a map quantity: tolerance");
   for (const auto& item : root)
     out[item.first.as<std::string>()] =
         YamlBounded(item.second, path, item.first.as<std::string>(), 0, 1e12);
@@ -60,16 +62,20 @@ void CheckStatements(const nlohmann::json& rows, const std::string& file, const 
     const nlohmann::json& q = rows[i];
     const std::string at = file + ": " + path + "[" + std::to_string(i) + "]";
     const double big_u = q["U"].is_number() ? q["U"].get<double>() : NAN;
-    const std::string expected = triangulation::CertificateStatement(
-        q["quantity"].get<std::string>(), q["value"].get<double>(), big_u, q["k"].get<double>(),
-        q["unit"].get<std::string>());
+    const std::string expected =
+        triangulation::CertificateStatement(q["quantity"].get<std::string>(),
+                                            q["value"].get<double>(),
+                                            big_u,
+                                            q["k"].get<double>(),
+                                            q["unit"].get<std::string>());
     if (q["statement"].get<std::string>() != expected)
       throw InputError(at + ".statement: '" + q["statement"].get<std::string>() +
                        "' does not state the row's value, U, k and unit ('" + expected + "')");
     if (q.contains("u_c") && q["u_c"].is_number() && std::isfinite(big_u)) {
       const double k_u_c = q["k"].get<double>() * q["u_c"].get<double>();
       if (!(std::abs(big_u - k_u_c) <= 1e-9 * std::max(1e-300, big_u)))
-        throw InputError(at + ".U: " + FormatNumber(big_u) + " is not k u_c = " + FormatNumber(k_u_c));
+        throw InputError(at + ".U: " + FormatNumber(big_u) +
+                         " is not k u_c = " + FormatNumber(k_u_c));
     }
   }
 }
@@ -82,8 +88,10 @@ const nlohmann::json* Uncertainty(const nlohmann::json& doc) {
   return nullptr;
 }
 
-nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous,
-                       const std::map<std::string, double>& tolerances, const std::string& previous_file) {
+nlohmann::json Compare(const nlohmann::json& now,
+                       const nlohmann::json& previous,
+                       const std::map<std::string, double>& tolerances,
+                       const std::string& previous_file) {
   nlohmann::json rows = nlohmann::json::array();
   bool all_pass = true;
   std::map<std::string, nlohmann::json> old;
@@ -93,8 +101,9 @@ nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous
     const auto o = old.find(name);
     if (o == old.end()) continue;
     if (q.value("unit", "") != o->second.value("unit", ""))
-      throw InputError(previous_file + ": quantity " + name + " is in " + o->second.value("unit", "") +
-                       ", the result's in " + q.value("unit", "") + " (--previous)");
+      throw InputError(previous_file + ": quantity " + name + " is in " +
+                       o->second.value("unit", "") + ", the result's in " + q.value("unit", "") +
+                       " (--previous)");
     const double v = q.at("value"), v_old = o->second.at("value");
     const nlohmann::json big_u = q.value("U", nlohmann::json()),
                          big_u_old = o->second.value("U", nlohmann::json());
@@ -103,8 +112,12 @@ nlohmann::json Compare(const nlohmann::json& now, const nlohmann::json& previous
     const double diff = v - v_old;
     // E_n = |difference| / sqrt(U^2 + U_prev^2) (ISO/IEC 17043 / ISO 13528): <= 1 consistent.
     const double en = std::abs(diff) / std::sqrt(u * u + u_old * u_old);
-    nlohmann::json row = {{"quantity", name}, {"unit", q.value("unit", nlohmann::json())},  {"value", v},
-                          {"previous", v_old}, {"difference", diff}, {"U", big_u},
+    nlohmann::json row = {{"quantity", name},
+                          {"unit", q.value("unit", nlohmann::json())},
+                          {"value", v},
+                          {"previous", v_old},
+                          {"difference", diff},
+                          {"U", big_u},
                           {"U_previous", big_u_old},
                           {"E_n", std::isfinite(en) ? nlohmann::json(en) : nlohmann::json()}};
     const auto t = tolerances.find(name);
@@ -154,7 +167,8 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
   const double redundancy = out.value("redundancy", 0.0);
   nlohmann::json budget = nlohmann::json::array();
   static const std::map<std::string, std::pair<const char*, const char*>> kQuantities = {
-      {"c", {"mm", "principal distance"}}, {"x0", {"mm", "principal point x"}},
+      {"c", {"mm", "principal distance"}},
+      {"x0", {"mm", "principal point x"}},
       {"y0", {"mm", "principal point y"}}};
   std::vector<triangulation::BudgetQuantity> quantities;
   for (const auto& [name, info] : kQuantities) {
@@ -184,7 +198,8 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
   int n = 0;
   for (const auto& r : out.value("residuals", nlohmann::json::array()))
     if (r.value("used", true) && r.contains("v_col_px")) {
-      sum2 += std::pow(r.at("v_col_px").get<double>(), 2) + std::pow(r.at("v_row_px").get<double>(), 2);
+      sum2 +=
+          std::pow(r.at("v_col_px").get<double>(), 2) + std::pow(r.at("v_row_px").get<double>(), 2);
       ++n;
     }
   const nlohmann::json format = flight.value("camera_format", nlohmann::json::object());
@@ -193,8 +208,9 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
        {{"kind", "in-flight calibration"},
         {"adjustment", chosen->value("name", "")},
         {"flight_data", flight.value("data", "")},
-        {"budget", "type A only (the adjustment's covariance); type B and group reproducibility "
-                   "are not evaluated for an in-flight calibration"}}},
+        {"budget",
+         "type A only (the adjustment's covariance); type B and group reproducibility "
+         "are not evaluated for an in-flight calibration"}}},
       {"camera",
        {{"id", camera.value("id", "")},
         {"file", flight.value("camera", "")},
@@ -233,14 +249,16 @@ nlohmann::json ReadCertificateLab(const std::string& path) {
   if (path.empty()) return out;
   const YAML::Node root = LoadYamlFile(path);
   if (!root || root.IsNull()) return out;
-  if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map of sections");
+  if (!root.IsMap())
+    throw InputError(WhereIs(root, path).ToString() + ": expected a map of sections");
   std::vector<std::string> names;
   for (const auto& [section, keys] : sections) names.push_back(section);
   RejectUnknownKeys(root, names, path);
   for (const auto& [section, keys] : sections) {
     const YAML::Node node = root[section];
     if (!node) continue;
-    if (!node.IsMap()) throw InputError(WhereIs(node, path).ToString() + ": " + section + " must be a map");
+    if (!node.IsMap())
+      throw InputError(WhereIs(node, path).ToString() + ": " + section + " must be a map");
     RejectUnknownKeys(node, keys, path);
     for (const auto& k : keys)
       if (node[k]) out[section][k] = YamlString(node[k], path, section + "." + k);
@@ -269,41 +287,82 @@ nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
                             {"axes", nlohmann::json::array()},
                             {"bars", nlohmann::json::array()},
                             {"stars", nlohmann::json::array()}};
-  const auto copy = [](const nlohmann::json& from, nlohmann::json* to, std::initializer_list<const char*> keys) {
-    for (const char* key : keys)
-      if (from.contains(key)) (*to)[key] = from[key];
-  };
+  const auto copy =
+      [](const nlohmann::json& from, nlohmann::json* to, std::initializer_list<const char*> keys) {
+        for (const char* key : keys)
+          if (from.contains(key)) (*to)[key] = from[key];
+      };
   for (const std::string& path : paths) {
     const nlohmann::json doc =
         ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality`");
     ReadTyped(path, "--quality", [&] {
       if (doc.at("kind") == "quality_star") {
         nlohmann::json star = {{"source", path}};
-        copy(doc, &star, {"method", "star", "options", "reference_modulation", "rings", "limiting_frequency_cy_px",
-                          "limit_in_range", "limiting_radius_px", "limiting_lp_per_mm", "limiting_resolved_distance_m"});
+        copy(doc,
+             &star,
+             {"method",
+              "star",
+              "options",
+              "reference_modulation",
+              "rings",
+              "limiting_frequency_cy_px",
+              "limit_in_range",
+              "limiting_radius_px",
+              "limiting_lp_per_mm",
+              "limiting_resolved_distance_m"});
         section["stars"].push_back(star);
         return 0;
       }
       if (doc.at("kind") == "quality_bars") {
         nlohmann::json bars = {{"source", path}};
-        copy(doc, &bars, {"method", "options", "reference_modulation", "groups", "limiting_frequency_cy_px",
-                          "limit_in_range", "limiting_lp_per_mm", "limiting_resolved_distance_m"});
+        copy(doc,
+             &bars,
+             {"method",
+              "options",
+              "reference_modulation",
+              "groups",
+              "limiting_frequency_cy_px",
+              "limit_in_range",
+              "limiting_lp_per_mm",
+              "limiting_resolved_distance_m"});
         section["bars"].push_back(bars);
         return 0;
       }
       section["method"] = doc.at("method");
       for (const auto& e : doc.at("edges")) {
         nlohmann::json edge = {{"source", path}};
-        copy(e, &edge, {"roi", "axis", "direction", "angle_deg", "mtf50_cy_px", "mtf50_expanded_cy_px",
-                        "coverage_factor", "mtf_nyquist", "mtf50_lp_per_mm", "mtf50_lp_per_mm_expanded",
-                        "mtf50_resolved_distance_m", "mtf50_resolved_distance_expanded_m", "curve", "budget"});
+        copy(e,
+             &edge,
+             {"roi",
+              "axis",
+              "direction",
+              "angle_deg",
+              "mtf50_cy_px",
+              "mtf50_expanded_cy_px",
+              "coverage_factor",
+              "mtf_nyquist",
+              "mtf50_lp_per_mm",
+              "mtf50_lp_per_mm_expanded",
+              "mtf50_resolved_distance_m",
+              "mtf50_resolved_distance_expanded_m",
+              "curve",
+              "budget"});
         section["edges"].push_back(edge);
       }
       for (const auto& [axis, c] : doc.at("axes").items()) {
         nlohmann::json combined = {{"source", path}, {"axis", axis}};
-        copy(c, &combined, {"direction", "count", "mtf50_cy_px", "type_a_u_cy_px", "type_b_u_cy_px",
-                            "mtf50_expanded_cy_px", "mtf50_lp_per_mm", "mtf50_lp_per_mm_expanded",
-                            "mtf50_resolved_distance_m", "mtf50_resolved_distance_expanded_m"});
+        copy(c,
+             &combined,
+             {"direction",
+              "count",
+              "mtf50_cy_px",
+              "type_a_u_cy_px",
+              "type_b_u_cy_px",
+              "mtf50_expanded_cy_px",
+              "mtf50_lp_per_mm",
+              "mtf50_lp_per_mm_expanded",
+              "mtf50_resolved_distance_m",
+              "mtf50_resolved_distance_expanded_m"});
         section["axes"].push_back(combined);
       }
       return 0;
@@ -336,9 +395,8 @@ nlohmann::json DistortionJson(const nlohmann::json& cert) {
     return nullptr;
   const triangulation::DistortionFigure figure = triangulation::DistortionOverFormat(camera);
   if (figure.profile.empty()) return nullptr;
-  return {{"profile_kind", figure.profile_kind},
-          {"profile", figure.profile},
-          {"grid", figure.grid}};
+  return {
+      {"profile_kind", figure.profile_kind}, {"profile", figure.profile}, {"grid", figure.grid}};
 }
 
 int WriteCertificate(const CertificateArgs& args) {
@@ -367,16 +425,17 @@ int WriteCertificate(const CertificateArgs& args) {
     cert["method"] = cal.at("method");
     cert["camera_file"] = cal.at("camera");
     cert["data"] = cal.at("data");
-    cert["adjustment"] = {{"sigma0", result["sigma0"]},
-                          {"sigma0_px", result["sigma0_px"]},
-                          {"sigma0_um", result["sigma0_um"]},
-                          {"redundancy", result["redundancy"]},
-                          {"converged", result["converged"]},
-                          {"valid", result.value("valid", false)},
-                          {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
-                          {"warnings", result.value("warnings", nlohmann::json::array())},
-                          {"self_calibration", result.value("self_calibration", nlohmann::json())},
-                          {"rms_px", cal.at("rms_px")}};
+    cert["adjustment"] = {
+        {"sigma0", result["sigma0"]},
+        {"sigma0_px", result["sigma0_px"]},
+        {"sigma0_um", result["sigma0_um"]},
+        {"redundancy", result["redundancy"]},
+        {"converged", result["converged"]},
+        {"valid", result.value("valid", false)},
+        {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
+        {"warnings", result.value("warnings", nlohmann::json::array())},
+        {"self_calibration", result.value("self_calibration", nlohmann::json())},
+        {"rms_px", cal.at("rms_px")}};
     cert["results"] = cal.at("uncertainty");
     cert["interior"] = result["cameras"][0];
     cert["camera_model"] = result.value("camera_model", nlohmann::json());
@@ -394,20 +453,24 @@ int WriteCertificate(const CertificateArgs& args) {
       if (r.value("used", true))
         residuals.push_back({r.at("col"), r.at("row"), r.at("v_col_px"), r.at("v_row_px")});
     cert["residuals"] = residuals;
-    for (const auto& q : cert["results"]) statements.push_back(q.at("statement").get<std::string>());
+    for (const auto& q : cert["results"])
+      statements.push_back(q.at("statement").get<std::string>());
     return cert["adjustment"]["valid"].get<bool>() && cal.at("stability").value("agree", true);
   });
   if (!args.quality.empty()) cert["dynamic_image_resolution"] = DynamicResolutionJson(args.quality);
   bool comparison_pass = true;
   if (!args.previous.empty()) {
-    const nlohmann::json previous = ReadResult(args.previous, {"certificate", "adjust"},
-                                               "`aerocal certificate` or `aerocal calibrate`");
+    const nlohmann::json previous = ReadResult(
+        args.previous, {"certificate", "adjust"}, "`aerocal certificate` or `aerocal calibrate`");
     comparison_pass = ReadTyped(args.previous, "--previous", [&] {
       const nlohmann::json* old = Uncertainty(previous);
       if (!old)
-        throw InputError(args.previous + ": neither a certificate.json nor a calibrate result (--previous)");
+        throw InputError(args.previous +
+                         ": neither a certificate.json nor a calibrate result (--previous)");
       ValidateJson(previous, InputSchema("previous"), args.previous);
-      CheckStatements(*old, args.previous, previous.contains("results") ? "results" : "calibration.uncertainty");
+      CheckStatements(*old,
+                      args.previous,
+                      previous.contains("results") ? "results" : "calibration.uncertainty");
       cert["comparison"] = Compare(cert["results"], *old, tolerances, args.previous);
       cert["comparison"]["previous"] = args.previous;
       if (previous.contains("lab"))
@@ -425,9 +488,11 @@ int WriteCertificate(const CertificateArgs& args) {
     const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
     const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
     if (!RunPythonScript(script, {json_path, set.staging()})) {
-      std::fprintf(stderr, "error: the certificate could not be rendered (%s); nothing written, the "
+      std::fprintf(stderr,
+                   "error: the certificate could not be rendered (%s); nothing written, the "
                    "previous certificate in %s is left as it was\n",
-                   PythonCommandLine(script, {json_path, set.staging()}).c_str(), args.out.c_str());
+                   PythonCommandLine(script, {json_path, set.staging()}).c_str(),
+                   args.out.c_str());
       return kExitInternal;
     }
     set.Commit({"certificate.json", "certificate.html", "certificate.pdf"});
@@ -439,9 +504,11 @@ int WriteCertificate(const CertificateArgs& args) {
   std::printf("certificate data -> %s/certificate.json\n", shown.c_str());
   for (const auto& statement : statements) std::printf("  %s\n", statement.c_str());
   if (cert.contains("comparison"))
-    std::printf("comparison with %s: %s\n", args.previous.c_str(), comparison_pass ? "pass" : "FAIL");
+    std::printf(
+        "comparison with %s: %s\n", args.previous.c_str(), comparison_pass ? "pass" : "FAIL");
   if (!args.no_render)
-    std::printf("certificate -> %s/certificate.html, %s/certificate.pdf\n", shown.c_str(), shown.c_str());
+    std::printf(
+        "certificate -> %s/certificate.html, %s/certificate.pdf\n", shown.c_str(), shown.c_str());
   const bool ok = valid && comparison_pass;
   return ok ? kExitOk : kExitNotConverged;
 }

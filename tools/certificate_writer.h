@@ -4,10 +4,10 @@
 // `aerocal certificate` and `aerocal flight --certificate`.
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 #include <vector>
-
-#include <nlohmann/json.hpp>
 
 namespace aerocal::tools {
 

@@ -59,7 +59,8 @@ int RunRigAdjust(const RigArgs& args,
 
   triangulation::RigAdjustmentResult result = triangulation::AdjustRig(project, options, rig);
   triangulation::ToInputFrame(frame, &result.adjustment);
-  std::printf("%s%s", triangulation::FormatSummary(result.adjustment).c_str(),
+  std::printf("%s%s",
+              triangulation::FormatSummary(result.adjustment).c_str(),
               triangulation::FormatRigSummary(result).c_str());
   nlohmann::json json = triangulation::AdjustmentToJson(result.adjustment);
   json.update(triangulation::RigResultToJson(result));
@@ -106,7 +107,8 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option(
          "--project", args->project, "Project YAML (or folder with project.yaml), FORMATS.md")
       ->required();
-  app.add_option("--out", args->out, "Output file: the result JSON (written atomically)")->required();
+  app.add_option("--out", args->out, "Output file: the result JSON (written atomically)")
+      ->required();
   app.add_option("--self-calibration",
                  args->self_calibration,
                  "Interior parameters to estimate: none (conventional, default), auto (those of "
@@ -120,8 +122,10 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option("--write-camera",
                  args->write_camera,
                  "Write the estimated camera file (camera-file YAML) for the next run");
-  app.add_option("--camera-format", args->camera_format,
-                 "Format of --write-camera: " + CameraFormatNames() + " (converted, with its residual)");
+  app.add_option(
+      "--camera-format",
+      args->camera_format,
+      "Format of --write-camera: " + CameraFormatNames() + " (converted, with its residual)");
   app.add_option("--sigma-px",
                  args->default_sigma_px,
                  "Image sigma where observations.csv has no sigma_px, px")
@@ -137,7 +141,8 @@ CommandRun SetupAdjust(CLI::App& app) {
                "image components of the first solve are above 10 sigma)");
   app.add_option("--max-rejections",
                  args->options.max_rejections,
-                 "Rejection cap of data snooping; reaching it is a warning and exit 3 (default: 10 % of the "
+                 "Rejection cap of data snooping; reaching it is a warning and exit 3 (default: 10 "
+                 "% of the "
                  "tested image observations, at least 100)")
       ->check(PositiveUpTo(1e7));
   app.add_option("--max-sigma0",
@@ -166,30 +171,40 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->options.correlation_threshold,
                  "Report parameter pairs correlated above this")
       ->check(FiniteRange(0.0, 1.0));
-  app.add_option("--lever-arm-m", args->lever_arm_m,
+  app.add_option("--lever-arm-m",
+                 args->lever_arm_m,
                  "GNSS lever arm a (projection centre -> antenna, camera frame), m, \"X,Y,Z\": its "
-                 "value (fixed) or start (free, weighted)")->check(FiniteRange(-1000, 1000))
+                 "value (fixed) or start (free, weighted)")
+      ->check(FiniteRange(-1000, 1000))
       ->delimiter(',')
       ->expected(3);
   app.add_option("--lever-arm", args->lever_arm, "Lever arm: fixed (default) | free | weighted");
-  app.add_option("--lever-arm-sigma-m", args->lever_arm_sigma_m,
+  app.add_option("--lever-arm-sigma-m",
+                 args->lever_arm_sigma_m,
                  "Lever arm sigma per axis when weighted, m")
       ->check(PositiveUpTo(1000));
-  app.add_option("--boresight-deg", args->boresight_deg,
-                 "Boresight misalignment M (IMU attitude = R M^T), omega,phi,kappa deg")->check(FiniteRange(-360, 360))
+  app.add_option("--boresight-deg",
+                 args->boresight_deg,
+                 "Boresight misalignment M (IMU attitude = R M^T), omega,phi,kappa deg")
+      ->check(FiniteRange(-360, 360))
       ->delimiter(',')
       ->expected(3);
   app.add_option("--boresight", args->boresight, "Boresight: fixed (default) | free | weighted");
-  app.add_option("--boresight-sigma-deg", args->boresight_sigma_deg,
+  app.add_option("--boresight-sigma-deg",
+                 args->boresight_sigma_deg,
                  "Boresight sigma per angle when weighted, deg")
       ->check(PositiveUpTo(180));
-  app.add_option("--gnss-time-offset-ms", args->time_offset_ms,
-                 "GNSS time offset dt (GNSS position = antenna at exposure time + dt; needs vX, vY, "
-                 "vZ in exposures.csv), ms")
+  app.add_option(
+         "--gnss-time-offset-ms",
+         args->time_offset_ms,
+         "GNSS time offset dt (GNSS position = antenna at exposure time + dt; needs vX, vY, "
+         "vZ in exposures.csv), ms")
       ->check(FiniteRange(-1e4, 1e4));
-  app.add_option("--gnss-time-offset", args->time_offset,
+  app.add_option("--gnss-time-offset",
+                 args->time_offset,
                  "GNSS time offset: fixed (default) | free | weighted");
-  app.add_option("--gnss-time-offset-sigma-ms", args->time_offset_sigma_ms,
+  app.add_option("--gnss-time-offset-sigma-ms",
+                 args->time_offset_sigma_ms,
                  "GNSS time offset sigma when weighted, ms")
       ->check(PositiveUpTo(1e4));
   AddJointAdjustOptions(app, &args->joint);
@@ -225,22 +240,34 @@ CommandRun SetupAdjust(CLI::App& app) {
   auto apply_platform = [args, &app](triangulation::PlatformSpec* p) -> bool {
     auto given = [&](const char* name) { return app.count(name) > 0; };
     if (given("--lever-arm-m"))
-      p->lever_arm_m = Eigen::Vector3d(args->lever_arm_m[0], args->lever_arm_m[1], args->lever_arm_m[2]);
+      p->lever_arm_m =
+          Eigen::Vector3d(args->lever_arm_m[0], args->lever_arm_m[1], args->lever_arm_m[2]);
     if (given("--boresight-deg"))
-      p->boresight_rad = Eigen::Vector3d(args->boresight_deg[0], args->boresight_deg[1],
-                                         args->boresight_deg[2]) *
-                         (M_PI / 180.0);
+      p->boresight_rad =
+          Eigen::Vector3d(args->boresight_deg[0], args->boresight_deg[1], args->boresight_deg[2]) *
+          (M_PI / 180.0);
     if (given("--gnss-time-offset-ms")) p->time_offset_s = args->time_offset_ms * 1e-3;
-    if (given("--lever-arm")) p->lever_arm = triangulation::PlatformParamModeOption(args->lever_arm, "--lever-arm");
-    if (given("--boresight")) p->boresight = triangulation::PlatformParamModeOption(args->boresight, "--boresight");
+    if (given("--lever-arm"))
+      p->lever_arm = triangulation::PlatformParamModeOption(args->lever_arm, "--lever-arm");
+    if (given("--boresight"))
+      p->boresight = triangulation::PlatformParamModeOption(args->boresight, "--boresight");
     if (given("--gnss-time-offset"))
-      p->time_offset = triangulation::PlatformParamModeOption(args->time_offset, "--gnss-time-offset");
+      p->time_offset =
+          triangulation::PlatformParamModeOption(args->time_offset, "--gnss-time-offset");
     if (given("--lever-arm-sigma-m")) p->lever_arm_sigma_m = args->lever_arm_sigma_m;
-    if (given("--boresight-sigma-deg")) p->boresight_sigma_rad = args->boresight_sigma_deg * M_PI / 180.0;
-    if (given("--gnss-time-offset-sigma-ms")) p->time_offset_sigma_s = args->time_offset_sigma_ms * 1e-3;
-    for (const char* name : {"--lever-arm-m", "--lever-arm", "--lever-arm-sigma-m", "--boresight-deg",
-                             "--boresight", "--boresight-sigma-deg", "--gnss-time-offset-ms",
-                             "--gnss-time-offset", "--gnss-time-offset-sigma-ms"})
+    if (given("--boresight-sigma-deg"))
+      p->boresight_sigma_rad = args->boresight_sigma_deg * M_PI / 180.0;
+    if (given("--gnss-time-offset-sigma-ms"))
+      p->time_offset_sigma_s = args->time_offset_sigma_ms * 1e-3;
+    for (const char* name : {"--lever-arm-m",
+                             "--lever-arm",
+                             "--lever-arm-sigma-m",
+                             "--boresight-deg",
+                             "--boresight",
+                             "--boresight-sigma-deg",
+                             "--gnss-time-offset-ms",
+                             "--gnss-time-offset",
+                             "--gnss-time-offset-sigma-ms"})
       if (given(name)) {
         p->source = p->source.empty() ? "options" : p->source + " and options";
         triangulation::ValidatePlatform(*p);
@@ -261,22 +288,26 @@ CommandRun SetupAdjust(CLI::App& app) {
     const bool other_model_names = !args->joint.Requested();
     const bool auto_free = args->self_calibration == "auto";
     if (auto_free && args->joint.Requested())
-      throw ConfigError("--self-calibration auto: not with --joint-stitching (give the list, e.g. "
-                        "the `self_calibration_choice.chosen` of an auto run)");
+      throw ConfigError(
+          "--self-calibration auto: not with --joint-stitching (give the list, e.g. "
+          "the `self_calibration_choice.chosen` of an auto run)");
     const std::string free_text = auto_free ? "all" : args->self_calibration;
-    if (!other_model_names)
-      options.free_interior = triangulation::ParseSelfCalibration(free_text);
+    if (!other_model_names) options.free_interior = triangulation::ParseSelfCalibration(free_text);
     options.Validate();
     CheckOutputFile(args->out, "--out");
     if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
     FindCameraFormat(args->camera_format, "--camera-format");
     if (args->joint.Requested() && args->camera_format != "aerocal")
-      throw ConfigError("--camera-format: the joint adjustment writes our camera file only (aerocal)");
+      throw ConfigError(
+          "--camera-format: the joint adjustment writes our camera file only (aerocal)");
     if (args->joint.Requested() && args->compare)
-      throw ConfigError("--compare and --joint-stitching do not combine (`aerocal flight` runs and compares both)");
-    triangulation::Project input = triangulation::ReadProject(args->project, args->default_sigma_px);
-    const bool self_calibrating = args->compare || (args->self_calibration != "none" &&
-                                                    !args->self_calibration.empty());
+      throw ConfigError(
+          "--compare and --joint-stitching do not combine (`aerocal flight` runs and compares "
+          "both)");
+    triangulation::Project input =
+        triangulation::ReadProject(args->project, args->default_sigma_px);
+    const bool self_calibrating =
+        args->compare || (args->self_calibration != "none" && !args->self_calibration.empty());
     const calib::CameraModelId model =
         self_calibrating ? CamerasModel(input) : calib::Camera::Model::kId;
     if (other_model_names) {
@@ -285,45 +316,52 @@ CommandRun SetupAdjust(CLI::App& app) {
     }
     apply_platform(&input.platform);
     if (args->joint.Requested())
-      return RunJointAdjust(args->joint, options, input, args->project, args->out, args->write_camera);
+      return RunJointAdjust(
+          args->joint, options, input, args->project, args->out, args->write_camera);
     const triangulation::ObjectFrame frame(input.frame);
     const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
-    const bool rig_option_given = std::any_of(
-        rig_options.begin(), rig_options.end(), [](const CLI::Option* o) { return o->count() > 0; });
+    const bool rig_option_given = std::any_of(rig_options.begin(),
+                                              rig_options.end(),
+                                              [](const CLI::Option* o) { return o->count() > 0; });
     if (!input.rigs.empty()) {
       const std::string rig = "rig project (camera '" + input.rigs.begin()->first + "')";
       if (args->compare)
-        throw ConfigError("--compare: not available for a " + rig + ": its conventional reference "
+        throw ConfigError("--compare: not available for a " + rig +
+                          ": its conventional reference "
                           "run is a frame-camera adjustment (run adjust with and without "
                           "--self-calibration instead)");
       if (auto_free)
-        throw ConfigError("--self-calibration auto: not available for a " + rig + " (give the "
+        throw ConfigError("--self-calibration auto: not available for a " + rig +
+                          " (give the "
                           "parameters to calibrate)");
       if (options.robust_start)
-        throw ConfigError("--robust-start: not available for a " + rig + ": the robust start "
+        throw ConfigError("--robust-start: not available for a " + rig +
+                          ": the robust start "
                           "re-adjusts frame cameras only (reject blunders with data snooping, the "
                           "default)");
       if (input.rigs.size() > 1) {
         std::string names;
         for (const auto& [id, unused] : input.rigs) names += (names.empty() ? "" : ", ") + id;
-        throw ConfigError(args->project + ": rig cameras " + names + ": the rig bundle takes one "
+        throw ConfigError(args->project + ": rig cameras " + names +
+                          ": the rig bundle takes one "
                           "rig per project (adjust each rig's exposures in a project of its own)");
       }
-      return RunRigAdjust(args->rig, options, input, project, frame, args->project, args->out,
-                          args->write_camera);
+      return RunRigAdjust(
+          args->rig, options, input, project, frame, args->project, args->out, args->write_camera);
     }
     if (rig_option_given)
-      throw ConfigError(args->project + ": the --rig-* options need a rig camera file (a camera "
-                                        "file with a rig section)");
+      throw ConfigError(args->project +
+                        ": the --rig-* options need a rig camera file (a camera "
+                        "file with a rig section)");
     if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
       throw ConfigError(
           "--write-camera needs a self-calibrating run (--self-calibration or --compare)");
 
     // Big blocks take minutes: a progress bar of the adjustment stages (terminal only).
-    const int stages = (auto_free && !options.free_interior.empty()
-                            ? triangulation::AutoFreeSetRounds(options)
-                            : triangulation::AdjustStages(options)) +
-                       (args->compare ? triangulation::BlockAdjustment::kRunStages : 0);
+    const int stages =
+        (auto_free && !options.free_interior.empty() ? triangulation::AutoFreeSetRounds(options)
+                                                     : triangulation::AdjustStages(options)) +
+        (args->compare ? triangulation::BlockAdjustment::kRunStages : 0);
     Progress progress("adjust", stages);
     auto run = [&](const std::vector<std::string>& free) {
       auto o = options;
@@ -364,10 +402,11 @@ CommandRun SetupAdjust(CLI::App& app) {
     if (!args->write_camera.empty() && main.valid)
       json["camera_written_from"] = {
           {"adjustment", main.free_interior.empty() ? "conventional" : "self_calibration"},
-          {"reason", main.free_interior.empty()
-                         ? "the adjustment run (no interior parameter estimated: the camera file's "
-                           "interior with the adjustment's frame)"
-                         : "the self-calibrating adjustment (--self-calibration)"}};
+          {"reason",
+           main.free_interior.empty()
+               ? "the adjustment run (no interior parameter estimated: the camera file's "
+                 "interior with the adjustment's frame)"
+               : "the self-calibrating adjustment (--self-calibration)"}};
     json["valid"] = main.valid;
     json["invalid_reasons"] = main.invalid_reasons;
     // Exit 3 (results written, valid: false) when the run must not be trusted; the camera file
@@ -376,8 +415,10 @@ CommandRun SetupAdjust(CLI::App& app) {
       for (const auto& estimate : main.cameras) {
         const std::string path =
             CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);
-        WriteCameraInFormat(path, triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate),
-                            args->camera_format, &estimate.sigma);
+        WriteCameraInFormat(path,
+                            triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate),
+                            args->camera_format,
+                            &estimate.sigma);
         std::printf("camera %s -> %s\n", estimate.id.c_str(), path.c_str());
       }
     });

@@ -1,18 +1,9 @@
 // aerocal camera: camera files in other tools' languages (issue 15).
-// `camera convert --from F --to G IN OUT`: read IN in format F into that format's own model, express
-// it in G's model (exact where the models are equivalent, else a least-squares fit over the format
-// whose residual is printed and reported), carry a covariance through, write OUT in format G.
-// `camera show --from F IN`: the parameters, a table in our convention (CONVENTIONS.md) and the
+// `camera convert --from F --to G IN OUT`: read IN in format F into that format's own model,
+// express it in G's model (exact where the models are equivalent, else a least-squares fit over the
+// format whose residual is printed and reported), carry a covariance through, write OUT in format
+// G. `camera show --from F IN`: the parameters, a table in our convention (CONVENTIONS.md) and the
 // distortion over the format (a profile table; --plot writes an SVG plot).
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <memory>
-#include <sstream>
-
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_model_json.h"
 #include "calib/camera/convert_camera.h"
 #include "calib/camera/distortion_folding.h"
@@ -26,6 +17,15 @@
 #include "tools/option_ranges.h"
 #include "tools/output_set.h"
 
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <sstream>
+
 namespace aerocal::tools {
 namespace {
 
@@ -37,16 +37,20 @@ struct ReadArgs {
   int width = 0, height = 0;
   double pixel_mm = 0;
   void Add(CLI::App* app) {
-    app->add_option("--from", from,
+    app->add_option("--from",
+                    from,
                     "Format of IN: " + CameraFormatNames() +
                         ", or auto (the one format the content looks like)")
         ->required();
-    app->add_option("--camera", camera_id,
+    app->add_option("--camera",
+                    camera_id,
                     "Which camera of a file holding several (COLMAP id, Metashape sensor id, "
                     "OpenSfM/Kalibr key, rig head, OpenCV stereo 1/2, Pix4D image, DJI record "
                     "file/date/number, DBAT id or report CameraN)");
-    app->add_option("--width", width, "Image width in px where the file has none (checked "
-                                      "against the file where it has one)")
+    app->add_option("--width",
+                    width,
+                    "Image width in px where the file has none (checked "
+                    "against the file where it has one)")
         ->check(FiniteRange(1, 1000000));
     app->add_option("--height", height, "Image height in px, as --width")
         ->check(FiniteRange(1, 1000000));
@@ -84,7 +88,8 @@ int RunConvert(const ConvertArgs& a) {
   const CameraFile source = a.read.Read();
   calib::FormatTarget target = to.target(source.camera);
   if (!a.model.empty()) {
-    if (a.to != "aerocal") throw ConfigError("--model: only with --to aerocal (other formats have their model)");
+    if (a.to != "aerocal")
+      throw ConfigError("--model: only with --to aerocal (other formats have their model)");
     const std::string name = a.model == "brown10" ? "brown_fraser_10" : a.model;
     const auto id = calib::CameraModelFromName(name);
     if (!id)
@@ -109,15 +114,18 @@ int RunConvert(const ConvertArgs& a) {
                       " holds no correlations: dropped)");
     else if (a.to != "metashape") {
       notes.push_back("covariance dropped: " + a.to + " (" +
-                      std::string(calib::CameraModelName(written.camera.model)) +
-                      ") holds none");
+                      std::string(calib::CameraModelName(written.camera.model)) + ") holds none");
       written.covariance.reset();
     }
   }
   const std::string model(calib::CameraModelName(r.camera.model));
-  std::printf("%s (%s, %s) -> %s (%s, %s): %s\n", a.read.in.c_str(), a.read.used.c_str(),
-              std::string(calib::CameraModelName(source.camera.model)).c_str(), a.out.c_str(),
-              a.to.c_str(), model.c_str(),
+  std::printf("%s (%s, %s) -> %s (%s, %s): %s\n",
+              a.read.in.c_str(),
+              a.read.used.c_str(),
+              std::string(calib::CameraModelName(source.camera.model)).c_str(),
+              a.out.c_str(),
+              a.to.c_str(),
+              model.c_str(),
               r.exact ? "exact (closed form)" : "least-squares fit over the format");
   std::printf("%s\n", DescribeConversion(r).c_str());
   for (const auto& note : notes) std::printf("note: %s\n", note.c_str());
@@ -147,8 +155,10 @@ int RunConvert(const ConvertArgs& a) {
   if (!a.report.empty()) WriteResult(set.StagePath(a.report), "camera_conversion", report);
   if (!r.acceptable) {
     if (!a.report.empty()) set.Commit({});
-    LogWarning("conversion_residual: " + DescribeConversion(r) + (r.residual.failed_points ? " (" +
-               std::to_string(r.residual.failed_points) + " points not invertible)" : "") +
+    LogWarning("conversion_residual: " + DescribeConversion(r) +
+               (r.residual.failed_points
+                    ? " (" + std::to_string(r.residual.failed_points) + " points not invertible)"
+                    : "") +
                " exceeds --max-residual-px " + FormatNumber(a.max_residual_px) + "; " + a.out +
                " not written");
     return kExitNotConverged;
@@ -167,30 +177,36 @@ struct ShowArgs {
 
 // Distortion at a measured pixel: the pixel minus the pinhole image of the same ray (principal
 // distance, principal point of the model's OpenCV form, no affinity), px.
-Eigen::Vector2d DistortionAt(const calib::ModelCamera& camera, const Eigen::Vector2d& pp,
-                             const Eigen::Vector2d& pixel, bool* ok) {
+Eigen::Vector2d DistortionAt(const calib::ModelCamera& camera,
+                             const Eigen::Vector2d& pp,
+                             const Eigen::Vector2d& pixel,
+                             bool* ok) {
   Eigen::Vector2d ideal;
   *ok = camera.IdealFromPixel(pixel, &ideal);
   const double p = camera.frame.pixel_size_mm;
   return pixel - (pp + Eigen::Vector2d(ideal.x() / p, -ideal.y() / p));
 }
 
-std::string Svg(const calib::ModelCamera& camera, const Eigen::Vector2d& pp,
-                const std::vector<std::pair<double, double>>& profile, const std::string& title) {
+std::string Svg(const calib::ModelCamera& camera,
+                const Eigen::Vector2d& pp,
+                const std::vector<std::pair<double, double>>& profile,
+                const std::string& title) {
   std::ostringstream s;
   const double W = camera.frame.width_px, H = camera.frame.height_px;
   double max_d = 1e-12, max_r = 1e-12;
   for (const auto& [r, d] : profile) max_d = std::max(max_d, d), max_r = std::max(max_r, r);
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"900\" height=\"420\" font-family=\"sans-serif\" font-size=\"12\">\n"
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"900\" height=\"420\" "
+       "font-family=\"sans-serif\" font-size=\"12\">\n"
     << "<text x=\"10\" y=\"18\">" << title << "</text>\n";
   // Left: |distortion| (px) against the distance from the principal point (px).
   const double x0 = 60, y0 = 380, w = 340, h = 320;
   s << "<rect x=\"" << x0 << "\" y=\"" << y0 - h << "\" width=\"" << w << "\" height=\"" << h
     << "\" fill=\"none\" stroke=\"black\"/>\n<polyline fill=\"none\" stroke=\"blue\" points=\"";
   for (const auto& [r, d] : profile) s << x0 + w * r / max_r << "," << y0 - h * d / max_d << " ";
-  s << "\"/>\n<text x=\"" << x0 << "\" y=\"" << y0 + 16 << "\">radius 0 .. " << FormatNumber(max_r, 5)
-    << " px (to the farthest corner)</text>\n<text x=\"" << x0 << "\" y=\"" << y0 - h - 6
-    << "\">|distortion| 0 .. " << FormatNumber(max_d, 4) << " px</text>\n";
+  s << "\"/>\n<text x=\"" << x0 << "\" y=\"" << y0 + 16 << "\">radius 0 .. "
+    << FormatNumber(max_r, 5) << " px (to the farthest corner)</text>\n<text x=\"" << x0
+    << "\" y=\"" << y0 - h - 6 << "\">|distortion| 0 .. " << FormatNumber(max_d, 4)
+    << " px</text>\n";
   // Right: distortion vectors over the format, scaled so the longest is one cell.
   const double fx0 = 460, fy0 = 60, fw = 420, fh = fw * H / W;
   const int nx = 15, ny = std::max(3, static_cast<int>(std::lround(15 * H / W)));
@@ -225,7 +241,10 @@ int RunShow(const ShowArgs& a) {
   const calib::ModelCamera& camera = file.camera;
   const calib::PixelFrame& f = camera.frame;
   const std::string model(calib::CameraModelName(camera.model));
-  std::printf("camera %s: %s, %d x %d px, pixel %s\n", file.name.c_str(), model.c_str(), f.width_px,
+  std::printf("camera %s: %s, %d x %d px, pixel %s\n",
+              file.name.c_str(),
+              model.c_str(),
+              f.width_px,
               f.height_px,
               file.pixel_size_known ? (FormatNumber(f.pixel_size_mm) + " mm").c_str()
                                     : "unknown (mm values below are in units of 0.001 mm)");
@@ -235,8 +254,10 @@ int RunShow(const ShowArgs& a) {
     std::string sigma;
     if (file.covariance && (*file.covariance)(i, i) > 0)
       sigma = FormatNumber(std::sqrt((*file.covariance)(i, i)), 6);
-    std::printf("%-6s %24s %-6s %s\n", std::string(table[i].name).c_str(),
-                FormatNumber(camera.params[i], 15).c_str(), std::string(table[i].unit).c_str(),
+    std::printf("%-6s %24s %-6s %s\n",
+                std::string(table[i].name).c_str(),
+                FormatNumber(camera.params[i], 15).c_str(),
+                std::string(table[i].unit).c_str(),
                 sigma.c_str());
   }
   // A lens whose distortion folds inside its format maps two image points to one ray: the table
@@ -244,28 +265,33 @@ int RunShow(const ShowArgs& a) {
   const std::string folding = calib::DistortionFoldingWarning(calib::FindDistortionFolding(camera));
   if (!folding.empty()) std::fprintf(stderr, "warning: %s\n", folding.c_str());
   calib::OpenCvParams cv;
-  calib::VisitCameraModel(camera.model, [&](auto m) {
-    return decltype(m)::ToOpenCv(camera.params.data(), f, &cv);
-  });
+  calib::VisitCameraModel(
+      camera.model, [&](auto m) { return decltype(m)::ToOpenCv(camera.params.data(), f, &cv); });
   using O = calib::OpenCvModel;
   const Eigen::Vector2d pp(cv[O::kCx], cv[O::kCy]);
   const double p = f.pixel_size_mm;
   std::printf("our convention (docs/conventions.md: photo frame at the format centre, y up):\n");
-  std::printf("  c  = %s mm (%s px)\n", FormatNumber(camera.PrincipalDistanceMm(), 10).c_str(),
+  std::printf("  c  = %s mm (%s px)\n",
+              FormatNumber(camera.PrincipalDistanceMm(), 10).c_str(),
               FormatNumber(camera.PrincipalDistanceMm() / p, 10).c_str());
   std::printf("  x0 = %s mm (%s px from the centre)\n",
               FormatNumber((pp.x() - 0.5 * (f.width_px - 1)) * p, 10).c_str(),
               FormatNumber(pp.x() - 0.5 * (f.width_px - 1), 10).c_str());
-  std::printf("  y0 = %s mm (%s px, y up)\n", FormatNumber(-(pp.y() - 0.5 * (f.height_px - 1)) * p, 10).c_str(),
+  std::printf("  y0 = %s mm (%s px, y up)\n",
+              FormatNumber(-(pp.y() - 0.5 * (f.height_px - 1)) * p, 10).c_str(),
               FormatNumber(-(pp.y() - 0.5 * (f.height_px - 1)), 10).c_str());
   std::printf("  fx / fy - 1 = %s (our B1 after a conversion)\n",
               FormatNumber(cv[O::kFx] / cv[O::kFy] - 1.0, 6).c_str());
   // Profile: along the lines from the principal point to the four corners.
-  std::printf("distortion (pixel minus the pinhole image of its ray), max over the 4 corner "
-              "directions:\n  %-8s %12s %12s\n", "r/r_max", "r px", "|d| px");
+  std::printf(
+      "distortion (pixel minus the pinhole image of its ray), max over the 4 corner "
+      "directions:\n  %-8s %12s %12s\n",
+      "r/r_max",
+      "r px",
+      "|d| px");
   std::vector<std::pair<double, double>> profile;
-  const Eigen::Vector2d corners[4] = {{0, 0}, {f.width_px - 1.0, 0}, {0, f.height_px - 1.0},
-                                      {f.width_px - 1.0, f.height_px - 1.0}};
+  const Eigen::Vector2d corners[4] = {
+      {0, 0}, {f.width_px - 1.0, 0}, {0, f.height_px - 1.0}, {f.width_px - 1.0, f.height_px - 1.0}};
   double r_max = 0;
   for (const auto& c : corners) r_max = std::max(r_max, (c - pp).norm());
   for (int k = 0; k <= 40; ++k) {
@@ -292,24 +318,29 @@ int RunShow(const ShowArgs& a) {
 CommandRun Setup(CLI::App& app) {
   app.require_subcommand(1);
   auto convert = std::make_shared<ConvertArgs>();
-  CLI::App* cv = app.add_subcommand(
-      "convert", "A camera file in another tool's format: exact where the models are "
-                 "equivalent, else a least-squares fit with its residual");
+  CLI::App* cv =
+      app.add_subcommand("convert",
+                         "A camera file in another tool's format: exact where the models are "
+                         "equivalent, else a least-squares fit with its residual");
   cv->option_defaults()->always_capture_default();
   convert->read.Add(cv);
   cv->add_option("--to", convert->to, "Format of OUT: " + CameraFormatNames())->required();
   cv->add_option("IN", convert->read.in, "Input camera file")->required();
   cv->add_option("OUT", convert->out, "Output camera file (written atomically)")->required();
-  cv->add_option("--model", convert->model,
+  cv->add_option("--model",
+                 convert->model,
                  "With --to aerocal: the registry model to write (e.g. brown10 = brown_fraser_10, "
                  "opencv, metashape_frame); default: the source's own model");
-  cv->add_option("--report", convert->report,
+  cv->add_option("--report",
+                 convert->report,
                  "JSON: {exact, acceptable, residual_px: {rms, max, max_at, max_inner80}, notes}");
-  cv->add_option("--max-residual-px", convert->max_residual_px,
+  cv->add_option("--max-residual-px",
+                 convert->max_residual_px,
                  "A conversion leaving more (max over the format, px) is an error: exit 3, OUT "
                  "not written")
       ->check(PositiveUpTo(1e6));
-  cv->add_option("--max-coefficients", convert->max_coefficients,
+  cv->add_option("--max-coefficients",
+                 convert->max_coefficients,
                  "OpenCV-form targets (opencv, ros, dji, colmap) reached by a fit: at most this "
                  "many distortion coefficients, 4 (k1 k2 p1 p2), 5 (+ k3) or 8 (+ k4-k6); the "
                  "fewest meeting --max-residual-px are written, each choice's residual printed")
@@ -331,7 +362,8 @@ CommandRun Setup(CLI::App& app) {
 
 }  // namespace
 
-AEROCAL_REGISTER_COMMAND(camera, "camera",
+AEROCAL_REGISTER_COMMAND(camera,
+                         "camera",
                          "Camera files in other tools' formats: convert (with how exact) and show",
                          Setup);
 

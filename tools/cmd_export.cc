@@ -36,7 +36,8 @@ int WriteTables(const ExportArgs& args) {
   const char* env = std::getenv("AEROCAL_TABLES_SCRIPT");
   const std::string script = env ? env : AEROCAL_TABLES_SCRIPT;
   if (!RunPythonScript(script, script_args)) {
-    std::fprintf(stderr, "error: the tables could not be written (%s)\n",
+    std::fprintf(stderr,
+                 "error: the tables could not be written (%s)\n",
                  PythonCommandLine(script, script_args).c_str());
     return kExitInternal;
   }
@@ -45,17 +46,22 @@ int WriteTables(const ExportArgs& args) {
 
 CommandRun SetupExport(CLI::App& app) {
   auto args = std::make_shared<ExportArgs>();
-  app.add_option("--project", args->project,
+  app.add_option("--project",
+                 args->project,
                  "The project adjusted (its frame: {crs: ...}); required by --write-crs, with "
                  "--tables it names the GeoJSON's CRS");
-  app.add_option("--result", args->result, "result.json of aerocal adjust (--tables: also of flight)")
+  app.add_option(
+         "--result", args->result, "result.json of aerocal adjust (--tables: also of flight)")
       ->required();
-  auto* write_crs = app.add_option("--write-crs", args->write_crs,
-                                   "CRS to write (EPSG code, compound EPSG:A+B, WKT or PROJ string)");
-  auto* out = app.add_option("--out", args->out,
-                             "Output folder: exposures, points and check-point errors in --write-crs");
+  auto* write_crs =
+      app.add_option("--write-crs",
+                     args->write_crs,
+                     "CRS to write (EPSG code, compound EPSG:A+B, WKT or PROJ string)");
+  auto* out = app.add_option(
+      "--out", args->out, "Output folder: exposures, points and check-point errors in --write-crs");
   auto* tables = app.add_option(
-      "--tables", args->tables,
+      "--tables",
+      args->tables,
       "Output folder: every table of the result as CSV (exposures, points, point errors, "
       "residuals with w and r, camera parameters with sigmas and correlations) and the point "
       "errors as GeoJSON, one subfolder per adjustment (tools/report/aerocal_tables.py)");
@@ -64,7 +70,8 @@ CommandRun SetupExport(CLI::App& app) {
   tables->excludes(write_crs);
   return [args]() {
     if (!args->tables.empty()) return WriteTables(*args);
-    if (args->write_crs.empty()) throw ConfigError("export: give --write-crs and --out, or --tables");
+    if (args->write_crs.empty())
+      throw ConfigError("export: give --write-crs and --out, or --tables");
     if (args->project.empty()) throw ConfigError("--write-crs: needs --project");
     CheckOutputFolder(args->out, "--out");
     const triangulation::Project project = triangulation::ReadProject(args->project);
@@ -75,7 +82,8 @@ CommandRun SetupExport(CLI::App& app) {
       throw InputError(args->result + ": not an aerocal adjust result (" + e.what() + ")");
     }
     std::printf("wrote %s/exposures.csv, points.csv (%s), check_errors.geojson, crs.txt\n",
-                args->out.c_str(), args->write_crs.c_str());
+                args->out.c_str(),
+                args->write_crs.c_str());
     return kExitOk;
   };
 }

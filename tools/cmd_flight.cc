@@ -18,8 +18,10 @@ CommandRun SetupFlight(CLI::App& app) {
 
 }  // namespace
 
-AEROCAL_REGISTER_COMMAND(flight, "flight",
-                         "Calibrate a flight: stitching, conventional / self-calibrating / joint adjustment, report",
-                         SetupFlight);
+AEROCAL_REGISTER_COMMAND(
+    flight,
+    "flight",
+    "Calibrate a flight: stitching, conventional / self-calibrating / joint adjustment, report",
+    SetupFlight);
 
 }  // namespace aerocal::tools

@@ -1,5 +1,6 @@
 // aerocal import: converts blocks from other tools (COLMAP text model, DBAT / PhotoModeler marks,
-// OpenDroneMap gcp_list.txt, a drone flight's images) once into the FORMATS.md block files (triangulation/import).
+// OpenDroneMap gcp_list.txt, a drone flight's images) once into the FORMATS.md block files
+// (triangulation/import).
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
@@ -36,19 +37,29 @@ struct MatchArgs {
 };
 
 void AddMatchOptions(CLI::App* images, const std::shared_ptr<MatchArgs>& m) {
-  images->add_option("--match", m->match,
-                     "Tie points after the import: none (default) or colmap (COLMAP's SIFT "
-                     "extraction, matching and mapper, aligned to the GNSS centres; files in OUT/colmap)")
+  images
+      ->add_option(
+          "--match",
+          m->match,
+          "Tie points after the import: none (default) or colmap (COLMAP's SIFT "
+          "extraction, matching and mapper, aligned to the GNSS centres; files in OUT/colmap)")
       ->check(CLI::IsMember({"none", "colmap"}));
   images->add_option("--colmap", m->colmap.program, "COLMAP executable (default: colmap on PATH)");
-  images->add_option("--colmap-matcher", m->colmap.matcher,
-                     "exhaustive (every pair; default) or spatial (pairs near in the EXIF GPS; large flights)")
+  images
+      ->add_option(
+          "--colmap-matcher",
+          m->colmap.matcher,
+          "exhaustive (every pair; default) or spatial (pairs near in the EXIF GPS; large flights)")
       ->check(CLI::IsMember({"exhaustive", "spatial"}));
-  images->add_option("--colmap-max-image-px", m->colmap.max_image_px,
-                     "SIFT on images downscaled to this longer side, px (default 3200)")
+  images
+      ->add_option("--colmap-max-image-px",
+                   m->colmap.max_image_px,
+                   "SIFT on images downscaled to this longer side, px (default 3200)")
       ->check(FiniteRange(100, 100000));
-  images->add_option("--colmap-align-error-m", m->colmap.align_error_m,
-                     "Inlier bound of the model's alignment to the GNSS centres, m (default 10)")
+  images
+      ->add_option("--colmap-align-error-m",
+                   m->colmap.align_error_m,
+                   "Inlier bound of the model's alignment to the GNSS centres, m (default 10)")
       ->check(PositiveUpTo(1e6));
   images->add_option("--sigma-px", m->sigma_px, "Sigma of the tie observations, px (default 1)")
       ->check(PositiveUpTo(100));
@@ -56,20 +67,25 @@ void AddMatchOptions(CLI::App* images, const std::shared_ptr<MatchArgs>& m) {
 
 // --match colmap: COLMAP's tie points added to the imported exposures (colmap_ties.h).
 triangulation::Project MatchWithColmap(const triangulation::ImageImportReport& report,
-                                       const std::string& images_dir, MatchArgs m, const std::string& out) {
+                                       const std::string& images_dir,
+                                       MatchArgs m,
+                                       const std::string& out) {
   m.colmap.work_dir = out + "/colmap";
-  const std::string text = RunColmapMatching(images_dir, triangulation::EcefCentres(report.project), m.colmap);
+  const std::string text =
+      RunColmapMatching(images_dir, triangulation::EcefCentres(report.project), m.colmap);
   triangulation::ColmapImportOptions c;
   c.folder = text;
   c.sigma_px = m.sigma_px;
   c.crs = "EPSG:4978";
   const triangulation::ColmapImportReport model = triangulation::ImportColmapModel(c);
-  triangulation::ColmapTiesReport ties = triangulation::AddColmapTies(report.project, model.project);
+  triangulation::ColmapTiesReport ties =
+      triangulation::AddColmapTies(report.project, model.project);
   for (const std::string& note : ties.notes) std::printf("note: %s\n", note.c_str());
   return ties.project;
 }
 
-void SetupImportImages(CLI::App& app, const std::shared_ptr<std::string>& out,
+void SetupImportImages(CLI::App& app,
+                       const std::shared_ptr<std::string>& out,
                        const std::shared_ptr<CommandRun>& run) {
   CLI::App* images = app.add_subcommand(
       "images", "A drone flight's JPEG/TIFF images: exposures and cameras from their EXIF and XMP");
@@ -77,25 +93,35 @@ void SetupImportImages(CLI::App& app, const std::shared_ptr<std::string>& out,
   auto gnss = std::make_shared<std::vector<double>>();
   auto attitude = std::make_shared<double>(0.0);
   images->add_option("dir", o->folder, "Folder of the images (files directly in it)")->required();
-  images->add_option("--crs", o->crs,
-                     "CRS of the written exposures (EPSG code, compound EPSG:A+B, WKT, PROJ string; "
-                     "default: the images' own, EPSG:4326+5773 or EPSG:4979 by --heights)");
-  images->add_option("--heights", o->heights,
-                     "What the images' altitudes are: egm96 (EXIF: above sea level; default) or "
-                     "ellipsoidal (WGS84)")
+  images->add_option(
+      "--crs",
+      o->crs,
+      "CRS of the written exposures (EPSG code, compound EPSG:A+B, WKT, PROJ string; "
+      "default: the images' own, EPSG:4326+5773 or EPSG:4979 by --heights)");
+  images
+      ->add_option("--heights",
+                   o->heights,
+                   "What the images' altitudes are: egm96 (EXIF: above sea level; default) or "
+                   "ellipsoidal (WGS84)")
       ->check(CLI::IsMember({"egm96", "ellipsoidal"}));
-  images->add_option("--gnss-sigma-m", *gnss,
-                     "Horizontal and vertical sigma (m) of centres without RTK standard deviations "
-                     "(default: none, the centre is not weighted)")
+  images
+      ->add_option("--gnss-sigma-m",
+                   *gnss,
+                   "Horizontal and vertical sigma (m) of centres without RTK standard deviations "
+                   "(default: none, the centre is not weighted)")
       ->expected(2)
       ->delimiter(',')
       ->check(PositiveUpTo(1e6));
-  images->add_option("--attitude-sigma-deg", *attitude,
-                     "Sigma (deg) of the attitude from the gimbal angles (default: none)")
+  images
+      ->add_option("--attitude-sigma-deg",
+                   *attitude,
+                   "Sigma (deg) of the attitude from the gimbal angles (default: none)")
       ->check(PositiveUpTo(360));
-  images->add_option("--pixel-size-mm", o->pixel_size_mm,
-                     "Pixel size, mm (default: EXIF FocalPlaneXResolution, else the 35 mm "
-                     "equivalent focal length)")
+  images
+      ->add_option("--pixel-size-mm",
+                   o->pixel_size_mm,
+                   "Pixel size, mm (default: EXIF FocalPlaneXResolution, else the 35 mm "
+                   "equivalent focal length)")
       ->check(PositiveUpTo(1));
   images->add_option("--out", *out, "Output folder")->required();
   auto match = std::make_shared<MatchArgs>();
@@ -107,14 +133,16 @@ void SetupImportImages(CLI::App& app, const std::shared_ptr<std::string>& out,
       if (*attitude > 0) o->attitude_sigma_deg = *attitude;
       triangulation::ImageImportReport report = triangulation::ImportImages(*o);
       for (const std::string& note : report.notes) std::printf("note: %s\n", note.c_str());
-      if (match->match == "colmap") report.project = MatchWithColmap(report, o->folder, *match, *out);
+      if (match->match == "colmap")
+        report.project = MatchWithColmap(report, o->folder, *match, *out);
       triangulation::WriteImageImport(report, *out);
-      std::printf("imported %zu exposures, %zu cameras from %s -> %s/project.yaml (tags.csv: the "
-                  "tag of every value)\n",
-                  report.project.exposures.size(),
-                  report.project.cameras.size(),
-                  o->folder.c_str(),
-                  out->c_str());
+      std::printf(
+          "imported %zu exposures, %zu cameras from %s -> %s/project.yaml (tags.csv: the "
+          "tag of every value)\n",
+          report.project.exposures.size(),
+          report.project.cameras.size(),
+          o->folder.c_str(),
+          out->c_str());
       if (match->match == "colmap")
         std::printf("COLMAP: %zu tie points, %zu image observations in %zu exposures\n",
                     report.project.points.size(),
@@ -137,11 +165,16 @@ CommandRun SetupImport(CLI::App& app) {
   CLI::App* colmap =
       app.add_subcommand("colmap", "COLMAP text model (cameras.txt, images.txt, points3D.txt)");
   auto c = std::make_shared<triangulation::ColmapImportOptions>();
-  colmap->add_option("--colmap-model", c->folder, "Folder of the COLMAP text model (cameras.txt, images.txt, points3D.txt)")->required();
+  colmap
+      ->add_option("--colmap-model",
+                   c->folder,
+                   "Folder of the COLMAP text model (cameras.txt, images.txt, points3D.txt)")
+      ->required();
   colmap->add_option("--pixel-size-mm", c->pixel_size_mm, "Pixel size, mm (COLMAP has none)")
       ->check(PositiveUpTo(1));
   colmap->add_option("--sigma-px", c->sigma_px, "Image sigma, px")->check(PositiveUpTo(100));
-  colmap->add_option("--crs", c->crs,
+  colmap->add_option("--crs",
+                     c->crs,
                      "CRS of a georeferenced model (EPSG:4978 after model_aligner, or a "
                      "projected CRS): the project gets frame: {crs: ...}");
   colmap->add_option("--out", *out, "Output folder")->required();
@@ -150,7 +183,8 @@ CommandRun SetupImport(CLI::App& app) {
       CheckOutputFolder(*out, "--out");
       const auto report = triangulation::ImportColmapModel(*c);
       for (const auto& note : report.notes) std::printf("%s\n", note.c_str());
-      const auto project = triangulation::UsableImportedBlock(report.project, c->folder + "/images.txt");
+      const auto project =
+          triangulation::UsableImportedBlock(report.project, c->folder + "/images.txt");
       triangulation::WriteProjectFolder(project, *out);
       Report(project, *out);
       return kExitOk;
@@ -176,7 +210,8 @@ CommandRun SetupImport(CLI::App& app) {
   dbat->callback([=] {
     *run = [=] {
       CheckOutputFolder(*out, "--out");
-      const auto project = triangulation::UsableImportedBlock(triangulation::ImportDbat(*d), d->marks);
+      const auto project =
+          triangulation::UsableImportedBlock(triangulation::ImportDbat(*d), d->marks);
       triangulation::WriteProjectFolder(project, *out);
       Report(project, *out);
       return kExitOk;
@@ -199,7 +234,8 @@ CommandRun SetupImport(CLI::App& app) {
       ->check(PositiveUpTo(1000));
   odm->add_option("--pixel-scale", o->pixel_scale, "Full-format px per listed px")
       ->check(PositiveUpTo(1e6));
-  odm->add_option("--crs", o->crs,
+  odm->add_option("--crs",
+                  o->crs,
                   "CRS of the list's coordinates (EPSG code, compound EPSG:A+B, WKT or PROJ "
                   "string; longitude / easting first), e.g. EPSG:4326 for a WGS84 list: the "
                   "project gets frame: {crs: ...} (default: projected, used as given)");
@@ -217,7 +253,8 @@ CommandRun SetupImport(CLI::App& app) {
           subset.crs = o->crs;
           for (const auto& p : triangulation::ImportOdmGcpList(subset).points)
             o->control_ids.insert(p.id);
-          if (o->control_ids.empty()) throw ConfigError("--control: " + *control + " lists no target");
+          if (o->control_ids.empty())
+            throw ConfigError("--control: " + *control + " lists no target");
         } else {
           for (const std::string& id : SplitCommaList(*control)) o->control_ids.insert(id);
         }
@@ -245,10 +282,11 @@ CommandRun SetupImport(CLI::App& app) {
 
 }  // namespace
 
-AEROCAL_REGISTER_COMMAND(import,
-                         "import",
-                         "Convert a COLMAP model, DBAT/PhotoModeler marks, an ODM gcp_list.txt or a "
-                         "drone flight's images into the block files",
-                         SetupImport);
+AEROCAL_REGISTER_COMMAND(
+    import,
+    "import",
+    "Convert a COLMAP model, DBAT/PhotoModeler marks, an ODM gcp_list.txt or a "
+    "drone flight's images into the block files",
+    SetupImport);
 
 }  // namespace aerocal::tools

@@ -4,13 +4,6 @@
 // contrast transfer of bar groups and the limiting frequency at a threshold
 // (stitch/quality/bar_target.h); `quality star` the same per radius of a Siemens star
 // (stitch/quality/siemens_star.h). stitch/quality/README.md.
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
-#include <memory>
-#include <sstream>
-
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
@@ -22,6 +15,13 @@
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <memory>
+#include <sstream>
+
 namespace aerocal::tools {
 namespace {
 
@@ -29,11 +29,15 @@ namespace {
 struct GroundArgs {
   double gsd_m = 0.0, gsd_sigma_m = 0.0, pixel_mm = 0.0;
   void Add(CLI::App* app) {
-    app->add_option("--pixel-size-mm", pixel_mm, "Pixel size (mm): frequencies also in line pairs per mm")
+    app->add_option(
+           "--pixel-size-mm", pixel_mm, "Pixel size (mm): frequencies also in line pairs per mm")
         ->check(PositiveUpTo(1));
-    app->add_option("--gsd-m", gsd_m, "Ground sample distance (m): frequencies as a ground resolved distance")
+    app->add_option("--gsd-m",
+                    gsd_m,
+                    "Ground sample distance (m): frequencies as a ground resolved distance")
         ->check(PositiveUpTo(1e4));
-    app->add_option("--gsd-sigma-m", gsd_sigma_m, "Standard uncertainty of the GSD (m), from the adjustment")
+    app->add_option(
+           "--gsd-sigma-m", gsd_sigma_m, "Standard uncertainty of the GSD (m), from the adjustment")
         ->check(FiniteRange(0, 1e4));
   }
   void Check() const {
@@ -73,8 +77,8 @@ stitch::PixelRegion ParseRegion(const std::string& text, const std::string& opti
   std::istringstream in(text);
   char c1 = 0, c2 = 0, c3 = 0;
   std::string rest;
-  if (!(in >> region.col >> c1 >> region.row >> c2 >> region.width >> c3 >> region.height) || c1 != ',' ||
-      c2 != ',' || c3 != ',' || (in >> rest))
+  if (!(in >> region.col >> c1 >> region.row >> c2 >> region.width >> c3 >> region.height) ||
+      c1 != ',' || c2 != ',' || c3 != ',' || (in >> rest))
     throw ConfigError(option + ": expected col,row,width,height in px (got '" + text + "')");
   return region;
 }
@@ -89,9 +93,11 @@ stitch::BarGroup ParseGroup(const std::string& text) {
   group.frequency_cy_px = std::strtod(text.c_str(), &end);
   if (comma == std::string::npos || end != text.c_str() + comma || !(group.frequency_cy_px > 0.0) ||
       group.frequency_cy_px > 0.5)
-    throw ConfigError("--group: expected frequency (0 < f <= 0.5 cycles/px),col,row,width,height[,x|y] (got '" +
-                      text + "')");
-  if (rest.size() > 2 && (rest.substr(rest.size() - 2) == ",x" || rest.substr(rest.size() - 2) == ",y")) {
+    throw ConfigError(
+        "--group: expected frequency (0 < f <= 0.5 cycles/px),col,row,width,height[,x|y] (got '" +
+        text + "')");
+  if (rest.size() > 2 &&
+      (rest.substr(rest.size() - 2) == ",x" || rest.substr(rest.size() - 2) == ",y")) {
     group.axis = rest.back() == 'x' ? stitch::MtfAxis::kX : stitch::MtfAxis::kY;
     rest.resize(rest.size() - 2);
   }
@@ -105,10 +111,10 @@ std::string Direction(stitch::MtfAxis axis, const std::string& flight_axis) {
   return std::string(stitch::MtfAxisName(axis)) == flight_axis ? "along_track" : "across_track";
 }
 
-
 // `prefix`_lp_per_mm and `prefix`_resolved_distance_m of frequency f (cycles/px); with `u` (the
 // frequency's standard uncertainty, >= 0) also their U (k = 2); without (u < 0) none.
-void AddGround(const GroundArgs& args, double f, double u, const std::string& prefix, nlohmann::json* json) {
+void AddGround(
+    const GroundArgs& args, double f, double u, const std::string& prefix, nlohmann::json* json) {
   if (!std::isfinite(f) || f <= 0.0) return;
   const stitch::GroundResolution g =
       stitch::ToGroundResolution(f, std::max(u, 0.0), args.pixel_mm, args.gsd_m, args.gsd_sigma_m);
@@ -150,10 +156,15 @@ int RunMtf(const MtfArgs& args) {
     edges.push_back(edge);
     determined = determined && std::isfinite(r.mtf50_cy_px);
     if (std::isfinite(r.mtf50_cy_px)) per_axis[r.axis == stitch::MtfAxis::kX ? 0 : 1].push_back(r);
-    std::printf("roi %s: MTF along %s, slant %.2f deg, MTF50 %.4f +- %.4f cycles/px (U, k = 2), "
-                "MTF at Nyquist %.3f\n",
-                args.rois[i].c_str(), std::string(stitch::MtfAxisName(r.axis)).c_str(), r.angle_deg,
-                r.mtf50_cy_px, r.mtf50_expanded_cy_px, r.mtf_nyquist);
+    std::printf(
+        "roi %s: MTF along %s, slant %.2f deg, MTF50 %.4f +- %.4f cycles/px (U, k = 2), "
+        "MTF at Nyquist %.3f\n",
+        args.rois[i].c_str(),
+        std::string(stitch::MtfAxisName(r.axis)).c_str(),
+        r.angle_deg,
+        r.mtf50_cy_px,
+        r.mtf50_expanded_cy_px,
+        r.mtf_nyquist);
   }
   nlohmann::json axes = nlohmann::json::object();
   for (int a = 0; a < 2; ++a) {
@@ -204,8 +215,10 @@ int RunBars(const BarsArgs& args) {
                         {"contrast_transfer", g.contrast_transfer}};
     AddGround(args.ground, g.frequency_cy_px, -1.0, "frequency", &j);
     out_groups.push_back(j);
-    std::printf("bars at %.4f cycles/px: modulation %.4f, contrast transfer %.4f\n", g.frequency_cy_px,
-                g.modulation, g.contrast_transfer);
+    std::printf("bars at %.4f cycles/px: modulation %.4f, contrast transfer %.4f\n",
+                g.frequency_cy_px,
+                g.modulation,
+                g.contrast_transfer);
   }
   const bool determined = std::isfinite(r.limiting_frequency_cy_px);
   nlohmann::json doc = {{"image", args.image},
@@ -215,13 +228,17 @@ int RunBars(const BarsArgs& args) {
                         {"groups", out_groups},
                         {"limit_in_range", r.limit_in_range},
                         {"determined", determined}};
-  doc["limiting_frequency_cy_px"] = determined ? nlohmann::json(r.limiting_frequency_cy_px) : nlohmann::json();
-  if (determined) AddGround(args.ground, r.limiting_frequency_cy_px, -1.0, "limiting", &doc);  // no U yet
+  doc["limiting_frequency_cy_px"] =
+      determined ? nlohmann::json(r.limiting_frequency_cy_px) : nlohmann::json();
+  if (determined)
+    AddGround(args.ground, r.limiting_frequency_cy_px, -1.0, "limiting", &doc);  // no U yet
   args.ground.Write(&doc);
   WriteResult(args.out, "quality_bars", doc);
   if (determined)
-    std::printf("limiting frequency at %.0f %% contrast transfer: %.4f cycles/px%s\n", 100.0 * args.threshold,
-                r.limiting_frequency_cy_px, r.limit_in_range ? "" : " (or higher: every group resolved)");
+    std::printf("limiting frequency at %.0f %% contrast transfer: %.4f cycles/px%s\n",
+                100.0 * args.threshold,
+                r.limiting_frequency_cy_px,
+                r.limit_in_range ? "" : " (or higher: every group resolved)");
   else
     std::printf("no group reaches %.0f %% contrast transfer\n", 100.0 * args.threshold);
   return determined ? kExitOk : kExitNotConverged;
@@ -233,7 +250,8 @@ Eigen::Vector2d ParseCentre(const std::string& text) {
   double col = 0, row = 0;
   char comma = 0;
   std::string rest;
-  if (!(in >> col >> comma >> row) || comma != ',' || (in >> rest) || !std::isfinite(col) || !std::isfinite(row))
+  if (!(in >> col >> comma >> row) || comma != ',' || (in >> rest) || !std::isfinite(col) ||
+      !std::isfinite(row))
     throw ConfigError("--centre: expected col,row in px (got '" + text + "')");
   return {col, row};
 }
@@ -268,20 +286,25 @@ int RunStar(const StarArgs& args) {
     rings.push_back(j);
   }
   const bool determined = std::isfinite(r.limiting_frequency_cy_px);
-  nlohmann::json doc = {{"image", args.image},
-                        {"method", "Siemens star: fundamental modulation per ring, limit at a threshold"},
-                        {"star", {{"centre_px", {star.centre_px.x(), star.centre_px.y()}},
-                                  {"cycles", star.cycles},
-                                  {"outer_radius_px", star.outer_radius_px},
-                                  {"inner_radius_px", star.inner_radius_px}}},
-                        {"options", {{"gamma", args.gamma}, {"threshold", args.threshold},
-                                     {"steps_per_octave", args.steps_per_octave}}},
-                        {"reference_modulation", r.reference_modulation},
-                        {"step_ratio", r.step_ratio},
-                        {"rings", rings},
-                        {"limit_in_range", r.limit_in_range},
-                        {"determined", determined}};
-  doc["limiting_frequency_cy_px"] = determined ? nlohmann::json(r.limiting_frequency_cy_px) : nlohmann::json();
+  nlohmann::json doc = {
+      {"image", args.image},
+      {"method", "Siemens star: fundamental modulation per ring, limit at a threshold"},
+      {"star",
+       {{"centre_px", {star.centre_px.x(), star.centre_px.y()}},
+        {"cycles", star.cycles},
+        {"outer_radius_px", star.outer_radius_px},
+        {"inner_radius_px", star.inner_radius_px}}},
+      {"options",
+       {{"gamma", args.gamma},
+        {"threshold", args.threshold},
+        {"steps_per_octave", args.steps_per_octave}}},
+      {"reference_modulation", r.reference_modulation},
+      {"step_ratio", r.step_ratio},
+      {"rings", rings},
+      {"limit_in_range", r.limit_in_range},
+      {"determined", determined}};
+  doc["limiting_frequency_cy_px"] =
+      determined ? nlohmann::json(r.limiting_frequency_cy_px) : nlohmann::json();
   if (determined) {
     AddGround(args.ground, r.limiting_frequency_cy_px, -1.0, "limiting", &doc);
     doc["limiting_radius_px"] = star.cycles / (2.0 * M_PI * r.limiting_frequency_cy_px);
@@ -289,10 +312,12 @@ int RunStar(const StarArgs& args) {
   args.ground.Write(&doc);
   WriteResult(args.out, "quality_star", doc);
   if (determined)
-    std::printf("limiting frequency at %.0f %% modulation transfer: %.4f cycles/px (radius %.1f px)%s\n",
-                100.0 * args.threshold, r.limiting_frequency_cy_px,
-                star.cycles / (2.0 * M_PI * r.limiting_frequency_cy_px),
-                r.limit_in_range ? "" : " (or higher: every ring resolved)");
+    std::printf(
+        "limiting frequency at %.0f %% modulation transfer: %.4f cycles/px (radius %.1f px)%s\n",
+        100.0 * args.threshold,
+        r.limiting_frequency_cy_px,
+        star.cycles / (2.0 * M_PI * r.limiting_frequency_cy_px),
+        r.limit_in_range ? "" : " (or higher: every ring resolved)");
   else
     std::printf("no ring reaches %.0f %% modulation transfer\n", 100.0 * args.threshold);
   return determined ? kExitOk : kExitNotConverged;
@@ -300,29 +325,37 @@ int RunStar(const StarArgs& args) {
 
 // `quality star`'s options.
 CLI::App* AddStar(CLI::App& app, StarArgs* star) {
-  CLI::App* s = app.add_subcommand(
-      "star", "Siemens star: modulation transfer per radius (frequency) and the limiting frequency at a threshold");
+  CLI::App* s = app.add_subcommand("star",
+                                   "Siemens star: modulation transfer per radius (frequency) and "
+                                   "the limiting frequency at a threshold");
   s->option_defaults()->always_capture_default();
   s->add_option("--image", star->image, "Grey-value image (8 or 16 bit)")->required();
   s->add_option("--centre", star->centre, "The star's centre col,row (px, sub-pixel)")->required();
   s->add_option("--cycles", star->cycles, "Bright + dark sector pairs round the star")
       ->check(FiniteRange(4, 10000))
       ->required();
-  s->add_option("--outer-radius-px", star->outer_radius_px,
+  s->add_option("--outer-radius-px",
+                star->outer_radius_px,
                 "Largest radius measured, inside the star (px; 12 px or more per sector there)")
       ->check(PositiveUpTo(1e5))
       ->required();
-  s->add_option("--inner-radius-px", star->inner_radius_px,
+  s->add_option("--inner-radius-px",
+                star->inner_radius_px,
                 "Smallest radius measured (px; 0: down to 0.5 cycles/px)")
       ->check(FiniteRange(0, 1e5));
   s->add_option("--steps-per-octave", star->steps_per_octave, "Radii per halving of the radius")
       ->check(FiniteRange(2, 96));
-  s->add_option("--threshold", star->threshold, "Modulation transfer defining the limiting frequency, 0 < T < 1")
+  s->add_option("--threshold",
+                star->threshold,
+                "Modulation transfer defining the limiting frequency, 0 < T < 1")
       ->check(FiniteRange(1e-6, 1.0 - 1e-6));
-  s->add_option("--gamma", star->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
+  s->add_option(
+       "--gamma", star->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
       ->check(FiniteRange(1e-6, 10.0));
   star->ground.Add(s);
-  s->add_option("--out", star->out, "Output file: the result JSON (kind quality_star, written atomically)")->required();
+  s->add_option(
+       "--out", star->out, "Output file: the result JSON (kind quality_star, written atomically)")
+      ->required();
   return s;
 }
 
@@ -330,45 +363,63 @@ CommandRun Setup(CLI::App& app) {
   app.require_subcommand(1);
   auto mtf = std::make_shared<MtfArgs>();
   CLI::App* m = app.add_subcommand(
-      "mtf", "Slanted-edge MTF (ISO 12233 e-SFR) of edge regions: MTF50, MTF at Nyquist, U (k = 2)");
+      "mtf",
+      "Slanted-edge MTF (ISO 12233 e-SFR) of edge regions: MTF50, MTF at Nyquist, U (k = 2)");
   m->option_defaults()->always_capture_default();
-  m->add_option("--image", mtf->image, "Grey-value image (8 or 16 bit; colour is converted to grey)")
+  m->add_option(
+       "--image", mtf->image, "Grey-value image (8 or 16 bit; colour is converted to grey)")
       ->required();
-  m->add_option("--roi", mtf->rois,
-                "Edge region col,row,width,height (px, at least 16 x 16), one edge slanted by 1..35 "
-                "deg; repeat for more edges")
+  m->add_option(
+       "--roi",
+       mtf->rois,
+       "Edge region col,row,width,height (px, at least 16 x 16), one edge slanted by 1..35 "
+       "deg; repeat for more edges")
       ->required();
-  m->add_option("--gamma", mtf->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
+  m->add_option(
+       "--gamma", mtf->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
       ->check(FiniteRange(1e-6, 10.0))
       ->capture_default_str();
   m->add_option("--oversampling", mtf->oversampling, "ESF bins per pixel (ISO 12233: 4)")
       ->check(FiniteRange(2, 16))
       ->capture_default_str();
   mtf->ground.Add(m);
-  m->add_option("--flight-axis", mtf->flight_axis, "Image axis of the flight direction (x or y): names "
+  m->add_option("--flight-axis",
+                mtf->flight_axis,
+                "Image axis of the flight direction (x or y): names "
                 "each MTF along or across track")
       ->check(CLI::IsMember({"x", "y"}));
-  m->add_option("--out", mtf->out, "Output file: the result JSON (kind quality_mtf, written atomically)")->required();
+  m->add_option(
+       "--out", mtf->out, "Output file: the result JSON (kind quality_mtf, written atomically)")
+      ->required();
   auto bars = std::make_shared<BarsArgs>();
   CLI::App* b = app.add_subcommand(
-      "bars", "Bar targets: contrast transfer per bar group and the limiting frequency at a threshold");
+      "bars",
+      "Bar targets: contrast transfer per bar group and the limiting frequency at a threshold");
   b->option_defaults()->always_capture_default();
   b->add_option("--image", bars->image, "Grey-value image (8 or 16 bit)")->required();
-  b->add_option("--group", bars->groups,
-                "Bar group frequency,col,row,width,height[,x|y]: its frequency in this image (cycles/px, "
-                "<= 0.5), its region (two periods or more across the bars) and the axis across the bars "
-                "(x: vertical bars, the default); repeat per group")
+  b->add_option(
+       "--group",
+       bars->groups,
+       "Bar group frequency,col,row,width,height[,x|y]: its frequency in this image (cycles/px, "
+       "<= 0.5), its region (two periods or more across the bars) and the axis across the bars "
+       "(x: vertical bars, the default); repeat per group")
       ->required();
-  b->add_option("--bright", bars->bright, "Large bright reference area col,row,width,height")->required();
+  b->add_option("--bright", bars->bright, "Large bright reference area col,row,width,height")
+      ->required();
   b->add_option("--dark", bars->dark, "Large dark reference area col,row,width,height")->required();
-  b->add_option("--threshold", bars->threshold, "Contrast transfer defining the limiting frequency, 0 < T < 1")
+  b->add_option("--threshold",
+                bars->threshold,
+                "Contrast transfer defining the limiting frequency, 0 < T < 1")
       ->check(FiniteRange(1e-6, 1.0 - 1e-6))
       ->capture_default_str();
-  b->add_option("--gamma", bars->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
+  b->add_option(
+       "--gamma", bars->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
       ->check(FiniteRange(1e-6, 10.0))
       ->capture_default_str();
   bars->ground.Add(b);
-  b->add_option("--out", bars->out, "Output file: the result JSON (kind quality_bars, written atomically)")->required();
+  b->add_option(
+       "--out", bars->out, "Output file: the result JSON (kind quality_bars, written atomically)")
+      ->required();
   auto star = std::make_shared<StarArgs>();
   CLI::App* s = AddStar(app, star.get());
   return [mtf, m, bars, b, star, s] {
@@ -381,9 +432,11 @@ CommandRun Setup(CLI::App& app) {
 
 }  // namespace
 
-AEROCAL_REGISTER_COMMAND(quality, "quality",
-                         "Dynamic image resolution: slanted-edge MTF (ISO 12233 e-SFR) with GUM uncertainty, bar "
-                         "targets, Siemens stars",
-                         Setup);
+AEROCAL_REGISTER_COMMAND(
+    quality,
+    "quality",
+    "Dynamic image resolution: slanted-edge MTF (ISO 12233 e-SFR) with GUM uncertainty, bar "
+    "targets, Siemens stars",
+    Setup);
 
 }  // namespace aerocal::tools

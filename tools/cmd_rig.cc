@@ -1,9 +1,40 @@
 // aerocal rig: multi-head rigs (stitch/rig/). `rig stitch`: the per-exposure self-calibrating
 // stitching of a rig block (stitch/rig/self_calibration.h) from a project's head observations.
-// `rig convert`: the head images of one exposure -> the virtual image (stitch/rig/rig_convert.h). `rig error-analysis`: the conversion error analysis
-// of the virtual image (stitch/rig/error_analysis.h) at one target or over a grid of targets,
-// result.json plus histogram / bound-map CSV files and, through tools/report/rig_error_plots.py
-// (matplotlib), their PNG plots.
+// `rig convert`: the head images of one exposure -> the virtual image (stitch/rig/rig_convert.h).
+// `rig error-analysis`: the conversion error analysis of the virtual image
+// (stitch/rig/error_analysis.h) at one target or over a grid of targets, result.json plus histogram
+// / bound-map CSV files and, through tools/report/rig_error_plots.py (matplotlib), their PNG plots.
+
+#include "calib/camera/camera_model_json.h"
+#include "calib/camera/rig_io.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/progress.h"
+#include "calib/core/result_file.h"
+#include "stitch/image_io/image_io.h"
+#include "stitch/resample/tiff_raster.h"
+#include "stitch/rig/dem_grid.h"
+#include "stitch/rig/error_analysis.h"
+#include "stitch/rig/error_analysis_json.h"
+#include "stitch/rig/rig_conversion.h"
+#include "stitch/rig/rig_convert.h"
+#include "stitch/rig/rig_design.h"
+#include "stitch/rig/rig_tie_matching.h"
+#include "stitch/rig/self_calibration.h"
+#include "stitch/rig/self_calibration_json.h"
+#include "stitch/rig/stitched_image.h"
+#include "tools/command_registry.h"
+#include "tools/image_sources.h"
+#include "tools/option_ranges.h"
+#include "tools/output_set.h"
+#include "tools/python_script.h"
+#include "tools/rig_design_document.h"
+#include "tools/rig_stitch_run.h"
+#include "tools/suspect_effect_option.h"
+#include "triangulation/block/block_io.h"
+
+#include <nlohmann/json.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -13,37 +44,6 @@
 #include <map>
 #include <memory>
 #include <optional>
-
-#include <nlohmann/json.hpp>
-
-#include "calib/camera/camera_model_json.h"
-#include "calib/camera/rig_io.h"
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
-#include "calib/core/error.h"
-#include "calib/core/progress.h"
-#include "calib/core/result_file.h"
-#include "stitch/rig/error_analysis.h"
-#include "stitch/rig/error_analysis_json.h"
-#include "stitch/resample/tiff_raster.h"
-#include "stitch/rig/rig_conversion.h"
-#include "stitch/rig/dem_grid.h"
-#include "stitch/rig/rig_convert.h"
-#include "stitch/rig/rig_design.h"
-#include "stitch/rig/self_calibration.h"
-#include "stitch/rig/self_calibration_json.h"
-#include "stitch/rig/rig_tie_matching.h"
-#include "stitch/rig/stitched_image.h"
-#include "stitch/image_io/image_io.h"
-#include "tools/command_registry.h"
-#include "tools/option_ranges.h"
-#include "tools/output_set.h"
-#include "tools/suspect_effect_option.h"
-#include "tools/python_script.h"
-#include "tools/rig_design_document.h"
-#include "tools/rig_stitch_run.h"
-#include "tools/image_sources.h"
-#include "triangulation/block/block_io.h"
 
 namespace aerocal::tools {
 namespace {
@@ -85,7 +85,8 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   const calib::Rig rig = calib::ReadRig(args.camera);
   const stitch::ErrorLimits limits = stitch::ReadErrorLimits(args.limits);
   if (rig.heads.size() < 2)
-    throw InputError(args.camera + ": a rig of one head is an ordinary camera; it has no "
+    throw InputError(args.camera +
+                     ": a rig of one head is an ordinary camera; it has no "
                      "conversion error to analyse");
   double height_m = args.height_m;
   if (height_m == 0.0) {
@@ -95,7 +96,8 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
     height_m = *rig.virtual_camera.height_m;
   }
   if (!(height_m >= 1 && height_m <= 1e5))
-    throw ConfigError("--height-m must be within 1 .. 100000 m (got " + FormatNumber(height_m) + ")");
+    throw ConfigError("--height-m must be within 1 .. 100000 m (got " + FormatNumber(height_m) +
+                      ")");
   if (!(limits.height_m < height_m))
     throw InputError(args.limits + ": the height limit (" + FormatNumber(limits.height_m) +
                      " m) must be below the flying height (" + FormatNumber(height_m) + " m)");
@@ -106,18 +108,19 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   if (args.grid < 0 || args.grid > 200) throw ConfigError("--grid must be within 1..200");
   // Every grid target runs its own Monte-Carlo: the work is grid x grid x samples (x heads).
   if (double(args.grid) * args.grid * args.samples > kMaxGridSamples)
-    throw ConfigError("--grid x --grid x --samples: " + std::to_string(args.grid) + " x " + std::to_string(args.grid) +
-                      " x " + std::to_string(args.samples) + " Monte-Carlo samples are more than 1e9 (fewer "
+    throw ConfigError("--grid x --grid x --samples: " + std::to_string(args.grid) + " x " +
+                      std::to_string(args.grid) + " x " + std::to_string(args.samples) +
+                      " Monte-Carlo samples are more than 1e9 (fewer "
                       "--samples or a coarser --grid)");
   if (!(args.relief_m >= 0)) throw ConfigError("--relief-m must be >= 0");
   if (!(args.relief_m < height_m))
-    throw ConfigError("--relief-m: " + FormatNumber(args.relief_m) + " m of relief reaches the flying height (" +
-                      FormatNumber(height_m) + " m)");
+    throw ConfigError("--relief-m: " + FormatNumber(args.relief_m) +
+                      " m of relief reaches the flying height (" + FormatNumber(height_m) + " m)");
 
   const int reference = rig.ReferenceIndex();
   const stitch::RigExposure nadir;
-  const stitch::RigConverter nominal(rig, nadir,
-                                     stitch::MakeRectificationPlane(rig, nadir, height_m));
+  const stitch::RigConverter nominal(
+      rig, nadir, stitch::MakeRectificationPlane(rig, nadir, height_m));
   int head = -1;
   Eigen::Vector2d virtual_px;
   if (!args.target.empty()) {
@@ -128,7 +131,8 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
     if (head < 0)
       throw ConfigError("--target: head '" + args.target.substr(0, colon) + "' is not in " +
                         args.camera);
-    const auto v = nominal.VirtualFromHead(head, ParsePixel(args.target.substr(colon + 1), "--target"));
+    const auto v =
+        nominal.VirtualFromHead(head, ParsePixel(args.target.substr(colon + 1), "--target"));
     if (!v) throw ConfigError("--target: the pixel does not reach the rectification plane");
     virtual_px = *v;
   } else if (!args.virtual_px.empty()) {
@@ -144,10 +148,11 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
     // Default: the format centre of the first non-reference head.
     head = reference == 0 ? 1 : 0;
     const calib::Camera& camera = rig.heads[head].camera;
-    const auto v = nominal.VirtualFromHead(
-        head, {0.5 * (camera.width_px - 1), 0.5 * (camera.height_px - 1)});
-    if (!v) throw InputError(args.camera + ": the centre of head " + rig.heads[head].id +
-                             " does not reach the rectification plane");
+    const auto v =
+        nominal.VirtualFromHead(head, {0.5 * (camera.width_px - 1), 0.5 * (camera.height_px - 1)});
+    if (!v)
+      throw InputError(args.camera + ": the centre of head " + rig.heads[head].id +
+                       " does not reach the rectification plane");
     virtual_px = *v;
   }
   if (head == reference)
@@ -165,8 +170,8 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
     const std::string what = e.what();
     return what.find("breaks the conversion") == std::string::npos
                ? e
-               : InputError(args.limits + ": " + what + " (rig " + args.camera + ", H = " + FormatNumber(height_m) +
-                            " m)");
+               : InputError(args.limits + ": " + what + " (rig " + args.camera +
+                            ", H = " + FormatNumber(height_m) + " m)");
   };
   if (args.grid > 0) {
     try {
@@ -181,7 +186,8 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
     files.bound_map_csv = stem + "_bound_map.csv";
   } else {
     try {
-      target = stitch::AnalyseTarget(rig, height_m, limits, head, virtual_px, args.samples, args.seed, true);
+      target = stitch::AnalyseTarget(
+          rig, height_m, limits, head, virtual_px, args.samples, args.seed, true);
     } catch (const InputError& e) {
       throw named(e);
     }
@@ -191,24 +197,28 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
     if (!files.histogram_csv.empty()) files.histogram_png = stem + "_histogram.png";
     if (!files.bound_map_csv.empty()) files.bound_map_png = stem + "_bound_map.png";
   }
-  nlohmann::json doc = stitch::ErrorAnalysisToJson(rig, height_m, limits, target, grid.get(),
-                                                   args.relief_m, files);
+  nlohmann::json doc =
+      stitch::ErrorAnalysisToJson(rig, height_m, limits, target, grid.get(), args.relief_m, files);
   doc["camera_models"] = HeadCameraModels(rig);
   // The JSON, its CSV files and plots are one set (tools/output_set.h): staged, then moved into
   // place together; a failing plot replaces nothing of an earlier analysis.
   OutputSet set(out.parent_path().string());
   std::vector<std::string> parts = {out.filename().string()};
-  for (const std::string& name : {files.histogram_csv, files.bound_map_csv, files.histogram_png, files.bound_map_png})
+  for (const std::string& name :
+       {files.histogram_csv, files.bound_map_csv, files.histogram_png, files.bound_map_png})
     if (!name.empty()) parts.push_back(name);
   if (!files.histogram_csv.empty())
-    WriteFileAtomically(set.Staged(files.histogram_csv), stitch::HistogramCsv(*target.monte_carlo, args.bins));
+    WriteFileAtomically(set.Staged(files.histogram_csv),
+                        stitch::HistogramCsv(*target.monte_carlo, args.bins));
   if (!files.bound_map_csv.empty())
     WriteFileAtomically(set.Staged(files.bound_map_csv), stitch::BoundMapCsv(rig, *grid));
   const std::string staged_json = set.Staged(out.filename().string());
   WriteResult(staged_json, "rig_error_analysis", doc);
-  const bool plots = !args.no_plots && !(files.histogram_png.empty() && files.bound_map_png.empty());
+  const bool plots =
+      !args.no_plots && !(files.histogram_png.empty() && files.bound_map_png.empty());
   if (plots && !RunPythonScript(PlotScript(), {staged_json})) {
-    std::fprintf(stderr, "error: the plots could not be drawn (%s); nothing written, an earlier "
+    std::fprintf(stderr,
+                 "error: the plots could not be drawn (%s); nothing written, an earlier "
                  "analysis in the folder is left as it was\n",
                  PythonCommandLine(PlotScript(), {args.out}).c_str());
     return kExitInternal;
@@ -216,31 +226,57 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
   set.Commit(parts);
 
   // Summary for people.
-  std::printf("conversion error at virtual pixel (%.2f, %.2f) = head %s pixel (%.2f, %.2f), "
-              "H = %g m\n",
-              target.virtual_px.x(), target.virtual_px.y(), rig.heads[target.head].id.c_str(),
-              target.head_px.x(), target.head_px.y(), height_m);
-  std::printf("%-12s %10s %10s %10s %10s   (px, ex = d col, ey = -d row)\n", "source", "+ex",
-              "+ey", "-ex", "-ey");
+  std::printf(
+      "conversion error at virtual pixel (%.2f, %.2f) = head %s pixel (%.2f, %.2f), "
+      "H = %g m\n",
+      target.virtual_px.x(),
+      target.virtual_px.y(),
+      rig.heads[target.head].id.c_str(),
+      target.head_px.x(),
+      target.head_px.y(),
+      height_m);
+  std::printf("%-12s %10s %10s %10s %10s   (px, ex = d col, ey = -d row)\n",
+              "source",
+              "+ex",
+              "+ey",
+              "-ex",
+              "-ey");
   for (const auto& row : target.per_source)
-    std::printf("%-12s %10.4f %10.4f %10.4f %10.4f\n", row.source.c_str(), row.plus_px.x(),
-                row.plus_px.y(), row.minus_px.x(), row.minus_px.y());
+    std::printf("%-12s %10.4f %10.4f %10.4f %10.4f\n",
+                row.source.c_str(),
+                row.plus_px.x(),
+                row.plus_px.y(),
+                row.minus_px.x(),
+                row.minus_px.y());
   const auto& all = target.worst_cases.back();
   std::printf("maximum error (all sources, worst corner): |ex| %.3f |ey| %.3f radial %.3f px\n",
-              all.max_abs_px.x(), all.max_abs_px.y(), all.max_radial_px);
+              all.max_abs_px.x(),
+              all.max_abs_px.y(),
+              all.max_radial_px);
   std::printf("linear: sigma %.4f %.4f px, 99.75 %% bound %.3f %.3f px, radial %.3f px\n",
-              target.linear.sigma_px.x(), target.linear.sigma_px.y(), target.linear.bound_px.x(),
-              target.linear.bound_px.y(), target.linear.bound_radial_px);
+              target.linear.sigma_px.x(),
+              target.linear.sigma_px.y(),
+              target.linear.bound_px.x(),
+              target.linear.bound_px.y(),
+              target.linear.bound_radial_px);
   if (target.monte_carlo)
-    std::printf("monte-carlo (n %d, seed %llu): sigma %.4f %.4f px, 99.75 %% bound %.3f %.3f px, "
-                "radial %.3f px, largest %.3f px\n",
-                target.monte_carlo->n, static_cast<unsigned long long>(args.seed),
-                target.monte_carlo->sigma_px.x(), target.monte_carlo->sigma_px.y(),
-                target.monte_carlo->bound_px.x(), target.monte_carlo->bound_px.y(),
-                target.monte_carlo->bound_radial_px, target.monte_carlo->max_radial_px);
+    std::printf(
+        "monte-carlo (n %d, seed %llu): sigma %.4f %.4f px, 99.75 %% bound %.3f %.3f px, "
+        "radial %.3f px, largest %.3f px\n",
+        target.monte_carlo->n,
+        static_cast<unsigned long long>(args.seed),
+        target.monte_carlo->sigma_px.x(),
+        target.monte_carlo->sigma_px.y(),
+        target.monte_carlo->bound_px.x(),
+        target.monte_carlo->bound_px.y(),
+        target.monte_carlo->bound_radial_px,
+        target.monte_carlo->max_radial_px);
   if (grid)
-    std::printf("grid %d x %d: %zu targets, worst shown above; %zu grid points unseen\n", args.grid,
-                args.grid, grid->points.size(), grid->unseen.size());
+    std::printf("grid %d x %d: %zu targets, worst shown above; %zu grid points unseen\n",
+                args.grid,
+                args.grid,
+                grid->points.size(),
+                grid->unseen.size());
   return kExitOk;
 }
 
@@ -274,7 +310,9 @@ int RunConvert(const ConvertArgs& args) {
   const std::vector<std::string> angles = SplitCommaList(args.opk_deg, {true, true});
   for (int i = 0; i < 3; ++i) {
     const auto value = angles.size() == 3 ? ParseDouble(angles[i]) : std::nullopt;
-    if (!value) throw ConfigError("--opk-deg: expected OMEGA,PHI,KAPPA in degrees (got '" + args.opk_deg + "')");
+    if (!value)
+      throw ConfigError("--opk-deg: expected OMEGA,PHI,KAPPA in degrees (got '" + args.opk_deg +
+                        "')");
     exposure.rig_opk_rad[i] = *value * M_PI / 180.0;
   }
   stitch::ResampleOptions options;
@@ -282,8 +320,8 @@ int RunConvert(const ConvertArgs& args) {
   options.fill = args.fill;
   options.strip_rows = args.strip_rows;
   if (options.strip_rows < 1) throw ConfigError("--strip-rows must be > 0");
-  const stitch::RigConverter converter(rig, exposure,
-                                       stitch::MakeRectificationPlane(rig, exposure, height_m));
+  const stitch::RigConverter converter(
+      rig, exposure, stitch::MakeRectificationPlane(rig, exposure, height_m));
   const calib::Camera as_camera = stitch::RigExposureAsSubimageCamera(converter);
   std::vector<std::string> ids;
   for (const auto& head : rig.heads) ids.push_back(head.id);
@@ -295,8 +333,9 @@ int RunConvert(const ConvertArgs& args) {
     throw ConfigError("--fill must fit the " + std::to_string(info.bits) + "-bit images");
   stitch::TiffWriteOptions tiff;
   tiff.description = stitch::MappingDescription(
-      as_camera, args.camera + " at H = " + FormatNumber(height_m) +
-                       " m (plane homographies; heads with distortion add correction grids)");
+      as_camera,
+      args.camera + " at H = " + FormatNumber(height_m) +
+          " m (plane homographies; heads with distortion add correction grids)");
   tiff.force_bigtiff = args.bigtiff;
   tiff.tile_px = args.tile_px;
   std::optional<stitch::DemGrid> dem;  // read before the writer opens --out
@@ -308,21 +347,32 @@ int RunConvert(const ConvertArgs& args) {
       converter, sources, &writer, options, &corrections, dem ? &*dem : nullptr);
   writer.Commit();
   if (corrections.finest_step_px > 0)
-    std::printf("%s: correction grids down to %d px, largest interpolation error %.4f px against "
-                "the exact map\n",
-                dem ? "DEM surface" : "heads with distortion", corrections.finest_step_px,
-                corrections.max_error_px);
-  std::printf("virtual image %d x %d px from %zu heads at H = %g m: %ld px covered, %ld in "
-              "overlaps, %ld filled, %.2f s\n",
-              as_camera.width_px, as_camera.height_px, rig.heads.size(), height_m, report.covered,
-              report.overlap, report.filled, report.seconds);
+    std::printf(
+        "%s: correction grids down to %d px, largest interpolation error %.4f px against "
+        "the exact map\n",
+        dem ? "DEM surface" : "heads with distortion",
+        corrections.finest_step_px,
+        corrections.max_error_px);
+  std::printf(
+      "virtual image %d x %d px from %zu heads at H = %g m: %ld px covered, %ld in "
+      "overlaps, %ld filled, %.2f s\n",
+      as_camera.width_px,
+      as_camera.height_px,
+      rig.heads.size(),
+      height_m,
+      report.covered,
+      report.overlap,
+      report.filled,
+      report.seconds);
   // Where the plane is not the terrain: relief displaces points between heads.
   const int reference = rig.ReferenceIndex();
   for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k)
     if (k != reference && args.relief_m < height_m)
-      std::printf("relief of %g m off the plane: %.3f px between heads %s and %s\n", args.relief_m,
+      std::printf("relief of %g m off the plane: %.3f px between heads %s and %s\n",
+                  args.relief_m,
                   stitch::ReliefDisplacementPx(rig, reference, k, height_m, args.relief_m),
-                  rig.reference_head.c_str(), rig.heads[k].id.c_str());
+                  rig.reference_head.c_str(),
+                  rig.heads[k].id.c_str());
   return kExitOk;
 }
 
@@ -347,7 +397,6 @@ struct StitchArgs {
   CLI::Option* relief_option = nullptr;
 };
 
-
 std::unique_ptr<stitch::RasterSource> OpenHeadImage(const std::string& path) {
   if (fs::path(path).extension() == ".tif" || fs::path(path).extension() == ".tiff")
     return stitch::OpenTiff(path);
@@ -356,9 +405,11 @@ std::unique_ptr<stitch::RasterSource> OpenHeadImage(const std::string& path) {
 
 // The stitched image of every exposure with the refined increments and offsets (stitch/rig/
 // stitched_image.h): <image>.tif and <image>_mask.tif under --stitched-out; the figures as JSON.
-nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig,
+nlohmann::json WriteStitchedImages(const StitchArgs& args,
+                                   const calib::Rig& rig,
                                    const std::vector<stitch::RigStitchExposure>& exposures,
-                                   const stitch::RigStitchResult& result, OutputSet* set) {
+                                   const stitch::RigStitchResult& result,
+                                   OutputSet* set) {
   stitch::StitchedImageOptions options;
   options.balance = !args.no_balance;
   options.feather_px = args.feather_px;
@@ -366,7 +417,8 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
   Progress progress("stitched images", static_cast<long>(exposures.size()));
   for (const auto& e : exposures) {
     progress.Stage(e.image);
-    const auto refined = std::find_if(result.exposures.begin(), result.exposures.end(),
+    const auto refined = std::find_if(result.exposures.begin(),
+                                      result.exposures.end(),
                                       [&](const auto& r) { return r.image == e.image; });
     if (refined == result.exposures.end()) continue;
     stitch::RigExposure pose = e.pose;
@@ -395,7 +447,8 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
                        FormatNumber(e.z_ref_m) + " m)";
     const std::string image_path = args.stitched_out + "/" + e.image + ".tif";
     const std::string mask_path = args.stitched_out + "/" + e.image + "_mask.tif";
-    stitch::TiffWriter image(set->StagePath(image_path), {v.width_px, v.height_px, 1, info.bits}, tiff);
+    stitch::TiffWriter image(
+        set->StagePath(image_path), {v.width_px, v.height_px, 1, info.bits}, tiff);
     tiff.description = "aerocal rig stitch: valid-area mask of " + e.image + " (255 valid)";
     stitch::TiffWriter mask(set->StagePath(mask_path), {v.width_px, v.height_px, 1, 8}, tiff);
     const stitch::StitchedImageReport r =
@@ -404,11 +457,14 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
     mask.Commit();
     nlohmann::json heads = nlohmann::json::array(), zones = nlohmann::json::array();
     for (const auto& h : r.heads)
-      heads.push_back({{"head", h.head}, {"gain", h.gain}, {"offset_dn", h.offset_dn},
-                       {"samples", h.samples}, {"reference", h.reference}});
+      heads.push_back({{"head", h.head},
+                       {"gain", h.gain},
+                       {"offset_dn", h.offset_dn},
+                       {"samples", h.samples},
+                       {"reference", h.reference}});
     const auto zone_json = [](const stitch::OverlapDisagreement& z) {
-      return nlohmann::json{{"zone", z.zone}, {"pixels", z.pixels}, {"rms_dn", z.rms_dn},
-                            {"mean_dn", z.mean_dn}};
+      return nlohmann::json{
+          {"zone", z.zone}, {"pixels", z.pixels}, {"rms_dn", z.rms_dn}, {"mean_dn", z.mean_dn}};
     };
     for (const auto& z : r.zones) zones.push_back(zone_json(z));
     out.push_back({{"image", e.image},
@@ -423,11 +479,18 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args, const calib::Rig& rig
                    {"radiometry", heads},
                    {"overlap_disagreement_dn", {{"all", zone_json(r.overall)}, {"zones", zones}}},
                    {"warnings", r.warnings}});
-    std::printf("stitched %s: %d x %d px, %ld valid, overlap disagreement %.3f DN RMS (head "
-                "against head before blending, %ld px) -> %s\n",
-                e.image.c_str(), r.width_px, r.height_px, r.valid_pixels, r.overall.rms_dn,
-                r.overall.pixels, image_path.c_str());
-    for (const auto& w : r.warnings) std::fprintf(stderr, "warning: %s: %s\n", e.image.c_str(), w.c_str());
+    std::printf(
+        "stitched %s: %d x %d px, %ld valid, overlap disagreement %.3f DN RMS (head "
+        "against head before blending, %ld px) -> %s\n",
+        e.image.c_str(),
+        r.width_px,
+        r.height_px,
+        r.valid_pixels,
+        r.overall.rms_dn,
+        r.overall.pixels,
+        image_path.c_str());
+    for (const auto& w : r.warnings)
+      std::fprintf(stderr, "warning: %s: %s\n", e.image.c_str(), w.c_str());
     progress.Advance();
   }
   return out;
@@ -440,11 +503,13 @@ int RunStitch(const StitchArgs& args) {
     throw ConfigError(std::string(args.match_ties ? "--match-ties" : "--stitched-out") +
                       " needs --images (the folder of the head images)");
   if (!args.images.empty() && args.stitched_out.empty() && !args.match_ties)
-    throw ConfigError("--images needs --stitched-out or --match-ties (what to do with the head "
-                      "images)");
+    throw ConfigError(
+        "--images needs --stitched-out or --match-ties (what to do with the head "
+        "images)");
   CheckTilePx(args.tile_px);
   if (!(args.feather_px >= 1 && args.feather_px <= 255))
-    throw ConfigError("--feather-px must be within 1..255 (got " + std::to_string(args.feather_px) + ")");
+    throw ConfigError("--feather-px must be within 1..255 (got " + std::to_string(args.feather_px) +
+                      ")");
   if (!args.images.empty() && !fs::is_directory(args.images))
     throw ConfigError("--images must be a folder of head images (got '" + args.images + "')");
   RigStitchRequest request;
@@ -453,7 +518,8 @@ int RunStitch(const StitchArgs& args) {
   request.mode = args.mode;
   request.no_snooping = args.no_snooping;
   request.alpha = args.alpha;
-  if (args.increment_sigma_option->count() > 0) request.increment_sigma_arcsec = args.increment_sigma_arcsec;
+  if (args.increment_sigma_option->count() > 0)
+    request.increment_sigma_arcsec = args.increment_sigma_arcsec;
   if (args.dt_sigma_option->count() > 0) request.dt_sigma_ms = args.dt_sigma_ms;
   if (args.relief_option->count() > 0) request.relief_m = args.relief_m;
   request.standard_radius_px = args.standard_radius_px;
@@ -503,20 +569,30 @@ int RunDesign(const DesignArgs& args) {
   if (!args.svg.empty()) WriteFileAtomically(args.svg, stitch::RigDesignSvg(rig, d));
   if (!args.out.empty()) WriteResult(args.out, "rig_design", doc);
 
-  std::printf("rig %s at H = %g m (virtual GSD %.4f m)\n", rig.name.c_str(), height_m,
-              d.virtual_gsd_m);
-  std::printf("%-6s %8s %10s   GSD ratio along / across the tilt: principal point, edges, corners\n",
-              "head", "tilt", "nadir GSD");
+  std::printf(
+      "rig %s at H = %g m (virtual GSD %.4f m)\n", rig.name.c_str(), height_m, d.virtual_gsd_m);
+  std::printf(
+      "%-6s %8s %10s   GSD ratio along / across the tilt: principal point, edges, corners\n",
+      "head",
+      "tilt",
+      "nadir GSD");
   for (const auto& head : d.heads) {
     std::printf("%-6s %7.2f° %9.4fm  ", head.id.c_str(), head.tilt_deg, head.nadir_gsd_m);
     for (const auto& s : head.samples) std::printf(" %.3f/%.3f", s.ratio.x(), s.ratio.y());
     std::printf("\n");
   }
-  std::printf("virtual format needed %.0f x %.0f px (file: %d x %d); covered %.0f m^2; effective "
-              "format %.0f x %.0f px (%.1f x %.1f m)\n",
-              d.covered_box_px.Width(), d.covered_box_px.Height(), v.width_px, v.height_px,
-              d.covered_area_m2, d.effective_px.Width(), d.effective_px.Height(),
-              d.effective_px.Width() * d.virtual_gsd_m, d.effective_px.Height() * d.virtual_gsd_m);
+  std::printf(
+      "virtual format needed %.0f x %.0f px (file: %d x %d); covered %.0f m^2; effective "
+      "format %.0f x %.0f px (%.1f x %.1f m)\n",
+      d.covered_box_px.Width(),
+      d.covered_box_px.Height(),
+      v.width_px,
+      v.height_px,
+      d.covered_area_m2,
+      d.effective_px.Width(),
+      d.effective_px.Height(),
+      d.effective_px.Width() * d.virtual_gsd_m,
+      d.effective_px.Height() * d.virtual_gsd_m);
   std::printf("overlap zones:");
   for (const auto& [zone, area] : d.zone_area_m2) std::printf(" %s %.0f m^2", zone.c_str(), area);
   std::printf("; %zu standard tie positions\n", d.standard_positions.size());
@@ -532,115 +608,177 @@ CommandRun Setup(CLI::App& app) {
       "Monte-Carlo, at one target or over a grid");
   ea->option_defaults()->always_capture_default();
   ea->add_option("--camera", args->camera, "Rig camera file (YAML with a rig section)")->required();
-  ea->add_option("--limits", args->limits,
+  ea->add_option("--limits",
+                 args->limits,
                  "Limits file: limits {principal_point_px, principal_distance_px, angles_arcsec, "
                  "lever_arm_mm, height_m}, sigmas")
       ->required();
-  ea->add_option("--height-m", args->height_m,
+  ea->add_option("--height-m",
+                 args->height_m,
                  "Relative flying height of the rectification plane, m (default: the rig file's "
-                 "virtual.height_m)")->check(FiniteRange(0, 1e5));
-  ea->add_option("--target", args->target,
+                 "virtual.height_m)")
+      ->check(FiniteRange(0, 1e5));
+  ea->add_option("--target",
+                 args->target,
                  "HEAD:COL,ROW: a pixel of a non-reference head, carried into the virtual image by "
                  "the nominal rig (default: the centre of the first non-reference head)");
-  ea->add_option("--virtual", args->virtual_px,
+  ea->add_option("--virtual",
+                 args->virtual_px,
                  "COL,ROW: a virtual pixel, analysed in the first non-reference head that sees it");
-  ea->add_option("--grid", args->grid, "N: an N x N grid of virtual pixels (bound map)")->check(FiniteRange(0, 200));
-  ea->add_option("--samples", args->samples, "Monte-Carlo samples per target (0: none)")->check(FiniteRange(0, 1e7));
-  ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)")->check(SeedCheck());
+  ea->add_option("--grid", args->grid, "N: an N x N grid of virtual pixels (bound map)")
+      ->check(FiniteRange(0, 200));
+  ea->add_option("--samples", args->samples, "Monte-Carlo samples per target (0: none)")
+      ->check(FiniteRange(0, 1e7));
+  ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)")
+      ->check(SeedCheck());
   ea->add_option("--bins", args->bins, "Histogram bins")->check(FiniteRange(1, 10000));
-  ea->add_option("--relief-m", args->relief_m,
-                 "Relief (m off the plane) whose displacement between heads is reported")->check(FiniteRange(0, 1e4));
+  ea->add_option("--relief-m",
+                 args->relief_m,
+                 "Relief (m off the plane) whose displacement between heads is reported")
+      ->check(FiniteRange(0, 1e4));
   ea->add_flag("--no-plots", args->no_plots, "Write JSON and CSV only (no PNG)");
-  ea->add_option("--out", args->out,
-                 "Output file: the result JSON; STEM_histogram.csv/.png or STEM_bound_map.csv/.png beside it")
+  ea->add_option("--out",
+                 args->out,
+                 "Output file: the result JSON; STEM_histogram.csv/.png or STEM_bound_map.csv/.png "
+                 "beside it")
       ->required();
   auto convert = std::make_shared<ConvertArgs>();
   CLI::App* cv = app.add_subcommand(
       "convert", "The images of one rig exposure -> the single-centre virtual image (TIFF)");
   cv->option_defaults()->always_capture_default();
-  cv->add_option("--camera", convert->camera, "Rig camera file (YAML with a rig section)")->required();
+  cv->add_option("--camera", convert->camera, "Rig camera file (YAML with a rig section)")
+      ->required();
   cv->add_option("--images", convert->images, "Head images: A=a.tif,B=b.tif,...")->required();
-  cv->add_option("--height-m", convert->height_m,
+  cv->add_option("--height-m",
+                 convert->height_m,
                  "Relative flying height of the rectification plane, m (default: the rig file's "
-                 "virtual.height_m)")->check(FiniteRange(0, 1e5));
-  cv->add_option("--opk-deg", convert->opk_deg,
+                 "virtual.height_m)")
+      ->check(FiniteRange(0, 1e5));
+  cv->add_option("--opk-deg",
+                 convert->opk_deg,
                  "Rig attitude omega,phi,kappa in degrees (matters for orientation: level)");
-  cv->add_option("--out", convert->out, "Output file: the virtual image (TIFF; BigTIFF beyond 4 GB)")->required();
+  cv->add_option(
+        "--out", convert->out, "Output file: the virtual image (TIFF; BigTIFF beyond 4 GB)")
+      ->required();
   cv->add_option("--interp", convert->interp, "bilinear | bicubic");
-  cv->add_option("--fill", convert->fill, "Grey value of pixels no head covers")->check(FiniteRange(0, 65535));
-  cv->add_option("--strip-rows", convert->strip_rows, "Rows per processing strip (memory bound)")->check(FiniteRange(1, 65536));
-  cv->add_option("--relief-m", convert->relief_m,
-                 "Relief (m off the plane) whose displacement between heads is reported")->check(FiniteRange(0, 1e4));
+  cv->add_option("--fill", convert->fill, "Grey value of pixels no head covers")
+      ->check(FiniteRange(0, 65535));
+  cv->add_option("--strip-rows", convert->strip_rows, "Rows per processing strip (memory bound)")
+      ->check(FiniteRange(1, 65536));
+  cv->add_option("--relief-m",
+                 convert->relief_m,
+                 "Relief (m off the plane) whose displacement between heads is reported")
+      ->check(FiniteRange(0, 1e4));
   cv->add_flag("--bigtiff", convert->bigtiff, "Write BigTIFF even when classic TIFF would do");
-  cv->add_option("--tile-px", convert->tile_px,
-                 "Tiled TIFF: square tiles of N x N px (a multiple of 16, 16..4096); 0: strips")->check(FiniteRange(0, 4096));
-  cv->add_option("--dem", convert->dem,
-                 "DEM (ESRI ASCII grid, object frame of the exposure) as the rectification surface; "
-                 "the plane at --height-m stays the base of the maps");
+  cv->add_option("--tile-px",
+                 convert->tile_px,
+                 "Tiled TIFF: square tiles of N x N px (a multiple of 16, 16..4096); 0: strips")
+      ->check(FiniteRange(0, 4096));
+  cv->add_option(
+      "--dem",
+      convert->dem,
+      "DEM (ESRI ASCII grid, object frame of the exposure) as the rectification surface; "
+      "the plane at --height-m stays the base of the maps");
   auto design = std::make_shared<DesignArgs>();
   CLI::App* ds = app.add_subcommand(
-      "design", "Design figures: GSD change ratios of the tilted heads, virtual format, covered "
-                "area, effective format, overlap zones, standard tie positions, footprint plot");
+      "design",
+      "Design figures: GSD change ratios of the tilted heads, virtual format, covered "
+      "area, effective format, overlap zones, standard tie positions, footprint plot");
   ds->option_defaults()->always_capture_default();
-  ds->add_option("--camera", design->camera, "Rig camera file (YAML with a rig section)")->required();
-  ds->add_option("--height-m", design->height_m,
-                 "Relative flying height, m (default: the rig file's virtual.height_m)")->check(FiniteRange(0, 1e5));
-  ds->add_option("--out", design->out, "Output file: the result JSON (optional; the summary is printed)");
+  ds->add_option("--camera", design->camera, "Rig camera file (YAML with a rig section)")
+      ->required();
+  ds->add_option("--height-m",
+                 design->height_m,
+                 "Relative flying height, m (default: the rig file's virtual.height_m)")
+      ->check(FiniteRange(0, 1e5));
+  ds->add_option(
+      "--out", design->out, "Output file: the result JSON (optional; the summary is printed)");
   ds->add_option("--svg", design->svg, "Footprint plot (SVG, ground metres)");
-  ds->add_option("--grid-cells", design->grid_cells,
-                 "Coverage grid cells along the longer side, 10..4000")->check(FiniteRange(10, 4000));
+  ds->add_option(
+        "--grid-cells", design->grid_cells, "Coverage grid cells along the longer side, 10..4000")
+      ->check(FiniteRange(10, 4000));
   auto stitching = std::make_shared<StitchArgs>();
   CLI::App* st = app.add_subcommand(
-      "stitch", "Self-calibrating stitching of a rig block: per-exposure attitude increments and "
-                "shutter offsets of the heads from the overlap ties, stitching RMS before/after");
+      "stitch",
+      "Self-calibrating stitching of a rig block: per-exposure attitude increments and "
+      "shutter offsets of the heads from the overlap ties, stitching RMS before/after");
   st->option_defaults()->always_capture_default();
-  st->add_option("--camera", stitching->camera,
+  st->add_option("--camera",
+                 stitching->camera,
                  "Rig camera file, the ground calibration (YAML with a rig section, virtual "
                  "orientation level)")
       ->required();
-  st->add_option("--project", stitching->project,
+  st->add_option("--project",
+                 stitching->project,
                  "Project YAML (or folder): exposures.csv with z_ref (and vX,vY,vZ), "
                  "observations.csv with the head column, points.csv (role check: check tie)")
       ->required();
-  st->add_option("--mode", stitching->mode,
+  st->add_option("--mode",
+                 stitching->mode,
                  "line (one dT per head for the flight, angles per exposure) | per-exposure "
                  "(everything per exposure; correlations reported) | angles (dT held at 0)");
-  st->add_option("--out", stitching->out, "Output file: the result JSON (kind rig_stitch)")->required();
+  st->add_option("--out", stitching->out, "Output file: the result JSON (kind rig_stitch)")
+      ->required();
   st->add_flag("--no-snooping", stitching->no_snooping, "No data snooping of the tie observations");
-  st->add_option("--alpha", stitching->alpha, "Family-wise level of the snooping, (0, 1)")->check(FiniteRange(0, 1, true));
-  stitching->increment_sigma_option = st->add_option(
-      "--increment-sigma-arcsec", stitching->increment_sigma_arcsec,
-      "Weighted prior (towards 0) on every increment angle, arcsec > 0 (default: none)")->check(PositiveUpTo(36000));
+  st->add_option("--alpha", stitching->alpha, "Family-wise level of the snooping, (0, 1)")
+      ->check(FiniteRange(0, 1, true));
+  stitching->increment_sigma_option =
+      st->add_option(
+            "--increment-sigma-arcsec",
+            stitching->increment_sigma_arcsec,
+            "Weighted prior (towards 0) on every increment angle, arcsec > 0 (default: none)")
+          ->check(PositiveUpTo(36000));
   stitching->dt_sigma_option =
-      st->add_option("--dt-sigma-ms", stitching->dt_sigma_ms,
-                     "Weighted prior (towards 0) on every time offset, ms > 0 (default: none)")->check(PositiveUpTo(1e4));
-  stitching->relief_option = st->add_option(
-      "--relief-m", stitching->relief_m,
-      "Relief of the block off the plane (m); its displacement between heads is reported")->check(FiniteRange(-1e4, 1e4));
-  st->add_option("--standard-radius-px", stitching->standard_radius_px,
-                 "A tie this close (virtual px) to a standard position of its zone counts for it")->check(PositiveUpTo(1e5));
-  st->add_option("--max-sigma0", stitching->max_sigma0, "sigma0 above: exit 3 (absurd), > 0")->check(PositiveUpTo(1e6));
+      st->add_option("--dt-sigma-ms",
+                     stitching->dt_sigma_ms,
+                     "Weighted prior (towards 0) on every time offset, ms > 0 (default: none)")
+          ->check(PositiveUpTo(1e4));
+  stitching->relief_option =
+      st->add_option(
+            "--relief-m",
+            stitching->relief_m,
+            "Relief of the block off the plane (m); its displacement between heads is reported")
+          ->check(FiniteRange(-1e4, 1e4));
+  st->add_option("--standard-radius-px",
+                 stitching->standard_radius_px,
+                 "A tie this close (virtual px) to a standard position of its zone counts for it")
+      ->check(PositiveUpTo(1e5));
+  st->add_option("--max-sigma0", stitching->max_sigma0, "sigma0 above: exit 3 (absurd), > 0")
+      ->check(PositiveUpTo(1e6));
   AddSuspectEffectOption(*st, &stitching->suspect_effect_limit);
-  st->add_option("--sigma-px", stitching->default_sigma_px,
-                 "Tie sigma (px) where observations.csv gives none")->check(PositiveUpTo(100));
-  st->add_option("--images", stitching->images,
-                 "Folder of the head images <image>_<head>.tif (simulate --rig --render-images writes "
-                 "them under images/); with --stitched-out");
-  st->add_option("--stitched-out", stitching->stitched_out,
+  st->add_option("--sigma-px",
+                 stitching->default_sigma_px,
+                 "Tie sigma (px) where observations.csv gives none")
+      ->check(PositiveUpTo(100));
+  st->add_option(
+      "--images",
+      stitching->images,
+      "Folder of the head images <image>_<head>.tif (simulate --rig --render-images writes "
+      "them under images/); with --stitched-out");
+  st->add_option("--stitched-out",
+                 stitching->stitched_out,
                  "Folder for the stitched level image of every exposure (<image>.tif, resampled "
                  "once with the refined increments and offsets, balanced, blended) and its "
                  "valid-area mask (<image>_mask.tif)");
-  st->add_flag("--match-ties", stitching->match_ties,
+  st->add_flag("--match-ties",
+               stitching->match_ties,
                "Match the ties on the head images under --images (Foerstner + least-squares "
                "matching per overlap zone, on the level plane of the ground calibration and the "
                "POS) instead of reading them from observations.csv (which must have no rows)");
-  st->add_option("--tile-px", stitching->tile_px,
-                 "Stitched images: square TIFF tiles of this size (multiple of 16, 16..4096; 0: strips)")->check(FiniteRange(0, 4096));
-  st->add_flag("--bigtiff", stitching->bigtiff, "Stitched images: BigTIFF even when classic TIFF would do");
-  st->add_flag("--no-balance", stitching->no_balance,
+  st->add_option(
+        "--tile-px",
+        stitching->tile_px,
+        "Stitched images: square TIFF tiles of this size (multiple of 16, 16..4096; 0: strips)")
+      ->check(FiniteRange(0, 4096));
+  st->add_flag(
+      "--bigtiff", stitching->bigtiff, "Stitched images: BigTIFF even when classic TIFF would do");
+  st->add_flag("--no-balance",
+               stitching->no_balance,
                "Stitched images: no radiometric balance (every head gain 1, offset 0)");
-  st->add_option("--feather-px", stitching->feather_px,
-                 "Stitched images: width of the blending ramp at each head's border, 1..255 px")->check(FiniteRange(1, 255));
+  st->add_option("--feather-px",
+                 stitching->feather_px,
+                 "Stitched images: width of the blending ramp at each head's border, 1..255 px")
+      ->check(FiniteRange(1, 255));
   return [args, ea, convert, cv, design, ds, stitching, st] {
     if (st->parsed()) return RunStitch(*stitching);
     if (ds->parsed()) return RunDesign(*design);
@@ -652,7 +790,8 @@ CommandRun Setup(CLI::App& app) {
 
 }  // namespace
 
-AEROCAL_REGISTER_COMMAND(rig, "rig",
+AEROCAL_REGISTER_COMMAND(rig,
+                         "rig",
                          "Multi-head rigs: self-calibrating stitching, conversion to the virtual "
                          "image, its error analysis, design figures",
                          Setup);

@@ -1,8 +1,5 @@
 // aerocal stitch: sub-image mapping adjustment of one frame or a whole flight
 // (stitch/adjustment/, result keys in stitch/io/stitch_result_json.h and stitch/README.md).
-#include <cstdio>
-#include <sstream>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
@@ -14,6 +11,9 @@
 #include "stitch/io/stitch_result_json.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
+
+#include <cstdio>
+#include <sstream>
 
 namespace aerocal::tools {
 namespace {
@@ -43,31 +43,43 @@ void PrintSummary(const stitch::BatchResult& result, const std::string& out) {
         worst_where = "frame " + a.frame + ", sub-image " + s.id;
       }
     if (result.frames.size() <= 10)
-      std::printf("frame %s: %s, sigma0 %.3f px, redundancy %d, %d tie points, %zu rejected, "
-                  "largest corner sigma %.2f px%s\n",
-                  a.frame.c_str(), std::string(calib::MappingModelName(a.model)).c_str(), a.sigma0_px,
-                  a.redundancy, a.n_ties, a.rejected.size(), a.max_corner_sigma_px,
-                  a.converged ? "" : " (NOT converged)");
+      std::printf(
+          "frame %s: %s, sigma0 %.3f px, redundancy %d, %d tie points, %zu rejected, "
+          "largest corner sigma %.2f px%s\n",
+          a.frame.c_str(),
+          std::string(calib::MappingModelName(a.model)).c_str(),
+          a.sigma0_px,
+          a.redundancy,
+          a.n_ties,
+          a.rejected.size(),
+          a.max_corner_sigma_px,
+          a.converged ? "" : " (NOT converged)");
   }
   if (result.frames.size() > 10)
-    std::printf("%zu frames, %d observations rejected as gross errors\n", result.frames.size(), rejected);
+    std::printf(
+        "%zu frames, %d observations rejected as gross errors\n", result.frames.size(), rejected);
   if (!worst_where.empty())
-    std::printf("largest predicted corner sigma: %.2f px (%s)%s\n", worst_corner, worst_where.c_str(),
-                worst_corner > 1.0 ? ": weakly determined, whatever sigma0 says; add reference points or "
-                                     "ties on the outer sub-images"
-                                   : "");
+    std::printf("largest predicted corner sigma: %.2f px (%s)%s\n",
+                worst_corner,
+                worst_where.c_str(),
+                worst_corner > 1.0
+                    ? ": weakly determined, whatever sigma0 says; add reference points or "
+                      "ties on the outer sub-images"
+                    : "");
   if (no_precision > 0)
-    std::printf("warning: %d frame(s) without a precision estimate (see diagnostics)\n", no_precision);
+    std::printf("warning: %d frame(s) without a precision estimate (see diagnostics)\n",
+                no_precision);
   if (single > 0)
-    std::printf("%d point(s) measured in one sub-image only carry no equation and were not used\n", single);
+    std::printf("%d point(s) measured in one sub-image only carry no equation and were not used\n",
+                single);
   std::printf("result: %s\n", out.c_str());
 }
 
 int RunStitch(const StitchArgs& args) {
   CheckOutputFile(args.out, "--out");
   const calib::Camera camera = calib::ReadCamera(args.camera);
-  const stitch::BatchOptions options = stitch::BatchOptionsFromText(
-      camera, args.model, args.base, args.alpha, !args.no_snooping);
+  const stitch::BatchOptions options =
+      stitch::BatchOptionsFromText(camera, args.model, args.base, args.alpha, !args.no_snooping);
   const auto frames = stitch::ReadStitchFrames(camera, args.camera, args.obs, args.sigma_px);
   Progress progress("stitch", static_cast<long>(frames.size()));
   const stitch::BatchResult result = stitch::RunStitchBatch(camera, frames, options, &progress);
@@ -82,14 +94,18 @@ CommandRun Setup(CLI::App& app) {
   auto args = std::make_shared<StitchArgs>();
   app.add_option("--camera", args->camera, "Camera file (YAML) with the sub-images")->required();
   app.add_option("--obs", args->obs, "stitch_obs.csv: one or many frames")->required();
-  app.add_option("--model", args->model,
+  app.add_option("--model",
+                 args->model,
                  "translation | conformal | affine | projective | auto (F test at --alpha)")
       ->capture_default_str();
-  app.add_option("--base", args->base,
+  app.add_option("--base",
+                 args->base,
                  "Comma-separated sub-images that keep the camera file's mapping (the datum)");
-  app.add_option("--sigma-px", args->sigma_px, "A-priori sigma (px) of rows without sigma_px")->check(PositiveUpTo(100))
+  app.add_option("--sigma-px", args->sigma_px, "A-priori sigma (px) of rows without sigma_px")
+      ->check(PositiveUpTo(100))
       ->capture_default_str();
-  app.add_option("--alpha", args->alpha, "Level of the model-choice F test and stability flags")->check(FiniteRange(0, 1, true))
+  app.add_option("--alpha", args->alpha, "Level of the model-choice F test and stability flags")
+      ->check(FiniteRange(0, 1, true))
       ->capture_default_str();
   app.add_flag("--no-snooping", args->no_snooping, "Do not search gross errors");
   app.add_option("--out", args->out, "Output file: the result JSON")->required();
@@ -98,7 +114,9 @@ CommandRun Setup(CLI::App& app) {
 
 }  // namespace
 
-AEROCAL_REGISTER_COMMAND(stitch, "stitch",
-                         "Adjust the sub-image mappings of a multi-CCD camera per frame", Setup);
+AEROCAL_REGISTER_COMMAND(stitch,
+                         "stitch",
+                         "Adjust the sub-image mappings of a multi-CCD camera per frame",
+                         Setup);
 
 }  // namespace aerocal::tools

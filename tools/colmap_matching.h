@@ -19,19 +19,20 @@
 namespace aerocal::tools {
 
 struct ColmapMatchingOptions {
-  std::string program = "colmap";       // the COLMAP executable (PATH searched)
-  std::string matcher = "exhaustive";   // exhaustive | spatial
-  std::string work_dir;                 // created; COLMAP's files and logs
-  int max_image_px = 3200;              // SIFT on images downscaled to this longer side, > 0
-  double align_error_m = 10;            // model_aligner inlier bound, m, > 0
+  std::string program = "colmap";      // the COLMAP executable (PATH searched)
+  std::string matcher = "exhaustive";  // exhaustive | spatial
+  std::string work_dir;                // created; COLMAP's files and logs
+  int max_image_px = 3200;             // SIFT on images downscaled to this longer side, > 0
+  double align_error_m = 10;           // model_aligner inlier bound, m, > 0
 };
 
 /// Runs the steps above on `images_dir` with `ecef_centres` (image file name -> X, Y, Z m) as the
 /// aligner's references; returns the folder of the aligned text model. ConfigError when the
 /// program cannot be started, InputError naming the step and its log when a step fails or
 /// COLMAP registers fewer than 3 images with a reference.
-std::string RunColmapMatching(const std::string& images_dir,
-                              const std::vector<std::pair<std::string, Eigen::Vector3d>>& ecef_centres,
-                              const ColmapMatchingOptions& options);
+std::string RunColmapMatching(
+    const std::string& images_dir,
+    const std::vector<std::pair<std::string, Eigen::Vector3d>>& ecef_centres,
+    const ColmapMatchingOptions& options);
 
 }  // namespace aerocal::tools

@@ -7,13 +7,13 @@
 // Throwing aerocal::InputError / ConfigError gives exit 2 with "error: FILE:LINE: ..." on stderr.
 #pragma once
 
+#include <CLI/CLI.hpp>
+
 #include <cerrno>
 #include <cstdlib>
 #include <functional>
 #include <string>
 #include <vector>
-
-#include <CLI/CLI.hpp>
 
 namespace aerocal::tools {
 

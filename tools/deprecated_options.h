@@ -9,9 +9,9 @@
 namespace aerocal::tools {
 
 struct DeprecatedOption {
-  std::string command;   // "stitch" or "camera convert": the (sub)command it belongs to
-  std::string old_name;  // "--sigma"
-  std::string new_name;  // "--sigma-px"
+  std::string command;     // "stitch" or "camera convert": the (sub)command it belongs to
+  std::string old_name;    // "--sigma"
+  std::string new_name;    // "--sigma-px"
   std::string removed_in;  // the release without the alias
 };
 

@@ -1,10 +1,5 @@
 #include "tools/flight_command.h"
 
-#include <algorithm>
-#include <cstdio>
-#include <cstdlib>
-#include <filesystem>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
@@ -16,30 +11,51 @@
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
 #include "tools/output_set.h"
-#include "tools/suspect_effect_option.h"
 #include "tools/python_script.h"
+#include "tools/suspect_effect_option.h"
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/joint/joint_adjustment.h"
 #include "triangulation/workflow/flight_workflow.h"
 
+#include <algorithm>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+
 namespace aerocal::tools {
 
 void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
-  app.add_option("--camera", args->options.camera_file, "Camera file (YAML) used by every step")->required();
-  app.add_option("--data", args->options.data_folder,
-                 "Flight folder: project.yaml (virtual-image observations), optional project_subimage.yaml "
-                 "(raw sub-image observations) and the stitching measurements the project names")
+  app.add_option("--camera", args->options.camera_file, "Camera file (YAML) used by every step")
       ->required();
-  app.add_option("--out", args->out, "Output folder: result.json, report.html, camera_calibrated.yaml")->required();
-  app.add_option("--base", args->base, "Base sub-images holding the datum of the focal plane (default: reference points)");
-  app.add_option("--stitch-sigma-px", args->options.stitch_sigma_px, "Stitching sigma where the file has none, px")
+  app.add_option(
+         "--data",
+         args->options.data_folder,
+         "Flight folder: project.yaml (virtual-image observations), optional project_subimage.yaml "
+         "(raw sub-image observations) and the stitching measurements the project names")
+      ->required();
+  app.add_option(
+         "--out", args->out, "Output folder: result.json, report.html, camera_calibrated.yaml")
+      ->required();
+  app.add_option(
+      "--base",
+      args->base,
+      "Base sub-images holding the datum of the focal plane (default: reference points)");
+  app.add_option("--stitch-sigma-px",
+                 args->options.stitch_sigma_px,
+                 "Stitching sigma where the file has none, px")
       ->check(PositiveUpTo(100));
-  app.add_flag("--no-joint", [args](std::int64_t) { args->options.joint = false; }, "Skip the joint adjustment");
-  app.add_option("--joint-model", args->joint_model,
-                 "Mapping model of the joint adjustment: translation | conformal | affine | projective | auto "
+  app.add_flag(
+      "--no-joint",
+      [args](std::int64_t) { args->options.joint = false; },
+      "Skip the joint adjustment");
+  app.add_option("--joint-model",
+                 args->joint_model,
+                 "Mapping model of the joint adjustment: translation | conformal | affine | "
+                 "projective | auto "
                  "(the model the flight's stitching F test chose)")
       ->capture_default_str();
-  app.add_option("--self-calibration", args->self_calibration,
+  app.add_option("--self-calibration",
+                 args->self_calibration,
                  "Interior parameters of the self-calibration: auto (default: those of the "
                  "10-parameter model that this block determines and that are significant, each "
                  "held one named with the reason, self_calibration_choice), all, or a list such "
@@ -47,26 +63,32 @@ void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
       ->capture_default_str();
   AddSuspectEffectOption(app, &args->options.suspect_effect_limit);
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
-  app.add_option("--camera-format", args->camera_format,
-                 "Also write the calibrated camera as camera_calibrated.FORMAT in another tool's format (" +
-                     CameraFormatNames() + "), converted with its residual printed");
-  app.add_flag("--certificate", args->certificate,
+  app.add_option(
+      "--camera-format",
+      args->camera_format,
+      "Also write the calibrated camera as camera_calibrated.FORMAT in another tool's format (" +
+          CameraFormatNames() + "), converted with its residual printed");
+  app.add_flag("--certificate",
+               args->certificate,
                "Also write the certificate of the in-flight calibration (OUT/certificate/: "
                "certificate.json, .html, .pdf; a type-A budget, as `aerocal certificate` of "
                "result.json); only for a valid flight");
   app.add_option("--lab", args->lab, "Lab YAML of the certificate (as `aerocal certificate --lab`)")
       ->needs("--certificate");
-  app.add_option("--quality", args->quality,
-                 "Results of `aerocal quality mtf|bars|star` on this flight's images: the certificate's "
-                 "dynamic image resolution section (as `aerocal certificate --quality`); repeatable")
+  app.add_option(
+         "--quality",
+         args->quality,
+         "Results of `aerocal quality mtf|bars|star` on this flight's images: the certificate's "
+         "dynamic image resolution section (as `aerocal certificate --quality`); repeatable")
       ->needs("--certificate");
 }
 
 void PrepareFlight(FlightArgs* args) {
   CheckOutputFolder(args->out, "--out");
   if (args->certificate) ReadCertificateLab(args->lab);  // a bad lab file before the flight runs
-  for (const auto& path : args->quality)  // and a file that is no quality result
-    ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality` (--quality)");
+  for (const auto& path : args->quality)                 // and a file that is no quality result
+    ReadResult(
+        path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality` (--quality)");
   if (!args->camera_format.empty()) FindCameraFormat(args->camera_format, "--camera-format");
   args->options.base_ids = SplitCommaList(args->base);
   // Every --base id names a sub-image of the camera (the stitching step would otherwise fail
@@ -76,7 +98,8 @@ void PrepareFlight(FlightArgs* args) {
     std::string known;
     for (const auto& s : camera.subimages) known += (known.empty() ? "" : ", ") + s.id;
     for (const auto& id : args->options.base_ids)
-      if (std::none_of(camera.subimages.begin(), camera.subimages.end(),
+      if (std::none_of(camera.subimages.begin(),
+                       camera.subimages.end(),
                        [&](const calib::SubimageMapping& s) { return s.id == id; }))
         throw ConfigError("--base: sub-image '" + id + "' is not in " + args->options.camera_file +
                           " (sub-images: " + (known.empty() ? "none" : known) + ")");
@@ -86,8 +109,9 @@ void PrepareFlight(FlightArgs* args) {
   if (!args->options.choose_free_set) {
     args->options.free_interior = triangulation::ParseSelfCalibration(args->self_calibration);
     if (args->options.free_interior.empty())
-      throw ConfigError("--self-calibration none: flight calibrates the camera (use `aerocal "
-                        "adjust` for a conventional run alone)");
+      throw ConfigError(
+          "--self-calibration none: flight calibrates the camera (use `aerocal "
+          "adjust` for a conventional run alone)");
   }
 }
 
@@ -129,9 +153,11 @@ int RunFlight(const FlightArgs& args) {
     const std::string html = set.Staged("report.html"), pdf = set.Staged("report.pdf");
     progress.Stage("report");
     if (!RunPythonScript(script, {json_path, html, pdf})) {
-      std::fprintf(stderr, "error: the report could not be written (%s); nothing written, the "
+      std::fprintf(stderr,
+                   "error: the report could not be written (%s); nothing written, the "
                    "previous flight in %s is left as it was\n",
-                   PythonCommandLine(script, {json_path, html, pdf}).c_str(), args.out.c_str());
+                   PythonCommandLine(script, {json_path, html, pdf}).c_str(),
+                   args.out.c_str());
       return kExitInternal;
     }
     progress.Advance();
@@ -151,13 +177,15 @@ int RunFlight(const FlightArgs& args) {
     certificate.quality = args.quality;
     certificate_code = WriteCertificate(certificate);
     if (certificate_code == kExitInternal) {
-      std::fprintf(stderr, "error: nothing written, the previous flight in %s is left as it was\n",
+      std::fprintf(stderr,
+                   "error: nothing written, the previous flight in %s is left as it was\n",
                    args.out.c_str());
       return certificate_code;
     }
     parts.push_back("certificate");
   } else {
-    if (args.certificate) std::fprintf(stderr, "flight: no certificate written (the flight is not valid)\n");
+    if (args.certificate)
+      std::fprintf(stderr, "flight: no certificate written (the flight is not valid)\n");
     obsolete.push_back("certificate");
   }
   set.Commit(parts, obsolete);

@@ -4,13 +4,13 @@
 // files.
 #pragma once
 
-#include <memory>
-#include <string>
-#include <vector>
+#include "triangulation/workflow/flight_workflow.h"
 
 #include <CLI/CLI.hpp>
 
-#include "triangulation/workflow/flight_workflow.h"
+#include <memory>
+#include <string>
+#include <vector>
 
 namespace aerocal::tools {
 

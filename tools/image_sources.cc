@@ -1,11 +1,11 @@
 #include "tools/image_sources.h"
 
-#include <algorithm>
-#include <cctype>
-
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "stitch/resample/tiff_raster.h"
+
+#include <algorithm>
+#include <cctype>
 
 namespace aerocal::tools {
 namespace {

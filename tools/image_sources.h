@@ -2,11 +2,11 @@
 // one raster per id (TIFF read on demand, other formats through OpenCV into memory).
 #pragma once
 
+#include "stitch/resample/raster.h"
+
 #include <memory>
 #include <string>
 #include <vector>
-
-#include "stitch/resample/raster.h"
 
 namespace aerocal::tools {
 

@@ -1,20 +1,20 @@
 // The aerocal command line: argument parsing and dispatch only; no algorithms live here.
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/log.h"
+#include "tools/command_registry.h"
+#include "tools/deprecated_options.h"
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+#include <yaml-cpp/yaml.h>
+
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <exception>
 #include <filesystem>
 #include <map>
-
-#include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
-#include <yaml-cpp/yaml.h>
-
-#include "calib/core/atomic_file.h"
-#include "calib/core/error.h"
-#include "calib/core/log.h"
-#include "tools/command_registry.h"
-#include "tools/deprecated_options.h"
 
 namespace aerocal::tools {
 std::vector<CommandEntry>& CommandRegistry() {
@@ -28,12 +28,14 @@ namespace {
 void RejectNonFiniteOptions(const CLI::App& app) {
   for (const CLI::Option* option : app.get_options()) {
     const std::string type = option->get_type_name();
-    if (type.find("FLOAT") == std::string::npos && type.find("NUMBER") == std::string::npos) continue;
+    if (type.find("FLOAT") == std::string::npos && type.find("NUMBER") == std::string::npos)
+      continue;
     for (const std::string& text : option->results()) {
       char* end = nullptr;
       const double value = std::strtod(text.c_str(), &end);
       if (end != text.c_str() && !std::isfinite(value))
-        throw aerocal::ConfigError(option->get_name() + ": must be a finite number (got '" + text + "')");
+        throw aerocal::ConfigError(option->get_name() + ": must be a finite number (got '" + text +
+                                   "')");
     }
   }
   for (const CLI::App* sub : app.get_subcommands()) RejectNonFiniteOptions(*sub);

@@ -1,8 +1,5 @@
 #include "tools/match_frames.h"
 
-#include <filesystem>
-#include <map>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
@@ -11,6 +8,9 @@
 #include "calib/core/string_printf.h"
 #include "stitch/image_io/image_io.h"
 #include "stitch/matching/overlap_matcher.h"
+
+#include <filesystem>
+#include <map>
 
 namespace aerocal::tools {
 namespace {
@@ -47,8 +47,8 @@ FrameImages FromList(const std::string& list, const calib::Camera& camera) {
       ThrowInputError(table.Where(row), "frame, subimage and image must not be empty");
     if (path.is_relative()) path = dir / path;
     if (camera.SubimageIndex(sub) < 0)
-      ThrowInputError(table.Where(row), "sub-image " + sub + " (frame " + frame +
-                                            ") is not in the camera file");
+      ThrowInputError(table.Where(row),
+                      "sub-image " + sub + " (frame " + frame + ") is not in the camera file");
     try {
       CheckInputFile(path.string());
     } catch (const InputError& e) {
@@ -59,7 +59,8 @@ FrameImages FromList(const std::string& list, const calib::Camera& camera) {
       frames.push_back({frame, {}});
     }
     if (!frames[index[frame]].second.emplace(sub, path.string()).second)
-      ThrowInputError(table.Where(row), "sub-image " + sub + " of frame " + frame + " listed twice");
+      ThrowInputError(table.Where(row),
+                      "sub-image " + sub + " of frame " + frame + " listed twice");
   }
   if (frames.empty()) throw InputError(list + ": no frames listed");
   for (const auto& [frame, paths] : frames)
@@ -69,15 +70,18 @@ FrameImages FromList(const std::string& list, const calib::Camera& camera) {
   return frames;
 }
 
-std::vector<stitch::GrayImage> LoadFrame(const calib::Camera& camera, const std::string& frame,
+std::vector<stitch::GrayImage> LoadFrame(const calib::Camera& camera,
+                                         const std::string& frame,
                                          const std::map<std::string, std::string>& paths) {
   for (const auto& [id, path] : paths)
     if (camera.SubimageIndex(id) < 0)
-      throw InputError(path + ": sub-image " + id + " (frame " + frame + ") is not in the camera file");
+      throw InputError(path + ": sub-image " + id + " (frame " + frame +
+                       ") is not in the camera file");
   std::vector<stitch::GrayImage> images;
   for (const calib::SubimageMapping& sub : camera.subimages) {
     const auto it = paths.find(sub.id);
-    if (it == paths.end()) throw InputError("frame " + frame + ": no image for sub-image " + sub.id);
+    if (it == paths.end())
+      throw InputError("frame " + frame + ": no image for sub-image " + sub.id);
     images.push_back(stitch::ReadSubimage(it->second, sub));
   }
   return images;
@@ -104,15 +108,35 @@ MatchRun RunMatching(const MatchRequest& args) {
       args.list.empty() ? FromImagesOption(args.frame, args.images) : FromList(args.list, camera);
   MatchRun run;
   Progress progress("match", static_cast<long>(frames.size()));
-  run.table = StringPrintf("%-6s %-10s %7s %7s %6s %6s %7s %7s %7s %6s %8s\n", "frame", "strip", "kp_a", "kp_b",
-                           "ratio", "ransac", "lsm", "lsm_nc", "lsm_low", "points", "coverage");
+  run.table = StringPrintf("%-6s %-10s %7s %7s %6s %6s %7s %7s %7s %6s %8s\n",
+                           "frame",
+                           "strip",
+                           "kp_a",
+                           "kp_b",
+                           "ratio",
+                           "ransac",
+                           "lsm",
+                           "lsm_nc",
+                           "lsm_low",
+                           "points",
+                           "coverage");
   for (const auto& [frame, paths] : frames) {
-    const stitch::FrameMatches m = stitch::MatchFrame(camera, LoadFrame(camera, frame, paths), frame, options);
+    const stitch::FrameMatches m =
+        stitch::MatchFrame(camera, LoadFrame(camera, frame, paths), frame, options);
     run.rows.insert(run.rows.end(), m.observations.begin(), m.observations.end());
     for (const stitch::StripReport& s : m.strips)
-      run.table += StringPrintf("%-6s %-10s %7d %7d %6d %6d %7d %7d %7d %6d %8.2f\n", frame.c_str(), s.name.c_str(),
-                                s.keypoints_a, s.keypoints_b, s.ratio_matches, s.ransac_inliers, s.lsm_tried,
-                                s.lsm_not_converged, s.lsm_poor_precision, s.points, s.Coverage());
+      run.table += StringPrintf("%-6s %-10s %7d %7d %6d %6d %7d %7d %7d %6d %8.2f\n",
+                                frame.c_str(),
+                                s.name.c_str(),
+                                s.keypoints_a,
+                                s.keypoints_b,
+                                s.ratio_matches,
+                                s.ransac_inliers,
+                                s.lsm_tried,
+                                s.lsm_not_converged,
+                                s.lsm_poor_precision,
+                                s.points,
+                                s.Coverage());
     progress.Advance();
   }
   progress.Finish();

@@ -3,10 +3,10 @@
 // `aerocal.match`.
 #pragma once
 
+#include "stitch/simulation/stitch_simulator.h"
+
 #include <string>
 #include <vector>
-
-#include "stitch/simulation/stitch_simulator.h"
 
 namespace aerocal::tools {
 

@@ -1,14 +1,14 @@
 #include "tools/opencv_storage_scan.h"
 
-#include <algorithm>
-#include <cmath>
-#include <cstdlib>
-#include <cctype>
-#include <regex>
-#include <sstream>
-
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+
+#include <algorithm>
+#include <cctype>
+#include <cmath>
+#include <cstdlib>
+#include <regex>
+#include <sstream>
 
 namespace aerocal::tools {
 namespace {
@@ -51,53 +51,65 @@ class Scanner {
       return;
     }
     // Every element of the matrix needs at least one character of the file.
-    if (header_.rows >= 0 && header_.cols >= 0 && header_.rows * header_.cols * header_.channels > limit_)
-      Throw(line, "a matrix of " + FormatNumber(header_.rows) + " x " + FormatNumber(header_.cols) +
-                      (header_.channels > 1 ? " x " + FormatNumber(header_.channels) : "") +
-                      " elements cannot be held by a file of " + FormatNumber(limit_) + " characters");
+    if (header_.rows >= 0 && header_.cols >= 0 &&
+        header_.rows * header_.cols * header_.channels > limit_)
+      Throw(line,
+            "a matrix of " + FormatNumber(header_.rows) + " x " + FormatNumber(header_.cols) +
+                (header_.channels > 1 ? " x " + FormatNumber(header_.channels) : "") +
+                " elements cannot be held by a file of " + FormatNumber(limit_) + " characters");
   }
 
   // cv::FileStorage parses nested collections recursively, without a limit: 200000 '[' overflowed
   // its stack. Nesting is bounded before it reads anything.
   void Nesting(int depth, int line, const char* what) const {
     if (depth > kMaxNesting)
-      Throw(line, std::string(what) + " nested deeper than " + std::to_string(kMaxNesting) + " levels");
+      Throw(line,
+            std::string(what) + " nested deeper than " + std::to_string(kMaxNesting) + " levels");
   }
   void EmptyKey(int line) const { Throw(line, "a key is empty (nothing before ':')"); }
   void Indentation(size_t columns, int line) const {
     if (columns > static_cast<size_t>(kMaxIndentation))
-      Throw(line, "indented " + std::to_string(columns) + " columns: YAML nested deeper than " +
-                      std::to_string(kMaxIndentation) + " columns");
+      Throw(line,
+            "indented " + std::to_string(columns) + " columns: YAML nested deeper than " +
+                std::to_string(kMaxIndentation) + " columns");
   }
 
   void Key(const std::string& key, int line, OpenCvStorageScan* scan) const {
     const auto [it, inserted] = scan->key_lines.emplace(key, line);
     if (!inserted)
-      Throw(line, "'" + key + "' occurs twice (first on line " + std::to_string(it->second) +
-                      "): cv::FileStorage would read one of them silently");
+      Throw(line,
+            "'" + key + "' occurs twice (first on line " + std::to_string(it->second) +
+                "): cv::FileStorage would read one of them silently");
   }
 
  private:
-  [[noreturn]] void Throw(int line, const std::string& what) const { ThrowInputError({path_, line}, what); }
+  [[noreturn]] void Throw(int line, const std::string& what) const {
+    ThrowInputError({path_, line}, what);
+  }
 
   double WholeNumber(const std::string& value, const std::string& name, int line) const {
     char* end = nullptr;
     const double v = std::strtod(value.c_str(), &end);
-    if (value.empty() || *end != '\0' || !std::isfinite(v) || v != std::floor(v) || v < 0 || v > limit_)
-      Throw(line, name + " must be a whole number within 0 .. " + FormatNumber(limit_) +
-                      " (the file's size) (got '" + value + "')");
+    if (value.empty() || *end != '\0' || !std::isfinite(v) || v != std::floor(v) || v < 0 ||
+        v > limit_)
+      Throw(line,
+            name + " must be a whole number within 0 .. " + FormatNumber(limit_) +
+                " (the file's size) (got '" + value + "')");
     return v;
   }
 
   // dt: an element type of OpenCV (u c w s i f d h), a matrix's with 1..4 channels in front; a
   // raw sequence's compound type ("2if") is checked for its letters only.
   double Channels(const std::string& value, int line) const {
-    static const std::regex kSingle(R"(([1-4]?)([ucwsifdh]))"), kCompound(R"(([0-9]{0,3}[ucwsifdhr])+)");
+    static const std::regex kSingle(R"(([1-4]?)([ucwsifdh]))"),
+        kCompound(R"(([0-9]{0,3}[ucwsifdhr])+)");
     std::smatch m;
     if (std::regex_match(value, m, kSingle)) return m[1].length() ? std::stod(m[1]) : 1.0;
     if (value.size() <= 32 && std::regex_match(value, kCompound)) return 1.0;
-    Throw(line, "dt must be an OpenCV element type (u c w s i f d h, 1..4 channels in front, as 'd' "
-                "or '3f') (got '" + value + "')");
+    Throw(line,
+          "dt must be an OpenCV element type (u c w s i f d h, 1..4 channels in front, as 'd' "
+          "or '3f') (got '" +
+              value + "')");
   }
 
   // An n-d matrix's sizes: whole numbers whose product the file can hold.
@@ -108,8 +120,9 @@ class Scanner {
     double product = 1;
     for (std::string item; in >> item;) product *= WholeNumber(item, "sizes", line);
     if (product > limit_)
-      Throw(line, "sizes of " + FormatNumber(product) + " elements cannot be held by a file of " +
-                      FormatNumber(limit_) + " characters");
+      Throw(line,
+            "sizes of " + FormatNumber(product) + " elements cannot be held by a file of " +
+                FormatNumber(limit_) + " characters");
   }
 
   std::string path_;
@@ -119,7 +132,8 @@ class Scanner {
 
 // A value as written: quotes stripped.
 std::string Unquoted(std::string value) {
-  if (value.size() >= 2 && (value.front() == '"' || value.front() == '\'') && value.back() == value.front())
+  if (value.size() >= 2 && (value.front() == '"' || value.front() == '\'') &&
+      value.back() == value.front())
     value = value.substr(1, value.size() - 2);
   return value;
 }
@@ -127,7 +141,10 @@ std::string Unquoted(std::string value) {
 // The scan is hand-written, not std::regex: libstdc++'s regex recurses once per character and
 // overflows the stack on a long line, and every step here is linear in the line.
 bool IsSpace(char c) { return c == ' ' || c == '\t' || c == '\r' || c == '\v' || c == '\f'; }
-bool IsNameChar(char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-' || c == ':'; }
+bool IsNameChar(char c) {
+  return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '.' || c == '-' ||
+         c == ':';
+}
 
 size_t SkipSpaces(const std::string& line, size_t i) {
   while (i < line.size() && IsSpace(line[i])) ++i;
@@ -135,7 +152,9 @@ size_t SkipSpaces(const std::string& line, size_t i) {
 }
 
 // A field's value cut to a length no valid value exceeds (the check then refuses it).
-std::string Bounded(const std::string& value) { return value.size() > 64 ? value.substr(0, 65) : value; }
+std::string Bounded(const std::string& value) {
+  return value.size() > 64 ? value.substr(0, 65) : value;
+}
 
 constexpr const char* kFieldNames[] = {"rows", "cols", "dt", "sizes", "data"};
 
@@ -146,7 +165,9 @@ void ScanFieldsYamlJson(const std::string& line, int number, Scanner* scanner) {
     for (size_t at = line.find(key); at != std::string::npos; at = line.find(key, at + 1)) {
       size_t begin = at;
       if (begin > 0 && line[begin - 1] == '"') --begin;
-      if (begin > 0 && !(IsSpace(line[begin - 1]) || line[begin - 1] == '{' || line[begin - 1] == ',')) continue;
+      if (begin > 0 &&
+          !(IsSpace(line[begin - 1]) || line[begin - 1] == '{' || line[begin - 1] == ','))
+        continue;
       size_t i = at + key.size();
       if (i < line.size() && line[i] == '"') ++i;
       i = SkipSpaces(line, i);
@@ -160,7 +181,8 @@ void ScanFieldsYamlJson(const std::string& line, int number, Scanner* scanner) {
         end = line.find('"', i + 1);
         end = end == std::string::npos ? line.size() : end + 1;
       } else {
-        while (end < line.size() && line[end] != ',' && line[end] != '}' && !IsSpace(line[end])) ++end;
+        while (end < line.size() && line[end] != ',' && line[end] != '}' && !IsSpace(line[end]))
+          ++end;
       }
       scanner->Field(key, Bounded(Unquoted(line.substr(i, end - i))), number);
     }
@@ -183,7 +205,10 @@ void ScanFieldsXml(const std::string& line, int number, Scanner* scanner) {
 
 // YAML: a key at column 0 (a name, or a quoted one, then ':' and a space or the line's end) is a
 // top-level key.
-void ScanKeyYaml(const std::string& line, int number, const Scanner& scanner, OpenCvStorageScan* scan) {
+void ScanKeyYaml(const std::string& line,
+                 int number,
+                 const Scanner& scanner,
+                 OpenCvStorageScan* scan) {
   if (line.empty()) return;
   size_t end = 0;
   if (line[0] == '"') {
@@ -227,7 +252,8 @@ class XmlKeys {
       const size_t name_begin = j;
       while (j < line.size() && IsNameChar(line[j])) ++j;
       const size_t close = line.find('>', j);
-      if (j == name_begin || !(std::isalpha(static_cast<unsigned char>(line[name_begin])) || line[name_begin] == '_')) {
+      if (j == name_begin || !(std::isalpha(static_cast<unsigned char>(line[name_begin])) ||
+                               line[name_begin] == '_')) {
         i = open + 1;  // a declaration (<?xml ...?>), text, or a tag cut by the line's end
         continue;
       }
@@ -273,8 +299,10 @@ class JsonKeys {
  private:
   static size_t StringEnd(const std::string& line, size_t open) {
     for (size_t i = open + 1; i < line.size(); ++i) {
-      if (line[i] == '\\') ++i;
-      else if (line[i] == '"') return i;
+      if (line[i] == '\\')
+        ++i;
+      else if (line[i] == '"')
+        return i;
     }
     return line.size();
   }
@@ -320,13 +348,15 @@ class YamlNesting {
  public:
   void Line(const std::string& line, int number, const Scanner& scanner) {
     size_t indent = 0;
-    while (indent < line.size() && (line[indent] == ' ' || (line[indent] == '-' && indent + 1 < line.size() &&
-                                                             line[indent + 1] == ' ')))
+    while (indent < line.size() &&
+           (line[indent] == ' ' ||
+            (line[indent] == '-' && indent + 1 < line.size() && line[indent + 1] == ' ')))
       ++indent;
     scanner.Indentation(indent, number);
     // An empty key (`   : 460.4`): OpenCV 4.6's YAML parser then asks std::string for a negative
     // length (std::length_error, found by fuzz/camera_formats).
-    if (indent < line.size() && line[indent] == ':' && (indent + 1 == line.size() || IsSpace(line[indent + 1])))
+    if (indent < line.size() && line[indent] == ':' &&
+        (indent + 1 == line.size() || IsSpace(line[indent + 1])))
       scanner.EmptyKey(number);
     char quote = 0;
     for (size_t i = indent; i < line.size(); ++i) {
@@ -361,8 +391,9 @@ OpenCvStorageScan ScanOpenCvStorage(const std::string& text, const std::string& 
   // declaration that made OpenCV 4.6 dereference a null pointer (found by fuzz/camera_formats).
   const size_t nul = text.find('\0');
   if (nul != std::string::npos)
-    ThrowInputError({path, 1 + static_cast<int>(std::count(text.begin(), text.begin() + nul, '\n'))},
-                    "a NUL byte: not a text file (an OpenCV FileStorage file is YAML, XML or JSON text)");
+    ThrowInputError(
+        {path, 1 + static_cast<int>(std::count(text.begin(), text.begin() + nul, '\n'))},
+        "a NUL byte: not a text file (an OpenCV FileStorage file is YAML, XML or JSON text)");
   OpenCvStorageScan scan;
   Scanner scanner(text, path);
   const Syntax syntax = SyntaxOf(text);

@@ -1,12 +1,11 @@
 #include "tools/output_set.h"
 
-#include <unistd.h>
+#include "calib/core/error.h"
 
 #include <algorithm>
 #include <filesystem>
 #include <system_error>
-
-#include "calib/core/error.h"
+#include <unistd.h>
 
 namespace aerocal::tools {
 
@@ -38,7 +37,8 @@ const std::string& OutputSet::StagingOf(const std::string& named) {
     if (ec) throw InputError(folder + ": cannot create the output folder: " + ec.message());
     created_.push_back(folder);
   }
-  const std::string staging = (fs::path(folder) / (".aerocal-staging-" + std::to_string(::getpid()))).string();
+  const std::string staging =
+      (fs::path(folder) / (".aerocal-staging-" + std::to_string(::getpid()))).string();
   fs::remove_all(staging, ec);
   fs::create_directory(staging, ec);
   if (ec) throw InputError(folder + ": cannot write into the output folder: " + ec.message());
@@ -53,9 +53,13 @@ OutputSet::~OutputSet() {
     if (fs::is_empty(*it, ec)) fs::remove(*it, ec);
 }
 
-std::string OutputSet::Staged(const std::string& name) const { return (fs::path(staging_) / name).string(); }
+std::string OutputSet::Staged(const std::string& name) const {
+  return (fs::path(staging_) / name).string();
+}
 
-std::string OutputSet::Final(const std::string& name) const { return (fs::path(out_) / name).string(); }
+std::string OutputSet::Final(const std::string& name) const {
+  return (fs::path(out_) / name).string();
+}
 
 std::string OutputSet::StagePath(const std::string& final_path) {
   const fs::path path(final_path);
@@ -66,13 +70,16 @@ std::string OutputSet::StagePath(const std::string& final_path) {
   return (fs::path(StagingOf(path.parent_path().string())) / path.filename()).string();
 }
 
-void OutputSet::Commit(const std::vector<std::string>& parts, const std::vector<std::string>& obsolete) {
+void OutputSet::Commit(const std::vector<std::string>& parts,
+                       const std::vector<std::string>& obsolete) {
   // (staged, final) of every part.
   std::vector<std::pair<std::string, std::string>> moves;
   for (const auto& part : parts) moves.emplace_back(Staged(part), Final(part));
   for (const auto& path : elsewhere_)
-    moves.emplace_back((fs::path(StagingOf(fs::path(path).parent_path().string())) / fs::path(path).filename()).string(),
-                       path);
+    moves.emplace_back(
+        (fs::path(StagingOf(fs::path(path).parent_path().string())) / fs::path(path).filename())
+            .string(),
+        path);
   std::error_code ec;
   for (const auto& [staged, final_path] : moves)
     if (!fs::exists(staged, ec))
@@ -107,12 +114,16 @@ void OutputSet::Commit(const std::vector<std::string>& parts, const std::vector<
   committed_ = true;
 }
 
-void CheckDistinctPath(const std::string& path, const std::string& option, const std::string& other,
+void CheckDistinctPath(const std::string& path,
+                       const std::string& option,
+                       const std::string& other,
                        const std::string& other_name) {
   if (path.empty() || other.empty()) return;
   std::error_code ec, ec_other;
-  bool same = fs::weakly_canonical(path, ec) == fs::weakly_canonical(other, ec_other) && !ec && !ec_other;
-  if (!same && fs::exists(path, ec) && fs::exists(other, ec)) same = fs::equivalent(path, other, ec) && !ec;
+  bool same =
+      fs::weakly_canonical(path, ec) == fs::weakly_canonical(other, ec_other) && !ec && !ec_other;
+  if (!same && fs::exists(path, ec) && fs::exists(other, ec))
+    same = fs::equivalent(path, other, ec) && !ec;
   if (same)
     throw ConfigError(option + ": '" + path + "' is " + other_name + " ('" + other +
                       "'): a command never writes over its own input or another of its outputs");

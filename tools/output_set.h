@@ -54,7 +54,9 @@ class OutputSet {
 /// ConfigError naming `option` when `path` is the file `other` names (`other_name`: OUT, IN, an
 /// option): an output that would replace an input or another output of the same command. Paths
 /// are compared after resolving `.`, `..` and symbolic links, and as hard links where both exist.
-void CheckDistinctPath(const std::string& path, const std::string& option, const std::string& other,
+void CheckDistinctPath(const std::string& path,
+                       const std::string& option,
+                       const std::string& other,
                        const std::string& other_name);
 
 }  // namespace aerocal::tools

@@ -2,9 +2,9 @@
 // keys from the command and from the Python module's to_json(), so that both stay one document.
 #pragma once
 
-#include <nlohmann/json.hpp>
-
 #include "triangulation/block/block.h"
+
+#include <nlohmann/json.hpp>
 
 namespace aerocal::tools {
 

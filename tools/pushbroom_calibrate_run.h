@@ -2,12 +2,12 @@
 // (tools/cmd_pushbroom.cc, which writes the files) and Python's `aerocal.pushbroom_calibrate`.
 #pragma once
 
-#include <string>
+#include "calib/camera/line_camera.h"
+#include "triangulation/pushbroom/line_calibration.h"
 
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/line_camera.h"
-#include "triangulation/pushbroom/line_calibration.h"
+#include <string>
 
 namespace aerocal::tools {
 
@@ -23,10 +23,10 @@ struct LineCalibrationRequest {
 };
 
 struct LineCalibrationRun {
-  calib::LineCamera camera;                  // as read
+  calib::LineCamera camera;  // as read
   triangulation::LineCalibrationResult result;
-  nlohmann::json json;                       // the result document (kind pushbroom)
-  std::string printed, errors;               // the command's stdout and stderr lines
+  nlohmann::json json;          // the result document (kind pushbroom)
+  std::string printed, errors;  // the command's stdout and stderr lines
   bool Ok() const { return result.valid && result.report.converged; }
 };
 

@@ -10,7 +10,8 @@ namespace aerocal::tools {
 PreparedResample PrepareResample(const ResampleRequest& request) {
   PreparedResample p;
   const calib::Camera nominal = calib::ReadCamera(request.camera);
-  if (nominal.subimages.empty()) throw InputError(request.camera + ": the camera has no sub-images");
+  if (nominal.subimages.empty())
+    throw InputError(request.camera + ": the camera has no sub-images");
   p.camera = stitch::ApplyStitchResult(nominal, request.mapping, request.frame);
   p.options.interpolation = stitch::ParseInterpolation(request.interpolation);
   p.options.fill = request.fill;

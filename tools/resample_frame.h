@@ -3,13 +3,13 @@
 // description, read and checked once for both callers.
 #pragma once
 
-#include <memory>
-#include <string>
-#include <vector>
-
 #include "calib/camera/camera.h"
 #include "stitch/resample/raster.h"
 #include "stitch/resample/virtual_image.h"
+
+#include <memory>
+#include <string>
+#include <vector>
 
 namespace aerocal::tools {
 
@@ -26,8 +26,9 @@ struct PreparedResample {
   std::vector<std::unique_ptr<stitch::RasterSource>> owned;
   std::vector<stitch::RasterSource*> sources;  // in the camera's sub-image order
   stitch::ResampleOptions options;
-  stitch::RasterInfo virtual_info;  // the virtual image: format of the camera, bands and bits of the inputs
-  std::string description;          // the TIFF description (stitch::MappingDescription)
+  stitch::RasterInfo
+      virtual_info;         // the virtual image: format of the camera, bands and bits of the inputs
+  std::string description;  // the TIFF description (stitch::MappingDescription)
 };
 
 /// Reads and checks everything; InputError / ConfigError naming the file or the option

@@ -2,19 +2,22 @@
 // `aerocal.rig_design`.
 #pragma once
 
-#include <string>
+#include "calib/camera/rig.h"
+#include "stitch/rig/rig_design.h"
 
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/rig.h"
-#include "stitch/rig/rig_design.h"
+#include <string>
 
 namespace aerocal::tools {
 
 /// The design figures `d` of `rig` (read from `camera_file`) at `height_m` as the result
 /// document; `svg` names the footprint plot written beside it ("" : none).
-nlohmann::json RigDesignDocument(const calib::Rig& rig, const std::string& camera_file, double height_m,
-                                 const stitch::RigDesign& d, const std::string& svg);
+nlohmann::json RigDesignDocument(const calib::Rig& rig,
+                                 const std::string& camera_file,
+                                 double height_m,
+                                 const stitch::RigDesign& d,
+                                 const std::string& svg);
 
 /// The relative flying height: `given_m` when not 0, else the rig file's virtual.height_m;
 /// ConfigError naming --height-m when neither is usable (1 .. 100000 m).

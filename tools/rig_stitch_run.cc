@@ -1,9 +1,5 @@
 #include "tools/rig_stitch_run.h"
 
-#include <cmath>
-#include <filesystem>
-#include <map>
-
 #include "calib/camera/camera_model_json.h"
 #include "calib/camera/rig_io.h"
 #include "calib/core/csv.h"
@@ -15,11 +11,17 @@
 #include "stitch/rig/rig_tie_matching.h"
 #include "triangulation/block/block_io.h"
 
+#include <cmath>
+#include <filesystem>
+#include <map>
+
 namespace aerocal::tools {
 
 namespace fs = std::filesystem;
 
-std::string HeadImagePath(const std::string& folder, const std::string& image, const std::string& head) {
+std::string HeadImagePath(const std::string& folder,
+                          const std::string& image,
+                          const std::string& head) {
   for (const char* ext : {".tif", ".tiff", ".png", ".jpg"}) {
     const std::string path = folder + "/" + image + "_" + head + ext;
     if (fs::exists(path)) return path;
@@ -30,7 +32,8 @@ std::string HeadImagePath(const std::string& folder, const std::string& image, c
 
 nlohmann::json HeadCameraModels(const calib::Rig& rig) {
   nlohmann::json models = nlohmann::json::object();
-  for (const auto& head : rig.heads) models[head.id] = calib::CameraModelTableToJson(head.camera.model);
+  for (const auto& head : rig.heads)
+    models[head.id] = calib::CameraModelTableToJson(head.camera.model);
   return models;
 }
 
@@ -51,8 +54,9 @@ stitch::RigStitchExposure StitchExposure(const triangulation::Project& project,
                                          const triangulation::Exposure& e) {
   if (!e.z_ref_m)
     ThrowInputError({project.exposures_file, e.line},
-                    "image " + e.image + " has no z_ref (rig stitch rectifies onto the level "
-                    "plane Z = z_ref of each exposure)");
+                    "image " + e.image +
+                        " has no z_ref (rig stitch rectifies onto the level "
+                        "plane Z = z_ref of each exposure)");
   if (!(e.center_m.z() > *e.z_ref_m))
     ThrowInputError({project.exposures_file, e.line},
                     "image " + e.image + ": z_ref (" + FormatNumber(*e.z_ref_m) +
@@ -67,7 +71,8 @@ stitch::RigStitchExposure StitchExposure(const triangulation::Project& project,
   return x;
 }
 
-StitchInputs StitchInputsFromProject(const triangulation::Project& project, const calib::Rig& rig,
+StitchInputs StitchInputsFromProject(const triangulation::Project& project,
+                                     const calib::Rig& rig,
                                      const std::string& camera_file) {
   StitchInputs in;
   std::map<std::string, int> tie_index, exposure_index;
@@ -83,8 +88,8 @@ StitchInputs StitchInputsFromProject(const triangulation::Project& project, cons
     if (head < 0) ThrowInputError(where, "head '" + o.head + "' is not a head of " + camera_file);
     auto [it, added] = exposure_index.try_emplace(o.image, static_cast<int>(in.exposures.size()));
     if (added) in.exposures.push_back(StitchExposure(project, *project.FindExposure(o.image)));
-    const std::string label = fs::path(project.observations_file).filename().string() + ":" +
-                              std::to_string(o.line);
+    const std::string label =
+        fs::path(project.observations_file).filename().string() + ":" + std::to_string(o.line);
     in.observations.push_back(
         {it->second, head, tie_index.at(o.point), o.pixel, o.sigma_px, label});
   }
@@ -93,18 +98,19 @@ StitchInputs StitchInputsFromProject(const triangulation::Project& project, cons
   return in;
 }
 
-
 // --match-ties: every exposure of the project, its ties matched on the head images under --images
 // (stitch/rig/rig_tie_matching.h); observations.csv must have no rows. The zones' counts in
 // `zones`, the RMS of the ties' LSM sigmas (virtual px) in `lsm_sigma_rms_px`.
-StitchInputs MatchedStitchInputs(const triangulation::Project& project, const calib::Rig& rig,
+StitchInputs MatchedStitchInputs(const triangulation::Project& project,
+                                 const calib::Rig& rig,
                                  const std::string& images,
                                  std::vector<stitch::RigZoneMatchReport>* zones,
                                  double* lsm_sigma_rms_px) {
   if (!project.observations.empty())
     ThrowInputError({project.observations_file, project.observations.front().line},
                     "--match-ties measures the ties on the head images: observations.csv must have "
-                    "no rows (got " + std::to_string(project.observations.size()) + ")");
+                    "no rows (got " +
+                        std::to_string(project.observations.size()) + ")");
   StitchInputs in;
   for (const auto& e : project.exposures) in.exposures.push_back(StitchExposure(project, e));
   if (in.exposures.empty()) throw InputError(project.exposures_file + ": no exposures");
@@ -117,7 +123,8 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
     for (const auto& head : rig.heads) {
       const std::string path = HeadImagePath(images, in.exposures[i].image, head.id);
       heads.push_back(stitch::ReadGrayImage(path));
-      if (heads.back().cols() != head.camera.width_px || heads.back().rows() != head.camera.height_px)
+      if (heads.back().cols() != head.camera.width_px ||
+          heads.back().rows() != head.camera.height_px)
         throw InputError(path + ": " + std::to_string(heads.back().cols()) + " x " +
                          std::to_string(heads.back().rows()) + " px, head " + head.id + " is " +
                          std::to_string(head.camera.width_px) + " x " +
@@ -128,7 +135,8 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
   }
   double sum2 = 0.0;
   for (double sigma : matches.lsm_sigma_px) sum2 += sigma * sigma;
-  *lsm_sigma_rms_px = matches.lsm_sigma_px.empty() ? 0.0 : std::sqrt(sum2 / matches.lsm_sigma_px.size());
+  *lsm_sigma_rms_px =
+      matches.lsm_sigma_px.empty() ? 0.0 : std::sqrt(sum2 / matches.lsm_sigma_px.size());
   in.ties = std::move(matches.ties);
   in.observations = std::move(matches.observations);
   *zones = std::move(matches.zones);
@@ -139,7 +147,8 @@ StitchInputs MatchedStitchInputs(const triangulation::Project& project, const ca
 stitch::RigStitchOptions OptionsOf(const RigStitchRequest& r) {
   stitch::RigStitchOptions options;
   const auto mode = stitch::ParseRigStitchMode(r.mode);
-  if (!mode) throw ConfigError("--mode must be line, per-exposure or angles (got '" + r.mode + "')");
+  if (!mode)
+    throw ConfigError("--mode must be line, per-exposure or angles (got '" + r.mode + "')");
   options.mode = *mode;
   options.snooping = !r.no_snooping;
   if (!(r.alpha > 0 && r.alpha < 1)) throw ConfigError("--alpha must be within (0, 1)");
@@ -163,21 +172,37 @@ stitch::RigStitchOptions OptionsOf(const RigStitchRequest& r) {
 }
 
 // The tie matching's figures for the result, and its lines for the summary.
-nlohmann::json TieMatchingJson(const StitchInputs& in, const std::vector<stitch::RigZoneMatchReport>& zones_in,
-                               double lsm_sigma_rms_px, double sigma0, std::string* printed) {
+nlohmann::json TieMatchingJson(const StitchInputs& in,
+                               const std::vector<stitch::RigZoneMatchReport>& zones_in,
+                               double lsm_sigma_rms_px,
+                               double sigma0,
+                               std::string* printed) {
   nlohmann::json zones = nlohmann::json::array();
   for (const auto& z : zones_in) {
-    zones.push_back({{"image", z.image}, {"zone", z.zone}, {"pixels", z.pixels}, {"cells", z.cells},
-                     {"lsm_tried", z.lsm_tried}, {"lsm_failed", z.lsm_failed}, {"ties", z.ties}});
+    zones.push_back({{"image", z.image},
+                     {"zone", z.zone},
+                     {"pixels", z.pixels},
+                     {"cells", z.cells},
+                     {"lsm_tried", z.lsm_tried},
+                     {"lsm_failed", z.lsm_failed},
+                     {"ties", z.ties}});
     *printed += StringPrintf("matched %s zone %s: %d ties (%d cells, LSM %d tried, %d failed)\n",
-                             z.image.c_str(), z.zone.c_str(), z.ties, z.cells, z.lsm_tried, z.lsm_failed);
+                             z.image.c_str(),
+                             z.zone.c_str(),
+                             z.ties,
+                             z.cells,
+                             z.lsm_tried,
+                             z.lsm_failed);
   }
   // The LSM sigmas take the template's residuals as independent; sigma0 says by how much they
   // are too small here, and the increments' sigmas are scaled by it (a-posteriori).
-  *printed += StringPrintf("matched ties: LSM sigma RMS %.4f virtual px; sigma0 %.2f: the LSM sigmas are %.2f x "
-                           "too %s, the increments' sigmas are scaled by sigma0\n",
-                           lsm_sigma_rms_px, sigma0, sigma0 >= 1 ? sigma0 : 1 / sigma0,
-                           sigma0 >= 1 ? "small" : "large");
+  *printed += StringPrintf(
+      "matched ties: LSM sigma RMS %.4f virtual px; sigma0 %.2f: the LSM sigmas are %.2f x "
+      "too %s, the increments' sigmas are scaled by sigma0\n",
+      lsm_sigma_rms_px,
+      sigma0,
+      sigma0 >= 1 ? sigma0 : 1 / sigma0,
+      sigma0 >= 1 ? "small" : "large");
   return {{"ties", in.ties.size()},
           {"observations", in.observations.size()},
           {"prefilter_sigma_px", stitch::RigTieMatchOptions{}.prefilter_sigma_px},
@@ -191,17 +216,19 @@ RigStitchRun RunRigStitch(const RigStitchRequest& r) {
   RigStitchRun run;
   run.rig = calib::ReadRig(r.camera);
   const calib::Rig& rig = run.rig;
-  if (rig.heads.size() < 2) throw InputError(r.camera + ": a rig of one head has nothing to stitch");
+  if (rig.heads.size() < 2)
+    throw InputError(r.camera + ": a rig of one head has nothing to stitch");
   if (rig.virtual_camera.orientation != calib::VirtualOrientation::kLevel)
-    throw InputError(r.camera + ": virtual.orientation must be level for rig stitch (the "
+    throw InputError(r.camera +
+                     ": virtual.orientation must be level for rig stitch (the "
                      "horizontal virtual image of the POS attitude)");
   run.options = OptionsOf(r);
   const triangulation::Project project = triangulation::ReadProject(r.project, r.default_sigma_px);
   std::vector<stitch::RigZoneMatchReport> matched_zones;
   double lsm_sigma_rms_px = 0.0;
-  const StitchInputs in = r.match_ties
-                              ? MatchedStitchInputs(project, rig, r.images, &matched_zones, &lsm_sigma_rms_px)
-                              : StitchInputsFromProject(project, rig, r.camera);
+  const StitchInputs in =
+      r.match_ties ? MatchedStitchInputs(project, rig, r.images, &matched_zones, &lsm_sigma_rms_px)
+                   : StitchInputsFromProject(project, rig, r.camera);
   double height_sum = 0.0;
   for (const auto& e : in.exposures) height_sum += e.pose.rig_center_m.z() - e.z_ref_m;
   const double height_m = height_sum / in.exposures.size();
@@ -214,15 +241,18 @@ RigStitchRun RunRigStitch(const RigStitchRequest& r) {
     sources.relief_m = *r.relief_m;
   }
   // The standard tie positions of the rig's design at the block's mean height.
-  const std::vector<stitch::StandardPosition> positions = stitch::DesignRig(rig, height_m, 200).standard_positions;
+  const std::vector<stitch::StandardPosition> positions =
+      stitch::DesignRig(rig, height_m, 200).standard_positions;
   if (r.need_head_images)  // every head image present before anything is computed or written
     for (const auto& e : in.exposures)
       for (const auto& head : rig.heads) HeadImagePath(r.images, e.image, head.id);
-  run.result = stitch::SelfCalibrateRigStitching(rig, in.exposures, in.ties, in.observations, positions, run.options);
+  run.result = stitch::SelfCalibrateRigStitching(
+      rig, in.exposures, in.ties, in.observations, positions, run.options);
   run.json = stitch::RigStitchToJson(rig, run.options, run.result, sources);
   run.json["camera_models"] = HeadCameraModels(rig);
   if (r.match_ties)
-    run.json["tie_matching"] = TieMatchingJson(in, matched_zones, lsm_sigma_rms_px, run.result.sigma0, &run.printed);
+    run.json["tie_matching"] =
+        TieMatchingJson(in, matched_zones, lsm_sigma_rms_px, run.result.sigma0, &run.printed);
   run.printed += stitch::FormatRigStitchSummary(run.options, run.result, sources);
   run.exposures = in.exposures;
   return run;

@@ -4,15 +4,15 @@
 // `aerocal.rig_stitch` (tools/python/bind_rig.cc).
 #pragma once
 
-#include <optional>
-#include <string>
-#include <vector>
-
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/rig.h"
 #include "stitch/rig/self_calibration.h"
 #include "stitch/rig/self_calibration_json.h"
+
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace aerocal::tools {
 
@@ -27,8 +27,8 @@ struct RigStitchRequest {
   double max_sigma0 = 3.0;
   double suspect_effect_limit = 1.0;
   double default_sigma_px = 0.5;
-  std::string images;         // folder of the head images <image>_<head>.tif
-  bool match_ties = false;    // ties matched on the head images instead of observations.csv
+  std::string images;             // folder of the head images <image>_<head>.tif
+  bool match_ties = false;        // ties matched on the head images instead of observations.csv
   bool need_head_images = false;  // every head image must exist (the stitched images follow)
 };
 
@@ -45,7 +45,9 @@ struct RigStitchRun {
 RigStitchRun RunRigStitch(const RigStitchRequest& request);
 
 /// The head image of an exposure under `folder`: <image>_<head>.tif (or .tiff, .png, .jpg).
-std::string HeadImagePath(const std::string& folder, const std::string& image, const std::string& head);
+std::string HeadImagePath(const std::string& folder,
+                          const std::string& image,
+                          const std::string& head);
 
 /// The camera model of each head with its parameter table, keyed by head id (`camera_models` of
 /// the rig result documents).

@@ -11,6 +11,7 @@ build_dir="${1:-build}"
 packages=(cmake make g++ pkg-config
   libceres-dev libeigen3-dev libopencv-dev libgeographiclib-dev libproj-dev libyaml-cpp-dev libcli11-dev
   nlohmann-json3-dev ccache libgtest-dev libgmock-dev libbenchmark-dev libtbb-dev libtiff-dev libtinyxml2-dev zlib1g-dev clang libclang-rt-dev
+  clang-format  # the style test (tests/style/check_format.sh, version 14)
   python3 python3-matplotlib python3-numpy poppler-utils
   python3-dev pybind11-dev python3-pytest
   weasyprint  # report.pdf: the HTML report typeset for A4 (tools/report/README.md)

@@ -2,9 +2,9 @@
 // option, one meaning (calib/problem/suspect_effect.h).
 #pragma once
 
-#include <CLI/CLI.hpp>
-
 #include "tools/option_ranges.h"
+
+#include <CLI/CLI.hpp>
 
 namespace aerocal::tools {
 

@@ -2,18 +2,20 @@
 
 namespace aerocal::calib {
 
-bool BrownFraser10Model::MeasuredFromIdeal(const double* params, const Eigen::Vector2d& ideal_mm,
-                                           Eigen::Vector2d* measured_mm, double tolerance_mm) {
+bool BrownFraser10Model::MeasuredFromIdeal(const double* params,
+                                           const Eigen::Vector2d& ideal_mm,
+                                           Eigen::Vector2d* measured_mm,
+                                           double tolerance_mm) {
   return MeasuredFromIdeal(params, ideal_mm.data(), measured_mm->data(), tolerance_mm);
 }
 
 bool BrownFraser10Model::ToOpenCv(const double* p, const PixelFrame& frame, OpenCvParams* cv) {
   cv->fill(0.0);
   const double pixel = frame.pixel_size_mm;
-  (*cv)[0] = p[kC] / ((1.0 + p[kB1]) * pixel);                 // fx
-  (*cv)[1] = p[kC] / pixel;                                    // fy
-  (*cv)[2] = p[kX0] / pixel + 0.5 * (frame.width_px - 1);      // cx
-  (*cv)[3] = -p[kY0] / pixel + 0.5 * (frame.height_px - 1);    // cy
+  (*cv)[0] = p[kC] / ((1.0 + p[kB1]) * pixel);               // fx
+  (*cv)[1] = p[kC] / pixel;                                  // fy
+  (*cv)[2] = p[kX0] / pixel + 0.5 * (frame.width_px - 1);    // cx
+  (*cv)[3] = -p[kY0] / pixel + 0.5 * (frame.height_px - 1);  // cy
   return p[kK1] == 0.0 && p[kK2] == 0.0 && p[kK3] == 0.0 && p[kP1] == 0.0 && p[kP2] == 0.0 &&
          p[kB2] == 0.0;
 }

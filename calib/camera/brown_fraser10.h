@@ -10,12 +10,12 @@
 // they obey collinearity: xb + dx = -c U / W, yb + dy = -c V / W.
 #pragma once
 
-#include <array>
-#include <string_view>
+#include "calib/camera/models/model_common.h"
 
 #include <Eigen/Core>
 
-#include "calib/camera/models/model_common.h"
+#include <array>
+#include <string_view>
 
 namespace aerocal::calib {
 
@@ -64,8 +64,10 @@ struct BrownFraser10Model {
 
   /// Inverse of IdealFromMeasured by Newton iteration: the measured photo coordinates (mm) whose
   /// ideal reduced coordinates are `ideal_mm`. Converges to |step| < tolerance_mm; false otherwise.
-  static bool MeasuredFromIdeal(const double* params, const Eigen::Vector2d& ideal_mm,
-                                Eigen::Vector2d* measured_mm, double tolerance_mm = 1e-11);
+  static bool MeasuredFromIdeal(const double* params,
+                                const Eigen::Vector2d& ideal_mm,
+                                Eigen::Vector2d* measured_mm,
+                                double tolerance_mm = 1e-11);
 
   // The uniform interface of the registry (camera_model.h, models/model_common.h).
   template <typename T>
@@ -73,19 +75,25 @@ struct BrownFraser10Model {
     return params[kC];
   }
   template <typename T>
-  static bool IdealFromMeasured(const T* params, const PixelFrame&, const T* measured_mm,
+  static bool IdealFromMeasured(const T* params,
+                                const PixelFrame&,
+                                const T* measured_mm,
                                 T* ideal_mm) {
     IdealFromMeasured(params, measured_mm, ideal_mm);
     return true;
   }
   /// Newton to 1e-10 px (Jet-safe: derivatives of the implicit solution).
   template <typename T>
-  static bool MeasuredFromIdeal(const T* params, const PixelFrame& frame, const T* ideal_mm,
+  static bool MeasuredFromIdeal(const T* params,
+                                const PixelFrame& frame,
+                                const T* ideal_mm,
                                 T* measured_mm) {
     return MeasuredFromIdeal(params, ideal_mm, measured_mm, 1e-10 * frame.pixel_size_mm);
   }
   template <typename T>
-  static bool MeasuredFromIdeal(const T* params, const T* ideal_mm, T* measured_mm,
+  static bool MeasuredFromIdeal(const T* params,
+                                const T* ideal_mm,
+                                T* measured_mm,
                                 double tolerance_mm) {
     const double start[2] = {ValueOf(ideal_mm[0]) + ValueOf(params[kX0]),
                              ValueOf(ideal_mm[1]) + ValueOf(params[kY0])};
@@ -93,8 +101,8 @@ struct BrownFraser10Model {
       IdealFromMeasured(p, xy, out);
     };
     const double centre[2] = {ValueOf(params[kX0]), ValueOf(params[kY0])};
-    return InvertMap2<kNumParams>(ideal, params, ideal_mm, start, measured_mm, tolerance_mm, 50,
-                                  centre);
+    return InvertMap2<kNumParams>(
+        ideal, params, ideal_mm, start, measured_mm, tolerance_mm, 50, centre);
   }
   /// Exact OpenCV equivalent when K1 = K2 = K3 = P1 = P2 = B2 = 0 (the affinity B1 becomes
   /// fx = c / ((1 + B1) p), fy = c / p); otherwise that pinhole part as a starting value.

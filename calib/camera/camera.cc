@@ -63,8 +63,10 @@ Camera Camera::WithModelCamera(const ModelCamera& camera) const {
   return out;
 }
 
-bool Camera::ProjectToPixel(const Eigen::Vector3d& opk_rad, const Eigen::Vector3d& center_m,
-                            const Eigen::Vector3d& point_m, Eigen::Vector2d* pixel) const {
+bool Camera::ProjectToPixel(const Eigen::Vector3d& opk_rad,
+                            const Eigen::Vector3d& center_m,
+                            const Eigen::Vector3d& point_m,
+                            Eigen::Vector2d* pixel) const {
   double uvw[3];
   ImageSpaceFromObject(opk_rad.data(), center_m.data(), point_m.data(), uvw);
   if (!(uvw[2] < 0)) return false;  // the camera looks along -W

@@ -10,18 +10,18 @@
 // the 10-parameter model (Camera::Model), and their readers refuse another one.
 #pragma once
 
+#include "calib/camera/brown_fraser10.h"
+#include "calib/camera/camera_model.h"
+#include "calib/camera/pixel_frame.h"
+#include "calib/camera/subimage_mapping.h"
+
+#include <Eigen/Core>
+
 #include <array>
 #include <initializer_list>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-
-#include "calib/camera/brown_fraser10.h"
-#include "calib/camera/camera_model.h"
-#include "calib/camera/pixel_frame.h"
-#include "calib/camera/subimage_mapping.h"
 
 namespace aerocal::calib {
 
@@ -74,9 +74,9 @@ using InteriorSigmas = ParamVector<std::optional<double>>;
 struct ReferencePoint {
   std::string id;
   std::string subimage;
-  double u = 0, v = 0;          // sub-image pixel
-  double U = 0, V = 0;          // virtual-image pixel
-  double sigma_px = 0.05;       // a-priori sigma of (U, V) relative to (u, v), px
+  double u = 0, v = 0;     // sub-image pixel
+  double U = 0, V = 0;     // virtual-image pixel
+  double sigma_px = 0.05;  // a-priori sigma of (U, V) relative to (u, v), px
 };
 
 struct Camera {
@@ -126,8 +126,10 @@ struct Camera {
 
   /// Measured virtual-image pixel of an object point seen from an exposure (opk rad, centre m).
   /// False when the point is behind the camera or the distortion inversion fails.
-  bool ProjectToPixel(const Eigen::Vector3d& opk_rad, const Eigen::Vector3d& center_m,
-                      const Eigen::Vector3d& point_m, Eigen::Vector2d* pixel) const;
+  bool ProjectToPixel(const Eigen::Vector3d& opk_rad,
+                      const Eigen::Vector3d& center_m,
+                      const Eigen::Vector3d& point_m,
+                      Eigen::Vector2d* pixel) const;
 
   /// Index of a sub-image by id; -1 when absent.
   int SubimageIndex(const std::string& id) const;

@@ -1,12 +1,12 @@
 #include "calib/camera/camera_io.h"
 
-#include <set>
-#include <sstream>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
+
+#include <set>
+#include <sstream>
 
 namespace aerocal::calib {
 namespace {
@@ -14,15 +14,15 @@ namespace {
 using Model = BrownFraser10Model;
 
 // Physical bounds of the camera file's values (calib/README.md "Camera file bounds").
-constexpr int kMaxFormatPx = 1000000;       // per side, virtual image or sub-image
-constexpr double kMaxPixelSizeMm = 1.0;     // 1 mm pixels
-constexpr double kMinPixelSizeMm = 1e-5;    // 10 nm pixels
-constexpr double kMaxCMm = 10000.0;         // 10 m principal distance
+constexpr int kMaxFormatPx = 1000000;              // per side, virtual image or sub-image
+constexpr double kMaxPixelSizeMm = 1.0;            // 1 mm pixels
+constexpr double kMinPixelSizeMm = 1e-5;           // 10 nm pixels
+constexpr double kMaxCMm = 10000.0;                // 10 m principal distance
 constexpr double kMinPrincipalDistancePx = 100.0;  // c / pixel size (a fisheye has about 400)
-constexpr double kMaxPpMm = 1e4;            // |x0|, |y0|
-constexpr double kMaxDistortion = 1e4;      // |K1..K3, P1, P2, B1, B2| (overflow-safe only)
-constexpr double kMaxMappingParam = 1e7;    // |sub-image mapping parameter|
-constexpr double kMaxPixelCoordinate = 1e7; // |u|, |v|, |U|, |V| of reference points, px
+constexpr double kMaxPpMm = 1e4;                   // |x0|, |y0|
+constexpr double kMaxDistortion = 1e4;             // |K1..K3, P1, P2, B1, B2| (overflow-safe only)
+constexpr double kMaxMappingParam = 1e7;           // |sub-image mapping parameter|
+constexpr double kMaxPixelCoordinate = 1e7;        // |u|, |v|, |U|, |V| of reference points, px
 constexpr double kMaxSigmaPx = 1e4;
 
 // Bound of |value| of a registered model's parameter, from its unit (calib/README.md "Camera file
@@ -30,8 +30,7 @@ constexpr double kMaxSigmaPx = 1e4;
 // coefficients as our distortion terms (overflow-safe only, not physical plausibility).
 double ModelParamBound(const ParamInfo& info) {
   if (info.unit == "px") return kMaxPixelCoordinate;
-  if (info.unit == "mm")
-    return info.group == ParamGroup::kPrincipalDistance ? kMaxCMm : kMaxPpMm;
+  if (info.unit == "mm") return info.group == ParamGroup::kPrincipalDistance ? kMaxCMm : kMaxPpMm;
   return kMaxDistortion;
 }
 
@@ -41,9 +40,9 @@ std::pair<int, int> ReadFormat(const YAML::Node& node, const std::string& file) 
   const int w = YamlInt(node[0], file, "format_px width");
   const int h = YamlInt(node[1], file, "format_px height");
   if (w <= 0 || h <= 0 || w > kMaxFormatPx || h > kMaxFormatPx)
-    ThrowInputError(WhereIs(node, file), "format_px must be within 1 .. " +
-                                             std::to_string(kMaxFormatPx) + " (got [" +
-                                             std::to_string(w) + ", " + std::to_string(h) + "])");
+    ThrowInputError(WhereIs(node, file),
+                    "format_px must be within 1 .. " + std::to_string(kMaxFormatPx) + " (got [" +
+                        std::to_string(w) + ", " + std::to_string(h) + "])");
   return {w, h};
 }
 
@@ -52,9 +51,11 @@ SubimageMapping ReadSubimage(const YAML::Node& node, const std::string& file) {
   SubimageMapping s;
   if (!node["id"]) ThrowInputError(WhereIs(node, file), "sub-image needs an 'id'");
   s.id = YamlString(node["id"], file, "id");
-  if (!node["format_px"]) ThrowInputError(WhereIs(node, file), "sub-image " + s.id + " needs format_px");
+  if (!node["format_px"])
+    ThrowInputError(WhereIs(node, file), "sub-image " + s.id + " needs format_px");
   std::tie(s.width_px, s.height_px) = ReadFormat(node["format_px"], file);
-  const std::string model_name = node["model"] ? YamlString(node["model"], file, "model") : "affine";
+  const std::string model_name =
+      node["model"] ? YamlString(node["model"], file, "model") : "affine";
   const auto model = ParseMappingModel(model_name);
   if (!model)
     ThrowInputError(WhereIs(node["model"], file),
@@ -64,9 +65,9 @@ SubimageMapping ReadSubimage(const YAML::Node& node, const std::string& file) {
   if (node["params"]) {
     const YAML::Node& p = node["params"];
     if (!p.IsSequence() || static_cast<int>(p.size()) != MappingParamCount(s.model))
-      ThrowInputError(WhereIs(p, file), "sub-image " + s.id + ": model " + model_name + " needs " +
-                                            std::to_string(MappingParamCount(s.model)) +
-                                            " params");
+      ThrowInputError(WhereIs(p, file),
+                      "sub-image " + s.id + ": model " + model_name + " needs " +
+                          std::to_string(MappingParamCount(s.model)) + " params");
     for (const auto& v : p)
       s.params.push_back(YamlBounded(v, file, "params", -kMaxMappingParam, kMaxMappingParam));
   } else {
@@ -75,12 +76,14 @@ SubimageMapping ReadSubimage(const YAML::Node& node, const std::string& file) {
   return s;
 }
 
-ReferencePoint ReadReferencePoint(const YAML::Node& node, const std::string& file,
+ReferencePoint ReadReferencePoint(const YAML::Node& node,
+                                  const std::string& file,
                                   const Camera& camera) {
   RejectUnknownKeys(node, {"id", "subimage", "u", "v", "U", "V", "sigma_px"}, file);
   ReferencePoint r;
   for (const char* key : {"id", "subimage", "u", "v", "U", "V"})
-    if (!node[key]) ThrowInputError(WhereIs(node, file), std::string("reference point needs '") + key + "'");
+    if (!node[key])
+      ThrowInputError(WhereIs(node, file), std::string("reference point needs '") + key + "'");
   r.id = YamlString(node["id"], file, "id");
   r.subimage = YamlString(node["subimage"], file, "subimage");
   if (camera.SubimageIndex(r.subimage) < 0)
@@ -90,43 +93,57 @@ ReferencePoint ReadReferencePoint(const YAML::Node& node, const std::string& fil
   r.v = YamlBounded(node["v"], file, "v", -kMaxPixelCoordinate, kMaxPixelCoordinate);
   r.U = YamlBounded(node["U"], file, "U", -kMaxPixelCoordinate, kMaxPixelCoordinate);
   r.V = YamlBounded(node["V"], file, "V", -kMaxPixelCoordinate, kMaxPixelCoordinate);
-  if (node["sigma_px"]) r.sigma_px = YamlBounded(node["sigma_px"], file, "sigma_px", 0, kMaxSigmaPx);
+  if (node["sigma_px"])
+    r.sigma_px = YamlBounded(node["sigma_px"], file, "sigma_px", 0, kMaxSigmaPx);
   if (!(r.sigma_px > 0))
-    ThrowInputError(WhereIs(node, file), "reference point " + r.id + ": sigma_px must be > 0 (got " +
-                                             FormatNumber(r.sigma_px) + ")");
+    ThrowInputError(WhereIs(node, file),
+                    "reference point " + r.id + ": sigma_px must be > 0 (got " +
+                        FormatNumber(r.sigma_px) + ")");
   return r;
 }
 
 }  // namespace
 
-Camera ParseCamera(const YAML::Node& root, const std::string& file, CameraModels models,
+Camera ParseCamera(const YAML::Node& root,
+                   const std::string& file,
+                   CameraModels models,
                    const std::vector<std::string>& record_keys) {
   if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
-  std::vector<std::string> allowed = {"name", "pixel_size_mm", "format_px", "interior", "interior_sigma",
-                                      "subimages", "reference_points", "model"};
+  std::vector<std::string> allowed = {"name",
+                                      "pixel_size_mm",
+                                      "format_px",
+                                      "interior",
+                                      "interior_sigma",
+                                      "subimages",
+                                      "reference_points",
+                                      "model"};
   allowed.insert(allowed.end(), record_keys.begin(), record_keys.end());
   RejectUnknownKeys(root, allowed, file);
   const std::string model_name =
       root["model"] ? YamlString(root["model"], file, "model") : std::string(Model::kName);
   const std::optional<CameraModelId> id = CameraModelFromName(model_name);
   if (!id)
-    ThrowInputError(WhereIs(root["model"], file),
-                    "unknown camera model '" + model_name + "' (expected one of " +
-                        CameraModelNames() + ")");
+    ThrowInputError(
+        WhereIs(root["model"], file),
+        "unknown camera model '" + model_name + "' (expected one of " + CameraModelNames() + ")");
   if (*id != Model::kId && models == CameraModels::kBrownFraser10Only)
     ThrowInputError(WhereIs(root["model"], file),
                     "camera model '" + model_name + "': this command needs " +
-                        std::string(Model::kName) + " (convert it first: aerocal camera convert "
-                        "--to aerocal --model " + std::string(Model::kName) + ")");
+                        std::string(Model::kName) +
+                        " (convert it first: aerocal camera convert "
+                        "--to aerocal --model " +
+                        std::string(Model::kName) + ")");
   if (*id != Model::kId && (root["subimages"] || root["reference_points"]))
     ThrowInputError(WhereIs(root["model"], file),
-                    "camera model '" + model_name + "': sub-image mappings and reference points "
-                    "need " + std::string(Model::kName) + " (convert the camera first)");
+                    "camera model '" + model_name +
+                        "': sub-image mappings and reference points "
+                        "need " +
+                        std::string(Model::kName) + " (convert the camera first)");
   Camera camera = Camera::OfModel(*id);
   camera.name = root["name"] ? YamlString(root["name"], file, "name") : "";
   if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
-  camera.pixel_size_mm = YamlBounded(root["pixel_size_mm"], file, "pixel_size_mm", kMinPixelSizeMm,
-                                     kMaxPixelSizeMm);
+  camera.pixel_size_mm =
+      YamlBounded(root["pixel_size_mm"], file, "pixel_size_mm", kMinPixelSizeMm, kMaxPixelSizeMm);
   if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
   std::tie(camera.width_px, camera.height_px) = ReadFormat(root["format_px"], file);
   // The interior and its sigmas are keyed by the model's parameter table: a new model needs
@@ -151,12 +168,14 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file, CameraModels
                           " (got " + FormatNumber(camera.interior[i]) + ")");
     // At least kMinPrincipalDistancePx pixels: a principal distance of 1e-9 mm is no lens (every
     // ray leaves the format at once) and passed as one.
-    const double c_px = table[i].unit == "px" ? camera.interior[i] : camera.interior[i] / camera.pixel_size_mm;
+    const double c_px =
+        table[i].unit == "px" ? camera.interior[i] : camera.interior[i] / camera.pixel_size_mm;
     if (table[i].unit != "1" && !(c_px >= kMinPrincipalDistancePx))
       ThrowInputError(WhereIs(interior[keys[i]] ? interior[keys[i]] : interior, file),
-                      "interior." + keys[i] + " must be at least " + FormatNumber(kMinPrincipalDistancePx) +
-                          " pixels (got " + FormatNumber(camera.interior[i]) + " " +
-                          std::string(table[i].unit) + " = " + FormatNumber(c_px) + " px)");
+                      "interior." + keys[i] + " must be at least " +
+                          FormatNumber(kMinPrincipalDistancePx) + " pixels (got " +
+                          FormatNumber(camera.interior[i]) + " " + std::string(table[i].unit) +
+                          " = " + FormatNumber(c_px) + " px)");
   }
   if (root["interior_sigma"]) {
     const YAML::Node& sig = root["interior_sigma"];
@@ -178,7 +197,8 @@ Camera ParseCamera(const YAML::Node& root, const std::string& file, CameraModels
     for (const auto& node : root["subimages"]) {
       camera.subimages.push_back(ReadSubimage(node, file));
       if (!ids.insert(camera.subimages.back().id).second)
-        ThrowInputError(WhereIs(node, file), "duplicate sub-image id '" + camera.subimages.back().id + "'");
+        ThrowInputError(WhereIs(node, file),
+                        "duplicate sub-image id '" + camera.subimages.back().id + "'");
     }
   }
   if (root["reference_points"]) {
@@ -218,8 +238,7 @@ std::string CameraToYaml(const Camera& camera) {
     out << YAML::Key << "interior_sigma" << YAML::Value << YAML::BeginMap;
     for (size_t i = 0; i < table.size(); ++i)
       if (camera.interior_sigma[i])
-        out << YAML::Key << std::string(table[i].name) << YAML::Value
-            << *camera.interior_sigma[i];
+        out << YAML::Key << std::string(table[i].name) << YAML::Value << *camera.interior_sigma[i];
     out << YAML::EndMap;
   }
   if (!camera.subimages.empty()) {
@@ -237,11 +256,11 @@ std::string CameraToYaml(const Camera& camera) {
   if (!camera.reference_points.empty()) {
     out << YAML::Key << "reference_points" << YAML::Value << YAML::BeginSeq;
     for (const auto& r : camera.reference_points) {
-      out << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << r.id
-          << YAML::Key << "subimage" << YAML::Value << r.subimage << YAML::Key << "u"
-          << YAML::Value << r.u << YAML::Key << "v" << YAML::Value << r.v << YAML::Key << "U"
-          << YAML::Value << r.U << YAML::Key << "V" << YAML::Value << r.V << YAML::Key
-          << "sigma_px" << YAML::Value << r.sigma_px << YAML::EndMap;
+      out << YAML::Flow << YAML::BeginMap << YAML::Key << "id" << YAML::Value << r.id << YAML::Key
+          << "subimage" << YAML::Value << r.subimage << YAML::Key << "u" << YAML::Value << r.u
+          << YAML::Key << "v" << YAML::Value << r.v << YAML::Key << "U" << YAML::Value << r.U
+          << YAML::Key << "V" << YAML::Value << r.V << YAML::Key << "sigma_px" << YAML::Value
+          << r.sigma_px << YAML::EndMap;
     }
     out << YAML::EndSeq;
   }

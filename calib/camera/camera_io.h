@@ -3,13 +3,13 @@
 // point on an unknown sub-image) are InputError("FILE:LINE: what").
 #pragma once
 
-#include <string>
-#include <vector>
+#include "calib/camera/camera.h"
+#include "calib/camera/camera_model.h"
 
 #include <yaml-cpp/yaml.h>
 
-#include "calib/camera/camera.h"
-#include "calib/camera/camera_model.h"
+#include <string>
+#include <vector>
 
 namespace aerocal::calib {
 

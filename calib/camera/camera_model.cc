@@ -11,8 +11,11 @@ std::optional<CameraModelId> CameraModelFromName(std::string_view name) {
 }
 
 namespace {
-using ColmapModels = CameraModelList<ColmapSimplePinholeModel, ColmapPinholeModel,
-                                     ColmapSimpleRadialModel, ColmapRadialModel, ColmapOpenCvModel,
+using ColmapModels = CameraModelList<ColmapSimplePinholeModel,
+                                     ColmapPinholeModel,
+                                     ColmapSimpleRadialModel,
+                                     ColmapRadialModel,
+                                     ColmapOpenCvModel,
                                      ColmapFullOpenCvModel>;
 }  // namespace
 

@@ -7,23 +7,14 @@
 //   kId (a frozen CameraModelId), kName (the YAML/JSON string), an Index enum, kNumParams,
 //   kParams (constexpr table: name, unit, group), kCorrectionForm, and the uniform functions in
 //   photo mm (models/model_common.h):
-//     template <T> bool IdealFromMeasured(const T* params, const PixelFrame&, const T* xy, T* ideal)
-//     template <T> bool MeasuredFromIdeal(const T* params, const PixelFrame&, const T* ideal, T* xy)
-//     template <T> T PrincipalDistanceMm(const T* params, const PixelFrame&)
-//     bool ToOpenCv(const double*, const PixelFrame&, OpenCvParams*)      // true: exact
-//     bool FromOpenCv(const OpenCvParams&, const PixelFrame&, double*)    // true: exact
+//     template <T> bool IdealFromMeasured(const T* params, const PixelFrame&, const T* xy, T*
+//     ideal) template <T> bool MeasuredFromIdeal(const T* params, const PixelFrame&, const T*
+//     ideal, T* xy) template <T> T PrincipalDistanceMm(const T* params, const PixelFrame&) bool
+//     ToOpenCv(const double*, const PixelFrame&, OpenCvParams*)      // true: exact bool
+//     FromOpenCv(const OpenCvParams&, const PixelFrame&, double*)    // true: exact
 // The templated functions work with ceres::Jet; one formula serves the solver and the
 // double-precision code.
 #pragma once
-
-#include <optional>
-#include <stdexcept>
-#include <string>
-#include <string_view>
-#include <utility>
-#include <vector>
-
-#include <Eigen/Core>
 
 #include "calib/camera/brown_fraser10.h"
 #include "calib/camera/models/colmap.h"
@@ -33,23 +24,39 @@
 #include "calib/camera/pixel_frame.h"
 #include "calib/core/error.h"
 
+#include <Eigen/Core>
+
+#include <optional>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
 namespace aerocal::calib {
 
 template <typename... Models>
 struct CameraModelList {};
 
 /// Every registered model. Adding a model: its header, one entry here (and its CameraModelId).
-using RegisteredCameraModels =
-    CameraModelList<BrownFraser10Model, OpenCvModel, OpenCvFisheyeModel, ColmapSimplePinholeModel,
-                    ColmapPinholeModel, ColmapSimpleRadialModel, ColmapRadialModel,
-                    ColmapOpenCvModel, ColmapFullOpenCvModel, MetashapeFrameModel,
-                    Pix4dPerspectiveModel>;
+using RegisteredCameraModels = CameraModelList<BrownFraser10Model,
+                                               OpenCvModel,
+                                               OpenCvFisheyeModel,
+                                               ColmapSimplePinholeModel,
+                                               ColmapPinholeModel,
+                                               ColmapSimpleRadialModel,
+                                               ColmapRadialModel,
+                                               ColmapOpenCvModel,
+                                               ColmapFullOpenCvModel,
+                                               MetashapeFrameModel,
+                                               Pix4dPerspectiveModel>;
 
 namespace internal {
 template <typename Visitor, typename First, typename... Rest>
 decltype(auto) VisitIn(CameraModelId id, Visitor&& visitor, CameraModelList<First, Rest...>) {
   if constexpr (sizeof...(Rest) == 0) {
-    if (id != First::kId) throw LogicError("unregistered camera model id " + std::to_string(static_cast<int>(id)));
+    if (id != First::kId)
+      throw LogicError("unregistered camera model id " + std::to_string(static_cast<int>(id)));
     return visitor(First{});
   } else {
     if (id == First::kId) return visitor(First{});

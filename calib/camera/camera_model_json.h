@@ -3,9 +3,9 @@
 // the model.
 #pragma once
 
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_model.h"
+
+#include <nlohmann/json.hpp>
 
 namespace aerocal::calib {
 

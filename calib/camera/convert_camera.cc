@@ -1,11 +1,11 @@
 #include "calib/camera/convert_camera.h"
 
+#include "calib/problem/problem_builder.h"
+#include "calib/residuals/autodiff_residual.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-
-#include "calib/problem/problem_builder.h"
-#include "calib/residuals/autodiff_residual.h"
 
 namespace aerocal::calib {
 namespace {
@@ -16,7 +16,8 @@ namespace {
 template <typename Model>
 struct ConversionFitResidual
     : AutoDiffResidual<ConversionFitResidual<Model>, 2, Model::kNumParams> {
-  ConversionFitResidual(const PixelFrame& frame, const Eigen::Vector2d& measured_mm,
+  ConversionFitResidual(const PixelFrame& frame,
+                        const Eigen::Vector2d& measured_mm,
                         const Eigen::Vector2d& direction)
       : frame_(frame), measured_mm_(measured_mm), direction_(direction) {}
   template <typename T>
@@ -45,13 +46,14 @@ struct ConversionFitResidual
 };
 
 template <typename Model>
-int FitParameters(const ModelCamera& from, const ConvertOptions& options,
+int FitParameters(const ModelCamera& from,
+                  const ConvertOptions& options,
                   std::vector<double>* params) {
   ProblemBuilder builder;
   std::vector<std::string> names;
   for (const auto& info : Model::kParams) names.emplace_back(info.name);
-  const BlockId block = builder.AddBlock("camera", params->data(), Model::kNumParams,
-                                         BlockKind::kInterior, names);
+  const BlockId block =
+      builder.AddBlock("camera", params->data(), Model::kNumParams, BlockKind::kInterior, names);
   std::vector<int> fixed;
   std::vector<std::string> held = options.fixed;
   held.insert(held.end(), options.zero.begin(), options.zero.end());
@@ -69,10 +71,11 @@ int FitParameters(const ModelCamera& from, const ConvertOptions& options,
   for (const Eigen::Vector2d& pixel : FormatGrid(from.frame, options.fit_grid)) {
     Eigen::Vector2d ideal;
     if (!from.IdealFromPixel(pixel, &ideal)) continue;
-    builder.AddResidual("conversion", ConversionFitResidual<Model>::Create(
-                                          from.frame, from.frame.PhotoFromPixel(pixel),
-                                          Eigen::Vector2d(ideal / c_from)),
-                        {block});
+    builder.AddResidual(
+        "conversion",
+        ConversionFitResidual<Model>::Create(
+            from.frame, from.frame.PhotoFromPixel(pixel), Eigen::Vector2d(ideal / c_from)),
+        {block});
   }
   SolverOptions solver;
   solver.max_iterations = 200;
@@ -124,7 +127,8 @@ ConversionResidual CompareCameras(const ModelCamera& a, const ModelCamera& b, in
   return out;
 }
 
-ConversionResult ConvertCamera(const ModelCamera& from, CameraModelId to,
+ConversionResult ConvertCamera(const ModelCamera& from,
+                               CameraModelId to,
                                const ConvertOptions& options) {
   AEROCAL_CHECK(static_cast<int>(from.params.size()) == CameraModelParamCount(from.model))
       << CameraModelName(from.model) << " needs " << CameraModelParamCount(from.model)
@@ -171,16 +175,21 @@ ConversionResult ConvertCamera(const ModelCamera& from, CameraModelId to,
 
 std::string ConversionResult::Summary() const {
   char buffer[320];
-  std::snprintf(buffer, sizeof(buffer),
-                "%s %s: residual rms %.3g px, max %.3g px at pixel (%.0f, %.0f), max within 80 %% "
-                "of the half-diagonal %.3g px%s",
-                std::string(CameraModelName(camera.model)).c_str(),
-                exact ? "(exact)" : "(least-squares fit)", residual.rms_px, residual.max_px,
-                residual.max_at_px.x(), residual.max_at_px.y(), residual.max_inner80_px,
-                residual.failed_points
-                    ? (", " + std::to_string(residual.failed_points) + " points not invertible")
-                          .c_str()
-                    : "");
+  std::snprintf(
+      buffer,
+      sizeof(buffer),
+      "%s %s: residual rms %.3g px, max %.3g px at pixel (%.0f, %.0f), max within 80 %% "
+      "of the half-diagonal %.3g px%s",
+      std::string(CameraModelName(camera.model)).c_str(),
+      exact ? "(exact)" : "(least-squares fit)",
+      residual.rms_px,
+      residual.max_px,
+      residual.max_at_px.x(),
+      residual.max_at_px.y(),
+      residual.max_inner80_px,
+      residual.failed_points
+          ? (", " + std::to_string(residual.failed_points) + " points not invertible").c_str()
+          : "");
   return buffer;
 }
 

@@ -12,19 +12,19 @@
 // half-diagonal. A fit that leaves more than ConvertOptions::max_residual_px is not `acceptable`.
 #pragma once
 
+#include "calib/camera/camera_model.h"
+
+#include <Eigen/Core>
+
 #include <limits>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
-#include "calib/camera/camera_model.h"
-
 namespace aerocal::calib {
 
 struct ConvertOptions {
-  int fit_grid = 41;    // fit points per format side (>= 5)
-  int check_grid = 101; // residual points per format side (>= 2)
+  int fit_grid = 41;     // fit points per format side (>= 5)
+  int check_grid = 101;  // residual points per format side (>= 2)
   /// Target parameters (table names) held at their starting values in a fit.
   std::vector<std::string> fixed;
   /// Target parameters the caller's file format cannot hold: set to 0 and held there (a closed
@@ -35,7 +35,7 @@ struct ConvertOptions {
 
 struct ConversionResidual {
   int points = 0;
-  int failed_points = 0;       // where a model's inversion did not converge (counted, not hidden)
+  int failed_points = 0;  // where a model's inversion did not converge (counted, not hidden)
   double rms_px = 0.0;
   double max_px = 0.0;
   Eigen::Vector2d max_at_px{0.0, 0.0};  // pixel (col, row) of the max
@@ -47,12 +47,13 @@ struct ConversionResult {
   bool exact = false;
   bool acceptable = false;  // residual.max_px <= max_residual_px and no failed points
   ConversionResidual residual;
-  int fit_iterations = 0;   // 0 for an exact conversion
+  int fit_iterations = 0;  // 0 for an exact conversion
   std::string Summary() const;
 };
 
 /// `from` expressed in model `to` over the same format.
-ConversionResult ConvertCamera(const ModelCamera& from, CameraModelId to,
+ConversionResult ConvertCamera(const ModelCamera& from,
+                               CameraModelId to,
                                const ConvertOptions& options = {});
 
 /// n x n pixel centres over the format, corners included, row by row.

@@ -1,10 +1,10 @@
 #include "calib/camera/distortion_folding.h"
 
-#include <cmath>
-#include <string>
-
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
+
+#include <cmath>
+#include <string>
 
 namespace aerocal::calib {
 
@@ -13,7 +13,8 @@ DistortionFolding FindDistortionFolding(const ModelCamera& camera) {
   AEROCAL_CHECK(frame.width_px > 0 && frame.height_px > 0 && frame.pixel_size_mm > 0)
       << "a camera format must be positive";
   DistortionFolding out;
-  const double w_mm = frame.width_px * frame.pixel_size_mm, h_mm = frame.height_px * frame.pixel_size_mm;
+  const double w_mm = frame.width_px * frame.pixel_size_mm,
+               h_mm = frame.height_px * frame.pixel_size_mm;
   out.half_diagonal_mm = 0.5 * std::hypot(w_mm, h_mm);
   // The principal point (measured) is the pixel of the ideal origin.
   Eigen::Vector2d pp_px;
@@ -63,7 +64,9 @@ std::string DistortionFoldingWarning(const DistortionFolding& folding) {
       "the distortion folds at r = %.4g mm from the principal point (direction %.0f deg), inside "
       "the format (half diagonal %.4g mm): beyond it two image points map to one ray; the "
       "distortion parameters are not those of a lens",
-      *folding.radius_mm, folding.direction_deg, folding.half_diagonal_mm);
+      *folding.radius_mm,
+      folding.direction_deg,
+      folding.half_diagonal_mm);
 }
 
 }  // namespace aerocal::calib

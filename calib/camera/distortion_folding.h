@@ -8,9 +8,9 @@
 // model), in 16 directions, at steps of 1/2000 of the format's half diagonal up to 1.5 times it.
 #pragma once
 
-#include <optional>
-
 #include "calib/camera/camera_model.h"
+
+#include <optional>
 
 namespace aerocal::calib {
 
@@ -18,9 +18,9 @@ struct DistortionFolding {
   /// Smallest measured radius (mm from the principal point, photo frame) at which the ideal radius
   /// stops growing or the model cannot be inverted; nullopt when none up to 1.5 half diagonals.
   std::optional<double> radius_mm;
-  double direction_deg = 0;          // direction of that radius (photo frame, from +x towards +y)
-  double half_diagonal_mm = 0;       // of the format, from the format centre
-  bool inside_format = false;        // the folding point lies inside the image format
+  double direction_deg = 0;     // direction of that radius (photo frame, from +x towards +y)
+  double half_diagonal_mm = 0;  // of the format, from the format centre
+  bool inside_format = false;   // the folding point lies inside the image format
 };
 
 /// The folding radius of `camera` (its format must be positive: LogicError otherwise).

@@ -1,10 +1,10 @@
 #include "calib/camera/line_camera.h"
 
-#include <cmath>
-
 #include "calib/camera/rotation.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+
+#include <cmath>
 
 namespace aerocal::calib {
 
@@ -76,25 +76,29 @@ void LineCamera::Validate(const std::string& file) const {
   if (!(pitch_mm > 0)) ThrowInputError(where, "line.pitch_mm must be > 0");
   if (!(c_mm > 0)) ThrowInputError(where, "line.c must be > 0");
   if (!dx_mm.empty() && !calibration.empty())
-    ThrowInputError(where, "line: give either dx_mm/dy_mm tables or calibration polynomials, not both");
+    ThrowInputError(where,
+                    "line: give either dx_mm/dy_mm tables or calibration polynomials, not both");
   if (dx_mm.size() != dy_mm.size() || (!dx_mm.empty() && int(dx_mm.size()) != detectors))
-    ThrowInputError(where, "line.dx_mm and line.dy_mm must both hold line.detectors (" +
-                               std::to_string(detectors) + ") values (got " +
-                               std::to_string(dx_mm.size()) + " and " +
-                               std::to_string(dy_mm.size()) + ")");
+    ThrowInputError(where,
+                    "line.dx_mm and line.dy_mm must both hold line.detectors (" +
+                        std::to_string(detectors) + ") values (got " +
+                        std::to_string(dx_mm.size()) + " and " + std::to_string(dy_mm.size()) +
+                        ")");
   // Ranges: contiguous, in order, covering 0 .. N-1.
   auto check_ranges = [&](const std::vector<std::pair<int, int>>& ranges, const std::string& what) {
     int next = 0;
     for (const auto& [first, last] : ranges) {
       if (first != next || last < first)
-        ThrowInputError(where, what + " ranges must be contiguous from detector 0, in order (range [" +
-                                   std::to_string(first) + ", " + std::to_string(last) +
-                                   "] should start at " + std::to_string(next) + ")");
+        ThrowInputError(where,
+                        what + " ranges must be contiguous from detector 0, in order (range [" +
+                            std::to_string(first) + ", " + std::to_string(last) +
+                            "] should start at " + std::to_string(next) + ")");
       next = last + 1;
     }
     if (next != detectors)
-      ThrowInputError(where, what + " ranges end at detector " + std::to_string(next - 1) +
-                                 ", expected line.detectors - 1 = " + std::to_string(detectors - 1));
+      ThrowInputError(where,
+                      what + " ranges end at detector " + std::to_string(next - 1) +
+                          ", expected line.detectors - 1 = " + std::to_string(detectors - 1));
   };
   if (!subcameras.empty()) {
     std::vector<std::pair<int, int>> r;
@@ -113,8 +117,9 @@ void LineCamera::Validate(const std::string& file) const {
       // Each polynomial range lies within one sub-camera (jumps only at seams).
       for (const auto& p : calibration)
         if (SubcameraOf(p.first) != SubcameraOf(p.last))
-          ThrowInputError(where, "line.calibration range [" + std::to_string(p.first) + ", " +
-                                     std::to_string(p.last) + "] spans a sub-camera seam");
+          ThrowInputError(where,
+                          "line.calibration range [" + std::to_string(p.first) + ", " +
+                              std::to_string(p.last) + "] spans a sub-camera seam");
     }
   }
   // The design must put every detector in front of the virtual camera.
@@ -124,11 +129,12 @@ void LineCamera::Validate(const std::string& file) const {
           RotationFromOpk(s.mount_rad) *
           Eigen::Vector3d((i - s.first - 0.5 * (s.Count() - 1)) * s.pitch_mm, 0.0, -s.c_mm);
       if (!(d.z() < -1e-3 * d.norm()))
-        ThrowInputError(where, "sub-camera " + s.id + ": detector " + std::to_string(i) +
-                                   " looks sideways or backwards in the virtual camera (mount " +
-                                   FormatNumber(s.mount_rad.x() * 180 / M_PI) + ", " +
-                                   FormatNumber(s.mount_rad.y() * 180 / M_PI) + ", " +
-                                   FormatNumber(s.mount_rad.z() * 180 / M_PI) + " deg)");
+        ThrowInputError(where,
+                        "sub-camera " + s.id + ": detector " + std::to_string(i) +
+                            " looks sideways or backwards in the virtual camera (mount " +
+                            FormatNumber(s.mount_rad.x() * 180 / M_PI) + ", " +
+                            FormatNumber(s.mount_rad.y() * 180 / M_PI) + ", " +
+                            FormatNumber(s.mount_rad.z() * 180 / M_PI) + " deg)");
     }
 }
 

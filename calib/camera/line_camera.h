@@ -12,29 +12,29 @@
 //   virtual focal plane: x = -c d_x / d_z, y = -c d_y / d_z (the patent's "stitching with the
 //   design parameters");
 // - CALIBRATION (dx_i, dy_i) mm is added to the design position: x_i = design_x(i) + dx_i,
-//   y_i = design_y(i) + dy_i. Without sub-cameras this is CONVENTIONS' x_i = (i - (N-1)/2) p + dx_i,
-//   y_i = dy_i exactly. It is a table (one value per detector; linear interpolation at fractional
-//   detector positions) or a polynomial per sub-camera in the NORMALISED index
-//   u = (2 i - first - last) / (last - first) in [-1, 1]: dx(i) = sum_k a_k u^k (mm).
+//   y_i = design_y(i) + dy_i. Without sub-cameras this is CONVENTIONS' x_i = (i - (N-1)/2) p +
+//   dx_i, y_i = dy_i exactly. It is a table (one value per detector; linear interpolation at
+//   fractional detector positions) or a polynomial per sub-camera in the NORMALISED index u = (2 i
+//   - first - last) / (last - first) in [-1, 1]: dx(i) = sum_k a_k u^k (mm).
 //
 // The patent (GFHK camera) writes the line along its y axis: a file in that convention swaps x and
 // y at the reader, never here.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace aerocal::calib {
 
 /// One physical line camera of the combination (design values).
 struct LineSubcamera {
   std::string id;
-  int first = 0, last = 0;                                // detector range in the virtual sequence
-  double c_mm = 0.0;                                      // its principal distance, > 0
-  double pitch_mm = 0.0;                                  // its detector pitch, > 0
-  Eigen::Vector3d mount_rad = Eigen::Vector3d::Zero();    // sub-camera -> virtual camera frame
+  int first = 0, last = 0;                              // detector range in the virtual sequence
+  double c_mm = 0.0;                                    // its principal distance, > 0
+  double pitch_mm = 0.0;                                // its detector pitch, > 0
+  Eigen::Vector3d mount_rad = Eigen::Vector3d::Zero();  // sub-camera -> virtual camera frame
   int Count() const { return last - first + 1; }
 };
 
@@ -51,12 +51,12 @@ struct LinePolynomial {
 
 struct LineCamera {
   std::string name;
-  int detectors = 0;                                        // N, > 0
-  double pitch_mm = 0.0;                                    // p, > 0
-  double c_mm = 0.0;                                        // principal distance, > 0
-  Eigen::Vector3d mount_rad = Eigen::Vector3d::Zero();      // virtual camera -> body (rad)
-  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();    // camera centre in the body frame (m)
-  std::vector<LineSubcamera> subcameras;  // empty: one straight line
+  int detectors = 0;                                      // N, > 0
+  double pitch_mm = 0.0;                                  // p, > 0
+  double c_mm = 0.0;                                      // principal distance, > 0
+  Eigen::Vector3d mount_rad = Eigen::Vector3d::Zero();    // virtual camera -> body (rad)
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();  // camera centre in the body frame (m)
+  std::vector<LineSubcamera> subcameras;                  // empty: one straight line
   /// Calibration: a table (size N each, or both empty) or polynomials (one per range).
   std::vector<double> dx_mm, dy_mm;
   std::vector<LinePolynomial> calibration;

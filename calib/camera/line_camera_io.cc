@@ -1,11 +1,11 @@
 #include "calib/camera/line_camera_io.h"
 
-#include <cmath>
-
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
+
+#include <cmath>
 
 namespace aerocal::calib {
 namespace {
@@ -20,22 +20,28 @@ constexpr double kMaxLeverArmM = 1000.0;
 constexpr double kMaxCorrectionMm = 1000.0;  // |dx|, |dy|, |polynomial coefficient|
 constexpr int kMaxPolynomialTerms = 10;
 
-double ReadPositive(const YAML::Node& node, const std::string& file, const std::string& what,
-                    double lo, double hi) {
+double ReadPositive(const YAML::Node& node,
+                    const std::string& file,
+                    const std::string& what,
+                    double lo,
+                    double hi) {
   const double value = YamlDouble(node, file, what);
   if (!(value >= lo && value <= hi && value > 0))
-    ThrowInputError(WhereIs(node, file), what + " must be within (" + FormatNumber(lo) + ", " +
-                                             FormatNumber(hi) + "] (got " + node.Scalar() + ")");
+    ThrowInputError(WhereIs(node, file),
+                    what + " must be within (" + FormatNumber(lo) + ", " + FormatNumber(hi) +
+                        "] (got " + node.Scalar() + ")");
   return value;
 }
 
-std::vector<double> ReadNumbers(const YAML::Node& node, const std::string& file,
-                                const std::string& what, size_t max_size) {
-  if (!node.IsSequence())
-    ThrowInputError(WhereIs(node, file), what + " must be a list of numbers");
+std::vector<double> ReadNumbers(const YAML::Node& node,
+                                const std::string& file,
+                                const std::string& what,
+                                size_t max_size) {
+  if (!node.IsSequence()) ThrowInputError(WhereIs(node, file), what + " must be a list of numbers");
   if (node.size() > max_size)
-    ThrowInputError(WhereIs(node, file), what + " holds at most " + std::to_string(max_size) +
-                                             " values (got " + std::to_string(node.size()) + ")");
+    ThrowInputError(WhereIs(node, file),
+                    what + " holds at most " + std::to_string(max_size) + " values (got " +
+                        std::to_string(node.size()) + ")");
   std::vector<double> values;
   values.reserve(node.size());
   for (const auto& v : node)
@@ -60,7 +66,7 @@ void ConvertLineAxis(LineCamera* camera, bool to_ours) {
   for (auto& s : camera->subcameras)
     s.mount_rad = OpkFromRotation(r.transpose() * RotationFromOpk(s.mount_rad) * r);
   const auto swap = [to_ours](std::vector<double>* x, std::vector<double>* y) {
-    std::swap(*x, *y);                      // to ours: x = y_file, y = x_file ...
+    std::swap(*x, *y);                           // to ours: x = y_file, y = x_file ...
     for (double& v : to_ours ? *y : *x) v = -v;  // ... then y = -x_file (back: x_file = -y)
   };
   swap(&camera->dx_mm, &camera->dy_mm);
@@ -82,8 +88,17 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
   const YAML::Node& line = root["line"];
   if (!line || !line.IsMap())
     ThrowInputError(WhereIs(line ? line : root, file), "a line-camera file needs a 'line' map");
-  RejectUnknownKeys(line, {"detectors", "pitch_mm", "c", "mount_deg", "lever_arm_m", "subcameras",
-                           "dx_mm", "dy_mm", "calibration", "line_axis"},
+  RejectUnknownKeys(line,
+                    {"detectors",
+                     "pitch_mm",
+                     "c",
+                     "mount_deg",
+                     "lever_arm_m",
+                     "subcameras",
+                     "dx_mm",
+                     "dy_mm",
+                     "calibration",
+                     "line_axis"},
                     file);
   for (const char* key : {"detectors", "pitch_mm", "c"})
     if (!line[key]) ThrowInputError(WhereIs(line, file), std::string("line: missing ") + key);
@@ -112,10 +127,12 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
       if (!node.IsMap()) ThrowInputError(WhereIs(node, file), "a sub-camera is a map");
       RejectUnknownKeys(node, {"id", "detectors", "c", "pitch_mm", "mount_deg"}, file);
       for (const char* key : {"id", "detectors", "c", "pitch_mm"})
-        if (!node[key]) ThrowInputError(WhereIs(node, file), std::string("sub-camera: missing ") + key);
+        if (!node[key])
+          ThrowInputError(WhereIs(node, file), std::string("sub-camera: missing ") + key);
       LineSubcamera s;
       s.id = YamlString(node["id"], file, "id");
-      if (s.id.empty()) ThrowInputError(WhereIs(node["id"], file), "sub-camera id must not be empty");
+      if (s.id.empty())
+        ThrowInputError(WhereIs(node["id"], file), "sub-camera id must not be empty");
       for (const auto& other : camera.subcameras)
         if (other.id == s.id)
           ThrowInputError(WhereIs(node["id"], file), "duplicate sub-camera id '" + s.id + "'");
@@ -124,12 +141,14 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
         ThrowInputError(WhereIs(node["detectors"], file),
                         "sub-camera " + s.id + ": detectors must be within 1 .. " +
                             std::to_string(camera.detectors - next) +
-                            " (the detectors line.detectors leaves; got " + std::to_string(n) + ")");
+                            " (the detectors line.detectors leaves; got " + std::to_string(n) +
+                            ")");
       s.first = next;
       s.last = next + n - 1;
       next += n;
       s.c_mm = ReadPositive(node["c"], file, "sub-camera c", 0.0, kMaxCMm);
-      s.pitch_mm = ReadPositive(node["pitch_mm"], file, "sub-camera pitch_mm", kMinPitchMm, kMaxPitchMm);
+      s.pitch_mm =
+          ReadPositive(node["pitch_mm"], file, "sub-camera pitch_mm", kMinPitchMm, kMaxPitchMm);
       if (node["mount_deg"])
         s.mount_rad =
             YamlVector3(
@@ -138,9 +157,9 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
       camera.subcameras.push_back(s);
     }
     if (next != camera.detectors)
-      ThrowInputError(WhereIs(subs, file), "line.subcameras hold " + std::to_string(next) +
-                                               " detectors, line.detectors is " +
-                                               std::to_string(camera.detectors));
+      ThrowInputError(WhereIs(subs, file),
+                      "line.subcameras hold " + std::to_string(next) +
+                          " detectors, line.detectors is " + std::to_string(camera.detectors));
   }
 
   const bool has_table = line["dx_mm"] || line["dy_mm"];
@@ -150,10 +169,10 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
   if (has_table) {
     for (const char* key : {"dx_mm", "dy_mm"}) {
       if (!line[key])
-        ThrowInputError(WhereIs(line, file), std::string("line: missing ") + key +
-                                                 " (the tables come in pairs)");
-      std::vector<double> values = ReadNumbers(line[key], file, std::string("line.") + key,
-                                               size_t(camera.detectors));
+        ThrowInputError(WhereIs(line, file),
+                        std::string("line: missing ") + key + " (the tables come in pairs)");
+      std::vector<double> values =
+          ReadNumbers(line[key], file, std::string("line.") + key, size_t(camera.detectors));
       if (int(values.size()) != camera.detectors)
         ThrowInputError(WhereIs(line[key], file),
                         std::string("line.") + key + " must hold line.detectors (" +
@@ -170,27 +189,30 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
       if (!node.IsMap()) ThrowInputError(WhereIs(node, file), "a calibration range is a map");
       RejectUnknownKeys(node, {"first", "last", "dx", "dy"}, file);
       for (const char* key : {"first", "last"})
-        if (!node[key]) ThrowInputError(WhereIs(node, file), std::string("calibration: missing ") + key);
+        if (!node[key])
+          ThrowInputError(WhereIs(node, file), std::string("calibration: missing ") + key);
       LinePolynomial p;
       p.first = YamlInt(node["first"], file, "first");
       p.last = YamlInt(node["last"], file, "last");
       if (p.first != next || p.last < p.first || p.last >= camera.detectors)
-        ThrowInputError(WhereIs(node, file),
-                        "calibration ranges must be contiguous from detector 0 to line.detectors - 1 (got [" +
-                            std::to_string(p.first) + ", " + std::to_string(p.last) +
-                            "], expected first = " + std::to_string(next) + ")");
+        ThrowInputError(
+            WhereIs(node, file),
+            "calibration ranges must be contiguous from detector 0 to line.detectors - 1 (got [" +
+                std::to_string(p.first) + ", " + std::to_string(p.last) +
+                "], expected first = " + std::to_string(next) + ")");
       next = p.last + 1;
       if (node["dx"]) p.dx = ReadNumbers(node["dx"], file, "calibration dx", kMaxPolynomialTerms);
       if (node["dy"]) p.dy = ReadNumbers(node["dy"], file, "calibration dy", kMaxPolynomialTerms);
       camera.calibration.push_back(p);
       if (!camera.subcameras.empty() && camera.SubcameraOf(p.first) != camera.SubcameraOf(p.last))
-        ThrowInputError(WhereIs(node, file), "calibration range [" + std::to_string(p.first) + ", " +
-                                                 std::to_string(p.last) + "] spans a sub-camera seam");
+        ThrowInputError(WhereIs(node, file),
+                        "calibration range [" + std::to_string(p.first) + ", " +
+                            std::to_string(p.last) + "] spans a sub-camera seam");
     }
     if (next != camera.detectors)
-      ThrowInputError(WhereIs(cal, file), "calibration ranges end at detector " +
-                                              std::to_string(next - 1) + ", expected " +
-                                              std::to_string(camera.detectors - 1));
+      ThrowInputError(WhereIs(cal, file),
+                      "calibration ranges end at detector " + std::to_string(next - 1) +
+                          ", expected " + std::to_string(camera.detectors - 1));
   }
   if (const YAML::Node& axis = line["line_axis"]) {
     const std::string value = YamlString(axis, file, "line.line_axis");

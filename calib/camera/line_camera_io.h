@@ -20,11 +20,11 @@
 // Every error is InputError("FILE:LINE: what (got X)"); unknown keys are errors.
 #pragma once
 
-#include <string>
+#include "calib/camera/line_camera.h"
 
 #include <yaml-cpp/yaml.h>
 
-#include "calib/camera/line_camera.h"
+#include <string>
 
 namespace aerocal::calib {
 

@@ -1,10 +1,10 @@
 #include "calib/camera/rig.h"
 
-#include <cmath>
-#include <set>
-
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+
+#include <cmath>
+#include <set>
 
 namespace aerocal::calib {
 
@@ -25,8 +25,7 @@ Eigen::Vector3d VirtualCamera::RayFromPixel(const Eigen::Vector2d& pixel) const 
 
 bool VirtualCamera::PixelFromRay(const Eigen::Vector3d& ray, Eigen::Vector2d* pixel) const {
   if (!(ray.z() < 0)) return false;
-  *pixel = PixelFromPhoto(
-      {x0_mm - c_mm * ray.x() / ray.z(), y0_mm - c_mm * ray.y() / ray.z()});
+  *pixel = PixelFromPhoto({x0_mm - c_mm * ray.x() / ray.z(), y0_mm - c_mm * ray.y() / ray.z()});
   return true;
 }
 
@@ -46,7 +45,8 @@ void Rig::Validate(const std::string& where) const {
   const SourceRef at{where, 0};
   if (heads.empty()) ThrowInputError(at, "a rig needs at least one head");
   if (heads.size() > kMaxRigHeads)
-    ThrowInputError(at, std::to_string(heads.size()) + " rig heads, at most " + std::to_string(kMaxRigHeads));
+    ThrowInputError(
+        at, std::to_string(heads.size()) + " rig heads, at most " + std::to_string(kMaxRigHeads));
   std::set<std::string> ids;
   for (const RigHead& head : heads) {
     if (head.id.empty()) ThrowInputError(at, "every rig head needs a non-empty id");
@@ -73,8 +73,8 @@ void Rig::Validate(const std::string& where) const {
       !std::isfinite(v.pixel_size_mm))
     ThrowInputError(at, "virtual camera: every value must be finite");
   if (v.height_m && !(*v.height_m > 0 && std::isfinite(*v.height_m)))
-    ThrowInputError(at, "virtual camera: height_m must be > 0 m (got " +
-                            FormatNumber(*v.height_m) + ")");
+    ThrowInputError(
+        at, "virtual camera: height_m must be > 0 m (got " + FormatNumber(*v.height_m) + ")");
 }
 
 Rig RigFromCamera(const Camera& camera, const std::string& head_id) {

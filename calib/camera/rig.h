@@ -20,15 +20,15 @@
 // bottom of the module arrows; the conversion to the virtual image is in stitch/rig/.
 #pragma once
 
-#include <optional>
-#include <string>
-#include <vector>
-
-#include <Eigen/Core>
-
 #include "calib/camera/brown_fraser10.h"
 #include "calib/camera/camera.h"
 #include "calib/camera/rotation.h"
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace aerocal::calib {
 
@@ -36,7 +36,7 @@ namespace aerocal::calib {
 /// place in the rig.
 struct RigHead {
   std::string id;
-  Camera camera;                                  // name = id; no sub-images
+  Camera camera;                                          // name = id; no sub-images
   Eigen::Vector3d mount_rad = Eigen::Vector3d::Zero();    // omega, phi, kappa: head -> rig (rad)
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();  // head centre in the rig frame (m)
   std::optional<Eigen::Vector3d> mount_sigma_rad;         // a-priori sigmas (rad), absent = free
@@ -53,10 +53,10 @@ enum class VirtualOrientation { kRig, kLevel };
 /// The virtual camera: a distortion-free central projection at the rig origin.
 struct VirtualCamera {
   VirtualOrientation orientation = VirtualOrientation::kRig;
-  double c_mm = 0.0;                 // principal distance, > 0
-  double pixel_size_mm = 0.0;        // > 0
-  int width_px = 0, height_px = 0;   // format
-  double x0_mm = 0.0, y0_mm = 0.0;   // principal point in the virtual photo frame
+  double c_mm = 0.0;                // principal distance, > 0
+  double pixel_size_mm = 0.0;       // > 0
+  int width_px = 0, height_px = 0;  // format
+  double x0_mm = 0.0, y0_mm = 0.0;  // principal point in the virtual photo frame
   /// Nominal relative flying height (m) of the rectification plane below the virtual centre, used
   /// when neither the exposure nor the command line gives one; absent = not given.
   std::optional<double> height_m;
@@ -138,9 +138,8 @@ void HeadPoseOfRotation(const T* object_from_rig,
   MultiplyRotations(r, m, rm);
   MultiplyRotations(rm, e, object_from_head);
   for (int i = 0; i < 3; ++i)
-    head_center_m[i] = rig_center_m[i] + r[3 * i] * lever_arm_m[0] +
-                       r[3 * i + 1] * lever_arm_m[1] + r[3 * i + 2] * lever_arm_m[2] +
-                       velocity_mps[i] * dt_s[0];
+    head_center_m[i] = rig_center_m[i] + r[3 * i] * lever_arm_m[0] + r[3 * i + 1] * lever_arm_m[1] +
+                       r[3 * i + 2] * lever_arm_m[2] + velocity_mps[i] * dt_s[0];
 }
 
 /// HeadPose(rig_opk, ...): the same with the rig attitude as rig_opk[3], omega, phi, kappa (rad),
@@ -169,8 +168,15 @@ bool ProjectHeadIdeal(const T* interior,
                       const T* point_m,
                       T* ideal_mm) {
   T rotation[9], center[3], uvw[3];
-  HeadPose(rig_opk, rig_center_m, mount_opk, lever_arm_m, increment_opk, dt_s, velocity_mps,
-           rotation, center);
+  HeadPose(rig_opk,
+           rig_center_m,
+           mount_opk,
+           lever_arm_m,
+           increment_opk,
+           dt_s,
+           velocity_mps,
+           rotation,
+           center);
   ImageSpaceFromObjectByMatrix(rotation, center, point_m, uvw);  // head k's image space
   if (!(uvw[2] < T(0))) return false;
   const T& c = interior[BrownFraser10Model::kC];

@@ -1,14 +1,14 @@
 #include "calib/camera/rig_io.h"
 
-#include <algorithm>
-#include <cmath>
-#include <set>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
 
 namespace aerocal::calib {
 namespace {
@@ -16,10 +16,10 @@ namespace {
 constexpr double kRadPerDeg = M_PI / 180.0;
 
 // The head keys that belong to the head's camera (read by ParseCamera) and those of the rig.
-const std::vector<std::string> kHeadCameraKeys = {"pixel_size_mm", "format_px", "interior",
-                                                  "interior_sigma", "model"};
-const std::vector<std::string> kHeadRigKeys = {"id", "mount_deg", "lever_arm_m", "mount_sigma_deg",
-                                               "lever_arm_sigma_m"};
+const std::vector<std::string> kHeadCameraKeys = {
+    "pixel_size_mm", "format_px", "interior", "interior_sigma", "model"};
+const std::vector<std::string> kHeadRigKeys = {
+    "id", "mount_deg", "lever_arm_m", "mount_sigma_deg", "lever_arm_sigma_m"};
 
 // Bounds of the rig's relative orientation (as the line camera's, calib/camera/line_camera_io.cc):
 // a mount is an attitude (|angle| <= 360 deg), a lever arm a body offset (|t| <= 1000 m); sigmas of
@@ -36,13 +36,15 @@ Eigen::Vector3d ReadSigma3(const YAML::Node& node,
                            double bound) {
   const Eigen::Vector3d sigma = YamlVector3(node, file, what, 0.0, bound);
   if (!(sigma.minCoeff() > 0))
-    ThrowInputError(WhereIs(node, file), what + " must be > 0 (got [" + FormatNumber(sigma[0]) +
-                                             ", " + FormatNumber(sigma[1]) + ", " +
-                                             FormatNumber(sigma[2]) + "])");
+    ThrowInputError(WhereIs(node, file),
+                    what + " must be > 0 (got [" + FormatNumber(sigma[0]) + ", " +
+                        FormatNumber(sigma[1]) + ", " + FormatNumber(sigma[2]) + "])");
   return sigma;
 }
 
-double ReadPositive(const YAML::Node& node, const std::string& file, const std::string& what,
+double ReadPositive(const YAML::Node& node,
+                    const std::string& file,
+                    const std::string& what,
                     const std::string& unit) {
   const double value = YamlDouble(node, file, what);
   if (!(value > 0))
@@ -77,8 +79,9 @@ RigHead ReadHead(const YAML::Node& node, const std::string& file) {
     const double tilt_deg = std::acos(std::clamp(-axis.z(), -1.0, 1.0)) / kRadPerDeg;
     if (!(tilt_deg <= kMaxHeadTiltDeg))
       ThrowInputError(WhereIs(node["mount_deg"], file),
-                      "head " + head.id + ": mount_deg turns the head's axis " + FormatNumber(tilt_deg, 4) +
-                          " deg off the rig's nadir (at most " + FormatNumber(kMaxHeadTiltDeg) + " deg)");
+                      "head " + head.id + ": mount_deg turns the head's axis " +
+                          FormatNumber(tilt_deg, 4) + " deg off the rig's nadir (at most " +
+                          FormatNumber(kMaxHeadTiltDeg) + " deg)");
   }
   if (node["lever_arm_m"])
     head.lever_arm_m =
@@ -93,8 +96,8 @@ RigHead ReadHead(const YAML::Node& node, const std::string& file) {
 }
 
 VirtualCamera ReadVirtual(const YAML::Node& node, const std::string& file) {
-  RejectUnknownKeys(node, {"orientation", "c", "pixel_size_mm", "format_px", "x0", "y0", "height_m"},
-                    file);
+  RejectUnknownKeys(
+      node, {"orientation", "c", "pixel_size_mm", "format_px", "x0", "y0", "height_m"}, file);
   for (const char* key : {"c", "pixel_size_mm", "format_px"})
     if (!node[key]) ThrowInputError(WhereIs(node, file), std::string("virtual: missing ") + key);
   VirtualCamera v;
@@ -159,8 +162,9 @@ Rig ParseRig(const YAML::Node& root, const std::string& file) {
     ThrowInputError(WhereIs(heads ? heads : section, file), "rig.heads must be a non-empty list");
   // Checked before any head is read: the rig's coverage and design work on a bit per head.
   if (heads.size() > kMaxRigHeads)
-    ThrowInputError(WhereIs(heads, file), "rig.heads: " + std::to_string(heads.size()) +
-                                              " heads, at most " + std::to_string(kMaxRigHeads));
+    ThrowInputError(WhereIs(heads, file),
+                    "rig.heads: " + std::to_string(heads.size()) + " heads, at most " +
+                        std::to_string(kMaxRigHeads));
   std::set<std::string> ids;
   for (const auto& node : heads) {
     RigHead head = ReadHead(node, file);
@@ -218,7 +222,8 @@ std::string RigToYaml(const Rig& rig) {
       if (camera[key]) out << YAML::Key << key << YAML::Value << camera[key];
     EmitVector3(out, "mount_deg", head.mount_rad / kRadPerDeg);
     EmitVector3(out, "lever_arm_m", head.lever_arm_m);
-    if (head.mount_sigma_rad) EmitVector3(out, "mount_sigma_deg", *head.mount_sigma_rad / kRadPerDeg);
+    if (head.mount_sigma_rad)
+      EmitVector3(out, "mount_sigma_deg", *head.mount_sigma_rad / kRadPerDeg);
     if (head.lever_arm_sigma_m) EmitVector3(out, "lever_arm_sigma_m", *head.lever_arm_sigma_m);
     out << YAML::EndMap;
   }

@@ -10,11 +10,11 @@
 // InputError("FILE:LINE: what").
 #pragma once
 
-#include <string>
+#include "calib/camera/rig.h"
 
 #include <yaml-cpp/yaml.h>
 
-#include "calib/camera/rig.h"
+#include <string>
 
 namespace aerocal::calib {
 

@@ -29,8 +29,7 @@ Eigen::Vector3d OpkFromQuaternion(const Eigen::Vector4d& q) {
 
 Eigen::Vector3d OpkFromQuaternionNear(const Eigen::Vector4d& q, const Eigen::Vector3d& near_opk) {
   Eigen::Vector3d opk = OpkFromQuaternion(q);
-  for (int k : {0, 2})
-    opk(k) -= 2.0 * M_PI * std::round((opk(k) - near_opk(k)) / (2.0 * M_PI));
+  for (int k : {0, 2}) opk(k) -= 2.0 * M_PI * std::round((opk(k) - near_opk(k)) / (2.0 * M_PI));
   return opk;
 }
 

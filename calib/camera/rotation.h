@@ -8,11 +8,11 @@
 // omega - kappa at -90 deg, is defined); the quaternion is not.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <cmath>
 #include <limits>
-
-#include <Eigen/Core>
 
 namespace aerocal::calib {
 

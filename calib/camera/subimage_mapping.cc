@@ -1,4 +1,5 @@
 #include "calib/camera/subimage_mapping.h"
+
 #include "calib/core/numeric_jacobian.h"
 
 #include <Eigen/Geometry>
@@ -27,7 +28,8 @@ std::vector<double> IdentityMappingParams(MappingModel model) {
   return ParamsFromHomography(model, Eigen::Matrix3d::Identity());
 }
 
-MappingConditioning MappingConditioning::ForSubimage(MappingModel model, int width_px,
+MappingConditioning MappingConditioning::ForSubimage(MappingModel model,
+                                                     int width_px,
                                                      int height_px) {
   MappingConditioning c;
   c.cu = 0.5 * (width_px - 1);
@@ -80,19 +82,22 @@ Eigen::Matrix3d ConditioningMatrix(const MappingConditioning& c) {
 }
 }  // namespace
 
-std::vector<double> ConditionedFromPlain(MappingModel model, const MappingConditioning& cond,
+std::vector<double> ConditionedFromPlain(MappingModel model,
+                                         const MappingConditioning& cond,
                                          const std::vector<double>& plain) {
-  return ParamsFromHomography(model, HomographyFromParams(model, plain.data()) *
-                                         ConditioningMatrix(cond));
+  return ParamsFromHomography(model,
+                              HomographyFromParams(model, plain.data()) * ConditioningMatrix(cond));
 }
 
-std::vector<double> PlainFromConditioned(MappingModel model, const MappingConditioning& cond,
+std::vector<double> PlainFromConditioned(MappingModel model,
+                                         const MappingConditioning& cond,
                                          const std::vector<double>& conditioned) {
-  return ParamsFromHomography(model, HomographyFromParams(model, conditioned.data()) *
-                                         ConditioningMatrix(cond).inverse());
+  return ParamsFromHomography(
+      model, HomographyFromParams(model, conditioned.data()) * ConditioningMatrix(cond).inverse());
 }
 
-Eigen::MatrixXd PlainFromConditionedJacobian(MappingModel model, const MappingConditioning& cond,
+Eigen::MatrixXd PlainFromConditionedJacobian(MappingModel model,
+                                             const MappingConditioning& cond,
                                              const std::vector<double>& conditioned) {
   return NumericJacobian(
       [&](const std::vector<double>& x) {
@@ -104,7 +109,8 @@ Eigen::MatrixXd PlainFromConditionedJacobian(MappingModel model, const MappingCo
 
 Eigen::Vector2d SubimageMapping::VirtualFromSub(const Eigen::Vector2d& uv) const {
   Eigen::Vector2d out;
-  VisitMappingModel(model, [&](auto m) { decltype(m)::Apply(params.data(), uv.data(), out.data()); });
+  VisitMappingModel(model,
+                    [&](auto m) { decltype(m)::Apply(params.data(), uv.data(), out.data()); });
   return out;
 }
 

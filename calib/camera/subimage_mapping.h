@@ -14,12 +14,12 @@
 // problem builder's joint residual (sub-image mapping in front of the camera) evaluates them.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <optional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace aerocal::calib {
 
@@ -86,9 +86,10 @@ decltype(auto) VisitMappingModel(MappingModel model, Visitor&& visitor) {
   return visitor(ProjectiveMapping{});
 }
 
-inline constexpr MappingModel kAllMappingModels[] = {
-    MappingModel::kTranslation, MappingModel::kConformal, MappingModel::kAffine,
-    MappingModel::kProjective};
+inline constexpr MappingModel kAllMappingModels[] = {MappingModel::kTranslation,
+                                                     MappingModel::kConformal,
+                                                     MappingModel::kAffine,
+                                                     MappingModel::kProjective};
 
 std::string_view MappingModelName(MappingModel model);
 std::optional<MappingModel> ParseMappingModel(std::string_view name);
@@ -122,15 +123,19 @@ struct SubimageMapping {
 
 /// H with [U V 1] ~ H [u v 1] for plain parameters.
 Eigen::Matrix3d HomographyFromParams(MappingModel model, const double* params);
-/// Plain parameters of `model` from H (H normalised so H(2,2) = 1; entries the model lacks ignored).
+/// Plain parameters of `model` from H (H normalised so H(2,2) = 1; entries the model lacks
+/// ignored).
 std::vector<double> ParamsFromHomography(MappingModel model, const Eigen::Matrix3d& h);
 
-std::vector<double> ConditionedFromPlain(MappingModel model, const MappingConditioning& cond,
+std::vector<double> ConditionedFromPlain(MappingModel model,
+                                         const MappingConditioning& cond,
                                          const std::vector<double>& plain);
-std::vector<double> PlainFromConditioned(MappingModel model, const MappingConditioning& cond,
+std::vector<double> PlainFromConditioned(MappingModel model,
+                                         const MappingConditioning& cond,
                                          const std::vector<double>& conditioned);
 /// d(plain)/d(conditioned) at `conditioned` (central differences; exact for the linear models).
-Eigen::MatrixXd PlainFromConditionedJacobian(MappingModel model, const MappingConditioning& cond,
+Eigen::MatrixXd PlainFromConditionedJacobian(MappingModel model,
+                                             const MappingConditioning& cond,
                                              const std::vector<double>& conditioned);
 
 }  // namespace aerocal::calib

@@ -1,18 +1,18 @@
 #include "calib/core/atomic_file.h"
 
+#include "calib/core/error.h"
+
 #include <climits>
-#include <fcntl.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
-
-#include "calib/core/error.h"
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace aerocal {
 namespace {
@@ -29,9 +29,13 @@ bool create_missing_folders = true;
 
 // Shared by the output checks: `is_folder` says what the target itself must become; a path the
 // user named (`user_path`) may lack its parent folders only when SetCreateMissingFolders allows it.
-void CheckOutputPath(const std::string& path, const std::string& what, bool is_folder, bool user_path) {
+void CheckOutputPath(const std::string& path,
+                     const std::string& what,
+                     bool is_folder,
+                     bool user_path) {
   const std::string who = what.empty() ? "'" + path + "'" : what + " '" + path + "'";
-  if (path.empty()) throw InputError((what.empty() ? std::string("output path") : what) + ": empty path");
+  if (path.empty())
+    throw InputError((what.empty() ? std::string("output path") : what) + ": empty path");
   if (path.size() >= PATH_MAX) throw InputError(who + ": path too long");
   std::stringstream names(path);
   std::string name;
@@ -41,8 +45,7 @@ void CheckOutputPath(const std::string& path, const std::string& what, bool is_f
                        std::to_string(NAME_MAX) + " characters)");
   struct stat st {};
   if (::stat(path.c_str(), &st) == 0) {
-    if (is_folder && !S_ISDIR(st.st_mode))
-      throw InputError(who + ": exists and is not a folder");
+    if (is_folder && !S_ISDIR(st.st_mode)) throw InputError(who + ": exists and is not a folder");
     if (!is_folder && !S_ISREG(st.st_mode))
       throw InputError(who + ": exists and is " + KindOf(st.st_mode) + ", not a regular file");
   } else if (errno == ELOOP) {
@@ -137,7 +140,8 @@ void CheckInputFile(const std::string& path) {
     if (err == ENAMETOOLONG) throw InputError(path + ": name too long");
     throw InputError(path + ": cannot read (" + std::strerror(err) + ")");
   }
-  if (!S_ISREG(st.st_mode)) throw InputError(path + ": is " + KindOf(st.st_mode) + ", not a regular file");
+  if (!S_ISREG(st.st_mode))
+    throw InputError(path + ": is " + KindOf(st.st_mode) + ", not a regular file");
   if (::access(path.c_str(), R_OK) != 0)
     throw InputError(path + ": cannot read (" + std::strerror(errno) + ")");
 }

@@ -1,13 +1,13 @@
 #include "calib/core/csv.h"
 
+#include "calib/core/atomic_file.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <sstream>
 #include <string_view>
-
-#include "calib/core/atomic_file.h"
 
 namespace aerocal {
 namespace {
@@ -46,8 +46,8 @@ std::vector<std::string> SplitCommaList(const std::string& text, ListSplit how) 
   size_t begin = 0;
   while (true) {
     const size_t comma = text.find(',', begin);
-    std::string field = text.substr(begin, comma == std::string::npos ? std::string::npos
-                                                                      : comma - begin);
+    std::string field =
+        text.substr(begin, comma == std::string::npos ? std::string::npos : comma - begin);
     if (how.trim) field = Trim(field);
     if (how.keep_empty || !field.empty()) out.push_back(std::move(field));
     if (comma == std::string::npos) return out;
@@ -123,13 +123,16 @@ CsvTable CsvTable::Read(const std::string& path) { return Parse(ReadTextFile(pat
 double CsvTable::Bounded(const Row& row, const std::string& column, double lo, double hi) const {
   const double value = Number(row, column);
   if (!(value >= lo && value <= hi))
-    ThrowInputError(Where(row), "column '" + column + "' out of range (got " + FormatNumber(value) +
-                                    ", expected " + FormatNumber(lo) + " .. " + FormatNumber(hi) + ")");
+    ThrowInputError(Where(row),
+                    "column '" + column + "' out of range (got " + FormatNumber(value) +
+                        ", expected " + FormatNumber(lo) + " .. " + FormatNumber(hi) + ")");
   return value;
 }
 
-std::optional<double> CsvTable::OptionalBounded(const Row& row, const std::string& column,
-                                                double lo, double hi) const {
+std::optional<double> CsvTable::OptionalBounded(const Row& row,
+                                                const std::string& column,
+                                                double lo,
+                                                double hi) const {
   if (String(row, column).empty()) return std::nullopt;
   return Bounded(row, column, lo, hi);
 }

@@ -8,12 +8,12 @@
 // name them.
 #pragma once
 
+#include "calib/core/error.h"
+
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include "calib/core/error.h"
 
 namespace aerocal {
 
@@ -51,7 +51,9 @@ class CsvTable {
   std::optional<double> OptionalNumber(const Row& row, const std::string& column) const;
   /// Number within [lo, hi]; InputError naming the range otherwise.
   double Bounded(const Row& row, const std::string& column, double lo, double hi) const;
-  std::optional<double> OptionalBounded(const Row& row, const std::string& column, double lo,
+  std::optional<double> OptionalBounded(const Row& row,
+                                        const std::string& column,
+                                        double lo,
                                         double hi) const;
 
  private:

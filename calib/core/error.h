@@ -1,9 +1,9 @@
 // Error types used at every API boundary (STYLE.md section 7).
 //
-// InputError: a bad file or value coming from the user, message "FILE:LINE: what (got X, expected Y)".
-// ConfigError: a bad option value.
-// LogicError: a violated precondition inside the program (AEROCAL_CHECK).
-// Non-convergence and rank defects are never exceptions: they are reported in SolveReport.
+// InputError: a bad file or value coming from the user, message "FILE:LINE: what (got X, expected
+// Y)". ConfigError: a bad option value. LogicError: a violated precondition inside the program
+// (AEROCAL_CHECK). Non-convergence and rank defects are never exceptions: they are reported in
+// SolveReport.
 #pragma once
 
 #include <sstream>
@@ -36,9 +36,7 @@ class LogicError : public Error {
 struct SourceRef {
   std::string file;
   int line = 0;
-  std::string ToString() const {
-    return line > 0 ? file + ":" + std::to_string(line) : file;
-  }
+  std::string ToString() const { return line > 0 ? file + ":" + std::to_string(line) : file; }
 };
 
 /// Throws InputError("FILE:LINE: message").

@@ -52,8 +52,14 @@ void CompressBlock(const unsigned char* block, std::array<uint32_t, 8>* state) {
 }  // namespace
 
 std::string Sha256Hex(const std::string& bytes) {
-  std::array<uint32_t, 8> state = {0x6a09e667, 0xbb67ae85, 0x3c6ef372, 0xa54ff53a,
-                                   0x510e527f, 0x9b05688c, 0x1f83d9ab, 0x5be0cd19};
+  std::array<uint32_t, 8> state = {0x6a09e667,
+                                   0xbb67ae85,
+                                   0x3c6ef372,
+                                   0xa54ff53a,
+                                   0x510e527f,
+                                   0x9b05688c,
+                                   0x1f83d9ab,
+                                   0x5be0cd19};
   const size_t full = bytes.size() / 64 * 64;
   const auto* data = reinterpret_cast<const unsigned char*>(bytes.data());
   for (size_t offset = 0; offset < full; offset += 64) CompressBlock(data + offset, &state);
@@ -74,7 +80,8 @@ std::string Sha256Hex(const std::string& bytes) {
   return hex;
 }
 
-nlohmann::json InputFilesToJson(const std::vector<std::pair<std::string, std::string>>& role_paths) {
+nlohmann::json InputFilesToJson(
+    const std::vector<std::pair<std::string, std::string>>& role_paths) {
   nlohmann::json out = nlohmann::json::array();
   std::set<std::string> seen;
   for (const auto& [role, path] : role_paths) {
@@ -82,7 +89,8 @@ nlohmann::json InputFilesToJson(const std::vector<std::pair<std::string, std::st
     std::ifstream in(path, std::ios::binary);
     if (!in) throw InputError(path + ": cannot read");
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-    out.push_back({{"role", role}, {"path", path}, {"bytes", bytes.size()}, {"sha256", Sha256Hex(bytes)}});
+    out.push_back(
+        {{"role", role}, {"path", path}, {"bytes", bytes.size()}, {"sha256", Sha256Hex(bytes)}});
   }
   return out;
 }

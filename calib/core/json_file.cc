@@ -1,11 +1,11 @@
 #include "calib/core/json_file.h"
 
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+
 #include <algorithm>
 #include <set>
 #include <vector>
-
-#include "calib/core/atomic_file.h"
-#include "calib/core/error.h"
 
 namespace aerocal {
 

@@ -2,9 +2,9 @@
 // into the `FILE:LINE: what` every reader reports.
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+
+#include <string>
 
 namespace aerocal {
 

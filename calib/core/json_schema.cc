@@ -1,11 +1,11 @@
 #include "calib/core/json_schema.h"
 
+#include "calib/core/csv.h"  // FormatNumber
+#include "calib/core/error.h"
+
 #include <cmath>
 #include <fstream>
 #include <set>
-
-#include "calib/core/csv.h"  // FormatNumber
-#include "calib/core/error.h"
 
 namespace aerocal {
 namespace {
@@ -27,16 +27,17 @@ std::string TypeOf(const nlohmann::json& v) {
 
 bool HasType(const nlohmann::json& v, const std::string& type) {
   if (type == "integer")
-    return v.is_number_integer() || (v.is_number_float() && std::isfinite(v.get<double>()) &&
-                                     std::floor(v.get<double>()) == v.get<double>() &&
-                                     std::abs(v.get<double>()) < 9e15);
+    return v.is_number_integer() ||
+           (v.is_number_float() && std::isfinite(v.get<double>()) &&
+            std::floor(v.get<double>()) == v.get<double>() && std::abs(v.get<double>()) < 9e15);
   if (type == "number") return v.is_number() && std::isfinite(v.get<double>());
   return TypeOf(v) == type;
 }
 
 class Validator {
  public:
-  Validator(const nlohmann::json& root_schema, const std::string& file) : root_(root_schema), file_(file) {}
+  Validator(const nlohmann::json& root_schema, const std::string& file)
+      : root_(root_schema), file_(file) {}
 
   void Check(const nlohmann::json& v, const nlohmann::json& schema, const std::string& path) const {
     if (schema.is_boolean()) {
@@ -56,15 +57,18 @@ class Validator {
     }
     if (schema.contains("type")) {
       const nlohmann::json& t = schema["type"];
-      std::vector<std::string> types = t.is_array() ? t.get<std::vector<std::string>>()
-                                                    : std::vector<std::string>{t.get<std::string>()};
+      std::vector<std::string> types = t.is_array()
+                                           ? t.get<std::vector<std::string>>()
+                                           : std::vector<std::string>{t.get<std::string>()};
       bool ok = false;
       for (const auto& type : types) ok = ok || HasType(v, type);
       if (!ok) {
         std::string expected;
         for (size_t i = 0; i < types.size(); ++i)
           expected += (i ? (i + 1 == types.size() ? " or " : ", ") : "") +
-                      (types[i] == "number" ? "a finite number" : types[i] == "integer" ? "an integer" : "a " + types[i]);
+                      (types[i] == "number"    ? "a finite number"
+                       : types[i] == "integer" ? "an integer"
+                                               : "a " + types[i]);
         Fail(path, "expected " + expected, v);
       }
     }
@@ -91,11 +95,13 @@ class Validator {
       if (schema.contains("maxItems") && v.size() > schema["maxItems"].get<size_t>())
         Fail(path, "expected at most " + schema["maxItems"].dump() + " items", v);
       if (schema.contains("items"))
-        for (size_t i = 0; i < v.size(); ++i) Check(v[i], schema["items"], path + "[" + std::to_string(i) + "]");
+        for (size_t i = 0; i < v.size(); ++i)
+          Check(v[i], schema["items"], path + "[" + std::to_string(i) + "]");
     }
     if (v.is_object()) {
       for (const auto& key : schema.value("required", nlohmann::json::array()))
-        if (!v.contains(key.get<std::string>())) Fail(Join(path, key.get<std::string>()), "missing", nullptr);
+        if (!v.contains(key.get<std::string>()))
+          Fail(Join(path, key.get<std::string>()), "missing", nullptr);
       const nlohmann::json properties = schema.value("properties", nlohmann::json::object());
       for (const auto& [key, value] : v.items()) {
         if (properties.contains(key))
@@ -110,22 +116,41 @@ class Validator {
   static std::string Join(const std::string& path, const std::string& key) {
     return path.empty() ? key : path + "." + key;
   }
-  [[noreturn]] void Fail(const std::string& path, const std::string& what, const nlohmann::json& v) const {
+  [[noreturn]] void Fail(const std::string& path,
+                         const std::string& what,
+                         const nlohmann::json& v) const {
     throw InputError(file_ + ": " + (path.empty() ? "the document" : path) + ": " + what +
                      (v.is_null() && what == "missing" ? "" : " (got " + Shown(v) + ")"));
   }
 
-  inline static const std::set<std::string> kKeywords = {
-      "type", "properties", "required", "additionalProperties", "items", "minItems", "maxItems",
-      "minimum", "maximum", "exclusiveMinimum", "maxLength", "enum", "$ref", "definitions",
-      "$schema", "$id", "title", "description", "$comment"};
+  inline static const std::set<std::string> kKeywords = {"type",
+                                                         "properties",
+                                                         "required",
+                                                         "additionalProperties",
+                                                         "items",
+                                                         "minItems",
+                                                         "maxItems",
+                                                         "minimum",
+                                                         "maximum",
+                                                         "exclusiveMinimum",
+                                                         "maxLength",
+                                                         "enum",
+                                                         "$ref",
+                                                         "definitions",
+                                                         "$schema",
+                                                         "$id",
+                                                         "title",
+                                                         "description",
+                                                         "$comment"};
   const nlohmann::json& root_;
   const std::string& file_;
 };
 
 }  // namespace
 
-void ValidateJson(const nlohmann::json& document, const nlohmann::json& schema, const std::string& file,
+void ValidateJson(const nlohmann::json& document,
+                  const nlohmann::json& schema,
+                  const std::string& file,
                   const std::string& root_path) {
   Validator(schema, file).Check(document, schema, root_path);
 }

@@ -10,9 +10,9 @@
 // always finite (a JSON 1e400 reads as infinity). The schemas live in docs/schema/.
 #pragma once
 
-#include <string>
-
 #include <nlohmann/json.hpp>
+
+#include <string>
 
 namespace aerocal {
 

@@ -2,11 +2,11 @@
 // precision), for functions whose autodiff form is not at hand.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace aerocal {
 

@@ -39,8 +39,14 @@ void Progress::LogLine(long done) {
   last_logged_ = done;
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start_).count();
-  std::fprintf(stderr, "%s: %ld/%ld%s%s (%.1f s)\n", label_.c_str(), done, total_, stage_.empty() ? "" : " ",
-               stage_.c_str(), seconds);
+  std::fprintf(stderr,
+               "%s: %ld/%ld%s%s (%.1f s)\n",
+               label_.c_str(),
+               done,
+               total_,
+               stage_.empty() ? "" : " ",
+               stage_.c_str(),
+               seconds);
   std::fflush(stderr);
 }
 
@@ -82,10 +88,20 @@ void Progress::Draw(bool final_line) {
   char rate[64] = "";
   if (done > 0 && seconds > 0) {
     const double per_second = done / seconds;
-    std::snprintf(rate, sizeof(rate), ", %.3g/s, ETA %.0f s", per_second, (total_ - done) / per_second);
+    std::snprintf(
+        rate, sizeof(rate), ", %.3g/s, ETA %.0f s", per_second, (total_ - done) / per_second);
   }
-  std::fprintf(stderr, "\r%s [%s] %ld/%ld %5.1f s%s%s%s   %s", label_.c_str(), bar.c_str(), done, total_,
-               seconds, rate, stage_.empty() ? "" : " ", stage_.c_str(), final_line ? "\n" : "");
+  std::fprintf(stderr,
+               "\r%s [%s] %ld/%ld %5.1f s%s%s%s   %s",
+               label_.c_str(),
+               bar.c_str(),
+               done,
+               total_,
+               seconds,
+               rate,
+               stage_.empty() ? "" : " ",
+               stage_.c_str(),
+               final_line ? "\n" : "");
   std::fflush(stderr);
 }
 

@@ -1,19 +1,19 @@
 // Result documents of the commands (JSON): ONE writer and ONE reader check for all of them.
 // Every result carries `kind` (which command wrote it: "adjust", "calibrate", "flight", "stitch",
 // "rig_stitch", "rig_error_analysis", "rig_design", "pushbroom", "pushbroom_control",
-// "camera_conversion", "certificate", "quality_mtf", "quality_bars", and the manifest of `aerocal batch plan`,
-// "batch_manifest") and `schema_version` (kResultSchemaVersion), and is written
+// "camera_conversion", "certificate", "quality_mtf", "quality_bars", and the manifest of `aerocal
+// batch plan`, "batch_manifest") and `schema_version` (kResultSchemaVersion), and is written
 // atomically (calib/core/atomic_file.h). A reader of a result (the certificate, the report, a
 // stitch result applied to a camera) checks both and refuses any other document with
 // `FILE: what` (an InputError: exit 2). The keys of each kind are in the README of the module that
 // builds it (calib/README.md "Result documents" lists them).
 #pragma once
 
+#include <nlohmann/json.hpp>
+
 #include <initializer_list>
 #include <string>
 #include <string_view>
-
-#include <nlohmann/json.hpp>
 
 namespace aerocal {
 

@@ -1,12 +1,13 @@
 #include "calib/core/yaml_util.h"
 
-#include <algorithm>
-#include <climits>
-#include <cmath>
-#include <set>
-
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+
+#include <climits>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
 
 namespace aerocal {
 
@@ -23,7 +24,8 @@ void CheckStrict(const YAML::Node& node, const std::string& file, int depth, lon
     std::set<std::string> keys;
     for (const auto& entry : node) {
       if (!entry.first.IsScalar())
-        ThrowInputError(WhereIs(entry.first, file), "a map key must be a plain name, not a list or map");
+        ThrowInputError(WhereIs(entry.first, file),
+                        "a map key must be a plain name, not a list or map");
       if (!keys.insert(entry.first.Scalar()).second)
         ThrowInputError(WhereIs(entry.first, file), "duplicate key '" + entry.first.Scalar() + "'");
       CheckStrict(entry.second, file, depth + 1, visited);
@@ -54,12 +56,14 @@ SourceRef WhereIs(const YAML::Node& node, const std::string& file) {
   return {file, LineOf(node.Mark())};
 }
 
-void RejectUnknownKeys(const YAML::Node& map, const std::vector<std::string>& allowed,
+void RejectUnknownKeys(const YAML::Node& map,
+                       const std::vector<std::string>& allowed,
                        const std::string& file) {
   if (!map.IsMap()) ThrowInputError(WhereIs(map, file), "expected a map");
   for (const auto& entry : map) {
     if (!entry.first.IsScalar())
-      ThrowInputError(WhereIs(entry.first, file), "a map key must be a plain name, not a list or map");
+      ThrowInputError(WhereIs(entry.first, file),
+                      "a map key must be a plain name, not a list or map");
     const std::string key = entry.first.Scalar();
     if (std::find(allowed.begin(), allowed.end(), key) == allowed.end()) {
       std::string list;
@@ -75,26 +79,29 @@ double YamlDouble(const YAML::Node& node, const std::string& file, const std::st
   if (!node.IsScalar()) ThrowInputError(WhereIs(node, file), what + " must be a number");
   const auto value = ParseDouble(node.Scalar());
   if (!value)
-    ThrowInputError(WhereIs(node, file),
-                    what + " must be a number (got '" + node.Scalar() + "')");
+    ThrowInputError(WhereIs(node, file), what + " must be a number (got '" + node.Scalar() + "')");
   return *value;
 }
 
 int YamlInt(const YAML::Node& node, const std::string& file, const std::string& what) {
   const double value = YamlDouble(node, file, what);
   if (std::abs(value) > INT_MAX || value != std::floor(value))
-    ThrowInputError(WhereIs(node, file), what + " must be an integer within +-" +
-                                             std::to_string(INT_MAX) + " (got " + node.Scalar() + ")");
+    ThrowInputError(WhereIs(node, file),
+                    what + " must be an integer within +-" + std::to_string(INT_MAX) + " (got " +
+                        node.Scalar() + ")");
   return static_cast<int>(value);
 }
 
-double YamlBounded(const YAML::Node& node, const std::string& file, const std::string& what,
-                   double lo, double hi) {
+double YamlBounded(const YAML::Node& node,
+                   const std::string& file,
+                   const std::string& what,
+                   double lo,
+                   double hi) {
   const double value = YamlDouble(node, file, what);
   if (!(value >= lo && value <= hi))
-    ThrowInputError(WhereIs(node, file), what + " out of range (got " + node.Scalar() +
-                                             ", expected " + FormatNumber(lo) + " .. " +
-                                             FormatNumber(hi) + ")");
+    ThrowInputError(WhereIs(node, file),
+                    what + " out of range (got " + node.Scalar() + ", expected " +
+                        FormatNumber(lo) + " .. " + FormatNumber(hi) + ")");
   return value;
 }
 

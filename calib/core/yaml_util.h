@@ -22,15 +22,16 @@ YAML::Node LoadYamlText(const std::string& text, const std::string& file);
 SourceRef WhereIs(const YAML::Node& node, const std::string& file);
 
 /// Throws InputError naming the first key of a map that is not in `allowed`.
-void RejectUnknownKeys(const YAML::Node& map, const std::vector<std::string>& allowed,
+void RejectUnknownKeys(const YAML::Node& map,
+                       const std::vector<std::string>& allowed,
                        const std::string& file);
 
 /// Reads a scalar as double / int / string; InputError at the node's line when it is not one.
 double YamlDouble(const YAML::Node& node, const std::string& file, const std::string& what);
 int YamlInt(const YAML::Node& node, const std::string& file, const std::string& what);
 /// A number within [lo, hi] (the physical bounds FORMATS/READMEs state); InputError otherwise.
-double YamlBounded(const YAML::Node& node, const std::string& file, const std::string& what,
-                   double lo, double hi);
+double YamlBounded(
+    const YAML::Node& node, const std::string& file, const std::string& what, double lo, double hi);
 std::string YamlString(const YAML::Node& node, const std::string& file, const std::string& what);
 /// A list of exactly 3 numbers, each within [lo, hi]; InputError at the node's line otherwise.
 Eigen::Vector3d YamlVector3(

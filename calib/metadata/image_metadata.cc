@@ -39,21 +39,25 @@ ImageMetadata ReadJpeg(const std::string& b, const std::string& path) {
     const unsigned marker = byte(i++);
     if (marker == 0xD8 || marker == 0x01 || (marker >= 0xD0 && marker <= 0xD7)) continue;
     if (marker == 0xD9) fail("JPEG without image data (EOI before SOS)");
-    if (i + 2 > b.size()) fail("truncated JPEG: segment " + Hex(marker) + " at byte " + std::to_string(i - 2));
+    if (i + 2 > b.size())
+      fail("truncated JPEG: segment " + Hex(marker) + " at byte " + std::to_string(i - 2));
     const size_t length = (byte(i) << 8) | byte(i + 1);
     if (length < 2 || i + length > b.size())
-      fail("truncated JPEG: segment " + Hex(marker) + " at byte " + std::to_string(i - 2) + " of length " +
-           std::to_string(length) + " runs past the end (" + std::to_string(b.size()) + " bytes)");
+      fail("truncated JPEG: segment " + Hex(marker) + " at byte " + std::to_string(i - 2) +
+           " of length " + std::to_string(length) + " runs past the end (" +
+           std::to_string(b.size()) + " bytes)");
     const std::string payload = b.substr(i + 2, length - 2);
     if (marker == 0xE1 && payload.compare(0, kExifHeader.size(), kExifHeader) == 0) {
       if (!exif.empty()) fail("two EXIF (APP1) segments");
       exif = payload.substr(kExifHeader.size());
       if (exif.empty()) fail("empty EXIF segment");
     } else if (marker == 0xE1 && payload.compare(0, kXmpHeader.size(), kXmpHeader) == 0) {
-      if (!xmp.empty()) fail("two XMP packets (APP1 segments): which one holds the image's values is not defined");
+      if (!xmp.empty())
+        fail("two XMP packets (APP1 segments): which one holds the image's values is not defined");
       xmp = payload.substr(kXmpHeader.size());
       if (xmp.empty()) fail("empty XMP segment");
-    } else if (marker == 0xE1 && payload.compare(0, kExtendedXmpHeader.size(), kExtendedXmpHeader) == 0) {
+    } else if (marker == 0xE1 &&
+               payload.compare(0, kExtendedXmpHeader.size(), kExtendedXmpHeader) == 0) {
       ++extended;
     } else if (IsSof(marker)) {
       if (sof) fail("two SOF markers");
@@ -83,7 +87,8 @@ ImageMetadata ReadTiff(const std::string& b, const std::string& path) {
   m.exif = ReadTiffTags(b, path);
   const auto size = [&](uint16_t tag) {
     const auto it = m.exif.find({TiffIfd::kImage, tag});
-    if (it == m.exif.end() || it->second.numbers.size() != 1 || !(it->second.numbers[0] >= 1 && it->second.numbers[0] <= 1e6))
+    if (it == m.exif.end() || it->second.numbers.size() != 1 ||
+        !(it->second.numbers[0] >= 1 && it->second.numbers[0] <= 1e6))
       throw InputError(path + ": TIFF without a valid " + TiffTagName(TiffIfd::kImage, tag));
     return static_cast<int>(it->second.numbers[0]);
   };
@@ -98,7 +103,8 @@ ImageMetadata ReadTiff(const std::string& b, const std::string& path) {
 
 bool IsJpegOrTiff(const std::string& bytes) {
   return (bytes.size() >= 3 && bytes.compare(0, 3, "\xFF\xD8\xFF") == 0) ||
-         (bytes.size() >= 4 && (bytes.compare(0, 4, "II*\0", 4) == 0 || bytes.compare(0, 4, "MM\0*", 4) == 0));
+         (bytes.size() >= 4 &&
+          (bytes.compare(0, 4, "II*\0", 4) == 0 || bytes.compare(0, 4, "MM\0*", 4) == 0));
 }
 
 ImageMetadata ImageMetadataOfBytes(const std::string& bytes, const std::string& path) {
@@ -111,8 +117,10 @@ ImageMetadata ReadImageMetadata(const std::string& path) {
   return ImageMetadataOfBytes(ReadTextFile(path), path);
 }
 
-std::optional<XmpPacket> XmpOfCameraFile(const std::string& bytes, const std::string& path,
-                                         int* width_px, int* height_px) {
+std::optional<XmpPacket> XmpOfCameraFile(const std::string& bytes,
+                                         const std::string& path,
+                                         int* width_px,
+                                         int* height_px) {
   if (IsJpegOrTiff(bytes)) {
     const ImageMetadata m = ImageMetadataOfBytes(bytes, path);
     *width_px = m.width_px;
@@ -123,7 +131,8 @@ std::optional<XmpPacket> XmpOfCameraFile(const std::string& bytes, const std::st
   const size_t first = bytes.find("<x:xmpmeta");
   if (first != std::string::npos && bytes.find("<x:xmpmeta", first + 1) != std::string::npos)
     throw InputError(path + ": two XMP packets (x:xmpmeta) in one file");
-  if (first == std::string::npos && bytes.find("<rdf:RDF") == std::string::npos) return std::nullopt;
+  if (first == std::string::npos && bytes.find("<rdf:RDF") == std::string::npos)
+    return std::nullopt;
   return XmpPacket::Parse(bytes, {path, 1});
 }
 

@@ -25,7 +25,7 @@ struct ImageMetadata {
   int width_px = 0, height_px = 0;  // from SOF / IFD0 (0 when a TIFF gives none)
   TiffTags exif;                    // empty when the file has no EXIF
   std::optional<XmpPacket> xmp;
-  std::vector<std::string> notes;   // what was present and not read
+  std::vector<std::string> notes;  // what was present and not read
 };
 
 /// True when `bytes` start like a JPEG (FF D8 FF) or a TIFF (II*\0, MM\0*).
@@ -42,7 +42,9 @@ ImageMetadata ReadImageMetadata(const std::string& path);
 /// packet, or the file itself when it is an XMP sidecar (text holding x:xmpmeta or rdf:RDF, parsed
 /// whole so line numbers are the file's); nullopt when the file is neither. Sets the image size
 /// of a JPEG / TIFF (else leaves it).
-std::optional<XmpPacket> XmpOfCameraFile(const std::string& bytes, const std::string& path,
-                                         int* width_px, int* height_px);
+std::optional<XmpPacket> XmpOfCameraFile(const std::string& bytes,
+                                         const std::string& path,
+                                         int* width_px,
+                                         int* height_px);
 
 }  // namespace aerocal::calib

@@ -16,11 +16,25 @@ constexpr uint16_t kGpsIfdPointer = 0x8825;
 // Bytes per value of each TIFF field type; 0 for unknown types.
 int TypeSize(int type) {
   switch (type) {
-    case 1: case 2: case 6: case 7: return 1;      // BYTE, ASCII, SBYTE, UNDEFINED
-    case 3: case 8: return 2;                      // SHORT, SSHORT
-    case 4: case 9: case 11: case 13: return 4;    // LONG, SLONG, FLOAT, IFD
-    case 5: case 10: case 12: return 8;            // RATIONAL, SRATIONAL, DOUBLE
-    default: return 0;
+    case 1:
+    case 2:
+    case 6:
+    case 7:
+      return 1;  // BYTE, ASCII, SBYTE, UNDEFINED
+    case 3:
+    case 8:
+      return 2;  // SHORT, SSHORT
+    case 4:
+    case 9:
+    case 11:
+    case 13:
+      return 4;  // LONG, SLONG, FLOAT, IFD
+    case 5:
+    case 10:
+    case 12:
+      return 8;  // RATIONAL, SRATIONAL, DOUBLE
+    default:
+      return 0;
   }
 }
 
@@ -54,29 +68,56 @@ class TiffReader {
 
   double Number(int type, uint64_t at) const {
     switch (type) {
-      case 1: case 7: return static_cast<double>(U(at, 1));
-      case 6: return static_cast<int8_t>(U(at, 1));
-      case 3: return U16(at);
-      case 8: return static_cast<int16_t>(U16(at));
-      case 4: case 13: return U32(at);
-      case 9: return static_cast<int32_t>(U32(at));
-      case 5: { const double den = U32(at + 4); return den == 0 ? NAN : U32(at) / den; }
+      case 1:
+      case 7:
+        return static_cast<double>(U(at, 1));
+      case 6:
+        return static_cast<int8_t>(U(at, 1));
+      case 3:
+        return U16(at);
+      case 8:
+        return static_cast<int16_t>(U16(at));
+      case 4:
+      case 13:
+        return U32(at);
+      case 9:
+        return static_cast<int32_t>(U32(at));
+      case 5: {
+        const double den = U32(at + 4);
+        return den == 0 ? NAN : U32(at) / den;
+      }
       case 10: {
         const double den = static_cast<int32_t>(U32(at + 4));
         return den == 0 ? NAN : static_cast<int32_t>(U32(at)) / den;
       }
-      case 11: { const uint32_t bits = U32(at); float f; std::memcpy(&f, &bits, 4); return f; }
-      case 12: { const uint64_t bits = U(at, 8); double v; std::memcpy(&v, &bits, 8); return v; }
-      default: return NAN;
+      case 11: {
+        const uint32_t bits = U32(at);
+        float f;
+        std::memcpy(&f, &bits, 4);
+        return f;
+      }
+      case 12: {
+        const uint64_t bits = U(at, 8);
+        double v;
+        std::memcpy(&v, &bits, 8);
+        return v;
+      }
+      default:
+        return NAN;
     }
   }
 
   void ReadIfd(uint64_t offset, TiffIfd ifd) {
-    if (!visited_.insert(offset).second) Fail("IFD loop: the IFD at byte " + std::to_string(offset) + " is pointed to twice");
-    if (offset < 8 || offset + 2 > d_.size()) Fail("IFD offset " + std::to_string(offset) + " outside the data");
+    if (!visited_.insert(offset).second)
+      Fail("IFD loop: the IFD at byte " + std::to_string(offset) + " is pointed to twice");
+    if (offset < 8 || offset + 2 > d_.size())
+      Fail("IFD offset " + std::to_string(offset) + " outside the data");
     const int n = U16(offset);
-    if (n > kMaxIfdEntries) Fail("IFD at byte " + std::to_string(offset) + " claims " + std::to_string(n) + " entries (at most " + std::to_string(kMaxIfdEntries) + ")");
-    if (offset + 2 + 12ull * n > d_.size()) Fail("IFD at byte " + std::to_string(offset) + " runs past the end");
+    if (n > kMaxIfdEntries)
+      Fail("IFD at byte " + std::to_string(offset) + " claims " + std::to_string(n) +
+           " entries (at most " + std::to_string(kMaxIfdEntries) + ")");
+    if (offset + 2 + 12ull * n > d_.size())
+      Fail("IFD at byte " + std::to_string(offset) + " runs past the end");
     std::set<uint16_t> seen;
     for (int k = 0; k < n; ++k) {
       const uint64_t e = offset + 2 + 12ull * k;
@@ -88,9 +129,12 @@ class TiffReader {
       if (size == 0) continue;  // unknown type: ignored (TIFF 6.0)
       const uint64_t bytes = static_cast<uint64_t>(count) * size;
       const uint64_t at = bytes <= 4 ? e + 8 : U32(e + 8);
-      if (at + bytes > d_.size()) Fail(TiffTagName(ifd, tag) + ": " + std::to_string(count) + " values at byte " + std::to_string(at) + " run past the end");
+      if (at + bytes > d_.size())
+        Fail(TiffTagName(ifd, tag) + ": " + std::to_string(count) + " values at byte " +
+             std::to_string(at) + " run past the end");
       if (ifd == TiffIfd::kImage && (tag == kExifIfdPointer || tag == kGpsIfdPointer)) {
-        if (count != 1 || (type != 4 && type != 13)) Fail(TiffTagName(ifd, tag) + " is not one offset");
+        if (count != 1 || (type != 4 && type != 13))
+          Fail(TiffTagName(ifd, tag) + " is not one offset");
         pointers_.emplace_back(U32(at), tag == kExifIfdPointer ? TiffIfd::kExif : TiffIfd::kGps);
         continue;
       }
@@ -159,7 +203,9 @@ std::string TiffTagName(TiffIfd ifd, uint16_t tag) {
   if (it != kNames.end()) return std::string("EXIF ") + it->second;
   char hex[8];
   std::snprintf(hex, sizeof(hex), "0x%04X", tag);
-  const char* group = ifd == TiffIfd::kImage ? "IFD0" : ifd == TiffIfd::kExif ? "Exif IFD" : "GPS IFD";
+  const char* group = ifd == TiffIfd::kImage  ? "IFD0"
+                      : ifd == TiffIfd::kExif ? "Exif IFD"
+                                              : "GPS IFD";
   return std::string("EXIF ") + group + " tag " + hex;
 }
 

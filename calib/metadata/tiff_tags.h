@@ -23,10 +23,10 @@ namespace aerocal::calib {
 enum class TiffIfd { kImage, kExif, kGps };
 
 struct TiffEntry {
-  int type = 0;                  // TIFF field type (2 ASCII, 3 SHORT, 5 RATIONAL, ...)
+  int type = 0;  // TIFF field type (2 ASCII, 3 SHORT, 5 RATIONAL, ...)
   uint32_t count = 0;
-  std::vector<double> numbers;   // numeric types; RATIONAL as numerator / denominator
-  std::string text;              // ASCII up to the first NUL; BYTE / UNDEFINED as raw bytes
+  std::vector<double> numbers;  // numeric types; RATIONAL as numerator / denominator
+  std::string text;             // ASCII up to the first NUL; BYTE / UNDEFINED as raw bytes
 };
 
 using TiffTags = std::map<std::pair<TiffIfd, uint16_t>, TiffEntry>;

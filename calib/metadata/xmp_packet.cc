@@ -1,7 +1,6 @@
 #include "calib/metadata/xmp_packet.h"
 
 #include <tinyxml2.h>
-
 #include <vector>
 
 namespace aerocal::calib {
@@ -40,25 +39,30 @@ struct XmpPacketBuilder {
   static Scope ScopeOf(const tinyxml2::XMLElement* e, Scope scope) {
     for (const tinyxml2::XMLAttribute* a = e->FirstAttribute(); a; a = a->Next()) {
       const std::string name = a->Name();
-      if (name == "xmlns") scope[""] = a->Value();
-      else if (name.rfind("xmlns:", 0) == 0) scope[name.substr(6)] = a->Value();
+      if (name == "xmlns")
+        scope[""] = a->Value();
+      else if (name.rfind("xmlns:", 0) == 0)
+        scope[name.substr(6)] = a->Value();
     }
     scope["xml"] = kXmlUri;
     return scope;
   }
 
   // (URI, local name) of a qualified name; unprefixed attributes have no namespace ("").
-  std::pair<std::string, std::string> Resolve(const std::string& qualified, const Scope& scope,
-                                              const tinyxml2::XMLElement* at, bool attribute) const {
+  std::pair<std::string, std::string> Resolve(const std::string& qualified,
+                                              const Scope& scope,
+                                              const tinyxml2::XMLElement* at,
+                                              bool attribute) const {
     const size_t colon = qualified.find(':');
     const std::string prefix = colon == std::string::npos ? "" : qualified.substr(0, colon);
     const std::string local = colon == std::string::npos ? qualified : qualified.substr(colon + 1);
     if (prefix.empty() && attribute) return {"", local};
     const auto it = scope.find(prefix);
     if (it == scope.end())
-      ThrowInputError(At(at), prefix.empty()
-                                  ? "element <" + qualified + "> has no namespace"
-                                  : "namespace prefix '" + prefix + "' of " + qualified + " is not declared");
+      ThrowInputError(At(at),
+                      prefix.empty() ? "element <" + qualified + "> has no namespace"
+                                     : "namespace prefix '" + prefix + "' of " + qualified +
+                                           " is not declared");
     return {it->second, local};
   }
 
@@ -66,9 +70,9 @@ struct XmpPacketBuilder {
     const auto key = std::make_pair(WithoutTrailingSlash(uri), local);
     const auto [it, inserted] = packet.properties_.emplace(key, property);
     if (!inserted)
-      ThrowInputError(property.where, "XMP property " + property.qualified + " (" + uri +
-                                          ") is given twice (first at " +
-                                          it->second.where.ToString() + ")");
+      ThrowInputError(property.where,
+                      "XMP property " + property.qualified + " (" + uri +
+                          ") is given twice (first at " + it->second.where.ToString() + ")");
   }
 
   void ReadDescription(const tinyxml2::XMLElement* d, const Scope& outer) {
@@ -88,10 +92,12 @@ struct XmpPacketBuilder {
   }
 
   // rdf:RDF elements below `e` (the packet's root is x:xmpmeta, or rdf:RDF itself).
-  void FindRdf(const tinyxml2::XMLElement* e, const Scope& outer,
+  void FindRdf(const tinyxml2::XMLElement* e,
+               const Scope& outer,
                std::vector<std::pair<const tinyxml2::XMLElement*, Scope>>* found) const {
     const Scope scope = ScopeOf(e, outer);
-    if (Resolve(e->Name(), scope, e, false) == std::make_pair(std::string(kRdfUri), std::string("RDF"))) {
+    if (Resolve(e->Name(), scope, e, false) ==
+        std::make_pair(std::string(kRdfUri), std::string("RDF"))) {
       found->emplace_back(e, scope);
       return;
     }
@@ -109,23 +115,30 @@ XmpPacket XmpPacket::Parse(const std::string& text, const SourceRef& where) {
   tinyxml2::XMLDocument doc;
   if (doc.Parse(xml.data(), xml.size()) != tinyxml2::XML_SUCCESS) {
     SourceRef at = b.At(nullptr);
-    if (where.line > 0) at.line = where.line - 1 + doc.ErrorLineNum();
-    else at.file = where.file + ": XMP line " + std::to_string(doc.ErrorLineNum());
+    if (where.line > 0)
+      at.line = where.line - 1 + doc.ErrorLineNum();
+    else
+      at.file = where.file + ": XMP line " + std::to_string(doc.ErrorLineNum());
     ThrowInputError(at, std::string("XMP packet is not well-formed XML: ") + doc.ErrorName());
   }
   if (!doc.RootElement()) ThrowInputError(b.At(nullptr), "empty XMP packet");
   // tinyxml2 accepts several top-level elements; an XMP packet has one (two are two packets).
   if (const tinyxml2::XMLElement* second = doc.RootElement()->NextSiblingElement())
-    ThrowInputError(b.At(second), "two XMP packets (a second top-level element <" + std::string(second->Name()) + ">)");
+    ThrowInputError(
+        b.At(second),
+        "two XMP packets (a second top-level element <" + std::string(second->Name()) + ">)");
   std::vector<std::pair<const tinyxml2::XMLElement*, Scope>> rdf;
   b.FindRdf(doc.RootElement(), {}, &rdf);
   if (rdf.empty()) ThrowInputError(b.At(doc.RootElement()), "XMP packet without rdf:RDF");
   if (rdf.size() > 1) ThrowInputError(b.At(rdf[1].first), "XMP packet with two rdf:RDF elements");
   const Scope rdf_scope = rdf[0].second;
-  for (const tinyxml2::XMLElement* d = rdf[0].first->FirstChildElement(); d; d = d->NextSiblingElement()) {
+  for (const tinyxml2::XMLElement* d = rdf[0].first->FirstChildElement(); d;
+       d = d->NextSiblingElement()) {
     const Scope scope = XmpPacketBuilder::ScopeOf(d, rdf_scope);
-    if (b.Resolve(d->Name(), scope, d, false) != std::make_pair(std::string(kRdfUri), std::string("Description")))
-      ThrowInputError(b.At(d), std::string("<") + d->Name() + "> inside rdf:RDF: expected rdf:Description");
+    if (b.Resolve(d->Name(), scope, d, false) !=
+        std::make_pair(std::string(kRdfUri), std::string("Description")))
+      ThrowInputError(b.At(d),
+                      std::string("<") + d->Name() + "> inside rdf:RDF: expected rdf:Description");
     b.ReadDescription(d, rdf_scope);
   }
   return b.packet;

@@ -25,7 +25,7 @@ struct XmpProperty {
   std::string qualified;  // as written in the file ("drone-dji:GpsLatitude"), for messages
   std::string value;      // text, blanks trimmed; empty for a structured property
   bool structured = false;
-  SourceRef where;        // file and line of the attribute's element or of the element
+  SourceRef where;  // file and line of the attribute's element or of the element
 };
 
 class XmpPacket {

@@ -174,7 +174,8 @@ class Snooper {
       // a whole: per-component w of another observation can exceed both of the blundered one's,
       // the joint statistic cannot (its non-centrality is the largest at the blunder).
       const auto at = t.row_of.find(id);
-      if (x.v.size() > 1 && at != t.row_of.end()) JointTest(t.clusters[at->second.first], at->second.second, s, &x);
+      if (x.v.size() > 1 && at != t.row_of.end())
+        JointTest(t.clusters[at->second.first], at->second.second, s, &x);
       t.index[id] = t.observations.size();
       t.observations.push_back(std::move(x));
     }
@@ -285,7 +286,8 @@ class Snooper {
     std::vector<std::string> evidence;
     if (first) {
       int on_report_only = 0;
-      for (const auto* x : top) on_report_only += x->point >= 0 && report_only_points_.count(x->point);
+      for (const auto* x : top)
+        on_report_only += x->point >= 0 && report_only_points_.count(x->point);
       if (n >= 2 && on_report_only >= 2 && on_report_only >= limit)
         evidence.push_back(std::to_string(on_report_only) + of + " on the " +
                            o_.report_only_groups.front() + " points");
@@ -311,8 +313,8 @@ class Snooper {
     }
     if (evidence.empty()) return;
     out_.model_error_suspected = true;
-    out_.model_error_evidence.insert(out_.model_error_evidence.end(), evidence.begin(),
-                                     evidence.end());
+    out_.model_error_evidence.insert(
+        out_.model_error_evidence.end(), evidence.begin(), evidence.end());
     std::string text = "model error suspected, not blunders:";
     for (size_t i = 0; i < evidence.size(); ++i) text += (i ? "; " : " ") + evidence[i];
     out_.findings.push_back(text);
@@ -326,8 +328,11 @@ class Snooper {
   // the suspicion withdrawn, `t` the test without it. Otherwise (a model error leaves the other
   // control rays above k and sigma0 above the band: the conventional flight's C5) it is restored
   // and the rays are held. Returns whether the ray was rejected.
-  bool TryControlRayBlunder(Test* t, int round, const SolverOptions& solver,
-                            size_t evidence_before, size_t findings_before) {
+  bool TryControlRayBlunder(Test* t,
+                            int round,
+                            const SolverOptions& solver,
+                            size_t evidence_before,
+                            size_t findings_before) {
     const TestedObservation* worst = nullptr;
     for (const auto& x : t->observations)
       if (x.point >= 0 && report_only_points_.count(x.point) &&
@@ -365,11 +370,12 @@ class Snooper {
     ray.round = round;
     ray.correlated = {ray.id};
     ray.group_size = 1;
-    ray.reason = "the largest w sat on this control point's rays, as a model error would show; "
-                 "without this ray every control ray passes and sigma0 " +
-                 Fixed(out_.report.sigma0, 3) + " is within the band: a blunder";
-    out_.findings.push_back("rejected: " + ray.label + " (w = " + Fixed(ray.w_max, 1) + "): " +
-                            ray.reason);
+    ray.reason =
+        "the largest w sat on this control point's rays, as a model error would show; "
+        "without this ray every control ray passes and sigma0 " +
+        Fixed(out_.report.sigma0, 3) + " is within the band: a blunder";
+    out_.findings.push_back("rejected: " + ray.label + " (w = " + Fixed(ray.w_max, 1) +
+                            "): " + ray.reason);
     out_.rejected.push_back(ray);
     *t = std::move(next);
     return true;
@@ -389,9 +395,8 @@ class Snooper {
     std::vector<TestedObservation*> candidates;
     for (auto& x : t.observations)
       if (x.w_max > out_.critical_value) candidates.push_back(&x);
-    std::sort(candidates.begin(), candidates.end(), [](auto* a, auto* b) {
-      return a->w_max > b->w_max;
-    });
+    std::sort(
+        candidates.begin(), candidates.end(), [](auto* a, auto* b) { return a->w_max > b->w_max; });
     // The largest w of each point, over every tested observation and its weakly controlled
     // components too (decided ones included: the rays of a point whose survey is suspected, or
     // whose largest w sits on a weakly controlled component, stay), and of each image
@@ -416,13 +421,15 @@ class Snooper {
       if (image >= 0 && !decided_.count(x->id) && best_of_image.at(image) != x->id) continue;
       if (decided_.count(x->id)) continue;
       if (Contains(o_.report_only_groups, x->group)) {
-        Decide(x, SnoopingVerdict::kHeld,
-               "suspected blunder in the " + x->group + " observation " + x->label + " (w = " +
-                   Fixed(x->w_max, 1) + "): check it; it is not rejected");
+        Decide(x,
+               SnoopingVerdict::kHeld,
+               "suspected blunder in the " + x->group + " observation " + x->label +
+                   " (w = " + Fixed(x->w_max, 1) + "): check it; it is not rejected");
         continue;
       }
       if (out_.model_error_suspected && x->point >= 0 && report_only_points_.count(x->point)) {
-        Decide(x, SnoopingVerdict::kHeld,
+        Decide(x,
+               SnoopingVerdict::kHeld,
                "model error suspected: the ray of a " + o_.report_only_groups.front() +
                    " point is kept");
         continue;
@@ -486,7 +493,8 @@ class Snooper {
     const auto at = t.row_of.find(x.id);
     if (at == t.row_of.end()) return 0.0;
     const int m = static_cast<int>(x.v.size());
-    const Eigen::MatrixXd q = t.clusters[at->second.first].qvv.block(at->second.second, at->second.second, m, m);
+    const Eigen::MatrixXd q =
+        t.clusters[at->second.first].qvv.block(at->second.second, at->second.second, m, m);
     return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(q).eigenvalues()(0);
   }
 
@@ -500,8 +508,8 @@ class Snooper {
     std::vector<TestedObservation> left;
     std::string stopped;  // why no (further) survey is left out although one fails
     std::vector<TestedObservation> suspects;  // failing, singled out, but not left out
-    bool inseparable = false;  // the suspects are a group the test cannot tell apart
-    bool unsolvable = false;   // the block without the last one left out cannot be solved
+    bool inseparable = false;                 // the suspects are a group the test cannot tell apart
+    bool unsolvable = false;  // the block without the last one left out cannot be solved
     for (;;) {
       Test t = Run(1);
       if (!out_.cofactors_ok) return;
@@ -509,7 +517,8 @@ class Snooper {
       std::vector<const TestedObservation*> failing;  // worst first
       for (const auto& x : t.observations)
         if (Contains(o_.report_only_groups, x.group) && x.w_full > k) failing.push_back(&x);
-      std::sort(failing.begin(), failing.end(), [](auto* a, auto* b) { return a->t_full > b->t_full; });
+      std::sort(
+          failing.begin(), failing.end(), [](auto* a, auto* b) { return a->t_full > b->t_full; });
       if (failing.empty()) {  // every remaining survey passes; does the block fit its sigmas?
         const double band = 1 + kFitBand / std::sqrt(2.0 * std::max(1, out_.report.redundancy));
         if (!left.empty() && out_.report.sigma0 > band)
@@ -532,7 +541,8 @@ class Snooper {
       if (together > 1) {
         stopped = "the surveys " + group +
                   " fail and the test cannot tell them apart (their chi-square statistics lie "
-                  "within k^2 = " + Fixed(k * k, 1) + "): one of them may be off";
+                  "within k^2 = " +
+                  Fixed(k * k, 1) + "): one of them may be off";
         for (const auto* x : failing)
           if (worst.t_full - x->t_full <= k * k) suspects.push_back(*x);
         inseparable = true;
@@ -540,12 +550,12 @@ class Snooper {
         stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
                   " over all its components) but its residual is " + Fixed(largest_v, 1) +
                   " sigma, within the critical value: the disagreement lies in a direction the "
-                  "block bends to fit (r < " + Fixed(o_.min_redundancy, 2) +
-                  "), where a model error looks the same";
+                  "block bends to fit (r < " +
+                  Fixed(o_.min_redundancy, 2) + "), where a model error looks the same";
       } else if (holds < kHoldsTheBlock) {
         stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
-                  ") but it alone holds the block in one direction (redundancy " +
-                  Fixed(holds, 6) + "): without it the block would be loose there";
+                  ") but it alone holds the block in one direction (redundancy " + Fixed(holds, 6) +
+                  "): without it the block would be loose there";
       } else if (static_cast<int>(left.size()) >= limit) {
         stopped = worst.label + " still fails (w = " + Fixed(worst.w_full, 1) + "); at most " +
                   std::to_string(limit) + " of the " + std::to_string(n_surveys) +
@@ -590,12 +600,12 @@ class Snooper {
         out_.report = b_.Solve(solver);
         ++out_.solves;
       }
-      out_.findings.push_back(
-          "surveys tested first: " + stopped +
-          (left.empty() ? std::string()
-                        : "; leaving out " + names + " (w = " + Fixed(left.front().w_full, 1) +
-                              ") did not make the block fit") +
-          ": every survey kept (a survey blunder, or a model error)");
+      out_.findings.push_back("surveys tested first: " + stopped +
+                              (left.empty() ? std::string()
+                                            : "; leaving out " + names +
+                                                  " (w = " + Fixed(left.front().w_full, 1) +
+                                                  ") did not make the block fit") +
+                              ": every survey kept (a survey blunder, or a model error)");
       return;
     }
     for (auto& x : left) {
@@ -616,8 +626,8 @@ class Snooper {
     x->reason = reason;
     if (decided_.emplace(x->id, std::make_pair(verdict, reason)).second &&
         verdict != SnoopingVerdict::kLeftAboveCritical)
-      out_.findings.push_back(std::string(VerdictName(verdict)) + ": " + x->label + " (w = " +
-                              Fixed(x->w_max, 1) + "): " + reason);
+      out_.findings.push_back(std::string(VerdictName(verdict)) + ": " + x->label +
+                              " (w = " + Fixed(x->w_max, 1) + "): " + reason);
   }
 
  private:
@@ -633,13 +643,20 @@ class Snooper {
 
 const char* VerdictName(SnoopingVerdict verdict) {
   switch (verdict) {
-    case SnoopingVerdict::kAccepted: return "accepted";
-    case SnoopingVerdict::kRejected: return "rejected";
-    case SnoopingVerdict::kWeaklyControlled: return "weakly controlled";
-    case SnoopingVerdict::kVetoed: return "vetoed";
-    case SnoopingVerdict::kHeld: return "held";
-    case SnoopingVerdict::kLeftAboveCritical: return "left above critical";
-    case SnoopingVerdict::kLeftOut: return "left out";
+    case SnoopingVerdict::kAccepted:
+      return "accepted";
+    case SnoopingVerdict::kRejected:
+      return "rejected";
+    case SnoopingVerdict::kWeaklyControlled:
+      return "weakly controlled";
+    case SnoopingVerdict::kVetoed:
+      return "vetoed";
+    case SnoopingVerdict::kHeld:
+      return "held";
+    case SnoopingVerdict::kLeftAboveCritical:
+      return "left above critical";
+    case SnoopingVerdict::kLeftOut:
+      return "left out";
   }
   return "?";
 }
@@ -690,8 +707,8 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
     out.report = builder.Solve(solver);
     ++out.solves;
   }
-  if (options.leave_out_report_only && !options.report_only_groups.empty() &&
-      out.report.usable && out.report.redundancy > 0)
+  if (options.leave_out_report_only && !options.report_only_groups.empty() && out.report.usable &&
+      out.report.redundancy > 0)
     snooper.TestSurveys(solver);
   snooper.CollectReportOnlyPoints();
   int removed_total = 0;

@@ -102,10 +102,10 @@ namespace aerocal::calib {
 struct SnoopingOptions {
   std::vector<std::string> groups;              // tested groups; empty = every group
   std::vector<std::string> report_only_groups;  // tested and reported, never rejected
-  double alpha = 0.05;           // family-wise level over the tested components, (0, 1)
-  double critical_value = 0.0;   // of |w|; 0: from alpha / n_tested (at least 3.29)
-  double power = 0.80;           // of the test, for the MDB, (0.5, 1)
-  double min_redundancy = 0.1;   // r below: weakly controlled, never rejected
+  double alpha = 0.05;              // family-wise level over the tested components, (0, 1)
+  double critical_value = 0.0;      // of |w|; 0: from alpha / n_tested (at least 3.29)
+  double power = 0.80;              // of the test, for the MDB, (0.5, 1)
+  double min_redundancy = 0.1;      // r below: weakly controlled, never rejected
   double group_correlation = 0.99;  // |rho| above: the observations cannot be told apart
   int max_rejections = 100;         // removals (group members count one each), > 0
   /// Test the report-only observations first and leave out the failing ones when that makes the
@@ -125,13 +125,13 @@ struct SnoopingOptions {
 };
 
 enum class SnoopingVerdict {
-  kAccepted,          // tested, below the critical value
-  kRejected,          // removed as a gross error (alone or with its correlated group)
-  kWeaklyControlled,  // above the critical value on a component with r < min_redundancy
-  kVetoed,            // candidate whose removal the caller refused (datum)
-  kHeld,              // candidate of a report-only group, or held by a suspected model error
-  kLeftAboveCritical, // candidate left when the rejection cap was reached
-  kLeftOut            // report-only observation left out: the others pass without it
+  kAccepted,           // tested, below the critical value
+  kRejected,           // removed as a gross error (alone or with its correlated group)
+  kWeaklyControlled,   // above the critical value on a component with r < min_redundancy
+  kVetoed,             // candidate whose removal the caller refused (datum)
+  kHeld,               // candidate of a report-only group, or held by a suspected model error
+  kLeftAboveCritical,  // candidate left when the rejection cap was reached
+  kLeftOut             // report-only observation left out: the others pass without it
 };
 const char* VerdictName(SnoopingVerdict verdict);
 
@@ -149,15 +149,15 @@ struct TestedObservation {
   /// The chi-square statistic behind w_max (v^T Q_ii^+ v / s^2 over the controlled directions;
   /// w_max^2 for one component): members of a correlated group are told apart by it.
   double t_joint = 0.0;
-  int component = -1;              // its largest-w controlled component (for the group)
-  double w_weak = 0.0;             // largest w of the weakly controlled components
+  int component = -1;   // its largest-w controlled component (for the group)
+  double w_weak = 0.0;  // largest w of the weakly controlled components
   /// The joint statistic over every testable direction (eigenvalue of Q_ii >= 1e-6, weakly
   /// controlled ones included) as a normal w: the test of a survey (leave_out_report_only).
   double w_full = 0.0;
-  double t_full = 0.0;  // the chi-square statistic behind w_full
+  double t_full = 0.0;                 // the chi-square statistic behind w_full
   std::vector<ResidualId> correlated;  // with itself: observations it cannot be told apart from
   int group_size = 1;
-  BlockId point = -1;              // its eliminable block, -1 when none
+  BlockId point = -1;  // its eliminable block, -1 when none
   SnoopingVerdict verdict = SnoopingVerdict::kAccepted;
   int round = 0;       // round of the verdict
   std::string reason;  // for the verdicts other than accepted
@@ -175,7 +175,7 @@ struct SnoopingOutcome {
   int rounds = 0;
   int solves = 0;  // solves made by snooping (0: `report` is the caller's `solved`)
   bool cap_reached = false;
-  int remaining_above_critical = 0;  // candidates left when the cap was reached
+  int remaining_above_critical = 0;         // candidates left when the cap was reached
   std::vector<TestedObservation> rejected;  // in order, with their test values
   /// Report-only observations left out (suspected survey blunders), with the test that failed.
   std::vector<TestedObservation> left_out;

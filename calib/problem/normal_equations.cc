@@ -142,7 +142,9 @@ SchurComplement::SchurComplement(ceres::CRSMatrix jacobian, const ColumnBlocks& 
   s_lower_.setFromTriplets(triplets.begin(), triplets.end());
 }
 
-void SchurComplement::RowReduced(int row, std::vector<int>* cols, std::vector<double>* values) const {
+void SchurComplement::RowReduced(int row,
+                                 std::vector<int>* cols,
+                                 std::vector<double>* values) const {
   cols->clear();
   values->clear();
   for (int k = jacobian_.rows[row]; k < jacobian_.rows[row + 1]; ++k) {
@@ -232,8 +234,7 @@ bool SelectedInverse::Compute(const Eigen::SparseMatrix<double>& s_lower,
   ldlt_ = std::make_unique<Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>, Eigen::Lower>>();
   ldlt_->compute(s_lower);
   const Eigen::VectorXd d = ldlt_->vectorD();
-  perm_.assign(ldlt_->permutationP().indices().data(),
-               ldlt_->permutationP().indices().data() + n_);
+  perm_.assign(ldlt_->permutationP().indices().data(), ldlt_->permutationP().indices().data() + n_);
   // A pivot that lost all but 1e-12 of its diagonal is a (numerical) rank defect.
   Eigen::VectorXd diagonal = Eigen::VectorXd::Zero(n_);
   for (int j = 0; j < n_; ++j)

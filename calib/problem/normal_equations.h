@@ -69,9 +69,9 @@ class SchurComplement {
   bool eliminated_ = true;
   int n_reduced_ = 0;
   std::vector<int> col_block_, col_local_;
-  std::vector<int> reduced_offset_;  // per block, -1 for a point
-  std::vector<int> point_index_;     // per block, -1 for a reduced block
-  std::vector<int> row_point_;       // per row
+  std::vector<int> reduced_offset_;                // per block, -1 for a point
+  std::vector<int> point_index_;                   // per block, -1 for a reduced block
+  std::vector<int> row_point_;                     // per row
   std::vector<int> point_row_start_, point_rows_;  // rows of each point (CSR by point index)
   std::vector<int> point_block_;                   // block of each point index
   Eigen::SparseMatrix<double> s_lower_;

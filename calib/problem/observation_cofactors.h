@@ -41,7 +41,7 @@ struct ObservationCofactors {
   std::string message;
   std::map<ResidualId, std::vector<double>> redundancy;  // r_ii per scalar component, in [0, 1]
   std::vector<ResidualCluster> clusters;                 // filled when with_clusters
-  int reduced_parameters = 0;   // size of S
+  int reduced_parameters = 0;                            // size of S
   long long factor_nonzeros = 0;  // entries of the sparse factor L (0 for the dense path)
 };
 

@@ -1,8 +1,8 @@
 #include "calib/problem/problem_builder.h"
 
+#include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/core/log.h"
-#include "calib/camera/rotation.h"
 #include "calib/problem/normal_equations.h"
 #include "calib/problem/rotation_manifold.h"
 #include "calib/problem/scaled_subset_manifold.h"
@@ -29,7 +29,7 @@ struct ProblemBuilder::Block {
   std::vector<std::string> entry_names;
   bool constant = false;
   std::vector<bool> entry_fixed;
-  int num_residuals = 0;       // residual blocks that use it
+  int num_residuals = 0;  // residual blocks that use it
   /// The block's manifold (owned by the ceres::Problem), created once per set of free entries
   /// and rescaled in place on every UpdateManifolds().
   ScaledSubsetManifold* manifold = nullptr;
@@ -224,8 +224,8 @@ BlockId ProblemBuilder::AddRotationBlock(const std::string& name,
   AEROCAL_CHECK(quaternion != nullptr) << "rotation block " << name;
   const double norm = std::sqrt(quaternion[0] * quaternion[0] + quaternion[1] * quaternion[1] +
                                 quaternion[2] * quaternion[2] + quaternion[3] * quaternion[3]);
-  AEROCAL_CHECK(std::abs(norm - 1.0) < 1e-9) << "rotation block " << name
-                                             << " is not a unit quaternion (norm " << norm << ")";
+  AEROCAL_CHECK(std::abs(norm - 1.0) < 1e-9)
+      << "rotation block " << name << " is not a unit quaternion (norm " << norm << ")";
   const BlockId id = AddBlock(name, quaternion, 4, BlockKind::kRotation);
   blocks_[id].rotation = true;
   blocks_[id].entry_names = std::move(report_names);
@@ -418,8 +418,7 @@ bool ProblemBuilder::UpdateManifolds() {
       b.manifold->SetScales(std::vector<double>(free.size(), 1.0));
       continue;
     }
-    b.manifold =
-        new ScaledSubsetManifold(b.size, free, std::vector<double>(free.size(), 1.0));
+    b.manifold = new ScaledSubsetManifold(b.size, free, std::vector<double>(free.size(), 1.0));
     problem_->SetManifold(b.values, b.manifold);
   }
   if (free_blocks.empty()) return true;
@@ -448,8 +447,8 @@ bool ProblemBuilder::UpdateManifolds() {
 }
 
 std::unique_ptr<ceres::Problem> ProblemBuilder::CopyInBlockOrder(std::vector<double>* buffer,
-                                                                  std::vector<double*>* pointers,
-                                                                  bool all) const {
+                                                                 std::vector<double*>* pointers,
+                                                                 bool all) const {
   ceres::Problem::Options options;
   options.cost_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
   options.loss_function_ownership = ceres::DO_NOT_TAKE_OWNERSHIP;
@@ -470,8 +469,8 @@ std::unique_ptr<ceres::Problem> ProblemBuilder::CopyInBlockOrder(std::vector<dou
       offset += b.size;
     }
     (*pointers)[id] = values;
-    mirror->AddParameterBlock(values, b.size,
-                              const_cast<ceres::Manifold*>(problem_->GetManifold(b.values)));
+    mirror->AddParameterBlock(
+        values, b.size, const_cast<ceres::Manifold*>(problem_->GetManifold(b.values)));
     if (problem_->IsParameterBlockConstant(b.values)) mirror->SetParameterBlockConstant(values);
   }
   for (const Residual& r : residuals_) {
@@ -591,7 +590,8 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   }
 
   ceres::Solver::Summary summary;
-  if (report.diagnostics.empty()) ceres::Solve(ceres_options, mirror ? mirror.get() : problem_.get(), &summary);
+  if (report.diagnostics.empty())
+    ceres::Solve(ceres_options, mirror ? mirror.get() : problem_.get(), &summary);
   if (mirror)
     for (BlockId id = 0; id < static_cast<BlockId>(blocks_.size()); ++id)
       if (mirror_pointers[id] != blocks_[id].values)
@@ -689,8 +689,9 @@ std::unique_ptr<internal::SchurComplement> ProblemBuilder::BuildSchurComplement(
   return std::make_unique<internal::SchurComplement>(std::move(crs), columns);
 }
 
-ObservationCofactors ProblemBuilder::ComputeObservationCofactors(
-    const std::vector<ResidualId>& ids, bool with_clusters, int max_dense_parameters) const {
+ObservationCofactors ProblemBuilder::ComputeObservationCofactors(const std::vector<ResidualId>& ids,
+                                                                 bool with_clusters,
+                                                                 int max_dense_parameters) const {
   ObservationCofactors out;
   auto not_computed = [&](const std::string& why) {
     out.ok = false;
@@ -699,8 +700,8 @@ ObservationCofactors ProblemBuilder::ComputeObservationCofactors(
     out.clusters.clear();
     for (ResidualId id : ids)
       if (residuals_.at(id).active)
-        out.redundancy[id] = std::vector<double>(residuals_[id].size,
-                                                 std::numeric_limits<double>::quiet_NaN());
+        out.redundancy[id] =
+            std::vector<double>(residuals_[id].size, std::numeric_limits<double>::quiet_NaN());
     return out;
   };
   const Factorized* factorized = Factorize(false, max_dense_parameters);
@@ -901,8 +902,8 @@ NullSpaceReport ProblemBuilder::NullSpace(double relative_threshold, int max_par
     const Block& block = blocks_[id];
     const int offset = schur->reduced_offset(static_cast<int>(b));
     const int size = block.TangentSize();
-    report.vectors[id] = PlusJacobianOf(id) * d.segment(offset, size).asDiagonal() *
-                         w.middleRows(offset, size);
+    report.vectors[id] =
+        PlusJacobianOf(id) * d.segment(offset, size).asDiagonal() * w.middleRows(offset, size);
     if (block.rotation) continue;
     // A subset (or no) manifold: tangent entry t is ambient entry free[t], scaled by s_t, so the
     // Jacobi-scaled coordinate sqrt(S_ee) x_e of the ambient entry is the eigenvector's.
@@ -1012,8 +1013,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     std::map<BlockId, int> index;  // block -> index in the Schur system
     for (size_t b = 0; b < order.size(); ++b) index[order[b]] = static_cast<int>(b);
     bool any_point = false;
-    for (size_t b = 0; b < order.size(); ++b)
-      any_point |= schur->is_point(static_cast<int>(b));
+    for (size_t b = 0; b < order.size(); ++b) any_point |= schur->is_point(static_cast<int>(b));
     report.method = std::string(any_point ? "schur_" : "normal_") +
                     (inverse.dense() ? "dense_inverse" : "selected_inverse");
     // Every requested block as a linear function of the reduced parameters s:
@@ -1095,7 +1095,8 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
   std::vector<int> interior_rows;
   for (int i = 0; i < total; ++i)
     if (blocks_[report.entry_block[i]].kind == BlockKind::kInterior) interior_rows.push_back(i);
-  report.interior_correlation = Eigen::MatrixXd::Identity(interior_rows.size(), interior_rows.size());
+  report.interior_correlation =
+      Eigen::MatrixXd::Identity(interior_rows.size(), interior_rows.size());
   for (size_t r = 0; r < interior_rows.size(); ++r) {
     report.interior_names.push_back(report.names[interior_rows[r]]);
     for (size_t q = 0; q < interior_rows.size(); ++q)

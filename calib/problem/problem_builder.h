@@ -147,9 +147,9 @@ struct CovarianceReport {
   /// "schur_dense_inverse" / "normal_dense_inverse" (small reduced matrix), or "ceres_dense_svd"
   /// (ceres::Covariance, up to 300 free parameters). All exact.
   std::string method;
-  std::vector<std::string> names;  // "block.entry" per row
-  std::vector<bool> free;          // false for fixed entries (sigma 0)
-  Eigen::VectorXd sigma;           // sqrt(diag)
+  std::vector<std::string> names;                  // "block.entry" per row
+  std::vector<bool> free;                          // false for fixed entries (sigma 0)
+  Eigen::VectorXd sigma;                           // sqrt(diag)
   std::vector<HighCorrelation> high_correlations;  // |rho| above the threshold, free entries only
   std::vector<std::string> undetermined;           // parameters in the null space (rank defect)
   std::map<BlockId, int> offsets;                  // row of each block's first entry
@@ -180,9 +180,9 @@ struct CovarianceReport {
 /// each block's manifold). Used to derive a minimal datum (e.g. triangulation/pushbroom).
 struct NullSpaceReport {
   bool ok = false;
-  std::string message;           // why it was not computed, when !ok
-  int reduced_parameters = 0;    // size of S
-  double threshold = 0.0;        // the relative eigenvalue threshold used
+  std::string message;         // why it was not computed, when !ok
+  int reduced_parameters = 0;  // size of S
+  double threshold = 0.0;      // the relative eigenvalue threshold used
   /// Ascending eigenvalues of D S D divided by the largest (the smallest ones, up to 16): the
   /// rank defect is the count below the threshold; the next one shows the gap.
   std::vector<double> smallest_relative_eigenvalues;

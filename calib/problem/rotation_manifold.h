@@ -11,9 +11,9 @@
 // (ours differs by using the full rotation angle |delta| and a scale per axis).
 #pragma once
 
-#include <array>
-
 #include <ceres/manifold.h>
+
+#include <array>
 
 namespace aerocal::calib {
 

@@ -6,7 +6,8 @@
 
 namespace aerocal::calib {
 
-ScaledSubsetManifold::ScaledSubsetManifold(int size, std::vector<int> free_entries,
+ScaledSubsetManifold::ScaledSubsetManifold(int size,
+                                           std::vector<int> free_entries,
                                            std::vector<double> scales)
     : size_(size), free_(std::move(free_entries)), scales_(std::move(scales)) {}
 
@@ -29,8 +30,7 @@ bool ScaledSubsetManifold::PlusJacobian(const double*, double* jacobian) const {
 }
 
 bool ScaledSubsetManifold::Minus(const double* y, const double* x, double* y_minus_x) const {
-  for (size_t k = 0; k < free_.size(); ++k)
-    y_minus_x[k] = (y[free_[k]] - x[free_[k]]) / scales_[k];
+  for (size_t k = 0; k < free_.size(); ++k) y_minus_x[k] = (y[free_[k]] - x[free_[k]]) / scales_[k];
   return true;
 }
 

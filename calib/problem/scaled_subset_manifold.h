@@ -6,9 +6,9 @@
 // (K3 in mm^-6 next to ground coordinates in m). The ambient covariance is unchanged by scaling.
 #pragma once
 
-#include <vector>
-
 #include <ceres/manifold.h>
+
+#include <vector>
 
 namespace aerocal::calib {
 

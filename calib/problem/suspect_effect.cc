@@ -1,7 +1,6 @@
 #include "calib/problem/suspect_effect.h"
 
 #include "calib/camera/rotation.h"
-
 #include "calib/core/csv.h"
 
 #include <algorithm>
@@ -42,11 +41,11 @@ nlohmann::json SuspectEffectJson(const SuspectEffect& e) {
   if (!e.message.empty()) j["message"] = e.message;
   j["calibrated"] = nlohmann::json::array();
   for (const auto& c : e.calibrated)
-    j["calibrated"].push_back({{"parameter", c.parameter},
-                               {"change", c.change},
-                               {"sigma", Finite(c.sigma)},
-                               {"sigmas", c.sigma > 0 ? Finite(std::abs(c.change) / c.sigma)
-                                                      : nlohmann::json()}});
+    j["calibrated"].push_back(
+        {{"parameter", c.parameter},
+         {"change", c.change},
+         {"sigma", Finite(c.sigma)},
+         {"sigmas", c.sigma > 0 ? Finite(std::abs(c.change) / c.sigma) : nlohmann::json()}});
   return j;
 }
 
@@ -64,8 +63,7 @@ SuspectEffect EffectOfLeavingOut(ProblemBuilder& builder,
     return effect;
   }
   std::vector<Eigen::VectorXd> before;
-  for (BlockId b : blocks)
-    before.push_back(ReportedValues(builder, b, Eigen::Vector3d::Zero()));
+  for (BlockId b : blocks) before.push_back(ReportedValues(builder, b, Eigen::Vector3d::Zero()));
   const std::vector<double> state = builder.ValuesSnapshot();
   for (ResidualId id : suspects) builder.RemoveResidual(id);
   const SolveReport without = builder.Solve(solver);

@@ -28,8 +28,8 @@ struct SuspectEffect {
   /// The decision: the largest |change| / sigma over the calibrated parameters (free interior and
   /// platform, rig increments), over every parameter when the run calibrates none (conventional).
   double max_sigmas = 0;
-  std::string parameter;  // where it is largest ("camera cam1.c", "image 0012 centre.Z")
-  double max_all_sigmas = 0;   // the largest over every parameter, exterior orientations included
+  std::string parameter;      // where it is largest ("camera cam1.c", "image 0012 centre.Z")
+  double max_all_sigmas = 0;  // the largest over every parameter, exterior orientations included
   std::string parameter_all;
   struct Change {
     std::string parameter;

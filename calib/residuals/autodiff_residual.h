@@ -1,10 +1,10 @@
 // CRTP base that declares a residual's sizes once and provides Create() (STYLE.md section 5).
 #pragma once
 
+#include <ceres/autodiff_cost_function.h>
+
 #include <memory>
 #include <utility>
-
-#include <ceres/autodiff_cost_function.h>
 
 namespace aerocal::calib {
 

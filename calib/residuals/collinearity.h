@@ -13,10 +13,6 @@
 // of a camera's model by its id (VisitCameraModel); a new model needs nothing here.
 #pragma once
 
-#include <memory>
-
-#include <Eigen/Core>
-
 #include "calib/camera/brown_fraser10.h"
 #include "calib/camera/camera_model.h"
 #include "calib/camera/pixel_frame.h"
@@ -24,6 +20,10 @@
 #include "calib/camera/rotation.h"
 #include "calib/camera/subimage_mapping.h"
 #include "calib/residuals/autodiff_residual.h"
+
+#include <Eigen/Core>
+
+#include <memory>
 
 namespace aerocal::calib {
 
@@ -34,8 +34,11 @@ namespace internal {
 /// sub-image, rig head) ends here. False behind the projection plane or where the model's
 /// inversion does not converge.
 template <typename Model, typename T>
-bool CollinearityErrorFromImageSpace(const T* interior, const PixelFrame& frame, const T* uvw,
-                                     const T* measured_xy_mm, double inverse_sigma_mm,
+bool CollinearityErrorFromImageSpace(const T* interior,
+                                     const PixelFrame& frame,
+                                     const T* uvw,
+                                     const T* measured_xy_mm,
+                                     double inverse_sigma_mm,
                                      T* residual) {
   if (!(uvw[2] < T(0))) return false;  // point on or behind the projection plane
   const T c = Model::PrincipalDistanceMm(interior, frame);
@@ -55,13 +58,18 @@ bool CollinearityErrorFromImageSpace(const T* interior, const PixelFrame& frame,
 }
 
 template <typename Model, typename T>
-bool CollinearityError(const T* interior, const PixelFrame& frame, const T* rotation,
-                       const T* center, const T* point, const T* measured_xy_mm,
-                       double inverse_sigma_mm, T* residual) {
+bool CollinearityError(const T* interior,
+                       const PixelFrame& frame,
+                       const T* rotation,
+                       const T* center,
+                       const T* point,
+                       const T* measured_xy_mm,
+                       double inverse_sigma_mm,
+                       T* residual) {
   T uvw[3];
   ImageSpaceFromObjectByQuaternion(rotation, center, point, uvw);
-  return CollinearityErrorFromImageSpace<Model>(interior, frame, uvw, measured_xy_mm,
-                                                inverse_sigma_mm, residual);
+  return CollinearityErrorFromImageSpace<Model>(
+      interior, frame, uvw, measured_xy_mm, inverse_sigma_mm, residual);
 }
 }  // namespace internal
 
@@ -76,11 +84,11 @@ struct ModelCollinearityResidual
     frame.PhotoFromPixel(pixel.data(), xy_mm_);
   }
   template <typename T>
-  bool operator()(const T* interior, const T* rotation, const T* center, const T* point,
-                  T* r) const {
+  bool operator()(
+      const T* interior, const T* rotation, const T* center, const T* point, T* r) const {
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
-    return internal::CollinearityError<Model>(interior, frame_, rotation, center, point, xy,
-                                              inverse_sigma_mm_, r);
+    return internal::CollinearityError<Model>(
+        interior, frame_, rotation, center, point, xy, inverse_sigma_mm_, r);
   }
 
  private:
@@ -112,20 +120,26 @@ inline std::unique_ptr<ceres::CostFunction> MakeCollinearityResidual(CameraModel
 template <typename Mapping>
 struct SubimageCollinearityResidual
     : AutoDiffResidual<SubimageCollinearityResidual<Mapping>, 2, Mapping::kNumParams, 10, 4, 3, 3> {
-  SubimageCollinearityResidual(const PixelFrame& frame, const MappingConditioning& cond,
-                               const Eigen::Vector2d& uv, double sigma_px)
+  SubimageCollinearityResidual(const PixelFrame& frame,
+                               const MappingConditioning& cond,
+                               const Eigen::Vector2d& uv,
+                               double sigma_px)
       : frame_(frame),
         uv_conditioned_{(uv.x() - cond.cu) / cond.scale, (uv.y() - cond.cv) / cond.scale},
         inverse_sigma_mm_(1.0 / (sigma_px * frame.pixel_size_mm)) {}
   template <typename T>
-  bool operator()(const T* mapping, const T* interior, const T* rotation, const T* center,
-                  const T* point, T* r) const {
+  bool operator()(const T* mapping,
+                  const T* interior,
+                  const T* rotation,
+                  const T* center,
+                  const T* point,
+                  T* r) const {
     const T uv[2] = {T(uv_conditioned_[0]), T(uv_conditioned_[1])};
     T virtual_px[2], xy[2];
     Mapping::Apply(mapping, uv, virtual_px);
     frame_.PhotoFromPixel(virtual_px, xy);
-    return internal::CollinearityError<BrownFraser10Model>(interior, frame_, rotation, center,
-                                                           point, xy, inverse_sigma_mm_, r);
+    return internal::CollinearityError<BrownFraser10Model>(
+        interior, frame_, rotation, center, point, xy, inverse_sigma_mm_, r);
   }
 
  private:
@@ -147,22 +161,37 @@ struct SubimageCollinearityResidual
 /// CollinearityResidual (tests/calib/residuals_test.cc checks it).
 struct RigHeadCollinearityResidual
     : AutoDiffResidual<RigHeadCollinearityResidual, 2, 10, 4, 3, 3, 3, 3, 1, 3> {
-  RigHeadCollinearityResidual(const PixelFrame& head_frame, const Eigen::Vector2d& pixel,
-                              double sigma_px, const Eigen::Vector3d& velocity_mps)
+  RigHeadCollinearityResidual(const PixelFrame& head_frame,
+                              const Eigen::Vector2d& pixel,
+                              double sigma_px,
+                              const Eigen::Vector3d& velocity_mps)
       : frame_(head_frame),
         inverse_sigma_mm_(1.0 / (sigma_px * head_frame.pixel_size_mm)),
         velocity_mps_{velocity_mps.x(), velocity_mps.y(), velocity_mps.z()} {
     head_frame.PhotoFromPixel(pixel.data(), xy_mm_);
   }
   template <typename T>
-  bool operator()(const T* interior, const T* rig_rotation, const T* rig_center, const T* mount,
-                  const T* lever_arm, const T* increment, const T* dt, const T* point,
+  bool operator()(const T* interior,
+                  const T* rig_rotation,
+                  const T* rig_center,
+                  const T* mount,
+                  const T* lever_arm,
+                  const T* increment,
+                  const T* dt,
+                  const T* point,
                   T* r) const {
     const T velocity[3] = {T(velocity_mps_[0]), T(velocity_mps_[1]), T(velocity_mps_[2])};
     T object_from_rig[9], object_from_head[9], head_center[3], uvw[3];
     ObjectFromImageRotationOfQuaternion(rig_rotation, object_from_rig);
-    HeadPoseOfRotation(object_from_rig, rig_center, mount, lever_arm,
-                       increment, dt, velocity, object_from_head, head_center);
+    HeadPoseOfRotation(object_from_rig,
+                       rig_center,
+                       mount,
+                       lever_arm,
+                       increment,
+                       dt,
+                       velocity,
+                       object_from_head,
+                       head_center);
     ImageSpaceFromObjectByMatrix(object_from_head, head_center, point, uvw);
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
     return internal::CollinearityErrorFromImageSpace<BrownFraser10Model>(

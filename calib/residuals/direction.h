@@ -20,17 +20,17 @@
 // (a, e in rad; fixed for a collimator, free for a goniometer's target).
 #pragma once
 
-#include <cmath>
-#include <memory>
-
-#include <Eigen/Cholesky>
-#include <Eigen/Core>
-
 #include "calib/camera/camera_model.h"
 #include "calib/camera/pixel_frame.h"
 #include "calib/camera/rotation.h"
 #include "calib/residuals/autodiff_residual.h"
 #include "calib/residuals/collinearity.h"
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include <cmath>
+#include <memory>
 
 namespace aerocal::calib {
 
@@ -89,9 +89,11 @@ struct ModelDirectionResidual
   bool operator()(const T* interior, const T* rotation, const T* direction, T* r) const {
     T t[3], g_t[3], q_r[9], uvw[3];
     DirectionFromAngles(direction, t);
-    for (int i = 0; i < 3; ++i) g_t[i] = T(gt_[3 * i]) * t[0] + T(gt_[3 * i + 1]) * t[1] + T(gt_[3 * i + 2]) * t[2];
+    for (int i = 0; i < 3; ++i)
+      g_t[i] = T(gt_[3 * i]) * t[0] + T(gt_[3 * i + 1]) * t[1] + T(gt_[3 * i + 2]) * t[2];
     ObjectFromImageRotationOfQuaternion(rotation, q_r);
-    for (int i = 0; i < 3; ++i) uvw[i] = q_r[i] * g_t[0] + q_r[3 + i] * g_t[1] + q_r[6 + i] * g_t[2];
+    for (int i = 0; i < 3; ++i)
+      uvw[i] = q_r[i] * g_t[0] + q_r[3 + i] * g_t[1] + q_r[6 + i] * g_t[2];
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
     T d[2];
     if (!internal::CollinearityErrorFromImageSpace<Model>(interior, frame_, uvw, xy, 1.0, d))
@@ -109,13 +111,15 @@ struct ModelDirectionResidual
 };
 
 /// The factory by model id (VisitCameraModel), blocks as ModelDirectionResidual.
-inline std::unique_ptr<ceres::CostFunction> MakeDirectionResidual(CameraModelId model,
-                                                                  const PixelFrame& frame,
-                                                                  const Eigen::Matrix3d& instrument_rotation,
-                                                                  const Eigen::Vector2d& pixel,
-                                                                  const Eigen::Matrix2d& covariance_mm2) {
+inline std::unique_ptr<ceres::CostFunction> MakeDirectionResidual(
+    CameraModelId model,
+    const PixelFrame& frame,
+    const Eigen::Matrix3d& instrument_rotation,
+    const Eigen::Vector2d& pixel,
+    const Eigen::Matrix2d& covariance_mm2) {
   return VisitCameraModel(model, [&](auto m) {
-    return ModelDirectionResidual<decltype(m)>::Create(frame, instrument_rotation, pixel, covariance_mm2);
+    return ModelDirectionResidual<decltype(m)>::Create(
+        frame, instrument_rotation, pixel, covariance_mm2);
   });
 }
 

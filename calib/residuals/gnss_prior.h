@@ -10,10 +10,10 @@
 // blocks: rotation[4], center[3] (m), lever_arm[3] (m), time_offset[1] (s).
 #pragma once
 
-#include <Eigen/Core>
-
 #include "calib/camera/rotation.h"
 #include "calib/residuals/autodiff_residual.h"
+
+#include <Eigen/Core>
 
 namespace aerocal::calib {
 

@@ -27,15 +27,15 @@
 // Returns false when the point is on or behind the camera (W >= 0).
 #pragma once
 
-#include <array>
-#include <cmath>
-
-#include <Eigen/Core>
-
 #include "calib/camera/line_camera.h"
 #include "calib/camera/rotation.h"
 #include "calib/residuals/autodiff_residual.h"
 #include "calib/residuals/collinearity.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cmath>
 
 namespace aerocal::calib {
 
@@ -56,8 +56,10 @@ inline SplineSpan CubicBSplineWeights(double t, int spacing) {
   span.first_node = int(std::floor(s));
   const double f = s - span.first_node;
   const double f2 = f * f, f3 = f2 * f;
-  span.weights = {(1 - f) * (1 - f) * (1 - f) / 6.0, (3 * f3 - 6 * f2 + 4) / 6.0,
-                  (-3 * f3 + 3 * f2 + 3 * f + 1) / 6.0, f3 / 6.0};
+  span.weights = {(1 - f) * (1 - f) * (1 - f) / 6.0,
+                  (3 * f3 - 6 * f2 + 4) / 6.0,
+                  (-3 * f3 + 3 * f2 + 3 * f + 1) / 6.0,
+                  f3 / 6.0};
   return span;
 }
 /// Nodes a spline over lines 0 .. last_line needs.
@@ -83,16 +85,28 @@ struct LineFocalPlaneModel {
   }
 };
 
-struct LineCollinearityResidual
-    : AutoDiffResidual<LineCollinearityResidual, 2, kLineNodeSize, kLineNodeSize, kLineNodeSize,
-                       kLineNodeSize, 2 * kLineMaxTerms, 1, 3, 3, 1, 3> {
+struct LineCollinearityResidual : AutoDiffResidual<LineCollinearityResidual,
+                                                   2,
+                                                   kLineNodeSize,
+                                                   kLineNodeSize,
+                                                   kLineNodeSize,
+                                                   kLineNodeSize,
+                                                   2 * kLineMaxTerms,
+                                                   1,
+                                                   3,
+                                                   3,
+                                                   1,
+                                                   3> {
   /// design_xy_mm: design focal-plane position of the measured detector position; u: its
   /// normalised index in its sub-camera; span: spline weights of its line; pos_opk_rad,
   /// pos_center_m: the POS pose interpolated to its line; sigma_xy_mm > 0 (see above);
   /// pos_velocity_m_s, pos_opk_rate_rad_s: the POS's time derivatives at the line (the time
   /// offset's lever).
-  LineCollinearityResidual(const Eigen::Vector2d& design_xy_mm, double u, const SplineSpan& span,
-                           const Eigen::Vector3d& pos_opk_rad, const Eigen::Vector3d& pos_center_m,
+  LineCollinearityResidual(const Eigen::Vector2d& design_xy_mm,
+                           double u,
+                           const SplineSpan& span,
+                           const Eigen::Vector3d& pos_opk_rad,
+                           const Eigen::Vector3d& pos_center_m,
                            const Eigen::Vector2d& sigma_xy_mm,
                            const Eigen::Vector3d& pos_velocity_m_s = Eigen::Vector3d::Zero(),
                            const Eigen::Vector3d& pos_opk_rate_rad_s = Eigen::Vector3d::Zero())
@@ -106,9 +120,17 @@ struct LineCollinearityResidual
         inverse_sigma_mm_{1.0 / sigma_xy_mm.x(), 1.0 / sigma_xy_mm.y()} {}
 
   template <typename T>
-  bool operator()(const T* n0, const T* n1, const T* n2, const T* n3, const T* detector,
-                  const T* c, const T* mount, const T* lever, const T* time_offset,
-                  const T* point, T* r) const {
+  bool operator()(const T* n0,
+                  const T* n1,
+                  const T* n2,
+                  const T* n3,
+                  const T* detector,
+                  const T* c,
+                  const T* mount,
+                  const T* lever,
+                  const T* time_offset,
+                  const T* point,
+                  T* r) const {
     const T* nodes[4] = {n0, n1, n2, n3};
     T opk[3], center[3];
     for (int a = 0; a < 3; ++a) {
@@ -120,7 +142,7 @@ struct LineCollinearityResidual
       }
     }
     T body[9], cam[9];
-    ObjectFromImageRotation(opk, body);  // body -> object, row-major
+    ObjectFromImageRotation(opk, body);   // body -> object, row-major
     ObjectFromImageRotation(mount, cam);  // camera -> body
     // C = O + R lever;  b = R^T (X - C);  v = M^T b
     T d[3];
@@ -131,8 +153,9 @@ struct LineCollinearityResidual
     for (int a = 0; a < 3; ++a) b[a] = body[a] * d[0] + body[3 + a] * d[1] + body[6 + a] * d[2];
     for (int a = 0; a < 3; ++a) v[a] = cam[a] * b[0] + cam[3 + a] * b[1] + cam[6 + a] * b[2];
     const T u(u_);
-    const T xy[2] = {T(design_[0]) + EvaluatePolynomial(detector, kLineMaxTerms, u),
-                     T(design_[1]) + EvaluatePolynomial(detector + kLineMaxTerms, kLineMaxTerms, u)};
+    const T xy[2] = {
+        T(design_[0]) + EvaluatePolynomial(detector, kLineMaxTerms, u),
+        T(design_[1]) + EvaluatePolynomial(detector + kLineMaxTerms, kLineMaxTerms, u)};
     // The one collinearity condition (unit sigma), then the per-axis whitening.
     T unit[2];
     if (!internal::CollinearityErrorFromImageSpace<LineFocalPlaneModel>(

@@ -1,13 +1,15 @@
 #include "calib/residuals/prior.h"
 
-#include <algorithm>
-
 #include "calib/core/error.h"
+
+#include <algorithm>
 
 namespace aerocal::calib {
 
-PriorCostFunction::PriorCostFunction(int block_size, std::vector<int> indices,
-                                     std::vector<double> values, std::vector<double> sigmas)
+PriorCostFunction::PriorCostFunction(int block_size,
+                                     std::vector<int> indices,
+                                     std::vector<double> values,
+                                     std::vector<double> sigmas)
     : block_size_(block_size), indices_(std::move(indices)), values_(std::move(values)) {
   AEROCAL_CHECK(indices_.size() == values_.size() && values_.size() == sigmas.size())
       << "prior sizes differ";
@@ -20,7 +22,8 @@ PriorCostFunction::PriorCostFunction(int block_size, std::vector<int> indices,
   mutable_parameter_block_sizes()->push_back(block_size_);
 }
 
-bool PriorCostFunction::Evaluate(double const* const* parameters, double* residuals,
+bool PriorCostFunction::Evaluate(double const* const* parameters,
+                                 double* residuals,
                                  double** jacobians) const {
   const int n = static_cast<int>(indices_.size());
   for (int k = 0; k < n; ++k)
@@ -36,8 +39,8 @@ std::unique_ptr<ceres::CostFunction> PriorCostFunction::Create(const std::vector
                                                                const std::vector<double>& sigmas) {
   std::vector<int> indices(values.size());
   for (size_t i = 0; i < indices.size(); ++i) indices[i] = static_cast<int>(i);
-  return std::make_unique<PriorCostFunction>(static_cast<int>(values.size()), indices, values,
-                                             sigmas);
+  return std::make_unique<PriorCostFunction>(
+      static_cast<int>(values.size()), indices, values, sigmas);
 }
 
 LinearConstraintCostFunction::LinearConstraintCostFunction(std::vector<Eigen::MatrixXd> weights,
@@ -56,7 +59,8 @@ LinearConstraintCostFunction::LinearConstraintCostFunction(std::vector<Eigen::Ma
   set_num_residuals(static_cast<int>(weights_[0].rows()));
 }
 
-bool LinearConstraintCostFunction::Evaluate(double const* const* parameters, double* residuals,
+bool LinearConstraintCostFunction::Evaluate(double const* const* parameters,
+                                            double* residuals,
                                             double** jacobians) const {
   Eigen::Map<Eigen::VectorXd> r(residuals, num_residuals());
   r.setZero();

@@ -4,20 +4,23 @@
 // GradientChecker test is in tests/calib/residuals_test.cc.
 #pragma once
 
-#include <memory>
-#include <vector>
-
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
+
+#include <memory>
+#include <vector>
 
 namespace aerocal::calib {
 
 class PriorCostFunction : public ceres::CostFunction {
  public:
   /// `block_size` entries in the block; `indices`, `values` and `sigmas` (> 0) have equal length.
-  PriorCostFunction(int block_size, std::vector<int> indices, std::vector<double> values,
+  PriorCostFunction(int block_size,
+                    std::vector<int> indices,
+                    std::vector<double> values,
                     std::vector<double> sigmas);
-  bool Evaluate(double const* const* parameters, double* residuals,
+  bool Evaluate(double const* const* parameters,
+                double* residuals,
                 double** jacobians) const override;
 
   /// Prior on all entries of a block.
@@ -41,7 +44,8 @@ class LinearConstraintCostFunction : public ceres::CostFunction {
   LinearConstraintCostFunction(std::vector<Eigen::MatrixXd> weights,
                                std::vector<Eigen::VectorXd> origins,
                                double sigma);
-  bool Evaluate(double const* const* parameters, double* residuals,
+  bool Evaluate(double const* const* parameters,
+                double* residuals,
                 double** jacobians) const override;
 
  private:

@@ -9,13 +9,13 @@
 // blocks: rotation[4], boresight[3] (rad).
 #pragma once
 
-#include <cmath>
+#include "calib/camera/rotation.h"
+#include "calib/residuals/autodiff_residual.h"
 
 #include <Eigen/Core>
 #include <ceres/jet.h>
 
-#include "calib/camera/rotation.h"
-#include "calib/residuals/autodiff_residual.h"
+#include <cmath>
 
 namespace aerocal::calib {
 

@@ -2,10 +2,10 @@
 // parameters (subimage_mapping.h). Both are [2, unitless], whitened by the point's sigma in px.
 #pragma once
 
-#include <Eigen/Core>
-
 #include "calib/camera/subimage_mapping.h"
 #include "calib/residuals/autodiff_residual.h"
+
+#include <Eigen/Core>
 
 namespace aerocal::calib {
 
@@ -35,8 +35,10 @@ struct MappedObservation {
 template <typename Mapping>
 struct StitchReferenceResidual
     : AutoDiffResidual<StitchReferenceResidual<Mapping>, 2, Mapping::kNumParams> {
-  StitchReferenceResidual(const MappingConditioning& cond, const Eigen::Vector2d& uv,
-                          const Eigen::Vector2d& virtual_px, double sigma_px)
+  StitchReferenceResidual(const MappingConditioning& cond,
+                          const Eigen::Vector2d& uv,
+                          const Eigen::Vector2d& virtual_px,
+                          double sigma_px)
       : observation_(cond, uv, sigma_px), target_{virtual_px.x(), virtual_px.y()} {}
   template <typename T>
   bool operator()(const T* mapping, T* r) const {

@@ -1,16 +1,16 @@
 #include "stitch/adjustment/flight_stability.h"
 
+#include "calib/core/error.h"
+#include "calib/core/progress.h"
+#include "stitch/adjustment/f_distribution.h"
+#include "stitch/adjustment/mapping_param_names.h"
+
+#include <Eigen/Cholesky>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
-
-#include <Eigen/Cholesky>
-
-#include "calib/core/error.h"
-#include "calib/core/progress.h"
-#include "stitch/adjustment/f_test.h"
-#include "stitch/adjustment/mapping_param_names.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -39,7 +39,8 @@ Spread SpreadOf(const std::vector<double>& x) {
 }  // namespace
 
 ModelStability ComputeStability(calib::MappingModel model,
-                                const std::vector<const FrameAdjustment*>& frames, double alpha) {
+                                const std::vector<const FrameAdjustment*>& frames,
+                                double alpha) {
   ModelStability out;
   out.model = model;
   out.n_frames = static_cast<int>(frames.size());
@@ -91,9 +92,12 @@ ModelStability ComputeStability(calib::MappingModel model,
       const double critical =
           FDistributionQuantile(1.0 - alpha / n_frames, frames[f]->redundancy, redundancy);
       if (ratio <= critical) continue;
-      std::snprintf(text, sizeof(text),
-                    "sigma0_px = %.4g: F = sigma0^2 / pooled sigma0^2 = %.3g > %.3g", s0px[f],
-                    ratio, critical);
+      std::snprintf(text,
+                    sizeof(text),
+                    "sigma0_px = %.4g: F = sigma0^2 / pooled sigma0^2 = %.3g > %.3g",
+                    s0px[f],
+                    ratio,
+                    critical);
       flags[f].reasons.push_back(text);
     }
   }
@@ -150,10 +154,14 @@ ModelStability ComputeStability(calib::MappingModel model,
     test(use, &d2);  // again without the frames out of line in the reference
     for (size_t f = 0; f < n_frames; ++f) {
       if (d2[f] <= critical) continue;
-      std::snprintf(text, sizeof(text),
+      std::snprintf(text,
+                    sizeof(text),
                     "sub-image %s: mapping differs from the other frames' mean by chi2 = %.3g > "
                     "%.3g (%d parameters)",
-                    e0.id.c_str(), d2[f], critical, n);
+                    e0.id.c_str(),
+                    d2[f],
+                    critical,
+                    n);
       flags[f].reasons.push_back(text);
     }
   }
@@ -165,7 +173,9 @@ ModelStability ComputeStability(calib::MappingModel model,
   return out;
 }
 
-FrameRun StitchFrame(const calib::Camera& camera, const FrameMeasurements& frame, const BatchOptions& options) {
+FrameRun StitchFrame(const calib::Camera& camera,
+                     const FrameMeasurements& frame,
+                     const BatchOptions& options) {
   FrameRun run;
   if (options.model) {
     run.adjustment = AdjustFrame(camera, frame, *options.model, options.stitch);
@@ -196,8 +206,10 @@ BatchResult CollectBatch(std::vector<FrameRun> frames, const BatchOptions& optio
   return result;
 }
 
-BatchResult RunStitchBatch(const calib::Camera& camera, const std::vector<FrameMeasurements>& frames,
-                           const BatchOptions& options, Progress* progress) {
+BatchResult RunStitchBatch(const calib::Camera& camera,
+                           const std::vector<FrameMeasurements>& frames,
+                           const BatchOptions& options,
+                           Progress* progress) {
   std::vector<FrameRun> runs;
   for (const FrameMeasurements& frame : frames) {
     runs.push_back(StitchFrame(camera, frame, options));
@@ -217,9 +229,11 @@ calib::MappingModel FlightModel(const BatchResult& result, const BatchOptions& o
   return model;
 }
 
-std::optional<calib::Camera> FlightMeanCamera(const calib::Camera& camera, const BatchResult& result,
+std::optional<calib::Camera> FlightMeanCamera(const calib::Camera& camera,
+                                              const BatchResult& result,
                                               calib::MappingModel model) {
-  const auto stability = std::find_if(result.stability.begin(), result.stability.end(),
+  const auto stability = std::find_if(result.stability.begin(),
+                                      result.stability.end(),
                                       [&](const ModelStability& s) { return s.model == model; });
   if (stability == result.stability.end()) return std::nullopt;
   const std::vector<std::string> names = MappingParamNames(model);

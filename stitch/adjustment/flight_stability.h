@@ -12,16 +12,16 @@
 //     and c = 1 + 1 / n_others for the mean's own noise; flagged when d^2 exceeds
 //     the chi^2 quantile at 1 - alpha / (n_frames * n_free_subimages). Frames found out of line
 //     in a first pass are left out of the means of a second. The mean, not the per-parameter
-//     median, keeps the centre consistent with strongly correlated parameters. The joint test uses the
-//     correlations: a corner parameter (a0, b0) may have a px-size sigma while a shift of the
+//     median, keeps the centre consistent with strongly correlated parameters. The joint test uses
+//     the correlations: a corner parameter (a0, b0) may have a px-size sigma while a shift of the
 //     sub-image centre by a fraction of that is clearly out of line.
 #pragma once
+
+#include "stitch/adjustment/model_selection.h"
 
 #include <optional>
 #include <string>
 #include <vector>
-
-#include "stitch/adjustment/model_selection.h"
 
 namespace aerocal {
 class Progress;
@@ -31,8 +31,8 @@ namespace aerocal::stitch {
 
 struct ParameterStability {
   std::string subimage, name;
-  double mean = 0, std = 0;     // over frames
-  double mean_sigma = 0;        // mean of the per-frame reported sigmas
+  double mean = 0, std = 0;  // over frames
+  double mean_sigma = 0;     // mean of the per-frame reported sigmas
 };
 
 struct FlaggedFrame {
@@ -61,8 +61,8 @@ struct BatchOptions {
 };
 
 struct FrameRun {
-  FrameAdjustment adjustment;          // the requested or chosen model
-  std::optional<ModelChoice> choice;   // --model auto only
+  FrameAdjustment adjustment;         // the requested or chosen model
+  std::optional<ModelChoice> choice;  // --model auto only
 };
 
 struct BatchResult {
@@ -72,7 +72,9 @@ struct BatchResult {
 
 /// One frame of a batch: adjusted with the requested model, or with the model its F test chooses.
 /// A unit of `aerocal batch`: frames are independent until CollectBatch.
-FrameRun StitchFrame(const calib::Camera& camera, const FrameMeasurements& frame, const BatchOptions& options);
+FrameRun StitchFrame(const calib::Camera& camera,
+                     const FrameMeasurements& frame,
+                     const BatchOptions& options);
 
 /// The batch of already adjusted `frames` (in flight order) with the stability of every model
 /// adjusted in all of them; RunStitchBatch = StitchFrame per frame, then this.
@@ -80,8 +82,10 @@ BatchResult CollectBatch(std::vector<FrameRun> frames, const BatchOptions& optio
 
 /// Adjusts every frame (InputError when a requested model is under-determined in a frame);
 /// `progress` (may be null) advances by one per frame.
-BatchResult RunStitchBatch(const calib::Camera& camera, const std::vector<FrameMeasurements>& frames,
-                           const BatchOptions& options, Progress* progress);
+BatchResult RunStitchBatch(const calib::Camera& camera,
+                           const std::vector<FrameMeasurements>& frames,
+                           const BatchOptions& options,
+                           Progress* progress);
 
 /// The flight's model: the requested one, or with --model auto the one chosen in most frames
 /// (the simpler on a tie). `result` must hold at least one frame.
@@ -90,7 +94,8 @@ calib::MappingModel FlightModel(const BatchResult& result, const BatchOptions& o
 /// `camera` with every free sub-image mapped by the flight mean of its `model` parameters (the
 /// stability of `model`); base sub-images keep the camera's mapping. nullopt when `model` was not
 /// adjusted in every frame.
-std::optional<calib::Camera> FlightMeanCamera(const calib::Camera& camera, const BatchResult& result,
+std::optional<calib::Camera> FlightMeanCamera(const calib::Camera& camera,
+                                              const BatchResult& result,
                                               calib::MappingModel model);
 
 }  // namespace aerocal::stitch

@@ -1,9 +1,9 @@
 #include "stitch/adjustment/frame_measurements.h"
 
+#include "calib/core/error.h"
+
 #include <map>
 #include <set>
-
-#include "calib/core/error.h"
 
 namespace aerocal::stitch {
 
@@ -33,7 +33,8 @@ std::vector<FrameMeasurements> GroupByFrame(const calib::Camera& camera,
       const std::string where =
           SourceRef{file, row->line}.ToString() + ": frame " + frame_id + ", point " + row->point;
       const int k = camera.SubimageIndex(row->subimage);
-      if (k < 0) throw InputError(where + ": sub-image '" + row->subimage + "' is not in the camera");
+      if (k < 0)
+        throw InputError(where + ": sub-image '" + row->subimage + "' is not in the camera");
       auto [it, inserted] = by_point.try_emplace(row->point);
       if (inserted) point_order.push_back(row->point);
       for (const StitchObservation* other : it->second)
@@ -52,11 +53,14 @@ std::vector<FrameMeasurements> GroupByFrame(const calib::Camera& camera,
         for (const StitchObservation* row : obs) {
           if (row->subimage != rp.subimage)
             throw InputError(SourceRef{file, row->line}.ToString() + ": frame " + frame.frame +
-                             ", point " + point +
-                             ": reference point of sub-image " + rp.subimage +
+                             ", point " + point + ": reference point of sub-image " + rp.subimage +
                              " measured in sub-image " + row->subimage);
-          frame.references.push_back({point, camera.SubimageIndex(rp.subimage),
-                                      {row->u, row->v}, {rp.U, rp.V}, row->sigma_px, true});
+          frame.references.push_back({point,
+                                      camera.SubimageIndex(rp.subimage),
+                                      {row->u, row->v},
+                                      {rp.U, rp.V},
+                                      row->sigma_px,
+                                      true});
         }
         measured_references.insert(point);
         continue;
@@ -73,8 +77,12 @@ std::vector<FrameMeasurements> GroupByFrame(const calib::Camera& camera,
     }
     for (const auto& rp : camera.reference_points)
       if (!measured_references.count(rp.id))
-        frame.references.push_back({rp.id, camera.SubimageIndex(rp.subimage), {rp.u, rp.v},
-                                    {rp.U, rp.V}, rp.sigma_px, false});
+        frame.references.push_back({rp.id,
+                                    camera.SubimageIndex(rp.subimage),
+                                    {rp.u, rp.v},
+                                    {rp.U, rp.V},
+                                    rp.sigma_px,
+                                    false});
     frames.push_back(std::move(frame));
   }
   return frames;

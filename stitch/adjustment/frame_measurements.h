@@ -8,23 +8,23 @@
 // Pixel frames per CONVENTIONS.md (sub-image (u, v), virtual (U, V), px).
 #pragma once
 
-#include <string>
-#include <vector>
+#include "calib/camera/camera.h"
+#include "stitch/simulation/stitch_simulator.h"
 
 #include <Eigen/Core>
 
-#include "calib/camera/camera.h"
-#include "stitch/simulation/stitch_simulator.h"
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
 struct ReferenceMeasurement {
   std::string point;
-  int subimage = -1;             // index into Camera::subimages
-  Eigen::Vector2d uv{0, 0};      // measured sub-image pixel
+  int subimage = -1;                 // index into Camera::subimages
+  Eigen::Vector2d uv{0, 0};          // measured sub-image pixel
   Eigen::Vector2d virtual_px{0, 0};  // surveyed (U, V) from the camera file
-  double sigma_px = 0.05;        // a-priori sigma of the measurement, px
-  bool measured = false;         // false: camera file's (u, v) used
+  double sigma_px = 0.05;            // a-priori sigma of the measurement, px
+  bool measured = false;             // false: camera file's (u, v) used
 };
 
 struct TieRay {

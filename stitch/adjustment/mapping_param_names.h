@@ -3,10 +3,10 @@
 // projective [a1, a2, a3, b1, b2, b3, c1, c2].
 #pragma once
 
+#include "calib/camera/subimage_mapping.h"
+
 #include <string>
 #include <vector>
-
-#include "calib/camera/subimage_mapping.h"
 
 namespace aerocal::stitch {
 

@@ -1,9 +1,9 @@
 #include "stitch/adjustment/model_selection.h"
 
-#include <cstdio>
-
 #include "calib/core/error.h"
-#include "stitch/adjustment/f_test.h"
+#include "stitch/adjustment/f_distribution.h"
+
+#include <cstdio>
 
 namespace aerocal::stitch {
 
@@ -13,13 +13,15 @@ const FrameAdjustment& ModelChoice::Chosen() const {
   throw LogicError("model choice without the chosen candidate");
 }
 
-ModelChoice ChooseModel(const calib::Camera& camera, const FrameMeasurements& frame,
-                        const StitchOptions& options, double alpha) {
+ModelChoice ChooseModel(const calib::Camera& camera,
+                        const FrameMeasurements& frame,
+                        const StitchOptions& options,
+                        double alpha) {
   ModelChoice choice;
   choice.alpha = alpha;
   char text[256];
-  std::snprintf(text, sizeof(text), "F test of the variance ratio between nested models, alpha %g",
-                alpha);
+  std::snprintf(
+      text, sizeof(text), "F test of the variance ratio between nested models, alpha %g", alpha);
   choice.test = text;
   int richest = -1;
   for (calib::MappingModel model : calib::kAllMappingModels) {
@@ -58,7 +60,8 @@ ModelChoice ChooseModel(const calib::Camera& camera, const FrameMeasurements& fr
     if (!c.determinable) continue;
     if (!accepted) {
       accepted = &c;
-      reason = std::string(calib::MappingModelName(c.model)) + " is the simplest determinable model";
+      reason =
+          std::string(calib::MappingModelName(c.model)) + " is the simplest determinable model";
       continue;
     }
     const FrameAdjustment& s = accepted->adjustment;
@@ -75,9 +78,17 @@ ModelChoice ChooseModel(const calib::Camera& camera, const FrameMeasurements& fr
     c.f_critical = FDistributionQuantile(1.0 - alpha, c.df1, c.df2);
     c.p_value = 1.0 - FDistributionCdf(c.f, c.df1, c.df2);
     c.significant = c.f > c.f_critical;
-    std::snprintf(text, sizeof(text), "; %s against %s: F = %.3g %s F(%g; %d, %d) = %.3g",
-                  std::string(calib::MappingModelName(c.model)).c_str(), c.against.c_str(), c.f,
-                  c.significant ? ">" : "<=", 1.0 - alpha, c.df1, c.df2, c.f_critical);
+    std::snprintf(text,
+                  sizeof(text),
+                  "; %s against %s: F = %.3g %s F(%g; %d, %d) = %.3g",
+                  std::string(calib::MappingModelName(c.model)).c_str(),
+                  c.against.c_str(),
+                  c.f,
+                  c.significant ? ">" : "<=",
+                  1.0 - alpha,
+                  c.df1,
+                  c.df2,
+                  c.f_critical);
     reason += text;
     reason += c.significant ? " (significant: accepted)" : " (not significant: stop)";
     if (!c.significant) break;

@@ -9,27 +9,27 @@
 //    whatever the simpler ones fit, and the same observations are removed from every candidate so
 //    that all models are compared on identical observations;
 // 3. starting from the simplest determinable model, the next richer model is accepted when the
-//    F test of the variance ratio (f_test.h) is significant at level alpha (default 5 %):
+//    F test of the variance ratio (f_distribution.h) is significant at level alpha (default 5 %):
 //      F = ((vtpv_s - vtpv_c) / (r_s - r_c)) / (vtpv_c / r_c) > F(1 - alpha; r_s - r_c, r_c);
 //    the first non-significant step stops the search. Each decision is one test at level alpha,
 //    so a model that is right is kept with probability 1 - alpha.
 #pragma once
 
+#include "stitch/adjustment/stitch_adjustment.h"
+
 #include <string>
 #include <vector>
-
-#include "stitch/adjustment/stitch_adjustment.h"
 
 namespace aerocal::stitch {
 
 struct ModelCandidate {
   calib::MappingModel model = calib::MappingModel::kAffine;
   bool determinable = false;
-  std::string refusal;          // why not, when !determinable
-  FrameAdjustment adjustment;   // when determinable
+  std::string refusal;         // why not, when !determinable
+  FrameAdjustment adjustment;  // when determinable
   // F test against the model accepted before it (tested only when that one exists).
   bool tested = false;
-  std::string against;          // name of the simpler model
+  std::string against;  // name of the simpler model
   double f = 0, f_critical = 0, p_value = 1;
   int df1 = 0, df2 = 0;
   bool significant = false;
@@ -37,17 +37,19 @@ struct ModelCandidate {
 
 struct ModelChoice {
   calib::MappingModel chosen = calib::MappingModel::kAffine;
-  std::string test;             // the named test and its level
+  std::string test;  // the named test and its level
   double alpha = 0.05;
-  std::string reason;           // human-readable decision
-  std::vector<ModelCandidate> candidates;  // all four models, simplest first
+  std::string reason;                         // human-readable decision
+  std::vector<ModelCandidate> candidates;     // all four models, simplest first
   std::vector<RejectedObservation> rejected;  // gross errors, found with the richest model
   const FrameAdjustment& Chosen() const;
 };
 
 /// Adjusts `frame` with every determinable model and chooses one (see above). Throws InputError
 /// with the reason for the simplest model when no model is determinable.
-ModelChoice ChooseModel(const calib::Camera& camera, const FrameMeasurements& frame,
-                        const StitchOptions& options, double alpha = 0.05);
+ModelChoice ChooseModel(const calib::Camera& camera,
+                        const FrameMeasurements& frame,
+                        const StitchOptions& options,
+                        double alpha = 0.05);
 
 }  // namespace aerocal::stitch

@@ -1,16 +1,16 @@
 #include "stitch/adjustment/stitch_adjustment.h"
+
+#include "calib/core/error.h"
 #include "calib/core/median.h"
 #include "calib/core/numeric_jacobian.h"
+#include "calib/problem/data_snooping.h"
+#include "calib/residuals/stitching.h"
 
 #include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <set>
-
-#include "calib/core/error.h"
-#include "calib/problem/data_snooping.h"
-#include "calib/residuals/stitching.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -29,7 +29,8 @@ MappingModel ModelOf(const calib::SubimageMapping& s, MappingModel model, bool b
 }
 
 /// Rays of a tie that are not excluded.
-std::vector<TieRay> ActiveRays(const calib::Camera& camera, const TieMeasurement& tie,
+std::vector<TieRay> ActiveRays(const calib::Camera& camera,
+                               const TieMeasurement& tie,
                                const std::set<ObservationKey>& excluded) {
   std::vector<TieRay> rays;
   for (const TieRay& ray : tie.rays)
@@ -39,13 +40,15 @@ std::vector<TieRay> ActiveRays(const calib::Camera& camera, const TieMeasurement
 
 /// d(U, V)/d(conditioned params) at conditioned input uv (central differences; exact for the
 /// linear models up to rounding).
-Eigen::MatrixXd VirtualJacobian(MappingModel model, const std::vector<double>& params,
+Eigen::MatrixXd VirtualJacobian(MappingModel model,
+                                const std::vector<double>& params,
                                 const Eigen::Vector2d& uv_conditioned) {
   return NumericJacobian(
       [&](const std::vector<double>& p) {
         Eigen::Vector2d out;
-        calib::VisitMappingModel(
-            model, [&](auto m) { decltype(m)::Apply(p.data(), uv_conditioned.data(), out.data()); });
+        calib::VisitMappingModel(model, [&](auto m) {
+          decltype(m)::Apply(p.data(), uv_conditioned.data(), out.data());
+        });
         return out;
       },
       params);
@@ -60,11 +63,14 @@ void StitchOptions::Validate(const calib::Camera& camera) const {
     if (camera.SubimageIndex(id) < 0)
       throw ConfigError("--base: sub-image '" + id + "' is not in the camera");
   if (!(snooping_alpha > 0 && snooping_alpha < 1))
-    throw ConfigError("snooping alpha must be in (0, 1) (got " + std::to_string(snooping_alpha) + ")");
+    throw ConfigError("snooping alpha must be in (0, 1) (got " + std::to_string(snooping_alpha) +
+                      ")");
 }
 
-std::string FindUnderdetermined(const calib::Camera& camera, const FrameMeasurements& frame,
-                                MappingModel model, const StitchOptions& options,
+std::string FindUnderdetermined(const calib::Camera& camera,
+                                const FrameMeasurements& frame,
+                                MappingModel model,
+                                const StitchOptions& options,
                                 const std::set<ObservationKey>& excluded) {
   // One pass over the measurements: points per sub-image (equations), and what anchors each
   // sub-image to the datum (base, reference point) or ties it to its neighbours.
@@ -122,7 +128,8 @@ namespace {
 
 // The robust start of AdjustFrame: observations far outside a Cauchy-loss solution.
 std::vector<RejectedObservation> RobustOutliers(const calib::Camera& camera,
-                                                const FrameMeasurements& frame, MappingModel model,
+                                                const FrameMeasurements& frame,
+                                                MappingModel model,
                                                 const StitchOptions& options,
                                                 const std::set<ObservationKey>& excluded) {
   StitchOptions robust = options;
@@ -150,8 +157,10 @@ std::vector<RejectedObservation> RobustOutliers(const calib::Camera& camera,
 
 }  // namespace
 
-FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements& frame,
-                            MappingModel model, const StitchOptions& options,
+FrameAdjustment AdjustFrame(const calib::Camera& camera,
+                            const FrameMeasurements& frame,
+                            MappingModel model,
+                            const StitchOptions& options,
                             const std::set<ObservationKey>& excluded_in) {
   const std::string refusal = FindUnderdetermined(camera, frame, model, options, excluded_in);
   if (!refusal.empty()) throw InputError(refusal);
@@ -162,7 +171,8 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
     robust_rejected = RobustOutliers(camera, frame, model, options, excluded);
     std::set<ObservationKey> more = excluded;
     for (const auto& r : robust_rejected) more.insert({r.point, r.subimage});
-    if (!robust_rejected.empty() && !FindUnderdetermined(camera, frame, model, options, more).empty()) {
+    if (!robust_rejected.empty() &&
+        !FindUnderdetermined(camera, frame, model, options, more).empty()) {
       robust_note = "frame " + frame.frame + ": the robust start found " +
                     std::to_string(robust_rejected.size()) +
                     " gross error(s) but leaving them out would under-determine the " +
@@ -189,8 +199,10 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
     const std::vector<double> plain = calib::ParamsFromHomography(
         models[k], calib::HomographyFromParams(s.model, s.params.data()));
     values[k] = calib::ConditionedFromPlain(models[k], conditioning[k], plain);
-    blocks[k] = builder.AddBlock("mapping " + s.id, values[k].data(),
-                                 static_cast<int>(values[k].size()), calib::BlockKind::kMapping);
+    blocks[k] = builder.AddBlock("mapping " + s.id,
+                                 values[k].data(),
+                                 static_cast<int>(values[k].size()),
+                                 calib::BlockKind::kMapping);
     if (base[k]) builder.FixBlock(blocks[k]);
   }
 
@@ -208,12 +220,14 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
     if (excluded.count({ref.point, s.id})) continue;
     const int k = ref.subimage;
     auto cost = calib::VisitMappingModel(models[k], [&](auto m) {
-      return calib::StitchReferenceResidual<decltype(m)>::Create(conditioning[k], ref.uv,
-                                                                 ref.virtual_px, ref.sigma_px);
+      return calib::StitchReferenceResidual<decltype(m)>::Create(
+          conditioning[k], ref.uv, ref.virtual_px, ref.sigma_px);
     });
-    const auto id = builder.AddResidual(calib::kGroupStitchReference, std::move(cost), {blocks[k]},
-                                        "frame " + frame.frame + " reference " + ref.point +
-                                            " sub-image " + s.id);
+    const auto id = builder.AddResidual(
+        calib::kGroupStitchReference,
+        std::move(cost),
+        {blocks[k]},
+        "frame " + frame.frame + " reference " + ref.point + " sub-image " + s.id);
     observed[id] = {ref.point, k, true, ref.sigma_px};
     sigmas.push_back(ref.sigma_px);
   }
@@ -226,19 +240,23 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
     Eigen::Vector2d start = Eigen::Vector2d::Zero();
     for (const TieRay& ray : rays) start += camera.subimages[ray.subimage].VirtualFromSub(ray.uv);
     tie_positions.push_back(start / static_cast<double>(rays.size()));
-    const auto point_block = builder.AddBlock("tie " + tie.point, tie_positions.back().data(), 2,
-                                              calib::BlockKind::kTiePoint2d, {"U", "V"});
+    const auto point_block = builder.AddBlock("tie " + tie.point,
+                                              tie_positions.back().data(),
+                                              2,
+                                              calib::BlockKind::kTiePoint2d,
+                                              {"U", "V"});
     ++n_ties;
     for (const TieRay& ray : rays) {
       const int k = ray.subimage;
       auto cost = calib::VisitMappingModel(models[k], [&](auto m) {
         return calib::StitchTieResidual<decltype(m)>::Create(conditioning[k], ray.uv, ray.sigma_px);
       });
-      const auto id = builder.AddResidual(calib::kGroupStitchTie, std::move(cost),
-                                          {blocks[k], point_block},
-                                          "frame " + frame.frame + " tie " + tie.point +
-                                              " sub-image " + camera.subimages[k].id,
-                                          options.loss);
+      const auto id = builder.AddResidual(
+          calib::kGroupStitchTie,
+          std::move(cost),
+          {blocks[k], point_block},
+          "frame " + frame.frame + " tie " + tie.point + " sub-image " + camera.subimages[k].id,
+          options.loss);
       observed[id] = {tie.point, k, false, ray.sigma_px};
       sigmas.push_back(ray.sigma_px);
     }
@@ -255,15 +273,20 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
   if (options.data_snooping) {
     calib::SnoopingOptions snooping;
     snooping.groups = {calib::kGroupStitchReference, calib::kGroupStitchTie};
-    snooping.critical_value = std::max(
-        3.29, calib::NormalCriticalValue(options.snooping_alpha /
-                                         std::max(1, builder.NumObservations())));
+    snooping.critical_value =
+        std::max(3.29,
+                 calib::NormalCriticalValue(options.snooping_alpha /
+                                            std::max(1, builder.NumObservations())));
     snooping.max_rejections = 200;
-    const calib::SnoopingOutcome snooped = calib::SolveWithDataSnooping(builder, options.solver, snooping);
+    const calib::SnoopingOutcome snooped =
+        calib::SolveWithDataSnooping(builder, options.solver, snooping);
     report = snooped.report;
     for (const auto& r : snooped.rejected) {
       const Observed& o = observed.at(r.id);
-      out.rejected.push_back({o.point, camera.subimages[o.subimage].id, o.reference, r.w_max,
+      out.rejected.push_back({o.point,
+                              camera.subimages[o.subimage].id,
+                              o.reference,
+                              r.w_max,
                               Eigen::Vector2d(r.v[0], r.v[1]) * o.sigma_px});
     }
   } else {
@@ -289,8 +312,11 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
   for (const auto& [id, o] : observed) {
     if (!builder.IsActive(id)) continue;
     const std::vector<double> r = builder.EvaluateResidual(id);
-    out.residuals.push_back({o.point, camera.subimages[o.subimage].id, o.reference,
-                             Eigen::Vector2d(r[0], r[1]) * o.sigma_px, o.sigma_px});
+    out.residuals.push_back({o.point,
+                             camera.subimages[o.subimage].id,
+                             o.reference,
+                             Eigen::Vector2d(r[0], r[1]) * o.sigma_px,
+                             o.sigma_px});
   }
 
   // Covariance of the free mappings (scaled by sigma0^2), then plain form and corners.
@@ -303,7 +329,8 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
   bool finite = std::isfinite(report.sigma0) && std::abs(report.sigma0) < 1e150;
   for (const auto& v : values)
     for (double x : v) finite = finite && std::isfinite(x) && std::abs(x) < 1e150;
-  for (const auto& p : tie_positions) finite = finite && p.allFinite() && p.cwiseAbs().maxCoeff() < 1e150;
+  for (const auto& p : tie_positions)
+    finite = finite && p.allFinite() && p.cwiseAbs().maxCoeff() < 1e150;
   calib::CovarianceReport covariance;
   if (finite) {
     covariance = builder.EstimateCovariance(free_blocks, std::max(report.sigma0, 0.0));
@@ -326,7 +353,8 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements
     e.params = calib::PlainFromConditioned(models[k], conditioning[k], values[k]);
     Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, n);
     if (!base[k] && covariance.ok) c = covariance.BlockCovariance(blocks[k], n);
-    const Eigen::MatrixXd j = calib::PlainFromConditionedJacobian(models[k], conditioning[k], values[k]);
+    const Eigen::MatrixXd j =
+        calib::PlainFromConditionedJacobian(models[k], conditioning[k], values[k]);
     e.covariance = j * c * j.transpose();
     for (int i = 0; i < n; ++i) e.sigma.push_back(std::sqrt(std::max(0.0, e.covariance(i, i))));
     const double corner_u[4] = {0.0, s.width_px - 1.0, 0.0, s.width_px - 1.0};

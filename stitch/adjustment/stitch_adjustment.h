@@ -16,17 +16,17 @@
 // observation listed with its standardized residual w).
 #pragma once
 
+#include "calib/camera/camera.h"
+#include "calib/problem/problem_builder.h"
+#include "stitch/adjustment/frame_measurements.h"
+
+#include <Eigen/Core>
+
 #include <array>
 #include <set>
 #include <string>
 #include <utility>
 #include <vector>
-
-#include <Eigen/Core>
-
-#include "calib/camera/camera.h"
-#include "calib/problem/problem_builder.h"
-#include "stitch/adjustment/frame_measurements.h"
 
 namespace aerocal::stitch {
 
@@ -36,9 +36,9 @@ struct StitchOptions {
   double snooping_alpha = 0.05;       // family-wise level of the snooping test, (0, 1)
   /// Robust start (with data snooping, as `adjust --robust-start`): first an adjustment with a
   /// Cauchy loss (scale `robust_scale_sigma` sigmas); observations whose residual exceeds
-  /// `robust_reject_sigma` robust scales (1.4826 median |v / sigma|, at least 1) are gross errors and left out
-  /// before the clean adjustment and its snooping, so a decimal slip of 1e4..1e6 px can neither
-  /// mask other errors nor pull the model choice (the F test sees clean adjustments).
+  /// `robust_reject_sigma` robust scales (1.4826 median |v / sigma|, at least 1) are gross errors
+  /// and left out before the clean adjustment and its snooping, so a decimal slip of 1e4..1e6 px
+  /// can neither mask other errors nor pull the model choice (the F test sees clean adjustments).
   bool robust_start = true;
   double robust_scale_sigma = 3.0;
   double robust_reject_sigma = 20.0;  // only the obvious: snooping decides the rest
@@ -54,16 +54,16 @@ struct CornerPrecision {
   Eigen::Vector2d uv{0, 0};          // sub-image corner pixel
   Eigen::Vector2d virtual_px{0, 0};  // its estimated virtual position
   double sigma_U_px = 0, sigma_V_px = 0;
-  double sigma_px() const;           // sqrt(sigma_U^2 + sigma_V^2)
+  double sigma_px() const;  // sqrt(sigma_U^2 + sigma_V^2)
 };
 
 struct SubimageEstimate {
   std::string id;
   calib::MappingModel model = calib::MappingModel::kAffine;
-  bool base = false;                 // held fixed (datum): sigmas 0
-  std::vector<double> params;        // plain form (FORMATS.md order)
-  std::vector<double> sigma;         // plain form, same order
-  Eigen::MatrixXd covariance;        // plain form
+  bool base = false;                       // held fixed (datum): sigmas 0
+  std::vector<double> params;              // plain form (FORMATS.md order)
+  std::vector<double> sigma;               // plain form, same order
+  Eigen::MatrixXd covariance;              // plain form
   std::array<CornerPrecision, 4> corners;  // (0,0), (W-1,0), (0,H-1), (W-1,H-1)
   double max_corner_sigma_px = 0;
 };
@@ -96,22 +96,26 @@ struct FrameAdjustment {
   std::vector<PointResidual> residuals;
   std::vector<RejectedObservation> rejected;
   std::vector<std::string> diagnostics;
-  double max_corner_sigma_px = 0;           // over all sub-images
+  double max_corner_sigma_px = 0;  // over all sub-images
 };
 
 /// Empty when every free sub-image of `frame` has at least as many observation equations as its
 /// mapping (under `model`) has parameters, counting the observations not in `excluded`;
 /// otherwise a message naming the first sub-image that does not
 /// ("frame 0001, sub-image V: 2 points give 4 equations for the 6 affine parameters").
-std::string FindUnderdetermined(const calib::Camera& camera, const FrameMeasurements& frame,
-                                calib::MappingModel model, const StitchOptions& options,
+std::string FindUnderdetermined(const calib::Camera& camera,
+                                const FrameMeasurements& frame,
+                                calib::MappingModel model,
+                                const StitchOptions& options,
                                 const std::set<ObservationKey>& excluded = {});
 
 /// Adjusts one frame with `model` for every free sub-image (base sub-images keep their own).
 /// Observations in `excluded` are left out (listed nowhere; the caller has listed them).
 /// Throws InputError with FindUnderdetermined's message when the model is under-determined.
-FrameAdjustment AdjustFrame(const calib::Camera& camera, const FrameMeasurements& frame,
-                            calib::MappingModel model, const StitchOptions& options,
+FrameAdjustment AdjustFrame(const calib::Camera& camera,
+                            const FrameMeasurements& frame,
+                            calib::MappingModel model,
+                            const StitchOptions& options,
                             const std::set<ObservationKey>& excluded = {});
 
 /// The camera with the frame's estimated mappings (for resampling and reports).

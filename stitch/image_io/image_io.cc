@@ -1,11 +1,11 @@
 #include "stitch/image_io/image_io.h"
 
-#include <sys/stat.h>
+#include "calib/core/error.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 
-#include "calib/core/error.h"
+#include <sys/stat.h>
 
 namespace aerocal::stitch {
 
@@ -15,11 +15,13 @@ GrayImage ReadGrayImage(const std::string& path) {
   if (!S_ISREG(info.st_mode)) ThrowInputError({path, 0}, "not a regular file");
   cv::Mat raw;
   try {
-    raw = cv::imread(path, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH | cv::IMREAD_IGNORE_ORIENTATION);
+    raw = cv::imread(path,
+                     cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH | cv::IMREAD_IGNORE_ORIENTATION);
   } catch (const cv::Exception& e) {
     ThrowInputError({path, 0}, std::string("cannot decode image: ") + e.what());
   }
-  if (raw.empty()) ThrowInputError({path, 0}, "cannot decode image (unknown format or corrupt file)");
+  if (raw.empty())
+    ThrowInputError({path, 0}, "cannot decode image (unknown format or corrupt file)");
   GrayImage image(raw.rows, raw.cols);
   cv::Mat view(raw.rows, raw.cols, CV_32F, image.data());
   raw.convertTo(view, CV_32F);
@@ -29,18 +31,20 @@ GrayImage ReadGrayImage(const std::string& path) {
 GrayImage ReadSubimage(const std::string& path, const calib::SubimageMapping& subimage) {
   GrayImage image = ReadGrayImage(path);
   if (image.cols() != subimage.width_px || image.rows() != subimage.height_px) {
-    ThrowInputError({path, 0}, "image is " + std::to_string(image.cols()) + " x " +
-                                   std::to_string(image.rows()) + " px, but sub-image " +
-                                   subimage.id + " of the camera file is " +
-                                   std::to_string(subimage.width_px) + " x " +
-                                   std::to_string(subimage.height_px) + " px");
+    ThrowInputError({path, 0},
+                    "image is " + std::to_string(image.cols()) + " x " +
+                        std::to_string(image.rows()) + " px, but sub-image " + subimage.id +
+                        " of the camera file is " + std::to_string(subimage.width_px) + " x " +
+                        std::to_string(subimage.height_px) + " px");
   }
   return image;
 }
 
 void WriteGrayImage(const std::string& path, const GrayImage& image, int bits) {
   AEROCAL_CHECK(bits == 8 || bits == 16) << "bits must be 8 or 16, got " << bits;
-  const cv::Mat view(static_cast<int>(image.rows()), static_cast<int>(image.cols()), CV_32F,
+  const cv::Mat view(static_cast<int>(image.rows()),
+                     static_cast<int>(image.cols()),
+                     CV_32F,
                      const_cast<float*>(image.data()));
   cv::Mat out;
   view.convertTo(out, bits == 8 ? CV_8U : CV_16U);  // rounds and saturates

@@ -4,10 +4,10 @@
 // camera file's sub-image formats describe.
 #pragma once
 
-#include <string>
-
 #include "calib/camera/subimage_mapping.h"
 #include "stitch/image_io/gray_image.h"
+
+#include <string>
 
 namespace aerocal::stitch {
 

@@ -1,21 +1,25 @@
 #include "stitch/image_io/subimage_cutter.h"
 
-#include <random>
+#include "calib/core/error.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "calib/core/error.h"
+#include <random>
 
 namespace aerocal::stitch {
 
-std::vector<GrayImage> CutSubimages(const GrayImage& frame, const calib::Camera& camera,
+std::vector<GrayImage> CutSubimages(const GrayImage& frame,
+                                    const calib::Camera& camera,
                                     const CutOptions& options) {
   const std::size_t n = camera.subimages.size();
   AEROCAL_CHECK(options.gains.empty() || options.gains.size() == n) << "one gain per sub-image";
-  AEROCAL_CHECK(options.offsets.empty() || options.offsets.size() == n) << "one offset per sub-image";
+  AEROCAL_CHECK(options.offsets.empty() || options.offsets.size() == n)
+      << "one offset per sub-image";
   AEROCAL_CHECK(options.noise_dn >= 0.0) << "noise_dn must be >= 0";
-  const cv::Mat source(static_cast<int>(frame.rows()), static_cast<int>(frame.cols()), CV_32F,
+  const cv::Mat source(static_cast<int>(frame.rows()),
+                       static_cast<int>(frame.cols()),
+                       CV_32F,
                        const_cast<float*>(frame.data()));
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> noise(0.0, 1.0);
@@ -28,8 +32,8 @@ std::vector<GrayImage> CutSubimages(const GrayImage& frame, const calib::Camera&
     cv::Mat target(sub.height_px, sub.width_px, CV_32F, image.data());
     const int flags = cv::INTER_CUBIC | cv::WARP_INVERSE_MAP;
     if (sub.model == calib::MappingModel::kProjective) {
-      const cv::Matx33d m(h(0, 0), h(0, 1), h(0, 2), h(1, 0), h(1, 1), h(1, 2), h(2, 0), h(2, 1),
-                          h(2, 2));
+      const cv::Matx33d m(
+          h(0, 0), h(0, 1), h(0, 2), h(1, 0), h(1, 1), h(1, 2), h(2, 0), h(2, 1), h(2, 2));
       cv::warpPerspective(source, target, m, target.size(), flags, cv::BORDER_REFLECT);
     } else {
       const cv::Matx23d m(h(0, 0), h(0, 1), h(0, 2), h(1, 0), h(1, 1), h(1, 2));

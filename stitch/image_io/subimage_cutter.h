@@ -5,11 +5,11 @@
 // one real photograph into a multi-CCD frame with a known geometric truth.
 #pragma once
 
-#include <cstdint>
-#include <vector>
-
 #include "calib/camera/camera.h"
 #include "stitch/image_io/gray_image.h"
+
+#include <cstdint>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -21,7 +21,8 @@ struct CutOptions {
 };
 
 /// One image per sub-image of `camera`, in camera order, of that sub-image's format.
-std::vector<GrayImage> CutSubimages(const GrayImage& frame, const calib::Camera& camera,
+std::vector<GrayImage> CutSubimages(const GrayImage& frame,
+                                    const calib::Camera& camera,
                                     const CutOptions& options);
 
 }  // namespace aerocal::stitch

@@ -1,9 +1,9 @@
 #include "stitch/io/frame_run_json.h"
 
+#include "calib/core/error.h"
+
 #include <cmath>
 #include <limits>
-
-#include "calib/core/error.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -65,10 +65,17 @@ calib::MappingModel ToModel(const json& j) {
 json SubimageToJson(const SubimageEstimate& s) {
   json corners = json::array();
   for (const CornerPrecision& c : s.corners)
-    corners.push_back({{"uv", Vec(c.uv)}, {"virtual_px", Vec(c.virtual_px)},
-                       {"sigma_U_px", Num(c.sigma_U_px)}, {"sigma_V_px", Num(c.sigma_V_px)}});
-  return {{"id", s.id}, {"model", Model(s.model)}, {"base", s.base}, {"params", Nums(s.params)},
-          {"sigma", Nums(s.sigma)}, {"covariance", Matrix(s.covariance)}, {"corners", corners},
+    corners.push_back({{"uv", Vec(c.uv)},
+                       {"virtual_px", Vec(c.virtual_px)},
+                       {"sigma_U_px", Num(c.sigma_U_px)},
+                       {"sigma_V_px", Num(c.sigma_V_px)}});
+  return {{"id", s.id},
+          {"model", Model(s.model)},
+          {"base", s.base},
+          {"params", Nums(s.params)},
+          {"sigma", Nums(s.sigma)},
+          {"covariance", Matrix(s.covariance)},
+          {"corners", corners},
           {"max_corner_sigma_px", Num(s.max_corner_sigma_px)}};
 }
 SubimageEstimate SubimageFromJson(const json& j) {
@@ -81,7 +88,9 @@ SubimageEstimate SubimageFromJson(const json& j) {
   s.covariance = ToMatrix(j.at("covariance"));
   for (size_t i = 0; i < s.corners.size(); ++i) {
     const json& c = j.at("corners").at(i);
-    s.corners[i] = {ToVec(c.at("uv")), ToVec(c.at("virtual_px")), ToNum(c.at("sigma_U_px")),
+    s.corners[i] = {ToVec(c.at("uv")),
+                    ToVec(c.at("virtual_px")),
+                    ToNum(c.at("sigma_U_px")),
                     ToNum(c.at("sigma_V_px"))};
   }
   s.max_corner_sigma_px = ToNum(j.at("max_corner_sigma_px"));
@@ -91,32 +100,51 @@ SubimageEstimate SubimageFromJson(const json& j) {
 json RejectedToJson(const std::vector<RejectedObservation>& rejected) {
   json a = json::array();
   for (const auto& r : rejected)
-    a.push_back({{"point", r.point}, {"subimage", r.subimage}, {"reference", r.reference},
-                 {"w", Num(r.w)}, {"v_px", Vec(r.v_px)}});
+    a.push_back({{"point", r.point},
+                 {"subimage", r.subimage},
+                 {"reference", r.reference},
+                 {"w", Num(r.w)},
+                 {"v_px", Vec(r.v_px)}});
   return a;
 }
 std::vector<RejectedObservation> RejectedFromJson(const json& a) {
   std::vector<RejectedObservation> out;
   for (const auto& r : a)
-    out.push_back({r.at("point").get<std::string>(), r.at("subimage").get<std::string>(),
-                   r.at("reference").get<bool>(), ToNum(r.at("w")), ToVec(r.at("v_px"))});
+    out.push_back({r.at("point").get<std::string>(),
+                   r.at("subimage").get<std::string>(),
+                   r.at("reference").get<bool>(),
+                   ToNum(r.at("w")),
+                   ToVec(r.at("v_px"))});
   return out;
 }
 
 json AdjustmentToJson(const FrameAdjustment& a) {
-  json j = {{"frame", a.frame}, {"model", Model(a.model)}, {"converged", a.converged},
-            {"iterations", a.iterations}, {"sigma0", Num(a.sigma0)}, {"sigma0_px", Num(a.sigma0_px)},
-            {"vtpv", Num(a.vtpv)}, {"redundancy", a.redundancy}, {"n_observations", a.n_observations},
-            {"n_unknowns", a.n_unknowns}, {"n_ties", a.n_ties}, {"n_references", a.n_references},
-            {"n_single_ray_points", a.n_single_ray_points}, {"covariance_ok", a.covariance_ok},
-            {"diagnostics", a.diagnostics}, {"max_corner_sigma_px", Num(a.max_corner_sigma_px)},
+  json j = {{"frame", a.frame},
+            {"model", Model(a.model)},
+            {"converged", a.converged},
+            {"iterations", a.iterations},
+            {"sigma0", Num(a.sigma0)},
+            {"sigma0_px", Num(a.sigma0_px)},
+            {"vtpv", Num(a.vtpv)},
+            {"redundancy", a.redundancy},
+            {"n_observations", a.n_observations},
+            {"n_unknowns", a.n_unknowns},
+            {"n_ties", a.n_ties},
+            {"n_references", a.n_references},
+            {"n_single_ray_points", a.n_single_ray_points},
+            {"covariance_ok", a.covariance_ok},
+            {"diagnostics", a.diagnostics},
+            {"max_corner_sigma_px", Num(a.max_corner_sigma_px)},
             {"rejected", RejectedToJson(a.rejected)}};
   j["subimages"] = json::array();
   for (const auto& s : a.subimages) j["subimages"].push_back(SubimageToJson(s));
   j["residuals"] = json::array();
   for (const auto& r : a.residuals)
-    j["residuals"].push_back({{"point", r.point}, {"subimage", r.subimage}, {"reference", r.reference},
-                              {"v_px", Vec(r.v_px)}, {"sigma_px", Num(r.sigma_px)}});
+    j["residuals"].push_back({{"point", r.point},
+                              {"subimage", r.subimage},
+                              {"reference", r.reference},
+                              {"v_px", Vec(r.v_px)},
+                              {"sigma_px", Num(r.sigma_px)}});
   return j;
 }
 
@@ -141,16 +169,26 @@ FrameAdjustment AdjustmentFromJson(const json& j) {
   a.rejected = RejectedFromJson(j.at("rejected"));
   for (const auto& s : j.at("subimages")) a.subimages.push_back(SubimageFromJson(s));
   for (const auto& r : j.at("residuals"))
-    a.residuals.push_back({r.at("point").get<std::string>(), r.at("subimage").get<std::string>(),
-                           r.at("reference").get<bool>(), ToVec(r.at("v_px")), ToNum(r.at("sigma_px"))});
+    a.residuals.push_back({r.at("point").get<std::string>(),
+                           r.at("subimage").get<std::string>(),
+                           r.at("reference").get<bool>(),
+                           ToVec(r.at("v_px")),
+                           ToNum(r.at("sigma_px"))});
   return a;
 }
 
 json CandidateToJson(const ModelCandidate& c) {
-  json j = {{"model", Model(c.model)}, {"determinable", c.determinable}, {"refusal", c.refusal},
-            {"tested", c.tested}, {"against", c.against}, {"f", Num(c.f)},
-            {"f_critical", Num(c.f_critical)}, {"p_value", Num(c.p_value)}, {"df1", c.df1},
-            {"df2", c.df2}, {"significant", c.significant}};
+  json j = {{"model", Model(c.model)},
+            {"determinable", c.determinable},
+            {"refusal", c.refusal},
+            {"tested", c.tested},
+            {"against", c.against},
+            {"f", Num(c.f)},
+            {"f_critical", Num(c.f_critical)},
+            {"p_value", Num(c.p_value)},
+            {"df1", c.df1},
+            {"df2", c.df2},
+            {"significant", c.significant}};
   j["adjustment"] = AdjustmentToJson(c.adjustment);
   return j;
 }
@@ -180,8 +218,12 @@ json FrameRunToJson(const FrameRun& run) {
     const ModelChoice& c = *run.choice;
     json candidates = json::array();
     for (const auto& candidate : c.candidates) candidates.push_back(CandidateToJson(candidate));
-    j["choice"] = {{"chosen", Model(c.chosen)}, {"test", c.test}, {"alpha", Num(c.alpha)},
-                   {"reason", c.reason}, {"candidates", candidates}, {"rejected", RejectedToJson(c.rejected)}};
+    j["choice"] = {{"chosen", Model(c.chosen)},
+                   {"test", c.test},
+                   {"alpha", Num(c.alpha)},
+                   {"reason", c.reason},
+                   {"candidates", candidates},
+                   {"rejected", RejectedToJson(c.rejected)}};
   }
   return j;
 }
@@ -197,7 +239,8 @@ FrameRun FrameRunFromJson(const json& document, const std::string& path) {
       choice.test = c.at("test").get<std::string>();
       choice.alpha = ToNum(c.at("alpha"));
       choice.reason = c.at("reason").get<std::string>();
-      for (const auto& candidate : c.at("candidates")) choice.candidates.push_back(CandidateFromJson(candidate));
+      for (const auto& candidate : c.at("candidates"))
+        choice.candidates.push_back(CandidateFromJson(candidate));
       choice.rejected = RejectedFromJson(c.at("rejected"));
       run.choice = std::move(choice);
     }

@@ -6,11 +6,11 @@
 // (those are FrameResultToJson's keys).
 #pragma once
 
-#include <string>
+#include "stitch/adjustment/flight_stability.h"
 
 #include <nlohmann/json.hpp>
 
-#include "stitch/adjustment/flight_stability.h"
+#include <string>
 
 namespace aerocal::stitch {
 

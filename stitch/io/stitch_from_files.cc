@@ -20,7 +20,8 @@ BatchOptions BatchOptionsFromText(const calib::Camera& camera,
       throw ConfigError(std::string(model_option) + ": unknown model '" + model +
                         "' (expected translation, conformal, affine, projective or auto)");
   }
-  if (!(alpha > 0 && alpha < 1)) throw ConfigError(std::string(alpha_option) + " must be in (0, 1)");
+  if (!(alpha > 0 && alpha < 1))
+    throw ConfigError(std::string(alpha_option) + " must be in (0, 1)");
   options.alpha = alpha;
   options.stitch.base_ids = SplitCommaList(base);
   options.stitch.data_snooping = data_snooping;

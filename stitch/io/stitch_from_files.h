@@ -1,13 +1,14 @@
 // The sub-image stitching of `aerocal stitch` from its inputs: the options as the command's text
-// gives them, and the frames of a stitch_obs.csv for RunStitchBatch. Shared by the command (tools/cmd_stitch.cc)
-// and the Python module (tools/python/bind_stitch.cc), so both run exactly the same steps.
+// gives them, and the frames of a stitch_obs.csv for RunStitchBatch. Shared by the command
+// (tools/cmd_stitch.cc) and the Python module (tools/python/bind_stitch.cc), so both run exactly
+// the same steps.
 #pragma once
-
-#include <string>
 
 #include "calib/camera/camera.h"
 #include "stitch/adjustment/flight_stability.h"
 #include "stitch/adjustment/frame_measurements.h"
+
+#include <string>
 
 namespace aerocal::stitch {
 

@@ -1,16 +1,16 @@
 #include "stitch/io/stitch_result_json.h"
 
-#include <algorithm>
-#include <cmath>
-#include <map>
-
-#include <Eigen/LU>
-
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
 #include "calib/core/result_file.h"
 #include "stitch/adjustment/mapping_param_names.h"
+
+#include <Eigen/LU>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
 
 namespace aerocal::stitch {
 namespace {
@@ -53,8 +53,12 @@ json CandidateToJson(const ModelCandidate& c) {
   j["vtpv"] = c.adjustment.vtpv;
   j["max_corner_sigma_px"] = c.adjustment.max_corner_sigma_px;
   if (c.tested)
-    j["test"] = {{"against", c.against},   {"F", c.f},     {"F_critical", c.f_critical},
-                 {"p_value", c.p_value},   {"df1", c.df1}, {"df2", c.df2},
+    j["test"] = {{"against", c.against},
+                 {"F", c.f},
+                 {"F_critical", c.f_critical},
+                 {"p_value", c.p_value},
+                 {"df1", c.df1},
+                 {"df2", c.df2},
                  {"significant", c.significant}};
   return j;
 }
@@ -69,10 +73,14 @@ json StabilityToJson(const ModelStability& s) {
                           {"mean_sigma", p.mean_sigma}});
   json flagged = json::array();
   for (const auto& f : s.flagged) flagged.push_back({{"frame", f.frame}, {"reasons", f.reasons}});
-  return {{"model", ModelName(s.model)},       {"n_frames", s.n_frames},
-          {"mean_sigma0", s.mean_sigma0},      {"std_sigma0", s.std_sigma0},
-          {"mean_sigma0_px", s.mean_sigma0_px}, {"std_sigma0_px", s.std_sigma0_px},
-          {"parameters", parameters},          {"flagged", flagged}};
+  return {{"model", ModelName(s.model)},
+          {"n_frames", s.n_frames},
+          {"mean_sigma0", s.mean_sigma0},
+          {"std_sigma0", s.std_sigma0},
+          {"mean_sigma0_px", s.mean_sigma0_px},
+          {"std_sigma0_px", s.std_sigma0_px},
+          {"parameters", parameters},
+          {"flagged", flagged}};
 }
 
 }  // namespace
@@ -154,9 +162,14 @@ json StitchResultToJson(const BatchResult& result, const BatchOptions& options) 
     if (run.adjustment.sigma0 > 0) scale = run.adjustment.sigma0_px / run.adjustment.sigma0;
   const double sigma0 = redundancy > 0 ? std::sqrt(vtpv / redundancy) : 0.0;
 
-  json j = {{"kind", "stitch"},          {"sigma0", sigma0},       {"sigma0_px", sigma0 * scale},
-            {"redundancy", redundancy},  {"iterations", iterations}, {"converged", converged},
-            {"model", ModelName(model)}, {"n_frames", result.frames.size()}};
+  json j = {{"kind", "stitch"},
+            {"sigma0", sigma0},
+            {"sigma0_px", sigma0 * scale},
+            {"redundancy", redundancy},
+            {"iterations", iterations},
+            {"converged", converged},
+            {"model", ModelName(model)},
+            {"n_frames", result.frames.size()}};
   json counts = json::object();
   for (const auto& [m, n] : chosen) counts[ModelName(m)] = n;
   j["models_chosen"] = counts;
@@ -212,7 +225,8 @@ json StitchResultToJson(const BatchResult& result, const BatchOptions& options) 
   return j;
 }
 
-calib::Camera ApplyStitchResult(const calib::Camera& camera, const std::string& path,
+calib::Camera ApplyStitchResult(const calib::Camera& camera,
+                                const std::string& path,
                                 const std::string& frame) {
   const json doc = ReadResult(path, {"stitch"}, "`aerocal stitch`");
   const json* source = &doc;
@@ -240,20 +254,25 @@ calib::Camera ApplyStitchResult(const calib::Camera& camera, const std::string& 
         throw InputError(path + ": sub-image " + id + ": wrong number of params");
       for (double p : params)
         if (!(std::abs(p) <= 1e7))
-          throw InputError(path + ": sub-image " + id + ": a parameter is not finite or beyond 1e7");
+          throw InputError(path + ": sub-image " + id +
+                           ": a parameter is not finite or beyond 1e7");
       out.subimages[k].model = *model;
       out.subimages[k].params = params;
       // The mapping must be invertible over the sub-image: its Jacobian at the centre and the
       // corners (central differences of 1 px) must not be singular (an all-zero affine is).
       const calib::SubimageMapping& m = out.subimages[k];
-      for (const auto& [cu, cv] : {std::pair{0.5, 0.5}, {0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {1.0, 1.0}}) {
+      for (const auto& [cu, cv] :
+           {std::pair{0.5, 0.5}, {0.0, 0.0}, {1.0, 0.0}, {0.0, 1.0}, {1.0, 1.0}}) {
         const Eigen::Vector2d uv(cu * m.width_px, cv * m.height_px);
         Eigen::Matrix2d j;
-        j.col(0) = (m.VirtualFromSub(uv + Eigen::Vector2d(0.5, 0)) - m.VirtualFromSub(uv - Eigen::Vector2d(0.5, 0)));
-        j.col(1) = (m.VirtualFromSub(uv + Eigen::Vector2d(0, 0.5)) - m.VirtualFromSub(uv - Eigen::Vector2d(0, 0.5)));
+        j.col(0) = (m.VirtualFromSub(uv + Eigen::Vector2d(0.5, 0)) -
+                    m.VirtualFromSub(uv - Eigen::Vector2d(0.5, 0)));
+        j.col(1) = (m.VirtualFromSub(uv + Eigen::Vector2d(0, 0.5)) -
+                    m.VirtualFromSub(uv - Eigen::Vector2d(0, 0.5)));
         const double det = j.determinant();
         if (!std::isfinite(det) || std::abs(det) < 1e-6)
-          throw InputError(path + ": sub-image " + id + ": the " + std::string(calib::MappingModelName(*model)) +
+          throw InputError(path + ": sub-image " + id + ": the " +
+                           std::string(calib::MappingModelName(*model)) +
                            " mapping is singular (not invertible) over the sub-image");
       }
       seen[k] = true;

@@ -9,13 +9,13 @@
 // Keys added to FORMATS.md's are documented in stitch/README.md.
 #pragma once
 
-#include <string>
-#include <vector>
+#include "calib/camera/camera.h"
+#include "stitch/adjustment/flight_stability.h"
 
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/camera.h"
-#include "stitch/adjustment/flight_stability.h"
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -28,7 +28,8 @@ nlohmann::json StitchResultToJson(const BatchResult& result, const BatchOptions&
 /// The camera with the mappings of a stitch result: those of frame `frame`, or the top level's
 /// when `frame` is empty. InputError("PATH: ...") when the document, the frame or a sub-image of
 /// the camera is missing.
-calib::Camera ApplyStitchResult(const calib::Camera& camera, const std::string& path,
+calib::Camera ApplyStitchResult(const calib::Camera& camera,
+                                const std::string& path,
                                 const std::string& frame);
 
 }  // namespace aerocal::stitch

@@ -1,17 +1,25 @@
 #include "stitch/layout/grid_layout.h"
 
+#include "calib/core/error.h"
+
 #include <algorithm>
 #include <cmath>
-
-#include "calib/core/error.h"
 
 namespace aerocal::stitch {
 
 std::string RomanNumeral(int n) {
-  static const std::pair<int, const char*> kTable[] = {{1000, "M"}, {900, "CM"}, {500, "D"},
-                                                       {400, "CD"}, {100, "C"},  {90, "XC"},
-                                                       {50, "L"},   {40, "XL"},  {10, "X"},
-                                                       {9, "IX"},   {5, "V"},    {4, "IV"},
+  static const std::pair<int, const char*> kTable[] = {{1000, "M"},
+                                                       {900, "CM"},
+                                                       {500, "D"},
+                                                       {400, "CD"},
+                                                       {100, "C"},
+                                                       {90, "XC"},
+                                                       {50, "L"},
+                                                       {40, "XL"},
+                                                       {10, "X"},
+                                                       {9, "IX"},
+                                                       {5, "V"},
+                                                       {4, "IV"},
                                                        {1, "I"}};
   std::string out;
   for (const auto& [value, symbol] : kTable)
@@ -45,8 +53,10 @@ calib::Camera MakeGridCamera(const GridLayoutOptions& o) {
       s.height_px = h;
       s.model = o.model;
       // The last column/row ends exactly at the virtual format's far edge.
-      const double tx = o.cols > 1 ? static_cast<double>(c) * (o.virtual_width_px - w) / (o.cols - 1) : 0.0;
-      const double ty = o.rows > 1 ? static_cast<double>(r) * (o.virtual_height_px - h) / (o.rows - 1) : 0.0;
+      const double tx =
+          o.cols > 1 ? static_cast<double>(c) * (o.virtual_width_px - w) / (o.cols - 1) : 0.0;
+      const double ty =
+          o.rows > 1 ? static_cast<double>(r) * (o.virtual_height_px - h) / (o.rows - 1) : 0.0;
       Eigen::Matrix3d shift = Eigen::Matrix3d::Identity();
       shift(0, 2) = std::round(tx);
       shift(1, 2) = std::round(ty);
@@ -55,7 +65,8 @@ calib::Camera MakeGridCamera(const GridLayoutOptions& o) {
     }
   }
   for (const auto& id : o.base_ids)
-    if (camera.SubimageIndex(id) < 0) throw ConfigError("base sub-image '" + id + "' is not in the layout");
+    if (camera.SubimageIndex(id) < 0)
+      throw ConfigError("base sub-image '" + id + "' is not in the layout");
 
   auto add_reference = [&](const calib::SubimageMapping& s, double u, double v) {
     const Eigen::Vector2d virtual_px = s.VirtualFromSub({u, v});

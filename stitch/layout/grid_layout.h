@@ -4,10 +4,10 @@
 // Sub-image ids are Roman numerals I, II, III, ... row by row from the top left.
 #pragma once
 
+#include "calib/camera/camera.h"
+
 #include <string>
 #include <vector>
-
-#include "calib/camera/camera.h"
 
 namespace aerocal::stitch {
 
@@ -18,15 +18,15 @@ enum class ReferencePlacement {
 
 struct GridLayoutOptions {
   std::string name = "grid camera";
-  int rows = 3, cols = 2;                      // sub-image grid
+  int rows = 3, cols = 2;  // sub-image grid
   int virtual_width_px = 14000, virtual_height_px = 12000;
-  int overlap_px = 200;                        // overlap strip width between neighbours, px
+  int overlap_px = 200;  // overlap strip width between neighbours, px
   double pixel_size_mm = 0.009;
   double c_mm = 170.0;
   calib::MappingModel model = calib::MappingModel::kAffine;
-  std::vector<std::string> base_ids;           // sub-images sitting on the focal plane (datum)
+  std::vector<std::string> base_ids;  // sub-images sitting on the focal plane (datum)
   ReferencePlacement reference_placement = ReferencePlacement::kBaseCorners;
-  double reference_inset_px = 30.0;            // distance of reference points from the edges
+  double reference_inset_px = 30.0;  // distance of reference points from the edges
   double reference_sigma_px = 0.05;
 };
 

@@ -1,24 +1,27 @@
 #include "stitch/matching/interest_operators.h"
 
-#include <algorithm>
-#include <cmath>
+#include "calib/core/error.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "calib/core/error.h"
+#include <algorithm>
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
 
 cv::Mat View(const GrayImage& image) {
-  return cv::Mat(static_cast<int>(image.rows()), static_cast<int>(image.cols()), CV_32F,
+  return cv::Mat(static_cast<int>(image.rows()),
+                 static_cast<int>(image.cols()),
+                 CV_32F,
                  const_cast<float*>(image.data()));
 }
 
 void RequireOddWindow(int value, const char* field) {
   if (value < 3 || value % 2 == 0)
-    throw ConfigError(std::string(field) + " must be odd and >= 3 (got " + std::to_string(value) + ")");
+    throw ConfigError(std::string(field) + " must be odd and >= 3 (got " + std::to_string(value) +
+                      ")");
 }
 
 }  // namespace
@@ -60,7 +63,8 @@ GrayImage WallisFilter(const GrayImage& image, const WallisOptions& options) {
   return out;
 }
 
-std::vector<InterestPoint> DetectFoerstner(const GrayImage& image, const FoerstnerOptions& options) {
+std::vector<InterestPoint> DetectFoerstner(const GrayImage& image,
+                                           const FoerstnerOptions& options) {
   options.Validate();
   const cv::Mat g = View(image);
   cv::Mat gx, gy;  // central differences: d/dcol, d/drow
@@ -83,8 +87,10 @@ std::vector<InterestPoint> DetectFoerstner(const GrayImage& image, const Foerstn
   }
   const double threshold = options.weight_factor * cv::mean(w)[0];
   cv::Mat local_max;
-  cv::dilate(w, local_max, cv::getStructuringElement(cv::MORPH_RECT, cv::Size(options.suppression_px,
-                                                                              options.suppression_px)));
+  cv::dilate(w,
+             local_max,
+             cv::getStructuringElement(cv::MORPH_RECT,
+                                       cv::Size(options.suppression_px, options.suppression_px)));
   // Points closer to the border than the tensor window have truncated support: skip them.
   const int border = options.window_px / 2 + 1;
   std::vector<InterestPoint> points;
@@ -96,8 +102,10 @@ std::vector<InterestPoint> DetectFoerstner(const GrayImage& image, const Foerstn
       points.push_back({Eigen::Vector2d(c, r), value, q.at<float>(r, c)});
     }
   }
-  std::stable_sort(points.begin(), points.end(),
-                   [](const InterestPoint& x, const InterestPoint& y) { return x.weight > y.weight; });
+  std::stable_sort(
+      points.begin(), points.end(), [](const InterestPoint& x, const InterestPoint& y) {
+        return x.weight > y.weight;
+      });
   if (static_cast<int>(points.size()) > options.max_points) points.resize(options.max_points);
   return points;
 }

@@ -12,31 +12,31 @@
 // q > q_min and w > w_factor * mean(w) (Foerstner's rule of thumb: 0.5 .. 1.5 times the mean).
 #pragma once
 
-#include <vector>
+#include "stitch/image_io/gray_image.h"
 
 #include <Eigen/Core>
 
-#include "stitch/image_io/gray_image.h"
+#include <vector>
 
 namespace aerocal::stitch {
 
 struct WallisOptions {
-  int window_px = 31;            // odd window side for local mean and standard deviation, >= 3
-  double target_mean = 127.0;    // m_f, DN
-  double target_std = 50.0;      // s_f, DN, > 0
-  double contrast = 0.8;         // c, 0 .. 1
-  double brightness = 0.9;       // b, 0 .. 1
-  void Validate() const;         // throws ConfigError naming the field
+  int window_px = 31;          // odd window side for local mean and standard deviation, >= 3
+  double target_mean = 127.0;  // m_f, DN
+  double target_std = 50.0;    // s_f, DN, > 0
+  double contrast = 0.8;       // c, 0 .. 1
+  double brightness = 0.9;     // b, 0 .. 1
+  void Validate() const;       // throws ConfigError naming the field
 };
 
 GrayImage WallisFilter(const GrayImage& image, const WallisOptions& options);
 
 struct FoerstnerOptions {
-  int window_px = 5;               // odd side of the structure tensor window, >= 3
-  double min_roundness = 0.5;      // q_min, 0 .. 1
-  double weight_factor = 1.0;      // w > weight_factor * mean(w), > 0
-  int suppression_px = 9;          // odd side of the non-maximum suppression window, >= 3
-  int max_points = 4000;           // strongest kept, > 0
+  int window_px = 5;           // odd side of the structure tensor window, >= 3
+  double min_roundness = 0.5;  // q_min, 0 .. 1
+  double weight_factor = 1.0;  // w > weight_factor * mean(w), > 0
+  int suppression_px = 9;      // odd side of the non-maximum suppression window, >= 3
+  int max_points = 4000;       // strongest kept, > 0
   void Validate() const;
 };
 

@@ -1,11 +1,11 @@
 #include "stitch/matching/least_squares_matching.h"
 
-#include <cmath>
-#include <vector>
+#include "calib/core/error.h"
 
 #include <Eigen/Dense>
 
-#include "calib/core/error.h"
+#include <cmath>
+#include <vector>
 
 namespace aerocal::stitch {
 namespace {
@@ -67,8 +67,11 @@ double LsmResult::SigmaMaxPx() const {
   return std::sqrt(std::max(0.0, eig.eigenvalues().maxCoeff()));
 }
 
-LsmResult MatchLeastSquares(const GrayImage& a, const Eigen::Vector2i& p_a, const GrayImage& b,
-                            const Eigen::Vector2d& t0, const Eigen::Matrix2d& a0,
+LsmResult MatchLeastSquares(const GrayImage& a,
+                            const Eigen::Vector2i& p_a,
+                            const GrayImage& b,
+                            const Eigen::Vector2d& t0,
+                            const Eigen::Matrix2d& a0,
                             const LsmOptions& options) {
   const int h = options.half_size_px;
   AEROCAL_CHECK(p_a.x() - h >= 0 && p_a.y() - h >= 0 && p_a.x() + h < a.cols() &&

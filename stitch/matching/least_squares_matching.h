@@ -7,20 +7,20 @@
 // exact. Precision: sigma0^2 = v^T v / (n - 8), Cov(t) = sigma0^2 (N^-1)_tt.
 #pragma once
 
-#include <Eigen/Core>
-
 #include "stitch/image_io/gray_image.h"
+
+#include <Eigen/Core>
 
 namespace aerocal::stitch {
 
 struct LsmOptions {
-  int half_size_px = 10;            // h: template is (2h+1)^2 px, >= 3
-  int max_iterations = 30;          // Gauss-Newton steps, >= 1
-  double convergence_px = 1e-3;     // stop when the shift update is below this, px
-  double max_shift_px = 3.0;        // reject when t moves farther than this from its start, px
-  double max_sigma_px = 0.2;        // reject when the position sigma (larger axis) exceeds this, px
-  double min_correlation = 0.7;     // reject below this template/patch correlation after the fit
-  void Validate() const;            // throws ConfigError naming the field
+  int half_size_px = 10;         // h: template is (2h+1)^2 px, >= 3
+  int max_iterations = 30;       // Gauss-Newton steps, >= 1
+  double convergence_px = 1e-3;  // stop when the shift update is below this, px
+  double max_shift_px = 3.0;     // reject when t moves farther than this from its start, px
+  double max_sigma_px = 0.2;     // reject when the position sigma (larger axis) exceeds this, px
+  double min_correlation = 0.7;  // reject below this template/patch correlation after the fit
+  void Validate() const;         // throws ConfigError naming the field
 };
 
 enum class LsmStatus { kConverged, kNotConverged, kOutside, kPoorPrecision, kLowCorrelation };
@@ -29,8 +29,8 @@ struct LsmResult {
   LsmStatus status = LsmStatus::kNotConverged;
   Eigen::Vector2d position_in_b = Eigen::Vector2d::Zero();  // t, image b px
   Eigen::Matrix2d cov_px2 = Eigen::Matrix2d::Zero();        // covariance of t, px^2
-  double sigma0_dn = 0;       // grey-value residual RMS, DN
-  double correlation = 0;     // correlation of template and fitted patch
+  double sigma0_dn = 0;                                     // grey-value residual RMS, DN
+  double correlation = 0;  // correlation of template and fitted patch
   double gain = 1, offset = 0;
   int iterations = 0;
   bool ok() const { return status == LsmStatus::kConverged; }
@@ -40,8 +40,11 @@ struct LsmResult {
 
 /// Matches the template of `a` centred on integer pixel `p_a` into `b`, starting at `t0` (b px)
 /// with linear part `a0` (image-b offsets per image-a offset). The template must lie inside `a`.
-LsmResult MatchLeastSquares(const GrayImage& a, const Eigen::Vector2i& p_a, const GrayImage& b,
-                            const Eigen::Vector2d& t0, const Eigen::Matrix2d& a0,
+LsmResult MatchLeastSquares(const GrayImage& a,
+                            const Eigen::Vector2i& p_a,
+                            const GrayImage& b,
+                            const Eigen::Vector2d& t0,
+                            const Eigen::Matrix2d& a0,
                             const LsmOptions& options);
 
 }  // namespace aerocal::stitch

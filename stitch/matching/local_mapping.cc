@@ -1,15 +1,16 @@
 #include "stitch/matching/local_mapping.h"
 
+#include <Eigen/Dense>
+
 #include <algorithm>
 #include <random>
-
-#include <Eigen/Dense>
 
 namespace aerocal::stitch {
 namespace {
 
 std::vector<int> Inliers(const std::vector<Eigen::Vector2d>& from,
-                         const std::vector<Eigen::Vector2d>& to, const LocalAffine& mapping,
+                         const std::vector<Eigen::Vector2d>& to,
+                         const LocalAffine& mapping,
                          double threshold_px) {
   std::vector<int> inliers;
   for (int i = 0; i < static_cast<int>(from.size()); ++i)
@@ -19,8 +20,10 @@ std::vector<int> Inliers(const std::vector<Eigen::Vector2d>& from,
 
 }  // namespace
 
-bool FitAffine(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to,
-               const std::vector<int>& use, LocalAffine* mapping) {
+bool FitAffine(const std::vector<Eigen::Vector2d>& from,
+               const std::vector<Eigen::Vector2d>& to,
+               const std::vector<int>& use,
+               LocalAffine* mapping) {
   if (use.size() < 3) return false;
   // Centre on the mean for conditioning; solve [x y 1] p = target per output coordinate.
   Eigen::Vector2d mean = Eigen::Vector2d::Zero();
@@ -41,7 +44,8 @@ bool FitAffine(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen
 }
 
 RansacResult RansacAffine(const std::vector<Eigen::Vector2d>& from,
-                          const std::vector<Eigen::Vector2d>& to, const RansacOptions& options) {
+                          const std::vector<Eigen::Vector2d>& to,
+                          const RansacOptions& options) {
   RansacResult best;
   const int n = static_cast<int>(from.size());
   if (n < std::max(3, options.min_inliers)) return best;

@@ -5,10 +5,10 @@
 // deterministic.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <cstdint>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace aerocal::stitch {
 
@@ -19,9 +19,9 @@ struct LocalAffine {
 };
 
 struct RansacOptions {
-  double threshold_px = 2.0;    // inlier when |uv_b - F(uv_a)| < this, px, > 0
-  int iterations = 500;         // random minimal samples, >= 1
-  int min_inliers = 6;          // fewer: no mapping (strip rejected), >= 3
+  double threshold_px = 2.0;  // inlier when |uv_b - F(uv_a)| < this, px, > 0
+  int iterations = 500;       // random minimal samples, >= 1
+  int min_inliers = 6;        // fewer: no mapping (strip rejected), >= 3
   std::uint64_t seed = 7;
 };
 
@@ -32,10 +32,13 @@ struct RansacResult {
 };
 
 /// Least-squares affine from >= 3 correspondences (false when degenerate).
-bool FitAffine(const std::vector<Eigen::Vector2d>& from, const std::vector<Eigen::Vector2d>& to,
-               const std::vector<int>& use, LocalAffine* mapping);
+bool FitAffine(const std::vector<Eigen::Vector2d>& from,
+               const std::vector<Eigen::Vector2d>& to,
+               const std::vector<int>& use,
+               LocalAffine* mapping);
 
 RansacResult RansacAffine(const std::vector<Eigen::Vector2d>& from,
-                          const std::vector<Eigen::Vector2d>& to, const RansacOptions& options);
+                          const std::vector<Eigen::Vector2d>& to,
+                          const RansacOptions& options);
 
 }  // namespace aerocal::stitch

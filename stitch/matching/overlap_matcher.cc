@@ -1,17 +1,17 @@
 #include "stitch/matching/overlap_matcher.h"
 
+#include "calib/core/error.h"
+#include "stitch/matching/overlap_strips.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/features2d.hpp>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <cmath>
 #include <set>
 #include <sys/stat.h>
 #include <tuple>
-
-#include <tbb/parallel_for.h>
-#include <opencv2/core.hpp>
-#include <opencv2/features2d.hpp>
-
-#include "calib/core/error.h"
-#include "stitch/matching/overlap_strips.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -46,9 +46,12 @@ bool KeypointBefore(const cv::KeyPoint& x, const cv::KeyPoint& y) {
          std::make_tuple(-y.response, y.pt.y, y.pt.x, y.size, y.angle, y.octave);
 }
 
-WindowFeatures DetectWindow(const GrayImage& image, const cv::Rect& rect,
+WindowFeatures DetectWindow(const GrayImage& image,
+                            const cv::Rect& rect,
                             const MatchOptions& options) {
-  const cv::Mat full(static_cast<int>(image.rows()), static_cast<int>(image.cols()), CV_32F,
+  const cv::Mat full(static_cast<int>(image.rows()),
+                     static_cast<int>(image.cols()),
+                     CV_32F,
                      const_cast<float*>(image.data()));
   const cv::Mat window = full(rect);
   cv::Ptr<cv::SIFT> sift = cv::SIFT::create(0, 3, options.sift_contrast);
@@ -62,23 +65,27 @@ WindowFeatures DetectWindow(const GrayImage& image, const cv::Rect& rect,
     for (int r = 0; r < rect.height; ++r)
       for (int c = 0; c < rect.width; ++c) block(r, c) = window.at<float>(r, c);
     const GrayImage wallis = WallisFilter(block, options.wallis);
-    cv::Mat(rect.height, rect.width, CV_32F, const_cast<float*>(wallis.data())).convertTo(gray8, CV_8U);
+    cv::Mat(rect.height, rect.width, CV_32F, const_cast<float*>(wallis.data()))
+        .convertTo(gray8, CV_8U);
     FoerstnerOptions foerstner = options.foerstner;
     foerstner.max_points = options.max_keypoints;
     for (const InterestPoint& p : DetectFoerstner(wallis, foerstner)) {
-      keypoints.emplace_back(cv::Point2f(static_cast<float>(p.position.x()),
-                                         static_cast<float>(p.position.y())),
-                             static_cast<float>(options.descriptor_size_px), 0.0f,
-                             static_cast<float>(p.weight));
+      keypoints.emplace_back(
+          cv::Point2f(static_cast<float>(p.position.x()), static_cast<float>(p.position.y())),
+          static_cast<float>(options.descriptor_size_px),
+          0.0f,
+          static_cast<float>(p.weight));
     }
   }
   // OpenCV may return keypoints in thread-dependent order: sort before cutting to the strongest.
   std::stable_sort(keypoints.begin(), keypoints.end(), KeypointBefore);
-  if (static_cast<int>(keypoints.size()) > options.max_keypoints) keypoints.resize(options.max_keypoints);
+  if (static_cast<int>(keypoints.size()) > options.max_keypoints)
+    keypoints.resize(options.max_keypoints);
   WindowFeatures features;
   if (keypoints.empty()) return features;
   sift->compute(gray8, keypoints, features.descriptors);
-  for (const cv::KeyPoint& k : keypoints) features.positions.emplace_back(k.pt.x + rect.x, k.pt.y + rect.y);
+  for (const cv::KeyPoint& k : keypoints)
+    features.positions.emplace_back(k.pt.x + rect.x, k.pt.y + rect.y);
   return features;
 }
 
@@ -88,15 +95,22 @@ struct Candidate {
   Eigen::Vector2d uv_a, uv_b;
 };
 
-StitchObservation Row(const std::string& frame, const std::string& point, const std::string& sub,
-                      const Eigen::Vector2d& uv, double sigma_px) {
+StitchObservation Row(const std::string& frame,
+                      const std::string& point,
+                      const std::string& sub,
+                      const Eigen::Vector2d& uv,
+                      double sigma_px) {
   return {frame, point, sub, uv.x(), uv.y(), sigma_px};
 }
 
 // Everything for one strip; appends rows and fills the report.
-void MatchStrip(const calib::Camera& camera, const std::vector<GrayImage>& images,
-                const OverlapStrip& strip, const std::string& frame, const MatchOptions& options,
-                std::vector<StitchObservation>* rows, StripReport* report) {
+void MatchStrip(const calib::Camera& camera,
+                const std::vector<GrayImage>& images,
+                const OverlapStrip& strip,
+                const std::string& frame,
+                const MatchOptions& options,
+                std::vector<StitchObservation>* rows,
+                StripReport* report) {
   const calib::SubimageMapping& sa = camera.subimages[strip.a];
   const calib::SubimageMapping& sb = camera.subimages[strip.b];
   report->name = strip.name;
@@ -140,9 +154,10 @@ void MatchStrip(const calib::Camera& camera, const std::vector<GrayImage>& image
     const int cy = std::clamp(static_cast<int>(std::floor(cell_xy.y())), 0, ny - 1);
     candidates.push_back({cy * nx + cx, ratios[i], from[i], to[i]});
   }
-  std::stable_sort(candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
-    return std::tie(x.cell, x.ratio) < std::tie(y.cell, y.ratio);
-  });
+  std::stable_sort(
+      candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
+        return std::tie(x.cell, x.ratio) < std::tie(y.cell, y.ratio);
+      });
 
   const int h = options.lsm.half_size_px;
   const GrayImage& image_a = images[strip.a];
@@ -159,13 +174,17 @@ void MatchStrip(const calib::Camera& camera, const std::vector<GrayImage>& image
     if (options.use_lsm) {
       const Eigen::Vector2i p_a(static_cast<int>(std::lround(c.uv_a.x())),
                                 static_cast<int>(std::lround(c.uv_a.y())));
-      if (p_a.x() < h || p_a.y() < h || p_a.x() + h >= image_a.cols() || p_a.y() + h >= image_a.rows())
+      if (p_a.x() < h || p_a.y() < h || p_a.x() + h >= image_a.cols() ||
+          p_a.y() + h >= image_a.rows())
         continue;  // template would leave sub-image a: not a candidate for LSM
       if (!used_a.insert({p_a.x(), p_a.y()}).second) continue;
       ++report->lsm_tried;
-      const LsmResult lsm = MatchLeastSquares(image_a, p_a, images[strip.b],
+      const LsmResult lsm = MatchLeastSquares(image_a,
+                                              p_a,
+                                              images[strip.b],
                                               ransac.mapping.Apply(p_a.cast<double>()),
-                                              ransac.mapping.linear, options.lsm);
+                                              ransac.mapping.linear,
+                                              options.lsm);
       if (lsm.status == LsmStatus::kLowCorrelation || lsm.status == LsmStatus::kPoorPrecision) {
         ++report->lsm_poor_precision;
         continue;
@@ -212,8 +231,10 @@ void MatchOptions::Validate() const {
   foerstner.Validate();
 }
 
-FrameMatches MatchFrame(const calib::Camera& camera, const std::vector<GrayImage>& images,
-                        const std::string& frame, const MatchOptions& options) {
+FrameMatches MatchFrame(const calib::Camera& camera,
+                        const std::vector<GrayImage>& images,
+                        const std::string& frame,
+                        const MatchOptions& options) {
   options.Validate();
   AEROCAL_CHECK(images.size() == camera.subimages.size()) << "one image per sub-image";
   for (std::size_t k = 0; k < images.size(); ++k) {
@@ -235,7 +256,8 @@ FrameMatches MatchFrame(const calib::Camera& camera, const std::vector<GrayImage
 }
 
 void WriteMatchedObservations(const std::string& path,
-                              const std::vector<StitchObservation>& observations, bool append,
+                              const std::vector<StitchObservation>& observations,
+                              bool append,
                               double default_sigma_px) {
   std::vector<StitchObservation> all;
   struct stat info {};
@@ -244,7 +266,8 @@ void WriteMatchedObservations(const std::string& path,
     std::set<std::string> existing;
     for (const StitchObservation& o : all) existing.insert(o.frame);
     for (const StitchObservation& o : observations)
-      if (existing.count(o.frame)) ThrowInputError({path, 0}, "frame " + o.frame + " is already in the file");
+      if (existing.count(o.frame))
+        ThrowInputError({path, 0}, "frame " + o.frame + " is already in the file");
   }
   all.insert(all.end(), observations.begin(), observations.end());
   WriteStitchObservations(path, all);

@@ -16,15 +16,15 @@
 // Deterministic: fixed seeds, keypoints sorted, strips processed in parallel into fixed slots.
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include "calib/camera/camera.h"
 #include "stitch/image_io/gray_image.h"
 #include "stitch/matching/interest_operators.h"
 #include "stitch/matching/least_squares_matching.h"
 #include "stitch/matching/local_mapping.h"
 #include "stitch/simulation/stitch_simulator.h"
+
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -35,34 +35,34 @@ Detector ParseDetector(const std::string& name);
 struct MatchOptions {
   Detector detector = Detector::kSift;
   bool use_lsm = true;
-  double margin_px = 20.0;          // search margin around the nominal strip and prediction, px, >= 0
-  double min_strip_width_px = 30.0; // narrower predicted overlaps are not matched, px
-  double sift_contrast = 0.01;       // SIFT contrast threshold on the stretched window, > 0 (OpenCV's
-                                    // 0.04 leaves low-contrast fields of an overlap empty)
-  int max_keypoints = 5000;         // per search window, strongest kept, > 0
-  double ratio = 0.8;               // Lowe ratio test: best / second-best distance < ratio, (0, 1]
-  double cell_px = 100.0;           // grid cell side along the strips, virtual px, > 0
-  int points_per_cell = 1;          // accepted tie points per cell, >= 1
-  double sigma_px = 0.3;            // sigma written without LSM, px, > 0
-  double min_sigma_px = 0.02;       // floor of the LSM sigma written, px, > 0 (unmodelled errors)
-  int descriptor_size_px = 16;      // support of the SIFT descriptor at Foerstner points, px
+  double margin_px = 20.0;  // search margin around the nominal strip and prediction, px, >= 0
+  double min_strip_width_px = 30.0;  // narrower predicted overlaps are not matched, px
+  double sift_contrast = 0.01;  // SIFT contrast threshold on the stretched window, > 0 (OpenCV's
+                                // 0.04 leaves low-contrast fields of an overlap empty)
+  int max_keypoints = 5000;     // per search window, strongest kept, > 0
+  double ratio = 0.8;           // Lowe ratio test: best / second-best distance < ratio, (0, 1]
+  double cell_px = 100.0;       // grid cell side along the strips, virtual px, > 0
+  int points_per_cell = 1;      // accepted tie points per cell, >= 1
+  double sigma_px = 0.3;        // sigma written without LSM, px, > 0
+  double min_sigma_px = 0.02;   // floor of the LSM sigma written, px, > 0 (unmodelled errors)
+  int descriptor_size_px = 16;  // support of the SIFT descriptor at Foerstner points, px
   RansacOptions ransac;
   LsmOptions lsm;
   WallisOptions wallis;
   FoerstnerOptions foerstner;
-  void Validate() const;            // throws ConfigError naming the field
+  void Validate() const;  // throws ConfigError naming the field
 };
 
 /// Counts of one overlap strip.
 struct StripReport {
-  std::string name;                 // "I-II"
+  std::string name;  // "I-II"
   int keypoints_a = 0, keypoints_b = 0;
-  int ratio_matches = 0;            // after ratio test and prediction gate
+  int ratio_matches = 0;  // after ratio test and prediction gate
   int ransac_inliers = 0;
   int lsm_tried = 0;
-  int lsm_not_converged = 0;        // includes leaving the image and drifting off
-  int lsm_poor_precision = 0;       // sigma > lsm.max_sigma_px or correlation < lsm.min_correlation
-  int points = 0;                   // tie points written
+  int lsm_not_converged = 0;   // includes leaving the image and drifting off
+  int lsm_poor_precision = 0;  // sigma > lsm.max_sigma_px or correlation < lsm.min_correlation
+  int points = 0;              // tie points written
   int cells = 0, covered_cells = 0;
   double Coverage() const { return cells > 0 ? static_cast<double>(covered_cells) / cells : 0.0; }
 };
@@ -74,14 +74,17 @@ struct FrameMatches {
 
 /// Matches all predicted overlap strips of one frame. `images[k]` is sub-image k of `camera`
 /// (its format is checked: LogicError when it differs; readers check files first).
-FrameMatches MatchFrame(const calib::Camera& camera, const std::vector<GrayImage>& images,
-                        const std::string& frame, const MatchOptions& options);
+FrameMatches MatchFrame(const calib::Camera& camera,
+                        const std::vector<GrayImage>& images,
+                        const std::string& frame,
+                        const MatchOptions& options);
 
 /// Writes `observations` as stitch_obs.csv, atomically. With `append` and an existing file, its
 /// rows are kept (rows without sigma_px get `default_sigma_px`) and the new frames added; a frame
 /// already in the file is an InputError naming the file and the frame.
 void WriteMatchedObservations(const std::string& path,
-                              const std::vector<StitchObservation>& observations, bool append,
+                              const std::vector<StitchObservation>& observations,
+                              bool append,
                               double default_sigma_px);
 
 }  // namespace aerocal::stitch

@@ -13,7 +13,8 @@ Eigen::Vector2d MaxCorner(const calib::SubimageMapping& s) {
 template <typename Map>
 Eigen::AlignedBox2d MapBox(const Eigen::AlignedBox2d& box, Map map) {
   Eigen::AlignedBox2d out;
-  for (int c = 0; c < 4; ++c) out.extend(map(box.corner(static_cast<Eigen::AlignedBox2d::CornerType>(c))));
+  for (int c = 0; c < 4; ++c)
+    out.extend(map(box.corner(static_cast<Eigen::AlignedBox2d::CornerType>(c))));
   return out;
 }
 
@@ -30,7 +31,8 @@ Eigen::AlignedBox2d WindowIn(const calib::SubimageMapping& s, const Eigen::Align
 
 }  // namespace
 
-std::vector<OverlapStrip> PredictOverlapStrips(const calib::Camera& camera, double margin_px,
+std::vector<OverlapStrip> PredictOverlapStrips(const calib::Camera& camera,
+                                               double margin_px,
                                                double min_width_px) {
   std::vector<OverlapStrip> strips;
   const int n = static_cast<int>(camera.subimages.size());
@@ -43,7 +45,8 @@ std::vector<OverlapStrip> PredictOverlapStrips(const calib::Camera& camera, doub
       Eigen::AlignedBox2d grown = overlap;
       grown.min().array() -= margin_px;
       grown.max().array() += margin_px;
-      strips.push_back({a, b, sa.id + "-" + sb.id, overlap, WindowIn(sa, grown), WindowIn(sb, grown)});
+      strips.push_back(
+          {a, b, sa.id + "-" + sb.id, overlap, WindowIn(sa, grown), WindowIn(sb, grown)});
     }
   }
   return strips;

@@ -1,17 +1,17 @@
 #include "stitch/quality/bar_target.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include "calib/core/error.h"
 #include "stitch/quality/limiting_frequency.h"
+
+#include <algorithm>
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
 
 bool Inside(const GrayImage& image, const PixelRegion& r) {
-  return r.col >= 0 && r.row >= 0 && r.width > 0 && r.height > 0 && r.col + r.width <= image.cols() &&
-         r.row + r.height <= image.rows();
+  return r.col >= 0 && r.row >= 0 && r.width > 0 && r.height > 0 &&
+         r.col + r.width <= image.cols() && r.row + r.height <= image.rows();
 }
 
 double Linear(float dn, double gamma) {
@@ -60,10 +60,12 @@ BarTargetResult MeasureBarTarget(const GrayImage& image,
                                  const PixelRegion& dark,
                                  const BarTargetOptions& options) {
   options.Validate();
-  if (!Inside(image, bright)) throw InputError("bright reference region: must lie inside the image");
+  if (!Inside(image, bright))
+    throw InputError("bright reference region: must lie inside the image");
   if (!Inside(image, dark)) throw InputError("dark reference region: must lie inside the image");
   BarTargetResult result;
-  const double b = RegionMean(image, bright, options.gamma), d = RegionMean(image, dark, options.gamma);
+  const double b = RegionMean(image, bright, options.gamma),
+               d = RegionMean(image, dark, options.gamma);
   if (!(b > d && b + d > 0.0))
     throw InputError("reference regions: the bright one (" + std::to_string(b) +
                      ") must be brighter than the dark one (" + std::to_string(d) + ")");
@@ -72,12 +74,14 @@ BarTargetResult MeasureBarTarget(const GrayImage& image,
   for (const BarGroup& g : groups) {
     if (!(g.frequency_cy_px > 0.0 && g.frequency_cy_px <= 0.5))
       throw InputError(GroupText(g) + ": the frequency must be within (0, 0.5] cycles/px");
-    if (!Inside(image, g.region)) throw InputError(GroupText(g) + ": the region must lie inside the image");
+    if (!Inside(image, g.region))
+      throw InputError(GroupText(g) + ": the region must lie inside the image");
     const std::vector<double> profile = Profile(image, g, options.gamma);
     const double period = 1.0 / g.frequency_cy_px;
     const int windows = static_cast<int>(std::floor(profile.size() / period));
     if (windows < 2 || (g.axis == MtfAxis::kX ? g.region.height : g.region.width) < 4)
-      throw InputError(GroupText(g) + ": the region must hold two periods across and 4 px along the bars");
+      throw InputError(GroupText(g) +
+                       ": the region must hold two periods across and 4 px along the bars");
     double max_sum = 0.0, min_sum = 0.0;
     for (int w = 0; w < windows; ++w) {
       const int begin = static_cast<int>(std::floor(w * period));
@@ -93,8 +97,9 @@ BarTargetResult MeasureBarTarget(const GrayImage& image,
     m.contrast_transfer = m.modulation / result.reference_modulation;
     result.groups.push_back(m);
   }
-  std::sort(result.groups.begin(), result.groups.end(),
-            [](const auto& a, const auto& b) { return a.frequency_cy_px < b.frequency_cy_px; });
+  std::sort(result.groups.begin(), result.groups.end(), [](const auto& a, const auto& b) {
+    return a.frequency_cy_px < b.frequency_cy_px;
+  });
 
   const LimitingFrequency limit = FindLimitingFrequencyOf(result.groups, options.threshold);
   result.limiting_frequency_cy_px = limit.frequency_cy_px;

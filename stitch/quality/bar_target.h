@@ -14,10 +14,10 @@
 // lp/mm and the ground resolved distance.
 #pragma once
 
-#include <vector>
-
 #include "stitch/image_io/gray_image.h"
 #include "stitch/quality/slanted_edge.h"
+
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -40,7 +40,7 @@ struct BarGroupModulation {
 };
 
 struct BarTargetResult {
-  double reference_modulation = 0.0;     // (B - D) / (B + D) of the large areas
+  double reference_modulation = 0.0;       // (B - D) / (B + D) of the large areas
   std::vector<BarGroupModulation> groups;  // by increasing frequency
   // Frequency (cycles/px) where the contrast transfer falls to the threshold; NaN when already the
   // lowest group is below it. When no group falls below it, the highest group's frequency with

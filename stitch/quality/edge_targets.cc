@@ -1,9 +1,9 @@
 #include "stitch/quality/edge_targets.h"
 
+#include "calib/core/error.h"
+
 #include <algorithm>
 #include <cmath>
-
-#include "calib/core/error.h"
 
 namespace aerocal::stitch {
 
@@ -12,7 +12,8 @@ EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
                                     const Eigen::Vector3d& center_m,
                                     const EdgeTarget& target,
                                     const EdgeTargetRegionOptions& options) {
-  AEROCAL_CHECK(options.half_width_px >= 8.0 && options.used_fraction > 0.0 && options.used_fraction <= 1.0)
+  AEROCAL_CHECK(options.half_width_px >= 8.0 && options.used_fraction > 0.0 &&
+                options.used_fraction <= 1.0)
       << "half_width_px >= 8 and 0 < used_fraction <= 1";
   EdgeTargetRegion out;
   out.id = target.id;
@@ -30,12 +31,14 @@ EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
   out.gsd_m = (target.end_m - target.start_m).norm() / length_px;
   // An edge running more along the rows than the columns has its normal nearer the x axis.
   out.axis = std::abs(d.y()) >= std::abs(d.x()) ? MtfAxis::kX : MtfAxis::kY;
-  out.slant_deg = std::atan2(std::min(std::abs(d.x()), std::abs(d.y())), std::max(std::abs(d.x()), std::abs(d.y()))) *
+  out.slant_deg = std::atan2(std::min(std::abs(d.x()), std::abs(d.y())),
+                             std::max(std::abs(d.x()), std::abs(d.y()))) *
                   180.0 / 3.14159265358979323846;
   const Eigen::Vector2d middle = 0.5 * (out.start_px + out.end_px);
   const Eigen::Vector2d half = 0.5 * options.used_fraction * d;
   const Eigen::Vector2d a = middle - half, b = middle + half;
-  // Along the edge: the used part; across it: half_width to each side of the edge's extreme positions.
+  // Along the edge: the used part; across it: half_width to each side of the edge's extreme
+  // positions.
   const double w = options.half_width_px;
   double col0, col1, row0, row1;
   if (out.axis == MtfAxis::kX) {
@@ -49,7 +52,8 @@ EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
   out.region.row = static_cast<int>(std::ceil(row0));
   out.region.width = static_cast<int>(std::floor(col1)) - out.region.col + 1;
   out.region.height = static_cast<int>(std::floor(row1)) - out.region.row + 1;
-  if (out.region.col < 0 || out.region.row < 0 || out.region.col + out.region.width > camera.width_px ||
+  if (out.region.col < 0 || out.region.row < 0 ||
+      out.region.col + out.region.width > camera.width_px ||
       out.region.row + out.region.height > camera.height_px) {
     out.reason = "the region leaves the image";
     return out;

@@ -9,12 +9,12 @@
 // it, as a pixel-axis rectangle; the local GSD is the edge's ground length over its image length.
 #pragma once
 
-#include <string>
+#include "calib/camera/camera.h"
+#include "stitch/quality/slanted_edge.h"
 
 #include <Eigen/Core>
 
-#include "calib/camera/camera.h"
-#include "stitch/quality/slanted_edge.h"
+#include <string>
 
 namespace aerocal::stitch {
 
@@ -25,14 +25,14 @@ struct EdgeTarget {
 };
 
 struct EdgeTargetRegionOptions {
-  double half_width_px = 32.0;   // across the edge, each side (>= 8)
-  double used_fraction = 0.8;    // of the edge's length, centred (0 < f <= 1; the ends are corners)
+  double half_width_px = 32.0;  // across the edge, each side (>= 8)
+  double used_fraction = 0.8;   // of the edge's length, centred (0 < f <= 1; the ends are corners)
 };
 
 struct EdgeTargetRegion {
   std::string id;
-  bool usable = false;       // both ends project in front of the camera and the region is inside
-  std::string reason;        // why not, when !usable
+  bool usable = false;  // both ends project in front of the camera and the region is inside
+  std::string reason;   // why not, when !usable
   PixelRegion region;
   Eigen::Vector2d start_px = Eigen::Vector2d::Zero(), end_px = Eigen::Vector2d::Zero();
   MtfAxis axis = MtfAxis::kX;  // the image axis nearer the edge normal

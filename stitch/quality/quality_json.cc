@@ -5,7 +5,9 @@
 namespace aerocal::stitch {
 namespace {
 
-nlohmann::json Number(double value) { return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json(); }
+nlohmann::json Number(double value) {
+  return std::isfinite(value) ? nlohmann::json(value) : nlohmann::json();
+}
 
 nlohmann::json Numbers(const std::vector<double>& values) {
   nlohmann::json array = nlohmann::json::array();
@@ -18,7 +20,9 @@ nlohmann::json Numbers(const std::vector<double>& values) {
 nlohmann::json SlantedEdgeToJson(const SlantedEdgeResult& r) {
   nlohmann::json budget = nlohmann::json::array();
   for (const auto& c : r.budget)
-    budget.push_back({{"name", c.name}, {"type", c.type}, {"distribution", c.distribution},
+    budget.push_back({{"name", c.name},
+                      {"type", c.type},
+                      {"distribution", c.distribution},
                       {"u_cy_px", Number(c.u)}});
   return {{"axis", std::string(MtfAxisName(r.axis))},
           {"angle_deg", r.angle_deg},

@@ -3,9 +3,9 @@
 // below 1 cycle/px) is written as null, never as a number.
 #pragma once
 
-#include <nlohmann/json.hpp>
-
 #include "stitch/quality/slanted_edge.h"
+
+#include <nlohmann/json.hpp>
 
 namespace aerocal::stitch {
 

@@ -1,8 +1,8 @@
 #include "stitch/quality/resampling_mtf.h"
 
-#include <cmath>
-
 #include "calib/core/error.h"
+
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
@@ -42,11 +42,14 @@ double InterpolationTransfer(Interpolation kind, double f_cy_px) {
   return KeysTransfer(f_cy_px);
 }
 
-double PredictResampledMtf50(const SlantedEdgeResult& raw, Interpolation kind, double normal_angle_rad) {
+double PredictResampledMtf50(const SlantedEdgeResult& raw,
+                             Interpolation kind,
+                             double normal_angle_rad) {
   const double cx = std::abs(std::cos(normal_angle_rad)), cy = std::abs(std::sin(normal_angle_rad));
   return FirstCrossingFrequency(
       [&](double f) {
-        return EdgeMtfAt(raw, f) * InterpolationTransfer(kind, f * cx) * InterpolationTransfer(kind, f * cy);
+        return EdgeMtfAt(raw, f) * InterpolationTransfer(kind, f * cx) *
+               InterpolationTransfer(kind, f * cy);
       },
       0.5);
 }

@@ -19,6 +19,8 @@ double InterpolationTransfer(Interpolation kind, double f_cy_px);
 /// The MTF50 an edge measured in a raw image will have after resampling with `kind`, its normal at
 /// `normal_angle_rad` to the resampled image's x axis. NaN when the product does not fall to 0.5
 /// below 1 cycle/px.
-double PredictResampledMtf50(const SlantedEdgeResult& raw, Interpolation kind, double normal_angle_rad);
+double PredictResampledMtf50(const SlantedEdgeResult& raw,
+                             Interpolation kind,
+                             double normal_angle_rad);
 
 }  // namespace aerocal::stitch

@@ -1,14 +1,14 @@
 #include "stitch/quality/siemens_star.h"
 
-#include <algorithm>
-#include <cmath>
-#include <string>
-
-#include <Eigen/Cholesky>
-
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 #include "stitch/quality/limiting_frequency.h"
+
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <string>
 
 namespace aerocal::stitch {
 namespace {
@@ -29,7 +29,8 @@ struct RingFit {
 };
 
 template <typename Visit>
-void ForRingPixels(const GrayImage& image, const SiemensStar& star, double r, double gamma, Visit&& visit) {
+void ForRingPixels(
+    const GrayImage& image, const SiemensStar& star, double r, double gamma, Visit&& visit) {
   const double cx = star.centre_px.x(), cy = star.centre_px.y();
   const int row0 = std::max(0, static_cast<int>(std::floor(cy - r - 1))),
             row1 = std::min<int>(image.rows() - 1, static_cast<int>(std::ceil(cy + r + 1)));
@@ -61,7 +62,10 @@ RingFit FitRing(const GrayImage& image, const SiemensStar& star, double r, doubl
 }
 
 // (B - D) / (B + D) from the middle thirds of the sectors of the outer ring.
-double ReferenceModulation(const GrayImage& image, const SiemensStar& star, const RingFit& outer, double gamma) {
+double ReferenceModulation(const GrayImage& image,
+                           const SiemensStar& star,
+                           const RingFit& outer,
+                           double gamma) {
   const double phase0 = std::atan2(outer.b, outer.a);  // v ~ m + A cos(n theta - phase0)
   double bright = 0, dark = 0;
   int n_bright = 0, n_dark = 0;
@@ -93,22 +97,29 @@ void SiemensStarOptions::Validate() const {
   if (!(threshold > 0.0 && threshold < 1.0))
     throw ConfigError("threshold must be within (0, 1) (got " + std::to_string(threshold) + ")");
   if (steps_per_octave < 2 || steps_per_octave > 96)
-    throw ConfigError("steps_per_octave must be within [2, 96] (got " + std::to_string(steps_per_octave) + ")");
+    throw ConfigError("steps_per_octave must be within [2, 96] (got " +
+                      std::to_string(steps_per_octave) + ")");
 }
 
-SiemensStarResult MeasureSiemensStar(const GrayImage& image, const SiemensStar& star,
+SiemensStarResult MeasureSiemensStar(const GrayImage& image,
+                                     const SiemensStar& star,
                                      const SiemensStarOptions& options) {
   options.Validate();
   const std::string what = StarText(star);
   const double r_out = star.outer_radius_px, cx = star.centre_px.x(), cy = star.centre_px.y();
-  if (star.cycles < 4) throw InputError(what + ": cycles must be >= 4 (got " + std::to_string(star.cycles) + ")");
-  if (!(r_out > 0) || !(cx - r_out - 1 >= 0 && cy - r_out - 1 >= 0 && cx + r_out + 1 <= image.cols() - 1 &&
-                        cy + r_out + 1 <= image.rows() - 1))
-    throw InputError(what + StringPrintf(": the outer radius %.1f px must lie inside the image", r_out));
+  if (star.cycles < 4)
+    throw InputError(what + ": cycles must be >= 4 (got " + std::to_string(star.cycles) + ")");
+  if (!(r_out > 0) || !(cx - r_out - 1 >= 0 && cy - r_out - 1 >= 0 &&
+                        cx + r_out + 1 <= image.cols() - 1 && cy + r_out + 1 <= image.rows() - 1))
+    throw InputError(what +
+                     StringPrintf(": the outer radius %.1f px must lie inside the image", r_out));
   if (kPi * r_out / star.cycles < kMinSectorPx)
-    throw InputError(what + StringPrintf(": %.1f px per sector on the outer radius (pi r / cycles); the reference "
-                                         "modulation needs %.0f px or more",
-                                         kPi * r_out / star.cycles, kMinSectorPx));
+    throw InputError(
+        what +
+        StringPrintf(": %.1f px per sector on the outer radius (pi r / cycles); the reference "
+                     "modulation needs %.0f px or more",
+                     kPi * r_out / star.cycles,
+                     kMinSectorPx));
   if (!(star.inner_radius_px >= 0 && star.inner_radius_px < r_out))
     throw InputError(what + ": the inner radius must be within [0, outer radius)");
 

@@ -26,19 +26,19 @@
 // resolved distance.
 #pragma once
 
-#include <vector>
+#include "stitch/image_io/gray_image.h"
 
 #include <Eigen/Core>
 
-#include "stitch/image_io/gray_image.h"
+#include <vector>
 
 namespace aerocal::stitch {
 
 struct SiemensStar {
   Eigen::Vector2d centre_px = Eigen::Vector2d::Zero();  // (col, row), sub-pixel, pixel frame
-  int cycles = 0;                 // bright + dark sector pairs round the star, >= 4
-  double outer_radius_px = 0.0;   // the largest radius measured (inside the star), px
-  double inner_radius_px = 0.0;   // the smallest radius measured, px (>= 0; 0: down to f = 0.5)
+  int cycles = 0;                // bright + dark sector pairs round the star, >= 4
+  double outer_radius_px = 0.0;  // the largest radius measured (inside the star), px
+  double inner_radius_px = 0.0;  // the smallest radius measured, px (>= 0; 0: down to f = 0.5)
 };
 
 /// Arc length of one sector on the outer ring below which M0 is not measured, px.
@@ -53,10 +53,10 @@ struct SiemensStarOptions {
 
 struct StarRing {
   double radius_px = 0.0;
-  double frequency_cy_px = 0.0;     // n / (2 pi r)
-  double modulation = 0.0;          // M1: the fundamental's amplitude over the ring's mean
-  double contrast_transfer = 0.0;   // M1 / (4 / pi M0)
-  int pixels = 0;                   // pixels of the ring
+  double frequency_cy_px = 0.0;    // n / (2 pi r)
+  double modulation = 0.0;         // M1: the fundamental's amplitude over the ring's mean
+  double contrast_transfer = 0.0;  // M1 / (4 / pi M0)
+  int pixels = 0;                  // pixels of the ring
 };
 
 struct SiemensStarResult {

@@ -1,13 +1,13 @@
 #include "stitch/quality/slanted_edge.h"
 
+#include "calib/core/error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <complex>
 #include <functional>
 #include <limits>
 #include <random>
-
-#include "calib/core/error.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -33,7 +33,10 @@ std::string RegionText(const PixelRegion& r) {
 
 // The region's linearised values, transposed when the edge is nearer horizontal, so that the edge
 // always runs along the rows of the returned matrix and its ESF runs across the columns.
-Matrix OrientedRegion(const GrayImage& image, const PixelRegion& region, double gamma, MtfAxis* axis) {
+Matrix OrientedRegion(const GrayImage& image,
+                      const PixelRegion& region,
+                      double gamma,
+                      MtfAxis* axis) {
   Matrix m(region.height, region.width);
   for (int r = 0; r < region.height; ++r)
     for (int c = 0; c < region.width; ++c) {
@@ -52,8 +55,8 @@ Matrix OrientedRegion(const GrayImage& image, const PixelRegion& region, double 
 }
 
 struct EdgeLine {
-  double a = 0.0;         // col of the edge at the mean row
-  double b = 0.0;         // slope, col per row
+  double a = 0.0;  // col of the edge at the mean row
+  double b = 0.0;  // slope, col per row
   double row_mean = 0.0;
   double slope_sigma = 0.0;
   double Col(double row) const { return a + b * (row - row_mean); }
@@ -89,8 +92,8 @@ EdgeLine FitLine(const std::vector<double>& centroid, const PixelRegion& region)
     if (std::isfinite(centroid[r])) n += 1.0, sr += r, sc += centroid[r];
   if (n < 0.5 * centroid.size() || n < 8)
     throw InputError(RegionText(region) + ": no edge across the region (an edge found in " +
-                     std::to_string(static_cast<int>(n)) + " of " + std::to_string(centroid.size()) +
-                     " lines)");
+                     std::to_string(static_cast<int>(n)) + " of " +
+                     std::to_string(centroid.size()) + " lines)");
   EdgeLine line;
   line.row_mean = sr / n;
   const double col_mean = sc / n;
@@ -163,9 +166,13 @@ Esf BinEsf(const Matrix& m, const EdgeLine& line, double slope, int oversampling
     while (left >= 0 && esf.count[left] == 0) --left;
     while (right < n && esf.count[right] == 0) ++right;
     if (left < 0 && right >= n) continue;
-    if (left < 0) esf.value[k] = esf.value[right];
-    else if (right >= n) esf.value[k] = esf.value[left];
-    else esf.value[k] = esf.value[left] + (esf.value[right] - esf.value[left]) * (k - left) / (right - left);
+    if (left < 0)
+      esf.value[k] = esf.value[right];
+    else if (right >= n)
+      esf.value[k] = esf.value[left];
+    else
+      esf.value[k] =
+          esf.value[left] + (esf.value[right] - esf.value[left]) * (k - left) / (right - left);
   }
   return esf;
 }
@@ -282,7 +289,9 @@ void ComputeBudget(const Matrix& m,
                    SlantedEdgeResult* result) {
   const double f0 = result->mtf50_cy_px;
   auto& budget = result->budget;
-  budget.push_back({"noise", "B", "normal (Monte-Carlo of the ESF bins)",
+  budget.push_back({"noise",
+                    "B",
+                    "normal (Monte-Carlo of the ESF bins)",
                     NoiseUncertainty(esf, sides, options.noise_samples)});
   // The edge angle: the slope +- its sigma. A wrong slope smears the ESF and lowers MTF50 either
   // way, so the mean of the two changes is the standard uncertainty (not their half difference).
@@ -290,15 +299,22 @@ void ComputeBudget(const Matrix& m,
       Mtf50(BinEsf(m, line, line.b + line.slope_sigma, options.oversampling, 0.0));
   const double f_minus =
       Mtf50(BinEsf(m, line, line.b - line.slope_sigma, options.oversampling, 0.0));
-  budget.push_back({"edge angle", "B", "normal (slope +- sigma)",
+  budget.push_back({"edge angle",
+                    "B",
+                    "normal (slope +- sigma)",
                     0.5 * (std::abs(f_plus - f0) + std::abs(f_minus - f0))});
   const double f_shifted = Mtf50(BinEsf(m, line, line.b, options.oversampling, 0.5));
-  budget.push_back({"oversampling", "B", "rectangular (bins shifted by half a bin)",
+  budget.push_back({"oversampling",
+                    "B",
+                    "rectangular (bins shifted by half a bin)",
                     std::abs(f_shifted - f0) / std::sqrt(3.0)});
-  budget.push_back({"method", "B", "rectangular (validation on rendered edges)",
+  budget.push_back({"method",
+                    "B",
+                    "rectangular (validation on rendered edges)",
                     options.method_relative_half_width * f0 / std::sqrt(3.0)});
   double u2 = 0.0;
-  for (const auto& component : budget) u2 += std::isfinite(component.u) ? component.u * component.u : 0.0;
+  for (const auto& component : budget)
+    u2 += std::isfinite(component.u) ? component.u * component.u : 0.0;
   result->mtf50_u_cy_px = std::sqrt(u2);
   result->mtf50_expanded_cy_px = result->coverage_factor * result->mtf50_u_cy_px;
 }
@@ -334,7 +350,8 @@ void SlantedEdgeOptions::Validate() const {
   if (!(gamma > 0.0 && gamma <= 10.0))
     throw ConfigError("gamma must be within (0, 10] (got " + std::to_string(gamma) + ")");
   if (oversampling < 2 || oversampling > 16)
-    throw ConfigError("oversampling must be within 2..16 (got " + std::to_string(oversampling) + ")");
+    throw ConfigError("oversampling must be within 2..16 (got " + std::to_string(oversampling) +
+                      ")");
   if (noise_samples < 8)
     throw ConfigError("noise_samples must be >= 8 (got " + std::to_string(noise_samples) + ")");
   if (!(min_angle_deg >= 0.0 && min_angle_deg < max_angle_deg && max_angle_deg <= 45.0))
@@ -372,8 +389,8 @@ SlantedEdgeResult MeasureSlantedEdge(const GrayImage& image,
   result.edge_offset_px = line.a;
   result.slope_sigma = line.slope_sigma;
   result.contrast = std::abs(sides.right - sides.left);
-  result.noise_sigma = std::sqrt(0.5 * (sides.noise_left * sides.noise_left +
-                                        sides.noise_right * sides.noise_right));
+  result.noise_sigma = std::sqrt(
+      0.5 * (sides.noise_left * sides.noise_left + sides.noise_right * sides.noise_right));
   result.empty_bins = esf.empty;
   const double abs_angle = std::abs(result.angle_deg);
   if (!(result.contrast > 10.0 * result.noise_sigma) || !(result.contrast > 0.0))
@@ -385,7 +402,8 @@ SlantedEdgeResult MeasureSlantedEdge(const GrayImage& image,
                      " deg to the pixel axis, expected " + std::to_string(options.min_angle_deg) +
                      " .. " + std::to_string(options.max_angle_deg) + " deg");
   if (esf.x.empty() || esf.x.front() > -3.0 || esf.x.back() < 3.0)
-    throw InputError(RegionText(region) + ": the edge is too near the region's border (at least 3 px "
+    throw InputError(RegionText(region) +
+                     ": the edge is too near the region's border (at least 3 px "
                      "of both sides are needed along every line)");
 
   result.esf_distance_px = esf.x;
@@ -424,11 +442,8 @@ EdgeMtfCombination CombineEdgeMeasurements(const std::vector<SlantedEdgeResult>&
   return combination;
 }
 
-GroundResolution ToGroundResolution(double f_cy_px,
-                                    double u_f_cy_px,
-                                    double pixel_size_mm,
-                                    double gsd_m,
-                                    double u_gsd_m) {
+GroundResolution ToGroundResolution(
+    double f_cy_px, double u_f_cy_px, double pixel_size_mm, double gsd_m, double u_gsd_m) {
   AEROCAL_CHECK(f_cy_px > 0.0) << "frequency must be > 0 cycles/px, got " << f_cy_px;
   GroundResolution g;
   if (pixel_size_mm > 0.0) {

@@ -12,7 +12,8 @@
 //     function (ESF); empty bins are interpolated from their neighbours;
 //  5. the line spread function (LSF) by the centred difference of the ESF, multiplied by a Hamming
 //     window centred on the edge;
-//  6. MTF(f) = |DTFT(LSF)(f)| / |DTFT(LSF)(0)|, f in cycles per pixel along the edge normal, divided
+//  6. MTF(f) = |DTFT(LSF)(f)| / |DTFT(LSF)(0)|, f in cycles per pixel along the edge normal,
+//  divided
 //     by the transfer functions of the centred difference, sinc(2 f D), and of the bin average,
 //     sinc(f D) (D the bin width in px; ISO 12233 corrects the derivative, the bin average is the
 //     same kind of correction). The DTFT is evaluated at any frequency, so MTF50 is found by
@@ -23,18 +24,19 @@
 // Uncertainty of MTF50 (GUM, JCGM 100:2008): type B components from the image noise (Monte-Carlo
 // of the ESF bins with the noise measured on the flat sides, GUM Supplement 1), the edge angle
 // (the line fit's slope +- its sigma), the oversampling (the bins shifted by half a bin) and the
-// method (a rectangular half-width from the validation on rendered edges, stitch/quality/README.md);
-// type A from repeated edges in CombineEdgeMeasurements. U = k u_c with k = 2.
+// method (a rectangular half-width from the validation on rendered edges,
+// stitch/quality/README.md); type A from repeated edges in CombineEdgeMeasurements. U = k u_c with
+// k = 2.
 //
 // Frames: pixel (col, row) of CONVENTIONS.md; frequencies in cycles per pixel (Nyquist 0.5).
 #pragma once
+
+#include "stitch/image_io/gray_image.h"
 
 #include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
-
-#include "stitch/image_io/gray_image.h"
 
 namespace aerocal::stitch {
 
@@ -48,10 +50,11 @@ enum class MtfAxis { kX, kY };
 std::string_view MtfAxisName(MtfAxis axis);  // "x" | "y"
 
 struct SlantedEdgeOptions {
-  double gamma = 1.0;         // linearisation: value = DN^gamma (> 0; 1: linear data, 2.2: sRGB-like)
-  int oversampling = 4;       // ESF bins per pixel, 2..16 (ISO 12233: 4)
-  int noise_samples = 64;     // Monte-Carlo repeats for the noise component, >= 8
-  double min_angle_deg = 1.0;   // edges closer than this to a pixel axis are refused (phase sampling)
+  double gamma = 1.0;      // linearisation: value = DN^gamma (> 0; 1: linear data, 2.2: sRGB-like)
+  int oversampling = 4;    // ESF bins per pixel, 2..16 (ISO 12233: 4)
+  int noise_samples = 64;  // Monte-Carlo repeats for the noise component, >= 8
+  double min_angle_deg =
+      1.0;  // edges closer than this to a pixel axis are refused (phase sampling)
   double max_angle_deg = 35.0;  // and farther than this
   // Relative half-width (of MTF50) of the method's remaining systematic error, rectangular; from
   // the validation on rendered edges (README "Measured"): a type-B component, >= 0.
@@ -67,23 +70,23 @@ struct UncertaintyComponent {
 };
 
 struct SlantedEdgeResult {
-  MtfAxis axis = MtfAxis::kX;      // image axis of the edge normal
-  double angle_deg = 0.0;          // edge slant to the nearer pixel axis, signed (col per row)
-  double edge_offset_px = 0.0;     // edge position across the region, px from its first col/row
-  double slope_sigma = 0.0;        // sigma of the fitted slope (col per row)
-  double contrast = 0.0;           // ESF step (linearised units), > 0
-  double noise_sigma = 0.0;        // pixel noise on the flat sides (linearised units)
-  int empty_bins = 0;              // ESF bins interpolated because no pixel fell into them
-  std::vector<double> frequency_cy_px;  // 0 .. 1 cycles/px in steps of 1/64
-  std::vector<double> mtf;              // MTF at those frequencies (1 at 0)
+  MtfAxis axis = MtfAxis::kX;   // image axis of the edge normal
+  double angle_deg = 0.0;       // edge slant to the nearer pixel axis, signed (col per row)
+  double edge_offset_px = 0.0;  // edge position across the region, px from its first col/row
+  double slope_sigma = 0.0;     // sigma of the fitted slope (col per row)
+  double contrast = 0.0;        // ESF step (linearised units), > 0
+  double noise_sigma = 0.0;     // pixel noise on the flat sides (linearised units)
+  int empty_bins = 0;           // ESF bins interpolated because no pixel fell into them
+  std::vector<double> frequency_cy_px;       // 0 .. 1 cycles/px in steps of 1/64
+  std::vector<double> mtf;                   // MTF at those frequencies (1 at 0)
   std::vector<double> esf_distance_px, esf;  // the oversampled ESF (bin centres, values)
-  double mtf50_cy_px = 0.0;        // first frequency where the MTF falls to 0.5; NaN if not <= 1
-  double mtf10_cy_px = 0.0;        // the same at 0.1
-  double mtf_nyquist = 0.0;        // MTF at 0.5 cycles/px
+  double mtf50_cy_px = 0.0;  // first frequency where the MTF falls to 0.5; NaN if not <= 1
+  double mtf10_cy_px = 0.0;  // the same at 0.1
+  double mtf_nyquist = 0.0;  // MTF at 0.5 cycles/px
   std::vector<UncertaintyComponent> budget;  // components of MTF50's uncertainty (cy/px)
-  double mtf50_u_cy_px = 0.0;      // combined standard uncertainty u_c
-  double mtf50_expanded_cy_px = 0.0;  // U = k u_c
-  double coverage_factor = 2.0;    // k
+  double mtf50_u_cy_px = 0.0;                // combined standard uncertainty u_c
+  double mtf50_expanded_cy_px = 0.0;         // U = k u_c
+  double coverage_factor = 2.0;              // k
 };
 
 /// Measures the slanted edge inside `region` of `image` (grey values as read, any bit depth).
@@ -105,10 +108,10 @@ double FirstCrossingFrequency(const std::function<double(double)>& mtf, double l
 /// The MTF50 of repeated edges combined.
 struct EdgeMtfCombination {
   int count = 0;
-  double mtf50_cy_px = 0.0;         // mean of the repeats
-  double type_a_u_cy_px = 0.0;      // s / sqrt(n)
-  double type_b_u_cy_px = 0.0;      // systematic part (method, oversampling), from the repeats' budgets
-  double mtf50_u_cy_px = 0.0;       // sqrt(u_A^2 + u_B^2)
+  double mtf50_cy_px = 0.0;     // mean of the repeats
+  double type_a_u_cy_px = 0.0;  // s / sqrt(n)
+  double type_b_u_cy_px = 0.0;  // systematic part (method, oversampling), from the repeats' budgets
+  double mtf50_u_cy_px = 0.0;   // sqrt(u_A^2 + u_B^2)
   double mtf50_expanded_cy_px = 0.0;  // k = 2
 };
 
@@ -121,13 +124,10 @@ EdgeMtfCombination CombineEdgeMeasurements(const std::vector<SlantedEdgeResult>&
 /// (pixel size in mm) and the ground resolved distance, the width of one bar (half a cycle):
 /// GRD = GSD / (2 f). u from u(f) and u(GSD) (uncorrelated, first order).
 struct GroundResolution {
-  double lp_per_mm = 0.0, lp_per_mm_u = 0.0;     // 0 when no pixel size is given
+  double lp_per_mm = 0.0, lp_per_mm_u = 0.0;                      // 0 when no pixel size is given
   double resolved_distance_m = 0.0, resolved_distance_u_m = 0.0;  // 0 when no GSD is given
 };
-GroundResolution ToGroundResolution(double f_cy_px,
-                                    double u_f_cy_px,
-                                    double pixel_size_mm,
-                                    double gsd_m,
-                                    double u_gsd_m);
+GroundResolution ToGroundResolution(
+    double f_cy_px, double u_f_cy_px, double pixel_size_mm, double gsd_m, double u_gsd_m);
 
 }  // namespace aerocal::stitch

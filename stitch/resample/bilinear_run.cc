@@ -23,8 +23,10 @@ struct Output {
   float* sum;
   // Rounded through int32: float -> int32 is one vector instruction, float -> uint16 is not.
   void Put(int k, float value) const {
-    if constexpr (kAdd) sum[k] += value;
-    else out[k] = static_cast<T>(static_cast<std::int32_t>(value + 0.5f));
+    if constexpr (kAdd)
+      sum[k] += value;
+    else
+      out[k] = static_cast<T>(static_cast<std::int32_t>(value + 0.5f));
   }
 };
 
@@ -32,9 +34,13 @@ struct Output {
 // fractions fu0 + lane_u[j], fv0 + lane_v[j] (mod 2^32, known to stay within [0, 2^32)). The
 // output does not overlap the samples (__restrict), so the loop with its stores vectorises.
 template <typename T, bool kAdd>
-AEROCAL_INLINE_INTO_CLONES void Block(const T* __restrict p, int stride, std::uint32_t fu0,
-                                      std::uint32_t fv0, const std::uint32_t* __restrict lane_u,
-                                      const std::uint32_t* __restrict lane_v, float* __restrict sum,
+AEROCAL_INLINE_INTO_CLONES void Block(const T* __restrict p,
+                                      int stride,
+                                      std::uint32_t fu0,
+                                      std::uint32_t fv0,
+                                      const std::uint32_t* __restrict lane_u,
+                                      const std::uint32_t* __restrict lane_v,
+                                      float* __restrict sum,
                                       T* __restrict out) {
   const T* __restrict q = p + stride;
   // The next virtual row reads the window row after q (a sub-image at about the virtual image's
@@ -48,17 +54,22 @@ AEROCAL_INLINE_INTO_CLONES void Block(const T* __restrict p, int stride, std::ui
     const float a = p[j], b = p[j + 1], c = q[j], d = q[j + 1];
     const float top = a + fu * (b - a), bottom = c + fu * (d - c);
     const float value = top + fv * (bottom - top);
-    if constexpr (kAdd) sum[j] += value;
-    else out[j] = static_cast<T>(static_cast<std::int32_t>(value + 0.5f));
+    if constexpr (kAdd)
+      sum[j] += value;
+    else
+      out[j] = static_cast<T>(static_cast<std::int32_t>(value + 0.5f));
   }
 }
 
 template <typename T, bool kAdd>
-AEROCAL_INLINE_INTO_CLONES void SampleRun(const SampleWindow<T>& window, const FixedRun& run, const Output<T, kAdd>& out) {
+AEROCAL_INLINE_INTO_CLONES void SampleRun(const SampleWindow<T>& window,
+                                          const FixedRun& run,
+                                          const Output<T, kAdd>& out) {
   std::int64_t u = run.u, v = run.v;
   int k = 0;
   // u = iu + 1 + eu per column; blocks pay when a block's fractions rarely wrap.
-  const std::int64_t eu = run.du - kOnePx, span_u = (kBlock - 1) * eu, span_v = (kBlock - 1) * run.dv;
+  const std::int64_t eu = run.du - kOnePx, span_u = (kBlock - 1) * eu,
+                     span_v = (kBlock - 1) * run.dv;
   if (std::llabs(span_u) < kOnePx / 2 && std::llabs(span_v) < kOnePx / 2) {
     std::uint32_t lane_u[kBlock], lane_v[kBlock];
     for (int j = 0; j < kBlock; ++j) {
@@ -70,29 +81,43 @@ AEROCAL_INLINE_INTO_CLONES void SampleRun(const SampleWindow<T>& window, const F
       const std::int64_t fu1 = fu0 + span_u, fv1 = fv0 + span_v;  // the block's last fractions
       if (fu1 >= 0 && fu1 < kOnePx && fv1 >= 0 && fv1 < kOnePx) {
         const T* p = window.data + (v >> kFractionBits) * window.stride + (u >> kFractionBits);
-        Block<T, kAdd>(p, window.stride, static_cast<std::uint32_t>(fu0),
-                       static_cast<std::uint32_t>(fv0), lane_u, lane_v, kAdd ? out.sum + k : nullptr,
+        Block<T, kAdd>(p,
+                       window.stride,
+                       static_cast<std::uint32_t>(fu0),
+                       static_cast<std::uint32_t>(fv0),
+                       lane_u,
+                       lane_v,
+                       kAdd ? out.sum + k : nullptr,
                        kAdd ? nullptr : out.out + k);
         u += kBlock * run.du;
         v += kBlock * run.dv;
       } else {
-        for (int j = 0; j < kBlock; ++j, u += run.du, v += run.dv) out.Put(k + j, SampleAt(window, u, v));
+        for (int j = 0; j < kBlock; ++j, u += run.du, v += run.dv)
+          out.Put(k + j, SampleAt(window, u, v));
       }
     }
   }
   for (; k < run.n; ++k, u += run.du, v += run.dv) out.Put(k, SampleAt(window, u, v));
 }
 
-AEROCAL_KERNEL_CLONES void Store8(const SampleWindow<std::uint8_t>& w, const FixedRun& run, std::uint8_t* out) {
+AEROCAL_KERNEL_CLONES void Store8(const SampleWindow<std::uint8_t>& w,
+                                  const FixedRun& run,
+                                  std::uint8_t* out) {
   SampleRun(w, run, Output<std::uint8_t, false>{out, nullptr});
 }
-AEROCAL_KERNEL_CLONES void Store16(const SampleWindow<std::uint16_t>& w, const FixedRun& run, std::uint16_t* out) {
+AEROCAL_KERNEL_CLONES void Store16(const SampleWindow<std::uint16_t>& w,
+                                   const FixedRun& run,
+                                   std::uint16_t* out) {
   SampleRun(w, run, Output<std::uint16_t, false>{out, nullptr});
 }
-AEROCAL_KERNEL_CLONES void Add8(const SampleWindow<std::uint8_t>& w, const FixedRun& run, float* sum) {
+AEROCAL_KERNEL_CLONES void Add8(const SampleWindow<std::uint8_t>& w,
+                                const FixedRun& run,
+                                float* sum) {
   SampleRun(w, run, Output<std::uint8_t, true>{nullptr, sum});
 }
-AEROCAL_KERNEL_CLONES void Add16(const SampleWindow<std::uint16_t>& w, const FixedRun& run, float* sum) {
+AEROCAL_KERNEL_CLONES void Add16(const SampleWindow<std::uint16_t>& w,
+                                 const FixedRun& run,
+                                 float* sum) {
   SampleRun(w, run, Output<std::uint16_t, true>{nullptr, sum});
 }
 

@@ -1,15 +1,15 @@
 #include "stitch/resample/fast_strip.h"
 
-#include <algorithm>
-#include <bitset>
-#include <cmath>
-#include <limits>
+#include "calib/core/error.h"
+#include "stitch/resample/bilinear_run.h"
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "calib/core/error.h"
-#include "stitch/resample/bilinear_run.h"
+#include <algorithm>
+#include <bitset>
+#include <cmath>
+#include <limits>
 
 namespace aerocal::stitch::internal {
 namespace {
@@ -73,7 +73,10 @@ void ForEachRun(const RowMap& map, int s, int e, Fn&& fn) {
     FixedRun run{u0 + (c - n0) * du, v0 + (c - n0) * dv, du, dv, end - c};
     auto clamped = [&](std::int64_t u, std::int64_t v) {
       return FixedRun{std::clamp<std::int64_t>(u, 0, map.max_u),
-                      std::clamp<std::int64_t>(v, 0, map.max_v), 0, 0, 1};
+                      std::clamp<std::int64_t>(v, 0, map.max_v),
+                      0,
+                      0,
+                      1};
     };
     while (run.n > 0 && !map.Inside(run.u, run.v)) {
       fn(clamped(run.u, run.v), c);
@@ -93,8 +96,14 @@ void ForEachRun(const RowMap& map, int s, int e, Fn&& fn) {
 constexpr int kMaxWindows = 64;
 
 template <typename T>
-void ResampleRow(const std::vector<Window>& windows, T fill, int width, double V, T* out,
-                 std::vector<float>* sum, long* covered, long* overlap) {
+void ResampleRow(const std::vector<Window>& windows,
+                 T fill,
+                 int width,
+                 double V,
+                 T* out,
+                 std::vector<float>* sum,
+                 long* covered,
+                 long* overlap) {
   RowMap maps[kMaxWindows];
   int cuts[2 * kMaxWindows + 2], n_cuts = 0;
   std::bitset<kMaxWindows> seen;
@@ -139,16 +148,24 @@ void ResampleRow(const std::vector<Window>& windows, T fill, int width, double V
       });
     }
     const float scale = 1.0f / n, max_value = std::numeric_limits<T>::max();
-    for (int c = s; c < e; ++c) out[c] = static_cast<T>(std::clamp(acc[c] * scale + 0.5f, 0.0f, max_value));
+    for (int c = s; c < e; ++c)
+      out[c] = static_cast<T>(std::clamp(acc[c] * scale + 0.5f, 0.0f, max_value));
   }
 }
 
 }  // namespace
 
 template <typename T>
-void ResampleStripFast(const std::vector<Window>& windows, float fill, int width, int y0, int rows,
-                       std::uint8_t* strip, std::atomic<long>* covered, std::atomic<long>* overlap) {
-  AEROCAL_CHECK(windows.size() <= static_cast<size_t>(kMaxWindows)) << windows.size() << " sub-images";
+void ResampleStripFast(const std::vector<Window>& windows,
+                       float fill,
+                       int width,
+                       int y0,
+                       int rows,
+                       std::uint8_t* strip,
+                       std::atomic<long>* covered,
+                       std::atomic<long>* overlap) {
+  AEROCAL_CHECK(windows.size() <= static_cast<size_t>(kMaxWindows))
+      << windows.size() << " sub-images";
   const T fill_value = static_cast<T>(fill + 0.5f);
   tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& range) {
     std::vector<float> sum(width);
@@ -162,9 +179,21 @@ void ResampleStripFast(const std::vector<Window>& windows, float fill, int width
   });
 }
 
-template void ResampleStripFast<std::uint8_t>(const std::vector<Window>&, float, int, int, int,
-                                              std::uint8_t*, std::atomic<long>*, std::atomic<long>*);
-template void ResampleStripFast<std::uint16_t>(const std::vector<Window>&, float, int, int, int,
-                                               std::uint8_t*, std::atomic<long>*, std::atomic<long>*);
+template void ResampleStripFast<std::uint8_t>(const std::vector<Window>&,
+                                              float,
+                                              int,
+                                              int,
+                                              int,
+                                              std::uint8_t*,
+                                              std::atomic<long>*,
+                                              std::atomic<long>*);
+template void ResampleStripFast<std::uint16_t>(const std::vector<Window>&,
+                                               float,
+                                               int,
+                                               int,
+                                               int,
+                                               std::uint8_t*,
+                                               std::atomic<long>*,
+                                               std::atomic<long>*);
 
 }  // namespace aerocal::stitch::internal

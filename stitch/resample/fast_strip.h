@@ -16,11 +16,11 @@
 // bit-identical for any thread count.
 #pragma once
 
+#include "stitch/resample/resample_window.h"
+
 #include <atomic>
 #include <cstdint>
 #include <vector>
-
-#include "stitch/resample/resample_window.h"
 
 namespace aerocal::stitch::internal {
 
@@ -30,7 +30,13 @@ inline constexpr double kChordPx = 1e-5;  // largest position error of the linea
 /// bit). `fill` is the value of uncovered pixels, already in T's range. Adds the covered and
 /// overlap pixel counts.
 template <typename T>
-void ResampleStripFast(const std::vector<Window>& windows, float fill, int width, int y0, int rows,
-                       std::uint8_t* strip, std::atomic<long>* covered, std::atomic<long>* overlap);
+void ResampleStripFast(const std::vector<Window>& windows,
+                       float fill,
+                       int width,
+                       int y0,
+                       int rows,
+                       std::uint8_t* strip,
+                       std::atomic<long>* covered,
+                       std::atomic<long>* overlap);
 
 }  // namespace aerocal::stitch::internal

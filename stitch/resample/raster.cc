@@ -1,17 +1,18 @@
 #include "stitch/resample/raster.h"
 
+#include "calib/core/error.h"
+
 #include <algorithm>
 #include <cmath>
 #include <cstring>
-
-#include "calib/core/error.h"
 
 namespace aerocal::stitch {
 
 MemoryRaster::MemoryRaster(const RasterInfo& info) : info_(info) {
   AEROCAL_CHECK(info.width > 0 && info.height > 0 && (info.bands == 1 || info.bands == 3) &&
                 (info.bits == 8 || info.bits == 16))
-      << info.width << " x " << info.height << " x " << info.bands << " bands, " << info.bits << " bit";
+      << info.width << " x " << info.height << " x " << info.bands << " bands, " << info.bits
+      << " bit";
   bytes_.assign(info.RowBytes() * info.height, 0);
 }
 
@@ -19,7 +20,8 @@ void MemoryRaster::ReadWindow(int x0, int y0, int w, int h, void* out) {
   const size_t sample = info_.BytesPerSample() * info_.bands;
   auto* dst = static_cast<std::uint8_t*>(out);
   for (int r = 0; r < h; ++r)
-    std::memcpy(dst + r * w * sample, bytes_.data() + (y0 + r) * info_.RowBytes() + x0 * sample,
+    std::memcpy(dst + r * w * sample,
+                bytes_.data() + (y0 + r) * info_.RowBytes() + x0 * sample,
                 w * sample);
 }
 

@@ -16,8 +16,10 @@ bool CoveredColumns(const Window& win, double V, int virtual_width, int* first, 
       return;
     }
     const double root = -b / a;
-    if (a > 0) lo = std::max(lo, root);
-    else hi = std::min(hi, root);
+    if (a > 0)
+      lo = std::max(lo, root);
+    else
+      hi = std::min(hi, root);
   };
   const double W = win.width_px - 1.0, H = win.height_px - 1.0;
   const double xa = m(0, 0), xb = m(0, 1) * V + m(0, 2);

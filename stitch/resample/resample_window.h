@@ -3,20 +3,20 @@
 // Internal to stitch/resample.
 #pragma once
 
-#include <cstdint>
-#include <vector>
+#include "stitch/resample/virtual_image.h"
 
 #include <Eigen/Core>
 
-#include "stitch/resample/virtual_image.h"
+#include <cstdint>
+#include <vector>
 
 namespace aerocal::stitch::internal {
 
 struct Window {
   bool used = false;
-  int x0 = 0, y0 = 0, w = 0, h = 0;      // in sub-image pixels
-  int width_px = 0, height_px = 0;       // sub-image format
-  Eigen::Matrix3d sub_from_virtual;      // homogeneous, scaled so that w > 0 in front
+  int x0 = 0, y0 = 0, w = 0, h = 0;               // in sub-image pixels
+  int width_px = 0, height_px = 0;                // sub-image format
+  Eigen::Matrix3d sub_from_virtual;               // homogeneous, scaled so that w > 0 in front
   const MapCorrectionGrid* correction = nullptr;  // none: the projectivity alone
   // w * h samples, then at least w + 2 samples of padding (read with weight 0 by the fast path).
   std::vector<std::uint8_t> bytes;

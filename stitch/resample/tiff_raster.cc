@@ -1,24 +1,25 @@
 #include "stitch/resample/tiff_raster.h"
 
-#include <algorithm>
-#include <cstdio>
-#include <cstring>
-#include <filesystem>
-#include <vector>
+#include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <tiffio.h>
 
-#include "calib/core/atomic_file.h"
-#include "calib/core/error.h"
+#include <algorithm>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <vector>
 
 namespace aerocal::stitch {
 namespace {
 
 void SilenceLibtiff() {
-  // libtiff prints warnings (unknown tags, ...) to stderr by default; errors become exceptions here.
+  // libtiff prints warnings (unknown tags, ...) to stderr by default; errors become exceptions
+  // here.
   TIFFSetWarningHandler(nullptr);
   TIFFSetErrorHandler(nullptr);
 }
@@ -27,7 +28,7 @@ class TiffReader : public RasterSource {
  public:
   explicit TiffReader(const std::string& path) : path_(path) {
     SilenceLibtiff();
-    CheckInputFile(path);  // a FIFO or device is refused before libtiff opens it
+    CheckInputFile(path);                  // a FIFO or device is refused before libtiff opens it
     tiff_ = TIFFOpen(path.c_str(), "rm");  // no memory mapping: windows are read as needed
     if (!tiff_) throw InputError(path + ": cannot open as TIFF");
     uint32_t width = 0, height = 0;
@@ -41,7 +42,8 @@ class TiffReader : public RasterSource {
     if ((bits != 8 && bits != 16) || format != SAMPLEFORMAT_UINT || (bands != 1 && bands != 3) ||
         (bands == 3 && planar != PLANARCONFIG_CONTIG)) {
       TIFFClose(tiff_);
-      throw InputError(path + ": expected 8- or 16-bit unsigned samples, 1 or 3 interleaved bands (got " +
+      throw InputError(path +
+                       ": expected 8- or 16-bit unsigned samples, 1 or 3 interleaved bands (got " +
                        std::to_string(bits) + " bit, " + std::to_string(bands) + " bands)");
     }
     info_ = {static_cast<int>(width), static_cast<int>(height), bands, bits};
@@ -70,7 +72,8 @@ class TiffReader : public RasterSource {
         const int c0 = std::max<int>(x0, bx), c1 = std::min<int>(x0 + w, bx + block_w_);
         for (int r = r0; r < r1; ++r)
           std::memcpy(dst + ((r - y0) * static_cast<size_t>(w) + (c0 - x0)) * sample,
-                      block.data() + (r - by) * block_row + (c0 - bx) * sample, (c1 - c0) * sample);
+                      block.data() + (r - by) * block_row + (c0 - bx) * sample,
+                      (c1 - c0) * sample);
       }
   }
 
@@ -79,12 +82,13 @@ class TiffReader : public RasterSource {
   // virtual image overlap by a few rows).
   const std::vector<std::uint8_t>& Block(uint32_t bx, uint32_t by) {
     if (cached_ && cached_x_ == bx && cached_y_ == by) return cache_;
-    cache_.assign(static_cast<size_t>(block_w_) * block_h_ * info_.bands * info_.BytesPerSample(), 0);
+    cache_.assign(static_cast<size_t>(block_w_) * block_h_ * info_.bands * info_.BytesPerSample(),
+                  0);
     const tmsize_t n =
-        tiled_ ? TIFFReadEncodedTile(tiff_, TIFFComputeTile(tiff_, bx, by, 0, 0), cache_.data(),
-                                     cache_.size())
-               : TIFFReadEncodedStrip(tiff_, TIFFComputeStrip(tiff_, by, 0), cache_.data(),
-                                      cache_.size());
+        tiled_ ? TIFFReadEncodedTile(
+                     tiff_, TIFFComputeTile(tiff_, bx, by, 0, 0), cache_.data(), cache_.size())
+               : TIFFReadEncodedStrip(
+                     tiff_, TIFFComputeStrip(tiff_, by, 0), cache_.data(), cache_.size());
     if (n < 0) throw InputError(path_ + ": cannot decode the block at row " + std::to_string(by));
     cached_ = true;
     cached_x_ = bx;
@@ -113,7 +117,7 @@ struct TiffWriter::Impl {
   TIFF* tiff = nullptr;
   RasterInfo info;
   int rows_per_strip = 64;
-  int tile_px = 0;                    // > 0: tiled
+  int tile_px = 0;  // > 0: tiled
   int next_row = 0;
   std::vector<std::uint8_t> pending;  // rows of the current strip or tile row
   std::vector<std::uint8_t> tile;     // one tile (tiled only)
@@ -124,7 +128,8 @@ struct TiffWriter::Impl {
   void WriteBlock(int y0, int rows, const std::uint8_t* src) {
     const size_t row_bytes = info.RowBytes();
     if (tile_px == 0) {
-      if (TIFFWriteEncodedStrip(tiff, y0 / rows_per_strip, const_cast<std::uint8_t*>(src), rows * row_bytes) < 0)
+      if (TIFFWriteEncodedStrip(
+              tiff, y0 / rows_per_strip, const_cast<std::uint8_t*>(src), rows * row_bytes) < 0)
         throw Error(path + ": cannot write the TIFF (disk full?)");
       return;
     }
@@ -135,13 +140,15 @@ struct TiffWriter::Impl {
       const size_t n = std::min(tile_px, info.width - x0) * pixel_bytes;
       for (int r = 0; r < rows; ++r)
         std::memcpy(tile.data() + r * tile_row_bytes, src + r * row_bytes + x0 * pixel_bytes, n);
-      if (TIFFWriteEncodedTile(tiff, TIFFComputeTile(tiff, x0, y0, 0, 0), tile.data(), tile.size()) < 0)
+      if (TIFFWriteEncodedTile(
+              tiff, TIFFComputeTile(tiff, x0, y0, 0, 0), tile.data(), tile.size()) < 0)
         throw Error(path + ": cannot write the TIFF (disk full?)");
     }
   }
 };
 
-TiffWriter::TiffWriter(const std::string& path, const RasterInfo& info,
+TiffWriter::TiffWriter(const std::string& path,
+                       const RasterInfo& info,
                        const TiffWriteOptions& options)
     : impl_(std::make_unique<Impl>()) {
   SilenceLibtiff();
@@ -157,8 +164,11 @@ TiffWriter::TiffWriter(const std::string& path, const RasterInfo& info,
   impl_->temp_path = path + ".part";
   // Classic TIFF offsets are 32-bit: beyond ~4 GiB (with room for the tags) BigTIFF is needed.
   // (Tiles pad the right and bottom edges.)
-  const auto padded = [&](int n) { return options.tile_px > 0 ? (n + options.tile_px - 1) / options.tile_px * options.tile_px : n; };
-  const double bytes = static_cast<double>(info.RowBytes()) / info.width * padded(info.width) * padded(info.height);
+  const auto padded = [&](int n) {
+    return options.tile_px > 0 ? (n + options.tile_px - 1) / options.tile_px * options.tile_px : n;
+  };
+  const double bytes =
+      static_cast<double>(info.RowBytes()) / info.width * padded(info.width) * padded(info.height);
   bigtiff_ = options.force_bigtiff || bytes > 3.9e9;
   impl_->tiff = TIFFOpen(impl_->temp_path.c_str(), bigtiff_ ? "w8" : "w");
   if (!impl_->tiff) throw Error(path + ": cannot create the TIFF");
@@ -174,7 +184,8 @@ TiffWriter::TiffWriter(const std::string& path, const RasterInfo& info,
   if (impl_->tile_px > 0) {
     TIFFSetField(t, TIFFTAG_TILEWIDTH, static_cast<uint32_t>(impl_->tile_px));
     TIFFSetField(t, TIFFTAG_TILELENGTH, static_cast<uint32_t>(impl_->tile_px));
-    impl_->tile.resize(static_cast<size_t>(impl_->tile_px) * impl_->tile_px * info.bands * info.BytesPerSample());
+    impl_->tile.resize(static_cast<size_t>(impl_->tile_px) * impl_->tile_px * info.bands *
+                       info.BytesPerSample());
   } else {
     TIFFSetField(t, TIFFTAG_ROWSPERSTRIP, static_cast<uint32_t>(impl_->rows_per_strip));
   }
@@ -189,7 +200,8 @@ TiffWriter::~TiffWriter() {
 }
 
 void TiffWriter::WriteRows(int y0, int rows, const void* data) {
-  AEROCAL_CHECK(y0 == impl_->next_row) << "rows must come in order: " << y0 << " after " << impl_->next_row;
+  AEROCAL_CHECK(y0 == impl_->next_row)
+      << "rows must come in order: " << y0 << " after " << impl_->next_row;
   const size_t row_bytes = impl_->info.RowBytes();
   const auto* src = static_cast<const std::uint8_t*>(data);
   impl_->pending.insert(impl_->pending.end(), src, src + rows * row_bytes);
@@ -257,9 +269,11 @@ MemoryRaster ReadImageFile(const std::string& path, bool gray) {
   if (image.depth() != CV_8U && image.depth() != CV_16U)
     throw InputError(path + ": expected 8- or 16-bit unsigned samples");
   if (image.channels() == 4) cv::cvtColor(image, image, cv::COLOR_BGRA2BGR);
-  if (image.channels() == 3) cv::cvtColor(image, image, gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2RGB);
+  if (image.channels() == 3)
+    cv::cvtColor(image, image, gray ? cv::COLOR_BGR2GRAY : cv::COLOR_BGR2RGB);
   if (image.channels() != 1 && image.channels() != 3)
-    throw InputError(path + ": expected 1 or 3 bands (got " + std::to_string(image.channels()) + ")");
+    throw InputError(path + ": expected 1 or 3 bands (got " + std::to_string(image.channels()) +
+                     ")");
   MemoryRaster raster({image.cols, image.rows, image.channels(), image.depth() == CV_8U ? 8 : 16});
   const size_t row_bytes = raster.Info().RowBytes();
   for (int r = 0; r < image.rows; ++r)

@@ -5,10 +5,10 @@
 // mapping model and parameters of every sub-image) and the Software tag.
 #pragma once
 
+#include "stitch/resample/raster.h"
+
 #include <memory>
 #include <string>
-
-#include "stitch/resample/raster.h"
 
 namespace aerocal::stitch {
 

@@ -1,5 +1,14 @@
 #include "stitch/resample/virtual_image.h"
 
+#include "calib/core/error.h"
+#include "stitch/resample/fast_strip.h"
+#include "stitch/resample/resample_window.h"
+
+#include <Eigen/LU>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+#include <tbb/task_arena.h>
+
 #include <algorithm>
 #include <atomic>
 #include <chrono>
@@ -8,15 +17,6 @@
 #include <cstdio>
 #include <cstring>
 #include <limits>
-
-#include <Eigen/LU>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
-#include <tbb/task_arena.h>
-
-#include "calib/core/error.h"
-#include "stitch/resample/fast_strip.h"
-#include "stitch/resample/resample_window.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -73,11 +73,13 @@ inline void AddSample(const Window& win, float u, float v, float* out) {
 
 // kAffine: the projective row of the map is (0, 0, 1), so w = 1 and no division is needed.
 template <typename T, int kBands, Interpolation kInterpolation, bool kAffine>
-void AccumulateRow(const Window& win, double V, int first, int last, float* sum,
-                   std::uint8_t* count) {
+void AccumulateRow(
+    const Window& win, double V, int first, int last, float* sum, std::uint8_t* count) {
   const Eigen::Matrix3d& m = win.sub_from_virtual;
-  double x = m(0, 0) * first + m(0, 1) * V + m(0, 2) - win.x0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
-  double y = m(1, 0) * first + m(1, 1) * V + m(1, 2) - win.y0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
+  double x =
+      m(0, 0) * first + m(0, 1) * V + m(0, 2) - win.x0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
+  double y =
+      m(1, 0) * first + m(1, 1) * V + m(1, 2) - win.y0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
   double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
   const double dx = m(0, 0) - win.x0 * m(2, 0), dy = m(1, 0) - win.y0 * m(2, 0), dw = m(2, 0);
   const float max_u = static_cast<float>(win.w - 1), max_v = static_cast<float>(win.h - 1);
@@ -111,8 +113,8 @@ void CorrectionAlongRow(const MapCorrectionGrid& g, double V, int first, int las
 
 // With a correction grid: (u, v) = projectivity + interpolated correction, coverage per pixel.
 template <typename T, int kBands, Interpolation kInterpolation>
-void AccumulateCorrectedRow(const Window& win, double V, int first, int last, float* sum,
-                            std::uint8_t* count) {
+void AccumulateCorrectedRow(
+    const Window& win, double V, int first, int last, float* sum, std::uint8_t* count) {
   thread_local std::vector<float> duv;
   duv.resize(2 * static_cast<size_t>(last - first + 1));
   CorrectionAlongRow(*win.correction, V, first, last, duv.data());
@@ -120,7 +122,8 @@ void AccumulateCorrectedRow(const Window& win, double V, int first, int last, fl
   double x = m(0, 0) * first + m(0, 1) * V + m(0, 2);
   double y = m(1, 0) * first + m(1, 1) * V + m(1, 2);
   double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
-  const float max_u = static_cast<float>(win.width_px - 1), max_v = static_cast<float>(win.height_px - 1);
+  const float max_u = static_cast<float>(win.width_px - 1),
+              max_v = static_cast<float>(win.height_px - 1);
   for (int c = first; c <= last; ++c, x += m(0, 0), y += m(1, 0), w += m(2, 0)) {
     const float su = static_cast<float>(x / w) + duv[2 * (c - first)];
     const float sv = static_cast<float>(y / w) + duv[2 * (c - first) + 1];
@@ -135,8 +138,13 @@ void AccumulateCorrectedRow(const Window& win, double V, int first, int last, fl
 }
 
 template <typename T, int kBands>
-void AccumulateRow(const Window& win, Interpolation interpolation, double V, int first, int last,
-                   float* sum, std::uint8_t* count) {
+void AccumulateRow(const Window& win,
+                   Interpolation interpolation,
+                   double V,
+                   int first,
+                   int last,
+                   float* sum,
+                   std::uint8_t* count) {
   if (win.correction) {
     if (interpolation == Interpolation::kBilinear)
       AccumulateCorrectedRow<T, kBands, Interpolation::kBilinear>(win, V, first, last, sum, count);
@@ -147,17 +155,26 @@ void AccumulateRow(const Window& win, Interpolation interpolation, double V, int
   const bool affine = win.sub_from_virtual(2, 0) == 0.0 && win.sub_from_virtual(2, 1) == 0.0 &&
                       win.sub_from_virtual(2, 2) == 1.0;
   if (interpolation == Interpolation::kBilinear) {
-    if (affine) AccumulateRow<T, kBands, Interpolation::kBilinear, true>(win, V, first, last, sum, count);
-    else AccumulateRow<T, kBands, Interpolation::kBilinear, false>(win, V, first, last, sum, count);
+    if (affine)
+      AccumulateRow<T, kBands, Interpolation::kBilinear, true>(win, V, first, last, sum, count);
+    else
+      AccumulateRow<T, kBands, Interpolation::kBilinear, false>(win, V, first, last, sum, count);
   } else {
-    if (affine) AccumulateRow<T, kBands, Interpolation::kBicubic, true>(win, V, first, last, sum, count);
-    else AccumulateRow<T, kBands, Interpolation::kBicubic, false>(win, V, first, last, sum, count);
+    if (affine)
+      AccumulateRow<T, kBands, Interpolation::kBicubic, true>(win, V, first, last, sum, count);
+    else
+      AccumulateRow<T, kBands, Interpolation::kBicubic, false>(win, V, first, last, sum, count);
   }
 }
 
 template <typename T, int kBands>
-void ResampleStrip(std::vector<Window>& windows, const ResampleOptions& options, int width,
-                   int y0, int rows, std::vector<std::uint8_t>* strip, std::atomic<long>* covered,
+void ResampleStrip(std::vector<Window>& windows,
+                   const ResampleOptions& options,
+                   int width,
+                   int y0,
+                   int rows,
+                   std::vector<std::uint8_t>* strip,
+                   std::atomic<long>* covered,
                    std::atomic<long>* overlap) {
   const float max_value = static_cast<float>(std::numeric_limits<T>::max());
   const float fill = std::clamp(static_cast<float>(options.fill), 0.0f, max_value);
@@ -177,8 +194,8 @@ void ResampleStrip(std::vector<Window>& windows, const ResampleOptions& options,
           first = 0;
           last = width - 1;
         }
-        AccumulateRow<T, kBands>(win, options.interpolation, V, first, last, sum.data(),
-                                 count.data());
+        AccumulateRow<T, kBands>(
+            win, options.interpolation, V, first, last, sum.data(), count.data());
       }
       T* out = reinterpret_cast<T*>(strip->data()) + static_cast<size_t>(r) * width * kBands;
       for (int c = 0; c < width; ++c) {
@@ -223,7 +240,8 @@ std::string MappingDescription(const calib::Camera& camera, const std::string& s
 }
 
 ResampleReport ResampleVirtualImage(const calib::Camera& camera,
-                                    const std::vector<RasterSource*>& sources, RasterSink* sink,
+                                    const std::vector<RasterSource*>& sources,
+                                    RasterSink* sink,
                                     const ResampleOptions& options,
                                     const std::vector<MapCorrectionGrid>& corrections) {
   const auto start = std::chrono::steady_clock::now();
@@ -269,10 +287,11 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   const int margin = options.interpolation == Interpolation::kBicubic ? 3 : 2;
   // The fast path (fast_strip.h): bilinear, one band, no correction grid.
-  const bool fast = !options.reference && options.interpolation == Interpolation::kBilinear &&
-                    first.bands == 1 &&
-                    std::none_of(windows.begin(), windows.end(), [](const Window& w) { return w.correction; });
-  const float fill = std::clamp(static_cast<float>(options.fill), 0.0f, first.bits == 8 ? 255.0f : 65535.0f);
+  const bool fast =
+      !options.reference && options.interpolation == Interpolation::kBilinear && first.bands == 1 &&
+      std::none_of(windows.begin(), windows.end(), [](const Window& w) { return w.correction; });
+  const float fill =
+      std::clamp(static_cast<float>(options.fill), 0.0f, first.bits == 8 ? 255.0f : 65535.0f);
   for (int y0 = 0; y0 < height; y0 += options.strip_rows) {
     const int rows = std::min(options.strip_rows, height - y0);
     // Window of each sub-image: bounding box of the strip's corners mapped into it, plus margin.
@@ -298,8 +317,10 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
           v0 = std::min(v0, p.y() / p.z());
           v1 = std::max(v1, p.y() / p.z());
         }
-      u0 = std::max(u0, -1e9), v0 = std::max(v0, -1e9), u1 = std::min(u1, 1e9), v1 = std::min(v1, 1e9);
-      const int extra = win.correction ? static_cast<int>(std::ceil(win.correction->max_abs_px)) + 1 : 0;
+      u0 = std::max(u0, -1e9), v0 = std::max(v0, -1e9), u1 = std::min(u1, 1e9),
+      v1 = std::min(v1, 1e9);
+      const int extra =
+          win.correction ? static_cast<int>(std::ceil(win.correction->max_abs_px)) + 1 : 0;
       const int x0 = std::max(0, static_cast<int>(std::floor(u0)) - margin - extra);
       const int x1 = std::min(win.width_px - 1, static_cast<int>(std::ceil(u1)) + margin + extra);
       const int wy0 = std::max(0, static_cast<int>(std::floor(v0)) - margin - extra);
@@ -315,7 +336,8 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
       const int sample_bytes = first.bands * first.BytesPerSample();
       if (fast && sources[k]->Samples() && wy1 + 2 < win.height_px) {
         // In place: the padding the fast path reads (the next row and its next sample) exists.
-        win.samples = sources[k]->Samples() + (static_cast<size_t>(wy0) * win.width_px + x0) * sample_bytes;
+        win.samples =
+            sources[k]->Samples() + (static_cast<size_t>(wy0) * win.width_px + x0) * sample_bytes;
         win.stride = win.width_px;
         return;
       }
@@ -325,22 +347,27 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
       win.stride = win.w;
     };
     // Sources are distinct objects: their windows are read in parallel.
-    arena.execute([&] {
-      tbb::parallel_for(size_t{0}, windows.size(), [&](size_t k) { prepare(k); });
-    });
+    arena.execute(
+        [&] { tbb::parallel_for(size_t{0}, windows.size(), [&](size_t k) { prepare(k); }); });
     arena.execute([&] {
       if (fast && first.bits == 8)
-        internal::ResampleStripFast<std::uint8_t>(windows, fill, width, y0, rows, strip.data(), &covered, &overlap);
+        internal::ResampleStripFast<std::uint8_t>(
+            windows, fill, width, y0, rows, strip.data(), &covered, &overlap);
       else if (fast)
-        internal::ResampleStripFast<std::uint16_t>(windows, fill, width, y0, rows, strip.data(), &covered, &overlap);
+        internal::ResampleStripFast<std::uint16_t>(
+            windows, fill, width, y0, rows, strip.data(), &covered, &overlap);
       else if (first.bits == 8 && first.bands == 1)
-        ResampleStrip<std::uint8_t, 1>(windows, options, width, y0, rows, &strip, &covered, &overlap);
+        ResampleStrip<std::uint8_t, 1>(
+            windows, options, width, y0, rows, &strip, &covered, &overlap);
       else if (first.bits == 8)
-        ResampleStrip<std::uint8_t, 3>(windows, options, width, y0, rows, &strip, &covered, &overlap);
+        ResampleStrip<std::uint8_t, 3>(
+            windows, options, width, y0, rows, &strip, &covered, &overlap);
       else if (first.bands == 1)
-        ResampleStrip<std::uint16_t, 1>(windows, options, width, y0, rows, &strip, &covered, &overlap);
+        ResampleStrip<std::uint16_t, 1>(
+            windows, options, width, y0, rows, &strip, &covered, &overlap);
       else
-        ResampleStrip<std::uint16_t, 3>(windows, options, width, y0, rows, &strip, &covered, &overlap);
+        ResampleStrip<std::uint16_t, 3>(
+            windows, options, width, y0, rows, &strip, &covered, &overlap);
     });
     sink->WriteRows(y0, rows, strip.data());
   }

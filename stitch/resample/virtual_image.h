@@ -28,11 +28,11 @@
 // the reference path's whatever the thread count.
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include "calib/camera/camera.h"
 #include "stitch/resample/raster.h"
+
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -40,16 +40,16 @@ enum class Interpolation { kBilinear, kBicubic };
 
 struct ResampleOptions {
   Interpolation interpolation = Interpolation::kBilinear;
-  double fill = 0.0;     // value of uncovered pixels, in the output's range
-  int strip_rows = 256;  // rows per strip, > 0 (memory ~ strip_rows x (virtual width + sources))
-  int threads = 0;       // 0: all cores
+  double fill = 0.0;       // value of uncovered pixels, in the output's range
+  int strip_rows = 256;    // rows per strip, > 0 (memory ~ strip_rows x (virtual width + sources))
+  int threads = 0;         // 0: all cores
   bool reference = false;  // true: the per-pixel reference path even where the fast one applies
 };
 
 struct ResampleReport {
-  long covered = 0;   // virtual pixels covered by at least one sub-image
-  long overlap = 0;   // covered by two or more
-  long filled = 0;    // covered by none
+  long covered = 0;  // virtual pixels covered by at least one sub-image
+  long overlap = 0;  // covered by two or more
+  long filled = 0;   // covered by none
   double seconds = 0;
 };
 
@@ -71,7 +71,8 @@ struct MapCorrectionGrid {
 /// Throws InputError naming the sub-image when a source's format, depth or bands do not match.
 /// `corrections`: empty, or one per sub-image (a grid with step 0 = none for that sub-image).
 ResampleReport ResampleVirtualImage(const calib::Camera& camera,
-                                    const std::vector<RasterSource*>& sources, RasterSink* sink,
+                                    const std::vector<RasterSource*>& sources,
+                                    RasterSink* sink,
                                     const ResampleOptions& options,
                                     const std::vector<MapCorrectionGrid>& corrections = {});
 

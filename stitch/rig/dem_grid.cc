@@ -1,5 +1,8 @@
 #include "stitch/rig/dem_grid.h"
 
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+
 #include <algorithm>
 #include <cctype>
 #include <cmath>
@@ -8,20 +11,18 @@
 #include <map>
 #include <sstream>
 
-#include "calib/core/csv.h"
-#include "calib/core/error.h"
-
 namespace aerocal::stitch {
 
 std::optional<double> DemGrid::HeightAt(double x_m, double y_m) const {
   const double gx = (x_m - x0_m) / cell_m, gy = (y_m - y0_m) / cell_m;
   if (!(gx >= 0 && gy >= 0 && gx <= cols - 1 && gy <= rows - 1)) return std::nullopt;
-  const int i = std::min(static_cast<int>(gx), cols - 2), j = std::min(static_cast<int>(gy), rows - 2);
+  const int i = std::min(static_cast<int>(gx), cols - 2),
+            j = std::min(static_cast<int>(gy), rows - 2);
   const double fx = gx - i, fy = gy - j;
   const double* south = height.data() + static_cast<size_t>(j) * cols + i;
   const double* north = south + cols;
-  const double h = (1 - fy) * ((1 - fx) * south[0] + fx * south[1]) +
-                   fy * ((1 - fx) * north[0] + fx * north[1]);
+  const double h =
+      (1 - fy) * ((1 - fx) * south[0] + fx * south[1]) + fy * ((1 - fx) * north[0] + fx * north[1]);
   if (!std::isfinite(h)) return std::nullopt;
   return h;
 }
@@ -69,9 +70,11 @@ DemGrid ReadDemAscii(const std::string& path) {
   const auto [cols, cols_line] = need("ncols", "");
   const auto [rows, rows_line] = need("nrows", "");
   if (!(cols >= 2 && cols <= 1e6 && cols == std::floor(cols)))
-    throw InputError(where(cols_line) + "ncols must be an integer 2..1e6 (got " + FormatNumber(cols) + ")");
+    throw InputError(where(cols_line) + "ncols must be an integer 2..1e6 (got " +
+                     FormatNumber(cols) + ")");
   if (!(rows >= 2 && rows <= 1e6 && rows == std::floor(rows)))
-    throw InputError(where(rows_line) + "nrows must be an integer 2..1e6 (got " + FormatNumber(rows) + ")");
+    throw InputError(where(rows_line) + "nrows must be an integer 2..1e6 (got " +
+                     FormatNumber(rows) + ")");
   dem.cols = static_cast<int>(cols);
   dem.rows = static_cast<int>(rows);
   const auto [cell, cell_line] = need("cellsize", "");
@@ -114,19 +117,24 @@ DemGrid ReadDemAscii(const std::string& path) {
       if (!(fields >> h))
         throw InputError(where(line_no) + "expected " + std::to_string(dem.cols) +
                          " heights, got " + std::to_string(c));
-      if (has_nodata && h == nodata) h = std::numeric_limits<double>::quiet_NaN();
-      else if (!(std::abs(h) <= 1e5)) throw InputError(where(line_no) + "height out of range (got " + FormatNumber(h) + ")");
-      else ++valid;
+      if (has_nodata && h == nodata)
+        h = std::numeric_limits<double>::quiet_NaN();
+      else if (!(std::abs(h) <= 1e5))
+        throw InputError(where(line_no) + "height out of range (got " + FormatNumber(h) + ")");
+      else
+        ++valid;
       dem.height[row_start + c] = h;
     }
     std::string rest;
-    if (fields >> rest) throw InputError(where(line_no) + "more than " + std::to_string(dem.cols) + " heights");
+    if (fields >> rest)
+      throw InputError(where(line_no) + "more than " + std::to_string(dem.cols) + " heights");
   }
   if (valid == 0) throw InputError(path + ": the DEM has no valid height");
   return dem;
 }
 
-std::optional<Eigen::Vector3d> IntersectDem(const DemGrid& dem, const Eigen::Vector3d& origin,
+std::optional<Eigen::Vector3d> IntersectDem(const DemGrid& dem,
+                                            const Eigen::Vector3d& origin,
                                             const Eigen::Vector3d& direction) {
   if (!(std::abs(direction.z()) > 1e-12)) return std::nullopt;
   double z = dem.MeanHeight();

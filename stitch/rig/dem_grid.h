@@ -6,11 +6,11 @@
 // Heights are sample values at cell centres, interpolated bilinearly between them.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace aerocal::stitch {
 
@@ -33,7 +33,8 @@ DemGrid ReadDemAscii(const std::string& path);
 /// Point where the ray origin + s direction (s > 0) meets the DEM, by fixed-point iteration on
 /// the height (converges for rays steeper than the terrain slopes, as near-nadir rays over
 /// terrain are) to 1e-6 m; nullopt when the ray leaves the grid or does not converge.
-std::optional<Eigen::Vector3d> IntersectDem(const DemGrid& dem, const Eigen::Vector3d& origin,
+std::optional<Eigen::Vector3d> IntersectDem(const DemGrid& dem,
+                                            const Eigen::Vector3d& origin,
                                             const Eigen::Vector3d& direction);
 
 }  // namespace aerocal::stitch

@@ -1,17 +1,17 @@
 #include "stitch/rig/error_analysis.h"
 
-#include <algorithm>
-#include <cmath>
-#include <random>
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/yaml_util.h"
+#include "stitch/rig/rig_conversion.h"
 
 #include <Eigen/Eigenvalues>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include "calib/core/csv.h"
-#include "calib/core/error.h"
-#include "calib/core/yaml_util.h"
-#include "stitch/rig/rig_conversion.h"
+#include <algorithm>
+#include <cmath>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -27,19 +27,21 @@ constexpr double kStepFraction = 1e-3;
 double Quantile(std::vector<double> values, double probability) {
   if (values.empty()) return 0.0;
   std::sort(values.begin(), values.end());
-  const auto rank = static_cast<size_t>(std::ceil(probability * static_cast<double>(values.size())));
+  const auto rank =
+      static_cast<size_t>(std::ceil(probability * static_cast<double>(values.size())));
   return values[std::min(values.size(), std::max<size_t>(rank, 1)) - 1];
 }
 
 // P(|e| <= r) for e ~ N(0, diag(l1, l2)), l1 >= l2 > 0: in polar coordinates
-// (1 / (2 pi sqrt(l1 l2))) * integral over theta of (1 - exp(-r^2 q / 2)) / q, q = cos^2/l1 + sin^2/l2
-// (trapezoid rule: the integrand is smooth and periodic, so it converges exponentially).
+// (1 / (2 pi sqrt(l1 l2))) * integral over theta of (1 - exp(-r^2 q / 2)) / q, q = cos^2/l1 +
+// sin^2/l2 (trapezoid rule: the integrand is smooth and periodic, so it converges exponentially).
 double RadialProbability(double l1, double l2, double r) {
   constexpr int kSteps = 2048;
   double sum = 0.0;
   for (int i = 0; i < kSteps; ++i) {
     const double theta = 2.0 * M_PI * i / kSteps;
-    const double q = std::cos(theta) * std::cos(theta) / l1 + std::sin(theta) * std::sin(theta) / l2;
+    const double q =
+        std::cos(theta) * std::cos(theta) / l1 + std::sin(theta) * std::sin(theta) / l2;
     sum += -std::expm1(-0.5 * r * r * q) / q;
   }
   return sum * (2.0 * M_PI / kSteps) / (2.0 * M_PI * std::sqrt(l1 * l2));
@@ -51,7 +53,7 @@ double RadialBound(const Eigen::Matrix2d& covariance) {
   const double l2 = std::max(eigen.eigenvalues()[0], 0.0);
   if (l1 == 0.0) return 0.0;
   if (l2 < 1e-14 * l1) return NormalBound99_75() * std::sqrt(l1);  // one-dimensional
-  double lo = 0.0, hi = 4.0 * std::sqrt(l1);  // chi^2_2 bound: 3.46 sqrt(l1)
+  double lo = 0.0, hi = 4.0 * std::sqrt(l1);                       // chi^2_2 bound: 3.46 sqrt(l1)
   for (int i = 0; i < 200 && hi - lo > 1e-13 * hi; ++i) {
     const double mid = 0.5 * (lo + hi);
     (RadialProbability(l1, l2, mid) < kProbability ? lo : hi) = mid;
@@ -111,9 +113,10 @@ ErrorLimits ParseErrorLimits(const YAML::Node& root, const std::string& file) {
   RejectUnknownKeys(root, {"limits", "sigmas"}, file);
   if (!root["limits"]) ThrowInputError({file, 1}, "missing limits");
   const YAML::Node& map = root["limits"];
-  RejectUnknownKeys(map, {"principal_point_px", "principal_distance_px", "angles_arcsec",
-                          "lever_arm_mm", "height_m"},
-                    file);
+  RejectUnknownKeys(
+      map,
+      {"principal_point_px", "principal_distance_px", "angles_arcsec", "lever_arm_mm", "height_m"},
+      file);
   ErrorLimits limits;
   limits.principal_point_px = ReadLimit(map, "principal_point_px", file);
   limits.principal_distance_px = ReadLimit(map, "principal_distance_px", file);
@@ -159,8 +162,10 @@ std::vector<ErrorSource> MakeErrorSources(const calib::Rig& rig, const ErrorLimi
   return sources;
 }
 
-ConversionErrorModel::ConversionErrorModel(const calib::Rig& rig, double height_m,
-                                           std::vector<ErrorSource> sources, int head,
+ConversionErrorModel::ConversionErrorModel(const calib::Rig& rig,
+                                           double height_m,
+                                           std::vector<ErrorSource> sources,
+                                           int head,
                                            const Eigen::Vector2d& virtual_px)
     : rig_(rig),
       height_m_(height_m),
@@ -199,16 +204,36 @@ std::optional<Eigen::Vector2d> ConversionErrorModel::Error(const Eigen::VectorXd
     if (d == 0.0) continue;
     using Model = calib::BrownFraser10Model;
     switch (s.kind) {
-      case ErrorSourceKind::kX0: rig.heads[s.head].camera.interior[Model::kX0] += d; break;
-      case ErrorSourceKind::kY0: rig.heads[s.head].camera.interior[Model::kY0] += d; break;
-      case ErrorSourceKind::kC: rig.heads[s.head].camera.interior[Model::kC] += d; break;
-      case ErrorSourceKind::kOmega: rig.heads[s.head].mount_rad[0] += d; break;
-      case ErrorSourceKind::kPhi: rig.heads[s.head].mount_rad[1] += d; break;
-      case ErrorSourceKind::kKappa: rig.heads[s.head].mount_rad[2] += d; break;
-      case ErrorSourceKind::kTx: rig.heads[s.head].lever_arm_m[0] += d; break;
-      case ErrorSourceKind::kTy: rig.heads[s.head].lever_arm_m[1] += d; break;
-      case ErrorSourceKind::kTz: rig.heads[s.head].lever_arm_m[2] += d; break;
-      case ErrorSourceKind::kHeight: height += d; break;
+      case ErrorSourceKind::kX0:
+        rig.heads[s.head].camera.interior[Model::kX0] += d;
+        break;
+      case ErrorSourceKind::kY0:
+        rig.heads[s.head].camera.interior[Model::kY0] += d;
+        break;
+      case ErrorSourceKind::kC:
+        rig.heads[s.head].camera.interior[Model::kC] += d;
+        break;
+      case ErrorSourceKind::kOmega:
+        rig.heads[s.head].mount_rad[0] += d;
+        break;
+      case ErrorSourceKind::kPhi:
+        rig.heads[s.head].mount_rad[1] += d;
+        break;
+      case ErrorSourceKind::kKappa:
+        rig.heads[s.head].mount_rad[2] += d;
+        break;
+      case ErrorSourceKind::kTx:
+        rig.heads[s.head].lever_arm_m[0] += d;
+        break;
+      case ErrorSourceKind::kTy:
+        rig.heads[s.head].lever_arm_m[1] += d;
+        break;
+      case ErrorSourceKind::kTz:
+        rig.heads[s.head].lever_arm_m[2] += d;
+        break;
+      case ErrorSourceKind::kHeight:
+        height += d;
+        break;
     }
   }
   if (!(height > 0)) return std::nullopt;
@@ -239,7 +264,8 @@ std::vector<SourceErrorRow> MaximumErrors(const ConversionErrorModel& model) {
   return rows;
 }
 
-std::vector<WorstCase> WorstCases(const ConversionErrorModel& model, const calib::Rig& rig,
+std::vector<WorstCase> WorstCases(const ConversionErrorModel& model,
+                                  const calib::Rig& rig,
                                   const std::vector<SourceErrorRow>& rows) {
   const auto& sources = model.sources();
   const int m = static_cast<int>(sources.size());
@@ -338,8 +364,7 @@ LinearPropagation PropagateLinearly(const ConversionErrorModel& model, double si
   result.bound_px = NormalBound99_75() * result.sigma_px;
   result.bound_radial_px = RadialBound(result.covariance);
   for (int i = 0; i < m; ++i) {
-    const Eigen::Vector2d part =
-        (result.sigma[i] * result.jacobian[i]).cwiseAbs2();
+    const Eigen::Vector2d part = (result.sigma[i] * result.jacobian[i]).cwiseAbs2();
     const auto share = [](double part_axis, double total) -> std::optional<double> {
       if (!(total > 0)) return std::nullopt;
       return part_axis / total;
@@ -350,8 +375,11 @@ LinearPropagation PropagateLinearly(const ConversionErrorModel& model, double si
   return result;
 }
 
-MonteCarloResult RunMonteCarlo(const ConversionErrorModel& model, double sigmas, int samples,
-                               std::uint64_t seed, bool keep_errors) {
+MonteCarloResult RunMonteCarlo(const ConversionErrorModel& model,
+                               double sigmas,
+                               int samples,
+                               std::uint64_t seed,
+                               bool keep_errors) {
   AEROCAL_CHECK(samples >= 1) << "samples " << samples;
   const int m = static_cast<int>(model.sources().size());
   // Deviations drawn in one sequence (sample-major), so the result does not depend on threads.
@@ -361,15 +389,16 @@ MonteCarloResult RunMonteCarlo(const ConversionErrorModel& model, double sigmas,
     for (int i = 0; i < m; ++i) deltas(i, s) = model.sources()[i].limit / sigmas * normal.Next();
   std::vector<Eigen::Vector2d> errors(samples);
   std::vector<char> ok(samples, 0);
-  tbb::parallel_for(tbb::blocked_range<int>(0, samples, 256), [&](const tbb::blocked_range<int>& r) {
-    for (int s = r.begin(); s < r.end(); ++s) {
-      const auto e = model.Error(deltas.col(s));
-      if (e) {
-        errors[s] = *e;
-        ok[s] = 1;
-      }
-    }
-  });
+  tbb::parallel_for(tbb::blocked_range<int>(0, samples, 256),
+                    [&](const tbb::blocked_range<int>& r) {
+                      for (int s = r.begin(); s < r.end(); ++s) {
+                        const auto e = model.Error(deltas.col(s));
+                        if (e) {
+                          errors[s] = *e;
+                          ok[s] = 1;
+                        }
+                      }
+                    });
   MonteCarloResult result;
   result.n = samples;
   result.seed = seed;
@@ -393,16 +422,22 @@ MonteCarloResult RunMonteCarlo(const ConversionErrorModel& model, double sigmas,
     result.max_abs_px = result.max_abs_px.cwiseMax(good[s].cwiseAbs());
     result.max_radial_px = std::max(result.max_radial_px, radial[s]);
   }
-  result.sigma_px = n > 1 ? Eigen::Vector2d((squares / (n - 1)).cwiseSqrt()) : Eigen::Vector2d::Zero();
+  result.sigma_px =
+      n > 1 ? Eigen::Vector2d((squares / (n - 1)).cwiseSqrt()) : Eigen::Vector2d::Zero();
   result.bound_px = {Quantile(abs_x, kProbability), Quantile(abs_y, kProbability)};
   result.bound_radial_px = Quantile(radial, kProbability);
   if (keep_errors) result.errors = std::move(good);
   return result;
 }
 
-TargetAnalysis AnalyseTarget(const calib::Rig& rig, double height_m, const ErrorLimits& limits,
-                             int head, const Eigen::Vector2d& virtual_px, int samples,
-                             std::uint64_t seed, bool keep_errors) {
+TargetAnalysis AnalyseTarget(const calib::Rig& rig,
+                             double height_m,
+                             const ErrorLimits& limits,
+                             int head,
+                             const Eigen::Vector2d& virtual_px,
+                             int samples,
+                             std::uint64_t seed,
+                             bool keep_errors) {
   const ConversionErrorModel model(rig, height_m, MakeErrorSources(rig, limits), head, virtual_px);
   TargetAnalysis analysis;
   analysis.head = head;

@@ -31,15 +31,15 @@
 //   Muller): sigma, mean, 99.75 % bound of |ex|, |ey| and the radial error, the largest errors.
 #pragma once
 
-#include <cstdint>
-#include <optional>
-#include <string>
-#include <vector>
+#include "calib/camera/rig.h"
 
 #include <Eigen/Core>
 #include <yaml-cpp/yaml.h>
 
-#include "calib/camera/rig.h"
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -60,11 +60,11 @@ ErrorLimits ParseErrorLimits(const YAML::Node& root, const std::string& file);
 enum class ErrorSourceKind { kX0, kY0, kC, kOmega, kPhi, kKappa, kTx, kTy, kTz, kHeight };
 
 struct ErrorSource {
-  std::string name;      // "x0:A", ..., "height"
+  std::string name;  // "x0:A", ..., "height"
   ErrorSourceKind kind;
-  int head = -1;         // -1 for the height
-  double limit = 0.0;    // in memory units: mm (x0, y0, c), rad (angles), m (lever arm, height)
-  std::string unit;      // of `limit`
+  int head = -1;       // -1 for the height
+  double limit = 0.0;  // in memory units: mm (x0, y0, c), rad (angles), m (lever arm, height)
+  std::string unit;    // of `limit`
 };
 
 /// The sources of a rig (order in the header comment) with the limits converted to memory units.
@@ -76,8 +76,11 @@ class ConversionErrorModel {
   /// `head`: the head in which the error is measured; `virtual_px`: the fixed virtual pixel;
   /// `height_m`: nominal relative flying height (> 0). Throws InputError when the nominal rig
   /// cannot carry the virtual pixel into the reference head or head k.
-  ConversionErrorModel(const calib::Rig& rig, double height_m, std::vector<ErrorSource> sources,
-                       int head, const Eigen::Vector2d& virtual_px);
+  ConversionErrorModel(const calib::Rig& rig,
+                       double height_m,
+                       std::vector<ErrorSource> sources,
+                       int head,
+                       const Eigen::Vector2d& virtual_px);
 
   /// e = (ex, ey) in head-k pixels for deviations `delta` (one per source, memory units);
   /// nullopt when the deviated conversion fails (ray parallel to the plane, point behind a head).
@@ -105,23 +108,23 @@ struct SourceErrorRow {
 };
 
 struct WorstCase {
-  std::string group;                  // "interior:A", "angles:B", "lever_arm:B",
-                                      // "relative_orientation:B", "height", "all"
+  std::string group;  // "interior:A", "angles:B", "lever_arm:B",
+                      // "relative_orientation:B", "height", "all"
   std::vector<std::string> sources;
-  bool exhaustive = true;             // all 2^m sign corners evaluated (m <= 16)
+  bool exhaustive = true;                                // all 2^m sign corners evaluated (m <= 16)
   Eigen::Vector2d max_abs_px = Eigen::Vector2d::Zero();  // largest |ex|, |ey| over the corners
-  double max_radial_px = 0.0;         // largest |e| over the corners
-  std::vector<int> signs;             // the corner of max_radial_px (+1 / -1 per source)
+  double max_radial_px = 0.0;                            // largest |e| over the corners
+  std::vector<int> signs;  // the corner of max_radial_px (+1 / -1 per source)
   Eigen::Vector2d sum_abs_px = Eigen::Vector2d::Zero();  // sum over sources of max(|plus|, |minus|)
 };
 
 struct LinearPropagation {
   Eigen::Matrix2d covariance = Eigen::Matrix2d::Zero();  // px^2
   Eigen::Vector2d sigma_px = Eigen::Vector2d::Zero();
-  Eigen::Vector2d bound_px = Eigen::Vector2d::Zero();    // z sigma, z for 99.75 % two-sided
-  double bound_radial_px = 0.0;                          // 99.75 % of |e| under the 2D normal
-  std::vector<Eigen::Vector2d> jacobian;                 // de/dsource, px per memory unit
-  std::vector<double> sigma;                             // sigma of each source, memory units
+  Eigen::Vector2d bound_px = Eigen::Vector2d::Zero();  // z sigma, z for 99.75 % two-sided
+  double bound_radial_px = 0.0;                        // 99.75 % of |e| under the 2D normal
+  std::vector<Eigen::Vector2d> jacobian;               // de/dsource, px per memory unit
+  std::vector<double> sigma;                           // sigma of each source, memory units
   /// Share of each source in each axis' variance (sums to 1 per axis); nullopt for an axis whose
   /// variance is zero (an unknown share is null, never 0).
   std::vector<std::optional<double>> share_x, share_y;
@@ -130,14 +133,14 @@ struct LinearPropagation {
 struct MonteCarloResult {
   int n = 0;
   std::uint64_t seed = 0;
-  int failed = 0;                                        // samples whose conversion failed
-  Eigen::Vector2d sigma_px = Eigen::Vector2d::Zero();    // sample standard deviation (n - 1)
+  int failed = 0;                                      // samples whose conversion failed
+  Eigen::Vector2d sigma_px = Eigen::Vector2d::Zero();  // sample standard deviation (n - 1)
   Eigen::Vector2d mean_px = Eigen::Vector2d::Zero();
-  Eigen::Vector2d bound_px = Eigen::Vector2d::Zero();    // 99.75 % quantile of |ex|, |ey|
-  double bound_radial_px = 0.0;                          // 99.75 % quantile of |e|
+  Eigen::Vector2d bound_px = Eigen::Vector2d::Zero();  // 99.75 % quantile of |ex|, |ey|
+  double bound_radial_px = 0.0;                        // 99.75 % quantile of |e|
   Eigen::Vector2d max_abs_px = Eigen::Vector2d::Zero();
   double max_radial_px = 0.0;
-  std::vector<Eigen::Vector2d> errors;                   // every sample's e (for histograms)
+  std::vector<Eigen::Vector2d> errors;  // every sample's e (for histograms)
 };
 
 struct TargetAnalysis {
@@ -153,17 +156,26 @@ struct TargetAnalysis {
 double NormalBound99_75();
 
 std::vector<SourceErrorRow> MaximumErrors(const ConversionErrorModel& model);
-std::vector<WorstCase> WorstCases(const ConversionErrorModel& model, const calib::Rig& rig,
+std::vector<WorstCase> WorstCases(const ConversionErrorModel& model,
+                                  const calib::Rig& rig,
                                   const std::vector<SourceErrorRow>& rows);
 LinearPropagation PropagateLinearly(const ConversionErrorModel& model, double sigmas);
 /// `samples` >= 1; `keep_errors`: keep every sample's error (histograms).
-MonteCarloResult RunMonteCarlo(const ConversionErrorModel& model, double sigmas, int samples,
-                               std::uint64_t seed, bool keep_errors);
+MonteCarloResult RunMonteCarlo(const ConversionErrorModel& model,
+                               double sigmas,
+                               int samples,
+                               std::uint64_t seed,
+                               bool keep_errors);
 
 /// All methods at one target (Monte-Carlo skipped when samples == 0).
-TargetAnalysis AnalyseTarget(const calib::Rig& rig, double height_m, const ErrorLimits& limits,
-                             int head, const Eigen::Vector2d& virtual_px, int samples,
-                             std::uint64_t seed, bool keep_errors);
+TargetAnalysis AnalyseTarget(const calib::Rig& rig,
+                             double height_m,
+                             const ErrorLimits& limits,
+                             int head,
+                             const Eigen::Vector2d& virtual_px,
+                             int samples,
+                             std::uint64_t seed,
+                             bool keep_errors);
 
 /// Histogram of `values` in `bins` equal bins over [lo, hi] (values outside are clamped into the
 /// end bins); counts.

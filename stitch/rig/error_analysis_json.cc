@@ -1,9 +1,9 @@
 #include "stitch/rig/error_analysis_json.h"
 
-#include <cstdio>
-
 #include "calib/core/error.h"
 #include "stitch/rig/rig_conversion.h"
+
+#include <cstdio>
 
 namespace aerocal::stitch {
 namespace {
@@ -16,15 +16,20 @@ json Pair(const Eigen::Vector2d& v) { return json::array({v.x(), v.y()}); }
 std::pair<double, std::string> FileLimit(const ErrorSource& s, const ErrorLimits& limits) {
   switch (s.kind) {
     case ErrorSourceKind::kX0:
-    case ErrorSourceKind::kY0: return {limits.principal_point_px, "px"};
-    case ErrorSourceKind::kC: return {limits.principal_distance_px, "px"};
+    case ErrorSourceKind::kY0:
+      return {limits.principal_point_px, "px"};
+    case ErrorSourceKind::kC:
+      return {limits.principal_distance_px, "px"};
     case ErrorSourceKind::kOmega:
     case ErrorSourceKind::kPhi:
-    case ErrorSourceKind::kKappa: return {limits.angles_arcsec, "arcsec"};
+    case ErrorSourceKind::kKappa:
+      return {limits.angles_arcsec, "arcsec"};
     case ErrorSourceKind::kTx:
     case ErrorSourceKind::kTy:
-    case ErrorSourceKind::kTz: return {limits.lever_arm_mm, "mm"};
-    case ErrorSourceKind::kHeight: return {limits.height_m, "m"};
+    case ErrorSourceKind::kTz:
+      return {limits.lever_arm_mm, "mm"};
+    case ErrorSourceKind::kHeight:
+      return {limits.height_m, "m"};
   }
   return {0.0, ""};
 }
@@ -74,8 +79,12 @@ json MonteCarloJson(const MonteCarloResult& mc, const ErrorAnalysisFiles& files)
   return out;
 }
 
-void AppendHistogram(const std::string& quantity, const std::vector<double>& values, double lo,
-                     double hi, int bins, std::string* out) {
+void AppendHistogram(const std::string& quantity,
+                     const std::vector<double>& values,
+                     double lo,
+                     double hi,
+                     int bins,
+                     std::string* out) {
   const std::vector<long> counts = Histogram(values, lo, hi, bins);
   for (int b = 0; b < bins; ++b)
     *out += quantity + "," + Number(lo + (hi - lo) * b / bins) + "," +
@@ -84,8 +93,12 @@ void AppendHistogram(const std::string& quantity, const std::vector<double>& val
 
 }  // namespace
 
-GridAnalysis AnalyseGrid(const calib::Rig& rig, double height_m, const ErrorLimits& limits, int n,
-                         int samples, std::uint64_t seed) {
+GridAnalysis AnalyseGrid(const calib::Rig& rig,
+                         double height_m,
+                         const ErrorLimits& limits,
+                         int n,
+                         int samples,
+                         std::uint64_t seed) {
   AEROCAL_CHECK(n >= 1) << "grid " << n;
   GridAnalysis grid;
   grid.n = n;
@@ -118,8 +131,12 @@ GridAnalysis AnalyseGrid(const calib::Rig& rig, double height_m, const ErrorLimi
   return grid;
 }
 
-json ErrorAnalysisToJson(const calib::Rig& rig, double height_m, const ErrorLimits& limits,
-                         const TargetAnalysis& target, const GridAnalysis* grid, double relief_m,
+json ErrorAnalysisToJson(const calib::Rig& rig,
+                         double height_m,
+                         const ErrorLimits& limits,
+                         const TargetAnalysis& target,
+                         const GridAnalysis* grid,
+                         double relief_m,
                          const ErrorAnalysisFiles& files) {
   const std::vector<ErrorSource> sources = MakeErrorSources(rig, limits);
   json doc;
@@ -170,9 +187,9 @@ json ErrorAnalysisToJson(const calib::Rig& rig, double height_m, const ErrorLimi
     if (k == reference) continue;
     relief["pairs"].push_back(
         {{"heads", json::array({rig.reference_head, rig.heads[k].id})},
-         {"displacement_px", relief_m < height_m
-                                 ? json(ReliefDisplacementPx(rig, reference, k, height_m, relief_m))
-                                 : json(nullptr)}});
+         {"displacement_px",
+          relief_m < height_m ? json(ReliefDisplacementPx(rig, reference, k, height_m, relief_m))
+                              : json(nullptr)}});
   }
   doc["relief"] = relief;
   if (grid) {
@@ -185,17 +202,19 @@ json ErrorAnalysisToJson(const calib::Rig& rig, double height_m, const ErrorLimi
                          {"bound_radial_px", t.linear.bound_radial_px}};
       point["max_error"] = {{"max_radial_px", all.max_radial_px},
                             {"max_abs_px", Pair(all.max_abs_px)}};
-      point["monte_carlo"] =
-          t.monte_carlo ? json{{"sigma_px", Pair(t.monte_carlo->sigma_px)},
-                               {"bound_px", Pair(t.monte_carlo->bound_px)},
-                               {"bound_radial_px", t.monte_carlo->bound_radial_px},
-                               {"max_abs_px", Pair(t.monte_carlo->max_abs_px)}}
-                        : json(nullptr);
+      point["monte_carlo"] = t.monte_carlo
+                                 ? json{{"sigma_px", Pair(t.monte_carlo->sigma_px)},
+                                        {"bound_px", Pair(t.monte_carlo->bound_px)},
+                                        {"bound_radial_px", t.monte_carlo->bound_radial_px},
+                                        {"max_abs_px", Pair(t.monte_carlo->max_abs_px)}}
+                                 : json(nullptr);
       points.push_back(point);
     }
     json unseen = json::array();
     for (const auto& p : grid->unseen) unseen.push_back(Pair(p));
-    doc["grid"] = {{"n", grid->n}, {"points", points}, {"unseen_virtual_px", unseen},
+    doc["grid"] = {{"n", grid->n},
+                   {"points", points},
+                   {"unseen_virtual_px", unseen},
                    {"worst_index", grid->worst}};
     if (!files.bound_map_csv.empty()) doc["grid"]["bound_map_csv"] = files.bound_map_csv;
     if (!files.bound_map_png.empty()) doc["grid"]["bound_map_png"] = files.bound_map_png;

@@ -5,13 +5,13 @@
 // fixes them, plus target, sources, worst_case, relief and (with a grid) grid.
 #pragma once
 
-#include <string>
-#include <vector>
+#include "calib/camera/rig.h"
+#include "stitch/rig/error_analysis.h"
 
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/rig.h"
-#include "stitch/rig/error_analysis.h"
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -25,8 +25,12 @@ struct GridAnalysis {
   /// Index in `points` of the largest linear radial bound (-1 when empty).
   int worst = -1;
 };
-GridAnalysis AnalyseGrid(const calib::Rig& rig, double height_m, const ErrorLimits& limits, int n,
-                         int samples, std::uint64_t seed);
+GridAnalysis AnalyseGrid(const calib::Rig& rig,
+                         double height_m,
+                         const ErrorLimits& limits,
+                         int n,
+                         int samples,
+                         std::uint64_t seed);
 
 struct ErrorAnalysisFiles {
   std::string histogram_csv, histogram_png;  // names beside the result (empty: none)
@@ -34,9 +38,12 @@ struct ErrorAnalysisFiles {
 };
 
 /// The result document for one analysed target (or a grid's worst point plus the grid).
-nlohmann::json ErrorAnalysisToJson(const calib::Rig& rig, double height_m,
-                                   const ErrorLimits& limits, const TargetAnalysis& target,
-                                   const GridAnalysis* grid, double relief_m,
+nlohmann::json ErrorAnalysisToJson(const calib::Rig& rig,
+                                   double height_m,
+                                   const ErrorLimits& limits,
+                                   const TargetAnalysis& target,
+                                   const GridAnalysis* grid,
+                                   double relief_m,
                                    const ErrorAnalysisFiles& files);
 
 /// `quantity,bin_low_px,bin_high_px,count` rows for ex, ey (bins over [-max, max]) and the radial

@@ -1,9 +1,9 @@
 #include "stitch/rig/rig_conversion.h"
 
-#include <cmath>
-
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
+
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
@@ -38,11 +38,13 @@ RectificationPlane MakeRectificationPlane(const calib::Rig& rig,
   return plane;
 }
 
-RigConverter::RigConverter(const calib::Rig& rig, const RigExposure& exposure,
+RigConverter::RigConverter(const calib::Rig& rig,
+                           const RigExposure& exposure,
                            const RectificationPlane& plane)
     : rig_(rig), plane_(plane) {
   const int n = static_cast<int>(rig.heads.size());
-  AEROCAL_CHECK(exposure.increment_rad.empty() || static_cast<int>(exposure.increment_rad.size()) == n)
+  AEROCAL_CHECK(exposure.increment_rad.empty() ||
+                static_cast<int>(exposure.increment_rad.size()) == n)
       << "one increment per head";
   AEROCAL_CHECK(exposure.dt_s.empty() || static_cast<int>(exposure.dt_s.size()) == n)
       << "one time offset per head";
@@ -53,9 +55,15 @@ RigConverter::RigConverter(const calib::Rig& rig, const RigExposure& exposure,
     const double dt = exposure.dt_s.empty() ? 0.0 : exposure.dt_s[k];
     double rotation[9];
     Eigen::Vector3d center;
-    calib::HeadPose(exposure.rig_opk_rad.data(), exposure.rig_center_m.data(),
-                    head.mount_rad.data(), head.lever_arm_m.data(), increment.data(), &dt,
-                    exposure.velocity_mps.data(), rotation, center.data());
+    calib::HeadPose(exposure.rig_opk_rad.data(),
+                    exposure.rig_center_m.data(),
+                    head.mount_rad.data(),
+                    head.lever_arm_m.data(),
+                    increment.data(),
+                    &dt,
+                    exposure.velocity_mps.data(),
+                    rotation,
+                    center.data());
     object_from_head_.push_back(FromRowMajor(rotation));
     head_center_.push_back(center);
   }
@@ -87,12 +95,12 @@ std::optional<Eigen::Vector3d> RigConverter::PlanePointOfHeadPixel(
 
 std::optional<Eigen::Vector3d> RigConverter::PlanePointOfVirtualPixel(
     const Eigen::Vector2d& pixel) const {
-  return IntersectPlane(plane_, virtual_center_,
-                        object_from_virtual_ * rig_.virtual_camera.RayFromPixel(pixel));
+  return IntersectPlane(
+      plane_, virtual_center_, object_from_virtual_ * rig_.virtual_camera.RayFromPixel(pixel));
 }
 
-std::optional<Eigen::Vector2d> RigConverter::HeadPixelOfPoint(int head,
-                                                              const Eigen::Vector3d& point_m) const {
+std::optional<Eigen::Vector2d> RigConverter::HeadPixelOfPoint(
+    int head, const Eigen::Vector3d& point_m) const {
   // Camera::ProjectToPixel with the head's pose: collinearity, then the correction inverted.
   const Eigen::Vector3d opk = calib::OpkFromRotation(object_from_head_[head]);
   Eigen::Vector2d pixel;
@@ -101,10 +109,11 @@ std::optional<Eigen::Vector2d> RigConverter::HeadPixelOfPoint(int head,
   return pixel;
 }
 
-std::optional<Eigen::Vector2d> RigConverter::VirtualPixelOfPoint(const Eigen::Vector3d& point_m) const {
+std::optional<Eigen::Vector2d> RigConverter::VirtualPixelOfPoint(
+    const Eigen::Vector3d& point_m) const {
   Eigen::Vector2d pixel;
-  if (!rig_.virtual_camera.PixelFromRay(object_from_virtual_.transpose() * (point_m - virtual_center_),
-                                        &pixel))
+  if (!rig_.virtual_camera.PixelFromRay(
+          object_from_virtual_.transpose() * (point_m - virtual_center_), &pixel))
     return std::nullopt;
   return pixel;
 }
@@ -129,8 +138,8 @@ bool RigConverter::InHeadFormat(int head, const Eigen::Vector2d& pixel) const {
          pixel.y() <= camera.height_px - 1;
 }
 
-double ReliefDisplacementPx(const calib::Rig& rig, int head_j, int head_k, double height_m,
-                            double dh_m) {
+double ReliefDisplacementPx(
+    const calib::Rig& rig, int head_j, int head_k, double height_m, double dh_m) {
   const double baseline_m = (rig.heads[head_j].lever_arm_m - rig.heads[head_k].lever_arm_m).norm();
   const calib::VirtualCamera& v = rig.virtual_camera;
   return v.c_mm / v.pixel_size_mm * baseline_m * dh_m / (height_m * (height_m - dh_m));

@@ -18,12 +18,12 @@
 // Units: pixels per CONVENTIONS.md pixel frame of each image; metres in the object frame.
 #pragma once
 
-#include <optional>
-#include <vector>
+#include "calib/camera/rig.h"
 
 #include <Eigen/Core>
 
-#include "calib/camera/rig.h"
+#include <optional>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -56,7 +56,8 @@ class RigConverter {
 
   /// Point G of the plane seen at a head's measured pixel; nullopt when the ray misses the plane
   /// (parallel or behind the head).
-  std::optional<Eigen::Vector3d> PlanePointOfHeadPixel(int head, const Eigen::Vector2d& pixel) const;
+  std::optional<Eigen::Vector3d> PlanePointOfHeadPixel(int head,
+                                                       const Eigen::Vector2d& pixel) const;
   /// Point G of the plane seen at a virtual pixel; nullopt when the ray misses the plane.
   std::optional<Eigen::Vector3d> PlanePointOfVirtualPixel(const Eigen::Vector2d& pixel) const;
   /// Measured pixel of an object point in head k; nullopt when it is behind the head or the
@@ -93,7 +94,7 @@ class RigConverter {
 /// The CONVENTIONS.md estimate of the displacement (virtual px) between heads j and k of a point
 /// `dh_m` above the rectification plane at relative flying height `height_m`:
 /// (c_v / p) |t_j - t_k| dh / (H (H - dh)).
-double ReliefDisplacementPx(const calib::Rig& rig, int head_j, int head_k, double height_m,
-                            double dh_m);
+double ReliefDisplacementPx(
+    const calib::Rig& rig, int head_j, int head_k, double height_m, double dh_m);
 
 }  // namespace aerocal::stitch

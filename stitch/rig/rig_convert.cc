@@ -1,15 +1,15 @@
 #include "stitch/rig/rig_convert.h"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
-#include <optional>
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
 
-#include "calib/core/csv.h"
-#include "calib/core/error.h"
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <optional>
 
 namespace aerocal::stitch {
 
@@ -32,8 +32,8 @@ Eigen::Matrix3d HeadFromVirtualHomography(const RigConverter& converter, int hea
       ((converter.VirtualCenter() - converter.HeadCenter(head)) * n.transpose() +
        h * Eigen::Matrix3d::Identity()) *
       converter.ObjectFromVirtual() * virtual_ray;
-  // Head space u -> measured pixel: x = -c u_x / u_z + x0 -> (c u_x - x0 u_z, c u_y - y0 u_z, -u_z),
-  // then col = x / p + (W - 1) / 2, row = -y / p + (H - 1) / 2.
+  // Head space u -> measured pixel: x = -c u_x / u_z + x0 -> (c u_x - x0 u_z, c u_y - y0 u_z,
+  // -u_z), then col = x / p + (W - 1) / 2, row = -y / p + (H - 1) / 2.
   const double c = camera.c_mm(), p = camera.pixel_size_mm;
   Eigen::Matrix3d photo;
   photo << c, 0, -camera.interior[Model::kX0],  //
@@ -80,12 +80,15 @@ bool HasDistortion(const calib::Camera& camera) {
 }
 
 // The exact head pixel of a virtual pixel: over the plane, or over the DEM when given.
-std::optional<Eigen::Vector2d> ExactHeadPixel(const RigConverter& converter, const DemGrid* dem,
-                                              int head, const Eigen::Vector2d& virtual_px) {
+std::optional<Eigen::Vector2d> ExactHeadPixel(const RigConverter& converter,
+                                              const DemGrid* dem,
+                                              int head,
+                                              const Eigen::Vector2d& virtual_px) {
   if (!dem) return converter.HeadFromVirtual(head, virtual_px);
-  const auto g = IntersectDem(*dem, converter.VirtualCenter(),
-                              converter.ObjectFromVirtual() *
-                                  converter.rig().virtual_camera.RayFromPixel(virtual_px));
+  const auto g = IntersectDem(
+      *dem,
+      converter.VirtualCenter(),
+      converter.ObjectFromVirtual() * converter.rig().virtual_camera.RayFromPixel(virtual_px));
   if (!g) return converter.HeadFromVirtual(head, virtual_px);
   return converter.HeadPixelOfPoint(head, *g);
 }
@@ -98,8 +101,10 @@ std::optional<Eigen::Vector2d> ExactHeadPixel(const RigConverter& converter, con
 // diverges and changes sign, so a grid node there holds values that are no correction at all,
 // and bilinear interpolation between such a node and its neighbour can land a virtual pixel far
 // outside the head inside its format (a spurious overlap zone).
-std::optional<Eigen::Vector2d> MapDifference(const RigConverter& converter, const DemGrid* dem,
-                                             int head, const Eigen::Matrix3d& h,
+std::optional<Eigen::Vector2d> MapDifference(const RigConverter& converter,
+                                             const DemGrid* dem,
+                                             int head,
+                                             const Eigen::Matrix3d& h,
                                              const Eigen::Vector2d& virtual_px) {
   const auto exact = ExactHeadPixel(converter, dem, head, virtual_px);
   if (!exact) return std::nullopt;
@@ -112,8 +117,11 @@ std::optional<Eigen::Vector2d> MapDifference(const RigConverter& converter, cons
   return *exact - linear;
 }
 
-MapCorrectionGrid MakeGrid(const RigConverter& converter, const DemGrid* dem, int head,
-                           const Eigen::Matrix3d& h, int step) {
+MapCorrectionGrid MakeGrid(const RigConverter& converter,
+                           const DemGrid* dem,
+                           int head,
+                           const Eigen::Matrix3d& h,
+                           int step) {
   const calib::VirtualCamera& v = converter.rig().virtual_camera;
   MapCorrectionGrid g;
   g.step_px = step;
@@ -135,8 +143,11 @@ MapCorrectionGrid MakeGrid(const RigConverter& converter, const DemGrid* dem, in
 
 // Largest |interpolated - exact| (px) at the cell centres whose exact head pixel lies inside the
 // head's format.
-double GridError(const RigConverter& converter, const DemGrid* dem, int head,
-                 const Eigen::Matrix3d& h, const MapCorrectionGrid& g) {
+double GridError(const RigConverter& converter,
+                 const DemGrid* dem,
+                 int head,
+                 const Eigen::Matrix3d& h,
+                 const MapCorrectionGrid& g) {
   double worst = 0.0;
   for (int j = 0; j + 1 < g.rows; ++j)
     for (int i = 0; i + 1 < g.cols; ++i) {
@@ -159,7 +170,8 @@ double GridError(const RigConverter& converter, const DemGrid* dem, int head,
 
 }  // namespace
 
-HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double tolerance_px,
+HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter,
+                                          double tolerance_px,
                                           const DemGrid* dem) {
   AEROCAL_CHECK(tolerance_px > 0) << tolerance_px;
   HeadMapCorrections out;
@@ -182,12 +194,14 @@ HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double 
 }
 
 ResampleReport ConvertRigExposure(const RigConverter& converter,
-                                  const std::vector<RasterSource*>& sources, RasterSink* sink,
-                                  const ResampleOptions& options, HeadMapCorrections* corrections,
+                                  const std::vector<RasterSource*>& sources,
+                                  RasterSink* sink,
+                                  const ResampleOptions& options,
+                                  HeadMapCorrections* corrections,
                                   const DemGrid* dem) {
   HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01, dem);
-  const ResampleReport report = ResampleVirtualImage(RigExposureAsSubimageCamera(converter),
-                                                     sources, sink, options, grids.grids);
+  const ResampleReport report = ResampleVirtualImage(
+      RigExposureAsSubimageCamera(converter), sources, sink, options, grids.grids);
   if (corrections) *corrections = std::move(grids);
   return report;
 }

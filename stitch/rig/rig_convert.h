@@ -13,16 +13,16 @@
 // reaches 2 px; the error reached is reported).
 #pragma once
 
-#include <vector>
-
-#include <Eigen/Core>
-
 #include "calib/camera/camera.h"
 #include "calib/camera/rig.h"
 #include "stitch/resample/raster.h"
 #include "stitch/resample/virtual_image.h"
 #include "stitch/rig/dem_grid.h"
 #include "stitch/rig/rig_conversion.h"
+
+#include <Eigen/Core>
+
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -47,14 +47,16 @@ struct HeadMapCorrections {
 /// plane, and every head gets a grid (the homography of the converter's plane stays the base:
 /// choose the plane near the DEM's mean height). Virtual pixels whose ray misses the DEM keep the
 /// plane's map.
-HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter, double tolerance_px = 0.01,
+HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter,
+                                          double tolerance_px = 0.01,
                                           const DemGrid* dem = nullptr);
 
 /// Converts the head images (`sources`, one per head, rig order) to the virtual image in `sink`.
 /// Heads with distortion, and every head over a DEM, go through MakeHeadMapCorrections (its
 /// report in `corrections` when given).
 ResampleReport ConvertRigExposure(const RigConverter& converter,
-                                  const std::vector<RasterSource*>& sources, RasterSink* sink,
+                                  const std::vector<RasterSource*>& sources,
+                                  RasterSink* sink,
                                   const ResampleOptions& options,
                                   HeadMapCorrections* corrections = nullptr,
                                   const DemGrid* dem = nullptr);

@@ -1,16 +1,16 @@
 #include "stitch/rig/rig_design.h"
 
+#include "calib/core/error.h"
+#include "calib/core/string_printf.h"
+#include "stitch/rig/rig_conversion.h"
+
+#include <Eigen/Eigenvalues>
+
 #include <algorithm>
 #include <bitset>
 #include <cmath>
 #include <map>
 #include <sstream>
-
-#include <Eigen/Eigenvalues>
-
-#include "calib/core/error.h"
-#include "calib/core/string_printf.h"
-#include "stitch/rig/rig_conversion.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -140,7 +140,8 @@ std::string ZoneName(const calib::Rig& rig, unsigned mask) {
 }
 
 RigCoverage ComputeRigCoverage(const calib::Rig& rig, double height_m, double cell_px) {
-  AEROCAL_CHECK(cell_px > 0 && rig.heads.size() <= calib::kMaxRigHeads) << "cell size > 0, at most 32 heads";
+  AEROCAL_CHECK(cell_px > 0 && rig.heads.size() <= calib::kMaxRigHeads)
+      << "cell size > 0, at most 32 heads";
   const RigConverter converter = NadirConverter(rig, height_m);
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo;
   for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k)
@@ -165,8 +166,7 @@ RigCoverage ComputeRigCoverage(const calib::Rig& rig, double height_m, double ce
   return c;
 }
 
-std::vector<StandardPosition> StandardTiePositions(const calib::Rig& rig,
-                                                   const RigCoverage& c) {
+std::vector<StandardPosition> StandardTiePositions(const calib::Rig& rig, const RigCoverage& c) {
   std::map<unsigned, std::vector<Eigen::Vector2d>> cells;
   for (int row = 0; row < c.rows; ++row)
     for (int col = 0; col < c.cols; ++col) {
@@ -198,9 +198,8 @@ std::vector<StandardPosition> StandardTiePositions(const calib::Rig& rig,
     }
     Eigen::Matrix2d scatter = Eigen::Matrix2d::Zero();
     for (const auto& p : points) scatter += (p - mean) * (p - mean).transpose();
-    const Eigen::Vector2d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter)
-                                     .eigenvectors()
-                                     .col(1);
+    const Eigen::Vector2d axis =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(scatter).eigenvectors().col(1);
     std::vector<double> along;
     for (const auto& p : points) along.push_back((p - mean).dot(axis));
     std::sort(along.begin(), along.end());
@@ -211,8 +210,8 @@ std::vector<StandardPosition> StandardTiePositions(const calib::Rig& rig,
       for (const auto& p : points)
         if (std::abs((p - mean).dot(axis) - q) <= 1.01 * c.cell_px)
           band.push_back({(p - mean).dot(Eigen::Vector2d(-axis.y(), axis.x())), p});
-      std::sort(band.begin(), band.end(),
-                [](const auto& a, const auto& b) { return a.first < b.first; });
+      std::sort(
+          band.begin(), band.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
       positions.push_back({zone + "-" + std::to_string(i + 1), zone, band[band.size() / 2].second});
     }
   }
@@ -253,8 +252,8 @@ RigDesign DesignRig(const calib::Rig& rig, double height_m, int grid_cells) {
   LargestCoveredRectangle(c, &c0, &r0, &c1, &r1);
   // Conservative: the rectangle spanned by the covered cell centres.
   d.effective_px = {c.CellCenter(c0, r0), c.CellCenter(c1, r1)};
-  d.effective_area_m2 = d.effective_px.Width() * d.effective_px.Height() *
-                        std::pow(d.virtual_gsd_m, 2);
+  d.effective_area_m2 =
+      d.effective_px.Width() * d.effective_px.Height() * std::pow(d.virtual_gsd_m, 2);
   d.standard_positions = StandardTiePositions(rig, c);
   return d;
 }
@@ -282,7 +281,10 @@ std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
   out << StringPrintf(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\">\n"
       "<title>%s: head footprints at H = %g m (ground metres, X right, Y up)</title>\n",
-      (hi.x() - lo.x()) * scale, (hi.y() - lo.y()) * scale, rig.name.c_str(), d.height_m);
+      (hi.x() - lo.x()) * scale,
+      (hi.y() - lo.y()) * scale,
+      rig.name.c_str(),
+      d.height_m);
   const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b"};
   for (size_t k = 0; k < d.heads.size(); ++k) {
     out << "<polygon fill=\"" << colours[k % 6] << "\" fill-opacity=\"0.2\" stroke=\""
@@ -292,23 +294,33 @@ std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
     for (const auto& p : d.heads[k].footprint_m) centre += p;
     centre /= std::max<size_t>(1, d.heads[k].footprint_m.size());
     out << "\"/>\n"
-        << StringPrintf("<text x=\"%.1f\" y=\"%.1f\" font-size=\"20\">%s</text>\n", sx(centre),
-                        sy(centre), d.heads[k].id.c_str());
+        << StringPrintf("<text x=\"%.1f\" y=\"%.1f\" font-size=\"20\">%s</text>\n",
+                        sx(centre),
+                        sy(centre),
+                        d.heads[k].id.c_str());
   }
   const auto rectangle = [&](const PixelRectangle& r, const char* style) {
     const Eigen::Vector2d a = ground(r.min_px), b = ground(r.max_px);
     out << StringPrintf("<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" %s/>\n",
-                        std::min(sx(a), sx(b)), std::min(sy(a), sy(b)), std::abs(sx(b) - sx(a)),
-                        std::abs(sy(b) - sy(a)), style);
+                        std::min(sx(a), sx(b)),
+                        std::min(sy(a), sy(b)),
+                        std::abs(sx(b) - sx(a)),
+                        std::abs(sy(b) - sy(a)),
+                        style);
   };
   rectangle({Eigen::Vector2d(-0.5, -0.5), Eigen::Vector2d(v.width_px - 0.5, v.height_px - 0.5)},
             "fill=\"none\" stroke=\"black\" stroke-dasharray=\"8,4\"");
   rectangle(d.effective_px, "fill=\"none\" stroke=\"black\" stroke-width=\"2\"");
   for (const auto& s : d.standard_positions) {
     const Eigen::Vector2d p = ground(s.virtual_px);
-    out << StringPrintf("<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\"/><text x=\"%.1f\" y=\"%.1f\" "
-                        "font-size=\"11\">%s</text>\n",
-                        sx(p), sy(p), sx(p) + 5, sy(p) - 5, s.name.c_str());
+    out << StringPrintf(
+        "<circle cx=\"%.1f\" cy=\"%.1f\" r=\"4\"/><text x=\"%.1f\" y=\"%.1f\" "
+        "font-size=\"11\">%s</text>\n",
+        sx(p),
+        sy(p),
+        sx(p) + 5,
+        sy(p) - 5,
+        s.name.c_str());
   }
   out << "</svg>\n";
   return out.str();

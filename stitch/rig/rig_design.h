@@ -24,12 +24,12 @@
 // (object frame of the nadir exposure: X along the rig x, Y along the rig y).
 #pragma once
 
-#include <string>
-#include <vector>
+#include "calib/camera/rig.h"
 
 #include <Eigen/Core>
 
-#include "calib/camera/rig.h"
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -50,9 +50,9 @@ struct GsdSample {
 
 struct HeadDesign {
   std::string id;
-  double tilt_deg = 0.0;      // angle between the head axis and the nadir
-  double nadir_gsd_m = 0.0;   // p H / c of this head
-  std::vector<GsdSample> samples;  // principal point, 4 edge midpoints, 4 corners
+  double tilt_deg = 0.0;                     // angle between the head axis and the nadir
+  double nadir_gsd_m = 0.0;                  // p H / c of this head
+  std::vector<GsdSample> samples;            // principal point, 4 edge midpoints, 4 corners
   std::vector<Eigen::Vector2d> footprint_m;  // ground outline (X, Y), closed polygon
   std::vector<Eigen::Vector2d> outline_px;   // the same outline in virtual pixels
 };
@@ -65,10 +65,10 @@ struct StandardPosition {
 
 /// Coverage of the virtual image on a grid of cells.
 struct RigCoverage {
-  double cell_px = 0.0;                    // cell side in virtual pixels
+  double cell_px = 0.0;                                 // cell side in virtual pixels
   Eigen::Vector2d origin_px = Eigen::Vector2d::Zero();  // centre of cell (0, 0)
   int cols = 0, rows = 0;
-  std::vector<unsigned> mask;              // per cell (row-major): bit k = head k sees it
+  std::vector<unsigned> mask;  // per cell (row-major): bit k = head k sees it
   /// Virtual pixel of a cell centre.
   Eigen::Vector2d CellCenter(int col, int row) const {
     return origin_px + cell_px * Eigen::Vector2d(col, row);
@@ -97,9 +97,9 @@ struct RigDesign {
   double height_m = 0.0;
   std::vector<HeadDesign> heads;
   RigCoverage coverage;
-  PixelRectangle covered_box_px;     // bounding box of the heads' outlines (the format needed)
-  PixelRectangle effective_px;       // largest fully covered rectangle (cell resolution)
-  double covered_area_m2 = 0.0;      // union of the footprints on the ground
+  PixelRectangle covered_box_px;  // bounding box of the heads' outlines (the format needed)
+  PixelRectangle effective_px;    // largest fully covered rectangle (cell resolution)
+  double covered_area_m2 = 0.0;   // union of the footprints on the ground
   double effective_area_m2 = 0.0;
   std::vector<std::pair<std::string, double>> zone_area_m2;  // per zone ("AB", ...)
   std::vector<StandardPosition> standard_positions;

@@ -1,21 +1,22 @@
 #include "stitch/rig/rig_tie_matching.h"
 
-#include <algorithm>
-#include <cmath>
-#include <map>
-
-#include <Eigen/Dense>
-#include <opencv2/imgproc.hpp>
-
 #include "calib/core/error.h"
 #include "stitch/rig/rig_convert.h"
 #include "stitch/rig/rig_design.h"
 #include "stitch/rig/stitched_image.h"
 
+#include <Eigen/Dense>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
 namespace aerocal::stitch {
 
 void RigTieMatchOptions::Validate() const {
-  if (!(cell_px >= 8)) throw ConfigError("tie matching: cell_px must be >= 8 (got " + std::to_string(cell_px) + ")");
+  if (!(cell_px >= 8))
+    throw ConfigError("tie matching: cell_px must be >= 8 (got " + std::to_string(cell_px) + ")");
   if (!(min_sigma_px > 0)) throw ConfigError("tie matching: min_sigma_px must be > 0");
   if (!(prefilter_sigma_px == 0 || (prefilter_sigma_px >= 0.3 && prefilter_sigma_px <= 5)))
     throw ConfigError("tie matching: prefilter_sigma_px must be 0 or within 0.3..5 (got " +
@@ -43,9 +44,12 @@ double HeadScale(const RigConverter& converter, int head, const Eigen::Vector2d&
 
 }  // namespace
 
-void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposure,
-                          int exposure_index, const std::vector<GrayImage>& heads,
-                          const RigTieMatchOptions& options, RigTieMatches* out) {
+void MatchRigExposureTies(const calib::Rig& rig,
+                          const RigStitchExposure& exposure,
+                          int exposure_index,
+                          const std::vector<GrayImage>& heads,
+                          const RigTieMatchOptions& options,
+                          RigTieMatches* out) {
   options.Validate();
   const int n_heads = static_cast<int>(rig.heads.size());
   AEROCAL_CHECK(static_cast<int>(heads.size()) == n_heads) << heads.size() << " head images";
@@ -58,14 +62,16 @@ void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposu
   RigExposure pose = exposure.pose;
   pose.increment_rad.clear();
   pose.dt_s.clear();
-  const RigConverter converter(rig, pose, RectificationPlane{Eigen::Vector3d::UnitZ(), exposure.z_ref_m});
+  const RigConverter converter(
+      rig, pose, RectificationPlane{Eigen::Vector3d::UnitZ(), exposure.z_ref_m});
   const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
   const calib::VirtualCamera& v = rig.virtual_camera;
   const int width = v.width_px, height = v.height_px;
 
   // Every head once on the virtual grid (float grey values) with its coverage shrunk by the
   // template half size plus the LSM shift bound and 2 px (the interpolation support).
-  const int margin = options.lsm.half_size_px + static_cast<int>(std::ceil(options.lsm.max_shift_px)) + 2;
+  const int margin =
+      options.lsm.half_size_px + static_cast<int>(std::ceil(options.lsm.max_shift_px)) + 2;
   std::vector<GrayImage> projected(n_heads), smoothed(n_heads);
   cv::Mat zone_mask(height, width, CV_8UC1, cv::Scalar(0));
   for (int k = 0; k < n_heads; ++k) {
@@ -73,7 +79,8 @@ void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposu
     for (int r = 0; r < heads[k].rows(); ++r)
       for (int c = 0; c < heads[k].cols(); ++c) top = std::max(top, heads[k](r, c));
     const double scale = top <= 255.0f ? 256.0 : 1.0;
-    MemoryRaster source({static_cast<int>(heads[k].cols()), static_cast<int>(heads[k].rows()), 1, 16});
+    MemoryRaster source(
+        {static_cast<int>(heads[k].cols()), static_cast<int>(heads[k].rows()), 1, 16});
     for (int r = 0; r < heads[k].rows(); ++r)
       for (int c = 0; c < heads[k].cols(); ++c)
         source.Set(c, r, 0, std::clamp(heads[k](r, c) * scale, 0.0, 65535.0));
@@ -132,7 +139,8 @@ void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposu
     const GrayImage crop = projected[first].block(box.y, box.x, box.height, box.width);
     FoerstnerOptions foerstner = options.foerstner;
     foerstner.max_points = std::max(foerstner.max_points, 100000);
-    const std::vector<InterestPoint> points = DetectFoerstner(WallisFilter(crop, options.wallis), foerstner);
+    const std::vector<InterestPoint> points =
+        DetectFoerstner(WallisFilter(crop, options.wallis), foerstner);
     // strongest first: the first point seen in a cell is its best
     std::map<std::pair<int, int>, Eigen::Vector2i> best;
     for (const InterestPoint& p : points) {
@@ -141,20 +149,25 @@ void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposu
       if (at.x() < 0 || at.y() < 0 || at.x() >= width || at.y() >= height ||
           zone_mask.at<std::uint8_t>(at.y(), at.x()) != mask)
         continue;
-      best.try_emplace({static_cast<int>(at.y() / options.cell_px),
-                        static_cast<int>(at.x() / options.cell_px)}, at);
+      best.try_emplace(
+          {static_cast<int>(at.y() / options.cell_px), static_cast<int>(at.x() / options.cell_px)},
+          at);
     }
     report.cells = static_cast<int>(best.size());
     for (const auto& [cell, at] : best) {
       const Eigen::Vector2d p(at.x(), at.y());
-      struct Row { int head; Eigen::Vector2d pixel; double sigma_px; };  // sigma in head px
+      struct Row {
+        int head;
+        Eigen::Vector2d pixel;
+        double sigma_px;
+      };  // sigma in head px
       std::vector<Row> rows;
       double largest = 0.0;
       for (size_t m = 1; m < members.size(); ++m) {
         const int k = members[m];
         ++report.lsm_tried;
-        const LsmResult lsm = MatchLeastSquares(smoothed[first], at, smoothed[k], p,
-                                                Eigen::Matrix2d::Identity(), options.lsm);
+        const LsmResult lsm = MatchLeastSquares(
+            smoothed[first], at, smoothed[k], p, Eigen::Matrix2d::Identity(), options.lsm);
         const auto raw = lsm.ok() ? converter.HeadFromVirtual(k, lsm.position_in_b) : std::nullopt;
         if (!raw || !converter.InHeadFormat(k, *raw)) {
           ++report.lsm_failed;
@@ -177,10 +190,16 @@ void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposu
       rows.insert(rows.begin(), Row{first, *raw_first, largest * first_scale});
       const int tie = static_cast<int>(out->ties.size());
       out->lsm_sigma_px.push_back(largest * std::sqrt(2.0));
-      out->ties.push_back({exposure.image + "/" + report.zone + "-" + std::to_string(report.ties + 1), false});
+      out->ties.push_back(
+          {exposure.image + "/" + report.zone + "-" + std::to_string(report.ties + 1), false});
       for (const Row& row : rows)
-        out->observations.push_back({exposure_index, row.head, tie, row.pixel, row.sigma_px,
-                                     "matched " + out->ties.back().id + "@" + rig.heads[row.head].id});
+        out->observations.push_back(
+            {exposure_index,
+             row.head,
+             tie,
+             row.pixel,
+             row.sigma_px,
+             "matched " + out->ties.back().id + "@" + rig.heads[row.head].id});
       ++report.ties;
     }
     out->zones.push_back(report);

@@ -25,9 +25,6 @@
 // of its tie. Deterministic (fixed order, no random sampling).
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include "calib/camera/rig.h"
 #include "stitch/image_io/gray_image.h"
 #include "stitch/matching/interest_operators.h"
@@ -35,11 +32,14 @@
 #include "stitch/rig/rig_conversion.h"
 #include "stitch/rig/self_calibration.h"
 
+#include <string>
+#include <vector>
+
 namespace aerocal::stitch {
 
 struct RigTieMatchOptions {
-  double cell_px = 40.0;       // one tie per cell of this side per zone, virtual px, >= 8
-  double min_sigma_px = 0.02;  // floor of the LSM sigma written, virtual px, > 0
+  double cell_px = 40.0;            // one tie per cell of this side per zone, virtual px, >= 8
+  double min_sigma_px = 0.02;       // floor of the LSM sigma written, virtual px, > 0
   double prefilter_sigma_px = 1.5;  // Gaussian low-pass of the projected heads for LSM (header
                                     // comment), virtual px; 0: none, else 0.3..5
   LsmOptions lsm;
@@ -54,7 +54,7 @@ struct RigZoneMatchReport {
   long pixels = 0;          // zone pixels (after the margin)
   int cells = 0;            // cells with a Foerstner point in the zone
   int lsm_tried = 0, lsm_failed = 0;
-  int ties = 0;             // ties written (two or more heads)
+  int ties = 0;  // ties written (two or more heads)
 };
 
 struct RigTieMatches {
@@ -68,8 +68,11 @@ struct RigTieMatches {
 /// Matches the ties of exposure `exposure_index` (`exposure`: its POS and z_ref) on `heads` (one
 /// image per head of `rig`, rig order, each of its head's format; LogicError otherwise) and
 /// appends them to `out` (tie indices continue from out->ties.size()).
-void MatchRigExposureTies(const calib::Rig& rig, const RigStitchExposure& exposure,
-                          int exposure_index, const std::vector<GrayImage>& heads,
-                          const RigTieMatchOptions& options, RigTieMatches* out);
+void MatchRigExposureTies(const calib::Rig& rig,
+                          const RigStitchExposure& exposure,
+                          int exposure_index,
+                          const std::vector<GrayImage>& heads,
+                          const RigTieMatchOptions& options,
+                          RigTieMatches* out);
 
 }  // namespace aerocal::stitch

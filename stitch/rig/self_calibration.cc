@@ -1,17 +1,17 @@
 #include "stitch/rig/self_calibration.h"
 
-#include <algorithm>
-#include <cmath>
-#include <deque>
-#include <map>
-#include <set>
-
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 #include "calib/problem/data_snooping.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
+
+#include <algorithm>
+#include <cmath>
+#include <deque>
+#include <map>
+#include <set>
 
 namespace aerocal::stitch {
 namespace {
@@ -49,9 +49,12 @@ std::optional<RigStitchMode> ParseRigStitchMode(const std::string& name) {
 
 const char* RigStitchModeName(RigStitchMode mode) {
   switch (mode) {
-    case RigStitchMode::kLine: return "line";
-    case RigStitchMode::kPerExposure: return "per-exposure";
-    case RigStitchMode::kAngles: return "angles";
+    case RigStitchMode::kLine:
+      return "line";
+    case RigStitchMode::kPerExposure:
+      return "per-exposure";
+    case RigStitchMode::kAngles:
+      return "angles";
   }
   return "?";
 }
@@ -82,16 +85,20 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   std::vector<calib::RigHead> heads = rig.heads;  // owned copies the blocks point into
   for (int k = 0; k < n_heads; ++k) {
     const std::string& id = heads[k].id;
-    interior[k] = builder.AddBlock("interior[" + id + "]", heads[k].camera.interior.data(),
-                                   calib::Camera::Model::kNumParams, calib::BlockKind::kInterior);
-    mount[k] = builder.AddBlock("mount[" + id + "]", heads[k].mount_rad.data(), 3,
-                                calib::BlockKind::kOther);
-    lever[k] = builder.AddBlock("lever_arm[" + id + "]", heads[k].lever_arm_m.data(), 3,
-                                calib::BlockKind::kOther);
+    interior[k] = builder.AddBlock("interior[" + id + "]",
+                                   heads[k].camera.interior.data(),
+                                   calib::Camera::Model::kNumParams,
+                                   calib::BlockKind::kInterior);
+    mount[k] = builder.AddBlock(
+        "mount[" + id + "]", heads[k].mount_rad.data(), 3, calib::BlockKind::kOther);
+    lever[k] = builder.AddBlock(
+        "lever_arm[" + id + "]", heads[k].lever_arm_m.data(), 3, calib::BlockKind::kOther);
     for (calib::BlockId b : {interior[k], mount[k], lever[k]}) builder.FixBlock(b);
   }
   const calib::BlockId zero_increment =
-      builder.AddBlock("E[reference]", vectors.emplace_back(Eigen::Vector3d::Zero()).data(), 3,
+      builder.AddBlock("E[reference]",
+                       vectors.emplace_back(Eigen::Vector3d::Zero()).data(),
+                       3,
                        calib::BlockKind::kOther);
   const calib::BlockId zero_dt =
       builder.AddBlock("dT[reference]", &scalars.emplace_back(0.0), 1, calib::BlockKind::kOther);
@@ -108,15 +115,16 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   std::vector<calib::BlockId> rig_opk(n_exposures), rig_center(n_exposures);
   std::vector<std::vector<calib::BlockId>> increment(n_exposures,
                                                      std::vector<calib::BlockId>(n_heads, -1));
-  std::vector<std::vector<calib::BlockId>> dt(n_exposures, std::vector<calib::BlockId>(n_heads, -1));
+  std::vector<std::vector<calib::BlockId>> dt(n_exposures,
+                                              std::vector<calib::BlockId>(n_heads, -1));
   std::vector<calib::BlockId> line_dt(n_heads, -1);
   std::vector<RigExposure> poses(n_exposures);
   std::vector<Eigen::Vector4d> rig_quaternion(n_exposures);  // sized once: blocks point into it
   const std::vector<std::string> angle_names = {"domega", "dphi", "dkappa"};
   for (int k = 0; k < n_heads; ++k) {
     if (k == reference || options.mode != RigStitchMode::kLine) continue;
-    line_dt[k] = builder.AddBlock("dT[" + heads[k].id + "]", &scalars.emplace_back(0.0), 1,
-                                  calib::BlockKind::kOther, {"dT"});
+    line_dt[k] = builder.AddBlock(
+        "dT[" + heads[k].id + "]", &scalars.emplace_back(0.0), 1, calib::BlockKind::kOther, {"dT"});
     if (result.dt_held) builder.FixBlock(line_dt[k]);
   }
   for (int i = 0; i < n_exposures; ++i) {
@@ -127,8 +135,8 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     // The exposure's POS attitude as the quaternion block the head residual takes (held).
     rig_quaternion[i] = calib::QuaternionFromOpk(poses[i].rig_opk_rad);
     rig_opk[i] = builder.AddRotationBlock("rig_opk[" + image + "]", rig_quaternion[i].data());
-    rig_center[i] = builder.AddBlock("rig_center[" + image + "]", poses[i].rig_center_m.data(), 3,
-                                     calib::BlockKind::kOther);
+    rig_center[i] = builder.AddBlock(
+        "rig_center[" + image + "]", poses[i].rig_center_m.data(), 3, calib::BlockKind::kOther);
     builder.FixBlock(rig_opk[i]);
     builder.FixBlock(rig_center[i]);
     for (int k = 0; k < n_heads; ++k) {
@@ -139,27 +147,31 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       }
       const std::string name = image + "/" + heads[k].id;
       increment[i][k] = builder.AddBlock("E[" + name + "]",
-                                         vectors.emplace_back(Eigen::Vector3d::Zero()).data(), 3,
-                                         calib::BlockKind::kOther, angle_names);
+                                         vectors.emplace_back(Eigen::Vector3d::Zero()).data(),
+                                         3,
+                                         calib::BlockKind::kOther,
+                                         angle_names);
       if (options.hold_heads) builder.FixBlock(increment[i][k]);
       if (options.mode == RigStitchMode::kLine) {
         dt[i][k] = line_dt[k];
       } else {
-        dt[i][k] = builder.AddBlock("dT[" + name + "]", &scalars.emplace_back(0.0), 1,
-                                    calib::BlockKind::kOther, {"dT"});
+        dt[i][k] = builder.AddBlock(
+            "dT[" + name + "]", &scalars.emplace_back(0.0), 1, calib::BlockKind::kOther, {"dT"});
         if (result.dt_held) builder.FixBlock(dt[i][k]);
       }
       if (options.increment_sigma_rad) {
         const double s = *options.increment_sigma_rad;
         builder.AddResidual(kGroupRigStitchPrior,
                             calib::PriorCostFunction::Create({0, 0, 0}, {s, s, s}),
-                            {increment[i][k]}, "prior E[" + name + "]");
+                            {increment[i][k]},
+                            "prior E[" + name + "]");
       }
       if (options.dt_sigma_s && !result.dt_held &&
           (options.mode == RigStitchMode::kPerExposure || i == 0))
         builder.AddResidual(kGroupRigStitchPrior,
                             calib::PriorCostFunction::Create({0}, {*options.dt_sigma_s}),
-                            {dt[i][k]}, "prior " + builder.BlockName(dt[i][k]));
+                            {dt[i][k]},
+                            "prior " + builder.BlockName(dt[i][k]));
     }
   }
 
@@ -202,18 +214,27 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     }
     Eigen::Vector3d& point = vectors.emplace_back(*start);
     point.z() = exposures[i].z_ref_m;
-    const calib::BlockId point_block = builder.AddBlock(
-        "tie[" + exposures[i].image + "/" + ties[t].id + "]", point.data(), 3,
-        calib::BlockKind::kGroundPoint, {"X", "Y", "Z"});
+    const calib::BlockId point_block =
+        builder.AddBlock("tie[" + exposures[i].image + "/" + ties[t].id + "]",
+                         point.data(),
+                         3,
+                         calib::BlockKind::kGroundPoint,
+                         {"X", "Y", "Z"});
     builder.FixEntries(point_block, {2});
     for (int o : obs) {
       const RigStitchObservation& ob = observations[o];
       const int k = ob.head;
       const calib::ResidualId id = builder.AddResidual(
           kGroupRigStitchTie,
-          calib::RigHeadCollinearityResidual::Create(heads[k].camera.frame(), ob.pixel,
-                                                     ob.sigma_px, exposures[i].pose.velocity_mps),
-          {interior[k], rig_opk[i], rig_center[i], mount[k], lever[k], increment[i][k], dt[i][k],
+          calib::RigHeadCollinearityResidual::Create(
+              heads[k].camera.frame(), ob.pixel, ob.sigma_px, exposures[i].pose.velocity_mps),
+          {interior[k],
+           rig_opk[i],
+           rig_center[i],
+           mount[k],
+           lever[k],
+           increment[i][k],
+           dt[i][k],
            point_block},
           ob.label.empty() ? ties[t].id + "@" + heads[k].id : ob.label);
       tie_of_residual[id] = key;
@@ -307,8 +328,13 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       wanted, std::max(result.sigma0, 1e-300), options.correlation_threshold);
   if (!cov.ok) result.warnings.push_back("covariance: " + cov.message);
   if (result.stopped)  // what the rig's calibration becomes without the ties kept against the test
-    result.stop_effect = calib::EffectOfLeavingOut(builder, kept_against_test, cov, wanted, wanted,
-                                                   options.solver, options.suspect_effect_limit);
+    result.stop_effect = calib::EffectOfLeavingOut(builder,
+                                                   kept_against_test,
+                                                   cov,
+                                                   wanted,
+                                                   wanted,
+                                                   options.solver,
+                                                   options.suspect_effect_limit);
   // The largest |rho| of each free dT with an angle of its head (each exposure for line mode).
   std::map<calib::BlockId, DtCorrelation> worst;
   std::set<calib::BlockId> undetermined_dt;
@@ -322,7 +348,8 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
           DtCorrelation& w = worst[dt[i][k]];
           if (w.dt.empty() || std::abs(rho) > std::abs(w.rho))
             w = {builder.BlockName(dt[i][k]),
-                 builder.BlockName(increment[i][k]) + "." + angle_names[a], rho};
+                 builder.BlockName(increment[i][k]) + "." + angle_names[a],
+                 rho};
         }
       }
   for (const auto& [block, w] : worst) {
@@ -376,8 +403,8 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   RmsSums flight_before, flight_after;
   for (int phase = 0; phase < 2; ++phase) {
     for (int i = 0; i < n_exposures; ++i) {
-      const RigConverter converter(rig, phase == 0 ? poses[i] : refined[i],
-                                   LevelPlane(exposures[i].z_ref_m));
+      const RigConverter converter(
+          rig, phase == 0 ? poses[i] : refined[i], LevelPlane(exposures[i].z_ref_m));
       RmsSums sums;
       std::map<std::string, RmsSums> exposure_zones;
       for (auto it = used.lower_bound({i, -1}); it != used.end() && it->first.first == i; ++it) {
@@ -385,13 +412,15 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
         std::vector<Eigen::Vector2d> v;
         unsigned mask = 0;
         for (int o : it->second)
-          if (const auto p = converter.VirtualFromHead(observations[o].head, observations[o].pixel)) {
+          if (const auto p =
+                  converter.VirtualFromHead(observations[o].head, observations[o].pixel)) {
             v.push_back(*p);
             mask |= 1u << observations[o].head;
           }
         if (v.size() < 2) continue;
         const std::string zone = ZoneName(rig, mask);
-        RmsSums* targets[] = {&sums, &exposure_zones[zone],
+        RmsSums* targets[] = {&sums,
+                              &exposure_zones[zone],
                               phase == 0 ? &flight_before : &flight_after,
                               phase == 0 ? &zone_sums[zone].first : &zone_sums[zone].second};
         for (RmsSums* s : targets) ++s->ties[c];
@@ -407,8 +436,9 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       for (const auto& zone_rms : exposure_zones) {
         const std::string& zone = zone_rms.first;  // (a lambda may not capture a binding, C++17)
         const RmsSums& s = zone_rms.second;
-        auto z = std::find_if(er.zones.begin(), er.zones.end(),
-                              [&](const ZoneStitchRms& r) { return r.zone == zone; });
+        auto z = std::find_if(er.zones.begin(), er.zones.end(), [&](const ZoneStitchRms& r) {
+          return r.zone == zone;
+        });
         if (z == er.zones.end()) z = er.zones.insert(er.zones.end(), ZoneStitchRms{zone, {}, {}});
         (phase == 0 ? z->before : z->after) = s.Finish();
       }
@@ -421,8 +451,10 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
 
   // Standard positions: fitted ties before and after the snooping.
   for (const auto& [where, keys] : position_ties) {
-    StandardPositionCount count{exposures[where.first].image, positions[where.second].name,
-                                static_cast<int>(keys.size()), 0};
+    StandardPositionCount count{exposures[where.first].image,
+                                positions[where.second].name,
+                                static_cast<int>(keys.size()),
+                                0};
     for (const TieKey& key : keys) count.ties_after += alive(key, {});
     result.standard_positions.push_back(count);
   }
@@ -452,14 +484,18 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
                               ": " + result.report.message + ")");
   if (!cov.ok) result.failures.push_back("covariance not computable (singular): " + cov.message);
   if (!(result.sigma0 <= options.max_sigma0))
-    result.failures.push_back(StringPrintf(
-        "sigma0 %.3g is above %.3g: the tie sigmas or the rig model are wrong", result.sigma0,
-        options.max_sigma0));
+    result.failures.push_back(
+        StringPrintf("sigma0 %.3g is above %.3g: the tie sigmas or the rig model are wrong",
+                     result.sigma0,
+                     options.max_sigma0));
   // A stop is judged by its effect: invalid when it matters, else a warning (issue 28 part 2).
   for (const auto& reason : result.stop_reasons) {
-    const std::string message = "snooping stopped: " + reason + "; " + result.stop_effect.Describe();
-    if (result.stop_effect.Matters()) result.failures.push_back(message);
-    else result.warnings.push_back(message + "; the tie is kept and the result stands: check it");
+    const std::string message =
+        "snooping stopped: " + reason + "; " + result.stop_effect.Describe();
+    if (result.stop_effect.Matters())
+      result.failures.push_back(message);
+    else
+      result.warnings.push_back(message + "; the tie is kept and the result stands: check it");
   }
   return result;
 }

@@ -37,17 +37,17 @@
 // never adjusted), per zone, per exposure and over the flight.
 #pragma once
 
-#include <optional>
-#include <string>
-#include <vector>
-
-#include <Eigen/Core>
-
 #include "calib/camera/rig.h"
 #include "calib/problem/problem_builder.h"
 #include "calib/problem/suspect_effect.h"
 #include "stitch/rig/rig_conversion.h"
 #include "stitch/rig/rig_design.h"
+
+#include <Eigen/Core>
+
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
@@ -73,7 +73,7 @@ struct RigStitchTie {
 };
 
 struct RigStitchObservation {
-  int exposure = 0, head = 0, tie = 0;  // indices into the inputs
+  int exposure = 0, head = 0, tie = 0;              // indices into the inputs
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // measured head pixel
   double sigma_px = 0.5;                            // > 0
   std::string label;                                // e.g. "observations.csv:17"
@@ -145,17 +145,17 @@ struct RigStitchResult {
   double sigma0 = 0.0;
   int redundancy = 0;
   std::vector<RigStitchExposureResult> exposures;
-  StitchRmsSet before, after;       // the flight
-  std::vector<ZoneStitchRms> zones;  // the flight
+  StitchRmsSet before, after;                  // the flight
+  std::vector<ZoneStitchRms> zones;            // the flight
   std::vector<DtCorrelation> dt_correlations;  // largest |rho| of each dT with an angle
   bool dt_determinable = true;
-  bool dt_held = false;  // angles mode, or no velocity
+  bool dt_held = false;               // angles mode, or no velocity
   std::vector<std::string> rejected;  // labels of the observations snooping removed
   bool stopped = false;               // snooping refused to empty a standard position
   std::vector<std::string> stop_reasons;
-  calib::SuspectEffect stop_effect;   // of the kept failing ties, when stopped
+  calib::SuspectEffect stop_effect;  // of the kept failing ties, when stopped
   std::vector<StandardPositionCount> standard_positions;
-  int dropped_ties = 0;           // fitted ties with fewer than two observations (not used)
+  int dropped_ties = 0;                 // fitted ties with fewer than two observations (not used)
   double relief_displacement_px = 0.0;  // largest over the head pairs, at options.relief_m
   double height_m = 0.0;                // mean relative flying height above z_ref (m)
   double sigma0_px = 0.0;  // sigma0 x the median a-priori sigma of the fitted tie observations

@@ -1,8 +1,8 @@
 #include "stitch/rig/self_calibration_json.h"
 
-#include <cmath>
-
 #include "calib/core/string_printf.h"
+
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
@@ -41,8 +41,10 @@ std::string Px(double value) {
 
 }  // namespace
 
-nlohmann::json RigStitchToJson(const calib::Rig& rig, const RigStitchOptions& options,
-                               const RigStitchResult& result, const RigStitchSources& sources) {
+nlohmann::json RigStitchToJson(const calib::Rig& rig,
+                               const RigStitchOptions& options,
+                               const RigStitchResult& result,
+                               const RigStitchSources& sources) {
   nlohmann::json doc;
   doc["kind"] = "rig_stitch";
   doc["camera"] = sources.camera;
@@ -61,8 +63,9 @@ nlohmann::json RigStitchToJson(const calib::Rig& rig, const RigStitchOptions& op
   doc["metric"] = {
       {"unit", "px of the level virtual image"},
       {"per_coordinate", "sqrt(sum(dx^2 + dy^2) / (2 n_pairs)) over the head pairs of each tie"},
-      {"pair_2d", "sqrt(sum(dx^2 + dy^2) / n_pairs): the 2-D pair disagreement, sqrt(2) x "
-                  "per_coordinate"},
+      {"pair_2d",
+       "sqrt(sum(dx^2 + dy^2) / n_pairs): the 2-D pair disagreement, sqrt(2) x "
+       "per_coordinate"},
       {"before", "ground calibration alone (E = I, dT = 0)"},
       {"after", "the estimated increments and offsets"},
       {"fit", "ties used in the adjustment (their observations left after the snooping)"},
@@ -78,8 +81,8 @@ nlohmann::json RigStitchToJson(const calib::Rig& rig, const RigStitchOptions& op
                          {"zones", ZonesJson(e.zones)}});
     for (const RigStitchHead& h : e.heads) {
       const Eigen::Vector3d deg = h.increment_rad * kDegPerRad;
-      nlohmann::json sigma = {{"domega", nullptr}, {"dphi", nullptr}, {"dkappa", nullptr},
-                              {"dT_ms", nullptr}};
+      nlohmann::json sigma = {
+          {"domega", nullptr}, {"dphi", nullptr}, {"dkappa", nullptr}, {"dT_ms", nullptr}};
       if (!h.reference && h.increment_sigma_rad.norm() > 0) {  // 0: no covariance
         sigma["domega"] = h.increment_sigma_rad.x() * kDegPerRad;
         sigma["dphi"] = h.increment_sigma_rad.y() * kDegPerRad;
@@ -113,39 +116,49 @@ nlohmann::json RigStitchToJson(const calib::Rig& rig, const RigStitchOptions& op
                          {"name", s.name},
                          {"ties_before", s.ties_before},
                          {"ties_after", s.ties_after}});
-  doc["snooping"] = {{"enabled", options.snooping},
-                     {"alpha", options.alpha},
-                     {"rejected", result.rejected},
-                     {"stopped", result.stopped},
-                     {"stop_reasons", result.stop_reasons},
-                     {"stop_effect", result.stopped ? calib::SuspectEffectJson(result.stop_effect)
-                                                    : nlohmann::json()},
-                     {"standard_positions", positions}};
+  doc["snooping"] = {
+      {"enabled", options.snooping},
+      {"alpha", options.alpha},
+      {"rejected", result.rejected},
+      {"stopped", result.stopped},
+      {"stop_reasons", result.stop_reasons},
+      {"stop_effect",
+       result.stopped ? calib::SuspectEffectJson(result.stop_effect) : nlohmann::json()},
+      {"standard_positions", positions}};
   doc["dropped_ties"] = result.dropped_ties;
   doc["relief_displacement"] = {
       {"relief_m", sources.relief_m ? nlohmann::json(*sources.relief_m) : nlohmann::json()},
       {"height_m", result.height_m},
       {"largest_px",
        sources.relief_m ? nlohmann::json(result.relief_displacement_px) : nlohmann::json()},
-      {"formula", "(c_v / p) |t_j - t_k| dh / (H (H - dh)), largest over the head pairs "
-                  "(CONVENTIONS.md \"Multi-head rigs\")"}};
+      {"formula",
+       "(c_v / p) |t_j - t_k| dh / (H (H - dh)), largest over the head pairs "
+       "(CONVENTIONS.md \"Multi-head rigs\")"}};
   return doc;
 }
 
-std::string FormatRigStitchSummary(const RigStitchOptions& options, const RigStitchResult& result,
+std::string FormatRigStitchSummary(const RigStitchOptions& options,
+                                   const RigStitchResult& result,
                                    const RigStitchSources& sources) {
   std::string out = StringPrintf(
       "rig stitch (%s mode): %zu exposures, sigma0 %.3f (%.3f px), redundancy %d, %s in %d "
       "iterations\n",
-      RigStitchModeName(options.mode), result.exposures.size(), result.sigma0, result.sigma0_px,
-      result.redundancy, result.report.converged ? "converged" : "NOT converged",
+      RigStitchModeName(options.mode),
+      result.exposures.size(),
+      result.sigma0,
+      result.sigma0_px,
+      result.redundancy,
+      result.report.converged ? "converged" : "NOT converged",
       result.report.iterations);
   out += "stitching RMS, virtual px per coordinate (pair_2d = sqrt(2) x): before -> after\n";
   out += StringPrintf("%-10s %16s %16s\n", "exposure", "fit ties", "check ties");
   const auto row = [&](const std::string& name, const StitchRmsSet& b, const StitchRmsSet& a) {
-    out += StringPrintf("%-10s %7s -> %-6s %7s -> %-6s\n", name.c_str(),
-                        Px(b.fit.per_coordinate).c_str(), Px(a.fit.per_coordinate).c_str(),
-                        Px(b.check.per_coordinate).c_str(), Px(a.check.per_coordinate).c_str());
+    out += StringPrintf("%-10s %7s -> %-6s %7s -> %-6s\n",
+                        name.c_str(),
+                        Px(b.fit.per_coordinate).c_str(),
+                        Px(a.fit.per_coordinate).c_str(),
+                        Px(b.check.per_coordinate).c_str(),
+                        Px(a.check.per_coordinate).c_str());
   };
   for (const auto& e : result.exposures) row(e.image, e.before, e.after);
   row("flight", result.before, result.after);
@@ -173,14 +186,19 @@ std::string FormatRigStitchSummary(const RigStitchOptions& options, const RigSti
       worst = &c;
     }
   if (worst)
-    out += StringPrintf("largest dT-angle correlation: %s with %s, rho %.3f%s\n", worst->dt.c_str(),
-                        worst->angle.c_str(), worst->rho,
+    out += StringPrintf("largest dT-angle correlation: %s with %s, rho %.3f%s\n",
+                        worst->dt.c_str(),
+                        worst->angle.c_str(),
+                        worst->rho,
                         result.dt_determinable ? "" : " (dT not determinable: not reported)");
-  out += StringPrintf("snooping: %zu observation(s) rejected%s\n", result.rejected.size(),
+  out += StringPrintf("snooping: %zu observation(s) rejected%s\n",
+                      result.rejected.size(),
                       result.stopped ? ", STOPPED at a standard position" : "");
   if (sources.relief_m)
     out += StringPrintf("relief of %g m off the plane at H = %.1f m: up to %.3f px between heads\n",
-                        *sources.relief_m, result.height_m, result.relief_displacement_px);
+                        *sources.relief_m,
+                        result.height_m,
+                        result.relief_displacement_px);
   for (const auto& w : result.warnings) out += "warning: " + w + "\n";
   for (const auto& f : result.failures) out += "FAILED: " + f + "\n";
   return out;

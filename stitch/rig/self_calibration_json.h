@@ -8,13 +8,13 @@
 // failures that make the run exit 3. And the terminal summary of the same result.
 #pragma once
 
-#include <optional>
-#include <string>
+#include "calib/camera/rig.h"
+#include "stitch/rig/self_calibration.h"
 
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/rig.h"
-#include "stitch/rig/self_calibration.h"
+#include <optional>
+#include <string>
 
 namespace aerocal::stitch {
 
@@ -24,12 +24,15 @@ struct RigStitchSources {
   std::optional<double> relief_m;  // relief of the block off the plane (m); nullopt: not given
 };
 
-nlohmann::json RigStitchToJson(const calib::Rig& rig, const RigStitchOptions& options,
-                               const RigStitchResult& result, const RigStitchSources& sources);
+nlohmann::json RigStitchToJson(const calib::Rig& rig,
+                               const RigStitchOptions& options,
+                               const RigStitchResult& result,
+                               const RigStitchSources& sources);
 
 /// Lines for people: sigma0, the RMS before -> after per exposure and over the flight, the time
 /// offsets, the rejections, the relief displacement, the warnings and failures.
-std::string FormatRigStitchSummary(const RigStitchOptions& options, const RigStitchResult& result,
+std::string FormatRigStitchSummary(const RigStitchOptions& options,
+                                   const RigStitchResult& result,
                                    const RigStitchSources& sources);
 
 }  // namespace aerocal::stitch

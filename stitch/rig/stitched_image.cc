@@ -1,15 +1,15 @@
 #include "stitch/rig/stitched_image.h"
 
-#include <algorithm>
-#include <cmath>
-#include <cstdint>
-#include <cstring>
+#include "calib/core/error.h"
+#include "stitch/rig/rig_convert.h"
 
 #include <Eigen/Dense>
 #include <opencv2/imgproc.hpp>
 
-#include "calib/core/error.h"
-#include "stitch/rig/rig_convert.h"
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
 
 namespace aerocal::stitch {
 
@@ -56,8 +56,10 @@ MemoryRaster AsSixteenBit(RasterSource* source, double scale) {
 
 }  // namespace
 
-HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter, int head,
-                                      const MapCorrectionGrid& grid, RasterSource* source,
+HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter,
+                                      int head,
+                                      const MapCorrectionGrid& grid,
+                                      RasterSource* source,
                                       const ResampleOptions& resample) {
   const calib::Camera all = RigExposureAsSubimageCamera(converter);
   const int width = all.width_px, height = all.height_px;
@@ -74,13 +76,15 @@ HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter, int head,
   coverage.fill = 0.0;
   ResampleVirtualImage(one, {&ones}, &covered, coverage, grids);
   out.covered.resize(static_cast<size_t>(width) * height);
-  for (size_t i = 0; i < out.covered.size(); ++i) out.covered[i] = covered.bytes()[i] > 127 ? 255 : 0;
+  for (size_t i = 0; i < out.covered.size(); ++i)
+    out.covered[i] = covered.bytes()[i] > 127 ? 255 : 0;
   return out;
 }
 
 StitchedImageReport MakeStitchedImage(const RigConverter& converter,
                                       const std::vector<RasterSource*>& sources,
-                                      const StitchedImageOptions& options, RasterSink* image,
+                                      const StitchedImageOptions& options,
+                                      RasterSink* image,
                                       RasterSink* mask) {
   options.Validate();
   const calib::Rig& rig = converter.rig();
@@ -109,7 +113,8 @@ StitchedImageReport MakeStitchedImage(const RigConverter& converter,
   std::vector<HeadOnVirtual> on(heads);
   for (int k = 0; k < heads; ++k) {
     MemoryRaster source = AsSixteenBit(sources[k], scale);
-    const HeadProjection projection = ProjectHeadOntoVirtual(converter, k, grids.grids[k], &source, resample);
+    const HeadProjection projection =
+        ProjectHeadOntoVirtual(converter, k, grids.grids[k], &source, resample);
     const MemoryRaster& values = projection.values;
     cv::Mat inside(height, width, CV_8UC1, const_cast<std::uint8_t*>(projection.covered.data()));
     cv::Mat distance;
@@ -121,9 +126,9 @@ StitchedImageReport MakeStitchedImage(const RigConverter& converter,
       for (int c = 0; c < width; ++c) {
         const float d = distance.at<float>(r, c);
         on[k].weight[static_cast<size_t>(r) * width + c] =
-            inside.at<std::uint8_t>(r, c) == 0
-                ? 0
-                : static_cast<std::uint8_t>(std::clamp(std::lround(d), 1L, long(options.feather_px)));
+            inside.at<std::uint8_t>(r, c) == 0 ? 0
+                                               : static_cast<std::uint8_t>(std::clamp(
+                                                     std::lround(d), 1L, long(options.feather_px)));
       }
   }
 
@@ -180,14 +185,16 @@ StitchedImageReport MakeStitchedImage(const RigConverter& converter,
     if (qr.rank() < n) {
       report.warnings.push_back(
           "radiometric balance not determinable (a head has no overlap chain to the reference "
-          "head " + rig.reference_head + "): every head kept at gain 1, offset 0");
+          "head " +
+          rig.reference_head + "): every head kept at gain 1, offset 0");
     } else {
       const Eigen::VectorXd x = qr.solve(rhs);
       for (int k = 0; k < heads; ++k)
         if (unknown[k] >= 0) gain[k] = x(2 * unknown[k]), offset[k] = x(2 * unknown[k] + 1);
     }
   }
-  for (int k = 0; k < heads; ++k) report.heads[k].gain = gain[k], report.heads[k].offset_dn = offset[k];
+  for (int k = 0; k < heads; ++k)
+    report.heads[k].gain = gain[k], report.heads[k].offset_dn = offset[k];
 
   // Disagreement before blending, per head pair, and the blended output with its mask.
   std::vector<double> sum(heads * heads, 0.0), sum2(heads * heads, 0.0);

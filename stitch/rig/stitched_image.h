@@ -24,23 +24,23 @@
 // output strip.
 #pragma once
 
-#include <cstdint>
-#include <string>
-#include <vector>
-
 #include "stitch/resample/raster.h"
 #include "stitch/resample/virtual_image.h"
 #include "stitch/rig/rig_conversion.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch {
 
 struct StitchedImageOptions {
   Interpolation interpolation = Interpolation::kBilinear;
-  bool balance = true;      // dodging; false: every head g = 1, o = 0
-  int sample_step_px = 2;   // overlap pixels sampled for the balance every this many px, 1..64
-  int feather_px = 64;      // blending ramp (px), 1..255
-  int strip_rows = 256;     // resampling strips, > 0
-  void Validate() const;    // ConfigError naming the field
+  bool balance = true;     // dodging; false: every head g = 1, o = 0
+  int sample_step_px = 2;  // overlap pixels sampled for the balance every this many px, 1..64
+  int feather_px = 64;     // blending ramp (px), 1..255
+  int strip_rows = 256;    // resampling strips, > 0
+  void Validate() const;   // ConfigError naming the field
 };
 
 struct HeadRadiometry {
@@ -74,8 +74,10 @@ struct HeadProjection {
   MemoryRaster values;
   std::vector<std::uint8_t> covered;
 };
-HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter, int head,
-                                      const MapCorrectionGrid& grid, RasterSource* source,
+HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter,
+                                      int head,
+                                      const MapCorrectionGrid& grid,
+                                      RasterSource* source,
                                       const ResampleOptions& resample = {});
 
 /// Makes the stitched image of the converter's exposure from `sources` (one per head, rig order,
@@ -84,7 +86,8 @@ HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter, int head,
 /// does not fit.
 StitchedImageReport MakeStitchedImage(const RigConverter& converter,
                                       const std::vector<RasterSource*>& sources,
-                                      const StitchedImageOptions& options, RasterSink* image,
+                                      const StitchedImageOptions& options,
+                                      RasterSink* image,
                                       RasterSink* mask);
 
 }  // namespace aerocal::stitch

@@ -1,12 +1,12 @@
 #include "stitch/simulation/stitch_simulator.h"
 
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <sstream>
-
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -33,7 +33,8 @@ Box Footprint(const calib::SubimageMapping& s) {
 
 calib::Camera MakeMisplacedCamera(const calib::Camera& nominal,
                                   const std::vector<std::string>& base_ids,
-                                  const MisplacementOptions& o, std::mt19937_64& rng) {
+                                  const MisplacementOptions& o,
+                                  std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
   calib::Camera truth = nominal;
   for (auto& s : truth.subimages) {
@@ -48,7 +49,8 @@ calib::Camera MakeMisplacedCamera(const calib::Camera& nominal,
     a(0, 1) = -scale * std::sin(angle) + skew;
     a(1, 0) = scale * std::sin(angle);
     a(1, 1) = scale * std::cos(angle) - 0.5 * dscale;
-    Eigen::Matrix3d to_centre = Eigen::Matrix3d::Identity(), from_centre = Eigen::Matrix3d::Identity();
+    Eigen::Matrix3d to_centre = Eigen::Matrix3d::Identity(),
+                    from_centre = Eigen::Matrix3d::Identity();
     const double cu = 0.5 * (s.width_px - 1), cv = 0.5 * (s.height_px - 1);
     to_centre(0, 2) = -cu;
     to_centre(1, 2) = -cv;
@@ -58,7 +60,8 @@ calib::Camera MakeMisplacedCamera(const calib::Camera& nominal,
         calib::HomographyFromParams(s.model, s.params.data()) * from_centre * a * to_centre;
     // Keep the nominal model unless the misplacement needs a richer one.
     calib::MappingModel needed = calib::MappingModel::kTranslation;
-    if (o.rotation_sigma_rad != 0.0 || o.scale_sigma != 0.0) needed = calib::MappingModel::kConformal;
+    if (o.rotation_sigma_rad != 0.0 || o.scale_sigma != 0.0)
+      needed = calib::MappingModel::kConformal;
     if (o.shear != 0.0) needed = calib::MappingModel::kAffine;
     if (static_cast<int>(s.model) < static_cast<int>(needed)) s.model = needed;
     s.params = calib::ParamsFromHomography(s.model, h);
@@ -66,7 +69,8 @@ calib::Camera MakeMisplacedCamera(const calib::Camera& nominal,
   return truth;
 }
 
-std::vector<StitchObservation> SimulateFrame(const calib::Camera& truth, const std::string& frame,
+std::vector<StitchObservation> SimulateFrame(const calib::Camera& truth,
+                                             const std::string& frame,
                                              const FrameSimulationOptions& o,
                                              std::mt19937_64& rng) {
   std::normal_distribution<double> normal(0.0, 1.0);
@@ -75,8 +79,12 @@ std::vector<StitchObservation> SimulateFrame(const calib::Camera& truth, const s
   for (const auto& ref : truth.reference_points) {
     const int k = truth.SubimageIndex(ref.subimage);
     const Eigen::Vector2d uv = truth.subimages[k].SubFromVirtual({ref.U, ref.V});
-    rows.push_back({frame, ref.id, ref.subimage, uv.x() + o.reference_noise_px * normal(rng),
-                    uv.y() + o.reference_noise_px * normal(rng), ref.sigma_px});
+    rows.push_back({frame,
+                    ref.id,
+                    ref.subimage,
+                    uv.x() + o.reference_noise_px * normal(rng),
+                    uv.y() + o.reference_noise_px * normal(rng),
+                    ref.sigma_px});
   }
   // Overlap strips: pairwise intersections of sub-image footprints.
   struct Strip {
@@ -88,7 +96,9 @@ std::vector<StitchObservation> SimulateFrame(const calib::Camera& truth, const s
   for (size_t a = 0; a < n; ++a)
     for (size_t b = a + 1; b < n; ++b) {
       const Box fa = Footprint(truth.subimages[a]), fb = Footprint(truth.subimages[b]);
-      const Box overlap{std::max(fa.u0, fb.u0), std::max(fa.v0, fb.v0), std::min(fa.u1, fb.u1),
+      const Box overlap{std::max(fa.u0, fb.u0),
+                        std::max(fa.v0, fb.v0),
+                        std::min(fa.u1, fb.u1),
                         std::min(fa.v1, fb.v1)};
       if (overlap.Area() <= 0) continue;
       strips.push_back({overlap});
@@ -96,7 +106,8 @@ std::vector<StitchObservation> SimulateFrame(const calib::Camera& truth, const s
     }
   int tie = 0;
   for (const auto& strip : strips) {
-    const int count = static_cast<int>(std::round(o.ties_per_frame * strip.box.Area() / total_area));
+    const int count =
+        static_cast<int>(std::round(o.ties_per_frame * strip.box.Area() / total_area));
     int made = 0;
     for (int attempt = 0; made < count && attempt < 20 * count + 100; ++attempt) {
       const Eigen::Vector2d p(strip.box.u0 + uniform(rng) * (strip.box.u1 - strip.box.u0),
@@ -121,7 +132,8 @@ std::vector<StitchObservation> SimulateFrame(const calib::Camera& truth, const s
   return rows;
 }
 
-void WriteStitchObservations(const std::string& path, const std::vector<StitchObservation>& rows,
+void WriteStitchObservations(const std::string& path,
+                             const std::vector<StitchObservation>& rows,
                              bool exact) {
   WriteFileAtomically(path, [&](std::ostream& out) {
     out << "frame,point,subimage,u,v,sigma_px\n";

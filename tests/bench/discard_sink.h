@@ -1,9 +1,9 @@
 // A raster sink for benchmarks: takes the rows and keeps a checksum (no disk in the measurement).
 #pragma once
 
-#include <cstdint>
-
 #include "stitch/resample/raster.h"
+
+#include <cstdint>
 
 namespace aerocal::stitch {
 

@@ -3,15 +3,14 @@
 // frame and the mean tie points per strip (counter "points_per_strip", "ties").
 // Arg 1: on one core (TBB and OpenCV limited to one thread), as issue 35 measures a unit.
 // Run: build/tests/bench/bench_match (AEROCAL_BUILD_BENCHMARKS=ON, Release).
+#include "stitch/matching/overlap_matcher.h"
+#include "tests/stitch/match_test_scene.h"
+
 #include <benchmark/benchmark.h>
-
-#include <memory>
-
 #include <opencv2/core/utility.hpp>
 #include <tbb/global_control.h>
 
-#include "stitch/matching/overlap_matcher.h"
-#include "tests/stitch/match_test_scene.h"
+#include <memory>
 
 namespace aerocal::stitch {
 namespace {
@@ -24,7 +23,8 @@ void BM_MatchFrame(benchmark::State& state) {
   }
   std::unique_ptr<tbb::global_control> one_core;
   if (state.range(1) == 1) {
-    one_core = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, 1);
+    one_core =
+        std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, 1);
     cv::setNumThreads(1);
   }
   MatchOptions options;

@@ -12,19 +12,19 @@
 // The end prints the time ratios of the pairs, measured in one run.
 //
 // Run: cmake -DAEROCAL_BUILD_BENCHMARKS=ON ...; build/tests/bench/bench_pushbroom
-#include <cstdio>
-#include <map>
-#include <random>
+#include "tests/bench/ratio_reporter.h"
+#include "triangulation/pushbroom/line_calibration.h"
+#include "triangulation/pushbroom/line_rectification.h"
+#include "triangulation/pushbroom/line_simulation.h"
 
 #include <Eigen/QR>
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "tests/bench/ratio_reporter.h"
-#include "triangulation/pushbroom/line_calibration.h"
-#include "triangulation/pushbroom/line_rectification.h"
-#include "triangulation/pushbroom/line_simulation.h"
+#include <cstdio>
+#include <map>
+#include <random>
 
 namespace aerocal::triangulation {
 namespace {
@@ -52,7 +52,8 @@ void BM_PushbroomCalibrate(benchmark::State& state) {
   LineCalibrationOptions options;
   LineCalibrationResult result;
   for (auto _ : state) {
-    result = CalibrateLineCamera(f.nominal, FlightPos(), f.observations, f.points, options, "observations.csv");
+    result = CalibrateLineCamera(
+        f.nominal, FlightPos(), f.observations, f.points, options, "observations.csv");
     benchmark::DoNotOptimize(result.dx_mm.data());
   }
   if (!result.valid) state.SkipWithError("the calibration is not valid");
@@ -150,14 +151,19 @@ int main(int argc, char** argv) {
   benchmark::Initialize(&argc, argv);
   aerocal::testing::RatioReporter reporter;
   benchmark::RunSpecifiedBenchmarks(&reporter);
-  const auto ratio = [&](const char* what, const char* ours, const char* peer, const char* peer_what) {
-    const double a = reporter.TimeOf(ours), b = reporter.TimeOf(peer);  // s
-    if (a > 0 && b > 0)
-      std::printf("%s: %.3f s, %s: %.3f s, ratio %.1f\n", what, a, peer_what, b, a / b);
-  };
-  ratio("calibration of 3 x 1000 detectors from 10,000 control points", "BM_PushbroomCalibrate",
-        "BM_PushbroomPolynomialFit", "the plain polynomial fit of the same observations");
-  ratio("L1 rectification of a 3000 x 10000 line image", "BM_L1Rectification", "BM_CvRemap",
+  const auto ratio =
+      [&](const char* what, const char* ours, const char* peer, const char* peer_what) {
+        const double a = reporter.TimeOf(ours), b = reporter.TimeOf(peer);  // s
+        if (a > 0 && b > 0)
+          std::printf("%s: %.3f s, %s: %.3f s, ratio %.1f\n", what, a, peer_what, b, a / b);
+      };
+  ratio("calibration of 3 x 1000 detectors from 10,000 control points",
+        "BM_PushbroomCalibrate",
+        "BM_PushbroomPolynomialFit",
+        "the plain polynomial fit of the same observations");
+  ratio("L1 rectification of a 3000 x 10000 line image",
+        "BM_L1Rectification",
+        "BM_CvRemap",
         "cv::remap through the same maps");
   benchmark::Shutdown();
   return 0;

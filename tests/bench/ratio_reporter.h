@@ -2,11 +2,11 @@
 // benchmark program can print the time ratio of a run against its peer measured in the same run.
 #pragma once
 
+#include <benchmark/benchmark.h>
+
 #include <map>
 #include <string>
 #include <vector>
-
-#include <benchmark/benchmark.h>
 
 namespace aerocal::testing {
 

@@ -7,26 +7,26 @@
 //
 // Run: cmake -DAEROCAL_BUILD_BENCHMARKS=ON ...; build/tests/bench/bench_rig
 // Arg 0: distortion-free heads (homographies only); arg 1: K1/P1/B1 of a few px (grids).
-#include <chrono>
-#include <cstdio>
-#include <map>
-#include <random>
+#include "stitch/resample/raster.h"
+#include "stitch/rig/error_analysis.h"
+#include "stitch/rig/rig_convert.h"
+#include "stitch/rig/rig_tie_matching.h"
+#include "stitch/rig/self_calibration.h"
+#include "stitch/rig/stitched_image.h"
+#include "tests/bench/discard_sink.h"
+#include "tests/bench/ratio_reporter.h"
+#include "tests/stitch/rig_stitch_line.h"
+#include "tests/support/test_support.h"
+#include "triangulation/simulation/rig_flight_simulator.h"
 
 #include <benchmark/benchmark.h>
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
-#include "stitch/resample/raster.h"
-#include "tests/bench/discard_sink.h"
-#include "tests/bench/ratio_reporter.h"
-#include "stitch/rig/error_analysis.h"
-#include "stitch/rig/rig_convert.h"
-#include "stitch/rig/self_calibration.h"
-#include "stitch/rig/rig_tie_matching.h"
-#include "stitch/rig/stitched_image.h"
-#include "tests/stitch/rig_stitch_line.h"
-#include "tests/support/test_support.h"
-#include "triangulation/simulation/rig_flight_simulator.h"
+#include <chrono>
+#include <cstdio>
+#include <map>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -35,7 +35,7 @@ calib::Rig BenchRig(bool distorted) {
   calib::Rig rig = triangulation::MakeNominalRig(triangulation::RigPreset::kDualLens);
   if (distorted) {
     using Model = calib::BrownFraser10Model;
-    rig.heads[0].camera.interior[Model::kK1] = 2e-7;   // 3 px at r = 45 mm
+    rig.heads[0].camera.interior[Model::kK1] = 2e-7;  // 3 px at r = 45 mm
     rig.heads[0].camera.interior[Model::kP1] = 1e-6;
     rig.heads[1].camera.interior[Model::kK1] = -1.5e-7;
     rig.heads[1].camera.interior[Model::kB1] = 5e-5;
@@ -57,7 +57,6 @@ const std::vector<MemoryRaster>& Heads() {
   return heads;
 }
 
-
 void BM_RigConvert(benchmark::State& state) {
   const calib::Rig rig = BenchRig(state.range(0) != 0);
   const RigExposure nadir;
@@ -68,9 +67,15 @@ void BM_RigConvert(benchmark::State& state) {
   for (auto _ : state) ConvertRigExposure(converter, sources, &sink, {});
   benchmark::DoNotOptimize(sink.checksum_);
   const double mpx = rig.virtual_camera.width_px * 1e-6 * rig.virtual_camera.height_px;
-  state.counters["Mpx/s"] = benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["Mpx/s"] =
+      benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
 }
-BENCHMARK(BM_RigConvert)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
+BENCHMARK(BM_RigConvert)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(2.0);
 
 // The same conversion with cv::remap: per strip, the maps of each head (homography + the same
 // correction grid, bilinear), remap (bilinear, constant border), coverage from the maps, average.
@@ -84,11 +89,13 @@ void BM_CvRemap(benchmark::State& state) {
   std::vector<cv::Mat> sources;
   std::vector<Eigen::Matrix3d> homographies;
   for (int k = 0; k < 2; ++k) {
-    sources.emplace_back(10000, 10000, CV_8UC1, const_cast<std::uint8_t*>(Heads()[k].bytes().data()));
+    sources.emplace_back(
+        10000, 10000, CV_8UC1, const_cast<std::uint8_t*>(Heads()[k].bytes().data()));
     homographies.push_back(HeadFromVirtualHomography(converter, k));
   }
   cv::Mat map_x(strip_rows, width, CV_32FC1), map_y(strip_rows, width, CV_32FC1);
-  cv::Mat warped, in_x, in_y, mask, sum(strip_rows, width, CV_32FC1), count(strip_rows, width, CV_32FC1);
+  cv::Mat warped, in_x, in_y, mask, sum(strip_rows, width, CV_32FC1),
+      count(strip_rows, width, CV_32FC1);
   cv::Mat mean, out;
   double map_seconds = 0.0;
   std::uint64_t checksum = 0;
@@ -124,9 +131,11 @@ void BM_CvRemap(benchmark::State& state) {
             }
           }
         }
-        map_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        map_seconds +=
+            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         const cv::Rect roi(0, 0, width, rows);
-        cv::remap(sources[k], warped, map_x(roi), map_y(roi), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
+        cv::remap(
+            sources[k], warped, map_x(roi), map_y(roi), cv::INTER_LINEAR, cv::BORDER_CONSTANT, 0);
         cv::inRange(map_x(roi), 0.0, 9999.0, in_x);
         cv::inRange(map_y(roi), 0.0, 9999.0, in_y);
         cv::bitwise_and(in_x, in_y, mask);
@@ -141,7 +150,8 @@ void BM_CvRemap(benchmark::State& state) {
   }
   benchmark::DoNotOptimize(checksum);
   const double mpx = width * 1e-6 * height;
-  state.counters["Mpx/s"] = benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["Mpx/s"] =
+      benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
   state.counters["map_s"] = map_seconds / state.iterations();
 }
 BENCHMARK(BM_CvRemap)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
@@ -188,13 +198,18 @@ void BM_RigSelfCalibrationExposure(benchmark::State& state) {
   RigStitchOptions options;
   options.hold_heads = state.range(0) != 0;
   for (auto _ : state) {
-    const RigStitchResult r = SelfCalibrateRigStitching(flight.truth, in.exposures, in.ties,
-                                                        in.observations, in.positions, options);
+    const RigStitchResult r = SelfCalibrateRigStitching(
+        flight.truth, in.exposures, in.ties, in.observations, in.positions, options);
     benchmark::DoNotOptimize(r.sigma0);
   }
   state.counters["observations"] = static_cast<double>(in.observations.size());
 }
-BENCHMARK(BM_RigSelfCalibrationExposure)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+BENCHMARK(BM_RigSelfCalibrationExposure)
+    ->Arg(0)
+    ->Arg(1)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->MinTime(1.0);
 
 // One exposure's self-calibration WITH tie matching and the stitched image (issue 16 items 2, 6):
 // the uav4 line at half its formats (heads 1456 x 2184 px, virtual 4330 x 5880 px), its head
@@ -235,7 +250,8 @@ const StitchedScene& Scene() {
     s.in.observations = first;
     triangulation::RigImageOptions render;
     render.texture_path = data + "/images/img_4880.jpg";
-    const triangulation::TexturedGround ground = triangulation::MakeRigGroundTexture(s.flight, render);
+    const triangulation::TexturedGround ground =
+        triangulation::MakeRigGroundTexture(s.flight, render);
     for (int k = 0; k < 4; ++k) {
       const GrayImage image = triangulation::RenderRigHeadImage(s.flight, ground, render, 0, k);
       s.gray.push_back(image);
@@ -264,8 +280,12 @@ void BM_StitchedExposure(benchmark::State& state) {
   for (auto _ : state) {
     RigTieMatches matches;
     MatchRigExposureTies(s.flight.truth, s.in.exposures[0], 0, s.gray, {}, &matches);
-    const RigStitchResult r = SelfCalibrateRigStitching(s.flight.truth, s.in.exposures, matches.ties,
-                                                        matches.observations, s.in.positions, options);
+    const RigStitchResult r = SelfCalibrateRigStitching(s.flight.truth,
+                                                        s.in.exposures,
+                                                        matches.ties,
+                                                        matches.observations,
+                                                        s.in.positions,
+                                                        options);
     RigExposure pose = s.in.exposures[0].pose;
     pose.increment_rad.assign(4, Eigen::Vector3d::Zero());
     pose.dt_s.assign(4, 0.0);
@@ -273,8 +293,8 @@ void BM_StitchedExposure(benchmark::State& state) {
       pose.increment_rad[s.flight.truth.HeadIndex(h.head)] = h.increment_rad;
       pose.dt_s[s.flight.truth.HeadIndex(h.head)] = h.dt_fitted_s;
     }
-    const RigConverter converter(s.flight.truth, pose,
-                                 {Eigen::Vector3d::UnitZ(), s.in.exposures[0].z_ref_m});
+    const RigConverter converter(
+        s.flight.truth, pose, {Eigen::Vector3d::UnitZ(), s.in.exposures[0].z_ref_m});
     std::vector<RasterSource*> sources;
     for (const auto& h : s.heads) sources.push_back(const_cast<MemoryRaster*>(&h));
     DiscardSink image(v.width_px), mask(v.width_px);
@@ -290,13 +310,14 @@ void BM_StitchedPeerRemap(benchmark::State& state) {
   const StitchedScene& s = Scene();
   if (SkipWithoutScene(s, state)) return;
   const calib::VirtualCamera& v = s.flight.truth.virtual_camera;
-  const RigConverter converter(s.flight.truth, s.in.exposures[0].pose,
+  const RigConverter converter(s.flight.truth,
+                               s.in.exposures[0].pose,
                                {Eigen::Vector3d::UnitZ(), s.in.exposures[0].z_ref_m});
   std::vector<cv::Mat> heads, map_x, map_y;
   for (int k = 0; k < 4; ++k) {
     const RasterInfo info = s.heads[k].Info();
-    heads.push_back(cv::Mat(info.height, info.width, CV_8UC1,
-                            const_cast<std::uint8_t*>(s.heads[k].bytes().data())));
+    heads.push_back(cv::Mat(
+        info.height, info.width, CV_8UC1, const_cast<std::uint8_t*>(s.heads[k].bytes().data())));
     const Eigen::Matrix3d h = HeadFromVirtualHomography(converter, k);
     cv::Mat mx(v.height_px, v.width_px, CV_32FC1), my(v.height_px, v.width_px, CV_32FC1);
     for (int r = 0; r < v.height_px; ++r)
@@ -330,21 +351,29 @@ int main(int argc, char** argv) {
     const double cv = time_of(std::string("BM_CvRemap") + arg);
     if (ours > 0 && cv > 0)
       std::printf("rig convert%s: %.1f ms, cv::remap on the same maps: %.1f ms, ratio %.2f\n",
-                  arg[1] == '0' ? " (distortion-free)" : " (distorted, grids)", ours, cv,
+                  arg[1] == '0' ? " (distortion-free)" : " (distorted, grids)",
+                  ours,
+                  cv,
                   ours / cv);
   }
   const double ours = time_of("BM_RigSelfCalibrationExposure/0");
   const double held = time_of("BM_RigSelfCalibrationExposure/1");
   if (ours > 0 && held > 0)
-    std::printf("self-calibration of one exposure: %.1f ms, the same problem with the heads held: "
-                "%.1f ms, ratio %.2f\n",
-                ours, held, ours / held);
+    std::printf(
+        "self-calibration of one exposure: %.1f ms, the same problem with the heads held: "
+        "%.1f ms, ratio %.2f\n",
+        ours,
+        held,
+        ours / held);
   const double stitched = time_of("BM_StitchedExposure");
   const double remap = time_of("BM_StitchedPeerRemap");
   if (stitched > 0 && remap > 0)
-    std::printf("one exposure's tie matching + self-calibration + stitched image (half formats): %.1f ms, "
-                "cv::remap of the four heads onto the same format: %.1f ms, ratio %.2f\n",
-                stitched, remap, stitched / remap);
+    std::printf(
+        "one exposure's tie matching + self-calibration + stitched image (half formats): %.1f ms, "
+        "cv::remap of the four heads onto the same format: %.1f ms, ratio %.2f\n",
+        stitched,
+        remap,
+        stitched / remap);
   benchmark::Shutdown();
   return 0;
 }

@@ -162,14 +162,19 @@ std::pair<double, double> ClopperPearson95(int k, int n) {
       const double m = 0.5 * (a + b);
       // lower bound: P(X >= k | p) = 0.025; upper: P(X <= k | p) = 0.025
       const double tail = lower ? BinomialTail(k, n, m, true) : BinomialTail(k, n, m, false);
-      if (lower == (tail < 0.025)) a = m; else b = m;
+      if (lower == (tail < 0.025))
+        a = m;
+      else
+        b = m;
     }
     return 0.5 * (a + b);
   };
   return {k == 0 ? 0.0 : solve(true), k == n ? 1.0 : solve(false)};
 }
 
-std::string RejectedBy(const AdjustmentResult& r, const std::string& image, const std::string& point) {
+std::string RejectedBy(const AdjustmentResult& r,
+                       const std::string& image,
+                       const std::string& point) {
   for (const auto& o : r.rejected)
     if (o.image == image && o.point == point) return o.by;
   return "";
@@ -189,10 +194,14 @@ void BM_ConventionalSeeds(benchmark::State& state) {
       model_error += a.snooping.model_error_suspected;
       const double ratio = a.check.spatial_rmse_m / b.check.spatial_rmse_m;
       if (std::abs(ratio - 1) > std::abs(worst_ratio - 1)) worst_ratio = ratio;
-      std::printf("seed %2d conventional: check RMSE %.3f m (no snooping %.3f m), %zu rejected, "
-                  "model error %s\n",
-                  seed, a.check.spatial_rmse_m, b.check.spatial_rmse_m, a.rejected.size(),
-                  a.snooping.model_error_suspected ? "suspected" : "no");
+      std::printf(
+          "seed %2d conventional: check RMSE %.3f m (no snooping %.3f m), %zu rejected, "
+          "model error %s\n",
+          seed,
+          a.check.spatial_rmse_m,
+          b.check.spatial_rmse_m,
+          a.rejected.size(),
+          a.snooping.model_error_suspected ? "suspected" : "no");
     }
     state.counters["control_rays_rejected"] = control_rejected;
     state.counters["worst_rmse_ratio"] = worst_ratio;
@@ -213,8 +222,11 @@ void BM_FalseRejections(benchmark::State& state) {
       runs_with_rejection += !r.rejected.empty();
       rejected += static_cast<int>(r.rejected.size());
       if (!r.rejected.empty())
-        std::printf("clean seed %d: %zu rejected (first w %.2f, group %d)\n", seed,
-                    r.rejected.size(), r.rejected[0].w, r.rejected[0].test.group_size);
+        std::printf("clean seed %d: %zu rejected (first w %.2f, group %d)\n",
+                    seed,
+                    r.rejected.size(),
+                    r.rejected[0].w,
+                    r.rejected[0].test.group_size);
     }
     state.counters["runs"] = runs;
     state.counters["runs_with_rejection"] = runs_with_rejection;
@@ -222,10 +234,15 @@ void BM_FalseRejections(benchmark::State& state) {
     state.counters["rejected"] = rejected;
     const auto ci = ClopperPearson95(runs_with_rejection, runs);
     state.counters["false_rejection_ci95_high"] = ci.second;
-    std::printf("clean flights: %d of %d runs with a rejection (%.3f, 95 %% interval %.3f-%.3f) "
-                "against the family-wise alpha 0.05; %d observations rejected\n",
-                runs_with_rejection, runs, static_cast<double>(runs_with_rejection) / runs,
-                ci.first, ci.second, rejected);
+    std::printf(
+        "clean flights: %d of %d runs with a rejection (%.3f, 95 %% interval %.3f-%.3f) "
+        "against the family-wise alpha 0.05; %d observations rejected\n",
+        runs_with_rejection,
+        runs,
+        static_cast<double>(runs_with_rejection) / runs,
+        ci.first,
+        ci.second,
+        rejected);
   }
 }
 BENCHMARK(BM_FalseRejections)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
@@ -251,7 +268,8 @@ AdjustOptions WithoutSnooping() {
 }
 
 // Whitened residual (col, row) of image/point in r; zero when absent.
-Eigen::Vector2d Whitened(const AdjustmentResult& r, const std::string& image,
+Eigen::Vector2d Whitened(const AdjustmentResult& r,
+                         const std::string& image,
                          const std::string& point) {
   for (const auto& o : r.residuals)
     if (o.image == image && o.point == point && o.used) return o.residual_px / o.sigma_px;
@@ -306,26 +324,41 @@ void BM_SingleBlunder(benchmark::State& state) {
       const double power = PredictedPower(lambda, t_crit * s0 * s0, &rng);
       predicted += power;
       // The former prediction (diagonal of R_ii, s = 1), for the record.
-      const double lambda_diagonal = g * g * (v.test.redundancy.x() * u.x() * u.x() +
-                                              v.test.redundancy.y() * u.y() * u.y());
+      const double lambda_diagonal =
+          g * g * (v.test.redundancy.x() * u.x() * u.x() + v.test.redundancy.y() * u.y() * u.y());
       predicted_diagonal += PredictedPower(lambda_diagonal, t_crit, &rng);
       if (!found)
-        std::printf("missed: seed %d %s/%s r (%.2f, %.2f) group %d lambda %.1f (diagonal %.1f) "
-                    "s %.3f predicted power %.2f, %zu rejected\n",
-                    seed, v.image.c_str(), v.point.c_str(), v.test.redundancy.x(),
-                    v.test.redundancy.y(), v.test.group_size, lambda, lambda_diagonal, s0, power,
-                    r.rejected.size());
+        std::printf(
+            "missed: seed %d %s/%s r (%.2f, %.2f) group %d lambda %.1f (diagonal %.1f) "
+            "s %.3f predicted power %.2f, %zu rejected\n",
+            seed,
+            v.image.c_str(),
+            v.point.c_str(),
+            v.test.redundancy.x(),
+            v.test.redundancy.y(),
+            v.test.group_size,
+            lambda,
+            lambda_diagonal,
+            s0,
+            power,
+            r.rejected.size());
     }
     state.counters["runs"] = runs;
     state.counters["detection_rate"] = static_cast<double>(detected) / runs;
     const auto ci = ClopperPearson95(detected, runs);
     state.counters["detection_ci95_low"] = ci.first;
     state.counters["detection_ci95_high"] = ci.second;
-    std::printf("%.0f sigma: found %d of %d (%.3f, 95 %% interval %.3f-%.3f), predicted power "
-                "%.3f (%s the interval)\n",
-                g, detected, runs, static_cast<double>(detected) / runs, ci.first, ci.second,
-                predicted / runs,
-                predicted / runs >= ci.first && predicted / runs <= ci.second ? "inside" : "OUTSIDE");
+    std::printf(
+        "%.0f sigma: found %d of %d (%.3f, 95 %% interval %.3f-%.3f), predicted power "
+        "%.3f (%s the interval)\n",
+        g,
+        detected,
+        runs,
+        static_cast<double>(detected) / runs,
+        ci.first,
+        ci.second,
+        predicted / runs,
+        predicted / runs >= ci.first && predicted / runs <= ci.second ? "inside" : "OUTSIDE");
     state.counters["predicted_power"] = predicted / runs;
     state.counters["predicted_power_diagonal"] = predicted_diagonal / runs;
     state.counters["blunders_in_groups"] = in_group;
@@ -334,7 +367,12 @@ void BM_SingleBlunder(benchmark::State& state) {
     state.counters["rejections_elsewhere"] = other_rejections;
   }
 }
-BENCHMARK(BM_SingleBlunder)->Arg(20)->Arg(8)->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_SingleBlunder)
+    ->Arg(20)
+    ->Arg(8)
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime();
 
 void BM_ManyBlunders(benchmark::State& state) {
   const double share = state.range(0) / 100.0;
@@ -380,34 +418,50 @@ void BM_ManyBlunders(benchmark::State& state) {
       // component with r < min_redundancy), in a correlated group, or controlled.
       for (const auto& key : blunders) {
         const ObservationResidual* v = clean_test.count(key) ? clean_test.at(key) : nullptr;
-        const int k = !v || !v->test.tested ? 3
+        const int k = !v || !v->test.tested                                             ? 3
                       : v->test.redundancy.minCoeff() < s.clean.snooping.min_redundancy ? 0
-                      : v->test.group_size > 1 ? 1 : 2;
+                      : v->test.group_size > 1                                          ? 1
+                                                                                        : 2;
         ++by_class[k];
         const bool hit = Rejected(r, key.first, key.second);
         found_by_class[k] += hit;
         if (!hit && k > 0)
           for (const auto& f : r.residuals)
             if (f.image == key.first && f.point == key.second)
-              std::printf("  kept %s/%s (%s, r (%.2f, %.2f) group %d): final w (%.2f, %.2f) "
-                          "r (%.2f, %.2f) %s %s\n",
-                          key.first.c_str(), key.second.c_str(), k == 1 ? "grouped" : "controlled",
-                          v->test.redundancy.x(), v->test.redundancy.y(), v->test.group_size,
-                          f.test.w.x(), f.test.w.y(), f.test.redundancy.x(), f.test.redundancy.y(),
-                          f.test.verdict.c_str(), f.test.reason.c_str());
+              std::printf(
+                  "  kept %s/%s (%s, r (%.2f, %.2f) group %d): final w (%.2f, %.2f) "
+                  "r (%.2f, %.2f) %s %s\n",
+                  key.first.c_str(),
+                  key.second.c_str(),
+                  k == 1 ? "grouped" : "controlled",
+                  v->test.redundancy.x(),
+                  v->test.redundancy.y(),
+                  v->test.group_size,
+                  f.test.w.x(),
+                  f.test.w.y(),
+                  f.test.redundancy.x(),
+                  f.test.redundancy.y(),
+                  f.test.verdict.c_str(),
+                  f.test.reason.c_str());
       }
       // The check points the blunders moved: which of their rays held a blunder and why it stayed.
       for (const auto& c : r.check_points)
         for (const auto& c0 : s.clean.check_points)
           if (c.point == c0.point && (c.difference_m - c0.difference_m).norm() > 0.3) {
-            std::printf("  check %s moved %.2f m (%d rays):", c.point.c_str(),
-                        (c.difference_m - c0.difference_m).norm(), c.rays);
+            std::printf("  check %s moved %.2f m (%d rays):",
+                        c.point.c_str(),
+                        (c.difference_m - c0.difference_m).norm(),
+                        c.rays);
             for (const auto& [image, point] : blunders)
               if (point == c.point) {
-                const auto* v = clean_test.count({image, point}) ? clean_test.at({image, point}) : nullptr;
-                std::printf(" blunder %s r (%.2f, %.2f) group %d %s;", image.c_str(),
-                            v ? v->test.redundancy.x() : -1, v ? v->test.redundancy.y() : -1,
-                            v ? v->test.group_size : 0, Rejected(r, image, point) ? "rejected" : "kept");
+                const auto* v =
+                    clean_test.count({image, point}) ? clean_test.at({image, point}) : nullptr;
+                std::printf(" blunder %s r (%.2f, %.2f) group %d %s;",
+                            image.c_str(),
+                            v ? v->test.redundancy.x() : -1,
+                            v ? v->test.redundancy.y() : -1,
+                            v ? v->test.group_size : 0,
+                            Rejected(r, image, point) ? "rejected" : "kept");
               }
             std::printf("\n");
           }
@@ -416,13 +470,15 @@ void BM_ManyBlunders(benchmark::State& state) {
       // correlated group of the clean run (no test can tell them from it), and the others.
       std::map<std::string, int> good_rays;
       std::map<std::pair<std::string, std::string>, int> group_of;
-      for (const auto& o : p.observations) good_rays[o.point] += !blunders.count({o.image, o.point});
+      for (const auto& o : p.observations)
+        good_rays[o.point] += !blunders.count({o.image, o.point});
       for (const auto& o : p.observations)
         if (!blunders.count({o.image, o.point})) {
           ++good;
           if (Used(r, o.image, o.point)) continue;
           ++good_lost;
-          const ObservationResidual* v = clean_test.count({o.image, o.point}) ? clean_test.at({o.image, o.point}) : nullptr;
+          const ObservationResidual* v =
+              clean_test.count({o.image, o.point}) ? clean_test.at({o.image, o.point}) : nullptr;
           // In the blunder's correlated group: in the clean run, or rejected with it as a group
           // the test could not separate (the group of the rejection holds a blundered image).
           bool beside_grouped_blunder = false;
@@ -440,8 +496,13 @@ void BM_ManyBlunders(benchmark::State& state) {
             ++good_lost_in_group;
           } else {
             ++good_lost_other;
-            std::printf("  good lost %s/%s (%d good rays of %s, by %s)\n", o.image.c_str(),
-                        o.point.c_str(), good_rays[o.point], o.point.c_str(), Rejected(r, o.image, o.point) ? RejectedBy(r, o.image, o.point).c_str() : "left out");
+            std::printf("  good lost %s/%s (%d good rays of %s, by %s)\n",
+                        o.image.c_str(),
+                        o.point.c_str(),
+                        good_rays[o.point],
+                        o.point.c_str(),
+                        Rejected(r, o.image, o.point) ? RejectedBy(r, o.image, o.point).c_str()
+                                                      : "left out");
           }
         }
       const double ratio = r.check.spatial_rmse_m / s.clean.check.spatial_rmse_m;
@@ -450,9 +511,13 @@ void BM_ManyBlunders(benchmark::State& state) {
       // beat: their information is gone). Its check RMSE over the clean run's says how much of
       // the ratio above is the lost information, not a fault of the detection.
       const AdjustmentResult oracle = AdjustWithout(p, blunders);
-      worst_oracle_ratio = std::max(worst_oracle_ratio, oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m);
-      worst_ratio_to_oracle = std::max(worst_ratio_to_oracle, ratio * s.clean.check.spatial_rmse_m / oracle.check.spatial_rmse_m);
-      std::printf("seed %d: check RMSE of the oracle (blunders removed by hand) %.3f m\n", seed,
+      worst_oracle_ratio =
+          std::max(worst_oracle_ratio, oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m);
+      worst_ratio_to_oracle =
+          std::max(worst_ratio_to_oracle,
+                   ratio * s.clean.check.spatial_rmse_m / oracle.check.spatial_rmse_m);
+      std::printf("seed %d: check RMSE of the oracle (blunders removed by hand) %.3f m\n",
+                  seed,
                   oracle.check.spatial_rmse_m);
       // The check points whose rays are all controlled, in this run and in the clean one.
       const double ratio_controlled =
@@ -467,10 +532,10 @@ void BM_ManyBlunders(benchmark::State& state) {
           const double d = std::abs(r.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
                            s.clean.cameras[0].sigma[k];
           if (d > camera_sigmas) std::tie(camera_sigmas, camera_worst) = std::make_tuple(d, k);
-          oracle_camera_sigmas = std::max(
-              oracle_camera_sigmas,
-              std::abs(oracle.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
-                  s.clean.cameras[0].sigma[k]);
+          oracle_camera_sigmas =
+              std::max(oracle_camera_sigmas,
+                       std::abs(oracle.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
+                           s.clean.cameras[0].sigma[k]);
         }
       worst_camera_sigmas = std::max(worst_camera_sigmas, camera_sigmas);
       // Why the camera moved: the oracle with the good rays this run lost removed too. The run
@@ -491,10 +556,13 @@ void BM_ManyBlunders(benchmark::State& state) {
       for (int k = 0; k < Model::kNumParams; ++k)
         if (s.clean.cameras[0].sigma[k] > 0) {
           const double sigma = s.clean.cameras[0].sigma[k];
-          lost_sigmas = std::max(lost_sigmas, std::abs(oracle_lost.cameras[0].estimated[k] -
-                                                       s.clean.cameras[0].estimated[k]) / sigma);
-          kept_sigmas = std::max(kept_sigmas, std::abs(r.cameras[0].estimated[k] -
-                                                       oracle_lost.cameras[0].estimated[k]) / sigma);
+          lost_sigmas = std::max(
+              lost_sigmas,
+              std::abs(oracle_lost.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
+                  sigma);
+          kept_sigmas = std::max(
+              kept_sigmas,
+              std::abs(r.cameras[0].estimated[k] - oracle_lost.cameras[0].estimated[k]) / sigma);
         }
       // The oracle's own spread: nested least squares, so oracle - clean has the covariance
       // Q_oracle - Q_clean; per parameter its sigma is sqrt(sigma_oracle^2 - sigma_clean^2).
@@ -505,16 +573,22 @@ void BM_ManyBlunders(benchmark::State& state) {
         if (s.clean.cameras[0].sigma[k] > 0) {
           const double sc = s.clean.cameras[0].sigma[k], so = oracle.cameras[0].sigma[k];
           const double spread = sc * OracleSpread(s.clean, oracle, k);
-          oracle_z = std::max(oracle_z, std::abs(oracle.cameras[0].estimated[k] -
-                                                 s.clean.cameras[0].estimated[k]) / spread);
+          oracle_z = std::max(
+              oracle_z,
+              std::abs(oracle.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) / spread);
           worst_spread = std::max(worst_spread, spread / sc);
           if (std::getenv("AEROCAL_BENCH_DEBUG_SIGMA"))
             std::printf("  %s: clean %.6g +- %.4g, oracle %.6g +- %.4g, run %.6g +- %.4g\n",
                         std::string(Model::kParams[k].name).c_str(),
-                        s.clean.cameras[0].estimated[k], sc, oracle.cameras[0].estimated[k], so,
-                        r.cameras[0].estimated[k], r.cameras[0].sigma[k]);
-          run_vs_oracle = std::max(run_vs_oracle, std::abs(r.cameras[0].estimated[k] -
-                                                           oracle.cameras[0].estimated[k]) / sc);
+                        s.clean.cameras[0].estimated[k],
+                        sc,
+                        oracle.cameras[0].estimated[k],
+                        so,
+                        r.cameras[0].estimated[k],
+                        r.cameras[0].sigma[k]);
+          run_vs_oracle =
+              std::max(run_vs_oracle,
+                       std::abs(r.cameras[0].estimated[k] - oracle.cameras[0].estimated[k]) / sc);
         }
       worst_oracle_z = std::max(worst_oracle_z, oracle_z);
       worst_run_vs_oracle = std::max(worst_run_vs_oracle, run_vs_oracle);
@@ -522,32 +596,42 @@ void BM_ManyBlunders(benchmark::State& state) {
         const int k = camera_worst;
         const double sc = s.clean.cameras[0].sigma[k], so = oracle.cameras[0].sigma[k];
         const double spread = OracleSpread(s.clean, oracle, k);
-        std::printf("seed %d: camera %s: sigma clean %.4g, oracle %.4g, this run %.4g; the oracle's "
-                    "expected spread about the clean camera sqrt(so^2 - sc^2) = %.2f clean sigmas, "
-                    "its offset %.2f of them; over all parameters: oracle |z| max %.2f, spread max "
-                    "%.2f clean sigmas, this run against the oracle max %.2f clean sigmas\n",
-                    seed, std::string(Model::kParams[k].name).c_str(), sc, so,
-                    r.cameras[0].sigma[k], spread,
-                    (oracle.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) /
-                        (sc * spread),
-                    oracle_z, worst_spread, run_vs_oracle);
+        std::printf(
+            "seed %d: camera %s: sigma clean %.4g, oracle %.4g, this run %.4g; the oracle's "
+            "expected spread about the clean camera sqrt(so^2 - sc^2) = %.2f clean sigmas, "
+            "its offset %.2f of them; over all parameters: oracle |z| max %.2f, spread max "
+            "%.2f clean sigmas, this run against the oracle max %.2f clean sigmas\n",
+            seed,
+            std::string(Model::kParams[k].name).c_str(),
+            sc,
+            so,
+            r.cameras[0].sigma[k],
+            spread,
+            (oracle.cameras[0].estimated[k] - s.clean.cameras[0].estimated[k]) / (sc * spread),
+            oracle_z,
+            worst_spread,
+            run_vs_oracle);
       }
       worst_oracle_lost_camera_sigmas = std::max(worst_oracle_lost_camera_sigmas, lost_sigmas);
       worst_kept_camera_sigmas = std::max(worst_kept_camera_sigmas, kept_sigmas);
       {
         const int k = camera_worst;
         const double sigma = s.clean.cameras[0].sigma[k], clean_k = s.clean.cameras[0].estimated[k];
-        std::printf("seed %d: camera %s from the clean run, signed, in sigmas: this run %+.2f, the "
-                    "oracle %+.2f, the oracle without the %zu good rays lost too %+.2f; this run "
-                    "against the latter (the %d blunders kept) %+.2f; over all parameters: "
-                    "oracle+lost %.2f, kept blunders %.2f\n",
-                    seed, std::string(Model::kParams[k].name).c_str(),
-                    (r.cameras[0].estimated[k] - clean_k) / sigma,
-                    (oracle.cameras[0].estimated[k] - clean_k) / sigma,
-                    drop_lost.size() - blunders.size(),
-                    (oracle_lost.cameras[0].estimated[k] - clean_k) / sigma, kept,
-                    (r.cameras[0].estimated[k] - oracle_lost.cameras[0].estimated[k]) / sigma,
-                    lost_sigmas, kept_sigmas);
+        std::printf(
+            "seed %d: camera %s from the clean run, signed, in sigmas: this run %+.2f, the "
+            "oracle %+.2f, the oracle without the %zu good rays lost too %+.2f; this run "
+            "against the latter (the %d blunders kept) %+.2f; over all parameters: "
+            "oracle+lost %.2f, kept blunders %.2f\n",
+            seed,
+            std::string(Model::kParams[k].name).c_str(),
+            (r.cameras[0].estimated[k] - clean_k) / sigma,
+            (oracle.cameras[0].estimated[k] - clean_k) / sigma,
+            drop_lost.size() - blunders.size(),
+            (oracle_lost.cameras[0].estimated[k] - clean_k) / sigma,
+            kept,
+            (r.cameras[0].estimated[k] - oracle_lost.cameras[0].estimated[k]) / sigma,
+            lost_sigmas,
+            kept_sigmas);
       }
       // Issue 9's check RMSE within 2 % of the clean run: by where the blunders fell. The check
       // points none of whose rays held a blunder keep their intersection whole; a check point
@@ -569,11 +653,18 @@ void BM_ManyBlunders(benchmark::State& state) {
       sum_ratio += ratio;
       sum_oracle_ratio += oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m;
       ++seeds_run;
-      std::printf("seed %d: check RMSE / clean run %.3f (the acceptance's figure), / the oracle %.3f, "
-                  "oracle / clean %.3f; over the %zu check points whose rays held no blunder (%zu "
-                  "touched): this run / clean %.3f, oracle / clean %.3f\n",
-                  seed, ratio, to_oracle, oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m,
-                  untouched.size(), touched.size(), ratio_untouched, oracle_untouched);
+      std::printf(
+          "seed %d: check RMSE / clean run %.3f (the acceptance's figure), / the oracle %.3f, "
+          "oracle / clean %.3f; over the %zu check points whose rays held no blunder (%zu "
+          "touched): this run / clean %.3f, oracle / clean %.3f\n",
+          seed,
+          ratio,
+          to_oracle,
+          oracle.check.spatial_rmse_m / s.clean.check.spatial_rmse_m,
+          untouched.size(),
+          touched.size(),
+          ratio_untouched,
+          oracle_untouched);
       if (controlled_only) {  // partial oracles: only the blunders of one kind removed
         const char kinds[3] = {'K', 'C', 'T'};
         std::printf("seed %d: oracle / clean with only the blunders on", seed);
@@ -582,10 +673,10 @@ void BM_ManyBlunders(benchmark::State& state) {
           for (const auto& key : blunders)
             if (!key.second.empty() && key.second[0] == kinds[k]) of_kind.insert(key);
           planted_by_kind[k] += static_cast<int>(of_kind.size());
-          const double kind_ratio =
-              of_kind.empty() ? 1.0
-                              : AdjustWithout(s.project, of_kind).check.spatial_rmse_m /
-                                    s.clean.check.spatial_rmse_m;
+          const double kind_ratio = of_kind.empty()
+                                        ? 1.0
+                                        : AdjustWithout(s.project, of_kind).check.spatial_rmse_m /
+                                              s.clean.check.spatial_rmse_m;
           sum_kind_ratio[k] += kind_ratio;
           worst_kind_ratio[k] = std::max(worst_kind_ratio[k], kind_ratio);
           std::printf(" %c rays (%zu) removed %.3f;", kinds[k], of_kind.size(), kind_ratio);
@@ -593,20 +684,30 @@ void BM_ManyBlunders(benchmark::State& state) {
         std::printf("\n");
       }
       worst_oracle_camera_sigmas = std::max(worst_oracle_camera_sigmas, oracle_camera_sigmas);
-      std::printf("seed %d: camera %.2f sigma from the clean run (%s); the oracle's %.2f\n", seed,
-                  camera_sigmas, std::string(Model::kParams[camera_worst].name).c_str(),
+      std::printf("seed %d: camera %.2f sigma from the clean run (%s); the oracle's %.2f\n",
+                  seed,
+                  camera_sigmas,
+                  std::string(Model::kParams[camera_worst].name).c_str(),
                   oracle_camera_sigmas);
-      std::printf("seed %d, %.0f %% blunders: %zu planted, robust start %s (%d excluded, %d "
-                  "re-admitted, %d re-tested), %zu rejected, valid %s, check RMSE %.3f m (clean %.3f m), "
-                  "controlled check points %d: %.3f m (clean %d: %.3f m)\n",
-                  seed, 100 * share, blunders.size(), r.snooping.robust_start ? "yes" : "no",
-                  r.snooping.robust_excluded, r.snooping.robust_readmitted,
-                  r.snooping.robust_retested, r.rejected.size(),
-                  r.valid ? "yes" : "no", r.check.spatial_rmse_m, s.clean.check.spatial_rmse_m,
-                  r.check_controlled ? r.check_controlled->n : 0,
-                  r.check_controlled ? r.check_controlled->spatial_rmse_m : 0.0,
-                  s.clean.check_controlled ? s.clean.check_controlled->n : 0,
-                  s.clean.check_controlled ? s.clean.check_controlled->spatial_rmse_m : 0.0);
+      std::printf(
+          "seed %d, %.0f %% blunders: %zu planted, robust start %s (%d excluded, %d "
+          "re-admitted, %d re-tested), %zu rejected, valid %s, check RMSE %.3f m (clean %.3f m), "
+          "controlled check points %d: %.3f m (clean %d: %.3f m)\n",
+          seed,
+          100 * share,
+          blunders.size(),
+          r.snooping.robust_start ? "yes" : "no",
+          r.snooping.robust_excluded,
+          r.snooping.robust_readmitted,
+          r.snooping.robust_retested,
+          r.rejected.size(),
+          r.valid ? "yes" : "no",
+          r.check.spatial_rmse_m,
+          s.clean.check.spatial_rmse_m,
+          r.check_controlled ? r.check_controlled->n : 0,
+          r.check_controlled ? r.check_controlled->spatial_rmse_m : 0.0,
+          s.clean.check_controlled ? s.clean.check_controlled->n : 0,
+          s.clean.check_controlled ? s.clean.check_controlled->spatial_rmse_m : 0.0);
       for (const auto& why : r.invalid_reasons) {  // issue 9 (c): why a run ends invalid
         std::printf("  seed %d invalid: %s\n", seed, why.c_str());
         ++invalid_by_reason[why.substr(0, why.find_first_of("(0123456789:"))];
@@ -623,40 +724,59 @@ void BM_ManyBlunders(benchmark::State& state) {
     state.counters["runs_within_2pct_of_clean"] = runs_within_2_clean;
     state.counters["runs_within_2pct_of_oracle"] = runs_within_2_oracle;
     state.counters["runs_within_2pct_of_clean_untouched"] = runs_within_2_untouched;
-    std::printf("over %d seeds: check RMSE / clean run mean %.3f, worst %.3f, within 2 %% in %d; "
-                "/ the oracle worst %.3f, within 2 %% in %d; oracle / clean mean %.3f, worst %.3f; "
-                "over the check points whose rays held no blunder: this run / clean worst %.3f, "
-                "within 2 %% in %d, oracle / clean worst %.3f\n",
-                seeds_run, sum_ratio / std::max(1, seeds_run), worst_rmse_ratio, runs_within_2_clean,
-                worst_ratio_to_oracle, runs_within_2_oracle,
-                sum_oracle_ratio / std::max(1, seeds_run), worst_oracle_ratio,
-                worst_ratio_untouched, runs_within_2_untouched, worst_oracle_untouched);
+    std::printf(
+        "over %d seeds: check RMSE / clean run mean %.3f, worst %.3f, within 2 %% in %d; "
+        "/ the oracle worst %.3f, within 2 %% in %d; oracle / clean mean %.3f, worst %.3f; "
+        "over the check points whose rays held no blunder: this run / clean worst %.3f, "
+        "within 2 %% in %d, oracle / clean worst %.3f\n",
+        seeds_run,
+        sum_ratio / std::max(1, seeds_run),
+        worst_rmse_ratio,
+        runs_within_2_clean,
+        worst_ratio_to_oracle,
+        runs_within_2_oracle,
+        sum_oracle_ratio / std::max(1, seeds_run),
+        worst_oracle_ratio,
+        worst_ratio_untouched,
+        runs_within_2_untouched,
+        worst_oracle_untouched);
     if (controlled_only)
       for (int k = 0; k < 3; ++k) {
         const char kinds[3] = {'K', 'C', 'T'};
-        std::printf("blunders on %c rays: %d planted; oracle / clean with only them removed: mean "
-                    "%.3f, worst %.3f\n",
-                    kinds[k], planted_by_kind[k], sum_kind_ratio[k] / std::max(1, seeds_run),
-                    worst_kind_ratio[k]);
+        std::printf(
+            "blunders on %c rays: %d planted; oracle / clean with only them removed: mean "
+            "%.3f, worst %.3f\n",
+            kinds[k],
+            planted_by_kind[k],
+            sum_kind_ratio[k] / std::max(1, seeds_run),
+            worst_kind_ratio[k]);
         state.counters[std::string("oracle_ratio_only_") + kinds[k]] = worst_kind_ratio[k];
       }
-    std::printf("camera: this run worst %.2f sigma from the clean run; the oracle %.2f; the oracle "
-                "without the good rays lost too %.2f; this run against the latter (kept blunders) "
-                "%.2f; this run against the oracle %.2f; the oracle's offset in its expected spread (z) "
-                "%.2f\n",
-                worst_camera_sigmas, worst_oracle_camera_sigmas, worst_oracle_lost_camera_sigmas,
-                worst_kept_camera_sigmas, worst_run_vs_oracle, worst_oracle_z);
+    std::printf(
+        "camera: this run worst %.2f sigma from the clean run; the oracle %.2f; the oracle "
+        "without the good rays lost too %.2f; this run against the latter (kept blunders) "
+        "%.2f; this run against the oracle %.2f; the oracle's offset in its expected spread (z) "
+        "%.2f\n",
+        worst_camera_sigmas,
+        worst_oracle_camera_sigmas,
+        worst_oracle_lost_camera_sigmas,
+        worst_kept_camera_sigmas,
+        worst_run_vs_oracle,
+        worst_oracle_z);
     state.counters["worst_oracle_rmse_ratio"] = worst_oracle_ratio;        // oracle / clean
     state.counters["worst_rmse_ratio_to_oracle"] = worst_ratio_to_oracle;  // this run / oracle
     state.counters["worst_oracle_camera_offset_sigmas"] = worst_oracle_camera_sigmas;
-    for (const auto& [why, n] : invalid_by_reason) std::printf("invalid %d run(s): %s\n", n, why.c_str());
+    for (const auto& [why, n] : invalid_by_reason)
+      std::printf("invalid %d run(s): %s\n", n, why.c_str());
     state.counters["planted"] = planted;
     state.counters["found_share"] = static_cast<double>(found) / std::max(1, planted);
     state.counters["good_lost_share"] = static_cast<double>(good_lost) / std::max(1, good);
     state.counters["good_lost_share_undetermined"] =
         static_cast<double>(good_lost_undetermined) / std::max(1, good);
-    state.counters["good_lost_share_in_group"] = static_cast<double>(good_lost_in_group) / std::max(1, good);
-    state.counters["good_lost_share_other"] = static_cast<double>(good_lost_other) / std::max(1, good);
+    state.counters["good_lost_share_in_group"] =
+        static_cast<double>(good_lost_in_group) / std::max(1, good);
+    state.counters["good_lost_share_other"] =
+        static_cast<double>(good_lost_other) / std::max(1, good);
     // Issue 18's "good observations lost", both ways: every good observation not used at the end,
     // and the avoidable ones. Not avoidable: the single good ray of a point whose other rays are
     // all blunders (one ray of an unknown point has no redundancy: it determines nothing else,
@@ -664,12 +784,16 @@ void BM_ManyBlunders(benchmark::State& state) {
     // with a blunder whose standardised residuals no test can separate (keeping them keeps the
     // blunder). A point with 2 good rays and 1 blunder is NOT in the first class.
     state.counters["good_lost_share_avoidable"] = state.counters["good_lost_share_other"];
-    std::printf("good observations lost: all %.2f %% (%d of %d), avoidable %.2f %% (%d); on points "
-                "left with < 2 good rays %.2f %%, in an inseparable group with a blunder %.2f %%\n",
-                100.0 * good_lost / std::max(1, good), good_lost, good,
-                100.0 * good_lost_other / std::max(1, good), good_lost_other,
-                100.0 * good_lost_undetermined / std::max(1, good),
-                100.0 * good_lost_in_group / std::max(1, good));
+    std::printf(
+        "good observations lost: all %.2f %% (%d of %d), avoidable %.2f %% (%d); on points "
+        "left with < 2 good rays %.2f %%, in an inseparable group with a blunder %.2f %%\n",
+        100.0 * good_lost / std::max(1, good),
+        good_lost,
+        good,
+        100.0 * good_lost_other / std::max(1, good),
+        good_lost_other,
+        100.0 * good_lost_undetermined / std::max(1, good),
+        100.0 * good_lost_in_group / std::max(1, good));
     state.counters["worst_rmse_ratio"] = worst_rmse_ratio;
     state.counters["worst_rmse_ratio_controlled"] = worst_rmse_ratio_controlled;
     state.counters["worst_camera_offset_sigmas"] = worst_camera_sigmas;
@@ -680,7 +804,13 @@ void BM_ManyBlunders(benchmark::State& state) {
     }
   }
 }
-BENCHMARK(BM_ManyBlunders)->Args({1, 1})->Args({1, 0})->Args({5, 0})->Iterations(1)->Unit(benchmark::kSecond)->UseRealTime();
+BENCHMARK(BM_ManyBlunders)
+    ->Args({1, 1})
+    ->Args({1, 0})
+    ->Args({5, 0})
+    ->Iterations(1)
+    ->Unit(benchmark::kSecond)
+    ->UseRealTime();
 
 void BM_OdmUavBlock(benchmark::State& state) {
   const std::string dir = testing::SharedDataDir("odm_br_uav_gcp_block");

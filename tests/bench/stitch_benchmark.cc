@@ -2,29 +2,28 @@
 // (a) BM_AdjustFrame: one 6-CCD frame (2 x 3, 14000 x 12000 px, base II and V) with 900 tie points
 //     adjusted, affine with data snooping, and with the model chosen by the F test (all 4 models).
 // (b) BM_Resample / BM_OpenCvWarpAffine / BM_Copy: the 14000 x 12000 16-bit virtual image from 6
-//     sub-images (sub-pixel affine misplacements), bilinear, overlaps averaged, ON ONE CORE (one TBB
-//     thread, cv::setNumThreads(1)); ours strip-wise, OpenCV's cv::warpAffine doing the same six
-//     warps (plus a coverage warp each) into the same strips and the same averaging, and a plain
-//     copy (std::memcpy) of as many bytes as the virtual image has, from one buffer to another,
-//     both far larger than the caches: the machine's memory bandwidth for this amount of output.
-//     Arg 0 of BM_Resample is the fast path, arg 1 the reference (per-pixel double) path.
+//     sub-images (sub-pixel affine misplacements), bilinear, overlaps averaged, ON ONE CORE (one
+//     TBB thread, cv::setNumThreads(1)); ours strip-wise, OpenCV's cv::warpAffine doing the same
+//     six warps (plus a coverage warp each) into the same strips and the same averaging, and a
+//     plain copy (std::memcpy) of as many bytes as the virtual image has, from one buffer to
+//     another, both far larger than the caches: the machine's memory bandwidth for this amount of
+//     output. Arg 0 of BM_Resample is the fast path, arg 1 the reference (per-pixel double) path.
 //     Counter "Mpx/s" is virtual-image Mpx per second; the program ends by printing the ratios.
 // Run: cmake -DAEROCAL_BUILD_BENCHMARKS=ON ...; build/tests/bench/bench_stitch
+#include "stitch/adjustment/model_selection.h"
+#include "stitch/resample/virtual_image.h"
+#include "tests/bench/discard_sink.h"
+#include "tests/bench/ratio_reporter.h"
+#include "tests/stitch/simulated_camera.h"
+
+#include <Eigen/LU>
 #include <benchmark/benchmark.h>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <cstring>
 #include <random>
 #include <string>
-
-#include <Eigen/LU>
-#include <opencv2/core.hpp>
-#include <opencv2/imgproc.hpp>
-
-#include "tests/bench/discard_sink.h"
-#include "tests/bench/ratio_reporter.h"
-#include "stitch/adjustment/model_selection.h"
-#include "stitch/resample/virtual_image.h"
-#include "tests/stitch/simulated_camera.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -40,7 +39,8 @@ void BM_AdjustFrame(benchmark::State& state) {
     if (choose)
       sigma0_px = ChooseModel(camera.nominal, frames[0], options).Chosen().sigma0_px;
     else
-      sigma0_px = AdjustFrame(camera.nominal, frames[0], calib::MappingModel::kAffine, options).sigma0_px;
+      sigma0_px =
+          AdjustFrame(camera.nominal, frames[0], calib::MappingModel::kAffine, options).sigma0_px;
   }
   state.SetLabel(choose ? "auto (4 models, F test)" : "affine");
   state.counters["ties"] = static_cast<double>(frames[0].ties.size());
@@ -71,7 +71,6 @@ const ResampleScene& Scene() {
   return scene;
 }
 
-
 void BM_Resample(benchmark::State& state) {
   auto& scene = const_cast<ResampleScene&>(Scene());
   std::vector<RasterSource*> sources;
@@ -83,7 +82,8 @@ void BM_Resample(benchmark::State& state) {
   options.reference = state.range(0) == 1;
   for (auto _ : state) ResampleVirtualImage(scene.truth, sources, &sink, options);
   const double mpx = scene.truth.width_px * 1e-6 * scene.truth.height_px;
-  state.counters["Mpx/s"] = benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["Mpx/s"] =
+      benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_Resample)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
@@ -94,8 +94,8 @@ void BM_OpenCvWarpAffine(benchmark::State& state) {
   std::vector<cv::Mat> sources;
   for (const auto& image : scene.images) {
     const RasterInfo info = image.Info();
-    sources.emplace_back(info.height, info.width, CV_16UC1,
-                         const_cast<std::uint8_t*>(image.bytes().data()));
+    sources.emplace_back(
+        info.height, info.width, CV_16UC1, const_cast<std::uint8_t*>(image.bytes().data()));
   }
   std::vector<cv::Mat> ones;
   for (const auto& s : sources) ones.emplace_back(s.size(), CV_8UC1, cv::Scalar(1));
@@ -118,13 +118,27 @@ void BM_OpenCvWarpAffine(benchmark::State& state) {
         if (x0 >= x1 || r0 >= r1) continue;
         // Affine map from the ROI's pixels to the sub-image (inverse map).
         const Eigen::Matrix3d m = calib::HomographyFromParams(s.model, s.params.data()).inverse();
-        cv::Mat map = (cv::Mat_<double>(2, 3) << m(0, 0), m(0, 1), m(0, 2) + m(0, 0) * x0 + m(0, 1) * r0,
-                       m(1, 0), m(1, 1), m(1, 2) + m(1, 0) * x0 + m(1, 1) * r0);
+        cv::Mat map = (cv::Mat_<double>(2, 3) << m(0, 0),
+                       m(0, 1),
+                       m(0, 2) + m(0, 0) * x0 + m(0, 1) * r0,
+                       m(1, 0),
+                       m(1, 1),
+                       m(1, 2) + m(1, 0) * x0 + m(1, 1) * r0);
         const cv::Size size(x1 - x0, r1 - r0);
-        cv::warpAffine(sources[k], warped, map, size, cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
-                       cv::BORDER_CONSTANT, 0);
-        cv::warpAffine(ones[k], coverage, map, size, cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
-                       cv::BORDER_CONSTANT, 0);
+        cv::warpAffine(sources[k],
+                       warped,
+                       map,
+                       size,
+                       cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
+                       cv::BORDER_CONSTANT,
+                       0);
+        cv::warpAffine(ones[k],
+                       coverage,
+                       map,
+                       size,
+                       cv::INTER_NEAREST | cv::WARP_INVERSE_MAP,
+                       cv::BORDER_CONSTANT,
+                       0);
         const cv::Rect roi(x0, r0 - y0, size.width, size.height);
         cv::Mat sum_roi = sum(roi), count_roi = count(roi);
         cv::accumulate(warped, sum_roi);
@@ -138,7 +152,8 @@ void BM_OpenCvWarpAffine(benchmark::State& state) {
   }
   benchmark::DoNotOptimize(checksum);
   const double mpx = width * 1e-6 * height;
-  state.counters["Mpx/s"] = benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["Mpx/s"] =
+      benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_OpenCvWarpAffine)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(5.0);
 
@@ -152,7 +167,8 @@ void BM_Copy(benchmark::State& state) {
     benchmark::DoNotOptimize(to.data());
     benchmark::ClobberMemory();
   }
-  state.counters["GB/s"] = benchmark::Counter(2e-9 * bytes * state.iterations(), benchmark::Counter::kIsRate);
+  state.counters["GB/s"] =
+      benchmark::Counter(2e-9 * bytes * state.iterations(), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_Copy)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(2.0);
 
@@ -173,10 +189,14 @@ int main(int argc, char** argv) {
     for (const std::string name : {"BM_Resample/0", "BM_Resample/1"}) {
       const double ours = time_of(name);
       if (ours <= 0) continue;
-      std::printf("%s %s (%s): %.1f ms", cpu ? "CPU " : "wall", name.c_str(),
-                  name.back() == '0' ? "fast" : "reference", ours);
+      std::printf("%s %s (%s): %.1f ms",
+                  cpu ? "CPU " : "wall",
+                  name.c_str(),
+                  name.back() == '0' ? "fast" : "reference",
+                  ours);
       if (warp > 0) std::printf(", cv::warpAffine %.1f ms: %.2fx as fast", warp, warp / ours);
-      if (copy > 0) std::printf(", copy %.1f ms: %.1f %% of the copy's bandwidth", copy, 100 * copy / ours);
+      if (copy > 0)
+        std::printf(", copy %.1f ms: %.1f %% of the copy's bandwidth", copy, 100 * copy / ours);
       std::printf("\n");
     }
   }

@@ -274,8 +274,8 @@ BENCHMARK(BM_AdjustDefaults)
 
 // issue 9's large block: `aerocal simulate --exposures N --strips S` (tie and surveyed point
 // densities of SimulateBlock: 16 tie points and 2 surveyed points per exposure, one control point
-// per 20 exposures), then `aerocal adjust` with its DEFAULT options (snooping and covariance on) in a child
-// process. Target at 10,000 / 40: < 15 min and < 16 GiB. Counters: adjust_s, adjust_cpu_s,
+// per 20 exposures), then `aerocal adjust` with its DEFAULT options (snooping and covariance on) in
+// a child process. Target at 10,000 / 40: < 15 min and < 16 GiB. Counters: adjust_s, adjust_cpu_s,
 // adjust_peak_rss_mb, the stages from the result's `timing` (solve_s, snooping_s, testing_s,
 // covariance_s), snooping_share (snooping_s / total_s), observations, exit code.
 // Run: /work/bin/cpu-long build/tests/bench/bench_triangulation
@@ -283,12 +283,12 @@ BENCHMARK(BM_AdjustDefaults)
 void BM_AdjustLargeSimulated(benchmark::State& state) {
   const int exposures = static_cast<int>(state.range(0)), strips = static_cast<int>(state.range(1));
   testing::TempDir dir("aerocal_bench_large");
-  const std::string simulate =
-      testing::AerocalBinary() + " simulate --exposures " + std::to_string(exposures) +
-      " --strips " + std::to_string(strips) + " --tie-points " + std::to_string(16 * exposures) +
-      " --surveyed-points " + std::to_string(2 * exposures) + " --control " +
-      std::to_string(exposures / 20) + " --stitch-ties 0 --out " + dir.File("block") +
-      " > /dev/null";
+  const std::string simulate = testing::AerocalBinary() + " simulate --exposures " +
+                               std::to_string(exposures) + " --strips " + std::to_string(strips) +
+                               " --tie-points " + std::to_string(16 * exposures) +
+                               " --surveyed-points " + std::to_string(2 * exposures) +
+                               " --control " + std::to_string(exposures / 20) +
+                               " --stitch-ties 0 --out " + dir.File("block") + " > /dev/null";
   if (std::system(simulate.c_str()) != 0) {
     state.SkipWithError("aerocal simulate failed");
     return;

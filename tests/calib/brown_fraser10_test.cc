@@ -1,12 +1,13 @@
 // Tests of the 10-parameter model (CONVENTIONS.md): zero terms, the inverse to 1e-6 px over the
 // whole format, derivatives against numeric differentiation, and a nadir projection by hand.
-#include <random>
+#include "calib/camera/brown_fraser10.h"
+
+#include "calib/camera/camera.h"
 
 #include <ceres/jet.h>
 #include <gtest/gtest.h>
 
-#include "calib/camera/brown_fraser10.h"
-#include "calib/camera/camera.h"
+#include <random>
 
 namespace aerocal::calib {
 namespace {
@@ -74,7 +75,8 @@ TEST(BrownFraser10, InverseRoundTripBelowOneMicropixelOverTheWholeFormat) {
   double worst_px = 0.0;
   for (int i = 0; i <= 40; ++i) {
     for (int k = 0; k <= 40; ++k) {
-      const Eigen::Vector2d measured(-half_w + 2 * half_w * i / 40.0, -half_h + 2 * half_h * k / 40.0);
+      const Eigen::Vector2d measured(-half_w + 2 * half_w * i / 40.0,
+                                     -half_h + 2 * half_h * k / 40.0);
       Eigen::Vector2d ideal, back;
       Model::IdealFromMeasured(p.data(), measured.data(), ideal.data());
       ASSERT_TRUE(Model::MeasuredFromIdeal(p.data(), ideal, &back));
@@ -113,7 +115,8 @@ TEST(BrownFraser10, AutodiffDerivativesMatchNumericDifferentiation) {
     Model::IdealFromMeasured(pm, xm, b);
     for (int k = 0; k < 2; ++k) {
       const double numeric = (a[k] - b[k]) / (2 * h);
-      EXPECT_NEAR(out[k].v[v], numeric, 1e-6 * std::max(1.0, std::abs(numeric))) << "variable " << v;
+      EXPECT_NEAR(out[k].v[v], numeric, 1e-6 * std::max(1.0, std::abs(numeric)))
+          << "variable " << v;
     }
   }
 }

@@ -1,17 +1,17 @@
 // Camera files as other tools really write them (issue 29): one reader test per variant, on a file
 // in the exact layout of that tool (small numeric records; where each layout comes from is said at
 // each test), plus the registry's detection (`--from auto`) and what a wrong --from says.
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/error.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
-
-#include <gtest/gtest.h>
-
-#include "calib/camera/formats/camera_formats.h"
-#include "calib/core/error.h"
-#include "tests/support/test_support.h"
 
 namespace aerocal::calib {
 namespace {
@@ -29,7 +29,8 @@ std::string Data(const std::string& name) {
 }
 
 // The InputError message of reading `path` as `format` ("" when it reads).
-std::string ReadError(const std::string& format, const std::string& path,
+std::string ReadError(const std::string& format,
+                      const std::string& path,
                       const CameraReadOptions& options = {}) {
   try {
     ReadCameraFileAs(format, path, options);
@@ -52,8 +53,18 @@ bool HasNote(const CameraFile& f, const std::string& part) {
 TEST(CameraFileRegistry, EveryWrittenFileIsDetectedAsItsOwnFormatOnly) {
   TempDir dir("aerocal_variants");
   const ModelCamera drone = {CameraModelId::kOpenCv,
-                             {3684.48, 3677.57, 2738.24, 1846.05, -0.263482, 0.106788, 3.71107e-5,
-                              -3.27247e-4, -0.0300783, 0, 0, 0},
+                             {3684.48,
+                              3677.57,
+                              2738.24,
+                              1846.05,
+                              -0.263482,
+                              0.106788,
+                              3.71107e-5,
+                              -3.27247e-4,
+                              -0.0300783,
+                              0,
+                              0,
+                              0},
                              {0.0024, 5472, 3648}};
   for (const CameraFormat& f : CameraFormats()) {
     SCOPED_TRACE(f.name);
@@ -69,7 +80,8 @@ TEST(CameraFileRegistry, EveryWrittenFileIsDetectedAsItsOwnFormatOnly) {
 
 TEST(CameraFileRegistry, AWrongFromNamesWhatTheFileLooksLike) {
   TempDir dir("aerocal_variants");
-  const std::string kalibr = Write(dir, "camchain.yaml",
+  const std::string kalibr = Write(dir,
+                                   "camchain.yaml",
                                    "cam0:\n  camera_model: pinhole\n  intrinsics: [458.654, "
                                    "457.296, 367.215, 248.375]\n  distortion_model: radtan\n"
                                    "  distortion_coeffs: [-0.28340811, 0.07395907, 0.00019359, "
@@ -91,7 +103,8 @@ TEST(CameraFileRegistry, AWrongFromNamesWhatTheFileLooksLike) {
 TEST(CameraFileVariants, RosCameraInfoOfARealCalibration) {
   TempDir dir("aerocal_variants");
   const std::string path = Write(
-      dir, "pg2_800x600_calib.yml",
+      dir,
+      "pg2_800x600_calib.yml",
       "image_width: 800\nimage_height: 600\ncamera_name: 00b09d0100990bb6\ncamera_matrix:\n"
       "  rows: 3\n  cols: 3\n  data: [538.63, 0, 457.698, 0, 539.723, 297.003, 0, 0, 1]\n"
       "distortion_coefficients:\n  rows: 1\n  cols: 5\n  data: [-0.30678, 0.0825017, 0.0028784, "
@@ -119,11 +132,14 @@ TEST(CameraFileVariants, RosCameraInfoRejectsWhatItCannotHold) {
   EXPECT_NE(ReadError("ros", Write(dir, "a.yaml", head + "  data: [.nan, 0, 0, 0, 0]\n"))
                 .find("a.yaml:11"),
             std::string::npos);
-  EXPECT_NE(ReadError("ros", Write(dir, "b.yaml", head + "  data: [0, 0, 0, 0]\n"))
-                .find("rows x cols"),
-            std::string::npos);
-  EXPECT_NE(ReadError("ros", Write(dir, "c.yaml", head + "  data: [0, 0, 0, 0, 0]\n"
-                                                         "image_width: 640\n"))
+  EXPECT_NE(
+      ReadError("ros", Write(dir, "b.yaml", head + "  data: [0, 0, 0, 0]\n")).find("rows x cols"),
+      std::string::npos);
+  EXPECT_NE(ReadError("ros",
+                      Write(dir,
+                            "c.yaml",
+                            head + "  data: [0, 0, 0, 0, 0]\n"
+                                   "image_width: 640\n"))
                 .find("c.yaml"),
             std::string::npos);  // a duplicated key is an error, not the first one taken
 }
@@ -135,7 +151,8 @@ TEST(CameraFileVariants, RosCameraInfoRejectsWhatItCannotHold) {
 TEST(CameraFileVariants, CamodocalPinholeOfVinsFusionEuroc) {
   TempDir dir("aerocal_variants");
   const std::string path = Write(
-      dir, "cam0_pinhole.yaml",
+      dir,
+      "cam0_pinhole.yaml",
       "%YAML:1.0\n---\nmodel_type: PINHOLE\ncamera_name: camera\nimage_width: 752\n"
       "image_height: 480\ndistortion_parameters:\n   k1: -2.9250563288482467e-01\n"
       "   k2: 8.3305380138632271e-02\n   p1: 2.4650824570721693e-05\n"
@@ -166,21 +183,23 @@ TEST(CameraFileVariants, CamodocalPinholeOfVinsFusionEuroc) {
 // without a calibration, then one whose <covariance> is beside the <calibration>.
 TEST(CameraFileVariants, MetashapeSensorsWithCovarianceBesideTheCalibration) {
   TempDir dir("aerocal_variants");
-  const std::string path = Write(
-      dir, "sensors.xml",
-      "<sensors>\n<sensor id=\"0\" label=\"Test_Pro (10.26mm)\" type=\"frame\">\n"
-      "<resolution width=\"5472\" height=\"3648\"/>\n</sensor>\n"
-      "<sensor id=\"1\" label=\"Test_Pro (10.26mm)\" type=\"frame\">\n"
-      "<resolution width=\"5472\" height=\"3648\"/>\n"
-      "<property name=\"pixel_width\" value=\"0.0024107142857142856\"/>\n"
-      "<property name=\"pixel_height\" value=\"0.0024107142857142856\"/>\n"
-      "<calibration type=\"frame\" class=\"adjusted\">\n<resolution width=\"5472\" height=\"3648\"/>\n"
-      "<f>3239.2350850187408</f>\n<cx>-17.266617222361305</cx>\n<cy>51.627079230267093</cy>\n"
-      "<k1>-0.0061748904544724733</k1>\n<k2>0.0085312948846406767</k2>\n"
-      "<k3>-0.0059426077261182687</k3>\n<p1>0.0038636434570336977</p1>\n"
-      "<p2>0.00036559169480901107</p2>\n</calibration>\n<covariance>\n<params>f cx</params>\n"
-      "<coeffs>1.3198921426619455e+02 -3.6441406803097598e-01 -3.6441406803097598e-01 "
-      "8.8492784732170038e-01</coeffs>\n</covariance>\n</sensor>\n</sensors>\n");
+  const std::string path =
+      Write(dir,
+            "sensors.xml",
+            "<sensors>\n<sensor id=\"0\" label=\"Test_Pro (10.26mm)\" type=\"frame\">\n"
+            "<resolution width=\"5472\" height=\"3648\"/>\n</sensor>\n"
+            "<sensor id=\"1\" label=\"Test_Pro (10.26mm)\" type=\"frame\">\n"
+            "<resolution width=\"5472\" height=\"3648\"/>\n"
+            "<property name=\"pixel_width\" value=\"0.0024107142857142856\"/>\n"
+            "<property name=\"pixel_height\" value=\"0.0024107142857142856\"/>\n"
+            "<calibration type=\"frame\" class=\"adjusted\">\n<resolution width=\"5472\" "
+            "height=\"3648\"/>\n"
+            "<f>3239.2350850187408</f>\n<cx>-17.266617222361305</cx>\n<cy>51.627079230267093</cy>\n"
+            "<k1>-0.0061748904544724733</k1>\n<k2>0.0085312948846406767</k2>\n"
+            "<k3>-0.0059426077261182687</k3>\n<p1>0.0038636434570336977</p1>\n"
+            "<p2>0.00036559169480901107</p2>\n</calibration>\n<covariance>\n<params>f cx</params>\n"
+            "<coeffs>1.3198921426619455e+02 -3.6441406803097598e-01 -3.6441406803097598e-01 "
+            "8.8492784732170038e-01</coeffs>\n</covariance>\n</sensor>\n</sensors>\n");
   EXPECT_EQ(DetectCameraFormats(path), std::vector<std::string>{"metashape"});
   const std::string listing = ReadError("metashape", path);
   EXPECT_NE(listing.find("name one with --camera (0 (Test_Pro (10.26mm)), 1 ("), std::string::npos)
@@ -205,7 +224,8 @@ TEST(CameraFileVariants, MetashapeSensorsWithCovarianceBesideTheCalibration) {
 TEST(CameraFileVariants, PhotoScanFxFyAbsoluteCentreForm) {
   TempDir dir("aerocal_variants");
   const std::string path = Write(
-      dir, "cameras.xml",
+      dir,
+      "cameras.xml",
       "<sensor id=\"keep the original\" label=\"keep the original\" type=\"frame\">\n"
       "  <resolution width=\"2048\" height=\"2048\"/>\n"
       "  <property name=\"pixel_width\" value=\"0.01\"/>\n"
@@ -263,7 +283,8 @@ TEST(CameraFileVariants, MetashapePsxProjectFolder) {
 TEST(CameraFileVariants, MetashapeNoSilentSubstitution) {
   TempDir dir("aerocal_variants");
   const auto calibration = [&](const std::string& name, const std::string& body) {
-    return Write(dir, name,
+    return Write(dir,
+                 name,
                  "<calibration>\n<projection>frame</projection>\n<width>100</width>\n"
                  "<height>80</height>\n<f>90</f>\n" +
                      body + "</calibration>\n");
@@ -276,19 +297,20 @@ TEST(CameraFileVariants, MetashapeNoSilentSubstitution) {
   EXPECT_NE(ReadError("metashape", calibration("nan.xml", "<k2>nan</k2>\n")).find("nan.xml:6"),
             std::string::npos);
   const std::string zero_pixel = Write(
-      dir, "pixel.xml",
+      dir,
+      "pixel.xml",
       "<sensor id=\"0\">\n<resolution width=\"100\" height=\"80\"/>\n<property "
       "name=\"pixel_width\" value=\"0\"/>\n<calibration><f>90</f></calibration>\n</sensor>\n");
   EXPECT_NE(ReadError("metashape", zero_pixel).find("pixel.xml:3: pixel_width must be > 0"),
             std::string::npos);
-  const std::string two_adjusted = Write(
-      dir, "two.xml",
-      "<sensor id=\"0\">\n<resolution width=\"100\" height=\"80\"/>\n<calibration "
-      "class=\"adjusted\"><f>90</f></calibration>\n<calibration "
-      "class=\"adjusted\"><f>91</f></calibration>\n</sensor>\n");
+  const std::string two_adjusted =
+      Write(dir,
+            "two.xml",
+            "<sensor id=\"0\">\n<resolution width=\"100\" height=\"80\"/>\n<calibration "
+            "class=\"adjusted\"><f>90</f></calibration>\n<calibration "
+            "class=\"adjusted\"><f>91</f></calibration>\n</sensor>\n");
   EXPECT_NE(ReadError("metashape", two_adjusted).find("two.xml:4"), std::string::npos);
 }
-
 
 // ---- Pix4D ----
 
@@ -342,8 +364,8 @@ TEST(CameraFileVariants, Pix4dCalibratedCameraParametersPerImage) {
   EXPECT_NEAR(P(cv.file, "cx"), 2287.77960528229596093297 - 0.5, 1e-9);  // corner origin
   EXPECT_EQ(P(cv.file, "k3"), -0.02928533838596112174);
   EXPECT_EQ(P(cv.file, "p1"), 0.00028446432839522286);  // T1
-  const std::string mixed = Write(dir, "m_calibrated_camera_parameters.txt",
-                                  header + p852 + p853 + dsc157);
+  const std::string mixed =
+      Write(dir, "m_calibrated_camera_parameters.txt", header + p852 + p853 + dsc157);
   CameraReadOptions options;
   options.camera_id = "DSC_0157.JPG";
   const CameraFile g = ReadCameraFileAs("pix4d", mixed, options);
@@ -351,8 +373,8 @@ TEST(CameraFileVariants, Pix4dCalibratedCameraParametersPerImage) {
   EXPECT_TRUE(HasNote(g, "2 of 3 images have another K"));
   options.camera_id = "nope.JPG";
   EXPECT_NE(ReadError("pix4d", mixed, options).find("images: P1000852"), std::string::npos);
-  const std::string cut = Write(dir, "c_calibrated_camera_parameters.txt",
-                                header + p852.substr(0, p852.size() / 2));
+  const std::string cut =
+      Write(dir, "c_calibrated_camera_parameters.txt", header + p852.substr(0, p852.size() / 2));
   EXPECT_NE(ReadError("pix4d", cut).find("c_calibrated_camera_parameters.txt:9: image "),
             std::string::npos);
 }
@@ -367,10 +389,12 @@ TEST(CameraFileVariants, Pix4dCalibratedCameraParametersPerImage) {
 TEST(CameraFileVariants, DjiExiftoolListingOfSeveralImages) {
   TempDir dir("aerocal_variants");
   const std::string path = Write(
-      dir, "exiftool.txt",
+      dir,
+      "exiftool.txt",
       "======== DJI_0001.JPG\nImage Width                     : 5472\n"
       "Image Height                    : 3648\nCalibrated Focal Length         : 3666.666504\n"
-      "Calibrated Optical Center X     : 2736.000000\nCalibrated Optical Center Y     : 1824.000000\n"
+      "Calibrated Optical Center X     : 2736.000000\nCalibrated Optical Center Y     : "
+      "1824.000000\n"
       "Dewarp Data                     : 2018-09-06;3684.480000000000,3677.570000000000,"
       "2.240000000000,22.050000000000,-0.263482000000,0.106788000000,0.000037110700,"
       "-0.000327247000,-0.030078300000\n"
@@ -380,8 +404,9 @@ TEST(CameraFileVariants, DjiExiftoolListingOfSeveralImages) {
       "-7.710000000000,45.900000000000,-0.269478000000,0.115681000000,-0.000087561900,"
       "-0.000306177000,-0.035762800000\n    2 image files read\n");
   EXPECT_EQ(DetectCameraFormats(path), std::vector<std::string>{"dji"});
-  EXPECT_NE(ReadError("auto", path).find("name one with --camera (1 (DJI_0001.JPG), 2 (DJI_0002.JPG))"),
-            std::string::npos)
+  EXPECT_NE(
+      ReadError("auto", path).find("name one with --camera (1 (DJI_0001.JPG), 2 (DJI_0002.JPG))"),
+      std::string::npos)
       << ReadError("auto", path);
   CameraReadOptions options;
   options.camera_id = "DJI_0002.JPG";
@@ -399,7 +424,8 @@ TEST(CameraFileVariants, DjiExiftoolListingOfSeveralImages) {
   const CameraFile back = ReadDjiDewarpData(out, {});
   EXPECT_EQ(back.name, "2018-09-06");
   for (size_t i = 0; i < a.camera.params.size(); ++i)
-    EXPECT_NEAR(back.camera.params[i], a.camera.params[i], 1e-12 * (1 + std::abs(a.camera.params[i])));
+    EXPECT_NEAR(
+        back.camera.params[i], a.camera.params[i], 1e-12 * (1 + std::abs(a.camera.params[i])));
   std::ifstream in(out);
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   EXPECT_NE(text.find("2018-09-06;3684.48,3677.57,"), std::string::npos) << text;
@@ -407,9 +433,11 @@ TEST(CameraFileVariants, DjiExiftoolListingOfSeveralImages) {
 
 TEST(CameraFileVariants, DjiTagNamesWithoutSizeNameBothOptions) {
   TempDir dir("aerocal_variants");
-  const std::string path = Write(dir, "dewarp_s.txt",
-                                 "DewarpData                      : 2018-09-06;3684.48,3677.57,"
-                                 "2.24,22.05,-0.263482,0.106788,3.71107e-5,-3.27247e-4,-0.0300783\n");
+  const std::string path =
+      Write(dir,
+            "dewarp_s.txt",
+            "DewarpData                      : 2018-09-06;3684.48,3677.57,"
+            "2.24,22.05,-0.263482,0.106788,3.71107e-5,-3.27247e-4,-0.0300783\n");
   EXPECT_NE(ReadError("auto", path).find("pass --width and --height"), std::string::npos);
   CameraReadOptions options;
   options.width_px = 5472;
@@ -427,28 +455,37 @@ TEST(CameraFileVariants, DjiTagNamesWithoutSizeNameBothOptions) {
 TEST(CameraFileVariants, KalibrCamchainImucamOfEuroc) {
   TempDir dir("aerocal_variants");
   const std::string path = Write(
-      dir, "euroc_camchain.yaml",
+      dir,
+      "euroc_camchain.yaml",
       "cam0:\n  T_cam_imu:\n"
       "  - [0.014067833389924844, 0.9996023098557362, -0.024440094001271714, 0.0657094717307726]\n"
-      "  - [-0.9998997399258257, 0.014103075047756597, 0.0012701852087405128, -0.01662153508680676]\n"
+      "  - [-0.9998997399258257, 0.014103075047756597, 0.0012701852087405128, "
+      "-0.01662153508680676]\n"
       "  - [0.0016143605484757653, 0.0244197748817434, 0.9997004893640622, 0.0014868599890966905]\n"
       "  - [0.0, 0.0, 0.0, 1.0]\n  cam_overlaps: [1]\n  camera_model: pinhole\n"
       "  distortion_coeffs: [-0.011602611404146694, 0.05399058892805103, -0.07542693754837938,\n"
       "    0.03666365316319072]\n  distortion_model: equidistant\n"
-      "  intrinsics: [461.3418503026154, 460.13885656354387, 366.4281018364134, 248.8415565479774]\n"
-      "  resolution: [752, 480]  # width, height\n  rostopic: /cam0/image_raw\n  flip_camera: true\n"
+      "  intrinsics: [461.3418503026154, 460.13885656354387, 366.4281018364134, "
+      "248.8415565479774]\n"
+      "  resolution: [752, 480]  # width, height\n  rostopic: /cam0/image_raw\n  flip_camera: "
+      "true\n"
       "cam1:\n  T_cam_imu:\n"
       "  - [0.011810542390279122, 0.9995951714398011, -0.02588444171084584, -0.04439379107435547]\n"
-      "  - [-0.9998052969172723, 0.01221433647773218, 0.015497685006934178, -0.016235309745499065]\n"
+      "  - [-0.9998052969172723, 0.01221433647773218, 0.015497685006934178, "
+      "-0.016235309745499065]\n"
       "  - [0.01580757238202092, 0.025696365864524458, 0.9995448051171812, 0.0012030335279962774]\n"
       "  - [0.0, 0.0, 0.0, 1.0]\n  T_cn_cnm1:\n"
-      "  - [0.9999964092230391, 0.0022551294207702314, -0.0014477335121195142, -0.11006339056724425]\n"
-      "  - [-0.002234380261272062, 0.9998970009983116, 0.014177268405057909, 0.000510253673254922]\n"
-      "  - [0.0014795559720994585, -0.014173982710466103, 0.9998984494078623, -0.0006164896618526655]\n"
+      "  - [0.9999964092230391, 0.0022551294207702314, -0.0014477335121195142, "
+      "-0.11006339056724425]\n"
+      "  - [-0.002234380261272062, 0.9998970009983116, 0.014177268405057909, "
+      "0.000510253673254922]\n"
+      "  - [0.0014795559720994585, -0.014173982710466103, 0.9998984494078623, "
+      "-0.0006164896618526655]\n"
       "  - [0.0, 0.0, 0.0, 1.0]\n  cam_overlaps: [0]\n  camera_model: pinhole\n"
       "  distortion_coeffs: [0.005730625619095735, -0.009587210461496316, 0.01921165649877144,\n"
       "    -0.010717188529046507]\n  distortion_model: equidistant\n"
-      "  intrinsics: [459.6820431465863, 458.37659300282706, 380.01198798196646, 255.55347731935623]\n"
+      "  intrinsics: [459.6820431465863, 458.37659300282706, 380.01198798196646, "
+      "255.55347731935623]\n"
       "  resolution: [752, 480]\n  rostopic: /cam1/image_raw\n  flip_camera: true\n");
   EXPECT_EQ(DetectCameraFormats(path), std::vector<std::string>{"kalibr"});
   EXPECT_NE(ReadError("auto", path).find("name one with --camera (cam0, cam1)"), std::string::npos);
@@ -477,12 +514,13 @@ TEST(CameraFileVariants, KalibrCamchainImucamOfEuroc) {
 // the layout of COLMAP's WriteCamerasBinary (src/colmap/scene/reconstruction_io.cc).
 TEST(CameraFileVariants, ColmapIdsFromZeroAndTheBinaryFile) {
   TempDir dir("aerocal_variants");
-  const std::string text = Write(
-      dir, "cameras.txt",
-      "# Camera list with one line of data per camera:\n#   CAMERA_ID, MODEL, WIDTH, HEIGHT, "
-      "PARAMS[]\n# Number of cameras: 3\n0 SIMPLE_PINHOLE 3072 2304 2559.81 1536 1152\n"
-      "1 PINHOLE 3072 2304 2560.56 2560.56 1536 1152\n"
-      "2 SIMPLE_RADIAL 3072 2304 2559.69 1536 1152 -0.0218531\n");
+  const std::string text =
+      Write(dir,
+            "cameras.txt",
+            "# Camera list with one line of data per camera:\n#   CAMERA_ID, MODEL, WIDTH, HEIGHT, "
+            "PARAMS[]\n# Number of cameras: 3\n0 SIMPLE_PINHOLE 3072 2304 2559.81 1536 1152\n"
+            "1 PINHOLE 3072 2304 2560.56 2560.56 1536 1152\n"
+            "2 SIMPLE_RADIAL 3072 2304 2559.69 1536 1152 -0.0218531\n");
   EXPECT_EQ(DetectCameraFormats(text), std::vector<std::string>{"colmap"});
   CameraReadOptions options;
   options.camera_id = "0";
@@ -506,7 +544,8 @@ TEST(CameraFileVariants, ColmapIdsFromZeroAndTheBinaryFile) {
   std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   const std::string cut = Write(dir, "cut.bin", bytes.substr(0, bytes.size() - 3));
   EXPECT_NE(ReadError("colmap", cut).find("cut.bin"), std::string::npos);
-  const std::string dup = Write(dir, "dup.txt", "0 PINHOLE 10 10 5 5 5 5\n0 PINHOLE 10 10 6 6 5 5\n");
+  const std::string dup =
+      Write(dir, "dup.txt", "0 PINHOLE 10 10 5 5 5 5\n0 PINHOLE 10 10 6 6 5 5\n");
   options.camera_id = "0";
   EXPECT_NE(ReadError("colmap", dup, options).find("dup.txt:2: camera id 0 occurs twice"),
             std::string::npos);
@@ -535,7 +574,8 @@ TEST(CameraFileVariants, DbatFragmentsAndTheAspectAsB1) {
   EXPECT_TRUE(HasNote(f, "not exact"));
   std::string second = camera;
   second.replace(second.find("<id>1</id>"), 10, "<id>2</id>");
-  const std::string two = Write(dir, "cameras.xml", "<cameras>\n" + camera + second + "</cameras>\n");
+  const std::string two =
+      Write(dir, "cameras.xml", "<cameras>\n" + camera + second + "</cameras>\n");
   EXPECT_NE(ReadError("auto", two).find("name one with --camera (1, 2)"), std::string::npos);
   CameraReadOptions options;
   options.camera_id = "2";
@@ -545,7 +585,8 @@ TEST(CameraFileVariants, DbatFragmentsAndTheAspectAsB1) {
   WriteDbatCameraXml(out, f);
   const CameraFile back = ReadDbatCameraXml(out, {});
   for (size_t i = 0; i < f.camera.params.size(); ++i)
-    EXPECT_NEAR(back.camera.params[i], f.camera.params[i], 1e-14 * (1 + std::abs(f.camera.params[i])));
+    EXPECT_NEAR(
+        back.camera.params[i], f.camera.params[i], 1e-14 * (1 + std::abs(f.camera.params[i])));
 }
 
 // DBAT's text report (DBAT 0.9.2.0 report.txt of its camcal demo and of the Roma EOS 5D project,
@@ -560,7 +601,8 @@ TEST(CameraFileVariants, DbatTextReportAgainstItsXml) {
   const CameraFile x = ReadDbatCameraXml(dir + "/result/c4040z.xml", {});
   EXPECT_EQ(r.name, "Camera1");
   for (size_t i = 0; i < x.camera.params.size(); ++i)
-    EXPECT_NEAR(r.camera.params[i], x.camera.params[i],
+    EXPECT_NEAR(r.camera.params[i],
+                x.camera.params[i],
                 6e-6 * std::abs(x.camera.params[i]) + (i == 1 || i == 2 ? 5e-6 : 1e-9))
         << i;  // x0, y0: px, py printed to 5e-6 mm
   EXPECT_LT(CompareCameras(x.camera, r.camera, 21).max_px, 0.05);  // 6 digits printed
@@ -589,8 +631,11 @@ TEST(CameraFileVariants, PhotoModelerReportBlockIsItsBundleSolnCamera) {
   const std::string dir = testing::SharedDataDir("dbat_camcal_olympus_c4040z");
   if (dir.empty()) GTEST_SKIP() << "../shared/data absent";
   TempDir tmp("aerocal_variants");
-  const auto entry = [](const std::string& title, const std::string& name, const std::string& value,
-                        const std::string& deviation, const std::string& unit) {
+  const auto entry = [](const std::string& title,
+                        const std::string& name,
+                        const std::string& value,
+                        const std::string& deviation,
+                        const std::string& unit) {
     return "            " + title + "\r\n                 Value: " + value + " " + unit +
            "\r\n                 Deviation: " + name + ": " + deviation + " " + unit + "\r\n";
   };
@@ -628,14 +673,15 @@ TEST(CameraFileVariants, PhotoModelerReportBlockIsItsBundleSolnCamera) {
 
 // ---- every reader on damaged files (what the camera_formats fuzzer does, in the unit build) ----
 
-// Each seed of the fuzzer and the project archives, cut at 8 lengths and with bytes overwritten at 4 places,
-// through every reader of the registry: a camera or an aerocal::Error, nothing else (a crash or
-// another exception fails the test).
+// Each seed of the fuzzer and the project archives, cut at 8 lengths and with bytes overwritten at
+// 4 places, through every reader of the registry: a camera or an aerocal::Error, nothing else (a
+// crash or another exception fails the test).
 TEST(CameraFileRegistry, EveryReaderRefusesDamagedFilesWithAnError) {
   namespace fs = std::filesystem;
   TempDir dir("aerocal_variants");
   std::vector<std::string> inputs;
-  const fs::path seeds = fs::path(AEROCAL_TEST_DATA_DIR) / ".." / "fuzz" / "seeds" / "camera_formats";
+  const fs::path seeds =
+      fs::path(AEROCAL_TEST_DATA_DIR) / ".." / "fuzz" / "seeds" / "camera_formats";
   for (const auto& entry : fs::directory_iterator(seeds)) inputs.push_back(entry.path().string());
   inputs.push_back(Data("photoscan12_project.psz"));
   inputs.push_back(Data("metashape_project.files/0/chunk.zip"));
@@ -647,7 +693,8 @@ TEST(CameraFileRegistry, EveryReaderRefusesDamagedFilesWithAnError) {
     for (int k = 0; k < 8; ++k) damaged.push_back(bytes.substr(0, bytes.size() * k / 8));
     for (int k = 1; k < 5; ++k) {
       std::string flipped = bytes;
-      for (size_t i = flipped.size() * k / 5; i < flipped.size() && i < flipped.size() * k / 5 + 3; ++i)
+      for (size_t i = flipped.size() * k / 5; i < flipped.size() && i < flipped.size() * k / 5 + 3;
+           ++i)
         flipped[i] = static_cast<char>(flipped[i] ^ 0x5a);
       damaged.push_back(flipped);
     }

@@ -4,18 +4,18 @@
 // very camera it read before (the number was one the reader does not use: a date, a name, a
 // comment). A reader that reads the `nan` or the empty field as 0, as the default or as another
 // field's value gives another camera and fails here, naming format, file, line and number.
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/error.h"
+#include "tests/support/bad_input_case.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
 #include <algorithm>
 #include <filesystem>
 #include <regex>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-
-#include "calib/camera/formats/camera_formats.h"
-#include "calib/core/error.h"
-#include "tests/support/bad_input_case.h"
-#include "tests/support/test_support.h"
 
 namespace aerocal::calib {
 namespace {
@@ -50,9 +50,11 @@ int LineOf(const std::string& text, size_t at) {
 
 TEST(CameraFormatsNoSubstitution, ANanOrAnEmptyNumberIsRefusedOrUnused) {
   testing::TempDir dir("aerocal_formats_substitution");
-  const fs::path seeds = fs::path(AEROCAL_TEST_DATA_DIR) / ".." / "fuzz" / "seeds" / "camera_formats";
+  const fs::path seeds =
+      fs::path(AEROCAL_TEST_DATA_DIR) / ".." / "fuzz" / "seeds" / "camera_formats";
   // A number not glued to a word (k1, cam0, 2023-01-01 are not touched as a whole).
-  const std::regex number(R"((^|[^A-Za-z0-9_.+-])([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)(?![A-Za-z0-9_.]))");
+  const std::regex number(
+      R"((^|[^A-Za-z0-9_.+-])([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)(?![A-Za-z0-9_.]))");
   int seeds_read = 0, mutations = 0, refused = 0, unused = 0;
   std::vector<std::string> substituted;
   for (const auto& entry : fs::directory_iterator(seeds)) {
@@ -68,7 +70,9 @@ TEST(CameraFormatsNoSubstitution, ANanOrAnEmptyNumberIsRefusedOrUnused) {
     ++seeds_read;
     const CameraFormat& reader = FindCameraFormat(format, "--from");
     const std::string text = testing::ReadFileText(seed);
-    for (auto it = std::sregex_iterator(text.begin(), text.end(), number); it != std::sregex_iterator(); ++it) {
+    for (auto it = std::sregex_iterator(text.begin(), text.end(), number);
+         it != std::sregex_iterator();
+         ++it) {
       const size_t at = static_cast<size_t>(it->position(2));
       const size_t length = static_cast<size_t>(it->length(2));
       for (const std::string replacement : {"nan", ""}) {
@@ -92,8 +96,12 @@ TEST(CameraFormatsNoSubstitution, ANanOrAnEmptyNumberIsRefusedOrUnused) {
       }
     }
   }
-  std::printf("%d seeds, %d mutations: %d refused, %d unused numbers, %zu substituted\n", seeds_read,
-              mutations, refused, unused, substituted.size());
+  std::printf("%d seeds, %d mutations: %d refused, %d unused numbers, %zu substituted\n",
+              seeds_read,
+              mutations,
+              refused,
+              unused,
+              substituted.size());
   EXPECT_GE(seeds_read, 12);
   EXPECT_GT(refused, mutations / 2);
   for (const std::string& s : substituted) ADD_FAILURE() << s;
@@ -107,8 +115,10 @@ TEST(CameraFormatsNoSubstitution, ANanOrAnEmptyNumberIsRefusedOrUnused) {
 // outside the element (two attributes of one name are refused: not well-formed XML).
 TEST(CameraFormatsNoSubstitution, ALineGivenTwiceIsRefusedOrUnused) {
   testing::TempDir dir("aerocal_formats_substitution");
-  const fs::path seeds = fs::path(AEROCAL_TEST_DATA_DIR) / ".." / "fuzz" / "seeds" / "camera_formats";
-  const std::regex number(R"((^|[^A-Za-z0-9_.+-])([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)(?![A-Za-z0-9_.]))");
+  const fs::path seeds =
+      fs::path(AEROCAL_TEST_DATA_DIR) / ".." / "fuzz" / "seeds" / "camera_formats";
+  const std::regex number(
+      R"((^|[^A-Za-z0-9_.+-])([-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)(?![A-Za-z0-9_.]))");
   int mutations = 0, refused = 0;
   std::vector<std::string> taken;
   for (const auto& entry : fs::directory_iterator(seeds)) {
@@ -132,7 +142,9 @@ TEST(CameraFormatsNoSubstitution, ALineGivenTwiceIsRefusedOrUnused) {
       std::smatch m;
       if (std::regex_search(row, m, number)) {
         std::string copy = row;
-        copy.replace(static_cast<size_t>(m.position(2)), static_cast<size_t>(m.length(2)), m.str(2) == "1" ? "2" : "1");
+        copy.replace(static_cast<size_t>(m.position(2)),
+                     static_cast<size_t>(m.length(2)),
+                     m.str(2) == "1" ? "2" : "1");
         for (const bool before : {true, false}) {
           std::string mutated = text;
           mutated.insert(before ? begin : end, before ? copy + "\n" : "\n" + copy);
@@ -141,9 +153,9 @@ TEST(CameraFormatsNoSubstitution, ALineGivenTwiceIsRefusedOrUnused) {
           ++mutations;
           try {
             if (!SameCamera(original, reader.read(path, options)))
-              taken.push_back(format + " " + entry.path().filename().string() + ":" + std::to_string(line) +
-                              ": a copy " + (before ? "before" : "after") + " it with '" + m.str(2) +
-                              "' changed is read");
+              taken.push_back(format + " " + entry.path().filename().string() + ":" +
+                              std::to_string(line) + ": a copy " + (before ? "before" : "after") +
+                              " it with '" + m.str(2) + "' changed is read");
           } catch (const Error&) {
             ++refused;
           }
@@ -152,7 +164,10 @@ TEST(CameraFormatsNoSubstitution, ALineGivenTwiceIsRefusedOrUnused) {
       begin = end + 1;
     }
   }
-  std::printf("%d duplicated lines: %d refused, %zu read as another camera\n", mutations, refused, taken.size());
+  std::printf("%d duplicated lines: %d refused, %zu read as another camera\n",
+              mutations,
+              refused,
+              taken.size());
   for (const std::string& t : taken) ADD_FAILURE() << t;
 }
 
@@ -160,7 +175,8 @@ TEST(CameraFormatsNoSubstitution, ALineGivenTwiceIsRefusedOrUnused) {
 // numbers, so a damaged row was skipped and its parameter read as 0 (and a second row ignored).
 TEST(CameraFormatsNoSubstitution, AustralisRowsAreOneLineEachWithFiveNumbers) {
   testing::TempDir dir("aerocal_formats_substitution");
-  const std::string seed = std::string(AEROCAL_TEST_DATA_DIR) + "/../fuzz/seeds/camera_formats/australis.txt";
+  const std::string seed =
+      std::string(AEROCAL_TEST_DATA_DIR) + "/../fuzz/seeds/camera_formats/australis.txt";
   const std::string text = testing::ReadFileText(seed);
   const std::string k1 = "K1 0.0420012803050355 0 0.0420012803050355 0 0\n";
   ASSERT_NE(text.find(k1), std::string::npos);
@@ -175,52 +191,62 @@ TEST(CameraFormatsNoSubstitution, AustralisRowsAreOneLineEachWithFiveNumbers) {
   };
   std::string nan = text;
   nan.replace(nan.find(k1), k1.size(), "K1 0.04 0 nan 0 0\n");
-  EXPECT_NE(error(nan).find("a.txt:16: K1 final value must be a number"), std::string::npos) << error(nan);
+  EXPECT_NE(error(nan).find("a.txt:16: K1 final value must be a number"), std::string::npos)
+      << error(nan);
   std::string twice = text;
   twice.insert(twice.find(k1) + k1.size(), "K1 0.05 0 0.05 0 0\n");
-  EXPECT_NE(error(twice).find("a.txt:17: a second 'K1' line (the first is line 16)"), std::string::npos)
+  EXPECT_NE(error(twice).find("a.txt:17: a second 'K1' line (the first is line 16)"),
+            std::string::npos)
       << error(twice);
   std::string short_row = text;
   short_row.replace(short_row.find(k1), k1.size(), "K1 0.04 0 0.04 0\n");
-  EXPECT_NE(error(short_row).find("a.txt:17: K1 final std. error must be a number"), std::string::npos)
+  EXPECT_NE(error(short_row).find("a.txt:17: K1 final std. error must be a number"),
+            std::string::npos)
       << error(short_row);
   std::string without = text;
   without.erase(without.find(k1), k1.size());
   testing::WriteFileText(dir.File("b.txt"), without);
   const CameraFile b = ReadAustralisCamera(dir.File("b.txt"), {});
   EXPECT_EQ(b.camera.params[BrownFraser10Model::kK1], 0.0);
-  EXPECT_NE(std::find(b.notes.begin(), b.notes.end(), "K1: no line in the report, 0"), b.notes.end());
+  EXPECT_NE(std::find(b.notes.begin(), b.notes.end(), "K1: no line in the report, 0"),
+            b.notes.end());
 }
 
 // What the duplicated lines found: each reader now names the second value (or the empty element).
 TEST(CameraFormatsNoSubstitution, DbatDjiAndOpenSfmNameTheSecondValue) {
   testing::TempDir dir("aerocal_formats_substitution");
-  const auto error = [&](const std::string& format, const std::string& name, const std::string& text) {
-    testing::WriteFileText(dir.File(name), text);
-    try {
-      ReadCameraFileAs(format, dir.File(name), {});
-    } catch (const InputError& e) {
-      return std::string(e.what());
-    }
-    return std::string("(read)");
-  };
-  const std::string dbat = "<cameras><camera><sensor>auto,24</sensor><image>6000,4000</image>\n<cc>35</cc>\n";
+  const auto error =
+      [&](const std::string& format, const std::string& name, const std::string& text) {
+        testing::WriteFileText(dir.File(name), text);
+        try {
+          ReadCameraFileAs(format, dir.File(name), {});
+        } catch (const InputError& e) {
+          return std::string(e.what());
+        }
+        return std::string("(read)");
+      };
+  const std::string dbat =
+      "<cameras><camera><sensor>auto,24</sensor><image>6000,4000</image>\n<cc>35</cc>\n";
   EXPECT_NE(error("dbat", "a.xml", dbat + "<cc>36</cc>\n</camera></cameras>\n")
                 .find("a.xml:3: <cc> occurs twice in <camera> (first on line 2)"),
             std::string::npos);
-  EXPECT_NE(error("dbat", "b.xml", dbat + "<K></K>\n</camera></cameras>\n").find("b.xml:3: <K> is empty"),
-            std::string::npos);
-  const std::string exif = "======== A.JPG\nImage Width : 5472\nExif Image Width : 5472\nImage Height : 3648\n"
-                           "Dewarp Data : 3684.48,3677.57,2.24,22.05,-0.26,0.1,3e-05,-3e-04,-0.03\n";
+  EXPECT_NE(
+      error("dbat", "b.xml", dbat + "<K></K>\n</camera></cameras>\n").find("b.xml:3: <K> is empty"),
+      std::string::npos);
+  const std::string exif =
+      "======== A.JPG\nImage Width : 5472\nExif Image Width : 5472\nImage Height : 3648\n"
+      "Dewarp Data : 3684.48,3677.57,2.24,22.05,-0.26,0.1,3e-05,-3e-04,-0.03\n";
   EXPECT_EQ(error("dji", "c.txt", exif), "(read)");  // the same width twice, as exiftool prints it
   EXPECT_NE(error("dji", "d.txt", exif + "Exif Image Height : 3000\n")
                 .find("d.txt:6: image height 3000 contradicts 3648 on line 4"),
             std::string::npos);
-  EXPECT_NE(error("opensfm", "e.json",
-                  "{\"cam\": {\"projection_type\": \"perspective\", \"width\": 640, \"height\": 480,\n"
-                  "\"focal\": 0.9, \"focal\": 1.0, \"k1\": 0, \"k2\": 0}}\n")
-                .find("e.json: cam: key \"focal\" occurs twice in one object"),
-            std::string::npos);
+  EXPECT_NE(
+      error("opensfm",
+            "e.json",
+            "{\"cam\": {\"projection_type\": \"perspective\", \"width\": 640, \"height\": 480,\n"
+            "\"focal\": 0.9, \"focal\": 1.0, \"k1\": 0, \"k2\": 0}}\n")
+          .find("e.json: cam: key \"focal\" occurs twice in one object"),
+      std::string::npos);
 }
 
 }  // namespace

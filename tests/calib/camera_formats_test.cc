@@ -5,6 +5,12 @@
 // (The OpenCV FileStorage format and cv::projectPoints / undistortPoints: tests/tools/.)
 #include "calib/camera/formats/camera_formats.h"
 
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -13,12 +19,6 @@
 #include <map>
 #include <regex>
 #include <sstream>
-
-#include <gtest/gtest.h>
-
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
-#include "tests/support/test_support.h"
 
 namespace aerocal::calib {
 namespace {
@@ -36,8 +36,18 @@ ModelCamera AerialCamera() {
 // 2.41 um pixels (8.8 mm / 3666.67 px design focal length ~ 2.4 um).
 ModelCamera DjiRecordA() {
   return {CameraModelId::kOpenCv,
-          {3684.48, 3677.57, 2738.24, 1846.05, -0.263482, 0.106788, 3.71107e-5, -3.27247e-4,
-           -0.0300783, 0, 0, 0},
+          {3684.48,
+           3677.57,
+           2738.24,
+           1846.05,
+           -0.263482,
+           0.106788,
+           3.71107e-5,
+           -3.27247e-4,
+           -0.0300783,
+           0,
+           0,
+           0},
           {0.0024, 5472, 3648}};
 }
 
@@ -77,8 +87,13 @@ struct Format {
 std::vector<Format> Formats() {
   std::vector<Format> formats;
   for (const CameraFormat& f : CameraFormats())
-    formats.push_back({f.name, f.read, f.write, f.target(AerialCamera()), f.writes_size,
-                       f.writes_pixel_size, f.extension});
+    formats.push_back({f.name,
+                       f.read,
+                       f.write,
+                       f.target(AerialCamera()),
+                       f.writes_size,
+                       f.writes_pixel_size,
+                       f.extension});
   return formats;
 }
 
@@ -148,7 +163,8 @@ TEST(CameraFormats, AVerifiedWriteTheReaderRefusesLeavesNoFile) {
     const std::string path = dir.File("huge" + f.extension);
     EXPECT_THROW(WriteCameraFileVerified(f, path, file), Error);
     EXPECT_FALSE(fs::exists(path));
-    for (const auto& entry : fs::directory_iterator(dir.path())) ADD_FAILURE() << "left " << entry.path();
+    for (const auto& entry : fs::directory_iterator(dir.path()))
+      ADD_FAILURE() << "left " << entry.path();
   }
 }
 
@@ -159,12 +175,14 @@ TEST(CameraFormats, Pix4dXmpTagsAreThePix4dCamValues) {
   TempDir dir("aerocal_pix4d_xmp");
   const std::string xmp = dir.File("p4d.xmp");
   const std::string body =
-      "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\"><rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
+      "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\"><rdf:RDF "
+      "xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
       "<rdf:Description xmlns:P4=\"http://pix4d.com/camera/1.0/\">\n"
       "<P4:ModelType>perspective</P4:ModelType>\n"
       "<P4:PrincipalPoint>2.42299,1.850154</P4:PrincipalPoint>\n"
       "<P4:PerspectiveFocalLength>4.569165</P4:PerspectiveFocalLength>\n"
-      "<P4:PerspectiveDistortion>0.201690322, -0.358534038, 0.256185599, 0.004208643, 0.000268361</P4:PerspectiveDistortion>\n"
+      "<P4:PerspectiveDistortion>0.201690322, -0.358534038, 0.256185599, 0.004208643, "
+      "0.000268361</P4:PerspectiveDistortion>\n"
       "</rdf:Description></rdf:RDF></x:xmpmeta>\n";
   WriteFileAtomically(xmp, body);
   CameraReadOptions options;
@@ -173,8 +191,10 @@ TEST(CameraFormats, Pix4dXmpTagsAreThePix4dCamValues) {
   options.pixel_size_mm = 0.00122;
   const CameraFile a = ReadPix4dXmp(xmp, options);
   const std::string cam = dir.File("p4d.cam");
-  WriteFileAtomically(cam, "Pix4D camera calibration file 0\nF 4.569165\nPx 2.42299\nPy 1.850154\n"
-                           "K1 0.201690322\nK2 -0.358534038\nK3 0.256185599\nT1 0.004208643\nT2 0.000268361\n");
+  WriteFileAtomically(
+      cam,
+      "Pix4D camera calibration file 0\nF 4.569165\nPx 2.42299\nPy 1.850154\n"
+      "K1 0.201690322\nK2 -0.358534038\nK3 0.256185599\nT1 0.004208643\nT2 0.000268361\n");
   const CameraFile b = ReadPix4dCam(cam, options);
   EXPECT_EQ(a.camera.params, b.camera.params);
   EXPECT_EQ(a.camera.frame.pixel_size_mm, b.camera.frame.pixel_size_mm);
@@ -186,31 +206,38 @@ TEST(CameraFormats, Pix4dXmpTagsAreThePix4dCamValues) {
     ReadPix4dXmp(xmp, options);
     ADD_FAILURE() << "fisheye accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("p4d.xmp:3: P4:ModelType 'fisheye'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("p4d.xmp:3: P4:ModelType 'fisheye'"), std::string::npos)
+        << e.what();
   }
 }
 
 TEST(CameraFormats, TermsOutsideOpenCvSurviveTheirFormat) {
   TempDir dir("aerocal_formats");
   // Metashape's b1, b2, k4, p3, p4; DewarpDataK6's k4-k6; a fisheye in OpenSfM and Kalibr.
-  ModelCamera metashape{CameraModelId::kMetashapeFrame,
-                        {3680, 2.2, 22.0, 0.8, -0.3, -0.26, 0.1, -0.03, 0.002, 4e-5, -3e-4, 0.01, -0.002},
-                        {0.0024, 5472, 3648}};
+  ModelCamera metashape{
+      CameraModelId::kMetashapeFrame,
+      {3680, 2.2, 22.0, 0.8, -0.3, -0.26, 0.1, -0.03, 0.002, 4e-5, -3e-4, 0.01, -0.002},
+      {0.0024, 5472, 3648}};
   const CameraFile m = WriteAndRead(FormatNamed("metashape"), File(metashape), dir);
   ExpectSameParams(metashape, m.camera, "metashape");
   ModelCamera k6 = DjiRecordA();
-  k6.params[OpenCvModel::kK4] = 0.01, k6.params[OpenCvModel::kK5] = -0.002, k6.params[OpenCvModel::kK6] = 1e-4;
+  k6.params[OpenCvModel::kK4] = 0.01, k6.params[OpenCvModel::kK5] = -0.002,
+  k6.params[OpenCvModel::kK6] = 1e-4;
   const CameraFile d = WriteAndRead(FormatNamed("dji"), File(k6), dir);
   ExpectSameParams(k6, d.camera, "DewarpDataK6");
   const ModelCamera fisheye{CameraModelId::kOpenCvFisheye,
                             {900, 900, 0.5 * 1279, 0.5 * 959, 0.05, -0.01, 0, 0},
                             {0.003, 1280, 960}};
-  ExpectSameParams(fisheye, WriteAndRead(FormatNamed("opensfm"), File(fisheye), dir).camera, "opensfm fisheye");
+  ExpectSameParams(
+      fisheye, WriteAndRead(FormatNamed("opensfm"), File(fisheye), dir).camera, "opensfm fisheye");
   ModelCamera equi = fisheye;
   equi.params[6] = 0.002, equi.params[7] = -4e-4, equi.params[0] = 901;
-  ExpectSameParams(equi, WriteAndRead(FormatNamed("kalibr"), File(equi), dir).camera, "kalibr equidistant");
+  ExpectSameParams(
+      equi, WriteAndRead(FormatNamed("kalibr"), File(equi), dir).camera, "kalibr equidistant");
   // Our file holds any registry model.
-  ExpectSameParams(metashape, WriteAndRead(FormatNamed("aerocal"), File(metashape), dir).camera, "aerocal metashape_frame");
+  ExpectSameParams(metashape,
+                   WriteAndRead(FormatNamed("aerocal"), File(metashape), dir).camera,
+                   "aerocal metashape_frame");
 }
 
 // ---- ours -> format -> ours ----
@@ -223,8 +250,7 @@ struct Trip {
 Trip OursThroughFormat(const ModelCamera& ours, const Format& f, const TempDir& dir) {
   const FileConversion out = ConvertCameraFile(File(ours), f.target);
   const CameraFile read = WriteAndRead(f, out.file, dir);
-  const FileConversion back =
-      ConvertCameraFile(read, {CameraModelId::kBrownFraser10, {}, true});
+  const FileConversion back = ConvertCameraFile(read, {CameraModelId::kBrownFraser10, {}, true});
   return {out.result.exact, out.result.residual.max_px, MaxDifferencePx(ours, back.file.camera)};
 }
 
@@ -237,10 +263,16 @@ TEST(CameraFormats, OursThroughEveryFormatAndBackStatesItsResidual) {
   for (const Format& f : Formats()) {
     const Trip a = OursThroughFormat(aerial, f, dir);
     const Trip d = OursThroughFormat(drone, f, dir);
-    std::printf("ours -> %-9s -> ours: aerial %s out max %.3g px, back max %.3g px; drone %s out "
-                "max %.3g px, back max %.3g px\n",
-                f.name.c_str(), a.exact_out ? "exact" : "fit", a.out_max_px, a.back_max_px,
-                d.exact_out ? "exact" : "fit", d.out_max_px, d.back_max_px);
+    std::printf(
+        "ours -> %-9s -> ours: aerial %s out max %.3g px, back max %.3g px; drone %s out "
+        "max %.3g px, back max %.3g px\n",
+        f.name.c_str(),
+        a.exact_out ? "exact" : "fit",
+        a.out_max_px,
+        a.back_max_px,
+        d.exact_out ? "exact" : "fit",
+        d.out_max_px,
+        d.back_max_px);
     const bool ours_model = f.target.model == CameraModelId::kBrownFraser10;
     if (ours_model && f.target.zero_params.empty()) {  // our own file: exact both ways
       EXPECT_TRUE(a.exact_out) << f.name;
@@ -262,9 +294,17 @@ TEST(CameraFormats, OursThroughEveryFormatAndBackStatesItsResidual) {
         // colmap, dji, ros: the simplest form, 5 coefficients (k1 k2 p1 p2 k3; issue 29), 9.56 px
         // for the drone; the 8-coefficient rational form gave 1.95 px with k1 = +2.33 for a lens
         // whose k1 is about -0.28, which every 5-coefficient reader misreads.
-        {"colmap", {0.048, 9.56}}, {"metashape", {5.6e-5, 3.46}}, {"pix4d", {0.090, 10.7}}, {"pix4d-xmp", {0.090, 10.7}},
-        {"opensfm", {0.048, 9.56}}, {"dji", {0.048, 9.56}},       {"dbat", {0.048, 0.013}} /* B1 as the aspect */, {"photomodeler", {0.090, 2.61}},
-        {"kalibr", {0.064, 16.3}}, {"ros", {0.048, 9.56}}, {"camodocal", {0.064, 16.3}}};
+        {"colmap", {0.048, 9.56}},
+        {"metashape", {5.6e-5, 3.46}},
+        {"pix4d", {0.090, 10.7}},
+        {"pix4d-xmp", {0.090, 10.7}},
+        {"opensfm", {0.048, 9.56}},
+        {"dji", {0.048, 9.56}},
+        {"dbat", {0.048, 0.013}} /* B1 as the aspect */,
+        {"photomodeler", {0.090, 2.61}},
+        {"kalibr", {0.064, 16.3}},
+        {"ros", {0.048, 9.56}},
+        {"camodocal", {0.064, 16.3}}};
     EXPECT_LT(a.out_max_px, 1.2 * stated.at(f.name).first) << f.name;
     EXPECT_LT(d.out_max_px, 1.2 * stated.at(f.name).second) << f.name;
   }
@@ -308,9 +348,24 @@ TEST(CameraFormatsRealData, DjiDewarpDataRecordsGiveCentrePlusOffset) {
   ASSERT_EQ(records.size(), 2u);
   // PROVENANCE.md "Known values": A (5472 x 3648) centre + (2.24, 22.05) = (2738.24, 1846.05) px;
   // B (4864 x 3648) offset (-7.71, 45.90).
-  const double expected[2][9] = {
-      {3684.48, 3677.57, 2738.24, 1846.05, -0.263482, 0.106788, 3.71107e-5, -3.27247e-4, -0.0300783},
-      {3659.78, 3653.17, 2432 - 7.71, 1824 + 45.90, -0.269478, 0.115681, -8.75619e-5, -3.06177e-4, -0.0357628}};
+  const double expected[2][9] = {{3684.48,
+                                  3677.57,
+                                  2738.24,
+                                  1846.05,
+                                  -0.263482,
+                                  0.106788,
+                                  3.71107e-5,
+                                  -3.27247e-4,
+                                  -0.0300783},
+                                 {3659.78,
+                                  3653.17,
+                                  2432 - 7.71,
+                                  1824 + 45.90,
+                                  -0.269478,
+                                  0.115681,
+                                  -8.75619e-5,
+                                  -3.06177e-4,
+                                  -0.0357628}};
   for (size_t k = 0; k < 2; ++k) {
     const DewarpRecord& r = records[k];
     const ModelCamera c = DjiDewarpDataCamera(r.data, {dir, r.line}, r.width, r.height);
@@ -431,9 +486,11 @@ TEST(CameraFormatsRealData, DbatResultCameraAgainstItsReport) {
   ExpectSameParams(f.camera, back.camera, "dbat");
   // Into Metashape (a forward model: fitted) and back into DBAT.
   const FileConversion m = ConvertCameraFile(f, FormatNamed("metashape").target);
-  const FileConversion again = ConvertCameraFile(WriteAndRead(FormatNamed("metashape"), m.file, tmp), FormatNamed("dbat").target);
+  const FileConversion again = ConvertCameraFile(
+      WriteAndRead(FormatNamed("metashape"), m.file, tmp), FormatNamed("dbat").target);
   std::printf("DBAT c4040z -> metashape: %s; -> DBAT: %.3g px max against the original\n",
-              m.result.Summary().c_str(), MaxDifferencePx(f.camera, again.file.camera));
+              m.result.Summary().c_str(),
+              MaxDifferencePx(f.camera, again.file.camera));
   // Measured: 0.057 px at the corner (rms 0.005 px) out, 5e-4 px back.
   EXPECT_LT(m.result.residual.max_px, 0.07);
   EXPECT_LT(MaxDifferencePx(f.camera, again.file.camera), 1e-3);
@@ -504,8 +561,16 @@ TEST(CameraFormatsRealData, AustralisReportOfThePublicExample) {
   EXPECT_EQ(a.camera.frame.width_px, 648);
   EXPECT_EQ(a.camera.frame.height_px, 494);
   EXPECT_DOUBLE_EQ(a.camera.frame.pixel_size_mm, 0.007);
-  const double expected[B::kNumParams] = {8.3094, -0.0280, 0.0214, 1.67381e-3, -7.80809e-6,
-                                          -1.22907e-6, 1.75249e-5, -8.64105e-6, -4.34298e-4, 1.79692e-5};
+  const double expected[B::kNumParams] = {8.3094,
+                                          -0.0280,
+                                          0.0214,
+                                          1.67381e-3,
+                                          -7.80809e-6,
+                                          -1.22907e-6,
+                                          1.75249e-5,
+                                          -8.64105e-6,
+                                          -4.34298e-4,
+                                          1.79692e-5};
   for (int k = 0; k < B::kNumParams; ++k) EXPECT_DOUBLE_EQ(a.camera.params[k], expected[k]) << k;
   ASSERT_TRUE(a.covariance);
   EXPECT_NEAR(std::sqrt((*a.covariance)(B::kC, B::kC)), 6.782e-3, 1e-15);
@@ -530,7 +595,8 @@ TEST(CameraFormatsRealData, AustralisReportOfThePublicExample) {
 TEST(CameraFormats, CovarianceThroughAnExactConversionIsTheLinearMap) {
   using M = MetashapeFrameModel;
   using P = Pix4dPerspectiveModel;
-  CameraFile m = File({M::kId, {3680, 2.2, 22.0, 0, 0, -0.26, 0.1, -0.03, 0, 4e-5, -3e-4, 0, 0},
+  CameraFile m = File({M::kId,
+                       {3680, 2.2, 22.0, 0, 0, -0.26, 0.1, -0.03, 0, 4e-5, -3e-4, 0, 0},
                        {0.0024, 5472, 3648}});
   Eigen::MatrixXd c = Eigen::MatrixXd::Zero(M::kNumParams, M::kNumParams);
   c(M::kF, M::kF) = 0.5 * 0.5, c(M::kCx, M::kCx) = 0.3 * 0.3, c(M::kF, M::kCx) = 0.05;
@@ -558,8 +624,8 @@ TEST(CameraFormats, CovarianceThroughAFitFollowsTheExactScaleAndShift) {
   // code.)
   using M = MetashapeFrameModel;
   using B = BrownFraser10Model;
-  CameraFile m = File({M::kId, {3680, 2.2, 22.0, 0.8, -0.3, 0, 0, 0, 0, 0, 0, 0, 0},
-                       {0.0024, 5472, 3648}});
+  CameraFile m =
+      File({M::kId, {3680, 2.2, 22.0, 0.8, -0.3, 0, 0, 0, 0, 0, 0, 0, 0}, {0.0024, 5472, 3648}});
   Eigen::MatrixXd c = Eigen::MatrixXd::Zero(M::kNumParams, M::kNumParams);
   c(M::kF, M::kF) = 0.8 * 0.8;
   c(M::kCx, M::kCx) = 0.4 * 0.4;

@@ -1,11 +1,12 @@
-#include <fstream>
-
-#include <gtest/gtest.h>
-
 #include "calib/camera/camera_io.h"
+
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <fstream>
 
 namespace aerocal::calib {
 namespace {
@@ -19,9 +20,11 @@ Camera ExampleCamera() {
   c.interior = {170.038, -0.1757, 0.3930, 3e-8, -2e-12, 1e-16, 2e-7, -1.5e-7, 1e-5, -8e-6};
   c.interior_sigma[BrownFraser10Model::kC] = 0.01;
   c.interior_sigma[BrownFraser10Model::kK1] = 1e-9;
-  c.subimages.push_back({"I", 7100, 4134, MappingModel::kAffine, {1.0001, 2e-5, 0.5, -1e-5, 0.9999, 3.25}});
+  c.subimages.push_back(
+      {"I", 7100, 4134, MappingModel::kAffine, {1.0001, 2e-5, 0.5, -1e-5, 0.9999, 3.25}});
   c.subimages.push_back({"II", 7100, 4134, MappingModel::kConformal, {1.0, 1e-5, 6900.0, -0.5}});
-  c.subimages.push_back({"III", 7100, 4134, MappingModel::kProjective, {1, 0, 1, 0, 1, 7933, 1e-9, -2e-9}});
+  c.subimages.push_back(
+      {"III", 7100, 4134, MappingModel::kProjective, {1, 0, 1, 0, 1, 7933, 1e-9, -2e-9}});
   c.subimages.push_back({"IV", 7100, 4134, MappingModel::kTranslation, {6900, 7933}});
   c.reference_points.push_back({"A", "I", 12.0, 8.0, 12.5, 11.25, 0.05});
   return c;
@@ -62,7 +65,8 @@ TEST(CameraIo, ReadsTheFormatsExample) {
             "name: DMZ-1\npixel_size_mm: 0.009\nformat_px: [14000, 12000]\ninterior:\n  c: 170.0\n"
             "  x0: -0.1757\n  y0: 0.3930\ninterior_sigma:\n  c: 0.01\nsubimages:\n  - id: I\n"
             "    format_px: [7000, 4000]\n    model: affine\n    params: [1, 0, 0, 0, 1, 0]\n"
-            "reference_points:\n  - {id: A, subimage: I, u: 12.0, v: 8.0, U: 12.0, V: 8.0, sigma_px: 0.05}\n");
+            "reference_points:\n  - {id: A, subimage: I, u: 12.0, v: 8.0, U: 12.0, V: 8.0, "
+            "sigma_px: 0.05}\n");
   const Camera c = ReadCamera(dir.File("c.yaml"));
   EXPECT_EQ(c.interior[BrownFraser10Model::kK1], 0.0) << "omitted terms are 0";
   EXPECT_DOUBLE_EQ(c.interior[BrownFraser10Model::kX0], -0.1757);
@@ -77,13 +81,17 @@ TEST(CameraIo, BadFilesNameFileAndLine) {
   struct Case {
     std::string text, expected;
   } cases[] = {
-      {"pixel_size_mm: -1\nformat_px: [100, 100]\ninterior: {c: 50}\n", ":1: pixel_size_mm out of range (got -1"},
+      {"pixel_size_mm: -1\nformat_px: [100, 100]\ninterior: {c: 50}\n",
+       ":1: pixel_size_mm out of range (got -1"},
       {base + "colour: red\n", ":5: unknown key 'colour'"},
       {base + "  K9: 1\n", ":5: unknown key 'K9'"},
-      {base + "subimages:\n  - id: I\n    format_px: [10, 10]\n    model: affine\n    params: [1, 0, 0]\n",
+      {base + "subimages:\n  - id: I\n    format_px: [10, 10]\n    model: affine\n    params: [1, "
+              "0, 0]\n",
        ":9: sub-image I: model affine needs 6 params"},
-      {base + "subimages:\n  - id: I\n    format_px: [10, 10]\n    model: spline\n", ":8: unknown mapping model 'spline'"},
-      {base + "subimages:\n  - {id: I, format_px: [10, 10]}\nreference_points:\n  - {id: A, subimage: II, u: 1, v: 1, U: 1, V: 1}\n",
+      {base + "subimages:\n  - id: I\n    format_px: [10, 10]\n    model: spline\n",
+       ":8: unknown mapping model 'spline'"},
+      {base + "subimages:\n  - {id: I, format_px: [10, 10]}\nreference_points:\n  - {id: A, "
+              "subimage: II, u: 1, v: 1, U: 1, V: 1}\n",
        ":8: reference point A names unknown sub-image 'II'"},
       {base + "interior_sigma: {c: 0}\n", ":5: interior_sigma.c must be > 0"},
       {"pixel_size_mm: [0.009\n", ":2: invalid YAML"},
@@ -136,16 +144,20 @@ TEST(ModelCameraFile, BadModelOrParameterNamesTheLine) {
                "cam.yaml:1: unknown camera model 'opencv_x'");
   expect_error("model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\ninterior: {K1: 1}\n",
                "cam.yaml:4");
-  // Values outside the unit-derived bounds (calib/README.md "Camera file bounds") name key and line.
-  expect_error("model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
-               "interior:\n  fx: 1000\n  k1: 1e300\n",
-               "cam.yaml:6: interior.k1 out of range");
-  expect_error("model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
-               "interior:\n  fx: 1e308\n",
-               "cam.yaml:5: interior.fx out of range");
-  expect_error("model: metashape_frame\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
-               "interior:\n  f: .nan\n",
-               "cam.yaml:5");
+  // Values outside the unit-derived bounds (calib/README.md "Camera file bounds") name key and
+  // line.
+  expect_error(
+      "model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
+      "interior:\n  fx: 1000\n  k1: 1e300\n",
+      "cam.yaml:6: interior.k1 out of range");
+  expect_error(
+      "model: opencv\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
+      "interior:\n  fx: 1e308\n",
+      "cam.yaml:5: interior.fx out of range");
+  expect_error(
+      "model: metashape_frame\npixel_size_mm: 0.004\nformat_px: [10, 10]\n"
+      "interior:\n  f: .nan\n",
+      "cam.yaml:5");
   expect_error("model: opencv\npixel_size_mm: 1e-30\nformat_px: [10, 10]\ninterior: {fx: 1}\n",
                "cam.yaml:2: pixel_size_mm out of range");
   // The 10-parameter reader says what to do with another registered model.

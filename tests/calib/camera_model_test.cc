@@ -3,13 +3,14 @@
 // inverts IdealFromMeasured to 1e-6 px over the format, autodiff derivatives (including those of
 // the Newton inversions) agree with central differences, and the parameter table is well formed.
 #include "calib/camera/camera_model.h"
+
 #include "calib/camera/convert_camera.h"
+
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <set>
 #include <string>
-
-#include <gtest/gtest.h>
 
 namespace aerocal::calib {
 namespace {
@@ -178,7 +179,8 @@ void CheckDerivatives(const std::vector<double>& p, const Eigen::Vector2d& in) {
 TYPED_TEST(CameraModelTest, AutodiffMatchesNumericDerivatives) {
   using Model = TypeParam;
   const std::vector<double> p = Sample<Model>(true);
-  for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(100.0, 2900.0), Eigen::Vector2d(3100, 700)}) {
+  for (const Eigen::Vector2d& pixel :
+       {Eigen::Vector2d(100.0, 2900.0), Eigen::Vector2d(3100, 700)}) {
     const Eigen::Vector2d xy = kFrame.PhotoFromPixel(pixel);
     CheckDerivatives<Model, false>(p, xy);
     Eigen::Vector2d ideal;

@@ -3,9 +3,9 @@
 // cannot hold.
 #include "calib/camera/convert_camera.h"
 
-#include <cstdio>
-
 #include <gtest/gtest.h>
+
+#include <cstdio>
 
 namespace aerocal::calib {
 namespace {
@@ -16,8 +16,8 @@ ModelCamera AerialCamera() {
   ModelCamera camera;
   camera.model = CameraModelId::kBrownFraser10;
   camera.frame = {0.009, 14000, 12000};
-  camera.params = {170.038, -0.0024, 0.0015, 3.0e-8, -2.0e-12, 1.0e-16, 2.0e-7, -1.5e-7,
-                   1.0e-5, -8.0e-6};
+  camera.params = {
+      170.038, -0.0024, 0.0015, 3.0e-8, -2.0e-12, 1.0e-16, 2.0e-7, -1.5e-7, 1.0e-5, -8.0e-6};
   return camera;
 }
 
@@ -36,7 +36,9 @@ void Print(const char* what, const ConversionResult& r) {
 }
 
 // A conversion the target cannot hold exactly: fitted, said so, with a residual above `at_least`.
-ConversionResult ExpectFitted(const char* what, const ModelCamera& from, CameraModelId to,
+ConversionResult ExpectFitted(const char* what,
+                              const ModelCamera& from,
+                              CameraModelId to,
                               double at_least) {
   const ConversionResult r = ConvertCamera(from, to);
   Print(what, r);
@@ -128,7 +130,8 @@ TEST(ConvertCamera, ColmapAndPix4dModelsAreExactSubsetsOfOpenCv) {
   ModelCamera cv = DroneLens();
   cv.params[OpenCvModel::kFx] = cv.params[OpenCvModel::kFy];  // one focal length
   cv.params[OpenCvModel::kK3] = 0.0;                          // COLMAP's OPENCV has no k3
-  for (CameraModelId id : {CameraModelId::kColmapOpenCv, CameraModelId::kColmapFullOpenCv,
+  for (CameraModelId id : {CameraModelId::kColmapOpenCv,
+                           CameraModelId::kColmapFullOpenCv,
                            CameraModelId::kPix4dPerspective}) {
     const ConversionResult to = ConvertCamera(cv, id);
     EXPECT_TRUE(to.exact) << CameraModelName(id);
@@ -178,8 +181,18 @@ TEST(ConvertCamera, EurocRadtanIntoTenParametersConvergesToTheBestFit) {
   ModelCamera euroc;
   euroc.model = CameraModelId::kOpenCv;
   euroc.frame = {0.006, 752, 480};
-  euroc.params = {458.654, 457.296, 367.215, 248.375, -0.28340811, 0.07395907, 0.00019359,
-                  1.76187114e-05, 0, 0, 0, 0};
+  euroc.params = {458.654,
+                  457.296,
+                  367.215,
+                  248.375,
+                  -0.28340811,
+                  0.07395907,
+                  0.00019359,
+                  1.76187114e-05,
+                  0,
+                  0,
+                  0,
+                  0};
   const ConversionResult r = ConvertCamera(euroc, CameraModelId::kBrownFraser10);
   Print("EuRoC radtan (k1 = -0.28, 752 x 480) -> 10-parameter", r);
   EXPECT_FALSE(r.exact);

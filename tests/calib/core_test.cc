@@ -1,13 +1,13 @@
 // The one Median, the one comma splitter and the one numeric Jacobian of calib/core.
-#include <cmath>
-
-#include <gtest/gtest.h>
-
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
 #include "calib/core/median.h"
 #include "calib/core/numeric_jacobian.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace aerocal {
 namespace {

@@ -1,12 +1,13 @@
-#include <gtest/gtest.h>
-
 #include "calib/core/csv.h"
+
+#include <gtest/gtest.h>
 
 namespace aerocal {
 namespace {
 
 TEST(CsvTable, ReadsHeaderCommentsAndBlankLines) {
-  const auto t = CsvTable::Parse("# comment\nframe,point,u\n\n0001, t1 ,12.5\n# x\n0002,t2,\n", "f.csv");
+  const auto t =
+      CsvTable::Parse("# comment\nframe,point,u\n\n0001, t1 ,12.5\n# x\n0002,t2,\n", "f.csv");
   ASSERT_EQ(t.rows().size(), 2u);
   EXPECT_EQ(t.rows()[0].line, 4);
   EXPECT_EQ(t.String(t.rows()[0], "point"), "t1");

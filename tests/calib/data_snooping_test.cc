@@ -30,16 +30,16 @@ struct Toy {
                 const std::string& group = kGroupImage) {
     values.push_back(0.0);
     const int p = static_cast<int>(blocks.size());
-    blocks.push_back(builder.AddBlock("point P" + std::to_string(p), &values.back(), 1,
-                                      BlockKind::kGroundPoint));
+    blocks.push_back(builder.AddBlock(
+        "point P" + std::to_string(p), &values.back(), 1, BlockKind::kGroundPoint));
     rays.emplace_back();
     for (size_t i = 0; i < sigmas.size(); ++i) {
       const double blunder = i < blunders_sigma.size() ? blunders_sigma[i] * sigmas[i] : 0.0;
-      rays.back().push_back(builder.AddResidual(group,
-                                                PriorCostFunction::Create({blunder}, {sigmas[i]}),
-                                                {blocks.back()},
-                                                "P" + std::to_string(p) + " obs " +
-                                                    std::to_string(i)));
+      rays.back().push_back(
+          builder.AddResidual(group,
+                              PriorCostFunction::Create({blunder}, {sigmas[i]}),
+                              {blocks.back()},
+                              "P" + std::to_string(p) + " obs " + std::to_string(i)));
     }
   }
 };

@@ -1,14 +1,13 @@
 // The direction residual (calib/residuals/direction.h): zero for a perfect observation computed
 // independently (Eigen rotation, the model's MeasuredFromIdeal), whitening by hand, the focal-plane
 // covariance of an angular sigma by hand, gradients against ceres::GradientChecker.
+#include "calib/camera/brown_fraser10.h"
 #include "calib/residuals/direction.h"
-
-#include <cmath>
 
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
-#include "calib/camera/brown_fraser10.h"
+#include <cmath>
 
 namespace aerocal::calib {
 namespace {
@@ -23,7 +22,8 @@ struct DirectionScene {
 
   // The measured pixel of the direction, computed with Eigen (independent of the functor).
   Eigen::Vector2d Pixel() const {
-    const Eigen::Vector3d t(std::sin(direction[0]) * std::cos(direction[1]), std::sin(direction[1]),
+    const Eigen::Vector3d t(std::sin(direction[0]) * std::cos(direction[1]),
+                            std::sin(direction[1]),
                             -std::cos(direction[0]) * std::cos(direction[1]));
     const Eigen::Vector3d uvw = RotationFromOpk(opk).transpose() * g.transpose() * t;
     const Eigen::Vector2d ideal(-interior[0] * uvw.x() / uvw.z(), -interior[0] * uvw.y() / uvw.z());
@@ -46,8 +46,8 @@ TEST(DirectionResidual, ZeroForAPerfectObservationWhitenedAndGradientsMatch) {
   EXPECT_NEAR(r[1], 0.0, 1e-5);
   // One pixel off in row: -1 px in y (photo y is up) -> about -10 sigma in y (the distortion's
   // derivative changes it by K1 r^2 order, < 2 % here).
-  auto shifted = ModelDirectionResidual<BrownFraser10Model>::Create(s.frame, s.g, pixel + Eigen::Vector2d(0, 1),
-                                                                    covariance);
+  auto shifted = ModelDirectionResidual<BrownFraser10Model>::Create(
+      s.frame, s.g, pixel + Eigen::Vector2d(0, 1), covariance);
   ASSERT_TRUE(shifted->Evaluate(blocks, r, nullptr));
   EXPECT_NEAR(r[1], -10.0, 0.2);
   EXPECT_NEAR(r[0], 0.0, 0.2);
@@ -58,8 +58,8 @@ TEST(DirectionResidual, ZeroForAPerfectObservationWhitenedAndGradientsMatch) {
   double* probe[] = {s.interior, s.rotation.data(), s.direction};
   EXPECT_TRUE(checker.Probe(probe, 1e-6, &results)) << results.error_log;
   // The factory by model id gives the same residual.
-  auto by_id = MakeDirectionResidual(CameraModelId::kBrownFraser10, s.frame, s.g, pixel + Eigen::Vector2d(0, 1),
-                                     covariance);
+  auto by_id = MakeDirectionResidual(
+      CameraModelId::kBrownFraser10, s.frame, s.g, pixel + Eigen::Vector2d(0, 1), covariance);
   double r2[2];
   ASSERT_TRUE(by_id->Evaluate(blocks, r2, nullptr));
   EXPECT_DOUBLE_EQ(r2[1], r[1]);
@@ -68,8 +68,8 @@ TEST(DirectionResidual, ZeroForAPerfectObservationWhitenedAndGradientsMatch) {
 TEST(DirectionResidual, DirectionBehindTheCameraIsRejected) {
   DirectionScene s;
   s.direction[0] = 3.0;  // nearly +z: behind the camera
-  auto cost = ModelDirectionResidual<BrownFraser10Model>::Create(s.frame, s.g, Eigen::Vector2d(3000, 2000),
-                                                                 Eigen::Matrix2d::Identity() * 1e-6);
+  auto cost = ModelDirectionResidual<BrownFraser10Model>::Create(
+      s.frame, s.g, Eigen::Vector2d(3000, 2000), Eigen::Matrix2d::Identity() * 1e-6);
   double r[2];
   const double* blocks[] = {s.interior, s.rotation.data(), s.direction};
   EXPECT_FALSE(cost->Evaluate(blocks, r, nullptr));
@@ -80,7 +80,8 @@ TEST(DirectionCovariance, AngularSigmaThroughThePrincipalDistance) {
   const Eigen::Matrix2d axis = DirectionCovarianceMm2({0.0, 0.0}, 100.0, 0.0, 0.006, 1e-5);
   EXPECT_NEAR(axis(0, 0), 1e-6, 1e-18);  // (100 mm 1e-5)^2
   EXPECT_NEAR(axis(1, 1), 1e-6, 1e-18);
-  // At 45 deg off axis along x (x = c): radial c sigma / cos^2 = 2 c sigma, tangential sqrt(2) c sigma.
+  // At 45 deg off axis along x (x = c): radial c sigma / cos^2 = 2 c sigma, tangential sqrt(2) c
+  // sigma.
   const Eigen::Matrix2d off = DirectionCovarianceMm2({100.0, 0.0}, 100.0, 0.5, 0.006, 1e-5);
   const double image = 0.5 * 0.006;
   EXPECT_NEAR(off(0, 0), 4e-6 + image * image, 1e-15);

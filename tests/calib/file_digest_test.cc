@@ -1,14 +1,15 @@
 // SHA-256 of calib/core/file_digest.h against the FIPS 180-4 / NIST example vectors, and the
 // result key `inputs` it writes.
+#include "calib/core/file_digest.h"
+
+#include "calib/core/error.h"
+
+#include <gtest/gtest.h>
+
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <string>
-
-#include <gtest/gtest.h>
-
-#include "calib/core/error.h"
-#include "calib/core/file_digest.h"
 
 namespace aerocal {
 namespace {
@@ -25,7 +26,8 @@ TEST(Sha256Hex, NistExampleVectors) {
 }
 
 TEST(InputFilesToJson, SizesChecksumsEachPathOnce) {
-  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "aerocal_file_digest_test";
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / "aerocal_file_digest_test";
   std::filesystem::create_directories(dir);
   const std::string file = (dir / "points.csv").string();
   std::ofstream(file) << "abc";
@@ -33,7 +35,8 @@ TEST(InputFilesToJson, SizesChecksumsEachPathOnce) {
   ASSERT_EQ(inputs.size(), 1u);
   EXPECT_EQ(inputs[0]["role"], "points");
   EXPECT_EQ(inputs[0]["bytes"], 3);
-  EXPECT_EQ(inputs[0]["sha256"], "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
+  EXPECT_EQ(inputs[0]["sha256"],
+            "ba7816bf8f01cfea414140de5dae2223b00361a396177a9cb410ff61f20015ad");
   EXPECT_THROW(InputFilesToJson({{"missing", (dir / "missing.csv").string()}}), InputError);
   std::filesystem::remove_all(dir);
 }

@@ -3,14 +3,14 @@
 // line-camera writers (CameraToYaml, RigToYaml, LineCameraToYaml) and read back as the same text
 // and the same number of sub-images / heads / sub-cameras. (The other tools' camera formats:
 // CameraFormats.AHostileNameNeverBreaksAFile in camera_formats_test.)
-#include <string>
-
-#include <gtest/gtest.h>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/line_camera_io.h"
 #include "calib/camera/rig_io.h"
 #include "calib/core/yaml_util.h"
+
+#include <gtest/gtest.h>
+
+#include <string>
 
 namespace aerocal::calib {
 namespace {
@@ -21,7 +21,9 @@ std::string Hostile(const std::string& tag) {
   return tag + " A&B <x> \"q\" 'p', c\nsecond: line\n- item # not a comment";
 }
 
-std::string Config(const std::string& name) { return std::string(AEROCAL_CONFIGS_DIR) + "/" + name; }
+std::string Config(const std::string& name) {
+  return std::string(AEROCAL_CONFIGS_DIR) + "/" + name;
+}
 
 TEST(HostileText, CameraNamesSubimageAndReferencePointIdsRoundTrip) {
   Camera camera = ReadCamera(Config("camera_2x3.yaml"));
@@ -38,7 +40,8 @@ TEST(HostileText, CameraNamesSubimageAndReferencePointIdsRoundTrip) {
   const Camera back = ParseCamera(LoadYamlText(CameraToYaml(camera), "back.yaml"), "back.yaml");
   EXPECT_EQ(back.name, camera.name);
   ASSERT_EQ(back.subimages.size(), camera.subimages.size());
-  for (size_t i = 0; i < camera.subimages.size(); ++i) EXPECT_EQ(back.subimages[i].id, camera.subimages[i].id);
+  for (size_t i = 0; i < camera.subimages.size(); ++i)
+    EXPECT_EQ(back.subimages[i].id, camera.subimages[i].id);
   ASSERT_EQ(back.reference_points.size(), camera.reference_points.size());
   EXPECT_EQ(back.reference_points[0].id, camera.reference_points[0].id);
   EXPECT_EQ(back.reference_points[0].subimage, camera.reference_points[0].subimage);
@@ -64,11 +67,14 @@ TEST(HostileText, LineCameraNameAndSubcameraIdsRoundTrip) {
   LineCamera camera = ReadLineCamera(Config("line_camera_three.yaml"));
   ASSERT_GE(camera.subcameras.size(), 2u);
   camera.name = Hostile("line");
-  for (size_t i = 0; i < camera.subcameras.size(); ++i) camera.subcameras[i].id = Hostile("s" + std::to_string(i));
-  const LineCamera back = ParseLineCamera(LoadYamlText(LineCameraToYaml(camera), "back.yaml"), "back.yaml");
+  for (size_t i = 0; i < camera.subcameras.size(); ++i)
+    camera.subcameras[i].id = Hostile("s" + std::to_string(i));
+  const LineCamera back =
+      ParseLineCamera(LoadYamlText(LineCameraToYaml(camera), "back.yaml"), "back.yaml");
   EXPECT_EQ(back.name, camera.name);
   ASSERT_EQ(back.subcameras.size(), camera.subcameras.size());
-  for (size_t i = 0; i < camera.subcameras.size(); ++i) EXPECT_EQ(back.subcameras[i].id, camera.subcameras[i].id);
+  for (size_t i = 0; i < camera.subcameras.size(); ++i)
+    EXPECT_EQ(back.subcameras[i].id, camera.subcameras[i].id);
 }
 
 }  // namespace

@@ -1,10 +1,11 @@
 // calib/metadata: the XMP packet by namespace URI, the bounded TIFF-IFD reader and the JPEG walk,
 // on the metadata-only DJI fixtures (tests/data/images), a real Canon JPEG (../shared/data) and
 // bytes built here to break one rule each (truncation, IFD loops, huge counts, duplicates).
+#include "calib/metadata/image_metadata.h"
+
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
-#include "calib/metadata/image_metadata.h"
 #include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
@@ -27,7 +28,8 @@ std::string ErrorOf(const std::function<void()>& f) {
 }
 
 std::string Packet(const std::string& description) {
-  return "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n<rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n" +
+  return "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n<rdf:RDF "
+         "xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n" +
          description + "\n</rdf:RDF>\n</x:xmpmeta>\n";
 }
 
@@ -36,7 +38,8 @@ TEST(XmpPacket, PropertiesAreFoundByNamespaceUriWhateverThePrefix) {
     const std::string p = prefix;
     const XmpPacket packet = XmpPacket::Parse(
         Packet("<rdf:Description xmlns:" + p + "=\"http://www.dji.com/drone-dji/1.0/\" " + p +
-               ":GpsLatitude=\" +46.5 \">\n<" + p + ":DewarpData>1,2</" + p + ":DewarpData>\n</rdf:Description>"),
+               ":GpsLatitude=\" +46.5 \">\n<" + p + ":DewarpData>1,2</" + p +
+               ":DewarpData>\n</rdf:Description>"),
         {"a.xmp", 1});
     ASSERT_NE(packet.Find(xmp_ns::kDji, "GpsLatitude"), nullptr) << prefix;
     EXPECT_EQ(packet.Text(xmp_ns::kDji, "GpsLatitude"), "+46.5");
@@ -44,36 +47,49 @@ TEST(XmpPacket, PropertiesAreFoundByNamespaceUriWhateverThePrefix) {
     EXPECT_EQ(packet.Find(xmp_ns::kDji, "DewarpData")->where.line, 4);
   }
   // The prefix "drone-dji" bound to another URI is not DJI's namespace.
-  const XmpPacket other = XmpPacket::Parse(
-      Packet("<rdf:Description xmlns:drone-dji=\"http://example.com/other/\" drone-dji:GpsLatitude=\"1\"/>"), {"b.xmp", 1});
+  const XmpPacket other =
+      XmpPacket::Parse(Packet("<rdf:Description xmlns:drone-dji=\"http://example.com/other/\" "
+                              "drone-dji:GpsLatitude=\"1\"/>"),
+                       {"b.xmp", 1});
   EXPECT_EQ(other.Find(xmp_ns::kDji, "GpsLatitude"), nullptr);
-  EXPECT_NE(other.Find("http://example.com/other", "GpsLatitude"), nullptr);  // trailing '/' ignored
+  EXPECT_NE(other.Find("http://example.com/other", "GpsLatitude"),
+            nullptr);  // trailing '/' ignored
 }
 
 TEST(XmpPacket, BrokenPacketsAreErrorsWithTheirLine) {
   const std::string dji = "xmlns:d=\"http://www.dji.com/drone-dji/1.0/\"";
   EXPECT_NE(ErrorOf([&] {
-              XmpPacket::Parse(Packet("<rdf:Description " + dji + " d:RtkFlag=\"50\">\n<d:RtkFlag>16</d:RtkFlag>\n</rdf:Description>"),
-                               {"dup.xmp", 1});
+              XmpPacket::Parse(
+                  Packet("<rdf:Description " + dji +
+                         " d:RtkFlag=\"50\">\n<d:RtkFlag>16</d:RtkFlag>\n</rdf:Description>"),
+                  {"dup.xmp", 1});
             }).find("dup.xmp:4: XMP property d:RtkFlag"),
             std::string::npos);
   EXPECT_NE(ErrorOf([&] {
-              XmpPacket::Parse(Packet("<rdf:Description " + dji + " d:RtkFlag=\"50\"/>\n<rdf:Description " + dji +
-                                      " d:RtkFlag=\"50\"/>"),
-                               {"two.xmp", 1});
+              XmpPacket::Parse(
+                  Packet("<rdf:Description " + dji + " d:RtkFlag=\"50\"/>\n<rdf:Description " +
+                         dji + " d:RtkFlag=\"50\"/>"),
+                  {"two.xmp", 1});
             }).find("given twice (first at two.xmp:3)"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { XmpPacket::Parse(Packet("<rdf:Description q:A=\"1\"/>"), {"ns.xmp", 1}); })
-                .find("ns.xmp:3: namespace prefix 'q'"),
+  EXPECT_NE(ErrorOf([&] {
+              XmpPacket::Parse(Packet("<rdf:Description q:A=\"1\"/>"), {"ns.xmp", 1});
+            }).find("ns.xmp:3: namespace prefix 'q'"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { XmpPacket::Parse(Packet("<rdf:Description " + dji + ">\n<d:A>1</d:B>\n</rdf:Description>"), {"bad.xmp", 1}); })
-                .find("bad.xmp:4: XMP packet is not well-formed XML"),
+  EXPECT_NE(ErrorOf([&] {
+              XmpPacket::Parse(
+                  Packet("<rdf:Description " + dji + ">\n<d:A>1</d:B>\n</rdf:Description>"),
+                  {"bad.xmp", 1});
+            }).find("bad.xmp:4: XMP packet is not well-formed XML"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([&] { XmpPacket::Parse(Packet("") + Packet(""), {"twice.xmp", 1}); }).find("twice.xmp"),
+  EXPECT_NE(ErrorOf([&] {
+              XmpPacket::Parse(Packet("") + Packet(""), {"twice.xmp", 1});
+            }).find("twice.xmp"),
             std::string::npos);
   // In a binary file the line is counted in the packet.
-  EXPECT_NE(ErrorOf([&] { XmpPacket::Parse(Packet("<rdf:Description q:A=\"1\"/>"), {"a.jpg", 0}); })
-                .find("a.jpg: XMP line 3:"),
+  EXPECT_NE(ErrorOf([&] {
+              XmpPacket::Parse(Packet("<rdf:Description q:A=\"1\"/>"), {"a.jpg", 0});
+            }).find("a.jpg: XMP line 3:"),
             std::string::npos);
 }
 
@@ -106,19 +122,30 @@ TEST(TiffTags, BoundedAgainstLoopsHugeCountsAndDuplicates) {
   EXPECT_EQ(ok.at({TiffIfd::kImage, 0x010F}).text, "Ab");
   EXPECT_EQ(ok.at({TiffIfd::kImage, 0x0100}).numbers, std::vector<double>{640});
   // The Exif IFD pointer points back at IFD0: a loop.
-  EXPECT_NE(ErrorOf([] { ReadTiffTags(Tiff({{0x8769, 4, 1, 8}}), "loop"); }).find("loop: IFD loop"), std::string::npos);
+  EXPECT_NE(ErrorOf([] {
+              ReadTiffTags(Tiff({{0x8769, 4, 1, 8}}), "loop");
+            }).find("loop: IFD loop"),
+            std::string::npos);
   // 0x40000000 rationals: 8 GB claimed in a 100-byte structure.
-  EXPECT_NE(ErrorOf([] { ReadTiffTags(Tiff({{0x010F, 5, 0x40000000, 20}}), "huge"); }).find("run past the end"),
+  EXPECT_NE(ErrorOf([] {
+              ReadTiffTags(Tiff({{0x010F, 5, 0x40000000, 20}}), "huge");
+            }).find("run past the end"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([] { ReadTiffTags(Tiff({{0x010F, 5, 0xFFFFFFFF, 0xFFFFFFF0}}), "wrap"); }).find("run past the end"),
+  EXPECT_NE(ErrorOf([] {
+              ReadTiffTags(Tiff({{0x010F, 5, 0xFFFFFFFF, 0xFFFFFFF0}}), "wrap");
+            }).find("run past the end"),
             std::string::npos);
-  EXPECT_NE(ErrorOf([] { ReadTiffTags(Tiff({{0x0100, 3, 1, 1}, {0x0100, 3, 1, 2}}), "dup"); })
-                .find("EXIF ImageWidth is given twice"),
+  EXPECT_NE(ErrorOf([] {
+              ReadTiffTags(Tiff({{0x0100, 3, 1, 1}, {0x0100, 3, 1, 2}}), "dup");
+            }).find("EXIF ImageWidth is given twice"),
             std::string::npos);
   std::string many = Tiff({});
   Put16(&many, 8, 60000);
-  EXPECT_NE(ErrorOf([&] { ReadTiffTags(many, "many"); }).find("claims 60000 entries"), std::string::npos);
-  EXPECT_NE(ErrorOf([] { ReadTiffTags(std::string("II*\0\xFF\xFF\xFF\x00", 8), "far"); }).find("outside the data"),
+  EXPECT_NE(ErrorOf([&] { ReadTiffTags(many, "many"); }).find("claims 60000 entries"),
+            std::string::npos);
+  EXPECT_NE(ErrorOf([] {
+              ReadTiffTags(std::string("II*\0\xFF\xFF\xFF\x00", 8), "far");
+            }).find("outside the data"),
             std::string::npos);
   // Every prefix of a valid structure is refused or read, never read out of bounds (ASan job).
   const std::string full = Tiff({{0x010F, 2, 3, 0x6241}, {0x8825, 4, 1, 8}});
@@ -135,7 +162,8 @@ TEST(TiffTags, BoundedAgainstLoopsHugeCountsAndDuplicates) {
 std::string Fixture(const std::string& name) { return ReadTextFile(kImages + "/" + name); }
 
 TEST(ImageMetadata, MetadataOnlyDjiJpegGivesItsTagsAndSize) {
-  const ImageMetadata m = ImageMetadataOfBytes(Fixture("dji_constructed.jpg"), "dji_constructed.jpg");
+  const ImageMetadata m =
+      ImageMetadataOfBytes(Fixture("dji_constructed.jpg"), "dji_constructed.jpg");
   EXPECT_EQ(m.format, "jpeg");
   EXPECT_EQ(m.width_px, 64);
   EXPECT_EQ(m.height_px, 48);
@@ -156,10 +184,16 @@ TEST(ImageMetadata, TruncatedOrDoubledJpegsAreErrorsNamingTheFile) {
   // A second copy of the XMP APP1 segment.
   const size_t xmp = jpeg.find("http://ns.adobe.com/xap/1.0/");
   const size_t start = xmp - 4;
-  const size_t length = (static_cast<unsigned char>(jpeg[start + 2]) << 8) | static_cast<unsigned char>(jpeg[start + 3]);
-  const std::string doubled = jpeg.substr(0, start + 2 + length) + jpeg.substr(start, 2 + length) + jpeg.substr(start + 2 + length);
-  EXPECT_NE(ErrorOf([&] { ImageMetadataOfBytes(doubled, "two.jpg"); }).find("two.jpg: two XMP packets"), std::string::npos);
-  EXPECT_NE(ErrorOf([&] { ImageMetadataOfBytes("GIF89a", "x.gif"); }).find("neither a JPEG nor a TIFF"), std::string::npos);
+  const size_t length = (static_cast<unsigned char>(jpeg[start + 2]) << 8) |
+                        static_cast<unsigned char>(jpeg[start + 3]);
+  const std::string doubled = jpeg.substr(0, start + 2 + length) + jpeg.substr(start, 2 + length) +
+                              jpeg.substr(start + 2 + length);
+  EXPECT_NE(
+      ErrorOf([&] { ImageMetadataOfBytes(doubled, "two.jpg"); }).find("two.jpg: two XMP packets"),
+      std::string::npos);
+  EXPECT_NE(
+      ErrorOf([&] { ImageMetadataOfBytes("GIF89a", "x.gif"); }).find("neither a JPEG nor a TIFF"),
+      std::string::npos);
 }
 
 TEST(ImageMetadata, RealCanonJpegGivesMakeModelAndSize) {
@@ -176,7 +210,8 @@ TEST(ImageMetadata, RealCanonJpegGivesMakeModelAndSize) {
 }
 
 TEST(ImageMetadata, TiffFileGivesItsSizeFromIfd0) {
-  const std::string tiff = ReadTextFile(std::string(AEROCAL_TEST_DATA_DIR) + "/../fuzz/seeds/image_metadata/tiny.tif");
+  const std::string tiff =
+      ReadTextFile(std::string(AEROCAL_TEST_DATA_DIR) + "/../fuzz/seeds/image_metadata/tiny.tif");
   const ImageMetadata m = ImageMetadataOfBytes(tiff, "tiny.tif");
   EXPECT_EQ(m.format, "tiff");
   EXPECT_EQ(m.width_px, 4);
@@ -199,16 +234,23 @@ TEST(CameraXmp, DjiDewarpDataIsReadByNamespaceUriNotPrefix) {
                       Packet("<rdf:Description xmlns:drone-dji=\"http://example.com/not-dji/\" "
                              "drone-dji:DewarpData=\"1,1,0,0,0,0,0,0,0\"/>"));
   options.width_px = 100, options.height_px = 100;
-  EXPECT_NE(ErrorOf([&] { ReadDjiDewarpData(dir.File("other.xmp"), options); }).find("no DewarpData of namespace"),
+  EXPECT_NE(ErrorOf([&] {
+              ReadDjiDewarpData(dir.File("other.xmp"), options);
+            }).find("no DewarpData of namespace"),
             std::string::npos);
   // Two packets in one sidecar, a duplicated DewarpData: errors naming the file.
   WriteFileAtomically(dir.File("two.xmp"), Packet("") + Packet(""));
-  EXPECT_NE(ErrorOf([&] { ReadDjiDewarpData(dir.File("two.xmp"), options); }).find("two.xmp: two XMP packets"),
+  EXPECT_NE(ErrorOf([&] {
+              ReadDjiDewarpData(dir.File("two.xmp"), options);
+            }).find("two.xmp: two XMP packets"),
             std::string::npos);
   WriteFileAtomically(dir.File("dup.xmp"),
-                      Packet("<rdf:Description xmlns:d=\"http://www.dji.com/drone-dji/1.0/\" d:DewarpData=\"1,1,0,0,0,0,0,0,0\">\n"
+                      Packet("<rdf:Description xmlns:d=\"http://www.dji.com/drone-dji/1.0/\" "
+                             "d:DewarpData=\"1,1,0,0,0,0,0,0,0\">\n"
                              "<d:DewarpData>2,2,0,0,0,0,0,0,0</d:DewarpData></rdf:Description>"));
-  EXPECT_NE(ErrorOf([&] { ReadDjiDewarpData(dir.File("dup.xmp"), options); }).find("dup.xmp:4: XMP property d:DewarpData"),
+  EXPECT_NE(ErrorOf([&] {
+              ReadDjiDewarpData(dir.File("dup.xmp"), options);
+            }).find("dup.xmp:4: XMP property d:DewarpData"),
             std::string::npos);
 }
 
@@ -224,12 +266,14 @@ TEST(CameraXmp, Pix4dTagsUnderAnotherNamespaceAreNotPix4ds) {
   CameraReadOptions options;
   options.width_px = 4000, options.height_px = 3000, options.pixel_size_mm = 0.0012;
   EXPECT_EQ(ReadPix4dXmp(dir.File("p.xmp"), options).camera.params[Pix4dPerspectiveModel::kF], 4.5);
-  WriteFileAtomically(dir.File("q.xmp"),
-                      Packet("<rdf:Description xmlns:Camera=\"http://example.com/camera/\">\n"
-                             "<Camera:PerspectiveFocalLength>99</Camera:PerspectiveFocalLength>\n"
-                             "<Camera:PrincipalPoint>2.4,1.8</Camera:PrincipalPoint>\n</rdf:Description>"));
-  EXPECT_NE(ErrorOf([&] { ReadPix4dXmp(dir.File("q.xmp"), options); }).find("no PerspectiveFocalLength"),
-            std::string::npos);
+  WriteFileAtomically(
+      dir.File("q.xmp"),
+      Packet("<rdf:Description xmlns:Camera=\"http://example.com/camera/\">\n"
+             "<Camera:PerspectiveFocalLength>99</Camera:PerspectiveFocalLength>\n"
+             "<Camera:PrincipalPoint>2.4,1.8</Camera:PrincipalPoint>\n</rdf:Description>"));
+  EXPECT_NE(
+      ErrorOf([&] { ReadPix4dXmp(dir.File("q.xmp"), options); }).find("no PerspectiveFocalLength"),
+      std::string::npos);
 }
 
 }  // namespace

@@ -3,18 +3,19 @@
 // cameras, table / polynomial calibration, file round trip and FILE:LINE errors, the B-spline
 // weights, a perfect observation's zero residual and the autodiff Jacobian against numeric
 // differentiation (ceres::GradientChecker).
-#include <cmath>
-#include <fstream>
-
-#include <ceres/gradient_checker.h>
-#include <gtest/gtest.h>
-
 #include "calib/camera/line_camera.h"
+
 #include "calib/camera/line_camera_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/residuals/line_collinearity.h"
 #include "tests/support/test_support.h"
+
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
 
 namespace aerocal::calib {
 namespace {
@@ -71,16 +72,16 @@ TEST(LineCamera, CombinedTiltedCamerasProjectOntoTheVirtualPlane) {
   EXPECT_NEAR(cam.DesignPosition(mid).y(), 0.0, 1e-15);
   // A detector j of the left camera: angle atan(x_j / c) + tilt.
   const double xj = (10 - 49.5) * 0.01;
-  EXPECT_NEAR(cam.DesignPosition(10).x(), -8.5 * std::tan(std::atan(-xj / 8.5) - 20 * kDeg) * 1.0,
-              1e-12);
+  EXPECT_NEAR(
+      cam.DesignPosition(10).x(), -8.5 * std::tan(std::atan(-xj / 8.5) - 20 * kDeg) * 1.0, 1e-12);
   // The nadir camera is the straight line of its own detectors.
   EXPECT_NEAR(cam.DesignPosition(100).x(), -49.5 * 0.01, 1e-12);
 }
 
 TEST(LineCamera, PolynomialCalibrationInTheNormalisedIndex) {
   LineCamera cam = ThreeTilted();
-  cam.calibration = {{0, 99, {0.001, 0.002}, {}}, {100, 199, {}, {0.0, 0.0, 0.003}},
-                     {200, 299, {0.004}, {0.005}}};
+  cam.calibration = {
+      {0, 99, {0.001, 0.002}, {}}, {100, 199, {}, {0.0, 0.0, 0.003}}, {200, 299, {0.004}, {0.005}}};
   cam.Validate("x");
   EXPECT_NEAR(cam.Correction(0).x(), 0.001 - 0.002, 1e-15);
   EXPECT_NEAR(cam.Correction(99).x(), 0.003, 1e-15);
@@ -96,7 +97,8 @@ TEST(LineCameraFile, RoundTripIsExact) {
   LineCamera cam = ThreeTilted();
   cam.mount_rad = Eigen::Vector3d(0.1, -0.2, 0.3) * kDeg;
   cam.lever_arm_m = {0.1, 0.2, -0.3};
-  cam.calibration = {{0, 99, {1e-3, 2e-4, 3.3e-5}, {-1e-4}}, {100, 199, {0.0}, {0.0}},
+  cam.calibration = {{0, 99, {1e-3, 2e-4, 3.3e-5}, {-1e-4}},
+                     {100, 199, {0.0}, {0.0}},
                      {200, 299, {4e-3}, {5e-3, 1e-7}}};
   WriteLineCamera(dir.File("line.yaml"), cam);
   const LineCamera back = ReadLineCamera(dir.File("line.yaml"));
@@ -133,14 +135,17 @@ TEST(LineCameraFile, BadFilesNameTheLine) {
       {"line:\n  detectors: 3\n  pitch_mm: -0.01\n  c: 8\n", ":3: line.pitch_mm must be within"},
       {"line:\n  detectors: 0\n  pitch_mm: 0.01\n  c: 8\n", ":2: line.detectors must be within 1"},
       {"line:\n  detectors: 3\n  pitch_mm: 0.01\n  c: 8\n  colour: red\n", ":5:"},
-      {"line:\n  detectors: 4\n  pitch_mm: 0.01\n  c: 8\n  calibration:\n    - {first: 0, last: 1}\n"
+      {"line:\n  detectors: 4\n  pitch_mm: 0.01\n  c: 8\n  calibration:\n    - {first: 0, last: "
+       "1}\n"
        "    - {first: 3, last: 3}\n",
        ":7: calibration ranges must be contiguous"},
       {"line:\n  detectors: 4\n  pitch_mm: 0.01\n  c: 8\n  subcameras:\n"
-       "    - {id: A, detectors: 2, c: 8, pitch_mm: 0.01}\n    - {id: B, detectors: 3, c: 8, pitch_mm: 0.01}\n",
+       "    - {id: A, detectors: 2, c: 8, pitch_mm: 0.01}\n    - {id: B, detectors: 3, c: 8, "
+       "pitch_mm: 0.01}\n",
        ":7: sub-camera B: detectors must be within 1 .. 2"},
       {"line:\n  detectors: 4\n  pitch_mm: 0.01\n  c: 8\n  subcameras:\n"
-       "    - {id: A, detectors: 2, c: 8, pitch_mm: 0.01}\n    - {id: B, detectors: 2, c: 8, pitch_mm: 0.01}\n"
+       "    - {id: A, detectors: 2, c: 8, pitch_mm: 0.01}\n    - {id: B, detectors: 2, c: 8, "
+       "pitch_mm: 0.01}\n"
        "  calibration:\n    - {first: 0, last: 2, dx: [1]}\n    - {first: 3, last: 3}\n",
        ":9: calibration range [0, 2] spans a sub-camera seam"},
       {"line:\n  detectors: 4\n  pitch_mm: 0.01\n  c: 8\n  calibration:\n"
@@ -211,11 +216,25 @@ TEST(LineCollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
   std::copy(point.data(), point.data() + 3, s.point);
 
   // A time offset (here 0) moves the pose along the POS velocity and attitude rate.
-  auto cost = LineCollinearityResidual::Create(design, u, span, pos_opk, pos_center, Eigen::Vector2d(0.003, 0.003),
-                                               Eigen::Vector3d(1, 60, -0.5), Eigen::Vector3d(0.01, -0.02, 0.005));
+  auto cost = LineCollinearityResidual::Create(design,
+                                               u,
+                                               span,
+                                               pos_opk,
+                                               pos_center,
+                                               Eigen::Vector2d(0.003, 0.003),
+                                               Eigen::Vector3d(1, 60, -0.5),
+                                               Eigen::Vector3d(0.01, -0.02, 0.005));
   double time_offset = 0.0;
-  const double* blocks[] = {s.nodes[0], s.nodes[1], s.nodes[2], s.nodes[3], s.detector,
-                            &s.c,       s.mount,    s.lever,    &time_offset, s.point};
+  const double* blocks[] = {s.nodes[0],
+                            s.nodes[1],
+                            s.nodes[2],
+                            s.nodes[3],
+                            s.detector,
+                            &s.c,
+                            s.mount,
+                            s.lever,
+                            &time_offset,
+                            s.point};
   double r[2];
   ASSERT_TRUE(cost->Evaluate(blocks, r, nullptr));
   EXPECT_NEAR(r[0], 0.0, 1e-9);
@@ -231,20 +250,39 @@ TEST(LineCollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
   ceres::GradientChecker checker(cost.get(), no_manifolds, options);
   ceres::GradientChecker::ProbeResults results;
   time_offset = 0.003;
-  std::vector<double*> mutable_blocks = {s.nodes[0], s.nodes[1], s.nodes[2], s.nodes[3], s.detector,
-                                         &s.c,       s.mount,    s.lever,    &time_offset, s.point};
+  std::vector<double*> mutable_blocks = {s.nodes[0],
+                                         s.nodes[1],
+                                         s.nodes[2],
+                                         s.nodes[3],
+                                         s.detector,
+                                         &s.c,
+                                         s.mount,
+                                         s.lever,
+                                         &time_offset,
+                                         s.point};
   EXPECT_TRUE(checker.Probe(mutable_blocks.data(), 1e-6, &results)) << results.error_log;
 }
 
 TEST(LineCollinearityResidual, RefusesAPointBehindTheCamera) {
   Scene s;
   s.point[2] = 3000;  // above the camera at 1000 m
-  auto cost = LineCollinearityResidual::Create(Eigen::Vector2d(0, 0), 0.0, CubicBSplineWeights(0, 10),
-                                               Eigen::Vector3d::Zero(), Eigen::Vector3d(0, 0, 1000),
+  auto cost = LineCollinearityResidual::Create(Eigen::Vector2d(0, 0),
+                                               0.0,
+                                               CubicBSplineWeights(0, 10),
+                                               Eigen::Vector3d::Zero(),
+                                               Eigen::Vector3d(0, 0, 1000),
                                                Eigen::Vector2d(0.003, 0.003));
   double time_offset = 0.0;
-  const double* blocks[] = {s.nodes[0], s.nodes[1], s.nodes[2], s.nodes[3], s.detector,
-                            &s.c,       s.mount,    s.lever,    &time_offset, s.point};
+  const double* blocks[] = {s.nodes[0],
+                            s.nodes[1],
+                            s.nodes[2],
+                            s.nodes[3],
+                            s.detector,
+                            &s.c,
+                            s.mount,
+                            s.lever,
+                            &time_offset,
+                            s.point};
   double r[2];
   EXPECT_FALSE(cost->Evaluate(blocks, r, nullptr));
 }

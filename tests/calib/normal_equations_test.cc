@@ -4,6 +4,7 @@
 // J (J^T J)^+ J^T of the same Jacobian; the datum-defect cases; one manifold per block; and
 // bit-identical results of two identical solves.
 #include "calib/problem/normal_equations.h"
+
 #include "calib/problem/problem_builder.h"
 #include "calib/residuals/autodiff_residual.h"
 
@@ -75,7 +76,8 @@ TEST(SelectedInverse, ASingularMatrixIsNotInvertedAboveTheDenseLimit) {
 // r = U interior + V pose + W point - y: a linear model with the block structure of a bundle
 // (every row one point, one pose, the shared interior), random coefficients per observation.
 struct LinearRayResidual : AutoDiffResidual<LinearRayResidual, 2, 4, 6, 3> {
-  LinearRayResidual(const Eigen::Matrix<double, 2, 13>& m, const Eigen::Vector2d& y) : m_(m), y_(y) {}
+  LinearRayResidual(const Eigen::Matrix<double, 2, 13>& m, const Eigen::Vector2d& y)
+      : m_(m), y_(y) {}
   template <typename T>
   bool operator()(const T* interior, const T* pose, const T* point, T* r) const {
     for (int i = 0; i < 2; ++i) {
@@ -137,10 +139,11 @@ struct LinearBlock {
         for (int r = 0; r < 2; ++r)
           for (int c = 0; c < 13; ++c) m(r, c) = uniform(rng);
         if (defect && pose == n_poses - 1) m.col(4 + 5).setZero();
-        rays.push_back(builder.AddResidual(kGroupImage,
-                                           LinearRayResidual::Create(m, Eigen::Vector2d(uniform(rng), uniform(rng))),
-                                           {interior_block, pose_blocks[pose], point_blocks[p]},
-                                           "ray " + std::to_string(p) + "/" + std::to_string(k)));
+        rays.push_back(builder.AddResidual(
+            kGroupImage,
+            LinearRayResidual::Create(m, Eigen::Vector2d(uniform(rng), uniform(rng))),
+            {interior_block, pose_blocks[pose], point_blocks[p]},
+            "ray " + std::to_string(p) + "/" + std::to_string(k)));
       }
     }
     for (int i = 0; i < n_poses; i += 10) {
@@ -171,9 +174,11 @@ struct LinearBlock {
   }
   // Row of each residual's first component in the dense oracle (residuals in insertion order:
   // rays, then priors).
-  int Row(ResidualId id) const { return id < static_cast<int>(rays.size()) ? 2 * id
-                                        : 2 * static_cast<int>(rays.size()) +
-                                              6 * (id - static_cast<int>(rays.size())); }
+  int Row(ResidualId id) const {
+    return id < static_cast<int>(rays.size())
+               ? 2 * id
+               : 2 * static_cast<int>(rays.size()) + 6 * (id - static_cast<int>(rays.size()));
+  }
 };
 
 std::vector<ResidualId> AllResiduals(const LinearBlock& block) {
@@ -215,7 +220,8 @@ TEST(ObservationCofactors, SparsePathMatchesTheDenseHatMatrix) {
           for (int k = 0; k < 2; ++k) {
             const int ra = block.Row(c.residuals[a]) + i, rb = block.Row(c.residuals[b]) + k;
             const double expected = (ra == rb ? 1.0 : 0.0) - hat(ra, rb);
-            worst_cluster = std::max(worst_cluster, std::abs(c.qvv(2 * a + i, 2 * b + k) - expected));
+            worst_cluster =
+                std::max(worst_cluster, std::abs(c.qvv(2 * a + i, 2 * b + k) - expected));
           }
   }
   EXPECT_LT(worst_cluster, kExact);
@@ -255,8 +261,8 @@ TEST(Covariance, SelectedInverseMatchesTheDenseInverse) {
   LinearBlock block(false);
   const SolveReport report = block.builder.Solve({});
   ASSERT_TRUE(report.usable);
-  const std::vector<BlockId> requested = {block.interior_block, block.pose_blocks[3],
-                                          block.pose_blocks[60], block.point_blocks[17]};
+  const std::vector<BlockId> requested = {
+      block.interior_block, block.pose_blocks[3], block.pose_blocks[60], block.point_blocks[17]};
   const CovarianceReport cov = block.builder.EstimateCovariance(requested, 2.0, 0.95);
   ASSERT_TRUE(cov.ok) << cov.message;
   EXPECT_EQ(cov.method, "schur_selected_inverse");
@@ -282,7 +288,8 @@ TEST(Covariance, SelectedInverseMatchesTheDenseInverse) {
   auto plus = [&](BlockId b) {
     const int n = block.builder.BlockSize(b);
     Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(n, n);
-    block.builder.problem().GetManifold(block.builder.BlockValues(b))
+    block.builder.problem()
+        .GetManifold(block.builder.BlockValues(b))
         ->PlusJacobian(block.builder.BlockValues(b), m.data());
     return Eigen::MatrixXd(m);
   };
@@ -294,8 +301,8 @@ TEST(Covariance, SelectedInverseMatchesTheDenseInverse) {
       const int na = block.builder.BlockSize(a), nb = block.builder.BlockSize(b);
       const Eigen::MatrixXd expected =
           4.0 * plus(a) * q.block(offset[a], offset[b], na, nb) * plus(b).transpose();
-      worst = std::max(worst, (got - expected).cwiseAbs().maxCoeff() /
-                                  expected.cwiseAbs().maxCoeff());
+      worst =
+          std::max(worst, (got - expected).cwiseAbs().maxCoeff() / expected.cwiseAbs().maxCoeff());
     }
   EXPECT_LT(worst, kExact);
   EXPECT_EQ(cov.interior_names.size(), 4u);

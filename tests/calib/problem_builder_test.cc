@@ -4,9 +4,9 @@
 // data snooping of a planted gross error, and the diagnostics of rank-deficient and badly
 // determined problems.
 #include "calib/problem/problem_builder.h"
-#include "calib/problem/data_snooping.h"
 
 #include "calib/camera/camera.h"
+#include "calib/problem/data_snooping.h"
 #include "calib/residuals/autodiff_residual.h"
 #include "calib/residuals/collinearity.h"
 
@@ -235,7 +235,8 @@ TEST(ProblemBuilder, DatumDefectIsReportedWithTheParametersInvolved) {
   // A free network: two exposures and free object points, nothing fixing position, attitude and
   // scale: the covariance cannot be computed and the diagnostics name the exterior orientation.
   const TestField f = MakeTestField();
-  std::vector<Eigen::Vector4d> rotations = {QuaternionFromOpk(f.opk[0]), QuaternionFromOpk(f.opk[2])};
+  std::vector<Eigen::Vector4d> rotations = {QuaternionFromOpk(f.opk[0]),
+                                            QuaternionFromOpk(f.opk[2])};
   std::vector<Eigen::Vector3d> centers = {f.centers[0], f.centers[2]};
   std::vector<Eigen::Vector3d> points = f.points;
   InteriorParams interior = f.camera.interior;
@@ -274,7 +275,8 @@ TEST(ProblemBuilder, DatumDefectIsReportedWithTheParametersInvolved) {
   const NullSpaceReport null_space = builder.NullSpace(1e-10);
   ASSERT_TRUE(null_space.ok) << null_space.message;
   EXPECT_EQ(null_space.rank_defect, 7);
-  EXPECT_GT(null_space.smallest_relative_eigenvalues[7], 1e4 * null_space.smallest_relative_eigenvalues[6]);
+  EXPECT_GT(null_space.smallest_relative_eigenvalues[7],
+            1e4 * null_space.smallest_relative_eigenvalues[6]);
   for (const BlockId b : {ob[0], cb[0], ob[1], cb[1]}) {
     ASSERT_TRUE(null_space.vectors.count(b));
     EXPECT_EQ(null_space.vectors.at(b).cols(), 7);

@@ -1,14 +1,14 @@
 // Every residual's autodiff Jacobian against Ceres' GradientChecker (numeric differentiation),
 // plus values by hand: a perfect observation gives a zero residual, whitening divides by sigma.
-#include <ceres/gradient_checker.h>
-#include <gtest/gtest.h>
-
 #include "calib/camera/camera.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/gnss_prior.h"
 #include "calib/residuals/prior.h"
 #include "calib/residuals/rotation_prior.h"
 #include "calib/residuals/stitching.h"
+
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
 
 namespace aerocal::calib {
 namespace {
@@ -38,8 +38,8 @@ TEST(CollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
   camera.height_px = 12000;
   std::copy(s.interior, s.interior + 10, camera.interior.begin());
   Eigen::Vector2d pixel;
-  ASSERT_TRUE(camera.ProjectToPixel(Eigen::Vector3d(s.opk), Eigen::Vector3d(s.center),
-                                    Eigen::Vector3d(s.point), &pixel));
+  ASSERT_TRUE(camera.ProjectToPixel(
+      Eigen::Vector3d(s.opk), Eigen::Vector3d(s.center), Eigen::Vector3d(s.point), &pixel));
   auto cost = CollinearityResidual::Create(s.frame, pixel, 0.2);
   double r[2];
   const double* blocks[] = {s.interior, s.rotation.data(), s.center, s.point};
@@ -75,13 +75,14 @@ void CheckStitchingResiduals() {
   const MappingConditioning cond = MappingConditioning::ForSubimage(Mapping::kModel, 7100, 4134);
   std::vector<double> p = ConditionedTestParams<Mapping>(cond);
   double point[2] = {10000.0, 9000.0};
-  auto ref = StitchReferenceResidual<Mapping>::Create(cond, Eigen::Vector2d(100, 200),
-                                                      Eigen::Vector2d(7000, 8100), 0.05);
+  auto ref = StitchReferenceResidual<Mapping>::Create(
+      cond, Eigen::Vector2d(100, 200), Eigen::Vector2d(7000, 8100), 0.05);
   ExpectGradientsMatch(*ref, {p.data()});
   auto tie = StitchTieResidual<Mapping>::Create(cond, Eigen::Vector2d(3000, 1200), 0.1);
   ExpectGradientsMatch(*tie, {p.data(), point});
   // Value: the mapped point minus the target, in sigmas.
-  SubimageMapping plain{"x", 7100, 4134, Mapping::kModel, PlainFromConditioned(Mapping::kModel, cond, p)};
+  SubimageMapping plain{
+      "x", 7100, 4134, Mapping::kModel, PlainFromConditioned(Mapping::kModel, cond, p)};
   const Eigen::Vector2d mapped = plain.VirtualFromSub({3000, 1200});
   double r[2];
   const double* blocks[] = {p.data(), point};
@@ -89,7 +90,8 @@ void CheckStitchingResiduals() {
   EXPECT_NEAR(r[0], (mapped.x() - point[0]) / 0.1, 1e-6);
   EXPECT_NEAR(r[1], (mapped.y() - point[1]) / 0.1, 1e-6);
   Scene s;
-  auto sub = SubimageCollinearityResidual<Mapping>::Create(s.frame, cond, Eigen::Vector2d(3000, 1200), 0.2);
+  auto sub = SubimageCollinearityResidual<Mapping>::Create(
+      s.frame, cond, Eigen::Vector2d(3000, 1200), 0.2);
   ExpectGradientsMatch(*sub, {p.data(), s.interior, s.rotation.data(), s.center, s.point});
 }
 
@@ -127,8 +129,14 @@ TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
   ASSERT_TRUE(head.ProjectToPixel(OpkFromRotation(rk), ok, Eigen::Vector3d(s.point), &pixel));
   auto cost = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.25, s.velocity);
   double res[2];
-  const double* blocks[] = {s.interior, s.rig_rotation.data(), s.rig_center, s.mount,
-                            s.lever,    s.increment, s.dt,        s.point};
+  const double* blocks[] = {s.interior,
+                            s.rig_rotation.data(),
+                            s.rig_center,
+                            s.mount,
+                            s.lever,
+                            s.increment,
+                            s.dt,
+                            s.point};
   ASSERT_TRUE(cost->Evaluate(blocks, res, nullptr));
   EXPECT_NEAR(res[0], 0.0, 1e-6);  // 1e-6 sigma = 2.5e-7 px (the distortion inverse's tolerance)
   EXPECT_NEAR(res[1], 0.0, 1e-6);
@@ -136,17 +144,32 @@ TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
   // residual is that projection shift in units of sigma (first order; distortion changes it by
   // < 1e-3 relative).
   double lever_moved[3] = {s.lever[0] + 1e-3, s.lever[1], s.lever[2]};
-  const double* moved[] = {s.interior, s.rig_rotation.data(), s.rig_center, s.mount,
-                           lever_moved, s.increment, s.dt,       s.point};
+  const double* moved[] = {s.interior,
+                           s.rig_rotation.data(),
+                           s.rig_center,
+                           s.mount,
+                           lever_moved,
+                           s.increment,
+                           s.dt,
+                           s.point};
   ASSERT_TRUE(cost->Evaluate(moved, res, nullptr));
   Eigen::Vector2d pixel_moved;
-  ASSERT_TRUE(head.ProjectToPixel(OpkFromRotation(rk), ok + r * Eigen::Vector3d(1e-3, 0, 0),
-                                  Eigen::Vector3d(s.point), &pixel_moved));
+  ASSERT_TRUE(head.ProjectToPixel(OpkFromRotation(rk),
+                                  ok + r * Eigen::Vector3d(1e-3, 0, 0),
+                                  Eigen::Vector3d(s.point),
+                                  &pixel_moved));
   const double expected = (pixel_moved - pixel).norm() / 0.25;
   ASSERT_GT(expected, 0.05);  // the shift is seen (0.13 um at 1150 m = 0.02 px)
   EXPECT_NEAR(std::hypot(res[0], res[1]), expected, 0.02 * expected);
-  ExpectGradientsMatch(*cost, {s.interior, s.rig_rotation.data(), s.rig_center, s.mount, s.lever, s.increment,
-                               s.dt, s.point});
+  ExpectGradientsMatch(*cost,
+                       {s.interior,
+                        s.rig_rotation.data(),
+                        s.rig_center,
+                        s.mount,
+                        s.lever,
+                        s.increment,
+                        s.dt,
+                        s.point});
 }
 
 TEST(RigHeadCollinearityResidual, TimeOffsetActsAsVelocityTimesOffset) {
@@ -158,10 +181,22 @@ TEST(RigHeadCollinearityResidual, TimeOffsetActsAsVelocityTimesOffset) {
   for (int i = 0; i < 3; ++i) shifted_center[i] = s.rig_center[i] + s.velocity[i] * s.dt[0];
   double zero_dt[1] = {0.0};
   double a[2], b[2];
-  const double* with_dt[] = {s.interior, s.rig_rotation.data(), s.rig_center, s.mount,
-                             s.lever,    s.increment, s.dt,        s.point};
-  const double* shifted[] = {s.interior, s.rig_rotation.data(), shifted_center, s.mount,
-                             s.lever,    s.increment, zero_dt,       s.point};
+  const double* with_dt[] = {s.interior,
+                             s.rig_rotation.data(),
+                             s.rig_center,
+                             s.mount,
+                             s.lever,
+                             s.increment,
+                             s.dt,
+                             s.point};
+  const double* shifted[] = {s.interior,
+                             s.rig_rotation.data(),
+                             shifted_center,
+                             s.mount,
+                             s.lever,
+                             s.increment,
+                             zero_dt,
+                             s.point};
   ASSERT_TRUE(cost->Evaluate(with_dt, a, nullptr));
   ASSERT_TRUE(still->Evaluate(shifted, b, nullptr));
   EXPECT_NEAR(a[0], b[0], 1e-9);  // the same head centre, to rounding
@@ -175,7 +210,8 @@ TEST(RigHeadCollinearityResidual, OneHeadRigIsTheFrameCamera) {
   double zero3a[3] = {0, 0, 0}, zero3b[3] = {0, 0, 0}, zero3c[3] = {0, 0, 0}, dt[1] = {0};
   const Eigen::Vector2d pixel(6100.5, 5222.25);
   auto frame_cost = CollinearityResidual::Create(s.frame, pixel, 0.2);
-  auto rig_cost = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.2, Eigen::Vector3d(30, 0, 0));
+  auto rig_cost =
+      RigHeadCollinearityResidual::Create(s.frame, pixel, 0.2, Eigen::Vector3d(30, 0, 0));
   const double* frame_blocks[] = {s.interior, s.rotation.data(), s.center, s.point};
   const double* rig_blocks[] = {
       s.interior, s.rotation.data(), s.center, zero3a, zero3b, zero3c, dt, s.point};
@@ -183,8 +219,14 @@ TEST(RigHeadCollinearityResidual, OneHeadRigIsTheFrameCamera) {
   std::vector<double> jf_int(20), jf_opk(8), jf_c(6), jf_p(6);
   std::vector<double> jr_int(20), jr_opk(8), jr_c(6), jr_m(6), jr_l(6), jr_e(6), jr_dt(2), jr_p(6);
   double* jf[] = {jf_int.data(), jf_opk.data(), jf_c.data(), jf_p.data()};
-  double* jr[] = {jr_int.data(), jr_opk.data(), jr_c.data(), jr_m.data(),
-                  jr_l.data(),   jr_e.data(),   jr_dt.data(), jr_p.data()};
+  double* jr[] = {jr_int.data(),
+                  jr_opk.data(),
+                  jr_c.data(),
+                  jr_m.data(),
+                  jr_l.data(),
+                  jr_e.data(),
+                  jr_dt.data(),
+                  jr_p.data()};
   ASSERT_TRUE(frame_cost->Evaluate(frame_blocks, rf, jf));
   ASSERT_TRUE(rig_cost->Evaluate(rig_blocks, rr, jr));
   EXPECT_DOUBLE_EQ(rr[0], rf[0]);
@@ -233,8 +275,8 @@ TEST(GnssPriorResidual, AntennaIsCentrePlusLeverArmPlusVelocityTimesOffset) {
   Scene s;
   const Eigen::Vector3d lever(0.2, -0.1, 1.5), velocity(70.0, -3.0, 0.5);
   const double dt = 0.02;
-  const Eigen::Vector3d antenna = Eigen::Vector3d(s.center) +
-                                  RotationFromQuaternion(s.rotation) * lever + velocity * dt;
+  const Eigen::Vector3d antenna =
+      Eigen::Vector3d(s.center) + RotationFromQuaternion(s.rotation) * lever + velocity * dt;
   const Eigen::Vector3d sigma(0.05, 0.05, 0.1);
   auto cost = GnssPriorResidual::Create(antenna + Eigen::Vector3d(0.05, 0, -0.2), sigma, velocity);
   double lever_arm[3] = {lever.x(), lever.y(), lever.z()}, offset[1] = {dt}, r[3];
@@ -268,12 +310,13 @@ TEST(LinearConstraintCostFunction, WhitenedSumOverBlocks) {
   Eigen::MatrixXd w0(2, 3), w1(2, 2);
   w0 << 1, 2, 3, 0, -1, 0.5;
   w1 << 4, 0, 0, 1;
-  const LinearConstraintCostFunction constraint({w0, w1}, {Eigen::Vector3d(1, 0, 0), Eigen::Vector2d(0, 2)}, 0.5);
+  const LinearConstraintCostFunction constraint(
+      {w0, w1}, {Eigen::Vector3d(1, 0, 0), Eigen::Vector2d(0, 2)}, 0.5);
   double x0[3] = {2.0, 1.0, -1.0}, x1[2] = {1.0, 3.0};
   const double* blocks[] = {x0, x1};
   double r[2];
   ASSERT_TRUE(constraint.Evaluate(blocks, r, nullptr));
-  EXPECT_DOUBLE_EQ(r[0], (1 + 2 - 3 + 4) / 0.5);       // w0 (1, 1, -1) + w1 (1, 1)
+  EXPECT_DOUBLE_EQ(r[0], (1 + 2 - 3 + 4) / 0.5);  // w0 (1, 1, -1) + w1 (1, 1)
   EXPECT_DOUBLE_EQ(r[1], (0 - 1 - 0.5 + 1) / 0.5);
   ExpectGradientsMatch(constraint, {x0, x1});
 }

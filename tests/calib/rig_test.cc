@@ -2,18 +2,19 @@
 // hand, its autodiff Jacobian against numeric differentiation (ceres::GradientChecker), the
 // one-head rig that is an ordinary camera, the FORMATS.md example, write/read round trip and
 // FILE:LINE for bad files.
-#include <cmath>
-#include <fstream>
+#include "calib/camera/rig.h"
+
+#include "calib/camera/camera_io.h"
+#include "calib/camera/rig_io.h"
+#include "calib/core/error.h"
+#include "tests/support/test_support.h"
 
 #include <ceres/autodiff_cost_function.h>
 #include <ceres/gradient_checker.h>
 #include <gtest/gtest.h>
 
-#include "calib/camera/camera_io.h"
-#include "calib/camera/rig.h"
-#include "calib/camera/rig_io.h"
-#include "calib/core/error.h"
-#include "tests/support/test_support.h"
+#include <cmath>
+#include <fstream>
 
 namespace aerocal::calib {
 namespace {
@@ -127,10 +128,11 @@ TEST(RigFile, AOneHeadRigIsAnOrdinaryCamera) {
   const Rig from_camera_file = ReadRig(dir.File("camera.yaml"));
   ASSERT_EQ(from_camera_file.heads.size(), 1u);
   // ... and a one-head rig file without reference_head or virtual section is allowed.
-  WriteText(dir.File("rig.yaml"),
-            "name: frame\nrig:\n  heads:\n    - id: H\n      pixel_size_mm: 0.009\n"
-            "      format_px: [14000, 12000]\n      interior: {c: 170.038, x0: -0.0024, y0: 0.0015, "
-            "K1: 3e-8, K2: -2e-12, K3: 1e-16, P1: 2e-7, P2: -1.5e-7, B1: 1e-5, B2: -8e-6}\n");
+  WriteText(
+      dir.File("rig.yaml"),
+      "name: frame\nrig:\n  heads:\n    - id: H\n      pixel_size_mm: 0.009\n"
+      "      format_px: [14000, 12000]\n      interior: {c: 170.038, x0: -0.0024, y0: 0.0015, "
+      "K1: 3e-8, K2: -2e-12, K3: 1e-16, P1: 2e-7, P2: -1.5e-7, B1: 1e-5, B2: -8e-6}\n");
   const Rig from_rig_file = ReadRig(dir.File("rig.yaml"));
   EXPECT_EQ(from_rig_file.reference_head, "H");
   EXPECT_EQ(from_rig_file.virtual_camera.c_mm, camera.c_mm());
@@ -152,15 +154,22 @@ TEST(RigFile, AOneHeadRigIsAnOrdinaryCamera) {
   const double zero[3] = {0, 0, 0}, dt = 0.0;
   const RigHead& head = from_rig_file.heads[0];
   double ideal[2];
-  ASSERT_TRUE(ProjectHeadIdeal(head.camera.interior.data(), opk, center, head.mount_rad.data(),
-                               head.lever_arm_m.data(), zero, &dt, zero, point, ideal));
+  ASSERT_TRUE(ProjectHeadIdeal(head.camera.interior.data(),
+                               opk,
+                               center,
+                               head.mount_rad.data(),
+                               head.lever_arm_m.data(),
+                               zero,
+                               &dt,
+                               zero,
+                               point,
+                               ideal));
   Eigen::Vector2d measured;
-  ASSERT_TRUE(BrownFraser10Model::MeasuredFromIdeal(head.camera.interior.data(),
-                                                    Eigen::Vector2d(ideal[0], ideal[1]), &measured,
-                                                    1e-12));
+  ASSERT_TRUE(BrownFraser10Model::MeasuredFromIdeal(
+      head.camera.interior.data(), Eigen::Vector2d(ideal[0], ideal[1]), &measured, 1e-12));
   Eigen::Vector2d expected;
-  ASSERT_TRUE(camera.ProjectToPixel(Eigen::Vector3d(opk), Eigen::Vector3d(center),
-                                    Eigen::Vector3d(point), &expected));
+  ASSERT_TRUE(camera.ProjectToPixel(
+      Eigen::Vector3d(opk), Eigen::Vector3d(center), Eigen::Vector3d(point), &expected));
   EXPECT_NEAR((head.camera.PixelFromPhoto(measured) - expected).norm(), 0.0, 1e-9);
 }
 
@@ -172,8 +181,15 @@ TEST(HeadPose, IsTheConventionsFormula) {
   const double dt = 0.002;
   double rotation[9];
   Eigen::Vector3d center;
-  HeadPose(rig_opk.data(), rig_center.data(), mount.data(), lever.data(), increment.data(), &dt,
-           velocity.data(), rotation, center.data());
+  HeadPose(rig_opk.data(),
+           rig_center.data(),
+           mount.data(),
+           lever.data(),
+           increment.data(),
+           &dt,
+           velocity.data(),
+           rotation,
+           center.data());
   const Eigen::Matrix3d expected =
       RotationFromOpk(rig_opk) * RotationFromOpk(mount) * RotationFromOpk(increment);
   for (int i = 0; i < 3; ++i)
@@ -196,11 +212,18 @@ TEST(HeadPose, IsTheConventionsFormula) {
 // against numeric differentiation in every block.
 struct HeadProjection {
   template <typename T>
-  bool operator()(const T* interior, const T* rig_opk, const T* rig_center, const T* mount,
-                  const T* lever, const T* increment, const T* dt, const T* velocity,
-                  const T* point, T* ideal) const {
-    return ProjectHeadIdeal(interior, rig_opk, rig_center, mount, lever, increment, dt, velocity,
-                            point, ideal);
+  bool operator()(const T* interior,
+                  const T* rig_opk,
+                  const T* rig_center,
+                  const T* mount,
+                  const T* lever,
+                  const T* increment,
+                  const T* dt,
+                  const T* velocity,
+                  const T* point,
+                  T* ideal) const {
+    return ProjectHeadIdeal(
+        interior, rig_opk, rig_center, mount, lever, increment, dt, velocity, point, ideal);
   }
 };
 
@@ -212,8 +235,8 @@ TEST(HeadPose, AutodiffMatchesNumericDerivatives) {
   double point[3] = {130.0, 260.0, 20.0};
   ceres::AutoDiffCostFunction<HeadProjection, 2, 10, 3, 3, 3, 3, 3, 1, 3, 3> cost(
       new HeadProjection);
-  std::vector<double*> blocks = {interior, rig_opk,  rig_center, mount, lever,
-                                 increment, dt,      velocity,   point};
+  std::vector<double*> blocks = {
+      interior, rig_opk, rig_center, mount, lever, increment, dt, velocity, point};
   ceres::NumericDiffOptions options;
   const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
   ceres::GradientChecker checker(&cost, no_manifolds, options);
@@ -231,13 +254,13 @@ TEST(RigFile, BadFilesNameFileAndLine) {
   const std::string head_a =
       "    - id: A\n      pixel_size_mm: 0.006\n      format_px: [100, 100]\n"
       "      interior: {c: 150}\n";
-  const std::string virt =
-      "  virtual: {c: 150, pixel_size_mm: 0.006, format_px: [120, 100]}\n";
+  const std::string virt = "  virtual: {c: 150, pixel_size_mm: 0.006, format_px: [120, 100]}\n";
   struct Case {
     std::string text, expected;
   } cases[] = {
       {"rig:\n  reference_head: Z\n" + virt + "  heads:\n" + head_a, ":2: reference_head 'Z'"},
-      {"rig:\n  reference_head: A\n" + virt + "  heads:\n" + head_a + head_a, ":9: duplicate head id 'A'"},
+      {"rig:\n  reference_head: A\n" + virt + "  heads:\n" + head_a + head_a,
+       ":9: duplicate head id 'A'"},
       {"rig:\n" + virt + "  heads:\n" + head_a +
            "    - id: B\n      pixel_size_mm: 0.006\n      format_px: [100, 100]\n"
            "      interior: {c: 150}\n",
@@ -263,10 +286,13 @@ TEST(RigFile, BadFilesNameFileAndLine) {
        "      interior: {c: 150}\n      mounts_deg: [0, 0, 0]\n",
        ":7: unknown key 'mounts_deg'"},
       {"rig:\n  reference_head: A\n  virtual: {orientation: tilted, c: 150, pixel_size_mm: 0.006, "
-       "format_px: [120, 100]}\n  heads:\n" + head_a,
+       "format_px: [120, 100]}\n  heads:\n" +
+           head_a,
        ":3: virtual.orientation must be rig or level"},
-      {"rig:\n  reference_head: A\n  virtual: {c: 150, pixel_size_mm: 0.006, format_px: [120, 100], "
-       "height_m: -3}\n  heads:\n" + head_a,
+      {"rig:\n  reference_head: A\n  virtual: {c: 150, pixel_size_mm: 0.006, format_px: [120, "
+       "100], "
+       "height_m: -3}\n  heads:\n" +
+           head_a,
        ":3: virtual.height_m out of range (got -3, expected 1 .. 100000)"},
       {"rig:\n  reference_head: A\n  virtual: {c: 150, format_px: [120, 100]}\n  heads:\n" + head_a,
        ":3: virtual: missing pixel_size_mm"},

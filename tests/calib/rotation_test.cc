@@ -4,6 +4,7 @@
 // d(omega, phi, kappa)/dq matches central differences away from phi = 90 deg and gives NaN
 // (not separable) for omega and kappa at it.
 #include "calib/camera/rotation.h"
+
 #include "calib/problem/rotation_manifold.h"
 
 #include <Eigen/Geometry>

@@ -15,9 +15,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzz::WriteScratch("exposures.csv", parts[0]);
   fuzz::WriteScratch("observations.csv", parts[1]);
   fuzz::WriteScratch("points.csv", parts[2]);
-  const std::string project = fuzz::WriteScratch(
-      "project.yaml", "cameras: {cam1: camera.yaml}\nexposures: exposures.csv\n"
-                      "observations: observations.csv\npoints: points.csv\n" + parts[3]);
+  const std::string project =
+      fuzz::WriteScratch("project.yaml",
+                         "cameras: {cam1: camera.yaml}\nexposures: exposures.csv\n"
+                         "observations: observations.csv\npoints: points.csv\n" +
+                             parts[3]);
   AEROCAL_FUZZ_EXPECTED_ERRORS({
     const triangulation::Project p = triangulation::ReadProject(project, 0.5);
     const triangulation::ObjectFrame frame(p.frame);

@@ -3,11 +3,11 @@
 // byte picks nothing: all readers see every input, so a seed of any format exercises the others'
 // refusals too. The registry includes the tool layer's OpenCV FileStorage row (tools/
 // camera_formats.cc is compiled in), read as YAML, XML and JSON by the file name's ending.
-#include <string>
-#include <vector>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "tests/fuzz/fuzz_support.h"
+
+#include <string>
+#include <vector>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   const std::string text(reinterpret_cast<const char*>(data), size);

@@ -18,9 +18,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
         aerocal::calib::ParseModelCamera(aerocal::LoadYamlText(text, "fuzz.yaml"), "fuzz.yaml");
     (void)aerocal::calib::ModelCameraToYaml(camera, "fuzz");
   });
-  AEROCAL_FUZZ_EXPECTED_ERRORS({
-    (void)aerocal::calib::ParseRig(aerocal::LoadYamlText(text, "fuzz.yaml"), "fuzz.yaml");
-  });
+  AEROCAL_FUZZ_EXPECTED_ERRORS(
+      { (void)aerocal::calib::ParseRig(aerocal::LoadYamlText(text, "fuzz.yaml"), "fuzz.yaml"); });
   AEROCAL_FUZZ_EXPECTED_ERRORS({
     (void)aerocal::calib::ParseLineCamera(aerocal::LoadYamlText(text, "fuzz.yaml"), "fuzz.yaml");
   });

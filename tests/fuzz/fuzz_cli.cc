@@ -16,6 +16,11 @@
 //      simulated flight in sim_flight/ (a seed's "directory" and relative flight arguments).
 // Exit 2 (bad input) and 3 (did not converge) are answers; exit 1 ("internal error": an exception
 // the command did not turn into FILE:LINE) is a finding, as is any crash, leak or UB report.
+#include "tests/fuzz/fuzz_support.h"
+
+#include <opencv2/core.hpp>
+#include <opencv2/imgcodecs.hpp>
+
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -23,11 +28,6 @@
 #include <map>
 #include <string>
 #include <vector>
-
-#include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
-
-#include "tests/fuzz/fuzz_support.h"
 
 int AerocalMain(int argc, char** argv);  // tools/main.cc
 
@@ -73,11 +73,13 @@ const std::string& PushbroomFixed() {
   static const std::string dir = [] {
     const std::string d = ScratchDir() + "/pb_fixed";
     fs::create_directories(d + "/images");
-    fs::copy_file(TestField() + "/camera_nominal.yaml", d + "/camera.yaml",
+    fs::copy_file(TestField() + "/camera_nominal.yaml",
+                  d + "/camera.yaml",
                   fs::copy_options::overwrite_existing);
     cv::Mat image(64, 64, CV_8U);
     for (int r = 0; r < image.rows; ++r)
-      for (int c = 0; c < image.cols; ++c) image.at<uint8_t>(r, c) = uint8_t((r * 7 + c * 13) % 256);
+      for (int c = 0; c < image.cols; ++c)
+        image.at<uint8_t>(r, c) = uint8_t((r * 7 + c * 13) % 256);
     cv::imwrite(d + "/line.png", image);
     for (const char* id : {"0001", "0002", "0003", "0004"})
       cv::imwrite(d + "/images/" + id + ".png", image);
@@ -96,13 +98,29 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fs::remove_all(out);
   int code = 0;
   if (kind == 0) {
-    code = Run({"certificate", "--result", WriteScratch("result.json", parts[0]), "--lab",
-                WriteScratch("lab.yaml", parts[1]), "--previous", WriteScratch("previous.json", parts[2]),
-                "--tolerances", WriteScratch("tolerances.yaml", parts[3]), "--no-render", "--out", out});
+    code = Run({"certificate",
+                "--result",
+                WriteScratch("result.json", parts[0]),
+                "--lab",
+                WriteScratch("lab.yaml", parts[1]),
+                "--previous",
+                WriteScratch("previous.json", parts[2]),
+                "--tolerances",
+                WriteScratch("tolerances.yaml", parts[3]),
+                "--no-render",
+                "--out",
+                out});
   } else if (kind == 1 || kind == 2) {
     const std::string& tf = TestField();
-    code = Run({"calibrate", "--camera", tf + "/camera_nominal.yaml", "--observations",
-                tf + "/observations.csv", "--points", tf + "/points.csv", "--out", out,
+    code = Run({"calibrate",
+                "--camera",
+                tf + "/camera_nominal.yaml",
+                "--observations",
+                tf + "/observations.csv",
+                "--points",
+                tf + "/points.csv",
+                "--out",
+                out,
                 kind == 1 ? "--groups" : "--budget",
                 WriteScratch(kind == 1 ? "groups.csv" : "budget.yaml", parts[0])});
   } else if (kind == 3) {
@@ -115,15 +133,32 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     WriteScratch("rig/exposures.csv", parts[1]);
     WriteScratch("rig/observations.csv", parts[2]);
     WriteScratch("rig/points.csv", parts[3]);
-    code = Run({"rig", "stitch", "--camera", dir + "/rig_truth.yaml", "--project",
-                dir + "/project.yaml", "--out", out});
+    code = Run({"rig",
+                "stitch",
+                "--camera",
+                dir + "/rig_truth.yaml",
+                "--project",
+                dir + "/project.yaml",
+                "--out",
+                out});
   } else if (kind == 4) {
     const std::string& fixed = PushbroomFixed();
-    code = Run({"pushbroom", "control", "--camera", WriteScratch("line.yaml", parts[0]), "--pos",
-                WriteScratch("pos.csv", parts[1]), "--line-image", fixed + "/line.png",
-                "--reference-camera", fixed + "/camera.yaml", "--reference-exposures",
-                WriteScratch("reference.csv", parts[2]), "--reference-images", fixed + "/images",
-                "--out", out});
+    code = Run({"pushbroom",
+                "control",
+                "--camera",
+                WriteScratch("line.yaml", parts[0]),
+                "--pos",
+                WriteScratch("pos.csv", parts[1]),
+                "--line-image",
+                fixed + "/line.png",
+                "--reference-camera",
+                fixed + "/camera.yaml",
+                "--reference-exposures",
+                WriteScratch("reference.csv", parts[2]),
+                "--reference-images",
+                fixed + "/images",
+                "--out",
+                out});
   } else {
     Simulated("flight", {"--exposures", "2", "--strips", "1"});
     fs::remove_all(ScratchDir() + "/batch");
@@ -133,7 +168,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     WriteScratch("batch/failed/u1.json", parts[2]);
     const fs::path cwd = fs::current_path();  // the command enters the manifest's "directory"
     fs::current_path(ScratchDir());
-    code = Run({"batch", "status", "--list", "--manifest", WriteScratch("batch/manifest.json", parts[0])});
+    code = Run(
+        {"batch", "status", "--list", "--manifest", WriteScratch("batch/manifest.json", parts[0])});
     fs::current_path(cwd);
   }
   if (code == 1) {

@@ -8,7 +8,8 @@
 namespace {
 
 void ReadAsImage(const std::string& bytes) {
-  const aerocal::calib::ImageMetadata meta = aerocal::calib::ImageMetadataOfBytes(bytes, "image.jpg");
+  const aerocal::calib::ImageMetadata meta =
+      aerocal::calib::ImageMetadataOfBytes(bytes, "image.jpg");
   aerocal::triangulation::internal::ReadImageRecord(meta, "image.jpg", "image.jpg");
 }
 

@@ -1,8 +1,8 @@
 // The importers: the first byte chooses COLMAP text (cameras / images / points3D separated by
 // "\n%%\n"), the DBAT camera XML, DBAT marks (with a fixed camera, images and EO) or an ODM
 // gcp_list; each result goes through the block check the `import` command applies.
-#include "calib/core/yaml_util.h"
 #include "calib/camera/camera_io.h"
+#include "calib/core/yaml_util.h"
 #include "tests/fuzz/fuzz_support.h"
 #include "triangulation/import/colmap_import.h"
 #include "triangulation/import/dbat_import.h"
@@ -36,13 +36,15 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
           "<document><cameras><camera><sensor>auto,24</sensor><image>6000,4000</image>"
           "<cc>35</cc></camera></cameras></document>\n");
       o.images = fuzz::WriteScratch("images.txt", "1, a.jpg\n2, b.jpg\n");
-      o.initial_eo = fuzz::WriteScratch("eo.txt", "1, 0, 0, 100, 0, 0, 0\n2, 20, 0, 100, 0, 0, 0\n");
+      o.initial_eo =
+          fuzz::WriteScratch("eo.txt", "1, 0, 0, 100, 0, 0, 0\n2, 20, 0, 100, 0, 0, 0\n");
       o.marks = fuzz::WriteScratch("marks.txt", text);
       (void)UsableImportedBlock(ImportDbat(o), o.marks);
     } else {
       OdmImportOptions o;
       static const calib::Camera camera = calib::ParseCamera(
-          LoadYamlText("pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n", "c"), "c");
+          LoadYamlText("pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n", "c"),
+          "c");
       o.camera = camera;
       o.gcp_list = fuzz::WriteScratch("gcp_list.txt", text);
       (void)ImportOdmGcpList(o);

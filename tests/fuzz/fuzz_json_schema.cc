@@ -1,10 +1,10 @@
 // The schema check of input documents (issue 37 class 1, calib/core/json_schema.h): any JSON text
 // against the certificate's input schema (docs/schema/certificate_inputs.schema.json), rooted at
 // each of its documents. Text that is not JSON is nlohmann's to refuse (discarded here).
-#include <nlohmann/json.hpp>
-
 #include "calib/core/json_schema.h"
 #include "tests/fuzz/fuzz_support.h"
+
+#include <nlohmann/json.hpp>
 
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   static const nlohmann::json schema =

@@ -9,11 +9,6 @@
 //   3: the `calibrate --budget` YAML (ReadBudgetOptions);
 //   4: the directions file of `calibrate --directions` (ReadDirections) against a fixed
 //      6000 x 4000 px camera, which bounds its image positions.
-#include <cstdint>
-#include <string>
-
-#include <Eigen/Core>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/line_camera_io.h"
 #include "calib/core/yaml_util.h"
@@ -22,6 +17,11 @@
 #include "triangulation/calibration/uncertainty_budget.h"
 #include "triangulation/pushbroom/line_calibration.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
 
 namespace {
 
@@ -52,7 +52,8 @@ void ReadOne(int kind, const std::string& text) {
     (void)triangulation::ReadBudgetOptions(fuzz::WriteScratch("budget.yaml", text));
   } else {
     static const calib::Camera camera = calib::ParseCamera(
-        LoadYamlText("pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n", "camera.yaml"),
+        LoadYamlText("pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n",
+                     "camera.yaml"),
         "camera.yaml");
     (void)triangulation::ReadDirections(fuzz::WriteScratch("directions.csv", text), camera, 0.3);
   }

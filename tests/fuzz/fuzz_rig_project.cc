@@ -14,9 +14,11 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   fuzz::WriteScratch("exposures.csv", parts[1]);
   fuzz::WriteScratch("observations.csv", parts[2]);
   fuzz::WriteScratch("points.csv", parts[3]);
-  const std::string project = fuzz::WriteScratch(
-      "project.yaml", "cameras: {rig1: rig.yaml}\nexposures: exposures.csv\n"
-                      "observations: observations.csv\npoints: points.csv\n" + parts[4]);
+  const std::string project =
+      fuzz::WriteScratch("project.yaml",
+                         "cameras: {rig1: rig.yaml}\nexposures: exposures.csv\n"
+                         "observations: observations.csv\npoints: points.csv\n" +
+                             parts[4]);
   AEROCAL_FUZZ_EXPECTED_ERRORS({
     const triangulation::Project p = triangulation::ReadProject(project, 0.5);
     triangulation::ValidatePlatform(p.platform);

@@ -9,11 +9,12 @@
 extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
   using namespace aerocal;
   static const calib::Camera camera = calib::ParseCamera(
-      LoadYamlText("pixel_size_mm: 0.009\nformat_px: [14000, 8000]\ninterior: {c: 170}\n"
-                   "subimages:\n  - {id: I, format_px: [7100, 8000], model: affine}\n"
-                   "  - {id: II, format_px: [7100, 8000], model: affine, params: [1, 0, 6900, 0, 1, 0]}\n"
-                   "reference_points:\n  - {id: R1, subimage: I, u: 30, v: 30, U: 30, V: 30}\n",
-                   "camera.yaml"),
+      LoadYamlText(
+          "pixel_size_mm: 0.009\nformat_px: [14000, 8000]\ninterior: {c: 170}\n"
+          "subimages:\n  - {id: I, format_px: [7100, 8000], model: affine}\n"
+          "  - {id: II, format_px: [7100, 8000], model: affine, params: [1, 0, 6900, 0, 1, 0]}\n"
+          "reference_points:\n  - {id: R1, subimage: I, u: 30, v: 30, U: 30, V: 30}\n",
+          "camera.yaml"),
       "camera.yaml");
   const std::string path =
       fuzz::WriteScratch("stitch_obs.csv", std::string(reinterpret_cast<const char*>(data), size));

@@ -3,25 +3,24 @@
 // a leak or undefined behaviour is a finding (ASan/UBSan are on in the fuzz build).
 #pragma once
 
-#include <unistd.h>
+#include "calib/core/error.h"
 
 #include <cstdint>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <string>
+#include <unistd.h>
 #include <vector>
-
-#include "calib/core/error.h"
 
 namespace aerocal::fuzz {
 
 /// A per-process scratch folder for readers that take paths.
 inline const std::string& ScratchDir() {
   static const std::string dir = [] {
-    const std::string d = (std::filesystem::temp_directory_path() /
-                           ("aerocal_fuzz_" + std::to_string(::getpid())))
-                              .string();
+    const std::string d =
+        (std::filesystem::temp_directory_path() / ("aerocal_fuzz_" + std::to_string(::getpid())))
+            .string();
     std::filesystem::create_directories(d);
     return d;
   }();

@@ -4,14 +4,14 @@
 // pixel's width (sinc), solved for 0.1.
 #include "stitch/quality/bar_target.h"
 
-#include <cmath>
-#include <cstdio>
-#include <random>
+#include "calib/core/error.h"
+#include "tests/support/rendered_targets.h"
 
 #include <gtest/gtest.h>
 
-#include "calib/core/error.h"
-#include "tests/support/rendered_targets.h"
+#include <cmath>
+#include <cstdio>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -28,7 +28,10 @@ struct RenderedTarget {
 
 // One block of rows per group (vertical bars across the width; or, transposed, horizontal bars),
 // then a bright and a dark block; bar phase random, noise of `noise_dn` DN rounded to 8 bit.
-RenderedTarget RenderTarget(double s, const std::vector<double>& frequencies, bool transpose, double noise_dn,
+RenderedTarget RenderTarget(double s,
+                            const std::vector<double>& frequencies,
+                            bool transpose,
+                            double noise_dn,
                             std::mt19937_64* rng) {
   const int blocks = static_cast<int>(frequencies.size()) + 2;
   GrayImage image(blocks * kBlockRows, kWidth);
@@ -37,10 +40,12 @@ RenderedTarget RenderTarget(double s, const std::vector<double>& frequencies, bo
   for (size_t g = 0; g < frequencies.size(); ++g) {
     const double x0 = phase(*rng);
     for (int c = 0; c < kWidth; ++c) {
-      const double v = kDark + (kBright - kDark) * testing::BarPixelFraction(c, 1.0 / frequencies[g], x0, s);
+      const double v =
+          kDark + (kBright - kDark) * testing::BarPixelFraction(c, 1.0 / frequencies[g], x0, s);
       for (int r = 0; r < kBlockRows; ++r) image(g * kBlockRows + r, c) = static_cast<float>(v);
     }
-    target.groups.push_back({frequencies[g], {4, static_cast<int>(g) * kBlockRows + 2, kWidth - 8, kBlockRows - 4},
+    target.groups.push_back({frequencies[g],
+                             {4, static_cast<int>(g) * kBlockRows + 2, kWidth - 8, kBlockRows - 4},
                              MtfAxis::kX});
   }
   const int bright_row = frequencies.size() * kBlockRows, dark_row = bright_row + kBlockRows;
@@ -51,12 +56,16 @@ RenderedTarget RenderTarget(double s, const std::vector<double>& frequencies, bo
   if (noise_dn > 0.0) {
     std::normal_distribution<double> normal(0.0, noise_dn);
     for (int i = 0; i < image.size(); ++i)
-      image.data()[i] = static_cast<float>(std::clamp(std::round(image.data()[i] + normal(*rng)), 0.0, 255.0));
+      image.data()[i] =
+          static_cast<float>(std::clamp(std::round(image.data()[i] + normal(*rng)), 0.0, 255.0));
   }
   if (transpose) {
     image = GrayImage(image.transpose());
-    for (auto& g : target.groups) g.region = {g.region.row, g.region.col, g.region.height, g.region.width}, g.axis = MtfAxis::kY;
-    for (PixelRegion* r : {&target.bright, &target.dark}) *r = {r->row, r->col, r->height, r->width};
+    for (auto& g : target.groups)
+      g.region = {g.region.row, g.region.col, g.region.height, g.region.width},
+      g.axis = MtfAxis::kY;
+    for (PixelRegion* r : {&target.bright, &target.dark})
+      *r = {r->row, r->col, r->height, r->width};
   }
   target.image = std::move(image);
   return target;
@@ -78,22 +87,29 @@ TEST(BarTarget, LimitingFrequencyAtTenPercentWithinOneStepOfTheAnalyticValue) {
       const double truth =
           testing::FirstCrossing([&](double f) { return testing::RenderedBarContrast(f, s); }, 0.1);
       const double steps = std::log(r.limiting_frequency_cy_px / truth) / std::log(kStep);
-      std::printf("noise %.0f DN s %.2f: limiting frequency %.4f, analytic %.4f (%+.2f steps)\n", noise, s,
-                  r.limiting_frequency_cy_px, truth, steps);
+      std::printf("noise %.0f DN s %.2f: limiting frequency %.4f, analytic %.4f (%+.2f steps)\n",
+                  noise,
+                  s,
+                  r.limiting_frequency_cy_px,
+                  truth,
+                  steps);
       EXPECT_TRUE(r.limit_in_range) << "s " << s;
       EXPECT_LE(std::abs(steps), 1.0) << "noise " << noise << " s " << s;
       // The reference modulation (220 - 30) / (220 + 30) within the 8-bit rounding.
       EXPECT_NEAR(r.reference_modulation, 190.0 / 250.0, 0.005);
       // At low frequency the contrast transfer is Coltman's response within 0.03.
       EXPECT_NEAR(r.groups.front().contrast_transfer,
-                  testing::RenderedBarContrast(r.groups.front().frequency_cy_px, s), 0.03) << "s " << s;
+                  testing::RenderedBarContrast(r.groups.front().frequency_cy_px, s),
+                  0.03)
+          << "s " << s;
     }
 }
 
 TEST(BarTarget, RefusesBadGroupsAndReferences) {
   std::mt19937_64 rng(5);
   const RenderedTarget t = RenderTarget(1.0, {0.1, 0.2}, false, 0.0, &rng);
-  EXPECT_THROW(MeasureBarTarget(t.image, t.groups, t.dark, t.bright), InputError);  // swapped references
+  EXPECT_THROW(MeasureBarTarget(t.image, t.groups, t.dark, t.bright),
+               InputError);  // swapped references
   auto groups = t.groups;
   groups[0].region.width = 12;  // one period of 10 px only
   EXPECT_THROW(MeasureBarTarget(t.image, groups, t.bright, t.dark), InputError);

@@ -4,11 +4,11 @@
 // measured in the region found: MTF50 within 2 % of the analytic value, the slant as projected.
 #include "stitch/quality/edge_targets.h"
 
-#include <cmath>
+#include "tests/support/rendered_targets.h"
 
 #include <gtest/gtest.h>
 
-#include "tests/support/rendered_targets.h"
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
@@ -32,7 +32,12 @@ GrayImage RenderAlong(const calib::Camera& camera, const EdgeTargetRegion& r, do
   const Eigen::Vector2d d = (r.end_px - r.start_px).normalized();
   const Eigen::Vector2d n(d.y(), -d.x());
   const double centre = n.x() * 0.5 * (camera.width_px - 1) + n.y() * 0.5 * (camera.height_px - 1);
-  return testing::RenderEdge(camera.width_px, camera.height_px, std::atan2(n.y(), n.x()), s, 40.0, 200.0,
+  return testing::RenderEdge(camera.width_px,
+                             camera.height_px,
+                             std::atan2(n.y(), n.x()),
+                             s,
+                             40.0,
+                             200.0,
                              n.dot(r.start_px) - centre);
 }
 
@@ -54,8 +59,8 @@ TEST(EdgeTargets, RegionSlantAndGsdOfANadirImage) {
   EXPECT_EQ(r.region.col, 159);
   EXPECT_EQ(r.region.width, 69);
   // A target outside the image is not usable, and says why.
-  const EdgeTargetRegion far = RegionOfEdgeTarget(camera, Eigen::Vector3d::Zero(), kCenter,
-                                                  {"far", {30.0, -6.0, 0.0}, {30.7, 6.0, 0.0}});
+  const EdgeTargetRegion far = RegionOfEdgeTarget(
+      camera, Eigen::Vector3d::Zero(), kCenter, {"far", {30.0, -6.0, 0.0}, {30.7, 6.0, 0.0}});
   EXPECT_FALSE(far.usable);
   EXPECT_EQ(far.reason, "the region leaves the image");
 }

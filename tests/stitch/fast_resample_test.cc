@@ -2,16 +2,16 @@
 // positions and a double-precision bilinear resampler written here, and against the reference
 // path (ResampleOptions::reference): positions within 1e-4 px, values within 0.5 DN before the
 // final rounding, the same coverage, and an output independent of threads and strips.
-#include <algorithm>
-#include <cmath>
-#include <random>
-
-#include <gtest/gtest.h>
-
 #include "calib/camera/subimage_mapping.h"
 #include "stitch/layout/grid_layout.h"
 #include "stitch/resample/bilinear_run.h"
 #include "stitch/resample/virtual_image.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -25,7 +25,8 @@ std::vector<std::uint16_t> Ramp(int w, int h, double slope_col, double slope_row
   std::vector<std::uint16_t> data(static_cast<size_t>(w) * (h + 1) + 2, 0);
   for (int r = 0; r < h; ++r)
     for (int c = 0; c < w; ++c)
-      data[static_cast<size_t>(r) * w + c] = static_cast<std::uint16_t>(slope_col * c + slope_row * r);
+      data[static_cast<size_t>(r) * w + c] =
+          static_cast<std::uint16_t>(slope_col * c + slope_row * r);
   return data;
 }
 
@@ -53,7 +54,8 @@ TEST(BilinearRun, PositionsExactTo1e4PxAlongRunsAtAnyScale) {
       }
     }
   }
-  std::printf("largest position error along runs: u %.2e px, v %.2e px\n", max_error_u, max_error_v);
+  std::printf(
+      "largest position error along runs: u %.2e px, v %.2e px\n", max_error_u, max_error_v);
   EXPECT_LT(max_error_u, 1e-4);
   EXPECT_LT(max_error_v, 1e-4);
 }
@@ -123,8 +125,8 @@ std::vector<MemoryRaster> SubImages(const calib::Camera& camera) {
 }
 
 // The double-precision resampler: exact inverse mapping, bilinear in double, plain average.
-double ExactValue(const calib::Camera& camera, const std::vector<MemoryRaster>& subs, int c, int r,
-                  int* n) {
+double ExactValue(
+    const calib::Camera& camera, const std::vector<MemoryRaster>& subs, int c, int r, int* n) {
   double sum = 0;
   *n = 0;
   for (size_t k = 0; k < subs.size(); ++k) {
@@ -145,8 +147,12 @@ double ExactValue(const calib::Camera& camera, const std::vector<MemoryRaster>& 
   return *n ? sum / *n : 0.0;
 }
 
-MemoryRaster RunResample(const calib::Camera& camera, std::vector<MemoryRaster>& subs, bool reference,
-                      int threads, int strip_rows, ResampleReport* report = nullptr) {
+MemoryRaster RunResample(const calib::Camera& camera,
+                         std::vector<MemoryRaster>& subs,
+                         bool reference,
+                         int threads,
+                         int strip_rows,
+                         ResampleReport* report = nullptr) {
   std::vector<RasterSource*> sources;
   for (auto& s : subs) sources.push_back(&s);
   MemoryRaster out({camera.width_px, camera.height_px, 1, 16});
@@ -189,9 +195,14 @@ TEST(FastResample, WithinHalfADnOfADoublePrecisionResamplerAndCoveringAsTheRefer
       differ += fast.At(c, r) != reference.At(c, r);
       ++n_pixels;
     }
-  std::printf("against exact double bilinear: fast max %.3f DN mean %.3f DN, reference max %.3f DN; "
-              "%ld of %ld px differ from the reference by 1 DN\n",
-              max_fast, sum_fast / n_pixels, max_reference, differ, n_pixels);
+  std::printf(
+      "against exact double bilinear: fast max %.3f DN mean %.3f DN, reference max %.3f DN; "
+      "%ld of %ld px differ from the reference by 1 DN\n",
+      max_fast,
+      sum_fast / n_pixels,
+      max_reference,
+      differ,
+      n_pixels);
   EXPECT_LT(max_fast, 0.5 + 0.05);
   EXPECT_LE(max_fast, max_reference);
   EXPECT_LT(sum_fast / n_pixels, 0.26);

@@ -2,12 +2,12 @@
 // checked against the simulation's truth.
 #include "stitch/adjustment/flight_stability.h"
 
-#include <cmath>
+#include "stitch/adjustment/model_selection.h"
+#include "tests/stitch/simulated_camera.h"
 
 #include <gtest/gtest.h>
 
-#include "stitch/adjustment/model_selection.h"
-#include "tests/stitch/simulated_camera.h"
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
@@ -58,13 +58,19 @@ TEST(FlightStability, TableOfThirtySevenFramesMatchesTheTruth) {
       expected_mean += m / lambdas.size();
       expected_mean2 += m * m / lambdas.size();
     }
-    const double lambda_spread = std::sqrt(std::max(0.0, expected_mean2 - expected_mean * expected_mean));
+    const double lambda_spread =
+        std::sqrt(std::max(0.0, expected_mean2 - expected_mean * expected_mean));
     const double expected_std = std::hypot(noise / std::sqrt(2.0 * r), lambda_spread);
     std::printf("%-11s mean sigma0_px %.4f (truth %.4f), std %.4f (truth %.4f), %zu flagged\n",
-                std::string(calib::MappingModelName(s.model)).c_str(), s.mean_sigma0_px,
-                expected_mean, s.std_sigma0_px, expected_std, s.flagged.size());
+                std::string(calib::MappingModelName(s.model)).c_str(),
+                s.mean_sigma0_px,
+                expected_mean,
+                s.std_sigma0_px,
+                expected_std,
+                s.flagged.size());
     EXPECT_EQ(s.n_frames, 37);
-    for (const auto& f : s.flagged) std::printf("  %s: %s\n", f.frame.c_str(), f.reasons.front().c_str());
+    for (const auto& f : s.flagged)
+      std::printf("  %s: %s\n", f.frame.c_str(), f.reasons.front().c_str());
     // The mean: 4 standard errors, plus the moved frame's share (<= 2 % of one frame's sigma0).
     EXPECT_NEAR(s.mean_sigma0_px, expected_mean, 4 * expected_std / std::sqrt(37.0) + 0.001);
     if (lambda < r) {  // with a large lambda the spread also grows with the misfit
@@ -89,7 +95,8 @@ TEST(FlightStability, TableOfThirtySevenFramesMatchesTheTruth) {
         << p.subimage << " " << p.name;
     ratio += p.std / p.mean_sigma / 18.0;
   }
-  std::printf("affine: spread over frames / reported sigma, mean over 18 parameters: %.3f\n", ratio);
+  std::printf("affine: spread over frames / reported sigma, mean over 18 parameters: %.3f\n",
+              ratio);
   EXPECT_NEAR(ratio, 1.0, 0.25);
   // The moved frame is flagged; the flags' false-alarm rate over the flight is 5 %.
   bool moved_flagged = false;

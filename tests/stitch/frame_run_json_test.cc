@@ -2,14 +2,14 @@
 // `aerocal batch` hands from a unit to the merge must give the single process's numbers.
 #include "stitch/io/frame_run_json.h"
 
-#include <cmath>
-#include <limits>
-
-#include <gtest/gtest.h>
-
 #include "calib/core/error.h"
 #include "stitch/io/stitch_result_json.h"
 #include "tests/stitch/simulated_camera.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
 
 namespace aerocal::stitch {
 namespace {
@@ -54,7 +54,8 @@ TEST(FrameRunJson, AnotherDocumentIsABadInputNamingTheFile) {
     FrameRunFromJson(nlohmann::json{{"kind", "stitch"}}, "units/x/frame_run.json");
     FAIL() << "no error";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("units/x/frame_run.json: not a stitching frame run"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("units/x/frame_run.json: not a stitching frame run"),
+              std::string::npos)
         << e.what();
   }
 }

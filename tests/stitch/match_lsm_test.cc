@@ -1,14 +1,14 @@
 // Least-squares matching, RANSAC on the local affine mapping and the interest operators on
 // images whose geometry is known exactly.
-#include <cmath>
-#include <random>
+#include "stitch/matching/interest_operators.h"
+#include "stitch/matching/least_squares_matching.h"
+#include "stitch/matching/local_mapping.h"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
-#include "stitch/matching/interest_operators.h"
-#include "stitch/matching/least_squares_matching.h"
-#include "stitch/matching/local_mapping.h"
+#include <cmath>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -36,8 +36,12 @@ struct Texture {
 };
 
 // Image whose pixel (u, v) shows the texture at M (u, v) + m, times gain plus offset.
-GrayImage Render(const Texture& texture, int size, const Eigen::Matrix2d& m,
-                 const Eigen::Vector2d& offset, double gain, double bias) {
+GrayImage Render(const Texture& texture,
+                 int size,
+                 const Eigen::Matrix2d& m,
+                 const Eigen::Vector2d& offset,
+                 double gain,
+                 double bias) {
   GrayImage image(size, size);
   for (int v = 0; v < size; ++v)
     for (int u = 0; u < size; ++u) {
@@ -58,8 +62,8 @@ TEST(LeastSquaresMatching, RecoversSubPixelAffineAndRadiometry) {
   const Eigen::Vector2i p_a(40, 38);
   const Eigen::Vector2d truth = b_linear.inverse() * (p_a.cast<double>() - b0);
   // Start 0.6 px off with the identity shape, as a keypoint match would.
-  const LsmResult r = MatchLeastSquares(a, p_a, b, truth + Eigen::Vector2d(0.6, -0.4),
-                                        Eigen::Matrix2d::Identity(), LsmOptions{});
+  const LsmResult r = MatchLeastSquares(
+      a, p_a, b, truth + Eigen::Vector2d(0.6, -0.4), Eigen::Matrix2d::Identity(), LsmOptions{});
   ASSERT_TRUE(r.ok()) << static_cast<int>(r.status);
   // Exact data: only the cubic interpolation of b limits the result (periods >= 6 px).
   EXPECT_LT((r.position_in_b - truth).norm(), 0.01) << r.position_in_b.transpose();
@@ -80,8 +84,8 @@ TEST(LeastSquaresMatching, PrecisionMatchesTheScatterUnderNoise) {
     for (Eigen::Index i = 0; i < a.size(); ++i) a.data()[i] += static_cast<float>(noise(rng));
     for (Eigen::Index i = 0; i < b.size(); ++i) b.data()[i] += static_cast<float>(noise(rng));
     const Eigen::Vector2i p_a(30, 30);
-    const LsmResult r = MatchLeastSquares(a, p_a, b, p_a.cast<double>() - b0,
-                                          Eigen::Matrix2d::Identity(), LsmOptions{});
+    const LsmResult r = MatchLeastSquares(
+        a, p_a, b, p_a.cast<double>() - b0, Eigen::Matrix2d::Identity(), LsmOptions{});
     ASSERT_TRUE(r.ok());
     sum_sq += (r.position_in_b - (p_a.cast<double>() - b0)).squaredNorm();
     sum_var += r.cov_px2.trace();
@@ -96,8 +100,8 @@ TEST(LeastSquaresMatching, PrecisionMatchesTheScatterUnderNoise) {
 
 TEST(LeastSquaresMatching, FlatPatchDoesNotConverge) {
   GrayImage flat = GrayImage::Constant(40, 40, 100.0f);
-  const LsmResult r = MatchLeastSquares(flat, {20, 20}, flat, {20.2, 20.1},
-                                        Eigen::Matrix2d::Identity(), LsmOptions{});
+  const LsmResult r = MatchLeastSquares(
+      flat, {20, 20}, flat, {20.2, 20.1}, Eigen::Matrix2d::Identity(), LsmOptions{});
   EXPECT_FALSE(r.ok());
 }
 
@@ -112,7 +116,8 @@ TEST(RansacAffine, RecoversTheMappingDespiteOutliers) {
   for (int i = 0; i < 200; ++i) {
     from.emplace_back(along(rng), across(rng));
     Eigen::Vector2d b = truth.Apply(from.back()) + Eigen::Vector2d(noise(rng), noise(rng));
-    if (i % 4 == 0) b += Eigen::Vector2d(wild(rng), wild(rng)) + Eigen::Vector2d(5, 5);  // 25 % outliers
+    if (i % 4 == 0)
+      b += Eigen::Vector2d(wild(rng), wild(rng)) + Eigen::Vector2d(5, 5);  // 25 % outliers
     to.push_back(b);
   }
   const RansacResult r = RansacAffine(from, to, RansacOptions{});
@@ -130,8 +135,10 @@ TEST(Foerstner, FindsTheCornersOfASquare) {
   options.weight_factor = 0.5;
   const std::vector<InterestPoint> points = DetectFoerstner(image, options);
   ASSERT_EQ(points.size(), 4u);
-  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(24.5, 19.5), Eigen::Vector2d(44.5, 19.5),
-                                        Eigen::Vector2d(24.5, 34.5), Eigen::Vector2d(44.5, 34.5)}) {
+  for (const Eigen::Vector2d& corner : {Eigen::Vector2d(24.5, 19.5),
+                                        Eigen::Vector2d(44.5, 19.5),
+                                        Eigen::Vector2d(24.5, 34.5),
+                                        Eigen::Vector2d(44.5, 34.5)}) {
     double nearest = 1e9;
     for (const InterestPoint& p : points) nearest = std::min(nearest, (p.position - corner).norm());
     // The 5 x 5 window peaks where it holds both edges: an integer pixel within 1.5 px per axis.
@@ -143,7 +150,8 @@ TEST(Wallis, ForcesLocalMeanAndContrast) {
   std::mt19937_64 rng(2);
   std::normal_distribution<double> noise(0, 3);
   GrayImage image(100, 100);
-  for (Eigen::Index i = 0; i < image.size(); ++i) image.data()[i] = static_cast<float>(40 + noise(rng));
+  for (Eigen::Index i = 0; i < image.size(); ++i)
+    image.data()[i] = static_cast<float>(40 + noise(rng));
   WallisOptions options;
   options.contrast = 1.0;
   options.brightness = 1.0;

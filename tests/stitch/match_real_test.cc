@@ -1,11 +1,11 @@
 // Matching on real pixels: the Boruszyn scene (match_test_scene.h) matched with both detectors,
 // LSM on and off; every tie's two rays mapped through the TRUE mappings must meet.
-#include <cstdio>
+#include "stitch/matching/overlap_matcher.h"
+#include "tests/stitch/match_test_scene.h"
 
 #include <gtest/gtest.h>
 
-#include "stitch/matching/overlap_matcher.h"
-#include "tests/stitch/match_test_scene.h"
+#include <cstdio>
 
 namespace aerocal::stitch {
 namespace {
@@ -15,9 +15,19 @@ using testing::BoruszynScene;
 
 void PrintStrips(const FrameMatches& m) {
   for (const StripReport& s : m.strips)
-    std::printf("  %-8s kp %5d/%5d ratio %4d ransac %4d lsm %3d (nc %d, poor %d) points %3d coverage %.2f\n",
-                s.name.c_str(), s.keypoints_a, s.keypoints_b, s.ratio_matches, s.ransac_inliers,
-                s.lsm_tried, s.lsm_not_converged, s.lsm_poor_precision, s.points, s.Coverage());
+    std::printf(
+        "  %-8s kp %5d/%5d ratio %4d ransac %4d lsm %3d (nc %d, poor %d) points %3d coverage "
+        "%.2f\n",
+        s.name.c_str(),
+        s.keypoints_a,
+        s.keypoints_b,
+        s.ratio_matches,
+        s.ransac_inliers,
+        s.lsm_tried,
+        s.lsm_not_converged,
+        s.lsm_poor_precision,
+        s.points,
+        s.Coverage());
 }
 
 struct MatchRun {
@@ -34,8 +44,11 @@ MatchRun MatchScene(Detector detector, bool lsm) {
   run.matches = MatchFrame(scene.nominal, scene.images, "4880", options);
   run.agreement = AgreementThroughTruth(scene.truth, run.matches.observations);
   std::printf("%s, LSM %s: %d ties, RMS %.3f px per coordinate, max %.3f px\n",
-              detector == Detector::kSift ? "SIFT" : "Foerstner", lsm ? "on" : "off",
-              run.agreement.ties, run.agreement.rms_px, run.agreement.max_px);
+              detector == Detector::kSift ? "SIFT" : "Foerstner",
+              lsm ? "on" : "off",
+              run.agreement.ties,
+              run.agreement.rms_px,
+              run.agreement.max_px);
   PrintStrips(run.matches);
   return run;
 }
@@ -64,7 +77,8 @@ TEST_P(MatchReal, LsmTiePointsMeetThroughTrueMappingsToATenthOfAPixel) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Detectors, MatchReal,
+INSTANTIATE_TEST_SUITE_P(Detectors,
+                         MatchReal,
                          ::testing::Values(Detector::kSift, Detector::kFoerstner));
 
 }  // namespace

@@ -5,18 +5,18 @@
 // stitching adjustment: sigma0 <= 0.12 px, every sub-image corner within 3 predicted sigmas and
 // 0.25 px of its true virtual position. Also: byte-identical output for identical inputs,
 // appending frames, and bad images named in the error.
-#include <cstdio>
-#include <fstream>
-#include <random>
-#include <sstream>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "stitch/adjustment/stitch_adjustment.h"
 #include "tests/stitch/match_test_scene.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
 
 namespace aerocal::stitch {
 namespace {
@@ -64,7 +64,8 @@ std::string WithReferences(const std::string& obs, const std::string& out) {
   for (const calib::ReferencePoint& p : scene.nominal.reference_points) {
     const auto& sub = scene.truth.subimages[scene.truth.SubimageIndex(p.subimage)];
     const Eigen::Vector2d uv = sub.SubFromVirtual({p.U, p.V});
-    rows.push_back({"4880", p.id, p.subimage, uv.x() + noise(rng), uv.y() + noise(rng), p.sigma_px});
+    rows.push_back(
+        {"4880", p.id, p.subimage, uv.x() + noise(rng), uv.y() + noise(rng), p.sigma_px});
   }
   WriteStitchObservations(out, rows);
   return out;
@@ -88,8 +89,9 @@ CornerCheck AdjustAndCompare(const std::string& obs) {
     for (const CornerPrecision& c : adj.subimages[k].corners) {
       const Eigen::Vector2d d = c.virtual_px - scene.truth.subimages[k].VirtualFromSub(c.uv);
       check.max_error_px = std::max(check.max_error_px, d.norm());
-      check.max_error_in_sigmas = std::max(
-          {check.max_error_in_sigmas, std::abs(d.x()) / c.sigma_U_px, std::abs(d.y()) / c.sigma_V_px});
+      check.max_error_in_sigmas = std::max({check.max_error_in_sigmas,
+                                            std::abs(d.x()) / c.sigma_U_px,
+                                            std::abs(d.y()) / c.sigma_V_px});
     }
   }
   std::printf("  rejected %zu, redundancy %d\n", adj.rejected.size(), adj.redundancy);
@@ -99,8 +101,11 @@ CornerCheck AdjustAndCompare(const std::string& obs) {
 // The acceptance bounds of matched ties: sigma0 <= 0.12 px, every corner within 0.25 px and 3
 // of its predicted sigmas of the truth.
 void ExpectMeetsTheAcceptance(const CornerCheck& check, const char* what) {
-  std::printf("%s: sigma0 %.3f px, corners max error %.3f px = %.2f sigma\n", what, check.sigma0_px,
-              check.max_error_px, check.max_error_in_sigmas);
+  std::printf("%s: sigma0 %.3f px, corners max error %.3f px = %.2f sigma\n",
+              what,
+              check.sigma0_px,
+              check.max_error_px,
+              check.max_error_in_sigmas);
   EXPECT_LE(check.sigma0_px, 0.12) << what;
   EXPECT_LE(check.max_error_px, 0.25) << what;
   EXPECT_LE(check.max_error_in_sigmas, 3.0) << what;
@@ -111,14 +116,17 @@ TEST_F(MatchStitch, MatchThenAffineStitchRecoversTheTrueCorners) {
   ASSERT_EQ(RunAerocal(Match(on)).exit_code, 0);
   ASSERT_EQ(RunAerocal(Match(off, "--lsm off")).exit_code, 0);
   const CornerCheck without = AdjustAndCompare(WithReferences(off, dir_->File("off_ref.csv")));
-  std::printf("LSM off: sigma0 %.3f px, corners max error %.3f px = %.2f sigma\n", without.sigma0_px,
-              without.max_error_px, without.max_error_in_sigmas);
-  ExpectMeetsTheAcceptance(AdjustAndCompare(WithReferences(on, dir_->File("on_ref.csv"))), "LSM on ");
+  std::printf("LSM off: sigma0 %.3f px, corners max error %.3f px = %.2f sigma\n",
+              without.sigma0_px,
+              without.max_error_px,
+              without.max_error_in_sigmas);
+  ExpectMeetsTheAcceptance(AdjustAndCompare(WithReferences(on, dir_->File("on_ref.csv"))),
+                           "LSM on ");
 
   // The stitch command reads the file as written.
-  const auto result = RunAerocal("stitch --camera " + dir_->File("camera.yaml") + " --obs " +
-                                 dir_->File("on_ref.csv") + " --model affine --out " +
-                                 dir_->File("r.json"));
+  const auto result =
+      RunAerocal("stitch --camera " + dir_->File("camera.yaml") + " --obs " +
+                 dir_->File("on_ref.csv") + " --model affine --out " + dir_->File("r.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
   const nlohmann::json doc = nlohmann::json::parse(ReadTextFile(dir_->File("r.json")));
   EXPECT_LE(doc.at("sigma0_px").get<double>(), 0.12);
@@ -145,11 +153,13 @@ TEST_F(MatchStitch, FlightListAppendsFramesAndRefusesDuplicates) {
   const std::string out = dir_->File("flight.csv");
   // Frame "a" first, then frame "b" of the list appended.
   ASSERT_EQ(RunAerocal("match --camera " + dir_->File("camera.yaml") + " --frame a --images " +
-                       *images_arg_ + " --detector foerstner --out " + out).exit_code, 0);
+                       *images_arg_ + " --detector foerstner --out " + out)
+                .exit_code,
+            0);
   const std::string before = ReadTextFile(out);
-  const std::string list_run =
-      "match --camera " + dir_->File("camera.yaml") + " --list " + dir_->File("list.csv") +
-      " --detector foerstner --append --out " + out;
+  const std::string list_run = "match --camera " + dir_->File("camera.yaml") + " --list " +
+                               dir_->File("list.csv") + " --detector foerstner --append --out " +
+                               out;
   ASSERT_EQ(RunAerocal(list_run).exit_code, 0);
   const auto rows = ReadStitchObservations(out, 0.1);
   std::set<std::string> frames;
@@ -179,15 +189,15 @@ TEST_F(MatchStitch, BadImagesAreNamedAndNothingIsWritten) {
       << r.output;
   // Not an image.
   WriteFileAtomically(dir_->File("text.tif"), "not an image\n");
-  r = RunAerocal("match --camera " + cam + " --frame 1 --images " + images_with(dir_->File("text.tif")) +
-                 " --out " + out);
+  r = RunAerocal("match --camera " + cam + " --frame 1 --images " +
+                 images_with(dir_->File("text.tif")) + " --out " + out);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find(dir_->File("text.tif") + ": cannot decode image"), std::string::npos)
       << r.output;
   // Wrong format for the camera file.
   WriteGrayImage(dir_->File("small.tif"), GrayImage::Constant(10, 20, 9.0f));
-  r = RunAerocal("match --camera " + cam + " --frame 1 --images " + images_with(dir_->File("small.tif")) +
-                 " --out " + out);
+  r = RunAerocal("match --camera " + cam + " --frame 1 --images " +
+                 images_with(dir_->File("small.tif")) + " --out " + out);
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find(dir_->File("small.tif") + ": image is 20 x 10 px, but sub-image II"),
             std::string::npos)

@@ -7,17 +7,17 @@
 // outer corners of the CCDs (GridLayout kOuterCorners).
 #pragma once
 
-#include <cmath>
-#include <optional>
-#include <random>
-#include <string>
-#include <vector>
-
 #include "stitch/image_io/image_io.h"
 #include "stitch/image_io/subimage_cutter.h"
 #include "stitch/layout/grid_layout.h"
 #include "stitch/simulation/stitch_simulator.h"
 #include "tests/support/test_support.h"
+
+#include <cmath>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch::testing {
 
@@ -63,8 +63,8 @@ inline const std::optional<MatchScene>& BoruszynScene() {
 
 struct TieAgreement {
   int ties = 0;
-  double rms_px = 0;      // per coordinate, of VirtualFromSub_true(a) - VirtualFromSub_true(b)
-  double max_px = 0;      // largest 2D discrepancy
+  double rms_px = 0;  // per coordinate, of VirtualFromSub_true(a) - VirtualFromSub_true(b)
+  double max_px = 0;  // largest 2D discrepancy
 };
 
 /// Maps both rays of every two-ray tie through the TRUE mappings and compares.

@@ -1,10 +1,10 @@
-// Model choice by the F test (model_selection.h, f_test.h).
+// Model choice by the F test (model_selection.h, f_distribution.h).
 #include "stitch/adjustment/model_selection.h"
 
-#include <gtest/gtest.h>
-
-#include "stitch/adjustment/f_test.h"
+#include "stitch/adjustment/f_distribution.h"
 #include "tests/stitch/simulated_camera.h"
+
+#include <gtest/gtest.h>
 
 namespace aerocal::stitch {
 namespace {
@@ -38,8 +38,10 @@ std::map<MappingModel, int> CountChoices(double shear, std::uint64_t seed) {
     EXPECT_LE(choice.candidates[3].adjustment.vtpv, choice.candidates[2].adjustment.vtpv);
   }
   for (const auto& [model, n] : counts)
-    std::printf("shear %.0e: %s chosen in %d of 20 frames\n", shear,
-                std::string(calib::MappingModelName(model)).c_str(), n);
+    std::printf("shear %.0e: %s chosen in %d of 20 frames\n",
+                shear,
+                std::string(calib::MappingModelName(model)).c_str(),
+                n);
   return counts;
 }
 

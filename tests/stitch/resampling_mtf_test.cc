@@ -6,13 +6,13 @@
 // kernel's transfer function (stitch/quality/resampling_mtf.h) within 2 %.
 #include "stitch/quality/resampling_mtf.h"
 
-#include <cmath>
-#include <cstdio>
+#include "stitch/resample/raster.h"
+#include "tests/support/rendered_targets.h"
 
 #include <gtest/gtest.h>
 
-#include "stitch/resample/raster.h"
-#include "tests/support/rendered_targets.h"
+#include <cmath>
+#include <cstdio>
 
 namespace aerocal::stitch {
 namespace {
@@ -25,7 +25,10 @@ calib::Camera TurnedCamera(double turn_rad) {
   camera.width_px = kVirtual;
   camera.height_px = kVirtual;
   camera.pixel_size_mm = 0.006;
-  camera.subimages.push_back({"I", kRaw, kRaw, calib::MappingModel::kConformal,
+  camera.subimages.push_back({"I",
+                              kRaw,
+                              kRaw,
+                              calib::MappingModel::kConformal,
                               {std::cos(turn_rad), std::sin(turn_rad), -14.37, -12.71}});
   return camera;
 }
@@ -41,12 +44,15 @@ GrayImage ToGray(const MemoryRaster& raster) {
 TEST(ResamplingMtf, KernelTransferFunctions) {
   // Bilinear: sinc^2; 1 at 0, 0 at 1 cycle/px, 4 / pi^2 at Nyquist.
   EXPECT_NEAR(InterpolationTransfer(Interpolation::kBilinear, 0.0), 1.0, 1e-15);
-  EXPECT_NEAR(InterpolationTransfer(Interpolation::kBilinear, 0.5), 4.0 / (kDeg * kDeg * 180.0 * 180.0), 1e-12);
+  EXPECT_NEAR(InterpolationTransfer(Interpolation::kBilinear, 0.5),
+              4.0 / (kDeg * kDeg * 180.0 * 180.0),
+              1e-12);
   // Keys a = -0.5: 1 at 0 (the kernel sums to 1), above bilinear below Nyquist, 0 at 1 cycle/px.
   EXPECT_NEAR(InterpolationTransfer(Interpolation::kBicubic, 0.0), 1.0, 1e-10);
   EXPECT_NEAR(InterpolationTransfer(Interpolation::kBicubic, 1.0), 0.0, 1e-10);
   for (double f : {0.1, 0.2, 0.3, 0.4, 0.5})
-    EXPECT_GT(InterpolationTransfer(Interpolation::kBicubic, f), InterpolationTransfer(Interpolation::kBilinear, f));
+    EXPECT_GT(InterpolationTransfer(Interpolation::kBicubic, f),
+              InterpolationTransfer(Interpolation::kBilinear, f));
 }
 
 TEST(ResamplingMtf, VirtualImageMtf50IsTheRawOneTimesTheKernelTransfer) {
@@ -67,13 +73,22 @@ TEST(ResamplingMtf, VirtualImageMtf50IsTheRawOneTimesTheKernelTransfer) {
       const SlantedEdgeResult virt = MeasureSlantedEdge(ToGray(sink), {18, 26, 128, 128});
       const double predicted = PredictResampledMtf50(raw, kind, std::abs(virt.angle_deg) * kDeg);
       const char* name = kind == Interpolation::kBilinear ? "bilinear" : "bicubic";
-      std::printf("s %.2f %-8s: raw MTF50 %.4f, virtual %.4f (loss %.2f %%), predicted %.4f (loss %.2f %%), "
-                  "virtual / predicted %+.2f %%\n",
-                  s, name, raw.mtf50_cy_px, virt.mtf50_cy_px, 100.0 * (1.0 - virt.mtf50_cy_px / raw.mtf50_cy_px),
-                  predicted, 100.0 * (1.0 - predicted / raw.mtf50_cy_px), 100.0 * (virt.mtf50_cy_px / predicted - 1.0));
+      std::printf(
+          "s %.2f %-8s: raw MTF50 %.4f, virtual %.4f (loss %.2f %%), predicted %.4f (loss %.2f "
+          "%%), "
+          "virtual / predicted %+.2f %%\n",
+          s,
+          name,
+          raw.mtf50_cy_px,
+          virt.mtf50_cy_px,
+          100.0 * (1.0 - virt.mtf50_cy_px / raw.mtf50_cy_px),
+          predicted,
+          100.0 * (1.0 - predicted / raw.mtf50_cy_px),
+          100.0 * (virt.mtf50_cy_px / predicted - 1.0));
       EXPECT_NEAR(std::abs(virt.angle_deg), (slant + turn) / kDeg, 0.05) << name << " s " << s;
-      // Bilinear resampling loses 1.7-11 % of MTF50 here: measurably lower. Bicubic's loss at s >= 1.5
-      // px (< 0.3 %) is below what one edge resolves, so only the prediction is checked there.
+      // Bilinear resampling loses 1.7-11 % of MTF50 here: measurably lower. Bicubic's loss at s
+      // >= 1.5 px (< 0.3 %) is below what one edge resolves, so only the prediction is checked
+      // there.
       if (kind == Interpolation::kBilinear) {
         EXPECT_LT(virt.mtf50_cy_px, raw.mtf50_cy_px) << name << " s " << s;
       }

@@ -1,15 +1,15 @@
 // 'aerocal rig error-analysis' on the dual-lens example of configs/: the issue's JSON keys, the
 // hand figures through the CLI, Monte-Carlo against linear propagation, byte-identical reruns,
 // exactness with zero limits, the grid and the refusals (exit 2, FILE:LINE, nothing written).
-#include <algorithm>
-#include <filesystem>
-#include <fstream>
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "calib/core/atomic_file.h"
-#include "tests/support/test_support.h"
+#include <algorithm>
+#include <filesystem>
+#include <fstream>
 
 namespace aerocal::stitch {
 namespace {
@@ -41,8 +41,19 @@ TEST(RigErrorAnalysisCommand, ExampleCameraWithTheIssueKeysAndByteIdenticalRerun
   const json doc = ReadJson(a.File("result.json"));
   EXPECT_EQ(doc["kind"], "rig_error_analysis");
   EXPECT_EQ(doc["height_m"], 1200.0) << "the rig file's virtual.height_m";
-  const std::vector<std::string> names = {"x0:A", "y0:A", "c:A", "x0:B", "y0:B", "c:B", "omega:B",
-                                          "phi:B", "kappa:B", "tx:B", "ty:B", "tz:B", "height"};
+  const std::vector<std::string> names = {"x0:A",
+                                          "y0:A",
+                                          "c:A",
+                                          "x0:B",
+                                          "y0:B",
+                                          "c:B",
+                                          "omega:B",
+                                          "phi:B",
+                                          "kappa:B",
+                                          "tx:B",
+                                          "ty:B",
+                                          "tz:B",
+                                          "height"};
   ASSERT_EQ(doc["per_source"].size(), names.size());
   for (size_t i = 0; i < names.size(); ++i) {
     const json& row = doc["per_source"][i];
@@ -51,8 +62,10 @@ TEST(RigErrorAnalysisCommand, ExampleCameraWithTheIssueKeysAndByteIdenticalRerun
     EXPECT_EQ(row["minus_px"].size(), 2u);
     EXPECT_TRUE(doc["linear"]["share"].contains(names[i])) << names[i];
   }
-  for (const char* key : {"sigma_px", "bound_px", "share"}) EXPECT_TRUE(doc["linear"].contains(key)) << key;
-  for (const char* key : {"n", "seed", "sigma_px", "mean_px", "bound_px", "bound_radial_px", "max_abs_px"})
+  for (const char* key : {"sigma_px", "bound_px", "share"})
+    EXPECT_TRUE(doc["linear"].contains(key)) << key;
+  for (const char* key :
+       {"n", "seed", "sigma_px", "mean_px", "bound_px", "bound_radial_px", "max_abs_px"})
     EXPECT_TRUE(doc["monte_carlo"].contains(key)) << key;
   EXPECT_EQ(doc["monte_carlo"]["n"], 100000);
   EXPECT_EQ(doc["monte_carlo"]["seed"], 7);
@@ -64,12 +77,17 @@ TEST(RigErrorAnalysisCommand, ExampleCameraWithTheIssueKeysAndByteIdenticalRerun
   EXPECT_NEAR(SourceRow(doc, "omega:B")["plus_px"][1].get<double>(), -1.212, 0.004);
   // Principal points of the two heads: opposite signs.
   EXPECT_LT(SourceRow(doc, "x0:A")["plus_px"][0].get<double>() *
-                SourceRow(doc, "x0:B")["plus_px"][0].get<double>(), 0.0);
+                SourceRow(doc, "x0:B")["plus_px"][0].get<double>(),
+            0.0);
   EXPECT_LT(SourceRow(doc, "y0:A")["plus_px"][1].get<double>() *
-                SourceRow(doc, "y0:B")["plus_px"][1].get<double>(), 0.0);
+                SourceRow(doc, "y0:B")["plus_px"][1].get<double>(),
+            0.0);
   for (int axis = 0; axis < 2; ++axis)
     EXPECT_NEAR(doc["monte_carlo"]["sigma_px"][axis].get<double>() /
-                    doc["linear"]["sigma_px"][axis].get<double>(), 1.0, 0.01) << axis;
+                    doc["linear"]["sigma_px"][axis].get<double>(),
+                1.0,
+                0.01)
+        << axis;
   EXPECT_LT(doc["monte_carlo"]["bound_radial_px"].get<double>(), 2.0);
   // Histograms: CSV (header + 3 x 60 bins) and PNG beside the result.
   const std::string csv = ReadTextFile(a.File("result_histogram.csv"));
@@ -90,15 +108,16 @@ TEST(RigErrorAnalysisCommand, ZeroLimitsGiveZeroError) {
   std::ofstream(tmp.File("zero.yaml"))
       << "limits: {principal_point_px: 0, principal_distance_px: 0, angles_arcsec: 0, "
          "lever_arm_mm: 0, height_m: 0}\n";
-  const auto run = RunAerocal("rig error-analysis --camera " + kRig + " --limits " +
-                              tmp.File("zero.yaml") + " --samples 1000 --no-plots --out " +
-                              tmp.File("r.json"));
+  const auto run =
+      RunAerocal("rig error-analysis --camera " + kRig + " --limits " + tmp.File("zero.yaml") +
+                 " --samples 1000 --no-plots --out " + tmp.File("r.json"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const json doc = ReadJson(tmp.File("r.json"));
   EXPECT_EQ(doc["limits"]["sigmas"], 3.0) << "default";
   for (const json& row : doc["per_source"])
     for (const char* key : {"plus_px", "minus_px"})
-      for (int axis = 0; axis < 2; ++axis) EXPECT_EQ(row[key][axis].get<double>(), 0.0) << row["source"];
+      for (int axis = 0; axis < 2; ++axis)
+        EXPECT_EQ(row[key][axis].get<double>(), 0.0) << row["source"];
   EXPECT_EQ(doc["linear"]["sigma_px"], json::array({0.0, 0.0}));
   EXPECT_TRUE(doc["linear"]["share"]["phi:B"][0].is_null()) << "an unknown share is null, never 0";
   EXPECT_EQ(doc["monte_carlo"]["max_abs_px"], json::array({0.0, 0.0}));
@@ -107,7 +126,8 @@ TEST(RigErrorAnalysisCommand, ZeroLimitsGiveZeroError) {
 
 TEST(RigErrorAnalysisCommand, GridVirtualPixelDefaultTargetAndHeight) {
   TempDir tmp;
-  auto run = RunAerocal(Analysis("--grid 2 --samples 300 --no-plots --out " + tmp.File("grid.json")));
+  auto run =
+      RunAerocal(Analysis("--grid 2 --samples 300 --no-plots --out " + tmp.File("grid.json")));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   json doc = ReadJson(tmp.File("grid.json"));
   ASSERT_EQ(doc["grid"]["points"].size(), 4u);
@@ -183,7 +203,6 @@ TEST(RigErrorAnalysisCommand, RefusesBadInputWithExitTwoAndNothingWritten) {
           "--height-m: the rig file");
 }
 
-
 TEST(RigDesignCommand, Uav4FiguresSvgAndRefusals) {
   TempDir tmp;
   const std::string uav4 = std::string(AEROCAL_CONFIGS_DIR) + "/rig_uav4.yaml";
@@ -198,12 +217,22 @@ TEST(RigDesignCommand, Uav4FiguresSvgAndRefusals) {
     ASSERT_EQ(head["gsd"].size(), 9u);
     const json& pp = head["gsd"][0];
     EXPECT_EQ(pp["where"], "principal_point");
-    EXPECT_NEAR(pp["gsd_ratio"]["along_tilt"].get<double>() / pp["closed_form"]["along_tilt"].get<double>(), 1, 0.005);
-    EXPECT_NEAR(pp["gsd_ratio"]["across_tilt"].get<double>() / pp["closed_form"]["across_tilt"].get<double>(), 1, 0.005);
+    EXPECT_NEAR(
+        pp["gsd_ratio"]["along_tilt"].get<double>() / pp["closed_form"]["along_tilt"].get<double>(),
+        1,
+        0.005);
+    EXPECT_NEAR(pp["gsd_ratio"]["across_tilt"].get<double>() /
+                    pp["closed_form"]["across_tilt"].get<double>(),
+                1,
+                0.005);
     EXPECT_TRUE(head["gsd"][5]["closed_form"].is_null()) << "a corner is off the principal line";
   }
-  for (const char* key : {"virtual_format", "covered_area_m2", "effective_format", "zones",
-                          "standard_positions", "grid"})
+  for (const char* key : {"virtual_format",
+                          "covered_area_m2",
+                          "effective_format",
+                          "zones",
+                          "standard_positions",
+                          "grid"})
     EXPECT_TRUE(doc.contains(key)) << key;
   EXPECT_EQ(doc["standard_positions"].size(), 12u);
   EXPECT_TRUE(doc["virtual_format"]["fits"].get<bool>());

@@ -3,22 +3,23 @@
 // two-head rig and converted back: geometric error measured by the gradient-based shift estimate
 // (< 0.1 px where the plane is exact; a 5 % wrong height is seen), no seam (measured as
 // tests/stitch/virtual_image_test.cc does), and the command on TIFF files.
-#include <algorithm>
-#include <array>
-#include <cmath>
-#include <filesystem>
-
-#include <Eigen/Dense>
-#include <gtest/gtest.h>
+#include "stitch/rig/rig_convert.h"
 
 #include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "stitch/resample/tiff_raster.h"
-#include "stitch/rig/rig_convert.h"
 #include "tests/support/cubic_sample.h"
 #include "tests/support/test_support.h"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <filesystem>
 
 namespace aerocal::stitch {
 namespace {
@@ -50,7 +51,8 @@ calib::Rig TwoHeadRig() {
 }
 
 TEST(RigConvert, PlaneHomographyIsTheExactConversion) {
-  for (const auto orientation : {calib::VirtualOrientation::kRig, calib::VirtualOrientation::kLevel}) {
+  for (const auto orientation :
+       {calib::VirtualOrientation::kRig, calib::VirtualOrientation::kLevel}) {
     calib::Rig rig = TwoHeadRig();
     rig.virtual_camera.orientation = orientation;
     RigExposure exposure;
@@ -61,8 +63,10 @@ TEST(RigConvert, PlaneHomographyIsTheExactConversion) {
     const RigConverter converter(rig, exposure, MakeRectificationPlane(rig, exposure, kHeight));
     for (int k = 0; k < 2; ++k) {
       const Eigen::Matrix3d h = HeadFromVirtualHomography(converter, k);
-      for (const Eigen::Vector2d& v : {Eigen::Vector2d(0, 0), Eigen::Vector2d(800, 600),
-                                       Eigen::Vector2d(1599, 1199), Eigen::Vector2d(200, 1000)}) {
+      for (const Eigen::Vector2d& v : {Eigen::Vector2d(0, 0),
+                                       Eigen::Vector2d(800, 600),
+                                       Eigen::Vector2d(1599, 1199),
+                                       Eigen::Vector2d(200, 1000)}) {
         const Eigen::Vector3d p = h * v.homogeneous();
         const auto exact = converter.HeadFromVirtual(k, v);
         ASSERT_TRUE(exact.has_value());
@@ -76,7 +80,7 @@ TEST(RigConvert, PlaneHomographyIsTheExactConversion) {
 calib::Rig DistortedTwoHeadRig() {
   calib::Rig rig = TwoHeadRig();
   using Model = calib::BrownFraser10Model;
-  rig.heads[0].camera.interior[Model::kK1] = 1e-4;   // 6 px at the corner (r = 8.5 mm)
+  rig.heads[0].camera.interior[Model::kK1] = 1e-4;  // 6 px at the corner (r = 8.5 mm)
   rig.heads[0].camera.interior[Model::kP1] = 3e-5;
   rig.heads[1].camera.interior[Model::kK1] = -8e-5;
   rig.heads[1].camera.interior[Model::kK2] = 5e-7;
@@ -87,8 +91,12 @@ calib::Rig DistortedTwoHeadRig() {
 
 // Largest distance (px) between homography + bilinear grid of `base` and the exact conversion of
 // `exact` at pseudo-random virtual pixels inside head k; `checked` counts them.
-double WorstGridError(const RigConverter& base, const RigConverter& exact, int k,
-                      const MapCorrectionGrid& g, int samples, int* checked) {
+double WorstGridError(const RigConverter& base,
+                      const RigConverter& exact,
+                      int k,
+                      const MapCorrectionGrid& g,
+                      int samples,
+                      int* checked) {
   const Eigen::Matrix3d h = HeadFromVirtualHomography(base, k);
   double worst = 0.0;
   *checked = 0;
@@ -97,7 +105,8 @@ double WorstGridError(const RigConverter& base, const RigConverter& exact, int k
     const auto p = exact.HeadFromVirtual(k, v);
     if (!p || !exact.InHeadFormat(k, *p)) continue;
     const double gu = v.x() / g.step_px, gv = v.y() / g.step_px;
-    const int ci = std::min(static_cast<int>(gu), g.cols - 2), cj = std::min(static_cast<int>(gv), g.rows - 2);
+    const int ci = std::min(static_cast<int>(gu), g.cols - 2),
+              cj = std::min(static_cast<int>(gv), g.rows - 2);
     const double fu = gu - ci, fv = gv - cj;
     Eigen::Vector2d d = Eigen::Vector2d::Zero();
     for (int dj = 0; dj < 2; ++dj)
@@ -132,7 +141,8 @@ TEST(RigConvert, CorrectionGridsCarryTheDistortionToTheTolerance) {
     EXPECT_LT(worst, 0.02) << "head " << k;  // 0.01 per axis at cell centres; float storage
   }
   // Distortion-free heads need no grid.
-  const RigConverter plain(TwoHeadRig(), exposure, MakeRectificationPlane(TwoHeadRig(), exposure, kHeight));
+  const RigConverter plain(
+      TwoHeadRig(), exposure, MakeRectificationPlane(TwoHeadRig(), exposure, kHeight));
   const HeadMapCorrections none = MakeHeadMapCorrections(plain);
   EXPECT_EQ(none.finest_step_px, 0);
   EXPECT_EQ(none.grids[0].step_px, 0);
@@ -154,7 +164,8 @@ calib::Rig SmallUav4Rig(bool distorted) {
   const auto scale = [](int& width, int& height, double& pixel_mm) {
     width /= 10, height /= 10, pixel_mm *= 10;
   };
-  scale(rig.virtual_camera.width_px, rig.virtual_camera.height_px, rig.virtual_camera.pixel_size_mm);
+  scale(
+      rig.virtual_camera.width_px, rig.virtual_camera.height_px, rig.virtual_camera.pixel_size_mm);
   for (auto& head : rig.heads) {
     scale(head.camera.width_px, head.camera.height_px, head.camera.pixel_size_mm);
     if (distorted) head.camera.interior[calib::BrownFraser10Model::kK1] = 2e-5;
@@ -187,8 +198,8 @@ TEST(RigConvert, TiltedHeadsCoverExactlyTheVirtualPixelsTheySee) {
       covered.emplace_back(RasterInfo{width, height, 1, 8});
       ResampleOptions options;
       options.fill = 0.0;
-      ResampleVirtualImage(one, {&white}, &covered.back(), options,
-                           std::vector<MapCorrectionGrid>{grids.grids[k]});
+      ResampleVirtualImage(
+          one, {&white}, &covered.back(), options, std::vector<MapCorrectionGrid>{grids.grids[k]});
     }
     long b_and_d = 0;
     for (int k = 0; k < 4; ++k) {
@@ -250,8 +261,8 @@ TEST(RigConvert, TiltedHeadsSampleTheExactHeadPixelInEveryStrip) {
         std::array<MemoryRaster, 2> out{MemoryRaster({width, height, 1, 16}),
                                         MemoryRaster({width, height, 1, 16})};
         for (int a = 0; a < 2; ++a)
-          ResampleVirtualImage(one, {&ramp[a]}, &out[a], options,
-                               std::vector<MapCorrectionGrid>{grids.grids[k]});
+          ResampleVirtualImage(
+              one, {&ramp[a]}, &out[a], options, std::vector<MapCorrectionGrid>{grids.grids[k]});
         long checked = 0, wrong = 0;
         double worst = 0.0;
         for (int r = 0; r < height; ++r)
@@ -278,8 +289,9 @@ TEST(RigConvert, TiltedHeadsSampleTheExactHeadPixelInEveryStrip) {
 // exact): the homography of the level plane plus the DEM grids reproduce the tilted plane's exact
 // conversion; and the reader names the line of a bad DEM.
 std::string TiltedDem(const testing::TempDir& dir) {
-  std::string text = "ncols 61\nnrows 51\nxllcorner -152.5\nyllcorner -127.5\ncellsize 5\n"
-                     "NODATA_value -9999\n";
+  std::string text =
+      "ncols 61\nnrows 51\nxllcorner -152.5\nyllcorner -127.5\ncellsize 5\n"
+      "NODATA_value -9999\n";
   for (int r = 50; r >= 0; --r) {  // north row first
     for (int c = 0; c <= 60; ++c) {
       const double x = -150.0 + 5.0 * c, y = -125.0 + 5.0 * r;
@@ -321,11 +333,14 @@ TEST(RigConvert, DemOfATiltedPlaneIsThatPlane) {
     const char* text;
     const char* expected;
   } bad_dems[] = {
-      {"bad.asc", "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize -1\n1 2 3\n4 5 6\n",
+      {"bad.asc",
+       "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize -1\n1 2 3\n4 5 6\n",
        "bad.asc:5: cellsize must be > 0"},
-      {"short.asc", "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 x 6\n",
+      {"short.asc",
+       "ncols 3\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 3\n4 x 6\n",
        "short.asc:7: expected 3 heights, got 1"},
-      {"huge.asc", "ncols 1000000\nnrows 1000000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n",
+      {"huge.asc",
+       "ncols 1000000\nnrows 1000000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n",
        "huge.asc:2: ncols x nrows = 1e+12 heights"},
   };
   for (const auto& bad : bad_dems) {
@@ -381,7 +396,9 @@ struct Comparison {
 };
 
 // Compares the converted image with the truth over pixels 3 px inside the coverage.
-Comparison Compare(const MemoryRaster& back, const MemoryRaster& truth, const RigConverter& converter) {
+Comparison Compare(const MemoryRaster& back,
+                   const MemoryRaster& truth,
+                   const RigConverter& converter) {
   Comparison out;
   const RasterInfo info = truth.Info();
   for (int r = 3; r < info.height - 3; ++r)
@@ -403,9 +420,12 @@ Comparison Compare(const MemoryRaster& back, const MemoryRaster& truth, const Ri
       const Eigen::Vector2d g(0.5 * (truth.At(c + 1, r) - truth.At(c - 1, r)),
                               0.5 * (truth.At(c, r + 1) - truth.At(c, r - 1)));
       if (edge) out.edge.Add(d, g);
-      if (inside[0] && inside[1]) out.overlap.Add(d, g);
-      else if (inside[0]) out.only_a.Add(d, g);
-      else out.only_b.Add(d, g);
+      if (inside[0] && inside[1])
+        out.overlap.Add(d, g);
+      else if (inside[0])
+        out.only_a.Add(d, g);
+      else
+        out.only_b.Add(d, g);
     }
   return out;
 }
@@ -435,8 +455,13 @@ TEST(RigConvert, RealPhotographThroughATwoHeadRigAndBack) {
                                      {"overlap", &cmp.overlap},
                                      {"edges", &cmp.edge}}) {
     const Eigen::Vector2d shift = region->Shift();
-    std::printf("%-8s %7ld px: RMS %.3f DN, mean %.3f DN, shift (%.4f, %.4f) px\n", name, region->n,
-                region->Rms(), region->Mean(), shift.x(), shift.y());
+    std::printf("%-8s %7ld px: RMS %.3f DN, mean %.3f DN, shift (%.4f, %.4f) px\n",
+                name,
+                region->n,
+                region->Rms(),
+                region->Mean(),
+                shift.x(),
+                shift.y());
     ASSERT_GT(region->n, 5000) << name;
     // Where the plane is exact the geometry is right to < 0.1 px (expected ~0.01: interpolation).
     EXPECT_LT(shift.norm(), 0.1) << name;
@@ -458,7 +483,8 @@ TEST(RigConvert, RealPhotographThroughATwoHeadRigAndBack) {
   MemoryRaster off({width, height, 1, 8});
   ConvertRigExposure(wrong, sources, &off, {});
   const Comparison bad = Compare(off, truth, converter);
-  std::printf("at 105 m: A only shift %.4f px, B only shift %.4f px\n", bad.only_a.Shift().norm(),
+  std::printf("at 105 m: A only shift %.4f px, B only shift %.4f px\n",
+              bad.only_a.Shift().norm(),
               bad.only_b.Shift().norm());
   EXPECT_LT(bad.only_a.Shift().norm(), 0.1);
   EXPECT_NEAR(bad.only_b.Shift().norm(), 0.238, 0.06);
@@ -487,8 +513,12 @@ TEST(RigConvert, RealPhotographThroughDistortedHeadsAndBack) {
                                      {"B only", &cmp.only_b},
                                      {"overlap", &cmp.overlap}}) {
     const Eigen::Vector2d shift = region->Shift();
-    std::printf("distorted %-8s %7ld px: RMS %.3f DN, shift (%.4f, %.4f) px\n", name, region->n,
-                region->Rms(), shift.x(), shift.y());
+    std::printf("distorted %-8s %7ld px: RMS %.3f DN, shift (%.4f, %.4f) px\n",
+                name,
+                region->n,
+                region->Rms(),
+                shift.x(),
+                shift.y());
     ASSERT_GT(region->n, 5000) << name;
     EXPECT_LT(shift.norm(), 0.1) << name;
   }
@@ -497,7 +527,8 @@ TEST(RigConvert, RealPhotographThroughDistortedHeadsAndBack) {
   MemoryRaster plain({width, height, 1, 8});
   ResampleVirtualImage(RigExposureAsSubimageCamera(converter), sources, &plain, {});
   const Comparison bad = Compare(plain, truth, converter);
-  std::printf("without grids: A only RMS %.3f DN, B only RMS %.3f DN\n", bad.only_a.Rms(),
+  std::printf("without grids: A only RMS %.3f DN, B only RMS %.3f DN\n",
+              bad.only_a.Rms(),
               bad.only_b.Rms());
   EXPECT_GT(bad.only_a.Rms(), 1.5 * cmp.only_a.Rms());
   EXPECT_GT(bad.only_b.Rms(), 1.5 * cmp.only_b.Rms());
@@ -557,8 +588,8 @@ TEST(RigConvertCommand, WritesTheVirtualTiffAndRefusesBadInput) {
   EXPECT_NE(run.output.find("--tile-px must be 0 (strips) or a multiple of 16"), std::string::npos)
       << run.output;
   // Refusals: exit 2, nothing written.
-  run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + " --images A=" +
-                            tmp.File("A.tif") + " --out " + tmp.File("v2.tif"));
+  run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") +
+                            " --images A=" + tmp.File("A.tif") + " --out " + tmp.File("v2.tif"));
   EXPECT_EQ(run.exit_code, 2);
   EXPECT_NE(run.output.find("no image for head B"), std::string::npos) << run.output;
   run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + images +
@@ -576,9 +607,9 @@ TEST(RigConvertCommand, WritesTheVirtualTiffAndRefusesBadInput) {
     writer.WriteRows(0, bent[k].Info().height, bent[k].bytes().data());
     writer.Commit();
   }
-  run = testing::RunAerocal("rig convert --camera " + tmp.File("distorted.yaml") + " --images A=" +
-                            tmp.File("dA.tif") + ",B=" + tmp.File("dB.tif") + " --out " +
-                            tmp.File("dv.tif"));
+  run = testing::RunAerocal("rig convert --camera " + tmp.File("distorted.yaml") +
+                            " --images A=" + tmp.File("dA.tif") + ",B=" + tmp.File("dB.tif") +
+                            " --out " + tmp.File("dv.tif"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("heads with distortion: correction grids down to"), std::string::npos)
       << run.output;
@@ -589,7 +620,8 @@ TEST(RigConvertCommand, WritesTheVirtualTiffAndRefusesBadInput) {
   run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + images + " --dem " +
                             tmp.File("flat.asc") + " --out " + tmp.File("dem.tif"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("DEM surface: correction grids down to 64 px"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("DEM surface: correction grids down to 64 px"), std::string::npos)
+      << run.output;
   const auto on_dem = OpenTiff(tmp.File("dem.tif"));
   const auto on_plane = OpenTiff(tmp.File("virtual.tif"));
   std::vector<std::uint8_t> a(1600), b(1600);
@@ -604,12 +636,12 @@ TEST(RigConvertCommand, WritesTheVirtualTiffAndRefusesBadInput) {
   run = testing::RunAerocal("rig convert --camera " + tmp.File("rig.yaml") + images + " --dem " +
                             tmp.File("broken.asc") + " --out " + tmp.File("dem2.tif"));
   EXPECT_EQ(run.exit_code, 2);
-  EXPECT_NE(run.output.find("broken.asc:5: missing header 'yllcorner'"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("broken.asc:5: missing header 'yllcorner'"), std::string::npos)
+      << run.output;
   EXPECT_FALSE(std::filesystem::exists(tmp.File("dem2.tif")));
   const auto bent_back = OpenTiff(tmp.File("dv.tif"));
   bent_back->ReadWindow(0, 620, 1600, 1, row.data());
-  for (const int col : {300, 820, 1300})
-    EXPECT_NEAR(row[col], truth.At(col, 620), 2.0) << col;
+  for (const int col : {300, 820, 1300}) EXPECT_NEAR(row[col], truth.At(col, 620), 2.0) << col;
 }
 
 }  // namespace

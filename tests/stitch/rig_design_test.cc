@@ -1,14 +1,15 @@
 // Design figures of a rig (stitch/rig/rig_design.h) on the four-head uav4 example of configs/:
 // GSD change ratios against the closed form of the tilted head, the coverage of one nadir head
 // against its format, the overlap zones and the twelve standard tie positions.
-#include <cmath>
-#include <set>
-
-#include <gtest/gtest.h>
+#include "stitch/rig/rig_design.h"
 
 #include "calib/camera/rig_io.h"
 #include "stitch/rig/rig_conversion.h"
-#include "stitch/rig/rig_design.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <set>
 
 namespace aerocal::stitch {
 namespace {
@@ -19,7 +20,9 @@ TEST(RigDesign, GsdRatiosOfTheTiltedHeadsAgreeWithTheClosedForm) {
   const RigDesign d = DesignRig(Uav4(), 300.0, 100);
   ASSERT_EQ(d.heads.size(), 4u);
   // Hand figures: at the principal point of a head tilted 24 deg, 1 / cos^2 24 and 1 / cos 24.
-  EXPECT_NEAR(ClosedFormGsdRatio(24 * M_PI / 180, 0).x(), 1.0 / std::pow(std::cos(24 * M_PI / 180), 2), 1e-15);
+  EXPECT_NEAR(ClosedFormGsdRatio(24 * M_PI / 180, 0).x(),
+              1.0 / std::pow(std::cos(24 * M_PI / 180), 2),
+              1e-15);
   EXPECT_NEAR(ClosedFormGsdRatio(24 * M_PI / 180, 0).x(), 1.198229, 1e-6);
   EXPECT_NEAR(ClosedFormGsdRatio(37 * M_PI / 180, 0).y(), 1.252136, 1e-6);
   constexpr double kTolerance = 0.005;  // the 0.5 %
@@ -32,11 +35,13 @@ TEST(RigDesign, GsdRatiosOfTheTiltedHeadsAgreeWithTheClosedForm) {
       if (!s.on_tilt_line) continue;
       ++compared;
       for (int axis = 0; axis < 2; ++axis)
-        EXPECT_NEAR(s.ratio[axis] / s.closed_form[axis], 1.0, kTolerance) << head.id << " " << s.where;
+        EXPECT_NEAR(s.ratio[axis] / s.closed_form[axis], 1.0, kTolerance)
+            << head.id << " " << s.where;
     }
     // The principal point and the two edge midpoints along the tilt lie on the principal line.
     EXPECT_TRUE(head.samples[0].on_tilt_line);
-    EXPECT_NEAR(head.samples[0].ratio.x(), ClosedFormGsdRatio(head.tilt_deg * M_PI / 180, 0).x(), 1e-6);
+    EXPECT_NEAR(
+        head.samples[0].ratio.x(), ClosedFormGsdRatio(head.tilt_deg * M_PI / 180, 0).x(), 1e-6);
   }
   EXPECT_EQ(compared, 12);
 }
@@ -71,8 +76,8 @@ TEST(RigDesign, Uav4HasFiveTwoFoldZonesTwoTripleZonesAndTwelveStandardPositions)
   }
   EXPECT_EQ(zones, (std::set<std::string>{"AB", "AC", "AD", "BC", "CD", "ABC", "ACD"}));
   ASSERT_EQ(d.standard_positions.size(), 12u);
-  const std::vector<std::string> names = {"AB-1", "AB-2", "AC-1", "AC-2", "AD-1", "AD-2",
-                                          "BC-1", "BC-2", "CD-1", "CD-2", "ABC",  "ACD"};
+  const std::vector<std::string> names = {
+      "AB-1", "AB-2", "AC-1", "AC-2", "AD-1", "AD-2", "BC-1", "BC-2", "CD-1", "CD-2", "ABC", "ACD"};
   const RigExposure nadir;
   const RigConverter converter(rig, nadir, MakeRectificationPlane(rig, nadir, 300.0));
   for (size_t i = 0; i < names.size(); ++i) {

@@ -2,14 +2,14 @@
 // hand (10" at c = 150 mm, the principal points of the two heads with opposite signs, lever arm
 // and height parallaxes), exactness (zero limits give exactly zero), Monte-Carlo against linear
 // propagation, the grouped worst cases and the grid.
-#include <cmath>
-
-#include <gtest/gtest.h>
-
 #include "calib/camera/rig_io.h"
 #include "stitch/rig/error_analysis.h"
 #include "stitch/rig/error_analysis_json.h"
 #include "stitch/rig/rig_conversion.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
@@ -48,14 +48,25 @@ TEST(RigErrorAnalysis, LimitsFileAndSources) {
   const auto sources = MakeErrorSources(ExampleRig(), limits);
   std::vector<std::string> names;
   for (const auto& s : sources) names.push_back(s.name);
-  EXPECT_EQ(names, (std::vector<std::string>{"x0:A", "y0:A", "c:A", "x0:B", "y0:B", "c:B",
-                                             "omega:B", "phi:B", "kappa:B", "tx:B", "ty:B", "tz:B",
-                                             "height"}));
-  EXPECT_DOUBLE_EQ(sources[0].limit, 0.5 * kPixel);   // mm
-  EXPECT_DOUBLE_EQ(sources[2].limit, 1.0 * kPixel);   // mm
-  EXPECT_DOUBLE_EQ(sources[6].limit, 10 * kArcsec);   // rad
-  EXPECT_DOUBLE_EQ(sources[9].limit, 1e-3);           // m
-  EXPECT_DOUBLE_EQ(sources[12].limit, 150.0);         // m
+  EXPECT_EQ(names,
+            (std::vector<std::string>{"x0:A",
+                                      "y0:A",
+                                      "c:A",
+                                      "x0:B",
+                                      "y0:B",
+                                      "c:B",
+                                      "omega:B",
+                                      "phi:B",
+                                      "kappa:B",
+                                      "tx:B",
+                                      "ty:B",
+                                      "tz:B",
+                                      "height"}));
+  EXPECT_DOUBLE_EQ(sources[0].limit, 0.5 * kPixel);  // mm
+  EXPECT_DOUBLE_EQ(sources[2].limit, 1.0 * kPixel);  // mm
+  EXPECT_DOUBLE_EQ(sources[6].limit, 10 * kArcsec);  // rad
+  EXPECT_DOUBLE_EQ(sources[9].limit, 1e-3);          // m
+  EXPECT_DOUBLE_EQ(sources[12].limit, 150.0);        // m
   EXPECT_NEAR(NormalBound99_75(), 3.0233, 1e-4);
 }
 
@@ -66,8 +77,8 @@ TEST(RigErrorAnalysis, LimitsFileAndSources) {
 // c 0.15 m (1/H - 1/(H + dH)) / p.
 TEST(RigErrorAnalysis, ExampleCameraPhysicsByHand) {
   const calib::Rig rig = ExampleRig();
-  const ConversionErrorModel model(rig, kHeight, MakeErrorSources(rig, ExampleLimits()), 1,
-                                   VirtualOfB(rig, {5499.5, 4499.5}));
+  const ConversionErrorModel model(
+      rig, kHeight, MakeErrorSources(rig, ExampleLimits()), 1, VirtualOfB(rig, {5499.5, 4499.5}));
   EXPECT_LT((model.head_px() - Eigen::Vector2d(5499.5, 4499.5)).norm(), 1e-8);
   const auto rows = MaximumErrors(model);
   const double rotation_px = kC * std::tan(10 * kArcsec) / kPixel;
@@ -87,7 +98,9 @@ TEST(RigErrorAnalysis, ExampleCameraPhysicsByHand) {
   EXPECT_NEAR(Row(rows, "y0:A").plus_px.y(), -0.5, 0.005);
   for (const char* axis : {"x0", "y0"}) {
     const int i = axis[0] == 'x' ? 0 : 1;
-    EXPECT_LT(Row(rows, std::string(axis) + ":A").plus_px[i] * Row(rows, std::string(axis) + ":B").plus_px[i], 0)
+    EXPECT_LT(Row(rows, std::string(axis) + ":A").plus_px[i] *
+                  Row(rows, std::string(axis) + ":B").plus_px[i],
+              0)
         << axis << ": opposite signs";
   }
   // Principal distance: at the principal point a scale change moves nothing (B); A's changes the
@@ -120,13 +133,14 @@ TEST(RigErrorAnalysis, ZeroLimitsGiveExactlyZero) {
   for (const auto& w : analysis.worst_cases) EXPECT_EQ(w.max_radial_px, 0.0) << w.group;
   EXPECT_EQ(analysis.linear.sigma_px, Eigen::Vector2d::Zero());
   EXPECT_EQ(analysis.linear.bound_radial_px, 0.0);
-  for (const auto& share : analysis.linear.share_x) EXPECT_FALSE(share.has_value()) << "null, never 0";
+  for (const auto& share : analysis.linear.share_x)
+    EXPECT_FALSE(share.has_value()) << "null, never 0";
   ASSERT_TRUE(analysis.monte_carlo.has_value());
   EXPECT_EQ(analysis.monte_carlo->max_radial_px, 0.0);
   EXPECT_EQ(analysis.monte_carlo->sigma_px, Eigen::Vector2d::Zero());
   // A deviation of zero in a model with real limits is also exactly zero.
-  const ConversionErrorModel model(rig, kHeight, MakeErrorSources(rig, ExampleLimits()), 1,
-                                   VirtualOfB(rig, {100.0, 9000.0}));
+  const ConversionErrorModel model(
+      rig, kHeight, MakeErrorSources(rig, ExampleLimits()), 1, VirtualOfB(rig, {100.0, 9000.0}));
   EXPECT_EQ(*model.Error(Eigen::VectorXd::Zero(13)), Eigen::Vector2d::Zero());
 }
 
@@ -178,13 +192,18 @@ TEST(RigErrorAnalysis, MonteCarloAgreesWithLinearPropagation) {
 
 TEST(RigErrorAnalysis, GroupedWorstCases) {
   const calib::Rig rig = ExampleRig();
-  const TargetAnalysis a = AnalyseTarget(rig, kHeight, ExampleLimits(), 1,
-                                         VirtualOfB(rig, {5499.5, 4499.5}), 0, 1, false);
+  const TargetAnalysis a = AnalyseTarget(
+      rig, kHeight, ExampleLimits(), 1, VirtualOfB(rig, {5499.5, 4499.5}), 0, 1, false);
   EXPECT_FALSE(a.monte_carlo.has_value());
   std::map<std::string, const WorstCase*> by_group;
   for (const auto& w : a.worst_cases) by_group[w.group] = &w;
-  for (const char* g : {"interior:A", "interior:B", "angles:B", "lever_arm:B",
-                        "relative_orientation:B", "height", "all"})
+  for (const char* g : {"interior:A",
+                        "interior:B",
+                        "angles:B",
+                        "lever_arm:B",
+                        "relative_orientation:B",
+                        "height",
+                        "all"})
     ASSERT_TRUE(by_group.count(g)) << g;
   // omega and phi at their limits together: sqrt(2) x 1.212 px.
   const double rotation_px = kC * std::tan(10 * kArcsec) / kPixel;

@@ -1,19 +1,20 @@
-// `aerocal simulate --rig uav4 --render-images --texture PHOTO` (rendered head images, issue 16) and
-// `aerocal rig stitch --images DIR --stitched-out DIR` (the stitched level image of every exposure,
-// issue 16 item 6) on a small line (formats x 0.2): the files, the formats, the tiled TIFF, the
-// valid-area mask and the JSON figures (radiometry per head, overlap disagreement per head pair).
-#include <filesystem>
-#include <fstream>
-#include <map>
-#include <string>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
+// `aerocal simulate --rig uav4 --render-images --texture PHOTO` (rendered head images, issue 16)
+// and `aerocal rig stitch --images DIR --stitched-out DIR` (the stitched level image of every
+// exposure, issue 16 item 6) on a small line (formats x 0.2): the files, the formats, the tiled
+// TIFF, the valid-area mask and the JSON figures (radiometry per head, overlap disagreement per
+// head pair).
 #include "stitch/image_io/image_io.h"
 #include "stitch/resample/tiff_raster.h"
 #include "tests/support/bad_input_case.h"
 #include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <string>
 
 namespace aerocal::stitch {
 namespace {
@@ -29,9 +30,13 @@ TEST(RigImagesCommand, RendersTheHeadsAndStitchesEveryExposure) {
   if (data.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
   TempDir tmp("aerocal_rig_images");
   const std::string sim = tmp.File("sim");
-  const auto s = RunAerocal("simulate --rig uav4 --exposures 2 --format-scale 0.2 --seed 3 --render-images "
-                            "--texture " + data + "/images/img_4880.jpg --texture-gsd-m 0.25 "
-                            "--grey-noise-dn 1 --out " + sim);
+  const auto s = RunAerocal(
+      "simulate --rig uav4 --exposures 2 --format-scale 0.2 --seed 3 --render-images "
+      "--texture " +
+      data +
+      "/images/img_4880.jpg --texture-gsd-m 0.25 "
+      "--grey-noise-dn 1 --out " +
+      sim);
   ASSERT_EQ(s.exit_code, 0) << s.output;
   EXPECT_NE(s.output.find("rendered 8 head images"), std::string::npos) << s.output;
   // Head formats x 0.2: A and C portrait 582 x 874, B and D landscape 874 x 582.
@@ -80,16 +85,18 @@ TEST(RigImagesCommand, RendersTheHeadsAndStitchesEveryExposure) {
     for (const std::string& folder : {tmp.path(), out})
       for (const auto& e : fs::directory_iterator(folder))
         if (e.is_regular_file() || e.is_directory())
-          files[e.path().string()] = e.is_regular_file() ? testing::ReadFileText(e.path().string()) : "(folder)";
+          files[e.path().string()] =
+              e.is_regular_file() ? testing::ReadFileText(e.path().string()) : "(folder)";
     return files;
   };
   const auto before = snapshot();
   const std::string bad_images = tmp.File("images_bad");
   fs::copy(sim + "/images", bad_images);
   testing::WriteFileText(bad_images + "/0002_D.tif", "not a TIFF\n");
-  const auto failed = RunAerocal("rig stitch --camera " + sim + "/rig_truth.yaml --project " + sim +
-                                 " --standard-radius-px 80 --images " + bad_images + " --stitched-out " + out +
-                                 " --tile-px 0 --out " + tmp.File("r.json"));
+  const auto failed =
+      RunAerocal("rig stitch --camera " + sim + "/rig_truth.yaml --project " + sim +
+                 " --standard-radius-px 80 --images " + bad_images + " --stitched-out " + out +
+                 " --tile-px 0 --out " + tmp.File("r.json"));
   EXPECT_EQ(failed.exit_code, 2) << failed.output;
   EXPECT_NE(failed.output.find("0002_D.tif"), std::string::npos) << failed.output;
   fs::remove_all(bad_images);
@@ -97,10 +104,10 @@ TEST(RigImagesCommand, RendersTheHeadsAndStitchesEveryExposure) {
 
   // Strips, BigTIFF forced, no balance (every gain 1, offset 0), a short ramp.
   const std::string out2 = tmp.File("stitched2");
-  const auto r2 = RunAerocal("rig stitch --camera " + sim + "/rig_truth.yaml --project " + sim +
-                             " --standard-radius-px 80 --images " + sim + "/images --stitched-out " +
-                             out2 + " --tile-px 0 --bigtiff --no-balance --feather-px 8 --out " +
-                             tmp.File("r2.json"));
+  const auto r2 =
+      RunAerocal("rig stitch --camera " + sim + "/rig_truth.yaml --project " + sim +
+                 " --standard-radius-px 80 --images " + sim + "/images --stitched-out " + out2 +
+                 " --tile-px 0 --bigtiff --no-balance --feather-px 8 --out " + tmp.File("r2.json"));
   ASSERT_EQ(r2.exit_code, 0) << r2.output;
   const json doc2 = ReadJson(tmp.File("r2.json"));
   ASSERT_EQ(doc2["stitched_images"].size(), 2u);
@@ -130,11 +137,12 @@ TEST(RigImagesCommand, RendersTheHeadsAndStitchesEveryExposure) {
     }
   }
   const auto m = RunAerocal("rig stitch --camera " + sim + "/rig_truth.yaml --project " + bare +
-                            " --standard-radius-px 80 --images " + sim + "/images --match-ties --out " +
-                            tmp.File("m.json"));
+                            " --standard-radius-px 80 --images " + sim +
+                            "/images --match-ties --out " + tmp.File("m.json"));
   ASSERT_EQ(m.exit_code, 0) << m.output;
   EXPECT_NE(m.output.find("matched 0001 zone AB:"), std::string::npos) << m.output;
-  EXPECT_NE(m.output.find("the increments' sigmas are scaled by sigma0"), std::string::npos) << m.output;
+  EXPECT_NE(m.output.find("the increments' sigmas are scaled by sigma0"), std::string::npos)
+      << m.output;
   const json matched = ReadJson(tmp.File("m.json"));
   ASSERT_TRUE(matched.contains("tie_matching"));
   EXPECT_EQ(matched["tie_matching"]["prefilter_sigma_px"].get<double>(), 1.5);
@@ -142,7 +150,8 @@ TEST(RigImagesCommand, RendersTheHeadsAndStitchesEveryExposure) {
   EXPECT_GT(matched["tie_matching"]["lsm_sigma_rms_px"].get<double>(), 0.028);
   EXPECT_LT(matched["tie_matching"]["lsm_sigma_rms_px"].get<double>(), 0.2);
   std::map<std::string, int> ties;
-  for (const json& z : matched["tie_matching"]["zones"]) ties[z["zone"].get<std::string>()] += z["ties"].get<int>();
+  for (const json& z : matched["tie_matching"]["zones"])
+    ties[z["zone"].get<std::string>()] += z["ties"].get<int>();
   for (const char* zone : {"AB", "AC", "AD", "BC", "CD"}) EXPECT_GE(ties[zone], 4) << zone;
   EXPECT_EQ(ties.count("BD"), 0u);
   const json& rms = matched["stitching_rms_px"];

@@ -4,13 +4,13 @@
 // estimates around the truth over N seeded lines of 8 exposures (issue 16: N >= 20, within 25 %),
 // the share within 3 sigma, and the after-fit stitching RMS against the pair metric's noise floor.
 // N = AEROCAL_RIG_LINES (default 40). No snooping: the question is the sigmas, not the rejections.
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include "tests/stitch/rig_stitch_line.h"
 
 #include <gtest/gtest.h>
 
-#include "tests/stitch/rig_stitch_line.h"
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace aerocal::stitch {
 namespace {
@@ -31,8 +31,8 @@ TEST(RigSelfCalibrationStudy, SigmasAgreeWithTheSpreadOverSimulatedLines) {
     const testing::RigStitchInputs in = testing::InputsFromFlight(f);
     RigStitchOptions options;
     options.snooping = false;
-    const RigStitchResult r = SelfCalibrateRigStitching(f.truth, in.exposures, in.ties,
-                                                        in.observations, in.positions, options);
+    const RigStitchResult r = SelfCalibrateRigStitching(
+        f.truth, in.exposures, in.ties, in.observations, in.positions, options);
     ASSERT_TRUE(r.failures.empty()) << seed << ": " << r.failures.front();
     sigma0_sum += r.sigma0;
     for (int i = 0; i < kExposures; ++i)
@@ -62,25 +62,40 @@ TEST(RigSelfCalibrationStudy, SigmasAgreeWithTheSpreadOverSimulatedLines) {
   constexpr double kTolerance = 0.25;  // the issue's bound
   const char* angles[] = {"domega", "dphi", "dkappa"};
   const char* heads[] = {"A", "B", "C", "D"};
-  std::printf("%d lines of %d exposures (seeds 1001..%d), sigma0 mean %.4f\n", lines, kExposures,
-              1000 + lines, sigma0_sum / lines);
+  std::printf("%d lines of %d exposures (seeds 1001..%d), sigma0 mean %.4f\n",
+              lines,
+              kExposures,
+              1000 + lines,
+              sigma0_sum / lines);
   for (int k = 1; k < kHeads; ++k) {
     for (int a = 0; a < 3; ++a) {
       const double spread = std::sqrt(error2[k][a] / n_angle);
       const double sigma = std::sqrt(sigma2[k][a] / n_angle);
-      std::printf("head %s %-6s  spread %.5f deg  reported sigma %.5f deg  ratio %.3f\n", heads[k],
-                  angles[a], spread * 180 / M_PI, sigma * 180 / M_PI, spread / sigma);
+      std::printf("head %s %-6s  spread %.5f deg  reported sigma %.5f deg  ratio %.3f\n",
+                  heads[k],
+                  angles[a],
+                  spread * 180 / M_PI,
+                  sigma * 180 / M_PI,
+                  spread / sigma);
       EXPECT_NEAR(spread / sigma, 1.0, kTolerance) << heads[k] << " " << angles[a];
     }
     const double spread = std::sqrt(dt_error2[k] / lines);
     const double sigma = std::sqrt(dt_sigma2[k] / lines);
     std::printf("head %s dT      spread %.3f ms     reported sigma %.3f ms     ratio %.3f\n",
-                heads[k], spread * 1e3, sigma * 1e3, spread / sigma);
+                heads[k],
+                spread * 1e3,
+                sigma * 1e3,
+                spread / sigma);
     EXPECT_NEAR(spread / sigma, 1.0, kTolerance) << heads[k] << " dT";
   }
-  std::printf("%d of %d estimates within 3 sigma; after-fit RMS %.4f px per coordinate, noise "
-              "floor of the pair metric %.4f px (ratio %.3f)\n",
-              within, total, after_sum / lines, floor_sum / lines, after_sum / floor_sum);
+  std::printf(
+      "%d of %d estimates within 3 sigma; after-fit RMS %.4f px per coordinate, noise "
+      "floor of the pair metric %.4f px (ratio %.3f)\n",
+      within,
+      total,
+      after_sum / lines,
+      floor_sum / lines,
+      after_sum / floor_sum);
   EXPECT_GE(within, static_cast<int>(std::floor(0.98 * total)));
   EXPECT_NEAR(after_sum / floor_sum, 1.0, 0.05);
 }

@@ -2,14 +2,14 @@
 // uav4 simulator: noise-free recovery, noisy recovery within 3 sigma, the before/after RMS of the
 // paper's kind and its noise floor (why 1.55 x the tie noise), sigmas against the spread over seeds
 // (pooled), the dT-rotation correlation of the per-exposure mode, a planted wrong tie.
-#include <algorithm>
-#include <cmath>
-#include <map>
+#include "stitch/rig/self_calibration.h"
+#include "tests/stitch/rig_stitch_line.h"
 
 #include <gtest/gtest.h>
 
-#include "stitch/rig/self_calibration.h"
-#include "tests/stitch/rig_stitch_line.h"
+#include <algorithm>
+#include <cmath>
+#include <map>
 
 namespace aerocal::stitch {
 namespace {
@@ -23,9 +23,11 @@ RigFlightSimulationOptions Line(std::uint64_t seed, int exposures) {
   return testing::Uav4Line(seed, exposures);
 }
 
-RigStitchResult Stitch(const SimulatedRigFlight& f, const Inputs& in, RigStitchOptions options = {}) {
-  return SelfCalibrateRigStitching(f.truth, in.exposures, in.ties, in.observations, in.positions,
-                                   options);
+RigStitchResult Stitch(const SimulatedRigFlight& f,
+                       const Inputs& in,
+                       RigStitchOptions options = {}) {
+  return SelfCalibrateRigStitching(
+      f.truth, in.exposures, in.ties, in.observations, in.positions, options);
 }
 
 TEST(RigSelfCalibration, NoiseFreeFlatTerrainExactPosRecoversTheIncrements) {
@@ -35,7 +37,7 @@ TEST(RigSelfCalibration, NoiseFreeFlatTerrainExactPosRecoversTheIncrements) {
   o.flight.gnss_sigma_m = 1e-9;
   o.flight.imu_sigma_deg = 1e-12;
   SimulatedRigFlight f = triangulation::SimulateRigFlight(o);
-  f.exposures_file = f.exposures_truth;  // exact POS
+  f.exposures_file = f.exposures_truth;                                  // exact POS
   for (auto& e : f.exposures_file) e.z_ref_m = o.flight.terrain_base_m;  // the flat terrain
   const Inputs in = InputsFromFlight(f);
   RigStitchOptions options;
@@ -88,17 +90,22 @@ TEST(RigSelfCalibration, NoisyLineWithinThreeSigmaAndThePapersBeforeAfter) {
   EXPECT_LT(r.after.check.per_coordinate, 2.5 * 0.3);
   EXPECT_NEAR(r.after.fit.pair_2d / r.after.fit.per_coordinate, std::sqrt(2.0), 1e-12);
   std::printf("before %.3f / %.3f px, after %.3f / %.3f px (fit / check, per coordinate)\n",
-              r.before.fit.per_coordinate, r.before.check.per_coordinate, r.after.fit.per_coordinate,
+              r.before.fit.per_coordinate,
+              r.before.check.per_coordinate,
+              r.after.fit.per_coordinate,
               r.after.check.per_coordinate);
   // Why "after" is ~1.55 x the 0.3 px tie noise, not the paper's ~1.3 x: the metric. A pair
   // compares TWO measured rays (sqrt 2) carried into the level virtual image, where a tilted
   // head's pixel covers more than one virtual pixel. The noise alone, propagated, predicts the
   // after figure; the true increments give the same floor (relief and POS noise add little).
   const testing::PairMetricFloor floor = testing::PairFloor(f, in);
-  std::printf("pair metric floor: noise prediction %.3f px (mean scale %.3f virtual px per head "
-              "px), true parameters %.3f px; after / prediction %.3f\n",
-              floor.noise_prediction, floor.mean_scale, floor.truth_parameters,
-              r.after.fit.per_coordinate / floor.noise_prediction);
+  std::printf(
+      "pair metric floor: noise prediction %.3f px (mean scale %.3f virtual px per head "
+      "px), true parameters %.3f px; after / prediction %.3f\n",
+      floor.noise_prediction,
+      floor.mean_scale,
+      floor.truth_parameters,
+      r.after.fit.per_coordinate / floor.noise_prediction);
   constexpr double kFloorTolerance = 0.10;  // the fit absorbs ~1 % (9 of ~1400 dof per exposure),
                                             // relief and POS noise add a few %
   EXPECT_NEAR(r.after.fit.per_coordinate / floor.noise_prediction, 1.0, kFloorTolerance);

@@ -4,15 +4,15 @@
 // benchmark.
 #pragma once
 
-#include <cmath>
-#include <map>
-#include <string>
-#include <vector>
-
 #include "stitch/rig/rig_conversion.h"
 #include "stitch/rig/rig_design.h"
 #include "stitch/rig/self_calibration.h"
 #include "triangulation/simulation/rig_flight_simulator.h"
+
+#include <cmath>
+#include <map>
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch::testing {
 
@@ -60,8 +60,12 @@ inline RigStitchInputs InputsFromFlight(const triangulation::SimulatedRigFlight&
     in.ties.push_back({p.id, p.role == triangulation::PointRole::kCheck});
   }
   for (const auto& o : f.observations)
-    in.observations.push_back({exposure.at(o.image), f.truth.HeadIndex(o.head), tie.at(o.point),
-                               o.pixel, o.sigma_px, o.image + "/" + o.head + "/" + o.point});
+    in.observations.push_back({exposure.at(o.image),
+                               f.truth.HeadIndex(o.head),
+                               tie.at(o.point),
+                               o.pixel,
+                               o.sigma_px,
+                               o.image + "/" + o.head + "/" + o.point});
   return in;
 }
 
@@ -90,7 +94,8 @@ inline PairMetricFloor PairFloor(const triangulation::SimulatedRigFlight& f,
       pose.increment_rad.push_back(f.rig_exposures[i * n_heads + k].increment_rad);
       pose.dt_s.push_back(f.rig_exposures[i * n_heads + k].dt_s);
     }
-    const RigConverter converter(f.truth, pose, {Eigen::Vector3d::UnitZ(), in.exposures[i].z_ref_m});
+    const RigConverter converter(
+        f.truth, pose, {Eigen::Vector3d::UnitZ(), in.exposures[i].z_ref_m});
     for (auto it = ties.lower_bound({i, -1}); it != ties.end() && it->first.first == i; ++it) {
       std::vector<Eigen::Vector2d> v;
       std::vector<double> j2;  // sigma^2 |J|_F^2 per ray

@@ -1,5 +1,5 @@
-// Rendered head images of the four-head rig (`simulate --rig uav4 --render-images`, issue 16) and the
-// horizontal stitched image of an exposure (stitch/rig/stitched_image.h, issue 16 item 6):
+// Rendered head images of the four-head rig (`simulate --rig uav4 --render-images`, issue 16) and
+// the horizontal stitched image of an exposure (stitch/rig/stitched_image.h, issue 16 item 6):
 // - every rendered pixel shows the ground point its TRUE head ray meets (ground calibration,
 //   increments and shutter offsets with the velocity), checked against the stitch module's own
 //   converter on flat terrain (point sampling), and the default renderer integrates the texture
@@ -12,24 +12,24 @@
 //   the increments self-calibrated from them within their sigmas.
 // The scene: the uav4 line at 0.2 x its formats (same geometry, 582 x 874 px heads), textured
 // with a real photograph (../shared/data/odm_boruszyn_kap_frames).
+#include "stitch/resample/raster.h"
+#include "stitch/rig/rig_conversion.h"
+#include "stitch/rig/rig_tie_matching.h"
+#include "stitch/rig/self_calibration.h"
+#include "stitch/rig/stitched_image.h"
+#include "tests/stitch/rig_stitch_line.h"
+#include "tests/support/test_support.h"
+#include "triangulation/simulation/rig_flight_simulator.h"
+
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
 #include <map>
+#include <memory>
 #include <optional>
 #include <utility>
-#include <memory>
-
-#include <gtest/gtest.h>
-
-#include "stitch/resample/raster.h"
-#include "stitch/rig/rig_conversion.h"
-#include "stitch/rig/self_calibration.h"
-#include "stitch/rig/stitched_image.h"
-#include "stitch/rig/rig_tie_matching.h"
-#include "tests/stitch/rig_stitch_line.h"
-#include "tests/support/test_support.h"
-#include "triangulation/simulation/rig_flight_simulator.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -66,7 +66,8 @@ RigExposure Pose(const SimulatedRigFlight& f, int exposure, bool with_truth) {
   pose.velocity_mps = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
   if (with_truth)
     for (size_t k = 0; k < f.truth.heads.size(); ++k) {
-      pose.increment_rad.push_back(f.rig_exposures[exposure * f.truth.heads.size() + k].increment_rad);
+      pose.increment_rad.push_back(
+          f.rig_exposures[exposure * f.truth.heads.size() + k].increment_rad);
       pose.dt_s.push_back(f.rig_exposures[exposure * f.truth.heads.size() + k].dt_s);
     }
   return pose;
@@ -79,8 +80,11 @@ MemoryRaster AsRaster(const GrayImage& image, double gain = 1.0, double offset =
   return raster;
 }
 
-StitchedImageReport Stitch(const SimulatedRigFlight& f, const RigExposure& pose, double z_ref_m,
-                           std::vector<MemoryRaster>& heads, MemoryRaster* image = nullptr) {
+StitchedImageReport Stitch(const SimulatedRigFlight& f,
+                           const RigExposure& pose,
+                           double z_ref_m,
+                           std::vector<MemoryRaster>& heads,
+                           MemoryRaster* image = nullptr) {
   const RigConverter converter(f.truth, pose, {Eigen::Vector3d::UnitZ(), z_ref_m});
   std::vector<RasterSource*> sources;
   for (auto& h : heads) sources.push_back(&h);
@@ -122,8 +126,8 @@ TEST(RigHeadImages, EveryPixelShowsTheGroundItsTrueRayMeets) {
         const auto g0 = without.PlanePointOfHeadPixel(k, Eigen::Vector2d(c, r));
         ASSERT_TRUE(g && g0);
         worst = std::max(worst, double(std::abs(image(r, c) - ground.At(g->x(), g->y()))));
-        worst_ground_only =
-            std::max(worst_ground_only, double(std::abs(image(r, c) - ground.At(g0->x(), g0->y()))));
+        worst_ground_only = std::max(worst_ground_only,
+                                     double(std::abs(image(r, c) - ground.At(g0->x(), g0->y()))));
       }
     // float grey values; the two ray intersections agree to ~1e-9 m
     EXPECT_LT(worst, 1e-3) << f.truth.heads[k].id;
@@ -162,8 +166,10 @@ TEST(RigHeadImages, EveryPixelIntegratesTheGroundOverItsFootprint) {
         double sum = 0;
         for (int j = 0; j < kReference; ++j)
           for (int i = 0; i < kReference; ++i) {
-            const auto g = converter.PlanePointOfHeadPixel(
-                k, Eigen::Vector2d(c - 0.5 + (i + 0.5) / kReference, r - 0.5 + (j + 0.5) / kReference));
+            const auto g =
+                converter.PlanePointOfHeadPixel(k,
+                                                Eigen::Vector2d(c - 0.5 + (i + 0.5) / kReference,
+                                                                r - 0.5 + (j + 0.5) / kReference));
             ASSERT_TRUE(g);
             sum += ground.At(g->x(), g->y());
           }
@@ -173,8 +179,13 @@ TEST(RigHeadImages, EveryPixelIntegratesTheGroundOverItsFootprint) {
         ++n;
       }
     const double area_rms = std::sqrt(area2 / n), centre_rms = std::sqrt(centre2 / n);
-    std::printf("head %s: %d pixels, against the 12 x 12 footprint mean: area integration RMS %.3f DN, "
-                "point sampling RMS %.3f DN\n", f.truth.heads[k].id.c_str(), n, area_rms, centre_rms);
+    std::printf(
+        "head %s: %d pixels, against the 12 x 12 footprint mean: area integration RMS %.3f DN, "
+        "point sampling RMS %.3f DN\n",
+        f.truth.heads[k].id.c_str(),
+        n,
+        area_rms,
+        centre_rms);
     EXPECT_GT(n, 120);
     EXPECT_LT(area_rms, 0.25 * centre_rms) << f.truth.heads[k].id;
   }
@@ -188,8 +199,8 @@ TEST(RigStitchedImage, SeamlessWithTheRefinedIncrementsAndBalancesAPlantedGain) 
   in.positions = DesignRig(f.nominal, f.options.flight.flying_height_m, 200).standard_positions;
   RigStitchOptions options;
   options.standard_radius_px *= kScale;
-  const RigStitchResult result = SelfCalibrateRigStitching(f.truth, in.exposures, in.ties,
-                                                           in.observations, in.positions, options);
+  const RigStitchResult result = SelfCalibrateRigStitching(
+      f.truth, in.exposures, in.ties, in.observations, in.positions, options);
   ASSERT_TRUE(result.failures.empty()) << result.failures.front();
 
   triangulation::RigImageOptions render;
@@ -217,13 +228,19 @@ TEST(RigStitchedImage, SeamlessWithTheRefinedIncrementsAndBalancesAPlantedGain) 
   for (const auto& z : with_refined.zones) EXPECT_GT(z.pixels, 1000) << z.zone;
   const double floor = with_truth.overall.rms_dn, after = with_refined.overall.rms_dn,
                before = ground_only.overall.rms_dn;
-  std::printf("overlap disagreement (RMS DN, head against head before blending): true parameters "
-              "%.3f, refined %.3f, ground calibration alone %.3f\n",
-              floor, after, before);
+  std::printf(
+      "overlap disagreement (RMS DN, head against head before blending): true parameters "
+      "%.3f, refined %.3f, ground calibration alone %.3f\n",
+      floor,
+      after,
+      before);
   for (size_t z = 0; z < with_refined.zones.size(); ++z)
     std::printf("  %s: %ld px, truth %.3f, refined %.3f, ground %.3f DN\n",
-                with_refined.zones[z].zone.c_str(), with_refined.zones[z].pixels,
-                with_truth.zones[z].rms_dn, with_refined.zones[z].rms_dn, ground_only.zones[z].rms_dn);
+                with_refined.zones[z].zone.c_str(),
+                with_refined.zones[z].pixels,
+                with_truth.zones[z].rms_dn,
+                with_refined.zones[z].rms_dn,
+                ground_only.zones[z].rms_dn);
   // The floor: 1 DN noise of two interpolated heads, 8-bit rounding and the interpolation of a
   // texture finer than the oblique heads' pixels. A misregistration adds its part in quadrature:
   // sqrt(d^2 - floor^2). The refined geometry's part at most a quarter of the ground
@@ -232,7 +249,8 @@ TEST(RigStitchedImage, SeamlessWithTheRefinedIncrementsAndBalancesAPlantedGain) 
   const double refined_part = std::sqrt(std::max(0.0, after * after - floor * floor));
   const double ground_part = std::sqrt(std::max(0.0, before * before - floor * floor));
   std::printf("misregistration's part in quadrature: refined %.3f DN, ground calibration %.3f DN\n",
-              refined_part, ground_part);
+              refined_part,
+              ground_part);
   EXPECT_LT(refined_part, 0.25 * ground_part);
   EXPECT_GT(before, 1.5 * after);
   for (const auto& h : with_refined.heads) {  // equal radiometry: gain 1, offset 0
@@ -249,7 +267,6 @@ TEST(RigStitchedImage, SeamlessWithTheRefinedIncrementsAndBalancesAPlantedGain) 
   EXPECT_NEAR(planted.overall.rms_dn, after, 0.02 * after);
 }
 
-
 // Errors of matched ties against the truth (issue 16 item 2 diagnosis): per matched observation
 // of a non-first head, the position LSM found minus the true position of the ground point the
 // first head's pixel sees (flat terrain: the first head's raw pixel through its TRUE pose onto
@@ -262,14 +279,16 @@ struct MatchedTieErrors {
   double rms_error_px = 0, rms_lsm_sigma_px = 0, rms_z = 0;
 };
 
-MatchedTieErrors MatchAndMeasure(const SimulatedRigFlight& f, const testing::RigStitchInputs& in,
+MatchedTieErrors MatchAndMeasure(const SimulatedRigFlight& f,
+                                 const testing::RigStitchInputs& in,
                                  const triangulation::RigImageOptions& render,
                                  const RigTieMatchOptions& match_options = {}) {
   MatchedTieErrors out;
   const triangulation::TexturedGround ground = triangulation::MakeRigGroundTexture(f, render);
   for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i) {
     std::vector<GrayImage> heads;
-    for (int k = 0; k < 4; ++k) heads.push_back(triangulation::RenderRigHeadImage(f, ground, render, i, k));
+    for (int k = 0; k < 4; ++k)
+      heads.push_back(triangulation::RenderRigHeadImage(f, ground, render, i, k));
     MatchRigExposureTies(f.truth, in.exposures[i], i, heads, match_options, &out.matches);
   }
   const RectificationPlane terrain{Eigen::Vector3d::UnitZ(), f.options.flight.terrain_base_m};
@@ -279,8 +298,10 @@ MatchedTieErrors MatchAndMeasure(const SimulatedRigFlight& f, const testing::Rig
     t.rig_opk_rad = f.exposures_truth[i].opk_rad;
     t.rig_center_m = f.exposures_truth[i].center_m;
     truth.emplace_back(f.truth, t, terrain);
-    ground_calibration.emplace_back(f.truth, Pose(f, i, false),
-                                    RectificationPlane{Eigen::Vector3d::UnitZ(), in.exposures[i].z_ref_m});
+    ground_calibration.emplace_back(
+        f.truth,
+        Pose(f, i, false),
+        RectificationPlane{Eigen::Vector3d::UnitZ(), in.exposures[i].z_ref_m});
   }
   const auto& obs = out.matches.observations;
   const double nan = std::numeric_limits<double>::quiet_NaN();
@@ -314,7 +335,11 @@ MatchedTieErrors MatchAndMeasure(const SimulatedRigFlight& f, const testing::Rig
 // Per zone and head (both exposures): count, mean error (the systematic part) and spread per
 // coordinate, the RMS LSM sigma; and the whole set.
 void PrintTieErrors(const char* title, const MatchedTieErrors& m, const calib::Rig& rig) {
-  struct Sums { int n = 0; Eigen::Vector2d sum = Eigen::Vector2d::Zero(), sum2 = Eigen::Vector2d::Zero(); double s2 = 0; };
+  struct Sums {
+    int n = 0;
+    Eigen::Vector2d sum = Eigen::Vector2d::Zero(), sum2 = Eigen::Vector2d::Zero();
+    double s2 = 0;
+  };
   std::map<std::string, Sums> per;
   const auto& obs = m.matches.observations;
   for (size_t o = 0; o < obs.size(); ++o) {
@@ -327,14 +352,25 @@ void PrintTieErrors(const char* title, const MatchedTieErrors& m, const calib::R
     s.sum2 += m.error_px[o].cwiseAbs2();
     s.s2 += std::pow(m.matches.lsm_sigma_px[obs[o].tie], 2);
   }
-  std::printf("%s: %zu ties; matched minus true position (virtual px): RMS per coordinate %.4f, "
-              "RMS LSM sigma %.4f, RMS z %.2f\n", title, m.matches.ties.size(), m.rms_error_px,
-              m.rms_lsm_sigma_px, m.rms_z);
+  std::printf(
+      "%s: %zu ties; matched minus true position (virtual px): RMS per coordinate %.4f, "
+      "RMS LSM sigma %.4f, RMS z %.2f\n",
+      title,
+      m.matches.ties.size(),
+      m.rms_error_px,
+      m.rms_lsm_sigma_px,
+      m.rms_z);
   for (const auto& [key, s] : per) {
     const Eigen::Vector2d mean = s.sum / s.n;
     const Eigen::Vector2d spread = (s.sum2 / s.n - mean.cwiseAbs2()).cwiseMax(0).cwiseSqrt();
     std::printf("  %-6s n %3d  mean (%+.4f, %+.4f)  spread (%.4f, %.4f)  LSM sigma %.4f px\n",
-                key.c_str(), s.n, mean.x(), mean.y(), spread.x(), spread.y(), std::sqrt(s.s2 / s.n));
+                key.c_str(),
+                s.n,
+                mean.x(),
+                mean.y(),
+                spread.x(),
+                spread.y(),
+                std::sqrt(s.s2 / s.n));
   }
 }
 
@@ -347,13 +383,14 @@ struct IncrementCheck {
   int beyond_3_sigma = 0;
 };
 
-IncrementCheck SelfCalibrateOnMatches(const SimulatedRigFlight& f, const testing::RigStitchInputs& in,
+IncrementCheck SelfCalibrateOnMatches(const SimulatedRigFlight& f,
+                                      const testing::RigStitchInputs& in,
                                       const RigTieMatches& matches) {
   IncrementCheck out;
   RigStitchOptions options;
   options.standard_radius_px *= kScale;
-  out.result = SelfCalibrateRigStitching(f.truth, in.exposures, matches.ties, matches.observations,
-                                         in.positions, options);
+  out.result = SelfCalibrateRigStitching(
+      f.truth, in.exposures, matches.ties, matches.observations, in.positions, options);
   double error2 = 0, truth2 = 0;
   for (int i = 0; i < static_cast<int>(in.exposures.size()); ++i)
     for (const auto& h : out.result.exposures[i].heads) {
@@ -385,8 +422,8 @@ TEST(RigTieMatching, DISABLED_DiagnosisMatchedTieErrors) {
   testing::RigStitchInputs in = testing::InputsFromFlight(f);
   in.positions = DesignRig(f.nominal, f.options.flight.flying_height_m, 200).standard_positions;
   for (double gsd : {1.0, 0.25})
-    for (const auto& [point, prefilter] : {std::pair<bool, double>{true, 0.0}, {false, 0.0}, {false, 1.0},
-                                           {false, 1.5}}) {
+    for (const auto& [point, prefilter] :
+         {std::pair<bool, double>{true, 0.0}, {false, 0.0}, {false, 1.0}, {false, 1.5}}) {
       triangulation::RigImageOptions render;
       render.texture_path = Photo();
       render.grey_noise_dn = 1.0;
@@ -395,15 +432,26 @@ TEST(RigTieMatching, DISABLED_DiagnosisMatchedTieErrors) {
       RigTieMatchOptions match;
       match.prefilter_sigma_px = prefilter;
       char title[160];
-      std::snprintf(title, sizeof title, "%s, texels %.2f m, 1 DN noise, prefilter %.1f px",
-                    point ? "point sampling" : "area integration", gsd, prefilter);
+      std::snprintf(title,
+                    sizeof title,
+                    "%s, texels %.2f m, 1 DN noise, prefilter %.1f px",
+                    point ? "point sampling" : "area integration",
+                    gsd,
+                    prefilter);
       const MatchedTieErrors m = MatchAndMeasure(f, in, render, match);
       PrintTieErrors(title, m, f.truth);
       const IncrementCheck c = SelfCalibrateOnMatches(f, in, m.matches);
-      std::printf("  -> sigma0 %.3f, %zu rejected, fit RMS %.4f -> %.4f px; increments RMS error %.3g rad, "
-                  "sum z^2 %.1f (18 angles), max |z| %.2f, %d beyond 3 sigma\n",
-                  c.result.sigma0, c.result.rejected.size(), c.result.before.fit.per_coordinate,
-                  c.result.after.fit.per_coordinate, c.rms_error_rad, c.sum_z2, c.max_abs_z, c.beyond_3_sigma);
+      std::printf(
+          "  -> sigma0 %.3f, %zu rejected, fit RMS %.4f -> %.4f px; increments RMS error %.3g rad, "
+          "sum z^2 %.1f (18 angles), max |z| %.2f, %d beyond 3 sigma\n",
+          c.result.sigma0,
+          c.result.rejected.size(),
+          c.result.before.fit.per_coordinate,
+          c.result.after.fit.per_coordinate,
+          c.rms_error_rad,
+          c.sum_z2,
+          c.max_abs_z,
+          c.beyond_3_sigma);
     }
 }
 
@@ -429,8 +477,14 @@ TEST(RigTieMatching, MatchedTiesGiveIncrementsWithinTheirSigmas) {
   const MatchedTieErrors m = MatchAndMeasure(f, in, render);
   std::map<std::string, int> ties_per_zone;
   for (const auto& z : m.matches.zones) {
-    std::printf("  %s %s: %ld px, %d cells, LSM %d tried %d failed, %d ties\n", z.image.c_str(),
-                z.zone.c_str(), z.pixels, z.cells, z.lsm_tried, z.lsm_failed, z.ties);
+    std::printf("  %s %s: %ld px, %d cells, LSM %d tried %d failed, %d ties\n",
+                z.image.c_str(),
+                z.zone.c_str(),
+                z.pixels,
+                z.cells,
+                z.lsm_tried,
+                z.lsm_failed,
+                z.ties);
     ties_per_zone[z.zone] += z.ties;
   }
   // AC is small (the corners between A and C beyond B and D's footprints)
@@ -444,7 +498,8 @@ TEST(RigTieMatching, MatchedTiesGiveIncrementsWithinTheirSigmas) {
     if (!std::isfinite(m.error_px[o].x())) continue;
     const RigStitchObservation& obs = m.matches.observations[o];
     const std::string& id = m.matches.ties[obs.tie].id;
-    auto& [n, sum] = mean[id.substr(id.find('/') + 1, id.find('-') - id.find('/') - 1) + f.truth.heads[obs.head].id];
+    auto& [n, sum] = mean[id.substr(id.find('/') + 1, id.find('-') - id.find('/') - 1) +
+                          f.truth.heads[obs.head].id];
     if (n == 0) sum.setZero();
     ++n;
     sum += m.error_px[o];
@@ -457,13 +512,19 @@ TEST(RigTieMatching, MatchedTiesGiveIncrementsWithinTheirSigmas) {
 
   const IncrementCheck c = SelfCalibrateOnMatches(f, in, m.matches);
   ASSERT_TRUE(c.result.failures.empty()) << c.result.failures.front();
-  std::printf("matched: %zu ties, %zu observations, LSM sigma RMS %.4f px; sigma0 %.3f, fit "
-              "stitching RMS per coordinate %.4f -> %.4f px, %zu rejected\n",
-              m.matches.ties.size(), m.matches.observations.size(), m.rms_lsm_sigma_px,
-              c.result.sigma0, c.result.before.fit.per_coordinate, c.result.after.fit.per_coordinate,
-              c.result.rejected.size());
+  std::printf(
+      "matched: %zu ties, %zu observations, LSM sigma RMS %.4f px; sigma0 %.3f, fit "
+      "stitching RMS per coordinate %.4f -> %.4f px, %zu rejected\n",
+      m.matches.ties.size(),
+      m.matches.observations.size(),
+      m.rms_lsm_sigma_px,
+      c.result.sigma0,
+      c.result.before.fit.per_coordinate,
+      c.result.after.fit.per_coordinate,
+      c.result.rejected.size());
   std::printf("increments: RMS(estimate - truth) %.3g rad, RMS(truth) %.3g rad; z-scores:",
-              c.rms_error_rad, c.rms_truth_rad);
+              c.rms_error_rad,
+              c.rms_truth_rad);
   for (double z : c.z) std::printf(" %.2f", z);
   std::printf("; sum z^2 %.1f\n", c.sum_z2);
   ASSERT_EQ(c.z.size(), 18u);

@@ -5,14 +5,14 @@
 // the tangential directions round the circle, mean_t sinc(f cos t) sinc(f sin t), falls to 0.1.
 #include "stitch/quality/siemens_star.h"
 
-#include <cmath>
-#include <cstdio>
-#include <random>
+#include "calib/core/error.h"
+#include "tests/support/rendered_targets.h"
 
 #include <gtest/gtest.h>
 
-#include "calib/core/error.h"
-#include "tests/support/rendered_targets.h"
+#include <cmath>
+#include <cstdio>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -27,7 +27,8 @@ GrayImage RenderStar(const Eigen::Vector2d& centre, double phase, double s, std:
   std::normal_distribution<double> noise(0.0, 1.0);
   for (int r = 0; r < kSize; ++r)
     for (int c = 0; c < kSize; ++c)
-      image(r, c) = static_cast<float>(std::clamp(std::round(image(r, c) + noise(*rng)), 0.0, 255.0));
+      image(r, c) =
+          static_cast<float>(std::clamp(std::round(image(r, c) + noise(*rng)), 0.0, 255.0));
   return image;
 }
 
@@ -44,15 +45,24 @@ TEST(SiemensStar, LimitingFrequencyWithinOneStepOfTheAnalyticOne) {
     star.cycles = kCycles;
     star.outer_radius_px = kOuter;
     const SiemensStarResult r = MeasureSiemensStar(image, star);
-    const double truth = testing::FirstCrossing([&](double f) { return AnalyticTransfer(f, s); }, 0.1);
+    const double truth =
+        testing::FirstCrossing([&](double f) { return AnalyticTransfer(f, s); }, 0.1);
     const double steps = std::log(r.limiting_frequency_cy_px / truth) / std::log(r.step_ratio);
-    std::printf("s %.1f px: limit %.4f cycles/px, analytic %.4f (%+.2f steps), M0 %.4f, %zu rings\n", s,
-                r.limiting_frequency_cy_px, truth, steps, r.reference_modulation, r.rings.size());
+    std::printf(
+        "s %.1f px: limit %.4f cycles/px, analytic %.4f (%+.2f steps), M0 %.4f, %zu rings\n",
+        s,
+        r.limiting_frequency_cy_px,
+        truth,
+        steps,
+        r.reference_modulation,
+        r.rings.size());
     EXPECT_TRUE(r.limit_in_range);
     EXPECT_LE(std::abs(steps), 1.0) << "s " << s;
     EXPECT_NEAR(r.reference_modulation, (kBright - kDark) / (kBright + kDark), 0.01);
     // The outermost ring passes the star unchanged: transfer 1 within the noise.
-    EXPECT_NEAR(r.rings.front().contrast_transfer, AnalyticTransfer(r.rings.front().frequency_cy_px, s), 0.02);
+    EXPECT_NEAR(r.rings.front().contrast_transfer,
+                AnalyticTransfer(r.rings.front().frequency_cy_px, s),
+                0.02);
   }
 }
 
@@ -70,7 +80,8 @@ TEST(SiemensStar, RefusesAStarOutsideTheImageOrWithTooNarrowSectors) {
   std::mt19937_64 rng(3622);
   const GrayImage image = RenderStar({209.5, 209.5}, 0.0, 1.0, &rng);
   EXPECT_THROW(MeasureSiemensStar(image, {{209.5, 209.5}, kCycles, 215.0, 0.0}), InputError);
-  EXPECT_THROW(MeasureSiemensStar(image, {{209.5, 209.5}, kCycles, 60.0, 0.0}), InputError);  // 7.9 px/sector
+  EXPECT_THROW(MeasureSiemensStar(image, {{209.5, 209.5}, kCycles, 60.0, 0.0}),
+               InputError);  // 7.9 px/sector
   EXPECT_THROW(MeasureSiemensStar(image, {{209.5, 209.5}, 2, 150.0, 0.0}), InputError);
   GrayImage flat = GrayImage::Constant(kSize, kSize, 100.0f);
   EXPECT_THROW(MeasureSiemensStar(flat, {{209.5, 209.5}, kCycles, kOuter, 0.0}), InputError);

@@ -2,13 +2,13 @@
 // frames (stitch/layout, stitch/simulation), with fixed seeds.
 #pragma once
 
-#include <random>
-#include <string>
-#include <vector>
-
 #include "stitch/adjustment/frame_measurements.h"
 #include "stitch/layout/grid_layout.h"
 #include "stitch/simulation/stitch_simulator.h"
+
+#include <random>
+#include <string>
+#include <vector>
 
 namespace aerocal::stitch::testing {
 
@@ -17,9 +17,13 @@ struct SimulatedCamera {
   std::vector<std::string> base;
 };
 
-inline SimulatedCamera MakeSimulatedCamera(int rows, int cols, std::vector<std::string> base,
-                                           double shear, std::uint64_t seed,
-                                           calib::MappingModel nominal_model = calib::MappingModel::kAffine) {
+inline SimulatedCamera MakeSimulatedCamera(
+    int rows,
+    int cols,
+    std::vector<std::string> base,
+    double shear,
+    std::uint64_t seed,
+    calib::MappingModel nominal_model = calib::MappingModel::kAffine) {
   GridLayoutOptions layout;
   layout.rows = rows;
   layout.cols = cols;
@@ -37,10 +41,10 @@ inline SimulatedCamera MakeSimulatedCamera(int rows, int cols, std::vector<std::
 
 /// `n` frames "0001", "0002", ... of `truth`, grouped against the nominal camera.
 /// `noise_scale` multiplies the simulator's default noise (0.1 px ties, 0.05 px references);
-/// 0 gives noise-free frames (their v^T P v is the non-centrality of a model that misses the truth).
-inline std::vector<FrameMeasurements> SimulateFrames(const SimulatedCamera& camera, int n,
-                                                     int ties, std::uint64_t seed,
-                                                     double noise_scale = 1.0) {
+/// 0 gives noise-free frames (their v^T P v is the non-centrality of a model that misses the
+/// truth).
+inline std::vector<FrameMeasurements> SimulateFrames(
+    const SimulatedCamera& camera, int n, int ties, std::uint64_t seed, double noise_scale = 1.0) {
   FrameSimulationOptions options;
   options.ties_per_frame = ties;
   options.noise_px *= noise_scale;
@@ -57,7 +61,9 @@ inline std::vector<FrameMeasurements> SimulateFrames(const SimulatedCamera& came
 }
 
 /// Leaves only the first `keep` ties of `frame` that touch sub-image `id` (others untouched).
-inline void KeepTiesTouching(const calib::Camera& camera, const std::string& id, int keep,
+inline void KeepTiesTouching(const calib::Camera& camera,
+                             const std::string& id,
+                             int keep,
                              FrameMeasurements* frame) {
   const int sub = camera.SubimageIndex(id);
   std::vector<TieMeasurement> kept;

@@ -1,16 +1,16 @@
 // The slanted-edge MTF on images we did not make: a synthetic
-// edge rendered by another project's generator (point-sampled, Gaussian blur along the rows) against
-// its analytic MTF50, and a real satellite image of the Baotou edge target against the MTF50 that
-// project published for it.
+// edge rendered by another project's generator (point-sampled, Gaussian blur along the rows)
+// against its analytic MTF50, and a real satellite image of the Baotou edge target against the
+// MTF50 that project published for it.
+#include "stitch/image_io/image_io.h"
+#include "stitch/quality/slanted_edge.h"
+
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
-
-#include <gtest/gtest.h>
-
-#include "stitch/image_io/image_io.h"
-#include "stitch/quality/slanted_edge.h"
 
 namespace aerocal::stitch {
 namespace {
@@ -34,9 +34,13 @@ TEST(SlantedEdgeReal, ThirdPartySyntheticEdgeGivesItsAnalyticMtf50) {
   const double slant = 16.77655;
   const double sigma = 2.101313 / (2.0 * std::sqrt(2.0 * std::log(2.0))) * std::cos(slant * kDeg);
   const double truth = std::sqrt(std::log(2.0) / 2.0) / (3.14159265358979323846 * sigma);
-  std::printf("third-party edge: slant %.4f deg, MTF50 %.5f +- %.5f (k = 2), analytic %.5f (%+.2f %%)\n",
-              std::abs(r.angle_deg), r.mtf50_cy_px, r.mtf50_expanded_cy_px, truth,
-              100.0 * (r.mtf50_cy_px / truth - 1.0));
+  std::printf(
+      "third-party edge: slant %.4f deg, MTF50 %.5f +- %.5f (k = 2), analytic %.5f (%+.2f %%)\n",
+      std::abs(r.angle_deg),
+      r.mtf50_cy_px,
+      r.mtf50_expanded_cy_px,
+      truth,
+      100.0 * (r.mtf50_cy_px / truth - 1.0));
   EXPECT_NEAR(std::abs(r.angle_deg), slant, 0.02);
   EXPECT_LT(std::abs(r.mtf50_cy_px / truth - 1.0), 0.02);  // the acceptance bound of issue 36
   EXPECT_LE(std::abs(r.mtf50_cy_px - truth), r.mtf50_expanded_cy_px);
@@ -57,14 +61,20 @@ TEST(SlantedEdgeReal, BaotouSatelliteEdgeAgreesWithThePublishedMtf50) {
   double slant = 0.0;
   for (const auto& h : halves) {
     slant += std::abs(h.angle_deg) / halves.size();
-    std::printf("Baotou half: slant %.3f deg, MTF50 %.4f +- %.4f (k = 2) cycles/px along the normal\n",
-                std::abs(h.angle_deg), h.mtf50_cy_px, h.mtf50_expanded_cy_px);
+    std::printf(
+        "Baotou half: slant %.3f deg, MTF50 %.4f +- %.4f (k = 2) cycles/px along the normal\n",
+        std::abs(h.angle_deg),
+        h.mtf50_cy_px,
+        h.mtf50_expanded_cy_px);
   }
   const double along_rows = c.mtf50_cy_px * std::cos(slant * kDeg);
   const double u_along_rows = c.mtf50_expanded_cy_px * std::cos(slant * kDeg);
   constexpr double kPublished = 0.171712;
-  std::printf("Baotou: MTF50 %.4f +- %.4f (k = 2) along the rows, published %.4f (%+.2f %%)\n", along_rows,
-              u_along_rows, kPublished, 100.0 * (along_rows / kPublished - 1.0));
+  std::printf("Baotou: MTF50 %.4f +- %.4f (k = 2) along the rows, published %.4f (%+.2f %%)\n",
+              along_rows,
+              u_along_rows,
+              kPublished,
+              100.0 * (along_rows / kPublished - 1.0));
   // Both halves are one edge of one image: they agree within their U.
   EXPECT_LE(std::abs(halves[0].mtf50_cy_px - halves[1].mtf50_cy_px),
             std::hypot(halves[0].mtf50_expanded_cy_px, halves[1].mtf50_expanded_cy_px));

@@ -4,14 +4,14 @@
 // projection included: the e-SFR measures the system MTF, the pixel aperture is part of it).
 #include "stitch/quality/slanted_edge.h"
 
-#include <cmath>
-#include <cstdio>
-#include <random>
+#include "calib/core/error.h"
+#include "tests/support/rendered_targets.h"
 
 #include <gtest/gtest.h>
 
-#include "calib/core/error.h"
-#include "tests/support/rendered_targets.h"
+#include <cmath>
+#include <cstdio>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -49,7 +49,8 @@ void AddNoiseAndQuantise(GrayImage* image, double sigma, int bits, std::mt19937_
   std::normal_distribution<double> normal(0.0, sigma);
   const double max_dn = bits == 8 ? 255.0 : 65535.0;
   for (int i = 0; i < image->size(); ++i)
-    image->data()[i] = static_cast<float>(std::clamp(std::round(image->data()[i] + normal(*rng)), 0.0, max_dn));
+    image->data()[i] =
+        static_cast<float>(std::clamp(std::round(image->data()[i] + normal(*rng)), 0.0, max_dn));
 }
 
 const PixelRegion kWhole{0, 0, kSize, kSize};
@@ -65,15 +66,21 @@ TEST(SlantedEdge, Mtf50WithinTwoPercentOfTheAnalyticValueOnNoiseFreeEdges) {
       const double truth = AnalyticMtf50(s, slant * kDeg);
       const double error = r.mtf50_cy_px / truth - 1.0;
       worst = std::max(worst, std::abs(error));
-      std::printf("s %.2f slant %4.1f %s: MTF50 %.5f analytic %.5f error %+.3f %%  U %.3f %%\n", s, slant,
-                  e.horizontal ? "y" : "x", r.mtf50_cy_px, truth, 100.0 * error,
+      std::printf("s %.2f slant %4.1f %s: MTF50 %.5f analytic %.5f error %+.3f %%  U %.3f %%\n",
+                  s,
+                  slant,
+                  e.horizontal ? "y" : "x",
+                  r.mtf50_cy_px,
+                  truth,
+                  100.0 * error,
                   100.0 * r.mtf50_expanded_cy_px / truth);
       EXPECT_LT(std::abs(error), kMtf50RelativeTolerance) << "s " << s << " slant " << slant;
       EXPECT_EQ(r.axis, e.horizontal ? MtfAxis::kY : MtfAxis::kX);
       // The slant to the pixel axis, within 0.02 deg (the centroid line of 128 rows).
       EXPECT_NEAR(std::abs(r.angle_deg), slant, 0.02) << "s " << s;
       // The MTF at Nyquist within 0.01 of the analytic one.
-      EXPECT_NEAR(r.mtf_nyquist, RenderedEdgeMtf(0.5, s, slant * kDeg), 0.01) << "s " << s << " slant " << slant;
+      EXPECT_NEAR(r.mtf_nyquist, RenderedEdgeMtf(0.5, s, slant * kDeg), 0.01)
+          << "s " << s << " slant " << slant;
       EXPECT_NEAR(r.mtf.front(), 1.0, 1e-12);
     }
   }
@@ -98,9 +105,15 @@ TEST(SlantedEdge, Mtf50WithinTwoPercentOnNoisyEightAndSixteenBitImages) {
         const double truth = AnalyticMtf50(s, slant * kDeg);
         const double error = r.mtf50_cy_px / truth - 1.0;
         worst = std::max(worst, std::abs(error));
-        std::printf("%2d bit s %.2f slant %4.1f: MTF50 error %+.3f %%, U %.3f %%, noise %.2f DN\n", bits, s,
-                    slant, 100.0 * error, 100.0 * r.mtf50_expanded_cy_px / truth, r.noise_sigma);
-        EXPECT_LT(std::abs(error), kMtf50RelativeTolerance) << bits << " bit s " << s << " slant " << slant;
+        std::printf("%2d bit s %.2f slant %4.1f: MTF50 error %+.3f %%, U %.3f %%, noise %.2f DN\n",
+                    bits,
+                    s,
+                    slant,
+                    100.0 * error,
+                    100.0 * r.mtf50_expanded_cy_px / truth,
+                    r.noise_sigma);
+        EXPECT_LT(std::abs(error), kMtf50RelativeTolerance)
+            << bits << " bit s " << s << " slant " << slant;
         // The measured noise is the injected one (with the 1/sqrt(12) DN of rounding), within 15 %.
         EXPECT_NEAR(r.noise_sigma / std::hypot(noise, 1.0 / std::sqrt(12.0)), 1.0, 0.15);
       }
@@ -132,13 +145,24 @@ TEST(SlantedEdge, ExpandedUncertaintyCoversTheErrorInNinetyFivePercentOfSeededRe
     }
     const EdgeMtfCombination c = CombineEdgeMeasurements(repeats);
     if (std::abs(c.mtf50_cy_px - truth) <= c.mtf50_expanded_cy_px) ++groups_covered;
-    std::printf("group %2d s %.2f slant %.1f: mean error %+.3f %%, U %.3f %% (A %.3f %%, B %.3f %%)\n", g, s,
-                slant, 100.0 * (c.mtf50_cy_px / truth - 1.0), 100.0 * c.mtf50_expanded_cy_px / truth,
-                100.0 * c.type_a_u_cy_px / truth, 100.0 * c.type_b_u_cy_px / truth);
+    std::printf(
+        "group %2d s %.2f slant %.1f: mean error %+.3f %%, U %.3f %% (A %.3f %%, B %.3f %%)\n",
+        g,
+        s,
+        slant,
+        100.0 * (c.mtf50_cy_px / truth - 1.0),
+        100.0 * c.mtf50_expanded_cy_px / truth,
+        100.0 * c.type_a_u_cy_px / truth,
+        100.0 * c.type_b_u_cy_px / truth);
   }
   const int n = kGroups * kPerGroup;
-  std::printf("single edges covered %d of %d (%.1f %%), mean U %.3f %%; groups covered %d of %d\n", covered, n,
-              100.0 * covered / n, 100.0 * sum_relative_u / n, groups_covered, kGroups);
+  std::printf("single edges covered %d of %d (%.1f %%), mean U %.3f %%; groups covered %d of %d\n",
+              covered,
+              n,
+              100.0 * covered / n,
+              100.0 * sum_relative_u / n,
+              groups_covered,
+              kGroups);
   EXPECT_GE(covered, static_cast<int>(std::ceil(0.95 * n)));
   // Informative: the mean U below the 2 % acceptance bound itself.
   EXPECT_LT(sum_relative_u / n, kMtf50RelativeTolerance);
@@ -158,7 +182,8 @@ TEST(SlantedEdge, GammaOptionLinearisesAnEncodedImage) {
   options.gamma = 2.2;
   const double linearised = MeasureSlantedEdge(image, kWhole, options).mtf50_cy_px;
   const double raw = MeasureSlantedEdge(image, kWhole).mtf50_cy_px;
-  std::printf("encoded edge: MTF50 error %+.3f %% linearised, %+.3f %% as read\n", 100.0 * (linearised / truth - 1.0),
+  std::printf("encoded edge: MTF50 error %+.3f %% linearised, %+.3f %% as read\n",
+              100.0 * (linearised / truth - 1.0),
               100.0 * (raw / truth - 1.0));
   EXPECT_LT(std::abs(linearised / truth - 1.0), kMtf50RelativeTolerance);
   EXPECT_GT(std::abs(raw / truth - 1.0), 2.0 * kMtf50RelativeTolerance);

@@ -3,13 +3,13 @@
 // CCDs are misplaced by shifts, rotations, scales and an affine part (shear 2e-4).
 #include "stitch/adjustment/stitch_adjustment.h"
 
-#include <algorithm>
-#include <cmath>
+#include "calib/core/error.h"
+#include "tests/stitch/simulated_camera.h"
 
 #include <gtest/gtest.h>
 
-#include "calib/core/error.h"
-#include "tests/stitch/simulated_camera.h"
+#include <algorithm>
+#include <cmath>
 
 namespace aerocal::stitch {
 namespace {
@@ -24,9 +24,10 @@ std::vector<double> NormalizedErrors(const calib::Camera& truth, const FrameAdju
   for (const SubimageEstimate& e : a.subimages) {
     if (e.base) continue;
     const auto& t = truth.subimages[truth.SubimageIndex(e.id)];
-    const std::vector<double> true_params = calib::ParamsFromHomography(
-        e.model, calib::HomographyFromParams(t.model, t.params.data()));
-    for (size_t i = 0; i < e.params.size(); ++i) z.push_back((e.params[i] - true_params[i]) / e.sigma[i]);
+    const std::vector<double> true_params =
+        calib::ParamsFromHomography(e.model, calib::HomographyFromParams(t.model, t.params.data()));
+    for (size_t i = 0; i < e.params.size(); ++i)
+      z.push_back((e.params[i] - true_params[i]) / e.sigma[i]);
   }
   return z;
 }
@@ -54,7 +55,9 @@ TEST(AdjustFrame, RecoversTruthOverTwentyFramesWithRealisticSigmas) {
   }
   const double rms_z = std::sqrt(sum_z2 / n_z);
   std::printf("RMS of (estimate - truth) / sigma over %d parameters: %.3f, beyond 3 sigma: %d\n",
-              n_z, rms_z, beyond3);
+              n_z,
+              rms_z,
+              beyond3);
   // Acceptance: the reported sigmas agree with the actual spread within 25 % (pooled: its own
   // sampling error is 1/sqrt(2 n) ~ 3 %); at most 1 % beyond 3 sigma (expected 0.27 %).
   EXPECT_NEAR(rms_z, 1.0, 0.25);
@@ -110,16 +113,22 @@ TEST(AdjustFrame, FindsAndListsAPlantedGrossError) {
   const FrameAdjustment a = AdjustFrame(camera.nominal, frames[0], MappingModel::kAffine, options);
   bool found = false;
   for (const auto& r : a.rejected) {
-    std::printf("rejected %s in %s: w = %.1f, v = (%.2f, %.2f) px\n", r.point.c_str(),
-                r.subimage.c_str(), r.w, r.v_px.x(), r.v_px.y());
+    std::printf("rejected %s in %s: w = %.1f, v = (%.2f, %.2f) px\n",
+                r.point.c_str(),
+                r.subimage.c_str(),
+                r.w,
+                r.v_px.x(),
+                r.v_px.y());
     found = found || r.point == tie.point;
   }
-  EXPECT_TRUE(found) << "the 2 px error on " << tie.point << " (" << bad_subimage << ") was not listed";
+  EXPECT_TRUE(found) << "the 2 px error on " << tie.point << " (" << bad_subimage
+                     << ") was not listed";
   EXPECT_LE(a.rejected.size(), 3u);  // the family-wise false-alarm rate is 5 %
   EXPECT_NEAR(a.sigma0_px, kNoisePx, 0.1 * kNoisePx);
   // Rejected observations never appear among the residuals of the clean adjustment.
   ASSERT_FALSE(a.rejected.empty());
-  for (const auto& r : a.residuals) EXPECT_FALSE(r.point == tie.point && r.subimage == a.rejected[0].subimage);
+  for (const auto& r : a.residuals)
+    EXPECT_FALSE(r.point == tie.point && r.subimage == a.rejected[0].subimage);
 }
 
 TEST(AdjustFrame, RefusesAnUnderdeterminedModelNamingTheSubimage) {
@@ -148,24 +157,34 @@ TEST(AdjustFrame, RefusesSubimagesThatNoTieChainConnectsToTheDatum) {
   auto frames = testing::SimulateFrames(camera, 1, 600, 18);
   const int i = camera.nominal.SubimageIndex("I"), iv = camera.nominal.SubimageIndex("IV");
   auto& ties = frames[0].ties;
-  ties.erase(std::remove_if(ties.begin(), ties.end(),
+  ties.erase(std::remove_if(ties.begin(),
+                            ties.end(),
                             [&](const TieMeasurement& t) {
                               bool left = false, other = false;
-                              for (const auto& r : t.rays) (r.subimage == i || r.subimage == iv ? left : other) = true;
+                              for (const auto& r : t.rays)
+                                (r.subimage == i || r.subimage == iv ? left : other) = true;
                               return left && other;
                             }),
              ties.end());
   StitchOptions options;
   options.base_ids = camera.base;
-  const std::string refusal = FindUnderdetermined(camera.nominal, frames[0], MappingModel::kConformal, options);
+  const std::string refusal =
+      FindUnderdetermined(camera.nominal, frames[0], MappingModel::kConformal, options);
   EXPECT_NE(refusal.find("sub-image I"), std::string::npos) << refusal;
   EXPECT_NE(refusal.find("no chain of tie points"), std::string::npos) << refusal;
   EXPECT_THROW(AdjustFrame(camera.nominal, frames[0], MappingModel::kAffine, options), InputError);
   // With a reference point on I the island has its datum again.
-  frames[0].references.push_back({"R1", i, Eigen::Vector2d(10, 10),
-                                  camera.truth.subimages[i].VirtualFromSub(Eigen::Vector2d(10, 10)), 0.05});
-  frames[0].references.push_back({"R2", iv, Eigen::Vector2d(10, 3000),
-                                  camera.truth.subimages[iv].VirtualFromSub(Eigen::Vector2d(10, 3000)), 0.05});
+  frames[0].references.push_back({"R1",
+                                  i,
+                                  Eigen::Vector2d(10, 10),
+                                  camera.truth.subimages[i].VirtualFromSub(Eigen::Vector2d(10, 10)),
+                                  0.05});
+  frames[0].references.push_back(
+      {"R2",
+       iv,
+       Eigen::Vector2d(10, 3000),
+       camera.truth.subimages[iv].VirtualFromSub(Eigen::Vector2d(10, 3000)),
+       0.05});
   EXPECT_EQ(FindUnderdetermined(camera.nominal, frames[0], MappingModel::kConformal, options), "");
 }
 
@@ -196,9 +215,13 @@ TEST(AdjustFrame, PredictsCornerPrecisionOfATwelveCcdLayout) {
       }
     }
   }
-  std::printf("12 CCDs: sigma0_px %.4f, largest predicted corner sigma %.2f px, RMS predicted %.2f px, "
-              "RMS actual corner error %.2f px\n",
-              sigma0_px, max_predicted, std::sqrt(predicted2 / n), std::sqrt(actual2 / n));
+  std::printf(
+      "12 CCDs: sigma0_px %.4f, largest predicted corner sigma %.2f px, RMS predicted %.2f px, "
+      "RMS actual corner error %.2f px\n",
+      sigma0_px,
+      max_predicted,
+      std::sqrt(predicted2 / n),
+      std::sqrt(actual2 / n));
   // The small sigma0 hides corner uncertainties of px size; the prediction says so.
   EXPECT_NEAR(sigma0_px, kNoisePx, 0.1 * kNoisePx);
   EXPECT_GT(max_predicted, 1.0);

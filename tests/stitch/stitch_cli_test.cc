@@ -1,16 +1,16 @@
 // The 'aerocal stitch' and 'aerocal resample' commands on the example cameras in configs/:
 // exit codes, FORMATS.md result keys, refusal messages, the virtual TIFF and its metadata.
-#include <fstream>
-#include <random>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/result_file.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/simulation/stitch_simulator.h"
 #include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -28,8 +28,10 @@ const Example kExamples[] = {{"camera_2x3.yaml", "II,V", {"II", "V"}},
                              {"camera_3x3.yaml", "V", {"V"}}};
 
 // Writes `frames` simulated frames of a misplaced copy of `camera` to PATH; returns the truth.
-calib::Camera WriteFrames(const calib::Camera& camera, const std::vector<std::string>& base,
-                          int frames, const std::string& path) {
+calib::Camera WriteFrames(const calib::Camera& camera,
+                          const std::vector<std::string>& base,
+                          int frames,
+                          const std::string& path) {
   std::mt19937_64 rng(42);
   MisplacementOptions misplacement;
   misplacement.shear = 2e-4;
@@ -58,15 +60,25 @@ TEST(StitchCommand, AdjustsEveryExampleCameraWithTheFormatsKeys) {
                                 " --base " + example.base + " --out " + tmp.File("r.json"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
     const auto doc = ReadJson(tmp.File("r.json"));
-    for (const char* key : {"kind", "sigma0", "sigma0_px", "redundancy", "iterations", "converged",
-                            "model", "subimages", "residuals", "rejected", "model_choice",
+    for (const char* key : {"kind",
+                            "sigma0",
+                            "sigma0_px",
+                            "redundancy",
+                            "iterations",
+                            "converged",
+                            "model",
+                            "subimages",
+                            "residuals",
+                            "rejected",
+                            "model_choice",
                             "max_corner_sigma_px"})
       EXPECT_TRUE(doc.contains(key)) << key;
     EXPECT_EQ(doc["kind"], "stitch");
     EXPECT_NEAR(doc["sigma0_px"].get<double>(), 0.1, 0.015);
     EXPECT_EQ(doc["subimages"].size(), camera.subimages.size());
     for (const auto& s : doc["subimages"]) {
-      for (const char* key : {"id", "model", "params", "sigma", "corners"}) EXPECT_TRUE(s.contains(key)) << key;
+      for (const char* key : {"id", "model", "params", "sigma", "corners"})
+        EXPECT_TRUE(s.contains(key)) << key;
       EXPECT_EQ(s["params"].size(), s["sigma"].size());
       EXPECT_EQ(s["corners"].size(), 4u);
     }
@@ -88,7 +100,8 @@ TEST(StitchCommand, BatchWritesFramesAndStability) {
   EXPECT_TRUE(doc["stability"].contains("std_sigma0_px"));
   EXPECT_NEAR(doc["stability"]["mean_sigma0_px"].get<double>(), 0.1, 0.01);
   for (const auto& f : doc["frames"])
-    for (const char* key : {"frame", "sigma0", "sigma0_px", "redundancy", "iterations", "converged", "subimages"})
+    for (const char* key :
+         {"frame", "sigma0", "sigma0_px", "redundancy", "iterations", "converged", "subimages"})
       EXPECT_TRUE(f.contains(key)) << key;
 }
 
@@ -116,7 +129,8 @@ TEST(StitchCommand, RefusesBadInputWithExitTwoAndNothingWritten) {
     std::ofstream out(tmp.File("few.csv"));
     out << "frame,point,subimage,u,v\n";
     for (int i = 0; i < 2; ++i)
-      out << "1,t" << i << ",I,4700," << 100 + 1000 * i << "\n1,t" << i << ",II,100," << 100 + 1000 * i << "\n";
+      out << "1,t" << i << ",I,4700," << 100 + 1000 * i << "\n1,t" << i << ",II,100,"
+          << 100 + 1000 * i << "\n";
   }
   run = RunAerocal("stitch --camera " + camera_path + " --obs " + tmp.File("few.csv") +
                    " --base II,V --model affine --out " + tmp.File("r.json"));
@@ -144,8 +158,9 @@ subimages:
   std::ofstream(tmp.File("camera.yaml")) << yaml;
   const calib::Camera camera = calib::ReadCamera(tmp.File("camera.yaml"));
   // Stitch result: the nominal mappings, II shifted left by half a pixel.
-  nlohmann::json result = {
-      {"kind", "stitch"}, {"schema_version", aerocal::kResultSchemaVersion}, {"subimages", nlohmann::json::array()}};
+  nlohmann::json result = {{"kind", "stitch"},
+                           {"schema_version", aerocal::kResultSchemaVersion},
+                           {"subimages", nlohmann::json::array()}};
   for (const auto& s : camera.subimages) {
     std::vector<double> p = s.params;
     if (s.id == "II") p[2] -= 0.5;
@@ -180,11 +195,13 @@ subimages:
   EXPECT_EQ(v.At(390, 290), 4000);  // IV only
   EXPECT_EQ(v.At(399, 10), 7);      // II moved by -0.5 px: the last column is not covered
   const std::string description = ReadTiffDescription(tmp.File("v.tif"));
-  EXPECT_NE(description.find("II affine 210 160 1 0 189.5 0 1 0"), std::string::npos) << description;
+  EXPECT_NE(description.find("II affine 210 160 1 0 189.5 0 1 0"), std::string::npos)
+      << description;
   // In strips of 7 rows and as BigTIFF: the same pixels.
-  const auto strips = RunAerocal("resample --camera " + tmp.File("camera.yaml") + " --mapping " +
-                                 tmp.File("r.json") + " --images " + images + " --out " +
-                                 tmp.File("b.tif") + " --fill 7 --interp bicubic --strip-rows 7 --bigtiff");
+  const auto strips =
+      RunAerocal("resample --camera " + tmp.File("camera.yaml") + " --mapping " +
+                 tmp.File("r.json") + " --images " + images + " --out " + tmp.File("b.tif") +
+                 " --fill 7 --interp bicubic --strip-rows 7 --bigtiff");
   ASSERT_EQ(strips.exit_code, 0) << strips.output;
   EXPECT_TRUE(IsBigTiff(tmp.File("b.tif")));
   EXPECT_FALSE(IsBigTiff(tmp.File("v.tif")));

@@ -2,13 +2,13 @@
 // classic and BigTIFF, windowed reads across strips, metadata, atomic output.
 #include "stitch/resample/tiff_raster.h"
 
-#include <filesystem>
-#include <random>
+#include "calib/core/error.h"
+#include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
 
-#include "calib/core/error.h"
-#include "tests/support/test_support.h"
+#include <filesystem>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -77,7 +77,8 @@ TEST(TiffRaster, TiledRoundTripsEveryDepthBandCountAndBigTiff) {
         {
           TiffWriter writer(path, info, options);
           for (int y = 0; y < info.height; y += 37)  // row chunks that do not match the tiles
-            writer.WriteRows(y, std::min(37, info.height - y), raster.bytes().data() + y * info.RowBytes());
+            writer.WriteRows(
+                y, std::min(37, info.height - y), raster.bytes().data() + y * info.RowBytes());
           writer.Commit();
         }
         EXPECT_EQ(IsBigTiff(path), big);
@@ -121,9 +122,7 @@ TEST(TiffRaster, LeavesNothingBehindWithoutCommit) {
   EXPECT_FALSE(std::filesystem::exists(path + ".part"));
 }
 
-TEST(TiffRaster, RejectsAMissingFile) {
-  EXPECT_THROW(OpenTiff("/nonexistent/x.tif"), InputError);
-}
+TEST(TiffRaster, RejectsAMissingFile) { EXPECT_THROW(OpenTiff("/nonexistent/x.tif"), InputError); }
 
 }  // namespace
 }  // namespace aerocal::stitch

@@ -2,16 +2,16 @@
 // aerial photograph cut into misplaced sub-images and resampled back.
 #include "stitch/resample/virtual_image.h"
 
-#include <cmath>
-#include <random>
-
-#include <gtest/gtest.h>
-
 #include "stitch/layout/grid_layout.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/simulation/stitch_simulator.h"
 #include "tests/support/cubic_sample.h"
 #include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
 
 namespace aerocal::stitch {
 namespace {
@@ -67,7 +67,8 @@ TEST(ResampleVirtualImage, ReproducesALinearRampExactlyAndFillsUncoveredPixels) 
       for (int v = 0; v < s.height_px; ++v)
         for (int u = 0; u < s.width_px; ++u) {
           const Eigen::Vector2d p = s.VirtualFromSub({u, v});
-          for (int b = 0; b < 3; ++b) sub.Set(u, v, b, 1000 + 50.0 * p.x() + 20.0 * p.y() + 7000 * b);
+          for (int b = 0; b < 3; ++b)
+            sub.Set(u, v, b, 1000 + 50.0 * p.x() + 20.0 * p.y() + 7000 * b);
         }
       subs.push_back(std::move(sub));
     }
@@ -97,10 +98,11 @@ TEST(ResampleVirtualImage, ReproducesALinearRampExactlyAndFillsUncoveredPixels) 
         // Bicubic repeats edge samples: within 1 px of a sub-image edge a ramp is not reproduced.
         if (near_edge && interpolation == Interpolation::kBicubic) continue;
         for (int b = 0; b < 3; ++b)
-          max_error = std::max(max_error, std::abs(out.At(c, r, b) - (1000 + 50.0 * c + 20.0 * r + 7000 * b)));
+          max_error = std::max(max_error,
+                               std::abs(out.At(c, r, b) - (1000 + 50.0 * c + 20.0 * r + 7000 * b)));
       }
     EXPECT_EQ(uncovered, report.filled);
-    EXPECT_GT(uncovered, 80);  // the bottom row right of V
+    EXPECT_GT(uncovered, 80);   // the bottom row right of V
     EXPECT_LE(max_error, 1.0);  // rounding to integers (ramp values are not integers everywhere)
   }
 }
@@ -130,7 +132,8 @@ TEST(ResampleVirtualImage, RealAerialImageResampledBackWithoutSeams) {
   MemoryRaster back({width, height, 1, 8});
   const ResampleReport report = ResampleVirtualImage(truth, Pointers(subs), &back, {});
   // Interior: 4 px from the border (misplaced CCDs need not reach the very edge).
-  double sum2 = 0, overlap_sum = 0, single_sum = 0, overlap2 = 0, single2 = 0, edge_sum = 0, edge2 = 0;
+  double sum2 = 0, overlap_sum = 0, single_sum = 0, overlap2 = 0, single2 = 0, edge_sum = 0,
+         edge2 = 0;
   long n = 0, n_overlap = 0, n_single = 0, n_edge = 0;
   for (int r = 4; r < height - 4; ++r)
     for (int c = 4; c < width - 4; ++c) {
@@ -154,11 +157,19 @@ TEST(ResampleVirtualImage, RealAerialImageResampledBackWithoutSeams) {
       (cover > 1 ? n_overlap : n_single)++;
     }
   const double rms = std::sqrt(sum2 / n);
-  const double rms_overlap = std::sqrt(overlap2 / n_overlap), rms_single = std::sqrt(single2 / n_single);
-  std::printf("real image %d x %d: RMS %.3f DN (overlaps %.3f, single coverage %.3f); mean "
-              "difference overlaps %.3f, single %.3f; %ld overlap px\n",
-              width, height, rms, rms_overlap, rms_single, overlap_sum / n_overlap,
-              single_sum / n_single, report.overlap);
+  const double rms_overlap = std::sqrt(overlap2 / n_overlap),
+               rms_single = std::sqrt(single2 / n_single);
+  std::printf(
+      "real image %d x %d: RMS %.3f DN (overlaps %.3f, single coverage %.3f); mean "
+      "difference overlaps %.3f, single %.3f; %ld overlap px\n",
+      width,
+      height,
+      rms,
+      rms_overlap,
+      rms_single,
+      overlap_sum / n_overlap,
+      single_sum / n_single,
+      report.overlap);
   EXPECT_LT(rms, 1.0);
   // No seam: the overlaps (averages of two or four sub-images) are no worse than single coverage
   // and carry no grey-level step.
@@ -166,7 +177,9 @@ TEST(ResampleVirtualImage, RealAerialImageResampledBackWithoutSeams) {
   EXPECT_LT(std::abs(overlap_sum / n_overlap - single_sum / n_single), 0.1);
   // Nor along the CCD edges themselves, where one sub-image starts or stops contributing.
   const double rms_edge = std::sqrt(edge2 / n_edge);
-  std::printf("along the sub-image edges (1.5 px band, %ld px): RMS %.3f DN, mean %.3f DN\n", n_edge, rms_edge,
+  std::printf("along the sub-image edges (1.5 px band, %ld px): RMS %.3f DN, mean %.3f DN\n",
+              n_edge,
+              rms_edge,
               edge_sum / n_edge);
   ASSERT_GT(n_edge, 5000);
   EXPECT_LT(rms_edge, rms_single * 1.1);

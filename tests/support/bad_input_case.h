@@ -4,17 +4,16 @@
 // FILE:LINE (or the option, or the key path), no internal error and no output left behind.
 #pragma once
 
-#include <sys/stat.h>
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
 
 #include <filesystem>
 #include <fstream>
 #include <functional>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-
-#include "tests/support/test_support.h"
+#include <sys/stat.h>
 
 namespace aerocal::testing {
 
@@ -33,7 +32,9 @@ inline void WriteFileText(const std::string& path, const std::string& text) {
 }
 
 /// Replaces the first `from` in the file by `to` (a case's one defect); `from` must be there.
-inline void ReplaceFirstInFile(const std::string& path, const std::string& from, const std::string& to) {
+inline void ReplaceFirstInFile(const std::string& path,
+                               const std::string& from,
+                               const std::string& to) {
   std::string text = ReadFileText(path);
   const size_t at = text.find(from);
   EXPECT_NE(at, std::string::npos) << from << " not in " << path;
@@ -55,12 +56,14 @@ inline void RunBadInputCase(const BadInputCase& c, int timeout_s = 60) {
   SCOPED_TRACE(c.name);
   TempDir dir("aerocal_bad_input");
   const std::string args = c.setup(dir);
-  const auto r = RunCommand("timeout " + std::to_string(timeout_s) + " " + AerocalBinary() + " " + args);
+  const auto r =
+      RunCommand("timeout " + std::to_string(timeout_s) + " " + AerocalBinary() + " " + args);
   EXPECT_EQ(r.exit_code, c.exit_code) << args << "\n" << r.output;
   std::string expect = c.expect;
   const auto at = expect.find("{DIR}");
   if (at != std::string::npos) expect.replace(at, 5, dir.path());
-  EXPECT_NE(r.output.find(expect), std::string::npos) << "expected '" << expect << "' in\n" << r.output;
+  EXPECT_NE(r.output.find(expect), std::string::npos) << "expected '" << expect << "' in\n"
+                                                      << r.output;
   EXPECT_EQ(r.output.find("internal error"), std::string::npos) << r.output;
   if (!c.output.empty()) {
     EXPECT_FALSE(std::filesystem::exists(dir.File(c.output))) << c.output << " was written";

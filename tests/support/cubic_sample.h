@@ -2,10 +2,10 @@
 // repeated: independent of the library's resampler, it renders "photographed" test images.
 #pragma once
 
+#include "stitch/resample/raster.h"
+
 #include <algorithm>
 #include <cmath>
-
-#include "stitch/resample/raster.h"
 
 namespace aerocal::testing {
 
@@ -21,7 +21,8 @@ inline double SampleCubic(const stitch::MemoryRaster& image, double x, double y,
   double sum = 0;
   for (int r = -1; r <= 2; ++r)
     for (int c = -1; c <= 2; ++c) {
-      const int col = std::clamp(ix + c, 0, info.width - 1), row = std::clamp(iy + r, 0, info.height - 1);
+      const int col = std::clamp(ix + c, 0, info.width - 1),
+                row = std::clamp(iy + r, 0, info.height - 1);
       sum += weight(x - (ix + c)) * weight(y - (iy + r)) * image.At(col, row, band);
     }
   return sum;

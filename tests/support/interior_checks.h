@@ -2,13 +2,13 @@
 // determines within 3 sigma of the simulated truth.
 #pragma once
 
-#include <cmath>
-#include <string>
+#include "calib/camera/brown_fraser10.h"
+#include "triangulation/adjustment/adjustment_result.h"
 
 #include <gtest/gtest.h>
 
-#include "calib/camera/brown_fraser10.h"
-#include "triangulation/adjustment/adjustment_result.h"
+#include <cmath>
+#include <string>
 
 namespace aerocal::testing {
 
@@ -16,7 +16,8 @@ namespace aerocal::testing {
 inline void ExpectInteriorWithinThreeSigma(const triangulation::CameraEstimate& c,
                                            const calib::InteriorParams& truth) {
   using Model = calib::BrownFraser10Model;
-  for (int k : {Model::kC, Model::kX0, Model::kY0, Model::kK1, Model::kK2, Model::kP1, Model::kP2}) {
+  for (int k :
+       {Model::kC, Model::kX0, Model::kY0, Model::kK1, Model::kK2, Model::kP1, Model::kP2}) {
     SCOPED_TRACE(std::string(Model::kParams[k].name));
     EXPECT_LE(std::abs(c.estimated[k] - truth[k]), 3.0 * c.sigma[k])
         << c.estimated[k] << " sigma " << c.sigma[k];

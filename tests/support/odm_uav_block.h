@@ -27,7 +27,8 @@ inline triangulation::Project ImportOdmUavBlock(const std::string& dir,
     triangulation::OdmImportOptions subset;
     subset.gcp_list = dir + "/odm_gcp_br/gcp_list_raw.txt";
     subset.camera = in.camera;
-    for (const auto& p : triangulation::ImportOdmGcpList(subset).points) in.control_ids.insert(p.id);
+    for (const auto& p : triangulation::ImportOdmGcpList(subset).points)
+      in.control_ids.insert(p.id);
   }
   if (control_ids) *control_ids = in.control_ids;
   triangulation::Project project = triangulation::ImportOdmGcpList(in);

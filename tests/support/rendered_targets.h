@@ -9,11 +9,11 @@
 // pixel square's projection onto n: exp(-2 pi^2 s^2 f^2) sinc(f cos t) sinc(f sin t).
 #pragma once
 
+#include <Eigen/Core>
+
 #include <algorithm>
 #include <cmath>
 #include <vector>
-
-#include <Eigen/Core>
 
 namespace aerocal::testing {
 
@@ -24,7 +24,7 @@ inline constexpr double kRenderPi = 3.14159265358979323846;
 inline double NormalCdf(double u) { return 0.5 * std::erfc(-u / std::sqrt(2.0)); }
 inline double NormalPdf(double u) { return std::exp(-0.5 * u * u) / std::sqrt(2.0 * kRenderPi); }
 inline double NormalCdfIntegral(double u) { return u * NormalCdf(u) + NormalPdf(u); }  // F1
-inline double NormalCdfIntegral2(double u) {                                              // F2
+inline double NormalCdfIntegral2(double u) {                                           // F2
   return 0.5 * ((u * u + 1.0) * NormalCdf(u) + u * NormalPdf(u));
 }
 inline double Sinc(double x) {
@@ -33,7 +33,8 @@ inline double Sinc(double x) {
 
 /// Fraction (0..1) of the bright side in pixel (col, row) for the blurred edge n . p = offset,
 /// n = (cos t, sin t) the unit normal pointing to the bright side, p = (col, row) px.
-inline double EdgePixelFraction(double col, double row, double angle_rad, double offset_px, double s_px) {
+inline double EdgePixelFraction(
+    double col, double row, double angle_rad, double offset_px, double s_px) {
   const double nx = std::cos(angle_rad), ny = std::sin(angle_rad);
   auto u = [&](double x, double y) { return (nx * x + ny * y - offset_px) / s_px; };
   const double x0 = col - 0.5, x1 = col + 0.5, y0 = row - 0.5, y1 = row + 0.5;
@@ -51,14 +52,20 @@ inline double EdgePixelFraction(double col, double row, double angle_rad, double
 
 /// A width x height image of an edge through the image centre shifted by `offset_px`, its normal
 /// at `angle_rad` from +x, dark `low` and bright `high` (floating point, no noise).
-inline RenderedImage RenderEdge(int width, int height, double angle_rad, double s_px, double low,
-                                double high, double offset_px = 0.0) {
+inline RenderedImage RenderEdge(int width,
+                                int height,
+                                double angle_rad,
+                                double s_px,
+                                double low,
+                                double high,
+                                double offset_px = 0.0) {
   RenderedImage image(height, width);
   const double nx = std::cos(angle_rad), ny = std::sin(angle_rad);
   const double centre = nx * 0.5 * (width - 1) + ny * 0.5 * (height - 1) + offset_px;
   for (int r = 0; r < height; ++r)
     for (int c = 0; c < width; ++c)
-      image(r, c) = static_cast<float>(low + (high - low) * EdgePixelFraction(c, r, angle_rad, centre, s_px));
+      image(r, c) =
+          static_cast<float>(low + (high - low) * EdgePixelFraction(c, r, angle_rad, centre, s_px));
   return image;
 }
 
@@ -66,7 +73,8 @@ inline RenderedImage RenderEdge(int width, int height, double angle_rad, double 
 /// every integer k, period P px, blurred by s and integrated over each pixel's column extent.
 inline double BarPixelFraction(double col, double period_px, double x0_px, double s_px) {
   double fraction = 0.0;
-  const int k_first = static_cast<int>(std::floor((col - 0.5 - 10.0 * s_px - x0_px) / period_px)) - 1;
+  const int k_first =
+      static_cast<int>(std::floor((col - 0.5 - 10.0 * s_px - x0_px) / period_px)) - 1;
   const int k_last = static_cast<int>(std::ceil((col + 0.5 + 10.0 * s_px - x0_px) / period_px)) + 1;
   for (int k = k_first; k <= k_last; ++k) {
     const double a = x0_px + k * period_px, b = a + 0.5 * period_px;  // one bright bar [a, b)
@@ -80,15 +88,16 @@ inline double BarPixelFraction(double col, double period_px, double x0_px, doubl
 
 /// MTF of the rendered edge along its normal: PSF times the projected pixel square.
 inline double RenderedEdgeMtf(double f, double s_px, double angle_rad) {
-  return std::exp(-2.0 * kRenderPi * kRenderPi * s_px * s_px * f * f) * Sinc(f * std::cos(angle_rad)) *
-         Sinc(f * std::sin(angle_rad));
+  return std::exp(-2.0 * kRenderPi * kRenderPi * s_px * s_px * f * f) *
+         Sinc(f * std::cos(angle_rad)) * Sinc(f * std::sin(angle_rad));
 }
 
 /// Coltman's square-wave response of vertical bars of frequency f (cycles/px) through the PSF and
 /// the pixel's column extent: (4/pi) sum over odd k of (-1)^((k-1)/2) M(k f) / k.
 inline double RenderedBarContrast(double f, double s_px) {
   double sum = 0.0;
-  for (int k = 1; k < 200; k += 2) sum += ((k / 2) % 2 == 0 ? 1.0 : -1.0) * RenderedEdgeMtf(k * f, s_px, 0.0) / k;
+  for (int k = 1; k < 200; k += 2)
+    sum += ((k / 2) % 2 == 0 ? 1.0 : -1.0) * RenderedEdgeMtf(k * f, s_px, 0.0) / k;
   return 4.0 / kRenderPi * sum;
 }
 
@@ -115,7 +124,8 @@ inline void GaussianPass(std::vector<float>* image, int n, double s, bool along_
   const int radius = static_cast<int>(std::ceil(4 * s));
   std::vector<double> kernel(2 * radius + 1);
   double sum = 0;
-  for (int k = -radius; k <= radius; ++k) sum += kernel[k + radius] = std::exp(-0.5 * k * k / (s * s));
+  for (int k = -radius; k <= radius; ++k)
+    sum += kernel[k + radius] = std::exp(-0.5 * k * k / (s * s));
   for (double& k : kernel) k /= sum;
   std::vector<float> out(image->size());
   for (int i = 0; i < n; ++i)
@@ -134,15 +144,22 @@ inline void GaussianPass(std::vector<float>* image, int n, double s, bool along_
 /// cos(cycles theta + phase) >= 0) centred at `centre` (px), blurred by a Gaussian of s px: the
 /// binary star at the centres of 4 x 4 sub-pixels, blurred there, averaged over each pixel (no
 /// noise). Its modulation transfer is RenderedStarTransfer.
-inline RenderedImage RenderSiemensStar(int size, int cycles, const Eigen::Vector2d& centre, double phase,
-                                       double s_px, double low, double high) {
+inline RenderedImage RenderSiemensStar(int size,
+                                       int cycles,
+                                       const Eigen::Vector2d& centre,
+                                       double phase,
+                                       double s_px,
+                                       double low,
+                                       double high) {
   constexpr int kSuper = 4;
   const int n = size * kSuper;
   std::vector<float> fine(static_cast<size_t>(n) * n);
   for (int i = 0; i < n; ++i)
     for (int j = 0; j < n; ++j) {
-      const double x = (j + 0.5) / kSuper - 0.5 - centre.x(), y = (i + 0.5) / kSuper - 0.5 - centre.y();
-      fine[static_cast<size_t>(i) * n + j] = static_cast<float>(std::cos(cycles * std::atan2(y, x) + phase) >= 0 ? high : low);
+      const double x = (j + 0.5) / kSuper - 0.5 - centre.x(),
+                   y = (i + 0.5) / kSuper - 0.5 - centre.y();
+      fine[static_cast<size_t>(i) * n + j] =
+          static_cast<float>(std::cos(cycles * std::atan2(y, x) + phase) >= 0 ? high : low);
     }
   GaussianPass(&fine, n, s_px * kSuper, true);
   GaussianPass(&fine, n, s_px * kSuper, false);
@@ -151,7 +168,8 @@ inline RenderedImage RenderSiemensStar(int size, int cycles, const Eigen::Vector
     for (int c = 0; c < size; ++c) {
       double sum = 0;
       for (int a = 0; a < kSuper; ++a)
-        for (int b = 0; b < kSuper; ++b) sum += fine[static_cast<size_t>(r * kSuper + a) * n + c * kSuper + b];
+        for (int b = 0; b < kSuper; ++b)
+          sum += fine[static_cast<size_t>(r * kSuper + a) * n + c * kSuper + b];
       image(r, c) = static_cast<float>(sum / (kSuper * kSuper));
     }
   return image;

@@ -5,27 +5,33 @@
 // tests.
 #pragma once
 
-#include <cmath>
-#include <limits>
-#include <random>
-
-#include <Eigen/Core>
-
 #include "calib/camera/brown_fraser10.h"
 #include "calib/camera/camera.h"
 #include "calib/camera/rotation.h"
+
+#include <Eigen/Core>
+
+#include <cmath>
+#include <limits>
+#include <random>
 
 namespace aerocal::testing {
 
 /// t(a, e) = (sin a cos e, sin e, -cos a cos e), angles in rad.
 inline Eigen::Vector3d InstrumentDirection(double azimuth, double elevation) {
-  return {std::sin(azimuth) * std::cos(elevation), std::sin(elevation), -std::cos(azimuth) * std::cos(elevation)};
+  return {std::sin(azimuth) * std::cos(elevation),
+          std::sin(elevation),
+          -std::cos(azimuth) * std::cos(elevation)};
 }
 
 /// The measured pixel (col, row) of t through g for the camera `truth` (10-parameter model) turned
-/// by `opk_rad`, with normal image noise of `sigma_px` per axis; NaN when the model's inversion fails.
-inline Eigen::Vector2d ObserveDirection(const calib::Camera& truth, const Eigen::Vector3d& opk_rad,
-                                        const Eigen::Matrix3d& g, const Eigen::Vector3d& t, double sigma_px,
+/// by `opk_rad`, with normal image noise of `sigma_px` per axis; NaN when the model's inversion
+/// fails.
+inline Eigen::Vector2d ObserveDirection(const calib::Camera& truth,
+                                        const Eigen::Vector3d& opk_rad,
+                                        const Eigen::Matrix3d& g,
+                                        const Eigen::Vector3d& t,
+                                        double sigma_px,
                                         std::mt19937_64* rng) {
   const Eigen::Vector3d uvw = calib::RotationFromOpk(opk_rad).transpose() * g.transpose() * t;
   const double c = truth.interior[0];

@@ -42,7 +42,8 @@ CommandResult RunCommand(const std::string& command) {
   if (!pipe) return result;
   std::array<char, 4096> buffer;
   size_t n;
-  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) result.output.append(buffer.data(), n);
+  while ((n = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0)
+    result.output.append(buffer.data(), n);
   const int status = ::pclose(pipe);
   result.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
   return result;
@@ -65,9 +66,7 @@ std::string SharedDataDir(const std::string& name) {
   return std::filesystem::is_directory(dir) ? dir : "";
 }
 
-nlohmann::json ReadJson(const std::string& path) {
-  return ReadJsonFile(path);
-}
+nlohmann::json ReadJson(const std::string& path) { return ReadJsonFile(path); }
 
 std::string ResultWithoutClock(const std::string& path) {
   std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& j) {

@@ -3,18 +3,6 @@
 // the exit code (2 bad input, 3 numerical failure) and the FILE:LINE (or option) the message must
 // name; the output must not exist afterwards. Plus the reader rules that must ACCEPT input (BOM,
 // CRLF, CR, '#' inside a row) and the stitching robust start against a 20000 px decimal slip.
-#include <sys/stat.h>
-#include <unistd.h>
-
-#include <filesystem>
-#include <fstream>
-#include <functional>
-#include <map>
-#include <sstream>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
@@ -24,6 +12,17 @@
 #include "tests/support/bad_input_case.h"
 #include "tests/support/test_support.h"
 #include "triangulation/block/block_io.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <sstream>
+#include <sys/stat.h>
+#include <unistd.h>
 
 namespace aerocal {
 namespace {
@@ -76,9 +75,10 @@ void SetField(const std::string& path, int line, int col, const std::string& val
 const std::string& BaseFlight() {
   static TempDir* dir = new TempDir("aerocal_bad_input_base");
   static const bool made = [] {
-    const auto r = RunAerocal("simulate --out " + dir->File("sim") +
-                              " --exposures 6 --strips 1 --surveyed-points 12 --control 6 --tie-points 40 "
-                              "--stitch-ties 60");
+    const auto r =
+        RunAerocal("simulate --out " + dir->File("sim") +
+                   " --exposures 6 --strips 1 --surveyed-points 12 --control 6 --tie-points 40 "
+                   "--stitch-ties 60");
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return true;
   }();
@@ -110,7 +110,10 @@ std::string PushbroomFlight(const TempDir& d) { return SimulatedCopy(d, "pb", "-
 std::string RigFlight(const TempDir& d) { return SimulatedCopy(d, "rig", "--rig dual-lens"); }
 // A frame flight whose exposures.csv carries the velocity columns vX, vY, vZ.
 std::string VelocityFlight(const TempDir& d) {
-  return SimulatedCopy(d, "vel", "--exposures 6 --strips 1 --surveyed-points 12 --control 6 --tie-points 40 --speed-mps 60");
+  return SimulatedCopy(
+      d,
+      "vel",
+      "--exposures 6 --strips 1 --surveyed-points 12 --control 6 --tie-points 40 --speed-mps 60");
 }
 // A small test field (`simulate --test-field`): 2 groups (A, B) of 4 images, groups.csv lines 2-9.
 std::string TestField(const TempDir& d) {
@@ -123,21 +126,24 @@ void ReplaceFirst(const std::string& path, const std::string& from, const std::s
 }
 
 std::string PushbroomArgs(const std::string& pb) {
-  return "pushbroom calibrate --camera " + pb + "/camera_nominal.yaml --pos " + pb + "/pos.csv --observations " +
-         pb + "/observations.csv --points " + pb + "/points.csv --out " + pb + "/r.json --write-camera " + pb +
-         "/cam_out.yaml";
+  return "pushbroom calibrate --camera " + pb + "/camera_nominal.yaml --pos " + pb +
+         "/pos.csv --observations " + pb + "/observations.csv --points " + pb +
+         "/points.csv --out " + pb + "/r.json --write-camera " + pb + "/cam_out.yaml";
 }
 
 // A line of the four-head rig (`simulate --rig uav4`, 2 exposures) and `rig stitch` on it.
-std::string Uav4Line(const TempDir& d) { return SimulatedCopy(d, "uav4", "--rig uav4 --exposures 2"); }
+std::string Uav4Line(const TempDir& d) {
+  return SimulatedCopy(d, "uav4", "--rig uav4 --exposures 2");
+}
 std::string RigStitchArgs(const std::string& line, const std::string& extra = "") {
   return "rig stitch --camera " + line + "/rig_truth.yaml --project " + line + " " + extra +
          " --out " + line + "/stitch.json";
 }
 
 std::string RigAnalysisArgs(const std::string& rig) {
-  return "rig error-analysis --camera " + rig + "/rig_nominal.yaml --limits " + std::string(AEROCAL_CONFIGS_DIR) +
-         "/rig_dual_lens_limits.yaml --no-plots --out " + rig + "/ea";
+  return "rig error-analysis --camera " + rig + "/rig_nominal.yaml --limits " +
+         std::string(AEROCAL_CONFIGS_DIR) + "/rig_dual_lens_limits.yaml --no-plots --out " + rig +
+         "/ea";
 }
 
 // Minimal DBAT block: a camera XML, two images, eight marks each, initial EO.
@@ -159,8 +165,8 @@ void WriteDbat(const std::string& dir) {
 
 std::string DbatArgs(const std::string& dir, const std::string& marks = "") {
   return "import dbat --camera-xml " + dir + "/cam.xml --marks " +
-         (marks.empty() ? dir + "/marks.txt" : marks) + " --images " +
-         dir + "/images.txt --initial-eo " + dir + "/eo.txt --out " + dir + "/out";
+         (marks.empty() ? dir + "/marks.txt" : marks) + " --images " + dir +
+         "/images.txt --initial-eo " + dir + "/eo.txt --out " + dir + "/out";
 }
 
 // Minimal COLMAP text model: one OPENCV camera, two images, four points.
@@ -185,7 +191,8 @@ void WriteColmap(const std::string& dir) {
 }
 
 std::string ColmapArgs(const std::string& dir) {
-  return "import colmap --colmap-model " + dir + "/model --pixel-size-mm 0.005 --out " + dir + "/out";
+  return "import colmap --colmap-model " + dir + "/model --pixel-size-mm 0.005 --out " + dir +
+         "/out";
 }
 
 // The ODM list of a 2x... near-nadir block: three targets seen by two images each.
@@ -195,12 +202,12 @@ void WriteOdm(const std::string& dir) {
   for (int image = 1; image <= 2; ++image)
     for (int t = 0; t < 3; ++t)
       gcp += std::to_string(xyz[t][0]) + " " + std::to_string(xyz[t][1]) + " " +
-             std::to_string(xyz[t][2]) + " " + std::to_string(3000 + 40 * (xyz[t][0] - 130) - 300 * image) +
-             " " + std::to_string(2000 - 40 * (xyz[t][1] - 125)) + " img" + std::to_string(image) +
+             std::to_string(xyz[t][2]) + " " +
+             std::to_string(3000 + 40 * (xyz[t][0] - 130) - 300 * image) + " " +
+             std::to_string(2000 - 40 * (xyz[t][1] - 125)) + " img" + std::to_string(image) +
              ".jpg T" + std::to_string(t + 1) + "\n";
   Write(dir + "/gcp.txt", gcp);
-  Write(dir + "/cam.yaml",
-        "pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n");
+  Write(dir + "/cam.yaml", "pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n");
 }
 
 std::string OdmArgs(const std::string& dir) {
@@ -209,7 +216,10 @@ std::string OdmArgs(const std::string& dir) {
 }
 
 // Sets the field of column `column` (by its header name) of 1-based line `line` of a CSV file.
-void SetColumn(const std::string& path, int line, const std::string& column, const std::string& value) {
+void SetColumn(const std::string& path,
+               int line,
+               const std::string& column,
+               const std::string& value) {
   const auto header = Lines(path).at(0);
   std::stringstream in(header);
   int index = 0;
@@ -233,10 +243,13 @@ std::string CalibrateArgs(const std::string& tf) {
 
 // The test field's observations with a `group` column from its groups.csv; the image of
 // observation row `odd_row` (1-based line) is put into group `odd_group` instead.
-void AddGroupColumn(const std::string& tf, const std::string& group_of_all = "", int odd_row = 0,
+void AddGroupColumn(const std::string& tf,
+                    const std::string& group_of_all = "",
+                    int odd_row = 0,
                     const std::string& odd_group = "") {
   std::map<std::string, std::string> groups;
-  for (const auto& line : Lines(tf + "/groups.csv")) groups[line.substr(0, line.find(','))] = line.substr(line.find(',') + 1);
+  for (const auto& line : Lines(tf + "/groups.csv"))
+    groups[line.substr(0, line.find(','))] = line.substr(line.find(',') + 1);
   auto lines = Lines(tf + "/observations.csv");
   lines[0] += ",group";
   for (size_t i = 1; i < lines.size(); ++i) {
@@ -254,8 +267,8 @@ std::string CertificateResult(const std::string& uncertainty_row, bool stability
   return "{\"kind\": \"adjust\", \"schema_version\": 1, \"command\": \"calibrate\",\n"
          " \"valid\": true, \"cameras\": [{}],\n"
          " \"calibration\": {\"method\": {}, \"camera\": {}, \"data\": {}, \"rms_px\": 0.1,"
-         " \"groups\": [],\n  \"uncertainty\": [" + uncertainty_row + "]" +
-         (stability ? ", \"stability\": {}" : "") + "}}\n";
+         " \"groups\": [],\n  \"uncertainty\": [" +
+         uncertainty_row + "]" + (stability ? ", \"stability\": {}" : "") + "}}\n";
 }
 
 // A valid uncertainty row (its statement states its value, U, k and unit; issue 37).
@@ -1002,15 +1015,17 @@ const std::vector<Case>& Cases() {
       {"rig_adjust_joint_stitching",
        [](const TempDir& d) { return RigAdjustArgs(RigFlight(d)) + " --joint-stitching per-flight"; },
        2, "camera 'rig1' is a rig: the joint adjustment", "a.json"},
-      // ---- the project's `platform:` section (lever arm, boresight, GNSS time offset) ----
-#define AEROCAL_PLATFORM_CASE(name, yaml, expect)                          \
-  {name,                                                                  \
-   [](const TempDir& d) {                                                 \
-     const auto sim = Flight(d);                                          \
-     Append(sim + "/project.yaml", std::string("platform:\n") + (yaml));  \
-     return AdjustArgs(sim);                                              \
-   },                                                                     \
-   2, (expect), "a.json"}
+  // ---- the project's `platform:` section (lever arm, boresight, GNSS time offset) ----
+#define AEROCAL_PLATFORM_CASE(name, yaml, expect)                        \
+  {name,                                                                 \
+   [](const TempDir& d) {                                                \
+     const auto sim = Flight(d);                                         \
+     Append(sim + "/project.yaml", std::string("platform:\n") + (yaml)); \
+     return AdjustArgs(sim);                                             \
+   },                                                                    \
+   2,                                                                    \
+   (expect),                                                             \
+   "a.json"}
       AEROCAL_PLATFORM_CASE("platform_lever_arm_nan", "  lever_arm_m: [.nan, 0, 0]\n",
                             "project.yaml:9: platform: lever_arm_m must be a number (got '.nan')"),
       AEROCAL_PLATFORM_CASE("platform_lever_arm_inf", "  lever_arm_m: [0, -.inf, 0]\n",
@@ -1054,15 +1069,17 @@ const std::vector<Case>& Cases() {
       AEROCAL_PLATFORM_CASE("platform_not_a_map", "  - 1\n",
                             "project.yaml:9: platform must be a map"),
 #undef AEROCAL_PLATFORM_CASE
-      // ---- velocity columns vX, vY, vZ of exposures.csv ----
-#define AEROCAL_VELOCITY_CASE(name, value, expect)           \
-  {name,                                                    \
-   [](const TempDir& d) {                                   \
-     const auto sim = VelocityFlight(d);                    \
-     SetColumn(sim + "/exposures.csv", 3, "vX", (value));   \
-     return AdjustArgs(sim);                                \
-   },                                                       \
-   2, (expect), "a.json"}
+  // ---- velocity columns vX, vY, vZ of exposures.csv ----
+#define AEROCAL_VELOCITY_CASE(name, value, expect)        \
+  {name,                                                  \
+   [](const TempDir& d) {                                 \
+     const auto sim = VelocityFlight(d);                  \
+     SetColumn(sim + "/exposures.csv", 3, "vX", (value)); \
+     return AdjustArgs(sim);                              \
+   },                                                     \
+   2,                                                     \
+   (expect),                                              \
+   "a.json"}
       AEROCAL_VELOCITY_CASE("velocity_nan", "nan", "exposures.csv:3: column 'vX' must be a number (got 'nan')"),
       AEROCAL_VELOCITY_CASE("velocity_inf", "-inf", "exposures.csv:3: column 'vX' must be a number (got '-inf')"),
       AEROCAL_VELOCITY_CASE("velocity_text", "fast", "exposures.csv:3: column 'vX' must be a number (got 'fast')"),
@@ -1150,10 +1167,15 @@ const std::vector<Case>& Cases() {
       {"simulate_seed_past_2_64",
        [](const TempDir& d) { return "simulate --out " + d.File("o") + " --seed 18446744073709551616"; },
        2, "--seed: must be an integer within 0 .. 18446744073709551615", "o"},
-      // ---- simulate --test-field options ----
-#define AEROCAL_TEST_FIELD_CASE(name, options, expect)                                         \
-  {name, [](const TempDir& d) { return "simulate --test-field --out " + d.File("o") + " " + (options); }, \
-   2, (expect), "o"}
+  // ---- simulate --test-field options ----
+#define AEROCAL_TEST_FIELD_CASE(name, options, expect)                      \
+  {name,                                                                    \
+   [](const TempDir& d) {                                                   \
+     return "simulate --test-field --out " + d.File("o") + " " + (options); \
+   },                                                                       \
+   2,                                                                       \
+   (expect),                                                                \
+   "o"}
       AEROCAL_TEST_FIELD_CASE("test_field_groups_zero", "--groups 0", "--groups: must be in [1, 26] (got 0)"),
       AEROCAL_TEST_FIELD_CASE("test_field_groups_27", "--groups 27", "--groups: must be in [1, 26] (got 27)"),
       AEROCAL_TEST_FIELD_CASE("test_field_groups_not_integer", "--groups 2.5", "--groups"),
@@ -1308,7 +1330,9 @@ TEST_P(BadInput, ExitsWithItsCodeNamesWhereAndWritesNothing) {
   testing::RunBadInputCase(Cases()[GetParam()]);
 }
 
-INSTANTIATE_TEST_SUITE_P(Issue12, BadInput, ::testing::Range<size_t>(0, Cases().size()),
+INSTANTIATE_TEST_SUITE_P(Issue12,
+                         BadInput,
+                         ::testing::Range<size_t>(0, Cases().size()),
                          [](const ::testing::TestParamInfo<size_t>& info) {
                            return std::string(Cases()[info.param].name);
                          });
@@ -1317,7 +1341,8 @@ INSTANTIATE_TEST_SUITE_P(Issue12, BadInput, ::testing::Range<size_t>(0, Cases().
 
 TEST(ReaderRules, ByteOrderMarkCrlfAndCrLineEndsAreAccepted) {
   for (const std::string eol : {"\n", "\r\n", "\r"}) {
-    const auto t = CsvTable::Parse("\xEF\xBB\xBFimage,X" + eol + "a,1" + eol + "b,2" + eol, "f.csv");
+    const auto t =
+        CsvTable::Parse("\xEF\xBB\xBFimage,X" + eol + "a,1" + eol + "b,2" + eol, "f.csv");
     ASSERT_EQ(t.rows().size(), 2u);
     EXPECT_EQ(t.header()[0], "image");
     EXPECT_EQ(t.rows()[1].line, 3);
@@ -1344,9 +1369,11 @@ TEST(ReaderRules, StrictYamlNamesTheLineOfADuplicateKey) {
     LoadYamlText("a: 1\nb: 2\na: 3\n", "x.yaml");
     FAIL() << "duplicate key accepted";
   } catch (const InputError& e) {
-    EXPECT_NE(std::string(e.what()).find("x.yaml:3: duplicate key 'a'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("x.yaml:3: duplicate key 'a'"), std::string::npos)
+        << e.what();
   }
-  EXPECT_THROW(LoadYamlText(std::string(100, '[') + std::string(100, ']'), "deep.yaml"), InputError);
+  EXPECT_THROW(LoadYamlText(std::string(100, '[') + std::string(100, ']'), "deep.yaml"),
+               InputError);
 }
 
 TEST(ReaderRules, ADirectoryIsNotAnEmptyFile) {
@@ -1364,7 +1391,8 @@ TEST(ReaderRules, DbatCameraXmlIsParsedNotPatternMatched) {
   WriteDbat(dir.path());
   // A commented-out <cc> and a <pp> inside <std> must not be taken.
   Replace(dir.File("cam.xml"), "<cc>35</cc>", "<!-- <cc>99</cc> -->\n<cc>35</cc>");
-  Replace(dir.File("cam.xml"), "<pp>0,0</pp>",
+  Replace(dir.File("cam.xml"),
+          "<pp>0,0</pp>",
           "<calibration_info><std><pp>1,2</pp></std></calibration_info>\n<pp>12.5,8.5</pp>");
   const auto r = RunAerocal(DbatArgs(dir.path()));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -1427,10 +1455,11 @@ TEST(StitchRobustStart, ADecimalSlipIsTheOnlyRejectionAndLeavesTheModelChoice) {
 // a named numerical failure (not converged, no covariance), never a signal in the SVD.
 TEST(StitchNumericalFailure, OverflowingMeasurementsAreNamedNotACrash) {
   const calib::Camera camera = calib::ParseCamera(
-      LoadYamlText("pixel_size_mm: 0.009\nformat_px: [14000, 8000]\ninterior: {c: 170}\n"
-                   "subimages:\n  - {id: I, format_px: [7100, 8000], model: affine}\n"
-                   "  - {id: II, format_px: [7100, 8000], model: affine, params: [1, 0, 6900, 0, 1, 0]}\n",
-                   "camera.yaml"),
+      LoadYamlText(
+          "pixel_size_mm: 0.009\nformat_px: [14000, 8000]\ninterior: {c: 170}\n"
+          "subimages:\n  - {id: I, format_px: [7100, 8000], model: affine}\n"
+          "  - {id: II, format_px: [7100, 8000], model: affine, params: [1, 0, 6900, 0, 1, 0]}\n",
+          "camera.yaml"),
       "camera.yaml");
   stitch::FrameMeasurements frame;
   frame.frame = "0001";

@@ -4,18 +4,17 @@
 // merged files equal `aerocal flight`'s (result.json to the last bit, the clock's timings aside;
 // the camera byte for byte). Units made missing afterwards are all a resubmission runs. Skipped
 // with the reason when Slurm or munge is not installed or the cluster does not come up.
-#include <unistd.h>
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
 
 #include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <string>
 #include <thread>
-
-#include <gtest/gtest.h>
-
-#include "calib/core/atomic_file.h"
-#include "tests/support/test_support.h"
+#include <unistd.h>
 
 namespace aerocal {
 namespace {
@@ -50,7 +49,8 @@ class SlurmBatch : public ::testing::Test {
       const auto queue = testing::RunCommand("squeue -h");
       if (queue.exit_code == 0 && queue.output.empty()) return;
     }
-    FAIL() << "the jobs did not finish within " << seconds << " s: " << testing::RunCommand("squeue").output;
+    FAIL() << "the jobs did not finish within " << seconds
+           << " s: " << testing::RunCommand("squeue").output;
   }
   void ExpectTheFlightsFiles() {
     ASSERT_TRUE(fs::exists(dir_.File("merged/result.json")))
@@ -65,20 +65,25 @@ class SlurmBatch : public ::testing::Test {
 };
 
 TEST_F(SlurmBatch, JobArrayAndDependentMergeGiveTheFlightsFiles) {
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + dir_.File("data") +
-                                " --seed 3 --exposures 12 --strips 2 --stitch-ties 200 --gnss-sigma-m 0.05")
+  ASSERT_EQ(testing::RunAerocal(
+                "simulate --out " + dir_.File("data") +
+                " --seed 3 --exposures 12 --strips 2 --stitch-ties 200 --gnss-sigma-m 0.05")
                 .exit_code,
             0);
   ASSERT_EQ(testing::RunAerocal("flight " + Flight("single")).exit_code, 0);
-  ASSERT_EQ(testing::RunAerocal("batch plan --work " + dir_.File("work") + " " + Flight("merged")).exit_code, 0);
+  ASSERT_EQ(testing::RunAerocal("batch plan --work " + dir_.File("work") + " " + Flight("merged"))
+                .exit_code,
+            0);
   const std::string manifest = dir_.File("work/manifest.json");
-  const auto scripts = testing::RunAerocal("batch slurm --manifest " + manifest +
-                                           " --shards 4 --max-running 2 --out " + dir_.File("slurm"));
+  const auto scripts =
+      testing::RunAerocal("batch slurm --manifest " + manifest +
+                          " --shards 4 --max-running 2 --out " + dir_.File("slurm"));
   ASSERT_EQ(scripts.exit_code, 0) << scripts.output;
   SubmitAndWait(300);
   ExpectTheFlightsFiles();
   for (int task = 0; task < 4; ++task)  // each task ran its three units
-    EXPECT_NE(testing::RunCommand("cat " + dir_.File("work/logs") + "/slurm-*_" + std::to_string(task) + ".out")
+    EXPECT_NE(testing::RunCommand("cat " + dir_.File("work/logs") + "/slurm-*_" +
+                                  std::to_string(task) + ".out")
                   .output.find("3 units: 3 run, 0 already done, 0 failed"),
               std::string::npos);
 

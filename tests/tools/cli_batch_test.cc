@@ -3,14 +3,14 @@
 // timings aside) and the same camera_calibrated.yaml (byte for byte) as `aerocal flight`; a run
 // killed midway and a rerun finish only what is missing; a changed input is redone, a failing unit
 // leaves its log, a failed record and no output, and the merge refuses to run without every unit.
-#include <filesystem>
-#include <fstream>
-#include <string>
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
 
-#include "calib/core/atomic_file.h"
-#include "tests/support/test_support.h"
+#include <filesystem>
+#include <fstream>
+#include <string>
 
 namespace aerocal {
 namespace {
@@ -21,8 +21,9 @@ class Batch : public ::testing::Test {
  protected:
   static void SetUpTestSuite() {
     dir_ = new testing::TempDir("aerocal_batch");
-    const auto sim = testing::RunAerocal("simulate --out " + dir_->File("data") +
-                                         " --seed 3 --exposures 12 --strips 2 --stitch-ties 200 --gnss-sigma-m 0.05");
+    const auto sim = testing::RunAerocal(
+        "simulate --out " + dir_->File("data") +
+        " --seed 3 --exposures 12 --strips 2 --stitch-ties 200 --gnss-sigma-m 0.05");
     ASSERT_EQ(sim.exit_code, 0) << sim.output;
     const auto flight = testing::RunAerocal("flight " + FlightArguments("single"));
     ASSERT_EQ(flight.exit_code, 0) << flight.output;
@@ -35,11 +36,14 @@ class Batch : public ::testing::Test {
   }
   // `batch plan` of the flight into WORK whose merge writes OUT.
   static std::string Plan(const std::string& work, const std::string& out) {
-    const auto r = testing::RunAerocal("batch plan --work " + dir_->File(work) + " " + FlightArguments(out));
+    const auto r =
+        testing::RunAerocal("batch plan --work " + dir_->File(work) + " " + FlightArguments(out));
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return dir_->File(work + "/manifest.json");
   }
-  static testing::CommandResult Batch_(const std::string& arguments) { return testing::RunAerocal("batch " + arguments); }
+  static testing::CommandResult Batch_(const std::string& arguments) {
+    return testing::RunAerocal("batch " + arguments);
+  }
   static void ExpectTheFlightsFiles(const std::string& out) {
     ASSERT_TRUE(fs::exists(dir_->File(out + "/result.json"))) << out;
     EXPECT_EQ(ReadTextFile(dir_->File(out + "/camera_calibrated.yaml")),
@@ -69,11 +73,14 @@ TEST_F(Batch, ShardsThenMergeGiveTheFlightsFiles) {
   for (const char* shard : {"0/3", "1/3", "2/3"}) {
     const auto r = Batch_("run --manifest " + manifest + " --shard " + shard);
     ASSERT_EQ(r.exit_code, 0) << r.output;
-    EXPECT_NE(r.output.find("4 units: 4 run, 0 already done, 0 failed"), std::string::npos) << r.output;
+    EXPECT_NE(r.output.find("4 units: 4 run, 0 already done, 0 failed"), std::string::npos)
+        << r.output;
   }
   const auto status = Batch_("status --manifest " + manifest + " --list");
-  EXPECT_NE(status.output.find("stitch-0007"), std::string::npos) << status.output;  // --list: one line per unit
-  EXPECT_NE(status.output.find("12 units: 12 done, 0 changed since done, 0 failed, 0 missing"), std::string::npos)
+  EXPECT_NE(status.output.find("stitch-0007"), std::string::npos)
+      << status.output;  // --list: one line per unit
+  EXPECT_NE(status.output.find("12 units: 12 done, 0 changed since done, 0 failed, 0 missing"),
+            std::string::npos)
       << status.output;
   EXPECT_NE(status.output.find("units/s"), std::string::npos) << status.output;
   merge = Batch_("merge --manifest " + manifest);
@@ -91,18 +98,20 @@ TEST_F(Batch, KilledRunAndRerunFinishOnlyWhatIsMissing) {
   std::printf("killed after %d of 12 units (exit %d)\n", done, killed.exit_code);
   const auto rerun = Batch_("run --manifest " + manifest);
   ASSERT_EQ(rerun.exit_code, 0) << rerun.output;
-  EXPECT_NE(rerun.output.find("12 units: " + std::to_string(12 - done) + " run, " + std::to_string(done) +
-                              " already done"),
+  EXPECT_NE(rerun.output.find("12 units: " + std::to_string(12 - done) + " run, " +
+                              std::to_string(done) + " already done"),
             std::string::npos)
       << rerun.output;
   // A unit killed while writing: its output's temporary file and no done record (deterministic).
   const std::string unit = dir_->File("killed/units/stitch-0005/frame_run.json");
   fs::remove(dir_->File("killed/done/stitch-0005.json"));
   WriteFileAtomically(unit + ".tmp99999", "{\"adjustment\": {\"fra");
-  EXPECT_NE(Batch_("status --manifest " + manifest).output.find("11 done, 0 changed since done, 0 failed, 1 missing"),
+  EXPECT_NE(Batch_("status --manifest " + manifest)
+                .output.find("11 done, 0 changed since done, 0 failed, 1 missing"),
             std::string::npos);
   const auto again = Batch_("run --manifest " + manifest);
-  EXPECT_NE(again.output.find("12 units: 1 run, 11 already done"), std::string::npos) << again.output;
+  EXPECT_NE(again.output.find("12 units: 1 run, 11 already done"), std::string::npos)
+      << again.output;
   EXPECT_FALSE(fs::exists(unit + ".tmp99999"));
   const auto merge = Batch_("merge --manifest " + manifest);
   ASSERT_EQ(merge.exit_code, 0) << merge.output;
@@ -123,7 +132,8 @@ TEST_F(Batch, ChangedInputIsRedoneAndAFailureIsRecorded) {
   changed.replace(sigma, row_end - sigma, "0.2");
   WriteFileAtomically(input, changed);
   auto status = Batch_("status --manifest " + manifest);
-  EXPECT_NE(status.output.find("11 done, 1 changed since done"), std::string::npos) << status.output;
+  EXPECT_NE(status.output.find("11 done, 1 changed since done"), std::string::npos)
+      << status.output;
   auto run = Batch_("run --manifest " + manifest);
   EXPECT_NE(run.output.find("12 units: 1 run, 11 already done"), std::string::npos) << run.output;
   // A sub-image the camera lacks: the unit fails with the reason, a failed record and its log.
@@ -132,11 +142,14 @@ TEST_F(Batch, ChangedInputIsRedoneAndAFailureIsRecorded) {
   WriteFileAtomically(input, bad);
   const auto failed = Batch_("run --manifest " + manifest + " --unit stitch-0003");
   EXPECT_EQ(failed.exit_code, 2) << failed.output;
-  EXPECT_NE(failed.output.find("sub-image 'XI' is not in the camera"), std::string::npos) << failed.output;
+  EXPECT_NE(failed.output.find("sub-image 'XI' is not in the camera"), std::string::npos)
+      << failed.output;
   EXPECT_TRUE(fs::exists(dir_->File("changed/failed/stitch-0003.json")));
-  EXPECT_NE(ReadTextFile(dir_->File("changed/logs/stitch-0003.log")).find("failed: "), std::string::npos);
+  EXPECT_NE(ReadTextFile(dir_->File("changed/logs/stitch-0003.log")).find("failed: "),
+            std::string::npos);
   status = Batch_("status --manifest " + manifest);
-  EXPECT_NE(status.output.find("11 done, 0 changed since done, 1 failed"), std::string::npos) << status.output;
+  EXPECT_NE(status.output.find("11 done, 0 changed since done, 1 failed"), std::string::npos)
+      << status.output;
   EXPECT_NE(status.output.find("failed stitch-0003: "), std::string::npos) << status.output;
   const auto merge = Batch_("merge --manifest " + manifest);
   EXPECT_EQ(merge.exit_code, 2) << merge.output;
@@ -145,7 +158,8 @@ TEST_F(Batch, ChangedInputIsRedoneAndAFailureIsRecorded) {
   // The planned input back: the unit runs once more and the merge is the flight's again.
   WriteFileAtomically(input, original);
   run = Batch_("run --manifest " + manifest);
-  EXPECT_NE(run.output.find("12 units: 1 run, 11 already done, 0 failed"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("12 units: 1 run, 11 already done, 0 failed"), std::string::npos)
+      << run.output;
   ASSERT_EQ(Batch_("merge --manifest " + manifest).exit_code, 0);
   ExpectTheFlightsFiles("changed_out");
 }
@@ -160,8 +174,9 @@ TEST_F(Batch, BadShardAndUnitAreRefusedByName) {
   const auto r = Batch_("run --manifest " + manifest + " --unit nope");
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--unit: no unit 'nope'"), std::string::npos) << r.output;
-  const auto plan = testing::RunAerocal("batch plan --work " + dir_->File("bad2") + " --camera " +
-                                        dir_->File("data/camera_nominal.yaml") + " --data " + dir_->File("data"));
+  const auto plan =
+      testing::RunAerocal("batch plan --work " + dir_->File("bad2") + " --camera " +
+                          dir_->File("data/camera_nominal.yaml") + " --data " + dir_->File("data"));
   EXPECT_EQ(plan.exit_code, 2) << plan.output;  // the flight's options as `flight` checks them
   EXPECT_NE(plan.output.find("--out is required"), std::string::npos) << plan.output;
   EXPECT_FALSE(fs::exists(dir_->File("bad2")));
@@ -170,10 +185,12 @@ TEST_F(Batch, BadShardAndUnitAreRefusedByName) {
 // The README's GNU Parallel line: shards as parallel jobs, then the merge.
 TEST_F(Batch, GnuParallelGivesTheFlightsFiles) {
   if (testing::RunCommand("command -v parallel").exit_code != 0)
-    GTEST_SKIP() << "GNU Parallel is not installed (apt-get install parallel; tools/setup.sh installs it)";
+    GTEST_SKIP()
+        << "GNU Parallel is not installed (apt-get install parallel; tools/setup.sh installs it)";
   const std::string manifest = Plan("parallel", "parallel_out");
-  const auto r = testing::RunCommand("parallel --will-cite -j 2 --halt now,fail=1 " + testing::AerocalBinary() +
-                                     " batch run --manifest " + manifest + " --shard {}/4 ::: 0 1 2 3");
+  const auto r = testing::RunCommand("parallel --will-cite -j 2 --halt now,fail=1 " +
+                                     testing::AerocalBinary() + " batch run --manifest " +
+                                     manifest + " --shard {}/4 ::: 0 1 2 3");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto merge = Batch_("merge --manifest " + manifest);
   ASSERT_EQ(merge.exit_code, 0) << merge.output;
@@ -182,16 +199,23 @@ TEST_F(Batch, GnuParallelGivesTheFlightsFiles) {
 
 TEST_F(Batch, SlurmScriptsNameTheArrayShardsAndTheDependentMerge) {
   const std::string manifest = Plan("slurm_work", "slurm_out");
-  const auto r = Batch_("slurm --manifest " + manifest + " --shards 4 --max-running 2 --partition p1 --time 01:00:00 "
-                        "--account a1 --aerocal /opt/aerocal/bin/aerocal --out " + dir_->File("slurm"));
+  const auto r = Batch_("slurm --manifest " + manifest +
+                        " --shards 4 --max-running 2 --partition p1 --time 01:00:00 "
+                        "--account a1 --aerocal /opt/aerocal/bin/aerocal --out " +
+                        dir_->File("slurm"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const std::string units = ReadTextFile(dir_->File("slurm/units.sbatch"));
-  for (const char* line : {"#SBATCH --array=0-3%2", "#SBATCH --partition=p1", "#SBATCH --time=01:00:00", "#SBATCH --account=a1",
+  for (const char* line : {"#SBATCH --array=0-3%2",
+                           "#SBATCH --partition=p1",
+                           "#SBATCH --time=01:00:00",
+                           "#SBATCH --account=a1",
                            "exec '/opt/aerocal/bin/aerocal' batch run",
                            "--shard \"${SLURM_ARRAY_TASK_ID}/4\""})
     EXPECT_NE(units.find(line), std::string::npos) << line << "\n" << units;
-  EXPECT_NE(ReadTextFile(dir_->File("slurm/merge.sbatch")).find("batch merge --manifest"), std::string::npos);
-  EXPECT_NE(ReadTextFile(dir_->File("slurm/submit.sh")).find("--dependency=afterok:$array"), std::string::npos);
+  EXPECT_NE(ReadTextFile(dir_->File("slurm/merge.sbatch")).find("batch merge --manifest"),
+            std::string::npos);
+  EXPECT_NE(ReadTextFile(dir_->File("slurm/submit.sh")).find("--dependency=afterok:$array"),
+            std::string::npos);
 }
 
 }  // namespace

@@ -22,11 +22,11 @@ using testing::RunCommand;
 using testing::SharedDataDir;
 using testing::TempDir;
 
-nlohmann::json ReadJson(const std::string& path) { return nlohmann::json::parse(ReadTextFile(path)); }
-
-void WriteText(const std::string& path, const std::string& text) {
-  std::ofstream(path) << text;
+nlohmann::json ReadJson(const std::string& path) {
+  return nlohmann::json::parse(ReadTextFile(path));
 }
+
+void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
 
 TEST(CalibrateCommand, OpenCvModelOnTheChessboardEqualsCalibrateCamera) {
   // Issue 14's acceptance: the camera file in the OpenCV model, the board held (--board-sigma-mm
@@ -39,22 +39,28 @@ TEST(CalibrateCommand, OpenCvModelOnTheChessboardEqualsCalibrateCamera) {
   WriteText(tmp.File("camera.yaml"),
             "name: left\nmodel: opencv\npixel_size_mm: 0.006\nformat_px: [640, 480]\n"
             "interior: {fx: 500, fy: 500, cx: 319.5, cy: 239.5}\n");
-  const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" + dir +
-                            "/left*.jpg' --board chessboard:9x6:25 --board-sigma-mm 1e-6 --self-calibration "
-                            "fx,fy,cx,cy,k1,k2,p1,p2,k3 --model opencv --no-snooping --out " + tmp.File("cv.json"));
+  const auto r =
+      RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" + dir +
+                 "/left*.jpg' --board chessboard:9x6:25 --board-sigma-mm 1e-6 --self-calibration "
+                 "fx,fy,cx,cy,k1,k2,p1,p2,k3 --model opencv --no-snooping --out " +
+                 tmp.File("cv.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = ReadJson(tmp.File("cv.json"));
   EXPECT_EQ(j["cameras"][0]["model"], "opencv");
   const auto& ours = j["cameras"][0]["estimated"];
   const auto& cv = j["calibration"]["opencv"];
   for (const char* p : {"fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2", "k3"})
-    EXPECT_NEAR(ours[p].get<double>(), cv[p].get<double>(), 1e-4 * std::abs(cv[p].get<double>())) << p;
-  EXPECT_NEAR(j["calibration"]["rms_px"].get<double>(), cv["rms_px"].get<double>(), 1e-4 * cv["rms_px"].get<double>());
+    EXPECT_NEAR(ours[p].get<double>(), cv[p].get<double>(), 1e-4 * std::abs(cv[p].get<double>()))
+        << p;
+  EXPECT_NEAR(j["calibration"]["rms_px"].get<double>(),
+              cv["rms_px"].get<double>(),
+              1e-4 * cv["rms_px"].get<double>());
 
   // Its certificate draws the OpenCV camera's own distortion (computed in its model, not restated
   // by the renderer): this lens's strong barrel distortion (k1 ~ -0.28) is a large outward
   // correction at the corners, not the flat zero curve a 10-parameter formula would draw.
-  const auto c = RunAerocal("certificate --result " + tmp.File("cv.json") + " --out " + tmp.File("cert"));
+  const auto c =
+      RunAerocal("certificate --result " + tmp.File("cv.json") + " --out " + tmp.File("cert"));
   ASSERT_LE(c.exit_code, 3) << c.output;
   const auto cert = ReadJson(tmp.File("cert/certificate.json"));
   // No lab file: a draft, not called a certificate (issue 33 item 2).
@@ -77,14 +83,26 @@ TEST(CalibrateCommand, OpenCvChessboardAgainstCalibrateCameraAndThePublishedResu
   TempDir tmp("aerocal_calibrate_cv");
   WriteText(tmp.File("camera.yaml"),
             "name: left\npixel_size_mm: 0.006\nformat_px: [640, 480]\ninterior: {c: 3.0}\n");
-  const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" + dir +
-                            "/left*.jpg' --board chessboard:9x6:25 --model opencv --write-marks " +
-                            tmp.File("marks") + " --out " + tmp.File("left.json") +
-                            " --write-camera " + tmp.File("left_calibrated.yml") + " --camera-format opencv");
+  const auto r =
+      RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" + dir +
+                 "/left*.jpg' --board chessboard:9x6:25 --model opencv --write-marks " +
+                 tmp.File("marks") + " --out " + tmp.File("left.json") + " --write-camera " +
+                 tmp.File("left_calibrated.yml") + " --camera-format opencv");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = ReadJson(tmp.File("left.json"));
-  for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations",
-                          "converged", "cameras", "control", "check", "exposures", "rejected", "calibration"})
+  for (const char* key : {"kind",
+                          "sigma0",
+                          "sigma0_px",
+                          "sigma0_um",
+                          "redundancy",
+                          "iterations",
+                          "converged",
+                          "cameras",
+                          "control",
+                          "check",
+                          "exposures",
+                          "rejected",
+                          "calibration"})
     EXPECT_TRUE(j.contains(key)) << key;
   const auto& cal = j["calibration"];
   EXPECT_EQ(cal["method"]["detected"].size(), 13u);  // left01..14 without 10
@@ -103,9 +121,18 @@ TEST(CalibrateCommand, OpenCvChessboardAgainstCalibrateCameraAndThePublishedResu
   const double f_px = est["c"].get<double>() / p;
   const double cx = est["x0"].get<double>() / p + 319.5, cy = -est["y0"].get<double>() / p + 239.5;
   const auto& cv = cal["opencv"];
-  std::printf("aerocal: f %.3f cx %.3f cy %.3f RMS %.4f px | cv::calibrateCamera: fx %.3f fy %.3f cx %.3f "
-              "cy %.3f RMS %.4f px\n", f_px, cx, cy, cal["rms_px"].get<double>(), cv["fx"].get<double>(),
-              cv["fy"].get<double>(), cv["cx"].get<double>(), cv["cy"].get<double>(), cv["rms_px"].get<double>());
+  std::printf(
+      "aerocal: f %.3f cx %.3f cy %.3f RMS %.4f px | cv::calibrateCamera: fx %.3f fy %.3f cx %.3f "
+      "cy %.3f RMS %.4f px\n",
+      f_px,
+      cx,
+      cy,
+      cal["rms_px"].get<double>(),
+      cv["fx"].get<double>(),
+      cv["fy"].get<double>(),
+      cv["cx"].get<double>(),
+      cv["cy"].get<double>(),
+      cv["rms_px"].get<double>());
   // Same corners, different distortion models (correction form vs OpenCV's forward form) and a
   // common c for fx, fy: the principal distance within 0.2 %, the principal point within 1 px,
   // the RMS within 10 %.
@@ -122,7 +149,8 @@ TEST(CalibrateCommand, OpenCvChessboardAgainstCalibrateCameraAndThePublishedResu
   // The budget states c with U and k.
   bool stated = false;
   for (const auto& q : cal["uncertainty"])
-    stated = stated || (q["quantity"] == "c" && q["U"].get<double>() > 0 && q["k"].get<double>() >= 2.0);
+    stated =
+        stated || (q["quantity"] == "c" && q["U"].get<double>() > 0 && q["k"].get<double>() >= 2.0);
   EXPECT_TRUE(stated);
 }
 
@@ -132,10 +160,11 @@ class OlympusCalibration : public ::testing::Test {
     dir_ = SharedDataDir("dbat_camcal_olympus_c4040z");
     if (dir_.empty()) GTEST_SKIP() << "../shared/data/dbat_camcal_olympus_c4040z is absent";
     // The block files from the DBAT marks (the importer needs stations; calibrate ignores them).
-    const auto imp = RunAerocal("import dbat --camera-xml " + dir_ + "/c4040z.xml --marks " + dir_ +
-                                "/measurements/markpts.txt --images " + dir_ + "/images/images.txt --control " +
-                                dir_ + "/reference/camcal-fixed.txt --control-sigma-m 1e-6 --photomodeler-export " +
-                                dir_ + "/photomodeler/camcal-pmexport.txt --out " + tmp_.File("oly"));
+    const auto imp = RunAerocal(
+        "import dbat --camera-xml " + dir_ + "/c4040z.xml --marks " + dir_ +
+        "/measurements/markpts.txt --images " + dir_ + "/images/images.txt --control " + dir_ +
+        "/reference/camcal-fixed.txt --control-sigma-m 1e-6 --photomodeler-export " + dir_ +
+        "/photomodeler/camcal-pmexport.txt --out " + tmp_.File("oly"));
     ASSERT_EQ(imp.exit_code, 0) << imp.output;
     std::string groups = "image,group\n";
     for (int i = 21; i <= 41; ++i)
@@ -152,7 +181,8 @@ class OlympusCalibration : public ::testing::Test {
 };
 
 TEST_F(OlympusCalibration, PublishedDbatValuesWithinThreeSigmaAndGroupStability) {
-  const auto r = RunAerocal(Calibrate("--groups " + tmp_.File("groups.csv") + " --out " + tmp_.File("oly.json")));
+  const auto r = RunAerocal(
+      Calibrate("--groups " + tmp_.File("groups.csv") + " --out " + tmp_.File("oly.json")));
   // The three groups of 7 images do not agree within their sigmas (y0, P2, ...): flagged, exit 3.
   ASSERT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("warning: group_stability"), std::string::npos);
@@ -182,9 +212,14 @@ TEST_F(OlympusCalibration, PublishedDbatValuesWithinThreeSigmaAndGroupStability)
   // DBAT 0.9.2.0 (PROVENANCE.md): c 7.45700, pp 3.61546 / 2.61329 mm from the top-left corner,
   // K1 4.58861e-3, K2 -4.51351e-5, K3 -2.05253e-6, P1 -6.12803e-5, P2 -4.41171e-5.
   const double p = 0.0031911032863849768;
-  const std::map<std::string, double> published = {
-      {"c", 7.45700}, {"x0", 3.61546 - 2272 * p / 2}, {"y0", 1704 * p / 2 - 2.61329},
-      {"K1", 4.58861e-3}, {"K2", -4.51351e-5}, {"K3", -2.05253e-6}, {"P1", -6.12803e-5}, {"P2", -4.41171e-5}};
+  const std::map<std::string, double> published = {{"c", 7.45700},
+                                                   {"x0", 3.61546 - 2272 * p / 2},
+                                                   {"y0", 1704 * p / 2 - 2.61329},
+                                                   {"K1", 4.58861e-3},
+                                                   {"K2", -4.51351e-5},
+                                                   {"K3", -2.05253e-6},
+                                                   {"P1", -6.12803e-5},
+                                                   {"P2", -4.41171e-5}};
   for (const auto& [name, value] : published) {
     SCOPED_TRACE(name);
     EXPECT_LE(std::abs(est[name].get<double>() - value), 3.0 * sig[name].get<double>())
@@ -202,8 +237,9 @@ TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
             "camera: {make: Olympus, model: C4040Z, serial: '123'}\n"
             "signatures: {calibrated_by: A, checked_by: B, approved_by: C}\n");
   WriteText(tmp_.File("tol.yaml"), "c: 0.001\nx0: 0.001\n");
-  const std::string args = "certificate --result " + tmp_.File("oly.json") + " --lab " + tmp_.File("lab.yaml") +
-                           " --previous " + tmp_.File("oly.json") + " --tolerances " + tmp_.File("tol.yaml");
+  const std::string args = "certificate --result " + tmp_.File("oly.json") + " --lab " +
+                           tmp_.File("lab.yaml") + " --previous " + tmp_.File("oly.json") +
+                           " --tolerances " + tmp_.File("tol.yaml");
   const auto c1 = RunAerocal(args + " --out " + tmp_.File("cert1"));
   ASSERT_EQ(c1.exit_code, 0) << c1.output;
   EXPECT_NE(c1.output.find("c = 7.457"), std::string::npos) << c1.output;
@@ -217,25 +253,37 @@ TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
     EXPECT_EQ(row["judged"].get<bool>(), q != "m_0" && q != "m_X" && q != "m_Y" && q != "m_Z") << q;
   }
   const std::string html = ReadTextFile(tmp_.File("cert1/certificate.html"));
-  for (const char* text : {"Calibration certificate", "T-1", "Uncertainty budget", "<svg", "Stability over image groups",
-                           "Check points", "Comparison with the previous certificate", "Signatures", "c = 7.457"})
+  for (const char* text : {"Calibration certificate",
+                           "T-1",
+                           "Uncertainty budget",
+                           "<svg",
+                           "Stability over image groups",
+                           "Check points",
+                           "Comparison with the previous certificate",
+                           "Signatures",
+                           "c = 7.457"})
     EXPECT_NE(html.find(text), std::string::npos) << text;
   // Deterministic: a second run writes the same bytes.
   const auto c2 = RunAerocal(args + " --out " + tmp_.File("cert2"));
   ASSERT_EQ(c2.exit_code, 0) << c2.output;
   for (const char* f : {"certificate.json", "certificate.html", "certificate.pdf"}) {
     SCOPED_TRACE(f);
-    EXPECT_EQ(ReadTextFile(tmp_.File(std::string("cert1/") + f)), ReadTextFile(tmp_.File(std::string("cert2/") + f)));
+    EXPECT_EQ(ReadTextFile(tmp_.File(std::string("cert1/") + f)),
+              ReadTextFile(tmp_.File(std::string("cert2/") + f)));
   }
   // Every PDF page rendered to PNG (poppler's pdftoppm).
   if (RunCommand("command -v pdftoppm").exit_code != 0)
-    GTEST_SKIP() << "pdftoppm is absent (Debian package poppler-utils): the PDF pages are not rendered";
-  const auto png = RunCommand("pdftoppm -r 40 -png " + tmp_.File("cert1/certificate.pdf") + " " + tmp_.File("page"));
+    GTEST_SKIP()
+        << "pdftoppm is absent (Debian package poppler-utils): the PDF pages are not rendered";
+  const auto png = RunCommand("pdftoppm -r 40 -png " + tmp_.File("cert1/certificate.pdf") + " " +
+                              tmp_.File("page"));
   ASSERT_EQ(png.exit_code, 0) << png.output;
   int pages = 0;
   for (const auto& e : std::filesystem::directory_iterator(tmp_.path()))
     if (e.path().extension() == ".png" && std::filesystem::file_size(e.path()) > 1000) ++pages;
-  EXPECT_GE(pages, 5);  // identification + results + budget, distortion, residuals, stability .. signatures
+  EXPECT_GE(
+      pages,
+      5);  // identification + results + budget, distortion, residuals, stability .. signatures
 }
 
 TEST_F(OlympusCalibration, GroupColumnOfTheObservationsGivesTheSameGroups) {
@@ -246,20 +294,23 @@ TEST_F(OlympusCalibration, GroupColumnOfTheObservationsGivesTheSameGroups) {
   for (size_t i = 0; i < obs.header().size(); ++i) out << (i ? "," : "") << obs.header()[i];
   out << ",group\n";
   for (const auto& row : obs.rows()) {
-    for (size_t i = 0; i < obs.header().size(); ++i) out << (i ? "," : "") << obs.String(row, obs.header()[i]);
+    for (size_t i = 0; i < obs.header().size(); ++i)
+      out << (i ? "," : "") << obs.String(row, obs.header()[i]);
     const int number = std::stoi(obs.String(row, "image").substr(6));
     out << ",G" << number % 3 + 1 << "\n";
   }
   out.close();
   const std::string grouped = "calibrate --camera " + tmp_.File("oly/camera_cam1.yaml") +
-                              " --observations " + tmp_.File("oly/observations_grouped.csv") + " --points " +
-                              tmp_.File("oly/points.csv") + " --self-calibration c,x0,y0,K1,K2,K3,P1,P2,B1 --no-snooping ";
+                              " --observations " + tmp_.File("oly/observations_grouped.csv") +
+                              " --points " + tmp_.File("oly/points.csv") +
+                              " --self-calibration c,x0,y0,K1,K2,K3,P1,P2,B1 --no-snooping ";
   const auto r = RunAerocal(grouped + "--out " + tmp_.File("col.json"));
   ASSERT_EQ(r.exit_code, 3) << r.output;  // the groups disagree, as with --groups
   const auto a = ReadJson(tmp_.File("col.json"));
   ASSERT_EQ(a["calibration"]["groups"].size(), 3u);
   for (const auto& g : a["calibration"]["groups"]) EXPECT_EQ(g["images"].size(), 7u);
-  const auto both = RunAerocal(grouped + "--groups " + tmp_.File("groups.csv") + " --out " + tmp_.File("both.json"));
+  const auto both = RunAerocal(grouped + "--groups " + tmp_.File("groups.csv") + " --out " +
+                               tmp_.File("both.json"));
   EXPECT_EQ(both.exit_code, 2) << both.output;
   EXPECT_NE(both.output.find("has a group column already"), std::string::npos) << both.output;
   EXPECT_FALSE(std::filesystem::exists(tmp_.File("both.json")));
@@ -267,24 +318,31 @@ TEST_F(OlympusCalibration, GroupColumnOfTheObservationsGivesTheSameGroups) {
 
 TEST(CalibrateCommand, BadInputExitsTwoAndWritesNothing) {
   TempDir tmp("aerocal_calibrate_bad");
-  WriteText(tmp.File("camera.yaml"), "name: c\npixel_size_mm: 0.006\nformat_px: [640, 480]\ninterior: {c: 3.0}\n");
-  WriteText(tmp.File("points.csv"), "point,X,Y,Z,sX,sY,sZ,role\nA,0,0,0,0.001,0.001,0.001,control\n");
+  WriteText(tmp.File("camera.yaml"),
+            "name: c\npixel_size_mm: 0.006\nformat_px: [640, 480]\ninterior: {c: 3.0}\n");
+  WriteText(tmp.File("points.csv"),
+            "point,X,Y,Z,sX,sY,sZ,role\nA,0,0,0,0.001,0.001,0.001,control\n");
   WriteText(tmp.File("obs.csv"), "image,point,col,row,sigma_px\ni1,A,10,10,0.5\ni1,B,abc,20,0.5\n");
   WriteText(tmp.File("few.csv"), "image,point,col,row,sigma_px\ni1,A,10,10,0.5\ni1,B,20,20,0.5\n");
-  auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" + tmp.File("*.jpg") +
-                      "' --board chessboard:9:25 --out " + tmp.File("out.json"));
+  auto r =
+      RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --images '" +
+                 tmp.File("*.jpg") + "' --board chessboard:9:25 --out " + tmp.File("out.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("--board"), std::string::npos) << r.output;
-  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " + tmp.File("obs.csv") +
-                 " --points " + tmp.File("points.csv") + " --out " + tmp.File("out.json"));
+  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " +
+                 tmp.File("obs.csv") + " --points " + tmp.File("points.csv") + " --out " +
+                 tmp.File("out.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("obs.csv:3"), std::string::npos) << r.output;  // col is not a number
-  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " + tmp.File("few.csv") +
-                 " --points " + tmp.File("points.csv") + " --out " + tmp.File("out.json"));
+  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " +
+                 tmp.File("few.csv") + " --points " + tmp.File("points.csv") + " --out " +
+                 tmp.File("out.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;  // one control point: no resection
-  EXPECT_NE(r.output.find("no starting orientation by resection for i1"), std::string::npos) << r.output;
-  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " + tmp.File("obs.csv") +
-                 " --images x --board chessboard:9x6:25 --out " + tmp.File("out.json"));
+  EXPECT_NE(r.output.find("no starting orientation by resection for i1"), std::string::npos)
+      << r.output;
+  r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " +
+                 tmp.File("obs.csv") + " --images x --board chessboard:9x6:25 --out " +
+                 tmp.File("out.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   for (const char* bad : {"0", "-1", "nan", "2e3"}) {  // issue 28: the effect limit, by name
     r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --observations " +

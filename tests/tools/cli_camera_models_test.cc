@@ -34,8 +34,9 @@ class FlightInAnotherModel : public ::testing::Test {
   static void SetUpTestSuite() {
     dir_ = new TempDir("aerocal_camera_models_flight");
     ASSERT_EQ(RunAerocal("simulate --out " + dir_->File("f")).exit_code, 0);
-    const auto c = RunAerocal("camera convert --from aerocal --to aerocal --model metashape_frame " +
-                              dir_->File("f/camera_nominal.yaml") + " " + dir_->File("f/cam_ms.yaml"));
+    const auto c =
+        RunAerocal("camera convert --from aerocal --to aerocal --model metashape_frame " +
+                   dir_->File("f/camera_nominal.yaml") + " " + dir_->File("f/cam_ms.yaml"));
     ASSERT_EQ(c.exit_code, 0) << c.output;
     WriteText(dir_->File("f/project_ms.yaml"),
               "cameras: {cam1: cam_ms.yaml}\nexposures: exposures.csv\npoints: points.csv\n"
@@ -69,18 +70,23 @@ TEST_F(FlightInAnotherModel, AdjustRunsInTheCameraFilesModelAndWritesItBackInIt)
   EXPECT_NEAR(j["sigma0"].get<double>() / b["sigma0"].get<double>(), 1.0, 0.01);
   for (int axis = 0; axis < 3; ++axis)
     EXPECT_NEAR(j["check"]["rmse_m"][axis].get<double>() / b["check"]["rmse_m"][axis].get<double>(),
-                1.0, 0.01);
+                1.0,
+                0.01);
   // c = f p: the two principal distances and their sigmas agree.
   const double p = 0.009;
-  EXPECT_NEAR(cam["estimated"]["f"].get<double>() * p, b["cameras"][0]["estimated"]["c"].get<double>(),
+  EXPECT_NEAR(cam["estimated"]["f"].get<double>() * p,
+              b["cameras"][0]["estimated"]["c"].get<double>(),
               0.1 * b["cameras"][0]["sigma"]["c"].get<double>());
-  EXPECT_NEAR(cam["sigma"]["f"].get<double>() * p / b["cameras"][0]["sigma"]["c"].get<double>(), 1.0,
-              0.01);
+  EXPECT_NEAR(
+      cam["sigma"]["f"].get<double>() * p / b["cameras"][0]["sigma"]["c"].get<double>(), 1.0, 0.01);
   // Written back in its own model, readable as the next run's camera.
-  const calib::Camera back = calib::ReadCamera(dir_->File("ms_out.yaml"), calib::CameraModels::kAny);
+  const calib::Camera back =
+      calib::ReadCamera(dir_->File("ms_out.yaml"), calib::CameraModels::kAny);
   EXPECT_EQ(back.model, calib::MetashapeFrameModel::kId);
-  EXPECT_DOUBLE_EQ(back.interior[calib::MetashapeFrameModel::kF], cam["estimated"]["f"].get<double>());
-  EXPECT_DOUBLE_EQ(back.interior[calib::MetashapeFrameModel::kK2], cam["estimated"]["k2"].get<double>());
+  EXPECT_DOUBLE_EQ(back.interior[calib::MetashapeFrameModel::kF],
+                   cam["estimated"]["f"].get<double>());
+  EXPECT_DOUBLE_EQ(back.interior[calib::MetashapeFrameModel::kK2],
+                   cam["estimated"]["k2"].get<double>());
 }
 
 TEST_F(FlightInAnotherModel, BadModelUseIsExitTwoWithNothingWritten) {
@@ -88,12 +94,14 @@ TEST_F(FlightInAnotherModel, BadModelUseIsExitTwoWithNothingWritten) {
   auto r = RunAerocal("adjust --project " + dir_->File("f/project_ms.yaml") +
                       " --self-calibration c,x0 --out " + dir_->File("bad1.json"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("--self-calibration: unknown parameter 'c'"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("--self-calibration: unknown parameter 'c'"), std::string::npos)
+      << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("bad1.json")));
   // Sub-image mappings need the 10-parameter model: FILE:LINE of the model key.
-  WriteText(dir_->File("f/cam_sub.yaml"),
-            "model: opencv\npixel_size_mm: 0.009\nformat_px: [100, 100]\ninterior: {fx: 10, fy: 10}\n"
-            "subimages:\n  - {id: I, format_px: [50, 50]}\n");
+  WriteText(
+      dir_->File("f/cam_sub.yaml"),
+      "model: opencv\npixel_size_mm: 0.009\nformat_px: [100, 100]\ninterior: {fx: 10, fy: 10}\n"
+      "subimages:\n  - {id: I, format_px: [50, 50]}\n");
   WriteText(dir_->File("f/project_sub.yaml"),
             "cameras: {cam1: cam_sub.yaml}\nexposures: exposures.csv\npoints: points.csv\n"
             "observations: observations.csv\n");
@@ -123,8 +131,9 @@ class TestFieldInOpenCv : public ::testing::Test {
                          dir_->File("tf"))
                   .exit_code,
               0);
-    const auto c = RunAerocal("camera convert --from aerocal --to aerocal --model opencv " +
-                              dir_->File("tf/camera_nominal.yaml") + " " + dir_->File("tf/cam_cv.yaml"));
+    const auto c =
+        RunAerocal("camera convert --from aerocal --to aerocal --model opencv " +
+                   dir_->File("tf/camera_nominal.yaml") + " " + dir_->File("tf/cam_cv.yaml"));
     ASSERT_EQ(c.exit_code, 0) << c.output;
   }
   static void TearDownTestSuite() { delete dir_; }
@@ -137,9 +146,9 @@ class TestFieldInOpenCv : public ::testing::Test {
 TempDir* TestFieldInOpenCv::dir_ = nullptr;
 
 TEST_F(TestFieldInOpenCv, AnOpenCvCameraFileIsCalibratedInTheOpenCvModel) {
-  const auto r = RunAerocal("calibrate --camera " + dir_->File("tf/cam_cv.yaml") + Field() +
-                            " --out " + dir_->File("cv.json") + " --write-camera " +
-                            dir_->File("cv_out.yaml"));
+  const auto r =
+      RunAerocal("calibrate --camera " + dir_->File("tf/cam_cv.yaml") + Field() + " --out " +
+                 dir_->File("cv.json") + " --write-camera " + dir_->File("cv_out.yaml"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = ReadJson(dir_->File("cv.json"));
   const auto& cam = j["cameras"][0];
@@ -154,9 +163,11 @@ TEST_F(TestFieldInOpenCv, AnOpenCvCameraFileIsCalibratedInTheOpenCvModel) {
   const auto& est = cam["estimated"];
   const auto& sigma = cam["sigma"];
   EXPECT_NEAR(est["fy"].get<double>(), truth.c_mm() / p, 3 * sigma["fy"].get<double>());
-  EXPECT_NEAR(est["cx"].get<double>(), truth.PrincipalPointMm().x() / p + 0.5 * (truth.width_px - 1),
+  EXPECT_NEAR(est["cx"].get<double>(),
+              truth.PrincipalPointMm().x() / p + 0.5 * (truth.width_px - 1),
               3 * sigma["cx"].get<double>());
-  EXPECT_NEAR(est["cy"].get<double>(), -truth.PrincipalPointMm().y() / p + 0.5 * (truth.height_px - 1),
+  EXPECT_NEAR(est["cy"].get<double>(),
+              -truth.PrincipalPointMm().y() / p + 0.5 * (truth.height_px - 1),
               3 * sigma["cy"].get<double>());
   // Simulated 0.1 px noise with sigma 0.1 px.
   EXPECT_NEAR(j["sigma0"].get<double>(), 1.0, 0.1);
@@ -164,7 +175,8 @@ TEST_F(TestFieldInOpenCv, AnOpenCvCameraFileIsCalibratedInTheOpenCvModel) {
   bool stated = false;
   for (const auto& q : j["calibration"]["uncertainty"]) stated = stated || q["quantity"] == "fx";
   EXPECT_TRUE(stated);
-  const calib::Camera back = calib::ReadCamera(dir_->File("cv_out.yaml"), calib::CameraModels::kAny);
+  const calib::Camera back =
+      calib::ReadCamera(dir_->File("cv_out.yaml"), calib::CameraModels::kAny);
   EXPECT_EQ(back.model, calib::OpenCvModel::kId);
   EXPECT_DOUBLE_EQ(back.interior[calib::OpenCvModel::kFx], est["fx"].get<double>());
 }

@@ -1,21 +1,22 @@
 // aerocal camera convert / show (issue 15): every format through the command line, the OpenCV
-// format against OpenCV itself (the published chessboard calibration projected by cv::projectPoints,
-// the DJI DewarpData records undistorted by cv::undistortPoints), --report, --max-residual-px,
+// format against OpenCV itself (the published chessboard calibration projected by
+// cv::projectPoints, the DJI DewarpData records undistorted by cv::undistortPoints), --report,
+// --max-residual-px,
 // --model, the distortion plot.
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <fstream>
-#include <sstream>
+#include "calib/camera/convert_camera.h"
+#include "tests/support/test_support.h"
+#include "tools/camera_formats.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 #include <opencv2/calib3d.hpp>
 #include <opencv2/core.hpp>
 
-#include "calib/camera/convert_camera.h"
-#include "tests/support/test_support.h"
-#include "tools/camera_formats.h"
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
 
 namespace aerocal {
 namespace {
@@ -43,26 +44,30 @@ cv::Point2d Project(const ModelCamera& camera, const cv::Point3d& q) {
   return {pixel.x(), pixel.y()};
 }
 
-// OpenCV's calibration sample output (samples/cpp/calibration.cpp saveCameraParams: calibration_time,
-// nframes, image_width, image_height, board size, flags, camera_matrix, distortion_coefficients,
-// avg_reprojection_error, per_view_reprojection_errors, extrinsic_parameters, image_points) as
-// cv::FileStorage writes it in XML and JSON, and the published YAML output cut short (its first
-// 30 lines: a copy that stops inside per_view_reprojection_errors' data).
+// OpenCV's calibration sample output (samples/cpp/calibration.cpp saveCameraParams:
+// calibration_time, nframes, image_width, image_height, board size, flags, camera_matrix,
+// distortion_coefficients, avg_reprojection_error, per_view_reprojection_errors,
+// extrinsic_parameters, image_points) as cv::FileStorage writes it in XML and JSON, and the
+// published YAML output cut short (its first 30 lines: a copy that stops inside
+// per_view_reprojection_errors' data).
 TEST(CameraFormatsOpenCv, SampleOutputAsXmlJsonAndCutShort) {
   TempDir tmp("aerocal_cli_camera");
-  const cv::Mat k = (cv::Mat_<double>(3, 3) << 535.9157, 0, 342.2832, 0, 535.9157, 235.5708, 0, 0, 1);
-  const cv::Mat d = (cv::Mat_<double>(5, 1) << -0.266373, -0.0385889, 0.00178319, -0.000281221, 0.238392);
+  const cv::Mat k =
+      (cv::Mat_<double>(3, 3) << 535.9157, 0, 342.2832, 0, 535.9157, 235.5708, 0, 0, 1);
+  const cv::Mat d =
+      (cv::Mat_<double>(5, 1) << -0.266373, -0.0385889, 0.00178319, -0.000281221, 0.238392);
   for (const char* extension : {".xml", ".json"}) {
     SCOPED_TRACE(extension);
     const std::string path = tmp.File(std::string("out_camera_data") + extension);
     {
       cv::FileStorage fs(path, cv::FileStorage::WRITE);
-      fs << "calibration_time" << "Fri Nov 27 10:00:00 2026" << "nframes" << 13
-         << "image_width" << 640 << "image_height" << 480 << "board_width" << 9
+      fs << "calibration_time"
+         << "Fri Nov 27 10:00:00 2026"
+         << "nframes" << 13 << "image_width" << 640 << "image_height" << 480 << "board_width" << 9
          << "board_height" << 6 << "square_size" << 0.025 << "flags" << 0 << "camera_matrix" << k
          << "distortion_coefficients" << d << "avg_reprojection_error" << 0.3926
-         << "extrinsic_parameters" << cv::Mat(13, 6, CV_64F, cv::Scalar(0.1))
-         << "image_points" << cv::Mat(13, 54, CV_32FC2, cv::Scalar(1, 2));
+         << "extrinsic_parameters" << cv::Mat(13, 6, CV_64F, cv::Scalar(0.1)) << "image_points"
+         << cv::Mat(13, 54, CV_32FC2, cv::Scalar(1, 2));
     }
     EXPECT_EQ(calib::DetectCameraFormats(path), std::vector<std::string>{"opencv"});
     const CameraFile f = calib::ReadCameraFileAs("auto", path, {});
@@ -124,12 +129,13 @@ TEST(CameraFormatsOpenCv, PublishedChessboardCalibrationThroughEveryFormatProjec
     options.height_px = format.writes_size ? 0 : 480;
     options.pixel_size_mm = format.writes_pixel_size ? 0 : 0.006;
     const CameraFile read = format.read(path, options);
-    const calib::FileConversion back =
-        calib::ConvertCameraFile(read, {CameraModelId::kOpenCv, {}});
+    const calib::FileConversion back = calib::ConvertCameraFile(read, {CameraModelId::kOpenCv, {}});
     double worst = 0, worst_back = 0;
     for (int v = 0; v < extrinsics.rows; ++v) {
-      const cv::Vec3d rvec(extrinsics.at<double>(v, 0), extrinsics.at<double>(v, 1), extrinsics.at<double>(v, 2));
-      const cv::Vec3d tvec(extrinsics.at<double>(v, 3), extrinsics.at<double>(v, 4), extrinsics.at<double>(v, 5));
+      const cv::Vec3d rvec(
+          extrinsics.at<double>(v, 0), extrinsics.at<double>(v, 1), extrinsics.at<double>(v, 2));
+      const cv::Vec3d tvec(
+          extrinsics.at<double>(v, 3), extrinsics.at<double>(v, 4), extrinsics.at<double>(v, 5));
       std::vector<cv::Point2d> expected;
       cv::projectPoints(board, rvec, tvec, k, d, expected);
       cv::Matx33d r;
@@ -141,10 +147,15 @@ TEST(CameraFormatsOpenCv, PublishedChessboardCalibrationThroughEveryFormatProjec
         worst_back = std::max(worst_back, cv::norm(Project(back.file.camera, qc) - expected[i]));
       }
     }
-    std::printf("left_intrinsics.yml -> %-9s (%s, %s): board max %.3g px; back in opencv %.3g px "
-                "(stated max %.3g px)\n",
-                format.name.c_str(), std::string(calib::CameraModelName(read.camera.model)).c_str(),
-                out.result.exact ? "exact" : "fit", worst, worst_back, out.result.residual.max_px);
+    std::printf(
+        "left_intrinsics.yml -> %-9s (%s, %s): board max %.3g px; back in opencv %.3g px "
+        "(stated max %.3g px)\n",
+        format.name.c_str(),
+        std::string(calib::CameraModelName(read.camera.model)).c_str(),
+        out.result.exact ? "exact" : "fit",
+        worst,
+        worst_back,
+        out.result.residual.max_px);
     if (out.result.exact) {
       EXPECT_LT(worst, 1e-9);
       EXPECT_LT(worst_back, 1e-9);
@@ -160,17 +171,27 @@ TEST(CameraFormatsOpenCv, DjiDewarpDataUndistortedLikeOpenCvWithinTheRefitResidu
   const ModelCamera dji = calib::DjiDewarpDataCamera(
       "2018-09-06;3684.480000000000,3677.570000000000,2.240000000000,22.050000000000,"
       "-0.263482000000,0.106788000000,0.000037110700,-0.000327247000,-0.030078300000",
-      {"record A", 1}, 5472, 3648);
+      {"record A", 1},
+      5472,
+      3648);
   ModelCamera with_pixel = dji;
   with_pixel.frame.pixel_size_mm = 0.0024;
-  const calib::ConversionResult ours = calib::ConvertCamera(with_pixel, CameraModelId::kBrownFraser10);
+  const calib::ConversionResult ours =
+      calib::ConvertCamera(with_pixel, CameraModelId::kBrownFraser10);
   const std::vector<double>& p = dji.params;
   const cv::Matx33d k(p[0], 0, p[2], 0, p[1], p[3], 0, 0, 1);
   const std::vector<double> d = {p[4], p[5], p[6], p[7], p[8]};
   std::vector<cv::Point2d> pixels, undistorted;
-  for (const Eigen::Vector2d& q : calib::FormatGrid(dji.frame, 21)) pixels.emplace_back(q.x(), q.y());
-  cv::undistortPoints(pixels, undistorted, k, d, cv::noArray(), cv::noArray(),
-                      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-15));
+  for (const Eigen::Vector2d& q : calib::FormatGrid(dji.frame, 21))
+    pixels.emplace_back(q.x(), q.y());
+  cv::undistortPoints(
+      pixels,
+      undistorted,
+      k,
+      d,
+      cv::noArray(),
+      cv::noArray(),
+      cv::TermCriteria(cv::TermCriteria::COUNT + cv::TermCriteria::EPS, 200, 1e-15));
   // Compared where the refit residual is defined, in measured pixels (OpenCV's undistorted ray
   // re-imaged by our refit), and printed also in undistorted pixels (ideal / c * fy), where the
   // corners are stretched by the undistortion (about 2.3 x at this lens's corners).
@@ -190,12 +211,18 @@ TEST(CameraFormatsOpenCv, DjiDewarpDataUndistortedLikeOpenCvWithinTheRefitResidu
     ASSERT_TRUE(ours.camera.PixelFromIdeal(cv_n * ours.camera.PrincipalDistanceMm(), &reimaged));
     worst_measured = std::max(worst_measured, (reimaged - pixel).norm());
     worst_ours = std::max(worst_ours, e_ours);
-    if ((pixel - Eigen::Vector2d(2735.5, 1823.5)).norm() <= inner) worst_inner = std::max(worst_inner, e_ours);
+    if ((pixel - Eigen::Vector2d(2735.5, 1823.5)).norm() <= inner)
+      worst_inner = std::max(worst_inner, e_ours);
   }
-  std::printf("DJI record A: our opencv model vs cv::undistortPoints %.3g px; our 10-parameter "
-              "refit: %.3g px measured (refit residual max %.3g px), %.3g px undistorted (within "
-              "80 %%: %.3g px)\n",
-              worst_model, worst_measured, ours.residual.max_px, worst_ours, worst_inner);
+  std::printf(
+      "DJI record A: our opencv model vs cv::undistortPoints %.3g px; our 10-parameter "
+      "refit: %.3g px measured (refit residual max %.3g px), %.3g px undistorted (within "
+      "80 %%: %.3g px)\n",
+      worst_model,
+      worst_measured,
+      ours.residual.max_px,
+      worst_ours,
+      worst_inner);
   EXPECT_LT(worst_model, 1e-6);  // the same model: agreement to the iterations' tolerance
   EXPECT_LT(worst_measured, ours.residual.max_px + 1e-6);
   EXPECT_LT(worst_inner, 2.5 * ours.residual.max_inner80_px);
@@ -204,10 +231,11 @@ TEST(CameraFormatsOpenCv, DjiDewarpDataUndistortedLikeOpenCvWithinTheRefitResidu
 // ---- the command line ----
 
 void WriteAerialCamera(const std::string& path) {
-  std::ofstream(path) << "name: aerial\npixel_size_mm: 0.009\nformat_px: [14000, 12000]\n"
-                         "interior: {c: 170.038, x0: -0.0024, y0: 0.0015, K1: 3.0e-8, K2: -2.0e-12, "
-                         "K3: 1.0e-16, P1: 2.0e-7, P2: -1.5e-7, B1: 1.0e-5, B2: -8.0e-6}\n"
-                         "interior_sigma: {c: 0.002, x0: 0.001}\n";
+  std::ofstream(path)
+      << "name: aerial\npixel_size_mm: 0.009\nformat_px: [14000, 12000]\n"
+         "interior: {c: 170.038, x0: -0.0024, y0: 0.0015, K1: 3.0e-8, K2: -2.0e-12, "
+         "K3: 1.0e-16, P1: 2.0e-7, P2: -1.5e-7, B1: 1.0e-5, B2: -8.0e-6}\n"
+         "interior_sigma: {c: 0.002, x0: 0.001}\n";
 }
 
 TEST(CliCamera, ConvertsOursIntoEveryFormatAndBackWithAReport) {
@@ -216,9 +244,10 @@ TEST(CliCamera, ConvertsOursIntoEveryFormatAndBackWithAReport) {
   WriteAerialCamera(ours);
   for (const tools::CameraFormat& format : tools::CameraFormats()) {
     SCOPED_TRACE(format.name);
-    const std::string out = tmp.File("cam." + format.name), report = tmp.File(format.name + ".json");
-    auto r = RunAerocal("camera convert --from aerocal --to " + format.name + " " + ours + " " + out +
-                        " --report " + report);
+    const std::string out = tmp.File("cam." + format.name),
+                      report = tmp.File(format.name + ".json");
+    auto r = RunAerocal("camera convert --from aerocal --to " + format.name + " " + ours + " " +
+                        out + " --report " + report);
     ASSERT_EQ(r.exit_code, 0) << r.output;
     EXPECT_NE(r.output.find("residual over the format"), std::string::npos) << r.output;
     const auto json = nlohmann::json::parse(Read(report));
@@ -237,7 +266,7 @@ TEST(CliCamera, ConvertsOursIntoEveryFormatAndBackWithAReport) {
     if (format.name == "metashape") {
       EXPECT_NE(Read(out).find("<covariance>"), std::string::npos);
     }
-    const std::string extra = !format.writes_size          ? " --width 14000 --height 12000"
+    const std::string extra = !format.writes_size        ? " --width 14000 --height 12000"
                               : format.writes_pixel_size ? ""
                                                          : " --pixel-size-mm 0.009";
     // Back with --from auto: every file we write is detected as its own format.
@@ -254,8 +283,10 @@ TEST(CliCamera, ShowPrintsOurConventionAndWritesThePlot) {
   const std::string dji = tmp.File("dji.txt");
   std::ofstream(dji) << "2018-09-06;3684.48,3677.57,2.24,22.05,-0.263482,0.106788,3.71107e-5,"
                         "-3.27247e-4,-0.0300783\n";
-  const auto r = RunAerocal("camera show --from dji " + dji + " --width 5472 --height 3648 "
-                            "--pixel-size-mm 0.0024 --plot " + tmp.File("d.svg"));
+  const auto r = RunAerocal("camera show --from dji " + dji +
+                            " --width 5472 --height 3648 "
+                            "--pixel-size-mm 0.0024 --plot " +
+                            tmp.File("d.svg"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("our convention"), std::string::npos) << r.output;
   // x0 = (2738.24 - 2735.5) px = 2.74 px from the centre.
@@ -264,7 +295,8 @@ TEST(CliCamera, ShowPrintsOurConventionAndWritesThePlot) {
   // The stereo file's second camera.
   const std::string data = testing::SharedDataDir("opencv_stereo_chessboard_9x6");
   if (!data.empty()) {
-    const auto s = RunAerocal("camera show --from opencv " + data + "/intrinsics.yml --camera 2 "
+    const auto s = RunAerocal("camera show --from opencv " + data +
+                              "/intrinsics.yml --camera 2 "
                               "--width 640 --height 480");
     EXPECT_EQ(s.exit_code, 0) << s.output;
     EXPECT_NE(s.output.find("334.557445279"), std::string::npos) << s.output;
@@ -274,10 +306,13 @@ TEST(CliCamera, ShowPrintsOurConventionAndWritesThePlot) {
 TEST(CliCamera, MaxResidualTurnsABadFitIntoExit3AndWritesNothing) {
   TempDir tmp("aerocal_cli_camera");
   const std::string dji = tmp.File("dji.txt");
-  std::ofstream(dji) << "3684.48,3677.57,2.24,22.05,-0.263482,0.106788,3.71107e-5,-3.27247e-4,-0.0300783\n";
+  std::ofstream(dji)
+      << "3684.48,3677.57,2.24,22.05,-0.263482,0.106788,3.71107e-5,-3.27247e-4,-0.0300783\n";
   const auto r = RunAerocal("camera convert --from dji --to aerocal --model brown10 " + dji + " " +
-                            tmp.File("ours.yaml") + " --width 5472 --height 3648 --pixel-size-mm 0.0024 "
-                            "--max-residual-px 5 --report " + tmp.File("r.json"));
+                            tmp.File("ours.yaml") +
+                            " --width 5472 --height 3648 --pixel-size-mm 0.0024 "
+                            "--max-residual-px 5 --report " +
+                            tmp.File("r.json"));
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("conversion_residual"), std::string::npos) << r.output;
   EXPECT_FALSE(fs::exists(tmp.File("ours.yaml")));
@@ -285,8 +320,9 @@ TEST(CliCamera, MaxResidualTurnsABadFitIntoExit3AndWritesNothing) {
   EXPECT_FALSE(json["acceptable"].get<bool>());
   EXPECT_GT(json["residual_px"]["max"].get<double>(), 5.0);
   // Kept in its own model (no --model) it is exact.
-  const auto exact = RunAerocal("camera convert --from dji --to aerocal " + dji + " " +
-                                tmp.File("dji.yaml") + " --width 5472 --height 3648 --pixel-size-mm 0.0024");
+  const auto exact =
+      RunAerocal("camera convert --from dji --to aerocal " + dji + " " + tmp.File("dji.yaml") +
+                 " --width 5472 --height 3648 --pixel-size-mm 0.0024");
   EXPECT_EQ(exact.exit_code, 0) << exact.output;
   EXPECT_NE(exact.output.find("exact (closed form)"), std::string::npos) << exact.output;
   EXPECT_NE(Read(tmp.File("dji.yaml")).find("model: opencv"), std::string::npos);

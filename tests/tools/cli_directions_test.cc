@@ -5,21 +5,21 @@
 // truth, the method stated in the result and in the certificate, the camera file written in the
 // requested format; two series as groups give the stability table and the reproducibility
 // component; bad rows name FILE:LINE (exit 2, nothing written).
+#include "calib/camera/camera.h"
+#include "calib/camera/rotation.h"
+#include "calib/core/string_printf.h"
+#include "tests/support/simulated_directions.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <random>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
-#include "calib/camera/camera.h"
-#include "calib/camera/rotation.h"
-#include "calib/core/string_printf.h"
-#include "tests/support/simulated_directions.h"
-#include "tests/support/test_support.h"
 
 namespace aerocal {
 namespace {
@@ -48,7 +48,9 @@ calib::Camera Truth() {
   return camera;
 }
 
-Eigen::Vector3d Direction(double azimuth, double elevation) { return testing::InstrumentDirection(azimuth, elevation); }
+Eigen::Vector3d Direction(double azimuth, double elevation) {
+  return testing::InstrumentDirection(azimuth, elevation);
+}
 
 // The measured pixel of direction t (instrument frame) through setting G, with image noise.
 Eigen::Vector2d Observe(const Eigen::Matrix3d& g, const Eigen::Vector3d& t, std::mt19937_64* rng) {
@@ -57,7 +59,9 @@ Eigen::Vector2d Observe(const Eigen::Matrix3d& g, const Eigen::Vector3d& t, std:
   return px;
 }
 
-Eigen::Matrix3d AngularError(std::mt19937_64* rng) { return testing::RandomSmallRotation(kSigmaArcsec * kArcSecond, rng); }
+Eigen::Matrix3d AngularError(std::mt19937_64* rng) {
+  return testing::RandomSmallRotation(kSigmaArcsec * kArcSecond, rng);
+}
 
 // Node (i, j) of the 9 x 9 grid: azimuth -17..17 deg, elevation -11 .. 11 deg.
 Eigen::Vector2d GridDeg(int i, int j) { return {-17.0 + 34.0 * i / 8.0, -11.0 + 22.0 * j / 8.0}; }
@@ -70,8 +74,16 @@ std::string CollimatorRows(std::mt19937_64* rng, const std::string& group) {
       const Eigen::Vector2d a = GridDeg(i, j);
       const Eigen::Vector3d t = AngularError(rng) * Direction(a.x() * kDeg, a.y() * kDeg);
       const Eigen::Vector2d px = Observe(Eigen::Matrix3d::Identity(), t, rng);
-      rows += StringPrintf("C%d%d,%.5f,%.5f,%.3f,%.6f,%.6f,%.2f%s\n", i, j, px.x(), px.y(), kSigmaPx, a.x(), a.y(),
-                           kSigmaArcsec, group.empty() ? "" : ("," + group).c_str());
+      rows += StringPrintf("C%d%d,%.5f,%.5f,%.3f,%.6f,%.6f,%.2f%s\n",
+                           i,
+                           j,
+                           px.x(),
+                           px.y(),
+                           kSigmaPx,
+                           a.x(),
+                           a.y(),
+                           kSigmaArcsec,
+                           group.empty() ? "" : ("," + group).c_str());
     }
   return rows;
 }
@@ -97,16 +109,17 @@ TEST(CalibrateDirections, CollimatorArrayRecoversTheInteriorWithinThreeSigmaAndS
   TempDir tmp("aerocal_directions_collimator");
   std::mt19937_64 rng(3610);
   WriteText(tmp.File("camera.yaml"), kCameraYaml);
-  WriteText(tmp.File("directions.csv"),
-            "# 9 x 9 collimator array\ntarget,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec\n" +
-                CollimatorRows(&rng, ""));
+  WriteText(
+      tmp.File("directions.csv"),
+      "# 9 x 9 collimator array\ntarget,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec\n" +
+          CollimatorRows(&rng, ""));
   WriteText(tmp.File("budget.yaml"),
             "components:\n  - {quantity: c, source: collimator focal length, value: 0.6, unit: um, "
             "distribution: rectangular}\n");
   const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
-                            tmp.File("directions.csv") + " --budget " + tmp.File("budget.yaml") + " --out " +
-                            tmp.File("result.json") + " --write-camera " + tmp.File("calibrated.yml") +
-                            " --camera-format opencv");
+                            tmp.File("directions.csv") + " --budget " + tmp.File("budget.yaml") +
+                            " --out " + tmp.File("result.json") + " --write-camera " +
+                            tmp.File("calibrated.yml") + " --camera-format opencv");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const nlohmann::json j = ReadJson(tmp.File("result.json"));
   ExpectWithinThreeSigma(j);
@@ -121,8 +134,10 @@ TEST(CalibrateDirections, CollimatorArrayRecoversTheInteriorWithinThreeSigmaAndS
   EXPECT_TRUE(std::filesystem::exists(tmp.File("calibrated.yml")));
   // The rotation to the instrument within 3 sigma; the start from the known directions is close.
   for (int a = 0; a < 3; ++a) {
-    const double error = cal["method"]["instrument_from_camera_opk_deg"][a].get<double>() * kDeg - kTrueOpk[a];
-    const double sigma = cal["method"]["instrument_from_camera_sigma_arcsec"][a].get<double>() * kArcSecond;
+    const double error =
+        cal["method"]["instrument_from_camera_opk_deg"][a].get<double>() * kDeg - kTrueOpk[a];
+    const double sigma =
+        cal["method"]["instrument_from_camera_sigma_arcsec"][a].get<double>() * kArcSecond;
     EXPECT_LE(std::abs(error), 3.0 * sigma) << "opk " << a;
   }
   EXPECT_NEAR(cal["start"]["opk_deg"][2].get<double>(), 3.0, 0.1);
@@ -140,11 +155,12 @@ TEST(CalibrateDirections, CollimatorArrayRecoversTheInteriorWithinThreeSigmaAndS
       EXPECT_NEAR(q["u_c"].get<double>(), std::hypot(sigma, 0.6e-3 / std::sqrt(3.0)), 1e-9 * sigma);
     }
   EXPECT_TRUE(has_c);
-  // --model opencv: the same rows calibrated in OpenCV's model beside it; --write-camera writes that
-  // camera.
-  const auto cv = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
-                             tmp.File("directions.csv") + " --model opencv --out " +
-                             tmp.File("cv.json") + " --write-camera " + tmp.File("cv.yml") + " --camera-format opencv");
+  // --model opencv: the same rows calibrated in OpenCV's model beside it; --write-camera writes
+  // that camera.
+  const auto cv =
+      RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
+                 tmp.File("directions.csv") + " --model opencv --out " + tmp.File("cv.json") +
+                 " --write-camera " + tmp.File("cv.yml") + " --camera-format opencv");
   ASSERT_EQ(cv.exit_code, 0) << cv.output;
   const nlohmann::json beside = ReadJson(tmp.File("cv.json"))["calibration"];
   EXPECT_EQ(beside["beside"]["model"], "opencv");
@@ -152,11 +168,12 @@ TEST(CalibrateDirections, CollimatorArrayRecoversTheInteriorWithinThreeSigmaAndS
   EXPECT_EQ(beside["camera_written"]["model"], "opencv");
   // fx in px against c / pixel size: the same camera within their sigmas (c's 1.2 um is 0.2 px).
   EXPECT_NEAR(beside["beside"]["estimated"]["fx"].get<double>(),
-              j["cameras"][0]["estimated"]["c"].get<double>() / 0.006, 1.0);
+              j["cameras"][0]["estimated"]["c"].get<double>() / 0.006,
+              1.0);
 
   // The certificate states the method.
-  const auto c = RunAerocal("certificate --result " + tmp.File("result.json") + " --out " + tmp.File("cert") +
-                            " --no-render");
+  const auto c = RunAerocal("certificate --result " + tmp.File("result.json") + " --out " +
+                            tmp.File("cert") + " --no-render");
   ASSERT_EQ(c.exit_code, 0) << c.output;
   const nlohmann::json cert = ReadJson(tmp.File("cert/certificate.json"));
   EXPECT_EQ(cert["method"]["kind"], "collimator array");
@@ -172,11 +189,19 @@ TEST(CalibrateDirections, GoniometerSequenceRecoversTheInteriorAndTheTarget) {
   for (int i = 0; i < 9; ++i)
     for (int j = 0; j < 9; ++j) {
       const Eigen::Vector2d s = GridDeg(i, j);
-      const Eigen::Matrix3d g = calib::RotationFromOpk(Eigen::Vector3d(s.y() * kDeg, s.x() * kDeg, 0.0));
-      const Eigen::Vector2d px =
-          Observe(g * AngularError(&rng), Direction(target_deg.x() * kDeg, target_deg.y() * kDeg), &rng);
-      rows += StringPrintf("cross,%.5f,%.5f,%.3f,%.2f,s%d%d,%.6f,%.6f\n", px.x(), px.y(), kSigmaPx, kSigmaArcsec,
-                           i, j, s.x(), s.y());
+      const Eigen::Matrix3d g =
+          calib::RotationFromOpk(Eigen::Vector3d(s.y() * kDeg, s.x() * kDeg, 0.0));
+      const Eigen::Vector2d px = Observe(
+          g * AngularError(&rng), Direction(target_deg.x() * kDeg, target_deg.y() * kDeg), &rng);
+      rows += StringPrintf("cross,%.5f,%.5f,%.3f,%.2f,s%d%d,%.6f,%.6f\n",
+                           px.x(),
+                           px.y(),
+                           kSigmaPx,
+                           kSigmaArcsec,
+                           i,
+                           j,
+                           s.x(),
+                           s.y());
     }
   WriteText(tmp.File("directions.csv"), rows);
   const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
@@ -191,7 +216,8 @@ TEST(CalibrateDirections, GoniometerSequenceRecoversTheInteriorAndTheTarget) {
   const auto& target = method["estimated_targets"]["cross"];
   for (int a = 0; a < 2; ++a) {
     const double error_arcsec =
-        ((a == 0 ? target["azimuth_deg"] : target["elevation_deg"]).get<double>() - target_deg[a]) * 3600.0;
+        ((a == 0 ? target["azimuth_deg"] : target["elevation_deg"]).get<double>() - target_deg[a]) *
+        3600.0;
     EXPECT_LE(std::abs(error_arcsec), 3.0 * target["sigma_arcsec"][a].get<double>()) << a;
   }
 }
@@ -200,8 +226,9 @@ TEST(CalibrateDirections, TwoSeriesAsGroupsGiveTheStabilityTableAndTheReproducib
   TempDir tmp("aerocal_directions_groups");
   std::mt19937_64 rng(3612);
   WriteText(tmp.File("camera.yaml"), kCameraYaml);
-  WriteText(tmp.File("directions.csv"), "target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,group\n" +
-                                            CollimatorRows(&rng, "monday") + CollimatorRows(&rng, "tuesday"));
+  WriteText(tmp.File("directions.csv"),
+            "target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,group\n" +
+                CollimatorRows(&rng, "monday") + CollimatorRows(&rng, "tuesday"));
   const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
                             tmp.File("directions.csv") + " --out " + tmp.File("result.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
@@ -212,7 +239,8 @@ TEST(CalibrateDirections, TwoSeriesAsGroupsGiveTheStabilityTableAndTheReproducib
   EXPECT_TRUE(cal["stability"]["agree"].get<bool>());
   bool reproducibility = false;
   for (const auto& c : cal["uncertainty"][0]["components"])
-    reproducibility = reproducibility || c["source"].get<std::string>().find("group reproducibility") == 0;
+    reproducibility =
+        reproducibility || c["source"].get<std::string>().find("group reproducibility") == 0;
   EXPECT_TRUE(reproducibility);
 }
 
@@ -225,16 +253,19 @@ TEST(CalibrateDirections, BadRowsNameTheirLineAndNothingIsWritten) {
     std::string text, message;
   };
   const Case cases[] = {
-      {header + good + "D,3000,2000,0,95\n", "directions.csv:5: column 'elevation_deg' out of range"},
+      {header + good + "D,3000,2000,0,95\n",
+       "directions.csv:5: column 'elevation_deg' out of range"},
       {header + good + "A,3000,2000,1,0\n", "directions.csv:5: target A: its azimuth_deg"},
       {header + good + "D,3000,9000,1,0\n", "directions.csv:5: column 'row' out of range"},
-      {header + good + "D,3000,2000,1,\n", "directions.csv:5: azimuth_deg and elevation_deg go together"},
+      {header + good + "D,3000,2000,1,\n",
+       "directions.csv:5: azimuth_deg and elevation_deg go together"},
       {header + good + ",3000,2000,1,1\n", "directions.csv:5: target must not be empty"},
       {header + good + "B,3100,2000,6.8,0\n", "directions.csv:5: target B is observed twice"},
       {header + good + "D,3000,2000,170,0\n", "directions.csv:5: target D is"},
       {"target,col,row,azimuth\n", "directions.csv:1: unknown column 'azimuth'"},
       {"target,col\n", "directions.csv:1: missing column 'row'"},
-      {"target,col,row,setting,turn_deg\nX,1,1,s1,5\nX,2,2,s1,6\n", "directions.csv:3: setting s1 has turn"},
+      {"target,col,row,setting,turn_deg\nX,1,1,s1,5\nX,2,2,s1,6\n",
+       "directions.csv:3: setting s1 has turn"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.text);
@@ -247,30 +278,34 @@ TEST(CalibrateDirections, BadRowsNameTheirLineAndNothingIsWritten) {
   }
   // Rows without sigma_px take --sigma-px (a 3-target file calibrating c alone: redundancy 2).
   WriteText(tmp.File("directions.csv"), header + good);
-  const auto sigma = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
-                                tmp.File("directions.csv") + " --self-calibration c --sigma-px 0.2 --out " +
-                                tmp.File("sigma.json"));
+  const auto sigma =
+      RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
+                 tmp.File("directions.csv") + " --self-calibration c --sigma-px 0.2 --out " +
+                 tmp.File("sigma.json"));
   ASSERT_LE(sigma.exit_code, 3) << sigma.output;
   const nlohmann::json s = ReadJson(tmp.File("sigma.json"));
   EXPECT_EQ(s["redundancy"], 2);
   EXPECT_NEAR(s["residuals"][0]["sigma_px"].get<double>(), 0.2, 1e-12);
   // Options of the test field are refused by name; a second source is refused.
-  for (const std::string& extra : {std::string("--board-sigma-mm 0.1"), std::string("--no-snooping"),
+  for (const std::string& extra : {std::string("--board-sigma-mm 0.1"),
+                                   std::string("--no-snooping"),
                                    std::string("--points p.csv --observations o.csv")}) {
-    const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
-                              tmp.File("directions.csv") + " --out " + tmp.File("result.json") + " " + extra);
+    const auto r =
+        RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
+                   tmp.File("directions.csv") + " --out " + tmp.File("result.json") + " " + extra);
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find(extra.substr(0, extra.find(' '))), std::string::npos) << r.output;
   }
   // A target radius (test-field eccentricity) is refused.
   WriteText(tmp.File("budget.yaml"), "target_radius_mm: 2\n");
-  const auto radius = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
-                                 tmp.File("directions.csv") + " --budget " + tmp.File("budget.yaml") + " --out " +
-                                 tmp.File("result.json"));
+  const auto radius = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") +
+                                 " --directions " + tmp.File("directions.csv") + " --budget " +
+                                 tmp.File("budget.yaml") + " --out " + tmp.File("result.json"));
   EXPECT_EQ(radius.exit_code, 2) << radius.output;
   EXPECT_NE(radius.output.find("target_radius_mm"), std::string::npos) << radius.output;
   // One group is no stability test.
-  WriteText(tmp.File("directions.csv"), "target,col,row,azimuth_deg,elevation_deg,group\nA,3000,2000,0,0,g\n");
+  WriteText(tmp.File("directions.csv"),
+            "target,col,row,azimuth_deg,elevation_deg,group\nA,3000,2000,0,0,g\n");
   const auto one = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
                               tmp.File("directions.csv") + " --out " + tmp.File("result.json"));
   EXPECT_EQ(one.exit_code, 2) << one.output;

@@ -1,22 +1,22 @@
 // `aerocal flight` on a simulated flight: the workflow finishes, result.json has the FORMATS.md
 // keys of every step, the calibrated camera is written, and report.html holds the tables and plots.
-#include <algorithm>
-#include <cmath>
-#include <filesystem>
-#include <set>
-#include <map>
-#include <functional>
-#include <fstream>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/result_file.h"
 #include "stitch/image_io/image_io.h"
 #include "tests/support/rendered_targets.h"
 #include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <map>
+#include <set>
 
 namespace aerocal {
 namespace {
@@ -28,19 +28,25 @@ class FlightWorkflow : public ::testing::Test {
     const auto sim = testing::RunAerocal("simulate --out " + dir_->File("data") +
                                          " --seed 3 --stitch-ties 200 --gnss-sigma-m 0.05");
     ASSERT_EQ(sim.exit_code, 0) << sim.output;
-    WriteFileAtomically(dir_->File("lab.yaml"), "certificate: {number: F-7, date: 2026-11-24}\n"
-                                                "camera: {make: Sim, model: Four-CCD}\n");
+    WriteFileAtomically(dir_->File("lab.yaml"),
+                        "certificate: {number: F-7, date: 2026-11-24}\n"
+                        "camera: {make: Sim, model: Four-CCD}\n");
     // A Siemens star's reading (`quality star`) for the certificate's resolution section.
-    stitch::WriteGrayImage(dir_->File("star.png"),
-                           testing::RenderSiemensStar(220, 12, {109.5, 109.5}, 0.0, 1.0, 30.0, 220.0), 8);
-    const auto star = testing::RunAerocal("quality star --image " + dir_->File("star.png") +
-                                          " --centre 109.5,109.5 --cycles 12 --outer-radius-px 100 --gsd-m 0.05 "
-                                          "--out " + dir_->File("star.json"));
+    stitch::WriteGrayImage(
+        dir_->File("star.png"),
+        testing::RenderSiemensStar(220, 12, {109.5, 109.5}, 0.0, 1.0, 30.0, 220.0),
+        8);
+    const auto star =
+        testing::RunAerocal("quality star --image " + dir_->File("star.png") +
+                            " --centre 109.5,109.5 --cycles 12 --outer-radius-px 100 --gsd-m 0.05 "
+                            "--out " +
+                            dir_->File("star.json"));
     ASSERT_EQ(star.exit_code, 0) << star.output;
     run_ = new testing::CommandResult(testing::RunAerocal(
-        "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " + dir_->File("data") +
-        " --base III,IV --out " + dir_->File("report") + " --camera-format metashape --certificate --lab " +
-        dir_->File("lab.yaml") + " --quality " + dir_->File("star.json")));
+        "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " +
+        dir_->File("data") + " --base III,IV --out " + dir_->File("report") +
+        " --camera-format metashape --certificate --lab " + dir_->File("lab.yaml") + " --quality " +
+        dir_->File("star.json")));
   }
   static void TearDownTestSuite() {
     delete run_;
@@ -65,16 +71,26 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
     roles.insert(f["role"].get<std::string>());
     EXPECT_TRUE(paths.insert(f["path"].get<std::string>()).second) << f.dump();
     EXPECT_EQ(f["sha256"].get<std::string>().size(), 64u);
-    EXPECT_EQ(f["bytes"].get<std::uintmax_t>(), std::filesystem::file_size(f["path"].get<std::string>()));
+    EXPECT_EQ(f["bytes"].get<std::uintmax_t>(),
+              std::filesystem::file_size(f["path"].get<std::string>()));
   }
   for (const char* role : {"project", "exposures", "observations", "points", "stitching"})
     EXPECT_EQ(roles.count(role), 1u) << role;
   // Not a terminal: one progress line per stage (issue 33 item 6), the report the last.
-  for (const char* line : {"flight: 1/6 stitching (", "flight: 5/6 result (", "flight: 6/6 report ("})
+  for (const char* line :
+       {"flight: 1/6 stitching (", "flight: 5/6 result (", "flight: 6/6 report ("})
     EXPECT_NE(run_->output.find(line), std::string::npos) << line << "\n" << run_->output;
   const auto& stitching = doc["stitching"];
-  for (const char* key : {"kind", "sigma0", "sigma0_px", "redundancy", "iterations", "converged", "model",
-                          "subimages", "frames", "stability"})
+  for (const char* key : {"kind",
+                          "sigma0",
+                          "sigma0_px",
+                          "redundancy",
+                          "iterations",
+                          "converged",
+                          "model",
+                          "subimages",
+                          "frames",
+                          "stability"})
     EXPECT_TRUE(stitching.contains(key)) << "stitching." << key;
   EXPECT_EQ(stitching["frames"].size(), 37u);
   EXPECT_NEAR(stitching["stability"]["mean_sigma0_px"].get<double>(), 0.1, 0.01);
@@ -83,8 +99,18 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   for (int i = 0; i < 3; ++i) {
     const auto& a = doc["adjustments"][i];
     EXPECT_EQ(a["name"], names[i]);
-    for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations", "converged",
-                            "cameras", "control", "check", "exposures", "rejected"})
+    for (const char* key : {"kind",
+                            "sigma0",
+                            "sigma0_px",
+                            "sigma0_um",
+                            "redundancy",
+                            "iterations",
+                            "converged",
+                            "cameras",
+                            "control",
+                            "check",
+                            "exposures",
+                            "rejected"})
       EXPECT_TRUE(a.contains(key)) << names[i] << "." << key;
     EXPECT_EQ(a["kind"], "adjust");
     EXPECT_TRUE(a["converged"].get<bool>());
@@ -111,7 +137,8 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   // Self-calibration removes the systematic error the conventional run shows in the check points.
   const auto spatial = [&](int i) {
     const auto& r = doc["adjustments"][i]["check"]["rmse_m"];
-    return std::sqrt(std::pow(r[0].get<double>(), 2) + std::pow(r[1].get<double>(), 2) + std::pow(r[2].get<double>(), 2));
+    return std::sqrt(std::pow(r[0].get<double>(), 2) + std::pow(r[1].get<double>(), 2) +
+                     std::pow(r[2].get<double>(), 2));
   };
   EXPECT_GT(spatial(0), 1.5 * spatial(1));
   // The calibrated camera reads back and carries the estimate.
@@ -123,7 +150,8 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   // printed), with the interior sigmas as a covariance.
   const std::string metashape = ReadTextFile(dir_->File("report/camera_calibrated.metashape"));
   EXPECT_NE(metashape.find("<calibration"), std::string::npos);
-  EXPECT_NE(run_->output.find("camera as metashape (metashape_frame): least-squares fit"), std::string::npos)
+  EXPECT_NE(run_->output.find("camera as metashape (metashape_frame): least-squares fit"),
+            std::string::npos)
       << run_->output;
 }
 
@@ -132,7 +160,8 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   // adjustment's camera, a type-A budget: U = k sigma, k from the redundancy) as `aerocal
   // certificate --result result.json` does; HTML and PDF rendered.
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto cert = nlohmann::json::parse(ReadTextFile(dir_->File("report/certificate/certificate.json")));
+  const auto cert =
+      nlohmann::json::parse(ReadTextFile(dir_->File("report/certificate/certificate.json")));
   EXPECT_EQ(cert["method"]["kind"], "in-flight calibration");
   EXPECT_EQ(cert["lab"]["certificate"]["number"], "F-7");
   // The certificate names the flight's result.json where it ends, not where it was staged.
@@ -148,21 +177,28 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
     EXPECT_DOUBLE_EQ(q["value"].get<double>(), joint["cameras"][0]["estimated"]["c"].get<double>());
     EXPECT_NEAR(q["U"].get<double>(), q["k"].get<double>() * sigma, 1e-15);
     EXPECT_EQ(q["components"][0]["type"], "A");
-    EXPECT_NE(q["statement"].get<std::string>().find("(k = 2)"), std::string::npos) << q["statement"];
+    EXPECT_NE(q["statement"].get<std::string>().find("(k = 2)"), std::string::npos)
+        << q["statement"];
   }
   EXPECT_TRUE(has_c);
   // --quality: the dynamic image resolution section from the star's reading.
   ASSERT_EQ(cert["dynamic_image_resolution"]["stars"].size(), 1u);
-  EXPECT_EQ(cert["dynamic_image_resolution"]["stars"][0]["limiting_frequency_cy_px"],
-            nlohmann::json::parse(ReadTextFile(dir_->File("star.json")))["limiting_frequency_cy_px"]);
+  EXPECT_EQ(
+      cert["dynamic_image_resolution"]["stars"][0]["limiting_frequency_cy_px"],
+      nlohmann::json::parse(ReadTextFile(dir_->File("star.json")))["limiting_frequency_cy_px"]);
   const std::string html = ReadTextFile(dir_->File("report/certificate/certificate.html"));
-  for (const char* text : {"Calibration certificate", "F-7", "in-flight calibration", "Uncertainty budget",
-                           "9. Dynamic image resolution", "Siemens star"})
+  for (const char* text : {"Calibration certificate",
+                           "F-7",
+                           "in-flight calibration",
+                           "Uncertainty budget",
+                           "9. Dynamic image resolution",
+                           "Siemens star"})
     EXPECT_NE(html.find(text), std::string::npos) << text;
   // The certificate command on the flight's result.json gives the same data (its source apart).
-  const auto r = testing::RunAerocal("certificate --result " + dir_->File("report/result.json") + " --lab " +
-                                     dir_->File("lab.yaml") + " --quality " + dir_->File("star.json") +
-                                     " --no-render --out " + dir_->File("cert"));
+  const auto r =
+      testing::RunAerocal("certificate --result " + dir_->File("report/result.json") + " --lab " +
+                          dir_->File("lab.yaml") + " --quality " + dir_->File("star.json") +
+                          " --no-render --out " + dir_->File("cert"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   auto again = nlohmann::json::parse(ReadTextFile(dir_->File("cert/certificate.json")));
   auto first = cert;
@@ -171,9 +207,11 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   EXPECT_EQ(first, again);
   // Every PDF page rendered to PNG (poppler's pdftoppm).
   if (testing::RunCommand("command -v pdftoppm").exit_code != 0)
-    GTEST_SKIP() << "pdftoppm is absent (Debian package poppler-utils): the PDF pages are not rendered";
-  const auto png = testing::RunCommand("pdftoppm -r 30 -png " + dir_->File("report/certificate/certificate.pdf") +
-                                       " " + dir_->File("page"));
+    GTEST_SKIP()
+        << "pdftoppm is absent (Debian package poppler-utils): the PDF pages are not rendered";
+  const auto png = testing::RunCommand("pdftoppm -r 30 -png " +
+                                       dir_->File("report/certificate/certificate.pdf") + " " +
+                                       dir_->File("page"));
   ASSERT_EQ(png.exit_code, 0) << png.output;
   int pages = 0;
   for (const auto& e : std::filesystem::directory_iterator(dir_->path()))
@@ -200,12 +238,14 @@ TEST_F(FlightWorkflow, AFailingLastPartReplacesNothingOfThePreviousFlight) {
   ASSERT_GE(before.size(), 6u);
   WriteFileAtomically(dir_->File("fail.py"), "import sys\nsys.exit(1)\n");
   // The same flight from a copy of the camera file: result.json (which names it) would differ.
-  std::filesystem::copy_file(dir_->File("data/camera_nominal.yaml"), dir_->File("camera_copy.yaml"),
+  std::filesystem::copy_file(dir_->File("data/camera_nominal.yaml"),
+                             dir_->File("camera_copy.yaml"),
                              std::filesystem::copy_options::overwrite_existing);
   const auto r = testing::RunCommand(
-      "AEROCAL_CERTIFICATE_SCRIPT=" + dir_->File("fail.py") + " " + testing::AerocalBinary() + " flight --camera " +
-      dir_->File("camera_copy.yaml") + " --data " + dir_->File("data") + " --base III,IV --out " + out +
-      " --camera-format metashape --certificate --lab " + dir_->File("lab.yaml"));
+      "AEROCAL_CERTIFICATE_SCRIPT=" + dir_->File("fail.py") + " " + testing::AerocalBinary() +
+      " flight --camera " + dir_->File("camera_copy.yaml") + " --data " + dir_->File("data") +
+      " --base III,IV --out " + out + " --camera-format metashape --certificate --lab " +
+      dir_->File("lab.yaml"));
   EXPECT_EQ(r.exit_code, 1) << r.output;
   EXPECT_NE(r.output.find("nothing written"), std::string::npos) << r.output;
   EXPECT_EQ(Snapshot(out), before);  // no file replaced, added (no staging folder) or removed
@@ -214,9 +254,11 @@ TEST_F(FlightWorkflow, AFailingLastPartReplacesNothingOfThePreviousFlight) {
 TEST_F(FlightWorkflow, CertificateOptionsAreCheckedBeforeTheFlightRuns) {
   // A bad lab file: FILE:LINE, exit 2, nothing written; --lab without --certificate: exit 2.
   WriteFileAtomically(dir_->File("bad_lab.yaml"), "certificate: {numbr: 1}\n");
-  const std::string flight = "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " +
-                             dir_->File("data") + " --base III,IV --out " + dir_->File("bad_report");
-  const auto bad = testing::RunAerocal(flight + " --certificate --lab " + dir_->File("bad_lab.yaml"));
+  const std::string flight = "flight --camera " + dir_->File("data/camera_nominal.yaml") +
+                             " --data " + dir_->File("data") + " --base III,IV --out " +
+                             dir_->File("bad_report");
+  const auto bad =
+      testing::RunAerocal(flight + " --certificate --lab " + dir_->File("bad_lab.yaml"));
   EXPECT_EQ(bad.exit_code, 2) << bad.output;
   EXPECT_NE(bad.output.find("bad_lab.yaml:1"), std::string::npos) << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("bad_report/result.json")));
@@ -224,7 +266,8 @@ TEST_F(FlightWorkflow, CertificateOptionsAreCheckedBeforeTheFlightRuns) {
   EXPECT_EQ(lone.exit_code, 2) << lone.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("bad_report/result.json")));
   // --quality with a file that is no quality result: exit 2 naming it, before the flight runs.
-  const auto quality = testing::RunAerocal(flight + " --certificate --quality " + dir_->File("lab.yaml"));
+  const auto quality =
+      testing::RunAerocal(flight + " --certificate --quality " + dir_->File("lab.yaml"));
   EXPECT_EQ(quality.exit_code, 2) << quality.output;
   EXPECT_NE(quality.output.find("lab.yaml"), std::string::npos) << quality.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("bad_report/result.json")));
@@ -237,9 +280,11 @@ TEST_F(FlightWorkflow, ReportHoldsTablesAndPlots) {
   for (size_t at = html.find("src=\"data:image/png;base64,"); at != std::string::npos;
        at = html.find("src=\"data:image/png;base64,", at + 1))
     ++images;
-  EXPECT_GE(images, 4) << "sigma0 per exposure, residual vectors, distortion curves, check-point map";
-  EXPECT_GE(std::count(html.begin(), html.end(), '<') , 100);
-  for (const char* text : {"<table", "conventional", "self", "joint", "sigma0", "RMSE", "K1", "stability"})
+  EXPECT_GE(images, 4)
+      << "sigma0 per exposure, residual vectors, distortion curves, check-point map";
+  EXPECT_GE(std::count(html.begin(), html.end(), '<'), 100);
+  for (const char* text :
+       {"<table", "conventional", "self", "joint", "sigma0", "RMSE", "K1", "stability"})
     EXPECT_NE(html.find(text), std::string::npos) << text;
   EXPECT_EQ(html.find("http://"), std::string::npos) << "the page must not need the network";
   EXPECT_EQ(html.find("https://"), std::string::npos) << "the page must not need the network";
@@ -257,8 +302,8 @@ TEST_F(FlightWorkflow, AutoSelfCalibrationCheckPointTestAndCameraOrigin) {
   ASSERT_TRUE(doc["check_point_test"]["tested"].get<bool>());
   EXPECT_FALSE(doc["check_point_test"]["worse"].get<bool>());
   EXPECT_EQ(doc["camera_written_from"]["adjustment"], "joint");
-  for (const std::string bad : {"--self-calibration none", "--self-calibration Q7",
-                                "--suspect-effect-limit -1"}) {
+  for (const std::string bad :
+       {"--self-calibration none", "--self-calibration Q7", "--suspect-effect-limit -1"}) {
     const auto r = testing::RunAerocal("flight --camera " + dir_->File("data/camera_nominal.yaml") +
                                        " --data " + dir_->File("data") + " --out " +
                                        dir_->File("bad") + " " + bad);
@@ -331,9 +376,10 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
 TEST(FlightWorkflowInput, MissingProjectIsABadInput) {
   testing::TempDir dir;
   std::filesystem::create_directories(dir.File("data"));
-  std::ofstream(dir.File("cam.yaml")) << "pixel_size_mm: 0.009\nformat_px: [100, 100]\ninterior: {c: 50}\n";
-  const auto r = testing::RunAerocal("flight --camera " + dir.File("cam.yaml") + " --data " + dir.File("data") +
-                                     " --out " + dir.File("out"));
+  std::ofstream(dir.File("cam.yaml"))
+      << "pixel_size_mm: 0.009\nformat_px: [100, 100]\ninterior: {c: 50}\n";
+  const auto r = testing::RunAerocal("flight --camera " + dir.File("cam.yaml") + " --data " +
+                                     dir.File("data") + " --out " + dir.File("out"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("project.yaml"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir.File("out/result.json")));

@@ -9,17 +9,17 @@
 //   3 sigma; without stitching measurements it converts the camera file's mappings to the model
 //   given; per exposure it estimates one mapping per exposure;
 // - a model that does not fit warns by residual group; bad options exit 2 and write nothing.
-#include <algorithm>
-#include <cmath>
-#include <filesystem>
-#include <fstream>
+#include "calib/camera/camera_io.h"
+#include "calib/core/atomic_file.h"
+#include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/camera_io.h"
-#include "calib/core/atomic_file.h"
-#include "tests/support/test_support.h"
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
 
 namespace aerocal {
 namespace {
@@ -66,9 +66,11 @@ class SimulatedFlight : public ::testing::Test {
   static calib::Camera Truth() { return calib::ReadCamera(File("data/camera_truth.yaml")); }
   // `aerocal adjust` of the raw sub-image block with `options`, expected to finish: its result
   // (empty when it did not).
-  static nlohmann::json AdjustJoint(const std::string& options, const std::string& name,
+  static nlohmann::json AdjustJoint(const std::string& options,
+                                    const std::string& name,
                                     const std::string& project = "data/project_subimage.yaml") {
-    const auto run = RunAerocal("adjust --project " + File(project) + " " + options + " --out " + File(name));
+    const auto run =
+        RunAerocal("adjust --project " + File(project) + " " + options + " --out " + File(name));
     EXPECT_EQ(run.exit_code, 0) << run.output;
     return run.exit_code == 0 ? ReadJson(File(name)) : nlohmann::json::object();
   }
@@ -79,21 +81,24 @@ class SimulatedFlight : public ::testing::Test {
 // sub-image).
 struct Sheared {
   static constexpr const char* kOptions =
-      "--seed 3 --stitch-ties 200 --gnss-sigma-m 0.05 --nominal-mapping translation --ccd-shear 2e-4";
+      "--seed 3 --stitch-ties 200 --gnss-sigma-m 0.05 --nominal-mapping translation --ccd-shear "
+      "2e-4";
 };
 using ShearedFlight = SimulatedFlight<Sheared>;
 
 // A small flight (9 exposures) with CCD shears of 2e-3 (7 px across a sub-image).
 struct StronglySheared {
   static constexpr const char* kOptions =
-      "--seed 4 --exposures 9 --surveyed-points 60 --tie-points 150 --stitch-ties 100 --gnss-sigma-m 0.05 "
+      "--seed 4 --exposures 9 --surveyed-points 60 --tie-points 150 --stitch-ties 100 "
+      "--gnss-sigma-m 0.05 "
       "--nominal-mapping translation --ccd-shear 2e-3";
 };
 using StronglyShearedFlight = SimulatedFlight<StronglySheared>;
 
 TEST_F(ShearedFlight, TheNominalCameraMapsByTranslationsAndTheTruthIsSheared) {
   const calib::Camera nominal = calib::ReadCamera(File("data/camera_nominal.yaml"));
-  for (const auto& s : nominal.subimages) EXPECT_EQ(s.model, calib::MappingModel::kTranslation) << s.id;
+  for (const auto& s : nominal.subimages)
+    EXPECT_EQ(s.model, calib::MappingModel::kTranslation) << s.id;
   const calib::Camera truth = Truth();
   const auto& i = truth.subimages[truth.SubimageIndex("I")];
   ASSERT_EQ(i.model, calib::MappingModel::kAffine);
@@ -102,11 +107,13 @@ TEST_F(ShearedFlight, TheNominalCameraMapsByTranslationsAndTheTruthIsSheared) {
 }
 
 TEST_F(ShearedFlight, FlightRefinesTheMappingsWithTheModelTheStitchingChose) {
-  const auto run = RunAerocal("flight --camera " + File("data/camera_nominal.yaml") + " --data " + File("data") +
-                              " --base III,IV --joint-model auto --stitch-sigma-px 0.1 --no-report --out " +
-                              File("flight"));
+  const auto run =
+      RunAerocal("flight --camera " + File("data/camera_nominal.yaml") + " --data " + File("data") +
+                 " --base III,IV --joint-model auto --stitch-sigma-px 0.1 --no-report --out " +
+                 File("flight"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("joint: mappings affine (chosen by the stitching F test"), std::string::npos)
+  EXPECT_NE(run.output.find("joint: mappings affine (chosen by the stitching F test"),
+            std::string::npos)
       << run.output;
   EXPECT_EQ(run.output.find("warning"), std::string::npos) << run.output;
   EXPECT_FALSE(std::filesystem::exists(File("flight/report.html"))) << "--no-report";
@@ -116,14 +123,19 @@ TEST_F(ShearedFlight, FlightRefinesTheMappingsWithTheModelTheStitchingChose) {
   const auto& self = doc["adjustments"][1];
   const auto& joint = doc["adjustments"][2];
   EXPECT_EQ(joint["mapping_model"], "affine");
-  EXPECT_NE(joint["mapping_model_reason"].get<std::string>().find("flight-mean affine mappings"), std::string::npos);
+  EXPECT_NE(joint["mapping_model_reason"].get<std::string>().find("flight-mean affine mappings"),
+            std::string::npos);
   EXPECT_TRUE(doc["warnings"].empty()) << doc["warnings"].dump();
   // The joint step fits the sub-images as well as the self-calibration fits the virtual image
   // (seed 3: 0.199 against 0.204 px); with translation mappings it was 0.40 px.
   const double ratio = joint["sigma0_px"].get<double>() / self["sigma0_px"].get<double>();
-  std::printf("joint sigma0 %.4f px, self-calibration %.4f px; check spatial RMSE joint %.3f m, self %.3f m\n",
-              joint["sigma0_px"].get<double>(), self["sigma0_px"].get<double>(),
-              joint["check"]["spatial_rmse_m"].get<double>(), self["check"]["spatial_rmse_m"].get<double>());
+  std::printf(
+      "joint sigma0 %.4f px, self-calibration %.4f px; check spatial RMSE joint %.3f m, self %.3f "
+      "m\n",
+      joint["sigma0_px"].get<double>(),
+      self["sigma0_px"].get<double>(),
+      joint["check"]["spatial_rmse_m"].get<double>(),
+      self["check"]["spatial_rmse_m"].get<double>());
   EXPECT_NEAR(ratio, 1.0, 0.10);
   for (const auto& g : joint["groups"]) EXPECT_LT(g["rms_sigma"].get<double>(), 1.5) << g["name"];
   ExpectWithinThreeSigma(MappingErrors(joint, Truth()));
@@ -139,10 +151,12 @@ TEST_F(ShearedFlight, FlightRefinesTheMappingsWithTheModelTheStitchingChose) {
 }
 
 TEST_F(ShearedFlight, FlightWithTranslationMappingsWarnsThatTheModelDoesNotFit) {
-  const auto run = RunAerocal("flight --camera " + File("data/camera_nominal.yaml") + " --data " + File("data") +
-                              " --base III,IV --joint-model translation --no-report --out " + File("translation"));
+  const auto run = RunAerocal(
+      "flight --camera " + File("data/camera_nominal.yaml") + " --data " + File("data") +
+      " --base III,IV --joint-model translation --no-report --out " + File("translation"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("joint: mappings translation (given by the user"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("joint: mappings translation (given by the user"), std::string::npos)
+      << run.output;
   EXPECT_NE(run.output.find("warning (joint): sigma0"), std::string::npos) << run.output;
   const auto doc = ReadJson(File("translation/result.json"));
   ASSERT_EQ(doc["warnings"].size(), 1u) << doc["warnings"].dump();
@@ -154,8 +168,9 @@ TEST_F(ShearedFlight, FlightWithTranslationMappingsWarnsThatTheModelDoesNotFit) 
 }
 
 TEST_F(ShearedFlight, FlightWithoutTheJointStepRunsTheOthers) {
-  const auto run = RunAerocal("flight --camera " + File("data/camera_nominal.yaml") + " --data " + File("data") +
-                              " --base III,IV --no-joint --no-report --out " + File("nojoint"));
+  const auto run =
+      RunAerocal("flight --camera " + File("data/camera_nominal.yaml") + " --data " + File("data") +
+                 " --base III,IV --no-joint --no-report --out " + File("nojoint"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto doc = ReadJson(File("nojoint/result.json"));
   ASSERT_EQ(doc["adjustments"].size(), 2u);
@@ -168,15 +183,33 @@ TEST_F(ShearedFlight, AdjustJointRecoversMappingsAndInteriorWithTheStitchingMode
                               "--stitch-sigma-px 0.1 --write-camera " +
                               File("joint_camera.yaml") + " --out " + File("joint.json"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  EXPECT_NE(run.output.find("joint mappings: affine, per-flight, 4 free (chosen by the stitching F test"),
-            std::string::npos)
+  EXPECT_NE(
+      run.output.find("joint mappings: affine, per-flight, 4 free (chosen by the stitching F test"),
+      std::string::npos)
       << run.output;
   EXPECT_NE(run.output.find("stitching sigma0 per exposure"), std::string::npos) << run.output;
   const auto j = ReadJson(File("joint.json"));
-  for (const char* key : {"kind", "sigma0", "sigma0_px", "sigma0_um", "redundancy", "iterations", "converged",
-                          "cameras", "control", "check", "exposures", "rejected", "groups", "warnings", "subimages",
-                          "datum", "mapping_scope", "mapping_model", "mapping_model_reason",
-                          "stitching_per_exposure", "mapping_interior_correlations"})
+  for (const char* key : {"kind",
+                          "sigma0",
+                          "sigma0_px",
+                          "sigma0_um",
+                          "redundancy",
+                          "iterations",
+                          "converged",
+                          "cameras",
+                          "control",
+                          "check",
+                          "exposures",
+                          "rejected",
+                          "groups",
+                          "warnings",
+                          "subimages",
+                          "datum",
+                          "mapping_scope",
+                          "mapping_model",
+                          "mapping_model_reason",
+                          "stitching_per_exposure",
+                          "mapping_interior_correlations"})
     EXPECT_TRUE(j.contains(key)) << key;
   EXPECT_TRUE(j["converged"].get<bool>());
   EXPECT_TRUE(j["warnings"].empty()) << j["warnings"].dump();
@@ -191,7 +224,8 @@ TEST_F(ShearedFlight, AdjustJointRecoversMappingsAndInteriorWithTheStitchingMode
   for (int k = 0; k < 10; ++k) {
     const double sigma = cam["sigma"][names[k]].get<double>();
     EXPECT_GT(sigma, 0.0) << names[k];
-    EXPECT_LT(std::abs(cam["estimated"][names[k]].get<double>() - truth.interior[k]), 3.0 * sigma) << names[k];
+    EXPECT_LT(std::abs(cam["estimated"][names[k]].get<double>() - truth.interior[k]), 3.0 * sigma)
+        << names[k];
   }
   // Stitching precision per exposure, before (own adjustment) and after (in the joint solution):
   // both at the simulated 0.1 px.
@@ -206,7 +240,8 @@ TEST_F(ShearedFlight, AdjustJointRecoversMappingsAndInteriorWithTheStitchingMode
   EXPECT_NEAR(written.interior[0], cam["estimated"]["c"].get<double>(), 1e-9);
   for (const auto& s : j["subimages"]) {
     const auto& w = written.subimages[written.SubimageIndex(s["id"].get<std::string>())];
-    EXPECT_EQ(std::string(calib::MappingModelName(w.model)), s["model"].get<std::string>()) << s["id"];
+    EXPECT_EQ(std::string(calib::MappingModelName(w.model)), s["model"].get<std::string>())
+        << s["id"];
     EXPECT_EQ(w.params, s["params"].get<std::vector<double>>()) << s["id"];
   }
 }
@@ -216,20 +251,26 @@ TEST_F(ShearedFlight, AdjustJointWithoutStitchingStartsFromTheCameraFileMappings
   // from (exit 2, nothing written); affine given, the translation mappings of the camera file are
   // the start and the image observations alone determine the affine mappings.
   std::string project = ReadTextFile(File("data/project_subimage.yaml"));
-  project.erase(project.find("stitching: stitch_obs.csv\n"), std::string("stitching: stitch_obs.csv\n").size());
+  project.erase(project.find("stitching: stitch_obs.csv\n"),
+                std::string("stitching: stitch_obs.csv\n").size());
   WriteFileAtomically(File("data/project_nostitch.yaml"), project);
-  const auto refused = RunAerocal("adjust --project " + File("data/project_nostitch.yaml") +
-                                  " --joint-stitching per-flight --base III,IV --out " + File("nostitch.json"));
+  const auto refused =
+      RunAerocal("adjust --project " + File("data/project_nostitch.yaml") +
+                 " --joint-stitching per-flight --base III,IV --out " + File("nostitch.json"));
   EXPECT_EQ(refused.exit_code, 2) << refused.output;
-  EXPECT_NE(refused.output.find("--joint-model auto needs the project's stitching measurements"), std::string::npos)
+  EXPECT_NE(refused.output.find("--joint-model auto needs the project's stitching measurements"),
+            std::string::npos)
       << refused.output;
   EXPECT_FALSE(std::filesystem::exists(File("nostitch.json")));
 
-  const auto j = AdjustJoint("--joint-stitching per-flight --joint-model affine --base III,IV --self-calibration all",
-                             "nostitch.json", "data/project_nostitch.yaml");
+  const auto j = AdjustJoint(
+      "--joint-stitching per-flight --joint-model affine --base III,IV --self-calibration all",
+      "nostitch.json",
+      "data/project_nostitch.yaml");
   ASSERT_FALSE(j.empty());
   EXPECT_EQ(j["mapping_model"], "affine");
-  EXPECT_NE(j["mapping_model_reason"].get<std::string>().find("camera file's mappings"), std::string::npos);
+  EXPECT_NE(j["mapping_model_reason"].get<std::string>().find("camera file's mappings"),
+            std::string::npos);
   EXPECT_TRUE(j["stitching_per_exposure"].empty());
   for (const auto& s : j["subimages"]) {
     if (s["base"].get<bool>()) continue;
@@ -247,26 +288,31 @@ TEST_F(ShearedFlight, AdjustJointWithoutStitchingStartsFromTheCameraFileMappings
 TEST_F(ShearedFlight, AdjustJointTakesThePlatformOptions) {
   // The joint adjustment is a sensor kind of the one block adjustment: the command line's
   // platform options reach it as they reach the plain run. The simulated lever arm is zero.
-  const auto j = AdjustJoint("--joint-stitching per-flight --base III,IV --self-calibration all "
-                             "--lever-arm-m 0,0,0 --lever-arm free", "joint_platform.json");
+  const auto j = AdjustJoint(
+      "--joint-stitching per-flight --base III,IV --self-calibration all "
+      "--lever-arm-m 0,0,0 --lever-arm free",
+      "joint_platform.json");
   ASSERT_TRUE(j.contains("platform")) << j.dump().substr(0, 400);
   const auto& lever = j["platform"]["lever_arm_m"];
   EXPECT_EQ(lever["mode"], "free");
   for (int i = 0; i < 3; ++i) {
     ASSERT_TRUE(lever["sigma"][i].is_number()) << i;
-    EXPECT_LE(std::abs(lever["value"][i].get<double>()), 3.0 * lever["sigma"][i].get<double>()) << i;
+    EXPECT_LE(std::abs(lever["value"][i].get<double>()), 3.0 * lever["sigma"][i].get<double>())
+        << i;
   }
 }
 
 TEST_F(StronglyShearedFlight, AModelThatDoesNotFitWarnsByResidualGroup) {
   // Translation mappings cannot follow the shears: the stitching ties (and the image rays) do not
   // fit, and the result says so by group name.
-  const auto run = RunAerocal("adjust --project " + File("data/project_subimage.yaml") +
-                              " --joint-stitching per-flight --joint-model translation --base III,IV --no-snooping "
-                              "--out " +
-                              File("translation.json"));
+  const auto run = RunAerocal(
+      "adjust --project " + File("data/project_subimage.yaml") +
+      " --joint-stitching per-flight --joint-model translation --base III,IV --no-snooping "
+      "--out " +
+      File("translation.json"));
   ASSERT_NE(run.exit_code, 2) << run.output;
-  EXPECT_NE(run.output.find("warning: residual group stitch_tie: RMS"), std::string::npos) << run.output;
+  EXPECT_NE(run.output.find("warning: residual group stitch_tie: RMS"), std::string::npos)
+      << run.output;
   const auto j = ReadJson(File("translation.json"));
   bool tie_warning = false;
   for (const auto& w : j["warnings"]) {
@@ -287,11 +333,13 @@ TEST_F(StronglyShearedFlight, AModelThatDoesNotFitWarnsByResidualGroup) {
 TEST_F(StronglyShearedFlight, AdjustJointPerExposureEstimatesOneMappingPerExposure) {
   // Self-calibrating: with the nominal interior held, every exposure's mappings absorb the
   // camera's affinity (B1, B2) and came out 3-6 sigma off in b2.
-  const auto j = AdjustJoint("--joint-stitching per-exposure --joint-model affine --base III,IV --self-calibration all",
-                             "per_exposure.json");
+  const auto j = AdjustJoint(
+      "--joint-stitching per-exposure --joint-model affine --base III,IV --self-calibration all",
+      "per_exposure.json");
   ASSERT_FALSE(j.empty());
   EXPECT_EQ(j["mapping_scope"], "per-exposure");
-  EXPECT_NE(j["mapping_model_reason"].get<std::string>().find("given by the user"), std::string::npos);
+  EXPECT_NE(j["mapping_model_reason"].get<std::string>().find("given by the user"),
+            std::string::npos);
   const calib::Camera truth = Truth();
   int free = 0;
   double worst = 0.0;
@@ -301,7 +349,9 @@ TEST_F(StronglyShearedFlight, AdjustJointPerExposureEstimatesOneMappingPerExposu
     ++free;
     const auto& t = truth.subimages[truth.SubimageIndex(s["id"].get<std::string>())];
     for (size_t i = 0; i < t.params.size(); ++i)
-      worst = std::max(worst, std::abs(s["params"][i].get<double>() - t.params[i]) / s["sigma"][i].get<double>());
+      worst = std::max(
+          worst,
+          std::abs(s["params"][i].get<double>() - t.params[i]) / s["sigma"][i].get<double>());
   }
   EXPECT_EQ(free, 9 * 4);
   // 216 parameters: one beyond 3 sigma may be expected (0.27 % each; seed 4: largest 2.6), none
@@ -320,7 +370,8 @@ TEST_F(StronglyShearedFlight, BadOptionsExitWithTwoAndWriteNothing) {
   const std::string subimage = "adjust --project " + File("data/project_subimage.yaml");
   const Case cases[] = {
       // Virtual-image observations: nothing for the joint adjustment to map.
-      {"adjust --project " + File("data/project.yaml") + " --joint-stitching per-flight --base III,IV",
+      {"adjust --project " + File("data/project.yaml") +
+           " --joint-stitching per-flight --base III,IV",
        "raw sub-image pixels"},
       {subimage + " --joint-stitching sideways", "per-flight"},
       {subimage + " --joint-stitching per-flight --joint-model shear", "--joint-model"},
@@ -329,7 +380,8 @@ TEST_F(StronglyShearedFlight, BadOptionsExitWithTwoAndWriteNothing) {
       {subimage + " --base III,IV", "--joint-stitching"},
       {subimage + " --joint-stitching per-flight --compare", "--compare"},
       {subimage + " --joint-stitching per-flight --robust-start", "--robust-start"},
-      {"flight --camera " + File("data/camera_nominal.yaml") + " --data " + File("data") + " --joint-model shear",
+      {"flight --camera " + File("data/camera_nominal.yaml") + " --data " + File("data") +
+           " --joint-model shear",
        "--joint-model"},
   };
   for (const Case& c : cases) {

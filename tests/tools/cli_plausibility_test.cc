@@ -3,17 +3,17 @@
 // camera file where aerocal's is expected, image coordinates off the camera's format (a list
 // measured on resized images), a principal distance given in pixels as millimetres. And the
 // global options' vocabulary (item 4): --verbose / --quiet after the command's name too.
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
 #include <string>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
-#include "tests/support/test_support.h"
 
 namespace aerocal {
 namespace {
@@ -56,9 +56,11 @@ class Plausibility : public ::testing::Test {
 TempDir* Plausibility::dir_ = nullptr;
 
 TEST_F(Plausibility, ACsvSeparatedBySemicolonsIsNamedAsSuch) {
-  const std::string semicolons = std::regex_replace(Original("observations.csv"), std::regex(","), ";");
+  const std::string semicolons =
+      std::regex_replace(Original("observations.csv"), std::regex(","), ";");
   const std::string flight = FlightWith("semicolons", "observations.csv", semicolons);
-  const auto r = RunAerocal("adjust --project " + flight + "/project.yaml --out " + flight + "/r.json");
+  const auto r =
+      RunAerocal("adjust --project " + flight + "/project.yaml --out " + flight + "/r.json");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("observations.csv:1: the fields are separated by ';'"), std::string::npos)
       << r.output;
@@ -68,18 +70,21 @@ TEST_F(Plausibility, ACsvSeparatedBySemicolonsIsNamedAsSuch) {
 TEST_F(Plausibility, AnotherToolsCameraFileGetsTheConversionCommand) {
   const std::string dir = dir_->File("foreign");
   std::filesystem::create_directories(dir);
-  const auto convert = RunAerocal("camera convert --from aerocal --to metashape " +
-                                  dir_->File("flight/camera_nominal.yaml") + " " + dir +
-                                  "/camera.xml");
+  const auto convert =
+      RunAerocal("camera convert --from aerocal --to metashape " +
+                 dir_->File("flight/camera_nominal.yaml") + " " + dir + "/camera.xml");
   ASSERT_EQ(convert.exit_code, 0) << convert.output;
   // Where a project names it, and where a command takes it directly.
-  const std::string flight =
-      FlightWith("foreign_project", "project.yaml",
-                 std::regex_replace(Original("project.yaml"), std::regex("camera_nominal\\.yaml"),
-                                    dir + "/camera.xml"));
-  const auto adjust = RunAerocal("adjust --project " + flight + "/project.yaml --out " + dir + "/r.json");
+  const std::string flight = FlightWith(
+      "foreign_project",
+      "project.yaml",
+      std::regex_replace(
+          Original("project.yaml"), std::regex("camera_nominal\\.yaml"), dir + "/camera.xml"));
+  const auto adjust =
+      RunAerocal("adjust --project " + flight + "/project.yaml --out " + dir + "/r.json");
   EXPECT_EQ(adjust.exit_code, 2) << adjust.output;
-  EXPECT_NE(adjust.output.find("looks like a metashape camera file"), std::string::npos) << adjust.output;
+  EXPECT_NE(adjust.output.find("looks like a metashape camera file"), std::string::npos)
+      << adjust.output;
   EXPECT_NE(adjust.output.find("aerocal camera convert --from metashape --to aerocal " + dir +
                                "/camera.xml"),
             std::string::npos)
@@ -104,7 +109,8 @@ TEST_F(Plausibility, CoordinatesOffTheFormatNameTheLineAndTheLikelyCause) {
   const size_t col = text.find(',', text.find(',', row) + 1) + 1;
   text.replace(col, text.find(',', col) - col, "15000.5");
   const std::string flight = FlightWith("off_format", "observations.csv", text);
-  const auto r = RunAerocal("adjust --project " + flight + "/project.yaml --out " + flight + "/r.json");
+  const auto r =
+      RunAerocal("adjust --project " + flight + "/project.yaml --out " + flight + "/r.json");
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("observations.csv:3: image"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("1001.5 px outside the 14000 x 12000 px format"), std::string::npos)
@@ -114,18 +120,22 @@ TEST_F(Plausibility, CoordinatesOffTheFormatNameTheLineAndTheLikelyCause) {
 
 TEST_F(Plausibility, APrincipalDistanceInPixelsIsWarnedBeforeTheSolveAndInTheResult) {
   // c = 170 mm with 0.02 mm pixels written as 8500 "mm": 23 times the format diagonal.
-  std::string camera = std::regex_replace(Original("camera_nominal.yaml"), std::regex("c: 170"),
-                                          "c: 8500");
+  std::string camera =
+      std::regex_replace(Original("camera_nominal.yaml"), std::regex("c: 170"), "c: 8500");
   camera = std::regex_replace(camera, std::regex("pixel_size_mm: [0-9.]+"), "pixel_size_mm: 0.02");
   const std::string flight = FlightWith("pixels_as_mm", "camera_nominal.yaml", camera);
-  const auto r = RunAerocal("adjust --project " + flight + "/project.yaml --max-iterations 3 --out " +
-                            flight + "/r.json");
+  const auto r = RunAerocal("adjust --project " + flight +
+                            "/project.yaml --max-iterations 3 --out " + flight + "/r.json");
   ASSERT_LE(r.exit_code, 3) << r.output;
-  EXPECT_NE(r.output.find("implausible_principal_distance: camera cam1: c = 8500 mm is 23 times the 369 mm format "
-                          "diagonal (a field of view of 2.5 deg)"),
+  EXPECT_NE(
+      r.output.find(
+          "implausible_principal_distance: camera cam1: c = 8500 mm is 23 times the 369 mm format "
+          "diagonal (a field of view of 2.5 deg)"),
+      std::string::npos)
+      << r.output;
+  EXPECT_NE(r.output.find("if c was given in pixels, it is 170 mm with 0.02 mm pixels"),
             std::string::npos)
       << r.output;
-  EXPECT_NE(r.output.find("if c was given in pixels, it is 170 mm with 0.02 mm pixels"), std::string::npos) << r.output;
   const auto doc = ReadJson(flight + "/r.json");
   bool found = false;
   for (const auto& w : doc["warnings"])
@@ -150,14 +160,15 @@ TEST(Vocabulary, GlobalOptionsAfterTheCommandAndWhatVerbosePrints) {
                 .exit_code,
             0);
   const std::string project = dir.File("f/project.yaml");
-  const auto verbose = RunAerocal("adjust --project " + project + " --out " + dir.File("v.json") +
-                                  " --verbose");
+  const auto verbose =
+      RunAerocal("adjust --project " + project + " --out " + dir.File("v.json") + " --verbose");
   ASSERT_EQ(verbose.exit_code, 0) << verbose.output;
-  EXPECT_NE(verbose.output.find("read " + project + ": 1 camera(s), 3 exposures"), std::string::npos)
+  EXPECT_NE(verbose.output.find("read " + project + ": 1 camera(s), 3 exposures"),
+            std::string::npos)
       << verbose.output;
   EXPECT_NE(verbose.output.find("iter      cost"), std::string::npos) << verbose.output;  // Ceres
-  const auto before = RunAerocal("--verbose adjust --project " + project + " --out " +
-                                 dir.File("b.json"));
+  const auto before =
+      RunAerocal("--verbose adjust --project " + project + " --out " + dir.File("b.json"));
   EXPECT_NE(before.output.find("iter      cost"), std::string::npos);
   const auto plain = RunAerocal("adjust --project " + project + " --out " + dir.File("p.json"));
   EXPECT_EQ(plain.output.find("iter      cost"), std::string::npos);

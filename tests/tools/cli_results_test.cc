@@ -3,15 +3,15 @@
 // and the readers of results refuse another kind or version with `FILE: what`, exit 2, nothing
 // written. `aerocal flight`, `rig stitch` and `pushbroom control` are checked the same way in their
 // own CLI tests (cli_flight, cli_rig_stitch, pushbroom_images): they are too long to run twice.
-#include <filesystem>
-#include <fstream>
-#include <string>
+#include "calib/core/result_file.h"
+#include "tests/support/test_support.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "calib/core/result_file.h"
-#include "tests/support/test_support.h"
+#include <filesystem>
+#include <fstream>
+#include <string>
 
 namespace aerocal {
 namespace {
@@ -36,7 +36,8 @@ void ExpectHeader(const json& doc, const std::string& kind, const std::string& m
   EXPECT_EQ(doc["camera_model"]["name"], model) << kind;
   EXPECT_FALSE(doc["camera_model"]["parameters"].empty()) << kind;
   for (const json& p : doc["camera_model"]["parameters"])
-    for (const char* key : {"name", "unit", "group"}) EXPECT_TRUE(p.contains(key)) << kind << " " << key;
+    for (const char* key : {"name", "unit", "group"})
+      EXPECT_TRUE(p.contains(key)) << kind << " " << key;
 }
 
 class ResultDocuments : public ::testing::Test {
@@ -48,9 +49,10 @@ class ResultDocuments : public ::testing::Test {
     const auto field = RunAerocal("simulate --test-field --groups 2 --images-per-group 4 --out " +
                                   dir_->File("tf"));
     ASSERT_EQ(field.exit_code, 0) << field.output;
-    const auto cal = RunAerocal("calibrate --camera " + dir_->File("tf/camera_nominal.yaml") +
-                                " --observations " + dir_->File("tf/observations.csv") + " --points " +
-                                dir_->File("tf/points.csv") + " --out " + dir_->File("cal.json"));
+    const auto cal =
+        RunAerocal("calibrate --camera " + dir_->File("tf/camera_nominal.yaml") +
+                   " --observations " + dir_->File("tf/observations.csv") + " --points " +
+                   dir_->File("tf/points.csv") + " --out " + dir_->File("cal.json"));
     ASSERT_LE(cal.exit_code, 3) << cal.output;  // 3: written, the group stability may disagree
   }
   static void TearDownTestSuite() { delete dir_; }
@@ -60,7 +62,8 @@ TempDir* ResultDocuments::dir_ = nullptr;
 
 TEST_F(ResultDocuments, EveryCommandWritesKindAndSchemaVersion) {
   const std::string sim = dir_->File("flight");
-  auto r = RunAerocal("adjust --project " + sim + "/project.yaml --out " + dir_->File("adjust.json"));
+  auto r =
+      RunAerocal("adjust --project " + sim + "/project.yaml --out " + dir_->File("adjust.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   ExpectHeader(ReadJson(dir_->File("adjust.json")), "adjust", "brown_fraser_10");
 
@@ -86,7 +89,8 @@ TEST_F(ResultDocuments, EveryCommandWritesKindAndSchemaVersion) {
   ExpectHeader(convert, "camera_conversion", "opencv");
   EXPECT_EQ(convert["source_camera_model"]["name"], "brown_fraser_10");
 
-  r = RunAerocal("rig design --camera " + kRig + " --grid-cells 50 --out " + dir_->File("design.json"));
+  r = RunAerocal("rig design --camera " + kRig + " --grid-cells 50 --out " +
+                 dir_->File("design.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const json design = ReadJson(dir_->File("design.json"));
   ExpectHeader(design, "rig_design");
@@ -100,7 +104,8 @@ TEST_F(ResultDocuments, EveryCommandWritesKindAndSchemaVersion) {
   EXPECT_EQ(error["camera_models"].size(), 2u);
 
   const std::string pb = dir_->File("pb");
-  r = RunAerocal("simulate --pushbroom --out " + pb + " --detectors 60 --lines 400 --control 300 --seed 3");
+  r = RunAerocal("simulate --pushbroom --out " + pb +
+                 " --detectors 60 --lines 400 --control 300 --seed 3");
   ASSERT_EQ(r.exit_code, 0) << r.output;
   r = RunAerocal("pushbroom calibrate --camera " + pb + "/camera_nominal.yaml --pos " + pb +
                  "/pos.csv --observations " + pb + "/observations.csv --points " + pb +
@@ -128,26 +133,30 @@ TEST_F(ResultDocuments, ReadersRefuseAnotherKindOrVersion) {
   r = RunAerocal("certificate --result " + dir_->File("v0.json") + " --no-render --out " +
                  dir_->File("cert_v0"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("v0.json: schema_version is null, expected 1"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("v0.json: schema_version is null, expected 1"), std::string::npos)
+      << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("cert_v0/certificate.json")));
 
   // A stitch result where a calibrate result is expected, and the other way round.
-  json stitch = {{"kind", "stitch"}, {"schema_version", kResultSchemaVersion}, {"subimages", json::array()}};
+  json stitch = {
+      {"kind", "stitch"}, {"schema_version", kResultSchemaVersion}, {"subimages", json::array()}};
   Write(dir_->File("stitch_kind.json"), stitch.dump());
   r = RunAerocal("certificate --result " + dir_->File("stitch_kind.json") + " --no-render --out " +
                  dir_->File("cert_stitch"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("stitch_kind.json: not a result of `aerocal calibrate` (kind is \"stitch\", "
-                          "expected \"adjust\" or \"flight\")"),
-            std::string::npos)
+  EXPECT_NE(
+      r.output.find("stitch_kind.json: not a result of `aerocal calibrate` (kind is \"stitch\", "
+                    "expected \"adjust\" or \"flight\")"),
+      std::string::npos)
       << r.output;
   const std::string sim = dir_->File("flight");
-  r = RunAerocal("resample --camera " + sim + "/camera_nominal.yaml --mapping " + dir_->File("cal.json") +
-                 " --images I=a.tif --out " + dir_->File("v.tif"));
+  r = RunAerocal("resample --camera " + sim + "/camera_nominal.yaml --mapping " +
+                 dir_->File("cal.json") + " --images I=a.tif --out " + dir_->File("v.tif"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("cal.json: not a result of `aerocal stitch` (kind is \"adjust\", expected "
-                          "\"stitch\")"),
-            std::string::npos)
+  EXPECT_NE(
+      r.output.find("cal.json: not a result of `aerocal stitch` (kind is \"adjust\", expected "
+                    "\"stitch\")"),
+      std::string::npos)
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("v.tif")));
 }

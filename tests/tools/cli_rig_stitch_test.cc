@@ -3,19 +3,19 @@
 // zone), increments within 3 sigma of the simulator's truth, the three modes (per-exposure names
 // the dT-rotation correlations and writes no dT it cannot determine; angles holds dT), and exit 3
 // by name: an absurd sigma0, a standard position the snooping would empty.
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/result_file.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <map>
 #include <sstream>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
-#include "calib/core/result_file.h"
-#include "tests/support/test_support.h"
 
 namespace aerocal {
 namespace {
@@ -61,8 +61,8 @@ void ExpectRms(const json& rms, const std::string& where) {
   for (const char* phase : {"before", "after"})
     for (const char* set : {"fit", "check"})
       for (const char* metric : {"per_coordinate", "pair_2d", "pairs", "ties"})
-        EXPECT_TRUE(rms[phase][set].contains(metric)) << where << " " << phase << " " << set << " "
-                                                      << metric;
+        EXPECT_TRUE(rms[phase][set].contains(metric))
+            << where << " " << phase << " " << set << " " << metric;
 }
 
 TEST(RigStitchCommand, LineModeOnASimulatedLineWithTheIssueKeys) {
@@ -104,7 +104,8 @@ TEST(RigStitchCommand, LineModeOnASimulatedLineWithTheIssueKeys) {
     }
     const char* angles[] = {"domega", "dphi", "dkappa"};
     for (int a = 0; a < 3; ++a)
-      outside += std::abs(h[angles[a]].get<double>() - t[a]) > 3 * h["sigma"][angles[a]].get<double>();
+      outside +=
+          std::abs(h[angles[a]].get<double>() - t[a]) > 3 * h["sigma"][angles[a]].get<double>();
   }
   EXPECT_LE(outside, 1) << "of 27 angles beyond 3 sigma";
   EXPECT_FALSE(doc["time_offsets"]["held"].get<bool>());
@@ -130,8 +131,9 @@ TEST(RigStitchCommand, PerExposureNamesTheCorrelationsAndAnglesHoldsTheOffsets) 
     for (const json& h : doc["rig_exposures"]) nulls += h["dT_ms"].is_null();
     EXPECT_GT(nulls, 0) << "no dT value the run cannot determine";
   }
-  run = RunAerocal(Stitch(Line(), "--mode angles --increment-sigma-arcsec 600 --alpha 0.01 --sigma-px 0.3",
-                         dir.File("a.json")));
+  run = RunAerocal(Stitch(Line(),
+                          "--mode angles --increment-sigma-arcsec 600 --alpha 0.01 --sigma-px 0.3",
+                          dir.File("a.json")));
   ASSERT_EQ(run.exit_code, 0) << run.output;
   doc = ReadJson(dir.File("a.json"));
   EXPECT_EQ(doc["snooping"]["alpha"].get<double>(), 0.01);
@@ -156,7 +158,8 @@ TEST(RigStitchCommand, ExitThreeByNameForAnAbsurdSigma0AndAnEmptiedStandardPosit
   std::istringstream in(ReadTextFile(line + "/observations.csv"));
   std::string text, row;
   while (std::getline(in, row)) {
-    if (row.find(",0001_t001,") != std::string::npos || row.find(",0001_t002,") != std::string::npos)
+    if (row.find(",0001_t001,") != std::string::npos ||
+        row.find(",0001_t002,") != std::string::npos)
       continue;
     if (row.rfind("0001,B,0001_t000,", 0) == 0) {
       auto f = SplitCommaList(row, {true, true});
@@ -184,7 +187,8 @@ TEST(RigStitchCommand, ExitThreeByNameForAnAbsurdSigma0AndAnEmptiedStandardPosit
   EXPECT_GT(sigmas, 1.0) << effect;
   EXPECT_EQ(run.exit_code, 3) << run.output;
   EXPECT_NE(run.output.find("leaving them out moves " + effect["parameter"].get<std::string>()),
-            std::string::npos) << run.output;
+            std::string::npos)
+      << run.output;
   EXPECT_FALSE(doc["valid"].get<bool>());
   // The same stop under a limit above its effect: valid, exit 0, the warning names the effect;
   // the numbers are those of the first run (the effect leaves the solution as it was).

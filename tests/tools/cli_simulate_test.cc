@@ -1,14 +1,14 @@
 // The command line: help, version, exit codes, determinism of `simulate`, bad options.
-#include <cmath>
-#include <filesystem>
-
-#include <gtest/gtest.h>
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "tests/support/test_support.h"
 #include "triangulation/block/block_io.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <filesystem>
 
 namespace aerocal {
 namespace {
@@ -30,11 +30,25 @@ TEST(Cli, HelpListsTheCommandsAndVersionPrints) {
 TEST(Cli, SimulateIsDeterministicAndWritesTheFormatsFiles) {
   testing::TempDir dir;
   const std::string a = dir.File("a"), b = dir.File("b");
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + a + " --seed 5 --exposures 9 --surveyed-points 60 --tie-points 50").exit_code, 0);
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + b + " --seed 5 --exposures 9 --surveyed-points 60 --tie-points 50").exit_code, 0);
-  for (const char* f : {"camera_nominal.yaml", "camera_truth.yaml", "exposures.csv", "observations.csv",
-                        "observations_subimage.csv", "points.csv", "stitch_obs.csv", "project.yaml",
-                        "project_subimage.yaml", "truth/exposures.csv", "truth/points.csv"}) {
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + a +
+                                " --seed 5 --exposures 9 --surveyed-points 60 --tie-points 50")
+                .exit_code,
+            0);
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + b +
+                                " --seed 5 --exposures 9 --surveyed-points 60 --tie-points 50")
+                .exit_code,
+            0);
+  for (const char* f : {"camera_nominal.yaml",
+                        "camera_truth.yaml",
+                        "exposures.csv",
+                        "observations.csv",
+                        "observations_subimage.csv",
+                        "points.csv",
+                        "stitch_obs.csv",
+                        "project.yaml",
+                        "project_subimage.yaml",
+                        "truth/exposures.csv",
+                        "truth/points.csv"}) {
     ASSERT_TRUE(std::filesystem::exists(a + "/" + f)) << f;
     EXPECT_EQ(ReadTextFile(a + "/" + f), ReadTextFile(b + "/" + f)) << f << " differs between runs";
   }
@@ -48,7 +62,10 @@ TEST(Cli, SimulateIsDeterministicAndWritesTheFormatsFiles) {
   EXPECT_EQ(camera.subimages.size(), 6u);
   EXPECT_EQ(camera.width_px, 14000);
   // Another seed gives other data.
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + b + " --seed 6 --exposures 9 --surveyed-points 60 --tie-points 50").exit_code, 0);
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + b +
+                                " --seed 6 --exposures 9 --surveyed-points 60 --tie-points 50")
+                .exit_code,
+            0);
   EXPECT_NE(ReadTextFile(a + "/observations.csv"), ReadTextFile(b + "/observations.csv"));
 }
 
@@ -58,19 +75,25 @@ TEST(Cli, BadOptionsExitWithTwoAndWriteNothing) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.output.find("--layout"), std::string::npos);
   EXPECT_FALSE(std::filesystem::exists(dir.File("x")));
-  EXPECT_EQ(testing::RunAerocal("simulate --out " + dir.File("y") + " --exposures -3").exit_code, 2);
+  EXPECT_EQ(testing::RunAerocal("simulate --out " + dir.File("y") + " --exposures -3").exit_code,
+            2);
   EXPECT_FALSE(std::filesystem::exists(dir.File("y")));
-  const auto model = testing::RunAerocal("simulate --out " + dir.File("z") + " --nominal-mapping shear");
+  const auto model =
+      testing::RunAerocal("simulate --out " + dir.File("z") + " --nominal-mapping shear");
   EXPECT_EQ(model.exit_code, 2);
   EXPECT_NE(model.output.find("--nominal-mapping"), std::string::npos) << model.output;
   EXPECT_FALSE(std::filesystem::exists(dir.File("z")));
-  EXPECT_EQ(testing::RunAerocal("simulate --out " + dir.File("z") + " --ccd-shear -1").exit_code, 2);
+  EXPECT_EQ(testing::RunAerocal("simulate --out " + dir.File("z") + " --ccd-shear -1").exit_code,
+            2);
   EXPECT_FALSE(std::filesystem::exists(dir.File("z")));
 }
 
 TEST(Cli, OtherLayoutsSimulate) {
   testing::TempDir dir;
-  ASSERT_EQ(testing::RunAerocal("simulate --out " + dir.path() + " --layout 3x4 --exposures 6 --surveyed-points 30 --tie-points 20").exit_code, 0);
+  ASSERT_EQ(testing::RunAerocal("simulate --out " + dir.path() +
+                                " --layout 3x4 --exposures 6 --surveyed-points 30 --tie-points 20")
+                .exit_code,
+            0);
   const auto camera = calib::ReadCamera(dir.File("camera_nominal.yaml"));
   EXPECT_EQ(camera.subimages.size(), 12u);
   EXPECT_FALSE(camera.reference_points.empty());
@@ -79,27 +102,38 @@ TEST(Cli, OtherLayoutsSimulate) {
 TEST(Cli, SimulateRigDualLensWritesHeadObservationsAndTruth) {
   testing::TempDir dir;
   const std::string a = dir.File("a"), b = dir.File("b");
-  const std::string args = " --rig dual-lens --seed 3 --exposures 8 --surveyed-points 12 --tie-points 40 "
-                           "--gnss-sigma-m 0.05 --imu-sigma-deg 0.005 --speed-mps 60 "
-                           "--head-time-offset-ms 0.5 --head-increment-arcsec 2";
+  const std::string args =
+      " --rig dual-lens --seed 3 --exposures 8 --surveyed-points 12 --tie-points 40 "
+      "--gnss-sigma-m 0.05 --imu-sigma-deg 0.005 --speed-mps 60 "
+      "--head-time-offset-ms 0.5 --head-increment-arcsec 2";
   const auto run = testing::RunAerocal("simulate --out " + a + args);
   ASSERT_EQ(run.exit_code, 0) << run.output;
   EXPECT_NE(run.output.find("x 2 heads"), std::string::npos) << run.output;
   ASSERT_EQ(testing::RunAerocal("simulate --out " + b + args).exit_code, 0);
-  for (const char* f : {"rig_nominal.yaml", "rig_truth.yaml", "exposures.csv", "observations.csv",
-                        "points.csv", "project.yaml", "truth/exposures.csv", "truth/points.csv",
+  for (const char* f : {"rig_nominal.yaml",
+                        "rig_truth.yaml",
+                        "exposures.csv",
+                        "observations.csv",
+                        "points.csv",
+                        "project.yaml",
+                        "truth/exposures.csv",
+                        "truth/points.csv",
                         "truth/rig_exposures.csv"}) {
     ASSERT_TRUE(std::filesystem::exists(a + "/" + f)) << f;
     EXPECT_EQ(ReadTextFile(a + "/" + f), ReadTextFile(b + "/" + f)) << f << " differs between runs";
   }
-  EXPECT_EQ(ReadTextFile(a + "/observations.csv").rfind("image,head,point,col,row,sigma_px\n", 0), 0u);
+  EXPECT_EQ(ReadTextFile(a + "/observations.csv").rfind("image,head,point,col,row,sigma_px\n", 0),
+            0u);
   const auto exposures = triangulation::ReadExposures(a + "/exposures.csv");
   ASSERT_EQ(exposures.size(), 8u);  // --exposures overrides the rig default (30)
-  EXPECT_TRUE(exposures[0].velocity_mps && exposures[0].center_sigma_m && exposures[0].opk_sigma_rad);
+  EXPECT_TRUE(exposures[0].velocity_mps && exposures[0].center_sigma_m &&
+              exposures[0].opk_sigma_rad);
   // The rig default flying height (1200 m above a 200..300 m terrain), and --height-m over it.
-  EXPECT_NEAR(triangulation::ReadExposures(a + "/truth/exposures.csv")[0].center_m.z(), 1450.0, 1e-6);
+  EXPECT_NEAR(
+      triangulation::ReadExposures(a + "/truth/exposures.csv")[0].center_m.z(), 1450.0, 1e-6);
   ASSERT_EQ(testing::RunAerocal("simulate --out " + b + args + " --height-m 2000").exit_code, 0);
-  EXPECT_NEAR(triangulation::ReadExposures(b + "/truth/exposures.csv")[0].center_m.z(), 2250.0, 1e-6);
+  EXPECT_NEAR(
+      triangulation::ReadExposures(b + "/truth/exposures.csv")[0].center_m.z(), 2250.0, 1e-6);
 }
 
 TEST(Cli, SimulateRigRefusesUnknownRigsAndFrameOptions) {
@@ -107,12 +141,14 @@ TEST(Cli, SimulateRigRefusesUnknownRigsAndFrameOptions) {
   const auto unknown = testing::RunAerocal("simulate --out " + dir.File("x") + " --rig triple");
   EXPECT_EQ(unknown.exit_code, 2);
   EXPECT_NE(unknown.output.find("--rig"), std::string::npos) << unknown.output;
-  const auto layout = testing::RunAerocal("simulate --out " + dir.File("x") + " --rig dual-lens --layout 2x2");
+  const auto layout =
+      testing::RunAerocal("simulate --out " + dir.File("x") + " --rig dual-lens --layout 2x2");
   EXPECT_EQ(layout.exit_code, 2);
   EXPECT_NE(layout.output.find("--layout"), std::string::npos) << layout.output;
   // A head option without --rig (--speed-mps applies to the frame flight too: its velocity
   // columns feed the GNSS time offset, triangulation/README.md).
-  const auto head = testing::RunAerocal("simulate --out " + dir.File("x") + " --head-time-offset-ms 5");
+  const auto head =
+      testing::RunAerocal("simulate --out " + dir.File("x") + " --head-time-offset-ms 5");
   EXPECT_EQ(head.exit_code, 2);
   EXPECT_NE(head.output.find("--head-time-offset-ms"), std::string::npos) << head.output;
   EXPECT_FALSE(std::filesystem::exists(dir.File("x")));
@@ -125,16 +161,21 @@ TEST(Cli, SimulateTestFieldThenCalibrateWithItsGroups) {
   const std::string sim = "simulate --test-field --groups 2 --images-per-group 8 --seed 4 --out ";
   ASSERT_EQ(testing::RunAerocal(sim + dir.File("a")).exit_code, 0);
   ASSERT_EQ(testing::RunAerocal(sim + dir.File("b")).exit_code, 0);
-  for (const char* f : {"camera_nominal.yaml", "camera_truth.yaml", "observations.csv", "points.csv",
-                        "groups.csv", "truth/exposures.csv", "truth/points.csv"}) {
+  for (const char* f : {"camera_nominal.yaml",
+                        "camera_truth.yaml",
+                        "observations.csv",
+                        "points.csv",
+                        "groups.csv",
+                        "truth/exposures.csv",
+                        "truth/points.csv"}) {
     ASSERT_TRUE(std::filesystem::exists(dir.File("a/") + f)) << f;
     EXPECT_EQ(ReadTextFile(dir.File("a/") + f), ReadTextFile(dir.File("b/") + f)) << f;
   }
   const std::string a = dir.File("a/");
-  const auto r = testing::RunAerocal("calibrate --camera " + a + "camera_nominal.yaml --observations " + a +
-                                     "observations.csv --points " + a + "points.csv --groups " + a +
-                                     "groups.csv --self-calibration c,x0,y0,K1,K2,P1,P2 --out " +
-                                     dir.File("calib.json"));
+  const auto r = testing::RunAerocal(
+      "calibrate --camera " + a + "camera_nominal.yaml --observations " + a +
+      "observations.csv --points " + a + "points.csv --groups " + a +
+      "groups.csv --self-calibration c,x0,y0,K1,K2,P1,P2 --out " + dir.File("calib.json"));
   ASSERT_NE(r.exit_code, 2) << r.output;  // 0, or 3 when the two groups happen to disagree
   const auto j = nlohmann::json::parse(ReadTextFile(dir.File("calib.json")));
   EXPECT_EQ(j["calibration"]["groups"].size(), 2u);
@@ -144,7 +185,8 @@ TEST(Cli, SimulateTestFieldThenCalibrateWithItsGroups) {
             3.0 * j["cameras"][0]["sigma"]["c"].get<double>());
   // Test-field options belong to --test-field; flight options do not apply to it.
   EXPECT_EQ(testing::RunAerocal("simulate --planar --out " + dir.File("c")).exit_code, 2);
-  EXPECT_EQ(testing::RunAerocal("simulate --test-field --strips 3 --out " + dir.File("d")).exit_code, 2);
+  EXPECT_EQ(
+      testing::RunAerocal("simulate --test-field --strips 3 --out " + dir.File("d")).exit_code, 2);
   EXPECT_FALSE(std::filesystem::exists(dir.File("d")));
 }
 
@@ -153,7 +195,8 @@ TEST(Cli, SimulateTestFieldThenCalibrateWithItsGroups) {
 TEST(Cli, SimulateRigUav4WritesTheStitchingLine) {
   testing::TempDir dir;
   const std::string out = dir.File("uav4");
-  const auto run = testing::RunAerocal("simulate --out " + out + " --rig uav4 --exposures 3 --seed 5");
+  const auto run =
+      testing::RunAerocal("simulate --out " + out + " --rig uav4 --exposures 3 --seed 5");
   ASSERT_EQ(run.exit_code, 0) << run.output;
   const auto exposures = triangulation::ReadExposures(out + "/exposures.csv");
   ASSERT_EQ(exposures.size(), 3u);

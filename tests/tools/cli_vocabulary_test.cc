@@ -2,6 +2,10 @@
 // every command, the option reference docs/options.md is the program's own listing, old spellings
 // work as deprecated aliases with a warning, the global options are accepted after the command's
 // name, and a missing parent folder of an output is an error unless --mkdir is given.
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -9,10 +13,6 @@
 #include <sstream>
 #include <string>
 #include <vector>
-
-#include <gtest/gtest.h>
-
-#include "tests/support/test_support.h"
 
 namespace aerocal {
 namespace {
@@ -78,10 +78,14 @@ TEST(CliVocabulary, EveryOutSaysWhetherItIsAFileOrAFolder) {
 TEST(CliVocabulary, SharedNamesHaveOneTypeAndUnit) {
   // name -> (type prefix, a word every description holds, or "" for none)
   const std::map<std::string, std::pair<std::string, std::string>> rules = {
-      {"--sigma-px", {"FLOAT", "px"}},     {"--pixel-size-mm", {"FLOAT", "mm"}},
-      {"--images", {"TEXT", ""}},          {"--project", {"TEXT", ""}},
-      {"--model", {"TEXT", ""}},           {"--camera", {"TEXT", ""}},
-      {"--height-m", {"FLOAT", ""}},       {"--seed", {"UINT", ""}}};
+      {"--sigma-px", {"FLOAT", "px"}},
+      {"--pixel-size-mm", {"FLOAT", "mm"}},
+      {"--images", {"TEXT", ""}},
+      {"--project", {"TEXT", ""}},
+      {"--model", {"TEXT", ""}},
+      {"--camera", {"TEXT", ""}},
+      {"--height-m", {"FLOAT", ""}},
+      {"--seed", {"UINT", ""}}};
   std::map<std::string, int> seen;
   for (const Option& o : AllOptions()) {
     const auto rule = rules.find(o.name);
@@ -89,14 +93,17 @@ TEST(CliVocabulary, SharedNamesHaveOneTypeAndUnit) {
     ++seen[o.name];
     SCOPED_TRACE(o.command + " " + o.name + " " + o.type + ": " + o.description);
     EXPECT_EQ(o.type.rfind(rule->second.first, 0), 0u);
-    if (!rule->second.second.empty()) EXPECT_NE(o.description.find(rule->second.second), std::string::npos);
+    if (!rule->second.second.empty())
+      EXPECT_NE(o.description.find(rule->second.second), std::string::npos);
   }
-  for (const auto& [name, rule] : rules) EXPECT_GE(seen[name], 2) << name << " is in fewer than two commands";
+  for (const auto& [name, rule] : rules)
+    EXPECT_GE(seen[name], 2) << name << " is in fewer than two commands";
 }
 
 TEST(CliVocabulary, NoCommandOffersAnOldSpelling) {
   const std::set<std::string> old = {"--pixel-mm", "--sigma", "--out-dir"};
-  for (const Option& o : AllOptions()) EXPECT_EQ(old.count(o.name), 0u) << o.command << " " << o.name;
+  for (const Option& o : AllOptions())
+    EXPECT_EQ(old.count(o.name), 0u) << o.command << " " << o.name;
 }
 
 TEST(CliVocabulary, AnOldSpellingWorksWithAWarningNamingTheNewOne) {
@@ -109,14 +116,17 @@ TEST(CliVocabulary, AnOldSpellingWorksWithAWarningNamingTheNewOne) {
   ASSERT_EQ(old.exit_code, 0) << old.output;
   EXPECT_EQ(now.output.find("deprecated"), std::string::npos) << now.output;
   const std::string warning =
-      "warning: camera show --pixel-mm is deprecated and goes in release 0.2.0: use --pixel-size-mm\n";
+      "warning: camera show --pixel-mm is deprecated and goes in release 0.2.0: use "
+      "--pixel-size-mm\n";
   ASSERT_EQ(old.output.rfind(warning, 0), 0u) << old.output;
   EXPECT_EQ(old.output.substr(warning.size()), now.output);  // the same run otherwise
   // The alias takes the new option's range check, and --quiet silences the warning.
   const auto out_of_range = RunAerocal(common + "--pixel-mm 7");
   EXPECT_EQ(out_of_range.exit_code, 2);
-  EXPECT_NE(out_of_range.output.find("--pixel-size-mm: must be in"), std::string::npos) << out_of_range.output;
-  EXPECT_EQ(RunAerocal(common + "--pixel-mm 0.0024 --quiet").output.find("deprecated"), std::string::npos);
+  EXPECT_NE(out_of_range.output.find("--pixel-size-mm: must be in"), std::string::npos)
+      << out_of_range.output;
+  EXPECT_EQ(RunAerocal(common + "--pixel-mm 0.0024 --quiet").output.find("deprecated"),
+            std::string::npos);
   // An old spelling of another command is not rewritten: calibrate never had --sigma.
   EXPECT_EQ(RunAerocal("calibrate --sigma 0.3").output.find("deprecated"), std::string::npos);
 }
@@ -133,16 +143,20 @@ TEST(CliVocabulary, AMissingParentFolderIsAnErrorUnlessMkdirIsGiven) {
       << refused.output;
   EXPECT_FALSE(std::filesystem::exists(tmp.File("no")));
   // --mkdir before and after the command's name.
-  const auto before = RunAerocal("--mkdir camera convert --from aerocal --to opencv " + in + " " + nested);
+  const auto before =
+      RunAerocal("--mkdir camera convert --from aerocal --to opencv " + in + " " + nested);
   ASSERT_EQ(before.exit_code, 0) << before.output;
   EXPECT_TRUE(std::filesystem::is_regular_file(nested));
   const std::string other = tmp.File("other/camera.yml");
-  const auto after = RunAerocal("camera convert --mkdir --from aerocal --to opencv " + in + " " + other);
+  const auto after =
+      RunAerocal("camera convert --mkdir --from aerocal --to opencv " + in + " " + other);
   ASSERT_EQ(after.exit_code, 0) << after.output;
   EXPECT_EQ(ReadFile(other), ReadFile(nested));
   // An output folder itself is created; only its parents must exist.
-  const auto folder = RunAerocal("simulate --exposures 2 --strips 1 --surveyed-points 6 --control 3 "
-                                 "--tie-points 10 --stitch-ties 10 --out " + tmp.File("sim"));
+  const auto folder = RunAerocal(
+      "simulate --exposures 2 --strips 1 --surveyed-points 6 --control 3 "
+      "--tie-points 10 --stitch-ties 10 --out " +
+      tmp.File("sim"));
   EXPECT_EQ(folder.exit_code, 0) << folder.output;
 }
 
@@ -150,13 +164,17 @@ TEST(CliVocabulary, SimulateHelpIsGroupedByMode) {
   const auto r = RunAerocal("simulate --help");
   ASSERT_EQ(r.exit_code, 0);
   std::vector<size_t> at;
-  for (const char* heading : {"Output:", "Frame-camera flight", "Multi-head rig flight (--rig):",
-                              "Calibration test field (--test-field):", "Pushbroom line camera (--pushbroom):",
+  for (const char* heading : {"Output:",
+                              "Frame-camera flight",
+                              "Multi-head rig flight (--rig):",
+                              "Calibration test field (--test-field):",
+                              "Pushbroom line camera (--pushbroom):",
                               "Rendered images (--render-images"}) {
     at.push_back(r.output.find(heading));
     EXPECT_NE(at.back(), std::string::npos) << heading << "\n" << r.output;
   }
-  // Each mode's own options sit under its heading: --planar after the test field's, before the pushbroom's.
+  // Each mode's own options sit under its heading: --planar after the test field's, before the
+  // pushbroom's.
   const size_t planar = r.output.find("--planar");
   EXPECT_GT(planar, at[3]);
   EXPECT_LT(planar, at[4]);

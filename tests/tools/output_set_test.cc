@@ -2,15 +2,15 @@
 // several folders, files and folders alike (issue 37 class 8).
 #include "tools/output_set.h"
 
-#include <filesystem>
-#include <map>
-#include <string>
-
-#include <gtest/gtest.h>
-
 #include "calib/core/error.h"
 #include "tests/support/bad_input_case.h"
 #include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+#include <string>
 
 namespace aerocal::tools {
 namespace {
@@ -29,7 +29,8 @@ void WriteFileText(const std::string& path, const std::string& text) {
 std::map<std::string, std::string> Tree(const std::string& folder) {
   std::map<std::string, std::string> tree;
   for (const auto& e : fs::recursive_directory_iterator(folder))
-    tree[fs::relative(e.path(), folder).string()] = e.is_directory() ? "/" : ReadFileText(e.path().string());
+    tree[fs::relative(e.path(), folder).string()] =
+        e.is_directory() ? "/" : ReadFileText(e.path().string());
   return tree;
 }
 
@@ -46,14 +47,15 @@ TEST(OutputSet, PartsInTwoFoldersAndAFolderPartAreCommittedTogether) {
     WriteFileText(set.StagePath(d.File("c/new.tif")), "new folder");
     set.Commit({"result.json", "cert"});
   }
-  EXPECT_EQ(Tree(d.path()), (std::map<std::string, std::string>{{"a", "/"},
-                                                                {"a/result.json", "new result"},
-                                                                {"a/cert", "/"},
-                                                                {"a/cert/certificate.json", "new certificate"},
-                                                                {"b", "/"},
-                                                                {"b/image.tif", "new image"},
-                                                                {"c", "/"},
-                                                                {"c/new.tif", "new folder"}}));
+  EXPECT_EQ(Tree(d.path()),
+            (std::map<std::string, std::string>{{"a", "/"},
+                                                {"a/result.json", "new result"},
+                                                {"a/cert", "/"},
+                                                {"a/cert/certificate.json", "new certificate"},
+                                                {"b", "/"},
+                                                {"b/image.tif", "new image"},
+                                                {"c", "/"},
+                                                {"c/new.tif", "new folder"}}));
 }
 
 TEST(OutputSet, APartNotWrittenReplacesNothingAndLeavesNoStaging) {
@@ -94,8 +96,10 @@ TEST(OutputSetPaths, AnOutputNamingAnInputIsRefusedWithItsOption) {
   WriteFileText(d.File("in.yml"), "x");
   fs::create_hard_link(d.File("in.yml"), d.File("hard.yml"));
   EXPECT_THROW(CheckDistinctPath(d.File("in.yml"), "OUT", d.File("in.yml"), "IN"), ConfigError);
-  EXPECT_THROW(CheckDistinctPath(d.File("sub/../in.yml"), "OUT", d.File("./in.yml"), "IN"), ConfigError);
-  EXPECT_THROW(CheckDistinctPath(d.File("hard.yml"), "--report", d.File("in.yml"), "IN"), ConfigError);
+  EXPECT_THROW(CheckDistinctPath(d.File("sub/../in.yml"), "OUT", d.File("./in.yml"), "IN"),
+               ConfigError);
+  EXPECT_THROW(CheckDistinctPath(d.File("hard.yml"), "--report", d.File("in.yml"), "IN"),
+               ConfigError);
   EXPECT_NO_THROW(CheckDistinctPath(d.File("out.yml"), "OUT", d.File("in.yml"), "IN"));
   EXPECT_NO_THROW(CheckDistinctPath("", "--report", d.File("in.yml"), "IN"));
   try {

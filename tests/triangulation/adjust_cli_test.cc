@@ -116,7 +116,8 @@ TEST_F(AdjustCommand, AnImageIdStartingWithHashIsAdjustedAndAnUnobservedImageIsN
     size_t begin = 0;
     while (begin < text.size()) {  // every line that starts with the id 0001
       const size_t end = text.find('\n', begin);
-      std::string line = text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
+      std::string line =
+          text.substr(begin, end == std::string::npos ? std::string::npos : end - begin);
       if (line.rfind("0001,", 0) == 0) line = "#" + line;
       out += line + "\n";
       if (end == std::string::npos) break;
@@ -177,13 +178,15 @@ TEST_F(AdjustCommand, SelfCalibrationAutoAndTheSuspectEffectLimit) {
 // them (options over the project YAML) and writes them with sigmas; a bad mode is exit 2.
 TEST(AdjustPlatform, SimulatedLeverArmAndTimeOffsetComeBack) {
   TempDir dir{"aerocal_adjust_platform"};
-  const auto sim = RunAerocal("simulate --gnss-sigma-m 0.05 --speed-mps 70 --lever-arm-m "
-                              "0.15,-0.25,1.3 --gnss-time-offset-ms 20 --out " +
-                              dir.File("flight"));
+  const auto sim = RunAerocal(
+      "simulate --gnss-sigma-m 0.05 --speed-mps 70 --lever-arm-m "
+      "0.15,-0.25,1.3 --gnss-time-offset-ms 20 --out " +
+      dir.File("flight"));
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
   const auto r = RunAerocal("adjust --project " + dir.File("flight") +
                             " --self-calibration all --lever-arm free --gnss-time-offset free "
-                            "--out " + dir.File("result.json"));
+                            "--out " +
+                            dir.File("result.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const auto j = ReadJson(dir.File("result.json"));
   ASSERT_TRUE(j.contains("platform")) << j.dump().substr(0, 400);
@@ -192,7 +195,8 @@ TEST(AdjustPlatform, SimulatedLeverArmAndTimeOffsetComeBack) {
   const double truth[3] = {0.15, -0.25, 1.3};
   for (int i = 0; i < 3; ++i)
     EXPECT_LE(std::abs(lever["value"][i].get<double>() - truth[i]),
-              3.0 * lever["sigma"][i].get<double>()) << i;
+              3.0 * lever["sigma"][i].get<double>())
+        << i;
   const auto& dt = j["platform"]["time_offset_ms"];
   EXPECT_LE(std::abs(dt["value"][0].get<double>() - 20.0), 3.0 * dt["sigma"][0].get<double>());
   // A mode that is not one of fixed | free | weighted: exit 2, nothing written.

@@ -3,13 +3,6 @@
 // `calibrate --budget` (units converted, FILE:LINE on bad content) and the directions file of
 // `calibrate --directions` (docs/formats.md "Directions file"). Good files give the values they
 // hold; each bad one an aerocal::Error naming the file, its line and the rule.
-#include <cmath>
-#include <fstream>
-#include <string>
-#include <vector>
-
-#include <gtest/gtest.h>
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/error.h"
 #include "calib/core/yaml_util.h"
@@ -17,6 +10,13 @@
 #include "tests/support/test_support.h"
 #include "triangulation/calibration/direction_io.h"
 #include "triangulation/calibration/uncertainty_budget.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 namespace {
@@ -45,7 +45,8 @@ std::string ErrorOf(Read read) {
 TEST(BudgetReader, ComponentsKeepValueUnitSensitivityAndLine) {
   TempDir dir("aerocal_budget_reader");
   const BudgetOptions b = ReadBudgetOptions(Write(
-      dir, "budget.yaml",
+      dir,
+      "budget.yaml",
       "radii_mm: [2.0, 4.0]\ntarget_radius_mm: 0.5\ncomponents:\n"
       "  - {quantity: c, source: temperature, value: 0.6, unit: um, distribution: rectangular}\n"
       "  - {quantity: x0, source: mount, value: 2, unit: K, sensitivity: 0.001, dof: 8}\n"));
@@ -91,19 +92,22 @@ TEST(BudgetReader, BadFilesNameTheirLine) {
 // A 6000 x 4000 px camera of 4 um, c = 24 mm: it bounds the image positions.
 calib::Camera SmallCamera() {
   return calib::ParseCamera(
-      LoadYamlText("pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n", "camera.yaml"),
+      LoadYamlText("pixel_size_mm: 0.004\nformat_px: [6000, 4000]\ninterior: {c: 24}\n",
+                   "camera.yaml"),
       "camera.yaml");
 }
 
 TEST(DirectionReader, CollimatorsAndGoniometerSettingsAsWritten) {
   TempDir dir("aerocal_direction_reader");
   const calib::Camera camera = SmallCamera();
-  const DirectionData known = ReadDirections(
-      Write(dir, "c.csv",
-            "target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,group\n"
-            "A,3000,2000,0.3,0,0,1,monday\nB,4000.5,2000,,6.8,0,1,monday\n"
-            "A,3000.1,2000.2,0.3,0,0,1,tuesday\n"),
-      camera, 0.2);
+  const DirectionData known =
+      ReadDirections(Write(dir,
+                           "c.csv",
+                           "target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,group\n"
+                           "A,3000,2000,0.3,0,0,1,monday\nB,4000.5,2000,,6.8,0,1,monday\n"
+                           "A,3000.1,2000.2,0.3,0,0,1,tuesday\n"),
+                     camera,
+                     0.2);
   ASSERT_EQ(known.targets.size(), 2u);
   EXPECT_TRUE(known.targets[1].known);
   EXPECT_NEAR(known.targets[1].angles_rad.x(), 6.8 * M_PI / 180, 1e-15);
@@ -115,10 +119,12 @@ TEST(DirectionReader, CollimatorsAndGoniometerSettingsAsWritten) {
   EXPECT_EQ(known.settings, 0);
 
   const DirectionData gonio = ReadDirections(
-      Write(dir, "g.csv",
+      Write(dir,
+            "g.csv",
             "target,col,row,setting,turn_deg,tilt_deg\nT,3000,2000,s1,0,0\nT,3410.7,2000,s2,5,0\n"
             "T,3000,1589.3,s3,0,-5\n"),
-      camera, 0.2);
+      camera,
+      0.2);
   ASSERT_EQ(gonio.targets.size(), 1u);
   EXPECT_FALSE(gonio.targets[0].known);
   EXPECT_EQ(gonio.settings, 3);

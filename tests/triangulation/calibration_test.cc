@@ -3,20 +3,19 @@
 // the numbers of their formulas; a simulated 3-D test field of 3 image groups calibrates to the
 // truth within 3 sigma, its groups agree, and they are flagged when one group's camera changes.
 #include "triangulation/calibration/calibration.h"
-#include "triangulation/calibration/resection.h"
-#include "triangulation/calibration/uncertainty_budget.h"
 
 #include "calib/camera/rotation.h"
 #include "tests/support/interior_checks.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
-
-#include <fstream>
+#include "triangulation/calibration/resection.h"
+#include "triangulation/calibration/uncertainty_budget.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <fstream>
 #include <random>
 
 namespace aerocal::triangulation {
@@ -54,7 +53,8 @@ Exposure LookAt(const Eigen::Vector3d& center, double roll_rad) {
 
 void ExpectSamePose(const Exposure& a, const Exposure& b, double tol_m, double tol_rad) {
   EXPECT_LE((a.center_m - b.center_m).norm(), tol_m);
-  const Eigen::Matrix3d d = calib::RotationFromOpk(a.opk_rad).transpose() * calib::RotationFromOpk(b.opk_rad);
+  const Eigen::Matrix3d d =
+      calib::RotationFromOpk(a.opk_rad).transpose() * calib::RotationFromOpk(b.opk_rad);
   EXPECT_LE(Eigen::AngleAxisd(d).angle(), tol_rad);
 }
 
@@ -82,7 +82,8 @@ TEST(Resection, PlanarAndGeneralPointsGiveTheExactPose) {
     EXPECT_LT(start->rms_px, 1e-5);
   }
   std::string why;
-  EXPECT_FALSE(ResectImage(camera, {{1, 1}, {2, 2}, {3, 3}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, &why));
+  EXPECT_FALSE(
+      ResectImage(camera, {{1, 1}, {2, 2}, {3, 3}}, {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, &why));
   EXPECT_NE(why.find("needs 4"), std::string::npos) << why;
 }
 
@@ -101,7 +102,8 @@ TEST(Resection, ClosedFormPrincipalDistanceOfAPlanarTarget) {
       p.role = PointRole::kControl;
       project.points.push_back(p);
     }
-  const std::vector<Eigen::Vector3d> centers = {{0.8, 0.1, 2.0}, {-0.7, 0.4, 1.9}, {0.2, -0.9, 2.1}, {0.1, 0.8, 1.7}};
+  const std::vector<Eigen::Vector3d> centers = {
+      {0.8, 0.1, 2.0}, {-0.7, 0.4, 1.9}, {0.2, -0.9, 2.1}, {0.1, 0.8, 1.7}};
   for (size_t i = 0; i < centers.size(); ++i) {
     const Exposure e = LookAt(centers[i], 0.2 * static_cast<double>(i));
     for (const auto& p : project.points) {
@@ -169,7 +171,8 @@ TEST(Resection, WuhanTextbookAnswer) {
   const AdjustmentResult r = Adjust(project, options);
   ASSERT_TRUE(r.converged());
   // The textbook's iteration stops at 1e-3 m / 1e-6 rad: agreement to 0.01 m and 1e-5.
-  EXPECT_LT((r.exposures[0].center_m - published).norm(), 0.01) << r.exposures[0].center_m.transpose();
+  EXPECT_LT((r.exposures[0].center_m - published).norm(), 0.01)
+      << r.exposures[0].center_m.transpose();
   const double phi = -0.003987, omega = 0.002114, kappa = -0.067578;
   Eigen::Matrix3d textbook;  // R = R_phi(Y) R_omega(X) R_kappa(Z) with the signs of PROVENANCE.md
   textbook << std::cos(phi) * std::cos(kappa) - std::sin(phi) * std::sin(omega) * std::sin(kappa),
@@ -184,13 +187,14 @@ TEST(Resection, WuhanTextbookAnswer) {
 }
 
 TEST(Statistics, QuantilesAndCoverageFactors) {
-  EXPECT_NEAR(ChiSquareQuantile(0.95, 2), 5.9915, 1e-3);   // tables
+  EXPECT_NEAR(ChiSquareQuantile(0.95, 2), 5.9915, 1e-3);  // tables
   EXPECT_NEAR(ChiSquareQuantile(0.99, 10), 23.209, 1e-2);
   EXPECT_EQ(CoverageFactor(std::numeric_limits<double>::infinity()), 2.0);
   EXPECT_EQ(CoverageFactor(200), 2.0);
   EXPECT_NEAR(CoverageFactor(10), 2.28, 0.005);  // GUM table G.2: t_95.45(10) = 2.28
   EXPECT_NEAR(CoverageFactor(2), 4.53, 0.005);   // t_95.45(2) = 4.53
-  EXPECT_EQ(CertificateStatement("c", 52.09171, 0.00304, 2, "mm"), "c = 52.0917 mm, U = 0.0030 mm (k = 2)");
+  EXPECT_EQ(CertificateStatement("c", 52.09171, 0.00304, 2, "mm"),
+            "c = 52.0917 mm, U = 0.0030 mm (k = 2)");
 }
 
 GroupCalibration FakeGroup(const std::string& name, double c, double sigma) {
@@ -207,16 +211,18 @@ GroupCalibration FakeGroup(const std::string& name, double c, double sigma) {
 TEST(GroupStability, ChiSquareOfTheGroupsAgainstTheirWeightedMean) {
   // 52.090 / 52.094 / 52.091 mm with sigma 2 um (the lab of the issue): weighted mean 52.09167,
   // chi2 = (1.667^2 + 2.333^2 + 0.667^2) / 4 = 2.167 < 5.99 (chi2_95 %(2)).
-  const auto ok = GroupStability({FakeGroup("1", 52.090, 0.002), FakeGroup("2", 52.094, 0.002),
-                                  FakeGroup("3", 52.091, 0.002)}, 0.05);
+  const auto ok = GroupStability(
+      {FakeGroup("1", 52.090, 0.002), FakeGroup("2", 52.094, 0.002), FakeGroup("3", 52.091, 0.002)},
+      0.05);
   ASSERT_EQ(ok.rows.size(), 1u);
   EXPECT_NEAR(ok.rows[0].weighted_mean, 52.0916667, 1e-6);
   EXPECT_NEAR(ok.rows[0].chi2, 2.1667, 1e-3);
   EXPECT_NEAR(ok.rows[0].critical, 5.9915, 1e-3);
   EXPECT_NEAR(ok.rows[0].spread, 0.0020817, 1e-6);
   EXPECT_TRUE(ok.agree);
-  const auto bad = GroupStability({FakeGroup("1", 52.090, 0.001), FakeGroup("2", 52.094, 0.001),
-                                   FakeGroup("3", 52.091, 0.001)}, 0.05);
+  const auto bad = GroupStability(
+      {FakeGroup("1", 52.090, 0.001), FakeGroup("2", 52.094, 0.001), FakeGroup("3", 52.091, 0.001)},
+      0.05);
   EXPECT_FALSE(bad.agree);  // chi2 = 8.67 > 5.99
   ASSERT_EQ(bad.flagged.size(), 1u);
   EXPECT_NE(bad.flagged[0].find("c: the groups disagree"), std::string::npos);
@@ -250,8 +256,10 @@ TestField SimulateTestField(uint32_t seed, double group3_dc_mm) {
       p.id = "t" + std::to_string(i) + "_" + std::to_string(j);
       p.xyz_m = Eigen::Vector3d(-4.0 + 1.0 * i, -3.0 + 1.0 * j, ((i + 2 * j) % 3) * 0.8);
       p.sigma_m = Eigen::Vector3d::Constant(0.0005);
-      p.role = (i + j) % 4 == 0 ? PointRole::kControl : ((i * j) % 7 == 3 ? PointRole::kCheck : PointRole::kTie);
-      if (p.role != PointRole::kTie) *p.xyz_m += Eigen::Vector3d(survey(rng), survey(rng), survey(rng));
+      p.role = (i + j) % 4 == 0 ? PointRole::kControl
+                                : ((i * j) % 7 == 3 ? PointRole::kCheck : PointRole::kTie);
+      if (p.role != PointRole::kTie)
+        *p.xyz_m += Eigen::Vector3d(survey(rng), survey(rng), survey(rng));
       f.project.points.push_back(p);
     }
   for (int k = 0; k < 24; ++k) {
@@ -260,7 +268,8 @@ TestField SimulateTestField(uint32_t seed, double group3_dc_mm) {
     const double tilt = 0.35 + 0.1 * (k % 2);
     const double distance = 14.0 + 2.0 * (k % 4);
     const Eigen::Vector3d center(distance * std::sin(tilt) * std::cos(azimuth),
-                                 distance * std::sin(tilt) * std::sin(azimuth), distance * std::cos(tilt));
+                                 distance * std::sin(tilt) * std::sin(azimuth),
+                                 distance * std::cos(tilt));
     const Exposure e = LookAt(center, (k % 4) * M_PI / 2);
     calib::Camera seen = f.truth;
     if (group == 2) seen.interior[Model::kC] += group3_dc_mm;
@@ -274,7 +283,8 @@ TestField SimulateTestField(uint32_t seed, double group3_dc_mm) {
         o.point = "t" + std::to_string(i) + "_" + std::to_string(j);
         o.sigma_px = 0.1;
         if (!seen.ProjectToPixel(e.opk_rad, e.center_m, x, &o.pixel)) continue;
-        if (o.pixel.x() < 0 || o.pixel.y() < 0 || o.pixel.x() > seen.width_px - 1 || o.pixel.y() > seen.height_px - 1)
+        if (o.pixel.x() < 0 || o.pixel.y() < 0 || o.pixel.x() > seen.width_px - 1 ||
+            o.pixel.y() > seen.height_px - 1)
           continue;
         o.pixel += Eigen::Vector2d(noise(rng), noise(rng));
         f.project.observations.push_back(o);
@@ -301,11 +311,13 @@ TEST(Calibrate, SimulatedTestFieldRecoversTheTruthAndItsGroupsAgree) {
   // sigma0 / injected sigma within 1 +- 3 / sqrt(2 r).
   EXPECT_NEAR(r.sigma0, 1.0, 3.0 / std::sqrt(2.0 * r.solve.redundancy));
   ASSERT_EQ(run.groups.size(), 3u);
-  EXPECT_TRUE(run.stability.agree) << (run.stability.flagged.empty() ? "" : run.stability.flagged[0]);
+  EXPECT_TRUE(run.stability.agree)
+      << (run.stability.flagged.empty() ? "" : run.stability.flagged[0]);
   ASSERT_TRUE(run.control_fixed);
   // The budget: c with its components, U = k u_c, and the check points' accuracy.
   const auto budget = UncertaintyBudget(run, run.project, {{10.0}, 5.0, {}});
-  const auto q = std::find_if(budget.begin(), budget.end(), [](const auto& b) { return b.name == "c"; });
+  const auto q =
+      std::find_if(budget.begin(), budget.end(), [](const auto& b) { return b.name == "c"; });
   ASSERT_NE(q, budget.end());
   ASSERT_EQ(q->components.size(), 4u);  // adjustment, groups, control, eccentricity
   double sum = 0;
@@ -313,8 +325,10 @@ TEST(Calibrate, SimulatedTestFieldRecoversTheTruthAndItsGroupsAgree) {
   EXPECT_NEAR(q->u_c, std::sqrt(sum), 1e-15);
   EXPECT_NEAR(q->expanded, q->k * q->u_c, 1e-15);
   EXPECT_GT(q->components[2].u, 0.0);  // 0.5 mm survey sigmas propagate
-  EXPECT_TRUE(std::any_of(budget.begin(), budget.end(), [](const auto& b) { return b.name == "m_Z"; }));
-  EXPECT_TRUE(std::any_of(budget.begin(), budget.end(), [](const auto& b) { return b.name == "dr@10"; }));
+  EXPECT_TRUE(
+      std::any_of(budget.begin(), budget.end(), [](const auto& b) { return b.name == "m_Z"; }));
+  EXPECT_TRUE(
+      std::any_of(budget.begin(), budget.end(), [](const auto& b) { return b.name == "dr@10"; }));
 }
 
 TEST(Calibrate, AGroupWhoseCameraChangedIsFlagged) {

@@ -6,15 +6,15 @@
 // - 0.1 px noise: every parameter within 3 of its sigmas, sigma0 within 1 +- 3 / sqrt(2 r);
 // - the same images calibrated in the 10-parameter model and converted to OpenCV with
 //   calib::ConvertCamera agree with the direct fit within the conversions' stated residuals.
+#include "calib/camera/convert_camera.h"
+#include "triangulation/calibration/calibration.h"
+#include "triangulation/simulation/test_field_simulator.h"
+
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <map>
 #include <random>
-
-#include "calib/camera/convert_camera.h"
-#include "triangulation/calibration/calibration.h"
-#include "triangulation/simulation/test_field_simulator.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -22,10 +22,10 @@ namespace {
 using CvModel = calib::OpenCvModel;
 
 struct OpenCvField {
-  SimulatedTestField field;        // the geometry (targets, stations, groups)
-  calib::Camera truth;             // the OpenCV camera that took the images
+  SimulatedTestField field;           // the geometry (targets, stations, groups)
+  calib::Camera truth;                // the OpenCV camera that took the images
   calib::ConversionResult from_ours;  // the simulator's 10-parameter truth as OpenCV (a fit)
-  Project project;                 // nominal OpenCV camera, points, the OpenCV truth's pixels
+  Project project;                    // nominal OpenCV camera, points, the OpenCV truth's pixels
 };
 
 calib::ConvertOptions WithoutRationalTerms() {
@@ -44,7 +44,8 @@ OpenCvField MakeOpenCvField(double noise_px, std::uint64_t seed) {
   o.image_noise_px = 0.0;
   out.field = SimulateTestField(o);
   const SimulatedTestField& f = out.field;
-  out.from_ours = calib::ConvertCamera(f.truth.AsModelCamera(), CvModel::kId, WithoutRationalTerms());
+  out.from_ours =
+      calib::ConvertCamera(f.truth.AsModelCamera(), CvModel::kId, WithoutRationalTerms());
   out.truth = f.truth.WithModelCamera(out.from_ours.camera);
   const calib::ConversionResult nominal =
       calib::ConvertCamera(f.nominal.AsModelCamera(), CvModel::kId, WithoutRationalTerms());
@@ -71,7 +72,8 @@ OpenCvField MakeOpenCvField(double noise_px, std::uint64_t seed) {
   return out;
 }
 
-CalibrationRun CalibrateIn(const Project& project, calib::CameraModelId model,
+CalibrationRun CalibrateIn(const Project& project,
+                           calib::CameraModelId model,
                            const std::string& free) {
   CalibrateOptions o;
   o.adjust.free_interior = ParseSelfCalibration(free, model);
@@ -88,8 +90,14 @@ CalibrationRun CalibrateIn(const Project& project, calib::CameraModelId model,
 }
 
 constexpr const char* kOpenCvFree = "fx,fy,cx,cy,k1,k2,p1,p2,k3";
-const std::vector<int> kOpenCvCalibrated = {CvModel::kFx, CvModel::kFy, CvModel::kCx, CvModel::kCy,
-                                            CvModel::kK1, CvModel::kK2, CvModel::kP1, CvModel::kP2,
+const std::vector<int> kOpenCvCalibrated = {CvModel::kFx,
+                                            CvModel::kFy,
+                                            CvModel::kCx,
+                                            CvModel::kCy,
+                                            CvModel::kK1,
+                                            CvModel::kK2,
+                                            CvModel::kP1,
+                                            CvModel::kP2,
                                             CvModel::kK3};
 
 TEST(OpenCvModelCalibration, NoiseFreeTestFieldRecoversTheOpenCvTruth) {
@@ -108,8 +116,11 @@ TEST(OpenCvModelCalibration, NoiseFreeTestFieldRecoversTheOpenCvTruth) {
   for (int k : {CvModel::kK4, CvModel::kK5, CvModel::kK6}) EXPECT_EQ(c.estimated[k], 0.0);
   EXPECT_LT(r.sigma0, 1e-3);
   std::printf("noise-free OpenCV truth: fx %.6f (truth %.6f) k1 %.8f (truth %.8f), sigma0 %.2e\n",
-              c.estimated[CvModel::kFx], f.truth.interior[CvModel::kFx], c.estimated[CvModel::kK1],
-              f.truth.interior[CvModel::kK1], r.sigma0);
+              c.estimated[CvModel::kFx],
+              f.truth.interior[CvModel::kFx],
+              c.estimated[CvModel::kK1],
+              f.truth.interior[CvModel::kK1],
+              r.sigma0);
 }
 
 class NoisyOpenCvField : public ::testing::Test {
@@ -165,10 +176,13 @@ TEST(OpenCvModelCalibration, TenParameterFitConvertedToOpenCvAgreesWithTheDirect
   // 10-parameter model holds these images up to that residual; the conversion of its fit back to
   // OpenCV states its own. The two results agree within their sum over the whole format.
   const double stated_px = f.from_ours.residual.max_px + converted.residual.max_px;
-  std::printf("10-parameter fit as OpenCV vs direct OpenCV fit: max %.5f px (rms %.5f), stated "
-              "residuals %.5f + %.5f px\n",
-              difference.max_px, difference.rms_px, f.from_ours.residual.max_px,
-              converted.residual.max_px);
+  std::printf(
+      "10-parameter fit as OpenCV vs direct OpenCV fit: max %.5f px (rms %.5f), stated "
+      "residuals %.5f + %.5f px\n",
+      difference.max_px,
+      difference.rms_px,
+      f.from_ours.residual.max_px,
+      converted.residual.max_px);
   EXPECT_EQ(difference.failed_points, 0);
   EXPECT_LE(difference.max_px, stated_px);
 }

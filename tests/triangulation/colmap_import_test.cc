@@ -201,8 +201,8 @@ TEST(ColmapExport, DistortionIsFittedIntoOpenCvNotDropped) {
   // leave pixels.
   const calib::ConversionResidual kept =
       calib::CompareCameras(Registry(f.truth), Registry(imported), 41);
-  std::printf("ours -> COLMAP OPENCV -> ours: rms %.3g px, max %.3g px\n", kept.rms_px,
-              kept.max_px);
+  std::printf(
+      "ours -> COLMAP OPENCV -> ours: rms %.3g px, max %.3g px\n", kept.rms_px, kept.max_px);
   EXPECT_LT(kept.max_px, 0.1);
   calib::Camera dropped = f.truth;
   for (int k = calib::BrownFraser10Model::kK1; k < calib::BrownFraser10Model::kNumParams; ++k)

@@ -2,9 +2,6 @@
 // compound CRSs with a geoid, missing grids, and the acceptance test of issue 34: the real ODM
 // UAV block given in its UTM zone, in WGS84 geodetic, in ECEF and in a national projection with
 // orthometric heights gives the same check-point RMSE and camera.
-#include "triangulation/georef/crs.h"
-#include "triangulation/georef/object_frame.h"
-
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
@@ -13,6 +10,8 @@
 #include "tests/support/simulated_block.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/georef/crs.h"
+#include "triangulation/georef/object_frame.h"
 #include "triangulation/import/colmap_export.h"
 #include "triangulation/import/write_project.h"
 #include "triangulation/simulation/flight_simulator.h"
@@ -76,7 +75,8 @@ TEST(Crs, CompoundWithInstalledGeoidAndSeparateVertical) {
   const CrsConverter compound = Crs("EPSG:32722+5773");
   ASSERT_TRUE(compound.orthometric());
   const Eigen::Vector3d g = compound.ToPivot({kUtm22s.x(), kUtm22s.y(), 0.0});
-  std::printf("EGM96 undulation at the ODM block: %.3f m (%s)\n", g.z(),
+  std::printf("EGM96 undulation at the ODM block: %.3f m (%s)\n",
+              g.z(),
               compound.OperationDescription().c_str());
   EXPECT_NEAR(g.z(), 4.0, 1.0);
   EXPECT_NE(compound.OperationDescription().find("egm96"), std::string::npos);
@@ -166,23 +166,33 @@ TEST(CrsFrame, OdmUavBlockInFourCrsGivesTheSameResult) {
     double round_trip_m = 0;
     for (size_t i = 0; i < local.points.size(); ++i)
       if (local.points[i].xyz_m)
-        round_trip_m = std::max(round_trip_m,
-                                (*converted.points[i].xyz_m - *local.points[i].xyz_m).norm());
+        round_trip_m =
+            std::max(round_trip_m, (*converted.points[i].xyz_m - *local.points[i].xyz_m).norm());
     double sigma_change = 0;
     for (const auto& p : converted.points)
-      sigma_change = std::max(sigma_change, (p.sigma_m / 0.02 - Eigen::Vector3d::Ones()).cwiseAbs().maxCoeff());
+      sigma_change = std::max(sigma_change,
+                              (p.sigma_m / 0.02 - Eigen::Vector3d::Ones()).cwiseAbs().maxCoeff());
     std::printf("%s: largest round-trip difference of a point %.3g m, of a sigma %.3g relative\n",
-                c.name, round_trip_m, sigma_change);
+                c.name,
+                round_trip_m,
+                sigma_change);
     EXPECT_LT(round_trip_m, 1e-4) << c.name;
     AdjustmentResult r = Adjust(converted, options);
     ToInputFrame(frame, &r);
     ASSERT_TRUE(r.converged()) << c.name;
-    std::printf("%-64s check RMSE %.4f %.4f %.4f m (n %d), c %.6f mm, first check point %.6f "
-                "%.6f %.3f\n  frame: %s\n",
-                c.name, r.check.rmse_m(0), r.check.rmse_m(1), r.check.rmse_m(2),
-                static_cast<int>(r.check.n), r.cameras[0].estimated[0],
-                r.check_points[0].adjusted_m.x(), r.check_points[0].adjusted_m.y(),
-                r.check_points[0].adjusted_m.z(), r.frame.c_str());
+    std::printf(
+        "%-64s check RMSE %.4f %.4f %.4f m (n %d), c %.6f mm, first check point %.6f "
+        "%.6f %.3f\n  frame: %s\n",
+        c.name,
+        r.check.rmse_m(0),
+        r.check.rmse_m(1),
+        r.check.rmse_m(2),
+        static_cast<int>(r.check.n),
+        r.cameras[0].estimated[0],
+        r.check_points[0].adjusted_m.x(),
+        r.check_points[0].adjusted_m.y(),
+        r.check_points[0].adjusted_m.z(),
+        r.frame.c_str());
     // Each result in its input CRS: the surveyed coordinates are the file's.
     const GroundPoint* survey = input.FindPoint(r.check_points[0].point);
     ASSERT_NE(survey, nullptr);
@@ -207,13 +217,16 @@ TEST(CrsFrame, OdmUavBlockInFourCrsGivesTheSameResult) {
       // 1e-6 relative, or of the parameter's precision where the value is near 0.
       const double scale = std::max(std::abs(ca[i]), a.cameras[0].sigma[i]);
       const double d = std::abs(ca[i] - cb[i]) / std::max(scale, 1e-300);
-      EXPECT_LT(d, k == 4 ? 1e-5 : 1e-6) << cases[k].name << " parameter " << i << ": " << ca[i] << " vs " << cb[i];
+      EXPECT_LT(d, k == 4 ? 1e-5 : 1e-6)
+          << cases[k].name << " parameter " << i << ": " << ca[i] << " vs " << cb[i];
       if (k != 4) max_camera = std::max(max_camera, d);
     }
   }
-  std::printf("largest differences to the UTM run: check RMSE %.3g m (all six), camera %.3g "
-              "relative (all but the Polyconic)\n",
-              max_rmse, max_camera);
+  std::printf(
+      "largest differences to the UTM run: check RMSE %.3g m (all six), camera %.3g "
+      "relative (all but the Polyconic)\n",
+      max_rmse,
+      max_camera);
 }
 
 // `import odm --crs`: the block's GCP list converted to WGS84 longitude/latitude (EPSG:4326, as a
@@ -243,9 +256,9 @@ TEST(CrsFrame, ImportOdmTakesAWgs84GcpList) {
   }
   WriteFileAtomically(tmp.File("gcp_wgs84.txt"), wgs84);
   // Without --crs the geographic list is refused, naming the option.
-  const auto refused = testing::RunAerocal("import odm --gcp-list " + tmp.File("gcp_wgs84.txt") +
-                                           " --camera " + tmp.File("camera.yaml") + " --out " +
-                                           tmp.File("refused"));
+  const auto refused =
+      testing::RunAerocal("import odm --gcp-list " + tmp.File("gcp_wgs84.txt") + " --camera " +
+                          tmp.File("camera.yaml") + " --out " + tmp.File("refused"));
   EXPECT_EQ(refused.exit_code, 2) << refused.output;
   EXPECT_NE(refused.output.find("--crs"), std::string::npos) << refused.output;
 
@@ -262,22 +275,24 @@ TEST(CrsFrame, ImportOdmTakesAWgs84GcpList) {
                                          " --robust-start --out " + tmp.File(name + ".json"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
     results.push_back(nlohmann::json::parse(ReadTextFile(tmp.File(name + ".json"))));
-    std::printf("%s: check RMSE %s\n  frame: %s\n", name.c_str(),
+    std::printf("%s: check RMSE %s\n  frame: %s\n",
+                name.c_str(),
                 results.back()["check"]["rmse_m"].dump().c_str(),
                 results.back()["frame"].get<std::string>().c_str());
   }
   ASSERT_EQ(results[0]["check"]["n"], results[1]["check"]["n"]);
   for (int k = 0; k < 3; ++k)
     EXPECT_NEAR(results[0]["check"]["rmse_m"][k].get<double>(),
-                results[1]["check"]["rmse_m"][k].get<double>(), 1e-3);
+                results[1]["check"]["rmse_m"][k].get<double>(),
+                1e-3);
   EXPECT_NE(results[1]["frame"].get<std::string>().find("X = longitude"), std::string::npos);
 
   // `aerocal export --write-crs EPSG:4326` of the UTM result gives the WGS84 result's exposures
   // (centres to 1e-8 deg ~ 1 mm, attitudes relative to east/north/up to 1e-4 deg) and a GeoJSON
   // of the check-point errors.
-  const auto exported = testing::RunAerocal(
-      "export --project " + tmp.File("utm/project.yaml") + " --result " + tmp.File("utm.json") +
-      " --write-crs EPSG:4326 --out " + tmp.File("export"));
+  const auto exported = testing::RunAerocal("export --project " + tmp.File("utm/project.yaml") +
+                                            " --result " + tmp.File("utm.json") +
+                                            " --write-crs EPSG:4326 --out " + tmp.File("export"));
   ASSERT_EQ(exported.exit_code, 0) << exported.output;
   const CsvTable table = CsvTable::Read(tmp.File("export/exposures.csv"));
   ASSERT_EQ(table.rows().size(), results[1]["exposures"].size());
@@ -350,8 +365,10 @@ TEST(CrsFrame, OrthometricHeightsGiveTheEllipsoidalResult) {
                                          " --robust-start --out " + tmp.File(name + ".json"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
     results.push_back(nlohmann::json::parse(ReadTextFile(tmp.File(name + ".json"))));
-    std::printf("%s: height of %s %.4f m, check RMSE %s, c %.6f\n  frame: %s\n", name.c_str(),
-                block.points.front().id.c_str(), first_height.back(),
+    std::printf("%s: height of %s %.4f m, check RMSE %s, c %.6f\n  frame: %s\n",
+                name.c_str(),
+                block.points.front().id.c_str(),
+                first_height.back(),
                 results.back()["check"]["rmse_m"].dump().c_str(),
                 results.back()["cameras"][0]["estimated"]["c"].get<double>(),
                 results.back()["frame"].get<std::string>().c_str());
@@ -362,7 +379,8 @@ TEST(CrsFrame, OrthometricHeightsGiveTheEllipsoidalResult) {
   for (size_t k = 1; k < results.size(); ++k) {
     for (int i = 0; i < 3; ++i)
       EXPECT_NEAR(results[0]["check"]["rmse_m"][i].get<double>(),
-                  results[k]["check"]["rmse_m"][i].get<double>(), 1e-6);
+                  results[k]["check"]["rmse_m"][i].get<double>(),
+                  1e-6);
     const double c0 = results[0]["cameras"][0]["estimated"]["c"].get<double>();
     EXPECT_NEAR(results[k]["cameras"][0]["estimated"]["c"].get<double>(), c0, 1e-6 * c0);
   }
@@ -412,13 +430,14 @@ TEST(CrsFrame, ImportColmapTakesAGeocentricModel) {
   for (const auto& g : model.points) points[g.id] = *g.xyz_m;
   testing::TempDir tmp("aerocal_crs_colmap");
   WriteColmapModel(model, points, tmp.File("model"));
-  const auto refused = testing::RunAerocal("import colmap --colmap-model " + tmp.File("model") +
-                                           " --pixel-size-mm 0.009 --crs EPSG:4326 --out " +
-                                           tmp.File("refused"));
+  const auto refused =
+      testing::RunAerocal("import colmap --colmap-model " + tmp.File("model") +
+                          " --pixel-size-mm 0.009 --crs EPSG:4326 --out " + tmp.File("refused"));
   EXPECT_EQ(refused.exit_code, 2) << refused.output;
   const auto imported = testing::RunAerocal("import colmap --colmap-model " + tmp.File("model") +
                                             " --pixel-size-mm 0.009 --sigma-px 0.2 --crs EPSG:4978 "
-                                            "--out " + tmp.File("block"));
+                                            "--out " +
+                                            tmp.File("block"));
   ASSERT_EQ(imported.exit_code, 0) << imported.output;
   const auto adjusted = testing::RunAerocal("adjust --project " + tmp.File("block/project.yaml") +
                                             " --out " + tmp.File("r.json"));
@@ -429,8 +448,10 @@ TEST(CrsFrame, ImportColmapTakesAGeocentricModel) {
   // The adjusted centres are written back geocentric (|X| ~ Earth radius).
   EXPECT_NEAR(Eigen::Vector3d(doc["exposures"][0]["X"].get<double>(),
                               doc["exposures"][0]["Y"].get<double>(),
-                              doc["exposures"][0]["Z"].get<double>()).norm(),
-              6.37e6, 2e4);
+                              doc["exposures"][0]["Z"].get<double>())
+                  .norm(),
+              6.37e6,
+              2e4);
 }
 
 }  // namespace

@@ -7,9 +7,8 @@
 // group size; with 5 % of the observations at 50 sigma the default run (robust start, snooping)
 // recovers the clean camera, loses no good ray a method could keep and lists every blunder it
 // keeps as one no test can judge.
-#include "triangulation/adjustment/block_adjustment.h"
-
 #include "tests/support/simulated_block.h"
+#include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
@@ -36,7 +35,8 @@ bool IsControl(const std::string& point) { return !point.empty() && point[0] == 
 
 // The oracle: `p` without the observations in `drop` (removed by hand), adjusted without
 // snooping or robust start.
-AdjustmentResult Oracle(const Project& p, const std::set<std::pair<std::string, std::string>>& drop) {
+AdjustmentResult Oracle(const Project& p,
+                        const std::set<std::pair<std::string, std::string>>& drop) {
   Project without = p;
   without.observations.clear();
   for (const auto& o : p.observations)
@@ -116,8 +116,7 @@ TEST_F(SnoopingOnTheSimulatedFlight, EveryTestedObservationListsRWMdbAndGroupSiz
       if (v.test.redundancy(k) > 1e-6) {
         const double unit =
             clean_->snooping.reference_sigma / std::sqrt(v.test.redundancy(k)) * v.sigma_px;
-        const bool joint =
-            std::abs(v.test.mdb_px(k) - clean_->snooping.delta0_joint * unit) < 1e-9;
+        const bool joint = std::abs(v.test.mdb_px(k) - clean_->snooping.delta0_joint * unit) < 1e-9;
         joint_mdbs += joint;
         if (!joint) {
           EXPECT_NEAR(v.test.mdb_px(k), clean_->snooping.delta0 * unit, 1e-9);
@@ -132,7 +131,8 @@ TEST_F(SnoopingOnTheSimulatedFlight, EveryTestedObservationListsRWMdbAndGroupSiz
   EXPECT_LE(clean_->rejected.size(), 1u);
   EXPECT_NEAR(clean_->snooping.delta0 - clean_->snooping.critical_value, 0.8416, 1e-3);
   EXPECT_NEAR(clean_->snooping.delta0_joint,
-              calib::NonCentralityJoint(clean_->snooping.critical_value, 0.8), 1e-12);
+              calib::NonCentralityJoint(clean_->snooping.critical_value, 0.8),
+              1e-12);
   EXPECT_GT(joint_mdbs, tested) << "most image observations are tested jointly in x and y";
 }
 
@@ -145,7 +145,8 @@ TEST_F(SnoopingOnTheSimulatedFlight, ObservationsNoTestCanJudgeAreListedWithThei
   int weak = 0;
   std::map<std::string, int> rays;
   for (const auto& v : clean_->residuals) rays[v.point] += v.used;
-  for (const auto& v : clean_->residuals) weak += v.used && v.test.redundancy.minCoeff() < s.min_redundancy;
+  for (const auto& v : clean_->residuals)
+    weak += v.used && v.test.redundancy.minCoeff() < s.min_redundancy;
   ASSERT_EQ(static_cast<int>(s.uncontrolled.size()), weak);
   ASSERT_GT(weak, 0);
   int two_ray = 0;
@@ -175,7 +176,9 @@ TEST_F(SnoopingOnTheSimulatedFlight, ObservationsNoTestCanJudgeAreListedWithThei
   EXPECT_GT(two_ray_checks, 0);
   EXPECT_EQ(clean_->check_controlled->n, static_cast<int>(controlled.size()));
   EXPECT_LT(clean_->check_controlled->n, clean_->check.n);
-  EXPECT_NEAR(clean_->check_controlled->spatial_rmse_m, ComputePointStatistics(controlled).spatial_rmse_m, 1e-12);
+  EXPECT_NEAR(clean_->check_controlled->spatial_rmse_m,
+              ComputePointStatistics(controlled).spatial_rmse_m,
+              1e-12);
   // Listed in the JSON and the terminal summary, beside the unchanged check statistics.
   const nlohmann::json j = AdjustmentToJson(*clean_);
   EXPECT_EQ(j["snooping"]["uncontrolled"].size(), s.uncontrolled.size());
@@ -185,7 +188,8 @@ TEST_F(SnoopingOnTheSimulatedFlight, ObservationsNoTestCanJudgeAreListedWithThei
             static_cast<size_t>(clean_->check.n - clean_->check_controlled->n));
   EXPECT_DOUBLE_EQ(j["check"]["spatial_rmse_m"].get<double>(), clean_->check.spatial_rmse_m);
   const std::string summary = FormatSummary(*clean_);
-  EXPECT_NE(summary.find("uncontrolled: " + std::to_string(weak) + " observation(s)"), std::string::npos);
+  EXPECT_NE(summary.find("uncontrolled: " + std::to_string(weak) + " observation(s)"),
+            std::string::npos);
   EXPECT_NE(summary.find("check*"), std::string::npos);
 }
 
@@ -193,8 +197,8 @@ TEST_F(SnoopingOnTheSimulatedFlight, PlantedTwentySigmaBlunderOnAPinnedObservati
   const ObservationResidual* v = Pick(1, 0.3);
   ASSERT_NE(v, nullptr);
   // 20 sigma (0.2 px) in both directions.
-  const AdjustmentResult r = Adjust(Planted(*v, 4.0 / std::sqrt(2.0), 4.0 / std::sqrt(2.0)),
-                                    SelfCalibration());
+  const AdjustmentResult r =
+      Adjust(Planted(*v, 4.0 / std::sqrt(2.0), 4.0 / std::sqrt(2.0)), SelfCalibration());
   bool found = false;
   for (const auto& o : r.rejected)
     if (o.image == v->image && o.point == v->point) {
@@ -254,11 +258,17 @@ TEST_F(SnoopingOnTheSimulatedFlight, BlunderOnAControlRayGoesAndTheCheckRmseIsTh
   // 2 %: the figure, now against the oracle (bench: within 1.8 % in 40 of 40 seeds).
   constexpr double kCheckRmseTolerance = 0.02;
   EXPECT_NEAR(r.check.spatial_rmse_m / oracle.check.spatial_rmse_m, 1.0, kCheckRmseTolerance);
-  std::printf("control ray %s/%s (r %.2f, %.2f): check RMSE %.4f m, the oracle %.4f m, the clean "
-              "run %.4f m (/ clean %.3f)\n",
-              v->image.c_str(), v->point.c_str(), v->test.redundancy.x(), v->test.redundancy.y(),
-              r.check.spatial_rmse_m, oracle.check.spatial_rmse_m, clean_->check.spatial_rmse_m,
-              r.check.spatial_rmse_m / clean_->check.spatial_rmse_m);
+  std::printf(
+      "control ray %s/%s (r %.2f, %.2f): check RMSE %.4f m, the oracle %.4f m, the clean "
+      "run %.4f m (/ clean %.3f)\n",
+      v->image.c_str(),
+      v->point.c_str(),
+      v->test.redundancy.x(),
+      v->test.redundancy.y(),
+      r.check.spatial_rmse_m,
+      oracle.check.spatial_rmse_m,
+      clean_->check.spatial_rmse_m,
+      r.check.spatial_rmse_m / clean_->check.spatial_rmse_m);
 }
 
 TEST_F(SnoopingOnTheSimulatedFlight, FivePercentOfFiftySigmaBlundersRecoverTheCleanCamera) {
@@ -316,13 +326,17 @@ TEST_F(SnoopingOnTheSimulatedFlight, FivePercentOfFiftySigmaBlundersRecoverTheCl
     bool beside_blunder = good_rays[v.point] < 2;
     for (const auto& x : r.rejected)
       if (x.image == v.image && x.point == v.point) {
-        EXPECT_FALSE(x.by == "robust start" && good_rays[v.point] >= 3) << v.image << " " << v.point;
+        EXPECT_FALSE(x.by == "robust start" && good_rays[v.point] >= 3)
+            << v.image << " " << v.point;
         for (const auto& member : x.group)
           beside_blunder |= member != v.image && blunders.count({member, v.point}) > 0;
       }
     lost_avoidable += !beside_blunder;
   }
-  std::printf("%zu blunders; good rays lost %d of %d, %d avoidable\n", blunders.size(), lost, good,
+  std::printf("%zu blunders; good rays lost %d of %d, %d avoidable\n",
+              blunders.size(),
+              lost,
+              good,
               lost_avoidable);
   EXPECT_LE(lost_avoidable, good / 500);  // 0.2 %
   // Every blunder still used is listed as one no test can judge (r below min_redundancy).

@@ -5,15 +5,15 @@
 // truth, sigma0 within 1 +- 3 / sqrt(2 r), the method named.
 #include "triangulation/calibration/direction_calibration.h"
 
-#include <cmath>
-#include <random>
-
-#include <gtest/gtest.h>
-
 #include "calib/camera/brown_fraser10.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "tests/support/simulated_directions.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <random>
 
 namespace aerocal::triangulation {
 namespace {
@@ -41,10 +41,14 @@ calib::Camera Truth() {
 
 const Eigen::Vector3d kTrueOpk(0.2 * kDeg, -0.3 * kDeg, 0.4 * kDeg);
 
-Eigen::Vector3d Direction(double azimuth, double elevation) { return testing::InstrumentDirection(azimuth, elevation); }
+Eigen::Vector3d Direction(double azimuth, double elevation) {
+  return testing::InstrumentDirection(azimuth, elevation);
+}
 
 // The measured pixel of direction t (instrument frame) seen through G: exact, then image noise.
-Eigen::Vector2d Observe(const calib::Camera& truth, const Eigen::Matrix3d& g, const Eigen::Vector3d& t,
+Eigen::Vector2d Observe(const calib::Camera& truth,
+                        const Eigen::Matrix3d& g,
+                        const Eigen::Vector3d& t,
                         std::mt19937_64* rng) {
   const Eigen::Vector2d px = testing::ObserveDirection(truth, kTrueOpk, g, t, kSigmaPx, rng);
   EXPECT_TRUE(px.allFinite());
@@ -52,7 +56,9 @@ Eigen::Vector2d Observe(const calib::Camera& truth, const Eigen::Matrix3d& g, co
 }
 
 // A small random rotation of kSigmaRad per axis (a direction's or a setting's error).
-Eigen::Matrix3d AngularError(std::mt19937_64* rng) { return testing::RandomSmallRotation(kSigmaRad, rng); }
+Eigen::Matrix3d AngularError(std::mt19937_64* rng) {
+  return testing::RandomSmallRotation(kSigmaRad, rng);
+}
 
 void ExpectWithinThreeSigma(const DirectionCalibration& r, const calib::Camera& truth) {
   ASSERT_TRUE(r.report.converged) << r.report.message;
@@ -60,14 +66,20 @@ void ExpectWithinThreeSigma(const DirectionCalibration& r, const calib::Camera& 
   const auto params = truth.Params();
   for (int i = 0; i < truth.interior.size(); ++i) {
     const double error = r.camera.interior[i] - truth.interior[i];
-    std::printf("%-3s truth %+.6e estimated %+.6e sigma %.3e (%+.2f sigma)\n", std::string(params[i].name).c_str(),
-                truth.interior[i], r.camera.interior[i], r.interior_sigma[i], error / r.interior_sigma[i]);
+    std::printf("%-3s truth %+.6e estimated %+.6e sigma %.3e (%+.2f sigma)\n",
+                std::string(params[i].name).c_str(),
+                truth.interior[i],
+                r.camera.interior[i],
+                r.interior_sigma[i],
+                error / r.interior_sigma[i]);
     EXPECT_GT(r.interior_sigma[i], 0.0) << params[i].name;
     EXPECT_LE(std::abs(error), 3.0 * r.interior_sigma[i]) << params[i].name;
   }
   for (int i = 0; i < 3; ++i) {
     const double error = r.opk_rad[i] - kTrueOpk[i];
-    std::printf("opk[%d] error %.3f arcsec sigma %.3f arcsec\n", i, error / kArcSecond,
+    std::printf("opk[%d] error %.3f arcsec sigma %.3f arcsec\n",
+                i,
+                error / kArcSecond,
                 r.opk_sigma_rad[i] / kArcSecond);
     EXPECT_LE(std::abs(error), 3.0 * r.opk_sigma_rad[i]) << "opk " << i;
   }
@@ -76,7 +88,8 @@ void ExpectWithinThreeSigma(const DirectionCalibration& r, const calib::Camera& 
   EXPECT_NEAR(r.report.sigma0, 1.0, 3.0 / std::sqrt(2.0 * redundancy));
 }
 
-// Node (i, j) of the 9 x 9 grid over the field of view: azimuth -17..17 deg, elevation -11.5..11.5 deg.
+// Node (i, j) of the 9 x 9 grid over the field of view: azimuth -17..17 deg, elevation -11.5..11.5
+// deg.
 Eigen::Vector2d GridAngles(int i, int j) {
   return Eigen::Vector2d(-17.0 + 34.0 * i / 8.0, -11.5 + 23.0 * j / 8.0) * kDeg;
 }
@@ -92,8 +105,13 @@ DirectionCalibration SimulateCollimatorArray(std::mt19937_64* rng) {
       targets.push_back({id, angles, true});
       // The collimator's true direction differs from its calibrated one by its 0.5" error.
       const Eigen::Vector3d t = AngularError(rng) * Direction(angles.x(), angles.y());
-      observations.push_back({id, "", Eigen::Matrix3d::Identity(), Observe(truth, Eigen::Matrix3d::Identity(), t, rng),
-                              kSigmaPx, kSigmaRad, ""});
+      observations.push_back({id,
+                              "",
+                              Eigen::Matrix3d::Identity(),
+                              Observe(truth, Eigen::Matrix3d::Identity(), t, rng),
+                              kSigmaPx,
+                              kSigmaRad,
+                              ""});
     }
   return CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations);
 }
@@ -110,9 +128,14 @@ DirectionCalibration SimulateGoniometer(std::mt19937_64* rng) {
       const Eigen::Vector2d ae = GridAngles(i, j);
       const Eigen::Matrix3d g = calib::RotationFromOpk(Eigen::Vector3d(ae.y(), ae.x(), 0.0));
       const Eigen::Matrix3d true_g = g * AngularError(rng);  // the setting's 0.5" error
-      observations.push_back({"cross", "a" + std::to_string(i) + "e" + std::to_string(j), g,
-                              Observe(truth, true_g, Direction(kTargetAngles.x(), kTargetAngles.y()), rng),
-                              kSigmaPx, kSigmaRad, ""});
+      observations.push_back(
+          {"cross",
+           "a" + std::to_string(i) + "e" + std::to_string(j),
+           g,
+           Observe(truth, true_g, Direction(kTargetAngles.x(), kTargetAngles.y()), rng),
+           kSigmaPx,
+           kSigmaRad,
+           ""});
     }
   return CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations);
 }
@@ -133,8 +156,11 @@ TEST(DirectionCalibration, GoniometerSequenceRecoversTheInteriorAndTheTargetWith
   ExpectWithinThreeSigma(r, Truth());
   const Eigen::Vector2d error = r.target_angles_rad.at("cross") - kTargetAngles;
   const Eigen::Vector2d sigma = r.target_sigma_rad.at("cross");
-  std::printf("target error %.3f %.3f arcsec, sigma %.3f %.3f arcsec\n", error.x() / kArcSecond,
-              error.y() / kArcSecond, sigma.x() / kArcSecond, sigma.y() / kArcSecond);
+  std::printf("target error %.3f %.3f arcsec, sigma %.3f %.3f arcsec\n",
+              error.x() / kArcSecond,
+              error.y() / kArcSecond,
+              sigma.x() / kArcSecond,
+              sigma.y() / kArcSecond);
   EXPECT_LE(std::abs(error.x()), 3.0 * sigma.x());
   EXPECT_LE(std::abs(error.y()), 3.0 * sigma.y());
 }
@@ -147,30 +173,40 @@ TEST(DirectionCalibration, ReportedSigmasMatchTheScatterOverSeeds) {
     std::vector<double> sum2(10, 0.0);
     std::mt19937_64 rng(goniometer ? 77 : 78);
     for (int seed = 0; seed < kSeeds; ++seed) {
-      const DirectionCalibration r = goniometer ? SimulateGoniometer(&rng) : SimulateCollimatorArray(&rng);
+      const DirectionCalibration r =
+          goniometer ? SimulateGoniometer(&rng) : SimulateCollimatorArray(&rng);
       ASSERT_TRUE(r.report.converged && r.covariance_ok);
-      for (int i = 0; i < 10; ++i) sum2[i] += std::pow((r.camera.interior[i] - Truth().interior[i]) / r.interior_sigma[i], 2);
+      for (int i = 0; i < 10; ++i)
+        sum2[i] += std::pow((r.camera.interior[i] - Truth().interior[i]) / r.interior_sigma[i], 2);
     }
     for (int i = 0; i < 10; ++i) {
       const double rms = std::sqrt(sum2[i] / kSeeds);
-      std::printf("%s %-3s rms(error / sigma) %.3f\n", goniometer ? "goniometer" : "collimator",
-                  std::string(Truth().Params()[i].name).c_str(), rms);
-      EXPECT_NEAR(rms, 1.0, 0.3) << (goniometer ? "goniometer " : "collimator ") << Truth().Params()[i].name;
+      std::printf("%s %-3s rms(error / sigma) %.3f\n",
+                  goniometer ? "goniometer" : "collimator",
+                  std::string(Truth().Params()[i].name).c_str(),
+                  rms);
+      EXPECT_NEAR(rms, 1.0, 0.3) << (goniometer ? "goniometer " : "collimator ")
+                                 << Truth().Params()[i].name;
     }
   }
 }
 
 TEST(DirectionCalibration, RefusesUnknownTargetsAndBadSigmas) {
   std::vector<DirectionTarget> targets = {{"a", Eigen::Vector2d::Zero(), true}};
-  std::vector<DirectionObservation> observations = {{"b", "", Eigen::Matrix3d::Identity(), {3000, 2000}, 0.1, 0, ""}};
-  EXPECT_THROW(CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations), InputError);
+  std::vector<DirectionObservation> observations = {
+      {"b", "", Eigen::Matrix3d::Identity(), {3000, 2000}, 0.1, 0, ""}};
+  EXPECT_THROW(CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations),
+               InputError);
   observations[0].target = "a";
   observations[0].sigma_px = 0.0;
-  EXPECT_THROW(CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations), InputError);
+  EXPECT_THROW(CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations),
+               InputError);
   DirectionCalibrationOptions options;
   options.free_interior = {"c", "K9"};
   observations[0].sigma_px = 0.1;
-  EXPECT_THROW(CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations, options), InputError);
+  EXPECT_THROW(
+      CalibrateFromDirections(Nominal(), Eigen::Vector3d::Zero(), targets, observations, options),
+      InputError);
 }
 
 }  // namespace

@@ -53,7 +53,8 @@ TEST(DistortionFigure, TenParameterGridIsTheModelsCorrection) {
     EXPECT_DOUBLE_EQ(s[1], RadialDistortionUm(interior, s[0]));
     EXPECT_DOUBLE_EQ(s[2], DecentringDistortionUm(interior, s[0]));
   }
-  EXPECT_NEAR(RadialDistortionUm(interior, 10.0), 1e4 * (-2e-4 * 100 + 3e-7 * 1e4 - 1e-10 * 1e6), 1e-9);
+  EXPECT_NEAR(
+      RadialDistortionUm(interior, 10.0), 1e4 * (-2e-4 * 100 + 3e-7 * 1e4 - 1e-10 * 1e6), 1e-9);
 }
 
 TEST(DistortionFigure, OpenCvRadialModelGivesItsForwardDistortionInverted) {
@@ -73,7 +74,8 @@ TEST(DistortionFigure, OpenCvRadialModelGivesItsForwardDistortionInverted) {
   for (const auto& s : figure.profile) {
     const double rho_d = s[0] / c;
     double rho = rho_d;
-    for (int i = 0; i < 50; ++i) rho -= (rho * (1 + k1 * rho * rho) - rho_d) / (1 + 3 * k1 * rho * rho);
+    for (int i = 0; i < 50; ++i)
+      rho -= (rho * (1 + k1 * rho * rho) - rho_d) / (1 + 3 * k1 * rho * rho);
     EXPECT_NEAR(s[1], 1e3 * c * (rho - rho_d), 1e-6) << s[0];
     EXPECT_NEAR(s[2], 0.0, 1e-6) << s[0];
   }

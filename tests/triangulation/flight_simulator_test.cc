@@ -131,10 +131,10 @@ TEST(FlightSimulator, ObservesEveryPointInEveryImageThatSeesIt) {
   for (const auto& p : f.points_truth) {
     for (const auto& e : f.exposures_truth) {
       Eigen::Vector2d px;
-      const bool inside =
-          f.truth.ProjectToPixel(e.opk_rad, e.center_m, *p.xyz_m, &px) && px.x() >= kMarginPx &&
-          px.y() >= kMarginPx && px.x() <= f.truth.width_px - 1 - kMarginPx &&
-          px.y() <= f.truth.height_px - 1 - kMarginPx;
+      const bool inside = f.truth.ProjectToPixel(e.opk_rad, e.center_m, *p.xyz_m, &px) &&
+                          px.x() >= kMarginPx && px.y() >= kMarginPx &&
+                          px.x() <= f.truth.width_px - 1 - kMarginPx &&
+                          px.y() <= f.truth.height_px - 1 - kMarginPx;
       expected += inside;
       EXPECT_EQ(observed.count({p.id, e.image}), inside ? 1u : 0u) << p.id << " in " << e.image;
     }

@@ -2,8 +2,9 @@
 // docs/conventions.md section 4 in east-north-up: checked against what the angles mean
 // geometrically (where the camera looks, where the image's right and top point), not against the
 // formula of gimbal_attitude.cc.
-#include "calib/camera/rotation.h"
 #include "triangulation/import/gimbal_attitude.h"
+
+#include "calib/camera/rotation.h"
 
 #include <Eigen/Geometry>
 #include <Eigen/LU>
@@ -48,7 +49,8 @@ TEST(GimbalAttitude, AnyAnglesLookWhereTheyPoint) {
     const Eigen::Matrix3d rot = calib::RotationFromOpk(OpkOfGimbal(y, p, r));
     const Eigen::Vector3d view = -rot.col(2);
     const Eigen::Vector3d expected_view(std::sin(y * kDeg) * std::cos(p * kDeg),
-                                        std::cos(y * kDeg) * std::cos(p * kDeg), std::sin(p * kDeg));
+                                        std::cos(y * kDeg) * std::cos(p * kDeg),
+                                        std::sin(p * kDeg));
     EXPECT_LT((view - expected_view).norm(), 1e-9) << y << " " << p << " " << r;
     const Eigen::Vector3d right0(std::cos(y * kDeg), -std::sin(y * kDeg), 0);
     const Eigen::Vector3d up0 = right0.cross(expected_view);  // y = W x x with W = -view

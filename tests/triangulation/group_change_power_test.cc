@@ -24,7 +24,8 @@ TEST(GroupChangePower, CentralTailsEqualTheClosedForms) {
     EXPECT_NEAR(ChiSquareTail(t, 4), std::exp(-t / 2) * (1 + t / 2), 1e-13) << t;
   }
   // The quantile of calibration.h is the tail's inverse.
-  for (int dof : {1, 2, 3, 6}) EXPECT_NEAR(ChiSquareTail(ChiSquareQuantile(0.95, dof), dof), 0.05, 1e-6);
+  for (int dof : {1, 2, 3, 6})
+    EXPECT_NEAR(ChiSquareTail(ChiSquareQuantile(0.95, dof), dof), 0.05, 1e-6);
 }
 
 TEST(GroupChangePower, NonCentralTailForOneDegreeIsTheShiftedNormal) {
@@ -49,7 +50,7 @@ TEST(GroupChangePower, NonCentralTailForTwoDegreesAgreesWithDataSnooping) {
 
 TEST(GroupChangePower, PowerMatchesAMonteCarloOfTheTest) {
   const std::vector<double> sigmas = {0.002, 0.003, 0.0025, 0.004};  // unequal groups
-  const double critical = ChiSquareQuantile(1 - 0.05 / 7, 3);  // Bonferroni over 7 parameters
+  const double critical = ChiSquareQuantile(1 - 0.05 / 7, 3);        // Bonferroni over 7 parameters
   const int changed = 1;
   const double change = 3 * sigmas[changed];
   const double predicted = GroupChangePower(sigmas, changed, change, critical);
@@ -80,8 +81,8 @@ TEST(GroupChangePower, ThreeEqualGroupsAtThreeSigmaHaveTheTextbookNonCentrality)
   // lambda = 9 * (1 - 1/3) = 6: one 5 % test with 2 dof flags ~58 %.
   const std::vector<double> sigmas(3, 1.0);
   const double critical = ChiSquareQuantile(0.95, 2);
-  EXPECT_NEAR(GroupChangePower(sigmas, 0, 3.0, critical),
-              NonCentralChiSquareTail(critical, 2, 6.0), 1e-14);
+  EXPECT_NEAR(
+      GroupChangePower(sigmas, 0, 3.0, critical), NonCentralChiSquareTail(critical, 2, 6.0), 1e-14);
   EXPECT_NEAR(GroupChangePower(sigmas, 0, 3.0, critical), 0.58, 0.01);
 }
 
@@ -94,7 +95,8 @@ TEST(GroupChangePower, DetectableChangeIsThePowersInverse) {
     EXPECT_GT(d, 2 * sigmas[g]);  // more than twice the group's own sigma at 80 %
   }
   // The least precise group needs the largest change.
-  EXPECT_LT(DetectableGroupChange(sigmas, 0, critical, 0.8), DetectableGroupChange(sigmas, 2, critical, 0.8));
+  EXPECT_LT(DetectableGroupChange(sigmas, 0, critical, 0.8),
+            DetectableGroupChange(sigmas, 2, critical, 0.8));
 }
 
 }  // namespace

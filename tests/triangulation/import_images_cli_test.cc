@@ -23,13 +23,16 @@ constexpr double kDeg = M_PI / 180.0;
 
 const std::string kImages = std::string(AEROCAL_TEST_DATA_DIR) + "/images";
 
-double XmpValue(const std::string& bytes, const std::string& name) { return testing::XmpAttribute(bytes, name); }
+double XmpValue(const std::string& bytes, const std::string& name) {
+  return testing::XmpAttribute(bytes, name);
+}
 
 // The fixture with its XMP text passed through `edit` (the APP1 length rewritten).
 std::string WithXmp(const std::string& jpeg, const std::function<std::string(std::string)>& edit) {
   const size_t header = jpeg.find("http://ns.adobe.com/xap/1.0/");
   const size_t start = header - 4;
-  const size_t length = (static_cast<unsigned char>(jpeg[start + 2]) << 8) | static_cast<unsigned char>(jpeg[start + 3]);
+  const size_t length = (static_cast<unsigned char>(jpeg[start + 2]) << 8) |
+                        static_cast<unsigned char>(jpeg[start + 3]);
   const size_t body = header + 29;
   const std::string xmp = edit(jpeg.substr(body, start + 2 + length - body));
   const size_t new_length = 2 + 29 + xmp.size();
@@ -59,10 +62,13 @@ struct Flight {
 TEST(ImportImages, DjiXmpGivesCentresAttitudesSigmasAndTheDewarpCamera) {
   Flight f;
   const std::string bytes = ReadTextFile(kImages + "/dji_constructed.jpg");
-  const auto r = RunAerocal("import images " + f.dir + " --pixel-size-mm 0.00241 --out " + f.tmp.File("out"));
+  const auto r =
+      RunAerocal("import images " + f.dir + " --pixel-size-mm 0.00241 --out " + f.tmp.File("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("imported 2 exposures, 1 cameras"), std::string::npos) << r.output;
-  EXPECT_NE(r.output.find("1 files not used (images_not_used.csv): flight_log.txt"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("1 files not used (images_not_used.csv): flight_log.txt"),
+            std::string::npos)
+      << r.output;
   const triangulation::Project p = triangulation::ReadProject(f.tmp.File("out"));
   EXPECT_EQ(p.frame.crs, "EPSG:4326+5773");
   ASSERT_EQ(p.exposures.size(), 2u);
@@ -72,8 +78,10 @@ TEST(ImportImages, DjiXmpGivesCentresAttitudesSigmasAndTheDewarpCamera) {
     EXPECT_DOUBLE_EQ(e.center_m.y(), XmpValue(bytes, "GpsLatitude"));
     EXPECT_DOUBLE_EQ(e.center_m.z(), XmpValue(bytes, "AbsoluteAltitude"));
     // yaw -90.10 (west), pitch -80: 10 deg from nadir toward the west, image top to the west.
-    const Eigen::Vector3d expected = triangulation::OpkOfGimbal(
-        XmpValue(bytes, "GimbalYawDegree"), XmpValue(bytes, "GimbalPitchDegree"), XmpValue(bytes, "GimbalRollDegree"));
+    const Eigen::Vector3d expected =
+        triangulation::OpkOfGimbal(XmpValue(bytes, "GimbalYawDegree"),
+                                   XmpValue(bytes, "GimbalPitchDegree"),
+                                   XmpValue(bytes, "GimbalRollDegree"));
     EXPECT_LT((e.opk_rad - expected).norm(), 1e-9);  // 8 decimals of degrees in the file
     EXPECT_NEAR(e.opk_rad.z(), 90.10 * kDeg, 0.01 * kDeg);
     EXPECT_NEAR(std::hypot(e.opk_rad.x(), e.opk_rad.y()), 10 * kDeg, 0.01 * kDeg);
@@ -88,34 +96,42 @@ TEST(ImportImages, DjiXmpGivesCentresAttitudesSigmasAndTheDewarpCamera) {
   EXPECT_EQ(p.cameras.begin()->first, "FIXTURE0001");  // EXIF BodySerialNumber
   const calib::ModelCamera m = c.AsModelCamera();
   EXPECT_EQ(m.model, calib::CameraModelId::kOpenCv);
-  EXPECT_DOUBLE_EQ(m.params[0], 3684.48);                 // fx of the DewarpData text
-  EXPECT_DOUBLE_EQ(m.params[2], 64 / 2.0 + 2.24);         // cx = W / 2 + 2.24
+  EXPECT_DOUBLE_EQ(m.params[0], 3684.48);          // fx of the DewarpData text
+  EXPECT_DOUBLE_EQ(m.params[2], 64 / 2.0 + 2.24);  // cx = W / 2 + 2.24
   EXPECT_DOUBLE_EQ(c.pixel_size_mm, 0.00241);
   // Which tag gave which value: the prefix as written in each file.
   const std::string tags = ReadTextFile(f.tmp.File("out/tags.csv"));
-  EXPECT_NE(tags.find("DJI_0001.JPG,latitude_deg,XMP drone-dji:GpsLatitude,-8.2942500"), std::string::npos) << tags;
-  EXPECT_NE(tags.find("DJI_0002.JPG,latitude_deg,XMP dji:GpsLatitude,-8.2942500"), std::string::npos);
-  EXPECT_NE(tags.find("DJI_0001.JPG,capture_time,EXIF DateTimeOriginal,2025:10:02 12:08:47"), std::string::npos);
+  EXPECT_NE(tags.find("DJI_0001.JPG,latitude_deg,XMP drone-dji:GpsLatitude,-8.2942500"),
+            std::string::npos)
+      << tags;
+  EXPECT_NE(tags.find("DJI_0002.JPG,latitude_deg,XMP dji:GpsLatitude,-8.2942500"),
+            std::string::npos);
+  EXPECT_NE(tags.find("DJI_0001.JPG,capture_time,EXIF DateTimeOriginal,2025:10:02 12:08:47"),
+            std::string::npos);
   const std::string not_used = ReadTextFile(f.tmp.File("out/images_not_used.csv"));
-  EXPECT_NE(not_used.find("flight_log.txt,not a .jpg/.jpeg/.tif/.tiff file"), std::string::npos) << not_used;
+  EXPECT_NE(not_used.find("flight_log.txt,not a .jpg/.jpeg/.tif/.tiff file"), std::string::npos)
+      << not_used;
 }
 
 TEST(ImportImages, ExifGpsWithRefsWhenTheXmpHasNoPosition) {
   Flight f;
   // Without the XMP position the EXIF GPS IFD is used: 8 deg 17' 39.30" S, 115 deg 27' 42.59" E.
-  const std::string jpeg = WithXmp(ReadTextFile(kImages + "/dji_constructed.jpg"), [](std::string x) {
-    x = Replace(x, "drone-dji:GpsLatitude=\"-8.2942500\"", "");
-    x = Replace(x, "drone-dji:GpsLongtitude=\"115.4618306\"", "");
-    x = Replace(x, "drone-dji:AbsoluteAltitude=\"+1131.876\"", "");
-    return Replace(x, "drone-dji:RtkStdLon=\"0.01234\"", "");
-  });
+  const std::string jpeg =
+      WithXmp(ReadTextFile(kImages + "/dji_constructed.jpg"), [](std::string x) {
+        x = Replace(x, "drone-dji:GpsLatitude=\"-8.2942500\"", "");
+        x = Replace(x, "drone-dji:GpsLongtitude=\"115.4618306\"", "");
+        x = Replace(x, "drone-dji:AbsoluteAltitude=\"+1131.876\"", "");
+        return Replace(x, "drone-dji:RtkStdLon=\"0.01234\"", "");
+      });
   fs::remove(f.dir + "/DJI_0002.JPG");
   WriteFileAtomically(f.dir + "/DJI_0001.JPG", WithXmp(jpeg, [](std::string x) {
-    x = Replace(x, "drone-dji:RtkStdLat=\"0.01456\"", "");
-    return Replace(x, "drone-dji:RtkStdHgt=\"0.02789\"", "");
-  }));
-  const auto r = RunAerocal("import images " + f.dir + " --pixel-size-mm 0.00241 --gnss-sigma-m 2,5 "
-                            "--attitude-sigma-deg 3 --out " + f.tmp.File("out"));
+                        x = Replace(x, "drone-dji:RtkStdLat=\"0.01456\"", "");
+                        return Replace(x, "drone-dji:RtkStdHgt=\"0.02789\"", "");
+                      }));
+  const auto r = RunAerocal("import images " + f.dir +
+                            " --pixel-size-mm 0.00241 --gnss-sigma-m 2,5 "
+                            "--attitude-sigma-deg 3 --out " +
+                            f.tmp.File("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const triangulation::Project p = triangulation::ReadProject(f.tmp.File("out"));
   ASSERT_EQ(p.exposures.size(), 1u);
@@ -127,13 +143,15 @@ TEST(ImportImages, ExifGpsWithRefsWhenTheXmpHasNoPosition) {
   EXPECT_EQ(*e.center_sigma_m, Eigen::Vector3d(2, 2, 5));
   EXPECT_NEAR(e.opk_sigma_rad->x(), 3 * kDeg, 1e-9);
   const std::string tags = ReadTextFile(f.tmp.File("out/tags.csv"));
-  EXPECT_NE(tags.find("latitude_deg,EXIF GPSLatitude + EXIF GPSLatitudeRef,8 17 39.3 S"), std::string::npos) << tags;
+  EXPECT_NE(tags.find("latitude_deg,EXIF GPSLatitude + EXIF GPSLatitudeRef,8 17 39.3 S"),
+            std::string::npos)
+      << tags;
 }
 
 TEST(ImportImages, CrsTurnsCentresAndAttitudesIntoTheProjection) {
   Flight f;
-  const auto r = RunAerocal("import images " + f.dir + " --pixel-size-mm 0.00241 --crs EPSG:32750 --out " +
-                            f.tmp.File("out"));
+  const auto r = RunAerocal("import images " + f.dir +
+                            " --pixel-size-mm 0.00241 --crs EPSG:32750 --out " + f.tmp.File("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   const triangulation::Project p = triangulation::ReadProject(f.tmp.File("out"));
   EXPECT_EQ(p.frame.crs, "EPSG:32750");
@@ -156,13 +174,26 @@ TEST(ImportImages, BrokenMetadataIsExitTwoNamingTheFileAndWritesNothing) {
   const std::string good = ReadTextFile(kImages + "/dji_constructed.jpg");
   const std::vector<std::pair<std::string, std::string>> cases = {
       {good.substr(0, good.size() / 2), "DJI_0001.JPG: truncated JPEG"},
-      {WithXmp(good, [](std::string x) { return Replace(x, "<drone-dji:DewarpData>", "<drone-dji:RtkFlag>16</drone-dji:RtkFlag><drone-dji:DewarpData>"); }),
+      {WithXmp(good,
+               [](std::string x) {
+                 return Replace(x,
+                                "<drone-dji:DewarpData>",
+                                "<drone-dji:RtkFlag>16</drone-dji:RtkFlag><drone-dji:DewarpData>");
+               }),
        "XMP property drone-dji:RtkFlag"},
-      {WithXmp(good, [](std::string x) { return Replace(x, "GpsLatitude=\"-8.2942500\"", "GpsLatitude=\"south\""); }),
+      {WithXmp(good,
+               [](std::string x) {
+                 return Replace(x, "GpsLatitude=\"-8.2942500\"", "GpsLatitude=\"south\"");
+               }),
        "drone-dji:GpsLatitude is not a number (got 'south')"},
-      {WithXmp(good, [](std::string x) { return Replace(x, "GpsLatitude=\"-8.2942500\"", "GpsLatitude=\"-98.1\""); }),
+      {WithXmp(good,
+               [](std::string x) {
+                 return Replace(x, "GpsLatitude=\"-8.2942500\"", "GpsLatitude=\"-98.1\"");
+               }),
        "latitude -98.1 is beyond 90 deg"},
-      {WithXmp(good, [](std::string x) { return Replace(x, "RtkStdLat=\"0.01456\"", "RtkStdLat=\"0\""); }),
+      {WithXmp(
+           good,
+           [](std::string x) { return Replace(x, "RtkStdLat=\"0.01456\"", "RtkStdLat=\"0\""); }),
        "RTK standard deviation 0 m must be in (0, 1e6]"},
       {WithXmp(good, [](std::string x) { return Replace(x, "xmlns:drone-dji", "xmlns:other"); }),
        "namespace prefix 'drone-dji'"},
@@ -172,7 +203,8 @@ TEST(ImportImages, BrokenMetadataIsExitTwoNamingTheFileAndWritesNothing) {
     testing::TempDir tmp("aerocal_import_images_bad");
     fs::create_directories(tmp.File("flight"));
     WriteFileAtomically(tmp.File("flight/DJI_0001.JPG"), bytes);
-    const auto r = RunAerocal("import images " + tmp.File("flight") + " --pixel-size-mm 0.00241 --out " + tmp.File("out"));
+    const auto r = RunAerocal("import images " + tmp.File("flight") +
+                              " --pixel-size-mm 0.00241 --out " + tmp.File("out"));
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(tmp.File("out")));
@@ -184,12 +216,14 @@ TEST(ImportImages, NoUsableImageIsExitTwoNamingEachFile) {
   fs::create_directories(tmp.File("flight"));
   const std::string good = ReadTextFile(kImages + "/dji_constructed.jpg");
   WriteFileAtomically(tmp.File("flight/zero.jpg"), WithXmp(good, [](std::string x) {
-    x = Replace(x, "GpsLatitude=\"-8.2942500\"", "GpsLatitude=\"0\"");
-    return Replace(x, "GpsLongtitude=\"115.4618306\"", "GpsLongtitude=\"0\"");
-  }));
+                        x = Replace(x, "GpsLatitude=\"-8.2942500\"", "GpsLatitude=\"0\"");
+                        return Replace(x, "GpsLongtitude=\"115.4618306\"", "GpsLongtitude=\"0\"");
+                      }));
   const auto r = RunAerocal("import images " + tmp.File("flight") + " --out " + tmp.File("out"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("zero.jpg: GPS position 0, 0 (the receiver had no fix)"), std::string::npos) << r.output;
+  EXPECT_NE(r.output.find("zero.jpg: GPS position 0, 0 (the receiver had no fix)"),
+            std::string::npos)
+      << r.output;
 }
 
 TEST(ImportImages, EveryOptionRefusesBadValuesByName) {
@@ -205,12 +239,14 @@ TEST(ImportImages, EveryOptionRefusesBadValuesByName) {
            {"--heights geoid", "--heights"},
            {"--crs EPSG:999999", "EPSG:999999"}}) {
     SCOPED_TRACE(option);
-    const auto r = RunAerocal("import images " + f.dir + " " + option + " --out " + f.tmp.File("out"));
+    const auto r =
+        RunAerocal("import images " + f.dir + " " + option + " --out " + f.tmp.File("out"));
     EXPECT_EQ(r.exit_code, 2) << r.output;
     EXPECT_NE(r.output.find(name), std::string::npos) << r.output;
     EXPECT_FALSE(fs::exists(f.tmp.File("out")));
   }
-  const auto r = RunAerocal("import images " + f.tmp.File("missing") + " --out " + f.tmp.File("out"));
+  const auto r =
+      RunAerocal("import images " + f.tmp.File("missing") + " --out " + f.tmp.File("out"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
   EXPECT_NE(r.output.find("missing: not a folder"), std::string::npos) << r.output;
 }
@@ -220,9 +256,12 @@ TEST(ImportImages, RealCanonJpegWithoutGpsIsNamedNotUsed) {
   if (data.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
   Flight f;
   fs::copy_file(data + "/images/img_4880.jpg", f.dir + "/img_4880.jpg");
-  const auto r = RunAerocal("import images " + f.dir + " --pixel-size-mm 0.00241 --out " + f.tmp.File("out"));
+  const auto r =
+      RunAerocal("import images " + f.dir + " --pixel-size-mm 0.00241 --out " + f.tmp.File("out"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  EXPECT_NE(ReadTextFile(f.tmp.File("out/images_not_used.csv")).find("img_4880.jpg,no GPS position"), std::string::npos);
+  EXPECT_NE(
+      ReadTextFile(f.tmp.File("out/images_not_used.csv")).find("img_4880.jpg,no GPS position"),
+      std::string::npos);
 }
 
 }  // namespace

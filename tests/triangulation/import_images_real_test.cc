@@ -25,7 +25,9 @@ constexpr double kDeg = M_PI / 180.0;
 
 const std::string kImages = std::string(AEROCAL_TEST_DATA_DIR) + "/images_brighton";
 
-double XmpValue(const std::string& bytes, const std::string& name) { return testing::XmpAttribute(bytes, name); }
+double XmpValue(const std::string& bytes, const std::string& name) {
+  return testing::XmpAttribute(bytes, name);
+}
 
 // EXIF GPSLatitude / GPSLongitude of two images as rationals (degrees, minutes, seconds), with
 // their refs N / W, printed by Pillow 9.4 (PIL.Image.getexif().get_ifd(0x8825)).
@@ -58,8 +60,10 @@ TEST(ImportImagesReal, DjiPhantom3JpegsGiveTheExifCentresAndGimbalAttitudes) {
       EXPECT_NEAR(e.center_m.x(), -(g.lon_d + g.lon_m / 60 + g.lon_s / 3600), 1e-10);
       EXPECT_NEAR(e.center_m.z(), g.altitude_m, 0.01);
     }
-    const double yaw = XmpValue(bytes, "GimbalYawDegree"), pitch = XmpValue(bytes, "GimbalPitchDegree");
-    const Eigen::Vector3d expected = triangulation::OpkOfGimbal(yaw, pitch, XmpValue(bytes, "GimbalRollDegree"));
+    const double yaw = XmpValue(bytes, "GimbalYawDegree"),
+                 pitch = XmpValue(bytes, "GimbalPitchDegree");
+    const Eigen::Vector3d expected =
+        triangulation::OpkOfGimbal(yaw, pitch, XmpValue(bytes, "GimbalRollDegree"));
     EXPECT_LT((e.opk_rad - expected).norm(), 3e-10);  // 8 decimals of degrees in the file
     // Pitch -89.90 (-90.00 in some): 0.1 deg from nadir; kappa = -yaw (the image top points
     // along the yaw) up to the coupling of the 0.1 deg tilt, below 1e-6 rad (7.6e-7 here).
@@ -77,13 +81,13 @@ TEST(ImportImagesReal, DjiPhantom3JpegsGiveTheExifCentresAndGimbalAttitudes) {
   EXPECT_DOUBLE_EQ(c.c_mm(), 3.61);
   EXPECT_NEAR(c.pixel_size_mm, 43.2666 * 3.61 / 20 / std::hypot(640, 360), 1e-9);
   const std::string tags = ReadTextFile(tmp.File("out/tags.csv"));
-  for (const char* row : {
-           "DJI_0019.JPG,latitude_deg,EXIF GPSLatitude + EXIF GPSLatitudeRef,46 50 33.6864 N",
-           "DJI_0019.JPG,longitude_deg,EXIF GPSLongitude + EXIF GPSLongitudeRef,91 59 39.9382 W",
-           "DJI_0019.JPG,altitude_m,XMP drone-dji:AbsoluteAltitude,+198.61",
-           "DJI_0019.JPG,gimbal_yaw_deg,XMP drone-dji:GimbalYawDegree,+42.80",
-           "DJI_0019.JPG,focal_length_mm,EXIF FocalLength,3.61",
-           "DJI_0019.JPG,capture_time,EXIF DateTimeOriginal,2016:06:23"})
+  for (const char* row :
+       {"DJI_0019.JPG,latitude_deg,EXIF GPSLatitude + EXIF GPSLatitudeRef,46 50 33.6864 N",
+        "DJI_0019.JPG,longitude_deg,EXIF GPSLongitude + EXIF GPSLongitudeRef,91 59 39.9382 W",
+        "DJI_0019.JPG,altitude_m,XMP drone-dji:AbsoluteAltitude,+198.61",
+        "DJI_0019.JPG,gimbal_yaw_deg,XMP drone-dji:GimbalYawDegree,+42.80",
+        "DJI_0019.JPG,focal_length_mm,EXIF FocalLength,3.61",
+        "DJI_0019.JPG,capture_time,EXIF DateTimeOriginal,2016:06:23"})
     EXPECT_NE(tags.find(row), std::string::npos) << row << "\n" << tags;
   const std::string not_used = ReadTextFile(tmp.File("out/images_not_used.csv"));
   EXPECT_NE(not_used.find("PROVENANCE.md,not a .jpg"), std::string::npos) << not_used;

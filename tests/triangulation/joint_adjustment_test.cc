@@ -2,11 +2,7 @@
 // 3 sigma, check points no worse than stitching first and triangulating after; and with the camera
 // file's mappings 0.5 px off and no stitching measurements, the joint run recovers them while the
 // two-step run cannot.
-#include <algorithm>
-#include <cmath>
-#include <set>
-
-#include <gtest/gtest.h>
+#include "triangulation/joint/joint_adjustment.h"
 
 #include "calib/camera/camera_io.h"
 #include "calib/core/error.h"
@@ -15,8 +11,13 @@
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/block/block_io.h"
-#include "triangulation/joint/joint_adjustment.h"
 #include "triangulation/simulation/flight_simulator.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <set>
 
 namespace aerocal::triangulation {
 namespace {
@@ -102,7 +103,8 @@ TEST(JointAdjustment, RecoversMappingsAndInteriorAndIsNoWorseThanTwoSteps) {
     std::vector<std::vector<double>> sum(stitched.subimages.size());
     int frames = 0;
     for (const auto& frame : stitch::GroupByFrame(stitched, rows, f->project.stitching_file)) {
-      const auto a = stitch::AdjustFrame(f->project.cameras.at("cam1"), frame, calib::MappingModel::kAffine, so);
+      const auto a = stitch::AdjustFrame(
+          f->project.cameras.at("cam1"), frame, calib::MappingModel::kAffine, so);
       ++frames;
       for (size_t k = 0; k < a.subimages.size(); ++k) {
         sum[k].resize(a.subimages[k].params.size(), 0.0);
@@ -110,13 +112,15 @@ TEST(JointAdjustment, RecoversMappingsAndInteriorAndIsNoWorseThanTwoSteps) {
       }
     }
     for (size_t k = 0; k < stitched.subimages.size(); ++k)
-      for (size_t i = 0; i < sum[k].size(); ++i) stitched.subimages[k].params[i] = sum[k][i] / frames;
+      for (size_t i = 0; i < sum[k].size(); ++i)
+        stitched.subimages[k].params[i] = sum[k][i] / frames;
   }
   Project two_step = f->project;
   two_step.cameras["cam1"] = stitched;
   const AdjustmentResult after = Adjust(two_step, SelfCalibration());
   ASSERT_TRUE(after.converged());
-  std::printf("check spatial RMSE: joint %.4f m, two-step %.4f m\n", joint.adjustment.check.spatial_rmse_m,
+  std::printf("check spatial RMSE: joint %.4f m, two-step %.4f m\n",
+              joint.adjustment.check.spatial_rmse_m,
               after.check.spatial_rmse_m);
   // "No worse": equal up to the scatter of two estimates from the same data (2 %).
   EXPECT_LE(joint.adjustment.check.spatial_rmse_m, 1.02 * after.check.spatial_rmse_m);
@@ -142,9 +146,12 @@ TEST(JointAdjustment, RecoversMappingsHalfAPixelOffWhereTwoStepsCannot) {
   // The two-step run maps with the camera file's mapping: the 0.5 px stays in the virtual image.
   const AdjustmentResult two_step = Adjust(f->project, SelfCalibration());
   ASSERT_TRUE(two_step.converged());
-  std::printf("sigma0: joint %.3f, two-step %.3f; check spatial RMSE: joint %.4f m, two-step %.4f m\n",
-              joint.adjustment.sigma0, two_step.sigma0, joint.adjustment.check.spatial_rmse_m,
-              two_step.check.spatial_rmse_m);
+  std::printf(
+      "sigma0: joint %.3f, two-step %.3f; check spatial RMSE: joint %.4f m, two-step %.4f m\n",
+      joint.adjustment.sigma0,
+      two_step.sigma0,
+      joint.adjustment.check.spatial_rmse_m,
+      two_step.check.spatial_rmse_m);
   EXPECT_NEAR(joint.adjustment.sigma0, 1.0, 0.1);
   EXPECT_GT(two_step.sigma0, joint.adjustment.sigma0 + 0.1)
       << "the 0.5 px shift of sub-image I shows in the two-step residuals";
@@ -182,13 +189,16 @@ TEST(JointAdjustment, PerExposureMappingsAreEstimatedForEveryExposure) {
     if (!m.base && m.subimage == "I") sigma_flight = m.sigma[2];  // a0, px
   for (const auto& m : per_exposure.mappings)
     if (!m.base && m.subimage == "I" && m.exposure == "0001") sigma_exposure = m.sigma[2];
-  std::printf("sigma of a0 (sub-image I): per flight %.4f px, per exposure %.4f px\n", sigma_flight, sigma_exposure);
+  std::printf("sigma of a0 (sub-image I): per flight %.4f px, per exposure %.4f px\n",
+              sigma_flight,
+              sigma_exposure);
   EXPECT_GT(sigma_exposure, 1.5 * sigma_flight);
   // 888 instead of 24 mapping parameters: the check points can only lose (seen: +26 % with 150
   // stitching ties per exposure, +39 % with 60), never gain, and not by a factor.
   const double check_flight = per_flight.adjustment.check.spatial_rmse_m;
   const double check_exposure = per_exposure.adjustment.check.spatial_rmse_m;
-  std::printf("check spatial RMSE: per flight %.3f m, per exposure %.3f m\n", check_flight, check_exposure);
+  std::printf(
+      "check spatial RMSE: per flight %.3f m, per exposure %.3f m\n", check_flight, check_exposure);
   EXPECT_GT(check_exposure, 0.95 * check_flight);
   EXPECT_LT(check_exposure, 2.0 * check_flight);
 }

@@ -70,7 +70,8 @@ TEST(ObjectFrame, GeodeticRoundTripsThroughLocalTangentPlaneAndUtm) {
 }
 
 // A velocity of geodetic input is east, north, up (m/s) at the exposure (object_frame.h).
-Eigen::Vector3d VelocityInFrame(const FrameSpec& spec, const Eigen::Vector3d& lon_lat_h,
+Eigen::Vector3d VelocityInFrame(const FrameSpec& spec,
+                                const Eigen::Vector3d& lon_lat_h,
                                 const Eigen::Vector3d& enu_mps) {
   Project project;
   Exposure e;
@@ -93,7 +94,8 @@ TEST(ObjectFrame, VelocitiesTurnWithTheFrame) {
   const Eigen::Vector3d east_of(local.lon_deg + 0.2, local.lat_deg, local.h_m);
   const Eigen::Vector3d turned = VelocityInFrame(local, east_of, v);
   const Eigen::Vector3d expected(v.x() * std::cos(turn) - v.y() * std::sin(turn),
-                                 v.x() * std::sin(turn) + v.y() * std::cos(turn), v.z());
+                                 v.x() * std::sin(turn) + v.y() * std::cos(turn),
+                                 v.z());
   EXPECT_LT((turned.head<2>() - expected.head<2>()).norm(), 1e-3 * v.norm());
   // The exposure's east axis dips below the origin's plane by d_lon cos(lat) = 2.36 mrad.
   EXPECT_NEAR(turned.z(), v.z() - v.x() * dlon * std::cos(lat), 1e-3);

@@ -2,10 +2,9 @@
 // simulated block whose GNSS centres carry a lever arm and a time offset (and whose IMU angles a
 // boresight misalignment) gives them back within 3 reported sigmas when they are free; a block
 // that cannot separate them says so by name.
-#include "triangulation/adjustment/block_adjustment.h"
-
 #include "calib/core/error.h"
 #include "tests/support/simulated_block.h"
+#include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/simulation/flight_simulator.h"
 
@@ -117,8 +116,7 @@ TEST(PlatformPriors, InseparableParametersAreNamed) {
   for (const auto& w : r.determinability.warnings)
     named |= w.find("platform time_offset.dt") != std::string::npos ||
              w.find("platform lever_arm.x") != std::string::npos;
-  for (const auto& u : r.determinability.undetermined)
-    named |= u.rfind("platform ", 0) == 0;
+  for (const auto& u : r.determinability.undetermined) named |= u.rfind("platform ", 0) == 0;
   EXPECT_TRUE(named);
 }
 

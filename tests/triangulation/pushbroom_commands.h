@@ -21,8 +21,10 @@ inline std::string PushbroomControlCommand(const std::string& dir, const std::st
 }
 
 /// `pushbroom calibrate` of the flight's nominal camera and POS from control `obs` and `points`.
-inline std::string PushbroomCalibrateCommand(const std::string& dir, const std::string& obs,
-                                             const std::string& points, const std::string& out) {
+inline std::string PushbroomCalibrateCommand(const std::string& dir,
+                                             const std::string& obs,
+                                             const std::string& points,
+                                             const std::string& out) {
   return "pushbroom calibrate --camera " + dir + "/camera_nominal.yaml --pos " + dir +
          "/pos.csv --observations " + obs + " --points " + points + " --out " + out;
 }

@@ -9,18 +9,18 @@
 // - the default datum equals `--datum none` with POS priors (no defect: nothing is held), and is
 //   within a few sigma of the truth; the earlier reference datum fits worse (it holds functions
 //   the data determine).
-#include <cmath>
-#include <cstdio>
-#include <set>
-#include <string>
-
-#include <Eigen/Dense>
-#include <gtest/gtest.h>
-
 #include "calib/camera/rotation.h"
 #include "triangulation/pushbroom/line_calibration.h"
 #include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
+
+#include <Eigen/Dense>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <set>
+#include <string>
 
 namespace aerocal::triangulation {
 namespace {
@@ -45,8 +45,8 @@ LineSimulationOptions DatumFlight(bool linear_layout, std::uint64_t seed) {
 
 LineCalibrationResult Calibrate(const LineSimulation& sim, const LineCalibrationOptions& options) {
   const PosTrajectory pos = PosTrajectory::FromRecords(sim.pos, "pos.csv");
-  return CalibrateLineCamera(sim.nominal, pos, sim.observations, sim.points, options,
-                             "observations.csv");
+  return CalibrateLineCamera(
+      sim.nominal, pos, sim.observations, sim.points, options, "observations.csv");
 }
 
 // Detector directions of a calibrated table: (x_i, y_i, -c) with x_i, y_i = design + table (mm).
@@ -54,8 +54,10 @@ struct Table {
   std::vector<Eigen::Vector3d> ray;
   double c = 0;
 };
-Table TableOf(const calib::LineCamera& design, const std::vector<double>& dx,
-              const std::vector<double>& dy, double c) {
+Table TableOf(const calib::LineCamera& design,
+              const std::vector<double>& dx,
+              const std::vector<double>& dy,
+              double c) {
   Table t;
   t.c = c;
   for (int i = 0; i < design.detectors; ++i) {
@@ -78,7 +80,9 @@ Table TruthTable(const LineSimulation& sim) {
 
 // b's detector rays turned by the camera rotation R(angles) and projected into a's focal plane
 // (principal distance a.c), minus a's positions, px (x then y per detector).
-Eigen::VectorXd RotatedDifference(const Table& a, const Table& b, const Eigen::Vector3d& angles,
+Eigen::VectorXd RotatedDifference(const Table& a,
+                                  const Table& b,
+                                  const Eigen::Vector3d& angles,
                                   double pitch_mm) {
   const Eigen::Matrix3d r = calib::RotationFromOpk(angles);
   Eigen::VectorXd out(2 * a.ray.size());
@@ -93,7 +97,9 @@ Eigen::VectorXd RotatedDifference(const Table& a, const Table& b, const Eigen::V
 // The difference of two tables modulo the gauge: the camera rotation that maps b onto a best
 // (Gauss-Newton, the exact rotation, not its first order), and the scale through each table's c.
 // Returns the remaining difference, px.
-Eigen::VectorXd ModuloGauge(const Table& a, const Table& b, double pitch_mm,
+Eigen::VectorXd ModuloGauge(const Table& a,
+                            const Table& b,
+                            double pitch_mm,
                             Eigen::Vector3d* angles_out = nullptr) {
   Eigen::Vector3d angles = Eigen::Vector3d::Zero();
   for (int iteration = 0; iteration < 10; ++iteration) {
@@ -125,11 +131,21 @@ const Config kConfigs[] = {
     {"priors", true, false, PlatformParamMode::kFixed, PlatformParamMode::kFixed, 0},
     {"priors, c free", true, true, PlatformParamMode::kFixed, PlatformParamMode::kFixed, 1},
     {"priors, boresight free", true, false, PlatformParamMode::kFree, PlatformParamMode::kFixed, 3},
-    {"priors, boresight and c free", true, true, PlatformParamMode::kFree, PlatformParamMode::kFixed, 4},
+    {"priors, boresight and c free",
+     true,
+     true,
+     PlatformParamMode::kFree,
+     PlatformParamMode::kFixed,
+     4},
     {"priors, lever arm free", true, false, PlatformParamMode::kFixed, PlatformParamMode::kFree, 0},
     {"no priors", false, false, PlatformParamMode::kFixed, PlatformParamMode::kFixed, -1},
     {"no priors, c free", false, true, PlatformParamMode::kFixed, PlatformParamMode::kFixed, -1},
-    {"no priors, boresight free", false, false, PlatformParamMode::kFree, PlatformParamMode::kFixed, -1},
+    {"no priors, boresight free",
+     false,
+     false,
+     PlatformParamMode::kFree,
+     PlatformParamMode::kFixed,
+     -1},
 };
 
 LineCalibrationOptions OptionsOf(const Config& config) {
@@ -143,8 +159,11 @@ LineCalibrationOptions OptionsOf(const Config& config) {
 }
 
 void PrintDatum(const char* what, const LineCalibrationResult& r) {
-  std::printf("%s: defect %d, constraints %d, in table %d, eigenvalues", what, r.datum.rank_defect,
-              r.datum.n_constraints, r.datum.in_table);
+  std::printf("%s: defect %d, constraints %d, in table %d, eigenvalues",
+              what,
+              r.datum.rank_defect,
+              r.datum.n_constraints,
+              r.datum.in_table);
   for (size_t k = 0; k < r.datum.smallest_relative_eigenvalues.size() && k < 10; ++k)
     std::printf(" %.1e", r.datum.smallest_relative_eigenvalues[k]);
   std::printf(", gauge:");
@@ -249,11 +268,19 @@ TEST_P(GaugeDatum, ReferenceChoicesAgreeModuloTheGauge) {
           const Eigen::VectorXd plain =
               RotatedDifference(tables[a], tables[b], Eigen::Vector3d::Zero(), pitch);
           const Eigen::VectorXd d = ModuloGauge(tables[a], tables[b], pitch, &angles);
-          std::printf("%s layout, %s, %s: reference %d vs %d: max difference %.2e px, modulo "
-                      "the gauge %.2e px (rotation %.2e %.2e %.2e rad)\n",
-                      linear ? "linear" : "subcameras", noise ? "noise" : "noise-free",
-                      config.name, a, b, plain.cwiseAbs().maxCoeff(), d.cwiseAbs().maxCoeff(),
-                      angles.x(), angles.y(), angles.z());
+          std::printf(
+              "%s layout, %s, %s: reference %d vs %d: max difference %.2e px, modulo "
+              "the gauge %.2e px (rotation %.2e %.2e %.2e rad)\n",
+              linear ? "linear" : "subcameras",
+              noise ? "noise" : "noise-free",
+              config.name,
+              a,
+              b,
+              plain.cwiseAbs().maxCoeff(),
+              d.cwiseAbs().maxCoeff(),
+              angles.x(),
+              angles.y(),
+              angles.z());
           // No defect: the same problem; it differs in the last bits only (the Schur ordering
           // follows block addresses; 100 iterations near a zero residual amplify them).
           if (config.expected_defect == 0) {
@@ -287,7 +314,8 @@ TEST_P(GaugeDatum, DefaultEqualsNoDatumWithPriorsAndTheTruth) {
   EXPECT_EQ(gauge.datum.n_constraints, 0);
   double worst_px = 0;
   for (int i = 0; i < sim.truth.detectors; ++i)
-    worst_px = std::max({worst_px, std::abs(gauge.dx_mm[i] - none.dx_mm[i]) / pitch,
+    worst_px = std::max({worst_px,
+                         std::abs(gauge.dx_mm[i] - none.dx_mm[i]) / pitch,
                          std::abs(gauge.dy_mm[i] - none.dy_mm[i]) / pitch});
   EXPECT_LT(worst_px, 1e-9);
   EXPECT_DOUBLE_EQ(gauge.report.sigma0, none.report.sigma0);
@@ -302,21 +330,33 @@ TEST_P(GaugeDatum, DefaultEqualsNoDatumWithPriorsAndTheTruth) {
       const Eigen::Vector2d e = Eigen::Vector2d(r.dx_mm[i], r.dy_mm[i]) - sim.truth.Correction(i);
       ex += e.x() * e.x();
       ey += e.y() * e.y();
-      if (r.dx_sigma_mm[i] && *r.dx_sigma_mm[i] > 0) *worst_z = std::max(*worst_z, std::abs(e.x()) / *r.dx_sigma_mm[i]);
-      if (r.dy_sigma_mm[i] && *r.dy_sigma_mm[i] > 0) *worst_z = std::max(*worst_z, std::abs(e.y()) / *r.dy_sigma_mm[i]);
+      if (r.dx_sigma_mm[i] && *r.dx_sigma_mm[i] > 0)
+        *worst_z = std::max(*worst_z, std::abs(e.x()) / *r.dx_sigma_mm[i]);
+      if (r.dy_sigma_mm[i] && *r.dy_sigma_mm[i] > 0)
+        *worst_z = std::max(*worst_z, std::abs(e.y()) / *r.dy_sigma_mm[i]);
     }
-    return Eigen::Vector2d(std::sqrt(ex / sim.truth.detectors), std::sqrt(ey / sim.truth.detectors)) / pitch;
+    return Eigen::Vector2d(std::sqrt(ex / sim.truth.detectors),
+                           std::sqrt(ey / sim.truth.detectors)) /
+           pitch;
   };
   double z_gauge = 0, z_reference = 0;
   const Eigen::Vector2d e_gauge = table_error(gauge, &z_gauge);
   const Eigen::Vector2d e_reference = table_error(reference, &z_reference);
   const Eigen::VectorXd modulo = ModuloGauge(TruthTable(sim), TableOf(gauge, sim.nominal), pitch);
-  std::printf("%s layout: table error across / along: gauge (default) %.4f / %.4f px (worst %.2f "
-              "sigma, modulo the gauge RMS %.4f px), sigma0 %.4f; reference datum %.4f / %.4f px "
-              "(worst %.1f sigma), sigma0 %.4f\n",
-              linear ? "linear" : "subcameras", e_gauge.x(), e_gauge.y(), z_gauge,
-              std::sqrt(modulo.squaredNorm() / double(modulo.size())), gauge.report.sigma0,
-              e_reference.x(), e_reference.y(), z_reference, reference.report.sigma0);
+  std::printf(
+      "%s layout: table error across / along: gauge (default) %.4f / %.4f px (worst %.2f "
+      "sigma, modulo the gauge RMS %.4f px), sigma0 %.4f; reference datum %.4f / %.4f px "
+      "(worst %.1f sigma), sigma0 %.4f\n",
+      linear ? "linear" : "subcameras",
+      e_gauge.x(),
+      e_gauge.y(),
+      z_gauge,
+      std::sqrt(modulo.squaredNorm() / double(modulo.size())),
+      gauge.report.sigma0,
+      e_reference.x(),
+      e_reference.y(),
+      z_reference,
+      reference.report.sigma0);
   EXPECT_LT(z_gauge, 3.64);
   EXPECT_NEAR(gauge.report.sigma0, 1.0, 3.0 / std::sqrt(2.0 * gauge.report.redundancy));
 }
@@ -339,10 +379,15 @@ TEST(TimeOffset, RecoveredWithPosPriorsAndNamedWithout) {
     if (name == "time_offset_vs_along_track") rho = value;
     if (name == "time_offset_vs_offset") rho_offset = value;
   }
-  std::printf("time offset %.6f +- %.6f s (truth 0.005), time_offset_vs_along_track %.4f, "
-              "time_offset_vs_offset %.4f, sigma0 %.4f, defect %d\n",
-              r.time_offset_s, *r.time_offset_sigma_s, rho, rho_offset, r.report.sigma0,
-              r.datum.rank_defect);
+  std::printf(
+      "time offset %.6f +- %.6f s (truth 0.005), time_offset_vs_along_track %.4f, "
+      "time_offset_vs_offset %.4f, sigma0 %.4f, defect %d\n",
+      r.time_offset_s,
+      *r.time_offset_sigma_s,
+      rho,
+      rho_offset,
+      r.report.sigma0,
+      r.datum.rank_defect);
   EXPECT_GT(rho_offset, 0.0);
   EXPECT_LT(rho_offset, 1.0);
   EXPECT_LT(std::abs(r.time_offset_s - 0.005), 3 * *r.time_offset_sigma_s);
@@ -366,7 +411,9 @@ TEST(TimeOffset, RecoveredWithPosPriorsAndNamedWithout) {
   EXPECT_FALSE(free.time_offset_sigma_s.has_value());
 }
 
-INSTANTIATE_TEST_SUITE_P(Layouts, GaugeDatum, ::testing::Values(false, true),
+INSTANTIATE_TEST_SUITE_P(Layouts,
+                         GaugeDatum,
+                         ::testing::Values(false, true),
                          [](const ::testing::TestParamInfo<bool>& info) {
                            return info.param ? "LinearVirtualCcd" : "Subcameras";
                          });

@@ -1,19 +1,19 @@
 // The degree test of the line camera's detector polynomials and the sigma of a selected table
-// (triangulation/pushbroom/line_degree_test.h): the polynomial's value and variance, the top-down
+// (triangulation/pushbroom/line_degree_choice.h): the polynomial's value and variance, the top-down
 // Wald test in the reduced model (not in the full fit), and the coverage the selected table's
 // sigma must give where the selected model's own sigma cannot (a Monte-Carlo of least-squares
 // fits with a real cubic at its detection limit).
+#include "calib/residuals/line_collinearity.h"
+#include "triangulation/pushbroom/line_degree_choice.h"
+
+#include <Eigen/Cholesky>
+#include <gtest/gtest.h>
+
 #include <cmath>
 #include <cstdio>
 #include <random>
 #include <set>
 #include <vector>
-
-#include <Eigen/Cholesky>
-#include <gtest/gtest.h>
-
-#include "calib/residuals/line_collinearity.h"
-#include "triangulation/pushbroom/line_degree_test.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -22,7 +22,7 @@ using calib::kLineMaxTerms;
 
 TEST(LineDegreeTest, PolynomialValueAndVarianceOnOneAxis) {
   std::vector<double> a(2 * kLineMaxTerms, 0.0);
-  a[0] = 1.0;                 // x: 1 + 2u
+  a[0] = 1.0;  // x: 1 + 2u
   a[1] = 2.0;
   a[kLineMaxTerms + 2] = 3.0;  // y: 3u^2
   Eigen::MatrixXd q = Eigen::MatrixXd::Zero(2 * kLineMaxTerms, 2 * kLineMaxTerms);
@@ -81,7 +81,7 @@ TEST(LineDegreeTest, SelectedSigmaIsAtLeastTheStartFitsAndGrowsWithTheShift) {
 // Least squares of y = sum_k b_k u^k + e (sigma 1) at 60 equally spaced u in [-1, 1], start
 // degree 3: b_0, b_1 ten of their sigmas, b_2 = 0, a cubic of tau of its sigma. The selected
 // table's error at the end detector (u = 1) against the 95 % interval. Measured over 20000 fits
-// (line_degree_test.h): tau 2.5, the cubic dropped in 30 %: the reduced fit's own sigma covers
+// (line_degree_choice.h): tau 2.5, the cubic dropped in 30 %: the reduced fit's own sigma covers
 // 0.72, SelectedTableSigma 0.926; tau 0 (dropped in 95 %): 0.925 and 0.982.
 struct Coverage {
   int reduced_runs = 0, covered_fit = 0, covered_selected = 0;
@@ -95,12 +95,15 @@ Coverage EndCoverage(double tau, int runs) {
   }
   const Eigen::MatrixXd q_start = (design.transpose() * design).inverse();
   Eigen::VectorXd truth(kStart + 1);
-  truth << 10 * std::sqrt(q_start(0, 0)), 10 * std::sqrt(q_start(1, 1)), 0.0, tau * std::sqrt(q_start(3, 3));
+  truth << 10 * std::sqrt(q_start(0, 0)), 10 * std::sqrt(q_start(1, 1)), 0.0,
+      tau * std::sqrt(q_start(3, 3));
   const double truth_at_end = truth.sum();  // u = 1
   std::mt19937 rng(17);
   std::normal_distribution<double> noise(0.0, 1.0);
   // A 12-entry detector block: the fitted x entries, the rest zero and held.
-  auto block = [](const Eigen::VectorXd& b, const Eigen::MatrixXd& qb, std::vector<double>* a,
+  auto block = [](const Eigen::VectorXd& b,
+                  const Eigen::MatrixXd& qb,
+                  std::vector<double>* a,
                   Eigen::MatrixXd* q) {
     a->assign(2 * kLineMaxTerms, 0.0);
     *q = Eigen::MatrixXd::Zero(2 * kLineMaxTerms, 2 * kLineMaxTerms);
@@ -144,11 +147,15 @@ TEST(LineDegreeTest, SelectedSigmaCoversTheTruthWhereTheReducedFitsDoesNot) {
   const Coverage none = EndCoverage(0.0, kRuns);
   EXPECT_GT(none.reduced_runs, 0.9 * kRuns);
   EXPECT_GT(none.covered_selected, 0.96 * kRuns);
-  std::printf("95 %% coverage at the end: cubic 2.5 sigma (dropped in %d of %d): fit sigma %.3f, "
-              "selected %.3f; no cubic: %.3f, %.3f\n",
-              limit.reduced_runs, kRuns, double(limit.covered_fit) / kRuns,
-              double(limit.covered_selected) / kRuns, double(none.covered_fit) / kRuns,
-              double(none.covered_selected) / kRuns);
+  std::printf(
+      "95 %% coverage at the end: cubic 2.5 sigma (dropped in %d of %d): fit sigma %.3f, "
+      "selected %.3f; no cubic: %.3f, %.3f\n",
+      limit.reduced_runs,
+      kRuns,
+      double(limit.covered_fit) / kRuns,
+      double(limit.covered_selected) / kRuns,
+      double(none.covered_fit) / kRuns,
+      double(none.covered_selected) / kRuns);
 }
 
 }  // namespace

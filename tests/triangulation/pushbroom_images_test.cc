@@ -1,5 +1,5 @@
-// Image mode of the pushbroom commands (issue 17): `aerocal simulate --pushbroom --render-images` renders
-// the line image and a reference frame strip of a scene textured with a real photograph
+// Image mode of the pushbroom commands (issue 17): `aerocal simulate --pushbroom --render-images`
+// renders the line image and a reference frame strip of a scene textured with a real photograph
 // (../shared/data/odm_boruszyn_kap_frames), `aerocal pushbroom control` rectifies, matches and
 // intersects the cloud control on those pixels, and `aerocal pushbroom calibrate` from that control
 // recovers the detector table within 1.5 x the error of the geometry-only run of the same flight
@@ -9,20 +9,20 @@
 // the ratio is 0.07-0.42, module README "Measured"). The per-detector 3-sigma check does NOT hold
 // in image mode (worst 7.8 sigma across here with the fit's own sigmas: a smaller smooth error of
 // unknown cause remains, module README "Measured"), so it is printed, not asserted.
-#include <algorithm>
-#include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <map>
+#include "calib/core/csv.h"
+#include "calib/core/result_file.h"
+#include "tests/support/test_support.h"
+#include "tests/triangulation/pushbroom_commands.h"
 
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "calib/core/csv.h"
-#include "calib/core/result_file.h"
-#include "tests/support/test_support.h"
-#include "tests/triangulation/pushbroom_commands.h"
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
 
 namespace aerocal::triangulation {
 namespace {
@@ -59,8 +59,10 @@ Eigen::Vector2d WorstNormalisedError(const std::string& dir, const json& result)
   for (const auto& d : result["detectors"]) {
     const Eigen::Vector2d e = Eigen::Vector2d(d["dx_mm"].get<double>(), d["dy_mm"].get<double>()) -
                               by_detector.at(d["i"].get<int>());
-    if (d["sigma_dx_mm"].is_number()) worst.x() = std::max(worst.x(), std::abs(e.x()) / d["sigma_dx_mm"].get<double>());
-    if (d["sigma_dy_mm"].is_number()) worst.y() = std::max(worst.y(), std::abs(e.y()) / d["sigma_dy_mm"].get<double>());
+    if (d["sigma_dx_mm"].is_number())
+      worst.x() = std::max(worst.x(), std::abs(e.x()) / d["sigma_dx_mm"].get<double>());
+    if (d["sigma_dy_mm"].is_number())
+      worst.y() = std::max(worst.y(), std::abs(e.y()) / d["sigma_dy_mm"].get<double>());
   }
   return worst;
 }
@@ -70,11 +72,15 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
   if (data.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
   TempDir tmp("aerocal_pushbroom_images");
   const std::string sim = tmp.File("sim");
-  const auto s = RunAerocal("simulate --pushbroom --render-images --texture " + data +
-                            "/images/img_4880.jpg --detectors 200 --lines 800 --seed 1 --out " + sim);
+  const auto s =
+      RunAerocal("simulate --pushbroom --render-images --texture " + data +
+                 "/images/img_4880.jpg --detectors 200 --lines 800 --seed 1 --out " + sim);
   ASSERT_EQ(s.exit_code, 0) << s.output;
-  for (const char* f : {"line_image.png", "reference/camera.yaml", "reference/exposures.csv",
-                        "reference/ref1.png", "reference/ref2.png"})
+  for (const char* f : {"line_image.png",
+                        "reference/camera.yaml",
+                        "reference/exposures.csv",
+                        "reference/ref1.png",
+                        "reference/ref2.png"})
     EXPECT_TRUE(std::filesystem::exists(sim + "/" + f)) << f;
 
   const std::string control = tmp.File("control");
@@ -95,24 +101,33 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
   int n = 0;
   for (const auto& row : points.rows()) {
     const double x = points.Number(row, "X"), y = points.Number(row, "Y");
-    const double dz = points.Number(row, "Z") - 10.0 * std::sin(x / 170.0 + 0.3) * std::cos(y / 230.0 - 0.2);
+    const double dz =
+        points.Number(row, "Z") - 10.0 * std::sin(x / 170.0 + 0.3) * std::cos(y / 230.0 - 0.2);
     sum += std::pow(dz / points.Number(row, "sZ"), 2);
     ++n;
   }
   EXPECT_LT(std::sqrt(sum / n), 1.5);
 
-  const auto g = RunAerocal(PushbroomCalibrateCommand(sim, sim + "/observations.csv", sim + "/points.csv", tmp.File("geometry.json")));
+  const auto g = RunAerocal(PushbroomCalibrateCommand(
+      sim, sim + "/observations.csv", sim + "/points.csv", tmp.File("geometry.json")));
   ASSERT_EQ(g.exit_code, 0) << g.output;
-  const auto i = RunAerocal(PushbroomCalibrateCommand(sim, control + "/observations.csv", control + "/points.csv", tmp.File("image.json")));
+  const auto i = RunAerocal(PushbroomCalibrateCommand(
+      sim, control + "/observations.csv", control + "/points.csv", tmp.File("image.json")));
   ASSERT_EQ(i.exit_code, 0) << i.output;
-  const json gj = testing::ReadJson(tmp.File("geometry.json")), ij = testing::ReadJson(tmp.File("image.json"));
+  const json gj = testing::ReadJson(tmp.File("geometry.json")),
+             ij = testing::ReadJson(tmp.File("image.json"));
   ASSERT_TRUE(ij["valid"].get<bool>()) << i.output;
   const Eigen::Vector2d geometry = TableRmsPx(sim, gj, 0.01), image = TableRmsPx(sim, ij, 0.01);
-  std::printf("table RMS error across / along: geometry %.4f / %.4f px, image mode %.4f / %.4f px\n",
-              geometry.x(), geometry.y(), image.x(), image.y());
+  std::printf(
+      "table RMS error across / along: geometry %.4f / %.4f px, image mode %.4f / %.4f px\n",
+      geometry.x(),
+      geometry.y(),
+      image.x(),
+      image.y());
   const Eigen::Vector2d worst = WorstNormalisedError(sim, ij);
   std::printf("image mode: worst |error| / sigma over the detectors across / along: %.2f / %.2f\n",
-              worst.x(), worst.y());
+              worst.x(),
+              worst.y());
   EXPECT_LE(image.x(), 1.5 * geometry.x());
   EXPECT_LE(image.y(), 1.5 * geometry.y());
 }

@@ -6,14 +6,14 @@
 // their curves (Scheffe) in (almost) every flight; how many flights stay within pointwise 3 sigma
 // is printed. AEROCAL_PUSHBROOM_FLIGHTS sets the number of flights (30), AEROCAL_PUSHBROOM_VERBOSE
 // prints each.
-#include <cmath>
-#include <cstdio>
-#include <cstdlib>
+#include "triangulation/pushbroom/line_calibration.h"
+#include "triangulation/pushbroom/line_simulation.h"
 
 #include <gtest/gtest.h>
 
-#include "triangulation/pushbroom/line_calibration.h"
-#include "triangulation/pushbroom/line_simulation.h"
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
 
 namespace aerocal::triangulation {
 namespace {
@@ -66,14 +66,26 @@ StudyFigures Study(double amplitude_px, const LineCalibrationOptions& options, c
     out.within_3_sigma += worst < 3.0;
     out.within_band += worst < kScheffeBound;
     if (std::getenv("AEROCAL_PUSHBROOM_VERBOSE"))
-      std::printf("%s flight %d: sigma0 %.3f, table RMS error %.4f px, predicted %.4f px, worst %.2f sigma\n",
-                  label, f, r.report.sigma0, std::sqrt(fe2 / (2 * sim.truth.detectors)) / sim.truth.pitch_mm,
-                  std::sqrt(fs2 / (2 * sim.truth.detectors)) / sim.truth.pitch_mm, worst);
+      std::printf(
+          "%s flight %d: sigma0 %.3f, table RMS error %.4f px, predicted %.4f px, worst %.2f "
+          "sigma\n",
+          label,
+          f,
+          r.report.sigma0,
+          std::sqrt(fe2 / (2 * sim.truth.detectors)) / sim.truth.pitch_mm,
+          std::sqrt(fs2 / (2 * sim.truth.detectors)) / sim.truth.pitch_mm,
+          worst);
   }
   out.ratio = std::sqrt(sum_e2 / sum_s2);
-  std::printf("%s, errors %.1f px, %d flights: table RMS error / predicted sigma = %.3f; %d flights "
-              "within 3 sigma, %d within the 1 %% band\n",
-              label, amplitude_px, flights, out.ratio, out.within_3_sigma, out.within_band);
+  std::printf(
+      "%s, errors %.1f px, %d flights: table RMS error / predicted sigma = %.3f; %d flights "
+      "within 3 sigma, %d within the 1 %% band\n",
+      label,
+      amplitude_px,
+      flights,
+      out.ratio,
+      out.within_3_sigma,
+      out.within_band);
   return out;
 }
 
@@ -92,7 +104,7 @@ void ExpectHonest(const StudyFigures& f, double lowest = 0.7) {
 // default: cubics at their detection limit, the pre-test's worst case) and 2 px (strong terms).
 // With errors of 0 the test drops every term of most curves: their table is zero and exact, while
 // its sigma stays the start-degree fit's (the data cannot tell the curve from zero any better):
-// 0.66 over 30 flights, conservative by design (line_degree_test.h), not optimistic. Since the
+// 0.66 over 30 flights, conservative by design (line_degree_choice.h), not optimistic. Since the
 // datum comes from the null space (issue 28), the reference sub-camera's curves are tested and
 // dropped like the others (the reference datum pinned them): 0.477 over the same 30 flights, and
 // the floor of this case 0.45 (a floor against gross over-statement; every value below 1 is
@@ -100,7 +112,8 @@ void ExpectHonest(const StudyFigures& f, double lowest = 0.7) {
 class LineCalibrationStudy : public ::testing::TestWithParam<double> {};
 
 TEST_P(LineCalibrationStudy, AutomaticDegreeTableErrorMatchesItsPredictedSigma) {
-  ExpectHonest(Study(GetParam(), LineCalibrationOptions{}, "automatic degree"), GetParam() == 0.0 ? 0.45 : 0.7);
+  ExpectHonest(Study(GetParam(), LineCalibrationOptions{}, "automatic degree"),
+               GetParam() == 0.0 ? 0.45 : 0.7);
 }
 
 // The oracle: the truth's degree (3) given, no test; the study measures the sigmas alone.

@@ -3,14 +3,6 @@
 // to 1e-6 px and the trajectory corrections exactly; with noise: every detector within 3 sigma at
 // the truth's degree, within the 1 % band with the degree test, sigma0 ~ 1) and the degenerate
 // cases reported by name.
-#include <cmath>
-#include <fstream>
-#include <map>
-#include <set>
-
-#include <ceres/gradient_checker.h>
-#include <gtest/gtest.h>
-
 #include "calib/core/error.h"
 #include "tests/support/test_support.h"
 #include "triangulation/pushbroom/line_calibration.h"
@@ -19,6 +11,14 @@
 #include "triangulation/pushbroom/pos_trajectory.h"
 #include "triangulation/sensor/frame_camera.h"
 #include "triangulation/sensor/line_scan_camera.h"
+
+#include <ceres/gradient_checker.h>
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <set>
 
 namespace aerocal::triangulation {
 namespace {
@@ -53,7 +53,8 @@ TEST(PosTrajectory, ReproducesCubicMotionAndInterpolatesLineTimes) {
     EXPECT_NEAR((opk - 0.01 * motion(t)).norm(), 0.0, 1e-14) << t;
   }
   EXPECT_TRUE(pos.CoversLine(119.6));
-  EXPECT_FALSE(pos.CoversLine(120.4));  // half a line beyond the last line, but after the last epoch
+  EXPECT_FALSE(
+      pos.CoversLine(120.4));  // half a line beyond the last line, but after the last epoch
   EXPECT_THROW(pos.LineTime(-3), InputError);
 }
 
@@ -71,7 +72,8 @@ TEST(PosTrajectory, BadFilesNameTheLine) {
       {header + good, "pos.csv:4: pos.csv needs at least 4 rows"},
       {header + good + "3,0.3,0,3,1000,0,0,x\n", "pos.csv:5:"},
       {"line,time_s,X,Y,Z,omega,phi\n0,0,0,0,1000,0,0\n", "missing column 'kappa'"},
-      {"line,time_s,X,Y,Z,omega,phi,kappa,sX,sY,sZ\n0,0,0,0,1000,0,0,0,1,1,\n", "pos.csv:2: sX, sY, sZ"},
+      {"line,time_s,X,Y,Z,omega,phi,kappa,sX,sY,sZ\n0,0,0,0,1000,0,0,0,1,1,\n",
+       "pos.csv:2: sX, sY, sZ"},
   };
   for (const auto& c : cases) {
     WriteText(dir.File("pos.csv"), c.text);
@@ -96,8 +98,8 @@ LineSimulationOptions SmallFlight() {
 
 LineCalibrationResult Calibrate(const LineSimulation& sim, const LineCalibrationOptions& options) {
   const PosTrajectory pos = PosTrajectory::FromRecords(sim.pos, "pos.csv");
-  return CalibrateLineCamera(sim.nominal, pos, sim.observations, sim.points, options,
-                             "observations.csv");
+  return CalibrateLineCamera(
+      sim.nominal, pos, sim.observations, sim.points, options, "observations.csv");
 }
 
 // The L1 maps (cell -> line-image position) invert the projection: at every cell the point of the
@@ -121,7 +123,8 @@ TEST(L1Rectification, MapsInvertTheProjection) {
       ++valid;
       Eigen::Vector2d xy;
       ASSERT_TRUE(ProjectAtLine(sim.nominal, pos, line(row, col), grid.Ground(col, row), &xy));
-      const double e = (xy - sim.nominal.DetectorPosition(detector(row, col))).norm() / sim.nominal.pitch_mm;
+      const double e =
+          (xy - sim.nominal.DetectorPosition(detector(row, col))).norm() / sim.nominal.pitch_mm;
       worst_px = std::max(worst_px, e);
       if (row % 8 == 0 && col % 8 == 0) worst_node_px = std::max(worst_node_px, e);
     }
@@ -138,9 +141,12 @@ TEST(L1Rectification, MapsInvertTheProjection) {
   double worst_grey = 0;
   for (int row = 0; row < l1.grid.height; ++row)
     for (int col = 0; col < l1.grid.width; ++col)
-      if (l1.Valid(col, row)) worst_grey = std::max(worst_grey, double(std::abs(l1.image(row, col) - l1.detector_map(row, col))));
+      if (l1.Valid(col, row))
+        worst_grey =
+            std::max(worst_grey, double(std::abs(l1.image(row, col) - l1.detector_map(row, col))));
   EXPECT_LT(worst_grey, 1e-3);
-  std::printf("L1 maps: %d cells checked, worst %.2e px (nodes %.2e px)\n", valid, worst_px, worst_node_px);
+  std::printf(
+      "L1 maps: %d cells checked, worst %.2e px (nodes %.2e px)\n", valid, worst_px, worst_node_px);
 }
 
 TEST(LineCalibration, NoiseFreeRecoversTheTableAndTheTrajectoryExactly) {
@@ -169,7 +175,8 @@ TEST(LineCalibration, NoiseFreeRecoversTheTableAndTheTrajectoryExactly) {
   double worst_px = 0;
   for (int i = 0; i < sim.truth.detectors; ++i) {
     const Eigen::Vector2d truth = sim.truth.Correction(i);
-    worst_px = std::max({worst_px, std::abs(r.dx_mm[i] - truth.x()) / pitch,
+    worst_px = std::max({worst_px,
+                         std::abs(r.dx_mm[i] - truth.x()) / pitch,
                          std::abs(r.dy_mm[i] - truth.y()) / pitch});
   }
   EXPECT_LT(worst_px, 1e-6);
@@ -189,13 +196,14 @@ TEST(LineCalibration, NoiseFreeRecoversTheTableAndTheTrajectoryExactly) {
   // this flight (LineScanCamera.StartingRayPassesThroughTheTruePoint), 1.2e-5 m / 1.2e-8 rad here.
   EXPECT_LT(worst_m, 3e-5);
   EXPECT_LT(worst_rad, 3e-8);
-  std::printf("noise-free: table %.2e px, trajectory %.2e m %.2e rad\n", worst_px, worst_m, worst_rad);
+  std::printf(
+      "noise-free: table %.2e px, trajectory %.2e m %.2e rad\n", worst_px, worst_m, worst_rad);
 }
 
 // With noise, the default (the automatic degree) and the truth's degree (3). The automatic degree
 // is a pre-test: on this flight it drops the along-track cubic of L (truth 2.2 sigma of its
 // estimate); with the reduced model's own sigmas its end detector was 6.3 sigma off, with the
-// selected table's sigmas (line_degree_test.h) the worst detector is 3.26 sigma, in the reference
+// selected table's sigmas (line_degree_choice.h) the worst detector is 3.26 sigma, in the reference
 // sub-camera N, which keeps the start degree 5 (degree 5 given: 3.27). The supremum over a curve
 // of k free coefficients stays within sqrt(chi2_k(1 %)) in 99 % of the curves (Scheffe's band):
 // 4.10 for k = 6. At the truth's degree every detector is within 3 sigma here (2.96).
@@ -210,18 +218,24 @@ TEST(LineCalibration, WithNoiseEveryDetectorIsWithinThreeSigma) {
     EXPECT_NEAR(automatic.report.sigma0, 1.0, 3.0 / std::sqrt(2.0 * automatic.report.redundancy));
     double worst = 0;
     for (int i = 0; i < sim.truth.detectors; ++i) {
-      const Eigen::Vector2d e = Eigen::Vector2d(automatic.dx_mm[i], automatic.dy_mm[i]) - sim.truth.Correction(i);
+      const Eigen::Vector2d e =
+          Eigen::Vector2d(automatic.dx_mm[i], automatic.dy_mm[i]) - sim.truth.Correction(i);
       // The selected table's sigma is never below its own fit's.
       EXPECT_GE(*automatic.dx_sigma_mm[i], *automatic.dx_fit_sigma_mm[i]);
       EXPECT_GE(*automatic.dy_sigma_mm[i], *automatic.dy_fit_sigma_mm[i]);
-      if (*automatic.dx_sigma_mm[i] > 0) worst = std::max(worst, std::abs(e.x()) / *automatic.dx_sigma_mm[i]);
-      if (*automatic.dy_sigma_mm[i] > 0) worst = std::max(worst, std::abs(e.y()) / *automatic.dy_sigma_mm[i]);
+      if (*automatic.dx_sigma_mm[i] > 0)
+        worst = std::max(worst, std::abs(e.x()) / *automatic.dx_sigma_mm[i]);
+      if (*automatic.dy_sigma_mm[i] > 0)
+        worst = std::max(worst, std::abs(e.y()) / *automatic.dy_sigma_mm[i]);
     }
     EXPECT_LT(worst, 4.10);
     for (const auto& s : automatic.subcameras) {
       EXPECT_LT(s.across_after_px, 0.25 * 1.3) << s.id;
       EXPECT_LT(s.along_after_px, 0.25 * 1.3) << s.id;
-      std::printf("automatic degree: sub-camera %s degree x %d y %d\n", s.id.c_str(), s.degree_x, s.degree_y);
+      std::printf("automatic degree: sub-camera %s degree x %d y %d\n",
+                  s.id.c_str(),
+                  s.degree_x,
+                  s.degree_y);
     }
     std::printf("automatic degree: worst |e|/sigma %.2f\n", worst);
   }
@@ -258,17 +272,26 @@ TEST(LineCalibration, WithNoiseEveryDetectorIsWithinThreeSigma) {
     EXPECT_LT(s.across_after_px, 0.25 * 1.3) << s.id;
     EXPECT_LT(s.along_after_px, 0.25 * 1.3) << s.id;
     std::printf("sub-camera %s: degree x %d y %d, RMS across %.3f -> %.3f, along %.3f -> %.3f px\n",
-                s.id.c_str(), s.degree_x, s.degree_y, s.across_before_px, s.across_after_px,
-                s.along_before_px, s.along_after_px);
+                s.id.c_str(),
+                s.degree_x,
+                s.degree_y,
+                s.across_before_px,
+                s.across_after_px,
+                s.along_before_px,
+                s.along_after_px);
   }
-  std::printf("noise: worst |e|/sigma %.2f, table RMS error %.4f px vs predicted %.4f px, sigma0 %.3f\n",
-              worst_z, std::sqrt(sum_e2 / (2 * sim.truth.detectors)) / pitch,
-              std::sqrt(sum_s2 / (2 * sim.truth.detectors)) / pitch, r.report.sigma0);
+  std::printf(
+      "noise: worst |e|/sigma %.2f, table RMS error %.4f px vs predicted %.4f px, sigma0 %.3f\n",
+      worst_z,
+      std::sqrt(sum_e2 / (2 * sim.truth.detectors)) / pitch,
+      std::sqrt(sum_s2 / (2 * sim.truth.detectors)) / pitch,
+      r.report.sigma0);
 }
 
 // The datum's Legendre mean and slope: 1 -> (1, 0), u -> (0, 1), u^2 -> (1/3, 0), u^3 -> (0, 3/5);
-// P2 = (3u^2 - 1)/2, P3 = (5u^3 - 3u)/2, P4, P5 -> (0, 0): adding or dropping them leaves the datum.
-// The residual is their whitened value per axis; its Jacobian matches numeric differentiation.
+// P2 = (3u^2 - 1)/2, P3 = (5u^3 - 3u)/2, P4, P5 -> (0, 0): adding or dropping them leaves the
+// datum. The residual is their whitened value per axis; its Jacobian matches numeric
+// differentiation.
 TEST(LineDatumResidual, HoldsTheLegendreMeanAndSlopeOnly) {
   auto moments = [](std::vector<double> a) {
     a.resize(calib::kLineMaxTerms, 0.0);
@@ -280,9 +303,9 @@ TEST(LineDatumResidual, HoldsTheLegendreMeanAndSlopeOnly) {
   EXPECT_LT((moments({0, 1}) - Eigen::Vector2d(0, 1)).norm(), 1e-15);
   EXPECT_LT((moments({0, 0, 1}) - Eigen::Vector2d(1.0 / 3, 0)).norm(), 1e-15);
   EXPECT_LT((moments({0, 0, 0, 1}) - Eigen::Vector2d(0, 0.6)).norm(), 1e-15);
-  EXPECT_LT(moments({-0.5, 0, 1.5}).norm(), 1e-15);                       // P2
-  EXPECT_LT(moments({0, -1.5, 0, 2.5}).norm(), 1e-15);                    // P3
-  EXPECT_LT(moments({3.0 / 8, 0, -30.0 / 8, 0, 35.0 / 8}).norm(), 1e-15);  // P4
+  EXPECT_LT(moments({-0.5, 0, 1.5}).norm(), 1e-15);                            // P2
+  EXPECT_LT(moments({0, -1.5, 0, 2.5}).norm(), 1e-15);                         // P3
+  EXPECT_LT(moments({3.0 / 8, 0, -30.0 / 8, 0, 35.0 / 8}).norm(), 1e-15);      // P4
   EXPECT_LT(moments({0, 15.0 / 8, 0, -70.0 / 8, 0, 63.0 / 8}).norm(), 1e-14);  // P5
   const auto cost = LineDatumResidual::Create(1e-6);
   std::array<double, 2 * calib::kLineMaxTerms> block;
@@ -311,7 +334,8 @@ TEST(LineCalibration, WithoutTheDatumTheOffsetsAreReportedIllPosed) {
   options.pos_prior = false;
   const LineCalibrationResult r = Calibrate(sim, options);
   for (const auto& [name, rho] : r.correlations) std::printf("%s %.6f\n", name.c_str(), rho);
-  for (const auto& w : r.warnings) std::printf("warning %s %s\n", w.name.c_str(), w.message.c_str());
+  for (const auto& w : r.warnings)
+    std::printf("warning %s %s\n", w.name.c_str(), w.message.c_str());
   EXPECT_FALSE(r.valid);
   bool named = false;
   for (const auto& w : r.warnings)
@@ -325,9 +349,9 @@ TEST(LineCalibration, WithoutTheDatumTheOffsetsAreReportedIllPosed) {
 // correlation against the free linear terms and the nodes' dZ, within 3 sigma of the truth. (The
 // earlier datum, a_1 = 0 beside a free u^3, let the reference's cubic take part of the scale:
 // scale_vs_c was above 0.9 then, 0.50 now.)
-// With the default datum, c free is a gauge freedom (the focal plane's scale with c: x, y, c -> s x,
-// s y, s c leaves every ray): the null space has one direction, named "scale", and the datum holds
-// it (one constraint on the reference sub-camera's polynomials).
+// With the default datum, c free is a gauge freedom (the focal plane's scale with c: x, y, c -> s
+// x, s y, s c leaves every ray): the null space has one direction, named "scale", and the datum
+// holds it (one constraint on the reference sub-camera's polynomials).
 TEST(LineCalibration, FreeCIsReportedAgainstTheScale) {
   const LineSimulation sim = SimulateLineFlight(SmallFlight());
   LineCalibrationOptions options;
@@ -350,7 +374,10 @@ TEST(LineCalibration, FreeCIsReportedAgainstTheScale) {
   double rho = -1;
   for (const auto& [name, value] : r.correlations)
     if (name == "scale_vs_c") rho = value;
-  std::printf("scale_vs_c %.4f, c %.6f +- %.6f mm (truth %.6f)\n", rho, r.c_mm, r.c_sigma_mm.value_or(-1),
+  std::printf("scale_vs_c %.4f, c %.6f +- %.6f mm (truth %.6f)\n",
+              rho,
+              r.c_mm,
+              r.c_sigma_mm.value_or(-1),
               sim.truth.c_mm);
   EXPECT_GE(rho, 0.0);
   EXPECT_LE(rho, 1.0);
@@ -403,8 +430,8 @@ TEST(LineScanCamera, StartingRayPassesThroughTheTruePoint) {
     worst_m = std::max(worst_m, miss);
   }
   // 1000 m range; the simulation solves the image position to ~1e-9 px, but beyond a sub-camera's
-  // last detector (measured: 1.4e-5 m at detector 239.19, the reference's end + 0.19) it extends the
-  // polynomial linearly (SubcameraPixelOfPoint) where DetectorPosition continues it.
+  // last detector (measured: 1.4e-5 m at detector 239.19, the reference's end + 0.19) it extends
+  // the polynomial linearly (SubcameraPixelOfPoint) where DetectorPosition continues it.
   EXPECT_LT(worst_m, 3e-5);
 
   calib::LineCamera mounted = sim.nominal;  // no calibration: DetectorPosition is the design
@@ -421,7 +448,8 @@ TEST(LineScanCamera, StartingRayPassesThroughTheTruePoint) {
       const ImageRay ray = mounted_line.StartingRay(mounted_context, observation);
       Eigen::Vector2d xy;
       ASSERT_TRUE(ProjectAtLine(mounted, pos, row, ray.center_m + 1000.0 * ray.direction, &xy));
-      worst_px = std::max(worst_px, (xy - mounted.DetectorPosition(detector)).norm() / mounted.pitch_mm);
+      worst_px =
+          std::max(worst_px, (xy - mounted.DetectorPosition(detector)).norm() / mounted.pitch_mm);
     }
   EXPECT_LT(worst_px, 1e-9);
 }
@@ -461,7 +489,8 @@ TEST(LineCalibration, BoresightAndLeverArmAreRecoveredWithinThreeSigma) {
       if (boresight) {
         const double s = (*r.boresight_sigma_rad)[a];
         std::printf("boresight %d: %.5f +- %.5f deg\n", a, r.boresight_rad[a] / kDeg, s / kDeg);
-        EXPECT_LT(std::abs(r.boresight_rad[a] - sim.truth.mount_rad[a]), 3 * s) << "boresight " << a;
+        EXPECT_LT(std::abs(r.boresight_rad[a] - sim.truth.mount_rad[a]), 3 * s)
+            << "boresight " << a;
         if (!lever) {
           EXPECT_GT(std::abs(r.boresight_rad[a] - planted_mount[a]), 3 * s) << a;
         }
@@ -469,7 +498,8 @@ TEST(LineCalibration, BoresightAndLeverArmAreRecoveredWithinThreeSigma) {
       if (lever) {
         const double s = (*r.lever_arm_sigma_m)[a];
         std::printf("lever arm %d: %.4f +- %.4f m\n", a, r.lever_arm_m[a], s);
-        EXPECT_LT(std::abs(r.lever_arm_m[a] - sim.truth.lever_arm_m[a]), 3 * s) << "lever arm " << a;
+        EXPECT_LT(std::abs(r.lever_arm_m[a] - sim.truth.lever_arm_m[a]), 3 * s)
+            << "lever arm " << a;
         if (!boresight && a < 2) {
           EXPECT_GT(std::abs(r.lever_arm_m[a] - planted_lever[a]), 3 * s) << a;
         }
@@ -485,11 +515,16 @@ TEST(LineCalibration, BoresightAndLeverArmAreRecoveredWithinThreeSigma) {
   const LineCalibrationResult both = run(true, true);
   ASSERT_TRUE(both.boresight_sigma_rad && both.lever_arm_sigma_m);
   std::map<std::string, double> rho(both.correlations.begin(), both.correlations.end());
-  for (const char* name : {"boresight_omega_vs_attitude", "boresight_phi_vs_attitude",
-                           "boresight_kappa_vs_attitude", "boresight_roll_vs_offset",
-                           "boresight_pitch_vs_offset", "lever_arm_x_vs_position",
-                           "lever_arm_y_vs_position", "lever_arm_z_vs_position",
-                           "lever_arm_x_vs_boresight", "lever_arm_y_vs_boresight"})
+  for (const char* name : {"boresight_omega_vs_attitude",
+                           "boresight_phi_vs_attitude",
+                           "boresight_kappa_vs_attitude",
+                           "boresight_roll_vs_offset",
+                           "boresight_pitch_vs_offset",
+                           "lever_arm_x_vs_position",
+                           "lever_arm_y_vs_position",
+                           "lever_arm_z_vs_position",
+                           "lever_arm_x_vs_boresight",
+                           "lever_arm_y_vs_boresight"})
     EXPECT_TRUE(rho.count(name)) << name;
   EXPECT_GT(rho["lever_arm_x_vs_boresight"], 0.95);
   bool warned = false;
@@ -538,7 +573,8 @@ TEST(LineCalibration, WeightedBoresightNeedsItsSigma) {
     EXPECT_LE((*r.lever_arm_sigma_m)[a], 0.05 * cap);
   }
   bool grouped = false;
-  for (const auto& g : r.report.groups) grouped |= g.name == kGroupLinePrior && g.n_observations == 6;
+  for (const auto& g : r.report.groups)
+    grouped |= g.name == kGroupLinePrior && g.n_observations == 6;
   EXPECT_TRUE(grouped);
 }
 

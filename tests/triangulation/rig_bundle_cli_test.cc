@@ -1,6 +1,7 @@
 // aerocal adjust on a simulated dual-lens rig flight (simulate --rig dual-lens): exit codes, the
 // rig keys of the result, --write-camera (the rig file for the next flight, read back and used
-// with weighted mounts), the --rig-* options, and a rig that cannot be determined (exit 3, no file).
+// with weighted mounts), the --rig-* options, and a rig that cannot be determined (exit 3, no
+// file).
 #include "calib/camera/rig_io.h"
 #include "tests/support/test_support.h"
 
@@ -20,7 +21,8 @@ using testing::TempDir;
 class RigAdjustCommand : public ::testing::Test {
  protected:
   void SetUp() override {
-    const auto r = RunAerocal("simulate --rig dual-lens --exposures 12 --out " + dir_.File("flight"));
+    const auto r =
+        RunAerocal("simulate --rig dual-lens --exposures 12 --out " + dir_.File("flight"));
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   std::string Adjust(const std::string& options, const std::string& out) {
@@ -30,7 +32,8 @@ class RigAdjustCommand : public ::testing::Test {
 };
 
 TEST_F(RigAdjustCommand, WritesTheRigResultAndTheRigFile) {
-  const auto r = RunAerocal(Adjust("--mkdir --write-camera " + dir_.File("next/rig.yaml"), "result.json"));
+  const auto r =
+      RunAerocal(Adjust("--mkdir --write-camera " + dir_.File("next/rig.yaml"), "result.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("head B mount (deg)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("is not separable"), std::string::npos);  // lever arm ~ mount at 1200 m
@@ -39,8 +42,13 @@ TEST_F(RigAdjustCommand, WritesTheRigResultAndTheRigFile) {
   const auto& heads = j["rig"]["heads"];
   ASSERT_EQ(heads.size(), 2u);
   EXPECT_TRUE(heads[0]["reference"].get<bool>());
-  for (const char* key : {"interior", "interior_sigma", "mount_deg", "mount_sigma_deg",
-                          "lever_arm_m", "lever_arm_sigma_m", "dT_ms"})
+  for (const char* key : {"interior",
+                          "interior_sigma",
+                          "mount_deg",
+                          "mount_sigma_deg",
+                          "lever_arm_m",
+                          "lever_arm_sigma_m",
+                          "dT_ms"})
     EXPECT_TRUE(heads[1].contains(key)) << key;
   EXPECT_GT(heads[1]["mount_sigma_deg"][1].get<double>(), 0.0);
   EXPECT_EQ(j["rig"]["options"]["mounts"], "free");
@@ -53,14 +61,15 @@ TEST_F(RigAdjustCommand, WritesTheRigResultAndTheRigFile) {
     EXPECT_NEAR(b.mount_rad(i) * 180.0 / M_PI, heads[1]["mount_deg"][i].get<double>(), 1e-12);
     EXPECT_NEAR(b.lever_arm_m(i), heads[1]["lever_arm_m"][i].get<double>(), 1e-12);
     ASSERT_TRUE(b.mount_sigma_rad.has_value());
-    EXPECT_NEAR((*b.mount_sigma_rad)(i) * 180.0 / M_PI,
-                heads[1]["mount_sigma_deg"][i].get<double>(), 1e-12);
+    EXPECT_NEAR(
+        (*b.mount_sigma_rad)(i)*180.0 / M_PI, heads[1]["mount_sigma_deg"][i].get<double>(), 1e-12);
   }
   // The next flight: the written rig with weighted mounts and lever arms.
-  std::filesystem::copy_file(dir_.File("next/rig.yaml"), dir_.File("flight/rig_nominal.yaml"),
+  std::filesystem::copy_file(dir_.File("next/rig.yaml"),
+                             dir_.File("flight/rig_nominal.yaml"),
                              std::filesystem::copy_options::overwrite_existing);
-  const auto again = RunAerocal(
-      Adjust("--rig-mounts weighted --rig-lever-arms weighted", "again.json"));
+  const auto again =
+      RunAerocal(Adjust("--rig-mounts weighted --rig-lever-arms weighted", "again.json"));
   ASSERT_EQ(again.exit_code, 0) << again.output;
   EXPECT_EQ(ReadJson(dir_.File("again.json"))["rig"]["options"]["lever_arms"], "weighted");
 }
@@ -69,9 +78,10 @@ TEST_F(RigAdjustCommand, WeightedIncrementsAndTimeOffsetsWithVelocity) {
   // dT = 3 ms at 55 m/s moves head B by 0.165 m along the track. The aircraft turns between
   // strips, so R t (lever arm along x) and v dT flip together: with a free lever arm the two are
   // one unknown (said by name); with the lever arm known, the data give dT.
-  const auto sim = RunAerocal("simulate --rig dual-lens --exposures 12 --speed-mps 55 "
-                              "--head-time-offset-ms 3 --head-increment-arcsec 2 --out " +
-                              dir_.File("moving"));
+  const auto sim = RunAerocal(
+      "simulate --rig dual-lens --exposures 12 --speed-mps 55 "
+      "--head-time-offset-ms 3 --head-increment-arcsec 2 --out " +
+      dir_.File("moving"));
   ASSERT_EQ(sim.exit_code, 0) << sim.output;
   const std::string run = "adjust --project " + dir_.File("moving") + " --out " +
                           dir_.File("moving.json") +

@@ -51,13 +51,19 @@ TEST(RigBundleStudy, SigmasAgreeWithTheSpreadOfSimulatedFlights) {
   const char* names[6] = {"omega", "phi", "kappa", "tx", "ty", "tz"};
   for (int i = 0; i < 6; ++i) {
     std::printf("head B %-5s  spread %.4g  reported sigma %.4g  ratio %.3f\n",
-                names[i], spread(i), sigma(i), spread(i) / sigma(i));
+                names[i],
+                spread(i),
+                sigma(i),
+                spread(i) / sigma(i));
     // Within 25 % (issue 13); the sample spread of N flights is itself uncertain by
     // 1 / sqrt(2 N) (11 % at N = 40).
     EXPECT_NEAR(spread(i) / sigma(i), 1.0, 0.25) << names[i];
   }
   std::printf("%d flights: %d of %d estimates within 3 sigma, mean sigma0 %.4f\n",
-              flights, within, total, sigma0_sum / flights);
+              flights,
+              within,
+              total,
+              sigma0_sum / flights);
   EXPECT_GE(within, static_cast<int>(std::floor(0.98 * total)));
 }
 

@@ -34,9 +34,7 @@ RigFlightSimulationOptions KnownInteriors() {
   return o;
 }
 
-const RigHeadEstimate& HeadB(const RigAdjustmentResult& r) {
-  return r.heads[1];
-}
+const RigHeadEstimate& HeadB(const RigAdjustmentResult& r) { return r.heads[1]; }
 
 TEST(RigBundle, NoiseFreeRecoversMountLeverArmAndTimeOffset) {
   RigFlightSimulationOptions o = KnownInteriors();
@@ -79,7 +77,8 @@ double WorstRigError(const RigAdjustmentResult& r, const calib::RigHead& truth) 
   if (!b.mount_sigma_rad || !b.lever_arm_sigma_m) return INFINITY;
   double worst = 0.0;
   for (int i = 0; i < 3; ++i) {
-    worst = std::max(worst, std::abs(b.mount_rad(i) - truth.mount_rad(i)) / (*b.mount_sigma_rad)(i));
+    worst =
+        std::max(worst, std::abs(b.mount_rad(i) - truth.mount_rad(i)) / (*b.mount_sigma_rad)(i));
     worst = std::max(worst,
                      std::abs(b.lever_arm_m(i) - truth.lever_arm_m(i)) / (*b.lever_arm_sigma_m)(i));
   }
@@ -111,12 +110,18 @@ TEST(RigBundle, NoisyFlightWithinThreeSigmaAndCheckPointsAsWithTheTrueRig) {
   known.lever_arms = RigParameterMode::kFixed;
   const RigAdjustmentResult t = AdjustRig(ProjectOf(f, f.truth), options, known);
   ASSERT_TRUE(t.adjustment.valid);
-  const Eigen::Vector3d estimated = r.adjustment.check.rmse_m, reference = t.adjustment.check.rmse_m;
-  EXPECT_LT(estimated.norm(), 1.10 * reference.norm()) << estimated.transpose() << " vs "
-                                                        << reference.transpose();
-  std::printf("noisy: worst |error| / sigma %.2f, sigma0 %.4f (r = %.0f), check RMSE %.4f m vs "
-              "%.4f m with the true rig\n",
-              worst, r.adjustment.sigma0, redundancy, estimated.norm(), reference.norm());
+  const Eigen::Vector3d estimated = r.adjustment.check.rmse_m,
+                        reference = t.adjustment.check.rmse_m;
+  EXPECT_LT(estimated.norm(), 1.10 * reference.norm())
+      << estimated.transpose() << " vs " << reference.transpose();
+  std::printf(
+      "noisy: worst |error| / sigma %.2f, sigma0 %.4f (r = %.0f), check RMSE %.4f m vs "
+      "%.4f m with the true rig\n",
+      worst,
+      r.adjustment.sigma0,
+      redundancy,
+      estimated.norm(),
+      reference.norm());
 }
 
 TEST(RigBundle, SelfCalibratingHeadsWithinThreeSigma) {
@@ -129,7 +134,8 @@ TEST(RigBundle, SelfCalibratingHeadsWithinThreeSigma) {
   ASSERT_TRUE(r.adjustment.valid) << r.adjustment.invalid_reasons.front();
   EXPECT_LT(WorstRigError(r, f.truth.heads[1]), 3.0);
   for (int k = 0; k < 2; ++k)
-    for (int i : {calib::BrownFraser10Model::kC, calib::BrownFraser10Model::kX0,
+    for (int i : {calib::BrownFraser10Model::kC,
+                  calib::BrownFraser10Model::kX0,
                   calib::BrownFraser10Model::kY0}) {
       ASSERT_TRUE(r.heads[k].interior_sigma[i].has_value());
       EXPECT_LT(std::abs(r.heads[k].interior[i] - f.truth.heads[k].camera.interior[i]),
@@ -155,9 +161,9 @@ TEST(RigBundle, FreeIncrementsWithAFreeMountAreNotDeterminable) {
   rig.increments = RigParameterMode::kWeighted;
   rig.increment_sigma_rad = 5.0 / 206264.806;
   const RigAdjustmentResult weighted = AdjustRig(project, options, rig);
-  EXPECT_TRUE(weighted.adjustment.valid)
-      << (weighted.adjustment.invalid_reasons.empty() ? ""
-                                                      : weighted.adjustment.invalid_reasons.front());
+  EXPECT_TRUE(weighted.adjustment.valid) << (weighted.adjustment.invalid_reasons.empty()
+                                                 ? ""
+                                                 : weighted.adjustment.invalid_reasons.front());
   EXPECT_EQ(weighted.exposures.size(), f.exposures_file.size());
 }
 
@@ -199,18 +205,18 @@ TEST(RigBundle, ProjectReaderTakesARigFileAndRejectsMisplacedHeads) {
   EXPECT_EQ(project.rigs.at("rig1").heads.size(), 2u);
   EXPECT_EQ(project.cameras.at("rig1").interior, project.rigs.at("rig1").heads[0].camera.interior);
 
-  const auto expect_error = [&](const std::string& observations, const std::string& where,
-                                const std::string& what) {
-    WriteFileAtomically(dir.File("flight/observations.csv"), observations);
-    try {
-      ReadProject(dir.File("flight"));
-      ADD_FAILURE() << "no error for " << what;
-    } catch (const InputError& e) {
-      const std::string message = e.what();
-      EXPECT_NE(message.find(where), std::string::npos) << message;
-      EXPECT_NE(message.find(what), std::string::npos) << message;
-    }
-  };
+  const auto expect_error =
+      [&](const std::string& observations, const std::string& where, const std::string& what) {
+        WriteFileAtomically(dir.File("flight/observations.csv"), observations);
+        try {
+          ReadProject(dir.File("flight"));
+          ADD_FAILURE() << "no error for " << what;
+        } catch (const InputError& e) {
+          const std::string message = e.what();
+          EXPECT_NE(message.find(where), std::string::npos) << message;
+          EXPECT_NE(message.find(what), std::string::npos) << message;
+        }
+      };
   const std::string image = project.exposures.front().image;
   expect_error("image,head,point,col,row,sigma_px\n" + image + ",A,C1,10,10,0.2\n" + image +
                    ",Q,C1,10,10,0.2\n",

@@ -2,11 +2,7 @@
 // is the example rig file, every head observation is the projection an independent Eigen oracle of
 // the head pose gives, both heads of one exposure see common points, the files read back, and the
 // time offset moves a head by v dT.
-#include <cmath>
-#include <map>
-#include <set>
-
-#include <gtest/gtest.h>
+#include "triangulation/simulation/rig_flight_simulator.h"
 
 #include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
@@ -14,7 +10,12 @@
 #include "stitch/rig/rig_design.h"
 #include "tests/support/test_support.h"
 #include "triangulation/block/block_io.h"
-#include "triangulation/simulation/rig_flight_simulator.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <set>
 
 namespace aerocal::triangulation {
 namespace {
@@ -43,13 +44,17 @@ TEST(RigFlightSimulator, NoiseFreeObservationsAreTheOracleProjections) {
   ASSERT_EQ(f.truth.heads.size(), 2u);
   ASSERT_EQ(f.rig_exposures.size(), 2 * f.exposures_truth.size());
   // The truth differs from the nominal rig by the stated errors of head B only.
-  EXPECT_NEAR((f.truth.heads[1].lever_arm_m - f.nominal.heads[1].lever_arm_m - o.lever_arm_error_m).norm(), 0, 1e-15);
+  EXPECT_NEAR(
+      (f.truth.heads[1].lever_arm_m - f.nominal.heads[1].lever_arm_m - o.lever_arm_error_m).norm(),
+      0,
+      1e-15);
   EXPECT_TRUE(f.truth.heads[0].lever_arm_m.isZero(0.0));
   EXPECT_TRUE(f.truth.heads[0].mount_rad.isZero(0.0));
   std::map<std::string, const GroundPoint*> points;
   for (const auto& p : f.points_truth) points[p.id] = &p;
   std::map<std::string, int> exposure_index;
-  for (size_t i = 0; i < f.exposures_truth.size(); ++i) exposure_index[f.exposures_truth[i].image] = i;
+  for (size_t i = 0; i < f.exposures_truth.size(); ++i)
+    exposure_index[f.exposures_truth[i].image] = i;
   std::set<std::pair<std::string, std::string>> seen_a, seen_b;
   double worst_px = 0.0;
   for (const auto& obs : f.observations) {
@@ -65,8 +70,8 @@ TEST(RigFlightSimulator, NoiseFreeObservationsAreTheOracleProjections) {
     const Eigen::Matrix3d rk = r * head.RigFromHead() * calib::RotationFromOpk(t.increment_rad);
     const Eigen::Vector3d ok = e.center_m + r * head.lever_arm_m + *e.velocity_mps * t.dt_s;
     Eigen::Vector2d px;
-    ASSERT_TRUE(head.camera.ProjectToPixel(calib::OpkFromRotation(rk), ok,
-                                           *points.at(obs.point)->xyz_m, &px));
+    ASSERT_TRUE(head.camera.ProjectToPixel(
+        calib::OpkFromRotation(rk), ok, *points.at(obs.point)->xyz_m, &px));
     worst_px = std::max(worst_px, (px - obs.pixel).cwiseAbs().maxCoeff());
     (k == 0 ? seen_a : seen_b).insert({obs.image, obs.point});
   }
@@ -77,7 +82,9 @@ TEST(RigFlightSimulator, NoiseFreeObservationsAreTheOracleProjections) {
   EXPECT_GT(common, 0.5 * seen_b.size()) << common << " of " << seen_b.size();
   EXPECT_GT(seen_b.size(), 100u);
   // Velocity along the strip: kappa 0 flies +x.
-  EXPECT_NEAR(f.exposures_truth[0].velocity_mps->x(), 55.0 * std::cos(f.exposures_truth[0].opk_rad.z()), 1e-12);
+  EXPECT_NEAR(f.exposures_truth[0].velocity_mps->x(),
+              55.0 * std::cos(f.exposures_truth[0].opk_rad.z()),
+              1e-12);
 }
 
 TEST(RigFlightSimulator, FilesReadBackWithHeadsAndVelocity) {
@@ -99,11 +106,13 @@ TEST(RigFlightSimulator, FilesReadBackWithHeadsAndVelocity) {
   }
   const auto exposures = ReadExposures(dir.File("exposures.csv"));
   ASSERT_EQ(exposures.size(), 9u);
-  ASSERT_TRUE(exposures[0].velocity_mps && exposures[0].center_sigma_m && exposures[0].opk_sigma_rad);
+  ASSERT_TRUE(exposures[0].velocity_mps && exposures[0].center_sigma_m &&
+              exposures[0].opk_sigma_rad);
   EXPECT_NEAR((*exposures[0].velocity_mps - *f.exposures_file[0].velocity_mps).norm(), 0.0, 1e-4);
   const calib::Rig truth = calib::ReadRig(dir.File("rig_truth.yaml"));
   EXPECT_NEAR((truth.heads[1].mount_rad - f.truth.heads[1].mount_rad).norm(), 0.0, 1e-15);
-  EXPECT_NE(ReadTextFile(dir.File("truth/rig_exposures.csv")).find("image,head,domega,dphi,dkappa,dT_ms\n0001,A,"),
+  EXPECT_NE(ReadTextFile(dir.File("truth/rig_exposures.csv"))
+                .find("image,head,domega,dphi,dkappa,dT_ms\n0001,A,"),
             std::string::npos);
   // The project reads as a rig project (the rig bundle: tests/triangulation/rig_bundle_test.cc).
   const Project project = ReadProject(dir.File("project.yaml"));
@@ -125,8 +134,7 @@ TEST(RigBlockFiles, PartialVelocityAndMixedColumnsAreRefusedByLine) {
               std::string::npos)
         << e.what();
   }
-  WriteFileAtomically(dir.File("observations.csv"),
-                      "image,head,subimage,point,u,v\n1,A,I,P,1,2\n");
+  WriteFileAtomically(dir.File("observations.csv"), "image,head,subimage,point,u,v\n1,A,I,P,1,2\n");
   EXPECT_THROW(ReadObservations(dir.File("observations.csv"), 0.5), InputError);
   WriteFileAtomically(dir.File("observations.csv"), "image,head,point,col,row\n1,,P,1,2\n");
   try {
@@ -146,18 +154,20 @@ TEST(RigFlightSimulator, TheSameSeedGivesTheSameFlight) {
   o.flight.tie_points = 20;
   const SimulatedRigFlight a = SimulateRigFlight(o), b = SimulateRigFlight(o);
   ASSERT_EQ(a.observations.size(), b.observations.size());
-  for (size_t i = 0; i < a.observations.size(); ++i) EXPECT_EQ(a.observations[i].pixel, b.observations[i].pixel);
+  for (size_t i = 0; i < a.observations.size(); ++i)
+    EXPECT_EQ(a.observations[i].pixel, b.observations[i].pixel);
   o.flight.seed = 2;
   EXPECT_NE(SimulateRigFlight(o).observations.front().pixel, a.observations.front().pixel);
 }
-
 
 TEST(RigFlightSimulator, Uav4StitchingTiesAreMeasuredInOneExposureAndReadBack) {
   RigFlightSimulationOptions o = RigFlightSimulationOptions::DefaultUav4();
   o.flight.exposures = 3;
   o.flight.image_noise_px = 0.0;
-  for (const auto& s : stitch::DesignRig(MakeNominalRig(RigPreset::kUav4), 300.0, 200).standard_positions)
-    if (s.name == "AB-1" || s.name == "ACD") o.stitch_ties.standard_positions.push_back({s.name, s.virtual_px});
+  for (const auto& s :
+       stitch::DesignRig(MakeNominalRig(RigPreset::kUav4), 300.0, 200).standard_positions)
+    if (s.name == "AB-1" || s.name == "ACD")
+      o.stitch_ties.standard_positions.push_back({s.name, s.virtual_px});
   const SimulatedRigFlight f = SimulateRigFlight(o);
   ASSERT_EQ(f.exposures_truth.size(), 3u);
   // Shutter offsets per head, the reference head's zero.

@@ -8,7 +8,7 @@
 // - The check-point test on known errors: F = ratio of the sums of squares against F(3n, 3n).
 #include "triangulation/adjustment/self_calibration_choice.h"
 
-#include "stitch/adjustment/f_test.h"
+#include "stitch/adjustment/f_distribution.h"
 #include "tests/support/odm_uav_block.h"
 #include "tests/support/simulated_block.h"
 #include "tests/support/test_support.h"

@@ -32,8 +32,7 @@ void EditObservations(const std::string& path, Edit edit) {
     std::vector<std::string> f;
     std::stringstream row(line);
     for (std::string cell; std::getline(row, cell, ',');) f.push_back(cell);
-    if (edit(index++, &f))
-      out += f[0] + "," + f[1] + "," + f[2] + "," + f[3] + "," + f[4] + "\n";
+    if (edit(index++, &f)) out += f[0] + "," + f[1] + "," + f[2] + "," + f[3] + "," + f[4] + "\n";
   }
   WriteFileAtomically(path, out);
 }
@@ -65,8 +64,9 @@ TEST(SnoopingCommand, RejectionCapIsAWarningAndExitThree) {
   EXPECT_GE(j["snooping"]["remaining_above_critical"].get<int>(), 1);
   EXPECT_EQ(j["rejected"].size(), 1u);
   // Without the cap all three are found (each a group of one or its correlated group).
-  const auto ok = RunAerocal("adjust --project " + dir.File("f/project.yaml") +
-                             " --self-calibration all --no-robust-start --out " + dir.File("s.json"));
+  const auto ok =
+      RunAerocal("adjust --project " + dir.File("f/project.yaml") +
+                 " --self-calibration all --no-robust-start --out " + dir.File("s.json"));
   EXPECT_EQ(ok.exit_code, 0) << ok.output;
   const auto s = ReadJson(dir.File("s.json"));
   EXPECT_TRUE(s["valid"].get<bool>());
@@ -87,7 +87,8 @@ TEST(SnoopingCommand, Sigma0AboveTheLimitIsNotValidAndWritesNoCamera) {
   // sigma0 is ~1.02 with self-calibration: a limit of 0.5 must fail the run, by name.
   const auto r = RunAerocal("adjust --project " + dir.File("f/project.yaml") +
                             " --self-calibration all --max-sigma0 0.5 --min-redundancy 0.2 "
-                            "--write-camera " + dir.File("cam.yaml") + " --out " + dir.File("r.json"));
+                            "--write-camera " +
+                            dir.File("cam.yaml") + " --out " + dir.File("r.json"));
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("above the limit 0.5 (max_sigma0)"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("camera not written"), std::string::npos);
@@ -104,16 +105,17 @@ TEST(SnoopingCommand, Sigma0AboveTheLimitIsNotValidAndWritesNoCamera) {
 
 TEST(SnoopingCommand, FlightOnAnUnsolvableBlockExitsThreeNamesTheStepAndWritesNoCamera) {
   TempDir dir("aerocal_snoop_flight");
-  ASSERT_EQ(RunAerocal("simulate --seed 5 --stitch-ties 50 --out " + dir.File("data")).exit_code, 0);
+  ASSERT_EQ(RunAerocal("simulate --seed 5 --stitch-ties 50 --out " + dir.File("data")).exit_code,
+            0);
   // One control point and no GNSS: position, attitude and scale of the block are not determined.
   std::string points = ReadTextFile(dir.File("data/points.csv"));
   points = std::regex_replace(points, std::regex("(\\nC[2-9][^\\n]*),control"), "$1,check");
   WriteFileAtomically(dir.File("data/points.csv"), points);
   std::filesystem::create_directories(dir.File("report"));
   WriteFileAtomically(dir.File("report/camera_calibrated.yaml"), "stale: true\n");
-  const auto r = RunAerocal("flight --camera " + dir.File("data/camera_nominal.yaml") + " --data " +
-                            dir.File("data") + " --out " + dir.File("report") +
-                            " --no-joint --no-report");
+  const auto r =
+      RunAerocal("flight --camera " + dir.File("data/camera_nominal.yaml") + " --data " +
+                 dir.File("data") + " --out " + dir.File("report") + " --no-joint --no-report");
   EXPECT_EQ(r.exit_code, 3) << r.output;
   EXPECT_NE(r.output.find("step self-calibration failed"), std::string::npos) << r.output;
   EXPECT_NE(r.output.find("no calibrated camera written"), std::string::npos);
@@ -167,9 +169,8 @@ bool Said(const nlohmann::json& result, const std::vector<std::string>& words) {
 // below the 2 cm survey; its height survey stays).
 void RemovePlanSurvey(const std::string& path, const std::string& point) {
   std::string points = ReadTextFile(path);
-  points = std::regex_replace(points,
-                              std::regex("\n(" + point + ",[^,]*,[^,]*,[^,]*),[^,]*,[^,]*,"),
-                              "\n$1,1000,1000,");
+  points = std::regex_replace(
+      points, std::regex("\n(" + point + ",[^,]*,[^,]*,[^,]*),[^,]*,[^,]*,"), "\n$1,1000,1000,");
   WriteFileAtomically(path, points);
 }
 
@@ -219,15 +220,15 @@ TEST(SnoopingCommand, ControlSurveyOffIsNamedAndLeftOutNotItsRays) {
   ASSERT_EQ(RunAerocal("simulate --seed 3 --out " + dir.File("f")).exit_code, 0);
   const std::string self_calibration = " --self-calibration all";
   // The oracle: C1's plan survey removed by hand (its height survey and its rays kept).
-  const SurveyRun oracle = AdjustWithSurvey(dir, self_calibration, [](const std::string& points) {
-    RemovePlanSurvey(points, "C1");
-  });
+  const SurveyRun oracle = AdjustWithSurvey(
+      dir, self_calibration, [](const std::string& points) { RemovePlanSurvey(points, "C1"); });
   ASSERT_EQ(oracle.exit_code, 0) << oracle.output;
   const double oracle_rmse_m = oracle.result["check"]["spatial_rmse_m"];
   const auto shift = [](int column, double offset_m) {
     return [=](const std::string& points) { ShiftSurvey(points, "C1", column, offset_m); };
   };
-  {  // 10 m in X: the data single C1's plan out; it leaves the adjustment, its height and rays stay.
+  {  // 10 m in X: the data single C1's plan out; it leaves the adjustment, its height and rays
+     // stay.
     const SurveyRun r = AdjustWithSurvey(dir, self_calibration, shift(1, 10.0));
     EXPECT_EQ(r.exit_code, 0) << r.output;  // a named warning; the other surveys fit
     EXPECT_NE(r.output.find("warning: suspected control blunder: the survey of control point C1 "
@@ -250,7 +251,8 @@ TEST(SnoopingCommand, ControlSurveyOffIsNamedAndLeftOutNotItsRays) {
     EXPECT_EQ(r.exit_code, 3) << r.output;
     const auto& j = r.result;
     EXPECT_TRUE(j["control_left_out"].empty());
-    EXPECT_TRUE(Said(j, {"control C1 plan", "control C4 plan", "cannot tell them apart"})) << r.output;
+    EXPECT_TRUE(Said(j, {"control C1 plan", "control C4 plan", "cannot tell them apart"}))
+        << r.output;
     EXPECT_TRUE(Warned(j, "control_blunder_unresolved", "control C1 plan"));
     EXPECT_FALSE(RejectedRayOf(j, "C1"));
   }
@@ -264,7 +266,8 @@ TEST(SnoopingCommand, ControlSurveyOffIsNamedAndLeftOutNotItsRays) {
   }
 }
 
-TEST(SnoopingCommand, HeightBlunderAtACornerIsAnUnresolvedGroupAndAPlanBlunderAtTheCentreIsLeftOut) {
+TEST(SnoopingCommand,
+     HeightBlunderAtACornerIsAnUnresolvedGroupAndAPlanBlunderAtTheCentreIsLeftOut) {
   // The self-calibrating simulated flight (seed 3, 5 control points, survey sigma 2 cm): the four
   // corners' heights share one redundant direction, the block's twist (their residuals correlate
   // |rho| 0.997-1.000; r 0.0012-0.0015 each): a height blunder on any corner gives all four the
@@ -296,9 +299,8 @@ TEST(SnoopingCommand, HeightBlunderAtACornerIsAnUnresolvedGroupAndAPlanBlunderAt
     EXPECT_FALSE(RejectedRayOf(j, "C1"));
   }
   // The oracle of C5: its plan survey removed by hand.
-  const SurveyRun oracle = AdjustWithSurvey(dir, self_calibration, [](const std::string& points) {
-    RemovePlanSurvey(points, "C5");
-  });
+  const SurveyRun oracle = AdjustWithSurvey(
+      dir, self_calibration, [](const std::string& points) { RemovePlanSurvey(points, "C5"); });
   ASSERT_EQ(oracle.exit_code, 0) << oracle.output;
   const double oracle_rmse_m = oracle.result["check"]["spatial_rmse_m"];
   {  // X +10 m on C5: its plan left out, its height kept, no ray of it rejected.
@@ -339,8 +341,8 @@ TEST(SnoopingCommand, ExposureLeftOutHasNullSigmasNeverZero) {
     if ((*f)[0] != "0005") return true;
     return kept++ < 2;
   });
-  const auto r = RunAerocal("adjust --project " + dir.File("f/project.yaml") + " --out " +
-                            dir.File("r.json"));
+  const auto r =
+      RunAerocal("adjust --project " + dir.File("f/project.yaml") + " --out " + dir.File("r.json"));
   ASSERT_NE(r.exit_code, 2) << r.output;
   const auto j = ReadJson(dir.File("r.json"));
   bool seen = false;

@@ -10,6 +10,11 @@
 //   uncertainty interval (k = 2 or from nu_eff) of c, x0, y0 covers the truth (>= 93 %).
 // AEROCAL_STUDY_RUNS=N scales both run counts down (a quick look); the asserted counts are the
 // issue's at 50 / 100 runs.
+#include "triangulation/calibration/calibration.h"
+#include "triangulation/calibration/group_change_power.h"
+#include "triangulation/calibration/uncertainty_budget.h"
+#include "triangulation/simulation/test_field_simulator.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -17,11 +22,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <map>
-
-#include "triangulation/calibration/calibration.h"
-#include "triangulation/calibration/group_change_power.h"
-#include "triangulation/calibration/uncertainty_budget.h"
-#include "triangulation/simulation/test_field_simulator.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -77,7 +77,8 @@ TEST(TestFieldStudy, GroupChiSquareAndSigmasAgainstTheSpread) {
     const CalibrationRun run_changed = CalibrateField(SimulateTestField(changed));
     const StabilityRow* changed_c = Row(run_changed, "c");
     changed_flagged += changed_c && !changed_c->agree;
-    const double power = GroupChangePower(row_c->sigmas, 1, 3.0 * row_c->sigmas[1], row_c->critical);
+    const double power =
+        GroupChangePower(row_c->sigmas, 1, 3.0 * row_c->sigmas[1], row_c->critical);
     changed_expected += power;
     changed_variance += power * (1 - power);
     // ... and by the change the stability table states as detectable with 80 % power.
@@ -87,14 +88,24 @@ TEST(TestFieldStudy, GroupChiSquareAndSigmasAgainstTheSpread) {
   }
   std::printf("%d runs: groups agree (all parameters) %d; per parameter:", runs, all_agree);
   for (const auto& [name, n] : agree) std::printf(" %s %d", name.c_str(), n);
-  std::printf("; c changed by 3 sigma in one group flagged %d (predicted %.1f); by the detectable "
-              "change (80 %%) flagged %d\n", changed_flagged, changed_expected, detectable_flagged);
+  std::printf(
+      "; c changed by 3 sigma in one group flagged %d (predicted %.1f); by the detectable "
+      "change (80 %%) flagged %d\n",
+      changed_flagged,
+      changed_expected,
+      detectable_flagged);
   for (int k = 0; k < 3; ++k) {
     const double mean = sum[k] / runs;
     const double spread = std::sqrt(std::max(0.0, sum2[k] / runs - mean * mean));
     const double sigma = std::sqrt(sigma2[k] / runs);
-    std::printf("%s: spread of the error %.3g mm, stated sigma (rms) %.3g mm, ratio %.3f, mean error %.3g\n",
-                std::string(Model::kParams[params[k]].name).c_str(), spread, sigma, spread / sigma, mean);
+    std::printf(
+        "%s: spread of the error %.3g mm, stated sigma (rms) %.3g mm, ratio %.3f, mean error "
+        "%.3g\n",
+        std::string(Model::kParams[params[k]].name).c_str(),
+        spread,
+        sigma,
+        spread / sigma,
+        mean);
     if (runs >= 50) {
       EXPECT_NEAR(spread / sigma, 1.0, 0.25) << Model::kParams[params[k]].name;
     }
@@ -125,14 +136,19 @@ TEST(TestFieldStudy, ExpandedUncertaintyCoversTheTruth) {
     ++valid;
     const auto budget = UncertaintyBudget(run, run.project, {{5.0, 10.0}, 0.0, {}});
     for (int k = 0; k < 3; ++k) {
-      const auto q = std::find_if(budget.begin(), budget.end(),
-                                  [&](const BudgetQuantity& b) { return b.name == names[k]; });
+      const auto q = std::find_if(budget.begin(), budget.end(), [&](const BudgetQuantity& b) {
+        return b.name == names[k];
+      });
       ASSERT_NE(q, budget.end()) << names[k];
       covered[k] += std::abs(q->value - f.truth.interior[params[k]]) <= q->expanded;
     }
   }
-  std::printf("%d runs (%d valid): U (k from nu_eff) covers the truth: c %d, x0 %d, y0 %d\n", runs,
-              valid, covered[0], covered[1], covered[2]);
+  std::printf("%d runs (%d valid): U (k from nu_eff) covers the truth: c %d, x0 %d, y0 %d\n",
+              runs,
+              valid,
+              covered[0],
+              covered[1],
+              covered[2]);
   EXPECT_EQ(valid, runs);
   if (runs >= 100) {
     for (int k = 0; k < 3; ++k) {

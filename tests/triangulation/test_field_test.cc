@@ -3,14 +3,13 @@
 // exterior orientation), its three groups agree and are flagged when one group's camera changes;
 // the planar variant starts from Zhang's closed form. The Monte-Carlo coverage study of the budget
 // is tests/triangulation/test_field_study_test.cc (label `long`).
+#include "tests/support/interior_checks.h"
+#include "triangulation/calibration/calibration.h"
 #include "triangulation/simulation/test_field_simulator.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
-
-#include "tests/support/interior_checks.h"
-#include "triangulation/calibration/calibration.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -21,7 +20,8 @@ CalibrationRun CalibrateField(const SimulatedTestField& f, bool groups = true) {
   CalibrateOptions o;  // the distortion terms the truth has (K3, B1, B2 are 0 there)
   o.adjust.free_interior = ParseSelfCalibration("c,x0,y0,K1,K2,P1,P2");
   o.adjust.data_snooping = false;
-  return Calibrate(TestFieldProject(f), o, groups ? f.group_of_image : std::map<std::string, std::string>{});
+  return Calibrate(
+      TestFieldProject(f), o, groups ? f.group_of_image : std::map<std::string, std::string>{});
 }
 
 TEST(TestFieldSimulator, ThreeGroupsOf24CalibrateToTheTruthAndAgree) {
@@ -39,9 +39,13 @@ TEST(TestFieldSimulator, ThreeGroupsOf24CalibrateToTheTruthAndAgree) {
   // Injected 0.1 px with sigma 0.1 px: sigma0 within 1 +- 3 / sqrt(2 r).
   EXPECT_NEAR(r.sigma0, 1.0, 3.0 / std::sqrt(2.0 * r.solve.redundancy));
   ASSERT_EQ(run.groups.size(), 3u);
-  EXPECT_TRUE(run.stability.agree) << (run.stability.flagged.empty() ? "" : run.stability.flagged[0]);
+  EXPECT_TRUE(run.stability.agree)
+      << (run.stability.flagged.empty() ? "" : run.stability.flagged[0]);
   std::printf("test field: c %.5f +- %.5f mm (truth %.5f), sigma0 %.3f, redundancy %d\n",
-              c.estimated[Model::kC], c.sigma[Model::kC], f.truth.interior[Model::kC], r.sigma0,
+              c.estimated[Model::kC],
+              c.sigma[Model::kC],
+              f.truth.interior[Model::kC],
+              r.sigma0,
               static_cast<int>(r.solve.redundancy));
 }
 
@@ -73,7 +77,8 @@ TEST(TestFieldSimulator, PlanarFieldStartsFromZhangsClosedForm) {
   EXPECT_NEAR(*run.closed_form_c_mm / f.truth.interior[Model::kC], 1.0, 0.01);
   const CameraEstimate& c = run.all.result.cameras[0];
   ASSERT_TRUE(run.all.result.valid);
-  EXPECT_LE(std::abs(c.estimated[Model::kC] - f.truth.interior[Model::kC]), 3.0 * c.sigma[Model::kC]);
+  EXPECT_LE(std::abs(c.estimated[Model::kC] - f.truth.interior[Model::kC]),
+            3.0 * c.sigma[Model::kC]);
 }
 
 }  // namespace

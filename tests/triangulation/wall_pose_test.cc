@@ -4,9 +4,8 @@
 // it converges like a nadir block. Oracles: noise-free, the pose and the points come back exactly
 // (1e-9 rad, 1e-6 m); with 0.1 px noise sigma0 / injected sigma is within 1 +- 3/sqrt(2r) and
 // every centre and phi lie within 3 reported sigmas of the truth.
-#include "triangulation/adjustment/block_adjustment.h"
-
 #include "calib/camera/rotation.h"
+#include "triangulation/adjustment/block_adjustment.h"
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>

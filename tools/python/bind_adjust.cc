@@ -6,8 +6,8 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
-#include "tools/python/bindings.h"
 #include "tools/project_facts.h"
+#include "tools/python/bindings.h"
 #include "tools/python/progress_callback.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/self_calibration_choice.h"
@@ -270,11 +270,11 @@ Result Adjust(const Block& block,
   options.Validate();
   if (!block.project.rigs.empty())
     throw ConfigError("a rig block: adjust it with the command line (`aerocal adjust`) for now");
-  const auto progress = CallbackProgress(
-      progress_callback,
-      "adjust",
-      auto_free && !options.free_interior.empty() ? triangulation::AutoFreeSetRounds(options)
-                                                  : triangulation::AdjustStages(options));
+  const auto progress = CallbackProgress(progress_callback,
+                                         "adjust",
+                                         auto_free && !options.free_interior.empty()
+                                             ? triangulation::AutoFreeSetRounds(options)
+                                             : triangulation::AdjustStages(options));
   Result out;
   {
     py::gil_scoped_release release;
@@ -341,7 +341,8 @@ py::dict ResidualTable(const AdjustmentResult& r) {
 // fixed entry has a zero row). `names`: entries "camera ID.NAME" or whole cameras
 // "camera ID" (expanded in the model's parameter order). Exterior blocks are not kept by the
 // result (their sigmas are), so they cannot be named here.
-Eigen::MatrixXd InteriorCovariance(const AdjustmentResult& r, const std::vector<std::string>& names) {
+Eigen::MatrixXd InteriorCovariance(const AdjustmentResult& r,
+                                   const std::vector<std::string>& names) {
   if (r.interior_correlation_names.empty())
     throw ConfigError("covariance: the adjustment has no covariance (see invalid_reasons)");
   std::map<std::string, double> sigma;

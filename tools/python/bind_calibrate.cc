@@ -19,28 +19,45 @@ struct CalibrationResult {
   std::string json;  // as `aerocal calibrate --out` writes it
 };
 
-std::string Text(const py::object& value) { return value.is_none() ? "" : py::str(value).cast<std::string>(); }
+std::string Text(const py::object& value) {
+  return value.is_none() ? "" : py::str(value).cast<std::string>();
+}
 
-CalibrationResult Calibrate(const std::string& camera, const py::object& directions,
-                            const py::object& observations, const py::object& points,
-                            const py::object& images, const py::object& board, const py::object& groups,
-                            const py::object& budget, const py::object& self_calibration,
-                            const py::object& model, double sigma_px, double board_sigma_mm,
-                            const std::vector<double>& radii_mm, bool no_snooping, bool no_closed_form,
-                            double suspect_effect_limit, const py::object& write_camera,
-                            const std::string& camera_format, const py::object& write_marks,
+CalibrationResult Calibrate(const std::string& camera,
+                            const py::object& directions,
+                            const py::object& observations,
+                            const py::object& points,
+                            const py::object& images,
+                            const py::object& board,
+                            const py::object& groups,
+                            const py::object& budget,
+                            const py::object& self_calibration,
+                            const py::object& model,
+                            double sigma_px,
+                            double board_sigma_mm,
+                            const std::vector<double>& radii_mm,
+                            bool no_snooping,
+                            bool no_closed_form,
+                            double suspect_effect_limit,
+                            const py::object& write_camera,
+                            const std::string& camera_format,
+                            const py::object& write_marks,
                             const py::object& out) {
   if (!(sigma_px > 0 && sigma_px <= 100)) throw ConfigError("sigma_px: must be in (0, 100]");
-  if (!(board_sigma_mm > 0 && board_sigma_mm <= 100)) throw ConfigError("board_sigma_mm: must be in (0, 100]");
+  if (!(board_sigma_mm > 0 && board_sigma_mm <= 100))
+    throw ConfigError("board_sigma_mm: must be in (0, 100]");
   if (!(suspect_effect_limit > 0 && suspect_effect_limit <= 1e3))
     throw ConfigError("suspect_effect_limit: must be in (0, 1000]");
   for (const double r : radii_mm)
     if (!(r > 0 && r <= 1e4)) throw ConfigError("radii_mm: each must be in (0, 10000]");
   if (!directions.is_none()) {  // a collimator array or a goniometer sequence
     if (!observations.is_none() || !points.is_none() || !images.is_none() || !board.is_none())
-      throw ConfigError("directions: give either directions, or observations and points, or images and board");
+      throw ConfigError(
+          "directions: give either directions, or observations and points, or images and board");
     if (!groups.is_none() || !write_marks.is_none() || no_snooping || no_closed_form)
-      throw ConfigError("groups, write_marks, no_snooping, no_closed_form: not options of a direction calibration");
+      throw ConfigError(
+          "groups, write_marks, no_snooping, no_closed_form: not options of a direction "
+          "calibration");
     tools::DirectionsArgs args;
     args.camera = camera;
     args.directions = Text(directions);
@@ -94,31 +111,52 @@ CalibrationResult Calibrate(const std::string& camera, const py::object& directi
 }  // namespace
 
 void BindCalibrate(py::module_& m) {
-  py::class_<CalibrationResult>(m, "CalibrationResult",
-                                "The result of calibrate(): as `aerocal calibrate` writes it")
-      .def_property_readonly("valid", [](const CalibrationResult& r) { return r.outcome.valid; },
-                             "The calibration is valid and its image groups agree (exit 0 of the command)")
-      .def_property_readonly("sigma0", [](const CalibrationResult& r) { return r.outcome.doc.at("sigma0").get<double>(); })
-      .def_property_readonly("calibration",
-                             [](const CalibrationResult& r) {
-                               return JsonToPython(r.outcome.doc.at("calibration").dump());
-                             },
-                             "The result's `calibration` section as a dict (values with U, budget, "
-                             "groups, stability, method)")
-      .def_property_readonly("printed", [](const CalibrationResult& r) { return r.outcome.printed; },
-                             "What the command prints")
-      .def("to_json", [](const CalibrationResult& r) { return r.json; },
-           "The result file's text, identical to `aerocal calibrate --out`");
-  m.def("calibrate", &Calibrate, py::arg("camera"), py::arg("directions") = py::none(),
+  py::class_<CalibrationResult>(
+      m, "CalibrationResult", "The result of calibrate(): as `aerocal calibrate` writes it")
+      .def_property_readonly(
+          "valid",
+          [](const CalibrationResult& r) { return r.outcome.valid; },
+          "The calibration is valid and its image groups agree (exit 0 of the command)")
+      .def_property_readonly(
+          "sigma0",
+          [](const CalibrationResult& r) { return r.outcome.doc.at("sigma0").get<double>(); })
+      .def_property_readonly(
+          "calibration",
+          [](const CalibrationResult& r) {
+            return JsonToPython(r.outcome.doc.at("calibration").dump());
+          },
+          "The result's `calibration` section as a dict (values with U, budget, "
+          "groups, stability, method)")
+      .def_property_readonly(
+          "printed",
+          [](const CalibrationResult& r) { return r.outcome.printed; },
+          "What the command prints")
+      .def(
+          "to_json",
+          [](const CalibrationResult& r) { return r.json; },
+          "The result file's text, identical to `aerocal calibrate --out`");
+  m.def("calibrate",
+        &Calibrate,
+        py::arg("camera"),
+        py::arg("directions") = py::none(),
         py::arg("observations") = py::none(),
-        py::arg("points") = py::none(), py::arg("images") = py::none(), py::arg("board") = py::none(),
-        py::arg("groups") = py::none(), py::arg("budget") = py::none(),
-        py::arg("self_calibration") = py::none(), py::arg("model") = py::none(),
-        py::arg("sigma_px") = 0.5, py::arg("board_sigma_mm") = tools::kDefaultBoardSigmaMm,
-        py::arg("radii_mm") = std::vector<double>{}, py::arg("no_snooping") = false,
-        py::arg("no_closed_form") = false, py::arg("suspect_effect_limit") = 1.0,
-        py::arg("write_camera") = py::none(), py::arg("camera_format") = "aerocal",
-        py::arg("write_marks") = py::none(), py::arg("out") = py::none(),
+        py::arg("points") = py::none(),
+        py::arg("images") = py::none(),
+        py::arg("board") = py::none(),
+        py::arg("groups") = py::none(),
+        py::arg("budget") = py::none(),
+        py::arg("self_calibration") = py::none(),
+        py::arg("model") = py::none(),
+        py::arg("sigma_px") = 0.5,
+        py::arg("board_sigma_mm") = tools::kDefaultBoardSigmaMm,
+        py::arg("radii_mm") = std::vector<double>{},
+        py::arg("no_snooping") = false,
+        py::arg("no_closed_form") = false,
+        py::arg("suspect_effect_limit") = 1.0,
+        py::arg("write_camera") = py::none(),
+        py::arg("camera_format") = "aerocal",
+        py::arg("write_marks") = py::none(),
+        py::arg("out") = py::none(),
         "Camera calibration as `aerocal calibrate`: a test field (observations, points: the CSV "
         "files), a planar board (images: a glob, board: 'chessboard:9x6:25') or known directions "
         "(directions: a collimator array or goniometer file); groups, budget, "

@@ -15,9 +15,15 @@ namespace {
 
 namespace py = pybind11;
 
-py::dict Match(const std::string& camera, const py::object& images, const std::string& frame,
-               const py::object& list, const std::string& detector, bool lsm, double sigma_px,
-               double cell_px, const std::string& out) {
+py::dict Match(const std::string& camera,
+               const py::object& images,
+               const std::string& frame,
+               const py::object& list,
+               const std::string& detector,
+               bool lsm,
+               double sigma_px,
+               double cell_px,
+               const std::string& out) {
   if (!(sigma_px > 0 && sigma_px <= 100)) throw ConfigError("sigma_px: must be in (0, 100]");
   if (!(cell_px >= 1 && cell_px <= 1e5)) throw ConfigError("cell_px: must be in [1, 100000]");
   if (!out.empty()) CheckOutputFile(out, "out");
@@ -61,9 +67,17 @@ py::dict Match(const std::string& camera, const py::object& images, const std::s
 }  // namespace
 
 void BindMatch(py::module_& m) {
-  m.def("match", &Match, py::arg("camera"), py::arg("images") = py::none(), py::arg("frame") = "",
-        py::arg("list") = py::none(), py::arg("detector") = "sift", py::arg("lsm") = true,
-        py::arg("sigma_px") = 0.3, py::arg("cell_px") = 100.0, py::arg("out") = "",
+  m.def("match",
+        &Match,
+        py::arg("camera"),
+        py::arg("images") = py::none(),
+        py::arg("frame") = "",
+        py::arg("list") = py::none(),
+        py::arg("detector") = "sift",
+        py::arg("lsm") = true,
+        py::arg("sigma_px") = 0.3,
+        py::arg("cell_px") = 100.0,
+        py::arg("out") = "",
         "Tie points in the overlap strips of multi-CCD frames as `aerocal match`: one frame "
         "(images {sub-image id: file} or 'I=a.tif,...', frame its id) or a flight (list: CSV "
         "frame,subimage,image); detector sift | foerstner; lsm: least-squares refinement. Returns "

@@ -1,13 +1,12 @@
 // aerocal.resample: the virtual image of one frame as `aerocal resample` makes it (the same
 // reading and checks, tools/resample_frame.h), returned as a numpy array and, with `out`, written
 // as the command's TIFF.
-#include <cstring>
-
 #include "calib/core/atomic_file.h"
 #include "stitch/resample/tiff_raster.h"
 #include "tools/python/bindings.h"
 #include "tools/resample_frame.h"
 
+#include <cstring>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 
@@ -64,11 +63,14 @@ std::string ImagesOptionText(const py::object& images) {
   if (py::isinstance<py::str>(images)) return images.cast<std::string>();
   std::string text;
   for (const auto& [id, path] : images.cast<py::dict>())
-    text += (text.empty() ? "" : ",") + py::str(id).cast<std::string>() + "=" + py::str(path).cast<std::string>();
+    text += (text.empty() ? "" : ",") + py::str(id).cast<std::string>() + "=" +
+            py::str(path).cast<std::string>();
   return text;
 }
 
-py::object JsonToPython(const std::string& text) { return py::module_::import("json").attr("loads")(text); }
+py::object JsonToPython(const std::string& text) {
+  return py::module_::import("json").attr("loads")(text);
+}
 
 void BindResample(py::module_& m) {
   m.def("resample",

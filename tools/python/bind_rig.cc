@@ -1,9 +1,9 @@
 // aerocal.rig_stitch: the self-calibrating stitching of a rig block as `aerocal rig stitch` runs it
 // (tools/rig_stitch_run.h: the same request and run), with the result document as the command
 // writes it (the stitched images stay with the command).
+#include "calib/camera/rig_io.h"
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
-#include "calib/camera/rig_io.h"
 #include "tools/python/bindings.h"
 #include "tools/rig_design_document.h"
 #include "tools/rig_stitch_run.h"
@@ -20,16 +20,26 @@ struct RigStitchResult {
   std::string json;  // as `aerocal rig stitch --out` writes it
 };
 
-RigStitchResult RigStitch(const std::string& camera, const std::string& project, const std::string& mode,
-                          bool no_snooping, double alpha, std::optional<double> increment_sigma_arcsec,
-                          std::optional<double> dt_sigma_ms, std::optional<double> relief_m,
-                          double standard_radius_px, double max_sigma0, double suspect_effect_limit,
-                          double sigma_px, const std::string& images, bool match_ties) {
+RigStitchResult RigStitch(const std::string& camera,
+                          const std::string& project,
+                          const std::string& mode,
+                          bool no_snooping,
+                          double alpha,
+                          std::optional<double> increment_sigma_arcsec,
+                          std::optional<double> dt_sigma_ms,
+                          std::optional<double> relief_m,
+                          double standard_radius_px,
+                          double max_sigma0,
+                          double suspect_effect_limit,
+                          double sigma_px,
+                          const std::string& images,
+                          bool match_ties) {
   for (const auto& [name, value] : {std::make_pair("standard_radius_px", standard_radius_px),
                                     std::make_pair("max_sigma0", max_sigma0),
                                     std::make_pair("suspect_effect_limit", suspect_effect_limit),
                                     std::make_pair("sigma_px", sigma_px)})
-    if (!(std::isfinite(value) && value > 0)) throw ConfigError(std::string(name) + ": must be a finite number > 0");
+    if (!(std::isfinite(value) && value > 0))
+      throw ConfigError(std::string(name) + ": must be a finite number > 0");
   tools::RigStitchRequest request;
   request.camera = camera;
   request.project = project;
@@ -45,7 +55,8 @@ RigStitchResult RigStitch(const std::string& camera, const std::string& project,
   request.default_sigma_px = sigma_px;
   request.images = images;
   request.match_ties = match_ties;
-  if (match_ties && images.empty()) throw ConfigError("match_ties needs images (the folder of the head images)");
+  if (match_ties && images.empty())
+    throw ConfigError("match_ties needs images (the folder of the head images)");
   RigStitchResult out;
   {
     py::gil_scoped_release release;
@@ -55,49 +66,79 @@ RigStitchResult RigStitch(const std::string& camera, const std::string& project,
   return out;
 }
 
-
 // `aerocal rig design`: the design document as a dict (the command's --out file's content).
 py::object RigDesign(const std::string& camera, double height_m, int grid_cells) {
   const calib::Rig rig = calib::ReadRig(camera);
   const double height = tools::FlyingHeight(rig, height_m, camera);
   if (grid_cells < 10 || grid_cells > 4000)
-    throw ConfigError("grid_cells must be within 10..4000 (got " + std::to_string(grid_cells) + ")");
+    throw ConfigError("grid_cells must be within 10..4000 (got " + std::to_string(grid_cells) +
+                      ")");
   stitch::RigDesign design;
   {
     py::gil_scoped_release release;
     design = stitch::DesignRig(rig, height, grid_cells);
   }
-  return JsonToPython(ResultText("rig_design", tools::RigDesignDocument(rig, camera, height, design, "")));
+  return JsonToPython(
+      ResultText("rig_design", tools::RigDesignDocument(rig, camera, height, design, "")));
 }
 
 }  // namespace
 
 void BindRig(py::module_& m) {
-  py::class_<RigStitchResult>(m, "RigStitchResult", "The result of rig_stitch(): as `aerocal rig stitch` writes it")
-      .def_property_readonly("valid", [](const RigStitchResult& r) { return r.run.result.failures.empty(); },
-                             "No failure (the command's exit 0)")
-      .def_property_readonly("failures", [](const RigStitchResult& r) { return r.run.result.failures; })
-      .def_property_readonly("warnings", [](const RigStitchResult& r) { return r.run.result.warnings; })
+  py::class_<RigStitchResult>(
+      m, "RigStitchResult", "The result of rig_stitch(): as `aerocal rig stitch` writes it")
+      .def_property_readonly(
+          "valid",
+          [](const RigStitchResult& r) { return r.run.result.failures.empty(); },
+          "No failure (the command's exit 0)")
+      .def_property_readonly("failures",
+                             [](const RigStitchResult& r) { return r.run.result.failures; })
+      .def_property_readonly("warnings",
+                             [](const RigStitchResult& r) { return r.run.result.warnings; })
       .def_property_readonly("sigma0", [](const RigStitchResult& r) { return r.run.result.sigma0; })
-      .def_property_readonly("rig_exposures", [](const RigStitchResult& r) { return JsonToPython(r.run.json.at("rig_exposures").dump()); },
-                             "Per exposure and head: domega, dphi, dkappa (deg), dT_ms and their sigmas "
-                             "(None where held or not computable)")
-      .def_property_readonly("snooping", [](const RigStitchResult& r) { return JsonToPython(r.run.json.at("snooping").dump()); })
-      .def_property_readonly("printed", [](const RigStitchResult& r) { return r.run.printed; },
-                             "What the command prints")
-      .def("to_json", [](const RigStitchResult& r) { return r.json; },
-           "The result file's text, identical to `aerocal rig stitch --out`");
-  m.def("rig_design", &RigDesign, py::arg("camera"), py::arg("height_m") = 0.0, py::arg("grid_cells") = 400,
+      .def_property_readonly(
+          "rig_exposures",
+          [](const RigStitchResult& r) {
+            return JsonToPython(r.run.json.at("rig_exposures").dump());
+          },
+          "Per exposure and head: domega, dphi, dkappa (deg), dT_ms and their sigmas "
+          "(None where held or not computable)")
+      .def_property_readonly(
+          "snooping",
+          [](const RigStitchResult& r) { return JsonToPython(r.run.json.at("snooping").dump()); })
+      .def_property_readonly(
+          "printed",
+          [](const RigStitchResult& r) { return r.run.printed; },
+          "What the command prints")
+      .def(
+          "to_json",
+          [](const RigStitchResult& r) { return r.json; },
+          "The result file's text, identical to `aerocal rig stitch --out`");
+  m.def("rig_design",
+        &RigDesign,
+        py::arg("camera"),
+        py::arg("height_m") = 0.0,
+        py::arg("grid_cells") = 400,
         "The design figures of a multi-head rig as `aerocal rig design --camera CAMERA --out F` "
         "writes them, as a dict: GSD change ratios of each head against the closed form, the "
         "virtual format needed, covered area, effective format, overlap zones, standard tie "
         "positions (height_m 0: the rig file's virtual.height_m).");
-  m.def("rig_stitch", &RigStitch, py::arg("camera"), py::arg("project"), py::arg("mode") = "line",
-        py::arg("no_snooping") = false, py::arg("alpha") = 0.05,
-        py::arg("increment_sigma_arcsec") = py::none(), py::arg("dt_sigma_ms") = py::none(),
-        py::arg("relief_m") = py::none(), py::arg("standard_radius_px") = 400.0,
-        py::arg("max_sigma0") = 3.0, py::arg("suspect_effect_limit") = 1.0, py::arg("sigma_px") = 0.5,
-        py::arg("images") = "", py::arg("match_ties") = false,
+  m.def("rig_stitch",
+        &RigStitch,
+        py::arg("camera"),
+        py::arg("project"),
+        py::arg("mode") = "line",
+        py::arg("no_snooping") = false,
+        py::arg("alpha") = 0.05,
+        py::arg("increment_sigma_arcsec") = py::none(),
+        py::arg("dt_sigma_ms") = py::none(),
+        py::arg("relief_m") = py::none(),
+        py::arg("standard_radius_px") = 400.0,
+        py::arg("max_sigma0") = 3.0,
+        py::arg("suspect_effect_limit") = 1.0,
+        py::arg("sigma_px") = 0.5,
+        py::arg("images") = "",
+        py::arg("match_ties") = false,
         "The self-calibrating stitching of a rig block as `aerocal rig stitch --camera CAMERA "
         "--project PROJECT`: mode line | per-exposure | angles, the command's other options as "
         "keywords (`-` -> `_`; sigma_px is --sigma-px); match_ties with images (the head images' "

@@ -75,8 +75,8 @@ StitchResult Stitch(const std::string& camera_path,
                     const py::object& progress_callback) {
   if (!(sigma_px > 0 && sigma_px <= 100)) throw ConfigError("sigma_px: must be in (0, 100]");
   const calib::Camera camera = calib::ReadCamera(camera_path);
-  const stitch::BatchOptions options = stitch::BatchOptionsFromText(
-      camera, model, base, alpha, !no_snooping, "model", "alpha");
+  const stitch::BatchOptions options =
+      stitch::BatchOptionsFromText(camera, model, base, alpha, !no_snooping, "model", "alpha");
   const auto frames = stitch::ReadStitchFrames(camera, camera_path, observations, sigma_px);
   const auto progress =
       CallbackProgress(progress_callback, "stitch", static_cast<long>(frames.size()));
@@ -95,9 +95,11 @@ StitchResult Stitch(const std::string& camera_path,
 }  // namespace
 
 void BindStitch(py::module_& m) {
-  py::class_<StitchResult>(m, "StitchResult", "The result of stitch(): as `aerocal stitch` writes it")
+  py::class_<StitchResult>(
+      m, "StitchResult", "The result of stitch(): as `aerocal stitch` writes it")
       .def_readonly("converged", &StitchResult::converged)
-      .def_readonly("flight_model", &StitchResult::flight_model,
+      .def_readonly("flight_model",
+                    &StitchResult::flight_model,
                     "The flight's model: the requested one, or the one chosen in most frames")
       .def_property_readonly(
           "frames",

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <pybind11/pybind11.h>
-
 #include <string>
 
 namespace aerocal::python {

@@ -2,11 +2,11 @@
 // the `progress=` keyword of adjust() and stitch().
 #pragma once
 
+#include "calib/core/progress.h"
+
 #include <memory>
 #include <pybind11/pybind11.h>
 #include <string>
-
-#include "calib/core/progress.h"
 
 namespace aerocal::python {
 

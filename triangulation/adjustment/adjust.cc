@@ -108,10 +108,11 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   BlockAdjustment clean_adjustment(next, clean_options);
   const AdjustmentResult clean = clean_adjustment.Run(progress);
   const int components = 2 * static_cast<int>(next.observations.size());
-  const double critical = options.snooping_critical_value > 0
-                              ? options.snooping_critical_value
-                              : std::max(3.29, calib::NormalCriticalValue(
-                                                   options.snooping_alpha / std::max(1, components)));
+  const double critical =
+      options.snooping_critical_value > 0
+          ? options.snooping_critical_value
+          : std::max(3.29,
+                     calib::NormalCriticalValue(options.snooping_alpha / std::max(1, components)));
   const double scale = std::max(1.0, clean.sigma0);
   std::vector<BlockAdjustment::Screened> still_excluded;
   int readmitted = 0, retested = 0;
@@ -163,14 +164,13 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   result.snooping.robust_excluded = static_cast<int>(screened.size());
   result.snooping.robust_readmitted = readmitted;
   result.snooping.robust_retested = retested;
-  result.notes.push_back("started from a robust (Cauchy, " +
-                         FormatNumber(options.robust_scale_sigma, 3) + " sigma) adjustment (" +
-                         reason + "): " + std::to_string(screened.size()) +
-                         " observation(s) beyond " + FormatNumber(options.robust_reject_sigma, 3) +
-                         " robust w excluded, " + std::to_string(readmitted) +
-                         " re-admitted because they fit the clean solution, " +
-                         std::to_string(retested) +
-                         " on points the clean solution could not hold left to snooping");
+  result.notes.push_back(
+      "started from a robust (Cauchy, " + FormatNumber(options.robust_scale_sigma, 3) +
+      " sigma) adjustment (" + reason + "): " + std::to_string(screened.size()) +
+      " observation(s) beyond " + FormatNumber(options.robust_reject_sigma, 3) +
+      " robust w excluded, " + std::to_string(readmitted) +
+      " re-admitted because they fit the clean solution, " + std::to_string(retested) +
+      " on points the clean solution could not hold left to snooping");
   return result;
 }
 

@@ -18,8 +18,9 @@ void AdjustOptions::Validate() const {
     // The names of any registered model; the frame camera checks them against each camera's own
     // model when the adjustment starts.
     bool known = false;
-    calib::ForEachCameraModel(
-        [&](auto model) { known = known || calib::IndexOfParam(decltype(model)::kParams, name) >= 0; });
+    calib::ForEachCameraModel([&](auto model) {
+      known = known || calib::IndexOfParam(decltype(model)::kParams, name) >= 0;
+    });
     if (!known)
       throw ConfigError("free_interior: unknown parameter '" + name +
                         "' (expected c, x0, y0, K1, K2, K3, P1, P2, B1, B2 or a parameter of the "
@@ -36,14 +37,15 @@ void AdjustOptions::Validate() const {
   if (!(robust_reject_sigma > 0))
     throw ConfigError("robust_reject_sigma must be > 0 (got " + FormatNumber(robust_reject_sigma) +
                       ")");
-  auto in_range = [](const char* name, double value, double lo, double hi, bool lo_open,
-                     bool hi_open) {
-    const bool ok = (lo_open ? value > lo : value >= lo) && (hi_open ? value < hi : value <= hi);
-    if (!ok)
-      throw ConfigError(std::string(name) + " must be in " + (lo_open ? "(" : "[") +
-                        FormatNumber(lo) + ", " + FormatNumber(hi) + (hi_open ? ")" : "]") +
-                        " (got " + FormatNumber(value) + ")");
-  };
+  auto in_range =
+      [](const char* name, double value, double lo, double hi, bool lo_open, bool hi_open) {
+        const bool ok =
+            (lo_open ? value > lo : value >= lo) && (hi_open ? value < hi : value <= hi);
+        if (!ok)
+          throw ConfigError(std::string(name) + " must be in " + (lo_open ? "(" : "[") +
+                            FormatNumber(lo) + ", " + FormatNumber(hi) + (hi_open ? ")" : "]") +
+                            " (got " + FormatNumber(value) + ")");
+      };
   in_range("snooping_alpha", snooping_alpha, 0, 1, true, true);
   in_range("snooping_power", snooping_power, 0.5, 1, true, true);
   in_range("min_redundancy", min_redundancy, 0, 1, false, true);
@@ -60,8 +62,10 @@ void AdjustOptions::Validate() const {
     throw ConfigError("suspect_effect_limit must be in (0, 1000] sigmas (got " +
                       FormatNumber(suspect_effect_limit) + ")");
   if (max_rejections < 0)
-    throw ConfigError("max_rejections must be >= 0 (0: 10 % of the tested observations, at least "
-                      "100; got " + std::to_string(max_rejections) + ")");
+    throw ConfigError(
+        "max_rejections must be >= 0 (0: 10 % of the tested observations, at least "
+        "100; got " +
+        std::to_string(max_rejections) + ")");
   if (!(correlation_threshold > 0 && correlation_threshold < 1))
     throw ConfigError("correlation_threshold must be in (0, 1) (got " +
                       FormatNumber(correlation_threshold) + ")");
@@ -80,13 +84,12 @@ std::vector<std::string> ParseSelfCalibration(const std::string& text, calib::Ca
   }
   for (const std::string& name : SplitCommaList(text)) {
     if (std::none_of(table.begin(), table.end(), [&](const auto& p) { return p.name == name; }))
-      throw ConfigError("--self-calibration: unknown parameter '" + name +
-                        "' (expected none, all or a list of " +
-                        (model == Model::kId ? std::string()
-                                             : "the parameters of model " +
-                                                   std::string(calib::CameraModelName(model)) +
-                                                   ": ") +
-                        calib::JoinParamNames(table) + ")");
+      throw ConfigError(
+          "--self-calibration: unknown parameter '" + name + "' (expected none, all or a list of " +
+          (model == Model::kId
+               ? std::string()
+               : "the parameters of model " + std::string(calib::CameraModelName(model)) + ": ") +
+          calib::JoinParamNames(table) + ")");
     names.push_back(name);
   }
   AdjustOptions probe;

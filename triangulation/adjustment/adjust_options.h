@@ -43,7 +43,7 @@ struct AdjustOptions {
   bool auto_robust_start = true;
   double robust_trigger_share = 0.01;  // [0, 1)
   double robust_trigger_w = 10.0;      // > 0
-  double robust_scale_sigma = 3.0;  // > 0
+  double robust_scale_sigma = 3.0;     // > 0
   /// After the robust adjustment, observations whose w = |v| / (s sqrt(r)) (redundancy numbers r,
   /// s = the robust scale of w) exceeds this are excluded from the clean re-adjustment, > 0;
   /// those that fit the clean solution (|v| / sigma below the snooping critical value) are
@@ -52,10 +52,10 @@ struct AdjustOptions {
   /// Snooping policy (data_snooping.h): family-wise alpha, power for the MDB, the redundancy
   /// below which an observation is weakly controlled (reported, never rejected), the correlation
   /// above which observations cannot be told apart (acted on as a group).
-  double snooping_alpha = 0.05;         // (0, 1)
-  double snooping_power = 0.80;         // (0.5, 1)
-  double min_redundancy = 0.1;          // [0, 1)
-  double group_correlation = 0.99;      // (0, 1]
+  double snooping_alpha = 0.05;     // (0, 1)
+  double snooping_power = 0.80;     // (0.5, 1)
+  double min_redundancy = 0.1;      // [0, 1)
+  double group_correlation = 0.99;  // (0, 1]
   /// Final sigma0 above which a model error is suspected (besides the clustering of the largest
   /// w on one point / image / the control), > 0.
   double model_error_sigma0 = 1.5;

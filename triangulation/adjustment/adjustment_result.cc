@@ -22,7 +22,8 @@ nlohmann::json Finite(double x) { return std::isfinite(x) ? nlohmann::json(x) : 
 // "platform": each parameter with its mode, value and sigma (null when fixed or unknown), in the
 // units of the project YAML's `platform:` keys (m, deg, ms).
 nlohmann::json PlatformToJson(const PlatformEstimate& p) {
-  auto entry = [](PlatformParamMode mode, const Eigen::VectorXd& value,
+  auto entry = [](PlatformParamMode mode,
+                  const Eigen::VectorXd& value,
                   const std::optional<Eigen::VectorXd>& sigma) {
     nlohmann::json e = {{"mode", PlatformParamModeName(mode)}};
     e["value"] = nlohmann::json::array();
@@ -124,7 +125,8 @@ nlohmann::json SnoopingToJson(const SnoopingSummary& s) {
                                        {"w", u.w},
                                        {"r", u.redundancy},
                                        {"residual_sigma", u.residual_sigma}});
-  if (!s.unresolved_surveys.empty()) j["unresolved_effect"] = calib::SuspectEffectJson(s.unresolved_effect);
+  if (!s.unresolved_surveys.empty())
+    j["unresolved_effect"] = calib::SuspectEffectJson(s.unresolved_effect);
   j["uncontrolled"] = nlohmann::json::array();
   for (const auto& u : s.uncontrolled)
     j["uncontrolled"].push_back({{"image", u.image},
@@ -211,25 +213,26 @@ std::string CalibrationTable(const AdjustmentResult& r) {
 std::string RejectedLines(const AdjustmentResult& r) {
   std::string out;
   for (const auto& o : r.rejected)
-    out +=
-        StringPrintf("rejected%s: image %s%s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f%s)\n",
-                     o.by == "snooping" ? "" : (" by the " + o.by).c_str(),
-                     o.image.c_str(),
-                     ((o.subimage.empty() ? "" : " sub-image " + o.subimage) +
-                      (o.head.empty() ? "" : " head " + o.head))
-                         .c_str(),
-                     o.point.c_str(),
-                     o.measured_px.x(),
-                     o.measured_px.y(),
-                     o.residual_px.norm(),
-                     o.w,
-                     o.test.tested ? StringPrintf(", r = (%.2f, %.2f), MDB (%.3g, %.3g) px, group of %d",
-                                                  o.test.redundancy.x(),
-                                                  o.test.redundancy.y(),
-                                                  o.test.mdb_px.x(),
-                                                  o.test.mdb_px.y(),
-                                                  o.test.group_size).c_str()
-                                   : "");
+    out += StringPrintf(
+        "rejected%s: image %s%s point %s at (%.1f, %.1f), residual %.2f px (w = %.1f%s)\n",
+        o.by == "snooping" ? "" : (" by the " + o.by).c_str(),
+        o.image.c_str(),
+        ((o.subimage.empty() ? "" : " sub-image " + o.subimage) +
+         (o.head.empty() ? "" : " head " + o.head))
+            .c_str(),
+        o.point.c_str(),
+        o.measured_px.x(),
+        o.measured_px.y(),
+        o.residual_px.norm(),
+        o.w,
+        o.test.tested ? StringPrintf(", r = (%.2f, %.2f), MDB (%.3g, %.3g) px, group of %d",
+                                     o.test.redundancy.x(),
+                                     o.test.redundancy.y(),
+                                     o.test.mdb_px.x(),
+                                     o.test.mdb_px.y(),
+                                     o.test.group_size)
+                            .c_str()
+                      : "");
   return out;
 }
 
@@ -241,24 +244,35 @@ std::string SnoopingLines(const AdjustmentResult& r) {
     out += StringPrintf(
         "robust start (%s): %d observation(s) excluded, %d re-admitted after the clean solution, "
         "%d on points it could not hold left to snooping\n",
-        s.robust_start_reason.c_str(), s.robust_excluded, s.robust_readmitted, s.robust_retested);
+        s.robust_start_reason.c_str(),
+        s.robust_excluded,
+        s.robust_readmitted,
+        s.robust_retested);
   if (!s.run) return out;
   out += StringPrintf(
       "data snooping: %d components tested, critical |w| %.2f (alpha %.3g family-wise), power "
       "%.0f %% (delta0 %.2f), %d round(s), %zu rejected; %d observation(s) weakly controlled "
       "(r < %.2f), %d in correlated groups; cofactors: %s\n",
-      s.n_tested_components, s.critical_value, s.alpha, 100 * s.power, s.delta0, s.rounds,
-      r.rejected.size(), s.n_weakly_controlled, s.min_redundancy, s.n_in_groups,
+      s.n_tested_components,
+      s.critical_value,
+      s.alpha,
+      100 * s.power,
+      s.delta0,
+      s.rounds,
+      r.rejected.size(),
+      s.n_weakly_controlled,
+      s.min_redundancy,
+      s.n_in_groups,
       s.cofactor_method.c_str());
   for (const auto& f : s.findings) out += "snooping: " + f + "\n";
   if (!s.uncontrolled.empty()) {
-    const auto untestable = std::count_if(s.uncontrolled.begin(), s.uncontrolled.end(), [](const auto& u) {
-      return u.untestable;
-    });
-    out += StringPrintf("uncontrolled: %zu observation(s) no test can judge (%d with r = 0, a blunder there "
-                        "is invisible); all in the result's snooping.uncontrolled:\n",
-                        s.uncontrolled.size(),
-                        static_cast<int>(untestable));
+    const auto untestable = std::count_if(
+        s.uncontrolled.begin(), s.uncontrolled.end(), [](const auto& u) { return u.untestable; });
+    out += StringPrintf(
+        "uncontrolled: %zu observation(s) no test can judge (%d with r = 0, a blunder there "
+        "is invisible); all in the result's snooping.uncontrolled:\n",
+        s.uncontrolled.size(),
+        static_cast<int>(untestable));
     constexpr size_t kShown = 10;
     for (size_t i = 0; i < s.uncontrolled.size() && i < kShown; ++i) {
       const auto& u = s.uncontrolled[i];
@@ -276,9 +290,11 @@ std::string SnoopingLines(const AdjustmentResult& r) {
   if (s.model_error_suspected && !s.suggestion.empty())
     out += "warning: model error suspected: " + s.suggestion + "\n";
   if (s.cap_reached)
-    out += StringPrintf("warning: rejection cap (%d) reached: %d candidate(s) left above the "
-                        "critical value\n",
-                        s.max_rejections, s.remaining_above_critical);
+    out += StringPrintf(
+        "warning: rejection cap (%d) reached: %d candidate(s) left above the "
+        "critical value\n",
+        s.max_rejections,
+        s.remaining_above_critical);
   return out;
 }
 
@@ -299,7 +315,8 @@ std::optional<double> LeftOutControl::LargestW() const {
 
 std::string LeftOutControl::ComponentNames() const {
   std::string names;
-  for (const auto& component : components) names += (names.empty() ? "" : " and ") + component.first;
+  for (const auto& component : components)
+    names += (names.empty() ? "" : " and ") + component.first;
   return names;
 }
 
@@ -330,18 +347,21 @@ void ClassifyUncontrolled(double min_redundancy, AdjustmentResult* result) {
     u.rays = rays[v.point];
     u.untestable = r < kUntestable;
     if (u.untestable && u.rays == 2)
-      u.reason = StringPrintf("r = 0 on photo %s: the component along the base of a two-ray point; no "
-                              "test can see a blunder there",
-                              axis[k]);
+      u.reason = StringPrintf(
+          "r = 0 on photo %s: the component along the base of a two-ray point; no "
+          "test can see a blunder there",
+          axis[k]);
     else if (u.untestable)
-      u.reason = StringPrintf("r = 0 on photo %s: no other observation checks this component", axis[k]);
+      u.reason =
+          StringPrintf("r = 0 on photo %s: no other observation checks this component", axis[k]);
     else
-      u.reason = StringPrintf("r = %.3f on photo %s < %.2f: weakly controlled; a blunder below the "
-                              "MDB of %.3g px is not found",
-                              r,
-                              axis[k],
-                              min_redundancy,
-                              v.test.mdb_px(k));
+      u.reason = StringPrintf(
+          "r = %.3f on photo %s < %.2f: weakly controlled; a blunder below the "
+          "MDB of %.3g px is not found",
+          r,
+          axis[k],
+          min_redundancy,
+          v.test.mdb_px(k));
     point_reason.try_emplace(v.point, "ray " + v.image + ": " + u.reason);
     s.uncontrolled.push_back(u);
   }
@@ -384,16 +404,17 @@ std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, dou
   std::vector<ResultWarning> out;
   for (const auto& g : solve.groups) {
     if (g.n_observations == 0 || !(g.rms > limit)) continue;
-    out.push_back({kWarningGroupRms,
-                   g.name,
-                   g.rms,
-                   limit,
-                   StringPrintf("residual group %s: RMS %.3g sigma over %d observations (limit %.3g): the "
-                                "model does not fit these observations, or their sigmas are too small",
-                                g.name.c_str(),
-                                g.rms,
-                                g.n_observations,
-                                limit)});
+    out.push_back(
+        {kWarningGroupRms,
+         g.name,
+         g.rms,
+         limit,
+         StringPrintf("residual group %s: RMS %.3g sigma over %d observations (limit %.3g): the "
+                      "model does not fit these observations, or their sigmas are too small",
+                      g.name.c_str(),
+                      g.rms,
+                      g.n_observations,
+                      limit)});
   }
   return out;
 }
@@ -475,7 +496,8 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   for (const auto& left : r.control_left_out) {
     const PointDifference& p = left.difference;
     nlohmann::json components = nlohmann::json::object();
-    for (const auto& [component, w_component] : left.components) components[component] = w_component;
+    for (const auto& [component, w_component] : left.components)
+      components[component] = w_component;
     const std::optional<double> largest = left.LargestW();
     const nlohmann::json w = largest ? nlohmann::json(*largest) : nlohmann::json();
     j["control_left_out"].push_back({{"point", p.point},
@@ -566,7 +588,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
                         {"undetermined", r.determinability.undetermined},
                         {"warnings", r.determinability.warnings}};
   nlohmann::json correlation = {{"names", r.interior_correlation_names},
-                                 {"matrix", nlohmann::json::array()}};
+                                {"matrix", nlohmann::json::array()}};
   for (int i = 0; i < r.interior_correlation.rows(); ++i) {
     nlohmann::json row = nlohmann::json::array();
     for (int k = 0; k < r.interior_correlation.cols(); ++k)
@@ -602,22 +624,24 @@ std::string FormatSummary(const AdjustmentResult& r) {
   out += StatisticsLine("control", r.control);
   for (const auto& left : r.control_left_out) {
     const PointDifference& p = left.difference;
-    out += StringPrintf("control %s LEFT OUT (%s survey; suspected control blunder): survey - block "
-                        "without it X %.3f  Y %.3f  Z %.3f m, %d rays kept\n",
-                        p.point.c_str(),
-                        left.ComponentNames().c_str(),
-                        -p.difference_m.x(),
-                        -p.difference_m.y(),
-                        -p.difference_m.z(),
-                        p.rays);
+    out += StringPrintf(
+        "control %s LEFT OUT (%s survey; suspected control blunder): survey - block "
+        "without it X %.3f  Y %.3f  Z %.3f m, %d rays kept\n",
+        p.point.c_str(),
+        left.ComponentNames().c_str(),
+        -p.difference_m.x(),
+        -p.difference_m.y(),
+        -p.difference_m.z(),
+        p.rays);
   }
   out += StatisticsLine("check", r.check);
   if (r.check_controlled && r.check_controlled->n < r.check.n) {
     out += StatisticsLine("check*", *r.check_controlled);
-    out += StringPrintf("  check* = the %d check point(s) whose rays are all controlled; %d rest on rays no test "
-                        "can judge (a blunder there moves the point unseen):",
-                        r.check_controlled->n,
-                        r.check.n - r.check_controlled->n);
+    out += StringPrintf(
+        "  check* = the %d check point(s) whose rays are all controlled; %d rest on rays no test "
+        "can judge (a blunder there moves the point unseen):",
+        r.check_controlled->n,
+        r.check.n - r.check_controlled->n);
     int shown = 0;
     for (const auto& p : r.check_points)
       if (!p.uncontrolled.empty() && shown++ < 10)
@@ -697,8 +721,9 @@ nlohmann::json ComparisonToJson(const AdjustmentResult& a, const AdjustmentResul
 
 calib::Camera UpdatedCamera(const calib::Camera& camera, const CameraEstimate& estimate) {
   AEROCAL_CHECK(estimate.model == camera.model)
-      << "camera " << camera.name << ": estimate in model " << calib::CameraModelName(estimate.model)
-      << ", camera in " << calib::CameraModelName(camera.model);
+      << "camera " << camera.name << ": estimate in model "
+      << calib::CameraModelName(estimate.model) << ", camera in "
+      << calib::CameraModelName(camera.model);
   calib::Camera out = camera;
   out.interior = estimate.estimated;
   return out;

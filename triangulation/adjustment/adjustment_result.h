@@ -70,9 +70,9 @@ struct CameraEstimate {
 /// The GNSS/IMU platform after the adjustment (triangulation/README.md "GNSS/IMU priors on the
 /// platform"): values (the given ones when fixed) and sigmas of the estimated ones.
 struct PlatformEstimate {
-  PlatformSpec spec;   // modes and given values
-  bool gnss = false;   // lever arm and time offset took part (GNSS priors)
-  bool imu = false;    // boresight took part (IMU priors)
+  PlatformSpec spec;  // modes and given values
+  bool gnss = false;  // lever arm and time offset took part (GNSS priors)
+  bool imu = false;   // boresight took part (IMU priors)
   Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();
   Eigen::Vector3d boresight_rad = Eigen::Vector3d::Zero();
   double time_offset_s = 0.0;
@@ -134,18 +134,18 @@ struct UncontrolledObservation {
   std::string image, point;
   Eigen::Vector2d redundancy = Eigen::Vector2d::Zero();  // r per component (photo x, y)
   Eigen::Vector2d mdb_px = Eigen::Vector2d::Zero();      // +inf (JSON null) where r ~ 0
-  int rays = 0;             // active rays of its point
-  bool untestable = false;  // a component with r ~ 0
+  int rays = 0;                                          // active rays of its point
+  bool untestable = false;                               // a component with r ~ 0
   std::string reason;
 };
 
 /// A control survey (its plan or its height) that fails the surveys-first test but could not be
 /// left out (calib::SnoopingOutcome::unresolved).
 struct UnresolvedSurvey {
-  std::string survey;            // "control C1 height"
-  double w = 0;                  // its test over all its components
-  double redundancy = 0;         // of its least redundant component
-  double residual_sigma = 0;     // its largest residual, in a-priori sigmas
+  std::string survey;         // "control C1 height"
+  double w = 0;               // its test over all its components
+  double redundancy = 0;      // of its least redundant component
+  double residual_sigma = 0;  // its largest residual, in a-priori sigmas
 };
 
 /// The effect of the unresolved suspects on the results (issue 28 part 2: a calibration is invalid
@@ -241,7 +241,8 @@ inline constexpr const char* kWarningControlBlunder = "control_blunder";
 inline constexpr const char* kWarningControlBlunderUnresolved = "control_blunder_unresolved";
 
 /// One kWarningGroupRms warning per residual group of `solve` whose RMS exceeds `limit`.
-std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, double limit = kGroupRmsLimit);
+std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve,
+                                            double limit = kGroupRmsLimit);
 
 /// Wall time of the stages of one BlockAdjustment::Run, s (JSON `timing`; for benchmarks and
 /// profiling, not statistics).
@@ -259,9 +260,9 @@ struct FreeSetChoice {
   std::vector<std::string> candidates, chosen;
   struct Held {
     std::string parameter;
-    std::string reason;        // "not determinable" | "not significant"
-    double statistic = 0;      // |rho| with `with`, or t
-    std::string with;          // the parameter it is traded against (not determinable)
+    std::string reason;    // "not determinable" | "not significant"
+    double statistic = 0;  // |rho| with `with`, or t
+    std::string with;      // the parameter it is traded against (not determinable)
     int round = 0;
   };
   std::vector<Held> held;

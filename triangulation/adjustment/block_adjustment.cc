@@ -5,13 +5,13 @@
 #include "calib/core/log.h"
 #include "calib/core/median.h"
 #include "calib/core/string_printf.h"
+#include "calib/problem/suspect_effect.h"
 #include "calib/residuals/gnss_prior.h"
 #include "calib/residuals/prior.h"
 #include "calib/residuals/rotation_prior.h"
 #include "triangulation/adjustment/determinability.h"
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/adjustment/plausibility.h"
-#include "calib/problem/suspect_effect.h"
 #include "triangulation/sensor/frame_camera.h"
 
 #include <Eigen/Eigenvalues>
@@ -140,8 +140,9 @@ const SensorContext& BlockAdjustment::context() const { return storage_->context
 BlockAdjustment::~BlockAdjustment() = default;
 
 BlockId BlockAdjustment::InteriorBlock(const std::string& camera) const {
-  return project_.cameras.count(camera) ? storage_->frame.InteriorBlock(storage_->index.Camera(camera))
-                                        : -1;
+  return project_.cameras.count(camera)
+             ? storage_->frame.InteriorBlock(storage_->index.Camera(camera))
+             : -1;
 }
 BlockId BlockAdjustment::RotationBlock(const std::string& image) const {
   const ExposureIndex e = storage_->index.FindExposure(image);
@@ -197,9 +198,10 @@ void BlockAdjustment::BuildExposures() {
   s.exposures.resize(n);  // once: the builder keeps pointers into the states
   s.exposure_order.resize(n);
   for (ExposureIndex k = 0; k < n; ++k) s.exposure_order[k] = k;
-  std::sort(s.exposure_order.begin(), s.exposure_order.end(), [&](ExposureIndex a, ExposureIndex b) {
-    return project_.exposures[a].image < project_.exposures[b].image;
-  });
+  std::sort(
+      s.exposure_order.begin(), s.exposure_order.end(), [&](ExposureIndex a, ExposureIndex b) {
+        return project_.exposures[a].image < project_.exposures[b].image;
+      });
   s.exposure_rank.resize(n);
   for (int rank = 0; rank < n; ++rank) s.exposure_rank[s.exposure_order[rank]] = rank;
   for (const auto& e : project_.exposures) {
@@ -210,8 +212,8 @@ void BlockAdjustment::BuildExposures() {
     state.camera = &project_.cameras.at(e.camera);
     state.rotation = calib::QuaternionFromOpk(e.opk_rad);
     state.center = e.center_m;
-    state.opk_block =
-        builder_.AddRotationBlock("image " + e.image + " angles", state.rotation.data(), kAngleNames);
+    state.opk_block = builder_.AddRotationBlock(
+        "image " + e.image + " angles", state.rotation.data(), kAngleNames);
     state.center_block = builder_.AddBlock(
         "image " + e.image + " centre", state.center.data(), 3, BlockKind::kCenter, kCenterNames);
     storage_->poses[state.index] = {state.opk_block, state.center_block};
@@ -285,9 +287,10 @@ void BlockAdjustment::BuildPoints() {
     if (observed[k]) continue;
     const Exposure& e = *s.exposures[k].exposure;
     const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
-    const std::string where = project_.exposures_file.empty()
-                                  ? ""
-                                  : " (" + SourceRef{project_.exposures_file, e.line}.ToString() + ")";
+    const std::string where =
+        project_.exposures_file.empty()
+            ? ""
+            : " (" + SourceRef{project_.exposures_file, e.line}.ToString() + ")";
     s.notes.push_back("image " + e.image + where + " has no image observation: " +
                       (held ? "its orientation is its GNSS/IMU priors only"
                             : "not adjusted, no orientation written"));
@@ -405,16 +408,16 @@ void BlockAdjustment::AddPriors() {
     // leaves out only the failing one (a wrong height must not take a good plan survey along).
     const calib::ResidualId plan = builder_.AddResidual(
         calib::kGroupControl,
-        std::make_unique<calib::PriorCostFunction>(3, std::vector<int>{0, 1},
+        std::make_unique<calib::PriorCostFunction>(3,
+                                                   std::vector<int>{0, 1},
                                                    std::vector<double>{xyz.x(), xyz.y()},
                                                    std::vector<double>{s.x(), s.y()}),
         {state.block},
         "control " + storage_->point_ids[p] + " plan");
     const calib::ResidualId height = builder_.AddResidual(
         calib::kGroupControl,
-        std::make_unique<calib::PriorCostFunction>(3, std::vector<int>{2},
-                                                   std::vector<double>{xyz.z()},
-                                                   std::vector<double>{s.z()}),
+        std::make_unique<calib::PriorCostFunction>(
+            3, std::vector<int>{2}, std::vector<double>{xyz.z()}, std::vector<double>{s.z()}),
         {state.block},
         "control " + storage_->point_ids[p] + " height");
     storage_->control_of_residual[plan] = {p, kSurveyPlan};
@@ -428,13 +431,12 @@ void BlockAdjustment::AddPriors() {
       const Exposure& e = *state.exposure;
       const std::string& image = e.image;
       if (e.center_sigma_m)
-        builder_.AddResidual(calib::kGroupEoPrior,
-                             calib::GnssPriorResidual::Create(
-                                 e.center_m,
-                                 *e.center_sigma_m,
-                                 e.velocity_mps.value_or(Eigen::Vector3d::Zero())),
-                             {state.opk_block, state.center_block, s.lever_block, s.time_block},
-                             "GNSS " + image);
+        builder_.AddResidual(
+            calib::kGroupEoPrior,
+            calib::GnssPriorResidual::Create(
+                e.center_m, *e.center_sigma_m, e.velocity_mps.value_or(Eigen::Vector3d::Zero())),
+            {state.opk_block, state.center_block, s.lever_block, s.time_block},
+            "GNSS " + image);
       if (e.opk_sigma_rad)
         builder_.AddResidual(calib::kGroupEoPrior,
                              calib::OpkPriorResidual::Create(e.opk_rad, *e.opk_sigma_rad),
@@ -458,12 +460,11 @@ void BlockAdjustment::AddPriors() {
         sigmas.push_back(*camera.interior_sigma[i]);
       }
       if (!indices.empty())
-        builder_.AddResidual(
-            calib::kGroupInteriorPrior,
-            std::make_unique<calib::PriorCostFunction>(camera.interior.size(), indices, values,
-                                                       sigmas),
-            {storage_->frame.InteriorBlock(k)},
-            "interior prior " + id);
+        builder_.AddResidual(calib::kGroupInteriorPrior,
+                             std::make_unique<calib::PriorCostFunction>(
+                                 camera.interior.size(), indices, values, sigmas),
+                             {storage_->frame.InteriorBlock(k)},
+                             "interior prior " + id);
     }
   }
 }
@@ -477,46 +478,59 @@ void BlockAdjustment::AddPlatformBlocks() {
     imu |= e.opk_sigma_rad.has_value();
   }
   const std::string where = p.source.empty() ? "platform" : p.source + ": platform";
-  if (!gnss && (p.lever_arm != PlatformParamMode::kFixed || p.time_offset != PlatformParamMode::kFixed))
-    throw ConfigError(where + ": the lever arm and the GNSS time offset are estimated from GNSS "
+  if (!gnss &&
+      (p.lever_arm != PlatformParamMode::kFixed || p.time_offset != PlatformParamMode::kFixed))
+    throw ConfigError(where +
+                      ": the lever arm and the GNSS time offset are estimated from GNSS "
                       "priors, but exposures.csv has no sigma_X/Y/Z columns");
   if (!imu && p.boresight != PlatformParamMode::kFixed)
-    throw ConfigError(where + ": the boresight is estimated from IMU priors, but exposures.csv has "
+    throw ConfigError(where +
+                      ": the boresight is estimated from IMU priors, but exposures.csv has "
                       "no sigma_omega/phi/kappa columns");
   // How one platform block enters: held, free, or its value as a weighted observation.
-  auto enter = [&](BlockId block, PlatformParamMode mode, const std::vector<double>& values,
-                   double sigma, const std::string& label) {
+  auto enter = [&](BlockId block,
+                   PlatformParamMode mode,
+                   const std::vector<double>& values,
+                   double sigma,
+                   const std::string& label) {
     if (mode == PlatformParamMode::kFixed) builder_.FixBlock(block);
     if (mode == PlatformParamMode::kWeighted)
-      builder_.AddResidual(kGroupPlatformPrior,
-                           calib::PriorCostFunction::Create(
-                               values, std::vector<double>(values.size(), sigma)),
-                           {block},
-                           label);
+      builder_.AddResidual(
+          kGroupPlatformPrior,
+          calib::PriorCostFunction::Create(values, std::vector<double>(values.size(), sigma)),
+          {block},
+          label);
   };
   if (gnss) {
     const bool timed = p.time_offset != PlatformParamMode::kFixed || p.time_offset_s != 0.0;
     for (const auto& e : project_.exposures)
       if (timed && e.center_sigma_m && !e.velocity_mps)
         ThrowInputError({project_.exposures_file, e.line},
-                        "image " + e.image + ": the GNSS time offset needs the platform velocity "
-                        "(columns vX, vY, vZ, m/s)");
+                        "image " + e.image +
+                            ": the GNSS time offset needs the platform velocity "
+                            "(columns vX, vY, vZ, m/s)");
     s.lever_arm = p.lever_arm_m;
     s.time_offset = p.time_offset_s;
     s.lever_block = builder_.AddBlock(
         "platform lever_arm", s.lever_arm.data(), 3, BlockKind::kOther, {"x", "y", "z"});
     s.time_block =
         builder_.AddBlock("platform time_offset", &s.time_offset, 1, BlockKind::kOther, {"dt"});
-    enter(s.lever_block, p.lever_arm, {s.lever_arm.x(), s.lever_arm.y(), s.lever_arm.z()},
-          p.lever_arm_sigma_m, "lever arm prior");
+    enter(s.lever_block,
+          p.lever_arm,
+          {s.lever_arm.x(), s.lever_arm.y(), s.lever_arm.z()},
+          p.lever_arm_sigma_m,
+          "lever arm prior");
     enter(s.time_block, p.time_offset, {s.time_offset}, p.time_offset_sigma_s, "time offset prior");
   }
   if (imu) {
     s.boresight = p.boresight_rad;
     s.boresight_block = builder_.AddBlock(
         "platform boresight", s.boresight.data(), 3, BlockKind::kOther, kAngleNames);
-    enter(s.boresight_block, p.boresight, {s.boresight.x(), s.boresight.y(), s.boresight.z()},
-          p.boresight_sigma_rad, "boresight prior");
+    enter(s.boresight_block,
+          p.boresight,
+          {s.boresight.x(), s.boresight.y(), s.boresight.z()},
+          p.boresight_sigma_rad,
+          "boresight prior");
   }
 }
 
@@ -603,7 +617,8 @@ std::optional<Eigen::Vector3d> FitPoint(const calib::ProblemBuilder& builder,
     for (const auto& v : at) m += static_cast<int>(v.size());
     Eigen::VectorXd r(m);
     Eigen::MatrixXd j(m, 3);
-    for (int c = 0, row = 0; c < static_cast<int>(at.size()); row += static_cast<int>(at[c].size()), ++c)
+    for (int c = 0, row = 0; c < static_cast<int>(at.size());
+         row += static_cast<int>(at[c].size()), ++c)
       r.segment(row, at[c].size()) = at[c];
     for (int k = 0; k < 3; ++k) {
       Eigen::Vector3d plus = start, minus = start;
@@ -611,7 +626,8 @@ std::optional<Eigen::Vector3d> FitPoint(const calib::ProblemBuilder& builder,
       minus(k) -= kStepM;
       const auto vp = ResidualsWithPointAt(builder, rays, xyz, plus);
       const auto vm = ResidualsWithPointAt(builder, rays, xyz, minus);
-      for (int c = 0, row = 0; c < static_cast<int>(at.size()); row += static_cast<int>(at[c].size()), ++c)
+      for (int c = 0, row = 0; c < static_cast<int>(at.size());
+           row += static_cast<int>(at[c].size()), ++c)
         j.block(row, k, at[c].size(), 1) = (vp[c] - vm[c]) / (2 * kStepM);
     }
     const Eigen::Matrix3d n = j.transpose() * j;
@@ -651,7 +667,8 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
     for (size_t k = 0; k < r.size(); ++k)
       if (r[k] > 1e-6) w = std::max(w, std::abs(v[k]) / (scale * std::sqrt(r[k])));
     w_of[id] = w;
-    rays_of_point[storage_->point_of_observation[storage_->observation_of_residual.at(id)]].push_back(id);
+    rays_of_point[storage_->point_of_observation[storage_->observation_of_residual.at(id)]]
+        .push_back(id);
   }
   // A point of three or more rays with a ray beyond `reject` is judged on its own, the poses and
   // the camera held at the robust solution: the Cauchy solution can settle a point on its
@@ -776,7 +793,8 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
   // Without GNSS centres the surveys hold the datum: at least three plan and three height
   // surveys stay.
   bool gnss = false;
-  for (const auto& state : st.exposures) gnss |= options_.use_eo_priors && state.exposure->center_sigma_m.has_value();
+  for (const auto& state : st.exposures)
+    gnss |= options_.use_eo_priors && state.exposure->center_sigma_m.has_value();
   snooping.veto = [&](const std::vector<calib::ResidualId>& ids) -> std::string {
     std::map<std::string, std::pair<int, int>> kept_leaving;  // by component: active, leaving
     for (const auto& [id, survey] : st.control_of_residual) {
@@ -876,8 +894,8 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
           "self-calibration with --self-calibration auto (it frees only what this block "
           "determines and what is significant, and names what it holds) may absorb it: the "
           "block has " +
-          std::to_string(storage_->exposures.size()) + " exposures and " +
-          std::to_string(control) + " control point(s)";
+          std::to_string(storage_->exposures.size()) + " exposures and " + std::to_string(control) +
+          " control point(s)";
     else
       s.suggestion = "the block is too weak to self-calibrate: more control or GNSS is needed";
   }
@@ -1049,7 +1067,8 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     const ImageObservation& o = storage_->observations[index];
     image_sigmas.push_back(o.sigma_px);
     image_sigmas_um.push_back(
-        o.sigma_px * storage_->exposures[storage_->exposure_of_observation[index]].camera->pixel_size_mm *
+        o.sigma_px *
+        storage_->exposures[storage_->exposure_of_observation[index]].camera->pixel_size_mm *
         1000.0);
   }
   result.sigma0 = result.solve.sigma0;
@@ -1128,15 +1147,15 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     e.center_m = state.center;
     e.opk_rad = calib::OpkFromQuaternionNear(state.rotation, state.exposure->opk_rad);
     const Exposure& x = *state.exposure;
-    e.used = used_images[k] ||
-             (options_.use_eo_priors && x.center_sigma_m && x.opk_sigma_rad);
+    e.used = used_images[k] || (options_.use_eo_priors && x.center_sigma_m && x.opk_sigma_rad);
     if (cov.ok && e.used) {
       e.center_sigma_m = cov.BlockSigma(state.center_block, 3);
       e.opk_sigma_rad = cov.BlockSigma(state.opk_block, 3);
       if (std::isnan(e.opk_sigma_rad->x()))
-        result.notes.push_back("image " + image +
-                               ": phi is 90 deg (gimbal lock), omega and kappa are not separable "
-                               "(only their sum or difference is): their sigmas are unknown (null)");
+        result.notes.push_back(
+            "image " + image +
+            ": phi is 90 deg (gimbal lock), omega and kappa are not separable "
+            "(only their sum or difference is): their sigmas are unknown (null)");
     }
     result.exposures.push_back(e);
   }
@@ -1217,25 +1236,31 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
          d.point,
          w,
          result.snooping.critical_value,
-         StringPrintf("suspected control blunder: the survey of control point %s (its %s) disagrees "
-                      "with its %d rays (w = %.1f > %.2f; survey - block X %.3f Y %.3f Z %.3f m) "
-                      "and every other survey fits without it: it is left out of the adjustment, its "
-                      "rays are kept; check its survey",
-                      d.point.c_str(),
-                      parts.c_str(),
-                      d.rays,
-                      w,
-                      result.snooping.critical_value,
-                      -d.difference_m.x(),
-                      -d.difference_m.y(),
-                      -d.difference_m.z())});
+         StringPrintf(
+             "suspected control blunder: the survey of control point %s (its %s) disagrees "
+             "with its %d rays (w = %.1f > %.2f; survey - block X %.3f Y %.3f Z %.3f m) "
+             "and every other survey fits without it: it is left out of the adjustment, its "
+             "rays are kept; check its survey",
+             d.point.c_str(),
+             parts.c_str(),
+             d.rays,
+             w,
+             result.snooping.critical_value,
+             -d.difference_m.x(),
+             -d.difference_m.y(),
+             -d.difference_m.z())});
   }
   if (!result.snooping.unresolved_surveys.empty()) {
     // Judged by its effect (issue 28): invalid only when leaving the suspects out moves a
     // parameter by more than the limit in its sigmas.
     SuspectEffect& effect = result.snooping.unresolved_effect;
-    effect = calib::EffectOfLeavingOut(builder_, storage_->unresolved_ids, cov, cov_blocks, cross_blocks,
-                                options_.solver, options_.suspect_effect_limit);
+    effect = calib::EffectOfLeavingOut(builder_,
+                                       storage_->unresolved_ids,
+                                       cov,
+                                       cov_blocks,
+                                       cross_blocks,
+                                       options_.solver,
+                                       options_.suspect_effect_limit);
     std::string names;
     double w = 0.0;
     for (const auto& u : result.snooping.unresolved_surveys) {

@@ -20,9 +20,7 @@ std::vector<Exposure> NadirStartFromControl(const Project& project, const std::s
     const GroundPoint* p = project.FindPoint(o.point);
     if (!p || !p->xyz_m) continue;
     const Eigen::Vector2d xy = camera.PhotoFromPixel(o.pixel) - principal_point;
-    pairs[o.image].push_back({{xy.x(), xy.y()},
-                              {p->xyz_m->x(), p->xyz_m->y()},
-                              p->xyz_m->z()});
+    pairs[o.image].push_back({{xy.x(), xy.y()}, {p->xyz_m->x(), p->xyz_m->y()}, p->xyz_m->z()});
   }
   std::vector<Exposure> out;
   for (auto& [image, list] : pairs) {

@@ -1,8 +1,8 @@
 #include "triangulation/adjustment/plausibility.h"
 
-#include <cmath>
-
 #include "calib/core/string_printf.h"
+
+#include <cmath>
 
 namespace aerocal::triangulation {
 namespace {
@@ -12,17 +12,23 @@ void CheckPrincipalDistance(const std::string& subject,
                             const calib::Camera& camera,
                             std::vector<ResultWarning>* out) {
   const double c_mm = camera.c_mm();
-  const double diagonal_mm =
-      camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
+  const double diagonal_mm = camera.pixel_size_mm * std::hypot(camera.width_px, camera.height_px);
   if (!(diagonal_mm > 0) || !(c_mm > 0)) return;
   const double ratio = c_mm / diagonal_mm;
   if (ratio <= kMaxPrincipalDistanceRatio) return;
   const double fov_deg = 2.0 * std::atan(0.5 / ratio) * 180.0 / M_PI;
   out->push_back(
-      {kWarningImplausiblePrincipalDistance, subject, ratio, kMaxPrincipalDistanceRatio,
+      {kWarningImplausiblePrincipalDistance,
+       subject,
+       ratio,
+       kMaxPrincipalDistanceRatio,
        StringPrintf("c = %.6g mm is %.0f times the %.3g mm format diagonal (a field of view of "
                     "%.2g deg): if c was given in pixels, it is %.6g mm with %.6g mm pixels",
-                    c_mm, ratio, diagonal_mm, fov_deg, c_mm * camera.pixel_size_mm,
+                    c_mm,
+                    ratio,
+                    diagonal_mm,
+                    fov_deg,
+                    c_mm * camera.pixel_size_mm,
                     camera.pixel_size_mm)});
 }
 

@@ -2,7 +2,7 @@
 
 #include "calib/core/csv.h"
 #include "calib/core/log.h"
-#include "stitch/adjustment/f_test.h"
+#include "stitch/adjustment/f_distribution.h"
 #include "triangulation/adjustment/block_adjustment.h"
 
 #include <algorithm>

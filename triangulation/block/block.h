@@ -1,30 +1,31 @@
-// A block for aerial triangulation as FORMATS.md "Block" defines it: cameras, exposures (approximate
-// or GNSS/IMU-measured exterior orientation), image observations (virtual-image pixels, or raw
-// sub-image pixels of a multi-CCD camera) and ground points with roles control / check / tie.
-// Angles are radians in memory, degrees in files (CONVENTIONS.md "Exterior orientation").
+// A block for aerial triangulation as FORMATS.md "Block" defines it: cameras, exposures
+// (approximate or GNSS/IMU-measured exterior orientation), image observations (virtual-image
+// pixels, or raw sub-image pixels of a multi-CCD camera) and ground points with roles control /
+// check / tie. Angles are radians in memory, degrees in files (CONVENTIONS.md "Exterior
+// orientation").
 #pragma once
+
+#include "calib/camera/camera.h"
+#include "calib/camera/rig.h"
+
+#include <Eigen/Core>
 
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
-#include "calib/camera/camera.h"
-#include "calib/camera/rig.h"
-
 namespace aerocal::triangulation {
 
 struct Exposure {
   std::string image, camera;
-  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();   // X0, Y0, Z0 in the object frame
-  Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();    // omega, phi, kappa
-  std::optional<Eigen::Vector3d> center_sigma_m;        // GNSS prior when present
-  std::optional<Eigen::Vector3d> opk_sigma_rad;         // IMU prior when present
-  std::optional<Eigen::Vector3d> velocity_mps;          // platform velocity (rig blocks: vX,vY,vZ)
+  Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  // X0, Y0, Z0 in the object frame
+  Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();   // omega, phi, kappa
+  std::optional<Eigen::Vector3d> center_sigma_m;       // GNSS prior when present
+  std::optional<Eigen::Vector3d> opk_sigma_rad;        // IMU prior when present
+  std::optional<Eigen::Vector3d> velocity_mps;         // platform velocity (rig blocks: vX,vY,vZ)
   std::optional<double> z_ref_m;  // rig blocks: height Z of the rectification plane (z_ref)
-  int line = 0;                                         // source line in exposures.csv
+  int line = 0;                   // source line in exposures.csv
 };
 
 enum class PointRole { kControl, kCheck, kTie };
@@ -41,8 +42,8 @@ struct GroundPoint {
 
 struct ImageObservation {
   std::string image, point;
-  std::string subimage;          // empty: virtual-image pixel (col, row); else raw (u, v)
-  std::string head;              // rig head id (observations.csv `head` column); empty: no rig
+  std::string subimage;  // empty: virtual-image pixel (col, row); else raw (u, v)
+  std::string head;      // rig head id (observations.csv `head` column); empty: no rig
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();
   double sigma_px = 0.5;
   int line = 0;
@@ -81,15 +82,15 @@ std::string PlatformParamModeName(PlatformParamMode mode);
 /// platform"): the GNSS antenna records X0 + R a + v dt, the IMU records the attitude R M^T.
 /// From the project YAML's `platform:` (FORMATS.md keys below) or `aerocal adjust` options.
 struct PlatformSpec {
-  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();   // a: centre -> antenna, camera frame
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();  // a: centre -> antenna, camera frame
   PlatformParamMode lever_arm = PlatformParamMode::kFixed;
   double lever_arm_sigma_m = 0.0;                           // > 0 when weighted, per axis
   Eigen::Vector3d boresight_rad = Eigen::Vector3d::Zero();  // M (imu_from_image) omega, phi, kappa
   PlatformParamMode boresight = PlatformParamMode::kFixed;
-  double boresight_sigma_rad = 0.0;                         // > 0 when weighted, per angle
-  double time_offset_s = 0.0;                               // dt: GNSS time - exposure time
+  double boresight_sigma_rad = 0.0;  // > 0 when weighted, per angle
+  double time_offset_s = 0.0;        // dt: GNSS time - exposure time
   PlatformParamMode time_offset = PlatformParamMode::kFixed;
-  double time_offset_sigma_s = 0.0;                         // > 0 when weighted
+  double time_offset_sigma_s = 0.0;  // > 0 when weighted
   std::string source;  // "project.yaml:LINE" of `platform:` (or the options), named in errors
 };
 

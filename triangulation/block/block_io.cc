@@ -1,12 +1,5 @@
 #include "triangulation/block/block_io.h"
 
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <map>
-#include <set>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/camera/rig_io.h"
@@ -17,6 +10,13 @@
 #include "calib/core/yaml_util.h"
 #include "triangulation/block/value_bounds.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <map>
+#include <set>
+
 namespace aerocal::triangulation {
 namespace {
 
@@ -25,12 +25,15 @@ constexpr double kDegToRad = M_PI / 180.0;
 using namespace bounds;  // block/value_bounds.h
 
 // An optional positive sigma column: empty is "not given", otherwise within (0, hi].
-std::optional<double> Sigma(const CsvTable& t, const CsvTable::Row& row, const std::string& column,
+std::optional<double> Sigma(const CsvTable& t,
+                            const CsvTable::Row& row,
+                            const std::string& column,
                             double hi) {
   const auto value = t.OptionalNumber(row, column);
   if (value && !(*value > 0 && *value <= hi))
-    ThrowInputError(t.Where(row), column + " must be > 0 and <= " + FormatNumber(hi) + " (got " +
-                                      FormatNumber(*value) + ")");
+    ThrowInputError(
+        t.Where(row),
+        column + " must be > 0 and <= " + FormatNumber(hi) + " (got " + FormatNumber(*value) + ")");
   return value;
 }
 
@@ -54,8 +57,24 @@ std::string ResolvePath(const std::string& base_dir, const std::string& file) {
 std::vector<Exposure> ReadExposures(const std::string& path) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"image", "X", "Y", "Z", "omega", "phi", "kappa"});
-  t.RejectUnknownColumns({"image", "camera", "X", "Y", "Z", "omega", "phi", "kappa", "sX", "sY", "sZ",
-                         "somega", "sphi", "skappa", "vX", "vY", "vZ", "z_ref"});
+  t.RejectUnknownColumns({"image",
+                          "camera",
+                          "X",
+                          "Y",
+                          "Z",
+                          "omega",
+                          "phi",
+                          "kappa",
+                          "sX",
+                          "sY",
+                          "sZ",
+                          "somega",
+                          "sphi",
+                          "skappa",
+                          "vX",
+                          "vY",
+                          "vZ",
+                          "z_ref"});
   std::vector<Exposure> out;
   std::set<std::string> seen;
   for (const auto& row : t.rows()) {
@@ -63,7 +82,8 @@ std::vector<Exposure> ReadExposures(const std::string& path) {
     e.line = row.line;
     e.image = t.String(row, "image");
     if (e.image.empty()) ThrowInputError(t.Where(row), "image id must not be empty");
-    if (!seen.insert(e.image).second) ThrowInputError(t.Where(row), "duplicate image '" + e.image + "'");
+    if (!seen.insert(e.image).second)
+      ThrowInputError(t.Where(row), "duplicate image '" + e.image + "'");
     e.camera = t.String(row, "camera");
     e.center_m = {t.Bounded(row, "X", -kMaxCoordinateM, kMaxCoordinateM),
                   t.Bounded(row, "Y", -kMaxCoordinateM, kMaxCoordinateM),
@@ -74,17 +94,19 @@ std::vector<Exposure> ReadExposures(const std::string& path) {
     const auto sx = Sigma(t, row, "sX", kMaxSigmaM), sy = Sigma(t, row, "sY", kMaxSigmaM),
                sz = Sigma(t, row, "sZ", kMaxSigmaM);
     if (sx || sy || sz) {
-      if (!(sx && sy && sz)) ThrowInputError(t.Where(row), "sX, sY, sZ must all be given or none (m)");
+      if (!(sx && sy && sz))
+        ThrowInputError(t.Where(row), "sX, sY, sZ must all be given or none (m)");
       e.center_sigma_m = Eigen::Vector3d(*sx, *sy, *sz);
     }
     const auto vx = t.OptionalNumber(row, "vX"), vy = t.OptionalNumber(row, "vY"),
                vz = t.OptionalNumber(row, "vZ");
     if (vx || vy || vz) {
-      if (!(vx && vy && vz)) ThrowInputError(t.Where(row), "vX, vY, vZ must all be given or none (m/s)");
+      if (!(vx && vy && vz))
+        ThrowInputError(t.Where(row), "vX, vY, vZ must all be given or none (m/s)");
       e.velocity_mps = Eigen::Vector3d(*vx, *vy, *vz);
       if (!(e.velocity_mps->cwiseAbs().maxCoeff() <= kMaxVelocityMps))
-        ThrowInputError(t.Where(row), "vX, vY, vZ must be within +-" + FormatNumber(kMaxVelocityMps) +
-                                          " m/s");
+        ThrowInputError(t.Where(row),
+                        "vX, vY, vZ must be within +-" + FormatNumber(kMaxVelocityMps) + " m/s");
     }
     if (const auto z_ref = t.OptionalBounded(row, "z_ref", -kMaxCoordinateM, kMaxCoordinateM))
       e.z_ref_m = *z_ref;
@@ -130,15 +152,17 @@ std::vector<ImageObservation> ReadObservations(const std::string& path, double d
     if (sub) {
       o.subimage = t.String(row, "subimage");
       if (o.subimage.empty()) ThrowInputError(t.Where(row), "subimage must not be empty");
-      o.pixel = {t.Bounded(row, "u", -kMaxPixel, kMaxPixel), t.Bounded(row, "v", -kMaxPixel, kMaxPixel)};
+      o.pixel = {t.Bounded(row, "u", -kMaxPixel, kMaxPixel),
+                 t.Bounded(row, "v", -kMaxPixel, kMaxPixel)};
     } else {
       o.pixel = {t.Bounded(row, "col", -kMaxPixel, kMaxPixel),
                  t.Bounded(row, "row", -kMaxPixel, kMaxPixel)};
     }
     o.sigma_px = Sigma(t, row, "sigma_px", kMaxSigmaPx).value_or(default_sigma_px);
     if (!(o.sigma_px > 0 && o.sigma_px <= kMaxSigmaPx))
-      ThrowInputError(t.Where(row), "sigma_px must be > 0 and <= " + FormatNumber(kMaxSigmaPx) +
-                                        " (got " + FormatNumber(o.sigma_px) + ")");
+      ThrowInputError(t.Where(row),
+                      "sigma_px must be > 0 and <= " + FormatNumber(kMaxSigmaPx) + " (got " +
+                          FormatNumber(o.sigma_px) + ")");
     out.push_back(o);
   }
   return out;
@@ -168,8 +192,10 @@ std::vector<GroundPoint> ReadPoints(const std::string& path) {
     const auto x = t.OptionalBounded(row, "X", -kMaxCoordinateM, kMaxCoordinateM),
                y = t.OptionalBounded(row, "Y", -kMaxCoordinateM, kMaxCoordinateM),
                z = t.OptionalBounded(row, "Z", -kMaxCoordinateM, kMaxCoordinateM);
-    if (x && y && z) p.xyz_m = Eigen::Vector3d(*x, *y, *z);
-    else if (x || y || z) ThrowInputError(t.Where(row), "give all of X, Y, Z or none");
+    if (x && y && z)
+      p.xyz_m = Eigen::Vector3d(*x, *y, *z);
+    else if (x || y || z)
+      ThrowInputError(t.Where(row), "give all of X, Y, Z or none");
     // A check point without coordinates is a check tie (rig stitch: measured, never adjusted).
     if (p.role == PointRole::kControl && !p.xyz_m)
       ThrowInputError(t.Where(row), PointRoleName(p.role) + " point '" + p.id + "' needs X, Y, Z");
@@ -179,8 +205,9 @@ std::vector<GroundPoint> ReadPoints(const std::string& path) {
                sz = Sigma(t, row, "sZ", kMaxSigmaM);
     if (p.role != PointRole::kTie && p.xyz_m) {
       if (!(sx && sy && sz))
-        ThrowInputError(t.Where(row), PointRoleName(p.role) + " point '" + p.id +
-                                          "' needs sX, sY, sZ > 0 (m): a survey sigma is required");
+        ThrowInputError(t.Where(row),
+                        PointRoleName(p.role) + " point '" + p.id +
+                            "' needs sX, sY, sZ > 0 (m): a survey sigma is required");
       p.sigma_m = Eigen::Vector3d(*sx, *sy, *sz);
     }
     out.push_back(p);
@@ -201,16 +228,23 @@ void CheckOnFormat(const Project& project,
                    const std::string& what) {
   constexpr double kTolerancePx = 1.5;
   if (width_px <= 0 || height_px <= 0) return;  // a format the camera file does not give
-  const double outside = std::max({-o.pixel.x(), o.pixel.x() - (width_px - 1),
-                                   -o.pixel.y(), o.pixel.y() - (height_px - 1)});
+  const double outside = std::max(
+      {-o.pixel.x(), o.pixel.x() - (width_px - 1), -o.pixel.y(), o.pixel.y() - (height_px - 1)});
   if (outside <= kTolerancePx) return;
   ThrowInputError({project.observations_file, o.line},
                   StringPrintf("image %s point %s at pixel (%.2f, %.2f) lies %.1f px outside "
                                "the %d x %d px format of %s of camera '%s': measured on a "
                                "resized copy of the images? (`import odm --pixel-scale` scales "
                                "such a list)",
-                               o.image.c_str(), o.point.c_str(), o.pixel.x(), o.pixel.y(),
-                               outside, width_px, height_px, what.c_str(), camera_id.c_str()));
+                               o.image.c_str(),
+                               o.point.c_str(),
+                               o.pixel.x(),
+                               o.pixel.y(),
+                               outside,
+                               width_px,
+                               height_px,
+                               what.c_str(),
+                               camera_id.c_str()));
 }
 
 }  // namespace
@@ -273,17 +307,20 @@ std::vector<std::pair<std::string, std::string>> ProjectFiles(const Project& pro
 Project ReadProject(const std::string& path_in, double default_sigma_px) {
   std::string path = path_in;
   std::error_code ec;  // the error_code form: a symbolic-link loop is then reported by the reader
-  if (std::filesystem::is_directory(path, ec)) path = (std::filesystem::path(path) / "project.yaml").string();
+  if (std::filesystem::is_directory(path, ec))
+    path = (std::filesystem::path(path) / "project.yaml").string();
   const YAML::Node root = LoadYamlFile(path);
   RejectUnknownKeys(
-      root, {"cameras", "exposures", "observations", "points", "stitching", "frame", "name", "platform"},
+      root,
+      {"cameras", "exposures", "observations", "points", "stitching", "frame", "name", "platform"},
       path);
   const std::string dir = std::filesystem::path(path).parent_path().string();
   Project project;
   project.path = path;
   for (const char* key : {"cameras", "exposures", "observations", "points"})
     if (!root[key]) ThrowInputError({path, 0}, std::string("missing '") + key + "'");
-  if (!root["cameras"].IsMap()) ThrowInputError(WhereIs(root["cameras"], path), "cameras must be a map id: file");
+  if (!root["cameras"].IsMap())
+    ThrowInputError(WhereIs(root["cameras"], path), "cameras must be a map id: file");
   if (root["cameras"].size() == 0) ThrowInputError(WhereIs(root["cameras"], path), "no cameras");
   for (const auto& entry : root["cameras"]) {
     const std::string id = entry.first.Scalar();
@@ -304,7 +341,8 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
     }
   }
   project.exposures_file = ResolvePath(dir, YamlString(root["exposures"], path, "exposures"));
-  project.observations_file = ResolvePath(dir, YamlString(root["observations"], path, "observations"));
+  project.observations_file =
+      ResolvePath(dir, YamlString(root["observations"], path, "observations"));
   project.points_file = ResolvePath(dir, YamlString(root["points"], path, "points"));
   if (root["stitching"])
     project.stitching_file = ResolvePath(dir, YamlString(root["stitching"], path, "stitching"));
@@ -334,7 +372,8 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
       if (f["origin"]) {
         const YAML::Node& origin = f["origin"];
         if (!origin.IsMap() || !origin["lat"] || !origin["lon"])
-          ThrowInputError(WhereIs(origin, path), "frame: origin needs {lat: DEG, lon: DEG[, h: M]}");
+          ThrowInputError(WhereIs(origin, path),
+                          "frame: origin needs {lat: DEG, lon: DEG[, h: M]}");
         RejectUnknownKeys(origin, {"lat", "lon", "h"}, path);
         s.lat_deg = YamlBounded(origin["lat"], path, "frame: origin lat", -90, 90);
         s.lon_deg = YamlBounded(origin["lon"], path, "frame: origin lon", -180, 360);
@@ -344,8 +383,9 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
       s.description = "crs " + s.crs;
     } else {
       if (!f.IsMap() || f.size() != 1)
-        ThrowInputError(where, "frame must be one of {crs: CRS, ...}, {local: {lat, lon, h}}, "
-                               "{utm: ZONE}, {projected: TEXT}, {geodetic: ...}");
+        ThrowInputError(where,
+                        "frame must be one of {crs: CRS, ...}, {local: {lat, lon, h}}, "
+                        "{utm: ZONE}, {projected: TEXT}, {geodetic: ...}");
       RejectUnknownKeys(f, {"local", "utm", "projected", "geodetic"}, path);
     }
     if (f["local"]) {
@@ -355,11 +395,13 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
       RejectUnknownKeys(local, {"lat", "lon", "h"}, path);
       for (const char* key : {"lat", "lon"})
         if (!local[key])
-          ThrowInputError(WhereIs(local, path), std::string("frame: local needs '") + key + "' (deg)");
+          ThrowInputError(WhereIs(local, path),
+                          std::string("frame: local needs '") + key + "' (deg)");
       project.frame.kind = FrameSpec::Kind::kLocal;
       project.frame.lat_deg = YamlBounded(local["lat"], path, "frame: local lat", -90, 90);
       project.frame.lon_deg = YamlBounded(local["lon"], path, "frame: local lon", -180, 360);
-      project.frame.h_m = local["h"] ? YamlBounded(local["h"], path, "frame: local h", -1e5, 1e5) : 0.0;
+      project.frame.h_m =
+          local["h"] ? YamlBounded(local["h"], path, "frame: local h", -1e5, 1e5) : 0.0;
       project.frame.description = "local tangent plane";
     } else if (f["utm"]) {
       project.frame.kind = FrameSpec::Kind::kUtm;
@@ -385,12 +427,14 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
         }
       if (n == 0) ThrowInputError(where, "frame: geodetic needs surveyed points or exposures");
       const Eigen::Vector3d origin = sum / n;  // X = longitude, Y = latitude (deg), Z = height (m)
-      if (!(std::abs(origin.y()) <= 90 && std::abs(origin.x()) <= 540 && std::abs(origin.z()) <= 1e5))
-        ThrowInputError(where, "frame: geodetic, but the block's mean X, Y, Z (" +
-                                   FormatNumber(origin.x()) + ", " + FormatNumber(origin.y()) + ", " +
-                                   FormatNumber(origin.z()) +
-                                   ") is no longitude/latitude/height: metre coordinates need "
-                                   "frame: {projected: ...}");
+      if (!(std::abs(origin.y()) <= 90 && std::abs(origin.x()) <= 540 &&
+            std::abs(origin.z()) <= 1e5))
+        ThrowInputError(where,
+                        "frame: geodetic, but the block's mean X, Y, Z (" +
+                            FormatNumber(origin.x()) + ", " + FormatNumber(origin.y()) + ", " +
+                            FormatNumber(origin.z()) +
+                            ") is no longitude/latitude/height: metre coordinates need "
+                            "frame: {projected: ...}");
       project.frame.lon_deg = origin.x();
       project.frame.lat_deg = origin.y();
       project.frame.h_m = origin.z();
@@ -400,12 +444,18 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
   if (root["platform"]) project.platform = ReadPlatform(root["platform"], path);
   ValidateProject(project);
   // What was read (--verbose): a wrong file named in the project shows here first.
-  LogInfo(StringPrintf("read %s: %zu camera(s), %zu exposures (%s), %zu points (%s), "
-                       "%zu image observations (%s), frame: %s",
-                       path.c_str(), project.cameras.size(), project.exposures.size(),
-                       project.exposures_file.c_str(), project.points.size(),
-                       project.points_file.c_str(), project.observations.size(),
-                       project.observations_file.c_str(), project.frame.description.c_str()));
+  LogInfo(
+      StringPrintf("read %s: %zu camera(s), %zu exposures (%s), %zu points (%s), "
+                   "%zu image observations (%s), frame: %s",
+                   path.c_str(),
+                   project.cameras.size(),
+                   project.exposures.size(),
+                   project.exposures_file.c_str(),
+                   project.points.size(),
+                   project.points_file.c_str(),
+                   project.observations.size(),
+                   project.observations_file.c_str(),
+                   project.frame.description.c_str()));
   return project;
 }
 
@@ -414,8 +464,15 @@ PlatformSpec ReadPlatform(const YAML::Node& node, const std::string& path) {
   if (!node.IsMap())
     ThrowInputError(where, "platform must be a map (lever_arm_m, lever_arm, boresight_deg, ...)");
   RejectUnknownKeys(node,
-                    {"lever_arm_m", "lever_arm", "lever_arm_sigma_m", "boresight_deg", "boresight",
-                     "boresight_sigma_deg", "time_offset_ms", "time_offset", "time_offset_sigma_ms"},
+                    {"lever_arm_m",
+                     "lever_arm",
+                     "lever_arm_sigma_m",
+                     "boresight_deg",
+                     "boresight",
+                     "boresight_sigma_deg",
+                     "time_offset_ms",
+                     "time_offset",
+                     "time_offset_sigma_ms"},
                     path);
   PlatformSpec p;
   p.source = where.ToString();
@@ -443,16 +500,17 @@ PlatformSpec ReadPlatform(const YAML::Node& node, const std::string& path) {
     if (!node[key]) return;
     const double value = YamlBounded(node[key], path, std::string("platform: ") + key, 0.0, bound);
     if (!(value > 0))
-      ThrowInputError(WhereIs(node[key], path), std::string("platform: ") + key +
-                                                    " must be > 0 (got 0; leave it out when unknown)");
+      ThrowInputError(
+          WhereIs(node[key], path),
+          std::string("platform: ") + key + " must be > 0 (got 0; leave it out when unknown)");
     *out = scale * value;
   };
   constexpr double kDegToRad = M_PI / 180.0;
   if (node["lever_arm_m"]) p.lever_arm_m = vector3("lever_arm_m", 1000.0);
   if (node["boresight_deg"]) p.boresight_rad = vector3("boresight_deg", 180.0) * kDegToRad;
   if (node["time_offset_ms"])
-    p.time_offset_s = 1e-3 * YamlBounded(node["time_offset_ms"], path, "platform: time_offset_ms",
-                                         -1e4, 1e4);
+    p.time_offset_s =
+        1e-3 * YamlBounded(node["time_offset_ms"], path, "platform: time_offset_ms", -1e4, 1e4);
   mode("lever_arm", &p.lever_arm);
   mode("boresight", &p.boresight);
   mode("time_offset", &p.time_offset);
@@ -548,7 +606,8 @@ void WritePoints(const std::string& path, const std::vector<GroundPoint>& points
     for (const auto& p : points) {
       out << p.id << ",";
       if (p.xyz_m)
-        out << Coordinate(p.xyz_m->x()) << "," << Coordinate(p.xyz_m->y()) << "," << Coordinate(p.xyz_m->z());
+        out << Coordinate(p.xyz_m->x()) << "," << Coordinate(p.xyz_m->y()) << ","
+            << Coordinate(p.xyz_m->z());
       else
         out << ",,";
       if (p.role == PointRole::kTie || !p.xyz_m)

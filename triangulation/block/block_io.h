@@ -4,13 +4,13 @@
 // point, an exposure of an unknown camera) is checked by ValidateProject with the line cited.
 #pragma once
 
-#include <string>
-#include <utility>
-#include <vector>
-
 #include "triangulation/block/block.h"
 
 #include <yaml-cpp/yaml.h>
+
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace aerocal::triangulation {
 

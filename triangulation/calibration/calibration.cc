@@ -2,7 +2,7 @@
 
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
-#include "stitch/adjustment/f_test.h"
+#include "stitch/adjustment/f_distribution.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/calibration/group_change_power.h"
 
@@ -45,7 +45,8 @@ double ChiSquareQuantile(double p, int dof) {
   return dof * stitch::FDistributionQuantile(p, dof, 1e7);
 }
 
-CalibrationAdjustment RunCalibrationAdjustment(const Project& project, const AdjustOptions& options) {
+CalibrationAdjustment RunCalibrationAdjustment(const Project& project,
+                                               const AdjustOptions& options) {
   CalibrationAdjustment out;
   BlockAdjustment adjustment(project, options);
   out.result = adjustment.Run();
@@ -79,8 +80,9 @@ StabilityReport GroupStability(const std::vector<GroupCalibration>& groups, doub
     if (all) free.push_back(k);
   }
   const double critical =
-      free.empty() ? 0.0
-                   : ChiSquareQuantile(1.0 - alpha / static_cast<double>(free.size()), n_groups - 1);
+      free.empty()
+          ? 0.0
+          : ChiSquareQuantile(1.0 - alpha / static_cast<double>(free.size()), n_groups - 1);
   for (int k : free) {
     StabilityRow row;
     row.parameter = std::string(table[k].name);
@@ -122,7 +124,11 @@ StabilityReport GroupStability(const std::vector<GroupCalibration>& groups, doub
       report.flagged.push_back(
           sigmas_known ? StringPrintf("%s: the groups disagree beyond their sigmas (chi2 = %.3g > "
                                       "%.3g, %d degrees of freedom, alpha %.3g / %zu)",
-                                      row.parameter.c_str(), row.chi2, critical, row.dof, alpha,
+                                      row.parameter.c_str(),
+                                      row.chi2,
+                                      critical,
+                                      row.dof,
+                                      alpha,
                                       free.size())
                        : row.parameter + ": a group's sigma is unknown, agreement not testable");
     }
@@ -144,8 +150,9 @@ CalibrationRun Calibrate(const Project& input,
   if (options.closed_form_c) {
     run.closed_form_c_mm = ClosedFormPrincipalDistance(project, run.camera);
     const double c_file = camera.c_mm();
-    if (run.closed_form_c_mm && *run.closed_form_c_mm < kClosedFormFactor * c_file &&
-        *run.closed_form_c_mm > c_file / kClosedFormFactor)
+    if (run.closed_form_c_mm &&
+        *run.closed_form_c_mm<kClosedFormFactor * c_file&& * run.closed_form_c_mm> c_file /
+            kClosedFormFactor)
       camera.SetPrincipalDistanceMm(*run.closed_form_c_mm);
   }
   run.start_c_mm = camera.c_mm();
@@ -153,9 +160,10 @@ CalibrationRun Calibrate(const Project& input,
   project.exposures.clear();
   for (const auto& s : run.starts) project.exposures.push_back(s.exposure);
   run.all = RunCalibrationAdjustment(project, options.adjust);
-  const bool has_control = std::any_of(project.points.begin(), project.points.end(), [](const auto& p) {
-    return p.role == PointRole::kControl && p.xyz_m;
-  });
+  const bool has_control =
+      std::any_of(project.points.begin(), project.points.end(), [](const auto& p) {
+        return p.role == PointRole::kControl && p.xyz_m;
+      });
   if (options.control_propagation && has_control) {
     Project fixed = project;
     for (auto& p : fixed.points) p.sigma_m *= kFixedControlScale;
@@ -169,8 +177,7 @@ CalibrationRun Calibrate(const Project& input,
     groups[group].insert(image);
   }
   for (const auto& [name, images] : groups) {
-    if (images.size() < 2)
-      throw InputError("groups: group " + name + " has fewer than two images");
+    if (images.size() < 2) throw InputError("groups: group " + name + " has fewer than two images");
     GroupCalibration g;
     g.group = name;
     g.images.assign(images.begin(), images.end());

@@ -75,8 +75,8 @@ struct CalibrationRun {
   std::optional<double> closed_form_c_mm;  // Zhang's value, when determined
   double start_c_mm = 0;                   // the c the resections used
   std::vector<ResectionStart> starts;
-  CalibrationAdjustment all;               // all images together: the certified result
-  std::vector<GroupCalibration> groups;    // empty without groups
+  CalibrationAdjustment all;             // all images together: the certified result
+  std::vector<GroupCalibration> groups;  // empty without groups
   StabilityReport stability;
   /// The run on all images with the control (nearly) fixed; absent without control points or
   /// without CalibrateOptions::control_propagation.
@@ -94,7 +94,8 @@ CalibrationRun Calibrate(const Project& project,
                          const std::map<std::string, std::string>& group_of_image);
 
 /// The adjustment of `project` as is (exposures given) with its interior covariance.
-CalibrationAdjustment RunCalibrationAdjustment(const Project& project, const AdjustOptions& options);
+CalibrationAdjustment RunCalibrationAdjustment(const Project& project,
+                                               const AdjustOptions& options);
 
 /// The stability table of the groups' estimates (see the header comment).
 StabilityReport GroupStability(const std::vector<GroupCalibration>& groups, double alpha);

@@ -11,7 +11,8 @@ namespace {
 // The model's parameter names (its table) of a camera estimate.
 std::vector<std::string> ParamNames(const CameraEstimate& c) {
   std::vector<std::string> names;
-  for (const calib::ParamInfo& info : calib::CameraModelParams(c.model)) names.emplace_back(info.name);
+  for (const calib::ParamInfo& info : calib::CameraModelParams(c.model))
+    names.emplace_back(info.name);
   return names;
 }
 
@@ -77,20 +78,20 @@ nlohmann::json CalibrationRunToJson(const AdjustmentResult& r) {
 nlohmann::json StabilityToJson(const StabilityReport& s) {
   nlohmann::json rows = nlohmann::json::array();
   for (const auto& r : s.rows)
-    rows.push_back({{"parameter", r.parameter},
-                    {"unit", r.unit},
-                    {"values", r.values},
-                    {"sigmas", r.sigmas},
-                    {"detectable_change", r.detectable_change.empty()
-                                              ? nlohmann::json()
-                                              : nlohmann::json(r.detectable_change)},
-                    {"mean", r.mean},
-                    {"spread", r.spread},
-                    {"weighted_mean", r.weighted_mean},
-                    {"chi2", std::isfinite(r.chi2) ? nlohmann::json(r.chi2) : nlohmann::json()},
-                    {"critical", r.critical},
-                    {"dof", r.dof},
-                    {"agree", r.agree}});
+    rows.push_back(
+        {{"parameter", r.parameter},
+         {"unit", r.unit},
+         {"values", r.values},
+         {"sigmas", r.sigmas},
+         {"detectable_change",
+          r.detectable_change.empty() ? nlohmann::json() : nlohmann::json(r.detectable_change)},
+         {"mean", r.mean},
+         {"spread", r.spread},
+         {"weighted_mean", r.weighted_mean},
+         {"chi2", std::isfinite(r.chi2) ? nlohmann::json(r.chi2) : nlohmann::json()},
+         {"critical", r.critical},
+         {"dof", r.dof},
+         {"agree", r.agree}});
   return {{"alpha", s.alpha},
           {"power", s.power},
           {"agree", s.agree},
@@ -98,9 +99,10 @@ nlohmann::json StabilityToJson(const StabilityReport& s) {
           {"flagged", s.flagged}};
 }
 
-
-nlohmann::json CalibrationToJson(const CalibrationRun& run, const std::vector<BudgetQuantity>& budget,
-                                 const std::vector<double>& radii_mm, double c_camera_file_mm) {
+nlohmann::json CalibrationToJson(const CalibrationRun& run,
+                                 const std::vector<BudgetQuantity>& budget,
+                                 const std::vector<double>& radii_mm,
+                                 double c_camera_file_mm) {
   nlohmann::json cal;
   nlohmann::json starts = nlohmann::json::array();
   for (const auto& s : run.starts)
@@ -109,8 +111,8 @@ nlohmann::json CalibrationToJson(const CalibrationRun& run, const std::vector<Bu
                       {"n_points", s.n_points},
                       {"rms_px", s.rms_px}});
   cal["start"] = {{"c_camera_file_mm", c_camera_file_mm},
-                  {"c_closed_form_mm", run.closed_form_c_mm ? nlohmann::json(*run.closed_form_c_mm)
-                                                            : nlohmann::json()},
+                  {"c_closed_form_mm",
+                   run.closed_form_c_mm ? nlohmann::json(*run.closed_form_c_mm) : nlohmann::json()},
                   {"c_start_mm", run.start_c_mm},
                   {"resections", starts}};
   int n_control = 0, n_check = 0;
@@ -125,7 +127,8 @@ nlohmann::json CalibrationToJson(const CalibrationRun& run, const std::vector<Bu
                  {"groups", run.groups.size()}};
   const AdjustmentResult& r = run.all.result;
   if (!r.cameras.empty())
-    cal["interior_covariance"] = InteriorCovarianceToJson(run.all.interior_covariance, r.cameras[0]);
+    cal["interior_covariance"] =
+        InteriorCovarianceToJson(run.all.interior_covariance, r.cameras[0]);
   cal["groups"] = nlohmann::json::array();
   for (const auto& g : run.groups) cal["groups"].push_back(GroupJson(g));
   cal["stability"] = StabilityToJson(run.stability);

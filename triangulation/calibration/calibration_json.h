@@ -28,7 +28,9 @@ nlohmann::json InteriorCovarianceToJson(const Eigen::MatrixXd& cov, const Camera
 nlohmann::json StabilityToJson(const StabilityReport& stability);
 
 /// start, data, interior_covariance, groups, stability, uncertainty, radii_mm.
-nlohmann::json CalibrationToJson(const CalibrationRun& run, const std::vector<BudgetQuantity>& budget,
-                                 const std::vector<double>& radii_mm, double c_camera_file_mm);
+nlohmann::json CalibrationToJson(const CalibrationRun& run,
+                                 const std::vector<BudgetQuantity>& budget,
+                                 const std::vector<double>& radii_mm,
+                                 double c_camera_file_mm);
 
 }  // namespace aerocal::triangulation

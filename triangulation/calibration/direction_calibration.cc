@@ -1,22 +1,23 @@
 #include "triangulation/calibration/direction_calibration.h"
 
-#include <algorithm>
-#include <deque>
-#include <set>
+#include "calib/camera/rotation.h"
+#include "calib/core/error.h"
+#include "calib/residuals/direction.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
 
-#include "calib/camera/rotation.h"
-#include "calib/core/error.h"
-#include "calib/residuals/direction.h"
+#include <algorithm>
+#include <deque>
+#include <set>
 
 namespace aerocal::triangulation {
 namespace {
 
 std::string ObservationText(size_t i, const DirectionObservation& o) {
-  return (o.where.empty() ? "" : o.where + ": ") + "direction observation " + std::to_string(i + 1) +
-         " (target " + o.target + (o.setting.empty() ? "" : ", setting " + o.setting) + ")";
+  return (o.where.empty() ? "" : o.where + ": ") + "direction observation " +
+         std::to_string(i + 1) + " (target " + o.target +
+         (o.setting.empty() ? "" : ", setting " + o.setting) + ")";
 }
 
 // The start camera's ray of a pixel (camera frame; principal point at the format centre, no
@@ -27,8 +28,10 @@ Eigen::Vector3d StartRay(const calib::Camera& start, const Eigen::Vector2d& pixe
 }
 
 // Fixes the interior entries not named in `free` (all of them: the whole block).
-void FixInteriorEntries(const calib::Camera& camera, const std::vector<std::string>& free,
-                        calib::BlockId block, calib::ProblemBuilder* builder) {
+void FixInteriorEntries(const calib::Camera& camera,
+                        const std::vector<std::string>& free,
+                        calib::BlockId block,
+                        calib::ProblemBuilder* builder) {
   std::vector<bool> is_free(camera.interior.size(), false);
   for (const auto& name : free) {
     const int index = camera.ParamIndex(name);
@@ -39,8 +42,10 @@ void FixInteriorEntries(const calib::Camera& camera, const std::vector<std::stri
   std::vector<int> fixed;
   for (int i = 0; i < camera.interior.size(); ++i)
     if (!is_free[i]) fixed.push_back(i);
-  if (static_cast<int>(fixed.size()) == camera.interior.size()) builder->FixBlock(block);
-  else if (!fixed.empty()) builder->FixEntries(block, fixed);
+  if (static_cast<int>(fixed.size()) == camera.interior.size())
+    builder->FixBlock(block);
+  else if (!fixed.empty())
+    builder->FixEntries(block, fixed);
 }
 
 }  // namespace
@@ -55,11 +60,15 @@ DirectionCalibration CalibrateFromDirections(const calib::Camera& start,
   calib::ProblemBuilder builder;
   std::vector<std::string> names;
   for (const auto& p : start.Params()) names.emplace_back(p.name);
-  const calib::BlockId interior = builder.AddBlock("interior", out.camera.interior.data(),
-                                                   out.camera.interior.size(), calib::BlockKind::kInterior, names);
+  const calib::BlockId interior = builder.AddBlock("interior",
+                                                   out.camera.interior.data(),
+                                                   out.camera.interior.size(),
+                                                   calib::BlockKind::kInterior,
+                                                   names);
   FixInteriorEntries(start, options.free_interior, interior, &builder);
   Eigen::Vector4d quaternion = calib::QuaternionFromOpk(start_opk_rad);
-  const calib::BlockId rotation = builder.AddRotationBlock("instrument_from_camera", quaternion.data());
+  const calib::BlockId rotation =
+      builder.AddRotationBlock("instrument_from_camera", quaternion.data());
 
   std::deque<Eigen::Vector2d> angles;  // stable addresses for the builder
   std::map<std::string, calib::BlockId> target_block;
@@ -68,10 +77,15 @@ DirectionCalibration CalibrateFromDirections(const calib::Camera& start,
   for (const auto& t : targets) {
     if (target_block.count(t.id)) throw InputError("direction target " + t.id + ": given twice");
     angles.push_back(t.angles_rad);
-    const calib::BlockId id =
-        builder.AddBlock("target " + t.id, angles.back().data(), 2, calib::BlockKind::kOther, {"azimuth", "elevation"});
-    if (t.known) builder.FixBlock(id);
-    else covariance_blocks.push_back(id);
+    const calib::BlockId id = builder.AddBlock("target " + t.id,
+                                               angles.back().data(),
+                                               2,
+                                               calib::BlockKind::kOther,
+                                               {"azimuth", "elevation"});
+    if (t.known)
+      builder.FixBlock(id);
+    else
+      covariance_blocks.push_back(id);
     all_known = all_known && t.known;
     target_block[t.id] = id;
   }
@@ -89,9 +103,12 @@ DirectionCalibration CalibrateFromDirections(const calib::Camera& start,
       throw InputError(ObservationText(i, o) + ": sigma_px must be > 0 and sigma_rad >= 0");
     const Eigen::Matrix2d covariance = calib::DirectionCovarianceMm2(
         frame.PhotoFromPixel(o.pixel), c_mm, o.sigma_px, frame.pixel_size_mm, o.sigma_rad);
-    ids.push_back(builder.AddResidual(
-        kGroupDirection, calib::MakeDirectionResidual(start.model, frame, o.instrument_rotation, o.pixel, covariance),
-        {interior, rotation, it->second}, ObservationText(i, o)));
+    ids.push_back(
+        builder.AddResidual(kGroupDirection,
+                            calib::MakeDirectionResidual(
+                                start.model, frame, o.instrument_rotation, o.pixel, covariance),
+                            {interior, rotation, it->second},
+                            ObservationText(i, o)));
     factors.push_back(covariance.llt().matrixL());
     out.apriori_sigma_px.push_back(std::sqrt(0.5 * covariance.trace()) / frame.pixel_size_mm);
   }
@@ -106,7 +123,8 @@ DirectionCalibration CalibrateFromDirections(const calib::Camera& start,
     out.residual_px.emplace_back(v_mm.x() / frame.pixel_size_mm, -v_mm.y() / frame.pixel_size_mm);
   }
 
-  const calib::CovarianceReport cov = builder.EstimateCovariance(covariance_blocks, out.report.sigma0);
+  const calib::CovarianceReport cov =
+      builder.EstimateCovariance(covariance_blocks, out.report.sigma0);
   out.covariance_ok = cov.ok;
   out.undetermined = cov.undetermined;
   out.high_correlations = cov.high_correlations;
@@ -152,11 +170,13 @@ void StartUnknownTargets(const calib::Camera& start,
   const Eigen::Matrix3d r = calib::RotationFromOpk(start_opk_rad);
   for (auto& t : *targets) {
     if (t.known) continue;
-    const auto o = std::find_if(observations.begin(), observations.end(),
+    const auto o = std::find_if(observations.begin(),
+                                observations.end(),
                                 [&](const DirectionObservation& x) { return x.target == t.id; });
     if (o == observations.end()) continue;
     const Eigen::Vector3d d = o->instrument_rotation * r * StartRay(start, o->pixel);
-    t.angles_rad = Eigen::Vector2d(std::atan2(d.x(), -d.z()), std::asin(std::clamp(d.y(), -1.0, 1.0)));
+    t.angles_rad =
+        Eigen::Vector2d(std::atan2(d.x(), -d.z()), std::asin(std::clamp(d.y(), -1.0, 1.0)));
   }
 }
 

@@ -12,14 +12,14 @@
 // several images would need its angles as weighted unknowns instead (not done).
 #pragma once
 
-#include <map>
-#include <string>
-#include <vector>
+#include "calib/camera/camera.h"
+#include "calib/problem/problem_builder.h"
 
 #include <Eigen/Core>
 
-#include "calib/camera/camera.h"
-#include "calib/problem/problem_builder.h"
+#include <map>
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 
@@ -27,8 +27,9 @@ inline constexpr const char* kGroupDirection = "direction";
 
 struct DirectionTarget {
   std::string id;
-  Eigen::Vector2d angles_rad = Eigen::Vector2d::Zero();  // azimuth, elevation (direction.h); start value when !known
-  bool known = true;  // a collimator: known (fixed); a goniometer's target: estimated
+  Eigen::Vector2d angles_rad =
+      Eigen::Vector2d::Zero();  // azimuth, elevation (direction.h); start value when !known
+  bool known = true;            // a collimator: known (fixed); a goniometer's target: estimated
 };
 
 struct DirectionObservation {
@@ -36,31 +37,33 @@ struct DirectionObservation {
   std::string setting;  // names the instrument setting in labels ("" for a collimator array)
   Eigen::Matrix3d instrument_rotation = Eigen::Matrix3d::Identity();  // G of direction.h
   Eigen::Vector2d pixel = Eigen::Vector2d::Zero();  // measured (col, row), camera pixel frame
-  double sigma_px = 0.1;   // image measurement sigma, > 0
+  double sigma_px = 0.1;                            // image measurement sigma, > 0
   double sigma_rad = 0.0;  // angular sigma of the direction (collimator or setting), >= 0
   std::string where;       // FILE:LINE of the observation for messages ("" : its number)
 };
 
 struct DirectionCalibrationOptions {
-  std::vector<std::string> free_interior = {"c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
+  std::vector<std::string> free_interior = {
+      "c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
   calib::SolverOptions solver;
 };
 
 struct DirectionCalibration {
   calib::SolveReport report;
-  calib::Camera camera;                   // the start camera with the estimated interior
-  std::vector<double> interior_sigma;     // a-posteriori, table order (0 for fixed entries)
+  calib::Camera camera;                // the start camera with the estimated interior
+  std::vector<double> interior_sigma;  // a-posteriori, table order (0 for fixed entries)
   /// A-posteriori covariance of the interior, table order and units (zero rows and columns for
   /// fixed entries); empty when !covariance_ok.
   Eigen::MatrixXd interior_covariance;
   std::vector<calib::HighCorrelation> high_correlations;  // |rho| > 0.95 of free parameters
-  std::vector<std::string> undetermined;                 // null-space parameters (rank defect)
+  std::vector<std::string> undetermined;                  // null-space parameters (rank defect)
   /// Per observation: v = measured - adjusted in the (corrected) photo space, (col, row) px; and
   /// its a-priori sigma sqrt(trace(C) / 2) / pixel size (C of DirectionCovarianceMm2: the image
   /// measurement and the direction's angular sigma), px.
   std::vector<Eigen::Vector2d> residual_px;
   std::vector<double> apriori_sigma_px;
-  Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();        // R (instrument_from_camera) as omega, phi, kappa
+  Eigen::Vector3d opk_rad =
+      Eigen::Vector3d::Zero();  // R (instrument_from_camera) as omega, phi, kappa
   Eigen::Vector3d opk_sigma_rad = Eigen::Vector3d::Zero();
   std::map<std::string, Eigen::Vector2d> target_angles_rad;  // estimated (unknown) targets
   std::map<std::string, Eigen::Vector2d> target_sigma_rad;

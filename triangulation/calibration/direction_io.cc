@@ -1,15 +1,15 @@
 #include "triangulation/calibration/direction_io.h"
 
+#include "calib/camera/rotation.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/string_printf.h"
+
 #include <cmath>
 #include <map>
 #include <optional>
 #include <set>
 #include <tuple>
-
-#include "calib/camera/rotation.h"
-#include "calib/core/csv.h"
-#include "calib/core/error.h"
-#include "calib/core/string_printf.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -36,29 +36,44 @@ bool SameAngles(const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
 }
 
 // A row's goniometer setting: its name and (turn, tilt) in degrees.
-std::pair<std::string, Eigen::Vector2d> RowSetting(const CsvTable& table, const CsvTable::Row& row) {
+std::pair<std::string, Eigen::Vector2d> RowSetting(const CsvTable& table,
+                                                   const CsvTable::Row& row) {
   const Eigen::Vector2d angles(table.OptionalBounded(row, "turn_deg", -180.0, 180.0).value_or(0.0),
                                table.OptionalBounded(row, "tilt_deg", -180.0, 180.0).value_or(0.0));
   std::string name = table.String(row, "setting");
   const bool has_angles = table.HasColumn("turn_deg") || table.HasColumn("tilt_deg");
-  if (name.empty() && has_angles) name = StringPrintf("turn %.6g tilt %.6g", angles.x(), angles.y());
+  if (name.empty() && has_angles)
+    name = StringPrintf("turn %.6g tilt %.6g", angles.x(), angles.y());
   return {name, angles};
 }
 
 }  // namespace
 
-DirectionData ReadDirections(const std::string& path, const calib::Camera& camera, double default_sigma_px) {
+DirectionData ReadDirections(const std::string& path,
+                             const calib::Camera& camera,
+                             double default_sigma_px) {
   const CsvTable table = CsvTable::Read(path);
   table.RequireColumns({"target", "col", "row"});
-  table.RejectUnknownColumns({"target", "col", "row", "sigma_px", "azimuth_deg", "elevation_deg", "sigma_arcsec",
-                              "setting", "turn_deg", "tilt_deg", "group"});
+  table.RejectUnknownColumns({"target",
+                              "col",
+                              "row",
+                              "sigma_px",
+                              "azimuth_deg",
+                              "elevation_deg",
+                              "sigma_arcsec",
+                              "setting",
+                              "turn_deg",
+                              "tilt_deg",
+                              "group"});
   if (table.HasColumn("azimuth_deg") != table.HasColumn("elevation_deg"))
     ThrowInputError({path, 0}, "azimuth_deg and elevation_deg go together (one column is missing)");
-  if (table.rows().empty()) ThrowInputError({path, 0}, "no rows (a directions file needs observations)");
+  if (table.rows().empty())
+    ThrowInputError({path, 0}, "no rows (a directions file needs observations)");
   DirectionData out;
-  std::map<std::string, std::pair<std::optional<Eigen::Vector2d>, int>> target_angles;  // -> (angles, line)
-  std::map<std::string, std::pair<Eigen::Vector2d, int>> settings;                      // -> (turn, tilt; line)
-  std::set<std::tuple<std::string, std::string, std::string>> seen;                     // target, setting, group
+  std::map<std::string, std::pair<std::optional<Eigen::Vector2d>, int>>
+      target_angles;                                                 // -> (angles, line)
+  std::map<std::string, std::pair<Eigen::Vector2d, int>> settings;   // -> (turn, tilt; line)
+  std::set<std::tuple<std::string, std::string, std::string>> seen;  // target, setting, group
   for (const auto& row : table.rows()) {
     const SourceRef where = table.Where(row);
     DirectionObservation o;
@@ -69,33 +84,45 @@ DirectionData ReadDirections(const std::string& path, const calib::Camera& camer
                               table.Bounded(row, "row", -0.5, camera.height_px - 0.5));
     o.sigma_px = table.OptionalBounded(row, "sigma_px", 0.0, 100.0).value_or(default_sigma_px);
     if (!(o.sigma_px > 0)) ThrowInputError(where, "sigma_px must be > 0 (got 0)");
-    o.sigma_rad = table.OptionalBounded(row, "sigma_arcsec", 0.0, kMaxSigmaArcsec).value_or(0.0) * kArcSecond;
+    o.sigma_rad =
+        table.OptionalBounded(row, "sigma_arcsec", 0.0, kMaxSigmaArcsec).value_or(0.0) * kArcSecond;
     const auto [setting, turn_tilt] = RowSetting(table, row);
     o.setting = setting;
-    o.instrument_rotation = calib::RotationFromOpk(Eigen::Vector3d(turn_tilt.y() * kDeg, turn_tilt.x() * kDeg, 0.0));
+    o.instrument_rotation =
+        calib::RotationFromOpk(Eigen::Vector3d(turn_tilt.y() * kDeg, turn_tilt.x() * kDeg, 0.0));
     if (!setting.empty()) {
       const auto [at, added] = settings.emplace(setting, std::make_pair(turn_tilt, row.line));
       if (!added && !SameAngles(at->second.first, turn_tilt))
-        ThrowInputError(where, StringPrintf("setting %s has turn %.9g, tilt %.9g deg here and %.9g, %.9g at line %d",
-                                            setting.c_str(), turn_tilt.x(), turn_tilt.y(), at->second.first.x(),
-                                            at->second.first.y(), at->second.second));
+        ThrowInputError(
+            where,
+            StringPrintf("setting %s has turn %.9g, tilt %.9g deg here and %.9g, %.9g at line %d",
+                         setting.c_str(),
+                         turn_tilt.x(),
+                         turn_tilt.y(),
+                         at->second.first.x(),
+                         at->second.first.y(),
+                         at->second.second));
     }
     const std::optional<Eigen::Vector2d> angles = RowAngles(table, row);
     const auto [at, added] = target_angles.emplace(o.target, std::make_pair(angles, row.line));
     if (added) {
-      const Eigen::Vector2d start_rad = angles ? Eigen::Vector2d(*angles * kDeg) : Eigen::Vector2d(0.0, 0.0);
+      const Eigen::Vector2d start_rad =
+          angles ? Eigen::Vector2d(*angles * kDeg) : Eigen::Vector2d(0.0, 0.0);
       out.targets.push_back({o.target, start_rad, angles.has_value()});
     } else if (at->second.first.has_value() != angles.has_value() ||
                (angles && !SameAngles(*angles, *at->second.first))) {
-      ThrowInputError(where, "target " + o.target + ": its azimuth_deg, elevation_deg differ from line " +
-                                 std::to_string(at->second.second) +
-                                 " (a known target gives the same direction on every row; an estimated one none)");
+      ThrowInputError(
+          where,
+          "target " + o.target + ": its azimuth_deg, elevation_deg differ from line " +
+              std::to_string(at->second.second) +
+              " (a known target gives the same direction on every row; an estimated one none)");
     }
     const std::string group = table.String(row, "group");
     if (!seen.emplace(o.target, o.setting, group).second)
-      ThrowInputError(where, "target " + o.target + (o.setting.empty() ? "" : " at setting " + o.setting) +
-                                 (group.empty() ? "" : " in group " + group) +
-                                 " is observed twice (a repeated series goes into its own group)");
+      ThrowInputError(where,
+                      "target " + o.target + (o.setting.empty() ? "" : " at setting " + o.setting) +
+                          (group.empty() ? "" : " in group " + group) +
+                          " is observed twice (a repeated series goes into its own group)");
     if (table.HasColumn("group")) out.groups.push_back(group);
     out.observations.push_back(o);
   }

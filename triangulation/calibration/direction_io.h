@@ -21,11 +21,11 @@
 // Each error names FILE:LINE, the column and the rule.
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include "calib/camera/camera.h"
 #include "triangulation/calibration/direction_calibration.h"
+
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 
@@ -39,6 +39,8 @@ struct DirectionData {
 /// Reads a directions file; `camera` bounds the image positions to its format and
 /// `default_sigma_px` (> 0) is the image sigma of rows without sigma_px. Throws InputError
 /// "FILE:LINE: ..." on bad content (see the header comment).
-DirectionData ReadDirections(const std::string& path, const calib::Camera& camera, double default_sigma_px);
+DirectionData ReadDirections(const std::string& path,
+                             const calib::Camera& camera,
+                             double default_sigma_px);
 
 }  // namespace aerocal::triangulation

@@ -1,15 +1,15 @@
 #include "triangulation/calibration/direction_run.h"
 
+#include "calib/camera/rotation.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/core/string_printf.h"
+#include "calib/residuals/direction.h"
+
 #include <algorithm>
 #include <cmath>
 #include <map>
 #include <set>
-
-#include "calib/camera/rotation.h"
-#include "calib/core/csv.h"
-#include "calib/residuals/direction.h"
-#include "calib/core/error.h"
-#include "calib/core/string_printf.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -43,12 +43,14 @@ void CheckInFront(const Eigen::Vector3d& start_opk_rad,
     calib::DirectionFromAngles(a->second.data(), t.data());
     const Eigen::Vector3d uvw = r.transpose() * o.instrument_rotation.transpose() * t;
     if (!(uvw.z() < -0.05))  // within ~87 deg of the axis: a camera sees nothing beyond
-      throw InputError((o.where.empty() ? "observation " + std::to_string(i + 1) : o.where) + ": target " +
-                       o.target + StringPrintf(" is %.1f deg off the camera's axis at the start orientation "
-                                               "(omega %.3f, phi %.3f, kappa %.3f deg): no camera sees it",
-                                               std::acos(std::clamp(-uvw.z(), -1.0, 1.0)) * 180 / M_PI,
-                                               start_opk_rad.x() * 180 / M_PI, start_opk_rad.y() * 180 / M_PI,
-                                               start_opk_rad.z() * 180 / M_PI));
+      throw InputError((o.where.empty() ? "observation " + std::to_string(i + 1) : o.where) +
+                       ": target " + o.target +
+                       StringPrintf(" is %.1f deg off the camera's axis at the start orientation "
+                                    "(omega %.3f, phi %.3f, kappa %.3f deg): no camera sees it",
+                                    std::acos(std::clamp(-uvw.z(), -1.0, 1.0)) * 180 / M_PI,
+                                    start_opk_rad.x() * 180 / M_PI,
+                                    start_opk_rad.y() * 180 / M_PI,
+                                    start_opk_rad.z() * 180 / M_PI));
   }
 }
 
@@ -67,7 +69,8 @@ CalibrationAdjustment AdjustmentOfDirections(const std::string& camera_id,
   r.sigma0 = d.report.sigma0;
   double sum2 = 0;
   for (double s : d.apriori_sigma_px) sum2 += s * s;
-  const double apriori_px = d.apriori_sigma_px.empty() ? 0.0 : std::sqrt(sum2 / d.apriori_sigma_px.size());
+  const double apriori_px =
+      d.apriori_sigma_px.empty() ? 0.0 : std::sqrt(sum2 / d.apriori_sigma_px.size());
   r.sigma0_px = r.sigma0 * apriori_px;
   r.sigma0_um = r.sigma0_px * start.pixel_size_mm * 1e3;
   CameraEstimate c;
@@ -96,13 +99,14 @@ CalibrationAdjustment AdjustmentOfDirections(const std::string& camera_id,
   r.frame = "instrument frame (directions; no position, no scale)";
   r.datum = "the known directions (collimators) and instrument settings (goniometer)";
   r.warnings = GroupRmsWarnings(r.solve);
-  if (!r.solve.converged) r.Invalidate("the adjustment did not converge (" + r.solve.termination + ")");
+  if (!r.solve.converged)
+    r.Invalidate("the adjustment did not converge (" + r.solve.termination + ")");
   if (r.sigma0 > max_sigma0)
-    r.Invalidate("sigma0 " + FormatNumber(r.sigma0, 3) + " is above the limit " + FormatNumber(max_sigma0, 3) +
-                 " (max_sigma0)");
+    r.Invalidate("sigma0 " + FormatNumber(r.sigma0, 3) + " is above the limit " +
+                 FormatNumber(max_sigma0, 3) + " (max_sigma0)");
   if (!d.undetermined.empty())
-    r.Invalidate("singular: " + std::to_string(d.undetermined.size()) + " parameter(s) not determinable (" +
-                 d.undetermined.front() + ", ...)");
+    r.Invalidate("singular: " + std::to_string(d.undetermined.size()) +
+                 " parameter(s) not determinable (" + d.undetermined.front() + ", ...)");
   else if (!d.covariance_ok)
     r.Invalidate("no covariance of the interior");
   out.interior_covariance = d.interior_covariance;
@@ -120,9 +124,12 @@ DirectionRun RunDirectionCalibration(const std::string& camera_id,
   StartUnknownTargets(start, out.start_opk_rad, observations, &targets);
   CheckInFront(out.start_opk_rad, targets, observations);
   const std::vector<std::string>& free = options.calibration.free_interior;
-  const auto adjust = [&](const std::vector<DirectionObservation>& obs, DirectionCalibration* keep) {
-    DirectionCalibration d = CalibrateFromDirections(start, out.start_opk_rad, targets, obs, options.calibration);
-    CalibrationAdjustment a = AdjustmentOfDirections(camera_id, start, d, obs, free, options.max_sigma0);
+  const auto adjust = [&](const std::vector<DirectionObservation>& obs,
+                          DirectionCalibration* keep) {
+    DirectionCalibration d =
+        CalibrateFromDirections(start, out.start_opk_rad, targets, obs, options.calibration);
+    CalibrationAdjustment a =
+        AdjustmentOfDirections(camera_id, start, d, obs, free, options.max_sigma0);
     if (keep) *keep = std::move(d);
     return a;
   };
@@ -132,15 +139,19 @@ DirectionRun RunDirectionCalibration(const std::string& camera_id,
   run.project.cameras[camera_id] = start;
   run.all = adjust(observations, &out.all);
 
-
   std::map<std::string, std::vector<DirectionObservation>> groups;
   for (size_t i = 0; i < group_of_observation.size() && i < observations.size(); ++i)
-    if (!group_of_observation[i].empty()) groups[group_of_observation[i]].push_back(observations[i]);
+    if (!group_of_observation[i].empty())
+      groups[group_of_observation[i]].push_back(observations[i]);
   for (const auto& [name, obs] : groups) {
     const int unknowns = Unknowns(targets, obs, static_cast<int>(free.size()));
     if (2 * static_cast<int>(obs.size()) <= unknowns)
-      throw InputError(StringPrintf("group %s: %zu observations (%zu scalar) cannot determine its %d unknowns",
-                                    name.c_str(), obs.size(), 2 * obs.size(), unknowns));
+      throw InputError(
+          StringPrintf("group %s: %zu observations (%zu scalar) cannot determine its %d unknowns",
+                       name.c_str(),
+                       obs.size(),
+                       2 * obs.size(),
+                       unknowns));
     GroupCalibration g;
     g.group = name;
     std::set<std::string> labels;

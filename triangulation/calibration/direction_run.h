@@ -19,11 +19,11 @@
 // No exposures, control or check points: a direction calibration has no positions.
 #pragma once
 
-#include <string>
-#include <vector>
-
 #include "triangulation/calibration/calibration.h"
 #include "triangulation/calibration/direction_calibration.h"
+
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 

@@ -30,8 +30,10 @@ double DecentringDistortionUm(const calib::InteriorParams& p, double r) {
   return 1e3 * r * r * std::hypot(p[Model::kP1], p[Model::kP2]);
 }
 
-DistortionFigure DistortionOverFormat(const calib::ModelCamera& camera, int profile_samples,
-                                      int columns, int rows) {
+DistortionFigure DistortionOverFormat(const calib::ModelCamera& camera,
+                                      int profile_samples,
+                                      int columns,
+                                      int rows) {
   DistortionFigure out;
   Eigen::Vector2d principal_px;
   if (!camera.PixelFromIdeal(Eigen::Vector2d::Zero(), &principal_px)) return out;

@@ -33,7 +33,9 @@ struct DistortionFigure {
 
 /// Samples of the camera's correction: `profile_samples` radii up to the half diagonal and a
 /// `columns` x `rows` grid over the format. Points where the model's inversion fails are left out.
-DistortionFigure DistortionOverFormat(const calib::ModelCamera& camera, int profile_samples = 100,
-                                      int columns = 11, int rows = 9);
+DistortionFigure DistortionOverFormat(const calib::ModelCamera& camera,
+                                      int profile_samples = 100,
+                                      int columns = 11,
+                                      int rows = 9);
 
 }  // namespace aerocal::triangulation

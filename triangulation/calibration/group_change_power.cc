@@ -69,14 +69,17 @@ double NonCentralChiSquareTail(double t, int dof, double lambda) {
   return std::min(1.0, sum);
 }
 
-double GroupChangePower(const std::vector<double>& sigmas, int group, double change,
+double GroupChangePower(const std::vector<double>& sigmas,
+                        int group,
+                        double change,
                         double critical) {
   const int dof = static_cast<int>(sigmas.size()) - 1;
-  return NonCentralChiSquareTail(critical, dof,
-                                 change * change * LambdaPerChange2(sigmas, group));
+  return NonCentralChiSquareTail(critical, dof, change * change * LambdaPerChange2(sigmas, group));
 }
 
-double DetectableGroupChange(const std::vector<double>& sigmas, int group, double critical,
+double DetectableGroupChange(const std::vector<double>& sigmas,
+                             int group,
+                             double critical,
                              double power) {
   const int dof = static_cast<int>(sigmas.size()) - 1;
   // The tail grows monotonically with lambda: bisection to relative 1e-12.

@@ -25,12 +25,16 @@ double NonCentralChiSquareTail(double t, int dof, double lambda);
 
 /// Power of the group-stability test (critical value `critical`, G - 1 = sigmas.size() - 1 degrees
 /// of freedom) against a change `change` of group `group` alone. Sigmas > 0.
-double GroupChangePower(const std::vector<double>& sigmas, int group, double change,
+double GroupChangePower(const std::vector<double>& sigmas,
+                        int group,
+                        double change,
                         double critical);
 
 /// The change of group `group` alone that the test detects with probability `power` (0 < power
 /// < 1). Sigmas > 0; two groups or more.
-double DetectableGroupChange(const std::vector<double>& sigmas, int group, double critical,
+double DetectableGroupChange(const std::vector<double>& sigmas,
+                             int group,
+                             double critical,
                              double power);
 
 }  // namespace aerocal::triangulation

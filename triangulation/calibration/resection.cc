@@ -132,7 +132,8 @@ std::optional<ResectionStart> ResectImage(const calib::Camera& camera,
   const bool planar = plane.extent(2) <= kPlanarRatio * plane.extent(0) || n < 6;
   if (planar) {
     std::vector<Eigen::Vector2d> ab;
-    for (const auto& p : points_m) ab.push_back((plane.axes.transpose() * (p - plane.centroid)).head<2>());
+    for (const auto& p : points_m)
+      ab.push_back((plane.axes.transpose() * (p - plane.centroid)).head<2>());
     Eigen::Matrix3d h;
     if (!FitHomography(ab, uv, &h)) {
       *why = "degenerate homography";
@@ -177,7 +178,8 @@ std::optional<ResectionStart> ResectImage(const calib::Camera& camera,
   double sum = 0;
   for (int i = 0; i < n; ++i) {
     Eigen::Vector2d projected;
-    if (!camera.ProjectToPixel(out.exposure.opk_rad, out.exposure.center_m, points_m[i], &projected)) {
+    if (!camera.ProjectToPixel(
+            out.exposure.opk_rad, out.exposure.center_m, points_m[i], &projected)) {
       *why = "a point of known coordinates lies behind the resected camera (" + out.method + ")";
       return std::nullopt;
     }
@@ -233,7 +235,8 @@ std::vector<ResectionStart> StartFromResections(const Project& project,
   }
   std::string missing;
   for (const auto& [image, list] : by_image)
-    if (!started.count(image)) missing += (missing.empty() ? "" : "; ") + image + ": " + reasons[image];
+    if (!started.count(image))
+      missing += (missing.empty() ? "" : "; ") + image + ": " + reasons[image];
   if (!missing.empty())
     throw InputError(project.observations_file + ": no starting orientation by resection for " +
                      missing);
@@ -255,13 +258,15 @@ std::optional<double> ClosedFormPrincipalDistance(const Project& project,
   if (all.size() < 4) return std::nullopt;
   const PlaneFrame plane = FitPlane(all);
   if (plane.extent(2) > kPlanarRatio * plane.extent(0)) return std::nullopt;
-  std::map<std::string, std::pair<std::vector<Eigen::Vector2d>, std::vector<Eigen::Vector2d>>> views;
+  std::map<std::string, std::pair<std::vector<Eigen::Vector2d>, std::vector<Eigen::Vector2d>>>
+      views;
   const Eigen::Vector2d principal_point = camera.PrincipalPointMm();
   for (const auto& o : project.observations) {
     const auto k = control.find(o.point);
     if (k == control.end()) continue;
     const Eigen::Vector2d xy = camera.PhotoFromPixel(o.pixel) - principal_point;
-    views[o.image].first.push_back((plane.axes.transpose() * (k->second - plane.centroid)).head<2>());
+    views[o.image].first.push_back(
+        (plane.axes.transpose() * (k->second - plane.centroid)).head<2>());
     views[o.image].second.push_back({xy.x(), -xy.y()});
   }
   double ata = 0, atb = 0;

@@ -39,7 +39,7 @@ struct ResectionStart {
   Exposure exposure;
   std::string method;  // "homography" | "dlt"
   int n_points = 0;
-  double rms_px = 0;   // reprojection RMS of its points with the camera file's interior, px
+  double rms_px = 0;  // reprojection RMS of its points with the camera file's interior, px
 };
 
 /// Pose from >= 4 (planar) or >= 6 (general) points; nullopt with `why` when the geometry does not

@@ -5,7 +5,7 @@
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
-#include "stitch/adjustment/f_test.h"
+#include "stitch/adjustment/f_distribution.h"
 #include "triangulation/calibration/distortion_figure.h"
 
 #include <Eigen/Dense>
@@ -69,8 +69,11 @@ void Finish(BudgetQuantity* q) {
   q->statement = CertificateStatement(q->name, q->value, q->expanded, q->k, q->unit);
 }
 
-UncertaintyComponent Component(const std::string& source, const std::string& type, double u,
-                               double dof, const std::string& unit,
+UncertaintyComponent Component(const std::string& source,
+                               const std::string& type,
+                               double u,
+                               double dof,
+                               const std::string& unit,
                                const std::string& distribution = "normal") {
   UncertaintyComponent c;
   c.source = source;
@@ -118,8 +121,8 @@ double MaxEccentricityPx(const CalibrationRun& run, const Project& project, doub
     const double d = ray.norm();
     const double cos_a = std::abs(ray.dot(normal)) / d;
     const double sin_a = std::sqrt(std::max(0.0, 1 - cos_a * cos_a));
-    const double e_mm = c * radius_m * radius_m * sin_a * cos_a /
-                        (d * d - radius_m * radius_m * sin_a * sin_a);
+    const double e_mm =
+        c * radius_m * radius_m * sin_a * cos_a / (d * d - radius_m * radius_m * sin_a * sin_a);
     max_mm = std::max(max_mm, e_mm);
   }
   return max_mm / camera.pixel_size_mm;
@@ -133,8 +136,8 @@ double CoverageFactor(double dof_eff) {
   return std::round(t * 100.0) / 100.0;
 }
 
-std::string CertificateStatement(const std::string& name, double value, double expanded, double k,
-                                 const std::string& unit) {
+std::string CertificateStatement(
+    const std::string& name, double value, double expanded, double k, const std::string& unit) {
   // A dimensionless quantity (table unit "1", e.g. B1) is written without a unit.
   const std::string u = unit == "1" || unit.empty() ? "" : " " + unit;
   if (!(expanded > 0) || !std::isfinite(expanded))
@@ -144,10 +147,22 @@ std::string CertificateStatement(const std::string& name, double value, double e
   const int exponent = static_cast<int>(std::floor(std::log10(expanded)));
   const int decimals = std::max(0, 1 - exponent);
   if (decimals > 8 || std::abs(value) < 1e-3 || std::abs(value) >= 1e6)
-    return StringPrintf("%s = %.4e%s, U = %#.2g%s (k = %g)", name.c_str(), value, u.c_str(), expanded,
-                        u.c_str(), k);
-  return StringPrintf("%s = %.*f%s, U = %.*f%s (k = %g)", name.c_str(), decimals, value, u.c_str(),
-                      decimals, expanded, u.c_str(), k);
+    return StringPrintf("%s = %.4e%s, U = %#.2g%s (k = %g)",
+                        name.c_str(),
+                        value,
+                        u.c_str(),
+                        expanded,
+                        u.c_str(),
+                        k);
+  return StringPrintf("%s = %.*f%s, U = %.*f%s (k = %g)",
+                      name.c_str(),
+                      decimals,
+                      value,
+                      u.c_str(),
+                      decimals,
+                      expanded,
+                      u.c_str(),
+                      k);
 }
 
 namespace {
@@ -158,12 +173,21 @@ struct BudgetUnit {
   const char* kind;
   double scale;
 };
-constexpr BudgetUnit kBudgetUnits[] = {
-    {"m", "length", 1.0},         {"mm", "length", 1e-3},     {"um", "length", 1e-6},
-    {"nm", "length", 1e-9},       {"px", "image", 1.0},       {"rad", "angle", 1.0},
-    {"mrad", "angle", 1e-3},      {"deg", "angle", M_PI / 180}, {"arcmin", "angle", M_PI / 10800},
-    {"arcsec", "angle", M_PI / 648000}, {"K", "temperature", 1.0}, {"degC", "temperature", 1.0},
-    {"1", "ratio", 1.0},          {"%", "ratio", 1e-2},       {"ppm", "ratio", 1e-6}};
+constexpr BudgetUnit kBudgetUnits[] = {{"m", "length", 1.0},
+                                       {"mm", "length", 1e-3},
+                                       {"um", "length", 1e-6},
+                                       {"nm", "length", 1e-9},
+                                       {"px", "image", 1.0},
+                                       {"rad", "angle", 1.0},
+                                       {"mrad", "angle", 1e-3},
+                                       {"deg", "angle", M_PI / 180},
+                                       {"arcmin", "angle", M_PI / 10800},
+                                       {"arcsec", "angle", M_PI / 648000},
+                                       {"K", "temperature", 1.0},
+                                       {"degC", "temperature", 1.0},
+                                       {"1", "ratio", 1.0},
+                                       {"%", "ratio", 1e-2},
+                                       {"ppm", "ratio", 1e-6}};
 
 const BudgetUnit* FindBudgetUnit(const std::string& name) {
   for (const auto& u : kBudgetUnits)
@@ -184,7 +208,8 @@ BudgetOptions ReadBudgetOptions(const std::string& path) {
   BudgetOptions options;
   // An empty budget file is a mistake (a wrong file, a failed export), not "no options".
   if (!root || root.IsNull() || (root.IsMap() && root.size() == 0))
-    throw InputError(path + ":1: an empty budget file (expected radii_mm, target_radius_mm or components)");
+    throw InputError(
+        path + ":1: an empty budget file (expected radii_mm, target_radius_mm or components)");
   if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map");
   RejectUnknownKeys(root, {"radii_mm", "target_radius_mm", "components"}, path);
   for (const char* list : {"radii_mm", "components"})  // a map or a scalar there is no list
@@ -195,11 +220,14 @@ BudgetOptions ReadBudgetOptions(const std::string& path) {
       options.radii_mm.push_back(YamlBounded(r, path, "radii_mm", 1e-9, 1e6));
   }
   if (root["target_radius_mm"])
-    options.target_radius_mm = YamlBounded(root["target_radius_mm"], path, "target_radius_mm", 0, 1e6);
+    options.target_radius_mm =
+        YamlBounded(root["target_radius_mm"], path, "target_radius_mm", 0, 1e6);
   if (root["components"]) {
     for (const auto& node : root["components"]) {
       RejectUnknownKeys(
-          node, {"quantity", "source", "value", "unit", "distribution", "sensitivity", "dof"}, path);
+          node,
+          {"quantity", "source", "value", "unit", "distribution", "sensitivity", "dof"},
+          path);
       UserComponent u;
       const std::string where = WhereIs(node, path).ToString();
       if (!node["quantity"] || !node["source"] || !node["value"])
@@ -214,8 +242,10 @@ BudgetOptions ReadBudgetOptions(const std::string& path) {
           throw InputError(WhereIs(node["unit"], path).ToString() + ": unknown unit '" + u.unit +
                            "' (expected one of " + BudgetUnits() + ")");
       }
-      if (node["distribution"]) u.distribution = YamlString(node["distribution"], path, "distribution");
-      Divisor(u.distribution, WhereIs(node["distribution"] ? node["distribution"] : node, path).ToString());
+      if (node["distribution"])
+        u.distribution = YamlString(node["distribution"], path, "distribution");
+      Divisor(u.distribution,
+              WhereIs(node["distribution"] ? node["distribution"] : node, path).ToString());
       if (node["sensitivity"]) {
         u.sensitivity = YamlBounded(node["sensitivity"], path, "sensitivity", -1e6, 1e6);
         u.sensitivity_given = true;
@@ -240,7 +270,8 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
   const std::vector<calib::ParamInfo> table = calib::CameraModelParams(camera.model);
   for (int k = 0; k < static_cast<int>(table.size()); ++k) {
     if (!camera.free[k]) continue;
-    functions.push_back({std::string(table[k].name), std::string(table[k].unit),
+    functions.push_back({std::string(table[k].name),
+                         std::string(table[k].unit),
                          "interior parameter",
                          [k](const calib::InteriorParams& p) { return p[k]; }});
   }
@@ -252,13 +283,17 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
   const bool decentring = ours && (camera.free[Model::kP1] || camera.free[Model::kP2]);
   for (double r : options.radii_mm) {
     if (radial)
-      functions.push_back({StringPrintf("dr@%g", r), "um",
-                           StringPrintf("radial distortion at r = %g mm", r),
-                           [r](const calib::InteriorParams& p) { return RadialDistortionUm(p, r); }});
+      functions.push_back(
+          {StringPrintf("dr@%g", r),
+           "um",
+           StringPrintf("radial distortion at r = %g mm", r),
+           [r](const calib::InteriorParams& p) { return RadialDistortionUm(p, r); }});
     if (decentring)
-      functions.push_back({StringPrintf("dt@%g", r), "um",
-                           StringPrintf("decentring distortion (magnitude) at r = %g mm", r),
-                           [r](const calib::InteriorParams& p) { return DecentringDistortionUm(p, r); }});
+      functions.push_back(
+          {StringPrintf("dt@%g", r),
+           "um",
+           StringPrintf("decentring distortion (magnitude) at r = %g mm", r),
+           [r](const calib::InteriorParams& p) { return DecentringDistortionUm(p, r); }});
   }
 
   std::vector<BudgetQuantity> out;
@@ -269,31 +304,43 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
     q.description = f.description;
     q.value = f.f(camera.estimated);
     const double u_a = Propagate(f, camera.estimated, run.all.interior_covariance);
-    q.components.push_back(Component("adjustment (sigma0 sqrt(Qxx))", "A", u_a, dof_adjustment, f.unit));
+    q.components.push_back(
+        Component("adjustment (sigma0 sqrt(Qxx))", "A", u_a, dof_adjustment, f.unit));
     if (run.groups.size() >= 2) {
       std::vector<double> values;
       for (const auto& g : run.groups)
-        if (!g.adjustment.result.cameras.empty()) values.push_back(f.f(g.adjustment.result.cameras[0].estimated));
+        if (!g.adjustment.result.cameras.empty())
+          values.push_back(f.f(g.adjustment.result.cameras[0].estimated));
       const double n = static_cast<double>(values.size());
       double mean = 0, ss = 0;
       for (double v : values) mean += v / n;
       for (double v : values) ss += (v - mean) * (v - mean);
       const double s2_mean = ss / (n - 1) / n;
-      q.components.push_back(Component(
-          StringPrintf("group reproducibility (%zu groups, excess over the adjustment)", values.size()),
-          "A", std::sqrt(std::max(0.0, s2_mean - u_a * u_a)), n - 1, f.unit));
+      q.components.push_back(
+          Component(StringPrintf("group reproducibility (%zu groups, excess over the adjustment)",
+                                 values.size()),
+                    "A",
+                    std::sqrt(std::max(0.0, s2_mean - u_a * u_a)),
+                    n - 1,
+                    f.unit));
     }
     if (run.control_fixed &&
         run.control_fixed->interior_covariance.rows() == camera.estimated.size()) {
       const double u_fixed = Propagate(f, camera.estimated, run.control_fixed->interior_covariance);
       q.components.push_back(Component("control / target coordinates (survey sigmas propagated)",
-                                       "B", std::sqrt(std::max(0.0, u_a * u_a - u_fixed * u_fixed)),
-                                       kInf, f.unit));
+                                       "B",
+                                       std::sqrt(std::max(0.0, u_a * u_a - u_fixed * u_fixed)),
+                                       kInf,
+                                       f.unit));
     }
     if (eccentricity_px > 0 && all.sigma0_px > 0) {
-      UncertaintyComponent c = Component("target-centre eccentricity (max " +
-                                             StringPrintf("%.3g", eccentricity_px) + " px)",
-                                         "B", 0, kInf, "px", "rectangular");
+      UncertaintyComponent c = Component(
+          "target-centre eccentricity (max " + StringPrintf("%.3g", eccentricity_px) + " px)",
+          "B",
+          0,
+          kInf,
+          "px",
+          "rectangular");
       c.value = eccentricity_px;
       c.divisor = std::sqrt(3.0);
       c.sensitivity = u_a / all.sigma0_px;
@@ -320,8 +367,11 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
       q.unit = "mm";
       q.description = "check-point RMSE";
       q.value = 1e3 * all.check.rmse_m(a);
-      q.components.push_back(Component(StringPrintf("sampling of %d check points", all.check.n), "A",
-                                       q.value / std::sqrt(2 * n), std::max(1.0, n - 1), "mm"));
+      q.components.push_back(Component(StringPrintf("sampling of %d check points", all.check.n),
+                                       "A",
+                                       q.value / std::sqrt(2 * n),
+                                       std::max(1.0, n - 1),
+                                       "mm"));
       q.components.push_back(Component("check-point survey", "B", 1e3 * survey(a), kInf, "mm"));
       out.push_back(q);
     }
@@ -332,16 +382,19 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
     q.unit = "um";
     q.description = "sigma0 of the image measurements";
     q.value = all.sigma0_um;
-    q.components.push_back(Component("redundancy " + std::to_string(all.solve.redundancy), "A",
-                                     all.sigma0_um / std::sqrt(2.0 * dof_adjustment), dof_adjustment,
+    q.components.push_back(Component("redundancy " + std::to_string(all.solve.redundancy),
+                                     "A",
+                                     all.sigma0_um / std::sqrt(2.0 * dof_adjustment),
+                                     dof_adjustment,
                                      "um"));
     out.push_back(q);
   }
   for (const auto& u : options.user) {
-    auto q = std::find_if(out.begin(), out.end(), [&](const BudgetQuantity& b) { return b.name == u.quantity; });
+    auto q = std::find_if(
+        out.begin(), out.end(), [&](const BudgetQuantity& b) { return b.name == u.quantity; });
     if (q == out.end())
-      throw ConfigError(u.where + ": budget component '" + u.source + "': unknown quantity " + u.quantity +
-                        " (not certified by this calibration)");
+      throw ConfigError(u.where + ": budget component '" + u.source + "': unknown quantity " +
+                        u.quantity + " (not certified by this calibration)");
     UncertaintyComponent c;
     c.source = u.source;
     c.type = "B";
@@ -365,8 +418,9 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
     c.sensitivity = u.sensitivity * factor;
     c.u = std::abs(c.sensitivity) * u.value / c.divisor;
     if (!std::isfinite(c.u))
-      throw ConfigError(who + ": the standard uncertainty is not finite (value " + FormatNumber(u.value) +
-                        " " + u.unit + ", sensitivity " + FormatNumber(u.sensitivity) + ")");
+      throw ConfigError(who + ": the standard uncertainty is not finite (value " +
+                        FormatNumber(u.value) + " " + u.unit + ", sensitivity " +
+                        FormatNumber(u.sensitivity) + ")");
     c.dof = u.dof;
     q->components.push_back(c);
   }
@@ -387,9 +441,15 @@ nlohmann::json BudgetToJson(const std::vector<BudgetQuantity>& budget) {
   auto number = [](double v) { return std::isfinite(v) ? nlohmann::json(v) : nlohmann::json(); };
   nlohmann::json out = nlohmann::json::array();
   for (const auto& q : budget) {
-    nlohmann::json j = {{"quantity", q.name},       {"unit", q.unit},     {"description", q.description},
-                        {"value", q.value},         {"u_c", number(q.u_c)}, {"dof_eff", number(q.dof_eff)},
-                        {"k", q.k},                 {"U", number(q.expanded)}, {"statement", q.statement}};
+    nlohmann::json j = {{"quantity", q.name},
+                        {"unit", q.unit},
+                        {"description", q.description},
+                        {"value", q.value},
+                        {"u_c", number(q.u_c)},
+                        {"dof_eff", number(q.dof_eff)},
+                        {"k", q.k},
+                        {"U", number(q.expanded)},
+                        {"statement", q.statement}};
     j["components"] = nlohmann::json::array();
     for (const auto& c : q.components)
       j["components"].push_back({{"source", c.source},

@@ -23,7 +23,8 @@
 // - B user components (temperature, ...): value with its distribution (normal: divisor 1,
 //   rectangular sqrt 3, triangular sqrt 6), sensitivity coefficient and degrees of freedom.
 // Check-point accuracy m_X, m_Y, m_Z (RMSE, CONVENTIONS.md): A sqrt(1 / (2 n)) m (nu = n - 1),
-// B the check points' survey sigma (RMS of sX, sY, sZ). m_0 = sigma0 in um: A sigma0_um / sqrt(2 r).
+// B the check points' survey sigma (RMS of sX, sY, sZ). m_0 = sigma0 in um: A sigma0_um / sqrt(2
+// r).
 #pragma once
 
 #include "triangulation/calibration/calibration.h"
@@ -42,9 +43,9 @@ struct UncertaintyComponent {
   std::string distribution;  // normal | rectangular | triangular
   double value = 0;          // as given, in `value_unit`
   std::string value_unit;
-  double divisor = 1;       // value / divisor = standard uncertainty of the input
-  double sensitivity = 1;   // c_i, quantity unit per value unit
-  double u = 0;             // |c_i| value / divisor, quantity unit
+  double divisor = 1;      // value / divisor = standard uncertainty of the input
+  double sensitivity = 1;  // c_i, quantity unit per value unit
+  double u = 0;            // |c_i| value / divisor, quantity unit
   double dof = std::numeric_limits<double>::infinity();
 };
 
@@ -96,8 +97,8 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
 /// k for the effective degrees of freedom (see the header comment).
 double CoverageFactor(double dof_eff);
 /// "c = 7.4570 mm, U = 0.0021 mm (k = 2)": U to two significant digits, the value to its decimals.
-std::string CertificateStatement(const std::string& name, double value, double expanded, double k,
-                                 const std::string& unit);
+std::string CertificateStatement(
+    const std::string& name, double value, double expanded, double k, const std::string& unit);
 
 nlohmann::json BudgetToJson(const std::vector<BudgetQuantity>& budget);
 

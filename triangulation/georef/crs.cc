@@ -2,12 +2,11 @@
 
 #include "calib/core/error.h"
 
-#include <proj.h>
-#include <proj_experimental.h>  // compound / 3D CRS construction (stable since PROJ 6)
-
 #include <cmath>
 #include <filesystem>
 #include <limits>
+#include <proj.h>
+#include <proj_experimental.h>  // compound / 3D CRS construction (stable since PROJ 6)
 #include <set>
 #include <vector>
 
@@ -46,9 +45,7 @@ struct CrsConverter::Impl {
     source.reset();
     if (ctx) proj_context_destroy(ctx);
   }
-  std::string LastError() const {
-    return proj_context_errno_string(ctx, proj_context_errno(ctx));
-  }
+  std::string LastError() const { return proj_context_errno_string(ctx, proj_context_errno(ctx)); }
 };
 
 CrsConverter::CrsConverter(const CrsOptions& o, const std::string& pivot_definition)
@@ -78,8 +75,8 @@ CrsConverter::CrsConverter(const CrsOptions& o, const std::string& pivot_definit
     if (!(t == PJ_TYPE_PROJECTED_CRS || t == PJ_TYPE_GEOGRAPHIC_2D_CRS))
       fail("a separate vertical CRS needs a 2D horizontal CRS ('" + o.definition +
            "' is not one; use a compound CRS instead)");
-    m.source.reset(proj_create_compound_crs(m.ctx, (o.definition + " + " + o.vertical).c_str(),
-                                            m.source.get(), vertical.get()));
+    m.source.reset(proj_create_compound_crs(
+        m.ctx, (o.definition + " + " + o.vertical).c_str(), m.source.get(), vertical.get()));
     if (!m.source) fail("PROJ cannot combine '" + o.definition + "' and '" + o.vertical + "'");
     m.definition += " + " + o.vertical;
   }
@@ -110,8 +107,10 @@ CrsConverter::CrsConverter(const CrsOptions& o, const std::string& pivot_definit
       PjPtr cs(proj_create_ellipsoidal_3D_cs(
           m.ctx, PJ_ELLPS3D_LONGITUDE_LATITUDE_HEIGHT, nullptr, 0, nullptr, 0));
       m.pivot.reset(proj_create_geographic_crs_from_datum(
-          m.ctx, (std::string(proj_get_name(geodetic.get())) + " (geographic 3D)").c_str(),
-          datum.get(), cs.get()));
+          m.ctx,
+          (std::string(proj_get_name(geodetic.get())) + " (geographic 3D)").c_str(),
+          datum.get(),
+          cs.get()));
     } else {
       m.pivot.reset(proj_crs_promote_to_3D(m.ctx, nullptr, geodetic.get()));
     }
@@ -154,8 +153,8 @@ CrsConverter::CrsConverter(const CrsOptions& o, const std::string& pivot_definit
     for (int g = 0; g < proj_coordoperation_get_grid_used_count(m.ctx, op); ++g) {
       const char *short_name = nullptr, *full_name = nullptr, *package = nullptr, *url = nullptr;
       int direct = 0, open = 0, available = 0;
-      proj_coordoperation_get_grid_used(m.ctx, op, g, &short_name, &full_name, &package, &url,
-                                        &direct, &open, &available);
+      proj_coordoperation_get_grid_used(
+          m.ctx, op, g, &short_name, &full_name, &package, &url, &direct, &open, &available);
       if (!available && short_name) names.emplace_back(short_name);
     }
     return names;
@@ -184,8 +183,16 @@ CrsConverter::CrsConverter(const CrsOptions& o, const std::string& pivot_definit
   for (int g = 0; g < proj_coordoperation_get_grid_used_count(m.ctx, chosen.get()); ++g) {
     const char *short_name = nullptr, *full_name = nullptr, *package = nullptr, *url = nullptr;
     int direct = 0, open = 0, available = 0;
-    proj_coordoperation_get_grid_used(m.ctx, chosen.get(), g, &short_name, &full_name, &package,
-                                      &url, &direct, &open, &available);
+    proj_coordoperation_get_grid_used(m.ctx,
+                                      chosen.get(),
+                                      g,
+                                      &short_name,
+                                      &full_name,
+                                      &package,
+                                      &url,
+                                      &direct,
+                                      &open,
+                                      &available);
     m.operation_name += std::string(g == 0 ? "; grids: " : ", ") + (short_name ? short_name : "?");
   }
   m.operation.reset(proj_normalize_for_visualization(m.ctx, chosen.get()));
@@ -198,9 +205,11 @@ CrsConverter::CrsConverter(const CrsOptions& o, const std::string& pivot_definit
     const std::string path = std::filesystem::absolute(o.geoid_grid).string();
     const std::string pipeline =
         "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad +step +proj=vgridshift "
-        "+grids=" + path + " +multiplier=1 +step +proj=unitconvert +xy_in=rad +xy_out=deg";
+        "+grids=" +
+        path + " +multiplier=1 +step +proj=unitconvert +xy_in=rad +xy_out=deg";
     m.geoid.reset(proj_create(m.ctx, pipeline.c_str()));
-    if (!m.geoid) fail("PROJ cannot read the geoid grid '" + o.geoid_grid + "' (" + m.LastError() + ")");
+    if (!m.geoid)
+      fail("PROJ cannot read the geoid grid '" + o.geoid_grid + "' (" + m.LastError() + ")");
     m.operation_name += "; heights + undulation of " + o.geoid_grid;
   }
 }

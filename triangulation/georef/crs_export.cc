@@ -47,37 +47,41 @@ std::string Number(double v, int digits = 12) { return FormatNumber(v, digits); 
 
 }  // namespace
 
-void ExportResultInCrs(const Project& project, const nlohmann::json& result,
-                       const std::string& write_crs, const std::string& folder) {
+void ExportResultInCrs(const Project& project,
+                       const nlohmann::json& result,
+                       const std::string& write_crs,
+                       const std::string& folder) {
   using File = ObjectFrame::File;
   if (project.frame.kind != FrameSpec::Kind::kCrs)
-    throw InputError(project.path + ": --write-crs needs a project with frame: {crs: ...} (the "
-                                    "CRS its numbers are in)");
+    throw InputError(project.path +
+                     ": --write-crs needs a project with frame: {crs: ...} (the "
+                     "CRS its numbers are in)");
   const ObjectFrame from(project.frame);
   from.FixOrigin(project);
   const ObjectFrame to(TargetSpec(project.frame, from, write_crs));
   const ObjectFrame wgs84(TargetSpec(project.frame, from, "EPSG:4979"));
   const CrsConverter target(CrsOptions{write_crs, "", "", "--write-crs"});
-  const auto convert = [&](const Eigen::Vector3d& in, File file, const ObjectFrame& out,
-                           const std::string& what) {
-    const Eigen::Vector3d x = out.ToInput(from.ToAdjustment(in, file));
-    if (!x.allFinite()) throw InputError("result: " + what + " cannot be converted to " + write_crs);
-    return x;
-  };
+  const auto convert =
+      [&](const Eigen::Vector3d& in, File file, const ObjectFrame& out, const std::string& what) {
+        const Eigen::Vector3d x = out.ToInput(from.ToAdjustment(in, file));
+        if (!x.allFinite())
+          throw InputError("result: " + what + " cannot be converted to " + write_crs);
+        return x;
+      };
   std::filesystem::create_directories(folder);
   // Exposures: centres and attitudes.
   WriteFileAtomically(folder + "/exposures.csv", [&](std::ostream& out) {
     out << "image,X,Y,Z,omega,phi,kappa\n";
     for (const auto& e : result.at("exposures")) {
       const std::string image = e.at("image").get<std::string>();
-      const Eigen::Vector3d c_in(e.at("X").get<double>(), e.at("Y").get<double>(),
-                                 e.at("Z").get<double>());
+      const Eigen::Vector3d c_in(
+          e.at("X").get<double>(), e.at("Y").get<double>(), e.at("Z").get<double>());
       const Eigen::Vector3d opk_in(e.at("omega").get<double>() * kDegToRad,
                                    e.at("phi").get<double>() * kDegToRad,
                                    e.at("kappa").get<double>() * kDegToRad);
       const Eigen::Vector3d c_out = convert(c_in, File::kExposures, to, "exposure " + image);
-      const Eigen::Matrix3d r_local =
-          NearestRotation(from.MetricJacobian(c_in, File::kExposures)) * calib::RotationFromOpk(opk_in);
+      const Eigen::Matrix3d r_local = NearestRotation(from.MetricJacobian(c_in, File::kExposures)) *
+                                      calib::RotationFromOpk(opk_in);
       const Eigen::Vector3d opk_out = calib::OpkFromRotation(
           NearestRotation(to.MetricJacobian(c_out, File::kExposures)).transpose() * r_local);
       out << image << "," << Number(c_out.x()) << "," << Number(c_out.y()) << ","
@@ -89,8 +93,8 @@ void ExportResultInCrs(const Project& project, const nlohmann::json& result,
   // Points: every adjusted point with its role.
   WriteFileAtomically(folder + "/points.csv", [&](std::ostream& out) {
     out << "point,X,Y,Z,role\n";
-    for (const auto& [table, role] : {std::pair<const char*, const char*>{"control", "control"},
-                                      {"check", "check"}})
+    for (const auto& [table, role] :
+         {std::pair<const char*, const char*>{"control", "control"}, {"check", "check"}})
       for (const auto& p : result.at(table).at("points")) {
         const std::string id = p.at("point").get<std::string>();
         const Eigen::Vector3d x =
@@ -103,23 +107,26 @@ void ExportResultInCrs(const Project& project, const nlohmann::json& result,
   nlohmann::json features = nlohmann::json::array();
   for (const auto& p : result.at("check").at("points")) {
     const std::string id = p.at("point").get<std::string>();
-    const Eigen::Vector3d g = convert(Vec(p.at("adjusted"), id), File::kPoints, wgs84, "check " + id);
+    const Eigen::Vector3d g =
+        convert(Vec(p.at("adjusted"), id), File::kPoints, wgs84, "check " + id);
     const Eigen::Vector3d d = Vec(p.at("difference_m"), id);
-    features.push_back(
-        {{"type", "Feature"},
-         {"geometry", {{"type", "Point"}, {"coordinates", {g.x(), g.y(), g.z()}}}},
-         {"properties",
-          {{"point", id}, {"dX_m", d.x()}, {"dY_m", d.y()}, {"dZ_m", d.z()},
-           {"d_plan_m", std::hypot(d.x(), d.y())}, {"d_m", d.norm()},
-           {"rays", p.value("rays", 0)}}}});
+    features.push_back({{"type", "Feature"},
+                        {"geometry", {{"type", "Point"}, {"coordinates", {g.x(), g.y(), g.z()}}}},
+                        {"properties",
+                         {{"point", id},
+                          {"dX_m", d.x()},
+                          {"dY_m", d.y()},
+                          {"dZ_m", d.z()},
+                          {"d_plan_m", std::hypot(d.x(), d.y())},
+                          {"d_m", d.norm()},
+                          {"rays", p.value("rays", 0)}}}});
   }
-  const nlohmann::json geojson = {{"type", "FeatureCollection"},
-                                  {"name", "check_errors"},
-                                  {"features", features}};
+  const nlohmann::json geojson = {
+      {"type", "FeatureCollection"}, {"name", "check_errors"}, {"features", features}};
   WriteFileAtomically(folder + "/check_errors.geojson", geojson.dump(1) + "\n");
   std::ostringstream crs;
   crs << "exposures.csv, points.csv: " << target.Name() << " (" << write_crs << "; "
-      << (target.axes() == CrsConverter::Axes::kGeographic   ? "X = longitude, Y = latitude (deg)"
+      << (target.axes() == CrsConverter::Axes::kGeographic  ? "X = longitude, Y = latitude (deg)"
           : target.axes() == CrsConverter::Axes::kProjected ? "X = easting, Y = northing (m)"
                                                             : "X, Y, Z geocentric (m)")
       << (target.axes() == CrsConverter::Axes::kGeocentric ? ""

@@ -19,7 +19,9 @@ namespace aerocal::triangulation {
 /// position, properties point, dX_m, dY_m, dZ_m (adjusted - surveyed, east/north/up metres of the
 /// tangent plane), d_plan_m, d_m, rays). FOLDER/crs.txt states the CRS of every number. The
 /// project needs a crs: frame; InputError otherwise, or when a value cannot be converted.
-void ExportResultInCrs(const Project& project, const nlohmann::json& result,
-                       const std::string& write_crs, const std::string& folder);
+void ExportResultInCrs(const Project& project,
+                       const nlohmann::json& result,
+                       const std::string& write_crs,
+                       const std::string& folder);
 
 }  // namespace aerocal::triangulation

@@ -52,7 +52,8 @@ std::string FramePrefix(const FrameSpec& spec) {
 // meridian convergence and the UTM point scale (grid metres per metre) for utm:, the rotation
 // between the exposure's and the origin's tangent planes for local:. The error of the difference
 // is of the order |v dt|^2 / Earth radius, < 1e-9 relative for aircraft speeds.
-Eigen::Vector3d VelocityToAdjustment(const ObjectFrame& frame, const Eigen::Vector3d& geodetic,
+Eigen::Vector3d VelocityToAdjustment(const ObjectFrame& frame,
+                                     const Eigen::Vector3d& geodetic,
                                      const Eigen::Vector3d& enu_mps) {
   const GeographicLib::LocalCartesian tangent(geodetic.y(), geodetic.x(), geodetic.z());
   const auto moved = [&](double dt) {
@@ -88,7 +89,8 @@ ObjectFrame::ObjectFrame(const FrameSpec& spec) : impl_(std::make_unique<Impl>()
                          "' is not a UTM zone like 33N (" + e.what() + ")");
       }
       if (impl_->zone == GeographicLib::UTMUPS::UPS)
-        throw InputError(FramePrefix(spec) + "utm zone '" + spec.utm_zone + "' is a polar (UPS) zone");
+        throw InputError(FramePrefix(spec) + "utm zone '" + spec.utm_zone +
+                         "' is a polar (UPS) zone");
       break;
     case FrameSpec::Kind::kProjected:
       break;
@@ -114,7 +116,8 @@ ObjectFrame::ObjectFrame(ObjectFrame&&) noexcept = default;
 ObjectFrame& ObjectFrame::operator=(ObjectFrame&&) noexcept = default;
 
 bool ObjectFrame::geodetic_input() const {
-  return impl_->spec.kind != FrameSpec::Kind::kProjected && impl_->spec.kind != FrameSpec::Kind::kCrs;
+  return impl_->spec.kind != FrameSpec::Kind::kProjected &&
+         impl_->spec.kind != FrameSpec::Kind::kCrs;
 }
 
 bool ObjectFrame::crs_input() const { return impl_->spec.kind == FrameSpec::Kind::kCrs; }
@@ -144,7 +147,8 @@ void ObjectFrame::FixOrigin(const Project& project) const {
       sum += g;
       ++n;
     }
-  if (n == 0) throw InputError(FramePrefix(impl_->spec) + "crs: needs surveyed points or exposures");
+  if (n == 0)
+    throw InputError(FramePrefix(impl_->spec) + "crs: needs surveyed points or exposures");
   const Eigen::Vector3d c = sum / n;
   impl_->SetOrigin(c.y(), c.x(), c.z());
 }
@@ -237,33 +241,38 @@ std::string ObjectFrame::Description() const {
   char text[1024];
   if (crs_input()) {
     const auto file_text = [&](const char* what, const CrsConverter& c) {
-      const char* axes = c.axes() == CrsConverter::Axes::kGeographic
-                             ? "X = longitude, Y = latitude (deg)"
-                         : c.axes() == CrsConverter::Axes::kProjected
-                             ? "X = easting, Y = northing (m)"
-                             : "X, Y, Z geocentric (m)";
+      const char* axes =
+          c.axes() == CrsConverter::Axes::kGeographic  ? "X = longitude, Y = latitude (deg)"
+          : c.axes() == CrsConverter::Axes::kProjected ? "X = easting, Y = northing (m)"
+                                                       : "X, Y, Z geocentric (m)";
       return std::string(what) + " in " + c.Name() + " (" + c.Definition() + "; " + axes +
-             (c.axes() == CrsConverter::Axes::kGeocentric
-                  ? std::string()
-                  : c.orthometric() ? ", Z = orthometric height (m)"
-                                    : ", Z = ellipsoidal height (m)") +
+             (c.axes() == CrsConverter::Axes::kGeocentric ? std::string()
+              : c.orthometric()                           ? ", Z = orthometric height (m)"
+                                                          : ", Z = ellipsoidal height (m)") +
              "; PROJ: " + c.OperationDescription() + ")";
     };
-    std::string out = "local tangent plane (east, north, up; GeographicLib LocalCartesian on the "
-                      "ellipsoid of " + impl_->main->Name() + ")";
-    std::snprintf(text, sizeof(text), " about lat %.9f, lon %.9f, h %.3f m (ellipsoidal)",
-                  s.lat_deg, s.lon_deg, s.h_m);
+    std::string out =
+        "local tangent plane (east, north, up; GeographicLib LocalCartesian on the "
+        "ellipsoid of " +
+        impl_->main->Name() + ")";
+    std::snprintf(text,
+                  sizeof(text),
+                  " about lat %.9f, lon %.9f, h %.3f m (ellipsoidal)",
+                  s.lat_deg,
+                  s.lon_deg,
+                  s.h_m);
     out += text;
     if (impl_->points->orthometric()) {
-      std::snprintf(text, sizeof(text), "; geoid undulation at the origin N = %.3f m",
-                    impl_->undulation_m);
+      std::snprintf(
+          text, sizeof(text), "; geoid undulation at the origin N = %.3f m", impl_->undulation_m);
       out += text;
     }
     out += "; " + file_text("points", *impl_->points);
     out += "; " + file_text("exposure centres", *impl_->exposures) +
            ", attitudes relative to that CRS's axes at the exposure";
-    out += "; results written back in each file's CRS; differences, RMSE and sigmas in metres of "
-           "the tangent plane";
+    out +=
+        "; results written back in each file's CRS; differences, RMSE and sigmas in metres of "
+        "the tangent plane";
     return out;
   }
   if (impl_->local) {
@@ -314,9 +323,10 @@ Project CrsToAdjustmentFrame(const Project& project, const ObjectFrame& frame) {
   const auto convert = [&](const Eigen::Vector3d& xyz, File file, const SourceRef& where) {
     const Eigen::Vector3d a = frame.ToAdjustment(xyz, file);
     if (!a.allFinite())
-      ThrowInputError(where, "cannot be converted from the file's CRS (" + frame.Description() +
-                                 "): outside the CRS's area, or not in its axis order (easting / "
-                                 "longitude first)?");
+      ThrowInputError(where,
+                      "cannot be converted from the file's CRS (" + frame.Description() +
+                          "): outside the CRS's area, or not in its axis order (easting / "
+                          "longitude first)?");
     return a;
   };
   for (auto& p : out.points) {
@@ -331,7 +341,8 @@ Project CrsToAdjustmentFrame(const Project& project, const ObjectFrame& frame) {
     if (e.center_sigma_m) e.center_sigma_m = PropagatedSigma(j, *e.center_sigma_m);
     e.opk_rad = calib::OpkFromRotation(NearestRotation(j) * calib::RotationFromOpk(e.opk_rad));
     if (e.z_ref_m)
-      e.z_ref_m = convert({e.center_m.x(), e.center_m.y(), *e.z_ref_m}, File::kExposures,
+      e.z_ref_m = convert({e.center_m.x(), e.center_m.y(), *e.z_ref_m},
+                          File::kExposures,
                           {project.exposures_file, e.line})
                       .z();
     e.center_m = convert(e.center_m, File::kExposures, {project.exposures_file, e.line});
@@ -355,16 +366,18 @@ Project ToAdjustmentFrame(const Project& project, const ObjectFrame& frame) {
         ") takes geodetic X = longitude, Y = latitude (deg), Z = height (m); metre coordinates "
         "need frame: {projected: ...}";
     if (!(std::abs(xyz.y()) <= 90.0 && std::abs(xyz.x()) <= 540.0 && std::abs(xyz.z()) <= 1e5))
-      ThrowInputError(where, "not a longitude/latitude/height (got " + std::to_string(xyz.x()) +
-                                 ", " + std::to_string(xyz.y()) + ", " + std::to_string(xyz.z()) +
-                                 "): " + frame_text);
+      ThrowInputError(where,
+                      "not a longitude/latitude/height (got " + std::to_string(xyz.x()) + ", " +
+                          std::to_string(xyz.y()) + ", " + std::to_string(xyz.z()) +
+                          "): " + frame_text);
     try {
       const Eigen::Vector3d a = frame.ToAdjustment(xyz);
       if (!a.allFinite()) ThrowInputError(where, "cannot be converted: " + frame_text);
       return a;
     } catch (const GeographicLib::GeographicErr& e) {
-      ThrowInputError(where, std::string("cannot be converted to the frame (") +
-                                 (spec.source.empty() ? "frame:" : spec.source) + "): " + e.what());
+      ThrowInputError(where,
+                      std::string("cannot be converted to the frame (") +
+                          (spec.source.empty() ? "frame:" : spec.source) + "): " + e.what());
     }
   };
   for (auto& p : out.points)
@@ -394,13 +407,15 @@ Project FromAdjustmentFrame(const Project& project, const ObjectFrame& frame) {
     p.sigma_m = PropagatedSigma(frame.MetricJacobian(*p.xyz_m, File::kPoints).inverse(), p.sigma_m);
   }
   for (auto& e : out.exposures) {
-    if (e.z_ref_m) e.z_ref_m = frame.ToInput({e.center_m.x(), e.center_m.y(), *e.z_ref_m}, File::kExposures).z();
+    if (e.z_ref_m)
+      e.z_ref_m = frame.ToInput({e.center_m.x(), e.center_m.y(), *e.z_ref_m}, File::kExposures).z();
     e.center_m = convert(e.center_m, File::kExposures, {project.exposures_file, e.line});
     const Eigen::Matrix3d j = frame.MetricJacobian(e.center_m, File::kExposures);
     const Eigen::Matrix3d j_inv = j.inverse();
     if (e.velocity_mps) e.velocity_mps = j_inv * *e.velocity_mps;
     if (e.center_sigma_m) e.center_sigma_m = PropagatedSigma(j_inv, *e.center_sigma_m);
-    e.opk_rad = calib::OpkFromRotation(NearestRotation(j).transpose() * calib::RotationFromOpk(e.opk_rad));
+    e.opk_rad =
+        calib::OpkFromRotation(NearestRotation(j).transpose() * calib::RotationFromOpk(e.opk_rad));
   }
   return out;
 }

@@ -20,7 +20,7 @@ namespace aerocal::triangulation {
 /// Observations of points absent from `points_m` are left out. Files written atomically.
 /// Returns one note per camera: exact, or the conversion residual RMS / max in pixels.
 std::vector<std::string> WriteColmapModel(const Project& project,
-                      const std::map<std::string, Eigen::Vector3d>& points_m,
-                      const std::string& folder);
+                                          const std::map<std::string, Eigen::Vector3d>& points_m,
+                                          const std::string& folder);
 
 }  // namespace aerocal::triangulation

@@ -26,7 +26,8 @@ using internal::TextRow;
 
 // A COLMAP camera in the registry's COLMAP model (calib/camera/models/colmap.h: OpenCV's formula,
 // COLMAP's pixel origin): the camera-format reader's row conversion (camera_formats.h).
-calib::ModelCamera ReadColmapCamera(const TextRow& row, const std::string& file,
+calib::ModelCamera ReadColmapCamera(const TextRow& row,
+                                    const std::string& file,
                                     double pixel_size_mm) {
   return calib::ColmapCameraFromFields(row.fields, {file, row.line}, pixel_size_mm);
 }
@@ -44,7 +45,8 @@ Eigen::Vector2d ColmapProject(const std::string& model,
   const calib::ModelCamera camera{*id, params, calib::PixelFrame{1.0, 2, 2}};
   const double c = camera.PrincipalDistanceMm();
   Eigen::Vector2d pixel;
-  AEROCAL_CHECK(camera.PixelFromIdeal(Eigen::Vector2d(c * q.x() / q.z(), -c * q.y() / q.z()), &pixel));
+  AEROCAL_CHECK(
+      camera.PixelFromIdeal(Eigen::Vector2d(c * q.x() / q.z(), -c * q.y() / q.z()), &pixel));
   return pixel + Eigen::Vector2d::Constant(calib::kColmapPixelOffset);  // COLMAP's pixel origin
 }
 
@@ -58,7 +60,8 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
   if (!o.crs.empty()) {
     const CrsConverter crs(CrsOptions{o.crs, "", "", "--crs"});
     if (crs.axes() == CrsConverter::Axes::kGeographic)
-      throw InputError("--crs " + o.crs + ": a COLMAP model is Cartesian; give its geocentric (e.g. "
+      throw InputError("--crs " + o.crs +
+                       ": a COLMAP model is Cartesian; give its geocentric (e.g. "
                        "EPSG:4978 after model_aligner --ref_is_gps) or projected CRS");
     project.frame.kind = FrameSpec::Kind::kCrs;
     project.frame.crs = o.crs;
@@ -89,8 +92,9 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
     // A conversion missing by more than 10 px somewhere in the format is no usable camera (the
     // test cameras convert to 0.016 px; OPENCV k1 = -1 or 10 miss by thousands of pixels).
     if (!finite || !(fit.residual.max_px <= 10.0))
-      ThrowInputError({cameras_file, row.line}, unusable + " (conversion misses by up to " +
-                                                    FormatNumber(fit.residual.max_px, 3) + " px)");
+      ThrowInputError({cameras_file, row.line},
+                      unusable + " (conversion misses by up to " +
+                          FormatNumber(fit.residual.max_px, 3) + " px)");
     calib::Camera camera;
     camera.name = "COLMAP camera " + id + " (" + model + ")";
     camera.width_px = colmap.frame.width_px;
@@ -131,8 +135,8 @@ ColmapImportReport ImportColmapModel(const ColmapImportOptions& o) {
                             NumberField(row, 7, images_file, "TZ"));
     // COLMAP writes unit quaternions; anything else (0,0,0,0 above all) is no rotation.
     if (!(std::abs(q.norm() - 1.0) <= 1e-3))
-      ThrowInputError({images_file, row.line}, "QW QX QY QZ is not a unit quaternion (norm " +
-                                                   FormatNumber(q.norm()) + ")");
+      ThrowInputError({images_file, row.line},
+                      "QW QX QY QZ is not a unit quaternion (norm " + FormatNumber(q.norm()) + ")");
     if (!(t.cwiseAbs().maxCoeff() <= 1e8))
       ThrowInputError({images_file, row.line}, "TX TY TZ beyond 1e8");
     const Eigen::Matrix3d camera_from_world = q.normalized().toRotationMatrix();

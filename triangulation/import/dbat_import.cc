@@ -9,9 +9,8 @@
 #include <cmath>
 #include <filesystem>
 #include <map>
-#include <sstream>
-
 #include <set>
+#include <sstream>
 
 namespace aerocal::triangulation {
 namespace {
@@ -59,7 +58,8 @@ Project ImportDbat(const DbatImportOptions& o) {
     if (!fresh)
       ThrowInputError({o.images, row.line},
                       "image " + id + " has the file name '" + stem + "' of line " +
-                          std::to_string(it->second) + ": two images would merge into one exposure");
+                          std::to_string(it->second) +
+                          ": two images would merge into one exposure");
   }
   if (image_name.empty()) ThrowInputError({o.images, 0}, "no images listed");
   auto name_of = [&](const std::string& id, const std::string& file, int line) {
@@ -79,7 +79,8 @@ Project ImportDbat(const DbatImportOptions& o) {
       for (int k = 0; k < 3; ++k)
         e.center_m[k] = BoundedField(row, 1 + k, o.initial_eo, "X, Y, Z", -1e8, 1e8);
       for (int k = 0; k < 3; ++k)
-        e.opk_rad[k] = BoundedField(row, 4 + k, o.initial_eo, "omega, phi, kappa", -360, 360) * kDegToRad;
+        e.opk_rad[k] =
+            BoundedField(row, 4 + k, o.initial_eo, "omega, phi, kappa", -360, 360) * kDegToRad;
       if (!exposures.emplace(e.image, e).second)
         ThrowInputError({o.initial_eo, row.line}, "image " + e.image + " given twice");
     }
@@ -115,7 +116,8 @@ Project ImportDbat(const DbatImportOptions& o) {
       ThrowInputError({o.marks, row.line}, "image " + obs.image + " has no initial orientation");
     obs.point = StringField(row, 1, o.marks, "point id");
     if (row.fields.size() > 5)
-      ThrowInputError({o.marks, row.line}, "too many fields (expected image id, point id, x, y[, sxy])");
+      ThrowInputError({o.marks, row.line},
+                      "too many fields (expected image id, point id, x, y[, sxy])");
     obs.pixel = {BoundedField(row, 2, o.marks, "x", -1e7, 1e7) - 0.5,
                  BoundedField(row, 3, o.marks, "y", -1e7, 1e7) - 0.5};
     obs.sigma_px = row.fields.size() > 4 ? NumberField(row, 4, o.marks, "sxy") : o.default_sigma_px;
@@ -139,8 +141,10 @@ Project ImportDbat(const DbatImportOptions& o) {
                                 BoundedField(row, 4, o.control, "Z", -1e8, 1e8));
       const double s =
           row.fields.size() > 5 ? NumberField(row, 5, o.control, "sxyz") : o.control_sigma_m;
-      if (!(s > 0 && s <= 1e6)) ThrowInputError({o.control, row.line}, "sxyz must be > 0 and <= 1e6 m");
-      if (control.count(p.id)) ThrowInputError({o.control, row.line}, "point " + p.id + " given twice");
+      if (!(s > 0 && s <= 1e6))
+        ThrowInputError({o.control, row.line}, "sxyz must be > 0 and <= 1e6 m");
+      if (control.count(p.id))
+        ThrowInputError({o.control, row.line}, "point " + p.id + " given twice");
       p.sigma_m = Eigen::Vector3d::Constant(s);
       control.insert(p.id);
       project.points.push_back(p);

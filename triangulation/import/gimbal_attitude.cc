@@ -16,13 +16,9 @@ Eigen::Matrix3d ObjectFromImageOfGimbal(double yaw_deg, double pitch_deg, double
        Eigen::AngleAxisd(roll_deg * kDeg, Eigen::Vector3d::UnitX()))
           .toRotationMatrix();
   Eigen::Matrix3d body_from_image;
-  body_from_image << 0, 0, -1,
-                     1, 0, 0,
-                     0, -1, 0;
+  body_from_image << 0, 0, -1, 1, 0, 0, 0, -1, 0;
   Eigen::Matrix3d enu_from_ned;
-  enu_from_ned << 0, 1, 0,
-                  1, 0, 0,
-                  0, 0, -1;
+  enu_from_ned << 0, 1, 0, 1, 0, 0, 0, 0, -1;
   return enu_from_ned * ned_from_body * body_from_image;
 }
 

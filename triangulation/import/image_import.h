@@ -42,12 +42,12 @@
 namespace aerocal::triangulation {
 
 struct ImageImportOptions {
-  std::string folder;                            // the images
-  std::string crs;                               // output CRS; "" = the images' own
-  std::string heights = "egm96";                 // egm96 | ellipsoidal: the altitudes' datum
-  std::optional<Eigen::Vector2d> gnss_sigma_m;   // (horizontal, vertical) m, > 0, without RTK std
-  std::optional<double> attitude_sigma_deg;      // > 0
-  double pixel_size_mm = 0;                      // > 0 overrides the images'; 0 = from the images
+  std::string folder;                           // the images
+  std::string crs;                              // output CRS; "" = the images' own
+  std::string heights = "egm96";                // egm96 | ellipsoidal: the altitudes' datum
+  std::optional<Eigen::Vector2d> gnss_sigma_m;  // (horizontal, vertical) m, > 0, without RTK std
+  std::optional<double> attitude_sigma_deg;     // > 0
+  double pixel_size_mm = 0;                     // > 0 overrides the images'; 0 = from the images
 };
 
 /// One value an image gave: quantity ("latitude_deg"), the tag ("XMP drone-dji:GpsLatitude",
@@ -57,7 +57,7 @@ struct UsedTag {
 };
 
 struct ImageImportReport {
-  Project project;                                            // cameras, exposures, frame
+  Project project;  // cameras, exposures, frame
   std::vector<UsedTag> used_tags;
   std::vector<std::pair<std::string, std::string>> not_used;  // file, reason
   std::vector<std::string> notes;

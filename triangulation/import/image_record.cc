@@ -54,14 +54,19 @@ class Reader {
   }
 
   // EXIF GPS degrees, minutes, seconds with its ref: -1 for `negative`, +1 for `positive`.
-  std::optional<double> ExifDegrees(uint16_t tag, uint16_t ref_tag, char positive, char negative,
-                                    double bound, const std::string& quantity) {
+  std::optional<double> ExifDegrees(uint16_t tag,
+                                    uint16_t ref_tag,
+                                    char positive,
+                                    char negative,
+                                    double bound,
+                                    const std::string& quantity) {
     const calib::TiffEntry* e = Exif(TiffIfd::kGps, tag);
     if (!e) return std::nullopt;
     const std::string name = calib::TiffTagName(TiffIfd::kGps, tag);
     if (e->numbers.size() != 3) Fail(name + " must hold 3 rationals (degrees, minutes, seconds)");
     for (double v : e->numbers)
-      if (!(v >= 0 && v < 1e4)) Fail(name + " holds " + FormatNumber(v) + " (degrees, minutes, seconds >= 0)");
+      if (!(v >= 0 && v < 1e4))
+        Fail(name + " holds " + FormatNumber(v) + " (degrees, minutes, seconds >= 0)");
     const double deg = e->numbers[0] + e->numbers[1] / 60.0 + e->numbers[2] / 3600.0;
     const calib::TiffEntry* ref = Exif(TiffIfd::kGps, ref_tag);
     const std::string ref_name = calib::TiffTagName(TiffIfd::kGps, ref_tag);
@@ -70,9 +75,12 @@ class Reader {
     if (c != positive && c != negative)
       Fail(ref_name + " must be " + positive + " or " + negative + " (got '" + ref->text + "')");
     const double value = c == negative ? -deg : deg;
-    if (!(std::abs(value) <= bound)) Fail(name + " " + FormatNumber(value) + " is beyond " + FormatNumber(bound) + " deg");
-    Use(quantity, name + " + " + ref_name,
-        FormatNumber(e->numbers[0]) + " " + FormatNumber(e->numbers[1]) + " " + FormatNumber(e->numbers[2]) + " " + c);
+    if (!(std::abs(value) <= bound))
+      Fail(name + " " + FormatNumber(value) + " is beyond " + FormatNumber(bound) + " deg");
+    Use(quantity,
+        name + " + " + ref_name,
+        FormatNumber(e->numbers[0]) + " " + FormatNumber(e->numbers[1]) + " " +
+            FormatNumber(e->numbers[2]) + " " + c);
     return value;
   }
 
@@ -98,26 +106,33 @@ void ReadPosition(Reader& rd, ImageRecord* r) {
     lat = rd.ExifDegrees(0x0002, 0x0001, 'N', 'S', 90, "latitude_deg");
     lon = rd.ExifDegrees(0x0004, 0x0003, 'E', 'W', 180, "longitude_deg");
   }
-  if (lat && !(std::abs(*lat) <= 90)) rd.Fail("latitude " + FormatNumber(*lat) + " is beyond 90 deg");
-  if (lon && !(std::abs(*lon) <= 180)) rd.Fail("longitude " + FormatNumber(*lon) + " is beyond 180 deg");
+  if (lat && !(std::abs(*lat) <= 90))
+    rd.Fail("latitude " + FormatNumber(*lat) + " is beyond 90 deg");
+  if (lon && !(std::abs(*lon) <= 180))
+    rd.Fail("longitude " + FormatNumber(*lon) + " is beyond 180 deg");
   std::optional<double> alt = rd.Dji("AbsoluteAltitude", "altitude_m");
   if (!alt) {
     alt = rd.ExifNumber(TiffIfd::kGps, 0x0006, "altitude_m");
     if (alt) {
       const calib::TiffEntry* ref = rd.Exif(TiffIfd::kGps, 0x0005);
       if (ref && !ref->numbers.empty() && ref->numbers[0] != 0) {
-        if (ref->numbers[0] != 1) rd.Fail("EXIF GPSAltitudeRef must be 0 (above) or 1 (below sea level)");
+        if (ref->numbers[0] != 1)
+          rd.Fail("EXIF GPSAltitudeRef must be 0 (above) or 1 (below sea level)");
         *alt = -*alt;
         rd.Use("altitude_m", "EXIF GPSAltitudeRef", "1 (below sea level)");
       }
     }
   }
-  if (alt && !(std::abs(*alt) <= 1e5)) rd.Fail("altitude " + FormatNumber(*alt) + " m is beyond 1e5 m");
+  if (alt && !(std::abs(*alt) <= 1e5))
+    rd.Fail("altitude " + FormatNumber(*alt) + " m is beyond 1e5 m");
   rd.Dji("RelativeAltitude", "relative_altitude_m (listed; not used)");
   if (!lat || !lon) {
-    r->no_position = "no GPS position (neither XMP drone-dji:GpsLatitude/GpsLongitude nor EXIF GPSLatitude/GPSLongitude)";
+    r->no_position =
+        "no GPS position (neither XMP drone-dji:GpsLatitude/GpsLongitude nor EXIF "
+        "GPSLatitude/GPSLongitude)";
   } else if (!alt) {
-    r->no_position = "no GPS altitude (neither XMP drone-dji:AbsoluteAltitude nor EXIF GPSAltitude)";
+    r->no_position =
+        "no GPS altitude (neither XMP drone-dji:AbsoluteAltitude nor EXIF GPSAltitude)";
   } else if (*lat == 0 && *lon == 0) {
     r->no_position = "GPS position 0, 0 (the receiver had no fix)";
   } else {
@@ -131,7 +146,8 @@ void ReadAttitudeAndSigmas(Reader& rd, ImageRecord* r) {
   const auto roll = rd.Dji("GimbalRollDegree", "gimbal_roll_deg");
   if (yaw && pitch && roll) {
     for (double a : {*yaw, *pitch, *roll})
-      if (!(std::abs(a) <= 360)) rd.Fail("gimbal angle " + FormatNumber(a) + " deg is beyond 360 deg");
+      if (!(std::abs(a) <= 360))
+        rd.Fail("gimbal angle " + FormatNumber(a) + " deg is beyond 360 deg");
     r->gimbal_ypr_deg = Eigen::Vector3d(*yaw, *pitch, *roll);
   } else if (yaw || pitch || roll) {
     rd.Fail("drone-dji gimbal angles incomplete (yaw, pitch and roll are all needed)");
@@ -145,7 +161,8 @@ void ReadAttitudeAndSigmas(Reader& rd, ImageRecord* r) {
   const auto hgt = rd.Dji("RtkStdHgt", "sigma_up_m");
   if (lon && lat && hgt) {
     for (double s : {*lon, *lat, *hgt})
-      if (!(s > 0 && s <= 1e6)) rd.Fail("RTK standard deviation " + FormatNumber(s) + " m must be in (0, 1e6]");
+      if (!(s > 0 && s <= 1e6))
+        rd.Fail("RTK standard deviation " + FormatNumber(s) + " m must be in (0, 1e6]");
     r->sigma_enu_m = Eigen::Vector3d(*lon, *lat, *hgt);
   } else if (lon || lat || hgt) {
     rd.Fail("drone-dji RtkStdLon / RtkStdLat / RtkStdHgt incomplete");
@@ -155,17 +172,21 @@ void ReadAttitudeAndSigmas(Reader& rd, ImageRecord* r) {
 void ReadCameraEvidence(Reader& rd, const calib::ImageMetadata& m, ImageRecord* r) {
   const std::string make = rd.ExifText(TiffIfd::kImage, 0x010F, "make");
   const std::string model = rd.ExifText(TiffIfd::kImage, 0x0110, "model");
-  r->make_model = (make + " " + model).find_first_not_of(' ') == std::string::npos ? "unknown camera" : make + " " + model;
+  r->make_model = (make + " " + model).find_first_not_of(' ') == std::string::npos
+                      ? "unknown camera"
+                      : make + " " + model;
   std::string serial = rd.ExifText(TiffIfd::kExif, 0xA431, "serial");
   if (serial.empty() && m.xmp)
-    if (const calib::XmpProperty* p = m.xmp->Find(kDji, "CameraSerialNumber"); p && !p->value.empty()) {
+    if (const calib::XmpProperty* p = m.xmp->Find(kDji, "CameraSerialNumber");
+        p && !p->value.empty()) {
       serial = p->value;
       rd.Use("serial", "XMP " + p->qualified, serial);
     }
   r->camera_key = serial.empty() ? r->make_model : serial;
   r->width_px = m.width_px;
   r->height_px = m.height_px;
-  rd.Use("format_px", m.format == "jpeg" ? "JPEG SOF" : "TIFF ImageWidth/ImageLength",
+  rd.Use("format_px",
+         m.format == "jpeg" ? "JPEG SOF" : "TIFF ImageWidth/ImageLength",
          std::to_string(m.width_px) + " x " + std::to_string(m.height_px));
   r->focal_mm = rd.ExifNumber(TiffIfd::kExif, 0x920A, "focal_length_mm");
   r->focal_35mm = rd.ExifNumber(TiffIfd::kExif, 0xA405, "focal_length_35mm_mm");
@@ -193,7 +214,8 @@ void ReadCaptureTime(Reader& rd) {
 
 }  // namespace
 
-ImageRecord ReadImageRecord(const calib::ImageMetadata& meta, const std::string& path,
+ImageRecord ReadImageRecord(const calib::ImageMetadata& meta,
+                            const std::string& path,
                             const std::string& image) {
   ImageRecord r;
   r.image = image;

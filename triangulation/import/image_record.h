@@ -16,15 +16,15 @@ namespace aerocal::triangulation::internal {
 
 struct ImageRecord {
   std::string image;
-  std::optional<Eigen::Vector3d> lon_lat_alt;   // deg, deg, m
-  std::string no_position;                      // why there is none ("" when there is)
-  std::optional<Eigen::Vector3d> sigma_enu_m;   // RtkStdLon, RtkStdLat, RtkStdHgt
+  std::optional<Eigen::Vector3d> lon_lat_alt;  // deg, deg, m
+  std::string no_position;                     // why there is none ("" when there is)
+  std::optional<Eigen::Vector3d> sigma_enu_m;  // RtkStdLon, RtkStdLat, RtkStdHgt
   std::optional<Eigen::Vector3d> gimbal_ypr_deg;
   // camera evidence
   std::string camera_key, make_model;
   int width_px = 0, height_px = 0;
   std::optional<double> focal_mm, focal_35mm, focal_plane_pixel_mm;
-  std::string dewarp_data;                      // "" when absent
+  std::string dewarp_data;  // "" when absent
   SourceRef dewarp_where;
   std::vector<UsedTag> tags;
 };
@@ -32,7 +32,8 @@ struct ImageRecord {
 /// The record of `meta` (read from `path`, named `image`). InputError for values that are present
 /// and wrong (a number that is none, a latitude beyond 90, a GPS ref other than N/S/E/W, two
 /// spellings of the longitude that differ).
-ImageRecord ReadImageRecord(const calib::ImageMetadata& meta, const std::string& path,
+ImageRecord ReadImageRecord(const calib::ImageMetadata& meta,
+                            const std::string& path,
                             const std::string& image);
 
 }  // namespace aerocal::triangulation::internal

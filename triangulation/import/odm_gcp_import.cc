@@ -51,8 +51,8 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
   std::map<std::string, GroundPoint> points;
   for (size_t i = 1; i < rows.size(); ++i) {
     const auto& row = rows[i];
-    using internal::NumberField;
     using internal::BoundedField;
+    using internal::NumberField;
     const Eigen::Vector3d xyz(BoundedField(row, 0, o.gcp_list, "geo_x", -1e8, 1e8),
                               BoundedField(row, 1, o.gcp_list, "geo_y", -1e8, 1e8),
                               BoundedField(row, 2, o.gcp_list, "geo_z", -1e8, 1e8));
@@ -90,7 +90,8 @@ Project ImportOdmGcpList(const OdmImportOptions& o) {
     project.observations.push_back(obs);
   }
   if (project.observations.empty())
-    ThrowInputError({o.gcp_list, 0}, "no targets listed (only the projection line): nothing to import");
+    ThrowInputError({o.gcp_list, 0},
+                    "no targets listed (only the projection line): nothing to import");
   for (const auto& id : o.control_ids)
     if (!points.count(id))
       throw ConfigError("--control: '" + id + "' is no target of " + o.gcp_list +

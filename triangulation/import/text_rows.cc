@@ -49,18 +49,18 @@ double NumberField(const TextRow& row, size_t k, const std::string& file, const 
   return *value;
 }
 
-double BoundedField(const TextRow& row, size_t k, const std::string& file, const char* what,
-                    double lo, double hi) {
+double BoundedField(
+    const TextRow& row, size_t k, const std::string& file, const char* what, double lo, double hi) {
   const double value = NumberField(row, k, file, what);
   if (!(value >= lo && value <= hi))
-    ThrowInputError({file, row.line}, std::string(what) + " out of range (got " +
-                                          FormatNumber(value) + ", expected " + FormatNumber(lo) +
-                                          " .. " + FormatNumber(hi) + ")");
+    ThrowInputError({file, row.line},
+                    std::string(what) + " out of range (got " + FormatNumber(value) +
+                        ", expected " + FormatNumber(lo) + " .. " + FormatNumber(hi) + ")");
   return value;
 }
 
-int IntegerField(const TextRow& row, size_t k, const std::string& file, const char* what, int lo,
-                 int hi) {
+int IntegerField(
+    const TextRow& row, size_t k, const std::string& file, const char* what, int lo, int hi) {
   const double value = BoundedField(row, k, file, what, lo, hi);
   if (value != static_cast<double>(static_cast<int>(value)))
     ThrowInputError({file, row.line},

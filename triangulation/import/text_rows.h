@@ -23,11 +23,11 @@ std::vector<TextRow> ReadTextRows(const std::string& path,
 /// Field k as a number; InputError("FILE:LINE: ...") when absent or not a number.
 double NumberField(const TextRow& row, size_t k, const std::string& file, const char* what);
 /// Field k as a number within [lo, hi]; InputError naming the range otherwise.
-double BoundedField(const TextRow& row, size_t k, const std::string& file, const char* what,
-                    double lo, double hi);
+double BoundedField(
+    const TextRow& row, size_t k, const std::string& file, const char* what, double lo, double hi);
 /// Field k as an integer within [lo, hi].
-int IntegerField(const TextRow& row, size_t k, const std::string& file, const char* what, int lo,
-                 int hi);
+int IntegerField(
+    const TextRow& row, size_t k, const std::string& file, const char* what, int lo, int hi);
 /// Field k as a string; InputError when absent.
 const std::string& StringField(const TextRow& row,
                                size_t k,

@@ -5,10 +5,10 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/log.h"
+#include "triangulation/block/block_io.h"
 
 #include <cmath>
 #include <set>
-#include "triangulation/block/block_io.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -32,8 +32,8 @@ std::string FrameYaml(const FrameSpec& f) {
   if (!f.points_crs.empty()) yaml += ", points_crs: " + Quoted(f.points_crs);
   if (!f.exposures_crs.empty()) yaml += ", exposures_crs: " + Quoted(f.exposures_crs);
   if (f.has_origin)
-    yaml += ", origin: {lat: " + FormatNumber(f.lat_deg, 15) + ", lon: " +
-            FormatNumber(f.lon_deg, 15) + ", h: " + FormatNumber(f.h_m, 10) + "}";
+    yaml += ", origin: {lat: " + FormatNumber(f.lat_deg, 15) +
+            ", lon: " + FormatNumber(f.lon_deg, 15) + ", h: " + FormatNumber(f.h_m, 10) + "}";
   return yaml + "}";
 }
 

@@ -1,18 +1,18 @@
 #include "triangulation/joint/joint_adjustment.h"
-#include "calib/core/median.h"
-
-#include <algorithm>
-#include <cmath>
-#include <map>
-#include <set>
 
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/median.h"
 #include "calib/core/string_printf.h"
 #include "stitch/adjustment/frame_measurements.h"
 #include "stitch/adjustment/stitch_adjustment.h"
 #include "stitch/simulation/stitch_simulator.h"
 #include "triangulation/adjustment/block_adjustment.h"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
 
 namespace aerocal::triangulation {
 namespace {
@@ -22,8 +22,9 @@ using calib::MappingModel;
 std::optional<calib::MappingModel> ParseJointModel(const std::string& text) {
   if (text == "auto") return std::nullopt;
   if (const auto model = calib::ParseMappingModel(text)) return model;
-  throw ConfigError("--joint-model must be translation, conformal, affine, projective or auto (got '" + text +
-                    "')");
+  throw ConfigError(
+      "--joint-model must be translation, conformal, affine, projective or auto (got '" + text +
+      "')");
 }
 
 void JointOptions::Validate(const Project& project) const {
@@ -42,8 +43,9 @@ void JointOptions::Validate(const Project& project) const {
         throw ConfigError("base sub-image '" + base + "' is not a sub-image of camera " + id);
     if (base_ids.empty() && camera.reference_points.empty())
       ThrowInputError({project.camera_files.at(id), 1},
-                      "camera " + id + " has neither base sub-images (--base) nor reference points: "
-                      "the focal plane has no datum");
+                      "camera " + id +
+                          " has neither base sub-images (--base) nor reference points: "
+                          "the focal plane has no datum");
   }
 }
 
@@ -63,12 +65,13 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
                      ? "reference points (maker-surveyed virtual positions) fix the focal plane"
                      : "base sub-images keep their camera-file mapping:";
   for (const auto& b : options.base_ids) result.datum += " " + b;
-  result.mapping_model = options.model ? std::string(calib::MappingModelName(*options.model)) : "camera file";
-  result.mapping_model_reason =
-      !options.model_reason.empty() ? options.model_reason
-      : options.model               ? "given by the caller"
-                                    : "each sub-image keeps its camera-file model";
-  SubimageReport report = subimage.Report(adjustment.context(), result.adjustment.sigma0, &result.adjustment);
+  result.mapping_model =
+      options.model ? std::string(calib::MappingModelName(*options.model)) : "camera file";
+  result.mapping_model_reason = !options.model_reason.empty() ? options.model_reason
+                                : options.model               ? "given by the caller"
+                                                : "each sub-image keeps its camera-file model";
+  SubimageReport report =
+      subimage.Report(adjustment.context(), result.adjustment.sigma0, &result.adjustment);
   result.mappings = std::move(report.mappings);
   result.stitching = std::move(report.stitching);
   result.mapping_interior_correlations = std::move(report.mapping_interior_correlations);
@@ -99,8 +102,10 @@ nlohmann::json JointResultToJson(const JointResult& result) {
   nlohmann::json stitching = nlohmann::json::array();
   for (const auto& s : result.stitching) {
     nlohmann::json e = {{"image", s.image}, {"n_observations", s.n_observations}};
-    e["sigma0_before_px"] = std::isfinite(s.sigma0_before_px) ? nlohmann::json(s.sigma0_before_px) : nlohmann::json();
-    e["sigma0_after_px"] = std::isfinite(s.sigma0_after_px) ? nlohmann::json(s.sigma0_after_px) : nlohmann::json();
+    e["sigma0_before_px"] =
+        std::isfinite(s.sigma0_before_px) ? nlohmann::json(s.sigma0_before_px) : nlohmann::json();
+    e["sigma0_after_px"] =
+        std::isfinite(s.sigma0_after_px) ? nlohmann::json(s.sigma0_after_px) : nlohmann::json();
     stitching.push_back(e);
   }
   j["stitching_per_exposure"] = stitching;
@@ -118,47 +123,58 @@ ExposureMeasurements ReadExposureMeasurements(const Project& project, double def
   for (const auto& [id, camera] : project.cameras) {
     if (camera.subimages.empty()) continue;
     if (!camera_id.empty())
-      throw ConfigError(project.path + ": the flight's stitching is run for one camera with sub-images (found " +
+      throw ConfigError(project.path +
+                        ": the flight's stitching is run for one camera with sub-images (found " +
                         camera_id + " and " + id + ")");
     camera_id = id;
   }
-  if (camera_id.empty()) ThrowInputError({project.path, 0}, "no camera of the project has sub-images to stitch");
+  if (camera_id.empty())
+    ThrowInputError({project.path, 0}, "no camera of the project has sub-images to stitch");
   ExposureMeasurements out;
   out.camera = project.cameras.at(camera_id);
   for (const auto& row : stitch::ReadStitchObservations(project.stitching_file, default_sigma_px)) {
     const Exposure* e = project.FindExposure(row.frame);
-    if (e && e->camera == camera_id) out.rows.push_back(row);  // the stitching of the block's exposures
+    if (e && e->camera == camera_id)
+      out.rows.push_back(row);  // the stitching of the block's exposures
   }
   out.frames = stitch::GroupByFrame(out.camera, out.rows, project.stitching_file);
   if (out.frames.empty())
-    ThrowInputError({project.stitching_file, 0}, "no stitching measurements of the block's exposures");
+    ThrowInputError({project.stitching_file, 0},
+                    "no stitching measurements of the block's exposures");
   return out;
 }
 
-stitch::BatchResult StitchExposures(const Project& project, const stitch::BatchOptions& options,
-                                    double default_sigma_px, Progress* progress) {
+stitch::BatchResult StitchExposures(const Project& project,
+                                    const stitch::BatchOptions& options,
+                                    double default_sigma_px,
+                                    Progress* progress) {
   const ExposureMeasurements m = ReadExposureMeasurements(project, default_sigma_px);
   return stitch::RunStitchBatch(m.camera, m.frames, options, progress);
 }
 
-calib::Camera JointMappingsFromStitching(const calib::Camera& camera, const stitch::BatchResult* batch,
+calib::Camera JointMappingsFromStitching(const calib::Camera& camera,
+                                         const stitch::BatchResult* batch,
                                          const stitch::BatchOptions& batch_options,
-                                         std::optional<calib::MappingModel> forced, JointOptions* options) {
+                                         std::optional<calib::MappingModel> forced,
+                                         JointOptions* options) {
   options->model = forced;
   if (!batch || batch->frames.empty()) {
-    options->model_reason = forced ? "given by the user; starting from the camera file's mappings"
-                                   : "each sub-image keeps its camera-file model (no stitching measurements)";
+    options->model_reason =
+        forced ? "given by the user; starting from the camera file's mappings"
+               : "each sub-image keeps its camera-file model (no stitching measurements)";
     return camera;
   }
   const MappingModel model = forced ? *forced : stitch::FlightModel(*batch, batch_options);
   const std::string name(calib::MappingModelName(model));
   options->model = model;
   for (const stitch::FrameRun& run : batch->frames) {
-    const stitch::FrameAdjustment* alone = run.adjustment.model == model ? &run.adjustment : nullptr;
+    const stitch::FrameAdjustment* alone =
+        run.adjustment.model == model ? &run.adjustment : nullptr;
     if (!alone && run.choice)
       for (const auto& c : run.choice->candidates)
         if (c.model == model && c.determinable) alone = &c.adjustment;
-    if (alone && alone->converged) options->stitching_sigma0_before_px[alone->frame] = alone->sigma0_px;
+    if (alone && alone->converged)
+      options->stitching_sigma0_before_px[alone->frame] = alone->sigma0_px;
   }
   std::string reason;
   if (forced) {
@@ -166,21 +182,27 @@ calib::Camera JointMappingsFromStitching(const calib::Camera& camera, const stit
   } else if (batch_options.model) {
     reason = "the model the stitching was run with";
   } else {
-    const auto chosen = std::count_if(batch->frames.begin(), batch->frames.end(),
-                                      [&](const stitch::FrameRun& run) { return run.adjustment.model == model; });
-    reason = "chosen by the stitching F test (alpha " + FormatNumber(batch_options.alpha, 3) + ") in " +
-             std::to_string(chosen) + " of " + std::to_string(batch->frames.size()) + " exposures";
+    const auto chosen =
+        std::count_if(batch->frames.begin(), batch->frames.end(), [&](const stitch::FrameRun& run) {
+          return run.adjustment.model == model;
+        });
+    reason = "chosen by the stitching F test (alpha " + FormatNumber(batch_options.alpha, 3) +
+             ") in " + std::to_string(chosen) + " of " + std::to_string(batch->frames.size()) +
+             " exposures";
   }
   if (auto mean = stitch::FlightMeanCamera(camera, *batch, model)) {
-    options->model_reason = reason + "; starting from the stitching's flight-mean " + name + " mappings";
+    options->model_reason =
+        reason + "; starting from the stitching's flight-mean " + name + " mappings";
     return *mean;
   }
-  options->model_reason = reason + "; starting from the camera file's mappings (the stitching did not adjust " +
-                          name + " in every exposure)";
+  options->model_reason =
+      reason + "; starting from the camera file's mappings (the stitching did not adjust " + name +
+      " in every exposure)";
   return camera;
 }
 
-calib::Camera JointUpdatedCamera(const calib::Camera& camera, const std::string& camera_id,
+calib::Camera JointUpdatedCamera(const calib::Camera& camera,
+                                 const std::string& camera_id,
                                  const JointResult& result) {
   calib::Camera out = camera;
   for (const auto& estimate : result.adjustment.cameras)
@@ -198,8 +220,9 @@ calib::Camera JointUpdatedCamera(const calib::Camera& camera, const std::string&
 std::string FormatJointSummary(const JointResult& result) {
   int free = 0;
   for (const auto& m : result.mappings) free += m.base ? 0 : 1;
-  std::string out = "joint mappings: " + result.mapping_model + ", " + MappingScopeName(result.scope) + ", " +
-                    std::to_string(free) + " free (" + result.mapping_model_reason + ")\n";
+  std::string out = "joint mappings: " + result.mapping_model + ", " +
+                    MappingScopeName(result.scope) + ", " + std::to_string(free) + " free (" +
+                    result.mapping_model_reason + ")\n";
   out += "focal-plane datum: " + result.datum + "\n";
   std::vector<double> before, after;
   for (const auto& s : result.stitching) {
@@ -207,10 +230,14 @@ std::string FormatJointSummary(const JointResult& result) {
     if (std::isfinite(s.sigma0_after_px)) after.push_back(s.sigma0_after_px);
   }
   if (!result.stitching.empty())
-    out += StringPrintf("stitching sigma0 per exposure (median of %zu): before %.3f px, after %.3f px\n",
-                        result.stitching.size(), Median(before), Median(after));
+    out += StringPrintf(
+        "stitching sigma0 per exposure (median of %zu): before %.3f px, after %.3f px\n",
+        result.stitching.size(),
+        Median(before),
+        Median(after));
   for (const auto& h : result.mapping_interior_correlations)
-    out += StringPrintf("mapping/interior correlation %.3f: %s ~ %s\n", h.correlation, h.a.c_str(), h.b.c_str());
+    out += StringPrintf(
+        "mapping/interior correlation %.3f: %s ~ %s\n", h.correlation, h.a.c_str(), h.b.c_str());
   return out;
 }
 

@@ -17,14 +17,6 @@
 // (JointMappingsFromStitching), starting from the stitching's flight-mean mappings.
 #pragma once
 
-#include <limits>
-#include <map>
-#include <optional>
-#include <string>
-#include <vector>
-
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/subimage_mapping.h"
 #include "calib/problem/problem_builder.h"
 #include "stitch/adjustment/flight_stability.h"
@@ -32,6 +24,14 @@
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
 #include "triangulation/sensor/subimage_camera.h"
+
+#include <nlohmann/json.hpp>
+
+#include <limits>
+#include <map>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace aerocal {
 class Progress;
@@ -82,8 +82,10 @@ ExposureMeasurements ReadExposureMeasurements(const Project& project, double def
 /// `aerocal stitch` does (`options.model` nullopt: per exposure the model the F test chooses),
 /// for the project's one camera with sub-images. InputError when the project names no stitching
 /// measurements or has no camera with sub-images, ConfigError when it has several.
-stitch::BatchResult StitchExposures(const Project& project, const stitch::BatchOptions& options,
-                                    double default_sigma_px, Progress* progress);
+stitch::BatchResult StitchExposures(const Project& project,
+                                    const stitch::BatchOptions& options,
+                                    double default_sigma_px,
+                                    Progress* progress);
 
 /// Mapping model and starting mappings of the joint adjustment from the flight's stitching
 /// (`batch`, run with `batch_options`; null: no stitching measurements): `forced` when given, else
@@ -92,13 +94,16 @@ stitch::BatchResult StitchExposures(const Project& project, const stitch::BatchO
 /// options->model_reason and options->stitching_sigma0_before_px (each exposure's stitching with
 /// that model); returns `camera` carrying the starting mappings (the stitching's flight means of
 /// that model, stitch::FlightMeanCamera, when it was adjusted in every exposure).
-calib::Camera JointMappingsFromStitching(const calib::Camera& camera, const stitch::BatchResult* batch,
+calib::Camera JointMappingsFromStitching(const calib::Camera& camera,
+                                         const stitch::BatchResult* batch,
                                          const stitch::BatchOptions& batch_options,
-                                         std::optional<calib::MappingModel> forced, JointOptions* options);
+                                         std::optional<calib::MappingModel> forced,
+                                         JointOptions* options);
 
 /// `camera` with the joint estimate: interior of camera `camera_id` and the flight's mappings
 /// (per-exposure mappings are not carried: the camera keeps its own).
-calib::Camera JointUpdatedCamera(const calib::Camera& camera, const std::string& camera_id,
+calib::Camera JointUpdatedCamera(const calib::Camera& camera,
+                                 const std::string& camera_id,
                                  const JointResult& result);
 
 /// Terminal lines of the joint part: mapping model and why, every free mapping's largest

@@ -1,17 +1,16 @@
 #include "triangulation/pushbroom/cloud_control.h"
 
-#include <algorithm>
-#include <cmath>
-
-#include <Eigen/Cholesky>
-#include <Eigen/LU>
-#include <nlohmann/json.hpp>
-
 #include "calib/core/error.h"
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/calibration/calibration.h"
 
+#include <Eigen/Cholesky>
+#include <Eigen/LU>
 #include <Eigen/QR>
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
+#include <cmath>
 
 namespace aerocal::triangulation {
 namespace {
@@ -25,9 +24,14 @@ struct Ray2 {
 // Normalised cross-correlation search: the template of `l1` at p against the reference image
 // resampled through the affine t0 + a0 x; returns the best integer shift (L1 cells) and its
 // correlation.
-bool SearchCorrelation(const stitch::GrayImage& l1, const Eigen::Vector2i& p,
-                       const stitch::GrayImage& b, const Eigen::Vector2d& t0,
-                       const Eigen::Matrix2d& a0, int h, int s, Eigen::Vector2i* shift,
+bool SearchCorrelation(const stitch::GrayImage& l1,
+                       const Eigen::Vector2i& p,
+                       const stitch::GrayImage& b,
+                       const Eigen::Vector2d& t0,
+                       const Eigen::Matrix2d& a0,
+                       int h,
+                       int s,
+                       Eigen::Vector2i* shift,
                        double* best) {
   const int n = 2 * (h + s) + 1, m = 2 * h + 1;
   Eigen::MatrixXd window(n, n);
@@ -59,12 +63,17 @@ bool SearchCorrelation(const stitch::GrayImage& l1, const Eigen::Vector2i& p,
 
 // Weighted intersection of the rays (Gauss-Newton on the pixel misclosures from a least-squares
 // ray intersection); returns v^T P v and N^-1 and the per-ray v^T P v.
-bool Intersect(const calib::Camera& camera, const std::vector<ReferenceFrame>& frames,
-               const std::vector<Ray2>& rays, Eigen::Vector3d* point, Eigen::Matrix3d* cov,
-               double* vtpv, std::vector<double>* per_ray) {
+bool Intersect(const calib::Camera& camera,
+               const std::vector<ReferenceFrame>& frames,
+               const std::vector<Ray2>& rays,
+               Eigen::Vector3d* point,
+               Eigen::Matrix3d* cov,
+               double* vtpv,
+               std::vector<double>* per_ray) {
   std::vector<ImageRay> lines;
   for (const auto& r : rays)
-    lines.push_back(RayFromPixel(camera, frames[r.frame].opk_rad, frames[r.frame].center_m, r.pixel));
+    lines.push_back(
+        RayFromPixel(camera, frames[r.frame].opk_rad, frames[r.frame].center_m, r.pixel));
   const auto start = IntersectRays(lines);
   if (!start) return false;
   Eigen::Vector3d x = *start;
@@ -112,10 +121,13 @@ bool Intersect(const calib::Camera& camera, const std::vector<ReferenceFrame>& f
 // the POS error adds ~ its own size), so per sub-camera and axis a degree-5 polynomial in the
 // normalised index is fitted robustly (3 rounds: least squares, then drop |v| > k 1.4826 MAD,
 // at least min_px); returns the indices to keep.
-std::vector<bool> SmoothMisclosureInliers(const calib::LineCamera& camera, const PosTrajectory& pos,
+std::vector<bool> SmoothMisclosureInliers(const calib::LineCamera& camera,
+                                          const PosTrajectory& pos,
                                           const std::vector<LineObservation>& obs,
-                                          const std::vector<GroundPoint>& points, double k,
-                                          double min_px, int* rejected) {
+                                          const std::vector<GroundPoint>& points,
+                                          double k,
+                                          double min_px,
+                                          int* rejected) {
   std::vector<bool> keep(obs.size(), true);
   std::vector<Eigen::Vector2d> v(obs.size());
   for (size_t n = 0; n < obs.size(); ++n) {
@@ -143,7 +155,8 @@ std::vector<bool> SmoothMisclosureInliers(const calib::LineCamera& camera, const
         Eigen::MatrixXd a(in.size(), terms);
         Eigen::VectorXd b(in.size());
         for (size_t r = 0; r < in.size(); ++r) {
-          const double u = last > first ? (2 * obs[in[r]].detector - first - last) / (last - first) : 0;
+          const double u =
+              last > first ? (2 * obs[in[r]].detector - first - last) / (last - first) : 0;
           for (int t = 0; t < terms; ++t) a(r, t) = std::pow(u, t);
           b[r] = v[in[r]][axis];
         }
@@ -170,19 +183,23 @@ void CloudControlOptions::Validate() const {
   };
   require(gsd_m >= 0, "--gsd-m must be >= 0 (0: the line spacing)");
   require(map_step_px >= 1 && map_step_px <= 64, "--map-step must be within 1 .. 64");
-  require(template_half_px >= 3 && template_half_px <= 30, "--template-half must be within 3 .. 30");
+  require(template_half_px >= 3 && template_half_px <= 30,
+          "--template-half must be within 3 .. 30");
   require(search_px >= 0 && search_px <= 100, "--search-px must be within 0 .. 100");
   require(min_correlation >= 0 && min_correlation <= 1, "--min-correlation must be within 0 .. 1");
   require(min_match_sigma_px > 0, "--min-match-sigma-px must be > 0");
   require(line_sigma_px > 0, "--line-sigma-px must be > 0");
-  require(gross_error_alpha > 0 && gross_error_alpha < 0.5, "--gross-error-alpha must be within (0, 0.5)");
+  require(gross_error_alpha > 0 && gross_error_alpha < 0.5,
+          "--gross-error-alpha must be within (0, 0.5)");
   require(max_point_sigma_m > 0, "--max-point-sigma-m must be > 0");
-  require(line_outlier_k > 0 && line_outlier_min_px > 0, "--line-outlier-k and --line-outlier-min-px must be > 0");
+  require(line_outlier_k > 0 && line_outlier_min_px > 0,
+          "--line-outlier-k and --line-outlier-min-px must be > 0");
   foerstner.Validate();
   lsm.Validate();
 }
 
-CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTrajectory& pos,
+CloudControlResult MakeCloudControl(const calib::LineCamera& camera,
+                                    const PosTrajectory& pos,
                                     const stitch::GrayImage& line_image,
                                     const calib::Camera& ref_camera,
                                     const std::vector<ReferenceFrame>& frames,
@@ -195,7 +212,8 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
     if (f.image.cols() != ref_camera.width_px || f.image.rows() != ref_camera.height_px)
       throw InputError(f.id + ": image is " + std::to_string(f.image.cols()) + " x " +
                        std::to_string(f.image.rows()) + " px, the reference camera " +
-                       std::to_string(ref_camera.width_px) + " x " + std::to_string(ref_camera.height_px));
+                       std::to_string(ref_camera.width_px) + " x " +
+                       std::to_string(ref_camera.height_px));
   CloudControlResult out;
   out.l1 = RectifyLineImage(camera, pos, line_image, o.mean_height_m, o.gsd_m, o.map_step_px);
   const L1Image& l1 = out.l1;
@@ -210,7 +228,8 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
     const Eigen::Vector2i p(int(std::lround(ip.position.x())), int(std::lround(ip.position.y())));
     // The template and a margin must lie on valid cells.
     const int r = h + 2;
-    if (p.x() < r || p.y() < r || p.x() >= l1.grid.width - r || p.y() >= l1.grid.height - r) continue;
+    if (p.x() < r || p.y() < r || p.x() >= l1.grid.width - r || p.y() >= l1.grid.height - r)
+      continue;
     bool valid = true;
     for (int y = -r; y <= r && valid; ++y)
       for (int x = -r; x <= r && valid; ++x) valid = l1.Valid(p.x() + x, p.y() + y);
@@ -221,8 +240,9 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
     const Eigen::Vector2d cell_in_line(l1.detector_map(p.y(), p.x()), l1.line_map(p.y(), p.x()));
     const auto [first, last] = ranges[camera.SubcameraOf(cell_in_line.x())];
     if (last - first < 2 * h + 2) continue;
-    const Eigen::Vector2i q(std::clamp<int>(int(std::lround(cell_in_line.x())), first + h + 1, last - h - 1),
-                            int(std::lround(cell_in_line.y())));
+    const Eigen::Vector2i q(
+        std::clamp<int>(int(std::lround(cell_in_line.x())), first + h + 1, last - h - 1),
+        int(std::lround(cell_in_line.y())));
     if (q.y() < h + 1 || q.y() > line_image.rows() - h - 2) continue;
     const auto q_ground = GroundOfDetector(camera, pos, q.x(), q.y(), plane);
     const auto qx_ground = GroundOfDetector(camera, pos, q.x() + 1, q.y(), plane);
@@ -235,8 +255,10 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
       const auto& f = frames[k];
       Eigen::Vector2d t0, tx, ty;
       if (!ref_camera.ProjectToPixel(f.opk_rad, f.center_m, g0, &t0) ||
-          !ref_camera.ProjectToPixel(f.opk_rad, f.center_m, g0 + Eigen::Vector3d(l1.grid.gsd_m, 0, 0), &tx) ||
-          !ref_camera.ProjectToPixel(f.opk_rad, f.center_m, g0 + Eigen::Vector3d(0, l1.grid.gsd_m, 0), &ty))
+          !ref_camera.ProjectToPixel(
+              f.opk_rad, f.center_m, g0 + Eigen::Vector3d(l1.grid.gsd_m, 0, 0), &tx) ||
+          !ref_camera.ProjectToPixel(
+              f.opk_rad, f.center_m, g0 + Eigen::Vector3d(0, l1.grid.gsd_m, 0), &ty))
         continue;
       Eigen::Matrix2d a0;
       a0.col(0) = tx - t0;
@@ -249,8 +271,8 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
       double ncc = 0;
       if (!SearchCorrelation(l1.image, p, f.image, t0, a0, h, o.search_px, &shift, &ncc)) continue;
       if (ncc < o.min_correlation) continue;
-      const auto m_l1 = stitch::MatchLeastSquares(l1.image, p, f.image,
-                                                  t0 + a0 * shift.cast<double>(), a0, lsm);
+      const auto m_l1 =
+          stitch::MatchLeastSquares(l1.image, p, f.image, t0 + a0 * shift.cast<double>(), a0, lsm);
       if (!m_l1.ok()) continue;
       // Refined from the line image itself: the L1 grey values are interpolated at fractional
       // line-image positions whose fraction drifts slowly over the L1 grid (its cells are not
@@ -292,7 +314,9 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
       Ray2 ray;
       ray.frame = int(k);
       ray.pixel = m.position_in_b - (mean_mapped - pq);
-      ray.weight = (m.cov_px2 + o.min_match_sigma_px * o.min_match_sigma_px * Eigen::Matrix2d::Identity()).inverse();
+      ray.weight =
+          (m.cov_px2 + o.min_match_sigma_px * o.min_match_sigma_px * Eigen::Matrix2d::Identity())
+              .inverse();
       rays.push_back(ray);
       ++out.n_rays;
     }
@@ -312,7 +336,8 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
         accepted = true;
         break;
       }
-      rays.erase(rays.begin() + (std::max_element(per_ray.begin(), per_ray.end()) - per_ray.begin()));
+      rays.erase(rays.begin() +
+                 (std::max_element(per_ray.begin(), per_ray.end()) - per_ray.begin()));
       ++out.n_rays_removed;
     }
     if (!accepted) {
@@ -339,8 +364,13 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
     out.observations.push_back(obs);
   }
   {
-    const auto keep = SmoothMisclosureInliers(camera, pos, out.observations, out.points,
-                                              o.line_outlier_k, o.line_outlier_min_px, &out.n_line_outliers);
+    const auto keep = SmoothMisclosureInliers(camera,
+                                              pos,
+                                              out.observations,
+                                              out.points,
+                                              o.line_outlier_k,
+                                              o.line_outlier_min_px,
+                                              &out.n_line_outliers);
     std::vector<LineObservation> observations;
     std::vector<GroundPoint> points;
     for (size_t n = 0; n < keep.size(); ++n)
@@ -352,7 +382,8 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
     out.points = std::move(points);
   }
   if (!match_sigmas.empty()) {
-    std::nth_element(match_sigmas.begin(), match_sigmas.begin() + match_sigmas.size() / 2, match_sigmas.end());
+    std::nth_element(
+        match_sigmas.begin(), match_sigmas.begin() + match_sigmas.size() / 2, match_sigmas.end());
     out.median_match_sigma_px = match_sigmas[match_sigmas.size() / 2];
   }
   return out;
@@ -361,19 +392,29 @@ CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTr
 nlohmann::json CloudControlToJson(const CloudControlResult& r, const CloudControlOptions& o) {
   nlohmann::json j;
   j["kind"] = "pushbroom_control";
-  j["l1"] = {{"width", r.l1.grid.width}, {"height", r.l1.grid.height}, {"gsd_m", r.l1.grid.gsd_m},
-             {"z_m", r.l1.grid.z_m}, {"x0_m", r.l1.grid.x0_m}, {"y0_m", r.l1.grid.y0_m}};
+  j["l1"] = {{"width", r.l1.grid.width},
+             {"height", r.l1.grid.height},
+             {"gsd_m", r.l1.grid.gsd_m},
+             {"z_m", r.l1.grid.z_m},
+             {"x0_m", r.l1.grid.x0_m},
+             {"y0_m", r.l1.grid.y0_m}};
   j["n_interest"] = r.n_interest;
   j["n_rays"] = r.n_rays;
   j["n_points"] = r.points.size();
-  j["rejected"] = {{"fewer_than_two_matches", r.n_no_match}, {"gross_error", r.n_gross},
-                   {"imprecise", r.n_imprecise}, {"rays_removed", r.n_rays_removed},
+  j["rejected"] = {{"fewer_than_two_matches", r.n_no_match},
+                   {"gross_error", r.n_gross},
+                   {"imprecise", r.n_imprecise},
+                   {"rays_removed", r.n_rays_removed},
                    {"line_outliers", r.n_line_outliers}};
   j["median_match_sigma_px"] = r.median_match_sigma_px;
-  j["options"] = {{"mean_height_m", o.mean_height_m}, {"map_step_px", o.map_step_px},
-                  {"template_half_px", o.template_half_px}, {"search_px", o.search_px},
-                  {"min_correlation", o.min_correlation}, {"min_match_sigma_px", o.min_match_sigma_px},
-                  {"line_sigma_px", o.line_sigma_px}, {"gross_error_alpha", o.gross_error_alpha},
+  j["options"] = {{"mean_height_m", o.mean_height_m},
+                  {"map_step_px", o.map_step_px},
+                  {"template_half_px", o.template_half_px},
+                  {"search_px", o.search_px},
+                  {"min_correlation", o.min_correlation},
+                  {"min_match_sigma_px", o.min_match_sigma_px},
+                  {"line_sigma_px", o.line_sigma_px},
+                  {"gross_error_alpha", o.gross_error_alpha},
                   {"max_point_sigma_m", o.max_point_sigma_m}};
   return j;
 }

@@ -26,11 +26,6 @@
 //    by a smooth function of the detector: measured, a 0.08 px across-track table bias.
 #pragma once
 
-#include <string>
-#include <vector>
-
-#include <Eigen/Core>
-
 #include "calib/camera/camera.h"
 #include "calib/camera/line_camera.h"
 #include "stitch/image_io/gray_image.h"
@@ -41,24 +36,29 @@
 #include "triangulation/pushbroom/line_rectification.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
 
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
 namespace aerocal::triangulation {
 
 struct CloudControlOptions {
-  double mean_height_m = 0.0;      // height of the L1 rectification plane, m
-  double gsd_m = 0.0;              // L1 cell size, m; 0: the POS line spacing
-  int map_step_px = 8;             // exact inverse every N cells, bilinear between, 1 .. 64
+  double mean_height_m = 0.0;  // height of the L1 rectification plane, m
+  double gsd_m = 0.0;          // L1 cell size, m; 0: the POS line spacing
+  int map_step_px = 8;         // exact inverse every N cells, bilinear between, 1 .. 64
   stitch::FoerstnerOptions foerstner = {5, 0.5, 0.5, 9, 5000};  // window, q_min, w factor, NMS, max
-  int template_half_px = 7;        // correlation and LSM template (2h+1)^2, 3 .. 30
-  int search_px = 15;              // correlation search +- L1 cells (relief displacement), 0 .. 100
-  double min_correlation = 0.7;    // of the correlation peak, 0 .. 1
-  stitch::LsmOptions lsm;          // half_size_px is set to template_half_px
+  int template_half_px = 7;      // correlation and LSM template (2h+1)^2, 3 .. 30
+  int search_px = 15;            // correlation search +- L1 cells (relief displacement), 0 .. 100
+  double min_correlation = 0.7;  // of the correlation peak, 0 .. 1
+  stitch::LsmOptions lsm;        // half_size_px is set to template_half_px
   double min_match_sigma_px = 0.05;  // floor of the LSM position sigma, px, > 0
-  double line_sigma_px = 0.05;     // sigma written for the line-image observations, px, > 0
+  double line_sigma_px = 0.05;       // sigma written for the line-image observations, px, > 0
   double gross_error_alpha = 0.001;  // of the misclosure test, (0, 0.5)
-  double max_point_sigma_m = 1.0;  // drop points less precise than this (largest axis), m, > 0
-  double line_outlier_k = 5.0;     // line-side gross errors: |v| > k 1.4826 MAD of the smooth fit
+  double max_point_sigma_m = 1.0;    // drop points less precise than this (largest axis), m, > 0
+  double line_outlier_k = 5.0;       // line-side gross errors: |v| > k 1.4826 MAD of the smooth fit
   double line_outlier_min_px = 0.25;  // ... and above this, px, > 0
-  void Validate() const;           // ConfigError naming the option
+  void Validate() const;              // ConfigError naming the option
 };
 
 /// One oriented reference frame image (the block result of `aerocal adjust`).
@@ -73,23 +73,26 @@ struct CloudControlResult {
   L1Image l1;
   std::vector<LineObservation> observations;  // col = detector, row = line
   std::vector<GroundPoint> points;            // control points with their intersection sigmas
-  int n_interest = 0;          // Foerstner points on the L1 image
-  int n_rays = 0;              // successful matches into reference images
-  int n_no_match = 0;          // fewer than two reference images matched
-  int n_gross = 0;             // dropped by the misclosure test
-  int n_imprecise = 0;         // dropped by max_point_sigma_m
-  int n_rays_removed = 0;      // single rays removed as gross errors (point kept)
-  int n_line_outliers = 0;     // dropped by the smooth-misclosure test of the line image
+  int n_interest = 0;                         // Foerstner points on the L1 image
+  int n_rays = 0;                             // successful matches into reference images
+  int n_no_match = 0;                         // fewer than two reference images matched
+  int n_gross = 0;                            // dropped by the misclosure test
+  int n_imprecise = 0;                        // dropped by max_point_sigma_m
+  int n_rays_removed = 0;                     // single rays removed as gross errors (point kept)
+  int n_line_outliers = 0;  // dropped by the smooth-misclosure test of the line image
   double median_match_sigma_px = 0.0;
 };
 
-CloudControlResult MakeCloudControl(const calib::LineCamera& camera, const PosTrajectory& pos,
+CloudControlResult MakeCloudControl(const calib::LineCamera& camera,
+                                    const PosTrajectory& pos,
                                     const stitch::GrayImage& line_image,
                                     const calib::Camera& reference_camera,
                                     const std::vector<ReferenceFrame>& references,
                                     const CloudControlOptions& options);
 
-/// control.json (kind "pushbroom_control", written by WriteResult): the counts above, the L1 grid and the options used.
-nlohmann::json CloudControlToJson(const CloudControlResult& result, const CloudControlOptions& options);
+/// control.json (kind "pushbroom_control", written by WriteResult): the counts above, the L1 grid
+/// and the options used.
+nlohmann::json CloudControlToJson(const CloudControlResult& result,
+                                  const CloudControlOptions& options);
 
 }  // namespace aerocal::triangulation

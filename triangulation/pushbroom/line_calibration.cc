@@ -1,24 +1,24 @@
 #include "triangulation/pushbroom/line_calibration.h"
 
-#include <algorithm>
-#include <cmath>
-#include <map>
-#include <set>
-#include <sstream>
-#include <tuple>
+#include "calib/camera/rotation.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/core/error.h"
+#include "calib/residuals/prior.h"
+#include "triangulation/pushbroom/line_degree_choice.h"
+#include "triangulation/sensor/frame_camera.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/QR>
 #include <Eigen/SVD>
 #include <nlohmann/json.hpp>
 
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
-#include "calib/camera/rotation.h"
-#include "calib/core/error.h"
-#include "calib/residuals/prior.h"
-#include "triangulation/pushbroom/line_degree_test.h"
-#include "triangulation/sensor/frame_camera.h"
+#include <algorithm>
+#include <cmath>
+#include <map>
+#include <set>
+#include <sstream>
+#include <tuple>
 
 namespace aerocal::triangulation {
 namespace {
@@ -65,14 +65,18 @@ std::vector<GaugeFunction> TableGaugeFunctions(const calib::LineCamera& camera,
   const int n = camera.detectors;
   const double c = sensor.CMm();
   std::vector<GaugeFunction> out = {
-      {"pitch", "a rotation about the line (camera x): dy = c + y^2/c, a constant along track",
+      {"pitch",
+       "a rotation about the line (camera x): dy = c + y^2/c, a constant along track",
        Eigen::VectorXd::Zero(2 * n)},
-      {"roll", "a rotation about the flight direction (camera y): dx = -(c + x^2/c), the across-"
-               "track shift 1 + x^2/c^2 together",
+      {"roll",
+       "a rotation about the flight direction (camera y): dx = -(c + x^2/c), the across-"
+       "track shift 1 + x^2/c^2 together",
        Eigen::VectorXd::Zero(2 * n)},
-      {"yaw", "a rotation about the camera axis (z): dx = -y, dy = x, a slope along track",
+      {"yaw",
+       "a rotation about the camera axis (z): dx = -y, dy = x, a slope along track",
        Eigen::VectorXd::Zero(2 * n)},
-      {"scale", "a scale of the focal plane (dx = x, dy = y), which c and the heights may fix",
+      {"scale",
+       "a scale of the focal plane (dx = x, dy = y), which c and the heights may fix",
        Eigen::VectorXd::Zero(2 * n)}};
   for (size_t s = 0; s < ranges.size(); ++s)
     for (int i = ranges[s].first; i <= ranges[s].second; ++i) {
@@ -194,35 +198,43 @@ calib::ResidualId AddGaugeDatum(calib::ProblemBuilder& builder,
   report->n_constraints = k;
   return builder.AddResidual(
       kGroupLineDatum,
-      std::make_unique<calib::LinearConstraintCostFunction>(weights, origins, 1.0), used, label);
+      std::make_unique<calib::LinearConstraintCostFunction>(weights, origins, 1.0),
+      used,
+      label);
 }
 
 }  // namespace
 
 const char* LineDatumName(LineDatum datum) {
   switch (datum) {
-    case LineDatum::kGauge: return "gauge";
-    case LineDatum::kReference: return "reference";
-    case LineDatum::kNone: return "none";
+    case LineDatum::kGauge:
+      return "gauge";
+    case LineDatum::kReference:
+      return "reference";
+    case LineDatum::kNone:
+      return "none";
   }
   return "";
 }
 
 void LineCalibrationOptions::Validate() const {
   if (node_spacing_lines < 1)
-    throw ConfigError("--node-spacing must be >= 1 line (got " + std::to_string(node_spacing_lines) + ")");
+    throw ConfigError("--node-spacing must be >= 1 line (got " +
+                      std::to_string(node_spacing_lines) + ")");
   if (max_degree < 0 || max_degree >= kLineMaxTerms)
-    throw ConfigError("--max-degree must be within 0 .. 5 (got " + std::to_string(max_degree) + ")");
+    throw ConfigError("--max-degree must be within 0 .. 5 (got " + std::to_string(max_degree) +
+                      ")");
   if (degree && (*degree < 0 || *degree >= kLineMaxTerms))
     throw ConfigError("--degree must be within 0 .. 5 (got " + std::to_string(*degree) + ")");
   if (!(degree_test_alpha > 0 && degree_test_alpha < 0.5))
-    throw ConfigError("--degree-alpha must be within (0, 0.5) (got " + FormatNumber(degree_test_alpha) + ")");
+    throw ConfigError("--degree-alpha must be within (0, 0.5) (got " +
+                      FormatNumber(degree_test_alpha) + ")");
   if (!(pos_sigma_m > 0) || !(pos_sigma_deg > 0))
     throw ConfigError("--pos-sigma-m and --pos-sigma-deg must be > 0");
   if (!(gauge_threshold > 0 && gauge_threshold <= 1e-3))
-    throw ConfigError("--gauge-threshold must be within (0, 1e-3] (got " + FormatNumber(gauge_threshold) + ")");
-  if (min_observations_per_segment < 0)
-    throw ConfigError("--min-per-segment must be >= 0");
+    throw ConfigError("--gauge-threshold must be within (0, 1e-3] (got " +
+                      FormatNumber(gauge_threshold) + ")");
+  if (min_observations_per_segment < 0) throw ConfigError("--min-per-segment must be >= 0");
   if (boresight == PlatformParamMode::kWeighted && !(boresight_sigma_rad > 0))
     throw ConfigError("--boresight-sigma-deg must be > 0 when --boresight is weighted (got " +
                       FormatNumber(boresight_sigma_rad * 180.0 / M_PI) + ")");
@@ -231,7 +243,8 @@ void LineCalibrationOptions::Validate() const {
                       FormatNumber(lever_arm_sigma_m) + ")");
 }
 
-void WriteLineObservations(const std::string& path, const std::vector<LineObservation>& observations) {
+void WriteLineObservations(const std::string& path,
+                           const std::vector<LineObservation>& observations) {
   std::ostringstream out;
   out << "image,point,col,row,sigma_px\n";
   for (const auto& o : observations)
@@ -240,7 +253,8 @@ void WriteLineObservations(const std::string& path, const std::vector<LineObserv
   WriteFileAtomically(path, out.str());
 }
 
-std::vector<LineObservation> ReadLineObservations(const std::string& path, double default_sigma_px) {
+std::vector<LineObservation> ReadLineObservations(const std::string& path,
+                                                  double default_sigma_px) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"point", "col", "row"});
   t.RejectUnknownColumns({"image", "point", "col", "row", "sigma_px"});
@@ -255,8 +269,9 @@ std::vector<LineObservation> ReadLineObservations(const std::string& path, doubl
     o.sigma_px = default_sigma_px;
     if (const auto s = t.OptionalNumber(row, "sigma_px")) {
       if (!(*s > 0 && *s <= kMaxSigmaPx))
-        ThrowInputError(t.Where(row), "sigma_px must be > 0 and <= " + FormatNumber(kMaxSigmaPx) +
-                                          " (got " + FormatNumber(*s) + ")");
+        ThrowInputError(t.Where(row),
+                        "sigma_px must be > 0 and <= " + FormatNumber(kMaxSigmaPx) + " (got " +
+                            FormatNumber(*s) + ")");
       o.sigma_px = *s;
     }
     out.push_back(o);
@@ -277,7 +292,8 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   const int n_sub = int(ranges.size());
   const int reference = options.reference_subcamera >= 0 ? options.reference_subcamera : n_sub / 2;
   if (reference >= n_sub)
-    throw ConfigError("--reference must be a sub-camera index within 0 .. " + std::to_string(n_sub - 1));
+    throw ConfigError("--reference must be a sub-camera index within 0 .. " +
+                      std::to_string(n_sub - 1));
   std::vector<std::string> sub_ids;
   for (int s = 0; s < n_sub; ++s)
     sub_ids.push_back(camera.subcameras.empty() ? std::to_string(s) : camera.subcameras[s].id);
@@ -332,13 +348,17 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
 
   std::vector<BlockId> point_blocks(control.size());
   for (size_t k = 0; k < control.size(); ++k) {
-    point_blocks[k] = b.AddBlock("point_" + control[k]->id, p.point_values[k].data(), 3,
-                                 calib::BlockKind::kGroundPoint, {"X", "Y", "Z"});
+    point_blocks[k] = b.AddBlock("point_" + control[k]->id,
+                                 p.point_values[k].data(),
+                                 3,
+                                 calib::BlockKind::kGroundPoint,
+                                 {"X", "Y", "Z"});
     const Eigen::Vector3d& v = *control[k]->xyz_m;
     const Eigen::Vector3d& s = control[k]->sigma_m;
     b.AddResidual(calib::kGroupControl,
                   calib::PriorCostFunction::Create({v.x(), v.y(), v.z()}, {s.x(), s.y(), s.z()}),
-                  {point_blocks[k]}, "control " + control[k]->id);
+                  {point_blocks[k]},
+                  "control " + control[k]->id);
   }
 
   // Image observations: each built by the kind (through the interface), added under its group.
@@ -361,12 +381,14 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     const int j = sensor.Terms().back().segment;
     ++per_segment[j];
     for (int m = 0; m < 4; ++m) ++per_node[j + m];
-    const auto id = b.AddResidual(term.group, std::move(term.cost), term.blocks, "point " + o.point);
+    const auto id =
+        b.AddResidual(term.group, std::move(term.cost), term.blocks, "point " + o.point);
     p.image_residuals.push_back(id);
     // The start must be a valid geometry (the point in front of the camera).
     if (b.EvaluateResidual(id).empty())
-      ThrowInputError(where, "point " + o.point + " lies behind the camera at line " +
-                                 FormatNumber(o.line) + " with the POS and the file's camera");
+      ThrowInputError(where,
+                      "point " + o.point + " lies behind the camera at line " +
+                          FormatNumber(o.line) + " with the POS and the file's camera");
   }
   result.n_observations = int(p.image_residuals.size());
   result.n_control = int(control.size());
@@ -385,7 +407,8 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     if (per_segment[j] < options.min_observations_per_segment)
       result.warnings.push_back({"few_points_per_line",
                                  "lines " + FormatNumber(a) + " .. " + FormatNumber(z),
-                                 double(per_segment[j]), double(options.min_observations_per_segment),
+                                 double(per_segment[j]),
+                                 double(options.min_observations_per_segment),
                                  "only " + std::to_string(per_segment[j]) +
                                      " observations between two spline nodes: the per-line "
                                      "corrections there rest on the POS prior"});
@@ -394,9 +417,13 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     if (per_node[j] == 0 && !options.pos_prior) {
       b.FixBlock(sensor.NodeBlocks()[j]);
       result.valid = false;
-      result.warnings.push_back({"few_points_per_line", "node " + std::to_string(j), 0, 1,
-                                 "no observation reaches spline node " + std::to_string(j) +
-                                     " and there is no POS prior: its correction is not determined"});
+      result.warnings.push_back(
+          {"few_points_per_line",
+           "node " + std::to_string(j),
+           0,
+           1,
+           "no observation reaches spline node " + std::to_string(j) +
+               " and there is no POS prior: its correction is not determined"});
     }
 
   // Fixed detector entries: above the degree. The datum (module README "Datum"): the reference
@@ -425,9 +452,12 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   result.datum.subcamera = sub_ids[reference];
   calib::ResidualId datum_residual = -1;
   bool time_offset_in_null_space = false;
-  std::vector<BlockId> datum_candidates = {sensor.DetectorBlocks()[reference], sensor.MountBlock(),
-                                           sensor.LeverArmBlock(), sensor.CBlock()};
-  datum_candidates.insert(datum_candidates.end(), sensor.NodeBlocks().begin(), sensor.NodeBlocks().end());
+  std::vector<BlockId> datum_candidates = {sensor.DetectorBlocks()[reference],
+                                           sensor.MountBlock(),
+                                           sensor.LeverArmBlock(),
+                                           sensor.CBlock()};
+  datum_candidates.insert(
+      datum_candidates.end(), sensor.NodeBlocks().begin(), sensor.NodeBlocks().end());
   auto derive_datum = [&]() {
     if (datum_residual >= 0) b.RemoveResidual(datum_residual);
     datum_residual = -1;
@@ -457,19 +487,22 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
       if (in_null_space(block)) d.parameters_in_null_space.push_back(name);
     if (time_offset_in_null_space) d.parameters_in_null_space.push_back("time_offset");
     if (options.datum == LineDatum::kGauge && null_space.ok)
-      datum_residual = AddGaugeDatum(b, null_space, datum_candidates, "datum " + sub_ids[reference], &d);
+      datum_residual =
+          AddGaugeDatum(b, null_space, datum_candidates, "datum " + sub_ids[reference], &d);
     if (options.datum == LineDatum::kReference) {
       d.n_constraints = 4;
       d.blocks = {b.BlockName(sensor.DetectorBlocks()[reference])};
-      datum_residual =
-          b.AddResidual(kGroupLineDatum, LineDatumResidual::Create(kDatumSigmaPx * camera.pitch_mm),
-                        {sensor.DetectorBlocks()[reference]}, "datum " + sub_ids[reference]);
+      datum_residual = b.AddResidual(kGroupLineDatum,
+                                     LineDatumResidual::Create(kDatumSigmaPx * camera.pitch_mm),
+                                     {sensor.DetectorBlocks()[reference]},
+                                     "datum " + sub_ids[reference]);
     }
   };
   derive_datum();
   // The sub-camera carrying the constraints keeps the start degree (the degree test leaves it).
   auto datum_on_reference = [&]() {
-    return std::find(result.datum.blocks.begin(), result.datum.blocks.end(),
+    return std::find(result.datum.blocks.begin(),
+                     result.datum.blocks.end(),
                      b.BlockName(sensor.DetectorBlocks()[reference])) != result.datum.blocks.end();
   };
 
@@ -500,7 +533,8 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   rms_by_subcamera(false);
 
   std::vector<BlockId> cov_blocks = sensor.NodeBlocks();
-  cov_blocks.insert(cov_blocks.end(), sensor.DetectorBlocks().begin(), sensor.DetectorBlocks().end());
+  cov_blocks.insert(
+      cov_blocks.end(), sensor.DetectorBlocks().begin(), sensor.DetectorBlocks().end());
   cov_blocks.push_back(sensor.CBlock());
   if (options.boresight != PlatformParamMode::kFixed) cov_blocks.push_back(sensor.MountBlock());
   if (options.lever_arm != PlatformParamMode::kFixed) cov_blocks.push_back(sensor.LeverArmBlock());
@@ -515,16 +549,17 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     std::vector<TableValue> table(2 * size_t(camera.detectors));
     for (int s = 0; s < n_sub; ++s) {
       const Eigen::MatrixXd q =
-          c.ok ? c.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms) : Eigen::MatrixXd();
+          c.ok ? c.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms)
+               : Eigen::MatrixXd();
       for (int i = ranges[s].first; i <= ranges[s].second; ++i)
         for (int axis = 0; axis < 2; ++axis)
-          table[axis * size_t(camera.detectors) + i] =
-              EvaluateDetectorPolynomial(sensor.Detectors()[s].data(), q, axis, NormalisedIndex(ranges[s], i));
+          table[axis * size_t(camera.detectors) + i] = EvaluateDetectorPolynomial(
+              sensor.Detectors()[s].data(), q, axis, NormalisedIndex(ranges[s], i));
     }
     return table;
   };
 
-  // Degree test (line_degree_test.h), per sub-camera and axis. Not applicable when sigma0 is ~0
+  // Degree test (line_degree_choice.h), per sub-camera and axis. Not applicable when sigma0 is ~0
   // (noise-free data): the start degree. The start-degree table is kept for the sigmas of the
   // selected one (SelectedTableSigma).
   std::vector<TableValue> start_table;
@@ -545,9 +580,13 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         }
         std::set<int> held = p.fixed_entries[s];
         held.insert(p.datum_entries[s].begin(), p.datum_entries[s].end());
-        degree = TopDownWaldDegree(sensor.Detectors()[s].data(),
-                                   cov.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms),
-                                   axis, start_degree, held, options.degree_test_alpha);
+        degree =
+            TopDownWaldDegree(sensor.Detectors()[s].data(),
+                              cov.BlockCovariance(sensor.DetectorBlocks()[s], 2 * kLineMaxTerms),
+                              axis,
+                              start_degree,
+                              held,
+                              options.degree_test_alpha);
         for (int k = degree + 1; k <= start_degree; ++k)
           if (p.fixed_entries[s].insert(axis * kLineMaxTerms + k).second) changed = true;
       }
@@ -582,23 +621,35 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
 
   if (!result.report.converged) {
     result.valid = false;
-    result.warnings.push_back({"not_converged", "adjustment", double(result.report.iterations), 0,
+    result.warnings.push_back({"not_converged",
+                               "adjustment",
+                               double(result.report.iterations),
+                               0,
                                "the adjustment did not converge: " + result.report.message});
   }
   if (result.report.sigma0 > options.max_sigma0) {
     result.valid = false;
-    result.warnings.push_back({"sigma0", "adjustment", result.report.sigma0, options.max_sigma0,
-                               "sigma0 is far above 1: the a-priori sigmas or the model are wrong"});
+    result.warnings.push_back(
+        {"sigma0",
+         "adjustment",
+         result.report.sigma0,
+         options.max_sigma0,
+         "sigma0 is far above 1: the a-priori sigmas or the model are wrong"});
   }
   if (!cov.ok && result.report.usable) {
     result.valid = false;
-    result.warnings.push_back({"covariance", "adjustment", 0, 0,
+    result.warnings.push_back({"covariance",
+                               "adjustment",
+                               0,
+                               0,
                                "no covariance (singular normal matrix?): " + cov.message});
     // Without the datum the singular direction is known: a constant along-track offset of all
     // detectors IS a pitch of the strip (exactly, for a line at y = 0); without a covariance its
     // correlation cannot be computed, so it is named with the value it has in the model.
     if (options.datum == LineDatum::kNone)
-      result.warnings.push_back({"offset_vs_pitch", "detector polynomials", 1.0,
+      result.warnings.push_back({"offset_vs_pitch",
+                                 "detector polynomials",
+                                 1.0,
                                  options.correlation_fail,
                                  "ill-posed: no datum and a singular normal matrix: a constant "
                                  "along-track offset of the detectors is a pitch of the strip"});
@@ -606,8 +657,10 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   result.undetermined = cov.undetermined;
   if (!cov.undetermined.empty()) {
     result.valid = false;
-    result.warnings.push_back({"undetermined", cov.undetermined.front(),
-                               double(cov.undetermined.size()), 0,
+    result.warnings.push_back({"undetermined",
+                               cov.undetermined.front(),
+                               double(cov.undetermined.size()),
+                               0,
                                std::to_string(cov.undetermined.size()) +
                                    " parameters are not determined (null space), first " +
                                    cov.undetermined.front()});
@@ -622,8 +675,10 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   };
   for (int s = 0; s < n_sub; ++s) {
     auto& out = result.subcameras[s];
-    out.dx_coefficients_mm.assign(sensor.Detectors()[s].begin(), sensor.Detectors()[s].begin() + kLineMaxTerms);
-    out.dy_coefficients_mm.assign(sensor.Detectors()[s].begin() + kLineMaxTerms, sensor.Detectors()[s].end());
+    out.dx_coefficients_mm.assign(sensor.Detectors()[s].begin(),
+                                  sensor.Detectors()[s].begin() + kLineMaxTerms);
+    out.dy_coefficients_mm.assign(sensor.Detectors()[s].begin() + kLineMaxTerms,
+                                  sensor.Detectors()[s].end());
     for (int k = 0; k < kLineMaxTerms; ++k) {
       out.dx_sigma_mm.push_back(entry_sigma(sensor.DetectorBlocks()[s], k));
       out.dy_sigma_mm.push_back(entry_sigma(sensor.DetectorBlocks()[s], kLineMaxTerms + k));
@@ -653,7 +708,7 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         auto& sigma = (axis == 0 ? result.dx_sigma_mm : result.dy_sigma_mm)[i];
         auto& fit_sigma = (axis == 0 ? result.dx_fit_sigma_mm : result.dy_fit_sigma_mm)[i];
         fit_sigma = estimated ? std::sqrt(table[j].variance) : 0.0;
-        // After a degree test: at least the start-degree fit's sigma (line_degree_test.h).
+        // After a degree test: at least the start-degree fit's sigma (line_degree_choice.h).
         sigma = start_table.empty() ? *fit_sigma : SelectedTableSigma(table[j], start_table[j]);
       }
     }
@@ -667,12 +722,16 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     const int s = sensor.Terms()[k].subcamera;
     const double u = sensor.Terms()[k].u;
     const Eigen::Vector2d base = camera.Correction(sensor.Terms()[k].detector);
-    const double dx = base.x() + calib::EvaluatePolynomial(sensor.Detectors()[s].data(), kLineMaxTerms, u);
+    const double dx =
+        base.x() + calib::EvaluatePolynomial(sensor.Detectors()[s].data(), kLineMaxTerms, u);
     const double dy =
-        base.y() + calib::EvaluatePolynomial(sensor.Detectors()[s].data() + kLineMaxTerms, kLineMaxTerms, u);
-    result.error_samples.push_back({sensor.Terms()[k].detector, s,
-                                    (dx - r[0] * sensor.Terms()[k].sigma_mm.x()) / camera.pitch_mm,
-                                    (dy - r[1] * sensor.Terms()[k].sigma_mm.y()) / camera.pitch_mm});
+        base.y() +
+        calib::EvaluatePolynomial(sensor.Detectors()[s].data() + kLineMaxTerms, kLineMaxTerms, u);
+    result.error_samples.push_back(
+        {sensor.Terms()[k].detector,
+         s,
+         (dx - r[0] * sensor.Terms()[k].sigma_mm.x()) / camera.pitch_mm,
+         (dy - r[1] * sensor.Terms()[k].sigma_mm.y()) / camera.pitch_mm});
   }
 
   // Spline nodes and per-line corrections with sigmas.
@@ -727,10 +786,14 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     for (const std::string& name : result.datum.parameters_in_null_space) {
       if (name == "time_offset") continue;  // below, with its own message
       result.valid = false;
-      result.warnings.push_back({name + "_not_determinable", name, 1.0, options.correlation_fail,
-                                 "ill-posed: " + name + " lies in the null space of the problem "
-                                 "(a gauge direction: its value is the datum's convention, not "
-                                 "the data's; datum.gauge_directions says which)"});
+      result.warnings.push_back({name + "_not_determinable",
+                                 name,
+                                 1.0,
+                                 options.correlation_fail,
+                                 "ill-posed: " + name +
+                                     " lies in the null space of the problem "
+                                     "(a gauge direction: its value is the datum's convention, not "
+                                     "the data's; datum.gauge_directions says which)"});
     }
   result.time_offset_estimated = options.time_offset;
   result.time_offset_s = sensor.TimeOffsetS();
@@ -739,7 +802,9 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
   if (time_offset_in_null_space && options.datum != LineDatum::kReference) {
     result.valid = false;
     result.time_offset_sigma_s.reset();
-    result.warnings.push_back({"time_offset_not_determinable", "time offset", 1.0,
+    result.warnings.push_back({"time_offset_not_determinable",
+                               "time offset",
+                               1.0,
                                options.correlation_fail,
                                "ill-posed: the time offset lies in the null space (an along-track "
                                "shift v dt the trajectory takes over entirely; the POS priors are "
@@ -802,9 +867,10 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         if (decides(block, entry)) c.emplace_back(block, entry, 1.0);
       return c;
     };
-    const double offset_roll = multiple(mean_free(sensor.DetectorBlocks(), 0), all_free(sensor.NodeBlocks(), roll));
-    const double offset_pitch =
-        multiple(mean_free(sensor.DetectorBlocks(), kLineMaxTerms), all_free(sensor.NodeBlocks(), pitch));
+    const double offset_roll =
+        multiple(mean_free(sensor.DetectorBlocks(), 0), all_free(sensor.NodeBlocks(), roll));
+    const double offset_pitch = multiple(mean_free(sensor.DetectorBlocks(), kLineMaxTerms),
+                                         all_free(sensor.NodeBlocks(), pitch));
     double scale_c = -1;
     if (options.free_c && entry_sigma(sensor.CBlock(), 0)) {
       Combination set = all_free(sensor.DetectorBlocks(), 1);
@@ -818,9 +884,11 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
       std::string meaning;
     };
     std::vector<Named> named = {
-        {"offset_vs_roll", offset_roll,
+        {"offset_vs_roll",
+         offset_roll,
          "a constant across-track offset of the detectors is a roll of the strip"},
-        {"offset_vs_pitch", offset_pitch,
+        {"offset_vs_pitch",
+         offset_pitch,
          "a constant along-track offset of the detectors is a pitch of the strip"},
         {"scale_vs_c", scale_c, "c and the detectors' linear term (or the height) are one scale"}};
     // The boresight and lever arm when estimated: multiple correlation of each entry with what
@@ -834,16 +902,19 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
                          multiple({{mount, a, 1.0}}, all_free(sensor.NodeBlocks(), 3 + a)),
                          "a constant boresight angle is a constant attitude correction of the "
                          "trajectory (only the POS prior tells them apart)"});
-      named.push_back({"boresight_roll_vs_offset",
-                       multiple({{mount, 1, 1.0}}, all_free(sensor.DetectorBlocks(), 0)),
-                       "the boresight roll (phi) is a constant across-track offset of the detectors"});
-      named.push_back({"boresight_pitch_vs_offset",
-                       multiple({{mount, 0, 1.0}}, all_free(sensor.DetectorBlocks(), kLineMaxTerms)),
-                       "the boresight pitch (omega) is a constant along-track offset of the detectors"});
+      named.push_back(
+          {"boresight_roll_vs_offset",
+           multiple({{mount, 1, 1.0}}, all_free(sensor.DetectorBlocks(), 0)),
+           "the boresight roll (phi) is a constant across-track offset of the detectors"});
+      named.push_back(
+          {"boresight_pitch_vs_offset",
+           multiple({{mount, 0, 1.0}}, all_free(sensor.DetectorBlocks(), kLineMaxTerms)),
+           "the boresight pitch (omega) is a constant along-track offset of the detectors"});
     }
     // The time offset: v dt is an along-track shift (the nodes' along-track position, its
     // drift included) and, seen from the height, a pitch; only the POS priors separate them.
-    if (options.time_offset && !time_offset_in_null_space && entry_sigma(sensor.TimeOffsetBlock(), 0)) {
+    if (options.time_offset && !time_offset_in_null_space &&
+        entry_sigma(sensor.TimeOffsetBlock(), 0)) {
       Combination along = all_free(sensor.NodeBlocks(), line_along_x ? 1 : 0);
       const Combination pitches = all_free(sensor.NodeBlocks(), pitch);
       along.insert(along.end(), pitches.begin(), pitches.end());
@@ -894,11 +965,14 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
         if (fail) result.valid = false;
         const bool own = name.rfind("boresight", 0) == 0 || name.rfind("lever_arm", 0) == 0;
         const bool time = name.rfind("time_offset", 0) == 0;
-        result.warnings.push_back(
-            {name, time ? "time offset" : own ? "boresight / lever arm" : "detector polynomials", rho,
-             fail ? options.correlation_fail : options.correlation_warn,
-             std::string(fail ? "ill-posed: " : "") + "correlation " + FormatNumber(rho, 6) +
-                 ": " + meaning});
+        result.warnings.push_back({name,
+                                   time  ? "time offset"
+                                   : own ? "boresight / lever arm"
+                                         : "detector polynomials",
+                                   rho,
+                                   fail ? options.correlation_fail : options.correlation_warn,
+                                   std::string(fail ? "ill-posed: " : "") + "correlation " +
+                                       FormatNumber(rho, 6) + ": " + meaning});
       }
     }
   }
@@ -923,11 +997,15 @@ LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
     for (int s = 0; s < n_sub; ++s) {
       polys[s].first = ranges[s].first;
       polys[s].last = ranges[s].second;
-      polys[s].dx.assign(sensor.Detectors()[s].begin(), sensor.Detectors()[s].begin() + kLineMaxTerms);
-      polys[s].dy.assign(sensor.Detectors()[s].begin() + kLineMaxTerms, sensor.Detectors()[s].end());
+      polys[s].dx.assign(sensor.Detectors()[s].begin(),
+                         sensor.Detectors()[s].begin() + kLineMaxTerms);
+      polys[s].dy.assign(sensor.Detectors()[s].begin() + kLineMaxTerms,
+                         sensor.Detectors()[s].end());
       if (!camera.calibration.empty()) {
-        for (size_t k = 0; k < camera.calibration[s].dx.size(); ++k) polys[s].dx[k] += camera.calibration[s].dx[k];
-        for (size_t k = 0; k < camera.calibration[s].dy.size(); ++k) polys[s].dy[k] += camera.calibration[s].dy[k];
+        for (size_t k = 0; k < camera.calibration[s].dx.size(); ++k)
+          polys[s].dx[k] += camera.calibration[s].dx[k];
+        for (size_t k = 0; k < camera.calibration[s].dy.size(); ++k)
+          polys[s].dy[k] += camera.calibration[s].dy[k];
       }
       while (polys[s].dx.size() > 1 && polys[s].dx.back() == 0.0) polys[s].dx.pop_back();
       while (polys[s].dy.size() > 1 && polys[s].dy.back() == 0.0) polys[s].dy.pop_back();
@@ -948,8 +1026,10 @@ std::string LineCorrectionsToCsv(const LineCalibrationResult& r) {
   const double deg = 180.0 / M_PI;
   for (size_t k = 0; k < r.lines.size(); ++k) {
     out += FormatNumber(r.lines[k]);
-    for (int a = 0; a < 6; ++a) out += "," + FormatNumber(r.line_corrections[k][a] * (a < 3 ? 1 : deg), 10);
-    for (int a = 0; a < 6; ++a) out += "," + FormatNumber(r.line_sigma[k][a] * (a < 3 ? 1 : deg), 6);
+    for (int a = 0; a < 6; ++a)
+      out += "," + FormatNumber(r.line_corrections[k][a] * (a < 3 ? 1 : deg), 10);
+    for (int a = 0; a < 6; ++a)
+      out += "," + FormatNumber(r.line_sigma[k][a] * (a < 3 ? 1 : deg), 6);
     out += "\n";
   }
   return out;
@@ -987,21 +1067,24 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
                   {"parameters_in_null_space", d.parameters_in_null_space},
                   {"message", d.message}};
   }
-  j["time_offset"] = {{"estimated", r.time_offset_estimated},
-                      {"dt_s", r.time_offset_s},
-                      {"sigma_s", r.time_offset_sigma_s ? json(*r.time_offset_sigma_s) : json(nullptr)}};
+  j["time_offset"] = {
+      {"estimated", r.time_offset_estimated},
+      {"dt_s", r.time_offset_s},
+      {"sigma_s", r.time_offset_sigma_s ? json(*r.time_offset_sigma_s) : json(nullptr)}};
   j["c_mm"] = r.c_mm;
   j["c_sigma_mm"] = opt(r.c_sigma_mm);
   const double deg = 180.0 / M_PI;
   auto vector3 = [](const Eigen::Vector3d& v, double scale) {
     return json::array({v.x() * scale, v.y() * scale, v.z() * scale});
   };
-  j["boresight"] = {{"mode", PlatformParamModeName(r.boresight)},
-                    {"opk_deg", vector3(r.boresight_rad, deg)},
-                    {"sigma_deg", r.boresight_sigma_rad ? vector3(*r.boresight_sigma_rad, deg) : json(nullptr)}};
-  j["lever_arm"] = {{"mode", PlatformParamModeName(r.lever_arm)},
-                    {"xyz_m", vector3(r.lever_arm_m, 1.0)},
-                    {"sigma_m", r.lever_arm_sigma_m ? vector3(*r.lever_arm_sigma_m, 1.0) : json(nullptr)}};
+  j["boresight"] = {
+      {"mode", PlatformParamModeName(r.boresight)},
+      {"opk_deg", vector3(r.boresight_rad, deg)},
+      {"sigma_deg", r.boresight_sigma_rad ? vector3(*r.boresight_sigma_rad, deg) : json(nullptr)}};
+  j["lever_arm"] = {
+      {"mode", PlatformParamModeName(r.lever_arm)},
+      {"xyz_m", vector3(r.lever_arm_m, 1.0)},
+      {"sigma_m", r.lever_arm_sigma_m ? vector3(*r.lever_arm_sigma_m, 1.0) : json(nullptr)}};
   json subs = json::array();
   for (const auto& s : r.subcameras) {
     json js;
@@ -1030,19 +1113,32 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
                       {"table_sigma", r.degree_test.reduced ? "selected" : "fit"}};
   json det = json::array();
   for (size_t i = 0; i < r.dx_mm.size(); ++i)
-    det.push_back({{"i", i}, {"dx_mm", r.dx_mm[i]}, {"dy_mm", r.dy_mm[i]},
-                   {"sigma_dx_mm", opt(r.dx_sigma_mm[i])}, {"sigma_dy_mm", opt(r.dy_sigma_mm[i])},
-                   {"sigma_dx_fit_mm", opt(r.dx_fit_sigma_mm[i])}, {"sigma_dy_fit_mm", opt(r.dy_fit_sigma_mm[i])}});
+    det.push_back({{"i", i},
+                   {"dx_mm", r.dx_mm[i]},
+                   {"dy_mm", r.dy_mm[i]},
+                   {"sigma_dx_mm", opt(r.dx_sigma_mm[i])},
+                   {"sigma_dy_mm", opt(r.dy_sigma_mm[i])},
+                   {"sigma_dx_fit_mm", opt(r.dx_fit_sigma_mm[i])},
+                   {"sigma_dy_fit_mm", opt(r.dy_fit_sigma_mm[i])}});
   j["detectors"] = det;
   json nodes = json::array();
   for (size_t k = 0; k < r.node_values.size(); ++k) {
     const auto& v = r.node_values[k];
     const auto& s = r.node_sigma[k];
     nodes.push_back({{"line", r.node_line[k]},
-                     {"dX", v[0]}, {"dY", v[1]}, {"dZ", v[2]},
-                     {"domega", v[3] * deg}, {"dphi", v[4] * deg}, {"dkappa", v[5] * deg},
-                     {"sigma", {{"dX", s[0]}, {"dY", s[1]}, {"dZ", s[2]}, {"domega", s[3] * deg},
-                                {"dphi", s[4] * deg}, {"dkappa", s[5] * deg}}}});
+                     {"dX", v[0]},
+                     {"dY", v[1]},
+                     {"dZ", v[2]},
+                     {"domega", v[3] * deg},
+                     {"dphi", v[4] * deg},
+                     {"dkappa", v[5] * deg},
+                     {"sigma",
+                      {{"dX", s[0]},
+                       {"dY", s[1]},
+                       {"dZ", s[2]},
+                       {"domega", s[3] * deg},
+                       {"dphi", s[4] * deg},
+                       {"dkappa", s[5] * deg}}}});
   }
   j["trajectory"] = {{"form", "cubic_bspline"}, {"nodes", nodes}};
   json corr = json::object();
@@ -1051,8 +1147,11 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
   j["undetermined"] = r.undetermined;
   json warnings = json::array();
   for (const auto& w : r.warnings)
-    warnings.push_back({{"name", w.name}, {"subject", w.subject}, {"value", w.value},
-                        {"limit", w.limit}, {"message", w.message}});
+    warnings.push_back({{"name", w.name},
+                        {"subject", w.subject},
+                        {"value", w.value},
+                        {"limit", w.limit},
+                        {"message", w.message}});
   j["warnings"] = warnings;
   json groups = json::array();
   for (const auto& g : r.report.groups)

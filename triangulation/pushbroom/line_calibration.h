@@ -1,12 +1,13 @@
 // Calibration of a line (pushbroom) camera from cloud control points (issue 17; module README):
 // one joint adjustment, through calib::ProblemBuilder, of
-// - per-line exterior-orientation corrections to the POS, a uniform cubic B-spline in the line index
+// - per-line exterior-orientation corrections to the POS, a uniform cubic B-spline in the line
+// index
 //   with nodes every `node_spacing_lines` lines (6 values per node: dX, dY, dZ m, domega, dphi,
 //   dkappa rad, added to the POS position and angles), with the POS sigmas as priors on the node
 //   values (the POS error is modelled as smooth; white POS noise stays in the residuals);
 // - the detector calibration: a polynomial per sub-camera and axis in the normalised index
 //   (degree <= 5, jumps allowed at the seams), its degree chosen top-down by a Wald test of the
-//   highest coefficient (alpha 5 %; not for the datum's sub-camera; line_degree_test.h), giving
+//   highest coefficient (alpha 5 %; not for the datum's sub-camera; line_degree_choice.h), giving
 //   dx_i, dy_i with sigmas for every detector (after a reduction: SelectedTableSigma, which
 //   accounts for the selection);
 // - the control points as weighted ground points (their survey sigmas);
@@ -29,18 +30,18 @@
 // The sub-camera that carries the constraints (gauge, reference) keeps the start degree.
 #pragma once
 
-#include <optional>
-#include <string>
-#include <vector>
-
-#include <Eigen/Core>
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/line_camera.h"
 #include "calib/problem/problem_builder.h"
 #include "triangulation/block/block.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
 #include "triangulation/sensor/line_scan_camera.h"
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 
@@ -49,37 +50,37 @@ enum class LineDatum { kGauge, kReference, kNone };
 const char* LineDatumName(LineDatum datum);
 
 struct LineCalibrationOptions {
-  int node_spacing_lines = 100;       // spline node spacing N, lines, >= 1
-  int max_degree = 5;                 // highest polynomial degree tried, 0 .. 5
-  std::optional<int> degree;          // a fixed degree (0 .. 5) instead of the test
-  double degree_test_alpha = 0.05;    // significance of the top-down Wald test, (0, 0.5)
+  int node_spacing_lines = 100;         // spline node spacing N, lines, >= 1
+  int max_degree = 5;                   // highest polynomial degree tried, 0 .. 5
+  std::optional<int> degree;            // a fixed degree (0 .. 5) instead of the test
+  double degree_test_alpha = 0.05;      // significance of the top-down Wald test, (0, 0.5)
   LineDatum datum = LineDatum::kGauge;  // the datum (header comment)
-  int reference_subcamera = -1;       // the sub-camera carrying the datum; -1: the middle one
+  int reference_subcamera = -1;         // the sub-camera carrying the datum; -1: the middle one
   // Relative eigenvalue (of the Jacobi-scaled reduced normal matrix) below which a direction is
   // a gauge freedom, (0, 1e-3]: exact gauges sit at ~1e-16, determined directions above 1e-9 on
   // the flights measured (module README "Datum").
   double gauge_threshold = 1e-5;
-  bool free_c = false;                // estimate c (nearly a scale of the table: scale_vs_c)
-  bool pos_prior = true;              // the POS sigmas as priors on the node values
-  double pos_sigma_m = 0.05;          // used when pos.csv gives no sigmas, > 0
-  double pos_sigma_deg = 0.005;       // used when pos.csv gives no sigmas, > 0
+  bool free_c = false;                    // estimate c (nearly a scale of the table: scale_vs_c)
+  bool pos_prior = true;                  // the POS sigmas as priors on the node values
+  double pos_sigma_m = 0.05;              // used when pos.csv gives no sigmas, > 0
+  double pos_sigma_deg = 0.005;           // used when pos.csv gives no sigmas, > 0
   int min_observations_per_segment = 12;  // fewer between two nodes: few_points_per_line
-  double correlation_warn = 0.95;     // |rho| above: warning by name
-  double correlation_fail = 0.999;    // |rho| above: the result cannot be trusted (valid = false)
-  double max_sigma0 = 3.0;            // sigma0 above: valid = false (absurd a-priori sigmas)
+  double correlation_warn = 0.95;         // |rho| above: warning by name
+  double correlation_fail = 0.999;  // |rho| above: the result cannot be trusted (valid = false)
+  double max_sigma0 = 3.0;          // sigma0 above: valid = false (absurd a-priori sigmas)
   // Boresight (the camera file's mount M) and lever arm: fixed at the file's values (default),
   // free, or weighted around them with these sigmas (as PlatformSpec of a frame block).
   PlatformParamMode boresight = PlatformParamMode::kFixed;
-  double boresight_sigma_rad = 0.0;   // weighted: per angle, rad, > 0
+  double boresight_sigma_rad = 0.0;  // weighted: per angle, rad, > 0
   PlatformParamMode lever_arm = PlatformParamMode::kFixed;
-  double lever_arm_sigma_m = 0.0;     // weighted: per axis, m, > 0
+  double lever_arm_sigma_m = 0.0;  // weighted: per axis, m, > 0
   // Estimate a time offset dt (s) of the line camera against the POS (shutter / POS latency;
   // LineScanCamera "time_offset"). It is an along-track shift v dt plus the attitude change over
   // dt: only the POS priors tell it from the trajectory's along-track and pitch corrections
   // (named time_offset_vs_along_track); without them it is not determinable (named, invalid).
   bool time_offset = false;
   calib::SolverOptions solver;
-  void Validate() const;              // ConfigError naming the option
+  void Validate() const;  // ConfigError naming the option
 };
 
 /// One image measurement: detector position (col) on scan line (row).
@@ -101,8 +102,8 @@ struct SubcameraRms {
   int first = 0, last = 0, n = 0;
   double across_before_px = 0, along_before_px = 0, across_after_px = 0, along_after_px = 0;
   int degree_x = 0, degree_y = 0;
-  std::vector<double> dx_coefficients_mm, dy_coefficients_mm;  // estimated polynomial (all terms)
-  std::vector<std::optional<double>> dx_sigma_mm, dy_sigma_mm; // null: fixed (degree)
+  std::vector<double> dx_coefficients_mm, dy_coefficients_mm;   // estimated polynomial (all terms)
+  std::vector<std::optional<double>> dx_sigma_mm, dy_sigma_mm;  // null: fixed (degree)
 };
 
 /// One observation's reprojection error without the detector calibration, at the adjusted
@@ -118,13 +119,13 @@ struct LineErrorSample {
 struct LineDatumReport {
   LineDatum mode = LineDatum::kGauge;
   bool null_space_computed = false;
-  std::string message;                          // why the null space was not computed
-  int rank_defect = 0;                          // of the normal matrix WITHOUT a datum
-  double threshold = 0.0;                       // relative eigenvalue threshold
+  std::string message;                                // why the null space was not computed
+  int rank_defect = 0;                                // of the normal matrix WITHOUT a datum
+  double threshold = 0.0;                             // relative eigenvalue threshold
   std::vector<double> smallest_relative_eigenvalues;  // ascending, without the datum
-  int n_constraints = 0;                        // constraints the datum adds
-  std::string subcamera;                        // the reference sub-camera's id
-  std::vector<std::string> blocks;              // the blocks the constraints act on
+  int n_constraints = 0;                              // constraints the datum adds
+  std::string subcamera;                              // the reference sub-camera's id
+  std::vector<std::string> blocks;                    // the blocks the constraints act on
   /// Gauge functions of the detector table found in the null space: name (pitch: a constant
   /// along-track shift c + y^2/c; roll: the across-track c + x^2/c; yaw: (-y, x); scale: (x, y)),
   /// the fraction of its norm over the table that the null space holds (1: a gauge freedom) and
@@ -146,12 +147,12 @@ struct LineDatumReport {
 struct LineCalibrationResult {
   calib::SolveReport report;
   LineDatumReport datum;
-  bool valid = true;               // false: cannot be trusted (warnings say why)
+  bool valid = true;  // false: cannot be trusted (warnings say why)
   std::vector<LineWarning> warnings;
   double sigma0_px = 0.0;
   std::vector<SubcameraRms> subcameras;
   /// Per detector: the estimated calibration (mm) and its sigma (mm, null when not determined).
-  /// After a degree test the sigma is SelectedTableSigma (line_degree_test.h): at least the
+  /// After a degree test the sigma is SelectedTableSigma (line_degree_choice.h): at least the
   /// start-degree fit's; the selected polynomial's own propagated sigma is the fit sigma.
   std::vector<double> dx_mm, dy_mm;
   std::vector<std::optional<double>> dx_sigma_mm, dy_sigma_mm;
@@ -194,7 +195,8 @@ struct LineCalibrationResult {
 std::vector<LineObservation> ReadLineObservations(const std::string& path, double default_sigma_px);
 
 /// Writes observations.csv (`image,point,col,row,sigma_px`, image "strip"; full precision).
-void WriteLineObservations(const std::string& path, const std::vector<LineObservation>& observations);
+void WriteLineObservations(const std::string& path,
+                           const std::vector<LineObservation>& observations);
 
 LineCalibrationResult CalibrateLineCamera(const calib::LineCamera& camera,
                                           const PosTrajectory& pos,

@@ -1,10 +1,5 @@
 #include "triangulation/pushbroom/line_images.h"
 
-#include <algorithm>
-#include <cmath>
-#include <filesystem>
-#include <random>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
@@ -13,6 +8,11 @@
 #include "triangulation/block/block_io.h"
 #include "triangulation/pushbroom/line_rectification.h"
 #include "triangulation/simulation/textured_ground.h"
+
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <random>
 
 namespace aerocal::triangulation {
 namespace {
@@ -34,7 +34,9 @@ stitch::GrayImage IntegrateOverPixels(const TexturedGround& texture,
                                       Noise&& noise) {
   const int rows = int(ground_x.rows()), cols = int(ground_x.cols());
   stitch::GrayImage image(rows, cols);
-  auto valid = [&](int r, int c) { return r >= 0 && c >= 0 && r < rows && c < cols && !std::isnan(ground_x(r, c)); };
+  auto valid = [&](int r, int c) {
+    return r >= 0 && c >= 0 && r < rows && c < cols && !std::isnan(ground_x(r, c));
+  };
   // d ground / d (pixel step) along one image axis at (r, c): central, else one-sided, else 0.
   auto derivative = [&](int r, int c, int dr, int dc) -> Eigen::Vector2d {
     const bool ahead = valid(r + dr, c + dc), behind = valid(r - dr, c - dc);
@@ -42,7 +44,8 @@ stitch::GrayImage IntegrateOverPixels(const TexturedGround& texture,
     const int r1 = ahead ? r + dr : r, c1 = ahead ? c + dc : c;
     const int r0 = behind ? r - dr : r, c0 = behind ? c - dc : c;
     const double steps = (ahead ? 1.0 : 0.0) + (behind ? 1.0 : 0.0);
-    return Eigen::Vector2d(ground_x(r1, c1) - ground_x(r0, c0), ground_y(r1, c1) - ground_y(r0, c0)) /
+    return Eigen::Vector2d(ground_x(r1, c1) - ground_x(r0, c0),
+                           ground_y(r1, c1) - ground_y(r0, c0)) /
            steps;
   };
   for (int r = 0; r < rows; ++r)
@@ -71,21 +74,25 @@ void LineImageOptions::Validate() const {
   auto require = [](bool ok, const std::string& message) {
     if (!ok) throw ConfigError(message);
   };
-  require(!texture_path.empty(), "--texture: the photograph of the scene is required with --render-images");
+  require(!texture_path.empty(),
+          "--texture: the photograph of the scene is required with --render-images");
   require(texture_gsd_m >= 0, "--texture-gsd-m must be >= 0");
   require(reference_width_px >= 100 && reference_width_px <= 20000 && reference_height_px >= 100 &&
               reference_height_px <= 20000,
           "the reference image format must be within 100 .. 20000 px");
   // Each reference frame holds two double grids of its format (16 bytes a pixel) while rendered.
   require(double(reference_width_px) * reference_height_px <= kMaxReferencePixels,
-          "--reference-size: " + std::to_string(reference_width_px) + "x" + std::to_string(reference_height_px) +
+          "--reference-size: " + std::to_string(reference_width_px) + "x" +
+              std::to_string(reference_height_px) +
               " px is more than the 2.5e7 px a reference frame may have");
   require(reference_pixel_mm > 0 && reference_gsd_m >= 0, "reference pixel > 0, GSD >= 0");
-  require(forward_overlap >= 0.5 && forward_overlap <= 0.9, "--reference-overlap must be within 0.5 .. 0.9");
+  require(forward_overlap >= 0.5 && forward_overlap <= 0.9,
+          "--reference-overlap must be within 0.5 .. 0.9");
   require(grey_noise_dn >= 0, "--grey-noise-dn must be >= 0");
 }
 
-LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimulationOptions& o,
+LineImageSimulation RenderLineImages(const LineSimulation& sim,
+                                     const LineSimulationOptions& o,
                                      const LineImageOptions& io) {
   io.Validate();
   const auto terrain = [&o](double x, double y) { return SimulatedTerrainHeight(o, x, y); };
@@ -118,7 +125,8 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimula
 
   TexturedGround texture;
   ReadGroundTexture(io.texture_path, &texture);
-  texture.gsd_m = io.texture_gsd_m > 0 ? io.texture_gsd_m : 0.5 * std::min(line_spacing_m, reference_gsd);
+  texture.gsd_m =
+      io.texture_gsd_m > 0 ? io.texture_gsd_m : 0.5 * std::min(line_spacing_m, reference_gsd);
   texture.x_c = 0.5 * (lo.x() + hi.x());
   texture.y_c = 0.5 * (lo.y() + hi.y());
   out.texture_gsd_m = texture.gsd_m;
@@ -161,12 +169,15 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim, const LineSimula
   const double along_m = io.reference_height_px * reference_gsd;  // image rows along Y
   const double base_m = (1 - io.forward_overlap) * along_m;
   int k = 0;
-  for (double y = lo.y() - 0.25 * along_m; y <= hi.y() + 0.25 * along_m + base_m; y += base_m, ++k) {
+  for (double y = lo.y() - 0.25 * along_m; y <= hi.y() + 0.25 * along_m + base_m;
+       y += base_m, ++k) {
     Exposure e;
     e.image = "ref" + std::to_string(k + 1);
     e.camera = "reference";
-    e.center_m = Eigen::Vector3d(x_mean + 2.0 * std::sin(0.7 * k), y, z_mean + 1.5 * std::cos(0.9 * k));
-    e.opk_rad = Eigen::Vector3d(0.3 * std::sin(1.3 * k), -0.2 * std::cos(0.8 * k), 0.4 * std::sin(0.5 * k)) *
+    e.center_m =
+        Eigen::Vector3d(x_mean + 2.0 * std::sin(0.7 * k), y, z_mean + 1.5 * std::cos(0.9 * k));
+    e.opk_rad = Eigen::Vector3d(
+                    0.3 * std::sin(1.3 * k), -0.2 * std::cos(0.8 * k), 0.4 * std::sin(0.5 * k)) *
                 (M_PI / 180.0);
     e.line = k + 2;
     out.reference_exposures.push_back(e);
@@ -187,8 +198,10 @@ void WriteLineImages(const LineImageSimulation& images, const std::string& folde
   namespace fs = std::filesystem;
   fs::create_directories(fs::path(folder) / "reference");
   stitch::WriteGrayImage((fs::path(folder) / "line_image.png").string(), images.line_image);
-  calib::WriteCamera((fs::path(folder) / "reference" / "camera.yaml").string(), images.reference_camera);
-  WriteExposures((fs::path(folder) / "reference" / "exposures.csv").string(), images.reference_exposures);
+  calib::WriteCamera((fs::path(folder) / "reference" / "camera.yaml").string(),
+                     images.reference_camera);
+  WriteExposures((fs::path(folder) / "reference" / "exposures.csv").string(),
+                 images.reference_exposures);
   for (size_t k = 0; k < images.reference_images.size(); ++k)
     stitch::WriteGrayImage(
         (fs::path(folder) / "reference" / (images.reference_exposures[k].image + ".png")).string(),

@@ -1,6 +1,6 @@
-// Image mode of `aerocal simulate --pushbroom --render-images` (issue 17, module README "Image mode"): the
-// scene of the simulated flight (line_simulation.h: its terrain) textured with a real photograph,
-// rendered
+// Image mode of `aerocal simulate --pushbroom --render-images` (issue 17, module README "Image
+// mode"): the scene of the simulated flight (line_simulation.h: its terrain) textured with a real
+// photograph, rendered
 // - through the TRUE line camera and the TRUE per-line poses into the line image (row r = scan
 //   line r, column = detector; pixel centres at integer positions), and
 // - through a distortion-free frame camera into reference frame images of one strip along the
@@ -11,14 +11,14 @@
 // mirrored beyond its edges; grey values bilinear in the texture, plus Gaussian grey-value noise.
 #pragma once
 
-#include <cstdint>
-#include <string>
-#include <vector>
-
 #include "calib/camera/camera.h"
 #include "stitch/image_io/gray_image.h"
 #include "triangulation/block/block.h"
 #include "triangulation/pushbroom/line_simulation.h"
+
+#include <cstdint>
+#include <string>
+#include <vector>
 
 namespace aerocal::triangulation {
 
@@ -29,16 +29,16 @@ inline constexpr double kMaxReferencePixels = 2.5e7;
 inline constexpr double kMaxLineImagePixels = 5e7;
 
 struct LineImageOptions {
-  std::string texture_path;          // the photograph (any format ReadGrayImage reads), required
-  double texture_gsd_m = 0.0;        // ground size of a texel (2 x 2 photo pixels); 0: automatic
-  int reference_width_px = 2000;     // frame image format, 100 .. 20000, at most kMaxReferencePixels
+  std::string texture_path;       // the photograph (any format ReadGrayImage reads), required
+  double texture_gsd_m = 0.0;     // ground size of a texel (2 x 2 photo pixels); 0: automatic
+  int reference_width_px = 2000;  // frame image format, 100 .. 20000, at most kMaxReferencePixels
   int reference_height_px = 1500;
-  double reference_pixel_mm = 0.006; // > 0
-  double reference_gsd_m = 0.0;      // nadir ground sampling of the frames; 0: 0.6 x line spacing
-  double forward_overlap = 0.6;      // of the reference strip, 0.5 .. 0.9
-  double grey_noise_dn = 1.0;        // Gaussian noise added to every rendered grey value, >= 0
+  double reference_pixel_mm = 0.006;  // > 0
+  double reference_gsd_m = 0.0;       // nadir ground sampling of the frames; 0: 0.6 x line spacing
+  double forward_overlap = 0.6;       // of the reference strip, 0.5 .. 0.9
+  double grey_noise_dn = 1.0;         // Gaussian noise added to every rendered grey value, >= 0
   std::uint64_t seed = 1;
-  void Validate() const;             // ConfigError naming the option
+  void Validate() const;  // ConfigError naming the option
 };
 
 struct LineImageSimulation {
@@ -46,7 +46,7 @@ struct LineImageSimulation {
   calib::Camera reference_camera;
   std::vector<Exposure> reference_exposures;
   std::vector<stitch::GrayImage> reference_images;  // one per exposure
-  double mean_height_m = 0.0;   // mean terrain height under the swath
+  double mean_height_m = 0.0;                       // mean terrain height under the swath
   double texture_gsd_m = 0.0;
 };
 

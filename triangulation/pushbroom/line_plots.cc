@@ -1,10 +1,10 @@
 #include "triangulation/pushbroom/line_plots.h"
 
+#include "calib/core/string_printf.h"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
-
-#include "calib/core/string_printf.h"
 
 namespace aerocal::triangulation {
 namespace {
@@ -12,11 +12,16 @@ namespace {
 std::string Escape(const std::string& text) {
   std::string out;
   for (char ch : text) {
-    if (ch == '&') out += "&amp;";
-    else if (ch == '<') out += "&lt;";
-    else if (ch == '>') out += "&gt;";
-    else if (ch == '"') out += "&quot;";
-    else out += ch;
+    if (ch == '&')
+      out += "&amp;";
+    else if (ch == '<')
+      out += "&lt;";
+    else if (ch == '>')
+      out += "&gt;";
+    else if (ch == '"')
+      out += "&quot;";
+    else
+      out += ch;
   }
   return out;
 }
@@ -38,7 +43,9 @@ std::string LineCalibrationSvg(const LineCalibrationResult& result, const std::s
       "font-family=\"sans-serif\" font-size=\"12\">\n<title>%s</title>\n"
       "<text x=\"10\" y=\"18\">%s: reprojection error without the detector calibration (dots), "
       "fitted table (line) and its 1-sigma band, px (pitches)</text>\n",
-      left + 2 * panel_w + gap_x + 20, top + rows * (panel_h + gap_y), Escape(title).c_str(),
+      left + 2 * panel_w + gap_x + 20,
+      top + rows * (panel_h + gap_y),
+      Escape(title).c_str(),
       Escape(title).c_str());
   for (int k = 0; k < rows; ++k) {
     const SubcameraRms& sub = result.subcameras[k];
@@ -72,23 +79,40 @@ std::string LineCalibrationSvg(const LineCalibrationResult& result, const std::s
       const auto px = [&](double i) { return x0 + panel_w * (i - sub.first) / span; };
       const auto py = [&](double v) { return y0 - panel_h * (v - lo) / (hi - lo); };
       const char* axis_name = axis == 0 ? "across" : "along";
-      s << StringPrintf("<g data-subcamera=\"%s\" data-axis=\"%s\">\n", Escape(sub.id).c_str(),
-                        axis_name)
-        << StringPrintf("<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" "
-                        "stroke=\"black\"/>\n",
-                        x0, y0 - panel_h, panel_w, panel_h);
+      s << StringPrintf(
+               "<g data-subcamera=\"%s\" data-axis=\"%s\">\n", Escape(sub.id).c_str(), axis_name)
+        << StringPrintf(
+               "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" "
+               "stroke=\"black\"/>\n",
+               x0,
+               y0 - panel_h,
+               panel_w,
+               panel_h);
       if (lo < 0 && hi > 0)
-        s << StringPrintf("<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#999\"/>\n",
-                          x0, py(0), x0 + panel_w, py(0));
-      s << StringPrintf("<text x=\"%.1f\" y=\"%.1f\">%s, %s track: %.4g .. %.4g px</text>\n", x0,
-                        y0 - panel_h - 6, Escape(sub.id).c_str(), axis_name, lo, hi)
-        << StringPrintf("<text x=\"%.1f\" y=\"%.1f\">detector %d .. %d</text>\n", x0, y0 + 16,
-                        sub.first, sub.last);
+        s << StringPrintf(
+            "<line x1=\"%.1f\" y1=\"%.1f\" x2=\"%.1f\" y2=\"%.1f\" stroke=\"#999\"/>\n",
+            x0,
+            py(0),
+            x0 + panel_w,
+            py(0));
+      s << StringPrintf("<text x=\"%.1f\" y=\"%.1f\">%s, %s track: %.4g .. %.4g px</text>\n",
+                        x0,
+                        y0 - panel_h - 6,
+                        Escape(sub.id).c_str(),
+                        axis_name,
+                        lo,
+                        hi)
+        << StringPrintf("<text x=\"%.1f\" y=\"%.1f\">detector %d .. %d</text>\n",
+                        x0,
+                        y0 + 16,
+                        sub.first,
+                        sub.last);
       // The band: upper edge forwards, lower edge backwards (only where the sigma is known).
       bool band = true;
       for (int i = sub.first; i <= sub.last; ++i) band = band && sigma[i].has_value();
       if (band) {
-        s << "<polygon class=\"band\" fill=\"#1f77b4\" fill-opacity=\"0.25\" stroke=\"none\" points=\"";
+        s << "<polygon class=\"band\" fill=\"#1f77b4\" fill-opacity=\"0.25\" stroke=\"none\" "
+             "points=\"";
         for (int i = sub.first; i <= sub.last; ++i)
           s << StringPrintf("%.1f,%.2f ", px(i), py((table[i] + *sigma[i]) / pitch));
         for (int i = sub.last; i >= sub.first; --i)
@@ -97,9 +121,12 @@ std::string LineCalibrationSvg(const LineCalibrationResult& result, const std::s
       }
       for (const auto& [i, v] : dots)
         if (v >= lo && v <= hi)
-          s << StringPrintf("<circle cx=\"%.1f\" cy=\"%.2f\" r=\"1.2\" fill=\"#d62728\"/>\n", px(i), py(v));
-      s << "<polyline class=\"fit\" fill=\"none\" stroke=\"#1f77b4\" stroke-width=\"1.5\" points=\"";
-      for (int i = sub.first; i <= sub.last; ++i) s << StringPrintf("%.1f,%.2f ", px(i), py(table[i] / pitch));
+          s << StringPrintf(
+              "<circle cx=\"%.1f\" cy=\"%.2f\" r=\"1.2\" fill=\"#d62728\"/>\n", px(i), py(v));
+      s << "<polyline class=\"fit\" fill=\"none\" stroke=\"#1f77b4\" stroke-width=\"1.5\" "
+           "points=\"";
+      for (int i = sub.first; i <= sub.last; ++i)
+        s << StringPrintf("%.1f,%.2f ", px(i), py(table[i] / pitch));
       s << "\"/>\n</g>\n";
     }
   }

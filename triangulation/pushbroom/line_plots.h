@@ -6,9 +6,9 @@
 // in pitches (px). SVG 1.1 text in the style of `camera show --plot` (tools/cmd_camera.cc).
 #pragma once
 
-#include <string>
-
 #include "triangulation/pushbroom/line_calibration.h"
+
+#include <string>
 
 namespace aerocal::triangulation {
 

@@ -1,18 +1,23 @@
 #include "triangulation/pushbroom/line_rectification.h"
 
-#include <algorithm>
-#include <cmath>
-#include <limits>
-
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "triangulation/pushbroom/line_calibration.h"
 
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
 namespace aerocal::triangulation {
 
-bool SubcameraPixelOfPoint(const calib::LineCamera& cam, const PosTrajectory& pos, int s,
-                           double line_guess, const Eigen::Vector3d& point, double* detector,
-                           double* line, bool strict) {
+bool SubcameraPixelOfPoint(const calib::LineCamera& cam,
+                           const PosTrajectory& pos,
+                           int s,
+                           double line_guess,
+                           const Eigen::Vector3d& point,
+                           double* detector,
+                           double* line,
+                           bool strict) {
   const auto ranges = cam.Ranges();
   const int first = ranges[s].first, last = ranges[s].second;
   double t = std::max(pos.first_line(), std::min(pos.last_line(), line_guess));
@@ -25,7 +30,10 @@ bool SubcameraPixelOfPoint(const calib::LineCamera& cam, const PosTrajectory& po
     const int mid = (lo + hi) / 2;
     ((cam.DesignPosition(mid).x() < xy.x()) == increasing ? lo : hi) = mid;
   }
-  double i = std::abs(cam.DesignPosition(lo).x() - xy.x()) <= std::abs(cam.DesignPosition(hi).x() - xy.x()) ? lo : hi;
+  double i =
+      std::abs(cam.DesignPosition(lo).x() - xy.x()) <= std::abs(cam.DesignPosition(hi).x() - xy.x())
+          ? lo
+          : hi;
   auto detector_at = [&](double di) {
     // The position within the sub-camera (its polynomial, its design), also just beyond its ends.
     const double clamped = std::max<double>(first, std::min<double>(last, di));
@@ -57,8 +65,12 @@ bool SubcameraPixelOfPoint(const calib::LineCamera& cam, const PosTrajectory& po
   return true;
 }
 
-bool LinePixelOfPoint(const calib::LineCamera& cam, const PosTrajectory& pos, double line_guess,
-                      const Eigen::Vector3d& point, double* detector, double* line) {
+bool LinePixelOfPoint(const calib::LineCamera& cam,
+                      const PosTrajectory& pos,
+                      double line_guess,
+                      const Eigen::Vector3d& point,
+                      double* detector,
+                      double* line) {
   const auto ranges = cam.Ranges();
   for (size_t s = 0; s < ranges.size(); ++s) {
     double i = 0, t = 0;
@@ -72,10 +84,12 @@ bool LinePixelOfPoint(const calib::LineCamera& cam, const PosTrajectory& pos, do
   return false;
 }
 
-std::optional<Eigen::Vector3d> GroundOfDetector(const calib::LineCamera& cam,
-                                                const PosTrajectory& pos, double detector,
-                                                double line,
-                                                const std::function<double(double, double)>& height) {
+std::optional<Eigen::Vector3d> GroundOfDetector(
+    const calib::LineCamera& cam,
+    const PosTrajectory& pos,
+    double detector,
+    double line,
+    const std::function<double(double, double)>& height) {
   Eigen::Vector3d center, opk;
   pos.PoseAtLine(line, &center, &opk);
   const Eigen::Matrix3d body = calib::RotationFromOpk(opk);
@@ -86,9 +100,10 @@ std::optional<Eigen::Vector3d> GroundOfDetector(const calib::LineCamera& cam,
   return IntersectSurface(origin, d, height);
 }
 
-std::optional<Eigen::Vector3d> IntersectSurface(const Eigen::Vector3d& origin,
-                                                const Eigen::Vector3d& direction,
-                                                const std::function<double(double, double)>& height) {
+std::optional<Eigen::Vector3d> IntersectSurface(
+    const Eigen::Vector3d& origin,
+    const Eigen::Vector3d& direction,
+    const std::function<double(double, double)>& height) {
   if (!(direction.z() < 0)) return std::nullopt;
   double z = height(origin.x(), origin.y());
   for (int iteration = 0; iteration < 100; ++iteration) {
@@ -100,7 +115,10 @@ std::optional<Eigen::Vector3d> IntersectSurface(const Eigen::Vector3d& origin,
   return std::nullopt;
 }
 
-L1Grid MakeL1Grid(const calib::LineCamera& cam, const PosTrajectory& pos, double z_m, double gsd_m) {
+L1Grid MakeL1Grid(const calib::LineCamera& cam,
+                  const PosTrajectory& pos,
+                  double z_m,
+                  double gsd_m) {
   const double first = std::ceil(pos.first_line()), last = std::floor(pos.last_line());
   if (!(last > first)) throw InputError("pos.csv: the L1 image needs at least two lines");
   if (!(gsd_m > 0)) {
@@ -136,8 +154,12 @@ L1Grid MakeL1Grid(const calib::LineCamera& cam, const PosTrajectory& pos, double
   return grid;
 }
 
-void ComputeL1Maps(const calib::LineCamera& cam, const PosTrajectory& pos, const L1Grid& grid,
-                   int step, Eigen::MatrixXf* detector_map, Eigen::MatrixXf* line_map) {
+void ComputeL1Maps(const calib::LineCamera& cam,
+                   const PosTrajectory& pos,
+                   const L1Grid& grid,
+                   int step,
+                   Eigen::MatrixXf* detector_map,
+                   Eigen::MatrixXf* line_map) {
   AEROCAL_CHECK(step >= 1) << "map step " << step;
   const float nan = std::numeric_limits<float>::quiet_NaN();
   const int nodes_x = (grid.width - 1 + step - 1) / step + 1;
@@ -183,11 +205,14 @@ void ComputeL1Maps(const calib::LineCamera& cam, const PosTrajectory& pos, const
       double i = lerp(node_detector), t = lerp(node_line);  // NaN when a node is invalid
       // Exact where the four nodes do not lie in one sub-camera (a seam: the map jumps there) or
       // not all are valid (the swath's edge).
-      const int s00 = SubcameraOfNode(node_detector(ny, nx)), s01 = SubcameraOfNode(node_detector(ny, nx1));
-      const int s10 = SubcameraOfNode(node_detector(ny1, nx)), s11 = SubcameraOfNode(node_detector(ny1, nx1));
+      const int s00 = SubcameraOfNode(node_detector(ny, nx)),
+                s01 = SubcameraOfNode(node_detector(ny, nx1));
+      const int s10 = SubcameraOfNode(node_detector(ny1, nx)),
+                s11 = SubcameraOfNode(node_detector(ny1, nx1));
       if (s00 < 0 || s00 != s01 || s00 != s10 || s00 != s11) {
         double guess = 0.5 * (first + last);
-        for (double node_t : {node_line(ny, nx), node_line(ny, nx1), node_line(ny1, nx), node_line(ny1, nx1)})
+        for (double node_t :
+             {node_line(ny, nx), node_line(ny, nx1), node_line(ny1, nx), node_line(ny1, nx1)})
           if (!std::isnan(node_t)) guess = node_t;
         const bool ok = LinePixelOfPoint(cam, pos, guess, grid.Ground(col, row), &i, &t) &&
                         t >= first - 0.5 && t <= last + 0.5;
@@ -204,7 +229,8 @@ float SampleBilinear(const stitch::GrayImage& image, double col, double row) {
     return std::numeric_limits<float>::quiet_NaN();
   const int c0 = std::min(int(col), int(image.cols()) - 2 < 0 ? 0 : int(image.cols()) - 2);
   const int r0 = std::min(int(row), int(image.rows()) - 2 < 0 ? 0 : int(image.rows()) - 2);
-  const int c1 = std::min(c0 + 1, int(image.cols()) - 1), r1 = std::min(r0 + 1, int(image.rows()) - 1);
+  const int c1 = std::min(c0 + 1, int(image.cols()) - 1),
+            r1 = std::min(r0 + 1, int(image.rows()) - 1);
   const float fc = float(col - c0), fr = float(row - r0);
   return (1 - fr) * ((1 - fc) * image(r0, c0) + fc * image(r0, c1)) +
          fr * ((1 - fc) * image(r1, c0) + fc * image(r1, c1));
@@ -223,8 +249,11 @@ stitch::GrayImage ResampleThroughMaps(const stitch::GrayImage& line_image,
   return out;
 }
 
-L1Image RectifyLineImage(const calib::LineCamera& cam, const PosTrajectory& pos,
-                         const stitch::GrayImage& line_image, double z_m, double gsd_m,
+L1Image RectifyLineImage(const calib::LineCamera& cam,
+                         const PosTrajectory& pos,
+                         const stitch::GrayImage& line_image,
+                         double z_m,
+                         double gsd_m,
                          int map_step_px) {
   L1Image l1;
   l1.grid = MakeL1Grid(cam, pos, z_m, gsd_m);

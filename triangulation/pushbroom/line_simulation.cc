@@ -1,10 +1,5 @@
 #include "triangulation/pushbroom/line_simulation.h"
 
-#include <cmath>
-#include <filesystem>
-#include <random>
-#include <sstream>
-
 #include "calib/camera/line_camera_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
@@ -13,6 +8,11 @@
 #include "calib/residuals/line_collinearity.h"
 #include "triangulation/pushbroom/line_rectification.h"
 #include "triangulation/sensor/line_scan_camera.h"
+
+#include <cmath>
+#include <filesystem>
+#include <random>
+#include <sstream>
 
 namespace aerocal::triangulation {
 namespace {
@@ -41,7 +41,8 @@ void LineSimulationOptions::Validate() const {
   require(relief_m < 0.5 * height_m, "--relief-m must be below half the flying height");
   require(control_points >= 0, "--control must be >= 0");
   require(image_noise_px >= 0 && image_sigma_px > 0, "--image-noise-px >= 0, --image-sigma-px > 0");
-  require(control_noise_m >= 0 && control_sigma_m > 0, "--control-noise-m >= 0, --control-sigma-m > 0");
+  require(control_noise_m >= 0 && control_sigma_m > 0,
+          "--control-noise-m >= 0, --control-sigma-m > 0");
   require(pos_error_m >= 0 && pos_error_deg >= 0, "--pos-error-m and --pos-error-deg must be >= 0");
   require(node_spacing_lines >= 1, "--node-spacing must be >= 1");
   require(detector_error_px >= 0, "--detector-error-px must be >= 0");
@@ -93,8 +94,10 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     p.last = k * n + n - 1;
     const bool reference = k == sim.reference_subcamera && sub_amp == 0;
     for (auto* axis : {&p.dx, &p.dy}) {
-      *axis = {reference ? 0.0 : amp * normal(rng), reference ? 0.0 : amp * normal(rng),
-               0.5 * amp * normal(rng), 0.5 * amp * normal(rng)};
+      *axis = {reference ? 0.0 : amp * normal(rng),
+               reference ? 0.0 : amp * normal(rng),
+               0.5 * amp * normal(rng),
+               0.5 * amp * normal(rng)};
       // The reference's errors satisfy the calibration's datum (zero Legendre mean and slope,
       // LineDatumResidual): a_0 = -a_2 / 3, a_1 = -3 a_3 / 5.
       if (reference) {
@@ -121,15 +124,21 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
   const double spacing_m = o.pitch_mm / c * o.height_m;  // along-track ground spacing of a line
   const double dt = spacing_m / o.speed_m_s;
   const double length = o.lines * spacing_m;
-  const double ph[6] = {uniform(rng) * 6.28, uniform(rng) * 6.28, uniform(rng) * 6.28,
-                        uniform(rng) * 6.28, uniform(rng) * 6.28, uniform(rng) * 6.28};
+  const double ph[6] = {uniform(rng) * 6.28,
+                        uniform(rng) * 6.28,
+                        uniform(rng) * 6.28,
+                        uniform(rng) * 6.28,
+                        uniform(rng) * 6.28,
+                        uniform(rng) * 6.28};
   const double a = o.attitude_variation_deg * kDeg, q = o.position_variation_m;
   // The body's trajectory at a (fractional) line index.
   auto trajectory = [&](double l, PosRecord* r) {
     const double s = l / double(o.lines);  // 0 .. 1 along the strip
-    r->center_m = {q * std::sin(2 * M_PI * 1.3 * s + ph[0]), l * spacing_m + 0.3 * q * std::sin(2 * M_PI * 0.7 * s + ph[1]),
+    r->center_m = {q * std::sin(2 * M_PI * 1.3 * s + ph[0]),
+                   l * spacing_m + 0.3 * q * std::sin(2 * M_PI * 0.7 * s + ph[1]),
                    o.height_m + q * std::sin(2 * M_PI * 0.9 * s + ph[2])};
-    r->opk_rad = {a * std::sin(2 * M_PI * 2.1 * s + ph[3]), a * std::sin(2 * M_PI * 1.7 * s + ph[4]),
+    r->opk_rad = {a * std::sin(2 * M_PI * 2.1 * s + ph[3]),
+                  a * std::sin(2 * M_PI * 1.7 * s + ph[4]),
                   0.5 * a * std::sin(2 * M_PI * 1.1 * s + ph[5])};
   };
   // A time offset: line l is exposed at its time stamp plus time_offset_s, so its true pose is
@@ -149,7 +158,8 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
   const int nodes = calib::SplineNodeCount(o.lines - 1, o.node_spacing_lines);
   std::vector<Vector6d> error_nodes(nodes);
   for (auto& e : error_nodes)
-    for (int k = 0; k < 6; ++k) e[k] = (k < 3 ? o.pos_error_m : o.pos_error_deg * kDeg) * normal(rng);
+    for (int k = 0; k < 6; ++k)
+      e[k] = (k < 3 ? o.pos_error_m : o.pos_error_deg * kDeg) * normal(rng);
   // Bias and drift: constant and linear in the line index, which the cubic B-spline holds exactly
   // (node j is centred on line (j - 1) spacing).
   if (o.pos_bias_m > 0 || o.pos_bias_deg > 0 || o.pos_drift_m > 0 || o.pos_drift_deg > 0) {
@@ -181,7 +191,8 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
   const double half_swath = o.height_m * std::tan(1.5 * o.tilt_deg * kDeg + half_field_rad * 0.3);
   auto terrain = [&](double x, double y) { return SimulatedTerrainHeight(o, x, y); };
   int placed = 0;
-  for (int attempt = 0; placed < o.control_points && attempt < 20 * o.control_points + 100; ++attempt) {
+  for (int attempt = 0; placed < o.control_points && attempt < 20 * o.control_points + 100;
+       ++attempt) {
     const double y = (0.02 + 0.96 * uniform(rng)) * length;
     const double x = (2 * uniform(rng) - 1) * half_swath;
     const Eigen::Vector3d ground(x, y, terrain(x, y));
@@ -202,8 +213,7 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
       // be read as the neighbour's detector, so it is not measured (and, at the outer edges,
       // beyond the line).
       const long column = std::lround(obs.detector);
-      if (!(obs.detector >= -0.5 && column >= first && column <= last))
-        continue;
+      if (!(obs.detector >= -0.5 && column >= first && column <= last)) continue;
       seen.push_back(obs);
     }
     if (seen.empty()) continue;
@@ -227,7 +237,9 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
 
 void WriteLineSimulation(const LineSimulation& sim, const std::string& folder) {
   std::filesystem::create_directories(folder);
-  auto path = [&](const std::string& name) { return (std::filesystem::path(folder) / name).string(); };
+  auto path = [&](const std::string& name) {
+    return (std::filesystem::path(folder) / name).string();
+  };
   calib::WriteLineCamera(path("camera_nominal.yaml"), sim.nominal);
   calib::WriteLineCamera(path("camera_truth.yaml"), sim.truth);
   WritePos(path("pos.csv"), sim.pos);
@@ -248,7 +260,8 @@ void WriteLineSimulation(const LineSimulation& sim, const std::string& folder) {
     for (int i = 0; i < sim.truth.detectors; ++i) {
       const Eigen::Vector2d d = sim.truth.Correction(i);
       const int k = sim.truth.SubcameraOf(i);
-      out << i << "," << (sim.truth.subcameras.empty() ? std::to_string(k) : sim.truth.subcameras[k].id) << ","
+      out << i << ","
+          << (sim.truth.subcameras.empty() ? std::to_string(k) : sim.truth.subcameras[k].id) << ","
           << FormatNumber(d.x(), 17) << "," << FormatNumber(d.y(), 17) << "\n";
     }
     WriteFileAtomically(path("truth_detectors.csv"), out.str());

@@ -14,37 +14,37 @@
 //   its own offset, scale, rotation and curvature error.
 #pragma once
 
-#include <cstdint>
-#include <string>
-#include <vector>
-
-#include <Eigen/Core>
-
 #include "calib/camera/line_camera.h"
 #include "triangulation/block/block.h"
 #include "triangulation/pushbroom/line_calibration.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
 
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
 namespace aerocal::triangulation {
 
 struct LineSimulationOptions {
-  int detectors_per_camera = 300;   // per sub-camera, 10 .. 100000
-  double tilt_deg = 20.0;           // across-track look angle of the outer cameras, 0 .. 40
-  double pitch_mm = 0.01;           // detector pitch, > 0
-  double overlap = 0.05;            // fraction of a sub-camera's field shared with its neighbour
-  int lines = 2000;                 // scan lines, 20 .. 1e6
-  double height_m = 1000.0;         // flying height above the mean terrain, > 0
-  double speed_m_s = 60.0;          // ground speed, > 0
-  double relief_m = 100.0;          // terrain relief peak to peak, >= 0
-  int control_points = 1500;        // cloud control points placed in the swath
-  double image_noise_px = 0.25;     // measurement noise (col and row), >= 0
-  double image_sigma_px = 0.25;     // a-priori sigma written, > 0
-  double control_noise_m = 0.1;     // coordinate noise of the control points, >= 0
-  double control_sigma_m = 0.1;     // their a-priori sigma written, > 0
-  double pos_error_m = 0.05;        // sigma of the POS error spline nodes (position), >= 0
-  double pos_error_deg = 0.005;     // sigma of the POS error spline nodes (attitude), >= 0
-  int node_spacing_lines = 100;     // of the POS error spline, >= 1
-  double detector_error_px = 0.5;   // size of the smooth per-detector errors, >= 0
+  int detectors_per_camera = 300;  // per sub-camera, 10 .. 100000
+  double tilt_deg = 20.0;          // across-track look angle of the outer cameras, 0 .. 40
+  double pitch_mm = 0.01;          // detector pitch, > 0
+  double overlap = 0.05;           // fraction of a sub-camera's field shared with its neighbour
+  int lines = 2000;                // scan lines, 20 .. 1e6
+  double height_m = 1000.0;        // flying height above the mean terrain, > 0
+  double speed_m_s = 60.0;         // ground speed, > 0
+  double relief_m = 100.0;         // terrain relief peak to peak, >= 0
+  int control_points = 1500;       // cloud control points placed in the swath
+  double image_noise_px = 0.25;    // measurement noise (col and row), >= 0
+  double image_sigma_px = 0.25;    // a-priori sigma written, > 0
+  double control_noise_m = 0.1;    // coordinate noise of the control points, >= 0
+  double control_sigma_m = 0.1;    // their a-priori sigma written, > 0
+  double pos_error_m = 0.05;       // sigma of the POS error spline nodes (position), >= 0
+  double pos_error_deg = 0.005;    // sigma of the POS error spline nodes (attitude), >= 0
+  int node_spacing_lines = 100;    // of the POS error spline, >= 1
+  double detector_error_px = 0.5;  // size of the smooth per-detector errors, >= 0
   // Per sub-camera errors of EVERY sub-camera (the reference too; issue 28): an offset (dx, dy),
   // a scale (dx ~ u), a rotation of the line in the focal plane (dy ~ u) and a curvature
   // (dy ~ u^2), each drawn with this sigma at the sub-camera's ends, px; 0: none (then the
@@ -67,8 +67,8 @@ struct LineSimulationOptions {
 };
 
 struct LineSimulation {
-  calib::LineCamera truth, nominal;   // truth: polynomial calibration; nominal: none
-  std::vector<PosRecord> pos_truth, pos;   // per line
+  calib::LineCamera truth, nominal;       // truth: polynomial calibration; nominal: none
+  std::vector<PosRecord> pos_truth, pos;  // per line
   std::vector<LineObservation> observations;
   std::vector<GroundPoint> points, points_truth;
   /// True per-line corrections the calibration should find (= minus the POS error): per line

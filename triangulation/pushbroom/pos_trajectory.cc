@@ -1,13 +1,13 @@
 #include "triangulation/pushbroom/pos_trajectory.h"
 
-#include <algorithm>
-#include <cmath>
-#include <sstream>
-
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "triangulation/block/value_bounds.h"
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
 
 namespace aerocal::triangulation {
 namespace {
@@ -18,14 +18,18 @@ using namespace bounds;
 constexpr double kMaxLine = 1e9;
 constexpr double kMaxTimeS = 1e10;
 
-std::optional<Eigen::Vector3d> SigmaTriple(const CsvTable& t, const CsvTable::Row& row,
-                                           const char* a, const char* b, const char* c, double hi) {
+std::optional<Eigen::Vector3d> SigmaTriple(const CsvTable& t,
+                                           const CsvTable::Row& row,
+                                           const char* a,
+                                           const char* b,
+                                           const char* c,
+                                           double hi) {
   const auto x = t.OptionalBounded(row, a, 0.0, hi), y = t.OptionalBounded(row, b, 0.0, hi),
              z = t.OptionalBounded(row, c, 0.0, hi);
   if (!x && !y && !z) return std::nullopt;
   if (!x || !y || !z || !(*x > 0 && *y > 0 && *z > 0))
-    ThrowInputError(t.Where(row), std::string(a) + ", " + b + ", " + c +
-                                      " must be given together and be > 0");
+    ThrowInputError(t.Where(row),
+                    std::string(a) + ", " + b + ", " + c + " must be given together and be > 0");
   return Eigen::Vector3d(*x, *y, *z);
 }
 
@@ -50,8 +54,20 @@ std::optional<Eigen::Vector3d> Median3(const std::vector<PosRecord>& records, bo
 PosTrajectory PosTrajectory::Read(const std::string& path) {
   const CsvTable t = CsvTable::Read(path);
   t.RequireColumns({"line", "time_s", "X", "Y", "Z", "omega", "phi", "kappa"});
-  t.RejectUnknownColumns({"line", "time_s", "X", "Y", "Z", "omega", "phi", "kappa", "sX", "sY", "sZ",
-                         "somega", "sphi", "skappa"});
+  t.RejectUnknownColumns({"line",
+                          "time_s",
+                          "X",
+                          "Y",
+                          "Z",
+                          "omega",
+                          "phi",
+                          "kappa",
+                          "sX",
+                          "sY",
+                          "sZ",
+                          "somega",
+                          "sphi",
+                          "skappa"});
   std::vector<PosRecord> records;
   for (const auto& row : t.rows()) {
     PosRecord r;
@@ -86,18 +102,21 @@ PosTrajectory PosTrajectory::FromRecords(std::vector<PosRecord> records, const s
     if (k > 0) {
       const PosRecord& prev = records[k - 1];
       if (!(r.time_s > prev.time_s))
-        ThrowInputError(where, "time_s must increase strictly down the file (got " +
-                                   FormatNumber(r.time_s) + " after " + FormatNumber(prev.time_s) + ")");
+        ThrowInputError(where,
+                        "time_s must increase strictly down the file (got " +
+                            FormatNumber(r.time_s) + " after " + FormatNumber(prev.time_s) + ")");
       for (int a = 0; a < 3; ++a)
         if (std::abs(r.opk_rad[a] - prev.opk_rad[a]) >= M_PI)
-          ThrowInputError(where, "the attitude jumps by 180 deg or more from the row before "
-                                 "(unwrap the angles: they are interpolated as they are)");
+          ThrowInputError(where,
+                          "the attitude jumps by 180 deg or more from the row before "
+                          "(unwrap the angles: they are interpolated as they are)");
     }
     if (r.line) {
       if (!pos.line_of_.empty() && !(*r.line > pos.line_of_.back()))
-        ThrowInputError(where, "line must increase strictly among the rows that have one (got " +
-                                   FormatNumber(*r.line) + " after " +
-                                   FormatNumber(pos.line_of_.back()) + ")");
+        ThrowInputError(where,
+                        "line must increase strictly among the rows that have one (got " +
+                            FormatNumber(*r.line) + " after " + FormatNumber(pos.line_of_.back()) +
+                            ")");
       pos.line_of_.push_back(*r.line);
       pos.time_of_line_.push_back(r.time_s);
     }
@@ -122,8 +141,9 @@ bool PosTrajectory::CoversLine(double line) const {
 
 double PosTrajectory::LineTime(double line) const {
   if (!CoversLine(line))
-    throw InputError(file_ + ": line " + FormatNumber(line) + " is outside the POS trajectory (lines " +
-                     FormatNumber(line_of_.front()) + " .. " + FormatNumber(line_of_.back()) + ")");
+    throw InputError(file_ + ": line " + FormatNumber(line) +
+                     " is outside the POS trajectory (lines " + FormatNumber(line_of_.front()) +
+                     " .. " + FormatNumber(line_of_.back()) + ")");
   const size_t n = line_of_.size();
   size_t k = std::upper_bound(line_of_.begin(), line_of_.end(), line) - line_of_.begin();
   k = std::min(std::max<size_t>(k, 1), n - 1);
@@ -131,15 +151,18 @@ double PosTrajectory::LineTime(double line) const {
   return (1 - w) * time_of_line_[k - 1] + w * time_of_line_[k];
 }
 
-void PosTrajectory::PoseAtTime(double time_s, Eigen::Vector3d* center_m,
+void PosTrajectory::PoseAtTime(double time_s,
+                               Eigen::Vector3d* center_m,
                                Eigen::Vector3d* opk_rad) const {
   const size_t n = records_.size();
   if (!(time_s >= records_.front().time_s && time_s <= records_.back().time_s))
     throw InputError(file_ + ": time " + FormatNumber(time_s) + " s is outside the POS rows (" +
                      FormatNumber(records_.front().time_s) + " .. " +
                      FormatNumber(records_.back().time_s) + " s)");
-  const auto it = std::upper_bound(records_.begin(), records_.end(), time_s,
-                                   [](double t, const PosRecord& r) { return t < r.time_s; });
+  const auto it =
+      std::upper_bound(records_.begin(), records_.end(), time_s, [](double t, const PosRecord& r) {
+        return t < r.time_s;
+      });
   // Interval [k, k+1] holds time_s; the 4 rows k-1 .. k+2, shifted inside the table.
   long k = long(it - records_.begin()) - 1;
   long first = std::min(std::max(k - 1, 0L), long(n) - 4);
@@ -165,7 +188,8 @@ std::optional<Eigen::Vector3d> PosTrajectory::MedianOpkSigma() const {
 
 void WritePos(const std::string& path, const std::vector<PosRecord>& records) {
   bool sigmas = !records.empty();
-  for (const auto& r : records) sigmas &= r.center_sigma_m.has_value() && r.opk_sigma_rad.has_value();
+  for (const auto& r : records)
+    sigmas &= r.center_sigma_m.has_value() && r.opk_sigma_rad.has_value();
   std::ostringstream out;
   out << "line,time_s,X,Y,Z,omega,phi,kappa";
   if (sigmas) out << ",sX,sY,sZ,somega,sphi,skappa";

@@ -16,16 +16,16 @@
 // - Sigmas (m, deg in the file; rad in memory) are optional; empty = not given.
 #pragma once
 
+#include <Eigen/Core>
+
 #include <optional>
 #include <string>
 #include <vector>
 
-#include <Eigen/Core>
-
 namespace aerocal::triangulation {
 
 struct PosRecord {
-  std::optional<double> line;                      // scan line this row belongs to, or an epoch
+  std::optional<double> line;  // scan line this row belongs to, or an epoch
   double time_s = 0.0;
   Eigen::Vector3d center_m = Eigen::Vector3d::Zero();  // body position (m)
   Eigen::Vector3d opk_rad = Eigen::Vector3d::Zero();   // body attitude (rad)

@@ -1,17 +1,18 @@
 #include "triangulation/pushbroom/reference_frames.h"
 
-#include <cmath>
-
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
+
+#include <cmath>
 
 namespace aerocal::triangulation {
 
 std::vector<Exposure> ReadAdjustedExposures(const std::string& result_path, int* skipped) {
   const nlohmann::json doc = ReadResult(result_path, {"adjust"}, "`aerocal adjust`");
   if (doc.contains("valid") && doc["valid"].is_boolean() && !doc["valid"].get<bool>())
-    throw InputError(result_path + ": the block adjustment is not valid (valid: false): its "
-                                   "orientations cannot serve as the reference");
+    throw InputError(result_path +
+                     ": the block adjustment is not valid (valid: false): its "
+                     "orientations cannot serve as the reference");
   if (!doc.contains("exposures") || !doc["exposures"].is_array())
     throw InputError(result_path + ": no exposures array");
   constexpr double kDegToRad = M_PI / 180.0;

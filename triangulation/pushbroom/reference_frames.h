@@ -3,10 +3,10 @@
 // from exposures.csv (FORMATS.md) or straight from the result.json of `aerocal adjust`.
 #pragma once
 
+#include "triangulation/block/block.h"
+
 #include <string>
 #include <vector>
-
-#include "triangulation/block/block.h"
 
 namespace aerocal::triangulation {
 

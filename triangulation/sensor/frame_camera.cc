@@ -32,8 +32,11 @@ void FrameCamera::RegisterBlocks(const SensorContext& context) {
                           " in model " + std::string(calib::CameraModelName(camera.model)) +
                           " (its parameters: " + calib::JoinParamNames(table) + ")");
     interior_[k] = camera.interior;
-    blocks_[k] = context.builder.AddBlock("camera " + id, interior_[k].data(), interior_[k].size(),
-                                          calib::BlockKind::kInterior, names);
+    blocks_[k] = context.builder.AddBlock("camera " + id,
+                                          interior_[k].data(),
+                                          interior_[k].size(),
+                                          calib::BlockKind::kInterior,
+                                          names);
     context.builder.FixEntries(blocks_[k], fixed);
   }
 }

@@ -1,17 +1,20 @@
 #include "triangulation/sensor/line_scan_camera.h"
 
-#include <algorithm>
-#include <cmath>
-
 #include "calib/camera/rotation.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/residuals/prior.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace aerocal::triangulation {
 
-bool ProjectAtLine(const calib::LineCamera& camera, const PosTrajectory& pos, double line,
-                   const Eigen::Vector3d& point, Eigen::Vector2d* xy) {
+bool ProjectAtLine(const calib::LineCamera& camera,
+                   const PosTrajectory& pos,
+                   double line,
+                   const Eigen::Vector3d& point,
+                   Eigen::Vector2d* xy) {
   Eigen::Vector3d center, opk;
   pos.PoseAtLine(line, &center, &opk);
   const Eigen::Matrix3d body = calib::RotationFromOpk(opk);
@@ -53,7 +56,8 @@ void LineScanCamera::RegisterBlocks(const SensorContext& context) {
     std::vector<std::string> names;
     for (int k = 0; k < calib::kLineMaxTerms; ++k) names.push_back("dx" + std::to_string(k));
     for (int k = 0; k < calib::kLineMaxTerms; ++k) names.push_back("dy" + std::to_string(k));
-    const std::string id = camera_.subcameras.empty() ? std::to_string(s) : camera_.subcameras[s].id;
+    const std::string id =
+        camera_.subcameras.empty() ? std::to_string(s) : camera_.subcameras[s].id;
     detector_blocks_.push_back(b.AddBlock("detector_" + id,
                                           detector_[s].data(),
                                           2 * calib::kLineMaxTerms,
@@ -63,7 +67,8 @@ void LineScanCamera::RegisterBlocks(const SensorContext& context) {
   c_block_ = b.AddBlock("c", &c_, 1, calib::BlockKind::kInterior, {"c"});
   mount_block_ =
       b.AddBlock("mount", mount_.data(), 3, calib::BlockKind::kOther, {"omega", "phi", "kappa"});
-  lever_block_ = b.AddBlock("lever_arm", lever_.data(), 3, calib::BlockKind::kOther, {"x", "y", "z"});
+  lever_block_ =
+      b.AddBlock("lever_arm", lever_.data(), 3, calib::BlockKind::kOther, {"x", "y", "z"});
   time_offset_s_ = 0.0;
   time_block_ = b.AddBlock("time_offset", &time_offset_s_, 1, calib::BlockKind::kOther, {"dt"});
   if (!options_.time_offset) b.FixBlock(time_block_);
@@ -86,10 +91,12 @@ LineDetectorSite LineScanCamera::DetectorSite(double detector) const {
   return site;
 }
 
-void LineScanCamera::PoseAtLine(double line, Eigen::Vector3d* center_m, Eigen::Vector3d* opk_rad) const {
+void LineScanCamera::PoseAtLine(double line,
+                                Eigen::Vector3d* center_m,
+                                Eigen::Vector3d* opk_rad) const {
   pos_.PoseAtLine(line, center_m, opk_rad);
-  const calib::SplineSpan span = calib::CubicBSplineWeights(
-      std::max(0.0, line - pos_.first_line()), options_.node_spacing_lines);
+  const calib::SplineSpan span = calib::CubicBSplineWeights(std::max(0.0, line - pos_.first_line()),
+                                                            options_.node_spacing_lines);
   const int j = std::min(span.first_node, NumNodes() - 4);
   for (int m = 0; m < 4; ++m) {
     *center_m += span.weights[m] * nodes_[j + m].head<3>();
@@ -107,12 +114,14 @@ ImageRay LineScanCamera::StartingRay(const SensorContext& context,
   const double* poly = detector_[site.subcamera].data();
   const Eigen::Vector2d xy =
       camera_.DetectorPosition(detector) +
-      Eigen::Vector2d(calib::EvaluatePolynomial(poly, calib::kLineMaxTerms, site.u),
-                      calib::EvaluatePolynomial(poly + calib::kLineMaxTerms, calib::kLineMaxTerms, site.u));
+      Eigen::Vector2d(
+          calib::EvaluatePolynomial(poly, calib::kLineMaxTerms, site.u),
+          calib::EvaluatePolynomial(poly + calib::kLineMaxTerms, calib::kLineMaxTerms, site.u));
   const Eigen::Matrix3d body = calib::RotationFromOpk(opk);
   ImageRay ray;
   ray.center_m = center + body * lever_;
-  ray.direction = (body * calib::RotationFromOpk(mount_) * Eigen::Vector3d(xy.x(), xy.y(), -c_)).normalized();
+  ray.direction =
+      (body * calib::RotationFromOpk(mount_) * Eigen::Vector3d(xy.x(), xy.y(), -c_)).normalized();
   return ray;
 }
 
@@ -123,13 +132,15 @@ ObservationTerm LineScanCamera::Observe(const SensorContext& context,
   const double detector = observation.pixel.x(), line = observation.pixel.y();
   const double first_line = pos_.first_line(), last_line = pos_.last_line();
   if (!(detector >= -0.5 && detector <= camera_.detectors - 0.5))
-    ThrowInputError(where, "col (detector) must be within -0.5 .. " +
-                               FormatNumber(camera_.detectors - 0.5) + " (got " +
-                               FormatNumber(detector) + ")");
+    ThrowInputError(where,
+                    "col (detector) must be within -0.5 .. " +
+                        FormatNumber(camera_.detectors - 0.5) + " (got " + FormatNumber(detector) +
+                        ")");
   if (!pos_.CoversLine(line))
-    ThrowInputError(where, "row (scan line) " + FormatNumber(line) +
-                               " is outside the POS trajectory (lines " + FormatNumber(first_line) +
-                               " .. " + FormatNumber(last_line) + ")");
+    ThrowInputError(where,
+                    "row (scan line) " + FormatNumber(line) +
+                        " is outside the POS trajectory (lines " + FormatNumber(first_line) +
+                        " .. " + FormatNumber(last_line) + ")");
   const LineDetectorSite site = DetectorSite(detector);
   const int s = site.subcamera;
   Eigen::Vector3d pos_center, pos_opk;
@@ -141,7 +152,8 @@ ObservationTerm LineScanCamera::Observe(const SensorContext& context,
   const double ic = std::max(ranges_[s].first + h, std::min(ranges_[s].second - h, detector));
   const double dx_di =
       ranges_[s].second > ranges_[s].first
-          ? std::abs(camera_.DesignPosition(ic + h).x() - camera_.DesignPosition(ic - h).x()) / (2 * h)
+          ? std::abs(camera_.DesignPosition(ic + h).x() - camera_.DesignPosition(ic - h).x()) /
+                (2 * h)
           : camera_.pitch_mm;
   const Eigen::Vector3d xyz = Eigen::Map<const Eigen::Vector3d>(context.builder.BlockValues(point));
   double dy_dt = 0;
@@ -170,11 +182,24 @@ ObservationTerm LineScanCamera::Observe(const SensorContext& context,
   Eigen::Vector3d c0, c1, o0, o1;
   pos_.PoseAtTime(t0, &c0, &o0);
   pos_.PoseAtTime(t1, &c1, &o1);
-  term.cost = calib::LineCollinearityResidual::Create(
-      camera_.DetectorPosition(detector), site.u, span, pos_opk, pos_center, sigma_xy_mm,
-      Eigen::Vector3d((c1 - c0) / (t1 - t0)), Eigen::Vector3d((o1 - o0) / (t1 - t0)));
-  term.blocks = {node_blocks_[j], node_blocks_[j + 1], node_blocks_[j + 2], node_blocks_[j + 3],
-                 detector_blocks_[s], c_block_, mount_block_, lever_block_, time_block_, point};
+  term.cost = calib::LineCollinearityResidual::Create(camera_.DetectorPosition(detector),
+                                                      site.u,
+                                                      span,
+                                                      pos_opk,
+                                                      pos_center,
+                                                      sigma_xy_mm,
+                                                      Eigen::Vector3d((c1 - c0) / (t1 - t0)),
+                                                      Eigen::Vector3d((o1 - o0) / (t1 - t0)));
+  term.blocks = {node_blocks_[j],
+                 node_blocks_[j + 1],
+                 node_blocks_[j + 2],
+                 node_blocks_[j + 3],
+                 detector_blocks_[s],
+                 c_block_,
+                 mount_block_,
+                 lever_block_,
+                 time_block_,
+                 point};
   return term;
 }
 

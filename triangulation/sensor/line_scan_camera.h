@@ -32,17 +32,17 @@
 // (group kGroupLinePrior).
 #pragma once
 
-#include <array>
-#include <cmath>
-#include <vector>
-
-#include <Eigen/Core>
-
 #include "calib/camera/line_camera.h"
 #include "calib/residuals/autodiff_residual.h"
 #include "calib/residuals/line_collinearity.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
 #include "triangulation/sensor/imaging_model.h"
+
+#include <Eigen/Core>
+
+#include <array>
+#include <cmath>
+#include <vector>
 
 namespace aerocal::triangulation {
 
@@ -73,14 +73,15 @@ void LegendreMeanAndSlope(const T* a, int n, T* mean, T* slope) {
 /// polynomials a_0..a_5, b_0..b_5, mm). A pseudo-observation as tight as the datum must be
 /// (`sigma_mm` ~ 1e-4 px: its own variance is ~1e-3 of a table's); it replaces the four fixed
 /// entries of the earlier datum (a_0 = a_1 = b_0 = b_1 = 0), so the redundancy is the same.
-struct LineDatumResidual
-    : calib::AutoDiffResidual<LineDatumResidual, 4, 2 * calib::kLineMaxTerms> {
+struct LineDatumResidual : calib::AutoDiffResidual<LineDatumResidual, 4, 2 * calib::kLineMaxTerms> {
   explicit LineDatumResidual(double sigma_mm) : inverse_sigma_(1.0 / sigma_mm) {}
   template <typename T>
   bool operator()(const T* coefficients, T* r) const {
     for (int axis = 0; axis < 2; ++axis) {
-      LegendreMeanAndSlope(coefficients + axis * calib::kLineMaxTerms, calib::kLineMaxTerms,
-                           &r[2 * axis], &r[2 * axis + 1]);
+      LegendreMeanAndSlope(coefficients + axis * calib::kLineMaxTerms,
+                           calib::kLineMaxTerms,
+                           &r[2 * axis],
+                           &r[2 * axis + 1]);
       r[2 * axis] *= inverse_sigma_;
       r[2 * axis + 1] *= inverse_sigma_;
     }
@@ -92,15 +93,18 @@ struct LineDatumResidual
 /// Focal-plane position (mm) of `point` seen from the pose of `trajectory` at (fractional) `line`
 /// through `camera`'s mount and lever arm (no spline corrections); false when it lies on or behind
 /// the camera.
-bool ProjectAtLine(const calib::LineCamera& camera, const PosTrajectory& trajectory, double line,
-                   const Eigen::Vector3d& point, Eigen::Vector2d* xy);
+bool ProjectAtLine(const calib::LineCamera& camera,
+                   const PosTrajectory& trajectory,
+                   double line,
+                   const Eigen::Vector3d& point,
+                   Eigen::Vector2d* xy);
 
 /// What the line camera estimates (the data are the camera file and the POS).
 struct LineScanOptions {
   int node_spacing_lines = 100;  // spline node spacing, lines, >= 1
   bool free_c = false;           // estimate c
   bool pos_prior = true;         // POS sigmas as priors on every node
-  Eigen::Vector3d pos_sigma_center_m = Eigen::Vector3d::Constant(0.05);   // > 0
+  Eigen::Vector3d pos_sigma_center_m = Eigen::Vector3d::Constant(0.05);                 // > 0
   Eigen::Vector3d pos_sigma_opk_rad = Eigen::Vector3d::Constant(0.005 * M_PI / 180.0);  // > 0
   PlatformParamMode boresight = PlatformParamMode::kFixed;  // the camera file's mount M
   double boresight_sigma_rad = 0.0;                         // weighted: per angle, > 0
@@ -120,7 +124,7 @@ struct LineTerm {
   int subcamera = 0;
   double detector = 0.0, u = 0.0;
   Eigen::Vector2d sigma_mm = Eigen::Vector2d::Zero();  // whitening, focal plane x and y
-  int segment = 0;                                      // first of its four spline nodes
+  int segment = 0;                                     // first of its four spline nodes
 };
 
 class LineScanCamera final : public ImagingModel {
@@ -161,7 +165,9 @@ class LineScanCamera final : public ImagingModel {
   const std::vector<DetectorValues>& Detectors() const { return detector_; }
   /// Sets the fixed entries of sub-camera s's polynomial block (their values to 0; the others
   /// free): degree and datum are the calibration's.
-  void SetFixedDetectorEntries(calib::ProblemBuilder& builder, int s, const std::vector<int>& fixed);
+  void SetFixedDetectorEntries(calib::ProblemBuilder& builder,
+                               int s,
+                               const std::vector<int>& fixed);
   calib::BlockId CBlock() const { return c_block_; }
   calib::BlockId MountBlock() const { return mount_block_; }
   calib::BlockId LeverArmBlock() const { return lever_block_; }

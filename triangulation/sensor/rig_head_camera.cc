@@ -57,20 +57,27 @@ std::optional<RigParameterMode> ParseRigParameterMode(std::string_view name) {
 
 std::string_view RigParameterModeName(RigParameterMode mode) {
   switch (mode) {
-    case RigParameterMode::kFixed: return "fixed";
-    case RigParameterMode::kFree: return "free";
-    case RigParameterMode::kWeighted: return "weighted";
+    case RigParameterMode::kFixed:
+      return "fixed";
+    case RigParameterMode::kFree:
+      return "free";
+    case RigParameterMode::kWeighted:
+      return "weighted";
   }
   return "fixed";
 }
 
 void RigAdjustOptions::Validate() const {
   if (increments == RigParameterMode::kWeighted && !(increment_sigma_rad > 0.0))
-    throw ConfigError("weighted rig increments need a sigma > 0 (--rig-increment-sigma-arcsec, "
-                      "got " + FormatNumber(increment_sigma_rad * kDegPerRad * 3600.0) + ")");
+    throw ConfigError(
+        "weighted rig increments need a sigma > 0 (--rig-increment-sigma-arcsec, "
+        "got " +
+        FormatNumber(increment_sigma_rad * kDegPerRad * 3600.0) + ")");
   if (time_offsets == RigParameterMode::kWeighted && !(time_offset_sigma_s > 0.0))
-    throw ConfigError("weighted rig time offsets need a sigma > 0 (--rig-time-offset-sigma-ms, "
-                      "got " + FormatNumber(time_offset_sigma_s * 1e3) + ")");
+    throw ConfigError(
+        "weighted rig time offsets need a sigma > 0 (--rig-time-offset-sigma-ms, "
+        "got " +
+        FormatNumber(time_offset_sigma_s * 1e3) + ")");
 }
 
 RigHeadCamera::RigHeadCamera(const RigAdjustOptions& options) : options_(options) {
@@ -151,8 +158,11 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
                                            calib::BlockKind::kOther,
                                            kIncrementNames);
   builder.FixBlock(zero_increment_block_);
-  zero_time_offset_block_ = builder.AddBlock(
-      "rig " + camera_ + " zero time offset", &zero_time_offset_, 1, calib::BlockKind::kOther, {"dT"});
+  zero_time_offset_block_ = builder.AddBlock("rig " + camera_ + " zero time offset",
+                                             &zero_time_offset_,
+                                             1,
+                                             calib::BlockKind::kOther,
+                                             {"dT"});
   builder.FixBlock(zero_time_offset_block_);
 
   // Exposures of the rig: per-head increments; velocity where the time offsets are estimated.
@@ -168,13 +178,12 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
     for (int k = 0; k < n; ++k) {
       if (k == reference_) continue;
       Increment& increment = increments_[{e, k}];
-      increment.block = builder.AddBlock(
-          "rig " + camera_ + " image " + exposure.image + " head " + rig_->heads[k].id +
-              " increment",
-          increment.rad.data(),
-          3,
-          calib::BlockKind::kOther,
-          kIncrementNames);
+      increment.block = builder.AddBlock("rig " + camera_ + " image " + exposure.image + " head " +
+                                             rig_->heads[k].id + " increment",
+                                         increment.rad.data(),
+                                         3,
+                                         calib::BlockKind::kOther,
+                                         kIncrementNames);
     }
   }
 }
@@ -204,10 +213,8 @@ ImageRay RigHeadCamera::StartingRay(const SensorContext& context,
   const ObservationSite site = context.Site(observation);
   const int k = rig_->HeadIndex(observation.head);
   const auto [object_from_head, center] = StartingHeadPose(context, site, k);
-  return RayFromPixel(rig_->heads[k].camera,
-                      calib::OpkFromRotation(object_from_head),
-                      center,
-                      observation.pixel);
+  return RayFromPixel(
+      rig_->heads[k].camera, calib::OpkFromRotation(object_from_head), center, observation.pixel);
 }
 
 ObservationTerm RigHeadCamera::Observe(const SensorContext& context,
@@ -236,12 +243,11 @@ void RigHeadCamera::AddOwnResiduals(const SensorContext& context) {
                           const Eigen::Vector3d& value,
                           const Eigen::Vector3d& sigma,
                           const std::string& label) {
-    builder.AddResidual(
-        kGroupRigPrior,
-        calib::PriorCostFunction::Create({value.x(), value.y(), value.z()},
-                                         {sigma.x(), sigma.y(), sigma.z()}),
-        {block},
-        label);
+    builder.AddResidual(kGroupRigPrior,
+                        calib::PriorCostFunction::Create({value.x(), value.y(), value.z()},
+                                                         {sigma.x(), sigma.y(), sigma.z()}),
+                        {block},
+                        label);
   };
   for (int k = 0; k < static_cast<int>(heads_.size()); ++k) {
     if (k == reference_) continue;
@@ -455,7 +461,9 @@ nlohmann::json RigResultToJson(const RigAdjustmentResult& r) {
   nlohmann::json exposures = nlohmann::json::array();
   for (const RigExposureEstimate& e : r.exposures) {
     const Eigen::Vector3d deg = e.increment_rad * kDegPerRad;
-    nlohmann::json sigma = {{"domega", nullptr}, {"dphi", nullptr}, {"dkappa", nullptr},
+    nlohmann::json sigma = {{"domega", nullptr},
+                            {"dphi", nullptr},
+                            {"dkappa", nullptr},
                             {"dT_ms", scalar(e.time_offset_sigma_s, 1e3)}};
     if (e.increment_sigma_rad) {
       sigma["domega"] = e.increment_sigma_rad->x() * kDegPerRad;
@@ -483,16 +491,17 @@ std::string FormatRigSummary(const RigAdjustmentResult& r) {
     out += "  head " + h.id + " mount (deg):";
     for (int i = 0; i < 3; ++i)
       out += " " + value_sigma(h.mount_rad(i) * kDegPerRad,
-                               h.mount_sigma_rad ? std::optional<double>((*h.mount_sigma_rad)(i) *
-                                                                         kDegPerRad)
-                                                 : std::nullopt,
+                               h.mount_sigma_rad
+                                   ? std::optional<double>((*h.mount_sigma_rad)(i)*kDegPerRad)
+                                   : std::nullopt,
                                8);
     out += "\n  head " + h.id + " lever arm (m):";
     for (int i = 0; i < 3; ++i)
-      out += " " + value_sigma(h.lever_arm_m(i),
-                               h.lever_arm_sigma_m ? std::optional<double>((*h.lever_arm_sigma_m)(i))
-                                                   : std::nullopt,
-                               6);
+      out +=
+          " " + value_sigma(h.lever_arm_m(i),
+                            h.lever_arm_sigma_m ? std::optional<double>((*h.lever_arm_sigma_m)(i))
+                                                : std::nullopt,
+                            6);
     out += "\n";
     if (r.options.time_offsets != RigParameterMode::kFixed)
       out += "  head " + h.id + " dT (ms): " +

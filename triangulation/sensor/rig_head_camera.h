@@ -57,14 +57,14 @@ std::string_view RigParameterModeName(RigParameterMode mode);
 
 /// What the rig bundle estimates besides the block (which parameters; the data is the rig file).
 struct RigAdjustOptions {
-  RigParameterMode mounts = RigParameterMode::kFree;      // M_k of the non-reference heads;
-                                                          // weighted: the file's mount_sigma_deg
-  RigParameterMode lever_arms = RigParameterMode::kFree;  // t_k; weighted: lever_arm_sigma_m
+  RigParameterMode mounts = RigParameterMode::kFree;       // M_k of the non-reference heads;
+                                                           // weighted: the file's mount_sigma_deg
+  RigParameterMode lever_arms = RigParameterMode::kFree;   // t_k; weighted: lever_arm_sigma_m
   RigParameterMode increments = RigParameterMode::kFixed;  // E_k per exposure and head (= 0 fixed)
-  double increment_sigma_rad = 0.0;    // weighted increments: sigma of each angle around 0, rad > 0
+  double increment_sigma_rad = 0.0;  // weighted increments: sigma of each angle around 0, rad > 0
   RigParameterMode time_offsets = RigParameterMode::kFixed;  // dT_k per head (= 0 fixed); free or
                                                              // weighted needs the velocity columns
-  double time_offset_sigma_s = 0.0;    // weighted time offsets: sigma around 0, s > 0
+  double time_offset_sigma_s = 0.0;  // weighted time offsets: sigma around 0, s > 0
   /// ConfigError naming the option: a weighted mode without its sigma, a sigma <= 0.
   void Validate() const;
 };
@@ -154,8 +154,8 @@ class RigHeadCamera final : public ImagingModel {
   int reference_ = -1;
   std::vector<Head> heads_;  // sized once: the builder holds their addresses
   std::map<std::pair<ExposureIndex, int>, Increment> increments_;  // stable addresses
-  Eigen::Vector3d zero_increment_ = Eigen::Vector3d::Zero();  // fixed: E = I
-  double zero_time_offset_ = 0.0;                             // fixed: dT = 0
+  Eigen::Vector3d zero_increment_ = Eigen::Vector3d::Zero();       // fixed: E = I
+  double zero_time_offset_ = 0.0;                                  // fixed: dT = 0
   calib::BlockId zero_increment_block_ = -1, zero_time_offset_block_ = -1;
 };
 

@@ -1,16 +1,16 @@
 #include "triangulation/simulation/flight_simulator.h"
 
-#include <algorithm>
-#include <cmath>
-#include <functional>
-#include <random>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "triangulation/block/block_io.h"
+
+#include <algorithm>
+#include <cmath>
+#include <functional>
+#include <random>
 
 namespace aerocal::triangulation {
 namespace {
@@ -37,7 +37,8 @@ struct Visible {
 // is a candidate.
 class ExposureIndex {
  public:
-  ExposureIndex(const calib::Camera& camera, const std::vector<Exposure>& exposures,
+  ExposureIndex(const calib::Camera& camera,
+                const std::vector<Exposure>& exposures,
                 double min_height_m)
       : min_height_m_(min_height_m), all_(exposures.size()) {
     for (size_t i = 0; i < exposures.size(); ++i) all_[i] = static_cast<int>(i);
@@ -123,8 +124,10 @@ class ExposureIndex {
 
 // The candidate images (increasing index) in which `point` projects inside the format (margin
 // in px).
-std::vector<Visible> VisibleIn(const calib::Camera& camera, const std::vector<Exposure>& exposures,
-                               const std::vector<int>& candidates, const Eigen::Vector3d& point,
+std::vector<Visible> VisibleIn(const calib::Camera& camera,
+                               const std::vector<Exposure>& exposures,
+                               const std::vector<int>& candidates,
+                               const Eigen::Vector3d& point,
                                double margin_px) {
   std::vector<Visible> out;
   for (const int i : candidates) {
@@ -142,8 +145,10 @@ std::vector<Visible> VisibleIn(const calib::Camera& camera, const std::vector<Ex
 
 namespace internal {
 
-std::vector<Exposure> PlanStrips(const FlightSimulationOptions& o, const Eigen::Vector2d& footprint_m,
-                                 const std::string& camera, SimulationRandom& random) {
+std::vector<Exposure> PlanStrips(const FlightSimulationOptions& o,
+                                 const Eigen::Vector2d& footprint_m,
+                                 const std::string& camera,
+                                 SimulationRandom& random) {
   auto& normal = random.normal;
   auto& rng = random.rng;
   const double base = (1.0 - o.forward_overlap) * footprint_m.x();
@@ -161,7 +166,8 @@ std::vector<Exposure> PlanStrips(const FlightSimulationOptions& o, const Eigen::
       e.image = id;
       e.camera = camera;
       const int along = s % 2 == 0 ? k : n - 1 - k;
-      e.center_m = {(along - 0.5 * (n - 1)) * base, (s - 0.5 * (o.strips - 1)) * spacing,
+      e.center_m = {(along - 0.5 * (n - 1)) * base,
+                    (s - 0.5 * (o.strips - 1)) * spacing,
                     mean_terrain + o.flying_height_m};
       e.opk_rad = {o.attitude_sigma_deg * kDegToRad * normal(rng),
                    o.attitude_sigma_deg * kDegToRad * normal(rng),
@@ -190,25 +196,31 @@ std::vector<Exposure> ExposuresAsMeasured(const FlightSimulationOptions& o,
       e.center_m += o.gnss_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
       e.center_sigma_m = Eigen::Vector3d::Constant(o.gnss_sigma_m);
     } else {
-      e.center_m += o.start_position_error_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      e.center_m +=
+          o.start_position_error_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
     }
     if (o.imu_sigma_deg > 0) {
       if (!o.boresight_rad.isZero())
         e.opk_rad = calib::OpkFromRotation(r * calib::RotationFromOpk(o.boresight_rad).transpose());
-      e.opk_rad += o.imu_sigma_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      e.opk_rad +=
+          o.imu_sigma_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
       e.opk_sigma_rad = Eigen::Vector3d::Constant(o.imu_sigma_deg * kDegToRad);
     } else {
-      e.opk_rad += o.start_angle_error_deg * kDegToRad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+      e.opk_rad += o.start_angle_error_deg * kDegToRad *
+                   Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
     }
     measured.push_back(e);
   }
   return measured;
 }
 
-void PlacePoints(const FlightSimulationOptions& o, const std::vector<Exposure>& exposures,
+void PlacePoints(const FlightSimulationOptions& o,
+                 const std::vector<Exposure>& exposures,
                  const Eigen::Vector2d& footprint_m,
-                 const std::function<int(const Eigen::Vector3d&)>& seen_by, SimulationRandom& random,
-                 std::vector<GroundPoint>* points_truth, std::vector<GroundPoint>* points_file) {
+                 const std::function<int(const Eigen::Vector3d&)>& seen_by,
+                 SimulationRandom& random,
+                 std::vector<GroundPoint>* points_truth,
+                 std::vector<GroundPoint>* points_file) {
   auto& normal = random.normal;
   auto& uniform = random.uniform;
   auto& rng = random.rng;
@@ -239,11 +251,12 @@ void PlacePoints(const FlightSimulationOptions& o, const std::vector<Exposure>& 
   };
   // Control: walk from each target towards the block centre until >= 3 images see it.
   const Eigen::Vector2d centre(0.5 * (x_min + x_max), 0.5 * (y_min + y_max));
-  std::vector<Eigen::Vector2d> targets = {{x_min, y_min}, {x_max, y_min}, {x_min, y_max},
-                                          {x_max, y_max}, centre};
+  std::vector<Eigen::Vector2d> targets = {
+      {x_min, y_min}, {x_max, y_min}, {x_min, y_max}, {x_max, y_max}, centre};
   targets.resize(std::min<size_t>(targets.size(), std::max(0, o.control_points)));
   for (int extra = static_cast<int>(targets.size()); extra < o.control_points; ++extra)
-    targets.push_back({x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min)});
+    targets.push_back(
+        {x_min + uniform(rng) * (x_max - x_min), y_min + uniform(rng) * (y_max - y_min)});
   int control_id = 0;
   // (The centre itself may lie in a two-fold overlap: look around it along the strip as well.)
   const double step_x = 0.05 * footprint_x;
@@ -313,10 +326,10 @@ stitch::MisplacementOptions FlightSimulationOptions::DefaultMisplacement() {
 
 calib::InteriorParams FlightSimulationOptions::DefaultInteriorCorrection() {
   calib::InteriorParams d{};
-  d[Model::kC] = 0.038;      // mm
-  d[Model::kX0] = -0.0024;   // mm
-  d[Model::kY0] = 0.0015;    // mm
-  d[Model::kK1] = 3.0e-8;    // 2.3 um at r = 50 mm, 15 um (1.7 px) at the corner (r = 83 mm)
+  d[Model::kC] = 0.038;     // mm
+  d[Model::kX0] = -0.0024;  // mm
+  d[Model::kY0] = 0.0015;   // mm
+  d[Model::kK1] = 3.0e-8;   // 2.3 um at r = 50 mm, 15 um (1.7 px) at the corner (r = 83 mm)
   d[Model::kK2] = -2.0e-12;
   d[Model::kK3] = 1.0e-16;
   d[Model::kP1] = 2.0e-7;
@@ -327,8 +340,9 @@ calib::InteriorParams FlightSimulationOptions::DefaultInteriorCorrection() {
 }
 
 double SimulatedTerrainHeight(const FlightSimulationOptions& o, double x, double y) {
-  const double shape = 0.5 + 0.32 * std::sin(2 * M_PI * x / 9000.0 + 0.3) * std::cos(2 * M_PI * y / 7000.0) +
-                       0.16 * std::sin(2 * M_PI * (x / 3100.0 + y / 4100.0));
+  const double shape =
+      0.5 + 0.32 * std::sin(2 * M_PI * x / 9000.0 + 0.3) * std::cos(2 * M_PI * y / 7000.0) +
+      0.16 * std::sin(2 * M_PI * (x / 3100.0 + y / 4100.0));
   return o.terrain_base_m + o.terrain_relief_m * std::clamp(shape, 0.0, 1.0);
 }
 
@@ -340,12 +354,14 @@ SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
   // point is projected into every exposure.
   const double ties = double(o.exposures) * o.stitching.ties_per_frame;
   if (ties > kMaxSimulatedStitchTies)
-    throw ConfigError("--exposures x --stitch-ties: " + FormatNumber(ties) + " stitching ties are more than " +
-                      FormatNumber(kMaxSimulatedStitchTies) + " (fewer --stitch-ties, default 900 a frame)");
+    throw ConfigError("--exposures x --stitch-ties: " + FormatNumber(ties) +
+                      " stitching ties are more than " + FormatNumber(kMaxSimulatedStitchTies) +
+                      " (fewer --stitch-ties, default 900 a frame)");
   const double pairs = double(o.exposures) * (double(o.ground_points) + o.tie_points);
   if (pairs > kMaxSimulatedPointExposurePairs)
     throw ConfigError("--exposures x (--surveyed-points + --tie-points): " + FormatNumber(pairs) +
-                      " point-exposure pairs are more than " + FormatNumber(kMaxSimulatedPointExposurePairs));
+                      " point-exposure pairs are more than " +
+                      FormatNumber(kMaxSimulatedPointExposurePairs));
   internal::SimulationRandom random(o.seed);
   std::mt19937_64& rng = random.rng;
   std::normal_distribution<double>& normal = random.normal;
@@ -366,9 +382,11 @@ SimulatedFlight SimulateFlight(const FlightSimulationOptions& o) {
   const auto visible = [&](const Eigen::Vector3d& p) {
     return VisibleIn(f.truth, f.exposures_truth, index.Candidates(p), p, kMarginPx);
   };
-  const auto seen_by = [&](const Eigen::Vector3d& p) { return static_cast<int>(visible(p).size()); };
-  internal::PlacePoints(o, f.exposures_truth, footprint, seen_by, random, &f.points_truth,
-                        &f.points_file);
+  const auto seen_by = [&](const Eigen::Vector3d& p) {
+    return static_cast<int>(visible(p).size());
+  };
+  internal::PlacePoints(
+      o, f.exposures_truth, footprint, seen_by, random, &f.points_truth, &f.points_file);
 
   // Image observations: virtual-image pixels and the same points in raw sub-image pixels.
   for (const auto& p : f.points_truth) {
@@ -408,13 +426,14 @@ void WriteSimulatedFlight(const SimulatedFlight& f, const std::string& folder) {
   stitch::WriteStitchObservations(path("stitch_obs.csv"), f.stitching);
   WriteExposures(path("truth/exposures.csv"), f.exposures_truth);
   WritePoints(path("truth/points.csv"), f.points_truth);
-  const std::string project =
-      "# Simulated flight (aerocal simulate --seed " + std::to_string(f.options.seed) + ")\n"
-      "cameras: {cam1: camera_nominal.yaml}\n"
-      "exposures: exposures.csv\n"
-      "points: points.csv\n"
-      "stitching: stitch_obs.csv\n"
-      "frame: {projected: \"simulated local frame\"}\n";
+  const std::string project = "# Simulated flight (aerocal simulate --seed " +
+                              std::to_string(f.options.seed) +
+                              ")\n"
+                              "cameras: {cam1: camera_nominal.yaml}\n"
+                              "exposures: exposures.csv\n"
+                              "points: points.csv\n"
+                              "stitching: stitch_obs.csv\n"
+                              "frame: {projected: \"simulated local frame\"}\n";
   WriteFileAtomically(path("project.yaml"), project + "observations: observations.csv\n");
   WriteFileAtomically(path("project_subimage.yaml"),
                       project + "observations: observations_subimage.csv\n");

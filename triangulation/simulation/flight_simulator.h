@@ -10,16 +10,16 @@
 // radial distortion of a few pixels at the format corner).
 #pragma once
 
+#include "calib/camera/camera.h"
+#include "stitch/layout/grid_layout.h"
+#include "stitch/simulation/stitch_simulator.h"
+#include "triangulation/block/block.h"
+
 #include <cstdint>
 #include <functional>
 #include <random>
 #include <string>
 #include <vector>
-
-#include "calib/camera/camera.h"
-#include "stitch/layout/grid_layout.h"
-#include "stitch/simulation/stitch_simulator.h"
-#include "triangulation/block/block.h"
 
 namespace aerocal::triangulation {
 
@@ -30,27 +30,27 @@ inline constexpr double kMaxSimulatedPointExposurePairs = 1e9;
 
 struct FlightSimulationOptions {
   std::uint64_t seed = 1;
-  int exposures = 37;                 // total, spread evenly over the strips
+  int exposures = 37;  // total, spread evenly over the strips
   int strips = 3;
-  double flying_height_m = 4500.0;    // above the mean terrain
+  double flying_height_m = 4500.0;  // above the mean terrain
   double forward_overlap = 0.60;
   double side_overlap = 0.30;
-  double terrain_relief_m = 300.0;    // peak-to-peak
-  double terrain_base_m = 200.0;      // lowest terrain height
-  int ground_points = 329;            // surveyed: control + check
-  int control_points = 5;             // at the block corners and centre (4 corners + centre)
-  int tie_points = 600;               // unsurveyed points measured in >= 2 images
-  double image_noise_px = 0.2;        // Gaussian noise of image measurements
-  double image_sigma_px = 0.2;        // a-priori sigma written to observations.csv
-  double survey_sigma_m = 0.02;       // noise and sigma of control/check coordinates
-  double attitude_sigma_deg = 0.5;    // spread of the true omega/phi
+  double terrain_relief_m = 300.0;       // peak-to-peak
+  double terrain_base_m = 200.0;         // lowest terrain height
+  int ground_points = 329;               // surveyed: control + check
+  int control_points = 5;                // at the block corners and centre (4 corners + centre)
+  int tie_points = 600;                  // unsurveyed points measured in >= 2 images
+  double image_noise_px = 0.2;           // Gaussian noise of image measurements
+  double image_sigma_px = 0.2;           // a-priori sigma written to observations.csv
+  double survey_sigma_m = 0.02;          // noise and sigma of control/check coordinates
+  double attitude_sigma_deg = 0.5;       // spread of the true omega/phi
   double start_position_error_m = 20.0;  // approximate EO in exposures.csv (no GNSS)
   double start_angle_error_deg = 1.0;
-  double gnss_sigma_m = 0.0;          // > 0: exposures.csv carries GNSS centres with this sigma
-  double imu_sigma_deg = 0.0;         // > 0: exposures.csv carries IMU angles with this sigma
+  double gnss_sigma_m = 0.0;   // > 0: exposures.csv carries GNSS centres with this sigma
+  double imu_sigma_deg = 0.0;  // > 0: exposures.csv carries IMU angles with this sigma
   /// The GNSS/IMU platform (triangulation/README.md "GNSS/IMU priors on the platform"): the GNSS
   /// records the antenna at X0 + R a + v dt, the IMU the attitude R M^T. Zero by default.
-  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();   // a, camera frame (m)
+  Eigen::Vector3d lever_arm_m = Eigen::Vector3d::Zero();    // a, camera frame (m)
   Eigen::Vector3d boresight_rad = Eigen::Vector3d::Zero();  // M = imu_from_image, omega-phi-kappa
   double gnss_time_offset_s = 0.0;                          // dt (s), needs speed_mps > 0
   double speed_mps = 0.0;  // > 0: exposures.csv carries the velocity vX, vY, vZ along the strips
@@ -67,11 +67,12 @@ struct FlightSimulationOptions {
 struct SimulatedFlight {
   FlightSimulationOptions options;
   calib::Camera nominal, truth;
-  std::vector<Exposure> exposures_truth, exposures_file;  // exposures_file: what exposures.csv holds
-  std::vector<GroundPoint> points_truth, points_file;      // points_file: what points.csv holds
-  std::vector<ImageObservation> observations;              // virtual-image pixels
-  std::vector<ImageObservation> subimage_observations;     // raw sub-image pixels
-  std::vector<stitch::StitchObservation> stitching;        // per-exposure stitching measurements
+  std::vector<Exposure> exposures_truth,
+      exposures_file;                                   // exposures_file: what exposures.csv holds
+  std::vector<GroundPoint> points_truth, points_file;   // points_file: what points.csv holds
+  std::vector<ImageObservation> observations;           // virtual-image pixels
+  std::vector<ImageObservation> subimage_observations;  // raw sub-image pixels
+  std::vector<stitch::StitchObservation> stitching;     // per-exposure stitching measurements
 };
 
 /// Terrain height (m) of the simulated block at (X, Y).

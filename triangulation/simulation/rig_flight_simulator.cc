@@ -1,11 +1,5 @@
 #include "triangulation/simulation/rig_flight_simulator.h"
 
-#include <algorithm>
-#include <cmath>
-#include <cstdio>
-#include <filesystem>
-#include <random>
-
 #include "calib/camera/rig_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
@@ -15,6 +9,12 @@
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/block/block_io.h"
 
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <random>
+
 namespace aerocal::triangulation {
 namespace {
 
@@ -22,8 +22,12 @@ constexpr double kDegToRad = M_PI / 180.0;
 constexpr double kMarginPx = 20.0;  // points are measured at least this far inside a head's format
 using Model = calib::Camera::Model;
 
-calib::RigHead MakeHead(const std::string& id, double pixel_size_mm, int width_px, int height_px,
-                        const Eigen::Vector3d& c_x0_y0_mm, const Eigen::Vector3d& mount_deg,
+calib::RigHead MakeHead(const std::string& id,
+                        double pixel_size_mm,
+                        int width_px,
+                        int height_px,
+                        const Eigen::Vector3d& c_x0_y0_mm,
+                        const Eigen::Vector3d& mount_deg,
                         const Eigen::Vector3d& lever_arm_m) {
   calib::RigHead head;
   head.id = id;
@@ -39,7 +43,8 @@ calib::RigHead MakeHead(const std::string& id, double pixel_size_mm, int width_p
   return head;
 }
 
-calib::RigHead DualLensHead(const std::string& id, const Eigen::Vector3d& mount_deg,
+calib::RigHead DualLensHead(const std::string& id,
+                            const Eigen::Vector3d& mount_deg,
                             const Eigen::Vector3d& lever_arm_m) {
   return MakeHead(id, 0.006, 10000, 10000, {150.0, 3.0, 3.0}, mount_deg, lever_arm_m);
 }
@@ -66,8 +71,10 @@ calib::Rig Uav4Rig() {
 
 // The point where the ray through a virtual pixel meets the terrain (bisection between planes
 // below and above the terrain's range); false when the ray does not point down.
-bool TerrainPointOfRay(const FlightSimulationOptions& o, const Eigen::Vector3d& origin,
-                       const Eigen::Vector3d& direction, Eigen::Vector3d* point,
+bool TerrainPointOfRay(const FlightSimulationOptions& o,
+                       const Eigen::Vector3d& origin,
+                       const Eigen::Vector3d& direction,
+                       Eigen::Vector3d* point,
                        int iterations = 80) {
   if (!(direction.z() < 0)) return false;
   const double z_lo = o.terrain_base_m - 1.0, z_hi = o.terrain_base_m + o.terrain_relief_m + 1.0;
@@ -169,18 +176,27 @@ std::vector<calib::InteriorParams> RigFlightSimulationOptions::DefaultHeadInteri
   return {a, b};
 }
 
-bool ProjectRigHead(const calib::RigHead& head, const Exposure& exposure,
-                    const RigExposureTruth& increment, const Eigen::Vector3d& point_m,
+bool ProjectRigHead(const calib::RigHead& head,
+                    const Exposure& exposure,
+                    const RigExposureTruth& increment,
+                    const Eigen::Vector3d& point_m,
                     Eigen::Vector2d* pixel) {
   const Eigen::Vector3d velocity = exposure.velocity_mps.value_or(Eigen::Vector3d::Zero());
   double rotation[9], center[3];
-  calib::HeadPose(exposure.opk_rad.data(), exposure.center_m.data(), head.mount_rad.data(),
-                  head.lever_arm_m.data(), increment.increment_rad.data(), &increment.dt_s,
-                  velocity.data(), rotation, center);
+  calib::HeadPose(exposure.opk_rad.data(),
+                  exposure.center_m.data(),
+                  head.mount_rad.data(),
+                  head.lever_arm_m.data(),
+                  increment.increment_rad.data(),
+                  &increment.dt_s,
+                  velocity.data(),
+                  rotation,
+                  center);
   const Eigen::Matrix3d object_from_head =
       Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation);
   return head.camera.ProjectToPixel(calib::OpkFromRotation(object_from_head),
-                                    Eigen::Vector3d(center[0], center[1], center[2]), point_m,
+                                    Eigen::Vector3d(center[0], center[1], center[2]),
+                                    point_m,
                                     pixel);
 }
 
@@ -221,8 +237,7 @@ void AddStitchingTies(SimulatedRigFlight& f, internal::SimulationRandom& random)
     if (!any) continue;
     int serial = 0;
     // A tie at a virtual pixel: measured in every head of this exposure that sees it (>= 2).
-    const auto place = [&](const Eigen::Vector2d& px, PointRole role,
-                           const std::string& position) {
+    const auto place = [&](const Eigen::Vector2d& px, PointRole role, const std::string& position) {
       Eigen::Vector3d g;
       if (!ground_of(px, &g)) return false;
       std::vector<std::pair<int, Eigen::Vector2d>> seen;
@@ -230,15 +245,16 @@ void AddStitchingTies(SimulatedRigFlight& f, internal::SimulationRandom& random)
         const calib::RigHead& head = f.truth.heads[k];
         Eigen::Vector2d p;
         if (!ProjectRigHead(head, e, f.rig_exposures[i * heads + k], g, &p)) continue;
-        if (p.x() < kMarginPx || p.y() < kMarginPx || p.x() > head.camera.width_px - 1 - kMarginPx ||
+        if (p.x() < kMarginPx || p.y() < kMarginPx ||
+            p.x() > head.camera.width_px - 1 - kMarginPx ||
             p.y() > head.camera.height_px - 1 - kMarginPx)
           continue;
         seen.push_back({static_cast<int>(k), p});
       }
       if (seen.size() < 2) return false;
       GroundPoint truth;
-      truth.id = StringPrintf("%s_%s%03d", e.image.c_str(),
-                              role == PointRole::kCheck ? "c" : "t", serial++);
+      truth.id = StringPrintf(
+          "%s_%s%03d", e.image.c_str(), role == PointRole::kCheck ? "c" : "t", serial++);
       truth.role = role;
       truth.xyz_m = g;
       GroundPoint file = truth;
@@ -258,10 +274,14 @@ void AddStitchingTies(SimulatedRigFlight& f, internal::SimulationRandom& random)
       return true;
     };
     for (const auto& s : st.standard_positions)
-      for (int j = 0, tries = 0; j < st.per_standard_position && tries < 100 * st.per_standard_position + 100; ++tries) {
-        const double radius = st.jitter_px * std::sqrt(uniform(rng)), angle = 2 * M_PI * uniform(rng);
+      for (int j = 0, tries = 0;
+           j < st.per_standard_position && tries < 100 * st.per_standard_position + 100;
+           ++tries) {
+        const double radius = st.jitter_px * std::sqrt(uniform(rng)),
+                     angle = 2 * M_PI * uniform(rng);
         j += place(s.virtual_px + radius * Eigen::Vector2d(std::cos(angle), std::sin(angle)),
-                   PointRole::kTie, s.name);
+                   PointRole::kTie,
+                   s.name);
       }
     for (PointRole role : {PointRole::kTie, PointRole::kCheck}) {
       const int wanted = role == PointRole::kTie ? st.dense : st.check;
@@ -297,10 +317,10 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
   const int reference = f.truth.ReferenceIndex();
   for (size_t k = 0; k < f.truth.heads.size(); ++k) {
     calib::RigHead& head = f.truth.heads[k];
-    const auto& correction = options.interior_correction.empty()
-                                 ? calib::InteriorParams{}
-                                 : options.interior_correction[std::min(
-                                       k, options.interior_correction.size() - 1)];
+    const auto& correction =
+        options.interior_correction.empty()
+            ? calib::InteriorParams{}
+            : options.interior_correction[std::min(k, options.interior_correction.size() - 1)];
     for (int i = 0; i < Model::kNumParams; ++i) head.camera.interior[i] += correction[i];
     if (static_cast<int>(k) == reference) continue;
     head.mount_rad += options.mount_error_rad;
@@ -315,7 +335,8 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
   if (options.speed_mps > 0)
     for (auto& e : f.exposures_truth)  // along the strip: kappa 0 flies +x, kappa 180 deg -x
       e.velocity_mps = Eigen::Vector3d(options.speed_mps * std::cos(e.opk_rad.z()),
-                                       options.speed_mps * std::sin(e.opk_rad.z()), 0.0);
+                                       options.speed_mps * std::sin(e.opk_rad.z()),
+                                       0.0);
   f.exposures_file = internal::ExposuresAsMeasured(o, f.exposures_truth, random);
   for (const auto& e : f.exposures_truth) {
     for (size_t k = 0; k < f.truth.heads.size(); ++k) {
@@ -323,18 +344,20 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
       t.image = e.image;
       t.head = f.truth.heads[k].id;
       if (static_cast<int>(k) != reference) {
-        t.increment_rad = options.increment_sigma_rad *
-                          Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-        t.dt_s = options.head_time_offsets_s.empty()
-                     ? options.time_offset_s
-                     : options.head_time_offsets_s[std::min(k, options.head_time_offsets_s.size() - 1)];
+        t.increment_rad =
+            options.increment_sigma_rad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
+        t.dt_s =
+            options.head_time_offsets_s.empty()
+                ? options.time_offset_s
+                : options.head_time_offsets_s[std::min(k, options.head_time_offsets_s.size() - 1)];
       }
       f.rig_exposures.push_back(t);
     }
   }
   const size_t heads = f.truth.heads.size();
   // Every head of exposure i that sees `point` inside its format (margin in px).
-  const auto measure = [&](size_t i, const Eigen::Vector3d& point,
+  const auto measure = [&](size_t i,
+                           const Eigen::Vector3d& point,
                            std::vector<std::pair<int, Eigen::Vector2d>>* seen) {
     seen->clear();
     for (size_t k = 0; k < heads; ++k) {
@@ -358,8 +381,8 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
     }
     return exposures;
   };
-  internal::PlacePoints(o, f.exposures_truth, footprint, seen_by, random, &f.points_truth,
-                        &f.points_file);
+  internal::PlacePoints(
+      o, f.exposures_truth, footprint, seen_by, random, &f.points_truth, &f.points_file);
 
   for (const auto& p : f.points_truth) {
     for (size_t i = 0; i < f.exposures_truth.size(); ++i) {
@@ -384,7 +407,9 @@ calib::Rig ScaleRigFormats(const calib::Rig& rig, double scale) {
     throw ConfigError("--format-scale must be within (0, 1] (got " + std::to_string(scale) + ")");
   calib::Rig out = rig;
   if (scale == 1.0) return out;
-  const auto scaled = [scale](int px) { return std::max(16, static_cast<int>(std::lround(px * scale))); };
+  const auto scaled = [scale](int px) {
+    return std::max(16, static_cast<int>(std::lround(px * scale)));
+  };
   for (calib::RigHead& head : out.heads) {
     head.camera.width_px = scaled(head.camera.width_px);
     head.camera.height_px = scaled(head.camera.height_px);
@@ -419,8 +444,11 @@ TexturedGround MakeRigGroundTexture(const SimulatedRigFlight& f, const RigImageO
   return ground;
 }
 
-stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f, const TexturedGround& ground,
-                                     const RigImageOptions& options, int exposure, int head) {
+stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f,
+                                     const TexturedGround& ground,
+                                     const RigImageOptions& options,
+                                     int exposure,
+                                     int head) {
   const size_t heads = f.truth.heads.size();
   AEROCAL_CHECK(exposure >= 0 && exposure < static_cast<int>(f.exposures_truth.size()) &&
                 head >= 0 && head < static_cast<int>(heads))
@@ -430,8 +458,15 @@ stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f, const Textured
   const RigExposureTruth& t = f.rig_exposures[exposure * heads + head];
   const Eigen::Vector3d velocity = e.velocity_mps.value_or(Eigen::Vector3d::Zero());
   double rotation[9], center[3];
-  calib::HeadPose(e.opk_rad.data(), e.center_m.data(), h.mount_rad.data(), h.lever_arm_m.data(),
-                  t.increment_rad.data(), &t.dt_s, velocity.data(), rotation, center);
+  calib::HeadPose(e.opk_rad.data(),
+                  e.center_m.data(),
+                  h.mount_rad.data(),
+                  h.lever_arm_m.data(),
+                  t.increment_rad.data(),
+                  &t.dt_s,
+                  velocity.data(),
+                  rotation,
+                  center);
   const Eigen::Vector3d opk = calib::OpkFromRotation(
       Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(rotation));
   const Eigen::Vector3d origin(center[0], center[1], center[2]);
@@ -453,7 +488,8 @@ stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f, const Textured
     for (int r = 0; r < rows; ++r)
       for (int c = 0; c < cols; ++c) {
         const Eigen::Vector2d g = ground_of(c, r);
-        image(r, c) = static_cast<float>(ground.At(g.x(), g.y()) + options.grey_noise_dn * noise(rng));
+        image(r, c) =
+            static_cast<float>(ground.At(g.x(), g.y()) + options.grey_noise_dn * noise(rng));
       }
     return image;
   }
@@ -475,7 +511,8 @@ stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f, const Textured
       const Eigen::Vector2d& g01 = bottom[c];
       const Eigen::Vector2d& g11 = bottom[c + 1];
       const double diagonal_m = std::max((g11 - g00).norm(), (g10 - g01).norm());
-      const int n = std::clamp(static_cast<int>(std::ceil(diagonal_m / ground.gsd_m)), 2, kMaxSamples);
+      const int n =
+          std::clamp(static_cast<int>(std::ceil(diagonal_m / ground.gsd_m)), 2, kMaxSamples);
       double sum = 0.0;
       for (int j = 0; j < n; ++j) {
         const double v = (j + 0.5) / n;
@@ -493,12 +530,14 @@ stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& f, const Textured
   return image;
 }
 
-std::string RigHeadImagePath(const std::string& folder, const std::string& image,
+std::string RigHeadImagePath(const std::string& folder,
+                             const std::string& image,
                              const std::string& head) {
   return folder + "/images/" + image + "_" + head + ".tif";
 }
 
-double WriteRigHeadImages(const SimulatedRigFlight& f, const RigImageOptions& options,
+double WriteRigHeadImages(const SimulatedRigFlight& f,
+                          const RigImageOptions& options,
                           const std::string& folder) {
   const TexturedGround ground = MakeRigGroundTexture(f, options);
   std::filesystem::create_directories(folder + "/images");
@@ -523,8 +562,10 @@ void WriteSimulatedRigFlight(const SimulatedRigFlight& f, const std::string& fol
     out << "image,head,domega,dphi,dkappa,dT_ms\n";
     for (const auto& t : f.rig_exposures)
       out << t.image << "," << t.head << ","
-          << StringPrintf("%.10f,%.10f,%.10f,%.6f", t.increment_rad.x() / kDegToRad,
-                          t.increment_rad.y() / kDegToRad, t.increment_rad.z() / kDegToRad,
+          << StringPrintf("%.10f,%.10f,%.10f,%.6f",
+                          t.increment_rad.x() / kDegToRad,
+                          t.increment_rad.y() / kDegToRad,
+                          t.increment_rad.z() / kDegToRad,
                           t.dt_s * 1e3)
           << "\n";
   });

@@ -20,12 +20,12 @@
 // check ties (points.csv role `check` without coordinates). Each exposure also gets `z_ref`, the
 // mean terrain height under the virtual image.
 //
-// Image mode (`simulate --rig uav4 --render-images --texture PHOTO`): every head image of every exposure
-// rendered through the TRUE head pose of that exposure (ground calibration + increments E_k +
-// offsets dT_k with the velocity; calib::HeadPose) and the head's true interior onto the terrain
-// textured with a real photograph (textured_ground.h), plus Gaussian grey-value noise. Each pixel
-// integrates the texture over its footprint, as a sensor integrates over its pixel area: the rays
-// through the pixel's four corners are intersected with the terrain exactly (bisection to
+// Image mode (`simulate --rig uav4 --render-images --texture PHOTO`): every head image of every
+// exposure rendered through the TRUE head pose of that exposure (ground calibration + increments
+// E_k + offsets dT_k with the velocity; calib::HeadPose) and the head's true interior onto the
+// terrain textured with a real photograph (textured_ground.h), plus Gaussian grey-value noise. Each
+// pixel integrates the texture over its footprint, as a sensor integrates over its pixel area: the
+// rays through the pixel's four corners are intersected with the terrain exactly (bisection to
 // 1e-10 m), the points inside bilinear in them, n x n samples (n = the footprint's longer
 // diagonal in texels, rounded up, within 2..8) averaged with equal weights (a box filter). The
 // texture is finer than the head pixels (2 texels per nadir pixel by default), so one sample per
@@ -35,20 +35,20 @@
 // same geometry.
 #pragma once
 
+#include "calib/camera/rig.h"
+#include "stitch/image_io/gray_image.h"
+#include "triangulation/block/block.h"
+#include "triangulation/simulation/flight_simulator.h"
+#include "triangulation/simulation/textured_ground.h"
+
+#include <Eigen/Core>
+
 #include <cmath>
 #include <cstdint>
 #include <map>
 #include <optional>
 #include <string>
 #include <vector>
-
-#include <Eigen/Core>
-
-#include "calib/camera/rig.h"
-#include "stitch/image_io/gray_image.h"
-#include "triangulation/block/block.h"
-#include "triangulation/simulation/flight_simulator.h"
-#include "triangulation/simulation/textured_ground.h"
 
 namespace aerocal::triangulation {
 
@@ -82,8 +82,8 @@ struct RigFlightSimulationOptions {
   std::vector<double> head_time_offsets_s;
 
   struct StandardPosition {
-    std::string name;               // "AB-1"
-    Eigen::Vector2d virtual_px;     // in the level virtual image of the nadir design
+    std::string name;            // "AB-1"
+    Eigen::Vector2d virtual_px;  // in the level virtual image of the nadir design
   };
   /// Stitching ties per exposure (see the header comment); all zero: none.
   struct StitchTies {
@@ -118,7 +118,7 @@ struct SimulatedRigFlight {
   calib::Rig nominal, truth;
   std::vector<Exposure> exposures_truth, exposures_file;
   std::vector<GroundPoint> points_truth, points_file;
-  std::vector<ImageObservation> observations;  // head pixels, `head` set
+  std::vector<ImageObservation> observations;   // head pixels, `head` set
   std::vector<RigExposureTruth> rig_exposures;  // every exposure and head
   /// Stitching tie id -> the standard position it was placed around ("" for dense / check ties).
   std::map<std::string, std::string> tie_position;
@@ -148,26 +148,32 @@ struct RigImageOptions {
   bool point_sampling = false;  // true: one texture sample at each pixel centre (the renderer
                                 // before area integration; kept for the comparison in
                                 // tests/stitch/rig_stitched_image_test.cc)
-  void Validate() const;       // ConfigError naming the option
+  void Validate() const;        // ConfigError naming the option
 };
 
 /// The photograph laid on the ground under the flight (centred on the mean exposure centre) with
 /// the options' texel size.
-TexturedGround MakeRigGroundTexture(const SimulatedRigFlight& flight, const RigImageOptions& options);
+TexturedGround MakeRigGroundTexture(const SimulatedRigFlight& flight,
+                                    const RigImageOptions& options);
 
 /// The image of head `head` in exposure `exposure` (indices into the flight) through its true
 /// pose and interior, grey values of `ground` plus the options' noise (seeded by options.seed,
 /// exposure and head). Error when a pixel's ray does not point down.
-stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& flight, const TexturedGround& ground,
-                                     const RigImageOptions& options, int exposure, int head);
+stitch::GrayImage RenderRigHeadImage(const SimulatedRigFlight& flight,
+                                     const TexturedGround& ground,
+                                     const RigImageOptions& options,
+                                     int exposure,
+                                     int head);
 
 /// The file of one head image under a folder: `images/<image>_<head>.tif` (8 bit).
-std::string RigHeadImagePath(const std::string& folder, const std::string& image,
+std::string RigHeadImagePath(const std::string& folder,
+                             const std::string& image,
                              const std::string& head);
 
 /// Renders and writes every head image of every exposure (RigHeadImagePath, 8 bit, rounded and
 /// clamped); returns the texel size used (m).
-double WriteRigHeadImages(const SimulatedRigFlight& flight, const RigImageOptions& options,
+double WriteRigHeadImages(const SimulatedRigFlight& flight,
+                          const RigImageOptions& options,
                           const std::string& folder);
 
 /// Writes rig_nominal.yaml, rig_truth.yaml (FORMATS.md "Multi-head rig"), exposures.csv,

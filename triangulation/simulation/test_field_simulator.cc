@@ -1,16 +1,16 @@
 #include "triangulation/simulation/test_field_simulator.h"
 
-#include <cmath>
-#include <cstdio>
-#include <random>
-
-#include <Eigen/Geometry>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "triangulation/block/block_io.h"
+
+#include <Eigen/Geometry>
+
+#include <cmath>
+#include <cstdio>
+#include <random>
 
 namespace aerocal::triangulation {
 namespace {
@@ -33,7 +33,9 @@ calib::Camera TruthCamera() {
 
 // object_from_image of a camera at `center` looking at `target` with roll `roll_rad` about its
 // axis: image z = -viewing direction (the camera looks along -z, CONVENTIONS.md), image y up.
-Eigen::Matrix3d LookAt(const Eigen::Vector3d& center, const Eigen::Vector3d& target, double roll_rad) {
+Eigen::Matrix3d LookAt(const Eigen::Vector3d& center,
+                       const Eigen::Vector3d& target,
+                       double roll_rad) {
   const Eigen::Vector3d z = (center - target).normalized();
   Eigen::Vector3d y0 = Eigen::Vector3d::UnitZ() - Eigen::Vector3d::UnitZ().dot(z) * z;
   y0.normalize();
@@ -54,13 +56,16 @@ void TestFieldOptions::Validate() const {
     if (!ok) throw ConfigError(what);
   };
   require(width_m > 0 && height_m > 0, "test field: width_m and height_m must be > 0");
-  require(target_spacing_m > 0 && width_m / target_spacing_m <= 200 && height_m / target_spacing_m <= 200,
+  require(target_spacing_m > 0 && width_m / target_spacing_m <= 200 &&
+              height_m / target_spacing_m <= 200,
           "test field: target_spacing_m must be > 0 and give at most 200 targets per side");
   require(groups >= 1 && groups <= 26, "test field: groups must be 1..26");
-  require(images_per_group >= 4 && images_per_group <= 1000, "test field: images_per_group must be 4..1000");
+  require(images_per_group >= 4 && images_per_group <= 1000,
+          "test field: images_per_group must be 4..1000");
   require(distance_m > 0, "test field: distance_m must be > 0");
   require(survey_sigma_m > 0, "test field: survey_sigma_m must be > 0");
-  require(image_noise_px >= 0 && image_sigma_px > 0, "test field: image noise >= 0, image sigma > 0 px");
+  require(image_noise_px >= 0 && image_sigma_px > 0,
+          "test field: image noise >= 0, image sigma > 0 px");
   require(check_every >= 0, "test field: check_every must be >= 0");
   require(changed_group < groups, "test field: changed_group must be below groups");
 }
@@ -90,7 +95,8 @@ SimulatedTestField SimulateTestField(const TestFieldOptions& o) {
     t.id = id;
     t.xyz_m = xyz;
     t.sigma_m = Eigen::Vector3d::Constant(o.survey_sigma_m);
-    t.role = o.check_every > 0 && number % o.check_every == 0 ? PointRole::kCheck : PointRole::kControl;
+    t.role =
+        o.check_every > 0 && number % o.check_every == 0 ? PointRole::kCheck : PointRole::kControl;
     f.points_truth.push_back(t);
     GroundPoint file = t;
     file.xyz_m = xyz + o.survey_sigma_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));

@@ -11,29 +11,29 @@
 // true camera (the negative case of the stability test).
 #pragma once
 
+#include "calib/camera/camera.h"
+#include "triangulation/block/block.h"
+
 #include <cstdint>
 #include <map>
 #include <string>
 #include <vector>
 
-#include "calib/camera/camera.h"
-#include "triangulation/block/block.h"
-
 namespace aerocal::triangulation {
 
 struct TestFieldOptions {
   std::uint64_t seed = 1;
-  bool planar = false;            // one plane (Y = 0) instead of the depth layers
-  double width_m = 20.0;          // facade extent along X, > 0
-  double height_m = 12.0;         // facade extent along Z, > 0
-  double target_spacing_m = 1.0;  // grid spacing of the wall targets, > 0
-  int groups = 3;                 // image groups, 1..26
-  int images_per_group = 24;      // stations per group, 4..1000
-  double distance_m = 16.0;       // camera distance from the wall, > 0
-  double survey_sigma_m = 0.0005; // target survey noise and the sigma written, > 0
-  double image_noise_px = 0.1;    // image measurement noise, >= 0
-  double image_sigma_px = 0.1;    // a-priori image sigma written, > 0
-  int check_every = 8;            // every n-th target is a check point (0: none)
+  bool planar = false;             // one plane (Y = 0) instead of the depth layers
+  double width_m = 20.0;           // facade extent along X, > 0
+  double height_m = 12.0;          // facade extent along Z, > 0
+  double target_spacing_m = 1.0;   // grid spacing of the wall targets, > 0
+  int groups = 3;                  // image groups, 1..26
+  int images_per_group = 24;       // stations per group, 4..1000
+  double distance_m = 16.0;        // camera distance from the wall, > 0
+  double survey_sigma_m = 0.0005;  // target survey noise and the sigma written, > 0
+  double image_noise_px = 0.1;     // image measurement noise, >= 0
+  double image_sigma_px = 0.1;     // a-priori image sigma written, > 0
+  int check_every = 8;             // every n-th target is a check point (0: none)
   /// Added to the true interior of group index `changed_group` (0-based; -1: none), table order.
   int changed_group = -1;
   calib::InteriorParams group_camera_change{};

@@ -1,10 +1,10 @@
 #include "triangulation/simulation/textured_ground.h"
 
-#include <cmath>
-
 #include "calib/core/error.h"
 #include "stitch/image_io/image_io.h"
 #include "triangulation/pushbroom/line_rectification.h"
+
+#include <cmath>
 
 namespace aerocal::triangulation {
 

@@ -1,14 +1,14 @@
 // A real photograph laid on the ground as the texture of a simulated scene (the image modes of
-// `aerocal simulate`: `--pushbroom --render-images`, pushbroom/line_images.h, and `--rig uav4 --render-images`,
-// rig_flight_simulator.h). The photograph is averaged over 2 x 2 pixels; texel (u, v) lies at
-// X = x_c + (u - W/2) gsd, Y = y_c - (v - H/2) gsd (object frame, m; W x H texels), mirrored
-// beyond the edges so that any ground position has a grey value; grey values are bilinear in the
-// texels (digital numbers of the photograph).
+// `aerocal simulate`: `--pushbroom --render-images`, pushbroom/line_images.h, and `--rig uav4
+// --render-images`, rig_flight_simulator.h). The photograph is averaged over 2 x 2 pixels; texel
+// (u, v) lies at X = x_c + (u - W/2) gsd, Y = y_c - (v - H/2) gsd (object frame, m; W x H texels),
+// mirrored beyond the edges so that any ground position has a grey value; grey values are bilinear
+// in the texels (digital numbers of the photograph).
 #pragma once
 
-#include <string>
-
 #include "stitch/image_io/gray_image.h"
+
+#include <string>
 
 namespace aerocal::triangulation {
 

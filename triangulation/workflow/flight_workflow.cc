@@ -1,9 +1,5 @@
 #include "triangulation/workflow/flight_workflow.h"
 
-#include <algorithm>
-#include <cstdio>
-#include <filesystem>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/camera_model_json.h"
 #include "calib/core/error.h"
@@ -20,6 +16,10 @@
 #include "triangulation/georef/object_frame.h"
 #include "triangulation/joint/joint_adjustment.h"
 
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+
 namespace aerocal::triangulation {
 namespace {
 
@@ -28,8 +28,9 @@ namespace fs = std::filesystem;
 // The project with every exposure using `camera` (a flight of one camera).
 Project WithCamera(Project project, const calib::Camera& camera, const std::string& camera_file) {
   if (project.cameras.size() != 1)
-    ThrowInputError({project.path, 0}, "the flight workflow takes a block of one camera (found " +
-                                           std::to_string(project.cameras.size()) + ")");
+    ThrowInputError({project.path, 0},
+                    "the flight workflow takes a block of one camera (found " +
+                        std::to_string(project.cameras.size()) + ")");
   const std::string id = project.cameras.begin()->first;
   project.cameras[id] = camera;
   project.camera_files[id] = camera_file;
@@ -51,14 +52,18 @@ std::string Line(const char* format, double a, double b, double c) {
 }
 
 // One terminal line per warning of an adjustment, naming it.
-void AddWarnings(const std::string& name, const AdjustmentResult& result, FlightWorkflowResult* out) {
-  for (const auto& w : result.warnings) out->summary.push_back("warning (" + name + "): " + w.message);
+void AddWarnings(const std::string& name,
+                 const AdjustmentResult& result,
+                 FlightWorkflowResult* out) {
+  for (const auto& w : result.warnings)
+    out->summary.push_back("warning (" + name + "): " + w.message);
 }
 
 std::string VirtualProjectPath(const FlightWorkflowOptions& options) {
   const std::string path = (fs::path(options.data_folder) / "project.yaml").string();
   if (!fs::exists(path))
-    throw InputError(options.data_folder + ": no project.yaml (the block with virtual-image observations)");
+    throw InputError(options.data_folder +
+                     ": no project.yaml (the block with virtual-image observations)");
   return path;
 }
 
@@ -67,15 +72,18 @@ bool HasStitching(const Project& project, const calib::Camera& camera) {
 }
 
 // Step 1 from the frames adjusted elsewhere, checked against the measurements they must come from.
-stitch::BatchResult CollectStitchedFrames(const Project& project, const FlightWorkflowOptions& options,
+stitch::BatchResult CollectStitchedFrames(const Project& project,
+                                          const FlightWorkflowOptions& options,
                                           const stitch::BatchOptions& batch) {
   const ExposureMeasurements m = ReadExposureMeasurements(project, options.stitch_sigma_px);
   const std::vector<stitch::FrameRun>& runs = *options.stitched_frames;
   bool same = runs.size() == m.frames.size();
-  for (size_t i = 0; same && i < runs.size(); ++i) same = runs[i].adjustment.frame == m.frames[i].frame;
+  for (size_t i = 0; same && i < runs.size(); ++i)
+    same = runs[i].adjustment.frame == m.frames[i].frame;
   if (!same)
-    throw InputError(project.stitching_file + ": the frames adjusted apart (" + std::to_string(runs.size()) +
-                     ") are not the flight's " + std::to_string(m.frames.size()) + " frames in order");
+    throw InputError(project.stitching_file + ": the frames adjusted apart (" +
+                     std::to_string(runs.size()) + ") are not the flight's " +
+                     std::to_string(m.frames.size()) + " frames in order");
   return stitch::CollectBatch(runs, batch);
 }
 
@@ -91,7 +99,8 @@ FlightStitching ReadFlightStitching(const FlightWorkflowOptions& options) {
   FlightStitching out;
   out.options = FlightStitchingOptions(options);
   const calib::Camera camera = calib::ReadCamera(options.camera_file);
-  const Project project = WithCamera(ReadProject(VirtualProjectPath(options)), camera, options.camera_file);
+  const Project project =
+      WithCamera(ReadProject(VirtualProjectPath(options)), camera, options.camera_file);
   if (!HasStitching(project, camera)) return out;
   ExposureMeasurements m = ReadExposureMeasurements(project, options.stitch_sigma_px);
   out.camera = std::move(m.camera);
@@ -104,13 +113,15 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   FlightWorkflowResult out;
   const calib::Camera camera = calib::ReadCamera(options.camera_file);
   const std::string virtual_project = VirtualProjectPath(options);
-  const std::string subimage_project = (fs::path(options.data_folder) / "project_subimage.yaml").string();
+  const std::string subimage_project =
+      (fs::path(options.data_folder) / "project_subimage.yaml").string();
   // Geodetic blocks are adjusted in a metric frame and their results written back (georef/).
   const Project input = WithCamera(ReadProject(virtual_project), camera, options.camera_file);
   const ObjectFrame object_frame(input.frame);
   const Project project = ToAdjustmentFrame(input, object_frame);
   const auto adjust = [&](const AdjustOptions& o) {
-    AdjustmentResult r = options.choose_free_set ? AdjustWithChosenFreeSet(project, o) : Adjust(project, o);
+    AdjustmentResult r =
+        options.choose_free_set ? AdjustWithChosenFreeSet(project, o) : Adjust(project, o);
     ToInputFrame(object_frame, &r);
     return r;
   };
@@ -138,12 +149,17 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   const stitch::BatchOptions batch = FlightStitchingOptions(options);
   std::optional<stitch::BatchResult> stitching;
   if (HasStitching(project, camera)) {
-    stitching = options.stitched_frames ? CollectStitchedFrames(project, options, batch)
-                                        : StitchExposures(project, batch, options.stitch_sigma_px, nullptr);
+    stitching = options.stitched_frames
+                    ? CollectStitchedFrames(project, options, batch)
+                    : StitchExposures(project, batch, options.stitch_sigma_px, nullptr);
     doc["stitching"] = stitch::StitchResultToJson(*stitching, batch);
     char line[256];
-    std::snprintf(line, sizeof(line), "stitching: %zu exposures, sigma0 %.3f px, model %s", stitching->frames.size(),
-                  doc["stitching"].value("sigma0_px", 0.0), doc["stitching"].value("model", std::string("?")).c_str());
+    std::snprintf(line,
+                  sizeof(line),
+                  "stitching: %zu exposures, sigma0 %.3f px, model %s",
+                  stitching->frames.size(),
+                  doc["stitching"].value("sigma0_px", 0.0),
+                  doc["stitching"].value("model", std::string("?")).c_str());
     out.summary.push_back(line);
   } else {
     out.summary.push_back("stitching: no stitching measurements in the project");
@@ -171,9 +187,12 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   // A self-calibrated camera that makes the check points significantly worse is not a calibration
   // (self_calibration_choice.h): not written, the result not valid, with the test.
   const CheckPointComparison check_test = CompareCheckPoints(conventional, self_calibration);
-  doc["check_point_test"] = {{"tested", check_test.tested}, {"n", check_test.n},
-                             {"f", check_test.f}, {"f_critical", check_test.f_critical},
-                             {"alpha", check_test.alpha}, {"worse", check_test.worse},
+  doc["check_point_test"] = {{"tested", check_test.tested},
+                             {"n", check_test.n},
+                             {"f", check_test.f},
+                             {"f_critical", check_test.f_critical},
+                             {"alpha", check_test.alpha},
+                             {"worse", check_test.worse},
                              {"message", check_test.message}};
   if (check_test.worse) self_calibration.Invalidate(check_test.message);
   out.summary.push_back(check_test.message);
@@ -193,8 +212,10 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
   for (const AdjustmentResult* r : {static_cast<const AdjustmentResult*>(&conventional),
                                     static_cast<const AdjustmentResult*>(&self_calibration)}) {
     const std::string name = r == &conventional ? "conventional" : "self-calibration";
-    out.summary.push_back(name + Line(": sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)", r->sigma0_px,
-                                      r->check.spatial_rmse_m, r->check.n));
+    out.summary.push_back(name + Line(": sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)",
+                                      r->sigma0_px,
+                                      r->check.spatial_rmse_m,
+                                      r->check.n));
     AddWarnings(name, *r, &out);
   }
 
@@ -205,23 +226,30 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     joint_options.base_ids = options.base_ids;
     joint_options.stitch_sigma_px = options.stitch_sigma_px;
     // The mapping model the flight's stitching chose (or the one given), from its flight means.
-    const calib::Camera start = JointMappingsFromStitching(camera, stitching ? &*stitching : nullptr, batch,
-                                                           options.joint_model, &joint_options);
-    const Project raw =
-        ToAdjustmentFrame(WithCamera(ReadProject(subimage_project), start, options.camera_file), object_frame);
+    const calib::Camera start = JointMappingsFromStitching(
+        camera, stitching ? &*stitching : nullptr, batch, options.joint_model, &joint_options);
+    const Project raw = ToAdjustmentFrame(
+        WithCamera(ReadProject(subimage_project), start, options.camera_file), object_frame);
     for (const auto& file : InputFilesToJson(ProjectFiles(raw)))
-      if (std::none_of(doc["inputs"].begin(), doc["inputs"].end(),
-                       [&](const nlohmann::json& f) { return f["path"] == file["path"]; }))
+      if (std::none_of(doc["inputs"].begin(), doc["inputs"].end(), [&](const nlohmann::json& f) {
+            return f["path"] == file["path"];
+          }))
         doc["inputs"].push_back(file);
     JointResult joint = AdjustJoint(raw, joint_options);
     ToInputFrame(object_frame, &joint.adjustment);
     const double ratio = joint.adjustment.sigma0 / self_calibration.sigma0;
     if (ratio > kJointSigma0RatioLimit)
       joint.adjustment.warnings.push_back(
-          {kWarningJointSigma0Ratio, "joint", ratio, kJointSigma0RatioLimit,
-           Line("sigma0 %.3f px against %.3f px of the self-calibration (ratio %.2f): ", joint.adjustment.sigma0_px,
-                self_calibration.sigma0_px, ratio) +
-               "the joint's mapping model (" + joint.mapping_model + ") does not fit the sub-images"});
+          {kWarningJointSigma0Ratio,
+           "joint",
+           ratio,
+           kJointSigma0RatioLimit,
+           Line("sigma0 %.3f px against %.3f px of the self-calibration (ratio %.2f): ",
+                joint.adjustment.sigma0_px,
+                self_calibration.sigma0_px,
+                ratio) +
+               "the joint's mapping model (" + joint.mapping_model +
+               ") does not fit the sub-images"});
     nlohmann::json j = JointResultToJson(joint);
     j["name"] = "joint";
     adjustments.push_back(j);
@@ -232,9 +260,11 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     out.camera_from_reason =
         "the joint stitching + triangulation adjustment (interior and the sub-image mappings "
         "refined together)";
-    out.summary.push_back("joint: mappings " + joint.mapping_model + " (" + joint.mapping_model_reason + ")");
+    out.summary.push_back("joint: mappings " + joint.mapping_model + " (" +
+                          joint.mapping_model_reason + ")");
     out.summary.push_back(Line("joint: sigma0 %.3f px, check RMSE spatial %.3f m (n=%.0f)",
-                               joint.adjustment.sigma0_px, joint.adjustment.check.spatial_rmse_m,
+                               joint.adjustment.sigma0_px,
+                               joint.adjustment.check.spatial_rmse_m,
                                joint.adjustment.check.n));
     AddWarnings("joint", joint.adjustment, &out);
   }

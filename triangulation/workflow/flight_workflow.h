@@ -9,15 +9,15 @@
 //      calibrated camera for the next flight.
 #pragma once
 
-#include <optional>
-#include <utility>
-#include <string>
-#include <vector>
+#include "calib/camera/camera.h"
+#include "stitch/adjustment/flight_stability.h"
 
 #include <nlohmann/json.hpp>
 
-#include "calib/camera/camera.h"
-#include "stitch/adjustment/flight_stability.h"
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
 
 namespace aerocal {
 class Progress;
@@ -32,11 +32,12 @@ struct FlightWorkflowOptions {
   /// The self-calibration's parameters; with choose_free_set the candidates of
   /// AdjustWithChosenFreeSet (self_calibration_choice.h: only what the block determines and what
   /// is significant), else calibrated as they are (`--self-calibration all` or a list).
-  std::vector<std::string> free_interior = {"c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
-  bool choose_free_set = true;  // `--self-calibration auto`, the default
+  std::vector<std::string> free_interior = {
+      "c", "x0", "y0", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
+  bool choose_free_set = true;        // `--self-calibration auto`, the default
   double suspect_effect_limit = 1.0;  // AdjustOptions::suspect_effect_limit
-  double stitch_sigma_px = 0.1;  // where stitch_obs.csv has no sigma_px
-  bool joint = true;             // run the joint adjustment when sub-image observations exist
+  double stitch_sigma_px = 0.1;       // where stitch_obs.csv has no sigma_px
+  bool joint = true;                  // run the joint adjustment when sub-image observations exist
   /// Mapping model of the joint step; nullopt: the one the stitching F test chose for the flight.
   std::optional<calib::MappingModel> joint_model;
   /// Step 1 already done frame by frame (`aerocal batch`): one run per frame of FlightStitching,
@@ -72,7 +73,7 @@ struct FlightWorkflowResult {
   /// failing steps and calibrated_camera must not be used (aerocal flight does not write it).
   bool valid = true;
   std::vector<std::pair<std::string, std::string>> failures;  // (step, reason)
-  std::vector<std::string> summary; // one line per step, for the terminal (and each warning)
+  std::vector<std::string> summary;  // one line per step, for the terminal (and each warning)
   /// Which adjustment calibrated_camera comes from ("self_calibration" or "joint") and why.
   std::string camera_from, camera_from_reason;
 };

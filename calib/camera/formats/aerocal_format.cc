@@ -1,11 +1,11 @@
 // Our camera file (FORMATS.md "Camera file", any registry model) and the heads of a rig file.
-#include <cmath>
-
 #include "calib/camera/camera_io.h"
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/yaml_util.h"
+
+#include <cmath>
 
 namespace aerocal::calib {
 
@@ -52,8 +52,8 @@ CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& o
     file = CameraFileFromCamera(ParseCamera(root, path, CameraModels::kAny));
   }
   const PixelFrame frame = file.camera.frame;
-  internal::ResolveFormat(&file, options, {path, 1}, frame.width_px, frame.height_px,
-                          frame.pixel_size_mm);
+  internal::ResolveFormat(
+      &file, options, {path, 1}, frame.width_px, frame.height_px, frame.pixel_size_mm);
   return file;
 }
 

@@ -4,8 +4,8 @@
 //   Sensor Size  Pixel Size (mm)
 //   H <width px>  <pixel width mm>
 //   V <height px> <pixel height mm>
-//   Camera Variable | Initial Value | Total Adjustment | Final Value | Initial Std. Error | Final Std. Error
-//   C  ... (mm)   XP ... (mm)   YP ... (mm)   K1 K2 K3 P1 P2 B1 B2
+//   Camera Variable | Initial Value | Total Adjustment | Final Value | Initial Std. Error | Final
+//   Std. Error C  ... (mm)   XP ... (mm)   YP ... (mm)   K1 K2 K3 P1 P2 B1 B2
 // Australis's model is Fraser's (1997) 10-parameter correction form, the one ours is
 // (brown_fraser_10, CONVENTIONS.md): c, the principal point offset (xp, yp) from the format centre
 // in mm with y up, K1-K3 (mm^-2, mm^-4, mm^-6), P1, P2 (mm^-1), B1, B2 (1), the correction added to
@@ -19,13 +19,13 @@
 // number is an error at its line, never a 0); a parameter without a line is 0, said in the notes
 // (C is required). H and V pixel sizes that differ are not modelled (square pixels of V's size,
 // said). Written in the same layout, Initial = Final and Total Adjustment 0.
-#include <cmath>
-#include <filesystem>
-#include <sstream>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
 
 namespace aerocal::calib {
 namespace {
@@ -40,8 +40,8 @@ struct Token {
 constexpr double kFreeSigma = 1000.0;  // Australis prints 1.0e+003 for a free parameter
 
 // The Australis name of each parameter of our table, in table order.
-constexpr const char* kAustralisNames[Model::kNumParams] = {"C",  "XP", "YP", "K1", "K2",
-                                                            "K3", "P1", "P2", "B1", "B2"};
+constexpr const char* kAustralisNames[Model::kNumParams] = {
+    "C", "XP", "YP", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
 
 }  // namespace
 
@@ -64,16 +64,18 @@ CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions&
     for (size_t i = from; i < tokens.size(); ++i) {
       if (tokens[i].text != name || (i > 0 && tokens[i - 1].line == tokens[i].line)) continue;
       if (found >= 0)
-        ThrowInputError({path, tokens[i].line}, "a second '" + name + "' line (the first is line " +
-                                                    std::to_string(tokens[found].line) + ")");
+        ThrowInputError({path, tokens[i].line},
+                        "a second '" + name + "' line (the first is line " +
+                            std::to_string(tokens[found].line) + ")");
       found = static_cast<long>(i);
     }
     return found;
   };
   const long h = row("H", 0), v = row("V", 0);
   if (h < 0 || v < 0)
-    ThrowInputError({path, 1}, "no sensor size: lines 'H <pixels> <pixel size mm>' and "
-                               "'V <pixels> <pixel size mm>'");
+    ThrowInputError({path, 1},
+                    "no sensor size: lines 'H <pixels> <pixel size mm>' and "
+                    "'V <pixels> <pixel size mm>'");
   // The k-th number after the name at token `i`.
   const auto number = [&](long i, long k, const std::string& what, double bound) {
     const size_t at = static_cast<size_t>(i + k);
@@ -81,13 +83,18 @@ CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions&
     return internal::ParseNumber(tokens[at].text, {path, tokens[at].line}, what, bound);
   };
   const double width = number(h, 1, "H pixels", 1e6), height = number(v, 1, "V pixels", 1e6);
-  const double pixel_h = number(h, 2, "H pixel size", 1.0), pixel_v = number(v, 2, "V pixel size", 1.0);
+  const double pixel_h = number(h, 2, "H pixel size", 1.0),
+               pixel_v = number(v, 2, "V pixel size", 1.0);
   if (!(width >= 1 && height >= 1 && width == std::floor(width) && height == std::floor(height)))
     ThrowInputError({path, tokens[h].line}, "H and V pixels must be positive integers");
   CameraFile file;
   file.name = std::filesystem::path(path).stem().string();
-  internal::ResolveFormat(&file, options, {path, tokens[v].line}, static_cast<int>(width),
-                          static_cast<int>(height), pixel_v);
+  internal::ResolveFormat(&file,
+                          options,
+                          {path, tokens[v].line},
+                          static_cast<int>(width),
+                          static_cast<int>(height),
+                          pixel_v);
   if (std::abs(pixel_h / pixel_v - 1.0) > 1e-9)
     file.notes.push_back("Australis H pixel size " + FormatNumber(pixel_h) + " mm differs from V " +
                          FormatNumber(pixel_v) + " mm: square pixels of V's size (not modelled)");
@@ -100,8 +107,9 @@ CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions&
     const long i = row(name, static_cast<size_t>(std::max(h, v)) + 1);
     if (i < 0) {
       if (k == Model::kC)
-        ThrowInputError({path, 1}, "no camera constant: a line 'C <initial> <adjustment> <final> "
-                                   "<initial sigma> <final sigma>'");
+        ThrowInputError({path, 1},
+                        "no camera constant: a line 'C <initial> <adjustment> <final> "
+                        "<initial sigma> <final sigma>'");
       file.notes.push_back(name + ": no line in the report, 0");
       continue;
     }
@@ -116,12 +124,12 @@ CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions&
       any_sigma = true;
     }
   }
-  if (!(file.camera.params[Model::kC] > 0))
-    ThrowInputError({path, 1}, "C must be > 0 mm");
+  if (!(file.camera.params[Model::kC] > 0)) ThrowInputError({path, 1}, "C must be > 0 mm");
   if (any_sigma) {
     file.covariance = covariance;
-    file.notes.push_back("Australis final std. errors read as a diagonal covariance (the report "
-                         "prints no correlations)");
+    file.notes.push_back(
+        "Australis final std. errors read as a diagonal covariance (the report "
+        "prints no correlations)");
   }
   return file;
 }
@@ -141,7 +149,8 @@ void WriteAustralisCamera(const std::string& path, const CameraFile& file) {
       << "Variable  Value      Adjustment  Value     Std. Error  Std. Error\n";
   for (int k = 0; k < Model::kNumParams; ++k) {
     double sigma = 0;
-    if (file.covariance && (*file.covariance)(k, k) > 0) sigma = std::sqrt((*file.covariance)(k, k));
+    if (file.covariance && (*file.covariance)(k, k) > 0)
+      sigma = std::sqrt((*file.covariance)(k, k));
     out << kAustralisNames[k] << " " << n(q[k]) << " 0 " << n(q[k]) << " "
         << n(sigma > 0 ? kFreeSigma : 0.0) << " " << n(sigma) << (k < 3 ? " (mm)" : "") << "\n";
   }

@@ -25,7 +25,8 @@
 //   the other reading moves the principal point by 0.5 px).
 // - dbat: DBAT camera XML (c, pp mm from the top-left corner, y down, K1-K3, P1, P2): our
 //   correction model (brown_fraser_10 without B1, B2).
-// - photomodeler: a PhotoModeler "Bundle Soln" export's camera (f, pp mm from the upper-left corner,
+// - photomodeler: a PhotoModeler "Bundle Soln" export's camera (f, pp mm from the upper-left
+// corner,
 //   format size, K1-K3, P1, P2; photomodeler_format.cc): brown_fraser_10 without B1, B2.
 // - australis: an Australis "Camera Parameters" report (C, XP, YP, K1-K3, P1, P2, B1, B2 with their
 //   standard errors; australis_format.cc): brown_fraser_10, all ten terms, diagonal covariance.
@@ -33,18 +34,18 @@
 //   intrinsics fu fv pu pv, distortion_coeffs, resolution); pixels as OpenCV.
 #pragma once
 
-#include <functional>
-#include <optional>
-#include <string>
-#include <vector>
-
-#include <Eigen/Core>
-#include <yaml-cpp/yaml.h>
-
 #include "calib/camera/camera.h"
 #include "calib/camera/camera_model.h"
 #include "calib/camera/convert_camera.h"
 #include "calib/core/error.h"
+
+#include <Eigen/Core>
+#include <yaml-cpp/yaml.h>
+
+#include <functional>
+#include <optional>
+#include <string>
+#include <vector>
 
 namespace aerocal::calib {
 
@@ -65,8 +66,8 @@ struct CameraFile {
 
 /// What the command line adds to a file.
 struct CameraReadOptions {
-  std::string camera_id;     // picks one camera of a file holding several ("" = the only one)
-  int width_px = 0;          // 0 = from the file; given and contradicting the file: InputError
+  std::string camera_id;  // picks one camera of a file holding several ("" = the only one)
+  int width_px = 0;       // 0 = from the file; given and contradicting the file: InputError
   int height_px = 0;
   double pixel_size_mm = 0;  // 0 = from the file (or unknown)
 };
@@ -93,20 +94,23 @@ struct FileConversion {
   std::vector<std::string> notes;
 };
 /// ConfigError("--pixel-size-mm ...") when the target needs a pixel size the source does not give.
-FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& target,
+FileConversion ConvertCameraFile(const CameraFile& from,
+                                 const FormatTarget& target,
                                  const ConvertOptions& options = {});
 
 /// The target of the formats written in OpenCV's model (opencv, ros, dji): the source itself when
 /// it is an opencv camera (exact), else a fit with 5 coefficients (coefficient_choice).
 FormatTarget OpenCvTarget(const ModelCamera& source);
 
-/// ConvertCameraFile in the simplest form of the format (issue 29): where target.coefficient_choice,
-/// the conversions with 4, 5 and 8 distortion coefficients up to `max_coefficients` (>= 4), one
-/// line each in `tried` ("5 coefficients (k1 k2 p1 p2 k3): residual max ... px, rms ... px"); the
-/// first whose max residual meets options.max_residual_px, or without that gate the first within
-/// 0.01 px of the best tried. Otherwise ConvertCameraFile.
-FileConversion ConvertCameraFileSimplest(const CameraFile& from, const FormatTarget& target,
-                                         const ConvertOptions& options, int max_coefficients,
+/// ConvertCameraFile in the simplest form of the format (issue 29): where
+/// target.coefficient_choice, the conversions with 4, 5 and 8 distortion coefficients up to
+/// `max_coefficients` (>= 4), one line each in `tried` ("5 coefficients (k1 k2 p1 p2 k3): residual
+/// max ... px, rms ... px"); the first whose max residual meets options.max_residual_px, or without
+/// that gate the first within 0.01 px of the best tried. Otherwise ConvertCameraFile.
+FileConversion ConvertCameraFileSimplest(const CameraFile& from,
+                                         const FormatTarget& target,
+                                         const ConvertOptions& options,
+                                         int max_coefficients,
                                          std::vector<std::string>* tried);
 
 /// Our camera (in its own model) as a camera file: interior_sigma as a diagonal covariance (the
@@ -153,14 +157,17 @@ std::string ForeignCameraHint(const std::string& path);
 /// the same camera (model, size, every pixel within 1e-6 px over a 21 x 21 grid): the writer runs
 /// on a scratch file beside `path`, which is renamed onto `path` when it reads back; else the
 /// scratch is removed and Error names what differs (nothing is written).
-void WriteCameraFileVerified(const CameraFormat& format, const std::string& path,
+void WriteCameraFileVerified(const CameraFormat& format,
+                             const std::string& path,
                              const CameraFile& file);
 /// Reads `path` as format `name`, or, with name "auto", as the one format it looks like
 /// (InputError naming the candidates when none or several). A reader's InputError on a file that
 /// looks like another format says so ("... (the file looks like kalibr: --from kalibr)").
 /// `*used` (optional) receives the format read.
-CameraFile ReadCameraFileAs(const std::string& name, const std::string& path,
-                            const CameraReadOptions& options, std::string* used = nullptr);
+CameraFile ReadCameraFileAs(const std::string& name,
+                            const std::string& path,
+                            const CameraReadOptions& options,
+                            std::string* used = nullptr);
 
 // ---- per format (name: reader, writer) ----
 CameraFile ReadAerocalCamera(const std::string& path, const CameraReadOptions& options);
@@ -173,7 +180,8 @@ bool LooksLikeColmapBinary(const std::string& head, const std::string& path);
 void WriteColmapCameras(const std::string& path, const CameraFile& camera);
 /// One cameras.txt row split into fields (CAMERA_ID MODEL WIDTH HEIGHT PARAMS...) -> the
 /// registry's COLMAP model; InputError("FILE:LINE: ...") on a bad row. The COLMAP import uses it.
-ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields, const SourceRef& where,
+ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields,
+                                   const SourceRef& where,
                                    double pixel_size_mm);
 
 CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOptions& options);
@@ -185,7 +193,8 @@ CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& option
 bool IsPix4dCalibratedParameters(const std::string& head);
 void WritePix4dCam(const std::string& path, const CameraFile& camera);
 /// Pix4D's camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, PerspectiveDistortion)
-/// from a JPEG or an XMP sidecar; the pixel size from exif:FocalPlaneXResolution or --pixel-size-mm.
+/// from a JPEG or an XMP sidecar; the pixel size from exif:FocalPlaneXResolution or
+/// --pixel-size-mm.
 CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& options);
 void WritePix4dXmp(const std::string& path, const CameraFile& camera);
 
@@ -195,7 +204,9 @@ void WriteOpenSfmCameras(const std::string& path, const CameraFile& camera);
 CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& options);
 /// The opencv camera of a DewarpData string ("[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" or the 12 values
 /// of DewarpDataK6) for an image of width x height px.
-ModelCamera DjiDewarpDataCamera(const std::string& text, const SourceRef& where, int width_px,
+ModelCamera DjiDewarpDataCamera(const std::string& text,
+                                const SourceRef& where,
+                                int width_px,
                                 int height_px);
 void WriteDjiDewarpData(const std::string& path, const CameraFile& camera);
 
@@ -230,13 +241,20 @@ namespace internal {
 /// Applies --width/--height/--pixel-size-mm to what a file gave (0 = not given): a given value that
 /// contradicts the file is InputError at `where`; a size nobody gave is InputError naming the
 /// options. Marks the pixel size as known or a placeholder.
-void ResolveFormat(CameraFile* file, const CameraReadOptions& options, const SourceRef& where,
-                   int file_width_px, int file_height_px, double file_pixel_size_mm);
+void ResolveFormat(CameraFile* file,
+                   const CameraReadOptions& options,
+                   const SourceRef& where,
+                   int file_width_px,
+                   int file_height_px,
+                   double file_pixel_size_mm);
 /// A finite number of the whole text within [-bound, bound]; InputError naming `what` otherwise.
-double ParseNumber(const std::string& text, const SourceRef& where, const std::string& what,
+double ParseNumber(const std::string& text,
+                   const SourceRef& where,
+                   const std::string& what,
                    double bound = 1e12);
 /// Every parameter in `names` of `camera` is zero (the format can hold the camera).
-void RequireZero(const ModelCamera& camera, const std::vector<std::string>& names,
+void RequireZero(const ModelCamera& camera,
+                 const std::vector<std::string>& names,
                  const std::string& format);
 double Param(const ModelCamera& camera, std::string_view name);
 /// A camera name as one line of text (control characters, a newline among them, become spaces):
@@ -253,8 +271,10 @@ std::string YamlQuoted(std::string_view text);
 YAML::Node LoadCameraYaml(const std::string& path);
 /// The camera of a DBAT or PhotoModeler text report (report_camera.cc): `tool` names it in
 /// messages; --camera CameraN picks one of several.
-CameraFile ReadReportCamera(const std::string& path, const std::vector<std::string>& lines,
-                            const CameraReadOptions& options, const std::string& tool);
+CameraFile ReadReportCamera(const std::string& path,
+                            const std::vector<std::string>& lines,
+                            const CameraReadOptions& options,
+                            const std::string& tool);
 /// The largest difference (px) over the format between a correction acting on x scaled by the
 /// pixel aspect s (DBAT's x = s xb) and ours with that scale as B1 = s - 1 (`ours` holds it).
 double AspectAsB1ResidualPx(const ModelCamera& ours, double s);

@@ -5,11 +5,11 @@
 //   distortion_parameters: {k1, k2, p1, p2} / projection_parameters: {fx, fy, cx, cy}
 // OpenCV's pinhole with k1 k2 p1 p2 in OpenCV pixels: the opencv model (k3-k6 held at 0) exactly.
 // Other camodocal models (KANNALA_BRANDT, MEI, SCARAMUZZA) are refused by name.
-#include <sstream>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/yaml_util.h"
+
+#include <sstream>
 
 namespace aerocal::calib {
 
@@ -52,12 +52,13 @@ void WriteCamodocalCamera(const std::string& path, const CameraFile& file) {
   const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
   out << "%YAML:1.0\n---\nmodel_type: PINHOLE\ncamera_name: \""
-      << internal::YamlQuoted(internal::OneLine(file.name)) << "\"\nimage_width: "
-      << file.camera.frame.width_px << "\nimage_height: " << file.camera.frame.height_px
+      << internal::YamlQuoted(internal::OneLine(file.name))
+      << "\"\nimage_width: " << file.camera.frame.width_px
+      << "\nimage_height: " << file.camera.frame.height_px
       << "\ndistortion_parameters:\n   k1: " << n(p[4]) << "\n   k2: " << n(p[5])
-      << "\n   p1: " << n(p[6]) << "\n   p2: " << n(p[7]) << "\nprojection_parameters:\n   fx: "
-      << n(p[0]) << "\n   fy: " << n(p[1]) << "\n   cx: " << n(p[2]) << "\n   cy: " << n(p[3])
-      << "\n";
+      << "\n   p1: " << n(p[6]) << "\n   p2: " << n(p[7])
+      << "\nprojection_parameters:\n   fx: " << n(p[0]) << "\n   fy: " << n(p[1])
+      << "\n   cx: " << n(p[2]) << "\n   cy: " << n(p[3]) << "\n";
   WriteFileAtomically(path, out.str());
 }
 

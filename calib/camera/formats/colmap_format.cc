@@ -7,15 +7,15 @@
 // the model's parameters as doubles), read into the same fields; written when OUT ends in .bin.
 // Camera ids are kept as they are (0 is a valid id); ours is written with its name when that is a
 // non-negative integer, else as camera 1.
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
 #include <regex>
 #include <sstream>
-
-#include "calib/camera/formats/camera_formats.h"
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
 
 namespace aerocal::calib {
 namespace {
@@ -29,9 +29,17 @@ std::vector<std::string> Blanks(const std::string& line) {
 
 // COLMAP's model ids (sensor/models.h) and their parameter counts; -1: not a COLMAP id.
 constexpr int kBinaryModelCount = 11;
-constexpr const char* kBinaryModelNames[kBinaryModelCount] = {
-    "SIMPLE_PINHOLE", "PINHOLE", "SIMPLE_RADIAL", "RADIAL", "OPENCV", "OPENCV_FISHEYE",
-    "FULL_OPENCV", "FOV", "SIMPLE_RADIAL_FISHEYE", "RADIAL_FISHEYE", "THIN_PRISM_FISHEYE"};
+constexpr const char* kBinaryModelNames[kBinaryModelCount] = {"SIMPLE_PINHOLE",
+                                                              "PINHOLE",
+                                                              "SIMPLE_RADIAL",
+                                                              "RADIAL",
+                                                              "OPENCV",
+                                                              "OPENCV_FISHEYE",
+                                                              "FULL_OPENCV",
+                                                              "FOV",
+                                                              "SIMPLE_RADIAL_FISHEYE",
+                                                              "RADIAL_FISHEYE",
+                                                              "THIN_PRISM_FISHEYE"};
 constexpr int kBinaryParamCounts[kBinaryModelCount] = {3, 4, 4, 5, 8, 8, 12, 5, 4, 5, 12};
 
 bool IsBinaryPath(const std::string& path) {
@@ -42,8 +50,9 @@ template <typename T>
 T Get(const std::string& bytes, size_t* at, const std::string& path, const char* what) {
   T value;
   if (bytes.size() - *at < sizeof(T))
-    ThrowInputError({path, 0}, std::string("cameras.bin ends inside ") + what + " (byte " +
-                                   std::to_string(*at) + ")");
+    ThrowInputError(
+        {path, 0},
+        std::string("cameras.bin ends inside ") + what + " (byte " + std::to_string(*at) + ")");
   std::memcpy(&value, bytes.data() + *at, sizeof(T));  // little-endian host (x86-64, arm64)
   *at += sizeof(T);
   return value;
@@ -55,9 +64,9 @@ std::vector<std::vector<std::string>> BinaryRows(const std::string& path) {
   size_t at = 0;
   const uint64_t count = Get<uint64_t>(bytes, &at, path, "the camera count");
   if (count > bytes.size() / 24)
-    ThrowInputError({path, 0}, "cameras.bin: camera count " + std::to_string(count) +
-                                   " does not fit the file's " + std::to_string(bytes.size()) +
-                                   " bytes");
+    ThrowInputError({path, 0},
+                    "cameras.bin: camera count " + std::to_string(count) +
+                        " does not fit the file's " + std::to_string(bytes.size()) + " bytes");
   std::vector<std::vector<std::string>> rows;
   for (uint64_t k = 0; k < count; ++k) {
     const uint32_t id = Get<uint32_t>(bytes, &at, path, "a camera id");
@@ -65,17 +74,21 @@ std::vector<std::vector<std::string>> BinaryRows(const std::string& path) {
     const uint64_t width = Get<uint64_t>(bytes, &at, path, "a width");
     const uint64_t height = Get<uint64_t>(bytes, &at, path, "a height");
     if (model < 0 || model >= kBinaryModelCount)
-      ThrowInputError({path, 0}, "cameras.bin camera " + std::to_string(id) + ": model id " +
-                                     std::to_string(model) + " is not one of COLMAP's (0-10)");
-    std::vector<std::string> row = {std::to_string(id), kBinaryModelNames[model],
-                                    std::to_string(width), std::to_string(height)};
+      ThrowInputError({path, 0},
+                      "cameras.bin camera " + std::to_string(id) + ": model id " +
+                          std::to_string(model) + " is not one of COLMAP's (0-10)");
+    std::vector<std::string> row = {std::to_string(id),
+                                    kBinaryModelNames[model],
+                                    std::to_string(width),
+                                    std::to_string(height)};
     for (int i = 0; i < kBinaryParamCounts[model]; ++i)
       row.push_back(internal::ShortestNumber(Get<double>(bytes, &at, path, "the parameters")));
     rows.push_back(row);
   }
   if (at != bytes.size())
-    ThrowInputError({path, 0}, "cameras.bin: " + std::to_string(bytes.size() - at) +
-                                   " bytes after the last camera");
+    ThrowInputError(
+        {path, 0},
+        "cameras.bin: " + std::to_string(bytes.size() - at) + " bytes after the last camera");
   return rows;
 }
 
@@ -89,16 +102,18 @@ bool LooksLikeColmapBinary(const std::string& head, const std::string& path) {
   return model >= 0 && model < kBinaryModelCount;
 }
 
-ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields, const SourceRef& where,
+ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields,
+                                   const SourceRef& where,
                                    double pixel_size_mm) {
   if (fields.size() < 4)
     ThrowInputError(where, "a camera line is CAMERA_ID MODEL WIDTH HEIGHT PARAMS...");
   const std::string& name = fields[1];
   const auto model = CameraModelFromColmapName(name);
   if (!model)
-    ThrowInputError(where, "camera model " + name +
-                               " is not supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, "
-                               "RADIAL, OPENCV, FULL_OPENCV)");
+    ThrowInputError(where,
+                    "camera model " + name +
+                        " is not supported (SIMPLE_PINHOLE, PINHOLE, SIMPLE_RADIAL, "
+                        "RADIAL, OPENCV, FULL_OPENCV)");
   const size_t num_params = CameraModelParamCount(*model);
   if (fields.size() != 4 + num_params)
     ThrowInputError(where, name + " needs " + std::to_string(num_params) + " parameters");
@@ -108,11 +123,11 @@ ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields, const
   const auto integer = [&](const std::string& text, const char* what) {
     const double v = internal::ParseNumber(text, where, what, 1e300);
     if (!(v >= 1 && v <= 1e6))
-      ThrowInputError(where, std::string(what) + " out of range (got " + text +
-                                 ", expected 1 .. 1000000)");
+      ThrowInputError(
+          where, std::string(what) + " out of range (got " + text + ", expected 1 .. 1000000)");
     if (v != static_cast<int>(v))
-      ThrowInputError(where, std::string(what) + " must be an integer within 1 .. 1000000 (got " +
-                                 text + ")");
+      ThrowInputError(
+          where, std::string(what) + " must be an integer within 1 .. 1000000 (got " + text + ")");
     return static_cast<int>(v);
   };
   camera.frame.width_px = integer(fields[2], "WIDTH");
@@ -122,8 +137,8 @@ ModelCamera ColmapCameraFromFields(const std::vector<std::string>& fields, const
   // Focal lengths (f, or fx and fy) lead every COLMAP model's parameters.
   const bool two_focals = name == "PINHOLE" || name == "OPENCV" || name == "FULL_OPENCV";
   if (!(camera.params[0] > 0) || (two_focals && !(camera.params[1] > 0)))
-    ThrowInputError(where, "focal length must be > 0 px (got " + FormatNumber(camera.params[0]) +
-                               ")");
+    ThrowInputError(where,
+                    "focal length must be > 0 px (got " + FormatNumber(camera.params[0]) + ")");
   return camera;
 }
 
@@ -155,19 +170,22 @@ CameraFile ReadColmapCameras(const std::string& path, const CameraReadOptions& o
     if (options.camera_id.empty()) break;
   }
   if (!found)
-    ThrowInputError({path, 1}, options.camera_id.empty()
-                                   ? "no camera line"
-                                   : "no camera " + options.camera_id + " (cameras: " + ids + ")");
+    ThrowInputError({path, 1},
+                    options.camera_id.empty()
+                        ? "no camera line"
+                        : "no camera " + options.camera_id + " (cameras: " + ids + ")");
   if (rows.size() > 1 && options.camera_id.empty())
-    ThrowInputError({path, 1}, "holds " + std::to_string(rows.size()) +
-                                   " cameras: name one with --camera (" + ids + ")");
+    ThrowInputError(
+        {path, 1},
+        "holds " + std::to_string(rows.size()) + " cameras: name one with --camera (" + ids + ")");
   CameraFile file;
   file.name = found->first[0];
   file.chosen_by_camera_id = !options.camera_id.empty();
-  file.camera = ColmapCameraFromFields(found->first, where_of(found->second), kPlaceholderPixelSizeMm);
+  file.camera =
+      ColmapCameraFromFields(found->first, where_of(found->second), kPlaceholderPixelSizeMm);
   const PixelFrame frame = file.camera.frame;
-  internal::ResolveFormat(&file, options, where_of(found->second), frame.width_px, frame.height_px,
-                          0.0);
+  internal::ResolveFormat(
+      &file, options, where_of(found->second), frame.width_px, frame.height_px, 0.0);
   return file;
 }
 

@@ -1,20 +1,22 @@
 // A camera file expressed in a format's model (camera_formats.h ConvertCameraFile): ConvertCamera
 // with the parameters the format cannot hold at 0, and the covariance carried through the
 // conversion's Jacobian.
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/numeric_jacobian.h"
+
 #include <cmath>
 #include <cstdio>
 #include <limits>
 
-#include "calib/camera/formats/camera_formats.h"
-#include "calib/core/numeric_jacobian.h"
-
 namespace aerocal::calib {
 
-FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& target,
+FileConversion ConvertCameraFile(const CameraFile& from,
+                                 const FormatTarget& target,
                                  const ConvertOptions& options) {
   if (target.needs_pixel_size && !from.pixel_size_known)
-    throw ConfigError("--pixel-size-mm: the target holds millimetres and the source gives no pixel "
-                      "size");
+    throw ConfigError(
+        "--pixel-size-mm: the target holds millimetres and the source gives no pixel "
+        "size");
   FileConversion out;
   ConvertOptions o = options;
   o.zero.insert(o.zero.end(), target.zero_params.begin(), target.zero_params.end());
@@ -33,8 +35,8 @@ FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& tar
           ModelCamera perturbed = from.camera;
           perturbed.params = params;
           const ConversionResult r = ConvertCamera(perturbed, target.model, quick);
-          return Eigen::VectorXd(Eigen::Map<const Eigen::VectorXd>(r.camera.params.data(),
-                                                                   r.camera.params.size()));
+          return Eigen::VectorXd(
+              Eigen::Map<const Eigen::VectorXd>(r.camera.params.data(), r.camera.params.size()));
         },
         from.camera.params);
     out.file.covariance = jacobian * *from.covariance * jacobian.transpose();
@@ -43,8 +45,10 @@ FileConversion ConvertCameraFile(const CameraFile& from, const FormatTarget& tar
   return out;
 }
 
-FileConversion ConvertCameraFileSimplest(const CameraFile& from, const FormatTarget& target,
-                                         const ConvertOptions& options, int max_coefficients,
+FileConversion ConvertCameraFileSimplest(const CameraFile& from,
+                                         const FormatTarget& target,
+                                         const ConvertOptions& options,
+                                         int max_coefficients,
                                          std::vector<std::string>* tried) {
   if (!target.coefficient_choice) return ConvertCameraFile(from, target, options);
   if (max_coefficients < 4) throw ConfigError("--max-coefficients must be >= 4 (k1 k2 p1 p2)");
@@ -72,8 +76,13 @@ FileConversion ConvertCameraFileSimplest(const CameraFile& from, const FormatTar
     results.emplace_back(c.n, ConvertCameraFile(from, t, ungated));
     const ConversionResidual& r = results.back().second.result.residual;
     char line[200];
-    std::snprintf(line, sizeof(line), "%d coefficients (%s): residual max %.3g px, rms %.3g px%s",
-                  c.n, c.terms, r.max_px, r.rms_px,
+    std::snprintf(line,
+                  sizeof(line),
+                  "%d coefficients (%s): residual max %.3g px, rms %.3g px%s",
+                  c.n,
+                  c.terms,
+                  r.max_px,
+                  r.rms_px,
                   r.failed_points ? " (points not invertible)" : "");
     if (tried) tried->push_back(line);
   }
@@ -93,10 +102,11 @@ FileConversion ConvertCameraFileSimplest(const CameraFile& from, const FormatTar
   FileConversion chosen = results[pick].second;
   chosen.result.acceptable = chosen.result.residual.failed_points == 0 &&
                              chosen.result.residual.max_px <= options.max_residual_px;
-  chosen.notes.push_back(std::to_string(results[pick].first) + " distortion coefficients written " +
-                         (gated ? "(the fewest meeting --max-residual-px)"
-                                : "(the fewest within 0.01 px of the best tried; --max-coefficients " +
-                                      std::to_string(max_coefficients) + ")"));
+  chosen.notes.push_back(
+      std::to_string(results[pick].first) + " distortion coefficients written " +
+      (gated ? "(the fewest meeting --max-residual-px)"
+             : "(the fewest within 0.01 px of the best tried; --max-coefficients " +
+                   std::to_string(max_coefficients) + ")"));
   return chosen;
 }
 

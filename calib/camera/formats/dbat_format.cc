@@ -11,21 +11,20 @@
 // difference measured over the format and said. A fragment (<cameras> or <camera> without
 // <document>) is read too; several cameras need --camera ID.
 // Also DBAT's text report (report.txt: "Cameras:" ... "Camera1 (simple)", then per parameter a
-// title line and "Value:" / "Deviation:" lines: Camera Constant, px, py, Format width/height, K1-K3,
-// P1, P2, as (off-unit aspect: pixel width = pixel height (1 + as)), sk, Image width/height): the
-// same mapping, 6 significant digits as printed, the deviations as a diagonal covariance; a
-// non-zero skew is an error (not modelled). --camera CameraN picks one of several. Read with an
-// XML parser (comments, CDATA and nesting handled), the camera's DIRECT children only (a <pp>
-// inside <std> is a sigma, not the principal point).
-#include <cmath>
-#include <filesystem>
-#include <sstream>
-
-#include <tinyxml2.h>
-
+// title line and "Value:" / "Deviation:" lines: Camera Constant, px, py, Format width/height,
+// K1-K3, P1, P2, as (off-unit aspect: pixel width = pixel height (1 + as)), sk, Image
+// width/height): the same mapping, 6 significant digits as printed, the deviations as a diagonal
+// covariance; a non-zero skew is an error (not modelled). --camera CameraN picks one of several.
+// Read with an XML parser (comments, CDATA and nesting handled), the camera's DIRECT children only
+// (a <pp> inside <std> is a sigma, not the principal point).
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
+#include <tinyxml2.h>
 
 namespace aerocal::calib {
 namespace {
@@ -43,8 +42,9 @@ struct XmlCamera {
   const tinyxml2::XMLElement* Child(const char* tag) const {
     const tinyxml2::XMLElement* e = camera->FirstChildElement(tag);
     if (const tinyxml2::XMLElement* again = e ? e->NextSiblingElement(tag) : nullptr)
-      ThrowInputError(Where(again), std::string("<") + tag + "> occurs twice in <camera> (first on line " +
-                                        std::to_string(e->GetLineNum()) + ")");
+      ThrowInputError(Where(again),
+                      std::string("<") + tag + "> occurs twice in <camera> (first on line " +
+                          std::to_string(e->GetLineNum()) + ")");
     return e;
   }
   // Text of <tag> split on commas, trimmed; empty when the tag is absent. A tag present but empty
@@ -61,13 +61,14 @@ struct XmlCamera {
     for (const auto& s : List(tag)) {
       const auto v = ParseDouble(s);
       if (!v || !(std::abs(*v) <= bound))
-        ThrowInputError(Where(Child(tag)), std::string("<") + tag + "> must hold numbers within +-" +
-                                               FormatNumber(bound) + " (got '" + s + "')");
+        ThrowInputError(Where(Child(tag)),
+                        std::string("<") + tag + "> must hold numbers within +-" +
+                            FormatNumber(bound) + " (got '" + s + "')");
       out.push_back(*v);
     }
     if (out.size() < min_size)
-      ThrowInputError(Where(Child(tag)), std::string("<") + tag + "> needs " +
-                                             std::to_string(min_size) + " values");
+      ThrowInputError(Where(Child(tag)),
+                      std::string("<") + tag + "> needs " + std::to_string(min_size) + " values");
     return out;
   }
 };
@@ -81,18 +82,21 @@ bool IsDbatReport(const std::string& head) {
 
 CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& options) {
   const std::string text = ReadTextFile(path);
-  if (IsDbatReport(text)) return internal::ReadReportCamera(path, SplitLines(text), options, "DBAT");
+  if (IsDbatReport(text))
+    return internal::ReadReportCamera(path, SplitLines(text), options, "DBAT");
   tinyxml2::XMLDocument doc;
   if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS)
     ThrowInputError({path, doc.ErrorLineNum()}, std::string("invalid XML: ") + doc.ErrorName());
   const tinyxml2::XMLElement* root = doc.RootElement();
   // A whole file (<document><cameras><camera>) or a fragment (<cameras> or one <camera>).
   const std::string root_name = root ? root->Name() : "";
-  const tinyxml2::XMLElement* cameras =
-      root_name == "cameras" ? root : root ? root->FirstChildElement("cameras") : nullptr;
-  XmlCamera xml{path, root_name == "camera" ? root
-                      : cameras             ? cameras->FirstChildElement("camera")
-                                            : nullptr};
+  const tinyxml2::XMLElement* cameras = root_name == "cameras" ? root
+                                        : root                 ? root->FirstChildElement("cameras")
+                                                               : nullptr;
+  XmlCamera xml{path,
+                root_name == "camera" ? root
+                : cameras             ? cameras->FirstChildElement("camera")
+                                      : nullptr};
   std::string ids;
   int count = 0;
   for (XmlCamera c = xml; c.camera; c.camera = c.camera->NextSiblingElement("camera"), ++count)
@@ -101,14 +105,16 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
     while (xml.camera && !(xml.List("id").size() == 1 && xml.List("id")[0] == options.camera_id))
       xml.camera = xml.camera->NextSiblingElement("camera");
   } else if (count > 1) {
-    ThrowInputError({path, root->GetLineNum()}, "holds " + std::to_string(count) +
-                                                    " cameras: name one with --camera (" + ids + ")");
+    ThrowInputError(
+        {path, root->GetLineNum()},
+        "holds " + std::to_string(count) + " cameras: name one with --camera (" + ids + ")");
   }
   if (!xml.camera)
-    ThrowInputError({path, root ? root->GetLineNum() : 0},
-                    options.camera_id.empty()
-                        ? "no <document><cameras><camera> element (not a DBAT camera file)"
-                        : "no camera with <id>" + options.camera_id + "</id> (cameras: " + ids + ")");
+    ThrowInputError(
+        {path, root ? root->GetLineNum() : 0},
+        options.camera_id.empty()
+            ? "no <document><cameras><camera> element (not a DBAT camera file)"
+            : "no camera with <id>" + options.camera_id + "</id> (cameras: " + ids + ")");
   CameraFile file;
   const auto name = xml.List("name");
   file.name = name.empty() ? std::filesystem::path(path).stem().string() : name.front();
@@ -135,22 +141,27 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
   if (sensor[0] != "auto") {
     const auto sensor_w = ParseDouble(sensor[0]);
     if (!sensor_w || !(*sensor_w > 0 && *sensor_w <= 1000))
-      ThrowInputError(xml.Where(xml.Child("sensor")), "<sensor> width must be > 0 and <= 1000 mm (or auto)");
+      ThrowInputError(xml.Where(xml.Child("sensor")),
+                      "<sensor> width must be > 0 and <= 1000 mm (or auto)");
     s = (*sensor_w / width) / pixel;
   }
   if (xml.Child("aspect")) {
     const double aspect = xml.Numbers("aspect", 1, 10)[0];
     if (!(aspect > 0)) ThrowInputError(xml.Where(xml.Child("aspect")), "<aspect> must be > 0");
-    if (sensor[0] == "auto") s = 2.0 - aspect;
+    if (sensor[0] == "auto")
+      s = 2.0 - aspect;
     else if (std::abs(s - (2.0 - aspect)) > 1e-6)
       ThrowInputError(xml.Where(xml.Child("aspect")),
-                      "<aspect> " + FormatNumber(aspect) + " contradicts the sensor width (pixel "
-                      "width / height " + FormatNumber(s) + ")");
+                      "<aspect> " + FormatNumber(aspect) +
+                          " contradicts the sensor width (pixel "
+                          "width / height " +
+                          FormatNumber(s) + ")");
   }
   double c = xml.Child("cc") ? xml.Numbers("cc", 1, 1e4)[0] : 0.0;
   if (c == 0) c = xml.Numbers("focal", 1, 1e4)[0];
   if (!(c > 0))
-    ThrowInputError(xml.Where(xml.Child(xml.Child("cc") ? "cc" : "focal")), "<cc>/<focal> must be > 0 mm");
+    ThrowInputError(xml.Where(xml.Child(xml.Child("cc") ? "cc" : "focal")),
+                    "<cc>/<focal> must be > 0 mm");
   auto pp = xml.Child("pp") ? xml.Numbers("pp", 2, 1e4) : std::vector<double>{0, 0};
   if (pp[0] == 0 && pp[1] == 0) {
     pp = {s * w_mm / 2, h_mm / 2};
@@ -167,8 +178,8 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
   const auto p = xml.Numbers("P", 0, 1.0);
   for (size_t i = 0; i < p.size() && i < 2; ++i) file.camera.params[Model::kP1 + i] = p[i];
   if (s != 1.0)
-    file.notes.push_back("DBAT pixel aspect (width / height " + FormatNumber(s) + ") read as B1 = " +
-                         FormatNumber(s - 1.0) + ": not exact, " +
+    file.notes.push_back("DBAT pixel aspect (width / height " + FormatNumber(s) +
+                         ") read as B1 = " + FormatNumber(s - 1.0) + ": not exact, " +
                          FormatNumber(internal::AspectAsB1ResidualPx(file.camera, s), 3) +
                          " px max over the format (DBAT's K, P act on the scaled x)");
   return file;
@@ -185,7 +196,8 @@ void WriteDbatCameraXml(const std::string& path, const CameraFile& file) {
   const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
   out << "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n<document dbat_camera_version=\"1.0\">\n"
-      << "   <cameras>\n      <camera>\n         <id>1</id>\n         <name>" << internal::XmlEscaped(internal::OneLine(file.name))
+      << "   <cameras>\n      <camera>\n         <id>1</id>\n         <name>"
+      << internal::XmlEscaped(internal::OneLine(file.name))
       << "</name>\n         <unit>mm</unit>\n         <calibrated>yes</calibrated>\n"
       << "         <sensor>" << n(w_mm) << "," << n(h_mm) << "</sensor>\n         <image>"
       << f.width_px << "," << f.height_px << "</image>\n         <aspect>" << n(2.0 - s)

@@ -7,21 +7,22 @@
 // point: cx_opencv = W / 2 + cx, cy_opencv = H / 2 + cy (which centre is meant is not stated;
 // (W - 1) / 2 would move it by 0.5 px). Input: a DJI JPEG (the XMP packet is found in the file;
 // the size from its SOF marker; calib/metadata/image_metadata.h: the properties are matched by
-// namespace URI, whatever prefix the file binds), an XMP sidecar, or a text file holding the string (then
+// namespace URI, whatever prefix the file binds), an XMP sidecar, or a text file holding the string
+// (then
 // --width/--height). CalibratedFocalLength and CalibratedOpticalCenterX/Y (design values) are
 // reported as notes. A text file may hold several records as exiftool prints them (default print
 // names "Dewarp Data : ...", -s tag names, -G group prefixes, "======== FILE" blocks with their
 // Image Width / Height) or bare lines; --camera picks one by file, date or number, identical
 // records are one camera (said). The date of the record is the camera's name and is written back.
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/metadata/image_metadata.h"
+
 #include <cctype>
 #include <cmath>
 #include <regex>
 #include <sstream>
-
-#include "calib/camera/formats/camera_formats.h"
-#include "calib/metadata/image_metadata.h"
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
 
 namespace aerocal::calib {
 
@@ -34,18 +35,22 @@ std::string TrimBlanks(const std::string& s) {
 
 }  // namespace
 
-ModelCamera DjiDewarpDataCamera(const std::string& text, const SourceRef& where, int width_px,
+ModelCamera DjiDewarpDataCamera(const std::string& text,
+                                const SourceRef& where,
+                                int width_px,
                                 int height_px) {
   std::string values = TrimBlanks(text);
   const size_t semicolon = values.find(';');
   if (semicolon != std::string::npos) values = values.substr(semicolon + 1);  // the date
   const std::vector<std::string> fields = SplitCommaList(values, {true, true});
   if (fields.size() != 9 && fields.size() != 12)
-    ThrowInputError(where, "DewarpData must hold 9 values (fx,fy,cx,cy,k1,k2,p1,p2,k3) or 12 "
-                           "(DewarpDataK6: ...,k4,k5,k6); got " +
-                               std::to_string(fields.size()));
+    ThrowInputError(where,
+                    "DewarpData must hold 9 values (fx,fy,cx,cy,k1,k2,p1,p2,k3) or 12 "
+                    "(DewarpDataK6: ...,k4,k5,k6); got " +
+                        std::to_string(fields.size()));
   std::vector<double> v;
-  for (const std::string& f : fields) v.push_back(internal::ParseNumber(f, where, "DewarpData value", 1e7));
+  for (const std::string& f : fields)
+    v.push_back(internal::ParseNumber(f, where, "DewarpData value", 1e7));
   if (!(v[0] > 0 && v[1] > 0)) ThrowInputError(where, "DewarpData fx, fy must be > 0 px");
   using O = OpenCvModel;
   ModelCamera camera;
@@ -89,7 +94,8 @@ std::string Date(const std::string& data) {
 std::string KeyOf(const std::string& key) {
   std::string out;
   for (char c : key)
-    if (c != ' ' && c != '\t') out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+    if (c != ' ' && c != '\t')
+      out += static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
   if (!out.empty() && out[0] == '[' && out.find(']') != std::string::npos)  // -G: "[XMP] "
     out = out.substr(out.find(']') + 1);
   return out;
@@ -106,12 +112,16 @@ std::vector<DewarpRecord> TextRecords(const std::string& path, const std::string
   std::vector<std::string> design;
   // A block's width or height given again (exiftool prints Image Width and Exif Image Width) must
   // agree with the first: two values are an error, not the last one taken.
-  const auto size = [&](const std::string& value, const SourceRef& where, const char* what, int* slot,
+  const auto size = [&](const std::string& value,
+                        const SourceRef& where,
+                        const char* what,
+                        int* slot,
                         int* slot_line) {
     const int v = static_cast<int>(internal::ParseNumber(value, where, what, 1e6));
     if (*slot != 0 && v != *slot)
-      ThrowInputError(where, std::string(what) + " " + std::to_string(v) + " contradicts " +
-                                 std::to_string(*slot) + " on line " + std::to_string(*slot_line));
+      ThrowInputError(where,
+                      std::string(what) + " " + std::to_string(v) + " contradicts " +
+                          std::to_string(*slot) + " on line " + std::to_string(*slot_line));
     *slot = v;
     *slot_line = where.line;
   };
@@ -133,11 +143,13 @@ std::vector<DewarpRecord> TextRecords(const std::string& path, const std::string
       design.clear();
       continue;
     }
-    static const std::regex kSummary(R"(\d+ (image |directories |)files? .*|\d+ directories scanned)");
+    static const std::regex kSummary(
+        R"(\d+ (image |directories |)files? .*|\d+ directories scanned)");
     if (std::regex_match(line, kSummary)) continue;  // exiftool's "2 image files read"
     const size_t colon = line.find(':');
     const size_t semicolon = line.find(';');
-    const bool tag = colon != std::string::npos && (semicolon == std::string::npos || colon < semicolon);
+    const bool tag =
+        colon != std::string::npos && (semicolon == std::string::npos || colon < semicolon);
     const std::string key = tag ? KeyOf(line.substr(0, colon)) : "dewarpdata";
     const std::string value = tag ? TrimBlanks(line.substr(colon + 1)) : line;
     if (!tag && line.find(',') == std::string::npos)
@@ -165,15 +177,18 @@ CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& o
   int file_width = 0, file_height = 0;
   const bool image = IsJpegOrTiff(bytes);
   std::vector<DewarpRecord> records;
-  if (const std::optional<XmpPacket> xmp = XmpOfCameraFile(bytes, path, &file_width, &file_height)) {
+  if (const std::optional<XmpPacket> xmp =
+          XmpOfCameraFile(bytes, path, &file_width, &file_height)) {
     // A JPEG's or TIFF's XMP packet, or a sidecar: properties by namespace URI, not by prefix.
     const XmpProperty* data = xmp->Find(xmp_ns::kDji, "DewarpDataK6");
     if (!data) data = xmp->Find(xmp_ns::kDji, "DewarpData");
     if (!data)
-      ThrowInputError({path, image ? 0 : 1}, std::string("no DewarpData of namespace ") + xmp_ns::kDji +
-                                                 " in the file's XMP");
+      ThrowInputError(
+          {path, image ? 0 : 1},
+          std::string("no DewarpData of namespace ") + xmp_ns::kDji + " in the file's XMP");
     DewarpRecord r{"", data->value, image ? 0 : data->where.line, 0, 0, {}};
-    for (const char* design : {"CalibratedFocalLength", "CalibratedOpticalCenterX", "CalibratedOpticalCenterY"})
+    for (const char* design :
+         {"CalibratedFocalLength", "CalibratedOpticalCenterX", "CalibratedOpticalCenterY"})
       if (const XmpProperty* p = xmp->Find(xmp_ns::kDji, design))
         r.design.push_back(std::string(design) + " = " + p->value + " px (design value, not used)");
     const XmpProperty* w = xmp->Find(xmp_ns::kTiff, "ImageWidth");
@@ -194,7 +209,9 @@ CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& o
   std::string ids;
   for (size_t k = 0; k < records.size(); ++k) {
     const DewarpRecord& r = records[k];
-    const std::string id = !r.file.empty() ? r.file : !Date(r.data).empty() ? Date(r.data) : std::to_string(k + 1);
+    const std::string id = !r.file.empty()         ? r.file
+                           : !Date(r.data).empty() ? Date(r.data)
+                                                   : std::to_string(k + 1);
     ids += (ids.empty() ? "" : ", ") + std::to_string(k + 1) + " (" + id + ")";
   }
   if (!options.camera_id.empty()) {
@@ -203,16 +220,20 @@ CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& o
       if (records[k].file == options.camera_id || Date(records[k].data) == options.camera_id ||
           std::to_string(k + 1) == options.camera_id)
         picked = &records[k];
-    if (!picked) ThrowInputError({path, 1}, "no DewarpData record " + options.camera_id + " (records: " + ids + ")");
+    if (!picked)
+      ThrowInputError({path, 1},
+                      "no DewarpData record " + options.camera_id + " (records: " + ids + ")");
   } else if (records.size() > 1) {
     for (const DewarpRecord& r : records)
       if (r.data != records.front().data)
-        ThrowInputError({path, r.line}, "holds " + std::to_string(records.size()) +
-                                            " different DewarpData records: name one with --camera (" + ids + ")");
+        ThrowInputError({path, r.line},
+                        "holds " + std::to_string(records.size()) +
+                            " different DewarpData records: name one with --camera (" + ids + ")");
   }
   const SourceRef where{path, picked->line};
   CameraFile file;
-  if (picked->width == 0 && picked->height == 0 && (options.width_px == 0 || options.height_px == 0))
+  if (picked->width == 0 && picked->height == 0 &&
+      (options.width_px == 0 || options.height_px == 0))
     ThrowInputError(where, "the file gives no image size: pass --width and --height");
   internal::ResolveFormat(&file, options, where, picked->width, picked->height, 0.0);
   const PixelFrame frame = file.camera.frame;
@@ -222,7 +243,8 @@ CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& o
   file.chosen_by_camera_id = !options.camera_id.empty();
   file.notes = picked->design;
   if (records.size() > 1 && options.camera_id.empty())
-    file.notes.push_back(std::to_string(records.size()) + " DewarpData records, all the same: one camera");
+    file.notes.push_back(std::to_string(records.size()) +
+                         " DewarpData records, all the same: one camera");
   return file;
 }
 
@@ -241,15 +263,16 @@ void WriteDjiDewarpData(const std::string& path, const CameraFile& file) {
       << n(p[O::kP1]) << "," << n(p[O::kP2]) << "," << n(p[O::kK3]);
   if (k6) out << "," << n(p[O::kK4]) << "," << n(p[O::kK5]) << "," << n(p[O::kK6]);
   // An XMP sidecar: what a DJI JPEG carries, readable by this reader and by XMP tools.
-  WriteFileAtomically(path, std::string("<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n <rdf:RDF "
-                                        "xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
-                                        "  <rdf:Description xmlns:drone-dji=\"http://www.dji.com/drone-dji/1.0/\"\n"
-                                        "    xmlns:tiff=\"http://ns.adobe.com/tiff/1.0/\"\n"
-                                        "    tiff:ImageWidth=\"") +
-                                std::to_string(f.width_px) + "\" tiff:ImageLength=\"" +
-                                std::to_string(f.height_px) + "\"\n    drone-dji:" +
-                                (k6 ? "DewarpDataK6" : "DewarpData") + "=\"" + out.str() +
-                                "\"/>\n </rdf:RDF>\n</x:xmpmeta>\n");
+  WriteFileAtomically(
+      path,
+      std::string("<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n <rdf:RDF "
+                  "xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
+                  "  <rdf:Description xmlns:drone-dji=\"http://www.dji.com/drone-dji/1.0/\"\n"
+                  "    xmlns:tiff=\"http://ns.adobe.com/tiff/1.0/\"\n"
+                  "    tiff:ImageWidth=\"") +
+          std::to_string(f.width_px) + "\" tiff:ImageLength=\"" + std::to_string(f.height_px) +
+          "\"\n    drone-dji:" + (k6 ? "DewarpDataK6" : "DewarpData") + "=\"" + out.str() +
+          "\"/>\n </rdf:RDF>\n</x:xmpmeta>\n");
 }
 
 }  // namespace aerocal::calib

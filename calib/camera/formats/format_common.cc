@@ -1,47 +1,58 @@
 // What the camera-format readers share (camera_formats.h).
-#include <charconv>
-#include <cmath>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/yaml_util.h"
 
+#include <charconv>
+#include <cmath>
+
 namespace aerocal::calib::internal {
 
-void ResolveFormat(CameraFile* file, const CameraReadOptions& options, const SourceRef& where,
-                   int file_width_px, int file_height_px, double file_pixel_size_mm) {
+void ResolveFormat(CameraFile* file,
+                   const CameraReadOptions& options,
+                   const SourceRef& where,
+                   int file_width_px,
+                   int file_height_px,
+                   double file_pixel_size_mm) {
   PixelFrame& frame = file->camera.frame;
   const auto pick = [&](int from_file, int given, const char* option) {
     if (from_file > 0 && given > 0 && from_file != given)
-      ThrowInputError(where, std::string("the file says ") + std::to_string(from_file) +
-                                 " px, " + option + " says " + std::to_string(given));
+      ThrowInputError(where,
+                      std::string("the file says ") + std::to_string(from_file) + " px, " + option +
+                          " says " + std::to_string(given));
     const int value = from_file > 0 ? from_file : given;
     if (value <= 0)
       ThrowInputError(where, std::string("the file gives no image size: pass ") + option);
-    if (value > 1000000) ThrowInputError(where, std::string("image size above 1e6 px (") + option + ")");
+    if (value > 1000000)
+      ThrowInputError(where, std::string("image size above 1e6 px (") + option + ")");
     return value;
   };
   frame.width_px = pick(file_width_px, options.width_px, "--width");
   frame.height_px = pick(file_height_px, options.height_px, "--height");
   if (file_pixel_size_mm > 0 && options.pixel_size_mm > 0 &&
       std::abs(file_pixel_size_mm - options.pixel_size_mm) > 1e-9 * file_pixel_size_mm)
-    ThrowInputError(where, "the file's pixel size " + FormatNumber(file_pixel_size_mm) +
-                               " mm contradicts --pixel-size-mm " + FormatNumber(options.pixel_size_mm));
+    ThrowInputError(where,
+                    "the file's pixel size " + FormatNumber(file_pixel_size_mm) +
+                        " mm contradicts --pixel-size-mm " + FormatNumber(options.pixel_size_mm));
   const double p = file_pixel_size_mm > 0 ? file_pixel_size_mm : options.pixel_size_mm;
   file->pixel_size_known = p > 0;
   frame.pixel_size_mm = p > 0 ? p : kPlaceholderPixelSizeMm;
   if (!(frame.pixel_size_mm >= 1e-5 && frame.pixel_size_mm <= 1.0))
-    ThrowInputError(where, "pixel size must be within 1e-5 .. 1 mm (got " +
-                               FormatNumber(frame.pixel_size_mm) + ")");
+    ThrowInputError(
+        where,
+        "pixel size must be within 1e-5 .. 1 mm (got " + FormatNumber(frame.pixel_size_mm) + ")");
 }
 
-double ParseNumber(const std::string& text, const SourceRef& where, const std::string& what,
+double ParseNumber(const std::string& text,
+                   const SourceRef& where,
+                   const std::string& what,
                    double bound) {
   const auto value = ParseDouble(text);
   if (!value || !(std::abs(*value) <= bound))
-    ThrowInputError(where, what + " must be a number within +-" + FormatNumber(bound) +
-                               " (got '" + text + "')");
+    ThrowInputError(
+        where,
+        what + " must be a number within +-" + FormatNumber(bound) + " (got '" + text + "')");
   return *value;
 }
 
@@ -53,7 +64,8 @@ double Param(const ModelCamera& camera, std::string_view name) {
                    std::string(name));
 }
 
-void RequireZero(const ModelCamera& camera, const std::vector<std::string>& names,
+void RequireZero(const ModelCamera& camera,
+                 const std::vector<std::string>& names,
                  const std::string& format) {
   for (const std::string& name : names)
     AEROCAL_CHECK(Param(camera, name) == 0.0)
@@ -93,12 +105,23 @@ std::string XmlEscaped(std::string_view text) {
   std::string out;
   for (const char c : text) {
     switch (c) {
-      case '&': out += "&amp;"; break;
-      case '<': out += "&lt;"; break;
-      case '>': out += "&gt;"; break;
-      case '"': out += "&quot;"; break;
-      case '\'': out += "&apos;"; break;
-      default: out += c;
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      case '\'':
+        out += "&apos;";
+        break;
+      default:
+        out += c;
     }
   }
   return out;

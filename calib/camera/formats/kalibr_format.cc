@@ -4,12 +4,12 @@
 // OpenCV fisheye), resolution [W, H]; other keys (T_cam_imu, rostopic, cam_overlaps, ...) are
 // kept out. Pixels as OpenCV (pixel centres at integer coordinates), so the opencv /
 // opencv_fisheye models hold a Kalibr camera exactly.
-#include <regex>
-#include <sstream>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/yaml_util.h"
+
+#include <regex>
+#include <sstream>
 
 namespace aerocal::calib {
 
@@ -20,14 +20,16 @@ CameraFile ReadKalibrCamchain(const std::string& path, const CameraReadOptions& 
   for (const auto& entry : root) ids += (ids.empty() ? "" : ", ") + entry.first.Scalar();
   if (id.empty()) {
     if (root.size() != 1)
-      ThrowInputError({path, 1}, "holds " + std::to_string(root.size()) +
-                                     " cameras: name one with --camera (" + ids + ")");
+      ThrowInputError({path, 1},
+                      "holds " + std::to_string(root.size()) +
+                          " cameras: name one with --camera (" + ids + ")");
     id = root.begin()->first.Scalar();
   }
   const YAML::Node cam = root[id];
   if (!cam) ThrowInputError({path, 1}, "no camera '" + id + "' (cameras: " + ids + ")");
   if (!cam.IsMap()) ThrowInputError(WhereIs(cam, path), id + " must be a map");
-  for (const char* key : {"camera_model", "intrinsics", "distortion_model", "distortion_coeffs", "resolution"})
+  for (const char* key :
+       {"camera_model", "intrinsics", "distortion_model", "distortion_coeffs", "resolution"})
     if (!cam[key]) ThrowInputError(WhereIs(cam, path), id + " needs '" + key + "'");
   const std::string camera_model = YamlString(cam["camera_model"], path, "camera_model");
   if (camera_model != "pinhole")
@@ -36,13 +38,15 @@ CameraFile ReadKalibrCamchain(const std::string& path, const CameraReadOptions& 
   const auto list = [&](const char* key, size_t n) {
     const YAML::Node node = cam[key];
     if (!node.IsSequence() || node.size() != n)
-      ThrowInputError(WhereIs(node, path), std::string(key) + " must hold " + std::to_string(n) + " values");
+      ThrowInputError(WhereIs(node, path),
+                      std::string(key) + " must hold " + std::to_string(n) + " values");
     std::vector<double> v;
     for (const auto& x : node) v.push_back(YamlBounded(x, path, key, -1e7, 1e7));
     return v;
   };
   const std::vector<double> k = list("intrinsics", 4);
-  if (!(k[0] > 0 && k[1] > 0)) ThrowInputError(WhereIs(cam["intrinsics"], path), "fu, fv must be > 0 px");
+  if (!(k[0] > 0 && k[1] > 0))
+    ThrowInputError(WhereIs(cam["intrinsics"], path), "fu, fv must be > 0 px");
   const std::vector<double> size = list("resolution", 2);
   const std::string distortion = YamlString(cam["distortion_model"], path, "distortion_model");
   CameraFile file;
@@ -62,8 +66,12 @@ CameraFile ReadKalibrCamchain(const std::string& path, const CameraReadOptions& 
   }
   if (size[0] != static_cast<int>(size[0]) || size[1] != static_cast<int>(size[1]))
     ThrowInputError(WhereIs(cam["resolution"], path), "resolution must be integers");
-  internal::ResolveFormat(&file, options, WhereIs(cam["resolution"], path),
-                          static_cast<int>(size[0]), static_cast<int>(size[1]), 0.0);
+  internal::ResolveFormat(&file,
+                          options,
+                          WhereIs(cam["resolution"], path),
+                          static_cast<int>(size[0]),
+                          static_cast<int>(size[1]),
+                          0.0);
   return file;
 }
 
@@ -71,7 +79,8 @@ void WriteKalibrCamchain(const std::string& path, const CameraFile& file) {
   const std::vector<double>& p = file.camera.params;
   const auto n = [](double v) { return internal::ShortestNumber(v); };
   // The camera's key survives (cam1 of a camchain); another name is written as cam0.
-  const std::string key = std::regex_match(file.name, std::regex("cam[0-9]{1,3}")) ? file.name : "cam0";
+  const std::string key =
+      std::regex_match(file.name, std::regex("cam[0-9]{1,3}")) ? file.name : "cam0";
   std::ostringstream out;
   out << key << ":\n  camera_model: pinhole\n  intrinsics: [" << n(p[0]) << ", " << n(p[1]) << ", "
       << n(p[2]) << ", " << n(p[3]) << "]\n";

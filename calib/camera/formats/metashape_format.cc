@@ -1,8 +1,9 @@
 // Agisoft Metashape / PhotoScan camera calibration, in every form the programs write it:
 // - the calibration export (Tools > Camera Calibration > Export, "Agisoft Camera Calibration
-//   (*.xml)"): <calibration> with <projection>frame</projection>, <width>, <height>, Metashape >= 1.3
-//   <f>, <cx>, <cy> (offsets from the image centre), <b1>, <b2>, <k1>-<k4>, <p1>-<p4> (absent = 0),
-//   and after an adjustment <covariance><params>f cx cy ...</params><coeffs>row-major</coeffs>;
+//   (*.xml)"): <calibration> with <projection>frame</projection>, <width>, <height>, Metashape
+//   >= 1.3 <f>, <cx>, <cy> (offsets from the image centre), <b1>, <b2>, <k1>-<k4>, <p1>-<p4>
+//   (absent = 0), and after an adjustment <covariance><params>f cx cy
+//   ...</params><coeffs>row-major</coeffs>;
 // - PhotoScan <= 1.2's form of the same element: <fx>, <fy>, ABSOLUTE <cx>, <cy> (pixels from the
 //   image corner), <skew>, <k1>-<k4>, <p1>, <p2> (no <f>). As Metashape's model it is
 //   f = fy, b1 = fx - fy, b2 = skew, cx - W / 2, cy - H / 2 (the corner origin and the pixel
@@ -20,17 +21,16 @@
 // unknown or missing id lists the ids and labels. Rules of issue 37: a duplicated element, a
 // duplicated calibration class, an empty or non-finite number, a pixel size <= 0 are errors
 // naming the file (or archive member) and line. Parameters in models/metashape.h's conventions.
-#include <cmath>
-#include <filesystem>
-#include <functional>
-#include <sstream>
-
-#include <tinyxml2.h>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/camera/formats/zip_archive.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <sstream>
+#include <tinyxml2.h>
 
 namespace aerocal::calib {
 namespace {
@@ -89,13 +89,15 @@ std::vector<XmlSource> LoadDocuments(const std::string& path) {
       const std::filesystem::path file =
           p.parent_path() / (p.stem().string() + ".files") / chunk_path;
       if (!std::filesystem::is_regular_file(file))
-        ThrowInputError({path, line}, "the project's chunk " + file.string() +
-                                          " is missing (a .psx needs its .files folder)");
+        ThrowInputError({path, line},
+                        "the project's chunk " + file.string() +
+                            " is missing (a .psx needs its .files folder)");
       chunk_bytes = ReadTextFile(file.string());
       where = file.string();
     }
     if (internal::LooksLikeZip(chunk_bytes)) {
-      docs.push_back(Parse(internal::ReadZipMember(chunk_bytes, "doc.xml", where), where + "!doc.xml"));
+      docs.push_back(
+          Parse(internal::ReadZipMember(chunk_bytes, "doc.xml", where), where + "!doc.xml"));
     } else {
       docs.push_back(Parse(chunk_bytes, where));
     }
@@ -118,7 +120,8 @@ struct Chosen {
 };
 
 // The sensor --camera names (or the only one) of all documents.
-Chosen ChooseSensor(const std::vector<XmlSource>& docs, const std::string& path,
+Chosen ChooseSensor(const std::vector<XmlSource>& docs,
+                    const std::string& path,
                     const CameraReadOptions& options) {
   struct Entry {
     const XmlSource* source;
@@ -131,7 +134,8 @@ Chosen ChooseSensor(const std::vector<XmlSource>& docs, const std::string& path,
     std::vector<const XMLElement*> sensors;
     CollectSensors(d.doc->RootElement(), &sensors);
     documents_with_sensors += !sensors.empty();
-    for (const XMLElement* s : sensors) entries.push_back({&d, s, s->Attribute("id") ? s->Attribute("id") : ""});
+    for (const XMLElement* s : sensors)
+      entries.push_back({&d, s, s->Attribute("id") ? s->Attribute("id") : ""});
   }
   if (documents_with_sensors > 1)
     for (Entry& e : entries) {
@@ -145,8 +149,9 @@ Chosen ChooseSensor(const std::vector<XmlSource>& docs, const std::string& path,
   if (entries.empty()) {
     const XMLElement* root = docs[0].doc->RootElement();
     if (std::string(root->Name()) == "calibration") return {&docs[0], nullptr, root};
-    ThrowInputError(docs[0].At(root), "no <calibration> or <sensor> element (not a Metashape "
-                                      "calibration, cameras or project file)");
+    ThrowInputError(docs[0].At(root),
+                    "no <calibration> or <sensor> element (not a Metashape "
+                    "calibration, cameras or project file)");
   }
   std::string ids;
   const Entry* found = nullptr;
@@ -159,23 +164,27 @@ Chosen ChooseSensor(const std::vector<XmlSource>& docs, const std::string& path,
     }
   }
   if (!found)
-    ThrowInputError({path, 1}, options.camera_id.empty()
-                                   ? "holds " + std::to_string(entries.size()) +
-                                         " sensors: name one with --camera (" + ids + ")"
-                                   : "no sensor id " + options.camera_id + " (sensors: " + ids + ")");
+    ThrowInputError({path, 1},
+                    options.camera_id.empty()
+                        ? "holds " + std::to_string(entries.size()) +
+                              " sensors: name one with --camera (" + ids + ")"
+                        : "no sensor id " + options.camera_id + " (sensors: " + ids + ")");
   return {found->source, found->sensor, nullptr};
 }
 
 // The adjusted calibration of a sensor, else the initial one (said).
-const XMLElement* ChooseCalibration(const XmlSource& s, const XMLElement* sensor,
+const XMLElement* ChooseCalibration(const XmlSource& s,
+                                    const XMLElement* sensor,
                                     std::vector<std::string>* notes) {
   const XMLElement *adjusted = nullptr, *initial = nullptr, *other = nullptr;
-  for (auto* c = sensor->FirstChildElement("calibration"); c; c = c->NextSiblingElement("calibration")) {
+  for (auto* c = sensor->FirstChildElement("calibration"); c;
+       c = c->NextSiblingElement("calibration")) {
     const std::string cls = c->Attribute("class") ? c->Attribute("class") : "";
     const XMLElement*& slot = cls == "adjusted" ? adjusted : cls == "initial" ? initial : other;
     if (slot)
-      ThrowInputError(s.At(c), "a second <calibration" + (cls.empty() ? "" : " class=\"" + cls + "\"") +
-                                   "> in the sensor");
+      ThrowInputError(s.At(c),
+                      "a second <calibration" + (cls.empty() ? "" : " class=\"" + cls + "\"") +
+                          "> in the sensor");
     slot = c;
   }
   if (adjusted && initial)
@@ -211,11 +220,14 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
   };
   // The projection: <projection> text (calibration file) or the type attribute (project).
   std::string projection = "frame";
-  if (const auto* p = Only(s, calibration, "projection")) projection = p->GetText() ? p->GetText() : "";
-  else if (const char* type = calibration->Attribute("type")) projection = type;
+  if (const auto* p = Only(s, calibration, "projection"))
+    projection = p->GetText() ? p->GetText() : "";
+  else if (const char* type = calibration->Attribute("type"))
+    projection = type;
   if (projection != "frame")
-    ThrowInputError(s.At(calibration), "projection '" + projection +
-                                           "' is not supported (only Metashape's frame camera)");
+    ThrowInputError(
+        s.At(calibration),
+        "projection '" + projection + "' is not supported (only Metashape's frame camera)");
   const auto integer = [&](const XMLElement* e, const char* text, const char* what) {
     const double v = internal::ParseNumber(text ? text : "", s.At(e), what, 1e6);
     if (!(v >= 1) || v != std::floor(v))
@@ -230,27 +242,31 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
       const int w = integer(r, r->Attribute("width"), "resolution width");
       const int h = integer(r, r->Attribute("height"), "resolution height");
       if (width != 0 && (w != width || h != height))
-        ThrowInputError(s.At(r), "resolution " + std::to_string(w) + " x " + std::to_string(h) +
-                                     " contradicts the calibration's " + std::to_string(width) +
-                                     " x " + std::to_string(height));
+        ThrowInputError(s.At(r),
+                        "resolution " + std::to_string(w) + " x " + std::to_string(h) +
+                            " contradicts the calibration's " + std::to_string(width) + " x " +
+                            std::to_string(height));
       width = w, height = h;
     }
   double pixel_size = 0;
   if (sensor) {
     double pixel_height = 0;
-    for (auto* p = sensor->FirstChildElement("property"); p; p = p->NextSiblingElement("property")) {
+    for (auto* p = sensor->FirstChildElement("property"); p;
+         p = p->NextSiblingElement("property")) {
       const std::string name = p->Attribute("name") ? p->Attribute("name") : "";
       if (name != "pixel_width" && name != "pixel_height") continue;
-      const double v = internal::ParseNumber(p->Attribute("value") ? p->Attribute("value") : "",
-                                             s.At(p), name, 1.0);
+      const double v = internal::ParseNumber(
+          p->Attribute("value") ? p->Attribute("value") : "", s.At(p), name, 1.0);
       if (!(v > 0)) ThrowInputError(s.At(p), name + " must be > 0 mm");
       double& slot = name == "pixel_width" ? pixel_size : pixel_height;
       if (slot) ThrowInputError(s.At(p), name + " occurs twice");
       slot = v;
     }
-    if (pixel_height > 0 && pixel_size > 0 && std::abs(pixel_height - pixel_size) > 1e-9 * pixel_size)
-      file.notes.push_back("pixel_height " + FormatNumber(pixel_height) + " mm differs from pixel_width " +
-                           FormatNumber(pixel_size) + " mm: pixel_width used (the rest is b1)");
+    if (pixel_height > 0 && pixel_size > 0 &&
+        std::abs(pixel_height - pixel_size) > 1e-9 * pixel_size)
+      file.notes.push_back("pixel_height " + FormatNumber(pixel_height) +
+                           " mm differs from pixel_width " + FormatNumber(pixel_size) +
+                           " mm: pixel_width used (the rest is b1)");
     if (pixel_size == 0 && pixel_height > 0)
       ThrowInputError(s.At(sensor), "the sensor gives pixel_height but no pixel_width");
   }
@@ -259,8 +275,10 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
   const XMLElement* fx = Only(s, calibration, "fx");
   const XMLElement* fy = Only(s, calibration, "fy");
   const bool old_form = fx || fy;
-  if (f && old_form) ThrowInputError(s.At(fx ? fx : fy), "both <f> and <fx>/<fy>: not one of Metashape's forms");
-  if (!f && !(fx && fy)) ThrowInputError(s.At(calibration), "missing <f> (or PhotoScan's <fx> and <fy>)");
+  if (f && old_form)
+    ThrowInputError(s.At(fx ? fx : fy), "both <f> and <fx>/<fy>: not one of Metashape's forms");
+  if (!f && !(fx && fy))
+    ThrowInputError(s.At(calibration), "missing <f> (or PhotoScan's <fx> and <fy>)");
   file.camera.model = M::kId;
   file.camera.params.assign(M::kNumParams, 0.0);
   std::vector<double>& p = file.camera.params;
@@ -270,7 +288,8 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
     if (const auto* e = Only(s, calibration, tag.c_str())) p[i] = number(e, "<" + tag + ">", 1e7);
   }
   if (old_form) {
-    if (width == 0) ThrowInputError(s.At(calibration), "PhotoScan's absolute cx, cy need the <resolution>");
+    if (width == 0)
+      ThrowInputError(s.At(calibration), "PhotoScan's absolute cx, cy need the <resolution>");
     const double fx_px = number(fx, "<fx>", 1e7), fy_px = number(fy, "<fy>", 1e7);
     if (!(fx_px > 0 && fy_px > 0)) ThrowInputError(s.At(fx), "<fx>, <fy> must be > 0 px");
     p[M::kF] = fy_px;
@@ -280,9 +299,11 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
     p[M::kCy] -= 0.5 * height;
     for (const char* tag : {"b1", "b2", "p3", "p4"})
       if (Only(s, calibration, tag))
-        ThrowInputError(s.At(Only(s, calibration, tag)), std::string("<") + tag + "> beside <fx>: not one of Metashape's forms");
-    file.notes.push_back("PhotoScan <= 1.2 calibration (fx, fy, absolute cx, cy, skew) read as "
-                         "f = fy, b1 = fx - fy, b2 = skew, cx - W/2, cy - H/2");
+        ThrowInputError(s.At(Only(s, calibration, tag)),
+                        std::string("<") + tag + "> beside <fx>: not one of Metashape's forms");
+    file.notes.push_back(
+        "PhotoScan <= 1.2 calibration (fx, fy, absolute cx, cy, skew) read as "
+        "f = fy, b1 = fx - fy, b2 = skew, cx - W/2, cy - H/2");
   } else {
     p[M::kF] = number(f, "<f>", 1e7);
     if (!(p[M::kF] > 0)) ThrowInputError(s.At(f), "<f> must be > 0 px");
@@ -290,8 +311,10 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
   // Covariance: in the calibration, or beside it in the sensor (it belongs to the adjusted one).
   const XMLElement* cov = Only(s, calibration, "covariance");
   if (!cov && sensor && Only(s, sensor, "covariance")) {
-    if (calibration->Attribute("class") && std::string(calibration->Attribute("class")) == "initial")
-      file.notes.push_back("the sensor's covariance (of the adjusted calibration) not read with the initial one");
+    if (calibration->Attribute("class") &&
+        std::string(calibration->Attribute("class")) == "initial")
+      file.notes.push_back(
+          "the sensor's covariance (of the adjusted calibration) not read with the initial one");
     else
       cov = Only(s, sensor, "covariance");
   }
@@ -303,19 +326,26 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
     const std::vector<std::string> values = Words(coeffs->GetText());
     const size_t n = names.size();
     if (n == 0 || values.size() != n * n)
-      ThrowInputError(s.At(coeffs), "<coeffs> must hold " + std::to_string(n) + "^2 = " +
-                                        std::to_string(n * n) + " values (got " +
-                                        std::to_string(values.size()) + ")");
-    // The linear map from the file's parameters to ours (identity but for PhotoScan's fx, fy, skew).
+      ThrowInputError(s.At(coeffs),
+                      "<coeffs> must hold " + std::to_string(n) + "^2 = " + std::to_string(n * n) +
+                          " values (got " + std::to_string(values.size()) + ")");
+    // The linear map from the file's parameters to ours (identity but for PhotoScan's fx, fy,
+    // skew).
     Eigen::MatrixXd map = Eigen::MatrixXd::Zero(M::kNumParams, n);
     for (size_t j = 0; j < n; ++j) {
       for (size_t i = 0; i < j; ++i)
-        if (names[i] == names[j]) ThrowInputError(s.At(params), "'" + names[j] + "' twice in <params>");
-      if (old_form && names[j] == "fx") map(M::kB1, j) = 1;
-      else if (old_form && names[j] == "fy") map(M::kF, j) = 1, map(M::kB1, j) = -1;
-      else if (old_form && names[j] == "skew") map(M::kB2, j) = 1;
-      else if (const int k = IndexOfParam(M::kParams, names[j]); k >= 0) map(k, j) = 1;
-      else ThrowInputError(s.At(params), "unknown parameter '" + names[j] + "' in <params>");
+        if (names[i] == names[j])
+          ThrowInputError(s.At(params), "'" + names[j] + "' twice in <params>");
+      if (old_form && names[j] == "fx")
+        map(M::kB1, j) = 1;
+      else if (old_form && names[j] == "fy")
+        map(M::kF, j) = 1, map(M::kB1, j) = -1;
+      else if (old_form && names[j] == "skew")
+        map(M::kB2, j) = 1;
+      else if (const int k = IndexOfParam(M::kParams, names[j]); k >= 0)
+        map(k, j) = 1;
+      else
+        ThrowInputError(s.At(params), "unknown parameter '" + names[j] + "' in <params>");
     }
     Eigen::MatrixXd c(n, n);
     for (size_t r = 0; r < n; ++r)

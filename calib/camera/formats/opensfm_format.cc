@@ -8,14 +8,14 @@
 // perspective (focal, k1, k2), simple_radial (focal, c_x, c_y, k1), radial (focal_x, focal_y,
 // c_x, c_y, k1, k2) and brown (+ p1, p2, k3) use OpenCV's formula: the opencv model, exactly;
 // fisheye (focal, k1, k2: theta_d = theta (1 + k1 theta^2 + k2 theta^4)) is opencv_fisheye.
-#include <algorithm>
-
-#include <nlohmann/json.hpp>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/json_file.h"
+
+#include <nlohmann/json.hpp>
+
+#include <algorithm>
 
 namespace aerocal::calib {
 namespace {
@@ -42,18 +42,23 @@ CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& 
   if (!cameras->is_object() || cameras->empty())
     ThrowInputError({path, 1}, "no cameras (expected {id: {projection_type, width, ...}})");
   std::string ids;
-  for (auto it = cameras->begin(); it != cameras->end(); ++it) ids += (ids.empty() ? "" : ", ") + it.key();
+  for (auto it = cameras->begin(); it != cameras->end(); ++it)
+    ids += (ids.empty() ? "" : ", ") + it.key();
   std::string id = options.camera_id;
   if (id.empty()) {
     if (cameras->size() > 1)
-      ThrowInputError({path, 1}, "holds " + std::to_string(cameras->size()) +
-                                     " cameras: name one with --camera (" + ids + ")");
+      ThrowInputError({path, 1},
+                      "holds " + std::to_string(cameras->size()) +
+                          " cameras: name one with --camera (" + ids + ")");
     id = cameras->begin().key();
   }
-  if (!cameras->contains(id)) ThrowInputError({path, 1}, "no camera '" + id + "' (cameras: " + ids + ")");
+  if (!cameras->contains(id))
+    ThrowInputError({path, 1}, "no camera '" + id + "' (cameras: " + ids + ")");
   const Json& c = (*cameras)[id];
   const size_t from = text.find("\"" + id + "\"");
-  const auto where = [&](const std::string& key) { return SourceRef{path, LineOfKey(text, key, from)}; };
+  const auto where = [&](const std::string& key) {
+    return SourceRef{path, LineOfKey(text, key, from)};
+  };
   if (!c.is_object()) ThrowInputError(where(id), "camera '" + id + "' is not an object");
   const auto number = [&](const std::string& key, double fallback) {
     if (!c.contains(key)) return fallback;
@@ -69,7 +74,8 @@ CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& 
       ThrowInputError(where(key), std::string(key) + " must be an integer within 1 .. 1e6");
     return static_cast<int>(v);
   };
-  if (!c.contains("width") || !c.contains("height")) ThrowInputError(where(id), "missing width/height");
+  if (!c.contains("width") || !c.contains("height"))
+    ThrowInputError(where(id), "missing width/height");
   const int w = size_of("width"), h = size_of("height");
   const double size = std::max(w, h);
   const double focal = number("focal", 0);
@@ -81,10 +87,16 @@ CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& 
   if (type == "fisheye") {
     using F = OpenCvFisheyeModel;
     file.camera.model = F::kId;
-    file.camera.params = {focal_x * size, focal_y * size, 0.5 * (w - 1) + number("c_x", 0) * size,
-                          0.5 * (h - 1) + number("c_y", 0) * size, number("k1", 0), number("k2", 0),
-                          0.0, 0.0};
-  } else if (type == "perspective" || type == "simple_radial" || type == "radial" || type == "brown") {
+    file.camera.params = {focal_x * size,
+                          focal_y * size,
+                          0.5 * (w - 1) + number("c_x", 0) * size,
+                          0.5 * (h - 1) + number("c_y", 0) * size,
+                          number("k1", 0),
+                          number("k2", 0),
+                          0.0,
+                          0.0};
+  } else if (type == "perspective" || type == "simple_radial" || type == "radial" ||
+             type == "brown") {
     using O = OpenCvModel;
     file.camera.model = O::kId;
     file.camera.params.assign(O::kNumParams, 0.0);
@@ -114,7 +126,8 @@ void WriteOpenSfmCameras(const std::string& path, const CameraFile& file) {
   Json c;
   c["width"] = f.width_px;
   c["height"] = f.height_px;
-  const double c_x = (p[2] - 0.5 * (f.width_px - 1)) / size, c_y = (p[3] - 0.5 * (f.height_px - 1)) / size;
+  const double c_x = (p[2] - 0.5 * (f.width_px - 1)) / size,
+               c_y = (p[3] - 0.5 * (f.height_px - 1)) / size;
   if (camera.model == OpenCvFisheyeModel::kId) {
     internal::RequireZero(camera, {"k3", "k4"}, "OpenSfM fisheye");
     AEROCAL_CHECK(p[0] == p[1] && c_x == 0 && c_y == 0) << "OpenSfM fisheye: fx = fy, centred";

@@ -25,30 +25,35 @@
 // lines with "Value: X mm" and "Deviation: Name: Y mm"; report_camera.cc), the same conventions.
 // Writing gives lines 1-5 with no photos: the camera as PhotoModeler's export holds it; that
 // PhotoModeler imports such a file is not verified (no PhotoModeler here).
-#include <cmath>
-#include <filesystem>
-#include <sstream>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+
+#include <cmath>
+#include <filesystem>
+#include <sstream>
 
 namespace aerocal::calib {
 namespace {
 
 using Model = BrownFraser10Model;
 
-std::vector<double> Numbers(const std::vector<std::string>& lines, int index, size_t count,
-                            const std::string& path, const std::string& what) {
+std::vector<double> Numbers(const std::vector<std::string>& lines,
+                            int index,
+                            size_t count,
+                            const std::string& path,
+                            const std::string& what) {
   const SourceRef where{path, index + 1};
   if (index >= static_cast<int>(lines.size()))
     ThrowInputError(where, "missing line " + std::to_string(index + 1) + " (" + what + ")");
   std::istringstream in(lines[index]);
   std::vector<double> out;
-  for (std::string token; in >> token;) out.push_back(internal::ParseNumber(token, where, what, 1e6));
+  for (std::string token; in >> token;)
+    out.push_back(internal::ParseNumber(token, where, what, 1e6));
   if (out.size() < count)
-    ThrowInputError(where, what + " needs " + std::to_string(count) + " numbers (got " +
-                               std::to_string(out.size()) + ")");
+    ThrowInputError(where,
+                    what + " needs " + std::to_string(count) + " numbers (got " +
+                        std::to_string(out.size()) + ")");
   return out;
 }
 
@@ -62,10 +67,12 @@ bool IsPhotoModelerReport(const std::string& head) {
 CameraFile ReadPhotoModelerCamera(const std::string& path, const CameraReadOptions& options) {
   const std::string text = ReadTextFile(path);
   const std::vector<std::string> lines = SplitLines(text);
-  if (IsPhotoModelerReport(text)) return internal::ReadReportCamera(path, lines, options, "PhotoModeler");
+  if (IsPhotoModelerReport(text))
+    return internal::ReadReportCamera(path, lines, options, "PhotoModeler");
   if (lines.empty() || lines[0].rfind("Bundle Soln", 0) != 0)
-    ThrowInputError({path, 1}, "not a PhotoModeler Bundle Soln export (line 1 must start with "
-                               "'Bundle Soln')");
+    ThrowInputError({path, 1},
+                    "not a PhotoModeler Bundle Soln export (line 1 must start with "
+                    "'Bundle Soln')");
   if (!options.camera_id.empty())
     ThrowInputError({path, 1}, "--camera: a Bundle Soln export holds one project camera");
   const std::vector<double> size = Numbers(lines, 1, 4, path, "tolerance, photos, width, height");
@@ -79,17 +86,23 @@ CameraFile ReadPhotoModelerCamera(const std::string& path, const CameraReadOptio
   if (!(fw > 0 && fh > 0)) ThrowInputError(where_cam, "format size must be > 0 mm");
   for (int i = 5; i < 10; ++i)
     if (!(std::abs(cam[i]) <= 1.0))
-      ThrowInputError(where_cam, "K1-K3, P1, P2 must be within +-1 (got " + FormatNumber(cam[i]) + ")");
+      ThrowInputError(where_cam,
+                      "K1-K3, P1, P2 must be within +-1 (got " + FormatNumber(cam[i]) + ")");
   CameraFile file;
-  file.name = lines[0].size() > 11 ? lines[0].substr(12) : std::filesystem::path(path).stem().string();
+  file.name =
+      lines[0].size() > 11 ? lines[0].substr(12) : std::filesystem::path(path).stem().string();
   const double pixel = fh / h;  // square pixels from the format height
-  internal::ResolveFormat(&file, options, where_size, static_cast<int>(w), static_cast<int>(h), pixel);
+  internal::ResolveFormat(
+      &file, options, where_size, static_cast<int>(w), static_cast<int>(h), pixel);
   const double p = file.camera.frame.pixel_size_mm;
   const double x_scale = fw / w;  // PhotoModeler's mm per pixel along x
   if (std::abs(x_scale / p - 1.0) > 1e-6)
     file.notes.push_back("PhotoModeler format width " + FormatNumber(fw) + " mm is " +
-                         FormatNumber(w * p) + " mm at the square pixel of the format height: x "
-                         "scale " + FormatNumber(x_scale / p - 1.0) + " not modelled (the "
+                         FormatNumber(w * p) +
+                         " mm at the square pixel of the format height: x "
+                         "scale " +
+                         FormatNumber(x_scale / p - 1.0) +
+                         " not modelled (the "
                          "principal point is kept in pixels)");
   file.camera.model = Model::kId;
   file.camera.params.assign(Model::kNumParams, 0.0);
@@ -102,8 +115,9 @@ CameraFile ReadPhotoModelerCamera(const std::string& path, const CameraReadOptio
   q[Model::kK3] = cam[7];
   q[Model::kP1] = cam[8];
   q[Model::kP2] = cam[9];
-  file.notes.push_back("PhotoModeler's y direction in its distortion formulas is not stated by its "
-                       "help: y up as DBAT reads it");
+  file.notes.push_back(
+      "PhotoModeler's y direction in its distortion formulas is not stated by its "
+      "help: y up as DBAT reads it");
   return file;
 }
 
@@ -115,7 +129,8 @@ void WritePhotoModelerCamera(const std::string& path, const CameraFile& file) {
   const double w_mm = f.width_px * f.pixel_size_mm, h_mm = f.height_px * f.pixel_size_mm;
   const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out << "Bundle Soln " << (file.name.empty() ? "aerocal camera" : internal::OneLine(file.name)) << "\n"
+  out << "Bundle Soln " << (file.name.empty() ? "aerocal camera" : internal::OneLine(file.name))
+      << "\n"
       << " 0 -1 " << f.width_px << " " << f.height_px << "\n"
       << " 1 0 0 0 0 0 0 0 0\n"
       << " " << n(q[Model::kC]) << " " << n(q[Model::kX0] + 0.5 * w_mm) << " "

@@ -20,13 +20,13 @@
 // size the camera is read with a placeholder one (pixels exact, mm meaningless, said).
 // `--camera IMAGE` picks an image, else the first; images whose K or distortion differ from the
 // picked one are said (they are another camera, or a per-image calibration).
-#include <cmath>
-#include <map>
-#include <sstream>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+
+#include <cmath>
+#include <map>
+#include <sstream>
 
 namespace aerocal::calib {
 
@@ -58,8 +58,9 @@ std::vector<CalibratedImage> ReadCalibratedImages(const std::string& path,
   for (size_t at = 0; at < tokens.size(); at += kPerImage) {
     if (tokens.size() - at < kPerImage)
       ThrowInputError({path, tokens[at].line},
-                      "image " + tokens[at].text + ": a record is NAME W H, K (9), radial (3), "
-                      "tangential (2), position (3), rotation (9): the file ends after " +
+                      "image " + tokens[at].text +
+                          ": a record is NAME W H, K (9), radial (3), "
+                          "tangential (2), position (3), rotation (9): the file ends after " +
                           std::to_string(tokens.size() - at) + " of its 29 values");
     CalibratedImage image;
     image.name = tokens[at].text;
@@ -67,12 +68,13 @@ std::vector<CalibratedImage> ReadCalibratedImages(const std::string& path,
     for (int k = 1; k <= 2; ++k) {
       const SourceRef where{path, tokens[at + k].line};
       const double v = internal::ParseNumber(tokens[at + k].text, where, "image size", 1e6);
-      if (!(v >= 1) || v != std::floor(v)) ThrowInputError(where, "image size must be a positive integer");
+      if (!(v >= 1) || v != std::floor(v))
+        ThrowInputError(where, "image size must be a positive integer");
       (k == 1 ? image.width : image.height) = static_cast<int>(v);
     }
     for (size_t k = 3; k < kPerImage; ++k) {
-      const double v = internal::ParseNumber(tokens[at + k].text, {path, tokens[at + k].line},
-                                             "image " + image.name + " value", 1e9);
+      const double v = internal::ParseNumber(
+          tokens[at + k].text, {path, tokens[at + k].line}, "image " + image.name + " value", 1e9);
       if (k < 3 + 9 + 3 + 2) image.intrinsics.push_back(v);
     }
     images.push_back(image);
@@ -94,15 +96,17 @@ CameraFile ReadPix4dCalibratedParameters(const std::string& path,
       names += (names.empty() ? "" : ", ") + image.name;
       if (image.name == options.camera_id) picked = &image;
     }
-    if (!picked) ThrowInputError({path, 1}, "no image " + options.camera_id + " (images: " + names + ")");
+    if (!picked)
+      ThrowInputError({path, 1}, "no image " + options.camera_id + " (images: " + names + ")");
   }
   const std::vector<double>& k = picked->intrinsics;
   const SourceRef where{path, picked->line};
   if (k[1] != 0 || k[3] != 0 || k[6] != 0 || k[7] != 0 || k[8] != 1)
     ThrowInputError(where, "K must be [f 0 cx; 0 f cy; 0 0 1]");
   if (!(k[0] > 0) || k[4] != k[0])
-    ThrowInputError(where, "K must hold one focal length > 0 px (Pix4D's F; got " +
-                               FormatNumber(k[0]) + " and " + FormatNumber(k[4]) + ")");
+    ThrowInputError(where,
+                    "K must hold one focal length > 0 px (Pix4D's F; got " + FormatNumber(k[0]) +
+                        " and " + FormatNumber(k[4]) + ")");
   CameraFile file;
   file.name = picked->name;
   file.chosen_by_camera_id = !options.camera_id.empty();
@@ -119,7 +123,8 @@ CameraFile ReadPix4dCalibratedParameters(const std::string& path,
                          " images share K and distortion: " + picked->name + " read");
   internal::ResolveFormat(&file, options, where, picked->width, picked->height, 0.0);
   if (!file.pixel_size_known)
-    file.notes.push_back("no pixel size (pass --pixel-size-mm): F, Px, Py in units of the placeholder");
+    file.notes.push_back(
+        "no pixel size (pass --pixel-size-mm): F, Px, Py in units of the placeholder");
   const double p = file.camera.frame.pixel_size_mm;
   file.camera.model = M::kId;
   file.camera.params = {k[0] * p, k[2] * p, k[5] * p, k[9], k[10], k[11], k[12], k[13]};
@@ -186,15 +191,18 @@ CameraFile ReadPix4dCam(const std::string& path, const CameraReadOptions& option
     if (height == 0 && pixel > 0) height = static_cast<int>(std::lround(sensor_h / pixel));
     if (pixel == 0 && width > 0) pixel = sensor_w / width;
     if (width > 0 && std::abs(sensor_w - width * pixel) > 0.5 * pixel)
-      ThrowInputError(where, "sensor width " + FormatNumber(sensor_w) + " mm contradicts " +
-                                 std::to_string(width) + " px of " + FormatNumber(pixel) + " mm");
+      ThrowInputError(where,
+                      "sensor width " + FormatNumber(sensor_w) + " mm contradicts " +
+                          std::to_string(width) + " px of " + FormatNumber(pixel) + " mm");
     if (height > 0 && std::abs(sensor_h - height * pixel) > 0.5 * pixel)
-      ThrowInputError(where, "sensor height " + FormatNumber(sensor_h) + " mm contradicts " +
-                                 std::to_string(height) + " px of " + FormatNumber(pixel) + " mm");
+      ThrowInputError(where,
+                      "sensor height " + FormatNumber(sensor_h) + " mm contradicts " +
+                          std::to_string(height) + " px of " + FormatNumber(pixel) + " mm");
   }
   if (!(pixel > 0))
-    ThrowInputError(where, "the pixel size is needed (F, Px, Py are mm): pass --width/--height "
-                           "with the sensor-size line, or --pixel-size-mm");
+    ThrowInputError(where,
+                    "the pixel size is needed (F, Px, Py are mm): pass --width/--height "
+                    "with the sensor-size line, or --pixel-size-mm");
   CameraReadOptions derived;
   internal::ResolveFormat(&file, derived, where, width, height, pixel);
   return file;
@@ -210,10 +218,9 @@ void WritePix4dCam(const std::string& path, const CameraFile& file) {
   out << "Pix4D camera calibration file 0\n#Focal Length mm assuming a sensor width of "
       << n(f.width_px * f.pixel_size_mm) << "x" << n(f.height_px * f.pixel_size_mm) << "mm\n"
       << "F " << n(p[M::kF]) << "\n#Principal Point mm\nPx " << n(p[M::kPx]) << "\nPy "
-      << n(p[M::kPy]) << "\n#Symmetrical Lens Distortion Coeffs\nK1 " << n(p[M::kR1])
-      << "\nK2 " << n(p[M::kR2]) << "\nK3 " << n(p[M::kR3])
-      << "\n#Tangential Lens Distortion Coeffs\nT1 " << n(p[M::kT1]) << "\nT2 " << n(p[M::kT2])
-      << "\n";
+      << n(p[M::kPy]) << "\n#Symmetrical Lens Distortion Coeffs\nK1 " << n(p[M::kR1]) << "\nK2 "
+      << n(p[M::kR2]) << "\nK3 " << n(p[M::kR3]) << "\n#Tangential Lens Distortion Coeffs\nT1 "
+      << n(p[M::kT1]) << "\nT2 " << n(p[M::kT2]) << "\n";
   WriteFileAtomically(path, out.str());
 }
 

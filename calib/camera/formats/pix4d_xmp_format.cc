@@ -1,6 +1,6 @@
-// Pix4D's camera XMP tags (namespace http://pix4d.com/camera/1.0, Pix4D support article 360016450032
-// "Specifications of XMP Camera Tags"): the "XML form" of Pix4D's internal camera parameters that
-// a camera maker writes into its images for Pix4D to use:
+// Pix4D's camera XMP tags (namespace http://pix4d.com/camera/1.0, Pix4D support article
+// 360016450032 "Specifications of XMP Camera Tags"): the "XML form" of Pix4D's internal camera
+// parameters that a camera maker writes into its images for Pix4D to use:
 //   Camera:ModelType              "perspective" (or "fisheye": not read, said)
 //   Camera:PerspectiveFocalLength  F, mm
 //   Camera:PrincipalPoint          "Px,Py", mm
@@ -10,14 +10,14 @@
 // or pixel size: the image size from a JPEG's SOF marker or a sidecar's tiff:ImageWidth/Length,
 // the pixel size from exif:FocalPlaneXResolution with exif:FocalPlaneResolutionUnit (2 inch,
 // 3 cm, 4 mm), which the writer adds and Pix4D also reads, else --pixel-size-mm.
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+#include "calib/metadata/image_metadata.h"
+
 #include <cmath>
 #include <optional>
 #include <sstream>
-
-#include "calib/camera/formats/camera_formats.h"
-#include "calib/metadata/image_metadata.h"
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
 
 namespace aerocal::calib {
 namespace {
@@ -61,8 +61,9 @@ CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& option
   const auto numbers = [&](const XmpText& t, size_t count) {
     const std::vector<std::string> fields = SplitCommaList(t.value, {true, true});
     if (fields.size() != count)
-      ThrowInputError(t.where, t.name + " must hold " + std::to_string(count) + " comma-separated values (got '" +
-                                   t.value + "')");
+      ThrowInputError(t.where,
+                      t.name + " must hold " + std::to_string(count) +
+                          " comma-separated values (got '" + t.value + "')");
     std::vector<double> v;
     for (const std::string& f : fields) v.push_back(internal::ParseNumber(f, t.where, t.name, 1e4));
     return v;
@@ -72,19 +73,21 @@ CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& option
   if (!focal || !pp) {
     const auto type = camera("ModelType");
     ThrowInputError(type ? type->where : SourceRef{path, image ? 0 : 1},
-                    std::string("no PerspectiveFocalLength / PrincipalPoint of namespace ") + kPix4dCameraUri +
-                        " (Pix4D camera XMP)");
+                    std::string("no PerspectiveFocalLength / PrincipalPoint of namespace ") +
+                        kPix4dCameraUri + " (Pix4D camera XMP)");
   }
   if (const auto type = camera("ModelType"); type && type->value != "perspective")
-    ThrowInputError(type->where, type->name + " '" + type->value +
-                                     "': only the perspective model is read (Pix4D's fisheye "
-                                     "polynomial is not a registry model)");
+    ThrowInputError(type->where,
+                    type->name + " '" + type->value +
+                        "': only the perspective model is read (Pix4D's fisheye "
+                        "polynomial is not a registry model)");
   CameraFile file;
   file.name = "pix4d";
   file.camera.model = M::kId;
   file.camera.params.assign(M::kNumParams, 0.0);
   file.camera.params[M::kF] = numbers(*focal, 1)[0];
-  if (!(file.camera.params[M::kF] > 0)) ThrowInputError(focal->where, "the focal length must be > 0 mm");
+  if (!(file.camera.params[M::kF] > 0))
+    ThrowInputError(focal->where, "the focal length must be > 0 mm");
   const std::vector<double> principal = numbers(*pp, 2);
   file.camera.params[M::kPx] = principal[0];
   file.camera.params[M::kPy] = principal[1];
@@ -103,18 +106,22 @@ CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& option
   double pixel_mm = 0.0;
   if (const auto res = find(xmp_ns::kExif, "FocalPlaneXResolution")) {
     const auto unit = find(xmp_ns::kExif, "FocalPlaneResolutionUnit");
-    const int u = unit ? static_cast<int>(internal::ParseNumber(unit->value, unit->where, unit->name, 10)) : 2;
+    const int u =
+        unit ? static_cast<int>(internal::ParseNumber(unit->value, unit->where, unit->name, 10))
+             : 2;
     const double mm_per_unit = u == 2 ? 25.4 : u == 3 ? 10.0 : u == 4 ? 1.0 : 0.0;
     if (mm_per_unit == 0)
-      ThrowInputError(unit->where, "exif:FocalPlaneResolutionUnit must be 2 (inch), 3 (cm) or 4 (mm)");
+      ThrowInputError(unit->where,
+                      "exif:FocalPlaneResolutionUnit must be 2 (inch), 3 (cm) or 4 (mm)");
     const double per_unit = ParseRational(*res, res->name);
     if (!(per_unit > 0)) ThrowInputError(res->where, "exif:FocalPlaneXResolution must be > 0");
     pixel_mm = mm_per_unit / per_unit;
   }
   internal::ResolveFormat(&file, options, where, width, height, pixel_mm);
   if (!file.pixel_size_known)
-    ThrowInputError(where, "the pixel size is needed (the tags are mm): the file has no "
-                           "exif:FocalPlaneXResolution; pass --pixel-size-mm");
+    ThrowInputError(where,
+                    "the pixel size is needed (the tags are mm): the file has no "
+                    "exif:FocalPlaneXResolution; pass --pixel-size-mm");
   return file;
 }
 
@@ -125,17 +132,21 @@ void WritePix4dXmp(const std::string& path, const CameraFile& file) {
   const std::vector<double>& p = file.camera.params;
   const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;
-  out << "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n <rdf:RDF xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
+  out << "<x:xmpmeta xmlns:x=\"adobe:ns:meta/\">\n <rdf:RDF "
+         "xmlns:rdf=\"http://www.w3.org/1999/02/22-rdf-syntax-ns#\">\n"
       << "  <rdf:Description xmlns:Camera=\"" << kPix4dCameraUri << "/\"\n"
-      << "    xmlns:tiff=\"http://ns.adobe.com/tiff/1.0/\" xmlns:exif=\"http://ns.adobe.com/exif/1.0/\"\n"
+      << "    xmlns:tiff=\"http://ns.adobe.com/tiff/1.0/\" "
+         "xmlns:exif=\"http://ns.adobe.com/exif/1.0/\"\n"
       << "    tiff:ImageWidth=\"" << f.width_px << "\" tiff:ImageLength=\"" << f.height_px << "\"\n"
-      << "    exif:FocalPlaneXResolution=\"" << n(1.0 / f.pixel_size_mm) << "\" exif:FocalPlaneYResolution=\""
-      << n(1.0 / f.pixel_size_mm) << "\" exif:FocalPlaneResolutionUnit=\"4\"\n"
+      << "    exif:FocalPlaneXResolution=\"" << n(1.0 / f.pixel_size_mm)
+      << "\" exif:FocalPlaneYResolution=\"" << n(1.0 / f.pixel_size_mm)
+      << "\" exif:FocalPlaneResolutionUnit=\"4\"\n"
       << "    Camera:ModelType=\"perspective\"\n"
       << "    Camera:PerspectiveFocalLength=\"" << n(p[M::kF]) << "\"\n"
       << "    Camera:PrincipalPoint=\"" << n(p[M::kPx]) << "," << n(p[M::kPy]) << "\"\n"
       << "    Camera:PerspectiveDistortion=\"" << n(p[M::kR1]) << "," << n(p[M::kR2]) << ","
-      << n(p[M::kR3]) << "," << n(p[M::kT1]) << "," << n(p[M::kT2]) << "\"/>\n </rdf:RDF>\n</x:xmpmeta>\n";
+      << n(p[M::kR3]) << "," << n(p[M::kT1]) << "," << n(p[M::kT2])
+      << "\"/>\n </rdf:RDF>\n</x:xmpmeta>\n";
   WriteFileAtomically(path, out.str());
 }
 

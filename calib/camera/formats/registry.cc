@@ -1,16 +1,16 @@
 // The camera-format registry (camera_formats.h CameraFormat): one row per format, with what its
 // files look like for `--from auto`. The OpenCV FileStorage row is added by the tool layer
 // (tools/camera_formats.cc, OpenCV staying out of calib).
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/camera/formats/zip_archive.h"
+#include "calib/core/atomic_file.h"
+#include "calib/core/csv.h"
+
 #include <algorithm>
 #include <filesystem>
 #include <fstream>
 #include <regex>
 #include <sstream>
-
-#include "calib/camera/formats/camera_formats.h"
-#include "calib/camera/formats/zip_archive.h"
-#include "calib/core/atomic_file.h"
-#include "calib/core/csv.h"
 
 namespace aerocal::calib {
 namespace {
@@ -45,24 +45,32 @@ bool LooksLikeColmapText(const std::string& head) {
 
 std::vector<CameraFormat>& Registry() {
   static std::vector<CameraFormat> formats = {
-      {"aerocal", "our camera YAML (any registry model; a rig file's head by --camera)",
-       ReadAerocalCamera, WriteAerocalCamera,
-       [](const ModelCamera& s) { return FormatTarget{s.model, {}, true}; },
+      {"aerocal",
+       "our camera YAML (any registry model; a rig file's head by --camera)",
+       ReadAerocalCamera,
+       WriteAerocalCamera,
+       [](const ModelCamera& s) {
+         return FormatTarget{s.model, {}, true};
+       },
        [](const std::string& h, const std::string&) {
          return Has(h, "format_px:") && Has(h, "pixel_size_mm:");
        },
-       ".yaml", true, true, true},
-      {"colmap", "COLMAP cameras.txt or cameras.bin (SIMPLE_PINHOLE ... FULL_OPENCV; --camera ID)", ReadColmapCameras,
+       ".yaml",
+       true,
+       true,
+       true},
+      {"colmap",
+       "COLMAP cameras.txt or cameras.bin (SIMPLE_PINHOLE ... FULL_OPENCV; --camera ID)",
+       ReadColmapCameras,
        WriteColmapCameras,
        [](const ModelCamera& source) {
          if (!ColmapName(source.model).empty()) return FormatTarget{source.model, {}};
          if (source.model == CameraModelId::kOpenCv) {  // exact: OPENCV when k3-k6 are 0
-           const bool full = source.params[OpenCvModel::kK3] != 0 ||
-                             source.params[OpenCvModel::kK4] != 0 ||
-                             source.params[OpenCvModel::kK5] != 0 ||
-                             source.params[OpenCvModel::kK6] != 0;
-           return FormatTarget{full ? CameraModelId::kColmapFullOpenCv : CameraModelId::kColmapOpenCv,
-                               {}};
+           const bool full =
+               source.params[OpenCvModel::kK3] != 0 || source.params[OpenCvModel::kK4] != 0 ||
+               source.params[OpenCvModel::kK5] != 0 || source.params[OpenCvModel::kK6] != 0;
+           return FormatTarget{
+               full ? CameraModelId::kColmapFullOpenCv : CameraModelId::kColmapOpenCv, {}};
          }
          return OpenCvFit(CameraModelId::kColmapFullOpenCv);
        },
@@ -70,40 +78,66 @@ std::vector<CameraFormat>& Registry() {
          return LooksLikeColmapText(h) || LooksLikeColmapBinary(h, path);
        },
        ".txt"},
-      {"metashape", "Agisoft Metashape / PhotoScan calibration XML, cameras XML, .psx / .psz project (--camera sensor id)",
-       ReadMetashapeCalibration, WriteMetashapeCalibration,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kMetashapeFrame, {}}; },
+      {"metashape",
+       "Agisoft Metashape / PhotoScan calibration XML, cameras XML, .psx / .psz project (--camera "
+       "sensor id)",
+       ReadMetashapeCalibration,
+       WriteMetashapeCalibration,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kMetashapeFrame, {}};
+       },
        [](const std::string& h, const std::string&) {
          // A calibration export, a cameras export, a .psx project, a .psz / .zip project archive.
          if (Has(h, "<opencv_storage>")) return false;  // OpenCV's <calibration_time>
          return Has(h, "<calibration>") || Has(h, "<calibration ") || Has(h, "<sensor ") ||
-                Has(h, "<sensors") ||
-                (Has(h, "<document") && Has(h, "<chunks")) ||
+                Has(h, "<sensors") || (Has(h, "<document") && Has(h, "<chunks")) ||
                 (internal::LooksLikeZip(h) && Has(h, "doc.xml"));
        },
-       ".xml", true, false, true},
-      {"pix4d", "Pix4D internal camera parameters (.cam), a project's calibrated_camera_parameters.txt (--camera IMAGE)", ReadPix4dCam, WritePix4dCam,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; },
+       ".xml",
+       true,
+       false,
+       true},
+      {"pix4d",
+       "Pix4D internal camera parameters (.cam), a project's calibrated_camera_parameters.txt "
+       "(--camera IMAGE)",
+       ReadPix4dCam,
+       WritePix4dCam,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kPix4dPerspective, {}, true};
+       },
        [](const std::string& h, const std::string&) {
          return Has(h, "Pix4D camera calibration file") || IsPix4dCalibratedParameters(h);
        },
-       ".cam", false, true},
+       ".cam",
+       false,
+       true},
       {"pix4d-xmp",
        "Pix4D camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, "
        "PerspectiveDistortion; a JPEG or an XMP sidecar)",
-       ReadPix4dXmp, WritePix4dXmp,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kPix4dPerspective, {}, true}; },
+       ReadPix4dXmp,
+       WritePix4dXmp,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kPix4dPerspective, {}, true};
+       },
        [](const std::string& h, const std::string&) { return Has(h, "PerspectiveFocalLength"); },
-       ".xmp", true, true},
-      {"opensfm", "OpenSfM / OpenDroneMap cameras.json", ReadOpenSfmCameras, WriteOpenSfmCameras,
+       ".xmp",
+       true,
+       true},
+      {"opensfm",
+       "OpenSfM / OpenDroneMap cameras.json",
+       ReadOpenSfmCameras,
+       WriteOpenSfmCameras,
        [](const ModelCamera& s) {
          return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {"k3", "k4"}}
                              : FormatTarget{CameraModelId::kOpenCv, {"k4", "k5", "k6"}};
        },
        [](const std::string& h, const std::string&) { return Has(h, "\"projection_type\""); },
        ".json"},
-      {"dji", "DJI XMP DewarpData / DewarpDataK6 (a DJI JPEG, an XMP sidecar or the string)",
-       ReadDjiDewarpData, WriteDjiDewarpData, OpenCvTarget,
+      {"dji",
+       "DJI XMP DewarpData / DewarpDataK6 (a DJI JPEG, an XMP sidecar or the string)",
+       ReadDjiDewarpData,
+       WriteDjiDewarpData,
+       OpenCvTarget,
        [](const std::string& h, const std::string&) {
          if (Has(h, "DewarpData") || Has(h, "Dewarp Data")) return true;
          // The bare string: "[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" on its first line.
@@ -113,33 +147,55 @@ std::vector<CameraFormat>& Registry() {
          return first.size() < 1000 && std::regex_match(first, kRecord);
        },
        ".xmp"},
-      {"dbat", "DBAT camera XML, whole or a <cameras> / <camera> fragment, or DBAT's text report (c, pp, aspect, K1-K3, P1, P2 in mm)",
-       ReadDbatCameraXml, WriteDbatCameraXml,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kBrownFraser10, {"B2"}, true}; },
+      {"dbat",
+       "DBAT camera XML, whole or a <cameras> / <camera> fragment, or DBAT's text report (c, pp, "
+       "aspect, K1-K3, P1, P2 in mm)",
+       ReadDbatCameraXml,
+       WriteDbatCameraXml,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kBrownFraser10, {"B2"}, true};
+       },
        [](const std::string& h, const std::string&) {
-         return ((Has(h, "<camera>") || Has(h, "<camera ")) && (Has(h, "<cc>") || Has(h, "<pp>"))) ||
+         return ((Has(h, "<camera>") || Has(h, "<camera ")) &&
+                 (Has(h, "<cc>") || Has(h, "<pp>"))) ||
                 IsDbatReport(h);
        },
-       ".xml", true, true},
-      {"photomodeler", "PhotoModeler Bundle Soln export's camera or a calibration report's camera block (f, pp, format, K1-K3, P1, P2 mm)",
-       ReadPhotoModelerCamera, WritePhotoModelerCamera,
+       ".xml",
+       true,
+       true},
+      {"photomodeler",
+       "PhotoModeler Bundle Soln export's camera or a calibration report's camera block (f, pp, "
+       "format, K1-K3, P1, P2 mm)",
+       ReadPhotoModelerCamera,
+       WritePhotoModelerCamera,
        [](const ModelCamera&) {
          return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
        },
        [](const std::string& h, const std::string&) {
          return h.rfind("Bundle Soln", 0) == 0 || IsPhotoModelerReport(h);
        },
-       ".txt", true, true},
-      {"australis", "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
-       ReadAustralisCamera, WriteAustralisCamera,
-       [](const ModelCamera&) { return FormatTarget{CameraModelId::kBrownFraser10, {}, true}; },
+       ".txt",
+       true,
+       true},
+      {"australis",
+       "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
+       ReadAustralisCamera,
+       WriteAustralisCamera,
+       [](const ModelCamera&) {
+         return FormatTarget{CameraModelId::kBrownFraser10, {}, true};
+       },
        [](const std::string& h, const std::string&) {
          return Has(h, "Australis") && Has(h, "Camera Parameters");
        },
-       ".txt", true, true, true},
-      {"ros", "ROS camera_info YAML (camera_matrix/distortion_coefficients {rows, cols, data}; "
-              "plumb_bob, rational_polynomial, equidistant)",
-       ReadRosCameraInfo, WriteRosCameraInfo,
+       ".txt",
+       true,
+       true,
+       true},
+      {"ros",
+       "ROS camera_info YAML (camera_matrix/distortion_coefficients {rows, cols, data}; "
+       "plumb_bob, rational_polynomial, equidistant)",
+       ReadRosCameraInfo,
+       WriteRosCameraInfo,
        [](const ModelCamera& s) {
          return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}} : OpenCvTarget(s);
        },
@@ -148,8 +204,10 @@ std::vector<CameraFormat>& Registry() {
                 !Has(h, "model_type:");
        },
        ".yaml"},
-      {"camodocal", "camodocal / VINS-Mono / VINS-Fusion PINHOLE camera YAML",
-       ReadCamodocalCamera, WriteCamodocalCamera,
+      {"camodocal",
+       "camodocal / VINS-Mono / VINS-Fusion PINHOLE camera YAML",
+       ReadCamodocalCamera,
+       WriteCamodocalCamera,
        [](const ModelCamera&) {
          return FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
        },
@@ -157,7 +215,9 @@ std::vector<CameraFormat>& Registry() {
          return Has(h, "model_type:") && Has(h, "projection_parameters");
        },
        ".yaml"},
-      {"kalibr", "Kalibr camchain YAML (pinhole radtan / equidistant)", ReadKalibrCamchain,
+      {"kalibr",
+       "Kalibr camchain YAML (pinhole radtan / equidistant)",
+       ReadKalibrCamchain,
        WriteKalibrCamchain,
        [](const ModelCamera& s) {
          return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}}
@@ -238,7 +298,8 @@ std::string ForeignCameraHint(const std::string& path) {
          names.front() + " --to aerocal " + path + " camera.yaml`)";
 }
 
-void WriteCameraFileVerified(const CameraFormat& format, const std::string& path,
+void WriteCameraFileVerified(const CameraFormat& format,
+                             const std::string& path,
                              const CameraFile& file) {
   namespace fs = std::filesystem;
   const fs::path target(path);
@@ -258,7 +319,8 @@ void WriteCameraFileVerified(const CameraFormat& format, const std::string& path
     if (back.camera.model != file.camera.model)
       problem = "reads back as " + std::string(CameraModelName(back.camera.model));
     else if (a.width_px != b.width_px || a.height_px != b.height_px)
-      problem = "reads back as " + std::to_string(b.width_px) + " x " + std::to_string(b.height_px) + " px";
+      problem = "reads back as " + std::to_string(b.width_px) + " x " +
+                std::to_string(b.height_px) + " px";
     else if (const ConversionResidual r = CompareCameras(file.camera, back.camera, 21);
              r.failed_points > 0 || !(r.max_px <= 1e-6))
       problem = "reads back " + FormatNumber(r.max_px) + " px away";
@@ -273,18 +335,22 @@ void WriteCameraFileVerified(const CameraFormat& format, const std::string& path
   fs::rename(scratch, target);
 }
 
-CameraFile ReadCameraFileAs(const std::string& name, const std::string& path,
-                            const CameraReadOptions& options, std::string* used) {
+CameraFile ReadCameraFileAs(const std::string& name,
+                            const std::string& path,
+                            const CameraReadOptions& options,
+                            std::string* used) {
   std::string chosen = name;
   if (name == "auto") {
     CheckInputFile(path);
     const std::vector<std::string> candidates = DetectCameraFormats(path);
     if (candidates.empty())
-      ThrowInputError({path, 1}, "--from auto: the file looks like none of the camera formats (" +
-                                     CameraFormatNames() + "): name one with --from");
+      ThrowInputError({path, 1},
+                      "--from auto: the file looks like none of the camera formats (" +
+                          CameraFormatNames() + "): name one with --from");
     if (candidates.size() > 1)
-      ThrowInputError({path, 1}, "--from auto: the file looks like several formats (" +
-                                     Joined(candidates) + "): name one with --from");
+      ThrowInputError({path, 1},
+                      "--from auto: the file looks like several formats (" + Joined(candidates) +
+                          "): name one with --from");
     chosen = candidates.front();
   }
   const CameraFormat& format = FindCameraFormat(chosen, "--from");
@@ -294,8 +360,9 @@ CameraFile ReadCameraFileAs(const std::string& name, const std::string& path,
     // A --camera on a file of one camera without ids (a single-camera format, a camera YAML
     // that is no rig, an OpenCV file without M1/M2) names no camera in it (issue 37 class 9).
     if (!options.camera_id.empty() && !file.chosen_by_camera_id)
-      ThrowInputError({path, 1}, "--camera " + options.camera_id + ": the file holds one " + chosen +
-                                     " camera and names no cameras (drop --camera)");
+      ThrowInputError({path, 1},
+                      "--camera " + options.camera_id + ": the file holds one " + chosen +
+                          " camera and names no cameras (drop --camera)");
     return file;
   } catch (const InputError& e) {
     if (name == "auto") throw;

@@ -9,12 +9,12 @@
 // width = pixel height (1 + as)), sk (skew: not modelled, must be 0), Image width/height | Iw/Ih.
 // Blocks of the same camera in several sections are merged; a parameter printed twice with other
 // values is an error.
+#include "calib/camera/formats/camera_formats.h"
+#include "calib/core/csv.h"
+
 #include <cmath>
 #include <map>
 #include <regex>
-
-#include "calib/camera/formats/camera_formats.h"
-#include "calib/core/csv.h"
 
 namespace aerocal::calib::internal {
 namespace {
@@ -27,11 +27,12 @@ struct ReportEntry {
 };
 using ReportBlock = std::map<std::string, ReportEntry>;
 
-std::vector<std::pair<std::string, ReportBlock>> ReportCameras(const std::string& path,
-                                                                const std::vector<std::string>& lines) {
+std::vector<std::pair<std::string, ReportBlock>> ReportCameras(
+    const std::string& path, const std::vector<std::string>& lines) {
   std::vector<std::pair<std::string, ReportBlock>> cameras;
   static const std::regex kCamera(R"(\s*(Camera\d+)(?: \(.*\)|:.*)?\s*)");
-  static const std::regex kValue(R"(\s*(Value|Deviation):\s*(?:[A-Za-z][A-Za-z0-9 ]*:\s*)?(\S+).*)");
+  static const std::regex kValue(
+      R"(\s*(Value|Deviation):\s*(?:[A-Za-z][A-Za-z0-9 ]*:\s*)?(\S+).*)");
   ReportBlock* block = nullptr;
   std::string title;
   size_t indent = 0;
@@ -64,8 +65,9 @@ std::vector<std::pair<std::string, ReportBlock>> ReportCameras(const std::string
       ReportEntry& e = (*block)[title];
       if (m[1] == "Value") {
         if (e.line != 0 && e.value != v)
-          ThrowInputError(where, title + " printed twice with other values (" +
-                                     FormatNumber(e.value) + " at line " + std::to_string(e.line) + ")");
+          ThrowInputError(where,
+                          title + " printed twice with other values (" + FormatNumber(e.value) +
+                              " at line " + std::to_string(e.line) + ")");
         e.value = v;
         e.line = where.line;
       } else {
@@ -102,8 +104,10 @@ double AspectAsB1ResidualPx(const ModelCamera& ours, double s) {
   return worst;
 }
 
-CameraFile ReadReportCamera(const std::string& path, const std::vector<std::string>& lines,
-                            const CameraReadOptions& options, const std::string& tool) {
+CameraFile ReadReportCamera(const std::string& path,
+                            const std::vector<std::string>& lines,
+                            const CameraReadOptions& options,
+                            const std::string& tool) {
   const auto cameras = ReportCameras(path, lines);
   std::string ids;
   const ReportBlock* found = nullptr;
@@ -113,32 +117,37 @@ CameraFile ReadReportCamera(const std::string& path, const std::vector<std::stri
     if (c.second.empty()) continue;  // a camera listed without parameters
     ++with_values;
     ids += (ids.empty() ? "" : ", ") + c.first;
-    if (c.first == options.camera_id || options.camera_id.empty()) found = &c.second, name = c.first;
+    if (c.first == options.camera_id || options.camera_id.empty())
+      found = &c.second, name = c.first;
   }
   if (!found || (options.camera_id.empty() && with_values > 1))
-    ThrowInputError({path, 1}, with_values == 0 ? "no camera block with parameter values (CameraN) in the " + tool + " report"
-                               : options.camera_id.empty()
-                                   ? "holds " + std::to_string(with_values) +
-                                         " cameras: name one with --camera (" + ids + ")"
-                                   : "no camera " + options.camera_id + " (cameras: " + ids + ")");
+    ThrowInputError(
+        {path, 1},
+        with_values == 0
+            ? "no camera block with parameter values (CameraN) in the " + tool + " report"
+        : options.camera_id.empty() ? "holds " + std::to_string(with_values) +
+                                          " cameras: name one with --camera (" + ids + ")"
+                                    : "no camera " + options.camera_id + " (cameras: " + ids + ")");
   // The entry under either tool's name; `required` false: absent is 0 (a term the report's model
   // does not have).
   const auto get = [&](std::initializer_list<const char*> titles, bool required) {
     for (const char* t : titles)
-      if (const auto it = found->find(t); it != found->end() && it->second.line != 0) return it->second;
+      if (const auto it = found->find(t); it != found->end() && it->second.line != 0)
+        return it->second;
     if (required)
       ThrowInputError({path, 1}, name + ": the report has no '" + *titles.begin() + "' value");
     return ReportEntry{};
   };
-  const ReportEntry c = get({"Camera Constant", "Focal Length"}, true), px = get({"px", "Xp"}, true),
-                    py = get({"py", "Yp"}, true), fh = get({"Format height", "Fh"}, true),
-                    iw = get({"Image width", "Iw"}, false), ih = get({"Image height", "Ih"}, false),
-                    as = get({"as"}, false), sk = get({"sk"}, false), b1 = get({"B1"}, false),
-                    b2 = get({"B2"}, false);
+  const ReportEntry c = get({"Camera Constant", "Focal Length"}, true),
+                    px = get({"px", "Xp"}, true), py = get({"py", "Yp"}, true),
+                    fh = get({"Format height", "Fh"}, true), iw = get({"Image width", "Iw"}, false),
+                    ih = get({"Image height", "Ih"}, false), as = get({"as"}, false),
+                    sk = get({"sk"}, false), b1 = get({"B1"}, false), b2 = get({"B2"}, false);
   for (const ReportEntry* e : {&sk, &b1, &b2})
     if (e->value != 0)
-      ThrowInputError({path, e->line}, tool + " term = " + FormatNumber(e->value) +
-                                           " (skew / aspect-ratio form) is not modelled");
+      ThrowInputError({path, e->line},
+                      tool + " term = " + FormatNumber(e->value) +
+                          " (skew / aspect-ratio form) is not modelled");
   CameraFile file;
   file.name = name;
   file.chosen_by_camera_id = !options.camera_id.empty();
@@ -162,10 +171,11 @@ CameraFile ReadReportCamera(const std::string& path, const std::vector<std::stri
   const double x_scale = as.line == 0 && fw.line != 0 ? fw.value / (width * pixel) : s;
   if (!(x_scale > 0)) ThrowInputError({path, fw.line}, "Format width must be > 0 mm");
   if (as.line == 0 && std::abs(x_scale - 1.0) > 1e-6)
-    file.notes.push_back("Format width " + FormatNumber(fw.value) + " mm is " +
-                         FormatNumber(width * pixel) + " mm at the square pixel of the format "
-                         "height: x scale " + FormatNumber(x_scale - 1.0) +
-                         " not modelled (the principal point is kept in pixels)");
+    file.notes.push_back(
+        "Format width " + FormatNumber(fw.value) + " mm is " + FormatNumber(width * pixel) +
+        " mm at the square pixel of the format "
+        "height: x scale " +
+        FormatNumber(x_scale - 1.0) + " not modelled (the principal point is kept in pixels)");
   std::vector<double>& q = file.camera.params;
   q.assign(Model::kNumParams, 0.0);
   file.camera.model = Model::kId;
@@ -187,8 +197,9 @@ CameraFile ReadReportCamera(const std::string& path, const std::vector<std::stri
   covariance(Model::kB1, Model::kB1) = as.deviation * as.deviation;
   if (covariance.diagonal().maxCoeff() > 0) {
     file.covariance = covariance;
-    file.notes.push_back("the report's deviations as a diagonal covariance (correlations are "
-                         "printed only over 95 %: not read)");
+    file.notes.push_back(
+        "the report's deviations as a diagonal covariance (correlations are "
+        "printed only over 95 %: not read)");
   }
   if (s != 1.0)
     file.notes.push_back(tool + " as = " + FormatNumber(as.value) + " read as B1: not exact, " +

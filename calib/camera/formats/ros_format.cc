@@ -8,18 +8,18 @@
 // camera exactly: plumb_bob (k1 k2 p1 p2 k3), rational_polynomial (k1 k2 p1 p2 k3 k4 k5 k6),
 // equidistant (k1-k4, OpenCV fisheye). A file without distortion_model is plumb_bob, the rule
 // camera_calibration_parsers applies (and warns about): said in a note.
-#include <sstream>
-
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/yaml_util.h"
+
+#include <sstream>
 
 namespace aerocal::calib {
 namespace {
 
 // A {rows, cols, data} matrix of the file; InputError at its line when it is not one.
-std::vector<double> RosMatrix(const YAML::Node& root, const char* key, const std::string& path,
-                              int rows, int cols) {
+std::vector<double> RosMatrix(
+    const YAML::Node& root, const char* key, const std::string& path, int rows, int cols) {
   const YAML::Node m = root[key];
   if (!m) ThrowInputError({path, 1}, std::string("missing ") + key);
   if (!m.IsMap() || !m["data"] || !m["data"].IsSequence())
@@ -28,10 +28,10 @@ std::vector<double> RosMatrix(const YAML::Node& root, const char* key, const std
   const int file_cols = YamlInt(m["cols"], path, std::string(key) + ".cols");
   if ((rows > 0 && file_rows != rows) || (cols > 0 && file_cols != cols) || file_rows < 1 ||
       file_cols < 1 || file_rows * static_cast<size_t>(file_cols) != m["data"].size())
-    ThrowInputError(WhereIs(m, path), std::string(key) + ": rows x cols must be " +
-                                          (rows > 0 ? std::to_string(rows) : "n") + " x " +
-                                          (cols > 0 ? std::to_string(cols) : "n") +
-                                          " and match the data's length");
+    ThrowInputError(WhereIs(m, path),
+                    std::string(key) + ": rows x cols must be " +
+                        (rows > 0 ? std::to_string(rows) : "n") + " x " +
+                        (cols > 0 ? std::to_string(cols) : "n") + " and match the data's length");
   std::vector<double> values;
   for (const auto& v : m["data"]) values.push_back(YamlBounded(v, path, key, -1e7, 1e7));
   return values;
@@ -47,8 +47,9 @@ CameraFile ReadRosCameraInfo(const std::string& path, const CameraReadOptions& o
   const std::vector<double> k = RosMatrix(root, "camera_matrix", path, 3, 3);
   const SourceRef k_where = WhereIs(root["camera_matrix"], path);
   if (k[1] != 0 || k[3] != 0 || k[6] != 0 || k[7] != 0 || k[8] != 1)
-    ThrowInputError(k_where, "camera_matrix must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
-                             "modelled)");
+    ThrowInputError(k_where,
+                    "camera_matrix must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
+                    "modelled)");
   if (!(k[0] > 0 && k[4] > 0)) ThrowInputError(k_where, "fx, fy must be > 0 px");
   std::string model = "plumb_bob";
   if (root["distortion_model"])
@@ -57,16 +58,18 @@ CameraFile ReadRosCameraInfo(const std::string& path, const CameraReadOptions& o
     file.notes.push_back("no distortion_model: plumb_bob (camera_calibration_parsers' rule)");
   const std::vector<double> d = RosMatrix(root, "distortion_coefficients", path, 0, 0);
   const SourceRef d_where = WhereIs(root["distortion_coefficients"], path);
-  const size_t n = model == "plumb_bob" ? 5 : model == "rational_polynomial" ? 8
-                                        : model == "equidistant"         ? 4
-                                                                         : 0;
+  const size_t n = model == "plumb_bob"             ? 5
+                   : model == "rational_polynomial" ? 8
+                   : model == "equidistant"         ? 4
+                                                    : 0;
   if (n == 0)
     ThrowInputError(WhereIs(root["distortion_model"], path),
                     "distortion_model '" + model +
                         "' is not supported (plumb_bob, rational_polynomial, equidistant)");
   if (d.size() != n)
-    ThrowInputError(d_where, model + " needs " + std::to_string(n) + " distortion coefficients (got " +
-                                 std::to_string(d.size()) + ")");
+    ThrowInputError(d_where,
+                    model + " needs " + std::to_string(n) + " distortion coefficients (got " +
+                        std::to_string(d.size()) + ")");
   if (model == "equidistant") {
     file.camera.model = OpenCvFisheyeModel::kId;
     file.camera.params = {k[0], k[4], k[2], k[5], d[0], d[1], d[2], d[3]};
@@ -106,8 +109,8 @@ void WriteRosCameraInfo(const std::string& path, const CameraFile& file) {
   // fx fy cx cy lead both models' parameters.
   const std::string fx = n(p[0]), fy = n(p[1]), cx = n(p[2]), cy = n(p[3]);
   std::ostringstream out;
-  out << "image_width: " << file.camera.frame.width_px << "\nimage_height: "
-      << file.camera.frame.height_px << "\ncamera_name: \""
+  out << "image_width: " << file.camera.frame.width_px
+      << "\nimage_height: " << file.camera.frame.height_px << "\ncamera_name: \""
       << internal::YamlQuoted(internal::OneLine(file.name)) << "\"\ncamera_matrix:\n  rows: 3\n"
       << "  cols: 3\n  data: [" << fx << ", 0, " << cx << ", 0, " << fy << ", " << cy
       << ", 0, 0, 1]\ndistortion_model: " << model << "\ndistortion_coefficients:\n  rows: 1\n"

@@ -1,11 +1,10 @@
 // ZIP members with zlib's raw inflate (zip_archive.h).
 #include "calib/camera/formats/zip_archive.h"
 
-#include <cstdint>
-
-#include <zlib.h>
-
 #include "calib/core/error.h"
+
+#include <cstdint>
+#include <zlib.h>
 
 namespace aerocal::calib::internal {
 namespace {
@@ -57,7 +56,9 @@ std::vector<Member> Members(const std::string& b, const std::string& where) {
 
 }  // namespace
 
-bool LooksLikeZip(const std::string& bytes) { return bytes.size() >= 4 && Le(bytes, 0, 4) == kLocalHeader; }
+bool LooksLikeZip(const std::string& bytes) {
+  return bytes.size() >= 4 && Le(bytes, 0, 4) == kLocalHeader;
+}
 
 std::vector<std::string> ZipMemberNames(const std::string& bytes, const std::string& where) {
   std::vector<std::string> names;

@@ -17,7 +17,8 @@ std::vector<std::string> ZipMemberNames(const std::string& bytes, const std::str
 
 /// The uncompressed bytes of member `name` (InputError naming `where` and the members when it is
 /// absent or cannot be read; members above 256 MiB are refused).
-std::string ReadZipMember(const std::string& bytes, const std::string& name,
+std::string ReadZipMember(const std::string& bytes,
+                          const std::string& name,
                           const std::string& where);
 
 }  // namespace aerocal::calib::internal

@@ -1,5 +1,5 @@
-// COLMAP's pinhole-family camera models as EXACT parameter subsets of OpenCvModel (models/opencv.h):
-// the distortion formula is OpenCV's, written once there.
+// COLMAP's pinhole-family camera models as EXACT parameter subsets of OpenCvModel
+// (models/opencv.h): the distortion formula is OpenCV's, written once there.
 //
 // Source: COLMAP documentation "Camera Models" (https://colmap.github.io/cameras.html) and
 // src/colmap/sensor/models.h: SIMPLE_PINHOLE (f, cx, cy), PINHOLE (fx, fy, cx, cy),
@@ -129,12 +129,22 @@ struct OpenCv {
   static constexpr std::string_view kName = "colmap_opencv";
   static constexpr std::string_view kColmapName = "OPENCV";
   enum Index : int { kFx_, kFy_, kCx_, kCy_, kK1_, kK2_, kP1_, kP2_, kNumParams };
-  static constexpr std::array<ParamInfo, kNumParams> kParams = {
-      {kFx, kFy, kCx, kCy, M::kParams[M::kK1], M::kParams[M::kK2], M::kParams[M::kP1],
-       M::kParams[M::kP2]}};
-  static constexpr std::array<unsigned, kNumParams> kSlots = {
-      {Bit(M::kFx), Bit(M::kFy), Bit(M::kCx), Bit(M::kCy), Bit(M::kK1), Bit(M::kK2),
-       Bit(M::kP1), Bit(M::kP2)}};
+  static constexpr std::array<ParamInfo, kNumParams> kParams = {{kFx,
+                                                                 kFy,
+                                                                 kCx,
+                                                                 kCy,
+                                                                 M::kParams[M::kK1],
+                                                                 M::kParams[M::kK2],
+                                                                 M::kParams[M::kP1],
+                                                                 M::kParams[M::kP2]}};
+  static constexpr std::array<unsigned, kNumParams> kSlots = {{Bit(M::kFx),
+                                                               Bit(M::kFy),
+                                                               Bit(M::kCx),
+                                                               Bit(M::kCy),
+                                                               Bit(M::kK1),
+                                                               Bit(M::kK2),
+                                                               Bit(M::kP1),
+                                                               Bit(M::kP2)}};
 };
 struct FullOpenCv {
   static constexpr CameraModelId kId = CameraModelId::kColmapFullOpenCv;
@@ -142,9 +152,18 @@ struct FullOpenCv {
   static constexpr std::string_view kColmapName = "FULL_OPENCV";
   enum Index : int { kNumParams = M::kNumParams };  // OpenCV's order and names
   static constexpr std::array<ParamInfo, kNumParams> kParams = M::kParams;
-  static constexpr std::array<unsigned, kNumParams> kSlots = {
-      {Bit(0), Bit(1), Bit(2), Bit(3), Bit(4), Bit(5), Bit(6), Bit(7), Bit(8), Bit(9), Bit(10),
-       Bit(11)}};
+  static constexpr std::array<unsigned, kNumParams> kSlots = {{Bit(0),
+                                                               Bit(1),
+                                                               Bit(2),
+                                                               Bit(3),
+                                                               Bit(4),
+                                                               Bit(5),
+                                                               Bit(6),
+                                                               Bit(7),
+                                                               Bit(8),
+                                                               Bit(9),
+                                                               Bit(10),
+                                                               Bit(11)}};
 };
 }  // namespace colmap_internal
 

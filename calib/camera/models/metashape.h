@@ -3,9 +3,9 @@
 //
 // Source: Agisoft Metashape User Manual (Professional Edition 1.6-2.x), Appendix C "Camera models",
 // "Frame cameras": with x = X/Z, y = Y/Z (camera x right, y down, z forward), r^2 = x^2 + y^2,
-//   x' = x (1 + K1 r^2 + K2 r^4 + K3 r^6 + K4 r^8) + (P1 (r^2 + 2 x^2) + 2 P2 x y)(1 + P3 r^2 + P4 r^4)
-//   y' = y (1 + K1 r^2 + K2 r^4 + K3 r^6 + K4 r^8) + (P2 (r^2 + 2 y^2) + 2 P1 x y)(1 + P3 r^2 + P4 r^4)
-//   u = w / 2 + cx + x' f + x' B1 + y' B2,   v = h / 2 + cy + y' f
+//   x' = x (1 + K1 r^2 + K2 r^4 + K3 r^6 + K4 r^8) + (P1 (r^2 + 2 x^2) + 2 P2 x y)(1 + P3 r^2 + P4
+//   r^4) y' = y (1 + K1 r^2 + K2 r^4 + K3 r^6 + K4 r^8) + (P2 (r^2 + 2 y^2) + 2 P1 x y)(1 + P3 r^2
+//   + P4 r^4) u = w / 2 + cx + x' f + x' B1 + y' B2,   v = h / 2 + cy + y' f
 // "the image coordinate system has the origin at the top left image pixel, with the center of the
 // top left pixel having coordinates (0.5, 0.5)". The same formulas and the (0.5, 0.5) corner are
 // quoted from Appendix C in the Agisoft forum thread on the distortion plot (agisoft.com/forum,

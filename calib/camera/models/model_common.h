@@ -15,15 +15,15 @@
 //                (the camera looks along -W; CONVENTIONS.md collinearity).
 #pragma once
 
-#include <array>
-#include <cmath>
-#include <string_view>
+#include "calib/camera/pixel_frame.h"
 
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <ceres/jet.h>
 
-#include "calib/camera/pixel_frame.h"
+#include <array>
+#include <cmath>
+#include <string_view>
 
 namespace aerocal::calib {
 
@@ -39,11 +39,16 @@ struct ParamInfo {
 /// decentering, affinity.
 constexpr std::string_view ParamGroupName(ParamGroup group) {
   switch (group) {
-    case ParamGroup::kPrincipalDistance: return "principal_distance";
-    case ParamGroup::kPrincipalPoint: return "principal_point";
-    case ParamGroup::kRadial: return "radial";
-    case ParamGroup::kDecentering: return "decentering";
-    case ParamGroup::kAffinity: return "affinity";
+    case ParamGroup::kPrincipalDistance:
+      return "principal_distance";
+    case ParamGroup::kPrincipalPoint:
+      return "principal_point";
+    case ParamGroup::kRadial:
+      return "radial";
+    case ParamGroup::kDecentering:
+      return "decentering";
+    case ParamGroup::kAffinity:
+      return "affinity";
   }
   return "";
 }
@@ -60,8 +65,8 @@ enum class CameraModelId : int {
   kColmapRadial = 7,
   kColmapOpenCv = 8,
   kColmapFullOpenCv = 9,
-  kMetashapeFrame = 10,     // Agisoft Metashape frame camera (models/metashape.h)
-  kPix4dPerspective = 11,   // Pix4D perspective lens (models/pix4d.h)
+  kMetashapeFrame = 10,    // Agisoft Metashape frame camera (models/metashape.h)
+  kPix4dPerspective = 11,  // Pix4D perspective lens (models/pix4d.h)
 };
 
 /// Index of a parameter by its table name; -1 when unknown.
@@ -89,8 +94,14 @@ double ValueOf(const ceres::Jet<U, K>& j) {
 /// `centre` (the target moved there from f(centre) in steps). False when neither reaches the
 /// target to |step| < tolerance on that branch (the target lies beyond the fold: not invertible).
 template <int kNumParams, typename T, typename F>
-bool InvertMap2(const F& f, const T* params, const T* target, const double* start, T* out,
-                double tolerance, int max_iterations = 50, const double* centre = nullptr) {
+bool InvertMap2(const F& f,
+                const T* params,
+                const T* target,
+                const double* start,
+                T* out,
+                double tolerance,
+                int max_iterations = 50,
+                const double* centre = nullptr) {
   using J = ceres::Jet<double, 2>;
   J pj[kNumParams];
   for (int i = 0; i < kNumParams; ++i) pj[i] = J(ValueOf(params[i]));
@@ -118,7 +129,8 @@ bool InvertMap2(const F& f, const T* params, const T* target, const double* star
     }
     return false;
   };
-  const Eigen::Vector2d middle = centre ? Eigen::Vector2d(centre[0], centre[1]) : Eigen::Vector2d::Zero();
+  const Eigen::Vector2d middle =
+      centre ? Eigen::Vector2d(centre[0], centre[1]) : Eigen::Vector2d::Zero();
   // The branch of `centre`: no fold (det J <= 0) on the segment from it to the solution.
   const auto on_centre_branch = [&](const Eigen::Vector2d& x) {
     for (int k = 1; k < 8; ++k) {
@@ -167,7 +179,9 @@ struct ForwardCameraModel {
   static constexpr bool kCorrectionForm = false;
 
   template <typename T>
-  static bool MeasuredFromIdeal(const T* params, const PixelFrame& frame, const T* ideal_mm,
+  static bool MeasuredFromIdeal(const T* params,
+                                const PixelFrame& frame,
+                                const T* ideal_mm,
                                 T* measured_mm) {
     const T c = Derived::PrincipalDistanceMm(params, frame);
     const T n[2] = {ideal_mm[0] / c, -ideal_mm[1] / c};
@@ -180,7 +194,9 @@ struct ForwardCameraModel {
   /// Newton inversion of Project, started at the pinhole inverse; tolerance 1e-13 in normalised
   /// coordinates (~1e-9 px at f = 10000 px).
   template <typename T>
-  static bool IdealFromMeasured(const T* params, const PixelFrame& frame, const T* measured_mm,
+  static bool IdealFromMeasured(const T* params,
+                                const PixelFrame& frame,
+                                const T* measured_mm,
                                 T* ideal_mm) {
     T pixel[2];
     frame.PixelFromPhoto(measured_mm, pixel);

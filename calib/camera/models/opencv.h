@@ -90,10 +90,14 @@ struct OpenCvFisheyeModel : ForwardCameraModel<OpenCvFisheyeModel> {
   static constexpr std::string_view kName = "opencv_fisheye";
   enum Index : int { kFx, kFy, kCx, kCy, kK1, kK2, kK3, kK4, kNumParams };
   static constexpr std::array<ParamInfo, kNumParams> kParams = {
-      {OpenCvModel::kParams[OpenCvModel::kFx], OpenCvModel::kParams[OpenCvModel::kFy],
-       OpenCvModel::kParams[OpenCvModel::kCx], OpenCvModel::kParams[OpenCvModel::kCy],
-       OpenCvModel::kParams[OpenCvModel::kK1], OpenCvModel::kParams[OpenCvModel::kK2],
-       OpenCvModel::kParams[OpenCvModel::kK3], OpenCvModel::kParams[OpenCvModel::kK4]}};
+      {OpenCvModel::kParams[OpenCvModel::kFx],
+       OpenCvModel::kParams[OpenCvModel::kFy],
+       OpenCvModel::kParams[OpenCvModel::kCx],
+       OpenCvModel::kParams[OpenCvModel::kCy],
+       OpenCvModel::kParams[OpenCvModel::kK1],
+       OpenCvModel::kParams[OpenCvModel::kK2],
+       OpenCvModel::kParams[OpenCvModel::kK3],
+       OpenCvModel::kParams[OpenCvModel::kK4]}};
 
   template <typename T>
   static void Distort(const T* k, const T* n, T* nd) {

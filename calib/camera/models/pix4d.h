@@ -89,8 +89,7 @@ struct Pix4dPerspectiveModel : ForwardCameraModel<Pix4dPerspectiveModel> {
     p[kR3] = cv[M::kK3];
     p[kT1] = cv[M::kP1];
     p[kT2] = cv[M::kP2];
-    return cv[M::kFx] == cv[M::kFy] && cv[M::kK4] == 0.0 && cv[M::kK5] == 0.0 &&
-           cv[M::kK6] == 0.0;
+    return cv[M::kFx] == cv[M::kFy] && cv[M::kK4] == 0.0 && cv[M::kK5] == 0.0 && cv[M::kK6] == 0.0;
   }
 };
 

@@ -14,9 +14,9 @@
 // what the start-degree fit knows and at least the distance the selection moved the table.
 #pragma once
 
-#include <set>
-
 #include <Eigen/Core>
+
+#include <set>
 
 namespace aerocal::triangulation {
 
@@ -25,7 +25,9 @@ namespace aerocal::triangulation {
 struct TableValue {
   double value = 0.0, variance = 0.0;
 };
-TableValue EvaluateDetectorPolynomial(const double* coefficients, const Eigen::MatrixXd& q, int axis,
+TableValue EvaluateDetectorPolynomial(const double* coefficients,
+                                      const Eigen::MatrixXd& q,
+                                      int axis,
                                       double u);
 
 /// Top-down Wald test of one axis: from `start_degree` down, drop the highest free coefficient
@@ -34,8 +36,12 @@ TableValue EvaluateDetectorPolynomial(const double* coefficients, const Eigen::M
 /// stop the test. The reduced model's estimate and variance come from the start fit by restricted
 /// least squares (b_e - Q_eB Q_BB^-1 b_B, Q_ee - Q_eB Q_BB^-1 Q_Be), so one solve serves every
 /// step. Returns the highest kept degree; -1 when every free term was dropped.
-int TopDownWaldDegree(const double* coefficients, const Eigen::MatrixXd& q, int axis, int start_degree,
-                      const std::set<int>& held, double alpha);
+int TopDownWaldDegree(const double* coefficients,
+                      const Eigen::MatrixXd& q,
+                      int axis,
+                      int start_degree,
+                      const std::set<int>& held,
+                      double alpha);
 
 /// Sigma of one table value after the degree test: sqrt(s_r^2 + max(d^2, s_0^2 - s_r^2)), with
 /// s_r the selected (reduced) fit's sigma, s_0 the start-degree fit's and d the reduced minus the

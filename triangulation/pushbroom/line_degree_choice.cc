@@ -1,20 +1,22 @@
-#include "triangulation/pushbroom/line_degree_test.h"
-
-#include <algorithm>
-#include <cmath>
-#include <vector>
-
-#include <Eigen/Cholesky>
+#include "triangulation/pushbroom/line_degree_choice.h"
 
 #include "calib/camera/line_camera.h"
 #include "calib/problem/problem_builder.h"
 #include "calib/residuals/line_collinearity.h"
 
+#include <Eigen/Cholesky>
+
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
 namespace aerocal::triangulation {
 
 using calib::kLineMaxTerms;
 
-TableValue EvaluateDetectorPolynomial(const double* coefficients, const Eigen::MatrixXd& q, int axis,
+TableValue EvaluateDetectorPolynomial(const double* coefficients,
+                                      const Eigen::MatrixXd& q,
+                                      int axis,
                                       double u) {
   const int base = axis * kLineMaxTerms;
   TableValue out;
@@ -27,8 +29,12 @@ TableValue EvaluateDetectorPolynomial(const double* coefficients, const Eigen::M
   return out;
 }
 
-int TopDownWaldDegree(const double* coefficients, const Eigen::MatrixXd& q, int axis, int start_degree,
-                      const std::set<int>& held, double alpha) {
+int TopDownWaldDegree(const double* coefficients,
+                      const Eigen::MatrixXd& q,
+                      int axis,
+                      int start_degree,
+                      const std::set<int>& held,
+                      double alpha) {
   const int base = axis * kLineMaxTerms;
   const double z = calib::NormalCriticalValue(alpha);
   std::vector<int> dropped;

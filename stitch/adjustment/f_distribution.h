@@ -1,5 +1,6 @@
 // F distribution for the variance-ratio test between nested least-squares models.
-// With v^T P v and redundancy r of a simpler model (s) and a richer one (c) on the same observations,
+// With v^T P v and redundancy r of a simpler model (s) and a richer one (c) on the same
+// observations,
 //   F = ((vtpv_s - vtpv_c) / (r_s - r_c)) / (vtpv_c / r_c)  ~  F(r_s - r_c, r_c)
 // when the extra parameters of the richer model are zero (Koch, Parameter Estimation and
 // Hypothesis Testing in Linear Models, section 4.2). The CDF is the regularized incomplete beta
