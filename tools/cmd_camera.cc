@@ -69,10 +69,16 @@ struct ReadArgs {
   }
 };
 
+// Without --max-residual-px a conversion is still refused when its fit misses by more than a
+// pixel somewhere on the format (issue 37 class 3): such a camera is not the one read, whatever
+// format holds it. Given, --max-residual-px replaces this limit and also chooses the coefficients.
+constexpr double kDefaultMaxResidualPx = 1.0;
+
 struct ConvertArgs {
   ReadArgs read;
   std::string to, out, model, report;
-  double max_residual_px = std::numeric_limits<double>::infinity();
+  double max_residual_px = kDefaultMaxResidualPx;
+  bool max_residual_given = false;  // chooses the fewest coefficients meeting it (else 0.01 px)
   int max_coefficients = kDefaultMaxCoefficients;
 };
 
@@ -98,11 +104,13 @@ int RunConvert(const ConvertArgs& a) {
     target.model = *id;
   }
   calib::ConvertOptions options;
-  options.max_residual_px = a.max_residual_px;
+  options.max_residual_px =
+      a.max_residual_given ? a.max_residual_px : std::numeric_limits<double>::infinity();
   std::vector<std::string> tried;
   const calib::FileConversion conversion =
       calib::ConvertCameraFileSimplest(source, target, options, a.max_coefficients, &tried);
   const calib::ConversionResult& r = conversion.result;
+  const bool acceptable = r.acceptable && r.residual.max_px <= a.max_residual_px;
   for (const std::string& line : tried) std::printf("  %s\n", line.c_str());
   std::vector<std::string> notes = source.notes;
   notes.insert(notes.end(), conversion.notes.begin(), conversion.notes.end());
@@ -135,7 +143,7 @@ int RunConvert(const ConvertArgs& a) {
       {"source_model", std::string(calib::CameraModelName(source.camera.model))},
       {"model", model},
       {"exact", r.exact},
-      {"acceptable", r.acceptable},
+      {"acceptable", acceptable},
       {"fit_iterations", r.fit_iterations},
       {"residual_px",
        {{"rms", r.residual.rms_px},
@@ -153,14 +161,15 @@ int RunConvert(const ConvertArgs& a) {
   // says why OUT was not written).
   OutputSet set(std::filesystem::path(a.out).parent_path().string());
   if (!a.report.empty()) WriteResult(set.StagePath(a.report), "camera_conversion", report);
-  if (!r.acceptable) {
+  if (!acceptable) {
     if (!a.report.empty()) set.Commit({});
     LogWarning("conversion_residual: " + DescribeConversion(r) +
                (r.residual.failed_points
                     ? " (" + std::to_string(r.residual.failed_points) + " points not invertible)"
                     : "") +
-               " exceeds --max-residual-px " + FormatNumber(a.max_residual_px) + "; " + a.out +
-               " not written");
+               " exceeds " + (a.max_residual_given ? "--max-residual-px " : "the default limit ") +
+               FormatNumber(a.max_residual_px) + " px; " + a.out + " not written" +
+               (a.max_residual_given ? "" : " (a larger --max-residual-px accepts it)"));
     return kExitNotConverged;
   }
   calib::WriteCameraFileVerified(to, set.StagePath(a.out), written);
@@ -336,9 +345,10 @@ CommandRun Setup(CLI::App& app) {
                  "JSON: {exact, acceptable, residual_px: {rms, max, max_at, max_inner80}, notes}");
   cv->add_option("--max-residual-px",
                  convert->max_residual_px,
-                 "A conversion leaving more (max over the format, px) is an error: exit 3, OUT "
-                 "not written")
-      ->check(PositiveUpTo(1e6));
+                 "A conversion leaving more (max over the format, px) does not fit: exit 3, OUT "
+                 "not written; given, it also chooses the fewest coefficients meeting it")
+      ->check(PositiveUpTo(1e6))
+      ->each([convert](const std::string&) { convert->max_residual_given = true; });
   cv->add_option("--max-coefficients",
                  convert->max_coefficients,
                  "OpenCV-form targets (opencv, ros, dji, colmap) reached by a fit: at most this "

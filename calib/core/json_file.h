@@ -12,13 +12,10 @@ namespace aerocal {
 int LineOfOffset(const std::string& text, size_t offset);
 
 /// Parses `text` (the contents of `path`); InputError("PATH:LINE: invalid JSON (reason)") when it
-/// is not a JSON document.
+/// is not a JSON document, and InputError("PATH: a / b: key \"k\" occurs twice in one object")
+/// when an object holds a key twice: nlohmann would keep the last, and no reader (ours or another
+/// tool's files) may choose silently (issue 37 class 4). The path names the enclosing keys.
 nlohmann::json ParseJsonText(const std::string& text, const std::string& path);
-
-/// InputError("PATH: a / b: key \"k\" occurs twice in one object") when an object of `text` (a
-/// JSON document ParseJsonText accepted) holds a key twice: nlohmann keeps the last, a reader of
-/// another tool's file must not choose (issue 37 class 4). The path names the object's keys.
-void RejectDuplicateJsonKeys(const std::string& text, const std::string& path);
 
 /// ReadTextFile (regular-file checks, BOM dropped) + ParseJsonText.
 nlohmann::json ReadJsonFile(const std::string& path);

@@ -61,5 +61,25 @@ TEST(ParseJsonText, NumberOverflowIsAnInputErrorNamingTheFile) {
   }
 }
 
+// Every JSON reader refuses a key given twice in one object (nlohmann would keep the last), at any
+// depth, naming the enclosing keys; the same key in two objects is fine.
+TEST(ParseJsonText, AKeyGivenTwiceInOneObjectIsAnInputErrorNamingItsPath) {
+  EXPECT_NO_THROW(
+      ParseJsonText(R"({"a": {"k": 1}, "b": {"k": 2}, "c": [{"k": 1}, {"k": 2}]})", "result.json"));
+  const std::pair<const char*, const char*> cases[] = {
+      {R"({"kind": "adjust", "kind": "flight"})", "result.json: key \"kind\" occurs twice"},
+      {R"({"cameras": {"c1": {"c": 1, "x0": 2, "c": 3}}})",
+       "result.json: cameras / c1: key \"c\" occurs twice"},
+      {R"({"list": [{"u": 1}, {"u": 2, "u": 3}]})", "result.json: list: key \"u\" occurs twice"}};
+  for (const auto& [text, message] : cases) {
+    try {
+      ParseJsonText(text, "result.json");
+      ADD_FAILURE() << "accepted " << text;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  }
+}
+
 }  // namespace
 }  // namespace aerocal

@@ -328,5 +328,31 @@ TEST(CliCamera, MaxResidualTurnsABadFitIntoExit3AndWritesNothing) {
   EXPECT_NE(Read(tmp.File("dji.yaml")).find("model: opencv"), std::string::npos);
 }
 
+// Issue 37 class 3: the same fit (max > 5 px) without --max-residual-px is refused by the default
+// limit of 1 px (a camera missing by more is not the one read); a larger limit, given, accepts it.
+TEST(CliCamera, AFitMissingByMoreThanAPixelIsExit3WithoutAGate) {
+  TempDir tmp("aerocal_cli_camera_default_limit");
+  const std::string dji = tmp.File("dji.txt");
+  std::ofstream(dji)
+      << "3684.48,3677.57,2.24,22.05,-0.263482,0.106788,3.71107e-5,-3.27247e-4,-0.0300783\n";
+  const std::string args = "camera convert --from dji --to aerocal --model brown10 " + dji + " " +
+                           tmp.File("ours.yaml") +
+                           " --width 5472 --height 3648 --pixel-size-mm 0.0024 --report " +
+                           tmp.File("r.json");
+  const auto refused = RunAerocal(args);
+  EXPECT_EQ(refused.exit_code, 3) << refused.output;
+  EXPECT_NE(refused.output.find("conversion_residual"), std::string::npos) << refused.output;
+  EXPECT_NE(refused.output.find("exceeds the default limit 1 px"), std::string::npos)
+      << refused.output;
+  EXPECT_FALSE(fs::exists(tmp.File("ours.yaml")));
+  EXPECT_FALSE(nlohmann::json::parse(Read(tmp.File("r.json")))["acceptable"].get<bool>());
+  const auto accepted = RunAerocal(args + " --max-residual-px 1000");
+  EXPECT_EQ(accepted.exit_code, 0) << accepted.output;
+  EXPECT_TRUE(fs::exists(tmp.File("ours.yaml")));
+  const auto json = nlohmann::json::parse(Read(tmp.File("r.json")));
+  EXPECT_TRUE(json["acceptable"].get<bool>());
+  EXPECT_GT(json["residual_px"]["max"].get<double>(), 1.0);
+}
+
 }  // namespace
 }  // namespace aerocal

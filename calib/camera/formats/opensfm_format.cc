@@ -33,7 +33,6 @@ int LineOfKey(const std::string& text, const std::string& key, size_t from) {
 CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options) {
   const std::string text = ReadTextFile(path);
   Json root = ParseJsonText(text, path);
-  RejectDuplicateJsonKeys(text, path);
   const Json* cameras = &root;
   if (root.is_array() && !root.empty() && root[0].is_object() && root[0].contains("cameras"))
     cameras = &root[0]["cameras"];
