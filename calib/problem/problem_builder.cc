@@ -482,15 +482,10 @@ std::unique_ptr<ceres::Problem> ProblemBuilder::CopyInBlockOrder(std::vector<dou
   return mirror;
 }
 
-SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
-  ReleaseFactorized();  // stale after the solve; its memory is the solver's now
-  SolveReport report;
-  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
-  if (!UpdateManifolds())
-    report.diagnostics.push_back(
-        "the residuals cannot be evaluated at the starting values (a point behind a camera?)");
+namespace {
 
+// Ceres' options from ours: tolerances, threads (one when deterministic), the iteration log.
+ceres::Solver::Options BaseCeresOptions(const SolverOptions& options) {
   ceres::Solver::Options ceres_options;
   ceres_options.max_num_iterations = options.max_iterations;
   ceres_options.function_tolerance = options.function_tolerance;
@@ -506,20 +501,20 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   ceres_options.minimizer_progress_to_stdout = verbose;
   ceres_options.logging_type = verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
 
-  std::unique_ptr<ceres::Problem> mirror;  // the Schur solve's problem (see the ordering below)
-  std::vector<double> mirror_buffer;
-  std::vector<double*> mirror_pointers;
-  int eliminable_params = 0, other_params = 0;
-  std::vector<BlockId> eliminable;
-  for (BlockId id : free_blocks) {
-    const Block& b = blocks_[id];
-    if (b.Eliminable()) {
-      eliminable.push_back(id);
-      eliminable_params += b.TangentSize();
-    } else {
-      other_params += b.TangentSize();
-    }
-  }
+  return ceres_options;
+}
+
+// The linear solver: options.linear_solver, or by the problem's size (kAuto): dense QR for small
+// problems, a Schur solver when points can be eliminated beside other parameters (iterative above
+// min_iterative_schur_parameters, dense up to max_dense_schur_parameters or without a sparse
+// library, else sparse), else sparse normal Cholesky. Sets it in `ceres_options`; returns its name.
+std::string SetLinearSolver(const SolverOptions& options,
+                            int eliminable_params,
+                            int other_params,
+                            bool has_eliminable,
+                            ceres::Solver::Options* ceres_options_ptr) {
+  ceres::Solver::Options& ceres_options = *ceres_options_ptr;
+  std::string name;
   const bool sparse_available =
       ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::SUITE_SPARSE) ||
       ceres::IsSparseLinearAlgebraLibraryTypeAvailable(ceres::EIGEN_SPARSE);
@@ -527,7 +522,7 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   if (choice == LinearSolverChoice::kAuto) {
     if (eliminable_params + other_params <= options.max_dense_qr_parameters)
       choice = LinearSolverChoice::kDenseQr;
-    else if (!eliminable.empty() && other_params > 0)
+    else if (has_eliminable && other_params > 0)
       choice = options.min_iterative_schur_parameters > 0 &&
                        other_params > options.min_iterative_schur_parameters
                    ? LinearSolverChoice::kIterativeSchur
@@ -542,26 +537,57 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
     case LinearSolverChoice::kDenseQr:
     case LinearSolverChoice::kAuto:
       ceres_options.linear_solver_type = ceres::DENSE_QR;
-      report.linear_solver = "dense_qr";
+      name = "dense_qr";
       break;
     case LinearSolverChoice::kDenseSchur:
       ceres_options.linear_solver_type = ceres::DENSE_SCHUR;
-      report.linear_solver = "dense_schur";
+      name = "dense_schur";
       break;
     case LinearSolverChoice::kSparseSchur:
       ceres_options.linear_solver_type = ceres::SPARSE_SCHUR;
-      report.linear_solver = "sparse_schur";
+      name = "sparse_schur";
       break;
     case LinearSolverChoice::kIterativeSchur:
       ceres_options.linear_solver_type = ceres::ITERATIVE_SCHUR;
       ceres_options.preconditioner_type = ceres::SCHUR_JACOBI;
-      report.linear_solver = "iterative_schur";
+      name = "iterative_schur";
       break;
     case LinearSolverChoice::kSparseNormalCholesky:
       ceres_options.linear_solver_type = ceres::SPARSE_NORMAL_CHOLESKY;
-      report.linear_solver = "sparse_normal_cholesky";
+      name = "sparse_normal_cholesky";
       break;
   }
+  return name;
+}
+
+}  // namespace
+
+SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
+  const auto start = std::chrono::steady_clock::now();
+  ReleaseFactorized();  // stale after the solve; its memory is the solver's now
+  SolveReport report;
+  const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
+  if (!UpdateManifolds())
+    report.diagnostics.push_back(
+        "the residuals cannot be evaluated at the starting values (a point behind a camera?)");
+
+  ceres::Solver::Options ceres_options = BaseCeresOptions(options);
+  std::unique_ptr<ceres::Problem> mirror;  // the Schur solve's problem (see the ordering below)
+  std::vector<double> mirror_buffer;
+  std::vector<double*> mirror_pointers;
+  int eliminable_params = 0, other_params = 0;
+  std::vector<BlockId> eliminable;
+  for (BlockId id : free_blocks) {
+    const Block& b = blocks_[id];
+    if (b.Eliminable()) {
+      eliminable.push_back(id);
+      eliminable_params += b.TangentSize();
+    } else {
+      other_params += b.TangentSize();
+    }
+  }
+  report.linear_solver = SetLinearSolver(
+      options, eliminable_params, other_params, !eliminable.empty(), &ceres_options);
   if (ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
       ceres_options.linear_solver_type == ceres::SPARSE_SCHUR ||
       ceres_options.linear_solver_type == ceres::ITERATIVE_SCHUR) {
@@ -605,7 +631,18 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       std::max(0, static_cast<int>(summary.iterations.size()) - 1);  // [0] is the start
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
+  AddSolveStatistics(&report);
+  if (!report.converged)
+    report.diagnostics.push_back("the adjustment did not converge: " + summary.message);
+  for (BlockId id = 0; id < static_cast<BlockId>(blocks_.size()); ++id)
+    if (!blocks_[id].constant && blocks_[id].num_residuals == 0)
+      report.diagnostics.push_back("block " + blocks_[id].name + " has no observations");
+  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  return report;
+}
 
+void ProblemBuilder::AddSolveStatistics(SolveReport* report_ptr) const {
+  SolveReport& report = *report_ptr;
   // Statistics without the loss function: v^T P v per group and overall.
   std::map<std::string, ResidualGroupStats> groups;
   for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
@@ -632,13 +669,6 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
                                  " observations for " + std::to_string(report.n_unknowns) +
                                  " unknowns; sigma0 cannot be estimated");
   }
-  if (!report.converged)
-    report.diagnostics.push_back("the adjustment did not converge: " + summary.message);
-  for (BlockId id = 0; id < static_cast<BlockId>(blocks_.size()); ++id)
-    if (!blocks_[id].constant && blocks_[id].num_residuals == 0)
-      report.diagnostics.push_back("block " + blocks_[id].name + " has no observations");
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  return report;
 }
 
 namespace {

@@ -309,6 +309,9 @@ class ProblemBuilder {
   /// Subset manifolds of the free entries, columns scaled to unit Jacobian norm at the current
   /// values; false when the residuals cannot be evaluated there (then the scales are 1).
   bool UpdateManifolds();
+  /// v^T P v per group and overall without the loss function, observations, unknowns,
+  /// redundancy and sigma0 (a diagnostic when there is no redundancy) at the current values.
+  void AddSolveStatistics(SolveReport* report) const;
   /// The problem as Ceres must see it where it orders blocks by their address: the eliminable
   /// blocks (a Schur solve) or every block (`all`: ceres::Covariance, which sorts the Jacobian's
   /// columns by address) copied into one buffer in BlockId order (`buffer`; `pointers[id]` is
