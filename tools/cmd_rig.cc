@@ -30,6 +30,7 @@
 #include "tools/output_set.h"
 #include "tools/python_script.h"
 #include "tools/rig_design_document.h"
+#include "tools/rig_error_analysis_run.h"
 #include "tools/rig_stitch_run.h"
 #include "tools/suspect_effect_option.h"
 #include "triangulation/block/block_io.h"
@@ -50,182 +51,25 @@ namespace {
 
 namespace fs = std::filesystem;
 
-// Monte-Carlo samples of a whole --grid analysis (about 20 min at ~1 us a sample).
-constexpr double kMaxGridSamples = 1e9;
-
+// The command's options: the request and the outputs.
 struct ErrorAnalysisArgs {
-  std::string camera, limits, target, virtual_px, out;
-  double height_m = 0.0;  // 0: the rig file's virtual.height_m
-  int grid = 0;
-  int samples = 100000;
-  std::uint64_t seed = 1;
-  int bins = 60;
-  double relief_m = 100.0;
+  RigErrorAnalysisRequest request;
+  std::string out;
   bool no_plots = false;
 };
-
-// "COL,ROW" -> pixel; ConfigError naming the option otherwise.
-Eigen::Vector2d ParsePixel(const std::string& text, const std::string& option) {
-  const std::vector<std::string> fields = SplitCommaList(text, {true, true});
-  const auto col = fields.size() == 2 ? ParseDouble(fields[0]) : std::nullopt;
-  const auto row = fields.size() == 2 ? ParseDouble(fields[1]) : std::nullopt;
-  if (!col || !row) throw ConfigError(option + ": expected COL,ROW (got '" + text + "')");
-  return {*col, *row};
-}
-
-// --height-m when given (!= 0), else the rig file's virtual.height_m; ConfigError unless > 0.
 
 std::string PlotScript() {
   if (const char* env = std::getenv("AEROCAL_RIG_PLOT_SCRIPT")) return env;
   return (fs::path(AEROCAL_REPORT_SCRIPT).parent_path() / "rig_error_plots.py").string();
 }
 
-int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
-  CheckOutputFile(args.out, "--out");
-  const calib::Rig rig = calib::ReadRig(args.camera);
-  const stitch::ErrorLimits limits = stitch::ReadErrorLimits(args.limits);
-  if (rig.heads.size() < 2)
-    throw InputError(args.camera +
-                     ": a rig of one head is an ordinary camera; it has no "
-                     "conversion error to analyse");
-  double height_m = args.height_m;
-  if (height_m == 0.0) {
-    if (!rig.virtual_camera.height_m)
-      throw ConfigError("--height-m: the rig file " + args.camera +
-                        " has no virtual.height_m; give the relative flying height");
-    height_m = *rig.virtual_camera.height_m;
-  }
-  if (!(height_m >= 1 && height_m <= 1e5))
-    throw ConfigError("--height-m must be within 1 .. 100000 m (got " + FormatNumber(height_m) +
-                      ")");
-  if (!(limits.height_m < height_m))
-    throw InputError(args.limits + ": the height limit (" + FormatNumber(limits.height_m) +
-                     " m) must be below the flying height (" + FormatNumber(height_m) + " m)");
-  const int modes = !args.target.empty() + !args.virtual_px.empty() + (args.grid > 0);
-  if (modes > 1) throw ConfigError("--target, --virtual and --grid exclude each other");
-  if (args.samples < 0) throw ConfigError("--samples must be >= 0");
-  if (args.bins < 1) throw ConfigError("--bins must be >= 1");
-  if (args.grid < 0 || args.grid > 200) throw ConfigError("--grid must be within 1..200");
-  // Every grid target runs its own Monte-Carlo: the work is grid x grid x samples (x heads).
-  if (double(args.grid) * args.grid * args.samples > kMaxGridSamples)
-    throw ConfigError("--grid x --grid x --samples: " + std::to_string(args.grid) + " x " +
-                      std::to_string(args.grid) + " x " + std::to_string(args.samples) +
-                      " Monte-Carlo samples are more than 1e9 (fewer "
-                      "--samples or a coarser --grid)");
-  if (!(args.relief_m >= 0)) throw ConfigError("--relief-m must be >= 0");
-  if (!(args.relief_m < height_m))
-    throw ConfigError("--relief-m: " + FormatNumber(args.relief_m) +
-                      " m of relief reaches the flying height (" + FormatNumber(height_m) + " m)");
-
-  const int reference = rig.ReferenceIndex();
-  const stitch::RigExposure nadir;
-  const stitch::RigConverter nominal(
-      rig, nadir, stitch::MakeRectificationPlane(rig, nadir, height_m));
-  int head = -1;
-  Eigen::Vector2d virtual_px;
-  if (!args.target.empty()) {
-    const auto colon = args.target.find(':');
-    if (colon == std::string::npos)
-      throw ConfigError("--target: expected HEAD:COL,ROW (got '" + args.target + "')");
-    head = rig.HeadIndex(args.target.substr(0, colon));
-    if (head < 0)
-      throw ConfigError("--target: head '" + args.target.substr(0, colon) + "' is not in " +
-                        args.camera);
-    const auto v =
-        nominal.VirtualFromHead(head, ParsePixel(args.target.substr(colon + 1), "--target"));
-    if (!v) throw ConfigError("--target: the pixel does not reach the rectification plane");
-    virtual_px = *v;
-  } else if (!args.virtual_px.empty()) {
-    virtual_px = ParsePixel(args.virtual_px, "--virtual");
-    for (int k = 0; k < static_cast<int>(rig.heads.size()) && head < 0; ++k) {
-      if (k == reference) continue;
-      const auto p = nominal.HeadFromVirtual(k, virtual_px);
-      if (p && nominal.InHeadFormat(k, *p)) head = k;
-    }
-    if (head < 0)
-      throw ConfigError("--virtual: no non-reference head sees virtual pixel " + args.virtual_px);
-  } else if (args.grid == 0) {
-    // Default: the format centre of the first non-reference head.
-    head = reference == 0 ? 1 : 0;
-    const calib::Camera& camera = rig.heads[head].camera;
-    const auto v =
-        nominal.VirtualFromHead(head, {0.5 * (camera.width_px - 1), 0.5 * (camera.height_px - 1)});
-    if (!v)
-      throw InputError(args.camera + ": the centre of head " + rig.heads[head].id +
-                       " does not reach the rectification plane");
-    virtual_px = *v;
-  }
-  if (head == reference)
-    throw ConfigError("--target: " + rig.reference_head +
-                      " is the reference head, which realises the virtual camera (its conversion "
-                      "error is zero by definition); choose another head");
-
-  const fs::path out(args.out);
-  const std::string stem = out.stem().string();
-  stitch::ErrorAnalysisFiles files;
-  std::unique_ptr<stitch::GridAnalysis> grid;
-  stitch::TargetAnalysis target;
-  // A limit that breaks the conversion is a value of the limits file: the message names it.
-  const auto named = [&](const InputError& e) {
-    const std::string what = e.what();
-    return what.find("breaks the conversion") == std::string::npos
-               ? e
-               : InputError(args.limits + ": " + what + " (rig " + args.camera +
-                            ", H = " + FormatNumber(height_m) + " m)");
-  };
-  if (args.grid > 0) {
-    try {
-      grid = std::make_unique<stitch::GridAnalysis>(
-          stitch::AnalyseGrid(rig, height_m, limits, args.grid, args.samples, args.seed));
-    } catch (const InputError& e) {
-      throw named(e);
-    }
-    if (grid->points.empty())
-      throw InputError(args.camera + ": no grid point is seen by a non-reference head");
-    target = grid->points[grid->worst];
-    files.bound_map_csv = stem + "_bound_map.csv";
-  } else {
-    try {
-      target = stitch::AnalyseTarget(
-          rig, height_m, limits, head, virtual_px, args.samples, args.seed, true);
-    } catch (const InputError& e) {
-      throw named(e);
-    }
-    if (target.monte_carlo) files.histogram_csv = stem + "_histogram.csv";
-  }
-  if (!args.no_plots) {
-    if (!files.histogram_csv.empty()) files.histogram_png = stem + "_histogram.png";
-    if (!files.bound_map_csv.empty()) files.bound_map_png = stem + "_bound_map.png";
-  }
-  nlohmann::json doc =
-      stitch::ErrorAnalysisToJson(rig, height_m, limits, target, grid.get(), args.relief_m, files);
-  doc["camera_models"] = HeadCameraModels(rig);
-  // The JSON, its CSV files and plots are one set (tools/output_set.h): staged, then moved into
-  // place together; a failing plot replaces nothing of an earlier analysis.
-  OutputSet set(out.parent_path().string());
-  std::vector<std::string> parts = {out.filename().string()};
-  for (const std::string& name :
-       {files.histogram_csv, files.bound_map_csv, files.histogram_png, files.bound_map_png})
-    if (!name.empty()) parts.push_back(name);
-  if (!files.histogram_csv.empty())
-    WriteFileAtomically(set.Staged(files.histogram_csv),
-                        stitch::HistogramCsv(*target.monte_carlo, args.bins));
-  if (!files.bound_map_csv.empty())
-    WriteFileAtomically(set.Staged(files.bound_map_csv), stitch::BoundMapCsv(rig, *grid));
-  const std::string staged_json = set.Staged(out.filename().string());
-  WriteResult(staged_json, "rig_error_analysis", doc);
-  const bool plots =
-      !args.no_plots && !(files.histogram_png.empty() && files.bound_map_png.empty());
-  if (plots && !RunPythonScript(PlotScript(), {staged_json})) {
-    std::fprintf(stderr,
-                 "error: the plots could not be drawn (%s); nothing written, an earlier "
-                 "analysis in the folder is left as it was\n",
-                 PythonCommandLine(PlotScript(), {args.out}).c_str());
-    return kExitInternal;
-  }
-  set.Commit(parts);
-
-  // Summary for people.
+// The summary for people: the target's error per source, the worst case, the linear and the
+// Monte-Carlo bounds, the grid.
+void PrintErrorAnalysis(const RigErrorAnalysisRequest& args,
+                        const calib::Rig& rig,
+                        double height_m,
+                        const stitch::TargetAnalysis& target,
+                        const stitch::GridAnalysis* grid) {
   std::printf(
       "conversion error at virtual pixel (%.2f, %.2f) = head %s pixel (%.2f, %.2f), "
       "H = %g m\n",
@@ -277,6 +121,43 @@ int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
                 args.grid,
                 grid->points.size(),
                 grid->unseen.size());
+}
+
+int RunErrorAnalysis(const ErrorAnalysisArgs& args) {
+  CheckOutputFile(args.out, "--out");
+  const fs::path out(args.out);
+  const RigErrorAnalysisRun run =
+      RunRigErrorAnalysis(args.request, out.stem().string(), !args.no_plots);
+  const stitch::ErrorAnalysisFiles& files = run.files;
+  const stitch::TargetAnalysis& target = run.target;
+  const calib::Rig& rig = run.rig;
+  const nlohmann::json& doc = run.document;
+  // The JSON, its CSV files and plots are one set (tools/output_set.h): staged, then moved into
+  // place together; a failing plot replaces nothing of an earlier analysis.
+  OutputSet set(out.parent_path().string());
+  std::vector<std::string> parts = {out.filename().string()};
+  for (const std::string& name :
+       {files.histogram_csv, files.bound_map_csv, files.histogram_png, files.bound_map_png})
+    if (!name.empty()) parts.push_back(name);
+  if (!files.histogram_csv.empty())
+    WriteFileAtomically(set.Staged(files.histogram_csv),
+                        stitch::HistogramCsv(*target.monte_carlo, args.request.bins));
+  if (!files.bound_map_csv.empty())
+    WriteFileAtomically(set.Staged(files.bound_map_csv), stitch::BoundMapCsv(rig, *run.grid));
+  const std::string staged_json = set.Staged(out.filename().string());
+  WriteResult(staged_json, "rig_error_analysis", doc);
+  const bool plots =
+      !args.no_plots && !(files.histogram_png.empty() && files.bound_map_png.empty());
+  if (plots && !RunPythonScript(PlotScript(), {staged_json})) {
+    std::fprintf(stderr,
+                 "error: the plots could not be drawn (%s); nothing written, an earlier "
+                 "analysis in the folder is left as it was\n",
+                 PythonCommandLine(PlotScript(), {args.out}).c_str());
+    return kExitInternal;
+  }
+  set.Commit(parts);
+
+  PrintErrorAnalysis(args.request, rig, run.height_m, target, run.grid.get());
   return kExitOk;
 }
 
@@ -607,33 +488,35 @@ CommandRun Setup(CLI::App& app) {
       "Conversion error analysis of the rig's virtual image: maximum error, linear propagation, "
       "Monte-Carlo, at one target or over a grid");
   ea->option_defaults()->always_capture_default();
-  ea->add_option("--camera", args->camera, "Rig camera file (YAML with a rig section)")->required();
+  ea->add_option("--camera", args->request.camera, "Rig camera file (YAML with a rig section)")
+      ->required();
   ea->add_option("--limits",
-                 args->limits,
+                 args->request.limits,
                  "Limits file: limits {principal_point_px, principal_distance_px, angles_arcsec, "
                  "lever_arm_mm, height_m}, sigmas")
       ->required();
   ea->add_option("--height-m",
-                 args->height_m,
+                 args->request.height_m,
                  "Relative flying height of the rectification plane, m (default: the rig file's "
                  "virtual.height_m)")
       ->check(FiniteRange(0, 1e5));
   ea->add_option("--target",
-                 args->target,
+                 args->request.target,
                  "HEAD:COL,ROW: a pixel of a non-reference head, carried into the virtual image by "
                  "the nominal rig (default: the centre of the first non-reference head)");
   ea->add_option("--virtual",
-                 args->virtual_px,
+                 args->request.virtual_px,
                  "COL,ROW: a virtual pixel, analysed in the first non-reference head that sees it");
-  ea->add_option("--grid", args->grid, "N: an N x N grid of virtual pixels (bound map)")
+  ea->add_option("--grid", args->request.grid, "N: an N x N grid of virtual pixels (bound map)")
       ->check(FiniteRange(0, 200));
-  ea->add_option("--samples", args->samples, "Monte-Carlo samples per target (0: none)")
+  ea->add_option("--samples", args->request.samples, "Monte-Carlo samples per target (0: none)")
       ->check(FiniteRange(0, 1e7));
-  ea->add_option("--seed", args->seed, "Monte-Carlo seed (the first grid target; +1 per target)")
+  ea->add_option(
+        "--seed", args->request.seed, "Monte-Carlo seed (the first grid target; +1 per target)")
       ->check(SeedCheck());
-  ea->add_option("--bins", args->bins, "Histogram bins")->check(FiniteRange(1, 10000));
+  ea->add_option("--bins", args->request.bins, "Histogram bins")->check(FiniteRange(1, 10000));
   ea->add_option("--relief-m",
-                 args->relief_m,
+                 args->request.relief_m,
                  "Relief (m off the plane) whose displacement between heads is reported")
       ->check(FiniteRange(0, 1e4));
   ea->add_flag("--no-plots", args->no_plots, "Write JSON and CSV only (no PNG)");

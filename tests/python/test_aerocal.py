@@ -423,6 +423,29 @@ def test_rig_design_equals_the_command(tmp_path):
         aerocal.rig_design(camera, height_m=300, grid_cells=5)
 
 
+def test_rig_error_analysis_equals_the_command(tmp_path):
+    camera = os.path.join(SOURCE, "configs", "rig_dual_lens.yaml")
+    limits = os.path.join(SOURCE, "configs", "rig_dual_lens_limits.yaml")
+    out = tmp_path / "ea.json"
+    code, text = run("rig", "error-analysis", "--camera", camera, "--limits", limits, "--samples", "2000",
+                     "--no-plots", "--out", str(out))
+    assert code == 0, text
+    with open(out) as f:
+        expected = json.load(f)
+    # The command names its CSV beside --out; the function writes no file.
+    assert expected["monte_carlo"].pop("histogram_csv") == "ea_histogram.csv"
+    doc = aerocal.rig_error_analysis(camera, limits, samples=2000)
+    assert doc == expected
+    # Every Monte-Carlo sample lies within the maximum error of all sources at their limits (the
+    # worst case), and for errors this small the linear propagation's bound is the Monte-Carlo's.
+    assert doc["worst_case"][-1]["group"] == "all"
+    assert 0 < doc["monte_carlo"]["max_radial_px"] <= doc["worst_case"][-1]["max_radial_px"]
+    linear, mc = doc["linear"]["bound_radial_px"], doc["monte_carlo"]["bound_radial_px"]
+    assert abs(linear - mc) < 0.15 * linear
+    with pytest.raises(ValueError, match="--target"):
+        aerocal.rig_error_analysis(camera, limits, target="nohead:1,1")
+
+
 def test_calibrate_from_directions_equals_the_command(tmp_path):
     camera = tmp_path / "camera.yaml"
     camera.write_text("name: lab\npixel_size_mm: 0.006\nformat_px: [6000, 4000]\ninterior: {c: 50.0}\n")
@@ -448,6 +471,17 @@ def test_calibrate_from_directions_equals_the_command(tmp_path):
     assert r.calibration["method"] == expected["calibration"]["method"]
     with pytest.raises(ValueError, match="give either directions"):
         aerocal.calibrate(str(camera), directions=str(directions), observations=str(directions))
+    # The certificate of that result, as `aerocal certificate` writes it into the same folder.
+    cert = tmp_path / "cert"
+    code_cli, text = run("certificate", "--result", str(cli), "--out", str(cert), "--no-render")
+    assert code_cli in (0, 3), text
+    with open(cert / "certificate.json") as f:
+        expected_cert = json.load(f)
+    code_py, document = aerocal.certificate(str(cli), str(cert), render=False)
+    assert (code_py, document) == (code_cli, expected_cert)
+    assert document["kind"] == "certificate" and sorted(os.listdir(cert)) == ["certificate.json"]
+    with pytest.raises(ValueError, match="lab.yaml"):
+        aerocal.certificate(str(cli), str(cert), lab=str(tmp_path / "lab.yaml"))
 
 
 MATCH_CAMERA = """name: small

@@ -1,13 +1,17 @@
 // aerocal.calibrate: camera calibration from a test field or a planar board as `aerocal calibrate`
 // runs it (tools/calibrate_request.h: the same request, the same outcome), with the result
 // document as the command writes it.
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
 #include "tools/calibrate_directions.h"
 #include "tools/calibrate_request.h"
+#include "tools/certificate_writer.h"
 #include "tools/python/bindings.h"
 
+#include <filesystem>
 #include <pybind11/stl.h>
+#include <stdexcept>
 
 namespace aerocal::python {
 namespace {
@@ -108,6 +112,35 @@ CalibrationResult Calibrate(const std::string& camera,
   return result;
 }
 
+// `aerocal certificate`: the files written into `out` as the command writes them; the exit code
+// and certificate.json as a dict.
+py::tuple Certificate(const std::string& result,
+                      const std::string& out,
+                      const std::string& lab,
+                      const std::string& previous,
+                      const std::string& tolerances,
+                      const std::vector<std::string>& quality,
+                      bool render) {
+  tools::CertificateArgs args;
+  args.result = result;
+  args.out = out;
+  args.lab = lab;
+  args.previous = previous;
+  args.tolerances = tolerances;
+  args.quality = quality;
+  args.no_render = !render;
+  int code = 0;
+  {
+    py::gil_scoped_release release;
+    code = tools::WriteCertificate(args);
+  }
+  if (code == 1)  // kExitInternal (tools/command_registry.h)
+    throw std::runtime_error("certificate: the renderer failed (nothing written into " + out +
+                             "; the message is on stderr)");
+  const std::string path = (std::filesystem::path(out) / "certificate.json").string();
+  return py::make_tuple(code, JsonToPython(ReadTextFile(path)));
+}
+
 }  // namespace
 
 void BindCalibrate(py::module_& m) {
@@ -162,6 +195,21 @@ void BindCalibrate(py::module_& m) {
         "(directions: a collimator array or goniometer file); groups, budget, "
         "self_calibration, model, ... as the command's options (`-` -> `_`). A result that is not "
         "valid comes back with valid=False. The GIL is released while calibrating.");
+  m.def("certificate",
+        &Certificate,
+        py::arg("result"),
+        py::arg("out"),
+        py::arg("lab") = "",
+        py::arg("previous") = "",
+        py::arg("tolerances") = "",
+        py::arg("quality") = std::vector<std::string>{},
+        py::arg("render") = true,
+        "The calibration certificate of a `calibrate` (or `flight`) result as `aerocal "
+        "certificate --result RESULT --out OUT` writes it: certificate.json, and with render "
+        "certificate.html / .pdf, into the folder `out`. Returns (code, certificate) with the "
+        "command's exit code (0; 3 when the calibration is not valid, its groups disagree or the "
+        "comparison fails) and certificate.json as a dict. Bad input raises ValueError, a failed "
+        "renderer RuntimeError (nothing written).");
 }
 
 }  // namespace aerocal::python

@@ -6,6 +6,7 @@
 #include "calib/core/result_file.h"
 #include "tools/python/bindings.h"
 #include "tools/rig_design_document.h"
+#include "tools/rig_error_analysis_run.h"
 #include "tools/rig_stitch_run.h"
 
 #include <pybind11/stl.h>
@@ -82,6 +83,18 @@ py::object RigDesign(const std::string& camera, double height_m, int grid_cells)
       ResultText("rig_design", tools::RigDesignDocument(rig, camera, height, design, "")));
 }
 
+// `aerocal rig error-analysis`: the result document as a dict (the command's --out content
+// without the names of its CSV and PNG files).
+py::object RigErrorAnalysis(const tools::RigErrorAnalysisRequest& request) {
+  std::string text;
+  {
+    py::gil_scoped_release release;
+    text =
+        ResultText("rig_error_analysis", tools::RunRigErrorAnalysis(request, "", false).document);
+  }
+  return JsonToPython(text);
+}
+
 }  // namespace
 
 void BindRig(py::module_& m) {
@@ -123,6 +136,43 @@ void BindRig(py::module_& m) {
         "writes them, as a dict: GSD change ratios of each head against the closed form, the "
         "virtual format needed, covered area, effective format, overlap zones, standard tie "
         "positions (height_m 0: the rig file's virtual.height_m).");
+  m.def(
+      "rig_error_analysis",
+      [](const std::string& camera,
+         const std::string& limits,
+         const std::string& target,
+         const std::string& virtual_px,
+         int grid,
+         double height_m,
+         int samples,
+         std::uint64_t seed,
+         double relief_m) {
+        tools::RigErrorAnalysisRequest request;
+        request.camera = camera;
+        request.limits = limits;
+        request.target = target;
+        request.virtual_px = virtual_px;
+        request.grid = grid;
+        request.height_m = height_m;
+        request.samples = samples;
+        request.seed = seed;
+        request.relief_m = relief_m;
+        return RigErrorAnalysis(request);
+      },
+      py::arg("camera"),
+      py::arg("limits"),
+      py::arg("target") = "",
+      py::arg("virtual") = "",
+      py::arg("grid") = 0,
+      py::arg("height_m") = 0.0,
+      py::arg("samples") = 100000,
+      py::arg("seed") = 1,
+      py::arg("relief_m") = 100.0,
+      "The conversion error analysis of a rig's virtual image as `aerocal rig error-analysis "
+      "--camera CAMERA --limits LIMITS --out F` writes it, as a dict (without the names of the "
+      "command's CSV and PNG files): target 'HEAD:COL,ROW', virtual 'COL,ROW' or an N x N grid; "
+      "maximum error, linear propagation and Monte-Carlo (samples, seed). The GIL is released "
+      "while it runs.");
   m.def("rig_stitch",
         &RigStitch,
         py::arg("camera"),

@@ -25,9 +25,12 @@ Sub-image stitching (multi-CCD cameras)
 Camera calibration (test field or planar board)
     calibrate(camera_file, observations=..., points=...) or (camera_file, images="b*.jpg",
               board="chessboard:9x6:25") -> CalibrationResult: valid, sigma0, calibration, to_json()
+    certificate(result_json, out_folder, lab="lab.yaml") -> (exit code, certificate.json as a dict)
 
 Multi-head rigs
     rig_design(rig_camera_file, height_m=0) -> dict (GSD ratios, formats, zones, tie positions)
+    rig_error_analysis(rig_camera_file, limits_file, target="B:100,200") -> dict (maximum error,
+               linear propagation, Monte-Carlo)
     rig_stitch(rig_camera_file, project, mode="line") -> RigStitchResult: valid, failures,
                rig_exposures, snooping, to_json()
 
@@ -58,6 +61,7 @@ from ._aerocal import (
     CalibrationResult,
     adjust,
     calibrate,
+    certificate,
     convert_camera,
     formats,
     match,
@@ -65,6 +69,7 @@ from ._aerocal import (
     pushbroom_calibrate,
     resample,
     rig_design,
+    rig_error_analysis,
     rig_stitch,
     stitch,
 )
@@ -82,6 +87,7 @@ __all__ = [
     "CalibrationResult",
     "adjust",
     "calibrate",
+    "certificate",
     "convert_camera",
     "formats",
     "match",
@@ -89,6 +95,7 @@ __all__ = [
     "pushbroom_calibrate",
     "resample",
     "rig_design",
+    "rig_error_analysis",
     "rig_stitch",
     "stitch",
 ]

@@ -142,6 +142,9 @@ def calibrate(camera: str, directions: Optional[str] = None, observations: Optio
               write_camera: Optional[str] = None, camera_format: str = "aerocal",
               write_marks: Optional[str] = None, out: Optional[str] = None) -> CalibrationResult: ...
 
+def certificate(result: str, out: str, lab: str = "", previous: str = "", tolerances: str = "",
+                quality: Sequence[str] = (), render: bool = True) -> Tuple[int, Dict[str, Any]]: ...
+
 class RigStitchResult:
     @property
     def valid(self) -> bool: ...
@@ -160,6 +163,10 @@ class RigStitchResult:
     def to_json(self) -> str: ...
 
 def rig_design(camera: str, height_m: float = 0.0, grid_cells: int = 400) -> Dict[str, Any]: ...
+
+def rig_error_analysis(camera: str, limits: str, target: str = "", virtual: str = "", grid: int = 0,
+                       height_m: float = 0.0, samples: int = 100000, seed: int = 1,
+                       relief_m: float = 100.0) -> Dict[str, Any]: ...
 
 def rig_stitch(camera: str, project: str, mode: str = "line", no_snooping: bool = False,
                alpha: float = 0.05, increment_sigma_arcsec: Optional[float] = None,
