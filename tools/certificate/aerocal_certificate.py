@@ -2,15 +2,13 @@
 """Renders the calibration certificate of `aerocal certificate`.
 
 Usage: aerocal_certificate.py CERTIFICATE.json OUT_DIR
-Writes OUT_DIR/certificate.html (figures inline as SVG) and OUT_DIR/certificate.pdf (matplotlib's
-PDF backend, A4 pages). Both are deterministic: no dates other than the lab file's, fixed SVG ids,
-no creation date in the PDF. Exit 0 on success, 2 on bad input (nothing written), 1 when
-matplotlib is missing.
-
-The PDF is rendered with matplotlib (python3-matplotlib, already a dependency of the reports),
-not with an HTML engine: weasyprint and chromium are not installed on the target machines and
-would add a large dependency; matplotlib's PDF backend is well kept, deterministic and draws the
-same figures as the HTML page.
+Writes OUT_DIR/certificate.html (figures inline as SVG) and OUT_DIR/certificate.pdf: the same page
+typeset for A4 by weasyprint (Debian's `weasyprint`, installed by tools/setup.sh, as for the flight
+report): tables, figures and the model as on the page, the title and "page x of y" on every page.
+Without weasyprint the PDF is drawn with matplotlib's PDF backend instead (monospace tables and the
+figures; a note on stderr says so). Both outputs are deterministic: no dates other than the lab
+file's, fixed SVG ids, no creation date in the PDF. Exit 0 on success, 2 on bad input (nothing
+written), 1 when matplotlib is missing.
 """
 import html
 import io
@@ -474,7 +472,8 @@ def html_table(rows, flag_col=None):
     return "\n".join(out)
 
 
-def write_html(c, path, figures):
+def page_html(c, figures):
+    """The certificate as one HTML page (print rules for A4 included)."""
     lab = c["lab"]
     draft = is_draft(c)
     parts = ["<!DOCTYPE html><html><head><meta charset='utf-8'><title>%s</title>" % html.escape(title_of(c)),
@@ -483,8 +482,10 @@ def write_html(c, path, figures):
              "text-align:left;font-size:10pt}.bad{color:#b00;font-weight:bold}.sig td{height:3em;width:14em}"
              ".draft{color:#b00;border:2px solid #b00;padding:4px 8px;font-weight:bold}"
              "h1{font-size:18pt}h2{font-size:13pt;border-bottom:1px solid #999}"
-             "@page{size:A4;margin:16mm 14mm;@bottom-right{content:'page ' counter(page) ' of ' counter(pages);"
-             "font-size:8pt}}@media print{body{max-width:none;font-size:9pt}td,th{font-size:7.5pt}"
+             "@page{size:A4;margin:18mm 14mm 16mm;@top-left{content:string(title);font-family:sans-serif;font-size:8pt;color:#555}"
+             "@bottom-right{content:'page ' counter(page) ' of ' counter(pages);font-family:sans-serif;font-size:8pt}}"
+             "h1{string-set:title content()}"
+             "@media print{body{max-width:none;font-size:9pt}td,th{font-size:7.5pt}"
              "svg{max-width:100%;height:auto}h2{break-after:avoid}}</style></head><body>",
              "<h1>%s</h1>" % html.escape(title_of(c))]
     if draft:
@@ -535,10 +536,15 @@ def write_html(c, path, figures):
                      "<th>approved by</th></tr><tr><td>%s</td><td>%s</td><td>%s</td></tr></table>"
                      % tuple(html.escape(s[k]) for k in ("calibrated_by", "checked_by", "approved_by")))
     parts.append("<p>%s</p></body></html>" % html.escape(lab["certificate"]["page_note"]))
+    return "\n".join(parts) + "\n"
+
+
+def write_atomically(path, data):
+    """`data` (str or bytes) into `path` through a temporary file: nothing partial is left."""
     tmp = path + ".tmp"
     try:
-        with open(tmp, "w", encoding="utf-8") as f:
-            f.write("\n".join(parts) + "\n")
+        with open(tmp, "wb") as f:
+            f.write(data.encode("utf-8") if isinstance(data, str) else data)
         os.replace(tmp, path)
     finally:
         if os.path.exists(tmp):
@@ -581,15 +587,27 @@ def text_pages(title, blocks):
     return figs
 
 
-def write_pdf(c, path):
-    title = title_of(c)
-    tmp = path + ".tmp"
+def write_pdf(c, path, page):
+    """`page` (page_html) typeset by weasyprint; without it matplotlib's pages (write_pdf_pages)."""
     try:
-        write_pdf_pages(c, tmp, title)
-        os.replace(tmp, path)
-    finally:
-        if os.path.exists(tmp):
-            os.remove(tmp)
+        import weasyprint
+    except ImportError:
+        sys.stderr.write("note: %s drawn with matplotlib: weasyprint is missing (Debian package "
+                         "weasyprint, tools/setup.sh installs it)\n" % path)
+        tmp = path + ".tmp"
+        try:
+            write_pdf_pages(c, tmp, title_of(c))
+            os.replace(tmp, path)
+        finally:
+            if os.path.exists(tmp):
+                os.remove(tmp)
+        return
+    # The page's user text is HTML-escaped (page_html). No creation date is written (weasyprint
+    # writes dates only from <meta name=dcterms.created>); the embedded font subsets carry a
+    # 'modified' time, which fontTools takes from SOURCE_DATE_EPOCH when set (reproducible builds):
+    # fixed here, so the PDF is the same byte for byte for the same certificate.
+    os.environ.setdefault("SOURCE_DATE_EPOCH", "0")
+    write_atomically(path, weasyprint.HTML(string=page).write_pdf())
 
 
 def write_pdf_pages(c, tmp, title):
@@ -672,8 +690,9 @@ def main(argv):
     figures = {"distortion": svg_of(fig_distortion(c)), "residuals": svg_of(fig_residuals_correlation(c))}
     if c.get("dynamic_image_resolution"):
         figures["mtf"] = svg_of(fig_mtf(c))
-    write_html(c, os.path.join(argv[2], "certificate.html"), figures)
-    write_pdf(c, os.path.join(argv[2], "certificate.pdf"))
+    page = page_html(c, figures)
+    write_atomically(os.path.join(argv[2], "certificate.html"), page)
+    write_pdf(c, os.path.join(argv[2], "certificate.pdf"), page)
     return 0
 
 

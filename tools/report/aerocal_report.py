@@ -87,6 +87,9 @@ def write_pdf(html, path):
 
     directory = os.path.dirname(os.path.abspath(path))
     tmp = os.path.join(directory, f".{os.path.basename(path)}.tmp{os.getpid()}")
+    # The embedded font subsets carry a 'modified' time (fontTools: SOURCE_DATE_EPOCH when set):
+    # fixed, so the same report gives the same PDF byte for byte.
+    os.environ.setdefault("SOURCE_DATE_EPOCH", "0")
     try:
         weasyprint.HTML(string=html, base_url=directory).write_pdf(tmp)
         os.replace(tmp, path)
