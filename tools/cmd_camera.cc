@@ -12,6 +12,7 @@
 #include "calib/core/error.h"
 #include "calib/core/log.h"
 #include "calib/core/result_file.h"
+#include "calib/core/svg.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
@@ -204,23 +205,27 @@ std::string Svg(const calib::ModelCamera& camera,
   const double W = camera.frame.width_px, H = camera.frame.height_px;
   double max_d = 1e-12, max_r = 1e-12;
   for (const auto& [r, d] : profile) max_d = std::max(max_d, d), max_r = std::max(max_r, r);
-  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"900\" height=\"420\" "
+  s << "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"920\" height=\"460\" "
        "font-family=\"sans-serif\" font-size=\"12\">\n"
-    << "<text x=\"10\" y=\"18\">" << title << "</text>\n";
-  // Left: |distortion| (px) against the distance from the principal point (px).
-  const double x0 = 60, y0 = 380, w = 340, h = 320;
-  s << "<rect x=\"" << x0 << "\" y=\"" << y0 - h << "\" width=\"" << w << "\" height=\"" << h
-    << "\" fill=\"none\" stroke=\"black\"/>\n<polyline fill=\"none\" stroke=\"blue\" points=\"";
-  for (const auto& [r, d] : profile) s << x0 + w * r / max_r << "," << y0 - h * d / max_d << " ";
-  s << "\"/>\n<text x=\"" << x0 << "\" y=\"" << y0 + 16 << "\">radius 0 .. "
-    << FormatNumber(max_r, 5) << " px (to the farthest corner)</text>\n<text x=\"" << x0
-    << "\" y=\"" << y0 - h - 6 << "\">|distortion| 0 .. " << FormatNumber(max_d, 4)
-    << " px</text>\n";
-  // Right: distortion vectors over the format, scaled so the longest is one cell.
-  const double fx0 = 460, fy0 = 60, fw = 420, fh = fw * H / W;
+    << "<text x=\"10\" y=\"18\">" << SvgEscape(title) << "</text>\n";
+  // Left: |distortion| (px) against the distance from the principal point (px), on axes.
+  SvgPanel panel;
+  panel.left = 70, panel.bottom = 390, panel.width = 330, panel.height = 320;
+  panel.x_lo = 0, panel.x_hi = max_r, panel.y_lo = 0, panel.y_hi = max_d;
+  s << SvgAxes(panel,
+               "distance from the principal point (px; to the farthest corner)",
+               "|distortion| (px)")
+    << "<polyline fill=\"none\" stroke=\"blue\" points=\"";
+  for (const auto& [r, d] : profile) s << panel.X(r) << "," << panel.Y(d) << " ";
+  s << "\"/>\n";
+  // Right: distortion vectors over the format (x right, y down as the pixels), scaled so the
+  // longest is one cell; the format's pixels on axes and a scale bar of the vectors.
+  const double fw = 400, fh = fw * H / W;
+  SvgPanel format;
+  format.left = 490, format.bottom = 60 + fh, format.width = fw, format.height = fh;
+  format.x_lo = 0, format.x_hi = W, format.y_lo = H, format.y_hi = 0;  // row 0 at the top
+  s << SvgAxes(format, "column (px)", "row (px)");
   const int nx = 15, ny = std::max(3, static_cast<int>(std::lround(15 * H / W)));
-  s << "<rect x=\"" << fx0 << "\" y=\"" << fy0 << "\" width=\"" << fw << "\" height=\"" << fh
-    << "\" fill=\"none\" stroke=\"black\"/>\n";
   std::vector<std::pair<Eigen::Vector2d, Eigen::Vector2d>> arrows;
   double longest = 1e-12;
   for (int j = 0; j < ny; ++j)
@@ -232,15 +237,17 @@ std::string Svg(const calib::ModelCamera& camera,
       arrows.emplace_back(pixel, d);
       longest = std::max(longest, d.norm());
     }
-  const double cell = fw / nx, scale = cell / longest;
+  const double cell = fw / nx, scale = cell / longest;  // SVG px per distortion px
   for (const auto& [pixel, d] : arrows) {
-    const double ax = fx0 + fw * pixel.x() / W, ay = fy0 + fh * pixel.y() / H;
+    const double ax = format.X(pixel.x()), ay = format.Y(pixel.y());
     s << "<line x1=\"" << ax << "\" y1=\"" << ay << "\" x2=\"" << ax + d.x() * scale << "\" y2=\""
       << ay + d.y() * scale << "\" stroke=\"red\"/>\n<circle cx=\"" << ax << "\" cy=\"" << ay
       << "\" r=\"1.5\"/>\n";
   }
-  s << "<text x=\"" << fx0 << "\" y=\"" << fy0 + fh + 16 << "\">distortion vectors (longest "
-    << FormatNumber(longest, 4) << " px = one cell)</text>\n</svg>\n";
+  s << SvgScaleBar(format.left, format.bottom + 60, 1.0 / scale, 2 * cell, "px of distortion")
+    << "<text x=\"" << format.left + 2.2 * cell << "\" y=\"" << format.bottom + 64
+    << "\">distortion vectors (longest " << FormatNumber(longest, 4)
+    << " px = one cell)</text>\n</svg>\n";
   return s.str();
 }
 

@@ -2,6 +2,7 @@
 
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
+#include "calib/core/svg.h"
 #include "stitch/rig/rig_conversion.h"
 
 #include <Eigen/Eigenvalues>
@@ -274,17 +275,35 @@ std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
   const double margin = 0.05 * (hi - lo).maxCoeff();
   lo -= Eigen::Vector2d::Constant(margin);
   hi += Eigen::Vector2d::Constant(margin);
+  // Ground metres on axes (X right, Y up), 800 SVG pixels along the longer side, a margin for
+  // the axes' labels and a scale bar under them.
   const double scale = 800.0 / (hi - lo).maxCoeff();
-  const auto sx = [&](const Eigen::Vector2d& p) { return (p.x() - lo.x()) * scale; };
-  const auto sy = [&](const Eigen::Vector2d& p) { return (hi.y() - p.y()) * scale; };  // Y up
+  SvgPanel panel;
+  panel.left = 80, panel.width = (hi.x() - lo.x()) * scale,
+  panel.height = (hi.y() - lo.y()) * scale;
+  panel.bottom = 40 + panel.height;
+  panel.x_lo = lo.x(), panel.x_hi = hi.x(), panel.y_lo = lo.y(), panel.y_hi = hi.y();
+  const auto sx = [&](const Eigen::Vector2d& p) { return panel.X(p.x()); };
+  const auto sy = [&](const Eigen::Vector2d& p) { return panel.Y(p.y()); };
   std::ostringstream out;
   out << StringPrintf(
-      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\">\n"
-      "<title>%s: head footprints at H = %g m (ground metres, X right, Y up)</title>\n",
-      (hi.x() - lo.x()) * scale,
-      (hi.y() - lo.y()) * scale,
-      rig.name.c_str(),
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
+      "font-family=\"sans-serif\" font-size=\"12\">\n"
+      "<title>%s: head footprints at H = %g m (ground metres, X right, Y up)</title>\n"
+      "<text x=\"10\" y=\"18\">%s: head footprints at H = %g m</text>\n",
+      panel.left + panel.width + 20,
+      panel.bottom + 110,
+      SvgEscape(rig.name).c_str(),
+      d.height_m,
+      SvgEscape(rig.name).c_str(),
       d.height_m);
+  out << SvgAxes(panel, "X (m, from the nadir point)", "Y (m)")
+      << SvgScaleBar(panel.left, panel.bottom + 70, 1.0 / scale, 0.4 * panel.width, "m")
+      << StringPrintf(
+             "<text x=\"%.1f\" y=\"%.1f\">dashed: the virtual format; bold: the effective "
+             "format; dots: standard tie positions</text>\n",
+             panel.left,
+             panel.bottom + 95);
   const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b"};
   for (size_t k = 0; k < d.heads.size(); ++k) {
     out << "<polygon fill=\"" << colours[k % 6] << "\" fill-opacity=\"0.2\" stroke=\""
@@ -297,7 +316,7 @@ std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
         << StringPrintf("<text x=\"%.1f\" y=\"%.1f\" font-size=\"20\">%s</text>\n",
                         sx(centre),
                         sy(centre),
-                        d.heads[k].id.c_str());
+                        SvgEscape(d.heads[k].id).c_str());
   }
   const auto rectangle = [&](const PixelRectangle& r, const char* style) {
     const Eigen::Vector2d a = ground(r.min_px), b = ground(r.max_px);
@@ -320,7 +339,7 @@ std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
         sy(p),
         sx(p) + 5,
         sy(p) - 5,
-        s.name.c_str());
+        SvgEscape(s.name).c_str());
   }
   out << "</svg>\n";
   return out.str();

@@ -4,6 +4,7 @@
 #include "calib/core/json_file.h"
 #include "calib/core/median.h"
 #include "calib/core/numeric_jacobian.h"
+#include "calib/core/svg.h"
 
 #include <gtest/gtest.h>
 
@@ -79,6 +80,42 @@ TEST(ParseJsonText, AKeyGivenTwiceInOneObjectIsAnInputErrorNamingItsPath) {
       EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
     }
   }
+}
+
+}  // namespace
+}  // namespace aerocal
+
+namespace aerocal {
+namespace {
+
+// Ticks are 1, 2 or 5 times a power of ten, at most `count` intervals, inside the range.
+TEST(NiceTicks, OneTwoFiveStepsInsideTheRange) {
+  EXPECT_EQ(NiceTicks(0.0, 3.7), (std::vector<double>{0, 1, 2, 3}));
+  EXPECT_EQ(NiceTicks(0.0, 10.0), (std::vector<double>{0, 2, 4, 6, 8, 10}));
+  const std::vector<double> small = NiceTicks(0.0012, 0.0089);
+  ASSERT_EQ(small.size(), 4u);  // step 0.002: 0.002 .. 0.008
+  EXPECT_NEAR(small.front(), 0.002, 1e-15);
+  EXPECT_NEAR(small.back(), 0.008, 1e-15);
+  const std::vector<double> negative = NiceTicks(-37.0, 12.0);  // step 10
+  EXPECT_EQ(negative, (std::vector<double>{-30, -20, -10, 0, 10}));
+  EXPECT_EQ(NiceTicks(5.0, 5.0), (std::vector<double>{5.0}));
+}
+
+TEST(SvgText, UserTextIsEscapedAndAxesAndScaleBarsAreLabelled) {
+  EXPECT_EQ(SvgEscape("a<b>&\"c'"), "a&lt;b&gt;&amp;&quot;c&apos;");
+  SvgPanel panel;
+  panel.left = 50, panel.bottom = 300, panel.width = 200, panel.height = 100;
+  panel.x_lo = 0, panel.x_hi = 4000, panel.y_lo = 0, panel.y_hi = 2.5;
+  EXPECT_DOUBLE_EQ(panel.X(2000), 150);
+  EXPECT_DOUBLE_EQ(panel.Y(2.5), 200);
+  const std::string axes = SvgAxes(panel, "radius (px)", "<distortion> (px)");
+  for (const char* text :
+       {">0<", ">1000<", ">4000<", ">0.5<", ">2.5<", "radius (px)", "&lt;distortion&gt; (px)"})
+    EXPECT_NE(axes.find(text), std::string::npos) << text;
+  // 0.37 m per SVG pixel, at most 300 px: 111 m fit, so the bar is 100 m long (270.3 px).
+  const std::string bar = SvgScaleBar(10, 20, 0.37, 300, "m");
+  EXPECT_NE(bar.find(">100 m<"), std::string::npos) << bar;
+  EXPECT_NE(bar.find("x2=\"280.3\""), std::string::npos) << bar;
 }
 
 }  // namespace

@@ -200,7 +200,7 @@ TEST(RigErrorAnalysisCommand, RefusesBadInputWithExitTwoAndNothingWritten) {
   no_height.erase(at, std::string(", height_m: 1200.0").size());
   std::ofstream(tmp.File("no_height.yaml")) << no_height;
   refused("rig error-analysis --camera " + tmp.File("no_height.yaml") + " --limits " + kLimits,
-          "--height-m: the rig file");
+          "no_height.yaml has no virtual.height_m");
 }
 
 TEST(RigDesignCommand, Uav4FiguresSvgAndRefusals) {
@@ -240,6 +240,10 @@ TEST(RigDesignCommand, Uav4FiguresSvgAndRefusals) {
   EXPECT_EQ(svg.rfind("<svg", 0), 0u);
   EXPECT_EQ(std::count(svg.begin(), svg.end(), '\n') > 4, true);
   EXPECT_NE(svg.find("<polygon"), std::string::npos);
+  // Readable without a caption: ground metres on both axes and a scale bar (issue 33 item 3).
+  for (const char* text :
+       {"X (m, from the nadir point)", "Y (m)", "class=\"scale-bar\"", " m</text>"})
+    EXPECT_NE(svg.find(text), std::string::npos) << text;
   // Refusals: exit 2, the option named, nothing written.
   for (const std::string bad : {"--height-m -5", "--grid-cells 3"}) {
     run = RunAerocal("rig design --camera " + uav4 + " " + bad + " --out " + tmp.File("x.json") +

@@ -291,7 +291,11 @@ TEST(CliCamera, ShowPrintsOurConventionAndWritesThePlot) {
   EXPECT_NE(r.output.find("our convention"), std::string::npos) << r.output;
   // x0 = (2738.24 - 2735.5) px = 2.74 px from the centre.
   EXPECT_NE(r.output.find("2.74 px from the centre"), std::string::npos) << r.output;
-  EXPECT_NE(Read(tmp.File("d.svg")).find("<svg"), std::string::npos);
+  const std::string svg = Read(tmp.File("d.svg"));
+  EXPECT_NE(svg.find("<svg"), std::string::npos);
+  // Readable without a caption: both panels on axes, the vectors with a scale bar.
+  for (const char* text : {"|distortion| (px)", "column (px)", "row (px)", "px of distortion"})
+    EXPECT_NE(svg.find(text), std::string::npos) << text;
   // The stereo file's second camera.
   const std::string data = testing::SharedDataDir("opencv_stereo_chessboard_9x6");
   if (!data.empty()) {

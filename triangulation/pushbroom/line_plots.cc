@@ -1,6 +1,7 @@
 #include "triangulation/pushbroom/line_plots.h"
 
 #include "calib/core/string_printf.h"
+#include "calib/core/svg.h"
 
 #include <algorithm>
 #include <cmath>
@@ -8,23 +9,6 @@
 
 namespace aerocal::triangulation {
 namespace {
-
-std::string Escape(const std::string& text) {
-  std::string out;
-  for (char ch : text) {
-    if (ch == '&')
-      out += "&amp;";
-    else if (ch == '<')
-      out += "&lt;";
-    else if (ch == '>')
-      out += "&gt;";
-    else if (ch == '"')
-      out += "&quot;";
-    else
-      out += ch;
-  }
-  return out;
-}
 
 // Value of `sorted` at fraction q (0 .. 1).
 double Quantile(const std::vector<double>& sorted, double q) {
@@ -45,8 +29,8 @@ std::string LineCalibrationSvg(const LineCalibrationResult& result, const std::s
       "fitted table (line) and its 1-sigma band, px (pitches)</text>\n",
       left + 2 * panel_w + gap_x + 20,
       top + rows * (panel_h + gap_y),
-      Escape(title).c_str(),
-      Escape(title).c_str());
+      SvgEscape(title).c_str(),
+      SvgEscape(title).c_str());
   for (int k = 0; k < rows; ++k) {
     const SubcameraRms& sub = result.subcameras[k];
     for (int axis = 0; axis < 2; ++axis) {
@@ -80,7 +64,7 @@ std::string LineCalibrationSvg(const LineCalibrationResult& result, const std::s
       const auto py = [&](double v) { return y0 - panel_h * (v - lo) / (hi - lo); };
       const char* axis_name = axis == 0 ? "across" : "along";
       s << StringPrintf(
-               "<g data-subcamera=\"%s\" data-axis=\"%s\">\n", Escape(sub.id).c_str(), axis_name)
+               "<g data-subcamera=\"%s\" data-axis=\"%s\">\n", SvgEscape(sub.id).c_str(), axis_name)
         << StringPrintf(
                "<rect x=\"%.1f\" y=\"%.1f\" width=\"%.1f\" height=\"%.1f\" fill=\"none\" "
                "stroke=\"black\"/>\n",
@@ -98,7 +82,7 @@ std::string LineCalibrationSvg(const LineCalibrationResult& result, const std::s
       s << StringPrintf("<text x=\"%.1f\" y=\"%.1f\">%s, %s track: %.4g .. %.4g px</text>\n",
                         x0,
                         y0 - panel_h - 6,
-                        Escape(sub.id).c_str(),
+                        SvgEscape(sub.id).c_str(),
                         axis_name,
                         lo,
                         hi)

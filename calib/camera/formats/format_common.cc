@@ -2,6 +2,7 @@
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
+#include "calib/core/svg.h"
 #include "calib/core/yaml_util.h"
 
 #include <charconv>
@@ -101,30 +102,6 @@ YAML::Node LoadCameraYaml(const std::string& path) {
   return LoadYamlText(text, path);
 }
 
-std::string XmlEscaped(std::string_view text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      case '\'':
-        out += "&apos;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
+std::string XmlEscaped(std::string_view text) { return SvgEscape(text); }
 
 }  // namespace aerocal::calib::internal
