@@ -11,6 +11,7 @@
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
 #include "tools/pushbroom_calibrate_run.h"
+#include "tools/pushbroom_control_run.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/pushbroom/cloud_control.h"
 #include "triangulation/pushbroom/line_calibration.h"
@@ -53,101 +54,28 @@ int RunCalibrate(CalibrateArgs& a) {
   return run.Ok() ? kExitOk : kExitNotConverged;
 }
 
-// Most cells of the L1 image of `pushbroom control` (two float maps and the image: about 1.2 GB).
-constexpr double kMaxL1Cells = 1e8;
-
 struct ControlArgs {
-  std::string camera, pos, line_image, reference_camera, reference_exposures, reference_result,
-      reference_images, out;
+  PushbroomControlRequest request;
+  std::string out;
   bool write_l1 = false;
   int min_points = 20;
-  triangulation::CloudControlOptions options;
 };
 
-// The image of an exposure in `folder`: the id as a file name, else with .png, .tif, .jpg;
-// `where` names the exposure's source in the error.
-std::string ReferenceImagePath(const std::string& folder,
-                               const triangulation::Exposure& e,
-                               const std::string& where) {
-  namespace fs = std::filesystem;
-  for (const char* ext : {"", ".png", ".tif", ".tiff", ".jpg"}) {
-    const fs::path p = fs::path(folder) / (e.image + ext);
-    if (fs::is_regular_file(p)) return p.string();
-  }
-  throw InputError(where + ": no image '" + e.image + "' (.png, .tif, .jpg) in " + folder);
-}
-
 int RunControl(ControlArgs& a) {
-  if (a.reference_exposures.empty() == a.reference_result.empty())
-    throw ConfigError("give one of --reference-exposures and --reference-result");
   CheckOutputFolder(a.out, "--out");
-  a.options.Validate();
-  const calib::LineCamera camera = calib::ReadLineCamera(a.camera);
-  const auto pos = triangulation::PosTrajectory::Read(a.pos);
-  const calib::Camera reference_camera = calib::ReadCamera(a.reference_camera);
-  // The orientations: exposures.csv, or the block result of `aerocal adjust` (its used exposures).
-  int skipped = 0;
-  const auto exposures = a.reference_result.empty()
-                             ? triangulation::ReadExposures(a.reference_exposures)
-                             : triangulation::ReadAdjustedExposures(a.reference_result, &skipped);
-  // A list without a reference exposure (a header only) is bad input, not a failed control (exit
-  // 2).
-  if (exposures.empty())
-    throw InputError(a.reference_result.empty()
-                         ? a.reference_exposures + ":1: no reference exposure (a header only)"
-                         : a.reference_result + ": no used reference exposure");
-  // The L1 image's size comes from --mean-height-m and --gsd-m: bounded before anything is
-  // allocated (a plane far from the terrain gave a footprint of millions of cells per side).
-  {
-    triangulation::L1Grid grid;
-    try {
-      grid = triangulation::MakeL1Grid(camera, pos, a.options.mean_height_m, a.options.gsd_m);
-    } catch (const InputError& e) {  // its messages say "pos.csv" for any POS file: name the inputs
-      throw InputError(std::string(e.what()) + " (--pos " + a.pos + ", --camera " + a.camera +
-                       ", --mean-height-m " + FormatNumber(a.options.mean_height_m) + ")");
-    }
-    const double cells = double(grid.width) * double(grid.height);
-    if (!(cells <= kMaxL1Cells))
-      throw ConfigError("--mean-height-m / --gsd-m: the L1 image would have " +
-                        std::to_string(grid.width) + " x " + std::to_string(grid.height) +
-                        " cells, at most " + FormatNumber(kMaxL1Cells) +
-                        " (the plane Z = " + FormatNumber(a.options.mean_height_m) +
-                        " m is far from the line footprint)");
-  }
-  if (skipped > 0)
-    std::printf(
-        "reference: %zu adjusted exposures of %s (%d not used by the adjustment, skipped)\n",
-        exposures.size(),
-        a.reference_result.c_str(),
-        skipped);
-  std::vector<std::string> image_paths;
-  for (const auto& e : exposures)
-    image_paths.push_back(ReferenceImagePath(
-        a.reference_images,
-        e,
-        a.reference_result.empty()
-            ? a.reference_exposures + ":" + std::to_string(e.line)
-            : a.reference_result + ": exposures[" + std::to_string(e.line - 1) + "]"));
-  const stitch::GrayImage line_image = stitch::ReadGrayImage(a.line_image);
-  std::vector<triangulation::ReferenceFrame> frames;
-  for (size_t k = 0; k < exposures.size(); ++k) {
-    triangulation::ReferenceFrame f;
-    f.id = exposures[k].image;
-    f.center_m = exposures[k].center_m;
-    f.opk_rad = exposures[k].opk_rad;
-    f.image = stitch::ReadGrayImage(image_paths[k]);
-    frames.push_back(std::move(f));
-  }
-  const auto result =
-      triangulation::MakeCloudControl(camera, pos, line_image, reference_camera, frames, a.options);
+  const PushbroomControlRun run = RunPushbroomControl(a.request);
+  const triangulation::CloudControlResult& result = run.result;
+  if (run.skipped_exposures > 0)
+    std::printf("reference: %d adjusted exposures of %s (%d not used by the adjustment, skipped)\n",
+                run.reference_exposures,
+                a.request.reference_result.c_str(),
+                run.skipped_exposures);
   namespace fs = std::filesystem;
   fs::create_directories(a.out);
   triangulation::WriteLineObservations((fs::path(a.out) / "observations.csv").string(),
                                        result.observations);
   triangulation::WritePoints((fs::path(a.out) / "points.csv").string(), result.points);
-  WriteResult((fs::path(a.out) / "control.json").string(),
-              "pushbroom_control",
-              triangulation::CloudControlToJson(result, a.options));
+  WriteResult((fs::path(a.out) / "control.json").string(), "pushbroom_control", run.document);
   if (a.write_l1) stitch::WriteGrayImage((fs::path(a.out) / "l1.png").string(), result.l1.image);
   std::printf(
       "cloud control: L1 image %d x %d cells of %.3f m at Z = %.2f m, %d interest points, "
@@ -270,34 +198,34 @@ CommandRun Setup(CLI::App& app) {
                   "Fewer observations between two nodes: warning few_points_per_line")
       ->check(FiniteRange(0, 1e6));
   auto control_args = std::make_shared<ControlArgs>();
-  auto& c = control_args->options;
+  auto& c = control_args->request.options;
   CLI::App* ctl = app.add_subcommand(
       "control",
       "Cloud control points from the line image: L1 rectification onto the mean terrain height, "
       "Foerstner points, matching into oriented reference frame images, forward intersection");
   ctl->option_defaults()->always_capture_default();
-  ctl->add_option("--camera", control_args->camera, "Nominal line camera file")->required();
-  ctl->add_option("--pos", control_args->pos, "pos.csv of the line image")->required();
+  ctl->add_option("--camera", control_args->request.camera, "Nominal line camera file")->required();
+  ctl->add_option("--pos", control_args->request.pos, "pos.csv of the line image")->required();
   ctl->add_option("--line-image",
-                  control_args->line_image,
+                  control_args->request.line_image,
                   "The line image: row = scan line, column = detector")
       ->required();
   ctl->add_option("--reference-camera",
-                  control_args->reference_camera,
+                  control_args->request.reference_camera,
                   "Camera file of the reference frame images")
       ->required();
   auto* ref_csv =
       ctl->add_option("--reference-exposures",
-                      control_args->reference_exposures,
+                      control_args->request.reference_exposures,
                       "exposures.csv with the oriented reference frames (the block result)");
   auto* ref_result = ctl->add_option(
       "--reference-result",
-      control_args->reference_result,
+      control_args->request.reference_result,
       "result.json of `aerocal adjust` with the oriented reference frames (instead of "
       "--reference-exposures; its used exposures)");
   ref_csv->excludes(ref_result);
   ctl->add_option("--reference-images",
-                  control_args->reference_images,
+                  control_args->request.reference_images,
                   "Folder of the reference images (named by their exposure id, .png/.tif/.jpg)")
       ->required();
   ctl->add_option("--out",

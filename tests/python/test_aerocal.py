@@ -5,6 +5,7 @@ AEROCAL_BINARY at the command; the simulated flight is made by `aerocal simulate
 is a second implementation: every number compared comes from both sides of the same library.
 """
 
+import csv
 import json
 import math
 import os
@@ -407,6 +408,41 @@ def test_pushbroom_calibrate_equals_the_command(tmp_path):
         aerocal.pushbroom_calibrate(*files, degre=3)
     with pytest.raises(ValueError, match="--datum must be gauge, reference or none"):
         aerocal.pushbroom_calibrate(*files, datum="middle")
+
+
+def test_pushbroom_control_equals_the_command(tmp_path):
+    photo = os.path.join(SHARED, "odm_boruszyn_kap_frames", "images", "img_4880.jpg")
+    if not os.path.exists(photo):
+        pytest.skip("../shared/data/odm_boruszyn_kap_frames is absent (the scene's texture)")
+    sim = tmp_path / "pb"
+    code, out = run("simulate", "--pushbroom", "--render-images", "--texture", photo, "--detectors", "100",
+                    "--lines", "300", "--out", str(sim))
+    assert code == 0, out
+    inputs = dict(camera=str(sim / "camera_nominal.yaml"), pos=str(sim / "pos.csv"),
+                  line_image=str(sim / "line_image.png"), reference_camera=str(sim / "reference" / "camera.yaml"),
+                  reference_images=str(sim / "reference"))
+    exposures = str(sim / "reference" / "exposures.csv")
+    cli = tmp_path / "control"
+    code, out = run("pushbroom", "control", *[a for k, v in inputs.items() for a in ("--" + k.replace("_", "-"), v)],
+                    "--reference-exposures", exposures, "--search-px", "12", "--out", str(cli))
+    assert code == 0, out
+    r = aerocal.pushbroom_control(**inputs, reference_exposures=exposures, search_px=12)
+    with open(cli / "control.json") as f:
+        assert r["document"] == json.load(f)
+    # The arrays hold what observations.csv and points.csv hold, row for row.
+    with open(cli / "points.csv") as f:
+        rows = list(csv.DictReader(f))
+    assert r["points"]["id"] == [row["point"] for row in rows]
+    assert r["points"]["xyz_m"].shape == (len(rows), 3) and np.all(r["points"]["sigma_m"] > 0)
+    np.testing.assert_allclose(r["points"]["xyz_m"][:, 2], [float(row["Z"]) for row in rows], rtol=1e-9)
+    # One line-image observation per control point (the reference rays made the point).
+    n = len(r["observations"]["point"])
+    assert sorted(r["observations"]["point"]) == sorted(r["points"]["id"])
+    assert r["observations"]["detector_line"].shape == (n, 2)
+    with pytest.raises(TypeError, match="unknown option 'search'"):
+        aerocal.pushbroom_control(**inputs, reference_exposures=exposures, search=3)
+    with pytest.raises(ValueError, match="give one of --reference-exposures and --reference-result"):
+        aerocal.pushbroom_control(**inputs)
 
 
 def test_rig_design_equals_the_command(tmp_path):

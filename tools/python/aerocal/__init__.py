@@ -37,6 +37,8 @@ Multi-head rigs
 Pushbroom line cameras
     pushbroom_calibrate(line_camera_file, pos_csv, observations_csv, points_csv, **options)
         -> LineCalibrationResult: valid, sigma0, document, to_json()
+    pushbroom_control(line_camera_file, pos_csv, line_image, reference_camera, reference_images,
+                      reference_exposures=...) -> dict: document, observations, points (arrays)
 
 The virtual image (resampling the sub-images of one frame)
     resample(camera_file, stitch_json, {"I": "I.tif", ...}, frame="", interpolation="bilinear",
@@ -67,6 +69,7 @@ from ._aerocal import (
     match,
     models,
     pushbroom_calibrate,
+    pushbroom_control,
     resample,
     rig_design,
     rig_error_analysis,
@@ -93,6 +96,7 @@ __all__ = [
     "match",
     "models",
     "pushbroom_calibrate",
+    "pushbroom_control",
     "resample",
     "rig_design",
     "rig_error_analysis",

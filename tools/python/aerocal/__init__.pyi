@@ -191,6 +191,10 @@ class LineCalibrationResult:
 def pushbroom_calibrate(camera: str, pos: str, observations: str, points: str,
                         **options: Any) -> LineCalibrationResult: ...
 
+def pushbroom_control(camera: str, pos: str, line_image: str, reference_camera: str,
+                      reference_images: str, reference_exposures: str = "", reference_result: str = "",
+                      **options: Any) -> Dict[str, Any]: ...
+
 def match(camera: str, images: Union[Mapping[str, str], str, None] = None, frame: str = "",
           list: Optional[str] = None, detector: str = "sift", lsm: bool = True,
           sigma_px: float = 0.3, cell_px: float = 100.0, out: str = "") -> Dict[str, Any]: ...
