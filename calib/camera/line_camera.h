@@ -87,6 +87,14 @@ T EvaluatePolynomial(const T* a, int n, const T& u) {
   return value;
 }
 
+/// Its derivative sum_k k a[k] u^(k-1) (Horner); templated for Jets.
+template <typename T>
+T EvaluatePolynomialDerivative(const T* a, int n, const T& u) {
+  T value = T(0);
+  for (int k = n - 1; k >= 1; --k) value = value * u + double(k) * a[k];
+  return value;
+}
+
 /// The combination of `subcameras` into one virtual line camera with principal distance c_mm and
 /// pitch_mm, numbered in sequence (their first/last are set here), no calibration.
 LineCamera CombineLineCameras(const std::string& name,

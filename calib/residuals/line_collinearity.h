@@ -10,13 +10,19 @@
 //   opk(t) = opk_pos + dt opk_rate + sum_m w_m node_m[3..5],
 //   O(t) = O_pos + dt velocity + sum_m w_m node_m[0..2]
 //   R = Rx Ry Rz(opk(t))   (body -> object),   camera centre C = O(t) + R t_lever
-//   [U V W]^T = M^T R^T (X - C),   M = Rx Ry Rz(mount) (camera -> body)
+//   g = [U V W]^T = M^T R^T (X - C),   M = Rx Ry Rz(mount) (camera -> body)
 // The detector's focal-plane position is its design position plus the calibration polynomial of
-// its sub-camera in the normalised index u (line_camera.h):
-//   x = x_design + sum_k a_k u^k,   y = y_design + sum_k b_k u^k
-//   r = ((x - (-c U / W)) / sigma_x_mm, (y - (-c V / W)) / sigma_y_mm)            [2, unitless]
-// computed by the one collinearity condition of aerocal (internal::CollinearityErrorFromImageSpace
-// with LineFocalPlaneModel, unit sigma) and then whitened per axis.
+// its sub-camera in the normalised index u (line_camera.h), and the table's line direction there
+// its derivative in the detector index:
+//   x = x_design + sum_k a_k u^k,   y = y_design + sum_k b_k u^k,
+//   x' = x_design' + du/di sum_k k a_k u^(k-1),   y' likewise
+// The residual is the ANGLE between the detector's ray d = (x, y, -c) and g in a frame attached to
+// the table (u1 along its line direction, u2 = e x u1; line_ray_angle.h), so that it is invariant
+// under a rotation of camera + table and under a scale of c with the table (issue 28: the gauges
+// are then exact), whitened in pixels at the nominal ray (c and the table at their start values):
+//   r = S a,   S = -diag(1 / sigma_xy_mm) A^-1   (LineRayAngleWhitening)              [2, unitless]
+// which equals ((x - (-c U / W)) / sigma_x_mm, (y - (-c V / W)) / sigma_y_mm), the focal-plane
+// residual of the one collinearity condition, to first order at the nominal ray.
 // sigma_x_mm = sigma_px |d x_design / d i| (the local detector spacing in the virtual focal plane:
 // up to 1 / cos^2 of the look angle times the pitch for a tilted sub-camera), sigma_y_mm =
 // sigma_px |d y / d t| (the image motion of one scan line), so that a measurement's sigma in
@@ -24,13 +30,13 @@
 //
 // blocks: node0..node3 [6] (m, rad), detector [2 kLineMaxTerms] = a_0..a_5, b_0..b_5 (mm),
 //         c [1] (mm), mount [3] (rad), lever_arm [3] (m), time_offset [1] (s), point [3] (m).
-// Returns false when the point is on or behind the camera (W >= 0).
+// Returns false when the point is not in front of the detector's ray (e.g <= 0).
 #pragma once
 
 #include "calib/camera/line_camera.h"
 #include "calib/camera/rotation.h"
 #include "calib/residuals/autodiff_residual.h"
-#include "calib/residuals/collinearity.h"
+#include "calib/residuals/line_ray_angle.h"
 
 #include <Eigen/Core>
 
@@ -67,22 +73,14 @@ inline int SplineNodeCount(double last_line, int spacing) {
   return int(std::floor(last_line / spacing)) + 4;
 }
 
-/// The line camera's focal plane as a camera model of the one collinearity condition
-/// (internal::CollinearityErrorFromImageSpace, collinearity.h): interior [c] (mm); the detector's
-/// calibrated focal-plane position (design + polynomial) is the ideal position itself (the
-/// detector calibration sits in the residual's detector block, not in a distortion model).
-struct LineFocalPlaneModel {
-  static constexpr bool kCorrectionForm = true;
-  template <typename T>
-  static T PrincipalDistanceMm(const T* c, const PixelFrame&) {
-    return c[0];
-  }
-  template <typename T>
-  static bool IdealFromMeasured(const T*, const PixelFrame&, const T* measured_mm, T* ideal_mm) {
-    ideal_mm[0] = measured_mm[0];
-    ideal_mm[1] = measured_mm[1];
-    return true;
-  }
+/// Where a measured detector position lies on the table (start values) and the principal distance
+/// its residual is weighted at.
+struct LineDetectorGeometry {
+  Eigen::Vector2d xy_mm = Eigen::Vector2d::Zero();     // design (+ the file's calibration), mm
+  Eigen::Vector2d slope_mm = Eigen::Vector2d::Zero();  // its derivative in the index, mm / detector
+  double u = 0.0;                                      // normalised index in its sub-camera
+  double du_di = 0.0;         // 2 / (last - first) of its sub-camera (0: one detector)
+  double nominal_c_mm = 0.0;  // the start value of c, > 0: the weight's principal distance
 };
 
 struct LineCollinearityResidual : AutoDiffResidual<LineCollinearityResidual,
@@ -97,27 +95,32 @@ struct LineCollinearityResidual : AutoDiffResidual<LineCollinearityResidual,
                                                    3,
                                                    1,
                                                    3> {
-  /// design_xy_mm: design focal-plane position of the measured detector position; u: its
-  /// normalised index in its sub-camera; span: spline weights of its line; pos_opk_rad,
-  /// pos_center_m: the POS pose interpolated to its line; sigma_xy_mm > 0 (see above);
-  /// pos_velocity_m_s, pos_opk_rate_rad_s: the POS's time derivatives at the line (the time
-  /// offset's lever).
-  LineCollinearityResidual(const Eigen::Vector2d& design_xy_mm,
-                           double u,
+  /// detector: the measured position on the table and its nominal principal distance; span:
+  /// spline weights of its line; pos_opk_rad, pos_center_m: the POS pose interpolated to its line;
+  /// sigma_xy_mm > 0 (see above); pos_velocity_m_s, pos_opk_rate_rad_s: the POS's time
+  /// derivatives at the line (the time offset's lever).
+  LineCollinearityResidual(const LineDetectorGeometry& detector,
                            const SplineSpan& span,
                            const Eigen::Vector3d& pos_opk_rad,
                            const Eigen::Vector3d& pos_center_m,
                            const Eigen::Vector2d& sigma_xy_mm,
                            const Eigen::Vector3d& pos_velocity_m_s = Eigen::Vector3d::Zero(),
                            const Eigen::Vector3d& pos_opk_rate_rad_s = Eigen::Vector3d::Zero())
-      : design_{design_xy_mm.x(), design_xy_mm.y()},
-        u_(u),
+      : design_{detector.xy_mm.x(), detector.xy_mm.y()},
+        slope_{detector.slope_mm.x(), detector.slope_mm.y()},
+        u_(detector.u),
+        du_di_(detector.du_di),
         weights_(span.weights),
         opk_{pos_opk_rad.x(), pos_opk_rad.y(), pos_opk_rad.z()},
         center_{pos_center_m.x(), pos_center_m.y(), pos_center_m.z()},
         velocity_{pos_velocity_m_s.x(), pos_velocity_m_s.y(), pos_velocity_m_s.z()},
-        opk_rate_{pos_opk_rate_rad_s.x(), pos_opk_rate_rad_s.y(), pos_opk_rate_rad_s.z()},
-        inverse_sigma_mm_{1.0 / sigma_xy_mm.x(), 1.0 / sigma_xy_mm.y()} {}
+        opk_rate_{pos_opk_rate_rad_s.x(), pos_opk_rate_rad_s.y(), pos_opk_rate_rad_s.z()} {
+    const Eigen::Matrix2d s = LineRayAngleWhitening(
+        Eigen::Vector3d(detector.xy_mm.x(), detector.xy_mm.y(), -detector.nominal_c_mm),
+        Eigen::Vector3d(detector.slope_mm.x(), detector.slope_mm.y(), 0.0),
+        sigma_xy_mm);
+    whitening_ = {s(0, 0), s(0, 1), s(1, 0), s(1, 1)};  // row-major
+  }
 
   template <typename T>
   bool operator()(const T* n0,
@@ -153,26 +156,29 @@ struct LineCollinearityResidual : AutoDiffResidual<LineCollinearityResidual,
     for (int a = 0; a < 3; ++a) b[a] = body[a] * d[0] + body[3 + a] * d[1] + body[6 + a] * d[2];
     for (int a = 0; a < 3; ++a) v[a] = cam[a] * b[0] + cam[3 + a] * b[1] + cam[6 + a] * b[2];
     const T u(u_);
-    const T xy[2] = {
-        T(design_[0]) + EvaluatePolynomial(detector, kLineMaxTerms, u),
-        T(design_[1]) + EvaluatePolynomial(detector + kLineMaxTerms, kLineMaxTerms, u)};
-    // The one collinearity condition (unit sigma), then the per-axis whitening.
-    T unit[2];
-    if (!internal::CollinearityErrorFromImageSpace<LineFocalPlaneModel>(
-            c, PixelFrame{}, v, xy, 1.0, unit))
-      return false;
-    r[0] = unit[0] * T(inverse_sigma_mm_[0]);
-    r[1] = unit[1] * T(inverse_sigma_mm_[1]);
+    const T* dx = detector;
+    const T* dy = detector + kLineMaxTerms;
+    const T ray[3] = {T(design_[0]) + EvaluatePolynomial(dx, kLineMaxTerms, u),
+                      T(design_[1]) + EvaluatePolynomial(dy, kLineMaxTerms, u),
+                      -c[0]};
+    const T line_direction[3] = {
+        T(slope_[0]) + du_di_ * EvaluatePolynomialDerivative(dx, kLineMaxTerms, u),
+        T(slope_[1]) + du_di_ * EvaluatePolynomialDerivative(dy, kLineMaxTerms, u),
+        T(0.0)};
+    T angle[2];
+    if (!LineRayAngle(ray, line_direction, v, angle)) return false;
+    r[0] = whitening_[0] * angle[0] + whitening_[1] * angle[1];
+    r[1] = whitening_[2] * angle[0] + whitening_[3] * angle[1];
     return true;
   }
 
  private:
-  double design_[2];
-  double u_;
+  double design_[2], slope_[2];
+  double u_, du_di_;
   std::array<double, 4> weights_;
   double opk_[3], center_[3];
   double velocity_[3], opk_rate_[3];
-  double inverse_sigma_mm_[2];
+  std::array<double, 4> whitening_;  // S, row-major (line_ray_angle.h)
 };
 
 }  // namespace aerocal::calib

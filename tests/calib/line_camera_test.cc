@@ -216,8 +216,13 @@ TEST(LineCollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
   std::copy(point.data(), point.data() + 3, s.point);
 
   // A time offset (here 0) moves the pose along the POS velocity and attitude rate.
-  auto cost = LineCollinearityResidual::Create(design,
-                                               u,
+  LineDetectorGeometry geometry;
+  geometry.xy_mm = design;
+  geometry.slope_mm = (cam.DesignPosition(i + 0.01) - cam.DesignPosition(i - 0.01)) / 0.02;
+  geometry.u = u;
+  geometry.du_di = 2.0 / 99.0;
+  geometry.nominal_c_mm = 8.5;
+  auto cost = LineCollinearityResidual::Create(geometry,
                                                span,
                                                pos_opk,
                                                pos_center,
@@ -266,8 +271,10 @@ TEST(LineCollinearityResidual, ZeroForAPerfectObservationAndGradientsMatch) {
 TEST(LineCollinearityResidual, RefusesAPointBehindTheCamera) {
   Scene s;
   s.point[2] = 3000;  // above the camera at 1000 m
-  auto cost = LineCollinearityResidual::Create(Eigen::Vector2d(0, 0),
-                                               0.0,
+  LineDetectorGeometry geometry;
+  geometry.slope_mm = Eigen::Vector2d(0.01, 0);
+  geometry.nominal_c_mm = 8.5;
+  auto cost = LineCollinearityResidual::Create(geometry,
                                                CubicBSplineWeights(0, 10),
                                                Eigen::Vector3d::Zero(),
                                                Eigen::Vector3d(0, 0, 1000),

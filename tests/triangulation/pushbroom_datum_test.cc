@@ -13,10 +13,12 @@
 #include "triangulation/pushbroom/line_calibration.h"
 #include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
+#include "triangulation/sensor/line_scan_camera.h"
 
 #include <Eigen/Dense>
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <set>
@@ -168,21 +170,28 @@ void PrintDatum(const char* what, const LineCalibrationResult& r) {
     std::printf(" %.1e", r.datum.smallest_relative_eigenvalues[k]);
   std::printf(", gauge:");
   for (const auto& d : r.datum.directions) std::printf(" %s (%.9f)", d.name.c_str(), d.fraction);
-  std::printf(", sigma0 %.6f, vtpv %.6f\n", r.report.sigma0, r.report.vtpv);
+  std::printf(", sigma0 %.6f, vtpv %.6f, c %.6f, %d iterations (%s)\n",
+              r.report.sigma0,
+              r.report.vtpv,
+              r.c_mm,
+              r.report.iterations,
+              r.report.termination.c_str());
 }
 
 class GaugeDatum : public ::testing::TestWithParam<bool> {};
 
 // The gauge directions are null directions of the model (the table functions of a camera rotation
-// or scale); the focal-plane residual makes them null only up to a term of the residuals' size
-// (a rotation by b changes a focal-plane residual e by about 2 b x e / c): measured relative
-// eigenvalues 5e-9 .. 2.4e-6 with the POS priors, against >= 1.9e-2 for every determined
-// direction with the boresight and lever arm fixed, but only 4.5e-5 for the lever arm free (its
-// vertical component is nearly a scale of the table, told apart by the relief). So the default
-// threshold 1e-5 separates them by a factor of 4 on either side, no more. Without the priors the
-// trajectory's constant attitude is a near-gauge too and the spectrum has no gap (1e-9 .. 2e-5):
-// the count then depends on the threshold; it is printed, not asserted.
-constexpr double kMargin = 4.0;  // eigenvalue ratio to the threshold on either side, at least
+// or scale), and the angular residual (calib/residuals/line_ray_angle.h) makes them exact: their
+// relative eigenvalues lie at the numerical floor on the linear layout (1e-16) and below 1.5e-10
+// on the sub-camera design (whose tilted design is not a polynomial in u: degree 3 represents its
+// gauge functions approximately), against >= 1.9e-2 for every determined direction with the
+// boresight and lever arm fixed, but only 4.4e-5 for the lever arm free (its vertical component is
+// nearly a scale of the table, told apart by the relief). The default threshold 1e-5 separates the
+// priors configurations by a factor of 4 on the determined side. Without the priors the exact
+// gauges are followed by the trajectory's weak directions from 7.5e-7 (position against attitude):
+// the count at 1e-5 includes some of those; it is printed, not asserted (module README "Datum").
+constexpr double kGaugeFloor = 1e-9;  // the gauge directions' eigenvalues lie below it (measured)
+constexpr double kMargin = 4.0;       // eigenvalue ratio to the threshold on either side, at least
 
 TEST_P(GaugeDatum, RankDefectEqualsTheConstraintsPerConfiguration) {
   const bool linear = GetParam();
@@ -205,6 +214,7 @@ TEST_P(GaugeDatum, RankDefectEqualsTheConstraintsPerConfiguration) {
       EXPECT_GT(e[k], kMargin * none.datum.threshold) << config.name;
       if (k > 0) {
         EXPECT_LT(e[k - 1], none.datum.threshold / kMargin) << config.name;
+        EXPECT_LT(std::abs(e[k - 1]), kGaugeFloor) << config.name;
       }
     }
     // The datum adds exactly the defect, and the problem with it has full rank: a covariance
@@ -213,6 +223,15 @@ TEST_P(GaugeDatum, RankDefectEqualsTheConstraintsPerConfiguration) {
     EXPECT_TRUE(gauge.undetermined.empty()) << config.name;
     for (const auto& w : gauge.warnings) EXPECT_NE(w.name, "covariance") << config.name;
     EXPECT_EQ(gauge.report.redundancy, none.report.redundancy + k);
+    // c free on the linear layout: the scale gauge is exact there (a scale of its design is linear
+    // in u), so the datum-free solve keeps the fit of the datum (it no longer walks down the
+    // scale to c ~ 0) and the datum costs nothing. On the sub-camera design the polynomials
+    // follow a scale of the tilted design only approximately (eigenvalue 2.4e-11): printed.
+    if (linear && config.pos_prior && config.free_c &&
+        config.boresight == PlatformParamMode::kFixed) {
+      EXPECT_NEAR(gauge.report.vtpv, none.report.vtpv, 1e-9 * none.report.vtpv) << config.name;
+      EXPECT_NEAR(none.c_mm, sim.truth.c_mm, 0.05 * sim.truth.c_mm) << config.name;
+    }
     // No defect: nothing is held, the problem is the datum-free one.
     if (k == 0) {
       EXPECT_DOUBLE_EQ(gauge.report.vtpv, none.report.vtpv) << config.name;
@@ -234,9 +253,70 @@ TEST_P(GaugeDatum, RankDefectEqualsTheConstraintsPerConfiguration) {
 // Any two valid choices of the sub-camera that carries the datum: with the POS priors and the
 // boresight fixed (the default) there is no defect and the tables are identical. With a defect
 // (boresight and c free: 4 gauge directions) the tables agree modulo the gauge to 1e-6 px on
-// data without any error (image, control, POS: the residuals vanish, so does the residual-size
-// term that makes the gauge inexact); with noise they differ by what that term moves (printed;
-// module README "Datum": the 1e-6 px is not met there).
+// data without any error. With noise (0.25 px, POS errors with priors) they agree to 5.6e-5 ..
+// 1.8e-4 px (with the focal-plane residual, which made the gauges inexact by the residuals' size:
+// 0.09-0.14 px): the 1e-6 px is not met there, and the bound asserted is the measured one
+// with a margin of 5 (module README "Datum": the solutions of the three references differ in
+// v^T P v by up to 0.006, above the boresight-fixed solution's, while their datum residuals are
+// ~1e-9; the solver run to its limits, printed below, ends at the same values: they are the
+// constrained minima, so the finite orbit leaves the model by ~1e-4 px, cause not found).
+constexpr double kNoisyGaugePx = 1e-3;
+
+// The three references' tables for one configuration, solved to `tolerance` (relative cost change,
+// step and gradient) within `iterations`.
+std::vector<Table> ReferenceTables(const LineSimulation& sim,
+                                   const Config& config,
+                                   double tolerance,
+                                   int iterations) {
+  std::vector<Table> tables;
+  for (int reference = 0; reference < 3; ++reference) {
+    LineCalibrationOptions options = OptionsOf(config);
+    options.degree = 5;  // a finite rotation of the table is a polynomial to 1e-9 px at 5
+    options.reference_subcamera = reference;
+    options.solver.function_tolerance = tolerance;
+    options.solver.parameter_tolerance = tolerance;
+    options.solver.gradient_tolerance = tolerance * 1e-4;
+    options.solver.max_iterations = iterations;
+    const LineCalibrationResult r = Calibrate(sim, options);
+    EXPECT_TRUE(r.report.usable) << r.report.message;
+    const calib::ResidualGroupStats* datum = r.report.Group(kGroupLineDatum);
+    std::printf("  reference %d: v^T P v %.9f (datum %.1e), %d iterations (%s)\n",
+                reference,
+                r.report.vtpv,
+                datum ? datum->vtpv : 0.0,
+                r.report.iterations,
+                r.report.message.c_str());
+    EXPECT_EQ(r.datum.n_constraints, config.expected_defect) << config.name;
+    tables.push_back(TableOf(r, sim.nominal));
+  }
+  return tables;
+}
+
+// The largest difference modulo the gauge between any two of the tables, px (printed per pair).
+double WorstModuloGauge(const std::vector<Table>& tables, double pitch, const std::string& what) {
+  double worst = 0;
+  for (int a = 0; a < 3; ++a)
+    for (int b = a + 1; b < 3; ++b) {
+      Eigen::Vector3d angles;
+      const Eigen::VectorXd plain =
+          RotatedDifference(tables[a], tables[b], Eigen::Vector3d::Zero(), pitch);
+      const Eigen::VectorXd d = ModuloGauge(tables[a], tables[b], pitch, &angles);
+      std::printf(
+          "%s: reference %d vs %d: max difference %.2e px, modulo the gauge %.2e px (rotation "
+          "%.2e %.2e %.2e rad)\n",
+          what.c_str(),
+          a,
+          b,
+          plain.cwiseAbs().maxCoeff(),
+          d.cwiseAbs().maxCoeff(),
+          angles.x(),
+          angles.y(),
+          angles.z());
+      worst = std::max(worst, d.cwiseAbs().maxCoeff());
+    }
+  return worst;
+}
+
 TEST_P(GaugeDatum, ReferenceChoicesAgreeModuloTheGauge) {
   const bool linear = GetParam();
   for (const bool noise : {false, true}) {
@@ -249,47 +329,26 @@ TEST_P(GaugeDatum, ReferenceChoicesAgreeModuloTheGauge) {
     const LineSimulation sim = SimulateLineFlight(o);
     const double pitch = sim.nominal.pitch_mm;
     for (const Config& config : {kConfigs[0], kConfigs[3]}) {
-      std::vector<Table> tables;
-      for (int reference = 0; reference < 3; ++reference) {
-        LineCalibrationOptions options = OptionsOf(config);
-        options.degree = 5;  // a finite rotation of the table is a polynomial to 1e-9 px at 5
-        options.reference_subcamera = reference;
-        options.solver.function_tolerance = 1e-16;
-        options.solver.parameter_tolerance = 1e-16;
-        options.solver.gradient_tolerance = 1e-20;
-        const LineCalibrationResult r = Calibrate(sim, options);
-        ASSERT_TRUE(r.report.usable) << r.report.message;
-        EXPECT_EQ(r.datum.n_constraints, config.expected_defect) << config.name;
-        tables.push_back(TableOf(r, sim.nominal));
+      const std::string what = std::string(linear ? "linear" : "subcameras") + " layout, " +
+                               (noise ? "noise" : "noise-free") + ", " + config.name;
+      std::printf("%s\n", what.c_str());
+      const std::vector<Table> tables = ReferenceTables(sim, config, 1e-16, 100);
+      const double worst = WorstModuloGauge(tables, pitch, what);
+      // No defect: the same problem; it differs in the last bits only (the Schur ordering
+      // follows block addresses; 100 iterations near a zero residual amplify them).
+      if (config.expected_defect == 0) {
+        EXPECT_LT(RotatedDifference(tables[0], tables[1], Eigen::Vector3d::Zero(), pitch)
+                      .cwiseAbs()
+                      .maxCoeff(),
+                  1e-9);
       }
-      for (int a = 0; a < 3; ++a)
-        for (int b = a + 1; b < 3; ++b) {
-          Eigen::Vector3d angles;
-          const Eigen::VectorXd plain =
-              RotatedDifference(tables[a], tables[b], Eigen::Vector3d::Zero(), pitch);
-          const Eigen::VectorXd d = ModuloGauge(tables[a], tables[b], pitch, &angles);
-          std::printf(
-              "%s layout, %s, %s: reference %d vs %d: max difference %.2e px, modulo "
-              "the gauge %.2e px (rotation %.2e %.2e %.2e rad)\n",
-              linear ? "linear" : "subcameras",
-              noise ? "noise" : "noise-free",
-              config.name,
-              a,
-              b,
-              plain.cwiseAbs().maxCoeff(),
-              d.cwiseAbs().maxCoeff(),
-              angles.x(),
-              angles.y(),
-              angles.z());
-          // No defect: the same problem; it differs in the last bits only (the Schur ordering
-          // follows block addresses; 100 iterations near a zero residual amplify them).
-          if (config.expected_defect == 0) {
-            EXPECT_LT(plain.cwiseAbs().maxCoeff(), 1e-9);
-          }
-          if (!noise) {
-            EXPECT_LT(d.cwiseAbs().maxCoeff(), 1e-6) << config.name << " " << a << " " << b;
-          }
-        }
+      EXPECT_LT(worst, noise ? kNoisyGaugePx : 1e-6) << what;
+      // The solver without its stopping rules (1e-30, 200 iterations; one layout, ~5 s): does the
+      // noisy case approach the gauge-equivalent solution? Measured, printed.
+      if (noise && linear && config.expected_defect > 0) {
+        std::printf("%s, solver run to its limits:\n", what.c_str());
+        WorstModuloGauge(ReferenceTables(sim, config, 1e-30, 200), pitch, what + " (limits)");
+      }
     }
   }
 }

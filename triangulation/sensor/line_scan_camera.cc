@@ -182,8 +182,20 @@ ObservationTerm LineScanCamera::Observe(const SensorContext& context,
   Eigen::Vector3d c0, c1, o0, o1;
   pos_.PoseAtTime(t0, &c0, &o0);
   pos_.PoseAtTime(t1, &c1, &o1);
-  term.cost = calib::LineCollinearityResidual::Create(camera_.DetectorPosition(detector),
-                                                      site.u,
+  // The table at its start values: the measured position, the line direction there (the ray
+  // angle's frame) and c, at which the angle is weighted (line_ray_angle.h).
+  calib::LineDetectorGeometry geometry;
+  geometry.xy_mm = camera_.DetectorPosition(detector);
+  geometry.slope_mm =
+      ranges_[s].second > ranges_[s].first
+          ? Eigen::Vector2d((camera_.DetectorPosition(ic + h) - camera_.DetectorPosition(ic - h)) /
+                            (2 * h))
+          : Eigen::Vector2d(camera_.pitch_mm, 0.0);
+  geometry.u = site.u;
+  geometry.du_di =
+      ranges_[s].second > ranges_[s].first ? 2.0 / double(ranges_[s].second - ranges_[s].first) : 0;
+  geometry.nominal_c_mm = camera_.c_mm;
+  term.cost = calib::LineCollinearityResidual::Create(geometry,
                                                       span,
                                                       pos_opk,
                                                       pos_center,

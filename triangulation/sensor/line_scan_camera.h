@@ -24,9 +24,11 @@
 //   "time_offset"     dt (s): the line's true time minus its pos.csv time (shutter / POS latency),
 //                     to first order through the POS velocity and attitude rate; fixed at 0
 //                     unless `time_offset`
-// Residual of an observation: calib::LineCollinearityResidual (group kGroupLineImage), which ends
-// in the one collinearity condition of aerocal (calib/residuals/collinearity.h); blocks node J ..
-// J+3, detector, c, mount, lever_arm, time_offset, point.
+// Residual of an observation: calib::LineCollinearityResidual (group kGroupLineImage): the angle
+// between the detector's ray and the ray to the point in a frame attached to the table
+// (calib/residuals/line_ray_angle.h; invariant under the camera's rotation and scale), weighted in
+// pixels at the file's c and table; blocks node J .. J+3, detector, c, mount, lever_arm,
+// time_offset, point.
 // Own residuals (AddOwnResiduals): the POS prior on every node (group kGroupPosPrior, around 0 with
 // the POS sigmas) when `pos_prior`; the weighted boresight and lever arm around the file's values
 // (group kGroupLinePrior).
@@ -123,8 +125,10 @@ struct LineDetectorSite {
 struct LineTerm {
   int subcamera = 0;
   double detector = 0.0, u = 0.0;
-  Eigen::Vector2d sigma_mm = Eigen::Vector2d::Zero();  // whitening, focal plane x and y
-  int segment = 0;                                     // first of its four spline nodes
+  // Focal-plane sigmas x and y: the residual is their first-order equivalent in angle, so
+  // r * sigma_mm is the focal-plane misclosure (mm) to first order.
+  Eigen::Vector2d sigma_mm = Eigen::Vector2d::Zero();
+  int segment = 0;  // first of its four spline nodes
 };
 
 class LineScanCamera final : public ImagingModel {
