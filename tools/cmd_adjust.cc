@@ -5,6 +5,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
+#include "calib/problem/mounted_block.h"
 #include "tools/adjust_joint.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
@@ -33,12 +34,6 @@ struct RigArgs {
   double increment_sigma_arcsec = 0.0, time_offset_sigma_ms = 0.0;
 };
 
-triangulation::RigParameterMode RigMode(const std::string& option, const std::string& value) {
-  const auto mode = triangulation::ParseRigParameterMode(value);
-  if (!mode) throw ConfigError(option + " must be fixed, free or weighted (got '" + value + "')");
-  return *mode;
-}
-
 // `adjust` of a project with a rig camera file: the rig bundle (rig_head_camera.h).
 int RunRigAdjust(const RigArgs& args,
                  const triangulation::AdjustOptions& options,
@@ -49,10 +44,10 @@ int RunRigAdjust(const RigArgs& args,
                  const std::string& out,
                  const std::string& write_camera) {
   triangulation::RigAdjustOptions rig;
-  rig.mounts = RigMode("--rig-mounts", args.mounts);
-  rig.lever_arms = RigMode("--rig-lever-arms", args.lever_arms);
-  rig.increments = RigMode("--rig-increments", args.increments);
-  rig.time_offsets = RigMode("--rig-time-offsets", args.time_offsets);
+  rig.mounts = calib::BlockModeOption(args.mounts, "--rig-mounts");
+  rig.lever_arms = calib::BlockModeOption(args.lever_arms, "--rig-lever-arms");
+  rig.increments = calib::BlockModeOption(args.increments, "--rig-increments");
+  rig.time_offsets = calib::BlockModeOption(args.time_offsets, "--rig-time-offsets");
   rig.increment_sigma_rad = args.increment_sigma_arcsec * M_PI / (180.0 * 3600.0);
   rig.time_offset_sigma_s = args.time_offset_sigma_ms * 1e-3;
   rig.Validate();
@@ -247,13 +242,10 @@ CommandRun SetupAdjust(CLI::App& app) {
           Eigen::Vector3d(args->boresight_deg[0], args->boresight_deg[1], args->boresight_deg[2]) *
           (M_PI / 180.0);
     if (given("--gnss-time-offset-ms")) p->time_offset_s = args->time_offset_ms * 1e-3;
-    if (given("--lever-arm"))
-      p->lever_arm = triangulation::PlatformParamModeOption(args->lever_arm, "--lever-arm");
-    if (given("--boresight"))
-      p->boresight = triangulation::PlatformParamModeOption(args->boresight, "--boresight");
+    if (given("--lever-arm")) p->lever_arm = calib::BlockModeOption(args->lever_arm, "--lever-arm");
+    if (given("--boresight")) p->boresight = calib::BlockModeOption(args->boresight, "--boresight");
     if (given("--gnss-time-offset"))
-      p->time_offset =
-          triangulation::PlatformParamModeOption(args->time_offset, "--gnss-time-offset");
+      p->time_offset = calib::BlockModeOption(args->time_offset, "--gnss-time-offset");
     if (given("--lever-arm-sigma-m")) p->lever_arm_sigma_m = args->lever_arm_sigma_m;
     if (given("--boresight-sigma-deg"))
       p->boresight_sigma_rad = args->boresight_sigma_deg * M_PI / 180.0;

@@ -4,6 +4,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
+#include "calib/problem/mounted_block.h"
 #include "triangulation/block/block_io.h"
 
 #include <cmath>
@@ -31,8 +32,8 @@ triangulation::LineCalibrationOptions CheckedOptions(const LineCalibrationReques
   if (a.pos_prior != "on" && a.pos_prior != "off")
     throw ConfigError("--pos-prior must be on or off (got '" + a.pos_prior + "')");
   o.pos_prior = a.pos_prior == "on";
-  o.boresight = triangulation::PlatformParamModeOption(a.boresight, "--boresight");
-  o.lever_arm = triangulation::PlatformParamModeOption(a.lever_arm, "--lever-arm");
+  o.boresight = calib::BlockModeOption(a.boresight, "--boresight");
+  o.lever_arm = calib::BlockModeOption(a.lever_arm, "--lever-arm");
   o.boresight_sigma_rad = a.boresight_sigma_deg * M_PI / 180.0;
   o.Validate();
   return o;

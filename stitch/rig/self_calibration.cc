@@ -4,6 +4,7 @@
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 #include "calib/problem/data_snooping.h"
+#include "calib/problem/mounted_block.h"
 #include "calib/residuals/collinearity.h"
 #include "calib/residuals/prior.h"
 
@@ -159,19 +160,27 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
             "dT[" + name + "]", &scalars.emplace_back(0.0), 1, calib::BlockKind::kOther, {"dT"});
         if (result.dt_held) builder.FixBlock(dt[i][k]);
       }
+      // Weighted around zero (calib/problem/mounted_block.h, group rig_stitch_prior); a held
+      // increment keeps its prior, as it always has (it counts in the redundancy).
       if (options.increment_sigma_rad) {
         const double s = *options.increment_sigma_rad;
-        builder.AddResidual(kGroupRigStitchPrior,
-                            calib::PriorCostFunction::Create({0, 0, 0}, {s, s, s}),
-                            {increment[i][k]},
-                            "prior E[" + name + "]");
+        calib::AddBlockPrior(builder,
+                             increment[i][k],
+                             calib::BlockMode::kWeighted,
+                             {0, 0, 0},
+                             {s, s, s},
+                             kRigStitchOwner,
+                             "prior E[" + name + "]");
       }
       if (options.dt_sigma_s && !result.dt_held &&
           (options.mode == RigStitchMode::kPerExposure || i == 0))
-        builder.AddResidual(kGroupRigStitchPrior,
-                            calib::PriorCostFunction::Create({0}, {*options.dt_sigma_s}),
-                            {dt[i][k]},
-                            "prior " + builder.BlockName(dt[i][k]));
+        calib::AddBlockPrior(builder,
+                             dt[i][k],
+                             calib::BlockMode::kWeighted,
+                             {0},
+                             {*options.dt_sigma_s},
+                             kRigStitchOwner,
+                             "prior " + builder.BlockName(dt[i][k]));
     }
   }
 

@@ -52,7 +52,9 @@
 namespace aerocal::stitch {
 
 inline constexpr const char* kGroupRigStitchTie = "rig_stitch_tie";
-inline constexpr const char* kGroupRigStitchPrior = "rig_stitch_prior";
+/// Owner of rig stitching's weighted increments and time offsets: their priors are in group
+/// calib::PriorGroup(kRigStitchOwner), "rig_stitch_prior" (calib/problem/mounted_block.h).
+inline constexpr const char* kRigStitchOwner = "rig_stitch";
 
 enum class RigStitchMode { kLine, kPerExposure, kAngles };
 /// "line" | "per-exposure" | "angles"; nullopt otherwise.

@@ -50,7 +50,7 @@ TEST(RigBundle, NoiseFreeRecoversMountLeverArmAndTimeOffset) {
   options.data_snooping = false;
   options.auto_robust_start = false;
   RigAdjustOptions rig;
-  rig.time_offsets = RigParameterMode::kFree;
+  rig.time_offsets = calib::BlockMode::kFree;
   const RigAdjustmentResult r = AdjustRig(project, options, rig);
   ASSERT_TRUE(r.adjustment.solve.converged) << r.adjustment.solve.message;
   const calib::RigHead& truth = f.truth.heads[1];
@@ -106,8 +106,8 @@ TEST(RigBundle, NoisyFlightWithinThreeSigmaAndCheckPointsAsWithTheTrueRig) {
   // Check points at the noise floor: as good as a bundle that knows the true rig (within 10 %:
   // the six estimated rig parameters cost a little redundancy, nothing more).
   RigAdjustOptions known;
-  known.mounts = RigParameterMode::kFixed;
-  known.lever_arms = RigParameterMode::kFixed;
+  known.mounts = calib::BlockMode::kFixed;
+  known.lever_arms = calib::BlockMode::kFixed;
   const RigAdjustmentResult t = AdjustRig(ProjectOf(f, f.truth), options, known);
   ASSERT_TRUE(t.adjustment.valid);
   const Eigen::Vector3d estimated = r.adjustment.check.rmse_m,
@@ -153,12 +153,12 @@ TEST(RigBundle, FreeIncrementsWithAFreeMountAreNotDeterminable) {
   AdjustOptions options;
   options.data_snooping = false;
   RigAdjustOptions rig;
-  rig.increments = RigParameterMode::kFree;
+  rig.increments = calib::BlockMode::kFree;
   const RigAdjustmentResult free = AdjustRig(project, options, rig);
   EXPECT_FALSE(free.adjustment.valid);
   EXPECT_FALSE(free.determinability.undetermined.empty());
   // Weighted increments (a-priori 5") make the same block determinable.
-  rig.increments = RigParameterMode::kWeighted;
+  rig.increments = calib::BlockMode::kWeighted;
   rig.increment_sigma_rad = 5.0 / 206264.806;
   const RigAdjustmentResult weighted = AdjustRig(project, options, rig);
   EXPECT_TRUE(weighted.adjustment.valid) << (weighted.adjustment.invalid_reasons.empty()
@@ -169,10 +169,10 @@ TEST(RigBundle, FreeIncrementsWithAFreeMountAreNotDeterminable) {
 
 TEST(RigBundle, OptionsAndRigFileRulesAreEnforced) {
   RigAdjustOptions weighted_without_sigma;
-  weighted_without_sigma.time_offsets = RigParameterMode::kWeighted;
+  weighted_without_sigma.time_offsets = calib::BlockMode::kWeighted;
   EXPECT_THROW(weighted_without_sigma.Validate(), ConfigError);
-  EXPECT_EQ(ParseRigParameterMode("weighted"), RigParameterMode::kWeighted);
-  EXPECT_FALSE(ParseRigParameterMode("Free").has_value());
+  EXPECT_EQ(calib::ParseBlockMode("weighted"), calib::BlockMode::kWeighted);
+  EXPECT_FALSE(calib::ParseBlockMode("Free").has_value());
 
   RigFlightSimulationOptions o = KnownInteriors();
   o.flight.exposures = 6;
@@ -180,10 +180,10 @@ TEST(RigBundle, OptionsAndRigFileRulesAreEnforced) {
   const SimulatedRigFlight f = SimulateRigFlight(o);  // no velocity columns
   const Project project = ProjectOf(f, f.nominal);
   RigAdjustOptions rig;
-  rig.time_offsets = RigParameterMode::kFree;
+  rig.time_offsets = calib::BlockMode::kFree;
   EXPECT_THROW(AdjustRig(project, AdjustOptions{}, rig), InputError);
   rig = {};
-  rig.mounts = RigParameterMode::kWeighted;  // the nominal rig file has no mount sigmas
+  rig.mounts = calib::BlockMode::kWeighted;  // the nominal rig file has no mount sigmas
   EXPECT_THROW(AdjustRig(project, AdjustOptions{}, rig), ConfigError);
   // The frame camera never takes a head pixel for a virtual-image pixel.
   try {

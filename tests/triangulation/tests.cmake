@@ -37,3 +37,5 @@ aerocal_add_test(triangulation/import_images_match LIBS aerocal::triangulation L
 # The budget YAML and directions file readers called directly (issue 37: `unit`, so the sanitizer
 # job runs them; their CLI tests are `cli`).
 aerocal_add_test(triangulation/calibration_readers LIBS aerocal::triangulation LABELS unit)
+# The platform data model and the sensor-kind factory (issue 30 item 1): the recipe's claims.
+aerocal_add_test(triangulation/sensor_platform LIBS aerocal::triangulation LABELS synthetic)

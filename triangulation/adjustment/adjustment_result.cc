@@ -19,38 +19,28 @@ nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 // A number, or null when it is not finite (untestable component, unknown sigma).
 nlohmann::json Finite(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
 
-// "platform": each parameter with its mode, value and sigma (null when fixed or unknown), in the
-// units of the project YAML's `platform:` keys (m, deg, ms).
+// "platform": each parameter in the one mounted-block form (calib::MountedBlockToJson: mode,
+// value, sigma null when fixed or unknown), in the units of the project YAML's `platform:` keys
+// (m, deg, ms).
 nlohmann::json PlatformToJson(const PlatformEstimate& p) {
-  auto entry = [](PlatformParamMode mode,
-                  const Eigen::VectorXd& value,
-                  const std::optional<Eigen::VectorXd>& sigma) {
-    nlohmann::json e = {{"mode", PlatformParamModeName(mode)}};
-    e["value"] = nlohmann::json::array();
-    e["sigma"] = nlohmann::json::array();
-    for (int i = 0; i < value.size(); ++i) {
-      e["value"].push_back(value(i));
-      e["sigma"].push_back(sigma ? Finite((*sigma)(i)) : nlohmann::json());
-    }
-    return e;
-  };
   constexpr double kDeg = 180.0 / M_PI;
   auto scaled = [](const auto& s, double k) {
     return s ? std::optional<Eigen::VectorXd>(Eigen::VectorXd(*s * k)) : std::nullopt;
   };
   nlohmann::json j;
   if (p.gnss) {
-    j["lever_arm_m"] = entry(p.spec.lever_arm, p.lever_arm_m, scaled(p.lever_arm_sigma_m, 1.0));
+    j["lever_arm_m"] = calib::MountedBlockToJson(
+        p.spec.lever_arm, p.lever_arm_m, scaled(p.lever_arm_sigma_m, 1.0));
     const std::optional<Eigen::VectorXd> dt_sigma =
         p.time_offset_sigma_s ? std::optional<Eigen::VectorXd>(
                                     Eigen::VectorXd::Constant(1, *p.time_offset_sigma_s * 1e3))
                               : std::nullopt;
-    j["time_offset_ms"] =
-        entry(p.spec.time_offset, Eigen::VectorXd::Constant(1, p.time_offset_s * 1e3), dt_sigma);
+    j["time_offset_ms"] = calib::MountedBlockToJson(
+        p.spec.time_offset, Eigen::VectorXd::Constant(1, p.time_offset_s * 1e3), dt_sigma);
   }
   if (p.imu)
-    j["boresight_deg"] =
-        entry(p.spec.boresight, p.boresight_rad * kDeg, scaled(p.boresight_sigma_rad, kDeg));
+    j["boresight_deg"] = calib::MountedBlockToJson(
+        p.spec.boresight, p.boresight_rad * kDeg, scaled(p.boresight_sigma_rad, kDeg));
   return j;
 }
 nlohmann::json Pair(const Eigen::Vector2d& v) { return {Finite(v.x()), Finite(v.y())}; }

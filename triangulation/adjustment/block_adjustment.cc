@@ -5,6 +5,7 @@
 #include "calib/core/log.h"
 #include "calib/core/median.h"
 #include "calib/core/string_printf.h"
+#include "calib/problem/mounted_block.h"
 #include "calib/problem/suspect_effect.h"
 #include "calib/residuals/gnss_prior.h"
 #include "calib/residuals/prior.h"
@@ -13,11 +14,13 @@
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/adjustment/plausibility.h"
 #include "triangulation/sensor/frame_camera.h"
+#include "triangulation/sensor/make_imaging_model.h"
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <optional>
@@ -36,8 +39,9 @@ const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
 // The automatic rejection cap (AdjustOptions::max_rejections 0): 10 % of the tested image
 // observations, at least this many.
 constexpr int kMinAutomaticCap = 100;
-// Residual group of the weighted platform parameters (lever arm, boresight, GNSS time offset).
-constexpr const char* kGroupPlatformPrior = "platform_prior";
+// Owner of the weighted platform parameters (lever arm, boresight, GNSS time offset): their priors
+// are in group calib::PriorGroup(kPlatformOwner), "platform_prior".
+constexpr const char* kPlatformOwner = "platform";
 // The two survey observations of a control point (labels "control <id> plan" / "... height").
 constexpr const char* kSurveyPlan = "plan";
 constexpr const char* kSurveyHeight = "height";
@@ -47,17 +51,13 @@ bool PlatformEstimated(const PlatformSpec& p) {
          p.time_offset != PlatformParamMode::kFixed;
 }
 
-// "image 0012 point T442", "image 0012 sub-image A1 point T442": an observation in reports.
-std::string DescribeObservation(const ImageObservation& o) {
-  return "image " + o.image + (o.subimage.empty() ? "" : " sub-image " + o.subimage) +
-         (o.head.empty() ? "" : " head " + o.head) + " point " + o.point;
-}
-
 }  // namespace
 
 struct BlockAdjustment::Storage {
   Storage(const Project& project, const AdjustOptions& options, calib::ProblemBuilder& builder)
-      : index(project), context{project, options, builder, index, poses, frame} {}
+      : platform(BuildPlatform(project)),
+        index(platform.index),
+        context{project, options, builder, index, poses, frame, &platform} {}
   struct ExposureState {
     const Exposure* exposure = nullptr;
     const calib::Camera* camera = nullptr;
@@ -81,10 +81,13 @@ struct BlockAdjustment::Storage {
     return it != point_ids.end() && *it == id ? static_cast<PointIndex>(it - point_ids.begin())
                                               : -1;
   }
-  DenseIndex index;
+  Platform platform;              // sensors and observations as dense indices (block/platform.h)
+  const DenseIndex& index;        // platform.index
   std::vector<PoseBlocks> poses;  // by ExposureIndex
-  FrameCamera frame;
-  std::vector<std::unique_ptr<ImagingModel>> sensors;  // asked first, the frame camera last
+  FrameCamera frame;              // the interiors of every camera, the frame kind's model
+  std::vector<std::unique_ptr<ImagingModel>> sensors;  // the other kinds' models: given, then made
+  // The model of each kind (by SensorKind), null when the kind cannot be adjusted here.
+  std::array<ImagingModel*, kSensorKinds.size()> model_of_kind{};
   SensorContext context;
   // Dense indices, assigned once when the block is built; ids are strings only when read and in
   // reports. Both vectors are sized once and never grow afterwards: the builder holds pointers
@@ -102,6 +105,7 @@ struct BlockAdjustment::Storage {
   std::vector<ExposureIndex> exposure_of_observation;
   std::vector<PointIndex> point_of_observation;
   std::map<calib::ResidualId, size_t> observation_of_residual;
+  std::set<std::string> snooped_groups;  // the groups of the image observations' terms
   // Surveyed coordinates: two residuals per control point, its plan (X, Y) and its height (Z).
   std::map<calib::ResidualId, std::pair<PointIndex, const char*>> control_of_residual;
   // Snooping left them out: the components ("plan", "height") with the w of their test.
@@ -126,7 +130,7 @@ BlockAdjustment::BlockAdjustment(const Project& project,
       options_(options),
       storage_(std::make_unique<Storage>(project, options_, builder_)) {
   options_.Validate();
-  storage_->sensors = std::move(sensors);
+  ChooseModels(std::move(sensors));
   BuildExposures();
   BuildPoints();
   AddImageResiduals(image_loss);
@@ -220,22 +224,38 @@ void BlockAdjustment::BuildExposures() {
   }
 }
 
-std::pair<ImagingModel*, ImageObservation> BlockAdjustment::SensorOf(
-    const ImageObservation& o) const {
-  for (auto& s : storage_->sensors)
-    if (s->Measures(o)) return {s.get(), o};
-  if (!o.head.empty())  // never a virtual-image pixel: the rig bundle measures it
+void BlockAdjustment::ChooseModels(std::vector<std::unique_ptr<ImagingModel>> given) {
+  Storage& s = *storage_;
+  s.model_of_kind[static_cast<int>(SensorKind::kFrame)] = &s.frame;
+  s.sensors = std::move(given);
+  for (const auto& model : s.sensors) {
+    ImagingModel*& slot = s.model_of_kind[static_cast<int>(model->Kind())];
+    AEROCAL_CHECK(slot == nullptr)
+        << "two models of the " << SensorKindName(model->Kind()) << " kind";
+    slot = model.get();
+  }
+  // The kinds the block observes and no caller configured: their default (MakeImagingModel);
+  // a kind without one is named at its first observation (BuildPoints).
+  for (SensorKind kind : kSensorKinds) {
+    ImagingModel*& slot = s.model_of_kind[static_cast<int>(kind)];
+    if (slot || !s.platform.Observes(kind)) continue;
+    if (auto made = MakeImagingModel(kind)) {
+      slot = made.get();
+      s.sensors.push_back(std::move(made));
+    }
+  }
+}
+
+ImagingModel* BlockAdjustment::ModelOf(size_t source) const {
+  const Sensor& sensor = storage_->platform.sensors[storage_->platform.observations[source].sensor];
+  ImagingModel* model = storage_->model_of_kind[static_cast<int>(sensor.kind)];
+  if (!model) {
+    const ImageObservation& o = project_.observations[source];
     ThrowInputError({project_.observations_file, o.line},
-                    "image " + o.image + " head " + o.head +
-                        ": rig head observations are adjusted by the rig bundle (aerocal "
-                        "adjust without --joint-stitching)");
-  if (storage_->frame.Measures(o)) return {&storage_->frame, o};
-  const ExposureIndex exposure = storage_->index.Exposure(o.image);
-  const auto& camera = *storage_->exposures[exposure].camera;
-  ImageObservation mapped = o;
-  mapped.pixel = camera.subimages[camera.SubimageIndex(o.subimage)].VirtualFromSub(o.pixel);
-  mapped.subimage.clear();
-  return {&storage_->frame, mapped};
+                    "image " + o.image + " " + sensor.name + ": " +
+                        std::string(UnconfiguredReason(sensor.kind)));
+  }
+  return model;
 }
 
 std::optional<Eigen::Vector2d> BlockAdjustment::ResidualAtCurrentValues(
@@ -243,8 +263,10 @@ std::optional<Eigen::Vector2d> BlockAdjustment::ResidualAtCurrentValues(
   const ExposureIndex exposure = storage_->index.FindExposure(observation.image);
   const BlockId point = PointBlock(observation.point);
   if (exposure < 0 || point < 0 || storage_->exposures[exposure].opk_block < 0) return std::nullopt;
-  auto [sensor, measured] = SensorOf(observation);
-  const ObservationTerm term = sensor->Observe(storage_->context, measured, point);
+  ImagingModel* model = storage_->model_of_kind[static_cast<int>(ObservationKind(observation))];
+  if (!model) return std::nullopt;
+  const ObservationTerm term =
+      model->Observe(storage_->context, model->AsAdjusted(storage_->context, observation), point);
   std::vector<const double*> values;
   for (BlockId b : term.blocks) values.push_back(builder_.BlockValues(b));
   if (term.cost->num_residuals() != 2) return std::nullopt;
@@ -254,21 +276,20 @@ std::optional<Eigen::Vector2d> BlockAdjustment::ResidualAtCurrentValues(
 }
 
 void BlockAdjustment::BuildPoints() {
-  // Each observation with the sensor kind that measures it; a raw sub-image observation no kind
-  // measures is mapped to the virtual image with the camera file's mapping.
+  // Each observation with the model of its sensor's kind (the platform's word), as that model
+  // keeps it (AsAdjusted).
+  Storage& s = *storage_;
   for (size_t source = 0; source < project_.observations.size(); ++source) {
-    const ImageObservation& o = project_.observations[source];
-    storage_->source_of_observation.push_back(static_cast<int>(source));
-    storage_->exposure_of_observation.push_back(storage_->index.Exposure(o.image));
-    auto [sensor, measured] = SensorOf(o);
-    storage_->observations.push_back(std::move(measured));
-    storage_->sensor_of_observation.push_back(sensor);
+    const PlatformObservation& x = s.platform.observations[source];
+    ImagingModel* model = ModelOf(source);
+    s.source_of_observation.push_back(static_cast<int>(source));
+    s.exposure_of_observation.push_back(x.exposure);
+    s.point_of_observation.push_back(x.point);
+    s.observations.push_back(model->AsAdjusted(s.context, project_.observations[source]));
+    s.sensor_of_observation.push_back(model);
   }
   // The points: a dense index per observed point id (sorted ids), assigned once.
-  Storage& s = *storage_;
-  for (const auto& o : s.observations) s.point_ids.push_back(o.point);
-  std::sort(s.point_ids.begin(), s.point_ids.end());
-  s.point_ids.erase(std::unique(s.point_ids.begin(), s.point_ids.end()), s.point_ids.end());
+  s.point_ids = s.platform.point_ids;
   s.points.resize(s.point_ids.size());  // once: the builder keeps pointers into the states
   // Project::FindPoint's first match, without its linear search (quadratic at 180,000 points).
   std::unordered_map<std::string_view, const GroundPoint*> ground_of_id;
@@ -277,7 +298,6 @@ void BlockAdjustment::BuildPoints() {
     const auto ground = ground_of_id.find(s.point_ids[p]);
     s.points[p].ground = ground == ground_of_id.end() ? nullptr : ground->second;
   }
-  for (const auto& o : s.observations) s.point_of_observation.push_back(s.FindPoint(o.point));
   const int n_exposures = s.index.NumExposures();
   const int n_points = static_cast<int>(s.points.size());
   // An exposure that no observation names is named, never silently unused (issue 28).
@@ -391,9 +411,11 @@ void BlockAdjustment::AddImageResiduals(const calib::LossOptions& loss) {
     const auto& o = storage_->observations[i];
     const BlockId point = storage_->points[storage_->point_of_observation[i]].block;
     if (point < 0) continue;
-    ObservationTerm term = storage_->sensor_of_observation[i]->Observe(storage_->context, o, point);
+    ImagingModel* model = storage_->sensor_of_observation[i];
+    ObservationTerm term = model->Observe(storage_->context, o, point);
+    storage_->snooped_groups.insert(term.group);
     const auto id = builder_.AddResidual(
-        term.group, std::move(term.cost), term.blocks, DescribeObservation(o), loss);
+        term.group, std::move(term.cost), term.blocks, model->Describe(o), loss);
     storage_->observation_of_residual[id] = i;
   }
 }
@@ -487,19 +509,21 @@ void BlockAdjustment::AddPlatformBlocks() {
     throw ConfigError(where +
                       ": the boresight is estimated from IMU priors, but exposures.csv has "
                       "no sigma_omega/phi/kappa columns");
-  // How one platform block enters: held, free, or its value as a weighted observation.
+  // How one platform block enters: held, free, or its value as a weighted observation
+  // (calib/problem/mounted_block.h; group platform_prior).
   auto enter = [&](BlockId block,
                    PlatformParamMode mode,
                    const std::vector<double>& values,
                    double sigma,
                    const std::string& label) {
-    if (mode == PlatformParamMode::kFixed) builder_.FixBlock(block);
-    if (mode == PlatformParamMode::kWeighted)
-      builder_.AddResidual(
-          kGroupPlatformPrior,
-          calib::PriorCostFunction::Create(values, std::vector<double>(values.size(), sigma)),
-          {block},
-          label);
+    calib::ApplyBlockMode(builder_, block, mode);
+    calib::AddBlockPrior(builder_,
+                         block,
+                         mode,
+                         values,
+                         std::vector<double>(values.size(), sigma),
+                         kPlatformOwner,
+                         label);
   };
   if (gnss) {
     const bool timed = p.time_offset != PlatformParamMode::kFixed || p.time_offset_s != 0.0;
@@ -645,7 +669,8 @@ std::optional<Eigen::Vector3d> FitPoint(const calib::ProblemBuilder& builder,
 std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double reject) {
   std::vector<calib::ResidualId> ids;
   for (const auto& [id, index] : storage_->observation_of_residual)
-    if (builder_.IsActive(id) && storage_->observations[index].subimage.empty()) ids.push_back(id);
+    if (builder_.IsActive(id) && builder_.ResidualGroup(id) == calib::kGroupImage)
+      ids.push_back(id);
   const calib::ObservationCofactors cof = builder_.ComputeObservationCofactors(ids, false);
   std::vector<double> scaled;  // |v| / sqrt(r) of the testable components
   std::map<calib::ResidualId, std::vector<double>> values;
@@ -762,7 +787,7 @@ std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double re
 std::string BlockAdjustment::Describe(calib::ResidualId id) const {
   const auto it = storage_->observation_of_residual.find(id);
   if (it == storage_->observation_of_residual.end()) return builder_.ResidualLabel(id);
-  return DescribeObservation(storage_->observations[it->second]);
+  return storage_->sensor_of_observation[it->second]->Describe(storage_->observations[it->second]);
 }
 
 calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
@@ -776,7 +801,9 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
       ++image_rays[st.exposure_of_observation[index]];
     }
   calib::SnoopingOptions snooping;
-  snooping.groups = {calib::kGroupImage, calib::kGroupSubimage, calib::kGroupControl};
+  // The image groups the kinds' terms came in (AddImageResiduals), and the control surveys.
+  snooping.groups.assign(st.snooped_groups.begin(), st.snooped_groups.end());
+  snooping.groups.push_back(calib::kGroupControl);
   snooping.report_only_groups = {calib::kGroupControl};
   snooping.alpha = options_.snooping_alpha;
   snooping.critical_value = options_.snooping_critical_value;
@@ -945,8 +972,7 @@ calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
     r.image = o.image;
     r.point = o.point;
     r.measured_px = o.pixel;
-    r.subimage = o.subimage;
-    r.head = o.head;
+    storage_->sensor_of_observation[it->second]->Annotate(o, &r);
     r.w = x.w_max;
     if (x.v.size() == 2) r.residual_px = Eigen::Vector2d(x.v[0], x.v[1]) * o.sigma_px;
     r.test = to_test(x, o.sigma_px);
@@ -1047,9 +1073,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     v.image = o.image;
     v.point = o.point;
     v.measured_px = o.pixel;
-    v.subimage = o.subimage;
-    v.head = o.head;
-    if (!o.subimage.empty()) v.subimage_px = o.pixel;
+    storage_->sensor_of_observation[index]->Annotate(o, &v);
     v.sigma_px = o.sigma_px;
     v.used = builder_.IsActive(id);
     const std::vector<double> r = v.used ? builder_.EvaluateResidual(id) : std::vector<double>{};

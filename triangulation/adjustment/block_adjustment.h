@@ -18,13 +18,16 @@
 // adjusts with the interior fixed, then frees the listed parameters (robust start from exterior
 // orientations off by tens of metres and degrees).
 //
-// Sensor kinds (triangulation/sensor/imaging_model.h): the frame camera measures virtual-image
-// pixels; other kinds (the sub-image camera of the joint adjustment, ...) are handed to the
-// constructor and asked first. Each registers its own blocks, gives the rays of its observations
-// for the point starting values and builds their residuals; the adjustment keeps the points, the
-// platform poses, the priors, the datum, statistics and data snooping. A raw sub-image
-// observation that no kind measures is mapped to the virtual image with the camera file's mapping
-// and measured by the frame camera.
+// Sensor kinds (triangulation/sensor/imaging_model.h): the platform (triangulation/block/
+// platform.h, built once from the project) says which sensor took each observation; the
+// observation goes to the model of that sensor's kind: the frame camera for virtual-image pixels,
+// a model the caller hands to the constructor (the sub-image camera of the joint adjustment, the
+// rig heads of the rig bundle), else the kind's default from MakeImagingModel (raw sub-image
+// pixels at the camera file's mappings). Each model registers its own blocks, gives the rays of
+// its observations for the point starting values, builds their residuals, describes them and
+// annotates their result entries; the adjustment keeps the points, the platform poses, the
+// priors, the datum, statistics and data snooping (of every group the kinds' terms came in) and
+// never tests a kind.
 //
 // Identities: exposures (ExposureIndex, Project::exposures order) and ground points (PointIndex,
 // the observed point ids sorted) are dense indices assigned once when the block is built; every
@@ -57,8 +60,9 @@ class BlockAdjustment {
   /// Validates the options, computes starting values and builds every residual.
   /// Throws InputError when the block cannot be started (an exposure without observations is
   /// only reported; an observation whose ray misses every start is an input error).
-  /// `sensors`: sensor kinds besides the frame camera, asked first which observations they
-  /// measure. `image_loss` is applied to the image observations (robust start); none by default.
+  /// `sensors`: models of sensor kinds besides the frame camera, at most one per kind; they take
+  /// every observation of their kind (kinds not given get MakeImagingModel's default). `image_loss`
+  /// is applied to the image observations (robust start); none by default.
   BlockAdjustment(const Project& project,
                   const AdjustOptions& options,
                   std::vector<std::unique_ptr<ImagingModel>> sensors = {},
@@ -104,11 +108,12 @@ class BlockAdjustment {
 
  private:
   struct Storage;
-  /// The sensor kind that measures `o` (the kinds given first, the frame camera last) and the
-  /// observation as it measures it: a raw sub-image observation no kind measures is mapped to the
-  /// virtual image with the camera file's mapping. InputError for a rig head observation no kind
-  /// measures.
-  std::pair<ImagingModel*, ImageObservation> SensorOf(const ImageObservation& o) const;
+  /// The model of each sensor kind: the frame camera, the given ones (one per kind), and for
+  /// every other kind the platform observes its default (MakeImagingModel), when it has one.
+  void ChooseModels(std::vector<std::unique_ptr<ImagingModel>> given);
+  /// The model of the kind of project observation `source` (its platform sensor). InputError
+  /// "observations_file:LINE" naming the command that adjusts a kind without a model here.
+  ImagingModel* ModelOf(size_t source) const;
   void BuildExposures();
   void BuildPoints();
   /// Adds the ground point block of `point` (a dense index of the observed points), starting at

@@ -16,31 +16,6 @@ std::string PointRoleName(PointRole role) {
   return "tie";
 }
 
-std::optional<PlatformParamMode> ParsePlatformParamMode(const std::string& text) {
-  if (text == "fixed") return PlatformParamMode::kFixed;
-  if (text == "free") return PlatformParamMode::kFree;
-  if (text == "weighted") return PlatformParamMode::kWeighted;
-  return std::nullopt;
-}
-
-PlatformParamMode PlatformParamModeOption(const std::string& text, const std::string& option) {
-  const auto mode = ParsePlatformParamMode(text);
-  if (!mode) throw ConfigError(option + " must be fixed, free or weighted (got '" + text + "')");
-  return *mode;
-}
-
-std::string PlatformParamModeName(PlatformParamMode mode) {
-  switch (mode) {
-    case PlatformParamMode::kFree:
-      return "free";
-    case PlatformParamMode::kWeighted:
-      return "weighted";
-    case PlatformParamMode::kFixed:
-      break;
-  }
-  return "fixed";
-}
-
 const Exposure* Project::FindExposure(const std::string& image) const {
   for (const auto& e : exposures)
     if (e.image == image) return &e;

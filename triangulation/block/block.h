@@ -7,6 +7,7 @@
 
 #include "calib/camera/camera.h"
 #include "calib/camera/rig.h"
+#include "calib/problem/mounted_block.h"
 
 #include <Eigen/Core>
 
@@ -69,14 +70,14 @@ struct FrameSpec {
   bool has_origin = false;    // lat_deg, lon_deg, h_m given (`origin:`)
 };
 
-/// How a platform parameter (lever arm, boresight, GNSS time offset) enters the adjustment:
-/// held at its value, estimated freely, or estimated with its value as a weighted observation.
-enum class PlatformParamMode { kFixed, kFree, kWeighted };
-/// "fixed" | "free" | "weighted" -> the mode; nullopt otherwise.
-std::optional<PlatformParamMode> ParsePlatformParamMode(const std::string& text);
-/// The mode given to a command-line `option`; ConfigError naming the option otherwise (exit 2).
-PlatformParamMode PlatformParamModeOption(const std::string& text, const std::string& option);
-std::string PlatformParamModeName(PlatformParamMode mode);
+/// How a platform parameter (lever arm, boresight, GNSS time offset) enters the adjustment: the
+/// one mounted-block mode (calib/problem/mounted_block.h). The pushbroom module still spells it
+/// PlatformParamMode; the alias goes when it moves onto the helper.
+using PlatformParamMode = calib::BlockMode;
+/// The mode's name (calib::BlockModeName), for the pushbroom module's writers.
+inline std::string PlatformParamModeName(PlatformParamMode mode) {
+  return std::string(calib::BlockModeName(mode));
+}
 
 /// The GNSS/IMU platform of the block (triangulation/README.md "GNSS/IMU priors on the
 /// platform"): the GNSS antenna records X0 + R a + v dt, the IMU records the attitude R M^T.

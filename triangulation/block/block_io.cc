@@ -488,7 +488,7 @@ PlatformSpec ReadPlatform(const YAML::Node& node, const std::string& path) {
   auto mode = [&](const char* key, PlatformParamMode* out) {
     if (!node[key]) return;
     const std::string text = YamlString(node[key], path, std::string("platform: ") + key);
-    const auto m = ParsePlatformParamMode(text);
+    const auto m = calib::ParseBlockMode(text);
     if (!m)
       ThrowInputError(WhereIs(node[key], path),
                       std::string("platform: ") + key + " must be fixed, free or weighted (got '" +

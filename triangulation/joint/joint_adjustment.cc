@@ -30,8 +30,10 @@ std::optional<calib::MappingModel> ParseJointModel(const std::string& text) {
 void JointOptions::Validate(const Project& project) const {
   adjust.Validate();
   if (!(stitch_sigma_px > 0)) throw ConfigError("stitch sigma must be > 0 px");
-  bool any_subimage = false;
-  for (const auto& o : project.observations) any_subimage |= !o.subimage.empty();
+  const bool any_subimage = std::any_of(
+      project.observations.begin(), project.observations.end(), [](const ImageObservation& o) {
+        return ObservationKind(o) == SensorKind::kSubimage;
+      });
   if (!any_subimage)
     throw ConfigError(project.observations_file +
                       ": the joint adjustment needs observations in raw sub-image pixels "

@@ -6,10 +6,6 @@
 #include <algorithm>
 
 namespace aerocal::triangulation {
-bool FrameCamera::Measures(const ImageObservation& observation) const {
-  return observation.subimage.empty();
-}
-
 void FrameCamera::RegisterBlocks(const SensorContext& context) {
   const int n = context.index.NumCameras();
   interior_.resize(n);
@@ -51,6 +47,12 @@ ImageRay FrameCamera::StartingRay(const SensorContext& context,
 ObservationTerm FrameCamera::Observe(const SensorContext& context,
                                      const ImageObservation& observation,
                                      calib::BlockId point) {
+  return Term(context, observation, point);
+}
+
+ObservationTerm FrameCamera::Term(const SensorContext& context,
+                                  const ImageObservation& observation,
+                                  calib::BlockId point) const {
   const ObservationSite site = context.Site(observation);
   ObservationTerm term;
   term.group = calib::kGroupImage;

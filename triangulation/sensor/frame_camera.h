@@ -17,9 +17,8 @@ namespace aerocal::triangulation {
 
 class FrameCamera final : public ImagingModel {
  public:
-  std::string Kind() const override { return "frame"; }
-  /// Virtual-image pixels (col, row): observations without a sub-image.
-  bool Measures(const ImageObservation& observation) const override;
+  /// Virtual-image pixels (col, row).
+  SensorKind Kind() const override { return SensorKind::kFrame; }
   /// One interior block per camera ("camera ID", entries named by its model's table).
   void RegisterBlocks(const SensorContext& context) override;
   ImageRay StartingRay(const SensorContext& context,
@@ -28,6 +27,11 @@ class FrameCamera final : public ImagingModel {
   ObservationTerm Observe(const SensorContext& context,
                           const ImageObservation& observation,
                           calib::BlockId point) override;
+  /// The term Observe builds, for other kinds that end in a virtual-image pixel of the frame
+  /// camera (the sub-image kind at the camera file's mappings).
+  ObservationTerm Term(const SensorContext& context,
+                       const ImageObservation& observation,
+                       calib::BlockId point) const;
 
   /// The interior block of a camera and its current values (table order).
   calib::BlockId InteriorBlock(CameraIndex camera) const { return blocks_[camera]; }

@@ -5,26 +5,32 @@
 // A sensor kind
 // - registers the parameter blocks it owns with THE problem builder once, by dense index
 //   (RegisterBlocks: interior per camera, mappings per sub-image, mounts per head, ...);
-// - says which image observations it measures (Measures) and gives their ray at the starting
-//   values (StartingRay: forward intersection of the point starting values, done once, by the
-//   adjustment);
+// - is handed the observations of its kind (Kind, the platform's sensors) and gives their ray at
+//   the starting values (StartingRay: forward intersection of the point starting values, done
+//   once, by the adjustment);
 // - for one observation returns the blocks its residual touches and the residual itself, a small
 //   templated functor, WHITENED (Observe); the adjustment adds it under the term's group, labels
 //   it, snoops it and reports it;
 // - may add residuals on its own blocks only (AddOwnResiduals: stitching measurements, mount
-//   priors), after the adjustment's priors.
+//   priors), after the adjustment's priors;
+// - says how its observations read in reports (Describe) and what it adds to their result
+//   entries (Annotate), so that the adjustment's result writer needs no kind test.
 // The exposure poses belong to the platform (the adjustment registers one rotation and one centre
 // block per exposure, PoseBlocks by ExposureIndex); the GNSS/IMU priors sit on them. Other kinds
 // put their own geometry between the pose and the frame camera's interior (SensorContext::frame).
 //
-// Ids are strings only at the file boundary and in reports; inside, cameras and exposures are
-// dense indices (DenseIndex), assigned once when the adjustment starts.
+// Ids are strings only at the file boundary and in reports; inside, cameras, exposures, sensors and
+// points are dense indices (triangulation/block/platform.h), assigned once when the adjustment
+// starts. Which kind takes an observation is the platform's word (its sensor), never a test of the
+// observation's columns; the kinds are made by MakeImagingModel (make_imaging_model.h).
 #pragma once
 
 #include "calib/problem/problem_builder.h"
 #include "triangulation/adjustment/adjust_options.h"
+#include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/adjustment/forward_intersection.h"
 #include "triangulation/block/block.h"
+#include "triangulation/block/platform.h"
 
 #include <ceres/cost_function.h>
 
@@ -34,35 +40,6 @@
 #include <vector>
 
 namespace aerocal::triangulation {
-
-using CameraIndex = int;    // position of a camera in DenseIndex::camera_ids (sorted ids)
-using ExposureIndex = int;  // position of an exposure in Project::exposures
-using PointIndex = int;     // position of a ground point among the adjustment's observed points
-                            // (sorted ids; BlockAdjustment assigns them once)
-
-/// Dense indices of the project's cameras and exposures. AEROCAL_CHECK (LogicError) on an unknown
-/// id: the readers have validated every reference before an adjustment starts.
-class DenseIndex {
- public:
-  explicit DenseIndex(const Project& project);
-  CameraIndex Camera(const std::string& id) const;
-  ExposureIndex Exposure(const std::string& image) const;
-  /// As Exposure, -1 when `image` is not an exposure of the project.
-  ExposureIndex FindExposure(const std::string& image) const;
-  /// The camera of an exposure.
-  CameraIndex CameraOfExposure(ExposureIndex exposure) const {
-    return camera_of_exposure_[exposure];
-  }
-  int NumCameras() const { return static_cast<int>(camera_ids_.size()); }
-  int NumExposures() const { return static_cast<int>(camera_of_exposure_.size()); }
-  const std::string& CameraId(CameraIndex camera) const { return camera_ids_[camera]; }
-
- private:
-  std::vector<std::string> camera_ids_;
-  std::map<std::string, CameraIndex> camera_by_id_;
-  std::map<std::string, ExposureIndex> exposure_by_image_;
-  std::vector<CameraIndex> camera_of_exposure_;
-};
 
 /// The platform's pose of one exposure: rotation image -> object (a unit quaternion block
 /// [w, x, y, z], ProblemBuilder::AddRotationBlock; residuals turn it into R with
@@ -100,6 +77,7 @@ struct SensorContext {
   const DenseIndex& index;
   const std::vector<PoseBlocks>& poses;  // by ExposureIndex
   const FrameCamera& frame;              // interior blocks of every camera (frame_camera.h)
+  const Platform* platform = nullptr;    // the block's sensors (null: a kind used on its own)
 
   ObservationSite Site(const ImageObservation& observation) const;
 };
@@ -107,25 +85,38 @@ struct SensorContext {
 class ImagingModel {
  public:
   virtual ~ImagingModel() = default;
-  /// "frame", "subimage", ...: the kind in notes and errors.
-  virtual std::string Kind() const = 0;
-  /// True when this sensor kind measures `observation` (the adjustment asks the kinds it was
-  /// given first, the frame camera last).
-  virtual bool Measures(const ImageObservation& observation) const = 0;
+  /// The kind of sensor this model adjusts: the adjustment hands it every observation of that
+  /// kind (Platform::observations), never asking the observation's columns.
+  virtual SensorKind Kind() const = 0;
   /// Registers the kind's own parameter blocks with context.builder, once, by dense index.
   /// Called once, before the platform poses are registered.
   virtual void RegisterBlocks(const SensorContext& context) = 0;
-  /// The ray of `observation` (which this kind measures) at the starting values.
+  /// The observation as the adjustment keeps, labels and reports it; itself by default (the
+  /// sub-image kind at the camera file's mappings hands over the virtual-image pixel).
+  virtual ImageObservation AsAdjusted(const SensorContext& context,
+                                      const ImageObservation& observation) const {
+    (void)context;
+    return observation;
+  }
+  /// The ray of `observation` (of this kind, as AsAdjusted returned it) at the starting values.
   virtual ImageRay StartingRay(const SensorContext& context,
                                const ImageObservation& observation) const = 0;
-  /// The residual of `observation` (measured by this kind, its exposure used) on the ground point
-  /// block `point`: blocks and whitened cost. Called once per observation the adjustment keeps.
+  /// The residual of `observation` (of this kind, as AsAdjusted returned it, its exposure used)
+  /// on the ground point block `point`: blocks and whitened cost; the term's group is also the
+  /// group data snooping tests. Called once per observation the adjustment keeps.
   virtual ObservationTerm Observe(const SensorContext& context,
                                   const ImageObservation& observation,
                                   calib::BlockId point) = 0;
   /// Residuals on the kind's own blocks only (stitching measurements, priors of mounts), added
   /// after the adjustment's priors. None by default.
   virtual void AddOwnResiduals(const SensorContext& context) { (void)context; }
+  /// An observation in reports and snooping findings: "image 0012 point T442" by default; a kind
+  /// names its part ("image 0012 head left point T442").
+  virtual std::string Describe(const ImageObservation& observation) const;
+  /// What the kind adds to an observation's entry in the result (its sub-image, its head):
+  /// nothing by default.
+  virtual void Annotate(const ImageObservation& observation, ObservationResidual* residual) const;
+  virtual void Annotate(const ImageObservation& observation, RejectedObservation* rejected) const;
 };
 
 }  // namespace aerocal::triangulation

@@ -3,6 +3,7 @@
 #include "calib/camera/rotation.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/problem/mounted_block.h"
 #include "calib/residuals/prior.h"
 
 #include <algorithm>
@@ -73,8 +74,8 @@ void LineScanCamera::RegisterBlocks(const SensorContext& context) {
   time_block_ = b.AddBlock("time_offset", &time_offset_s_, 1, calib::BlockKind::kOther, {"dt"});
   if (!options_.time_offset) b.FixBlock(time_block_);
   if (!options_.free_c) b.FixBlock(c_block_);
-  if (options_.boresight == PlatformParamMode::kFixed) b.FixBlock(mount_block_);
-  if (options_.lever_arm == PlatformParamMode::kFixed) b.FixBlock(lever_block_);
+  calib::ApplyBlockMode(b, mount_block_, options_.boresight);
+  calib::ApplyBlockMode(b, lever_block_, options_.lever_arm);
 }
 
 LineDetectorSite LineScanCamera::DetectorSite(double detector) const {
@@ -226,22 +227,24 @@ void LineScanCamera::AddOwnResiduals(const SensorContext& context) {
                         {0, 0, 0, 0, 0, 0}, {sc.x(), sc.y(), sc.z(), so.x(), so.y(), so.z()}),
                     {node_blocks_[j]},
                     "pos node " + std::to_string(j));
-  if (options_.boresight == PlatformParamMode::kWeighted) {
-    const double s = options_.boresight_sigma_rad;
-    const Eigen::Vector3d& m = camera_.mount_rad;
-    b.AddResidual(kGroupLinePrior,
-                  calib::PriorCostFunction::Create({m.x(), m.y(), m.z()}, {s, s, s}),
-                  {mount_block_},
-                  "boresight");
-  }
-  if (options_.lever_arm == PlatformParamMode::kWeighted) {
-    const double s = options_.lever_arm_sigma_m;
-    const Eigen::Vector3d& a = camera_.lever_arm_m;
-    b.AddResidual(kGroupLinePrior,
-                  calib::PriorCostFunction::Create({a.x(), a.y(), a.z()}, {s, s, s}),
-                  {lever_block_},
-                  "lever arm");
-  }
+  // The weighted boresight and lever arm around the camera file's values (group line_prior).
+  const double sb = options_.boresight_sigma_rad, sl = options_.lever_arm_sigma_m;
+  const Eigen::Vector3d& m = camera_.mount_rad;
+  const Eigen::Vector3d& a = camera_.lever_arm_m;
+  calib::AddBlockPrior(b,
+                       mount_block_,
+                       options_.boresight,
+                       {m.x(), m.y(), m.z()},
+                       {sb, sb, sb},
+                       kLineOwner,
+                       "boresight");
+  calib::AddBlockPrior(b,
+                       lever_block_,
+                       options_.lever_arm,
+                       {a.x(), a.y(), a.z()},
+                       {sl, sl, sl},
+                       kLineOwner,
+                       "lever arm");
 }
 
 void LineScanCamera::SetFixedDetectorEntries(calib::ProblemBuilder& builder,

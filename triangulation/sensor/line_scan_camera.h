@@ -50,6 +50,9 @@ namespace aerocal::triangulation {
 
 inline constexpr const char* kGroupLineImage = "line_image";
 inline constexpr const char* kGroupPosPrior = "pos_prior";
+/// Owner of the line camera's mounted blocks (boresight, lever arm): their priors are in group
+/// calib::PriorGroup(kLineOwner) = kGroupLinePrior (calib/problem/mounted_block.h).
+inline constexpr const char* kLineOwner = "line";
 inline constexpr const char* kGroupLinePrior = "line_prior";  // boresight / lever-arm priors
 inline constexpr const char* kLineStripImage = "strip";       // the image id of a line strip
 inline constexpr const char* kGroupLineDatum = "line_datum";  // the reference sub-camera's datum
@@ -140,9 +143,9 @@ class LineScanCamera final : public ImagingModel {
   LineScanCamera(const calib::LineCamera& camera,
                  const PosTrajectory& pos,
                  const LineScanOptions& options);
-  std::string Kind() const override { return "line"; }
+  SensorKind Kind() const override { return SensorKind::kLine; }
   /// Observations of the strip (image kLineStripImage).
-  bool Measures(const ImageObservation& observation) const override;
+  bool Measures(const ImageObservation& observation) const;
   /// Nodes, detector polynomials, c, mount, lever arm (header comment), fixed per the options.
   void RegisterBlocks(const SensorContext& context) override;
   /// The detector's ray at its line's pose (POS + spline corrections) through the mount, lever arm

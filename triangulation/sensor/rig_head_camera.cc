@@ -48,32 +48,13 @@ Eigen::Vector3d VelocityOf(const Exposure& exposure) {
 
 }  // namespace
 
-std::optional<RigParameterMode> ParseRigParameterMode(std::string_view name) {
-  if (name == "fixed") return RigParameterMode::kFixed;
-  if (name == "free") return RigParameterMode::kFree;
-  if (name == "weighted") return RigParameterMode::kWeighted;
-  return std::nullopt;
-}
-
-std::string_view RigParameterModeName(RigParameterMode mode) {
-  switch (mode) {
-    case RigParameterMode::kFixed:
-      return "fixed";
-    case RigParameterMode::kFree:
-      return "free";
-    case RigParameterMode::kWeighted:
-      return "weighted";
-  }
-  return "fixed";
-}
-
 void RigAdjustOptions::Validate() const {
-  if (increments == RigParameterMode::kWeighted && !(increment_sigma_rad > 0.0))
+  if (increments == calib::BlockMode::kWeighted && !(increment_sigma_rad > 0.0))
     throw ConfigError(
         "weighted rig increments need a sigma > 0 (--rig-increment-sigma-arcsec, "
         "got " +
         FormatNumber(increment_sigma_rad * kDegPerRad * 3600.0) + ")");
-  if (time_offsets == RigParameterMode::kWeighted && !(time_offset_sigma_s > 0.0))
+  if (time_offsets == calib::BlockMode::kWeighted && !(time_offset_sigma_s > 0.0))
     throw ConfigError(
         "weighted rig time offsets need a sigma > 0 (--rig-time-offset-sigma-ms, "
         "got " +
@@ -84,8 +65,18 @@ RigHeadCamera::RigHeadCamera(const RigAdjustOptions& options) : options_(options
   options_.Validate();
 }
 
-bool RigHeadCamera::Measures(const ImageObservation& observation) const {
-  return !observation.head.empty();
+std::string RigHeadCamera::Describe(const ImageObservation& observation) const {
+  return "image " + observation.image + " head " + observation.head + " point " + observation.point;
+}
+
+void RigHeadCamera::Annotate(const ImageObservation& observation,
+                             ObservationResidual* residual) const {
+  residual->head = observation.head;
+}
+
+void RigHeadCamera::Annotate(const ImageObservation& observation,
+                             RejectedObservation* rejected) const {
+  rejected->head = observation.head;
 }
 
 void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
@@ -106,9 +97,6 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
     if (std::find(free.begin(), free.end(), std::string(Model::kParams[i].name)) == free.end())
       fixed_interior.push_back(i);
   }
-  const auto apply_mode = [&](BlockId block, RigParameterMode mode) {
-    if (mode == RigParameterMode::kFixed) builder.FixBlock(block);
-  };
   const int n = static_cast<int>(rig_->heads.size());
   heads_.assign(n, Head{});
   for (int k = 0; k < n; ++k) {
@@ -137,18 +125,18 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
       builder.FixBlock(h.lever_arm_block);
       continue;
     }
-    apply_mode(h.mount_block, options_.mounts);
-    apply_mode(h.lever_arm_block, options_.lever_arms);
+    calib::ApplyBlockMode(builder, h.mount_block, options_.mounts);
+    calib::ApplyBlockMode(builder, h.lever_arm_block, options_.lever_arms);
     const auto weighted_needs = [&](bool has, const char* what, const char* key) {
       if (!has)
         throw ConfigError(context.project.camera_files.at(camera_) + ": head " + head.id + ": " +
                           what + " weighted needs the head's " + key);
     };
-    if (options_.mounts == RigParameterMode::kWeighted)
+    if (options_.mounts == calib::BlockMode::kWeighted)
       weighted_needs(head.mount_sigma_rad.has_value(), "--rig-mounts", "mount_sigma_deg");
-    if (options_.lever_arms == RigParameterMode::kWeighted)
+    if (options_.lever_arms == calib::BlockMode::kWeighted)
       weighted_needs(head.lever_arm_sigma_m.has_value(), "--rig-lever-arms", "lever_arm_sigma_m");
-    if (options_.time_offsets != RigParameterMode::kFixed)
+    if (options_.time_offsets != calib::BlockMode::kFixed)
       h.time_offset_block = builder.AddBlock(
           name + " time offset", &h.time_offset_s, 1, calib::BlockKind::kOther, {"dT"});
   }
@@ -169,12 +157,12 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
   for (ExposureIndex e = 0; e < context.index.NumExposures(); ++e) {
     const Exposure& exposure = project.exposures[e];
     if (exposure.camera != camera_) continue;
-    if (options_.time_offsets != RigParameterMode::kFixed && n > 1 && !exposure.velocity_mps)
+    if (options_.time_offsets != calib::BlockMode::kFixed && n > 1 && !exposure.velocity_mps)
       ThrowInputError({project.exposures_file, exposure.line},
                       "image " + exposure.image +
                           ": estimating rig time offsets needs the platform velocity (columns "
                           "vX,vY,vZ)");
-    if (options_.increments == RigParameterMode::kFixed) continue;
+    if (options_.increments == calib::BlockMode::kFixed) continue;
     for (int k = 0; k < n; ++k) {
       if (k == reference_) continue;
       Increment& increment = increments_[{e, k}];
@@ -239,30 +227,41 @@ ObservationTerm RigHeadCamera::Observe(const SensorContext& context,
 
 void RigHeadCamera::AddOwnResiduals(const SensorContext& context) {
   calib::ProblemBuilder& builder = context.builder;
+  // A weighted rig block around `value` (calib/problem/mounted_block.h, group rig_prior).
   const auto prior3 = [&](BlockId block,
+                          calib::BlockMode mode,
                           const Eigen::Vector3d& value,
                           const Eigen::Vector3d& sigma,
                           const std::string& label) {
-    builder.AddResidual(kGroupRigPrior,
-                        calib::PriorCostFunction::Create({value.x(), value.y(), value.z()},
-                                                         {sigma.x(), sigma.y(), sigma.z()}),
-                        {block},
-                        label);
+    calib::AddBlockPrior(builder,
+                         block,
+                         mode,
+                         {value.x(), value.y(), value.z()},
+                         {sigma.x(), sigma.y(), sigma.z()},
+                         kRigOwner,
+                         label);
   };
   for (int k = 0; k < static_cast<int>(heads_.size()); ++k) {
     if (k == reference_) continue;
     const calib::RigHead& head = rig_->heads[k];
     const Head& h = heads_[k];
     const std::string name = "rig prior head " + head.id;
-    if (options_.mounts == RigParameterMode::kWeighted)
-      prior3(h.mount_block, head.mount_rad, *head.mount_sigma_rad, name + " mount");
-    if (options_.lever_arms == RigParameterMode::kWeighted)
-      prior3(h.lever_arm_block, head.lever_arm_m, *head.lever_arm_sigma_m, name + " lever arm");
-    if (options_.time_offsets == RigParameterMode::kWeighted)
-      builder.AddResidual(kGroupRigPrior,
-                          calib::PriorCostFunction::Create({0.0}, {options_.time_offset_sigma_s}),
-                          {h.time_offset_block},
-                          name + " time offset");
+    if (options_.mounts == calib::BlockMode::kWeighted)
+      prior3(
+          h.mount_block, options_.mounts, head.mount_rad, *head.mount_sigma_rad, name + " mount");
+    if (options_.lever_arms == calib::BlockMode::kWeighted)
+      prior3(h.lever_arm_block,
+             options_.lever_arms,
+             head.lever_arm_m,
+             *head.lever_arm_sigma_m,
+             name + " lever arm");
+    calib::AddBlockPrior(builder,
+                         h.time_offset_block,
+                         options_.time_offsets,
+                         {0.0},
+                         {options_.time_offset_sigma_s},
+                         kRigOwner,
+                         name + " time offset");
     if (context.options.use_interior_sigma) {
       std::vector<int> indices;
       std::vector<double> values, sigmas;
@@ -281,10 +280,11 @@ void RigHeadCamera::AddOwnResiduals(const SensorContext& context) {
             "interior prior " + camera_ + " head " + head.id);
     }
   }
-  if (options_.increments == RigParameterMode::kWeighted) {
+  if (options_.increments == calib::BlockMode::kWeighted) {
     const double s = options_.increment_sigma_rad;
     for (const auto& [key, increment] : increments_)
       prior3(increment.block,
+             options_.increments,
              Eigen::Vector3d::Zero(),
              Eigen::Vector3d::Constant(s),
              "rig prior image " + context.project.exposures[key.first].image + " head " +
@@ -439,16 +439,16 @@ nlohmann::json RigResultToJson(const RigAdjustmentResult& r) {
       {"camera", r.camera},
       {"reference_head", r.reference_head},
       {"options",
-       {{"mounts", RigParameterModeName(o.mounts)},
-        {"lever_arms", RigParameterModeName(o.lever_arms)},
-        {"increments", RigParameterModeName(o.increments)},
+       {{"mounts", calib::BlockModeName(o.mounts)},
+        {"lever_arms", calib::BlockModeName(o.lever_arms)},
+        {"increments", calib::BlockModeName(o.increments)},
         {"increment_sigma_arcsec",
-         o.increments == RigParameterMode::kWeighted
+         o.increments == calib::BlockMode::kWeighted
              ? nlohmann::json(o.increment_sigma_rad * kDegPerRad * 3600.0)
              : nlohmann::json()},
-        {"time_offsets", RigParameterModeName(o.time_offsets)},
+        {"time_offsets", calib::BlockModeName(o.time_offsets)},
         {"time_offset_sigma_ms",
-         o.time_offsets == RigParameterMode::kWeighted ? nlohmann::json(o.time_offset_sigma_s * 1e3)
+         o.time_offsets == calib::BlockMode::kWeighted ? nlohmann::json(o.time_offset_sigma_s * 1e3)
                                                        : nlohmann::json()}}},
       {"heads", heads},
       {"determinability",
@@ -503,7 +503,7 @@ std::string FormatRigSummary(const RigAdjustmentResult& r) {
                                                 : std::nullopt,
                             6);
     out += "\n";
-    if (r.options.time_offsets != RigParameterMode::kFixed)
+    if (r.options.time_offsets != calib::BlockMode::kFixed)
       out += "  head " + h.id + " dT (ms): " +
              value_sigma(h.time_offset_s * 1e3,
                          h.time_offset_sigma_s ? std::optional<double>(*h.time_offset_sigma_s * 1e3)
@@ -525,9 +525,9 @@ calib::Rig UpdatedRig(const calib::Rig& rig, const RigAdjustmentResult& result) 
     head.mount_rad = e.mount_rad;
     head.lever_arm_m = e.lever_arm_m;
     if (e.reference) continue;
-    if (result.options.mounts != RigParameterMode::kFixed && e.mount_sigma_rad)
+    if (result.options.mounts != calib::BlockMode::kFixed && e.mount_sigma_rad)
       head.mount_sigma_rad = e.mount_sigma_rad;
-    if (result.options.lever_arms != RigParameterMode::kFixed && e.lever_arm_sigma_m)
+    if (result.options.lever_arms != calib::BlockMode::kFixed && e.lever_arm_sigma_m)
       head.lever_arm_sigma_m = e.lever_arm_sigma_m;
   }
   return out;

@@ -22,7 +22,7 @@
 // (at the file's values, E = 0, dT = 0); the other heads are relative to it. Each group of the
 // other heads' parameters is fixed, free or weighted (RigAdjustOptions): weighted mounts and lever
 // arms use the rig file's a-priori sigmas around the file's values, weighted increments and time
-// offsets a sigma around zero (group kGroupRigPrior).
+// offsets a sigma around zero (group rig_prior, calib/problem/mounted_block.h).
 //
 // Determinability: AdjustRig estimates the covariance of the rig's blocks with every exposure's
 // pose and names each rig parameter whose strongest correlation exceeds the threshold (a lever arm
@@ -32,6 +32,7 @@
 #pragma once
 
 #include "calib/camera/rig.h"
+#include "calib/problem/mounted_block.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/sensor/imaging_model.h"
 
@@ -47,22 +48,18 @@
 
 namespace aerocal::triangulation {
 
-inline constexpr const char* kGroupRigPrior = "rig_prior";  // mount/lever-arm/increment priors
-
-/// How a group of rig parameters of the non-reference heads enters the adjustment.
-enum class RigParameterMode { kFixed, kFree, kWeighted };
-/// "fixed" | "free" | "weighted" -> mode; nullopt for any other name.
-std::optional<RigParameterMode> ParseRigParameterMode(std::string_view name);
-std::string_view RigParameterModeName(RigParameterMode mode);
+/// Owner of the rig's mounted blocks: their priors are in group calib::PriorGroup(kRigOwner),
+/// "rig_prior" (calib/problem/mounted_block.h).
+inline constexpr const char* kRigOwner = "rig";
 
 /// What the rig bundle estimates besides the block (which parameters; the data is the rig file).
 struct RigAdjustOptions {
-  RigParameterMode mounts = RigParameterMode::kFree;       // M_k of the non-reference heads;
+  calib::BlockMode mounts = calib::BlockMode::kFree;       // M_k of the non-reference heads;
                                                            // weighted: the file's mount_sigma_deg
-  RigParameterMode lever_arms = RigParameterMode::kFree;   // t_k; weighted: lever_arm_sigma_m
-  RigParameterMode increments = RigParameterMode::kFixed;  // E_k per exposure and head (= 0 fixed)
+  calib::BlockMode lever_arms = calib::BlockMode::kFree;   // t_k; weighted: lever_arm_sigma_m
+  calib::BlockMode increments = calib::BlockMode::kFixed;  // E_k per exposure and head (= 0 fixed)
   double increment_sigma_rad = 0.0;  // weighted increments: sigma of each angle around 0, rad > 0
-  RigParameterMode time_offsets = RigParameterMode::kFixed;  // dT_k per head (= 0 fixed); free or
+  calib::BlockMode time_offsets = calib::BlockMode::kFixed;  // dT_k per head (= 0 fixed); free or
                                                              // weighted needs the velocity columns
   double time_offset_sigma_s = 0.0;  // weighted time offsets: sigma around 0, s > 0
   /// ConfigError naming the option: a weighted mode without its sigma, a sigma <= 0.
@@ -104,9 +101,8 @@ struct RigAdjustmentResult {
 class RigHeadCamera final : public ImagingModel {
  public:
   explicit RigHeadCamera(const RigAdjustOptions& options);
-  std::string Kind() const override { return "rig head"; }
-  /// Head pixels: observations with a `head`.
-  bool Measures(const ImageObservation& observation) const override;
+  /// Head pixels (col, row).
+  SensorKind Kind() const override { return SensorKind::kRigHead; }
   /// The project's one rig: heads' interiors (reference head: the frame camera's block), mounts,
   /// lever arms, time offsets, increments. ConfigError when the project has no rig or several,
   /// or a weighted mount / lever arm without the file's sigmas, or free / weighted time offsets
@@ -119,9 +115,14 @@ class RigHeadCamera final : public ImagingModel {
   ObservationTerm Observe(const SensorContext& context,
                           const ImageObservation& observation,
                           calib::BlockId point) override;
-  /// Priors of weighted rig parameters (kGroupRigPrior) and the non-reference heads' interior
+  /// Priors of weighted rig parameters (group rig_prior) and the non-reference heads' interior
   /// sigmas (kGroupInteriorPrior, with AdjustOptions::use_interior_sigma).
   void AddOwnResiduals(const SensorContext& context) override;
+  /// "image 0012 head left point T442".
+  std::string Describe(const ImageObservation& observation) const override;
+  /// The head.
+  void Annotate(const ImageObservation& observation, ObservationResidual* residual) const override;
+  void Annotate(const ImageObservation& observation, RejectedObservation* rejected) const override;
 
   /// The rig's blocks whose covariance AdjustRig reports (fixed ones included).
   std::vector<calib::BlockId> Blocks() const;

@@ -52,8 +52,20 @@ MappingScope ParseMappingScope(const std::string& text) {
   throw ConfigError("--joint-stitching must be per-flight or per-exposure (got '" + text + "')");
 }
 
-bool SubimageCamera::Measures(const ImageObservation& observation) const {
-  return !observation.subimage.empty();
+std::string SubimageCamera::Describe(const ImageObservation& observation) const {
+  return "image " + observation.image + " sub-image " + observation.subimage + " point " +
+         observation.point;
+}
+
+void SubimageCamera::Annotate(const ImageObservation& observation,
+                              ObservationResidual* residual) const {
+  residual->subimage = observation.subimage;
+  residual->subimage_px = observation.pixel;
+}
+
+void SubimageCamera::Annotate(const ImageObservation& observation,
+                              RejectedObservation* rejected) const {
+  rejected->subimage = observation.subimage;
 }
 
 SubimageCamera::Key SubimageCamera::KeyOf(const SensorContext& context,
@@ -81,7 +93,7 @@ void SubimageCamera::RegisterBlocks(const SensorContext& context) {
   // Which mappings are used, in order of first use: the observations, then the stitching.
   std::vector<std::pair<std::string, std::string>> uses;  // (image, sub-image)
   for (const auto& o : project.observations)
-    if (Measures(o)) uses.emplace_back(o.image, o.subimage);
+    if (ObservationKind(o) == Kind()) uses.emplace_back(o.image, o.subimage);
   if (options_.use_stitching && !project.stitching_file.empty()) {
     const auto rows =
         stitch::ReadStitchObservations(project.stitching_file, options_.stitch_sigma_px);

@@ -73,9 +73,8 @@ struct SubimageReport {
 class SubimageCamera final : public ImagingModel {
  public:
   explicit SubimageCamera(SubimageCameraOptions options) : options_(std::move(options)) {}
-  std::string Kind() const override { return "subimage"; }
-  /// Raw sub-image pixels: observations with a sub-image.
-  bool Measures(const ImageObservation& observation) const override;
+  /// Raw sub-image pixels (u, v), mappings refined in the bundle.
+  SensorKind Kind() const override { return SensorKind::kSubimage; }
   /// Reads the stitching measurements (options.use_stitching) and registers one mapping block
   /// per (camera, sub-image[, exposure]) that an observation or a stitching measurement uses,
   /// by dense index; base sub-images fixed.
@@ -89,6 +88,11 @@ class SubimageCamera final : public ImagingModel {
                           calib::BlockId point) override;
   /// The stitching measurements (reference and tie residuals) and their "before" figures.
   void AddOwnResiduals(const SensorContext& context) override;
+  /// "image 0012 sub-image III point T442".
+  std::string Describe(const ImageObservation& observation) const override;
+  /// The sub-image and its raw pixel (u, v).
+  void Annotate(const ImageObservation& observation, ObservationResidual* residual) const override;
+  void Annotate(const ImageObservation& observation, RejectedObservation* rejected) const override;
 
   /// After the adjustment ran with `sigma0`: mappings with sigmas (plain form), their
   /// correlations with the interior, stitching precision after; and the virtual-image position
