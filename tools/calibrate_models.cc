@@ -2,6 +2,7 @@
 
 #include "calib/camera/convert_camera.h"
 #include "calib/core/error.h"
+#include "calib/core/finding.h"
 
 #include <algorithm>
 #include <cmath>
@@ -55,11 +56,8 @@ calib::Camera StartInModel(const calib::Camera& camera,
 void AddStabilityWarnings(const triangulation::StabilityReport& stability, nlohmann::json* json) {
   for (const auto& f : stability.flagged) {
     std::printf("warning: group_stability: %s\n", f.c_str());
-    (*json)["warnings"].push_back({{"name", "group_stability"},
-                                   {"subject", f.substr(0, f.find(':'))},
-                                   {"value", nullptr},
-                                   {"limit", nullptr},
-                                   {"message", f}});
+    (*json)["warnings"].push_back(
+        FindingToJson({"group_stability", f.substr(0, f.find(':')), NAN, NAN, f}));
   }
 }
 

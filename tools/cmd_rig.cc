@@ -10,6 +10,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/finding.h"
 #include "calib/core/progress.h"
 #include "calib/core/result_file.h"
 #include "stitch/image_io/image_io.h"
@@ -359,7 +360,7 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args,
                    {"valid_pixels", r.valid_pixels},
                    {"radiometry", heads},
                    {"overlap_disagreement_dn", {{"all", zone_json(r.overall)}, {"zones", zones}}},
-                   {"warnings", r.warnings}});
+                   {"warnings", FindingsToJson(r.warnings)}});
     std::printf(
         "stitched %s: %d x %d px, %ld valid, overlap disagreement %.3f DN RMS (head "
         "against head before blending, %ld px) -> %s\n",
@@ -371,7 +372,7 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args,
         r.overall.pixels,
         image_path.c_str());
     for (const auto& w : r.warnings)
-      std::fprintf(stderr, "warning: %s: %s\n", e.image.c_str(), w.c_str());
+      std::fprintf(stderr, "warning: %s: %s\n", e.image.c_str(), w.message.c_str());
     progress.Advance();
   }
   return out;

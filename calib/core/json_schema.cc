@@ -4,8 +4,10 @@
 #include "calib/core/error.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <set>
+#include <vector>
 
 namespace aerocal {
 namespace {
@@ -50,11 +52,13 @@ class Validator {
     if (schema.contains("$ref")) {
       const std::string ref = schema["$ref"];
       const std::string prefix = "#/definitions/";
-      AEROCAL_CHECK(ref.rfind(prefix, 0) == 0 && root_.contains("definitions") &&
-                    root_["definitions"].contains(ref.substr(prefix.size())))
+      AEROCAL_CHECK(ref == "#" || (ref.rfind(prefix, 0) == 0 && root_.contains("definitions") &&
+                                   root_["definitions"].contains(ref.substr(prefix.size()))))
           << "schema $ref " << ref;
-      Check(v, root_["definitions"][ref.substr(prefix.size())], path);
+      Check(v, ref == "#" ? root_ : root_["definitions"][ref.substr(prefix.size())], path);
     }
+    if (schema.contains("allOf"))
+      for (const nlohmann::json& part : schema["allOf"]) Check(v, part, path);
     if (schema.contains("type")) {
       const nlohmann::json& t = schema["type"];
       std::vector<std::string> types = t.is_array()
@@ -124,6 +128,7 @@ class Validator {
   }
 
   inline static const std::set<std::string> kKeywords = {"type",
+                                                         "allOf",
                                                          "properties",
                                                          "required",
                                                          "additionalProperties",
@@ -155,7 +160,9 @@ void ValidateJson(const nlohmann::json& document,
   Validator(schema, file).Check(document, schema, root_path);
 }
 
-nlohmann::json ReadJsonSchema(const std::string& path) {
+namespace {
+
+nlohmann::json ReadSchemaFile(const std::string& path) {
   std::ifstream in(path);
   AEROCAL_CHECK(in.good()) << "schema " << path << " is missing (installation)";
   try {
@@ -164,6 +171,82 @@ nlohmann::json ReadJsonSchema(const std::string& path) {
     AEROCAL_CHECK(false) << "schema " << path << " is not JSON: " << e.what();
   }
   return nullptr;
+}
+
+// Makes the schema of one file self-contained for the Validator, which resolves only
+// "#/definitions/NAME": a reference to another file, "FILE#/definitions/NAME" or "FILE" (its
+// whole schema; FILE relative to the folder of the schema that names it), becomes
+// "#/definitions/FILE#NAME" (or "FILE#"), and that definition is copied into the root's
+// definitions, its own references rewritten the same way ("#/definitions/X" inside FILE becomes
+// "#/definitions/FILE#X"). Each file is read once; cycles between files are therefore fine.
+class Bundler {
+ public:
+  Bundler(std::string folder, nlohmann::json* definitions)
+      : folder_(std::move(folder)), definitions_(definitions) {}
+
+  // Rewrites the references in `node`, which belongs to `file` ("" for the root file).
+  void Rewrite(nlohmann::json* node, const std::string& file) {
+    if (node->is_array()) {
+      for (auto& item : *node) Rewrite(&item, file);
+      return;
+    }
+    if (!node->is_object()) return;
+    for (auto& [key, value] : node->items()) {
+      if (key == "$ref" && value.is_string()) {
+        value = Resolved(value.get<std::string>(), file);
+      } else if (key != "definitions" && key != "enum") {
+        Rewrite(&value, file);
+      }
+    }
+  }
+
+ private:
+  std::string Resolved(const std::string& ref, const std::string& file) {
+    const std::string local = "#/definitions/";
+    const size_t hash = ref.find('#');
+    const std::string target = ref.substr(0, hash);
+    const std::string fragment = hash == std::string::npos ? "" : ref.substr(hash);
+    AEROCAL_CHECK(fragment.empty() || fragment == "#" || fragment.rfind(local, 0) == 0)
+        << "schema $ref " << ref << " (expected FILE, FILE#/definitions/NAME or "
+        << "#/definitions/NAME)";
+    const std::string name = fragment.size() > local.size() ? fragment.substr(local.size()) : "";
+    const std::string owner = target.empty() ? file : target;
+    if (owner.empty()) return ref;  // a definition of the root file
+    Load(owner);
+    return local + owner + "#" + name;
+  }
+
+  void Load(const std::string& file) {
+    if (!loaded_.insert(file).second) return;
+    nlohmann::json schema = ReadSchemaFile((std::filesystem::path(folder_) / file).string());
+    nlohmann::json own = schema.value("definitions", nlohmann::json::object());
+    schema.erase("definitions");
+    Rewrite(&schema, file);
+    (*definitions_)[file + "#"] = schema;
+    for (auto& [name, definition] : own.items()) {
+      Rewrite(&definition, file);
+      (*definitions_)[file + "#" + name] = definition;
+    }
+  }
+
+  std::string folder_;
+  nlohmann::json* definitions_;
+  std::set<std::string> loaded_;
+};
+
+}  // namespace
+
+nlohmann::json ReadJsonSchema(const std::string& path) {
+  nlohmann::json schema = ReadSchemaFile(path);
+  AEROCAL_CHECK(schema.is_object()) << "schema " << path << " is not an object";
+  nlohmann::json definitions = schema.value("definitions", nlohmann::json::object());
+  Bundler bundler(std::filesystem::path(path).parent_path().string(), &definitions);
+  std::vector<std::string> names;  // first: bundling adds definitions while it rewrites
+  for (const auto& [name, _] : definitions.items()) names.push_back(name);
+  for (const std::string& name : names) bundler.Rewrite(&definitions[name], "");
+  bundler.Rewrite(&schema, "");
+  schema["definitions"] = definitions;
+  return schema;
 }
 
 }  // namespace aerocal

@@ -6,8 +6,10 @@
 // The subset (JSON Schema draft 7 keywords, same meaning): type (a name or a list of names:
 // object, array, number, integer, string, boolean, null), properties, required,
 // additionalProperties (false or a schema), items (one schema), minItems, maxItems, minimum,
-// maximum, exclusiveMinimum (a number), maxLength, enum, $ref ("#/definitions/NAME"). A number is
-// always finite (a JSON 1e400 reads as infinity). The schemas live in docs/schema/.
+// maximum, exclusiveMinimum (a number), maxLength, enum, allOf, $ref ("#/definitions/NAME"; and,
+// through ReadJsonSchema, "FILE#/definitions/NAME" or "FILE" for another schema file of the same
+// folder). A number is always finite (a JSON 1e400 reads as infinity). The schemas live in
+// docs/schema/ (docs/schema/README.md).
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -24,8 +26,11 @@ void ValidateJson(const nlohmann::json& document,
                   const std::string& file,
                   const std::string& root_path = "");
 
-/// Reads a schema file (our own, e.g. docs/schema/certificate_inputs.schema.json); LogicError
-/// when it is missing or not JSON (an installation fault, not bad input).
+/// Reads a schema file (our own, e.g. docs/schema/certificate_inputs.schema.json) with every schema
+/// file it refers to (`"$ref": "common.schema.json#/definitions/finding"`), bundled into one
+/// document whose references ValidateJson resolves (the other file's definitions copied into
+/// `definitions` as "FILE#NAME", its whole schema as "FILE#"); LogicError when a file is missing
+/// or not JSON (an installation fault, not bad input).
 nlohmann::json ReadJsonSchema(const std::string& path);
 
 }  // namespace aerocal

@@ -3,10 +3,15 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
+#include "calib/core/json_schema.h"
+
+#include <algorithm>
 
 namespace aerocal {
 
 std::string ResultText(std::string_view kind, nlohmann::json document, int indent) {
+  AEROCAL_CHECK(std::find(kResultKinds.begin(), kResultKinds.end(), kind) != kResultKinds.end())
+      << "result kind " << kind << " is not in kResultKinds (calib/core/result_file.h)";
   AEROCAL_CHECK(document.is_object()) << "a result document is a JSON object";
   if (document.contains("kind")) {
     AEROCAL_CHECK(document["kind"] == std::string(kind))
@@ -43,6 +48,21 @@ void CheckResult(const nlohmann::json& document,
   if (!version.is_number_integer() || version.get<long long>() != kResultSchemaVersion)
     throw InputError(path + ": schema_version is " + version.dump() + ", expected " +
                      std::to_string(kResultSchemaVersion) + " (kind " + kind.dump() + ")");
+}
+
+void ValidateResult(const nlohmann::json& document,
+                    const std::string& path,
+                    const std::string& schema_dir) {
+  const nlohmann::json kind =
+      document.is_object() && document.contains("kind") ? document["kind"] : nlohmann::json();
+  const auto known = std::find_if(kResultKinds.begin(), kResultKinds.end(), [&](auto k) {
+    return kind.is_string() && kind == std::string(k);
+  });
+  if (known == kResultKinds.end())
+    throw InputError(path + ": not a result of aerocal (kind is " + kind.dump() + ")");
+  CheckResult(document, path, {*known}, "aerocal");
+  ValidateJson(
+      document, ReadJsonSchema(schema_dir + "/" + std::string(*known) + ".schema.json"), path);
 }
 
 nlohmann::json ReadResult(const std::string& path,

@@ -111,7 +111,11 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   result.dt_held = options.mode == RigStitchMode::kAngles || !any_velocity || options.hold_heads;
   if (!any_velocity && options.mode != RigStitchMode::kAngles)
     result.warnings.push_back(
-        "no platform velocity in the exposures: the time offsets move no head and are held at 0");
+        {"no_platform_velocity",
+         "time offsets",
+         NAN,
+         NAN,
+         "no platform velocity in the exposures: the time offsets move no head and are held at 0"});
 
   std::vector<calib::BlockId> rig_opk(n_exposures), rig_center(n_exposures);
   std::vector<std::vector<calib::BlockId>> increment(n_exposures,
@@ -313,7 +317,8 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
         result.stopped = true;
         kept_against_test.push_back(t.id);
       }
-    for (const auto& f : outcome.findings) result.warnings.push_back(f);
+    for (const auto& f : outcome.findings)
+      result.warnings.push_back({"data_snooping", "ties", NAN, NAN, f});
   } else {
     result.report = builder.Solve(options.solver);
   }
@@ -335,7 +340,9 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       }
   const calib::CovarianceReport cov = builder.EstimateCovariance(
       wanted, std::max(result.sigma0, 1e-300), options.correlation_threshold);
-  if (!cov.ok) result.warnings.push_back("covariance: " + cov.message);
+  if (!cov.ok)
+    result.warnings.push_back(
+        {"covariance", "increments and time offsets", NAN, NAN, "covariance: " + cov.message});
   if (result.stopped)  // what the rig's calibration becomes without the ties kept against the test
     result.stop_effect = calib::EffectOfLeavingOut(builder,
                                                    kept_against_test,
@@ -504,7 +511,11 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     if (result.stop_effect.Matters())
       result.failures.push_back(message);
     else
-      result.warnings.push_back(message + "; the tie is kept and the result stands: check it");
+      result.warnings.push_back({"snooping_stopped",
+                                 reason,
+                                 NAN,
+                                 NAN,
+                                 message + "; the tie is kept and the result stands: check it"});
   }
   return result;
 }

@@ -38,6 +38,7 @@
 #pragma once
 
 #include "calib/camera/rig.h"
+#include "calib/core/finding.h"
 #include "calib/problem/problem_builder.h"
 #include "calib/problem/suspect_effect.h"
 #include "stitch/rig/rig_conversion.h"
@@ -161,7 +162,7 @@ struct RigStitchResult {
   double relief_displacement_px = 0.0;  // largest over the head pairs, at options.relief_m
   double height_m = 0.0;                // mean relative flying height above z_ref (m)
   double sigma0_px = 0.0;  // sigma0 x the median a-priori sigma of the fitted tie observations
-  std::vector<std::string> warnings;
+  std::vector<Finding> warnings;  // doubtful, not invalid: by name (calib/core/finding.h)
   /// Why the run must not be trusted, each by name: not converged, covariance singular, sigma0
   /// above options.max_sigma0, snooping stopped at a standard position with an effect that
   /// matters (else a warning). Empty: a valid run.

@@ -1,6 +1,8 @@
 #include "stitch/rig/self_calibration_json.h"
 
+#include "calib/core/finding.h"
 #include "calib/core/string_printf.h"
+#include "calib/problem/solve_statistics_json.h"
 
 #include <cmath>
 
@@ -51,15 +53,12 @@ nlohmann::json RigStitchToJson(const calib::Rig& rig,
   doc["project"] = sources.project;
   doc["mode"] = RigStitchModeName(options.mode);
   doc["reference_head"] = rig.reference_head;
-  doc["converged"] = result.report.converged;
-  doc["iterations"] = result.report.iterations;
-  doc["termination"] = result.report.termination;
+  doc.update(calib::SolveStatisticsToJson(result.report));  // redundancy .. seconds, groups
   doc["sigma0"] = result.sigma0;
   doc["sigma0_px"] = result.sigma0_px;
-  doc["redundancy"] = result.redundancy;
   doc["valid"] = result.failures.empty();
   doc["failures"] = result.failures;
-  doc["warnings"] = result.warnings;
+  doc["warnings"] = FindingsToJson(result.warnings);
   doc["metric"] = {
       {"unit", "px of the level virtual image"},
       {"per_coordinate", "sqrt(sum(dx^2 + dy^2) / (2 n_pairs)) over the head pairs of each tie"},
@@ -199,7 +198,7 @@ std::string FormatRigStitchSummary(const RigStitchOptions& options,
                         *sources.relief_m,
                         result.height_m,
                         result.relief_displacement_px);
-  for (const auto& w : result.warnings) out += "warning: " + w + "\n";
+  for (const auto& w : result.warnings) out += "warning: " + w.message + "\n";
   for (const auto& f : result.failures) out += "FAILED: " + f + "\n";
   return out;
 }

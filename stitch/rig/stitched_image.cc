@@ -184,9 +184,13 @@ StitchedImageReport MakeStitchedImage(const RigConverter& converter,
     const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(normal);
     if (qr.rank() < n) {
       report.warnings.push_back(
-          "radiometric balance not determinable (a head has no overlap chain to the reference "
-          "head " +
-          rig.reference_head + "): every head kept at gain 1, offset 0");
+          {"radiometry_not_determinable",
+           "radiometric balance",
+           NAN,
+           NAN,
+           "radiometric balance not determinable (a head has no overlap chain to the reference "
+           "head " +
+               rig.reference_head + "): every head kept at gain 1, offset 0"});
     } else {
       const Eigen::VectorXd x = qr.solve(rhs);
       for (int k = 0; k < heads; ++k)
@@ -260,7 +264,11 @@ StitchedImageReport MakeStitchedImage(const RigConverter& converter,
   }
   for (int k = 0; k < heads; ++k)
     if (k != reference && report.heads[k].samples == 0)
-      report.warnings.push_back("head " + rig.heads[k].id + " overlaps no other head");
+      report.warnings.push_back({"head_without_overlap",
+                                 rig.heads[k].id,
+                                 NAN,
+                                 NAN,
+                                 "head " + rig.heads[k].id + " overlaps no other head"});
   return report;
 }
 

@@ -24,6 +24,7 @@
 // output strip.
 #pragma once
 
+#include "calib/core/finding.h"
 #include "stitch/resample/raster.h"
 #include "stitch/resample/virtual_image.h"
 #include "stitch/rig/rig_conversion.h"
@@ -62,7 +63,7 @@ struct StitchedImageReport {
   std::vector<HeadRadiometry> heads;
   std::vector<OverlapDisagreement> zones;  // per head pair with overlap
   OverlapDisagreement overall;             // zone "all"
-  std::vector<std::string> warnings;       // e.g. a head without overlap (held)
+  std::vector<Finding> warnings;  // e.g. a head without overlap (held); calib/core/finding.h
 };
 
 /// One head's pixels resampled alone onto the converter's virtual grid through the `rig convert`

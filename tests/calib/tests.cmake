@@ -10,6 +10,8 @@ aerocal_add_test(calib/normal_equations LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/camera_model LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/convert_camera LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/core LIBS aerocal::calib LABELS unit)
+# Schemas of the result documents (docs/schema): cross-file references, every kind, findings.
+aerocal_add_test(calib/json_schema LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/file_digest LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/rig LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/camera_formats LIBS aerocal::calib LABELS unit)

@@ -299,7 +299,7 @@ def test_resample_equals_the_command(tmp_path):
             p = [1, -1e-3, e - 0.37, 1e-3, 1, f + 0.21]
         subimages.append({"id": sid, "model": "affine", "params": p})
     mapping = tmp_path / "r.json"
-    mapping.write_text(json.dumps({"kind": "stitch", "schema_version": 1, "subimages": subimages}))
+    mapping.write_text(json.dumps({"kind": "stitch", "schema_version": 2, "subimages": subimages}))
     rng = np.random.default_rng(3)
     images = {}
     for sid in ("I", "II", "III", "IV"):

@@ -128,7 +128,7 @@ TEST_F(MatchStitch, MatchThenAffineStitchRecoversTheTrueCorners) {
       RunAerocal("stitch --camera " + dir_->File("camera.yaml") + " --obs " +
                  dir_->File("on_ref.csv") + " --model affine --out " + dir_->File("r.json"));
   ASSERT_EQ(result.exit_code, 0) << result.output;
-  const nlohmann::json doc = nlohmann::json::parse(ReadTextFile(dir_->File("r.json")));
+  const nlohmann::json doc = aerocal::testing::ReadJson(dir_->File("r.json"));
   EXPECT_LE(doc.at("sigma0_px").get<double>(), 0.12);
 
   // Same inputs, same file, byte for byte.

@@ -1,8 +1,14 @@
 #include "tests/support/test_support.h"
 
 #include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
 #include "calib/core/json_file.h"
+#include "calib/core/json_schema.h"
+#include "calib/core/result_file.h"
 
+#include <gtest/gtest.h>
+
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdio>
@@ -66,7 +72,27 @@ std::string SharedDataDir(const std::string& name) {
   return std::filesystem::is_directory(dir) ? dir : "";
 }
 
-nlohmann::json ReadJson(const std::string& path) { return ReadJsonFile(path); }
+nlohmann::json ReadJson(const std::string& path) {
+  nlohmann::json document = ReadJsonFile(path);
+  // A result of a command: every test that reads one checks it against its kind's schema.
+  if (document.is_object() && document.contains("kind") && document.contains("schema_version"))
+    ExpectValidResult(document, path);
+  return document;
+}
+
+std::string SchemaPath(const std::string& kind) {
+  return std::string(AEROCAL_SCHEMA_DIR) + "/" + kind + ".schema.json";
+}
+
+void ExpectValidResult(const nlohmann::json& document, const std::string& path) {
+  try {
+    ValidateResult(document, path, AEROCAL_SCHEMA_DIR);
+  } catch (const std::exception& e) {  // InputError: the document; LogicError: the schema
+    ADD_FAILURE() << "result does not match its schema in docs/schema: " << e.what();
+  }
+}
+
+void ExpectValidResult(const std::string& path) { ExpectValidResult(ReadJsonFile(path), path); }
 
 std::string ResultWithoutClock(const std::string& path) {
   std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& j) {

@@ -31,8 +31,19 @@ std::string AerocalBinary();
 /// Runs the aerocal binary with the given arguments.
 CommandResult RunAerocal(const std::string& arguments);
 
-/// The JSON document in `path` (a result the aerocal binary wrote).
+/// The JSON document in `path` (a result the aerocal binary wrote). A result document (one with
+/// `kind` and `schema_version`) is checked by ExpectValidResult on the way.
 nlohmann::json ReadJson(const std::string& path);
+
+/// docs/schema/<kind>.schema.json of the source tree.
+std::string SchemaPath(const std::string& kind);
+
+/// Adds a test failure unless `document` (read from `path`) is a result of one of kResultKinds, of
+/// kResultSchemaVersion, that validates against docs/schema/<kind>.schema.json (the failure names
+/// the first key path that does not, calib/core/json_schema.h).
+void ExpectValidResult(const nlohmann::json& document, const std::string& path);
+/// The same for the result file `path`.
+void ExpectValidResult(const std::string& path);
 
 /// The result document in `path` without the clock's keys (`seconds`, `timing`,
 /// `seconds_testing`, at any depth), as text: two runs' texts are equal byte for byte exactly

@@ -264,7 +264,7 @@ void AddGroupColumn(const std::string& tf,
 // A minimal calibrate result for `certificate`: one uncertainty row, with or without the
 // calibration's stability table.
 std::string CertificateResult(const std::string& uncertainty_row, bool stability = true) {
-  return "{\"kind\": \"adjust\", \"schema_version\": 1, \"command\": \"calibrate\",\n"
+  return "{\"kind\": \"adjust\", \"schema_version\": 2, \"command\": \"calibrate\",\n"
          " \"valid\": true, \"cameras\": [{}],\n"
          " \"calibration\": {\"method\": {}, \"camera\": {}, \"data\": {}, \"rms_px\": 0.1,"
          " \"groups\": [],\n  \"uncertainty\": [" +
@@ -503,7 +503,7 @@ const std::vector<Case>& Cases() {
        [](const TempDir& d) {
          const auto sim = Flight(d);
          Write(d.File("m.json"),
-               R"({"kind": "stitch", "schema_version": 1,
+               R"({"kind": "stitch", "schema_version": 2,
                    "subimages": [{"id": "I", "model": "affine", "params": [0,0,0,0,0,0]}]})");
          return "resample --camera " + sim + "/camera_nominal.yaml --mapping " + d.File("m.json") +
                 " --images I=a.tif --out " + d.File("v.tif");
@@ -1270,13 +1270,13 @@ const std::vector<Case>& Cases() {
        2, "has a group column already", "cal.json"},
       {"certificate_of_a_broken_json",
        [](const TempDir& d) {
-         Write(d.File("r.json"), "{\"schema_version\": 1,\n \"values\": [1, 2\n");
+         Write(d.File("r.json"), "{\"schema_version\": 2,\n \"values\": [1, 2\n");
          return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
        },
        2, "r.json:3: invalid JSON", "cert"},
       {"certificate_of_an_adjust_result",
        [](const TempDir& d) {
-         Write(d.File("r.json"), "{\"schema_version\": 1, \"kind\": \"self_calibration\"}\n");
+         Write(d.File("r.json"), "{\"schema_version\": 2, \"kind\": \"self_calibration\"}\n");
          return "certificate --result " + d.File("r.json") + " --no-render --out " + d.File("cert");
        },
        2, "r.json: not a result of `aerocal calibrate`", "cert"},
@@ -1313,7 +1313,7 @@ const std::vector<Case>& Cases() {
       {"certificate_previous_value_not_a_number",
        [](const TempDir& d) {
          Write(d.File("r.json"), CertificateResult(kCertificateRow));
-         Write(d.File("p.json"), "{\"kind\": \"certificate\", \"schema_version\": 1,\n"
+         Write(d.File("p.json"), "{\"kind\": \"certificate\", \"schema_version\": 2,\n"
                                  " \"results\": [{\"quantity\": \"c\", \"unit\": \"mm\", \"value\": \"1.0\", \"U\": 0.1,"
                                  " \"k\": 2, \"statement\": \"c = 1.00 mm, U = 0.10 mm (k = 2)\"}]}\n");
          return "certificate --result " + d.File("r.json") + " --previous " + d.File("p.json") +

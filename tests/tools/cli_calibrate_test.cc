@@ -22,9 +22,7 @@ using testing::RunCommand;
 using testing::SharedDataDir;
 using testing::TempDir;
 
-nlohmann::json ReadJson(const std::string& path) {
-  return nlohmann::json::parse(ReadTextFile(path));
-}
+nlohmann::json ReadJson(const std::string& path) { return aerocal::testing::ReadJson(path); }
 
 void WriteText(const std::string& path, const std::string& text) { std::ofstream(path) << text; }
 

@@ -60,7 +60,7 @@ testing::CommandResult* FlightWorkflow::run_ = nullptr;
 
 TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
+  const auto doc = aerocal::testing::ReadJson(dir_->File("report/result.json"));
   EXPECT_EQ(doc["kind"], "flight");
   EXPECT_EQ(doc["schema_version"], kResultSchemaVersion);
   EXPECT_EQ(doc["camera_model"]["name"], "brown_fraser_10");
@@ -160,13 +160,12 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   // adjustment's camera, a type-A budget: U = k sigma, k from the redundancy) as `aerocal
   // certificate --result result.json` does; HTML and PDF rendered.
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto cert =
-      nlohmann::json::parse(ReadTextFile(dir_->File("report/certificate/certificate.json")));
+  const auto cert = aerocal::testing::ReadJson(dir_->File("report/certificate/certificate.json"));
   EXPECT_EQ(cert["method"]["kind"], "in-flight calibration");
   EXPECT_EQ(cert["lab"]["certificate"]["number"], "F-7");
   // The certificate names the flight's result.json where it ends, not where it was staged.
   EXPECT_EQ(cert["source"], dir_->File("report/result.json"));
-  const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
+  const auto doc = aerocal::testing::ReadJson(dir_->File("report/result.json"));
   const auto& joint = doc["adjustments"][2];  // the joint adjustment's camera is the certified one
   ASSERT_EQ(joint["name"], "joint");
   bool has_c = false;
@@ -183,9 +182,8 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   EXPECT_TRUE(has_c);
   // --quality: the dynamic image resolution section from the star's reading.
   ASSERT_EQ(cert["dynamic_image_resolution"]["stars"].size(), 1u);
-  EXPECT_EQ(
-      cert["dynamic_image_resolution"]["stars"][0]["limiting_frequency_cy_px"],
-      nlohmann::json::parse(ReadTextFile(dir_->File("star.json")))["limiting_frequency_cy_px"]);
+  EXPECT_EQ(cert["dynamic_image_resolution"]["stars"][0]["limiting_frequency_cy_px"],
+            aerocal::testing::ReadJson(dir_->File("star.json"))["limiting_frequency_cy_px"]);
   const std::string html = ReadTextFile(dir_->File("report/certificate/certificate.html"));
   for (const char* text : {"Calibration certificate",
                            "F-7",
@@ -200,7 +198,7 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
                           dir_->File("lab.yaml") + " --quality " + dir_->File("star.json") +
                           " --no-render --out " + dir_->File("cert"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  auto again = nlohmann::json::parse(ReadTextFile(dir_->File("cert/certificate.json")));
+  auto again = aerocal::testing::ReadJson(dir_->File("cert/certificate.json"));
   auto first = cert;
   again.erase("source");
   first.erase("source");
@@ -295,7 +293,7 @@ TEST_F(FlightWorkflow, ReportHoldsTablesAndPlots) {
 // (flight calibrates), and so is a bad --suspect-effect-limit, each by name with exit 2.
 TEST_F(FlightWorkflow, AutoSelfCalibrationCheckPointTestAndCameraOrigin) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto doc = nlohmann::json::parse(ReadTextFile(dir_->File("report/result.json")));
+  const auto doc = aerocal::testing::ReadJson(dir_->File("report/result.json"));
   const auto& self = doc["adjustments"][1];
   ASSERT_TRUE(self.contains("self_calibration_choice"));
   EXPECT_EQ(self["self_calibration_choice"]["candidates"].size(), 10u);
@@ -332,8 +330,8 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
       for (auto& value : j) strip(value);
     }
   };
-  auto first = nlohmann::json::parse(ReadTextFile(dir_->File("once/result.json")));
-  auto second = nlohmann::json::parse(ReadTextFile(dir_->File("again/result.json")));
+  auto first = aerocal::testing::ReadJson(dir_->File("once/result.json"));
+  auto second = aerocal::testing::ReadJson(dir_->File("again/result.json"));
   strip(first);
   strip(second);
   // The numbers of every step, to the last bit (issue 33 item 7: a lab checksums its re-runs; paths

@@ -34,7 +34,7 @@ TEST(CliOptions, StitchModelAutoTestsAtTheGivenAlpha) {
                  dir.File("data/stitch_obs.csv") +
                  " --model auto --alpha 0.01 --base III,IV --out " + dir.File("r.json"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  const auto doc = nlohmann::json::parse(ReadTextFile(dir.File("r.json")));
+  const auto doc = aerocal::testing::ReadJson(dir.File("r.json"));
   ASSERT_EQ(doc["frames"].size(), 2u);
   for (const auto& frame : doc["frames"]) {
     EXPECT_EQ(frame["model_choice"]["alpha"].get<double>(), 0.01);
@@ -73,7 +73,7 @@ TEST(CliOptions, ImportDbatThenAdjustGivesThePublishedCalibration) {
       "adjust --project " + dir.File("block/project.yaml") +
       " --self-calibration c,x0,y0,K1,K2,K3,P1,P2,B1 --no-snooping --out " + dir.File("r.json"));
   ASSERT_EQ(adjusted.exit_code, 0) << adjusted.output;
-  const auto doc = nlohmann::json::parse(ReadTextFile(dir.File("r.json")));
+  const auto doc = aerocal::testing::ReadJson(dir.File("r.json"));
   // Published (DBAT 0.9.2.0): c 7.45700 (0.00105) mm, sigma0 0.16148 px.
   const auto& camera = doc["cameras"][0];
   EXPECT_LT(std::abs(camera["estimated"]["c"].get<double>() - 7.45700),
@@ -97,7 +97,7 @@ TEST(CliOptions, AdjustWritesTheCameraInAnotherToolsFormat) {
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_NE(r.output.find("camera as australis (brown_fraser_10): exact"), std::string::npos)
       << r.output;
-  const auto doc = nlohmann::json::parse(ReadTextFile(dir.File("a.json")));
+  const auto doc = aerocal::testing::ReadJson(dir.File("a.json"));
   const double c = doc["cameras"][0]["estimated"]["c"].get<double>();
   const double sigma_c = doc["cameras"][0]["sigma"]["c"].get<double>();
   auto shown = RunAerocal("camera show --from australis " + dir.File("cam.aus.txt"));

@@ -1,8 +1,11 @@
 // Result documents of the commands (calib/core/result_file.h): every command's result carries
 // `kind` and `schema_version` (and the camera model's parameter table where a camera is in it),
 // and the readers of results refuse another kind or version with `FILE: what`, exit 2, nothing
-// written. `aerocal flight`, `rig stitch` and `pushbroom control` are checked the same way in their
-// own CLI tests (cli_flight, cli_rig_stitch, pushbroom_images): they are too long to run twice.
+// written. Every result read through testing::ReadJson is checked against its kind's schema
+// (docs/schema/<kind>.schema.json, testing::ExpectValidResult); EveryKindIsValidatedSomewhere
+// lists, for each of kResultKinds, the file this suite writes or the CLI test that writes and
+// validates it (`flight`, `rig stitch`, `pushbroom control`, `batch plan` and `quality` are too
+// long or need images: their own CLI tests read their results through ReadJson).
 #include "calib/core/result_file.h"
 #include "tests/support/test_support.h"
 
@@ -11,6 +14,7 @@
 
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <string>
 
 namespace aerocal {
@@ -114,26 +118,100 @@ TEST_F(ResultDocuments, EveryCommandWritesKindAndSchemaVersion) {
   ExpectHeader(ReadJson(dir_->File("pushbroom.json")), "pushbroom");
 }
 
+// Each kind of kResultKinds is written and validated: here (the file) or in the CLI test named.
+TEST_F(ResultDocuments, EveryKindIsValidatedSomewhere) {
+  const std::map<std::string, std::string> here = {{"adjust", "adjust.json"},
+                                                   {"certificate", "cert/certificate.json"},
+                                                   {"stitch", "stitch.json"},
+                                                   {"camera_conversion", "convert.json"},
+                                                   {"rig_design", "design.json"},
+                                                   {"rig_error_analysis", "error.json"},
+                                                   {"pushbroom", "pushbroom.json"}};
+  const std::map<std::string, std::string> elsewhere = {
+      {"flight", "tools/cli_flight"},
+      {"rig_stitch", "tools/cli_rig_stitch"},
+      {"pushbroom_control", "triangulation/pushbroom_control_cli"},
+      {"batch_manifest", "tools/cli_batch"},
+      {"quality_mtf", "tools/cli_quality"},
+      {"quality_bars", "tools/cli_quality"},
+      {"quality_star", "tools/cli_quality"}};
+  for (std::string_view k : kResultKinds) {
+    const std::string kind(k);
+    EXPECT_TRUE(std::filesystem::exists(testing::SchemaPath(kind))) << kind << ": no schema";
+    if (elsewhere.count(kind)) continue;
+    ASSERT_TRUE(here.count(kind)) << kind << ": no CLI test writes and validates it";
+    const std::string path = dir_->File(here.at(kind));
+    if (!std::filesystem::exists(path)) {  // EveryCommandWritesKindAndSchemaVersion writes it
+      ADD_FAILURE() << path << " was not written";
+      continue;
+    }
+    EXPECT_EQ(ReadJson(path)["kind"], kind);  // ReadJson validates it against the schema
+  }
+  // The calibrate form of an adjust result (command, calibration) validates too.
+  testing::ExpectValidResult(dir_->File("cal.json"));
+}
+
+// `aerocal validate`: results against their schemas; a key the schema does not list, a value of
+// the wrong type, another kind: exit 2 naming the file and the key path.
+TEST_F(ResultDocuments, ValidateChecksResultsAgainstTheirSchemas) {
+  auto r = RunAerocal("validate " + dir_->File("cal.json") + " " + dir_->File("adjust.json"));
+  EXPECT_EQ(r.exit_code, 0) << r.output;
+  EXPECT_NE(r.output.find("cal.json: valid"), std::string::npos) << r.output;
+
+  json doc = ReadJson(dir_->File("cal.json"));
+  doc["sigma0_pixels"] = 0.1;  // not a key of the adjust result
+  Write(dir_->File("extra.json"), doc.dump());
+  r = RunAerocal("validate " + dir_->File("extra.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("extra.json: sigma0_pixels: not allowed here (got 0.1)"),
+            std::string::npos)
+      << r.output;
+
+  doc.erase("sigma0_pixels");
+  doc["cameras"][0]["sigma"]["c"] = -0.001;  // a sigma is >= 0 or null
+  Write(dir_->File("sigma.json"), doc.dump());
+  r = RunAerocal("validate " + dir_->File("sigma.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("sigma.json: cameras[0].sigma.c: must be >= 0"), std::string::npos)
+      << r.output;
+
+  Write(dir_->File("other.json"),
+        json({{"kind", "report"}, {"schema_version", kResultSchemaVersion}}).dump());
+  r = RunAerocal("validate " + dir_->File("other.json"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find("other.json: not a result of aerocal (kind is \"report\")"),
+            std::string::npos)
+      << r.output;
+}
+
 // A reader of results refuses another kind and another schema_version by name, exit 2, and
 // writes nothing: the certificate (of `calibrate`) and resample's stitch result (--mapping).
 TEST_F(ResultDocuments, ReadersRefuseAnotherKindOrVersion) {
+  // A file of version 1 (before the findings of docs/schema/CHANGES.md) and of a later version.
   json doc = ReadJson(dir_->File("cal.json"));
-  doc["schema_version"] = kResultSchemaVersion + 1;
-  Write(dir_->File("v2.json"), doc.dump());
-  auto r = RunAerocal("certificate --result " + dir_->File("v2.json") + " --no-render --out " +
-                      dir_->File("cert_v2"));
-  EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("v2.json: schema_version is 2, expected 1 (kind \"adjust\")"),
-            std::string::npos)
-      << r.output;
-  EXPECT_FALSE(std::filesystem::exists(dir_->File("cert_v2/certificate.json")));
+  for (const int version : {1, kResultSchemaVersion + 1}) {
+    doc["schema_version"] = version;
+    const std::string name = "v" + std::to_string(version);
+    Write(dir_->File(name + ".json"), doc.dump());
+    const auto r = RunAerocal("certificate --result " + dir_->File(name + ".json") +
+                              " --no-render --out " + dir_->File("cert_" + name));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(
+        r.output.find(name + ".json: schema_version is " + std::to_string(version) + ", expected " +
+                      std::to_string(kResultSchemaVersion) + " (kind \"adjust\")"),
+        std::string::npos)
+        << r.output;
+    EXPECT_FALSE(std::filesystem::exists(dir_->File("cert_" + name + "/certificate.json")));
+  }
 
   doc.erase("schema_version");
   Write(dir_->File("v0.json"), doc.dump());
-  r = RunAerocal("certificate --result " + dir_->File("v0.json") + " --no-render --out " +
-                 dir_->File("cert_v0"));
+  auto r = RunAerocal("certificate --result " + dir_->File("v0.json") + " --no-render --out " +
+                      dir_->File("cert_v0"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("v0.json: schema_version is null, expected 1"), std::string::npos)
+  EXPECT_NE(r.output.find("v0.json: schema_version is null, expected " +
+                          std::to_string(kResultSchemaVersion)),
+            std::string::npos)
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("cert_v0/certificate.json")));
 

@@ -177,7 +177,7 @@ TEST(Cli, SimulateTestFieldThenCalibrateWithItsGroups) {
       "observations.csv --points " + a + "points.csv --groups " + a +
       "groups.csv --self-calibration c,x0,y0,K1,K2,P1,P2 --out " + dir.File("calib.json"));
   ASSERT_NE(r.exit_code, 2) << r.output;  // 0, or 3 when the two groups happen to disagree
-  const auto j = nlohmann::json::parse(ReadTextFile(dir.File("calib.json")));
+  const auto j = aerocal::testing::ReadJson(dir.File("calib.json"));
   EXPECT_EQ(j["calibration"]["groups"].size(), 2u);
   EXPECT_EQ(j["calibration"]["start"]["resections"].size(), 16u);
   const double truth = calib::ReadCamera(a + "camera_truth.yaml").interior[0];

@@ -10,3 +10,11 @@ add_test(NAME tools/report
   WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR})
 set_tests_properties(tools/report PROPERTIES LABELS cli TIMEOUT 180 ENVIRONMENT
   "PYTHONDONTWRITEBYTECODE=1;AEROCAL_REPORT_SCRIPT=${AEROCAL_REPORT_ROOT}/tools/report/aerocal_report.py;AEROCAL_REPORT_FIXTURE=${AEROCAL_REPORT_ROOT}/tests/data/report/result.json")
+# The renderers (report, certificate, rig error plots) read only keys their input's schema lists
+# (docs/schema; issue 30 item 5): each runs on a result `aerocal validate` accepted, its key
+# lookups recorded and checked against the schema.
+add_test(NAME tools/schema_keys
+  COMMAND ${AEROCAL_PYTHON3} -m unittest -v schema_keys_test
+  WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR})
+set_tests_properties(tools/schema_keys PROPERTIES LABELS cli TIMEOUT 300 ENVIRONMENT
+  "PYTHONDONTWRITEBYTECODE=1;AEROCAL_BINARY=$<TARGET_FILE:aerocal>")

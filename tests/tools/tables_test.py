@@ -87,7 +87,7 @@ class BadInput(unittest.TestCase):
         with tempfile.TemporaryDirectory() as tmp:
             other = os.path.join(tmp, "stitch.json")
             with open(other, "w") as f:
-                json.dump({"kind": "stitch", "schema_version": 1}, f)
+                json.dump({"kind": "stitch", "schema_version": 2}, f)
             out = os.path.join(tmp, "tables")
             r = runs.aerocal("export", "--result", other, "--tables", out, ok=(2,))
             self.assertIn("stitch.json", r.stderr)

@@ -274,7 +274,7 @@ TEST(CrsFrame, ImportOdmTakesAWgs84GcpList) {
     const auto run = testing::RunAerocal("adjust --project " + tmp.File(name + "/project.yaml") +
                                          " --robust-start --out " + tmp.File(name + ".json"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
-    results.push_back(nlohmann::json::parse(ReadTextFile(tmp.File(name + ".json"))));
+    results.push_back(aerocal::testing::ReadJson(tmp.File(name + ".json")));
     std::printf("%s: check RMSE %s\n  frame: %s\n",
                 name.c_str(),
                 results.back()["check"]["rmse_m"].dump().c_str(),
@@ -308,7 +308,7 @@ TEST(CrsFrame, ImportOdmTakesAWgs84GcpList) {
       }
   }
   const nlohmann::json geojson =
-      nlohmann::json::parse(ReadTextFile(tmp.File("export/check_errors.geojson")));
+      aerocal::testing::ReadJson(tmp.File("export/check_errors.geojson"));
   EXPECT_EQ(geojson["type"], "FeatureCollection");
   EXPECT_EQ(geojson["features"].size(), results[0]["check"]["points"].size());
   EXPECT_NEAR(geojson["features"][0]["geometry"]["coordinates"][0].get<double>(), -49.42, 0.01);
@@ -364,7 +364,7 @@ TEST(CrsFrame, OrthometricHeightsGiveTheEllipsoidalResult) {
     const auto run = testing::RunAerocal("adjust --project " + tmp.File(name + "/project.yaml") +
                                          " --robust-start --out " + tmp.File(name + ".json"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
-    results.push_back(nlohmann::json::parse(ReadTextFile(tmp.File(name + ".json"))));
+    results.push_back(aerocal::testing::ReadJson(tmp.File(name + ".json")));
     std::printf("%s: height of %s %.4f m, check RMSE %s, c %.6f\n  frame: %s\n",
                 name.c_str(),
                 block.points.front().id.c_str(),
@@ -442,7 +442,7 @@ TEST(CrsFrame, ImportColmapTakesAGeocentricModel) {
   const auto adjusted = testing::RunAerocal("adjust --project " + tmp.File("block/project.yaml") +
                                             " --out " + tmp.File("r.json"));
   ASSERT_EQ(adjusted.exit_code, 0) << adjusted.output;
-  const auto doc = nlohmann::json::parse(ReadTextFile(tmp.File("r.json")));
+  const auto doc = aerocal::testing::ReadJson(tmp.File("r.json"));
   EXPECT_NEAR(doc["sigma0_px"].get<double>(), 0.2, 0.02);
   EXPECT_NE(doc["frame"].get<std::string>().find("X, Y, Z geocentric"), std::string::npos);
   // The adjusted centres are written back geocentric (|X| ~ Earth radius).

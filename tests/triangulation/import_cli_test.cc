@@ -30,7 +30,7 @@ TEST(ImportCommand, OdmListImportedOnceThenAdjustedWithItsBlundersListed) {
   r = RunAerocal("adjust --project " + tmp.File("block") + " --robust-start --out " +
                  tmp.File("r.json"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
-  const auto j = nlohmann::json::parse(ReadTextFile(tmp.File("r.json")));
+  const auto j = aerocal::testing::ReadJson(tmp.File("r.json"));
   int gross = 0;
   for (const auto& o : j["rejected"]) gross += o["residual_px"].get<double>() > 100.0;
   EXPECT_EQ(gross, 2);
@@ -93,7 +93,7 @@ TEST(ImportCommand, ColmapModelImportedOnceThenAdjusted) {
   const auto adjusted = RunAerocal("adjust --project " + tmp.File("block/project.yaml") +
                                    " --out " + tmp.File("r.json"));
   ASSERT_EQ(adjusted.exit_code, 0) << adjusted.output;
-  const auto doc = nlohmann::json::parse(ReadTextFile(tmp.File("r.json")));
+  const auto doc = aerocal::testing::ReadJson(tmp.File("r.json"));
   EXPECT_NE(doc["datum"].get<std::string>().find("free network"), std::string::npos);
   EXPECT_NEAR(doc["sigma0_px"].get<double>(), 0.2, 0.02);
 }

@@ -171,7 +171,7 @@ TEST(ObjectFrame, GeodeticFrameWithoutOriginAdjustsAboutTheBlockCentre) {
         "adjust --project " + dir.File(std::string(name) + "/project.yaml") +
         " --self-calibration all --out " + dir.File(std::string(name) + ".json"));
     ASSERT_EQ(run.exit_code, 0) << run.output;
-    results.push_back(nlohmann::json::parse(ReadTextFile(dir.File(std::string(name) + ".json"))));
+    results.push_back(aerocal::testing::ReadJson(dir.File(std::string(name) + ".json")));
   }
   for (const auto& r : results)
     std::printf("sigma0 %.4f, iterations %d, rejected %zu, converged %d, frame %s\n",

@@ -57,7 +57,7 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
           " --pos-sigma-m 0.05 --pos-sigma-deg 0.005 --sigma-px 0.25"
           " --min-per-segment 5"));
   ASSERT_EQ(run.exit_code, 0) << run.output;
-  const json doc = json::parse(ReadTextFile(dir.File("result.json")));
+  const json doc = aerocal::testing::ReadJson(dir.File("result.json"));
   for (const char* key : {"kind",
                           "sigma0",
                           "sigma0_px",
@@ -143,7 +143,7 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
     EXPECT_NE(gauge.output.find("datum gauge: rank defect 0 without it, 0 constraints"),
               std::string::npos)
         << gauge.output;
-    const json d = json::parse(ReadTextFile(dir.File("gauge.json")))["datum"];
+    const json d = aerocal::testing::ReadJson(dir.File("gauge.json"))["datum"];
     for (const char* key : {"mode",
                             "rank_defect",
                             "threshold",
@@ -174,7 +174,7 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
               bad.output.find("warning: undetermined") != std::string::npos)
       << bad.output;
   EXPECT_FALSE(std::filesystem::exists(dir.File("none.yaml")));
-  EXPECT_EQ(json::parse(ReadTextFile(dir.File("none.json")))["valid"], false);
+  EXPECT_EQ(aerocal::testing::ReadJson(dir.File("none.json"))["valid"], false);
 }
 
 // A boresight misalignment and a lever arm planted in the camera file (off the flight's by (0.05,
@@ -227,7 +227,7 @@ TEST(PushbroomCommands, BoresightAndLeverArmFromAPlantedMisalignment) {
     EXPECT_NE(run.output.find(boresight ? "boresight (free): omega" : "lever arm (free): x"),
               std::string::npos)
         << run.output;
-    const json doc = json::parse(ReadTextFile(dir.File(name + ".json")));
+    const json doc = aerocal::testing::ReadJson(dir.File(name + ".json"));
     const json& entry = boresight ? doc["boresight"] : doc["lever_arm"];
     ASSERT_EQ(entry["mode"], "free");
     const calib::LineCamera out = calib::ReadLineCamera(dir.File(name + "_out.yaml"));
@@ -245,7 +245,7 @@ TEST(PushbroomCommands, BoresightAndLeverArmFromAPlantedMisalignment) {
   auto both = calibrate(true, true, "both", " --boresight free --lever-arm free");
   ASSERT_TRUE(both.exit_code == 0 || both.exit_code == 3) << both.output;
   EXPECT_NE(both.output.find("lever_arm_x_vs_boresight"), std::string::npos) << both.output;
-  const json doc = json::parse(ReadTextFile(dir.File("both.json")));
+  const json doc = aerocal::testing::ReadJson(dir.File("both.json"));
   for (const char* name : {"boresight_roll_vs_offset",
                            "boresight_pitch_vs_offset",
                            "boresight_phi_vs_attitude",
@@ -267,7 +267,7 @@ TEST(PushbroomCommands, BoresightAndLeverArmFromAPlantedMisalignment) {
                             " --boresight weighted --boresight-sigma-deg 0.01"
                             " --lever-arm weighted --lever-arm-sigma-m 0.05");
   ASSERT_TRUE(weighted.exit_code == 0 || weighted.exit_code == 3) << weighted.output;
-  const json w = json::parse(ReadTextFile(dir.File("weighted.json")));
+  const json w = aerocal::testing::ReadJson(dir.File("weighted.json"));
   ASSERT_EQ(w["boresight"]["mode"], "weighted");
   const double cap = std::max(1.0, w["sigma0"].get<double>()) * (1 + 1e-9);  // sigma0 sqrt(Q)
   for (int a = 0; a < 3; ++a) {
@@ -355,8 +355,8 @@ TEST(PushbroomCommands, PatentLineAxisGivesTheSameCalibration) {
   const auto y_run = calibrate(dir.File("camera_y.yaml"), "y");
   ASSERT_EQ(x_run.exit_code, 0) << x_run.output;
   ASSERT_EQ(y_run.exit_code, 0) << y_run.output;
-  const json x = json::parse(ReadTextFile(dir.File("x.json")));
-  const json y = json::parse(ReadTextFile(dir.File("y.json")));
+  const json x = aerocal::testing::ReadJson(dir.File("x.json"));
+  const json y = aerocal::testing::ReadJson(dir.File("y.json"));
   ASSERT_EQ(x["detectors"].size(), y["detectors"].size());
   for (size_t i = 0; i < x["detectors"].size(); ++i)
     for (const char* key : {"dx_mm", "dy_mm", "sigma_dx_mm", "sigma_dy_mm"})

@@ -669,6 +669,10 @@ def write_pdf_pages(c, tmp, title):
             plt.close(fig)
 
 
+# kResultSchemaVersion of calib/core/result_file.h: the certificate version this renderer reads.
+SCHEMA_VERSION = 2
+
+
 def main(argv):
     if len(argv) != 3:
         print("usage: aerocal_certificate.py CERTIFICATE.json OUT_DIR", file=sys.stderr)
@@ -682,10 +686,9 @@ def main(argv):
     if not isinstance(c, dict) or c.get("kind") != "certificate":
         print("error: %s: not a certificate.json (kind must be \"certificate\")" % argv[1], file=sys.stderr)
         return 2
-    # kResultSchemaVersion of calib/core/result_file.h
-    if c.get("schema_version") != 1 or isinstance(c.get("schema_version"), bool):
-        print("error: %s: schema_version is %s, expected 1 (kind \"certificate\")"
-              % (argv[1], json.dumps(c.get("schema_version"))), file=sys.stderr)
+    if c.get("schema_version") != SCHEMA_VERSION or isinstance(c.get("schema_version"), bool):
+        print("error: %s: schema_version is %s, expected %d (kind \"certificate\")"
+              % (argv[1], json.dumps(c.get("schema_version")), SCHEMA_VERSION), file=sys.stderr)
         return 2
     figures = {"distortion": svg_of(fig_distortion(c)), "residuals": svg_of(fig_residuals_correlation(c))}
     if c.get("dynamic_image_resolution"):

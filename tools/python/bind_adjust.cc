@@ -5,6 +5,7 @@
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/finding.h"
 #include "calib/core/result_file.h"
 #include "tools/project_facts.h"
 #include "tools/python/bindings.h"
@@ -443,18 +444,8 @@ arrays (exposures, points, observations).)doc")
       .def_property_readonly("invalid_reasons",
                              [](const Result& r) { return r.result.invalid_reasons; })
       .def_property_readonly("warnings",
-                             [](const Result& r) {
-                               py::list out;
-                               for (const auto& w : r.result.warnings) {
-                                 py::dict d;
-                                 d["name"] = w.name;
-                                 d["subject"] = w.subject;
-                                 d["value"] = w.value;
-                                 d["limit"] = w.limit;
-                                 d["message"] = w.message;
-                                 out.append(d);
-                               }
-                               return out;
+                             [](const Result& r) {  // the result JSON's findings
+                               return JsonToPython(FindingsToJson(r.result.warnings).dump());
                              })
       .def_property_readonly("notes", [](const Result& r) { return r.result.notes; })
       .def_property_readonly("cameras", [](const Result& r) { return r.result.cameras; })

@@ -3,6 +3,7 @@
 // writes it (the stitched images stay with the command).
 #include "calib/camera/rig_io.h"
 #include "calib/core/error.h"
+#include "calib/core/finding.h"
 #include "calib/core/result_file.h"
 #include "tools/python/bindings.h"
 #include "tools/rig_design_document.h"
@@ -107,7 +108,9 @@ void BindRig(py::module_& m) {
       .def_property_readonly("failures",
                              [](const RigStitchResult& r) { return r.run.result.failures; })
       .def_property_readonly("warnings",
-                             [](const RigStitchResult& r) { return r.run.result.warnings; })
+                             [](const RigStitchResult& r) {  // the result JSON's findings
+                               return JsonToPython(FindingsToJson(r.run.result.warnings).dump());
+                             })
       .def_property_readonly("sigma0", [](const RigStitchResult& r) { return r.run.result.sigma0; })
       .def_property_readonly(
           "rig_exposures",

@@ -92,11 +92,10 @@ def points(a):
     rows = []
     for role, p in _points(a):
         adjusted, surveyed = rd.triple(p.get("adjusted")), rd.triple(p.get("surveyed"))
-        sigma = rd.triple(p.get("sigma_m"))
         rows.append([p.get("point", ""), role, cell(p.get("rays"))] + [cell(v) for v in adjusted] +
-                    [cell(v) for v in surveyed] + [cell(v) for v in sigma])
-    return csv_text(["point", "role", "rays", "X", "Y", "Z", "X_surveyed", "Y_surveyed", "Z_surveyed", "sX_m", "sY_m",
-                     "sZ_m"], rows)
+                    [cell(v) for v in surveyed])
+    # No sigma columns: an adjust result holds no sigmas of the control and check points.
+    return csv_text(["point", "role", "rays", "X", "Y", "Z", "X_surveyed", "Y_surveyed", "Z_surveyed"], rows)
 
 
 def point_errors(a):

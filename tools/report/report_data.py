@@ -1,9 +1,10 @@
-"""Tolerant reading of the `aerocal flight` result document (FORMATS.md "Results (JSON)").
+"""Tolerant reading of the `aerocal flight` result document (docs/formats.md "Result documents").
 
 Every accessor returns plain Python values or None when a key is absent, so that a missing section
-is shown as "not available" instead of stopping the report. Where two spellings of a key exist
-(the FORMATS.md / C++ writers' name and an older draft name), both are accepted; the first listed
-is the one the writers emit.
+is shown as "not available" instead of stopping the report. Only keys of the result's schema
+(docs/schema/flight.schema.json, adjust.schema.json, stitch.schema.json) are read, in the writers'
+spelling: tests/tools/schema_keys_test.py records every key the report looks up and fails on one
+the schema does not list.
 """
 import json
 import math
@@ -18,7 +19,7 @@ ADJUSTMENT_TITLES = {"conventional": "Conventional triangulation",
 
 
 # kResultSchemaVersion of calib/core/result_file.h: the result version this reader understands.
-SCHEMA_VERSION = 1
+SCHEMA_VERSION = 2
 
 
 class InputError(Exception):
@@ -108,15 +109,10 @@ def candidates(frame):
     """Per-model rows of a frame's model comparison: dicts with model, sigma0, sigma0_px,
     redundancy, determinable, refusal and test (dict: against, F, F_critical, p_value, significant)."""
     rows = []
-    for c in listing(get(model_choice(frame), "table", "models", "candidates")):
+    for c in listing(get(model_choice(frame), "table")):
         if not isinstance(c, dict) or not isinstance(c.get("model"), str):
             continue
-        test = c.get("test")
-        if not isinstance(test, dict):  # a draft flattened the test into the row
-            test = {"F": c.get("F"), "F_critical": c.get("F_critical"), "against": c.get("against"),
-                    "p_value": c.get("p_value"), "significant": c.get("significant")}
-            if test["F"] is None:
-                test = None
+        test = c.get("test") if isinstance(c.get("test"), dict) else None  # the first has none
         rows.append({"model": c["model"], "sigma0": number(c.get("sigma0")),
                      "sigma0_px": number(c.get("sigma0_px")), "redundancy": number(c.get("redundancy")),
                      "determinable": c.get("determinable", True) is not False,
@@ -128,32 +124,27 @@ def stability_models(stitching):
     """Per-model flight stability entries (model, n_frames, mean/std sigma0[_px], flagged, parameters)."""
     stability = get(stitching, "stability") or {}
     out = []
-    for m in listing(get(stability, "models", "per_model")):
+    for m in listing(get(stability, "models")):
         if isinstance(m, dict) and isinstance(m.get("model"), str):
             out.append(m)
     return out
 
 
 def flagged(entry):
-    """[(frame, [reasons])] of a stability entry; accepts strings or {frame, reasons}."""
+    """[(frame, [reasons])] of a stability entry's {frame, reasons} list."""
     out = []
-    for f in listing(get(entry, "flagged", "flagged_frames")):
+    for f in listing(get(entry, "flagged")):
         if isinstance(f, dict):
-            reasons = f.get("reasons", f.get("reason", []))
-            out.append((str(f.get("frame", "?")), reasons if isinstance(reasons, list) else [str(reasons)]))
-        else:
-            out.append((str(f), []))
+            out.append((str(f.get("frame", "?")), [str(r) for r in listing(f.get("reasons"))]))
     return out
 
 
 def flags_by_frame(stitching):
-    """{frame: [models whose stability test flags it]}; a flight-level list without model gives ""."""
+    """{frame: [models whose stability test flags it]}."""
     out = {}
     for m in stability_models(stitching):
         for f, _ in flagged(m):
             out.setdefault(f, []).append(m["model"])
-    for f, _ in flagged(get(stitching, "stability") or {}):
-        out.setdefault(f, []).append("")
     return out
 
 
@@ -180,12 +171,8 @@ def point_statistics(adjustment, which):
     if not isinstance(s, dict):
         return None
     rmse = triple(s.get("rmse_m"))
-    plan = number(get(s, "planimetric_rmse_m", "rmse_planimetric_m"))
-    spatial = number(get(s, "spatial_rmse_m", "rmse_spatial_m"))
-    if plan is None and None not in rmse[:2]:
-        plan = math.hypot(rmse[0], rmse[1])
-    if spatial is None and None not in rmse:
-        spatial = math.sqrt(sum(v * v for v in rmse))
+    plan = number(s.get("planimetric_rmse_m"))  # C++ exports every figure: none is recomputed here
+    spatial = number(s.get("spatial_rmse_m"))
     return {"n": number(s.get("n")), "rmse": rmse, "plan": plan, "spatial": spatial,
             "mean": triple(s.get("mean_m")), "max": triple(s.get("max_abs_m"))}
 
@@ -196,12 +183,7 @@ def point_errors(adjustment, which):
     for p in listing(get(get(adjustment, which), "points")):
         if not isinstance(p, dict):
             continue
-        surveyed = p.get("surveyed", p.get("surveyed_m"))
-        xyz = triple(surveyed) if surveyed is not None else [number(p.get(k)) for k in "XYZ"]
-        if "difference_m" in p:
-            d = triple(p["difference_m"])
-        else:
-            d = [number(p.get(k)) for k in ("dX", "dY", "dZ")]
+        xyz, d = triple(p.get("surveyed")), triple(p.get("difference_m"))
         if None in xyz[:2] or None in d:
             continue
         out.append((str(p.get("point", "")), xyz[0], xyz[1], xyz[2], d[0], d[1], d[2]))
@@ -216,7 +198,7 @@ def residuals(adjustment):
         if not isinstance(r, dict) or r.get("used") is False:
             continue
         v = [number(get(r, "col")), number(get(r, "row")),
-             number(get(r, "v_col_px", "vcol_px")), number(get(r, "v_row_px", "vrow_px"))]
+             number(get(r, "v_col_px")), number(get(r, "v_row_px"))]
         if None not in v:
             out.append(tuple(v))
     return out

@@ -121,9 +121,10 @@ def facts(doc):
     out = ['<h2 id="project">2. Project</h2>']
     main = _main_adjustment(doc)
     geo = geometry(doc, main) if main else None
-    names = doc.get("camera_names") if isinstance(doc.get("camera_names"), dict) else {}
-    if doc.get("camera_name"):
+    if doc.get("camera_name"):  # a flight: its one camera
         names = {"camera": doc.get("camera_name")}
+    else:  # an adjust result: every camera by id
+        names = doc.get("camera_names") if isinstance(doc.get("camera_names"), dict) else {}
     cameras = "; ".join(f"{esc(k)}: {esc(v or 'unnamed')}" for k, v in names.items()) or "not available"
     fmt_info = rd.camera_format(doc)
     fmt_text = (f"{int(fmt_info[0])} x {int(fmt_info[1])} px, pixel {fmt_info[2] * 1000:g} um, "

@@ -17,6 +17,10 @@ import sys
 sys.dont_write_bytecode = True  # keep the source tree free of __pycache__
 
 
+# kResultSchemaVersion of calib/core/result_file.h: the result version this reader understands.
+SCHEMA_VERSION = 2
+
+
 def _fail(message, code):
     sys.stderr.write(f"error: {message}\n")
     sys.exit(code)
@@ -80,9 +84,8 @@ def main(argv):
         _fail(f"{argv[1]}: {e}", 2)
     if not isinstance(doc, dict) or doc.get("kind") != "rig_error_analysis":
         _fail(f"{argv[1]}: not a rig error analysis (kind must be 'rig_error_analysis')", 2)
-    # kResultSchemaVersion of calib/core/result_file.h
-    if doc.get("schema_version") != 1 or isinstance(doc.get("schema_version"), bool):
-        _fail(f"{argv[1]}: schema_version is {json.dumps(doc.get('schema_version'))}, expected 1 "
+    if doc.get("schema_version") != SCHEMA_VERSION or isinstance(doc.get("schema_version"), bool):
+        _fail(f"{argv[1]}: schema_version is {json.dumps(doc.get('schema_version'))}, expected {SCHEMA_VERSION} "
               f"(kind \"rig_error_analysis\")", 2)
     try:
         import matplotlib

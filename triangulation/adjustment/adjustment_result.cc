@@ -2,6 +2,7 @@
 
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
+#include "calib/problem/solve_statistics_json.h"
 
 #include <algorithm>
 #include <cmath>
@@ -419,12 +420,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["sigma0"] = r.sigma0;
   j["sigma0_px"] = r.sigma0_px;
   j["sigma0_um"] = r.sigma0_um;
-  j["redundancy"] = r.solve.redundancy;
-  j["iterations"] = r.solve.iterations;
-  j["converged"] = r.solve.converged;
-  j["termination"] = r.solve.termination;
-  j["linear_solver"] = r.solve.linear_solver;
-  j["seconds"] = r.solve.seconds;
+  j.update(calib::SolveStatisticsToJson(r.solve));  // redundancy .. seconds, groups
   j["timing"] = {{"solve_s", r.timing.solve_s},
                  {"snooping_s", r.timing.snooping_s},
                  {"testing_s", r.timing.testing_s},
@@ -435,17 +431,7 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
   j["self_calibration"] = r.free_interior;
   j["n_observations"] = r.solve.n_observations;
   j["n_unknowns"] = r.solve.n_unknowns;
-  nlohmann::json groups = nlohmann::json::array();
-  for (const auto& g : r.solve.groups)
-    groups.push_back({{"name", g.name}, {"n", g.n_observations}, {"rms_sigma", g.rms}});
-  j["groups"] = groups;
-  j["warnings"] = nlohmann::json::array();
-  for (const auto& w : r.warnings)
-    j["warnings"].push_back({{"name", w.name},
-                             {"subject", w.subject},
-                             {"value", w.value},
-                             {"limit", w.limit},
-                             {"message", w.message}});
+  j["warnings"] = FindingsToJson(r.warnings);
   j["cameras"] = nlohmann::json::array();
   for (const auto& c : r.cameras) {
     nlohmann::json sigma = nlohmann::json::object(), free = nlohmann::json::array();

@@ -7,6 +7,7 @@
 
 #include "calib/camera/camera.h"
 #include "calib/camera/camera_model_json.h"
+#include "calib/core/finding.h"
 #include "calib/core/result_file.h"
 #include "calib/problem/problem_builder.h"
 #include "calib/problem/suspect_effect.h"
@@ -214,14 +215,9 @@ struct Determinability {
   bool determinable() const { return covariance_ok; }
 };
 
-/// A finding that makes a result doubtful, by name, for people and programs (JSON `warnings`:
+/// A finding that makes a result doubtful, by name (calib/core/finding.h; JSON `warnings`:
 /// [{name, subject, value, limit, message}]).
-struct ResultWarning {
-  std::string name;     // kWarningGroupRms, ...
-  std::string subject;  // what it is about (for kWarningGroupRms the residual group)
-  double value = 0, limit = 0;
-  std::string message;  // one sentence for people
-};
+using ResultWarning = Finding;
 
 /// Name of the warning for a residual group whose RMS in a-priori sigmas exceeds the limit: the
 /// model does not fit those observations (or their sigmas are far too small).

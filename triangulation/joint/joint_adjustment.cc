@@ -5,6 +5,7 @@
 #include "calib/core/median.h"
 #include "calib/core/string_printf.h"
 #include "stitch/adjustment/frame_measurements.h"
+#include "stitch/adjustment/mapping_param_names.h"
 #include "stitch/adjustment/stitch_adjustment.h"
 #include "stitch/simulation/stitch_simulator.h"
 #include "triangulation/adjustment/block_adjustment.h"
@@ -93,6 +94,7 @@ nlohmann::json JointResultToJson(const JointResult& result) {
     nlohmann::json s = {{"id", m.subimage},
                         {"camera", m.camera},
                         {"model", std::string(calib::MappingModelName(m.model))},
+                        {"param_names", stitch::MappingParamNames(m.model)},
                         {"params", m.params},
                         {"sigma", m.sigma},
                         {"initial", m.initial},

@@ -4,6 +4,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/problem/solve_statistics_json.h"
 #include "calib/residuals/prior.h"
 #include "triangulation/pushbroom/line_degree_choice.h"
 #include "triangulation/sensor/frame_camera.h"
@@ -1042,9 +1043,7 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
   j["kind"] = "pushbroom";
   j["sigma0"] = r.report.sigma0;
   j["sigma0_px"] = r.sigma0_px;
-  j["redundancy"] = r.report.redundancy;
-  j["iterations"] = r.report.iterations;
-  j["converged"] = r.report.converged;
+  j.update(calib::SolveStatisticsToJson(r.report));  // redundancy .. seconds, groups
   j["valid"] = r.valid;
   j["n_observations"] = r.n_observations;
   j["n_control"] = r.n_control;
@@ -1145,18 +1144,7 @@ nlohmann::json LineCalibrationToJson(const LineCalibrationResult& r) {
   for (const auto& [name, rho] : r.correlations) corr[name] = rho;
   j["correlations"] = corr;
   j["undetermined"] = r.undetermined;
-  json warnings = json::array();
-  for (const auto& w : r.warnings)
-    warnings.push_back({{"name", w.name},
-                        {"subject", w.subject},
-                        {"value", w.value},
-                        {"limit", w.limit},
-                        {"message", w.message}});
-  j["warnings"] = warnings;
-  json groups = json::array();
-  for (const auto& g : r.report.groups)
-    groups.push_back({{"name", g.name}, {"n", g.n_observations}, {"rms", g.rms}});
-  j["groups"] = groups;
+  j["warnings"] = FindingsToJson(r.warnings);
   return j;
 }
 

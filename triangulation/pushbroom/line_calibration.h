@@ -31,6 +31,7 @@
 #pragma once
 
 #include "calib/camera/line_camera.h"
+#include "calib/core/finding.h"
 #include "calib/problem/problem_builder.h"
 #include "triangulation/block/block.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
@@ -91,11 +92,7 @@ struct LineObservation {
   int source_line = 0;
 };
 
-struct LineWarning {
-  std::string name, subject;
-  double value = 0.0, limit = 0.0;
-  std::string message;
-};
+using LineWarning = Finding;  // calib/core/finding.h
 
 struct SubcameraRms {
   std::string id;

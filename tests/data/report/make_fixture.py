@@ -142,7 +142,7 @@ def main():
             a["mapping_interior_correlations"] = []
         adjustments.append(a)
 
-    doc = {"kind": "flight", "schema_version": 1, "aerocal_version": "0.1.0", "camera": "data/camera_nominal.yaml", "data": "data",
+    doc = {"kind": "flight", "schema_version": 2, "aerocal_version": "0.1.0", "camera": "data/camera_nominal.yaml", "data": "data",
            "camera_format": {"width_px": W, "height_px": H, "pixel_size_mm": p},
            "stitching": stitch, "adjustments": adjustments}
     # The project facts of the flight result (tools/report/report_facts.py), as the writer states them.

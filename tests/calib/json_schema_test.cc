@@ -1,0 +1,129 @@
+// The JSON-Schema subset of calib/core/json_schema.h: references to another schema file (bundled
+// by ReadJsonSchema), allOf, "#" (the whole schema); the finding type every result's `warnings`
+// uses (calib/core/finding.h) and the list of result kinds (calib/core/result_file.h).
+#include "calib/core/json_schema.h"
+
+#include "calib/core/error.h"
+#include "calib/core/finding.h"
+#include "calib/core/result_file.h"
+#include "calib/problem/solve_statistics_json.h"
+#include "tests/support/test_support.h"
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <fstream>
+#include <map>
+#include <string>
+
+namespace aerocal {
+namespace {
+
+using nlohmann::json;
+
+void Write(const std::string& path, const json& j) { std::ofstream(path) << j.dump(); }
+
+// The InputError text of ValidateJson, "" when the document validates.
+std::string Refusal(const json& document, const json& schema) {
+  try {
+    ValidateJson(document, schema, "r.json");
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(JsonSchema, ResolvesDefinitionsOfAnotherFileAndTheirOwnReferences) {
+  testing::TempDir dir("aerocal_json_schema");
+  Write(dir.File("common.schema.json"),
+        {{"definitions",
+          {{"sigma", {{"type", {"number", "null"}}, {"minimum", 0}}},
+           {"pair", {{"type", "array"}, {"items", {{"$ref", "#/definitions/sigma"}}}}}}}});
+  Write(dir.File("inner.schema.json"),
+        {{"type", "object"},
+         {"required", {"n"}},
+         {"properties", {{"n", {{"type", "integer"}}}, {"self", {{"$ref", "#"}}}}}});
+  Write(dir.File("kind.schema.json"),
+        {{"type", "object"},
+         {"additionalProperties", false},
+         {"properties",
+          {{"s", {{"$ref", "common.schema.json#/definitions/pair"}}},
+           {"inner", {{"$ref", "inner.schema.json"}}},
+           {"both", {{"allOf", {{{"type", "integer"}}, {{"minimum", 2}}}}}}}}});
+  const json schema = ReadJsonSchema(dir.File("kind.schema.json"));
+  EXPECT_EQ(Refusal({{"s", {0.1, nullptr}}, {"inner", {{"n", 1}}}, {"both", 3}}, schema), "");
+  // A reference inside the other file resolves within that file ("#/definitions/sigma").
+  EXPECT_EQ(Refusal({{"s", {-1.0}}}, schema), "r.json: s[0]: must be >= 0 (got -1.0)");
+  // "#" inside inner.schema.json is inner's whole schema, not kind's.
+  EXPECT_EQ(Refusal({{"inner", {{"n", 1}, {"self", {{"m", 1}}}}}}, schema),
+            "r.json: inner.self.n: missing");
+  EXPECT_EQ(Refusal({{"both", 1}}, schema), "r.json: both: must be >= 2 (got 1)");
+  EXPECT_EQ(Refusal({{"other", 1}}, schema), "r.json: other: not allowed here (got 1)");
+  // A reference to a file that is not there: an installation fault (LogicError), not bad input.
+  Write(dir.File("broken.schema.json"), {{"$ref", "missing.schema.json#/definitions/x"}});
+  EXPECT_THROW(ReadJsonSchema(dir.File("broken.schema.json")), LogicError);
+}
+
+// Every kind a command writes has its schema, and every schema reads (its references resolve).
+TEST(JsonSchema, EveryResultKindHasASchema) {
+  for (std::string_view kind : kResultKinds) {
+    const std::string path = testing::SchemaPath(std::string(kind));
+    ASSERT_TRUE(std::ifstream(path).good()) << kind << " has no schema " << path;
+    const json schema = ReadJsonSchema(path);
+    // The schema names its kind: a document of another kind does not validate.
+    EXPECT_NE(Refusal({{"kind", "not_" + std::string(kind)}}, schema), "") << kind;
+  }
+  EXPECT_THROW(ResultText("no_such_kind", json::object()), LogicError);
+}
+
+TEST(Finding, OneShapeWithNullForAMissingFigure) {
+  const json common = ReadJsonSchema(testing::SchemaPath("common"));
+  const json finding = {{"$ref", "#/definitions/finding"}, {"definitions", common["definitions"]}};
+  const json with = FindingToJson({"group_rms", "image", 4.5, 3.0, "too large"});
+  EXPECT_EQ(with,
+            json({{"name", "group_rms"},
+                  {"subject", "image"},
+                  {"value", 4.5},
+                  {"limit", 3.0},
+                  {"message", "too large"}}));
+  EXPECT_EQ(Refusal(with, finding), "");
+  Finding without{"group_stability", "group 2", NAN, NAN, "group 2: c differs"};
+  const json listed = FindingsToJson({without});
+  ASSERT_EQ(listed.size(), 1u);
+  EXPECT_TRUE(listed[0]["value"].is_null());
+  EXPECT_TRUE(listed[0]["limit"].is_null());
+  EXPECT_EQ(Refusal(listed[0], finding), "");
+}
+
+// The one writer of the solve statistics: the keys and types common.schema.json defines, NaN RMS
+// of an empty group as null.
+TEST(SolveStatistics, KeysOfTheCommonSchema) {
+  calib::SolveReport report;
+  report.converged = true;
+  report.iterations = 4;
+  report.termination = "CONVERGENCE";
+  report.linear_solver = "dense_schur";
+  report.redundancy = 12;
+  report.seconds = 0.5;
+  report.groups = {{"image", 3, 20, 18.0, 0.9486832980505138}, {"gnss", 0, 0, 0.0, NAN}};
+  const json j = calib::SolveStatisticsToJson(report);
+  const json common = ReadJsonSchema(testing::SchemaPath("common"));
+  const std::map<std::string, std::string> definition = {{"redundancy", "redundancy"},
+                                                         {"iterations", "iterations"},
+                                                         {"converged", "converged"},
+                                                         {"termination", "termination"},
+                                                         {"linear_solver", "linear_solver"},
+                                                         {"seconds", "seconds"},
+                                                         {"groups", "residual_groups"}};
+  ASSERT_EQ(j.size(), definition.size()) << j.dump();
+  for (const auto& [key, name] : definition) {
+    const json schema = {{"$ref", "#/definitions/" + name}, {"definitions", common["definitions"]}};
+    EXPECT_EQ(Refusal(j.at(key), schema), "") << key;
+  }
+  EXPECT_EQ(j["groups"][0],
+            json({{"name", "image"}, {"n", 20}, {"rms_sigma", 0.9486832980505138}}));
+  EXPECT_TRUE(j["groups"][1]["rms_sigma"].is_null());
+}
+
+}  // namespace
+}  // namespace aerocal
