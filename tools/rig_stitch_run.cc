@@ -90,8 +90,10 @@ StitchInputs StitchInputsFromProject(const triangulation::Project& project,
     if (added) in.exposures.push_back(StitchExposure(project, *project.FindExposure(o.image)));
     const std::string label =
         fs::path(project.observations_file).filename().string() + ":" + std::to_string(o.line);
-    in.observations.push_back(
-        {it->second, head, tie_index.at(o.point), o.pixel, o.sigma_px, label});
+    // A point observed but not listed in points.csv is a tie, as in the block adjustment.
+    const auto [tie, new_tie] = tie_index.try_emplace(o.point, static_cast<int>(in.ties.size()));
+    if (new_tie) in.ties.push_back({o.point, false});
+    in.observations.push_back({it->second, head, tie->second, o.pixel, o.sigma_px, label});
   }
   if (in.observations.empty())
     throw InputError(project.observations_file + ": no head observations to stitch");
