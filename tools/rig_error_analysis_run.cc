@@ -42,8 +42,10 @@ double ErrorAnalysisHeight(const RigErrorAnalysisRequest& args,
 void CheckErrorAnalysisOptions(const RigErrorAnalysisRequest& args, double height_m) {
   const int modes = !args.target.empty() + !args.virtual_px.empty() + (args.grid > 0);
   if (modes > 1) throw ConfigError("--target, --virtual and --grid exclude each other");
-  if (args.samples < 0) throw ConfigError("--samples must be >= 0");
-  if (args.bins < 1) throw ConfigError("--bins must be >= 1");
+  // The command's CLI11 ranges again, for callers without the command line (Python).
+  if (args.samples < 0 || args.samples > 10000000)
+    throw ConfigError("--samples must be within 0..10000000");
+  if (args.bins < 1 || args.bins > 10000) throw ConfigError("--bins must be within 1..10000");
   if (args.grid < 0 || args.grid > 200) throw ConfigError("--grid must be within 1..200");
   // Every grid target runs its own Monte-Carlo: the work is grid x grid x samples (x heads).
   if (double(args.grid) * args.grid * args.samples > kMaxGridSamples)
@@ -51,7 +53,8 @@ void CheckErrorAnalysisOptions(const RigErrorAnalysisRequest& args, double heigh
                       std::to_string(args.grid) + " x " + std::to_string(args.samples) +
                       " Monte-Carlo samples are more than 1e9 (fewer "
                       "--samples or a coarser --grid)");
-  if (!(args.relief_m >= 0)) throw ConfigError("--relief-m must be >= 0");
+  if (!(args.relief_m >= 0 && args.relief_m <= 1e4))
+    throw ConfigError("--relief-m must be within 0..10000 m");
   if (!(args.relief_m < height_m))
     throw ConfigError("--relief-m: " + FormatNumber(args.relief_m) +
                       " m of relief reaches the flying height (" + FormatNumber(height_m) + " m)");

@@ -480,6 +480,8 @@ def test_rig_error_analysis_equals_the_command(tmp_path):
     assert abs(linear - mc) < 0.15 * linear
     with pytest.raises(ValueError, match="--target"):
         aerocal.rig_error_analysis(camera, limits, target="nohead:1,1")
+    with pytest.raises(ValueError, match="--samples must be within 0..10000000"):
+        aerocal.rig_error_analysis(camera, limits, samples=10**9)
 
 
 def test_calibrate_from_directions_equals_the_command(tmp_path):
