@@ -7,6 +7,8 @@
 // Throwing aerocal::InputError / ConfigError gives exit 2 with "error: FILE:LINE: ..." on stderr.
 #pragma once
 
+#include "tools/exit_codes.h"
+
 #include <CLI/CLI.hpp>
 
 #include <cerrno>
@@ -16,11 +18,6 @@
 #include <vector>
 
 namespace aerocal::tools {
-
-inline constexpr int kExitOk = 0;
-inline constexpr int kExitInternal = 1;
-inline constexpr int kExitBadInput = 2;
-inline constexpr int kExitNotConverged = 3;
 
 /// Check of a random seed option: decimal digits only, within 0 .. 2^64 - 1 (CLI11 itself turns
 /// "-1" into 2^64 - 1 and accepts a value past 2^64).

@@ -7,11 +7,13 @@
 #include "tools/calibrate_directions.h"
 #include "tools/calibrate_request.h"
 #include "tools/certificate_writer.h"
+#include "tools/exit_codes.h"
 #include "tools/python/bindings.h"
 
 #include <filesystem>
 #include <pybind11/stl.h>
 #include <stdexcept>
+#include <utility>
 
 namespace aerocal::python {
 namespace {
@@ -25,6 +27,16 @@ struct CalibrationResult {
 
 std::string Text(const py::object& value) {
   return value.is_none() ? "" : py::str(value).cast<std::string>();
+}
+
+// The result of a calibration as the command has it: its document's text, and the file `out`
+// when given (either way of calibrating ends here).
+CalibrationResult Finished(tools::CalibrateOutcome outcome, const std::string& out) {
+  CalibrationResult result;
+  result.outcome = std::move(outcome);
+  result.json = ResultText("adjust", result.outcome.doc);
+  if (!out.empty()) WriteResult(out, "adjust", result.outcome.doc);
+  return result;
 }
 
 CalibrationResult Calibrate(const std::string& camera,
@@ -73,14 +85,8 @@ CalibrationResult Calibrate(const std::string& camera,
     args.model = Text(model);
     args.sigma_px = sigma_px;
     args.radii_mm = radii_mm;
-    CalibrationResult result;
-    {
-      py::gil_scoped_release release;
-      result.outcome = tools::CalibrateFromDirections(args);
-    }
-    result.json = ResultText("adjust", result.outcome.doc);
-    if (!args.out.empty()) WriteResult(args.out, "adjust", result.outcome.doc);
-    return result;
+    py::gil_scoped_release release;
+    return Finished(tools::CalibrateFromDirections(args), args.out);
   }
   tools::CalibrateRequest request;
   request.camera = camera;
@@ -102,14 +108,8 @@ CalibrationResult Calibrate(const std::string& camera,
   request.camera_format = camera_format;
   request.write_marks = Text(write_marks);
   request.out = Text(out);
-  CalibrationResult result;
-  {
-    py::gil_scoped_release release;
-    result.outcome = tools::RunCalibration(request);
-  }
-  result.json = ResultText("adjust", result.outcome.doc);
-  if (!request.out.empty()) WriteResult(request.out, "adjust", result.outcome.doc);
-  return result;
+  py::gil_scoped_release release;
+  return Finished(tools::RunCalibration(request), request.out);
 }
 
 // `aerocal certificate`: the files written into `out` as the command writes them; the exit code
@@ -134,7 +134,7 @@ py::tuple Certificate(const std::string& result,
     py::gil_scoped_release release;
     code = tools::WriteCertificate(args);
   }
-  if (code == 1)  // kExitInternal (tools/command_registry.h)
+  if (code == tools::kExitInternal)
     throw std::runtime_error("certificate: the renderer failed (nothing written into " + out +
                              "; the message is on stderr)");
   const std::string path = (std::filesystem::path(out) / "certificate.json").string();
