@@ -259,13 +259,11 @@ RigDesign DesignRig(const calib::Rig& rig, double height_m, int grid_cells) {
   return d;
 }
 
-std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
-  // Ground metres of a virtual pixel (level nadir virtual camera: x -> X, y up -> Y).
-  const calib::VirtualCamera& v = rig.virtual_camera;
-  const auto ground = [&](const Eigen::Vector2d& px) {
-    const Eigen::Vector2d xy = v.PhotoFromPixel(px) - Eigen::Vector2d(v.x0_mm, v.y0_mm);
-    return Eigen::Vector2d(xy * d.height_m / v.c_mm);
-  };
+namespace {
+
+// The footprints' panel: ground metres (X right, Y up) on axes, 800 SVG pixels along the longer
+// side of the footprints' extent plus a 5 % margin, room for the axes' labels.
+SvgPanel FootprintPanel(const RigDesign& d) {
   Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo;
   for (const auto& head : d.heads)
     for (const auto& p : head.footprint_m) {
@@ -275,16 +273,18 @@ std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
   const double margin = 0.05 * (hi - lo).maxCoeff();
   lo -= Eigen::Vector2d::Constant(margin);
   hi += Eigen::Vector2d::Constant(margin);
-  // Ground metres on axes (X right, Y up), 800 SVG pixels along the longer side, a margin for
-  // the axes' labels and a scale bar under them.
   const double scale = 800.0 / (hi - lo).maxCoeff();
   SvgPanel panel;
   panel.left = 80, panel.width = (hi.x() - lo.x()) * scale,
   panel.height = (hi.y() - lo.y()) * scale;
   panel.bottom = 40 + panel.height;
   panel.x_lo = lo.x(), panel.x_hi = hi.x(), panel.y_lo = lo.y(), panel.y_hi = hi.y();
-  const auto sx = [&](const Eigen::Vector2d& p) { return panel.X(p.x()); };
-  const auto sy = [&](const Eigen::Vector2d& p) { return panel.Y(p.y()); };
+  return panel;
+}
+
+// The SVG's opening, title, axes, scale bar and legend.
+std::string FootprintSvgHead(const calib::Rig& rig, const RigDesign& d, const SvgPanel& panel) {
+  const double metres_per_svg_px = (panel.x_hi - panel.x_lo) / panel.width;
   std::ostringstream out;
   out << StringPrintf(
       "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"%.0f\" height=\"%.0f\" "
@@ -298,12 +298,29 @@ std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
       SvgEscape(rig.name).c_str(),
       d.height_m);
   out << SvgAxes(panel, "X (m, from the nadir point)", "Y (m)")
-      << SvgScaleBar(panel.left, panel.bottom + 70, 1.0 / scale, 0.4 * panel.width, "m")
+      << SvgScaleBar(panel.left, panel.bottom + 70, metres_per_svg_px, 0.4 * panel.width, "m")
       << StringPrintf(
              "<text x=\"%.1f\" y=\"%.1f\">dashed: the virtual format; bold: the effective "
              "format; dots: standard tie positions</text>\n",
              panel.left,
              panel.bottom + 95);
+  return out.str();
+}
+
+}  // namespace
+
+std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
+  // Ground metres of a virtual pixel (level nadir virtual camera: x -> X, y up -> Y).
+  const calib::VirtualCamera& v = rig.virtual_camera;
+  const auto ground = [&](const Eigen::Vector2d& px) {
+    const Eigen::Vector2d xy = v.PhotoFromPixel(px) - Eigen::Vector2d(v.x0_mm, v.y0_mm);
+    return Eigen::Vector2d(xy * d.height_m / v.c_mm);
+  };
+  const SvgPanel panel = FootprintPanel(d);
+  const auto sx = [&](const Eigen::Vector2d& p) { return panel.X(p.x()); };
+  const auto sy = [&](const Eigen::Vector2d& p) { return panel.Y(p.y()); };
+  std::ostringstream out;
+  out << FootprintSvgHead(rig, d, panel);
   const char* colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b"};
   for (size_t k = 0; k < d.heads.size(); ++k) {
     out << "<polygon fill=\"" << colours[k % 6] << "\" fill-opacity=\"0.2\" stroke=\""
