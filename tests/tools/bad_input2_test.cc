@@ -46,14 +46,14 @@ void ReplaceFirst(const std::string& path, const std::string& from, const std::s
 
 // A simulated data set (`simulate --out NAME OPTIONS`), made once, copied into `d`/NAME.
 std::string Simulated(const TempDir& d, const std::string& name, const std::string& options) {
-  static TempDir* base = new TempDir("aerocal_bad_input2_base");
+  static TempDir base("aerocal_bad_input2_base");
   static std::map<std::string, bool> made;
   if (!made[name]) {
-    const auto r = RunAerocal("simulate --out " + base->File(name) + " " + options);
+    const auto r = RunAerocal("simulate --out " + base.File(name) + " " + options);
     EXPECT_EQ(r.exit_code, 0) << r.output;
     made[name] = true;
   }
-  fs::copy(base->File(name), d.File(name), fs::copy_options::recursive);
+  fs::copy(base.File(name), d.File(name), fs::copy_options::recursive);
   return d.File(name);
 }
 std::string Flight(const TempDir& d) {
@@ -75,15 +75,15 @@ std::string CalibrateArgs(const std::string& tf, const std::string& out) {
 
 // A calibrate result of the test field (made once), copied to `path`.
 void CalibrateResult(const std::string& path) {
-  static TempDir* base = new TempDir("aerocal_bad_input2_cal");
+  static TempDir base("aerocal_bad_input2_cal");
   static const bool made = [] {
-    const std::string tf = TestField(*base);
-    const auto r = RunAerocal(CalibrateArgs(tf, base->File("cal.json")));
+    const std::string tf = TestField(base);
+    const auto r = RunAerocal(CalibrateArgs(tf, base.File("cal.json")));
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return true;
   }();
   (void)made;
-  fs::copy_file(base->File("cal.json"), path, fs::copy_options::overwrite_existing);
+  fs::copy_file(base.File("cal.json"), path, fs::copy_options::overwrite_existing);
 }
 
 // Edits the JSON document in `path`.

@@ -73,17 +73,17 @@ void SetField(const std::string& path, int line, int col, const std::string& val
 
 // The small simulated flight every CLI case starts from (made once).
 const std::string& BaseFlight() {
-  static TempDir* dir = new TempDir("aerocal_bad_input_base");
+  static TempDir dir("aerocal_bad_input_base");
   static const bool made = [] {
     const auto r =
-        RunAerocal("simulate --out " + dir->File("sim") +
+        RunAerocal("simulate --out " + dir.File("sim") +
                    " --exposures 6 --strips 1 --surveyed-points 12 --control 6 --tie-points 40 "
                    "--stitch-ties 60");
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return true;
   }();
   (void)made;
-  static const std::string path = dir->File("sim");
+  static const std::string path = dir.File("sim");
   return path;
 }
 
@@ -96,14 +96,14 @@ std::string Flight(const TempDir& d) {
 // A copy of a simulated pushbroom flight (`simulate --pushbroom`) or dual-lens rig flight
 // (`simulate --rig dual-lens`), each simulated once, in the fresh folder `d`/`name`.
 std::string SimulatedCopy(const TempDir& d, const std::string& name, const std::string& options) {
-  static TempDir* base = new TempDir("aerocal_bad_input_kinds");
+  static TempDir base("aerocal_bad_input_kinds");
   static std::map<std::string, bool> made;
   if (!made[name]) {
-    const auto r = RunAerocal("simulate --out " + base->File(name) + " " + options);
+    const auto r = RunAerocal("simulate --out " + base.File(name) + " " + options);
     EXPECT_EQ(r.exit_code, 0) << r.output;
     made[name] = true;
   }
-  fs::copy(base->File(name), d.File(name), fs::copy_options::recursive);
+  fs::copy(base.File(name), d.File(name), fs::copy_options::recursive);
   return d.File(name);
 }
 std::string PushbroomFlight(const TempDir& d) { return SimulatedCopy(d, "pb", "--pushbroom"); }

@@ -28,8 +28,8 @@ using testing::TempDir;
 
 // One simulated line of 3 exposures (seed 5), made once; each test copies it.
 const std::string& Line() {
-  static TempDir* dir = new TempDir("aerocal_rig_stitch_line");
-  static const std::string path = dir->File("uav4");
+  static TempDir dir("aerocal_rig_stitch_line");
+  static const std::string path = dir.File("uav4");
   static const bool made = [] {
     const auto r = RunAerocal("simulate --rig uav4 --exposures 3 --seed 5 --out " + path);
     EXPECT_EQ(r.exit_code, 0) << r.output;
