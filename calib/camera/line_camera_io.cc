@@ -82,6 +82,131 @@ void EmitVector3(YAML::Emitter& out, const std::string& key, const Eigen::Vector
 
 bool IsLineCameraFile(const YAML::Node& root) { return root.IsMap() && root["line"]; }
 
+namespace {
+
+// line.subcameras: consecutive detector ranges covering line.detectors, each with its c, pitch
+// and mount.
+void ReadSubcameras(const YAML::Node& line, const std::string& file, LineCamera* camera) {
+  if (const YAML::Node& subs = line["subcameras"]) {
+    if (!subs.IsSequence() || subs.size() == 0)
+      ThrowInputError(WhereIs(subs, file), "line.subcameras must be a non-empty list");
+    int next = 0;
+    for (const auto& node : subs) {
+      if (!node.IsMap()) ThrowInputError(WhereIs(node, file), "a sub-camera is a map");
+      RejectUnknownKeys(node, {"id", "detectors", "c", "pitch_mm", "mount_deg"}, file);
+      for (const char* key : {"id", "detectors", "c", "pitch_mm"})
+        if (!node[key])
+          ThrowInputError(WhereIs(node, file), std::string("sub-camera: missing ") + key);
+      LineSubcamera s;
+      s.id = YamlString(node["id"], file, "id");
+      if (s.id.empty())
+        ThrowInputError(WhereIs(node["id"], file), "sub-camera id must not be empty");
+      for (const auto& other : camera->subcameras)
+        if (other.id == s.id)
+          ThrowInputError(WhereIs(node["id"], file), "duplicate sub-camera id '" + s.id + "'");
+      const int n = YamlInt(node["detectors"], file, "sub-camera detectors");
+      if (n < 1 || n > camera->detectors - next)
+        ThrowInputError(WhereIs(node["detectors"], file),
+                        "sub-camera " + s.id + ": detectors must be within 1 .. " +
+                            std::to_string(camera->detectors - next) +
+                            " (the detectors line.detectors leaves; got " + std::to_string(n) +
+                            ")");
+      s.first = next;
+      s.last = next + n - 1;
+      next += n;
+      s.c_mm = ReadPositive(node["c"], file, "sub-camera c", 0.0, kMaxCMm);
+      s.pitch_mm =
+          ReadPositive(node["pitch_mm"], file, "sub-camera pitch_mm", kMinPitchMm, kMaxPitchMm);
+      if (node["mount_deg"])
+        s.mount_rad =
+            YamlVector3(
+                node["mount_deg"], file, "sub-camera mount_deg", -kMaxAngleDeg, kMaxAngleDeg) *
+            kRadPerDeg;
+      camera->subcameras.push_back(s);
+    }
+    if (next != camera->detectors)
+      ThrowInputError(WhereIs(subs, file),
+                      "line.subcameras hold " + std::to_string(next) +
+                          " detectors, line.detectors is " + std::to_string(camera->detectors));
+  }
+}
+
+// line.dx_mm / line.dy_mm: a correction per detector, both tables or none, not beside
+// line.calibration.
+void ReadCorrectionTables(const YAML::Node& line, const std::string& file, LineCamera* camera) {
+  const bool has_table = line["dx_mm"] || line["dy_mm"];
+  if (has_table && line["calibration"])
+    ThrowInputError(WhereIs(line["calibration"], file),
+                    "give either dx_mm/dy_mm tables or calibration polynomials, not both");
+  if (has_table) {
+    for (const char* key : {"dx_mm", "dy_mm"}) {
+      if (!line[key])
+        ThrowInputError(WhereIs(line, file),
+                        std::string("line: missing ") + key + " (the tables come in pairs)");
+      std::vector<double> values =
+          ReadNumbers(line[key], file, std::string("line.") + key, size_t(camera->detectors));
+      if (int(values.size()) != camera->detectors)
+        ThrowInputError(WhereIs(line[key], file),
+                        std::string("line.") + key + " must hold line.detectors (" +
+                            std::to_string(camera->detectors) + ") values (got " +
+                            std::to_string(values.size()) + ")");
+      (std::string(key) == "dx_mm" ? camera->dx_mm : camera->dy_mm) = std::move(values);
+    }
+  }
+}
+
+// line.calibration: polynomial ranges contiguous from detector 0 to the last, none across a
+// sub-camera seam.
+void ReadCalibrationRanges(const YAML::Node& line, const std::string& file, LineCamera* camera) {
+  if (const YAML::Node& cal = line["calibration"]) {
+    if (!cal.IsSequence() || cal.size() == 0)
+      ThrowInputError(WhereIs(cal, file), "line.calibration must be a non-empty list");
+    int next = 0;
+    for (const auto& node : cal) {
+      if (!node.IsMap()) ThrowInputError(WhereIs(node, file), "a calibration range is a map");
+      RejectUnknownKeys(node, {"first", "last", "dx", "dy"}, file);
+      for (const char* key : {"first", "last"})
+        if (!node[key])
+          ThrowInputError(WhereIs(node, file), std::string("calibration: missing ") + key);
+      LinePolynomial p;
+      p.first = YamlInt(node["first"], file, "first");
+      p.last = YamlInt(node["last"], file, "last");
+      if (p.first != next || p.last < p.first || p.last >= camera->detectors)
+        ThrowInputError(
+            WhereIs(node, file),
+            "calibration ranges must be contiguous from detector 0 to line.detectors - 1 (got [" +
+                std::to_string(p.first) + ", " + std::to_string(p.last) +
+                "], expected first = " + std::to_string(next) + ")");
+      next = p.last + 1;
+      if (node["dx"]) p.dx = ReadNumbers(node["dx"], file, "calibration dx", kMaxPolynomialTerms);
+      if (node["dy"]) p.dy = ReadNumbers(node["dy"], file, "calibration dy", kMaxPolynomialTerms);
+      camera->calibration.push_back(p);
+      if (!camera->subcameras.empty() &&
+          camera->SubcameraOf(p.first) != camera->SubcameraOf(p.last))
+        ThrowInputError(WhereIs(node, file),
+                        "calibration range [" + std::to_string(p.first) + ", " +
+                            std::to_string(p.last) + "] spans a sub-camera seam");
+    }
+    if (next != camera->detectors)
+      ThrowInputError(WhereIs(cal, file),
+                      "calibration ranges end at detector " + std::to_string(next - 1) +
+                          ", expected " + std::to_string(camera->detectors - 1));
+  }
+}
+
+// line.line_axis: the file's frame (y: the patent's, line along y) converted to ours.
+void ReadLineAxis(const YAML::Node& line, const std::string& file, LineCamera* camera) {
+  if (const YAML::Node& axis = line["line_axis"]) {
+    const std::string value = YamlString(axis, file, "line.line_axis");
+    if (value != "x" && value != "y")
+      ThrowInputError(WhereIs(axis, file), "line.line_axis must be x or y (got " + value + ")");
+    camera->file_line_along_y = value == "y";
+    if (camera->file_line_along_y) ConvertLineAxis(camera, true);
+  }
+}
+
+}  // namespace
+
 LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
   if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
   RejectUnknownKeys(root, {"name", "line"}, file);
@@ -119,108 +244,11 @@ LineCamera ParseLineCamera(const YAML::Node& root, const std::string& file) {
     camera.lever_arm_m =
         YamlVector3(line["lever_arm_m"], file, "line.lever_arm_m", -kMaxLeverArmM, kMaxLeverArmM);
 
-  if (const YAML::Node& subs = line["subcameras"]) {
-    if (!subs.IsSequence() || subs.size() == 0)
-      ThrowInputError(WhereIs(subs, file), "line.subcameras must be a non-empty list");
-    int next = 0;
-    for (const auto& node : subs) {
-      if (!node.IsMap()) ThrowInputError(WhereIs(node, file), "a sub-camera is a map");
-      RejectUnknownKeys(node, {"id", "detectors", "c", "pitch_mm", "mount_deg"}, file);
-      for (const char* key : {"id", "detectors", "c", "pitch_mm"})
-        if (!node[key])
-          ThrowInputError(WhereIs(node, file), std::string("sub-camera: missing ") + key);
-      LineSubcamera s;
-      s.id = YamlString(node["id"], file, "id");
-      if (s.id.empty())
-        ThrowInputError(WhereIs(node["id"], file), "sub-camera id must not be empty");
-      for (const auto& other : camera.subcameras)
-        if (other.id == s.id)
-          ThrowInputError(WhereIs(node["id"], file), "duplicate sub-camera id '" + s.id + "'");
-      const int n = YamlInt(node["detectors"], file, "sub-camera detectors");
-      if (n < 1 || n > camera.detectors - next)
-        ThrowInputError(WhereIs(node["detectors"], file),
-                        "sub-camera " + s.id + ": detectors must be within 1 .. " +
-                            std::to_string(camera.detectors - next) +
-                            " (the detectors line.detectors leaves; got " + std::to_string(n) +
-                            ")");
-      s.first = next;
-      s.last = next + n - 1;
-      next += n;
-      s.c_mm = ReadPositive(node["c"], file, "sub-camera c", 0.0, kMaxCMm);
-      s.pitch_mm =
-          ReadPositive(node["pitch_mm"], file, "sub-camera pitch_mm", kMinPitchMm, kMaxPitchMm);
-      if (node["mount_deg"])
-        s.mount_rad =
-            YamlVector3(
-                node["mount_deg"], file, "sub-camera mount_deg", -kMaxAngleDeg, kMaxAngleDeg) *
-            kRadPerDeg;
-      camera.subcameras.push_back(s);
-    }
-    if (next != camera.detectors)
-      ThrowInputError(WhereIs(subs, file),
-                      "line.subcameras hold " + std::to_string(next) +
-                          " detectors, line.detectors is " + std::to_string(camera.detectors));
-  }
+  ReadSubcameras(line, file, &camera);
 
-  const bool has_table = line["dx_mm"] || line["dy_mm"];
-  if (has_table && line["calibration"])
-    ThrowInputError(WhereIs(line["calibration"], file),
-                    "give either dx_mm/dy_mm tables or calibration polynomials, not both");
-  if (has_table) {
-    for (const char* key : {"dx_mm", "dy_mm"}) {
-      if (!line[key])
-        ThrowInputError(WhereIs(line, file),
-                        std::string("line: missing ") + key + " (the tables come in pairs)");
-      std::vector<double> values =
-          ReadNumbers(line[key], file, std::string("line.") + key, size_t(camera.detectors));
-      if (int(values.size()) != camera.detectors)
-        ThrowInputError(WhereIs(line[key], file),
-                        std::string("line.") + key + " must hold line.detectors (" +
-                            std::to_string(camera.detectors) + ") values (got " +
-                            std::to_string(values.size()) + ")");
-      (std::string(key) == "dx_mm" ? camera.dx_mm : camera.dy_mm) = std::move(values);
-    }
-  }
-  if (const YAML::Node& cal = line["calibration"]) {
-    if (!cal.IsSequence() || cal.size() == 0)
-      ThrowInputError(WhereIs(cal, file), "line.calibration must be a non-empty list");
-    int next = 0;
-    for (const auto& node : cal) {
-      if (!node.IsMap()) ThrowInputError(WhereIs(node, file), "a calibration range is a map");
-      RejectUnknownKeys(node, {"first", "last", "dx", "dy"}, file);
-      for (const char* key : {"first", "last"})
-        if (!node[key])
-          ThrowInputError(WhereIs(node, file), std::string("calibration: missing ") + key);
-      LinePolynomial p;
-      p.first = YamlInt(node["first"], file, "first");
-      p.last = YamlInt(node["last"], file, "last");
-      if (p.first != next || p.last < p.first || p.last >= camera.detectors)
-        ThrowInputError(
-            WhereIs(node, file),
-            "calibration ranges must be contiguous from detector 0 to line.detectors - 1 (got [" +
-                std::to_string(p.first) + ", " + std::to_string(p.last) +
-                "], expected first = " + std::to_string(next) + ")");
-      next = p.last + 1;
-      if (node["dx"]) p.dx = ReadNumbers(node["dx"], file, "calibration dx", kMaxPolynomialTerms);
-      if (node["dy"]) p.dy = ReadNumbers(node["dy"], file, "calibration dy", kMaxPolynomialTerms);
-      camera.calibration.push_back(p);
-      if (!camera.subcameras.empty() && camera.SubcameraOf(p.first) != camera.SubcameraOf(p.last))
-        ThrowInputError(WhereIs(node, file),
-                        "calibration range [" + std::to_string(p.first) + ", " +
-                            std::to_string(p.last) + "] spans a sub-camera seam");
-    }
-    if (next != camera.detectors)
-      ThrowInputError(WhereIs(cal, file),
-                      "calibration ranges end at detector " + std::to_string(next - 1) +
-                          ", expected " + std::to_string(camera.detectors - 1));
-  }
-  if (const YAML::Node& axis = line["line_axis"]) {
-    const std::string value = YamlString(axis, file, "line.line_axis");
-    if (value != "x" && value != "y")
-      ThrowInputError(WhereIs(axis, file), "line.line_axis must be x or y (got " + value + ")");
-    camera.file_line_along_y = value == "y";
-    if (camera.file_line_along_y) ConvertLineAxis(&camera, true);
-  }
+  ReadCorrectionTables(line, file, &camera);
+  ReadCalibrationRanges(line, file, &camera);
+  ReadLineAxis(line, file, &camera);
   camera.Validate(file);  // the design geometry (every detector looks forward)
   return camera;
 }
