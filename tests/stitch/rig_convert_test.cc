@@ -342,6 +342,26 @@ TEST(RigConvert, DemOfATiltedPlaneIsThatPlane) {
       {"huge.asc",
        "ncols 1000000\nnrows 1000000\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n",
        "huge.asc:2: ncols x nrows = 1e+12 heights"},
+      {"twice.asc",
+       "ncols 2\nnrows 2\nNCOLS 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2\n3 4\n",
+       "twice.asc:3: duplicate header 'ncols'"},
+      {"unknown.asc",
+       "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nzone 33\n1 2\n3 4\n",
+       "unknown.asc:6: unknown header 'zone'"},
+      {"nocell.asc",
+       "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\n1 2\n3 4\n",
+       "nocell.asc:5: missing header 'cellsize'"},
+      {"two.asc", "ncols 2 3\nnrows 2\n", "two.asc:1: header 'ncols' needs one number"},
+      {"rows.asc",
+       "ncols 2\nnrows 3\nxllcorner 0\nyllcorner 0\ncellsize 1\n1.0 2.0\n3.0 4.0\n",
+       "rows.asc:8: expected 3 rows of heights, got 2"},
+      {"wide.asc",
+       "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\n1 2 9\n3 4\n",
+       "wide.asc:6: more than 2 heights"},
+      {"empty.asc",
+       "ncols 2\nnrows 2\nxllcorner 0\nyllcorner 0\ncellsize 1\nNODATA_value -9\n-9 -9\n-9 "
+       "-9\n",
+       "empty.asc: the DEM has no valid height"},
   };
   for (const auto& bad : bad_dems) {
     WriteFileAtomically(dir.File(bad.file), bad.text);
