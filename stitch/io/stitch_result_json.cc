@@ -135,81 +135,86 @@ json FrameResultToJson(const FrameAdjustment& a, const ModelChoice* choice) {
   return j;
 }
 
-json StitchResultToJson(const BatchResult& result, const BatchOptions& options) {
-  AEROCAL_CHECK(!result.frames.empty()) << "stitch result without frames";
-  auto frame_json = [](const FrameRun& run) {
-    return FrameResultToJson(run.adjustment, run.choice ? &*run.choice : nullptr);
-  };
-  if (result.frames.size() == 1) return frame_json(result.frames.front());
+namespace {
 
-  json frames = json::array();
+// The flight's statistics over its frames: sigma0 from the summed v^T P v and redundancy, the
+// a-priori sigma from any frame (sigma0_px / sigma0), the models the frames chose.
+json FlightSummaryJson(const BatchResult& result, calib::MappingModel model) {
   double vtpv = 0;
   int redundancy = 0, iterations = 0;
   bool converged = true;
   std::map<calib::MappingModel, int> chosen;
+  double scale = 0;
   for (const FrameRun& run : result.frames) {
-    frames.push_back(frame_json(run));
     vtpv += run.adjustment.vtpv;
     redundancy += run.adjustment.redundancy;
     iterations = std::max(iterations, run.adjustment.iterations);
     converged = converged && run.adjustment.converged;
     ++chosen[run.adjustment.model];
-  }
-  const calib::MappingModel model = FlightModel(result, options);
-  // Frames' median a-priori sigma: sigma0_px / sigma0 of any frame.
-  double scale = 0;
-  for (const FrameRun& run : result.frames)
     if (run.adjustment.sigma0 > 0) scale = run.adjustment.sigma0_px / run.adjustment.sigma0;
+  }
   const double sigma0 = redundancy > 0 ? std::sqrt(vtpv / redundancy) : 0.0;
-
-  json j = {{"kind", "stitch"},
-            {"sigma0", sigma0},
-            {"sigma0_px", sigma0 * scale},
-            {"redundancy", redundancy},
-            {"iterations", iterations},
-            {"converged", converged},
-            {"model", ModelName(model)},
-            {"n_frames", result.frames.size()}};
   json counts = json::object();
   for (const auto& [m, n] : chosen) counts[ModelName(m)] = n;
-  j["models_chosen"] = counts;
+  return {{"kind", "stitch"},
+          {"sigma0", sigma0},
+          {"sigma0_px", sigma0 * scale},
+          {"redundancy", redundancy},
+          {"iterations", iterations},
+          {"converged", converged},
+          {"model", ModelName(model)},
+          {"n_frames", result.frames.size()},
+          {"models_chosen", counts}};
+}
 
-  // Flight mean mappings of the reported model (base sub-images keep their own).
-  json subimages = json::array();
-  json stability = json::object();
-  json per_model = json::array();
-  for (const ModelStability& s : result.stability) {
-    per_model.push_back(StabilityToJson(s));
-    if (s.model != model) continue;
-    stability["mean_sigma0_px"] = s.mean_sigma0_px;
-    stability["std_sigma0_px"] = s.std_sigma0_px;
-    const FrameAdjustment* first = nullptr;
-    for (const FrameRun& run : result.frames) {
-      if (run.adjustment.model == model) first = &run.adjustment;
-      if (run.choice)
-        for (const auto& c : run.choice->candidates)
-          if (c.model == model && c.determinable) first = &c.adjustment;
-      if (first) break;
-    }
-    for (const SubimageEstimate& e : first->subimages) {
-      json sub = {{"id", e.id}, {"model", ModelName(e.model)}, {"base", e.base}};
-      std::vector<double> params = e.params, sigma(e.params.size(), 0.0);
-      const auto names = MappingParamNames(e.model);
-      for (const auto& p : s.parameters)
-        if (p.subimage == e.id)
-          for (size_t i = 0; i < names.size(); ++i)
-            if (names[i] == p.name) {
-              params[i] = p.mean;
-              sigma[i] = p.std;
-            }
-      sub["param_names"] = names;
-      sub["params"] = params;
-      sub["sigma"] = sigma;
-      subimages.push_back(sub);
-    }
+// The first frame adjustment in `model` (a frame's own or a determinable candidate of its choice).
+const FrameAdjustment* FirstAdjustmentIn(const BatchResult& result, calib::MappingModel model) {
+  for (const FrameRun& run : result.frames) {
+    const FrameAdjustment* found = run.adjustment.model == model ? &run.adjustment : nullptr;
+    if (run.choice)
+      for (const auto& c : run.choice->candidates)
+        if (c.model == model && c.determinable) found = &c.adjustment;
+    if (found) return found;
   }
-  if (!stability.contains("mean_sigma0_px")) {
-    // The reported model was not adjusted in every frame: the spread of the frames' results.
+  return nullptr;
+}
+
+// The flight's mean mappings in the reported model, their sigma the spread over the frames. A
+// base sub-image keeps its own (held: sigma 0); a parameter without a spread has a null sigma.
+json FlightSubimagesJson(const BatchResult& result, const ModelStability& s) {
+  json subimages = json::array();
+  const FrameAdjustment* first = FirstAdjustmentIn(result, s.model);
+  AEROCAL_CHECK(first) << "stability of a model no frame adjusted";
+  for (const SubimageEstimate& e : first->subimages) {
+    const auto names = MappingParamNames(e.model);
+    std::vector<double> params = e.params;
+    json sigma = json::array();
+    for (size_t i = 0; i < e.params.size(); ++i) sigma.push_back(e.base ? json(0.0) : json());
+    for (const auto& p : s.parameters)
+      if (p.subimage == e.id)
+        for (size_t i = 0; i < names.size(); ++i)
+          if (names[i] == p.name) {
+            params[i] = p.mean;
+            sigma[i] = p.std;
+          }
+    subimages.push_back({{"id", e.id},
+                         {"model", ModelName(e.model)},
+                         {"base", e.base},
+                         {"param_names", names},
+                         {"params", params},
+                         {"sigma", sigma}});
+  }
+  return subimages;
+}
+
+// sigma0's mean and spread over the frames (of the reported model's stability, else of the
+// frames' own results when that model was not adjusted in every frame) and every model's.
+json FlightStabilityJson(const BatchResult& result, const ModelStability* reported) {
+  json stability = json::object();
+  if (reported) {
+    stability["mean_sigma0_px"] = reported->mean_sigma0_px;
+    stability["std_sigma0_px"] = reported->std_sigma0_px;
+  } else {
     double mean = 0, var = 0;
     const double n = static_cast<double>(result.frames.size());
     for (const FrameRun& run : result.frames) mean += run.adjustment.sigma0_px / n;
@@ -218,9 +223,30 @@ json StitchResultToJson(const BatchResult& result, const BatchOptions& options) 
     stability["mean_sigma0_px"] = mean;
     stability["std_sigma0_px"] = std::sqrt(var);
   }
+  json per_model = json::array();
+  for (const ModelStability& s : result.stability) per_model.push_back(StabilityToJson(s));
   stability["models"] = per_model;
-  j["subimages"] = subimages;
-  j["stability"] = stability;
+  return stability;
+}
+
+}  // namespace
+
+json StitchResultToJson(const BatchResult& result, const BatchOptions& options) {
+  AEROCAL_CHECK(!result.frames.empty()) << "stitch result without frames";
+  auto frame_json = [](const FrameRun& run) {
+    return FrameResultToJson(run.adjustment, run.choice ? &*run.choice : nullptr);
+  };
+  if (result.frames.size() == 1) return frame_json(result.frames.front());
+
+  const calib::MappingModel model = FlightModel(result, options);
+  json j = FlightSummaryJson(result, model);
+  const ModelStability* reported = nullptr;
+  for (const ModelStability& s : result.stability)
+    if (s.model == model) reported = &s;
+  j["subimages"] = reported ? FlightSubimagesJson(result, *reported) : json::array();
+  j["stability"] = FlightStabilityJson(result, reported);
+  json frames = json::array();
+  for (const FrameRun& run : result.frames) frames.push_back(frame_json(run));
   j["frames"] = frames;
   return j;
 }
