@@ -22,7 +22,19 @@
 // are then exact), whitened in pixels at the nominal ray (c and the table at their start values):
 //   r = S a,   S = -diag(1 / sigma_xy_mm) A^-1   (LineRayAngleWhitening)              [2, unitless]
 // which equals ((x - (-c U / W)) / sigma_x_mm, (y - (-c V / W)) / sigma_y_mm), the focal-plane
-// residual of the one collinearity condition, to first order at the nominal ray.
+// residual of the one collinearity condition, to first order at the nominal ray; then each
+// component is put into the units of the measurement at the CURRENT values, a detector index
+// across and a scan line along (sigma_px is a sigma in those units):
+//   r_x *= rho_0 / rho,   rho = |l_perp| / |d|   (the angle per detector; LineAnglePerIndex)
+//   r_y *= |g| / |g_0|                           (a line is the platform's motion per line seen
+//                                                 from the range |g|: an angle ~ 1 / |g|)
+// with rho_0, |g_0| at the start values (both factors 1 there). Both are invariant under the
+// gauges (a rotation of camera + table, a scale of c with the table). Why (issue 28; module README
+// "Datum", "The free lever arm"): with the weight fixed at the start's angles, a raised camera
+// (lever arm z, height) with the table shrunk by H / (H + dz) sees the ground through the same
+// rays but every measured detector and line as a smaller angle: the whole noise part E of
+// v^T P v shrank by 2 E dz / H, and the free lever arm's z went to dz ~ sigma_z^2 E / H (+32.8 m,
+// 6 sigma, on every one of 25 flights).
 // sigma_x_mm = sigma_px |d x_design / d i| (the local detector spacing in the virtual focal plane:
 // up to 1 / cos^2 of the look angle times the pitch for a tilted sub-camera), sigma_y_mm =
 // sigma_px |d y / d t| (the image motion of one scan line), so that a measurement's sigma in
@@ -76,6 +88,9 @@ inline int SplineNodeCount(double last_line, int spacing) {
 /// Where a measured detector position lies on the table (start values) and the principal distance
 /// its residual is weighted at.
 struct LineDetectorGeometry {
+  // The range (m) from the camera to the point at the start values; 0: the along-track residual
+  // is not rescaled to the current range (header comment).
+  double nominal_range_m = 0.0;
   Eigen::Vector2d xy_mm = Eigen::Vector2d::Zero();     // design (+ the file's calibration), mm
   Eigen::Vector2d slope_mm = Eigen::Vector2d::Zero();  // its derivative in the index, mm / detector
   double u = 0.0;                                      // normalised index in its sub-camera
@@ -114,7 +129,11 @@ struct LineCollinearityResidual : AutoDiffResidual<LineCollinearityResidual,
         opk_{pos_opk_rad.x(), pos_opk_rad.y(), pos_opk_rad.z()},
         center_{pos_center_m.x(), pos_center_m.y(), pos_center_m.z()},
         velocity_{pos_velocity_m_s.x(), pos_velocity_m_s.y(), pos_velocity_m_s.z()},
-        opk_rate_{pos_opk_rate_rad_s.x(), pos_opk_rate_rad_s.y(), pos_opk_rate_rad_s.z()} {
+        opk_rate_{pos_opk_rate_rad_s.x(), pos_opk_rate_rad_s.y(), pos_opk_rate_rad_s.z()},
+        nominal_range_m_(detector.nominal_range_m) {
+    const double nominal_ray[3] = {detector.xy_mm.x(), detector.xy_mm.y(), -detector.nominal_c_mm};
+    const double nominal_line[3] = {detector.slope_mm.x(), detector.slope_mm.y(), 0.0};
+    nominal_angle_per_detector_ = LineAnglePerIndex(nominal_ray, nominal_line);
     const Eigen::Matrix2d s = LineRayAngleWhitening(
         Eigen::Vector3d(detector.xy_mm.x(), detector.xy_mm.y(), -detector.nominal_c_mm),
         Eigen::Vector3d(detector.slope_mm.x(), detector.slope_mm.y(), 0.0),
@@ -167,8 +186,14 @@ struct LineCollinearityResidual : AutoDiffResidual<LineCollinearityResidual,
         T(0.0)};
     T angle[2];
     if (!LineRayAngle(ray, line_direction, v, angle)) return false;
-    r[0] = whitening_[0] * angle[0] + whitening_[1] * angle[1];
-    r[1] = whitening_[2] * angle[0] + whitening_[3] * angle[1];
+    // In detector indices and lines at the current values (header comment).
+    const T across = nominal_angle_per_detector_ / LineAnglePerIndex(ray, line_direction);
+    using std::sqrt;
+    const T along = nominal_range_m_ > 0.0
+                        ? sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]) / nominal_range_m_
+                        : T(1.0);
+    r[0] = across * (whitening_[0] * angle[0] + whitening_[1] * angle[1]);
+    r[1] = along * (whitening_[2] * angle[0] + whitening_[3] * angle[1]);
     return true;
   }
 
@@ -178,7 +203,9 @@ struct LineCollinearityResidual : AutoDiffResidual<LineCollinearityResidual,
   std::array<double, 4> weights_;
   double opk_[3], center_[3];
   double velocity_[3], opk_rate_[3];
-  std::array<double, 4> whitening_;  // S, row-major (line_ray_angle.h)
+  std::array<double, 4> whitening_;          // S, row-major (line_ray_angle.h)
+  double nominal_range_m_;                   // |g_0|, m (0: along not rescaled)
+  double nominal_angle_per_detector_ = 0.0;  // rho_0 (rad per detector index)
 };
 
 }  // namespace aerocal::calib

@@ -17,8 +17,9 @@
 // e. A frame from the camera's fixed axes (x, y) would turn with the camera but not with the
 // table's rotation gauge (which moves the table, not the axes): it leaves a b |a| term.
 //
-// Whitening (LineRayAngleWhitening): pixels at a FIXED nominal ray (the start value of c and of
-// the table), so sigma_px keeps its meaning and the weight does not move with c. Moving the ground
+// Whitening (LineRayAngleWhitening): pixels at the nominal ray (the start value of c and of the
+// table); LineCollinearityResidual then rescales each component to the CURRENT angle per detector
+// (LineAnglePerIndex) and per line (line_collinearity.h: why). Moving the ground
 // ray's focal-plane intersection by delta = (dx, dy) gives a = A delta + O(delta^2), A = [u1_xy;
 // u2_xy] / |d|, while the focal-plane residual (observed - projected) is -delta; so
 // r = S a with S = -diag(1 / sigma_xy_mm) A^-1 equals the whitened focal-plane residual to first
@@ -64,6 +65,20 @@ bool LineRayAngle(const T* ray, const T* line_direction, const T* to_point, T* a
   angle[0] = internal::Dot3(u1, to_point) / depth;
   angle[1] = internal::Dot3(u2, to_point) / depth;
   return true;
+}
+
+/// The angle (rad) one detector index subtends across the line at this table: |l_perp| / |d|,
+/// l_perp = l - (l.e) e. Invariant under a rotation of d and l together and under a scale of both
+/// (the gauges); it follows a scale of the table alone (a table shrunk with a raised camera makes
+/// every detector a smaller angle). ray and line_direction as in LineRayAngle.
+template <typename T>
+T LineAnglePerIndex(const T* ray, const T* line_direction) {
+  using std::sqrt;
+  const T ray_norm_sq = internal::Dot3(ray, ray);
+  const T along = internal::Dot3(line_direction, ray) / ray_norm_sq;
+  T perp[3];
+  for (int k = 0; k < 3; ++k) perp[k] = line_direction[k] - along * ray[k];
+  return sqrt(internal::Dot3(perp, perp) / ray_norm_sq);
 }
 
 /// S (2 x 2, 1 / rad) with r = S a equal to the focal-plane residual (observed - projected) / sigma

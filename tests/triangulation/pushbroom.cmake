@@ -14,3 +14,8 @@ aerocal_add_test(triangulation/pushbroom_control_cli LIBS aerocal::triangulation
 # pushbroom_datum: the datum from the null space (issue 28): rank defect = constraints per
 # configuration, reference choices equal modulo the gauge, the default against --datum none.
 aerocal_add_test(triangulation/pushbroom_datum LIBS aerocal::triangulation LABELS synthetic)
+# pushbroom_gauge_oracle: a finite gauge (rotation, scale) applied exactly and through the
+# degree-5 table to a converged solution (issue 28: why the reference choices differ with noise).
+aerocal_add_test(triangulation/pushbroom_gauge_oracle LIBS aerocal::triangulation LABELS synthetic)
+# pushbroom_lever_arm_study: the free lever arm over 25 seeds (issue 28: bias or spread?).
+aerocal_add_test(triangulation/pushbroom_lever_arm_study LIBS aerocal::triangulation LABELS long TIMEOUT 1200)

@@ -5,11 +5,14 @@
 //   gauge datum adds, per configuration, and the constrained problem has full rank with the same
 //   fit (v^T P v) as the datum-free one;
 // - the tables of any two valid datum choices (reference 0, 1, 2) are equal modulo the gauge (a
-//   rotation of the camera frame, and with c free its scale) to 1e-6 px;
+//   rotation of the camera frame, and with c free its scale) to 1e-6 px on data without error;
+//   with noise to the non-closure of the degree-5 table under the finite rotation between them
+//   (~1e-4 px; pushbroom_gauge_oracle_test.cc proves that no datum on the reference does better);
 // - the default datum equals `--datum none` with POS priors (no defect: nothing is held), and is
 //   within a few sigma of the truth; the earlier reference datum fits worse (it holds functions
 //   the data determine).
 #include "calib/camera/rotation.h"
+#include "tests/triangulation/pushbroom_flights.h"
 #include "triangulation/pushbroom/line_calibration.h"
 #include "triangulation/pushbroom/line_simulation.h"
 #include "triangulation/pushbroom/pos_trajectory.h"
@@ -26,24 +29,6 @@
 
 namespace aerocal::triangulation {
 namespace {
-
-// A flight as in the issue: every sub-camera with its own errors (1 px), POS with bias and drift,
-// control 0.1 m, image sigma 0.25 px.
-LineSimulationOptions DatumFlight(bool linear_layout, std::uint64_t seed) {
-  LineSimulationOptions o;
-  o.detectors_per_camera = 120;
-  o.lines = 800;
-  o.control_points = 700;
-  o.node_spacing_lines = 100;
-  o.subcamera_error_px = 1.0;
-  o.linear_layout = linear_layout;
-  o.pos_bias_m = 0.05;
-  o.pos_bias_deg = 0.005;
-  o.pos_drift_m = 0.05;
-  o.pos_drift_deg = 0.005;
-  o.seed = seed;
-  return o;
-}
 
 LineCalibrationResult Calibrate(const LineSimulation& sim, const LineCalibrationOptions& options) {
   const PosTrajectory pos = PosTrajectory::FromRecords(sim.pos, "pos.csv");
@@ -255,13 +240,13 @@ TEST_P(GaugeDatum, RankDefectEqualsTheConstraintsPerConfiguration) {
 // Any two valid choices of the sub-camera that carries the datum: with the POS priors and the
 // boresight fixed (the default) there is no defect and the tables are identical. With a defect
 // (boresight and c free: 4 gauge directions) the tables agree modulo the gauge to 1e-6 px on
-// data without any error. With noise (0.25 px, POS errors with priors) they agree to 5.6e-5 ..
-// 1.8e-4 px (with the focal-plane residual, which made the gauges inexact by the residuals' size:
-// 0.09-0.14 px): the issue's 1e-6 px is not met there, and the bound asserted is the measured one
-// with a margin of 5 (module README "Datum": the solutions of the three references differ in
-// v^T P v by up to 0.006, above the boresight-fixed solution's, while their datum residuals are
-// ~1e-9; the solver run to its limits, printed below, ends at the same values: they are the
-// constrained minima, so the finite orbit leaves the model by ~1e-4 px, cause not found).
+// data without any error. With noise (0.25 px, POS errors with priors) they agree to 5.4e-5 ..
+// 1.65e-4 px: the issue's 1e-6 px is not reachable there (module README "Datum", "The
+// finite-gauge oracle"): a pitch or roll of the camera is a homography of the focal plane, which
+// maps the noise's degree-5 content of a table out of the degree-5 model (non-closure ~1e-4 px
+// at the 1e-3 .. 1.4e-2 rad between the references' solutions; pushbroom_gauge_oracle_test.cc),
+// so the three constrained minima are different fits (their v^T P v differ by up to 0.004), not
+// one fit in three gauges. The bound asserted is the measured one with a margin of 5.
 constexpr double kNoisyGaugePx = 1e-3;
 
 // The three references' tables for one configuration, solved to `tolerance` (relative cost change,
@@ -273,7 +258,7 @@ std::vector<Table> ReferenceTables(const LineSimulation& sim,
   std::vector<Table> tables;
   for (int reference = 0; reference < 3; ++reference) {
     LineCalibrationOptions options = OptionsOf(config);
-    options.degree = 5;  // a finite rotation of the table is a polynomial to 1e-9 px at 5
+    options.degree = 5;  // a rotated error-free table is a degree-5 polynomial to 1e-9 px
     options.reference_subcamera = reference;
     options.solver.function_tolerance = tolerance;
     options.solver.parameter_tolerance = tolerance;
@@ -323,11 +308,7 @@ TEST_P(GaugeDatum, ReferenceChoicesAgreeModuloTheGauge) {
   const bool linear = GetParam();
   for (const bool noise : {false, true}) {
     LineSimulationOptions o = DatumFlight(linear, 12);
-    if (!noise) {  // no residual at all: the POS is exact too, so the priors hold the truth
-      o.image_noise_px = o.control_noise_m = 0;
-      o.pos_error_m = o.pos_error_deg = o.pos_bias_m = o.pos_bias_deg = 0;
-      o.pos_drift_m = o.pos_drift_deg = 0;
-    }
+    if (!noise) RemoveNoise(&o);  // no residual at all: the POS is exact, the priors hold the truth
     const LineSimulation sim = SimulateLineFlight(o);
     const double pitch = sim.nominal.pitch_mm;
     for (const Config& config : {kConfigs[0], kConfigs[3]}) {

@@ -5,6 +5,7 @@
 // cases reported by name.
 #include "calib/core/error.h"
 #include "tests/support/test_support.h"
+#include "tests/triangulation/pushbroom_flights.h"
 #include "triangulation/pushbroom/line_calibration.h"
 #include "triangulation/pushbroom/line_rectification.h"
 #include "triangulation/pushbroom/line_simulation.h"
@@ -84,16 +85,6 @@ TEST(PosTrajectory, BadFilesNameTheLine) {
       EXPECT_NE(std::string(e.what()).find(c.expected), std::string::npos) << e.what();
     }
   }
-}
-
-LineSimulationOptions SmallFlight() {
-  LineSimulationOptions o;
-  o.detectors_per_camera = 120;
-  o.lines = 800;
-  o.control_points = 700;
-  o.node_spacing_lines = 100;
-  o.seed = 7;
-  return o;
 }
 
 LineCalibrationResult Calibrate(const LineSimulation& sim, const LineCalibrationOptions& options) {

@@ -196,6 +196,8 @@ ObservationTerm LineScanCamera::Observe(const SensorContext& context,
   geometry.du_di =
       ranges_[s].second > ranges_[s].first ? 2.0 / double(ranges_[s].second - ranges_[s].first) : 0;
   geometry.nominal_c_mm = camera_.c_mm;
+  geometry.nominal_range_m =
+      (xyz - pos_center - calib::RotationFromOpk(pos_opk) * camera_.lever_arm_m).norm();
   term.cost = calib::LineCollinearityResidual::Create(geometry,
                                                       span,
                                                       pos_opk,

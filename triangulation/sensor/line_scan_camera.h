@@ -27,8 +27,9 @@
 // Residual of an observation: calib::LineCollinearityResidual (group kGroupLineImage): the angle
 // between the detector's ray and the ray to the point in a frame attached to the table
 // (calib/residuals/line_ray_angle.h; invariant under the camera's rotation and scale), weighted in
-// pixels at the file's c and table; blocks node J .. J+3, detector, c, mount, lever_arm,
-// time_offset, point.
+// pixels at the file's c and table and rescaled to the current angle per detector and per line
+// (the start range to the point from the POS, the file's lever arm and the point's start value);
+// blocks node J .. J+3, detector, c, mount, lever_arm, time_offset, point.
 // Own residuals (AddOwnResiduals): the POS prior on every node (group kGroupPosPrior, around 0 with
 // the POS sigmas) when `pos_prior`; the weighted boresight and lever arm around the file's values
 // (group kGroupLinePrior).
