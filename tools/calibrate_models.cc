@@ -30,9 +30,7 @@ calib::CameraModelId ModelOfOption(const std::string& name) {
 }
 
 std::string DefaultSelfCalibration(calib::CameraModelId model) {
-  if (model == calib::BrownFraser10Model::kId) return "c,x0,y0,K1,K2,K3,P1,P2";
-  if (model == calib::OpenCvModel::kId) return "fx,fy,cx,cy,k1,k2,p1,p2,k3";
-  return "all";
+  return std::string(calib::DefaultFreeInterior(model));  // the model struct's kDefaultFree
 }
 
 calib::Camera StartInModel(const calib::Camera& camera,

@@ -15,6 +15,7 @@
 #include <Eigen/Core>
 
 #include <array>
+#include <cmath>
 #include <string_view>
 
 namespace aerocal::calib {
@@ -39,6 +40,19 @@ struct BrownFraser10Model {
 
   /// Index of a parameter by its table name ("c", "K1", ...); -1 when unknown.
   static int IndexOf(std::string_view name) { return IndexOfParam(kParams, name); }
+
+  /// The free set of a calibration when none is given (`calibrate`): all but the affinity.
+  static constexpr std::string_view kDefaultFree = "c,x0,y0,K1,K2,K3,P1,P2";
+
+  /// The distortion profile at a radius r (mm from the principal point), um (Fraser 1997):
+  /// radial dr = K1 r^3 + K2 r^5 + K3 r^7, decentring magnitude dt = r^2 sqrt(P1^2 + P2^2).
+  static double RadialDistortionUm(const double* params, double r_mm) {
+    const double r2 = r_mm * r_mm;
+    return 1e3 * r_mm * (params[kK1] * r2 + params[kK2] * r2 * r2 + params[kK3] * r2 * r2 * r2);
+  }
+  static double DecentringDistortionUm(const double* params, double r_mm) {
+    return 1e3 * r_mm * r_mm * std::hypot(params[kP1], params[kP2]);
+  }
 
   /// Correction (dx, dy) in mm at the principal-point-reduced MEASURED coordinates xb (mm).
   template <typename T>

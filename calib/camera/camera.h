@@ -5,9 +5,9 @@
 // sub-image mappings and maker reference points.
 // Pixel (col, row) and photo (x, y) frames per CONVENTIONS.md (pixel_frame.h):
 //   x = (col - (W - 1) / 2) p,  y = -(row - (H - 1) / 2) p.
-// The frame camera of the adjustment works in the camera's own model (the residual factory in
-// calib/residuals/collinearity.h); the sub-image mappings, rig heads and the stitching still need
-// the 10-parameter model (Camera::Model), and their readers refuse another one.
+// The adjustment works in the camera's own model: the frame camera, the raw sub-images through
+// their mappings and the heads of a rig (the residual factories of calib/residuals/collinearity.h).
+// The stitching and flight commands still read the 10-parameter model only (camera_io.h).
 #pragma once
 
 #include "calib/camera/brown_fraser10.h"
@@ -25,9 +25,9 @@
 
 namespace aerocal::calib {
 
-/// The 10-parameter model, the default of a camera file and the model the sub-image mappings, rig
-/// heads and stitching need: use this name (`using Model = Camera::Model`) instead of naming
-/// BrownFraser10Model again.
+/// The 10-parameter model, the default of a camera file (and the model of the code that names its
+/// terms: the camera file formats of DBAT, PhotoModeler, Australis; the calibration report): use
+/// this name (`using Model = Camera::Model`) instead of naming BrownFraser10Model again.
 using AdjustmentCameraModel = BrownFraser10Model;
 
 /// Per-parameter values of a camera model (values, sigmas, free flags) in the model's table order.

@@ -133,12 +133,6 @@ Camera ParseCamera(const YAML::Node& root,
                         " (convert it first: aerocal camera convert "
                         "--to aerocal --model " +
                         std::string(Model::kName) + ")");
-  if (*id != Model::kId && (root["subimages"] || root["reference_points"]))
-    ThrowInputError(WhereIs(root["model"], file),
-                    "camera model '" + model_name +
-                        "': sub-image mappings and reference points "
-                        "need " +
-                        std::string(Model::kName) + " (convert the camera first)");
   Camera camera = Camera::OfModel(*id);
   camera.name = root["name"] ? YamlString(root["name"], file, "name") : "";
   if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");

@@ -13,14 +13,16 @@
 
 namespace aerocal::calib {
 
-/// Which camera models a reader accepts: the commands whose sensor kinds need the 10-parameter
-/// model (sub-image mappings, rig heads, stitching) read with the default and refuse another
-/// model with "convert it first"; the adjustment's frame cameras and `calibrate` take any model.
+/// Which camera models a reader accepts: the stitching and flight commands (their self-calibration
+/// sets and resampling are written for the 10-parameter model) read with the default and refuse
+/// another model with "convert it first"; the adjustment's cameras (frame, sub-image, rig head),
+/// rig files and `calibrate` take any model.
 enum class CameraModels { kBrownFraser10Only, kAny };
 
 /// `model:` one of the registry's names (default brown_fraser_10); `interior:` and
 /// `interior_sigma:` keyed by that model's parameter names (absent = 0 / not weighted), the
-/// principal-distance parameters > 0; sub-images and reference points only with brown_fraser_10.
+/// principal-distance parameters > 0; sub-images and reference points with any model (the
+/// mappings are 2D, in pixels).
 Camera ReadCamera(const std::string& path, CameraModels models = CameraModels::kBrownFraser10Only);
 /// `record_keys`: further keys of `root` that its caller reads (a rig head's id, mount...), not
 /// refused as unknown (reading the camera keys in place: a copy of them into a new node merged the

@@ -1,5 +1,7 @@
 #include "calib/camera/camera_model.h"
 
+#include <type_traits>
+
 namespace aerocal::calib {
 
 std::optional<CameraModelId> CameraModelFromName(std::string_view name) {
@@ -49,6 +51,36 @@ std::string CameraModelNames() {
     names += (names.empty() ? "" : ", ") + std::string(decltype(model)::kName);
   });
   return names;
+}
+
+std::string_view DefaultFreeInterior(CameraModelId id) {
+  return VisitCameraModel(id, [](auto model) { return decltype(model)::kDefaultFree; });
+}
+
+namespace {
+// Whether Model defines its distortion profile at a radius (RadialDistortionUm).
+template <typename Model, typename = void>
+struct HasRadiusProfile : std::false_type {};
+template <typename Model>
+struct HasRadiusProfile<Model, std::void_t<decltype(&Model::RadialDistortionUm)>> : std::true_type {
+};
+}  // namespace
+
+std::optional<DistortionAtRadius> ModelDistortionAtRadius(CameraModelId id,
+                                                          const double* params,
+                                                          double r_mm) {
+  return VisitCameraModel(id, [&](auto model) -> std::optional<DistortionAtRadius> {
+    using Model = decltype(model);
+    if constexpr (HasRadiusProfile<Model>::value)
+      return DistortionAtRadius{Model::RadialDistortionUm(params, r_mm),
+                                Model::DecentringDistortionUm(params, r_mm)};
+    else
+      return std::nullopt;
+  });
+}
+
+bool HasDistortionAtRadius(CameraModelId id) {
+  return VisitCameraModel(id, [](auto model) { return HasRadiusProfile<decltype(model)>::value; });
 }
 
 int CameraModelParamCount(CameraModelId id) {

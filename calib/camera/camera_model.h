@@ -93,6 +93,19 @@ std::string_view CameraModelName(CameraModelId id);
 /// The registered names, comma separated (for messages).
 std::string CameraModelNames();
 int CameraModelParamCount(CameraModelId id);
+/// The model's free set of a calibration when none is given (its kDefaultFree: comma-separated
+/// table names, or "all").
+std::string_view DefaultFreeInterior(CameraModelId id);
+/// The distortion profile at a radius r (mm from the principal point), um, of a model that defines
+/// one with its own terms (static RadialDistortionUm / DecentringDistortionUm in its struct:
+/// brown_fraser_10); nullopt for any other model (DistortionOverFormat measures those).
+struct DistortionAtRadius {
+  double radial_um = 0.0, decentring_um = 0.0;
+};
+std::optional<DistortionAtRadius> ModelDistortionAtRadius(CameraModelId id,
+                                                          const double* params,
+                                                          double r_mm);
+bool HasDistortionAtRadius(CameraModelId id);
 std::vector<ParamInfo> CameraModelParams(CameraModelId id);
 /// The names of a parameter table, comma separated (for messages).
 std::string JoinParamNames(const std::vector<ParamInfo>& table);

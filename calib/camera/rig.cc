@@ -93,8 +93,9 @@ Rig RigFromCamera(const Camera& camera, const std::string& head_id) {
   v.pixel_size_mm = camera.pixel_size_mm;
   v.width_px = camera.width_px;
   v.height_px = camera.height_px;
-  v.x0_mm = camera.interior[BrownFraser10Model::kX0];
-  v.y0_mm = camera.interior[BrownFraser10Model::kY0];
+  const Eigen::Vector2d principal = camera.PrincipalPointMm();
+  v.x0_mm = principal.x();
+  v.y0_mm = principal.y();
   return rig;
 }
 

@@ -1,5 +1,6 @@
 // A multi-head rig (CONVENTIONS.md "Multi-head rigs"; file: FORMATS.md "Multi-head rig"): several
-// heads, each an ordinary camera with its own 10-parameter interior (camera.h), fixed to one body,
+// heads, each an ordinary camera with its own interior in any registered model (camera.h, the
+// heads of one rig may differ), fixed to one body,
 // whose images are converted into ONE virtual image of an equivalent single-centre camera.
 //
 // Frames: the rig frame is the frame of the virtual camera (origin at the virtual projection
@@ -32,8 +33,8 @@
 
 namespace aerocal::calib {
 
-/// One head: an ordinary camera (its own pixel frame, format and 10-parameter interior) and its
-/// place in the rig.
+/// One head: an ordinary camera (its own pixel frame, format and interior in any registered model)
+/// and its place in the rig.
 struct RigHead {
   std::string id;
   Camera camera;                                          // name = id; no sub-images
@@ -50,7 +51,8 @@ struct RigHead {
 /// (R_v = Rz(kappa_rig)).
 enum class VirtualOrientation { kRig, kLevel };
 
-/// The virtual camera: a distortion-free central projection at the rig origin.
+/// The virtual camera: a distortion-free central projection at the rig origin (whatever the heads'
+/// models: RigFromCamera takes the pinhole part, c and principal point, of a camera in any model).
 struct VirtualCamera {
   VirtualOrientation orientation = VirtualOrientation::kRig;
   double c_mm = 0.0;                // principal distance, > 0
@@ -152,8 +154,8 @@ void HeadPose(const T* rig_opk, Rest... rest) {
 }
 
 /// Ideal photo coordinates reduced to head k's principal point, -c [U V] / W (mm), of an object
-/// point seen in one rig exposure: the projection the rig residual compares with
-/// BrownFraser10Model::IdealFromMeasured of the measured head pixel. Blocks as in HeadPose, plus
+/// point seen in one rig exposure, for a head in the 10-parameter model (the rig residual itself,
+/// calib/residuals/collinearity.h, works in any model). Blocks as in HeadPose, plus
 /// interior[10] (table units; only c is used here) and point_m[3]. False when the point is not in
 /// front of the head (W >= 0).
 template <typename T>

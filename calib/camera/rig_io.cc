@@ -67,7 +67,7 @@ RigHead ReadHead(const YAML::Node& node, const std::string& file) {
   // The head's camera keys, read in place by the camera reader (it cites their lines). Copying them
   // into a new node merged the whole document into that node's memory (yaml-cpp), once per head:
   // reading was quadratic in the number of heads (1000 heads took about 20 s).
-  head.camera = ParseCamera(node, file, CameraModels::kBrownFraser10Only, kHeadRigKeys);
+  head.camera = ParseCamera(node, file, CameraModels::kAny, kHeadRigKeys);
   head.camera.name = head.id;
   if (node["mount_deg"]) {
     head.mount_rad =
@@ -145,7 +145,7 @@ std::optional<VirtualOrientation> ParseVirtualOrientation(std::string_view name)
 Rig ParseRig(const YAML::Node& root, const std::string& file) {
   if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
   if (!root["rig"]) {
-    const Camera camera = ParseCamera(root, file);
+    const Camera camera = ParseCamera(root, file, CameraModels::kAny);
     if (!camera.subimages.empty() || !camera.reference_points.empty())
       ThrowInputError({file, 1}, "a camera with sub-images is not a rig head (no 'rig' section)");
     Rig rig = RigFromCamera(camera);

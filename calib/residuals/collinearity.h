@@ -9,8 +9,10 @@
 // [2, unitless], sigma_mm = sigma_px * pixel_size, xy the measured photo coordinates (mm). The
 // exposure rotation R is a unit quaternion block q = [w, x, y, z] (object_from_image,
 // calib/camera/rotation.h), moved by the builder's rotation-increment manifold; R(q) equals
-// Rx(omega) Ry(phi) Rz(kappa) of the files. MakeCollinearityResidual is THE factory: the residual
-// of a camera's model by its id (VisitCameraModel); a new model needs nothing here.
+// Rx(omega) Ry(phi) Rz(kappa) of the files. Every family is templated on the model and made by
+// its factory through VisitCameraModel: MakeCollinearityResidual (frame camera),
+// MakeSubimageCollinearityResidual (raw sub-image through its mapping),
+// MakeRigHeadCollinearityResidual (head of a rig); a new model needs nothing here.
 #pragma once
 
 #include "calib/camera/brown_fraser10.h"
@@ -114,16 +116,23 @@ inline std::unique_ptr<ceres::CostFunction> MakeCollinearityResidual(CameraModel
 }
 
 /// Observation (u, v) in a RAW sub-image; the sub-image mapping (conditioned parameters, see
-/// subimage_mapping.h) takes it to the virtual image, then collinearity as above.
-/// blocks: mapping[Mapping::kNumParams], interior[10], rotation[4] (quaternion), center[3] (m),
-/// point[3] (m).
-template <typename Mapping>
-struct SubimageCollinearityResidual
-    : AutoDiffResidual<SubimageCollinearityResidual<Mapping>, 2, Mapping::kNumParams, 10, 4, 3, 3> {
-  SubimageCollinearityResidual(const PixelFrame& frame,
-                               const MappingConditioning& cond,
-                               const Eigen::Vector2d& uv,
-                               double sigma_px)
+/// subimage_mapping.h) takes it to the virtual image, then collinearity as above in the camera's
+/// model `Model`.
+/// blocks: mapping[Mapping::kNumParams], interior[Model::kNumParams], rotation[4] (quaternion),
+/// center[3] (m), point[3] (m).
+template <typename Model, typename Mapping>
+struct ModelSubimageCollinearityResidual
+    : AutoDiffResidual<ModelSubimageCollinearityResidual<Model, Mapping>,
+                       2,
+                       Mapping::kNumParams,
+                       Model::kNumParams,
+                       4,
+                       3,
+                       3> {
+  ModelSubimageCollinearityResidual(const PixelFrame& frame,
+                                    const MappingConditioning& cond,
+                                    const Eigen::Vector2d& uv,
+                                    double sigma_px)
       : frame_(frame),
         uv_conditioned_{(uv.x() - cond.cu) / cond.scale, (uv.y() - cond.cv) / cond.scale},
         inverse_sigma_mm_(1.0 / (sigma_px * frame.pixel_size_mm)) {}
@@ -138,7 +147,7 @@ struct SubimageCollinearityResidual
     T virtual_px[2], xy[2];
     Mapping::Apply(mapping, uv, virtual_px);
     frame_.PhotoFromPixel(virtual_px, xy);
-    return internal::CollinearityError<BrownFraser10Model>(
+    return internal::CollinearityError<Model>(
         interior, frame_, rotation, center, point, xy, inverse_sigma_mm_, r);
   }
 
@@ -148,23 +157,55 @@ struct SubimageCollinearityResidual
   double inverse_sigma_mm_;
 };
 
+/// The sub-image residual of the 10-parameter model (blocks mapping, interior[10], ...).
+template <typename Mapping>
+using SubimageCollinearityResidual = ModelSubimageCollinearityResidual<BrownFraser10Model, Mapping>;
+
+/// The sub-image residual of a camera in model `model` with mappings of `mapping` (both
+/// dispatches: VisitCameraModel, VisitMappingModel). Blocks as ModelSubimageCollinearityResidual.
+inline std::unique_ptr<ceres::CostFunction> MakeSubimageCollinearityResidual(
+    CameraModelId model,
+    MappingModel mapping,
+    const PixelFrame& frame,
+    const MappingConditioning& cond,
+    const Eigen::Vector2d& uv,
+    double sigma_px) {
+  return VisitCameraModel(model, [&](auto m) {
+    return VisitMappingModel(mapping, [&](auto map) {
+      return ModelSubimageCollinearityResidual<decltype(m), decltype(map)>::Create(
+          frame, cond, uv, sigma_px);
+    });
+  });
+}
+
 /// Observation (col, row) in the pixel frame of head k of a rig (CONVENTIONS.md "Multi-head
 /// rigs"): the head's pose is R_k = R M_k E_k, O_k = O + R t_k + v dT_k (calib/camera/rig.h
 /// HeadPose), then the same collinearity as the frame camera with the head's own interior.
 ///   r = ((xb + dx, yb + dy) - (-c_k U / W, -c_k V / W)) / sigma_mm,  [U V W] = R_k^T (X - O_k)
-/// blocks: interior[10] (head k, table units), rig_rotation[4] (quaternion of R, as the frame
+/// in the head's camera model `Model`.
+/// blocks: interior[Model::kNumParams] (head k, table units), rig_rotation[4] (quaternion of R, as
+/// the frame
 ///         camera's rotation block), rig_center[3] (m),
 ///         mount[3] (M_k omega, phi, kappa, rad), lever_arm[3] (t_k in the rig frame, m),
 ///         increment[3] (E_k, rad), dt[1] (dT_k, s), point[3] (m).
 /// The platform velocity v (object frame, m/s) is data of the exposure, held by value.
 /// A rig of one head with identity mount, zero lever arm, zero increment and dT = 0 gives exactly
-/// CollinearityResidual (tests/calib/residuals_test.cc checks it).
-struct RigHeadCollinearityResidual
-    : AutoDiffResidual<RigHeadCollinearityResidual, 2, 10, 4, 3, 3, 3, 3, 1, 3> {
-  RigHeadCollinearityResidual(const PixelFrame& head_frame,
-                              const Eigen::Vector2d& pixel,
-                              double sigma_px,
-                              const Eigen::Vector3d& velocity_mps)
+/// ModelCollinearityResidual<Model> (tests/calib/residuals_test.cc checks it for every model).
+template <typename Model>
+struct ModelRigHeadCollinearityResidual : AutoDiffResidual<ModelRigHeadCollinearityResidual<Model>,
+                                                           2,
+                                                           Model::kNumParams,
+                                                           4,
+                                                           3,
+                                                           3,
+                                                           3,
+                                                           3,
+                                                           1,
+                                                           3> {
+  ModelRigHeadCollinearityResidual(const PixelFrame& head_frame,
+                                   const Eigen::Vector2d& pixel,
+                                   double sigma_px,
+                                   const Eigen::Vector3d& velocity_mps)
       : frame_(head_frame),
         inverse_sigma_mm_(1.0 / (sigma_px * head_frame.pixel_size_mm)),
         velocity_mps_{velocity_mps.x(), velocity_mps.y(), velocity_mps.z()} {
@@ -194,7 +235,7 @@ struct RigHeadCollinearityResidual
                        head_center);
     ImageSpaceFromObjectByMatrix(object_from_head, head_center, point, uvw);
     const T xy[2] = {T(xy_mm_[0]), T(xy_mm_[1])};
-    return internal::CollinearityErrorFromImageSpace<BrownFraser10Model>(
+    return internal::CollinearityErrorFromImageSpace<Model>(
         interior, frame_, uvw, xy, inverse_sigma_mm_, r);
   }
 
@@ -204,5 +245,22 @@ struct RigHeadCollinearityResidual
   double inverse_sigma_mm_;
   double velocity_mps_[3];
 };
+
+/// The rig-head residual of the 10-parameter model (blocks interior[10], ...).
+using RigHeadCollinearityResidual = ModelRigHeadCollinearityResidual<BrownFraser10Model>;
+
+/// The rig-head residual of a head in model `model` (VisitCameraModel); blocks as
+/// ModelRigHeadCollinearityResidual.
+inline std::unique_ptr<ceres::CostFunction> MakeRigHeadCollinearityResidual(
+    CameraModelId model,
+    const PixelFrame& head_frame,
+    const Eigen::Vector2d& pixel,
+    double sigma_px,
+    const Eigen::Vector3d& velocity_mps) {
+  return VisitCameraModel(model, [&](auto m) {
+    return ModelRigHeadCollinearityResidual<decltype(m)>::Create(
+        head_frame, pixel, sigma_px, velocity_mps);
+  });
+}
 
 }  // namespace aerocal::calib

@@ -141,7 +141,15 @@ std::vector<ErrorSource> MakeErrorSources(const calib::Rig& rig, const ErrorLimi
   const int reference = rig.ReferenceIndex();
   for (int h = 0; h < static_cast<int>(rig.heads.size()); ++h) {
     const std::string& id = rig.heads[h].id;
-    const double p = rig.heads[h].camera.pixel_size_mm;
+    const calib::Camera& camera = rig.heads[h].camera;
+    // The interior sources are entries of the head's model table, in mm (brown_fraser_10's).
+    for (const char* name : {"x0", "y0", "c"})
+      if (camera.ParamIndex(name) < 0 || camera.Params()[camera.ParamIndex(name)].unit != "mm")
+        throw InputError("head " + id + " in model " +
+                         std::string(calib::CameraModelName(camera.model)) +
+                         ": the error analysis perturbs x0, y0 and c in mm, which the model does "
+                         "not have (convert the head to brown_fraser_10: aerocal camera convert)");
+    const double p = camera.pixel_size_mm;
     sources.push_back({"x0:" + id, ErrorSourceKind::kX0, h, limits.principal_point_px * p, "mm"});
     sources.push_back({"y0:" + id, ErrorSourceKind::kY0, h, limits.principal_point_px * p, "mm"});
     sources.push_back({"c:" + id, ErrorSourceKind::kC, h, limits.principal_distance_px * p, "mm"});
@@ -202,16 +210,16 @@ std::optional<Eigen::Vector2d> ConversionErrorModel::Error(const Eigen::VectorXd
     const ErrorSource& s = sources_[i];
     const double d = delta[static_cast<int>(i)];
     if (d == 0.0) continue;
-    using Model = calib::BrownFraser10Model;
+    calib::Camera& camera = rig.heads[s.head].camera;  // MakeErrorSources checked the names
     switch (s.kind) {
       case ErrorSourceKind::kX0:
-        rig.heads[s.head].camera.interior[Model::kX0] += d;
+        camera.interior[camera.ParamIndex("x0")] += d;
         break;
       case ErrorSourceKind::kY0:
-        rig.heads[s.head].camera.interior[Model::kY0] += d;
+        camera.interior[camera.ParamIndex("y0")] += d;
         break;
       case ErrorSourceKind::kC:
-        rig.heads[s.head].camera.interior[Model::kC] += d;
+        camera.interior[camera.ParamIndex("c")] += d;
         break;
       case ErrorSourceKind::kOmega:
         rig.heads[s.head].mount_rad[0] += d;

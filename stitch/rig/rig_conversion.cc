@@ -86,9 +86,8 @@ std::optional<Eigen::Vector3d> IntersectPlane(const RectificationPlane& plane,
 std::optional<Eigen::Vector3d> RigConverter::PlanePointOfHeadPixel(
     int head, const Eigen::Vector2d& pixel) const {
   const calib::Camera& camera = rig_.heads[head].camera;
-  const Eigen::Vector2d xy = camera.PhotoFromPixel(pixel);
   Eigen::Vector2d ideal;
-  calib::BrownFraser10Model::IdealFromMeasured(camera.interior.data(), xy.data(), ideal.data());
+  if (!camera.IdealFromPixel(pixel, &ideal)) return std::nullopt;
   const Eigen::Vector3d ray_in_head(ideal.x(), ideal.y(), -camera.c_mm());
   return IntersectPlane(plane_, head_center_[head], object_from_head_[head] * ray_in_head);
 }

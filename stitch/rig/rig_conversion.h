@@ -1,12 +1,12 @@
 // Conversion between the head images of one rig exposure and the single-centre virtual image
 // (CONVENTIONS.md "Multi-head rigs", "Conversion of a head pixel to the virtual image"):
 //
-//   head pixel -> photo (x, y) -> ideal photo (xb + dx, yb + dy) (10-parameter correction)
+//   head pixel -> photo (x, y) -> ideal photo (xb + dx, yb + dy) (the head's model, any registered)
 //   -> ray d = R_k [xb + dx, yb + dy, -c_k]^T from O_k -> its intersection G with the
 //   rectification plane -> G projected into the virtual camera at O with attitude R_v.
 //
 // and back (virtual pixel -> ray from O with R_v -> G on the plane -> head k's measured pixel,
-// the correction inverted by Newton iteration to 1e-10 px as Camera::ProjectToPixel does).
+// the model's measured-from-ideal map, as Camera::ProjectToPixel does).
 // The rectification plane lies at the relative flying height H below the virtual centre:
 // perpendicular to the virtual axis for `orientation: rig` (R_v = R), the horizontal plane
 // Z = O_Z - H for `orientation: level` (R_v = Rz(kappa_rig)).

@@ -17,7 +17,6 @@ Eigen::Matrix3d HeadFromVirtualHomography(const RigConverter& converter, int hea
   const calib::Rig& rig = converter.rig();
   const calib::VirtualCamera& v = rig.virtual_camera;
   const calib::Camera& camera = rig.heads[head].camera;
-  using Model = calib::BrownFraser10Model;
   // Virtual pixel -> ray in the virtual camera frame: (x - x0, y - y0, -c).
   Eigen::Matrix3d virtual_ray;
   virtual_ray << v.pixel_size_mm, 0, -0.5 * (v.width_px - 1) * v.pixel_size_mm - v.x0_mm,  //
@@ -35,9 +34,10 @@ Eigen::Matrix3d HeadFromVirtualHomography(const RigConverter& converter, int hea
   // Head space u -> measured pixel: x = -c u_x / u_z + x0 -> (c u_x - x0 u_z, c u_y - y0 u_z,
   // -u_z), then col = x / p + (W - 1) / 2, row = -y / p + (H - 1) / 2.
   const double c = camera.c_mm(), p = camera.pixel_size_mm;
+  const Eigen::Vector2d principal = camera.PrincipalPointMm();
   Eigen::Matrix3d photo;
-  photo << c, 0, -camera.interior[Model::kX0],  //
-      0, c, -camera.interior[Model::kY0],       //
+  photo << c, 0, -principal.x(),  //
+      0, c, -principal.y(),       //
       0, 0, -1;
   Eigen::Matrix3d pixel;
   pixel << 1 / p, 0, 0.5 * (camera.width_px - 1),  //
@@ -73,9 +73,21 @@ calib::Camera RigExposureAsSubimageCamera(const RigConverter& converter) {
 
 namespace {
 
+// Distortion: the head's model is not the pinhole (c, principal point) the homography uses, at
+// the image's corners and centre (in any registered model, without naming its terms).
 bool HasDistortion(const calib::Camera& camera) {
-  for (int i = calib::BrownFraser10Model::kK1; i < calib::BrownFraser10Model::kNumParams; ++i)
-    if (camera.interior[i] != 0.0) return true;
+  const Eigen::Vector2d principal = camera.PrincipalPointMm();
+  const double w = camera.width_px - 1, h = camera.height_px - 1;
+  for (const Eigen::Vector2d& pixel : {Eigen::Vector2d(0, 0),
+                                       Eigen::Vector2d(w, 0),
+                                       Eigen::Vector2d(0, h),
+                                       Eigen::Vector2d(w, h),
+                                       Eigen::Vector2d(w / 2, h / 2)}) {
+    Eigen::Vector2d ideal;
+    if (!camera.IdealFromPixel(pixel, &ideal)) return true;
+    const Eigen::Vector2d pinhole = camera.PhotoFromPixel(pixel) - principal;
+    if ((ideal - pinhole).norm() > 1e-9 * camera.pixel_size_mm) return true;
+  }
   return false;
 }
 

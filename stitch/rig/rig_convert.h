@@ -7,7 +7,7 @@
 // (A_v: virtual pixel -> virtual ray, K_k: head ray -> measured pixel). It is exact for heads
 // without lens distortion. A head with distortion terms enters the resampler with the same
 // homography plus a correction grid (resample/virtual_image.h MapCorrectionGrid): at grid nodes
-// the exact head pixel (the 10-parameter correction inverted, RigConverter::HeadFromVirtual) minus
+// the exact head pixel (the head's model, RigConverter::HeadFromVirtual) minus
 // the homography's; the step is halved from 64 px until the bilinear interpolation of the grid
 // reproduces the exact map at every cell centre inside the head to `tolerance_px` (or the step
 // reaches 2 px; the error reached is reported).

@@ -51,8 +51,7 @@ HeadDesign DesignHead(const RigConverter& converter, int k, double height_m) {
   const Eigen::Vector2d across(-along.y(), along.x());
   const double head_height_m = converter.HeadCenter(k).z() + height_m;  // above Z = -H
   design.nadir_gsd_m = camera.pixel_size_mm * head_height_m / camera.c_mm();
-  const Eigen::Vector2d principal(camera.interior[calib::Camera::Model::kX0],
-                                  camera.interior[calib::Camera::Model::kY0]);
+  const Eigen::Vector2d principal = camera.PrincipalPointMm();
   const double w = camera.width_px - 1, h = camera.height_px - 1;
   const std::vector<std::pair<std::string, Eigen::Vector2d>> points = {
       {"principal_point", camera.PixelFromPhoto(principal)},

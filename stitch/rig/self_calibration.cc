@@ -88,7 +88,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     const std::string& id = heads[k].id;
     interior[k] = builder.AddBlock("interior[" + id + "]",
                                    heads[k].camera.interior.data(),
-                                   calib::Camera::Model::kNumParams,
+                                   heads[k].camera.interior.size(),
                                    calib::BlockKind::kInterior);
     mount[k] = builder.AddBlock(
         "mount[" + id + "]", heads[k].mount_rad.data(), 3, calib::BlockKind::kOther);
@@ -239,8 +239,11 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       const int k = ob.head;
       const calib::ResidualId id = builder.AddResidual(
           kGroupRigStitchTie,
-          calib::RigHeadCollinearityResidual::Create(
-              heads[k].camera.frame(), ob.pixel, ob.sigma_px, exposures[i].pose.velocity_mps),
+          calib::MakeRigHeadCollinearityResidual(heads[k].camera.model,
+                                                 heads[k].camera.frame(),
+                                                 ob.pixel,
+                                                 ob.sigma_px,
+                                                 exposures[i].pose.velocity_mps),
           {interior[k],
            rig_opk[i],
            rig_center[i],

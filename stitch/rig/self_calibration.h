@@ -18,9 +18,10 @@
 //   tie points: one ground point per tie on the plane Z = z_ref of its exposure (X, Y free, Z
 //          held: the plane model of the virtual image; relief leaves the CONVENTIONS residual
 //          displacement, reported).
-// Observations: the tie's measured head pixels, RigHeadCollinearityResidual (calib/residuals),
-// whitened by their sigma_px, group kGroupRigStitchTie. Optional weighted priors (towards 0) on
-// the increments and offsets where sigmas are given. One ProblemBuilder owns the problem.
+// Observations: the tie's measured head pixels, calib::MakeRigHeadCollinearityResidual in the
+// head's own model (calib/residuals), whitened by their sigma_px, group kGroupRigStitchTie.
+// Optional weighted priors (towards 0) on the increments and offsets where sigmas are given. One
+// ProblemBuilder owns the problem.
 //
 // Gross errors: data snooping (calib/problem/data_snooping.h) on the tie observations, with a
 // veto: a removal that would leave a standard position of an exposure (rig_design.h: two per

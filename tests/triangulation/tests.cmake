@@ -21,6 +21,8 @@ aerocal_add_test(triangulation/test_field_study LIBS aerocal::triangulation LABE
 aerocal_add_test(triangulation/rig_bundle LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/rig_bundle_study LIBS aerocal::triangulation LABELS long TIMEOUT 1200)
 aerocal_add_test(triangulation/rig_bundle_cli LIBS aerocal::triangulation LABELS cli)
+# Every camera model in every residual family: frame, sub-image, rig head (issue 30 item 4).
+aerocal_add_test(triangulation/model_families LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/wall_pose LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/platform LIBS aerocal::triangulation LABELS synthetic)
 aerocal_add_test(triangulation/robust_start_models LIBS aerocal::triangulation LABELS unit)

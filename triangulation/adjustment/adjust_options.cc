@@ -10,8 +10,6 @@
 
 namespace aerocal::triangulation {
 
-using Model = calib::Camera::Model;
-
 void AdjustOptions::Validate() const {
   std::set<std::string> seen;
   for (const auto& name : free_interior) {
@@ -84,12 +82,10 @@ std::vector<std::string> ParseSelfCalibration(const std::string& text, calib::Ca
   }
   for (const std::string& name : SplitCommaList(text)) {
     if (std::none_of(table.begin(), table.end(), [&](const auto& p) { return p.name == name; }))
-      throw ConfigError(
-          "--self-calibration: unknown parameter '" + name + "' (expected none, all or a list of " +
-          (model == Model::kId
-               ? std::string()
-               : "the parameters of model " + std::string(calib::CameraModelName(model)) + ": ") +
-          calib::JoinParamNames(table) + ")");
+      throw ConfigError("--self-calibration: unknown parameter '" + name +
+                        "' (expected none, all or a list of the parameters of model " +
+                        std::string(calib::CameraModelName(model)) + ": " +
+                        calib::JoinParamNames(table) + ")");
     names.push_back(name);
   }
   AdjustOptions probe;

@@ -471,20 +471,9 @@ void BlockAdjustment::AddPriors() {
   if (options_.use_interior_sigma) {
     for (CameraIndex k = 0; k < storage_->index.NumCameras(); ++k) {
       const std::string& id = storage_->index.CameraId(k);
-      const calib::Camera& camera = project_.cameras.at(id);
-      std::vector<int> indices;
-      std::vector<double> values, sigmas;
-      for (const auto& name : options_.free_interior) {
-        const int i = camera.ParamIndex(name);  // >= 0: the frame camera checked the names
-        if (!camera.interior_sigma[i]) continue;
-        indices.push_back(i);
-        values.push_back(camera.interior[i]);
-        sigmas.push_back(*camera.interior_sigma[i]);
-      }
-      if (!indices.empty())
+      if (auto prior = InteriorPriorOf(project_.cameras.at(id), options_.free_interior))
         builder_.AddResidual(calib::kGroupInteriorPrior,
-                             std::make_unique<calib::PriorCostFunction>(
-                                 camera.interior.size(), indices, values, sigmas),
+                             std::move(prior),
                              {storage_->frame.InteriorBlock(k)},
                              "interior prior " + id);
     }

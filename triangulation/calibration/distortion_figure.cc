@@ -22,12 +22,11 @@ std::optional<Eigen::Vector2d> CorrectionMm(const calib::ModelCamera& camera,
 }  // namespace
 
 double RadialDistortionUm(const calib::InteriorParams& p, double r) {
-  const double r2 = r * r;
-  return 1e3 * r * (p[Model::kK1] * r2 + p[Model::kK2] * r2 * r2 + p[Model::kK3] * r2 * r2 * r2);
+  return Model::RadialDistortionUm(p.data(), r);
 }
 
 double DecentringDistortionUm(const calib::InteriorParams& p, double r) {
-  return 1e3 * r * r * std::hypot(p[Model::kP1], p[Model::kP2]);
+  return Model::DecentringDistortionUm(p.data(), r);
 }
 
 DistortionFigure DistortionOverFormat(const calib::ModelCamera& camera,
@@ -42,16 +41,16 @@ DistortionFigure DistortionOverFormat(const calib::ModelCamera& camera,
   const double half_w = 0.5 * p * camera.frame.width_px, half_h = 0.5 * p * camera.frame.height_px;
   const double r_max = std::hypot(half_w, half_h);
 
-  const bool ours = camera.model == Model::kId;
-  out.profile_kind = ours ? "10-parameter terms" : "mean over directions";
-  calib::InteriorParams params{};
-  if (ours)
-    for (int k = 0; k < Model::kNumParams; ++k) params[k] = camera.params[k];
+  // A model with its own profile at a radius (its struct's terms) gives it; any other is measured
+  // over the format as the mean over directions.
+  const bool own = calib::HasDistortionAtRadius(camera.model);
+  out.profile_kind = own ? "10-parameter terms" : "mean over directions";
   constexpr int kDirections = 72;
   for (int i = 0; i <= profile_samples; ++i) {
     const double r = r_max * i / profile_samples;
-    if (ours) {
-      out.profile.push_back({r, RadialDistortionUm(params, r), DecentringDistortionUm(params, r)});
+    if (own) {
+      const auto d = calib::ModelDistortionAtRadius(camera.model, camera.params.data(), r);
+      out.profile.push_back({r, d->radial_um, d->decentring_um});
       continue;
     }
     double radial = 0, tangential2 = 0;

@@ -17,7 +17,6 @@
 namespace aerocal::triangulation {
 namespace {
 
-using Model = calib::BrownFraser10Model;
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Degrees of freedom from which k = 2 is kept (t_95.45(50) = 2.05).
 constexpr double kLargeDof = 50.0;
@@ -275,25 +274,33 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
                          "interior parameter",
                          [k](const calib::InteriorParams& p) { return p[k]; }});
   }
-  // The distortion values at radii are the 10-parameter model's correction terms (header); a
-  // camera in another model certifies its parameters.
-  const bool ours = camera.model == Model::kId;
-  const bool radial =
-      ours && (camera.free[Model::kK1] || camera.free[Model::kK2] || camera.free[Model::kK3]);
-  const bool decentring = ours && (camera.free[Model::kP1] || camera.free[Model::kP2]);
+  // The distortion values at radii are the model's own terms (calib::ModelDistortionAtRadius:
+  // brown_fraser_10's, header), there when a term of their group is free; a camera in a model
+  // without such a profile certifies its parameters.
+  const bool own = calib::HasDistortionAtRadius(camera.model);
+  const auto any_free = [&](calib::ParamGroup group) {
+    for (int k = 0; k < static_cast<int>(table.size()); ++k)
+      if (table[k].group == group && camera.free[k]) return true;
+    return false;
+  };
+  const bool radial = own && any_free(calib::ParamGroup::kRadial);
+  const bool decentring = own && any_free(calib::ParamGroup::kDecentering);
   for (double r : options.radii_mm) {
     if (radial)
-      functions.push_back(
-          {StringPrintf("dr@%g", r),
-           "um",
-           StringPrintf("radial distortion at r = %g mm", r),
-           [r](const calib::InteriorParams& p) { return RadialDistortionUm(p, r); }});
+      functions.push_back({StringPrintf("dr@%g", r),
+                           "um",
+                           StringPrintf("radial distortion at r = %g mm", r),
+                           [r, model = camera.model](const calib::InteriorParams& p) {
+                             return calib::ModelDistortionAtRadius(model, p.data(), r)->radial_um;
+                           }});
     if (decentring)
       functions.push_back(
           {StringPrintf("dt@%g", r),
            "um",
            StringPrintf("decentring distortion (magnitude) at r = %g mm", r),
-           [r](const calib::InteriorParams& p) { return DecentringDistortionUm(p, r); }});
+           [r, model = camera.model](const calib::InteriorParams& p) {
+             return calib::ModelDistortionAtRadius(model, p.data(), r)->decentring_um;
+           }});
   }
 
   std::vector<BudgetQuantity> out;

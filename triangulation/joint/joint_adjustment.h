@@ -4,7 +4,7 @@
 // Not a second adjustment: the block adjustment with the sub-image camera as a sensor kind
 // (triangulation/sensor/subimage_camera.h), whose observations and own residuals are
 // - subimage_image: raw sub-image measurements (u, v) -> mapping of their sub-image -> virtual
-//   pixel -> 10-parameter camera -> collinearity (calib::SubimageCollinearityResidual);
+//   pixel -> the camera in its model -> collinearity (calib::MakeSubimageCollinearityResidual);
 // - stitch_reference: maker reference points, Map_k(u, v) = (U, V)_surveyed, per exposure;
 // - stitch_tie: stitching tie points of each exposure, Map_k(u, v) = P (unknown virtual P);
 // - plus image / control / GNSS-IMU / interior priors of BlockAdjustment.

@@ -2,38 +2,63 @@
 
 #include "calib/core/error.h"
 #include "calib/residuals/collinearity.h"
+#include "calib/residuals/prior.h"
 
 #include <algorithm>
 
 namespace aerocal::triangulation {
+
+InteriorLayout InteriorLayoutOf(const calib::Camera& camera,
+                                const std::vector<std::string>& free,
+                                const std::string& who) {
+  // Free entries by the names of the camera's own model.
+  const std::vector<calib::ParamInfo> table = camera.Params();
+  InteriorLayout layout;
+  for (int i = 0; i < static_cast<int>(table.size()); ++i) {
+    layout.names.emplace_back(table[i].name);
+    if (std::find(free.begin(), free.end(), layout.names.back()) == free.end())
+      layout.fixed.push_back(i);
+  }
+  for (const std::string& name : free)
+    if (camera.ParamIndex(name) < 0)
+      throw ConfigError("free_interior: '" + name + "' is not a parameter of " + who +
+                        " in model " + std::string(calib::CameraModelName(camera.model)) +
+                        " (its parameters: " + calib::JoinParamNames(table) + ")");
+  return layout;
+}
+
+std::unique_ptr<ceres::CostFunction> InteriorPriorOf(const calib::Camera& camera,
+                                                     const std::vector<std::string>& free) {
+  std::vector<int> indices;
+  std::vector<double> values, sigmas;
+  for (const auto& name : free) {
+    const int i = camera.ParamIndex(name);  // >= 0: InteriorLayoutOf checked the names
+    if (!camera.interior_sigma[i]) continue;
+    indices.push_back(i);
+    values.push_back(camera.interior[i]);
+    sigmas.push_back(*camera.interior_sigma[i]);
+  }
+  if (indices.empty()) return nullptr;
+  return std::make_unique<calib::PriorCostFunction>(
+      camera.interior.size(), indices, values, sigmas);
+}
+
 void FrameCamera::RegisterBlocks(const SensorContext& context) {
   const int n = context.index.NumCameras();
   interior_.resize(n);
   blocks_.assign(n, -1);
-  const auto& free = context.options.free_interior;
   for (CameraIndex k = 0; k < n; ++k) {
     const std::string& id = context.index.CameraId(k);
     const calib::Camera& camera = context.project.cameras.at(id);
-    // Free entries by the names of the camera's own model (AdjustOptions::free_interior).
-    const std::vector<calib::ParamInfo> table = camera.Params();
-    std::vector<std::string> names;
-    std::vector<int> fixed;
-    for (int i = 0; i < static_cast<int>(table.size()); ++i) {
-      names.emplace_back(table[i].name);
-      if (std::find(free.begin(), free.end(), names.back()) == free.end()) fixed.push_back(i);
-    }
-    for (const std::string& name : free)
-      if (camera.ParamIndex(name) < 0)
-        throw ConfigError("free_interior: '" + name + "' is not a parameter of camera " + id +
-                          " in model " + std::string(calib::CameraModelName(camera.model)) +
-                          " (its parameters: " + calib::JoinParamNames(table) + ")");
+    const InteriorLayout layout =
+        InteriorLayoutOf(camera, context.options.free_interior, "camera " + id);
     interior_[k] = camera.interior;
     blocks_[k] = context.builder.AddBlock("camera " + id,
                                           interior_[k].data(),
                                           interior_[k].size(),
                                           calib::BlockKind::kInterior,
-                                          names);
-    context.builder.FixEntries(blocks_[k], fixed);
+                                          layout.names);
+    context.builder.FixEntries(blocks_[k], layout.fixed);
   }
 }
 

@@ -5,15 +5,37 @@
 // (CameraIndex, sized by the camera's model), whose free entries are AdjustOptions::free_interior
 // named by that model's table (a subset manifold in the builder; a name the model does not have is
 // a ConfigError); other sensor kinds put their geometry in front of these blocks (sub-image
-// mappings, rig mounts: those need the 10-parameter model).
+// mappings, rig mounts), in the same model.
 #pragma once
 
 #include "calib/camera/camera.h"
 #include "triangulation/sensor/imaging_model.h"
 
+#include <ceres/cost_function.h>
+
+#include <memory>
+#include <string>
 #include <vector>
 
 namespace aerocal::triangulation {
+
+/// An interior block of a camera in any registered model: its entry names (the model's table) and
+/// the entries held fixed (those not named in `free`, AdjustOptions::free_interior). ConfigError
+/// when a free name is not a parameter of the model; `who` names the camera ("camera RC30", "rig
+/// R head B").
+struct InteriorLayout {
+  std::vector<std::string> names;
+  std::vector<int> fixed;
+};
+InteriorLayout InteriorLayoutOf(const calib::Camera& camera,
+                                const std::vector<std::string>& free,
+                                const std::string& who);
+
+/// The prior (group kGroupInteriorPrior) of the free entries of `camera` that carry an a-priori
+/// sigma, around the camera file's values; nullptr when none does. `free` checked by
+/// InteriorLayoutOf.
+std::unique_ptr<ceres::CostFunction> InteriorPriorOf(const calib::Camera& camera,
+                                                     const std::vector<std::string>& free);
 
 class FrameCamera final : public ImagingModel {
  public:

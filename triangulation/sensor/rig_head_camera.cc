@@ -14,7 +14,6 @@
 namespace aerocal::triangulation {
 namespace {
 
-using Model = calib::Camera::Model;
 using calib::BlockId;
 
 constexpr double kDegPerRad = 180.0 / M_PI;
@@ -29,17 +28,11 @@ const std::vector<std::string> kIncrementNames = {"domega", "dphi", "dkappa"};
 std::unique_ptr<ceres::CostFunction> HeadCost(const calib::Camera& head,
                                               const ImageObservation& observation,
                                               const Eigen::Vector3d& velocity_mps) {
-  return calib::RigHeadCollinearityResidual::Create(
-      head.frame(), observation.pixel, observation.sigma_px, velocity_mps);
+  return calib::MakeRigHeadCollinearityResidual(
+      head.model, head.frame(), observation.pixel, observation.sigma_px, velocity_mps);
 }
 Eigen::Matrix3d ObjectFromRig(const Exposure& exposure) {
   return calib::RotationFromOpk(exposure.opk_rad);
-}
-
-std::vector<std::string> InteriorNames() {
-  std::vector<std::string> names;
-  for (const auto& p : Model::kParams) names.emplace_back(p.name);
-  return names;
 }
 
 Eigen::Vector3d VelocityOf(const Exposure& exposure) {
@@ -90,13 +83,6 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
   calib::ProblemBuilder& builder = context.builder;
   const std::string prefix = "rig " + camera_ + " head ";
 
-  // Free interior entries as the frame camera (AdjustOptions::free_interior).
-  std::vector<int> fixed_interior;
-  for (int i = 0; i < Model::kNumParams; ++i) {
-    const auto& free = context.options.free_interior;
-    if (std::find(free.begin(), free.end(), std::string(Model::kParams[i].name)) == free.end())
-      fixed_interior.push_back(i);
-  }
   const int n = static_cast<int>(rig_->heads.size());
   heads_.assign(n, Head{});
   for (int k = 0; k < n; ++k) {
@@ -108,13 +94,16 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
     if (k == reference_) {
       h.interior_block = context.frame.InteriorBlock(context.index.Camera(camera_));
     } else {
+      // Free interior entries as the frame camera's, named by the head's own model.
+      const InteriorLayout layout =
+          InteriorLayoutOf(head.camera, context.options.free_interior, name);
       h.interior = head.camera.interior;
       h.interior_block = builder.AddBlock(name + " interior",
                                           h.interior.data(),
-                                          Model::kNumParams,
+                                          h.interior.size(),
                                           calib::BlockKind::kInterior,
-                                          InteriorNames());
-      builder.FixEntries(h.interior_block, fixed_interior);
+                                          layout.names);
+      builder.FixEntries(h.interior_block, layout.fixed);
     }
     h.mount_block = builder.AddBlock(
         name + " mount", h.mount_rad.data(), 3, calib::BlockKind::kOther, kMountNames);
@@ -262,23 +251,12 @@ void RigHeadCamera::AddOwnResiduals(const SensorContext& context) {
                          {options_.time_offset_sigma_s},
                          kRigOwner,
                          name + " time offset");
-    if (context.options.use_interior_sigma) {
-      std::vector<int> indices;
-      std::vector<double> values, sigmas;
-      for (const auto& free : context.options.free_interior) {
-        const int i = Model::IndexOf(free);
-        if (!head.camera.interior_sigma[i]) continue;
-        indices.push_back(i);
-        values.push_back(head.camera.interior[i]);
-        sigmas.push_back(*head.camera.interior_sigma[i]);
-      }
-      if (!indices.empty())
-        builder.AddResidual(
-            calib::kGroupInteriorPrior,
-            std::make_unique<calib::PriorCostFunction>(Model::kNumParams, indices, values, sigmas),
-            {h.interior_block},
-            "interior prior " + camera_ + " head " + head.id);
-    }
+    if (!context.options.use_interior_sigma) continue;
+    if (auto prior = InteriorPriorOf(head.camera, context.options.free_interior))
+      builder.AddResidual(calib::kGroupInteriorPrior,
+                          std::move(prior),
+                          {h.interior_block},
+                          "interior prior " + camera_ + " head " + head.id);
   }
   if (options_.increments == calib::BlockMode::kWeighted) {
     const double s = options_.increment_sigma_rad;
@@ -320,9 +298,11 @@ void RigHeadCamera::Collect(const SensorContext& context,
     e.id = rig_->heads[k].id;
     e.reference = k == reference_;
     e.interior = e.reference ? context.frame.Interior(context.index.Camera(camera_)) : h.interior;
+    e.model = rig_->heads[k].camera.model;
+    e.interior_sigma = calib::InteriorSigmas::ForModel(e.model);
     if (cov.ok) {
-      const Eigen::VectorXd s = cov.BlockSigma(h.interior_block, Model::kNumParams);
-      for (int i = 0; i < Model::kNumParams; ++i) e.interior_sigma[i] = s(i);
+      const Eigen::VectorXd s = cov.BlockSigma(h.interior_block, e.interior.size());
+      for (int i = 0; i < e.interior.size(); ++i) e.interior_sigma[i] = s(i);
     }
     e.mount_rad = h.mount_rad;
     e.lever_arm_m = h.lever_arm_m;
@@ -414,8 +394,9 @@ nlohmann::json RigResultToJson(const RigAdjustmentResult& r) {
   nlohmann::json heads = nlohmann::json::array();
   for (const RigHeadEstimate& h : r.heads) {
     nlohmann::json interior, interior_sigma;
-    for (int i = 0; i < Model::kNumParams; ++i) {
-      const std::string name(Model::kParams[i].name);
+    const std::vector<calib::ParamInfo> table = calib::CameraModelParams(h.model);
+    for (int i = 0; i < static_cast<int>(table.size()); ++i) {
+      const std::string name(table[i].name);
       interior[name] = h.interior[i];
       interior_sigma[name] = scalar(h.interior_sigma[i], 1.0);
     }

@@ -6,8 +6,9 @@
 // column). The exposure's pose is the platform's (the rig's virtual centre O and attitude R,
 // PoseBlocks); head k sees the object through
 //   R_k = R M_k E_k,   O_k = O + R t_k + v dT_k
-// (calib/camera/rig.h HeadPose) and obeys the one collinearity of aerocal with its own
-// 10-parameter interior (calib::RigHeadCollinearityResidual, group kGroupImage).
+// (calib/camera/rig.h HeadPose) and obeys the one collinearity of aerocal with its own interior in
+// its own registered model (calib::MakeRigHeadCollinearityResidual, group kGroupImage; the heads
+// of one rig may differ in model).
 //
 // Blocks the kind owns, per head k (entries in table units, rad, m, s):
 //   "camera ID"                    interior of the REFERENCE head: the frame camera's block of
@@ -71,8 +72,9 @@ struct RigAdjustOptions {
 struct RigHeadEstimate {
   std::string id;
   bool reference = false;
-  calib::InteriorParams interior{};
-  std::array<std::optional<double>, calib::BrownFraser10Model::kNumParams> interior_sigma{};
+  calib::CameraModelId model = calib::CameraModelId::kBrownFraser10;  // the head's camera model
+  calib::InteriorParams interior{};        // in the head's model, table order and units
+  calib::InteriorSigmas interior_sigma{};  // the same size
   Eigen::Vector3d mount_rad = Eigen::Vector3d::Zero(), lever_arm_m = Eigen::Vector3d::Zero();
   std::optional<Eigen::Vector3d> mount_sigma_rad, lever_arm_sigma_m;
   double time_offset_s = 0.0;
@@ -111,7 +113,7 @@ class RigHeadCamera final : public ImagingModel {
   ImageRay StartingRay(const SensorContext& context,
                        const ImageObservation& observation) const override;
   /// Group kGroupImage; blocks interior, rotation, centre, mount, lever arm, increment, time
-  /// offset, point (calib::RigHeadCollinearityResidual).
+  /// offset, point (calib::MakeRigHeadCollinearityResidual in the head's model).
   ObservationTerm Observe(const SensorContext& context,
                           const ImageObservation& observation,
                           calib::BlockId point) override;

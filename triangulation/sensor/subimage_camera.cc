@@ -165,10 +165,12 @@ ObservationTerm SubimageCamera::Observe(const SensorContext& context,
   m.used = true;
   ObservationTerm term;
   term.group = calib::kGroupSubimage;
-  term.cost = calib::VisitMappingModel(m.model, [&](auto model) {
-    return calib::SubimageCollinearityResidual<decltype(model)>::Create(
-        site.camera->frame(), m.conditioning, observation.pixel, observation.sigma_px);
-  });
+  term.cost = calib::MakeSubimageCollinearityResidual(site.camera->model,
+                                                      m.model,
+                                                      site.camera->frame(),
+                                                      m.conditioning,
+                                                      observation.pixel,
+                                                      observation.sigma_px);
   term.blocks = {m.block,
                  context.frame.InteriorBlock(site.camera_index),
                  site.pose.rotation,

@@ -1,12 +1,12 @@
 // The sub-image camera: a multi-CCD camera whose observations are RAW sub-image pixels (u, v),
 // taken to the virtual image by the mapping of their sub-image (CONVENTIONS.md "Sub-image to
-// virtual image"), then through the frame camera's interior and the exposure's pose
-// (calib::SubimageCollinearityResidual, group kGroupSubimage). The mappings are refined inside the
-// bundle (the joint stitching + triangulation adjustment, triangulation/joint/): one block per
-// (camera, sub-image) for the flight, or per exposure (MappingScope), in the conditioned
-// parameterisation (calib/camera/subimage_mapping.h). Its own residuals: the stitching
-// measurements of the block's exposures (maker reference points, group stitch_reference;
-// stitching tie points with unknown virtual positions, group stitch_tie).
+// virtual image"), then through the frame camera's interior, in the camera's own registered model,
+// and the exposure's pose (calib::MakeSubimageCollinearityResidual, group kGroupSubimage). The
+// mappings are refined inside the bundle (the joint stitching + triangulation adjustment,
+// triangulation/joint/): one block per (camera, sub-image) for the flight, or per exposure
+// (MappingScope), in the conditioned parameterisation (calib/camera/subimage_mapping.h). Its own
+// residuals: the stitching measurements of the block's exposures (maker reference points, group
+// stitch_reference; stitching tie points with unknown virtual positions, group stitch_tie).
 // Datum of the focal plane: the base sub-images keep their camera-file mapping; without base
 // sub-images the reference points carry it.
 #pragma once

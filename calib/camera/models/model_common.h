@@ -177,6 +177,9 @@ using OpenCvParams = std::array<double, 12>;
 template <typename Derived>
 struct ForwardCameraModel {
   static constexpr bool kCorrectionForm = false;
+  /// The free set of a calibration when none is given: every parameter (a model that knows
+  /// better hides this with its own kDefaultFree, as OpenCvModel does).
+  static constexpr std::string_view kDefaultFree = "all";
 
   template <typename T>
   static bool MeasuredFromIdeal(const T* params,

@@ -39,6 +39,9 @@ struct OpenCvModel : ForwardCameraModel<OpenCvModel> {
       {"k5", "1", ParamGroup::kRadial},
       {"k6", "1", ParamGroup::kRadial},
   }};
+  /// The free set of a calibration when none is given: OpenCV's own default (calibrateCamera
+  /// without CALIB_RATIONAL_MODEL: the rational k4-k6 held at 0).
+  static constexpr std::string_view kDefaultFree = "fx,fy,cx,cy,k1,k2,p1,p2,k3";
 
   /// OpenCV's distortion of normalised coordinates n (x right, y down): coefficients in
   /// distCoeffs order k = (k1, k2, p1, p2, k3, k4, k5, k6).
