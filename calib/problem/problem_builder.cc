@@ -590,6 +590,18 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   }
   report.linear_solver = SetLinearSolver(
       options, eliminable_params, other_params, !eliminable.empty(), &ceres_options);
+  const bool schur = ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
+                     ceres_options.linear_solver_type == ceres::SPARSE_SCHUR;
+  if (schur && options.engine == SolverEngine::kAerocal && report.diagnostics.empty()) {
+    const int max_dense = ceres_options.linear_solver_type == ceres::DENSE_SCHUR
+                              ? std::numeric_limits<int>::max()
+                              : -1;
+    if (SolveWithAerocal(options, free_blocks, max_dense, &report)) {
+      report.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return report;
+    }
+  }
   if (ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
       ceres_options.linear_solver_type == ceres::SPARSE_SCHUR ||
       ceres_options.linear_solver_type == ceres::ITERATIVE_SCHUR) {
@@ -617,18 +629,6 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
     }
   }
 
-  const bool schur = ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
-                     ceres_options.linear_solver_type == ceres::SPARSE_SCHUR;
-  if (schur && options.engine == SolverEngine::kAerocal && report.diagnostics.empty()) {
-    const int max_dense = ceres_options.linear_solver_type == ceres::DENSE_SCHUR
-                              ? std::numeric_limits<int>::max()
-                              : -1;
-    if (SolveWithAerocal(options, free_blocks, max_dense, &report)) {
-      report.seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      return report;
-    }
-  }
   ceres::Solver::Summary summary;
   if (report.diagnostics.empty())
     ceres::Solve(ceres_options, mirror ? mirror.get() : problem_.get(), &summary);
