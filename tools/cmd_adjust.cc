@@ -162,6 +162,10 @@ CommandRun SetupAdjust(CLI::App& app) {
                "Ignore the camera file's interior_sigma (unweighted self-calibration)");
   app.add_option("--max-iterations", args->options.solver.max_iterations, "Solver iterations")
       ->check(PositiveUpTo(1e5));
+  app.add_option("--threads",
+                 args->options.solver.num_threads,
+                 "Solver threads (0: all cores); the result is the same bits for every count")
+      ->check(CLI::Range(0, 1024));
   app.add_option("--correlation-threshold",
                  args->options.correlation_threshold,
                  "Report parameter pairs correlated above this")

@@ -3,7 +3,9 @@
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/core/log.h"
+#include "calib/problem/levenberg_marquardt.h"
 #include "calib/problem/normal_equations.h"
+#include "calib/problem/parallel_for.h"
 #include "calib/problem/rotation_manifold.h"
 #include "calib/problem/scaled_subset_manifold.h"
 
@@ -588,6 +590,18 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   }
   report.linear_solver = SetLinearSolver(
       options, eliminable_params, other_params, !eliminable.empty(), &ceres_options);
+  const bool schur = ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
+                     ceres_options.linear_solver_type == ceres::SPARSE_SCHUR;
+  if (schur && options.engine == SolverEngine::kAerocal && report.diagnostics.empty()) {
+    const int max_dense = ceres_options.linear_solver_type == ceres::DENSE_SCHUR
+                              ? std::numeric_limits<int>::max()
+                              : -1;
+    if (SolveWithAerocal(options, free_blocks, max_dense, &report)) {
+      report.seconds =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+      return report;
+    }
+  }
   if (ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
       ceres_options.linear_solver_type == ceres::SPARSE_SCHUR ||
       ceres_options.linear_solver_type == ceres::ITERATIVE_SCHUR) {
@@ -631,14 +645,67 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       std::max(0, static_cast<int>(summary.iterations.size()) - 1);  // [0] is the start
   report.initial_cost = summary.initial_cost;
   report.final_cost = summary.final_cost;
-  AddSolveStatistics(&report);
-  if (!report.converged)
-    report.diagnostics.push_back("the adjustment did not converge: " + summary.message);
-  for (BlockId id = 0; id < static_cast<BlockId>(blocks_.size()); ++id)
-    if (!blocks_[id].constant && blocks_[id].num_residuals == 0)
-      report.diagnostics.push_back("block " + blocks_[id].name + " has no observations");
+  report.evaluation_seconds =
+      summary.residual_evaluation_time_in_seconds + summary.jacobian_evaluation_time_in_seconds;
+  report.linear_solver_seconds = summary.linear_solver_time_in_seconds;
+  FinishSolveReport(&report);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
+}
+
+void ProblemBuilder::FinishSolveReport(SolveReport* report) const {
+  AddSolveStatistics(report);
+  if (!report->converged)
+    report->diagnostics.push_back("the adjustment did not converge: " + report->message);
+  for (BlockId id = 0; id < static_cast<BlockId>(blocks_.size()); ++id)
+    if (!blocks_[id].constant && blocks_[id].num_residuals == 0)
+      report->diagnostics.push_back("block " + blocks_[id].name + " has no observations");
+}
+
+bool ProblemBuilder::SolveWithAerocal(const SolverOptions& options,
+                                      const std::vector<BlockId>& free_blocks,
+                                      int max_dense,
+                                      SolveReport* report) {
+  std::vector<int> free_index(blocks_.size(), -1);
+  std::vector<internal::FreeBlock> free;
+  for (BlockId id : free_blocks) {
+    const Block& b = blocks_[id];
+    free_index[id] = static_cast<int>(free.size());
+    free.push_back(
+        {b.values, b.size, b.TangentSize(), problem_->GetManifold(b.values), b.Eliminable()});
+  }
+  std::vector<internal::ResidualTerm> terms;
+  for (const Residual& r : residuals_) {
+    if (!r.active) continue;
+    internal::ResidualTerm t{r.cost.get(), r.loss.get(), {}, {}};
+    for (BlockId id : r.blocks) {
+      t.free.push_back(free_index[id]);
+      t.constant.push_back(blocks_[id].values);
+    }
+    terms.push_back(std::move(t));
+  }
+  internal::ResidualEvaluator evaluator(
+      std::move(free), std::move(terms), internal::ResolveThreads(options.num_threads));
+  const auto system = internal::ReducedSystem::Create(evaluator, max_dense);
+  if (system == nullptr) return false;
+  internal::LmOptions lm{options.max_iterations,
+                         options.function_tolerance,
+                         options.gradient_tolerance,
+                         options.parameter_tolerance};
+  const internal::LmSummary summary =
+      internal::MinimizeLevenbergMarquardt(lm, &evaluator, system.get());
+  report->linear_solver = system->dense() ? "dense_schur" : "sparse_schur";
+  report->termination = summary.termination;
+  report->message = summary.message;
+  report->converged = summary.converged;
+  report->usable = summary.usable;
+  report->iterations = summary.iterations;
+  report->initial_cost = summary.initial_cost;
+  report->final_cost = summary.final_cost;
+  report->evaluation_seconds = summary.evaluation_seconds;
+  report->linear_solver_seconds = summary.linear_solver_seconds;
+  FinishSolveReport(report);
+  return true;
 }
 
 void ProblemBuilder::AddSolveStatistics(SolveReport* report_ptr) const {

@@ -82,6 +82,8 @@ enum class LinearSolverChoice {
   kSparseNormalCholesky
 };
 
+enum class SolverEngine { kAerocal, kCeres };
+
 struct SolverOptions {
   int max_iterations = 100;           // Levenberg-Marquardt iterations, > 0
   double function_tolerance = 1e-12;  // relative cost change to stop
@@ -97,10 +99,16 @@ struct SolverOptions {
   /// reduced system is solved iteratively (ITERATIVE_SCHUR, conjugate gradients with the
   /// SCHUR_JACOBI preconditioner) instead of factorised: memory grows linearly with the block.
   int min_iterative_schur_parameters = 0;
-  /// Identical inputs give bit-identical results: the solve runs on one thread (Ceres' threaded
-  /// gradient and Schur reductions add in scheduling order). False: `num_threads` threads.
+  /// Who minimises: aerocal's own Levenberg-Marquardt (levenberg_marquardt.h) wherever the
+  /// linear solver is a Schur one (dense or sparse) and every residual sees at most one point
+  /// block, else Ceres; kCeres: Ceres always (the reference path).
+  SolverEngine engine = SolverEngine::kAerocal;
+  /// Threads of aerocal's engine (0: all cores): its results are the same bits for every count.
+  /// Ceres' threads: `num_threads` when !deterministic, else one.
+  int num_threads = 0;
+  /// Ceres' engine only: identical inputs give bit-identical results, the solve runs on one
+  /// thread (Ceres' threaded gradient and Schur reductions add in scheduling order).
   bool deterministic = true;
-  int num_threads = 0;   // when !deterministic; 0: all cores
   bool verbose = false;  // Ceres per-iteration log on stdout
 };
 
@@ -126,6 +134,9 @@ struct SolveReport {
   double vtpv = 0.0;
   double sigma0 = 0.0;  // unitless, 1 when the a-priori sigmas are right
   double seconds = 0.0;
+  /// Of `seconds`: residual and Jacobian evaluation, and the linear solver (Schur reduction,
+  /// factorisation, back-substitution), summed over the iterations, s.
+  double evaluation_seconds = 0.0, linear_solver_seconds = 0.0;
   std::vector<ResidualGroupStats> groups;
   std::vector<std::string> diagnostics;
   const ResidualGroupStats* Group(const std::string& name) const;
@@ -296,6 +307,13 @@ class ProblemBuilder {
     ++structure_version_;
   }
 
+  /// The solve by aerocal's own engine (SolverOptions::engine); false, and nothing changed, when
+  /// the problem is not one it solves (then Ceres does).
+  bool SolveWithAerocal(const SolverOptions& options,
+                        const std::vector<BlockId>& free_blocks,
+                        int max_dense,
+                        SolveReport* report);
+
   /// Free parameters (tangent space) and scalar residuals currently in the problem.
   int NumFreeParameters() const;
   int NumObservations() const;
@@ -312,6 +330,8 @@ class ProblemBuilder {
   /// v^T P v per group and overall without the loss function, observations, unknowns,
   /// redundancy and sigma0 (a diagnostic when there is no redundancy) at the current values.
   void AddSolveStatistics(SolveReport* report) const;
+  /// The statistics and the diagnostics of a solve (not converged, blocks without observations).
+  void FinishSolveReport(SolveReport* report) const;
   /// The problem as Ceres must see it where it orders blocks by their address: the eliminable
   /// blocks (a Schur solve) or every block (`all`: ceres::Covariance, which sorts the Jacobian's
   /// columns by address) copied into one buffer in BlockId order (`buffer`; `pointers[id]` is

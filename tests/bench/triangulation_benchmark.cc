@@ -24,6 +24,7 @@
 
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -63,6 +64,7 @@ struct ColmapRun {
   bool ok = false;
   double seconds = 0, f_px = 0, final_rms_px = 0;
   double cpu_seconds = 0;  // user + system of bundle_adjuster (all its threads)
+  int iterations = 0;      // Ceres' iterations in COLMAP's report
 };
 
 // User + system CPU time of the reaped children of this process, s.
@@ -111,6 +113,9 @@ ColmapRun RunColmap(const Project& project) {
   // COLMAP's bundle-adjustment report: "Final cost : X [px]" (RMS reprojection error).
   std::ifstream log(dir.File("log.txt"));
   while (std::getline(log, line)) {
+    const auto iterations = line.find("Iterations");
+    if (iterations != std::string::npos && line.find(':', iterations) != std::string::npos)
+      run.iterations = std::atoi(line.substr(line.find(':', iterations) + 1).c_str());
     const auto at = line.find("Final cost");
     if (at == std::string::npos) continue;
     std::istringstream in(line.substr(line.find(':', at) + 1));
@@ -125,6 +130,7 @@ struct CliRun {
   int exit_code = -1;
   double seconds = 0, peak_rss_mb = 0;
   double cpu_seconds = 0;  // user + system of the child
+  int iterations = 0;      // the final solve's, from the result
 };
 
 // `aerocal adjust` on the project file `project_file`, result written to `out`.
@@ -155,6 +161,7 @@ CliRun RunAdjustCli(const std::string& project_file,
   // 0 converged; 3 ran but flagged (e.g. the rejection cap): a finished run all the same.
   run.ok = WIFEXITED(status) && (WEXITSTATUS(status) == 0 || WEXITSTATUS(status) == 3);
   run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  if (run.ok) run.iterations = testing::ReadJson(out).value("iterations", 0);
   return run;
 }
 
@@ -248,6 +255,8 @@ void BM_AdjustDefaults(benchmark::State& state) {
     return;
   }
   state.counters["adjust_s"] = with.seconds;
+  state.counters["adjust_iterations"] = with.iterations;  // the final solve's
+  state.counters["adjust_no_snooping_iterations"] = without.iterations;
   state.counters["adjust_cpu_s"] = with.cpu_seconds;
   state.counters["adjust_peak_rss_mb"] = with.peak_rss_mb;
   state.counters["adjust_no_snooping_s"] = without.seconds;
@@ -260,6 +269,8 @@ void BM_AdjustDefaults(benchmark::State& state) {
     state.counters["colmap_cpu_s"] = colmap.cpu_seconds;
     state.counters["ratio_aerocal_over_colmap"] = with.seconds / colmap.seconds;
     state.counters["ratio_cpu_aerocal_over_colmap"] = with.cpu_seconds / colmap.cpu_seconds;
+    state.counters["colmap_iterations"] = colmap.iterations;
+    state.counters["colmap_s_per_iteration"] = colmap.seconds / std::max(1, colmap.iterations);
   } else {
     state.SetLabel("colmap missing (apt-get install colmap) or failed: no ratio");
   }

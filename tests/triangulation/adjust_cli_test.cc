@@ -106,6 +106,24 @@ TEST_F(AdjustCommand, NotConvergedExitsThreeWithTheResultWritten) {
   EXPECT_FALSE(std::filesystem::exists(dir_.File("cam.yaml")));
 }
 
+// Issue 31: --threads chooses the solver's threads; the adjustment is the same bits for every
+// count.
+TEST_F(AdjustCommand, ThreadsGiveTheSameResultAndANegativeCountIsRefused) {
+  const std::string base = "adjust --project " + dir_.File("flight/project.yaml") +
+                           " --self-calibration all --no-snooping --threads ";
+  const auto one = RunAerocal(base + "1 --out " + dir_.File("one.json"));
+  const auto two = RunAerocal(base + "2 --out " + dir_.File("two.json"));
+  ASSERT_EQ(one.exit_code, 0) << one.output;
+  ASSERT_EQ(two.exit_code, 0) << two.output;
+  const auto a = ReadJson(dir_.File("one.json")), b = ReadJson(dir_.File("two.json"));
+  for (const char* key : {"sigma0", "cameras", "exposures", "residuals"})
+    EXPECT_EQ(a[key], b[key]) << key;
+  const auto bad = RunAerocal(base + "-1 --out " + dir_.File("bad.json"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("--threads"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_.File("bad.json")));
+}
+
 // Issue 28: an image id that starts with '#' ('#0001') was read as a comment, and the exposure and
 // its observations vanished with exit 0. It is an id: the exposure is adjusted under its name. An
 // exposure no observation names is named in the notes, never silently unused.

@@ -41,3 +41,4 @@ aerocal_add_test(triangulation/import_images_match LIBS aerocal::triangulation L
 aerocal_add_test(triangulation/calibration_readers LIBS aerocal::triangulation LABELS unit)
 # The platform data model and the sensor-kind factory (issue 30 item 1): the recipe's claims.
 aerocal_add_test(triangulation/sensor_platform LIBS aerocal::triangulation LABELS synthetic)
+aerocal_add_test(triangulation/solver_engine LIBS aerocal::triangulation LABELS unit)

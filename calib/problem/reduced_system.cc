@@ -1,0 +1,362 @@
+#include "calib/problem/reduced_system.h"
+
+#include "calib/problem/parallel_for.h"
+
+#include <Eigen/CholmodSupport>
+#include <Eigen/Dense>
+#include <Eigen/SparseCore>
+
+#include <algorithm>
+#include <atomic>
+#include <cmath>
+
+namespace aerocal::calib::internal {
+
+namespace {
+
+using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+using ConstMap = Eigen::Map<const RowMatrix>;
+using Map = Eigen::Map<RowMatrix>;
+
+constexpr double kMinDiagonal = 1e-6, kMaxDiagonal = 1e32;  // Ceres' LM defaults
+
+// Slot of free block `b` among the parameters of residual term `t`.
+int SlotOf(const ResidualTerm& t, int b) {
+  return static_cast<int>(std::find(t.free.begin(), t.free.end(), b) - t.free.begin());
+}
+
+// CSR-like grouping: items of each of n groups, in increasing item order.
+void Group(int n,
+           const std::vector<std::pair<int, int>>& group_item,
+           std::vector<int>* start,
+           std::vector<int>* items) {
+  start->assign(n + 1, 0);
+  for (const auto& [g, i] : group_item) ++(*start)[g + 1];
+  for (int g = 0; g < n; ++g) (*start)[g + 1] += (*start)[g];
+  items->resize(group_item.size());
+  std::vector<int> fill(start->begin(), start->end() - 1);
+  for (const auto& [g, i] : group_item) (*items)[fill[g]++] = i;
+}
+
+}  // namespace
+
+struct ReducedSystem::Sparse {
+  Eigen::SparseMatrix<double> s;  // lower triangle, the pattern fixed at Create
+  std::vector<long long> source;  // per stored value: its index in s_
+  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+};
+
+ReducedSystem::~ReducedSystem() = default;
+
+std::unique_ptr<ReducedSystem> ReducedSystem::Create(const ResidualEvaluator& ev, int max_dense) {
+  std::unique_ptr<ReducedSystem> sys(new ReducedSystem());
+  ReducedSystem& s = *sys;
+  s.threads_ = ev.threads();
+  const int n_blocks = ev.num_blocks();
+  s.point_of_block_.assign(n_blocks, -1);
+  s.reduced_of_block_.assign(n_blocks, -1);
+  s.reduced_offset_ = {0};
+  for (int b = 0; b < n_blocks; ++b) {
+    if (ev.block(b).eliminable) {
+      s.point_of_block_[b] = static_cast<int>(s.points_.size());
+      s.points_.push_back(b);
+    } else {
+      s.reduced_of_block_[b] = static_cast<int>(s.reduced_.size());
+      s.reduced_.push_back(b);
+      s.reduced_offset_.push_back(s.reduced_offset_.back() + ev.block(b).tangent);
+    }
+  }
+  s.n_reduced_ = s.reduced_offset_.back();
+  if (s.points_.empty() || s.reduced_.empty()) return nullptr;
+  s.residual_point_.assign(ev.num_residuals(), -1);
+  for (int i = 0; i < ev.num_residuals(); ++i)
+    for (int b : ev.term(i).free) {
+      if (b < 0 || s.point_of_block_[b] < 0) continue;
+      if (s.residual_point_[i] >= 0) return nullptr;  // two points in one residual
+      s.residual_point_[i] = s.point_of_block_[b];
+    }
+  s.BuildStructure(ev);
+  s.dense_ = s.n_reduced_ <= max_dense;
+  if (s.dense_) {
+    s.dense_s_.setZero(s.n_reduced_, s.n_reduced_);  // cells outside the pattern stay 0
+  } else {
+    s.sparse_ = std::make_unique<Sparse>();
+    std::vector<Eigen::Triplet<double>> triplets;
+    const int n_red = static_cast<int>(s.reduced_.size());
+    for (int i = 0; i < n_red; ++i)
+      for (int c = s.row_start_[i]; c < s.row_start_[i + 1]; ++c) {
+        const int j = s.row_cols_[c];
+        const int si = ev.block(s.reduced_[i]).tangent, sj = ev.block(s.reduced_[j]).tangent;
+        for (int a = 0; a < si; ++a)
+          for (int b = 0; b < sj && (i != j || b <= a); ++b)
+            triplets.emplace_back(s.reduced_offset_[i] + a,
+                                  s.reduced_offset_[j] + b,
+                                  static_cast<double>(s.cell_offset_[c] + a * sj + b));
+      }
+    s.sparse_->s.resize(s.n_reduced_, s.n_reduced_);
+    s.sparse_->s.setFromTriplets(triplets.begin(), triplets.end());
+    const auto& m = s.sparse_->s;
+    s.sparse_->source.resize(m.nonZeros());
+    for (long long k = 0; k < m.nonZeros(); ++k)
+      s.sparse_->source[k] = std::llround(m.valuePtr()[k]);
+    s.sparse_->llt.analyzePattern(s.sparse_->s);
+  }
+  return sys;
+}
+
+void ReducedSystem::BuildStructure(const ResidualEvaluator& ev) {
+  const int n_pts = static_cast<int>(points_.size()), n_red = static_cast<int>(reduced_.size());
+  std::vector<std::pair<int, int>> pr, rr;  // (point, residual), (reduced block, residual)
+  for (int i = 0; i < ev.num_residuals(); ++i) {
+    if (residual_point_[i] >= 0) pr.emplace_back(residual_point_[i], i);
+    for (int b : ev.term(i).free)
+      if (b >= 0 && reduced_of_block_[b] >= 0) rr.emplace_back(reduced_of_block_[b], i);
+  }
+  Group(n_pts, pr, &point_res_start_, &point_res_);
+  Group(n_red, rr, &red_res_start_, &red_res_);
+  red_res_slot_.resize(red_res_.size());
+  for (int j = 0; j < n_red; ++j)
+    for (int k = red_res_start_[j]; k < red_res_start_[j + 1]; ++k)
+      red_res_slot_[k] = SlotOf(ev.term(red_res_[k]), reduced_[j]);
+  // Per point: its reduced blocks, where its W and Q blocks live; per row, its column blocks.
+  point_blk_start_ = {0};
+  std::vector<std::vector<int>> cols(n_red);
+  std::vector<std::pair<int, int>> rp;  // (reduced block, entry)
+  long long w_size = 0, v_size = 0;
+  v_offset_.clear();
+  for (int e = 0; e < n_pts; ++e) {
+    std::vector<int> blk;
+    for (int k = point_res_start_[e]; k < point_res_start_[e + 1]; ++k)
+      for (int b : ev.term(point_res_[k]).free)
+        if (b >= 0 && reduced_of_block_[b] >= 0) blk.push_back(reduced_of_block_[b]);
+    std::sort(blk.begin(), blk.end());
+    blk.erase(std::unique(blk.begin(), blk.end()), blk.end());
+    const int t = ev.block(points_[e]).tangent;
+    v_offset_.push_back(v_size);
+    v_size += t * t;
+    for (size_t a = 0; a < blk.size(); ++a) {
+      rp.emplace_back(blk[a], static_cast<int>(point_blk_.size()));
+      point_blk_.push_back(blk[a]);
+      entry_point_.push_back(e);
+      point_w_.push_back(w_size);
+      w_size += static_cast<long long>(t) * ev.block(reduced_[blk[a]]).tangent;
+      for (size_t b = 0; b <= a; ++b) cols[blk[a]].push_back(blk[b]);
+    }
+    point_blk_start_.push_back(static_cast<int>(point_blk_.size()));
+  }
+  Group(n_red, rp, &red_pt_start_, &red_pt_entry_);
+  for (int i = 0; i < ev.num_residuals(); ++i) {
+    std::vector<int> blk;
+    for (int b : ev.term(i).free)
+      if (b >= 0 && reduced_of_block_[b] >= 0) blk.push_back(reduced_of_block_[b]);
+    for (int a : blk)
+      for (int b : blk)
+        if (b <= a) cols[a].push_back(b);
+  }
+  row_start_ = {0};
+  long long s_size = 0;
+  std::vector<double> row_cost(n_red), point_cost(n_pts);
+  for (int i = 0; i < n_red; ++i) {
+    std::sort(cols[i].begin(), cols[i].end());
+    cols[i].erase(std::unique(cols[i].begin(), cols[i].end()), cols[i].end());
+    const int si = ev.block(reduced_[i]).tangent;
+    for (int j : cols[i]) {
+      row_cols_.push_back(j);
+      cell_offset_.push_back(s_size);
+      s_size += static_cast<long long>(si) * ev.block(reduced_[j]).tangent;
+    }
+    row_start_.push_back(static_cast<int>(row_cols_.size()));
+    row_cost[i] = 2.0 * (red_res_start_[i + 1] - red_res_start_[i]) + cols[i].size();
+    for (int k = red_pt_start_[i]; k < red_pt_start_[i + 1]; ++k) {
+      const int entry = red_pt_entry_[k];
+      row_cost[i] += 1.0 + entry - point_blk_start_[entry_point_[entry]];
+    }
+  }
+  for (int e = 0; e < n_pts; ++e)
+    point_cost[e] = 1.0 + (point_res_start_[e + 1] - point_res_start_[e]) *
+                              (point_blk_start_[e + 1] - point_blk_start_[e]);
+  s_.assign(s_size, 0.0);
+  v_.assign(v_size, 0.0);
+  vinv_.assign(v_size, 0.0);
+  w_.assign(w_size, 0.0);
+  q_.assign(w_size, 0.0);
+  qg_.assign(ev.num_tangent(), 0.0);
+  row_bounds_ = BalancedBounds(row_cost, threads_);
+  point_bounds_ = BalancedBounds(point_cost, threads_);
+}
+
+double* ReducedSystem::Cell(int row, int col_block) {
+  const int* begin = row_cols_.data() + row_start_[row];
+  const int* end = row_cols_.data() + row_start_[row + 1];
+  return s_.data() + cell_offset_[std::lower_bound(begin, end, col_block) - row_cols_.data()];
+}
+
+void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
+  g_.setZero(ev.num_tangent());
+  diag_.setZero(ev.num_tangent());
+  // Per point: V_e = E^T E, g_e = E^T r, W_e = E^T F (each point by one thread).
+  ParallelRanges(point_bounds_, [&](int begin, int end, int) {
+    for (int e = begin; e < end; ++e) {
+      const int pb = points_[e], t = ev.block(pb).tangent, to = ev.tangent_offset(pb);
+      Map v(v_.data() + v_offset_[e], t, t);
+      v.setZero();
+      const int b0 = point_blk_start_[e], b1 = point_blk_start_[e + 1];
+      for (int a = b0; a < b1; ++a)
+        Map(w_.data() + point_w_[a], t, ev.block(reduced_[point_blk_[a]]).tangent).setZero();
+      for (int k = point_res_start_[e]; k < point_res_start_[e + 1]; ++k) {
+        const int i = point_res_[k], rows = ev.residual_size(i);
+        const ResidualTerm& term = ev.term(i);
+        const ConstMap ej(ev.jacobian(i, SlotOf(term, pb)), rows, t);
+        const Eigen::Map<const Eigen::VectorXd> r(ev.residual(i), rows);
+        v.noalias() += ej.transpose().lazyProduct(ej);
+        g_.segment(to, t).noalias() += ej.transpose().lazyProduct(r);
+        for (size_t q = 0; q < term.free.size(); ++q) {
+          const int b = term.free[q];
+          if (b < 0 || reduced_of_block_[b] < 0) continue;
+          const int j = reduced_of_block_[b], sj = ev.block(b).tangent;
+          const int a = static_cast<int>(
+              std::lower_bound(point_blk_.begin() + b0, point_blk_.begin() + b1, j) -
+              point_blk_.begin());
+          Map(w_.data() + point_w_[a], t, sj).noalias() +=
+              ej.transpose().lazyProduct(ConstMap(ev.jacobian(i, static_cast<int>(q)), rows, sj));
+        }
+      }
+      diag_.segment(to, t) = v.diagonal();
+    }
+  });
+  // Per reduced block: g_j = F_j^T r and diag(F_j^T F_j), residuals in index order.
+  ParallelRanges(row_bounds_, [&](int begin, int end, int) {
+    for (int j = begin; j < end; ++j) {
+      const int b = reduced_[j], sj = ev.block(b).tangent, to = ev.tangent_offset(b);
+      for (int k = red_res_start_[j]; k < red_res_start_[j + 1]; ++k) {
+        const int i = red_res_[k], rows = ev.residual_size(i);
+        const ConstMap f(ev.jacobian(i, red_res_slot_[k]), rows, sj);
+        g_.segment(to, sj).noalias() +=
+            f.transpose().lazyProduct(Eigen::Map<const Eigen::VectorXd>(ev.residual(i), rows));
+        diag_.segment(to, sj) += f.colwise().squaredNorm().transpose();
+      }
+    }
+  });
+}
+
+void ReducedSystem::AssembleRow(const ResidualEvaluator& ev, int i) {
+  const int bi = reduced_[i], si = ev.block(bi).tangent, oi = reduced_offset_[i];
+  for (int c = row_start_[i]; c < row_start_[i + 1]; ++c)
+    std::fill_n(s_.data() + cell_offset_[c], si * ev.block(reduced_[row_cols_[c]]).tangent, 0.0);
+  // U = F^T F, the residuals by index.
+  for (int k = red_res_start_[i]; k < red_res_start_[i + 1]; ++k) {
+    const int r = red_res_[k], rows = ev.residual_size(r);
+    const ResidualTerm& term = ev.term(r);
+    const ConstMap fi(ev.jacobian(r, red_res_slot_[k]), rows, si);
+    for (size_t q = 0; q < term.free.size(); ++q) {
+      const int b = term.free[q];
+      if (b < 0 || reduced_of_block_[b] < 0 || reduced_of_block_[b] > i) continue;
+      const int sj = ev.block(b).tangent;
+      Map(Cell(i, reduced_of_block_[b]), si, sj).noalias() +=
+          fi.transpose().lazyProduct(ConstMap(ev.jacobian(r, static_cast<int>(q)), rows, sj));
+    }
+  }
+  Map diagonal(Cell(i, i), si, si);
+  const int ti = ev.tangent_offset(bi);
+  for (int a = 0; a < si; ++a) diagonal(a, a) += d2_(ti + a);
+  rhs_.segment(oi, si) = -g_.segment(ti, si);
+  // - W_e^T V_e^-1 W_e, the points by index.
+  for (int k = red_pt_start_[i]; k < red_pt_start_[i + 1]; ++k) {
+    const int entry = red_pt_entry_[k];
+    const int e = entry_point_[entry];
+    const int t = ev.block(points_[e]).tangent;
+    const ConstMap wi(w_.data() + point_w_[entry], t, si);
+    for (int a = point_blk_start_[e]; a <= entry; ++a) {
+      const int j = point_blk_[a], sj = ev.block(reduced_[j]).tangent;
+      Map(Cell(i, j), si, sj).noalias() -=
+          wi.transpose().lazyProduct(ConstMap(q_.data() + point_w_[a], t, sj));
+    }
+    rhs_.segment(oi, si).noalias() += wi.transpose().lazyProduct(
+        Eigen::Map<const Eigen::VectorXd>(qg_.data() + ev.tangent_offset(points_[e]), t));
+  }
+}
+
+bool ReducedSystem::Factorize(Eigen::VectorXd* rhs) {
+  const int n_red = static_cast<int>(reduced_.size());
+  if (dense_) {
+    for (int i = 0; i < n_red; ++i) {
+      const int si = reduced_offset_[i + 1] - reduced_offset_[i];
+      for (int c = row_start_[i]; c < row_start_[i + 1]; ++c) {
+        const int j = row_cols_[c], sj = reduced_offset_[j + 1] - reduced_offset_[j];
+        dense_s_.block(reduced_offset_[i], reduced_offset_[j], si, sj) =
+            ConstMap(s_.data() + cell_offset_[c], si, sj);
+      }
+    }
+    Eigen::LLT<Eigen::MatrixXd, Eigen::Lower> llt(dense_s_);
+    if (llt.info() != Eigen::Success) return false;
+    llt.solveInPlace(*rhs);
+    return rhs->allFinite();
+  }
+  double* values = sparse_->s.valuePtr();
+  for (size_t k = 0; k < sparse_->source.size(); ++k) values[k] = s_[sparse_->source[k]];
+  sparse_->llt.factorize(sparse_->s);
+  if (sparse_->llt.info() != Eigen::Success) return false;
+  *rhs = sparse_->llt.solve(*rhs);
+  return sparse_->llt.info() == Eigen::Success && rhs->allFinite();
+}
+
+bool ReducedSystem::Solve(const ResidualEvaluator& ev, double radius, Eigen::VectorXd* dx) {
+  d2_ = diag_.cwiseMax(kMinDiagonal).cwiseMin(kMaxDiagonal) / radius;
+  std::atomic<bool> ok{true};
+  // V_e^-1 (damped), Q_e = V_e^-1 W_e, V_e^-1 g_e per point.
+  ParallelRanges(point_bounds_, [&](int begin, int end, int) {
+    for (int e = begin; e < end; ++e) {
+      const int pb = points_[e], t = ev.block(pb).tangent, to = ev.tangent_offset(pb);
+      Eigen::MatrixXd v = ConstMap(v_.data() + v_offset_[e], t, t);
+      v.diagonal() += d2_.segment(to, t);
+      Map vinv(vinv_.data() + v_offset_[e], t, t);
+      const Eigen::LLT<Eigen::MatrixXd> llt(v);
+      if (llt.info() == Eigen::Success) {
+        vinv = llt.solve(Eigen::MatrixXd::Identity(t, t));
+      } else {  // a point its rays do not determine (one ray): the pseudo-inverse, as Ceres
+        const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(v);
+        const double max = eig.eigenvalues().cwiseAbs().maxCoeff();
+        Eigen::VectorXd inverse = eig.eigenvalues();
+        for (int k = 0; k < t; ++k) inverse(k) = inverse(k) > 1e-12 * max ? 1.0 / inverse(k) : 0.0;
+        vinv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+      }
+      if (!vinv.allFinite()) {
+        ok = false;
+        continue;
+      }
+      Eigen::Map<Eigen::VectorXd>(qg_.data() + to, t).noalias() =
+          vinv.lazyProduct(g_.segment(to, t));
+      for (int a = point_blk_start_[e]; a < point_blk_start_[e + 1]; ++a) {
+        const int sj = ev.block(reduced_[point_blk_[a]]).tangent;
+        Map(q_.data() + point_w_[a], t, sj).noalias() =
+            vinv.lazyProduct(ConstMap(w_.data() + point_w_[a], t, sj));
+      }
+    }
+  });
+  if (!ok) return false;
+  rhs_.resize(n_reduced_);
+  ParallelRanges(row_bounds_, [&](int begin, int end, int) {
+    for (int i = begin; i < end; ++i) AssembleRow(ev, i);
+  });
+  if (!Factorize(&rhs_)) return false;
+  dx->resize(ev.num_tangent());
+  for (size_t j = 0; j < reduced_.size(); ++j)
+    dx->segment(ev.tangent_offset(reduced_[j]), reduced_offset_[j + 1] - reduced_offset_[j]) =
+        rhs_.segment(reduced_offset_[j], reduced_offset_[j + 1] - reduced_offset_[j]);
+  // Back-substitution: dx_e = -V_e^-1 g_e - Q_e dx_F.
+  ParallelRanges(point_bounds_, [&](int begin, int end, int) {
+    for (int e = begin; e < end; ++e) {
+      const int pb = points_[e], t = ev.block(pb).tangent, to = ev.tangent_offset(pb);
+      Eigen::VectorXd x = -Eigen::Map<const Eigen::VectorXd>(qg_.data() + to, t);
+      for (int a = point_blk_start_[e]; a < point_blk_start_[e + 1]; ++a) {
+        const int j = point_blk_[a], sj = reduced_offset_[j + 1] - reduced_offset_[j];
+        x.noalias() -= ConstMap(q_.data() + point_w_[a], t, sj)
+                           .lazyProduct(rhs_.segment(reduced_offset_[j], sj));
+      }
+      dx->segment(to, t) = x;
+    }
+  });
+  return dx->allFinite();
+}
+
+}  // namespace aerocal::calib::internal

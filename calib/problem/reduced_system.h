@@ -1,0 +1,81 @@
+// The damped normal equations of the deterministic solver (levenberg_marquardt.h) with the point
+// blocks eliminated: the reduced camera system, assembled in parallel with a fixed summation order,
+// factorised by Cholesky (dense LLT, or CHOLMOD's supernodal LLT when sparse), and the points
+// back-substituted. Internal to calib/problem.
+//
+// With the tangent Jacobian J = [E F] (E: point columns, F: the others), g = J^T r and the
+// Levenberg-Marquardt damping D^2 = diag(J^T J) / radius (diag clamped to [1e-6, 1e32], as Ceres):
+//   V_e = E_e^T E_e + D_e^2 per point e,  W_e = E_e^T F,  U = F^T F + D_F^2,
+//   S = U - sum_e W_e^T V_e^-1 W_e,   S dx_F = -g_F + sum_e W_e^T V_e^-1 g_e,
+//   dx_e = -V_e^-1 (g_e + W_e dx_F).
+// Determinism: the per-point terms are computed independently (any thread); S is stored by block
+// rows of reduced blocks, and each block row is assembled by ONE thread (rows split by cost), its
+// cells summed in a fixed order (the residuals by index, then the points by index). So S, its
+// factor and the step are the same bits for every thread count.
+#pragma once
+
+#include "calib/problem/residual_evaluator.h"
+
+#include <Eigen/Core>
+
+#include <memory>
+#include <vector>
+
+namespace aerocal::calib::internal {
+
+class ReducedSystem {
+ public:
+  /// nullptr when a residual sees two point blocks (no block-diagonal elimination) or there are no
+  /// points or no reduced blocks. Up to `max_dense` reduced parameters the factorisation is dense.
+  static std::unique_ptr<ReducedSystem> Create(const ResidualEvaluator& evaluator, int max_dense);
+  ~ReducedSystem();
+
+  /// The terms that do not depend on the damping, from the evaluator's current Jacobian.
+  void Linearize(const ResidualEvaluator& evaluator);
+  /// The step dx (tangent, evaluator's block order) for the damping 1 / radius; false when the
+  /// factorisation fails.
+  bool Solve(const ResidualEvaluator& evaluator, double radius, Eigen::VectorXd* dx);
+
+  const Eigen::VectorXd& gradient() const { return g_; }  // J^T r (tangent)
+  /// The damping D^2 of the last Solve (tangent).
+  const Eigen::VectorXd& damping() const { return d2_; }
+  bool dense() const { return dense_; }
+  int num_reduced() const { return n_reduced_; }
+
+ private:
+  ReducedSystem() = default;
+  void BuildStructure(const ResidualEvaluator& ev);
+  double* Cell(int row, int col_block);
+  void AssembleRow(const ResidualEvaluator& ev, int row);
+  bool Factorize(Eigen::VectorXd* rhs);
+
+  struct Sparse;  // CHOLMOD
+  int threads_ = 1;
+  bool dense_ = true;
+  int n_reduced_ = 0;
+  std::vector<int> point_of_block_, reduced_of_block_;  // per free block: index or -1
+  std::vector<int> points_, reduced_;                   // free block of each point / reduced block
+  std::vector<int> reduced_offset_;                     // scalar offset in S per reduced block
+  std::vector<int> residual_point_;                     // per residual: point index or -1
+  // per point: its residuals, its reduced blocks (sorted) and where W_e / Q_e of each start
+  std::vector<int> point_res_start_, point_res_;
+  std::vector<int> point_blk_start_, point_blk_;
+  std::vector<long long> point_w_;  // per entry of point_blk_: offset in w_ / q_
+  std::vector<int> entry_point_;    // per entry of point_blk_: its point
+  // per reduced block: the residuals touching it (slot of the block in the residual), the points
+  std::vector<int> red_res_start_, red_res_, red_res_slot_;
+  std::vector<int> red_pt_start_, red_pt_entry_;  // entry: index into point_blk_
+  // S by block rows: column blocks (sorted, <= row) and their cells (row-major s_i x s_j)
+  std::vector<int> row_start_, row_cols_;
+  std::vector<long long> cell_offset_;
+  std::vector<double> s_;
+  std::vector<int> row_bounds_, point_bounds_;
+  // per point: V (undamped), V^-1 (damped), g_e; W, Q = V^-1 W
+  std::vector<long long> v_offset_;
+  std::vector<double> v_, vinv_, w_, q_, qg_;
+  Eigen::VectorXd g_, diag_, d2_, rhs_;
+  Eigen::MatrixXd dense_s_;
+  std::unique_ptr<Sparse> sparse_;
+};
+
+}  // namespace aerocal::calib::internal
