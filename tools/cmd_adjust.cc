@@ -165,7 +165,7 @@ CommandRun SetupAdjust(CLI::App& app) {
   app.add_option("--threads",
                  args->options.solver.num_threads,
                  "Solver threads (0: all cores); the result is the same bits for every count")
-      ->check(CLI::Range(0, 1024));
+      ->check(FiniteRange(0, 1024));
   app.add_option("--correlation-threshold",
                  args->options.correlation_threshold,
                  "Report parameter pairs correlated above this")
