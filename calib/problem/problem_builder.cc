@@ -19,7 +19,6 @@
 #include <cmath>
 #include <limits>
 #include <set>
-#include <thread>
 
 namespace aerocal::calib {
 
@@ -494,16 +493,28 @@ ceres::Solver::Options BaseCeresOptions(const SolverOptions& options) {
   ceres_options.gradient_tolerance = options.gradient_tolerance;
   ceres_options.parameter_tolerance = options.parameter_tolerance;
   ceres_options.num_threads =
-      options.deterministic ? 1
-      : options.num_threads > 0
-          ? options.num_threads
-          : static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+      options.deterministic ? 1 : internal::ResolveThreads(options.num_threads);
   // The solver's iterations: asked for by the caller, or by the command line's --verbose.
   const bool verbose = options.verbose || GetLogLevel() == LogLevel::kInfo;
   ceres_options.minimizer_progress_to_stdout = verbose;
   ceres_options.logging_type = verbose ? ceres::PER_MINIMIZER_ITERATION : ceres::SILENT;
 
   return ceres_options;
+}
+
+// What Ceres' summary says of the solve: termination, iterations, costs, where the time went.
+void CopyCeresSummary(const ceres::Solver::Summary& summary, SolveReport* report) {
+  report->termination = ceres::TerminationTypeToString(summary.termination_type);
+  report->message = summary.message;
+  report->converged = summary.termination_type == ceres::CONVERGENCE;
+  report->usable = summary.IsSolutionUsable();
+  report->iterations =
+      std::max(0, static_cast<int>(summary.iterations.size()) - 1);  // [0] is the start
+  report->initial_cost = summary.initial_cost;
+  report->final_cost = summary.final_cost;
+  report->evaluation_seconds =
+      summary.residual_evaluation_time_in_seconds + summary.jacobian_evaluation_time_in_seconds;
+  report->linear_solver_seconds = summary.linear_solver_time_in_seconds;
 }
 
 // The linear solver: options.linear_solver, or by the problem's size (kAuto): dense QR for small
@@ -590,17 +601,11 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
   }
   report.linear_solver = SetLinearSolver(
       options, eliminable_params, other_params, !eliminable.empty(), &ceres_options);
-  const bool schur = ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
-                     ceres_options.linear_solver_type == ceres::SPARSE_SCHUR;
-  if (schur && options.engine == SolverEngine::kAerocal && report.diagnostics.empty()) {
-    const int max_dense = ceres_options.linear_solver_type == ceres::DENSE_SCHUR
-                              ? std::numeric_limits<int>::max()
-                              : -1;
-    if (SolveWithAerocal(options, free_blocks, max_dense, &report)) {
-      report.seconds =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-      return report;
-    }
+  if (report.diagnostics.empty() &&
+      SolveWithAerocal(options, ceres_options.linear_solver_type, free_blocks, &report)) {
+    report.seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return report;
   }
   if (ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
       ceres_options.linear_solver_type == ceres::SPARSE_SCHUR ||
@@ -637,17 +642,7 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       if (mirror_pointers[id] != blocks_[id].values)
         std::copy(mirror_pointers[id], mirror_pointers[id] + blocks_[id].size, blocks_[id].values);
 
-  report.termination = ceres::TerminationTypeToString(summary.termination_type);
-  report.message = summary.message;
-  report.converged = summary.termination_type == ceres::CONVERGENCE;
-  report.usable = summary.IsSolutionUsable();
-  report.iterations =
-      std::max(0, static_cast<int>(summary.iterations.size()) - 1);  // [0] is the start
-  report.initial_cost = summary.initial_cost;
-  report.final_cost = summary.final_cost;
-  report.evaluation_seconds =
-      summary.residual_evaluation_time_in_seconds + summary.jacobian_evaluation_time_in_seconds;
-  report.linear_solver_seconds = summary.linear_solver_time_in_seconds;
+  CopyCeresSummary(summary, &report);
   FinishSolveReport(&report);
   report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return report;
@@ -663,9 +658,15 @@ void ProblemBuilder::FinishSolveReport(SolveReport* report) const {
 }
 
 bool ProblemBuilder::SolveWithAerocal(const SolverOptions& options,
+                                      ceres::LinearSolverType chosen,
                                       const std::vector<BlockId>& free_blocks,
-                                      int max_dense,
                                       SolveReport* report) {
+  // The engine takes the place of Ceres' dense and sparse Schur solvers, factorising the reduced
+  // system as the chosen one would.
+  if (options.engine != SolverEngine::kAerocal ||
+      (chosen != ceres::DENSE_SCHUR && chosen != ceres::SPARSE_SCHUR))
+    return false;
+  const int max_dense = chosen == ceres::DENSE_SCHUR ? std::numeric_limits<int>::max() : -1;
   std::vector<int> free_index(blocks_.size(), -1);
   std::vector<internal::FreeBlock> free;
   for (BlockId id : free_blocks) {

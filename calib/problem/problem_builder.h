@@ -37,6 +37,7 @@
 
 #include <Eigen/Core>
 #include <ceres/cost_function.h>
+#include <ceres/types.h>
 
 #include <map>
 #include <memory>
@@ -307,13 +308,6 @@ class ProblemBuilder {
     ++structure_version_;
   }
 
-  /// The solve by aerocal's own engine (SolverOptions::engine); false, and nothing changed, when
-  /// the problem is not one it solves (then Ceres does).
-  bool SolveWithAerocal(const SolverOptions& options,
-                        const std::vector<BlockId>& free_blocks,
-                        int max_dense,
-                        SolveReport* report);
-
   /// Free parameters (tangent space) and scalar residuals currently in the problem.
   int NumFreeParameters() const;
   int NumObservations() const;
@@ -332,6 +326,12 @@ class ProblemBuilder {
   void AddSolveStatistics(SolveReport* report) const;
   /// The statistics and the diagnostics of a solve (not converged, blocks without observations).
   void FinishSolveReport(SolveReport* report) const;
+  /// The solve by aerocal's own engine (SolverOptions::engine) in place of Ceres' `chosen` Schur
+  /// solver; false, and nothing changed, when the problem is not one it solves (then Ceres does).
+  bool SolveWithAerocal(const SolverOptions& options,
+                        ceres::LinearSolverType chosen,
+                        const std::vector<BlockId>& free_blocks,
+                        SolveReport* report);
   /// The problem as Ceres must see it where it orders blocks by their address: the eliminable
   /// blocks (a Schur solve) or every block (`all`: ceres::Covariance, which sorts the Jacobian's
   /// columns by address) copied into one buffer in BlockId order (`buffer`; `pointers[id]` is
