@@ -183,9 +183,8 @@ inline std::unique_ptr<ceres::CostFunction> MakeSubimageCollinearityResidual(
 /// HeadPose), then the same collinearity as the frame camera with the head's own interior.
 ///   r = ((xb + dx, yb + dy) - (-c_k U / W, -c_k V / W)) / sigma_mm,  [U V W] = R_k^T (X - O_k)
 /// in the head's camera model `Model`.
-/// blocks: interior[Model::kNumParams] (head k, table units), rig_rotation[4] (quaternion of R, as
-/// the frame
-///         camera's rotation block), rig_center[3] (m),
+/// blocks: interior[Model::kNumParams] (head k, table units), rig_rotation[4] (quaternion of R,
+///         as the frame camera's rotation block), rig_center[3] (m),
 ///         mount[3] (M_k omega, phi, kappa, rad), lever_arm[3] (t_k in the rig frame, m),
 ///         increment[3] (E_k, rad), dt[1] (dT_k, s), point[3] (m).
 /// The platform velocity v (object frame, m/s) is data of the exposure, held by value.

@@ -456,12 +456,7 @@ TEST(TimeOffset, RecoveredWithPosPriorsAndNamedWithout) {
   EXPECT_FALSE(free.time_offset_sigma_s.has_value());
 }
 
-INSTANTIATE_TEST_SUITE_P(Layouts,
-                         GaugeDatum,
-                         ::testing::Values(false, true),
-                         [](const ::testing::TestParamInfo<bool>& info) {
-                           return info.param ? "LinearVirtualCcd" : "Subcameras";
-                         });
+INSTANTIATE_TEST_SUITE_P(Layouts, GaugeDatum, ::testing::Values(false, true), LayoutName);
 
 }  // namespace
 }  // namespace aerocal::triangulation

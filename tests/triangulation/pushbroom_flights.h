@@ -4,7 +4,10 @@
 
 #include "triangulation/pushbroom/line_simulation.h"
 
+#include <gtest/gtest.h>
+
 #include <cstdint>
+#include <string>
 
 namespace aerocal::triangulation {
 
@@ -38,6 +41,11 @@ inline void RemoveNoise(LineSimulationOptions* o) {
   o->image_noise_px = o->control_noise_m = 0;
   o->pos_error_m = o->pos_error_deg = o->pos_bias_m = o->pos_bias_deg = 0;
   o->pos_drift_m = o->pos_drift_deg = 0;
+}
+
+/// The name of a test parameterised by the layout (DatumFlight's `linear_layout`).
+inline std::string LayoutName(const ::testing::TestParamInfo<bool>& info) {
+  return info.param ? "LinearVirtualCcd" : "Subcameras";
 }
 
 }  // namespace aerocal::triangulation

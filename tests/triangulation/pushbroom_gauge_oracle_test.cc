@@ -458,12 +458,7 @@ TEST(LeverArmOracle, ProfileOfTheVerticalLeverArm) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Layouts,
-                         GaugeOracle,
-                         ::testing::Values(false, true),
-                         [](const ::testing::TestParamInfo<bool>& info) {
-                           return info.param ? "LinearVirtualCcd" : "Subcameras";
-                         });
+INSTANTIATE_TEST_SUITE_P(Layouts, GaugeOracle, ::testing::Values(false, true), LayoutName);
 
 }  // namespace
 }  // namespace aerocal::triangulation
