@@ -106,14 +106,12 @@ using CollinearityResidual = ModelCollinearityResidual<BrownFraser10Model>;
 /// THE residual factory: the collinearity residual of an observation (col, row) of a camera in
 /// model `model` (blocks interior[CameraModelParamCount(model)], rotation[4], center[3],
 /// point[3]).
-inline std::unique_ptr<ceres::CostFunction> MakeCollinearityResidual(CameraModelId model,
-                                                                     const PixelFrame& frame,
-                                                                     const Eigen::Vector2d& pixel,
-                                                                     double sigma_px) {
-  return VisitCameraModel(model, [&](auto m) {
-    return ModelCollinearityResidual<decltype(m)>::Create(frame, pixel, sigma_px);
-  });
-}
+/// Defined in collinearity_factory.cc (the factories are compiled once, library
+/// aerocal::residual_factories: each instantiates its functor for every model).
+std::unique_ptr<ceres::CostFunction> MakeCollinearityResidual(CameraModelId model,
+                                                              const PixelFrame& frame,
+                                                              const Eigen::Vector2d& pixel,
+                                                              double sigma_px);
 
 /// Observation (u, v) in a RAW sub-image; the sub-image mapping (conditioned parameters, see
 /// subimage_mapping.h) takes it to the virtual image, then collinearity as above in the camera's
@@ -163,20 +161,14 @@ using SubimageCollinearityResidual = ModelSubimageCollinearityResidual<BrownFras
 
 /// The sub-image residual of a camera in model `model` with mappings of `mapping` (both
 /// dispatches: VisitCameraModel, VisitMappingModel). Blocks as ModelSubimageCollinearityResidual.
-inline std::unique_ptr<ceres::CostFunction> MakeSubimageCollinearityResidual(
+/// Defined in subimage_collinearity_factory.cc.
+std::unique_ptr<ceres::CostFunction> MakeSubimageCollinearityResidual(
     CameraModelId model,
     MappingModel mapping,
     const PixelFrame& frame,
     const MappingConditioning& cond,
     const Eigen::Vector2d& uv,
-    double sigma_px) {
-  return VisitCameraModel(model, [&](auto m) {
-    return VisitMappingModel(mapping, [&](auto map) {
-      return ModelSubimageCollinearityResidual<decltype(m), decltype(map)>::Create(
-          frame, cond, uv, sigma_px);
-    });
-  });
-}
+    double sigma_px);
 
 /// Observation (col, row) in the pixel frame of head k of a rig (CONVENTIONS.md "Multi-head
 /// rigs"): the head's pose is R_k = R M_k E_k, O_k = O + R t_k + v dT_k (calib/camera/rig.h
@@ -250,16 +242,12 @@ using RigHeadCollinearityResidual = ModelRigHeadCollinearityResidual<BrownFraser
 
 /// The rig-head residual of a head in model `model` (VisitCameraModel); blocks as
 /// ModelRigHeadCollinearityResidual.
-inline std::unique_ptr<ceres::CostFunction> MakeRigHeadCollinearityResidual(
+/// Defined in rig_head_collinearity_factory.cc.
+std::unique_ptr<ceres::CostFunction> MakeRigHeadCollinearityResidual(
     CameraModelId model,
     const PixelFrame& head_frame,
     const Eigen::Vector2d& pixel,
     double sigma_px,
-    const Eigen::Vector3d& velocity_mps) {
-  return VisitCameraModel(model, [&](auto m) {
-    return ModelRigHeadCollinearityResidual<decltype(m)>::Create(
-        head_frame, pixel, sigma_px, velocity_mps);
-  });
-}
+    const Eigen::Vector3d& velocity_mps);
 
 }  // namespace aerocal::calib

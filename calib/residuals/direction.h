@@ -110,17 +110,13 @@ struct ModelDirectionResidual
   double whitening_[4];
 };
 
-/// The factory by model id (VisitCameraModel), blocks as ModelDirectionResidual.
-inline std::unique_ptr<ceres::CostFunction> MakeDirectionResidual(
+/// The factory by model id (VisitCameraModel), blocks as ModelDirectionResidual. Defined in
+/// direction_factory.cc (compiled once, library aerocal::residual_factories).
+std::unique_ptr<ceres::CostFunction> MakeDirectionResidual(
     CameraModelId model,
     const PixelFrame& frame,
     const Eigen::Matrix3d& instrument_rotation,
     const Eigen::Vector2d& pixel,
-    const Eigen::Matrix2d& covariance_mm2) {
-  return VisitCameraModel(model, [&](auto m) {
-    return ModelDirectionResidual<decltype(m)>::Create(
-        frame, instrument_rotation, pixel, covariance_mm2);
-  });
-}
+    const Eigen::Matrix2d& covariance_mm2);
 
 }  // namespace aerocal::calib

@@ -30,7 +30,7 @@ aerocal_add_test(tools/cli_plausibility LIBS aerocal::calib LABELS cli)
 # Issue 37, part 3: OpenCV FileStorage bounds and lines, --camera on files of one camera, camera
 # convert's outputs as a set, size products of options.
 aerocal_add_test(tools/bad_input3 LIBS aerocal::calib LABELS cli)
-aerocal_add_test(tools/output_set LIBS aerocal::calib LABELS unit)
+aerocal_add_test(tools/output_set LIBS aerocal::calib LABELS unit reader)
 target_sources(test_tools_output_set PRIVATE ${PROJECT_SOURCE_DIR}/tools/output_set.cc)
 # `aerocal batch` (issue 35): plan / run --shard / status / merge against `flight`, a killed run,
 # changed and failing units, GNU Parallel (skipped without it), the Slurm scripts.

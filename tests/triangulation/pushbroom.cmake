@@ -1,6 +1,6 @@
 # Line (pushbroom) cameras (issue 17): the model, file and residual (calib), the POS trajectory,
 # the calibration on simulated flights, the commands; the Monte-Carlo study is labelled `long`.
-aerocal_add_test(calib/line_camera LIBS aerocal::calib LABELS unit)
+aerocal_add_test(calib/line_camera LIBS aerocal::calib LABELS unit reader)
 # The angular residual of the line camera (issue 28): invariance under rotation and scale.
 aerocal_add_test(calib/line_ray_angle LIBS aerocal::calib LABELS unit)
 aerocal_add_test(triangulation/pushbroom_degree LIBS aerocal::triangulation LABELS unit)
