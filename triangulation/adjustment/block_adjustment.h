@@ -131,6 +131,27 @@ class BlockAdjustment {
   /// Human name of a residual: "image 0012 point T442" or the builder's label.
   std::string Describe(calib::ResidualId id) const;
 
+  // Run's steps (block_adjustment_run.cc), in their order there.
+  /// The share of the active image residuals' components above robust_trigger_w.
+  double GrossShare() const;
+  void DropSingleRayPoints(AdjustmentResult* result);
+  void CollectResiduals(AdjustmentResult* result) const;
+  /// sigma0, and in px and um through the median a-priori image sigma.
+  void SetSigma0Units(AdjustmentResult* result) const;
+  struct CovarianceBlocks {
+    std::vector<calib::BlockId> all;    // whose covariance is estimated
+    std::vector<calib::BlockId> cross;  // with everything (interior, free platform parameters)
+  };
+  CovarianceBlocks CovarianceBlocksOf(bool with_exterior) const;
+  calib::CovarianceReport EstimateCovariance(const CovarianceBlocks& blocks,
+                                             const AdjustmentResult& result);
+  void CollectCameras(const calib::CovarianceReport& cov, AdjustmentResult* result) const;
+  void CollectExposures(const calib::CovarianceReport& cov, AdjustmentResult* result) const;
+  void CollectPoints(AdjustmentResult* result) const;
+  void JudgeUnresolvedSurveys(const calib::CovarianceReport& cov,
+                              const CovarianceBlocks& blocks,
+                              AdjustmentResult* result);
+
   const Project& project_;
   AdjustOptions options_;
   calib::ProblemBuilder builder_;
