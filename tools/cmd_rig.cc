@@ -320,7 +320,7 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args,
       sources.push_back(owned.back().get());
     }
     const stitch::RasterInfo info = sources.front()->Info();
-    const calib::VirtualCamera& v = rig.virtual_camera;
+    const calib::Camera& v = rig.virtual_camera.camera;
     stitch::TiffWriteOptions tiff;
     tiff.tile_px = args.tile_px;
     tiff.force_bigtiff = args.bigtiff;
@@ -446,7 +446,7 @@ int RunDesign(const DesignArgs& args) {
     throw ConfigError("--grid-cells must be within 10..4000 (got " +
                       std::to_string(args.grid_cells) + ")");
   const stitch::RigDesign d = stitch::DesignRig(rig, height_m, args.grid_cells);
-  const calib::VirtualCamera& v = rig.virtual_camera;
+  const calib::Camera& v = rig.virtual_camera.camera;
   const nlohmann::json doc = RigDesignDocument(rig, args.camera, height_m, d, args.svg);
   if (!args.svg.empty()) WriteFileAtomically(args.svg, stitch::RigDesignSvg(rig, d));
   if (!args.out.empty()) WriteResult(args.out, "rig_design", doc);

@@ -77,7 +77,9 @@ void PrintSummary(const stitch::BatchResult& result, const std::string& out) {
 
 int RunStitch(const StitchArgs& args) {
   CheckOutputFile(args.out, "--out");
-  const calib::Camera camera = calib::ReadCamera(args.camera);
+  // Any registered model: the stitching adjusts the sub-image mappings in pixels and reads no
+  // interior term.
+  const calib::Camera camera = calib::ReadCamera(args.camera, calib::CameraModels::kAny);
   const stitch::BatchOptions options =
       stitch::BatchOptionsFromText(camera, args.model, args.base, args.alpha, !args.no_snooping);
   const auto frames = stitch::ReadStitchFrames(camera, args.camera, args.obs, args.sigma_px);

@@ -90,7 +90,8 @@ std::vector<stitch::GrayImage> LoadFrame(const calib::Camera& camera,
 }  // namespace
 
 MatchRun RunMatching(const MatchRequest& args) {
-  const calib::Camera camera = calib::ReadCamera(args.camera);
+  // Any registered model: matching works on the sub-images and their mappings (pixels) only.
+  const calib::Camera camera = calib::ReadCamera(args.camera, calib::CameraModels::kAny);
   if (camera.subimages.size() < 2)
     throw InputError(args.camera + ": matching needs a camera with two or more sub-images");
   if (args.list.empty() == args.images.empty())

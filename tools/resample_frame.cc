@@ -9,7 +9,9 @@ namespace aerocal::tools {
 
 PreparedResample PrepareResample(const ResampleRequest& request) {
   PreparedResample p;
-  const calib::Camera nominal = calib::ReadCamera(request.camera);
+  // Any registered model: the virtual image is made through the sub-image mappings (pixels); the
+  // interior is not used.
+  const calib::Camera nominal = calib::ReadCamera(request.camera, calib::CameraModels::kAny);
   if (nominal.subimages.empty())
     throw InputError(request.camera + ": the camera has no sub-images");
   p.camera = stitch::ApplyStitchResult(nominal, request.mapping, request.frame);

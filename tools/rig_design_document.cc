@@ -29,7 +29,7 @@ nlohmann::json RigDesignDocument(const calib::Rig& rig,
                                  double height_m,
                                  const stitch::RigDesign& d,
                                  const std::string& svg) {
-  const calib::VirtualCamera& v = rig.virtual_camera;
+  const calib::Camera& v = rig.virtual_camera.camera;
   nlohmann::json doc;
   doc["kind"] = "rig_design";
   doc["camera_models"] = HeadCameraModels(rig);

@@ -47,6 +47,16 @@ bool Camera::IdealFromPixel(const Eigen::Vector2d& pixel, Eigen::Vector2d* ideal
   });
 }
 
+bool Camera::PixelFromIdeal(const Eigen::Vector2d& ideal_mm, Eigen::Vector2d* pixel) const {
+  Eigen::Vector2d measured;
+  const bool ok = VisitCameraModel(model, [&](auto m) {
+    return decltype(m)::MeasuredFromIdeal(
+        interior.data(), frame(), ideal_mm.data(), measured.data());
+  });
+  if (ok) *pixel = PixelFromPhoto(measured);
+  return ok;
+}
+
 ModelCamera Camera::AsModelCamera() const { return {model, interior.values(), frame()}; }
 
 Camera Camera::WithModelCamera(const ModelCamera& camera) const {
@@ -71,22 +81,27 @@ bool Camera::ProjectToPixel(const Eigen::Vector3d& opk_rad,
   ImageSpaceFromObject(opk_rad.data(), center_m.data(), point_m.data(), uvw);
   if (!(uvw[2] < 0)) return false;  // the camera looks along -W
   const double c = c_mm();
-  const double ideal[2] = {-c * uvw[0] / uvw[2], -c * uvw[1] / uvw[2]};
-  Eigen::Vector2d measured;
   // The models' inversions converge to 1e-10 px (brown_fraser_10) or 1e-13 in normalised
   // coordinates (forward models: closed form).
-  const bool ok = VisitCameraModel(model, [&](auto m) {
-    return decltype(m)::MeasuredFromIdeal(interior.data(), frame(), ideal, measured.data());
-  });
-  if (!ok) return false;
-  *pixel = PixelFromPhoto(measured);
-  return true;
+  return PixelFromIdeal({-c * uvw[0] / uvw[2], -c * uvw[1] / uvw[2]}, pixel);
 }
 
 int Camera::SubimageIndex(const std::string& id) const {
   for (size_t i = 0; i < subimages.size(); ++i)
     if (subimages[i].id == id) return static_cast<int>(i);
   return -1;
+}
+
+Camera PinholeCamera(double c_mm, double x0_mm, double y0_mm, const PixelFrame& frame) {
+  using Model = AdjustmentCameraModel;
+  Camera camera = Camera::OfModel(Model::kId);
+  camera.pixel_size_mm = frame.pixel_size_mm;
+  camera.width_px = frame.width_px;
+  camera.height_px = frame.height_px;
+  camera.interior[Model::kC] = c_mm;
+  camera.interior[Model::kX0] = x0_mm;
+  camera.interior[Model::kY0] = y0_mm;
+  return camera;
 }
 
 }  // namespace aerocal::calib

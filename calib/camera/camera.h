@@ -7,7 +7,7 @@
 //   x = (col - (W - 1) / 2) p,  y = -(row - (H - 1) / 2) p.
 // The adjustment works in the camera's own model: the frame camera, the raw sub-images through
 // their mappings and the heads of a rig (the residual factories of calib/residuals/collinearity.h).
-// The stitching and flight commands still read the 10-parameter model only (camera_io.h).
+// The flight commands still read the 10-parameter model only (camera_io.h).
 #pragma once
 
 #include "calib/camera/brown_fraser10.h"
@@ -110,6 +110,8 @@ struct Camera {
   /// Ideal photo coordinates (mm, reduced to the principal point, at c_mm()) of a measured pixel;
   /// false where the model's inversion does not converge.
   bool IdealFromPixel(const Eigen::Vector2d& pixel, Eigen::Vector2d* ideal_mm) const;
+  /// Measured pixel of ideal photo coordinates (mm); false where the inversion does not converge.
+  bool PixelFromIdeal(const Eigen::Vector2d& ideal_mm, Eigen::Vector2d* pixel) const;
   /// The camera as {model, params, frame} (camera_model.h) and back (name, sigmas, sub-images of
   /// `this` kept; throws LogicError when the parameter count does not fit the model).
   ModelCamera AsModelCamera() const;
@@ -134,5 +136,9 @@ struct Camera {
   /// Index of a sub-image by id; -1 when absent.
   int SubimageIndex(const std::string& id) const;
 };
+
+/// The distortion-free central projection on a format: the default model with only the principal
+/// distance c (mm, > 0) and the principal point (x0, y0) (mm) set; ideal = photo - (x0, y0).
+Camera PinholeCamera(double c_mm, double x0_mm, double y0_mm, const PixelFrame& frame);
 
 }  // namespace aerocal::calib

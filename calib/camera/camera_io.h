@@ -13,10 +13,10 @@
 
 namespace aerocal::calib {
 
-/// Which camera models a reader accepts: the stitching and flight commands (their self-calibration
-/// sets and resampling are written for the 10-parameter model) read with the default and refuse
-/// another model with "convert it first"; the adjustment's cameras (frame, sub-image, rig head),
-/// rig files and `calibrate` take any model.
+/// Which camera models a reader accepts: the flight commands (`flight`, `batch`: their
+/// self-calibration candidates name the 10-parameter model's terms) read with the default and
+/// refuse another model with "convert it first"; the adjustment's cameras (frame, sub-image, rig
+/// head), rig files, `calibrate`, `stitch`, `match` and `resample` (no interior term) take any.
 enum class CameraModels { kBrownFraser10Only, kAny };
 
 /// `model:` one of the registry's names (default brown_fraser_10); `interior:` and

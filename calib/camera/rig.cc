@@ -8,25 +8,29 @@
 
 namespace aerocal::calib {
 
-Eigen::Vector2d VirtualCamera::PhotoFromPixel(const Eigen::Vector2d& pixel) const {
-  return {(pixel.x() - 0.5 * (width_px - 1)) * pixel_size_mm,
-          -(pixel.y() - 0.5 * (height_px - 1)) * pixel_size_mm};
+VirtualCamera VirtualCamera::Pinhole(VirtualOrientation orientation,
+                                     double c_mm,
+                                     double pixel_size_mm,
+                                     int width_px,
+                                     int height_px,
+                                     double x0_mm,
+                                     double y0_mm,
+                                     std::optional<double> height_m) {
+  return {orientation,
+          PinholeCamera(c_mm, x0_mm, y0_mm, {pixel_size_mm, width_px, height_px}),
+          height_m};
 }
 
-Eigen::Vector2d VirtualCamera::PixelFromPhoto(const Eigen::Vector2d& xy_mm) const {
-  return {xy_mm.x() / pixel_size_mm + 0.5 * (width_px - 1),
-          -xy_mm.y() / pixel_size_mm + 0.5 * (height_px - 1)};
-}
-
-Eigen::Vector3d VirtualCamera::RayFromPixel(const Eigen::Vector2d& pixel) const {
-  const Eigen::Vector2d xy = PhotoFromPixel(pixel);
-  return {xy.x() - x0_mm, xy.y() - y0_mm, -c_mm};
+std::optional<Eigen::Vector3d> VirtualCamera::RayFromPixel(const Eigen::Vector2d& pixel) const {
+  Eigen::Vector2d ideal;
+  if (!camera.IdealFromPixel(pixel, &ideal)) return std::nullopt;
+  return Eigen::Vector3d(ideal.x(), ideal.y(), -camera.c_mm());
 }
 
 bool VirtualCamera::PixelFromRay(const Eigen::Vector3d& ray, Eigen::Vector2d* pixel) const {
   if (!(ray.z() < 0)) return false;
-  *pixel = PixelFromPhoto({x0_mm - c_mm * ray.x() / ray.z(), y0_mm - c_mm * ray.y() / ray.z()});
-  return true;
+  const double c = camera.c_mm();
+  return camera.PixelFromIdeal({-c * ray.x() / ray.z(), -c * ray.y() / ray.z()}, pixel);
 }
 
 int Rig::HeadIndex(const std::string& id) const {
@@ -66,15 +70,18 @@ void Rig::Validate(const std::string& where) const {
   }
   if (HeadIndex(reference_head) < 0)
     ThrowInputError(at, "reference_head '" + reference_head + "' is not one of the heads");
-  const VirtualCamera& v = virtual_camera;
-  if (!(v.c_mm > 0) || !(v.pixel_size_mm > 0) || v.width_px <= 0 || v.height_px <= 0)
+  const Camera& v = virtual_camera.camera;
+  if (!(v.pixel_size_mm > 0) || v.width_px <= 0 || v.height_px <= 0 || !(v.c_mm() > 0))
     ThrowInputError(at, "virtual camera: c, pixel size and format must be positive");
-  if (!std::isfinite(v.x0_mm) || !std::isfinite(v.y0_mm) || !std::isfinite(v.c_mm) ||
-      !std::isfinite(v.pixel_size_mm))
-    ThrowInputError(at, "virtual camera: every value must be finite");
-  if (v.height_m && !(*v.height_m > 0 && std::isfinite(*v.height_m)))
-    ThrowInputError(
-        at, "virtual camera: height_m must be > 0 m (got " + FormatNumber(*v.height_m) + ")");
+  bool finite = std::isfinite(v.pixel_size_mm);
+  for (double value : v.interior) finite &= std::isfinite(value);
+  if (!finite) ThrowInputError(at, "virtual camera: every value must be finite");
+  if (!v.subimages.empty() || !v.reference_points.empty())
+    ThrowInputError(at, "virtual camera: no sub-images or reference points");
+  const std::optional<double>& height_m = virtual_camera.height_m;
+  if (height_m && !(*height_m > 0 && std::isfinite(*height_m)))
+    ThrowInputError(at,
+                    "virtual camera: height_m must be > 0 m (got " + FormatNumber(*height_m) + ")");
 }
 
 Rig RigFromCamera(const Camera& camera, const std::string& head_id) {
@@ -87,15 +94,9 @@ Rig RigFromCamera(const Camera& camera, const std::string& head_id) {
   head.id = head_id;
   head.camera = camera;
   rig.heads.push_back(head);
-  VirtualCamera& v = rig.virtual_camera;
-  v.orientation = VirtualOrientation::kRig;
-  v.c_mm = camera.c_mm();
-  v.pixel_size_mm = camera.pixel_size_mm;
-  v.width_px = camera.width_px;
-  v.height_px = camera.height_px;
   const Eigen::Vector2d principal = camera.PrincipalPointMm();
-  v.x0_mm = principal.x();
-  v.y0_mm = principal.y();
+  rig.virtual_camera.camera =
+      PinholeCamera(camera.c_mm(), principal.x(), principal.y(), camera.frame());
   return rig;
 }
 

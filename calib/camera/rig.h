@@ -51,25 +51,33 @@ struct RigHead {
 /// (R_v = Rz(kappa_rig)).
 enum class VirtualOrientation { kRig, kLevel };
 
-/// The virtual camera: a distortion-free central projection at the rig origin (whatever the heads'
-/// models: RigFromCamera takes the pinhole part, c and principal point, of a camera in any model).
+/// The virtual camera: a camera in any registered model at the rig origin, whose image the heads
+/// are converted into. The default (a rig file's `virtual` with `c`, `x0`, `y0`, or no `virtual`
+/// at all: RigFromCamera) is the distortion-free central projection, the 10-parameter model with
+/// only c and the principal point (PinholeCamera); a `virtual` with `interior` (and `model`) is any
+/// camera, e.g. one whose distortion the converted image keeps.
 struct VirtualCamera {
   VirtualOrientation orientation = VirtualOrientation::kRig;
-  double c_mm = 0.0;                // principal distance, > 0
-  double pixel_size_mm = 0.0;       // > 0
-  int width_px = 0, height_px = 0;  // format
-  double x0_mm = 0.0, y0_mm = 0.0;  // principal point in the virtual photo frame
+  Camera camera;  // format, pixel size and interior; no sub-images, no sigmas
   /// Nominal relative flying height (m) of the rectification plane below the virtual centre, used
   /// when neither the exposure nor the command line gives one; absent = not given.
   std::optional<double> height_m;
 
-  /// Pixel (col, row) <-> photo (x, y) mm of the virtual image (CONVENTIONS.md pixel/photo frames).
-  Eigen::Vector2d PhotoFromPixel(const Eigen::Vector2d& pixel) const;
-  Eigen::Vector2d PixelFromPhoto(const Eigen::Vector2d& xy_mm) const;
-  /// Direction (virtual camera frame, not normalised) of the ray through a virtual pixel.
-  Eigen::Vector3d RayFromPixel(const Eigen::Vector2d& pixel) const;
+  /// The distortion-free virtual camera: PinholeCamera(c_mm, x0_mm, y0_mm) on the format.
+  static VirtualCamera Pinhole(VirtualOrientation orientation,
+                               double c_mm,
+                               double pixel_size_mm,
+                               int width_px,
+                               int height_px,
+                               double x0_mm = 0.0,
+                               double y0_mm = 0.0,
+                               std::optional<double> height_m = std::nullopt);
+
+  /// Direction (virtual camera frame, not normalised) of the ray through a virtual pixel:
+  /// (ideal x, ideal y, -c) of the camera's model; nullopt where its inversion does not converge.
+  std::optional<Eigen::Vector3d> RayFromPixel(const Eigen::Vector2d& pixel) const;
   /// Virtual pixel of a direction in the virtual camera frame; false when it does not point
-  /// forward (z >= 0).
+  /// forward (z >= 0) or the model's inversion does not converge.
   bool PixelFromRay(const Eigen::Vector3d& ray, Eigen::Vector2d* pixel) const;
 };
 
@@ -93,9 +101,10 @@ struct Rig {
   void Validate(const std::string& where) const;
 };
 
-/// A rig of one head with identity mount and zero lever arm whose virtual camera is the camera's
-/// own format, principal distance and principal point: the ordinary camera as a rig. Sub-images
-/// and reference points are not part of a rig head (LogicError when the camera has them).
+/// A rig of one head with identity mount and zero lever arm whose virtual camera is the pinhole of
+/// the camera's own format, principal distance and principal point: the ordinary camera as a rig.
+/// Sub-images and reference points are not part of a rig head (LogicError when the camera has
+/// them).
 Rig RigFromCamera(const Camera& camera, const std::string& head_id = "A");
 
 /// The ordinary camera equal to a rig of one head with identity mount and zero lever arm (the

@@ -95,12 +95,56 @@ RigHead ReadHead(const YAML::Node& node, const std::string& file) {
   return head;
 }
 
-VirtualCamera ReadVirtual(const YAML::Node& node, const std::string& file) {
-  RejectUnknownKeys(
-      node, {"orientation", "c", "pixel_size_mm", "format_px", "x0", "y0", "height_m"}, file);
+// The keys of a `virtual` section: the rig's own, then either the pinhole's (c, x0, y0) or a
+// camera's in any model (model, interior), with the format keys common to both.
+const std::vector<std::string> kVirtualRigKeys = {"orientation", "height_m"};
+const std::vector<std::string> kVirtualPinholeKeys = {
+    "c", "pixel_size_mm", "format_px", "x0", "y0"};
+
+// The pinhole form: c (mm, > 0), pixel_size_mm, format_px, optional x0, y0 (mm).
+Camera ReadVirtualPinhole(const YAML::Node& node, const std::string& file) {
   for (const char* key : {"c", "pixel_size_mm", "format_px"})
     if (!node[key]) ThrowInputError(WhereIs(node, file), std::string("virtual: missing ") + key);
+  PixelFrame frame;
+  const double c_mm = ReadPositive(node["c"], file, "virtual.c", "mm");
+  frame.pixel_size_mm = ReadPositive(node["pixel_size_mm"], file, "virtual.pixel_size_mm", "mm");
+  const YAML::Node& format = node["format_px"];
+  if (!format.IsSequence() || format.size() != 2)
+    ThrowInputError(WhereIs(format, file), "virtual.format_px must be [width, height]");
+  frame.width_px = YamlInt(format[0], file, "virtual.format_px width");
+  frame.height_px = YamlInt(format[1], file, "virtual.format_px height");
+  if (frame.width_px <= 0 || frame.height_px <= 0)
+    ThrowInputError(WhereIs(format, file), "virtual.format_px must be positive");
+  const double x0_mm = node["x0"] ? YamlDouble(node["x0"], file, "virtual.x0") : 0.0;
+  const double y0_mm = node["y0"] ? YamlDouble(node["y0"], file, "virtual.y0") : 0.0;
+  return PinholeCamera(c_mm, x0_mm, y0_mm, frame);
+}
+
+// The camera form: the camera reader on the section (any model; no sigmas or sub-images).
+Camera ReadVirtualModelCamera(const YAML::Node& node, const std::string& file) {
+  for (const char* key : {"c", "x0", "y0"})
+    if (node[key])
+      ThrowInputError(WhereIs(node[key], file),
+                      std::string("virtual.") + key +
+                          ": give the pinhole's c, x0, y0 or a camera's interior, not both");
+  for (const char* key : {"name", "interior_sigma", "subimages", "reference_points"})
+    if (node[key])
+      ThrowInputError(WhereIs(node[key], file),
+                      std::string("virtual.") + key + ": the virtual camera has no " + key);
+  return ParseCamera(node, file, CameraModels::kAny, kVirtualRigKeys);
+}
+
+VirtualCamera ReadVirtual(const YAML::Node& node, const std::string& file) {
+  if (!node.IsMap()) ThrowInputError(WhereIs(node, file), "rig.virtual must be a map");
   VirtualCamera v;
+  if (node["interior"] || node["model"]) {
+    v.camera = ReadVirtualModelCamera(node, file);
+  } else {
+    std::vector<std::string> allowed = kVirtualRigKeys;
+    allowed.insert(allowed.end(), kVirtualPinholeKeys.begin(), kVirtualPinholeKeys.end());
+    RejectUnknownKeys(node, allowed, file);
+    v.camera = ReadVirtualPinhole(node, file);
+  }
   if (node["orientation"]) {
     const std::string name = YamlString(node["orientation"], file, "orientation");
     const auto orientation = ParseVirtualOrientation(name);
@@ -109,20 +153,28 @@ VirtualCamera ReadVirtual(const YAML::Node& node, const std::string& file) {
                       "virtual.orientation must be rig or level (got '" + name + "')");
     v.orientation = *orientation;
   }
-  v.c_mm = ReadPositive(node["c"], file, "virtual.c", "mm");
-  v.pixel_size_mm = ReadPositive(node["pixel_size_mm"], file, "virtual.pixel_size_mm", "mm");
-  const YAML::Node& format = node["format_px"];
-  if (!format.IsSequence() || format.size() != 2)
-    ThrowInputError(WhereIs(format, file), "virtual.format_px must be [width, height]");
-  v.width_px = YamlInt(format[0], file, "virtual.format_px width");
-  v.height_px = YamlInt(format[1], file, "virtual.format_px height");
-  if (v.width_px <= 0 || v.height_px <= 0)
-    ThrowInputError(WhereIs(format, file), "virtual.format_px must be positive");
-  if (node["x0"]) v.x0_mm = YamlDouble(node["x0"], file, "virtual.x0");
-  if (node["y0"]) v.y0_mm = YamlDouble(node["y0"], file, "virtual.y0");
   if (node["height_m"])
     v.height_m = YamlBounded(node["height_m"], file, "virtual.height_m", kMinHeightM, kMaxHeightM);
   return v;
+}
+
+// The virtual camera's keys: the pinhole form when it reads back as the same camera, else the
+// camera writer's model, format and interior.
+void EmitVirtualCamera(YAML::Emitter& out, const Camera& camera) {
+  const Eigen::Vector2d principal = camera.PrincipalPointMm();
+  const Camera pinhole = PinholeCamera(camera.c_mm(), principal.x(), principal.y(), camera.frame());
+  if (pinhole.model == camera.model && pinhole.interior == camera.interior) {
+    out << YAML::Key << "c" << YAML::Value << camera.c_mm();
+    out << YAML::Key << "pixel_size_mm" << YAML::Value << camera.pixel_size_mm;
+    out << YAML::Key << "format_px" << YAML::Value << YAML::Flow << YAML::BeginSeq
+        << camera.width_px << camera.height_px << YAML::EndSeq;
+    out << YAML::Key << "x0" << YAML::Value << principal.x();
+    out << YAML::Key << "y0" << YAML::Value << principal.y();
+    return;
+  }
+  const YAML::Node keys = YAML::Load(CameraToYaml(camera));
+  for (const char* key : {"model", "pixel_size_mm", "format_px", "interior"})
+    out << YAML::Key << key << YAML::Value << keys[key];
 }
 
 void EmitVector3(YAML::Emitter& out, const std::string& key, const Eigen::Vector3d& v) {
@@ -205,12 +257,7 @@ std::string RigToYaml(const Rig& rig) {
   out << YAML::Key << "virtual" << YAML::Value << YAML::BeginMap;
   out << YAML::Key << "orientation" << YAML::Value
       << std::string(VirtualOrientationName(v.orientation));
-  out << YAML::Key << "c" << YAML::Value << v.c_mm;
-  out << YAML::Key << "pixel_size_mm" << YAML::Value << v.pixel_size_mm;
-  out << YAML::Key << "format_px" << YAML::Value << YAML::Flow << YAML::BeginSeq << v.width_px
-      << v.height_px << YAML::EndSeq;
-  out << YAML::Key << "x0" << YAML::Value << v.x0_mm;
-  out << YAML::Key << "y0" << YAML::Value << v.y0_mm;
+  EmitVirtualCamera(out, v.camera);
   if (v.height_m) out << YAML::Key << "height_m" << YAML::Value << *v.height_m;
   out << YAML::EndMap;
   out << YAML::Key << "heads" << YAML::Value << YAML::BeginSeq;

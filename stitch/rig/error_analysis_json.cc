@@ -104,7 +104,7 @@ GridAnalysis AnalyseGrid(const calib::Rig& rig,
   grid.n = n;
   const RigExposure nadir;
   const RigConverter converter(rig, nadir, MakeRectificationPlane(rig, nadir, height_m));
-  const calib::VirtualCamera& v = rig.virtual_camera;
+  const calib::Camera& v = rig.virtual_camera.camera;
   const int reference = rig.ReferenceIndex();
   std::uint64_t index = 0;
   for (int row = 0; row < n; ++row) {

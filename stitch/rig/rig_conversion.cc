@@ -94,8 +94,9 @@ std::optional<Eigen::Vector3d> RigConverter::PlanePointOfHeadPixel(
 
 std::optional<Eigen::Vector3d> RigConverter::PlanePointOfVirtualPixel(
     const Eigen::Vector2d& pixel) const {
-  return IntersectPlane(
-      plane_, virtual_center_, object_from_virtual_ * rig_.virtual_camera.RayFromPixel(pixel));
+  const std::optional<Eigen::Vector3d> ray = rig_.virtual_camera.RayFromPixel(pixel);
+  if (!ray) return std::nullopt;
+  return IntersectPlane(plane_, virtual_center_, object_from_virtual_ * *ray);
 }
 
 std::optional<Eigen::Vector2d> RigConverter::HeadPixelOfPoint(
@@ -140,8 +141,8 @@ bool RigConverter::InHeadFormat(int head, const Eigen::Vector2d& pixel) const {
 double ReliefDisplacementPx(
     const calib::Rig& rig, int head_j, int head_k, double height_m, double dh_m) {
   const double baseline_m = (rig.heads[head_j].lever_arm_m - rig.heads[head_k].lever_arm_m).norm();
-  const calib::VirtualCamera& v = rig.virtual_camera;
-  return v.c_mm / v.pixel_size_mm * baseline_m * dh_m / (height_m * (height_m - dh_m));
+  const calib::Camera& v = rig.virtual_camera.camera;
+  return v.c_mm() / v.pixel_size_mm * baseline_m * dh_m / (height_m * (height_m - dh_m));
 }
 
 }  // namespace aerocal::stitch

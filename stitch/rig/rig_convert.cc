@@ -15,13 +15,15 @@ namespace aerocal::stitch {
 
 Eigen::Matrix3d HeadFromVirtualHomography(const RigConverter& converter, int head) {
   const calib::Rig& rig = converter.rig();
-  const calib::VirtualCamera& v = rig.virtual_camera;
+  const calib::Camera& v = rig.virtual_camera.camera;
   const calib::Camera& camera = rig.heads[head].camera;
-  // Virtual pixel -> ray in the virtual camera frame: (x - x0, y - y0, -c).
+  // Virtual pixel -> ray in the virtual camera frame: (x - x0, y - y0, -c) of its pinhole part
+  // (the virtual camera's distortion, like a head's, is left to the correction grid).
+  const Eigen::Vector2d v0 = v.PrincipalPointMm();
   Eigen::Matrix3d virtual_ray;
-  virtual_ray << v.pixel_size_mm, 0, -0.5 * (v.width_px - 1) * v.pixel_size_mm - v.x0_mm,  //
-      0, -v.pixel_size_mm, 0.5 * (v.height_px - 1) * v.pixel_size_mm - v.y0_mm,            //
-      0, 0, -v.c_mm;
+  virtual_ray << v.pixel_size_mm, 0, -0.5 * (v.width_px - 1) * v.pixel_size_mm - v0.x(),  //
+      0, -v.pixel_size_mm, 0.5 * (v.height_px - 1) * v.pixel_size_mm - v0.y(),            //
+      0, 0, -v.c_mm();
   // Ray d (object frame) from O -> G = O + (h / n.d) d; in head space
   // u = R_k^T (G - O_k) ~ R_k^T ((O - O_k) n^T + h I) d.
   const Eigen::Vector3d n = converter.Plane().normal;
@@ -48,12 +50,8 @@ Eigen::Matrix3d HeadFromVirtualHomography(const RigConverter& converter, int hea
 
 calib::Camera RigExposureAsSubimageCamera(const RigConverter& converter) {
   const calib::Rig& rig = converter.rig();
-  calib::Camera camera;
+  calib::Camera camera = rig.virtual_camera.camera;  // its model, interior and format
   camera.name = rig.name;
-  camera.pixel_size_mm = rig.virtual_camera.pixel_size_mm;
-  camera.width_px = rig.virtual_camera.width_px;
-  camera.height_px = rig.virtual_camera.height_px;
-  camera.interior[calib::BrownFraser10Model::kC] = rig.virtual_camera.c_mm;
   for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k) {
     const calib::RigHead& head = rig.heads[k];
     Eigen::Matrix3d virtual_from_head = HeadFromVirtualHomography(converter, k).inverse();
@@ -97,10 +95,11 @@ std::optional<Eigen::Vector2d> ExactHeadPixel(const RigConverter& converter,
                                               int head,
                                               const Eigen::Vector2d& virtual_px) {
   if (!dem) return converter.HeadFromVirtual(head, virtual_px);
-  const auto g = IntersectDem(
-      *dem,
-      converter.VirtualCenter(),
-      converter.ObjectFromVirtual() * converter.rig().virtual_camera.RayFromPixel(virtual_px));
+  const std::optional<Eigen::Vector3d> ray =
+      converter.rig().virtual_camera.RayFromPixel(virtual_px);
+  if (!ray) return std::nullopt;
+  const auto g =
+      IntersectDem(*dem, converter.VirtualCenter(), converter.ObjectFromVirtual() * *ray);
   if (!g) return converter.HeadFromVirtual(head, virtual_px);
   return converter.HeadPixelOfPoint(head, *g);
 }
@@ -134,7 +133,7 @@ MapCorrectionGrid MakeGrid(const RigConverter& converter,
                            int head,
                            const Eigen::Matrix3d& h,
                            int step) {
-  const calib::VirtualCamera& v = converter.rig().virtual_camera;
+  const calib::Camera& v = converter.rig().virtual_camera.camera;
   MapCorrectionGrid g;
   g.step_px = step;
   g.cols = std::max((v.width_px - 1 + step - 1) / step + 1, 2);
@@ -190,7 +189,10 @@ HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter,
   const calib::Rig& rig = converter.rig();
   out.grids.resize(rig.heads.size());
   for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k) {
-    if (!dem && !HasDistortion(rig.heads[k].camera)) continue;
+    // The homography is exact between two pinholes over the plane: a grid where the head or the
+    // virtual camera has distortion, or a DEM is the surface.
+    if (!dem && !HasDistortion(rig.heads[k].camera) && !HasDistortion(rig.virtual_camera.camera))
+      continue;
     const Eigen::Matrix3d h = HeadFromVirtualHomography(converter, k);
     double error = 0.0;
     int step = 64;

@@ -4,13 +4,14 @@
 //
 // Over the rectification plane, virtual pixel -> head pixel is the plane-induced homography
 //   head ~ K_k R_k^T [ (O - O_k) n^T + h I ] R_v A_v [U V 1]^T,   h = offset - n . O
-// (A_v: virtual pixel -> virtual ray, K_k: head ray -> measured pixel). It is exact for heads
-// without lens distortion. A head with distortion terms enters the resampler with the same
-// homography plus a correction grid (resample/virtual_image.h MapCorrectionGrid): at grid nodes
-// the exact head pixel (the head's model, RigConverter::HeadFromVirtual) minus
-// the homography's; the step is halved from 64 px until the bilinear interpolation of the grid
-// reproduces the exact map at every cell centre inside the head to `tolerance_px` (or the step
-// reaches 2 px; the error reached is reported).
+// (A_v: virtual pixel -> virtual ray, K_k: head ray -> measured pixel, both the pinhole parts: c
+// and principal point). It is exact for heads and a virtual camera without lens distortion. A
+// head with distortion terms, or any head when the virtual camera has them, enters the resampler
+// with the same homography plus a correction grid (resample/virtual_image.h MapCorrectionGrid): at
+// grid nodes the exact head pixel (the virtual camera's and the head's models,
+// RigConverter::HeadFromVirtual) minus the homography's; the step is halved from 64 px until the
+// bilinear interpolation of the grid reproduces the exact map at every cell centre inside the head
+// to `tolerance_px` (or the step reaches 2 px; the error reached is reported).
 #pragma once
 
 #include "calib/camera/camera.h"
@@ -27,15 +28,17 @@
 namespace aerocal::stitch {
 
 /// Homography (virtual pixel -> measured pixel of head k) of the converter's exposure and plane,
-/// ignoring the head's distortion terms (exact when they are zero).
+/// ignoring the head's and the virtual camera's distortion terms (exact when they are zero).
 Eigen::Matrix3d HeadFromVirtualHomography(const RigConverter& converter, int head);
 
-/// The rig exposure as a multi-CCD camera for ResampleVirtualImage: the virtual format, one
-/// projective sub-image per head (id, format, head pixel -> virtual pixel, distortion ignored).
+/// The rig exposure as a multi-CCD camera for ResampleVirtualImage: the virtual camera (model,
+/// interior, format), one projective sub-image per head (id, format, head pixel -> virtual pixel,
+/// distortion ignored).
 /// InputError naming the head when its homography degenerates.
 calib::Camera RigExposureAsSubimageCamera(const RigConverter& converter);
 
-/// Correction grids of every head (step 0 for a head without distortion terms) and the largest
+/// Correction grids of every head (step 0 for a head without distortion terms under a virtual
+/// camera without them) and the largest
 /// interpolation error of the grids against the exact map (px) at their cell centres inside the
 /// head formats.
 struct HeadMapCorrections {
@@ -52,7 +55,8 @@ HeadMapCorrections MakeHeadMapCorrections(const RigConverter& converter,
                                           const DemGrid* dem = nullptr);
 
 /// Converts the head images (`sources`, one per head, rig order) to the virtual image in `sink`.
-/// Heads with distortion, and every head over a DEM, go through MakeHeadMapCorrections (its
+/// Heads with distortion, every head under a virtual camera with distortion and every head over a
+/// DEM go through MakeHeadMapCorrections (its
 /// report in `corrections` when given).
 ResampleReport ConvertRigExposure(const RigConverter& converter,
                                   const std::vector<RasterSource*>& sources,

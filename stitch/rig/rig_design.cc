@@ -233,8 +233,8 @@ RigDesign DesignRig(const calib::Rig& rig, double height_m, int grid_cells) {
     }
   d.coverage = ComputeRigCoverage(rig, height_m, (hi - lo).maxCoeff() / grid_cells);
   const RigCoverage& c = d.coverage;
-  const calib::VirtualCamera& v = rig.virtual_camera;
-  d.virtual_gsd_m = v.pixel_size_mm * height_m / v.c_mm;
+  const calib::Camera& v = rig.virtual_camera.camera;
+  d.virtual_gsd_m = v.pixel_size_mm * height_m / v.c_mm();  // at the principal point
   const double cell_area_m2 = std::pow(c.cell_px * d.virtual_gsd_m, 2);
   std::map<std::string, int> zone_cells;
   int covered = 0;
@@ -309,11 +309,17 @@ std::string FootprintSvgHead(const calib::Rig& rig, const RigDesign& d, const Sv
 }  // namespace
 
 std::string RigDesignSvg(const calib::Rig& rig, const RigDesign& d) {
-  // Ground metres of a virtual pixel (level nadir virtual camera: x -> X, y up -> Y).
-  const calib::VirtualCamera& v = rig.virtual_camera;
+  // Ground metres of a virtual pixel (level nadir virtual camera: x -> X, y up -> Y): its ray
+  // (ideal x, ideal y, -c) scaled to the height; the pinhole part where the model's inversion
+  // fails (a pixel far outside a strongly distorted format).
+  const calib::Camera& v = rig.virtual_camera.camera;
   const auto ground = [&](const Eigen::Vector2d& px) {
-    const Eigen::Vector2d xy = v.PhotoFromPixel(px) - Eigen::Vector2d(v.x0_mm, v.y0_mm);
-    return Eigen::Vector2d(xy * d.height_m / v.c_mm);
+    const std::optional<Eigen::Vector3d> ray = rig.virtual_camera.RayFromPixel(px);
+    const Eigen::Vector3d r =
+        ray ? *ray
+            : (Eigen::Vector3d() << v.PhotoFromPixel(px) - v.PrincipalPointMm(), -v.c_mm())
+                  .finished();
+    return Eigen::Vector2d(r.head<2>() * d.height_m / -r.z());
   };
   const SvgPanel panel = FootprintPanel(d);
   const auto sx = [&](const Eigen::Vector2d& p) { return panel.X(p.x()); };

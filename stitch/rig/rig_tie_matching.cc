@@ -65,7 +65,7 @@ void MatchRigExposureTies(const calib::Rig& rig,
   const RigConverter converter(
       rig, pose, RectificationPlane{Eigen::Vector3d::UnitZ(), exposure.z_ref_m});
   const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
-  const calib::VirtualCamera& v = rig.virtual_camera;
+  const calib::Camera& v = rig.virtual_camera.camera;
   const int width = v.width_px, height = v.height_px;
 
   // Every head once on the virtual grid (float grey values) with its coverage shrunk by the

@@ -63,10 +63,11 @@ void BM_RigConvert(benchmark::State& state) {
   const RigConverter converter(rig, nadir, MakeRectificationPlane(rig, nadir, 1200.0));
   auto& heads = const_cast<std::vector<MemoryRaster>&>(Heads());
   std::vector<RasterSource*> sources = {&heads[0], &heads[1]};
-  DiscardSink sink(rig.virtual_camera.width_px);
+  DiscardSink sink(rig.virtual_camera.camera.width_px);
   for (auto _ : state) ConvertRigExposure(converter, sources, &sink, {});
   benchmark::DoNotOptimize(sink.checksum_);
-  const double mpx = rig.virtual_camera.width_px * 1e-6 * rig.virtual_camera.height_px;
+  const double mpx =
+      rig.virtual_camera.camera.width_px * 1e-6 * rig.virtual_camera.camera.height_px;
   state.counters["Mpx/s"] =
       benchmark::Counter(mpx * state.iterations(), benchmark::Counter::kIsRate);
 }
@@ -84,7 +85,8 @@ void BM_CvRemap(benchmark::State& state) {
   const RigExposure nadir;
   const RigConverter converter(rig, nadir, MakeRectificationPlane(rig, nadir, 1200.0));
   const HeadMapCorrections corrections = MakeHeadMapCorrections(converter);
-  const int width = rig.virtual_camera.width_px, height = rig.virtual_camera.height_px;
+  const int width = rig.virtual_camera.camera.width_px,
+            height = rig.virtual_camera.camera.height_px;
   const int strip_rows = 256;
   std::vector<cv::Mat> sources;
   std::vector<Eigen::Matrix3d> homographies;
@@ -274,7 +276,7 @@ bool SkipWithoutScene(const StitchedScene& s, benchmark::State& state) {
 void BM_StitchedExposure(benchmark::State& state) {
   const StitchedScene& s = Scene();
   if (SkipWithoutScene(s, state)) return;
-  const calib::VirtualCamera& v = s.flight.truth.virtual_camera;
+  const calib::Camera& v = s.flight.truth.virtual_camera.camera;
   RigStitchOptions options;
   options.standard_radius_px *= 0.5;
   for (auto _ : state) {
@@ -309,7 +311,7 @@ BENCHMARK(BM_StitchedExposure)->Unit(benchmark::kMillisecond)->UseRealTime()->Mi
 void BM_StitchedPeerRemap(benchmark::State& state) {
   const StitchedScene& s = Scene();
   if (SkipWithoutScene(s, state)) return;
-  const calib::VirtualCamera& v = s.flight.truth.virtual_camera;
+  const calib::Camera& v = s.flight.truth.virtual_camera.camera;
   const RigConverter converter(s.flight.truth,
                                s.in.exposures[0].pose,
                                {Eigen::Vector3d::UnitZ(), s.in.exposures[0].z_ref_m});

@@ -1,12 +1,13 @@
 // The rig model (calib/camera/rig.h) and its camera file (rig_io.h): the head pose formula by
 // hand, its autodiff Jacobian against numeric differentiation (ceres::GradientChecker), the
-// one-head rig that is an ordinary camera, the FORMATS.md example, write/read round trip and
-// FILE:LINE for bad files.
+// one-head rig that is an ordinary camera, the FORMATS.md example, write/read round trip, a virtual
+// camera in another model and FILE:LINE for bad files.
 #include "calib/camera/rig.h"
 
 #include "calib/camera/camera_io.h"
 #include "calib/camera/rig_io.h"
 #include "calib/core/error.h"
+#include "calib/core/yaml_util.h"
 #include "tests/support/test_support.h"
 
 #include <ceres/autodiff_cost_function.h>
@@ -55,8 +56,8 @@ TEST(RigFile, ReadsTheFormatsExample) {
   EXPECT_EQ(rig.reference_head, "A");
   EXPECT_EQ(rig.ReferenceIndex(), 0);
   EXPECT_EQ(rig.virtual_camera.orientation, VirtualOrientation::kLevel);
-  EXPECT_EQ(rig.virtual_camera.width_px, 12154);
-  EXPECT_EQ(rig.virtual_camera.c_mm, 24.5);
+  EXPECT_EQ(rig.virtual_camera.camera.width_px, 12154);
+  EXPECT_EQ(rig.virtual_camera.camera.c_mm(), 24.5);
   EXPECT_FALSE(rig.virtual_camera.height_m.has_value());
   const RigHead& a = rig.heads[0];
   EXPECT_EQ(a.camera.width_px, 4368);
@@ -82,7 +83,8 @@ TEST(RigFile, WriteThenReadGivesTheSameRigAndTheSameBytes) {
   EXPECT_EQ(b.name, a.name);
   EXPECT_EQ(b.reference_head, a.reference_head);
   EXPECT_EQ(b.virtual_camera.orientation, a.virtual_camera.orientation);
-  EXPECT_EQ(b.virtual_camera.x0_mm, a.virtual_camera.x0_mm);
+  EXPECT_EQ(b.virtual_camera.camera.model, a.virtual_camera.camera.model);
+  EXPECT_EQ(b.virtual_camera.camera.interior, a.virtual_camera.camera.interior);
   EXPECT_EQ(*b.virtual_camera.height_m, 1200.0);
   for (size_t k = 0; k < a.heads.size(); ++k) {
     EXPECT_EQ(b.heads[k].id, a.heads[k].id);
@@ -95,6 +97,58 @@ TEST(RigFile, WriteThenReadGivesTheSameRigAndTheSameBytes) {
     EXPECT_EQ(b.heads[k].mount_sigma_rad.has_value(), a.heads[k].mount_sigma_rad.has_value());
   }
   EXPECT_EQ(RigToYaml(ReadRig(dir.File("out.yaml"))), RigToYaml(b));
+}
+
+// The virtual camera is a camera in any registered model: `virtual` with `model` and `interior`
+// (the camera reader's keys) reads as that camera and is written back in the same form; the
+// distortion-free default keeps its short form (c, x0, y0), so existing rig files are written as
+// before.
+TEST(RigFile, AVirtualCameraInAnyModelRoundTrips) {
+  // A one-head rig with this `virtual` section.
+  const auto rig_with_virtual = [](const std::string& section) {
+    return ParseRig(LoadYamlText("rig:\n  virtual: " + section +
+                                     "\n  heads:\n    - id: A\n      pixel_size_mm: 0.006\n"
+                                     "      format_px: [1000, 800]\n      interior: {c: 15}\n",
+                                 "rig.yaml"),
+                    "rig.yaml");
+  };
+  const Rig rig = rig_with_virtual(
+      "{orientation: level, model: opencv, pixel_size_mm: 0.006, format_px: [1200, 900], "
+      "interior: {fx: 2500, fy: 2501, cx: 600.5, cy: 449, k1: -0.03, p1: 1e-4}, height_m: 300}");
+  const Camera& v = rig.virtual_camera.camera;
+  EXPECT_EQ(v.model, CameraModelId::kOpenCv);
+  EXPECT_EQ(v.width_px, 1200);
+  EXPECT_EQ(v.interior[v.ParamIndex("k1")], -0.03);
+  EXPECT_EQ(rig.virtual_camera.orientation, VirtualOrientation::kLevel);
+  EXPECT_EQ(*rig.virtual_camera.height_m, 300.0);
+  EXPECT_NEAR(v.c_mm(), 2501 * 0.006, 1e-12);  // OpenCV's principal distance: fy p
+  // A ray through a pixel and back through the model.
+  const Eigen::Vector2d pixel(10.0, 880.0);
+  const std::optional<Eigen::Vector3d> ray = rig.virtual_camera.RayFromPixel(pixel);
+  ASSERT_TRUE(ray.has_value());
+  EXPECT_EQ(ray->z(), -v.c_mm());
+  Eigen::Vector2d back;
+  ASSERT_TRUE(rig.virtual_camera.PixelFromRay(*ray * 3.0, &back));
+  EXPECT_LT((back - pixel).norm(), 1e-9);
+  EXPECT_FALSE(rig.virtual_camera.PixelFromRay(-*ray, &back));  // behind the camera
+  const std::string text = RigToYaml(rig);
+  EXPECT_NE(text.find("model: opencv"), std::string::npos) << text;
+  const Rig again = ParseRig(LoadYamlText(text, "back.yaml"), "back.yaml");
+  EXPECT_EQ(again.virtual_camera.camera.model, v.model);
+  EXPECT_EQ(again.virtual_camera.camera.interior, v.interior);
+  EXPECT_EQ(RigToYaml(again), text);
+  // The default: the short form, c / x0 / y0 of the 10-parameter model's pinhole.
+  const Rig pinhole = rig_with_virtual(
+      "{c: 150, pixel_size_mm: 0.006, format_px: [1200, 900], x0: 0.25, y0: -0.5}");
+  const Camera& p = pinhole.virtual_camera.camera;
+  EXPECT_EQ(p.model, BrownFraser10Model::kId);
+  EXPECT_EQ(p.interior, PinholeCamera(150, 0.25, -0.5, p.frame()).interior);
+  EXPECT_EQ(p.PrincipalPointMm(), Eigen::Vector2d(0.25, -0.5));
+  const YAML::Node written = LoadYamlText(RigToYaml(pinhole), "out.yaml")["rig"]["virtual"];
+  EXPECT_EQ(written["c"].as<double>(), 150.0);
+  EXPECT_EQ(written["x0"].as<double>(), 0.25);
+  EXPECT_FALSE(written["interior"]);
+  EXPECT_FALSE(written["model"]);
 }
 
 TEST(RigFile, TheDualLensExampleLoads) {
@@ -135,8 +189,9 @@ TEST(RigFile, AOneHeadRigIsAnOrdinaryCamera) {
       "K1: 3e-8, K2: -2e-12, K3: 1e-16, P1: 2e-7, P2: -1.5e-7, B1: 1e-5, B2: -8e-6}\n");
   const Rig from_rig_file = ReadRig(dir.File("rig.yaml"));
   EXPECT_EQ(from_rig_file.reference_head, "H");
-  EXPECT_EQ(from_rig_file.virtual_camera.c_mm, camera.c_mm());
-  EXPECT_EQ(from_rig_file.virtual_camera.x0_mm, camera.interior[BrownFraser10Model::kX0]);
+  EXPECT_EQ(from_rig_file.virtual_camera.camera.c_mm(), camera.c_mm());
+  EXPECT_EQ(from_rig_file.virtual_camera.camera.PrincipalPointMm().x(),
+            camera.interior[BrownFraser10Model::kX0]);
   for (const Rig* rig : {&from_camera_file, &from_rig_file}) {
     const auto back = CameraFromSingleHeadRig(*rig);
     ASSERT_TRUE(back.has_value());
@@ -296,6 +351,18 @@ TEST(RigFile, BadFilesNameFileAndLine) {
        ":3: virtual.height_m out of range (got -3, expected 1 .. 100000)"},
       {"rig:\n  reference_head: A\n  virtual: {c: 150, format_px: [120, 100]}\n  heads:\n" + head_a,
        ":3: virtual: missing pixel_size_mm"},
+      {"rig:\n  reference_head: A\n  virtual: {c: 150, pixel_size_mm: 0.006, format_px: [120, "
+       "100], interior: {c: 150}}\n  heads:\n" +
+           head_a,
+       ":3: virtual.c: give the pinhole's c, x0, y0 or a camera's interior, not both"},
+      {"rig:\n  reference_head: A\n  virtual: {model: opencv, pixel_size_mm: 0.006, format_px: "
+       "[120, 100], interior: {fx: 2500, fy: 2500}, interior_sigma: {fx: 1}}\n  heads:\n" +
+           head_a,
+       ":3: virtual.interior_sigma: the virtual camera has no interior_sigma"},
+      {"rig:\n  reference_head: A\n  virtual: {model: pinhole9, pixel_size_mm: 0.006, format_px: "
+       "[120, 100], interior: {c: 150}}\n  heads:\n" +
+           head_a,
+       ":3: unknown camera model 'pinhole9'"},
       {"rig:\n  heads: []\n", ":2: rig.heads must be a non-empty list"},
       {"name: x\nrig:\n  heads:\n" + head_a + "extra: 1\n", ":8: unknown key 'extra'"},
   };

@@ -4,8 +4,9 @@
 // sub-images through the true mappings (noise 0.05 px, their camera-file sigma), then the affine
 // stitching adjustment: sigma0 <= 0.12 px, every sub-image corner within 3 predicted sigmas and
 // 0.25 px of its true virtual position. Also: byte-identical output for identical inputs,
-// appending frames, and bad images named in the error.
+// appending frames, a camera file in another model, and bad images named in the error.
 #include "calib/camera/camera_io.h"
+#include "calib/camera/convert_camera.h"
 #include "calib/core/atomic_file.h"
 #include "stitch/adjustment/stitch_adjustment.h"
 #include "tests/stitch/match_test_scene.h"
@@ -172,6 +173,23 @@ TEST_F(MatchStitch, FlightListAppendsFramesAndRefusesDuplicates) {
   EXPECT_EQ(again.exit_code, 2);
   EXPECT_NE(again.output.find("frame b is already in the file"), std::string::npos) << again.output;
   EXPECT_EQ(ReadTextFile(out), after);
+}
+
+// Matching reads no interior term: the camera file in OpenCV's model (its sub-images kept) gives
+// the same observations, byte for byte.
+TEST_F(MatchStitch, ACameraInAnotherModelGivesTheSameObservations) {
+  const calib::Camera camera = calib::ReadCamera(dir_->File("camera.yaml"));
+  calib::WriteCamera(
+      dir_->File("camera_opencv.yaml"),
+      camera.WithModelCamera(
+          calib::ConvertCamera(camera.AsModelCamera(), calib::CameraModelId::kOpenCv).camera));
+  const std::string options =
+      " --frame 4880 --images " + *images_arg_ + " --detector foerstner --lsm off --out ";
+  const std::string a = dir_->File("model_bf.csv"), b = dir_->File("model_cv.csv");
+  ASSERT_EQ(RunAerocal("match --camera " + dir_->File("camera.yaml") + options + a).exit_code, 0);
+  const auto other = RunAerocal("match --camera " + dir_->File("camera_opencv.yaml") + options + b);
+  ASSERT_EQ(other.exit_code, 0) << other.output;
+  EXPECT_EQ(ReadTextFile(b), ReadTextFile(a));
 }
 
 TEST_F(MatchStitch, BadImagesAreNamedAndNothingIsWritten) {

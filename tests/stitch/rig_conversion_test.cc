@@ -40,7 +40,8 @@ calib::Rig DistortedRig(calib::VirtualOrientation orientation) {
     head.lever_arm_m = Eigen::Vector3d(0.0, 0.08 * (k == 1) - 0.08 * (k == 2), 0.01 * k);
     rig.heads.push_back(head);
   }
-  rig.virtual_camera = {orientation, 80.0, 0.0046, 30000, 9000, 0.1, -0.05, 800.0};
+  rig.virtual_camera =
+      calib::VirtualCamera::Pinhole(orientation, 80.0, 0.0046, 30000, 9000, 0.1, -0.05, 800.0);
   return rig;
 }
 
@@ -103,10 +104,11 @@ TEST(RigConversion, FollowsTheConventionsChain) {
       0.0,
       1e-15);
   const Eigen::Vector3d in_virtual = rv.transpose() * (*ground - exposure.rig_center_m);
-  const calib::VirtualCamera& v = rig.virtual_camera;
-  const Eigen::Vector2d expected =
-      v.PixelFromPhoto({v.x0_mm - v.c_mm * in_virtual.x() / in_virtual.z(),
-                        v.y0_mm - v.c_mm * in_virtual.y() / in_virtual.z()});
+  const calib::Camera& v = rig.virtual_camera.camera;
+  const double c = v.c_mm();
+  const Eigen::Vector2d expected = v.PixelFromPhoto(
+      v.PrincipalPointMm() +
+      Eigen::Vector2d(-c * in_virtual.x() / in_virtual.z(), -c * in_virtual.y() / in_virtual.z()));
   EXPECT_LT((*converter.VirtualFromHead(1, head_px) - expected).norm(), 1e-9);
   // Rig orientation: the plane is perpendicular to the rig's axis, H below O along it.
   const calib::Rig tilted = DistortedRig(calib::VirtualOrientation::kRig);
@@ -140,8 +142,8 @@ TEST(RigConversion, DualLensExampleReferenceHeadIsAShiftOfTheVirtualImage) {
     ASSERT_TRUE(v.has_value());
     EXPECT_GE(v->x(), 0.0);
     EXPECT_GE(v->y(), 0.0);
-    EXPECT_LE(v->x(), rig.virtual_camera.width_px - 1.0);
-    EXPECT_LE(v->y(), rig.virtual_camera.height_px - 1.0);
+    EXPECT_LE(v->x(), rig.virtual_camera.camera.width_px - 1.0);
+    EXPECT_LE(v->y(), rig.virtual_camera.camera.height_px - 1.0);
   }
   // Converging by 1 deg: B's image sits c tan(1 deg) / p = 436 px left of A's in the virtual
   // image, less the 3 px parallax of the 0.15 m baseline at 1200 m (c 0.15 / H / p).

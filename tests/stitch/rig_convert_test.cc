@@ -5,10 +5,12 @@
 // tests/stitch/virtual_image_test.cc does), and the command on TIFF files.
 #include "stitch/rig/rig_convert.h"
 
+#include "calib/camera/convert_camera.h"
 #include "calib/camera/rig_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
+#include "calib/core/yaml_util.h"
 #include "stitch/resample/tiff_raster.h"
 #include "tests/support/cubic_sample.h"
 #include "tests/support/test_support.h"
@@ -34,7 +36,8 @@ calib::Rig TwoHeadRig() {
   calib::Rig rig;
   rig.name = "two-head test rig";
   rig.reference_head = "A";
-  rig.virtual_camera = {calib::VirtualOrientation::kRig, 10.0, 0.01, 1600, 1200, 0.0, 0.0, kHeight};
+  rig.virtual_camera = calib::VirtualCamera::Pinhole(
+      calib::VirtualOrientation::kRig, 10.0, 0.01, 1600, 1200, 0.0, 0.0, kHeight);
   for (int k = 0; k < 2; ++k) {
     calib::RigHead head;
     head.id = k == 0 ? "A" : "B";
@@ -164,8 +167,9 @@ calib::Rig SmallUav4Rig(bool distorted) {
   const auto scale = [](int& width, int& height, double& pixel_mm) {
     width /= 10, height /= 10, pixel_mm *= 10;
   };
-  scale(
-      rig.virtual_camera.width_px, rig.virtual_camera.height_px, rig.virtual_camera.pixel_size_mm);
+  scale(rig.virtual_camera.camera.width_px,
+        rig.virtual_camera.camera.height_px,
+        rig.virtual_camera.camera.pixel_size_mm);
   for (auto& head : rig.heads) {
     scale(head.camera.width_px, head.camera.height_px, head.camera.pixel_size_mm);
     if (distorted) head.camera.interior[calib::BrownFraser10Model::kK1] = 2e-5;
@@ -226,63 +230,114 @@ TEST(RigConvert, TiltedHeadsCoverExactlyTheVirtualPixelsTheySee) {
   }
 }
 
+// Head k's images as ramps (16 bit, 16 x the head column, or row) resampled onto the virtual image
+// with its correction grid: the resampled value / 16 is the sampled head position (bilinear and
+// bicubic interpolation of a ramp are exact inside the format), compared with the exact map at
+// every virtual pixel whose head pixel lies 1 px inside the format (the bicubic support and the
+// coverage rule stay out of it).
+struct RampCheck {
+  long checked = 0, wrong = 0;
+  double worst_px = 0.0;
+};
+RampCheck SampleRamps(const RigConverter& converter,
+                      const HeadMapCorrections& grids,
+                      int k,
+                      const ResampleOptions& options,
+                      double tolerance_px) {
+  const calib::Camera all = RigExposureAsSubimageCamera(converter);
+  const int width = all.width_px, height = all.height_px;
+  calib::Camera one = all;
+  one.subimages = {all.subimages[k]};
+  const calib::Camera& camera = converter.rig().heads[k].camera;
+  std::array<MemoryRaster, 2> ramp{MemoryRaster({camera.width_px, camera.height_px, 1, 16}),
+                                   MemoryRaster({camera.width_px, camera.height_px, 1, 16})};
+  for (int r = 0; r < camera.height_px; ++r)
+    for (int c = 0; c < camera.width_px; ++c) {
+      ramp[0].Set(c, r, 0, 16.0 * c);
+      ramp[1].Set(c, r, 0, 16.0 * r);
+    }
+  std::array<MemoryRaster, 2> out{MemoryRaster({width, height, 1, 16}),
+                                  MemoryRaster({width, height, 1, 16})};
+  for (int a = 0; a < 2; ++a)
+    ResampleVirtualImage(
+        one, {&ramp[a]}, &out[a], options, std::vector<MapCorrectionGrid>{grids.grids[k]});
+  RampCheck check;
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c) {
+      const auto exact = converter.HeadFromVirtual(k, Eigen::Vector2d(c, r));
+      if (!exact || exact->x() < 1 || exact->y() < 1 || exact->x() > camera.width_px - 2 ||
+          exact->y() > camera.height_px - 2)
+        continue;
+      const Eigen::Vector2d sampled(out[0].At(c, r) / 16.0, out[1].At(c, r) / 16.0);
+      const double error = (sampled - *exact).cwiseAbs().maxCoeff();
+      check.worst_px = std::max(check.worst_px, error);
+      ++check.checked;
+      check.wrong += error > tolerance_px;
+    }
+  return check;
+}
+
+// The grid's tolerance (0.01 px), the 16-bit rounding (1/32 px) and float rounding.
+constexpr double kRampTolerancePx = 0.05;
+
 // Every covered virtual pixel takes its value from the head pixel its exact map gives, with a
-// correction grid too: the head images are ramps (16 bit, 16 x the head column, or row), so the
-// resampled value / 16 is the sampled head position (bilinear and bicubic interpolation of a ramp
-// are exact inside the format). A sample outside the strip's source window must never be clamped
-// to the window's edge (a wrong value); short strips (16 rows), the default (256) and one strip
-// for the whole image (4096 rows: a strip that reaches beyond a tilted head's horizon).
+// correction grid too. A sample outside the strip's source window must never be clamped to the
+// window's edge (a wrong value); short strips (16 rows), the default (256) and one strip for the
+// whole image (4096 rows: a strip that reaches beyond a tilted head's horizon).
 TEST(RigConvert, TiltedHeadsSampleTheExactHeadPixelInEveryStrip) {
   const calib::Rig rig = SmallUav4Rig(/*distorted=*/true);
   const RigExposure exposure = TurnedExposure();
   const RigConverter converter(rig, exposure, MakeRectificationPlane(rig, exposure, 300.0));
-  const calib::Camera all = RigExposureAsSubimageCamera(converter);
   const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
-  const int width = all.width_px, height = all.height_px;
-  // The grid's tolerance (0.01 px), the 16-bit rounding (1/32 px) and float rounding.
-  constexpr double kTolerancePx = 0.05;
   for (const int strip_rows : {16, 256, 4096})
     for (const Interpolation interpolation : {Interpolation::kBilinear, Interpolation::kBicubic})
       for (int k = 0; k < 4; ++k) {
-        calib::Camera one = all;
-        one.subimages = {all.subimages[k]};
-        const calib::Camera& camera = rig.heads[k].camera;
-        std::array<MemoryRaster, 2> ramp{MemoryRaster({camera.width_px, camera.height_px, 1, 16}),
-                                         MemoryRaster({camera.width_px, camera.height_px, 1, 16})};
-        for (int r = 0; r < camera.height_px; ++r)
-          for (int c = 0; c < camera.width_px; ++c) {
-            ramp[0].Set(c, r, 0, 16.0 * c);
-            ramp[1].Set(c, r, 0, 16.0 * r);
-          }
         ResampleOptions options;
         options.fill = 0.0;
         options.strip_rows = strip_rows;
         options.interpolation = interpolation;
-        std::array<MemoryRaster, 2> out{MemoryRaster({width, height, 1, 16}),
-                                        MemoryRaster({width, height, 1, 16})};
-        for (int a = 0; a < 2; ++a)
-          ResampleVirtualImage(
-              one, {&ramp[a]}, &out[a], options, std::vector<MapCorrectionGrid>{grids.grids[k]});
-        long checked = 0, wrong = 0;
-        double worst = 0.0;
-        for (int r = 0; r < height; ++r)
-          for (int c = 0; c < width; ++c) {
-            const auto exact = converter.HeadFromVirtual(k, Eigen::Vector2d(c, r));
-            // 1 px inside the format: the bicubic support and the coverage rule stay out of it
-            if (!exact || exact->x() < 1 || exact->y() < 1 || exact->x() > camera.width_px - 2 ||
-                exact->y() > camera.height_px - 2)
-              continue;
-            const Eigen::Vector2d sampled(out[0].At(c, r) / 16.0, out[1].At(c, r) / 16.0);
-            const double error = (sampled - *exact).cwiseAbs().maxCoeff();
-            worst = std::max(worst, error);
-            ++checked;
-            wrong += error > kTolerancePx;
-          }
-        EXPECT_GT(checked, 10000) << rig.heads[k].id;
-        EXPECT_EQ(wrong, 0) << rig.heads[k].id << ", strips of " << strip_rows << " rows, "
-                            << (interpolation == Interpolation::kBilinear ? "bilinear" : "bicubic")
-                            << ": worst " << worst << " px";
+        const RampCheck check = SampleRamps(converter, grids, k, options, kRampTolerancePx);
+        EXPECT_GT(check.checked, 10000) << rig.heads[k].id;
+        EXPECT_EQ(check.wrong, 0) << rig.heads[k].id << ", strips of " << strip_rows << " rows, "
+                                  << (interpolation == Interpolation::kBilinear ? "bilinear"
+                                                                                : "bicubic")
+                                  << ": worst " << check.worst_px << " px";
       }
+}
+
+// The virtual camera in another model, with distortion of its own (OpenCV's, k1 = -0.005: about
+// 20 px at the corner of the small uav4 format) and distortion-free heads: the homography between
+// the pinhole parts is no longer the map, so every head gets a correction grid, and the converted
+// image samples the exact head pixel (the virtual camera's own model) to the same tolerance.
+TEST(RigConvert, AVirtualCameraWithDistortionIsConvertedThroughItsOwnModel) {
+  calib::Rig rig = SmallUav4Rig(/*distorted=*/false);
+  calib::Camera& v = rig.virtual_camera.camera;
+  v = v.WithModelCamera(
+      calib::ConvertCamera(v.AsModelCamera(), calib::CameraModelId::kOpenCv).camera);
+  v.interior[v.ParamIndex("k1")] = -0.005;
+  const calib::Rig written =
+      calib::ParseRig(LoadYamlText(calib::RigToYaml(rig), "rig.yaml"), "rig.yaml");
+  EXPECT_EQ(written.virtual_camera.camera.model, calib::CameraModelId::kOpenCv);
+  EXPECT_EQ(written.virtual_camera.camera.interior, v.interior);
+  const RigExposure exposure = TurnedExposure();
+  const RigConverter converter(rig, exposure, MakeRectificationPlane(rig, exposure, 300.0));
+  // The ray of a virtual pixel goes through the virtual camera's model and back.
+  const Eigen::Vector2d corner(0, 0);
+  const auto ray = rig.virtual_camera.RayFromPixel(corner);
+  ASSERT_TRUE(ray.has_value());
+  Eigen::Vector2d back;
+  ASSERT_TRUE(rig.virtual_camera.PixelFromRay(*ray, &back));
+  EXPECT_LT((back - corner).norm(), 1e-9);
+  const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
+  EXPECT_GT(grids.finest_step_px, 0);
+  ResampleOptions options;
+  options.fill = 0.0;
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_GT(grids.grids[k].max_abs_px, 1.0) << rig.heads[k].id;
+    const RampCheck check = SampleRamps(converter, grids, k, options, kRampTolerancePx);
+    EXPECT_GT(check.checked, 10000) << rig.heads[k].id;
+    EXPECT_EQ(check.wrong, 0) << rig.heads[k].id << ": worst " << check.worst_px << " px";
+  }
 }
 
 // A DEM of a tilted plane is a tilted rectification plane (bilinear interpolation of a plane is
@@ -455,7 +510,8 @@ TEST(RigConvert, RealPhotographThroughATwoHeadRigAndBack) {
   if (dir.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
   const MemoryRaster full = ReadImageFile(dir + "/images/img_4880.jpg", /*gray=*/true);
   const calib::Rig rig = TwoHeadRig();
-  const int width = rig.virtual_camera.width_px, height = rig.virtual_camera.height_px;
+  const int width = rig.virtual_camera.camera.width_px,
+            height = rig.virtual_camera.camera.height_px;
   const int x_off = (full.Info().width - width) / 2, y_off = (full.Info().height - height) / 2;
   MemoryRaster truth({width, height, 1, 8});
   for (int r = 0; r < height; ++r)
@@ -515,7 +571,8 @@ TEST(RigConvert, RealPhotographThroughDistortedHeadsAndBack) {
   if (dir.empty()) GTEST_SKIP() << "../shared/data/odm_boruszyn_kap_frames is absent";
   const MemoryRaster full = ReadImageFile(dir + "/images/img_4880.jpg", /*gray=*/true);
   const calib::Rig rig = DistortedTwoHeadRig();
-  const int width = rig.virtual_camera.width_px, height = rig.virtual_camera.height_px;
+  const int width = rig.virtual_camera.camera.width_px,
+            height = rig.virtual_camera.camera.height_px;
   const int x_off = (full.Info().width - width) / 2, y_off = (full.Info().height - height) / 2;
   MemoryRaster truth({width, height, 1, 8});
   for (int r = 0; r < height; ++r)

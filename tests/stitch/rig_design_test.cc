@@ -93,8 +93,8 @@ TEST(RigDesign, Uav4HasFiveTwoFoldZonesTwoTripleZonesAndTwelveStandardPositions)
   }
   // The effective format lies inside the covered box, which the file's format holds.
   EXPECT_GE(d.effective_px.min_px.minCoeff(), d.covered_box_px.min_px.minCoeff());
-  EXPECT_LE(d.covered_box_px.Width(), rig.virtual_camera.width_px);
-  EXPECT_LE(d.covered_box_px.Height(), rig.virtual_camera.height_px);
+  EXPECT_LE(d.covered_box_px.Width(), rig.virtual_camera.camera.width_px);
+  EXPECT_LE(d.covered_box_px.Height(), rig.virtual_camera.camera.height_px);
   EXPECT_GT(d.effective_area_m2, 0.5 * d.covered_area_m2);
   EXPECT_LT(d.effective_area_m2, d.covered_area_m2);
 }

@@ -88,7 +88,7 @@ StitchedImageReport Stitch(const SimulatedRigFlight& f,
   const RigConverter converter(f.truth, pose, {Eigen::Vector3d::UnitZ(), z_ref_m});
   std::vector<RasterSource*> sources;
   for (auto& h : heads) sources.push_back(&h);
-  const calib::VirtualCamera& v = f.truth.virtual_camera;
+  const calib::Camera& v = f.truth.virtual_camera.camera;
   MemoryRaster out({v.width_px, v.height_px, 1, 8}), mask({v.width_px, v.height_px, 1, 8});
   const StitchedImageReport report = MakeStitchedImage(converter, sources, {}, &out, &mask);
   long valid = 0;

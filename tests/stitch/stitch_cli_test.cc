@@ -1,6 +1,8 @@
 // The 'aerocal stitch' and 'aerocal resample' commands on the example cameras in configs/:
-// exit codes, FORMATS.md result keys, refusal messages, the virtual TIFF and its metadata.
+// exit codes, FORMATS.md result keys, refusal messages, the virtual TIFF and its metadata, and a
+// camera file in another model (OpenCV's) giving the same result and pixels.
 #include "calib/camera/camera_io.h"
+#include "calib/camera/convert_camera.h"
 #include "calib/core/result_file.h"
 #include "stitch/resample/tiff_raster.h"
 #include "stitch/simulation/stitch_simulator.h"
@@ -103,6 +105,29 @@ TEST(StitchCommand, BatchWritesFramesAndStability) {
     for (const char* key :
          {"frame", "sigma0", "sigma0_px", "redundancy", "iterations", "converged", "subimages"})
       EXPECT_TRUE(f.contains(key)) << key;
+}
+
+// `camera` in OpenCV's model (the exact conversion of its pinhole), its sub-images kept.
+calib::Camera InOpenCvModel(const calib::Camera& camera) {
+  return camera.WithModelCamera(
+      calib::ConvertCamera(camera.AsModelCamera(), calib::CameraModelId::kOpenCv).camera);
+}
+
+// The stitching reads no interior term: a camera file in another registered model with the same
+// sub-images gives the same result, number for number.
+TEST(StitchCommand, ACameraInAnotherModelGivesTheSameResult) {
+  TempDir tmp;
+  const std::string camera_path = std::string(AEROCAL_CONFIGS_DIR) + "/camera_2x3.yaml";
+  const calib::Camera camera = calib::ReadCamera(camera_path);
+  calib::WriteCamera(tmp.File("opencv.yaml"), InOpenCvModel(camera));
+  WriteFrames(camera, {"II", "V"}, 1, tmp.File("obs.csv"));
+  const std::string args = " --obs " + tmp.File("obs.csv") + " --base II,V --out ";
+  const auto ours = RunAerocal("stitch --camera " + camera_path + args + tmp.File("bf.json"));
+  ASSERT_EQ(ours.exit_code, 0) << ours.output;
+  const auto other =
+      RunAerocal("stitch --camera " + tmp.File("opencv.yaml") + args + tmp.File("cv.json"));
+  ASSERT_EQ(other.exit_code, 0) << other.output;
+  EXPECT_EQ(ReadJson(tmp.File("cv.json")), ReadJson(tmp.File("bf.json")));
 }
 
 TEST(StitchCommand, RefusesBadInputWithExitTwoAndNothingWritten) {
@@ -208,6 +233,15 @@ subimages:
   MemoryRaster b(source->Info());
   OpenTiff(tmp.File("b.tif"))->ReadWindow(0, 0, 400, 300, b.bytes().data());
   EXPECT_EQ(b.bytes(), v.bytes());
+  // The camera in OpenCV's model (the resampling reads no interior term): the same pixels.
+  calib::WriteCamera(tmp.File("opencv.yaml"), InOpenCvModel(camera));
+  const auto other = RunAerocal("resample --camera " + tmp.File("opencv.yaml") + " --mapping " +
+                                tmp.File("r.json") + " --images " + images + " --out " +
+                                tmp.File("cv.tif") + " --fill 7 --interp bicubic");
+  ASSERT_EQ(other.exit_code, 0) << other.output;
+  MemoryRaster cv(source->Info());
+  OpenTiff(tmp.File("cv.tif"))->ReadWindow(0, 0, 400, 300, cv.bytes().data());
+  EXPECT_EQ(cv.bytes(), v.bytes());
   // A sub-image without an image is refused.
   const auto bad = RunAerocal("resample --camera " + tmp.File("camera.yaml") + " --mapping " +
                               tmp.File("r.json") + " --images I=" + tmp.File("I.tif") + " --out " +

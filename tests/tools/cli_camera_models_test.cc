@@ -8,7 +8,7 @@
 // - `calibrate` on the simulated test field with an OpenCV camera file calibrates the OpenCV
 //   model; `--model opencv` on a 10-parameter camera file adds the OpenCV fit beside it;
 // - bad input: a parameter the model does not have, another model where the 10-parameter model is
-//   needed (sub-images, rig heads): exit 2, FILE:LINE or the option, nothing written.
+//   needed (`flight`, `batch`): exit 2, FILE:LINE naming the model, nothing written.
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "tests/support/test_support.h"
@@ -98,16 +98,23 @@ TEST_F(FlightInAnotherModel, BadModelUseIsExitTwoWithNothingWritten) {
       << r.output;
   EXPECT_FALSE(std::filesystem::exists(dir_->File("bad1.json")));
   // (Sub-image mappings and rig heads take any model since issue 30 item 4:
-  // tests/triangulation/model_families_test.cc.)
-  // The stitching commands read the 10-parameter model only: "convert it first".
-  r = RunAerocal("stitch --camera " + dir_->File("f/cam_ms.yaml") + " --obs " +
-                 dir_->File("f/stitch_obs.csv") + " --out " + dir_->File("bad3.json"));
+  // tests/triangulation/model_families_test.cc; stitch, match and resample read no interior term
+  // and take any model: tests/stitch/stitch_cli_test.cc, match_stitch_test.cc.)
+  // The flight commands read the 10-parameter model only (their self-calibration candidates name
+  // its terms): "convert it first", naming the model.
+  const std::string flight = " --camera " + dir_->File("f/cam_ms.yaml") + " --data " +
+                             dir_->File("f") + " --base III,IV --no-report --out ";
+  const std::string message =
+      "cam_ms.yaml:2: camera model 'metashape_frame': this command needs brown_fraser_10 (convert "
+      "it first";
+  r = RunAerocal("flight" + flight + dir_->File("bad3"));
   EXPECT_EQ(r.exit_code, 2) << r.output;
-  EXPECT_NE(r.output.find("cam_ms.yaml:2: camera model 'metashape_frame': this command needs "
-                          "brown_fraser_10 (convert it first"),
-            std::string::npos)
-      << r.output;
-  EXPECT_FALSE(std::filesystem::exists(dir_->File("bad3.json")));
+  EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_->File("bad3")));
+  r = RunAerocal("batch plan --work " + dir_->File("bad4_work") + flight + dir_->File("bad4"));
+  EXPECT_EQ(r.exit_code, 2) << r.output;
+  EXPECT_NE(r.output.find(message), std::string::npos) << r.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_->File("bad4_work")));
 }
 
 class TestFieldInOpenCv : public ::testing::Test {

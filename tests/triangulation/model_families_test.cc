@@ -5,12 +5,15 @@
 //   size, that is zero at the true geometry and whose Jacobians match numeric differentiation;
 // - a rig whose heads are in OpenCV's and COLMAP's models, noise-free, gives back the true mount,
 //   lever arm and distortion of head B in the rig bundle, and its rig file round-trips;
+// - every registered model is a rig's virtual camera: its rig file round-trips, the conversion
+//   between heads and the virtual image goes through its own projection;
 // - a multi-CCD camera in OpenCV's model, noise-free, gives back a sub-image's mapping half a
 //   pixel off (joint adjustment) and the distortion (default sub-image kind) to 1e-8.
 #include "calib/camera/camera_io.h"
 #include "calib/camera/convert_camera.h"
 #include "calib/camera/rig_io.h"
 #include "calib/residuals/collinearity.h"
+#include "stitch/rig/rig_conversion.h"
 #include "tests/support/rig_flight_project.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/block/block_io.h"
@@ -194,6 +197,53 @@ TEST(ModelFamilies, EveryRegisteredModelReachesEveryCameraResidualFamily) {
   });
   std::printf("%d registered models x 3 families (frame, sub-image, rig head)\n", models);
   EXPECT_GE(models, 11);
+}
+
+// ---------------------------------------------------------------------------------------------
+// The virtual camera of a rig in every model.
+
+// The dual-lens rig's virtual camera in `Model` (with its radial term): the rig file keeps it; a
+// virtual pixel's point on the rectification plane is seen at that pixel by the virtual camera as
+// a frame camera at the virtual pose (its own projection, Camera::ProjectToPixel), and every head
+// that sees the point carries it back to the same virtual pixel.
+template <typename Model>
+void CheckVirtualCamera() {
+  SCOPED_TRACE(std::string(Model::kName));
+  calib::Rig rig = MakeNominalRig(RigPreset::kDualLens);
+  calib::Camera& v = rig.virtual_camera.camera;
+  v = CameraInModel(v, Model::kId);
+  const calib::Rig back = calib::ParseRig(YAML::Load(calib::RigToYaml(rig)), "rig.yaml");
+  EXPECT_EQ(back.virtual_camera.camera.model, Model::kId);
+  EXPECT_EQ(back.virtual_camera.camera.interior, v.interior);
+  stitch::RigExposure exposure;
+  exposure.rig_opk_rad = Eigen::Vector3d(0.01, -0.02, 0.3);
+  exposure.rig_center_m = Eigen::Vector3d(10.0, -20.0, 1250.0);
+  const stitch::RigConverter converter(
+      rig, exposure, stitch::MakeRectificationPlane(rig, exposure, 1200.0));
+  const Eigen::Vector3d virtual_opk = calib::OpkFromRotation(converter.ObjectFromVirtual());
+  int seen_by_heads = 0;
+  for (int i = 0; i <= 4; ++i)
+    for (int j = 0; j <= 4; ++j) {
+      const Eigen::Vector2d pixel(i * (v.width_px - 1) / 4.0, j * (v.height_px - 1) / 4.0);
+      const auto ground = converter.PlanePointOfVirtualPixel(pixel);
+      ASSERT_TRUE(ground.has_value()) << pixel.transpose();
+      Eigen::Vector2d seen;
+      ASSERT_TRUE(v.ProjectToPixel(virtual_opk, converter.VirtualCenter(), *ground, &seen));
+      EXPECT_LT((seen - pixel).norm(), 1e-6) << pixel.transpose();
+      for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k) {
+        const auto head_px = converter.HeadFromVirtual(k, pixel);
+        if (!head_px || !converter.InHeadFormat(k, *head_px)) continue;
+        const auto again = converter.VirtualFromHead(k, *head_px);
+        ASSERT_TRUE(again.has_value());
+        EXPECT_LT((*again - pixel).norm(), 1e-6) << rig.heads[k].id << " " << pixel.transpose();
+        ++seen_by_heads;
+      }
+    }
+  EXPECT_GE(seen_by_heads, 10);
+}
+
+TEST(ModelFamilies, EveryRegisteredModelIsARigsVirtualCamera) {
+  calib::ForEachCameraModel([&](auto model) { CheckVirtualCamera<decltype(model)>(); });
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -74,7 +74,7 @@ StitchResult Stitch(const std::string& camera_path,
                     bool no_snooping,
                     const py::object& progress_callback) {
   if (!(sigma_px > 0 && sigma_px <= 100)) throw ConfigError("sigma_px: must be in (0, 100]");
-  const calib::Camera camera = calib::ReadCamera(camera_path);
+  const calib::Camera camera = calib::ReadCamera(camera_path, calib::CameraModels::kAny);
   const stitch::BatchOptions options =
       stitch::BatchOptionsFromText(camera, model, base, alpha, !no_snooping, "model", "alpha");
   const auto frames = stitch::ReadStitchFrames(camera, camera_path, observations, sigma_px);

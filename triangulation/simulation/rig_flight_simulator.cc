@@ -54,13 +54,9 @@ calib::Rig Uav4Rig() {
   calib::Rig rig;
   rig.name = "uav4-24";
   rig.reference_head = "A";
-  calib::VirtualCamera& v = rig.virtual_camera;
-  v.orientation = calib::VirtualOrientation::kLevel;
-  v.c_mm = 24.5;
-  v.pixel_size_mm = 0.0082;
-  v.width_px = 8660;
-  v.height_px = 11760;
-  v.height_m = 300.0;
+  rig.virtual_camera =
+      calib::VirtualCamera::Pinhole(calib::VirtualOrientation::kLevel, 24.5, 0.0082, 8660, 11760);
+  rig.virtual_camera.height_m = 300.0;
   const Eigen::Vector3d interior(24.5, 0.0, 0.0);
   rig.heads.push_back(MakeHead("A", 0.0082, 2912, 4368, interior, {0, -24, 0}, {0.06, 0, 0}));
   rig.heads.push_back(MakeHead("B", 0.0082, 4368, 2912, interior, {37, 0, 0}, {0, 0.06, 0}));
@@ -106,15 +102,8 @@ calib::Rig MakeNominalRig(RigPreset preset) {
   calib::Rig rig;
   rig.name = "dual-lens-150";
   rig.reference_head = "A";
-  calib::VirtualCamera& v = rig.virtual_camera;
-  v.orientation = calib::VirtualOrientation::kRig;
-  v.c_mm = 150.0;
-  v.pixel_size_mm = 0.006;
-  v.width_px = 10460;
-  v.height_px = 10044;
-  v.x0_mm = 4.374;
-  v.y0_mm = 3.006;
-  v.height_m = 1200.0;
+  rig.virtual_camera = calib::VirtualCamera::Pinhole(
+      calib::VirtualOrientation::kRig, 150.0, 0.006, 10460, 10044, 4.374, 3.006, 1200.0);
   rig.heads.push_back(DualLensHead("A", Eigen::Vector3d::Zero(), Eigen::Vector3d::Zero()));
   rig.heads.push_back(DualLensHead("B", {0.0, 1.0, 0.0}, {0.15, 0.01, 0.01}));
   return rig;
@@ -210,7 +199,8 @@ void AddStitchingTies(SimulatedRigFlight& f, internal::SimulationRandom& random)
   auto& rng = random.rng;
   auto& normal = random.normal;
   auto& uniform = random.uniform;
-  const calib::VirtualCamera& v = f.nominal.virtual_camera;
+  const calib::VirtualCamera& virtual_camera = f.nominal.virtual_camera;
+  const calib::Camera& v = virtual_camera.camera;
   const size_t heads = f.truth.heads.size();
   const bool any = st.dense > 0 || st.check > 0 ||
                    (st.per_standard_position > 0 && !st.standard_positions.empty());
@@ -220,7 +210,8 @@ void AddStitchingTies(SimulatedRigFlight& f, internal::SimulationRandom& random)
     const double kappa = calib::OpkFromRotation(calib::RotationFromOpk(e.opk_rad)).z();
     const Eigen::Matrix3d object_from_virtual = calib::RotationFromOpk({0.0, 0.0, kappa});
     const auto ground_of = [&](const Eigen::Vector2d& px, Eigen::Vector3d* g) {
-      return TerrainPointOfRay(o, e.center_m, object_from_virtual * v.RayFromPixel(px), g);
+      const std::optional<Eigen::Vector3d> ray = virtual_camera.RayFromPixel(px);
+      return ray && TerrainPointOfRay(o, e.center_m, object_from_virtual * *ray, g);
     };
     // z_ref: the mean terrain height under the virtual image (a 20 x 20 grid).
     double sum = 0.0;
@@ -327,8 +318,8 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
     head.lever_arm_m += options.lever_arm_error_m;
   }
 
-  const calib::VirtualCamera& v = f.nominal.virtual_camera;
-  const double scale = o.flying_height_m / (v.c_mm * 1e-3);
+  const calib::Camera& v = f.nominal.virtual_camera.camera;
+  const double scale = o.flying_height_m / (v.c_mm() * 1e-3);
   const Eigen::Vector2d footprint(v.width_px * v.pixel_size_mm * 1e-3 * scale,
                                   v.height_px * v.pixel_size_mm * 1e-3 * scale);
   f.exposures_truth = internal::PlanStrips(o, footprint, "rig1", random);
@@ -415,9 +406,10 @@ calib::Rig ScaleRigFormats(const calib::Rig& rig, double scale) {
     head.camera.height_px = scaled(head.camera.height_px);
     head.camera.pixel_size_mm /= scale;
   }
-  out.virtual_camera.width_px = scaled(out.virtual_camera.width_px);
-  out.virtual_camera.height_px = scaled(out.virtual_camera.height_px);
-  out.virtual_camera.pixel_size_mm /= scale;
+  calib::Camera& v = out.virtual_camera.camera;
+  v.width_px = scaled(v.width_px);
+  v.height_px = scaled(v.height_px);
+  v.pixel_size_mm /= scale;
   return out;
 }
 
@@ -432,10 +424,10 @@ TexturedGround MakeRigGroundTexture(const SimulatedRigFlight& f, const RigImageO
   options.Validate();
   TexturedGround ground;
   ReadGroundTexture(options.texture_path, &ground);
-  const calib::VirtualCamera& v = f.nominal.virtual_camera;
+  const calib::Camera& v = f.nominal.virtual_camera.camera;
   ground.gsd_m = options.texture_gsd_m > 0
                      ? options.texture_gsd_m
-                     : 0.5 * v.pixel_size_mm * f.options.flight.flying_height_m / v.c_mm;
+                     : 0.5 * v.pixel_size_mm * f.options.flight.flying_height_m / v.c_mm();
   Eigen::Vector2d centre = Eigen::Vector2d::Zero();
   for (const Exposure& e : f.exposures_truth) centre += e.center_m.head<2>();
   centre /= static_cast<double>(f.exposures_truth.size());

@@ -23,6 +23,7 @@
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <sstream>
@@ -43,23 +44,14 @@ constexpr double kFreeSigma = 1000.0;  // Australis prints 1.0e+003 for a free p
 constexpr const char* kAustralisNames[Model::kNumParams] = {
     "C", "XP", "YP", "K1", "K2", "K3", "P1", "P2", "B1", "B2"};
 
-}  // namespace
-
-CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions& options) {
-  const std::vector<std::string> lines = SplitLines(ReadTextFile(path));
+// The report as whitespace-separated tokens with their line numbers.
+struct Report {
+  std::string path;
   std::vector<Token> tokens;
-  for (size_t i = 0; i < lines.size(); ++i) {
-    std::istringstream in(lines[i]);
-    for (std::string t; in >> t;) tokens.push_back({t, static_cast<int>(i + 1)});
-  }
-  bool australis = false;
-  for (const std::string& line : lines) australis |= line.find("Australis") != std::string::npos;
-  if (!australis)
-    ThrowInputError({path, 1}, "not an Australis camera-parameter report (no 'Australis' line)");
-  if (!options.camera_id.empty())
-    ThrowInputError({path, 1}, "--camera: one camera per Australis report is read");
-  // The token index of the one line at or after token `from` that starts with `name` (-1: none).
-  const auto row = [&](const std::string& name, size_t from) -> long {
+
+  // The token index of the one line at or after token `from` that starts with `name` (-1: none);
+  // a second such line is an error.
+  long Row(const std::string& name, size_t from) const {
     long found = -1;
     for (size_t i = from; i < tokens.size(); ++i) {
       if (tokens[i].text != name || (i > 0 && tokens[i - 1].line == tokens[i].line)) continue;
@@ -70,67 +62,103 @@ CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions&
       found = static_cast<long>(i);
     }
     return found;
-  };
-  const long h = row("H", 0), v = row("V", 0);
-  if (h < 0 || v < 0)
-    ThrowInputError({path, 1},
-                    "no sensor size: lines 'H <pixels> <pixel size mm>' and "
-                    "'V <pixels> <pixel size mm>'");
+  }
   // The k-th number after the name at token `i`.
-  const auto number = [&](long i, long k, const std::string& what, double bound) {
+  double Number(long i, long k, const std::string& what, double bound) const {
     const size_t at = static_cast<size_t>(i + k);
     if (at >= tokens.size()) ThrowInputError({path, tokens[i].line}, what + " is missing");
     return internal::ParseNumber(tokens[at].text, {path, tokens[at].line}, what, bound);
-  };
-  const double width = number(h, 1, "H pixels", 1e6), height = number(v, 1, "V pixels", 1e6);
-  const double pixel_h = number(h, 2, "H pixel size", 1.0),
-               pixel_v = number(v, 2, "V pixel size", 1.0);
+  }
+};
+
+Report ReadReport(const std::string& path) {
+  const std::vector<std::string> lines = SplitLines(ReadTextFile(path));
+  Report report{path, {}};
+  for (size_t i = 0; i < lines.size(); ++i) {
+    std::istringstream in(lines[i]);
+    for (std::string t; in >> t;) report.tokens.push_back({t, static_cast<int>(i + 1)});
+  }
+  bool australis = false;
+  for (const std::string& line : lines) australis |= line.find("Australis") != std::string::npos;
+  if (!australis)
+    ThrowInputError({path, 1}, "not an Australis camera-parameter report (no 'Australis' line)");
+  return report;
+}
+
+// The sensor size (lines H and V: pixels, pixel size mm) into the file's format (square pixels of
+// V's size); returns the token after which the parameter lines start.
+size_t ReadSensorSize(const Report& r, const CameraReadOptions& options, CameraFile* file) {
+  const long h = r.Row("H", 0), v = r.Row("V", 0);
+  if (h < 0 || v < 0)
+    ThrowInputError({r.path, 1},
+                    "no sensor size: lines 'H <pixels> <pixel size mm>' and "
+                    "'V <pixels> <pixel size mm>'");
+  const double width = r.Number(h, 1, "H pixels", 1e6), height = r.Number(v, 1, "V pixels", 1e6);
+  const double pixel_h = r.Number(h, 2, "H pixel size", 1.0),
+               pixel_v = r.Number(v, 2, "V pixel size", 1.0);
   if (!(width >= 1 && height >= 1 && width == std::floor(width) && height == std::floor(height)))
-    ThrowInputError({path, tokens[h].line}, "H and V pixels must be positive integers");
-  CameraFile file;
-  file.name = std::filesystem::path(path).stem().string();
-  internal::ResolveFormat(&file,
+    ThrowInputError({r.path, r.tokens[h].line}, "H and V pixels must be positive integers");
+  internal::ResolveFormat(file,
                           options,
-                          {path, tokens[v].line},
+                          {r.path, r.tokens[v].line},
                           static_cast<int>(width),
                           static_cast<int>(height),
                           pixel_v);
   if (std::abs(pixel_h / pixel_v - 1.0) > 1e-9)
-    file.notes.push_back("Australis H pixel size " + FormatNumber(pixel_h) + " mm differs from V " +
-                         FormatNumber(pixel_v) + " mm: square pixels of V's size (not modelled)");
-  file.camera.model = Model::kId;
-  file.camera.params.assign(Model::kNumParams, 0.0);
+    file->notes.push_back("Australis H pixel size " + FormatNumber(pixel_h) +
+                          " mm differs from V " + FormatNumber(pixel_v) +
+                          " mm: square pixels of V's size (not modelled)");
+  return static_cast<size_t>(std::max(h, v)) + 1;
+}
+
+// Each parameter's line (name, initial, total adjustment, final, initial sigma, final sigma): the
+// final value, and the final sigma as a diagonal covariance where both sigmas are > 0 (0: fixed).
+void ReadParameters(const Report& r, size_t from, CameraFile* file) {
+  file->camera.model = Model::kId;
+  file->camera.params.assign(Model::kNumParams, 0.0);
   Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(Model::kNumParams, Model::kNumParams);
   bool any_sigma = false;
   for (int k = 0; k < Model::kNumParams; ++k) {
     const std::string name = kAustralisNames[k];
-    const long i = row(name, static_cast<size_t>(std::max(h, v)) + 1);
+    const long i = r.Row(name, from);
     if (i < 0) {
       if (k == Model::kC)
-        ThrowInputError({path, 1},
+        ThrowInputError({r.path, 1},
                         "no camera constant: a line 'C <initial> <adjustment> <final> "
                         "<initial sigma> <final sigma>'");
-      file.notes.push_back(name + ": no line in the report, 0");
+      file->notes.push_back(name + ": no line in the report, 0");
       continue;
     }
-    number(i, 1, name + " initial value", 1e12);
-    number(i, 2, name + " total adjustment", 1e12);
-    file.camera.params[k] = number(i, 3, name + " final value", k == Model::kC ? 1e4 : 1e3);
-    const double initial_sigma = number(i, 4, name + " initial std. error", 1e12);
-    const double sigma = number(i, 5, name + " final std. error", 1e12);
-    if (sigma < 0) ThrowInputError({path, tokens[i].line}, name + " std. error must be >= 0");
-    if (sigma > 0 && initial_sigma > 0) {  // 0: fixed (or not given)
+    r.Number(i, 1, name + " initial value", 1e12);
+    r.Number(i, 2, name + " total adjustment", 1e12);
+    file->camera.params[k] = r.Number(i, 3, name + " final value", k == Model::kC ? 1e4 : 1e3);
+    const double initial_sigma = r.Number(i, 4, name + " initial std. error", 1e12);
+    const double sigma = r.Number(i, 5, name + " final std. error", 1e12);
+    if (sigma < 0) ThrowInputError({r.path, r.tokens[i].line}, name + " std. error must be >= 0");
+    if (sigma > 0 && initial_sigma > 0) {
       covariance(k, k) = sigma * sigma;
       any_sigma = true;
     }
   }
-  if (!(file.camera.params[Model::kC] > 0)) ThrowInputError({path, 1}, "C must be > 0 mm");
+  if (!(file->camera.params[Model::kC] > 0)) ThrowInputError({r.path, 1}, "C must be > 0 mm");
   if (any_sigma) {
-    file.covariance = covariance;
-    file.notes.push_back(
+    file->covariance = covariance;
+    file->notes.push_back(
         "Australis final std. errors read as a diagonal covariance (the report "
         "prints no correlations)");
   }
+}
+
+}  // namespace
+
+CameraFile ReadAustralisCamera(const std::string& path, const CameraReadOptions& options) {
+  const Report report = ReadReport(path);
+  if (!options.camera_id.empty())
+    ThrowInputError({path, 1}, "--camera: one camera per Australis report is read");
+  CameraFile file;
+  file.name = std::filesystem::path(path).stem().string();
+  const size_t parameters_from = ReadSensorSize(report, options, &file);
+  ReadParameters(report, parameters_from, &file);
   return file;
 }
 

@@ -73,22 +73,11 @@ struct XmlCamera {
   }
 };
 
-}  // namespace
-
-bool IsDbatReport(const std::string& head) {
-  return head.find("Camera Constant:") != std::string::npos &&
-         head.find("px - principal point x:") != std::string::npos;
-}
-
-CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& options) {
-  const std::string text = ReadTextFile(path);
-  if (IsDbatReport(text))
-    return internal::ReadReportCamera(path, SplitLines(text), options, "DBAT");
-  tinyxml2::XMLDocument doc;
-  if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS)
-    ThrowInputError({path, doc.ErrorLineNum()}, std::string("invalid XML: ") + doc.ErrorName());
-  const tinyxml2::XMLElement* root = doc.RootElement();
-  // A whole file (<document><cameras><camera>) or a fragment (<cameras> or one <camera>).
+// The camera the options name among the document's: a whole file (<document><cameras><camera>) or
+// a fragment (<cameras> or one <camera>); several cameras need --camera ID.
+XmlCamera FindCamera(const std::string& path,
+                     const tinyxml2::XMLElement* root,
+                     const CameraReadOptions& options) {
   const std::string root_name = root ? root->Name() : "";
   const tinyxml2::XMLElement* cameras = root_name == "cameras" ? root
                                         : root                 ? root->FirstChildElement("cameras")
@@ -115,10 +104,18 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
         options.camera_id.empty()
             ? "no <document><cameras><camera> element (not a DBAT camera file)"
             : "no camera with <id>" + options.camera_id + "</id> (cameras: " + ids + ")");
-  CameraFile file;
-  const auto name = xml.List("name");
-  file.name = name.empty() ? std::filesystem::path(path).stem().string() : name.front();
-  file.chosen_by_camera_id = !options.camera_id.empty();
+  return xml;
+}
+
+// The format in mm and DBAT's pixel aspect s (x scale: pixel width over pixel height).
+struct DbatSensor {
+  double w_mm = 0, h_mm = 0, s = 1.0;
+};
+
+// <image> W,H px and <sensor> W,H mm (or auto,H) into the file's format (our pixel: the pixel
+// height); the aspect from the sensor width, or 1 + as = 2 - <aspect> where the width is "auto"
+// (DBAT's report: pixel width = pixel height (1 + as), the XML's aspect = 1 - as).
+DbatSensor ReadFormat(const XmlCamera& xml, const CameraReadOptions& options, CameraFile* file) {
   const auto image = xml.Numbers("image", 2, 1e6);
   if (!(image[0] >= 1 && image[1] >= 1) || image[0] != std::floor(image[0]) ||
       image[1] != std::floor(image[1]))
@@ -132,31 +129,33 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
   if (!height_mm || !(*height_mm > 0 && *height_mm <= 1000))
     ThrowInputError(xml.Where(xml.Child("sensor")), "<sensor> height must be > 0 and <= 1000 mm");
   const double pixel = *height_mm / height;  // our pixel: the pixel height
-  internal::ResolveFormat(&file, options, xml.Where(xml.Child("image")), width, height, pixel);
-  const double w_mm = width * pixel, h_mm = *height_mm;
-  // DBAT's pixel aspect: the sensor width over the image width against the pixel height, or
-  // 1 + as = 2 - <aspect> where the width is "auto" (DBAT's report: pixel width = pixel height
-  // (1 + as), the XML's aspect = 1 - as). It scales DBAT's x: held as B1 = s - 1.
-  double s = 1.0;
+  internal::ResolveFormat(file, options, xml.Where(xml.Child("image")), width, height, pixel);
+  DbatSensor f{width * pixel, *height_mm, 1.0};
   if (sensor[0] != "auto") {
     const auto sensor_w = ParseDouble(sensor[0]);
     if (!sensor_w || !(*sensor_w > 0 && *sensor_w <= 1000))
       ThrowInputError(xml.Where(xml.Child("sensor")),
                       "<sensor> width must be > 0 and <= 1000 mm (or auto)");
-    s = (*sensor_w / width) / pixel;
+    f.s = (*sensor_w / width) / pixel;
   }
   if (xml.Child("aspect")) {
     const double aspect = xml.Numbers("aspect", 1, 10)[0];
     if (!(aspect > 0)) ThrowInputError(xml.Where(xml.Child("aspect")), "<aspect> must be > 0");
     if (sensor[0] == "auto")
-      s = 2.0 - aspect;
-    else if (std::abs(s - (2.0 - aspect)) > 1e-6)
+      f.s = 2.0 - aspect;
+    else if (std::abs(f.s - (2.0 - aspect)) > 1e-6)
       ThrowInputError(xml.Where(xml.Child("aspect")),
                       "<aspect> " + FormatNumber(aspect) +
                           " contradicts the sensor width (pixel "
                           "width / height " +
-                          FormatNumber(s) + ")");
+                          FormatNumber(f.s) + ")");
   }
+  return f;
+}
+
+// <cc> (or <focal>), <pp>, <K>, <P> into brown_fraser_10: x0 = px / s - W p / 2, y0 = H p / 2 -
+// py, B1 = s - 1 (not exact where s != 1: the difference over the format said in a note).
+void ReadInterior(const XmlCamera& xml, const DbatSensor& f, CameraFile* file) {
   double c = xml.Child("cc") ? xml.Numbers("cc", 1, 1e4)[0] : 0.0;
   if (c == 0) c = xml.Numbers("focal", 1, 1e4)[0];
   if (!(c > 0))
@@ -164,24 +163,47 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
                     "<cc>/<focal> must be > 0 mm");
   auto pp = xml.Child("pp") ? xml.Numbers("pp", 2, 1e4) : std::vector<double>{0, 0};
   if (pp[0] == 0 && pp[1] == 0) {
-    pp = {s * w_mm / 2, h_mm / 2};
-    file.notes.push_back("<pp> 0,0 (DBAT: not known): the format centre");
+    pp = {f.s * f.w_mm / 2, f.h_mm / 2};
+    file->notes.push_back("<pp> 0,0 (DBAT: not known): the format centre");
   }
-  file.camera.model = Model::kId;
-  file.camera.params.assign(Model::kNumParams, 0.0);
-  file.camera.params[Model::kC] = c;
-  file.camera.params[Model::kX0] = pp[0] / s - w_mm / 2;
-  file.camera.params[Model::kY0] = h_mm / 2 - pp[1];
-  file.camera.params[Model::kB1] = s - 1.0;
+  std::vector<double>& params = file->camera.params;
+  file->camera.model = Model::kId;
+  params.assign(Model::kNumParams, 0.0);
+  params[Model::kC] = c;
+  params[Model::kX0] = pp[0] / f.s - f.w_mm / 2;
+  params[Model::kY0] = f.h_mm / 2 - pp[1];
+  params[Model::kB1] = f.s - 1.0;
   const auto k = xml.Numbers("K", 0, 1.0);
-  for (size_t i = 0; i < k.size() && i < 3; ++i) file.camera.params[Model::kK1 + i] = k[i];
+  for (size_t i = 0; i < k.size() && i < 3; ++i) params[Model::kK1 + i] = k[i];
   const auto p = xml.Numbers("P", 0, 1.0);
-  for (size_t i = 0; i < p.size() && i < 2; ++i) file.camera.params[Model::kP1 + i] = p[i];
-  if (s != 1.0)
-    file.notes.push_back("DBAT pixel aspect (width / height " + FormatNumber(s) +
-                         ") read as B1 = " + FormatNumber(s - 1.0) + ": not exact, " +
-                         FormatNumber(internal::AspectAsB1ResidualPx(file.camera, s), 3) +
-                         " px max over the format (DBAT's K, P act on the scaled x)");
+  for (size_t i = 0; i < p.size() && i < 2; ++i) params[Model::kP1 + i] = p[i];
+  if (f.s != 1.0)
+    file->notes.push_back("DBAT pixel aspect (width / height " + FormatNumber(f.s) +
+                          ") read as B1 = " + FormatNumber(f.s - 1.0) + ": not exact, " +
+                          FormatNumber(internal::AspectAsB1ResidualPx(file->camera, f.s), 3) +
+                          " px max over the format (DBAT's K, P act on the scaled x)");
+}
+
+}  // namespace
+
+bool IsDbatReport(const std::string& head) {
+  return head.find("Camera Constant:") != std::string::npos &&
+         head.find("px - principal point x:") != std::string::npos;
+}
+
+CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& options) {
+  const std::string text = ReadTextFile(path);
+  if (IsDbatReport(text))
+    return internal::ReadReportCamera(path, SplitLines(text), options, "DBAT");
+  tinyxml2::XMLDocument doc;
+  if (doc.Parse(text.data(), text.size()) != tinyxml2::XML_SUCCESS)
+    ThrowInputError({path, doc.ErrorLineNum()}, std::string("invalid XML: ") + doc.ErrorName());
+  const XmlCamera xml = FindCamera(path, doc.RootElement(), options);
+  CameraFile file;
+  const auto name = xml.List("name");
+  file.name = name.empty() ? std::filesystem::path(path).stem().string() : name.front();
+  file.chosen_by_camera_id = !options.camera_id.empty();
+  ReadInterior(xml, ReadFormat(xml, options, &file), &file);
   return file;
 }
 

@@ -31,6 +31,7 @@
 #include <functional>
 #include <sstream>
 #include <tinyxml2.h>
+#include <utility>
 
 namespace aerocal::calib {
 namespace {
@@ -203,6 +204,192 @@ std::vector<std::string> Words(const char* text) {
   return words;
 }
 
+// The projection: <projection> text (calibration file) or the type attribute (project); only
+// Metashape's frame camera is read.
+void CheckFrameProjection(const XmlSource& s, const XMLElement* calibration) {
+  std::string projection = "frame";
+  if (const auto* p = Only(s, calibration, "projection"))
+    projection = p->GetText() ? p->GetText() : "";
+  else if (const char* type = calibration->Attribute("type"))
+    projection = type;
+  if (projection != "frame")
+    ThrowInputError(
+        s.At(calibration),
+        "projection '" + projection + "' is not supported (only Metashape's frame camera)");
+}
+
+int PositiveInteger(const XmlSource& s, const XMLElement* e, const char* text, const char* what) {
+  const double v = internal::ParseNumber(text ? text : "", s.At(e), what, 1e6);
+  if (!(v >= 1) || v != std::floor(v))
+    ThrowInputError(s.At(e), std::string(what) + " must be a positive integer");
+  return static_cast<int>(v);
+}
+
+// The image size: <width>, <height> of the calibration and/or <resolution> of the calibration or
+// the sensor, which must agree; 0 x 0 when none is given.
+std::pair<int, int> ReadImageSize(const XmlSource& s,
+                                  const XMLElement* calibration,
+                                  const XMLElement* sensor) {
+  int width = 0, height = 0;
+  if (const auto* w = Only(s, calibration, "width"))
+    width = PositiveInteger(s, w, w->GetText(), "<width>");
+  if (const auto* h = Only(s, calibration, "height"))
+    height = PositiveInteger(s, h, h->GetText(), "<height>");
+  for (const auto* holder : {calibration, sensor})
+    if (const auto* r = Only(s, holder, "resolution")) {
+      const int w = PositiveInteger(s, r, r->Attribute("width"), "resolution width");
+      const int h = PositiveInteger(s, r, r->Attribute("height"), "resolution height");
+      if (width != 0 && (w != width || h != height))
+        ThrowInputError(s.At(r),
+                        "resolution " + std::to_string(w) + " x " + std::to_string(h) +
+                            " contradicts the calibration's " + std::to_string(width) + " x " +
+                            std::to_string(height));
+      width = w, height = h;
+    }
+  return {width, height};
+}
+
+// The sensor's pixel size (mm): its pixel_width property (pixel_height only compared with it);
+// 0 when not given.
+double ReadPixelSize(const XmlSource& s,
+                     const XMLElement* sensor,
+                     std::vector<std::string>* notes) {
+  if (!sensor) return 0.0;
+  double pixel_size = 0, pixel_height = 0;
+  for (auto* p = sensor->FirstChildElement("property"); p; p = p->NextSiblingElement("property")) {
+    const std::string name = p->Attribute("name") ? p->Attribute("name") : "";
+    if (name != "pixel_width" && name != "pixel_height") continue;
+    const double v = internal::ParseNumber(
+        p->Attribute("value") ? p->Attribute("value") : "", s.At(p), name, 1.0);
+    if (!(v > 0)) ThrowInputError(s.At(p), name + " must be > 0 mm");
+    double& slot = name == "pixel_width" ? pixel_size : pixel_height;
+    if (slot) ThrowInputError(s.At(p), name + " occurs twice");
+    slot = v;
+  }
+  if (pixel_height > 0 && pixel_size > 0 && std::abs(pixel_height - pixel_size) > 1e-9 * pixel_size)
+    notes->push_back("pixel_height " + FormatNumber(pixel_height) +
+                     " mm differs from pixel_width " + FormatNumber(pixel_size) +
+                     " mm: pixel_width used (the rest is b1)");
+  if (pixel_size == 0 && pixel_height > 0)
+    ThrowInputError(s.At(sensor), "the sensor gives pixel_height but no pixel_width");
+  return pixel_size;
+}
+
+double ReadNumber(const XmlSource& s, const XMLElement* e, const std::string& what) {
+  return internal::ParseNumber(e->GetText() ? e->GetText() : "", s.At(e), what, 1e7);
+}
+
+// The parameters into file->camera (Metashape's model): Metashape >= 1.3's <f> and offsets, or
+// PhotoScan <= 1.2's <fx>, <fy>, absolute <cx>, <cy>, <skew> mapped to it (f = fy, b1 = fx - fy,
+// b2 = skew, cx - W/2, cy - H/2; said in a note). Returns true for PhotoScan's form.
+bool ReadParameters(
+    const XmlSource& s, const XMLElement* calibration, int width, int height, CameraFile* file) {
+  const XMLElement* f = Only(s, calibration, "f");
+  const XMLElement* fx = Only(s, calibration, "fx");
+  const XMLElement* fy = Only(s, calibration, "fy");
+  const bool old_form = fx || fy;
+  if (f && old_form)
+    ThrowInputError(s.At(fx ? fx : fy), "both <f> and <fx>/<fy>: not one of Metashape's forms");
+  if (!f && !(fx && fy))
+    ThrowInputError(s.At(calibration), "missing <f> (or PhotoScan's <fx> and <fy>)");
+  file->camera.model = M::kId;
+  file->camera.params.assign(M::kNumParams, 0.0);
+  std::vector<double>& p = file->camera.params;
+  for (int i = 0; i < M::kNumParams; ++i) {
+    const std::string tag(M::kParams[i].name);
+    if (i == M::kF || (old_form && (i == M::kB1 || i == M::kB2))) continue;
+    if (const auto* e = Only(s, calibration, tag.c_str())) p[i] = ReadNumber(s, e, "<" + tag + ">");
+  }
+  if (!old_form) {
+    p[M::kF] = ReadNumber(s, f, "<f>");
+    if (!(p[M::kF] > 0)) ThrowInputError(s.At(f), "<f> must be > 0 px");
+    return false;
+  }
+  if (width == 0)
+    ThrowInputError(s.At(calibration), "PhotoScan's absolute cx, cy need the <resolution>");
+  const double fx_px = ReadNumber(s, fx, "<fx>"), fy_px = ReadNumber(s, fy, "<fy>");
+  if (!(fx_px > 0 && fy_px > 0)) ThrowInputError(s.At(fx), "<fx>, <fy> must be > 0 px");
+  p[M::kF] = fy_px;
+  p[M::kB1] = fx_px - fy_px;
+  if (const auto* skew = Only(s, calibration, "skew")) p[M::kB2] = ReadNumber(s, skew, "<skew>");
+  p[M::kCx] -= 0.5 * width;
+  p[M::kCy] -= 0.5 * height;
+  for (const char* tag : {"b1", "b2", "p3", "p4"})
+    if (Only(s, calibration, tag))
+      ThrowInputError(s.At(Only(s, calibration, tag)),
+                      std::string("<") + tag + "> beside <fx>: not one of Metashape's forms");
+  file->notes.push_back(
+      "PhotoScan <= 1.2 calibration (fx, fy, absolute cx, cy, skew) read as "
+      "f = fy, b1 = fx - fy, b2 = skew, cx - W/2, cy - H/2");
+  return true;
+}
+
+// The covariance's element: in the calibration, or beside it in the sensor (it belongs to the
+// adjusted calibration: not read with the initial one, said in a note); nullptr when none.
+const XMLElement* FindCovariance(const XmlSource& s,
+                                 const XMLElement* calibration,
+                                 const XMLElement* sensor,
+                                 std::vector<std::string>* notes) {
+  if (const XMLElement* cov = Only(s, calibration, "covariance")) return cov;
+  if (!sensor || !Only(s, sensor, "covariance")) return nullptr;
+  if (calibration->Attribute("class") &&
+      std::string(calibration->Attribute("class")) == "initial") {
+    notes->push_back(
+        "the sensor's covariance (of the adjusted calibration) not read with the initial one");
+    return nullptr;
+  }
+  return Only(s, sensor, "covariance");
+}
+
+// The linear map from the file's parameter names to Metashape's model (identity but for
+// PhotoScan's fx, fy, skew: f = fy, b1 = fx - fy, b2 = skew); a name twice or unknown: InputError.
+Eigen::MatrixXd ParamsFromFileNames(const XmlSource& s,
+                                    const XMLElement* params,
+                                    const std::vector<std::string>& names,
+                                    bool old_form) {
+  const size_t n = names.size();
+  Eigen::MatrixXd map = Eigen::MatrixXd::Zero(M::kNumParams, n);
+  for (size_t j = 0; j < n; ++j) {
+    for (size_t i = 0; i < j; ++i)
+      if (names[i] == names[j])
+        ThrowInputError(s.At(params), "'" + names[j] + "' twice in <params>");
+    if (old_form && names[j] == "fx")
+      map(M::kB1, j) = 1;
+    else if (old_form && names[j] == "fy")
+      map(M::kF, j) = 1, map(M::kB1, j) = -1;
+    else if (old_form && names[j] == "skew")
+      map(M::kB2, j) = 1;
+    else if (const int k = IndexOfParam(M::kParams, names[j]); k >= 0)
+      map(k, j) = 1;
+    else
+      ThrowInputError(s.At(params), "unknown parameter '" + names[j] + "' in <params>");
+  }
+  return map;
+}
+
+// <covariance><params>names</params><coeffs>row-major</coeffs> carried into the model's order.
+void ReadCovariance(const XmlSource& s, const XMLElement* cov, bool old_form, CameraFile* file) {
+  const auto* params = Only(s, cov, "params");
+  const auto* coeffs = Only(s, cov, "coeffs");
+  if (!params || !coeffs) ThrowInputError(s.At(cov), "<covariance> needs <params> and <coeffs>");
+  const std::vector<std::string> names = Words(params->GetText());
+  const std::vector<std::string> values = Words(coeffs->GetText());
+  const size_t n = names.size();
+  if (n == 0 || values.size() != n * n)
+    ThrowInputError(s.At(coeffs),
+                    "<coeffs> must hold " + std::to_string(n) + "^2 = " + std::to_string(n * n) +
+                        " values (got " + std::to_string(values.size()) + ")");
+  const Eigen::MatrixXd map = ParamsFromFileNames(s, params, names, old_form);
+  Eigen::MatrixXd c(n, n);
+  for (size_t r = 0; r < n; ++r)
+    for (size_t k = 0; k < n; ++k)
+      c(r, k) = internal::ParseNumber(values[r * n + k], s.At(coeffs), "<coeffs>", 1e20);
+  for (size_t r = 0; r < n; ++r)
+    if (!(c(r, r) >= 0)) ThrowInputError(s.At(coeffs), "negative variance of " + names[r]);
+  file->covariance = map * c * map.transpose();
+  file->notes.push_back("covariance of " + std::to_string(n) + " parameters read");
+}
+
 }  // namespace
 
 CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOptions& options) {
@@ -215,147 +402,12 @@ CameraFile ReadMetashapeCalibration(const std::string& path, const CameraReadOpt
       sensor ? ChooseCalibration(s, sensor, &file.notes) : chosen.calibration;
   if (sensor && sensor->Attribute("label")) file.name = sensor->Attribute("label");
   file.chosen_by_camera_id = sensor && !options.camera_id.empty();
-  const auto number = [&](const XMLElement* e, const std::string& what, double bound) {
-    return internal::ParseNumber(e->GetText() ? e->GetText() : "", s.At(e), what, bound);
-  };
-  // The projection: <projection> text (calibration file) or the type attribute (project).
-  std::string projection = "frame";
-  if (const auto* p = Only(s, calibration, "projection"))
-    projection = p->GetText() ? p->GetText() : "";
-  else if (const char* type = calibration->Attribute("type"))
-    projection = type;
-  if (projection != "frame")
-    ThrowInputError(
-        s.At(calibration),
-        "projection '" + projection + "' is not supported (only Metashape's frame camera)");
-  const auto integer = [&](const XMLElement* e, const char* text, const char* what) {
-    const double v = internal::ParseNumber(text ? text : "", s.At(e), what, 1e6);
-    if (!(v >= 1) || v != std::floor(v))
-      ThrowInputError(s.At(e), std::string(what) + " must be a positive integer");
-    return static_cast<int>(v);
-  };
-  int width = 0, height = 0;
-  if (const auto* w = Only(s, calibration, "width")) width = integer(w, w->GetText(), "<width>");
-  if (const auto* h = Only(s, calibration, "height")) height = integer(h, h->GetText(), "<height>");
-  for (const auto* holder : {calibration, sensor})
-    if (const auto* r = Only(s, holder, "resolution")) {
-      const int w = integer(r, r->Attribute("width"), "resolution width");
-      const int h = integer(r, r->Attribute("height"), "resolution height");
-      if (width != 0 && (w != width || h != height))
-        ThrowInputError(s.At(r),
-                        "resolution " + std::to_string(w) + " x " + std::to_string(h) +
-                            " contradicts the calibration's " + std::to_string(width) + " x " +
-                            std::to_string(height));
-      width = w, height = h;
-    }
-  double pixel_size = 0;
-  if (sensor) {
-    double pixel_height = 0;
-    for (auto* p = sensor->FirstChildElement("property"); p;
-         p = p->NextSiblingElement("property")) {
-      const std::string name = p->Attribute("name") ? p->Attribute("name") : "";
-      if (name != "pixel_width" && name != "pixel_height") continue;
-      const double v = internal::ParseNumber(
-          p->Attribute("value") ? p->Attribute("value") : "", s.At(p), name, 1.0);
-      if (!(v > 0)) ThrowInputError(s.At(p), name + " must be > 0 mm");
-      double& slot = name == "pixel_width" ? pixel_size : pixel_height;
-      if (slot) ThrowInputError(s.At(p), name + " occurs twice");
-      slot = v;
-    }
-    if (pixel_height > 0 && pixel_size > 0 &&
-        std::abs(pixel_height - pixel_size) > 1e-9 * pixel_size)
-      file.notes.push_back("pixel_height " + FormatNumber(pixel_height) +
-                           " mm differs from pixel_width " + FormatNumber(pixel_size) +
-                           " mm: pixel_width used (the rest is b1)");
-    if (pixel_size == 0 && pixel_height > 0)
-      ThrowInputError(s.At(sensor), "the sensor gives pixel_height but no pixel_width");
-  }
-  // Parameters: Metashape >= 1.3 (f, offsets) or PhotoScan <= 1.2 (fx, fy, absolute cx, cy, skew).
-  const XMLElement* f = Only(s, calibration, "f");
-  const XMLElement* fx = Only(s, calibration, "fx");
-  const XMLElement* fy = Only(s, calibration, "fy");
-  const bool old_form = fx || fy;
-  if (f && old_form)
-    ThrowInputError(s.At(fx ? fx : fy), "both <f> and <fx>/<fy>: not one of Metashape's forms");
-  if (!f && !(fx && fy))
-    ThrowInputError(s.At(calibration), "missing <f> (or PhotoScan's <fx> and <fy>)");
-  file.camera.model = M::kId;
-  file.camera.params.assign(M::kNumParams, 0.0);
-  std::vector<double>& p = file.camera.params;
-  for (int i = 0; i < M::kNumParams; ++i) {
-    const std::string tag(M::kParams[i].name);
-    if (i == M::kF || (old_form && (i == M::kB1 || i == M::kB2))) continue;
-    if (const auto* e = Only(s, calibration, tag.c_str())) p[i] = number(e, "<" + tag + ">", 1e7);
-  }
-  if (old_form) {
-    if (width == 0)
-      ThrowInputError(s.At(calibration), "PhotoScan's absolute cx, cy need the <resolution>");
-    const double fx_px = number(fx, "<fx>", 1e7), fy_px = number(fy, "<fy>", 1e7);
-    if (!(fx_px > 0 && fy_px > 0)) ThrowInputError(s.At(fx), "<fx>, <fy> must be > 0 px");
-    p[M::kF] = fy_px;
-    p[M::kB1] = fx_px - fy_px;
-    if (const auto* skew = Only(s, calibration, "skew")) p[M::kB2] = number(skew, "<skew>", 1e7);
-    p[M::kCx] -= 0.5 * width;
-    p[M::kCy] -= 0.5 * height;
-    for (const char* tag : {"b1", "b2", "p3", "p4"})
-      if (Only(s, calibration, tag))
-        ThrowInputError(s.At(Only(s, calibration, tag)),
-                        std::string("<") + tag + "> beside <fx>: not one of Metashape's forms");
-    file.notes.push_back(
-        "PhotoScan <= 1.2 calibration (fx, fy, absolute cx, cy, skew) read as "
-        "f = fy, b1 = fx - fy, b2 = skew, cx - W/2, cy - H/2");
-  } else {
-    p[M::kF] = number(f, "<f>", 1e7);
-    if (!(p[M::kF] > 0)) ThrowInputError(s.At(f), "<f> must be > 0 px");
-  }
-  // Covariance: in the calibration, or beside it in the sensor (it belongs to the adjusted one).
-  const XMLElement* cov = Only(s, calibration, "covariance");
-  if (!cov && sensor && Only(s, sensor, "covariance")) {
-    if (calibration->Attribute("class") &&
-        std::string(calibration->Attribute("class")) == "initial")
-      file.notes.push_back(
-          "the sensor's covariance (of the adjusted calibration) not read with the initial one");
-    else
-      cov = Only(s, sensor, "covariance");
-  }
-  if (cov) {
-    const auto* params = Only(s, cov, "params");
-    const auto* coeffs = Only(s, cov, "coeffs");
-    if (!params || !coeffs) ThrowInputError(s.At(cov), "<covariance> needs <params> and <coeffs>");
-    const std::vector<std::string> names = Words(params->GetText());
-    const std::vector<std::string> values = Words(coeffs->GetText());
-    const size_t n = names.size();
-    if (n == 0 || values.size() != n * n)
-      ThrowInputError(s.At(coeffs),
-                      "<coeffs> must hold " + std::to_string(n) + "^2 = " + std::to_string(n * n) +
-                          " values (got " + std::to_string(values.size()) + ")");
-    // The linear map from the file's parameters to ours (identity but for PhotoScan's fx, fy,
-    // skew).
-    Eigen::MatrixXd map = Eigen::MatrixXd::Zero(M::kNumParams, n);
-    for (size_t j = 0; j < n; ++j) {
-      for (size_t i = 0; i < j; ++i)
-        if (names[i] == names[j])
-          ThrowInputError(s.At(params), "'" + names[j] + "' twice in <params>");
-      if (old_form && names[j] == "fx")
-        map(M::kB1, j) = 1;
-      else if (old_form && names[j] == "fy")
-        map(M::kF, j) = 1, map(M::kB1, j) = -1;
-      else if (old_form && names[j] == "skew")
-        map(M::kB2, j) = 1;
-      else if (const int k = IndexOfParam(M::kParams, names[j]); k >= 0)
-        map(k, j) = 1;
-      else
-        ThrowInputError(s.At(params), "unknown parameter '" + names[j] + "' in <params>");
-    }
-    Eigen::MatrixXd c(n, n);
-    for (size_t r = 0; r < n; ++r)
-      for (size_t k = 0; k < n; ++k)
-        c(r, k) = internal::ParseNumber(values[r * n + k], s.At(coeffs), "<coeffs>", 1e20);
-    for (size_t r = 0; r < n; ++r)
-      if (!(c(r, r) >= 0)) ThrowInputError(s.At(coeffs), "negative variance of " + names[r]);
-    file.covariance = map * c * map.transpose();
-    file.notes.push_back("covariance of " + std::to_string(n) + " parameters read");
-  }
+  CheckFrameProjection(s, calibration);
+  const auto [width, height] = ReadImageSize(s, calibration, sensor);
+  const double pixel_size = ReadPixelSize(s, sensor, &file.notes);
+  const bool old_form = ReadParameters(s, calibration, width, height, &file);
+  if (const XMLElement* cov = FindCovariance(s, calibration, sensor, &file.notes))
+    ReadCovariance(s, cov, old_form, &file);
   internal::ResolveFormat(&file, options, s.At(calibration), width, height, pixel_size);
   return file;
 }

@@ -28,11 +28,9 @@ int LineOfKey(const std::string& text, const std::string& key, size_t from) {
   return LineOfOffset(text, at == std::string::npos ? from : at);
 }
 
-}  // namespace
-
-CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options) {
-  const std::string text = ReadTextFile(path);
-  Json root = ParseJsonText(text, path);
+// The cameras map of the file: cameras.json itself, or the "cameras" of a reconstruction.json
+// (an array of reconstructions or one).
+const Json& CamerasOf(const Json& root, const std::string& path) {
   const Json* cameras = &root;
   if (root.is_array() && !root.empty() && root[0].is_object() && root[0].contains("cameras"))
     cameras = &root[0]["cameras"];
@@ -40,80 +38,116 @@ CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& 
     cameras = &root["cameras"];
   if (!cameras->is_object() || cameras->empty())
     ThrowInputError({path, 1}, "no cameras (expected {id: {projection_type, width, ...}})");
+  return *cameras;
+}
+
+// The id of the camera the options name (the only one when none is named).
+std::string ChooseCamera(const Json& cameras,
+                         const std::string& path,
+                         const CameraReadOptions& options) {
   std::string ids;
-  for (auto it = cameras->begin(); it != cameras->end(); ++it)
+  for (auto it = cameras.begin(); it != cameras.end(); ++it)
     ids += (ids.empty() ? "" : ", ") + it.key();
   std::string id = options.camera_id;
   if (id.empty()) {
-    if (cameras->size() > 1)
+    if (cameras.size() > 1)
       ThrowInputError({path, 1},
-                      "holds " + std::to_string(cameras->size()) +
+                      "holds " + std::to_string(cameras.size()) +
                           " cameras: name one with --camera (" + ids + ")");
-    id = cameras->begin().key();
+    id = cameras.begin().key();
   }
-  if (!cameras->contains(id))
+  if (!cameras.contains(id))
     ThrowInputError({path, 1}, "no camera '" + id + "' (cameras: " + ids + ")");
-  const Json& c = (*cameras)[id];
-  const size_t from = text.find("\"" + id + "\"");
-  const auto where = [&](const std::string& key) {
-    return SourceRef{path, LineOfKey(text, key, from)};
-  };
-  if (!c.is_object()) ThrowInputError(where(id), "camera '" + id + "' is not an object");
-  const auto number = [&](const std::string& key, double fallback) {
+  return id;
+}
+
+// One camera's entry: its keys' lines in the text and its numbers.
+struct Entry {
+  const std::string& path;
+  const std::string& text;
+  const Json& c;
+  size_t from;  // offset of the camera's id in the text
+
+  SourceRef Where(const std::string& key) const { return {path, LineOfKey(text, key, from)}; }
+  double Number(const std::string& key, double fallback) const {
     if (!c.contains(key)) return fallback;
-    if (!c[key].is_number()) ThrowInputError(where(key), key + " must be a number");
-    return internal::ParseNumber(FormatNumber(c[key].get<double>(), 17), where(key), key, 1e6);
-  };
-  if (!c.contains("projection_type") || !c["projection_type"].is_string())
-    ThrowInputError(where(id), "missing projection_type");
-  const std::string type = c["projection_type"];
-  const auto size_of = [&](const char* key) {
-    const double v = number(key, 0);
+    if (!c[key].is_number()) ThrowInputError(Where(key), key + " must be a number");
+    return internal::ParseNumber(FormatNumber(c[key].get<double>(), 17), Where(key), key, 1e6);
+  }
+  int Size(const char* key) const {
+    const double v = Number(key, 0);
     if (!(v >= 1 && v <= 1e6) || v != static_cast<int>(v))
-      ThrowInputError(where(key), std::string(key) + " must be an integer within 1 .. 1e6");
+      ThrowInputError(Where(key), std::string(key) + " must be an integer within 1 .. 1e6");
     return static_cast<int>(v);
-  };
-  if (!c.contains("width") || !c.contains("height"))
-    ThrowInputError(where(id), "missing width/height");
-  const int w = size_of("width"), h = size_of("height");
+  }
+};
+
+// The projection's parameters in OpenCV pixels (fx = focal_x max(W, H), cx = (W - 1) / 2 + c_x
+// max(W, H)): fisheye as opencv_fisheye, the others as opencv.
+void ReadParameters(const Entry& e,
+                    const std::string& type,
+                    int w,
+                    int h,
+                    double focal_x,
+                    double focal_y,
+                    ModelCamera* camera) {
   const double size = std::max(w, h);
-  const double focal = number("focal", 0);
-  const double focal_x = number("focal_x", focal), focal_y = number("focal_y", focal_x);
-  if (!(focal_x > 0 && focal_y > 0)) ThrowInputError(where(id), "focal length must be > 0");
-  CameraFile file;
-  file.name = id;
-  file.chosen_by_camera_id = !options.camera_id.empty();
   if (type == "fisheye") {
     using F = OpenCvFisheyeModel;
-    file.camera.model = F::kId;
-    file.camera.params = {focal_x * size,
-                          focal_y * size,
-                          0.5 * (w - 1) + number("c_x", 0) * size,
-                          0.5 * (h - 1) + number("c_y", 0) * size,
-                          number("k1", 0),
-                          number("k2", 0),
-                          0.0,
-                          0.0};
+    camera->model = F::kId;
+    camera->params = {focal_x * size,
+                      focal_y * size,
+                      0.5 * (w - 1) + e.Number("c_x", 0) * size,
+                      0.5 * (h - 1) + e.Number("c_y", 0) * size,
+                      e.Number("k1", 0),
+                      e.Number("k2", 0),
+                      0.0,
+                      0.0};
   } else if (type == "perspective" || type == "simple_radial" || type == "radial" ||
              type == "brown") {
     using O = OpenCvModel;
-    file.camera.model = O::kId;
-    file.camera.params.assign(O::kNumParams, 0.0);
-    file.camera.params[O::kFx] = focal_x * size;
-    file.camera.params[O::kFy] = focal_y * size;
-    file.camera.params[O::kCx] = 0.5 * (w - 1) + number("c_x", 0) * size;
-    file.camera.params[O::kCy] = 0.5 * (h - 1) + number("c_y", 0) * size;
-    file.camera.params[O::kK1] = number("k1", 0);
-    file.camera.params[O::kK2] = number("k2", 0);
-    file.camera.params[O::kK3] = number("k3", 0);
-    file.camera.params[O::kP1] = number("p1", 0);
-    file.camera.params[O::kP2] = number("p2", 0);
+    camera->model = O::kId;
+    std::vector<double>& p = camera->params;
+    p.assign(O::kNumParams, 0.0);
+    p[O::kFx] = focal_x * size;
+    p[O::kFy] = focal_y * size;
+    p[O::kCx] = 0.5 * (w - 1) + e.Number("c_x", 0) * size;
+    p[O::kCy] = 0.5 * (h - 1) + e.Number("c_y", 0) * size;
+    p[O::kK1] = e.Number("k1", 0);
+    p[O::kK2] = e.Number("k2", 0);
+    p[O::kK3] = e.Number("k3", 0);
+    p[O::kP1] = e.Number("p1", 0);
+    p[O::kP2] = e.Number("p2", 0);
   } else {
-    ThrowInputError(where("projection_type"),
+    ThrowInputError(e.Where("projection_type"),
                     "projection_type '" + type +
                         "' is not supported (perspective, simple_radial, radial, brown, fisheye)");
   }
-  internal::ResolveFormat(&file, options, where(id), w, h, 0.0);
+}
+
+}  // namespace
+
+CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options) {
+  const std::string text = ReadTextFile(path);
+  const Json root = ParseJsonText(text, path);
+  const Json& cameras = CamerasOf(root, path);
+  const std::string id = ChooseCamera(cameras, path, options);
+  const Entry e{path, text, cameras[id], text.find("\"" + id + "\"")};
+  if (!e.c.is_object()) ThrowInputError(e.Where(id), "camera '" + id + "' is not an object");
+  if (!e.c.contains("projection_type") || !e.c["projection_type"].is_string())
+    ThrowInputError(e.Where(id), "missing projection_type");
+  const std::string type = e.c["projection_type"];
+  if (!e.c.contains("width") || !e.c.contains("height"))
+    ThrowInputError(e.Where(id), "missing width/height");
+  const int w = e.Size("width"), h = e.Size("height");
+  const double focal = e.Number("focal", 0);
+  const double focal_x = e.Number("focal_x", focal), focal_y = e.Number("focal_y", focal_x);
+  if (!(focal_x > 0 && focal_y > 0)) ThrowInputError(e.Where(id), "focal length must be > 0");
+  CameraFile file;
+  file.name = id;
+  file.chosen_by_camera_id = !options.camera_id.empty();
+  ReadParameters(e, type, w, h, focal_x, focal_y, &file.camera);
+  internal::ResolveFormat(&file, options, e.Where(id), w, h, 0.0);
   return file;
 }
 

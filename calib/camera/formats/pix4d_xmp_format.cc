@@ -40,84 +40,104 @@ double ParseRational(const XmpText& t, const std::string& what) {
   return a / b;
 }
 
+// The packet's properties by namespace URI (with or without its trailing '/'): the prefix is
+// whatever the file binds ("Camera", "P4", ...); messages quote it as written.
+struct Tags {
+  const XmpPacket& xmp;
+
+  std::optional<XmpText> Find(const char* uri, const std::string& name) const {
+    const XmpProperty* p = xmp.Find(uri, name);
+    if (!p) return std::nullopt;
+    if (p->structured) ThrowInputError(p->where, p->qualified + " must be a simple value");
+    return XmpText{p->value, p->where, p->qualified};
+  }
+  std::optional<XmpText> CameraTag(const std::string& name) const {
+    return Find(kPix4dCameraUri, name);
+  }
+};
+
+// `count` comma-separated numbers of a tag.
+std::vector<double> Numbers(const XmpText& t, size_t count) {
+  const std::vector<std::string> fields = SplitCommaList(t.value, {true, true});
+  if (fields.size() != count)
+    ThrowInputError(t.where,
+                    t.name + " must hold " + std::to_string(count) +
+                        " comma-separated values (got '" + t.value + "')");
+  std::vector<double> v;
+  for (const std::string& f : fields) v.push_back(internal::ParseNumber(f, t.where, t.name, 1e4));
+  return v;
+}
+
+// F, Px, Py and the distortion into Pix4D's perspective model; the line of the focal length's tag
+// (the camera's place in the file). The fisheye model type is refused.
+int ReadParameters(const Tags& tags, const std::string& path, bool image, ModelCamera* camera) {
+  using M = Pix4dPerspectiveModel;
+  const auto focal = tags.CameraTag("PerspectiveFocalLength");
+  const auto pp = tags.CameraTag("PrincipalPoint");
+  if (!focal || !pp) {
+    const auto type = tags.CameraTag("ModelType");
+    ThrowInputError(type ? type->where : SourceRef{path, image ? 0 : 1},
+                    std::string("no PerspectiveFocalLength / PrincipalPoint of namespace ") +
+                        kPix4dCameraUri + " (Pix4D camera XMP)");
+  }
+  if (const auto type = tags.CameraTag("ModelType"); type && type->value != "perspective")
+    ThrowInputError(type->where,
+                    type->name + " '" + type->value +
+                        "': only the perspective model is read (Pix4D's fisheye "
+                        "polynomial is not a registry model)");
+  camera->model = M::kId;
+  std::vector<double>& p = camera->params;
+  p.assign(M::kNumParams, 0.0);
+  p[M::kF] = Numbers(*focal, 1)[0];
+  if (!(p[M::kF] > 0)) ThrowInputError(focal->where, "the focal length must be > 0 mm");
+  const std::vector<double> principal = Numbers(*pp, 2);
+  p[M::kPx] = principal[0];
+  p[M::kPy] = principal[1];
+  if (const auto d = tags.CameraTag("PerspectiveDistortion")) {
+    const std::vector<double> v = Numbers(*d, 5);  // R1, R2, R3, T1, T2
+    for (int i = 0; i < 5; ++i) p[M::kR1 + i] = v[i];
+  }
+  return focal->where.line;
+}
+
+// The pixel size (mm) from exif:FocalPlaneXResolution and its unit (2 inch, the default, 3 cm,
+// 4 mm); 0 when the tag is absent.
+double ReadPixelSize(const Tags& tags) {
+  const auto res = tags.Find(xmp_ns::kExif, "FocalPlaneXResolution");
+  if (!res) return 0.0;
+  const auto unit = tags.Find(xmp_ns::kExif, "FocalPlaneResolutionUnit");
+  const int u =
+      unit ? static_cast<int>(internal::ParseNumber(unit->value, unit->where, unit->name, 10)) : 2;
+  const double mm_per_unit = u == 2 ? 25.4 : u == 3 ? 10.0 : u == 4 ? 1.0 : 0.0;
+  if (mm_per_unit == 0)
+    ThrowInputError(unit->where,
+                    "exif:FocalPlaneResolutionUnit must be 2 (inch), 3 (cm) or 4 (mm)");
+  const double per_unit = ParseRational(*res, res->name);
+  if (!(per_unit > 0)) ThrowInputError(res->where, "exif:FocalPlaneXResolution must be > 0");
+  return mm_per_unit / per_unit;
+}
+
 }  // namespace
 
 CameraFile ReadPix4dXmp(const std::string& path, const CameraReadOptions& options) {
-  using M = Pix4dPerspectiveModel;
   const std::string bytes = ReadTextFile(path);
   int width = 0, height = 0;
   const bool image = IsJpegOrTiff(bytes);
   const std::optional<XmpPacket> xmp = XmpOfCameraFile(bytes, path, &width, &height);
   if (!xmp) ThrowInputError({path, 1}, "neither an image nor an XMP packet (x:xmpmeta / rdf:RDF)");
-  // Properties by namespace URI (kPix4dCameraUri, with or without its trailing '/'): the prefix is
-  // whatever the file binds ("Camera", "P4", ...); messages quote it as written.
-  const auto find = [&](const char* uri, const std::string& name) -> std::optional<XmpText> {
-    const XmpProperty* p = xmp->Find(uri, name);
-    if (!p) return std::nullopt;
-    if (p->structured) ThrowInputError(p->where, p->qualified + " must be a simple value");
-    return XmpText{p->value, p->where, p->qualified};
-  };
-  const auto camera = [&](const std::string& name) { return find(kPix4dCameraUri, name); };
-  const auto numbers = [&](const XmpText& t, size_t count) {
-    const std::vector<std::string> fields = SplitCommaList(t.value, {true, true});
-    if (fields.size() != count)
-      ThrowInputError(t.where,
-                      t.name + " must hold " + std::to_string(count) +
-                          " comma-separated values (got '" + t.value + "')");
-    std::vector<double> v;
-    for (const std::string& f : fields) v.push_back(internal::ParseNumber(f, t.where, t.name, 1e4));
-    return v;
-  };
-  const auto focal = camera("PerspectiveFocalLength");
-  const auto pp = camera("PrincipalPoint");
-  if (!focal || !pp) {
-    const auto type = camera("ModelType");
-    ThrowInputError(type ? type->where : SourceRef{path, image ? 0 : 1},
-                    std::string("no PerspectiveFocalLength / PrincipalPoint of namespace ") +
-                        kPix4dCameraUri + " (Pix4D camera XMP)");
-  }
-  if (const auto type = camera("ModelType"); type && type->value != "perspective")
-    ThrowInputError(type->where,
-                    type->name + " '" + type->value +
-                        "': only the perspective model is read (Pix4D's fisheye "
-                        "polynomial is not a registry model)");
+  const Tags tags{*xmp};
   CameraFile file;
   file.name = "pix4d";
-  file.camera.model = M::kId;
-  file.camera.params.assign(M::kNumParams, 0.0);
-  file.camera.params[M::kF] = numbers(*focal, 1)[0];
-  if (!(file.camera.params[M::kF] > 0))
-    ThrowInputError(focal->where, "the focal length must be > 0 mm");
-  const std::vector<double> principal = numbers(*pp, 2);
-  file.camera.params[M::kPx] = principal[0];
-  file.camera.params[M::kPy] = principal[1];
-  if (const auto d = camera("PerspectiveDistortion")) {
-    const std::vector<double> v = numbers(*d, 5);  // R1, R2, R3, T1, T2
-    for (int i = 0; i < 5; ++i) file.camera.params[M::kR1 + i] = v[i];
-  }
-  const SourceRef where{path, focal->where.line};
-  if (!image) {
-    const auto w = find(xmp_ns::kTiff, "ImageWidth"), h = find(xmp_ns::kTiff, "ImageLength");
+  const SourceRef where{path, ReadParameters(tags, path, image, &file.camera)};
+  if (!image) {  // a sidecar: the image size from its tiff tags
+    const auto w = tags.Find(xmp_ns::kTiff, "ImageWidth"),
+               h = tags.Find(xmp_ns::kTiff, "ImageLength");
     if (w && h) {
       width = static_cast<int>(internal::ParseNumber(w->value, w->where, w->name, 1e6));
       height = static_cast<int>(internal::ParseNumber(h->value, h->where, h->name, 1e6));
     }
   }
-  double pixel_mm = 0.0;
-  if (const auto res = find(xmp_ns::kExif, "FocalPlaneXResolution")) {
-    const auto unit = find(xmp_ns::kExif, "FocalPlaneResolutionUnit");
-    const int u =
-        unit ? static_cast<int>(internal::ParseNumber(unit->value, unit->where, unit->name, 10))
-             : 2;
-    const double mm_per_unit = u == 2 ? 25.4 : u == 3 ? 10.0 : u == 4 ? 1.0 : 0.0;
-    if (mm_per_unit == 0)
-      ThrowInputError(unit->where,
-                      "exif:FocalPlaneResolutionUnit must be 2 (inch), 3 (cm) or 4 (mm)");
-    const double per_unit = ParseRational(*res, res->name);
-    if (!(per_unit > 0)) ThrowInputError(res->where, "exif:FocalPlaneXResolution must be > 0");
-    pixel_mm = mm_per_unit / per_unit;
-  }
-  internal::ResolveFormat(&file, options, where, width, height, pixel_mm);
+  internal::ResolveFormat(&file, options, where, width, height, ReadPixelSize(tags));
   if (!file.pixel_size_known)
     ThrowInputError(where,
                     "the pixel size is needed (the tags are mm): the file has no "

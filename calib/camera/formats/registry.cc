@@ -43,191 +43,244 @@ bool LooksLikeColmapText(const std::string& head) {
   return false;
 }
 
+// One function per format: its row of the registry (name, description, reader, writer, the model
+// it writes a camera in, what its files look like, extension and what a written file holds).
+CameraFormat AerocalFormat() {
+  return {"aerocal",
+          "our camera YAML (any registry model; a rig file's head by --camera)",
+          ReadAerocalCamera,
+          WriteAerocalCamera,
+          [](const ModelCamera& s) {
+            return FormatTarget{s.model, {}, true};
+          },
+          [](const std::string& h, const std::string&) {
+            return Has(h, "format_px:") && Has(h, "pixel_size_mm:");
+          },
+          ".yaml",
+          true,
+          true,
+          true};
+}
+
+CameraFormat ColmapFormat() {
+  return {"colmap",
+          "COLMAP cameras.txt or cameras.bin (SIMPLE_PINHOLE ... FULL_OPENCV; --camera ID)",
+          ReadColmapCameras,
+          WriteColmapCameras,
+          [](const ModelCamera& source) {
+            if (!ColmapName(source.model).empty()) return FormatTarget{source.model, {}};
+            if (source.model == CameraModelId::kOpenCv) {  // exact: OPENCV when k3-k6 are 0
+              const bool full =
+                  source.params[OpenCvModel::kK3] != 0 || source.params[OpenCvModel::kK4] != 0 ||
+                  source.params[OpenCvModel::kK5] != 0 || source.params[OpenCvModel::kK6] != 0;
+              return FormatTarget{
+                  full ? CameraModelId::kColmapFullOpenCv : CameraModelId::kColmapOpenCv, {}};
+            }
+            return OpenCvFit(CameraModelId::kColmapFullOpenCv);
+          },
+          [](const std::string& h, const std::string& path) {
+            return LooksLikeColmapText(h) || LooksLikeColmapBinary(h, path);
+          },
+          ".txt"};
+}
+
+CameraFormat MetashapeFormat() {
+  return {
+      "metashape",
+      "Agisoft Metashape / PhotoScan calibration XML, cameras XML, .psx / .psz project (--camera "
+      "sensor id)",
+      ReadMetashapeCalibration,
+      WriteMetashapeCalibration,
+      [](const ModelCamera&) {
+        return FormatTarget{CameraModelId::kMetashapeFrame, {}};
+      },
+      [](const std::string& h, const std::string&) {
+        // A calibration export, a cameras export, a .psx project, a .psz / .zip project archive.
+        if (Has(h, "<opencv_storage>")) return false;  // OpenCV's <calibration_time>
+        return Has(h, "<calibration>") || Has(h, "<calibration ") || Has(h, "<sensor ") ||
+               Has(h, "<sensors") || (Has(h, "<document") && Has(h, "<chunks")) ||
+               (internal::LooksLikeZip(h) && Has(h, "doc.xml"));
+      },
+      ".xml",
+      true,
+      false,
+      true};
+}
+
+CameraFormat Pix4dFormat() {
+  return {"pix4d",
+          "Pix4D internal camera parameters (.cam), a project's calibrated_camera_parameters.txt "
+          "(--camera IMAGE)",
+          ReadPix4dCam,
+          WritePix4dCam,
+          [](const ModelCamera&) {
+            return FormatTarget{CameraModelId::kPix4dPerspective, {}, true};
+          },
+          [](const std::string& h, const std::string&) {
+            return Has(h, "Pix4D camera calibration file") || IsPix4dCalibratedParameters(h);
+          },
+          ".cam",
+          false,
+          true};
+}
+
+CameraFormat Pix4dXmpFormat() {
+  return {"pix4d-xmp",
+          "Pix4D camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, "
+          "PerspectiveDistortion; a JPEG or an XMP sidecar)",
+          ReadPix4dXmp,
+          WritePix4dXmp,
+          [](const ModelCamera&) {
+            return FormatTarget{CameraModelId::kPix4dPerspective, {}, true};
+          },
+          [](const std::string& h, const std::string&) { return Has(h, "PerspectiveFocalLength"); },
+          ".xmp",
+          true,
+          true};
+}
+
+CameraFormat OpenSfmFormat() {
+  return {"opensfm",
+          "OpenSfM / OpenDroneMap cameras.json",
+          ReadOpenSfmCameras,
+          WriteOpenSfmCameras,
+          [](const ModelCamera& s) {
+            return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {"k3", "k4"}}
+                                : FormatTarget{CameraModelId::kOpenCv, {"k4", "k5", "k6"}};
+          },
+          [](const std::string& h, const std::string&) { return Has(h, "\"projection_type\""); },
+          ".json"};
+}
+
+CameraFormat DjiFormat() {
+  return {"dji",
+          "DJI XMP DewarpData / DewarpDataK6 (a DJI JPEG, an XMP sidecar or the string)",
+          ReadDjiDewarpData,
+          WriteDjiDewarpData,
+          OpenCvTarget,
+          [](const std::string& h, const std::string&) {
+            if (Has(h, "DewarpData") || Has(h, "Dewarp Data")) return true;
+            // The bare string: "[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" on its first line.
+            static const std::regex kRecord(
+                R"(^\s*([0-9-]+;)?\s*[-+0-9.eE]+(\s*,\s*[-+0-9.eE]+){8}([-+0-9.eE,\s]*)$)");
+            const std::string first = h.substr(0, h.find('\n'));
+            return first.size() < 1000 && std::regex_match(first, kRecord);
+          },
+          ".xmp"};
+}
+
+CameraFormat DbatFormat() {
+  return {
+      "dbat",
+      "DBAT camera XML, whole or a <cameras> / <camera> fragment, or DBAT's text report (c, pp, "
+      "aspect, K1-K3, P1, P2 in mm)",
+      ReadDbatCameraXml,
+      WriteDbatCameraXml,
+      [](const ModelCamera&) {
+        return FormatTarget{CameraModelId::kBrownFraser10, {"B2"}, true};
+      },
+      [](const std::string& h, const std::string&) {
+        return ((Has(h, "<camera>") || Has(h, "<camera ")) && (Has(h, "<cc>") || Has(h, "<pp>"))) ||
+               IsDbatReport(h);
+      },
+      ".xml",
+      true,
+      true};
+}
+
+CameraFormat PhotoModelerFormat() {
+  return {"photomodeler",
+          "PhotoModeler Bundle Soln export's camera or a calibration report's camera block (f, pp, "
+          "format, K1-K3, P1, P2 mm)",
+          ReadPhotoModelerCamera,
+          WritePhotoModelerCamera,
+          [](const ModelCamera&) {
+            return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
+          },
+          [](const std::string& h, const std::string&) {
+            return h.rfind("Bundle Soln", 0) == 0 || IsPhotoModelerReport(h);
+          },
+          ".txt",
+          true,
+          true};
+}
+
+CameraFormat AustralisFormat() {
+  return {"australis",
+          "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
+          ReadAustralisCamera,
+          WriteAustralisCamera,
+          [](const ModelCamera&) {
+            return FormatTarget{CameraModelId::kBrownFraser10, {}, true};
+          },
+          [](const std::string& h, const std::string&) {
+            return Has(h, "Australis") && Has(h, "Camera Parameters");
+          },
+          ".txt",
+          true,
+          true,
+          true};
+}
+
+CameraFormat RosFormat() {
+  return {"ros",
+          "ROS camera_info YAML (camera_matrix/distortion_coefficients {rows, cols, data}; "
+          "plumb_bob, rational_polynomial, equidistant)",
+          ReadRosCameraInfo,
+          WriteRosCameraInfo,
+          [](const ModelCamera& s) {
+            return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}} : OpenCvTarget(s);
+          },
+          [](const std::string& h, const std::string&) {
+            return Has(h, "camera_matrix:") && Has(h, "rows:") && !Has(h, "opencv-matrix") &&
+                   !Has(h, "model_type:");
+          },
+          ".yaml"};
+}
+
+CameraFormat CamodocalFormat() {
+  return {"camodocal",
+          "camodocal / VINS-Mono / VINS-Fusion PINHOLE camera YAML",
+          ReadCamodocalCamera,
+          WriteCamodocalCamera,
+          [](const ModelCamera&) {
+            return FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
+          },
+          [](const std::string& h, const std::string&) {
+            return Has(h, "model_type:") && Has(h, "projection_parameters");
+          },
+          ".yaml"};
+}
+
+CameraFormat KalibrFormat() {
+  return {"kalibr",
+          "Kalibr camchain YAML (pinhole radtan / equidistant)",
+          ReadKalibrCamchain,
+          WriteKalibrCamchain,
+          [](const ModelCamera& s) {
+            return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}}
+                                : FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
+          },
+          [](const std::string& h, const std::string&) {
+            return Has(h, "camera_model:") && Has(h, "intrinsics:");
+          },
+          ".yaml"};
+}
+
 std::vector<CameraFormat>& Registry() {
-  static std::vector<CameraFormat> formats = {
-      {"aerocal",
-       "our camera YAML (any registry model; a rig file's head by --camera)",
-       ReadAerocalCamera,
-       WriteAerocalCamera,
-       [](const ModelCamera& s) {
-         return FormatTarget{s.model, {}, true};
-       },
-       [](const std::string& h, const std::string&) {
-         return Has(h, "format_px:") && Has(h, "pixel_size_mm:");
-       },
-       ".yaml",
-       true,
-       true,
-       true},
-      {"colmap",
-       "COLMAP cameras.txt or cameras.bin (SIMPLE_PINHOLE ... FULL_OPENCV; --camera ID)",
-       ReadColmapCameras,
-       WriteColmapCameras,
-       [](const ModelCamera& source) {
-         if (!ColmapName(source.model).empty()) return FormatTarget{source.model, {}};
-         if (source.model == CameraModelId::kOpenCv) {  // exact: OPENCV when k3-k6 are 0
-           const bool full =
-               source.params[OpenCvModel::kK3] != 0 || source.params[OpenCvModel::kK4] != 0 ||
-               source.params[OpenCvModel::kK5] != 0 || source.params[OpenCvModel::kK6] != 0;
-           return FormatTarget{
-               full ? CameraModelId::kColmapFullOpenCv : CameraModelId::kColmapOpenCv, {}};
-         }
-         return OpenCvFit(CameraModelId::kColmapFullOpenCv);
-       },
-       [](const std::string& h, const std::string& path) {
-         return LooksLikeColmapText(h) || LooksLikeColmapBinary(h, path);
-       },
-       ".txt"},
-      {"metashape",
-       "Agisoft Metashape / PhotoScan calibration XML, cameras XML, .psx / .psz project (--camera "
-       "sensor id)",
-       ReadMetashapeCalibration,
-       WriteMetashapeCalibration,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kMetashapeFrame, {}};
-       },
-       [](const std::string& h, const std::string&) {
-         // A calibration export, a cameras export, a .psx project, a .psz / .zip project archive.
-         if (Has(h, "<opencv_storage>")) return false;  // OpenCV's <calibration_time>
-         return Has(h, "<calibration>") || Has(h, "<calibration ") || Has(h, "<sensor ") ||
-                Has(h, "<sensors") || (Has(h, "<document") && Has(h, "<chunks")) ||
-                (internal::LooksLikeZip(h) && Has(h, "doc.xml"));
-       },
-       ".xml",
-       true,
-       false,
-       true},
-      {"pix4d",
-       "Pix4D internal camera parameters (.cam), a project's calibrated_camera_parameters.txt "
-       "(--camera IMAGE)",
-       ReadPix4dCam,
-       WritePix4dCam,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kPix4dPerspective, {}, true};
-       },
-       [](const std::string& h, const std::string&) {
-         return Has(h, "Pix4D camera calibration file") || IsPix4dCalibratedParameters(h);
-       },
-       ".cam",
-       false,
-       true},
-      {"pix4d-xmp",
-       "Pix4D camera XMP tags (Camera:PerspectiveFocalLength, PrincipalPoint, "
-       "PerspectiveDistortion; a JPEG or an XMP sidecar)",
-       ReadPix4dXmp,
-       WritePix4dXmp,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kPix4dPerspective, {}, true};
-       },
-       [](const std::string& h, const std::string&) { return Has(h, "PerspectiveFocalLength"); },
-       ".xmp",
-       true,
-       true},
-      {"opensfm",
-       "OpenSfM / OpenDroneMap cameras.json",
-       ReadOpenSfmCameras,
-       WriteOpenSfmCameras,
-       [](const ModelCamera& s) {
-         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {"k3", "k4"}}
-                             : FormatTarget{CameraModelId::kOpenCv, {"k4", "k5", "k6"}};
-       },
-       [](const std::string& h, const std::string&) { return Has(h, "\"projection_type\""); },
-       ".json"},
-      {"dji",
-       "DJI XMP DewarpData / DewarpDataK6 (a DJI JPEG, an XMP sidecar or the string)",
-       ReadDjiDewarpData,
-       WriteDjiDewarpData,
-       OpenCvTarget,
-       [](const std::string& h, const std::string&) {
-         if (Has(h, "DewarpData") || Has(h, "Dewarp Data")) return true;
-         // The bare string: "[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" on its first line.
-         static const std::regex kRecord(
-             R"(^\s*([0-9-]+;)?\s*[-+0-9.eE]+(\s*,\s*[-+0-9.eE]+){8}([-+0-9.eE,\s]*)$)");
-         const std::string first = h.substr(0, h.find('\n'));
-         return first.size() < 1000 && std::regex_match(first, kRecord);
-       },
-       ".xmp"},
-      {"dbat",
-       "DBAT camera XML, whole or a <cameras> / <camera> fragment, or DBAT's text report (c, pp, "
-       "aspect, K1-K3, P1, P2 in mm)",
-       ReadDbatCameraXml,
-       WriteDbatCameraXml,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kBrownFraser10, {"B2"}, true};
-       },
-       [](const std::string& h, const std::string&) {
-         return ((Has(h, "<camera>") || Has(h, "<camera ")) &&
-                 (Has(h, "<cc>") || Has(h, "<pp>"))) ||
-                IsDbatReport(h);
-       },
-       ".xml",
-       true,
-       true},
-      {"photomodeler",
-       "PhotoModeler Bundle Soln export's camera or a calibration report's camera block (f, pp, "
-       "format, K1-K3, P1, P2 mm)",
-       ReadPhotoModelerCamera,
-       WritePhotoModelerCamera,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
-       },
-       [](const std::string& h, const std::string&) {
-         return h.rfind("Bundle Soln", 0) == 0 || IsPhotoModelerReport(h);
-       },
-       ".txt",
-       true,
-       true},
-      {"australis",
-       "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
-       ReadAustralisCamera,
-       WriteAustralisCamera,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kBrownFraser10, {}, true};
-       },
-       [](const std::string& h, const std::string&) {
-         return Has(h, "Australis") && Has(h, "Camera Parameters");
-       },
-       ".txt",
-       true,
-       true,
-       true},
-      {"ros",
-       "ROS camera_info YAML (camera_matrix/distortion_coefficients {rows, cols, data}; "
-       "plumb_bob, rational_polynomial, equidistant)",
-       ReadRosCameraInfo,
-       WriteRosCameraInfo,
-       [](const ModelCamera& s) {
-         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}} : OpenCvTarget(s);
-       },
-       [](const std::string& h, const std::string&) {
-         return Has(h, "camera_matrix:") && Has(h, "rows:") && !Has(h, "opencv-matrix") &&
-                !Has(h, "model_type:");
-       },
-       ".yaml"},
-      {"camodocal",
-       "camodocal / VINS-Mono / VINS-Fusion PINHOLE camera YAML",
-       ReadCamodocalCamera,
-       WriteCamodocalCamera,
-       [](const ModelCamera&) {
-         return FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
-       },
-       [](const std::string& h, const std::string&) {
-         return Has(h, "model_type:") && Has(h, "projection_parameters");
-       },
-       ".yaml"},
-      {"kalibr",
-       "Kalibr camchain YAML (pinhole radtan / equidistant)",
-       ReadKalibrCamchain,
-       WriteKalibrCamchain,
-       [](const ModelCamera& s) {
-         return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}}
-                             : FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
-       },
-       [](const std::string& h, const std::string&) {
-         return Has(h, "camera_model:") && Has(h, "intrinsics:");
-       },
-       ".yaml"},
-  };
+  static std::vector<CameraFormat> formats = {AerocalFormat(),
+                                              ColmapFormat(),
+                                              MetashapeFormat(),
+                                              Pix4dFormat(),
+                                              Pix4dXmpFormat(),
+                                              OpenSfmFormat(),
+                                              DjiFormat(),
+                                              DbatFormat(),
+                                              PhotoModelerFormat(),
+                                              AustralisFormat(),
+                                              RosFormat(),
+                                              CamodocalFormat(),
+                                              KalibrFormat()};
   return formats;
 }
 
