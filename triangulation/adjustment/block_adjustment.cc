@@ -1055,7 +1055,9 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   }
 
   // Residuals of every image observation (whitened r = (ideal - projected) / sigma in photo
-  // space, x right and y up; in (col, row) pixels that is (r_x, -r_y) sigma).
+  // space, x right and y up; in (col, row) pixels that is (r_x, -r_y) sigma). Reserved: grown by
+  // doubling it was the largest allocation at the peak heap (heaptrack, 600 exposures).
+  result.residuals.reserve(result.residuals.size() + storage_->observation_of_residual.size());
   for (const auto& [id, index] : storage_->observation_of_residual) {
     const auto& o = storage_->observations[index];
     ObservationResidual v;
@@ -1069,7 +1071,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     if (r.size() == 2) v.residual_px = Eigen::Vector2d(r[0], -r[1]) * o.sigma_px;
     const auto test = storage_->tests.find(id);
     if (test != storage_->tests.end()) v.test = test->second;
-    result.residuals.push_back(v);
+    result.residuals.push_back(std::move(v));
   }
   // Statistics in the units of the image measurements (CONVENTIONS.md "Statistics"), over every
   // active image observation, virtual or raw: the median a-priori sigma in px, and in um with
