@@ -35,6 +35,18 @@ int LocalIndex(const std::vector<int>& cols, int col) {
 
 SchurComplement::SchurComplement(ceres::CRSMatrix jacobian, const ColumnBlocks& blocks)
     : jacobian_(std::move(jacobian)), blocks_(blocks) {
+  IndexRows();
+  AssembleS();
+}
+
+SchurComplement::SchurComplement(ceres::CRSMatrix jacobian,
+                                 const ColumnBlocks& blocks,
+                                 Eigen::SparseMatrix<double> s_lower)
+    : jacobian_(std::move(jacobian)), blocks_(blocks), s_lower_(std::move(s_lower)) {
+  IndexRows();
+}
+
+void SchurComplement::IndexRows() {
   const int n_blocks = static_cast<int>(blocks_.size.size());
   for (int b = 0; b < n_blocks; ++b)
     for (int k = 0; k < blocks_.size[b]; ++k) {
@@ -74,7 +86,11 @@ SchurComplement::SchurComplement(ceres::CRSMatrix jacobian, const ColumnBlocks& 
   std::vector<int> fill(point_row_start_.begin(), point_row_start_.end() - 1);
   for (int r = 0; r < n_rows; ++r)
     if (row_point_[r] >= 0) point_rows_[fill[point_index_[row_point_[r]]]++] = r;
+}
 
+void SchurComplement::AssembleS() {
+  const int n_blocks = static_cast<int>(blocks_.size.size());
+  const int n_rows = jacobian_.num_rows;
   // S, accumulated per pair of reduced blocks (lower: block i >= block j), each a dense
   // size_i x size_j column-major cell in `values`.
   std::unordered_map<long long, size_t> cell;

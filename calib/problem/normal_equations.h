@@ -35,6 +35,12 @@ struct ColumnBlocks {
 class SchurComplement {
  public:
   SchurComplement(ceres::CRSMatrix jacobian, const ColumnBlocks& blocks);
+  /// The same with S given (the solver's reduced system at the solution, ReducedSystem::
+  /// UndampedLower): only the row bookkeeping is built. The caller guarantees that `s_lower` is
+  /// S of this Jacobian (eliminated as above; a row observing two points is not eliminable there).
+  SchurComplement(ceres::CRSMatrix jacobian,
+                  const ColumnBlocks& blocks,
+                  Eigen::SparseMatrix<double> s_lower);
 
   /// Terms of one point block: the reduced blocks its rows touch, their scalar reduced columns
   /// (`cols`, in increasing order), A^+ (pseudo-inverse of the point's normal block) and B_e
@@ -64,6 +70,8 @@ class SchurComplement {
   std::vector<int> ReducedColumns(std::vector<int> blocks) const;
 
  private:
+  void IndexRows();  // rows per point, reduced offsets
+  void AssembleS();  // s_lower_ from the Jacobian
   ceres::CRSMatrix jacobian_;
   ColumnBlocks blocks_;
   bool eliminated_ = true;

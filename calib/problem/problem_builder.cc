@@ -82,6 +82,11 @@ struct ProblemBuilder::Factorized {
   std::unique_ptr<internal::SchurComplement> schur;
   internal::SelectedInverse inverse;
   bool inverse_ok = false;
+  // Pending (schur not built yet): aerocal's engine at the end of a solve without loss functions,
+  // its Jacobian and reduced system at the solution. Factorize builds the Schur complement from
+  // them instead of evaluating and reducing again when the state is still the same (issue 31).
+  std::unique_ptr<internal::ResidualEvaluator> evaluator;
+  std::unique_ptr<internal::ReducedSystem> system;
 };
 
 const ResidualGroupStats* SolveReport::Group(const std::string& name) const {
@@ -161,6 +166,32 @@ void ProblemBuilder::RestoreValues(const std::vector<double>& snapshot) {
   AEROCAL_CHECK(at == snapshot.size()) << "RestoreValues: snapshot of another builder";
 }
 
+namespace {
+
+// The Schur system's columns (the free blocks in order: tangent size, eliminable) and each active
+// residual's first row (-1 inactive). Templated on the builder's private block and residual types.
+template <typename Blocks, typename Residuals>
+internal::ColumnBlocks SchurLayout(const Blocks& blocks,
+                                   const std::vector<BlockId>& free_blocks,
+                                   const Residuals& residuals,
+                                   std::vector<int>* first_row) {
+  internal::ColumnBlocks columns;
+  for (BlockId id : free_blocks) {
+    columns.size.push_back(blocks[id].TangentSize());
+    columns.eliminable.push_back(blocks[id].Eliminable());
+  }
+  first_row->assign(residuals.size(), -1);
+  int row = 0;
+  for (size_t i = 0; i < residuals.size(); ++i) {
+    if (!residuals[i].active) continue;
+    (*first_row)[i] = row;
+    row += residuals[i].size;
+  }
+  return columns;
+}
+
+}  // namespace
+
 void ProblemBuilder::ReleaseFactorized() const { factorized_.reset(); }
 
 const ProblemBuilder::Factorized* ProblemBuilder::Factorize(bool apply_loss,
@@ -170,14 +201,29 @@ const ProblemBuilder::Factorized* ProblemBuilder::Factorize(bool apply_loss,
   for (const Residual& r : residuals_) any_loss = any_loss || (r.active && r.has_loss);
   const bool loss_applied = apply_loss && any_loss;
   std::vector<double> values = ValuesSnapshot();
-  if (factorized_ && factorized_->structure_version == structure_version_ &&
+  if (factorized_ && factorized_->schur && factorized_->structure_version == structure_version_ &&
       factorized_->loss_applied == loss_applied && factorized_->values == values &&
       ((factorized_->inverse_ok && !factorized_->inverse.singular()) ||
        factorized_->max_dense == max_dense_parameters))
     return factorized_.get();
-  factorized_.reset();
-  auto f = std::make_unique<Factorized>();
-  f->schur = BuildSchurComplement(loss_applied, &f->free_blocks, &f->first_row);
+  std::unique_ptr<Factorized> f = std::move(factorized_);
+  // The engine's reduced system at the solution when it is current (no loss function there, so
+  // its Jacobian is the loss-free one and S is the loss-free S), else evaluated and reduced here.
+  Eigen::SparseMatrix<double> s_lower;
+  if (f && f->system && f->structure_version == structure_version_ && f->values == values &&
+      f->system->UndampedLower(*f->evaluator, &s_lower)) {
+    f->system.reset();  // each part freed as soon as it is copied: the statistics' peak memory
+    ceres::CRSMatrix jacobian = f->evaluator->TangentJacobian();
+    f->evaluator.reset();
+    f->free_blocks = FreeBlocksInOrder();
+    f->schur = std::make_unique<internal::SchurComplement>(
+        std::move(jacobian),
+        SchurLayout(blocks_, f->free_blocks, residuals_, &f->first_row),
+        std::move(s_lower));
+  } else {
+    f = std::make_unique<Factorized>();
+    f->schur = BuildSchurComplement(loss_applied, &f->free_blocks, &f->first_row);
+  }
   if (!f->schur) return nullptr;
   f->structure_version = structure_version_;
   f->loss_applied = loss_applied;
@@ -685,16 +731,18 @@ bool ProblemBuilder::SolveWithAerocal(const SolverOptions& options,
     }
     terms.push_back(std::move(t));
   }
-  internal::ResidualEvaluator evaluator(
+  bool any_loss = false;
+  for (const internal::ResidualTerm& t : terms) any_loss = any_loss || t.loss != nullptr;
+  auto evaluator = std::make_unique<internal::ResidualEvaluator>(
       std::move(free), std::move(terms), internal::ResolveThreads(options.num_threads));
-  const auto system = internal::ReducedSystem::Create(evaluator, max_dense);
+  auto system = internal::ReducedSystem::Create(*evaluator, max_dense);
   if (system == nullptr) return false;
   internal::LmOptions lm{options.max_iterations,
                          options.function_tolerance,
                          options.gradient_tolerance,
                          options.parameter_tolerance};
   const internal::LmSummary summary =
-      internal::MinimizeLevenbergMarquardt(lm, &evaluator, system.get());
+      internal::MinimizeLevenbergMarquardt(lm, evaluator.get(), system.get());
   report->linear_solver = system->dense() ? "dense_schur" : "sparse_schur";
   report->termination = summary.termination;
   report->message = summary.message;
@@ -706,6 +754,16 @@ bool ProblemBuilder::SolveWithAerocal(const SolverOptions& options,
   report->evaluation_seconds = summary.evaluation_seconds;
   report->linear_solver_seconds = summary.linear_solver_seconds;
   FinishSolveReport(report);
+  // Kept for the statistics at this solution (the evaluator's Jacobian is the one at the returned
+  // values: the minimiser linearises at every accepted state and ends on one).
+  if (summary.usable && !any_loss) {
+    system->ReleaseFactor();
+    factorized_ = std::make_unique<Factorized>();
+    factorized_->structure_version = structure_version_;
+    factorized_->values = ValuesSnapshot();
+    factorized_->evaluator = std::move(evaluator);
+    factorized_->system = std::move(system);
+  }
   return true;
 }
 
@@ -765,21 +823,11 @@ constexpr int kCeresCovarianceLimit = 300;
 std::unique_ptr<internal::SchurComplement> ProblemBuilder::BuildSchurComplement(
     bool apply_loss, std::vector<BlockId>* free_blocks, std::vector<int>* first_row) const {
   *free_blocks = FreeBlocksInOrder();
-  internal::ColumnBlocks columns;
+  const internal::ColumnBlocks columns = SchurLayout(blocks_, *free_blocks, residuals_, first_row);
   ceres::Problem::EvaluateOptions eval;
-  for (BlockId id : *free_blocks) {
-    columns.size.push_back(blocks_[id].TangentSize());
-    columns.eliminable.push_back(blocks_[id].Eliminable());
-    eval.parameter_blocks.push_back(blocks_[id].values);
-  }
-  first_row->assign(residuals_.size(), -1);
-  int row = 0;
-  for (ResidualId i = 0; i < static_cast<ResidualId>(residuals_.size()); ++i) {
-    if (!residuals_[i].active) continue;
-    eval.residual_blocks.push_back(residuals_[i].id);
-    (*first_row)[i] = row;
-    row += residuals_[i].size;
-  }
+  for (BlockId id : *free_blocks) eval.parameter_blocks.push_back(blocks_[id].values);
+  for (const Residual& r : residuals_)
+    if (r.active) eval.residual_blocks.push_back(r.id);
   eval.apply_loss_function = apply_loss;
   ceres::CRSMatrix crs;
   double cost = 0.0;

@@ -1,5 +1,6 @@
 #include "calib/problem/reduced_system.h"
 
+#include "calib/problem/block_kernels.h"
 #include "calib/problem/parallel_for.h"
 
 #include <Eigen/CholmodSupport>
@@ -38,12 +39,39 @@ void Group(int n,
   for (const auto& [g, i] : group_item) (*items)[fill[g]++] = i;
 }
 
+// (V + diag(d2))^-1 of a point (t x t, row-major), symmetrised; the pseudo-inverse (eigenvalues
+// below 1e-12 of the largest dropped, as Ceres and normal_equations.h) for a point its rays do not
+// determine (one ray), or always with `pseudo` (the statistics' A_e^+). kSize: t at compile time
+// (3, the ground points) or Eigen::Dynamic. False when not finite.
+template <int kSize>
+bool InvertDamped(const double* v_undamped, const double* d2, int t, bool pseudo, double* out) {
+  using Matrix = Eigen::Matrix<double, kSize, kSize, Eigen::RowMajor>;
+  Matrix v = Eigen::Map<const Matrix>(v_undamped, t, t);
+  for (int k = 0; k < t; ++k) v(k, k) += d2[k];
+  Eigen::Map<Matrix> vinv(out, t, t);
+  const Eigen::LLT<Matrix> llt(v);
+  if (!pseudo && llt.info() == Eigen::Success) {
+    vinv = llt.solve(Matrix::Identity(t, t));
+  } else {
+    const Eigen::SelfAdjointEigenSolver<Matrix> eig(v);
+    const double max = eig.eigenvalues().cwiseAbs().maxCoeff();
+    Eigen::Matrix<double, kSize, 1> inverse = eig.eigenvalues();
+    for (int k = 0; k < t; ++k)
+      inverse(k) = inverse(k) > 1e-12 * max && max > 0 ? 1.0 / inverse(k) : 0.0;
+    vinv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
+  }
+  const Matrix symmetric = 0.5 * (vinv + vinv.transpose());
+  vinv = symmetric;
+  return vinv.allFinite();
+}
+
 }  // namespace
 
 struct ReducedSystem::Sparse {
   Eigen::SparseMatrix<double> s;  // lower triangle, the pattern fixed at Create
   std::vector<long long> source;  // per stored value: its index in s_
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  // The factor, freed by ReleaseFactor (the pattern s stays for UndampedLower).
+  std::unique_ptr<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>> llt;
 };
 
 ReducedSystem::~ReducedSystem() = default;
@@ -99,7 +127,9 @@ std::unique_ptr<ReducedSystem> ReducedSystem::Create(const ResidualEvaluator& ev
     s.sparse_->source.resize(m.nonZeros());
     for (long long k = 0; k < m.nonZeros(); ++k)
       s.sparse_->source[k] = std::llround(m.valuePtr()[k]);
-    s.sparse_->llt.analyzePattern(s.sparse_->s);
+    s.sparse_->llt =
+        std::make_unique<Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower>>();
+    s.sparse_->llt->analyzePattern(s.sparse_->s);
   }
   return sys;
 }
@@ -183,12 +213,38 @@ void ReducedSystem::BuildStructure(const ResidualEvaluator& ev) {
   qg_.assign(ev.num_tangent(), 0.0);
   row_bounds_ = BalancedBounds(row_cost, threads_);
   point_bounds_ = BalancedBounds(point_cost, threads_);
+  IndexCells(ev);
 }
 
-double* ReducedSystem::Cell(int row, int col_block) {
+int ReducedSystem::CellIndex(int row, int col_block) const {
   const int* begin = row_cols_.data() + row_start_[row];
   const int* end = row_cols_.data() + row_start_[row + 1];
-  return s_.data() + cell_offset_[std::lower_bound(begin, end, col_block) - row_cols_.data()];
+  return static_cast<int>(std::lower_bound(begin, end, col_block) - row_cols_.data());
+}
+
+void ReducedSystem::IndexCells(const ResidualEvaluator& ev) {
+  // The cell of every product AssembleRow adds, looked up once: per point entry (row block
+  // point_blk_[entry]) the cells of its pairs with the point's earlier blocks ...
+  pair_cell_start_ = {0};
+  pair_cell_.clear();
+  for (size_t entry = 0; entry < point_blk_.size(); ++entry) {
+    const int e = entry_point_[entry];
+    for (size_t a = point_blk_start_[e]; a <= entry; ++a)
+      pair_cell_.push_back(CellIndex(point_blk_[entry], point_blk_[a]));
+    pair_cell_start_.push_back(static_cast<long long>(pair_cell_.size()));
+  }
+  // ... and per residual of a block row, the cell of each of its parameters (-1: none).
+  u_cell_start_ = {0};
+  u_cell_.clear();
+  for (size_t j = 0; j + 1 < red_res_start_.size(); ++j)
+    for (int k = red_res_start_[j]; k < red_res_start_[j + 1]; ++k) {
+      for (int b : ev.term(red_res_[k]).free) {
+        const int col = b < 0 ? -1 : reduced_of_block_[b];
+        u_cell_.push_back(
+            col < 0 || col > static_cast<int>(j) ? -1 : CellIndex(static_cast<int>(j), col));
+      }
+      u_cell_start_.push_back(static_cast<long long>(u_cell_.size()));
+    }
 }
 
 void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
@@ -198,18 +254,20 @@ void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
   ParallelRanges(point_bounds_, [&](int begin, int end, int) {
     for (int e = begin; e < end; ++e) {
       const int pb = points_[e], t = ev.block(pb).tangent, to = ev.tangent_offset(pb);
-      Map v(v_.data() + v_offset_[e], t, t);
-      v.setZero();
+      double* v = v_.data() + v_offset_[e];
+      std::fill_n(v, t * t, 0.0);
       const int b0 = point_blk_start_[e], b1 = point_blk_start_[e + 1];
-      for (int a = b0; a < b1; ++a)
-        Map(w_.data() + point_w_[a], t, ev.block(reduced_[point_blk_[a]]).tangent).setZero();
+      if (b0 < b1)  // the point's W blocks lie one after the other
+        std::fill(w_.data() + point_w_[b0],
+                  b1 < static_cast<int>(point_w_.size()) ? w_.data() + point_w_[b1]
+                                                         : w_.data() + w_.size(),
+                  0.0);
       for (int k = point_res_start_[e]; k < point_res_start_[e + 1]; ++k) {
         const int i = point_res_[k], rows = ev.residual_size(i);
         const ResidualTerm& term = ev.term(i);
-        const ConstMap ej(ev.jacobian(i, SlotOf(term, pb)), rows, t);
-        const Eigen::Map<const Eigen::VectorXd> r(ev.residual(i), rows);
-        v.noalias() += ej.transpose().lazyProduct(ej);
-        g_.segment(to, t).noalias() += ej.transpose().lazyProduct(r);
+        const double* ej = ev.jacobian(i, SlotOf(term, pb));
+        AddTransposedProduct(ej, ej, rows, t, t, 1.0, v);
+        AddTransposedProduct(ej, ev.residual(i), rows, t, 1, 1.0, g_.data() + to);
         for (size_t q = 0; q < term.free.size(); ++q) {
           const int b = term.free[q];
           if (b < 0 || reduced_of_block_[b] < 0) continue;
@@ -217,11 +275,11 @@ void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
           const int a = static_cast<int>(
               std::lower_bound(point_blk_.begin() + b0, point_blk_.begin() + b1, j) -
               point_blk_.begin());
-          Map(w_.data() + point_w_[a], t, sj).noalias() +=
-              ej.transpose().lazyProduct(ConstMap(ev.jacobian(i, static_cast<int>(q)), rows, sj));
+          AddTransposedProduct(
+              ej, ev.jacobian(i, static_cast<int>(q)), rows, t, sj, 1.0, w_.data() + point_w_[a]);
         }
       }
-      diag_.segment(to, t) = v.diagonal();
+      for (int a = 0; a < t; ++a) diag_(to + a) = v[a * t + a];
     }
   });
   // Per reduced block: g_j = F_j^T r and diag(F_j^T F_j), residuals in index order.
@@ -230,10 +288,13 @@ void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
       const int b = reduced_[j], sj = ev.block(b).tangent, to = ev.tangent_offset(b);
       for (int k = red_res_start_[j]; k < red_res_start_[j + 1]; ++k) {
         const int i = red_res_[k], rows = ev.residual_size(i);
-        const ConstMap f(ev.jacobian(i, red_res_slot_[k]), rows, sj);
-        g_.segment(to, sj).noalias() +=
-            f.transpose().lazyProduct(Eigen::Map<const Eigen::VectorXd>(ev.residual(i), rows));
-        diag_.segment(to, sj) += f.colwise().squaredNorm().transpose();
+        const double* f = ev.jacobian(i, red_res_slot_[k]);
+        AddTransposedProduct(f, ev.residual(i), rows, sj, 1, 1.0, g_.data() + to);
+        for (int a = 0; a < sj; ++a) {
+          double norm2 = 0.0;
+          for (int row = 0; row < rows; ++row) norm2 += f[row * sj + a] * f[row * sj + a];
+          diag_(to + a) += norm2;
+        }
       }
     }
   });
@@ -247,32 +308,43 @@ void ReducedSystem::AssembleRow(const ResidualEvaluator& ev, int i) {
   for (int k = red_res_start_[i]; k < red_res_start_[i + 1]; ++k) {
     const int r = red_res_[k], rows = ev.residual_size(r);
     const ResidualTerm& term = ev.term(r);
-    const ConstMap fi(ev.jacobian(r, red_res_slot_[k]), rows, si);
+    const double* fi = ev.jacobian(r, red_res_slot_[k]);
+    const int* cells = u_cell_.data() + u_cell_start_[k];
     for (size_t q = 0; q < term.free.size(); ++q) {
-      const int b = term.free[q];
-      if (b < 0 || reduced_of_block_[b] < 0 || reduced_of_block_[b] > i) continue;
-      const int sj = ev.block(b).tangent;
-      Map(Cell(i, reduced_of_block_[b]), si, sj).noalias() +=
-          fi.transpose().lazyProduct(ConstMap(ev.jacobian(r, static_cast<int>(q)), rows, sj));
+      if (cells[q] < 0) continue;
+      const int sj = ev.block(term.free[q]).tangent;
+      AddTransposedProduct(fi,
+                           ev.jacobian(r, static_cast<int>(q)),
+                           rows,
+                           si,
+                           sj,
+                           1.0,
+                           s_.data() + cell_offset_[cells[q]]);
     }
   }
-  Map diagonal(Cell(i, i), si, si);
+  double* diagonal = s_.data() + cell_offset_[CellIndex(i, i)];
   const int ti = ev.tangent_offset(bi);
-  for (int a = 0; a < si; ++a) diagonal(a, a) += d2_(ti + a);
+  for (int a = 0; a < si; ++a) diagonal[a * si + a] += d2_(ti + a);
   rhs_.segment(oi, si) = -g_.segment(ti, si);
   // - W_e^T V_e^-1 W_e, the points by index.
   for (int k = red_pt_start_[i]; k < red_pt_start_[i + 1]; ++k) {
     const int entry = red_pt_entry_[k];
     const int e = entry_point_[entry];
     const int t = ev.block(points_[e]).tangent;
-    const ConstMap wi(w_.data() + point_w_[entry], t, si);
+    const double* wi = w_.data() + point_w_[entry];
+    const int* cells = pair_cell_.data() + pair_cell_start_[entry];
     for (int a = point_blk_start_[e]; a <= entry; ++a) {
-      const int j = point_blk_[a], sj = ev.block(reduced_[j]).tangent;
-      Map(Cell(i, j), si, sj).noalias() -=
-          wi.transpose().lazyProduct(ConstMap(q_.data() + point_w_[a], t, sj));
+      const int sj = reduced_offset_[point_blk_[a] + 1] - reduced_offset_[point_blk_[a]];
+      AddTransposedProduct(wi,
+                           q_.data() + point_w_[a],
+                           t,
+                           si,
+                           sj,
+                           -1.0,
+                           s_.data() + cell_offset_[cells[a - point_blk_start_[e]]]);
     }
-    rhs_.segment(oi, si).noalias() += wi.transpose().lazyProduct(
-        Eigen::Map<const Eigen::VectorXd>(qg_.data() + ev.tangent_offset(points_[e]), t));
+    AddTransposedProduct(
+        wi, qg_.data() + ev.tangent_offset(points_[e]), t, si, 1, 1.0, rhs_.data() + oi);
   }
 }
 
@@ -294,42 +366,39 @@ bool ReducedSystem::Factorize(Eigen::VectorXd* rhs) {
   }
   double* values = sparse_->s.valuePtr();
   for (size_t k = 0; k < sparse_->source.size(); ++k) values[k] = s_[sparse_->source[k]];
-  sparse_->llt.factorize(sparse_->s);
-  if (sparse_->llt.info() != Eigen::Success) return false;
-  *rhs = sparse_->llt.solve(*rhs);
-  return sparse_->llt.info() == Eigen::Success && rhs->allFinite();
+  sparse_->llt->factorize(sparse_->s);
+  if (sparse_->llt->info() != Eigen::Success) return false;
+  *rhs = sparse_->llt->solve(*rhs);
+  return sparse_->llt->info() == Eigen::Success && rhs->allFinite();
 }
 
-bool ReducedSystem::Solve(const ResidualEvaluator& ev, double radius, Eigen::VectorXd* dx) {
-  d2_ = diag_.cwiseMax(kMinDiagonal).cwiseMin(kMaxDiagonal) / radius;
+bool ReducedSystem::Reduce(const ResidualEvaluator& ev, bool pseudo) {
   std::atomic<bool> ok{true};
   // V_e^-1 (damped), Q_e = V_e^-1 W_e, V_e^-1 g_e per point.
   ParallelRanges(point_bounds_, [&](int begin, int end, int) {
     for (int e = begin; e < end; ++e) {
       const int pb = points_[e], t = ev.block(pb).tangent, to = ev.tangent_offset(pb);
-      Eigen::MatrixXd v = ConstMap(v_.data() + v_offset_[e], t, t);
-      v.diagonal() += d2_.segment(to, t);
-      Map vinv(vinv_.data() + v_offset_[e], t, t);
-      const Eigen::LLT<Eigen::MatrixXd> llt(v);
-      if (llt.info() == Eigen::Success) {
-        vinv = llt.solve(Eigen::MatrixXd::Identity(t, t));
-      } else {  // a point its rays do not determine (one ray): the pseudo-inverse, as Ceres
-        const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(v);
-        const double max = eig.eigenvalues().cwiseAbs().maxCoeff();
-        Eigen::VectorXd inverse = eig.eigenvalues();
-        for (int k = 0; k < t; ++k) inverse(k) = inverse(k) > 1e-12 * max ? 1.0 / inverse(k) : 0.0;
-        vinv = eig.eigenvectors() * inverse.asDiagonal() * eig.eigenvectors().transpose();
-      }
-      if (!vinv.allFinite()) {
+      double* vinv = vinv_.data() + v_offset_[e];
+      const double* v = v_.data() + v_offset_[e];
+      const bool inverted = t == 3
+                                ? InvertDamped<3>(v, d2_.data() + to, t, pseudo, vinv)
+                                : InvertDamped<Eigen::Dynamic>(v, d2_.data() + to, t, pseudo, vinv);
+      if (!inverted) {
         ok = false;
         continue;
       }
-      Eigen::Map<Eigen::VectorXd>(qg_.data() + to, t).noalias() =
-          vinv.lazyProduct(g_.segment(to, t));
-      for (int a = point_blk_start_[e]; a < point_blk_start_[e + 1]; ++a) {
+      // V^-1 is symmetric (InvertDamped), so V^-1 x = (V^-1)^T x: the transposed kernel serves.
+      std::fill_n(qg_.data() + to, t, 0.0);
+      AddTransposedProduct(vinv, g_.data() + to, t, t, 1, 1.0, qg_.data() + to);
+      const int a0 = point_blk_start_[e], a1 = point_blk_start_[e + 1];
+      if (a0 < a1)
+        std::fill(q_.data() + point_w_[a0],
+                  a1 < static_cast<int>(point_w_.size()) ? q_.data() + point_w_[a1]
+                                                         : q_.data() + q_.size(),
+                  0.0);
+      for (int a = a0; a < a1; ++a) {
         const int sj = ev.block(reduced_[point_blk_[a]]).tangent;
-        Map(q_.data() + point_w_[a], t, sj).noalias() =
-            vinv.lazyProduct(ConstMap(w_.data() + point_w_[a], t, sj));
+        AddTransposedProduct(vinv, w_.data() + point_w_[a], t, t, sj, 1.0, q_.data() + point_w_[a]);
       }
     }
   });
@@ -338,7 +407,43 @@ bool ReducedSystem::Solve(const ResidualEvaluator& ev, double radius, Eigen::Vec
   ParallelRanges(row_bounds_, [&](int begin, int end, int) {
     for (int i = begin; i < end; ++i) AssembleRow(ev, i);
   });
-  if (!Factorize(&rhs_)) return false;
+  return true;
+}
+
+bool ReducedSystem::UndampedLower(const ResidualEvaluator& ev, Eigen::SparseMatrix<double>* s) {
+  d2_.setZero(ev.num_tangent());
+  if (!Reduce(ev, true)) return false;
+  if (sparse_) {  // the solve's pattern, handed over (no copy: the statistics' peak memory)
+    double* values = sparse_->s.valuePtr();
+    for (size_t k = 0; k < sparse_->source.size(); ++k) values[k] = s_[sparse_->source[k]];
+    *s = std::move(sparse_->s);
+    sparse_.reset();
+    return true;
+  }
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (size_t i = 0; i < reduced_.size(); ++i) {
+    const int si = reduced_offset_[i + 1] - reduced_offset_[i];
+    for (int c = row_start_[i]; c < row_start_[i + 1]; ++c) {
+      const int j = row_cols_[c], sj = reduced_offset_[j + 1] - reduced_offset_[j];
+      const double* cell = s_.data() + cell_offset_[c];
+      for (int a = 0; a < si; ++a)
+        for (int b = 0; b < sj && (j != static_cast<int>(i) || b <= a); ++b)
+          triplets.emplace_back(reduced_offset_[i] + a, reduced_offset_[j] + b, cell[a * sj + b]);
+    }
+  }
+  s->resize(n_reduced_, n_reduced_);
+  s->setFromTriplets(triplets.begin(), triplets.end());
+  return true;
+}
+
+void ReducedSystem::ReleaseFactor() {
+  if (sparse_) sparse_->llt.reset();
+  dense_s_.resize(0, 0);
+}
+
+bool ReducedSystem::Solve(const ResidualEvaluator& ev, double radius, Eigen::VectorXd* dx) {
+  d2_ = diag_.cwiseMax(kMinDiagonal).cwiseMin(kMaxDiagonal) / radius;
+  if (!Reduce(ev, false) || !Factorize(&rhs_)) return false;
   dx->resize(ev.num_tangent());
   for (size_t j = 0; j < reduced_.size(); ++j)
     dx->segment(ev.tangent_offset(reduced_[j]), reduced_offset_[j + 1] - reduced_offset_[j]) =
@@ -347,13 +452,12 @@ bool ReducedSystem::Solve(const ResidualEvaluator& ev, double radius, Eigen::Vec
   ParallelRanges(point_bounds_, [&](int begin, int end, int) {
     for (int e = begin; e < end; ++e) {
       const int pb = points_[e], t = ev.block(pb).tangent, to = ev.tangent_offset(pb);
-      Eigen::VectorXd x = -Eigen::Map<const Eigen::VectorXd>(qg_.data() + to, t);
+      double* x = dx->data() + to;
+      for (int k = 0; k < t; ++k) x[k] = -qg_[to + k];
       for (int a = point_blk_start_[e]; a < point_blk_start_[e + 1]; ++a) {
         const int j = point_blk_[a], sj = reduced_offset_[j + 1] - reduced_offset_[j];
-        x.noalias() -= ConstMap(q_.data() + point_w_[a], t, sj)
-                           .lazyProduct(rhs_.segment(reduced_offset_[j], sj));
+        SubtractProduct(q_.data() + point_w_[a], rhs_.data() + reduced_offset_[j], t, sj, x);
       }
-      dx->segment(to, t) = x;
     }
   });
   return dx->allFinite();

@@ -17,6 +17,7 @@
 #include "calib/problem/residual_evaluator.h"
 
 #include <Eigen/Core>
+#include <Eigen/SparseCore>
 
 #include <memory>
 #include <vector>
@@ -36,6 +37,15 @@ class ReducedSystem {
   /// factorisation fails.
   bool Solve(const ResidualEvaluator& evaluator, double radius, Eigen::VectorXd* dx);
 
+  /// S at zero damping with the points' pseudo-inverses A_e^+ (the S of normal_equations.h for
+  /// the same Jacobian), lower triangle, from the last Linearize: the statistics' reduced matrix at
+  /// the solution without a second reduction. False when a point block is not finite. Overwrites
+  /// the step's work arrays and hands the sparse pattern over: once, after the last Solve.
+  bool UndampedLower(const ResidualEvaluator& evaluator, Eigen::SparseMatrix<double>* s_lower);
+
+  /// Frees the factor of the last Solve (no Solve after this; UndampedLower still works).
+  void ReleaseFactor();
+
   const Eigen::VectorXd& gradient() const { return g_; }  // J^T r (tangent)
   /// The damping D^2 of the last Solve (tangent).
   const Eigen::VectorXd& damping() const { return d2_; }
@@ -45,8 +55,13 @@ class ReducedSystem {
  private:
   ReducedSystem() = default;
   void BuildStructure(const ResidualEvaluator& ev);
-  double* Cell(int row, int col_block);
+  /// Index (into row_cols_ / cell_offset_) of the cell (row, col_block), col_block <= row.
+  int CellIndex(int row, int col_block) const;
+  void IndexCells(const ResidualEvaluator& ev);
   void AssembleRow(const ResidualEvaluator& ev, int row);
+  /// V_e^-1 (damped by d2_; pseudo-inverse with `pseudo`), Q_e, V_e^-1 g_e per point, then every
+  /// row of S and the right-hand side. False when a point block is not finite.
+  bool Reduce(const ResidualEvaluator& ev, bool pseudo);
   bool Factorize(Eigen::VectorXd* rhs);
 
   struct Sparse;  // CHOLMOD
@@ -68,6 +83,11 @@ class ReducedSystem {
   // S by block rows: column blocks (sorted, <= row) and their cells (row-major s_i x s_j)
   std::vector<int> row_start_, row_cols_;
   std::vector<long long> cell_offset_;
+  // The cells AssembleRow adds into, looked up once (IndexCells): per point entry, the cells of
+  // its pairs with the point's blocks up to it; per entry of red_res_, the cell of each parameter
+  // of the residual (-1: a point, constant, or a column block above the row).
+  std::vector<long long> pair_cell_start_, u_cell_start_;
+  std::vector<int> pair_cell_, u_cell_;
   std::vector<double> s_;
   std::vector<int> row_bounds_, point_bounds_;
   // per point: V (undamped), V^-1 (damped), g_e; W, Q = V^-1 W

@@ -1,5 +1,6 @@
 #include "calib/problem/residual_evaluator.h"
 
+#include "calib/problem/block_kernels.h"
 #include "calib/problem/parallel_for.h"
 
 #include <Eigen/Core>
@@ -136,6 +137,30 @@ bool ResidualEvaluator::Evaluate(const std::vector<double>& x, bool jacobians, d
   return std::isfinite(sum);
 }
 
+ceres::CRSMatrix ResidualEvaluator::TangentJacobian() const {
+  ceres::CRSMatrix crs;
+  crs.num_rows = static_cast<int>(r_offset_.back());
+  crs.num_cols = num_tangent();
+  crs.rows.reserve(crs.num_rows + 1);
+  crs.rows.push_back(0);
+  for (int i = 0; i < num_residuals(); ++i) {
+    const ResidualTerm& t = residuals_[i];
+    for (int row = 0; row < residual_size(i); ++row) {
+      for (size_t k = 0; k < t.free.size(); ++k) {
+        if (t.free[k] < 0) continue;
+        const int tangent = blocks_[t.free[k]].tangent;
+        const double* j = jacobian(i, static_cast<int>(k)) + row * tangent;
+        for (int c = 0; c < tangent; ++c) {
+          crs.cols.push_back(tangent_offset_[t.free[k]] + c);
+          crs.values.push_back(j[c]);
+        }
+      }
+      crs.rows.push_back(static_cast<int>(crs.cols.size()));
+    }
+  }
+  return crs;
+}
+
 bool ResidualEvaluator::EvaluateRange(
     const std::vector<double>& x, bool jacobians, int begin, int end, double* r_all) {
   std::vector<const double*> params;
@@ -168,13 +193,11 @@ bool ResidualEvaluator::EvaluateRange(
       if (b < 0) continue;
       double* out = j_.data() + j_offset_[slot_start_[i] + k];
       const FreeBlock& fb = blocks_[b];
-      const Eigen::Map<const RowMatrix> ja(ambient[k].data(), rows, fb.size);
-      Eigen::Map<RowMatrix> jt(out, rows, fb.tangent);
       if (fb.manifold == nullptr)
-        jt = ja;
+        std::copy_n(ambient[k].data(), rows * fb.size, out);
       else
-        jt.noalias() = ja.lazyProduct(
-            Eigen::Map<const RowMatrix>(plus_.data() + plus_offset_[b], fb.size, fb.tangent));
+        MultiplyInto(
+            ambient[k].data(), plus_.data() + plus_offset_[b], rows, fb.size, fb.tangent, out);
       if (t.loss != nullptr) correction.Jacobian(r, rows, fb.tangent, out);
     }
     if (t.loss != nullptr)

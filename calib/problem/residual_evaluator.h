@@ -11,6 +11,7 @@
 #pragma once
 
 #include <ceres/cost_function.h>
+#include <ceres/crs_matrix.h>
 #include <ceres/loss_function.h>
 #include <ceres/manifold.h>
 
@@ -66,6 +67,10 @@ class ResidualEvaluator {
     return at < 0 ? nullptr : j_.data() + at;
   }
   int threads() const { return threads_; }
+  /// The last Evaluate's tangent Jacobian as Ceres' Problem::Evaluate writes it (rows: the
+  /// residuals in order; columns: the free blocks' tangents in order, each row's entries block by
+  /// block in parameter order).
+  ceres::CRSMatrix TangentJacobian() const;
 
  private:
   /// Residuals [begin, end) at x: cost per residual into costs_, residuals into `r`, and the

@@ -65,6 +65,7 @@ struct ColmapRun {
   double seconds = 0, f_px = 0, final_rms_px = 0;
   double cpu_seconds = 0;  // user + system of bundle_adjuster (all its threads)
   int iterations = 0;      // Ceres' iterations in COLMAP's report
+  double peak_rss_mb = 0;  // bundle_adjuster's own peak (GNU time), 0 without /usr/bin/time
 };
 
 // User + system CPU time of the reaped children of this process, s.
@@ -82,8 +83,11 @@ ColmapRun RunColmap(const Project& project) {
   std::filesystem::create_directories(dir.File("in"));
   std::filesystem::create_directories(dir.File("out"));
   WriteColmapModel(project, StartPoints(project), dir.File("in"));
+  // GNU time reports the peak resident memory of bundle_adjuster alone (%M, KiB).
+  const bool timed = std::filesystem::exists("/usr/bin/time");
   const std::string command =
-      "QT_QPA_PLATFORM=offscreen colmap bundle_adjuster --input_path " + dir.File("in") +
+      (timed ? "/usr/bin/time -f %M -o " + dir.File("rss.txt") + " " : std::string()) +
+      "env QT_QPA_PLATFORM=offscreen colmap bundle_adjuster --input_path " + dir.File("in") +
       " --output_path " + dir.File("out") +
       " --BundleAdjustment.refine_focal_length 1 --BundleAdjustment.refine_principal_point 1"
       " --BundleAdjustment.refine_extra_params 1 --log_to_stderr 1 > " +
@@ -94,6 +98,11 @@ ColmapRun RunColmap(const Project& project) {
   run.seconds = Seconds(start);
   run.cpu_seconds = ChildrenCpuSeconds() - cpu_start;
   if (rc != 0) return run;
+  if (timed) {
+    std::ifstream rss(dir.File("rss.txt"));
+    double kib = 0;
+    if (rss >> kib) run.peak_rss_mb = kib / 1024.0;
+  }
   // Export to text (bundle_adjuster writes the binary format).
   const std::string convert = "colmap model_converter --input_path " + dir.File("out") +
                               " --output_path " + dir.File("out") +
@@ -237,6 +246,8 @@ BENCHMARK(BM_SimulatedBlock)
 //   adjust_no_snooping_s             the same with --no-snooping
 //   snooping_share                   1 - adjust_no_snooping_s / adjust_s
 //   colmap_s, ratio_aerocal_over_colmap (adjust_s / colmap_s), adjust_exit_code
+//   colmap_peak_rss_mb               bundle_adjuster's own peak RSS (GNU time); observations,
+//                                    points: the block's (memory per observation / point)
 //   *_cpu_s, snooping_share_cpu, ratio_cpu_aerocal_over_colmap: the same in CPU time (user +
 //   system of the child; COLMAP's over all its threads, aerocal solves on one): on a machine
 //   shared with other work the wall times measure the load as much as the programs.
@@ -259,6 +270,7 @@ void BM_AdjustDefaults(benchmark::State& state) {
   state.counters["adjust_no_snooping_iterations"] = without.iterations;
   state.counters["adjust_cpu_s"] = with.cpu_seconds;
   state.counters["adjust_peak_rss_mb"] = with.peak_rss_mb;
+  state.counters["points"] = static_cast<double>(project.points.size());
   state.counters["adjust_no_snooping_s"] = without.seconds;
   state.counters["adjust_no_snooping_cpu_s"] = without.cpu_seconds;
   state.counters["snooping_share"] = 1.0 - without.seconds / with.seconds;
@@ -271,6 +283,7 @@ void BM_AdjustDefaults(benchmark::State& state) {
     state.counters["ratio_cpu_aerocal_over_colmap"] = with.cpu_seconds / colmap.cpu_seconds;
     state.counters["colmap_iterations"] = colmap.iterations;
     state.counters["colmap_s_per_iteration"] = colmap.seconds / std::max(1, colmap.iterations);
+    state.counters["colmap_peak_rss_mb"] = colmap.peak_rss_mb;
   } else {
     state.SetLabel("colmap missing (apt-get install colmap) or failed: no ratio");
   }

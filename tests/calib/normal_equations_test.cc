@@ -316,6 +316,45 @@ TEST(Covariance, SelectedInverseMatchesTheDenseInverse) {
   EXPECT_TRUE(cross.CrossCovariance(block.interior_block, block.pose_blocks[60], &unused));
 }
 
+// After a solve by aerocal's engine the statistics take its reduced system at the solution
+// (ProblemBuilder keeps it, issue 31) instead of evaluating the Jacobian and reducing again: the
+// same redundancy numbers, Q_vv and covariance as a fresh reduction to 1e-12 (the fresh one is
+// forced by a structure change that changes nothing), with the reduced system sparse (CHOLMOD in
+// the solve) and dense.
+TEST(ObservationCofactors, TheEnginesReducedSystemGivesTheFreshReductionsNumbers) {
+  constexpr double kSame = 1e-12;
+  for (const int max_dense : {0, 800}) {
+    LinearBlock block(false);
+    SolverOptions options;
+    options.max_dense_schur_parameters = max_dense;
+    ASSERT_TRUE(block.builder.Solve(options).usable);
+    const std::vector<ResidualId> ids = AllResiduals(block);
+    const std::vector<BlockId> requested = {
+        block.interior_block, block.pose_blocks[3], block.point_blocks[17]};
+    const ObservationCofactors shared = block.builder.ComputeObservationCofactors(ids, true);
+    const CovarianceReport shared_cov = block.builder.EstimateCovariance(requested, 1.0, 0.95);
+    block.builder.SetDenseInverseLimit(300);  // the same limit: only the kept state is dropped
+    const ObservationCofactors fresh = block.builder.ComputeObservationCofactors(ids, true);
+    const CovarianceReport fresh_cov = block.builder.EstimateCovariance(requested, 1.0, 0.95);
+    ASSERT_TRUE(shared.ok && fresh.ok && shared_cov.ok && fresh_cov.ok);
+    double worst = 0.0;
+    for (ResidualId id : ids)
+      for (size_t k = 0; k < fresh.redundancy.at(id).size(); ++k)
+        worst = std::max(worst, std::abs(shared.redundancy.at(id)[k] - fresh.redundancy.at(id)[k]));
+    ASSERT_EQ(shared.clusters.size(), fresh.clusters.size());
+    for (size_t c = 0; c < fresh.clusters.size(); ++c)
+      worst =
+          std::max(worst, (shared.clusters[c].qvv - fresh.clusters[c].qvv).cwiseAbs().maxCoeff());
+    EXPECT_LT(worst, kSame) << "max_dense_schur_parameters " << max_dense;
+    for (BlockId a : requested)
+      for (BlockId b : requested) {
+        Eigen::MatrixXd x, y;
+        ASSERT_TRUE(shared_cov.CrossCovariance(a, b, &x) && fresh_cov.CrossCovariance(a, b, &y));
+        EXPECT_LT((x - y).cwiseAbs().maxCoeff(), kSame * y.cwiseAbs().maxCoeff());
+      }
+  }
+}
+
 TEST(ProblemBuilder, ManifoldsAreCreatedOncePerBlock) {
   LinearBlock block(false);
   ASSERT_TRUE(block.builder.Solve({}).usable);

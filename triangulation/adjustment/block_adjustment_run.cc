@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <utility>
 
 namespace aerocal::triangulation {
 namespace {
@@ -221,8 +222,10 @@ void BlockAdjustment::DropSingleRayPoints(AdjustmentResult* result) {
 }
 
 // Residuals of every image observation (whitened r = (ideal - projected) / sigma in photo space,
-// x right and y up; in (col, row) pixels that is (r_x, -r_y) sigma).
+// x right and y up; in (col, row) pixels that is (r_x, -r_y) sigma). Reserved: grown by doubling
+// it was the largest allocation at the peak heap (heaptrack, 600 exposures).
 void BlockAdjustment::CollectResiduals(AdjustmentResult* result) const {
+  result->residuals.reserve(result->residuals.size() + storage_->observation_of_residual.size());
   for (const auto& [id, index] : storage_->observation_of_residual) {
     const auto& o = storage_->observations[index];
     ObservationResidual v;
@@ -236,7 +239,7 @@ void BlockAdjustment::CollectResiduals(AdjustmentResult* result) const {
     if (r.size() == 2) v.residual_px = Eigen::Vector2d(r[0], -r[1]) * o.sigma_px;
     const auto test = storage_->tests.find(id);
     if (test != storage_->tests.end()) v.test = test->second;
-    result->residuals.push_back(v);
+    result->residuals.push_back(std::move(v));
   }
 }
 

@@ -1,7 +1,7 @@
 #include "triangulation/sensor/frame_camera.h"
 
 #include "calib/core/error.h"
-#include "calib/residuals/collinearity.h"
+#include "calib/residuals/frame_collinearity_cost_function.h"
 #include "calib/residuals/prior.h"
 
 #include <algorithm>
@@ -81,7 +81,7 @@ ObservationTerm FrameCamera::Term(const SensorContext& context,
   const ObservationSite site = context.Site(observation);
   ObservationTerm term;
   term.group = calib::kGroupImage;
-  term.cost = calib::MakeCollinearityResidual(
+  term.cost = calib::MakeFrameCollinearityResidual(
       site.camera->model, site.camera->frame(), observation.pixel, observation.sigma_px);
   term.blocks = {blocks_[site.camera_index], site.pose.rotation, site.pose.center, point};
   return term;

@@ -1,11 +1,11 @@
 // The frame camera: one image per exposure with the exposure's pose, observations in the virtual
 // image's pixel frame, collinearity with the camera's interior in the camera's OWN model (any
-// registered model: the residual comes from calib::MakeCollinearityResidual, the one factory,
-// calib/residuals/collinearity.h; CONVENTIONS.md). It owns one interior block per camera
-// (CameraIndex, sized by the camera's model), whose free entries are AdjustOptions::free_interior
-// named by that model's table (a subset manifold in the builder; a name the model does not have is
-// a ConfigError); other sensor kinds put their geometry in front of these blocks (sub-image
-// mappings, rig mounts), in the same model.
+// registered model: the residual comes from calib::MakeFrameCollinearityResidual, a hand-written
+// Jacobian for the 10-parameter model, else collinearity.h's one factory; CONVENTIONS.md). It
+// owns one interior block per camera (CameraIndex, sized by the camera's model), whose free
+// entries are AdjustOptions::free_interior named by that model's table (a subset manifold in the
+// builder; a name the model does not have is a ConfigError); other sensor kinds put their geometry
+// in front of these blocks (sub-image mappings, rig mounts), in the same model.
 #pragma once
 
 #include "calib/camera/camera.h"
