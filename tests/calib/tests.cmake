@@ -1,7 +1,7 @@
 aerocal_add_test(calib/brown_fraser10 LIBS aerocal::calib LABELS unit)
 aerocal_add_test(calib/camera_io LIBS aerocal::calib LABELS unit reader)
 aerocal_add_test(calib/subimage_mapping LIBS aerocal::calib LABELS unit)
-aerocal_add_test(calib/residuals LIBS aerocal::calib LABELS unit)
+aerocal_add_test(calib/residuals LIBS aerocal::residual_factories LABELS unit)
 aerocal_add_test(calib/problem_builder LIBS aerocal::calib LABELS synthetic)
 aerocal_add_test(calib/mounted_block LIBS aerocal::calib LABELS unit reader)
 aerocal_add_test(calib/csv LIBS aerocal::calib LABELS unit reader)
