@@ -14,6 +14,7 @@
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/command_registry.h"
+#include "tools/observation_tables.h"
 #include "tools/output_set.h"
 #include "tools/python_script.h"
 #include "triangulation/calibration/distortion_figure.h"
@@ -181,6 +182,9 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
     q.value = camera.at("estimated").at(name).get<double>();
     triangulation::UncertaintyComponent a;
     a.source = "adjustment covariance (in-flight self-calibration)";
+    a.origin =
+        "the flight adjustment's sigma: image observations, control survey sigmas and GNSS/IMU "
+        "priors together, scaled by sigma0 (redundancy as degrees of freedom)";
     a.type = "A";
     a.distribution = "normal";
     a.value = a.u = sigma.get<double>();
@@ -410,8 +414,10 @@ int WriteCertificate(const CertificateArgs& args) {
   nlohmann::json cert;
   std::vector<std::string> statements;  // checked before anything is written
   const bool valid = ReadTyped(args.result, "--result", [&] {
-    if (result.is_object() && result.value("kind", "") == "flight")
+    if (result.is_object() && result.value("kind", "") == "flight") {
+      InflateResidualTables(&result, args.result);  // `flight --residuals-csv`
       result = CalibrateFormOfFlight(result, args.result);
+    }
     if (!result.is_object() || result.value("command", "") != "calibrate" ||
         !result.contains("calibration"))
       throw InputError(args.result + ": not a result of `aerocal calibrate` (--result)");

@@ -63,7 +63,8 @@ CommandRun SetupCalibrate(CLI::App& app) {
       "is calibrated too and the stability over the groups tested (chi-square, 5 %)");
   app.add_option("--budget",
                  args->budget,
-                 "Uncertainty budget options (YAML: radii_mm, target_radius_mm, components)");
+                 "Uncertainty budget options (YAML: radii_mm, target_radius_mm, "
+                 "pixel_size_tolerance_mm, components)");
   app.add_option("--radii-mm",
                  args->radii_mm,
                  "Radii of the certified distortion values, mm (default: 1/4 .. 4/4 of the half "

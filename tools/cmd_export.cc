@@ -6,6 +6,7 @@
 #include "calib/core/json_file.h"
 #include "calib/core/result_file.h"
 #include "tools/command_registry.h"
+#include "tools/observation_tables.h"
 #include "tools/python_script.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/crs_export.h"
@@ -27,7 +28,11 @@ struct ExportArgs {
 // coordinates of a projected or local frame, as the result holds them).
 int WriteTables(const ExportArgs& args) {
   CheckOutputFolder(args.tables, "--tables");
-  ReadResult(args.result, {"adjust", "flight"}, "`aerocal adjust` or `aerocal flight`");
+  nlohmann::json result =
+      ReadResult(args.result, {"adjust", "flight"}, "`aerocal adjust` or `aerocal flight`");
+  // `flight --residuals-csv`: its tables are there and are the result's (checked here, so a
+  // changed or missing one is a bad input, exit 2, before the script runs).
+  InflateResidualTables(&result, args.result);
   std::vector<std::string> script_args = {args.result, args.tables};
   if (!args.project.empty()) {
     const triangulation::Project project = triangulation::ReadProject(args.project);

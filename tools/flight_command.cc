@@ -9,6 +9,7 @@
 #include "tools/camera_formats.h"
 #include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
+#include "tools/observation_tables.h"
 #include "tools/option_ranges.h"
 #include "tools/output_set.h"
 #include "tools/python_script.h"
@@ -63,6 +64,11 @@ void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
       ->capture_default_str();
   AddSuspectEffectOption(app, &args->options.suspect_effect_limit);
   app.add_flag("--no-report", args->no_report, "Write result.json only (no report.html)");
+  app.add_flag("--residuals-csv",
+               args->residuals_csv,
+               "Write each adjustment's per-observation residual table as "
+               "residuals_<adjustment>.csv beside result.json (named there with its SHA-256) "
+               "instead of inside it: a big flight's result.json stays small");
   app.add_option(
       "--camera-format",
       args->camera_format,
@@ -134,6 +140,15 @@ int RunFlight(const FlightArgs& args) {
   const std::string json_path = set.Staged("result.json");
   nlohmann::json document = result.document;
   document["aerocal_version"] = AEROCAL_VERSION;
+  // The residual tables beside result.json, or none (a previous run's would not describe this).
+  const std::vector<std::string> tables = args.residuals_csv
+                                              ? SplitResidualTables(&document, set.staging())
+                                              : std::vector<std::string>{};
+  parts.insert(parts.end(), tables.begin(), tables.end());
+  for (const char* name : {"conventional", "self_calibration", "joint"})
+    if (std::find(tables.begin(), tables.end(), "residuals_" + std::string(name) + ".csv") ==
+        tables.end())
+      obsolete.push_back("residuals_" + std::string(name) + ".csv");
   WriteResult(json_path, "flight", document);
   // A calibrated camera is written only for a valid flight: a file that exists is one the next
   // flight may use (an old one in the folder is removed, so it cannot pass for this run's).

@@ -19,6 +19,7 @@ struct FlightArgs {
   std::string out, base, joint_model = "auto", camera_format, lab, self_calibration = "auto";
   std::vector<std::string> quality;  // `aerocal quality` results for the certificate
   bool no_report = false, certificate = false;
+  bool residuals_csv = false;  // residual tables as CSV beside result.json (observation_tables.h)
 };
 
 /// The options of `aerocal flight` on `app`, stored into `args`.

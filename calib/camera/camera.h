@@ -84,6 +84,9 @@ struct Camera {
   std::string name;
   CameraModelId model = Model::kId;  // the camera file's `model:` (default brown_fraser_10)
   double pixel_size_mm = 0.0;
+  /// Half-width of the pixel pitch's tolerance (the maker's +-, mm; a rectangular distribution),
+  /// when the camera file states one: a type-B component of a calibration's budget.
+  std::optional<double> pixel_size_tolerance_mm;
   int width_px = 0, height_px = 0;  // virtual image format
   /// The model's parameters in its table order and units (brown_fraser_10: c, x0, y0, K1, K2, K3,
   /// P1, P2, B1, B2); size CameraModelParamCount(model).

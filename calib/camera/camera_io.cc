@@ -111,6 +111,7 @@ Camera ParseCamera(const YAML::Node& root,
   if (!root.IsMap()) ThrowInputError({file, 1}, "a camera file is a YAML map");
   std::vector<std::string> allowed = {"name",
                                       "pixel_size_mm",
+                                      "pixel_size_tolerance_mm",
                                       "format_px",
                                       "interior",
                                       "interior_sigma",
@@ -138,6 +139,9 @@ Camera ParseCamera(const YAML::Node& root,
   if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
   camera.pixel_size_mm =
       YamlBounded(root["pixel_size_mm"], file, "pixel_size_mm", kMinPixelSizeMm, kMaxPixelSizeMm);
+  if (root["pixel_size_tolerance_mm"])
+    camera.pixel_size_tolerance_mm = YamlBounded(
+        root["pixel_size_tolerance_mm"], file, "pixel_size_tolerance_mm", 0, camera.pixel_size_mm);
   if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
   std::tie(camera.width_px, camera.height_px) = ReadFormat(root["format_px"], file);
   // The interior and its sigmas are keyed by the model's parameter table: a new model needs
@@ -219,6 +223,8 @@ std::string CameraToYaml(const Camera& camera) {
   out << YAML::Key << "name" << YAML::Value << camera.name;
   out << YAML::Key << "model" << YAML::Value << std::string(CameraModelName(camera.model));
   out << YAML::Key << "pixel_size_mm" << YAML::Value << camera.pixel_size_mm;
+  if (camera.pixel_size_tolerance_mm)
+    out << YAML::Key << "pixel_size_tolerance_mm" << YAML::Value << *camera.pixel_size_tolerance_mm;
   out << YAML::Key << "format_px" << YAML::Value << YAML::Flow << YAML::BeginSeq << camera.width_px
       << camera.height_px << YAML::EndSeq;
   const std::vector<ParamInfo> table = camera.Params();

@@ -39,6 +39,12 @@ TEST(CameraIo, WriteThenReadGivesTheSameCamera) {
   const Camera b = ReadCamera(dir.File("cam.yaml"));
   EXPECT_EQ(b.name, a.name);
   EXPECT_EQ(b.pixel_size_mm, a.pixel_size_mm);
+  EXPECT_FALSE(b.pixel_size_tolerance_mm.has_value());
+  // The pitch's tolerance (a type-B component of calibrate's budget) is kept when stated.
+  Camera with_tolerance = a;
+  with_tolerance.pixel_size_tolerance_mm = 2.5e-5;
+  WriteCamera(dir.File("tol.yaml"), with_tolerance);
+  EXPECT_EQ(ReadCamera(dir.File("tol.yaml")).pixel_size_tolerance_mm, 2.5e-5);
   EXPECT_EQ(b.width_px, a.width_px);
   EXPECT_EQ(b.height_px, a.height_px);
   for (int i = 0; i < BrownFraser10Model::kNumParams; ++i) {
@@ -94,6 +100,8 @@ TEST(CameraIo, BadFilesNameFileAndLine) {
               "subimage: II, u: 1, v: 1, U: 1, V: 1}\n",
        ":8: reference point A names unknown sub-image 'II'"},
       {base + "interior_sigma: {c: 0}\n", ":5: interior_sigma.c must be > 0"},
+      {base + "pixel_size_tolerance_mm: 0.01\n",
+       ":5: pixel_size_tolerance_mm out of range (got 0.01"},
       {"pixel_size_mm: [0.009\n", ":2: invalid YAML"},
   };
   for (const auto& c : cases) {

@@ -227,7 +227,10 @@ TEST_F(OlympusCalibration, PublishedDbatValuesWithinThreeSigmaAndGroupStability)
 }
 
 TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
-  const auto r = RunAerocal(Calibrate("--out " + tmp_.File("oly.json")));
+  // The pitch's tolerance from the budget file: a type-B component of every length (issue 33).
+  WriteText(tmp_.File("budget.yaml"), "pixel_size_tolerance_mm: 3.2e-6\n");
+  const auto r = RunAerocal(
+      Calibrate("--budget " + tmp_.File("budget.yaml") + " --out " + tmp_.File("oly.json")));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   WriteText(tmp_.File("lab.yaml"),
             "lab: {name: Test Lab, address: 1 Road, accreditation: none}\n"
@@ -259,8 +262,24 @@ TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
                            "Check points",
                            "Comparison with the previous certificate",
                            "Signatures",
-                           "c = 7.457"})
+                           "c = 7.457",
+                           // the budget's components and where each comes from
+                           "Sources of the components",
+                           "Type A (statistical, from this calibration&#x27;s data): image "
+                           "measurements",
+                           "<td>control coordinates</td><td>B</td>",
+                           "survey sigmas of",
+                           "<td>pixel pitch</td><td>B</td>",
+                           "stated in the budget file"})
     EXPECT_NE(html.find(text), std::string::npos) << text;
+  // c's pitch component: c 7.457 mm times 3.2e-6 / 0.00319 / sqrt 3 (0.1 % of the pitch).
+  for (const auto& q : cert["results"])
+    if (q["quantity"] == "c")
+      for (const auto& comp : q["components"])
+        if (comp["source"] == "pixel pitch")
+          EXPECT_NEAR(comp["u"].get<double>(),
+                      q["value"].get<double>() * 3.2e-6 / 0.0031911032863849768 / std::sqrt(3.0),
+                      1e-9);
   // Deterministic: a second run writes the same bytes.
   const auto c2 = RunAerocal(args + " --out " + tmp_.File("cert2"));
   ASSERT_EQ(c2.exit_code, 0) << c2.output;

@@ -141,17 +141,20 @@ TEST(CalibrateDirections, CollimatorArrayRecoversTheInteriorWithinThreeSigmaAndS
     EXPECT_LE(std::abs(error), 3.0 * sigma) << "opk " << a;
   }
   EXPECT_NEAR(cal["start"]["opk_deg"][2].get<double>(), 3.0, 0.1);
-  // The budget of c: the adjustment's covariance (the directions' sigmas are in it) and the
-  // --budget file's type-B component (0.6 um rectangular: 0.6e-3 / sqrt(3) mm).
+  // The budget of c: the adjustment's covariance (the directions' sigmas are in it), the pixel
+  // pitch (zero: no tolerance stated) and the --budget file's type-B component (0.6 um
+  // rectangular: 0.6e-3 / sqrt(3) mm).
   bool has_c = false;
   for (const auto& q : cal["uncertainty"])
     if (q["quantity"] == "c") {
       has_c = true;
-      ASSERT_EQ(q["components"].size(), 2u) << q.dump();
+      ASSERT_EQ(q["components"].size(), 3u) << q.dump();
       const double sigma = j["cameras"][0]["sigma"]["c"].get<double>();
       EXPECT_NEAR(q["components"][0]["u"].get<double>(), sigma, 1e-9 * sigma);
-      EXPECT_EQ(q["components"][1]["type"], "B");
-      EXPECT_NEAR(q["components"][1]["u"].get<double>(), 0.6e-3 / std::sqrt(3.0), 1e-12);
+      EXPECT_EQ(q["components"][1]["source"], "pixel pitch");
+      EXPECT_EQ(q["components"][1]["u"].get<double>(), 0.0);
+      EXPECT_EQ(q["components"][2]["type"], "B");
+      EXPECT_NEAR(q["components"][2]["u"].get<double>(), 0.6e-3 / std::sqrt(3.0), 1e-12);
       EXPECT_NEAR(q["u_c"].get<double>(), std::hypot(sigma, 0.6e-3 / std::sqrt(3.0)), 1e-9 * sigma);
     }
   EXPECT_TRUE(has_c);

@@ -2,10 +2,13 @@
 // keys of every step, the calibrated camera is written, and report.html holds the tables and plots.
 #include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
+#include "calib/core/error.h"
+#include "calib/core/file_digest.h"
 #include "calib/core/result_file.h"
 #include "stitch/image_io/image_io.h"
 #include "tests/support/rendered_targets.h"
 #include "tests/support/test_support.h"
+#include "tools/observation_tables.h"
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -315,10 +318,13 @@ TEST_F(FlightWorkflow, AutoSelfCalibrationCheckPointTestAndCameraOrigin) {
 // flight runs several adjustments in one process, and the reduced system's layout once followed
 // heap addresses (calib/problem/problem_builder.cc, the Ceres ordering).
 TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
+  // The second run writes its residual tables as CSV beside result.json (--residuals-csv): read
+  // back, they must be the first run's inline arrays to the bit.
   for (const char* out : {"once", "again"}) {
+    const std::string tables = std::string(out) == "again" ? " --residuals-csv" : "";
     const auto r = testing::RunAerocal("flight --camera " + dir_->File("data/camera_nominal.yaml") +
-                                       " --data " + dir_->File("data") +
-                                       " --base III,IV --no-report --out " + dir_->File(out));
+                                       " --data " + dir_->File("data") + " --base III,IV" + tables +
+                                       " --no-report --out " + dir_->File(out));
     ASSERT_EQ(r.exit_code, 0) << r.output;
   }
   std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& j) {
@@ -332,6 +338,21 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
   };
   auto first = aerocal::testing::ReadJson(dir_->File("once/result.json"));
   auto second = aerocal::testing::ReadJson(dir_->File("again/result.json"));
+  testing::ExpectValidResult(second, dir_->File("again/result.json"));
+  for (const auto& a : second["adjustments"]) {
+    const std::string name = a["name"];
+    ASSERT_FALSE(a.contains("residuals")) << name;
+    ASSERT_TRUE(a.contains("residuals_file")) << name;
+    EXPECT_EQ(a["residuals_file"]["path"], "residuals_" + name + ".csv");
+    EXPECT_EQ(a["residuals_file"]["sha256"],
+              Sha256Hex(ReadTextFile(dir_->File("again/residuals_" + name + ".csv"))));
+  }
+  // This flight's adjustments' residual tables are about half of its result.json (measured:
+  // 10.7 MB inline, 5.6 MB with the tables beside it; the rest is mostly the stitching frames'
+  // residuals, which stay inline).
+  EXPECT_LT(std::filesystem::file_size(dir_->File("again/result.json")),
+            0.6 * std::filesystem::file_size(dir_->File("once/result.json")));
+  tools::InflateResidualTables(&second, dir_->File("again/result.json"));
   strip(first);
   strip(second);
   // The numbers of every step, to the last bit (issue 33 item 7: a lab checksums its re-runs; paths
@@ -369,6 +390,47 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
   }
   EXPECT_EQ(ReadTextFile(dir_->File("once/camera_calibrated.yaml")),
             ReadTextFile(dir_->File("again/camera_calibrated.yaml")));
+  // The Python readers (report_data.load, here through `export --tables`) see the same residuals.
+  for (const char* out : {"once", "again"}) {
+    const auto e =
+        testing::RunAerocal("export --result " + dir_->File(std::string(out) + "/result.json") +
+                            " --tables " + dir_->File(std::string(out) + "_tables"));
+    ASSERT_EQ(e.exit_code, 0) << e.output;
+  }
+  for (const char* name : {"conventional", "self_calibration", "joint"})
+    EXPECT_EQ(ReadTextFile(dir_->File(std::string("once_tables/") + name + "/residuals.csv")),
+              ReadTextFile(dir_->File(std::string("again_tables/") + name + "/residuals.csv")))
+        << name;
+  // A table changed after the run is refused by its checksum.
+  WriteFileAtomically(dir_->File("again/residuals_joint.csv"),
+                      ReadTextFile(dir_->File("again/residuals_joint.csv")) + "\n");
+  const auto changed = testing::RunAerocal("export --result " + dir_->File("again/result.json") +
+                                           " --tables " + dir_->File("changed_tables"));
+  EXPECT_EQ(changed.exit_code, 2) << changed.output;
+  EXPECT_NE(changed.output.find("residuals_joint.csv: SHA-256 differs"), std::string::npos)
+      << changed.output;
+}
+
+TEST(ResidualTables, EveryValueReadsBackAndQuotedTextSurvives) {
+  // Untested and tested entries, a null w, a sub-image, a reason with commas and quotes.
+  const nlohmann::json residuals = nlohmann::json::parse(R"([
+    {"image": "A", "point": "P1", "col": 100.0, "row": 0.1, "v_col_px": 0.30000000000000004,
+     "v_row_px": -1e-300, "sigma_px": 0.5, "used": true},
+    {"image": "B", "point": "P,2", "col": 1.5, "row": 2.5, "v_col_px": 0.0, "v_row_px": 0.0,
+     "sigma_px": 0.25, "used": false, "subimage": "III", "u": 10.25, "v": 20.5, "head": "h1",
+     "r": [0.5, 0.0], "w_xy": [3.5, null], "mdb_sigma": [4.1, null], "mdb_px": [2.0, null],
+     "group_size": 2, "verdict": "rejected", "reason": "w = 3.5 > 3.29, \"gross\" error"}
+  ])");
+  const std::string csv = tools::ResidualTableCsv(residuals);
+  EXPECT_EQ(tools::ResidualTableFromCsv(csv, "t.csv"), residuals) << csv;
+  EXPECT_NE(csv.find("\"P,2\""), std::string::npos) << csv;
+  // A row with a field too few is refused with its line.
+  try {
+    tools::ResidualTableFromCsv(csv.substr(0, csv.rfind(',')) + "\n", "t.csv");
+    ADD_FAILURE() << "a short row was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("t.csv:3:"), std::string::npos) << e.what();
+  }
 }
 
 TEST(FlightWorkflowInput, MissingProjectIsABadInput) {

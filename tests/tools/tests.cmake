@@ -2,6 +2,7 @@ aerocal_add_test(tools/cli_simulate LIBS aerocal::triangulation LABELS cli)
 # `aerocal rig stitch` (issue 16) on a simulated uav4 line.
 aerocal_add_test(tools/cli_rig_stitch LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/cli_flight LIBS aerocal::stitch LABELS cli TIMEOUT 600)
+target_sources(test_tools_cli_flight PRIVATE ${PROJECT_SOURCE_DIR}/tools/observation_tables.cc)
 include(${CMAKE_CURRENT_SOURCE_DIR}/tools/report.cmake)
 include(${CMAKE_CURRENT_SOURCE_DIR}/tools/report_outputs.cmake)
 aerocal_add_test(tools/bad_input LIBS aerocal::triangulation LABELS cli)

@@ -80,6 +80,8 @@ TEST(BudgetReader, BadFilesNameTheirLine) {
       {"radii_mm: [2.0, -1]\n", "budget.yaml:1"},
       {"radii_mm: [2.0, 1e308]\n", "budget.yaml:1"},
       {"components: [\n", "budget.yaml"},
+      {"radii_mm: [2.0]\npixel_size_tolerance_mm: -1e-6\n",
+       "budget.yaml:2: pixel_size_tolerance_mm out of range"},
   };
   for (const auto& k : cases) {
     SCOPED_TRACE(k.text);

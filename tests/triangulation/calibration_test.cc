@@ -5,6 +5,8 @@
 #include "triangulation/calibration/calibration.h"
 
 #include "calib/camera/rotation.h"
+#include "calib/core/error.h"
+#include "calib/core/string_printf.h"
 #include "tests/support/interior_checks.h"
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
@@ -16,6 +18,7 @@
 
 #include <cmath>
 #include <fstream>
+#include <map>
 #include <random>
 
 namespace aerocal::triangulation {
@@ -313,13 +316,14 @@ TEST(Calibrate, SimulatedTestFieldRecoversTheTruthAndItsGroupsAgree) {
   ASSERT_EQ(run.groups.size(), 3u);
   EXPECT_TRUE(run.stability.agree)
       << (run.stability.flagged.empty() ? "" : run.stability.flagged[0]);
-  ASSERT_TRUE(run.control_fixed);
+  ASSERT_GT(run.all.control_cofactor.size(), 0);
   // The budget: c with its components, U = k u_c, and the check points' accuracy.
   const auto budget = UncertaintyBudget(run, run.project, {{10.0}, 5.0, {}});
   const auto q =
       std::find_if(budget.begin(), budget.end(), [](const auto& b) { return b.name == "c"; });
   ASSERT_NE(q, budget.end());
-  ASSERT_EQ(q->components.size(), 4u);  // adjustment, groups, control, eccentricity
+  // image measurements, groups, control, eccentricity, pixel pitch (zero: no tolerance stated)
+  ASSERT_EQ(q->components.size(), 5u);
   double sum = 0;
   for (const auto& comp : q->components) sum += comp.u * comp.u;
   EXPECT_NEAR(q->u_c, std::sqrt(sum), 1e-15);
@@ -329,6 +333,147 @@ TEST(Calibrate, SimulatedTestFieldRecoversTheTruthAndItsGroupsAgree) {
       std::any_of(budget.begin(), budget.end(), [](const auto& b) { return b.name == "m_Z"; }));
   EXPECT_TRUE(
       std::any_of(budget.begin(), budget.end(), [](const auto& b) { return b.name == "dr@10"; }));
+}
+
+// The control coordinates' component by the GUM's law of propagation written out (JCGM 100
+// 5.1.2, the sensitivities found numerically as 5.1.3 allows): u^2 = sum_j (dq/dX_j s_j)^2 over
+// every control coordinate X_j with survey sigma s_j, dq/dX_j measured by moving X_j and adjusting
+// again. This shares nothing with the budget's covariance split but the adjustment itself.
+struct Propagated {
+  double c = 0, x0 = 0, y0 = 0;  // u of the control coordinates, mm
+};
+
+Propagated PropagateControlBySensitivities(const CalibrationRun& run,
+                                           const AdjustOptions& options) {
+  Project base = run.project;  // started at the solution: each re-adjustment takes few steps
+  base.cameras.begin()->second.interior = run.all.result.cameras[0].estimated;
+  for (auto& e : base.exposures)
+    for (const auto& a : run.all.result.exposures)
+      if (a.image == e.image) {
+        e.center_m = a.center_m;
+        e.opk_rad = a.opk_rad;
+      }
+  const auto estimate = [&](const Project& p) {
+    return RunCalibrationAdjustment(p, options).result.cameras[0].estimated;
+  };
+  const calib::InteriorParams at = estimate(base);
+  // 2 mm, four survey sigmas: the response is linear to ~1e-4 (2 mm over 15 m) and far above
+  // the solver's tolerances.
+  constexpr double kStepM = 0.002;
+  Propagated sum;
+  for (size_t j = 0; j < base.points.size(); ++j) {
+    if (base.points[j].role != PointRole::kControl) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      Project moved = base;
+      (*moved.points[j].xyz_m)(axis) += kStepM;
+      const calib::InteriorParams p = estimate(moved);
+      const double s = base.points[j].sigma_m(axis) / kStepM;
+      sum.c += std::pow((p[Model::kC] - at[Model::kC]) * s, 2);
+      sum.x0 += std::pow((p[Model::kX0] - at[Model::kX0]) * s, 2);
+      sum.y0 += std::pow((p[Model::kY0] - at[Model::kY0]) * s, 2);
+    }
+  }
+  return {std::sqrt(sum.c), std::sqrt(sum.x0), std::sqrt(sum.y0)};
+}
+
+const UncertaintyComponent& ComponentOf(const BudgetQuantity& q, const std::string& source) {
+  const auto it = std::find_if(
+      q.components.begin(), q.components.end(), [&](const auto& c) { return c.source == source; });
+  AEROCAL_CHECK(it != q.components.end()) << q.name << " has no component " << source;
+  return *it;
+}
+
+TEST(UncertaintyBudget, ControlSigmasPropagateAsTheirSensitivitiesSayAndDoubledTheyGrowU) {
+  const TestField f = SimulateTestField(7, 0.0);
+  CalibrateOptions options = TestFieldOptions();
+  options.adjust.free_interior = ParseSelfCalibration("c,x0,y0,K1,K2");
+  std::map<std::string, double> expanded_c;
+  for (const double scale : {1.0, 2.0}) {
+    SCOPED_TRACE(StringPrintf("control sigmas x %g", scale));
+    Project project = f.project;
+    for (auto& p : project.points)
+      if (p.role == PointRole::kControl) p.sigma_m *= scale;
+    const CalibrationRun run = Calibrate(project, options, {});
+    ASSERT_TRUE(run.all.result.valid);
+    ASSERT_GT(run.all.control_cofactor.size(), 0);
+    const auto budget = UncertaintyBudget(run, run.project, {});
+    const Propagated independent = PropagateControlBySensitivities(run, options.adjust);
+    const AdjustmentResult& r = run.all.result;
+    const double sigma0 = r.sigma0;
+    const std::map<std::string, std::pair<int, double>> checked = {
+        {"c", {Model::kC, independent.c}},
+        {"x0", {Model::kX0, independent.x0}},
+        {"y0", {Model::kY0, independent.y0}}};
+    for (const auto& [name, index_and_u] : checked) {
+      const auto q =
+          std::find_if(budget.begin(), budget.end(), [&](const auto& b) { return b.name == name; });
+      ASSERT_NE(q, budget.end());
+      const double u_control = ComponentOf(*q, "control coordinates").u;
+      // The budget's derivative of the covariance against the re-adjustments' sensitivities:
+      // 2 % covers the finite steps of both (relative errors ~1e-3 and ~1e-4).
+      EXPECT_NEAR(u_control, index_and_u.second, 0.02 * index_and_u.second) << name;
+      EXPECT_GT(u_control, 0.0) << name;
+      // u_c^2 = sigma0^2 g^T Q g (the adjustment's own sigma, image and control sigmas both
+      // scaled by sigma0) + (1 - sigma0^2) u_control^2 (the control sigmas are taken as stated):
+      // what the combined uncertainty must be, from the adjustment's reported sigma and the
+      // independent control part; the pixel pitch (no tolerance) adds nothing.
+      const double sigma = r.cameras[0].sigma[index_and_u.first];
+      const double u_c =
+          std::sqrt(sigma * sigma + (1 - sigma0 * sigma0) * std::pow(index_and_u.second, 2));
+      EXPECT_NEAR(q->u_c, u_c, 0.01 * u_c) << name;
+      EXPECT_NEAR(q->expanded, q->k * q->u_c, 1e-15) << name;
+      EXPECT_EQ(ComponentOf(*q, "pixel pitch").u, 0.0);
+      if (name == "c") expanded_c[StringPrintf("%g", scale)] = q->expanded;
+    }
+  }
+  // Doubled survey sigmas weaken the control: U of c grows (by the amounts checked above).
+  EXPECT_GT(expanded_c["2"], expanded_c["1"]);
+}
+
+TEST(UncertaintyBudget, APixelPitchToleranceScalesTheLengthsAndTheBudgetFileReplacesIt) {
+  const TestField f = SimulateTestField(7, 0.0);
+  CalibrateOptions options = TestFieldOptions();
+  options.adjust.free_interior = ParseSelfCalibration("c,x0,y0,K1,K2");
+  options.control_propagation = false;
+  Project project = f.project;
+  project.cameras.begin()->second.pixel_size_tolerance_mm = 6e-6;  // 0.1 % of 0.006 mm
+  const CalibrationRun run = Calibrate(project, options, {});
+  BudgetOptions with_radius;
+  with_radius.radii_mm = {10.0};
+  const auto budget = UncertaintyBudget(run, run.project, with_radius);
+  const calib::InteriorParams& p = run.all.result.cameras[0].estimated;
+  const auto u_of = [&](const std::string& name) {
+    const auto q =
+        std::find_if(budget.begin(), budget.end(), [&](const auto& b) { return b.name == name; });
+    AEROCAL_CHECK(q != budget.end()) << name;
+    return ComponentOf(*q, "pixel pitch").u;
+  };
+  // A pitch 0.1 % off scales every photo length by 0.1 %: u = |length| 1e-3 / sqrt(3).
+  const double rel = 1e-3 / std::sqrt(3.0);
+  EXPECT_NEAR(u_of("c"), p[Model::kC] * rel, 1e-9);
+  EXPECT_NEAR(u_of("x0"), std::abs(p[Model::kX0]) * rel, 1e-9);
+  // K1 [mm^-2] scales by s^-2; dr(10 mm) = 10 (K1 100 + K2 1e4) mm with K1' = K1 / s^2,
+  // K2' = K2 / s^4 at the fixed radius: d dr / ds = -2 K1 1e3 - 4 K2 1e5 (mm), in um.
+  EXPECT_NEAR(u_of("K1"), 2 * std::abs(p[Model::kK1]) * rel, 1e-12);
+  const double ddr_ds_um = 1e3 * (-2 * p[Model::kK1] * 1e3 - 4 * p[Model::kK2] * 1e5);
+  EXPECT_NEAR(u_of("dr@10"), std::abs(ddr_ds_um) * rel, 1e-6 * std::abs(ddr_ds_um));
+  // The budget file's component of the same name replaces aerocal's.
+  BudgetOptions user = with_radius;
+  UserComponent pitch;
+  pitch.quantity = "c";
+  pitch.source = "Pixel Pitch";
+  pitch.value = 0.004;
+  pitch.where = "budget.yaml:3";
+  user.user.push_back(pitch);
+  const auto replaced = UncertaintyBudget(run, run.project, user);
+  const auto c =
+      std::find_if(replaced.begin(), replaced.end(), [](const auto& b) { return b.name == "c"; });
+  ASSERT_NE(c, replaced.end());
+  int named = 0;
+  for (const auto& comp : c->components)
+    named += comp.source == "pixel pitch" || comp.source == "Pixel Pitch";
+  EXPECT_EQ(named, 1);
+  EXPECT_NEAR(ComponentOf(*c, "Pixel Pitch").u, 0.004, 1e-15);
 }
 
 TEST(Calibrate, AGroupWhoseCameraChangedIsFlagged) {

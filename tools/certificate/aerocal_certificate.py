@@ -101,6 +101,22 @@ def budget_rows(c):
     return rows
 
 
+def source_rows(c):
+    """Where each component comes from (ISO/IEC 17025 7.8.4 / GUM 7.2.7: every source named), once per
+    kind of component; a component without an `origin` (an older result) says so."""
+    rows = [["component", "type", "quantities", "where it comes from"]]
+    seen = {}
+    for q in c["results"]:
+        for comp in q["components"]:
+            key = (comp["source"], comp["type"], comp.get("origin") or "not stated (older result)")
+            seen.setdefault(key, []).append(q["quantity"])
+    for (source, kind, origin), quantities in seen.items():
+        names = ", ".join(quantities) if len(quantities) <= 6 else "%s, ... (%d)" % (
+            ", ".join(quantities[:5]), len(quantities))
+        rows.append([source, kind, names, origin])
+    return rows
+
+
 def stability_rows(c):
     s = c.get("stability") or {}
     groups = c.get("groups") or []
@@ -365,16 +381,28 @@ def warning_lines(c):
 
 
 def type_a_note(c):
-    """What is type A only, said in the document (not only in the JSON)."""
+    """What is type A only and which type B components were found empty, said in the document (not
+    only in the JSON)."""
     kinds = {comp["type"] for q in c["results"] for comp in q["components"]
              if comp.get("u") and comp["u"] > 0}
     if kinds == {"A"}:
         return ("This budget holds type A components only (the adjustment's statistics): no type B "
                 "component is known for this calibration (give a budget file: aerocal calibrate --budget).")
-    zero_b = sorted({comp["source"] for q in c["results"] for comp in q["components"]
-                     if comp["type"] == "B" and not comp.get("u")})
-    return ("Type B components of zero size (their source gave no uncertainty): %s." % "; ".join(zero_b)
-            if zero_b else "")
+    type_a = sorted({comp["source"] for q in c["results"] for comp in q["components"] if comp["type"] == "A"})
+    zero_b = sorted({"%s (%s)" % (comp["source"], comp["origin"]) if comp.get("origin") else comp["source"]
+                     for q in c["results"] for comp in q["components"]
+                     if comp["type"] == "B" and not comp.get("u") and not is_independent(comp)})
+    note = ("Type A (statistical, from this calibration's data): %s; every other component is type B "
+            "(the table below says where each comes from)." % ", ".join(type_a)) if type_a else ""
+    if zero_b:
+        note += " Type B components of zero size (their source gave no uncertainty): %s." % "; ".join(zero_b)
+    return note.strip()
+
+
+def is_independent(comp):
+    """A type B component the quantity does not depend on (sensitivity 0: a quantity in pixels and the
+    pixel pitch) is no missing source."""
+    return comp.get("sensitivity") == 0 and comp.get("value")
 
 
 # ---------------------------------------------------------------- figures
@@ -502,6 +530,7 @@ def page_html(c, figures):
               "<ul>" + "".join("<li>%s</li>" % html.escape(q["statement"]) for q in c["results"]) + "</ul>",
               html_table(result_rows(c)),
               "<h2>3. Uncertainty budget</h2>", "<p>%s</p>" % html.escape(type_a_note(c)), html_table(budget_rows(c)),
+              "<h3>Sources of the components</h3>", html_table(source_rows(c)),
              "<h2>4. Distortion</h2>", figures["distortion"],
              "<h2>5. Residuals and correlations</h2>", figures["residuals"]]
     st = stability_rows(c)
@@ -621,7 +650,9 @@ def write_pdf_pages(c, tmp, title):
                   ("2. Results (U = k u_c, ISO GUM / JJF 1059.1)", statements),
                   ("", result_rows(c)),
                   ("3. Uncertainty budget", [[line] for line in textwrap.wrap(type_a_note(c), 150)] or [[""]]),
-                  ("", budget_rows(c))]
+                  ("", budget_rows(c)),
+                  ("Sources of the components", [[r[0], r[1], r[2], line] for r in source_rows(c)
+                                                  for line in (textwrap.wrap(r[3], 90) or [""])])]
         if is_draft(c):
             blocks.insert(0, ("DRAFT: no laboratory file (--lab): not a calibration certificate", [[""]]))
         for fig in text_pages(title, blocks):

@@ -6,8 +6,12 @@ is shown as "not available" instead of stopping the report. Only keys of the res
 spelling: tests/tools/schema_keys_test.py records every key the report looks up and fails on one
 the schema does not list.
 """
+import csv
+import hashlib
+import io
 import json
 import math
+import os
 
 # The 10-parameter model's table (CONVENTIONS.md): name, unit.
 INTERIOR_PARAMETERS = [("c", "mm"), ("x0", "mm"), ("y0", "mm"), ("K1", "mm^-2"), ("K2", "mm^-4"),
@@ -44,7 +48,77 @@ def load(path):
     if doc.get("schema_version") != SCHEMA_VERSION or isinstance(doc.get("schema_version"), bool):
         raise InputError(f"{path}: schema_version is {json.dumps(doc.get('schema_version'))}, "
                          f"expected {SCHEMA_VERSION} (kind {json.dumps(doc.get('kind'))})")
-    return as_flight_document(doc) if doc["kind"] == "adjust" else doc
+    if doc["kind"] == "adjust":
+        return as_flight_document(doc)
+    inflate_residual_tables(doc, path)  # `flight --residuals-csv`: only a flight writes them
+    return doc
+
+
+# The columns of a residuals_<adjustment>.csv (tools/observation_tables.h, the writer's table):
+# CSV name, JSON key, element of a pair (None: the value itself), type, whether the key exists only
+# for a tested observation (group_size filled).
+RESIDUAL_COLUMNS = [("image", "image", None, str, False), ("point", "point", None, str, False),
+                    ("col", "col", None, float, False), ("row", "row", None, float, False),
+                    ("v_col_px", "v_col_px", None, float, False), ("v_row_px", "v_row_px", None, float, False),
+                    ("sigma_px", "sigma_px", None, float, False), ("used", "used", None, bool, False),
+                    ("subimage", "subimage", None, str, False), ("u", "u", None, float, False),
+                    ("v", "v", None, float, False), ("head", "head", None, str, False),
+                    ("group_size", "group_size", None, int, True), ("verdict", "verdict", None, str, True),
+                    ("r_x", "r", 0, float, True), ("r_y", "r", 1, float, True),
+                    ("w_x", "w_xy", 0, float, True), ("w_y", "w_xy", 1, float, True),
+                    ("mdb_sigma_x", "mdb_sigma", 0, float, True), ("mdb_sigma_y", "mdb_sigma", 1, float, True),
+                    ("mdb_px_x", "mdb_px", 0, float, True), ("mdb_px_y", "mdb_px", 1, float, True),
+                    ("reason", "reason", None, str, False)]
+
+
+def residual_rows(text, where):
+    """The residual entries of a residuals_<adjustment>.csv text, as the result's JSON held them."""
+    reader = csv.reader(io.StringIO(text, newline=""))
+    header = next(reader, None)
+    names = [c[0] for c in RESIDUAL_COLUMNS]
+    if header != names:
+        raise InputError(f"{where}:1: not a residual table (expected the header {','.join(names)})")
+    out = []
+    for fields in reader:
+        if not fields:
+            continue
+        if len(fields) != len(names):
+            raise InputError(f"{where}:{reader.line_num}: {len(fields)} fields (expected {len(names)})")
+        tested = fields[12] != ""
+        entry = {}
+        for (name, key, element, kind, only_tested), f in zip(RESIDUAL_COLUMNS, fields):
+            if only_tested and not tested:
+                continue
+            try:
+                value = (None if f == "" and kind is not str else (f == "true") if kind is bool
+                         else kind(float(f)) if kind is int else kind(f))
+            except ValueError:
+                raise InputError(f"{where}:{reader.line_num}: {name} is not a number ({f!r})")
+            if element is not None:
+                entry.setdefault(key, [None, None])[element] = value if f != "" else None
+            elif f != "" or (only_tested and kind is str):
+                entry[key] = value
+        out.append(entry)
+    return out
+
+
+def inflate_residual_tables(doc, path):
+    """`flight --residuals-csv`: each adjustment's `residuals_file` read back (beside the result,
+    SHA-256 checked) into its `residuals`, so every reader sees one document."""
+    for a in doc.get("adjustments") or []:
+        spec = a.get("residuals_file") if isinstance(a, dict) else None
+        if not isinstance(spec, dict):
+            continue
+        table = os.path.join(os.path.dirname(path), str(spec.get("path")))
+        try:
+            with open(table, "rb") as f:
+                data = f.read()
+        except OSError as e:
+            raise InputError(f"{table}: cannot read the residual table {path} names ({e.strerror})")
+        if hashlib.sha256(data).hexdigest() != spec.get("sha256"):
+            raise InputError(f"{table}: SHA-256 differs from the one {path} states")
+        a["residuals"] = residual_rows(data.decode("utf-8"), table)
+        del a["residuals_file"]
 
 
 def as_flight_document(doc):

@@ -352,6 +352,35 @@ void BlockAdjustment::AddImageResiduals(const calib::LossOptions& loss) {
   }
 }
 
+void BlockAdjustment::ScaleControlWeights(double weight) {
+  AEROCAL_CHECK(weight > 0) << "control weight factor " << weight;
+  const double k = 1.0 / std::sqrt(weight);
+  std::map<calib::ResidualId, std::pair<PointIndex, const char*>> scaled;
+  for (const auto& [id, survey] : storage_->control_of_residual) {
+    if (!builder_.IsActive(id)) {  // left out by snooping: stays out
+      scaled[id] = survey;
+      continue;
+    }
+    const auto& state = storage_->points[survey.first];
+    const Eigen::Vector3d& xyz = *state.ground->xyz_m;
+    const Eigen::Vector3d s = state.ground->sigma_m * k;
+    const bool plan = survey.second == kSurveyPlan;
+    auto cost =
+        plan
+            ? std::make_unique<calib::PriorCostFunction>(3,
+                                                         std::vector<int>{0, 1},
+                                                         std::vector<double>{xyz.x(), xyz.y()},
+                                                         std::vector<double>{s.x(), s.y()})
+            : std::make_unique<calib::PriorCostFunction>(
+                  3, std::vector<int>{2}, std::vector<double>{xyz.z()}, std::vector<double>{s.z()});
+    const std::string label = builder_.ResidualLabel(id);
+    builder_.RemoveResidual(id);
+    scaled[builder_.AddResidual(calib::kGroupControl, std::move(cost), {state.block}, label)] =
+        survey;
+  }
+  storage_->control_of_residual = std::move(scaled);
+}
+
 void BlockAdjustment::AddPriors() {
   for (PointIndex p = 0; p < static_cast<PointIndex>(storage_->points.size()); ++p) {
     const auto& state = storage_->points[p];

@@ -102,6 +102,11 @@ class BlockAdjustment {
   /// own model through the registry). nullopt when its exposure or point has no block here, or
   /// the ray misses (behind the camera, the model's inversion fails).
   std::optional<Eigen::Vector2d> ResidualAtCurrentValues(const ImageObservation& observation);
+  /// After Run(): every active control observation's weight times `weight` (> 0; its sigmas over
+  /// sqrt(weight), from the survey's, so 1 restores them) at the current values, nothing solved:
+  /// the covariance then taken is Q(t) = (N_image + t N_control)^-1 at the same linearisation
+  /// (the control part of the budget, triangulation/calibration/uncertainty_budget.h).
+  void ScaleControlWeights(double weight);
   /// With options.auto_robust_start: Run() returns right after the first solve, with
   /// robust_start_needed set, when its residuals call for a robust start (Adjust() uses it).
   void StopWhenRobustStartNeeded(bool stop) { stop_for_robust_start_ = stop; }

@@ -17,8 +17,6 @@ using Model = calib::BrownFraser10Model;
 
 // Largest relative change of c the closed form may make to the camera file's value.
 constexpr double kClosedFormFactor = 2.0;
-// Control sigmas of the "fixed" comparison run, relative to the survey's.
-constexpr double kFixedControlScale = 1e-3;
 
 Project Subset(const Project& project, const std::set<std::string>& images) {
   Project out = project;
@@ -46,7 +44,8 @@ double ChiSquareQuantile(double p, int dof) {
 }
 
 CalibrationAdjustment RunCalibrationAdjustment(const Project& project,
-                                               const AdjustOptions& options) {
+                                               const AdjustOptions& options,
+                                               bool control_cofactor) {
   CalibrationAdjustment out;
   BlockAdjustment adjustment(project, options);
   out.result = adjustment.Run();
@@ -56,9 +55,18 @@ CalibrationAdjustment RunCalibrationAdjustment(const Project& project,
       out.result.determinability.covariance_ok) {
     const calib::CovarianceReport cov =
         adjustment.builder().EstimateCovariance({block}, out.result.sigma0);
-    if (cov.ok)
-      out.interior_covariance =
-          cov.BlockCovariance(block, project.cameras.begin()->second.interior.size());
+    const int size = project.cameras.begin()->second.interior.size();
+    if (cov.ok) out.interior_covariance = cov.BlockCovariance(block, size);
+    if (cov.ok && control_cofactor && out.result.sigma0 > 0) {
+      adjustment.ScaleControlWeights(1.0 - kControlWeightStep);
+      const calib::CovarianceReport step = adjustment.builder().EstimateCovariance({block}, 1.0);
+      adjustment.ScaleControlWeights(1.0);
+      const double s0 = out.result.sigma0;
+      if (step.ok)
+        out.control_cofactor =
+            (step.BlockCovariance(block, size) - out.interior_covariance / (s0 * s0)) /
+            kControlWeightStep;
+    }
   }
   return out;
 }
@@ -159,16 +167,12 @@ CalibrationRun Calibrate(const Project& input,
   run.starts = StartFromResections(project, run.camera);
   project.exposures.clear();
   for (const auto& s : run.starts) project.exposures.push_back(s.exposure);
-  run.all = RunCalibrationAdjustment(project, options.adjust);
   const bool has_control =
       std::any_of(project.points.begin(), project.points.end(), [](const auto& p) {
         return p.role == PointRole::kControl && p.xyz_m;
       });
-  if (options.control_propagation && has_control) {
-    Project fixed = project;
-    for (auto& p : fixed.points) p.sigma_m *= kFixedControlScale;
-    run.control_fixed = RunCalibrationAdjustment(fixed, options.adjust);
-  }
+  run.all =
+      RunCalibrationAdjustment(project, options.adjust, options.control_propagation && has_control);
 
   std::map<std::string, std::set<std::string>> groups;
   for (const auto& [image, group] : group_of_image) {

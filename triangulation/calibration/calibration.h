@@ -33,8 +33,9 @@ struct CalibrateOptions {
   /// when it is determined (within a factor of 2 of the file's value).
   bool closed_form_c = true;
   double stability_alpha = 0.05;  // level of the group agreement test, (0, 1)
-  /// Also adjust with the control sigmas 1000 times smaller (the type-B component of the control
-  /// coordinates in uncertainty_budget.h).
+  /// The part of the parameters' variance that comes from the control coordinates (the type-B
+  /// component of uncertainty_budget.h): CalibrationAdjustment::control_cofactor of the run on
+  /// all images.
   bool control_propagation = true;
 };
 
@@ -43,6 +44,10 @@ struct CalibrateOptions {
 struct CalibrationAdjustment {
   AdjustmentResult result;
   Eigen::MatrixXd interior_covariance;
+  /// Q N_control Q of the interior (table order and units, not scaled by sigma0): the part of
+  /// the cofactor matrix that the control coordinates' sigmas give (uncertainty_budget.h); empty
+  /// without control or unless asked for (RunCalibrationAdjustment).
+  Eigen::MatrixXd control_cofactor;
 };
 
 struct GroupCalibration {
@@ -70,6 +75,12 @@ struct StabilityReport {
   std::vector<std::string> flagged;  // one sentence per parameter out of agreement
 };
 
+/// Relative step of the control weights for CalibrationAdjustment::control_cofactor. At one
+/// linearisation (the solution) Q(t) = (N_image + t N_control)^-1 gives
+/// Q N_control Q = (Q(1 - d) - Q(1)) / d + O(d), with a relative error below d
+/// (Q^1/2 N_control Q^1/2 <= I) and far above the covariance's rounding at d = 1e-3.
+inline constexpr double kControlWeightStep = 1e-3;
+
 struct CalibrationRun {
   std::string camera;
   std::optional<double> closed_form_c_mm;  // Zhang's value, when determined
@@ -78,9 +89,6 @@ struct CalibrationRun {
   CalibrationAdjustment all;             // all images together: the certified result
   std::vector<GroupCalibration> groups;  // empty without groups
   StabilityReport stability;
-  /// The run on all images with the control (nearly) fixed; absent without control points or
-  /// without CalibrateOptions::control_propagation.
-  std::optional<CalibrationAdjustment> control_fixed;
   /// The calibrated block: the project with the resections as its exposures.
   Project project;
 };
@@ -93,9 +101,12 @@ CalibrationRun Calibrate(const Project& project,
                          const CalibrateOptions& options,
                          const std::map<std::string, std::string>& group_of_image);
 
-/// The adjustment of `project` as is (exposures given) with its interior covariance.
+/// The adjustment of `project` as is (exposures given) with its interior covariance and, with
+/// `control_cofactor`, the control part of its cofactor matrix (at the solution: the control
+/// weights times 1 - kControlWeightStep, the covariance again, the weights restored).
 CalibrationAdjustment RunCalibrationAdjustment(const Project& project,
-                                               const AdjustOptions& options);
+                                               const AdjustOptions& options,
+                                               bool control_cofactor = false);
 
 /// The stability table of the groups' estimates (see the header comment).
 StabilityReport GroupStability(const std::vector<GroupCalibration>& groups, double alpha);

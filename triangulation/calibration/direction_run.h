@@ -6,10 +6,8 @@
 //
 // The directions' angular sigmas (collimators, goniometer settings) are part of each
 // observation's a-priori covariance (DirectionCovarianceMm2), so the adjustment's covariance, the
-// budget's component "adjustment (sigma0 sqrt(Qxx))", already holds them; no `control_fixed` run is
-// made. (A run with the angular sigmas made small and its covariance subtracted would count them
-// twice, and its a-posteriori scaling by its own, larger sigma0 puts them back: measured, the
-// difference was 0 for c.)
+// budget's type-A component "image measurements", already holds them; no `control_cofactor` is
+// computed (a direction calibration has no control coordinates).
 //
 // What a direction run puts into the AdjustmentResult of each run: the solve report, sigma0 (and
 // in px: sigma0 times the RMS of the observations' a-priori focal-plane sigmas, which include the
@@ -34,7 +32,7 @@ struct DirectionRunOptions {
 };
 
 struct DirectionRun {
-  CalibrationRun run;        // all, groups, stability (no control_fixed: see the header comment)
+  CalibrationRun run;        // all, groups, stability (no control_cofactor: see the header comment)
   DirectionCalibration all;  // the rotation, the estimated targets, the residuals
   Eigen::Vector3d start_opk_rad = Eigen::Vector3d::Zero();  // StartRotationFromDirections
 };

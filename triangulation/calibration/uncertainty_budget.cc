@@ -11,8 +11,12 @@
 #include <Eigen/Dense>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
+#include <cstdlib>
 #include <functional>
+#include <optional>
+#include <string_view>
 
 namespace aerocal::triangulation {
 namespace {
@@ -127,6 +131,176 @@ double MaxEccentricityPx(const CalibrationRun& run, const Project& project, doub
   return max_mm / camera.pixel_size_mm;
 }
 
+// The parameters' covariance split by input: the GUM's law of propagation for the weighted
+// estimator x = Q A^T P l (Q = N^-1) with uncorrelated image and control observations gives
+// Cov(x) = Q A_i^T P_i S_i P_i A_i Q + Q A_c^T P_c S_c P_c A_c Q. The image sigmas are scaled by
+// the estimated sigma0 (S_i = sigma0^2 P_i^-1, type A), the control survey sigmas are taken as
+// stated (S_c = P_c^-1, type B): image part sigma0^2 Q N_i Q = sigma0^2 (Q - Q N_c Q), control
+// part Q N_c Q (CalibrationAdjustment::control_cofactor: with control weights t N_c at one
+// linearisation, dQ/dt = -Q N_c Q).
+struct CovarianceSplit {
+  Eigen::MatrixXd image;    // sigma0^2 Q N_i Q (all of sigma0^2 Q without the control part)
+  Eigen::MatrixXd control;  // Q N_c Q; empty without control
+};
+
+CovarianceSplit SplitCovariance(const CalibrationRun& run) {
+  CovarianceSplit split;
+  split.image = run.all.interior_covariance;
+  const Eigen::MatrixXd& control = run.all.control_cofactor;
+  const double s0 = run.all.result.sigma0;
+  if (!(s0 > 0) || split.image.size() == 0 || control.rows() != split.image.rows()) return split;
+  split.control = control;
+  split.image -= s0 * s0 * control;
+  return split;
+}
+
+// Length dimension of a parameter's unit: the photo coordinates (mm) scale with the pixel pitch,
+// so mm -> 1, mm^-k -> -k; px and 1 do not change with it.
+int LengthExponent(std::string_view unit) {
+  if (unit == "mm") return 1;
+  if (unit.substr(0, 3) == "mm^") return std::atoi(std::string(unit.substr(3)).c_str());
+  return 0;
+}
+
+// d quantity / d pitch (quantity unit per mm): a pitch s times the stated one makes every photo
+// coordinate s times larger, so the same camera has the parameters p_k s^e_k (e_k their length
+// exponent: c' = s c, K1' = K1 / s^2) and the quantity f(p'); central difference in s.
+double PitchSensitivity(const InteriorFunction& f,
+                        const calib::InteriorParams& p,
+                        const std::vector<calib::ParamInfo>& table,
+                        double pixel_size_mm) {
+  constexpr double kStep = 1e-6;
+  const auto scaled = [&](double s) {
+    calib::InteriorParams out = p;
+    for (size_t k = 0; k < table.size(); ++k) out[k] *= std::pow(s, LengthExponent(table[k].unit));
+    return f.f(out);
+  };
+  return (scaled(1 + kStep) - scaled(1 - kStep)) / (2 * kStep) / pixel_size_mm;
+}
+
+// What every interior quantity's default components need, computed once.
+struct BudgetInputs {
+  const CalibrationRun* run = nullptr;
+  CovarianceSplit split;
+  std::vector<calib::ParamInfo> table;
+  double dof_adjustment = 1;
+  double eccentricity_px = 0;
+  double target_radius_mm = 0;
+  double pixel_size_mm = 0;
+  std::optional<double> pitch_tolerance_mm;
+  std::string pitch_source;  // where the tolerance was stated
+  std::string image_origin, control_origin;
+};
+
+BudgetInputs MakeBudgetInputs(const CalibrationRun& run,
+                              const Project& project,
+                              const BudgetOptions& options) {
+  BudgetInputs in;
+  in.run = &run;
+  in.split = SplitCovariance(run);
+  in.table = calib::CameraModelParams(run.all.result.cameras[0].model);
+  in.dof_adjustment = std::max(1, run.all.result.solve.redundancy);
+  in.eccentricity_px = MaxEccentricityPx(run, project, options.target_radius_mm);
+  in.target_radius_mm = options.target_radius_mm;
+  const calib::Camera& camera = project.cameras.at(run.camera);
+  in.pixel_size_mm = camera.pixel_size_mm;
+  in.pitch_tolerance_mm = options.pixel_size_tolerance_mm ? options.pixel_size_tolerance_mm
+                                                          : camera.pixel_size_tolerance_mm;
+  in.pitch_source = options.pixel_size_tolerance_mm ? "the budget file" : "the camera file";
+  double sum2 = 0;
+  for (const auto& o : project.observations) sum2 += o.sigma_px * o.sigma_px;
+  const size_t n = project.observations.size();
+  // The a-priori sigmas set the weights; their scale is estimated (sigma0, type A); their model
+  // (each observation's own sigma, uncorrelated) is an assumption the document states.
+  const std::string sigmas =
+      n > 0 ? StringPrintf("%zu image observations, a-priori sigma RMS %.3g px",
+                           n,
+                           std::sqrt(sum2 / static_cast<double>(n)))
+            : std::string("the observations' a-priori sigmas");
+  in.image_origin = StringPrintf(
+      "%s, scaled by sigma0 = %.3g (redundancy %d); their model (each observation's own sigma, "
+      "uncorrelated) is assumed",
+      sigmas.c_str(),
+      run.all.result.sigma0,
+      run.all.result.solve.redundancy);
+  int n_control = 0;
+  for (const auto& p : project.points) n_control += p.role == PointRole::kControl && p.xyz_m;
+  in.control_origin = StringPrintf(
+      "survey sigmas of %d control points propagated through the adjustment (Q N_control Q; "
+      "the scale definition of the field is part of them)",
+      n_control);
+  return in;
+}
+
+UncertaintyComponent PixelPitchComponent(const InteriorFunction& f,
+                                         const calib::InteriorParams& p,
+                                         const BudgetInputs& in) {
+  UncertaintyComponent c = Component("pixel pitch", "B", 0, kInf, "mm", "rectangular");
+  c.divisor = std::sqrt(3.0);
+  c.sensitivity = PitchSensitivity(f, p, in.table, in.pixel_size_mm);
+  if (!in.pitch_tolerance_mm) {
+    c.value = 0;
+    c.origin = "no tolerance stated (camera file or budget file pixel_size_tolerance_mm)";
+    return c;
+  }
+  c.value = *in.pitch_tolerance_mm;
+  c.u = std::abs(c.sensitivity) * c.value / c.divisor;
+  c.origin = StringPrintf("+-%g mm of the pixel size %g mm, stated in %s",
+                          c.value,
+                          in.pixel_size_mm,
+                          in.pitch_source.c_str());
+  return c;
+}
+
+// The default components of one interior quantity (see the header comment).
+std::vector<UncertaintyComponent> InteriorComponents(const InteriorFunction& f,
+                                                     const BudgetInputs& in) {
+  const CalibrationRun& run = *in.run;
+  const calib::InteriorParams& p = run.all.result.cameras[0].estimated;
+  std::vector<UncertaintyComponent> out;
+  const double u_image = Propagate(f, p, in.split.image);
+  out.push_back(Component("image measurements", "A", u_image, in.dof_adjustment, f.unit));
+  out.back().origin = in.image_origin;
+  if (run.groups.size() >= 2) {
+    // The groups share the control: their scatter is compared with the image part alone.
+    std::vector<double> values;
+    for (const auto& g : run.groups)
+      if (!g.adjustment.result.cameras.empty())
+        values.push_back(f.f(g.adjustment.result.cameras[0].estimated));
+    const double n = static_cast<double>(values.size());
+    double mean = 0, ss = 0;
+    for (double v : values) mean += v / n;
+    for (double v : values) ss += (v - mean) * (v - mean);
+    const double s2_mean = ss / (n - 1) / n;
+    out.push_back(Component("group reproducibility",
+                            "A",
+                            std::sqrt(std::max(0.0, s2_mean - u_image * u_image)),
+                            n - 1,
+                            f.unit));
+    out.back().origin = StringPrintf(
+        "scatter of %zu image groups' values beyond the image measurements' part", values.size());
+  }
+  if (in.split.control.size() > 0) {
+    out.push_back(
+        Component("control coordinates", "B", Propagate(f, p, in.split.control), kInf, f.unit));
+    out.back().origin = in.control_origin;
+  }
+  const double sigma0_px = run.all.result.sigma0_px;
+  if (in.eccentricity_px > 0 && sigma0_px > 0) {
+    UncertaintyComponent c = Component("target eccentricity", "B", 0, kInf, "px", "rectangular");
+    c.value = in.eccentricity_px;
+    c.divisor = std::sqrt(3.0);
+    c.sensitivity = u_image / sigma0_px;  // propagated as an image error
+    c.u = c.sensitivity * in.eccentricity_px / c.divisor;
+    c.origin = StringPrintf("circular targets of radius %g mm: largest centre offset %.3g px",
+                            in.target_radius_mm,
+                            in.eccentricity_px);
+    out.push_back(c);
+  }
+  out.push_back(PixelPitchComponent(f, p, in));
+  return out;
+}
+
 }  // namespace
 
 double CoverageFactor(double dof_eff) {
@@ -165,6 +339,13 @@ std::string CertificateStatement(
 }
 
 namespace {
+
+bool SameName(const std::string& a, const std::string& b) {
+  return a.size() == b.size() && std::equal(a.begin(), a.end(), b.begin(), [](char x, char y) {
+           return std::tolower(static_cast<unsigned char>(x)) ==
+                  std::tolower(static_cast<unsigned char>(y));
+         });
+}
 
 // A unit of a budget component: its kind and its size in the kind's base unit.
 struct BudgetUnit {
@@ -208,9 +389,12 @@ BudgetOptions ReadBudgetOptions(const std::string& path) {
   // An empty budget file is a mistake (a wrong file, a failed export), not "no options".
   if (!root || root.IsNull() || (root.IsMap() && root.size() == 0))
     throw InputError(
-        path + ":1: an empty budget file (expected radii_mm, target_radius_mm or components)");
+        path +
+        ":1: an empty budget file (expected radii_mm, target_radius_mm, pixel_size_tolerance_mm "
+        "or components)");
   if (!root.IsMap()) throw InputError(WhereIs(root, path).ToString() + ": expected a map");
-  RejectUnknownKeys(root, {"radii_mm", "target_radius_mm", "components"}, path);
+  RejectUnknownKeys(
+      root, {"radii_mm", "target_radius_mm", "pixel_size_tolerance_mm", "components"}, path);
   for (const char* list : {"radii_mm", "components"})  // a map or a scalar there is no list
     if (root[list] && !root[list].IsSequence())
       throw InputError(WhereIs(root[list], path).ToString() + ": " + list + " must be a list");
@@ -221,6 +405,9 @@ BudgetOptions ReadBudgetOptions(const std::string& path) {
   if (root["target_radius_mm"])
     options.target_radius_mm =
         YamlBounded(root["target_radius_mm"], path, "target_radius_mm", 0, 1e6);
+  if (root["pixel_size_tolerance_mm"])
+    options.pixel_size_tolerance_mm =
+        YamlBounded(root["pixel_size_tolerance_mm"], path, "pixel_size_tolerance_mm", 0, 1);
   if (root["components"]) {
     for (const auto& node : root["components"]) {
       RejectUnknownKeys(
@@ -262,11 +449,11 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
   const AdjustmentResult& all = run.all.result;
   if (all.cameras.empty()) return {};
   const CameraEstimate& camera = all.cameras[0];
-  const double dof_adjustment = std::max(1, all.solve.redundancy);
-  const double eccentricity_px = MaxEccentricityPx(run, project, options.target_radius_mm);
+  const BudgetInputs inputs = MakeBudgetInputs(run, project, options);
+  const double dof_adjustment = inputs.dof_adjustment;
 
   std::vector<InteriorFunction> functions;
-  const std::vector<calib::ParamInfo> table = calib::CameraModelParams(camera.model);
+  const std::vector<calib::ParamInfo>& table = inputs.table;
   for (int k = 0; k < static_cast<int>(table.size()); ++k) {
     if (!camera.free[k]) continue;
     functions.push_back({std::string(table[k].name),
@@ -310,50 +497,7 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
     q.unit = f.unit;
     q.description = f.description;
     q.value = f.f(camera.estimated);
-    const double u_a = Propagate(f, camera.estimated, run.all.interior_covariance);
-    q.components.push_back(
-        Component("adjustment (sigma0 sqrt(Qxx))", "A", u_a, dof_adjustment, f.unit));
-    if (run.groups.size() >= 2) {
-      std::vector<double> values;
-      for (const auto& g : run.groups)
-        if (!g.adjustment.result.cameras.empty())
-          values.push_back(f.f(g.adjustment.result.cameras[0].estimated));
-      const double n = static_cast<double>(values.size());
-      double mean = 0, ss = 0;
-      for (double v : values) mean += v / n;
-      for (double v : values) ss += (v - mean) * (v - mean);
-      const double s2_mean = ss / (n - 1) / n;
-      q.components.push_back(
-          Component(StringPrintf("group reproducibility (%zu groups, excess over the adjustment)",
-                                 values.size()),
-                    "A",
-                    std::sqrt(std::max(0.0, s2_mean - u_a * u_a)),
-                    n - 1,
-                    f.unit));
-    }
-    if (run.control_fixed &&
-        run.control_fixed->interior_covariance.rows() == camera.estimated.size()) {
-      const double u_fixed = Propagate(f, camera.estimated, run.control_fixed->interior_covariance);
-      q.components.push_back(Component("control / target coordinates (survey sigmas propagated)",
-                                       "B",
-                                       std::sqrt(std::max(0.0, u_a * u_a - u_fixed * u_fixed)),
-                                       kInf,
-                                       f.unit));
-    }
-    if (eccentricity_px > 0 && all.sigma0_px > 0) {
-      UncertaintyComponent c = Component(
-          "target-centre eccentricity (max " + StringPrintf("%.3g", eccentricity_px) + " px)",
-          "B",
-          0,
-          kInf,
-          "px",
-          "rectangular");
-      c.value = eccentricity_px;
-      c.divisor = std::sqrt(3.0);
-      c.sensitivity = u_a / all.sigma0_px;
-      c.u = c.sensitivity * eccentricity_px / c.divisor;
-      q.components.push_back(c);
-    }
+    q.components = InteriorComponents(f, inputs);
     out.push_back(q);
   }
   // Check-point accuracy and m_0.
@@ -374,12 +518,12 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
       q.unit = "mm";
       q.description = "check-point RMSE";
       q.value = 1e3 * all.check.rmse_m(a);
-      q.components.push_back(Component(StringPrintf("sampling of %d check points", all.check.n),
-                                       "A",
-                                       q.value / std::sqrt(2 * n),
-                                       std::max(1.0, n - 1),
-                                       "mm"));
+      q.components.push_back(Component(
+          "check-point sampling", "A", q.value / std::sqrt(2 * n), std::max(1.0, n - 1), "mm"));
+      q.components.back().origin =
+          StringPrintf("%d check points: the RMSE's standard deviation m / sqrt(2 n)", all.check.n);
       q.components.push_back(Component("check-point survey", "B", 1e3 * survey(a), kInf, "mm"));
+      q.components.back().origin = "RMS of the check points' survey sigmas (points file)";
       out.push_back(q);
     }
   }
@@ -389,11 +533,13 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
     q.unit = "um";
     q.description = "sigma0 of the image measurements";
     q.value = all.sigma0_um;
-    q.components.push_back(Component("redundancy " + std::to_string(all.solve.redundancy),
+    q.components.push_back(Component("variance estimate",
                                      "A",
                                      all.sigma0_um / std::sqrt(2.0 * dof_adjustment),
                                      dof_adjustment,
                                      "um"));
+    q.components.back().origin =
+        "sigma0 / sqrt(2 r), redundancy r = " + std::to_string(all.solve.redundancy);
     out.push_back(q);
   }
   for (const auto& u : options.user) {
@@ -429,7 +575,19 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
                         FormatNumber(u.value) + " " + u.unit + ", sensitivity " +
                         FormatNumber(u.sensitivity) + ")");
     c.dof = u.dof;
-    q->components.push_back(c);
+    c.origin = "budget file " + u.where;
+    // A component of the same name (case aside) replaces the default one: the budget file
+    // overrides what aerocal derived (a pitch tolerance from a better datasheet, ...).
+    const auto same = std::find_if(
+        q->components.begin(), q->components.end(), [&](const UncertaintyComponent& d) {
+          return SameName(d.source, u.source);
+        });
+    if (same != q->components.end()) {
+      c.origin += " (replaces aerocal's: " + same->origin + ")";
+      *same = c;
+    } else {
+      q->components.push_back(c);
+    }
   }
   for (auto& q : out) {
     Finish(&q);
@@ -467,7 +625,8 @@ nlohmann::json BudgetToJson(const std::vector<BudgetQuantity>& budget) {
                                  {"divisor", c.divisor},
                                  {"sensitivity", number(c.sensitivity)},
                                  {"u", number(c.u)},
-                                 {"dof", number(c.dof)}});
+                                 {"dof", number(c.dof)},
+                                 {"origin", c.origin}});
     out.push_back(j);
   }
   return out;

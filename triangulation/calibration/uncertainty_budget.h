@@ -6,22 +6,35 @@
 // coverage factor k = t_{95.45 %}(nu_eff), taken as 2 when nu_eff >= 50 (t differs by < 0.05);
 // the expanded uncertainty U = k u_c.
 //
-// Components (CalibrationRun, calibration.h):
-// - A "adjustment": sigma0 sqrt(Qxx) of the run on all images (nu = its redundancy); for a
-//   function f of parameters (distortion at a radius) sqrt(g^T C g), g = df/dp.
+// Components of every interior quantity (CalibrationRun, calibration.h), each with its `origin`
+// (where it comes from, printed by the certificate):
+// - A "image measurements": the part of the adjustment's covariance that comes from the image
+//   observations, sigma0^2 Q N_image Q (their a-priori sigmas scaled by the estimated sigma0, nu =
+//   redundancy); for a function f of the parameters (distortion at a radius) sqrt(g^T C g),
+//   g = df/dp. Without a control run: all of sigma0^2 Q.
 // - A "group reproducibility": with G >= 2 image groups, the scatter of the groups' values not
-//   explained by the adjustment: sqrt(max(0, s_g^2 / G - u_adjustment^2)) (nu = G - 1), s_g the
-//   groups' standard deviation.
-// - B "control coordinates": the control/target survey sigmas propagated through the adjustment:
-//   sqrt(max(0, u_weighted^2 - u_fixed^2)) from the run with the control weighted by its sigmas
-//   and a run with them 1000 times smaller (nu = inf).
+//   explained by the image measurements (the groups share the control):
+//   sqrt(max(0, s_g^2 / G - u_image^2)) (nu = G - 1), s_g the groups' standard deviation.
+// - B "control coordinates": the control/target survey sigmas, as stated, propagated through the
+//   weighted adjustment: Q N_control Q (the GUM's law of propagation for x = Q A^T P l: the
+//   sensitivity of x to a control coordinate times its sigma, summed in quadrature), computed as
+//   the derivative of Q with respect to the control weights at the solution (calibration.h,
+//   CalibrationAdjustment::control_cofactor).
+//   Image part + control part = the adjustment's covariance when sigma0 = 1. The field's scale
+//   comes from these coordinates (aerocal has no scale-bar observations; the interior parameters
+//   do not change under a similarity of object space).
 // - B "target eccentricity": the image offset of a circular target's centre e = c r^2 sin(a)
 //   cos(a) / (D^2 - r^2 sin^2 a) (r target radius, D distance, a viewing angle to the target
 //   normal, taken as the normal of the control points' best-fit plane; Ahn, Warnecke, Kotowski
 //   1999), largest over all observations, rectangular
-//   (u_px = e_max / sqrt 3), propagated as an image error: u = u_adjustment u_px / sigma0_px.
-// - B user components (temperature, ...): value with its distribution (normal: divisor 1,
-//   rectangular sqrt 3, triangular sqrt 6), sensitivity coefficient and degrees of freedom.
+//   (u_px = e_max / sqrt 3), propagated as an image error: u = u_image u_px / sigma0_px.
+// - B "pixel pitch": the maker's tolerance +-T of the pixel size (camera file or budget file
+//   `pixel_size_tolerance_mm`), rectangular (T / sqrt 3), times df/dpitch: a pitch s times the
+//   stated one scales every photo coordinate by s, so the parameter p_k with length exponent e_k
+//   (mm: 1, mm^-2: -2, px and 1: 0) becomes p_k s^e_k; zero (and said so) without a tolerance.
+// - B user components (temperature, ...) of the budget file: value with its distribution (normal:
+//   divisor 1, rectangular sqrt 3, triangular sqrt 6), sensitivity coefficient and degrees of
+//   freedom; one named like a default component of its quantity (case aside) replaces it.
 // Check-point accuracy m_X, m_Y, m_Z (RMSE, CONVENTIONS.md): A sqrt(1 / (2 n)) m (nu = n - 1),
 // B the check points' survey sigma (RMS of sX, sY, sZ). m_0 = sigma0 in um: A sigma0_um / sqrt(2
 // r).
@@ -32,6 +45,7 @@
 #include <nlohmann/json.hpp>
 
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -47,6 +61,7 @@ struct UncertaintyComponent {
   double sensitivity = 1;  // c_i, quantity unit per value unit
   double u = 0;            // |c_i| value / divisor, quantity unit
   double dof = std::numeric_limits<double>::infinity();
+  std::string origin;  // where the component comes from (input, file, formula), for the document
 };
 
 struct BudgetQuantity {
@@ -78,13 +93,16 @@ struct UserComponent {
 std::string BudgetUnits();
 
 struct BudgetOptions {
-  std::vector<double> radii_mm;     // radii of the distortion values, mm, > 0
-  double target_radius_mm = 0;      // circular targets' radius in object space; 0: corners
+  std::vector<double> radii_mm;  // radii of the distortion values, mm, > 0
+  double target_radius_mm = 0;   // circular targets' radius in object space; 0: corners
+  /// The pixel pitch's tolerance (+-, mm, [0, 1]); overrides the camera file's.
+  std::optional<double> pixel_size_tolerance_mm;
   std::vector<UserComponent> user;  // extra type-B components
 };
 
-/// Reads a budget YAML {radii_mm: [...], target_radius_mm: r, components: [{quantity, source,
-/// value, unit, distribution, sensitivity, dof}]}; ConfigError with FILE:LINE on bad content.
+/// Reads a budget YAML {radii_mm: [...], target_radius_mm: r, pixel_size_tolerance_mm: t,
+/// components: [{quantity, source, value, unit, distribution, sensitivity, dof}]}; ConfigError
+/// with FILE:LINE on bad content.
 BudgetOptions ReadBudgetOptions(const std::string& path);
 
 /// The budget of every free interior parameter, the radial and decentring distortion at

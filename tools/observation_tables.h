@@ -1,0 +1,45 @@
+// Per-observation tables of a flight result as CSV sidecars (issue 33 item 3): a 37-image flight's
+// result.json holds about a hundred thousand residual entries per adjustment (23 MB), too much
+// for an editor or a browser's JSON viewer. With `flight --residuals-csv` each adjustment's
+// `residuals` array is written as `residuals_<adjustment>.csv` beside result.json, and the array
+// is replaced by
+//
+//   "residuals_file": {"path": "residuals_joint.csv", "sha256": "...", "rows": 104512,
+//                      "columns": ["image", "point", "col", ...]}
+//
+// The CSV holds exactly what the array held (docs/formats.md "residuals_<adjustment>.csv"): one
+// row per entry; numbers in the shortest text that reads back to the same double (%.17g), so
+// reading the table back gives the same JSON; `r`, `w_xy`, `mdb_sigma`, `mdb_px` as two columns
+// each (_x, _y; photo x, y); an empty cell is an absent key (subimage, u, v, head, reason, and the
+// test's keys of an untested observation: `group_size` empty) or, within a tested row, a null
+// (an untestable component's w). Text cells are quoted as RFC 4180 says where needed (a reason
+// with commas). Every reader of result.json inflates the tables first (report_data.load in
+// Python, InflateResidualTables here), checking the SHA-256.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <string>
+#include <vector>
+
+namespace aerocal::tools {
+
+/// Writes every adjustment's `residuals` of `document` (a flight result: `adjustments[]`) to
+/// `folder/residuals_<name>.csv` (atomically) and replaces the array by `residuals_file`. An
+/// adjustment whose entries carry a key the table has no column for keeps its array (nothing is
+/// dropped). Returns the file names written (relative to `folder`).
+std::vector<std::string> SplitResidualTables(nlohmann::json* document, const std::string& folder);
+
+/// The inverse for a reader: every `residuals_file` of `document`'s adjustments read from the
+/// folder of `result_path` back into `residuals` (the same JSON values). InputError naming the
+/// file when it is missing, its SHA-256 differs from the result's, or a row is malformed
+/// (FILE:LINE).
+void InflateResidualTables(nlohmann::json* document, const std::string& result_path);
+
+/// The CSV text of one residual array and its inverse (for tests; FILE names messages).
+std::string ResidualTableCsv(const nlohmann::json& residuals);
+nlohmann::json ResidualTableFromCsv(const std::string& text, const std::string& file);
+/// The table's columns, in order.
+std::vector<std::string> ResidualTableColumns();
+
+}  // namespace aerocal::tools
