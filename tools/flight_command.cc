@@ -145,10 +145,7 @@ int RunFlight(const FlightArgs& args) {
                                               ? SplitResidualTables(&document, set.staging())
                                               : std::vector<std::string>{};
   parts.insert(parts.end(), tables.begin(), tables.end());
-  for (const char* name : {"conventional", "self_calibration", "joint"})
-    if (std::find(tables.begin(), tables.end(), "residuals_" + std::string(name) + ".csv") ==
-        tables.end())
-      obsolete.push_back("residuals_" + std::string(name) + ".csv");
+  obsolete = ResidualTablesNotWritten(tables);
   WriteResult(json_path, "flight", document);
   // A calibrated camera is written only for a valid flight: a file that exists is one the next
   // flight may use (an old one in the folder is removed, so it cannot pass for this run's).

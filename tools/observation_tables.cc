@@ -5,6 +5,7 @@
 #include "calib/core/file_digest.h"
 #include "calib/core/string_printf.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -203,13 +204,25 @@ nlohmann::json ResidualTableFromCsv(const std::string& text, const std::string& 
   return out;
 }
 
+std::string ResidualTableFile(const std::string& adjustment) {
+  return "residuals_" + adjustment + ".csv";
+}
+
+std::vector<std::string> ResidualTablesNotWritten(const std::vector<std::string>& written) {
+  std::vector<std::string> out;
+  for (const char* adjustment : {"conventional", "self_calibration", "joint"}) {
+    const std::string file = ResidualTableFile(adjustment);
+    if (std::find(written.begin(), written.end(), file) == written.end()) out.push_back(file);
+  }
+  return out;
+}
+
 std::vector<std::string> SplitResidualTables(nlohmann::json* document, const std::string& folder) {
   std::vector<std::string> written;
   if (!document->contains("adjustments")) return written;
   for (auto& a : (*document)["adjustments"]) {
     if (!a.contains("residuals") || !Representable(a["residuals"])) continue;
-    const std::string name =
-        "residuals_" + a.value("name", std::to_string(written.size())) + ".csv";
+    const std::string name = ResidualTableFile(a.value("name", std::to_string(written.size())));
     const std::string text = ResidualTableCsv(a["residuals"]);
     WriteFileAtomically((std::filesystem::path(folder) / name).string(), text);
     a["residuals_file"] = {{"path", name},

@@ -24,6 +24,11 @@
 
 namespace aerocal::tools {
 
+/// The table file of adjustment `adjustment`: residuals_<adjustment>.csv.
+std::string ResidualTableFile(const std::string& adjustment);
+/// The tables of the adjustments a flight can run (conventional, self_calibration, joint) that
+/// are not among `written`: a previous run's there would not describe this one (to be removed).
+std::vector<std::string> ResidualTablesNotWritten(const std::vector<std::string>& written);
 /// Writes every adjustment's `residuals` of `document` (a flight result: `adjustments[]`) to
 /// `folder/residuals_<name>.csv` (atomically) and replaces the array by `residuals_file`. An
 /// adjustment whose entries carry a key the table has no column for keeps its array (nothing is
