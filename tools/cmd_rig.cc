@@ -33,6 +33,7 @@
 #include "tools/rig_design_document.h"
 #include "tools/rig_error_analysis_run.h"
 #include "tools/rig_stitch_run.h"
+#include "tools/rig_stitched_image_run.h"
 #include "tools/suspect_effect_option.h"
 #include "triangulation/block/block_io.h"
 
@@ -279,48 +280,22 @@ struct StitchArgs {
   CLI::Option* relief_option = nullptr;
 };
 
-std::unique_ptr<stitch::RasterSource> OpenHeadImage(const std::string& path) {
-  if (fs::path(path).extension() == ".tif" || fs::path(path).extension() == ".tiff")
-    return stitch::OpenTiff(path);
-  return std::make_unique<stitch::MemoryRaster>(stitch::ReadImageFile(path, true));
-}
-
-// The stitched image of every exposure with the refined increments and offsets (stitch/rig/
-// stitched_image.h): <image>.tif and <image>_mask.tif under --stitched-out; the figures as JSON.
+// The stitched image of every exposure with the refined increments and offsets (tools/
+// rig_stitched_image_run.h): <image>.tif and <image>_mask.tif under --stitched-out; the figures as
+// JSON.
 nlohmann::json WriteStitchedImages(const StitchArgs& args,
-                                   const calib::Rig& rig,
-                                   const std::vector<stitch::RigStitchExposure>& exposures,
-                                   const stitch::RigStitchResult& result,
+                                   const RigStitchRun& run,
                                    OutputSet* set) {
   stitch::StitchedImageOptions options;
   options.balance = !args.no_balance;
   options.feather_px = args.feather_px;
   nlohmann::json out = nlohmann::json::array();
-  Progress progress("stitched images", static_cast<long>(exposures.size()));
-  for (const auto& e : exposures) {
+  Progress progress("stitched images", static_cast<long>(run.exposures.size()));
+  for (const auto& e : run.exposures) {
     progress.Stage(e.image);
-    const auto refined = std::find_if(result.exposures.begin(),
-                                      result.exposures.end(),
-                                      [&](const auto& r) { return r.image == e.image; });
-    if (refined == result.exposures.end()) continue;
-    stitch::RigExposure pose = e.pose;
-    pose.increment_rad.assign(rig.heads.size(), Eigen::Vector3d::Zero());
-    pose.dt_s.assign(rig.heads.size(), 0.0);
-    for (const auto& h : refined->heads) {
-      const int k = rig.HeadIndex(h.head);
-      pose.increment_rad[k] = h.increment_rad;
-      pose.dt_s[k] = h.dt_fitted_s;  // also where not determinable on its own: the fitted geometry
-    }
-    const stitch::RigConverter converter(
-        rig, pose, stitch::MakeRectificationPlane(rig, pose, e.pose.rig_center_m.z() - e.z_ref_m));
-    std::vector<std::unique_ptr<stitch::RasterSource>> owned;
-    std::vector<stitch::RasterSource*> sources;
-    for (const auto& head : rig.heads) {
-      owned.push_back(OpenHeadImage(HeadImagePath(args.images, e.image, head.id)));
-      sources.push_back(owned.back().get());
-    }
-    const stitch::RasterInfo info = sources.front()->Info();
-    const calib::Camera& v = rig.virtual_camera.camera;
+    if (RefinedExposure(run, e.image) == nullptr) continue;
+    RigExposureImages heads = OpenRigExposureImages(run.rig, args.images, e.image);
+    const calib::Camera& v = run.rig.virtual_camera.camera;
     stitch::TiffWriteOptions tiff;
     tiff.tile_px = args.tile_px;
     tiff.force_bigtiff = args.bigtiff;
@@ -330,37 +305,20 @@ nlohmann::json WriteStitchedImages(const StitchArgs& args,
     const std::string image_path = args.stitched_out + "/" + e.image + ".tif";
     const std::string mask_path = args.stitched_out + "/" + e.image + "_mask.tif";
     stitch::TiffWriter image(
-        set->StagePath(image_path), {v.width_px, v.height_px, 1, info.bits}, tiff);
+        set->StagePath(image_path), {v.width_px, v.height_px, 1, heads.bits()}, tiff);
     tiff.description = "aerocal rig stitch: valid-area mask of " + e.image + " (255 valid)";
     stitch::TiffWriter mask(set->StagePath(mask_path), {v.width_px, v.height_px, 1, 8}, tiff);
     const stitch::StitchedImageReport r =
-        stitch::MakeStitchedImage(converter, sources, options, &image, &mask);
+        StitchRigExposure(run, e.image, heads, options, &image, &mask);
     image.Commit();
     mask.Commit();
-    nlohmann::json heads = nlohmann::json::array(), zones = nlohmann::json::array();
-    for (const auto& h : r.heads)
-      heads.push_back({{"head", h.head},
-                       {"gain", h.gain},
-                       {"offset_dn", h.offset_dn},
-                       {"samples", h.samples},
-                       {"reference", h.reference}});
-    const auto zone_json = [](const stitch::OverlapDisagreement& z) {
-      return nlohmann::json{
-          {"zone", z.zone}, {"pixels", z.pixels}, {"rms_dn", z.rms_dn}, {"mean_dn", z.mean_dn}};
-    };
-    for (const auto& z : r.zones) zones.push_back(zone_json(z));
-    out.push_back({{"image", e.image},
-                   {"file", image_path},
-                   {"mask", mask_path},
-                   {"width_px", r.width_px},
-                   {"height_px", r.height_px},
-                   {"bits", r.bits},
-                   {"bigtiff", image.bigtiff()},
-                   {"tile_px", args.tile_px},
-                   {"valid_pixels", r.valid_pixels},
-                   {"radiometry", heads},
-                   {"overlap_disagreement_dn", {{"all", zone_json(r.overall)}, {"zones", zones}}},
-                   {"warnings", FindingsToJson(r.warnings)}});
+    nlohmann::json entry = StitchedImageReportJson(r);
+    entry.update({{"image", e.image},
+                  {"file", image_path},
+                  {"mask", mask_path},
+                  {"bigtiff", image.bigtiff()},
+                  {"tile_px", args.tile_px}});
+    out.push_back(std::move(entry));
     std::printf(
         "stitched %s: %d x %d px, %ld valid, overlap disagreement %.3f DN RMS (head "
         "against head before blending, %ld px) -> %s\n",
@@ -421,7 +379,7 @@ int RunStitch(const StitchArgs& args) {
   OutputSet set(out.parent_path().string());
   if (!args.stitched_out.empty()) {
     if (result.failures.empty())
-      json["stitched_images"] = WriteStitchedImages(args, run.rig, run.exposures, result, &set);
+      json["stitched_images"] = WriteStitchedImages(args, run, &set);
     else
       std::fprintf(stderr, "error: no stitched images: the self-calibration is not valid\n");
   }

@@ -387,6 +387,40 @@ def test_rig_stitch_equals_the_command(tmp_path):
         aerocal.rig_stitch(camera, str(line), mode="spline")
 
 
+def test_rig_stitched_image_equals_the_command(tmp_path):
+    from PIL import Image  # Debian's python3-pil (a dependency of python3-matplotlib)
+    photo = os.path.join(SHARED, "odm_boruszyn_kap_frames", "images", "img_4880.jpg")
+    if not os.path.exists(photo):
+        pytest.skip("../shared/data/odm_boruszyn_kap_frames is absent (the scene's texture)")
+    sim = tmp_path / "uav4"
+    code, out = run("simulate", "--rig", "uav4", "--exposures", "2", "--format-scale", "0.2", "--seed", "3",
+                    "--render-images", "--texture", photo, "--texture-gsd-m", "0.25", "--grey-noise-dn", "1",
+                    "--out", str(sim))
+    assert code == 0, out
+    camera, images = str(sim / "rig_truth.yaml"), str(sim / "images")
+    stitched = tmp_path / "stitched"
+    code, out = run("rig", "stitch", "--camera", camera, "--project", str(sim), "--standard-radius-px", "80",
+                    "--images", images, "--stitched-out", str(stitched), "--out", str(tmp_path / "cli.json"))
+    assert code == 0, out
+    with open(tmp_path / "cli.json") as f:
+        expected = json.load(f)["stitched_images"]
+    r = aerocal.rig_stitch(camera, str(sim), standard_radius_px=80, images=images)
+    assert len(expected) == 2
+    for entry in expected:
+        got = r.stitched_image(entry["image"])
+        # The same pixels as the command's TIFFs, and the same figures.
+        np.testing.assert_array_equal(got["pixels"], np.asarray(Image.open(entry["file"])))
+        np.testing.assert_array_equal(got["mask"], np.asarray(Image.open(entry["mask"])))
+        assert got["pixels"].shape == (entry["height_px"], entry["width_px"])
+        assert int((got["mask"] == 255).sum()) == entry["valid_pixels"]
+        for key in ("radiometry", "overlap_disagreement_dn", "warnings", "bits"):
+            assert got[key] == entry[key], key
+    with pytest.raises(ValueError, match="not an exposure of the rig stitch result"):
+        r.stitched_image("nothing_like_this")
+    with pytest.raises(ValueError, match="feather_px must be within 1..255"):
+        r.stitched_image(expected[0]["image"], feather_px=0)
+
+
 def test_pushbroom_calibrate_equals_the_command(tmp_path):
     sim = tmp_path / "pb"
     code, out = run("simulate", "--pushbroom", "--out", str(sim))

@@ -15,16 +15,6 @@ namespace {
 
 namespace py = pybind11;
 
-template <typename T>
-py::array Pixels(const stitch::MemoryRaster& raster) {
-  const stitch::RasterInfo info = raster.Info();
-  std::vector<py::ssize_t> shape = {info.height, info.width};
-  if (info.bands > 1) shape.push_back(info.bands);
-  py::array_t<T> out(shape);
-  std::memcpy(out.mutable_data(), raster.bytes().data(), raster.bytes().size());
-  return out;
-}
-
 py::array Resample(const std::string& camera,
                    const std::string& mapping,
                    const py::object& images,
@@ -53,10 +43,24 @@ py::array Resample(const std::string& camera,
       writer.Commit();
     }
   }
-  return p.virtual_info.bits == 8 ? Pixels<std::uint8_t>(raster) : Pixels<std::uint16_t>(raster);
+  return RasterToNumpy(raster);
+}
+
+template <typename T>
+py::array Pixels(const stitch::MemoryRaster& raster) {
+  const stitch::RasterInfo info = raster.Info();
+  std::vector<py::ssize_t> shape = {info.height, info.width};
+  if (info.bands > 1) shape.push_back(info.bands);
+  py::array_t<T> out(shape);
+  std::memcpy(out.mutable_data(), raster.bytes().data(), raster.bytes().size());
+  return out;
 }
 
 }  // namespace
+
+py::array RasterToNumpy(const stitch::MemoryRaster& raster) {
+  return raster.Info().bits == 8 ? Pixels<std::uint8_t>(raster) : Pixels<std::uint16_t>(raster);
+}
 
 std::string ImagesOptionText(const py::object& images) {
   if (images.is_none()) return "";

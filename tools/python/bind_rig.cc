@@ -9,6 +9,7 @@
 #include "tools/rig_design_document.h"
 #include "tools/rig_error_analysis_run.h"
 #include "tools/rig_stitch_run.h"
+#include "tools/rig_stitched_image_run.h"
 
 #include <pybind11/stl.h>
 
@@ -19,8 +20,46 @@ namespace py = pybind11;
 
 struct RigStitchResult {
   tools::RigStitchRun run;
-  std::string json;  // as `aerocal rig stitch --out` writes it
+  std::string json;    // as `aerocal rig stitch --out` writes it
+  std::string images;  // the head images' folder given to rig_stitch ("" if none)
 };
+
+// One exposure's stitched level image as `rig stitch --stitched-out` makes it (tools/
+// rig_stitched_image_run.h), held in memory: {"pixels", "mask"} as numpy arrays plus the figures
+// of the command's `stitched_images[]` entry.
+py::dict StitchedImage(const RigStitchResult& r,
+                       const std::string& image,
+                       const std::string& images,
+                       bool balance,
+                       int feather_px) {
+  const std::string folder = images.empty() ? r.images : images;
+  if (folder.empty())
+    throw ConfigError("images: the folder of the head images (<image>_<head>.tif) is needed");
+  if (!r.run.result.failures.empty())
+    throw ConfigError("no stitched image: the self-calibration is not valid");
+  if (!(feather_px >= 1 && feather_px <= 255))
+    throw ConfigError("feather_px must be within 1..255 (got " + std::to_string(feather_px) + ")");
+  if (tools::RefinedExposure(r.run, image) == nullptr)
+    throw InputError("image " + image + ": not an exposure of the rig stitch result");
+  stitch::StitchedImageOptions options;
+  options.balance = balance;
+  options.feather_px = feather_px;
+  const calib::Camera& v = r.run.rig.virtual_camera.camera;
+  tools::RigExposureImages heads = tools::OpenRigExposureImages(r.run.rig, folder, image);
+  stitch::MemoryRaster pixels({v.width_px, v.height_px, 1, heads.bits()});
+  stitch::MemoryRaster mask({v.width_px, v.height_px, 1, 8});
+  stitch::StitchedImageReport report;
+  {
+    py::gil_scoped_release release;
+    report = tools::StitchRigExposure(r.run, image, heads, options, &pixels, &mask);
+  }
+  nlohmann::json figures = tools::StitchedImageReportJson(report);
+  figures["image"] = image;
+  py::dict out = JsonToPython(figures.dump());
+  out["pixels"] = RasterToNumpy(pixels);
+  out["mask"] = RasterToNumpy(mask);
+  return out;
+}
 
 RigStitchResult RigStitch(const std::string& camera,
                           const std::string& project,
@@ -65,6 +104,7 @@ RigStitchResult RigStitch(const std::string& camera,
     out.run = tools::RunRigStitch(request);
   }
   out.json = ResultText("rig_stitch", out.run.json);
+  out.images = images;
   return out;
 }
 
@@ -129,7 +169,20 @@ void BindRig(py::module_& m) {
       .def(
           "to_json",
           [](const RigStitchResult& r) { return r.json; },
-          "The result file's text, identical to `aerocal rig stitch --out`");
+          "The result file's text, identical to `aerocal rig stitch --out`")
+      .def("stitched_image",
+           &StitchedImage,
+           py::arg("image"),
+           py::arg("images") = "",
+           py::arg("balance") = true,
+           py::arg("feather_px") = 64,
+           "The stitched level image of exposure `image` as `aerocal rig stitch --images DIR "
+           "--stitched-out DIR` makes it, in memory: a dict with 'pixels' (numpy, the virtual "
+           "format, the heads' depth), 'mask' (uint8, 255 valid) and the figures of the "
+           "command's stitched_images[] entry (radiometry, overlap_disagreement_dn, "
+           "valid_pixels, warnings). images: the folder of the head images <image>_<head>.tif "
+           "(default: the one given to rig_stitch); balance False is --no-balance. The GIL is "
+           "released while stitching.");
   m.def("rig_design",
         &RigDesign,
         py::arg("camera"),

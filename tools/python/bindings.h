@@ -3,10 +3,18 @@
 // tools/python/aerocal/__init__.py is the package around it (docstrings, help(aerocal)).
 #pragma once
 
+#include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <string>
 
+namespace aerocal::stitch {
+class MemoryRaster;
+}
+
 namespace aerocal::python {
+
+/// The raster's samples as a numpy array (rows, cols[, bands]) of uint8 or uint16, copied.
+pybind11::array RasterToNumpy(const stitch::MemoryRaster& raster);
 
 /// The `--images` text "I=a.tif,II=b.tif" of a {sub-image id: file} dict, the text itself, or ""
 /// for None (resample, match).
