@@ -8,6 +8,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <glob.h>
@@ -30,6 +31,49 @@ std::vector<std::string> Glob(const std::string& pattern) {
   globfree(&g);
   std::sort(out.begin(), out.end());
   return out;
+}
+
+// One image's marks as observations of the board points r{row}c{col}.
+void AddBoardImage(const std::string& image,
+                   const std::vector<Eigen::Vector2d>& marks,
+                   const BoardSpec& board,
+                   double sigma_px,
+                   DetectedBoards* out) {
+  for (int r = 0; r < board.rows; ++r)
+    for (int c = 0; c < board.columns; ++c) {
+      triangulation::ImageObservation o;
+      o.image = image;
+      o.point = StringPrintf("r%dc%d", r, c);
+      o.pixel = marks[r * board.columns + c];
+      o.sigma_px = sigma_px;
+      out->observations.push_back(o);
+    }
+}
+
+// The board's points on the plane Z = 0 (m), control with the board's design sigma.
+void AddBoardPoints(const BoardSpec& board, double point_sigma_mm, DetectedBoards* out) {
+  for (int r = 0; r < board.rows; ++r)
+    for (int c = 0; c < board.columns; ++c) {
+      triangulation::GroundPoint p;
+      p.id = StringPrintf("r%dc%d", r, c);
+      p.xyz_m =
+          Eigen::Vector3d((board.kind == "acircles" ? 2 * c + r % 2 : c) * board.square_mm * 1e-3,
+                          r * board.square_mm * 1e-3,
+                          0.0);
+      p.sigma_m = Eigen::Vector3d::Constant(point_sigma_mm * 1e-3);
+      p.role = triangulation::PointRole::kControl;
+      out->points.push_back(p);
+    }
+}
+
+std::string TooFewBoards(const BoardSpec& board, size_t found, size_t given, const char* where) {
+  return StringPrintf("%s: the board %s:%dx%d was found in %zu of %zu images (needs 3)",
+                      where,
+                      board.kind.c_str(),
+                      board.columns,
+                      board.rows,
+                      found,
+                      given);
 }
 
 }  // namespace
@@ -110,37 +154,59 @@ DetectedBoards DetectBoards(const std::string& glob,
     const std::string image = std::filesystem::path(path).stem().string();
     out.images.push_back(image);
     out.image_paths.push_back(path);
-    for (int r = 0; r < board.rows; ++r)
-      for (int c = 0; c < board.columns; ++c) {
-        triangulation::ImageObservation o;
-        o.image = image;
-        o.point = StringPrintf("r%dc%d", r, c);
-        o.pixel = {marks[r * board.columns + c].x, marks[r * board.columns + c].y};
-        o.sigma_px = sigma_px;
-        out.observations.push_back(o);
-      }
+    std::vector<Eigen::Vector2d> pixels;
+    for (const cv::Point2f& m : marks) pixels.emplace_back(m.x, m.y);
+    AddBoardImage(image, pixels, board, sigma_px, &out);
   }
   if (out.images.size() < 3)
-    throw InputError(
-        StringPrintf("--images: the board %s:%dx%d was found in %zu of %zu images "
-                     "(needs 3)",
-                     board.kind.c_str(),
-                     board.columns,
-                     board.rows,
-                     out.images.size(),
-                     files.size()));
-  for (int r = 0; r < board.rows; ++r)
-    for (int c = 0; c < board.columns; ++c) {
-      triangulation::GroundPoint p;
-      p.id = StringPrintf("r%dc%d", r, c);
-      p.xyz_m =
-          Eigen::Vector3d((board.kind == "acircles" ? 2 * c + r % 2 : c) * board.square_mm * 1e-3,
-                          r * board.square_mm * 1e-3,
-                          0.0);
-      p.sigma_m = Eigen::Vector3d::Constant(point_sigma_mm * 1e-3);
-      p.role = triangulation::PointRole::kControl;
-      out.points.push_back(p);
+    throw InputError(TooFewBoards(board, out.images.size(), files.size(), "--images"));
+  AddBoardPoints(board, point_sigma_mm, &out);
+  return out;
+}
+
+DetectedBoards BoardsFromMarks(
+    const std::vector<std::pair<std::string, std::vector<Eigen::Vector2d>>>& marks,
+    const BoardSpec& board,
+    int width_px,
+    int height_px,
+    double sigma_px,
+    double point_sigma_mm) {
+  DetectedBoards out;
+  out.width_px = width_px;
+  out.height_px = height_px;
+  const size_t count = static_cast<size_t>(board.columns) * board.rows;
+  for (const auto& [image, pixels] : marks) {
+    const std::string where = "corners['" + image + "']";
+    if (image.empty()) throw InputError("corners: an empty image id");
+    if (std::find(out.images.begin(), out.images.end(), image) != out.images.end())
+      throw InputError(where + ": the image is given twice");
+    if (pixels.size() != count)
+      throw InputError(StringPrintf(
+          "%s: %zu marks, the board has %zu (%d x %d, row-major as the detector gives them)",
+          where.c_str(),
+          pixels.size(),
+          count,
+          board.columns,
+          board.rows));
+    for (size_t k = 0; k < pixels.size(); ++k) {
+      const Eigen::Vector2d& p = pixels[k];
+      if (!(p.allFinite() && p.x() > -0.5 && p.y() > -0.5 && p.x() < width_px - 0.5 &&
+            p.y() < height_px - 0.5))
+        throw InputError(StringPrintf("%s[%zu]: (%g, %g) is not a pixel of the %d x %d format",
+                                      where.c_str(),
+                                      k,
+                                      p.x(),
+                                      p.y(),
+                                      width_px,
+                                      height_px));
     }
+    out.images.push_back(image);
+    out.image_paths.push_back(where);
+    AddBoardImage(image, pixels, board, sigma_px, &out);
+  }
+  if (out.images.size() < 3)
+    throw InputError(TooFewBoards(board, out.images.size(), marks.size(), "corners"));
+  AddBoardPoints(board, point_sigma_mm, &out);
   return out;
 }
 

@@ -39,6 +39,19 @@ DetectedBoards DetectBoards(const std::string& glob,
                             double sigma_px,
                             double point_sigma_mm);
 
+/// Board marks measured elsewhere (Python arrays): per image id, columns x rows marks in the
+/// detector's order (row-major, pixel frame of CONVENTIONS.md), made into the same observations
+/// and points as DetectBoards; the format is the camera's (width_px, height_px). InputError naming
+/// the image when its count differs from the board's, a mark is not finite or lies off the format,
+/// an image id is empty or given twice, or fewer than 3 images are given.
+DetectedBoards BoardsFromMarks(
+    const std::vector<std::pair<std::string, std::vector<Eigen::Vector2d>>>& marks,
+    const BoardSpec& board,
+    int width_px,
+    int height_px,
+    double sigma_px,
+    double point_sigma_mm);
+
 /// cv::calibrateCamera (k1, k2, p1, p2, k3; fx, fy, cx, cy free) on the detected marks.
 struct OpenCvCalibration {
   double rms_px = 0, seconds = 0;

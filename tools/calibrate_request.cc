@@ -89,14 +89,22 @@ std::map<std::string, std::string> GroupsFromObservations(const std::string& pat
   return CheckedGroups(out, path, observed);
 }
 
+// How the board's marks were found, for the result's method.
+std::string BoardDetector(const CalibrateRequest& r, const BoardSpec& spec) {
+  if (!r.corners.empty()) return "given (corners measured by the caller)";
+  return spec.kind == "chessboard"
+             ? "cv::findChessboardCorners + cv::cornerSubPix (11 x 11, 1e-4 px)"
+             : "cv::findCirclesGrid";
+}
+
 // The marks of the request in `project` (a test field's files, or the board detected in the
-// images), and the method's description for the result.
+// images or given as marks), and the method's description for the result.
 nlohmann::json LoadMarks(const CalibrateRequest& r,
                          const calib::Camera& camera,
                          DetectedBoards* detected,
                          triangulation::Project* project,
                          std::string* printed) {
-  if (r.images.empty()) {
+  if (r.images.empty() && r.corners.empty()) {
     project->observations = triangulation::ReadObservations(r.observations, r.sigma_px);
     project->points = triangulation::ReadPoints(r.points);
     project->path = project->observations_file = r.observations;
@@ -104,32 +112,34 @@ nlohmann::json LoadMarks(const CalibrateRequest& r,
     return {{"kind", "test field"}, {"observations", r.observations}, {"points", r.points}};
   }
   const BoardSpec spec = ParseBoard(r.board, "--board");
-  *detected = DetectBoards(r.images, spec, r.sigma_px, r.board_sigma_mm);
-  if (detected->width_px != camera.width_px || detected->height_px != camera.height_px)
-    throw InputError(StringPrintf("%s: format_px is %d x %d, the images are %d x %d px",
-                                  r.camera.c_str(),
-                                  camera.width_px,
-                                  camera.height_px,
-                                  detected->width_px,
-                                  detected->height_px));
+  if (!r.corners.empty()) {
+    *detected = BoardsFromMarks(
+        r.corners, spec, camera.width_px, camera.height_px, r.sigma_px, r.board_sigma_mm);
+  } else {
+    *detected = DetectBoards(r.images, spec, r.sigma_px, r.board_sigma_mm);
+    if (detected->width_px != camera.width_px || detected->height_px != camera.height_px)
+      throw InputError(StringPrintf("%s: format_px is %d x %d, the images are %d x %d px",
+                                    r.camera.c_str(),
+                                    camera.width_px,
+                                    camera.height_px,
+                                    detected->width_px,
+                                    detected->height_px));
+  }
   project->observations = detected->observations;
   project->points = detected->points;
-  project->path = project->observations_file = r.images;
+  project->path = project->observations_file = r.corners.empty() ? r.images : "corners";
   for (const auto& path : detected->not_detected)
     *printed += "warning: board not found in " + path + " (image left out)\n";
-  return {
-      {"kind", "planar target"},
-      {"board", spec.kind},
-      {"columns", spec.columns},
-      {"rows", spec.rows},
-      {"spacing_mm", spec.square_mm},
-      {"board_sigma_mm", r.board_sigma_mm},
-      {"images", r.images},
-      {"detected", detected->image_paths},
-      {"not_detected", detected->not_detected},
-      {"detector",
-       spec.kind == "chessboard" ? "cv::findChessboardCorners + cv::cornerSubPix (11 x 11, 1e-4 px)"
-                                 : "cv::findCirclesGrid"}};
+  return {{"kind", "planar target"},
+          {"board", spec.kind},
+          {"columns", spec.columns},
+          {"rows", spec.rows},
+          {"spacing_mm", spec.square_mm},
+          {"board_sigma_mm", r.board_sigma_mm},
+          {"images", r.corners.empty() ? r.images : "corners"},
+          {"detected", detected->image_paths},
+          {"not_detected", detected->not_detected},
+          {"detector", BoardDetector(r, spec)}};
 }
 
 // The cross-file checks of the block readers, with one exposure per observed image.
@@ -261,13 +271,17 @@ nlohmann::json WriteCalibratedCamera(const CalibrateRequest& r,
 
 void CheckRequest(const CalibrateRequest& r) {
   const bool field = !r.observations.empty() || !r.points.empty();
-  const bool board = !r.images.empty() || !r.board.empty();
+  const bool board = !r.images.empty() || !r.board.empty() || !r.corners.empty();
   if (field == board)
     throw ConfigError(
         "give either --observations and --points, or --images and --board, or --directions");
   if (field && (r.observations.empty() || r.points.empty()))
     throw ConfigError("--observations and --points go together");
-  if (board && (r.images.empty() || r.board.empty()))
+  if (!r.images.empty() && !r.corners.empty())
+    throw ConfigError("corners: give either the images or their corners, not both");
+  if (!r.corners.empty() && r.board.empty())
+    throw ConfigError("corners needs board (e.g. 'chessboard:9x6:25')");
+  if (board && ((r.images.empty() && r.corners.empty()) || r.board.empty()))
     throw ConfigError("--images and --board go together");
 }
 
@@ -305,7 +319,8 @@ CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
   ValidateMarks(project, camera_id);
   const std::map<std::string, std::string> groups = GroupsOf(r, project);
   if (budget.radii_mm.empty()) budget.radii_mm = DefaultCertifiedRadiiMm(camera);
-  if (!r.write_marks.empty() && !r.images.empty()) {
+  const bool board_marks = !r.images.empty() || !r.corners.empty();
+  if (!r.write_marks.empty() && board_marks) {
     triangulation::WriteObservations(r.write_marks + "/observations.csv", project.observations);
     triangulation::WritePoints(r.write_marks + "/points.csv", project.points);
   }
@@ -333,7 +348,7 @@ CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
     beside = CalibrateBeside(project, camera_id, camera, beside_model, options, &outcome.printed);
     cal["beside"] = beside.json;
   }
-  if (beside_model == calib::OpenCvModel::kId && !r.images.empty())
+  if (beside_model == calib::OpenCvModel::kId && board_marks)
     cal["opencv"] = OpenCvBeside(detected, camera, &outcome.printed);
   cal["rms_px"] = RmsPx(result);
   // With --model the model-M estimate of this run is written (issue 29), not a refit of ours.

@@ -5,9 +5,11 @@
 // tools/calibrate_directions.h.
 #pragma once
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace aerocal::tools {
@@ -19,6 +21,9 @@ struct CalibrateRequest {
   std::string camera;                // camera file: pixel size, format, an approximate c
   std::string observations, points;  // a test field (together) ...
   std::string images, board;         // ... or a planar board: glob and "chessboard:9x6:25"
+  // ... or the board's marks measured elsewhere (Python's arrays), with `board`: per image id,
+  // columns x rows marks in the detector's order (tools/board_detection.h, BoardsFromMarks)
+  std::vector<std::pair<std::string, std::vector<Eigen::Vector2d>>> corners;
   std::string groups, budget, write_marks, write_camera, camera_format = "aerocal";
   std::string self_calibration;  // default: the model's (DefaultSelfCalibration)
   std::string model;             // default: the camera file's

@@ -518,6 +518,73 @@ def test_rig_error_analysis_equals_the_command(tmp_path):
         aerocal.rig_error_analysis(camera, limits, samples=10**9)
 
 
+def _board_corners(camera, poses, distance_m, rng, noise_px):
+    """A 9 x 6 chessboard (25 mm) seen from `poses` (omega, phi, kappa in degrees about the board's
+    centre, the camera `distance_m` away on its axis): the inner corners row-major, as OpenCV's
+    detector orders them, through the camera file's own camera, with Gaussian noise."""
+    xyz = np.array([[c * 0.025, r * 0.025, 0.0] for r in range(6) for c in range(9)])
+    corners = {}
+    for i, (om, ph, ka) in enumerate(np.radians(poses)):
+        rx = np.array([[1, 0, 0], [0, np.cos(om), -np.sin(om)], [0, np.sin(om), np.cos(om)]])
+        ry = np.array([[np.cos(ph), 0, np.sin(ph)], [0, 1, 0], [-np.sin(ph), 0, np.cos(ph)]])
+        rz = np.array([[np.cos(ka), -np.sin(ka), 0], [np.sin(ka), np.cos(ka), 0], [0, 0, 1]])
+        p = ((rz @ rx @ ry) @ (xyz - xyz.mean(axis=0)).T).T - [0, 0, distance_m]  # camera frame
+        pixels = camera.ray_to_image(p[:, :2] / -p[:, 2:3]) + rng.normal(0, noise_px, (len(xyz), 2))
+        corners[f"board{i:02d}"] = np.array([[float(f"{v:.4f}") for v in row] for row in pixels])
+    return corners
+
+
+def test_calibrate_from_board_corners(tmp_path):
+    model = "model: brown_fraser_10\npixel_size_mm: 0.006\nformat_px: [6000, 4000]\n"
+    (tmp_path / "truth.yaml").write_text(model + "interior: {c: 50.3, x0: 0.04, y0: -0.03, K1: 2.0e-5}\n")
+    nominal = str(tmp_path / "nominal.yaml")
+    (tmp_path / "nominal.yaml").write_text(model + "interior: {c: 50.0}\n")
+    poses = [(0, 0, 0), (25, 0, 0), (-25, 0, 0), (0, 25, 0), (0, -25, 0), (20, 20, 90), (-20, 20, 90),
+             (20, -20, 180), (-15, -20, 270)]
+    truth = aerocal.Camera.read(str(tmp_path / "truth.yaml"))
+    corners = _board_corners(truth, poses, 0.5, np.random.default_rng(7), 0.05)
+    r = aerocal.calibrate(nominal, corners=corners, board="chessboard:9x6:25", sigma_px=0.05)
+    doc = json.loads(r.to_json())
+    assert r.valid and r.calibration["data"]["observations"] == 9 * 54
+    assert r.calibration["method"]["detector"] == "given (corners measured by the caller)"
+    cam = doc["cameras"][0]
+    for name in ("c", "x0", "y0", "K1"):  # the truth within 3 sigma
+        assert abs(cam["estimated"][name] - truth.params[name]) < 3 * cam["sigma"][name], name
+    # The same marks as a test field's files give the same adjustment to 1e-9 (the board's points on
+    # Z = 0 with the board's sigma, control).
+    with open(tmp_path / "obs.csv", "w") as f:
+        f.write("image,point,col,row,sigma_px\n")
+        for image, pixels in corners.items():
+            for k, (col, row) in enumerate(pixels):
+                f.write(f"{image},r{k // 9}c{k % 9},{col:.4f},{row:.4f},0.05\n")
+    with open(tmp_path / "points.csv", "w") as f:
+        f.write("point,X,Y,Z,sX,sY,sZ,role\n")
+        for k in range(54):
+            f.write(f"r{k // 9}c{k % 9},{k % 9 * 0.025!r},{k // 9 * 0.025!r},0,1e-05,1e-05,1e-05,control\n")
+    code, out = run("calibrate", "--camera", nominal, "--observations", str(tmp_path / "obs.csv"), "--points",
+                    str(tmp_path / "points.csv"), "--sigma-px", "0.05", "--out", str(tmp_path / "cli.json"))
+    assert code == 0, out
+    with open(tmp_path / "cli.json") as f:
+        cli = json.load(f)
+    assert cli["redundancy"] == doc["redundancy"]
+    assert cli["sigma0"] == pytest.approx(doc["sigma0"], rel=1e-9)
+    for key in ("estimated", "sigma"):
+        for name, value in cli["cameras"][0][key].items():
+            assert cam[key][name] == pytest.approx(value, rel=1e-9, abs=1e-18), (key, name)
+    # Bad marks are ValueErrors naming the image.
+    with pytest.raises(ValueError, match=r"corners\['board00'\]: 53 marks, the board has 54"):
+        aerocal.calibrate(nominal, corners={**corners, "board00": corners["board00"][1:]},
+                          board="chessboard:9x6:25")
+    with pytest.raises(ValueError, match=r"corners\['board01'\]\[0\]: \(-7, 3\) is not a pixel"):
+        bad = corners["board01"].copy()
+        bad[0] = (-7, 3)
+        aerocal.calibrate(nominal, corners={**corners, "board01": bad}, board="chessboard:9x6:25")
+    with pytest.raises(ValueError, match="corners needs board"):
+        aerocal.calibrate(nominal, corners=corners)
+    with pytest.raises(ValueError, match="shape"):
+        aerocal.calibrate(nominal, corners={"a": [1, 2, 3]}, board="chessboard:9x6:25")
+
+
 def test_calibrate_from_directions_equals_the_command(tmp_path):
     camera = tmp_path / "camera.yaml"
     camera.write_text("name: lab\npixel_size_mm: 0.006\nformat_px: [6000, 4000]\ninterior: {c: 50.0}\n")

@@ -11,6 +11,7 @@
 #include "tools/python/bindings.h"
 
 #include <filesystem>
+#include <pybind11/numpy.h>
 #include <pybind11/stl.h>
 #include <stdexcept>
 #include <utility>
@@ -29,6 +30,26 @@ std::string Text(const py::object& value) {
   return value.is_none() ? "" : py::str(value).cast<std::string>();
 }
 
+// {image id: array-like (N, 2) of pixels} as the request's board marks, in the dict's order.
+std::vector<std::pair<std::string, std::vector<Eigen::Vector2d>>> BoardMarks(
+    const py::object& corners) {
+  std::vector<std::pair<std::string, std::vector<Eigen::Vector2d>>> out;
+  if (corners.is_none()) return out;
+  if (!py::isinstance<py::dict>(corners))
+    throw ConfigError("corners: expected a dict {image id: array (N, 2) of pixels}");
+  for (const auto& [id, value] : corners.cast<py::dict>()) {
+    const std::string image = py::str(id).cast<std::string>();
+    const auto a = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(value);
+    if (!a || a.ndim() != 2 || a.shape(1) != 2)
+      throw ConfigError("corners['" + image + "']: expected an array of shape (N, 2) of pixels");
+    std::vector<Eigen::Vector2d> marks;
+    for (py::ssize_t k = 0; k < a.shape(0); ++k) marks.emplace_back(a.at(k, 0), a.at(k, 1));
+    out.emplace_back(image, std::move(marks));
+  }
+  if (out.empty()) throw ConfigError("corners: no image given");
+  return out;
+}
+
 // The result of a calibration as the command has it: its document's text, and the file `out`
 // when given (either way of calibrating ends here).
 CalibrationResult Finished(tools::CalibrateOutcome outcome, const std::string& out) {
@@ -45,6 +66,7 @@ CalibrationResult Calibrate(const std::string& camera,
                             const py::object& points,
                             const py::object& images,
                             const py::object& board,
+                            const py::object& corners,
                             const py::object& groups,
                             const py::object& budget,
                             const py::object& self_calibration,
@@ -67,7 +89,8 @@ CalibrationResult Calibrate(const std::string& camera,
   for (const double r : radii_mm)
     if (!(r > 0 && r <= 1e4)) throw ConfigError("radii_mm: each must be in (0, 10000]");
   if (!directions.is_none()) {  // a collimator array or a goniometer sequence
-    if (!observations.is_none() || !points.is_none() || !images.is_none() || !board.is_none())
+    if (!observations.is_none() || !points.is_none() || !images.is_none() || !board.is_none() ||
+        !corners.is_none())
       throw ConfigError(
           "directions: give either directions, or observations and points, or images and board");
     if (!groups.is_none() || !write_marks.is_none() || no_snooping || no_closed_form)
@@ -94,6 +117,7 @@ CalibrationResult Calibrate(const std::string& camera,
   request.points = Text(points);
   request.images = Text(images);
   request.board = Text(board);
+  request.corners = BoardMarks(corners);
   request.groups = Text(groups);
   request.budget = Text(budget);
   request.self_calibration = Text(self_calibration);
@@ -176,6 +200,7 @@ void BindCalibrate(py::module_& m) {
         py::arg("points") = py::none(),
         py::arg("images") = py::none(),
         py::arg("board") = py::none(),
+        py::arg("corners") = py::none(),
         py::arg("groups") = py::none(),
         py::arg("budget") = py::none(),
         py::arg("self_calibration") = py::none(),
@@ -191,7 +216,9 @@ void BindCalibrate(py::module_& m) {
         py::arg("write_marks") = py::none(),
         py::arg("out") = py::none(),
         "Camera calibration as `aerocal calibrate`: a test field (observations, points: the CSV "
-        "files), a planar board (images: a glob, board: 'chessboard:9x6:25') or known directions "
+        "files), a planar board (images: a glob, board: 'chessboard:9x6:25'; or corners: "
+        "{image id: array (N, 2)} of the board's marks measured elsewhere, row-major as "
+        "OpenCV's detectors give them, with board) or known directions "
         "(directions: a collimator array or goniometer file); groups, budget, "
         "self_calibration, model, ... as the command's options (`-` -> `_`). A result that is not "
         "valid comes back with valid=False. The GIL is released while calibrating.");

@@ -134,6 +134,7 @@ class CalibrationResult:
 
 def calibrate(camera: str, directions: Optional[str] = None, observations: Optional[str] = None, points: Optional[str] = None,
               images: Optional[str] = None, board: Optional[str] = None,
+              corners: Optional[Mapping[str, npt.ArrayLike]] = None,
               groups: Optional[str] = None, budget: Optional[str] = None,
               self_calibration: Optional[str] = None, model: Optional[str] = None,
               sigma_px: float = 0.5, board_sigma_mm: float = 0.01,
