@@ -285,14 +285,10 @@ void CheckRequest(const CalibrateRequest& r) {
     throw ConfigError("--images and --board go together");
 }
 
-}  // namespace
-
-CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
-  CheckRequest(r);
-  CalibrateOutcome outcome;
-  const calib::Camera camera = calib::ReadCamera(r.camera, calib::CameraModels::kAny);
-  const calib::CameraModelId model = camera.model;
-  const calib::CameraModelId beside_model = r.model.empty() ? model : ModelOfOption(r.model);
+// The adjustment's options of the request: the free set (the model's default unless given), data
+// snooping, the closed-form start of c.
+triangulation::CalibrateOptions CalibrateOptionsOf(const CalibrateRequest& r,
+                                                   calib::CameraModelId model) {
   triangulation::CalibrateOptions options;
   options.adjust.free_interior = triangulation::ParseSelfCalibration(
       r.self_calibration.empty() ? DefaultSelfCalibration(model) : r.self_calibration, model);
@@ -302,10 +298,54 @@ CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
   options.adjust.suspect_effect_limit = r.suspect_effect_limit;
   options.closed_form_c = !r.no_closed_form;
   options.adjust.Validate();
+  return options;
+}
+
+// Every output checked before the work (nothing is written when one cannot be).
+void CheckOutputs(const CalibrateRequest& r) {
   if (!r.out.empty()) CheckOutputFile(r.out, "--out");
   if (!r.write_marks.empty()) CheckOutputFolder(r.write_marks, "--write-marks");
   if (!r.write_camera.empty()) CheckOutputFile(r.write_camera, "--write-camera");
   FindCameraFormat(r.camera_format, "--camera-format");
+}
+
+// --write-camera: the camera of this run, or with --model (`beside` given) the model-M estimate of
+// this run (issue 29), not a refit of ours; null and a message when the estimate is not valid.
+nlohmann::json WriteCameraOf(const CalibrateRequest& r,
+                             const calib::Camera& camera,
+                             const BesideRun* beside,
+                             const AdjustmentResult& result,
+                             CalibrateOutcome* outcome) {
+  if (beside != nullptr && beside->camera)
+    return WriteCalibratedCamera(r,
+                                 *beside->camera,
+                                 *beside->estimate,
+                                 std::string(calib::CameraModelName(beside->camera->model)),
+                                 &outcome->printed);
+  if (beside != nullptr) {
+    outcome->errors += "camera not written: the --model result is not valid\n";
+    return nullptr;
+  }
+  if (result.valid && !result.cameras.empty())
+    return WriteCalibratedCamera(r,
+                                 triangulation::UpdatedCamera(camera, result.cameras[0]),
+                                 result.cameras[0],
+                                 "",
+                                 &outcome->printed);
+  outcome->errors += "camera not written: the result is not valid\n";
+  return nullptr;
+}
+
+}  // namespace
+
+CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
+  CheckRequest(r);
+  CalibrateOutcome outcome;
+  const calib::Camera camera = calib::ReadCamera(r.camera, calib::CameraModels::kAny);
+  const calib::CameraModelId model = camera.model;
+  const calib::CameraModelId beside_model = r.model.empty() ? model : ModelOfOption(r.model);
+  const triangulation::CalibrateOptions options = CalibrateOptionsOf(r, model);
+  CheckOutputs(r);
   triangulation::BudgetOptions budget;
   if (!r.budget.empty()) budget = triangulation::ReadBudgetOptions(r.budget);
   if (!r.radii_mm.empty()) budget.radii_mm = r.radii_mm;
@@ -351,24 +391,11 @@ CalibrateOutcome RunCalibration(const CalibrateRequest& r) {
   if (beside_model == calib::OpenCvModel::kId && board_marks)
     cal["opencv"] = OpenCvBeside(detected, camera, &outcome.printed);
   cal["rms_px"] = RmsPx(result);
-  // With --model the model-M estimate of this run is written (issue 29), not a refit of ours.
-  if (!r.write_camera.empty() && beside_model != model && beside.camera)
-    cal["camera_written"] = WriteCalibratedCamera(r,
-                                                  *beside.camera,
-                                                  *beside.estimate,
-                                                  std::string(calib::CameraModelName(beside_model)),
-                                                  &outcome.printed);
-  else if (!r.write_camera.empty() && beside_model != model)
-    outcome.errors += "camera not written: the --model result is not valid\n";
-  else if (!r.write_camera.empty() && result.valid && !result.cameras.empty())
-    cal["camera_written"] =
-        WriteCalibratedCamera(r,
-                              triangulation::UpdatedCamera(camera, result.cameras[0]),
-                              result.cameras[0],
-                              "",
-                              &outcome.printed);
-  else if (!r.write_camera.empty())
-    outcome.errors += "camera not written: the result is not valid\n";
+  if (!r.write_camera.empty()) {
+    const nlohmann::json written =
+        WriteCameraOf(r, camera, beside_model != model ? &beside : nullptr, result, &outcome);
+    if (!written.is_null()) cal["camera_written"] = written;
+  }
   json["calibration"] = cal;
   for (const auto& reason : result.invalid_reasons)
     outcome.errors += "calibrate: not valid: " + reason + "\n";
