@@ -439,9 +439,8 @@ int RunDesign(const DesignArgs& args) {
   return kExitOk;
 }
 
-CommandRun Setup(CLI::App& app) {
-  app.require_subcommand(1);
-  auto args = std::make_shared<ErrorAnalysisArgs>();
+// `rig error-analysis` and its options.
+CLI::App* AddErrorAnalysis(CLI::App& app, const std::shared_ptr<ErrorAnalysisArgs>& args) {
   CLI::App* ea = app.add_subcommand(
       "error-analysis",
       "Conversion error analysis of the rig's virtual image: maximum error, linear propagation, "
@@ -484,7 +483,11 @@ CommandRun Setup(CLI::App& app) {
                  "Output file: the result JSON; STEM_histogram.csv/.png or STEM_bound_map.csv/.png "
                  "beside it")
       ->required();
-  auto convert = std::make_shared<ConvertArgs>();
+  return ea;
+}
+
+// `rig convert` and its options.
+CLI::App* AddConvert(CLI::App& app, const std::shared_ptr<ConvertArgs>& convert) {
   CLI::App* cv = app.add_subcommand(
       "convert", "The images of one rig exposure -> the single-centre virtual image (TIFF)");
   cv->option_defaults()->always_capture_default();
@@ -521,7 +524,11 @@ CommandRun Setup(CLI::App& app) {
       convert->dem,
       "DEM (ESRI ASCII grid, object frame of the exposure) as the rectification surface; "
       "the plane at --height-m stays the base of the maps");
-  auto design = std::make_shared<DesignArgs>();
+  return cv;
+}
+
+// `rig design` and its options.
+CLI::App* AddDesign(CLI::App& app, const std::shared_ptr<DesignArgs>& design) {
   CLI::App* ds = app.add_subcommand(
       "design",
       "Design figures: GSD change ratios of the tilted heads, virtual format, covered "
@@ -539,7 +546,44 @@ CommandRun Setup(CLI::App& app) {
   ds->add_option(
         "--grid-cells", design->grid_cells, "Coverage grid cells along the longer side, 10..4000")
       ->check(FiniteRange(10, 4000));
-  auto stitching = std::make_shared<StitchArgs>();
+  return ds;
+}
+
+// `rig stitch`'s options of the head images: tie matching on them, the stitched images.
+void AddStitchedImageOptions(CLI::App* st, StitchArgs* stitching) {
+  st->add_option(
+      "--images",
+      stitching->images,
+      "Folder of the head images <image>_<head>.tif (simulate --rig --render-images writes "
+      "them under images/); with --stitched-out");
+  st->add_option("--stitched-out",
+                 stitching->stitched_out,
+                 "Folder for the stitched level image of every exposure (<image>.tif, resampled "
+                 "once with the refined increments and offsets, balanced, blended) and its "
+                 "valid-area mask (<image>_mask.tif)");
+  st->add_flag("--match-ties",
+               stitching->match_ties,
+               "Match the ties on the head images under --images (Foerstner + least-squares "
+               "matching per overlap zone, on the level plane of the ground calibration and the "
+               "POS) instead of reading them from observations.csv (which must have no rows)");
+  st->add_option(
+        "--tile-px",
+        stitching->tile_px,
+        "Stitched images: square TIFF tiles of this size (multiple of 16, 16..4096; 0: strips)")
+      ->check(FiniteRange(0, 4096));
+  st->add_flag(
+      "--bigtiff", stitching->bigtiff, "Stitched images: BigTIFF even when classic TIFF would do");
+  st->add_flag("--no-balance",
+               stitching->no_balance,
+               "Stitched images: no radiometric balance (every head gain 1, offset 0)");
+  st->add_option("--feather-px",
+                 stitching->feather_px,
+                 "Stitched images: width of the blending ramp at each head's border, 1..255 px")
+      ->check(FiniteRange(1, 255));
+}
+
+// `rig stitch` and its options (the stitched images' options last).
+CLI::App* AddStitch(CLI::App& app, const std::shared_ptr<StitchArgs>& stitching) {
   CLI::App* st = app.add_subcommand(
       "stitch",
       "Self-calibrating stitching of a rig block: per-exposure attitude increments and "
@@ -592,35 +636,20 @@ CommandRun Setup(CLI::App& app) {
                  stitching->default_sigma_px,
                  "Tie sigma (px) where observations.csv gives none")
       ->check(PositiveUpTo(100));
-  st->add_option(
-      "--images",
-      stitching->images,
-      "Folder of the head images <image>_<head>.tif (simulate --rig --render-images writes "
-      "them under images/); with --stitched-out");
-  st->add_option("--stitched-out",
-                 stitching->stitched_out,
-                 "Folder for the stitched level image of every exposure (<image>.tif, resampled "
-                 "once with the refined increments and offsets, balanced, blended) and its "
-                 "valid-area mask (<image>_mask.tif)");
-  st->add_flag("--match-ties",
-               stitching->match_ties,
-               "Match the ties on the head images under --images (Foerstner + least-squares "
-               "matching per overlap zone, on the level plane of the ground calibration and the "
-               "POS) instead of reading them from observations.csv (which must have no rows)");
-  st->add_option(
-        "--tile-px",
-        stitching->tile_px,
-        "Stitched images: square TIFF tiles of this size (multiple of 16, 16..4096; 0: strips)")
-      ->check(FiniteRange(0, 4096));
-  st->add_flag(
-      "--bigtiff", stitching->bigtiff, "Stitched images: BigTIFF even when classic TIFF would do");
-  st->add_flag("--no-balance",
-               stitching->no_balance,
-               "Stitched images: no radiometric balance (every head gain 1, offset 0)");
-  st->add_option("--feather-px",
-                 stitching->feather_px,
-                 "Stitched images: width of the blending ramp at each head's border, 1..255 px")
-      ->check(FiniteRange(1, 255));
+  AddStitchedImageOptions(st, stitching.get());
+  return st;
+}
+
+CommandRun Setup(CLI::App& app) {
+  app.require_subcommand(1);
+  auto args = std::make_shared<ErrorAnalysisArgs>();
+  auto convert = std::make_shared<ConvertArgs>();
+  auto design = std::make_shared<DesignArgs>();
+  auto stitching = std::make_shared<StitchArgs>();
+  CLI::App* ea = AddErrorAnalysis(app, args);
+  CLI::App* cv = AddConvert(app, convert);
+  CLI::App* ds = AddDesign(app, design);
+  CLI::App* st = AddStitch(app, stitching);
   return [args, ea, convert, cv, design, ds, stitching, st] {
     if (st->parsed()) return RunStitch(*stitching);
     if (ds->parsed()) return RunDesign(*design);
