@@ -191,78 +191,125 @@ bool ProjectRigHead(const calib::RigHead& head,
 
 namespace {
 
+using HeadPixels = std::vector<std::pair<int, Eigen::Vector2d>>;
+
+// Every head of exposure i that sees `point` inside its format (kMarginPx from the border).
+HeadPixels HeadsSeeing(const SimulatedRigFlight& f, size_t i, const Eigen::Vector3d& point) {
+  const size_t heads = f.truth.heads.size();
+  HeadPixels seen;
+  for (size_t k = 0; k < heads; ++k) {
+    const calib::RigHead& head = f.truth.heads[k];
+    Eigen::Vector2d px;
+    if (!ProjectRigHead(head, f.exposures_truth[i], f.rig_exposures[i * heads + k], point, &px))
+      continue;
+    if (px.x() < kMarginPx || px.y() < kMarginPx || px.x() > head.camera.width_px - 1 - kMarginPx ||
+        px.y() > head.camera.height_px - 1 - kMarginPx)
+      continue;
+    seen.push_back({static_cast<int>(k), px});
+  }
+  return seen;
+}
+
+// The head observations of `point` in exposure i, with the flight's image noise.
+void AddHeadObservations(SimulatedRigFlight& f,
+                         size_t i,
+                         const std::string& point,
+                         const HeadPixels& seen,
+                         internal::SimulationRandom& random) {
+  const FlightSimulationOptions& o = f.options.flight;
+  for (const auto& [k, px] : seen) {
+    ImageObservation obs;
+    obs.image = f.exposures_truth[i].image;
+    obs.head = f.truth.heads[k].id;
+    obs.point = point;
+    obs.sigma_px = o.image_sigma_px;
+    obs.pixel = px + o.image_noise_px *
+                         Eigen::Vector2d(random.normal(random.rng), random.normal(random.rng));
+    f.observations.push_back(obs);
+  }
+}
+
+// The level virtual camera of exposure i with the rig's heading (CONVENTIONS.md), at O: the
+// terrain point of a virtual pixel.
+struct VirtualGround {
+  const SimulatedRigFlight& f;
+  const Exposure& e;
+  Eigen::Matrix3d object_from_virtual;
+  VirtualGround(const SimulatedRigFlight& flight, size_t i)
+      : f(flight), e(flight.exposures_truth[i]) {
+    const double kappa = calib::OpkFromRotation(calib::RotationFromOpk(e.opk_rad)).z();
+    object_from_virtual = calib::RotationFromOpk({0.0, 0.0, kappa});
+  }
+  bool operator()(const Eigen::Vector2d& px, Eigen::Vector3d* g) const {
+    const std::optional<Eigen::Vector3d> ray = f.nominal.virtual_camera.RayFromPixel(px);
+    return ray && TerrainPointOfRay(f.options.flight, e.center_m, object_from_virtual * *ray, g);
+  }
+};
+
+// z_ref: the mean terrain height under the virtual image (a 20 x 20 grid); nullopt where no ray
+// meets the terrain.
+std::optional<double> MeanTerrainHeight(const VirtualGround& ground_of, const calib::Camera& v) {
+  double sum = 0.0;
+  int n = 0;
+  for (int r = 0; r < 20; ++r)
+    for (int c = 0; c < 20; ++c) {
+      Eigen::Vector3d g;
+      if (ground_of({(c + 0.5) * v.width_px / 20.0, (r + 0.5) * v.height_px / 20.0}, &g)) {
+        sum += g.z();
+        ++n;
+      }
+    }
+  if (n == 0) return std::nullopt;
+  return sum / n;
+}
+
+// A stitching tie (or check tie) of exposure i at a virtual pixel: measured in every head that
+// sees it (>= 2), without coordinates in the file. False where fewer than two heads see it.
+bool PlaceTie(SimulatedRigFlight& f,
+              size_t i,
+              const VirtualGround& ground_of,
+              const Eigen::Vector2d& px,
+              PointRole role,
+              const std::string& position,
+              int* serial,
+              internal::SimulationRandom& random) {
+  Eigen::Vector3d g;
+  if (!ground_of(px, &g)) return false;
+  const HeadPixels seen = HeadsSeeing(f, i, g);
+  if (seen.size() < 2) return false;
+  GroundPoint truth;
+  truth.id = StringPrintf("%s_%s%03d",
+                          f.exposures_truth[i].image.c_str(),
+                          role == PointRole::kCheck ? "c" : "t",
+                          (*serial)++);
+  truth.role = role;
+  truth.xyz_m = g;
+  GroundPoint file = truth;
+  file.xyz_m.reset();  // a stitching tie (and a check tie) has no coordinates
+  f.points_truth.push_back(truth);
+  f.points_file.push_back(file);
+  if (!position.empty()) f.tie_position[truth.id] = position;
+  AddHeadObservations(f, i, truth.id, seen, random);
+  return true;
+}
+
 // z_ref of every exposure and the stitching ties (header comment), drawn after everything else so
 // that the flight, points and observations of a seed do not depend on them.
 void AddStitchingTies(SimulatedRigFlight& f, internal::SimulationRandom& random) {
-  const FlightSimulationOptions& o = f.options.flight;
   const auto& st = f.options.stitch_ties;
   auto& rng = random.rng;
-  auto& normal = random.normal;
   auto& uniform = random.uniform;
-  const calib::VirtualCamera& virtual_camera = f.nominal.virtual_camera;
-  const calib::Camera& v = virtual_camera.camera;
-  const size_t heads = f.truth.heads.size();
+  const calib::Camera& v = f.nominal.virtual_camera.camera;
   const bool any = st.dense > 0 || st.check > 0 ||
                    (st.per_standard_position > 0 && !st.standard_positions.empty());
   for (size_t i = 0; i < f.exposures_truth.size(); ++i) {
-    const Exposure& e = f.exposures_truth[i];
-    // The level virtual camera with the rig's heading (CONVENTIONS.md), at O.
-    const double kappa = calib::OpkFromRotation(calib::RotationFromOpk(e.opk_rad)).z();
-    const Eigen::Matrix3d object_from_virtual = calib::RotationFromOpk({0.0, 0.0, kappa});
-    const auto ground_of = [&](const Eigen::Vector2d& px, Eigen::Vector3d* g) {
-      const std::optional<Eigen::Vector3d> ray = virtual_camera.RayFromPixel(px);
-      return ray && TerrainPointOfRay(o, e.center_m, object_from_virtual * *ray, g);
-    };
-    // z_ref: the mean terrain height under the virtual image (a 20 x 20 grid).
-    double sum = 0.0;
-    int n = 0;
-    for (int r = 0; r < 20; ++r)
-      for (int c = 0; c < 20; ++c) {
-        Eigen::Vector3d g;
-        if (ground_of({(c + 0.5) * v.width_px / 20.0, (r + 0.5) * v.height_px / 20.0}, &g)) {
-          sum += g.z();
-          ++n;
-        }
-      }
-    if (n > 0) f.exposures_truth[i].z_ref_m = f.exposures_file[i].z_ref_m = sum / n;
+    const VirtualGround ground_of(f, i);
+    if (const auto z_ref = MeanTerrainHeight(ground_of, v))
+      f.exposures_truth[i].z_ref_m = f.exposures_file[i].z_ref_m = *z_ref;
     if (!any) continue;
     int serial = 0;
-    // A tie at a virtual pixel: measured in every head of this exposure that sees it (>= 2).
     const auto place = [&](const Eigen::Vector2d& px, PointRole role, const std::string& position) {
-      Eigen::Vector3d g;
-      if (!ground_of(px, &g)) return false;
-      std::vector<std::pair<int, Eigen::Vector2d>> seen;
-      for (size_t k = 0; k < heads; ++k) {
-        const calib::RigHead& head = f.truth.heads[k];
-        Eigen::Vector2d p;
-        if (!ProjectRigHead(head, e, f.rig_exposures[i * heads + k], g, &p)) continue;
-        if (p.x() < kMarginPx || p.y() < kMarginPx ||
-            p.x() > head.camera.width_px - 1 - kMarginPx ||
-            p.y() > head.camera.height_px - 1 - kMarginPx)
-          continue;
-        seen.push_back({static_cast<int>(k), p});
-      }
-      if (seen.size() < 2) return false;
-      GroundPoint truth;
-      truth.id = StringPrintf(
-          "%s_%s%03d", e.image.c_str(), role == PointRole::kCheck ? "c" : "t", serial++);
-      truth.role = role;
-      truth.xyz_m = g;
-      GroundPoint file = truth;
-      file.xyz_m.reset();  // a stitching tie (and a check tie) has no coordinates
-      f.points_truth.push_back(truth);
-      f.points_file.push_back(file);
-      if (!position.empty()) f.tie_position[truth.id] = position;
-      for (const auto& [k, p] : seen) {
-        ImageObservation obs;
-        obs.image = e.image;
-        obs.head = f.truth.heads[k].id;
-        obs.point = truth.id;
-        obs.sigma_px = o.image_sigma_px;
-        obs.pixel = p + o.image_noise_px * Eigen::Vector2d(normal(rng), normal(rng));
-        f.observations.push_back(obs);
-      }
-      return true;
+      return PlaceTie(f, i, ground_of, px, role, position, &serial, random);
     };
     for (const auto& s : st.standard_positions)
       for (int j = 0, tries = 0;
@@ -282,9 +329,7 @@ void AddStitchingTies(SimulatedRigFlight& f, internal::SimulationRandom& random)
   }
 }
 
-}  // namespace
-
-SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) {
+void CheckRigSimulationOptions(const RigFlightSimulationOptions& options) {
   const FlightSimulationOptions& o = options.flight;
   if (o.exposures < 2 || o.strips < 1 || o.exposures < o.strips)
     throw ConfigError("a flight needs at least 2 exposures and one strip per exposure row");
@@ -296,18 +341,16 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
   const auto& st = options.stitch_ties;
   if (st.per_standard_position < 0 || st.dense < 0 || st.check < 0 || !(st.jitter_px >= 0))
     throw ConfigError("rig simulation: stitching tie counts and jitter must be >= 0");
-  internal::SimulationRandom random(o.seed);
-  auto& rng = random.rng;
-  auto& normal = random.normal;
+}
 
-  SimulatedRigFlight f;
-  f.options = options;
-  f.nominal = ScaleRigFormats(MakeNominalRig(options.preset), options.format_scale);
-  f.truth = f.nominal;
-  f.truth.name = f.nominal.name + " (truth)";
-  const int reference = f.truth.ReferenceIndex();
-  for (size_t k = 0; k < f.truth.heads.size(); ++k) {
-    calib::RigHead& head = f.truth.heads[k];
+// The true rig: the nominal one with each head's interior correction and, for the non-reference
+// heads, the mount and lever-arm errors.
+calib::Rig TrueRig(const calib::Rig& nominal, const RigFlightSimulationOptions& options) {
+  calib::Rig truth = nominal;
+  truth.name = nominal.name + " (truth)";
+  const int reference = truth.ReferenceIndex();
+  for (size_t k = 0; k < truth.heads.size(); ++k) {
+    calib::RigHead& head = truth.heads[k];
     const auto& correction =
         options.interior_correction.empty()
             ? calib::InteriorParams{}
@@ -317,6 +360,43 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
     head.mount_rad += options.mount_error_rad;
     head.lever_arm_m += options.lever_arm_error_m;
   }
+  return truth;
+}
+
+// The true increments and time offsets of every head and exposure (exposure-major), the reference
+// head's held at zero.
+void DrawRigExposures(SimulatedRigFlight& f, internal::SimulationRandom& random) {
+  const RigFlightSimulationOptions& options = f.options;
+  const int reference = f.truth.ReferenceIndex();
+  for (const auto& e : f.exposures_truth) {
+    for (size_t k = 0; k < f.truth.heads.size(); ++k) {
+      RigExposureTruth t;
+      t.image = e.image;
+      t.head = f.truth.heads[k].id;
+      if (static_cast<int>(k) != reference) {
+        t.increment_rad = options.increment_sigma_rad * Eigen::Vector3d(random.normal(random.rng),
+                                                                        random.normal(random.rng),
+                                                                        random.normal(random.rng));
+        t.dt_s =
+            options.head_time_offsets_s.empty()
+                ? options.time_offset_s
+                : options.head_time_offsets_s[std::min(k, options.head_time_offsets_s.size() - 1)];
+      }
+      f.rig_exposures.push_back(t);
+    }
+  }
+}
+
+}  // namespace
+
+SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) {
+  CheckRigSimulationOptions(options);
+  const FlightSimulationOptions& o = options.flight;
+  internal::SimulationRandom random(o.seed);
+  SimulatedRigFlight f;
+  f.options = options;
+  f.nominal = ScaleRigFormats(MakeNominalRig(options.preset), options.format_scale);
+  f.truth = TrueRig(f.nominal, options);
 
   const calib::Camera& v = f.nominal.virtual_camera.camera;
   const double scale = o.flying_height_m / (v.c_mm() * 1e-3);
@@ -329,66 +409,18 @@ SimulatedRigFlight SimulateRigFlight(const RigFlightSimulationOptions& options) 
                                        options.speed_mps * std::sin(e.opk_rad.z()),
                                        0.0);
   f.exposures_file = internal::ExposuresAsMeasured(o, f.exposures_truth, random);
-  for (const auto& e : f.exposures_truth) {
-    for (size_t k = 0; k < f.truth.heads.size(); ++k) {
-      RigExposureTruth t;
-      t.image = e.image;
-      t.head = f.truth.heads[k].id;
-      if (static_cast<int>(k) != reference) {
-        t.increment_rad =
-            options.increment_sigma_rad * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-        t.dt_s =
-            options.head_time_offsets_s.empty()
-                ? options.time_offset_s
-                : options.head_time_offsets_s[std::min(k, options.head_time_offsets_s.size() - 1)];
-      }
-      f.rig_exposures.push_back(t);
-    }
-  }
-  const size_t heads = f.truth.heads.size();
-  // Every head of exposure i that sees `point` inside its format (margin in px).
-  const auto measure = [&](size_t i,
-                           const Eigen::Vector3d& point,
-                           std::vector<std::pair<int, Eigen::Vector2d>>* seen) {
-    seen->clear();
-    for (size_t k = 0; k < heads; ++k) {
-      const calib::RigHead& head = f.truth.heads[k];
-      Eigen::Vector2d px;
-      if (!ProjectRigHead(head, f.exposures_truth[i], f.rig_exposures[i * heads + k], point, &px))
-        continue;
-      if (px.x() < kMarginPx || px.y() < kMarginPx ||
-          px.x() > head.camera.width_px - 1 - kMarginPx ||
-          px.y() > head.camera.height_px - 1 - kMarginPx)
-        continue;
-      seen->push_back({static_cast<int>(k), px});
-    }
-  };
-  std::vector<std::pair<int, Eigen::Vector2d>> seen;
+  DrawRigExposures(f, random);
   const auto seen_by = [&](const Eigen::Vector3d& p) {
     int exposures = 0;
-    for (size_t i = 0; i < f.exposures_truth.size(); ++i) {
-      measure(i, p, &seen);
-      exposures += seen.empty() ? 0 : 1;
-    }
+    for (size_t i = 0; i < f.exposures_truth.size(); ++i)
+      exposures += HeadsSeeing(f, i, p).empty() ? 0 : 1;
     return exposures;
   };
   internal::PlacePoints(
       o, f.exposures_truth, footprint, seen_by, random, &f.points_truth, &f.points_file);
-
-  for (const auto& p : f.points_truth) {
-    for (size_t i = 0; i < f.exposures_truth.size(); ++i) {
-      measure(i, *p.xyz_m, &seen);
-      for (const auto& [k, px] : seen) {
-        ImageObservation obs;
-        obs.image = f.exposures_truth[i].image;
-        obs.head = f.truth.heads[k].id;
-        obs.point = p.id;
-        obs.sigma_px = o.image_sigma_px;
-        obs.pixel = px + o.image_noise_px * Eigen::Vector2d(normal(rng), normal(rng));
-        f.observations.push_back(obs);
-      }
-    }
-  }
+  for (const auto& p : f.points_truth)
+    for (size_t i = 0; i < f.exposures_truth.size(); ++i)
+      AddHeadObservations(f, i, p.id, HeadsSeeing(f, i, *p.xyz_m), random);
   AddStitchingTies(f, random);
   return f;
 }
