@@ -1,14 +1,19 @@
 #include "triangulation/simulation/flight_edge_targets.h"
 
+#include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "stitch/image_io/image_io.h"
 #include "stitch/resample/raster.h"
 #include "stitch/resample/virtual_image.h"
 #include "stitch/simulation/rendered_edge.h"
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
+#include <map>
 #include <random>
 #include <sstream>
+#include <utility>
 
 namespace aerocal::triangulation {
 namespace {
@@ -229,6 +234,88 @@ std::vector<EdgeTargetPatch> RenderEdgeTargetPatches(const SimulatedFlight& flig
       patches.push_back(std::move(p));
     }
   return patches;
+}
+
+namespace {
+
+constexpr int kTilesPerRow = 8;
+
+// A mosaic of patches: tile k at column k % 8, row k / 8 of tiles `tile` px wide.
+struct Mosaic {
+  std::vector<const stitch::GrayImage*> tiles;
+  stitch::PixelRegion Place(const stitch::GrayImage& image,
+                            const stitch::PixelRegion& region,
+                            int tile) {
+    AEROCAL_CHECK(image.rows() <= tile && image.cols() <= tile) << "a patch exceeds its tile";
+    const int k = static_cast<int>(tiles.size());
+    tiles.push_back(&image);
+    return {region.col + (k % kTilesPerRow) * tile,
+            region.row + (k / kTilesPerRow) * tile,
+            region.width,
+            region.height};
+  }
+  stitch::GrayImage Image(int tile) const {
+    const int n = static_cast<int>(tiles.size());
+    const int cols = std::min(n, kTilesPerRow), rows = (n + kTilesPerRow - 1) / kTilesPerRow;
+    stitch::GrayImage out = stitch::GrayImage::Zero(rows * tile, cols * tile);
+    for (int k = 0; k < n; ++k)
+      out.block((k / kTilesPerRow) * tile,
+                (k % kTilesPerRow) * tile,
+                tiles[k]->rows(),
+                tiles[k]->cols()) = *tiles[k];
+    return out;
+  }
+};
+
+std::string RoiColumns(const stitch::PixelRegion& r) {
+  std::ostringstream out;
+  out << r.col << ',' << r.row << ',' << r.width << ',' << r.height;
+  return out.str();
+}
+
+}  // namespace
+
+void WriteEdgeTargetPatches(const std::vector<EdgeTargetPatch>& patches,
+                            const std::vector<stitch::EdgeTarget>& edges,
+                            const FlightEdgeTargetOptions& options,
+                            const std::string& folder) {
+  namespace fs = std::filesystem;
+  fs::create_directories(folder);
+  const int tile = options.patch_px + 16;
+  std::map<std::string, Mosaic> raw;  // by sub-image
+  Mosaic virt;
+  std::ostringstream csv;
+  csv << "# edge target patches of the simulated flight (docs/formats.md); regions in px\n"
+      << "target,image,subimage,axis,raw_file,raw_col,raw_row,raw_width,raw_height,virtual_file,"
+         "virtual_col,virtual_row,virtual_width,virtual_height,raw_origin_col,raw_origin_row,"
+         "virtual_origin_col,virtual_origin_row,shift_x_px,shift_y_px,gsd_m\n";
+  csv.precision(10);
+  for (const EdgeTargetPatch& p : patches) {
+    const std::string raw_file = "raw_" + p.subimage + ".tif";
+    Eigen::Vector2d mean_shift = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector2d& d : p.shifts)
+      mean_shift += d / static_cast<double>(p.shifts.size());
+    csv << p.target << ',' << p.image << ',' << p.subimage << ',' << stitch::MtfAxisName(p.axis)
+        << ',' << raw_file << ',' << RoiColumns(raw[p.subimage].Place(p.raw, p.raw_region, tile))
+        << ",virtual.tif," << RoiColumns(virt.Place(p.virtual_image, p.virtual_region, tile)) << ','
+        << p.raw_origin_px.x() << ',' << p.raw_origin_px.y() << ',' << p.virtual_origin_px.x()
+        << ',' << p.virtual_origin_px.y() << ',' << mean_shift.x() << ',' << mean_shift.y() << ','
+        << p.gsd_m << '\n';
+  }
+  for (const auto& [sub, mosaic] : raw)
+    stitch::WriteGrayImage(
+        (fs::path(folder) / ("raw_" + sub + ".tif")).string(), mosaic.Image(tile), 16);
+  if (!patches.empty())
+    stitch::WriteGrayImage((fs::path(folder) / "virtual.tif").string(), virt.Image(tile), 16);
+  std::ostringstream targets;
+  targets << "# edge targets: bright on the left of start -> end seen from above (m)\n"
+          << "id,start_x,start_y,start_z,end_x,end_y,end_z\n";
+  targets.precision(12);
+  for (const stitch::EdgeTarget& e : edges)
+    targets << e.id << ',' << e.start_m.x() << ',' << e.start_m.y() << ',' << e.start_m.z() << ','
+            << e.end_m.x() << ',' << e.end_m.y() << ',' << e.end_m.z() << '\n';
+  WriteFileAtomically((fs::path(folder) / "targets.csv").string(), targets.str());
+  WriteFileAtomically((fs::path(folder) / "patches.csv").string(), csv.str());
 }
 
 }  // namespace aerocal::triangulation

@@ -74,4 +74,15 @@ std::vector<EdgeTargetPatch> RenderEdgeTargetPatches(const SimulatedFlight& flig
                                                      const std::vector<stitch::EdgeTarget>& edges,
                                                      const FlightEdgeTargetOptions& options);
 
+/// Writes the patches into `folder` (created): `raw_<SUB>.tif` per sub-image and `virtual.tif`,
+/// 16-bit mosaics of the patches (tiles of patch_px + 16 px, 8 to a row, 0 between them), so that
+/// one `aerocal quality mtf --image FILE --roi ...` measures all edges of a file; `patches.csv`
+/// (docs/formats.md "Edge target patches": per patch its edge, image, sub-image, axis, the regions
+/// to measure in the mosaics, the windows' origins, the mean sub-pixel shift and the GSD); and
+/// `targets.csv` (the edges' ground ends). Every text file is written atomically.
+void WriteEdgeTargetPatches(const std::vector<EdgeTargetPatch>& patches,
+                            const std::vector<stitch::EdgeTarget>& edges,
+                            const FlightEdgeTargetOptions& options,
+                            const std::string& folder);
+
 }  // namespace aerocal::triangulation
