@@ -6,6 +6,7 @@
 #include "tools/option_ranges.h"
 #include "triangulation/pushbroom/line_images.h"
 #include "triangulation/pushbroom/line_simulation.h"
+#include "triangulation/simulation/flight_edge_targets.h"
 #include "triangulation/simulation/flight_simulator.h"
 #include "triangulation/simulation/rig_flight_simulator.h"
 #include "triangulation/simulation/test_field_simulator.h"
@@ -35,6 +36,8 @@ struct SimulateArgs {
   triangulation::LineImageOptions line_images;
   bool test_field = false;
   triangulation::TestFieldOptions field;
+  bool edge_targets = false;  // frame flight: resolution targets and their image patches
+  triangulation::FlightEdgeTargetOptions edge;
 };
 
 // `simulate --test-field`: the calibration test field (triangulation/simulation/
@@ -156,6 +159,24 @@ int RunRigSimulation(const CLI::App& app,
       flight.observations.size(),
       args.out.c_str());
   return kExitOk;
+}
+
+// `simulate --edge-targets`: the flight's resolution targets and their patches in OUT/edge_targets
+// (triangulation/simulation/flight_edge_targets.h).
+void WriteEdgeTargets(const triangulation::SimulatedFlight& flight,
+                      triangulation::FlightEdgeTargetOptions options,
+                      std::uint64_t seed,
+                      const std::string& out) {
+  options.seed = seed;
+  const auto edges = triangulation::LayOutEdgeTargets(flight, options);
+  const auto patches = triangulation::RenderEdgeTargetPatches(flight, edges, options);
+  triangulation::WriteEdgeTargetPatches(patches, edges, options, out + "/edge_targets");
+  std::printf(
+      "rendered %zu edge target patches of %zu edges (PSF sigma %.2f px) -> %s/edge_targets\n",
+      patches.size(),
+      edges.size(),
+      options.psf_sigma_px,
+      out.c_str());
 }
 
 // `simulate --help` grouped by mode (issue 33 item 4): the options each mode adds, under its
@@ -329,6 +350,24 @@ CommandRun SetupSimulate(CLI::App& app) {
                  "GNSS time offset dt planted in the GNSS centres (+ v dt), -10000..10000 ms (with "
                  "--gnss-sigma-m and --speed-mps)")
       ->check(FiniteRange(-1e4, 1e4));
+  auto* edge_targets = app.add_flag(
+      "--edge-targets",
+      args->edge_targets,
+      "Also lay out square edge targets (both directions) on the ground and write "
+      "OUT/edge_targets/: raw sub-image patches of every exposure that sees an edge, rendered "
+      "through the true camera and a Gaussian PSF, and the virtual image's patches resampled "
+      "from them (bilinear), as mosaics for `aerocal quality mtf` with patches.csv");
+  app.add_option("--psf-sigma-px",
+                 args->edge.psf_sigma_px,
+                 "--edge-targets: sigma of the Gaussian PSF of the raw sub-images, 0.3..3 px")
+      ->needs(edge_targets)
+      ->check(FiniteRange(0.3, 3.0));
+  app.add_option("--edge-noise-dn",
+                 args->edge.noise_dn,
+                 "--edge-targets: Gaussian noise of the patches' pixels (16-bit, a 32000 DN step), "
+                 "0..2000 DN")
+      ->needs(edge_targets)
+      ->check(FiniteRange(0.0, 2000.0));
   // Line camera (pushbroom) flight: its own options; the shared ones above apply when given.
   auto& l = args->line;
   app.add_flag(
@@ -465,6 +504,8 @@ CommandRun SetupSimulate(CLI::App& app) {
   GroupOptionsByMode(app);
   return [args, &app, int_options, double_options, increment, time_offset, format_scale]() {
     CheckOutputFolder(args->out, "--out");
+    if (args->edge_targets && (args->test_field || args->pushbroom || !args->rig.empty()))
+      throw ConfigError("--edge-targets applies to a frame-camera flight only");
     if (args->test_field) return RunTestFieldSimulation(app, *args);
     for (const char* field_only : {"--planar", "--groups", "--images-per-group", "--distance-m"})
       if (app.count(field_only) > 0)
@@ -592,6 +633,7 @@ CommandRun SetupSimulate(CLI::App& app) {
                         "): control points are among the surveyed points");
     const auto flight = triangulation::SimulateFlight(o);
     triangulation::WriteSimulatedFlight(flight, args->out);
+    if (args->edge_targets) WriteEdgeTargets(flight, args->edge, args->seed, args->out);
     // Points are placed only where enough images see them: say when fewer than asked fit.
     int control = 0, check = 0, tie = 0;
     for (const auto& p : flight.points_truth)

@@ -3,6 +3,7 @@
 #include "calib/core/error.h"
 
 #include <cmath>
+#include <complex>
 
 namespace aerocal::stitch {
 namespace {
@@ -34,6 +35,12 @@ double KeysTransfer(double f) {
   return 2.0 * sum * h / 3.0;
 }
 
+// Bilinear interpolation's transfer along one axis at shift d, referred to the output pixel.
+std::complex<double> BilinearShiftTransfer(double d, double f) {
+  const double w = 2.0 * kPi * f;
+  return (1.0 - d) * std::polar(1.0, -w * d) + d * std::polar(1.0, w * (1.0 - d));
+}
+
 }  // namespace
 
 double InterpolationTransfer(Interpolation kind, double f_cy_px) {
@@ -51,6 +58,25 @@ double PredictResampledMtf50(const SlantedEdgeResult& raw,
         return EdgeMtfAt(raw, f) * InterpolationTransfer(kind, f * cx) *
                InterpolationTransfer(kind, f * cy);
       },
+      0.5);
+}
+
+double BilinearTransferAtShifts(const std::vector<Eigen::Vector2d>& shifts,
+                                const Eigen::Vector2d& normal,
+                                double f_cy_px) {
+  AEROCAL_CHECK(!shifts.empty()) << "no shifts";
+  std::complex<double> sum = 0.0;
+  for (const Eigen::Vector2d& d : shifts)
+    sum += BilinearShiftTransfer(d.x(), f_cy_px * normal.x()) *
+           BilinearShiftTransfer(d.y(), f_cy_px * normal.y());
+  return std::abs(sum) / static_cast<double>(shifts.size());
+}
+
+double PredictResampledMtf50AtShifts(const SlantedEdgeResult& raw,
+                                     const std::vector<Eigen::Vector2d>& shifts,
+                                     const Eigen::Vector2d& normal) {
+  return FirstCrossingFrequency(
+      [&](double f) { return EdgeMtfAt(raw, f) * BilinearTransferAtShifts(shifts, normal, f); },
       0.5);
 }
 

@@ -6,10 +6,16 @@
 // from the truth by the interior correction.
 #include "triangulation/simulation/flight_simulator.h"
 
+#include "stitch/quality/resampling_mtf.h"
+#include "tests/support/rendered_targets.h"
+#include "triangulation/simulation/flight_edge_targets.h"
+
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
+#include <complex>
+#include <cstdio>
 #include <map>
 #include <set>
 
@@ -141,6 +147,103 @@ TEST(FlightSimulator, ObservesEveryPointInEveryImageThatSeesIt) {
   }
   EXPECT_EQ(f.observations.size(), expected);
   EXPECT_GT(expected, 2000u);  // 2525 with seed 4
+}
+
+// The flight example of issue 36: edge targets laid out on the ground, raw sub-image patches
+// rendered through the true camera and a Gaussian PSF (s = 1 raw px, 40 DN noise on a 32000 DN
+// step), the virtual patches resampled from them (bilinear, the production resampler). The raw
+// MTF50 is the analytic one of the PSF and the pixel, and the virtual MTF50 is the raw one times
+// bilinear interpolation's transfer at the exact sub-pixel shifts of the true mapping
+// (stitch/quality/resampling_mtf.h), both within their stated U (k = 2).
+TEST(FlightEdgeTargets, VirtualImageLosesTheMtfBilinearResamplingPredicts) {
+  FlightSimulationOptions o;
+  o.ground_points = 40, o.tie_points = 100;  // the targets need only the exposures
+  const SimulatedFlight flight = SimulateFlight(o);
+  FlightEdgeTargetOptions t;
+  const std::vector<EdgeTargetPatch> patches =
+      RenderEdgeTargetPatches(flight, LayOutEdgeTargets(flight, t), t);
+  std::map<stitch::MtfAxis, std::vector<stitch::SlantedEdgeResult>> raw_by_axis, virtual_by_axis;
+  std::map<stitch::MtfAxis, double> predicted_sum;
+  for (const EdgeTargetPatch& p : patches) {
+    const stitch::SlantedEdgeResult raw = stitch::MeasureSlantedEdge(p.raw, p.raw_region);
+    const stitch::SlantedEdgeResult virt =
+        stitch::MeasureSlantedEdge(p.virtual_image, p.virtual_region);
+    const double analytic = testing::FirstCrossing(
+        [&](double f) {
+          return testing::RenderedEdgeMtf(
+              f, t.psf_sigma_px, std::atan2(p.raw_normal.y(), p.raw_normal.x()));
+        },
+        0.5);
+    const double predicted = stitch::PredictResampledMtf50AtShifts(raw, p.shifts, p.normal);
+    const double uniform = stitch::PredictResampledMtf50(
+        raw, stitch::Interpolation::kBilinear, std::atan2(p.normal.y(), p.normal.x()));
+    // The prediction carries the raw edge's U scaled to it; the two are counted as independent
+    // (the virtual patch's noise is the raw one's, interpolated: a conservative sum).
+    const double u_prediction = raw.mtf50_expanded_cy_px * predicted / raw.mtf50_cy_px;
+    const double expanded = std::hypot(virt.mtf50_expanded_cy_px, u_prediction);
+    std::printf(
+        "%-5s %-4s %-4s raw %.4f (analytic %.4f, U %.4f) virtual %.4f (U %.4f), loss "
+        "%5.2f %%, predicted %5.2f %% (uniform phases %5.2f %%), virtual / predicted "
+        "%+.2f %%\n",
+        p.target.c_str(),
+        p.image.c_str(),
+        p.subimage.c_str(),
+        raw.mtf50_cy_px,
+        analytic,
+        raw.mtf50_expanded_cy_px,
+        virt.mtf50_cy_px,
+        virt.mtf50_expanded_cy_px,
+        100.0 * (1.0 - virt.mtf50_cy_px / raw.mtf50_cy_px),
+        100.0 * (1.0 - predicted / raw.mtf50_cy_px),
+        100.0 * (1.0 - uniform / raw.mtf50_cy_px),
+        100.0 * (virt.mtf50_cy_px / predicted - 1.0));
+    EXPECT_EQ(raw.axis, p.axis) << p.target << " " << p.image;
+    EXPECT_NEAR(raw.mtf50_cy_px, analytic, raw.mtf50_expanded_cy_px) << p.target << " " << p.image;
+    EXPECT_NEAR(virt.mtf50_cy_px, predicted, expanded) << p.target << " " << p.image;
+    raw_by_axis[p.axis].push_back(raw);
+    virtual_by_axis[p.axis].push_back(virt);
+    predicted_sum[p.axis] += predicted;
+  }
+  for (stitch::MtfAxis axis : {stitch::MtfAxis::kX, stitch::MtfAxis::kY}) {
+    ASSERT_GE(raw_by_axis[axis].size(), 4u) << stitch::MtfAxisName(axis);
+    const stitch::EdgeMtfCombination raw = stitch::CombineEdgeMeasurements(raw_by_axis[axis]);
+    const stitch::EdgeMtfCombination virt = stitch::CombineEdgeMeasurements(virtual_by_axis[axis]);
+    std::printf("axis %s: %d patches, raw MTF50 %.4f +- %.4f, virtual %.4f +- %.4f (k = 2)\n",
+                std::string(stitch::MtfAxisName(axis)).c_str(),
+                raw.count,
+                raw.mtf50_cy_px,
+                raw.mtf50_expanded_cy_px,
+                virt.mtf50_cy_px,
+                virt.mtf50_expanded_cy_px);
+    EXPECT_LT(virt.mtf50_cy_px, raw.mtf50_cy_px) << stitch::MtfAxisName(axis);
+    // The combined virtual MTF50 is the mean prediction within its U (type A from the patches'
+    // scatter, which holds the spread of the shifts' losses too).
+    EXPECT_NEAR(virt.mtf50_cy_px, predicted_sum[axis] / virt.count, virt.mtf50_expanded_cy_px)
+        << stitch::MtfAxisName(axis);
+  }
+}
+
+// Bilinear interpolation's transfer at given shifts (stitch/quality/resampling_mtf.h): at one
+// shift d it is |(1 - d) + d e^{2 pi i f}| per axis; over shifts spread uniformly over the pixel it
+// is sinc^2, the transfer of the triangle kernel.
+TEST(FlightEdgeTargets, BilinearTransferAtShiftsHasItsClosedForms) {
+  const Eigen::Vector2d along_x(1.0, 0.0), slanted(std::cos(0.3), std::sin(0.3));
+  for (double d : {0.0, 0.25, 0.5, 0.8})
+    for (double f : {0.1, 0.3, 0.5}) {
+      const double expected = std::abs(std::complex<double>(1.0 - d, 0.0) +
+                                       d * std::polar(1.0, 2.0 * testing::kRenderPi * f));
+      EXPECT_NEAR(stitch::BilinearTransferAtShifts({{d, 0.7}}, along_x, f), expected, 1e-12);
+    }
+  EXPECT_NEAR(stitch::BilinearTransferAtShifts({{0.5, 0.5}}, along_x, 0.5), 0.0, 1e-12);
+  std::vector<Eigen::Vector2d> spread;  // a 64 x 64 grid of shifts over the pixel (midpoints)
+  for (int i = 0; i < 64; ++i)
+    for (int j = 0; j < 64; ++j) spread.push_back({(i + 0.5) / 64, (j + 0.5) / 64});
+  for (double f : {0.1, 0.25, 0.4}) {
+    const double expected =
+        stitch::InterpolationTransfer(stitch::Interpolation::kBilinear, f * slanted.x()) *
+        stitch::InterpolationTransfer(stitch::Interpolation::kBilinear, f * slanted.y());
+    EXPECT_NEAR(stitch::BilinearTransferAtShifts(spread, slanted, f), expected, 1e-3) << f;
+  }
 }
 
 }  // namespace

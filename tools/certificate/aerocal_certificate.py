@@ -268,9 +268,13 @@ def resolution_edge_rows(c):
 def resolution_axis_rows(c):
     """Repeated edges of one axis combined: type A from their scatter, type B the systematic part."""
     d = c.get("dynamic_image_resolution") or {}
-    rows = [["axis", "direction", "edges", "MTF50 cy/px", "u_A", "u_B", "U (k=2)", "lp/mm", "U", "GRD m", "U"]]
+    # One row per quality result and axis: the result's file name says which image (a sub-image, a
+    # head or the virtual image) its edges were measured in.
+    rows = [["result", "axis", "direction", "edges", "MTF50 cy/px", "u_A", "u_B", "U (k=2)", "lp/mm", "U",
+             "GRD m", "U"]]
     for a in d.get("axes", []):
-        rows.append([a.get("axis"), a.get("direction", "-"), a.get("count"), fmt(a.get("mtf50_cy_px"), 4),
+        source = os.path.splitext(os.path.basename(a.get("source", "-")))[0]
+        rows.append([source, a.get("axis"), a.get("direction", "-"), a.get("count"), fmt(a.get("mtf50_cy_px"), 4),
                      fmt(a.get("type_a_u_cy_px"), 2), fmt(a.get("type_b_u_cy_px"), 2),
                      fmt(a.get("mtf50_expanded_cy_px"), 2), fmt(a.get("mtf50_lp_per_mm"), 4),
                      fmt(a.get("mtf50_lp_per_mm_expanded"), 2), fmt(a.get("mtf50_resolved_distance_m"), 4),

@@ -71,9 +71,44 @@ struct DirectionCalibration {
   bool covariance_ok = false;
 };
 
+/// One camera unit of a multi-unit instrument: a sub-image (CCD) of a multi-CCD camera or a head
+/// of a rig, with its own interior (camera model, format) and its own mount on the instrument.
+struct DirectionUnit {
+  std::string id;       // sub-image or head id ("" for a single camera)
+  calib::Camera start;  // start interior, format and model of the unit
+  Eigen::Vector3d start_opk_rad = Eigen::Vector3d::Zero();  // start of instrument_from_unit
+  std::vector<DirectionObservation> observations;
+};
+
+/// The units of one instrument calibrated in ONE adjustment: a shared instrument rotation R (the
+/// first unit's, instrument_from_reference), per unit its interior and its mount M_k =
+/// reference_from_unit (M = identity for the first unit), the targets' directions shared by all.
+/// The problem is parameterised by each unit's rotation to the instrument, R_k = R M_k: a
+/// one-to-one reparameterisation of (R, M_2 .. M_n), so the estimate, sigma0 and the covariance
+/// (propagated through M_k = R_1^T R_k with the joint cross-covariance) are those of the
+/// (R, M) parameterisation. Units are coupled by the targets they share (a goniometer's fixed
+/// target seen by several heads) and by the common sigma0.
+struct DirectionUnitsCalibration {
+  calib::SolveReport report;
+  std::string method;                       // "collimator array" or "goniometer"
+  std::vector<DirectionCalibration> units;  // per unit: camera, sigmas, residuals, R_k (opk_rad)
+  /// Per unit: M_k = R_1^T R_k as omega, phi, kappa and its sigma (zero for the first unit).
+  std::vector<Eigen::Vector3d> mount_opk_rad, mount_sigma_rad;
+  std::map<std::string, Eigen::Vector2d> target_angles_rad, target_sigma_rad;
+  bool covariance_ok = false;
+};
+
+/// Adjusts every unit's observations of `targets` in one problem (DirectionUnitsCalibration).
+/// Throws as CalibrateFromDirections, naming the unit; LogicError without units.
+DirectionUnitsCalibration CalibrateUnitsFromDirections(
+    const std::vector<DirectionUnit>& units,
+    const std::vector<DirectionTarget>& targets,
+    const DirectionCalibrationOptions& options = {});
+
 /// Adjusts `observations` of `targets` starting from `start` (interior, format, model) and the
-/// rotation `start_opk_rad`. Throws InputError naming the observation for an unknown target id, a
-/// sigma out of range or a parameter name not in the model's table.
+/// rotation `start_opk_rad` (CalibrateUnitsFromDirections with one unit). Throws InputError naming
+/// the observation for an unknown target id, a sigma out of range or a parameter name not in the
+/// model's table.
 DirectionCalibration CalibrateFromDirections(const calib::Camera& start,
                                              const Eigen::Vector3d& start_opk_rad,
                                              const std::vector<DirectionTarget>& targets,
