@@ -80,55 +80,60 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
   camera_ = project.rigs.begin()->first;
   rig_ = &project.rigs.begin()->second;
   reference_ = rig_->ReferenceIndex();
-  calib::ProblemBuilder& builder = context.builder;
-  const std::string prefix = "rig " + camera_ + " head ";
-
   const int n = static_cast<int>(rig_->heads.size());
   heads_.assign(n, Head{});
-  for (int k = 0; k < n; ++k) {
-    const calib::RigHead& head = rig_->heads[k];
-    Head& h = heads_[k];
-    h.mount_rad = head.mount_rad;
-    h.lever_arm_m = head.lever_arm_m;
-    const std::string name = prefix + head.id;
-    if (k == reference_) {
-      h.interior_block = context.frame.InteriorBlock(context.index.Camera(camera_));
-    } else {
-      // Free interior entries as the frame camera's, named by the head's own model.
-      const InteriorLayout layout =
-          InteriorLayoutOf(head.camera, context.options.free_interior, name);
-      h.interior = head.camera.interior;
-      h.interior_block = builder.AddBlock(name + " interior",
-                                          h.interior.data(),
-                                          h.interior.size(),
-                                          calib::BlockKind::kInterior,
-                                          layout.names);
-      builder.FixEntries(h.interior_block, layout.fixed);
-    }
-    h.mount_block = builder.AddBlock(
-        name + " mount", h.mount_rad.data(), 3, calib::BlockKind::kOther, kMountNames);
-    h.lever_arm_block = builder.AddBlock(
-        name + " lever arm", h.lever_arm_m.data(), 3, calib::BlockKind::kOther, kLeverArmNames);
-    if (k == reference_) {
-      builder.FixBlock(h.mount_block);  // the rig's datum: the reference head
-      builder.FixBlock(h.lever_arm_block);
-      continue;
-    }
-    calib::ApplyBlockMode(builder, h.mount_block, options_.mounts);
-    calib::ApplyBlockMode(builder, h.lever_arm_block, options_.lever_arms);
-    const auto weighted_needs = [&](bool has, const char* what, const char* key) {
-      if (!has)
-        throw ConfigError(context.project.camera_files.at(camera_) + ": head " + head.id + ": " +
-                          what + " weighted needs the head's " + key);
-    };
-    if (options_.mounts == calib::BlockMode::kWeighted)
-      weighted_needs(head.mount_sigma_rad.has_value(), "--rig-mounts", "mount_sigma_deg");
-    if (options_.lever_arms == calib::BlockMode::kWeighted)
-      weighted_needs(head.lever_arm_sigma_m.has_value(), "--rig-lever-arms", "lever_arm_sigma_m");
-    if (options_.time_offsets != calib::BlockMode::kFixed)
-      h.time_offset_block = builder.AddBlock(
-          name + " time offset", &h.time_offset_s, 1, calib::BlockKind::kOther, {"dT"});
+  for (int k = 0; k < n; ++k) RegisterHead(context, k);
+  RegisterZeroBlocks(context.builder);
+  RegisterIncrements(context);
+}
+
+void RigHeadCamera::RegisterHead(const SensorContext& context, int k) {
+  calib::ProblemBuilder& builder = context.builder;
+  const calib::RigHead& head = rig_->heads[k];
+  Head& h = heads_[k];
+  h.mount_rad = head.mount_rad;
+  h.lever_arm_m = head.lever_arm_m;
+  const std::string name = "rig " + camera_ + " head " + head.id;
+  if (k == reference_) {
+    h.interior_block = context.frame.InteriorBlock(context.index.Camera(camera_));
+  } else {
+    // Free interior entries as the frame camera's, named by the head's own model.
+    const InteriorLayout layout =
+        InteriorLayoutOf(head.camera, context.options.free_interior, name);
+    h.interior = head.camera.interior;
+    h.interior_block = builder.AddBlock(name + " interior",
+                                        h.interior.data(),
+                                        h.interior.size(),
+                                        calib::BlockKind::kInterior,
+                                        layout.names);
+    builder.FixEntries(h.interior_block, layout.fixed);
   }
+  h.mount_block = builder.AddBlock(
+      name + " mount", h.mount_rad.data(), 3, calib::BlockKind::kOther, kMountNames);
+  h.lever_arm_block = builder.AddBlock(
+      name + " lever arm", h.lever_arm_m.data(), 3, calib::BlockKind::kOther, kLeverArmNames);
+  if (k == reference_) {
+    builder.FixBlock(h.mount_block);  // the rig's datum: the reference head
+    builder.FixBlock(h.lever_arm_block);
+    return;
+  }
+  calib::ApplyBlockMode(builder, h.mount_block, options_.mounts);
+  calib::ApplyBlockMode(builder, h.lever_arm_block, options_.lever_arms);
+  const auto weighted_needs = [&](bool has, const char* what, const char* key) {
+    if (!has)
+      throw ConfigError(context.project.camera_files.at(camera_) + ": head " + head.id + ": " +
+                        what + " weighted needs the head's " + key);
+  };
+  if (options_.mounts == calib::BlockMode::kWeighted)
+    weighted_needs(head.mount_sigma_rad.has_value(), "--rig-mounts", "mount_sigma_deg");
+  if (options_.lever_arms == calib::BlockMode::kWeighted)
+    weighted_needs(head.lever_arm_sigma_m.has_value(), "--rig-lever-arms", "lever_arm_sigma_m");
+  if (options_.time_offsets != calib::BlockMode::kFixed)
+    h.time_offset_block = builder.AddBlock(
+        name + " time offset", &h.time_offset_s, 1, calib::BlockKind::kOther, {"dT"});
+}
+
+void RigHeadCamera::RegisterZeroBlocks(calib::ProblemBuilder& builder) {
   zero_increment_block_ = builder.AddBlock("rig " + camera_ + " zero increment",
                                            zero_increment_.data(),
                                            3,
@@ -141,8 +146,12 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
                                              calib::BlockKind::kOther,
                                              {"dT"});
   builder.FixBlock(zero_time_offset_block_);
+}
 
-  // Exposures of the rig: per-head increments; velocity where the time offsets are estimated.
+// Exposures of the rig: per-head increments; velocity where the time offsets are estimated.
+void RigHeadCamera::RegisterIncrements(const SensorContext& context) {
+  const Project& project = context.project;
+  const int n = static_cast<int>(rig_->heads.size());
   for (ExposureIndex e = 0; e < context.index.NumExposures(); ++e) {
     const Exposure& exposure = project.exposures[e];
     if (exposure.camera != camera_) continue;
@@ -155,12 +164,12 @@ void RigHeadCamera::RegisterBlocks(const SensorContext& context) {
     for (int k = 0; k < n; ++k) {
       if (k == reference_) continue;
       Increment& increment = increments_[{e, k}];
-      increment.block = builder.AddBlock("rig " + camera_ + " image " + exposure.image + " head " +
-                                             rig_->heads[k].id + " increment",
-                                         increment.rad.data(),
-                                         3,
-                                         calib::BlockKind::kOther,
-                                         kIncrementNames);
+      increment.block = context.builder.AddBlock("rig " + camera_ + " image " + exposure.image +
+                                                     " head " + rig_->heads[k].id + " increment",
+                                                 increment.rad.data(),
+                                                 3,
+                                                 calib::BlockKind::kOther,
+                                                 kIncrementNames);
     }
   }
 }

@@ -150,6 +150,11 @@ class RigHeadCamera final : public ImagingModel {
                                                                const ObservationSite& site,
                                                                int head) const;
   calib::BlockId IncrementBlock(ExposureIndex exposure, int head) const;
+  // RegisterBlocks' steps: one head's interior, mount, lever arm and time offset; the fixed zero
+  // increment and time offset of the reference head; the per-exposure increments.
+  void RegisterHead(const SensorContext& context, int k);
+  void RegisterZeroBlocks(calib::ProblemBuilder& builder);
+  void RegisterIncrements(const SensorContext& context);
 
   RigAdjustOptions options_;
   std::string camera_;  // the rig's camera id
