@@ -157,11 +157,10 @@ void SetupImportImages(CLI::App& app,
   });
 }
 
-CommandRun SetupImport(CLI::App& app) {
-  app.require_subcommand(1);
-  auto out = std::make_shared<std::string>();
-  auto run = std::make_shared<CommandRun>();
-
+// `import colmap`: a COLMAP text model.
+void SetupImportColmap(CLI::App& app,
+                       const std::shared_ptr<std::string>& out,
+                       const std::shared_ptr<CommandRun>& run) {
   CLI::App* colmap =
       app.add_subcommand("colmap", "COLMAP text model (cameras.txt, images.txt, points3D.txt)");
   auto c = std::make_shared<triangulation::ColmapImportOptions>();
@@ -190,7 +189,12 @@ CommandRun SetupImport(CLI::App& app) {
       return kExitOk;
     };
   });
+}
 
+// `import dbat`: DBAT / PhotoModeler marks with a DBAT camera.
+void SetupImportDbat(CLI::App& app,
+                     const std::shared_ptr<std::string>& out,
+                     const std::shared_ptr<CommandRun>& run) {
   CLI::App* dbat = app.add_subcommand("dbat", "DBAT / PhotoModeler marks with a DBAT camera");
   auto d = std::make_shared<triangulation::DbatImportOptions>();
   dbat->add_option("--camera-xml", d->camera_xml, "DBAT camera XML")->required();
@@ -217,7 +221,30 @@ CommandRun SetupImport(CLI::App& app) {
       return kExitOk;
     };
   });
+}
 
+// --control of `import odm`: comma-separated target names, or a gcp_list whose targets are control.
+std::set<std::string> OdmControlIds(const std::string& control,
+                                    const triangulation::OdmImportOptions& o) {
+  std::set<std::string> ids;
+  if (control.find(',') == std::string::npos && control.find('.') != std::string::npos) {
+    triangulation::OdmImportOptions subset;
+    subset.gcp_list = control;
+    subset.camera = o.camera;
+    subset.pixel_scale = o.pixel_scale;
+    subset.crs = o.crs;
+    for (const auto& p : triangulation::ImportOdmGcpList(subset).points) ids.insert(p.id);
+    if (ids.empty()) throw ConfigError("--control: " + control + " lists no target");
+  } else {
+    for (const std::string& id : SplitCommaList(control)) ids.insert(id);
+  }
+  return ids;
+}
+
+// `import odm`: an OpenDroneMap gcp_list.txt.
+void SetupImportOdm(CLI::App& app,
+                    const std::shared_ptr<std::string>& out,
+                    const std::shared_ptr<CommandRun>& run) {
   CLI::App* odm =
       app.add_subcommand("odm", "OpenDroneMap gcp_list.txt (targets in near-nadir images)");
   auto o = std::make_shared<triangulation::OdmImportOptions>();
@@ -244,21 +271,7 @@ CommandRun SetupImport(CLI::App& app) {
     *run = [=] {
       CheckOutputFolder(*out, "--out");
       o->camera = calib::ReadCamera(*camera_file);
-      if (!control->empty()) {
-        if (control->find(',') == std::string::npos && control->find('.') != std::string::npos) {
-          triangulation::OdmImportOptions subset;
-          subset.gcp_list = *control;
-          subset.camera = o->camera;
-          subset.pixel_scale = o->pixel_scale;
-          subset.crs = o->crs;
-          for (const auto& p : triangulation::ImportOdmGcpList(subset).points)
-            o->control_ids.insert(p.id);
-          if (o->control_ids.empty())
-            throw ConfigError("--control: " + *control + " lists no target");
-        } else {
-          for (const std::string& id : SplitCommaList(*control)) o->control_ids.insert(id);
-        }
-      }
+      if (!control->empty()) o->control_ids = OdmControlIds(*control, *o);
       auto project = triangulation::ImportOdmGcpList(*o);
       if (project.observations.empty())
         throw InputError(o->gcp_list + ": no image sees two or more targets: nothing to import");
@@ -276,6 +289,15 @@ CommandRun SetupImport(CLI::App& app) {
       return kExitOk;
     };
   });
+}
+
+CommandRun SetupImport(CLI::App& app) {
+  app.require_subcommand(1);
+  auto out = std::make_shared<std::string>();
+  auto run = std::make_shared<CommandRun>();
+  SetupImportColmap(app, out, run);
+  SetupImportDbat(app, out, run);
+  SetupImportOdm(app, out, run);
   SetupImportImages(app, out, run);
   return [run]() { return (*run)(); };
 }

@@ -106,37 +106,10 @@ int RunControl(ControlArgs& a) {
   return kExitOk;
 }
 
-CommandRun Setup(CLI::App& app) {
-  app.require_subcommand(1);
-  auto args = std::make_shared<CalibrateArgs>();
+// `pushbroom calibrate`'s estimation: the spline, the polynomial test, the datum, the POS and
+// the mount (boresight, lever arm, time offset).
+void AddLineEstimationOptions(CLI::App* cal, CalibrateArgs* args) {
   auto& o = args->options;
-  CLI::App* cal = app.add_subcommand(
-      "calibrate",
-      "Per-line EO corrections (cubic B-spline) and per-detector calibration (polynomial per "
-      "sub-camera) of a line camera from control points");
-  cal->option_defaults()->always_capture_default();
-  cal->add_option("--camera", args->camera, "Line camera file (YAML with a line section)")
-      ->required();
-  cal->add_option("--pos", args->pos, "pos.csv: line,time_s,X,Y,Z,omega,phi,kappa[,sigmas]")
-      ->required();
-  cal->add_option("--observations",
-                  args->observations,
-                  "observations.csv: point,col,row[,sigma_px] (col = detector, row = scan line)")
-      ->required();
-  cal->add_option(
-         "--points", args->points, "points.csv: control points with sX,sY,sZ (others ignored)")
-      ->required();
-  cal->add_option("--out", args->out, "Output file: the result JSON")->required();
-  cal->add_option("--write-camera",
-                  args->write_camera,
-                  "The updated camera file (written only when the result is valid)");
-  cal->add_option("--lines", args->lines_csv, "Per-line corrections with sigmas (CSV)");
-  cal->add_option("--plot",
-                  args->plot,
-                  "SVG: per sub-camera the errors along and across track against the detector with "
-                  "the fitted polynomial and its sigma band");
-  cal->add_option("--sigma-px", args->sigma_px, "Image sigma where observations.csv gives none, px")
-      ->check(PositiveUpTo(100));
   cal->add_option("--node-spacing", o.node_spacing_lines, "Spline nodes every N lines, >= 1")
       ->check(FiniteRange(1, 1e6));
   cal->add_option(
@@ -197,41 +170,11 @@ CommandRun Setup(CLI::App& app) {
                   o.min_observations_per_segment,
                   "Fewer observations between two nodes: warning few_points_per_line")
       ->check(FiniteRange(0, 1e6));
-  auto control_args = std::make_shared<ControlArgs>();
+}
+
+// `pushbroom control`'s L1 rectification, matching and gross-error options.
+void AddControlMatchingOptions(CLI::App* ctl, ControlArgs* control_args) {
   auto& c = control_args->request.options;
-  CLI::App* ctl = app.add_subcommand(
-      "control",
-      "Cloud control points from the line image: L1 rectification onto the mean terrain height, "
-      "Foerstner points, matching into oriented reference frame images, forward intersection");
-  ctl->option_defaults()->always_capture_default();
-  ctl->add_option("--camera", control_args->request.camera, "Nominal line camera file")->required();
-  ctl->add_option("--pos", control_args->request.pos, "pos.csv of the line image")->required();
-  ctl->add_option("--line-image",
-                  control_args->request.line_image,
-                  "The line image: row = scan line, column = detector")
-      ->required();
-  ctl->add_option("--reference-camera",
-                  control_args->request.reference_camera,
-                  "Camera file of the reference frame images")
-      ->required();
-  auto* ref_csv =
-      ctl->add_option("--reference-exposures",
-                      control_args->request.reference_exposures,
-                      "exposures.csv with the oriented reference frames (the block result)");
-  auto* ref_result = ctl->add_option(
-      "--reference-result",
-      control_args->request.reference_result,
-      "result.json of `aerocal adjust` with the oriented reference frames (instead of "
-      "--reference-exposures; its used exposures)");
-  ref_csv->excludes(ref_result);
-  ctl->add_option("--reference-images",
-                  control_args->request.reference_images,
-                  "Folder of the reference images (named by their exposure id, .png/.tif/.jpg)")
-      ->required();
-  ctl->add_option("--out",
-                  control_args->out,
-                  "Output folder: observations.csv, points.csv, control.json (and l1.png)")
-      ->required();
   ctl->add_option("--mean-height-m", c.mean_height_m, "Height of the L1 rectification plane, m")
       ->check(FiniteRange(-500, 10000));
   ctl->add_option("--gsd-m", c.gsd_m, "L1 cell size, m (0: the POS line spacing)")
@@ -280,6 +223,86 @@ CommandRun Setup(CLI::App& app) {
                   "Fewer control points: warning too_few_control_points, exit 3")
       ->check(FiniteRange(0, 1e6));
   ctl->add_flag("--write-l1", control_args->write_l1, "Also write the L1 image (l1.png)");
+}
+
+// `pushbroom calibrate`: its files, then the estimation's options.
+CLI::App* AddCalibrate(CLI::App& app, const std::shared_ptr<CalibrateArgs>& args) {
+  CLI::App* cal = app.add_subcommand(
+      "calibrate",
+      "Per-line EO corrections (cubic B-spline) and per-detector calibration (polynomial per "
+      "sub-camera) of a line camera from control points");
+  cal->option_defaults()->always_capture_default();
+  cal->add_option("--camera", args->camera, "Line camera file (YAML with a line section)")
+      ->required();
+  cal->add_option("--pos", args->pos, "pos.csv: line,time_s,X,Y,Z,omega,phi,kappa[,sigmas]")
+      ->required();
+  cal->add_option("--observations",
+                  args->observations,
+                  "observations.csv: point,col,row[,sigma_px] (col = detector, row = scan line)")
+      ->required();
+  cal->add_option(
+         "--points", args->points, "points.csv: control points with sX,sY,sZ (others ignored)")
+      ->required();
+  cal->add_option("--out", args->out, "Output file: the result JSON")->required();
+  cal->add_option("--write-camera",
+                  args->write_camera,
+                  "The updated camera file (written only when the result is valid)");
+  cal->add_option("--lines", args->lines_csv, "Per-line corrections with sigmas (CSV)");
+  cal->add_option("--plot",
+                  args->plot,
+                  "SVG: per sub-camera the errors along and across track against the detector with "
+                  "the fitted polynomial and its sigma band");
+  cal->add_option("--sigma-px", args->sigma_px, "Image sigma where observations.csv gives none, px")
+      ->check(PositiveUpTo(100));
+  AddLineEstimationOptions(cal, args.get());
+  return cal;
+}
+
+// `pushbroom control`: its files, then the rectification's and matching's options.
+CLI::App* AddControl(CLI::App& app, const std::shared_ptr<ControlArgs>& control_args) {
+  CLI::App* ctl = app.add_subcommand(
+      "control",
+      "Cloud control points from the line image: L1 rectification onto the mean terrain height, "
+      "Foerstner points, matching into oriented reference frame images, forward intersection");
+  ctl->option_defaults()->always_capture_default();
+  ctl->add_option("--camera", control_args->request.camera, "Nominal line camera file")->required();
+  ctl->add_option("--pos", control_args->request.pos, "pos.csv of the line image")->required();
+  ctl->add_option("--line-image",
+                  control_args->request.line_image,
+                  "The line image: row = scan line, column = detector")
+      ->required();
+  ctl->add_option("--reference-camera",
+                  control_args->request.reference_camera,
+                  "Camera file of the reference frame images")
+      ->required();
+  auto* ref_csv =
+      ctl->add_option("--reference-exposures",
+                      control_args->request.reference_exposures,
+                      "exposures.csv with the oriented reference frames (the block result)");
+  auto* ref_result = ctl->add_option(
+      "--reference-result",
+      control_args->request.reference_result,
+      "result.json of `aerocal adjust` with the oriented reference frames (instead of "
+      "--reference-exposures; its used exposures)");
+  ref_csv->excludes(ref_result);
+  ctl->add_option("--reference-images",
+                  control_args->request.reference_images,
+                  "Folder of the reference images (named by their exposure id, .png/.tif/.jpg)")
+      ->required();
+  ctl->add_option("--out",
+                  control_args->out,
+                  "Output folder: observations.csv, points.csv, control.json (and l1.png)")
+      ->required();
+  AddControlMatchingOptions(ctl, control_args.get());
+  return ctl;
+}
+
+CommandRun Setup(CLI::App& app) {
+  app.require_subcommand(1);
+  auto args = std::make_shared<CalibrateArgs>();
+  auto control_args = std::make_shared<ControlArgs>();
+  CLI::App* cal = AddCalibrate(app, args);
+  CLI::App* ctl = AddControl(app, control_args);
   return [args, cal, control_args, ctl] {
     if (ctl->parsed()) return RunControl(*control_args);
     if (cal->parsed()) return RunCalibrate(*args);
