@@ -67,8 +67,9 @@ void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
   app.add_flag("--residuals-csv",
                args->residuals_csv,
                "Write each adjustment's per-observation residual table as "
-               "residuals_<adjustment>.csv beside result.json (named there with its SHA-256) "
-               "instead of inside it: a big flight's result.json stays small");
+               "residuals_<adjustment>.csv and the stitching frames' as residuals_stitching.csv "
+               "beside result.json (named there with their SHA-256) instead of inside it: a big "
+               "flight's result.json stays small");
   app.add_option(
       "--camera-format",
       args->camera_format,

@@ -3,6 +3,8 @@ aerocal_add_test(tools/cli_simulate LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(tools/cli_rig_stitch LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/cli_flight LIBS aerocal::stitch LABELS cli TIMEOUT 600)
 target_sources(test_tools_cli_flight PRIVATE ${PROJECT_SOURCE_DIR}/tools/observation_tables.cc)
+# The report script the tests run on a flight's output (AEROCAL_REPORT_SCRIPT, as the program's).
+target_compile_definitions(test_tools_cli_flight PRIVATE ${AEROCAL_TOOL_DEFINITIONS})
 include(${CMAKE_CURRENT_SOURCE_DIR}/tools/report.cmake)
 include(${CMAKE_CURRENT_SOURCE_DIR}/tools/report_outputs.cmake)
 aerocal_add_test(tools/bad_input LIBS aerocal::triangulation LABELS cli)
