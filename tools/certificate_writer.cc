@@ -144,29 +144,22 @@ nlohmann::json Compare(const nlohmann::json& now,
   return {{"rows", rows}, {"pass", all_pass}};
 }
 
-// An in-flight calibration (`aerocal flight` result.json) in the form of a `calibrate` result: the
-// adjustment whose camera the flight certifies (the joint one when it ran, else the
-// self-calibration), and an uncertainty budget of type A only: the adjustment's standard deviation
-// of each calibrated parameter (dof = the redundancy, k from it). Type B components (control
-// survey, target eccentricity, conditions) and group reproducibility need a test field and image
-// groups: not evaluated here, said in the method.
-nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::string& path) {
+// The adjustment whose camera a flight certifies: the joint one when it ran, else the
+// self-calibration (a reference into `flight`).
+const nlohmann::json& CertifiedAdjustment(const nlohmann::json& flight, const std::string& path) {
   const nlohmann::json* chosen = nullptr;
   if (flight.contains("adjustments") && flight["adjustments"].is_array())
-    for (const auto& a : flight["adjustments"])  // a reference into `flight`, kept below
+    for (const auto& a : flight["adjustments"])
       if (a.value("name", "") == "self_calibration" || a.value("name", "") == "joint") chosen = &a;
   if (!chosen || !chosen->contains("cameras") || (*chosen)["cameras"].empty())
     throw InputError(path + ": a flight result without a self-calibrating adjustment (--result)");
-  nlohmann::json out = *chosen;
-  out["command"] = "calibrate";
-  out["valid"] = flight.value("valid", false);
-  out["invalid_reasons"] = nlohmann::json::array();
-  for (const auto& f : flight.value("failures", nlohmann::json::array()))
-    out["invalid_reasons"].push_back(f.value("step", "") + ": " + f.value("reason", ""));
-  out["warnings"] = flight.value("warnings", nlohmann::json::array());
-  const nlohmann::json& camera = out["cameras"][0];
-  const double redundancy = out.value("redundancy", 0.0);
-  nlohmann::json budget = nlohmann::json::array();
+  return *chosen;
+}
+
+// The type-A budget of c, x0, y0 of a flight's certified camera: the adjustment's standard
+// deviation of each (dof = the redundancy, k from it); fixed or unknown ones are left out.
+std::vector<triangulation::BudgetQuantity> TypeABudget(const nlohmann::json& camera,
+                                                       double redundancy) {
   static const std::map<std::string, std::pair<const char*, const char*>> kQuantities = {
       {"c", {"mm", "principal distance"}},
       {"x0", {"mm", "principal point x"}},
@@ -198,19 +191,42 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
     q.statement = triangulation::CertificateStatement(q.name, q.value, q.expanded, q.k, q.unit);
     quantities.push_back(q);
   }
+  return quantities;
+}
+
+// The number of used image residuals and their RMS (px, both components together).
+std::pair<int, double> UsedResidualRms(const nlohmann::json& adjustment) {
   double sum2 = 0;
   int n = 0;
-  for (const auto& r : out.value("residuals", nlohmann::json::array()))
+  for (const auto& r : adjustment.value("residuals", nlohmann::json::array()))
     if (r.value("used", true) && r.contains("v_col_px")) {
       sum2 +=
           std::pow(r.at("v_col_px").get<double>(), 2) + std::pow(r.at("v_row_px").get<double>(), 2);
       ++n;
     }
+  return {n, n > 0 ? std::sqrt(sum2 / n) : 0.0};
+}
+
+// An in-flight calibration (`aerocal flight` result.json) in the form of a `calibrate` result: the
+// certified adjustment (CertifiedAdjustment) and an uncertainty budget of type A only
+// (TypeABudget). Type B components (control survey, target eccentricity, conditions) and group
+// reproducibility need a test field and image groups: not evaluated here, said in the method.
+nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::string& path) {
+  const nlohmann::json& chosen = CertifiedAdjustment(flight, path);
+  nlohmann::json out = chosen;
+  out["command"] = "calibrate";
+  out["valid"] = flight.value("valid", false);
+  out["invalid_reasons"] = nlohmann::json::array();
+  for (const auto& f : flight.value("failures", nlohmann::json::array()))
+    out["invalid_reasons"].push_back(f.value("step", "") + ": " + f.value("reason", ""));
+  out["warnings"] = flight.value("warnings", nlohmann::json::array());
+  const nlohmann::json& camera = out["cameras"][0];
+  const auto [n, rms_px] = UsedResidualRms(out);
   const nlohmann::json format = flight.value("camera_format", nlohmann::json::object());
   out["calibration"] = {
       {"method",
        {{"kind", "in-flight calibration"},
-        {"adjustment", chosen->value("name", "")},
+        {"adjustment", chosen.value("name", "")},
         {"flight_data", flight.value("data", "")},
         {"budget",
          "type A only (the adjustment's covariance); type B and group reproducibility "
@@ -226,11 +242,12 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
         {"control_points", out["control"].value("n", 0)},
         {"check_points", out["check"].value("n", 0)},
         {"groups", 0}}},
-      {"uncertainty", triangulation::BudgetToJson(quantities)},
+      {"uncertainty",
+       triangulation::BudgetToJson(TypeABudget(camera, out.value("redundancy", 0.0)))},
       {"groups", nlohmann::json::array()},
       {"stability", nlohmann::json::object()},
       {"radii_mm", nlohmann::json::array()},
-      {"rms_px", n > 0 ? std::sqrt(sum2 / n) : 0.0}};
+      {"rms_px", rms_px}};
   return out;
 }
 
@@ -270,6 +287,8 @@ nlohmann::json ReadCertificateLab(const std::string& path) {
   return out;
 }
 
+namespace {
+
 // Runs `read` (typed access into a JSON document); a value of the wrong JSON type or a missing
 // table (nlohmann's exception) is bad input naming the file and option (exit 2, nothing written).
 template <typename Read>
@@ -281,61 +300,55 @@ auto ReadTyped(const std::string& path, const char* option, Read&& read) -> decl
   }
 }
 
-// The "dynamic image resolution" section from `aerocal quality` results: per edge the slanted-edge
-// MTF50 with U (and its units), MTF at Nyquist and the curve; per axis the repeated edges combined;
-// per bar target and per Siemens star the limiting frequency. Values are copied, nothing is
-// recomputed.
-nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
-  nlohmann::json section = {{"sources", paths},
-                            {"edges", nlohmann::json::array()},
-                            {"axes", nlohmann::json::array()},
-                            {"bars", nlohmann::json::array()},
-                            {"stars", nlohmann::json::array()}};
-  const auto copy =
-      [](const nlohmann::json& from, nlohmann::json* to, std::initializer_list<const char*> keys) {
-        for (const char* key : keys)
-          if (from.contains(key)) (*to)[key] = from[key];
-      };
-  for (const std::string& path : paths) {
-    const nlohmann::json doc =
-        ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality`");
-    ReadTyped(path, "--quality", [&] {
-      if (doc.at("kind") == "quality_star") {
-        nlohmann::json star = {{"source", path}};
-        copy(doc,
-             &star,
-             {"method",
-              "star",
-              "options",
-              "reference_modulation",
-              "rings",
-              "limiting_frequency_cy_px",
-              "limit_in_range",
-              "limiting_radius_px",
-              "limiting_lp_per_mm",
-              "limiting_resolved_distance_m"});
-        section["stars"].push_back(star);
-        return 0;
-      }
-      if (doc.at("kind") == "quality_bars") {
-        nlohmann::json bars = {{"source", path}};
-        copy(doc,
-             &bars,
-             {"method",
-              "options",
-              "reference_modulation",
-              "groups",
-              "limiting_frequency_cy_px",
-              "limit_in_range",
-              "limiting_lp_per_mm",
-              "limiting_resolved_distance_m"});
-        section["bars"].push_back(bars);
-        return 0;
-      }
-      section["method"] = doc.at("method");
-      for (const auto& e : doc.at("edges")) {
-        nlohmann::json edge = {{"source", path}};
-        copy(e,
+// Copies `keys` of `from` that exist into `to` (the quality results' values, not recomputed).
+void CopyKeys(const nlohmann::json& from,
+              nlohmann::json* to,
+              std::initializer_list<const char*> keys) {
+  for (const char* key : keys)
+    if (from.contains(key)) (*to)[key] = from[key];
+}
+
+// A Siemens star's reading (`quality star`): its limiting frequency.
+nlohmann::json StarJson(const nlohmann::json& doc, const std::string& path) {
+  nlohmann::json star = {{"source", path}};
+  CopyKeys(doc,
+           &star,
+           {"method",
+            "star",
+            "options",
+            "reference_modulation",
+            "rings",
+            "limiting_frequency_cy_px",
+            "limit_in_range",
+            "limiting_radius_px",
+            "limiting_lp_per_mm",
+            "limiting_resolved_distance_m"});
+  return star;
+}
+
+// A bar target's reading (`quality bars`): its limiting frequency.
+nlohmann::json BarsJson(const nlohmann::json& doc, const std::string& path) {
+  nlohmann::json bars = {{"source", path}};
+  CopyKeys(doc,
+           &bars,
+           {"method",
+            "options",
+            "reference_modulation",
+            "groups",
+            "limiting_frequency_cy_px",
+            "limit_in_range",
+            "limiting_lp_per_mm",
+            "limiting_resolved_distance_m"});
+  return bars;
+}
+
+// A slanted-edge reading (`quality mtf`) into `section`: its method, every edge's MTF50 with U,
+// MTF at Nyquist and the curve, and per axis the repeated edges combined.
+void AddMtf(const nlohmann::json& doc, const std::string& path, nlohmann::json* section) {
+  (*section)["method"] = doc.at("method");
+  for (const auto& e : doc.at("edges")) {
+    nlohmann::json edge = {{"source", path}};
+    CopyKeys(e,
              &edge,
              {"roi",
               "axis",
@@ -351,11 +364,11 @@ nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
               "mtf50_resolved_distance_expanded_m",
               "curve",
               "budget"});
-        section["edges"].push_back(edge);
-      }
-      for (const auto& [axis, c] : doc.at("axes").items()) {
-        nlohmann::json combined = {{"source", path}, {"axis", axis}};
-        copy(c,
+    (*section)["edges"].push_back(edge);
+  }
+  for (const auto& [axis, c] : doc.at("axes").items()) {
+    nlohmann::json combined = {{"source", path}, {"axis", axis}};
+    CopyKeys(c,
              &combined,
              {"direction",
               "count",
@@ -367,8 +380,30 @@ nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
               "mtf50_lp_per_mm_expanded",
               "mtf50_resolved_distance_m",
               "mtf50_resolved_distance_expanded_m"});
-        section["axes"].push_back(combined);
-      }
+    (*section)["axes"].push_back(combined);
+  }
+}
+
+// The "dynamic image resolution" section from `aerocal quality` results: per edge the slanted-edge
+// MTF50 with U (and its units), MTF at Nyquist and the curve; per axis the repeated edges combined;
+// per bar target and per Siemens star the limiting frequency. Values are copied, nothing is
+// recomputed.
+nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
+  nlohmann::json section = {{"sources", paths},
+                            {"edges", nlohmann::json::array()},
+                            {"axes", nlohmann::json::array()},
+                            {"bars", nlohmann::json::array()},
+                            {"stars", nlohmann::json::array()}};
+  for (const std::string& path : paths) {
+    const nlohmann::json doc =
+        ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality`");
+    ReadTyped(path, "--quality", [&] {
+      if (doc.at("kind") == "quality_star")
+        section["stars"].push_back(StarJson(doc, path));
+      else if (doc.at("kind") == "quality_bars")
+        section["bars"].push_back(BarsJson(doc, path));
+      else
+        AddMtf(doc, path, &section);
       return 0;
     });
   }
@@ -403,17 +438,59 @@ nlohmann::json DistortionJson(const nlohmann::json& cert) {
       {"profile_kind", figure.profile_kind}, {"profile", figure.profile}, {"grid", figure.grid}};
 }
 
-int WriteCertificate(const CertificateArgs& args) {
-  CheckOutputFolder(args.out, "--out");
-  if (!args.tolerances.empty() && args.previous.empty())
-    throw ConfigError("--tolerances needs --previous");
-  const nlohmann::json lab = ReadCertificateLab(args.lab);
-  const auto tolerances = ReadTolerances(args.tolerances);
+// The certificate's data from a checked `calibrate` result (or a flight's in that form): the
+// method, camera, data, adjustment statistics, budget, interior, groups, check and control
+// statistics, the distortion samples and the used residual vectors.
+nlohmann::json CertificateData(const nlohmann::json& result,
+                               const nlohmann::json& lab,
+                               const std::string& source) {
+  const nlohmann::json& cal = result["calibration"];
+  nlohmann::json cert;
+  cert["kind"] = "certificate";
+  cert["lab"] = lab;
+  cert["source"] = source;
+  cert["method"] = cal.at("method");
+  cert["camera_file"] = cal.at("camera");
+  cert["data"] = cal.at("data");
+  cert["adjustment"] = {
+      {"sigma0", result["sigma0"]},
+      {"sigma0_px", result["sigma0_px"]},
+      {"sigma0_um", result["sigma0_um"]},
+      {"redundancy", result["redundancy"]},
+      {"converged", result["converged"]},
+      {"valid", result.value("valid", false)},
+      {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
+      {"warnings", result.value("warnings", nlohmann::json::array())},
+      {"self_calibration", result.value("self_calibration", nlohmann::json())},
+      {"rms_px", cal.at("rms_px")}};
+  cert["results"] = cal.at("uncertainty");
+  cert["interior"] = result["cameras"][0];
+  cert["camera_model"] = result.value("camera_model", nlohmann::json());
+  cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
+  cert["groups"] = cal.at("groups");
+  cert["stability"] = cal.at("stability");
+  cert["check"] = result["check"];
+  cert["control"] = result["control"];
+  cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
+  cert["opencv"] = cal.value("opencv", nlohmann::json());
+  cert["distortion"] = DistortionJson(cert);
+  // Residual vectors (image pixels) for the vector field plot.
+  nlohmann::json residuals = nlohmann::json::array();
+  for (const auto& r : result.value("residuals", nlohmann::json::array()))
+    if (r.value("used", true))
+      residuals.push_back({r.at("col"), r.at("row"), r.at("v_col_px"), r.at("v_row_px")});
+  cert["residuals"] = residuals;
+  return cert;
+}
+
+// The certificate of args.result (a calibrate or flight result), checked through its schema and
+// every statement against its numbers; `valid`: the calibration is valid and its groups agree.
+nlohmann::json CertificateOfResult(const CertificateArgs& args,
+                                   const nlohmann::json& lab,
+                                   bool* valid) {
   // The result of `aerocal calibrate` (kind "adjust", command "calibrate") or of `aerocal flight`.
   nlohmann::json result = ReadResult(args.result, {"adjust", "flight"}, "`aerocal calibrate`");
-  nlohmann::json cert;
-  std::vector<std::string> statements;  // checked before anything is written
-  const bool valid = ReadTyped(args.result, "--result", [&] {
+  return ReadTyped(args.result, "--result", [&] {
     if (result.is_object() && result.value("kind", "") == "flight") {
       InflateResidualTables(&result, args.result);  // `flight --residuals-csv`
       result = CalibrateFormOfFlight(result, args.result);
@@ -424,99 +501,93 @@ int WriteCertificate(const CertificateArgs& args) {
     // Through its schema (key path in the message), and every statement against its numbers.
     ValidateJson(result, InputSchema("calibrate_result"), args.result);
     CheckStatements(result["calibration"]["uncertainty"], args.result, "calibration.uncertainty");
-    const nlohmann::json& cal = result["calibration"];
-    cert["kind"] = "certificate";
-    cert["lab"] = lab;
-    cert["source"] = args.result_name.empty() ? args.result : args.result_name;
-    cert["method"] = cal.at("method");
-    cert["camera_file"] = cal.at("camera");
-    cert["data"] = cal.at("data");
-    cert["adjustment"] = {
-        {"sigma0", result["sigma0"]},
-        {"sigma0_px", result["sigma0_px"]},
-        {"sigma0_um", result["sigma0_um"]},
-        {"redundancy", result["redundancy"]},
-        {"converged", result["converged"]},
-        {"valid", result.value("valid", false)},
-        {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
-        {"warnings", result.value("warnings", nlohmann::json::array())},
-        {"self_calibration", result.value("self_calibration", nlohmann::json())},
-        {"rms_px", cal.at("rms_px")}};
-    cert["results"] = cal.at("uncertainty");
-    cert["interior"] = result["cameras"][0];
-    cert["camera_model"] = result.value("camera_model", nlohmann::json());
-    cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
-    cert["groups"] = cal.at("groups");
-    cert["stability"] = cal.at("stability");
-    cert["check"] = result["check"];
-    cert["control"] = result["control"];
-    cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
-    cert["opencv"] = cal.value("opencv", nlohmann::json());
-    cert["distortion"] = DistortionJson(cert);
-    // Residual vectors (image pixels) for the vector field plot.
-    nlohmann::json residuals = nlohmann::json::array();
-    for (const auto& r : result.value("residuals", nlohmann::json::array()))
-      if (r.value("used", true))
-        residuals.push_back({r.at("col"), r.at("row"), r.at("v_col_px"), r.at("v_row_px")});
-    cert["residuals"] = residuals;
-    for (const auto& q : cert["results"])
-      statements.push_back(q.at("statement").get<std::string>());
-    return cert["adjustment"]["valid"].get<bool>() && cal.at("stability").value("agree", true);
+    nlohmann::json cert =
+        CertificateData(result, lab, args.result_name.empty() ? args.result : args.result_name);
+    *valid = cert["adjustment"]["valid"].get<bool>() &&
+             result["calibration"].at("stability").value("agree", true);
+    return cert;
   });
-  if (!args.quality.empty()) cert["dynamic_image_resolution"] = DynamicResolutionJson(args.quality);
-  bool comparison_pass = true;
-  if (!args.previous.empty()) {
-    const nlohmann::json previous = ReadResult(
-        args.previous, {"certificate", "adjust"}, "`aerocal certificate` or `aerocal calibrate`");
-    comparison_pass = ReadTyped(args.previous, "--previous", [&] {
-      const nlohmann::json* old = Uncertainty(previous);
-      if (!old)
-        throw InputError(args.previous +
-                         ": neither a certificate.json nor a calibrate result (--previous)");
-      ValidateJson(previous, InputSchema("previous"), args.previous);
-      CheckStatements(*old,
-                      args.previous,
-                      previous.contains("results") ? "results" : "calibration.uncertainty");
-      cert["comparison"] = Compare(cert["results"], *old, tolerances, args.previous);
-      cert["comparison"]["previous"] = args.previous;
-      if (previous.contains("lab"))
-        cert["comparison"]["previous_certificate"] = previous["lab"].at("certificate");
-      return cert["comparison"]["pass"].get<bool>();
-    });
-  }
-  // certificate.json, .html and .pdf are one set (tools/output_set.h): all are written into a
-  // staging folder and moved into args.out only when every part was written, so a failing
-  // renderer replaces nothing of the previous certificate.
+}
+
+// The comparison with args.previous (a certificate.json or calibrate result) against the
+// tolerances, into cert["comparison"]; whether it passes.
+bool CompareWithPrevious(const CertificateArgs& args,
+                         const std::map<std::string, double>& tolerances,
+                         nlohmann::json* cert) {
+  const nlohmann::json previous = ReadResult(
+      args.previous, {"certificate", "adjust"}, "`aerocal certificate` or `aerocal calibrate`");
+  return ReadTyped(args.previous, "--previous", [&] {
+    const nlohmann::json* old = Uncertainty(previous);
+    if (!old)
+      throw InputError(args.previous +
+                       ": neither a certificate.json nor a calibrate result (--previous)");
+    ValidateJson(previous, InputSchema("previous"), args.previous);
+    CheckStatements(
+        *old, args.previous, previous.contains("results") ? "results" : "calibration.uncertainty");
+    (*cert)["comparison"] = Compare((*cert)["results"], *old, tolerances, args.previous);
+    (*cert)["comparison"]["previous"] = args.previous;
+    if (previous.contains("lab"))
+      (*cert)["comparison"]["previous_certificate"] = previous["lab"].at("certificate");
+    return (*cert)["comparison"]["pass"].get<bool>();
+  });
+}
+
+// certificate.json, .html and .pdf are one set (tools/output_set.h): all are written into a
+// staging folder and moved into args.out only when every part was written, so a failing
+// renderer replaces nothing of the previous certificate. kExitInternal when rendering failed.
+int WriteCertificateFiles(const CertificateArgs& args, const nlohmann::json& cert) {
   OutputSet set(args.out);
   const std::string json_path = set.Staged("certificate.json");
   WriteResult(json_path, "certificate", cert);
-  if (!args.no_render) {
-    const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
-    const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
-    if (!RunPythonScript(script, {json_path, set.staging()})) {
-      std::fprintf(stderr,
-                   "error: the certificate could not be rendered (%s); nothing written, the "
-                   "previous certificate in %s is left as it was\n",
-                   PythonCommandLine(script, {json_path, set.staging()}).c_str(),
-                   args.out.c_str());
-      return kExitInternal;
-    }
-    set.Commit({"certificate.json", "certificate.html", "certificate.pdf"});
-  } else {
+  if (args.no_render) {
     // certificate.json alone: an .html / .pdf of a previous certificate would not describe it.
     set.Commit({"certificate.json"}, {"certificate.html", "certificate.pdf"});
+    return kExitOk;
   }
+  const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
+  const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
+  if (!RunPythonScript(script, {json_path, set.staging()})) {
+    std::fprintf(stderr,
+                 "error: the certificate could not be rendered (%s); nothing written, the "
+                 "previous certificate in %s is left as it was\n",
+                 PythonCommandLine(script, {json_path, set.staging()}).c_str(),
+                 args.out.c_str());
+    return kExitInternal;
+  }
+  set.Commit({"certificate.json", "certificate.html", "certificate.pdf"});
+  return kExitOk;
+}
+
+// What was written, every statement, and the comparison's verdict.
+void PrintCertificate(const CertificateArgs& args, const nlohmann::json& cert, bool pass) {
   const std::string shown = args.out_name.empty() ? args.out : args.out_name;
   std::printf("certificate data -> %s/certificate.json\n", shown.c_str());
-  for (const auto& statement : statements) std::printf("  %s\n", statement.c_str());
+  for (const auto& q : cert["results"])
+    std::printf("  %s\n", q.at("statement").get<std::string>().c_str());
   if (cert.contains("comparison"))
-    std::printf(
-        "comparison with %s: %s\n", args.previous.c_str(), comparison_pass ? "pass" : "FAIL");
+    std::printf("comparison with %s: %s\n", args.previous.c_str(), pass ? "pass" : "FAIL");
   if (!args.no_render)
     std::printf(
         "certificate -> %s/certificate.html, %s/certificate.pdf\n", shown.c_str(), shown.c_str());
-  const bool ok = valid && comparison_pass;
-  return ok ? kExitOk : kExitNotConverged;
+}
+
+}  // namespace
+
+int WriteCertificate(const CertificateArgs& args) {
+  CheckOutputFolder(args.out, "--out");
+  if (!args.tolerances.empty() && args.previous.empty())
+    throw ConfigError("--tolerances needs --previous");
+  const nlohmann::json lab = ReadCertificateLab(args.lab);
+  const auto tolerances = ReadTolerances(args.tolerances);
+  bool valid = false;
+  nlohmann::json cert = CertificateOfResult(args, lab, &valid);
+  if (!args.quality.empty()) cert["dynamic_image_resolution"] = DynamicResolutionJson(args.quality);
+  const bool comparison_pass =
+      args.previous.empty() || CompareWithPrevious(args, tolerances, &cert);
+  // Everything is checked before anything is written.
+  if (WriteCertificateFiles(args, cert) == kExitInternal) return kExitInternal;
+  PrintCertificate(args, cert, comparison_pass);
+  return valid && comparison_pass ? kExitOk : kExitNotConverged;
 }
 
 }  // namespace aerocal::tools
