@@ -5,6 +5,7 @@
 // tolerances. Deterministic: no clock, no random numbers (the date comes from the lab file).
 #include "tools/certificate_writer.h"
 
+#include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -27,6 +28,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <vector>
 
 namespace aerocal::tools {
@@ -156,41 +158,86 @@ const nlohmann::json& CertifiedAdjustment(const nlohmann::json& flight, const st
   return *chosen;
 }
 
-// The type-A budget of c, x0, y0 of a flight's certified camera: the adjustment's standard
-// deviation of each (dof = the redundancy, k from it); fixed or unknown ones are left out.
-std::vector<triangulation::BudgetQuantity> TypeABudget(const nlohmann::json& camera,
-                                                       double redundancy) {
-  static const std::map<std::string, std::pair<const char*, const char*>> kQuantities = {
-      {"c", {"mm", "principal distance"}},
-      {"x0", {"mm", "principal point x"}},
-      {"y0", {"mm", "principal point y"}}};
-  std::vector<triangulation::BudgetQuantity> quantities;
-  for (const auto& [name, info] : kQuantities) {
-    const nlohmann::json sigma = camera.at("sigma").value(name, nlohmann::json());
-    if (!sigma.is_number() || !(sigma.get<double>() > 0)) continue;  // fixed or unknown
-    triangulation::BudgetQuantity q;
-    q.name = name;
-    q.unit = info.first;
-    q.description = info.second;
-    q.value = camera.at("estimated").at(name).get<double>();
-    triangulation::UncertaintyComponent a;
-    a.source = "adjustment covariance (in-flight self-calibration)";
-    a.origin =
-        "the flight adjustment's sigma: image observations, control survey sigmas and GNSS/IMU "
-        "priors together, scaled by sigma0 (redundancy as degrees of freedom)";
-    a.type = "A";
-    a.distribution = "normal";
-    a.value = a.u = sigma.get<double>();
-    a.value_unit = q.unit;
-    a.dof = redundancy > 0 ? redundancy : std::numeric_limits<double>::infinity();
-    q.components.push_back(a);
-    q.u_c = a.u;
-    q.dof_eff = a.dof;
-    q.k = triangulation::CoverageFactor(q.dof_eff);
-    q.expanded = q.k * q.u_c;
-    q.statement = triangulation::CertificateStatement(q.name, q.value, q.expanded, q.k, q.unit);
-    quantities.push_back(q);
+// A matrix of a result's JSON ({names, matrix}); empty unless it is `size` x `size` of numbers.
+Eigen::MatrixXd MatrixOf(const nlohmann::json& block, int size) {
+  if (!block.is_object() || !block.contains("matrix") || !block["matrix"].is_array() ||
+      static_cast<int>(block["matrix"].size()) != size)
+    return {};
+  Eigen::MatrixXd m(size, size);
+  for (int i = 0; i < size; ++i) {
+    const nlohmann::json& row = block["matrix"][i];
+    if (!row.is_array() || static_cast<int>(row.size()) != size) return {};
+    for (int k = 0; k < size; ++k) {
+      if (!row[k].is_number()) return {};
+      m(i, k) = row[k].get<double>();
+    }
   }
+  return m;
+}
+
+// The pixel pitch's tolerance from the flight's camera file (pixel_size_tolerance_mm), when the
+// file is still there and states one.
+std::optional<double> PitchTolerance(const std::string& camera_file) {
+  std::error_code ec;
+  if (camera_file.empty() || !fs::exists(camera_file, ec)) return std::nullopt;
+  return calib::ReadCamera(camera_file).pixel_size_tolerance_mm;
+}
+
+// The flight's certified interior as the budget needs it (triangulation::AdjustedInterior): its
+// estimates, a covariance holding the adjustment's variances (sigma^2; only single parameters
+// are certified, so g^T C g needs no covariances), the joint adjustment's Q N_control Q and the
+// camera file's pitch tolerance.
+triangulation::AdjustedInterior FlightInterior(const nlohmann::json& flight,
+                                               const nlohmann::json& adjustment) {
+  const nlohmann::json& camera = adjustment.at("cameras").at(0);
+  triangulation::AdjustedInterior in;
+  const auto model = calib::CameraModelFromName(camera.value("model", ""));
+  in.table = calib::CameraModelParams(model ? *model : calib::CameraModelId::kBrownFraser10);
+  const int n = static_cast<int>(in.table.size());
+  in.params = calib::InteriorParams(std::vector<double>(n, 0.0));
+  in.covariance = Eigen::MatrixXd::Zero(n, n);
+  for (int k = 0; k < n; ++k) {
+    const std::string name(in.table[k].name);
+    in.params[k] = camera.at("estimated").value(name, 0.0);
+    const nlohmann::json sigma = camera.at("sigma").value(name, nlohmann::json());
+    if (sigma.is_number()) in.covariance(k, k) = std::pow(sigma.get<double>(), 2);
+  }
+  in.sigma0 = adjustment.value("sigma0", 1.0);
+  in.redundancy = adjustment.value("redundancy", 0.0);
+  in.control_cofactor =
+      MatrixOf(adjustment.value("interior_control_cofactor", nlohmann::json()), n);
+  const nlohmann::json format = flight.value("camera_format", nlohmann::json::object());
+  in.pixel_size_mm = format.value("pixel_size_mm", 0.0);
+  const std::string camera_file = flight.value("camera", "");
+  in.pitch_tolerance_mm = PitchTolerance(camera_file);
+  in.pitch_source = "the camera file " + camera_file;
+  in.image_origin = StringPrintf(
+      "the flight adjustment's image observations (and GNSS/IMU priors where it has them), scaled "
+      "by sigma0 = %.3g "
+      "(redundancy %.0f as degrees of freedom)%s",
+      in.sigma0,
+      in.redundancy,
+      in.control_cofactor.size() ? "; the control survey's part apart" : "");
+  in.control_origin = StringPrintf(
+      "survey sigmas of %d control points propagated through the flight adjustment (Q N_control "
+      "Q)",
+      adjustment.value("control", nlohmann::json::object()).value("n", 0));
+  return in;
+}
+
+// The budget of c, x0, y0 of a flight's certified camera (the calibrated ones; fixed or unknown
+// are left out): the test field's default components where their source is known
+// (triangulation::InteriorParameterBudget: image measurements, control coordinates, pixel pitch).
+std::vector<triangulation::BudgetQuantity> FlightBudget(const nlohmann::json& flight,
+                                                        const nlohmann::json& adjustment) {
+  static const std::map<std::string, const char*> kQuantities = {
+      {"c", "principal distance"}, {"x0", "principal point x"}, {"y0", "principal point y"}};
+  const triangulation::AdjustedInterior in = FlightInterior(flight, adjustment);
+  std::vector<triangulation::BudgetQuantity> quantities;
+  for (const auto& [name, description] : kQuantities)
+    for (int k = 0; k < static_cast<int>(in.table.size()); ++k)
+      if (in.table[k].name == name && in.covariance(k, k) > 0)
+        quantities.push_back(triangulation::InteriorParameterBudget(in, k, description));
   return quantities;
 }
 
@@ -207,10 +254,22 @@ std::pair<int, double> UsedResidualRms(const nlohmann::json& adjustment) {
   return {n, n > 0 ? std::sqrt(sum2 / n) : 0.0};
 }
 
+// What the flight's budget holds, for the method statement.
+std::string FlightBudgetMethod(const nlohmann::json& adjustment) {
+  const bool control = adjustment.contains("interior_control_cofactor");
+  return std::string(
+             "type A: the image measurements (and GNSS/IMU priors where the flight has them) of "
+             "the adjustment, scaled by sigma0; type B: ") +
+         (control ? "the control coordinates' survey sigmas propagated (Q N_control Q), "
+                  : "the control coordinates are in type A (this adjustment did not separate "
+                    "them), ") +
+         "the pixel pitch's tolerance of the camera file; target eccentricity and group "
+         "reproducibility need a test field and image groups and are not evaluated for an "
+         "in-flight calibration";
+}
+
 // An in-flight calibration (`aerocal flight` result.json) in the form of a `calibrate` result: the
-// certified adjustment (CertifiedAdjustment) and an uncertainty budget of type A only
-// (TypeABudget). Type B components (control survey, target eccentricity, conditions) and group
-// reproducibility need a test field and image groups: not evaluated here, said in the method.
+// certified adjustment (CertifiedAdjustment) and its uncertainty budget (FlightBudget).
 nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::string& path) {
   const nlohmann::json& chosen = CertifiedAdjustment(flight, path);
   nlohmann::json out = chosen;
@@ -228,9 +287,7 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
        {{"kind", "in-flight calibration"},
         {"adjustment", chosen.value("name", "")},
         {"flight_data", flight.value("data", "")},
-        {"budget",
-         "type A only (the adjustment's covariance); type B and group reproducibility "
-         "are not evaluated for an in-flight calibration"}}},
+        {"budget", FlightBudgetMethod(chosen)}}},
       {"camera",
        {{"id", camera.value("id", "")},
         {"file", flight.value("camera", "")},
@@ -242,8 +299,7 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
         {"control_points", out["control"].value("n", 0)},
         {"check_points", out["check"].value("n", 0)},
         {"groups", 0}}},
-      {"uncertainty",
-       triangulation::BudgetToJson(TypeABudget(camera, out.value("redundancy", 0.0)))},
+      {"uncertainty", triangulation::BudgetToJson(FlightBudget(flight, chosen))},
       {"groups", nlohmann::json::array()},
       {"stability", nlohmann::json::object()},
       {"radii_mm", nlohmann::json::array()},

@@ -78,8 +78,8 @@ void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
   app.add_flag("--certificate",
                args->certificate,
                "Also write the certificate of the in-flight calibration (OUT/certificate/: "
-               "certificate.json, .html, .pdf; a type-A budget, as `aerocal certificate` of "
-               "result.json); only for a valid flight");
+               "certificate.json, .html, .pdf; its budget as `aerocal certificate` of "
+               "result.json gives it); only for a valid flight");
   app.add_option("--lab", args->lab, "Lab YAML of the certificate (as `aerocal certificate --lab`)")
       ->needs("--certificate");
   app.add_option(

@@ -160,8 +160,8 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
 
 TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   // `flight --certificate` writes the certificate form of the in-flight calibration (the joint
-  // adjustment's camera, a type-A budget: U = k sigma, k from the redundancy) as `aerocal
-  // certificate --result result.json` does; HTML and PDF rendered.
+  // adjustment's camera and its budget) as `aerocal certificate --result result.json` does; HTML
+  // and PDF rendered.
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
   const auto cert = aerocal::testing::ReadJson(dir_->File("report/certificate/certificate.json"));
   EXPECT_EQ(cert["method"]["kind"], "in-flight calibration");
@@ -177,8 +177,25 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
     has_c = true;
     const double sigma = joint["cameras"][0]["sigma"]["c"].get<double>();
     EXPECT_DOUBLE_EQ(q["value"].get<double>(), joint["cameras"][0]["estimated"]["c"].get<double>());
-    EXPECT_NEAR(q["U"].get<double>(), q["k"].get<double>() * sigma, 1e-15);
-    EXPECT_EQ(q["components"][0]["type"], "A");
+    // The test field's default components (issue 33): A image measurements, B control
+    // coordinates (the joint adjustment's Q N_control Q), B pixel pitch (no tolerance in the
+    // simulated camera file: zero, said so). The adjustment's variance splits as
+    // sigma^2 = u_image^2 + sigma0^2 u_control^2; U = k u_c.
+    const auto& c = q["components"];
+    ASSERT_EQ(c.size(), 3u) << c.dump();
+    EXPECT_EQ(c[0]["source"], "image measurements");
+    EXPECT_EQ(c[0]["type"], "A");
+    EXPECT_EQ(c[1]["source"], "control coordinates");
+    EXPECT_EQ(c[1]["type"], "B");
+    EXPECT_EQ(c[2]["source"], "pixel pitch");
+    const double u_image = c[0]["u"], u_control = c[1]["u"], u_pitch = c[2]["u"];
+    const double s0 = joint["sigma0"];
+    EXPECT_GT(u_control, 0.0);
+    EXPECT_EQ(u_pitch, 0.0);
+    EXPECT_NEAR(
+        u_image * u_image + s0 * s0 * u_control * u_control, sigma * sigma, 1e-9 * sigma * sigma);
+    const double u_c = std::sqrt(u_image * u_image + u_control * u_control);
+    EXPECT_NEAR(q["U"].get<double>(), q["k"].get<double>() * u_c, 1e-12 * u_c);
     EXPECT_NE(q["statement"].get<std::string>().find("(k = 2)"), std::string::npos)
         << q["statement"];
   }
