@@ -38,6 +38,7 @@ target_sources(test_tools_output_set PRIVATE ${PROJECT_SOURCE_DIR}/tools/output_
 # `aerocal batch` (issue 35): plan / run --shard / status / merge against `flight`, a killed run,
 # changed and failing units, GNU Parallel (skipped without it), the Slurm scripts.
 aerocal_add_test(tools/cli_batch LIBS aerocal::calib LABELS cli)
+target_sources(test_tools_cli_batch PRIVATE ${PROJECT_SOURCE_DIR}/tools/observation_tables.cc)
 # The same for real under Slurm: munged, slurmctld and slurmd started on this machine
 # (tests/tools/slurm_localhost.sh), a 4-task job array and the dependent merge. Skipped with the
 # reason without slurm-wlm and munge (not in tools/setup.sh); label long: it starts daemons.
