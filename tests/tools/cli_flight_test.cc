@@ -237,6 +237,38 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   EXPECT_GE(pages, 2);
 }
 
+TEST_F(FlightWorkflow, CertificatePixelPitchComponentFromTheCameraFile) {
+  // The flight's camera file states the pitch's tolerance +-T: the pixel pitch component of c is
+  // |dc/dpitch| T / sqrt 3 with dc/dpitch = c / pitch (a pitch s times the stated one makes
+  // every photo length, c among them, s times longer; uncertainty_budget.h).
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  constexpr double kTolerance = 2e-5;  // mm
+  WriteFileAtomically(dir_->File("camera_tolerance.yaml"),
+                      ReadTextFile(dir_->File("data/camera_nominal.yaml")) +
+                          "pixel_size_tolerance_mm: " + std::to_string(kTolerance) + "\n");
+  auto doc = aerocal::testing::ReadJson(dir_->File("report/result.json"));
+  doc["camera"] = dir_->File("camera_tolerance.yaml");
+  WriteFileAtomically(dir_->File("pitch/result.json"), doc.dump());
+  const auto r = testing::RunAerocal("certificate --result " + dir_->File("pitch/result.json") +
+                                     " --no-render --out " + dir_->File("pitch"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto cert = aerocal::testing::ReadJson(dir_->File("pitch/certificate.json"));
+  const double pitch = doc["camera_format"]["pixel_size_mm"];
+  bool has_c = false;
+  for (const auto& q : cert["results"]) {
+    if (q["quantity"] != "c") continue;
+    has_c = true;
+    const auto& pixel = q["components"][2];
+    ASSERT_EQ(pixel["source"], "pixel pitch");
+    const double c = q["value"];
+    EXPECT_NEAR(pixel["u"].get<double>(),
+                c / pitch * kTolerance / std::sqrt(3.0),
+                1e-6 * c / pitch * kTolerance);
+    EXPECT_NE(pixel["origin"].get<std::string>().find("camera_tolerance.yaml"), std::string::npos);
+  }
+  EXPECT_TRUE(has_c);
+}
+
 // Every file under `folder` (relative path -> content).
 std::map<std::string, std::string> Snapshot(const std::string& folder) {
   std::map<std::string, std::string> files;
