@@ -5,6 +5,7 @@
 // tolerances. Deterministic: no clock, no random numbers (the date comes from the lab file).
 #include "tools/certificate_writer.h"
 
+#include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -27,6 +28,7 @@
 #include <filesystem>
 #include <limits>
 #include <map>
+#include <optional>
 #include <vector>
 
 namespace aerocal::tools {
@@ -144,20 +146,133 @@ nlohmann::json Compare(const nlohmann::json& now,
   return {{"rows", rows}, {"pass", all_pass}};
 }
 
-// An in-flight calibration (`aerocal flight` result.json) in the form of a `calibrate` result: the
-// adjustment whose camera the flight certifies (the joint one when it ran, else the
-// self-calibration), and an uncertainty budget of type A only: the adjustment's standard deviation
-// of each calibrated parameter (dof = the redundancy, k from it). Type B components (control
-// survey, target eccentricity, conditions) and group reproducibility need a test field and image
-// groups: not evaluated here, said in the method.
-nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::string& path) {
+// The adjustment whose camera a flight certifies: the joint one when it ran, else the
+// self-calibration (a reference into `flight`).
+const nlohmann::json& CertifiedAdjustment(const nlohmann::json& flight, const std::string& path) {
   const nlohmann::json* chosen = nullptr;
   if (flight.contains("adjustments") && flight["adjustments"].is_array())
-    for (const auto& a : flight["adjustments"])  // a reference into `flight`, kept below
+    for (const auto& a : flight["adjustments"])
       if (a.value("name", "") == "self_calibration" || a.value("name", "") == "joint") chosen = &a;
   if (!chosen || !chosen->contains("cameras") || (*chosen)["cameras"].empty())
     throw InputError(path + ": a flight result without a self-calibrating adjustment (--result)");
-  nlohmann::json out = *chosen;
+  return *chosen;
+}
+
+// A matrix of a result's JSON ({names, matrix}); empty unless it is `size` x `size` of numbers.
+Eigen::MatrixXd MatrixOf(const nlohmann::json& block, int size) {
+  if (!block.is_object() || !block.contains("matrix") || !block["matrix"].is_array() ||
+      static_cast<int>(block["matrix"].size()) != size)
+    return {};
+  Eigen::MatrixXd m(size, size);
+  for (int i = 0; i < size; ++i) {
+    const nlohmann::json& row = block["matrix"][i];
+    if (!row.is_array() || static_cast<int>(row.size()) != size) return {};
+    for (int k = 0; k < size; ++k) {
+      if (!row[k].is_number()) return {};
+      m(i, k) = row[k].get<double>();
+    }
+  }
+  return m;
+}
+
+// The pixel pitch's tolerance from the flight's camera file (pixel_size_tolerance_mm), when the
+// file is still there and states one.
+std::optional<double> PitchTolerance(const std::string& camera_file) {
+  std::error_code ec;
+  if (camera_file.empty() || !fs::exists(camera_file, ec)) return std::nullopt;
+  return calib::ReadCamera(camera_file).pixel_size_tolerance_mm;
+}
+
+// The flight's certified interior as the budget needs it (triangulation::AdjustedInterior): its
+// estimates, a covariance holding the adjustment's variances (sigma^2; only single parameters
+// are certified, so g^T C g needs no covariances), the joint adjustment's Q N_control Q and the
+// camera file's pitch tolerance.
+triangulation::AdjustedInterior FlightInterior(const nlohmann::json& flight,
+                                               const nlohmann::json& adjustment) {
+  const nlohmann::json& camera = adjustment.at("cameras").at(0);
+  triangulation::AdjustedInterior in;
+  const auto model = calib::CameraModelFromName(camera.value("model", ""));
+  in.table = calib::CameraModelParams(model ? *model : calib::CameraModelId::kBrownFraser10);
+  const int n = static_cast<int>(in.table.size());
+  in.params = calib::InteriorParams(std::vector<double>(n, 0.0));
+  in.covariance = Eigen::MatrixXd::Zero(n, n);
+  for (int k = 0; k < n; ++k) {
+    const std::string name(in.table[k].name);
+    in.params[k] = camera.at("estimated").value(name, 0.0);
+    const nlohmann::json sigma = camera.at("sigma").value(name, nlohmann::json());
+    if (sigma.is_number()) in.covariance(k, k) = std::pow(sigma.get<double>(), 2);
+  }
+  in.sigma0 = adjustment.value("sigma0", 1.0);
+  in.redundancy = adjustment.value("redundancy", 0.0);
+  in.control_cofactor =
+      MatrixOf(adjustment.value("interior_control_cofactor", nlohmann::json()), n);
+  const nlohmann::json format = flight.value("camera_format", nlohmann::json::object());
+  in.pixel_size_mm = format.value("pixel_size_mm", 0.0);
+  const std::string camera_file = flight.value("camera", "");
+  in.pitch_tolerance_mm = PitchTolerance(camera_file);
+  in.pitch_source = "the camera file " + camera_file;
+  in.image_origin = StringPrintf(
+      "the flight adjustment's image observations (and GNSS/IMU priors where it has them), scaled "
+      "by sigma0 = %.3g "
+      "(redundancy %.0f as degrees of freedom)%s",
+      in.sigma0,
+      in.redundancy,
+      in.control_cofactor.size() ? "; the control survey's part apart" : "");
+  in.control_origin = StringPrintf(
+      "survey sigmas of %d control points propagated through the flight adjustment (Q N_control "
+      "Q)",
+      adjustment.value("control", nlohmann::json::object()).value("n", 0));
+  return in;
+}
+
+// The budget of c, x0, y0 of a flight's certified camera (the calibrated ones; fixed or unknown
+// are left out): the test field's default components where their source is known
+// (triangulation::InteriorParameterBudget: image measurements, control coordinates, pixel pitch).
+std::vector<triangulation::BudgetQuantity> FlightBudget(const nlohmann::json& flight,
+                                                        const nlohmann::json& adjustment) {
+  static const std::map<std::string, const char*> kQuantities = {
+      {"c", "principal distance"}, {"x0", "principal point x"}, {"y0", "principal point y"}};
+  const triangulation::AdjustedInterior in = FlightInterior(flight, adjustment);
+  std::vector<triangulation::BudgetQuantity> quantities;
+  for (const auto& [name, description] : kQuantities)
+    for (int k = 0; k < static_cast<int>(in.table.size()); ++k)
+      if (in.table[k].name == name && in.covariance(k, k) > 0)
+        quantities.push_back(triangulation::InteriorParameterBudget(in, k, description));
+  return quantities;
+}
+
+// The number of used image residuals and their RMS (px, both components together).
+std::pair<int, double> UsedResidualRms(const nlohmann::json& adjustment) {
+  double sum2 = 0;
+  int n = 0;
+  for (const auto& r : adjustment.value("residuals", nlohmann::json::array()))
+    if (r.value("used", true) && r.contains("v_col_px")) {
+      sum2 +=
+          std::pow(r.at("v_col_px").get<double>(), 2) + std::pow(r.at("v_row_px").get<double>(), 2);
+      ++n;
+    }
+  return {n, n > 0 ? std::sqrt(sum2 / n) : 0.0};
+}
+
+// What the flight's budget holds, for the method statement.
+std::string FlightBudgetMethod(const nlohmann::json& adjustment) {
+  const bool control = adjustment.contains("interior_control_cofactor");
+  return std::string(
+             "type A: the image measurements (and GNSS/IMU priors where the flight has them) of "
+             "the adjustment, scaled by sigma0; type B: ") +
+         (control ? "the control coordinates' survey sigmas propagated (Q N_control Q), "
+                  : "the control coordinates are in type A (this adjustment did not separate "
+                    "them), ") +
+         "the pixel pitch's tolerance of the camera file; target eccentricity and group "
+         "reproducibility need a test field and image groups and are not evaluated for an "
+         "in-flight calibration";
+}
+
+// An in-flight calibration (`aerocal flight` result.json) in the form of a `calibrate` result: the
+// certified adjustment (CertifiedAdjustment) and its uncertainty budget (FlightBudget).
+nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::string& path) {
+  const nlohmann::json& chosen = CertifiedAdjustment(flight, path);
+  nlohmann::json out = chosen;
   out["command"] = "calibrate";
   out["valid"] = flight.value("valid", false);
   out["invalid_reasons"] = nlohmann::json::array();
@@ -165,56 +280,14 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
     out["invalid_reasons"].push_back(f.value("step", "") + ": " + f.value("reason", ""));
   out["warnings"] = flight.value("warnings", nlohmann::json::array());
   const nlohmann::json& camera = out["cameras"][0];
-  const double redundancy = out.value("redundancy", 0.0);
-  nlohmann::json budget = nlohmann::json::array();
-  static const std::map<std::string, std::pair<const char*, const char*>> kQuantities = {
-      {"c", {"mm", "principal distance"}},
-      {"x0", {"mm", "principal point x"}},
-      {"y0", {"mm", "principal point y"}}};
-  std::vector<triangulation::BudgetQuantity> quantities;
-  for (const auto& [name, info] : kQuantities) {
-    const nlohmann::json sigma = camera.at("sigma").value(name, nlohmann::json());
-    if (!sigma.is_number() || !(sigma.get<double>() > 0)) continue;  // fixed or unknown
-    triangulation::BudgetQuantity q;
-    q.name = name;
-    q.unit = info.first;
-    q.description = info.second;
-    q.value = camera.at("estimated").at(name).get<double>();
-    triangulation::UncertaintyComponent a;
-    a.source = "adjustment covariance (in-flight self-calibration)";
-    a.origin =
-        "the flight adjustment's sigma: image observations, control survey sigmas and GNSS/IMU "
-        "priors together, scaled by sigma0 (redundancy as degrees of freedom)";
-    a.type = "A";
-    a.distribution = "normal";
-    a.value = a.u = sigma.get<double>();
-    a.value_unit = q.unit;
-    a.dof = redundancy > 0 ? redundancy : std::numeric_limits<double>::infinity();
-    q.components.push_back(a);
-    q.u_c = a.u;
-    q.dof_eff = a.dof;
-    q.k = triangulation::CoverageFactor(q.dof_eff);
-    q.expanded = q.k * q.u_c;
-    q.statement = triangulation::CertificateStatement(q.name, q.value, q.expanded, q.k, q.unit);
-    quantities.push_back(q);
-  }
-  double sum2 = 0;
-  int n = 0;
-  for (const auto& r : out.value("residuals", nlohmann::json::array()))
-    if (r.value("used", true) && r.contains("v_col_px")) {
-      sum2 +=
-          std::pow(r.at("v_col_px").get<double>(), 2) + std::pow(r.at("v_row_px").get<double>(), 2);
-      ++n;
-    }
+  const auto [n, rms_px] = UsedResidualRms(out);
   const nlohmann::json format = flight.value("camera_format", nlohmann::json::object());
   out["calibration"] = {
       {"method",
        {{"kind", "in-flight calibration"},
-        {"adjustment", chosen->value("name", "")},
+        {"adjustment", chosen.value("name", "")},
         {"flight_data", flight.value("data", "")},
-        {"budget",
-         "type A only (the adjustment's covariance); type B and group reproducibility "
-         "are not evaluated for an in-flight calibration"}}},
+        {"budget", FlightBudgetMethod(chosen)}}},
       {"camera",
        {{"id", camera.value("id", "")},
         {"file", flight.value("camera", "")},
@@ -226,11 +299,11 @@ nlohmann::json CalibrateFormOfFlight(const nlohmann::json& flight, const std::st
         {"control_points", out["control"].value("n", 0)},
         {"check_points", out["check"].value("n", 0)},
         {"groups", 0}}},
-      {"uncertainty", triangulation::BudgetToJson(quantities)},
+      {"uncertainty", triangulation::BudgetToJson(FlightBudget(flight, chosen))},
       {"groups", nlohmann::json::array()},
       {"stability", nlohmann::json::object()},
       {"radii_mm", nlohmann::json::array()},
-      {"rms_px", n > 0 ? std::sqrt(sum2 / n) : 0.0}};
+      {"rms_px", rms_px}};
   return out;
 }
 
@@ -270,6 +343,8 @@ nlohmann::json ReadCertificateLab(const std::string& path) {
   return out;
 }
 
+namespace {
+
 // Runs `read` (typed access into a JSON document); a value of the wrong JSON type or a missing
 // table (nlohmann's exception) is bad input naming the file and option (exit 2, nothing written).
 template <typename Read>
@@ -281,61 +356,55 @@ auto ReadTyped(const std::string& path, const char* option, Read&& read) -> decl
   }
 }
 
-// The "dynamic image resolution" section from `aerocal quality` results: per edge the slanted-edge
-// MTF50 with U (and its units), MTF at Nyquist and the curve; per axis the repeated edges combined;
-// per bar target and per Siemens star the limiting frequency. Values are copied, nothing is
-// recomputed.
-nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
-  nlohmann::json section = {{"sources", paths},
-                            {"edges", nlohmann::json::array()},
-                            {"axes", nlohmann::json::array()},
-                            {"bars", nlohmann::json::array()},
-                            {"stars", nlohmann::json::array()}};
-  const auto copy =
-      [](const nlohmann::json& from, nlohmann::json* to, std::initializer_list<const char*> keys) {
-        for (const char* key : keys)
-          if (from.contains(key)) (*to)[key] = from[key];
-      };
-  for (const std::string& path : paths) {
-    const nlohmann::json doc =
-        ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality`");
-    ReadTyped(path, "--quality", [&] {
-      if (doc.at("kind") == "quality_star") {
-        nlohmann::json star = {{"source", path}};
-        copy(doc,
-             &star,
-             {"method",
-              "star",
-              "options",
-              "reference_modulation",
-              "rings",
-              "limiting_frequency_cy_px",
-              "limit_in_range",
-              "limiting_radius_px",
-              "limiting_lp_per_mm",
-              "limiting_resolved_distance_m"});
-        section["stars"].push_back(star);
-        return 0;
-      }
-      if (doc.at("kind") == "quality_bars") {
-        nlohmann::json bars = {{"source", path}};
-        copy(doc,
-             &bars,
-             {"method",
-              "options",
-              "reference_modulation",
-              "groups",
-              "limiting_frequency_cy_px",
-              "limit_in_range",
-              "limiting_lp_per_mm",
-              "limiting_resolved_distance_m"});
-        section["bars"].push_back(bars);
-        return 0;
-      }
-      section["method"] = doc.at("method");
-      for (const auto& e : doc.at("edges")) {
-        nlohmann::json edge = {{"source", path}};
-        copy(e,
+// Copies `keys` of `from` that exist into `to` (the quality results' values, not recomputed).
+void CopyKeys(const nlohmann::json& from,
+              nlohmann::json* to,
+              std::initializer_list<const char*> keys) {
+  for (const char* key : keys)
+    if (from.contains(key)) (*to)[key] = from[key];
+}
+
+// A Siemens star's reading (`quality star`): its limiting frequency.
+nlohmann::json StarJson(const nlohmann::json& doc, const std::string& path) {
+  nlohmann::json star = {{"source", path}};
+  CopyKeys(doc,
+           &star,
+           {"method",
+            "star",
+            "options",
+            "reference_modulation",
+            "rings",
+            "limiting_frequency_cy_px",
+            "limit_in_range",
+            "limiting_radius_px",
+            "limiting_lp_per_mm",
+            "limiting_resolved_distance_m"});
+  return star;
+}
+
+// A bar target's reading (`quality bars`): its limiting frequency.
+nlohmann::json BarsJson(const nlohmann::json& doc, const std::string& path) {
+  nlohmann::json bars = {{"source", path}};
+  CopyKeys(doc,
+           &bars,
+           {"method",
+            "options",
+            "reference_modulation",
+            "groups",
+            "limiting_frequency_cy_px",
+            "limit_in_range",
+            "limiting_lp_per_mm",
+            "limiting_resolved_distance_m"});
+  return bars;
+}
+
+// A slanted-edge reading (`quality mtf`) into `section`: its method, every edge's MTF50 with U,
+// MTF at Nyquist and the curve, and per axis the repeated edges combined.
+void AddMtf(const nlohmann::json& doc, const std::string& path, nlohmann::json* section) {
+  (*section)["method"] = doc.at("method");
+  for (const auto& e : doc.at("edges")) {
+    nlohmann::json edge = {{"source", path}};
+    CopyKeys(e,
              &edge,
              {"roi",
               "axis",
@@ -351,11 +420,11 @@ nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
               "mtf50_resolved_distance_expanded_m",
               "curve",
               "budget"});
-        section["edges"].push_back(edge);
-      }
-      for (const auto& [axis, c] : doc.at("axes").items()) {
-        nlohmann::json combined = {{"source", path}, {"axis", axis}};
-        copy(c,
+    (*section)["edges"].push_back(edge);
+  }
+  for (const auto& [axis, c] : doc.at("axes").items()) {
+    nlohmann::json combined = {{"source", path}, {"axis", axis}};
+    CopyKeys(c,
              &combined,
              {"direction",
               "count",
@@ -367,8 +436,30 @@ nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
               "mtf50_lp_per_mm_expanded",
               "mtf50_resolved_distance_m",
               "mtf50_resolved_distance_expanded_m"});
-        section["axes"].push_back(combined);
-      }
+    (*section)["axes"].push_back(combined);
+  }
+}
+
+// The "dynamic image resolution" section from `aerocal quality` results: per edge the slanted-edge
+// MTF50 with U (and its units), MTF at Nyquist and the curve; per axis the repeated edges combined;
+// per bar target and per Siemens star the limiting frequency. Values are copied, nothing is
+// recomputed.
+nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
+  nlohmann::json section = {{"sources", paths},
+                            {"edges", nlohmann::json::array()},
+                            {"axes", nlohmann::json::array()},
+                            {"bars", nlohmann::json::array()},
+                            {"stars", nlohmann::json::array()}};
+  for (const std::string& path : paths) {
+    const nlohmann::json doc =
+        ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality`");
+    ReadTyped(path, "--quality", [&] {
+      if (doc.at("kind") == "quality_star")
+        section["stars"].push_back(StarJson(doc, path));
+      else if (doc.at("kind") == "quality_bars")
+        section["bars"].push_back(BarsJson(doc, path));
+      else
+        AddMtf(doc, path, &section);
       return 0;
     });
   }
@@ -403,17 +494,59 @@ nlohmann::json DistortionJson(const nlohmann::json& cert) {
       {"profile_kind", figure.profile_kind}, {"profile", figure.profile}, {"grid", figure.grid}};
 }
 
-int WriteCertificate(const CertificateArgs& args) {
-  CheckOutputFolder(args.out, "--out");
-  if (!args.tolerances.empty() && args.previous.empty())
-    throw ConfigError("--tolerances needs --previous");
-  const nlohmann::json lab = ReadCertificateLab(args.lab);
-  const auto tolerances = ReadTolerances(args.tolerances);
+// The certificate's data from a checked `calibrate` result (or a flight's in that form): the
+// method, camera, data, adjustment statistics, budget, interior, groups, check and control
+// statistics, the distortion samples and the used residual vectors.
+nlohmann::json CertificateData(const nlohmann::json& result,
+                               const nlohmann::json& lab,
+                               const std::string& source) {
+  const nlohmann::json& cal = result["calibration"];
+  nlohmann::json cert;
+  cert["kind"] = "certificate";
+  cert["lab"] = lab;
+  cert["source"] = source;
+  cert["method"] = cal.at("method");
+  cert["camera_file"] = cal.at("camera");
+  cert["data"] = cal.at("data");
+  cert["adjustment"] = {
+      {"sigma0", result["sigma0"]},
+      {"sigma0_px", result["sigma0_px"]},
+      {"sigma0_um", result["sigma0_um"]},
+      {"redundancy", result["redundancy"]},
+      {"converged", result["converged"]},
+      {"valid", result.value("valid", false)},
+      {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
+      {"warnings", result.value("warnings", nlohmann::json::array())},
+      {"self_calibration", result.value("self_calibration", nlohmann::json())},
+      {"rms_px", cal.at("rms_px")}};
+  cert["results"] = cal.at("uncertainty");
+  cert["interior"] = result["cameras"][0];
+  cert["camera_model"] = result.value("camera_model", nlohmann::json());
+  cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
+  cert["groups"] = cal.at("groups");
+  cert["stability"] = cal.at("stability");
+  cert["check"] = result["check"];
+  cert["control"] = result["control"];
+  cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
+  cert["opencv"] = cal.value("opencv", nlohmann::json());
+  cert["distortion"] = DistortionJson(cert);
+  // Residual vectors (image pixels) for the vector field plot.
+  nlohmann::json residuals = nlohmann::json::array();
+  for (const auto& r : result.value("residuals", nlohmann::json::array()))
+    if (r.value("used", true))
+      residuals.push_back({r.at("col"), r.at("row"), r.at("v_col_px"), r.at("v_row_px")});
+  cert["residuals"] = residuals;
+  return cert;
+}
+
+// The certificate of args.result (a calibrate or flight result), checked through its schema and
+// every statement against its numbers; `valid`: the calibration is valid and its groups agree.
+nlohmann::json CertificateOfResult(const CertificateArgs& args,
+                                   const nlohmann::json& lab,
+                                   bool* valid) {
   // The result of `aerocal calibrate` (kind "adjust", command "calibrate") or of `aerocal flight`.
   nlohmann::json result = ReadResult(args.result, {"adjust", "flight"}, "`aerocal calibrate`");
-  nlohmann::json cert;
-  std::vector<std::string> statements;  // checked before anything is written
-  const bool valid = ReadTyped(args.result, "--result", [&] {
+  return ReadTyped(args.result, "--result", [&] {
     if (result.is_object() && result.value("kind", "") == "flight") {
       InflateResidualTables(&result, args.result);  // `flight --residuals-csv`
       result = CalibrateFormOfFlight(result, args.result);
@@ -424,99 +557,93 @@ int WriteCertificate(const CertificateArgs& args) {
     // Through its schema (key path in the message), and every statement against its numbers.
     ValidateJson(result, InputSchema("calibrate_result"), args.result);
     CheckStatements(result["calibration"]["uncertainty"], args.result, "calibration.uncertainty");
-    const nlohmann::json& cal = result["calibration"];
-    cert["kind"] = "certificate";
-    cert["lab"] = lab;
-    cert["source"] = args.result_name.empty() ? args.result : args.result_name;
-    cert["method"] = cal.at("method");
-    cert["camera_file"] = cal.at("camera");
-    cert["data"] = cal.at("data");
-    cert["adjustment"] = {
-        {"sigma0", result["sigma0"]},
-        {"sigma0_px", result["sigma0_px"]},
-        {"sigma0_um", result["sigma0_um"]},
-        {"redundancy", result["redundancy"]},
-        {"converged", result["converged"]},
-        {"valid", result.value("valid", false)},
-        {"invalid_reasons", result.value("invalid_reasons", nlohmann::json::array())},
-        {"warnings", result.value("warnings", nlohmann::json::array())},
-        {"self_calibration", result.value("self_calibration", nlohmann::json())},
-        {"rms_px", cal.at("rms_px")}};
-    cert["results"] = cal.at("uncertainty");
-    cert["interior"] = result["cameras"][0];
-    cert["camera_model"] = result.value("camera_model", nlohmann::json());
-    cert["correlation"] = cal.value("interior_covariance", nlohmann::json());
-    cert["groups"] = cal.at("groups");
-    cert["stability"] = cal.at("stability");
-    cert["check"] = result["check"];
-    cert["control"] = result["control"];
-    cert["radii_mm"] = cal.value("radii_mm", nlohmann::json::array());
-    cert["opencv"] = cal.value("opencv", nlohmann::json());
-    cert["distortion"] = DistortionJson(cert);
-    // Residual vectors (image pixels) for the vector field plot.
-    nlohmann::json residuals = nlohmann::json::array();
-    for (const auto& r : result.value("residuals", nlohmann::json::array()))
-      if (r.value("used", true))
-        residuals.push_back({r.at("col"), r.at("row"), r.at("v_col_px"), r.at("v_row_px")});
-    cert["residuals"] = residuals;
-    for (const auto& q : cert["results"])
-      statements.push_back(q.at("statement").get<std::string>());
-    return cert["adjustment"]["valid"].get<bool>() && cal.at("stability").value("agree", true);
+    nlohmann::json cert =
+        CertificateData(result, lab, args.result_name.empty() ? args.result : args.result_name);
+    *valid = cert["adjustment"]["valid"].get<bool>() &&
+             result["calibration"].at("stability").value("agree", true);
+    return cert;
   });
-  if (!args.quality.empty()) cert["dynamic_image_resolution"] = DynamicResolutionJson(args.quality);
-  bool comparison_pass = true;
-  if (!args.previous.empty()) {
-    const nlohmann::json previous = ReadResult(
-        args.previous, {"certificate", "adjust"}, "`aerocal certificate` or `aerocal calibrate`");
-    comparison_pass = ReadTyped(args.previous, "--previous", [&] {
-      const nlohmann::json* old = Uncertainty(previous);
-      if (!old)
-        throw InputError(args.previous +
-                         ": neither a certificate.json nor a calibrate result (--previous)");
-      ValidateJson(previous, InputSchema("previous"), args.previous);
-      CheckStatements(*old,
-                      args.previous,
-                      previous.contains("results") ? "results" : "calibration.uncertainty");
-      cert["comparison"] = Compare(cert["results"], *old, tolerances, args.previous);
-      cert["comparison"]["previous"] = args.previous;
-      if (previous.contains("lab"))
-        cert["comparison"]["previous_certificate"] = previous["lab"].at("certificate");
-      return cert["comparison"]["pass"].get<bool>();
-    });
-  }
-  // certificate.json, .html and .pdf are one set (tools/output_set.h): all are written into a
-  // staging folder and moved into args.out only when every part was written, so a failing
-  // renderer replaces nothing of the previous certificate.
+}
+
+// The comparison with args.previous (a certificate.json or calibrate result) against the
+// tolerances, into cert["comparison"]; whether it passes.
+bool CompareWithPrevious(const CertificateArgs& args,
+                         const std::map<std::string, double>& tolerances,
+                         nlohmann::json* cert) {
+  const nlohmann::json previous = ReadResult(
+      args.previous, {"certificate", "adjust"}, "`aerocal certificate` or `aerocal calibrate`");
+  return ReadTyped(args.previous, "--previous", [&] {
+    const nlohmann::json* old = Uncertainty(previous);
+    if (!old)
+      throw InputError(args.previous +
+                       ": neither a certificate.json nor a calibrate result (--previous)");
+    ValidateJson(previous, InputSchema("previous"), args.previous);
+    CheckStatements(
+        *old, args.previous, previous.contains("results") ? "results" : "calibration.uncertainty");
+    (*cert)["comparison"] = Compare((*cert)["results"], *old, tolerances, args.previous);
+    (*cert)["comparison"]["previous"] = args.previous;
+    if (previous.contains("lab"))
+      (*cert)["comparison"]["previous_certificate"] = previous["lab"].at("certificate");
+    return (*cert)["comparison"]["pass"].get<bool>();
+  });
+}
+
+// certificate.json, .html and .pdf are one set (tools/output_set.h): all are written into a
+// staging folder and moved into args.out only when every part was written, so a failing
+// renderer replaces nothing of the previous certificate. kExitInternal when rendering failed.
+int WriteCertificateFiles(const CertificateArgs& args, const nlohmann::json& cert) {
   OutputSet set(args.out);
   const std::string json_path = set.Staged("certificate.json");
   WriteResult(json_path, "certificate", cert);
-  if (!args.no_render) {
-    const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
-    const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
-    if (!RunPythonScript(script, {json_path, set.staging()})) {
-      std::fprintf(stderr,
-                   "error: the certificate could not be rendered (%s); nothing written, the "
-                   "previous certificate in %s is left as it was\n",
-                   PythonCommandLine(script, {json_path, set.staging()}).c_str(),
-                   args.out.c_str());
-      return kExitInternal;
-    }
-    set.Commit({"certificate.json", "certificate.html", "certificate.pdf"});
-  } else {
+  if (args.no_render) {
     // certificate.json alone: an .html / .pdf of a previous certificate would not describe it.
     set.Commit({"certificate.json"}, {"certificate.html", "certificate.pdf"});
+    return kExitOk;
   }
+  const char* env = std::getenv("AEROCAL_CERTIFICATE_SCRIPT");
+  const std::string script = env ? env : AEROCAL_CERTIFICATE_SCRIPT;
+  if (!RunPythonScript(script, {json_path, set.staging()})) {
+    std::fprintf(stderr,
+                 "error: the certificate could not be rendered (%s); nothing written, the "
+                 "previous certificate in %s is left as it was\n",
+                 PythonCommandLine(script, {json_path, set.staging()}).c_str(),
+                 args.out.c_str());
+    return kExitInternal;
+  }
+  set.Commit({"certificate.json", "certificate.html", "certificate.pdf"});
+  return kExitOk;
+}
+
+// What was written, every statement, and the comparison's verdict.
+void PrintCertificate(const CertificateArgs& args, const nlohmann::json& cert, bool pass) {
   const std::string shown = args.out_name.empty() ? args.out : args.out_name;
   std::printf("certificate data -> %s/certificate.json\n", shown.c_str());
-  for (const auto& statement : statements) std::printf("  %s\n", statement.c_str());
+  for (const auto& q : cert["results"])
+    std::printf("  %s\n", q.at("statement").get<std::string>().c_str());
   if (cert.contains("comparison"))
-    std::printf(
-        "comparison with %s: %s\n", args.previous.c_str(), comparison_pass ? "pass" : "FAIL");
+    std::printf("comparison with %s: %s\n", args.previous.c_str(), pass ? "pass" : "FAIL");
   if (!args.no_render)
     std::printf(
         "certificate -> %s/certificate.html, %s/certificate.pdf\n", shown.c_str(), shown.c_str());
-  const bool ok = valid && comparison_pass;
-  return ok ? kExitOk : kExitNotConverged;
+}
+
+}  // namespace
+
+int WriteCertificate(const CertificateArgs& args) {
+  CheckOutputFolder(args.out, "--out");
+  if (!args.tolerances.empty() && args.previous.empty())
+    throw ConfigError("--tolerances needs --previous");
+  const nlohmann::json lab = ReadCertificateLab(args.lab);
+  const auto tolerances = ReadTolerances(args.tolerances);
+  bool valid = false;
+  nlohmann::json cert = CertificateOfResult(args, lab, &valid);
+  if (!args.quality.empty()) cert["dynamic_image_resolution"] = DynamicResolutionJson(args.quality);
+  const bool comparison_pass =
+      args.previous.empty() || CompareWithPrevious(args, tolerances, &cert);
+  // Everything is checked before anything is written.
+  if (WriteCertificateFiles(args, cert) == kExitInternal) return kExitInternal;
+  PrintCertificate(args, cert, comparison_pass);
+  return valid && comparison_pass ? kExitOk : kExitNotConverged;
 }
 
 }  // namespace aerocal::tools

@@ -14,7 +14,7 @@ CommandRun SetupCertificate(CLI::App& app) {
          "--result",
          args->result,
          "Result JSON of `aerocal calibrate`, or an `aerocal flight` result.json (in-flight "
-         "calibration: type A budget)")
+         "calibration: image measurements, control coordinates and pixel pitch in the budget)")
       ->required();
   app.add_option("--lab",
                  args->lab,

@@ -67,8 +67,9 @@ void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
   app.add_flag("--residuals-csv",
                args->residuals_csv,
                "Write each adjustment's per-observation residual table as "
-               "residuals_<adjustment>.csv beside result.json (named there with its SHA-256) "
-               "instead of inside it: a big flight's result.json stays small");
+               "residuals_<adjustment>.csv and the stitching frames' as residuals_stitching.csv "
+               "beside result.json (named there with their SHA-256) instead of inside it: a big "
+               "flight's result.json stays small");
   app.add_option(
       "--camera-format",
       args->camera_format,
@@ -77,8 +78,8 @@ void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
   app.add_flag("--certificate",
                args->certificate,
                "Also write the certificate of the in-flight calibration (OUT/certificate/: "
-               "certificate.json, .html, .pdf; a type-A budget, as `aerocal certificate` of "
-               "result.json); only for a valid flight");
+               "certificate.json, .html, .pdf; its budget as `aerocal certificate` of "
+               "result.json gives it); only for a valid flight");
   app.add_option("--lab", args->lab, "Lab YAML of the certificate (as `aerocal certificate --lab`)")
       ->needs("--certificate");
   app.add_option(

@@ -9,6 +9,8 @@
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <iterator>
+#include <optional>
 #include <set>
 
 namespace aerocal::tools {
@@ -25,8 +27,10 @@ struct Column {
   int element;  // -1: the key's value itself; 0 / 1: photo x / y of a pair
   Cell cell;
   bool tested;
+  bool null_if_empty = false;  // the key is always there: an empty cell is its null
 };
 
+// An adjustment's residual table (residuals_<adjustment>.csv).
 constexpr Column kColumns[] = {{"image", "image", -1, Cell::kString, false},
                                {"point", "point", -1, Cell::kString, false},
                                {"col", "col", -1, Cell::kNumber, false},
@@ -51,6 +55,30 @@ constexpr Column kColumns[] = {{"image", "image", -1, Cell::kString, false},
                                {"mdb_px_y", "mdb_px", 1, Cell::kNumber, true},
                                {"reason", "reason", -1, Cell::kString, false}};
 
+// The stitching frames' residual table (residuals_stitching.csv): every frame's `residuals`
+// entries (stitch_result_json.cc, FrameResultToJson) in the frames' order, each row with its
+// frame's id; every key is always written, sigma_px may be null.
+constexpr Column kStitchingColumns[] = {{"frame", "frame", -1, Cell::kString, false},
+                                        {"point", "point", -1, Cell::kString, false},
+                                        {"subimage", "subimage", -1, Cell::kString, false},
+                                        {"kind", "kind", -1, Cell::kString, false},
+                                        {"vU_px", "vU_px", -1, Cell::kNumber, false},
+                                        {"vV_px", "vV_px", -1, Cell::kNumber, false},
+                                        {"sigma_px", "sigma_px", -1, Cell::kNumber, false, true}};
+
+// A table: its columns and the column whose empty cell marks an untested row (-1: none).
+struct Table {
+  const Column* begin;
+  const Column* end;
+  int tested_marker;
+  size_t size() const { return static_cast<size_t>(end - begin); }
+};
+
+constexpr Table kAdjustmentTable = {std::begin(kColumns), std::end(kColumns), 12};  // group_size
+constexpr Table kStitchingTable = {std::begin(kStitchingColumns), std::end(kStitchingColumns), -1};
+
+constexpr const char* kStitchingTableFile = "residuals_stitching.csv";
+
 // RFC 4180: a field with a separator, a quote or a line break is quoted, quotes doubled.
 std::string Quoted(const std::string& text) {
   if (text.find_first_of(",\"\r\n") == std::string::npos) return text;
@@ -72,22 +100,6 @@ std::string CellText(const nlohmann::json& value, Cell cell) {
       return StringPrintf("%.17g", value.get<double>());
   }
   return "";
-}
-
-// Whether every key of every entry has a column (else the table would drop it).
-bool Representable(const nlohmann::json& residuals) {
-  std::set<std::string> keys;
-  for (const auto& c : kColumns) keys.insert(c.key);
-  for (const auto& entry : residuals) {
-    if (!entry.is_object()) return false;
-    for (const auto& [key, value] : entry.items()) {
-      if (!keys.count(key)) return false;
-      const bool pair = key == "r" || key == "w_xy" || key == "mdb_sigma" || key == "mdb_px";
-      if (pair && !(value.is_array() && value.size() == 2)) return false;
-      if (!pair && value.is_structured()) return false;
-    }
-  }
-  return true;
 }
 
 // The records of a CSV text (RFC 4180 quoting), each with the line it starts on.
@@ -145,36 +157,33 @@ nlohmann::json ParseCell(const std::string& text, Cell cell, const std::string& 
   return x;
 }
 
-}  // namespace
-
-std::vector<std::string> ResidualTableColumns() {
+std::vector<std::string> Names(const Table& table) {
   std::vector<std::string> out;
-  for (const auto& c : kColumns) out.emplace_back(c.name);
+  for (const Column* c = table.begin; c != table.end; ++c) out.emplace_back(c->name);
   return out;
 }
 
-std::string ResidualTableCsv(const nlohmann::json& residuals) {
+std::string TableCsv(const Table& table, const nlohmann::json& entries) {
   std::string out;
-  for (const auto& c : kColumns) out += std::string(out.empty() ? "" : ",") + c.name;
+  for (const Column* c = table.begin; c != table.end; ++c)
+    out += std::string(out.empty() ? "" : ",") + c->name;
   out += "\n";
-  for (const auto& entry : residuals) {
+  for (const auto& entry : entries) {
     std::string line;
-    bool first = true;
-    for (const auto& c : kColumns) {
-      if (!first) line += ",";
-      first = false;
-      const auto it = entry.find(c.key);
+    for (const Column* c = table.begin; c != table.end; ++c) {
+      if (c != table.begin) line += ",";
+      const auto it = entry.find(c->key);
       if (it == entry.end()) continue;
-      line += CellText(c.element < 0 ? *it : (*it)[c.element], c.cell);
+      line += CellText(c->element < 0 ? *it : (*it)[c->element], c->cell);
     }
     out += line + "\n";
   }
   return out;
 }
 
-nlohmann::json ResidualTableFromCsv(const std::string& text, const std::string& file) {
+nlohmann::json TableFromCsv(const Table& table, const std::string& text, const std::string& file) {
   const auto records = Records(text, file);
-  const std::vector<std::string> columns = ResidualTableColumns();
+  const std::vector<std::string> columns = Names(table);
   if (records.empty() || records[0].second != columns)
     throw InputError(file + ":1: not a residual table (expected the header " +
                      nlohmann::json(columns).dump() + ")");
@@ -186,15 +195,18 @@ nlohmann::json ResidualTableFromCsv(const std::string& text, const std::string& 
       throw InputError(where +
                        StringPrintf(": %zu fields (expected %zu)", fields.size(), columns.size()));
     nlohmann::json entry = nlohmann::json::object();
-    const bool tested = !fields[12].empty();  // group_size: the test's keys are there
+    // The test's keys are there when the marker column is filled.
+    const bool tested = table.tested_marker >= 0 && !fields[table.tested_marker].empty();
     for (size_t i = 0; i < columns.size(); ++i) {
-      const Column& c = kColumns[i];
+      const Column& c = table.begin[i];
       const std::string& f = fields[i];
       const std::string at = where + " (" + c.name + ")";
       if (c.tested && !tested) continue;
       if (c.element >= 0) {
         if (!entry.contains(c.key)) entry[c.key] = {nullptr, nullptr};
         if (!f.empty()) entry[c.key][c.element] = ParseCell(f, c.cell, at);
+      } else if (f.empty() && c.null_if_empty) {
+        entry[c.key] = nullptr;
       } else if (!f.empty() || (c.tested && c.cell == Cell::kString)) {
         entry[c.key] = ParseCell(f, c.cell, at);
       }
@@ -204,54 +216,163 @@ nlohmann::json ResidualTableFromCsv(const std::string& text, const std::string& 
   return out;
 }
 
+// The table's text of `entries` when it reads back to exactly them (every key has a column,
+// every value its column's type and no null where an empty cell means an absent key); nullopt
+// otherwise: such entries stay in the JSON, nothing is dropped.
+std::optional<std::string> LosslessCsv(const Table& table, const nlohmann::json& entries) {
+  try {
+    std::string text = TableCsv(table, entries);
+    if (TableFromCsv(table, text, "") == entries) return text;
+  } catch (const nlohmann::json::exception&) {
+  } catch (const InputError&) {
+  }
+  return std::nullopt;
+}
+
+// `text` written as `name` in `folder`, and the `residuals_file` that names it.
+nlohmann::json WriteTable(const std::string& folder,
+                          const std::string& name,
+                          const std::string& text,
+                          size_t rows,
+                          const Table& table) {
+  WriteFileAtomically((std::filesystem::path(folder) / name).string(), text);
+  return {{"path", name}, {"sha256", Sha256Hex(text)}, {"rows", rows}, {"columns", Names(table)}};
+}
+
+// The text of the table `spec` (a `residuals_file`) names, beside `result_path`, checked against
+// its SHA-256; `path` is set to the table's path for messages.
+std::string ReadTable(const nlohmann::json& spec,
+                      const std::string& result_path,
+                      const std::string& key,
+                      std::string* path) {
+  if (!spec.is_object() || !spec.contains("path") || !spec["path"].is_string() ||
+      !spec.contains("sha256") || !spec["sha256"].is_string())
+    throw InputError(result_path + ": " + key + ".residuals_file needs a path and a sha256");
+  *path =
+      (std::filesystem::path(result_path).parent_path() / spec["path"].get<std::string>()).string();
+  const std::string text = ReadTextFile(*path);
+  if (Sha256Hex(text) != spec["sha256"].get<std::string>())
+    throw InputError(*path + ": SHA-256 differs from the one " + result_path +
+                     " states (the table was changed or belongs to another result)");
+  return text;
+}
+
+// The stitching frames' residuals as one table (rows in frame order, each with its frame's id);
+// nullopt when the flight has none, frame ids repeat (rows could not be given back) or the
+// entries are not lossless in the table.
+std::optional<std::string> StitchingTable(const nlohmann::json& frames, size_t* rows) {
+  nlohmann::json all = nlohmann::json::array();
+  std::set<std::string> ids;
+  for (const auto& f : frames) {
+    if (!f.is_object() || !f.contains("frame") || !f["frame"].is_string() ||
+        !f.contains("residuals") || !f["residuals"].is_array() ||
+        !ids.insert(f["frame"].get<std::string>()).second)
+      return std::nullopt;
+    for (const auto& r : f["residuals"]) {
+      if (!r.is_object() || r.contains("frame")) return std::nullopt;
+      all.push_back(r);
+      all.back()["frame"] = f["frame"];
+    }
+  }
+  *rows = all.size();
+  if (ids.empty()) return std::nullopt;
+  return LosslessCsv(kStitchingTable, all);
+}
+
+std::string SplitStitchingTable(nlohmann::json* document, const std::string& folder) {
+  if (!document->contains("stitching") || !(*document)["stitching"].is_object()) return "";
+  nlohmann::json& stitching = (*document)["stitching"];
+  if (!stitching.contains("frames") || !stitching["frames"].is_array()) return "";
+  size_t rows = 0;
+  const auto text = StitchingTable(stitching["frames"], &rows);
+  if (!text) return "";
+  stitching["residuals_file"] =
+      WriteTable(folder, kStitchingTableFile, *text, rows, kStitchingTable);
+  for (auto& f : stitching["frames"]) f.erase("residuals");
+  return kStitchingTableFile;
+}
+
+// The rows of the stitching table handed back to their frames: in frame order, a frame's rows
+// together (as StitchingTable wrote them).
+void InflateStitchingTable(nlohmann::json* document, const std::string& result_path) {
+  if (!document->contains("stitching") || !(*document)["stitching"].is_object()) return;
+  nlohmann::json& stitching = (*document)["stitching"];
+  if (!stitching.contains("residuals_file")) return;
+  if (!stitching.contains("frames") || !stitching["frames"].is_array())
+    throw InputError(result_path + ": stitching.residuals_file without stitching.frames");
+  std::string path;
+  const std::string text = ReadTable(stitching["residuals_file"], result_path, "stitching", &path);
+  nlohmann::json& frames = stitching["frames"];
+  for (auto& f : frames) f["residuals"] = nlohmann::json::array();
+  size_t k = 0, row = 1;
+  for (auto& entry : TableFromCsv(kStitchingTable, text, path)) {
+    ++row;
+    while (k < frames.size() && frames[k].value("frame", std::string()) != entry["frame"]) ++k;
+    if (k == frames.size())
+      throw InputError(path + StringPrintf(":%zu: frame '", row) +
+                       entry["frame"].get<std::string>() + "' is not a frame of " + result_path +
+                       " after the previous row's (rows are in the frames' order)");
+    entry.erase("frame");
+    frames[k]["residuals"].push_back(std::move(entry));
+  }
+  stitching.erase("residuals_file");
+}
+
+}  // namespace
+
+std::vector<std::string> ResidualTableColumns() { return Names(kAdjustmentTable); }
+
+std::string ResidualTableCsv(const nlohmann::json& residuals) {
+  return TableCsv(kAdjustmentTable, residuals);
+}
+
+nlohmann::json ResidualTableFromCsv(const std::string& text, const std::string& file) {
+  return TableFromCsv(kAdjustmentTable, text, file);
+}
+
 std::string ResidualTableFile(const std::string& adjustment) {
   return "residuals_" + adjustment + ".csv";
 }
 
 std::vector<std::string> ResidualTablesNotWritten(const std::vector<std::string>& written) {
   std::vector<std::string> out;
-  for (const char* adjustment : {"conventional", "self_calibration", "joint"}) {
-    const std::string file = ResidualTableFile(adjustment);
+  for (const std::string& file : {ResidualTableFile("conventional"),
+                                  ResidualTableFile("self_calibration"),
+                                  ResidualTableFile("joint"),
+                                  std::string(kStitchingTableFile)})
     if (std::find(written.begin(), written.end(), file) == written.end()) out.push_back(file);
-  }
   return out;
 }
 
 std::vector<std::string> SplitResidualTables(nlohmann::json* document, const std::string& folder) {
   std::vector<std::string> written;
-  if (!document->contains("adjustments")) return written;
-  for (auto& a : (*document)["adjustments"]) {
-    if (!a.contains("residuals") || !Representable(a["residuals"])) continue;
-    const std::string name = ResidualTableFile(a.value("name", std::to_string(written.size())));
-    const std::string text = ResidualTableCsv(a["residuals"]);
-    WriteFileAtomically((std::filesystem::path(folder) / name).string(), text);
-    a["residuals_file"] = {{"path", name},
-                           {"sha256", Sha256Hex(text)},
-                           {"rows", a["residuals"].size()},
-                           {"columns", ResidualTableColumns()}};
-    a.erase("residuals");
-    written.push_back(name);
-  }
+  if (document->contains("adjustments") && (*document)["adjustments"].is_array())
+    for (auto& a : (*document)["adjustments"]) {
+      if (!a.is_object() || !a.contains("residuals")) continue;
+      const auto text = LosslessCsv(kAdjustmentTable, a["residuals"]);
+      if (!text) continue;
+      const std::string name = ResidualTableFile(a.value("name", std::to_string(written.size())));
+      a["residuals_file"] =
+          WriteTable(folder, name, *text, a["residuals"].size(), kAdjustmentTable);
+      a.erase("residuals");
+      written.push_back(name);
+    }
+  const std::string stitching = SplitStitchingTable(document, folder);
+  if (!stitching.empty()) written.push_back(stitching);
   return written;
 }
 
 void InflateResidualTables(nlohmann::json* document, const std::string& result_path) {
-  if (!document->contains("adjustments") || !(*document)["adjustments"].is_array()) return;
-  const std::filesystem::path folder = std::filesystem::path(result_path).parent_path();
-  for (auto& a : (*document)["adjustments"]) {
-    if (!a.is_object() || !a.contains("residuals_file")) continue;
-    const nlohmann::json& f = a["residuals_file"];
-    if (!f.is_object() || !f.contains("path") || !f["path"].is_string() || !f.contains("sha256") ||
-        !f["sha256"].is_string())
-      throw InputError(result_path + ": residuals_file needs a path and a sha256");
-    const std::string path = (folder / f["path"].get<std::string>()).string();
-    const std::string text = ReadTextFile(path);
-    if (Sha256Hex(text) != f["sha256"].get<std::string>())
-      throw InputError(path + ": SHA-256 differs from the one " + result_path +
-                       " states (the table was changed or belongs to another result)");
-    a["residuals"] = ResidualTableFromCsv(text, path);
-    a.erase("residuals_file");
-  }
+  if (document->contains("adjustments") && (*document)["adjustments"].is_array())
+    for (auto& a : (*document)["adjustments"]) {
+      if (!a.is_object() || !a.contains("residuals_file")) continue;
+      std::string path;
+      const std::string text =
+          ReadTable(a["residuals_file"], result_path, a.value("name", "adjustment"), &path);
+      a["residuals"] = ResidualTableFromCsv(text, path);
+      a.erase("residuals_file");
+    }
+  InflateStitchingTable(document, result_path);
 }
 
 }  // namespace aerocal::tools

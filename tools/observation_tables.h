@@ -7,14 +7,21 @@
 //   "residuals_file": {"path": "residuals_joint.csv", "sha256": "...", "rows": 104512,
 //                      "columns": ["image", "point", "col", ...]}
 //
-// The CSV holds exactly what the array held (docs/formats.md "residuals_<adjustment>.csv"): one
+// The stitching frames' residuals (`stitching.frames[].residuals`, about 70k entries and 17 MB of
+// the same flight's JSON) go the same way into one table, `residuals_stitching.csv`, with the
+// frame's id in its first column; `stitching.residuals_file` names it and the frames lose their
+// arrays.
+//
+// A table holds exactly what the arrays held (docs/formats.md "residuals_<adjustment>.csv"): one
 // row per entry; numbers in the shortest text that reads back to the same double (%.17g), so
 // reading the table back gives the same JSON; `r`, `w_xy`, `mdb_sigma`, `mdb_px` as two columns
 // each (_x, _y; photo x, y); an empty cell is an absent key (subimage, u, v, head, reason, and the
 // test's keys of an untested observation: `group_size` empty) or, within a tested row, a null
-// (an untestable component's w). Text cells are quoted as RFC 4180 says where needed (a reason
-// with commas). Every reader of result.json inflates the tables first (report_data.load in
-// Python, InflateResidualTables here), checking the SHA-256.
+// (an untestable component's w); in the stitching table an empty sigma_px is a null. Text cells
+// are quoted as RFC 4180 says where needed (a reason with commas). An array the table would not
+// give back exactly (a key without a column, a value of another type) stays in the JSON. Every
+// reader of result.json inflates the tables first (report_data.load in Python,
+// InflateResidualTables here), checking the SHA-256.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -26,19 +33,21 @@ namespace aerocal::tools {
 
 /// The table file of adjustment `adjustment`: residuals_<adjustment>.csv.
 std::string ResidualTableFile(const std::string& adjustment);
-/// The tables of the adjustments a flight can run (conventional, self_calibration, joint) that
-/// are not among `written`: a previous run's there would not describe this one (to be removed).
+/// The tables a flight can write (its adjustments' and residuals_stitching.csv) that are not
+/// among `written`: a previous run's there would not describe this one (to be removed).
 std::vector<std::string> ResidualTablesNotWritten(const std::vector<std::string>& written);
 /// Writes every adjustment's `residuals` of `document` (a flight result: `adjustments[]`) to
-/// `folder/residuals_<name>.csv` (atomically) and replaces the array by `residuals_file`. An
-/// adjustment whose entries carry a key the table has no column for keeps its array (nothing is
-/// dropped). Returns the file names written (relative to `folder`).
+/// `folder/residuals_<name>.csv` and the stitching frames' (`stitching.frames[].residuals`) to
+/// `folder/residuals_stitching.csv` (atomically), replacing the arrays by `residuals_file` (of
+/// the adjustment, of `stitching`). An array the table would not give back exactly keeps its
+/// place (nothing is dropped); so do the frames' when two share an id. Returns the file names
+/// written (relative to `folder`).
 std::vector<std::string> SplitResidualTables(nlohmann::json* document, const std::string& folder);
 
-/// The inverse for a reader: every `residuals_file` of `document`'s adjustments read from the
-/// folder of `result_path` back into `residuals` (the same JSON values). InputError naming the
-/// file when it is missing, its SHA-256 differs from the result's, or a row is malformed
-/// (FILE:LINE).
+/// The inverse for a reader: every `residuals_file` of `document`'s adjustments and of its
+/// `stitching` read from the folder of `result_path` back into the `residuals` arrays (the same
+/// JSON values). InputError naming the file when it is missing, its SHA-256 differs from the
+/// result's, or a row is malformed or names no frame of the result (FILE:LINE).
 void InflateResidualTables(nlohmann::json* document, const std::string& result_path);
 
 /// The CSV text of one residual array and its inverse (for tests; FILE names messages).

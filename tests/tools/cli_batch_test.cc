@@ -1,12 +1,15 @@
 // `aerocal batch` (issue 35) on a simulated 12-exposure flight: plan + run (in shards, in one
 // process, under GNU Parallel) + merge writes the same result.json (to the last bit, the clock's
-// timings aside) and the same camera_calibrated.yaml (byte for byte) as `aerocal flight`; a run
-// killed midway and a rerun finish only what is missing; a changed input is redone, a failing unit
-// leaves its log, a failed record and no output, and the merge refuses to run without every unit.
+// timings aside; with --residuals-csv its tables read back) and the same camera_calibrated.yaml
+// (byte for byte) as `aerocal flight`; a run killed midway and a rerun finish only what is
+// missing; a changed input is redone, a failing unit leaves its log, a failed record and no
+// output, and the merge refuses to run without every unit.
 #include "calib/core/atomic_file.h"
 #include "tests/support/test_support.h"
+#include "tools/observation_tables.h"
 
 #include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
 
 #include <filesystem>
 #include <fstream>
@@ -34,10 +37,12 @@ class Batch : public ::testing::Test {
     return "--camera " + dir_->File("data/camera_nominal.yaml") + " --data " + dir_->File("data") +
            " --base III,IV --no-report --out " + dir_->File(out);
   }
-  // `batch plan` of the flight into WORK whose merge writes OUT.
-  static std::string Plan(const std::string& work, const std::string& out) {
-    const auto r =
-        testing::RunAerocal("batch plan --work " + dir_->File(work) + " " + FlightArguments(out));
+  // `batch plan` of the flight (and `extra` flight options) into WORK whose merge writes OUT.
+  static std::string Plan(const std::string& work,
+                          const std::string& out,
+                          const std::string& extra = "") {
+    const auto r = testing::RunAerocal("batch plan --work " + dir_->File(work) + " " +
+                                       FlightArguments(out) + extra);
     EXPECT_EQ(r.exit_code, 0) << r.output;
     return dir_->File(work + "/manifest.json");
   }
@@ -45,10 +50,18 @@ class Batch : public ::testing::Test {
     return testing::RunAerocal("batch " + arguments);
   }
   static void ExpectTheFlightsFiles(const std::string& out) {
-    ASSERT_TRUE(fs::exists(dir_->File(out + "/result.json"))) << out;
+    std::string result = dir_->File(out + "/result.json");
+    ASSERT_TRUE(fs::exists(result)) << out;
     EXPECT_EQ(ReadTextFile(dir_->File(out + "/camera_calibrated.yaml")),
               ReadTextFile(dir_->File("single/camera_calibrated.yaml")));
-    EXPECT_TRUE(testing::ResultWithoutClock(dir_->File(out + "/result.json")) ==
+    if (fs::exists(dir_->File(out + "/residuals_stitching.csv"))) {
+      // `--residuals-csv`: the tables beside it read back into the arrays first.
+      nlohmann::json document = testing::ReadJson(result);
+      tools::InflateResidualTables(&document, result);
+      result = dir_->File(out + "_inflated.json");
+      WriteFileAtomically(result, document.dump());
+    }
+    EXPECT_TRUE(testing::ResultWithoutClock(result) ==
                 testing::ResultWithoutClock(dir_->File("single/result.json")))
         << out << "/result.json differs from the single-process flight's";
   }
@@ -63,7 +76,9 @@ class Batch : public ::testing::Test {
 testing::TempDir* Batch::dir_ = nullptr;
 
 TEST_F(Batch, ShardsThenMergeGiveTheFlightsFiles) {
-  const std::string manifest = Plan("work", "merged");
+  // The merge writes the flight's residual tables beside result.json (issue 33): read back, the
+  // single-process flight's arrays.
+  const std::string manifest = Plan("work", "merged", " --residuals-csv");
   EXPECT_EQ(testing::ReadJson(manifest)["units"].size(), 12u);
   // The merge needs every unit: refused (exit 2, the missing ones named), nothing written.
   auto merge = Batch_("merge --manifest " + manifest);
@@ -85,6 +100,8 @@ TEST_F(Batch, ShardsThenMergeGiveTheFlightsFiles) {
   EXPECT_NE(status.output.find("units/s"), std::string::npos) << status.output;
   merge = Batch_("merge --manifest " + manifest);
   ASSERT_EQ(merge.exit_code, 0) << merge.output;
+  for (const char* table : {"stitching", "conventional", "self_calibration", "joint"})
+    EXPECT_TRUE(fs::exists(dir_->File("merged/residuals_" + std::string(table) + ".csv"))) << table;
   ExpectTheFlightsFiles("merged");
 }
 

@@ -303,6 +303,52 @@ TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
       5);  // identification + results + budget, distortion, residuals, stability .. signatures
 }
 
+TEST_F(OlympusCalibration, StatedImageSigmaScaleIsAbsorbedBySigma0) {
+  // Issue 33 (the a-priori image sigma in the budget, tools/certificate/README.md): every stated
+  // image sigma times 3 gives sigma0 / 3 and the same image component and U of every certified
+  // quantity: the scale cancels in sigma0^2 Q N_image Q, so no type B component counts it. Exact
+  // with the images the only weights; here the control (1e-6 m) mixes in at 1.3e-4 relative
+  // (seen), hence 1e-3.
+  constexpr double kMixing = 1e-3;
+  const CsvTable obs = CsvTable::Read(tmp_.File("oly/observations.csv"));
+  std::ofstream out(tmp_.File("oly/observations_x3.csv"));
+  for (size_t i = 0; i < obs.header().size(); ++i) out << (i ? "," : "") << obs.header()[i];
+  out << "\n";
+  for (const auto& row : obs.rows())
+    for (size_t i = 0; i < obs.header().size(); ++i) {
+      const std::string& key = obs.header()[i];
+      out << (i ? "," : "")
+          << (key == "sigma_px" ? FormatNumber(3 * obs.Number(row, key)) : obs.String(row, key))
+          << (i + 1 == obs.header().size() ? "\n" : "");
+    }
+  out.close();
+  nlohmann::json results[2];
+  const char* files[2] = {"oly/observations.csv", "oly/observations_x3.csv"};
+  for (int k = 0; k < 2; ++k) {
+    const auto r =
+        RunAerocal("calibrate --camera " + tmp_.File("oly/camera_cam1.yaml") + " --observations " +
+                   tmp_.File(files[k]) + " --points " + tmp_.File("oly/points.csv") +
+                   " --self-calibration c,x0,y0,K1,K2,K3,P1,P2,B1 --no-snooping --out " +
+                   tmp_.File("x" + std::to_string(k) + ".json"));
+    ASSERT_EQ(r.exit_code, 0) << r.output;
+    results[k] = ReadJson(tmp_.File("x" + std::to_string(k) + ".json"));
+  }
+  EXPECT_NEAR(results[1]["sigma0"].get<double>() * 3,
+              results[0]["sigma0"].get<double>(),
+              kMixing * results[0]["sigma0"].get<double>());
+  const auto& a = results[0]["calibration"]["uncertainty"];
+  const auto& b = results[1]["calibration"]["uncertainty"];
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    if (a[i]["quantity"] == "m_0") continue;  // sigma0 itself, in um: scales with the sigmas
+    const double u = a[i]["components"][0]["u"], u3 = b[i]["components"][0]["u"];
+    EXPECT_EQ(a[i]["components"][0]["source"], b[i]["components"][0]["source"]);
+    EXPECT_NEAR(u3, u, kMixing * u) << a[i]["quantity"];
+    EXPECT_NEAR(b[i]["U"].get<double>(), a[i]["U"].get<double>(), kMixing * a[i]["U"].get<double>())
+        << a[i]["quantity"];
+  }
+}
+
 TEST_F(OlympusCalibration, GroupColumnOfTheObservationsGivesTheSameGroups) {
   // The groups as a `group` column of observations.csv instead of --groups: the same three groups
   // of 7 images, the same per-group results; both at once is a bad input.

@@ -191,8 +191,8 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
 
 TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   // `flight --certificate` writes the certificate form of the in-flight calibration (the joint
-  // adjustment's camera, a type-A budget: U = k sigma, k from the redundancy) as `aerocal
-  // certificate --result result.json` does; HTML and PDF rendered.
+  // adjustment's camera and its budget) as `aerocal certificate --result result.json` does; HTML
+  // and PDF rendered.
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
   const auto cert = aerocal::testing::ReadJson(dir_->File("report/certificate/certificate.json"));
   EXPECT_EQ(cert["method"]["kind"], "in-flight calibration");
@@ -208,8 +208,25 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
     has_c = true;
     const double sigma = joint["cameras"][0]["sigma"]["c"].get<double>();
     EXPECT_DOUBLE_EQ(q["value"].get<double>(), joint["cameras"][0]["estimated"]["c"].get<double>());
-    EXPECT_NEAR(q["U"].get<double>(), q["k"].get<double>() * sigma, 1e-15);
-    EXPECT_EQ(q["components"][0]["type"], "A");
+    // The test field's default components (issue 33): A image measurements, B control
+    // coordinates (the joint adjustment's Q N_control Q), B pixel pitch (no tolerance in the
+    // simulated camera file: zero, said so). The adjustment's variance splits as
+    // sigma^2 = u_image^2 + sigma0^2 u_control^2; U = k u_c.
+    const auto& c = q["components"];
+    ASSERT_EQ(c.size(), 3u) << c.dump();
+    EXPECT_EQ(c[0]["source"], "image measurements");
+    EXPECT_EQ(c[0]["type"], "A");
+    EXPECT_EQ(c[1]["source"], "control coordinates");
+    EXPECT_EQ(c[1]["type"], "B");
+    EXPECT_EQ(c[2]["source"], "pixel pitch");
+    const double u_image = c[0]["u"], u_control = c[1]["u"], u_pitch = c[2]["u"];
+    const double s0 = joint["sigma0"];
+    EXPECT_GT(u_control, 0.0);
+    EXPECT_EQ(u_pitch, 0.0);
+    EXPECT_NEAR(
+        u_image * u_image + s0 * s0 * u_control * u_control, sigma * sigma, 1e-9 * sigma * sigma);
+    const double u_c = std::sqrt(u_image * u_image + u_control * u_control);
+    EXPECT_NEAR(q["U"].get<double>(), q["k"].get<double>() * u_c, 1e-12 * u_c);
     EXPECT_NE(q["statement"].get<std::string>().find("(k = 2)"), std::string::npos)
         << q["statement"];
   }
@@ -252,6 +269,38 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
   for (const auto& e : std::filesystem::directory_iterator(dir_->path()))
     if (e.path().extension() == ".png" && std::filesystem::file_size(e.path()) > 1000) ++pages;
   EXPECT_GE(pages, 2);
+}
+
+TEST_F(FlightWorkflow, CertificatePixelPitchComponentFromTheCameraFile) {
+  // The flight's camera file states the pitch's tolerance +-T: the pixel pitch component of c is
+  // |dc/dpitch| T / sqrt 3 with dc/dpitch = c / pitch (a pitch s times the stated one makes
+  // every photo length, c among them, s times longer; uncertainty_budget.h).
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  constexpr double kTolerance = 2e-5;  // mm
+  WriteFileAtomically(dir_->File("camera_tolerance.yaml"),
+                      ReadTextFile(dir_->File("data/camera_nominal.yaml")) +
+                          "pixel_size_tolerance_mm: " + std::to_string(kTolerance) + "\n");
+  auto doc = aerocal::testing::ReadJson(dir_->File("report/result.json"));
+  doc["camera"] = dir_->File("camera_tolerance.yaml");
+  WriteFileAtomically(dir_->File("pitch/result.json"), doc.dump());
+  const auto r = testing::RunAerocal("certificate --result " + dir_->File("pitch/result.json") +
+                                     " --no-render --out " + dir_->File("pitch"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto cert = aerocal::testing::ReadJson(dir_->File("pitch/certificate.json"));
+  const double pitch = doc["camera_format"]["pixel_size_mm"];
+  bool has_c = false;
+  for (const auto& q : cert["results"]) {
+    if (q["quantity"] != "c") continue;
+    has_c = true;
+    const auto& pixel = q["components"][2];
+    ASSERT_EQ(pixel["source"], "pixel pitch");
+    const double c = q["value"];
+    EXPECT_NEAR(pixel["u"].get<double>(),
+                c / pitch * kTolerance / std::sqrt(3.0),
+                1e-6 * c / pitch * kTolerance);
+    EXPECT_NE(pixel["origin"].get<std::string>().find("camera_tolerance.yaml"), std::string::npos);
+  }
+  EXPECT_TRUE(has_c);
 }
 
 // Every file under `folder` (relative path -> content).
@@ -375,20 +424,29 @@ TEST_F(FlightWorkflow, AutoSelfCalibrationCheckPointTestAndCameraOrigin) {
   }
 }
 
+// The flight report's renderer, as `aerocal flight` runs it.
+std::string ReportScript() { return AEROCAL_REPORT_SCRIPT; }
+
+// The fixture's flight again with its residual tables as CSV beside result.json
+// (--residuals-csv), report and certificate: run once, for the tests below.
+const testing::CommandResult& SplitFlight(const testing::TempDir& dir) {
+  static const testing::CommandResult run = testing::RunAerocal(
+      "flight --camera " + dir.File("data/camera_nominal.yaml") + " --data " + dir.File("data") +
+      " --base III,IV --residuals-csv --certificate --lab " + dir.File("lab.yaml") + " --quality " +
+      dir.File("star.json") + " --out " + dir.File("again"));
+  return run;
+}
+
 // Issue 33 item 7: a lab checksums its re-runs. `flight` twice on the same data gives the same
 // result, the clock's timings aside (`seconds`, `timing`, `seconds_testing`): the
 // flight runs several adjustments in one process, and the reduced system's layout once followed
 // heap addresses (calib/problem/problem_builder.cc, the Ceres ordering).
 TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
-  // The second run writes its residual tables as CSV beside result.json (--residuals-csv): read
-  // back, they must be the first run's inline arrays to the bit.
-  for (const char* out : {"once", "again"}) {
-    const std::string tables = std::string(out) == "again" ? " --residuals-csv" : "";
-    const auto r = testing::RunAerocal("flight --camera " + dir_->File("data/camera_nominal.yaml") +
-                                       " --data " + dir_->File("data") + " --base III,IV" + tables +
-                                       " --no-report --out " + dir_->File(out));
-    ASSERT_EQ(r.exit_code, 0) << r.output;
-  }
+  // The second run (SplitFlight) writes its residual tables as CSV beside result.json
+  // (--residuals-csv): read back, they must be the first run's inline arrays to the bit.
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const auto& r = SplitFlight(*dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
   std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& j) {
     if (j.is_object()) {
       for (const char* clock : {"seconds", "timing", "seconds_testing", "aerocal_version"})
@@ -398,7 +456,7 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
       for (auto& value : j) strip(value);
     }
   };
-  auto first = aerocal::testing::ReadJson(dir_->File("once/result.json"));
+  auto first = aerocal::testing::ReadJson(dir_->File("report/result.json"));
   auto second = aerocal::testing::ReadJson(dir_->File("again/result.json"));
   testing::ExpectValidResult(second, dir_->File("again/result.json"));
   for (const auto& a : second["adjustments"]) {
@@ -409,11 +467,21 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
     EXPECT_EQ(a["residuals_file"]["sha256"],
               Sha256Hex(ReadTextFile(dir_->File("again/residuals_" + name + ".csv"))));
   }
-  // This flight's adjustments' residual tables are about half of its result.json (measured:
-  // 10.7 MB inline, 5.6 MB with the tables beside it; the rest is mostly the stitching frames'
-  // residuals, which stay inline).
+  // The stitching frames' residuals: one table, the frames without their arrays.
+  const auto& stitching = second["stitching"];
+  ASSERT_TRUE(stitching.contains("residuals_file"));
+  EXPECT_EQ(stitching["residuals_file"]["path"], "residuals_stitching.csv");
+  EXPECT_EQ(stitching["residuals_file"]["sha256"],
+            Sha256Hex(ReadTextFile(dir_->File("again/residuals_stitching.csv"))));
+  size_t frame_rows = 0;
+  for (const auto& f : first["stitching"]["frames"]) frame_rows += f["residuals"].size();
+  EXPECT_EQ(stitching["residuals_file"]["rows"], frame_rows);
+  for (const auto& f : stitching["frames"]) ASSERT_FALSE(f.contains("residuals")) << f["frame"];
+  // Every per-observation table is out of result.json: what stays is a small fraction (measured:
+  // 10.7 MB inline, 5.6 MB with the adjustments' tables beside it, 2.0 MB with the stitching
+  // frames' too; the rest is mostly the snooping and check-point tables).
   EXPECT_LT(std::filesystem::file_size(dir_->File("again/result.json")),
-            0.6 * std::filesystem::file_size(dir_->File("once/result.json")));
+            0.25 * std::filesystem::file_size(dir_->File("report/result.json")));
   tools::InflateResidualTables(&second, dir_->File("again/result.json"));
   strip(first);
   strip(second);
@@ -450,27 +518,68 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
     ASSERT_TRUE(first.contains(part)) << part;
     EXPECT_EQ(differ(first[part], second[part], part), 0) << part;
   }
-  EXPECT_EQ(ReadTextFile(dir_->File("once/camera_calibrated.yaml")),
+  EXPECT_EQ(ReadTextFile(dir_->File("report/camera_calibrated.yaml")),
             ReadTextFile(dir_->File("again/camera_calibrated.yaml")));
   // The Python readers (report_data.load, here through `export --tables`) see the same residuals.
-  for (const char* out : {"once", "again"}) {
+  for (const char* out : {"report", "again"}) {
     const auto e =
         testing::RunAerocal("export --result " + dir_->File(std::string(out) + "/result.json") +
                             " --tables " + dir_->File(std::string(out) + "_tables"));
     ASSERT_EQ(e.exit_code, 0) << e.output;
   }
   for (const char* name : {"conventional", "self_calibration", "joint"})
-    EXPECT_EQ(ReadTextFile(dir_->File(std::string("once_tables/") + name + "/residuals.csv")),
+    EXPECT_EQ(ReadTextFile(dir_->File(std::string("report_tables/") + name + "/residuals.csv")),
               ReadTextFile(dir_->File(std::string("again_tables/") + name + "/residuals.csv")))
         << name;
-  // A table changed after the run is refused by its checksum.
-  WriteFileAtomically(dir_->File("again/residuals_joint.csv"),
-                      ReadTextFile(dir_->File("again/residuals_joint.csv")) + "\n");
-  const auto changed = testing::RunAerocal("export --result " + dir_->File("again/result.json") +
-                                           " --tables " + dir_->File("changed_tables"));
-  EXPECT_EQ(changed.exit_code, 2) << changed.output;
-  EXPECT_NE(changed.output.find("residuals_joint.csv: SHA-256 differs"), std::string::npos)
-      << changed.output;
+}
+
+// Issue 33: `flight --certificate --residuals-csv` end to end. The certificate and the report
+// are written from result.json with its tables beside it (the certificate's residual vectors are
+// the inline run's), and a table changed afterwards is refused by every reader, by name, exit 2.
+TEST_F(FlightWorkflow, CertificateAndReportReadTheResidualTables) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const auto& r = SplitFlight(*dir_);
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  auto inline_cert = aerocal::testing::ReadJson(dir_->File("report/certificate/certificate.json"));
+  auto split_cert = aerocal::testing::ReadJson(dir_->File("again/certificate/certificate.json"));
+  ASSERT_GT(split_cert["residuals"].size(), 1000u);
+  inline_cert.erase("source");
+  split_cert.erase("source");
+  EXPECT_EQ(inline_cert, split_cert);
+  // The report: its residual figures and tables from the inflated arrays, as the inline run's.
+  // (The row of the clock, "report written (UTC)", apart.)
+  const auto without_clock = [](std::string html) {
+    const size_t at = html.find("<tr><td>report written (UTC)</td>");
+    if (at != std::string::npos) html.erase(at, html.find("</tr>", at) - at);
+    return html;
+  };
+  const std::string html = ReadTextFile(dir_->File("again/report.html"));
+  EXPECT_NE(html.find("<tr><td>report written (UTC)</td>"), std::string::npos);
+  EXPECT_EQ(without_clock(html), without_clock(ReadTextFile(dir_->File("report/report.html"))));
+  // A copy of the output with one table changed (a row's residual): each reader refuses it.
+  const std::string copy = dir_->File("tampered");
+  std::filesystem::copy(dir_->File("again"), copy, std::filesystem::copy_options::recursive);
+  for (const std::string table : {"residuals_stitching.csv", "residuals_joint.csv"}) {
+    const std::string path = copy + "/" + table;
+    const std::string original = ReadTextFile(path);
+    std::string changed = original;
+    const size_t comma = changed.find(',', changed.find('\n') + 1);
+    changed.insert(comma + 1, "X");
+    WriteFileAtomically(path, changed);
+    const std::string refused = table + ": SHA-256 differs";
+    const auto cert = testing::RunAerocal("certificate --result " + copy + "/result.json --lab " +
+                                          dir_->File("lab.yaml") + " --no-render --out " +
+                                          dir_->File("tampered_cert"));
+    EXPECT_EQ(cert.exit_code, 2) << table << ": " << cert.output;
+    EXPECT_NE(cert.output.find(refused), std::string::npos) << cert.output;
+    EXPECT_FALSE(std::filesystem::exists(dir_->File("tampered_cert/certificate.json")));
+    const auto report = testing::RunCommand("python3 " + ReportScript() + " " + copy +
+                                            "/result.json " + dir_->File("tampered.html"));
+    EXPECT_EQ(report.exit_code, 2) << table << ": " << report.output;
+    EXPECT_NE(report.output.find(refused), std::string::npos) << report.output;
+    EXPECT_FALSE(std::filesystem::exists(dir_->File("tampered.html")));
+    WriteFileAtomically(path, original);
+  }
 }
 
 TEST(ResidualTables, EveryValueReadsBackAndQuotedTextSurvives) {
@@ -493,6 +602,62 @@ TEST(ResidualTables, EveryValueReadsBackAndQuotedTextSurvives) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("t.csv:3:"), std::string::npos) << e.what();
   }
+}
+
+TEST(ResidualTables, StitchingFramesGoToOneTableAndComeBack) {
+  // Four frames (one without residuals, an id with a comma), a null sigma; the table is written
+  // beside result.json, the frames lose their arrays and get them back, bit for bit.
+  testing::TempDir dir("aerocal_tables");
+  const nlohmann::json frames = nlohmann::json::parse(R"([
+    {"frame": "E1", "sigma0": 1.0, "residuals": [
+      {"point": "t1", "subimage": "I", "kind": "tie", "vU_px": 0.1, "vV_px": -2e-17,
+       "sigma_px": 0.25},
+      {"point": "r1", "subimage": "II", "kind": "reference", "vU_px": 0.0, "vV_px": 1.5,
+       "sigma_px": null}]},
+    {"frame": "E,2", "residuals": [
+      {"point": "t9", "subimage": "I", "kind": "tie", "vU_px": 1e-300, "vV_px": 3.0,
+       "sigma_px": 0.25}]},
+    {"frame": "E3", "residuals": []},
+    {"frame": "E4", "residuals": [
+      {"point": "t1", "subimage": "III", "kind": "tie", "vU_px": -0.30000000000000004,
+       "vV_px": 7.0, "sigma_px": 0.5}]}])");
+  const nlohmann::json original = {{"adjustments", nlohmann::json::array()},
+                                   {"stitching", {{"frames", frames}}}};
+  nlohmann::json doc = original;
+  const auto written = tools::SplitResidualTables(&doc, dir.path());
+  ASSERT_EQ(written, std::vector<std::string>{"residuals_stitching.csv"});
+  const std::string table = dir.File("residuals_stitching.csv");
+  EXPECT_EQ(doc["stitching"]["residuals_file"]["rows"], 4);
+  EXPECT_EQ(doc["stitching"]["residuals_file"]["sha256"], Sha256Hex(ReadTextFile(table)));
+  for (const auto& f : doc["stitching"]["frames"]) EXPECT_FALSE(f.contains("residuals"));
+  EXPECT_NE(ReadTextFile(table).find("\n\"E,2\",t9,"), std::string::npos) << ReadTextFile(table);
+  const nlohmann::json split = doc;
+  tools::InflateResidualTables(&doc, dir.File("result.json"));
+  EXPECT_EQ(doc, original);
+  // A table naming a frame the result does not have (after the previous row's): FILE:LINE.
+  const std::string text =
+      "frame,point,subimage,kind,vU_px,vV_px,sigma_px\nE4,t1,I,tie,0,0,\nE1,t1,I,tie,0,0,\n";
+  WriteFileAtomically(table, text);
+  const auto expect_refused = [&](nlohmann::json doc, const std::string& message) {
+    try {
+      tools::InflateResidualTables(&doc, dir.File("result.json"));
+      ADD_FAILURE() << "accepted: " << message;
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(message), std::string::npos) << e.what();
+    }
+  };
+  doc = split;
+  doc["stitching"]["residuals_file"]["sha256"] = Sha256Hex(text);
+  expect_refused(doc, "residuals_stitching.csv:3: frame 'E1'");
+  // A changed table: refused by its checksum.
+  expect_refused(split, "residuals_stitching.csv: SHA-256 differs");
+  // Two frames with one id: their rows could not be given back; the arrays stay inline.
+  doc = original;
+  doc["stitching"]["frames"][3]["frame"] = "E1";
+  std::filesystem::remove(table);
+  EXPECT_TRUE(tools::SplitResidualTables(&doc, dir.path()).empty());
+  EXPECT_TRUE(doc["stitching"]["frames"][0].contains("residuals"));
+  EXPECT_FALSE(std::filesystem::exists(table));
 }
 
 TEST(FlightWorkflowInput, MissingProjectIsABadInput) {

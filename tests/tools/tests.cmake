@@ -3,6 +3,8 @@ aerocal_add_test(tools/cli_simulate LIBS aerocal::triangulation LABELS cli)
 aerocal_add_test(tools/cli_rig_stitch LIBS aerocal::calib LABELS cli)
 aerocal_add_test(tools/cli_flight LIBS aerocal::stitch LABELS cli TIMEOUT 600)
 target_sources(test_tools_cli_flight PRIVATE ${PROJECT_SOURCE_DIR}/tools/observation_tables.cc)
+# The report script the tests run on a flight's output (AEROCAL_REPORT_SCRIPT, as the program's).
+target_compile_definitions(test_tools_cli_flight PRIVATE ${AEROCAL_TOOL_DEFINITIONS})
 include(${CMAKE_CURRENT_SOURCE_DIR}/tools/report.cmake)
 include(${CMAKE_CURRENT_SOURCE_DIR}/tools/report_outputs.cmake)
 aerocal_add_test(tools/bad_input LIBS aerocal::triangulation LABELS cli)
@@ -36,6 +38,7 @@ target_sources(test_tools_output_set PRIVATE ${PROJECT_SOURCE_DIR}/tools/output_
 # `aerocal batch` (issue 35): plan / run --shard / status / merge against `flight`, a killed run,
 # changed and failing units, GNU Parallel (skipped without it), the Slurm scripts.
 aerocal_add_test(tools/cli_batch LIBS aerocal::calib LABELS cli)
+target_sources(test_tools_cli_batch PRIVATE ${PROJECT_SOURCE_DIR}/tools/observation_tables.cc)
 # The same for real under Slurm: munged, slurmctld and slurmd started on this machine
 # (tests/tools/slurm_localhost.sh), a 4-task job array and the dependent merge. Skipped with the
 # reason without slurm-wlm and munge (not in tools/setup.sh); label long: it starts daemons.

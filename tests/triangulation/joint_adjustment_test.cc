@@ -1,7 +1,8 @@
 // Joint stitching + triangulation on the simulated flight: mappings and interior recovered within
 // 3 sigma, check points no worse than stitching first and triangulating after; and with the camera
 // file's mappings 0.5 px off and no stitching measurements, the joint run recovers them while the
-// two-step run cannot.
+// two-step run cannot. The interior's control-survey part (control_cofactor.h) against its
+// sigmas.
 #include "triangulation/joint/joint_adjustment.h"
 
 #include "calib/camera/camera_io.h"
@@ -11,6 +12,7 @@
 #include "tests/support/test_support.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/block/block_io.h"
+#include "triangulation/calibration/uncertainty_budget.h"
 #include "triangulation/simulation/flight_simulator.h"
 
 #include <gtest/gtest.h>
@@ -201,6 +203,77 @@ TEST(JointAdjustment, PerExposureMappingsAreEstimatedForEveryExposure) {
       "check spatial RMSE: per flight %.3f m, per exposure %.3f m\n", check_flight, check_exposure);
   EXPECT_GT(check_exposure, 0.95 * check_flight);
   EXPECT_LT(check_exposure, 2.0 * check_flight);
+}
+
+// The control survey's part of the interior's cofactor (control_cofactor.h), at the stated
+// survey sigmas and at twice them. With t scaling the control weights (doubled sigmas: t = 1/4),
+// Q(t) = (N_image + t N_c)^-1, dQ/dt = -Q N_c Q =: -D(t), and D decreases with t
+// (dD/dt = -2 Q N_c Q N_c Q). The runs report C(1) = D(1) and C(1/4) = D(1/4) / 4 (each its own
+// weights' Q N_c Q), so Q(1/4) - Q(1) = integral of D over [1/4, 1] lies between 3/4 C(1) and
+// 3 C(1/4) for every parameter. The certificate's components split each variance as the GUM
+// says: sigma^2 = u_image^2 + sigma0^2 u_control^2, u_control^2 = C.
+TEST(JointAdjustment, ControlSurveyPartOfTheInteriorFollowsItsSigmas) {
+  auto f = MakeFlight(12, 0);
+  JointOptions options = SelfCalibratingJoint();
+  options.use_stitching = false;
+  options.control_cofactor = true;
+  const JointResult stated = AdjustJoint(f->project, options);
+  Project doubled_project = f->project;
+  for (auto& p : doubled_project.points)
+    if (p.role == PointRole::kControl) p.sigma_m *= 2.0;
+  const JointResult doubled = AdjustJoint(doubled_project, options);
+  ASSERT_TRUE(stated.adjustment.converged() && doubled.adjustment.converged());
+  ASSERT_EQ(stated.interior_camera, "cam1");
+  ASSERT_EQ(stated.interior_control_cofactor.rows(), calib::BrownFraser10Model::kNumParams);
+  ASSERT_EQ(doubled.interior_control_cofactor.rows(), calib::BrownFraser10Model::kNumParams);
+  // The difference quotient's step (kControlWeightStep = 1e-3) and the two runs' slightly
+  // different solutions: 1 % of slack on either bound.
+  constexpr double kSlack = 0.01;
+  const auto cofactor = [](const JointResult& r, int k) {
+    return std::pow(r.adjustment.cameras[0].sigma[k] / r.adjustment.sigma0, 2);
+  };
+  for (int k : {calib::BrownFraser10Model::kC,
+                calib::BrownFraser10Model::kX0,
+                calib::BrownFraser10Model::kY0}) {
+    const double c1 = stated.interior_control_cofactor(k, k);
+    const double c4 = doubled.interior_control_cofactor(k, k);
+    const double dq = cofactor(doubled, k) - cofactor(stated, k);
+    const char* name = calib::BrownFraser10Model::kParams[k].name.data();
+    std::printf("%s: u_control %.3g -> %.3g (sigmas doubled), Q %.4g -> %.4g\n",
+                name,
+                std::sqrt(c1),
+                std::sqrt(c4),
+                cofactor(stated, k),
+                cofactor(doubled, k));
+    EXPECT_GT(c1, 0.0) << name;
+    EXPECT_GE(dq, (1 - kSlack) * 0.75 * c1) << name;
+    EXPECT_LE(dq, (1 + kSlack) * 3.0 * c4) << name;
+    // The budget of the parameter (the flight certificate's, InteriorParameterBudget).
+    AdjustedInterior in;
+    const auto& camera = stated.adjustment.cameras[0];
+    in.params = camera.estimated;
+    in.table = calib::CameraModelParams(camera.model);
+    in.covariance = Eigen::MatrixXd::Zero(in.table.size(), in.table.size());
+    for (int i = 0; i < static_cast<int>(in.table.size()); ++i)
+      in.covariance(i, i) = camera.sigma[i] * camera.sigma[i];
+    in.control_cofactor = stated.interior_control_cofactor;
+    in.sigma0 = stated.adjustment.sigma0;
+    in.redundancy = stated.adjustment.solve.redundancy;
+    in.pixel_size_mm = f->project.cameras.at("cam1").pixel_size_mm;
+    const BudgetQuantity q = InteriorParameterBudget(in, k, "test");
+    ASSERT_EQ(q.components.size(), 3u) << name;
+    EXPECT_EQ(q.components[0].source, "image measurements");
+    EXPECT_EQ(q.components[1].source, "control coordinates");
+    EXPECT_EQ(q.components[2].source, "pixel pitch");
+    EXPECT_EQ(q.components[2].u, 0.0) << "no tolerance stated";
+    const double u_image = q.components[0].u, u_control = q.components[1].u;
+    EXPECT_NEAR(u_control * u_control, c1, 1e-9 * c1) << name;
+    EXPECT_NEAR(u_image * u_image + std::pow(in.sigma0 * u_control, 2),
+                std::pow(camera.sigma[k], 2),
+                1e-9 * std::pow(camera.sigma[k], 2))
+        << name;
+    EXPECT_NEAR(q.u_c, std::hypot(u_image, u_control), 1e-12 * q.u_c) << name;
+  }
 }
 
 TEST(JointAdjustment, RefusesAProjectWithoutSubimageObservations) {

@@ -71,11 +71,21 @@ RESIDUAL_COLUMNS = [("image", "image", None, str, False), ("point", "point", Non
                     ("reason", "reason", None, str, False)]
 
 
-def residual_rows(text, where):
-    """The residual entries of a residuals_<adjustment>.csv text, as the result's JSON held them."""
+# The columns of residuals_stitching.csv (the stitching frames' residuals, each row with its frame's
+# id): always written, an empty sigma_px is a null.
+STITCHING_RESIDUAL_COLUMNS = [("frame", "frame", None, str, False), ("point", "point", None, str, False),
+                              ("subimage", "subimage", None, str, False), ("kind", "kind", None, str, False),
+                              ("vU_px", "vU_px", None, float, False), ("vV_px", "vV_px", None, float, False),
+                              ("sigma_px", "sigma_px", None, float, False)]
+
+
+def residual_rows(text, where, columns=RESIDUAL_COLUMNS):
+    """The residual entries of a residual table's text (`columns`: RESIDUAL_COLUMNS for
+    residuals_<adjustment>.csv, STITCHING_RESIDUAL_COLUMNS), as the result's JSON held them."""
     reader = csv.reader(io.StringIO(text, newline=""))
     header = next(reader, None)
-    names = [c[0] for c in RESIDUAL_COLUMNS]
+    names = [c[0] for c in columns]
+    stitching = columns is STITCHING_RESIDUAL_COLUMNS
     if header != names:
         raise InputError(f"{where}:1: not a residual table (expected the header {','.join(names)})")
     out = []
@@ -84,9 +94,9 @@ def residual_rows(text, where):
             continue
         if len(fields) != len(names):
             raise InputError(f"{where}:{reader.line_num}: {len(fields)} fields (expected {len(names)})")
-        tested = fields[12] != ""
+        tested = not stitching and fields[12] != ""  # group_size: the test's keys are there
         entry = {}
-        for (name, key, element, kind, only_tested), f in zip(RESIDUAL_COLUMNS, fields):
+        for (name, key, element, kind, only_tested), f in zip(columns, fields):
             if only_tested and not tested:
                 continue
             try:
@@ -96,29 +106,53 @@ def residual_rows(text, where):
                 raise InputError(f"{where}:{reader.line_num}: {name} is not a number ({f!r})")
             if element is not None:
                 entry.setdefault(key, [None, None])[element] = value if f != "" else None
-            elif f != "" or (only_tested and kind is str):
+            elif f != "" or (only_tested and kind is str) or stitching:
                 entry[key] = value
         out.append(entry)
     return out
 
 
+def _table_text(spec, path):
+    """The text of the table a `residuals_file` names, beside the result, SHA-256 checked."""
+    table = os.path.join(os.path.dirname(path), str(spec.get("path")))
+    try:
+        with open(table, "rb") as f:
+            data = f.read()
+    except OSError as e:
+        raise InputError(f"{table}: cannot read the residual table {path} names ({e.strerror})")
+    if hashlib.sha256(data).hexdigest() != spec.get("sha256"):
+        raise InputError(f"{table}: SHA-256 differs from the one {path} states")
+    return table, data.decode("utf-8")
+
+
 def inflate_residual_tables(doc, path):
-    """`flight --residuals-csv`: each adjustment's `residuals_file` read back (beside the result,
-    SHA-256 checked) into its `residuals`, so every reader sees one document."""
+    """`flight --residuals-csv`: each adjustment's `residuals_file` and the stitching's read back
+    (beside the result, SHA-256 checked) into their `residuals`, so every reader sees one document."""
     for a in doc.get("adjustments") or []:
         spec = a.get("residuals_file") if isinstance(a, dict) else None
         if not isinstance(spec, dict):
             continue
-        table = os.path.join(os.path.dirname(path), str(spec.get("path")))
-        try:
-            with open(table, "rb") as f:
-                data = f.read()
-        except OSError as e:
-            raise InputError(f"{table}: cannot read the residual table {path} names ({e.strerror})")
-        if hashlib.sha256(data).hexdigest() != spec.get("sha256"):
-            raise InputError(f"{table}: SHA-256 differs from the one {path} states")
-        a["residuals"] = residual_rows(data.decode("utf-8"), table)
+        table, text = _table_text(spec, path)
+        a["residuals"] = residual_rows(text, table)
         del a["residuals_file"]
+    stitching = doc.get("stitching")
+    spec = stitching.get("residuals_file") if isinstance(stitching, dict) else None
+    if isinstance(spec, dict):
+        table, text = _table_text(spec, path)
+        frames = [f for f in stitching.get("frames") or [] if isinstance(f, dict)]
+        for f in frames:
+            f["residuals"] = []
+        k = 0
+        for row, entry in enumerate(residual_rows(text, table, STITCHING_RESIDUAL_COLUMNS), start=2):
+            # Rows are in the frames' order, a frame's rows together (observation_tables.cc).
+            while k < len(frames) and frames[k].get("frame") != entry["frame"]:
+                k += 1
+            if k == len(frames):
+                raise InputError(f"{table}:{row}: frame {entry['frame']!r} is not a frame of {path} "
+                                 "after the previous row's (rows are in the frames' order)")
+            del entry["frame"]
+            frames[k]["residuals"].append(entry)
+        del stitching["residuals_file"]
 
 
 def as_flight_document(doc):

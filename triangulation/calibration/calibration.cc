@@ -57,16 +57,9 @@ CalibrationAdjustment RunCalibrationAdjustment(const Project& project,
         adjustment.builder().EstimateCovariance({block}, out.result.sigma0);
     const int size = project.cameras.begin()->second.interior.size();
     if (cov.ok) out.interior_covariance = cov.BlockCovariance(block, size);
-    if (cov.ok && control_cofactor && out.result.sigma0 > 0) {
-      adjustment.ScaleControlWeights(1.0 - kControlWeightStep);
-      const calib::CovarianceReport step = adjustment.builder().EstimateCovariance({block}, 1.0);
-      adjustment.ScaleControlWeights(1.0);
-      const double s0 = out.result.sigma0;
-      if (step.ok)
-        out.control_cofactor =
-            (step.BlockCovariance(block, size) - out.interior_covariance / (s0 * s0)) /
-            kControlWeightStep;
-    }
+    if (cov.ok && control_cofactor && out.result.sigma0 > 0)
+      out.control_cofactor =
+          ControlCofactor(adjustment, block, size, out.result.sigma0, out.interior_covariance);
   }
   return out;
 }

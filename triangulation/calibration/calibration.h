@@ -16,6 +16,7 @@
 #include "triangulation/adjustment/adjust_options.h"
 #include "triangulation/adjustment/adjustment_result.h"
 #include "triangulation/block/block.h"
+#include "triangulation/calibration/control_cofactor.h"
 #include "triangulation/calibration/resection.h"
 
 #include <Eigen/Core>
@@ -74,12 +75,6 @@ struct StabilityReport {
   std::vector<StabilityRow> rows;
   std::vector<std::string> flagged;  // one sentence per parameter out of agreement
 };
-
-/// Relative step of the control weights for CalibrationAdjustment::control_cofactor. At one
-/// linearisation (the solution) Q(t) = (N_image + t N_control)^-1 gives
-/// Q N_control Q = (Q(1 - d) - Q(1)) / d + O(d), with a relative error below d
-/// (Q^1/2 N_control Q^1/2 <= I) and far above the covariance's rounding at d = 1e-3.
-inline constexpr double kControlWeightStep = 1e-3;
 
 struct CalibrationRun {
   std::string camera;

@@ -143,11 +143,11 @@ struct CovarianceSplit {
   Eigen::MatrixXd control;  // Q N_c Q; empty without control
 };
 
-CovarianceSplit SplitCovariance(const CalibrationRun& run) {
+CovarianceSplit SplitCovariance(const Eigen::MatrixXd& covariance,
+                                const Eigen::MatrixXd& control,
+                                double s0) {
   CovarianceSplit split;
-  split.image = run.all.interior_covariance;
-  const Eigen::MatrixXd& control = run.all.control_cofactor;
-  const double s0 = run.all.result.sigma0;
+  split.image = covariance;
   if (!(s0 > 0) || split.image.size() == 0 || control.rows() != split.image.rows()) return split;
   split.control = control;
   split.image -= s0 * s0 * control;
@@ -180,7 +180,9 @@ double PitchSensitivity(const InteriorFunction& f,
 
 // What every interior quantity's default components need, computed once.
 struct BudgetInputs {
-  const CalibrationRun* run = nullptr;
+  calib::InteriorParams params;                           // estimated, table units
+  const std::vector<GroupCalibration>* groups = nullptr;  // image groups (test field), or none
+  double sigma0_px = 0;
   CovarianceSplit split;
   std::vector<calib::ParamInfo> table;
   double dof_adjustment = 1;
@@ -196,8 +198,11 @@ BudgetInputs MakeBudgetInputs(const CalibrationRun& run,
                               const Project& project,
                               const BudgetOptions& options) {
   BudgetInputs in;
-  in.run = &run;
-  in.split = SplitCovariance(run);
+  in.params = run.all.result.cameras[0].estimated;
+  in.groups = &run.groups;
+  in.sigma0_px = run.all.result.sigma0_px;
+  in.split =
+      SplitCovariance(run.all.interior_covariance, run.all.control_cofactor, run.all.result.sigma0);
   in.table = calib::CameraModelParams(run.all.result.cameras[0].model);
   in.dof_adjustment = std::max(1, run.all.result.solve.redundancy);
   in.eccentricity_px = MaxEccentricityPx(run, project, options.target_radius_mm);
@@ -255,16 +260,15 @@ UncertaintyComponent PixelPitchComponent(const InteriorFunction& f,
 // The default components of one interior quantity (see the header comment).
 std::vector<UncertaintyComponent> InteriorComponents(const InteriorFunction& f,
                                                      const BudgetInputs& in) {
-  const CalibrationRun& run = *in.run;
-  const calib::InteriorParams& p = run.all.result.cameras[0].estimated;
+  const calib::InteriorParams& p = in.params;
   std::vector<UncertaintyComponent> out;
   const double u_image = Propagate(f, p, in.split.image);
   out.push_back(Component("image measurements", "A", u_image, in.dof_adjustment, f.unit));
   out.back().origin = in.image_origin;
-  if (run.groups.size() >= 2) {
+  if (in.groups && in.groups->size() >= 2) {
     // The groups share the control: their scatter is compared with the image part alone.
     std::vector<double> values;
-    for (const auto& g : run.groups)
+    for (const auto& g : *in.groups)
       if (!g.adjustment.result.cameras.empty())
         values.push_back(f.f(g.adjustment.result.cameras[0].estimated));
     const double n = static_cast<double>(values.size());
@@ -285,7 +289,7 @@ std::vector<UncertaintyComponent> InteriorComponents(const InteriorFunction& f,
         Component("control coordinates", "B", Propagate(f, p, in.split.control), kInf, f.unit));
     out.back().origin = in.control_origin;
   }
-  const double sigma0_px = run.all.result.sigma0_px;
+  const double sigma0_px = in.sigma0_px;
   if (in.eccentricity_px > 0 && sigma0_px > 0) {
     UncertaintyComponent c = Component("target eccentricity", "B", 0, kInf, "px", "rectangular");
     c.value = in.eccentricity_px;
@@ -299,6 +303,17 @@ std::vector<UncertaintyComponent> InteriorComponents(const InteriorFunction& f,
   }
   out.push_back(PixelPitchComponent(f, p, in));
   return out;
+}
+
+// An interior quantity with its default components (not yet combined: Finish).
+BudgetQuantity InteriorQuantity(const InteriorFunction& f, const BudgetInputs& in) {
+  BudgetQuantity q;
+  q.name = f.name;
+  q.unit = f.unit;
+  q.description = f.description;
+  q.value = f.f(in.params);
+  q.components = InteriorComponents(f, in);
+  return q;
 }
 
 }  // namespace
@@ -443,6 +458,28 @@ BudgetOptions ReadBudgetOptions(const std::string& path) {
   return options;
 }
 
+BudgetQuantity InteriorParameterBudget(const AdjustedInterior& interior,
+                                       int index,
+                                       const std::string& description) {
+  BudgetInputs in;
+  in.params = interior.params;
+  in.split = SplitCovariance(interior.covariance, interior.control_cofactor, interior.sigma0);
+  in.table = interior.table;
+  in.dof_adjustment = std::max(1.0, interior.redundancy);
+  in.pixel_size_mm = interior.pixel_size_mm;
+  in.pitch_tolerance_mm = interior.pitch_tolerance_mm;
+  in.pitch_source = interior.pitch_source;
+  in.image_origin = interior.image_origin;
+  in.control_origin = interior.control_origin;
+  const InteriorFunction f{std::string(in.table.at(index).name),
+                           std::string(in.table.at(index).unit),
+                           description,
+                           [index](const calib::InteriorParams& p) { return p[index]; }};
+  BudgetQuantity q = InteriorQuantity(f, in);
+  Finish(&q);
+  return q;
+}
+
 std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
                                               const Project& project,
                                               const BudgetOptions& options) {
@@ -491,15 +528,7 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
   }
 
   std::vector<BudgetQuantity> out;
-  for (const auto& f : functions) {
-    BudgetQuantity q;
-    q.name = f.name;
-    q.unit = f.unit;
-    q.description = f.description;
-    q.value = f.f(camera.estimated);
-    q.components = InteriorComponents(f, inputs);
-    out.push_back(q);
-  }
+  for (const auto& f : functions) out.push_back(InteriorQuantity(f, inputs));
   // Check-point accuracy and m_0.
   if (all.check.n > 0) {
     const double n = all.check.n;

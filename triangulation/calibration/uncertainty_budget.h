@@ -32,6 +32,13 @@
 //   `pixel_size_tolerance_mm`), rectangular (T / sqrt 3), times df/dpitch: a pitch s times the
 //   stated one scales every photo coordinate by s, so the parameter p_k with length exponent e_k
 //   (mm: 1, mm^-2: -2, px and 1: 0) becomes p_k s^e_k; zero (and said so) without a tolerance.
+// - No component for the a-priori image sigma, even where a file states its uncertainty: a
+//   common factor s on the stated sigmas gives P_i / s^2, Q s^2, N_i / s^2 and sigma0^2 / s^2,
+//   so sigma0^2 Q N_i Q is unchanged (exactly when the images are the only weighted
+//   observations; with control or GNSS/IMU priors the estimator stays unbiased and the
+//   propagation uses the weights actually used). What remains is sigma0's own
+//   uncertainty from r degrees of freedom: the image component's nu. Counting the stated sigma's
+//   uncertainty again would count it twice (tools/certificate/README.md).
 // - B user components (temperature, ...) of the budget file: value with its distribution (normal:
 //   divisor 1, rectangular sqrt 3, triangular sqrt 6), sensitivity coefficient and degrees of
 //   freedom; one named like a default component of its quantity (case aside) replaces it.
@@ -42,6 +49,7 @@
 
 #include "triangulation/calibration/calibration.h"
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include <limits>
@@ -111,6 +119,30 @@ BudgetOptions ReadBudgetOptions(const std::string& path);
 std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
                                               const Project& project,
                                               const BudgetOptions& options);
+
+/// An adjusted camera's interior as the default components of its parameters need it: a test
+/// field's CalibrationRun gives it (UncertaintyBudget), and so does a flight's certified
+/// adjustment (the flight certificate, tools/certificate_writer.cc).
+struct AdjustedInterior {
+  calib::InteriorParams params;         // estimated, table units
+  std::vector<calib::ParamInfo> table;  // the model's parameter table
+  Eigen::MatrixXd covariance;           // sigma0^2 Q of the interior (table order)
+  Eigen::MatrixXd control_cofactor;     // Q N_control Q (control_cofactor.h); empty: no control
+  double sigma0 = 1;                    // of the adjustment, > 0
+  double redundancy = 1;                // degrees of freedom of the type-A part
+  double pixel_size_mm = 0;             // the pitch the photo coordinates were made with
+  std::optional<double> pitch_tolerance_mm;  // +- (rectangular); none: the component is zero
+  std::string pitch_source;                  // where the tolerance is stated
+  std::string image_origin, control_origin;  // the components' origins, for the document
+};
+
+/// The budget of the interior parameter `index` (table order) of `interior` with the default
+/// components that need no test field: A "image measurements" (sigma0^2 Q - sigma0^2 Q N_c Q),
+/// B "control coordinates" (Q N_c Q, when known) and B "pixel pitch", combined (u_c, nu_eff, k,
+/// U, statement) as UncertaintyBudget does.
+BudgetQuantity InteriorParameterBudget(const AdjustedInterior& interior,
+                                       int index,
+                                       const std::string& description);
 
 /// k for the effective degrees of freedom (see the header comment).
 double CoverageFactor(double dof_eff);

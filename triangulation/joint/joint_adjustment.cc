@@ -9,6 +9,7 @@
 #include "stitch/adjustment/stitch_adjustment.h"
 #include "stitch/simulation/stitch_simulator.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/calibration/control_cofactor.h"
 
 #include <algorithm>
 #include <cmath>
@@ -18,6 +19,30 @@
 namespace aerocal::triangulation {
 namespace {
 using calib::MappingModel;
+
+// Q N_control Q of the interior of `camera` in the solved `adjustment` (control_cofactor.h);
+// empty when its covariance is not determinable.
+Eigen::MatrixXd InteriorControlCofactor(const Project& project,
+                                        const std::string& camera,
+                                        const AdjustmentResult& result,
+                                        BlockAdjustment& adjustment) {
+  const calib::BlockId block = adjustment.InteriorBlock(camera);
+  if (block < 0 || !result.solve.usable || result.solve.redundancy <= 0 ||
+      !result.determinability.covariance_ok || !(result.sigma0 > 0))
+    return {};
+  const int size = project.cameras.at(camera).interior.size();
+  const calib::CovarianceReport cov =
+      adjustment.builder().EstimateCovariance({block}, result.sigma0);
+  if (!cov.ok) return {};
+  return ControlCofactor(adjustment, block, size, result.sigma0, cov.BlockCovariance(block, size));
+}
+
+// The camera whose sub-images the joint adjustment maps (the first with sub-images).
+std::string SubimageCameraId(const Project& project) {
+  for (const auto& [id, camera] : project.cameras)
+    if (!camera.subimages.empty()) return id;
+  return project.cameras.empty() ? std::string() : project.cameras.begin()->first;
+}
 }  // namespace
 
 std::optional<calib::MappingModel> ParseJointModel(const std::string& text) {
@@ -79,6 +104,12 @@ JointResult AdjustJoint(const Project& project, const JointOptions& options) {
   result.stitching = std::move(report.stitching);
   result.mapping_interior_correlations = std::move(report.mapping_interior_correlations);
   result.mapping_covariance_ok = report.mapping_covariance_ok;
+  // After the report: the control weights are stepped and restored (new residual ids).
+  if (options.control_cofactor) {
+    result.interior_camera = SubimageCameraId(project);
+    result.interior_control_cofactor =
+        InteriorControlCofactor(project, result.interior_camera, result.adjustment, adjustment);
+  }
   return result;
 }
 
@@ -117,6 +148,22 @@ nlohmann::json JointResultToJson(const JointResult& result) {
   for (const auto& h : result.mapping_interior_correlations)
     correlations.push_back({{"a", h.a}, {"b", h.b}, {"correlation", h.correlation}});
   j["mapping_interior_correlations"] = correlations;
+  if (result.interior_control_cofactor.size() > 0) {
+    const auto& camera = result.adjustment.cameras;
+    nlohmann::json names = nlohmann::json::array(), matrix = nlohmann::json::array();
+    for (const auto& e : camera)
+      if (e.id == result.interior_camera)
+        for (const auto& info : calib::CameraModelParams(e.model))
+          names.push_back(std::string(info.name));
+    for (int i = 0; i < result.interior_control_cofactor.rows(); ++i) {
+      nlohmann::json row = nlohmann::json::array();
+      for (int k = 0; k < result.interior_control_cofactor.cols(); ++k)
+        row.push_back(result.interior_control_cofactor(i, k));
+      matrix.push_back(row);
+    }
+    j["interior_control_cofactor"] = {
+        {"camera", result.interior_camera}, {"names", names}, {"matrix", matrix}};
+  }
   return j;
 }
 

@@ -25,6 +25,7 @@
 #include "triangulation/block/block.h"
 #include "triangulation/sensor/subimage_camera.h"
 
+#include <Eigen/Core>
 #include <nlohmann/json.hpp>
 
 #include <limits>
@@ -48,6 +49,9 @@ std::optional<calib::MappingModel> ParseJointModel(const std::string& text);
 struct JointOptions : SubimageCameraOptions {
   AdjustOptions adjust;
   std::string model_reason;  // why that model, in words (written to the result)
+  /// Also the part of the interior's cofactor matrix that the control survey sigmas give
+  /// (JointResult::interior_control_cofactor; two more covariance evaluations, no solve).
+  bool control_cofactor = false;
   /// ConfigError for an unknown base sub-image or a project without sub-image observations,
   /// InputError when the focal plane has no datum (no base sub-image and no reference point).
   void Validate(const Project& project) const;
@@ -63,6 +67,11 @@ struct JointResult {
   bool mapping_covariance_ok = false;
   std::string mapping_model;         // of the free mappings ("affine"), or "camera file"
   std::string mapping_model_reason;  // JointOptions::model_reason
+  /// With JointOptions::control_cofactor: Q N_control Q of the sub-image camera's interior
+  /// (calibration/control_cofactor.h; parameter table order and units, not scaled by sigma0),
+  /// the control coordinates' type-B part of its covariance; empty without a covariance.
+  std::string interior_camera;
+  Eigen::MatrixXd interior_control_cofactor;
 };
 
 JointResult AdjustJoint(const Project& project, const JointOptions& options);

@@ -225,6 +225,9 @@ FlightWorkflowResult RunFlightWorkflow(const FlightWorkflowOptions& options, Pro
     joint_options.adjust = self_options;
     joint_options.base_ids = options.base_ids;
     joint_options.stitch_sigma_px = options.stitch_sigma_px;
+    // The control survey's part of the certified interior's covariance (the certificate's type-B
+    // component "control coordinates", as a test field's).
+    joint_options.control_cofactor = true;
     // The mapping model the flight's stitching chose (or the one given), from its flight means.
     const calib::Camera start = JointMappingsFromStitching(
         camera, stitching ? &*stitching : nullptr, batch, options.joint_model, &joint_options);
