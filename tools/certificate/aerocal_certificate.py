@@ -10,6 +10,7 @@ figures; a note on stderr says so). Both outputs are deterministic: no dates oth
 file's, fixed SVG ids, no creation date in the PDF. Exit 0 on success, 2 on bad input (nothing
 written), 1 when matplotlib is missing.
 """
+import base64
 import html
 import io
 import json
@@ -484,11 +485,16 @@ def fig_residuals_correlation(c):
 
 
 def svg_of(fig):
+    """The figure as an SVG image in the HTML (a data URI, not inline markup): WeasyPrint 57 does not
+    draw the <use> references of matplotlib's glyph paths in an inline SVG, which left the PDF's
+    figures without any label, tick or legend text."""
     buf = io.StringIO()
     fig.savefig(buf, format="svg", metadata={"Date": None})
     plt.close(fig)
     text = buf.getvalue()
-    return text[text.index("<svg"):]
+    svg = text[text.index("<svg"):]
+    data = base64.b64encode(svg.encode("utf-8")).decode("ascii")
+    return f'<img class="figure" alt="figure" src="data:image/svg+xml;base64,{data}">'
 
 
 # ---------------------------------------------------------------- HTML
@@ -513,12 +519,12 @@ def page_html(c, figures):
              "table{border-collapse:collapse;margin:0.5em 0}td,th{border:1px solid #999;padding:2px 6px;"
              "text-align:left;font-size:10pt}.bad{color:#b00;font-weight:bold}.sig td{height:3em;width:14em}"
              ".draft{color:#b00;border:2px solid #b00;padding:4px 8px;font-weight:bold}"
-             "h1{font-size:18pt}h2{font-size:13pt;border-bottom:1px solid #999}"
+             "h1{font-size:18pt}h2{font-size:13pt;border-bottom:1px solid #999}img.figure{max-width:100%;height:auto}"
              "@page{size:A4;margin:18mm 14mm 16mm;@top-left{content:string(title);font-family:sans-serif;font-size:8pt;color:#555}"
              "@bottom-right{content:'page ' counter(page) ' of ' counter(pages);font-family:sans-serif;font-size:8pt}}"
              "h1{string-set:title content()}"
              "@media print{body{max-width:none;font-size:9pt}td,th{font-size:7.5pt}"
-             "svg{max-width:100%;height:auto}h2{break-after:avoid}}</style></head><body>",
+             "h2{break-after:avoid}}</style></head><body>",
              "<h1>%s</h1>" % html.escape(title_of(c))]
     if draft:
         parts.append("<p class='draft'>DRAFT: no laboratory file (--lab) was given. This document states "

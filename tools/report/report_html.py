@@ -46,6 +46,9 @@ figcaption { font-size: 13px; color: #4a5563; margin-top: 3px; }
   table { font-size: 7pt; max-width: 100%; } td.num { font-size: 7pt; } td.hash { font-size: 6pt; max-width: 60mm; }
   th, td { padding: 1px 3px; }
   td.text-small { font-size: 6.5pt; max-width: none; } td details { display: none; }
+  /* The second line of a number cell (e.g. "r = 1986; F = 171 > 1.94") may wrap on paper: wide
+     tables (the model choice per exposure) stay inside the page. */
+  td.num small { white-space: normal; }
   /* A folded list stays folded on paper: its summary line is printed, the rows are in the HTML
      report and in `aerocal export --tables`. */
   details:not([open]) > :not(summary) { display: none; }
