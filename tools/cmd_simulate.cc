@@ -223,9 +223,8 @@ void GroupOptionsByMode(CLI::App& app) {
   }
 }
 
-CommandRun SetupSimulate(CLI::App& app) {
-  using Args = SimulateArgs;
-  auto args = std::make_shared<Args>();
+// The frame-camera flight: block, points, noise, sigmas, the multi-CCD layout.
+void AddFlightOptions(CLI::App& app, SimulateArgs* args) {
   auto& o = args->options;
   app.add_option("--out", args->out, "Output folder (created; files replaced atomically)")
       ->required();
@@ -300,6 +299,15 @@ CommandRun SetupSimulate(CLI::App& app) {
                  "Affine part of the true CCD misplacements (x-scale minus y-scale and skew, each "
                  "+-this), 0..0.1")
       ->check(FiniteRange(0.0, 0.1));
+}
+
+// The options a frame-camera flight refuses (they apply to --rig only).
+struct RigOptions {
+  CLI::Option *increment = nullptr, *time_offset = nullptr, *format_scale = nullptr;
+};
+
+// --rig and its options.
+RigOptions AddRigOptions(CLI::App& app, SimulateArgs* args) {
   app.add_option(
       "--rig",
       args->rig,
@@ -309,23 +317,28 @@ CommandRun SetupSimulate(CLI::App& app) {
       "relief, 10 m/s, increments 0.025 deg, shutter offsets ~3 ms, stitching ties at "
       "the 12 standard positions, dense and check ties per exposure); the flight "
       "options above override the defaults");
-  auto* increment =
-      app.add_option("--head-increment-arcsec",
-                     args->increment_arcsec,
-                     "--rig: sigma of the per-exposure attitude increments E_k of the "
-                     "non-reference heads, 0..3600 arcsec")
-          ->check(FiniteRange(0.0, 3600.0));
-  auto* time_offset = app.add_option("--head-time-offset-ms",
-                                     args->time_offset_ms,
-                                     "--rig: exposure time offset dT_k of the non-reference heads, "
-                                     "-1000..1000 ms (with --speed-mps)")
-                          ->check(FiniteRange(-1000.0, 1000.0));
-  auto* format_scale = app.add_option("--format-scale",
-                                      args->format_scale,
-                                      "--rig: every format (heads, virtual image) x this, pixel "
-                                      "sizes / this: the same geometry in "
-                                      "fewer pixels (small rendered images), (0, 1]")
-                           ->check(FiniteRange(0, 1, true));
+  RigOptions rig;
+  rig.increment = app.add_option("--head-increment-arcsec",
+                                 args->increment_arcsec,
+                                 "--rig: sigma of the per-exposure attitude increments E_k of the "
+                                 "non-reference heads, 0..3600 arcsec")
+                      ->check(FiniteRange(0.0, 3600.0));
+  rig.time_offset = app.add_option("--head-time-offset-ms",
+                                   args->time_offset_ms,
+                                   "--rig: exposure time offset dT_k of the non-reference heads, "
+                                   "-1000..1000 ms (with --speed-mps)")
+                        ->check(FiniteRange(-1000.0, 1000.0));
+  rig.format_scale = app.add_option("--format-scale",
+                                    args->format_scale,
+                                    "--rig: every format (heads, virtual image) x this, pixel "
+                                    "sizes / this: the same geometry in "
+                                    "fewer pixels (small rendered images), (0, 1]")
+                         ->check(FiniteRange(0, 1, true));
+  return rig;
+}
+
+// The platform: speed, GNSS lever arm, IMU boresight, GNSS time offset.
+void AddPlatformOptions(CLI::App& app, SimulateArgs* args) {
   app.add_option("--speed-mps",
                  args->speed_mps,
                  "Platform speed along the strips, 0..1000 m/s (> 0: exposures.csv carries vX, vY, "
@@ -350,6 +363,10 @@ CommandRun SetupSimulate(CLI::App& app) {
                  "GNSS time offset dt planted in the GNSS centres (+ v dt), -10000..10000 ms (with "
                  "--gnss-sigma-m and --speed-mps)")
       ->check(FiniteRange(-1e4, 1e4));
+}
+
+// --edge-targets and its patches' PSF and noise.
+void AddEdgeTargetOptions(CLI::App& app, SimulateArgs* args) {
   auto* edge_targets = app.add_flag(
       "--edge-targets",
       args->edge_targets,
@@ -368,8 +385,10 @@ CommandRun SetupSimulate(CLI::App& app) {
                  "0..2000 DN")
       ->needs(edge_targets)
       ->check(FiniteRange(0.0, 2000.0));
-  // Line camera (pushbroom) flight: its own options; the shared ones above apply when given.
-  auto& l = args->line;
+}
+
+// --test-field: a camera-calibration test field instead of a flight.
+void AddTestFieldOptions(CLI::App& app, SimulateArgs* args) {
   app.add_flag(
       "--test-field",
       args->test_field,
@@ -385,6 +404,11 @@ CommandRun SetupSimulate(CLI::App& app) {
   app.add_option(
          "--distance-m", args->field.distance_m, "Test field: camera distance from the wall, m")
       ->check(FiniteRange(1.0, 1000.0));
+}
+
+// Line camera (pushbroom) flight: its own options; the shared flight options apply when given.
+void AddLineOptions(CLI::App& app, SimulateArgs* args) {
+  auto& l = args->line;
   app.add_flag(
       "--pushbroom",
       args->pushbroom,
@@ -452,6 +476,10 @@ CommandRun SetupSimulate(CLI::App& app) {
                  l.control_noise_m,
                  "Pushbroom: control-point coordinate noise, 0..1000 m")
       ->check(FiniteRange(0.0, 1e3));
+}
+
+// --render-images (--pushbroom or --rig) and its texture, reference frames and noise.
+void AddLineImageOptions(CLI::App& app, SimulateArgs* args) {
   auto* images = app.add_flag(
       "--render-images",
       args->pushbroom_images,
@@ -481,6 +509,168 @@ CommandRun SetupSimulate(CLI::App& app) {
                  "--render-images: Gaussian grey-value noise of the rendered images, DN")
       ->needs(images)
       ->check(FiniteRange(0.0, 100.0));
+}
+
+// `simulate --pushbroom`: the line camera flight (the shared flight options where given), its
+// rendered images with --render-images.
+int RunLineSimulation(const CLI::App& app, SimulateArgs& args, const CLI::Option* format_scale) {
+  if (!args.rig.empty()) throw ConfigError("--pushbroom and --rig: choose one");
+  if (format_scale->count() > 0) throw ConfigError("--format-scale applies to --rig only");
+  auto& l = args.line;
+  l.seed = args.seed;
+  auto given = [&](const char* name) { return app.count(name) > 0; };
+  if (given("--height-m")) l.height_m = args.options.flying_height_m;
+  if (given("--relief-m")) l.relief_m = args.options.terrain_relief_m;
+  if (given("--image-noise-px")) l.image_noise_px = args.options.image_noise_px;
+  if (given("--image-sigma-px")) l.image_sigma_px = args.options.image_sigma_px;
+  if (given("--survey-sigma-m")) {
+    l.control_sigma_m = args.options.survey_sigma_m;
+    if (!given("--control-noise-m")) l.control_noise_m = args.options.survey_sigma_m;
+  }
+  if (given("--control")) l.control_points = args.options.control_points;
+  if (args.pushbroom_images && !given("--relief-m")) l.relief_m = 20.0;
+  auto& io = args.line_images;
+  if (args.pushbroom_images) {
+    io.seed = args.seed;
+    char x = 0;
+    std::istringstream in(args.reference_size);
+    std::string rest;
+    if (!(in >> io.reference_width_px >> x >> io.reference_height_px) || x != 'x' || (in >> rest))
+      throw ConfigError("--reference-size must be WIDTHxHEIGHT (got '" + args.reference_size +
+                        "')");
+    io.Validate();
+    // The line image is rendered through two double grids of lines x all detectors: the
+    // product is bounded before anything is allocated.
+    const double pixels = double(l.lines) * 3 * l.detectors_per_camera;
+    if (pixels > triangulation::kMaxLineImagePixels)
+      throw ConfigError("--lines x --detectors: a line image of " + std::to_string(l.lines) +
+                        " lines x 3 x " + std::to_string(l.detectors_per_camera) +
+                        " detectors is " + FormatNumber(pixels) +
+                        " px, more than the 5e7 px --render-images renders");
+  }
+  const auto sim = triangulation::SimulateLineFlight(l);
+  if (args.pushbroom_images) {
+    // Rendered before anything is written: a bad photograph leaves no partial output.
+    const auto rendered = triangulation::RenderLineImages(sim, l, io);
+    triangulation::WriteLineSimulation(sim, args.out);
+    triangulation::WriteLineImages(rendered, args.out);
+    std::printf(
+        "rendered a line image of %d x %zu px and %zu reference frames of %d x %d px "
+        "(texture %.3f m per texel, mean terrain height %.2f m)\n",
+        sim.truth.detectors,
+        sim.pos.size(),
+        rendered.reference_images.size(),
+        io.reference_width_px,
+        io.reference_height_px,
+        rendered.texture_gsd_m,
+        rendered.mean_height_m);
+  } else {
+    triangulation::WriteLineSimulation(sim, args.out);
+  }
+  std::printf(
+      "simulated a line camera of %d detectors (3 x %d), %d lines, %zu control points, "
+      "%zu observations -> %s\n",
+      sim.truth.detectors,
+      l.detectors_per_camera,
+      l.lines,
+      sim.points.size(),
+      sim.observations.size(),
+      args.out.c_str());
+  return kExitOk;
+}
+
+// `simulate` of a frame-camera flight (multi-CCD layout, platform, edge targets).
+int RunFrameFlightSimulation(SimulateArgs& args) {
+  auto& o = args.options;
+  o.seed = args.seed;
+  o.speed_mps = args.speed_mps;
+  if (!args.lever_arm_m.empty()) {
+    if (o.gnss_sigma_m <= 0) throw ConfigError("--lever-arm-m needs --gnss-sigma-m > 0");
+    for (double v : args.lever_arm_m)
+      if (!(std::abs(v) <= 1000.0)) throw ConfigError("--lever-arm-m must be within +-1000 m");
+    o.lever_arm_m = Eigen::Vector3d(args.lever_arm_m[0], args.lever_arm_m[1], args.lever_arm_m[2]);
+  }
+  if (!args.boresight_deg.empty()) {
+    if (o.imu_sigma_deg <= 0) throw ConfigError("--boresight-deg needs --imu-sigma-deg > 0");
+    for (double v : args.boresight_deg)
+      if (!(std::abs(v) <= 180.0)) throw ConfigError("--boresight-deg must be within +-180 deg");
+    o.boresight_rad =
+        Eigen::Vector3d(args.boresight_deg[0], args.boresight_deg[1], args.boresight_deg[2]) *
+        (M_PI / 180.0);
+  }
+  o.gnss_time_offset_s = args.gnss_time_offset_ms * 1e-3;
+  if (o.gnss_time_offset_s != 0.0 && (o.gnss_sigma_m <= 0 || o.speed_mps <= 0))
+    throw ConfigError("--gnss-time-offset-ms needs --gnss-sigma-m > 0 and --speed-mps > 0");
+  int rows = 0, cols = 0;
+  char x = 0;
+  std::istringstream in(args.layout);
+  std::string rest;
+  if (!(in >> rows >> x >> cols) || x != 'x' || (in >> rest) || rows < 1 || cols < 1 || rows > 10 ||
+      cols > 10 || rows * cols < 2)
+    throw ConfigError(
+        "--layout must be ROWSxCOLS, 1..10 each, with at least two sub-images (got '" +
+        args.layout + "')");
+  if (rows != o.layout.rows || cols != o.layout.cols) {
+    o.layout.rows = rows;
+    o.layout.cols = cols;
+    // Base CCDs: the one or two sub-images at the centre of the grid.
+    o.layout.base_ids.clear();
+    const int r = (rows - 1) / 2;
+    for (int c = (cols - 1) / 2; c <= cols / 2; ++c)
+      o.layout.base_ids.push_back(stitch::RomanNumeral(r * cols + c + 1));
+  }
+  const auto nominal_mapping = calib::ParseMappingModel(args.nominal_mapping);
+  if (!nominal_mapping)
+    throw ConfigError(
+        "--nominal-mapping must be translation, conformal, affine or projective (got '" +
+        args.nominal_mapping + "')");
+  o.layout.model = *nominal_mapping;
+  if (o.control_points > o.ground_points)
+    throw ConfigError("--control (" + std::to_string(o.control_points) +
+                      ") must not exceed --surveyed-points (" + std::to_string(o.ground_points) +
+                      "): control points are among the surveyed points");
+  const auto flight = triangulation::SimulateFlight(o);
+  triangulation::WriteSimulatedFlight(flight, args.out);
+  if (args.edge_targets) WriteEdgeTargets(flight, args.edge, args.seed, args.out);
+  // Points are placed only where enough images see them: say when fewer than asked fit.
+  int control = 0, check = 0, tie = 0;
+  for (const auto& p : flight.points_truth)
+    (p.role == triangulation::PointRole::kControl ? control
+     : p.role == triangulation::PointRole::kCheck ? check
+                                                  : tie)++;
+  const int asked_check = o.ground_points - o.control_points;
+  if (control < o.control_points || check < asked_check || tie < o.tie_points)
+    std::fprintf(stderr,
+                 "warning: placed %d of %d control, %d of %d check and %d of %d tie points (the "
+                 "others found no place seen by enough images)\n",
+                 control,
+                 o.control_points,
+                 check,
+                 asked_check,
+                 tie,
+                 o.tie_points);
+  std::printf(
+      "simulated %zu exposures, %zu ground points, %zu image observations, %zu stitching "
+      "measurements -> %s\n",
+      flight.exposures_truth.size(),
+      flight.points_truth.size(),
+      flight.observations.size(),
+      flight.stitching.size(),
+      args.out.c_str());
+  return kExitOk;
+}
+
+CommandRun SetupSimulate(CLI::App& app) {
+  auto args = std::make_shared<SimulateArgs>();
+  AddFlightOptions(app, args.get());
+  const RigOptions rig = AddRigOptions(app, args.get());
+  AddPlatformOptions(app, args.get());
+  AddEdgeTargetOptions(app, args.get());
+  AddTestFieldOptions(app, args.get());
+  AddLineOptions(app, args.get());
+  AddLineImageOptions(app, args.get());
+  CLI::Option *increment = rig.increment, *time_offset = rig.time_offset,
+              *format_scale = rig.format_scale;
   // Flight options a rig flight takes over when given (the rig's defaults otherwise).
   using Flight = triangulation::FlightSimulationOptions;
   const std::vector<std::pair<std::string, int Flight::*>> int_options = {
@@ -512,154 +702,12 @@ CommandRun SetupSimulate(CLI::App& app) {
         throw ConfigError(std::string(field_only) + " applies to --test-field only");
     if (args->pushbroom_images && !args->pushbroom && args->rig.empty())
       throw ConfigError("--render-images applies to --pushbroom or --rig only");
-    if (args->pushbroom) {
-      if (!args->rig.empty()) throw ConfigError("--pushbroom and --rig: choose one");
-      if (format_scale->count() > 0) throw ConfigError("--format-scale applies to --rig only");
-      auto& l = args->line;
-      l.seed = args->seed;
-      auto given = [&](const char* name) { return app.count(name) > 0; };
-      if (given("--height-m")) l.height_m = args->options.flying_height_m;
-      if (given("--relief-m")) l.relief_m = args->options.terrain_relief_m;
-      if (given("--image-noise-px")) l.image_noise_px = args->options.image_noise_px;
-      if (given("--image-sigma-px")) l.image_sigma_px = args->options.image_sigma_px;
-      if (given("--survey-sigma-m")) {
-        l.control_sigma_m = args->options.survey_sigma_m;
-        if (!given("--control-noise-m")) l.control_noise_m = args->options.survey_sigma_m;
-      }
-      if (given("--control")) l.control_points = args->options.control_points;
-      if (args->pushbroom_images && !given("--relief-m")) l.relief_m = 20.0;
-      auto& io = args->line_images;
-      if (args->pushbroom_images) {
-        io.seed = args->seed;
-        char x = 0;
-        std::istringstream in(args->reference_size);
-        std::string rest;
-        if (!(in >> io.reference_width_px >> x >> io.reference_height_px) || x != 'x' ||
-            (in >> rest))
-          throw ConfigError("--reference-size must be WIDTHxHEIGHT (got '" + args->reference_size +
-                            "')");
-        io.Validate();
-        // The line image is rendered through two double grids of lines x all detectors: the
-        // product is bounded before anything is allocated.
-        const double pixels = double(l.lines) * 3 * l.detectors_per_camera;
-        if (pixels > triangulation::kMaxLineImagePixels)
-          throw ConfigError("--lines x --detectors: a line image of " + std::to_string(l.lines) +
-                            " lines x 3 x " + std::to_string(l.detectors_per_camera) +
-                            " detectors is " + FormatNumber(pixels) +
-                            " px, more than the 5e7 px --render-images renders");
-      }
-      const auto sim = triangulation::SimulateLineFlight(l);
-      if (args->pushbroom_images) {
-        // Rendered before anything is written: a bad photograph leaves no partial output.
-        const auto rendered = triangulation::RenderLineImages(sim, l, io);
-        triangulation::WriteLineSimulation(sim, args->out);
-        triangulation::WriteLineImages(rendered, args->out);
-        std::printf(
-            "rendered a line image of %d x %zu px and %zu reference frames of %d x %d px "
-            "(texture %.3f m per texel, mean terrain height %.2f m)\n",
-            sim.truth.detectors,
-            sim.pos.size(),
-            rendered.reference_images.size(),
-            io.reference_width_px,
-            io.reference_height_px,
-            rendered.texture_gsd_m,
-            rendered.mean_height_m);
-      } else {
-        triangulation::WriteLineSimulation(sim, args->out);
-      }
-      std::printf(
-          "simulated a line camera of %d detectors (3 x %d), %d lines, %zu control points, "
-          "%zu observations -> %s\n",
-          sim.truth.detectors,
-          l.detectors_per_camera,
-          l.lines,
-          sim.points.size(),
-          sim.observations.size(),
-          args->out.c_str());
-      return kExitOk;
-    }
+    if (args->pushbroom) return RunLineSimulation(app, *args, format_scale);
     if (!args->rig.empty()) return RunRigSimulation(app, *args, int_options, double_options);
     for (const CLI::Option* rig_only : {increment, time_offset, format_scale})
       if (rig_only->count() > 0)
         throw ConfigError(rig_only->get_name() + " applies to a rig flight (--rig) only");
-    auto& o = args->options;
-    o.seed = args->seed;
-    o.speed_mps = args->speed_mps;
-    if (!args->lever_arm_m.empty()) {
-      if (o.gnss_sigma_m <= 0) throw ConfigError("--lever-arm-m needs --gnss-sigma-m > 0");
-      for (double v : args->lever_arm_m)
-        if (!(std::abs(v) <= 1000.0)) throw ConfigError("--lever-arm-m must be within +-1000 m");
-      o.lever_arm_m =
-          Eigen::Vector3d(args->lever_arm_m[0], args->lever_arm_m[1], args->lever_arm_m[2]);
-    }
-    if (!args->boresight_deg.empty()) {
-      if (o.imu_sigma_deg <= 0) throw ConfigError("--boresight-deg needs --imu-sigma-deg > 0");
-      for (double v : args->boresight_deg)
-        if (!(std::abs(v) <= 180.0)) throw ConfigError("--boresight-deg must be within +-180 deg");
-      o.boresight_rad =
-          Eigen::Vector3d(args->boresight_deg[0], args->boresight_deg[1], args->boresight_deg[2]) *
-          (M_PI / 180.0);
-    }
-    o.gnss_time_offset_s = args->gnss_time_offset_ms * 1e-3;
-    if (o.gnss_time_offset_s != 0.0 && (o.gnss_sigma_m <= 0 || o.speed_mps <= 0))
-      throw ConfigError("--gnss-time-offset-ms needs --gnss-sigma-m > 0 and --speed-mps > 0");
-    int rows = 0, cols = 0;
-    char x = 0;
-    std::istringstream in(args->layout);
-    std::string rest;
-    if (!(in >> rows >> x >> cols) || x != 'x' || (in >> rest) || rows < 1 || cols < 1 ||
-        rows > 10 || cols > 10 || rows * cols < 2)
-      throw ConfigError(
-          "--layout must be ROWSxCOLS, 1..10 each, with at least two sub-images (got '" +
-          args->layout + "')");
-    if (rows != o.layout.rows || cols != o.layout.cols) {
-      o.layout.rows = rows;
-      o.layout.cols = cols;
-      // Base CCDs: the one or two sub-images at the centre of the grid.
-      o.layout.base_ids.clear();
-      const int r = (rows - 1) / 2;
-      for (int c = (cols - 1) / 2; c <= cols / 2; ++c)
-        o.layout.base_ids.push_back(stitch::RomanNumeral(r * cols + c + 1));
-    }
-    const auto nominal_mapping = calib::ParseMappingModel(args->nominal_mapping);
-    if (!nominal_mapping)
-      throw ConfigError(
-          "--nominal-mapping must be translation, conformal, affine or projective (got '" +
-          args->nominal_mapping + "')");
-    o.layout.model = *nominal_mapping;
-    if (o.control_points > o.ground_points)
-      throw ConfigError("--control (" + std::to_string(o.control_points) +
-                        ") must not exceed --surveyed-points (" + std::to_string(o.ground_points) +
-                        "): control points are among the surveyed points");
-    const auto flight = triangulation::SimulateFlight(o);
-    triangulation::WriteSimulatedFlight(flight, args->out);
-    if (args->edge_targets) WriteEdgeTargets(flight, args->edge, args->seed, args->out);
-    // Points are placed only where enough images see them: say when fewer than asked fit.
-    int control = 0, check = 0, tie = 0;
-    for (const auto& p : flight.points_truth)
-      (p.role == triangulation::PointRole::kControl ? control
-       : p.role == triangulation::PointRole::kCheck ? check
-                                                    : tie)++;
-    const int asked_check = o.ground_points - o.control_points;
-    if (control < o.control_points || check < asked_check || tie < o.tie_points)
-      std::fprintf(stderr,
-                   "warning: placed %d of %d control, %d of %d check and %d of %d tie points (the "
-                   "others found no place seen by enough images)\n",
-                   control,
-                   o.control_points,
-                   check,
-                   asked_check,
-                   tie,
-                   o.tie_points);
-    std::printf(
-        "simulated %zu exposures, %zu ground points, %zu image observations, %zu stitching "
-        "measurements -> %s\n",
-        flight.exposures_truth.size(),
-        flight.points_truth.size(),
-        flight.observations.size(),
-        flight.stitching.size(),
-        args->out.c_str());
-    return kExitOk;
+    return RunFrameFlightSimulation(*args);
   };
 }
 
