@@ -34,7 +34,8 @@ const bool kOpenCvRegistered = [] {
        "OpenCV FileStorage YAML/XML/JSON (camera_matrix, distortion_coefficients)",
        ReadOpenCvCamera,
        WriteOpenCvCamera,
-       calib::OpenCvTarget,
+       // k1 k2 p1 p2 [k3 [k4 k5 k6]]: a camera of another model is fitted choosing 4, 5 or 8.
+       {{calib::CameraModelId::kOpenCv, {}, calib::CovarianceForm::kNone, true}},
        LooksLikeOpenCv,
        ".yml"});
   return true;
@@ -72,13 +73,15 @@ calib::ConversionResult WriteCameraInFormat(const std::string& path,
     const Eigen::Map<const Eigen::VectorXd> sigma(posterior_sigma->data(), posterior_sigma->size());
     source.covariance = Eigen::MatrixXd(sigma.cwiseAbs2().asDiagonal());
   }
-  if (source.covariance && !format.holds_covariance) {
+  const calib::FormatTarget target = format.target(source.camera);
+  if (source.covariance &&
+      calib::CovarianceHeld(format, target.model) == calib::CovarianceForm::kNone) {
     source.covariance.reset();
     std::printf("note: interior sigmas not written: %s holds no covariance\n", format.name.c_str());
   }
   std::vector<std::string> tried;
-  const calib::FileConversion conversion = calib::ConvertCameraFileSimplest(
-      source, format.target(source.camera), {}, kDefaultMaxCoefficients, &tried);
+  const calib::FileConversion conversion =
+      calib::ConvertCameraFileSimplest(source, target, {}, kDefaultMaxCoefficients, &tried);
   for (const std::string& line : tried) std::printf("  %s\n", line.c_str());
   calib::WriteCameraFileVerified(format, path, conversion.file);
   const calib::ConversionResult& r = conversion.result;

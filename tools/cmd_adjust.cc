@@ -83,22 +83,26 @@ calib::CameraModelId CamerasModel(const triangulation::Project& project) {
   return model;
 }
 
-CommandRun SetupAdjust(CLI::App& app) {
-  struct Args {
-    std::string project, out, write_camera, self_calibration = "none", camera_format = "aerocal";
-    bool compare = false, no_snooping = false, no_eo_priors = false, no_interior_sigma = false;
-    bool no_robust_start = false;
-    double default_sigma_px = 0.5;
-    triangulation::AdjustOptions options;
-    JointAdjustArgs joint;
-    RigArgs rig;
-    // The GNSS/IMU platform over the project YAML's `platform:` (each given option replaces).
-    std::vector<double> lever_arm_m, boresight_deg;
-    double time_offset_ms = 0.0, lever_arm_sigma_m = 0.0, boresight_sigma_deg = 0.0,
-           time_offset_sigma_ms = 0.0;
-    std::string lever_arm, boresight, time_offset;  // fixed | free | weighted
-  };
-  auto args = std::make_shared<Args>();
+// Everything `adjust` reads from its command line.
+struct AdjustArgs {
+  std::string project, out, write_camera, self_calibration = "none", camera_format = "aerocal";
+  bool compare = false, no_snooping = false, no_eo_priors = false, no_interior_sigma = false;
+  bool no_robust_start = false;
+  double default_sigma_px = 0.5;
+  triangulation::AdjustOptions options;
+  JointAdjustArgs joint;
+  RigArgs rig;
+  // The GNSS/IMU platform over the project YAML's `platform:` (each given option replaces).
+  std::vector<double> lever_arm_m, boresight_deg;
+  double time_offset_ms = 0.0, lever_arm_sigma_m = 0.0, boresight_sigma_deg = 0.0,
+         time_offset_sigma_ms = 0.0;
+  std::string lever_arm, boresight, time_offset;  // fixed | free | weighted
+};
+
+// The options by topic, in the order --help lists them.
+
+// The project, the outputs and what to estimate.
+void AddInputOptions(CLI::App& app, AdjustArgs* args) {
   app.add_option(
          "--project", args->project, "Project YAML (or folder with project.yaml), FORMATS.md")
       ->required();
@@ -125,6 +129,10 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->default_sigma_px,
                  "Image sigma where observations.csv has no sigma_px, px")
       ->check(PositiveUpTo(100));
+}
+
+// Gross errors: data snooping, the robust start and when a result is not valid.
+void AddRobustnessOptions(CLI::App& app, AdjustArgs* args) {
   app.add_flag("--no-snooping", args->no_snooping, "Do not test for gross errors");
   app.add_flag("--robust-start",
                args->options.robust_start,
@@ -154,6 +162,10 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->options.snooping_critical_value,
                  "Critical |w| of data snooping (0: from alpha = 5 % / n; 1e6: never reject)")
       ->check(FiniteRange(0, 1e9));
+}
+
+// The a-priori weights used and the solver.
+void AddSolverOptions(CLI::App& app, AdjustArgs* args) {
   app.add_flag("--no-eo-priors",
                args->no_eo_priors,
                "Ignore the GNSS/IMU sigma columns of exposures.csv (starting values only)");
@@ -170,6 +182,10 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->options.correlation_threshold,
                  "Report parameter pairs correlated above this")
       ->check(FiniteRange(0.0, 1.0));
+}
+
+// The GNSS/IMU platform: lever arm, boresight, GNSS time offset.
+void AddPlatformOptions(CLI::App& app, AdjustArgs* args) {
   app.add_option("--lever-arm-m",
                  args->lever_arm_m,
                  "GNSS lever arm a (projection centre -> antenna, camera frame), m, \"X,Y,Z\": its "
@@ -206,10 +222,12 @@ CommandRun SetupAdjust(CLI::App& app) {
                  args->time_offset_sigma_ms,
                  "GNSS time offset sigma when weighted, ms")
       ->check(PositiveUpTo(1e4));
-  AddJointAdjustOptions(app, &args->joint);
-  // The rig bundle (a project whose camera file has a `rig` section): which rig parameters of the
-  // non-reference heads are estimated.
-  std::vector<CLI::Option*> rig_options = {
+}
+
+// The rig bundle (a project whose camera file has a `rig` section): which rig parameters of the
+// non-reference heads are estimated. Returns the options (a project without a rig refuses them).
+std::vector<CLI::Option*> AddRigOptions(CLI::App& app, AdjustArgs* args) {
+  return {
       app.add_option("--rig-mounts",
                      args->rig.mounts,
                      "Rig: mount angles of the non-reference heads: fixed | free (default) | "
@@ -235,190 +253,224 @@ CommandRun SetupAdjust(CLI::App& app) {
                      args->rig.time_offset_sigma_ms,
                      "Rig: sigma of weighted time offsets around zero, ms")
           ->check(PositiveUpTo(1e4))};
-  // The command line's platform options over the project's `platform:`.
-  auto apply_platform = [args, &app](triangulation::PlatformSpec* p) -> bool {
-    auto given = [&](const char* name) { return app.count(name) > 0; };
-    if (given("--lever-arm-m"))
-      p->lever_arm_m =
-          Eigen::Vector3d(args->lever_arm_m[0], args->lever_arm_m[1], args->lever_arm_m[2]);
-    if (given("--boresight-deg"))
-      p->boresight_rad =
-          Eigen::Vector3d(args->boresight_deg[0], args->boresight_deg[1], args->boresight_deg[2]) *
-          (M_PI / 180.0);
-    if (given("--gnss-time-offset-ms")) p->time_offset_s = args->time_offset_ms * 1e-3;
-    if (given("--lever-arm")) p->lever_arm = calib::BlockModeOption(args->lever_arm, "--lever-arm");
-    if (given("--boresight")) p->boresight = calib::BlockModeOption(args->boresight, "--boresight");
-    if (given("--gnss-time-offset"))
-      p->time_offset = calib::BlockModeOption(args->time_offset, "--gnss-time-offset");
-    if (given("--lever-arm-sigma-m")) p->lever_arm_sigma_m = args->lever_arm_sigma_m;
-    if (given("--boresight-sigma-deg"))
-      p->boresight_sigma_rad = args->boresight_sigma_deg * M_PI / 180.0;
-    if (given("--gnss-time-offset-sigma-ms"))
-      p->time_offset_sigma_s = args->time_offset_sigma_ms * 1e-3;
-    for (const char* name : {"--lever-arm-m",
-                             "--lever-arm",
-                             "--lever-arm-sigma-m",
-                             "--boresight-deg",
-                             "--boresight",
-                             "--boresight-sigma-deg",
-                             "--gnss-time-offset-ms",
-                             "--gnss-time-offset",
-                             "--gnss-time-offset-sigma-ms"})
-      if (given(name)) {
-        p->source = p->source.empty() ? "options" : p->source + " and options";
-        triangulation::ValidatePlatform(*p);
-        return true;
-      }
-    return false;
-  };
-  return [args, rig_options, apply_platform]() {
-    auto options = args->options;
-    options.data_snooping = !args->no_snooping;
-    options.use_eo_priors = !args->no_eo_priors;
-    options.auto_robust_start = !args->no_robust_start;
-    if (options.robust_start && args->no_robust_start)
-      throw ConfigError("--robust-start and --no-robust-start exclude each other");
-    options.use_interior_sigma = !args->no_interior_sigma;
-    // The names of the 10-parameter model here (the joint adjustment needs it); the plain
-    // adjustment reads them again in the model of the project's cameras below.
-    const bool other_model_names = !args->joint.Requested();
-    const bool auto_free = args->self_calibration == "auto";
-    if (auto_free && args->joint.Requested())
-      throw ConfigError(
-          "--self-calibration auto: not with --joint-stitching (give the list, e.g. "
-          "the `self_calibration_choice.chosen` of an auto run)");
-    const std::string free_text = auto_free ? "all" : args->self_calibration;
-    if (!other_model_names) options.free_interior = triangulation::ParseSelfCalibration(free_text);
-    options.Validate();
-    CheckOutputFile(args->out, "--out");
-    if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
-    FindCameraFormat(args->camera_format, "--camera-format");
-    if (args->joint.Requested() && args->camera_format != "aerocal")
-      throw ConfigError(
-          "--camera-format: the joint adjustment writes our camera file only (aerocal)");
-    if (args->joint.Requested() && args->compare)
-      throw ConfigError(
-          "--compare and --joint-stitching do not combine (`aerocal flight` runs and compares "
-          "both)");
-    triangulation::Project input =
-        triangulation::ReadProject(args->project, args->default_sigma_px);
-    const bool self_calibrating =
-        args->compare || (args->self_calibration != "none" && !args->self_calibration.empty());
-    const calib::CameraModelId model =
-        self_calibrating ? CamerasModel(input) : calib::Camera::Model::kId;
-    if (other_model_names) {
-      options.free_interior = triangulation::ParseSelfCalibration(free_text, model);
-      options.Validate();
-    }
-    apply_platform(&input.platform);
-    if (args->joint.Requested())
-      return RunJointAdjust(
-          args->joint, options, input, args->project, args->out, args->write_camera);
-    const triangulation::ObjectFrame frame(input.frame);
-    const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
-    const bool rig_option_given = std::any_of(rig_options.begin(),
-                                              rig_options.end(),
-                                              [](const CLI::Option* o) { return o->count() > 0; });
-    if (!input.rigs.empty()) {
-      const std::string rig = "rig project (camera '" + input.rigs.begin()->first + "')";
-      if (args->compare)
-        throw ConfigError("--compare: not available for a " + rig +
-                          ": its conventional reference "
-                          "run is a frame-camera adjustment (run adjust with and without "
-                          "--self-calibration instead)");
-      if (auto_free)
-        throw ConfigError("--self-calibration auto: not available for a " + rig +
-                          " (give the "
-                          "parameters to calibrate)");
-      if (options.robust_start)
-        throw ConfigError("--robust-start: not available for a " + rig +
-                          ": the robust start "
-                          "re-adjusts frame cameras only (reject blunders with data snooping, the "
-                          "default)");
-      if (input.rigs.size() > 1) {
-        std::string names;
-        for (const auto& [id, unused] : input.rigs) names += (names.empty() ? "" : ", ") + id;
-        throw ConfigError(args->project + ": rig cameras " + names +
-                          ": the rig bundle takes one "
-                          "rig per project (adjust each rig's exposures in a project of its own)");
-      }
-      return RunRigAdjust(
-          args->rig, options, input, project, frame, args->project, args->out, args->write_camera);
-    }
-    if (rig_option_given)
-      throw ConfigError(args->project +
-                        ": the --rig-* options need a rig camera file (a camera "
-                        "file with a rig section)");
-    if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
-      throw ConfigError(
-          "--write-camera needs a self-calibrating run (--self-calibration or --compare)");
+}
 
-    // Big blocks take minutes: a progress bar of the adjustment stages (terminal only).
-    const int stages =
-        (auto_free && !options.free_interior.empty() ? triangulation::AutoFreeSetRounds(options)
-                                                     : triangulation::AdjustStages(options)) +
-        (args->compare ? triangulation::BlockAdjustment::kRunStages : 0);
-    Progress progress("adjust", stages);
-    auto run = [&](const std::vector<std::string>& free) {
-      auto o = options;
-      o.free_interior = free;
-      AdjustmentResult r = auto_free && !free.empty()
-                               ? triangulation::AdjustWithChosenFreeSet(project, o, {}, &progress)
-                               : triangulation::Adjust(project, o, &progress);
-      triangulation::ToInputFrame(frame, &r);
-      return r;
-    };
-    nlohmann::json json;
-    AdjustmentResult main;
-    if (args->compare) {
-      const auto self_list = options.free_interior.empty()
-                                 ? triangulation::ParseSelfCalibration("all", model)
-                                 : options.free_interior;
-      main = run(self_list);
-      AdjustmentResult conventional =
-          triangulation::AdjustConventionalReference(project, options, main, &progress);
-      triangulation::ToInputFrame(frame, &conventional);
-      progress.Finish();  // before the tables, so the bar never interleaves with them
-      std::printf("%s", triangulation::FormatComparison(conventional, main).c_str());
-      json = triangulation::AdjustmentToJson(main);
-      json["comparison"] = triangulation::ComparisonToJson(conventional, main);
-      json["conventional"] = triangulation::AdjustmentToJson(conventional);
-      main.solve.converged = main.solve.converged && conventional.solve.converged;
-      for (const auto& reason : conventional.invalid_reasons)
-        main.Invalidate("conventional run: " + reason);
-    } else {
-      main = run(options.free_interior);
-      progress.Finish();
-      std::printf("%s", triangulation::FormatSummary(main).c_str());
-      json = triangulation::AdjustmentToJson(main);
+// The command line's platform options over the project's `platform:`; true when any was given.
+bool ApplyPlatformOptions(const CLI::App& app,
+                          const AdjustArgs* args,
+                          triangulation::PlatformSpec* p) {
+  auto given = [&](const char* name) { return app.count(name) > 0; };
+  if (given("--lever-arm-m"))
+    p->lever_arm_m =
+        Eigen::Vector3d(args->lever_arm_m[0], args->lever_arm_m[1], args->lever_arm_m[2]);
+  if (given("--boresight-deg"))
+    p->boresight_rad =
+        Eigen::Vector3d(args->boresight_deg[0], args->boresight_deg[1], args->boresight_deg[2]) *
+        (M_PI / 180.0);
+  if (given("--gnss-time-offset-ms")) p->time_offset_s = args->time_offset_ms * 1e-3;
+  if (given("--lever-arm")) p->lever_arm = calib::BlockModeOption(args->lever_arm, "--lever-arm");
+  if (given("--boresight")) p->boresight = calib::BlockModeOption(args->boresight, "--boresight");
+  if (given("--gnss-time-offset"))
+    p->time_offset = calib::BlockModeOption(args->time_offset, "--gnss-time-offset");
+  if (given("--lever-arm-sigma-m")) p->lever_arm_sigma_m = args->lever_arm_sigma_m;
+  if (given("--boresight-sigma-deg"))
+    p->boresight_sigma_rad = args->boresight_sigma_deg * M_PI / 180.0;
+  if (given("--gnss-time-offset-sigma-ms"))
+    p->time_offset_sigma_s = args->time_offset_sigma_ms * 1e-3;
+  for (const char* name : {"--lever-arm-m",
+                           "--lever-arm",
+                           "--lever-arm-sigma-m",
+                           "--boresight-deg",
+                           "--boresight",
+                           "--boresight-sigma-deg",
+                           "--gnss-time-offset-ms",
+                           "--gnss-time-offset",
+                           "--gnss-time-offset-sigma-ms"})
+    if (given(name)) {
+      p->source = p->source.empty() ? "options" : p->source + " and options";
+      triangulation::ValidatePlatform(*p);
+      return true;
     }
-    json["project"] = args->project;
-    AddProjectFacts(input, &json);
-    // Which adjustment a written camera comes from (as flight's camera_written_from).
-    if (!args->write_camera.empty() && main.valid)
-      json["camera_written_from"] = {
-          {"adjustment", main.free_interior.empty() ? "conventional" : "self_calibration"},
-          {"reason",
-           main.free_interior.empty()
-               ? "the adjustment run (no interior parameter estimated: the camera file's "
-                 "interior with the adjustment's frame)"
-               : "the self-calibrating adjustment (--self-calibration)"}};
-    json["valid"] = main.valid;
-    json["invalid_reasons"] = main.invalid_reasons;
-    // Exit 3 (results written, valid: false) when the run must not be trusted; the camera file
-    // is then not written at all.
-    return FinishAdjust(main, json, args->out, args->write_camera, "camera", [&] {
-      for (const auto& estimate : main.cameras) {
-        const std::string path =
-            CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);
-        WriteCameraInFormat(path,
-                            triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate),
-                            args->camera_format,
-                            &estimate.sigma);
-        std::printf("camera %s -> %s\n", estimate.id.c_str(), path.c_str());
-      }
-    });
+  return false;
+}
+
+// The refusals of a rig project (the rig bundle takes one rig and no frame-camera-only option).
+void CheckRigProject(const AdjustArgs* args,
+                     const triangulation::AdjustOptions& options,
+                     const triangulation::Project& input,
+                     bool auto_free) {
+  const std::string rig = "rig project (camera '" + input.rigs.begin()->first + "')";
+  if (args->compare)
+    throw ConfigError("--compare: not available for a " + rig +
+                      ": its conventional reference "
+                      "run is a frame-camera adjustment (run adjust with and without "
+                      "--self-calibration instead)");
+  if (auto_free)
+    throw ConfigError("--self-calibration auto: not available for a " + rig +
+                      " (give the "
+                      "parameters to calibrate)");
+  if (options.robust_start)
+    throw ConfigError("--robust-start: not available for a " + rig +
+                      ": the robust start "
+                      "re-adjusts frame cameras only (reject blunders with data snooping, the "
+                      "default)");
+  if (input.rigs.size() > 1) {
+    std::string names;
+    for (const auto& [id, unused] : input.rigs) names += (names.empty() ? "" : ", ") + id;
+    throw ConfigError(args->project + ": rig cameras " + names +
+                      ": the rig bundle takes one "
+                      "rig per project (adjust each rig's exposures in a project of its own)");
+  }
+}
+
+// The adjustment of a frame-camera project: one run, or --compare's two, then the result and the
+// camera written.
+int RunFrameAdjust(const AdjustArgs* args,
+                   const triangulation::AdjustOptions& options,
+                   const triangulation::Project& input,
+                   const triangulation::Project& project,
+                   const triangulation::ObjectFrame& frame,
+                   bool auto_free,
+                   calib::CameraModelId model) {
+  // Big blocks take minutes: a progress bar of the adjustment stages (terminal only).
+  const int stages =
+      (auto_free && !options.free_interior.empty() ? triangulation::AutoFreeSetRounds(options)
+                                                   : triangulation::AdjustStages(options)) +
+      (args->compare ? triangulation::BlockAdjustment::kRunStages : 0);
+  Progress progress("adjust", stages);
+  auto run = [&](const std::vector<std::string>& free) {
+    auto o = options;
+    o.free_interior = free;
+    AdjustmentResult r = auto_free && !free.empty()
+                             ? triangulation::AdjustWithChosenFreeSet(project, o, {}, &progress)
+                             : triangulation::Adjust(project, o, &progress);
+    triangulation::ToInputFrame(frame, &r);
+    return r;
   };
+  nlohmann::json json;
+  AdjustmentResult main;
+  if (args->compare) {
+    const auto self_list = options.free_interior.empty()
+                               ? triangulation::ParseSelfCalibration("all", model)
+                               : options.free_interior;
+    main = run(self_list);
+    AdjustmentResult conventional =
+        triangulation::AdjustConventionalReference(project, options, main, &progress);
+    triangulation::ToInputFrame(frame, &conventional);
+    progress.Finish();  // before the tables, so the bar never interleaves with them
+    std::printf("%s", triangulation::FormatComparison(conventional, main).c_str());
+    json = triangulation::AdjustmentToJson(main);
+    json["comparison"] = triangulation::ComparisonToJson(conventional, main);
+    json["conventional"] = triangulation::AdjustmentToJson(conventional);
+    main.solve.converged = main.solve.converged && conventional.solve.converged;
+    for (const auto& reason : conventional.invalid_reasons)
+      main.Invalidate("conventional run: " + reason);
+  } else {
+    main = run(options.free_interior);
+    progress.Finish();
+    std::printf("%s", triangulation::FormatSummary(main).c_str());
+    json = triangulation::AdjustmentToJson(main);
+  }
+  json["project"] = args->project;
+  AddProjectFacts(input, &json);
+  // Which adjustment a written camera comes from (as flight's camera_written_from).
+  if (!args->write_camera.empty() && main.valid)
+    json["camera_written_from"] = {
+        {"adjustment", main.free_interior.empty() ? "conventional" : "self_calibration"},
+        {"reason",
+         main.free_interior.empty()
+             ? "the adjustment run (no interior parameter estimated: the camera file's "
+               "interior with the adjustment's frame)"
+             : "the self-calibrating adjustment (--self-calibration)"}};
+  json["valid"] = main.valid;
+  json["invalid_reasons"] = main.invalid_reasons;
+  // Exit 3 (results written, valid: false) when the run must not be trusted; the camera file
+  // is then not written at all.
+  return FinishAdjust(main, json, args->out, args->write_camera, "camera", [&] {
+    for (const auto& estimate : main.cameras) {
+      const std::string path =
+          CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);
+      WriteCameraInFormat(path,
+                          triangulation::UpdatedCamera(input.cameras.at(estimate.id), estimate),
+                          args->camera_format,
+                          &estimate.sigma);
+      std::printf("camera %s -> %s\n", estimate.id.c_str(), path.c_str());
+    }
+  });
+}
+
+int RunAdjust(const CLI::App& app,
+              const AdjustArgs* args,
+              const std::vector<CLI::Option*>& rig_options) {
+  auto options = args->options;
+  options.data_snooping = !args->no_snooping;
+  options.use_eo_priors = !args->no_eo_priors;
+  options.auto_robust_start = !args->no_robust_start;
+  if (options.robust_start && args->no_robust_start)
+    throw ConfigError("--robust-start and --no-robust-start exclude each other");
+  options.use_interior_sigma = !args->no_interior_sigma;
+  // The names of the 10-parameter model here (the joint adjustment needs it); the plain
+  // adjustment reads them again in the model of the project's cameras below.
+  const bool other_model_names = !args->joint.Requested();
+  const bool auto_free = args->self_calibration == "auto";
+  if (auto_free && args->joint.Requested())
+    throw ConfigError(
+        "--self-calibration auto: not with --joint-stitching (give the list, e.g. "
+        "the `self_calibration_choice.chosen` of an auto run)");
+  const std::string free_text = auto_free ? "all" : args->self_calibration;
+  if (!other_model_names) options.free_interior = triangulation::ParseSelfCalibration(free_text);
+  options.Validate();
+  CheckOutputFile(args->out, "--out");
+  if (!args->write_camera.empty()) CheckOutputFile(args->write_camera, "--write-camera");
+  FindCameraFormat(args->camera_format, "--camera-format");
+  if (args->joint.Requested() && args->camera_format != "aerocal")
+    throw ConfigError(
+        "--camera-format: the joint adjustment writes our camera file only (aerocal)");
+  if (args->joint.Requested() && args->compare)
+    throw ConfigError(
+        "--compare and --joint-stitching do not combine (`aerocal flight` runs and compares "
+        "both)");
+  triangulation::Project input = triangulation::ReadProject(args->project, args->default_sigma_px);
+  const bool self_calibrating =
+      args->compare || (args->self_calibration != "none" && !args->self_calibration.empty());
+  const calib::CameraModelId model =
+      self_calibrating ? CamerasModel(input) : calib::Camera::Model::kId;
+  if (other_model_names) {
+    options.free_interior = triangulation::ParseSelfCalibration(free_text, model);
+    options.Validate();
+  }
+  ApplyPlatformOptions(app, args, &input.platform);
+  if (args->joint.Requested())
+    return RunJointAdjust(
+        args->joint, options, input, args->project, args->out, args->write_camera);
+  const triangulation::ObjectFrame frame(input.frame);
+  const triangulation::Project project = triangulation::ToAdjustmentFrame(input, frame);
+  const bool rig_option_given = std::any_of(
+      rig_options.begin(), rig_options.end(), [](const CLI::Option* o) { return o->count() > 0; });
+  if (!input.rigs.empty()) {
+    CheckRigProject(args, options, input, auto_free);
+    return RunRigAdjust(
+        args->rig, options, input, project, frame, args->project, args->out, args->write_camera);
+  }
+  if (rig_option_given)
+    throw ConfigError(args->project +
+                      ": the --rig-* options need a rig camera file (a camera "
+                      "file with a rig section)");
+  if (!args->write_camera.empty() && options.free_interior.empty() && !args->compare)
+    throw ConfigError(
+        "--write-camera needs a self-calibrating run (--self-calibration or --compare)");
+  return RunFrameAdjust(args, options, input, project, frame, auto_free, model);
+}
+
+CommandRun SetupAdjust(CLI::App& app) {
+  auto args = std::make_shared<AdjustArgs>();
+  AddInputOptions(app, args.get());
+  AddRobustnessOptions(app, args.get());
+  AddSolverOptions(app, args.get());
+  AddPlatformOptions(app, args.get());
+  AddJointAdjustOptions(app, &args->joint);
+  const std::vector<CLI::Option*> rig_options = AddRigOptions(app, args.get());
+  return [&app, args, rig_options]() { return RunAdjust(app, args.get(), rig_options); };
 }
 
 }  // namespace

@@ -83,6 +83,21 @@ struct ConvertArgs {
   int max_coefficients = kDefaultMaxCoefficients;
 };
 
+// --model: one of the models the format writes (its registry row), by name (brown10 =
+// brown_fraser_10); ConfigError naming the option, the format and the model otherwise.
+calib::FormatTarget ModelTarget(const CameraFormat& to, const std::string& model) {
+  const std::string name = model == "brown10" ? "brown_fraser_10" : model;
+  const auto id = calib::CameraModelFromName(name);
+  if (!id)
+    throw ConfigError("--model: unknown camera model '" + model + "' (expected " +
+                      calib::CameraModelNames() + ")");
+  try {
+    return calib::TargetInModel(to, *id);
+  } catch (const InputError& e) {
+    throw ConfigError("--model " + model + ": " + e.what());
+  }
+}
+
 int RunConvert(const ConvertArgs& a) {
   CheckOutputFile(a.out, "OUT");
   CheckDistinctPath(a.out, "OUT", a.read.in, "IN");
@@ -93,17 +108,8 @@ int RunConvert(const ConvertArgs& a) {
   }
   const CameraFormat& to = FindCameraFormat(a.to, "--to");
   const CameraFile source = a.read.Read();
-  calib::FormatTarget target = to.target(source.camera);
-  if (!a.model.empty()) {
-    if (a.to != "aerocal")
-      throw ConfigError("--model: only with --to aerocal (other formats have their model)");
-    const std::string name = a.model == "brown10" ? "brown_fraser_10" : a.model;
-    const auto id = calib::CameraModelFromName(name);
-    if (!id)
-      throw ConfigError("--model: unknown camera model '" + a.model + "' (expected " +
-                        calib::CameraModelNames() + ")");
-    target.model = *id;
-  }
+  const calib::FormatTarget target =
+      a.model.empty() ? to.target(source.camera) : ModelTarget(to, a.model);
   calib::ConvertOptions options;
   options.max_residual_px =
       a.max_residual_given ? a.max_residual_px : std::numeric_limits<double>::infinity();
@@ -117,14 +123,17 @@ int RunConvert(const ConvertArgs& a) {
   notes.insert(notes.end(), conversion.notes.begin(), conversion.notes.end());
   CameraFile written = conversion.file;
   if (written.covariance) {
-    if ((a.to == "aerocal" || a.to == "australis") &&
-        written.camera.model == calib::CameraModelId::kBrownFraser10)
-      notes.push_back("covariance written as standard deviations (" + a.to +
-                      " holds no correlations: dropped)");
-    else if (a.to != "metashape") {
-      notes.push_back("covariance dropped: " + a.to + " (" +
-                      std::string(calib::CameraModelName(written.camera.model)) + ") holds none");
-      written.covariance.reset();
+    switch (calib::CovarianceHeld(to, written.camera.model)) {
+      case calib::CovarianceForm::kFull:
+        break;
+      case calib::CovarianceForm::kSigmas:
+        notes.push_back("covariance written as standard deviations (" + a.to +
+                        " holds no correlations: dropped)");
+        break;
+      case calib::CovarianceForm::kNone:
+        notes.push_back("covariance dropped: " + a.to + " (" +
+                        std::string(calib::CameraModelName(written.camera.model)) + ") holds none");
+        written.covariance.reset();
     }
   }
   const std::string model(calib::CameraModelName(r.camera.model));
@@ -345,8 +354,10 @@ CommandRun Setup(CLI::App& app) {
   cv->add_option("OUT", convert->out, "Output camera file (written atomically)")->required();
   cv->add_option("--model",
                  convert->model,
-                 "With --to aerocal: the registry model to write (e.g. brown10 = brown_fraser_10, "
-                 "opencv, metashape_frame); default: the source's own model");
+                 "The registry model to write, one the --to format writes (any with aerocal, "
+                 "e.g. brown10 = brown_fraser_10, opencv, metashape_frame; colmap_* with colmap; "
+                 "opencv or opencv_fisheye with ros); default: the source's own model where the "
+                 "format writes it, else the format's");
   cv->add_option("--report",
                  convert->report,
                  "JSON: {exact, acceptable, residual_px: {rms, max, max_at, max_inner80}, notes}");

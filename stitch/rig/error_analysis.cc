@@ -136,23 +136,51 @@ ErrorLimits ReadErrorLimits(const std::string& path) {
   return ParseErrorLimits(LoadYamlFile(path), path);
 }
 
+namespace {
+
+// The interior sources of a head: the entries of its model's table in the principal-point group,
+// then those in the principal-distance group (table order), their limits (given in pixels)
+// converted to the table's unit, mm or px.
+void AddInteriorSources(const calib::RigHead& head,
+                        int h,
+                        const ErrorLimits& limits,
+                        std::vector<ErrorSource>* sources) {
+  const calib::Camera& camera = head.camera;
+  const std::vector<calib::ParamInfo> table = camera.Params();
+  const std::string model(calib::CameraModelName(camera.model));
+  const std::pair<calib::ParamGroup, ErrorSourceKind> groups[] = {
+      {calib::ParamGroup::kPrincipalPoint, ErrorSourceKind::kPrincipalPoint},
+      {calib::ParamGroup::kPrincipalDistance, ErrorSourceKind::kPrincipalDistance}};
+  for (const auto& [group, kind] : groups) {
+    const double limit_px = kind == ErrorSourceKind::kPrincipalPoint ? limits.principal_point_px
+                                                                     : limits.principal_distance_px;
+    bool any = false;
+    for (int i = 0; i < static_cast<int>(table.size()); ++i) {
+      if (table[i].group != group) continue;
+      const std::string unit(table[i].unit);
+      if (unit != "mm" && unit != "px")
+        throw InputError("head " + head.id + " in model " + model + ": the error analysis " +
+                         "perturbs the principal point and distance in mm or px, and " +
+                         std::string(table[i].name) + " is in " + unit);
+      const double limit = unit == "mm" ? limit_px * camera.pixel_size_mm : limit_px;
+      sources->push_back({std::string(table[i].name) + ":" + head.id, kind, h, limit, unit, i});
+      any = true;
+    }
+    if (!any)
+      throw InputError(
+          "head " + head.id + " in model " + model + ": no " +
+          (kind == ErrorSourceKind::kPrincipalPoint ? "principal point" : "principal distance") +
+          " in its table to perturb");
+  }
+}
+
+}  // namespace
+
 std::vector<ErrorSource> MakeErrorSources(const calib::Rig& rig, const ErrorLimits& limits) {
   std::vector<ErrorSource> sources;
   const int reference = rig.ReferenceIndex();
   for (int h = 0; h < static_cast<int>(rig.heads.size()); ++h) {
-    const std::string& id = rig.heads[h].id;
-    const calib::Camera& camera = rig.heads[h].camera;
-    // The interior sources are entries of the head's model table, in mm (brown_fraser_10's).
-    for (const char* name : {"x0", "y0", "c"})
-      if (camera.ParamIndex(name) < 0 || camera.Params()[camera.ParamIndex(name)].unit != "mm")
-        throw InputError("head " + id + " in model " +
-                         std::string(calib::CameraModelName(camera.model)) +
-                         ": the error analysis perturbs x0, y0 and c in mm, which the model does "
-                         "not have (convert the head to brown_fraser_10: aerocal camera convert)");
-    const double p = camera.pixel_size_mm;
-    sources.push_back({"x0:" + id, ErrorSourceKind::kX0, h, limits.principal_point_px * p, "mm"});
-    sources.push_back({"y0:" + id, ErrorSourceKind::kY0, h, limits.principal_point_px * p, "mm"});
-    sources.push_back({"c:" + id, ErrorSourceKind::kC, h, limits.principal_distance_px * p, "mm"});
+    AddInteriorSources(rig.heads[h], h, limits, &sources);
   }
   for (int h = 0; h < static_cast<int>(rig.heads.size()); ++h) {
     if (h == reference) continue;
@@ -210,16 +238,10 @@ std::optional<Eigen::Vector2d> ConversionErrorModel::Error(const Eigen::VectorXd
     const ErrorSource& s = sources_[i];
     const double d = delta[static_cast<int>(i)];
     if (d == 0.0) continue;
-    calib::Camera& camera = rig.heads[s.head].camera;  // MakeErrorSources checked the names
     switch (s.kind) {
-      case ErrorSourceKind::kX0:
-        camera.interior[camera.ParamIndex("x0")] += d;
-        break;
-      case ErrorSourceKind::kY0:
-        camera.interior[camera.ParamIndex("y0")] += d;
-        break;
-      case ErrorSourceKind::kC:
-        camera.interior[camera.ParamIndex("c")] += d;
+      case ErrorSourceKind::kPrincipalPoint:
+      case ErrorSourceKind::kPrincipalDistance:
+        rig.heads[s.head].camera.interior[s.param] += d;
         break;
       case ErrorSourceKind::kOmega:
         rig.heads[s.head].mount_rad[0] += d;
@@ -289,7 +311,8 @@ std::vector<WorstCase> WorstCases(const ConversionErrorModel& model,
   };
   using K = ErrorSourceKind;
   for (const calib::RigHead& head : rig.heads)
-    groups.push_back({"interior:" + head.id, members(head.id, {K::kX0, K::kY0, K::kC})});
+    groups.push_back(
+        {"interior:" + head.id, members(head.id, {K::kPrincipalPoint, K::kPrincipalDistance})});
   for (const calib::RigHead& head : rig.heads) {
     if (head.id == rig.reference_head) continue;
     groups.push_back({"angles:" + head.id, members(head.id, {K::kOmega, K::kPhi, K::kKappa})});

@@ -2,9 +2,12 @@
 // the head pixel that the conversion assigns to a fixed virtual pixel moves when the rig's
 // parameters are in error by their limits.
 //
-// Error sources (in this order): x0, y0, c of every head (file order), then omega, phi, kappa (the
-// mount angles of the file) and tx, ty, tz (the lever arm) of every non-reference head, then the
-// relative flying height H of the rectification plane. Names `x0:HEAD` ... `tz:HEAD`, `height`.
+// Error sources (in this order): the interior of every head (file order) as its model names it in
+// the registry's table: the principal point's entries, then the principal distance's (x0, y0, c of
+// brown_fraser_10; cx, cy, fx, fy of opencv; cx, cy, f of colmap_simple_pinhole ...), then omega,
+// phi, kappa (the mount angles of the file) and tx, ty, tz (the lever arm) of every non-reference
+// head, then the relative flying height H of the rectification plane. Names `x0:HEAD` (the table
+// name) ... `tz:HEAD`, `height`.
 //
 // The virtual camera is realised by the reference head (the virtual image of a dual-lens camera is
 // the reference image extended): a virtual pixel's ray is the reference head's ray through the
@@ -47,8 +50,8 @@ namespace aerocal::stitch {
 /// lever_arm_mm, height_m}` (all required, >= 0) and `sigmas` (> 0, default 3: the limits are that
 /// many standard deviations in the linear propagation and the Monte-Carlo).
 struct ErrorLimits {
-  double principal_point_px = 0.0;     // x0 and y0 of every head, in that head's pixels
-  double principal_distance_px = 0.0;  // c of every head, in that head's pixels
+  double principal_point_px = 0.0;     // each principal-point entry of every head, in its pixels
+  double principal_distance_px = 0.0;  // each principal-distance entry of every head, in its pixels
   double angles_arcsec = 0.0;          // omega, phi, kappa of the non-reference heads
   double lever_arm_mm = 0.0;           // tx, ty, tz of the non-reference heads
   double height_m = 0.0;               // relative flying height
@@ -57,14 +60,25 @@ struct ErrorLimits {
 ErrorLimits ReadErrorLimits(const std::string& path);
 ErrorLimits ParseErrorLimits(const YAML::Node& root, const std::string& file);
 
-enum class ErrorSourceKind { kX0, kY0, kC, kOmega, kPhi, kKappa, kTx, kTy, kTz, kHeight };
+enum class ErrorSourceKind {
+  kPrincipalPoint,     // an entry of the head's model table in that group
+  kPrincipalDistance,  // ditto
+  kOmega,
+  kPhi,
+  kKappa,
+  kTx,
+  kTy,
+  kTz,
+  kHeight
+};
 
 struct ErrorSource {
   std::string name;  // "x0:A", ..., "height"
   ErrorSourceKind kind;
   int head = -1;       // -1 for the height
-  double limit = 0.0;  // in memory units: mm (x0, y0, c), rad (angles), m (lever arm, height)
+  double limit = 0.0;  // in memory units: the table's (mm or px) for the interior, rad, m
   std::string unit;    // of `limit`
+  int param = -1;      // the interior's entry in the head's model table
 };
 
 /// The sources of a rig (order in the header comment) with the limits converted to memory units.

@@ -15,10 +15,9 @@ json Pair(const Eigen::Vector2d& v) { return json::array({v.x(), v.y()}); }
 // Limit of a source in the units of the limits file.
 std::pair<double, std::string> FileLimit(const ErrorSource& s, const ErrorLimits& limits) {
   switch (s.kind) {
-    case ErrorSourceKind::kX0:
-    case ErrorSourceKind::kY0:
+    case ErrorSourceKind::kPrincipalPoint:
       return {limits.principal_point_px, "px"};
-    case ErrorSourceKind::kC:
+    case ErrorSourceKind::kPrincipalDistance:
       return {limits.principal_distance_px, "px"};
     case ErrorSourceKind::kOmega:
     case ErrorSourceKind::kPhi:

@@ -240,6 +240,76 @@ TEST(CameraFormats, TermsOutsideOpenCvSurviveTheirFormat) {
                    "aerocal metashape_frame");
 }
 
+// ---- what a format holds: its registry row, every format x every model ----
+
+// Runs `write`, which must throw an InputError whose message names each of `named`.
+void ExpectRefused(const std::function<void()>& write, const std::vector<std::string>& named) {
+  try {
+    write();
+    ADD_FAILURE() << "written";
+  } catch (const InputError& e) {
+    for (const std::string& name : named)
+      EXPECT_NE(std::string(e.what()).find(name), std::string::npos) << e.what();
+  }
+}
+
+// Issue 30 item 1: what a format can hold is its registry row (CameraFormat::models) and nothing
+// else. Every registered format x every registered model: a pair the row lists round-trips
+// through the format's own writer and reader (the camera: DJI record A fitted into the model with
+// the row's zero parameters at 0, conformed where the format derives parameters), every parameter
+// within 1e-9 relative; every other pair is refused by the registry's writer with an InputError
+// naming the file, the format and the model, and nothing is written; so is a listed model with a
+// term the format has no field for, or with a parameter the format derives set otherwise.
+TEST(CameraFormats, EveryFormatWritesExactlyTheModelsItsRowLists) {
+  namespace fs = std::filesystem;
+  TempDir dir("aerocal_formats_models");
+  std::vector<CameraModelId> models;
+  ForEachCameraModel([&](auto m) { models.push_back(decltype(m)::kId); });
+  int written = 0, refused = 0;
+  for (const CameraFormat& f : CameraFormats()) {
+    for (const CameraModelId id : models) {
+      const std::string model(CameraModelName(id));
+      SCOPED_TRACE(f.name + " x " + model);
+      const WritableModel* row = FindWritableModel(f, id);
+      ConvertOptions options;
+      if (row) options.zero = row->zero_params;
+      CameraFile file = File(ConvertCamera(DjiRecordA(), id, options).camera);
+      const std::string path = dir.File(f.name + "_" + model + f.extension);
+      if (!row) {
+        ExpectRefused([&] { f.write(path, file); }, {path, f.name, model});
+        EXPECT_FALSE(fs::exists(path));
+        ++refused;
+        continue;
+      }
+      if (row->conform) {
+        ModelCamera derived = file.camera;
+        row->conform(&derived);
+        EXPECT_NE(derived.params, file.camera.params) << "DJI record A is not centred";
+        ExpectRefused([&] { f.write(path, file); }, {f.name, model, "derives"});
+        file.camera = derived;
+      }
+      if (!row->zero_params.empty()) {
+        CameraFile held = file;
+        const std::string& term = row->zero_params.front();
+        const std::vector<ParamInfo> table = CameraModelParams(id);
+        for (size_t i = 0; i < table.size(); ++i)
+          if (table[i].name == term) held.camera.params[i] = 1e-3;
+        ExpectRefused([&] { f.write(path, held); }, {f.name, model, term});
+      }
+      EXPECT_FALSE(fs::exists(path));
+      const CameraFile back = WriteAndRead(FormatNamed(f.name), file, dir);
+      ASSERT_EQ(back.camera.model, id);
+      for (size_t i = 0; i < file.camera.params.size(); ++i) {
+        const double a = file.camera.params[i], b = back.camera.params[i];
+        EXPECT_LE(std::abs(a - b), 1e-9 * std::max(std::abs(a), std::abs(b))) << i;
+      }
+      ++written;
+    }
+  }
+  std::printf("formats x models: %d pairs written and read back, %d refused\n", written, refused);
+  EXPECT_GT(written, 20);
+}
+
 // ---- ours -> format -> ours ----
 
 struct Trip {

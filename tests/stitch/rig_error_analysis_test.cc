@@ -2,6 +2,7 @@
 // hand (10" at c = 150 mm, the principal points of the two heads with opposite signs, lever arm
 // and height parallaxes), exactness (zero limits give exactly zero), Monte-Carlo against linear
 // propagation, the grouped worst cases and the grid.
+#include "calib/camera/convert_camera.h"
 #include "calib/camera/rig_io.h"
 #include "stitch/rig/error_analysis.h"
 #include "stitch/rig/error_analysis_json.h"
@@ -118,6 +119,40 @@ TEST(RigErrorAnalysis, ExampleCameraPhysicsByHand) {
   EXPECT_NEAR(Row(rows, "height").plus_px.x(), plus_h, 0.01 * plus_h);
   EXPECT_NEAR(Row(rows, "height").minus_px.x(), minus_h, 0.01 * std::abs(minus_h));
   EXPECT_NEAR(Row(rows, "height").plus_px.y(), plus_h / 15.0, 0.01);
+}
+
+// Issue 30 item 2: the interior sources are the head model's own parameters (the registry's
+// table). The example rig's heads have no distortion, so their opencv form is exact
+// (fx = fy = c / p, cx, cy from x0, y0): the sources are cx, cy, fx, fy per head; head B's cx moves
+// its pixel by exactly the limit in col (ex = +0.5 px), its cy in row (down, so ey = -0.5 px); the
+// mount and the height act as on the brown_fraser_10 heads (the same rays, to 1e-9 px).
+TEST(RigErrorAnalysis, SourcesAreTheHeadModelsOwnParameters) {
+  const calib::Rig ours = ExampleRig();
+  calib::Rig opencv = ours;
+  for (calib::RigHead& head : opencv.heads) {
+    const calib::ConversionResult r =
+        calib::ConvertCamera(head.camera.AsModelCamera(), calib::CameraModelId::kOpenCv);
+    ASSERT_TRUE(r.exact);
+    head.camera = calib::Camera::OfModel(calib::CameraModelId::kOpenCv).WithModelCamera(r.camera);
+  }
+  const auto sources = MakeErrorSources(opencv, ExampleLimits());
+  std::vector<std::string> names;
+  for (size_t i = 0; i < 8; ++i) names.push_back(sources[i].name);
+  EXPECT_EQ(
+      names,
+      (std::vector<std::string>{"cx:A", "cy:A", "fx:A", "fy:A", "cx:B", "cy:B", "fx:B", "fy:B"}));
+  EXPECT_EQ(sources[0].unit, "px");
+  EXPECT_DOUBLE_EQ(sources[0].limit, 0.5);  // px, as the limits file gives it
+  EXPECT_DOUBLE_EQ(sources[2].limit, 1.0);
+  const Eigen::Vector2d target = VirtualOfB(ours, {5499.5, 4499.5});
+  const auto rows = MaximumErrors(ConversionErrorModel(opencv, kHeight, sources, 1, target));
+  EXPECT_NEAR(Row(rows, "cx:B").plus_px.x(), 0.5, 1e-6);
+  EXPECT_NEAR(Row(rows, "cx:B").plus_px.y(), 0.0, 1e-6);
+  EXPECT_NEAR(Row(rows, "cy:B").plus_px.y(), -0.5, 1e-6);
+  const auto theirs = MaximumErrors(
+      ConversionErrorModel(ours, kHeight, MakeErrorSources(ours, ExampleLimits()), 1, target));
+  for (const char* name : {"omega:B", "phi:B", "kappa:B", "tx:B", "height"})
+    EXPECT_LT((Row(rows, name).plus_px - Row(theirs, name).plus_px).norm(), 1e-9) << name;
 }
 
 TEST(RigErrorAnalysis, ZeroLimitsGiveExactlyZero) {

@@ -332,6 +332,29 @@ TEST(CliCamera, MaxResidualTurnsABadFitIntoExit3AndWritesNothing) {
   EXPECT_NE(Read(tmp.File("dji.yaml")).find("model: opencv"), std::string::npos);
 }
 
+// Issue 30 item 1: --model picks one of the models the --to format's registry row lists (COLMAP's
+// RADIAL here: exact from a camera already in it); a model the format does not write is exit 2
+// naming the option, the format and the model, and OUT is left as it was.
+TEST(CliCamera, ModelMustBeOneTheFormatWrites) {
+  TempDir tmp("aerocal_cli_camera_model");
+  const std::string colmap = tmp.File("cameras.txt"), out = tmp.File("out.txt");
+  std::ofstream(colmap) << "1 RADIAL 640 480 500 320 240 -0.1 0.01\n";
+  const auto radial = RunAerocal("camera convert --from colmap --to colmap --model colmap_radial " +
+                                 colmap + " " + out + " --pixel-size-mm 0.006");
+  ASSERT_EQ(radial.exit_code, 0) << radial.output;
+  EXPECT_NE(Read(out).find("RADIAL 640 480"), std::string::npos) << Read(out);
+  const std::string kalibr = tmp.File("camchain.yaml");
+  std::ofstream(kalibr) << "previous\n";
+  const auto refused = RunAerocal("camera convert --from colmap --to kalibr --model brown10 " +
+                                  colmap + " " + kalibr + " --pixel-size-mm 0.006");
+  EXPECT_EQ(refused.exit_code, 2) << refused.output;
+  EXPECT_NE(refused.output.find("--model brown10: the kalibr format cannot hold a brown_fraser_10 "
+                                "camera (it writes opencv, opencv_fisheye)"),
+            std::string::npos)
+      << refused.output;
+  EXPECT_EQ(Read(kalibr), "previous\n");
+}
+
 // Issue 37 class 3: the same fit (max > 5 px) without --max-residual-px is refused by the default
 // limit of 1 px (a camera missing by more is not the one read); a larger limit, given, accepts it.
 TEST(CliCamera, AFitMissingByMoreThanAPixelIsExit3WithoutAGate) {

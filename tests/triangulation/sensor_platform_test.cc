@@ -2,7 +2,7 @@
 // (triangulation/sensor/make_imaging_model.h), with the claims of docs/architecture.md "How to
 // add a sensor kind" that a test can check: the factory has a model for every kind or names the
 // command that adjusts it, every ImagingModel in triangulation/sensor/ is made by a factory row,
-// and the generic adjustment (block_adjustment.cc, adjust.cc) tests no kind.
+// and the generic adjustment (block_adjustment*.cc, adjust.cc) tests no kind.
 #include "calib/camera/line_camera_io.h"
 #include "calib/core/error.h"
 #include "tests/support/rig_flight_project.h"
@@ -150,8 +150,10 @@ TEST(SensorKindFactory, EveryImagingModelInTheSensorFolderIsAFactoryRow) {
 
 // The generic adjustment asks the platform, never an observation's columns or a kind.
 TEST(BlockAdjustmentDriver, TestsNoSensorKind) {
-  for (const char* file :
-       {"triangulation/adjustment/block_adjustment.cc", "triangulation/adjustment/adjust.cc"}) {
+  for (const char* file : {"triangulation/adjustment/block_adjustment.cc",
+                           "triangulation/adjustment/block_adjustment_snooping.cc",
+                           "triangulation/adjustment/block_adjustment_screening.cc",
+                           "triangulation/adjustment/adjust.cc"}) {
     const std::string text = ReadSource(file);
     for (const char* kind_test : {".subimage.empty()",
                                   ".head.empty()",

@@ -41,10 +41,10 @@ CameraFile ReadCamera(const std::string& path,
 
 void WriteCamera(const CameraFile& camera, const std::string& path, const std::string& format) {
   const calib::CameraFormat& f = calib::FindCameraFormat(format, "format");
-  if (f.target(camera.camera).model != camera.camera.model)
-    throw ConfigError("format " + format + " writes the " +
-                      std::string(calib::CameraModelName(f.target(camera.camera).model)) +
-                      " model: convert_camera(camera, model=...) first, and look at its residual");
+  if (!calib::FindWritableModel(f, camera.camera.model))
+    throw ConfigError(
+        "format " + format + " writes " + calib::WritableModelNames(f) +
+        " cameras: convert_camera(camera, model=...) first, and look at its residual");
   calib::WriteCameraFileVerified(f, path, camera);
 }
 

@@ -37,9 +37,6 @@ using calib::BlockKind;
 
 const std::vector<std::string> kCenterNames = {"X", "Y", "Z"};
 const std::vector<std::string> kAngleNames = {"omega", "phi", "kappa"};
-// The automatic rejection cap (AdjustOptions::max_rejections 0): 10 % of the tested image
-// observations, at least this many.
-constexpr int kMinAutomaticCap = 100;
 // Owner of the weighted platform parameters (lever arm, boresight, GNSS time offset): their priors
 // are in group calib::PriorGroup(kPlatformOwner), "platform_prior".
 constexpr const char* kPlatformOwner = "platform";
@@ -208,6 +205,16 @@ std::optional<Eigen::Vector2d> BlockAdjustment::ResidualAtCurrentValues(
 }
 
 void BlockAdjustment::BuildPoints() {
+  CollectObservations();
+  IndexPoints();
+  NoteUnobservedExposures();
+  // Leaving out an exposure can leave a point with one ray, so repeat until nothing changes.
+  while (DropUndeterminedExposures()) {
+  }
+  StartPoints();
+}
+
+void BlockAdjustment::CollectObservations() {
   // Each observation with the model of its sensor's kind (the platform's word), as that model
   // keeps it (AsAdjusted).
   Storage& s = *storage_;
@@ -220,7 +227,11 @@ void BlockAdjustment::BuildPoints() {
     s.observations.push_back(model->AsAdjusted(s.context, project_.observations[source]));
     s.sensor_of_observation.push_back(model);
   }
+}
+
+void BlockAdjustment::IndexPoints() {
   // The points: a dense index per observed point id (sorted ids), assigned once.
+  Storage& s = *storage_;
   s.point_ids = s.platform.point_ids;
   s.points.resize(s.point_ids.size());  // once: the builder keeps pointers into the states
   // Project::FindPoint's first match, without its linear search (quadratic at 180,000 points).
@@ -230,10 +241,12 @@ void BlockAdjustment::BuildPoints() {
     const auto ground = ground_of_id.find(s.point_ids[p]);
     s.points[p].ground = ground == ground_of_id.end() ? nullptr : ground->second;
   }
-  const int n_exposures = s.index.NumExposures();
-  const int n_points = static_cast<int>(s.points.size());
+}
+
+void BlockAdjustment::NoteUnobservedExposures() {
   // An exposure that no observation names is named, never silently unused (issue 28).
-  std::vector<bool> observed(n_exposures, false);
+  Storage& s = *storage_;
+  std::vector<bool> observed(s.index.NumExposures(), false);
   for (ExposureIndex e : s.exposure_of_observation) observed[e] = true;
   for (ExposureIndex k : s.exposure_order) {
     if (observed[k]) continue;
@@ -247,54 +260,62 @@ void BlockAdjustment::BuildPoints() {
                       (held ? "its orientation is its GNSS/IMU priors only"
                             : "not adjusted, no orientation written"));
   }
+}
+
+bool BlockAdjustment::DropUndeterminedExposures() {
   // An exposure seeing fewer than three points (and not held by GNSS and IMU priors) cannot be
-  // oriented; leaving it out can leave a point with one ray, so repeat until nothing changes.
-  for (bool changed = true; changed;) {
-    changed = false;
-    std::vector<std::set<PointIndex>> points_of_image(n_exposures);
-    std::vector<std::set<ExposureIndex>> images_of_point(n_points);
-    for (size_t i = 0; i < s.observations.size(); ++i) {
-      points_of_image[s.exposure_of_observation[i]].insert(s.point_of_observation[i]);
-      images_of_point[s.point_of_observation[i]].insert(s.exposure_of_observation[i]);
-    }
-    std::vector<bool> dropped(n_exposures, false);
-    bool any_dropped = false;
-    for (ExposureIndex k : s.exposure_order) {
-      const std::set<PointIndex>& points = points_of_image[k];
-      if (points.empty()) continue;  // not observed
-      const Exposure& e = *s.exposures[k].exposure;
-      const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
-      if (points.size() >= 3 || held) continue;
-      dropped[k] = any_dropped = true;
-      s.notes.push_back("image " + e.image + " sees " + std::to_string(points.size()) +
-                        " point(s) only: its orientation cannot be determined; left out");
-    }
-    std::vector<bool> single(n_points, false);
-    for (PointIndex p = 0; p < n_points; ++p)
-      single[p] = images_of_point[p].size() == 1 && !s.points[p].Control();
-    const size_t before = s.observations.size();
-    std::vector<ImageObservation> kept;
-    std::vector<ImagingModel*> kept_sensors;
-    std::vector<int> kept_sources;
-    std::vector<ExposureIndex> kept_exposures;
-    std::vector<PointIndex> kept_points;
-    for (size_t i = 0; i < before; ++i) {
-      const ExposureIndex e = s.exposure_of_observation[i];
-      const PointIndex p = s.point_of_observation[i];
-      if (dropped[e] || (any_dropped && single[p])) continue;
-      kept.push_back(s.observations[i]);
-      kept_sensors.push_back(s.sensor_of_observation[i]);
-      kept_sources.push_back(s.source_of_observation[i]);
-      kept_exposures.push_back(e);
-      kept_points.push_back(p);
-    }
-    s.observations = std::move(kept);
-    s.sensor_of_observation = std::move(kept_sensors);
-    s.source_of_observation = std::move(kept_sources);
-    s.exposure_of_observation = std::move(kept_exposures);
-    s.point_of_observation = std::move(kept_points);
-    changed = s.observations.size() != before;
+  // oriented; with it go the points it leaves with one ray (not control points).
+  Storage& s = *storage_;
+  const int n_exposures = s.index.NumExposures();
+  const int n_points = static_cast<int>(s.points.size());
+  std::vector<std::set<PointIndex>> points_of_image(n_exposures);
+  std::vector<std::set<ExposureIndex>> images_of_point(n_points);
+  for (size_t i = 0; i < s.observations.size(); ++i) {
+    points_of_image[s.exposure_of_observation[i]].insert(s.point_of_observation[i]);
+    images_of_point[s.point_of_observation[i]].insert(s.exposure_of_observation[i]);
   }
+  std::vector<bool> dropped(n_exposures, false);
+  bool any_dropped = false;
+  for (ExposureIndex k : s.exposure_order) {
+    const std::set<PointIndex>& points = points_of_image[k];
+    if (points.empty()) continue;  // not observed
+    const Exposure& e = *s.exposures[k].exposure;
+    const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
+    if (points.size() >= 3 || held) continue;
+    dropped[k] = any_dropped = true;
+    s.notes.push_back("image " + e.image + " sees " + std::to_string(points.size()) +
+                      " point(s) only: its orientation cannot be determined; left out");
+  }
+  std::vector<bool> single(n_points, false);
+  for (PointIndex p = 0; p < n_points; ++p)
+    single[p] = images_of_point[p].size() == 1 && !s.points[p].Control();
+  const size_t before = s.observations.size();
+  std::vector<ImageObservation> kept;
+  std::vector<ImagingModel*> kept_sensors;
+  std::vector<int> kept_sources;
+  std::vector<ExposureIndex> kept_exposures;
+  std::vector<PointIndex> kept_points;
+  for (size_t i = 0; i < before; ++i) {
+    const ExposureIndex e = s.exposure_of_observation[i];
+    const PointIndex p = s.point_of_observation[i];
+    if (dropped[e] || (any_dropped && single[p])) continue;
+    kept.push_back(s.observations[i]);
+    kept_sensors.push_back(s.sensor_of_observation[i]);
+    kept_sources.push_back(s.source_of_observation[i]);
+    kept_exposures.push_back(e);
+    kept_points.push_back(p);
+  }
+  s.observations = std::move(kept);
+  s.sensor_of_observation = std::move(kept_sensors);
+  s.source_of_observation = std::move(kept_sources);
+  s.exposure_of_observation = std::move(kept_exposures);
+  s.point_of_observation = std::move(kept_points);
+  return s.observations.size() != before;
+}
+
+void BlockAdjustment::StartPoints() {
+  Storage& s = *storage_;
+  const int n_points = static_cast<int>(s.points.size());
   std::vector<std::vector<ImageRay>> rays(n_points);
   for (size_t i = 0; i < s.observations.size(); ++i)
     rays[s.point_of_observation[i]].push_back(
@@ -557,384 +578,10 @@ void BlockAdjustment::DefineDatum() {
   storage_->datum = text;
 }
 
-namespace {
-
-// Whitened image residuals of `ids` with the point block (values at `xyz`) set to `at`.
-std::vector<Eigen::VectorXd> ResidualsWithPointAt(const calib::ProblemBuilder& builder,
-                                                  const std::vector<calib::ResidualId>& ids,
-                                                  Eigen::Vector3d* xyz,
-                                                  const Eigen::Vector3d& at) {
-  *xyz = at;
-  std::vector<Eigen::VectorXd> out;
-  for (calib::ResidualId id : ids) {
-    const std::vector<double> v = builder.EvaluateResidual(id);
-    out.push_back(Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<int>(v.size())));
-  }
-  return out;
-}
-
-// Least squares of the point alone (the poses and the camera held) on the rays `use` of `ids`,
-// Gauss-Newton from `start` with a central-difference Jacobian; nullopt when the rays do not
-// determine the point.
-std::optional<Eigen::Vector3d> FitPoint(const calib::ProblemBuilder& builder,
-                                        const std::vector<calib::ResidualId>& ids,
-                                        const std::vector<bool>& use,
-                                        Eigen::Vector3d* xyz,
-                                        Eigen::Vector3d start) {
-  constexpr double kStepM = 1e-3;  // central differences of residuals linear at this scale
-  std::vector<calib::ResidualId> rays;
-  for (size_t i = 0; i < ids.size(); ++i)
-    if (use[i]) rays.push_back(ids[i]);
-  for (int iteration = 0; iteration < 8; ++iteration) {
-    const auto at = ResidualsWithPointAt(builder, rays, xyz, start);
-    int m = 0;
-    for (const auto& v : at) m += static_cast<int>(v.size());
-    Eigen::VectorXd r(m);
-    Eigen::MatrixXd j(m, 3);
-    for (int c = 0, row = 0; c < static_cast<int>(at.size());
-         row += static_cast<int>(at[c].size()), ++c)
-      r.segment(row, at[c].size()) = at[c];
-    for (int k = 0; k < 3; ++k) {
-      Eigen::Vector3d plus = start, minus = start;
-      plus(k) += kStepM;
-      minus(k) -= kStepM;
-      const auto vp = ResidualsWithPointAt(builder, rays, xyz, plus);
-      const auto vm = ResidualsWithPointAt(builder, rays, xyz, minus);
-      for (int c = 0, row = 0; c < static_cast<int>(at.size());
-           row += static_cast<int>(at[c].size()), ++c)
-        j.block(row, k, at[c].size(), 1) = (vp[c] - vm[c]) / (2 * kStepM);
-    }
-    const Eigen::Matrix3d n = j.transpose() * j;
-    Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(n);
-    if (!(eig.eigenvalues()(0) > 1e-9 * eig.eigenvalues()(2))) return std::nullopt;
-    const Eigen::Vector3d step = -n.ldlt().solve(j.transpose() * r);
-    start += step;
-    if (step.norm() < 1e-6) break;
-  }
-  return start;
-}
-
-}  // namespace
-
-std::vector<BlockAdjustment::Screened> BlockAdjustment::ScreenRobustly(double reject) {
-  std::vector<calib::ResidualId> ids;
-  for (const auto& [id, index] : storage_->observation_of_residual)
-    if (builder_.IsActive(id) && builder_.ResidualGroup(id) == calib::kGroupImage)
-      ids.push_back(id);
-  const calib::ObservationCofactors cof = builder_.ComputeObservationCofactors(ids, false);
-  std::vector<double> scaled;  // |v| / sqrt(r) of the testable components
-  std::map<calib::ResidualId, std::vector<double>> values;
-  for (calib::ResidualId id : ids) {
-    values[id] = builder_.EvaluateResidual(id);
-    const auto& r = cof.redundancy.at(id);
-    for (size_t k = 0; k < r.size(); ++k)
-      if (r[k] > 1e-6) scaled.push_back(std::abs(values[id][k]) / std::sqrt(r[k]));
-  }
-  std::vector<Screened> out;
-  if (scaled.empty()) return out;
-  const double scale = std::max(1e-12, 1.4826 * Median(scaled));
-  std::map<calib::ResidualId, double> w_of;
-  std::map<PointIndex, std::vector<calib::ResidualId>> rays_of_point;  // by point (id order)
-  for (calib::ResidualId id : ids) {
-    const auto& r = cof.redundancy.at(id);
-    const auto& v = values.at(id);
-    double w = 0.0;
-    for (size_t k = 0; k < r.size(); ++k)
-      if (r[k] > 1e-6) w = std::max(w, std::abs(v[k]) / (scale * std::sqrt(r[k])));
-    w_of[id] = w;
-    rays_of_point[storage_->point_of_observation[storage_->observation_of_residual.at(id)]]
-        .push_back(id);
-  }
-  // A point of three or more rays with a ray beyond `reject` is judged on its own, the poses and
-  // the camera held at the robust solution: the Cauchy solution can settle a point on its
-  // blunder and one good ray (a local minimum), which makes the good rays look like the gross
-  // errors. The point is fitted to every pair of its rays; the fit that most rays agree with
-  // (|v| / s <= reject on every component; ties by the truncated sum of squares), refitted to
-  // those rays, judges every ray by its residual there. When two fits with different sets of
-  // rays agree equally well, the rays cannot be told apart here: none is excluded, and the final
-  // adjustment's snooping judges them with their correlated group. A control point keeps the
-  // one-pass cut, except when every one of its rays is beyond it: then its survey is the suspect
-  // (a wrong survey makes all its good rays look like gross errors), and the rays go to the final
-  // adjustment, which tests the survey first.
-  std::map<calib::ResidualId, double> judged;  // per-point verdicts: the ray's |v| / s there
-  for (const auto& point_rays : rays_of_point) {
-    // (a lambda may not capture a structured binding in C++17)
-    Storage::PointState& state = storage_->points[point_rays.first];
-    const auto& rays = point_rays.second;
-    const int n = static_cast<int>(rays.size());
-    const bool control = state.Control();
-    bool suspect = false;
-    for (calib::ResidualId id : rays) suspect |= w_of.at(id) > reject;
-    if (!suspect) continue;
-    if (control) {  // every ray beyond the cut: its survey is suspect, not its rays
-      bool all = n >= 2;
-      for (calib::ResidualId id : rays) all &= w_of.at(id) > reject;
-      if (all)
-        for (calib::ResidualId id : rays) judged[id] = 0.0;  // the final adjustment tests both
-      continue;
-    }
-    if (n < 3) continue;
-    Eigen::Vector3d* xyz = &state.xyz;
-    const Eigen::Vector3d robust = *xyz;
-    const auto judge = [&](const Eigen::Vector3d& at, std::vector<bool>* agree, double* cost) {
-      const auto v = ResidualsWithPointAt(builder_, rays, xyz, at);
-      int count = 0;
-      *cost = 0.0;
-      for (int i = 0; i < n; ++i) {
-        const double worst = v[i].cwiseAbs().maxCoeff() / scale;
-        (*agree)[i] = worst <= reject;
-        count += (*agree)[i];
-        *cost += std::min(v[i].squaredNorm() / (scale * scale), reject * reject);
-      }
-      return count;
-    };
-    int best_count = -1;
-    double best_cost = 0.0;
-    std::vector<bool> best(n, false), agree(n, false);
-    bool ambiguous = false;
-    const auto consider = [&](const Eigen::Vector3d& at) {
-      double cost = 0.0;
-      const int count = judge(at, &agree, &cost);
-      if (count > best_count || (count == best_count && cost < best_cost)) {
-        ambiguous = count == best_count && agree != best;
-        best_count = count;
-        best_cost = cost;
-        best = agree;
-      } else if (count == best_count && agree != best) {
-        ambiguous = true;
-      }
-    };
-    consider(robust);
-    for (int a = 0; a < n; ++a)
-      for (int b = a + 1; b < n; ++b) {
-        std::vector<bool> pair(n, false);
-        pair[a] = pair[b] = true;
-        if (const auto fit = FitPoint(builder_, rays, pair, xyz, robust)) consider(*fit);
-      }
-    if (!ambiguous && best_count >= 2) {
-      if (const auto fit = FitPoint(builder_, rays, best, xyz, robust)) {
-        const auto v = ResidualsWithPointAt(builder_, rays, xyz, *fit);
-        for (int i = 0; i < n; ++i) judged[rays[i]] = v[i].cwiseAbs().maxCoeff() / scale;
-      }
-    } else {
-      for (calib::ResidualId id : rays) judged[id] = 0.0;  // left to the final snooping
-    }
-    *xyz = robust;
-  }
-  for (calib::ResidualId id : ids) {
-    const auto by_point = judged.find(id);
-    const double w = by_point != judged.end() ? by_point->second : w_of.at(id);
-    if (w <= reject) continue;
-    const auto& v = values.at(id);
-    const size_t index = storage_->observation_of_residual.at(id);
-    const ImageObservation& o = storage_->observations.at(index);
-    out.push_back(
-        {o, storage_->source_of_observation[index], Eigen::Vector2d(v[0], v[1]) * o.sigma_px, w});
-  }
-  return out;
-}
-
 std::string BlockAdjustment::Describe(calib::ResidualId id) const {
   const auto it = storage_->observation_of_residual.find(id);
   if (it == storage_->observation_of_residual.end()) return builder_.ResidualLabel(id);
   return storage_->sensor_of_observation[it->second]->Describe(storage_->observations[it->second]);
-}
-
-calib::SnoopingOutcome BlockAdjustment::Snoop(AdjustmentResult* result) {
-  // The datum guard: no control point below two rays, no exposure below three points (unless
-  // GNSS and IMU priors hold it). Counts of the active rays, kept up to date on every approval.
-  Storage& st = *storage_;
-  std::vector<int> point_rays(st.points.size(), 0), image_rays(st.exposures.size(), 0);
-  for (const auto& [id, index] : st.observation_of_residual)
-    if (builder_.IsActive(id)) {
-      ++point_rays[st.point_of_observation[index]];
-      ++image_rays[st.exposure_of_observation[index]];
-    }
-  calib::SnoopingOptions snooping;
-  // The image groups the kinds' terms came in (AddImageResiduals), and the control surveys.
-  snooping.groups.assign(st.snooped_groups.begin(), st.snooped_groups.end());
-  snooping.groups.push_back(calib::kGroupControl);
-  snooping.report_only_groups = {calib::kGroupControl};
-  snooping.alpha = options_.snooping_alpha;
-  snooping.critical_value = options_.snooping_critical_value;
-  snooping.power = options_.snooping_power;
-  snooping.min_redundancy = options_.min_redundancy;
-  snooping.group_correlation = options_.group_correlation;
-  int tested_images = 0;
-  for (int n : image_rays) tested_images += n;
-  snooping.max_rejections = options_.max_rejections > 0
-                                ? options_.max_rejections
-                                : std::max(kMinAutomaticCap, tested_images / 10);
-  snooping.model_error_sigma0 = options_.model_error_sigma0;
-  snooping.leave_out_report_only = options_.leave_out_failing_control;
-  // Without GNSS centres the surveys hold the datum: at least three plan and three height
-  // surveys stay.
-  bool gnss = false;
-  for (const auto& state : st.exposures)
-    gnss |= options_.use_eo_priors && state.exposure->center_sigma_m.has_value();
-  snooping.veto = [&](const std::vector<calib::ResidualId>& ids) -> std::string {
-    std::map<std::string, std::pair<int, int>> kept_leaving;  // by component: active, leaving
-    for (const auto& [id, survey] : st.control_of_residual) {
-      auto& [surveys, leaving] = kept_leaving[survey.second];
-      surveys += builder_.IsActive(id);
-      leaving += std::find(ids.begin(), ids.end(), id) != ids.end();
-    }
-    for (const auto& [component, count] : kept_leaving)
-      if (count.second > 0 && !gnss && count.first - count.second < 3)
-        return "leaving out the survey would leave " + std::to_string(count.first - count.second) +
-               " control point(s) with a " + component +
-               " survey and no GNSS centres: the datum needs 3";
-    // Keyed by point index (id order) and by exposure rank (image id order): the first veto
-    // found is the one named.
-    std::map<PointIndex, int> lose_point;
-    std::map<int, int> lose_image;
-    for (calib::ResidualId id : ids) {
-      const auto it = st.observation_of_residual.find(id);
-      if (it == st.observation_of_residual.end()) continue;
-      ++lose_point[st.point_of_observation[it->second]];
-      ++lose_image[st.exposure_rank[st.exposure_of_observation[it->second]]];
-    }
-    for (const auto& [point, n] : lose_point) {
-      if (st.points[point].Control() && point_rays[point] - n < 2)
-        return "control point " + st.point_ids[point] + " would keep " +
-               std::to_string(point_rays[point] - n) +
-               " ray(s): its rays are kept, check its measurements";
-    }
-    for (const auto& [rank, n] : lose_image) {
-      const ExposureIndex image = st.exposure_order[rank];
-      const Exposure& e = *st.exposures[image].exposure;
-      const bool held = options_.use_eo_priors && e.center_sigma_m && e.opk_sigma_rad;
-      if (!held && image_rays[image] - n < 3)
-        return "image " + e.image + " would keep " + std::to_string(image_rays[image] - n) +
-               " point(s) and be under-determined";
-    }
-    for (const auto& [point, n] : lose_point) point_rays[point] -= n;
-    for (const auto& [rank, n] : lose_image) image_rays[st.exposure_order[rank]] -= n;
-    return "";
-  };
-  const calib::SolveReport first = result->solve;
-  calib::SnoopingOutcome out =
-      calib::SolveWithDataSnooping(builder_, options_.solver, snooping, &first);
-  for (const auto& x : out.left_out) {
-    const auto it = st.control_of_residual.find(x.id);
-    if (it != st.control_of_residual.end())
-      st.survey_left_out[it->second.first].emplace_back(it->second.second, x.w_full);
-  }
-  result->solve = out.report;
-  if (out.solves > 0) {
-    result->solve.iterations += first.iterations;  // the first solve, before snooping
-    result->solve.initial_cost = first.initial_cost;
-  }
-
-  SnoopingSummary& s = result->snooping;
-  s.run = true;
-  s.alpha = out.alpha;
-  s.alpha0 = out.alpha0;
-  s.critical_value = out.critical_value;
-  s.power = out.power;
-  s.delta0 = out.delta0;
-  s.delta0_joint = out.delta0_joint;
-  s.min_redundancy = out.min_redundancy;
-  s.group_correlation = out.group_correlation;
-  s.reference_sigma = out.reference_sigma;
-  s.cofactor_method = out.cofactor_method;
-  s.cofactors_ok = out.cofactors_ok;
-  s.cofactor_message = out.cofactor_message;
-  s.n_tested_components = out.n_tested_components;
-  s.rounds = out.rounds;
-  s.max_rejections = snooping.max_rejections;
-  s.cap_reached = out.cap_reached;
-  s.remaining_above_critical = out.remaining_above_critical;
-  s.model_error_suspected = out.model_error_suspected;
-  s.model_error_evidence = out.model_error_evidence;
-  s.findings = out.findings;
-  s.unresolved_reason = out.unresolved_reason;
-  for (const auto& x : out.unresolved) {
-    storage_->unresolved_ids.push_back(x.id);
-    UnresolvedSurvey u;
-    u.survey = x.label;
-    u.w = x.w_full;
-    u.redundancy = *std::min_element(x.redundancy.begin(), x.redundancy.end());
-    for (double v : x.v) u.residual_sigma = std::max(u.residual_sigma, std::abs(v));
-    s.unresolved_surveys.push_back(u);
-  }
-  s.seconds_testing = out.seconds_testing;
-  if (out.model_error_suspected) {
-    int control = 0;
-    for (const auto& state : storage_->points) control += state.block >= 0 && state.Control();
-    if (!options_.free_interior.empty())
-      s.suggestion =
-          "the run already self-calibrates: check the camera model, the control survey and the "
-          "a-priori sigmas";
-    else if (storage_->exposures.size() >= 3 && (control >= 3 || !storage_->free_network))
-      s.suggestion =
-          "self-calibration with --self-calibration auto (it frees only what this block "
-          "determines and what is significant, and names what it holds) may absorb it: the "
-          "block has " +
-          std::to_string(storage_->exposures.size()) + " exposures and " + std::to_string(control) +
-          " control point(s)";
-    else
-      s.suggestion = "the block is too weak to self-calibrate: more control or GNSS is needed";
-  }
-
-  const auto to_test = [&](const calib::TestedObservation& x, double sigma_px) {
-    ObservationTest t;
-    t.tested = true;
-    for (int k = 0; k < 2 && k < static_cast<int>(x.v.size()); ++k) {
-      t.redundancy(k) = x.redundancy[k];
-      t.w(k) = x.w[k];
-      t.mdb_sigma(k) = x.mdb_sigma[k];
-      t.mdb_px(k) = x.mdb_sigma[k] * sigma_px;
-    }
-    t.group_size = x.group_size;
-    t.verdict = calib::VerdictName(x.verdict);
-    t.reason = x.reason;
-    return t;
-  };
-  for (const auto& x : out.tested) {
-    const auto it = storage_->observation_of_residual.find(x.id);
-    const bool image = it != storage_->observation_of_residual.end();
-    if (image) {
-      const ObservationTest t = to_test(x, storage_->observations[it->second].sigma_px);
-      storage_->tests[x.id] = t;
-      s.n_weakly_controlled += t.redundancy.minCoeff() < options_.min_redundancy;
-      s.n_untestable += t.redundancy.minCoeff() < 1e-6;
-      s.n_in_groups += t.group_size > 1;
-    }
-    if (x.verdict == calib::SnoopingVerdict::kAccepted) continue;
-    FlaggedObservation f;
-    f.what = image ? Describe(x.id) : x.label;
-    f.verdict = calib::VerdictName(x.verdict);
-    f.reason = x.reason;
-    f.w = x.verdict == calib::SnoopingVerdict::kWeaklyControlled ? x.w_weak : x.w_max;
-    if (x.component >= 0) {
-      f.redundancy = x.redundancy[x.component];
-      f.mdb_sigma = x.mdb_sigma[x.component];
-    }
-    f.group_size = x.group_size;
-    s.flagged.push_back(f);
-  }
-  for (const auto& x : out.rejected) {
-    const auto it = storage_->observation_of_residual.find(x.id);
-    if (it == storage_->observation_of_residual.end()) continue;
-    const auto& o = storage_->observations[it->second];
-    RejectedObservation r;
-    r.image = o.image;
-    r.point = o.point;
-    r.measured_px = o.pixel;
-    storage_->sensor_of_observation[it->second]->Annotate(o, &r);
-    r.w = x.w_max;
-    if (x.v.size() == 2) r.residual_px = Eigen::Vector2d(x.v[0], x.v[1]) * o.sigma_px;
-    r.test = to_test(x, o.sigma_px);
-    for (calib::ResidualId member : x.correlated) {
-      const auto m = storage_->observation_of_residual.find(member);
-      if (m != storage_->observation_of_residual.end())
-        r.group.push_back(storage_->observations[m->second].image);
-    }
-    storage_->tests[x.id] = r.test;
-    result->rejected.push_back(r);
-  }
-  return out;
 }
 
 }  // namespace aerocal::triangulation

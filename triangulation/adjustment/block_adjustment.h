@@ -46,6 +46,7 @@
 
 #include <Eigen/Core>
 
+#include <functional>
 #include <map>
 #include <memory>
 #include <optional>
@@ -120,7 +121,20 @@ class BlockAdjustment {
   /// "observations_file:LINE" naming the command that adjusts a kind without a model here.
   ImagingModel* ModelOf(size_t source) const;
   void BuildExposures();
+  /// The observations, the points and their starting values, in these steps:
   void BuildPoints();
+  /// Each observation with the model of its sensor's kind, as that model keeps it (AsAdjusted).
+  void CollectObservations();
+  /// A dense index per observed point id (sorted ids) with its ground point, if any.
+  void IndexPoints();
+  /// Notes each exposure no observation names (issue 28).
+  void NoteUnobservedExposures();
+  /// One pass leaving out the exposures that see fewer than three points (unless GNSS and IMU
+  /// priors hold them) and then the points left with one ray; true when it left anything out.
+  bool DropUndeterminedExposures();
+  /// The points' starting values (survey, intersection of the rays, a fallback height) and
+  /// blocks; notes the points left out.
+  void StartPoints();
   /// Adds the ground point block of `point` (a dense index of the observed points), starting at
   /// `start_m`; its block when it has one already.
   calib::BlockId AddPoint(PointIndex point, const Eigen::Vector3d& start_m);
@@ -133,6 +147,26 @@ class BlockAdjustment {
   void DefineDatum();
   /// Data snooping with the datum guard; fills result->rejected and result->snooping.
   calib::SnoopingOutcome Snoop(AdjustmentResult* result);
+  // Snoop's steps (block_adjustment_snooping.cc).
+  calib::SnoopingOptions SnoopingSettings(const std::vector<int>& image_rays) const;
+  /// The datum guard: refuses a removal that leaves a control point below two rays, an exposure
+  /// below three points (unless GNSS and IMU priors hold it) or, without GNSS centres, fewer than
+  /// three plan or height surveys; keeps the active ray counts up to date on every approval.
+  std::function<std::string(const std::vector<calib::ResidualId>&)> DatumVeto(
+      std::vector<int>* point_rays, std::vector<int>* image_rays) const;
+  void SummariseSnooping(const calib::SnoopingOutcome& out, SnoopingSummary* summary);
+  /// What to do about a suspected model error, by what the block can determine.
+  std::string SelfCalibrationSuggestion() const;
+  void RecordTested(const calib::SnoopingOutcome& out, SnoopingSummary* summary);
+  void RecordRejected(const calib::SnoopingOutcome& out, AdjustmentResult* result);
+  /// ScreenRobustly's verdict on the rays of one point (block_adjustment_screening.cc): `judged`
+  /// gets each ray's |v| / s at the point's own fit, or 0 where the final snooping decides.
+  void JudgeRaysOfPoint(PointIndex point,
+                        const std::vector<calib::ResidualId>& rays,
+                        const std::map<calib::ResidualId, double>& w_of,
+                        double scale,
+                        double reject,
+                        std::map<calib::ResidualId, double>* judged);
   /// Human name of a residual: "image 0012 point T442" or the builder's label.
   std::string Describe(calib::ResidualId id) const;
 

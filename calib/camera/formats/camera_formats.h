@@ -98,10 +98,6 @@ FileConversion ConvertCameraFile(const CameraFile& from,
                                  const FormatTarget& target,
                                  const ConvertOptions& options = {});
 
-/// The target of the formats written in OpenCV's model (opencv, ros, dji): the source itself when
-/// it is an opencv camera (exact), else a fit with 5 coefficients (coefficient_choice).
-FormatTarget OpenCvTarget(const ModelCamera& source);
-
 /// ConvertCameraFile in the simplest form of the format (issue 29): where
 /// target.coefficient_choice, the conversions with 4, 5 and 8 distortion coefficients up to
 /// `max_coefficients` (>= 4), one line each in `tried` ("5 coefficients (k1 k2 p1 p2 k3): residual
@@ -119,15 +115,42 @@ CameraFile CameraFileFromCamera(const Camera& camera);
 
 // ---- the registry (issue 30 item 7): the CLI, the tests and the fuzzers iterate it ----
 
+/// What a format keeps of a camera's covariance.
+enum class CovarianceForm {
+  kNone,    // nothing (a conversion drops it and says so)
+  kSigmas,  // the standard deviations (the diagonal): correlations dropped
+  kFull,    // the whole matrix
+};
+
+/// A registry model a format's writer takes, with what the format holds of it: the parameters the
+/// format has no field for (a camera written must have them at 0; a conversion holds them there)
+/// and its covariance. The capabilities of a format are its rows of these and nothing else: the
+/// registry's write refuses every other camera, `camera convert --model` offers these models.
+struct WritableModel {
+  CameraModelId model;
+  std::vector<std::string> zero_params;
+  CovarianceForm covariance = CovarianceForm::kNone;
+  /// A camera of another model is fitted into this one choosing 4, 5 or 8 OpenCV distortion
+  /// coefficients (FormatTarget::coefficient_choice; opencv-form models only).
+  bool fit_coefficient_choice = false;
+  /// Where the format derives parameters rather than storing them (OpenSfM's fisheye: fy = fx,
+  /// the principal point at the image centre): sets them so. CheckWritable refuses a camera this
+  /// would change; empty when the format stores every parameter it does not hold at 0.
+  std::function<void(ModelCamera*)> conform = nullptr;
+};
+
 /// One camera-file format: a new format is its file plus one row in registry.cc (or, for the
 /// OpenCV FileStorage entry that needs OpenCV, a RegisterCameraFormat call in the tool layer).
 struct CameraFormat {
   std::string name;         // the command-line name (--from, --to, --camera-format)
   std::string description;  // one line for --help
   std::function<CameraFile(const std::string& path, const CameraReadOptions&)> read;
+  /// The format's writer; in a registered row it first checks the camera against `models`
+  /// (CheckWritable: InputError naming the format and the model).
   std::function<void(const std::string& path, const CameraFile&)> write;
-  /// The model (and zero parameters) a source camera is written in by this format.
-  std::function<FormatTarget(const ModelCamera& source)> target;
+  /// The models the writer takes (see WritableModel); a camera of another model is converted
+  /// into one of them first (`target`).
+  std::vector<WritableModel> models;
   /// True when a file whose first bytes (up to kDetectBytes) are `head` and whose path is `path`
   /// is of this format (`--from auto`, and what a wrong --from names). Content first: the path
   /// only where the content cannot tell (cameras.bin).
@@ -135,8 +158,27 @@ struct CameraFormat {
   std::string extension;           // a file name ending the writer uses (tests, fuzzers)
   bool writes_size = true;         // a written file holds the image size (else --width/--height)
   bool writes_pixel_size = false;  // ... and the pixel size (else --pixel-size-mm)
-  bool holds_covariance = false;   // the writer keeps CameraFile::covariance
+  /// The model (and zero parameters) a source camera is written in. Left empty in a row, the
+  /// registry sets DefaultFormatTarget: the source's own model when the format writes it, else a
+  /// fit into models.front().
+  std::function<FormatTarget(const ModelCamera& source)> target = nullptr;
 };
+
+/// The row of `models` for `model`; nullptr when the format does not write it.
+const WritableModel* FindWritableModel(const CameraFormat& format, CameraModelId model);
+/// The names of the models a format writes, comma separated (messages, --help).
+std::string WritableModelNames(const CameraFormat& format);
+/// The target of a camera written in `model` by `format` (its zero parameters; a pixel size
+/// needed when the format writes millimetres); InputError naming the format and the model when
+/// the format does not write it.
+FormatTarget TargetInModel(const CameraFormat& format, CameraModelId model);
+/// The source's own model when `format` writes it, else a fit into the format's first model.
+FormatTarget DefaultFormatTarget(const CameraFormat& format, const ModelCamera& source);
+/// InputError ("<format> cannot hold a <model> camera (it writes ...)", or naming the parameter
+/// the format has no field for and its value) unless `format` can write `camera` as it is.
+void CheckWritable(const CameraFormat& format, const ModelCamera& camera);
+/// What `format` keeps of a covariance of a camera in `model` (kNone when it does not write it).
+CovarianceForm CovarianceHeld(const CameraFormat& format, CameraModelId model);
 
 inline constexpr size_t kDetectBytes = 1 << 16;
 
@@ -200,6 +242,9 @@ void WritePix4dXmp(const std::string& path, const CameraFile& camera);
 
 CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& options);
 void WriteOpenSfmCameras(const std::string& path, const CameraFile& camera);
+/// OpenSfM's fisheye holds one focal length and no principal point: fy = fx, (cx, cy) the image
+/// centre ((W - 1) / 2, (H - 1) / 2 in aerocal/OpenCV pixels).
+void ConformOpenSfmFisheye(ModelCamera* camera);
 
 CameraFile ReadDjiDewarpData(const std::string& path, const CameraReadOptions& options);
 /// The opencv camera of a DewarpData string ("[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" or the 12 values
@@ -252,10 +297,6 @@ double ParseNumber(const std::string& text,
                    const SourceRef& where,
                    const std::string& what,
                    double bound = 1e12);
-/// Every parameter in `names` of `camera` is zero (the format can hold the camera).
-void RequireZero(const ModelCamera& camera,
-                 const std::vector<std::string>& names,
-                 const std::string& format);
 double Param(const ModelCamera& camera, std::string_view name);
 /// A camera name as one line of text (control characters, a newline among them, become spaces):
 /// line-oriented formats put the name on a line of its own.

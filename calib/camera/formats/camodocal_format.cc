@@ -47,7 +47,6 @@ CameraFile ReadCamodocalCamera(const std::string& path, const CameraReadOptions&
 
 void WriteCamodocalCamera(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == OpenCvModel::kId) << "not opencv";
-  internal::RequireZero(file.camera, {"k3", "k4", "k5", "k6"}, "camodocal PINHOLE");
   const std::vector<double>& p = file.camera.params;
   const auto n = [](double v) { return internal::ShortestNumber(v); };
   std::ostringstream out;

@@ -209,7 +209,6 @@ CameraFile ReadDbatCameraXml(const std::string& path, const CameraReadOptions& o
 
 void WriteDbatCameraXml(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == Model::kId) << "not brown_fraser_10";
-  internal::RequireZero(file.camera, {"B2"}, "DBAT");
   const PixelFrame& f = file.camera.frame;
   const std::vector<double>& q = file.camera.params;
   // B1 as DBAT's pixel aspect (the reader's rule backwards): sensor width and pp x scaled.

@@ -65,15 +65,6 @@ double Param(const ModelCamera& camera, std::string_view name) {
                    std::string(name));
 }
 
-void RequireZero(const ModelCamera& camera,
-                 const std::vector<std::string>& names,
-                 const std::string& format) {
-  for (const std::string& name : names)
-    AEROCAL_CHECK(Param(camera, name) == 0.0)
-        << format << " cannot hold " << name << " = " << Param(camera, name)
-        << " (convert with it held at 0 first)";
-}
-
 std::string OneLine(std::string_view name) {
   std::string out(name);
   for (char& c : out)

@@ -89,7 +89,6 @@ void WriteKalibrCamchain(const std::string& path, const CameraFile& file) {
         << ", " << n(p[6]) << ", " << n(p[7]) << "]\n";
   } else {
     AEROCAL_CHECK(file.camera.model == OpenCvModel::kId) << "not opencv";
-    internal::RequireZero(file.camera, {"k3", "k4", "k5", "k6"}, "Kalibr radtan");
     out << "  distortion_model: radtan\n  distortion_coeffs: [" << n(p[4]) << ", " << n(p[5])
         << ", " << n(p[6]) << ", " << n(p[7]) << "]\n";
   }

@@ -151,6 +151,16 @@ CameraFile ReadOpenSfmCameras(const std::string& path, const CameraReadOptions& 
   return file;
 }
 
+void ConformOpenSfmFisheye(ModelCamera* camera) {
+  using F = OpenCvFisheyeModel;
+  std::vector<double>& p = camera->params;
+  p[F::kFy] = p[F::kFx];
+  p[F::kCx] = 0.5 * (camera->frame.width_px - 1);
+  p[F::kCy] = 0.5 * (camera->frame.height_px - 1);
+}
+
+// The camera is one the format holds (the registry's CheckWritable: k4-k6 of opencv, k3, k4 of the
+// fisheye at 0, the fisheye conformed by ConformOpenSfmFisheye).
 void WriteOpenSfmCameras(const std::string& path, const CameraFile& file) {
   const ModelCamera& camera = file.camera;
   const PixelFrame& f = camera.frame;
@@ -162,8 +172,6 @@ void WriteOpenSfmCameras(const std::string& path, const CameraFile& file) {
   const double c_x = (p[2] - 0.5 * (f.width_px - 1)) / size,
                c_y = (p[3] - 0.5 * (f.height_px - 1)) / size;
   if (camera.model == OpenCvFisheyeModel::kId) {
-    internal::RequireZero(camera, {"k3", "k4"}, "OpenSfM fisheye");
-    AEROCAL_CHECK(p[0] == p[1] && c_x == 0 && c_y == 0) << "OpenSfM fisheye: fx = fy, centred";
     c["projection_type"] = "fisheye";
     c["focal"] = p[0] / size;
     c["k1"] = p[4];
@@ -171,7 +179,6 @@ void WriteOpenSfmCameras(const std::string& path, const CameraFile& file) {
   } else {
     using O = OpenCvModel;
     AEROCAL_CHECK(camera.model == O::kId) << "not opencv";
-    internal::RequireZero(camera, {"k4", "k5", "k6"}, "OpenSfM");
     const bool perspective = p[O::kFx] == p[O::kFy] && c_x == 0 && c_y == 0 && p[O::kK3] == 0 &&
                              p[O::kP1] == 0 && p[O::kP2] == 0;
     if (perspective) {

@@ -123,7 +123,6 @@ CameraFile ReadPhotoModelerCamera(const std::string& path, const CameraReadOptio
 
 void WritePhotoModelerCamera(const std::string& path, const CameraFile& file) {
   AEROCAL_CHECK(file.camera.model == Model::kId) << "not brown_fraser_10";
-  internal::RequireZero(file.camera, {"B1", "B2"}, "PhotoModeler");
   const PixelFrame& f = file.camera.frame;
   const std::vector<double>& q = file.camera.params;
   const double w_mm = f.width_px * f.pixel_size_mm, h_mm = f.height_px * f.pixel_size_mm;

@@ -19,7 +19,29 @@ bool Has(const std::string& head, const char* marker) {
   return head.find(marker) != std::string::npos;
 }
 
-bool IsFisheye(const ModelCamera& c) { return c.model == CameraModelId::kOpenCvFisheye; }
+// Every registered model, with the covariance form a format keeps of each (our camera file).
+std::vector<WritableModel> EveryModel(CovarianceForm covariance) {
+  std::vector<WritableModel> models;
+  ForEachCameraModel([&](auto m) { models.push_back({decltype(m)::kId, {}, covariance}); });
+  return models;
+}
+
+// The models COLMAP has (their kColmapName, camera_model.h ColmapName).
+std::vector<WritableModel> ColmapModels() {
+  std::vector<WritableModel> models;
+  ForEachCameraModel([&](auto m) {
+    if (!ColmapName(decltype(m)::kId).empty()) models.push_back({decltype(m)::kId, {}});
+  });
+  return models;
+}
+
+// OpenCV's distortion, written as 4, 5 or 8 coefficients (opencv, dji, ros): a camera of another
+// model is fitted choosing among them.
+WritableModel OpenCvChoosingCoefficients() {
+  WritableModel opencv{CameraModelId::kOpenCv, {}};
+  opencv.fit_coefficient_choice = true;
+  return opencv;
+}
 
 // A fit into OpenCV's distortion: 5 coefficients (k1 k2 p1 p2 k3) unless the caller chooses
 // (ConvertCameraFileSimplest).
@@ -50,14 +72,11 @@ CameraFormat AerocalFormat() {
           "our camera YAML (any registry model; a rig file's head by --camera)",
           ReadAerocalCamera,
           WriteAerocalCamera,
-          [](const ModelCamera& s) {
-            return FormatTarget{s.model, {}, true};
-          },
+          EveryModel(CovarianceForm::kSigmas),  // interior_sigma
           [](const std::string& h, const std::string&) {
             return Has(h, "format_px:") && Has(h, "pixel_size_mm:");
           },
           ".yaml",
-          true,
           true,
           true};
 }
@@ -67,6 +86,13 @@ CameraFormat ColmapFormat() {
           "COLMAP cameras.txt or cameras.bin (SIMPLE_PINHOLE ... FULL_OPENCV; --camera ID)",
           ReadColmapCameras,
           WriteColmapCameras,
+          ColmapModels(),
+          [](const std::string& h, const std::string& path) {
+            return LooksLikeColmapText(h) || LooksLikeColmapBinary(h, path);
+          },
+          ".txt",
+          true,
+          false,
           [](const ModelCamera& source) {
             if (!ColmapName(source.model).empty()) return FormatTarget{source.model, {}};
             if (source.model == CameraModelId::kOpenCv) {  // exact: OPENCV when k3-k6 are 0
@@ -77,11 +103,7 @@ CameraFormat ColmapFormat() {
                   full ? CameraModelId::kColmapFullOpenCv : CameraModelId::kColmapOpenCv, {}};
             }
             return OpenCvFit(CameraModelId::kColmapFullOpenCv);
-          },
-          [](const std::string& h, const std::string& path) {
-            return LooksLikeColmapText(h) || LooksLikeColmapBinary(h, path);
-          },
-          ".txt"};
+          }};
 }
 
 CameraFormat MetashapeFormat() {
@@ -91,9 +113,7 @@ CameraFormat MetashapeFormat() {
       "sensor id)",
       ReadMetashapeCalibration,
       WriteMetashapeCalibration,
-      [](const ModelCamera&) {
-        return FormatTarget{CameraModelId::kMetashapeFrame, {}};
-      },
+      {{CameraModelId::kMetashapeFrame, {}, CovarianceForm::kFull}},
       [](const std::string& h, const std::string&) {
         // A calibration export, a cameras export, a .psx project, a .psz / .zip project archive.
         if (Has(h, "<opencv_storage>")) return false;  // OpenCV's <calibration_time>
@@ -103,8 +123,7 @@ CameraFormat MetashapeFormat() {
       },
       ".xml",
       true,
-      false,
-      true};
+      false};
 }
 
 CameraFormat Pix4dFormat() {
@@ -113,9 +132,7 @@ CameraFormat Pix4dFormat() {
           "(--camera IMAGE)",
           ReadPix4dCam,
           WritePix4dCam,
-          [](const ModelCamera&) {
-            return FormatTarget{CameraModelId::kPix4dPerspective, {}, true};
-          },
+          {{CameraModelId::kPix4dPerspective, {}}},
           [](const std::string& h, const std::string&) {
             return Has(h, "Pix4D camera calibration file") || IsPix4dCalibratedParameters(h);
           },
@@ -130,9 +147,7 @@ CameraFormat Pix4dXmpFormat() {
           "PerspectiveDistortion; a JPEG or an XMP sidecar)",
           ReadPix4dXmp,
           WritePix4dXmp,
-          [](const ModelCamera&) {
-            return FormatTarget{CameraModelId::kPix4dPerspective, {}, true};
-          },
+          {{CameraModelId::kPix4dPerspective, {}}},
           [](const std::string& h, const std::string&) { return Has(h, "PerspectiveFocalLength"); },
           ".xmp",
           true,
@@ -144,10 +159,12 @@ CameraFormat OpenSfmFormat() {
           "OpenSfM / OpenDroneMap cameras.json",
           ReadOpenSfmCameras,
           WriteOpenSfmCameras,
-          [](const ModelCamera& s) {
-            return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {"k3", "k4"}}
-                                : FormatTarget{CameraModelId::kOpenCv, {"k4", "k5", "k6"}};
-          },
+          {{CameraModelId::kOpenCv, {"k4", "k5", "k6"}},
+           {CameraModelId::kOpenCvFisheye,
+            {"k3", "k4"},
+            CovarianceForm::kNone,
+            false,
+            ConformOpenSfmFisheye}},
           [](const std::string& h, const std::string&) { return Has(h, "\"projection_type\""); },
           ".json"};
 }
@@ -157,7 +174,7 @@ CameraFormat DjiFormat() {
           "DJI XMP DewarpData / DewarpDataK6 (a DJI JPEG, an XMP sidecar or the string)",
           ReadDjiDewarpData,
           WriteDjiDewarpData,
-          OpenCvTarget,
+          {OpenCvChoosingCoefficients()},
           [](const std::string& h, const std::string&) {
             if (Has(h, "DewarpData") || Has(h, "Dewarp Data")) return true;
             // The bare string: "[date;]fx,fy,cx,cy,k1,k2,p1,p2,k3" on its first line.
@@ -176,9 +193,7 @@ CameraFormat DbatFormat() {
       "aspect, K1-K3, P1, P2 in mm)",
       ReadDbatCameraXml,
       WriteDbatCameraXml,
-      [](const ModelCamera&) {
-        return FormatTarget{CameraModelId::kBrownFraser10, {"B2"}, true};
-      },
+      {{CameraModelId::kBrownFraser10, {"B2"}}},  // B1 as DBAT's pixel aspect
       [](const std::string& h, const std::string&) {
         return ((Has(h, "<camera>") || Has(h, "<camera ")) && (Has(h, "<cc>") || Has(h, "<pp>"))) ||
                IsDbatReport(h);
@@ -194,9 +209,7 @@ CameraFormat PhotoModelerFormat() {
           "format, K1-K3, P1, P2 mm)",
           ReadPhotoModelerCamera,
           WritePhotoModelerCamera,
-          [](const ModelCamera&) {
-            return FormatTarget{CameraModelId::kBrownFraser10, {"B1", "B2"}, true};
-          },
+          {{CameraModelId::kBrownFraser10, {"B1", "B2"}}},
           [](const std::string& h, const std::string&) {
             return h.rfind("Bundle Soln", 0) == 0 || IsPhotoModelerReport(h);
           },
@@ -210,14 +223,11 @@ CameraFormat AustralisFormat() {
           "Australis camera-parameter report (C, XP, YP, K1-K3, P1, P2, B1, B2 mm)",
           ReadAustralisCamera,
           WriteAustralisCamera,
-          [](const ModelCamera&) {
-            return FormatTarget{CameraModelId::kBrownFraser10, {}, true};
-          },
+          {{CameraModelId::kBrownFraser10, {}, CovarianceForm::kSigmas}},
           [](const std::string& h, const std::string&) {
             return Has(h, "Australis") && Has(h, "Camera Parameters");
           },
           ".txt",
-          true,
           true,
           true};
 }
@@ -228,9 +238,7 @@ CameraFormat RosFormat() {
           "plumb_bob, rational_polynomial, equidistant)",
           ReadRosCameraInfo,
           WriteRosCameraInfo,
-          [](const ModelCamera& s) {
-            return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}} : OpenCvTarget(s);
-          },
+          {OpenCvChoosingCoefficients(), {CameraModelId::kOpenCvFisheye, {}}},
           [](const std::string& h, const std::string&) {
             return Has(h, "camera_matrix:") && Has(h, "rows:") && !Has(h, "opencv-matrix") &&
                    !Has(h, "model_type:");
@@ -243,9 +251,7 @@ CameraFormat CamodocalFormat() {
           "camodocal / VINS-Mono / VINS-Fusion PINHOLE camera YAML",
           ReadCamodocalCamera,
           WriteCamodocalCamera,
-          [](const ModelCamera&) {
-            return FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
-          },
+          {{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}}},
           [](const std::string& h, const std::string&) {
             return Has(h, "model_type:") && Has(h, "projection_parameters");
           },
@@ -257,14 +263,30 @@ CameraFormat KalibrFormat() {
           "Kalibr camchain YAML (pinhole radtan / equidistant)",
           ReadKalibrCamchain,
           WriteKalibrCamchain,
-          [](const ModelCamera& s) {
-            return IsFisheye(s) ? FormatTarget{CameraModelId::kOpenCvFisheye, {}}
-                                : FormatTarget{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}};
-          },
+          {{CameraModelId::kOpenCv, {"k3", "k4", "k5", "k6"}}, {CameraModelId::kOpenCvFisheye, {}}},
           [](const std::string& h, const std::string&) {
             return Has(h, "camera_model:") && Has(h, "intrinsics:");
           },
           ".yaml"};
+}
+
+// A row as the registry keeps it: the default target where the row gives none, and a writer that
+// checks the camera against the row's models first (so no writer decides what it holds).
+CameraFormat Registered(CameraFormat format) {
+  if (!format.target)
+    format.target = [rows = format](const ModelCamera& source) {
+      return DefaultFormatTarget(rows, source);
+    };
+  format.write = [checked = format, write = format.write](const std::string& path,
+                                                          const CameraFile& file) {
+    try {
+      CheckWritable(checked, file.camera);
+    } catch (const InputError& e) {
+      throw InputError(path + ": not written: " + e.what());
+    }
+    write(path, file);
+  };
+  return format;
 }
 
 std::vector<CameraFormat>& Registry() {
@@ -281,6 +303,11 @@ std::vector<CameraFormat>& Registry() {
                                               RosFormat(),
                                               CamodocalFormat(),
                                               KalibrFormat()};
+  static const bool registered = [] {
+    for (CameraFormat& f : formats) f = Registered(std::move(f));
+    return true;
+  }();
+  (void)registered;
   return formats;
 }
 
@@ -301,17 +328,76 @@ std::string Joined(const std::vector<std::string>& names) {
 
 }  // namespace
 
-FormatTarget OpenCvTarget(const ModelCamera& source) {
-  if (source.model == CameraModelId::kOpenCv) return {CameraModelId::kOpenCv, {}};
-  return OpenCvFit(CameraModelId::kOpenCv);
+const std::vector<CameraFormat>& CameraFormats() { return Registry(); }
+
+const WritableModel* FindWritableModel(const CameraFormat& format, CameraModelId model) {
+  for (const WritableModel& m : format.models)
+    if (m.model == model) return &m;
+  return nullptr;
 }
 
-const std::vector<CameraFormat>& CameraFormats() { return Registry(); }
+std::string WritableModelNames(const CameraFormat& format) {
+  std::vector<std::string> names;
+  for (const WritableModel& m : format.models) names.emplace_back(CameraModelName(m.model));
+  return Joined(names);
+}
+
+// The format's row for `model`, or InputError naming the format, the model and what it writes.
+const WritableModel& RowFor(const CameraFormat& format, CameraModelId model) {
+  const WritableModel* row = FindWritableModel(format, model);
+  if (!row)
+    throw InputError("the " + format.name + " format cannot hold a " +
+                     std::string(CameraModelName(model)) + " camera (it writes " +
+                     WritableModelNames(format) + ")");
+  return *row;
+}
+
+FormatTarget TargetInModel(const CameraFormat& format, CameraModelId model) {
+  return {model, RowFor(format, model).zero_params, format.writes_pixel_size};
+}
+
+FormatTarget DefaultFormatTarget(const CameraFormat& format, const ModelCamera& source) {
+  AEROCAL_CHECK(!format.models.empty()) << "camera format " << format.name << " writes no model";
+  if (FindWritableModel(format, source.model)) return TargetInModel(format, source.model);
+  const WritableModel& fit = format.models.front();
+  FormatTarget target =
+      fit.fit_coefficient_choice ? OpenCvFit(fit.model) : FormatTarget{fit.model, fit.zero_params};
+  target.needs_pixel_size = format.writes_pixel_size;
+  return target;
+}
+
+void CheckWritable(const CameraFormat& format, const ModelCamera& camera) {
+  const WritableModel& row = RowFor(format, camera.model);
+  const std::string model(CameraModelName(camera.model));
+  for (const std::string& name : row.zero_params)
+    if (const double value = internal::Param(camera, name); value != 0.0)
+      throw InputError("the " + format.name + " format holds no " + name + " of a " + model +
+                       " camera (must be 0, got " + FormatNumber(value) +
+                       "; convert with it held at 0)");
+  if (!row.conform) return;
+  ModelCamera conformed = camera;
+  row.conform(&conformed);
+  const std::vector<ParamInfo> table = CameraModelParams(camera.model);
+  std::string derived;
+  for (size_t i = 0; i < table.size(); ++i)
+    if (conformed.params[i] != camera.params[i])
+      derived += (derived.empty() ? "" : ", ") + std::string(table[i].name) + " = " +
+                 FormatNumber(camera.params[i]) + " (it holds " +
+                 FormatNumber(conformed.params[i]) + ")";
+  if (!derived.empty())
+    throw InputError("the " + format.name + " format cannot hold this " + model +
+                     " camera: it derives " + derived);
+}
+
+CovarianceForm CovarianceHeld(const CameraFormat& format, CameraModelId model) {
+  const WritableModel* row = FindWritableModel(format, model);
+  return row ? row->covariance : CovarianceForm::kNone;
+}
 
 void RegisterCameraFormat(CameraFormat format) {
   for (const CameraFormat& f : Registry())
     AEROCAL_CHECK(f.name != format.name) << "camera format " << format.name << " registered twice";
-  Registry().push_back(std::move(format));
+  Registry().push_back(Registered(std::move(format)));
 }
 
 std::string CameraFormatNames() {
@@ -357,6 +443,11 @@ void WriteCameraFileVerified(const CameraFormat& format,
   namespace fs = std::filesystem;
   const fs::path target(path);
   const fs::path scratch = target.parent_path() / (".aerocal_check_" + target.filename().string());
+  try {
+    CheckWritable(format, file.camera);  // before the scratch write, naming `path`
+  } catch (const InputError& e) {
+    throw InputError(path + ": not written: " + e.what());
+  }
   format.write(scratch.string(), file);
   std::string problem;
   try {
