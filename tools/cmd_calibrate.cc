@@ -18,11 +18,13 @@
 namespace aerocal::tools {
 namespace {
 
-CommandRun SetupCalibrate(CLI::App& app) {
-  struct Args : CalibrateRequest {
-    std::string directions;
-  };
-  auto args = std::make_shared<Args>();
+// The command's options: the request of a test field or board, or a directions file.
+struct CalibrateArgs : CalibrateRequest {
+  std::string directions;
+};
+
+// The marks (a test field, a board, known directions) and the camera.
+void AddCalibrateInputs(CLI::App& app, CalibrateArgs* args) {
   app.add_option("--camera",
                  args->camera,
                  "Camera file (FORMATS.md): pixel size, format and an approximate c")
@@ -43,6 +45,10 @@ CommandRun SetupCalibrate(CLI::App& app) {
                  args->directions,
                  "Laboratory calibration from known directions: a collimator array or a goniometer "
                  "sequence (CSV target,col,row,... of docs/formats.md 'Directions file')");
+}
+
+// What is calibrated and how its uncertainty is stated.
+void AddCalibrateModelOptions(CLI::App& app, CalibrateArgs* args) {
   app.add_option("--self-calibration",
                  args->self_calibration,
                  "Interior parameters calibrated, names of the camera file's model: all, or a "
@@ -76,7 +82,10 @@ CommandRun SetupCalibrate(CLI::App& app) {
          "Image sigma where observations.csv or the directions file has no sigma_px, and of "
          "detected marks, px")
       ->check(PositiveUpTo(100));
-  // Options of the test field / board only: refused by name with --directions.
+}
+
+// Options of the test field / board only: refused by name with --directions.
+std::vector<CLI::Option*> AddFieldOnlyOptions(CLI::App& app, CalibrateArgs* args) {
   std::vector<CLI::Option*> field_only = {app.get_option("--groups")};
   field_only.push_back(
       app.add_option("--board-sigma-mm",
@@ -95,6 +104,10 @@ CommandRun SetupCalibrate(CLI::App& app) {
       app.add_option("--write-marks",
                      args->write_marks,
                      "Write the detected marks as DIR/observations.csv and DIR/points.csv"));
+  return field_only;
+}
+
+void AddCalibrateOutputs(CLI::App& app, CalibrateArgs* args) {
   app.add_option(
          "--out", args->out, "Output file: the result JSON (keys of `adjust` plus `calibration`)")
       ->required();
@@ -105,36 +118,46 @@ CommandRun SetupCalibrate(CLI::App& app) {
                  args->camera_format,
                  "Format of --write-camera: " + CameraFormatNames() +
                      " (converted into the format's model where it differs, with its residual)");
-  return [args, field_only]() {
-    const bool field = !args->observations.empty() || !args->points.empty();
-    const bool board = !args->images.empty() || !args->board.empty();
-    if (!args->directions.empty()) {
-      if (field || board)
-        throw ConfigError(
-            "--directions: give either --directions, or --observations and --points, or "
-            "--images and --board");
-      for (const CLI::Option* o : field_only)
-        if (o->count() > 0)
-          throw ConfigError(o->get_name() +
-                            ": not an option of a direction calibration (--directions)");
-      return CalibrateFromDirectionsFile({args->camera,
-                                          args->directions,
-                                          args->budget,
-                                          args->out,
-                                          args->write_camera,
-                                          args->camera_format,
-                                          args->self_calibration,
-                                          args->model,
-                                          args->sigma_px,
-                                          args->radii_mm});
-    }
-    const CalibrateOutcome outcome = RunCalibration(*args);
-    std::printf("%s", outcome.printed.c_str());
-    std::fprintf(stderr, "%s", outcome.errors.c_str());
-    WriteResult(args->out, "adjust", outcome.doc);
-    std::printf("result -> %s\n", args->out.c_str());
-    return outcome.valid ? kExitOk : kExitNotConverged;
-  };
+}
+
+int RunCalibrate(const CalibrateArgs& args, const std::vector<CLI::Option*>& field_only) {
+  const bool field = !args.observations.empty() || !args.points.empty();
+  const bool board = !args.images.empty() || !args.board.empty();
+  if (!args.directions.empty()) {
+    if (field || board)
+      throw ConfigError(
+          "--directions: give either --directions, or --observations and --points, or "
+          "--images and --board");
+    for (const CLI::Option* o : field_only)
+      if (o->count() > 0)
+        throw ConfigError(o->get_name() +
+                          ": not an option of a direction calibration (--directions)");
+    return CalibrateFromDirectionsFile({args.camera,
+                                        args.directions,
+                                        args.budget,
+                                        args.out,
+                                        args.write_camera,
+                                        args.camera_format,
+                                        args.self_calibration,
+                                        args.model,
+                                        args.sigma_px,
+                                        args.radii_mm});
+  }
+  const CalibrateOutcome outcome = RunCalibration(args);
+  std::printf("%s", outcome.printed.c_str());
+  std::fprintf(stderr, "%s", outcome.errors.c_str());
+  WriteResult(args.out, "adjust", outcome.doc);
+  std::printf("result -> %s\n", args.out.c_str());
+  return outcome.valid ? kExitOk : kExitNotConverged;
+}
+
+CommandRun SetupCalibrate(CLI::App& app) {
+  auto args = std::make_shared<CalibrateArgs>();
+  AddCalibrateInputs(app, args.get());
+  AddCalibrateModelOptions(app, args.get());
+  const std::vector<CLI::Option*> field_only = AddFieldOnlyOptions(app, args.get());
+  AddCalibrateOutputs(app, args.get());
+  return [args, field_only]() { return RunCalibrate(*args, field_only); };
 }
 
 }  // namespace
