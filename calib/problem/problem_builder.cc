@@ -8,6 +8,7 @@
 #include "calib/problem/parallel_for.h"
 #include "calib/problem/rotation_manifold.h"
 #include "calib/problem/scaled_subset_manifold.h"
+#include "calib/problem/smallest_eigenpairs.h"
 
 #include <Eigen/Dense>
 #include <Eigen/Sparse>
@@ -798,18 +799,36 @@ void ProblemBuilder::AddSolveStatistics(SolveReport* report_ptr) const {
 }
 
 namespace {
-// The names of the parameters that the eigenvectors of (scaled) `n` with eigenvalues below
-// 1e-12 of the largest involve (|component| > 0.2).
-std::set<std::string> NullSpaceNames(Eigen::MatrixXd n, const std::vector<std::string>& names) {
-  Eigen::VectorXd d = n.diagonal().cwiseSqrt();
+// The smallest eigenpairs of the Jacobi-scaled reduced matrix that NullSpace reports: the 16
+// smallest and every one below `relative_threshold` x the largest (the count doubled while all
+// of those found are below it). Iterative (smallest_eigenpairs.h) above `dense_limit` rows, dense
+// at or below it and wherever the iteration fails.
+internal::SymmetricEigenpairs SmallestNullSpaceEigenpairs(const Eigen::SparseMatrix<double>& m,
+                                                          double relative_threshold,
+                                                          int dense_limit) {
+  const int n = static_cast<int>(m.rows());
+  for (int count = std::min(n, 16);; count = std::min(n, 2 * count)) {
+    const internal::SymmetricEigenpairs eig = internal::SmallestEigenpairs(m, count, dense_limit);
+    if (!eig.ok) return internal::DenseEigenpairs(m);
+    const int below =
+        static_cast<int>((eig.values.array() <= relative_threshold * eig.largest).count());
+    if (below < count || count == n) return eig;
+  }
+}
+
+// The names of the parameters that the eigenvectors of (Jacobi-scaled) `lower` with eigenvalues
+// below 1e-12 of the largest involve (|component| > 0.2); the smallest eigenpairs only.
+std::set<std::string> NullSpaceNames(const Eigen::SparseMatrix<double>& lower,
+                                     const std::vector<std::string>& names,
+                                     int dense_limit) {
+  Eigen::VectorXd d = lower.diagonal().cwiseSqrt();
   for (int i = 0; i < d.size(); ++i) d(i) = d(i) > 0 ? 1.0 / d(i) : 1.0;
-  n = d.asDiagonal() * n * d.asDiagonal();
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(n);
-  const double max_eig = eig.eigenvalues().maxCoeff();
+  const Eigen::SparseMatrix<double> m = d.asDiagonal() * lower * d.asDiagonal();
+  const internal::SymmetricEigenpairs eig = SmallestNullSpaceEigenpairs(m, 1e-12, dense_limit);
   std::set<std::string> out;
-  for (int k = 0; k < eig.eigenvalues().size(); ++k) {
-    if (eig.eigenvalues()(k) > 1e-12 * max_eig) break;  // ascending order
-    const Eigen::VectorXd v = eig.eigenvectors().col(k);
+  for (int k = 0; k < eig.values.size(); ++k) {
+    if (eig.values(k) > 1e-12 * eig.largest) break;  // ascending order
+    const Eigen::VectorXd v = eig.vectors.col(k);
     for (int i = 0; i < v.size(); ++i)
       if (std::abs(v(i)) > 0.2) out.insert(names[i]);
   }
@@ -980,8 +999,8 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
       for (int e : blocks_[blocks[b]].TangentEntries())
         names.push_back(blocks_[blocks[b]].EntryName(e));
     }
-    const Eigen::MatrixXd s = Eigen::MatrixXd(schur->s_lower()).selfadjointView<Eigen::Lower>();
-    const std::set<std::string> reduced = NullSpaceNames(s, names);
+    const std::set<std::string> reduced =
+        NullSpaceNames(schur->s_lower(), names, dense_null_space_limit_);
     out.insert(reduced.begin(), reduced.end());
     return {out.begin(), out.end()};
   }
@@ -989,7 +1008,10 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
   std::vector<std::string> names;
   for (BlockId b : free_blocks)
     for (int e : blocks_[b].TangentEntries()) names.push_back(blocks_[b].EntryName(e));
-  const std::set<std::string> out = NullSpaceNames(j.transpose() * j, names);
+  const Eigen::SparseMatrix<double> sparse_j = j.sparseView();
+  const Eigen::SparseMatrix<double> n =
+      (sparse_j.transpose() * sparse_j).triangularView<Eigen::Lower>();
+  const std::set<std::string> out = NullSpaceNames(n, names, dense_null_space_limit_);
   return {out.begin(), out.end()};
 }
 
@@ -1026,22 +1048,23 @@ NullSpaceReport ProblemBuilder::NullSpace(double relative_threshold, int max_par
     report.ok = true;
     return report;
   }
-  Eigen::MatrixXd s = Eigen::MatrixXd(schur->s_lower()).selfadjointView<Eigen::Lower>();
-  Eigen::VectorXd d = s.diagonal().cwiseSqrt();
+  // Jacobi scaling D S D, D = diag(S)^-1/2 (1 where S_ee = 0).
+  Eigen::VectorXd d = schur->s_lower().diagonal().cwiseSqrt();
   for (int i = 0; i < n; ++i) d(i) = d(i) > 0 ? 1.0 / d(i) : 1.0;
-  s = d.asDiagonal() * s * d.asDiagonal();
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eig(s);
-  const double max_eig = eig.eigenvalues().maxCoeff();
+  const Eigen::SparseMatrix<double> scaled_s = d.asDiagonal() * schur->s_lower() * d.asDiagonal();
+  const internal::SymmetricEigenpairs eig =
+      SmallestNullSpaceEigenpairs(scaled_s, relative_threshold, dense_null_space_limit_);
+  const double max_eig = eig.largest;
   if (!(max_eig > 0)) {
     report.message = "the normal matrix is zero";
     return report;
   }
-  for (int k = 0; k < n && k < 16; ++k)
-    report.smallest_relative_eigenvalues.push_back(eig.eigenvalues()(k) / max_eig);
-  while (report.rank_defect < n &&
-         eig.eigenvalues()(report.rank_defect) <= relative_threshold * max_eig)
+  for (int k = 0; k < eig.values.size() && k < 16; ++k)
+    report.smallest_relative_eigenvalues.push_back(eig.values(k) / max_eig);
+  while (report.rank_defect < eig.values.size() &&
+         eig.values(report.rank_defect) <= relative_threshold * max_eig)
     ++report.rank_defect;
-  const Eigen::MatrixXd w = eig.eigenvectors().leftCols(report.rank_defect);
+  const Eigen::MatrixXd w = eig.vectors.leftCols(report.rank_defect);
   for (size_t b = 0; b < free_blocks.size(); ++b) {
     if (schur->is_point(static_cast<int>(b))) continue;
     const BlockId id = free_blocks[b];

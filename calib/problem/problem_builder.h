@@ -186,7 +186,7 @@ struct CovarianceReport {
 
 /// The null space of the normal matrix N = J^T J at the current values (loss not applied), the
 /// ground points eliminated (Schur complement; a point block is never part of a null vector here:
-/// a weighted point is determined once the other parameters are). From the eigen-decomposition of
+/// a weighted point is determined once the other parameters are). From the smallest eigenpairs of
 /// the Jacobi-scaled reduced matrix D S D (D = diag(S)^-1/2): the eigenvectors whose eigenvalue is
 /// below `relative_threshold` x the largest, mapped back to AMBIENT block entries (d = D w through
 /// each block's manifold). Used to derive a minimal datum (e.g. triangulation/pushbroom).
@@ -283,8 +283,13 @@ class ProblemBuilder {
                                       const std::vector<BlockId>& cross_blocks = {}) const;
 
   /// The null space of the normal matrix at the current state (NullSpaceReport); not computed
-  /// (ok false) above `max_parameters` reduced parameters (dense eigen-decomposition).
+  /// (ok false) above `max_parameters` reduced parameters. Only the smallest eigenpairs are
+  /// computed (shift-invert subspace iteration, smallest_eigenpairs.h); dense up to
+  /// SetDenseNullSpaceLimit parameters and wherever the iteration fails.
   NullSpaceReport NullSpace(double relative_threshold, int max_parameters = 3000) const;
+  /// Reduced matrices up to `parameters` (default 200) are eigen-decomposed densely by NullSpace,
+  /// larger ones iteratively. For tests that compare the two on one problem.
+  void SetDenseNullSpaceLimit(int parameters) { dense_null_space_limit_ = parameters; }
 
   /// Cofactors of the listed (active) residuals at the current values, loss not applied:
   /// redundancy numbers r_ii of every scalar component and, with `with_clusters`, Q_vv among the
@@ -370,6 +375,7 @@ class ProblemBuilder {
   std::map<std::string, BlockId> block_by_name_;
   std::map<const double*, BlockId> block_by_pointer_;
   int dense_inverse_limit_ = 300;
+  int dense_null_space_limit_ = 200;
   /// Bumped by every change of the problem other than parameter values (blocks, residuals,
   /// fixing, manifold scales at each Solve): part of a kept factorisation's state.
   long long structure_version_ = 0;

@@ -7,6 +7,7 @@
 
 #include "calib/camera/camera.h"
 #include "calib/problem/data_snooping.h"
+#include "calib/problem/smallest_eigenpairs.h"
 #include "calib/residuals/autodiff_residual.h"
 #include "calib/residuals/collinearity.h"
 
@@ -287,6 +288,117 @@ TEST(ProblemBuilder, DatumDefectIsReportedWithTheParametersInvolved) {
   bool names_a_center = false;
   for (const auto& n : cov.undetermined) names_a_center |= n.rfind("center", 0) == 0;
   EXPECT_TRUE(names_a_center) << cov.message;
+}
+
+// The singular values of a matrix divided by the largest (invariant under an orthogonal change of
+// the null-space basis: what a caller derives from a block's rows of the null vectors).
+Eigen::VectorXd RelativeSingularValues(const Eigen::MatrixXd& m) {
+  const Eigen::VectorXd sv = Eigen::JacobiSVD<Eigen::MatrixXd>(m).singularValues();
+  return sv(0) > 0 ? Eigen::VectorXd(sv / sv(0)) : sv;
+}
+
+TEST(ProblemBuilder, NullSpaceIterativeEqualsTheDenseDecomposition) {
+  // A free network of 30 exposures on a ring (180 reduced parameters, points eliminated): the
+  // null space from the smallest eigenpairs (shift-invert subspace iteration) against the dense
+  // eigen-decomposition of the same matrix: the same rank defect (the 7 of a similarity), the
+  // same eigenvalues above it, the same span, and per block the same reach into it.
+  const TestField f = MakeTestField();
+  std::vector<Eigen::Vector4d> rotations;
+  std::vector<Eigen::Vector3d> centers, opks;
+  for (int k = 0; k < 30; ++k) {
+    const double a = 2 * M_PI * k / 30;
+    centers.emplace_back(8.0 * std::cos(a), 8.0 * std::sin(a), 14.0 + (k % 3));
+    opks.push_back(LookAt(centers.back(), {0, 0, 1.5}, 0.3 * (k % 5)));
+    rotations.push_back(QuaternionFromOpk(opks.back()));
+  }
+  std::vector<Eigen::Vector3d> points = f.points;
+  InteriorParams interior = f.camera.interior;
+  ProblemBuilder builder;
+  const BlockId ib = builder.AddBlock("interior", interior.data(), 10, BlockKind::kInterior);
+  builder.FixBlock(ib);
+  std::vector<BlockId> pb(points.size(), -1), ob, cb;
+  const PixelFrame frame{f.camera.pixel_size_mm, f.camera.width_px, f.camera.height_px};
+  for (size_t i = 0; i < centers.size(); ++i) {
+    ob.push_back(builder.AddRotationBlock("opk" + std::to_string(i), rotations[i].data()));
+    cb.push_back(
+        builder.AddBlock("center" + std::to_string(i), centers[i].data(), 3, BlockKind::kCenter));
+  }
+  for (size_t i = 0; i < centers.size(); ++i)
+    for (size_t p = 0; p < points.size(); ++p) {
+      Eigen::Vector2d px;
+      if (!f.camera.ProjectToPixel(opks[i], centers[i], points[p], &px) || px.x() < 0 ||
+          px.y() < 0 || px.x() > f.camera.width_px - 1 || px.y() > f.camera.height_px - 1)
+        continue;
+      if (pb[p] < 0)  // only observed points (a block without residuals is not in the problem)
+        pb[p] = builder.AddBlock(
+            "point" + std::to_string(p), points[p].data(), 3, BlockKind::kGroundPoint);
+      builder.AddResidual(
+          kGroupImage, CollinearityResidual::Create(frame, px, 0.2), {ib, ob[i], cb[i], pb[p]});
+    }
+  ASSERT_TRUE(builder.Solve({}).usable);  // sets the manifolds up (noise-free: at the truth)
+  builder.SetDenseNullSpaceLimit(100000);
+  const NullSpaceReport dense = builder.NullSpace(1e-10);
+  builder.SetDenseNullSpaceLimit(0);
+  const NullSpaceReport iterative = builder.NullSpace(1e-10);
+  ASSERT_TRUE(dense.ok) << dense.message;
+  ASSERT_TRUE(iterative.ok) << iterative.message;
+  EXPECT_EQ(dense.reduced_parameters, 180);
+  EXPECT_EQ(dense.rank_defect, 7);
+  EXPECT_EQ(iterative.rank_defect, 7);
+  ASSERT_EQ(iterative.smallest_relative_eigenvalues.size(), 16u);
+  for (int k = 0; k < 16; ++k) {
+    const double a = iterative.smallest_relative_eigenvalues[k];
+    const double b = dense.smallest_relative_eigenvalues[k];
+    if (k < 7)
+      EXPECT_LT(std::abs(a), 1e-13) << k;  // rounding noise of a null eigenvalue, both ways
+    else
+      EXPECT_NEAR(a, b, 1e-9 * b) << k;
+  }
+  // The span: the dense null vectors (ambient, every block stacked) reproduce the iterative ones.
+  Eigen::MatrixXd v_dense(0, 7), v_iterative(0, 7);
+  auto append = [](Eigen::MatrixXd* stack, const Eigen::MatrixXd& rows) {
+    stack->conservativeResize(stack->rows() + rows.rows(), Eigen::NoChange);
+    stack->bottomRows(rows.rows()) = rows;
+  };
+  for (const auto& [id, v] : dense.vectors) {
+    ASSERT_TRUE(iterative.vectors.count(id));
+    append(&v_dense, v);
+    append(&v_iterative, iterative.vectors.at(id));
+    EXPECT_TRUE(
+        RelativeSingularValues(v).isApprox(RelativeSingularValues(iterative.vectors.at(id)), 1e-8))
+        << builder.BlockName(id);
+  }
+  const Eigen::MatrixXd coefficients = v_dense.colPivHouseholderQr().solve(v_iterative);
+  EXPECT_LT((v_dense * coefficients - v_iterative).norm(), 1e-9 * v_iterative.norm());
+  for (const BlockId b : cb) {
+    ASSERT_TRUE(iterative.scaled.count(b));
+    EXPECT_TRUE(RelativeSingularValues(dense.scaled.at(b))
+                    .isApprox(RelativeSingularValues(iterative.scaled.at(b)), 1e-8));
+    EXPECT_TRUE(dense.scale.at(b).isApprox(iterative.scale.at(b), 1e-14));
+  }
+}
+
+TEST(SmallestEigenpairs, PathLaplacianAgainstItsClosedForm) {
+  // The Laplacian of a path of n nodes: eigenvalues 2 - 2 cos(k pi / n), k = 0 .. n - 1; the
+  // null space is the constant vector. The 16 smallest by the iteration, to 1e-12 of the largest.
+  const int n = 400;
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int i = 0; i < n; ++i) {
+    entries.emplace_back(i, i, (i == 0 || i == n - 1) ? 1.0 : 2.0);
+    if (i > 0) entries.emplace_back(i, i - 1, -1.0);
+  }
+  Eigen::SparseMatrix<double> lower(n, n);
+  lower.setFromTriplets(entries.begin(), entries.end());
+  const internal::SymmetricEigenpairs eig = internal::SmallestEigenpairs(lower, 16, 0);
+  ASSERT_TRUE(eig.ok);
+  EXPECT_GT(eig.iterations, 0);
+  // The path's largest eigenvalues are a tight cluster (spacing ~ 1e-4): Lanczos' largest Ritz
+  // value lands on an eigenvalue of it, 1e-7 below the largest (a ratio the reports can bear).
+  EXPECT_NEAR(eig.largest, 2.0 - 2.0 * std::cos((n - 1) * M_PI / n), 1e-6);
+  for (int k = 0; k < 16; ++k)
+    EXPECT_NEAR(eig.values(k), 2.0 - 2.0 * std::cos(k * M_PI / n), 1e-12 * eig.largest) << k;
+  const Eigen::VectorXd constant = Eigen::VectorXd::Constant(n, 1.0 / std::sqrt(n));
+  EXPECT_NEAR(std::abs(eig.vectors.col(0).dot(constant)), 1.0, 1e-12);
 }
 
 // y = a t + b (t + 1e-3 t^2): a and b are almost indistinguishable.
