@@ -444,6 +444,12 @@ Eigen::MatrixXd ProblemBuilder::DenseJacobian(const std::vector<BlockId>& blocks
   return dense;
 }
 
+bool ProblemBuilder::RotationManifoldsSet() const {
+  for (BlockId id : FreeBlocksInOrder())
+    if (blocks_[id].rotation && blocks_[id].rotation_manifold == nullptr) return false;
+  return true;
+}
+
 bool ProblemBuilder::UpdateManifolds() {
   // Tangent scaling: unit Jacobian columns at the current values (scaled_subset_manifold.h).
   // One manifold per block: a new one only when its free entries change (Ceres keeps every
@@ -981,6 +987,7 @@ std::map<ResidualId, std::vector<double>> ProblemBuilder::RedundancyNumbers(
 }
 
 std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters) const {
+  if (!RotationManifoldsSet()) return {};  // not solved yet: nothing is known about the rank
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   if (NumFreeParameters() > max_parameters) {
     // Large blocks: the datum defect lives in the exterior / interior parameters; find it in the
@@ -1030,6 +1037,10 @@ Eigen::MatrixXd ProblemBuilder::PlusJacobianOf(BlockId id) const {
 NullSpaceReport ProblemBuilder::NullSpace(double relative_threshold, int max_parameters) const {
   NullSpaceReport report;
   report.threshold = relative_threshold;
+  if (!RotationManifoldsSet()) {  // before the first Solve the rotations have no tangent space
+    report.message = "the problem has not been solved yet (Solve sets up the rotations' manifolds)";
+    return report;
+  }
   std::vector<BlockId> free_blocks;
   std::vector<int> first_row;
   const auto schur = BuildSchurComplement(false, &free_blocks, &first_row);

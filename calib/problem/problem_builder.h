@@ -285,7 +285,8 @@ class ProblemBuilder {
   /// The null space of the normal matrix at the current state (NullSpaceReport); not computed
   /// (ok false) above `max_parameters` reduced parameters. Only the smallest eigenpairs are
   /// computed (shift-invert subspace iteration, smallest_eigenpairs.h); dense up to
-  /// SetDenseNullSpaceLimit parameters and wherever the iteration fails.
+  /// SetDenseNullSpaceLimit parameters and wherever the iteration fails. Not computed (ok false)
+  /// before the first Solve, which sets up the rotations' tangent manifolds.
   NullSpaceReport NullSpace(double relative_threshold, int max_parameters = 3000) const;
   /// Reduced matrices up to `parameters` (default 200) are eigen-decomposed densely by NullSpace,
   /// larger ones iteratively. For tests that compare the two on one problem.
@@ -326,6 +327,9 @@ class ProblemBuilder {
   /// Subset manifolds of the free entries, columns scaled to unit Jacobian norm at the current
   /// values; false when the residuals cannot be evaluated there (then the scales are 1).
   bool UpdateManifolds();
+  /// Every free rotation block has its tangent manifold (set up by Solve through
+  /// UpdateManifolds): the reduced system's rotation columns exist only then.
+  bool RotationManifoldsSet() const;
   /// v^T P v per group and overall without the loss function, observations, unknowns,
   /// redundancy and sigma0 (a diagnostic when there is no redundancy) at the current values.
   void AddSolveStatistics(SolveReport* report) const;

@@ -335,6 +335,10 @@ TEST(ProblemBuilder, NullSpaceIterativeEqualsTheDenseDecomposition) {
       builder.AddResidual(
           kGroupImage, CollinearityResidual::Create(frame, px, 0.2), {ib, ob[i], cb[i], pb[p]});
     }
+  // Before the first Solve the rotations have no tangent space: a message, not a crash.
+  const NullSpaceReport unsolved = builder.NullSpace(1e-10);
+  EXPECT_FALSE(unsolved.ok);
+  EXPECT_NE(unsolved.message.find("not been solved"), std::string::npos) << unsolved.message;
   ASSERT_TRUE(builder.Solve({}).usable);  // sets the manifolds up (noise-free: at the truth)
   builder.SetDenseNullSpaceLimit(100000);
   const NullSpaceReport dense = builder.NullSpace(1e-10);
