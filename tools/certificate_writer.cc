@@ -15,6 +15,7 @@
 #include "calib/core/string_printf.h"
 #include "calib/core/yaml_util.h"
 #include "tools/command_registry.h"
+#include "tools/dynamic_resolution.h"
 #include "tools/observation_tables.h"
 #include "tools/output_set.h"
 #include "tools/python_script.h"
@@ -354,116 +355,6 @@ auto ReadTyped(const std::string& path, const char* option, Read&& read) -> decl
   } catch (const nlohmann::json::exception& e) {
     throw InputError(path + ": not a result written by aerocal (" + option + "): " + e.what());
   }
-}
-
-// Copies `keys` of `from` that exist into `to` (the quality results' values, not recomputed).
-void CopyKeys(const nlohmann::json& from,
-              nlohmann::json* to,
-              std::initializer_list<const char*> keys) {
-  for (const char* key : keys)
-    if (from.contains(key)) (*to)[key] = from[key];
-}
-
-// A Siemens star's reading (`quality star`): its limiting frequency.
-nlohmann::json StarJson(const nlohmann::json& doc, const std::string& path) {
-  nlohmann::json star = {{"source", path}};
-  CopyKeys(doc,
-           &star,
-           {"method",
-            "star",
-            "options",
-            "reference_modulation",
-            "rings",
-            "limiting_frequency_cy_px",
-            "limit_in_range",
-            "limiting_radius_px",
-            "limiting_lp_per_mm",
-            "limiting_resolved_distance_m"});
-  return star;
-}
-
-// A bar target's reading (`quality bars`): its limiting frequency.
-nlohmann::json BarsJson(const nlohmann::json& doc, const std::string& path) {
-  nlohmann::json bars = {{"source", path}};
-  CopyKeys(doc,
-           &bars,
-           {"method",
-            "options",
-            "reference_modulation",
-            "groups",
-            "limiting_frequency_cy_px",
-            "limit_in_range",
-            "limiting_lp_per_mm",
-            "limiting_resolved_distance_m"});
-  return bars;
-}
-
-// A slanted-edge reading (`quality mtf`) into `section`: its method, every edge's MTF50 with U,
-// MTF at Nyquist and the curve, and per axis the repeated edges combined.
-void AddMtf(const nlohmann::json& doc, const std::string& path, nlohmann::json* section) {
-  (*section)["method"] = doc.at("method");
-  for (const auto& e : doc.at("edges")) {
-    nlohmann::json edge = {{"source", path}};
-    CopyKeys(e,
-             &edge,
-             {"roi",
-              "axis",
-              "direction",
-              "angle_deg",
-              "mtf50_cy_px",
-              "mtf50_expanded_cy_px",
-              "coverage_factor",
-              "mtf_nyquist",
-              "mtf50_lp_per_mm",
-              "mtf50_lp_per_mm_expanded",
-              "mtf50_resolved_distance_m",
-              "mtf50_resolved_distance_expanded_m",
-              "curve",
-              "budget"});
-    (*section)["edges"].push_back(edge);
-  }
-  for (const auto& [axis, c] : doc.at("axes").items()) {
-    nlohmann::json combined = {{"source", path}, {"axis", axis}};
-    CopyKeys(c,
-             &combined,
-             {"direction",
-              "count",
-              "mtf50_cy_px",
-              "type_a_u_cy_px",
-              "type_b_u_cy_px",
-              "mtf50_expanded_cy_px",
-              "mtf50_lp_per_mm",
-              "mtf50_lp_per_mm_expanded",
-              "mtf50_resolved_distance_m",
-              "mtf50_resolved_distance_expanded_m"});
-    (*section)["axes"].push_back(combined);
-  }
-}
-
-// The "dynamic image resolution" section from `aerocal quality` results: per edge the slanted-edge
-// MTF50 with U (and its units), MTF at Nyquist and the curve; per axis the repeated edges combined;
-// per bar target and per Siemens star the limiting frequency. Values are copied, nothing is
-// recomputed.
-nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
-  nlohmann::json section = {{"sources", paths},
-                            {"edges", nlohmann::json::array()},
-                            {"axes", nlohmann::json::array()},
-                            {"bars", nlohmann::json::array()},
-                            {"stars", nlohmann::json::array()}};
-  for (const std::string& path : paths) {
-    const nlohmann::json doc =
-        ReadResult(path, {"quality_mtf", "quality_bars", "quality_star"}, "`aerocal quality`");
-    ReadTyped(path, "--quality", [&] {
-      if (doc.at("kind") == "quality_star")
-        section["stars"].push_back(StarJson(doc, path));
-      else if (doc.at("kind") == "quality_bars")
-        section["bars"].push_back(BarsJson(doc, path));
-      else
-        AddMtf(doc, path, &section);
-      return 0;
-    });
-  }
-  return section;
 }
 
 // The samples of the distortion figure (distortion_figure.h) from the certified camera: its model

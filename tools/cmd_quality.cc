@@ -51,6 +51,8 @@ struct GroundArgs {
 
 struct MtfArgs {
   std::string image, out, flight_axis;
+  std::string sub_image;  // the raw sub-image / head the image shows ("" = not a raw image)
+  bool virtual_image = false;
   std::vector<std::string> rois;
   double gamma = 1.0;
   int oversampling = 4;
@@ -187,6 +189,10 @@ int RunMtf(const MtfArgs& args) {
                         {"determined", determined}};
   args.ground.Write(&doc);
   if (!args.flight_axis.empty()) doc["flight_axis"] = args.flight_axis;
+  // Which image of a multi-CCD / multi-head camera: the resampling loss (virtual against the raw
+  // sub-images' mean, tools/dynamic_resolution.h) compares results by it.
+  if (!args.sub_image.empty()) doc["image_kind"] = "raw", doc["sub_image"] = args.sub_image;
+  if (args.virtual_image) doc["image_kind"] = "virtual";
   WriteResult(args.out, "quality_mtf", doc);
   return determined ? kExitOk : kExitNotConverged;
 }
@@ -388,6 +394,16 @@ CommandRun Setup(CLI::App& app) {
                 "Image axis of the flight direction (x or y): names "
                 "each MTF along or across track")
       ->check(CLI::IsMember({"x", "y"}));
+  CLI::Option* sub_image = m->add_option(
+      "--sub-image",
+      mtf->sub_image,
+      "The image is a raw sub-image (CCD) or head of this id: its MTF50 enters the raw mean the "
+      "resampling loss is taken from");
+  m->add_flag("--virtual",
+              mtf->virtual_image,
+              "The image is the stitched / resampled virtual image: its MTF50 is compared with the "
+              "raw sub-images' mean (the resampling loss)")
+      ->excludes(sub_image);
   m->add_option(
        "--out", mtf->out, "Output file: the result JSON (kind quality_mtf, written atomically)")
       ->required();

@@ -9,6 +9,7 @@
 #include "tools/camera_formats.h"
 #include "tools/certificate_writer.h"
 #include "tools/command_registry.h"
+#include "tools/dynamic_resolution.h"
 #include "tools/observation_tables.h"
 #include "tools/option_ranges.h"
 #include "tools/output_set.h"
@@ -83,11 +84,11 @@ void AddFlightOptions(CLI::App& app, const std::shared_ptr<FlightArgs>& args) {
   app.add_option("--lab", args->lab, "Lab YAML of the certificate (as `aerocal certificate --lab`)")
       ->needs("--certificate");
   app.add_option(
-         "--quality",
-         args->quality,
-         "Results of `aerocal quality mtf|bars|star` on this flight's images: the certificate's "
-         "dynamic image resolution section (as `aerocal certificate --quality`); repeatable")
-      ->needs("--certificate");
+      "--quality",
+      args->quality,
+      "Results of `aerocal quality mtf|bars|star` on this flight's images: the dynamic image "
+      "resolution section of result.json and report.html (and of the certificate, as `aerocal "
+      "certificate --quality`); repeatable");
 }
 
 void PrepareFlight(FlightArgs* args) {
@@ -141,6 +142,9 @@ int RunFlight(const FlightArgs& args) {
   const std::string json_path = set.Staged("result.json");
   nlohmann::json document = result.document;
   document["aerocal_version"] = AEROCAL_VERSION;
+  // The resolution targets' results, as the certificate has them, for report.html (issue 36).
+  if (!args.quality.empty())
+    document["dynamic_image_resolution"] = DynamicResolutionJson(args.quality);
   // The residual tables beside result.json, or none (a previous run's would not describe this).
   const std::vector<std::string> tables = args.residuals_csv
                                               ? SplitResidualTables(&document, set.staging())

@@ -52,11 +52,12 @@ class FlightWorkflow : public ::testing::Test {
         "flight --camera " + dir_->File("data/camera_nominal.yaml") + " --data " +
         dir_->File("data") + " --base III,IV --out " + dir_->File("report") +
         " --camera-format metashape --certificate --lab " + dir_->File("lab.yaml") + " --quality " +
-        dir_->File("star.json") + " --quality " + dir_->File("quality_virtual.json")));
+        dir_->File("star.json") + *quality_options_));
   }
   // simulate --edge-targets wrote mosaics of edge patches (raw_<SUB>.tif per sub-image and
   // virtual.tif) and patches.csv with the regions to measure: `quality mtf` on each mosaic,
-  // quality_<mosaic>.json; the virtual image's result goes into the certificate.
+  // quality_<mosaic>.json (named raw sub-image or virtual); all go into result.json (the report's
+  // resolution section) and the certificate.
   static void MeasureEdgeTargetPatches() {
     std::ifstream in(dir_->File("data/edge_targets/patches.csv"));
     std::map<std::string, std::string> rois;  // by mosaic file
@@ -72,25 +73,32 @@ class FlightWorkflow : public ::testing::Test {
       ++edge_patches_;
     }
     ASSERT_GE(edge_patches_, 8);
+    quality_options_ = new std::string;
     for (const auto& [file, roi] : rois) {
+      const std::string stem = file.substr(0, file.find('.'));  // raw_<SUB> or virtual
+      const std::string which = stem == "virtual" ? " --virtual" : " --sub-image " + stem.substr(4);
+      const std::string out = dir_->File("quality_" + stem + ".json");
       const auto r =
           testing::RunAerocal("quality mtf --image " + dir_->File("data/edge_targets/" + file) +
-                              roi + " --flight-axis x --pixel-size-mm 0.009 --out " +
-                              dir_->File("quality_" + file.substr(0, file.find('.')) + ".json"));
+                              roi + which + " --flight-axis x --pixel-size-mm 0.009 --out " + out);
       ASSERT_EQ(r.exit_code, 0) << file << ": " << r.output;
+      *quality_options_ += " --quality " + out;
     }
   }
   static void TearDownTestSuite() {
+    delete quality_options_;
     delete run_;
     delete dir_;
   }
   static testing::TempDir* dir_;
   static testing::CommandResult* run_;
   static int edge_patches_;
+  static std::string* quality_options_;  // --quality of every edge targets' result
 };
 testing::TempDir* FlightWorkflow::dir_ = nullptr;
 testing::CommandResult* FlightWorkflow::run_ = nullptr;
 int FlightWorkflow::edge_patches_ = 0;
+std::string* FlightWorkflow::quality_options_ = nullptr;
 
 TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
@@ -231,11 +239,14 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
         << q["statement"];
   }
   EXPECT_TRUE(has_c);
-  // --quality: the dynamic image resolution section from the star's reading and the virtual
-  // image's edge targets (both axes).
+  // --quality: the dynamic image resolution section from the star's reading and the edge targets
+  // of the raw sub-images and of the virtual image (each patch in both), as result.json has it.
   ASSERT_EQ(cert["dynamic_image_resolution"]["stars"].size(), 1u);
-  EXPECT_EQ(cert["dynamic_image_resolution"]["edges"].size(), static_cast<size_t>(edge_patches_));
-  EXPECT_EQ(cert["dynamic_image_resolution"]["axes"].size(), 2u);
+  EXPECT_EQ(cert["dynamic_image_resolution"]["edges"].size(),
+            2 * static_cast<size_t>(edge_patches_));
+  EXPECT_GE(cert["dynamic_image_resolution"]["axes"].size(), 6u);  // virtual x, y + raw per CCD
+  EXPECT_EQ(cert["dynamic_image_resolution"]["resampling_loss"].size(), 2u);
+  EXPECT_EQ(cert["dynamic_image_resolution"], doc["dynamic_image_resolution"]);
   EXPECT_EQ(cert["dynamic_image_resolution"]["stars"][0]["limiting_frequency_cy_px"],
             aerocal::testing::ReadJson(dir_->File("star.json"))["limiting_frequency_cy_px"]);
   const std::string html = ReadTextFile(dir_->File("report/certificate/certificate.html"));
@@ -244,13 +255,14 @@ TEST_F(FlightWorkflow, CertificateOfTheInFlightCalibration) {
                            "in-flight calibration",
                            "Uncertainty budget",
                            "9. Dynamic image resolution",
+                           "resampling loss",
                            "Siemens star"})
     EXPECT_NE(html.find(text), std::string::npos) << text;
   // The certificate command on the flight's result.json gives the same data (its source apart).
-  const auto r = testing::RunAerocal(
-      "certificate --result " + dir_->File("report/result.json") + " --lab " +
-      dir_->File("lab.yaml") + " --quality " + dir_->File("star.json") + " --quality " +
-      dir_->File("quality_virtual.json") + " --no-render --out " + dir_->File("cert"));
+  const auto r =
+      testing::RunAerocal("certificate --result " + dir_->File("report/result.json") + " --lab " +
+                          dir_->File("lab.yaml") + " --quality " + dir_->File("star.json") +
+                          *quality_options_ + " --no-render --out " + dir_->File("cert"));
   ASSERT_EQ(r.exit_code, 0) << r.output;
   auto again = aerocal::testing::ReadJson(dir_->File("cert/certificate.json"));
   auto first = cert;
@@ -337,6 +349,55 @@ TEST_F(FlightWorkflow, EdgeTargetsShowTheLossOfBilinearResampling) {
     // The virtual image's combined MTF50 and its U (k = 2) lie below the raw mean.
     EXPECT_LT(a["mtf50_cy_px"].get<double>() + a["mtf50_expanded_cy_px"].get<double>(), mean)
         << axis;
+  }
+}
+
+// `flight --quality`: result.json and report.html state the resampling loss per axis, the virtual
+// image's MTF50 against the mean of the raw sub-images' (each the combined MTF50 of its edges),
+// with its U (k = 2) from the results' standard uncertainties.
+TEST_F(FlightWorkflow, TheReportStatesTheResamplingLossWithItsUncertainty) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const auto doc = aerocal::testing::ReadJson(dir_->File("report/result.json"));
+  const auto& section = doc["dynamic_image_resolution"];
+  const auto virt = aerocal::testing::ReadJson(dir_->File("quality_virtual.json"));
+  const std::string html = ReadTextFile(dir_->File("report/report.html"));
+  for (const char* text : {"10. Dynamic image resolution",
+                           "id=\"resolution-axes\"",
+                           "id=\"resolution-loss\"",
+                           "id=\"resolution-limits\"",
+                           "id=\"resolution-edges\"",
+                           "sub-image I",
+                           "virtual image"})
+    EXPECT_NE(html.find(text), std::string::npos) << text;
+  ASSERT_EQ(section["resampling_loss"].size(), 2u);
+  for (const auto& loss : section["resampling_loss"]) {
+    const std::string axis = loss["axis"];
+    double sum = 0.0, sum_u2 = 0.0;
+    int n = 0;
+    for (const auto& e : std::filesystem::directory_iterator(dir_->path()))
+      if (e.path().filename().string().rfind("quality_raw_", 0) == 0) {
+        const auto raw = aerocal::testing::ReadJson(e.path().string());
+        if (!raw["axes"].contains(axis)) continue;
+        sum += raw["axes"][axis]["mtf50_cy_px"].get<double>();
+        sum_u2 += std::pow(raw["axes"][axis]["mtf50_u_cy_px"].get<double>(), 2);
+        ++n;
+      }
+    ASSERT_GE(n, 2) << axis;
+    EXPECT_EQ(loss["sub_images"].size(), static_cast<size_t>(n));
+    const double raw_mean = sum / n, virtual_mtf50 = virt["axes"][axis]["mtf50_cy_px"];
+    const double u = std::hypot(std::sqrt(sum_u2) / n, virt["axes"][axis]["mtf50_u_cy_px"]);
+    EXPECT_NEAR(loss["raw_mean_mtf50_cy_px"].get<double>(), raw_mean, 1e-12);
+    EXPECT_NEAR(loss["loss_cy_px"].get<double>(), raw_mean - virtual_mtf50, 1e-12);
+    EXPECT_NEAR(loss["loss_expanded_cy_px"].get<double>(), 2.0 * u, 1e-12);
+    // Bilinear resampling at the CCDs' sub-pixel shifts: 4.6 % and 7.5 % (stitch/quality/README),
+    // both more than their U.
+    const double percent = loss["loss_percent"];
+    EXPECT_GT(percent, 2.0) << axis;
+    EXPECT_LT(percent, 10.0) << axis;
+    EXPECT_GT(loss["loss_cy_px"].get<double>(), loss["loss_expanded_cy_px"].get<double>()) << axis;
+    char shown[32];
+    std::snprintf(shown, sizeof shown, ">%.2f<", percent);
+    EXPECT_NE(html.find(shown), std::string::npos) << shown;
   }
 }
 

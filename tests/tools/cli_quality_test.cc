@@ -88,6 +88,7 @@ TEST(CliQuality, BadOptionsExitTwoNamingTheOption) {
       {" --roi 0,0,128,128 --oversampling 1", "--oversampling"},
       {" --roi 0,0,128,128 --flight-axis z", "--flight-axis"},
       {" --roi 0,0,128,128 --gsd-sigma-m 0.01", "--gsd-sigma-m"},
+      {" --roi 0,0,128,128 --sub-image I --virtual", "--virtual"},  // a raw or the virtual image
   };
   for (const auto& [options, name] : cases) {
     const auto run = RunAerocal(base + options);

@@ -508,6 +508,42 @@ class WhatPeopleRead(unittest.TestCase):
         self.assertNotIn("strips", advice)
         self.assertIn("convergent and rolled", advice)
 
+    def test_the_dynamic_resolution_section_restates_the_quality_numbers(self):
+        # `flight --quality`: C++ copies the quality results and computes the resampling loss
+        # (tools/dynamic_resolution.h); the report shows them per image and axis, unchanged.
+        axis = {"axis": "x", "direction": "along_track", "count": 4, "type_a_u_cy_px": 0.0004,
+                "type_b_u_cy_px": 0.0009, "mtf50_u_cy_px": 0.001}
+        section = {
+            "sources": ["q/raw_I.json", "q/virtual.json", "q/bars.json"], "method": "ISO 12233:2017 e-SFR",
+            "edges": [{"source": "q/raw_I.json", "image_kind": "raw", "sub_image": "I", "roi": [10, 20, 64, 64],
+                       "axis": "x", "direction": "along_track", "angle_deg": 5.01, "mtf50_cy_px": 0.1803,
+                       "mtf50_expanded_cy_px": 0.0021, "mtf_nyquist": 0.043}],
+            "axes": [dict(axis, source="q/raw_I.json", image_kind="raw", sub_image="I", mtf50_cy_px=0.1805,
+                          mtf50_expanded_cy_px=0.002),
+                     dict(axis, source="q/virtual.json", image_kind="virtual", mtf50_cy_px=0.1720,
+                          mtf50_expanded_cy_px=0.0038)],
+            "resampling_loss": [{"axis": "x", "direction": "along_track", "sub_images": ["I"],
+                                 "raw_mean_mtf50_cy_px": 0.1805, "raw_mean_u_cy_px": 0.001, "virtual_results": 1,
+                                 "virtual_mtf50_cy_px": 0.1720, "virtual_u_cy_px": 0.0019, "loss_cy_px": 0.0085,
+                                 "loss_u_cy_px": 0.00215, "loss_expanded_cy_px": 0.0043, "loss_percent": 4.709,
+                                 "loss_expanded_percent": 2.382, "coverage_factor": 2}],
+            "bars": [{"source": "q/bars.json", "options": {"gamma": 1, "threshold": 0.1},
+                      "limiting_frequency_cy_px": 0.3311, "limit_in_range": True, "limiting_lp_per_mm": 36.79}],
+            "stars": []}
+        text, page = self.render({"kind": "flight", "schema_version": 2, "dynamic_image_resolution": section})
+        self.assertIn("10. Dynamic image resolution", page.headings)
+        self.assertIn('<a href="#resolution">', text)
+        self.assertEqual(page.row("resolution-axes", "sub-image I")[:5],
+                         ["sub-image I", "x", "along_track", "4", "0.1805"])
+        self.assertEqual(page.row("resolution-axes", "virtual image")[7], "0.0038")
+        self.assertEqual(page.row("resolution-loss", "x"),
+                         ["x", "along_track", "I", "0.1805", "0.1720", "0.0085", "0.0043", "4.71", "2.38"])
+        self.assertEqual(page.row("resolution-limits", "bar target 1")[:4], ["bar target 1", "0.10", "0.3311", "36.79"])
+        self.assertEqual(page.row("resolution-edges", "sub-image I")[1], "10,20,64,64")
+        # Without --quality the section and its entry in the contents are absent.
+        text, page = self.render({"kind": "flight", "schema_version": 2})
+        self.assertNotIn("Dynamic image resolution", text)
+
 
 if __name__ == "__main__":
     unittest.main()

@@ -283,6 +283,20 @@ def resolution_axis_rows(c):
     return rows if len(rows) > 1 else []
 
 
+def resolution_loss_rows(c):
+    """The resampling loss per axis: the virtual image's MTF50 against the raw sub-images' mean
+    (computed by tools/dynamic_resolution.cc from results named `--sub-image` / `--virtual`)."""
+    d = c.get("dynamic_image_resolution") or {}
+    rows = [["resampling loss", "direction", "raw sub-images", "raw mean cy/px", "virtual cy/px", "loss cy/px",
+             "U", "loss %", "U %"]]
+    for r in d.get("resampling_loss", []):
+        rows.append([r.get("axis"), r.get("direction") or "-", ", ".join(r.get("sub_images", [])),
+                     fmt(r.get("raw_mean_mtf50_cy_px"), 4), fmt(r.get("virtual_mtf50_cy_px"), 4),
+                     fmt(r.get("loss_cy_px"), 4), fmt(r.get("loss_expanded_cy_px"), 2),
+                     fmt(r.get("loss_percent"), 3), fmt(r.get("loss_expanded_percent"), 2)])
+    return rows if len(rows) > 1 else []
+
+
 def resolution_bar_rows(c):
     """Bar targets (`aerocal quality bars`): the limiting frequency at the threshold."""
     d = c.get("dynamic_image_resolution") or {}
@@ -561,8 +575,8 @@ def page_html(c, figures):
         parts.append("<h2>9. Dynamic image resolution</h2><p>%s; MTF50 with U = k u_c (k = 2); GRD = GSD / "
                      "(2 f), one bar width. Sources: %s.</p>" % (
                          html.escape(d.get("method", "bar targets")), html.escape(", ".join(d.get("sources", [])))))
-        for rows in (resolution_edge_rows(c), resolution_axis_rows(c), resolution_bar_rows(c),
-                     resolution_star_rows(c)):
+        for rows in (resolution_edge_rows(c), resolution_axis_rows(c), resolution_loss_rows(c),
+                     resolution_bar_rows(c), resolution_star_rows(c)):
             if rows:
                 parts.append(html_table(rows))
         parts.append(figures["mtf"])

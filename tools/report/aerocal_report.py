@@ -55,22 +55,25 @@ SECTIONS = [("summary", "Summary"), ("project", "Project"), ("stitching", "Stitc
             ("adjustments", "Adjustments"), ("left-out", "Left out"), ("comparison", "Comparison"),
             ("calibration", "Calibration and distortion"), ("residuals", "Image residuals"),
             ("check-map", "Check-point errors")]
+RESOLUTION = ("resolution", "Dynamic image resolution")  # only with `flight --quality`
 
 
 def render(doc):
     import report_adjustments as adj
     import report_facts as facts
+    import report_resolution as res
     import report_sections as sec
     from report_html import esc, page
 
     what = "flight calibration" if doc.get("kind") == "flight" else "block adjustment"
     source = (f'camera {esc(doc.get("camera", "n/a"))}, data {esc(doc.get("data", "n/a"))}'
               if doc.get("kind") == "flight" else f'project {esc(doc.get("project", "n/a"))}')
+    toc = SECTIONS + ([RESOLUTION] if isinstance(doc.get("dynamic_image_resolution"), dict) else [])
     parts = [f"<h1>aerocal {what} report</h1>",
              f'<p class="note">{source}, aerocal {esc(doc.get("aerocal_version", "n/a"))}</p>',
-             "<nav><ol>" + "".join(f'<li><a href="#{a}">{t}</a></li>' for a, t in SECTIONS) + "</ol></nav>"]
+             "<nav><ol>" + "".join(f'<li><a href="#{a}">{t}</a></li>' for a, t in toc) + "</ol></nav>"]
     for section in (sec.summary, facts.facts, sec.stitching, adj.adjustments, adj.left_out, adj.comparison,
-                    adj.calibration, adj.residual_plot, adj.check_map):
+                    adj.calibration, adj.residual_plot, adj.check_map, res.resolution):
         try:
             parts.append(section(doc))
         except (KeyError, TypeError, ValueError, IndexError, AttributeError, ZeroDivisionError) as e:
