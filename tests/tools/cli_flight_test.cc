@@ -489,12 +489,13 @@ TEST_F(FlightWorkflow, AutoSelfCalibrationCheckPointTestAndCameraOrigin) {
 std::string ReportScript() { return AEROCAL_REPORT_SCRIPT; }
 
 // The fixture's flight again with its residual tables as CSV beside result.json
-// (--residuals-csv), report and certificate: run once, for the tests below.
-const testing::CommandResult& SplitFlight(const testing::TempDir& dir) {
+// (--residuals-csv), report and certificate, with the same quality results (`quality`: the edge
+// targets' --quality options): run once, for the tests below.
+const testing::CommandResult& SplitFlight(const testing::TempDir& dir, const std::string& quality) {
   static const testing::CommandResult run = testing::RunAerocal(
       "flight --camera " + dir.File("data/camera_nominal.yaml") + " --data " + dir.File("data") +
       " --base III,IV --residuals-csv --certificate --lab " + dir.File("lab.yaml") + " --quality " +
-      dir.File("star.json") + " --out " + dir.File("again"));
+      dir.File("star.json") + quality + " --out " + dir.File("again"));
   return run;
 }
 
@@ -506,7 +507,7 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
   // The second run (SplitFlight) writes its residual tables as CSV beside result.json
   // (--residuals-csv): read back, they must be the first run's inline arrays to the bit.
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto& r = SplitFlight(*dir_);
+  const auto& r = SplitFlight(*dir_, *quality_options_);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& j) {
     if (j.is_object()) {
@@ -599,7 +600,7 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
 // the inline run's), and a table changed afterwards is refused by every reader, by name, exit 2.
 TEST_F(FlightWorkflow, CertificateAndReportReadTheResidualTables) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto& r = SplitFlight(*dir_);
+  const auto& r = SplitFlight(*dir_, *quality_options_);
   ASSERT_EQ(r.exit_code, 0) << r.output;
   auto inline_cert = aerocal::testing::ReadJson(dir_->File("report/certificate/certificate.json"));
   auto split_cert = aerocal::testing::ReadJson(dir_->File("again/certificate/certificate.json"));
