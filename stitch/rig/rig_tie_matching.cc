@@ -1,6 +1,7 @@
 #include "stitch/rig/rig_tie_matching.h"
 
 #include "calib/core/error.h"
+#include "stitch/rig/head_window.h"
 #include "stitch/rig/rig_convert.h"
 #include "stitch/rig/rig_design.h"
 #include "stitch/rig/stitched_image.h"
@@ -42,36 +43,95 @@ double HeadScale(const RigConverter& converter, int head, const Eigen::Vector2d&
   return Eigen::JacobiSVD<Eigen::Matrix2d>(j).singularValues()(0);
 }
 
-}  // namespace
+// One tie: the first head's point `p` (virtual px) and, per other member head, LSM's match from
+// `match(k)` (virtual px); appended to `out` when at least two heads remain (header comment).
+template <typename MatchFn>
+void AppendTie(const RigConverter& converter,
+               const RigTieMatchOptions& options,
+               const std::vector<int>& members,
+               const Eigen::Vector2d& p,
+               int exposure_index,
+               MatchFn match,
+               RigZoneMatchReport* report,
+               RigTieMatches* out) {
+  struct Row {
+    int head;
+    Eigen::Vector2d pixel;
+    double sigma_px;  // head px
+  };
+  std::vector<Row> rows;
+  double largest = 0.0;
+  const int first = members.front();
+  for (size_t m = 1; m < members.size(); ++m) {
+    const int k = members[m];
+    ++report->lsm_tried;
+    const LsmResult lsm = match(k);
+    const auto raw = lsm.ok() ? converter.HeadFromVirtual(k, lsm.position_in_b) : std::nullopt;
+    const double head_scale = raw ? HeadScale(converter, k, lsm.position_in_b) : 0.0;
+    if (!raw || !converter.InHeadFormat(k, *raw) || !(head_scale > 0)) {
+      ++report->lsm_failed;
+      continue;
+    }
+    const double sigma = std::max(options.min_sigma_px, lsm.SigmaMaxPx() / std::sqrt(2.0));
+    largest = std::max(largest, sigma);
+    rows.push_back({k, *raw, sigma * head_scale});
+  }
+  const auto raw_first = converter.HeadFromVirtual(first, p);
+  const double first_scale = HeadScale(converter, first, p);
+  if (rows.empty() || !raw_first || !converter.InHeadFormat(first, *raw_first) ||
+      !(first_scale > 0))
+    return;
+  rows.insert(rows.begin(), Row{first, *raw_first, largest * first_scale});
+  const int tie = static_cast<int>(out->ties.size());
+  out->lsm_sigma_px.push_back(largest * std::sqrt(2.0));
+  out->ties.push_back(
+      {report->image + "/" + report->zone + "-" + std::to_string(report->ties + 1), false});
+  const calib::Rig& rig = converter.rig();
+  for (const Row& row : rows)
+    out->observations.push_back({exposure_index,
+                                 row.head,
+                                 tie,
+                                 row.pixel,
+                                 row.sigma_px,
+                                 "matched " + out->ties.back().id + "@" + rig.heads[row.head].id});
+  ++report->ties;
+}
 
-void MatchRigExposureTies(const calib::Rig& rig,
-                          const RigStitchExposure& exposure,
-                          int exposure_index,
-                          const std::vector<GrayImage>& heads,
-                          const RigTieMatchOptions& options,
-                          RigTieMatches* out) {
-  options.Validate();
-  const int n_heads = static_cast<int>(rig.heads.size());
-  AEROCAL_CHECK(static_cast<int>(heads.size()) == n_heads) << heads.size() << " head images";
-  AEROCAL_CHECK(n_heads <= 8) << "at most 8 heads";
+// One exposure's inputs to either path.
+struct ExposureToMatch {
+  const RigConverter& converter;
+  const HeadMapCorrections& grids;
+  const RigStitchExposure& exposure;
+  int exposure_index;
+  const std::vector<GrayImage>& heads;
+};
+
+// A zone pixel lies this far inside each of its heads' coverage: the template half size plus
+// the LSM shift bound and 2 px (the interpolation support).
+int ZoneMarginPx(const RigTieMatchOptions& options) {
+  return options.lsm.half_size_px + static_cast<int>(std::ceil(options.lsm.max_shift_px)) + 2;
+}
+
+std::vector<int> Members(unsigned mask, int n_heads) {
+  std::vector<int> members;
   for (int k = 0; k < n_heads; ++k)
-    AEROCAL_CHECK(heads[k].cols() == rig.heads[k].camera.width_px &&
-                  heads[k].rows() == rig.heads[k].camera.height_px)
-        << "head " << rig.heads[k].id << ": image " << heads[k].cols() << " x " << heads[k].rows();
-  // The ground calibration and the POS: no increments, no offsets.
-  RigExposure pose = exposure.pose;
-  pose.increment_rad.clear();
-  pose.dt_s.clear();
-  const RigConverter converter(
-      rig, pose, RectificationPlane{Eigen::Vector3d::UnitZ(), exposure.z_ref_m});
-  const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
+    if (mask & (1u << k)) members.push_back(k);
+  return members;
+}
+
+// The former path (RigTieMatchOptions::whole_projections): every head projected onto the whole
+// virtual format, zones from distance transforms, Foerstner over each zone's bounding box.
+void MatchOnWholeProjections(const ExposureToMatch& in,
+                             const RigTieMatchOptions& options,
+                             RigTieMatches* out) {
+  const auto& [converter, grids, exposure, exposure_index, heads] = in;
+  const calib::Rig& rig = converter.rig();
+  const int n_heads = static_cast<int>(rig.heads.size());
   const calib::Camera& v = rig.virtual_camera.camera;
   const int width = v.width_px, height = v.height_px;
-
   // Every head once on the virtual grid (float grey values) with its coverage shrunk by the
   // template half size plus the LSM shift bound and 2 px (the interpolation support).
-  const int margin =
-      options.lsm.half_size_px + static_cast<int>(std::ceil(options.lsm.max_shift_px)) + 2;
+  const int margin = ZoneMarginPx(options);
   std::vector<GrayImage> projected(n_heads), smoothed(n_heads);
   cv::Mat zone_mask(height, width, CV_8UC1, cv::Scalar(0));
   for (int k = 0; k < n_heads; ++k) {
@@ -132,9 +192,7 @@ void MatchRigExposureTies(const calib::Rig& rig,
     report.image = exposure.image;
     report.zone = ZoneName(rig, mask);
     report.pixels = zone_pixels[mask];
-    std::vector<int> members;
-    for (int k = 0; k < n_heads; ++k)
-      if (mask & (1u << k)) members.push_back(k);
+    const std::vector<int> members = Members(mask, n_heads);
     const int first = members.front();
     const GrayImage crop = projected[first].block(box.y, box.x, box.height, box.width);
     FoerstnerOptions foerstner = options.foerstner;
@@ -154,56 +212,217 @@ void MatchRigExposureTies(const calib::Rig& rig,
           at);
     }
     report.cells = static_cast<int>(best.size());
-    for (const auto& [cell, at] : best) {
+    for (const auto& cell_point : best) {
+      const Eigen::Vector2i at = cell_point.second;  // a copy: lambdas capture it
       const Eigen::Vector2d p(at.x(), at.y());
-      struct Row {
-        int head;
-        Eigen::Vector2d pixel;
-        double sigma_px;
-      };  // sigma in head px
-      std::vector<Row> rows;
-      double largest = 0.0;
-      for (size_t m = 1; m < members.size(); ++m) {
-        const int k = members[m];
-        ++report.lsm_tried;
-        const LsmResult lsm = MatchLeastSquares(
-            smoothed[first], at, smoothed[k], p, Eigen::Matrix2d::Identity(), options.lsm);
-        const auto raw = lsm.ok() ? converter.HeadFromVirtual(k, lsm.position_in_b) : std::nullopt;
-        if (!raw || !converter.InHeadFormat(k, *raw)) {
-          ++report.lsm_failed;
-          continue;
-        }
-        const double sigma = std::max(options.min_sigma_px, lsm.SigmaMaxPx() / std::sqrt(2.0));
-        const double head_scale = HeadScale(converter, k, lsm.position_in_b);
-        if (!(head_scale > 0)) {
-          ++report.lsm_failed;
-          continue;
-        }
-        largest = std::max(largest, sigma);
-        rows.push_back({k, *raw, sigma * head_scale});
-      }
-      const auto raw_first = converter.HeadFromVirtual(first, p);
-      const double first_scale = HeadScale(converter, first, p);
-      if (rows.empty() || !raw_first || !converter.InHeadFormat(first, *raw_first) ||
-          !(first_scale > 0))
-        continue;
-      rows.insert(rows.begin(), Row{first, *raw_first, largest * first_scale});
-      const int tie = static_cast<int>(out->ties.size());
-      out->lsm_sigma_px.push_back(largest * std::sqrt(2.0));
-      out->ties.push_back(
-          {exposure.image + "/" + report.zone + "-" + std::to_string(report.ties + 1), false});
-      for (const Row& row : rows)
-        out->observations.push_back(
-            {exposure_index,
-             row.head,
-             tie,
-             row.pixel,
-             row.sigma_px,
-             "matched " + out->ties.back().id + "@" + rig.heads[row.head].id});
-      ++report.ties;
+      AppendTie(
+          converter,
+          options,
+          members,
+          p,
+          exposure_index,
+          [&](int k) {
+            return MatchLeastSquares(
+                smoothed[first], at, smoothed[k], p, Eigen::Matrix2d::Identity(), options.lsm);
+          },
+          &report,
+          out);
     }
     out->zones.push_back(report);
   }
+}
+
+// Zones on a coarse grid (every kCoarseStep virtual px): per head the coverage, its distance
+// transform, and per zone the sample count above the margin (the zone's pixels, estimated) and
+// the cells with a sample within the margin relaxed by two steps (candidates: the exact zone of
+// a point is decided at the point).
+constexpr int kCoarseStep = 4;
+
+struct CoarseZones {
+  std::map<unsigned, long> pixels;                     // zone -> estimated pixels
+  std::map<std::pair<int, int>, unsigned> cell_heads;  // (row, col) cell -> union of heads
+};
+
+CoarseZones FindCoarseZones(const std::vector<HeadWindowSampler>& samplers,
+                            int width,
+                            int height,
+                            double margin,
+                            double cell_px) {
+  const int cols = (width + kCoarseStep - 1) / kCoarseStep;
+  const int rows = (height + kCoarseStep - 1) / kCoarseStep;
+  cv::Mat exact(rows, cols, CV_8UC1, cv::Scalar(0)), relaxed(rows, cols, CV_8UC1, cv::Scalar(0));
+  for (size_t k = 0; k < samplers.size(); ++k) {
+    cv::Mat covered(rows, cols, CV_8UC1);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c)
+        covered.at<std::uint8_t>(r, c) =
+            samplers[k].Covers(c * kCoarseStep, r * kCoarseStep) ? 255 : 0;
+    cv::Mat distance;
+    cv::distanceTransform(covered, distance, cv::DIST_L2, 3);
+    for (int r = 0; r < rows; ++r)
+      for (int c = 0; c < cols; ++c) {
+        const double d = distance.at<float>(r, c) * kCoarseStep;
+        if (d > margin) exact.at<std::uint8_t>(r, c) |= 1u << k;
+        if (d > margin - 2 * kCoarseStep) relaxed.at<std::uint8_t>(r, c) |= 1u << k;
+      }
+  }
+  CoarseZones out;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const unsigned m = exact.at<std::uint8_t>(r, c), m_relaxed = relaxed.at<std::uint8_t>(r, c);
+      if (m & (m - 1)) out.pixels[m] += kCoarseStep * kCoarseStep;
+      if ((m_relaxed & (m_relaxed - 1)) == 0) continue;
+      const std::pair<int, int> cell(static_cast<int>(r * kCoarseStep / cell_px),
+                                     static_cast<int>(c * kCoarseStep / cell_px));
+      out.cell_heads[cell] |= m_relaxed;
+    }
+  return out;
+}
+
+// The zone of a virtual pixel: the heads whose coverage holds the disc of `margin` around it.
+unsigned ZoneAt(const std::vector<HeadWindowSampler>& samplers,
+                const Eigen::Vector2i& at,
+                double margin) {
+  unsigned mask = 0;
+  for (size_t k = 0; k < samplers.size(); ++k)
+    if (samplers[k].CoversDisc(at.x(), at.y(), margin)) mask |= 1u << k;
+  return mask;
+}
+
+// The rectangle [x0, x1) x [y0, y1) grown by `border` and clipped to the format.
+cv::Rect Grown(int x0, int y0, int x1, int y1, int border, int width, int height) {
+  const int left = std::max(0, x0 - border), top = std::max(0, y0 - border);
+  return cv::Rect(
+      left, top, std::min(width, x1 + border) - left, std::min(height, y1 + border) - top);
+}
+
+// Per zone and cell the strongest Foerstner point of the zone's first head whose zone is exactly
+// that zone (the whole-projection path's rule), each head's window being its cell grown by the
+// Wallis and Foerstner supports.
+std::map<unsigned, std::map<std::pair<int, int>, Eigen::Vector2i>> BestPointsPerCell(
+    const std::vector<HeadWindowSampler>& samplers,
+    const CoarseZones& zones,
+    int width,
+    int height,
+    double margin,
+    const RigTieMatchOptions& options) {
+  const int border = options.wallis.window_px / 2 + options.foerstner.window_px / 2 +
+                     options.foerstner.suppression_px / 2 + 2;
+  FoerstnerOptions foerstner = options.foerstner;
+  foerstner.max_points = std::max(foerstner.max_points, 100000);
+  std::map<unsigned, std::map<std::pair<int, int>, Eigen::Vector2i>> best;
+  for (const auto& [cell, heads] : zones.cell_heads) {
+    const int x0 = static_cast<int>(std::ceil(cell.second * options.cell_px));
+    const int y0 = static_cast<int>(std::ceil(cell.first * options.cell_px));
+    const int x1 =
+        std::min(width, static_cast<int>(std::ceil((cell.second + 1) * options.cell_px)));
+    const int y1 =
+        std::min(height, static_cast<int>(std::ceil((cell.first + 1) * options.cell_px)));
+    const cv::Rect box = Grown(x0, y0, x1, y1, border, width, height);
+    for (size_t first = 0; first < samplers.size(); ++first) {
+      // a first head: in the cell's union with a higher head after it
+      if (!(heads & (1u << first)) || (heads >> (first + 1)) == 0) continue;
+      const VirtualWindow w = samplers[first].Project(box.x, box.y, box.width, box.height);
+      for (const InterestPoint& p :
+           DetectFoerstner(WallisFilter(w.values, options.wallis), foerstner)) {
+        const Eigen::Vector2i at(box.x + static_cast<int>(std::lround(p.position.x())),
+                                 box.y + static_cast<int>(std::lround(p.position.y())));
+        if (at.x() < x0 || at.y() < y0 || at.x() >= x1 || at.y() >= y1) continue;
+        const unsigned mask = ZoneAt(samplers, at, margin);
+        if ((mask & (mask - 1)) == 0 || !(mask & (1u << first)) || (mask & ((1u << first) - 1)))
+          continue;  // not a zone, or first is not its first head
+        const std::pair<int, int> key(static_cast<int>(at.y() / options.cell_px),
+                                      static_cast<int>(at.x() / options.cell_px));
+        best[mask].try_emplace(key, at);
+      }
+    }
+  }
+  return best;
+}
+
+// The default path: zones on a coarse grid, Foerstner per cell window, LSM between small
+// low-passed windows around the point (the head->virtual geometry of the ground calibration is
+// good to a few px, so nothing else of the projections is needed).
+void MatchInWindows(const ExposureToMatch& in,
+                    const RigTieMatchOptions& options,
+                    RigTieMatches* out) {
+  const auto& [converter, grids, exposure, exposure_index, heads] = in;
+  const calib::Rig& rig = converter.rig();
+  std::vector<HeadWindowSampler> samplers;
+  const int n_heads = static_cast<int>(heads.size());
+  samplers.reserve(n_heads);
+  for (int k = 0; k < n_heads; ++k) samplers.emplace_back(converter, k, heads[k], grids.grids[k]);
+  const int width = rig.virtual_camera.camera.width_px;
+  const int height = rig.virtual_camera.camera.height_px;
+  const int margin = ZoneMarginPx(options);
+  const CoarseZones zones = FindCoarseZones(samplers, width, height, margin, options.cell_px);
+  const auto best = BestPointsPerCell(samplers, zones, width, height, margin, options);
+  // Window half sides: the template plus the prefilter's border; the search adds the shift bound,
+  // an affine slack and the bicubic support.
+  const int blur = PrefilterBorderPx(options.prefilter_sigma_px);
+  const int half_a = options.lsm.half_size_px + 1 + blur;
+  const int half_b =
+      options.lsm.half_size_px + static_cast<int>(std::ceil(options.lsm.max_shift_px)) + 6 + blur;
+  for (const auto& [mask, cells] : best) {
+    RigZoneMatchReport report;
+    report.image = exposure.image;
+    report.zone = ZoneName(rig, mask);
+    const auto pixels = zones.pixels.find(mask);
+    report.pixels = pixels == zones.pixels.end() ? 0 : pixels->second;
+    report.cells = static_cast<int>(cells.size());
+    const std::vector<int> members = Members(mask, n_heads);
+    const int first = members.front();
+    for (const auto& cell_point : cells) {
+      const Eigen::Vector2i at = cell_point.second;  // a copy: lambdas capture it
+      const Eigen::Vector2d p(at.x(), at.y());
+      const cv::Rect box_a = Grown(at.x(), at.y(), at.x() + 1, at.y() + 1, half_a, width, height);
+      const VirtualWindow a = samplers[first].ProjectSmoothed(
+          box_a.x, box_a.y, box_a.width, box_a.height, options.prefilter_sigma_px);
+      const Eigen::Vector2i at_a(at.x() - a.x0, at.y() - a.y0);
+      const auto match = [&](int k) {
+        const cv::Rect box_b = Grown(at.x(), at.y(), at.x() + 1, at.y() + 1, half_b, width, height);
+        const VirtualWindow b = samplers[k].ProjectSmoothed(
+            box_b.x, box_b.y, box_b.width, box_b.height, options.prefilter_sigma_px);
+        const Eigen::Vector2d origin(b.x0, b.y0);
+        LsmResult lsm = MatchLeastSquares(
+            a.values, at_a, b.values, p - origin, Eigen::Matrix2d::Identity(), options.lsm);
+        lsm.position_in_b += origin;
+        return lsm;
+      };
+      AppendTie(converter, options, members, p, exposure_index, match, &report, out);
+    }
+    out->zones.push_back(report);
+  }
+}
+
+}  // namespace
+
+void MatchRigExposureTies(const calib::Rig& rig,
+                          const RigStitchExposure& exposure,
+                          int exposure_index,
+                          const std::vector<GrayImage>& heads,
+                          const RigTieMatchOptions& options,
+                          RigTieMatches* out) {
+  options.Validate();
+  const int n_heads = static_cast<int>(rig.heads.size());
+  AEROCAL_CHECK(static_cast<int>(heads.size()) == n_heads) << heads.size() << " head images";
+  AEROCAL_CHECK(n_heads <= 8) << "at most 8 heads";
+  for (int k = 0; k < n_heads; ++k)
+    AEROCAL_CHECK(heads[k].cols() == rig.heads[k].camera.width_px &&
+                  heads[k].rows() == rig.heads[k].camera.height_px)
+        << "head " << rig.heads[k].id << ": image " << heads[k].cols() << " x " << heads[k].rows();
+  // The ground calibration and the POS: no increments, no offsets.
+  RigExposure pose = exposure.pose;
+  pose.increment_rad.clear();
+  pose.dt_s.clear();
+  const RigConverter converter(
+      rig, pose, RectificationPlane{Eigen::Vector3d::UnitZ(), exposure.z_ref_m});
+  const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
+  const ExposureToMatch in{converter, grids, exposure, exposure_index, heads};
+  if (options.whole_projections)
+    MatchOnWholeProjections(in, options, out);
+  else
+    MatchInWindows(in, options, out);
 }
 
 }  // namespace aerocal::stitch

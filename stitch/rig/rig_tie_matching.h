@@ -3,7 +3,14 @@
 // is resampled once onto the level virtual image of the exposure (plane Z = z_ref, the stitched
 // image's projection: stitch/rig/stitched_image.h ProjectHeadOntoVirtual); on the virtual grid
 // the overlap zones are the pixels covered by the same set of two or more heads ("AB", ...,
-// triple zones "ABC"), each shrunk by the LSM template and search margin. The matcher of
+// triple zones "ABC"), each shrunk by the LSM template and search margin. Only the windows the
+// matching needs are projected (stitch/rig/head_window.h; issue 35): the zones are found on a grid
+// of every 4th virtual px (coverage and its distance transform; a point's zone is decided at the
+// point, from 17 samples of the disc of the margin), the interest points on the first head's
+// projection of each cell grown by the Wallis and Foerstner supports, LSM between windows of a
+// few tens of px around the point. `whole_projections` keeps the former path: every head on the
+// whole virtual format, Foerstner over each zone's bounding box (the same rule per cell; its
+// mean-weight threshold then over the whole box instead of the cell). The matcher of
 // `aerocal match` (stitch/matching) then works per zone:
 //  1. Foerstner points (interest_operators.h) on the Wallis-filtered projection of the zone's
 //     first head (rig order), the strongest one per square cell of `cell_px` virtual px;
@@ -42,6 +49,8 @@ struct RigTieMatchOptions {
   double min_sigma_px = 0.02;       // floor of the LSM sigma written, virtual px, > 0
   double prefilter_sigma_px = 1.5;  // Gaussian low-pass of the projected heads for LSM (header
                                     // comment), virtual px; 0: none, else 0.3..5
+  bool whole_projections = false;   // true: the former path (every head projected onto the whole
+                                    // virtual format); false: small windows (header comment)
   LsmOptions lsm;
   WallisOptions wallis;
   FoerstnerOptions foerstner;
