@@ -38,6 +38,14 @@ const stitch::RigStitchExposureResult* RefinedExposure(const RigStitchRun& run,
   return it == refined.end() ? nullptr : &*it;
 }
 
+const stitch::RigStitchExposureResult& RequireRefinedExposure(const RigStitchRun& run,
+                                                              const std::string& image) {
+  const stitch::RigStitchExposureResult* refined = RefinedExposure(run, image);
+  if (refined == nullptr)
+    throw InputError("image " + image + ": not an exposure of the rig stitch result");
+  return *refined;
+}
+
 stitch::StitchedImageReport StitchRigExposure(const RigStitchRun& run,
                                               const std::string& image,
                                               RigExposureImages& heads,
@@ -46,14 +54,13 @@ stitch::StitchedImageReport StitchRigExposure(const RigStitchRun& run,
                                               stitch::RasterSink* mask_sink) {
   const auto exposure = std::find_if(
       run.exposures.begin(), run.exposures.end(), [&](const auto& e) { return e.image == image; });
-  const stitch::RigStitchExposureResult* refined = RefinedExposure(run, image);
-  if (exposure == run.exposures.end() || refined == nullptr)
-    throw InputError("image " + image + ": not an exposure of the rig stitch result");
+  const stitch::RigStitchExposureResult& refined = RequireRefinedExposure(run, image);
+  AEROCAL_CHECK(exposure != run.exposures.end());  // the result's exposures are the run's
   const calib::Rig& rig = run.rig;
   stitch::RigExposure pose = exposure->pose;
   pose.increment_rad.assign(rig.heads.size(), Eigen::Vector3d::Zero());
   pose.dt_s.assign(rig.heads.size(), 0.0);
-  for (const auto& h : refined->heads) {
+  for (const auto& h : refined.heads) {
     const int k = rig.HeadIndex(h.head);
     pose.increment_rad[k] = h.increment_rad;
     pose.dt_s[k] = h.dt_fitted_s;  // also where not determinable on its own: the fitted geometry

@@ -31,6 +31,9 @@ RigExposureImages OpenRigExposureImages(const calib::Rig& rig,
 /// (an exposure without ties in the adjustment).
 const stitch::RigStitchExposureResult* RefinedExposure(const RigStitchRun& run,
                                                        const std::string& image);
+/// The same, an InputError naming the image where the result has none (no stitched image of it).
+const stitch::RigStitchExposureResult& RequireRefinedExposure(const RigStitchRun& run,
+                                                              const std::string& image);
 
 /// Makes the stitched image of exposure `image` (one of run.exposures, with a refined result)
 /// from `heads` into `image_sink` (the virtual camera's format, the heads' depth) and `mask_sink`

@@ -39,8 +39,7 @@ py::dict StitchedImage(const RigStitchResult& r,
     throw ConfigError("no stitched image: the self-calibration is not valid");
   if (!(feather_px >= 1 && feather_px <= 255))
     throw ConfigError("feather_px must be within 1..255 (got " + std::to_string(feather_px) + ")");
-  if (tools::RefinedExposure(r.run, image) == nullptr)
-    throw InputError("image " + image + ": not an exposure of the rig stitch result");
+  tools::RequireRefinedExposure(r.run, image);  // before the head images are looked for
   stitch::StitchedImageOptions options;
   options.balance = balance;
   options.feather_px = feather_px;
