@@ -39,8 +39,15 @@ CommandRun Setup(CLI::App& app) {
       "--list", args->list, "Flight: CSV frame,subimage,image (paths relative to the list file)");
   app.add_option("--out", args->out, "Output file: the stitching observations (stitch_obs.csv)")
       ->required();
-  app.add_option("--detector", args->detector, "sift | foerstner (on Wallis-filtered strips)")
+  app.add_option("--search",
+                 args->search,
+                 "predicted: Foerstner points found by correlation at the nominal mappings' "
+                 "prediction | descriptors: keypoints of both sub-images matched by descriptors")
       ->capture_default_str();
+  app.add_option(
+      "--detector",
+      args->detector,
+      "With --search descriptors: sift (default) | foerstner (on Wallis-filtered strips)");
   app.add_option("--lsm", args->lsm, "on | off: least-squares matching refinement")
       ->capture_default_str();
   app.add_option("--sigma-px",

@@ -99,7 +99,14 @@ MatchRun RunMatching(const MatchRequest& args) {
   if (!args.images.empty() && args.frame.empty()) throw ConfigError("--images needs --frame");
   if (args.lsm != "on" && args.lsm != "off") throw ConfigError("--lsm must be on or off");
   stitch::MatchOptions options;
-  options.detector = stitch::ParseDetector(args.detector);
+  options.search = stitch::ParseSearch(args.search);
+  if (!args.detector.empty()) {
+    if (options.search == stitch::Search::kPredicted)
+      throw ConfigError(
+          "--detector applies to --search descriptors (the predicted search uses "
+          "Foerstner points of the first sub-image of each strip)");
+    options.detector = stitch::ParseDetector(args.detector);
+  }
   options.use_lsm = args.lsm == "on";
   options.sigma_px = args.sigma_px;
   options.cell_px = args.cell_px;

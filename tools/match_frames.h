@@ -14,7 +14,9 @@ struct MatchRequest {
   std::string camera;
   std::string frame, images;  // one frame: --frame and --images I=a.tif,II=b.tif,...
   std::string list;           // or a flight: CSV frame,subimage,image
-  std::string detector = "sift", lsm = "on";
+  std::string search = "predicted";
+  std::string detector;  // --search descriptors only; empty: sift
+  std::string lsm = "on";
   double sigma_px = 0.3;
   double cell_px = 100.0;
 };

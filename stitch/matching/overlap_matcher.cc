@@ -2,9 +2,8 @@
 
 #include "calib/core/error.h"
 #include "stitch/matching/overlap_strips.h"
+#include "stitch/matching/strip_candidates.h"
 
-#include <opencv2/core.hpp>
-#include <opencv2/features2d.hpp>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
@@ -16,82 +15,9 @@
 namespace aerocal::stitch {
 namespace {
 
-// Keypoints of one search window, in full sub-image pixels, with descriptors (one row each).
-struct WindowFeatures {
-  std::vector<Eigen::Vector2d> positions;
-  cv::Mat descriptors;
-};
-
-// Integer pixel rectangle [x0, x1) x [y0, y1) covering a window box.
-cv::Rect PixelRect(const Eigen::AlignedBox2d& box) {
-  const int x0 = static_cast<int>(std::floor(box.min().x()));
-  const int y0 = static_cast<int>(std::floor(box.min().y()));
-  const int x1 = static_cast<int>(std::ceil(box.max().x())) + 1;
-  const int y1 = static_cast<int>(std::ceil(box.max().y())) + 1;
-  return {x0, y0, x1 - x0, y1 - y0};
-}
-
-// Linear stretch of mean +- 3 std to 0..255 (SIFT wants 8 bit; this makes it gain/offset free).
-cv::Mat To8Bit(const cv::Mat& window) {
-  cv::Scalar mean, stddev;
-  cv::meanStdDev(window, mean, stddev);
-  const double scale = stddev[0] > 0 ? 255.0 / (6.0 * stddev[0]) : 1.0;
-  cv::Mat out;
-  window.convertTo(out, CV_8U, scale, 127.5 - scale * mean[0]);
-  return out;
-}
-
-bool KeypointBefore(const cv::KeyPoint& x, const cv::KeyPoint& y) {
-  return std::make_tuple(-x.response, x.pt.y, x.pt.x, x.size, x.angle, x.octave) <
-         std::make_tuple(-y.response, y.pt.y, y.pt.x, y.size, y.angle, y.octave);
-}
-
-WindowFeatures DetectWindow(const GrayImage& image,
-                            const cv::Rect& rect,
-                            const MatchOptions& options) {
-  const cv::Mat full(static_cast<int>(image.rows()),
-                     static_cast<int>(image.cols()),
-                     CV_32F,
-                     const_cast<float*>(image.data()));
-  const cv::Mat window = full(rect);
-  cv::Ptr<cv::SIFT> sift = cv::SIFT::create(0, 3, options.sift_contrast);
-  std::vector<cv::KeyPoint> keypoints;
-  cv::Mat gray8;
-  if (options.detector == Detector::kSift) {
-    gray8 = To8Bit(window);
-    sift->detect(gray8, keypoints);
-  } else {
-    GrayImage block(rect.height, rect.width);
-    for (int r = 0; r < rect.height; ++r)
-      for (int c = 0; c < rect.width; ++c) block(r, c) = window.at<float>(r, c);
-    const GrayImage wallis = WallisFilter(block, options.wallis);
-    cv::Mat(rect.height, rect.width, CV_32F, const_cast<float*>(wallis.data()))
-        .convertTo(gray8, CV_8U);
-    FoerstnerOptions foerstner = options.foerstner;
-    foerstner.max_points = options.max_keypoints;
-    for (const InterestPoint& p : DetectFoerstner(wallis, foerstner)) {
-      keypoints.emplace_back(
-          cv::Point2f(static_cast<float>(p.position.x()), static_cast<float>(p.position.y())),
-          static_cast<float>(options.descriptor_size_px),
-          0.0f,
-          static_cast<float>(p.weight));
-    }
-  }
-  // OpenCV may return keypoints in thread-dependent order: sort before cutting to the strongest.
-  std::stable_sort(keypoints.begin(), keypoints.end(), KeypointBefore);
-  if (static_cast<int>(keypoints.size()) > options.max_keypoints)
-    keypoints.resize(options.max_keypoints);
-  WindowFeatures features;
-  if (keypoints.empty()) return features;
-  sift->compute(gray8, keypoints, features.descriptors);
-  for (const cv::KeyPoint& k : keypoints)
-    features.positions.emplace_back(k.pt.x + rect.x, k.pt.y + rect.y);
-  return features;
-}
-
 struct Candidate {
   int cell = 0;
-  double ratio = 0;
+  double score = 0;  // lower is better (StripCandidates::score)
   Eigen::Vector2d uv_a, uv_b;
 };
 
@@ -119,29 +45,14 @@ void MatchStrip(const calib::Camera& camera,
   const int ny = std::max(1, static_cast<int>(std::ceil(size.y() / options.cell_px)));
   report->cells = nx * ny;
 
-  const WindowFeatures fa = DetectWindow(images[strip.a], PixelRect(strip.window_in_a), options);
-  const WindowFeatures fb = DetectWindow(images[strip.b], PixelRect(strip.window_in_b), options);
-  report->keypoints_a = static_cast<int>(fa.positions.size());
-  report->keypoints_b = static_cast<int>(fb.positions.size());
-  if (fa.positions.empty() || fb.positions.size() < 2) return;
-
-  std::vector<std::vector<cv::DMatch>> knn;
-  cv::BFMatcher(cv::NORM_L2).knnMatch(fa.descriptors, fb.descriptors, knn, 2);
-  std::vector<Eigen::Vector2d> from, to;
-  std::vector<double> ratios;
-  for (const std::vector<cv::DMatch>& m : knn) {
-    if (m.size() < 2 || m[1].distance <= 0) continue;
-    const double ratio = m[0].distance / m[1].distance;
-    if (ratio >= options.ratio) continue;
-    const Eigen::Vector2d& uv_a = fa.positions[m[0].queryIdx];
-    const Eigen::Vector2d& uv_b = fb.positions[m[0].trainIdx];
-    const Eigen::Vector2d predicted = sb.SubFromVirtual(sa.VirtualFromSub(uv_a));
-    if ((predicted - uv_b).norm() > options.margin_px) continue;
-    from.push_back(uv_a);
-    to.push_back(uv_b);
-    ratios.push_back(ratio);
-  }
-  report->ratio_matches = static_cast<int>(from.size());
+  const StripCandidates found = options.search == Search::kPredicted
+                                    ? PredictedCandidates(camera, images, strip, options)
+                                    : DescriptorCandidates(camera, images, strip, options);
+  report->keypoints_a = found.keypoints_a;
+  report->keypoints_b = found.keypoints_b;
+  report->ratio_matches = static_cast<int>(found.in_a.size());
+  const std::vector<Eigen::Vector2d>& from = found.in_a;
+  const std::vector<Eigen::Vector2d>& to = found.in_b;
   const RansacResult ransac = RansacAffine(from, to, options.ransac);
   if (!ransac.ok) return;
   report->ransac_inliers = static_cast<int>(ransac.inliers.size());
@@ -152,11 +63,11 @@ void MatchStrip(const calib::Camera& camera,
         (sa.VirtualFromSub(from[i]) - strip.in_virtual.min()) / options.cell_px;
     const int cx = std::clamp(static_cast<int>(std::floor(cell_xy.x())), 0, nx - 1);
     const int cy = std::clamp(static_cast<int>(std::floor(cell_xy.y())), 0, ny - 1);
-    candidates.push_back({cy * nx + cx, ratios[i], from[i], to[i]});
+    candidates.push_back({cy * nx + cx, found.score[i], from[i], to[i]});
   }
   std::stable_sort(
       candidates.begin(), candidates.end(), [](const Candidate& x, const Candidate& y) {
-        return std::tie(x.cell, x.ratio) < std::tie(y.cell, y.ratio);
+        return std::tie(x.cell, x.score) < std::tie(y.cell, y.score);
       });
 
   const int h = options.lsm.half_size_px;
@@ -206,30 +117,6 @@ void MatchStrip(const calib::Camera& camera,
 }
 
 }  // namespace
-
-Detector ParseDetector(const std::string& name) {
-  if (name == "sift") return Detector::kSift;
-  if (name == "foerstner") return Detector::kFoerstner;
-  throw ConfigError("detector must be sift or foerstner (got " + name + ")");
-}
-
-void MatchOptions::Validate() const {
-  if (!(margin_px >= 0)) throw ConfigError("margin_px must be >= 0");
-  if (!(min_strip_width_px > 0)) throw ConfigError("min_strip_width_px must be > 0");
-  if (!(sift_contrast > 0)) throw ConfigError("sift_contrast must be > 0");
-  if (max_keypoints <= 0) throw ConfigError("max_keypoints must be > 0");
-  if (!(ratio > 0 && ratio <= 1)) throw ConfigError("ratio must be in (0, 1]");
-  if (!(cell_px > 0)) throw ConfigError("cell_px must be > 0");
-  if (points_per_cell < 1) throw ConfigError("points_per_cell must be >= 1");
-  if (!(sigma_px > 0)) throw ConfigError("sigma_px must be > 0");
-  if (!(min_sigma_px > 0)) throw ConfigError("min_sigma_px must be > 0");
-  if (descriptor_size_px < 4) throw ConfigError("descriptor_size_px must be >= 4");
-  if (!(ransac.threshold_px > 0) || ransac.iterations < 1 || ransac.min_inliers < 3)
-    throw ConfigError("ransac: threshold_px > 0, iterations >= 1, min_inliers >= 3 required");
-  lsm.Validate();
-  wallis.Validate();
-  foerstner.Validate();
-}
 
 FrameMatches MatchFrame(const calib::Camera& camera,
                         const std::vector<GrayImage>& images,

@@ -1,9 +1,10 @@
 // Tie points of one multi-CCD frame, measured on the pixels of its sub-images:
 //  1. overlap strips and search windows from the camera's nominal mappings (overlap_strips.h);
-//  2. keypoints in each window: SIFT (Lowe 2004, OpenCV), or the Foerstner operator on the
-//     Wallis-filtered window (interest_operators.h) described with SIFT descriptors (upright);
-//  3. descriptor matching with Lowe's ratio test; candidates farther than the search margin from
-//     their nominal prediction are dropped;
+//  2./3. candidates (strip_candidates.h, MatchOptions::search): keypoints in both windows (SIFT,
+//     Lowe 2004, or the Foerstner operator on the Wallis-filtered window with upright SIFT
+//     descriptors) matched with Lowe's ratio test and gated by the nominal prediction; or the
+//     strongest Foerstner points of a per cell, found in b by normalised cross-correlation
+//     around the nominal prediction;
 //  4. RANSAC on the local affine mapping b <- a of the strip (local_mapping.h);
 //  5. even distribution: a grid of square cells (virtual px) over the strip; in each cell the best
 //     candidates (lowest ratio) are tried in turn until `points_per_cell` are accepted;
@@ -18,9 +19,7 @@
 
 #include "calib/camera/camera.h"
 #include "stitch/image_io/gray_image.h"
-#include "stitch/matching/interest_operators.h"
-#include "stitch/matching/least_squares_matching.h"
-#include "stitch/matching/local_mapping.h"
+#include "stitch/matching/match_options.h"
 #include "stitch/simulation/stitch_simulator.h"
 
 #include <string>
@@ -28,36 +27,11 @@
 
 namespace aerocal::stitch {
 
-enum class Detector { kSift, kFoerstner };
-/// "sift" | "foerstner"; ConfigError otherwise.
-Detector ParseDetector(const std::string& name);
-
-struct MatchOptions {
-  Detector detector = Detector::kSift;
-  bool use_lsm = true;
-  double margin_px = 20.0;  // search margin around the nominal strip and prediction, px, >= 0
-  double min_strip_width_px = 30.0;  // narrower predicted overlaps are not matched, px
-  double sift_contrast = 0.01;  // SIFT contrast threshold on the stretched window, > 0 (OpenCV's
-                                // 0.04 leaves low-contrast fields of an overlap empty)
-  int max_keypoints = 5000;     // per search window, strongest kept, > 0
-  double ratio = 0.8;           // Lowe ratio test: best / second-best distance < ratio, (0, 1]
-  double cell_px = 100.0;       // grid cell side along the strips, virtual px, > 0
-  int points_per_cell = 1;      // accepted tie points per cell, >= 1
-  double sigma_px = 0.3;        // sigma written without LSM, px, > 0
-  double min_sigma_px = 0.02;   // floor of the LSM sigma written, px, > 0 (unmodelled errors)
-  int descriptor_size_px = 16;  // support of the SIFT descriptor at Foerstner points, px
-  RansacOptions ransac;
-  LsmOptions lsm;
-  WallisOptions wallis;
-  FoerstnerOptions foerstner;
-  void Validate() const;  // throws ConfigError naming the field
-};
-
 /// Counts of one overlap strip.
 struct StripReport {
   std::string name;  // "I-II"
   int keypoints_a = 0, keypoints_b = 0;
-  int ratio_matches = 0;  // after ratio test and prediction gate
+  int ratio_matches = 0;  // candidates: after the ratio test and prediction gate, or NCC peaks
   int ransac_inliers = 0;
   int lsm_tried = 0;
   int lsm_not_converged = 0;   // includes leaving the image and drifting off

@@ -635,16 +635,21 @@ subimages:
 """
 
 
+def lowpassed_noise(seed, rows, cols):
+    """White noise low-passed by a Gaussian of 2 px, stretched to 8 bit: a texture to match."""
+    noise = np.random.default_rng(seed).normal(size=(rows, cols))
+    fy, fx = np.fft.fftfreq(rows)[:, None], np.fft.fftfreq(cols)[None, :]
+    scene = np.real(np.fft.ifft2(np.fft.fft2(noise) * np.exp(-2 * np.pi ** 2 * 4.0 * (fx ** 2 + fy ** 2))))
+    return (255 * (scene - scene.min()) / (scene.max() - scene.min())).astype(np.uint8)
+
+
 def test_match_equals_the_command(tmp_path):
     from PIL import Image
     camera = tmp_path / "camera.yaml"
     camera.write_text(MATCH_CAMERA)
     # One scene of the 600 x 400 virtual format (white noise low-passed by a Gaussian of 2 px),
     # cut along the nominal mappings into four 340 x 240 sub-images with 80 px overlaps.
-    noise = np.random.default_rng(7).normal(size=(400, 600))
-    fy, fx = np.fft.fftfreq(400)[:, None], np.fft.fftfreq(600)[None, :]
-    scene = np.real(np.fft.ifft2(np.fft.fft2(noise) * np.exp(-2 * np.pi ** 2 * 4.0 * (fx ** 2 + fy ** 2))))
-    scene = (255 * (scene - scene.min()) / (scene.max() - scene.min())).astype(np.uint8)
+    scene = lowpassed_noise(7, 400, 600)
     images = {}
     for sid, (e, f) in {"I": (0, 0), "II": (260, 0), "III": (0, 160), "IV": (260, 160)}.items():
         path = tmp_path / f"{sid}.png"
@@ -663,3 +668,31 @@ def test_match_equals_the_command(tmp_path):
     assert r["table"].splitlines()[0].split()[:2] == ["frame", "strip"]
     with pytest.raises(ValueError, match="--images needs --frame"):
         aerocal.match(str(camera), images)
+    with pytest.raises(ValueError, match="--detector applies to --search descriptors"):
+        aerocal.match(str(camera), images, frame="1", detector="sift")
+
+
+def test_both_searches_find_sub_images_misplaced_against_the_nominal_mappings(tmp_path):
+    """Sub-image IV is cut 3 px right and 2 px down of where the camera file puts it: the
+    predicted search (correlation around the nominal prediction) and the descriptor search must
+    both find the true offsets, so every tie meets through the TRUE mappings."""
+    from PIL import Image
+    camera = tmp_path / "camera.yaml"
+    camera.write_text(MATCH_CAMERA)
+    scene = lowpassed_noise(11, 400, 610)
+    true_offsets = {"I": (0, 0), "II": (260, 0), "III": (0, 160), "IV": (263, 158)}
+    images = {}
+    for sid, (e, f) in true_offsets.items():
+        path = tmp_path / f"{sid}.png"
+        Image.fromarray(scene[f:f + 240, e:e + 340]).save(path)
+        images[sid] = str(path)
+    for search, detector in (("predicted", None), ("descriptors", "sift")):
+        r = aerocal.match(str(camera), images, frame="1", search=search, detector=detector)
+        rows = {}
+        for point, sub, uv in zip(r["point"], r["subimage"], r["pixel"]):
+            rows.setdefault(point, []).append(uv + np.array(true_offsets[sub]))
+        gaps = np.array([v[0] - v[1] for v in rows.values() if len(v) == 2])
+        strips = {p.rsplit("_", 1)[0] for p in rows}
+        assert strips == {"I-II", "I-III", "I-IV", "II-III", "II-IV", "III-IV"}, (search, strips)
+        assert len(gaps) >= 12, (search, len(gaps))
+        assert np.sqrt(np.mean(gaps ** 2)) < 0.05, (search, np.sqrt(np.mean(gaps ** 2)))

@@ -1,11 +1,13 @@
-// Matching on real pixels: the Boruszyn scene (match_test_scene.h) matched with both detectors,
-// LSM on and off; every tie's two rays mapped through the TRUE mappings must meet.
+// Matching on real pixels: the Boruszyn scene (match_test_scene.h) matched with both detectors of
+// the descriptor search and with the predicted search, LSM on and off; every tie's two rays mapped
+// through the TRUE mappings must meet.
 #include "stitch/matching/overlap_matcher.h"
 #include "tests/stitch/match_test_scene.h"
 
 #include <gtest/gtest.h>
 
 #include <cstdio>
+#include <string>
 
 namespace aerocal::stitch {
 namespace {
@@ -35,16 +37,23 @@ struct MatchRun {
   testing::TieAgreement agreement;
 };
 
-MatchRun MatchScene(Detector detector, bool lsm) {
+struct Method {
+  Search search;
+  Detector detector;
+  const char* name;
+};
+
+MatchRun MatchScene(const Method& method, bool lsm) {
   const auto& scene = *BoruszynScene();
   MatchOptions options;
-  options.detector = detector;
+  options.search = method.search;
+  options.detector = method.detector;
   options.use_lsm = lsm;
   MatchRun run;
   run.matches = MatchFrame(scene.nominal, scene.images, "4880", options);
   run.agreement = AgreementThroughTruth(scene.truth, run.matches.observations);
   std::printf("%s, LSM %s: %d ties, RMS %.3f px per coordinate, max %.3f px\n",
-              detector == Detector::kSift ? "SIFT" : "Foerstner",
+              method.name,
               lsm ? "on" : "off",
               run.agreement.ties,
               run.agreement.rms_px,
@@ -53,7 +62,7 @@ MatchRun MatchScene(Detector detector, bool lsm) {
   return run;
 }
 
-class MatchReal : public ::testing::TestWithParam<Detector> {
+class MatchReal : public ::testing::TestWithParam<Method> {
  protected:
   void SetUp() override {
     if (!BoruszynScene()) GTEST_SKIP() << "shared data odm_boruszyn_kap_frames absent";
@@ -77,9 +86,17 @@ TEST_P(MatchReal, LsmTiePointsMeetThroughTrueMappingsToATenthOfAPixel) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(Detectors,
-                         MatchReal,
-                         ::testing::Values(Detector::kSift, Detector::kFoerstner));
+INSTANTIATE_TEST_SUITE_P(
+    Methods,
+    MatchReal,
+    ::testing::Values(Method{Search::kDescriptors, Detector::kSift, "SIFT"},
+                      Method{Search::kDescriptors, Detector::kFoerstner, "Foerstner"},
+                      Method{Search::kPredicted, Detector::kSift, "predicted (Foerstner + NCC)"}),
+    [](const ::testing::TestParamInfo<Method>& info) {
+      return std::string(info.param.search == Search::kPredicted  ? "Predicted"
+                         : info.param.detector == Detector::kSift ? "Sift"
+                                                                  : "Foerstner");
+    });
 
 }  // namespace
 }  // namespace aerocal::stitch

@@ -1,6 +1,7 @@
 // Acceptance of `aerocal match` on real pixels (issue: tie points to a tenth of a pixel): the
 // Boruszyn scene (match_test_scene.h) written as 8-bit TIFF sub-images plus the NOMINAL camera
-// file; `aerocal match` (SIFT, LSM on and off), the maker reference points measured in the
+// file; `aerocal match` (the predicted search, LSM on and off; the descriptor search with SIFT and
+// Foerstner), the maker reference points measured in the
 // sub-images through the true mappings (noise 0.05 px, their camera-file sigma), then the affine
 // stitching adjustment: sigma0 <= 0.12 px, every sub-image corner within 3 predicted sigmas and
 // 0.25 px of its true virtual position. Also: byte-identical output for identical inputs,
@@ -137,13 +138,18 @@ TEST_F(MatchStitch, MatchThenAffineStitchRecoversTheTrueCorners) {
   EXPECT_EQ(ReadTextFile(on), ReadTextFile(dir_->File("again.csv")));
 }
 
-TEST_F(MatchStitch, FoerstnerOnWallisFilteredImagesMeetsTheSameBoundsAndRepeats) {
-  const std::string a = dir_->File("foerstner.csv"), b = dir_->File("foerstner_again.csv");
-  ASSERT_EQ(RunAerocal(Match(a, "--detector foerstner")).exit_code, 0);
-  ExpectMeetsTheAcceptance(AdjustAndCompare(WithReferences(a, dir_->File("foerstner_ref.csv"))),
-                           "Foerstner, LSM on");
-  ASSERT_EQ(RunAerocal(Match(b, "--detector foerstner")).exit_code, 0);
-  EXPECT_EQ(ReadTextFile(a), ReadTextFile(b));
+// The descriptor search (the fallback where the nominal mappings are not known to the margin),
+// with either detector.
+TEST_F(MatchStitch, TheDescriptorSearchMeetsTheSameBoundsAndRepeats) {
+  for (const std::string detector : {"sift", "foerstner"}) {
+    const std::string a = dir_->File(detector + ".csv"), b = dir_->File(detector + "_again.csv");
+    const std::string options = "--search descriptors --detector " + detector;
+    ASSERT_EQ(RunAerocal(Match(a, options)).exit_code, 0);
+    ExpectMeetsTheAcceptance(AdjustAndCompare(WithReferences(a, dir_->File(detector + "_ref.csv"))),
+                             (detector + ", LSM on").c_str());
+    ASSERT_EQ(RunAerocal(Match(b, options)).exit_code, 0);
+    EXPECT_EQ(ReadTextFile(a), ReadTextFile(b));
+  }
 }
 
 TEST_F(MatchStitch, FlightListAppendsFramesAndRefusesDuplicates) {
@@ -154,13 +160,12 @@ TEST_F(MatchStitch, FlightListAppendsFramesAndRefusesDuplicates) {
   const std::string out = dir_->File("flight.csv");
   // Frame "a" first, then frame "b" of the list appended.
   ASSERT_EQ(RunAerocal("match --camera " + dir_->File("camera.yaml") + " --frame a --images " +
-                       *images_arg_ + " --detector foerstner --out " + out)
+                       *images_arg_ + " --out " + out)
                 .exit_code,
             0);
   const std::string before = ReadTextFile(out);
   const std::string list_run = "match --camera " + dir_->File("camera.yaml") + " --list " +
-                               dir_->File("list.csv") + " --detector foerstner --append --out " +
-                               out;
+                               dir_->File("list.csv") + " --append --out " + out;
   ASSERT_EQ(RunAerocal(list_run).exit_code, 0);
   const auto rows = ReadStitchObservations(out, 0.1);
   std::set<std::string> frames;
@@ -183,8 +188,7 @@ TEST_F(MatchStitch, ACameraInAnotherModelGivesTheSameObservations) {
       dir_->File("camera_opencv.yaml"),
       camera.WithModelCamera(
           calib::ConvertCamera(camera.AsModelCamera(), calib::CameraModelId::kOpenCv).camera));
-  const std::string options =
-      " --frame 4880 --images " + *images_arg_ + " --detector foerstner --lsm off --out ";
+  const std::string options = " --frame 4880 --images " + *images_arg_ + " --lsm off --out ";
   const std::string a = dir_->File("model_bf.csv"), b = dir_->File("model_cv.csv");
   ASSERT_EQ(RunAerocal("match --camera " + dir_->File("camera.yaml") + options + a).exit_code, 0);
   const auto other = RunAerocal("match --camera " + dir_->File("camera_opencv.yaml") + options + b);

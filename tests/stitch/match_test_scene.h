@@ -13,6 +13,7 @@
 #include "stitch/simulation/stitch_simulator.h"
 #include "tests/support/test_support.h"
 
+#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <random>
@@ -26,38 +27,63 @@ struct MatchScene {
   std::vector<GrayImage> images;  // camera order
 };
 
-/// The scene, or nullopt when the shared data set is absent. Built once per test binary.
+/// `frame` enlarged `scale` times by bilinear interpolation (pixel centres aligned).
+inline GrayImage Enlarged(const GrayImage& frame, int scale) {
+  GrayImage out(frame.rows() * scale, frame.cols() * scale);
+  const Eigen::Index last_r = frame.rows() - 1, last_c = frame.cols() - 1;
+  for (Eigen::Index r = 0; r < out.rows(); ++r) {
+    const double y = std::clamp((r + 0.5) / scale - 0.5, 0.0, double(last_r));
+    const Eigen::Index r0 = std::min<Eigen::Index>(static_cast<Eigen::Index>(y), last_r - 1);
+    const float fy = static_cast<float>(y - r0);
+    for (Eigen::Index c = 0; c < out.cols(); ++c) {
+      const double x = std::clamp((c + 0.5) / scale - 0.5, 0.0, double(last_c));
+      const Eigen::Index c0 = std::min<Eigen::Index>(static_cast<Eigen::Index>(x), last_c - 1);
+      const float fx = static_cast<float>(x - c0);
+      out(r, c) = (1 - fy) * ((1 - fx) * frame(r0, c0) + fx * frame(r0, c0 + 1)) +
+                  fy * ((1 - fx) * frame(r0 + 1, c0) + fx * frame(r0 + 1, c0 + 1));
+    }
+  }
+  return out;
+}
+
+/// The scene with the photograph enlarged `scale` times (bilinear; the overlaps stay 200 px), or
+/// nullopt when the shared data set is absent. Scale 3 gives a 13,824 x 10,368 px frame of six
+/// 7,012 x 3,589 px sub-images: the production size of issue 35's matching target.
+inline std::optional<MatchScene> MakeBoruszynScene(int scale) {
+  const std::string dir = aerocal::testing::SharedDataDir("odm_boruszyn_kap_frames");
+  if (dir.empty()) return std::nullopt;
+  GrayImage frame = ReadGrayImage(dir + "/images/img_4880.jpg");
+  if (scale > 1) frame = Enlarged(frame, scale);
+  GridLayoutOptions layout;
+  layout.rows = 3;
+  layout.cols = 2;
+  layout.virtual_width_px = static_cast<int>(frame.cols());
+  layout.virtual_height_px = static_cast<int>(frame.rows());
+  layout.overlap_px = 200;
+  layout.model = calib::MappingModel::kAffine;
+  layout.reference_placement = ReferencePlacement::kOuterCorners;
+  MatchScene s;
+  s.nominal = MakeGridCamera(layout);
+  MisplacementOptions misplacement;  // sub-pixel: 0.5 px shifts, 1e-4 rotation/scale/shear
+  misplacement.shift_sigma_px = 0.5;
+  misplacement.rotation_sigma_rad = 1e-4;
+  misplacement.scale_sigma = 1e-4;
+  misplacement.shear = 1e-4;
+  std::mt19937_64 rng(4880);
+  s.truth = MakeMisplacedCamera(s.nominal, {}, misplacement, rng);
+  CutOptions cut;
+  cut.gains = {1.0, 0.93, 1.06, 0.97, 1.04, 0.95};
+  cut.offsets = {0.0, 4.0, -3.0, 2.0, -5.0, 3.0};
+  cut.noise_dn = 1.5;
+  cut.seed = 11;
+  s.images = CutSubimages(frame, s.truth, cut);
+  for (GrayImage& image : s.images) image = image.array().round().max(0.0f).min(255.0f).matrix();
+  return s;
+}
+
+/// The full-resolution scene (scale 1), built once per test binary.
 inline const std::optional<MatchScene>& BoruszynScene() {
-  static const std::optional<MatchScene> scene = []() -> std::optional<MatchScene> {
-    const std::string dir = aerocal::testing::SharedDataDir("odm_boruszyn_kap_frames");
-    if (dir.empty()) return std::nullopt;
-    const GrayImage frame = ReadGrayImage(dir + "/images/img_4880.jpg");
-    GridLayoutOptions layout;
-    layout.rows = 3;
-    layout.cols = 2;
-    layout.virtual_width_px = static_cast<int>(frame.cols());
-    layout.virtual_height_px = static_cast<int>(frame.rows());
-    layout.overlap_px = 200;
-    layout.model = calib::MappingModel::kAffine;
-    layout.reference_placement = ReferencePlacement::kOuterCorners;
-    MatchScene s;
-    s.nominal = MakeGridCamera(layout);
-    MisplacementOptions misplacement;  // sub-pixel: 0.5 px shifts, 1e-4 rotation/scale/shear
-    misplacement.shift_sigma_px = 0.5;
-    misplacement.rotation_sigma_rad = 1e-4;
-    misplacement.scale_sigma = 1e-4;
-    misplacement.shear = 1e-4;
-    std::mt19937_64 rng(4880);
-    s.truth = MakeMisplacedCamera(s.nominal, {}, misplacement, rng);
-    CutOptions cut;
-    cut.gains = {1.0, 0.93, 1.06, 0.97, 1.04, 0.95};
-    cut.offsets = {0.0, 4.0, -3.0, 2.0, -5.0, 3.0};
-    cut.noise_dn = 1.5;
-    cut.seed = 11;
-    s.images = CutSubimages(frame, s.truth, cut);
-    for (GrayImage& image : s.images) image = image.array().round().max(0.0f).min(255.0f).matrix();
-    return s;
-  }();
+  static const std::optional<MatchScene> scene = MakeBoruszynScene(1);
   return scene;
 }
 

@@ -636,6 +636,21 @@ const std::vector<Case>& Cases() {
                 " --out " + d.File("m.csv");
        },
        2, "list.csv:3: sub-image XX", "m.csv"},
+      {"match_detector_with_the_predicted_search",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Write(d.File("a.tif"), "x");
+         return "match --camera " + sim + "/camera_nominal.yaml --frame 1 --images I=" +
+                d.File("a.tif") + " --detector sift --out " + d.File("m.csv");
+       },
+       2, "--detector applies to --search descriptors", "m.csv"},
+      {"match_unknown_search",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         return "match --camera " + sim + "/camera_nominal.yaml --frame 1 --images I=x.tif"
+                " --search nearest --out " + d.File("m.csv");
+       },
+       2, "search must be descriptors or predicted (got nearest)", "m.csv"},
       // ---- camera convert / show (issue 15): each format's reader ----
       {"metashape_calibration_without_f",
        [](const TempDir& d) {

@@ -19,7 +19,8 @@ py::dict Match(const std::string& camera,
                const py::object& images,
                const std::string& frame,
                const py::object& list,
-               const std::string& detector,
+               const std::string& search,
+               const py::object& detector,
                bool lsm,
                double sigma_px,
                double cell_px,
@@ -32,7 +33,8 @@ py::dict Match(const std::string& camera,
   request.images = ImagesOptionText(images);
   request.frame = frame;
   request.list = list.is_none() ? "" : py::str(list).cast<std::string>();
-  request.detector = detector;
+  request.search = search;
+  request.detector = detector.is_none() ? "" : py::str(detector).cast<std::string>();
   request.lsm = lsm ? "on" : "off";
   request.sigma_px = sigma_px;
   request.cell_px = cell_px;
@@ -73,14 +75,18 @@ void BindMatch(py::module_& m) {
         py::arg("images") = py::none(),
         py::arg("frame") = "",
         py::arg("list") = py::none(),
-        py::arg("detector") = "sift",
+        py::arg("search") = "predicted",
+        py::arg("detector") = py::none(),
         py::arg("lsm") = true,
         py::arg("sigma_px") = 0.3,
         py::arg("cell_px") = 100.0,
         py::arg("out") = "",
         "Tie points in the overlap strips of multi-CCD frames as `aerocal match`: one frame "
         "(images {sub-image id: file} or 'I=a.tif,...', frame its id) or a flight (list: CSV "
-        "frame,subimage,image); detector sift | foerstner; lsm: least-squares refinement. Returns "
+        "frame,subimage,image); search predicted (Foerstner points found by correlation at the "
+        "nominal "
+        "prediction) | descriptors; detector sift | foerstner (descriptors only); lsm: "
+        "least-squares refinement. Returns "
         "{frame, point, subimage: lists, pixel: (N, 2) sub-image pixels, sigma_px: (N,), table: "
         "the per-strip counts}; out: also the command's stitch_obs.csv. The GIL is released.");
 }

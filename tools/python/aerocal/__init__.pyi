@@ -199,5 +199,6 @@ def pushbroom_control(camera: str, pos: str, line_image: str, reference_camera: 
                       **options: Any) -> Dict[str, Any]: ...
 
 def match(camera: str, images: Union[Mapping[str, str], str, None] = None, frame: str = "",
-          list: Optional[str] = None, detector: str = "sift", lsm: bool = True,
+          list: Optional[str] = None, search: str = "predicted",
+          detector: Optional[str] = None, lsm: bool = True,
           sigma_px: float = 0.3, cell_px: float = 100.0, out: str = "") -> Dict[str, Any]: ...
