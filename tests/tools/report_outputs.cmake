@@ -3,7 +3,9 @@
 #   real ODM block (skipped without ../shared/data), read back with csv / pandas and json (cli);
 # - tools/render: the ODM block's and a flight's reports and a test field's certificate rendered
 #   (HTML -> PNG by headless chromium, PDF -> PNG by pdftoppm), sections present, nothing past
-#   the page box; seconds per page, so label long (`ctest -L render`); skipped without chromium.
+#   the page box; seconds per page, so label long (`ctest -L render`); skipped without chromium;
+# - tools/render_pdf: the same without chromium (AEROCAL_RENDER_PARTS=pdf): the PDFs typeset by
+#   WeasyPrint, rasterised by pdftoppm, every page's ink inside its margins (cli: in CI).
 # AEROCAL_PYTHON3 comes from report.cmake (included before this file).
 get_filename_component(AEROCAL_REPORT_OUTPUTS_ROOT "${CMAKE_CURRENT_LIST_DIR}/../.." ABSOLUTE)
 set(AEROCAL_REPORT_OUTPUTS_ENV
@@ -16,3 +18,8 @@ add_test(NAME tools/render
   COMMAND ${AEROCAL_PYTHON3} -m unittest -v render_test
   WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR})
 set_tests_properties(tools/render PROPERTIES LABELS "render;long" TIMEOUT 900 ENVIRONMENT "${AEROCAL_REPORT_OUTPUTS_ENV}")
+add_test(NAME tools/render_pdf
+  COMMAND ${AEROCAL_PYTHON3} -m unittest -v render_test
+  WORKING_DIRECTORY ${CMAKE_CURRENT_LIST_DIR})
+set_tests_properties(tools/render_pdf PROPERTIES LABELS "render;cli" TIMEOUT 600
+  ENVIRONMENT "${AEROCAL_REPORT_OUTPUTS_ENV};AEROCAL_RENDER_PARTS=pdf")
