@@ -16,15 +16,25 @@
 namespace aerocal::fuzz {
 
 /// A per-process scratch folder for readers that take paths.
+// Removed when the process exits normally (libFuzzer's -max_total_time and -runs end by exit()),
+// so that runs do not leave a folder each in the temporary directory; a crash leaves it to look at.
+struct ScratchDirectory {
+  std::string path;
+  ~ScratchDirectory() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path, ignored);
+  }
+};
+
 inline const std::string& ScratchDir() {
-  static const std::string dir = [] {
+  static const ScratchDirectory dir = [] {
     const std::string d =
         (std::filesystem::temp_directory_path() / ("aerocal_fuzz_" + std::to_string(::getpid())))
             .string();
     std::filesystem::create_directories(d);
-    return d;
+    return ScratchDirectory{d};
   }();
-  return dir;
+  return dir.path;
 }
 
 /// Writes `text` to ScratchDir()/name and returns the path.
