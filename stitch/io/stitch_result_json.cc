@@ -257,11 +257,18 @@ calib::Camera ApplyStitchResult(const calib::Camera& camera,
   const json doc = ReadResult(path, {"stitch"}, "`aerocal stitch`");
   const json* source = &doc;
   if (!frame.empty()) {
+    // A frame's result is an object whose "frame" is that id; a flight's "frames" an array of them.
+    auto is_frame = [&frame](const json& j) {
+      return j.is_object() && j.contains("frame") && j["frame"].is_string() &&
+             j["frame"].get<std::string>() == frame;
+    };
     source = nullptr;
-    if (doc.value("frame", std::string()) == frame) source = &doc;
-    if (doc.contains("frames"))
+    if (is_frame(doc)) source = &doc;
+    if (doc.contains("frames")) {
+      if (!doc["frames"].is_array()) throw InputError(path + ": frames: not an array");
       for (const json& f : doc["frames"])
-        if (f.value("frame", std::string()) == frame) source = &f;
+        if (is_frame(f)) source = &f;
+    }
     if (!source) throw InputError(path + ": no result for frame " + frame);
   }
   if (!source->contains("subimages") || !(*source)["subimages"].is_array())

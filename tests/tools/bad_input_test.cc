@@ -509,6 +509,28 @@ const std::vector<Case>& Cases() {
                 " --images I=a.tif --out " + d.File("v.tif");
        },
        2, "m.json: sub-image I: the affine mapping is singular", "v.tif"},
+      // Found by fuzz_stitch_result (2026-11-28): `frames` not an array ended in an uncaught
+      // nlohmann type_error (exit 1 in the command, abort in the fuzzer).
+      {"resample_frames_not_an_array",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Write(d.File("m.json"),
+               R"({"kind": "stitch", "schema_version": 2, "frames": "conformal",
+                   "subimages": [{"id": "I", "model": "affine", "params": [1,0,0,0,1,0]}]})");
+         return "resample --camera " + sim + "/camera_nominal.yaml --mapping " + d.File("m.json") +
+                " --frame 0001 --images I=a.tif --out " + d.File("v.tif");
+       },
+       2, "m.json: frames: not an array", "v.tif"},
+      {"resample_frame_id_not_a_string",
+       [](const TempDir& d) {
+         const auto sim = Flight(d);
+         Write(d.File("m.json"),
+               R"({"kind": "stitch", "schema_version": 2, "frames": [{"frame": 1}, "x"],
+                   "subimages": [{"id": "I", "model": "affine", "params": [1,0,0,0,1,0]}]})");
+         return "resample --camera " + sim + "/camera_nominal.yaml --mapping " + d.File("m.json") +
+                " --frame 0001 --images I=a.tif --out " + d.File("v.tif");
+       },
+       2, "m.json: no result for frame 0001", "v.tif"},
       // ---- COLMAP ----
       {"colmap_k1_minus_one",
        [](const TempDir& d) {
