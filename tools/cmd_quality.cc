@@ -4,6 +4,7 @@
 // contrast transfer of bar groups and the limiting frequency at a threshold
 // (stitch/quality/bar_target.h); `quality star` the same per radius of a Siemens star
 // (stitch/quality/siemens_star.h). stitch/quality/README.md.
+#include "calib/camera/camera_io.h"
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
@@ -13,6 +14,7 @@
 #include "stitch/quality/siemens_star.h"
 #include "stitch/quality/slanted_edge.h"
 #include "tools/command_registry.h"
+#include "tools/edge_target_regions.h"
 #include "tools/option_ranges.h"
 
 #include <algorithm>
@@ -57,6 +59,17 @@ struct MtfArgs {
   double gamma = 1.0;
   int oversampling = 4;
   GroundArgs ground;
+  // --targets: the regions from edge targets and the image's adjusted orientation.
+  std::string targets, camera, orientation, image_id, origin = "0,0";
+  std::vector<std::string> only_targets;
+  double target_length_px = 64.0, target_half_width_px = 32.0;
+};
+
+// One region to measure: how the user or the target file named it, and what the target adds.
+struct MtfRegion {
+  std::string label;  // "--roi TEXT" or "target ID"
+  stitch::PixelRegion region;
+  nlohmann::json extra = nlohmann::json::object();
 };
 
 struct StarArgs {
@@ -130,15 +143,95 @@ void AddGround(
   }
 }
 
+// "col,row" in px (sub-pixel); ConfigError naming `option` otherwise.
+Eigen::Vector2d ParsePoint(const std::string& text, const std::string& option) {
+  std::istringstream in(text);
+  double col = 0, row = 0;
+  char comma = 0;
+  std::string rest;
+  if (!(in >> col >> comma >> row) || comma != ',' || (in >> rest) || !std::isfinite(col) ||
+      !std::isfinite(row))
+    throw ConfigError(option + ": expected col,row in px (got '" + text + "')");
+  return {col, row};
+}
+
+void CheckTargetArgs(const MtfArgs& args) {
+  if (args.rois.empty() && args.targets.empty())
+    throw ConfigError("quality mtf: give the edge regions with --roi or --targets");
+  if (args.targets.empty()) return;
+  if (args.camera.empty() || args.orientation.empty() || args.image_id.empty())
+    throw ConfigError("--targets needs --camera, --orientation and --image-id");
+  if (!args.sub_image.empty())
+    throw ConfigError(
+        "--targets: the edges are projected into the virtual image; a raw sub-image (--sub-image) "
+        "is not supported yet");
+  const Eigen::Vector2d origin = ParsePoint(args.origin, "--image-origin");
+  if (origin != origin.array().round().matrix())
+    throw ConfigError("--image-origin: whole pixels expected (got '" + args.origin + "')");
+}
+
+// The regions of --targets in `image`, each with its target's id, projected edge and local GSD;
+// the skipped targets by name into `doc`'s `targets` table.
+std::vector<MtfRegion> TargetRegions(const MtfArgs& args,
+                                     const stitch::GrayImage& image,
+                                     nlohmann::json* doc) {
+  const std::vector<stitch::EdgeTarget> targets = ReadEdgeTargets(args.targets);
+  const calib::Camera camera = calib::ReadCamera(args.camera);
+  const ExposureOrientation orientation = ReadExposureOrientation(args.orientation, args.image_id);
+  const Eigen::Vector2i origin = ParsePoint(args.origin, "--image-origin").cast<int>();
+  stitch::EdgeTargetRegionOptions options;
+  options.max_length_px = args.target_length_px;
+  options.half_width_px = args.target_half_width_px;
+  const FoundEdgeRegions found = FindEdgeRegions(camera,
+                                                 orientation,
+                                                 targets,
+                                                 args.only_targets,
+                                                 origin,
+                                                 static_cast<int>(image.cols()),
+                                                 static_cast<int>(image.rows()),
+                                                 options);
+  std::vector<MtfRegion> regions;
+  for (const FoundEdgeRegion& f : found.found) {
+    const nlohmann::json extra = {
+        {"target", f.target.id},
+        {"projected_start_px", {f.target.start_px.x(), f.target.start_px.y()}},
+        {"projected_end_px", {f.target.end_px.x(), f.target.end_px.y()}},
+        {"projected_offset_px", f.projected_offset_px},
+        {"target_gsd_m", f.target.gsd_m}};
+    regions.push_back({"target " + f.target.id, f.region, extra});
+  }
+  nlohmann::json skipped = nlohmann::json::array();
+  for (const auto& [id, reason] : found.skipped)
+    skipped.push_back({{"id", id}, {"reason", reason}});
+  (*doc)["targets"] = {{"file", args.targets},
+                       {"camera", args.camera},
+                       {"orientation", args.orientation},
+                       {"image_id", args.image_id},
+                       {"image_origin_px", {origin.x(), origin.y()}},
+                       {"length_px", args.target_length_px},
+                       {"half_width_px", args.target_half_width_px},
+                       {"found", found.found.size()},
+                       {"skipped_count", found.skipped.size()},
+                       {"skipped", skipped}};
+  if (!orientation.adjustment.empty()) (*doc)["targets"]["adjustment"] = orientation.adjustment;
+  for (const auto& [id, reason] : found.skipped)
+    std::printf("target %s skipped: %s\n", id.c_str(), reason.c_str());
+  return regions;
+}
+
 int RunMtf(const MtfArgs& args) {
   CheckOutputFile(args.out, "--out");
-  std::vector<stitch::PixelRegion> regions;
-  for (const auto& text : args.rois) regions.push_back(ParseRegion(text));
+  std::vector<MtfRegion> regions;
+  for (const auto& text : args.rois) regions.push_back({"--roi " + text, ParseRegion(text)});
+  CheckTargetArgs(args);
   args.ground.Check();
   stitch::SlantedEdgeOptions options;
   options.gamma = args.gamma;
   options.oversampling = args.oversampling;
   const stitch::GrayImage image = stitch::ReadGrayImage(args.image);
+  nlohmann::json doc = nlohmann::json::object();
+  if (!args.targets.empty())
+    for (MtfRegion& r : TargetRegions(args, image, &doc)) regions.push_back(std::move(r));
 
   nlohmann::json edges = nlohmann::json::array();
   std::vector<stitch::SlantedEdgeResult> per_axis[2];
@@ -146,12 +239,14 @@ int RunMtf(const MtfArgs& args) {
   for (size_t i = 0; i < regions.size(); ++i) {
     stitch::SlantedEdgeResult r;
     try {
-      r = stitch::MeasureSlantedEdge(image, regions[i], options);
+      r = stitch::MeasureSlantedEdge(image, regions[i].region, options);
     } catch (const InputError& e) {
-      throw InputError("--roi " + args.rois[i] + ": " + args.image + ": " + e.what());
+      throw InputError(regions[i].label + ": " + args.image + ": " + e.what());
     }
     nlohmann::json edge = stitch::SlantedEdgeToJson(r);
-    edge["roi"] = {regions[i].col, regions[i].row, regions[i].width, regions[i].height};
+    const stitch::PixelRegion& roi = regions[i].region;
+    edge["roi"] = {roi.col, roi.row, roi.width, roi.height};
+    edge.update(regions[i].extra);
     const std::string direction = Direction(r.axis, args.flight_axis);
     if (!direction.empty()) edge["direction"] = direction;
     AddGround(args.ground, r.mtf50_cy_px, r.mtf50_u_cy_px, "mtf50", &edge);
@@ -159,9 +254,9 @@ int RunMtf(const MtfArgs& args) {
     determined = determined && std::isfinite(r.mtf50_cy_px);
     if (std::isfinite(r.mtf50_cy_px)) per_axis[r.axis == stitch::MtfAxis::kX ? 0 : 1].push_back(r);
     std::printf(
-        "roi %s: MTF along %s, slant %.2f deg, MTF50 %.4f +- %.4f cycles/px (U, k = 2), "
+        "%s: MTF along %s, slant %.2f deg, MTF50 %.4f +- %.4f cycles/px (U, k = 2), "
         "MTF at Nyquist %.3f\n",
-        args.rois[i].c_str(),
+        regions[i].label.c_str(),
         std::string(stitch::MtfAxisName(r.axis)).c_str(),
         r.angle_deg,
         r.mtf50_cy_px,
@@ -179,14 +274,16 @@ int RunMtf(const MtfArgs& args) {
     AddGround(args.ground, c.mtf50_cy_px, c.mtf50_u_cy_px, "mtf50", &combined);
     axes[std::string(stitch::MtfAxisName(axis))] = combined;
   }
-  nlohmann::json doc = {{"image", args.image},
-                        {"width_px", image.cols()},
-                        {"height_px", image.rows()},
-                        {"method", "ISO 12233:2017 e-SFR (slanted edge)"},
-                        {"options", {{"gamma", args.gamma}, {"oversampling", args.oversampling}}},
-                        {"edges", edges},
-                        {"axes", axes},
-                        {"determined", determined}};
+  // An image where every target was skipped measured nothing: not determined (exit 3).
+  determined = determined && !regions.empty();
+  doc.update({{"image", args.image},
+              {"width_px", image.cols()},
+              {"height_px", image.rows()},
+              {"method", "ISO 12233:2017 e-SFR (slanted edge)"},
+              {"options", {{"gamma", args.gamma}, {"oversampling", args.oversampling}}},
+              {"edges", edges},
+              {"axes", axes},
+              {"determined", determined}});
   args.ground.Write(&doc);
   if (!args.flight_axis.empty()) doc["flight_axis"] = args.flight_axis;
   // Which image of a multi-CCD / multi-head camera: the resampling loss (virtual against the raw
@@ -250,23 +347,11 @@ int RunBars(const BarsArgs& args) {
   return determined ? kExitOk : kExitNotConverged;
 }
 
-// "col,row" in px (sub-pixel); ConfigError naming --centre otherwise.
-Eigen::Vector2d ParseCentre(const std::string& text) {
-  std::istringstream in(text);
-  double col = 0, row = 0;
-  char comma = 0;
-  std::string rest;
-  if (!(in >> col >> comma >> row) || comma != ',' || (in >> rest) || !std::isfinite(col) ||
-      !std::isfinite(row))
-    throw ConfigError("--centre: expected col,row in px (got '" + text + "')");
-  return {col, row};
-}
-
 int RunStar(const StarArgs& args) {
   CheckOutputFile(args.out, "--out");
   args.ground.Check();
   stitch::SiemensStar star;
-  star.centre_px = ParseCentre(args.centre);
+  star.centre_px = ParsePoint(args.centre, "--centre");
   star.cycles = args.cycles;
   star.outer_radius_px = args.outer_radius_px;
   star.inner_radius_px = args.inner_radius_px;
@@ -376,11 +461,32 @@ CommandRun Setup(CLI::App& app) {
        "--image", mtf->image, "Grey-value image (8 or 16 bit; colour is converted to grey)")
       ->required();
   m->add_option(
-       "--roi",
-       mtf->rois,
-       "Edge region col,row,width,height (px, at least 16 x 16), one edge slanted by 1..35 "
-       "deg; repeat for more edges")
-      ->required();
+      "--roi",
+      mtf->rois,
+      "Edge region col,row,width,height (px, at least 16 x 16), one edge slanted by 1..35 "
+      "deg; repeat for more edges (or --targets)");
+  m->add_option(
+      "--targets",
+      mtf->targets,
+      "Edge targets' ground ends (targets.csv, docs/formats.md): the regions are found by "
+      "projecting each edge with --camera and the image's orientation from --orientation");
+  m->add_option("--camera", mtf->camera, "--targets: the adjusted camera file (YAML)");
+  m->add_option("--orientation",
+                mtf->orientation,
+                "--targets: adjust or flight result.json holding the image's exterior orientation");
+  m->add_option("--image-id", mtf->image_id, "--targets: the image's id in --orientation");
+  m->add_option("--image-origin",
+                mtf->origin,
+                "--targets: the file's top-left pixel col,row in the full (virtual) image, for a "
+                "file that is a window of it");
+  m->add_option("--target", mtf->only_targets, "--targets: measure only this edge id; repeat");
+  m->add_option(
+       "--target-length-px", mtf->target_length_px, "--targets: region length along the edge (px)")
+      ->check(FiniteRange(16, 1e4));
+  m->add_option("--target-half-width-px",
+                mtf->target_half_width_px,
+                "--targets: region width each side of the edge (px)")
+      ->check(FiniteRange(8, 1e4));
   m->add_option(
        "--gamma", mtf->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
       ->check(FiniteRange(1e-6, 10.0))

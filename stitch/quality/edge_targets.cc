@@ -13,8 +13,9 @@ EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
                                     const EdgeTarget& target,
                                     const EdgeTargetRegionOptions& options) {
   AEROCAL_CHECK(options.half_width_px >= 8.0 && options.used_fraction > 0.0 &&
-                options.used_fraction <= 1.0)
-      << "half_width_px >= 8 and 0 < used_fraction <= 1";
+                options.used_fraction <= 1.0 &&
+                (options.max_length_px == 0.0 || options.max_length_px >= 16.0))
+      << "half_width_px >= 8, 0 < used_fraction <= 1, max_length_px 0 or >= 16";
   EdgeTargetRegion out;
   out.id = target.id;
   if (!camera.ProjectToPixel(opk_rad, center_m, target.start_m, &out.start_px) ||
@@ -35,7 +36,9 @@ EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
                              std::max(std::abs(d.x()), std::abs(d.y()))) *
                   180.0 / 3.14159265358979323846;
   const Eigen::Vector2d middle = 0.5 * (out.start_px + out.end_px);
-  const Eigen::Vector2d half = 0.5 * options.used_fraction * d;
+  double fraction = options.used_fraction;
+  if (options.max_length_px > 0.0) fraction = std::min(fraction, options.max_length_px / length_px);
+  const Eigen::Vector2d half = 0.5 * fraction * d;
   const Eigen::Vector2d a = middle - half, b = middle + half;
   // Along the edge: the used part; across it: half_width to each side of the edge's extreme
   // positions.

@@ -5,8 +5,9 @@
 // A target's edge is the segment between two ground points (object frame, m). Both ends are
 // projected into the (virtual) image with the camera and the exposure's orientation
 // (calib::Camera::ProjectToPixel: collinearity and the camera's distortion). The region spans the
-// central `used_fraction` of the projected edge along it and `half_width_px` to both sides across
-// it, as a pixel-axis rectangle; the local GSD is the edge's ground length over its image length.
+// central `used_fraction` of the projected edge (at most `max_length_px`) along it and
+// `half_width_px` to both sides across it, as a pixel-axis rectangle; the local GSD is the edge's
+// ground length over its image length.
 #pragma once
 
 #include "calib/camera/camera.h"
@@ -27,6 +28,7 @@ struct EdgeTarget {
 struct EdgeTargetRegionOptions {
   double half_width_px = 32.0;  // across the edge, each side (>= 8)
   double used_fraction = 0.8;   // of the edge's length, centred (0 < f <= 1; the ends are corners)
+  double max_length_px = 0.0;  // and at most this long along the edge (px, 0: no limit, else >= 16)
 };
 
 struct EdgeTargetRegion {

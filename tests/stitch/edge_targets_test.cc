@@ -58,6 +58,16 @@ TEST(EdgeTargets, RegionSlantAndGsdOfANadirImage) {
   EXPECT_EQ(r.region.height, 96);
   EXPECT_EQ(r.region.col, 159);
   EXPECT_EQ(r.region.width, 69);
+  // At most 64 px along the edge (max_length_px): rows 117.5 .. 181.5, cols 191.1 .. 194.9.
+  EdgeTargetRegionOptions short_region;
+  short_region.max_length_px = 64.0;
+  const EdgeTargetRegion s =
+      RegionOfEdgeTarget(camera, Eigen::Vector3d::Zero(), kCenter, kTarget, short_region);
+  ASSERT_TRUE(s.usable) << s.reason;
+  EXPECT_EQ(s.region.row, 118);
+  EXPECT_EQ(s.region.height, 64);
+  EXPECT_EQ(s.region.col, 160);
+  EXPECT_EQ(s.region.width, 67);
   // A target outside the image is not usable, and says why.
   const EdgeTargetRegion far = RegionOfEdgeTarget(
       camera, Eigen::Vector3d::Zero(), kCenter, {"far", {30.0, -6.0, 0.0}, {30.7, 6.0, 0.0}});

@@ -352,6 +352,79 @@ TEST_F(FlightWorkflow, EdgeTargetsShowTheLossOfBilinearResampling) {
   }
 }
 
+// `quality mtf --targets` (issue 36 item 1): each virtual patch's edge region found by projecting
+// the target's ground ends with the flight's adjusted camera and exposure, instead of the --roi
+// the simulator wrote. The tile of patch k is a window of the virtual image whose top-left pixel
+// is the patch's origin less the tile's place in the mosaic (8 tiles of 112 px a row). The MTF50
+// agrees with the --roi measurement's within its U (k = 2), and the projected edge lies within a
+// pixel of the measured one (the adjustment's orientation error is a few hundredths of a px).
+TEST_F(FlightWorkflow, EdgeRegionsFoundFromTargetsAndTheAdjustedOrientation) {
+  ASSERT_EQ(run_->exit_code, 0) << run_->output;
+  const auto by_roi = aerocal::testing::ReadJson(dir_->File("quality_virtual.json"));
+  std::ifstream in(dir_->File("data/edge_targets/patches.csv"));
+  std::string line;
+  const std::string common = "quality mtf --image " + dir_->File("data/edge_targets/virtual.tif") +
+                             " --virtual --targets " + dir_->File("data/edge_targets/targets.csv") +
+                             " --camera " + dir_->File("report/camera_calibrated.yaml") +
+                             " --orientation " + dir_->File("report/result.json") +
+                             " --target-length-px 64 --target-half-width-px 32";
+  int k = -1;
+  for (int n = 0; std::getline(in, line) && k < 5; ++n) {
+    if (n < 2) continue;  // the comment and the header
+    ++k;
+    std::vector<std::string> f;
+    std::stringstream fields(line);
+    for (std::string v; std::getline(fields, v, ',');) f.push_back(v);
+    const int col = std::stoi(f[16]) - (k % 8) * 112, row = std::stoi(f[17]) - (k / 8) * 112;
+    const std::string out = dir_->File("targets_" + std::to_string(k) + ".json");
+    const auto r = testing::RunAerocal(common + " --image-id " + f[1] + " --target " + f[0] +
+                                       " --image-origin " + std::to_string(col) + "," +
+                                       std::to_string(row) + " --out " + out);
+    ASSERT_EQ(r.exit_code, 0) << line << "\n" << r.output;
+    const auto doc = aerocal::testing::ReadJson(out);
+    ASSERT_EQ(doc["edges"].size(), 1u) << line;
+    const auto& found = doc["edges"][0];
+    const auto& given = by_roi["edges"][k];
+    EXPECT_EQ(found["target"], f[0]);
+    EXPECT_EQ(found["axis"], f[3]);
+    EXPECT_NEAR(found["mtf50_cy_px"].get<double>(),
+                given["mtf50_cy_px"].get<double>(),
+                given["mtf50_expanded_cy_px"].get<double>())
+        << line;
+    EXPECT_NEAR(
+        found["edge_offset_px"].get<double>(), found["projected_offset_px"].get<double>(), 1.0)
+        << line;
+  }
+  ASSERT_EQ(k, 5);
+  // The whole mosaic taken as the image's top-left corner: every target of the image lies outside
+  // the file; each is skipped by name and counted, nothing is measured (exit 3).
+  const auto none =
+      testing::RunAerocal(common + " --image-id 0003 --out " + dir_->File("targets_none.json"));
+  EXPECT_EQ(none.exit_code, 3) << none.output;
+  const auto doc = aerocal::testing::ReadJson(dir_->File("targets_none.json"));
+  EXPECT_EQ(doc["targets"]["found"], 0);
+  EXPECT_EQ(doc["targets"]["skipped_count"], 8);
+  EXPECT_EQ(doc["targets"]["skipped"].size(), 8u);
+  // Bad input: an image the result does not hold, a target row with a bad number (exit 2,
+  // FILE:LINE).
+  const auto unknown =
+      testing::RunAerocal(common + " --image-id 9999 --out " + dir_->File("targets_bad.json"));
+  EXPECT_EQ(unknown.exit_code, 2) << unknown.output;
+  EXPECT_NE(unknown.output.find("no exposure of image '9999'"), std::string::npos)
+      << unknown.output;
+  WriteFileAtomically(
+      dir_->File("bad_targets.csv"),
+      "id,start_x,start_y,start_z,end_x,end_y,end_z\nT1,0,0,0,1,1,0\nT2,0,x,0,1,1,0\n");
+  const auto bad = testing::RunAerocal(
+      "quality mtf --image " + dir_->File("data/edge_targets/virtual.tif") + " --targets " +
+      dir_->File("bad_targets.csv") + " --camera " + dir_->File("report/camera_calibrated.yaml") +
+      " --orientation " + dir_->File("report/result.json") + " --image-id 0003 --out " +
+      dir_->File("targets_bad.json"));
+  EXPECT_EQ(bad.exit_code, 2) << bad.output;
+  EXPECT_NE(bad.output.find("bad_targets.csv:3"), std::string::npos) << bad.output;
+  EXPECT_FALSE(std::filesystem::exists(dir_->File("targets_bad.json")));
+}
+
 // `flight --quality`: result.json and report.html state the resampling loss per axis, the virtual
 // image's MTF50 against the mean of the raw sub-images' (each the combined MTF50 of its edges),
 // with its U (k = 2) from the results' standard uncertainties.

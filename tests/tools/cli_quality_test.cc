@@ -89,6 +89,14 @@ TEST(CliQuality, BadOptionsExitTwoNamingTheOption) {
       {" --roi 0,0,128,128 --flight-axis z", "--flight-axis"},
       {" --roi 0,0,128,128 --gsd-sigma-m 0.01", "--gsd-sigma-m"},
       {" --roi 0,0,128,128 --sub-image I --virtual", "--virtual"},  // a raw or the virtual image
+      {"", "--roi or --targets"},                                   // no region at all
+      {" --targets t.csv", "--targets needs --camera"},             // no orientation
+      {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --sub-image I",
+       "--sub-image"},  // projected into the virtual image only
+      {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --image-origin 1.5,0",
+       "--image-origin"},
+      {" --roi 0,0,128,128 --target-length-px 8", "--target-length-px"},
+      {" --roi 0,0,128,128 --target-half-width-px 2", "--target-half-width-px"},
   };
   for (const auto& [options, name] : cases) {
     const auto run = RunAerocal(base + options);
