@@ -5,6 +5,7 @@
 #include "calib/core/error.h"
 #include "calib/core/result_file.h"
 #include "calib/core/string_printf.h"
+#include "tools/calibrate_direction_units.h"
 #include "tools/calibrate_models.h"
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
@@ -111,6 +112,8 @@ nlohmann::json WriteCamera(const DirectionsArgs& args,
 }  // namespace
 
 CalibrateOutcome CalibrateFromDirections(const DirectionsArgs& args) {
+  // A rig file: its heads are the units of one adjustment (the directions' `unit` column).
+  if (IsRigCameraFile(args.camera)) return CalibrateRigFromDirections(args);
   CalibrateOutcome outcome;
   const calib::Camera camera = calib::ReadCamera(args.camera, calib::CameraModels::kAny);
   const calib::CameraModelId beside_model =

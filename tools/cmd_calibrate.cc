@@ -41,10 +41,12 @@ void AddCalibrateInputs(CLI::App& app, CalibrateArgs* args) {
                  args->board,
                  "Board of --images: chessboard|circles|acircles:COLSxROWS:SPACING_MM, e.g. "
                  "chessboard:9x6:25 (inner corners)");
-  app.add_option("--directions",
-                 args->directions,
-                 "Laboratory calibration from known directions: a collimator array or a goniometer "
-                 "sequence (CSV target,col,row,... of docs/formats.md 'Directions file')");
+  app.add_option(
+      "--directions",
+      args->directions,
+      "Laboratory calibration from known directions: a collimator array or a goniometer "
+      "sequence (CSV target,col,row,... of docs/formats.md 'Directions file'); with a rig file "
+      "as --camera, its unit column names each row's head (one adjustment)");
 }
 
 // What is calibrated and how its uncertainty is stated.

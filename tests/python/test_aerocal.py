@@ -585,6 +585,20 @@ def test_calibrate_from_board_corners(tmp_path):
         aerocal.calibrate(nominal, corners={"a": [1, 2, 3]}, board="chessboard:9x6:25")
 
 
+def _directions_both_ways(tmp_path, camera, rows):
+    """The directions file of `rows` calibrated by the command and by the module: the same result."""
+    directions = tmp_path / "directions.csv"
+    directions.write_text("\n".join(rows) + "\n")
+    cli = tmp_path / "cli.json"
+    code, out = run("calibrate", "--camera", str(camera), "--directions", str(directions), "--out", str(cli))
+    assert code in (0, 3), out
+    r = aerocal.calibrate(str(camera), directions=str(directions))
+    with open(cli) as f:
+        expected = json.load(f)
+    assert _without_clock(json.loads(r.to_json())) == _without_clock(expected)
+    return directions, cli, code, r, expected
+
+
 def test_calibrate_from_directions_equals_the_command(tmp_path):
     camera = tmp_path / "camera.yaml"
     camera.write_text("name: lab\npixel_size_mm: 0.006\nformat_px: [6000, 4000]\ninterior: {c: 50.0}\n")
@@ -597,16 +611,8 @@ def test_calibrate_from_directions_equals_the_command(tmp_path):
     rows = ["target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec"]
     for k, (p, ak, ek) in enumerate(zip(pixels, np.degrees(a).ravel(), np.degrees(e).ravel())):
         rows.append(f"C{k},{p[0]:.5f},{p[1]:.5f},0.05,{ak:.6f},{ek:.6f},0.5")
-    directions = tmp_path / "directions.csv"
-    directions.write_text("\n".join(rows) + "\n")
-    cli = tmp_path / "cli.json"
-    code, out = run("calibrate", "--camera", str(camera), "--directions", str(directions), "--out", str(cli))
-    assert code in (0, 3), out
-    r = aerocal.calibrate(str(camera), directions=str(directions))
+    directions, cli, code, r, expected = _directions_both_ways(tmp_path, camera, rows)
     assert r.valid == (code == 0)
-    with open(cli) as f:
-        expected = json.load(f)
-    assert _without_clock(json.loads(r.to_json())) == _without_clock(expected)
     assert r.calibration["method"] == expected["calibration"]["method"]
     with pytest.raises(ValueError, match="give either directions"):
         aerocal.calibrate(str(camera), directions=str(directions), observations=str(directions))
@@ -622,6 +628,31 @@ def test_calibrate_from_directions_equals_the_command(tmp_path):
     with pytest.raises(ValueError, match="lab.yaml"):
         aerocal.certificate(str(cli), str(cert), lab=str(tmp_path / "lab.yaml"))
 
+
+def test_calibrate_rig_heads_from_directions_equals_the_command(tmp_path):
+    # Two heads of a rig (the second turned by -20 deg about y) before one collimator array; the
+    # directions file's unit column names each row's head (docs/formats.md "Several units").
+    head = "pixel_size_mm: 0.006, format_px: [6000, 4000], interior: {c: 50.0}"
+    rig = tmp_path / "rig.yaml"
+    rig.write_text("name: lab rig\nrig:\n  reference_head: A\n  heads:\n"
+                   f"    - {{id: A, {head}}}\n    - {{id: B, {head}, mount_deg: [0, -20, 0]}}\n")
+    camera = tmp_path / "camera.yaml"
+    camera.write_text("name: lab\npixel_size_mm: 0.006\nformat_px: [6000, 4000]\ninterior: {c: 50.0}\n")
+    a, e = np.meshgrid(np.radians(np.arange(-15, 36, 3.0)), np.radians(np.linspace(-9, 9, 7)))
+    t = np.stack([np.sin(a) * np.cos(e), np.sin(e), -np.cos(a) * np.cos(e)], axis=-1).reshape(-1, 3)
+    rng = np.random.default_rng(6)
+    rows = ["target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,unit"]
+    for unit, phi in (("A", 0.0), ("B", np.radians(-20.0))):
+        ry = np.array([[np.cos(phi), 0, np.sin(phi)], [0, 1, 0], [-np.sin(phi), 0, np.cos(phi)]])
+        v = t @ ry  # head-frame rays, M^T t per row
+        pixels = aerocal.Camera.read(str(camera)).ray_to_image(v[:, :2] / -v[:, 2:3])
+        pixels += rng.normal(0.0, 0.05, pixels.shape)
+        for k, (p, ak, ek) in enumerate(zip(pixels, np.degrees(a).ravel(), np.degrees(e).ravel())):
+            if 0 <= p[0] <= 5999 and 0 <= p[1] <= 3999:
+                rows.append(f"C{k},{p[0]:.5f},{p[1]:.5f},0.05,{ak:.6f},{ek:.6f},0.5,{unit}")
+    _, _, _, r, _ = _directions_both_ways(tmp_path, rig, rows)
+    assert [u["id"] for u in r.calibration["units"]] == ["A", "B"]
+    assert abs(r.calibration["units"][1]["mount_opk_deg"][1] + 20.0) < 0.01
 
 MATCH_CAMERA = """name: small
 pixel_size_mm: 0.009

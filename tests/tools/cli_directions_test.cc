@@ -4,8 +4,11 @@
 // unknown direction. The oracle: c, x0, y0 and the distortion within 3 reported sigmas of the
 // truth, the method stated in the result and in the certificate, the camera file written in the
 // requested format; two series as groups give the stability table and the reproducibility
-// component; bad rows name FILE:LINE (exit 2, nothing written).
+// component; bad rows name FILE:LINE (exit 2, nothing written). A rig of three heads before one
+// collimator array (the `unit` column) recovers every head's interior, the shared rotation and the
+// mounts within 3 sigma, and writes the rig file again.
 #include "calib/camera/camera.h"
+#include "calib/camera/rig_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/string_printf.h"
 #include "tests/support/simulated_directions.h"
@@ -14,6 +17,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -105,6 +109,17 @@ void ExpectWithinThreeSigma(const nlohmann::json& j) {
   EXPECT_EQ(n, 8);
 }
 
+// The rotation to the instrument (the first unit's) within 3 sigma of kTrueOpk.
+void ExpectRotationWithinThreeSigma(const nlohmann::json& method) {
+  for (int a = 0; a < 3; ++a) {
+    const double error =
+        method["instrument_from_camera_opk_deg"][a].get<double>() * kDeg - kTrueOpk[a];
+    const double sigma =
+        method["instrument_from_camera_sigma_arcsec"][a].get<double>() * kArcSecond;
+    EXPECT_LE(std::abs(error), 3.0 * sigma) << "opk " << a;
+  }
+}
+
 TEST(CalibrateDirections, CollimatorArrayRecoversTheInteriorWithinThreeSigmaAndStatesTheMethod) {
   TempDir tmp("aerocal_directions_collimator");
   std::mt19937_64 rng(3610);
@@ -133,13 +148,7 @@ TEST(CalibrateDirections, CollimatorArrayRecoversTheInteriorWithinThreeSigmaAndS
   EXPECT_EQ(cal["camera_written"]["format"], "opencv");
   EXPECT_TRUE(std::filesystem::exists(tmp.File("calibrated.yml")));
   // The rotation to the instrument within 3 sigma; the start from the known directions is close.
-  for (int a = 0; a < 3; ++a) {
-    const double error =
-        cal["method"]["instrument_from_camera_opk_deg"][a].get<double>() * kDeg - kTrueOpk[a];
-    const double sigma =
-        cal["method"]["instrument_from_camera_sigma_arcsec"][a].get<double>() * kArcSecond;
-    EXPECT_LE(std::abs(error), 3.0 * sigma) << "opk " << a;
-  }
+  ExpectRotationWithinThreeSigma(cal["method"]);
   EXPECT_NEAR(cal["start"]["opk_deg"][2].get<double>(), 3.0, 0.1);
   // The budget of c: the adjustment's covariance (the directions' sigmas are in it), the pixel
   // pitch (zero: no tolerance stated) and the --budget file's type-B component (0.6 um
@@ -314,6 +323,186 @@ TEST(CalibrateDirections, BadRowsNameTheirLineAndNothingIsWritten) {
   EXPECT_EQ(one.exit_code, 2) << one.output;
   EXPECT_NE(one.output.find("1 group"), std::string::npos) << one.output;
   EXPECT_FALSE(std::filesystem::exists(tmp.File("result.json")));
+}
+
+// A rig of three heads (6000 x 4000 px of 6 um, c 50 mm; the side heads turned by -+20 deg about
+// y, with small offsets from the rig file's design mounts) before one collimator array of 25 x 7
+// directions over -36..36 x -9..9 deg: each head measures the directions on its format.
+struct RigHeadTruth {
+  const char* id;
+  double interior[10];
+  Eigen::Vector3d mount_deg;  // rig_from_head, the truth (the file holds the design: 0, phi, 0)
+};
+const RigHeadTruth kHeads[] = {
+    {"A", {50.012, 0.011, -0.007, -3e-5, 2e-8, -5e-12, 3e-6, -2e-6, 0, 0}, {0, 0, 0}},
+    {"B", {49.991, -0.008, 0.013, -2e-5, 1e-8, 0, -2e-6, 1e-6, 0, 0}, {0.05, -20.0, 0.1}},
+    {"C", {50.004, 0.006, 0.004, -4e-5, 3e-8, -8e-12, 1e-6, 3e-6, 0, 0}, {-0.04, 20.0, -0.08}}};
+
+std::string RigYaml() {
+  std::string yaml = "name: lab rig\nrig:\n  reference_head: A\n  heads:\n";
+  for (const auto& h : kHeads)
+    yaml += StringPrintf(
+        "    - {id: %s, pixel_size_mm: 0.006, format_px: [6000, 4000], "
+        "interior: {c: 50.0}, mount_deg: [0, %.1f, 0]}\n",
+        h.id,
+        h.mount_deg.y());
+  return yaml;
+}
+
+calib::Camera HeadTruth(const RigHeadTruth& h) {
+  calib::Camera camera = Truth();
+  std::copy(h.interior, h.interior + 10, camera.interior.begin());
+  return camera;
+}
+
+// instrument_from_head = R M_k (R the instrument_from_rig of the reference head A: kTrueOpk).
+Eigen::Vector3d HeadOpk(const RigHeadTruth& h) {
+  return calib::OpkFromRotation(calib::RotationFromOpk(kTrueOpk) *
+                                calib::RotationFromOpk(h.mount_deg * kDeg));
+}
+
+// Each head's rows (target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,unit).
+std::vector<std::string> RigRows(std::mt19937_64* rng) {
+  std::vector<std::string> rows;
+  for (const auto& h : kHeads) {
+    std::string text;
+    for (int i = 0; i < 25; ++i)
+      for (int j = 0; j < 7; ++j) {
+        const double a = -36.0 + 3.0 * i, e = -9.0 + 3.0 * j;
+        const Eigen::Vector3d t = AngularError(rng) * Direction(a * kDeg, e * kDeg);
+        const Eigen::Vector3d uvw = calib::RotationFromOpk(HeadOpk(h)).transpose() * t;
+        if (!(uvw.z() < -0.5)) continue;  // behind or far off the head's axis
+        const Eigen::Vector2d px = testing::ObserveDirection(
+            HeadTruth(h), HeadOpk(h), Eigen::Matrix3d::Identity(), t, kSigmaPx, rng);
+        if (!px.allFinite() || px.x() < 0 || px.y() < 0 || px.x() > 5999 || px.y() > 3999) continue;
+        text += StringPrintf("C%02d%d,%.5f,%.5f,%.3f,%.1f,%.1f,%.2f,%s\n",
+                             i,
+                             j,
+                             px.x(),
+                             px.y(),
+                             kSigmaPx,
+                             a,
+                             e,
+                             kSigmaArcsec,
+                             h.id);
+      }
+    rows.push_back(text);
+  }
+  return rows;
+}
+
+constexpr const char* kRigHeader =
+    "target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,unit\n";
+
+TEST(CalibrateDirections, RigHeadsInOneAdjustmentRecoverInteriorsAndMountsWithinThreeSigma) {
+  TempDir tmp("aerocal_directions_rig");
+  std::mt19937_64 rng(3613);
+  WriteText(tmp.File("rig.yaml"), RigYaml());
+  const std::vector<std::string> rows = RigRows(&rng);
+  WriteText(tmp.File("directions.csv"), kRigHeader + rows[0] + rows[1] + rows[2]);
+  const auto r = RunAerocal("calibrate --camera " + tmp.File("rig.yaml") + " --directions " +
+                            tmp.File("directions.csv") + " --out " + tmp.File("result.json") +
+                            " --write-camera " + tmp.File("calibrated.yaml"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = ReadJson(tmp.File("result.json"));
+  const auto& cal = j["calibration"];
+  EXPECT_EQ(cal["method"]["kind"], "collimator array");
+  ASSERT_EQ(j["cameras"].size(), 3u);
+  ASSERT_EQ(cal["units"].size(), 3u);
+  const double redundancy = j["redundancy"];
+  EXPECT_EQ(redundancy, 2.0 * cal["data"]["observations"].get<int>() - 3 * 11);
+  EXPECT_NEAR(j["sigma0"].get<double>(), 1.0, 3.0 / std::sqrt(2.0 * redundancy));
+  const calib::Rig written = calib::ReadRig(tmp.File("calibrated.yaml"));
+  for (int k = 0; k < 3; ++k) {
+    const RigHeadTruth& h = kHeads[k];
+    const auto& camera = j["cameras"][k];
+    const auto& unit = cal["units"][k];
+    ASSERT_EQ(camera["id"], h.id);
+    ASSERT_EQ(unit["id"], h.id);
+    const calib::Camera truth = HeadTruth(h);
+    for (const char* p : {"c", "x0", "y0", "K1", "K2", "K3", "P1", "P2"}) {
+      const double estimate = camera["estimated"][p], sigma = camera["sigma"][p];
+      const double error = estimate - truth.interior[truth.ParamIndex(p)];
+      std::printf(
+          "%s %-3s error %+.3e sigma %.3e (%+.2f sigma)\n", h.id, p, error, sigma, error / sigma);
+      EXPECT_LE(std::abs(error), 3.0 * sigma) << h.id << " " << p;
+    }
+    EXPECT_FALSE(camera["sigma"].contains("B1"));  // fixed: no sigma
+    // The mount relative to the first unit (A, whose design mount is the identity), the written
+    // rig's mount and interior.
+    const calib::RigHead& head = written.heads[written.HeadIndex(h.id)];
+    EXPECT_NEAR(head.camera.interior[0], camera["estimated"]["c"].get<double>(), 1e-12);
+    for (int a = 0; a < 3; ++a) {
+      const double mount_deg = unit["mount_opk_deg"][a];
+      EXPECT_NEAR(head.mount_rad[a] / kDeg, mount_deg, 1e-9);
+      if (k == 0) {
+        EXPECT_TRUE(unit["mount_sigma_arcsec"].is_null());
+        continue;
+      }
+      const double sigma = unit["mount_sigma_arcsec"][a];
+      const double error_arcsec = (mount_deg - h.mount_deg[a]) * 3600.0;
+      std::printf("%s mount %d error %+.2f\" sigma %.2f\"\n", h.id, a, error_arcsec, sigma);
+      EXPECT_GT(sigma, 0.0);
+      EXPECT_LE(std::abs(error_arcsec), 3.0 * sigma) << h.id << " mount " << a;
+    }
+  }
+  // The shared rotation (the reference head's) within 3 sigma.
+  ExpectRotationWithinThreeSigma(cal["method"]);
+  // A multi-unit certificate is not built: refused by name, nothing written.
+  const auto c = RunAerocal("certificate --result " + tmp.File("result.json") + " --out " +
+                            tmp.File("cert") + " --no-render");
+  EXPECT_EQ(c.exit_code, 2) << c.output;
+  EXPECT_NE(c.output.find("a calibration of 3 units (A, B, C)"), std::string::npos) << c.output;
+  EXPECT_FALSE(std::filesystem::exists(tmp.File("cert/certificate.json")));
+}
+
+TEST(CalibrateDirections, BadUnitsNameTheirLineAndNothingIsWritten) {
+  TempDir tmp("aerocal_directions_bad_units");
+  std::mt19937_64 rng(3614);
+  WriteText(tmp.File("rig.yaml"), RigYaml());
+  WriteText(tmp.File("camera.yaml"), kCameraYaml);
+  const std::vector<std::string> rows = RigRows(&rng);
+  const std::string ab = kRigHeader + rows[0] + rows[1];
+  const int next = 2 + static_cast<int>(std::count(ab.begin(), ab.end(), '\n')) - 1;
+  const std::string line = "directions.csv:" + std::to_string(next) + ": ";
+  struct Case {
+    std::string camera, text, message;
+  };
+  const Case cases[] = {
+      {"rig.yaml", ab + "Z,3000,2000,0.05,0,0,0.5,D\n", line + "unit D is not a unit of"},
+      {"rig.yaml", ab + "Z,3000,2000,0.05,0,0,0.5,\n", line + "unit must not be empty"},
+      {"rig.yaml",
+       ab + "Z1,3000,2000,0.05,20,0,0.5,C\nZ2,3000,1000,0.05,20,3,0.5,C\n"
+            "Z3,3000,3000,0.05,20,-3,0.5,C\n",
+       line + "unit C: 3 directions (6 scalar) cannot determine its 11 unknowns"},
+      {"rig.yaml",
+       "target,col,row,azimuth_deg,elevation_deg\nA,3000,2000,0,0\n",
+       "directions.csv:1: no 'unit' column"},
+      {"camera.yaml",
+       "target,col,row,azimuth_deg,elevation_deg,unit\nA,3000,2000,0,0,\nB,4000,2000,6.8,0,A\n",
+       "directions.csv:3: unit A: the camera file is one camera"},
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.message);
+    WriteText(tmp.File("directions.csv"), c.text);
+    const auto r = RunAerocal("calibrate --camera " + tmp.File(c.camera) + " --directions " +
+                              tmp.File("directions.csv") + " --out " + tmp.File("result.json") +
+                              " --write-camera " + tmp.File("written.yaml"));
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(c.message), std::string::npos) << r.output;
+    EXPECT_FALSE(std::filesystem::exists(tmp.File("result.json")));
+    EXPECT_FALSE(std::filesystem::exists(tmp.File("written.yaml")));
+  }
+  // Options of a single camera are refused by name with a rig file.
+  WriteText(tmp.File("directions.csv"), ab);
+  for (const std::string& extra :
+       {std::string("--model opencv"), std::string("--camera-format opencv")}) {
+    const auto r =
+        RunAerocal("calibrate --camera " + tmp.File("rig.yaml") + " --directions " +
+                   tmp.File("directions.csv") + " --out " + tmp.File("result.json") + " " + extra);
+    EXPECT_EQ(r.exit_code, 2) << r.output;
+    EXPECT_NE(r.output.find(extra.substr(0, extra.find(' '))), std::string::npos) << r.output;
+  }
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include "calib/core/string_printf.h"
 
 #include <cmath>
+#include <functional>
 #include <map>
 #include <optional>
 #include <set>
@@ -47,12 +48,14 @@ std::pair<std::string, Eigen::Vector2d> RowSetting(const CsvTable& table,
   return {name, angles};
 }
 
-}  // namespace
+// The camera a row is measured in (its pixel frame bounds col, row); sets the row's unit.
+using CameraOfRow =
+    std::function<const calib::Camera&(const CsvTable&, const CsvTable::Row&, std::string* unit)>;
 
-DirectionData ReadDirections(const std::string& path,
-                             const calib::Camera& camera,
-                             double default_sigma_px) {
-  const CsvTable table = CsvTable::Read(path);
+DirectionData ReadRows(const CsvTable& table,
+                       const std::string& path,
+                       const CameraOfRow& camera_of_row,
+                       double default_sigma_px) {
   table.RequireColumns({"target", "col", "row"});
   table.RejectUnknownColumns({"target",
                               "col",
@@ -64,18 +67,22 @@ DirectionData ReadDirections(const std::string& path,
                               "setting",
                               "turn_deg",
                               "tilt_deg",
-                              "group"});
+                              "group",
+                              "unit"});
   if (table.HasColumn("azimuth_deg") != table.HasColumn("elevation_deg"))
     ThrowInputError({path, 0}, "azimuth_deg and elevation_deg go together (one column is missing)");
   if (table.rows().empty())
     ThrowInputError({path, 0}, "no rows (a directions file needs observations)");
   DirectionData out;
   std::map<std::string, std::pair<std::optional<Eigen::Vector2d>, int>>
-      target_angles;                                                 // -> (angles, line)
-  std::map<std::string, std::pair<Eigen::Vector2d, int>> settings;   // -> (turn, tilt; line)
-  std::set<std::tuple<std::string, std::string, std::string>> seen;  // target, setting, group
+      target_angles;                                                // -> (angles, line)
+  std::map<std::string, std::pair<Eigen::Vector2d, int>> settings;  // -> (turn, tilt; line)
+  // target, setting, group, unit
+  std::set<std::tuple<std::string, std::string, std::string, std::string>> seen;
   for (const auto& row : table.rows()) {
     const SourceRef where = table.Where(row);
+    std::string unit;
+    const calib::Camera& camera = camera_of_row(table, row, &unit);
     DirectionObservation o;
     o.where = where.ToString();
     o.target = table.String(row, "target");
@@ -118,16 +125,63 @@ DirectionData ReadDirections(const std::string& path,
               " (a known target gives the same direction on every row; an estimated one none)");
     }
     const std::string group = table.String(row, "group");
-    if (!seen.emplace(o.target, o.setting, group).second)
+    if (!seen.emplace(o.target, o.setting, group, unit).second)
       ThrowInputError(where,
                       "target " + o.target + (o.setting.empty() ? "" : " at setting " + o.setting) +
                           (group.empty() ? "" : " in group " + group) +
+                          (unit.empty() ? "" : " by unit " + unit) +
                           " is observed twice (a repeated series goes into its own group)");
     if (table.HasColumn("group")) out.groups.push_back(group);
+    if (!unit.empty()) out.units.push_back(unit);
     out.observations.push_back(o);
   }
   out.settings = static_cast<int>(settings.size());
   return out;
+}
+
+}  // namespace
+
+DirectionData ReadDirections(const std::string& path,
+                             const calib::Camera& camera,
+                             double default_sigma_px) {
+  const CsvTable table = CsvTable::Read(path);
+  const auto one_camera =
+      [&](const CsvTable& t, const CsvTable::Row& row, std::string*) -> const calib::Camera& {
+    const std::string unit = t.String(row, "unit");
+    if (!unit.empty())
+      ThrowInputError(t.Where(row),
+                      "unit " + unit +
+                          ": the camera file is one camera; a unit names a head of a rig file "
+                          "(--camera)");
+    return camera;
+  };
+  return ReadRows(table, path, one_camera, default_sigma_px);
+}
+
+DirectionData ReadUnitDirections(const std::string& path,
+                                 const std::map<std::string, calib::Camera>& units,
+                                 const std::string& camera_file,
+                                 double default_sigma_px) {
+  const CsvTable table = CsvTable::Read(path);
+  std::string ids;
+  for (const auto& [id, camera] : units) ids += (ids.empty() ? "" : ", ") + id;
+  if (!table.HasColumn("unit"))
+    ThrowInputError({path, 1},
+                    "no 'unit' column: " + camera_file + " has several units (" + ids +
+                        "); every row names the one that measured it");
+  const auto unit_camera =
+      [&](const CsvTable& t, const CsvTable::Row& row, std::string* unit) -> const calib::Camera& {
+    *unit = t.String(row, "unit");
+    if (unit->empty())
+      ThrowInputError(t.Where(row),
+                      "unit must not be empty (every row names its unit: " + ids + ")");
+    const auto it = units.find(*unit);
+    if (it == units.end())
+      ThrowInputError(t.Where(row),
+                      "unit " + *unit + " is not a unit of " + camera_file + " (" + ids + ")");
+    return it->second;
+  };
+  return ReadRows(table, path, unit_camera, default_sigma_px);
 }
 
 }  // namespace aerocal::triangulation

@@ -27,11 +27,11 @@ int Unknowns(const std::vector<DirectionTarget>& targets,
   return n;
 }
 
-// An observation whose direction is behind the camera at the start orientation cannot be
-// adjusted (the residual is undefined there): bad input, refused before solving.
-void CheckInFront(const Eigen::Vector3d& start_opk_rad,
-                  const std::vector<DirectionTarget>& targets,
-                  const std::vector<DirectionObservation>& observations) {
+}  // namespace
+
+void CheckDirectionsInFront(const Eigen::Vector3d& start_opk_rad,
+                            const std::vector<DirectionTarget>& targets,
+                            const std::vector<DirectionObservation>& observations) {
   std::map<std::string, Eigen::Vector2d> angles;
   for (const auto& t : targets) angles[t.id] = t.angles_rad;
   const Eigen::Matrix3d r = calib::RotationFromOpk(start_opk_rad);
@@ -53,8 +53,6 @@ void CheckInFront(const Eigen::Vector3d& start_opk_rad,
                                     start_opk_rad.z() * 180 / M_PI));
   }
 }
-
-}  // namespace
 
 CalibrationAdjustment AdjustmentOfDirections(const std::string& camera_id,
                                              const calib::Camera& start,
@@ -122,7 +120,7 @@ DirectionRun RunDirectionCalibration(const std::string& camera_id,
   DirectionRun out;
   out.start_opk_rad = StartRotationFromDirections(start, targets, observations);
   StartUnknownTargets(start, out.start_opk_rad, observations, &targets);
-  CheckInFront(out.start_opk_rad, targets, observations);
+  CheckDirectionsInFront(out.start_opk_rad, targets, observations);
   const std::vector<std::string>& free = options.calibration.free_interior;
   const auto adjust = [&](const std::vector<DirectionObservation>& obs,
                           DirectionCalibration* keep) {

@@ -49,6 +49,13 @@ DirectionRun RunDirectionCalibration(const std::string& camera_id,
                                      const std::vector<std::string>& group_of_observation,
                                      const DirectionRunOptions& options = {});
 
+/// Throws InputError at the observation's FILE:LINE when its direction is more than ~87 deg off
+/// the camera's axis at the start rotation `start_opk_rad`: the residual is undefined there (no
+/// camera sees it), so the input is refused before solving.
+void CheckDirectionsInFront(const Eigen::Vector3d& start_opk_rad,
+                            const std::vector<DirectionTarget>& targets,
+                            const std::vector<DirectionObservation>& observations);
+
 /// One direction calibration as a calibration adjustment (see the header comment).
 CalibrationAdjustment AdjustmentOfDirections(const std::string& camera_id,
                                              const calib::Camera& start,
