@@ -10,6 +10,7 @@
 #include "tools/camera_formats.h"
 #include "tools/command_registry.h"
 #include "tools/option_ranges.h"
+#include "tools/rig_adjust_run.h"
 #include "tools/suspect_effect_option.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/conventional_reference.h"
@@ -28,43 +29,19 @@ namespace {
 
 using triangulation::AdjustmentResult;
 
-// The --rig-* options as given.
-struct RigArgs {
-  std::string mounts = "free", lever_arms = "free", increments = "fixed", time_offsets = "fixed";
-  double increment_sigma_arcsec = 0.0, time_offset_sigma_ms = 0.0;
-};
-
-// `adjust` of a project with a rig camera file: the rig bundle (rig_head_camera.h).
-int RunRigAdjust(const RigArgs& args,
-                 const triangulation::AdjustOptions& options,
-                 const triangulation::Project& input,
-                 const triangulation::Project& project,
-                 const triangulation::ObjectFrame& frame,
-                 const std::string& project_path,
-                 const std::string& out,
-                 const std::string& write_camera) {
-  triangulation::RigAdjustOptions rig;
-  rig.mounts = calib::BlockModeOption(args.mounts, "--rig-mounts");
-  rig.lever_arms = calib::BlockModeOption(args.lever_arms, "--rig-lever-arms");
-  rig.increments = calib::BlockModeOption(args.increments, "--rig-increments");
-  rig.time_offsets = calib::BlockModeOption(args.time_offsets, "--rig-time-offsets");
-  rig.increment_sigma_rad = args.increment_sigma_arcsec * M_PI / (180.0 * 3600.0);
-  rig.time_offset_sigma_s = args.time_offset_sigma_ms * 1e-3;
-  rig.Validate();
-
-  triangulation::RigAdjustmentResult result = triangulation::AdjustRig(project, options, rig);
-  triangulation::ToInputFrame(frame, &result.adjustment);
-  std::printf("%s%s",
-              triangulation::FormatSummary(result.adjustment).c_str(),
-              triangulation::FormatRigSummary(result).c_str());
-  nlohmann::json json = triangulation::AdjustmentToJson(result.adjustment);
-  json.update(triangulation::RigResultToJson(result));
-  json["project"] = project_path;
-  AddProjectFacts(input, &json);
-  json["valid"] = result.adjustment.valid;
-  json["invalid_reasons"] = result.adjustment.invalid_reasons;
+// `adjust` of a project with a rig camera file: the rig bundle (tools/rig_adjust_run.h), then
+// the result and the rig file written.
+int RunRigAdjustment(const RigAdjustRequest& request,
+                     const triangulation::AdjustOptions& options,
+                     const triangulation::Project& input,
+                     const std::string& project_path,
+                     const std::string& out,
+                     const std::string& write_camera) {
+  const RigAdjustRun run = RunRigAdjust(request, options, input, project_path);
+  std::printf("%s", run.printed.c_str());
+  const triangulation::RigAdjustmentResult& result = run.result;
   // As the frame camera: exit 3 and no rig file when the result is not valid.
-  return FinishAdjust(result.adjustment, json, out, write_camera, "rig camera", [&] {
+  return FinishAdjust(result.adjustment, run.json, out, write_camera, "rig camera", [&] {
     calib::WriteRig(write_camera, triangulation::UpdatedRig(input.rigs.at(result.camera), result));
     std::printf("rig camera %s -> %s\n", result.camera.c_str(), write_camera.c_str());
   });
@@ -91,7 +68,7 @@ struct AdjustArgs {
   double default_sigma_px = 0.5;
   triangulation::AdjustOptions options;
   JointAdjustArgs joint;
-  RigArgs rig;
+  RigAdjustRequest rig;
   // The GNSS/IMU platform over the project YAML's `platform:` (each given option replaces).
   std::vector<double> lever_arm_m, boresight_deg;
   double time_offset_ms = 0.0, lever_arm_sigma_m = 0.0, boresight_sigma_deg = 0.0,
@@ -294,35 +271,6 @@ bool ApplyPlatformOptions(const CLI::App& app,
   return false;
 }
 
-// The refusals of a rig project (the rig bundle takes one rig and no frame-camera-only option).
-void CheckRigProject(const AdjustArgs* args,
-                     const triangulation::AdjustOptions& options,
-                     const triangulation::Project& input,
-                     bool auto_free) {
-  const std::string rig = "rig project (camera '" + input.rigs.begin()->first + "')";
-  if (args->compare)
-    throw ConfigError("--compare: not available for a " + rig +
-                      ": its conventional reference "
-                      "run is a frame-camera adjustment (run adjust with and without "
-                      "--self-calibration instead)");
-  if (auto_free)
-    throw ConfigError("--self-calibration auto: not available for a " + rig +
-                      " (give the "
-                      "parameters to calibrate)");
-  if (options.robust_start)
-    throw ConfigError("--robust-start: not available for a " + rig +
-                      ": the robust start "
-                      "re-adjusts frame cameras only (reject blunders with data snooping, the "
-                      "default)");
-  if (input.rigs.size() > 1) {
-    std::string names;
-    for (const auto& [id, unused] : input.rigs) names += (names.empty() ? "" : ", ") + id;
-    throw ConfigError(args->project + ": rig cameras " + names +
-                      ": the rig bundle takes one "
-                      "rig per project (adjust each rig's exposures in a project of its own)");
-  }
-}
-
 // The adjustment of a frame-camera project: one run, or --compare's two, then the result and the
 // camera written.
 int RunFrameAdjust(const AdjustArgs* args,
@@ -448,9 +396,9 @@ int RunAdjust(const CLI::App& app,
   const bool rig_option_given = std::any_of(
       rig_options.begin(), rig_options.end(), [](const CLI::Option* o) { return o->count() > 0; });
   if (!input.rigs.empty()) {
-    CheckRigProject(args, options, input, auto_free);
-    return RunRigAdjust(
-        args->rig, options, input, project, frame, args->project, args->out, args->write_camera);
+    CheckRigProject(input, args->project, args->compare, auto_free, options.robust_start);
+    return RunRigAdjustment(
+        args->rig, options, input, args->project, args->out, args->write_camera);
   }
   if (rig_option_given)
     throw ConfigError(args->project +

@@ -387,6 +387,46 @@ def test_rig_stitch_equals_the_command(tmp_path):
         aerocal.rig_stitch(camera, str(line), mode="spline")
 
 
+def test_adjust_of_a_rig_block_equals_the_command(tmp_path):
+    # The rig bundle of `aerocal adjust --project P` (P's camera file has a rig section), shared
+    # code (tools/rig_adjust_run.h): the same document, clock keys aside, and typed accessors.
+    flight = tmp_path / "dual"
+    code, out = run("simulate", "--rig", "dual-lens", "--exposures", "8", "--out", str(flight))
+    assert code == 0, out
+    cli = tmp_path / "cli.json"
+    code, out = run("adjust", "--project", str(flight), "--self-calibration", "c",
+                    "--rig-lever-arms", "fixed", "--out", str(cli))
+    assert code == 0, out
+    block = aerocal.Block.read(str(flight))
+    r = aerocal.adjust(block, self_calibration="c", rig_lever_arms="fixed")
+    with open(cli) as f:
+        expected = json.load(f)
+    assert _without_clock(json.loads(r.to_json())) == _without_clock(expected)
+    assert r.valid and r.sigma0 == expected["sigma0"]
+    assert r.warnings == expected["warnings"]
+    assert r.cameras[0].estimated["c"] == expected["cameras"][0]["estimated"]["c"]
+    assert r.cameras[0].sigma["c"] == expected["cameras"][0]["sigma"]["c"]
+    assert r.rig == expected["rig"]
+    heads = r.heads
+    assert [h["id"] for h in heads] == [h["id"] for h in expected["rig"]["heads"]]
+    for h, e in zip(heads, expected["rig"]["heads"]):
+        assert h["estimated"] == e["interior"] and h["sigma"] == e["interior_sigma"]
+        assert h["mount_deg"] == e["mount_deg"] and h["lever_arm_m"] == e["lever_arm_m"]
+    assert heads[1]["mount_sigma_deg"][1] > 0
+    # The command's refusals, by the keyword's option name.
+    with pytest.raises(ValueError, match="--self-calibration auto: not available for a rig project"):
+        aerocal.adjust(block, self_calibration="auto")
+    with pytest.raises(ValueError, match="--rig-mounts"):
+        aerocal.adjust(block, rig_mounts="loose")
+
+
+def test_rig_keywords_need_a_rig_block(flight):
+    b = aerocal.Block.read(os.path.join(flight, "flight"))
+    with pytest.raises(ValueError, match="rig camera file"):
+        aerocal.adjust(b, rig_mounts="free")
+    assert aerocal.adjust(b).heads == [] and aerocal.adjust(b).rig is None
+
+
 def test_rig_stitched_image_equals_the_command(tmp_path):
     from PIL import Image  # Debian's python3-pil (a dependency of python3-matplotlib)
     photo = os.path.join(SHARED, "odm_boruszyn_kap_frames", "images", "img_4880.jpg")

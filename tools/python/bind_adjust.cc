@@ -1,7 +1,8 @@
 // aerocal.Block and aerocal.adjust: the block files (triangulation/block/block_io.h) or arrays, the
 // adjustment exactly as `aerocal adjust` runs it (tools/cmd_adjust.cc: the object frame, the free
-// set, `--self-calibration auto`), the typed result with numpy arrays and to_json() identical to
-// the command's result file.
+// set, `--self-calibration auto`; a rig block's rig bundle through the command's own run,
+// tools/rig_adjust_run.h), the typed result with numpy arrays and to_json() identical to the
+// command's result file.
 #include "calib/camera/formats/camera_formats.h"
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
@@ -10,6 +11,7 @@
 #include "tools/project_facts.h"
 #include "tools/python/bindings.h"
 #include "tools/python/progress_callback.h"
+#include "tools/rig_adjust_run.h"
 #include "triangulation/adjustment/block_adjustment.h"
 #include "triangulation/adjustment/self_calibration_choice.h"
 #include "triangulation/block/block_io.h"
@@ -36,8 +38,9 @@ struct Block {
 };
 
 struct Result {
-  AdjustmentResult result;
-  std::string json;  // the result file's text, as `aerocal adjust --out` writes it
+  AdjustmentResult result;  // a rig block's: the block part of the rig bundle's result
+  std::string json;         // the result file's text, as `aerocal adjust --out` writes it
+  nlohmann::json rig;       // a rig block's `rig` section of that file; null for frame cameras
 };
 
 constexpr double kDegToRad = M_PI / 180.0;
@@ -226,7 +229,13 @@ triangulation::AdjustOptions OptionsFromKeywords(const py::kwargs& kw) {
                                               "no_interior_sigma",
                                               "max_iterations",
                                               "correlation_threshold",
-                                              "suspect_effect_limit"};
+                                              "suspect_effect_limit",
+                                              "rig_mounts",
+                                              "rig_lever_arms",
+                                              "rig_increments",
+                                              "rig_increment_sigma_arcsec",
+                                              "rig_time_offsets",
+                                              "rig_time_offset_sigma_ms"};
   for (const auto& item : kw) {
     const std::string key = item.first.cast<std::string>();
     if (!known.count(key)) {
@@ -256,6 +265,52 @@ triangulation::AdjustOptions OptionsFromKeywords(const py::kwargs& kw) {
   return o;
 }
 
+// The --rig-* keywords (rig_mounts, ...); a frame-camera block refuses them, as the command.
+tools::RigAdjustRequest RigRequestFromKeywords(const py::kwargs& kw, bool rig_block) {
+  tools::RigAdjustRequest r;
+  bool given = false;
+  auto text = [&](const char* k, std::string* v) {
+    if (kw.contains(k)) *v = kw[k].cast<std::string>(), given = true;
+  };
+  auto number = [&](const char* k, double* v) {
+    if (kw.contains(k)) *v = kw[k].cast<double>(), given = true;
+  };
+  text("rig_mounts", &r.mounts);
+  text("rig_lever_arms", &r.lever_arms);
+  text("rig_increments", &r.increments);
+  text("rig_time_offsets", &r.time_offsets);
+  number("rig_increment_sigma_arcsec", &r.increment_sigma_arcsec);
+  number("rig_time_offset_sigma_ms", &r.time_offset_sigma_ms);
+  if (given && !rig_block)
+    throw ConfigError(
+        "rig_*: the rig options need a rig camera file (a camera file with a rig "
+        "section)");
+  return r;
+}
+
+// A rig block: the command's rig bundle (tools/rig_adjust_run.h), the same refusals.
+Result AdjustRigBlock(const Block& block,
+                      bool auto_free,
+                      const triangulation::AdjustOptions& options,
+                      const py::kwargs& kw) {
+  tools::CheckRigProject(block.project,
+                         block.path.empty() ? block.project.path : block.path,
+                         false,
+                         auto_free,
+                         options.robust_start);
+  const tools::RigAdjustRequest request = RigRequestFromKeywords(kw, true);
+  tools::RigAdjustRun run;
+  {
+    py::gil_scoped_release release;
+    run = tools::RunRigAdjust(request, options, block.project, block.path, !block.path.empty());
+  }
+  Result out;
+  out.result = run.result.adjustment;
+  out.json = ResultText("adjust", run.json);
+  out.rig = run.json.at("rig");
+  return out;
+}
+
 Result Adjust(const Block& block,
               const std::string& self_calibration,
               const py::object& progress_callback,
@@ -269,8 +324,8 @@ Result Adjust(const Block& block,
   options.free_interior =
       triangulation::ParseSelfCalibration(auto_free ? "all" : self_calibration, model);
   options.Validate();
-  if (!block.project.rigs.empty())
-    throw ConfigError("a rig block: adjust it with the command line (`aerocal adjust`) for now");
+  if (!block.project.rigs.empty()) return AdjustRigBlock(block, auto_free, options, kw);
+  RigRequestFromKeywords(kw, false);
   const auto progress = CallbackProgress(progress_callback,
                                          "adjust",
                                          auto_free && !options.free_interior.empty()
@@ -293,6 +348,23 @@ Result Adjust(const Block& block,
   json["invalid_reasons"] = out.result.invalid_reasons;
   out.json = ResultText("adjust", json);
   return out;
+}
+
+// The rig heads of a rig result, each {id, reference, estimated, sigma (by the head model's
+// parameter names; None where unknown), mount_deg, mount_sigma_deg, lever_arm_m,
+// lever_arm_sigma_m, dT_ms, dT_sigma_ms}: the result file's `rig.heads` with the frame
+// cameras' names for the interior.
+py::list RigHeads(const Result& r) {
+  py::list heads;
+  if (r.rig.is_null()) return heads;
+  for (nlohmann::json h : r.rig.at("heads")) {
+    h["estimated"] = h.at("interior");
+    h["sigma"] = h.at("interior_sigma");
+    h.erase("interior");
+    h.erase("interior_sigma");
+    heads.append(JsonToPython(h.dump()));
+  }
+  return heads;
 }
 
 py::dict ParamDict(const triangulation::CameraEstimate& c,
@@ -450,6 +522,19 @@ arrays (exposures, points, observations).)doc")
       .def_property_readonly("notes", [](const Result& r) { return r.result.notes; })
       .def_property_readonly("cameras", [](const Result& r) { return r.result.cameras; })
       .def_property_readonly(
+          "heads",
+          &RigHeads,
+          "A rig block's heads (rig file order): dicts {id, reference, estimated, sigma (by "
+          "parameter name; None where unknown), mount_deg, mount_sigma_deg, lever_arm_m, "
+          "lever_arm_sigma_m, dT_ms, dT_sigma_ms}; [] for frame cameras")
+      .def_property_readonly(
+          "rig",
+          [](const Result& r) {
+            return r.rig.is_null() ? py::object(py::none()) : JsonToPython(r.rig.dump());
+          },
+          "A rig block's `rig` section of the result file (heads, options, determinability); "
+          "None for frame cameras")
+      .def_property_readonly(
           "check_rmse_m",
           [](const Result& r) { return Eigen::Vector3d(r.result.check.rmse_m); },
           "Check-point RMSE per axis X, Y, Z (m)")
@@ -492,7 +577,10 @@ arrays (exposures, points, observations).)doc")
         "every other option of the command as a keyword (no_snooping, "
         "robust_start, no_robust_start, max_rejections, max_sigma0, min_redundancy, "
         "critical_value, no_eo_priors, no_interior_sigma, max_iterations, "
-        "correlation_threshold, suspect_effect_limit). The GIL is released while solving. A "
+        "correlation_threshold, suspect_effect_limit; for a rig block rig_mounts, "
+        "rig_lever_arms, rig_increments, rig_increment_sigma_arcsec, rig_time_offsets, "
+        "rig_time_offset_sigma_ms). A block whose camera file has a rig section runs the "
+        "command's rig bundle (heads and rig on the result). The GIL is released while solving. A "
         "result that did not converge or is not valid is returned with valid=False.");
 }
 
