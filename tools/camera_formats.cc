@@ -161,83 +161,105 @@ int ImageSize(const cv::FileStorage& fs, const std::string& key, const SourceRef
   return static_cast<int>(v);
 }
 
-}  // namespace
+// cv::FileStorage's parse error, said at its line (FILE:LINE) in the reader's words.
+[[noreturn]] void ThrowUnparsable(const std::string& path, const std::string& error) {
+  const auto [line, what] = OpenCvParseErrorLine(error);
+  ThrowInputError({path, line}, "cv::FileStorage cannot parse the file here (" + what + ")");
+}
 
-CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOptions& options) {
-  CheckInputFile(path);
-  cv::FileStorage fs;
-  std::vector<std::string> notes;
-  // The text is read by our reader (regular-file checks, BOM), scanned for its lines and matrix
-  // sizes (tools/opencv_storage_scan.h: nothing huge reaches cv::FileStorage) and parsed from
-  // memory.
-  const std::string text = ReadTextFile(path);
-  const OpenCvStorageScan scan = ScanOpenCvStorage(text, path);
-  const auto at = [&](const std::string& key) { return SourceRef{path, scan.Line(key)}; };
-  std::string error;
-  const auto unparsable = [&]() {
-    const auto [line, what] = OpenCvParseErrorLine(error);
-    ThrowInputError({path, line}, "cv::FileStorage cannot parse the file here (" + what + ")");
-  };
-  if (!OpenStorage(text, &fs, &error)) {
+// Opens the text in `fs`. A YAML file cut short is read up to its last complete entry (a note
+// says which lines); `error` keeps cv's parse error then, so a later miss can name the cut.
+// The top level must be a map: cv::FileStorage asserts (cv::Exception) on keys of another.
+void OpenCameraStorage(const std::string& path,
+                       const std::string& text,
+                       cv::FileStorage* fs,
+                       std::string* error,
+                       std::vector<std::string>* notes) {
+  if (!OpenStorage(text, fs, error)) {
     const std::vector<std::string> lines = SplitLines(text);
-    const size_t error_line = static_cast<size_t>(OpenCvParseErrorLine(error).first);
+    const size_t error_line = static_cast<size_t>(OpenCvParseErrorLine(*error).first);
     const size_t kept =
-        text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, error_line, &fs) : 0;
-    if (kept == 0) unparsable();
-    notes.push_back("the file is cut short: lines 1-" + std::to_string(kept) +
-                    " read (the entry from line " + std::to_string(kept + 1) +
-                    " on is incomplete)");
+        text.rfind("%YAML", 0) == 0 ? ReadablePrefixLines(lines, error_line, fs) : 0;
+    if (kept == 0) ThrowUnparsable(path, *error);
+    notes->push_back("the file is cut short: lines 1-" + std::to_string(kept) +
+                     " read (the entry from line " + std::to_string(kept + 1) +
+                     " on is incomplete)");
   }
-  // Keys are looked up in a map: cv::FileStorage asserts (cv::Exception) on any other top level.
-  if (!fs.root().isMap()) {
-    if (!error.empty()) unparsable();
+  if (!fs->root().isMap()) {
+    if (!error->empty()) ThrowUnparsable(path, *error);
     ThrowInputError(
         {path, 1},
         "the top level is not a map of keys (camera_matrix, distortion_coefficients, ...)");
   }
-  std::string matrix_key = "camera_matrix", dist_key = "distortion_coefficients";
+}
+
+// The keys of the camera read: camera_matrix / distortion_coefficients, or a stereo file's
+// M1/D1 or M2/D2 (--camera names which; required when both are there).
+struct OpenCvCameraKeys {
+  std::string matrix = "camera_matrix";
+  std::string dist = "distortion_coefficients";
   bool stereo = false;
-  if (fs["camera_matrix"].empty()) {
-    const std::string id = options.camera_id.empty() ? "1" : options.camera_id;
-    if (fs["M" + id].empty() && !error.empty()) unparsable();  // a prefix read without the camera
-    if (fs["M" + id].empty())
-      ThrowInputError({path, 1},
-                      options.camera_id.empty() ? "no camera_matrix (nor a stereo M1/D1)"
-                                                : "no camera M" + id + "/D" + id);
-    if (options.camera_id.empty() && !fs["M2"].empty())
-      ThrowInputError(at("M2"), "a stereo file: name the camera with --camera (1 or 2)");
-    matrix_key = "M" + id;
-    dist_key = "D" + id;
-    stereo = true;
-  }
-  const cv::Mat k = ReadMatrix(fs, matrix_key, at(matrix_key));
-  const cv::Mat d = ReadMatrix(fs, dist_key, at(dist_key));
+};
+
+OpenCvCameraKeys FindCameraKeys(const cv::FileStorage& fs,
+                                const std::string& path,
+                                const OpenCvStorageScan& scan,
+                                const std::string& error,
+                                const calib::CameraReadOptions& options) {
+  OpenCvCameraKeys keys;
+  if (!fs["camera_matrix"].empty()) return keys;
+  const std::string id = options.camera_id.empty() ? "1" : options.camera_id;
+  if (fs["M" + id].empty() && !error.empty())
+    ThrowUnparsable(path, error);  // a prefix read without the camera
+  if (fs["M" + id].empty())
+    ThrowInputError({path, 1},
+                    options.camera_id.empty() ? "no camera_matrix (nor a stereo M1/D1)"
+                                              : "no camera M" + id + "/D" + id);
+  if (options.camera_id.empty() && !fs["M2"].empty())
+    ThrowInputError({path, scan.Line("M2")},
+                    "a stereo file: name the camera with --camera (1 or 2)");
+  keys.matrix = "M" + id;
+  keys.dist = "D" + id;
+  keys.stereo = true;
+  return keys;
+}
+
+// The forms the opencv model holds: K = [fx 0 cx; 0 fy cy; 0 0 1] and 4, 5, 8, 12 or 14
+// distortion values whose thin-prism and tilt terms (from the 9th) are 0.
+void CheckOpenCvMatrices(const cv::Mat& k,
+                         const cv::Mat& d,
+                         const OpenCvCameraKeys& keys,
+                         const SourceRef& matrix_at,
+                         const SourceRef& dist_at) {
   if (k.rows != 3 || k.cols != 3)
-    ThrowInputError(at(matrix_key), matrix_key + " must be a 3 x 3 matrix");
+    ThrowInputError(matrix_at, keys.matrix + " must be a 3 x 3 matrix");
   const size_t n = d.total();
   if (n != 0 && n != 4 && n != 5 && n != 8 && n != 12 && n != 14)
     ThrowInputError(
-        at(dist_key),
-        dist_key + " must hold 4, 5, 8, 12 or 14 values (got " + std::to_string(n) + ")");
+        dist_at, keys.dist + " must hold 4, 5, 8, 12 or 14 values (got " + std::to_string(n) + ")");
   for (size_t i = 8; i < n; ++i)
     if (d.at<double>(static_cast<int>(i)) != 0.0)
-      ThrowInputError(at(dist_key),
-                      dist_key +
+      ThrowInputError(dist_at,
+                      keys.dist +
                           ": the thin-prism s1-s4 and tilt terms are not "
                           "modelled (must be 0)");
   if (k.at<double>(0, 1) != 0.0 || k.at<double>(1, 0) != 0.0 || k.at<double>(2, 0) != 0.0 ||
       k.at<double>(2, 1) != 0.0 || k.at<double>(2, 2) != 1.0)
-    ThrowInputError(at(matrix_key),
-                    matrix_key +
+    ThrowInputError(matrix_at,
+                    keys.matrix +
                         " must be [fx 0 cx; 0 fy cy; 0 0 1] (skew is not "
                         "modelled)");
-  CameraFile file;
-  file.notes = notes;
-  file.name = std::filesystem::path(path).stem().string();
-  file.chosen_by_camera_id = stereo && !options.camera_id.empty();
-  file.camera.model = CameraModelId::kOpenCv;
-  file.camera.params.assign(OpenCvModel::kNumParams, 0.0);
-  std::vector<double>& p = file.camera.params;
+}
+
+// The opencv model's parameters from K and the first (up to 8) distortion values, in OpenCV's
+// order k1 k2 p1 p2 k3 k4 k5 k6; every value read must be finite and fx, fy > 0.
+std::vector<double> OpenCvParams(const cv::Mat& k,
+                                 const cv::Mat& d,
+                                 const OpenCvCameraKeys& keys,
+                                 const SourceRef& matrix_at,
+                                 const SourceRef& dist_at) {
+  const size_t n = d.total();
+  std::vector<double> p(OpenCvModel::kNumParams, 0.0);
   p[OpenCvModel::kFx] = k.at<double>(0, 0);
   p[OpenCvModel::kFy] = k.at<double>(1, 1);
   p[OpenCvModel::kCx] = k.at<double>(0, 2);
@@ -252,16 +274,42 @@ CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOpti
                                 OpenCvModel::kK6};
   for (size_t i = 0; i < n && i < 8; ++i) p[kOrder[i]] = d.at<double>(static_cast<int>(i));
   for (int i : {OpenCvModel::kFx, OpenCvModel::kFy, OpenCvModel::kCx, OpenCvModel::kCy})
-    if (!std::isfinite(p[i]))
-      ThrowInputError(at(matrix_key), matrix_key + ": a value is not finite");
+    if (!std::isfinite(p[i])) ThrowInputError(matrix_at, keys.matrix + ": a value is not finite");
   for (size_t i = 0; i < n && i < 8; ++i)
     if (!std::isfinite(p[kOrder[i]]))
-      ThrowInputError(at(dist_key), dist_key + ": a value is not finite");
+      ThrowInputError(dist_at, keys.dist + ": a value is not finite");
   if (!(p[OpenCvModel::kFx] > 0 && p[OpenCvModel::kFy] > 0))
-    ThrowInputError(at(matrix_key), "fx, fy must be > 0 px");
+    ThrowInputError(matrix_at, "fx, fy must be > 0 px");
+  return p;
+}
+
+}  // namespace
+
+CameraFile ReadOpenCvCamera(const std::string& path, const calib::CameraReadOptions& options) {
+  CheckInputFile(path);
+  // The text is read by our reader (regular-file checks, BOM), scanned for its lines and matrix
+  // sizes (tools/opencv_storage_scan.h: nothing huge reaches cv::FileStorage) and parsed from
+  // memory.
+  const std::string text = ReadTextFile(path);
+  const OpenCvStorageScan scan = ScanOpenCvStorage(text, path);
+  const auto at = [&](const std::string& key) { return SourceRef{path, scan.Line(key)}; };
+  cv::FileStorage fs;
+  std::string error;
+  std::vector<std::string> notes;
+  OpenCameraStorage(path, text, &fs, &error, &notes);
+  const OpenCvCameraKeys keys = FindCameraKeys(fs, path, scan, error, options);
+  const cv::Mat k = ReadMatrix(fs, keys.matrix, at(keys.matrix));
+  const cv::Mat d = ReadMatrix(fs, keys.dist, at(keys.dist));
+  CheckOpenCvMatrices(k, d, keys, at(keys.matrix), at(keys.dist));
+  CameraFile file;
+  file.notes = notes;
+  file.name = std::filesystem::path(path).stem().string();
+  file.chosen_by_camera_id = keys.stereo && !options.camera_id.empty();
+  file.camera.model = CameraModelId::kOpenCv;
+  file.camera.params = OpenCvParams(k, d, keys, at(keys.matrix), at(keys.dist));
   const int width = ImageSize(fs, "image_width", at("image_width"));
   const int height = ImageSize(fs, "image_height", at("image_height"));
-  calib::internal::ResolveFormat(&file, options, at(matrix_key), width, height, 0.0);
+  calib::internal::ResolveFormat(&file, options, at(keys.matrix), width, height, 0.0);
   return file;
 }
 

@@ -98,7 +98,8 @@ calib::FormatTarget ModelTarget(const CameraFormat& to, const std::string& model
   }
 }
 
-int RunConvert(const ConvertArgs& a) {
+// OUT and --report must be writable and differ from each other and from IN (exit 2 otherwise).
+void CheckConvertOutputs(const ConvertArgs& a) {
   CheckOutputFile(a.out, "OUT");
   CheckDistinctPath(a.out, "OUT", a.read.in, "IN");
   if (!a.report.empty()) {
@@ -106,6 +107,89 @@ int RunConvert(const ConvertArgs& a) {
     CheckDistinctPath(a.report, "--report", a.out, "OUT");
     CheckDistinctPath(a.report, "--report", a.read.in, "IN");
   }
+}
+
+// Keeps of the converted file's covariance what the target format holds (full, standard
+// deviations only, or nothing) and says in `notes` what was dropped.
+void FitCovarianceToFormat(const CameraFormat& to,
+                           const std::string& to_name,
+                           CameraFile* written,
+                           std::vector<std::string>* notes) {
+  if (!written->covariance) return;
+  switch (calib::CovarianceHeld(to, written->camera.model)) {
+    case calib::CovarianceForm::kFull:
+      break;
+    case calib::CovarianceForm::kSigmas:
+      notes->push_back("covariance written as standard deviations (" + to_name +
+                       " holds no correlations: dropped)");
+      break;
+    case calib::CovarianceForm::kNone:
+      notes->push_back("covariance dropped: " + to_name + " (" +
+                       std::string(calib::CameraModelName(written->camera.model)) + ") holds none");
+      written->covariance.reset();
+  }
+}
+
+// The conversion's summary on stdout: source and target (file, format, model), how it was
+// converted, the residual and the notes.
+void PrintConversion(const ConvertArgs& a,
+                     const CameraFile& source,
+                     const calib::ConversionResult& r,
+                     const std::vector<std::string>& notes) {
+  const std::string model(calib::CameraModelName(r.camera.model));
+  std::printf("%s (%s, %s) -> %s (%s, %s): %s\n",
+              a.read.in.c_str(),
+              a.read.used.c_str(),
+              std::string(calib::CameraModelName(source.camera.model)).c_str(),
+              a.out.c_str(),
+              a.to.c_str(),
+              model.c_str(),
+              r.exact ? "exact (closed form)" : "least-squares fit over the format");
+  std::printf("%s\n", DescribeConversion(r).c_str());
+  for (const auto& note : notes) std::printf("note: %s\n", note.c_str());
+}
+
+// The `camera_conversion` result (--report): formats, models, the fit's residual over the
+// format, the notes and the coefficient choices tried.
+nlohmann::json ConversionReportJson(const ConvertArgs& a,
+                                    const CameraFile& source,
+                                    const calib::ConversionResult& r,
+                                    bool acceptable,
+                                    const std::vector<std::string>& notes,
+                                    const std::vector<std::string>& tried) {
+  return {{"from", a.read.used},
+          {"to", a.to},
+          {"source_model", std::string(calib::CameraModelName(source.camera.model))},
+          {"model", std::string(calib::CameraModelName(r.camera.model))},
+          {"exact", r.exact},
+          {"acceptable", acceptable},
+          {"fit_iterations", r.fit_iterations},
+          {"residual_px",
+           {{"rms", r.residual.rms_px},
+            {"max", r.residual.max_px},
+            {"max_at", {r.residual.max_at_px.x(), r.residual.max_at_px.y()}},
+            {"max_inner80", r.residual.max_inner80_px},
+            {"points", r.residual.points},
+            {"failed_points", r.residual.failed_points}}},
+          {"notes", notes},
+          {"coefficient_choices", tried},
+          {"source_camera_model", calib::CameraModelTableToJson(source.camera.model)},
+          {"camera_model", calib::CameraModelTableToJson(r.camera.model)}};
+}
+
+// The warning of a conversion whose residual exceeds the limit (OUT is not written).
+std::string ConversionResidualWarning(const ConvertArgs& a, const calib::ConversionResult& r) {
+  return "conversion_residual: " + DescribeConversion(r) +
+         (r.residual.failed_points
+              ? " (" + std::to_string(r.residual.failed_points) + " points not invertible)"
+              : "") +
+         " exceeds " + (a.max_residual_given ? "--max-residual-px " : "the default limit ") +
+         FormatNumber(a.max_residual_px) + " px; " + a.out + " not written" +
+         (a.max_residual_given ? "" : " (a larger --max-residual-px accepts it)");
+}
+
+int RunConvert(const ConvertArgs& a) {
+  CheckConvertOutputs(a);
   const CameraFormat& to = FindCameraFormat(a.to, "--to");
   const CameraFile source = a.read.Read();
   const calib::FormatTarget target =
@@ -122,50 +206,9 @@ int RunConvert(const ConvertArgs& a) {
   std::vector<std::string> notes = source.notes;
   notes.insert(notes.end(), conversion.notes.begin(), conversion.notes.end());
   CameraFile written = conversion.file;
-  if (written.covariance) {
-    switch (calib::CovarianceHeld(to, written.camera.model)) {
-      case calib::CovarianceForm::kFull:
-        break;
-      case calib::CovarianceForm::kSigmas:
-        notes.push_back("covariance written as standard deviations (" + a.to +
-                        " holds no correlations: dropped)");
-        break;
-      case calib::CovarianceForm::kNone:
-        notes.push_back("covariance dropped: " + a.to + " (" +
-                        std::string(calib::CameraModelName(written.camera.model)) + ") holds none");
-        written.covariance.reset();
-    }
-  }
-  const std::string model(calib::CameraModelName(r.camera.model));
-  std::printf("%s (%s, %s) -> %s (%s, %s): %s\n",
-              a.read.in.c_str(),
-              a.read.used.c_str(),
-              std::string(calib::CameraModelName(source.camera.model)).c_str(),
-              a.out.c_str(),
-              a.to.c_str(),
-              model.c_str(),
-              r.exact ? "exact (closed form)" : "least-squares fit over the format");
-  std::printf("%s\n", DescribeConversion(r).c_str());
-  for (const auto& note : notes) std::printf("note: %s\n", note.c_str());
-  nlohmann::json report = {
-      {"from", a.read.used},
-      {"to", a.to},
-      {"source_model", std::string(calib::CameraModelName(source.camera.model))},
-      {"model", model},
-      {"exact", r.exact},
-      {"acceptable", acceptable},
-      {"fit_iterations", r.fit_iterations},
-      {"residual_px",
-       {{"rms", r.residual.rms_px},
-        {"max", r.residual.max_px},
-        {"max_at", {r.residual.max_at_px.x(), r.residual.max_at_px.y()}},
-        {"max_inner80", r.residual.max_inner80_px},
-        {"points", r.residual.points},
-        {"failed_points", r.residual.failed_points}}},
-      {"notes", notes},
-      {"coefficient_choices", tried},
-      {"source_camera_model", calib::CameraModelTableToJson(source.camera.model)},
-      {"camera_model", calib::CameraModelTableToJson(r.camera.model)}};
+  FitCovarianceToFormat(to, a.to, &written, &notes);
+  PrintConversion(a, source, r, notes);
+  const nlohmann::json report = ConversionReportJson(a, source, r, acceptable, notes, tried);
   // OUT and the report are one set (tools/output_set.h): neither replaces its previous file
   // unless both were written. A conversion that is not acceptable writes the report alone (it
   // says why OUT was not written).
@@ -173,13 +216,7 @@ int RunConvert(const ConvertArgs& a) {
   if (!a.report.empty()) WriteResult(set.StagePath(a.report), "camera_conversion", report);
   if (!acceptable) {
     if (!a.report.empty()) set.Commit({});
-    LogWarning("conversion_residual: " + DescribeConversion(r) +
-               (r.residual.failed_points
-                    ? " (" + std::to_string(r.residual.failed_points) + " points not invertible)"
-                    : "") +
-               " exceeds " + (a.max_residual_given ? "--max-residual-px " : "the default limit ") +
-               FormatNumber(a.max_residual_px) + " px; " + a.out + " not written" +
-               (a.max_residual_given ? "" : " (a larger --max-residual-px accepts it)"));
+    LogWarning(ConversionResidualWarning(a, r));
     return kExitNotConverged;
   }
   calib::WriteCameraFileVerified(to, set.StagePath(a.out), written);
