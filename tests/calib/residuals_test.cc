@@ -13,6 +13,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 namespace aerocal::calib {
 namespace {
@@ -161,6 +162,18 @@ struct RigScene {
   PixelFrame frame{0.006, 10000, 10000};
 };
 
+// The rig residual's blocks of a scene in the functor's order.
+std::vector<const double*> BlocksOf(const RigScene& s) {
+  return {s.interior,
+          s.rig_rotation.data(),
+          s.rig_center,
+          s.mount,
+          s.lever,
+          s.increment,
+          s.dt,
+          s.point};
+}
+
 TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
   RigScene s;
   // Oracle: R_k = R M_k E_k, O_k = O + R t_k + v dT_k with Eigen matrices (CONVENTIONS.md).
@@ -178,15 +191,7 @@ TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
   ASSERT_TRUE(head.ProjectToPixel(OpkFromRotation(rk), ok, Eigen::Vector3d(s.point), &pixel));
   auto cost = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.25, s.velocity);
   double res[2];
-  const double* blocks[] = {s.interior,
-                            s.rig_rotation.data(),
-                            s.rig_center,
-                            s.mount,
-                            s.lever,
-                            s.increment,
-                            s.dt,
-                            s.point};
-  ASSERT_TRUE(cost->Evaluate(blocks, res, nullptr));
+  ASSERT_TRUE(cost->Evaluate(BlocksOf(s).data(), res, nullptr));
   EXPECT_NEAR(res[0], 0.0, 1e-6);  // 1e-6 sigma = 2.5e-7 px (the distortion inverse's tolerance)
   EXPECT_NEAR(res[1], 0.0, 1e-6);
   // A lever-arm error of 1 mm along the rig's x moves the head centre by R [1e-3 0 0]^T: the
@@ -221,6 +226,50 @@ TEST(RigHeadCollinearityResidual, ZeroAtTheOraclePoseAndGradientsMatch) {
                         s.point});
 }
 
+// The factory's cost function (rig_head_cost_function.h) differentiates over increment, dt and
+// point only (7-wide Jets) when the held blocks' Jacobians are not asked for: residuals and those
+// Jacobians equal the 30-wide autodiff's to 1e-10 relative on random states; asked for every
+// Jacobian it gives the autodiff's own.
+TEST(RigHeadCollinearityResidual, ReducedJetsEqualTheFullAutodiff) {
+  std::mt19937 rng(35);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  for (int trial = 0; trial < 20; ++trial) {
+    RigScene s;
+    for (double& a : s.increment) a = 0.01 * u(rng);
+    for (double& a : s.mount) a += 0.02 * u(rng);
+    for (double& a : s.lever) a += 0.05 * u(rng);
+    for (int a = 0; a < 3; ++a) s.point[a] += 200.0 * u(rng);
+    s.dt[0] = 0.01 * u(rng);
+    s.interior[0] += u(rng);
+    const Eigen::Vector2d pixel(5000.0 + 4000.0 * u(rng), 5000.0 + 4000.0 * u(rng));
+    auto full = RigHeadCollinearityResidual::Create(s.frame, pixel, 0.25, s.velocity);
+    auto reduced = MakeRigHeadCollinearityResidual(
+        CameraModelId::kBrownFraser10, s.frame, pixel, 0.25, s.velocity);
+    const std::vector<const double*> blocks = BlocksOf(s);
+    const int sizes[] = {10, 4, 3, 3, 3, 3, 1, 3};
+    for (bool all : {false, true}) {
+      std::vector<std::vector<double>> j_full(8), j_reduced(8);
+      double* jf[8];
+      double* jr[8];
+      for (int b = 0; b < 8; ++b) {
+        j_full[b].assign(2 * sizes[b], 0.0);
+        j_reduced[b].assign(2 * sizes[b], NAN);
+        jf[b] = j_full[b].data();
+        jr[b] = (all || b >= 5) ? j_reduced[b].data() : nullptr;
+      }
+      double r_full[2], r_reduced[2];
+      ASSERT_TRUE(full->Evaluate(blocks.data(), r_full, jf));
+      ASSERT_TRUE(reduced->Evaluate(blocks.data(), r_reduced, jr));
+      for (int row = 0; row < 2; ++row)
+        EXPECT_NEAR(r_reduced[row], r_full[row], 1e-10 * std::abs(r_full[row]) + 1e-300);
+      for (int b = all ? 0 : 5; b < 8; ++b)
+        for (int i = 0; i < 2 * sizes[b]; ++i)
+          EXPECT_NEAR(j_reduced[b][i], j_full[b][i], 1e-10 * std::abs(j_full[b][i]) + 1e-300)
+              << "trial " << trial << " block " << b << " entry " << i;
+    }
+  }
+}
+
 TEST(RigHeadCollinearityResidual, TimeOffsetActsAsVelocityTimesOffset) {
   RigScene s;
   const Eigen::Vector2d pixel(4200.0, 5300.0);
@@ -230,14 +279,7 @@ TEST(RigHeadCollinearityResidual, TimeOffsetActsAsVelocityTimesOffset) {
   for (int i = 0; i < 3; ++i) shifted_center[i] = s.rig_center[i] + s.velocity[i] * s.dt[0];
   double zero_dt[1] = {0.0};
   double a[2], b[2];
-  const double* with_dt[] = {s.interior,
-                             s.rig_rotation.data(),
-                             s.rig_center,
-                             s.mount,
-                             s.lever,
-                             s.increment,
-                             s.dt,
-                             s.point};
+  const std::vector<const double*> with_dt = BlocksOf(s);
   const double* shifted[] = {s.interior,
                              s.rig_rotation.data(),
                              shifted_center,
@@ -246,7 +288,7 @@ TEST(RigHeadCollinearityResidual, TimeOffsetActsAsVelocityTimesOffset) {
                              s.increment,
                              zero_dt,
                              s.point};
-  ASSERT_TRUE(cost->Evaluate(with_dt, a, nullptr));
+  ASSERT_TRUE(cost->Evaluate(with_dt.data(), a, nullptr));
   ASSERT_TRUE(still->Evaluate(shifted, b, nullptr));
   EXPECT_NEAR(a[0], b[0], 1e-9);  // the same head centre, to rounding
   EXPECT_NEAR(a[1], b[1], 1e-9);
