@@ -166,8 +166,9 @@ void CheckTargetArgs(const MtfArgs& args) {
         "--targets: the edges are projected into the virtual image; a raw sub-image (--sub-image) "
         "is not supported yet");
   const Eigen::Vector2d origin = ParsePoint(args.origin, "--image-origin");
-  if (origin != origin.array().round().matrix())
-    throw ConfigError("--image-origin: whole pixels expected (got '" + args.origin + "')");
+  if (origin != origin.array().round().matrix() || origin.cwiseAbs().maxCoeff() > 1e7)
+    throw ConfigError("--image-origin: whole pixels within +-1e7 expected (got '" + args.origin +
+                      "')");
 }
 
 // The regions of --targets in `image`, each with its target's id, projected edge and local GSD;

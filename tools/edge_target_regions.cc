@@ -30,7 +30,8 @@ const nlohmann::json& ExposuresOf(const nlohmann::json& doc,
   const nlohmann::json* chosen = nullptr;
   for (const auto& a : doc["adjustments"]) {
     if (!a.is_object() || !a.contains("exposures") || !a["exposures"].is_array()) continue;
-    const std::string name = a.value("name", std::string());
+    const std::string name =
+        a.contains("name") && a["name"].is_string() ? a["name"].get<std::string>() : "";
     if (wanted.empty() || name == wanted) chosen = &a, *adjustment = name;
     if (!wanted.empty() && name == wanted) break;
   }

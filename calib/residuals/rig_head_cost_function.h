@@ -7,7 +7,8 @@
 // asks for no Jacobian of a held block, and falls back to the full autodiff otherwise (a block
 // that adjusts in another problem, or a caller asking for every Jacobian). The scalar parts and the
 // derivatives are computed by the same operations as the 30-wide Jets', so residuals and
-// Jacobians equal the autodiff's (tests/calib/rig_test.cc checks 1e-12 relative on random states).
+// Jacobians equal the autodiff's (tests/calib/residuals_test.cc checks 1e-10 relative on random
+// states).
 #pragma once
 
 #include "calib/residuals/collinearity.h"

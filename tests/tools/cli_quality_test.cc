@@ -95,6 +95,8 @@ TEST(CliQuality, BadOptionsExitTwoNamingTheOption) {
        "--sub-image"},  // projected into the virtual image only
       {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --image-origin 1.5,0",
        "--image-origin"},
+      {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --image-origin 1e12,0",
+       "--image-origin"},  // would overflow the integer origin
       {" --roi 0,0,128,128 --target-length-px 8", "--target-length-px"},
       {" --roi 0,0,128,128 --target-half-width-px 2", "--target-half-width-px"},
   };
