@@ -1,6 +1,7 @@
 #include "stitch/image_io/image_io.h"
 
 #include "calib/core/error.h"
+#include "stitch/image_io/cv_view.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -42,10 +43,7 @@ GrayImage ReadSubimage(const std::string& path, const calib::SubimageMapping& su
 
 void WriteGrayImage(const std::string& path, const GrayImage& image, int bits) {
   AEROCAL_CHECK(bits == 8 || bits == 16) << "bits must be 8 or 16, got " << bits;
-  const cv::Mat view(static_cast<int>(image.rows()),
-                     static_cast<int>(image.cols()),
-                     CV_32F,
-                     const_cast<float*>(image.data()));
+  const cv::Mat view = CvView(image);
   cv::Mat out;
   view.convertTo(out, bits == 8 ? CV_8U : CV_16U);  // rounds and saturates
   bool ok = false;

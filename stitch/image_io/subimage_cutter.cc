@@ -1,6 +1,7 @@
 #include "stitch/image_io/subimage_cutter.h"
 
 #include "calib/core/error.h"
+#include "stitch/image_io/cv_view.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -17,10 +18,7 @@ std::vector<GrayImage> CutSubimages(const GrayImage& frame,
   AEROCAL_CHECK(options.offsets.empty() || options.offsets.size() == n)
       << "one offset per sub-image";
   AEROCAL_CHECK(options.noise_dn >= 0.0) << "noise_dn must be >= 0";
-  const cv::Mat source(static_cast<int>(frame.rows()),
-                       static_cast<int>(frame.cols()),
-                       CV_32F,
-                       const_cast<float*>(frame.data()));
+  const cv::Mat source = CvView(frame);
   std::mt19937_64 rng(options.seed);
   std::normal_distribution<double> noise(0.0, 1.0);
   std::vector<GrayImage> out;

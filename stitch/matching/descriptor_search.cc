@@ -1,5 +1,6 @@
 // Search::kDescriptors (strip_candidates.h): SIFT, or Foerstner points with upright SIFT
 // descriptors, in both windows; brute-force matching with Lowe's ratio test (Lowe 2004).
+#include "stitch/image_io/cv_view.h"
 #include "stitch/matching/strip_candidates.h"
 
 #include <opencv2/features2d.hpp>
@@ -35,11 +36,7 @@ bool KeypointBefore(const cv::KeyPoint& x, const cv::KeyPoint& y) {
 WindowFeatures DetectWindow(const GrayImage& image,
                             const cv::Rect& rect,
                             const MatchOptions& options) {
-  const cv::Mat full(static_cast<int>(image.rows()),
-                     static_cast<int>(image.cols()),
-                     CV_32F,
-                     const_cast<float*>(image.data()));
-  const cv::Mat window = full(rect);
+  const cv::Mat window = CvView(image)(rect);
   cv::Ptr<cv::SIFT> sift = cv::SIFT::create(0, 3, options.sift_contrast);
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat gray8;
@@ -49,8 +46,7 @@ WindowFeatures DetectWindow(const GrayImage& image,
   } else {
     const GrayImage block = image.block(rect.y, rect.x, rect.height, rect.width);
     const GrayImage wallis = WallisFilter(block, options.wallis);
-    cv::Mat(rect.height, rect.width, CV_32F, const_cast<float*>(wallis.data()))
-        .convertTo(gray8, CV_8U);
+    CvView(wallis).convertTo(gray8, CV_8U);
     FoerstnerOptions foerstner = options.foerstner;
     foerstner.max_points = options.max_keypoints;
     for (const InterestPoint& p : DetectFoerstner(wallis, foerstner)) {

@@ -1,6 +1,7 @@
 #include "stitch/matching/interest_operators.h"
 
 #include "calib/core/error.h"
+#include "stitch/image_io/cv_view.h"
 
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
@@ -10,13 +11,6 @@
 
 namespace aerocal::stitch {
 namespace {
-
-cv::Mat View(const GrayImage& image) {
-  return cv::Mat(static_cast<int>(image.rows()),
-                 static_cast<int>(image.cols()),
-                 CV_32F,
-                 const_cast<float*>(image.data()));
-}
 
 void RequireOddWindow(int value, const char* field) {
   if (value < 3 || value % 2 == 0)
@@ -44,7 +38,7 @@ void FoerstnerOptions::Validate() const {
 
 GrayImage WallisFilter(const GrayImage& image, const WallisOptions& options) {
   options.Validate();
-  const cv::Mat g = View(image);
+  const cv::Mat g = CvView(image);
   const cv::Size window(options.window_px, options.window_px);
   cv::Mat mean, mean_sq;
   cv::boxFilter(g, mean, CV_32F, window, cv::Point(-1, -1), true, cv::BORDER_REFLECT);
@@ -66,7 +60,7 @@ GrayImage WallisFilter(const GrayImage& image, const WallisOptions& options) {
 std::vector<InterestPoint> DetectFoerstner(const GrayImage& image,
                                            const FoerstnerOptions& options) {
   options.Validate();
-  const cv::Mat g = View(image);
+  const cv::Mat g = CvView(image);
   cv::Mat gx, gy;  // central differences: d/dcol, d/drow
   const cv::Mat kx = (cv::Mat_<float>(1, 3) << -0.5f, 0.0f, 0.5f);
   cv::filter2D(g, gx, CV_32F, kx, cv::Point(-1, -1), 0, cv::BORDER_REFLECT);

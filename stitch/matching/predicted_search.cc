@@ -7,6 +7,7 @@
 // the template of a is located in it by normalised cross-correlation (OpenCV TM_CCOEFF_NORMED,
 // gain / offset free) with a parabolic sub-pixel peak. The caller's RANSAC drops wrong peaks
 // (repetitive texture); least-squares matching then refines the survivors.
+#include "stitch/image_io/cv_view.h"
 #include "stitch/matching/strip_candidates.h"
 
 #include <opencv2/imgproc.hpp>
@@ -22,13 +23,6 @@ namespace {
 // The global Foerstner threshold as a fraction of the mean weight: low, since each cell keeps its
 // own strongest points; it only drops flat, noise-only pixels.
 constexpr double kCellWeightFactor = 0.05;
-
-cv::Mat View(const GrayImage& image) {
-  return cv::Mat(static_cast<int>(image.rows()),
-                 static_cast<int>(image.cols()),
-                 CV_32F,
-                 const_cast<float*>(image.data()));
-}
 
 // d(uv_b) / d(uv_a) of the nominal prediction at uv_a (central differences over 1 px: the
 // mappings are affine or smooth polynomials).
@@ -94,14 +88,14 @@ std::optional<Eigen::Vector2d> FindByCorrelation(const GrayImage& a,
   const cv::Matx23d patch_to_b(
       b_per_a(0, 0), b_per_a(0, 1), origin.x(), b_per_a(1, 0), b_per_a(1, 1), origin.y());
   cv::Mat patch, ncc;
-  cv::warpAffine(View(b),
+  cv::warpAffine(CvView(b),
                  patch,
                  patch_to_b,
                  cv::Size(side, side),
                  cv::INTER_LINEAR | cv::WARP_INVERSE_MAP,
                  cv::BORDER_REPLICATE);
   const cv::Mat templ =
-      View(a)(cv::Rect(p_a.x() - half, p_a.y() - half, 2 * half + 1, 2 * half + 1));
+      CvView(a)(cv::Rect(p_a.x() - half, p_a.y() - half, 2 * half + 1, 2 * half + 1));
   cv::matchTemplate(patch, templ, ncc, cv::TM_CCOEFF_NORMED);
   const std::optional<Eigen::Vector2d> offset = PeakOffset(ncc, min_ncc, ncc_peak);
   if (!offset) return std::nullopt;
