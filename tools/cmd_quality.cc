@@ -16,12 +16,14 @@
 #include "tools/command_registry.h"
 #include "tools/edge_target_regions.h"
 #include "tools/option_ranges.h"
+#include "tools/resampling_comparison.h"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <memory>
+#include <optional>
 #include <sstream>
 
 namespace aerocal::tools {
@@ -62,6 +64,8 @@ struct MtfArgs {
   // --targets: the regions from edge targets and the image's adjusted orientation.
   std::string targets, camera, orientation, image_id, origin = "0,0";
   std::vector<std::string> only_targets;
+  // --sub-image with --targets: the mappings into the raw sub-image, the virtual image's file.
+  std::string mapping, frame, virtual_file, virtual_origin = "0,0";
   double target_length_px = 64.0, target_half_width_px = 32.0;
 };
 
@@ -70,6 +74,15 @@ struct MtfRegion {
   std::string label;  // "--roi TEXT" or "target ID"
   stitch::PixelRegion region;
   nlohmann::json extra = nlohmann::json::object();
+  std::optional<FoundEdgeRegion> found;  // a target's: compared with the virtual image when raw
+};
+
+// What --targets found beyond the regions: the raw sub-image's mapping (with --sub-image) and the
+// virtual image's file to measure the same edges in.
+struct TargetContext {
+  std::optional<calib::SubimageMapping> subimage;
+  std::optional<stitch::GrayImage> virtual_image;
+  VirtualWindow window;
 };
 
 struct StarArgs {
@@ -155,55 +168,54 @@ Eigen::Vector2d ParsePoint(const std::string& text, const std::string& option) {
   return {col, row};
 }
 
+// "col,row" in whole pixels within +-1e7 (a file's top-left pixel in a larger image).
+Eigen::Vector2i WholePixels(const std::string& text, const std::string& option) {
+  const Eigen::Vector2d origin = ParsePoint(text, option);
+  if (origin != origin.array().round().matrix() || origin.cwiseAbs().maxCoeff() > 1e7)
+    throw ConfigError(option + ": whole pixels within +-1e7 expected (got '" + text + "')");
+  return origin.cast<int>();
+}
+
 void CheckTargetArgs(const MtfArgs& args) {
   if (args.rois.empty() && args.targets.empty())
     throw ConfigError("quality mtf: give the edge regions with --roi or --targets");
+  const bool raw_targets = !args.targets.empty() && !args.sub_image.empty();
+  if (!raw_targets && !(args.mapping.empty() && args.frame.empty() && args.virtual_file.empty()))
+    throw ConfigError("--mapping, --frame and --virtual-image need --targets and --sub-image");
+  if (!args.frame.empty() && args.mapping.empty()) throw ConfigError("--frame needs --mapping");
   if (args.targets.empty()) return;
   if (args.camera.empty() || args.orientation.empty() || args.image_id.empty())
     throw ConfigError("--targets needs --camera, --orientation and --image-id");
-  if (!args.sub_image.empty())
-    throw ConfigError(
-        "--targets: the edges are projected into the virtual image; a raw sub-image (--sub-image) "
-        "is not supported yet");
-  const Eigen::Vector2d origin = ParsePoint(args.origin, "--image-origin");
-  if (origin != origin.array().round().matrix() || origin.cwiseAbs().maxCoeff() > 1e7)
-    throw ConfigError("--image-origin: whole pixels within +-1e7 expected (got '" + args.origin +
-                      "')");
+  WholePixels(args.origin, "--image-origin");
+  WholePixels(args.virtual_origin, "--virtual-origin");
 }
 
-// The regions of --targets in `image`, each with its target's id, projected edge and local GSD;
-// the skipped targets by name into `doc`'s `targets` table.
-std::vector<MtfRegion> TargetRegions(const MtfArgs& args,
-                                     const stitch::GrayImage& image,
-                                     nlohmann::json* doc) {
-  const std::vector<stitch::EdgeTarget> targets = ReadEdgeTargets(args.targets);
-  const calib::Camera camera = calib::ReadCamera(args.camera);
-  const ExposureOrientation orientation = ReadExposureOrientation(args.orientation, args.image_id);
-  const Eigen::Vector2i origin = ParsePoint(args.origin, "--image-origin").cast<int>();
-  stitch::EdgeTargetRegionOptions options;
-  options.max_length_px = args.target_length_px;
-  options.half_width_px = args.target_half_width_px;
-  const FoundEdgeRegions found = FindEdgeRegions(camera,
-                                                 orientation,
-                                                 targets,
-                                                 args.only_targets,
-                                                 origin,
-                                                 static_cast<int>(image.cols()),
-                                                 static_cast<int>(image.rows()),
-                                                 options);
-  std::vector<MtfRegion> regions;
-  for (const FoundEdgeRegion& f : found.found) {
-    const nlohmann::json extra = {
-        {"target", f.target.id},
-        {"projected_start_px", {f.target.start_px.x(), f.target.start_px.y()}},
-        {"projected_end_px", {f.target.end_px.x(), f.target.end_px.y()}},
-        {"projected_offset_px", f.projected_offset_px},
-        {"target_gsd_m", f.target.gsd_m}};
-    regions.push_back({"target " + f.target.id, f.region, extra});
+// The raw sub-image --sub-image names, in the camera with --mapping's mappings; ConfigError naming
+// --sub-image for an id the camera lacks.
+calib::SubimageMapping RawSubimage(const MtfArgs& args, const calib::Camera& camera) {
+  const calib::Camera mapped =
+      args.mapping.empty() ? camera : CameraWithMappings(camera, args.mapping, args.frame);
+  const int k = mapped.SubimageIndex(args.sub_image);
+  if (k < 0) {
+    std::string ids;
+    for (const auto& s : mapped.subimages) ids += (ids.empty() ? "" : ", ") + s.id;
+    throw ConfigError("--sub-image: no sub-image '" + args.sub_image + "' in " + args.camera +
+                      " (it has " + (ids.empty() ? "none" : ids) + ")");
   }
+  return mapped.subimages[k];
+}
+
+// `doc`'s `targets` table: the inputs, how many were found, the skipped by name (also printed).
+void WriteTargetTable(const MtfArgs& args,
+                      const FoundEdgeRegions& found,
+                      const ExposureOrientation& orientation,
+                      nlohmann::json* doc) {
   nlohmann::json skipped = nlohmann::json::array();
-  for (const auto& [id, reason] : found.skipped)
+  for (const auto& [id, reason] : found.skipped) {
     skipped.push_back({{"id", id}, {"reason", reason}});
+    std::printf("target %s skipped: %s\n", id.c_str(), reason.c_str());
+  }
+  const Eigen::Vector2i origin = WholePixels(args.origin, "--image-origin");
   (*doc)["targets"] = {{"file", args.targets},
                        {"camera", args.camera},
                        {"orientation", args.orientation},
@@ -215,15 +227,93 @@ std::vector<MtfRegion> TargetRegions(const MtfArgs& args,
                        {"skipped_count", found.skipped.size()},
                        {"skipped", skipped}};
   if (!orientation.adjustment.empty()) (*doc)["targets"]["adjustment"] = orientation.adjustment;
-  for (const auto& [id, reason] : found.skipped)
-    std::printf("target %s skipped: %s\n", id.c_str(), reason.c_str());
+  if (!args.mapping.empty()) (*doc)["targets"]["mapping"] = args.mapping;
+  if (!args.frame.empty()) (*doc)["targets"]["frame"] = args.frame;
+}
+
+// The regions of --targets in `image` (the virtual image, or with --sub-image that raw sub-image
+// through --mapping), each with its target's id, projected edge, local GSD and its position in
+// the virtual image; the skipped targets by name into `doc`'s `targets` table.
+std::vector<MtfRegion> TargetRegions(const MtfArgs& args,
+                                     const stitch::GrayImage& image,
+                                     TargetContext* context,
+                                     nlohmann::json* doc) {
+  const std::vector<stitch::EdgeTarget> targets = ReadEdgeTargets(args.targets);
+  const calib::Camera camera = calib::ReadCamera(args.camera);
+  if (!args.sub_image.empty()) context->subimage = RawSubimage(args, camera);
+  const ExposureOrientation orientation = ReadExposureOrientation(args.orientation, args.image_id);
+  stitch::EdgeTargetRegionOptions options;
+  options.max_length_px = args.target_length_px;
+  options.half_width_px = args.target_half_width_px;
+  const FoundEdgeRegions found = FindEdgeRegions(camera,
+                                                 orientation,
+                                                 targets,
+                                                 args.only_targets,
+                                                 WholePixels(args.origin, "--image-origin"),
+                                                 static_cast<int>(image.cols()),
+                                                 static_cast<int>(image.rows()),
+                                                 options,
+                                                 context->subimage ? &*context->subimage : nullptr);
+  std::vector<MtfRegion> regions;
+  for (const FoundEdgeRegion& f : found.found) {
+    const nlohmann::json extra = {
+        {"target", f.target.id},
+        {"projected_start_px", {f.target.start_px.x(), f.target.start_px.y()}},
+        {"projected_end_px", {f.target.end_px.x(), f.target.end_px.y()}},
+        {"projected_offset_px", f.projected_offset_px},
+        {"target_gsd_m", f.target.gsd_m},
+        {"position_virtual_px", RegionCentreJson(f.in_virtual.region, {0, 0})}};
+    regions.push_back({"target " + f.target.id, f.region, extra, f});
+  }
+  WriteTargetTable(args, found, orientation, doc);
+  (*doc)["virtual_format_px"] = {camera.width_px, camera.height_px};
   return regions;
+}
+
+// One region measured: the edge's JSON with its region, target, direction, ground units and,
+// for a raw sub-image's target edge, the comparison with the virtual image.
+nlohmann::json MeasureRegion(const MtfArgs& args,
+                             const stitch::GrayImage& image,
+                             const MtfRegion& region,
+                             const stitch::SlantedEdgeOptions& options,
+                             const TargetContext& context,
+                             stitch::SlantedEdgeResult* result) {
+  try {
+    *result = stitch::MeasureSlantedEdge(image, region.region, options);
+  } catch (const InputError& e) {
+    throw InputError(region.label + ": " + args.image + ": " + e.what());
+  }
+  const stitch::SlantedEdgeResult& r = *result;
+  nlohmann::json edge = stitch::SlantedEdgeToJson(r);
+  const stitch::PixelRegion& roi = region.region;
+  edge["roi"] = {roi.col, roi.row, roi.width, roi.height};
+  edge.update(region.extra);
+  // A --roi of the virtual image: its place in the format (the file's origin added).
+  if (args.virtual_image && !region.found)
+    edge["position_virtual_px"] = RegionCentreJson(roi, WholePixels(args.origin, "--image-origin"));
+  if (context.subimage && region.found)
+    edge["resampling"] =
+        ResamplingComparisonJson(r, *region.found, *context.subimage, context.window, options);
+  const std::string direction = Direction(r.axis, args.flight_axis);
+  if (!direction.empty()) edge["direction"] = direction;
+  AddGround(args.ground, r.mtf50_cy_px, r.mtf50_u_cy_px, "mtf50", &edge);
+  std::printf(
+      "%s: MTF along %s, slant %.2f deg, MTF50 %.4f +- %.4f cycles/px (U, k = 2), "
+      "MTF at Nyquist %.3f\n",
+      region.label.c_str(),
+      std::string(stitch::MtfAxisName(r.axis)).c_str(),
+      r.angle_deg,
+      r.mtf50_cy_px,
+      r.mtf50_expanded_cy_px,
+      r.mtf_nyquist);
+  return edge;
 }
 
 int RunMtf(const MtfArgs& args) {
   CheckOutputFile(args.out, "--out");
   std::vector<MtfRegion> regions;
-  for (const auto& text : args.rois) regions.push_back({"--roi " + text, ParseRegion(text)});
+  for (const auto& text : args.rois)
+    regions.push_back({"--roi " + text, ParseRegion(text), nlohmann::json::object(), std::nullopt});
   CheckTargetArgs(args);
   args.ground.Check();
   stitch::SlantedEdgeOptions options;
@@ -231,38 +321,24 @@ int RunMtf(const MtfArgs& args) {
   options.oversampling = args.oversampling;
   const stitch::GrayImage image = stitch::ReadGrayImage(args.image);
   nlohmann::json doc = nlohmann::json::object();
+  TargetContext context;
   if (!args.targets.empty())
-    for (MtfRegion& r : TargetRegions(args, image, &doc)) regions.push_back(std::move(r));
+    for (MtfRegion& r : TargetRegions(args, image, &context, &doc)) regions.push_back(std::move(r));
+  if (!args.virtual_file.empty()) {
+    context.virtual_image = stitch::ReadGrayImage(args.virtual_file);
+    context.window = {&*context.virtual_image,
+                      args.virtual_file,
+                      WholePixels(args.virtual_origin, "--virtual-origin")};
+  }
 
   nlohmann::json edges = nlohmann::json::array();
   std::vector<stitch::SlantedEdgeResult> per_axis[2];
   bool determined = true;
-  for (size_t i = 0; i < regions.size(); ++i) {
+  for (const MtfRegion& region : regions) {
     stitch::SlantedEdgeResult r;
-    try {
-      r = stitch::MeasureSlantedEdge(image, regions[i].region, options);
-    } catch (const InputError& e) {
-      throw InputError(regions[i].label + ": " + args.image + ": " + e.what());
-    }
-    nlohmann::json edge = stitch::SlantedEdgeToJson(r);
-    const stitch::PixelRegion& roi = regions[i].region;
-    edge["roi"] = {roi.col, roi.row, roi.width, roi.height};
-    edge.update(regions[i].extra);
-    const std::string direction = Direction(r.axis, args.flight_axis);
-    if (!direction.empty()) edge["direction"] = direction;
-    AddGround(args.ground, r.mtf50_cy_px, r.mtf50_u_cy_px, "mtf50", &edge);
-    edges.push_back(edge);
+    edges.push_back(MeasureRegion(args, image, region, options, context, &r));
     determined = determined && std::isfinite(r.mtf50_cy_px);
     if (std::isfinite(r.mtf50_cy_px)) per_axis[r.axis == stitch::MtfAxis::kX ? 0 : 1].push_back(r);
-    std::printf(
-        "%s: MTF along %s, slant %.2f deg, MTF50 %.4f +- %.4f cycles/px (U, k = 2), "
-        "MTF at Nyquist %.3f\n",
-        regions[i].label.c_str(),
-        std::string(stitch::MtfAxisName(r.axis)).c_str(),
-        r.angle_deg,
-        r.mtf50_cy_px,
-        r.mtf50_expanded_cy_px,
-        r.mtf_nyquist);
   }
   nlohmann::json axes = nlohmann::json::object();
   for (int a = 0; a < 2; ++a) {
@@ -481,6 +557,22 @@ CommandRun Setup(CLI::App& app) {
                 "--targets: the file's top-left pixel col,row in the full (virtual) image, for a "
                 "file that is a window of it");
   m->add_option("--target", mtf->only_targets, "--targets: measure only this edge id; repeat");
+  m->add_option("--mapping",
+                mtf->mapping,
+                "--targets with --sub-image: the stitch result (or a flight result, its stitching) "
+                "whose sub-image mappings carry each edge from the virtual image into the raw "
+                "sub-image");
+  m->add_option("--frame",
+                mtf->frame,
+                "--mapping: the mappings of this frame (exposure) of the stitch result (default: "
+                "the top level's, a flight's mean)");
+  m->add_option("--virtual-image",
+                mtf->virtual_file,
+                "--mapping: the virtual image resampled from the sub-image (or a window of it): "
+                "each edge is measured there too and the resampling loss stated per edge");
+  m->add_option("--virtual-origin",
+                mtf->virtual_origin,
+                "--virtual-image: the file's top-left pixel col,row in the full virtual image");
   m->add_option(
        "--target-length-px", mtf->target_length_px, "--targets: region length along the edge (px)")
       ->check(FiniteRange(16, 1e4));

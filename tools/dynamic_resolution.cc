@@ -59,6 +59,9 @@ void AddMtfResult(const nlohmann::json& doc, const std::string& path, nlohmann::
   (*section)["method"] = doc.at("method");
   nlohmann::json origin = {{"source", path}};
   CopyKeys(doc, &origin, {"image_kind", "sub_image"});
+  if (doc.contains("targets")) CopyKeys(doc.at("targets"), &origin, {"image_id"});
+  if (doc.contains("virtual_format_px") && !section->contains("virtual_format_px"))
+    (*section)["virtual_format_px"] = doc["virtual_format_px"];
   for (const auto& e : doc.at("edges")) {
     nlohmann::json edge = origin;
     CopyKeys(e,
@@ -76,7 +79,10 @@ void AddMtfResult(const nlohmann::json& doc, const std::string& path, nlohmann::
               "mtf50_resolved_distance_m",
               "mtf50_resolved_distance_expanded_m",
               "curve",
-              "budget"});
+              "budget",
+              "target",
+              "position_virtual_px",
+              "resampling"});
     (*section)["edges"].push_back(edge);
   }
   for (const auto& [axis, c] : doc.at("axes").items()) {
@@ -108,7 +114,58 @@ struct Mean {
   double U() const { return std::sqrt(sum_u2) / n; }
 };
 
+// A number of a JSON object, NaN when absent or null.
+double NumberAt(const nlohmann::json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : std::nan("");
+}
+
+// Plain means of values (NaN ones left out); null when there are none.
+struct PlainMean {
+  double sum = 0.0;
+  int n = 0;
+  void Add(double v) {
+    if (std::isfinite(v)) sum += v, ++n;
+  }
+  nlohmann::json Json() const { return n > 0 ? nlohmann::json(sum / n) : nlohmann::json(); }
+};
+
 }  // namespace
+
+nlohmann::json ResamplingPerSubImageJson(const nlohmann::json& edges) {
+  struct Row {
+    nlohmann::json direction;
+    PlainMean raw, virtual_image, loss, predicted, uniform;
+    int edges = 0, measured = 0;
+  };
+  std::map<std::pair<std::string, std::string>, Row> rows;  // by sub-image and axis
+  for (const auto& e : edges) {
+    if (!e.contains("resampling") || !e["resampling"].is_object()) continue;
+    const nlohmann::json& r = e["resampling"];
+    Row& row = rows[{e.value("sub_image", ""), e.value("axis", "")}];
+    if (e.contains("direction")) row.direction = e["direction"];
+    ++row.edges;
+    row.raw.Add(NumberAt(e, "mtf50_cy_px"));
+    row.predicted.Add(NumberAt(r, "predicted_loss_percent"));
+    row.uniform.Add(NumberAt(r, "uniform_phase_loss_percent"));
+    if (!std::isfinite(NumberAt(r, "virtual_mtf50_cy_px"))) continue;
+    ++row.measured;
+    row.virtual_image.Add(NumberAt(r, "virtual_mtf50_cy_px"));
+    row.loss.Add(NumberAt(r, "loss_percent"));
+  }
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& [key, row] : rows)
+    out.push_back({{"sub_image", key.first},
+                   {"axis", key.second},
+                   {"direction", row.direction},
+                   {"edges", row.edges},
+                   {"raw_mean_mtf50_cy_px", row.raw.Json()},
+                   {"virtual_measured", row.measured},
+                   {"virtual_mean_mtf50_cy_px", row.virtual_image.Json()},
+                   {"mean_loss_percent", row.loss.Json()},
+                   {"mean_predicted_loss_percent", row.predicted.Json()},
+                   {"mean_uniform_phase_loss_percent", row.uniform.Json()}});
+  return out;
+}
 
 nlohmann::json ResamplingLossJson(const nlohmann::json& axes) {
   constexpr double kCoverage = 2.0;
@@ -176,6 +233,7 @@ nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths) {
     }
   }
   section["resampling_loss"] = ResamplingLossJson(section["axes"]);
+  section["resampling_per_sub_image"] = ResamplingPerSubImageJson(section["edges"]);
   return section;
 }
 

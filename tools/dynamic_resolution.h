@@ -14,9 +14,11 @@ namespace aerocal::tools {
 
 /// The section from the results of `aerocal quality mtf` / `bars` / `star` at `paths`: `sources`,
 /// `method`, `edges` and `axes` (each with the source, and `image_kind` raw / virtual and
-/// `sub_image` where `quality mtf --sub-image / --virtual` named them), `bars`, `stars` and
-/// `resampling_loss` (ResamplingLossJson). InputError naming the file for one that is not a
-/// quality result or lacks a table.
+/// `sub_image` where `quality mtf --sub-image / --virtual` named them; an edge found from a target
+/// also its `target`, `image_id`, `position_virtual_px` and a raw one its `resampling` block),
+/// `virtual_format_px` (the first result's that has it), `bars`, `stars`, `resampling_loss`
+/// (ResamplingLossJson) and `resampling_per_sub_image` (ResamplingPerSubImageJson). InputError
+/// naming the file for one that is not a quality result or lacks a table.
 nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths);
 
 /// Per axis (x, y) where both raw sub-images and the virtual image have a combined MTF50: the raw
@@ -26,5 +28,12 @@ nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths);
 /// are taken as measured independently: their shared type-B part, which the difference partly
 /// cancels, is counted in full, so U is on the safe side. `axes` is the section's `axes` array.
 nlohmann::json ResamplingLossJson(const nlohmann::json& axes);
+
+/// Per raw sub-image and axis, over the section's edges measured with `quality mtf --targets
+/// --sub-image --mapping` (those with a `resampling` block): `edges`, the plain means of the raw
+/// MTF50, of the virtual MTF50 and the measured loss (over the `virtual_measured` edges measured in
+/// the virtual image too), and of the predicted losses (at the mapping's shifts and at uniform
+/// phases), in percent of each edge's raw MTF50. The report's per-sub-image table.
+nlohmann::json ResamplingPerSubImageJson(const nlohmann::json& edges);
 
 }  // namespace aerocal::tools

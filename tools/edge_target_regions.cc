@@ -3,6 +3,8 @@
 #include "calib/core/csv.h"
 #include "calib/core/error.h"
 #include "calib/core/json_file.h"
+#include "calib/core/result_file.h"
+#include "stitch/io/stitch_result_json.h"
 
 #include <nlohmann/json.hpp>
 
@@ -60,7 +62,34 @@ double ProjectedOffset(const stitch::EdgeTargetRegion& t,
   return a.y() + (col - a.x()) * d.y() / d.x() - region.row;
 }
 
+// The edge `v` of the virtual image in raw sub-image `sub`: its ends mapped by the sub-image's
+// projectivity, the region built in the sub-image's format.
+stitch::EdgeTargetRegion InSubimage(const stitch::EdgeTargetRegion& v,
+                                    const calib::SubimageMapping& sub,
+                                    const stitch::EdgeTarget& target,
+                                    const stitch::EdgeTargetRegionOptions& options) {
+  stitch::EdgeTargetRegion t = stitch::RegionOfImageEdge(target.id,
+                                                         sub.SubFromVirtual(v.start_px),
+                                                         sub.SubFromVirtual(v.end_px),
+                                                         (target.end_m - target.start_m).norm(),
+                                                         sub.width_px,
+                                                         sub.height_px,
+                                                         options);
+  if (!t.usable) t.reason = "not in sub-image " + sub.id + ": " + t.reason;
+  return t;
+}
+
 }  // namespace
+
+calib::Camera CameraWithMappings(const calib::Camera& camera,
+                                 const std::string& path,
+                                 const std::string& frame) {
+  const nlohmann::json doc = ReadResult(path, {"stitch", "flight"}, "`aerocal stitch` or `flight`");
+  if (doc.at("kind") == "stitch") return stitch::ApplyStitchDocument(camera, doc, path, frame);
+  if (!doc.contains("stitching") || !doc["stitching"].is_object())
+    throw InputError(path + ": a flight result without its stitching (no sub-image mappings)");
+  return stitch::ApplyStitchDocument(camera, doc["stitching"], path + ": stitching", frame);
+}
 
 std::vector<stitch::EdgeTarget> ReadEdgeTargets(const std::string& path) {
   const std::vector<std::string> columns = {
@@ -116,15 +145,22 @@ FoundEdgeRegions FindEdgeRegions(const calib::Camera& camera,
                                  const Eigen::Vector2i& origin_px,
                                  int file_cols,
                                  int file_rows,
-                                 const stitch::EdgeTargetRegionOptions& options) {
+                                 const stitch::EdgeTargetRegionOptions& options,
+                                 const calib::SubimageMapping* subimage) {
   for (const std::string& id : only)
     if (std::none_of(targets.begin(), targets.end(), [&](const auto& t) { return t.id == id; }))
       throw ConfigError("--target: no edge target '" + id + "' in the target file");
   FoundEdgeRegions out;
   for (const stitch::EdgeTarget& target : targets) {
     if (!only.empty() && std::find(only.begin(), only.end(), target.id) == only.end()) continue;
-    const stitch::EdgeTargetRegion t = stitch::RegionOfEdgeTarget(
+    const stitch::EdgeTargetRegion v = stitch::RegionOfEdgeTarget(
         camera, orientation.opk_rad, orientation.center_m, target, options);
+    if (!v.usable) {
+      out.skipped.emplace_back(target.id, v.reason);
+      continue;
+    }
+    const stitch::EdgeTargetRegion t =
+        subimage == nullptr ? v : InSubimage(v, *subimage, target, options);
     if (!t.usable) {
       out.skipped.emplace_back(target.id, t.reason);
       continue;
@@ -135,7 +171,7 @@ FoundEdgeRegions FindEdgeRegions(const calib::Camera& camera,
       out.skipped.emplace_back(target.id, "the region leaves the image file");
       continue;
     }
-    out.found.push_back({t, r, ProjectedOffset(t, r, origin_px)});
+    out.found.push_back({t, v, r, ProjectedOffset(t, r, origin_px)});
   }
   return out;
 }

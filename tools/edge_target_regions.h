@@ -38,9 +38,10 @@ ExposureOrientation ReadExposureOrientation(const std::string& result_path,
                                             const std::string& image);
 
 struct FoundEdgeRegion {
-  stitch::EdgeTargetRegion target;   // projected in the full image
-  stitch::PixelRegion region;        // in the file's pixels (shifted by -origin)
-  double projected_offset_px = 0.0;  // the projected edge across `region` at its middle line
+  stitch::EdgeTargetRegion target;      // projected in the full image (virtual, or the sub-image)
+  stitch::EdgeTargetRegion in_virtual;  // the same edge in the virtual image (= target there)
+  stitch::PixelRegion region;           // in the file's pixels (shifted by -origin)
+  double projected_offset_px = 0.0;     // the projected edge across `region` at its middle line
 };
 
 struct FoundEdgeRegions {
@@ -50,7 +51,10 @@ struct FoundEdgeRegions {
 
 /// The regions of `targets` (all when `only` is empty, else those named; an unknown name is a
 /// ConfigError naming --target) in an image file of `file_cols` x `file_rows` px whose top-left
-/// pixel is `origin_px` in the camera's image.
+/// pixel is `origin_px` in the camera's (virtual) image, or with `subimage` in that raw sub-image:
+/// the edge's ends projected into the virtual image are mapped by SubFromVirtual (a projectivity
+/// keeps the edge straight) and the region is built there; a target whose region leaves the
+/// sub-image is skipped ("not in sub-image ID: ...").
 FoundEdgeRegions FindEdgeRegions(const calib::Camera& camera,
                                  const ExposureOrientation& orientation,
                                  const std::vector<stitch::EdgeTarget>& targets,
@@ -58,6 +62,15 @@ FoundEdgeRegions FindEdgeRegions(const calib::Camera& camera,
                                  const Eigen::Vector2i& origin_px,
                                  int file_cols,
                                  int file_rows,
-                                 const stitch::EdgeTargetRegionOptions& options);
+                                 const stitch::EdgeTargetRegionOptions& options,
+                                 const calib::SubimageMapping* subimage = nullptr);
+
+/// The camera with the mappings of `path`: a stitch result (`aerocal stitch`, as `resample
+/// --mapping` reads it) or a flight result, whose `stitching` is one; those of frame `frame`, or
+/// the top level's (the flight's mean) when empty. InputError naming the file when it does not
+/// match the camera (a sub-image missing on either side, a frame it lacks).
+calib::Camera CameraWithMappings(const calib::Camera& camera,
+                                 const std::string& path,
+                                 const std::string& frame);
 
 }  // namespace aerocal::tools

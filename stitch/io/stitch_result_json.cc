@@ -254,7 +254,13 @@ json StitchResultToJson(const BatchResult& result, const BatchOptions& options) 
 calib::Camera ApplyStitchResult(const calib::Camera& camera,
                                 const std::string& path,
                                 const std::string& frame) {
-  const json doc = ReadResult(path, {"stitch"}, "`aerocal stitch`");
+  return ApplyStitchDocument(camera, ReadResult(path, {"stitch"}, "`aerocal stitch`"), path, frame);
+}
+
+calib::Camera ApplyStitchDocument(const calib::Camera& camera,
+                                  const json& doc,
+                                  const std::string& path,
+                                  const std::string& frame) {
   const json* source = &doc;
   if (!frame.empty()) {
     // A frame's result is an object whose "frame" is that id; a flight's "frames" an array of them.

@@ -32,4 +32,11 @@ calib::Camera ApplyStitchResult(const calib::Camera& camera,
                                 const std::string& path,
                                 const std::string& frame);
 
+/// The same from a stitch document already read (a stitch result, or a flight result's
+/// `stitching`); `path` names it in the errors.
+calib::Camera ApplyStitchDocument(const calib::Camera& camera,
+                                  const nlohmann::json& doc,
+                                  const std::string& path,
+                                  const std::string& frame);
+
 }  // namespace aerocal::stitch

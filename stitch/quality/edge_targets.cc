@@ -12,24 +12,44 @@ EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
                                     const Eigen::Vector3d& center_m,
                                     const EdgeTarget& target,
                                     const EdgeTargetRegionOptions& options) {
+  Eigen::Vector2d start_px, end_px;
+  if (!camera.ProjectToPixel(opk_rad, center_m, target.start_m, &start_px) ||
+      !camera.ProjectToPixel(opk_rad, center_m, target.end_m, &end_px)) {
+    EdgeTargetRegion out;
+    out.id = target.id;
+    out.reason = "an end of the edge is not seen by the camera";
+    return out;
+  }
+  return RegionOfImageEdge(target.id,
+                           start_px,
+                           end_px,
+                           (target.end_m - target.start_m).norm(),
+                           camera.width_px,
+                           camera.height_px,
+                           options);
+}
+
+EdgeTargetRegion RegionOfImageEdge(const std::string& id,
+                                   const Eigen::Vector2d& start_px,
+                                   const Eigen::Vector2d& end_px,
+                                   double ground_length_m,
+                                   int width_px,
+                                   int height_px,
+                                   const EdgeTargetRegionOptions& options) {
   AEROCAL_CHECK(options.half_width_px >= 8.0 && options.used_fraction > 0.0 &&
                 options.used_fraction <= 1.0 &&
                 (options.max_length_px == 0.0 || options.max_length_px >= 16.0))
       << "half_width_px >= 8, 0 < used_fraction <= 1, max_length_px 0 or >= 16";
   EdgeTargetRegion out;
-  out.id = target.id;
-  if (!camera.ProjectToPixel(opk_rad, center_m, target.start_m, &out.start_px) ||
-      !camera.ProjectToPixel(opk_rad, center_m, target.end_m, &out.end_px)) {
-    out.reason = "an end of the edge is not seen by the camera";
-    return out;
-  }
+  out.id = id;
+  out.start_px = start_px, out.end_px = end_px;
   const Eigen::Vector2d d = out.end_px - out.start_px;
   const double length_px = d.norm();
   if (length_px < 16.0) {
     out.reason = "the edge is shorter than 16 px in the image";
     return out;
   }
-  out.gsd_m = (target.end_m - target.start_m).norm() / length_px;
+  out.gsd_m = ground_length_m / length_px;
   // An edge running more along the rows than the columns has its normal nearer the x axis.
   out.axis = std::abs(d.y()) >= std::abs(d.x()) ? MtfAxis::kX : MtfAxis::kY;
   out.slant_deg = std::atan2(std::min(std::abs(d.x()), std::abs(d.y())),
@@ -55,9 +75,8 @@ EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
   out.region.row = static_cast<int>(std::ceil(row0));
   out.region.width = static_cast<int>(std::floor(col1)) - out.region.col + 1;
   out.region.height = static_cast<int>(std::floor(row1)) - out.region.row + 1;
-  if (out.region.col < 0 || out.region.row < 0 ||
-      out.region.col + out.region.width > camera.width_px ||
-      out.region.row + out.region.height > camera.height_px) {
+  if (out.region.col < 0 || out.region.row < 0 || out.region.col + out.region.width > width_px ||
+      out.region.row + out.region.height > height_px) {
     out.reason = "the region leaves the image";
     return out;
   }

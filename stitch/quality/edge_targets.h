@@ -42,6 +42,19 @@ struct EdgeTargetRegion {
   double gsd_m = 0.0;          // ground length per image pixel along the edge
 };
 
+/// The region of an edge whose ends lie at `start_px`, `end_px` in an image of `width_px` x
+/// `height_px` (the ends may lie outside it: only the region must be inside), `ground_length_m` its
+/// length on the ground (for gsd_m). The edge is straight between the ends in that image: true of
+/// a projected target's edge to the distortion's curvature over the edge (far below 0.01 px over a
+/// region), and kept by a sub-image mapping, a projectivity (`quality mtf --sub-image`).
+EdgeTargetRegion RegionOfImageEdge(const std::string& id,
+                                   const Eigen::Vector2d& start_px,
+                                   const Eigen::Vector2d& end_px,
+                                   double ground_length_m,
+                                   int width_px,
+                                   int height_px,
+                                   const EdgeTargetRegionOptions& options = {});
+
 /// The region of `target` in the image of `camera` seen from (opk_rad, center_m).
 EdgeTargetRegion RegionOfEdgeTarget(const calib::Camera& camera,
                                     const Eigen::Vector3d& opk_rad,

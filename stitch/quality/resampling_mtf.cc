@@ -74,9 +74,13 @@ double BilinearTransferAtShifts(const std::vector<Eigen::Vector2d>& shifts,
 
 double PredictResampledMtf50AtShifts(const SlantedEdgeResult& raw,
                                      const std::vector<Eigen::Vector2d>& shifts,
-                                     const Eigen::Vector2d& normal) {
+                                     const Eigen::Vector2d& normal,
+                                     double raw_per_virtual_px) {
+  AEROCAL_CHECK(raw_per_virtual_px > 0.0) << "scale must be > 0, got " << raw_per_virtual_px;
   return FirstCrossingFrequency(
-      [&](double f) { return EdgeMtfAt(raw, f) * BilinearTransferAtShifts(shifts, normal, f); },
+      [&](double f) {
+        return EdgeMtfAt(raw, f / raw_per_virtual_px) * BilinearTransferAtShifts(shifts, normal, f);
+      },
       0.5);
 }
 

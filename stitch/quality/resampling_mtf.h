@@ -47,11 +47,14 @@ double BilinearTransferAtShifts(const std::vector<Eigen::Vector2d>& shifts,
                                 const Eigen::Vector2d& normal,
                                 double f_cy_px);
 
-/// The MTF50 of a raw edge after bilinear resampling at the given shifts: the first f where
-/// EdgeMtfAt(raw, f) BilinearTransferAtShifts(shifts, normal, f) falls to 0.5; NaN when it does
-/// not fall so far below 1 cycle/px.
+/// The MTF50 of a raw edge after bilinear resampling at the given shifts: the first f (cycles per
+/// virtual px) where EdgeMtfAt(raw, f / s) BilinearTransferAtShifts(shifts, normal, f) falls to
+/// 0.5, s = `raw_per_virtual_px` the mapping's scale along the normal (a period of P virtual px is
+/// P s raw px, f / s cycles per raw px; 1 for a translation); NaN when it does not fall so far
+/// below 1 cycle/px.
 double PredictResampledMtf50AtShifts(const SlantedEdgeResult& raw,
                                      const std::vector<Eigen::Vector2d>& shifts,
-                                     const Eigen::Vector2d& normal);
+                                     const Eigen::Vector2d& normal,
+                                     double raw_per_virtual_px = 1.0);
 
 }  // namespace aerocal::stitch

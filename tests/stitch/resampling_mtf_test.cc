@@ -55,6 +55,23 @@ TEST(ResamplingMtf, KernelTransferFunctions) {
               InterpolationTransfer(Interpolation::kBilinear, f));
 }
 
+// At whole-pixel shifts bilinear interpolation passes every frequency (H_0 = 1): the predicted
+// virtual MTF is the raw one at f / s, s raw px per virtual px, so its MTF50 is s times the raw
+// one; at shifts of half a pixel along the normal |H| = |cos(pi f)| on top.
+TEST(ResamplingMtf, PredictionAtShiftsScalesWithTheMapping) {
+  const SlantedEdgeResult raw = MeasureSlantedEdge(
+      testing::RenderEdge(96, 96, 5.0 * kDeg, 1.0, 1000.0, 5000.0), {16, 16, 64, 64});
+  const std::vector<Eigen::Vector2d> whole(4, Eigen::Vector2d::Zero());
+  for (double s : {1.0, 0.98, 1.03})
+    EXPECT_NEAR(PredictResampledMtf50AtShifts(raw, whole, Eigen::Vector2d::UnitX(), s),
+                s * raw.mtf50_cy_px,
+                1e-6)
+        << s;
+  const std::vector<Eigen::Vector2d> half(4, Eigen::Vector2d(0.5, 0.0));
+  const double f = PredictResampledMtf50AtShifts(raw, half, Eigen::Vector2d::UnitX());
+  EXPECT_NEAR(EdgeMtfAt(raw, f) * std::abs(std::cos(3.14159265358979323846 * f)), 0.5, 1e-6);
+}
+
 TEST(ResamplingMtf, VirtualImageMtf50IsTheRawOneTimesTheKernelTransfer) {
   const double turn = 2.0 * kDeg, slant = 5.0 * kDeg;
   const calib::Camera camera = TurnedCamera(turn);

@@ -91,8 +91,16 @@ TEST(CliQuality, BadOptionsExitTwoNamingTheOption) {
       {" --roi 0,0,128,128 --sub-image I --virtual", "--virtual"},  // a raw or the virtual image
       {"", "--roi or --targets"},                                   // no region at all
       {" --targets t.csv", "--targets needs --camera"},             // no orientation
-      {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --sub-image I",
-       "--sub-image"},  // projected into the virtual image only
+      {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --sub-image I "
+       "--frame 3",
+       "--frame needs --mapping"},  // a frame of the stitch result
+      {" --roi 0,0,128,128 --mapping m.json", "--mapping, --frame and --virtual-image need"},
+      {" --roi 0,0,128,128 --sub-image I --frame 7", "--mapping, --frame and --virtual-image need"},
+      {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --virtual-image v.tif",
+       "--virtual-image need --targets and --sub-image"},
+      {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --sub-image I "
+       "--mapping m.json --virtual-image v.tif --virtual-origin 0,2.5",
+       "--virtual-origin"},
       {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --image-origin 1.5,0",
        "--image-origin"},
       {" --targets t.csv --camera c.yaml --orientation r.json --image-id 1 --image-origin 1e12,0",

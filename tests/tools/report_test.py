@@ -517,7 +517,24 @@ class WhatPeopleRead(unittest.TestCase):
             "sources": ["q/raw_I.json", "q/virtual.json", "q/bars.json"], "method": "ISO 12233:2017 e-SFR",
             "edges": [{"source": "q/raw_I.json", "image_kind": "raw", "sub_image": "I", "roi": [10, 20, 64, 64],
                        "axis": "x", "direction": "along_track", "angle_deg": 5.01, "mtf50_cy_px": 0.1803,
-                       "mtf50_expanded_cy_px": 0.0021, "mtf_nyquist": 0.043}],
+                       "mtf50_expanded_cy_px": 0.0021, "mtf_nyquist": 0.043},
+                      # Found from target T1_x in raw sub-image I and compared with the virtual image
+                      # (quality mtf --targets --sub-image I --mapping --virtual-image).
+                      {"source": "q/raw_I_targets.json", "image_kind": "raw", "sub_image": "I", "image_id": "0007",
+                       "target": "T1_x", "roi": [20, 12, 70, 64], "axis": "x", "direction": "along_track",
+                       "mtf50_cy_px": 0.1806, "mtf50_expanded_cy_px": 0.0022, "position_virtual_px": [2100.5, 3300.5],
+                       "resampling": {"virtual_mtf50_cy_px": 0.1652, "virtual_mtf50_expanded_cy_px": 0.0021,
+                                      "loss_percent": 8.527, "loss_expanded_percent": 1.68,
+                                      "predicted_loss_percent": 8.31, "uniform_phase_loss_percent": 7.12}},
+                      {"source": "q/virtual_targets.json", "image_kind": "virtual", "image_id": "0007",
+                       "target": "T1_y", "axis": "y", "direction": "across_track", "mtf50_cy_px": 0.1690,
+                       "position_virtual_px": [9000, 5000]}],
+            "virtual_format_px": [14000, 12000],
+            "resampling_per_sub_image": [{"sub_image": "I", "axis": "x", "direction": "along_track", "edges": 1,
+                                          "raw_mean_mtf50_cy_px": 0.1806, "virtual_measured": 1,
+                                          "virtual_mean_mtf50_cy_px": 0.1652, "mean_loss_percent": 8.527,
+                                          "mean_predicted_loss_percent": 8.31,
+                                          "mean_uniform_phase_loss_percent": 7.12}],
             "axes": [dict(axis, source="q/raw_I.json", image_kind="raw", sub_image="I", mtf50_cy_px=0.1805,
                           mtf50_expanded_cy_px=0.002),
                      dict(axis, source="q/virtual.json", image_kind="virtual", mtf50_cy_px=0.1720,
@@ -540,6 +557,16 @@ class WhatPeopleRead(unittest.TestCase):
                          ["x", "along_track", "I", "0.1805", "0.1720", "0.0085", "0.0043", "4.71", "2.38"])
         self.assertEqual(page.row("resolution-limits", "bar target 1")[:4], ["bar target 1", "0.10", "0.3311", "36.79"])
         self.assertEqual(page.row("resolution-edges", "sub-image I")[1], "10,20,64,64")
+        # The map of MTF50 across the format (issue 36 item 3) and the per-sub-image and per-edge tables.
+        self.assertIn('id="resolution-map"', text)
+        self.assertIn("MTF50 across the format", text)
+        self.assertIn("(14000 x 12000 px)", text)
+        self.assertEqual(text.count(PNG_URI), 1)
+        self.assertEqual(page.row("resolution-subimages", "I"),
+                         ["I", "x", "along_track", "1", "0.1806", "1", "0.1652", "8.53", "8.31", "7.12"])
+        self.assertEqual(page.row("resolution-pairs", "I"),
+                         ["I", "0007", "T1_x", "along_track", "0.1806", "0.0022", "0.1652", "0.0021", "8.53", "1.68",
+                          "8.31", "7.12"])
         # Without --quality the section and its entry in the contents are absent.
         text, page = self.render({"kind": "flight", "schema_version": 2})
         self.assertNotIn("Dynamic image resolution", text)

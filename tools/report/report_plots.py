@@ -214,3 +214,31 @@ def check_point_map(panels):
         ax.ticklabel_format(useOffset=False, style="plain")
     fig.colorbar(scatter, ax=axes, shrink=0.9, aspect=40, label="Z error dZ [m]")
     return _png(fig), {"exaggeration": exaggeration, "key_m": key_m, "z_lim": z_lim}
+
+
+# ---- MTF50 across the format (dynamic image resolution) -------------------------------------
+
+def mtf_map(panels, width_px, height_px):
+    """panels: [(title, [(col, row, mtf50_cy_px)])], positions in the virtual image's pixels. One
+    colour scale for all panels; the marker's area grows with MTF50 too, so the map reads without
+    colour. Returns (png, facts dict)."""
+    values = [p[2] for _, points in panels for p in points]
+    lo, hi = min(values), max(values)
+    if hi - lo < 1e-9:
+        lo, hi = lo - 0.005, hi + 0.005
+    fig, axes = _panels(len(panels), 2, 4.6)
+    scatter = None
+    for ax, (title, points) in zip(axes, panels):
+        ax.add_patch(plt.Rectangle((0, 0), width_px, height_px, fill=False, color="grey"))
+        p = np.array(points, dtype=float).reshape(-1, 3)
+        scatter = ax.scatter(p[:, 0], p[:, 1], c=p[:, 2], cmap="viridis", vmin=lo, vmax=hi,
+                             s=20 + 100 * (p[:, 2] - lo) / (hi - lo), edgecolors="#333333", linewidths=0.4)
+        ax.set_aspect("equal")
+        ax.set_xlim(-0.02 * width_px, 1.02 * width_px)
+        ax.set_ylim(1.02 * height_px, -0.02 * height_px)  # image rows grow downwards
+        ax.set_xlabel("column [px]")
+        ax.set_ylabel("row [px]")
+        ax.set_title(f"{title}\n{len(points)} edge regions", fontsize=9, loc="left")
+        ax.tick_params(labelsize=7)
+    fig.colorbar(scatter, ax=axes, shrink=0.9, aspect=40, label="MTF50 [cycles/px]")
+    return _png(fig), {"lo": lo, "hi": hi}

@@ -2,13 +2,16 @@
 
 Every number is the one C++ wrote into result.json's `dynamic_image_resolution`
 (tools/dynamic_resolution.h, the certificate's section): the edge regions measured, MTF50 with U
-(k = 2) per image and axis, the resampling loss (virtual image against the raw sub-images' mean)
-and the limiting resolution of bar targets and Siemens stars. Nothing is recomputed here.
+(k = 2) per image and axis, the resampling loss (virtual image against the raw sub-images' mean,
+and per edge and sub-image where the edges were found from targets in the raw sub-images), the map
+of MTF50 across the format (the edges' positions in the virtual image) and the limiting resolution
+of bar targets and Siemens stars. Nothing is recomputed here.
 """
 import os
 
 import report_data as rd
-from report_html import esc, note, num, table, text
+import report_plots as plots
+from report_html import esc, figure, note, num, table, text
 from report_points import folded
 
 
@@ -66,6 +69,67 @@ def _loss(d):
                   "loss %", "U %"], rows)
 
 
+def _map(d):
+    """MTF50 across the format: a panel per direction (or axis) and image kind, the edges that carry their
+    position in the virtual image (`quality mtf --targets`, or `--virtual` with --roi)."""
+    fmt_px = [rd.number(v) for v in rd.listing(rd.get(d, "virtual_format_px"))]
+    panels = {}
+    for e in rd.listing(rd.get(d, "edges")):
+        pos = [rd.number(v) for v in rd.listing(rd.get(e, "position_virtual_px"))]
+        mtf50 = rd.number(rd.get(e, "mtf50_cy_px"))
+        if len(pos) != 2 or None in pos or mtf50 is None:
+            continue
+        direction, axis = rd.get(e, "direction"), rd.get(e, "axis")
+        which = "raw sub-images" if rd.get(e, "image_kind") == "raw" else "virtual image"
+        title = f"{direction.replace('_', ' ')} (MTF along {axis}), {which}" if direction else \
+            f"MTF along {axis}, {which}"
+        panels.setdefault(title, []).append((pos[0], pos[1], mtf50))
+    if not panels or len(fmt_px) != 2 or None in fmt_px:
+        return ""
+    png, facts = plots.mtf_map(sorted(panels.items()), fmt_px[0], fmt_px[1])
+    return figure("resolution-map", png, "MTF50 across the format",
+                  f"MTF50 of each edge region at its place in the virtual image ({fmt_px[0]:.0f} x {fmt_px[1]:.0f} px), "
+                  f"a panel per direction and image (a raw sub-image's edge drawn where the virtual image shows it); "
+                  f"colour and size from "
+                  f"{facts['lo']:.4f} to {facts['hi']:.4f} cycles/px.")
+
+
+def _pairs(d):
+    """Per edge found in a raw sub-image: its MTF50 against the same edge's in the virtual image."""
+    rows = []
+    for e in rd.listing(rd.get(d, "edges")):
+        r = rd.get(e, "resampling") if isinstance(e, dict) else None
+        if not isinstance(r, dict):
+            continue
+        rows.append([text(str(rd.get(e, "sub_image") or "-")), text(str(rd.get(e, "image_id") or "-")),
+                     text(str(rd.get(e, "target") or "-")), text(rd.get(e, "direction") or rd.get(e, "axis") or "-"),
+                     num(rd.number(rd.get(e, "mtf50_cy_px"))), num(rd.number(rd.get(e, "mtf50_expanded_cy_px"))),
+                     num(rd.number(rd.get(r, "virtual_mtf50_cy_px"))),
+                     num(rd.number(rd.get(r, "virtual_mtf50_expanded_cy_px"))),
+                     num(rd.number(rd.get(r, "loss_percent")), ".2f"), num(rd.number(rd.get(r, "loss_expanded_percent")), ".2f"),
+                     num(rd.number(rd.get(r, "predicted_loss_percent")), ".2f"),
+                     num(rd.number(rd.get(r, "uniform_phase_loss_percent")), ".2f")])
+    if not rows:
+        return ""
+    body = table("resolution-pairs", "Per edge: raw sub-image against the virtual image resampled from it",
+                 ["sub-image", "image", "target", "direction", "raw MTF50 cy/px", "U", "virtual MTF50", "U",
+                  "loss %", "U %", "predicted % (mapping shifts)", "predicted % (uniform phase)"], rows)
+    return folded(f"Edges in the raw sub-images ({len(rows)})", body, len(rows))
+
+
+def _subimages(d):
+    rows = [[text(str(rd.get(r, "sub_image") or "-")), text(rd.get(r, "axis") or "-"),
+             text(rd.get(r, "direction") or "-"), num(rd.get(r, "edges"), "d"),
+             num(rd.number(rd.get(r, "raw_mean_mtf50_cy_px"))), num(rd.get(r, "virtual_measured"), "d"),
+             num(rd.number(rd.get(r, "virtual_mean_mtf50_cy_px"))), num(rd.number(rd.get(r, "mean_loss_percent")), ".2f"),
+             num(rd.number(rd.get(r, "mean_predicted_loss_percent")), ".2f"),
+             num(rd.number(rd.get(r, "mean_uniform_phase_loss_percent")), ".2f")]
+            for r in rd.listing(rd.get(d, "resampling_per_sub_image")) if isinstance(r, dict)]
+    return table("resolution-subimages", "Per raw sub-image: MTF50 and the resampling loss of its edges (means)",
+                 ["sub-image", "axis", "direction", "edges", "raw MTF50 cy/px", "in virtual", "virtual MTF50",
+                  "loss %", "predicted % (mapping shifts)", "predicted % (uniform phase)"], rows) if rows else ""
+
+
 def _limits(d):
     rows = []
     for kind, key in (("bar target", "bars"), ("Siemens star", "stars")):
@@ -90,5 +154,5 @@ def resolution(doc):
     out = ['<h2 id="resolution">10. Dynamic image resolution</h2>',
            note(f"{esc(rd.get(d, 'method') or 'bar targets / Siemens stars')}; U = k u_c with k = 2; GRD = GSD / "
                 f"(2 f), one bar width; from the results of `aerocal quality` ({sources}), as in the certificate.")]
-    out += [_axes(d), _loss(d), _limits(d), _edges(d)]
+    out += [_axes(d), _loss(d), _subimages(d), _map(d), _limits(d), _pairs(d), _edges(d)]
     return "".join(out)
