@@ -247,7 +247,7 @@ def test_covariance_of_exposures_and_points_on_the_example_flight(flight):
     interior = r.covariance(["camera cam1"])
     si = np.sqrt(np.diag(interior))
     assert np.abs((joint[:10, :10] - interior) / np.outer(si, si)).max() < 1e-8  # 1.4e-9 measured
-    # The strip's first and last exposure share no point: their cross block is computed, not 0.
+    # The block's first and last exposure share no point: their cross block is computed, not 0.
     cross = joint[10:16, 16:22] / np.outer(s[10:16], s[16:22])
     assert np.abs(cross).max() > 1e-3
     # The same entries asked in another order are the same numbers.
