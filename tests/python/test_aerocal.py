@@ -213,6 +213,182 @@ def test_covariance_is_the_sigmas_around_the_correlation(flight):
         r.covariance(["camera nope"])
 
 
+def test_covariance_of_exposures_and_points_on_the_example_flight(flight):
+    """(a) an exposure's diagonal squares to the result file's sigmas; (b) the joint matrix with
+    the interior, two exposures and a point is symmetric positive semi-definite, its interior
+    block the interior covariance of the run; (d) names the result does not hold raise."""
+    r = aerocal.adjust(aerocal.Block.read(os.path.join(flight, "flight")), self_calibration="all")
+    doc = json.loads(r.to_json())
+    used = [e for e in doc["exposures"] if e["used"]]
+    first, last = used[0], used[-1]
+    keys = ("X", "Y", "Z", "omega", "phi", "kappa")
+    for e in (first, last):
+        cov = r.covariance(["exposure " + e["image"]])
+        assert cov.shape == (6, 6)
+        # The run took its covariance from the solver's reduced system at the solution, this
+        # call from a fresh evaluation of the same Jacobian: equal to the rounding, which the
+        # c ~ Z0 correlation of a fully self-calibrating flight amplifies to ~1e-9 (measured 7e-10).
+        np.testing.assert_allclose(np.sqrt(np.diag(cov)), [e["sigma"][k] for k in keys],
+                                   rtol=1e-8, atol=0)
+    table = r.exposures
+    i = table["image"].index(first["image"])
+    np.testing.assert_allclose(table["sigma_center_m"][i], [first["sigma"][k] for k in keys[:3]],
+                               rtol=1e-15)
+    np.testing.assert_allclose(table["center_m"][i], [first[k] for k in keys[:3]], rtol=1e-15)
+    point = r.points["point"][0]
+    names = ["camera cam1", "exposure " + first["image"], "exposure " + last["image"],
+             "point " + point]
+    joint = r.covariance(names)
+    assert joint.shape == (10 + 6 + 6 + 3, 10 + 6 + 6 + 3)
+    np.testing.assert_array_equal(joint, joint.T)
+    s = np.sqrt(np.diag(joint))
+    assert np.all(s > 0)
+    assert np.linalg.eigvalsh(joint / np.outer(s, s)).min() > -1e-9
+    interior = r.covariance(["camera cam1"])
+    si = np.sqrt(np.diag(interior))
+    assert np.abs((joint[:10, :10] - interior) / np.outer(si, si)).max() < 1e-8  # 1.4e-9 measured
+    # The block's first and last exposure share no point: their cross block is computed, not 0.
+    cross = joint[10:16, 16:22] / np.outer(s[10:16], s[16:22])
+    assert np.abs(cross).max() > 1e-3
+    # The same entries asked in another order are the same numbers.
+    swapped = r.covariance(["point " + point, "exposure " + first["image"]])
+    np.testing.assert_allclose(swapped[3:, :3], joint[10:16, 22:25], rtol=1e-10, atol=0)
+    for bad in ("exposure nope", "point nope", "camera cam1.Q9", "cam1"):
+        with pytest.raises(ValueError, match=bad):
+            r.covariance(["exposure " + first["image"], bad])
+
+
+def _rotation(opk):
+    """R = Rx(omega) Ry(phi) Rz(kappa) per row of opk (rad), CONVENTIONS.md section 4."""
+    o, p, k = opk[:, 0], opk[:, 1], opk[:, 2]
+    one, zero = np.ones_like(o), np.zeros_like(o)
+    rx = np.stack([one, zero, zero, zero, np.cos(o), -np.sin(o), zero, np.sin(o), np.cos(o)], 1)
+    ry = np.stack([np.cos(p), zero, np.sin(p), zero, one, zero, -np.sin(p), zero, np.cos(p)], 1)
+    rz = np.stack([np.cos(k), -np.sin(k), zero, np.sin(k), np.cos(k), zero, zero, zero, one], 1)
+    return (rx.reshape(-1, 3, 3) @ ry.reshape(-1, 3, 3)) @ rz.reshape(-1, 3, 3)
+
+
+def test_covariance_cross_blocks_equal_the_inverse_normal_matrix(tmp_path):
+    """(c) The oracle: a block of two strips of 28 exposures built from arrays (more than 300
+    reduced parameters: the sparse selected inverse), its normal matrix J^T J formed here from a
+    numerical Jacobian of the collinearity equations and the control points' weights, inverted
+    densely and scaled by sigma0^2, against covariance() of two exposures that share no point, a
+    tie point and c."""
+    rng = np.random.default_rng(7)
+    path = tmp_path / "camera.yaml"
+    path.write_text("name: oracle\nmodel: brown_fraser_10\npixel_size_mm: 0.01\n"
+                    "format_px: [1000, 800]\ninterior: {c: 50}\n")
+    cam = aerocal.Camera.read(str(path))
+    n_strip, base_m, height_m, sigma_px, pixel_mm = 28, 25.0, 500.0, 0.3, 0.01
+    centers = np.array([[i * base_m, 50.0 * s, height_m] for s in range(2) for i in range(n_strip)])
+    centers += rng.normal(0, 2.0, centers.shape)
+    opk = np.radians(rng.normal(0, 1.0, centers.shape))
+    gx, gy = np.meshgrid(np.arange(-40, n_strip * base_m + 40, 20.0), np.arange(-30, 81, 20.0))
+    truth = np.column_stack([gx.ravel(), gy.ravel(), rng.uniform(0, 30, gx.size)])
+    rot = _rotation(opk)
+    images, points, pixels = [], [], []
+    for e in range(len(centers)):
+        uvw = (truth - centers[e]) @ rot[e]  # R^T (X - X0) per row
+        px = cam.ray_to_image(-uvw[:, :2] / uvw[:, 2:])
+        inside = (px[:, 0] > 5) & (px[:, 0] < 995) & (px[:, 1] > 5) & (px[:, 1] < 795)
+        for p in np.flatnonzero(inside):
+            images.append(e), points.append(p), pixels.append(px[p])
+    images, points = np.array(images), np.array(points)
+    pixels = np.array(pixels) + rng.normal(0, sigma_px, (len(images), 2))
+    seen = np.bincount(points, minlength=len(truth)) >= 2
+    keep = seen[points]
+    images, points, pixels = images[keep], points[keep], pixels[keep]
+    ids = ["P%03d" % p for p in range(len(truth))]
+    control = [p for p in np.flatnonzero(seen) if p % 7 == 0]
+    exposures = {"image": ["E%02d" % e for e in range(len(centers))],
+                 "camera": ["cam1"] * len(centers)}
+    start = centers + rng.normal(0, 1.0, centers.shape)
+    for k, key in enumerate("XYZ"):
+        exposures[key] = start[:, k]
+    for k, key in enumerate(("omega", "phi", "kappa")):
+        exposures[key] = np.degrees(opk[:, k]) + 0.05
+    survey = truth + rng.normal(0, 0.03, truth.shape)
+    nan = float("nan")
+    table = {"point": [ids[p] for p in np.flatnonzero(seen)],
+             "role": ["control" if p in control else "tie" for p in np.flatnonzero(seen)]}
+    for k, key in enumerate("XYZ"):
+        table[key] = [survey[p, k] if p in control else nan for p in np.flatnonzero(seen)]
+        table["s" + key] = [0.03 if p in control else nan for p in np.flatnonzero(seen)]
+    observations = {"image": [exposures["image"][e] for e in images],
+                    "point": [ids[p] for p in points], "col": pixels[:, 0], "row": pixels[:, 1],
+                    "sigma_px": np.full(len(images), sigma_px)}
+    block = aerocal.Block.from_arrays({"cam1": cam}, exposures, table, observations)
+    r = aerocal.adjust(block, self_calibration="c", no_snooping=True, no_interior_sigma=True)
+    assert r.converged and r.residuals["used"].all()
+    method = json.loads(r.to_json())["determinability"]["covariance_method"]
+    assert method == "schur_selected_inverse"  # the sparse path, where pairs can miss the pattern
+
+    # The oracle's unknowns at the adjustment's solution: centres, angles (rad), points, c.
+    adjusted = r.exposures
+    C = adjusted["center_m"].copy()
+    A = np.radians(adjusted["opk_deg"])
+    order = {p: i for i, p in enumerate(r.points["point"])}
+    P = r.points["xyz_m"].copy()
+    pidx = np.array([order[ids[p]] for p in points])
+    c = r.cameras[0].estimated["c"]
+    cam.set_param("c", c)
+    ideal = c * cam.image_to_ray(pixels)  # the measured photo coordinates, corrected (mm)
+    ctrl = np.array([order[ids[p]] for p in control])
+    ctrl_survey = survey[control]
+    sigma_mm = sigma_px * pixel_mm
+
+    def residuals(C, A, P, c):
+        uvw = np.einsum("nji,nj->ni", _rotation(A)[images], P[pidx] - C[images])
+        image = (ideal + c * uvw[:, :2] / uvw[:, 2:]) / sigma_mm
+        return np.concatenate([image.ravel(), ((P[ctrl] - ctrl_survey) / 0.03).ravel()])
+
+    v = residuals(C, A, P, c)
+    ne, npt = len(C), len(P)
+    n_unknowns = 6 * ne + 3 * npt + 1
+    # The same model as the adjustment's: its residuals and sigma0.
+    res = r.residuals
+    by_ray = {(i, p): x for i, p, x in zip(res["image"], res["point"], res["residual_px"])}
+    theirs = np.array([by_ray[exposures["image"][e], ids[p]] for e, p in zip(images, points)])
+    np.testing.assert_allclose(v[:2 * len(images)].reshape(-1, 2) * sigma_px * [1, -1], theirs,
+                               atol=1e-6)
+    assert math.sqrt(v @ v / (len(v) - n_unknowns)) == pytest.approx(r.sigma0, rel=1e-6)
+    # Numerical Jacobian: every row depends on one exposure and one point, so one component of
+    # all exposures (points) moved at once gives each row's derivative by its own block.
+    J = np.zeros((len(v), n_unknowns))
+    image_rows = np.repeat(np.arange(len(images)) * 2, 2) + np.tile([0, 1], len(images))
+    rows_e = np.repeat(images, 2)
+    rows_p = np.concatenate([np.repeat(pidx, 2), np.repeat(ctrl, 3)])
+    all_rows = np.arange(len(v))
+    for k in range(3):
+        for offset, h, which in ((0, 1e-4, "C"), (3 * ne, 1e-6, "A"), (6 * ne, 1e-4, "P")):
+            plus, minus = [C.copy(), A.copy(), P.copy()], [C.copy(), A.copy(), P.copy()]
+            i = "CAP".index(which)
+            plus[i][:, k] += h
+            minus[i][:, k] -= h
+            d = (residuals(*plus, c) - residuals(*minus, c)) / (2 * h)
+            if which == "P":
+                J[all_rows, offset + 3 * rows_p + k] = d
+            else:
+                J[image_rows, offset + 3 * rows_e + k] = d[image_rows]
+    J[:, -1] = (residuals(C, A, P, c + 1e-5) - residuals(C, A, P, c - 1e-5)) / 2e-5
+    Q = r.sigma0 ** 2 * np.linalg.inv(J.T @ J)
+    far = (0, 2 * n_strip - 1)  # strip 1's first and strip 2's last exposure: no common point
+    assert not set(pidx[images == far[0]]) & set(pidx[images == far[1]])
+    tie = r.points["point"].index(ids[next(p for p in np.flatnonzero(seen) if p not in control)])
+    index = []
+    for e in far:
+        index += [3 * e + k for k in range(3)] + [3 * ne + 3 * e + k for k in range(3)]
+    index += [6 * ne + 3 * tie + k for k in range(3)] + [n_unknowns - 1]
+    scale = np.array([1, 1, 1] + [180 / math.pi] * 3 + [1, 1, 1] + [180 / math.pi] * 3 +
+                     [1, 1, 1, 1])
+    expected = Q[np.ix_(index, index)] * np.outer(scale, scale)
+    got = r.covariance(["exposure E%02d" % far[0], "exposure E%02d" % far[1],
+                        "point " + r.points["point"][tie], "camera cam1.c"])
+    s = np.sqrt(np.diag(expected))
+    assert np.abs((got - expected) / np.outer(s, s)).max() < 1e-7  # 4.5e-9 measured
+    assert np.abs(expected[:6, 6:12] / np.outer(s[:6], s[6:12])).max() > 1e-3  # not a zero block
+
+
 def test_stitch_equals_the_command_and_types_its_result(flight):
     camera = os.path.join(flight, "flight", "camera_nominal.yaml")
     obs = os.path.join(flight, "flight", "stitch_obs.csv")
@@ -418,6 +594,10 @@ def test_adjust_of_a_rig_block_equals_the_command(tmp_path):
         aerocal.adjust(block, self_calibration="auto")
     with pytest.raises(ValueError, match="--rig-mounts"):
         aerocal.adjust(block, rig_mounts="loose")
+    # The rig bundle keeps no solved problem: its exposures' covariance is refused by name.
+    image = expected["exposures"][0]["image"]
+    with pytest.raises(ValueError, match="exposure " + image + "': a rig block"):
+        r.covariance(["exposure " + image])
 
 
 def test_rig_keywords_need_a_rig_block(flight):

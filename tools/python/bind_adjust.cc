@@ -13,12 +13,15 @@
 #include "tools/python/progress_callback.h"
 #include "tools/rig_adjust_run.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/adjustment/kept_adjustment.h"
 #include "triangulation/adjustment/self_calibration_choice.h"
 #include "triangulation/block/block_io.h"
 #include "triangulation/georef/object_frame.h"
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
+#include <mutex>
 #include <pybind11/eigen.h>
 #include <pybind11/numpy.h>
 #include <pybind11/stl.h>
@@ -37,10 +40,18 @@ struct Block {
   std::string path;  // as given to Block.read ("" for a block built from arrays)
 };
 
+// The solved problem behind a frame-camera result (triangulation/adjustment/kept_adjustment.h),
+// for covariance() of exposures and points; its builder is not thread-safe, hence the mutex.
+struct Kept {
+  triangulation::KeptAdjustment adjustment;
+  std::mutex mutex;
+};
+
 struct Result {
-  AdjustmentResult result;  // a rig block's: the block part of the rig bundle's result
-  std::string json;         // the result file's text, as `aerocal adjust --out` writes it
-  nlohmann::json rig;       // a rig block's `rig` section of that file; null for frame cameras
+  AdjustmentResult result;     // a rig block's: the block part of the rig bundle's result
+  std::string json;            // the result file's text, as `aerocal adjust --out` writes it
+  nlohmann::json rig;          // a rig block's `rig` section of that file; null for frame cameras
+  std::shared_ptr<Kept> kept;  // null for a rig block (the rig bundle's run keeps nothing)
 };
 
 constexpr double kDegToRad = M_PI / 180.0;
@@ -332,13 +343,16 @@ Result Adjust(const Block& block,
                                              ? triangulation::AutoFreeSetRounds(options)
                                              : triangulation::AdjustStages(options));
   Result out;
+  out.kept = std::make_shared<Kept>();
   {
     py::gil_scoped_release release;
     const triangulation::ObjectFrame frame(block.project.frame);
     const Project project = triangulation::ToAdjustmentFrame(block.project, frame);
-    out.result = auto_free && !options.free_interior.empty()
-                     ? triangulation::AdjustWithChosenFreeSet(project, options, {}, progress.get())
-                     : triangulation::Adjust(project, options, progress.get());
+    triangulation::KeptAdjustment* keep = &out.kept->adjustment;
+    out.result =
+        auto_free && !options.free_interior.empty()
+            ? triangulation::AdjustWithChosenFreeSet(project, options, {}, progress.get(), keep)
+            : triangulation::Adjust(project, options, progress.get(), keep);
     triangulation::ToInputFrame(frame, &out.result);
   }
   nlohmann::json json = triangulation::AdjustmentToJson(out.result);
@@ -409,11 +423,46 @@ py::dict ResidualTable(const AdjustmentResult& r) {
   return d;
 }
 
+// The adjusted points (two rays or control) in the result's frame, sorted by id: {point, xyz_m}.
+py::dict AdjustedPoints(const AdjustmentResult& r) {
+  std::vector<std::string> id;
+  Eigen::MatrixX3d xyz(r.points_m.size(), 3);
+  for (const auto& [point, p] : r.points_m) {
+    xyz.row(static_cast<Eigen::Index>(id.size())) = p;
+    id.push_back(point);
+  }
+  return py::dict(py::arg("point") = id, py::arg("xyz_m") = xyz);
+}
+
+// The exposures as the result file's `exposures`: {image, used, center_m, opk_deg, sigma_center_m,
+// sigma_opk_deg}, sigmas NaN where unknown (left out, no covariance, gimbal lock).
+py::dict AdjustedExposures(const AdjustmentResult& r) {
+  const size_t n = r.exposures.size();
+  std::vector<std::string> image(n);
+  std::vector<bool> used(n);
+  Eigen::MatrixX3d center(n, 3), opk(n, 3), center_sigma(n, 3), opk_sigma(n, 3);
+  const double nan = std::nan("");
+  for (size_t i = 0; i < n; ++i) {
+    const auto& e = r.exposures[i];
+    image[i] = e.image;
+    used[i] = e.used;
+    center.row(i) = e.center_m;
+    opk.row(i) = e.opk_rad / kDegToRad;
+    center_sigma.row(i) = e.center_sigma_m.value_or(Eigen::Vector3d::Constant(nan));
+    opk_sigma.row(i) = e.opk_sigma_rad.value_or(Eigen::Vector3d::Constant(nan)) / kDegToRad;
+  }
+  return py::dict(py::arg("image") = image,
+                  py::arg("used") = used,
+                  py::arg("center_m") = center,
+                  py::arg("opk_deg") = opk,
+                  py::arg("sigma_center_m") = center_sigma,
+                  py::arg("sigma_opk_deg") = opk_sigma);
+}
+
 // sigma0^2 Q of the named interior entries, Sigma = S R S with S = diag(sigma): the result's
 // a-posteriori sigmas and its correlation matrix R (both from the same covariance estimate; a
 // fixed entry has a zero row). `names`: entries "camera ID.NAME" or whole cameras
-// "camera ID" (expanded in the model's parameter order). Exterior blocks are not kept by the
-// result (their sigmas are), so they cannot be named here.
+// "camera ID" (expanded in the model's parameter order). Exposures and points: Covariance below.
 Eigen::MatrixXd InteriorCovariance(const AdjustmentResult& r,
                                    const std::vector<std::string>& names) {
   if (r.interior_correlation_names.empty())
@@ -447,6 +496,26 @@ Eigen::MatrixXd InteriorCovariance(const AdjustmentResult& r,
                                                    std::max(rows[i], rows[k]))) *
                   (s[i] * s[k]);
   return out;
+}
+
+// covariance(names): interior names alone from the result's own sigmas and correlation (the
+// numbers of the JSON); with an exposure or a point, the joint matrix from the kept adjustment
+// (CovarianceOfNamed: every pair of the named blocks), the GIL released while it is computed.
+Eigen::MatrixXd Covariance(const Result& r, const std::vector<std::string>& names) {
+  const bool interior_only = std::all_of(
+      names.begin(), names.end(), [](const std::string& n) { return n.rfind("camera ", 0) == 0; });
+  if (interior_only) return InteriorCovariance(r.result, names);
+  if (!r.kept || !r.kept->adjustment.adjustment) {
+    for (const auto& name : names)
+      if (name.rfind("camera ", 0) != 0)
+        throw ConfigError("covariance: '" + name +
+                          "': a rig block's result keeps the interior covariance only");
+  }
+  if (!r.result.determinability.covariance_ok)
+    throw ConfigError("covariance: the adjustment has no covariance (see invalid_reasons)");
+  py::gil_scoped_release release;
+  const std::lock_guard<std::mutex> lock(r.kept->mutex);
+  return triangulation::CovarianceOfNamed(*r.kept->adjustment.adjustment, r.result, names).matrix;
 }
 
 }  // namespace
@@ -547,15 +616,32 @@ arrays (exposures, points, observations).)doc")
           "Correlation matrix of the interior parameters (rows: correlation_names)")
       .def_property_readonly("correlation_names",
                              [](const Result& r) { return r.result.interior_correlation_names; })
-      .def(
-          "covariance",
-          [](const Result& r, const std::vector<std::string>& names) {
-            return InteriorCovariance(r.result, names);
-          },
-          py::arg("names"),
-          "sigma0^2 Q of the named interior entries ('camera ID.NAME') or whole cameras "
-          "('camera ID', in the model's order), in the parameters' table units; fixed entries "
-          "have zero rows. Raises ValueError for a name the result does not hold.")
+      .def("covariance",
+           &Covariance,
+           py::arg("names"),
+           "The joint covariance sigma0^2 Q (numpy, symmetric) of the named entries, rows in the "
+           "order of `names` expanded, cross blocks included: 'camera ID.NAME' (one interior "
+           "parameter) or 'camera ID' (all, in the model's order), in the parameter table's "
+           "units; 'exposure ID': X, Y, Z (m), omega, phi, kappa (deg) of that exposure; 'point "
+           "ID': X, Y, Z (m) of an adjusted point. Exposures and points are in the adjustment "
+           "frame (the frame of the result's sigmas: the local tangent plane for local / crs "
+           "frames, the UTM zone for utm, the given one for projected), even where to_json() "
+           "writes positions back in geodetic or CRS coordinates. Interior names alone come "
+           "from the result's sigmas and correlation; with an exposure or a point the matrix is "
+           "computed from the solved problem this result keeps (the same covariance code as the "
+           "run's; the GIL is released). Fixed entries have zero rows. Raises ValueError for a "
+           "name the result does not hold (unknown, or left out of the adjustment), when the "
+           "result has no covariance, and for exposures and points of a rig block.")
+      .def_property_readonly(
+          "points",
+          [](const Result& r) { return AdjustedPoints(r.result); },
+          "The adjusted ground points (two rays or control), sorted by id: {point, xyz_m (N, 3)} "
+          "in the result's frame (as to_json() writes coordinates)")
+      .def_property_readonly(
+          "exposures",
+          [](const Result& r) { return AdjustedExposures(r.result); },
+          "The exposures as the result file's: {image, used, center_m (N, 3), opk_deg (N, 3), "
+          "sigma_center_m, sigma_opk_deg (N, 3; NaN where unknown)}")
       .def_property_readonly(
           "residuals",
           [](const Result& r) { return ResidualTable(r.result); },

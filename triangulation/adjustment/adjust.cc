@@ -4,9 +4,11 @@
 // (AdjustOptions::auto_robust_start).
 #include "calib/core/csv.h"
 #include "triangulation/adjustment/block_adjustment.h"
+#include "triangulation/adjustment/kept_adjustment.h"
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <unordered_map>
 
 namespace aerocal::triangulation {
@@ -58,14 +60,22 @@ int AdjustStages(const AdjustOptions& options) {
   return (options.robust_start ? 3 : 1) * BlockAdjustment::kRunStages;
 }
 
-AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Progress* progress) {
+AdjustmentResult Adjust(const Project& project,
+                        const AdjustOptions& options,
+                        Progress* progress,
+                        KeptAdjustment* keep) {
   std::string reason = "--robust-start";
   double gross_share = 0.0;
   if (!options.robust_start) {
-    BlockAdjustment adjustment(project, options);
-    adjustment.StopWhenRobustStartNeeded(options.auto_robust_start);
-    AdjustmentResult plain = adjustment.Run(progress);
-    if (!plain.robust_start_needed) return plain;
+    // Kept: the adjustment refers to its project, so a kept one is built on a copy the keeper owns.
+    auto copy = keep ? std::make_unique<const Project>(project) : nullptr;
+    auto adjustment = std::make_unique<BlockAdjustment>(keep ? *copy : project, options);
+    adjustment->StopWhenRobustStartNeeded(options.auto_robust_start);
+    AdjustmentResult plain = adjustment->Run(progress);
+    if (!plain.robust_start_needed) {
+      if (keep) *keep = {std::move(copy), std::move(adjustment)};
+      return plain;
+    }
     gross_share = plain.snooping.gross_share;
     reason = FormatNumber(100 * gross_share, 3) + " % of the image components above " +
              FormatNumber(options.robust_trigger_w, 3) + " sigma in the first solve";
@@ -134,8 +144,10 @@ AdjustmentResult Adjust(const Project& project, const AdjustOptions& options, Pr
   // 3. The final adjustment with snooping and covariance.
   AdjustOptions final_options = options;
   final_options.robust_start = false;
-  BlockAdjustment adjustment(next, final_options);
-  AdjustmentResult result = adjustment.Run(progress);
+  auto final_project = keep ? std::make_unique<const Project>(next) : nullptr;
+  auto adjustment = std::make_unique<BlockAdjustment>(keep ? *final_project : next, final_options);
+  AdjustmentResult result = adjustment->Run(progress);
+  if (keep) *keep = {std::move(final_project), std::move(adjustment)};
   for (auto& c : result.cameras) c.initial = project.cameras.at(c.id).interior;
   std::vector<RejectedObservation> pre_rejected;
   for (const auto& s : still_excluded) {

@@ -56,6 +56,8 @@
 
 namespace aerocal::triangulation {
 
+struct KeptAdjustment;
+
 class BlockAdjustment {
  public:
   /// Validates the options, computes starting values and builds every residual.
@@ -200,10 +202,13 @@ class BlockAdjustment {
 
 /// Builds and runs; with options.robust_start, first a robust adjustment whose solution starts
 /// the final one (the reported initial interior stays the camera file's). `progress` (may be null)
-/// advances by AdjustStages(options) units of work.
+/// advances by AdjustStages(options) units of work. With `keep`, the final adjustment (solved,
+/// at its solution) and a copy of the project it was built from are left there
+/// (kept_adjustment.h: the covariance of entries named after the run).
 AdjustmentResult Adjust(const Project& project,
                         const AdjustOptions& options,
-                        Progress* progress = nullptr);
+                        Progress* progress = nullptr,
+                        KeptAdjustment* keep = nullptr);
 /// Units of work of Adjust() with these options, for a Progress bar.
 int AdjustStages(const AdjustOptions& options);
 

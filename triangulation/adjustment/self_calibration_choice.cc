@@ -78,7 +78,8 @@ std::optional<FreeSetChoice::Held> LeastSignificant(const AdjustmentResult& r,
 AdjustmentResult AdjustWithChosenFreeSet(const Project& project,
                                          const AdjustOptions& options,
                                          const FreeSetChoiceOptions& choice_options,
-                                         Progress* progress) {
+                                         Progress* progress,
+                                         KeptAdjustment* keep) {
   FreeSetChoice choice;
   choice.candidates = options.free_interior;
   choice.significance_t = calib::NormalCriticalValue(
@@ -86,7 +87,7 @@ AdjustmentResult AdjustWithChosenFreeSet(const Project& project,
   choice.correlation_limit = choice_options.correlation_limit;
   AdjustOptions o = options;
   for (int round = 1;; ++round) {
-    AdjustmentResult r = Adjust(project, o, nullptr);
+    AdjustmentResult r = Adjust(project, o, nullptr, keep);
     choice.rounds = round;
     std::optional<FreeSetChoice::Held> held;
     // Without a solution or a covariance nothing can be judged: the result says why.

@@ -34,6 +34,8 @@
 
 namespace aerocal::triangulation {
 
+struct KeptAdjustment;
+
 struct FreeSetChoiceOptions {
   double alpha = 0.05;              // family-wise level of the significance tests, (0, 1)
   double correlation_limit = 0.95;  // (0, 1)
@@ -43,10 +45,12 @@ struct FreeSetChoiceOptions {
 /// header says until every free one is determinable and significant. The returned result is the
 /// adjustment with the chosen set; its `free_set_choice` says what was held and why. `progress`
 /// (may be null) advances by AutoFreeSetRounds(options) units: one per round, the rest at the end.
+/// `keep`: the last round's adjustment, as Adjust() keeps it.
 AdjustmentResult AdjustWithChosenFreeSet(const Project& project,
                                          const AdjustOptions& options,
                                          const FreeSetChoiceOptions& choice = {},
-                                         Progress* progress = nullptr);
+                                         Progress* progress = nullptr,
+                                         KeptAdjustment* keep = nullptr);
 /// The most rounds AdjustWithChosenFreeSet can take: one per candidate held, plus the final one.
 inline int AutoFreeSetRounds(const AdjustOptions& options) {
   return static_cast<int>(options.free_interior.size()) + 1;

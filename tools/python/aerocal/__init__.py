@@ -15,7 +15,10 @@ Blocks and the adjustment
     adjust(block, self_calibration="all", **options) -> AdjustmentResult
     result.sigma0, result.valid, result.check_rmse_m, result.cameras[0].estimated["c"],
     result.cameras[0].sigma["c"], result.correlation, result.residuals, result.to_json()
-    result.covariance(["camera cam1"]); adjust(..., progress=lambda done, total: ...)
+    result.points, result.exposures   adjusted coordinates (and the exposures' sigmas)
+    result.covariance(["camera cam1", "exposure 0012", "point T17"])   the joint sigma0^2 Q,
+        cross blocks included (exposure: X, Y, Z m, omega, phi, kappa deg; point: X, Y, Z m)
+    adjust(..., progress=lambda done, total: ...)
 
 Sub-image stitching (multi-CCD cameras)
     match(camera_file, {"I": "I.tif", ...}, frame="1") -> {frame, point, subimage, pixel, sigma_px}
