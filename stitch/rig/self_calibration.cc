@@ -9,6 +9,7 @@
 #include "calib/residuals/prior.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <deque>
 #include <map>
@@ -38,6 +39,11 @@ struct RmsSums {
 };
 
 RectificationPlane LevelPlane(double z_ref_m) { return {Eigen::Vector3d::UnitZ(), z_ref_m}; }
+
+using Clock = std::chrono::steady_clock;
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 }  // namespace
 
@@ -72,6 +78,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   const int n_exposures = static_cast<int>(exposures.size());
   const int reference = rig.ReferenceIndex();
   RigStitchResult result;
+  const Clock::time_point call_start = Clock::now();
 
   // Observations of each (exposure, tie).
   std::map<TieKey, std::vector<int>> tie_observations;
@@ -314,6 +321,11 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
     const calib::SnoopingOutcome outcome =
         calib::SolveWithDataSnooping(builder, options.solver, snooping);
     result.report = outcome.report;
+    result.profile.solves = outcome.solves;
+    result.profile.iterations = outcome.solve_iterations;
+    result.profile.snooping_rounds = outcome.rounds;
+    result.profile.solve_s = outcome.seconds_solving;
+    result.profile.testing_s = outcome.seconds_testing;
     for (const auto& r : outcome.rejected) result.rejected.push_back(r.label);
     for (const auto& t : outcome.tested)
       if (t.verdict == calib::SnoopingVerdict::kVetoed) {
@@ -324,6 +336,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
       result.warnings.push_back({"data_snooping", "ties", NAN, NAN, f});
   } else {
     result.report = builder.Solve(options.solver);
+    result.profile = {1, result.report.iterations, 0, result.report.seconds};
   }
   std::sort(result.stop_reasons.begin(), result.stop_reasons.end());
   result.stop_reasons.erase(std::unique(result.stop_reasons.begin(), result.stop_reasons.end()),
@@ -341,8 +354,11 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
             std::find(wanted.begin(), wanted.end(), dt[i][k]) == wanted.end())
           wanted.push_back(dt[i][k]);
       }
+  Clock::time_point start = Clock::now();
   const calib::CovarianceReport cov = builder.EstimateCovariance(
       wanted, std::max(result.sigma0, 1e-300), options.correlation_threshold);
+  result.profile.covariance_s = SecondsSince(start);
+  start = Clock::now();
   if (!cov.ok)
     result.warnings.push_back(
         {"covariance", "increments and time offsets", NAN, NAN, "covariance: " + cov.message});
@@ -354,6 +370,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
                                                    wanted,
                                                    options.solver,
                                                    options.suspect_effect_limit);
+  result.profile.effect_s = SecondsSince(start);
   // The largest |rho| of each free dT with an angle of its head (each exposure for line mode).
   std::map<calib::BlockId, DtCorrelation> worst;
   std::set<calib::BlockId> undetermined_dt;
@@ -520,6 +537,7 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
                                  NAN,
                                  message + "; the tie is kept and the result stands: check it"});
   }
+  result.profile.total_s = SecondsSince(call_start);
   return result;
 }
 
