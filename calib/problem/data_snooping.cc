@@ -92,6 +92,16 @@ struct Test {
   std::string method;
 };
 
+// A solve of the snooping (the first one or a re-solve after removals or restorations): from the
+// current values, i.e. warm-started at the previous solution. Counted, with its LM iterations and
+// seconds, so that a caller can see what the rounds cost.
+void Resolve(ProblemBuilder& builder, const SolverOptions& solver, SnoopingOutcome* out) {
+  out->report = builder.Solve(solver);
+  ++out->solves;
+  out->solve_iterations += out->report.iterations;
+  out->seconds_solving += out->report.seconds;
+}
+
 class Snooper {
  public:
   Snooper(ProblemBuilder& builder, const SnoopingOptions& options, SnoopingOutcome* out)
@@ -344,8 +354,7 @@ class Snooper {
     TestedObservation ray = *worst;
     const double reference_sigma = out_.reference_sigma;
     b_.RemoveResidual(ray.id);
-    out_.report = b_.Solve(solver);
-    ++out_.solves;
+    Resolve(b_, solver, &out_);
     bool fits = out_.report.usable && out_.report.redundancy > 0;
     Test next;
     if (fits) {
@@ -358,8 +367,7 @@ class Snooper {
     }
     if (!fits) {
       b_.RestoreResidual(ray.id);
-      out_.report = b_.Solve(solver);
-      ++out_.solves;
+      Resolve(b_, solver, &out_);
       out_.reference_sigma = reference_sigma;  // `t` stands: the solution is back
       return false;
     }
@@ -570,8 +578,7 @@ class Snooper {
       }
       left.push_back(worst);
       b_.RemoveResidual(worst.id);
-      out_.report = b_.Solve(solver);
-      ++out_.solves;
+      Resolve(b_, solver, &out_);
       if (!out_.report.usable) {
         stopped = "the block without " + worst.label + " cannot be solved";
         unsolvable = true;  // it is in `left`: a suspect with those left out before it
@@ -597,8 +604,7 @@ class Snooper {
       for (const auto& x : left) names += (names.empty() ? "" : ", ") + x.label;
       if (!left.empty()) {
         for (const auto& x : left) b_.RestoreResidual(x.id);
-        out_.report = b_.Solve(solver);
-        ++out_.solves;
+        Resolve(b_, solver, &out_);
       }
       out_.findings.push_back("surveys tested first: " + stopped +
                               (left.empty() ? std::string()
@@ -704,8 +710,7 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
   if (solved) {
     out.report = *solved;
   } else {
-    out.report = builder.Solve(solver);
-    ++out.solves;
+    Resolve(builder, solver, &out);
   }
   if (options.leave_out_report_only && !options.report_only_groups.empty() && out.report.usable &&
       out.report.redundancy > 0)
@@ -757,8 +762,7 @@ SnoopingOutcome SolveWithDataSnooping(ProblemBuilder& builder,
       out.tested = std::move(test.observations);
       break;
     }
-    out.report = builder.Solve(solver);
-    ++out.solves;
+    Resolve(builder, solver, &out);
   }
   return out;
 }

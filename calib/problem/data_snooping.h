@@ -173,7 +173,9 @@ struct SnoopingOutcome {
   bool cofactors_ok = true;  // false: nothing could be tested (cofactor_message says why)
   std::string cofactor_message;
   int rounds = 0;
-  int solves = 0;  // solves made by snooping (0: `report` is the caller's `solved`)
+  int solves = 0;                // solves made by snooping (0: `report` is the caller's `solved`)
+  int solve_iterations = 0;      // LM iterations of those solves, summed
+  double seconds_solving = 0.0;  // their SolveReport::seconds, summed
   bool cap_reached = false;
   int remaining_above_critical = 0;         // candidates left when the cap was reached
   std::vector<TestedObservation> rejected;  // in order, with their test values

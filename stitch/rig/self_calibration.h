@@ -144,8 +144,22 @@ struct DtCorrelation {
   double rho = 0.0;
 };
 
+/// Where the run's time went (issue 35), wall seconds of this process.
+struct RigStitchProfile {
+  int solves = 0;           // adjustments solved (the first one and the snooping's re-solves)
+  int iterations = 0;       // their Levenberg-Marquardt iterations, summed
+  int snooping_rounds = 0;  // test rounds (cofactors + w tests)
+  double solve_s = 0.0;     // the solves
+  double testing_s = 0.0;   // the snooping's redundancy numbers and tests
+  double covariance_s = 0.0, effect_s = 0.0;  // covariance; the stop's leave-out re-solve
+  double setup_s = 0.0;                       // blocks, priors and ties added to the problem
+  double figures_s = 0.0;  // per-head results, stitching RMS, standard positions, relief, validity
+  double total_s = 0.0;    // the whole call
+};
+
 struct RigStitchResult {
   calib::SolveReport report;
+  RigStitchProfile profile;
   double sigma0 = 0.0;
   int redundancy = 0;
   std::vector<RigStitchExposureResult> exposures;

@@ -6,6 +6,7 @@
 #include "stitch/rig/self_calibration_problem.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 namespace aerocal::stitch::internal {
@@ -59,6 +60,11 @@ std::vector<calib::ResidualId> SolveWithSnooping(RigStitchProblem& p) {
     const calib::SnoopingOutcome outcome =
         calib::SolveWithDataSnooping(p.builder, p.options.solver, snooping);
     result.report = outcome.report;
+    result.profile.solves = outcome.solves;
+    result.profile.iterations = outcome.solve_iterations;
+    result.profile.snooping_rounds = outcome.rounds;
+    result.profile.solve_s = outcome.seconds_solving;
+    result.profile.testing_s = outcome.seconds_testing;
     for (const auto& r : outcome.rejected) result.rejected.push_back(r.label);
     for (const auto& t : outcome.tested)
       if (t.verdict == calib::SnoopingVerdict::kVetoed) {
@@ -69,6 +75,9 @@ std::vector<calib::ResidualId> SolveWithSnooping(RigStitchProblem& p) {
       result.warnings.push_back({"data_snooping", "ties", NAN, NAN, f});
   } else {
     result.report = p.builder.Solve(p.options.solver);
+    result.profile.solves = 1;
+    result.profile.iterations = result.report.iterations;
+    result.profile.solve_s = result.report.seconds;
   }
   std::sort(result.stop_reasons.begin(), result.stop_reasons.end());
   result.stop_reasons.erase(std::unique(result.stop_reasons.begin(), result.stop_reasons.end()),
@@ -79,6 +88,11 @@ std::vector<calib::ResidualId> SolveWithSnooping(RigStitchProblem& p) {
 }
 
 namespace {
+
+using Clock = std::chrono::steady_clock;
+double SecondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
 
 // The increments of the non-reference heads and their free time offsets (each once).
 std::vector<calib::BlockId> IncrementsAndOffsets(const RigStitchProblem& p) {
@@ -128,14 +142,18 @@ void DtCorrelations(RigStitchProblem& p) {
 void EstimatePrecision(RigStitchProblem& p, const std::vector<calib::ResidualId>& kept) {
   auto& result = p.result;
   const std::vector<calib::BlockId> wanted = IncrementsAndOffsets(p);
+  Clock::time_point start = Clock::now();
   p.cov = p.builder.EstimateCovariance(
       wanted, std::max(result.sigma0, 1e-300), p.options.correlation_threshold);
+  result.profile.covariance_s = SecondsSince(start);
   if (!p.cov.ok)
     result.warnings.push_back(
         {"covariance", "increments and time offsets", NAN, NAN, "covariance: " + p.cov.message});
+  start = Clock::now();
   if (result.stopped)  // what the rig's calibration becomes without the ties kept against the test
     result.stop_effect = calib::EffectOfLeavingOut(
         p.builder, kept, p.cov, wanted, wanted, p.options.solver, p.options.suspect_effect_limit);
+  result.profile.effect_s = SecondsSince(start);
   DtCorrelations(p);
 }
 

@@ -283,6 +283,40 @@ bool SkipWithoutScene(const StitchedScene& s, benchmark::State& state) {
   return !s.ok;
 }
 
+// Exposure 0's ties matched with `match`, then self-calibrated; the process CPU seconds of each
+// stage (all threads) added to *match_s and *calibrate_s.
+RigStitchResult MatchAndCalibrate(const StitchedScene& s,
+                                  const RigTieMatchOptions& match,
+                                  const RigStitchOptions& options,
+                                  RigTieMatches* matches,
+                                  double* match_s,
+                                  double* calibrate_s) {
+  const std::clock_t t0 = std::clock();
+  MatchRigExposureTies(s.flight.truth, s.in.exposures[0], 0, s.gray, match, matches);
+  const std::clock_t t1 = std::clock();
+  RigStitchResult r = SelfCalibrateRigStitching(s.flight.truth,
+                                                s.in.exposures,
+                                                matches->ties,
+                                                matches->observations,
+                                                s.in.positions,
+                                                options);
+  *match_s += double(t1 - t0) / CLOCKS_PER_SEC;
+  *calibrate_s += double(std::clock() - t1) / CLOCKS_PER_SEC;
+  return r;
+}
+
+// The exposure's pose with the self-calibration's increments and offsets.
+RigExposure RefinedPose(const StitchedScene& s, const RigStitchResult& r) {
+  RigExposure pose = s.in.exposures[0].pose;
+  pose.increment_rad.assign(4, Eigen::Vector3d::Zero());
+  pose.dt_s.assign(4, 0.0);
+  for (const auto& h : r.exposures[0].heads) {
+    pose.increment_rad[s.flight.truth.HeadIndex(h.head)] = h.increment_rad;
+    pose.dt_s[s.flight.truth.HeadIndex(h.head)] = h.dt_fitted_s;
+  }
+  return pose;
+}
+
 void BM_StitchedExposure(benchmark::State& state) {
   const StitchedScene& s = Scene();
   if (SkipWithoutScene(s, state)) return;
@@ -292,28 +326,11 @@ void BM_StitchedExposure(benchmark::State& state) {
   // CPU seconds of the process per stage (all threads), summed over the iterations.
   double match_s = 0.0, calibrate_s = 0.0, stitch_s = 0.0;
   for (auto _ : state) {
-    std::clock_t t0 = std::clock();
     RigTieMatches matches;
-    MatchRigExposureTies(s.flight.truth, s.in.exposures[0], 0, s.gray, {}, &matches);
-    std::clock_t t1 = std::clock();
-    match_s += double(t1 - t0) / CLOCKS_PER_SEC;
-    const RigStitchResult r = SelfCalibrateRigStitching(s.flight.truth,
-                                                        s.in.exposures,
-                                                        matches.ties,
-                                                        matches.observations,
-                                                        s.in.positions,
-                                                        options);
-    t0 = std::clock();
-    calibrate_s += double(t0 - t1) / CLOCKS_PER_SEC;
-    RigExposure pose = s.in.exposures[0].pose;
-    pose.increment_rad.assign(4, Eigen::Vector3d::Zero());
-    pose.dt_s.assign(4, 0.0);
-    for (const auto& h : r.exposures[0].heads) {
-      pose.increment_rad[s.flight.truth.HeadIndex(h.head)] = h.increment_rad;
-      pose.dt_s[s.flight.truth.HeadIndex(h.head)] = h.dt_fitted_s;
-    }
+    const RigStitchResult r = MatchAndCalibrate(s, {}, options, &matches, &match_s, &calibrate_s);
+    const std::clock_t t0 = std::clock();
     const RigConverter converter(
-        s.flight.truth, pose, {Eigen::Vector3d::UnitZ(), s.in.exposures[0].z_ref_m});
+        s.flight.truth, RefinedPose(s, r), {Eigen::Vector3d::UnitZ(), s.in.exposures[0].z_ref_m});
     std::vector<RasterSource*> sources;
     for (const auto& h : s.heads) sources.push_back(const_cast<MemoryRaster*>(&h));
     DiscardSink image(v.width_px), mask(v.width_px);
@@ -321,6 +338,18 @@ void BM_StitchedExposure(benchmark::State& state) {
     benchmark::DoNotOptimize(report.overall.rms_dn);
     stitch_s += double(std::clock() - t0) / CLOCKS_PER_SEC;
     state.counters["ties"] = static_cast<double>(matches.ties.size());
+    state.counters["observations"] = static_cast<double>(r.report.n_observations);
+    state.counters["solves"] = r.profile.solves;
+    state.counters["lm_iterations"] = r.profile.iterations;
+    state.counters["snoop_rounds"] = r.profile.snooping_rounds;
+    state.counters["rejected"] = static_cast<double>(r.rejected.size());
+    state.counters["solve_s"] = r.profile.solve_s;
+    state.counters["testing_s"] = r.profile.testing_s;
+    state.counters["covariance_s"] = r.profile.covariance_s;
+    state.counters["effect_s"] = r.profile.effect_s;
+    state.counters["setup_s"] = r.profile.setup_s;
+    state.counters["figures_s"] = r.profile.figures_s;
+    state.counters["calibrate_s"] = r.profile.total_s;
   }
   state.counters["virtual_mpx"] = v.width_px * 1e-6 * v.height_px;
   state.counters["match_cpu_s"] = match_s / state.iterations();
@@ -328,6 +357,88 @@ void BM_StitchedExposure(benchmark::State& state) {
   state.counters["stitch_cpu_s"] = stitch_s / state.iterations();
 }
 BENCHMARK(BM_StitchedExposure)->Unit(benchmark::kMillisecond)->UseRealTime()->MinTime(1.0);
+
+// The seam misregistration the calibration error leaves in the stitched image (virtual px, per
+// coordinate): on a grid of every 50th virtual px, each head covering the pixel under the TRUE
+// increments and offsets sees the ground there at head pixel p_k; the refined pose carries p_k to
+// virtual pixel v_k. Two heads at one pixel disagree by v_j - v_k (0 with a perfect calibration).
+double SeamMisregistrationPx(const StitchedScene& s, const RigExposure& refined) {
+  RigExposure true_pose = s.in.exposures[0].pose;
+  true_pose.increment_rad.assign(4, Eigen::Vector3d::Zero());
+  true_pose.dt_s.assign(4, 0.0);
+  for (int k = 0; k < 4; ++k) {
+    true_pose.increment_rad[k] = s.flight.rig_exposures[k].increment_rad;
+    true_pose.dt_s[k] = s.flight.rig_exposures[k].dt_s;
+  }
+  const RectificationPlane plane{Eigen::Vector3d::UnitZ(), s.in.exposures[0].z_ref_m};
+  const RigConverter truth(s.flight.truth, true_pose, plane), fit(s.flight.truth, refined, plane);
+  const calib::Camera& v = s.flight.truth.virtual_camera.camera;
+  double sum2 = 0.0;
+  long pairs = 0;
+  for (int r = 0; r < v.height_px; r += 50)
+    for (int c = 0; c < v.width_px; c += 50) {
+      std::vector<Eigen::Vector2d> seen;
+      for (int k = 0; k < 4; ++k) {
+        const calib::Camera& head = s.flight.truth.heads[k].camera;
+        const auto p = truth.HeadFromVirtual(k, Eigen::Vector2d(c, r));
+        if (!p || p->x() < 0 || p->y() < 0 || p->x() > head.width_px - 1 ||
+            p->y() > head.height_px - 1)
+          continue;
+        if (const auto back = fit.VirtualFromHead(k, *p)) seen.push_back(*back);
+      }
+      for (size_t a = 0; a < seen.size(); ++a)
+        for (size_t b = a + 1; b < seen.size(); ++b, ++pairs)
+          sum2 += (seen[a] - seen[b]).squaredNorm();
+    }
+  return pairs > 0 ? std::sqrt(sum2 / (2.0 * pairs)) : NAN;
+}
+
+// Tie density against what the self-calibration gives (issue 35): the matcher's cell (arg,
+// virtual px; one tie per cell and zone) against the ties, the CPU seconds of matching and
+// self-calibration, the RMS of the increments' sigmas and of their errors against the
+// simulator's truth (arcsec), and the seam misregistration the result leaves in the stitched
+// image (SeamMisregistrationPx). Run with AEROCAL_BENCH_RIG_SCALE=1 for the full formats.
+void BM_TieDensity(benchmark::State& state) {
+  const StitchedScene& s = Scene();
+  if (SkipWithoutScene(s, state)) return;
+  RigTieMatchOptions match;
+  match.cell_px = static_cast<double>(state.range(0));
+  RigStitchOptions options;
+  options.standard_radius_px *= SceneFormatScale();
+  constexpr double kArcsec = 180.0 * 3600.0 / M_PI;
+  for (auto _ : state) {
+    RigTieMatches matches;
+    double match_s = 0.0, calibrate_s = 0.0;
+    const RigStitchResult r =
+        MatchAndCalibrate(s, match, options, &matches, &match_s, &calibrate_s);
+    double sigma2 = 0.0, error2 = 0.0;
+    int n = 0;
+    for (const auto& h : r.exposures[0].heads) {
+      if (h.reference) continue;
+      const Eigen::Vector3d truth =
+          s.flight.rig_exposures[s.flight.truth.HeadIndex(h.head)].increment_rad;
+      sigma2 += h.increment_sigma_rad.squaredNorm();
+      error2 += (h.increment_rad - truth).squaredNorm();
+      n += 3;
+    }
+    state.counters["ties"] = static_cast<double>(matches.ties.size());
+    state.counters["match_cpu_s"] = match_s;
+    state.counters["calibrate_cpu_s"] = calibrate_s;
+    state.counters["sigma_arcsec"] = std::sqrt(sigma2 / n) * kArcsec;
+    state.counters["error_arcsec"] = std::sqrt(error2 / n) * kArcsec;
+    state.counters["seam_px"] = SeamMisregistrationPx(s, RefinedPose(s, r));
+    state.counters["sigma0"] = r.sigma0;
+    state.counters["valid"] = r.failures.empty() ? 1 : 0;
+  }
+}
+BENCHMARK(BM_TieDensity)
+    ->Arg(40)
+    ->Arg(80)
+    ->Arg(160)
+    ->Arg(320)
+    ->Unit(benchmark::kMillisecond)
+    ->UseRealTime()
+    ->Iterations(1);
 
 void BM_StitchedPeerRemap(benchmark::State& state) {
   const StitchedScene& s = Scene();
