@@ -210,12 +210,13 @@ CalibrateOutcome CalibrateRigFromDirections(const DirectionsArgs& args) {
   cal["units"] = UnitsJson(run, written);
   cal["data"] = DirectionDataJson(data, 0);
   cal["data"]["units"] = run.ids.size();
-  // The first unit's pixel size and format: the certificate's distortion figure is its.
+  // The first unit's id, pixel size and format: the certificate's distortion figure is its.
   const calib::Camera& first_head = rig.heads[rig.HeadIndex(run.ids.front())].camera;
   cal["camera"] = {{"file", args.camera},
                    {"kind", "rig"},
                    {"reference_head", rig.reference_head},
                    {"first_unit", run.ids.front()},
+                   {"id", run.ids.front()},
                    {"pixel_size_mm", first_head.pixel_size_mm},
                    {"format_px", {first_head.width_px, first_head.height_px}}};
   cal["rms_px"] = RmsPx(r);

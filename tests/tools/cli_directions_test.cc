@@ -569,7 +569,7 @@ TEST(CalibrateDirections, MultiCcdSubImagesInOneAdjustmentWithGaugeBudgetAndCert
       const std::string name =
           s["id"].get<std::string>() + "." + s["param_names"][e].get<std::string>();
       ASSERT_TRUE(budget.count(name)) << name;
-      EXPECT_NEAR(budget[name]["expanded"].get<double>(),
+      EXPECT_NEAR(budget[name]["U"].get<double>(),
                   budget[name]["k"].get<double>() * s["sigma"][e].get<double>(),
                   1e-12);
     }
