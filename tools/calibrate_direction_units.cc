@@ -10,6 +10,7 @@
 #include "tools/calibrate_models.h"
 #include "tools/camera_formats.h"
 #include "triangulation/adjustment/adjust_options.h"
+#include "triangulation/calibration/calibration_json.h"
 #include "triangulation/calibration/direction_io.h"
 #include "triangulation/calibration/direction_units_run.h"
 
@@ -23,16 +24,6 @@ namespace aerocal::tools {
 namespace {
 
 constexpr double kDeg = M_PI / 180.0;
-constexpr double kArcSecond = kDeg / 3600.0;
-
-nlohmann::json Degrees(const Eigen::Vector3d& rad) {
-  return {rad.x() / kDeg, rad.y() / kDeg, rad.z() / kDeg};
-}
-// Sigmas in arc seconds; null when the covariance is not known.
-nlohmann::json ArcsecOrNull(const Eigen::Vector3d& rad, bool known) {
-  if (!known) return nullptr;
-  return {rad.x() / kArcSecond, rad.y() / kArcSecond, rad.z() / kArcSecond};
-}
 
 // Options of a single camera that a rig run does not take: refused by name.
 void RefuseSingleCameraOptions(const DirectionsArgs& args) {
@@ -44,11 +35,57 @@ void RefuseSingleCameraOptions(const DirectionsArgs& args) {
   if (args.camera_format != "aerocal")
     throw ConfigError("--camera-format: a rig file is written in aerocal's rig layout (got " +
                       args.camera_format + ")");
-  if (!args.budget.empty() || !args.radii_mm.empty())
-    throw ConfigError(std::string(args.budget.empty() ? "--radii-mm" : "--budget") +
-                      ": the uncertainty budget of a multi-unit run is not built (a rig file, "
-                      "--camera " +
-                      args.camera + ")");
+}
+
+// The quantity renamed "UNIT.name" (its statement with it).
+triangulation::BudgetQuantity OfUnit(const std::string& unit, triangulation::BudgetQuantity q) {
+  q.name = unit + "." + q.name;
+  q.statement = triangulation::CertificateStatement(q.name, q.value, q.expanded, q.k, q.unit);
+  return q;
+}
+
+// The budget of every head (see the header comment): its interior as a single camera's from its
+// adjustment (the marginal covariance of the joint solve, its sigma0 and redundancy, the head's
+// pixel pitch), "HEAD.c", ...; m_0 once (one solve); the mounts of the heads after the first,
+// "HEAD.mount_omega" ... in deg. `first` gets the first head's run (the certificate's
+// correlation table and radii).
+std::vector<triangulation::BudgetQuantity> UnitsBudget(const calib::Rig& rig,
+                                                       const triangulation::DirectionUnitsRun& run,
+                                                       const DirectionsArgs& args,
+                                                       const triangulation::BudgetOptions& options,
+                                                       triangulation::CalibrationRun* first) {
+  std::vector<triangulation::BudgetQuantity> out;
+  const char* axes[3] = {"omega", "phi", "kappa"};
+  for (size_t k = 0; k < run.ids.size(); ++k) {
+    const calib::Camera& camera = rig.heads[rig.HeadIndex(run.ids[k])].camera;
+    triangulation::CalibrationRun unit;
+    unit.camera = run.ids[k];
+    unit.start_c_mm = camera.c_mm();
+    unit.project.cameras[unit.camera] = camera;
+    unit.all = run.adjustments[k];
+    triangulation::BudgetOptions of_unit = options;
+    if (args.radii_mm.empty() && options.radii_mm.empty())
+      of_unit.radii_mm = DefaultCertifiedRadiiMm(camera);
+    for (const auto& q : triangulation::UncertaintyBudget(unit, unit.project, of_unit)) {
+      if (q.name.rfind("m_", 0) == 0) {
+        if (k == 0) out.push_back(q);
+        continue;
+      }
+      out.push_back(OfUnit(run.ids[k], q));
+    }
+    const triangulation::DirectionUnitsCalibration& c = run.calibration;
+    for (int i = 0; k > 0 && c.covariance_ok && i < 3; ++i)
+      out.push_back(triangulation::AdjustedQuantityBudget(
+          run.ids[k] + ".mount_" + axes[i],
+          "deg",
+          "mount of head " + run.ids[k] + " relative to head " + run.ids[0] + " (" + axes[i] + ")",
+          c.mount_opk_rad[k][i] / kDeg,
+          c.mount_sigma_rad[k][i] / kDeg,
+          run.all.solve.redundancy,
+          "the joint covariance of the two heads' rotations, propagated to the mount"));
+    if (k == 0) *first = unit;
+  }
+  return out;
 }
 
 // The units in the adjustment's order: the reference head first, then the rig's order.
@@ -85,13 +122,13 @@ nlohmann::json UnitsJson(const triangulation::DirectionUnitsRun& run, const cali
     units.push_back(
         {{"id", run.ids[k]},
          {"observations", run.observations[k]},
-         {"instrument_from_unit_opk_deg", Degrees(u.opk_rad)},
-         {"instrument_from_unit_sigma_arcsec", ArcsecOrNull(u.opk_sigma_rad, c.covariance_ok)},
-         {"mount_opk_deg", Degrees(c.mount_opk_rad[k])},
+         {"instrument_from_unit_opk_deg", DegreesJson(u.opk_rad)},
+         {"instrument_from_unit_sigma_arcsec", ArcsecOrNullJson(u.opk_sigma_rad, c.covariance_ok)},
+         {"mount_opk_deg", DegreesJson(c.mount_opk_rad[k])},
          {"mount_sigma_arcsec",
-          k == 0 ? nlohmann::json() : ArcsecOrNull(c.mount_sigma_rad[k], c.covariance_ok)},
-         {"rig_mount_deg", Degrees(written.heads[written.HeadIndex(run.ids[k])].mount_rad)},
-         {"start_opk_deg", Degrees(run.start_opk_rad[k])},
+          k == 0 ? nlohmann::json() : ArcsecOrNullJson(c.mount_sigma_rad[k], c.covariance_ok)},
+         {"rig_mount_deg", DegreesJson(written.heads[written.HeadIndex(run.ids[k])].mount_rad)},
+         {"start_opk_deg", DegreesJson(run.start_opk_rad[k])},
          {"start_rotation", run.start_rotation[k]}});
   }
   return units;
@@ -104,16 +141,6 @@ nlohmann::json MethodJson(const triangulation::DirectionUnitsRun& run,
   const triangulation::DirectionUnitsCalibration& c = run.calibration;
   int known = 0;
   for (const auto& t : data.targets) known += t.known;
-  nlohmann::json targets = nlohmann::json::object();
-  for (const auto& [id, angles] : c.target_angles_rad) {
-    const auto s = c.target_sigma_rad.find(id);
-    targets[id] = {{"azimuth_deg", angles.x() / kDeg},
-                   {"elevation_deg", angles.y() / kDeg},
-                   {"sigma_arcsec",
-                    s == c.target_sigma_rad.end() ? nlohmann::json()
-                                                  : nlohmann::json({s->second.x() / kArcSecond,
-                                                                    s->second.y() / kArcSecond})}};
-  }
   return {{"kind", c.method},
           {"directions", path},
           {"targets", data.targets.size()},
@@ -125,10 +152,10 @@ nlohmann::json MethodJson(const triangulation::DirectionUnitsRun& run,
            "(triangulation/calibration/direction_calibration.h, CalibrateUnitsFromDirections): a "
            "shared rotation of the instrument, per unit its interior and its mount relative to the "
            "first unit; no position, no scale; no data snooping"},
-          {"instrument_from_camera_opk_deg", Degrees(c.units.front().opk_rad)},
+          {"instrument_from_camera_opk_deg", DegreesJson(c.units.front().opk_rad)},
           {"instrument_from_camera_sigma_arcsec",
-           ArcsecOrNull(c.units.front().opk_sigma_rad, c.covariance_ok)},
-          {"estimated_targets", targets},
+           ArcsecOrNullJson(c.units.front().opk_sigma_rad, c.covariance_ok)},
+          {"estimated_targets", EstimatedTargetsJson(c.target_angles_rad, c.target_sigma_rad)},
           {"sub_images",
            "the heads of a rig file in one adjustment; the sub-images of a multi-CCD camera file "
            "are not (one interior for the whole file)"}};
@@ -146,15 +173,8 @@ CalibrateOutcome CalibrateRigFromDirections(const DirectionsArgs& args) {
   RefuseSingleCameraOptions(args);
   const calib::Rig rig = calib::ReadRig(args.camera);
   const calib::Camera& reference = rig.heads[rig.ReferenceIndex()].camera;
-  triangulation::DirectionRunOptions options;
-  options.calibration.free_interior = triangulation::ParseSelfCalibration(
-      args.self_calibration.empty() ? DefaultSelfCalibration(reference.model)
-                                    : args.self_calibration,
-      reference.model);
-  if (options.calibration.free_interior.empty())
-    throw ConfigError("--self-calibration: calibrate needs at least one parameter (got none)");
-  if (!args.out.empty()) CheckOutputFile(args.out, "--out");
-  if (!args.write_camera.empty()) CheckOutputFile(args.write_camera, "--write-camera");
+  const DirectionSetup setup = ReadDirectionSetup(args, reference);
+  const triangulation::DirectionRunOptions& options = setup.options;
   std::map<std::string, calib::Camera> units;
   for (const auto& h : rig.heads) units[h.id] = h.camera;
   const triangulation::DirectionData data =
@@ -162,8 +182,8 @@ CalibrateOutcome CalibrateRigFromDirections(const DirectionsArgs& args) {
   for (const auto& g : data.groups)
     if (!g.empty())
       ThrowInputError({args.directions, 1},
-                      "group: the groups' stability test of a multi-unit run is not built "
-                      "(--camera " +
+                      "group: the groups' stability test of a rig's heads is not built (each "
+                      "group would have to determine every head alone; --camera " +
                           args.camera + " is a rig)");
 
   const triangulation::DirectionUnitsRun run = triangulation::RunDirectionUnitsCalibration(
@@ -175,25 +195,30 @@ CalibrateOutcome CalibrateRigFromDirections(const DirectionsArgs& args) {
                                   args.directions.c_str(),
                                   triangulation::FormatSummary(r).c_str());
   const calib::Rig written = UpdatedRig(rig, run);
-  nlohmann::json json = triangulation::AdjustmentToJson(r);
-  json["command"] = "calibrate";
-  json["valid"] = r.valid;
-  json["invalid_reasons"] = r.invalid_reasons;
-  json["self_calibration"] = options.calibration.free_interior;
-  nlohmann::json cal;
+  nlohmann::json json = DirectionResultJson(r, setup);
+  triangulation::CalibrationRun first;
+  const auto budget = UnitsBudget(rig, run, args, setup.budget, &first);
+  for (const auto& q : budget) outcome.printed += StringPrintf("  %s\n", q.statement.c_str());
+  // The first head's run gives the interior correlations, groups (none), stability and radii;
+  // the budget lists every head's quantities.
+  nlohmann::json cal = triangulation::CalibrationToJson(
+      first,
+      budget,
+      setup.budget.radii_mm.empty() ? DefaultCertifiedRadiiMm(reference) : setup.budget.radii_mm,
+      reference.c_mm());
   cal["method"] = MethodJson(run, data, args.directions);
   cal["units"] = UnitsJson(run, written);
-  int known = 0;
-  for (const auto& t : data.targets) known += t.known;
-  cal["data"] = {{"images", std::max(1, data.settings)},
-                 {"observations", data.observations.size()},
-                 {"control_points", known},
-                 {"check_points", 0},
-                 {"groups", 0},
-                 {"targets", data.targets.size()},
-                 {"settings", data.settings},
-                 {"units", run.ids.size()}};
-  cal["camera"] = {{"file", args.camera}, {"kind", "rig"}, {"reference_head", rig.reference_head}};
+  cal["data"] = DirectionDataJson(data, 0);
+  cal["data"]["units"] = run.ids.size();
+  // The first unit's id, pixel size and format: the certificate's distortion figure is its.
+  const calib::Camera& first_head = rig.heads[rig.HeadIndex(run.ids.front())].camera;
+  cal["camera"] = {{"file", args.camera},
+                   {"kind", "rig"},
+                   {"reference_head", rig.reference_head},
+                   {"first_unit", run.ids.front()},
+                   {"id", run.ids.front()},
+                   {"pixel_size_mm", first_head.pixel_size_mm},
+                   {"format_px", {first_head.width_px, first_head.height_px}}};
   cal["rms_px"] = RmsPx(r);
   for (size_t k = 0; k < run.ids.size(); ++k) {
     const Eigen::Vector3d& m = run.calibration.mount_opk_rad[k];
@@ -215,10 +240,7 @@ CalibrateOutcome CalibrateRigFromDirections(const DirectionsArgs& args) {
     outcome.errors += "camera not written: the result is not valid\n";
   }
   json["calibration"] = cal;
-  for (const auto& reason : r.invalid_reasons)
-    outcome.errors += "calibrate: not valid: " + reason + "\n";
-  outcome.doc = std::move(json);
-  outcome.valid = r.valid;
+  FinishDirectionOutcome(r, std::move(json), true, &outcome);
   return outcome;
 }
 

@@ -5,8 +5,13 @@
 // inputs; the method states the instrument) and the camera file in the requested model / format.
 #pragma once
 
+#include "calib/camera/camera.h"
 #include "tools/calibrate_request.h"
+#include "triangulation/calibration/direction_io.h"
+#include "triangulation/calibration/direction_run.h"
+#include "triangulation/calibration/uncertainty_budget.h"
 
+#include <map>
 #include <string>
 #include <vector>
 
@@ -20,6 +25,38 @@ struct DirectionsArgs {
   std::vector<double>
       radii_mm;  // certified distortion radii (default: 1/4 .. 4/4 of the half diagonal)
 };
+
+/// What every direction run takes from the options: the free interior (--self-calibration), the
+/// budget (--budget, --radii-mm; no target radius); the output paths checked.
+struct DirectionSetup {
+  triangulation::DirectionRunOptions options;
+  triangulation::BudgetOptions budget;
+};
+/// Throws ConfigError naming the option on bad values; `camera` gives the model and the default
+/// radii.
+DirectionSetup ReadDirectionSetup(const DirectionsArgs& args, const calib::Camera& camera);
+
+/// The `group` column names two groups or more (or none): InputError at FILE:0 otherwise.
+void CheckGroups(const triangulation::DirectionData& data, const std::string& path);
+/// True when the directions file has a `unit` column.
+bool HasUnitColumn(const std::string& directions);
+
+/// The result document's top (AdjustmentToJson, command, validity, self_calibration) and its
+/// `calibration.data` section.
+nlohmann::json DirectionResultJson(const triangulation::AdjustmentResult& result,
+                                   const DirectionSetup& setup);
+nlohmann::json DirectionDataJson(const triangulation::DirectionData& data, size_t groups);
+/// Angles (rad) as [omega, phi, kappa] in deg; sigmas (rad) in arc seconds, null when not known.
+nlohmann::json DegreesJson(const Eigen::Vector3d& rad);
+nlohmann::json ArcsecOrNullJson(const Eigen::Vector3d& rad, bool known);
+/// The estimated targets {id: {azimuth_deg, elevation_deg, sigma_arcsec [2] or null}}.
+nlohmann::json EstimatedTargetsJson(const std::map<std::string, Eigen::Vector2d>& angles_rad,
+                                    const std::map<std::string, Eigen::Vector2d>& sigma_rad);
+/// The outcome's document, validity (valid and the groups agree) and not-valid lines.
+void FinishDirectionOutcome(const triangulation::AdjustmentResult& result,
+                            nlohmann::json json,
+                            bool groups_agree,
+                            CalibrateOutcome* outcome);
 
 /// Runs the calibration and writes --write-camera (not the result file; `out` is checked when
 /// given). Throws InputError / ConfigError on bad input before anything is written.

@@ -427,19 +427,12 @@ nlohmann::json CertificateData(const nlohmann::json& result,
     if (r.value("used", true))
       residuals.push_back({r.at("col"), r.at("row"), r.at("v_col_px"), r.at("v_row_px")});
   cert["residuals"] = residuals;
+  // Several units from directions (a rig's heads, a multi-CCD camera's sub-images): each unit's
+  // values with U are rows "UNIT.quantity" of `results`; the units themselves listed here.
+  if (cal.contains("units")) cert["units"] = cal["units"];
+  if (cal.contains("subimages")) cert["units"] = cal["subimages"];
+  if (cal.contains("gauge")) cert["gauge"] = cal["gauge"];
   return cert;
-}
-
-// A calibration of several units (a rig's heads from directions) has no single camera, budget or
-// stability table: its certificate (one per unit, or one listing the units) is not built.
-void RefuseSeveralUnits(const nlohmann::json& result, const std::string& path) {
-  const nlohmann::json& units = result["calibration"].value("units", nlohmann::json::array());
-  if (!units.is_array() || units.empty()) return;
-  std::string ids;
-  for (const auto& u : units) ids += (ids.empty() ? "" : ", ") + u.value("id", std::string("?"));
-  throw InputError(path + ": a calibration of " + std::to_string(units.size()) + " units (" + ids +
-                   ") from directions: the certificate covers one camera; a multi-unit "
-                   "certificate is not built (--result)");
 }
 
 // The certificate of args.result (a calibrate or flight result), checked through its schema and
@@ -457,7 +450,6 @@ nlohmann::json CertificateOfResult(const CertificateArgs& args,
     if (!result.is_object() || result.value("command", "") != "calibrate" ||
         !result.contains("calibration"))
       throw InputError(args.result + ": not a result of `aerocal calibrate` (--result)");
-    RefuseSeveralUnits(result, args.result);
     // Through its schema (key path in the message), and every statement against its numbers.
     ValidateJson(result, InputSchema("calibrate_result"), args.result);
     CheckStatements(result["calibration"]["uncertainty"], args.result, "calibration.uncertainty");

@@ -46,7 +46,8 @@ void AddCalibrateInputs(CLI::App& app, CalibrateArgs* args) {
       args->directions,
       "Laboratory calibration from known directions: a collimator array or a goniometer "
       "sequence (CSV target,col,row,... of docs/formats.md 'Directions file'); with a rig file "
-      "as --camera, its unit column names each row's head (one adjustment)");
+      "as --camera, its unit column names each row's head, with a multi-CCD camera file each "
+      "row's sub-image (one adjustment)");
 }
 
 // What is calibrated and how its uncertainty is stated.

@@ -1,6 +1,7 @@
 // The direction residual (calib/residuals/direction.h): zero for a perfect observation computed
 // independently (Eigen rotation, the model's MeasuredFromIdeal), whitening by hand, the focal-plane
-// covariance of an angular sigma by hand, gradients against ceres::GradientChecker.
+// covariance of an angular sigma by hand, gradients against ceres::GradientChecker; the sub-image
+// residual (mapping in front) against the frame residual at the mapped pixel.
 #include "calib/camera/brown_fraser10.h"
 #include "calib/residuals/direction.h"
 
@@ -63,6 +64,49 @@ TEST(DirectionResidual, ZeroForAPerfectObservationWhitenedAndGradientsMatch) {
   double r2[2];
   ASSERT_TRUE(by_id->Evaluate(blocks, r2, nullptr));
   EXPECT_DOUBLE_EQ(r2[1], r[1]);
+}
+
+// The sub-image residual is the frame residual at the mapped virtual pixel: an affine mapping
+// (conditioned parameters) from a sub-image pixel to the pixel the scene computes, the same
+// whitened residual as ModelDirectionResidual there; gradients (mapping block included) against
+// ceres::GradientChecker; the factory by ids gives the same value.
+TEST(SubimageDirectionResidual, EqualsTheFrameResidualAtTheMappedPixelAndGradientsMatch) {
+  DirectionScene s;
+  const Eigen::Vector2d virtual_pixel = s.Pixel() + Eigen::Vector2d(0.3, -0.7);  // not exact
+  SubimageMapping mapping{"II", 3000, 2000, MappingModel::kAffine, {}};
+  // A near-unit affine map; the sub-image pixel that lands on virtual_pixel by its inverse.
+  const double a1 = 1.0002, a2 = -0.0003, b1 = 0.0004, b2 = 0.9998, a0 = 2990.0, b0 = 1.5;
+  mapping.params = {a1, a2, a0, b1, b2, b0};
+  const Eigen::Vector2d uv = mapping.SubFromVirtual(virtual_pixel);
+  ASSERT_NEAR((mapping.VirtualFromSub(uv) - virtual_pixel).norm(), 0.0, 1e-9);
+  const MappingConditioning cond = mapping.Conditioning();
+  std::vector<double> conditioned = ConditionedFromPlain(mapping.model, cond, mapping.params);
+  const Eigen::Matrix2d covariance = DirectionCovarianceMm2(
+      s.frame.PhotoFromPixel(virtual_pixel), s.interior[0], 0.1, s.frame.pixel_size_mm, 2e-6);
+  auto sub = ModelSubimageDirectionResidual<BrownFraser10Model, AffineMapping>::Create(
+      s.frame, cond, uv, s.g, covariance);
+  auto frame =
+      ModelDirectionResidual<BrownFraser10Model>::Create(s.frame, s.g, virtual_pixel, covariance);
+  double r_sub[2], r_frame[2];
+  const double* sub_blocks[] = {conditioned.data(), s.interior, s.rotation.data(), s.direction};
+  const double* frame_blocks[] = {s.interior, s.rotation.data(), s.direction};
+  ASSERT_TRUE(sub->Evaluate(sub_blocks, r_sub, nullptr));
+  ASSERT_TRUE(frame->Evaluate(frame_blocks, r_frame, nullptr));
+  EXPECT_GT(std::abs(r_frame[1]), 1.0);     // the 0.7 px offset shows
+  EXPECT_NEAR(r_sub[0], r_frame[0], 1e-7);  // 1e-7 sigma: the mapping round trip's 1e-9 px
+  EXPECT_NEAR(r_sub[1], r_frame[1], 1e-7);
+  ceres::NumericDiffOptions numeric;
+  const std::vector<const ceres::Manifold*>* no_manifolds = nullptr;
+  ceres::GradientChecker checker(sub.get(), no_manifolds, numeric);
+  ceres::GradientChecker::ProbeResults results;
+  double* probe[] = {conditioned.data(), s.interior, s.rotation.data(), s.direction};
+  EXPECT_TRUE(checker.Probe(probe, 1e-6, &results)) << results.error_log;
+  auto by_id = MakeSubimageDirectionResidual(
+      CameraModelId::kBrownFraser10, MappingModel::kAffine, s.frame, cond, uv, s.g, covariance);
+  double r_id[2];
+  ASSERT_TRUE(by_id->Evaluate(sub_blocks, r_id, nullptr));
+  EXPECT_DOUBLE_EQ(r_id[0], r_sub[0]);
+  EXPECT_DOUBLE_EQ(r_id[1], r_sub[1]);
 }
 
 TEST(DirectionResidual, DirectionBehindTheCameraIsRejected) {

@@ -6,8 +6,12 @@
 // requested format; two series as groups give the stability table and the reproducibility
 // component; bad rows name FILE:LINE (exit 2, nothing written). A rig of three heads before one
 // collimator array (the `unit` column) recovers every head's interior, the shared rotation and the
-// mounts within 3 sigma, and writes the rig file again.
+// mounts within 3 sigma, writes the rig file again, and gives a budget and certificate per head. A
+// 2 x 3-CCD camera's sub-images (the `unit` column naming them) are calibrated in one adjustment
+// with a gauge from the rank of the normal matrix, a budget with every mapping entry's U, groups,
+// the certificate, and the camera file written again.
 #include "calib/camera/camera.h"
+#include "calib/camera/camera_io.h"
 #include "calib/camera/rig_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/string_printf.h"
@@ -22,6 +26,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <map>
 #include <random>
 #include <string>
 
@@ -448,12 +453,191 @@ TEST(CalibrateDirections, RigHeadsInOneAdjustmentRecoverInteriorsAndMountsWithin
   }
   // The shared rotation (the reference head's) within 3 sigma.
   ExpectRotationWithinThreeSigma(cal["method"]);
-  // A multi-unit certificate is not built: refused by name, nothing written.
+  // The budget per head: every head's interior as "HEAD.name", the mounts after the first head;
+  // the certificate lists them with U (k = 2) and names the units and the method.
+  std::map<std::string, nlohmann::json> budget;
+  for (const auto& q : cal["uncertainty"]) budget[q["quantity"].get<std::string>()] = q;
+  for (const char* name : {"A.c", "B.c", "C.c", "B.x0", "C.K1", "B.mount_phi", "C.mount_kappa"})
+    ASSERT_TRUE(budget.count(name)) << name;
+  EXPECT_FALSE(budget.count("A.mount_phi"));  // the first head is the mounts' reference
+  EXPECT_NEAR(budget["B.c"]["components"][0]["u"].get<double>(),
+              j["cameras"][1]["sigma"]["c"].get<double>(),
+              1e-12);
+  EXPECT_NEAR(budget["B.mount_phi"]["u_c"].get<double>() * 3600.0,
+              cal["units"][1]["mount_sigma_arcsec"][1].get<double>(),
+              1e-9);
+  EXPECT_EQ(budget["C.c"]["statement"].get<std::string>().rfind("C.c = ", 0), 0u);
   const auto c = RunAerocal("certificate --result " + tmp.File("result.json") + " --out " +
                             tmp.File("cert") + " --no-render");
-  EXPECT_EQ(c.exit_code, 2) << c.output;
-  EXPECT_NE(c.output.find("a calibration of 3 units (A, B, C)"), std::string::npos) << c.output;
-  EXPECT_FALSE(std::filesystem::exists(tmp.File("cert/certificate.json")));
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  const nlohmann::json cert = ReadJson(tmp.File("cert/certificate.json"));
+  EXPECT_EQ(cert["method"]["kind"], "collimator array");
+  EXPECT_EQ(cert["units"].size(), 3u);
+  EXPECT_EQ(cert["results"].size(), cal["uncertainty"].size());
+  EXPECT_NE(c.output.find("B.c = "), std::string::npos) << c.output;
+}
+
+// A 2 x 3-CCD camera (tests/support/simulated_directions.h: six 2100 x 2100 px CCDs on a
+// 6000 x 4000 px virtual image by affine mappings) before a collimator array of 25 x 17
+// directions, every cross measured in the CCDs it falls on; the camera file holds the nominal
+// mappings (the true ones differ by up to 2 px and 3e-4 rad, CCD A's not at all).
+std::string MultiCcdYaml() {
+  std::string yaml = std::string(kCameraYaml) + "subimages:\n";
+  for (int k = 0; k < 6; ++k) {
+    const calib::SubimageMapping m = testing::MultiCcdMapping(k);
+    yaml += StringPrintf(
+        "  - {id: %s, format_px: [2100, 2100], model: affine, params: [%.17g, "
+        "%.17g, %.17g, %.17g, %.17g, %.17g]}\n",
+        m.id.c_str(),
+        m.params[0],
+        m.params[1],
+        m.params[2],
+        m.params[3],
+        m.params[4],
+        m.params[5]);
+  }
+  return yaml;
+}
+
+calib::Camera MultiCcdTruth() {
+  calib::Camera camera = Truth();
+  camera.subimages = testing::TrueMultiCcdMappings();
+  return camera;
+}
+
+// The rows (target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,unit[,group]).
+std::string MultiCcdRows(std::mt19937_64* rng, const std::string& group) {
+  std::string rows;
+  for (int i = 0; i < 25; ++i)
+    for (int j = 0; j < 17; ++j) {
+      const double a = -19.0 + 1.55 * i, e = -13.0 + 1.6 * j;
+      const Eigen::Vector3d t = AngularError(rng) * Direction(a * kDeg, e * kDeg);
+      for (const auto& [sub, uv] :
+           testing::ObserveInSubimages(MultiCcdTruth(), kTrueOpk, t, kSigmaPx, rng))
+        rows += StringPrintf("C%02d%02d,%.5f,%.5f,%.3f,%.2f,%.2f,%.2f,%s%s\n",
+                             i,
+                             j,
+                             uv.x(),
+                             uv.y(),
+                             kSigmaPx,
+                             a,
+                             e,
+                             kSigmaArcsec,
+                             sub.c_str(),
+                             group.empty() ? "" : ("," + group).c_str());
+    }
+  return rows;
+}
+
+TEST(CalibrateDirections, MultiCcdSubImagesInOneAdjustmentWithGaugeBudgetAndCertificate) {
+  TempDir tmp("aerocal_directions_multi_ccd");
+  std::mt19937_64 rng(3615);
+  WriteText(tmp.File("camera.yaml"), MultiCcdYaml());
+  WriteText(tmp.File("directions.csv"), kRigHeader + MultiCcdRows(&rng, ""));
+  const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
+                            tmp.File("directions.csv") + " --out " + tmp.File("result.json") +
+                            " --write-camera " + tmp.File("calibrated.yaml"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const nlohmann::json j = ReadJson(tmp.File("result.json"));
+  ExpectWithinThreeSigma(j);
+  const auto& cal = j["calibration"];
+  ExpectRotationWithinThreeSigma(cal["method"]);
+  EXPECT_EQ(cal["method"]["kind"], "collimator array");
+  EXPECT_EQ(cal["camera"]["kind"], "multi-CCD");
+  // The gauge: the rank defect of the normal matrix with every mapping free is 6 (an affine map
+  // of the virtual plane; B1, B2 held by the default self-calibration: then it is 4), the
+  // reference's entries that span it held, full rank with them.
+  const auto& gauge = cal["gauge"];
+  EXPECT_EQ(gauge["reference"], "A");
+  EXPECT_TRUE(gauge["ok"].get<bool>());
+  EXPECT_EQ(gauge["rank_defect_with_gauge"], 0);
+  EXPECT_EQ(gauge["held"].size(), gauge["rank_defect"].get<size_t>());
+  // Every estimated mapping entry within 3 sigma of the truth, with its U in the budget.
+  std::map<std::string, nlohmann::json> budget;
+  for (const auto& q : cal["uncertainty"]) budget[q["quantity"].get<std::string>()] = q;
+  const calib::Camera truth = MultiCcdTruth();
+  ASSERT_EQ(cal["subimages"].size(), 6u);
+  for (const auto& s : cal["subimages"]) {
+    const calib::SubimageMapping& m = truth.subimages[truth.SubimageIndex(s["id"])];
+    for (size_t e = 0; e < 6; ++e) {
+      if (s["sigma"][e].is_null()) {
+        EXPECT_EQ(s["id"], "A");
+        continue;
+      }
+      const double error = s["params"][e].get<double>() - m.params[e];
+      EXPECT_LE(std::abs(error), 3.0 * s["sigma"][e].get<double>()) << s["id"] << " " << e;
+      const std::string name =
+          s["id"].get<std::string>() + "." + s["param_names"][e].get<std::string>();
+      ASSERT_TRUE(budget.count(name)) << name;
+      EXPECT_NEAR(budget[name]["U"].get<double>(),
+                  budget[name]["k"].get<double>() * s["sigma"][e].get<double>(),
+                  1e-12);
+    }
+  }
+  EXPECT_TRUE(budget.count("c"));
+  EXPECT_TRUE(budget.count("B.a0"));
+  // --write-camera: the camera file's own format, read back with the estimated mappings.
+  const calib::Camera written = calib::ReadCamera(tmp.File("calibrated.yaml"));
+  ASSERT_EQ(written.subimages.size(), 6u);
+  EXPECT_NEAR(written.interior[0], j["cameras"][0]["estimated"]["c"].get<double>(), 1e-12);
+  for (const auto& s : cal["subimages"])
+    for (size_t e = 0; e < 6; ++e)
+      EXPECT_NEAR(written.subimages[written.SubimageIndex(s["id"])].params[e],
+                  s["params"][e].get<double>(),
+                  1e-9);
+  // The certificate: the method, the virtual camera's budget and every sub-image's mapping with U.
+  const auto c = RunAerocal("certificate --result " + tmp.File("result.json") + " --out " +
+                            tmp.File("cert") + " --no-render");
+  ASSERT_EQ(c.exit_code, 0) << c.output;
+  const nlohmann::json cert = ReadJson(tmp.File("cert/certificate.json"));
+  EXPECT_EQ(cert["method"]["kind"], "collimator array");
+  EXPECT_EQ(cert["units"].size(), 6u);
+  EXPECT_EQ(cert["results"].size(), cal["uncertainty"].size());
+  EXPECT_NE(c.output.find("B.a0 = "), std::string::npos) << c.output;
+}
+
+TEST(CalibrateDirections, MultiCcdTwoSeriesAsGroupsAndBadSubimageRows) {
+  TempDir tmp("aerocal_directions_multi_ccd_groups");
+  std::mt19937_64 rng(3616);
+  WriteText(tmp.File("camera.yaml"), MultiCcdYaml());
+  const std::string header =
+      "target,col,row,sigma_px,azimuth_deg,elevation_deg,sigma_arcsec,unit,group\n";
+  WriteText(tmp.File("directions.csv"),
+            header + MultiCcdRows(&rng, "monday") + MultiCcdRows(&rng, "tuesday"));
+  const auto r = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
+                            tmp.File("directions.csv") + " --out " + tmp.File("result.json"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  const auto cal = ReadJson(tmp.File("result.json"))["calibration"];
+  EXPECT_EQ(cal["groups"].size(), 2u);
+  EXPECT_EQ(cal["stability"]["rows"].size(), 8u);  // the virtual camera's free interior
+  EXPECT_TRUE(cal["stability"]["agree"].get<bool>());
+
+  // Bad rows name FILE:LINE, bad options their name; nothing is written.
+  const std::string head = kRigHeader + std::string("X1,1000,1000,0.05,0,0,0.5,A\n");
+  struct Case {
+    std::string text, extra, message;
+  };
+  const Case cases[] = {
+      {head + "X2,1000,1000,0.05,1,0,0.5,Q\n", "", "bad.csv:3: unit Q is not a unit of"},
+      {head + "X2,1000,2500,0.05,1,0,0.5,B\n", "", "bad.csv:3: column 'row' out of range"},
+      {head + "X2,1000,1000,0.05,1,0,0.5,\n", "", "bad.csv:3: unit must not be empty"},
+      {kRigHeader + std::string("X1,1000,1000,0.05,0,0,0.5,A\nX2,1000,1500,0.05,0,2,0.5,A\n"),
+       "",
+       "bad.csv:2: sub-image A: 2 directions (4 scalar) cannot determine its 6"},
+      {head, "--model opencv", "--model"},
+      {head, "--camera-format opencv", "--camera-format"},
+  };
+  for (const Case& k : cases) {
+    SCOPED_TRACE(k.message);
+    WriteText(tmp.File("bad.csv"), k.text);
+    const auto b = RunAerocal("calibrate --camera " + tmp.File("camera.yaml") + " --directions " +
+                              tmp.File("bad.csv") + " --out " + tmp.File("bad.json") +
+                              " --write-camera " + tmp.File("bad.yaml") + " " + k.extra);
+    EXPECT_EQ(b.exit_code, 2) << b.output;
+    EXPECT_NE(b.output.find(k.message), std::string::npos) << b.output;
+    EXPECT_FALSE(std::filesystem::exists(tmp.File("bad.json")));
+    EXPECT_FALSE(std::filesystem::exists(tmp.File("bad.yaml")));
+  }
 }
 
 TEST(CalibrateDirections, BadUnitsNameTheirLineAndNothingIsWritten) {
@@ -481,6 +665,9 @@ TEST(CalibrateDirections, BadUnitsNameTheirLineAndNothingIsWritten) {
       {"camera.yaml",
        "target,col,row,azimuth_deg,elevation_deg,unit\nA,3000,2000,0,0,\nB,4000,2000,6.8,0,A\n",
        "directions.csv:3: unit A: the camera file is one camera"},
+      {"rig.yaml",
+       "target,col,row,azimuth_deg,elevation_deg,unit,group\nA,3000,2000,0,0,A,g1\n",
+       "directions.csv:1: group: the groups' stability test of a rig's heads is not built"},
   };
   for (const Case& c : cases) {
     SCOPED_TRACE(c.message);

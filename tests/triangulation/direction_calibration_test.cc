@@ -6,13 +6,17 @@
 #include "triangulation/calibration/direction_calibration.h"
 
 #include "calib/camera/brown_fraser10.h"
+#include "calib/camera/camera_io.h"
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "tests/support/simulated_directions.h"
+#include "triangulation/calibration/direction_subimages.h"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
+#include <filesystem>
 #include <random>
 
 namespace aerocal::triangulation {
@@ -403,6 +407,128 @@ TEST(DirectionCalibration, MultiCcdSubImagesInOneGoniometerAdjustment) {
   const Eigen::Vector2d sigma = r.target_sigma_rad.at("cross");
   EXPECT_LE(std::abs(error.x()), 3.0 * sigma.x());
   EXPECT_LE(std::abs(error.y()), 3.0 * sigma.y());
+}
+
+// A 2 x 3-CCD camera (issue 36 item 6): one lens (the virtual camera of Truth(): 6000 x 4000 px of
+// 6 um, c = 50 mm, the 10-parameter distortion), six CCDs of 2100 x 2100 px, each on the virtual
+// image by an affine mapping (truth: the nominal layout turned by up to 3e-4 rad, scaled by up
+// to 2e-4, sheared, shifted by up to 2 px), CCD "A" the reference (its mapping the nominal one,
+// which the gauge holds). A collimator array of 25 x 17 directions (0.5 arc second each), each
+// cross measured in every CCD it falls on (0.05 px).
+struct MultiCcdScene {
+  calib::Camera truth,
+      start;  // truth: estimated values; start: the nominal mappings, no distortion
+  std::vector<DirectionTarget> targets;
+  std::vector<DirectionObservation> observations;
+  std::vector<std::string> subimage_of;
+};
+
+MultiCcdScene SimulateMultiCcd(std::mt19937_64* rng) {
+  MultiCcdScene s{Truth(), Nominal(), {}, {}, {}};
+  s.truth.subimages = testing::TrueMultiCcdMappings();
+  for (int k = 0; k < 6; ++k) s.start.subimages.push_back(testing::MultiCcdMapping(k));
+  for (int i = 0; i < 25; ++i)
+    for (int j = 0; j < 17; ++j) {
+      const Eigen::Vector2d angles = Eigen::Vector2d(-19.0 + 1.55 * i, -13.0 + 1.6 * j) * kDeg;
+      const std::string id = "c" + std::to_string(i) + "_" + std::to_string(j);
+      s.targets.push_back({id, angles, true});
+      const Eigen::Vector3d t = AngularError(rng) * Direction(angles.x(), angles.y());
+      for (const auto& [sub, uv] :
+           testing::ObserveInSubimages(s.truth, kTrueOpk, t, kSigmaPx, rng)) {
+        s.observations.push_back(
+            {id, "", Eigen::Matrix3d::Identity(), uv, kSigmaPx, kSigmaRad, ""});
+        s.subimage_of.push_back(sub);
+      }
+    }
+  return s;
+}
+
+SubimageDirectionsCalibration CalibrateScene(const MultiCcdScene& s,
+                                             const DirectionCalibrationOptions& options = {}) {
+  const Eigen::Vector3d start_opk = StartRotationFromDirections(
+      s.start, s.targets, VirtualObservations(s.start, s.observations, s.subimage_of));
+  return CalibrateSubimagesFromDirections(
+      s.start, start_opk, s.targets, s.observations, s.subimage_of, "", options);
+}
+
+TEST(DirectionCalibration, MultiCcdCameraSubImagesRecoverInteriorAndMappingsWithinThreeSigma) {
+  std::mt19937_64 rng(3605);
+  const MultiCcdScene s = SimulateMultiCcd(&rng);
+  const SubimageDirectionsCalibration r = CalibrateScene(s);
+  const DirectionCalibration& f = r.frame;
+  ASSERT_TRUE(r.gauge.ok) << r.gauge.message;
+  EXPECT_EQ(r.gauge.reference, "A");
+  ASSERT_EQ(r.subimages.size(), 6u);
+  // Unknowns: 10 interior + 3 rotation + 5 x 6 mapping entries (the reference's held).
+  EXPECT_EQ(f.report.redundancy, static_cast<int>(2 * s.observations.size()) - 43);
+  ExpectWithinThreeSigma(f, s.truth);
+  for (size_t k = 0; k < r.subimages.size(); ++k) {
+    const SubimageDirectionMapping& m = r.subimages[k];
+    const calib::SubimageMapping& truth = s.truth.subimages[s.truth.SubimageIndex(m.id)];
+    std::printf("CCD %s: %d directions\n", m.id.c_str(), m.observations);
+    EXPECT_GE(m.observations, 40) << m.id;
+    for (size_t e = 0; e < truth.params.size(); ++e) {
+      const double error = m.mapping.params[e] - truth.params[e];
+      if (k == 0) {  // the reference: held at the camera file's (= the true) values
+        EXPECT_TRUE(m.held[e]);
+        EXPECT_FALSE(m.sigma[e].has_value());
+        EXPECT_DOUBLE_EQ(m.mapping.params[e], truth.params[e]);
+        continue;
+      }
+      ASSERT_TRUE(m.sigma[e].has_value()) << m.id << " " << e;
+      std::printf("  %zu error %+.3e sigma %.3e\n", e, error, *m.sigma[e]);
+      EXPECT_LE(std::abs(error), 3.0 * *m.sigma[e]) << m.id << " " << e;
+    }
+  }
+  // The camera file's own format: written and read back with the estimated mappings.
+  const std::string path =
+      (std::filesystem::temp_directory_path() / "aerocal_multi_ccd_directions.yaml").string();
+  calib::WriteCamera(path, f.camera);
+  const calib::Camera back = calib::ReadCamera(path, calib::CameraModels::kAny);
+  std::filesystem::remove(path);
+  ASSERT_EQ(back.subimages.size(), 6u);
+  for (int i = 0; i < 10; ++i) EXPECT_NEAR(back.interior[i], f.camera.interior[i], 1e-12);
+  for (size_t k = 0; k < 6; ++k)
+    for (size_t e = 0; e < 6; ++e)
+      EXPECT_NEAR(back.subimages[k].params[e], f.camera.subimages[k].params[e], 1e-9);
+}
+
+// The datum is derived from the rank of the normal matrix: with every mapping free the design's
+// normal matrix (distortion-free, exact observations) has a rank defect of 6 with all 10 interior
+// terms free (an affine map of the whole virtual plane), of 4 with B1, B2 held (a similarity);
+// holding the reference entries that span it leaves full rank (no eigenvalue below the
+// threshold).
+TEST(DirectionCalibration, MultiCcdGaugeFromTheRankOfTheNormalMatrix) {
+  std::mt19937_64 rng(3606);
+  const MultiCcdScene s = SimulateMultiCcd(&rng);
+  DirectionCalibrationOptions no_affinity;
+  no_affinity.free_interior = {"c", "x0", "y0", "K1", "K2", "K3", "P1", "P2"};
+  for (const auto& [options, defect] :
+       {std::make_pair(DirectionCalibrationOptions{}, 6), std::make_pair(no_affinity, 4)}) {
+    const SubimageDirectionsCalibration r = CalibrateScene(s, options);
+    const SubimageDirectionGauge& g = r.gauge;
+    std::printf("free %zu: rank defect %d without the gauge, %d with; held:",
+                options.free_interior.size(),
+                g.rank_defect,
+                g.rank_defect_with_gauge);
+    for (const auto& h : g.held) std::printf(" %s", h.c_str());
+    std::printf("\n  smallest relative eigenvalues without:");
+    for (double e : g.smallest_relative_eigenvalues) std::printf(" %.1e", e);
+    std::printf("\n  with:");
+    for (double e : g.smallest_relative_eigenvalues_with_gauge) std::printf(" %.1e", e);
+    std::printf("\n");
+    ASSERT_TRUE(g.ok) << g.message;
+    EXPECT_EQ(g.rank_defect, defect);
+    EXPECT_EQ(static_cast<int>(g.held.size()), defect);
+    EXPECT_EQ(g.rank_defect_with_gauge, 0);
+    ASSERT_FALSE(g.smallest_relative_eigenvalues_with_gauge.empty());
+    EXPECT_GT(g.smallest_relative_eigenvalues_with_gauge.front(), g.threshold);
+    ASSERT_GT(g.smallest_relative_eigenvalues.size(), static_cast<size_t>(defect));
+    EXPECT_LT(g.smallest_relative_eigenvalues[defect - 1], g.threshold);
+    EXPECT_TRUE(r.frame.report.converged);
+    EXPECT_TRUE(r.frame.covariance_ok);
+    EXPECT_TRUE(r.frame.undetermined.empty());
+  }
 }
 
 }  // namespace

@@ -373,9 +373,13 @@ def method_text(m):
         return "in-flight calibration (aerocal flight, %s adjustment) of %s; uncertainty budget: %s" % (
             m.get("adjustment"), m.get("flight_data"), m.get("budget"))
     if m.get("kind") in ("collimator array", "goniometer"):
-        return "%s (laboratory, known directions): %s; %d targets (%d of known direction), %d settings; %s" % (
+        units = ""
+        if m.get("units"):
+            units = "; units %s in one adjustment (each unit's values with U: rows UNIT.quantity)" % (
+                ", ".join(m["units"]))
+        return "%s (laboratory, known directions): %s; %d targets (%d of known direction), %d settings; %s%s" % (
             m["kind"], m.get("directions"), m.get("targets", 0), m.get("known_targets", 0), m.get("settings", 0),
-            m.get("adjustment", ""))
+            m.get("adjustment", ""), units)
     if m.get("kind") == "planar target":
         return "planar %s %dx%d, spacing %s mm, %s; %d of %d images detected" % (
             m["board"], m["columns"], m["rows"], fmt(m["spacing_mm"]), m["detector"], len(m["detected"]),

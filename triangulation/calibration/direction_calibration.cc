@@ -3,6 +3,7 @@
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/residuals/direction.h"
+#include "triangulation/calibration/direction_problem.h"
 
 #include <Eigen/Cholesky>
 #include <Eigen/SVD>
@@ -14,65 +15,10 @@
 namespace aerocal::triangulation {
 namespace {
 
-std::string ObservationText(size_t i, const DirectionObservation& o, const std::string& unit) {
-  return (o.where.empty() ? "" : o.where + ": ") + (unit.empty() ? "" : "unit " + unit + ": ") +
-         "direction observation " + std::to_string(i + 1) + " (target " + o.target +
-         (o.setting.empty() ? "" : ", setting " + o.setting) + ")";
-}
-
-// The start camera's ray of a pixel (camera frame; principal point at the format centre, no
-// distortion): a start value only.
-Eigen::Vector3d StartRay(const calib::Camera& start, const Eigen::Vector2d& pixel) {
-  const Eigen::Vector2d xy = start.frame().PhotoFromPixel(pixel);
-  return Eigen::Vector3d(xy.x(), xy.y(), -start.c_mm()).normalized();
-}
-
-// Fixes the interior entries not named in `free` (all of them: the whole block).
-void FixInteriorEntries(const calib::Camera& camera,
-                        const std::vector<std::string>& free,
-                        calib::BlockId block,
-                        calib::ProblemBuilder* builder) {
-  std::vector<bool> is_free(camera.interior.size(), false);
-  for (const auto& name : free) {
-    const int index = camera.ParamIndex(name);
-    if (index < 0)
-      throw InputError("free_interior: '" + name + "' is not a parameter of the camera's model");
-    is_free[index] = true;
-  }
-  std::vector<int> fixed;
-  for (int i = 0; i < camera.interior.size(); ++i)
-    if (!is_free[i]) fixed.push_back(i);
-  if (static_cast<int>(fixed.size()) == camera.interior.size())
-    builder->FixBlock(block);
-  else if (!fixed.empty())
-    builder->FixEntries(block, fixed);
-}
-
-// The targets' blocks (a known target's fixed); the unknown ones join `covariance_blocks`.
-// Returns the method: "collimator array" when every target is known, else "goniometer".
-std::string AddTargetBlocks(const std::vector<DirectionTarget>& targets,
-                            calib::ProblemBuilder* builder,
-                            std::deque<Eigen::Vector2d>* angles,
-                            std::map<std::string, calib::BlockId>* target_block,
-                            std::vector<calib::BlockId>* covariance_blocks) {
-  bool all_known = true;
-  for (const auto& t : targets) {
-    if (target_block->count(t.id)) throw InputError("direction target " + t.id + ": given twice");
-    angles->push_back(t.angles_rad);
-    const calib::BlockId id = builder->AddBlock("target " + t.id,
-                                                angles->back().data(),
-                                                2,
-                                                calib::BlockKind::kOther,
-                                                {"azimuth", "elevation"});
-    if (t.known)
-      builder->FixBlock(id);
-    else
-      covariance_blocks->push_back(id);
-    all_known = all_known && t.known;
-    (*target_block)[t.id] = id;
-  }
-  return all_known ? "collimator array" : "goniometer";
-}
+using internal::AddTargetBlocks;
+using internal::DirectionObservationText;
+using internal::DirectionStartRay;
+using internal::FixInteriorEntries;
 
 // One unit's blocks and residuals in the problem.
 struct UnitProblem {
@@ -117,18 +63,15 @@ void AddUnitResiduals(const DirectionUnit& unit,
     const DirectionObservation& o = unit.observations[i];
     const auto it = target_block.find(o.target);
     if (it == target_block.end())
-      throw InputError(ObservationText(i, o, unit_name) + ": no such target");
-    if (!(o.sigma_px > 0.0) || !(o.sigma_rad >= 0.0))
-      throw InputError(ObservationText(i, o, unit_name) +
-                       ": sigma_px must be > 0 and sigma_rad >= 0");
-    const Eigen::Matrix2d covariance = calib::DirectionCovarianceMm2(
-        frame.PhotoFromPixel(o.pixel), c_mm, o.sigma_px, frame.pixel_size_mm, o.sigma_rad);
+      throw InputError(DirectionObservationText(i, o, unit_name) + ": no such target");
+    const Eigen::Matrix2d covariance = internal::DirectionObservationCovariance(
+        i, o, unit_name, frame.PhotoFromPixel(o.pixel), c_mm, frame.pixel_size_mm);
     p->ids.push_back(builder->AddResidual(
         kGroupDirection,
         calib::MakeDirectionResidual(
             unit.start.model, frame, o.instrument_rotation, o.pixel, covariance),
         {p->interior, p->rotation, it->second},
-        ObservationText(i, o, unit_name)));
+        DirectionObservationText(i, o, unit_name)));
     p->factors.push_back(covariance.llt().matrixL());
     out->apriori_sigma_px.push_back(std::sqrt(0.5 * covariance.trace()) / frame.pixel_size_mm);
   }
@@ -264,7 +207,7 @@ Eigen::Vector3d StartRotationFromDirections(const calib::Camera& start,
     if (it == known.end()) continue;
     Eigen::Vector3d t;
     calib::DirectionFromAngles(it->second->angles_rad.data(), t.data());
-    b += (o.instrument_rotation.transpose() * t) * StartRay(start, o.pixel).transpose();
+    b += (o.instrument_rotation.transpose() * t) * DirectionStartRay(start, o.pixel).transpose();
     used.insert(o.target);
   }
   if (used.size() < 2) return Eigen::Vector3d::Zero();
@@ -285,7 +228,7 @@ void StartUnknownTargets(const calib::Camera& start,
                                 observations.end(),
                                 [&](const DirectionObservation& x) { return x.target == t.id; });
     if (o == observations.end()) continue;
-    const Eigen::Vector3d d = o->instrument_rotation * r * StartRay(start, o->pixel);
+    const Eigen::Vector3d d = o->instrument_rotation * r * DirectionStartRay(start, o->pixel);
     t.angles_rad =
         Eigen::Vector2d(std::atan2(d.x(), -d.z()), std::asin(std::clamp(d.y(), -1.0, 1.0)));
   }

@@ -151,8 +151,8 @@ DirectionData ReadDirections(const std::string& path,
     if (!unit.empty())
       ThrowInputError(t.Where(row),
                       "unit " + unit +
-                          ": the camera file is one camera; a unit names a head of a rig file "
-                          "(--camera)");
+                          ": the camera file is one camera; a unit names a head of a rig file or a "
+                          "sub-image of a multi-CCD camera file (--camera)");
     return camera;
   };
   return ReadRows(table, path, one_camera, default_sigma_px);

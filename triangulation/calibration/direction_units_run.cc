@@ -121,7 +121,7 @@ DirectionUnitsRun RunDirectionUnitsCalibration(
     StartUnknownTargets(u->start, u->start_opk_rad, u->observations, &targets);
   for (const auto& u : units) CheckDirectionsInFront(u.start_opk_rad, targets, u.observations);
   out.calibration = CalibrateUnitsFromDirections(units, targets, options.calibration);
-  std::vector<CalibrationAdjustment> adjustments;
+  std::vector<CalibrationAdjustment>& adjustments = out.adjustments;
   for (size_t k = 0; k < units.size(); ++k) {
     out.ids.push_back(units[k].id);
     out.start_opk_rad.push_back(units[k].start_opk_rad);

@@ -8,7 +8,7 @@
 // instrument by Wahba's problem on them (StartRotationFromDirections); any other unit (a
 // goniometer's) from the first unit's start and the design mounts of the file,
 // R_k = R_1 M_1^T M_k (M = rig_from_unit). Unknown targets start from the first unit that sees
-// them. No groups: the stability test of a multi-unit run is not built.
+// them. No groups here: the command refuses them for a rig (tools/calibrate_direction_units.h).
 #pragma once
 
 #include "triangulation/calibration/direction_run.h"
@@ -32,6 +32,9 @@ struct DirectionUnitsRun {
   std::vector<std::string> start_rotation;     // per unit: how it was started
   std::vector<int> observations;               // per unit
   AdjustmentResult all;  // every unit's camera estimate and residuals (image "UNIT[ SETTING]")
+  /// Per unit: its calibration adjustment (AdjustmentOfDirections: camera estimate, interior
+  /// covariance from the joint solve, residuals, validity), for a budget per unit.
+  std::vector<CalibrationAdjustment> adjustments;
 };
 
 /// Calibrates the `units` that have observations (`unit_of_observation` names each observation's

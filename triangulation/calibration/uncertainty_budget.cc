@@ -480,6 +480,26 @@ BudgetQuantity InteriorParameterBudget(const AdjustedInterior& interior,
   return q;
 }
 
+BudgetQuantity AdjustedQuantityBudget(const std::string& name,
+                                      const std::string& unit,
+                                      const std::string& description,
+                                      double value,
+                                      double sigma,
+                                      double redundancy,
+                                      const std::string& origin) {
+  BudgetQuantity q;
+  q.name = name;
+  q.unit = unit;
+  q.description = description;
+  q.value = value;
+  UncertaintyComponent c =
+      Component("image measurements", "A", sigma, std::max(1.0, redundancy), unit);
+  c.origin = origin;
+  q.components.push_back(c);
+  Finish(&q);
+  return q;
+}
+
 std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
                                               const Project& project,
                                               const BudgetOptions& options) {

@@ -144,6 +144,18 @@ BudgetQuantity InteriorParameterBudget(const AdjustedInterior& interior,
                                        int index,
                                        const std::string& description);
 
+/// The budget of an adjusted quantity that is not an interior parameter (a sub-image's mapping
+/// entry, a rig head's mount angle): one type-A component "image measurements", its a-posteriori
+/// sigma (sigma0^2 Q, the adjustment's covariance: the directions' angular sigmas are part of the
+/// observations' weights) with nu = `redundancy`; combined (k, U, statement) as every quantity.
+BudgetQuantity AdjustedQuantityBudget(const std::string& name,
+                                      const std::string& unit,
+                                      const std::string& description,
+                                      double value,
+                                      double sigma,
+                                      double redundancy,
+                                      const std::string& origin);
+
 /// k for the effective degrees of freedom (see the header comment).
 double CoverageFactor(double dof_eff);
 /// "c = 7.4570 mm, U = 0.0021 mm (k = 2)": U to two significant digits, the value to its decimals.
