@@ -561,7 +561,7 @@ CommandRun Setup(CLI::App& app) {
                 mtf->mapping,
                 "--targets with --sub-image: the stitch result (or a flight result, its stitching) "
                 "whose sub-image mappings carry each edge from the virtual image into the raw "
-                "sub-image");
+                "sub-image (default: the --camera file's own mappings)");
   m->add_option("--frame",
                 mtf->frame,
                 "--mapping: the mappings of this frame (exposure) of the stitch result (default: "
