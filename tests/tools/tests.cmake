@@ -44,6 +44,5 @@ target_sources(test_tools_cli_batch PRIVATE ${PROJECT_SOURCE_DIR}/tools/observat
 # reason without slurm-wlm and munge (not in tools/setup.sh); label long: it starts daemons.
 aerocal_add_test(tools/cli_batch_slurm LIBS aerocal::calib LABELS long TIMEOUT 900)
 aerocal_add_test(tools/cli_vocabulary LABELS cli)
-target_compile_definitions(test_tools_cli_vocabulary PRIVATE AEROCAL_SOURCE_DIR="${PROJECT_SOURCE_DIR}")
 # The numeric options' validators (FiniteRange, SeedCheck) on every kind of value, in process.
 aerocal_add_test(tools/option_ranges LIBS aerocal::calib LABELS unit)
