@@ -1,7 +1,8 @@
 // The slanted-edge MTF on images we did not make: a synthetic
 // edge rendered by another project's generator (point-sampled, Gaussian blur along the rows)
-// against its analytic MTF50, and a real satellite image of the Baotou edge target against the
-// MTF50 that project published for it.
+// against its analytic MTF50, a real satellite image of the Baotou edge target against the
+// MTF50 that project published for it, and the two colour test edges of an sfrmat5 fork against
+// the SFR50 that sfrmat5 (the ISO 12233 reference implementation) printed for them.
 #include "stitch/image_io/image_io.h"
 #include "stitch/quality/slanted_edge.h"
 
@@ -84,6 +85,35 @@ TEST(SlantedEdgeReal, BaotouSatelliteEdgeAgreesWithThePublishedMtf50) {
   // e-SFR here) and no accuracy is published, so this is an agreement check, not a calibration:
   // measured -2.7 %, outside our own U (k = 2) of 2 %.
   EXPECT_NEAR(along_rows / kPublished, 1.0, 0.05);
+}
+
+// tests/data/sfrmat5_edges (MIT; PROVENANCE.md there): one edge, horizontal and turned upright,
+// with the SFR50 that repository's sfrmat5 printed for the whole image (its test_results/*.png):
+// 0.202 and 0.203 cycles/px at 95.4 and 5.38 deg. Published to three decimals with no stated
+// uncertainty; sfrmat5 weights the colour channels 0.213/0.715/0.072, OpenCV's grey conversion here
+// 0.299/0.587/0.114 (the channels differ by up to 6 DN). The bound: our U (k = 2) combined with the
+// half unit of the published last digit.
+TEST(SlantedEdgeReal, Sfrmat5TestEdgesAgreeWithTheirPublishedSfr50) {
+  const std::string dir = std::string(AEROCAL_TEST_DATA_DIR) + "/sfrmat5_edges/";
+  struct Case {
+    const char* file;
+    PixelRegion whole;
+    double published_sfr50, published_slant_deg;
+  };
+  for (const Case& c : {Case{"h_edge.tif", {0, 0, 300, 125}, 0.202, 5.4},
+                        Case{"v_edge.tif", {0, 0, 125, 300}, 0.203, 5.38}}) {
+    SCOPED_TRACE(c.file);
+    const SlantedEdgeResult r = MeasureSlantedEdge(ReadGrayImage(dir + c.file), c.whole);
+    std::printf("sfrmat5 edge %s: slant %.3f deg, MTF50 %.4f +- %.4f (k = 2), sfrmat5 %.3f\n",
+                c.file,
+                std::abs(r.angle_deg),
+                r.mtf50_cy_px,
+                r.mtf50_expanded_cy_px,
+                c.published_sfr50);
+    EXPECT_NEAR(std::abs(r.angle_deg), c.published_slant_deg, 0.05);
+    EXPECT_LE(std::abs(r.mtf50_cy_px - c.published_sfr50),
+              std::hypot(r.mtf50_expanded_cy_px, 0.0005));
+  }
 }
 
 }  // namespace
