@@ -104,6 +104,7 @@ void ResampleRow(const std::vector<Window>& windows,
                  ColumnSpan columns,
                  double V,
                  T* out_row,
+                 std::uint8_t* coverage_row,
                  std::vector<float>* sum,
                  long* covered,
                  long* overlap) {
@@ -129,6 +130,8 @@ void ResampleRow(const std::vector<Window>& windows,
     int n = 0, only = -1;
     for (size_t k = 0; k < windows.size(); ++k)
       if (seen[k] && maps[k].first <= s && maps[k].last >= e - 1) ++n, only = static_cast<int>(k);
+    if (coverage_row)  // the rule of the values: covered where a sub-image is sampled
+      std::fill(coverage_row + (s - begin), coverage_row + (e - begin), n > 0 ? 255 : 0);
     if (n == 0) {
       std::fill(out(s), out(e), fill);
       continue;
@@ -168,6 +171,7 @@ void ResampleStripFast(const std::vector<Window>& windows,
                        int y0,
                        int rows,
                        std::uint8_t* strip,
+                       std::uint8_t* coverage,
                        std::atomic<long>* covered,
                        std::atomic<long>* overlap) {
   AEROCAL_CHECK(windows.size() <= static_cast<size_t>(kMaxWindows))
@@ -177,9 +181,17 @@ void ResampleStripFast(const std::vector<Window>& windows,
     std::vector<float> sum(width);
     long n_covered = 0, n_overlap = 0;
     for (int r = range.begin(); r < range.end(); ++r) {
-      T* out = reinterpret_cast<T*>(strip) + static_cast<size_t>(r) * columns.Count();
-      ResampleRow<T>(
-          windows, fill_value, width, columns, y0 + r, out, &sum, &n_covered, &n_overlap);
+      const size_t at = static_cast<size_t>(r) * columns.Count();
+      ResampleRow<T>(windows,
+                     fill_value,
+                     width,
+                     columns,
+                     y0 + r,
+                     reinterpret_cast<T*>(strip) + at,
+                     coverage ? coverage + at : nullptr,
+                     &sum,
+                     &n_covered,
+                     &n_overlap);
     }
     *covered += n_covered;
     *overlap += n_overlap;
@@ -193,6 +205,7 @@ template void ResampleStripFast<std::uint8_t>(const std::vector<Window>&,
                                               int,
                                               int,
                                               std::uint8_t*,
+                                              std::uint8_t*,
                                               std::atomic<long>*,
                                               std::atomic<long>*);
 template void ResampleStripFast<std::uint16_t>(const std::vector<Window>&,
@@ -201,6 +214,7 @@ template void ResampleStripFast<std::uint16_t>(const std::vector<Window>&,
                                                ColumnSpan,
                                                int,
                                                int,
+                                               std::uint8_t*,
                                                std::uint8_t*,
                                                std::atomic<long>*,
                                                std::atomic<long>*);

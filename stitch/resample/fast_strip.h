@@ -29,7 +29,8 @@ inline constexpr double kChordPx = 1e-5;  // largest position error of the linea
 /// Resamples the columns `columns` of virtual rows [y0, y0 + rows) into `strip` (rows of
 /// columns.Count() samples of T, 8 or 16 bit); `width` is the virtual format's, and each pixel is
 /// the one the whole row gives (the same runs and nodes). `fill` is the value of uncovered pixels,
-/// already in T's range. Adds the covered and overlap pixel counts.
+/// already in T's range. With `coverage` (rows of columns.Count() bytes): 255 where a sub-image
+/// covers the pixel, 0 elsewhere. Adds the covered and overlap pixel counts.
 template <typename T>
 void ResampleStripFast(const std::vector<Window>& windows,
                        float fill,
@@ -38,6 +39,7 @@ void ResampleStripFast(const std::vector<Window>& windows,
                        int y0,
                        int rows,
                        std::uint8_t* strip,
+                       std::uint8_t* coverage,
                        std::atomic<long>* covered,
                        std::atomic<long>* overlap);
 

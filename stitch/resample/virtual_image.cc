@@ -191,6 +191,7 @@ void ResampleStrip(std::vector<Window>& windows,
                    int y0,
                    int rows,
                    std::vector<std::uint8_t>* strip,
+                   std::uint8_t* coverage,
                    std::atomic<long>* covered,
                    std::atomic<long>* overlap) {
   const float max_value = static_cast<float>(std::numeric_limits<T>::max());
@@ -223,6 +224,9 @@ void ResampleStrip(std::vector<Window>& windows,
         n_overlap += n > 1;
         const float scale = n > 0 ? 1.0f / n : 0.0f;
         const int o = (c - columns.first) * kBands;
+        if (coverage)
+          coverage[static_cast<size_t>(r) * columns.Count() + (c - columns.first)] =
+              n > 0 ? 255 : 0;
         for (int b = 0; b < kBands; ++b) {
           const float value = n > 0 ? sum[c * kBands + b] * scale : fill;
           out[o + b] = static_cast<T>(std::clamp(value + 0.5f, 0.0f, max_value));
@@ -263,7 +267,8 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
                                     const std::vector<RasterSource*>& sources,
                                     RasterSink* sink,
                                     const ResampleOptions& options,
-                                    const std::vector<MapCorrectionGrid>& corrections) {
+                                    const std::vector<MapCorrectionGrid>& corrections,
+                                    RasterSink* coverage) {
   const Stopwatch resampling;
   AEROCAL_CHECK(corrections.empty() || corrections.size() == sources.size())
       << corrections.size() << " correction grids for " << sources.size() << " sources";
@@ -311,6 +316,8 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
   const int region_end = region.y0 + region.height;
   const RasterInfo out_info{region.width, region.height, first.bands, first.bits};
   std::vector<std::uint8_t> strip(out_info.RowBytes() * options.strip_rows);
+  std::vector<std::uint8_t> coverage_strip(coverage ? region.width * options.strip_rows : 0);
+  std::uint8_t* const coverage_rows = coverage ? coverage_strip.data() : nullptr;
   std::atomic<long> covered{0}, overlap{0};
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   const int margin = options.interpolation == Interpolation::kBicubic ? 3 : 2;
@@ -383,24 +390,25 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
     arena.execute([&] {
       if (fast && first.bits == 8)
         internal::ResampleStripFast<std::uint8_t>(
-            windows, fill, width, columns, r0, n, strip.data(), &covered, &overlap);
+            windows, fill, width, columns, r0, n, strip.data(), coverage_rows, &covered, &overlap);
       else if (fast)
         internal::ResampleStripFast<std::uint16_t>(
-            windows, fill, width, columns, r0, n, strip.data(), &covered, &overlap);
+            windows, fill, width, columns, r0, n, strip.data(), coverage_rows, &covered, &overlap);
       else if (first.bits == 8 && first.bands == 1)
         ResampleStrip<std::uint8_t, 1>(
-            windows, options, width, columns, r0, n, &strip, &covered, &overlap);
+            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
       else if (first.bits == 8)
         ResampleStrip<std::uint8_t, 3>(
-            windows, options, width, columns, r0, n, &strip, &covered, &overlap);
+            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
       else if (first.bands == 1)
         ResampleStrip<std::uint16_t, 1>(
-            windows, options, width, columns, r0, n, &strip, &covered, &overlap);
+            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
       else
         ResampleStrip<std::uint16_t, 3>(
-            windows, options, width, columns, r0, n, &strip, &covered, &overlap);
+            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
     });
     sink->WriteRows(r0 - region.y0, n, strip.data());
+    if (coverage) coverage->WriteRows(r0 - region.y0, n, coverage_rows);
   }
   ResampleReport report;
   report.covered = covered;

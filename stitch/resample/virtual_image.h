@@ -89,11 +89,14 @@ struct MapCorrectionGrid {
 /// format; all of one bit depth and band count) to `sink`, with the sources' depth and bands.
 /// Throws InputError naming the sub-image when a source's format, depth or bands do not match.
 /// `corrections`: empty, or one per sub-image (a grid with step 0 = none for that sub-image).
+/// `coverage` (optional; one band, 8 bit, the sink's format): 255 where at least one sub-image
+/// covers the pixel (the pixels that get a value, not the fill), 0 elsewhere.
 ResampleReport ResampleVirtualImage(const calib::Camera& camera,
                                     const std::vector<RasterSource*>& sources,
                                     RasterSink* sink,
                                     const ResampleOptions& options,
-                                    const std::vector<MapCorrectionGrid>& corrections = {});
+                                    const std::vector<MapCorrectionGrid>& corrections = {},
+                                    RasterSink* coverage = nullptr);
 
 Interpolation ParseInterpolation(const std::string& name);  // ConfigError when unknown
 

@@ -307,16 +307,9 @@ HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter,
   const std::vector<MapCorrectionGrid> grids = {grid};
   const RasterInfo info = source->Info();
   HeadProjection out{region, MemoryRaster({width, height, 1, info.bits}), {}};
-  ResampleVirtualImage(one, {source}, &out.values, resample, grids);
-  MemoryRaster ones({info.width, info.height, 1, 8});
-  std::fill(ones.bytes().begin(), ones.bytes().end(), 0xFF);
   MemoryRaster covered({width, height, 1, 8});
-  ResampleOptions coverage = resample;
-  coverage.fill = 0.0;
-  ResampleVirtualImage(one, {&ones}, &covered, coverage, grids);
-  out.covered.resize(static_cast<size_t>(width) * height);
-  for (size_t i = 0; i < out.covered.size(); ++i)
-    out.covered[i] = covered.bytes()[i] > 127 ? 255 : 0;
+  ResampleVirtualImage(one, {source}, &out.values, resample, grids, &covered);
+  out.covered = std::move(covered.bytes());
   return out;
 }
 

@@ -75,10 +75,11 @@ struct StitchedImageReport {
 /// One head's pixels resampled alone onto the converter's virtual grid through the `rig convert`
 /// map (plane homography plus `grid`, stitch/rig/rig_convert.h): `values` (virtual format, one
 /// band, the source's depth) and `covered` (row-major virtual format: 255 where the resampler puts
-/// the virtual pixel inside the head's format, 0 elsewhere; its own rule, from a constant image
-/// through the same map). Shared by the stitched image and the tie matching (rig_tie_matching.h).
-/// With `resample.region` set, only that box of the virtual image (values and covered are
-/// region-sized; `region` says which pixels they hold), each pixel equal to the whole format's.
+/// the virtual pixel inside the head's format, 0 elsewhere; its own rule: the coverage output of
+/// the same resampling pass, the set a constant image through the same map covers). Shared by the
+/// stitched image and the tie matching (rig_tie_matching.h). With `resample.region` set, only that
+/// box of the virtual image (values and covered are region-sized; `region` says which pixels they
+/// hold), each pixel equal to the whole format's.
 struct HeadProjection {
   VirtualRegion region;  // the virtual pixels held (the whole format when the request had none)
   MemoryRaster values;

@@ -234,7 +234,9 @@ std::vector<MapCorrectionGrid> SmoothCorrections(const calib::Camera& camera) {
 
 // A region of the virtual image (ResampleOptions::region) holds the whole format's pixels to the
 // last bit, on every path: fast, reference (bilinear and bicubic) and with correction grids; the
-// regions start inside strips (strip_rows 100), end at the format's corner, or are one row.
+// regions start inside strips (strip_rows 100), end at the format's corner, or are one row. The
+// coverage output is 255 exactly where a constant 8-bit image of 255 through the same maps gets
+// a value above the fill 0, and 0 elsewhere.
 TEST(FastResample, ARegionHoldsTheWholeFormatsPixelsBitForBit) {
   const calib::Camera camera = MisplacedCamera();
   std::vector<MemoryRaster> subs = SubImages(camera);
@@ -259,8 +261,29 @@ TEST(FastResample, ARegionHoldsTheWholeFormatsPixelsBitForBit) {
     const std::vector<MapCorrectionGrid> corrections =
         path.corrected ? grids : std::vector<MapCorrectionGrid>{};
     MemoryRaster whole({camera.width_px, camera.height_px, 1, 16});
-    const ResampleReport all = ResampleVirtualImage(camera, sources, &whole, options, corrections);
+    MemoryRaster coverage({camera.width_px, camera.height_px, 1, 8});
+    const ResampleReport all =
+        ResampleVirtualImage(camera, sources, &whole, options, corrections, &coverage);
     EXPECT_GT(all.overlap, 50000) << path.name;
+    std::vector<MemoryRaster> ones;
+    for (const auto& s : camera.subimages) {
+      ones.emplace_back(RasterInfo{s.width_px, s.height_px, 1, 8});
+      std::fill(ones.back().bytes().begin(), ones.back().bytes().end(), 255);
+    }
+    std::vector<RasterSource*> one_sources;
+    for (auto& o : ones) one_sources.push_back(&o);
+    ResampleOptions constant = options;
+    constant.fill = 0;
+    MemoryRaster constant_out({camera.width_px, camera.height_px, 1, 8});
+    ResampleVirtualImage(camera, one_sources, &constant_out, constant, corrections);
+    long wrong = 0, covered = 0;
+    for (size_t i = 0; i < coverage.bytes().size(); ++i) {
+      const std::uint8_t c = coverage.bytes()[i];
+      wrong += (c != 0 && c != 255) || (c == 255) != (constant_out.bytes()[i] > 127);
+      covered += c == 255;
+    }
+    EXPECT_EQ(wrong, 0) << path.name;
+    EXPECT_EQ(covered, all.covered) << path.name;
     for (const VirtualRegion& region : {VirtualRegion{123, 257, 700, 301},
                                         VirtualRegion{1390, 990, 10, 10},
                                         VirtualRegion{0, 999, 1400, 1},
