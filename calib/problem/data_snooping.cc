@@ -1,11 +1,11 @@
 #include "calib/problem/data_snooping.h"
 
 #include "calib/core/error.h"
+#include "calib/core/stopwatch.h"
 
 #include <Eigen/Eigenvalues>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <map>
@@ -108,7 +108,7 @@ class Snooper {
       : b_(builder), o_(options), out_(*out) {}
 
   Test Run(int round) {
-    const auto start = std::chrono::steady_clock::now();
+    const Stopwatch round_time;
     Test t;
     std::vector<ResidualId> ids;
     int components = 0;
@@ -197,8 +197,7 @@ class Snooper {
     }
     for (auto& x : t.observations) x.group_size = static_cast<int>(x.correlated.size());
     out_.cofactor_method = t.method;
-    out_.seconds_testing +=
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    out_.seconds_testing += round_time.Seconds();
     return t;
   }
 

@@ -1,7 +1,8 @@
 #include "calib/problem/levenberg_marquardt.h"
 
+#include "calib/core/stopwatch.h"
+
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace aerocal::calib::internal {
@@ -11,11 +12,6 @@ namespace {
 constexpr double kInitialRadius = 1e4, kMaxRadius = 1e16, kMinRadius = 1e-32;
 constexpr double kMinRelativeDecrease = 1e-3;
 constexpr int kMaxConsecutiveInvalidSteps = 5;
-
-using Clock = std::chrono::steady_clock;
-double Since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
 
 double Norm(const std::vector<double>& x) {
   double s = 0;
@@ -33,9 +29,9 @@ LmSummary MinimizeLevenbergMarquardt(const LmOptions& options,
   std::vector<double> x = ev.Gather(), x_new;
   double cost = 0;
   auto evaluate = [&](const std::vector<double>& at, bool jacobians, double* c) {
-    const auto start = Clock::now();
+    const Stopwatch evaluation;
     const bool ok = ev.Evaluate(at, jacobians, c);
-    summary.evaluation_seconds += Since(start);
+    summary.evaluation_seconds += evaluation.Seconds();
     return ok;
   };
   if (!evaluate(x, true, &cost)) {
@@ -45,9 +41,9 @@ LmSummary MinimizeLevenbergMarquardt(const LmOptions& options,
   summary.initial_cost = cost;
   summary.usable = true;
   auto linear = [&](auto&& f) {
-    const auto start = Clock::now();
+    const Stopwatch solution;
     const auto result = f();
-    summary.linear_solver_seconds += Since(start);
+    summary.linear_solver_seconds += solution.Seconds();
     return result;
   };
   linear([&] {

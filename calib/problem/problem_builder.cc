@@ -3,6 +3,7 @@
 #include "calib/camera/rotation.h"
 #include "calib/core/error.h"
 #include "calib/core/log.h"
+#include "calib/core/stopwatch.h"
 #include "calib/problem/levenberg_marquardt.h"
 #include "calib/problem/normal_equations.h"
 #include "calib/problem/parallel_for.h"
@@ -16,7 +17,6 @@
 #include <ceres/ceres.h>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <limits>
 #include <set>
@@ -33,12 +33,13 @@ struct ProblemBuilder::Block {
   std::vector<bool> entry_fixed;
   int num_residuals = 0;  // residual blocks that use it
   /// The block's manifold (owned by the ceres::Problem), created once per set of free entries
-  /// and rescaled in place on every UpdateManifolds().
-  ScaledSubsetManifold* manifold = nullptr;
+  /// and rescaled in place on every UpdateManifolds() (mutable: set up lazily, see
+  /// ProblemBuilder::SettleManifolds).
+  mutable ScaledSubsetManifold* manifold = nullptr;
   /// A rotation block (AddRotationBlock): a quaternion of 4 entries with 3 tangent (and 3
   /// reported, entry_names: omega, phi, kappa) entries, its manifold ScaledRotationManifold.
   bool rotation = false;
-  ScaledRotationManifold* rotation_manifold = nullptr;
+  mutable ScaledRotationManifold* rotation_manifold = nullptr;
 
   std::vector<int> FreeEntries() const {
     std::vector<int> out;
@@ -236,7 +237,10 @@ const ProblemBuilder::Factorized* ProblemBuilder::Factorize(bool apply_loss,
   return factorized_.get();
 }
 
-ceres::Problem& ProblemBuilder::problem() { return *problem_; }
+ceres::Problem& ProblemBuilder::problem() {
+  SettleManifolds();  // the caller may read the manifolds of entries fixed since the last use
+  return *problem_;
+}
 
 BlockId ProblemBuilder::AddBlock(const std::string& name,
                                  double* values,
@@ -311,8 +315,15 @@ void ProblemBuilder::FixEntries(BlockId id, const std::vector<int>& entries) {
     FixBlock(id);
     return;
   }
-  // In force at once, for a covariance or redundancy numbers before the next Solve().
-  UpdateManifolds();
+  // In force at the next use (Solve, covariance, cofactors, null space, problem()), not here: the
+  // update evaluates the whole problem's Jacobian, and a caller fixing one entry per point (the
+  // rig stitching's tie heights) paid one whole-problem evaluation per point, quadratic in the
+  // points.
+  manifolds_stale_ = true;
+}
+
+void ProblemBuilder::SettleManifolds() const {
+  if (manifolds_stale_) UpdateManifolds();
 }
 
 bool ProblemBuilder::IsBlockFixed(BlockId id) const { return blocks_.at(id).constant; }
@@ -450,14 +461,15 @@ bool ProblemBuilder::RotationManifoldsSet() const {
   return true;
 }
 
-bool ProblemBuilder::UpdateManifolds() {
+bool ProblemBuilder::UpdateManifolds() const {
   // Tangent scaling: unit Jacobian columns at the current values (scaled_subset_manifold.h).
   // One manifold per block: a new one only when its free entries change (Ceres keeps every
   // manifold it was given until the problem dies), otherwise rescaled in place.
   ++structure_version_;  // the scales change the tangent space of a kept factorisation
+  manifolds_stale_ = false;
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   for (BlockId id : free_blocks) {
-    Block& b = blocks_[id];
+    const Block& b = blocks_[id];
     if (b.rotation) {
       if (b.rotation_manifold != nullptr) {
         b.rotation_manifold->SetScales({1.0, 1.0, 1.0});
@@ -487,7 +499,7 @@ bool ProblemBuilder::UpdateManifolds() {
     norm2[crs.cols[k]] += crs.values[k] * crs.values[k];
   int col = 0;
   for (BlockId id : free_blocks) {
-    Block& b = blocks_[id];
+    const Block& b = blocks_[id];
     const size_t n_free = b.TangentEntries().size();
     std::vector<double> scales;
     for (size_t k = 0; k < n_free; ++k, ++col)
@@ -629,7 +641,7 @@ std::string SetLinearSolver(const SolverOptions& options,
 }  // namespace
 
 SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
-  const auto start = std::chrono::steady_clock::now();
+  const Stopwatch solve_time;
   ReleaseFactorized();  // stale after the solve; its memory is the solver's now
   SolveReport report;
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
@@ -656,8 +668,7 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
       options, eliminable_params, other_params, !eliminable.empty(), &ceres_options);
   if (report.diagnostics.empty() &&
       SolveWithAerocal(options, ceres_options.linear_solver_type, free_blocks, &report)) {
-    report.seconds =
-        std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    report.seconds = solve_time.Seconds();
     return report;
   }
   if (ceres_options.linear_solver_type == ceres::DENSE_SCHUR ||
@@ -697,7 +708,7 @@ SolveReport ProblemBuilder::Solve(const SolverOptions& options) {
 
   CopyCeresSummary(summary, &report);
   FinishSolveReport(&report);
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.seconds = solve_time.Seconds();
   return report;
 }
 
@@ -863,6 +874,7 @@ std::unique_ptr<internal::SchurComplement> ProblemBuilder::BuildSchurComplement(
 ObservationCofactors ProblemBuilder::ComputeObservationCofactors(const std::vector<ResidualId>& ids,
                                                                  bool with_clusters,
                                                                  int max_dense_parameters) const {
+  SettleManifolds();
   ObservationCofactors out;
   auto not_computed = [&](const std::string& why) {
     out.ok = false;
@@ -1035,6 +1047,7 @@ Eigen::MatrixXd ProblemBuilder::PlusJacobianOf(BlockId id) const {
 }
 
 NullSpaceReport ProblemBuilder::NullSpace(double relative_threshold, int max_parameters) const {
+  SettleManifolds();
   NullSpaceReport report;
   report.threshold = relative_threshold;
   if (!RotationManifoldsSet()) {  // before the first Solve the rotations have no tangent space
@@ -1107,6 +1120,7 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
     double sigma0,
     double correlation_threshold,
     const std::vector<BlockId>& cross_blocks) const {
+  SettleManifolds();
   CovarianceReport report;
   int total = 0;
   for (BlockId id : blocks) {

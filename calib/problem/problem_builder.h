@@ -236,6 +236,9 @@ class ProblemBuilder {
   void FixBlock(BlockId id);
   void FreeBlock(BlockId id);
   /// Fixes the listed entries (0-based); the others stay free. All entries -> FixBlock.
+  /// In force from the next Solve, EstimateCovariance, ComputeObservationCofactors, NullSpace or
+  /// problem() on, which set up the manifolds of the free entries at the values they find then
+  /// (one evaluation of the problem for any number of FixEntries calls before it).
   void FixEntries(BlockId id, const std::vector<int>& entries);
   bool IsBlockFixed(BlockId id) const;
   int BlockSize(BlockId id) const;
@@ -325,8 +328,12 @@ class ProblemBuilder {
   struct Residual;
   std::vector<BlockId> FreeBlocksInOrder() const;
   /// Subset manifolds of the free entries, columns scaled to unit Jacobian norm at the current
-  /// values; false when the residuals cannot be evaluated there (then the scales are 1).
-  bool UpdateManifolds();
+  /// values; false when the residuals cannot be evaluated there (then the scales are 1). Const:
+  /// the manifolds are derived state (the fixed entries and the Jacobian), set up when used.
+  bool UpdateManifolds() const;
+  /// UpdateManifolds() when entries were fixed since the last update (FixEntries defers it):
+  /// called first by every public function that reads the manifolds.
+  void SettleManifolds() const;
   /// Every free rotation block has its tangent manifold (set up by Solve through
   /// UpdateManifolds): the reduced system's rotation columns exist only then.
   bool RotationManifoldsSet() const;
@@ -382,7 +389,9 @@ class ProblemBuilder {
   int dense_null_space_limit_ = 200;
   /// Bumped by every change of the problem other than parameter values (blocks, residuals,
   /// fixing, manifold scales at each Solve): part of a kept factorisation's state.
-  long long structure_version_ = 0;
+  mutable long long structure_version_ = 0;
+  /// FixEntries changed a block's free entries and UpdateManifolds has not run since.
+  mutable bool manifolds_stale_ = false;
   mutable std::unique_ptr<Factorized> factorized_;
 };
 

@@ -95,28 +95,34 @@ void ForEachRun(const RowMap& map, int s, int e, Fn&& fn) {
 
 constexpr int kMaxWindows = 64;
 
+// One virtual row's columns `columns` into out[0 .. columns.Count()): the maps (runs, nodes) are
+// the whole row's, only the cuts are clipped to the columns, so each pixel is the whole row's.
 template <typename T>
 void ResampleRow(const std::vector<Window>& windows,
                  T fill,
                  int width,
+                 ColumnSpan columns,
                  double V,
-                 T* out,
+                 T* out_row,
+                 std::uint8_t* coverage_row,
                  std::vector<float>* sum,
                  long* covered,
                  long* overlap) {
   RowMap maps[kMaxWindows];
   int cuts[2 * kMaxWindows + 2], n_cuts = 0;
   std::bitset<kMaxWindows> seen;
-  cuts[n_cuts++] = 0;
-  cuts[n_cuts++] = width;
+  const int begin = columns.first, end = columns.last + 1;
+  cuts[n_cuts++] = begin;
+  cuts[n_cuts++] = end;
   for (size_t k = 0; k < windows.size(); ++k) {
     int first = 0, last = -1;
     if (!windows[k].used || !CoveredColumns(windows[k], V, width, &first, &last)) continue;
     maps[k] = MakeRowMap(windows[k], V, first, last);
     seen[k] = true;
-    cuts[n_cuts++] = first;
-    cuts[n_cuts++] = last + 1;
+    cuts[n_cuts++] = std::clamp(first, begin, end);
+    cuts[n_cuts++] = std::clamp(last + 1, begin, end);
   }
+  const auto out = [&](int c) { return out_row + (c - begin); };  // column c's sample
   std::sort(cuts, cuts + n_cuts);
   n_cuts = static_cast<int>(std::unique(cuts, cuts + n_cuts) - cuts);
   for (int i = 0; i + 1 < n_cuts; ++i) {
@@ -124,8 +130,10 @@ void ResampleRow(const std::vector<Window>& windows,
     int n = 0, only = -1;
     for (size_t k = 0; k < windows.size(); ++k)
       if (seen[k] && maps[k].first <= s && maps[k].last >= e - 1) ++n, only = static_cast<int>(k);
+    if (coverage_row)  // the rule of the values: covered where a sub-image is sampled
+      std::fill(coverage_row + (s - begin), coverage_row + (e - begin), n > 0 ? 255 : 0);
     if (n == 0) {
-      std::fill(out + s, out + e, fill);
+      std::fill(out(s), out(e), fill);
       continue;
     }
     *covered += e - s;
@@ -134,7 +142,7 @@ void ResampleRow(const std::vector<Window>& windows,
     };
     if (n == 1) {
       ForEachRun(maps[only], s, e, [&](const FixedRun& run, int c) {
-        SampleRunStore(window_of(only), run, out + c);
+        SampleRunStore(window_of(only), run, out(c));
       });
       continue;
     }
@@ -149,7 +157,7 @@ void ResampleRow(const std::vector<Window>& windows,
     }
     const float scale = 1.0f / n, max_value = std::numeric_limits<T>::max();
     for (int c = s; c < e; ++c)
-      out[c] = static_cast<T>(std::clamp(acc[c] * scale + 0.5f, 0.0f, max_value));
+      *out(c) = static_cast<T>(std::clamp(acc[c] * scale + 0.5f, 0.0f, max_value));
   }
 }
 
@@ -159,9 +167,11 @@ template <typename T>
 void ResampleStripFast(const std::vector<Window>& windows,
                        float fill,
                        int width,
+                       ColumnSpan columns,
                        int y0,
                        int rows,
                        std::uint8_t* strip,
+                       std::uint8_t* coverage,
                        std::atomic<long>* covered,
                        std::atomic<long>* overlap) {
   AEROCAL_CHECK(windows.size() <= static_cast<size_t>(kMaxWindows))
@@ -171,8 +181,17 @@ void ResampleStripFast(const std::vector<Window>& windows,
     std::vector<float> sum(width);
     long n_covered = 0, n_overlap = 0;
     for (int r = range.begin(); r < range.end(); ++r) {
-      T* out = reinterpret_cast<T*>(strip) + static_cast<size_t>(r) * width;
-      ResampleRow<T>(windows, fill_value, width, y0 + r, out, &sum, &n_covered, &n_overlap);
+      const size_t at = static_cast<size_t>(r) * columns.Count();
+      ResampleRow<T>(windows,
+                     fill_value,
+                     width,
+                     columns,
+                     y0 + r,
+                     reinterpret_cast<T*>(strip) + at,
+                     coverage ? coverage + at : nullptr,
+                     &sum,
+                     &n_covered,
+                     &n_overlap);
     }
     *covered += n_covered;
     *overlap += n_overlap;
@@ -182,16 +201,20 @@ void ResampleStripFast(const std::vector<Window>& windows,
 template void ResampleStripFast<std::uint8_t>(const std::vector<Window>&,
                                               float,
                                               int,
+                                              ColumnSpan,
                                               int,
                                               int,
+                                              std::uint8_t*,
                                               std::uint8_t*,
                                               std::atomic<long>*,
                                               std::atomic<long>*);
 template void ResampleStripFast<std::uint16_t>(const std::vector<Window>&,
                                                float,
                                                int,
+                                               ColumnSpan,
                                                int,
                                                int,
+                                               std::uint8_t*,
                                                std::uint8_t*,
                                                std::atomic<long>*,
                                                std::atomic<long>*);

@@ -26,16 +26,20 @@ namespace aerocal::stitch::internal {
 
 inline constexpr double kChordPx = 1e-5;  // largest position error of the linearised projectivity
 
-/// Resamples virtual rows [y0, y0 + rows) into `strip` (rows of `width` samples of T, 8 or 16
-/// bit). `fill` is the value of uncovered pixels, already in T's range. Adds the covered and
-/// overlap pixel counts.
+/// Resamples the columns `columns` of virtual rows [y0, y0 + rows) into `strip` (rows of
+/// columns.Count() samples of T, 8 or 16 bit); `width` is the virtual format's, and each pixel is
+/// the one the whole row gives (the same runs and nodes). `fill` is the value of uncovered pixels,
+/// already in T's range. With `coverage` (rows of columns.Count() bytes): 255 where a sub-image
+/// covers the pixel, 0 elsewhere. Adds the covered and overlap pixel counts.
 template <typename T>
 void ResampleStripFast(const std::vector<Window>& windows,
                        float fill,
                        int width,
+                       ColumnSpan columns,
                        int y0,
                        int rows,
                        std::uint8_t* strip,
+                       std::uint8_t* coverage,
                        std::atomic<long>* covered,
                        std::atomic<long>* overlap);
 

@@ -26,6 +26,13 @@ struct Window {
   int stride = 0;  // samples per row
 };
 
+/// The columns [first, last] of a virtual row that a strip makes (the whole row, or a region's):
+/// output sample c - first holds column c.
+struct ColumnSpan {
+  int first = 0, last = -1;
+  int Count() const { return last - first + 1; }
+};
+
 /// Columns [first, last] of virtual row V whose (u, v) lies inside the sub-image's pixel centres,
 /// 0 <= u <= W-1, 0 <= v <= H-1 (each bound is a U + b >= 0 for a projectivity with w > 0);
 /// false when none.

@@ -1,6 +1,7 @@
 #include "stitch/resample/virtual_image.h"
 
 #include "calib/core/error.h"
+#include "calib/core/stopwatch.h"
 #include "stitch/resample/fast_strip.h"
 #include "stitch/resample/resample_window.h"
 
@@ -11,7 +12,6 @@
 
 #include <algorithm>
 #include <atomic>
-#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -21,6 +21,7 @@
 namespace aerocal::stitch {
 namespace {
 
+using internal::ColumnSpan;
 using internal::CoveredColumns;
 using internal::Window;
 
@@ -71,10 +72,22 @@ inline void AddSample(const Window& win, float u, float v, float* out) {
   }
 }
 
+// One virtual row V of one window: its covered run [first, last] (positions are stepped from
+// `first`), the columns made, and the row's sums and counts (indexed by virtual column).
+struct RowTask {
+  double V;
+  int first, last;
+  ColumnSpan columns;
+  float* sum;
+  std::uint8_t* count;
+};
+
 // kAffine: the projective row of the map is (0, 0, 1), so w = 1 and no division is needed.
+// Positions are stepped from column `first` (the covered run's start) whatever `columns` the
+// strip makes, so a region's pixels get the whole row's bits.
 template <typename T, int kBands, Interpolation kInterpolation, bool kAffine>
-void AccumulateRow(
-    const Window& win, double V, int first, int last, float* sum, std::uint8_t* count) {
+void AccumulateRow(const Window& win, const RowTask& row) {
+  const auto [V, first, last, columns, sum, count] = row;
   const Eigen::Matrix3d& m = win.sub_from_virtual;
   double x =
       m(0, 0) * first + m(0, 1) * V + m(0, 2) - win.x0 * (m(2, 0) * first + m(2, 1) * V + m(2, 2));
@@ -83,7 +96,9 @@ void AccumulateRow(
   double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
   const double dx = m(0, 0) - win.x0 * m(2, 0), dy = m(1, 0) - win.y0 * m(2, 0), dw = m(2, 0);
   const float max_u = static_cast<float>(win.w - 1), max_v = static_cast<float>(win.h - 1);
-  for (int c = first; c <= last; ++c, x += dx, y += dy, w += dw) {
+  const int from = std::max(first, columns.first), to = std::min(last, columns.last);
+  for (int c = first; c < from; ++c) x += dx, y += dy, w += dw;
+  for (int c = from; c <= to; ++c, x += dx, y += dy, w += dw) {
     const float u = std::clamp(static_cast<float>(kAffine ? x : x / w), 0.0f, max_u);
     const float v = std::clamp(static_cast<float>(kAffine ? y : y / w), 0.0f, max_v);
     ++count[c];
@@ -112,21 +127,26 @@ void CorrectionAlongRow(const MapCorrectionGrid& g, double V, int first, int las
 }
 
 // With a correction grid: (u, v) = projectivity + interpolated correction, coverage per pixel.
+// The projectivity is stepped from column `first` (0: the whole row), the correction is per
+// column; only `columns` are sampled.
 template <typename T, int kBands, Interpolation kInterpolation>
-void AccumulateCorrectedRow(
-    const Window& win, double V, int first, int last, float* sum, std::uint8_t* count) {
+void AccumulateCorrectedRow(const Window& win, const RowTask& row) {
+  const auto [V, first, last, columns, sum, count] = row;
+  const int from = std::max(first, columns.first), to = std::min(last, columns.last);
+  if (from > to) return;
   thread_local std::vector<float> duv;
-  duv.resize(2 * static_cast<size_t>(last - first + 1));
-  CorrectionAlongRow(*win.correction, V, first, last, duv.data());
+  duv.resize(2 * static_cast<size_t>(to - from + 1));
+  CorrectionAlongRow(*win.correction, V, from, to, duv.data());
   const Eigen::Matrix3d& m = win.sub_from_virtual;
   double x = m(0, 0) * first + m(0, 1) * V + m(0, 2);
   double y = m(1, 0) * first + m(1, 1) * V + m(1, 2);
   double w = m(2, 0) * first + m(2, 1) * V + m(2, 2);
   const float max_u = static_cast<float>(win.width_px - 1),
               max_v = static_cast<float>(win.height_px - 1);
-  for (int c = first; c <= last; ++c, x += m(0, 0), y += m(1, 0), w += m(2, 0)) {
-    const float su = static_cast<float>(x / w) + duv[2 * (c - first)];
-    const float sv = static_cast<float>(y / w) + duv[2 * (c - first) + 1];
+  for (int c = first; c < from; ++c) x += m(0, 0), y += m(1, 0), w += m(2, 0);
+  for (int c = from; c <= to; ++c, x += m(0, 0), y += m(1, 0), w += m(2, 0)) {
+    const float su = static_cast<float>(x / w) + duv[2 * (c - from)];
+    const float sv = static_cast<float>(y / w) + duv[2 * (c - from) + 1];
     if (!(w > 0 && su >= 0.0f && su <= max_u && sv >= 0.0f && sv <= max_v)) continue;
     // The strip's window holds every such sample (ResampleVirtualImage); one outside it is
     // dropped, never clamped to the window's edge (that would be another pixel's value).
@@ -138,53 +158,52 @@ void AccumulateCorrectedRow(
 }
 
 template <typename T, int kBands>
-void AccumulateRow(const Window& win,
-                   Interpolation interpolation,
-                   double V,
-                   int first,
-                   int last,
-                   float* sum,
-                   std::uint8_t* count) {
+void AccumulateRow(const Window& win, Interpolation interpolation, const RowTask& row) {
+  constexpr Interpolation kLinear = Interpolation::kBilinear, kCubic = Interpolation::kBicubic;
   if (win.correction) {
-    if (interpolation == Interpolation::kBilinear)
-      AccumulateCorrectedRow<T, kBands, Interpolation::kBilinear>(win, V, first, last, sum, count);
+    if (interpolation == kLinear)
+      AccumulateCorrectedRow<T, kBands, kLinear>(win, row);
     else
-      AccumulateCorrectedRow<T, kBands, Interpolation::kBicubic>(win, V, first, last, sum, count);
+      AccumulateCorrectedRow<T, kBands, kCubic>(win, row);
     return;
   }
   const bool affine = win.sub_from_virtual(2, 0) == 0.0 && win.sub_from_virtual(2, 1) == 0.0 &&
                       win.sub_from_virtual(2, 2) == 1.0;
-  if (interpolation == Interpolation::kBilinear) {
+  if (interpolation == kLinear) {
     if (affine)
-      AccumulateRow<T, kBands, Interpolation::kBilinear, true>(win, V, first, last, sum, count);
+      AccumulateRow<T, kBands, kLinear, true>(win, row);
     else
-      AccumulateRow<T, kBands, Interpolation::kBilinear, false>(win, V, first, last, sum, count);
+      AccumulateRow<T, kBands, kLinear, false>(win, row);
   } else {
     if (affine)
-      AccumulateRow<T, kBands, Interpolation::kBicubic, true>(win, V, first, last, sum, count);
+      AccumulateRow<T, kBands, kCubic, true>(win, row);
     else
-      AccumulateRow<T, kBands, Interpolation::kBicubic, false>(win, V, first, last, sum, count);
+      AccumulateRow<T, kBands, kCubic, false>(win, row);
   }
 }
 
+// Virtual rows [y0, y0 + rows), columns `columns` (of a format `width` wide) into `strip`.
 template <typename T, int kBands>
 void ResampleStrip(std::vector<Window>& windows,
                    const ResampleOptions& options,
                    int width,
+                   ColumnSpan columns,
                    int y0,
                    int rows,
                    std::vector<std::uint8_t>* strip,
+                   std::uint8_t* coverage,
                    std::atomic<long>* covered,
                    std::atomic<long>* overlap) {
   const float max_value = static_cast<float>(std::numeric_limits<T>::max());
   const float fill = std::clamp(static_cast<float>(options.fill), 0.0f, max_value);
   tbb::parallel_for(tbb::blocked_range<int>(0, rows), [&](const tbb::blocked_range<int>& range) {
-    std::vector<float> sum(static_cast<size_t>(width) * kBands);
+    std::vector<float> sum(static_cast<size_t>(width) * kBands);  // indexed by virtual column
     std::vector<std::uint8_t> count(width);
     long n_covered = 0, n_overlap = 0;
     for (int r = range.begin(); r < range.end(); ++r) {
-      std::fill(sum.begin(), sum.end(), 0.0f);
-      std::fill(count.begin(), count.end(), 0);
+      std::fill(
+          sum.begin() + columns.first * kBands, sum.begin() + (columns.last + 1) * kBands, 0.0f);
+      std::fill(count.begin() + columns.first, count.begin() + columns.last + 1, 0);
       const double V = y0 + r;
       for (const Window& win : windows) {
         int first = 0, last = -1;
@@ -195,17 +214,22 @@ void ResampleStrip(std::vector<Window>& windows,
           last = width - 1;
         }
         AccumulateRow<T, kBands>(
-            win, options.interpolation, V, first, last, sum.data(), count.data());
+            win, options.interpolation, {V, first, last, columns, sum.data(), count.data()});
       }
-      T* out = reinterpret_cast<T*>(strip->data()) + static_cast<size_t>(r) * width * kBands;
-      for (int c = 0; c < width; ++c) {
+      T* out =
+          reinterpret_cast<T*>(strip->data()) + static_cast<size_t>(r) * columns.Count() * kBands;
+      for (int c = columns.first; c <= columns.last; ++c) {
         const int n = count[c];
         n_covered += n > 0;
         n_overlap += n > 1;
         const float scale = n > 0 ? 1.0f / n : 0.0f;
+        const int o = (c - columns.first) * kBands;
+        if (coverage)
+          coverage[static_cast<size_t>(r) * columns.Count() + (c - columns.first)] =
+              n > 0 ? 255 : 0;
         for (int b = 0; b < kBands; ++b) {
           const float value = n > 0 ? sum[c * kBands + b] * scale : fill;
-          out[c * kBands + b] = static_cast<T>(std::clamp(value + 0.5f, 0.0f, max_value));
+          out[o + b] = static_cast<T>(std::clamp(value + 0.5f, 0.0f, max_value));
         }
       }
     }
@@ -243,8 +267,9 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
                                     const std::vector<RasterSource*>& sources,
                                     RasterSink* sink,
                                     const ResampleOptions& options,
-                                    const std::vector<MapCorrectionGrid>& corrections) {
-  const auto start = std::chrono::steady_clock::now();
+                                    const std::vector<MapCorrectionGrid>& corrections,
+                                    RasterSink* coverage) {
+  const Stopwatch resampling;
   AEROCAL_CHECK(corrections.empty() || corrections.size() == sources.size())
       << corrections.size() << " correction grids for " << sources.size() << " sources";
   AEROCAL_CHECK(sources.size() == camera.subimages.size())
@@ -281,8 +306,18 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
     }
   }
   const int width = camera.width_px, height = camera.height_px;
-  const RasterInfo out_info{width, height, first.bands, first.bits};
+  const VirtualRegion region =
+      options.region.Empty() ? VirtualRegion{0, 0, width, height} : options.region;
+  AEROCAL_CHECK(region.x0 >= 0 && region.y0 >= 0 && region.height > 0 &&
+                region.x0 + region.width <= width && region.y0 + region.height <= height)
+      << "region " << region.x0 << " " << region.y0 << " " << region.width << " x " << region.height
+      << " outside the virtual format " << width << " x " << height;
+  const ColumnSpan columns{region.x0, region.x0 + region.width - 1};
+  const int region_end = region.y0 + region.height;
+  const RasterInfo out_info{region.width, region.height, first.bands, first.bits};
   std::vector<std::uint8_t> strip(out_info.RowBytes() * options.strip_rows);
+  std::vector<std::uint8_t> coverage_strip(coverage ? region.width * options.strip_rows : 0);
+  std::uint8_t* const coverage_rows = coverage ? coverage_strip.data() : nullptr;
   std::atomic<long> covered{0}, overlap{0};
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
   const int margin = options.interpolation == Interpolation::kBicubic ? 3 : 2;
@@ -292,7 +327,9 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
       std::none_of(windows.begin(), windows.end(), [](const Window& w) { return w.correction; });
   const float fill =
       std::clamp(static_cast<float>(options.fill), 0.0f, first.bits == 8 ? 255.0f : 65535.0f);
-  for (int y0 = 0; y0 < height; y0 += options.strip_rows) {
+  // The whole format's strips (from row 0), so that a region gets the same windows.
+  for (int y0 = region.y0 / options.strip_rows * options.strip_rows; y0 < region_end;
+       y0 += options.strip_rows) {
     const int rows = std::min(options.strip_rows, height - y0);
     // Window of each sub-image: bounding box of the strip's corners mapped into it, plus margin.
     auto prepare = [&](size_t k) {
@@ -349,33 +386,35 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
     // Sources are distinct objects: their windows are read in parallel.
     arena.execute(
         [&] { tbb::parallel_for(size_t{0}, windows.size(), [&](size_t k) { prepare(k); }); });
+    const int r0 = std::max(y0, region.y0), n = std::min(y0 + rows, region_end) - r0;
     arena.execute([&] {
       if (fast && first.bits == 8)
         internal::ResampleStripFast<std::uint8_t>(
-            windows, fill, width, y0, rows, strip.data(), &covered, &overlap);
+            windows, fill, width, columns, r0, n, strip.data(), coverage_rows, &covered, &overlap);
       else if (fast)
         internal::ResampleStripFast<std::uint16_t>(
-            windows, fill, width, y0, rows, strip.data(), &covered, &overlap);
+            windows, fill, width, columns, r0, n, strip.data(), coverage_rows, &covered, &overlap);
       else if (first.bits == 8 && first.bands == 1)
         ResampleStrip<std::uint8_t, 1>(
-            windows, options, width, y0, rows, &strip, &covered, &overlap);
+            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
       else if (first.bits == 8)
         ResampleStrip<std::uint8_t, 3>(
-            windows, options, width, y0, rows, &strip, &covered, &overlap);
+            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
       else if (first.bands == 1)
         ResampleStrip<std::uint16_t, 1>(
-            windows, options, width, y0, rows, &strip, &covered, &overlap);
+            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
       else
         ResampleStrip<std::uint16_t, 3>(
-            windows, options, width, y0, rows, &strip, &covered, &overlap);
+            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
     });
-    sink->WriteRows(y0, rows, strip.data());
+    sink->WriteRows(r0 - region.y0, n, strip.data());
+    if (coverage) coverage->WriteRows(r0 - region.y0, n, coverage_rows);
   }
   ResampleReport report;
   report.covered = covered;
   report.overlap = overlap;
-  report.filled = static_cast<long>(width) * height - report.covered;
-  report.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  report.filled = static_cast<long>(region.width) * region.height - report.covered;
+  report.seconds = resampling.Seconds();
   return report;
 }
 

@@ -26,6 +26,12 @@
 //   projectivity in double, then float; bicubic, 3 bands and correction grids go this way.
 // The fast path's output is bit-identical whatever the thread count and strip height (tested),
 // the reference path's whatever the thread count.
+//
+// A region (ResampleOptions::region) makes only a rectangle of the virtual image, each of its
+// pixels bit-identical to the whole format's: the same strips (aligned to strip_rows from row 0),
+// the same sub-image windows, and every row's positions stepped from the same column as in the
+// whole row; only the pixels outside the rectangle are not computed. One sub-image's footprint
+// (the rig's stitched image) then costs its footprint, not the format.
 #pragma once
 
 #include "calib/camera/camera.h"
@@ -38,18 +44,31 @@ namespace aerocal::stitch {
 
 enum class Interpolation { kBilinear, kBicubic };
 
+/// A rectangle of the virtual image (virtual px: columns x0 .. x0 + width - 1, rows y0 ..
+/// y0 + height - 1). Width 0: the whole format.
+struct VirtualRegion {
+  int x0 = 0, y0 = 0, width = 0, height = 0;
+  bool Empty() const { return width <= 0; }
+  bool operator==(const VirtualRegion& o) const {
+    return x0 == o.x0 && y0 == o.y0 && width == o.width && height == o.height;
+  }
+};
+
 struct ResampleOptions {
   Interpolation interpolation = Interpolation::kBilinear;
   double fill = 0.0;       // value of uncovered pixels, in the output's range
   int strip_rows = 256;    // rows per strip, > 0 (memory ~ strip_rows x (virtual width + sources))
   int threads = 0;         // 0: all cores
   bool reference = false;  // true: the per-pixel reference path even where the fast one applies
+  /// Only this rectangle (inside the format) is made: the sink receives region.height rows of
+  /// region.width pixels, equal bit for bit to the whole format's there. Empty: the whole format.
+  VirtualRegion region;
 };
 
-struct ResampleReport {
-  long covered = 0;  // virtual pixels covered by at least one sub-image
-  long overlap = 0;  // covered by two or more
-  long filled = 0;   // covered by none
+struct ResampleReport {  // counts over the region made (the whole format by default)
+  long covered = 0;      // virtual pixels covered by at least one sub-image
+  long overlap = 0;      // covered by two or more
+  long filled = 0;       // covered by none
   double seconds = 0;
 };
 
@@ -70,11 +89,14 @@ struct MapCorrectionGrid {
 /// format; all of one bit depth and band count) to `sink`, with the sources' depth and bands.
 /// Throws InputError naming the sub-image when a source's format, depth or bands do not match.
 /// `corrections`: empty, or one per sub-image (a grid with step 0 = none for that sub-image).
+/// `coverage` (optional; one band, 8 bit, the sink's format): 255 where at least one sub-image
+/// covers the pixel (the pixels that get a value, not the fill), 0 elsewhere.
 ResampleReport ResampleVirtualImage(const calib::Camera& camera,
                                     const std::vector<RasterSource*>& sources,
                                     RasterSink* sink,
                                     const ResampleOptions& options,
-                                    const std::vector<MapCorrectionGrid>& corrections = {});
+                                    const std::vector<MapCorrectionGrid>& corrections = {},
+                                    RasterSink* coverage = nullptr);
 
 Interpolation ParseInterpolation(const std::string& name);  // ConfigError when unknown
 

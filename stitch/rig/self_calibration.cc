@@ -4,9 +4,8 @@
 #include "stitch/rig/self_calibration.h"
 
 #include "calib/core/error.h"
+#include "calib/core/stopwatch.h"
 #include "stitch/rig/self_calibration_problem.h"
-
-#include <chrono>
 
 namespace aerocal::stitch {
 
@@ -40,28 +39,24 @@ RigStitchResult SelfCalibrateRigStitching(const calib::Rig& rig,
   using namespace internal;  // the steps (self_calibration_problem.h)
   AEROCAL_CHECK(rig.virtual_camera.orientation == calib::VirtualOrientation::kLevel)
       << "the self-calibrating stitching makes the level (horizontal) virtual image";
-  using Clock = std::chrono::steady_clock;
-  const auto seconds_since = [](Clock::time_point t) {
-    return std::chrono::duration<double>(Clock::now() - t).count();
-  };
-  const Clock::time_point call_start = Clock::now();
+  const Stopwatch call;
   RigStitchProblem p(rig, exposures, ties, observations, positions, options);
   AddHeadBlocks(p);
   DecideTimeOffsets(p);
   AddExposureBlocks(p);
   AddTies(p);
-  p.result.profile.setup_s = seconds_since(call_start);
+  p.result.profile.setup_s = call.Seconds();
   const std::vector<calib::ResidualId> kept_against_test = SolveWithSnooping(p);
   EstimatePrecision(p, kept_against_test);
-  const Clock::time_point figures_start = Clock::now();
+  const Stopwatch figures;
   const std::vector<RigExposure> refined = CollectHeads(p);
   StitchingRms(p, refined);
   CountStandardPositions(p);
   ReliefDisplacement(p);
   Sigma0InPixels(p);
   JudgeRun(p);
-  p.result.profile.figures_s = seconds_since(figures_start);
-  p.result.profile.total_s = seconds_since(call_start);
+  p.result.profile.figures_s = figures.Seconds();
+  p.result.profile.total_s = call.Seconds();
   return std::move(p.result);
 }
 

@@ -1,12 +1,12 @@
 // Solve of the self-calibrating rig stitching (self_calibration_problem.h): data snooping with the
 // standard-position veto, the covariance of the increments and offsets, the stop's effect, the dT
 // correlations, the per-head results and the rules that make the run not valid.
+#include "calib/core/stopwatch.h"
 #include "calib/core/string_printf.h"
 #include "calib/problem/data_snooping.h"
 #include "stitch/rig/self_calibration_problem.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 
 namespace aerocal::stitch::internal {
@@ -89,11 +89,6 @@ std::vector<calib::ResidualId> SolveWithSnooping(RigStitchProblem& p) {
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-double SecondsSince(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
 // The increments of the non-reference heads and their free time offsets (each once).
 std::vector<calib::BlockId> IncrementsAndOffsets(const RigStitchProblem& p) {
   std::vector<calib::BlockId> wanted;
@@ -142,18 +137,18 @@ void DtCorrelations(RigStitchProblem& p) {
 void EstimatePrecision(RigStitchProblem& p, const std::vector<calib::ResidualId>& kept) {
   auto& result = p.result;
   const std::vector<calib::BlockId> wanted = IncrementsAndOffsets(p);
-  Clock::time_point start = Clock::now();
+  Stopwatch stage;
   p.cov = p.builder.EstimateCovariance(
       wanted, std::max(result.sigma0, 1e-300), p.options.correlation_threshold);
-  result.profile.covariance_s = SecondsSince(start);
+  result.profile.covariance_s = stage.Seconds();
   if (!p.cov.ok)
     result.warnings.push_back(
         {"covariance", "increments and time offsets", NAN, NAN, "covariance: " + p.cov.message});
-  start = Clock::now();
+  stage.Restart();
   if (result.stopped)  // what the rig's calibration becomes without the ties kept against the test
     result.stop_effect = calib::EffectOfLeavingOut(
         p.builder, kept, p.cov, wanted, wanted, p.options.solver, p.options.suspect_effect_limit);
-  result.profile.effect_s = SecondsSince(start);
+  result.profile.effect_s = stage.Seconds();
   DtCorrelations(p);
 }
 

@@ -20,8 +20,14 @@
 // |grad I| x the misregistration.
 //
 // Precision: 8-bit heads are resampled as 16-bit (x 256), so the interpolated values keep 1/256 DN;
-// the output has the heads' depth (rounded). Memory: 3 bytes per head and virtual pixel, plus the
-// output strip.
+// the output has the heads' depth (rounded).
+//
+// Cost: each head is resampled, and its distance transform taken, over its footprint's box only
+// (HeadFootprintBox: its format's border through the exact map, plus a margin), not over the
+// whole virtual format; the box's pixels are the whole format's bit for bit (VirtualRegion in
+// virtual_image.h; the distance transform's too, since the box keeps a ring of uncovered pixels
+// or the format's own edge around the coverage, checked). Memory: 3 bytes per head and pixel of
+// its box, plus the output strip.
 #pragma once
 
 #include "calib/core/finding.h"
@@ -69,9 +75,13 @@ struct StitchedImageReport {
 /// One head's pixels resampled alone onto the converter's virtual grid through the `rig convert`
 /// map (plane homography plus `grid`, stitch/rig/rig_convert.h): `values` (virtual format, one
 /// band, the source's depth) and `covered` (row-major virtual format: 255 where the resampler puts
-/// the virtual pixel inside the head's format, 0 elsewhere; its own rule, from a constant image
-/// through the same map). Shared by the stitched image and the tie matching (rig_tie_matching.h).
+/// the virtual pixel inside the head's format, 0 elsewhere; its own rule: the coverage output of
+/// the same resampling pass, the set a constant image through the same map covers). Shared by the
+/// stitched image and the tie matching (rig_tie_matching.h). With `resample.region` set, only that
+/// box of the virtual image (values and covered are region-sized; `region` says which pixels they
+/// hold), each pixel equal to the whole format's.
 struct HeadProjection {
+  VirtualRegion region;  // the virtual pixels held (the whole format when the request had none)
   MemoryRaster values;
   std::vector<std::uint8_t> covered;
 };
@@ -80,6 +90,21 @@ HeadProjection ProjectHeadOntoVirtual(const RigConverter& converter,
                                       const MapCorrectionGrid& grid,
                                       RasterSource* source,
                                       const ResampleOptions& resample = {});
+
+/// The box of the virtual image holding head `head`'s coverage: its format's border (every 16 px
+/// and the corners) through the converter's exact map, widened by `margin_px` and cut to the
+/// format; empty (the whole format) when a border pixel has no virtual image (beyond the
+/// horizon of the rectification plane).
+VirtualRegion HeadFootprintBox(const RigConverter& converter, int head, int margin_px = 8);
+
+/// ProjectHeadOntoVirtual over the head's footprint box; the whole format instead when the
+/// coverage reaches the box's border anywhere but at the format's edge (then the box would cut
+/// it, or the distance transform at its border would differ from the whole format's).
+HeadProjection ProjectHeadFootprint(const RigConverter& converter,
+                                    int head,
+                                    const MapCorrectionGrid& grid,
+                                    RasterSource* source,
+                                    const ResampleOptions& resample = {});
 
 /// Makes the stitched image of the converter's exposure from `sources` (one per head, rig order,
 /// each of its head's format, one band, 8 or 16 bit) into `image` (virtual format, one band, the

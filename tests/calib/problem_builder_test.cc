@@ -12,6 +12,7 @@
 #include "calib/residuals/collinearity.h"
 
 #include <Eigen/Geometry>
+#include <ceres/sized_cost_function.h>
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -461,6 +462,67 @@ TEST(ProblemBuilder, FixedEntriesStayAndAreNotCounted) {
   EXPECT_GT(again.sigma(Model::kK1), 0.0);
   // Fewer free parameters: K1 is determined at least as well as before.
   EXPECT_LE(again.sigma(Model::kK1), cov.sigma(Model::kK1) * (1 + 1e-9));
+}
+
+// r = (x - m) / sigma over a point block [3], Jacobian I / sigma; counts its evaluations.
+class CountingOffsetCost : public ceres::SizedCostFunction<3, 3> {
+ public:
+  CountingOffsetCost(const Eigen::Vector3d& m, double sigma, int* evaluations)
+      : m_(m), sigma_(sigma), evaluations_(evaluations) {}
+  bool Evaluate(double const* const* x, double* r, double** jacobians) const override {
+    ++*evaluations_;
+    for (int i = 0; i < 3; ++i) r[i] = (x[0][i] - m_[i]) / sigma_;
+    if (jacobians && jacobians[0])
+      for (int i = 0; i < 9; ++i) jacobians[0][i] = i % 4 == 0 ? 1.0 / sigma_ : 0.0;
+    return true;
+  }
+
+ private:
+  Eigen::Vector3d m_;
+  double sigma_;
+  int* evaluations_;
+};
+
+TEST(ProblemBuilder, FixedEntriesWaitForTheirNextUse) {
+  // The rig stitching holds the height of every tie point (FixEntries(point, {2})): each call used
+  // to evaluate the whole problem's Jacobian at once, quadratic in the points. The manifolds are
+  // now set up at the next use, once. Each point: X, Y free, Z held 1 sigma off its measurement,
+  // so v^T P v = n, redundancy 3n - 2n = n, sigma0 = 1 and sigma_X = sigma exactly.
+  constexpr int kPoints = 200;
+  constexpr double kSigma = 0.5;
+  int evaluations = 0;
+  ProblemBuilder builder;
+  std::vector<Eigen::Vector3d> points(kPoints), measured(kPoints);
+  std::vector<BlockId> blocks;
+  for (int i = 0; i < kPoints; ++i) {
+    measured[i] = Eigen::Vector3d(i, -2.0 * i, 100.0 + i);
+    points[i] = measured[i] + Eigen::Vector3d(3.0, -1.0, kSigma);
+    blocks.push_back(builder.AddBlock(
+        "p" + std::to_string(i), points[i].data(), 3, BlockKind::kGroundPoint, {"X", "Y", "Z"}));
+    builder.AddResidual(kGroupControl,
+                        std::make_unique<CountingOffsetCost>(measured[i], kSigma, &evaluations),
+                        {blocks.back()});
+    builder.FixEntries(blocks.back(), {2});
+  }
+  EXPECT_EQ(evaluations, 0);  // before: 1 + 2 + ... + 200 residual evaluations
+  const SolveReport report = builder.Solve({});
+  ASSERT_TRUE(report.converged) << report.message;
+  EXPECT_EQ(report.n_unknowns, 2 * kPoints);
+  EXPECT_EQ(report.redundancy, kPoints);
+  EXPECT_NEAR(report.sigma0, 1.0, 1e-12);
+  // The solver stops on its function tolerance a few 1e-9 px short of the exact solution.
+  constexpr double kSolvedPx = 1e-7;
+  for (int i = 0; i < kPoints; ++i) {
+    EXPECT_NEAR(points[i].x(), measured[i].x(), kSolvedPx);
+    EXPECT_NEAR(points[i].y(), measured[i].y(), kSolvedPx);
+    EXPECT_EQ(points[i].z(), measured[i].z() + kSigma);  // held: never moved
+  }
+  const CovarianceReport cov = builder.EstimateCovariance({blocks[7]}, report.sigma0);
+  ASSERT_TRUE(cov.ok) << cov.message;
+  EXPECT_NEAR(cov.sigma(0), kSigma, 1e-12);
+  EXPECT_NEAR(cov.sigma(1), kSigma, 1e-12);
+  EXPECT_FALSE(cov.free[2]);
+  EXPECT_EQ(cov.sigma(2), 0.0);
 }
 
 TEST(NormalCriticalValue, KnownQuantiles) {

@@ -416,6 +416,17 @@ IncrementCheck SelfCalibrateOnMatches(const SimulatedRigFlight& f,
   return out;
 }
 
+// Exposure 0 of `f` converted at the ground calibration (no increments, no time offsets) over
+// its level plane.
+RigConverter FirstExposureAtGroundCalibration(const SimulatedRigFlight& f) {
+  const testing::RigStitchInputs in = testing::InputsFromFlight(f);
+  RigExposure pose = in.exposures[0].pose;
+  pose.increment_rad.clear();
+  pose.dt_s.clear();
+  return RigConverter(
+      f.truth, pose, RectificationPlane{Eigen::Vector3d::UnitZ(), in.exposures[0].z_ref_m});
+}
+
 // The windows of the tie matching (issue 35) are the whole-format projection's pixels: on the
 // uav4 heads at 0.2 x their formats (tilted, with their correction grids), a random 8-bit texture
 // per head, every pixel of a 300 x 300 window around each head's centre has the coverage of
@@ -423,12 +434,7 @@ IncrementCheck SelfCalibrateOnMatches(const SimulatedRigFlight& f,
 // resamples 16-bit values x 256) plus float rounding.
 TEST(RigHeadWindow, WindowsEqualTheWholeFormatProjection) {
   const SimulatedRigFlight f = triangulation::SimulateRigFlight(SmallLine(0.0));
-  const testing::RigStitchInputs in = testing::InputsFromFlight(f);
-  RigExposure pose = in.exposures[0].pose;
-  pose.increment_rad.clear();
-  pose.dt_s.clear();
-  const RigConverter converter(
-      f.truth, pose, RectificationPlane{Eigen::Vector3d::UnitZ(), in.exposures[0].z_ref_m});
+  const RigConverter converter = FirstExposureAtGroundCalibration(f);
   const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
   std::mt19937 rng(5);
   for (int k = 0; k < static_cast<int>(f.truth.heads.size()); ++k) {
@@ -463,6 +469,43 @@ TEST(RigHeadWindow, WindowsEqualTheWholeFormatProjection) {
     EXPECT_GT(covered, 20000) << f.truth.heads[k].id;
     EXPECT_EQ(differ, 0) << f.truth.heads[k].id;
     EXPECT_LT(worst, 1.0 / 256 + 1e-3) << f.truth.heads[k].id;  // 16-bit rounding + float
+  }
+}
+
+// The stitched image projects each head over its footprint's box only (ProjectHeadFootprint):
+// on the uav4 heads at 0.2 x (tilted, with correction grids) and a random 16-bit texture, the box
+// is well under half the virtual format, holds every covered pixel of the whole-format
+// projection, and each of its pixels (value and coverage) is the whole format's to the last bit.
+TEST(RigStitchedImage, FootprintBoxHoldsTheWholeFormatsPixelsBitForBit) {
+  const SimulatedRigFlight f = triangulation::SimulateRigFlight(SmallLine(0.0));
+  const RigConverter converter = FirstExposureAtGroundCalibration(f);
+  const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
+  const int width = f.truth.virtual_camera.camera.width_px;
+  const int height = f.truth.virtual_camera.camera.height_px;
+  std::mt19937 rng(11);
+  for (int k = 0; k < static_cast<int>(f.truth.heads.size()); ++k) {
+    const calib::Camera& head = f.truth.heads[k].camera;
+    MemoryRaster source({head.width_px, head.height_px, 1, 16});
+    for (int r = 0; r < head.height_px; ++r)
+      for (int c = 0; c < head.width_px; ++c) source.Set(c, r, 0, rng() % 65536);
+    const HeadProjection whole = ProjectHeadOntoVirtual(converter, k, grids.grids[k], &source);
+    const HeadProjection box = ProjectHeadFootprint(converter, k, grids.grids[k], &source);
+    const VirtualRegion& b = box.region;
+    EXPECT_LT(2.0 * b.width * b.height, 1.0 * width * height) << f.truth.heads[k].id;
+    long covered_whole = 0, covered_box = 0, differ = 0;
+    for (int y = 0; y < height; ++y)
+      for (int x = 0; x < width; ++x) {
+        const bool covered = whole.covered[static_cast<size_t>(y) * width + x] != 0;
+        covered_whole += covered;
+        if (x < b.x0 || y < b.y0 || x >= b.x0 + b.width || y >= b.y0 + b.height) continue;
+        const size_t at = static_cast<size_t>(y - b.y0) * b.width + (x - b.x0);
+        covered_box += box.covered[at] != 0;
+        differ += (box.covered[at] != 0) != covered ||
+                  box.values.At(x - b.x0, y - b.y0) != whole.values.At(x, y);
+      }
+    EXPECT_GT(covered_whole, 100000) << f.truth.heads[k].id;
+    EXPECT_EQ(covered_box, covered_whole) << f.truth.heads[k].id;
+    EXPECT_EQ(differ, 0) << f.truth.heads[k].id;
   }
 }
 

@@ -3,6 +3,7 @@
 #include "calib/core/csv.h"
 #include "calib/core/log.h"
 #include "calib/core/median.h"
+#include "calib/core/stopwatch.h"
 #include "calib/core/string_printf.h"
 #include "calib/problem/suspect_effect.h"
 #include "triangulation/adjustment/block_adjustment.h"
@@ -13,7 +14,6 @@
 #include <Eigen/Geometry>
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <utility>
 
@@ -21,11 +21,6 @@ namespace aerocal::triangulation {
 namespace {
 
 using calib::BlockId;
-using Clock = std::chrono::steady_clock;
-
-double SecondsSince(Clock::time_point t) {
-  return std::chrono::duration<double>(Clock::now() - t).count();
-}
 
 // The determinability of the interior and of the free platform parameters, by name.
 void AddDeterminability(const calib::CovarianceReport& cov,
@@ -122,7 +117,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     if (progress) progress->Advance();
   };
   AdjustmentResult result;
-  const Clock::time_point run_start = Clock::now();
+  const Stopwatch run_time;
   result.free_interior = options_.free_interior;
   result.frame = project_.frame.description;
   result.datum = storage_->datum;
@@ -150,11 +145,11 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
     result.robust_start_needed = true;
     return result;
   }
-  result.timing.solve_s = SecondsSince(run_start);
+  result.timing.solve_s = run_time.Seconds();
   calib::SnoopingOutcome snooped;
-  const Clock::time_point snooping_start = Clock::now();
+  const Stopwatch snooping_time;
   if (options_.data_snooping) snooped = Snoop(&result);
-  result.timing.snooping_s = SecondsSince(snooping_start);
+  result.timing.snooping_s = snooping_time.Seconds();
   result.timing.testing_s = snooped.seconds_testing;
   if (!snooped.rejected.empty()) DropSingleRayPoints(&result);
 
@@ -162,9 +157,9 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   SetSigma0Units(&result);
   const CovarianceBlocks blocks = CovarianceBlocksOf(true);
   advance();
-  const Clock::time_point covariance_start = Clock::now();
+  const Stopwatch covariance_time;
   const calib::CovarianceReport cov = EstimateCovariance(blocks, result);
-  result.timing.covariance_s = SecondsSince(covariance_start);
+  result.timing.covariance_s = covariance_time.Seconds();
   advance();
   AddDeterminability(cov, options_.correlation_threshold, &result);
   result.platform = PlatformResult(cov);
@@ -182,7 +177,7 @@ AdjustmentResult BlockAdjustment::Run(Progress* progress) {
   for (auto& w : GroupRmsWarnings(result.solve)) result.warnings.push_back(std::move(w));
   AddControlBlunderWarnings(&result);
   if (!result.snooping.unresolved_surveys.empty()) JudgeUnresolvedSurveys(cov, blocks, &result);
-  result.timing.total_s = SecondsSince(run_start);
+  result.timing.total_s = run_time.Seconds();
   return result;
 }
 
