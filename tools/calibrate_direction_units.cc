@@ -113,12 +113,16 @@ calib::Rig UpdatedRig(const calib::Rig& rig, const triangulation::DirectionUnits
   return out;
 }
 
-// Per unit: its rotation to the instrument, its mount relative to the first unit, the start.
+// Per unit: its rotation to the instrument, its mount relative to the first unit, the start, its
+// format and pixel pitch and its interior's correlations (the certificate draws every head's
+// distortion and correlation map from these, not only the first head's).
 nlohmann::json UnitsJson(const triangulation::DirectionUnitsRun& run, const calib::Rig& written) {
   nlohmann::json units = nlohmann::json::array();
   const triangulation::DirectionUnitsCalibration& c = run.calibration;
   for (size_t k = 0; k < run.ids.size(); ++k) {
     const triangulation::DirectionCalibration& u = c.units[k];
+    const calib::Camera& head = written.heads[written.HeadIndex(run.ids[k])].camera;
+    const triangulation::CalibrationAdjustment& a = run.adjustments[k];
     units.push_back(
         {{"id", run.ids[k]},
          {"observations", run.observations[k]},
@@ -129,7 +133,12 @@ nlohmann::json UnitsJson(const triangulation::DirectionUnitsRun& run, const cali
           k == 0 ? nlohmann::json() : ArcsecOrNullJson(c.mount_sigma_rad[k], c.covariance_ok)},
          {"rig_mount_deg", DegreesJson(written.heads[written.HeadIndex(run.ids[k])].mount_rad)},
          {"start_opk_deg", DegreesJson(run.start_opk_rad[k])},
-         {"start_rotation", run.start_rotation[k]}});
+         {"start_rotation", run.start_rotation[k]},
+         {"pixel_size_mm", head.pixel_size_mm},
+         {"format_px", {head.width_px, head.height_px}}});
+    if (!a.result.cameras.empty())
+      units.back()["interior_covariance"] =
+          triangulation::InteriorCovarianceToJson(a.interior_covariance, a.result.cameras[0]);
   }
   return units;
 }

@@ -386,6 +386,31 @@ nlohmann::json DistortionJson(const nlohmann::json& cert) {
       {"profile_kind", figure.profile_kind}, {"profile", figure.profile}, {"grid", figure.grid}};
 }
 
+// A rig's heads calibrated in one adjustment: per head its distortion samples (DistortionJson over
+// its own estimate, format and pitch) and its interior's correlations, in the units' order, so that
+// the renderer draws every head, not only the first (the certificate's `distortion`,
+// `correlation`).
+nlohmann::json UnitFigures(const nlohmann::json& result, const nlohmann::json& cert) {
+  nlohmann::json out = nlohmann::json::array();
+  const nlohmann::json& cameras = result.value("cameras", nlohmann::json::array());
+  for (const auto& unit : cert["units"]) {
+    const std::string id = unit.value("id", "");
+    nlohmann::json of_unit = {{"camera_model", cert["camera_model"]}, {"interior", nullptr}};
+    for (const auto& c : cameras)
+      if (c.value("id", "") == id) of_unit["interior"] = c;
+    if (unit.contains("format_px") && unit.contains("pixel_size_mm"))
+      of_unit["camera_file"] = {{"format_px", unit["format_px"]},
+                                {"pixel_size_mm", unit["pixel_size_mm"]}};
+    else
+      of_unit["camera_file"] = nlohmann::json::object();
+    const bool known = of_unit["interior"].is_object();
+    out.push_back({{"id", id},
+                   {"distortion", known ? DistortionJson(of_unit) : nlohmann::json()},
+                   {"correlation", unit.value("interior_covariance", nlohmann::json())}});
+  }
+  return out;
+}
+
 // The certificate's data from a checked `calibrate` result (or a flight's in that form): the
 // method, camera, data, adjustment statistics, budget, interior, groups, check and control
 // statistics, the distortion samples and the used residual vectors.
@@ -430,7 +455,10 @@ nlohmann::json CertificateData(const nlohmann::json& result,
   cert["residuals"] = residuals;
   // Several units from directions (a rig's heads, a multi-CCD camera's sub-images): each unit's
   // values with U are rows "UNIT.quantity" of `results`; the units themselves listed here.
-  if (cal.contains("units")) cert["units"] = cal["units"];
+  if (cal.contains("units")) {
+    cert["units"] = cal["units"];
+    cert["unit_figures"] = UnitFigures(result, cert);
+  }
   if (cal.contains("subimages")) cert["units"] = cal["subimages"];
   if (cal.contains("gauge")) cert["gauge"] = cal["gauge"];
   return cert;

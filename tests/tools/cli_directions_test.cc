@@ -475,6 +475,23 @@ TEST(CalibrateDirections, RigHeadsInOneAdjustmentRecoverInteriorsAndMountsWithin
   EXPECT_EQ(cert["units"].size(), 3u);
   EXPECT_EQ(cert["results"].size(), cal["uncertainty"].size());
   EXPECT_NE(c.output.find("B.c = "), std::string::npos) << c.output;
+  // Every head's figure data (the renderer draws one panel per head): the first head's are the
+  // certificate's own distortion and correlation; the others are computed over their own estimate
+  // (different interiors: different curves) with their own correlation table.
+  const auto& figures = cert["unit_figures"];
+  ASSERT_EQ(figures.size(), 3u);
+  EXPECT_EQ(figures[0]["distortion"], cert["distortion"]);
+  EXPECT_EQ(figures[0]["correlation"], cert["correlation"]);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(figures[k]["id"], kHeads[k].id);
+    ASSERT_TRUE(figures[k]["distortion"].is_object()) << k;
+    ASSERT_TRUE(figures[k]["correlation"].is_object()) << k;
+    EXPECT_EQ(figures[k]["correlation"]["names"], cert["correlation"]["names"]);
+    const auto& rho = figures[k]["correlation"]["correlation"];
+    for (size_t i = 0; i < rho.size(); ++i) EXPECT_NEAR(rho[i][i].get<double>(), 1.0, 1e-12);
+  }
+  EXPECT_NE(figures[1]["distortion"]["profile"], figures[0]["distortion"]["profile"]);
+  EXPECT_NE(figures[2]["correlation"]["covariance"], figures[0]["correlation"]["covariance"]);
 }
 
 // A 2 x 3-CCD camera (tests/support/simulated_directions.h: six 2100 x 2100 px CCDs on a

@@ -572,5 +572,74 @@ class WhatPeopleRead(unittest.TestCase):
         self.assertNotIn("Dynamic image resolution", text)
 
 
+class CertificateHeads(unittest.TestCase):
+    """tools/certificate/aerocal_certificate.py draws every head of a rig's certificate (its
+    `unit_figures`, computed by aerocal), not only the first: one distortion row and one
+    correlation map per head, each from that head's own numbers."""
+
+    @classmethod
+    def setUpClass(cls):
+        import importlib.util
+        path = os.path.join(HERE, "..", "..", "tools", "certificate", "aerocal_certificate.py")
+        spec = importlib.util.spec_from_file_location("aerocal_certificate", path)
+        cls.cert = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(cls.cert)
+
+    @staticmethod
+    def certificate(heads):
+        # Exported numbers as certificate.json holds them (head k's curve scaled by k + 1, so each
+        # panel's line tells which head's samples it drew).
+        units = [{"id": h,
+                  "distortion": {"profile_kind": "10-parameter terms",
+                                 "profile": [[r, (k + 1) * 0.1 * r, 0.01 * r] for r in range(0, 31, 10)],
+                                 "grid": [[x, y, (k + 1) * 0.1, -0.1] for x in (-10, 10) for y in (-5, 5)]},
+                  "correlation": {"names": ["c", "x0"], "covariance": [[1e-6, 0], [0, 1e-6]],
+                                  "correlation": [[1.0, 0.1 * k], [0.1 * k, 1.0]]}}
+                 for k, h in enumerate(heads)]
+        return {"camera_file": {"format_px": [6000, 4000]}, "residuals": [[100, 100, 0.5, -0.2]],
+                "results": [{"quantity": "%s.dr@20" % h, "value": 2.0 * (k + 1), "U": 0.3}
+                            for k, h in enumerate(heads)],
+                "distortion": units[0]["distortion"], "correlation": units[0]["correlation"],
+                "unit_figures": units}
+
+    def titles(self, fig):
+        return [ax.get_title() for ax in fig.axes if ax.get_title()]
+
+    def test_four_heads_give_four_distortion_rows_and_four_correlation_maps(self):
+        heads = ["A", "B", "C", "D"]
+        c = self.certificate(heads)
+        fig = self.cert.fig_distortion(c)
+        titles = self.titles(fig)
+        for k, h in enumerate(heads):
+            self.assertIn("head %s: distortion curves (bars: U, k as stated)" % h, titles)
+            self.assertIn("head %s: correction dx, dy over the format" % h, titles)
+            ax = next(a for a in fig.axes if a.get_title().startswith("head %s: distortion" % h))
+            # The radial curve is the head's own samples, and its certified point is its own row.
+            self.assertEqual(list(ax.lines[0].get_ydata()), [(k + 1) * 0.1 * r for r in range(0, 31, 10)])
+            self.assertTrue(any(list(line.get_ydata()) == [2.0 * (k + 1)] for line in ax.lines))
+        self.assertEqual(sum(t.endswith("distortion curves (bars: U, k as stated)") for t in titles), 4)
+        self.cert.plt.close(fig)
+        fig = self.cert.fig_residuals_correlation(c)
+        titles = self.titles(fig)
+        maps = [t for t in titles if t.endswith("correlation of the interior parameters")]
+        self.assertEqual(maps, ["head %s: correlation of the interior parameters" % h for h in heads])
+        for k, h in enumerate(heads):
+            ax = next(a for a in fig.axes if a.get_title() == maps[k])
+            self.assertAlmostEqual(ax.images[0].get_array()[0][1], 0.1 * k)
+        self.cert.plt.close(fig)
+
+    def test_a_single_camera_keeps_one_row(self):
+        c = self.certificate(["A"])
+        del c["unit_figures"]
+        c["results"] = [{"quantity": "dr@20", "value": 2.0, "U": 0.3}]
+        fig = self.cert.fig_distortion(c)
+        self.assertEqual(self.titles(fig), ["distortion curves (bars: U, k as stated)",
+                                            "correction dx, dy over the format"])
+        self.cert.plt.close(fig)
+        fig = self.cert.fig_residuals_correlation(c)
+        self.assertIn("correlation of the interior parameters", self.titles(fig))
+        self.cert.plt.close(fig)
+
+
 if __name__ == "__main__":
     unittest.main()

@@ -430,29 +430,50 @@ def is_independent(comp):
 
 # ---------------------------------------------------------------- figures
 
-def fig_distortion(c):
-    """The camera's correction as aerocal computed it in its model (certificate.json `distortion`:
-    triangulation/calibration/distortion_figure.h); this script restates no camera model."""
-    d = c.get("distortion")
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(8, 3.4))
+def unit_panels(c):
+    """[(title prefix, quantity prefix, distortion, correlation)]: one per rig head when the certificate
+    has `unit_figures` (every head's samples, computed by aerocal: tools/certificate_writer.cc
+    UnitFigures), else the certificate's own single camera."""
+    units = c.get("unit_figures") or []
+    if units:
+        return [("head %s: " % u.get("id", "?"), "%s." % u.get("id", "?"), u.get("distortion"),
+                 u.get("correlation")) for u in units]
+    return [("", "", c.get("distortion"), c.get("correlation"))]
+
+
+def certified_points(c, prefix):
+    """[(radius, value, U, key)] of the budget rows "PREFIXdr@R" / "PREFIXdt@R" that have a U."""
+    out = []
+    for q in c["results"]:
+        name = q["quantity"]
+        if not name.startswith(prefix) or q.get("U") is None:
+            continue
+        rest = name[len(prefix):]
+        for key in ("dr", "dt"):
+            if rest.startswith(key + "@"):
+                try:
+                    out.append((float(rest[len(key) + 1:]), q["value"], q["U"], key))
+                except ValueError:
+                    pass
+    return out
+
+
+def draw_distortion(ax1, ax2, d, c, title, prefix):
+    """One camera's distortion curves and correction grid from aerocal's samples `d`."""
     if not d:
         for ax in (ax1, ax2):
             ax.axis("off")
-        ax1.text(0, 0.5, "no distortion samples in certificate.json", fontsize=9)
-        return fig
+        ax1.text(0, 0.5, "%sno distortion samples in certificate.json" % title, fontsize=9)
+        return
     r, dr, dt = zip(*d["profile"])
     terms = d["profile_kind"] == "10-parameter terms"
     ax1.plot(r, dr, label="radial dr(r)" if terms else "radial dr(r), mean over directions")
     ax1.plot(r, dt, label="decentring |dt|(r)" if terms else "tangential, RMS over directions")
-    by_name = {q["quantity"]: q for q in c["results"]}
-    for rad in c.get("radii_mm", []):
-        for key, color in (("dr@%g" % rad, "C0"), ("dt@%g" % rad, "C1")):
-            q = by_name.get(key)
-            if q and q["U"] is not None:
-                ax1.errorbar([rad], [q["value"]], yerr=[q["U"]], fmt="o", color=color, capsize=3, ms=3)
+    for rad, value, u, key in certified_points(c, prefix):
+        ax1.errorbar([rad], [value], yerr=[u], fmt="o", color="C0" if key == "dr" else "C1", capsize=3, ms=3)
     ax1.set_xlabel("radius r (mm)")
     ax1.set_ylabel("distortion (um)")
-    ax1.set_title("distortion curves (bars: U, k as stated)")
+    ax1.set_title("%sdistortion curves (bars: U, k as stated)" % title)
     ax1.grid(True, lw=0.3)
     ax1.legend()
     # Distortion grid over the format (photo frame, mm; vectors exaggerated).
@@ -463,13 +484,46 @@ def fig_distortion(c):
     ax2.set_aspect("equal")
     ax2.set_xlabel("x (mm)")
     ax2.set_ylabel("y (mm)")
-    ax2.set_title("correction dx, dy over the format", pad=14)
+    ax2.set_title("%scorrection dx, dy over the format" % title, pad=14)
+
+
+def fig_distortion(c):
+    """The camera's correction as aerocal computed it in its model (certificate.json `distortion`:
+    triangulation/calibration/distortion_figure.h; a rig's heads: one row per head from
+    `unit_figures`); this script restates no camera model."""
+    panels = unit_panels(c)
+    fig, axes = plt.subplots(len(panels), 2, figsize=(8, 3.4 * len(panels)), squeeze=False)
+    for (title, prefix, d, _), (ax1, ax2) in zip(panels, axes):
+        draw_distortion(ax1, ax2, d, c, title, prefix)
     fig.tight_layout()
     return fig
 
 
+def draw_correlation(ax, corr, title):
+    """The interior parameters' correlation matrix as aerocal exported it."""
+    if corr and corr.get("correlation"):
+        m = np.array(corr["correlation"])
+        im = ax.imshow(m, vmin=-1, vmax=1, cmap="RdBu_r")
+        names = corr["names"]
+        ax.set_xticks(range(len(names)))
+        ax.set_xticklabels(names, rotation=90)
+        ax.set_yticks(range(len(names)))
+        ax.set_yticklabels(names)
+        for i in range(len(names)):
+            for j in range(len(names)):
+                ax.text(j, i, "%.2f" % m[i, j], ha="center", va="center", fontsize=5)
+        ax.figure.colorbar(im, ax=ax, shrink=0.8)
+    ax.set_title("%scorrelation of the interior parameters" % title)
+
+
 def fig_residuals_correlation(c):
-    fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(8, 3.6))
+    """The residual vectors of all images, then one correlation map per head (a single camera: one),
+    two panels a row."""
+    panels = unit_panels(c)
+    rows = (len(panels) + 2) // 2
+    fig, axes = plt.subplots(rows, 2, figsize=(8, 3.6 * rows), squeeze=False)
+    axes = list(axes.flat)
+    ax1 = axes[0]
     cf = c["camera_file"]
     w, h = cf["format_px"]
     res = c.get("residuals") or []
@@ -484,20 +538,10 @@ def fig_residuals_correlation(c):
     ax1.set_title("image residuals (all images)", pad=14)
     ax1.set_xlabel("col (px)")
     ax1.set_ylabel("row (px)")
-    corr = c.get("correlation")
-    if corr and corr.get("correlation"):
-        m = np.array(corr["correlation"])
-        im = ax2.imshow(m, vmin=-1, vmax=1, cmap="RdBu_r")
-        names = corr["names"]
-        ax2.set_xticks(range(len(names)))
-        ax2.set_xticklabels(names, rotation=90)
-        ax2.set_yticks(range(len(names)))
-        ax2.set_yticklabels(names)
-        for i in range(len(names)):
-            for j in range(len(names)):
-                ax2.text(j, i, "%.2f" % m[i, j], ha="center", va="center", fontsize=5)
-        fig.colorbar(im, ax=ax2, shrink=0.8)
-    ax2.set_title("correlation of the interior parameters")
+    for (title, _, _, corr), ax in zip(panels, axes[1:]):
+        draw_correlation(ax, corr, title)
+    for ax in axes[1 + len(panels):]:
+        ax.axis("off")
     fig.tight_layout()
     return fig
 
@@ -695,7 +739,9 @@ def write_pdf_pages(c, tmp, title):
             plt.close(sub)
             buf.seek(0)
             img = plt.imread(buf)
-            ax = fig.add_axes([0.08, 0.45, 0.84, 0.5])  # 17 mm margins on A4
+            # 17 mm margins on A4; a rig's row per head takes the page's height.
+            tall = img.shape[0] > img.shape[1]
+            ax = fig.add_axes([0.08, 0.05, 0.84, 0.88] if tall else [0.08, 0.45, 0.84, 0.5])
             ax.imshow(img)
             ax.axis("off")
             pdf.savefig(fig)
