@@ -24,12 +24,12 @@ std::string CameraOutputPath(const std::string& out, const std::string& id, bool
 }
 
 int FinishAdjust(const triangulation::AdjustmentResult& result,
-                 const nlohmann::json& json,
+                 nlohmann::json json,
                  const std::string& out,
                  const std::string& write_camera,
                  const std::string& camera_kind,
                  const std::function<void()>& write_cameras) {
-  WriteResult(out, "adjust", json);
+  WriteResult(out, "adjust", std::move(json));  // no copy: the document is most of the peak
   const bool ok = result.valid;
   for (const auto& reason : result.invalid_reasons)
     std::fprintf(stderr, "adjust: not valid: %s\n", reason.c_str());
@@ -125,7 +125,7 @@ int RunJointAdjust(const JointAdjustArgs& joint,
   json["project"] = project_path;
   AddProjectFacts(input, &json);
   // As the plain adjustment: exit 3 and no camera when the result is not valid.
-  return FinishAdjust(result.adjustment, json, out, write_camera, "camera", [&] {
+  return FinishAdjust(result.adjustment, std::move(json), out, write_camera, "camera", [&] {
     const auto& cameras = result.adjustment.cameras;
     for (const auto& estimate : cameras) {
       const std::string path = CameraOutputPath(write_camera, estimate.id, cameras.size() > 1);

@@ -33,7 +33,7 @@ std::string CameraOutputPath(const std::string& out, const std::string& id, bool
 /// exists is one the next flight may use; otherwise says "<camera_kind> not written". Returns the
 /// exit code: 0 valid, 3 not valid (AdjustmentResult::valid).
 int FinishAdjust(const triangulation::AdjustmentResult& result,
-                 const nlohmann::json& json,
+                 nlohmann::json json,
                  const std::string& out,
                  const std::string& write_camera,
                  const std::string& camera_kind,

@@ -37,11 +37,11 @@ int RunRigAdjustment(const RigAdjustRequest& request,
                      const std::string& project_path,
                      const std::string& out,
                      const std::string& write_camera) {
-  const RigAdjustRun run = RunRigAdjust(request, options, input, project_path);
+  RigAdjustRun run = RunRigAdjust(request, options, input, project_path);
   std::printf("%s", run.printed.c_str());
   const triangulation::RigAdjustmentResult& result = run.result;
   // As the frame camera: exit 3 and no rig file when the result is not valid.
-  return FinishAdjust(result.adjustment, run.json, out, write_camera, "rig camera", [&] {
+  return FinishAdjust(result.adjustment, std::move(run.json), out, write_camera, "rig camera", [&] {
     calib::WriteRig(write_camera, triangulation::UpdatedRig(input.rigs.at(result.camera), result));
     std::printf("rig camera %s -> %s\n", result.camera.c_str(), write_camera.c_str());
   });
@@ -334,7 +334,7 @@ int RunFrameAdjust(const AdjustArgs* args,
   json["invalid_reasons"] = main.invalid_reasons;
   // Exit 3 (results written, valid: false) when the run must not be trusted; the camera file
   // is then not written at all.
-  return FinishAdjust(main, json, args->out, args->write_camera, "camera", [&] {
+  return FinishAdjust(main, std::move(json), args->out, args->write_camera, "camera", [&] {
     for (const auto& estimate : main.cameras) {
       const std::string path =
           CameraOutputPath(args->write_camera, estimate.id, main.cameras.size() > 1);

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include <fstream>
+#include <iterator>
 #include <map>
 #include <string>
 
@@ -74,6 +75,30 @@ TEST(JsonSchema, EveryResultKindHasASchema) {
     EXPECT_NE(Refusal({{"kind", "not_" + std::string(kind)}}, schema), "") << kind;
   }
   EXPECT_THROW(ResultText("no_such_kind", json::object()), LogicError);
+}
+
+// WriteResult streams the document into the file instead of building its text: the file holds
+// exactly ResultText's bytes, for every indent (0 is pretty with no indentation, -1 one line),
+// with non-ASCII text, nested arrays, doubles and nulls; a bad kind or invalid UTF-8 leaves no
+// file.
+TEST(ResultFile, WrittenFileIsResultTextByteForByte) {
+  testing::TempDir dir("aerocal_result_file");
+  const json document = {
+      {"b", {1.0 / 3.0, nullptr, -0.0, 1e-300, 12345678901234.5}},
+      {"a", {{"name", "Gau\u00df-Kr\u00fcger \"x\"\n"}, {"empty", json::array()}}},
+      {"n", 7},
+      {"o", json::object()}};
+  for (int indent : {2, 1, 0, -1}) {
+    const std::string path = dir.File("r" + std::to_string(indent + 1) + ".json");
+    WriteResult(path, "adjust", document, indent);
+    std::ifstream in(path, std::ios::binary);
+    const std::string written((std::istreambuf_iterator<char>(in)), {});
+    EXPECT_EQ(written, ResultText("adjust", document, indent)) << "indent " << indent;
+  }
+  EXPECT_THROW(WriteResult(dir.File("k.json"), "no_such_kind", document), LogicError);
+  EXPECT_THROW(WriteResult(dir.File("u.json"), "adjust", {{"s", "\xff"}}), json::type_error);
+  EXPECT_FALSE(std::ifstream(dir.File("k.json")).good());
+  EXPECT_FALSE(std::ifstream(dir.File("u.json")).good());
 }
 
 TEST(Finding, OneShapeWithNullForAMissingFigure) {
