@@ -198,6 +198,7 @@ void ProblemBuilder::ReleaseFactorized() const { factorized_.reset(); }
 
 const ProblemBuilder::Factorized* ProblemBuilder::Factorize(bool apply_loss,
                                                             int max_dense_parameters) const {
+  SettleManifolds();
   // With no loss function on an active residual, applying the loss changes nothing.
   bool any_loss = false;
   for (const Residual& r : residuals_) any_loss = any_loss || (r.active && r.has_loss);
@@ -436,6 +437,7 @@ int ProblemBuilder::NumObservations() const {
 
 Eigen::MatrixXd ProblemBuilder::DenseJacobian(const std::vector<BlockId>& blocks,
                                               std::vector<ResidualId>* row_owner) const {
+  SettleManifolds();
   ceres::Problem::EvaluateOptions options;
   for (BlockId b : blocks) options.parameter_blocks.push_back(blocks_[b].values);
   std::vector<ResidualId> owners;
@@ -858,6 +860,7 @@ constexpr int kCeresCovarianceLimit = 300;
 
 std::unique_ptr<internal::SchurComplement> ProblemBuilder::BuildSchurComplement(
     bool apply_loss, std::vector<BlockId>* free_blocks, std::vector<int>* first_row) const {
+  SettleManifolds();
   *free_blocks = FreeBlocksInOrder();
   const internal::ColumnBlocks columns = SchurLayout(blocks_, *free_blocks, residuals_, first_row);
   ceres::Problem::EvaluateOptions eval;
@@ -999,6 +1002,7 @@ std::map<ResidualId, std::vector<double>> ProblemBuilder::RedundancyNumbers(
 }
 
 std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters) const {
+  SettleManifolds();
   if (!RotationManifoldsSet()) return {};  // not solved yet: nothing is known about the rank
   const std::vector<BlockId> free_blocks = FreeBlocksInOrder();
   if (NumFreeParameters() > max_parameters) {
@@ -1035,6 +1039,7 @@ std::vector<std::string> ProblemBuilder::NullSpaceParameters(int max_parameters)
 }
 
 Eigen::MatrixXd ProblemBuilder::PlusJacobianOf(BlockId id) const {
+  SettleManifolds();
   const Block& block = blocks_[id];
   const ceres::Manifold* manifold = problem_->GetManifold(block.values);
   Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> j(block.size,
