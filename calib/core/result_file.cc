@@ -9,16 +9,23 @@
 
 namespace aerocal {
 
+int ResultSchemaVersion(std::string_view kind) {
+  for (const ResultKind& k : kResultKindTable)
+    if (k.name == kind) return k.schema_version;
+  AEROCAL_CHECK(false) << "result kind " << kind
+                       << " is not in kResultKinds (calib/core/result_file.h)";
+  return 0;
+}
+
 std::string ResultText(std::string_view kind, nlohmann::json document, int indent) {
-  AEROCAL_CHECK(std::find(kResultKinds.begin(), kResultKinds.end(), kind) != kResultKinds.end())
-      << "result kind " << kind << " is not in kResultKinds (calib/core/result_file.h)";
+  const int version = ResultSchemaVersion(kind);  // LogicError for a kind not listed
   AEROCAL_CHECK(document.is_object()) << "a result document is a JSON object";
   if (document.contains("kind")) {
     AEROCAL_CHECK(document["kind"] == std::string(kind))
         << "result of kind " << document["kind"].dump() << " written as " << kind;
   }
   document["kind"] = std::string(kind);
-  document["schema_version"] = kResultSchemaVersion;
+  document["schema_version"] = version;
   return document.dump(indent) + "\n";
 }
 
@@ -45,9 +52,10 @@ void CheckResult(const nlohmann::json& document,
                      ", expected " + expected + ")");
   const nlohmann::json version =
       document.contains("schema_version") ? document["schema_version"] : nlohmann::json();
-  if (!version.is_number_integer() || version.get<long long>() != kResultSchemaVersion)
+  const int expected_version = ResultSchemaVersion(kind.get<std::string>());
+  if (!version.is_number_integer() || version.get<long long>() != expected_version)
     throw InputError(path + ": schema_version is " + version.dump() + ", expected " +
-                     std::to_string(kResultSchemaVersion) + " (kind " + kind.dump() + ")");
+                     std::to_string(expected_version) + " (kind " + kind.dump() + ")");
 }
 
 void ValidateResult(const nlohmann::json& document,
