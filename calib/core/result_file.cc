@@ -10,19 +10,27 @@
 
 namespace aerocal {
 
+int ResultSchemaVersion(std::string_view kind) {
+  for (const ResultKind& k : kResultKindTable)
+    if (k.name == kind) return k.schema_version;
+  AEROCAL_CHECK(false) << "result kind " << kind
+                       << " is not in kResultKinds (calib/core/result_file.h)";
+  return 0;
+}
+
 namespace {
 
-// `document` checked and stamped with `kind` and `schema_version` (ResultText's contract).
+// `document` checked and stamped with `kind` and its kind's `schema_version` (ResultText's
+// contract); LogicError for a kind not listed.
 void Stamp(std::string_view kind, nlohmann::json* document) {
-  AEROCAL_CHECK(std::find(kResultKinds.begin(), kResultKinds.end(), kind) != kResultKinds.end())
-      << "result kind " << kind << " is not in kResultKinds (calib/core/result_file.h)";
+  const int version = ResultSchemaVersion(kind);
   AEROCAL_CHECK(document->is_object()) << "a result document is a JSON object";
   if (document->contains("kind")) {
     AEROCAL_CHECK((*document)["kind"] == std::string(kind))
         << "result of kind " << (*document)["kind"].dump() << " written as " << kind;
   }
   (*document)["kind"] = std::string(kind);
-  (*document)["schema_version"] = kResultSchemaVersion;
+  (*document)["schema_version"] = version;
 }
 
 // The text of document.dump(indent) written straight into `os`: the same serializer with the
@@ -67,9 +75,10 @@ void CheckResult(const nlohmann::json& document,
                      ", expected " + expected + ")");
   const nlohmann::json version =
       document.contains("schema_version") ? document["schema_version"] : nlohmann::json();
-  if (!version.is_number_integer() || version.get<long long>() != kResultSchemaVersion)
+  const int expected_version = ResultSchemaVersion(kind.get<std::string>());
+  if (!version.is_number_integer() || version.get<long long>() != expected_version)
     throw InputError(path + ": schema_version is " + version.dump() + ", expected " +
-                     std::to_string(kResultSchemaVersion) + " (kind " + kind.dump() + ")");
+                     std::to_string(expected_version) + " (kind " + kind.dump() + ")");
 }
 
 void ValidateResult(const nlohmann::json& document,

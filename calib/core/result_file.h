@@ -1,10 +1,10 @@
 // Result documents of the commands (JSON): ONE writer and ONE reader check for all of them.
 // Every result carries `kind` (which command wrote it: one of kResultKinds) and `schema_version`
-// (kResultSchemaVersion), and is written atomically (calib/core/atomic_file.h). A reader of a
-// result (the certificate, the report, a stitch result applied to a camera) checks both and
-// refuses any other document with `FILE: what` (an InputError: exit 2). The keys of each kind are
-// in its JSON Schema, docs/schema/<kind>.schema.json (docs/schema/README.md), which the CLI tests
-// check every written result against.
+// (the kind's version, ResultSchemaVersion), and is written atomically (calib/core/atomic_file.h).
+// A reader of a result (the certificate, the report, a stitch result applied to a camera) checks
+// both and refuses any other document with `FILE: what` (an InputError: exit 2). The keys of each
+// kind are in its JSON Schema, docs/schema/<kind>.schema.json (docs/schema/README.md), which the
+// CLI tests check every written result against.
 #pragma once
 
 #include <nlohmann/json.hpp>
@@ -16,28 +16,41 @@
 
 namespace aerocal {
 
-/// Version of every result document; raised when a key is renamed, removed or changes meaning or
-/// type (adding a key does not raise it), each raise listed in docs/schema/CHANGES.md. Readers
-/// accept exactly this version.
-inline constexpr int kResultSchemaVersion = 2;  // docs/schema/CHANGES.md
+/// A kind of result document and the version of its keys, raised when a key of that kind is
+/// renamed, removed or changes meaning or type (adding a key does not raise it), each raise listed
+/// in docs/schema/CHANGES.md. Readers accept exactly the kind's current version.
+struct ResultKind {
+  std::string_view name;
+  int schema_version;
+};
 
 /// Every kind of result document; each has its schema docs/schema/<kind>.schema.json (the test
 /// tools/cli_results fails for a kind without one). `calibrate` writes an "adjust" result with
 /// `command: "calibrate"`; `batch_manifest` is the manifest of `aerocal batch plan`.
-inline constexpr std::array<std::string_view, 14> kResultKinds = {"adjust",
-                                                                  "flight",
-                                                                  "stitch",
-                                                                  "rig_stitch",
-                                                                  "rig_error_analysis",
-                                                                  "rig_design",
-                                                                  "pushbroom",
-                                                                  "pushbroom_control",
-                                                                  "camera_conversion",
-                                                                  "certificate",
-                                                                  "quality_mtf",
-                                                                  "quality_bars",
-                                                                  "quality_star",
-                                                                  "batch_manifest"};
+inline constexpr std::array<ResultKind, 14> kResultKindTable = {{{"adjust", 3},
+                                                                 {"flight", 2},
+                                                                 {"stitch", 2},
+                                                                 {"rig_stitch", 3},
+                                                                 {"rig_error_analysis", 2},
+                                                                 {"rig_design", 2},
+                                                                 {"pushbroom", 3},
+                                                                 {"pushbroom_control", 2},
+                                                                 {"camera_conversion", 2},
+                                                                 {"certificate", 2},
+                                                                 {"quality_mtf", 2},
+                                                                 {"quality_bars", 2},
+                                                                 {"quality_star", 2},
+                                                                 {"batch_manifest", 2}}};
+
+/// The names of kResultKindTable, in its order.
+inline constexpr std::array<std::string_view, kResultKindTable.size()> kResultKinds = [] {
+  std::array<std::string_view, kResultKindTable.size()> names{};
+  for (size_t i = 0; i < names.size(); ++i) names[i] = kResultKindTable[i].name;
+  return names;
+}();
+
+/// The current schema_version of `kind`; LogicError when `kind` is not one of kResultKinds.
+int ResultSchemaVersion(std::string_view kind);
 
 /// `document` (a JSON object) stamped with `kind` and `schema_version`, as text (`indent` spaces,
 /// newline at the end). Throws LogicError when `kind` is not one of kResultKinds, `document` is not
@@ -52,7 +65,7 @@ void WriteResult(const std::string& path,
 
 /// Throws InputError("PATH: not a result of WHAT (kind is K, expected A or B)") unless `document`
 /// is an object whose `kind` is one of `kinds`, and InputError("PATH: schema_version is V, expected
-/// N (kind K)") unless its `schema_version` is kResultSchemaVersion. `what` names the
+/// N (kind K)") unless its `schema_version` is ResultSchemaVersion(K). `what` names the
 /// command for people ("`aerocal calibrate`").
 void CheckResult(const nlohmann::json& document,
                  const std::string& path,

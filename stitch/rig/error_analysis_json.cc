@@ -90,6 +90,77 @@ void AppendHistogram(const std::string& quantity,
             Number(lo + (hi - lo) * (b + 1) / bins) + "," + std::to_string(counts[b]) + "\n";
 }
 
+json SourcesJson(const std::vector<ErrorSource>& sources, const ErrorLimits& limits) {
+  json source_list = json::array();
+  for (const ErrorSource& s : sources) {
+    const auto [limit, unit] = FileLimit(s, limits);
+    source_list.push_back(
+        {{"source", s.name}, {"limit", limit}, {"sigma", limit / limits.sigmas}, {"unit", unit}});
+  }
+  return source_list;
+}
+
+json WorstCasesJson(const std::vector<WorstCase>& worst_cases) {
+  json worst = json::array();
+  for (const WorstCase& w : worst_cases) {
+    json signs = json::object();
+    for (size_t j = 0; j < w.sources.size(); ++j) signs[w.sources[j]] = w.signs[j];
+    worst.push_back({{"group", w.group},
+                     {"sources", w.sources},
+                     {"exhaustive", w.exhaustive},
+                     {"max_abs_px", Pair(w.max_abs_px)},
+                     {"max_radial_px", w.max_radial_px},
+                     {"signs", signs},
+                     {"sum_abs_px", Pair(w.sum_abs_px)}});
+  }
+  return worst;
+}
+
+// Relief: displacement between the reference head and each other head of a point relief_m off
+// the plane (CONVENTIONS.md formula).
+json ReliefJson(const calib::Rig& rig, double height_m, double relief_m) {
+  json relief = {{"dh_m", relief_m}, {"pairs", json::array()}};
+  const int reference = rig.ReferenceIndex();
+  for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k) {
+    if (k == reference) continue;
+    relief["pairs"].push_back(
+        {{"heads", json::array({rig.reference_head, rig.heads[k].id})},
+         {"displacement_px",
+          relief_m < height_m ? json(ReliefDisplacementPx(rig, reference, k, height_m, relief_m))
+                              : json(nullptr)}});
+  }
+  return relief;
+}
+
+json GridPointJson(const calib::Rig& rig, const TargetAnalysis& t) {
+  const WorstCase& all = t.worst_cases.back();
+  json point = TargetJson(rig, t);
+  point["linear"] = {{"sigma_px", Pair(t.linear.sigma_px)},
+                     {"bound_px", Pair(t.linear.bound_px)},
+                     {"bound_radial_px", t.linear.bound_radial_px}};
+  point["max_error"] = {{"max_radial_px", all.max_radial_px}, {"max_abs_px", Pair(all.max_abs_px)}};
+  point["monte_carlo"] = t.monte_carlo ? json{{"sigma_px", Pair(t.monte_carlo->sigma_px)},
+                                              {"bound_px", Pair(t.monte_carlo->bound_px)},
+                                              {"bound_radial_px", t.monte_carlo->bound_radial_px},
+                                              {"max_abs_px", Pair(t.monte_carlo->max_abs_px)}}
+                                       : json(nullptr);
+  return point;
+}
+
+json GridJson(const calib::Rig& rig, const GridAnalysis& grid, const ErrorAnalysisFiles& files) {
+  json points = json::array();
+  for (const TargetAnalysis& t : grid.points) points.push_back(GridPointJson(rig, t));
+  json unseen = json::array();
+  for (const auto& p : grid.unseen) unseen.push_back(Pair(p));
+  json out = {{"n", grid.n},
+              {"points", points},
+              {"unseen_virtual_px", unseen},
+              {"worst_index", grid.worst}};
+  if (!files.bound_map_csv.empty()) out["bound_map_csv"] = files.bound_map_csv;
+  if (!files.bound_map_png.empty()) out["bound_map_png"] = files.bound_map_png;
+  return out;
+}
+
 }  // namespace
 
 GridAnalysis AnalyseGrid(const calib::Rig& rig,
@@ -149,75 +220,19 @@ json ErrorAnalysisToJson(const calib::Rig& rig,
                    {"lever_arm_mm", limits.lever_arm_mm},
                    {"height_m", limits.height_m},
                    {"sigmas", limits.sigmas}};
-  json source_list = json::array();
-  for (const ErrorSource& s : sources) {
-    const auto [limit, unit] = FileLimit(s, limits);
-    source_list.push_back(
-        {{"source", s.name}, {"limit", limit}, {"sigma", limit / limits.sigmas}, {"unit", unit}});
-  }
-  doc["sources"] = source_list;
+  doc["sources"] = SourcesJson(sources, limits);
   doc["target"] = TargetJson(rig, target);
   json rows = json::array();
   for (const SourceErrorRow& row : target.per_source)
     rows.push_back(
         {{"source", row.source}, {"plus_px", Pair(row.plus_px)}, {"minus_px", Pair(row.minus_px)}});
   doc["per_source"] = rows;
-  json worst = json::array();
-  for (const WorstCase& w : target.worst_cases) {
-    json signs = json::object();
-    for (size_t j = 0; j < w.sources.size(); ++j) signs[w.sources[j]] = w.signs[j];
-    worst.push_back({{"group", w.group},
-                     {"sources", w.sources},
-                     {"exhaustive", w.exhaustive},
-                     {"max_abs_px", Pair(w.max_abs_px)},
-                     {"max_radial_px", w.max_radial_px},
-                     {"signs", signs},
-                     {"sum_abs_px", Pair(w.sum_abs_px)}});
-  }
-  doc["worst_case"] = worst;
+  doc["worst_case"] = WorstCasesJson(target.worst_cases);
   doc["linear"] = LinearJson(sources, target.linear);
   doc["monte_carlo"] =
       target.monte_carlo ? MonteCarloJson(*target.monte_carlo, files) : json(nullptr);
-  // Relief: displacement between the reference head and each other head of a point relief_m off
-  // the plane (CONVENTIONS.md formula).
-  json relief = {{"dh_m", relief_m}, {"pairs", json::array()}};
-  const int reference = rig.ReferenceIndex();
-  for (int k = 0; k < static_cast<int>(rig.heads.size()); ++k) {
-    if (k == reference) continue;
-    relief["pairs"].push_back(
-        {{"heads", json::array({rig.reference_head, rig.heads[k].id})},
-         {"displacement_px",
-          relief_m < height_m ? json(ReliefDisplacementPx(rig, reference, k, height_m, relief_m))
-                              : json(nullptr)}});
-  }
-  doc["relief"] = relief;
-  if (grid) {
-    json points = json::array();
-    for (const TargetAnalysis& t : grid->points) {
-      const WorstCase& all = t.worst_cases.back();
-      json point = TargetJson(rig, t);
-      point["linear"] = {{"sigma_px", Pair(t.linear.sigma_px)},
-                         {"bound_px", Pair(t.linear.bound_px)},
-                         {"bound_radial_px", t.linear.bound_radial_px}};
-      point["max_error"] = {{"max_radial_px", all.max_radial_px},
-                            {"max_abs_px", Pair(all.max_abs_px)}};
-      point["monte_carlo"] = t.monte_carlo
-                                 ? json{{"sigma_px", Pair(t.monte_carlo->sigma_px)},
-                                        {"bound_px", Pair(t.monte_carlo->bound_px)},
-                                        {"bound_radial_px", t.monte_carlo->bound_radial_px},
-                                        {"max_abs_px", Pair(t.monte_carlo->max_abs_px)}}
-                                 : json(nullptr);
-      points.push_back(point);
-    }
-    json unseen = json::array();
-    for (const auto& p : grid->unseen) unseen.push_back(Pair(p));
-    doc["grid"] = {{"n", grid->n},
-                   {"points", points},
-                   {"unseen_virtual_px", unseen},
-                   {"worst_index", grid->worst}};
-    if (!files.bound_map_csv.empty()) doc["grid"]["bound_map_csv"] = files.bound_map_csv;
-    if (!files.bound_map_png.empty()) doc["grid"]["bound_map_png"] = files.bound_map_png;
-  }
+  doc["relief"] = ReliefJson(rig, height_m, relief_m);
+  if (grid) doc["grid"] = GridJson(rig, *grid, files);
   return doc;
 }
 

@@ -41,6 +41,93 @@ std::string Px(double value) {
   return std::isfinite(value) ? StringPrintf("%.3f", value) : std::string("-");
 }
 
+// What the two RMS metrics, before / after and fit / check mean.
+nlohmann::json MetricJson() {
+  return {
+      {"unit", "px of the level virtual image"},
+      {"per_coordinate", "sqrt(sum(dx^2 + dy^2) / (2 n_pairs)) over the head pairs of each tie"},
+      {"pair_2d",
+       "sqrt(sum(dx^2 + dy^2) / n_pairs): the 2-D pair disagreement, sqrt(2) x "
+       "per_coordinate"},
+      {"before", "ground calibration alone (E = I, dT = 0)"},
+      {"after", "the estimated increments and offsets"},
+      {"fit", "ties used in the adjustment (their observations left after the snooping)"},
+      {"check", "check ties (points.csv role check without coordinates): never adjusted"}};
+}
+
+// One exposure's head: increments in deg and dT in ms, each sigma null where held or not
+// determinable (a zero increment sigma: no covariance).
+nlohmann::json RigExposureJson(const std::string& image, const RigStitchHead& h) {
+  const Eigen::Vector3d deg = h.increment_rad * kDegPerRad;
+  nlohmann::json sigma = {
+      {"domega", nullptr}, {"dphi", nullptr}, {"dkappa", nullptr}, {"dT_ms", nullptr}};
+  if (!h.reference && h.increment_sigma_rad.norm() > 0) {  // 0: no covariance
+    sigma["domega"] = h.increment_sigma_rad.x() * kDegPerRad;
+    sigma["dphi"] = h.increment_sigma_rad.y() * kDegPerRad;
+    sigma["dkappa"] = h.increment_sigma_rad.z() * kDegPerRad;
+  }
+  if (h.dt_sigma_s) sigma["dT_ms"] = *h.dt_sigma_s * 1e3;
+  return {{"image", image},
+          {"head", h.head},
+          {"reference", h.reference},
+          {"domega", deg.x()},
+          {"dphi", deg.y()},
+          {"dkappa", deg.z()},
+          {"dT_ms", h.dt_s ? nlohmann::json(*h.dt_s * 1e3) : nlohmann::json()},
+          {"sigma", sigma}};
+}
+
+// `exposures` (RMS per exposure and zone) and `rig_exposures` (per exposure and head).
+void WriteExposures(const RigStitchResult& result, nlohmann::json* doc) {
+  nlohmann::json exposures = nlohmann::json::array();
+  nlohmann::json rig_exposures = nlohmann::json::array();
+  for (const RigStitchExposureResult& e : result.exposures) {
+    exposures.push_back({{"image", e.image},
+                         {"stitching_rms_px", BeforeAfterJson(e.before, e.after)},
+                         {"zones", ZonesJson(e.zones)}});
+    for (const RigStitchHead& h : e.heads) rig_exposures.push_back(RigExposureJson(e.image, h));
+  }
+  (*doc)["exposures"] = exposures;
+  (*doc)["rig_exposures"] = rig_exposures;
+}
+
+nlohmann::json TimeOffsetsJson(const RigStitchOptions& options, const RigStitchResult& result) {
+  nlohmann::json correlations = nlohmann::json::array();
+  for (const auto& c : result.dt_correlations)
+    correlations.push_back({{"dT", c.dt}, {"angle", c.angle}, {"rho", c.rho}});
+  return {{"held", result.dt_held},
+          {"determinable", result.dt_determinable},
+          {"correlation_threshold", options.correlation_threshold},
+          {"correlations", correlations}};
+}
+
+nlohmann::json SnoopingJson(const RigStitchOptions& options, const RigStitchResult& result) {
+  nlohmann::json positions = nlohmann::json::array();
+  for (const auto& s : result.standard_positions)
+    positions.push_back({{"image", s.image},
+                         {"name", s.name},
+                         {"ties_before", s.ties_before},
+                         {"ties_after", s.ties_after}});
+  return {{"enabled", options.snooping},
+          {"alpha", options.alpha},
+          {"rejected", result.rejected},
+          {"stopped", result.stopped},
+          {"stop_reasons", result.stop_reasons},
+          {"stop_effect",
+           result.stopped ? calib::SuspectEffectJson(result.stop_effect) : nlohmann::json()},
+          {"standard_positions", positions}};
+}
+
+nlohmann::json ReliefJson(const RigStitchResult& result, const RigStitchSources& sources) {
+  return {{"relief_m", sources.relief_m ? nlohmann::json(*sources.relief_m) : nlohmann::json()},
+          {"height_m", result.height_m},
+          {"largest_px",
+           sources.relief_m ? nlohmann::json(result.relief_displacement_px) : nlohmann::json()},
+          {"formula",
+           "(c_v / p) |t_j - t_k| dh / (H (H - dh)), largest over the head pairs "
+           "(CONVENTIONS.md \"Multi-head rigs\")"}};
+}
+
 }  // namespace
 
 nlohmann::json RigStitchToJson(const calib::Rig& rig,
@@ -57,82 +144,16 @@ nlohmann::json RigStitchToJson(const calib::Rig& rig,
   doc["sigma0"] = result.sigma0;
   doc["sigma0_px"] = result.sigma0_px;
   doc["valid"] = result.failures.empty();
-  doc["failures"] = result.failures;
+  doc["invalid_reasons"] = result.failures;  // common.schema.json, as adjust
   doc["warnings"] = FindingsToJson(result.warnings);
-  doc["metric"] = {
-      {"unit", "px of the level virtual image"},
-      {"per_coordinate", "sqrt(sum(dx^2 + dy^2) / (2 n_pairs)) over the head pairs of each tie"},
-      {"pair_2d",
-       "sqrt(sum(dx^2 + dy^2) / n_pairs): the 2-D pair disagreement, sqrt(2) x "
-       "per_coordinate"},
-      {"before", "ground calibration alone (E = I, dT = 0)"},
-      {"after", "the estimated increments and offsets"},
-      {"fit", "ties used in the adjustment (their observations left after the snooping)"},
-      {"check", "check ties (points.csv role check without coordinates): never adjusted"}};
+  doc["metric"] = MetricJson();
   doc["stitching_rms_px"] = BeforeAfterJson(result.before, result.after);
   doc["zones"] = ZonesJson(result.zones);
-
-  nlohmann::json exposures = nlohmann::json::array();
-  nlohmann::json rig_exposures = nlohmann::json::array();
-  for (const RigStitchExposureResult& e : result.exposures) {
-    exposures.push_back({{"image", e.image},
-                         {"stitching_rms_px", BeforeAfterJson(e.before, e.after)},
-                         {"zones", ZonesJson(e.zones)}});
-    for (const RigStitchHead& h : e.heads) {
-      const Eigen::Vector3d deg = h.increment_rad * kDegPerRad;
-      nlohmann::json sigma = {
-          {"domega", nullptr}, {"dphi", nullptr}, {"dkappa", nullptr}, {"dT_ms", nullptr}};
-      if (!h.reference && h.increment_sigma_rad.norm() > 0) {  // 0: no covariance
-        sigma["domega"] = h.increment_sigma_rad.x() * kDegPerRad;
-        sigma["dphi"] = h.increment_sigma_rad.y() * kDegPerRad;
-        sigma["dkappa"] = h.increment_sigma_rad.z() * kDegPerRad;
-      }
-      if (h.dt_sigma_s) sigma["dT_ms"] = *h.dt_sigma_s * 1e3;
-      rig_exposures.push_back({{"image", e.image},
-                               {"head", h.head},
-                               {"reference", h.reference},
-                               {"domega", deg.x()},
-                               {"dphi", deg.y()},
-                               {"dkappa", deg.z()},
-                               {"dT_ms", h.dt_s ? nlohmann::json(*h.dt_s * 1e3) : nlohmann::json()},
-                               {"sigma", sigma}});
-    }
-  }
-  doc["exposures"] = exposures;
-  doc["rig_exposures"] = rig_exposures;
-
-  nlohmann::json correlations = nlohmann::json::array();
-  for (const auto& c : result.dt_correlations)
-    correlations.push_back({{"dT", c.dt}, {"angle", c.angle}, {"rho", c.rho}});
-  doc["time_offsets"] = {{"held", result.dt_held},
-                         {"determinable", result.dt_determinable},
-                         {"correlation_threshold", options.correlation_threshold},
-                         {"correlations", correlations}};
-
-  nlohmann::json positions = nlohmann::json::array();
-  for (const auto& s : result.standard_positions)
-    positions.push_back({{"image", s.image},
-                         {"name", s.name},
-                         {"ties_before", s.ties_before},
-                         {"ties_after", s.ties_after}});
-  doc["snooping"] = {
-      {"enabled", options.snooping},
-      {"alpha", options.alpha},
-      {"rejected", result.rejected},
-      {"stopped", result.stopped},
-      {"stop_reasons", result.stop_reasons},
-      {"stop_effect",
-       result.stopped ? calib::SuspectEffectJson(result.stop_effect) : nlohmann::json()},
-      {"standard_positions", positions}};
+  WriteExposures(result, &doc);
+  doc["time_offsets"] = TimeOffsetsJson(options, result);
+  doc["snooping"] = SnoopingJson(options, result);
   doc["dropped_ties"] = result.dropped_ties;
-  doc["relief_displacement"] = {
-      {"relief_m", sources.relief_m ? nlohmann::json(*sources.relief_m) : nlohmann::json()},
-      {"height_m", result.height_m},
-      {"largest_px",
-       sources.relief_m ? nlohmann::json(result.relief_displacement_px) : nlohmann::json()},
-      {"formula",
-       "(c_v / p) |t_j - t_k| dh / (H (H - dh)), largest over the head pairs "
-       "(CONVENTIONS.md \"Multi-head rigs\")"}};
+  doc["relief_displacement"] = ReliefJson(result, sources);
   return doc;
 }
 

@@ -6,6 +6,7 @@
 #include "calib/core/error.h"
 #include "calib/core/finding.h"
 #include "calib/core/result_file.h"
+#include "calib/problem/mounted_block.h"
 #include "calib/problem/solve_statistics_json.h"
 #include "tests/support/test_support.h"
 
@@ -99,6 +100,63 @@ TEST(ResultFile, WrittenFileIsResultTextByteForByte) {
   EXPECT_THROW(WriteResult(dir.File("u.json"), "adjust", {{"s", "\xff"}}), json::type_error);
   EXPECT_FALSE(std::ifstream(dir.File("k.json")).good());
   EXPECT_FALSE(std::ifstream(dir.File("u.json")).good());
+}
+
+// Each kind carries its own schema_version (docs/schema/CHANGES.md): version 3 raised the kinds
+// whose keys changed (adjust, pushbroom, rig_stitch) and left the others at 2, so their files stay
+// readable. The writer stamps the kind's version; a reader refuses another by the kind's number.
+TEST(ResultKinds, EachKindHasItsOwnVersion) {
+  for (const char* kind : {"adjust", "pushbroom", "rig_stitch"})
+    EXPECT_EQ(ResultSchemaVersion(kind), 3) << kind;
+  for (const char* kind : {"flight", "stitch", "certificate", "rig_error_analysis"})
+    EXPECT_EQ(ResultSchemaVersion(kind), 2) << kind;
+  EXPECT_THROW(ResultSchemaVersion("no_such_kind"), LogicError);
+  ASSERT_EQ(kResultKinds.size(), kResultKindTable.size());
+  for (size_t i = 0; i < kResultKinds.size(); ++i) {
+    EXPECT_EQ(kResultKinds[i], kResultKindTable[i].name);
+    const json stamped = json::parse(ResultText(kResultKinds[i], json::object()));
+    EXPECT_EQ(stamped["schema_version"], kResultKindTable[i].schema_version) << kResultKinds[i];
+  }
+  const auto refusal = [](const json& document) -> std::string {
+    try {
+      CheckResult(document, "r.json", {"adjust", "stitch"}, "a test");
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(refusal({{"kind", "stitch"}, {"schema_version", 2}}), "");
+  EXPECT_EQ(refusal({{"kind", "adjust"}, {"schema_version", 3}}), "");
+  EXPECT_EQ(refusal({{"kind", "adjust"}, {"schema_version", 2}}),
+            "r.json: schema_version is 2, expected 3 (kind \"adjust\")");
+  EXPECT_EQ(refusal({{"kind", "stitch"}, {"schema_version", 3}}),
+            "r.json: schema_version is 3, expected 2 (kind \"stitch\")");
+}
+
+// The one form of a block mounted on a carrier (calib/problem/mounted_block.h) is the schema's
+// mounted_block: three entries for a mount or lever arm, one for a time offset, an unknown sigma
+// null; the wrong number of entries (keys are checked in name order: sigma first) or an unknown
+// mode does not validate.
+TEST(MountedBlock, OneShapeInTheCommonSchema) {
+  const json common = ReadJsonSchema(testing::SchemaPath("common"));
+  const auto schema = [&](const std::string& name) {
+    return json({{"$ref", "#/definitions/" + name}, {"definitions", common["definitions"]}});
+  };
+  const json mount = calib::MountedBlockToJson(
+      calib::BlockMode::kFree, Eigen::Vector3d(0.1, 1.0, -0.2), Eigen::VectorXd::Constant(3, 1e-3));
+  EXPECT_EQ(Refusal(mount, schema("mounted_block_3")), "");
+  const json held =
+      calib::MountedBlockToJson(calib::BlockMode::kFixed, Eigen::VectorXd::Zero(1), std::nullopt);
+  EXPECT_EQ(held, json({{"mode", "fixed"}, {"value", {0.0}}, {"sigma", {nullptr}}}));
+  EXPECT_EQ(Refusal(held, schema("mounted_block_1")), "");
+  EXPECT_EQ(Refusal(held, schema("mounted_block_3")),
+            "r.json: sigma: expected at least 3 items (got [null])");
+  EXPECT_EQ(Refusal(mount, schema("mounted_block_1")),
+            "r.json: sigma: expected at most 1 items (got [0.001,0.001,0.001])");
+  json loose = mount;
+  loose["mode"] = "loose";
+  EXPECT_NE(Refusal(loose, schema("mounted_block")).find("mode: expected one of"),
+            std::string::npos);
 }
 
 TEST(Finding, OneShapeWithNullForAMissingFigure) {

@@ -588,7 +588,8 @@ def test_adjust_of_a_rig_block_equals_the_command(tmp_path):
     for h, e in zip(heads, expected["rig"]["heads"]):
         assert h["estimated"] == e["interior"] and h["sigma"] == e["interior_sigma"]
         assert h["mount_deg"] == e["mount_deg"] and h["lever_arm_m"] == e["lever_arm_m"]
-    assert heads[1]["mount_sigma_deg"][1] > 0
+    assert heads[1]["mount_deg"]["mode"] == "free" and heads[1]["mount_deg"]["sigma"][1] > 0
+    assert heads[1]["lever_arm_m"]["mode"] == "fixed" and heads[1]["lever_arm_m"]["sigma"] == [None] * 3
     # The command's refusals, by the keyword's option name.
     with pytest.raises(ValueError, match="--self-calibration auto: not available for a rig project"):
         aerocal.adjust(block, self_calibration="auto")

@@ -185,7 +185,7 @@ subimages:
   const calib::Camera camera = calib::ReadCamera(tmp.File("camera.yaml"));
   // Stitch result: the nominal mappings, II shifted left by half a pixel.
   nlohmann::json result = {{"kind", "stitch"},
-                           {"schema_version", aerocal::kResultSchemaVersion},
+                           {"schema_version", aerocal::ResultSchemaVersion("stitch")},
                            {"subimages", nlohmann::json::array()}};
   for (const auto& s : camera.subimages) {
     std::vector<double> p = s.params;

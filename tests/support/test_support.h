@@ -39,8 +39,8 @@ nlohmann::json ReadJson(const std::string& path);
 std::string SchemaPath(const std::string& kind);
 
 /// Adds a test failure unless `document` (read from `path`) is a result of one of kResultKinds, of
-/// kResultSchemaVersion, that validates against docs/schema/<kind>.schema.json (the failure names
-/// the first key path that does not, calib/core/json_schema.h).
+/// its kind's ResultSchemaVersion, that validates against docs/schema/<kind>.schema.json (the
+/// failure names the first key path that does not, calib/core/json_schema.h).
 void ExpectValidResult(const nlohmann::json& document, const std::string& path);
 /// The same for the result file `path`.
 void ExpectValidResult(const std::string& path);

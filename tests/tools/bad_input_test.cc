@@ -265,7 +265,7 @@ void AddGroupColumn(const std::string& tf,
 // A minimal calibrate result for `certificate`: one uncertainty row, with or without the
 // calibration's stability table.
 std::string CertificateResult(const std::string& uncertainty_row, bool stability = true) {
-  return "{\"kind\": \"adjust\", \"schema_version\": 2, \"command\": \"calibrate\",\n"
+  return "{\"kind\": \"adjust\", \"schema_version\": 3, \"command\": \"calibrate\",\n"
          " \"valid\": true, \"cameras\": [{}],\n"
          " \"calibration\": {\"method\": {}, \"camera\": {}, \"data\": {}, \"rms_px\": 0.1,"
          " \"groups\": [],\n  \"uncertainty\": [" +

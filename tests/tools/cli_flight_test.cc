@@ -126,7 +126,7 @@ TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
   const auto doc = aerocal::testing::ReadJson(dir_->File("report/result.json"));
   EXPECT_EQ(doc["kind"], "flight");
-  EXPECT_EQ(doc["schema_version"], kResultSchemaVersion);
+  EXPECT_EQ(doc["schema_version"], ResultSchemaVersion("flight"));
   EXPECT_EQ(doc["camera_model"]["name"], "brown_fraser_10");
   // Every file read, with its SHA-256 (issue 33 item 1): the virtual project's and the joint
   // step's sub-image project's, each once.

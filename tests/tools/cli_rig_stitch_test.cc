@@ -72,7 +72,7 @@ TEST(RigStitchCommand, LineModeOnASimulatedLineWithTheIssueKeys) {
   EXPECT_NE(run.output.find("before -> after"), std::string::npos) << run.output;
   const json doc = ReadJson(dir.File("r.json"));
   EXPECT_EQ(doc["kind"], "rig_stitch");
-  EXPECT_EQ(doc["schema_version"], kResultSchemaVersion);
+  EXPECT_EQ(doc["schema_version"], ResultSchemaVersion("rig_stitch"));
   EXPECT_FALSE(doc["camera_models"].empty());
   EXPECT_EQ(doc["mode"], "line");
   EXPECT_TRUE(doc["converged"].get<bool>());

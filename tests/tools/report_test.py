@@ -435,7 +435,7 @@ def adjust_result(**extra):
                {"image": "A", "point": "K1", "rays": 2, "r": [0.2, 0.0], "untestable": True, "reason": "r = 0"},
                {"image": "B", "point": "K1", "rays": 2, "r": [0.3, 0.05], "reason": "weak"}]},
            "warnings": []}
-    doc = dict(own, kind="adjust", schema_version=2, project="p",
+    doc = dict(own, kind="adjust", schema_version=3, project="p",
                camera_format={"width_px": 1000, "height_px": 800, "pixel_size_mm": 0.01},
                conventional=dict(own, self_calibration=[], name="x"))
     doc.update(extra)

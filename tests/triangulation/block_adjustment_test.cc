@@ -131,7 +131,7 @@ TEST_F(SimulatedFlightAdjustment, ResultJsonHasTheFormatsKeys) {
 
 TEST_F(SimulatedFlightAdjustment, ResultJsonCarriesItsSchemaVersionAndTheModelsParameterTable) {
   const auto j = AdjustmentToJson(*self_);
-  EXPECT_EQ(j["schema_version"], kResultSchemaVersion);
+  EXPECT_EQ(j["schema_version"], ResultSchemaVersion("adjust"));
   const auto& model = j["camera_model"];
   EXPECT_EQ(model["name"], std::string(Model::kName));
   EXPECT_EQ(model["id"], static_cast<int>(Model::kId));

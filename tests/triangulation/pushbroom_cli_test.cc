@@ -76,10 +76,17 @@ TEST(PushbroomCommands, SimulateThenCalibrate) {
     EXPECT_TRUE(doc.contains(key)) << key;
   EXPECT_EQ(doc["kind"], "pushbroom");
   EXPECT_TRUE(doc["c_sigma_mm"].is_null()) << "c fixed: unknown sigma is null";
-  EXPECT_EQ(doc["boresight"]["mode"], "fixed");
-  EXPECT_TRUE(doc["boresight"]["sigma_deg"].is_null()) << "fixed: sigma null";
-  EXPECT_EQ(doc["lever_arm"]["mode"], "fixed");
-  EXPECT_TRUE(doc["lever_arm"]["sigma_m"].is_null()) << "fixed: sigma null";
+  // The mounted blocks in the one form {mode, value, sigma} (calib/problem/mounted_block.h): held,
+  // so each sigma is null, and the time offset held at 0 ms.
+  for (const char* key : {"boresight_deg", "lever_arm_m"}) {
+    EXPECT_EQ(doc[key]["mode"], "fixed") << key;
+    ASSERT_EQ(doc[key]["value"].size(), 3u) << key;
+    for (const json& s : doc[key]["sigma"])
+      EXPECT_TRUE(s.is_null()) << key << ": fixed, sigma null";
+  }
+  EXPECT_EQ(doc["time_offset_ms"]["mode"], "fixed");
+  EXPECT_EQ(doc["time_offset_ms"]["value"], json::array({0.0}));
+  EXPECT_TRUE(doc["time_offset_ms"]["sigma"][0].is_null());
   ASSERT_EQ(doc["subcameras"].size(), 3u);
   for (const json& s : doc["subcameras"]) {
     EXPECT_LT(s["rms_after_px"]["across"].get<double>(), 0.35);
@@ -229,12 +236,11 @@ TEST(PushbroomCommands, BoresightAndLeverArmFromAPlantedMisalignment) {
               std::string::npos)
         << run.output;
     const json doc = aerocal::testing::ReadJson(dir.File(name + ".json"));
-    const json& entry = boresight ? doc["boresight"] : doc["lever_arm"];
+    const json& entry = boresight ? doc["boresight_deg"] : doc["lever_arm_m"];
     ASSERT_EQ(entry["mode"], "free");
     const calib::LineCamera out = calib::ReadLineCamera(dir.File(name + "_out.yaml"));
     for (int a = 0; a < 3; ++a) {
-      const double v = entry[boresight ? "opk_deg" : "xyz_m"][a],
-                   s = entry[boresight ? "sigma_deg" : "sigma_m"][a];
+      const double v = entry["value"][a], s = entry["sigma"][a];
       EXPECT_LT(std::abs(v - (boresight ? truth_deg[a] : truth_m[a])), 3 * s) << name << " " << a;
       if (boresight || a < 2) {
         EXPECT_GT(std::abs(v - (boresight ? planted_deg[a] : planted_m[a])), 3 * s)
@@ -254,11 +260,11 @@ TEST(PushbroomCommands, BoresightAndLeverArmFromAPlantedMisalignment) {
                            "lever_arm_x_vs_boresight"})
     EXPECT_TRUE(doc["correlations"].contains(name)) << name;
   for (int a = 0; a < 3; ++a) {
-    EXPECT_LT(std::abs(doc["boresight"]["opk_deg"][a].get<double>() - truth_deg[a]),
-              3 * doc["boresight"]["sigma_deg"][a].get<double>())
+    EXPECT_LT(std::abs(doc["boresight_deg"]["value"][a].get<double>() - truth_deg[a]),
+              3 * doc["boresight_deg"]["sigma"][a].get<double>())
         << a;
-    EXPECT_LT(std::abs(doc["lever_arm"]["xyz_m"][a].get<double>() - truth_m[a]),
-              3 * doc["lever_arm"]["sigma_m"][a].get<double>())
+    EXPECT_LT(std::abs(doc["lever_arm_m"]["value"][a].get<double>() - truth_m[a]),
+              3 * doc["lever_arm_m"]["sigma"][a].get<double>())
         << a;
   }
 
@@ -269,11 +275,12 @@ TEST(PushbroomCommands, BoresightAndLeverArmFromAPlantedMisalignment) {
                             " --lever-arm weighted --lever-arm-sigma-m 0.05");
   ASSERT_TRUE(weighted.exit_code == 0 || weighted.exit_code == 3) << weighted.output;
   const json w = aerocal::testing::ReadJson(dir.File("weighted.json"));
-  ASSERT_EQ(w["boresight"]["mode"], "weighted");
+  ASSERT_EQ(w["boresight_deg"]["mode"], "weighted");
+  ASSERT_EQ(w["lever_arm_m"]["mode"], "weighted");
   const double cap = std::max(1.0, w["sigma0"].get<double>()) * (1 + 1e-9);  // sigma0 sqrt(Q)
   for (int a = 0; a < 3; ++a) {
-    EXPECT_LE(w["boresight"]["sigma_deg"][a].get<double>(), 0.01 * cap);
-    EXPECT_LE(w["lever_arm"]["sigma_m"][a].get<double>(), 0.05 * cap);
+    EXPECT_LE(w["boresight_deg"]["sigma"][a].get<double>(), 0.01 * cap);
+    EXPECT_LE(w["lever_arm_m"]["sigma"][a].get<double>(), 0.05 * cap);
   }
 }
 

@@ -105,7 +105,7 @@ TEST(PushbroomControl, ReferenceOrientationFromTheBlockResult) {
     std::ofstream(path) << doc.dump(1);
   };
   const json result = {{"kind", "adjust"},
-                       {"schema_version", kResultSchemaVersion},
+                       {"schema_version", ResultSchemaVersion("adjust")},
                        {"valid", true},
                        {"exposures", exposures}};
   write(tmp.File("result.json"), result);

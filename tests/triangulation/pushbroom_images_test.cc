@@ -88,7 +88,7 @@ TEST(PushbroomImageMode, ControlOnRenderedPixelsCalibratesWithinOneAndAHalfTheGe
   ASSERT_EQ(c.exit_code, 0) << c.output;
   const json cj = testing::ReadJson(control + "/control.json");
   EXPECT_EQ(cj["kind"], "pushbroom_control");
-  EXPECT_EQ(cj["schema_version"], kResultSchemaVersion);
+  EXPECT_EQ(cj["schema_version"], ResultSchemaVersion("pushbroom_control"));
   EXPECT_GE(cj["n_points"].get<int>(), 250) << c.output;
   // Gross errors are few on clean synthetic pixels: below 5 % of the points.
   EXPECT_LT(cj["rejected"]["gross_error"].get<int>(), cj["n_points"].get<int>() / 20 + 1);

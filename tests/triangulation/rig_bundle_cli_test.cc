@@ -42,15 +42,21 @@ TEST_F(RigAdjustCommand, WritesTheRigResultAndTheRigFile) {
   const auto& heads = j["rig"]["heads"];
   ASSERT_EQ(heads.size(), 2u);
   EXPECT_TRUE(heads[0]["reference"].get<bool>());
-  for (const char* key : {"interior",
-                          "interior_sigma",
-                          "mount_deg",
-                          "mount_sigma_deg",
-                          "lever_arm_m",
-                          "lever_arm_sigma_m",
-                          "dT_ms"})
+  for (const char* key :
+       {"interior", "interior_sigma", "mount_deg", "lever_arm_m", "time_offset_ms"})
     EXPECT_TRUE(heads[1].contains(key)) << key;
-  EXPECT_GT(heads[1]["mount_sigma_deg"][1].get<double>(), 0.0);
+  // Mounted blocks in the one form {mode, value, sigma}: head B's as the options say, the
+  // reference head's held (the rig's datum) with null sigmas; time offsets held by default.
+  EXPECT_EQ(heads[1]["mount_deg"]["mode"], "free");
+  EXPECT_EQ(heads[1]["lever_arm_m"]["mode"], "free");
+  EXPECT_GT(heads[1]["mount_deg"]["sigma"][1].get<double>(), 0.0);
+  for (const char* key : {"mount_deg", "lever_arm_m", "time_offset_ms"}) {
+    EXPECT_EQ(heads[0][key]["mode"], "fixed") << key;
+    for (const auto& s : heads[0][key]["sigma"]) EXPECT_TRUE(s.is_null()) << key;
+  }
+  EXPECT_EQ(heads[1]["time_offset_ms"]["mode"], "fixed");
+  EXPECT_TRUE(heads[1]["time_offset_ms"]["sigma"][0].is_null());
+  EXPECT_TRUE(j["rig_exposures"][0]["sigma"]["dphi"].is_null()) << "held increment: no sigma";
   EXPECT_EQ(j["rig"]["options"]["mounts"], "free");
   EXPECT_EQ(j["rig_exposures"].size(), 12u);  // 12 exposures x head B
   EXPECT_TRUE(j["rig"]["determinability"]["determinable"].get<bool>());
@@ -58,11 +64,13 @@ TEST_F(RigAdjustCommand, WritesTheRigResultAndTheRigFile) {
   const calib::Rig next = calib::ReadRig(dir_.File("next/rig.yaml"));
   const calib::RigHead& b = next.heads[next.HeadIndex("B")];
   for (int i = 0; i < 3; ++i) {
-    EXPECT_NEAR(b.mount_rad(i) * 180.0 / M_PI, heads[1]["mount_deg"][i].get<double>(), 1e-12);
-    EXPECT_NEAR(b.lever_arm_m(i), heads[1]["lever_arm_m"][i].get<double>(), 1e-12);
-    ASSERT_TRUE(b.mount_sigma_rad.has_value());
     EXPECT_NEAR(
-        (*b.mount_sigma_rad)(i)*180.0 / M_PI, heads[1]["mount_sigma_deg"][i].get<double>(), 1e-12);
+        b.mount_rad(i) * 180.0 / M_PI, heads[1]["mount_deg"]["value"][i].get<double>(), 1e-12);
+    EXPECT_NEAR(b.lever_arm_m(i), heads[1]["lever_arm_m"]["value"][i].get<double>(), 1e-12);
+    ASSERT_TRUE(b.mount_sigma_rad.has_value());
+    EXPECT_NEAR((*b.mount_sigma_rad)(i)*180.0 / M_PI,
+                heads[1]["mount_deg"]["sigma"][i].get<double>(),
+                1e-12);
   }
   // The next flight: the written rig with weighted mounts and lever arms.
   std::filesystem::copy_file(dir_.File("next/rig.yaml"),
@@ -97,11 +105,14 @@ TEST_F(RigAdjustCommand, WeightedIncrementsAndTimeOffsetsWithVelocity) {
   EXPECT_EQ(j["rig"]["options"]["time_offset_sigma_ms"].get<double>(), 50.0);
   EXPECT_NEAR(j["rig"]["options"]["increment_sigma_arcsec"].get<double>(), 5.0, 1e-12);
   const auto& b = j["rig"]["heads"][1];
-  const double dt = b["dT_ms"].get<double>(), sigma = b["dT_sigma_ms"].get<double>();
+  ASSERT_EQ(b["time_offset_ms"]["mode"], "weighted");
+  const double dt = b["time_offset_ms"]["value"][0].get<double>(),
+               sigma = b["time_offset_ms"]["sigma"][0].get<double>();
   EXPECT_GT(sigma, 0.0);
   EXPECT_LT(std::abs(dt - 3.0), 3.0 * sigma) << dt << " +- " << sigma;
   EXPECT_LT(sigma, 5.0);  // the data, not the 50 ms prior, determine it
-  EXPECT_EQ(b["lever_arm_sigma_m"][0].get<double>(), 0.0);  // fixed
+  EXPECT_EQ(b["lever_arm_m"]["mode"], "fixed");
+  EXPECT_TRUE(b["lever_arm_m"]["sigma"][0].is_null()) << "held: no sigma, never 0";
   EXPECT_GT(j["rig_exposures"][0]["sigma"]["dphi"].get<double>(), 0.0);
 }
 

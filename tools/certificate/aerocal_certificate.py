@@ -774,7 +774,7 @@ def write_pdf_pages(c, tmp, title):
             plt.close(fig)
 
 
-# kResultSchemaVersion of calib/core/result_file.h: the certificate version this renderer reads.
+# ResultSchemaVersion("certificate") of calib/core/result_file.h: the version this renderer reads.
 SCHEMA_VERSION = 2
 
 

@@ -365,9 +365,9 @@ Result Adjust(const Block& block,
 }
 
 // The rig heads of a rig result, each {id, reference, estimated, sigma (by the head model's
-// parameter names; None where unknown), mount_deg, mount_sigma_deg, lever_arm_m,
-// lever_arm_sigma_m, dT_ms, dT_sigma_ms}: the result file's `rig.heads` with the frame
-// cameras' names for the interior.
+// parameter names; None where unknown), mount_deg, lever_arm_m, time_offset_ms (each a mounted
+// block {mode, value, sigma})}: the result file's `rig.heads` with the frame cameras' names for
+// the interior.
 py::list RigHeads(const Result& r) {
   py::list heads;
   if (r.rig.is_null()) return heads;
@@ -594,8 +594,9 @@ arrays (exposures, points, observations).)doc")
           "heads",
           &RigHeads,
           "A rig block's heads (rig file order): dicts {id, reference, estimated, sigma (by "
-          "parameter name; None where unknown), mount_deg, mount_sigma_deg, lever_arm_m, "
-          "lever_arm_sigma_m, dT_ms, dT_sigma_ms}; [] for frame cameras")
+          "parameter name; None where unknown), mount_deg, lever_arm_m, time_offset_ms (each "
+          "{mode, value, sigma}: fixed, free or weighted, sigma None where held or unknown)}; [] "
+          "for frame cameras")
       .def_property_readonly(
           "rig",
           [](const Result& r) {

@@ -22,8 +22,8 @@ ADJUSTMENT_TITLES = {"conventional": "Conventional triangulation",
                      "joint": "Joint adjustment (stitching and triangulation)"}
 
 
-# kResultSchemaVersion of calib/core/result_file.h: the result version this reader understands.
-SCHEMA_VERSION = 2
+# ResultSchemaVersion of calib/core/result_file.h: the version of each kind this reader understands.
+SCHEMA_VERSIONS = {"flight": 2, "adjust": 3}
 
 
 class InputError(Exception):
@@ -45,9 +45,10 @@ def load(path):
     if doc.get("kind") not in ("flight", "adjust"):
         raise InputError(f"{path}: not a flight or adjust result (kind is {json.dumps(doc.get('kind'))}, "
                          f"expected \"flight\" or \"adjust\")")
-    if doc.get("schema_version") != SCHEMA_VERSION or isinstance(doc.get("schema_version"), bool):
+    expected = SCHEMA_VERSIONS[doc["kind"]]
+    if doc.get("schema_version") != expected or isinstance(doc.get("schema_version"), bool):
         raise InputError(f"{path}: schema_version is {json.dumps(doc.get('schema_version'))}, "
-                         f"expected {SCHEMA_VERSION} (kind {json.dumps(doc.get('kind'))})")
+                         f"expected {expected} (kind {json.dumps(doc.get('kind'))})")
     if doc["kind"] == "adjust":
         return as_flight_document(doc)
     inflate_residual_tables(doc, path)  # `flight --residuals-csv`: only a flight writes them

@@ -17,7 +17,7 @@ import sys
 sys.dont_write_bytecode = True  # keep the source tree free of __pycache__
 
 
-# kResultSchemaVersion of calib/core/result_file.h: the result version this reader understands.
+# ResultSchemaVersion("rig_error_analysis") of calib/core/result_file.h: the version this reader understands.
 SCHEMA_VERSION = 2
 
 

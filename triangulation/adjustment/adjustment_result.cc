@@ -3,6 +3,8 @@
 #include "calib/core/error.h"
 #include "calib/core/string_printf.h"
 #include "calib/problem/solve_statistics_json.h"
+#include "triangulation/adjustment/determinability.h"
+#include "triangulation/adjustment/mounted_json.h"
 
 #include <algorithm>
 #include <cmath>
@@ -20,28 +22,19 @@ nlohmann::json Vec(const Eigen::Vector3d& v) { return {v.x(), v.y(), v.z()}; }
 // A number, or null when it is not finite (untestable component, unknown sigma).
 nlohmann::json Finite(double x) { return std::isfinite(x) ? nlohmann::json(x) : nlohmann::json(); }
 
-// "platform": each parameter in the one mounted-block form (calib::MountedBlockToJson: mode,
+// "platform": each parameter in the one mounted-block form (MountedToJson: mode,
 // value, sigma null when fixed or unknown), in the units of the project YAML's `platform:` keys
 // (m, deg, ms).
 nlohmann::json PlatformToJson(const PlatformEstimate& p) {
-  constexpr double kDeg = 180.0 / M_PI;
-  auto scaled = [](const auto& s, double k) {
-    return s ? std::optional<Eigen::VectorXd>(Eigen::VectorXd(*s * k)) : std::nullopt;
-  };
   nlohmann::json j;
   if (p.gnss) {
-    j["lever_arm_m"] = calib::MountedBlockToJson(
-        p.spec.lever_arm, p.lever_arm_m, scaled(p.lever_arm_sigma_m, 1.0));
-    const std::optional<Eigen::VectorXd> dt_sigma =
-        p.time_offset_sigma_s ? std::optional<Eigen::VectorXd>(
-                                    Eigen::VectorXd::Constant(1, *p.time_offset_sigma_s * 1e3))
-                              : std::nullopt;
-    j["time_offset_ms"] = calib::MountedBlockToJson(
-        p.spec.time_offset, Eigen::VectorXd::Constant(1, p.time_offset_s * 1e3), dt_sigma);
+    j["lever_arm_m"] = MountedToJson(p.spec.lever_arm, p.lever_arm_m, p.lever_arm_sigma_m, 1.0);
+    j["time_offset_ms"] =
+        MountedToJson(p.spec.time_offset, p.time_offset_s, p.time_offset_sigma_s, 1e3);
   }
   if (p.imu)
-    j["boresight_deg"] = calib::MountedBlockToJson(
-        p.spec.boresight, p.boresight_rad * kDeg, scaled(p.boresight_sigma_rad, kDeg));
+    j["boresight_deg"] =
+        MountedToJson(p.spec.boresight, p.boresight_rad, p.boresight_sigma_rad, kRadToDeg);
   return j;
 }
 nlohmann::json Pair(const Eigen::Vector2d& v) { return {Finite(v.x()), Finite(v.y())}; }
@@ -410,29 +403,12 @@ std::vector<ResultWarning> GroupRmsWarnings(const calib::SolveReport& solve, dou
   return out;
 }
 
-nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
-  nlohmann::json j;
-  j["kind"] = "adjust";
-  j["schema_version"] = kResultSchemaVersion;
-  // The model of the cameras (the first camera's when they differ; each camera names its own).
-  j["camera_model"] =
-      calib::CameraModelTableToJson(r.cameras.empty() ? Model::kId : r.cameras.front().model);
-  j["sigma0"] = r.sigma0;
-  j["sigma0_px"] = r.sigma0_px;
-  j["sigma0_um"] = r.sigma0_um;
-  j.update(calib::SolveStatisticsToJson(r.solve));  // redundancy .. seconds, groups
-  j["timing"] = {{"solve_s", r.timing.solve_s},
-                 {"snooping_s", r.timing.snooping_s},
-                 {"testing_s", r.timing.testing_s},
-                 {"covariance_s", r.timing.covariance_s},
-                 {"total_s", r.timing.total_s}};
-  j["frame"] = r.frame;
-  j["datum"] = r.datum;
-  j["self_calibration"] = r.free_interior;
-  j["n_observations"] = r.solve.n_observations;
-  j["n_unknowns"] = r.solve.n_unknowns;
-  j["warnings"] = FindingsToJson(r.warnings);
-  j["cameras"] = nlohmann::json::array();
+namespace {
+
+// `cameras`: per camera its model, initial and estimated interior, the free parameters and their
+// sigmas (null without a covariance).
+nlohmann::json CamerasToJson(const AdjustmentResult& r) {
+  nlohmann::json cameras = nlohmann::json::array();
   for (const auto& c : r.cameras) {
     nlohmann::json sigma = nlohmann::json::object(), free = nlohmann::json::array();
     const std::vector<calib::ParamInfo> table = calib::CameraModelParams(c.model);
@@ -444,31 +420,32 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
             r.determinability.covariance_ok ? nlohmann::json(c.sigma[k]) : nlohmann::json();
       }
     }
-    j["cameras"].push_back({{"id", c.id},
-                            {"model", std::string(calib::CameraModelName(c.model))},
-                            {"initial", Interior(c.model, c.initial)},
-                            {"estimated", Interior(c.model, c.estimated)},
-                            {"sigma", sigma},
-                            {"free", free}});
+    cameras.push_back({{"id", c.id},
+                       {"model", std::string(calib::CameraModelName(c.model))},
+                       {"initial", Interior(c.model, c.initial)},
+                       {"estimated", Interior(c.model, c.estimated)},
+                       {"sigma", sigma},
+                       {"free", free}});
   }
-  nlohmann::json control = PointStatisticsToJson(r.control), check = PointStatisticsToJson(r.check);
-  auto table = [](const std::vector<PointDifference>& points) {
-    nlohmann::json t = nlohmann::json::array();
-    for (const auto& p : points) {
-      t.push_back({{"point", p.point},
-                   {"surveyed", Vec(p.surveyed_m)},
-                   {"adjusted", Vec(p.adjusted_m)},
-                   {"difference_m", Vec(p.difference_m)},
-                   {"rays", p.rays}});
-      if (!p.uncontrolled.empty()) t.back()["uncontrolled"] = p.uncontrolled;
-    }
-    return t;
-  };
-  control["points"] = table(r.control_points);
-  check["points"] = table(r.check_points);
-  j["control"] = control;
-  j["check"] = check;
-  j["control_left_out"] = nlohmann::json::array();
+  return cameras;
+}
+
+nlohmann::json PointTableToJson(const std::vector<PointDifference>& points) {
+  nlohmann::json t = nlohmann::json::array();
+  for (const auto& p : points) {
+    t.push_back({{"point", p.point},
+                 {"surveyed", Vec(p.surveyed_m)},
+                 {"adjusted", Vec(p.adjusted_m)},
+                 {"difference_m", Vec(p.difference_m)},
+                 {"rays", p.rays}});
+    if (!p.uncontrolled.empty()) t.back()["uncontrolled"] = p.uncontrolled;
+  }
+  return t;
+}
+
+// Control points the adjustment left out, each with its largest w and w per component.
+nlohmann::json ControlLeftOutToJson(const AdjustmentResult& r) {
+  nlohmann::json out = nlohmann::json::array();
   for (const auto& left : r.control_left_out) {
     const PointDifference& p = left.difference;
     nlohmann::json components = nlohmann::json::object();
@@ -476,27 +453,44 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
       components[component] = w_component;
     const std::optional<double> largest = left.LargestW();
     const nlohmann::json w = largest ? nlohmann::json(*largest) : nlohmann::json();
-    j["control_left_out"].push_back({{"point", p.point},
-                                     {"surveyed_m", Vec(p.surveyed_m)},
-                                     {"adjusted_m", Vec(p.adjusted_m)},
-                                     {"difference_m", Vec(p.difference_m)},
-                                     {"rays", p.rays},
-                                     {"w", w},
-                                     {"components", components}});
+    out.push_back({{"point", p.point},
+                   {"surveyed_m", Vec(p.surveyed_m)},
+                   {"adjusted_m", Vec(p.adjusted_m)},
+                   {"difference_m", Vec(p.difference_m)},
+                   {"rays", p.rays},
+                   {"w", w},
+                   {"components", components}});
   }
-  if (r.check_controlled) {
-    nlohmann::json c = PointStatisticsToJson(*r.check_controlled);
-    c["uncontrolled_points"] = nlohmann::json::array();
-    for (const auto& p : r.check_points)
-      if (!p.uncontrolled.empty())
-        c["uncontrolled_points"].push_back({{"point", p.point},
-                                            {"difference_m", Vec(p.difference_m)},
-                                            {"rays", p.rays},
-                                            {"reason", p.uncontrolled}});
-    j["check_controlled"] = c;
-  }
-  j["exposures"] = nlohmann::json::array();
-  for (const auto& e : r.exposures) {
+  return out;
+}
+
+// The check statistics over the controlled check points, with the others and why.
+nlohmann::json CheckControlledToJson(const AdjustmentResult& r) {
+  nlohmann::json c = PointStatisticsToJson(*r.check_controlled);
+  c["uncontrolled_points"] = nlohmann::json::array();
+  for (const auto& p : r.check_points)
+    if (!p.uncontrolled.empty())
+      c["uncontrolled_points"].push_back({{"point", p.point},
+                                          {"difference_m", Vec(p.difference_m)},
+                                          {"rays", p.rays},
+                                          {"reason", p.uncontrolled}});
+  return c;
+}
+
+// `control`, `check`, `control_left_out` and `check_controlled` (when there is one).
+void WritePoints(const AdjustmentResult& r, nlohmann::json* j) {
+  nlohmann::json control = PointStatisticsToJson(r.control), check = PointStatisticsToJson(r.check);
+  control["points"] = PointTableToJson(r.control_points);
+  check["points"] = PointTableToJson(r.check_points);
+  (*j)["control"] = control;
+  (*j)["check"] = check;
+  (*j)["control_left_out"] = ControlLeftOutToJson(r);
+  if (r.check_controlled) (*j)["check_controlled"] = CheckControlledToJson(r);
+}
+
+nlohmann::json ExposuresToJson(const std::vector<ExposureEstimate>& exposures) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& e : exposures) {
     nlohmann::json x = {{"image", e.image},
                         {"X", e.center_m.x()},
                         {"Y", e.center_m.y()},
@@ -520,9 +514,13 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
                {"kappa", Finite(e.opk_sigma_rad->z() * kRadToDeg)}};
     x["sigma"] = sigma;
     x["used"] = e.used;
-    j["exposures"].push_back(x);
+    out.push_back(x);
   }
-  j["rejected"] = nlohmann::json::array();
+  return out;
+}
+
+nlohmann::json RejectedToJson(const AdjustmentResult& r) {
+  nlohmann::json out = nlohmann::json::array();
   for (const auto& o : r.rejected) {
     nlohmann::json x = {{"image", o.image},
                         {"point", o.point},
@@ -535,13 +533,17 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
     if (!o.subimage.empty()) x["subimage"] = o.subimage;
     if (!o.head.empty()) x["head"] = o.head;
     AddTest(o.test, &x);
-    j["rejected"].push_back(x);
+    out.push_back(x);
   }
-  // Every image observation: where it was measured (virtual pixels) and its residual, for the
-  // residual plots of the report. Built in place (reserved, each record moved in): the records
-  // are the bulk of the document, and a copy per record doubled their share of the peak.
-  nlohmann::json::array_t residuals;
-  residuals.reserve(r.residuals.size());
+  return out;
+}
+
+// Every image observation: where it was measured (virtual pixels) and its residual, for the
+// residual plots of the report. Built in place (reserved, each record moved in): the records
+// are the bulk of the document, and a copy per record doubled their share of the peak.
+nlohmann::json ResidualsToJson(const AdjustmentResult& r) {
+  nlohmann::json::array_t out;
+  out.reserve(r.residuals.size());
   for (const auto& o : r.residuals) {
     nlohmann::json v = {{"image", o.image},
                         {"point", o.point},
@@ -558,14 +560,12 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
     }
     if (!o.head.empty()) v["head"] = o.head;
     AddTest(o.test, &v);
-    residuals.push_back(std::move(v));
+    out.push_back(std::move(v));
   }
-  j["residuals"] = std::move(residuals);
-  nlohmann::json det = {{"determinable", r.determinability.covariance_ok},
-                        {"message", r.determinability.message},
-                        {"covariance_method", r.determinability.covariance_method},
-                        {"undetermined", r.determinability.undetermined},
-                        {"warnings", r.determinability.warnings}};
+  return out;
+}
+
+nlohmann::json InteriorCorrelationToJson(const AdjustmentResult& r) {
   nlohmann::json correlation = {{"names", r.interior_correlation_names},
                                 {"matrix", nlohmann::json::array()}};
   for (int i = 0; i < r.interior_correlation.rows(); ++i) {
@@ -574,11 +574,40 @@ nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
       row.push_back(Finite(r.interior_correlation(i, k)));
     correlation["matrix"].push_back(row);
   }
-  j["interior_correlation"] = correlation;
-  det["high_correlations"] = nlohmann::json::array();
-  for (const auto& h : r.determinability.high_correlations)
-    det["high_correlations"].push_back({{"a", h.a}, {"b", h.b}, {"correlation", h.correlation}});
-  j["determinability"] = det;
+  return correlation;
+}
+
+}  // namespace
+
+nlohmann::json AdjustmentToJson(const AdjustmentResult& r) {
+  nlohmann::json j;
+  j["kind"] = "adjust";
+  j["schema_version"] = ResultSchemaVersion("adjust");
+  // The model of the cameras (the first camera's when they differ; each camera names its own).
+  j["camera_model"] =
+      calib::CameraModelTableToJson(r.cameras.empty() ? Model::kId : r.cameras.front().model);
+  j["sigma0"] = r.sigma0;
+  j["sigma0_px"] = r.sigma0_px;
+  j["sigma0_um"] = r.sigma0_um;
+  j.update(calib::SolveStatisticsToJson(r.solve));  // redundancy .. seconds, groups
+  j["timing"] = {{"solve_s", r.timing.solve_s},
+                 {"snooping_s", r.timing.snooping_s},
+                 {"testing_s", r.timing.testing_s},
+                 {"covariance_s", r.timing.covariance_s},
+                 {"total_s", r.timing.total_s}};
+  j["frame"] = r.frame;
+  j["datum"] = r.datum;
+  j["self_calibration"] = r.free_interior;
+  j["n_observations"] = r.solve.n_observations;
+  j["n_unknowns"] = r.solve.n_unknowns;
+  j["warnings"] = FindingsToJson(r.warnings);
+  j["cameras"] = CamerasToJson(r);
+  WritePoints(r, &j);
+  j["exposures"] = ExposuresToJson(r.exposures);
+  j["rejected"] = RejectedToJson(r);
+  j["residuals"] = ResidualsToJson(r);
+  j["interior_correlation"] = InteriorCorrelationToJson(r);
+  j["determinability"] = DeterminabilityToJson(r.determinability, r.determinability.covariance_ok);
   if (r.platform.gnss || r.platform.imu) j["platform"] = PlatformToJson(r.platform);
   j["notes"] = r.notes;
   if (r.free_set_choice) j["self_calibration_choice"] = FreeSetChoiceJson(*r.free_set_choice);

@@ -319,7 +319,7 @@ struct AdjustmentResult {
 /// such a ray (PointDifference::uncontrolled) and sets check_controlled over the others.
 void ClassifyUncontrolled(double min_redundancy, AdjustmentResult* result);
 
-/// JSON of FORMATS.md (kind "adjust", schema_version kResultSchemaVersion of
+/// JSON of FORMATS.md (kind "adjust", schema_version ResultSchemaVersion("adjust") of
 /// calib/core/result_file.h, written by WriteResult); angles in degrees, coordinates in the object
 /// frame. `camera_model` is the model of its cameras with its parameter table
 /// (calib::CameraModelTableToJson; the first camera's when they differ: each camera entry names

@@ -50,4 +50,16 @@ Determinability AssessDeterminability(const calib::CovarianceReport& cov,
   return det;
 }
 
+nlohmann::json DeterminabilityToJson(const Determinability& d, bool determinable) {
+  nlohmann::json correlations = nlohmann::json::array();
+  for (const auto& h : d.high_correlations)
+    correlations.push_back({{"a", h.a}, {"b", h.b}, {"correlation", h.correlation}});
+  return {{"determinable", determinable},
+          {"message", d.message},
+          {"covariance_method", d.covariance_method},
+          {"undetermined", d.undetermined},
+          {"high_correlations", correlations},
+          {"warnings", d.warnings}};
+}
+
 }  // namespace aerocal::triangulation

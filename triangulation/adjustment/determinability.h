@@ -8,6 +8,8 @@
 #include "calib/problem/problem_builder.h"
 #include "triangulation/adjustment/adjustment_result.h"
 
+#include <nlohmann/json.hpp>
+
 #include <string>
 
 namespace aerocal::triangulation {
@@ -17,5 +19,12 @@ namespace aerocal::triangulation {
 Determinability AssessDeterminability(const calib::CovarianceReport& covariance,
                                       const std::string& prefix,
                                       double threshold);
+
+/// {determinable, message, covariance_method, undetermined, high_correlations [{a, b,
+/// correlation}], warnings}: the `determinability` of an adjustment result and of a rig's
+/// parameters (docs/schema/adjust.schema.json#/definitions/determinability). `determinable` as
+/// the caller decides it (the block: its covariance could be computed; the rig: and no rig
+/// parameter is undetermined).
+nlohmann::json DeterminabilityToJson(const Determinability& determinability, bool determinable);
 
 }  // namespace aerocal::triangulation

@@ -2,6 +2,7 @@
 // "pushbroom", module README "Result"), one writer per section, and the per-line corrections CSV.
 #include "calib/core/csv.h"
 #include "calib/problem/solve_statistics_json.h"
+#include "triangulation/adjustment/mounted_json.h"
 #include "triangulation/pushbroom/line_calibration.h"
 
 #include <cmath>
@@ -14,10 +15,6 @@ using nlohmann::json;
 constexpr double kDeg = 180.0 / M_PI;
 
 json Optional(const std::optional<double>& v) { return v ? json(*v) : json(nullptr); }
-
-json Vector3(const Eigen::Vector3d& v, double scale) {
-  return json::array({v.x() * scale, v.y() * scale, v.z() * scale});
-}
 
 json DatumToJson(const LineDatumReport& d) {
   json directions = json::array();
@@ -37,21 +34,19 @@ json DatumToJson(const LineDatumReport& d) {
           {"message", d.message}};
 }
 
-// time_offset, c, boresight, lever_arm.
+// c, and the blocks mounted on the platform in the one mounted-block form {mode, value, sigma}
+// (MountedToJson): the time offset (fixed, or free when estimated) in ms, the boresight in deg,
+// the lever arm in m; a sigma is null when held or not determined.
 void WriteMountedParameters(const LineCalibrationResult& r, json* j) {
-  (*j)["time_offset"] = {{"estimated", r.time_offset_estimated},
-                         {"dt_s", r.time_offset_s},
-                         {"sigma_s", Optional(r.time_offset_sigma_s)}};
+  (*j)["time_offset_ms"] =
+      MountedToJson(r.time_offset_estimated ? calib::BlockMode::kFree : calib::BlockMode::kFixed,
+                    r.time_offset_s,
+                    r.time_offset_sigma_s,
+                    1e3);
   (*j)["c_mm"] = r.c_mm;
   (*j)["c_sigma_mm"] = Optional(r.c_sigma_mm);
-  (*j)["boresight"] = {
-      {"mode", PlatformParamModeName(r.boresight)},
-      {"opk_deg", Vector3(r.boresight_rad, kDeg)},
-      {"sigma_deg", r.boresight_sigma_rad ? Vector3(*r.boresight_sigma_rad, kDeg) : json(nullptr)}};
-  (*j)["lever_arm"] = {
-      {"mode", PlatformParamModeName(r.lever_arm)},
-      {"xyz_m", Vector3(r.lever_arm_m, 1.0)},
-      {"sigma_m", r.lever_arm_sigma_m ? Vector3(*r.lever_arm_sigma_m, 1.0) : json(nullptr)}};
+  (*j)["boresight_deg"] = MountedToJson(r.boresight, r.boresight_rad, r.boresight_sigma_rad, kDeg);
+  (*j)["lever_arm_m"] = MountedToJson(r.lever_arm, r.lever_arm_m, r.lever_arm_sigma_m, 1.0);
 }
 
 json SubcameraToJson(const SubcameraRms& s) {
