@@ -62,7 +62,7 @@ struct MtfArgs {
   int oversampling = 4;
   GroundArgs ground;
   // --targets: the regions from edge targets and the image's adjusted orientation.
-  std::string targets, camera, orientation, image_id, origin = "0,0";
+  std::string targets, camera, orientation, image_id, origin;  // origin: "" when not given
   std::vector<std::string> only_targets;
   // --sub-image with --targets: the mappings into the raw sub-image, the virtual image's file.
   std::string mapping, frame, virtual_file, virtual_origin = "0,0";
@@ -176,6 +176,11 @@ Eigen::Vector2i WholePixels(const std::string& text, const std::string& option) 
   return origin.cast<int>();
 }
 
+// --image-origin, 0,0 when not given (the file is the whole image).
+Eigen::Vector2i ImageOrigin(const MtfArgs& args) {
+  return args.origin.empty() ? Eigen::Vector2i(0, 0) : WholePixels(args.origin, "--image-origin");
+}
+
 void CheckTargetArgs(const MtfArgs& args) {
   if (args.rois.empty() && args.targets.empty())
     throw ConfigError("quality mtf: give the edge regions with --roi or --targets");
@@ -186,7 +191,7 @@ void CheckTargetArgs(const MtfArgs& args) {
   if (args.targets.empty()) return;
   if (args.camera.empty() || args.orientation.empty() || args.image_id.empty())
     throw ConfigError("--targets needs --camera, --orientation and --image-id");
-  WholePixels(args.origin, "--image-origin");
+  ImageOrigin(args);
   WholePixels(args.virtual_origin, "--virtual-origin");
 }
 
@@ -215,7 +220,7 @@ void WriteTargetTable(const MtfArgs& args,
     skipped.push_back({{"id", id}, {"reason", reason}});
     std::printf("target %s skipped: %s\n", id.c_str(), reason.c_str());
   }
-  const Eigen::Vector2i origin = WholePixels(args.origin, "--image-origin");
+  const Eigen::Vector2i origin = ImageOrigin(args);
   (*doc)["targets"] = {{"file", args.targets},
                        {"camera", args.camera},
                        {"orientation", args.orientation},
@@ -249,7 +254,7 @@ std::vector<MtfRegion> TargetRegions(const MtfArgs& args,
                                                  orientation,
                                                  targets,
                                                  args.only_targets,
-                                                 WholePixels(args.origin, "--image-origin"),
+                                                 ImageOrigin(args),
                                                  static_cast<int>(image.cols()),
                                                  static_cast<int>(image.rows()),
                                                  options,
@@ -288,9 +293,10 @@ nlohmann::json MeasureRegion(const MtfArgs& args,
   const stitch::PixelRegion& roi = region.region;
   edge["roi"] = {roi.col, roi.row, roi.width, roi.height};
   edge.update(region.extra);
-  // A --roi of the virtual image: its place in the format (the file's origin added).
-  if (args.virtual_image && !region.found)
-    edge["position_virtual_px"] = RegionCentreJson(roi, WholePixels(args.origin, "--image-origin"));
+  // A --roi of the virtual image: its place in the format (the file's origin added). Only with
+  // --image-origin: a file of patches cut from several exposures (a mosaic) has no one place.
+  if (args.virtual_image && !region.found && !args.origin.empty())
+    edge["position_virtual_px"] = RegionCentreJson(roi, ImageOrigin(args));
   if (context.subimage && region.found)
     edge["resampling"] =
         ResamplingComparisonJson(r, *region.found, *context.subimage, context.window, options);
@@ -554,8 +560,9 @@ CommandRun Setup(CLI::App& app) {
   m->add_option("--image-id", mtf->image_id, "--targets: the image's id in --orientation");
   m->add_option("--image-origin",
                 mtf->origin,
-                "--targets: the file's top-left pixel col,row in the full (virtual) image, for a "
-                "file that is a window of it");
+                "The file's top-left pixel col,row in the full (virtual) image, for a file that "
+                "is a window of it (default 0,0); with --virtual and --roi it gives each region "
+                "its place in the virtual image (the report's MTF50 map), without it none");
   m->add_option("--target", mtf->only_targets, "--targets: measure only this edge id; repeat");
   m->add_option("--mapping",
                 mtf->mapping,

@@ -179,6 +179,10 @@ nlohmann::json ResamplingLossJson(const nlohmann::json& axes) {
     const nlohmann::json& m = a.value("mtf50_cy_px", nlohmann::json());
     const nlohmann::json& u = a.value("mtf50_u_cy_px", nlohmann::json());
     if ((kind != "raw" && kind != "virtual") || !m.is_number() || !u.is_number()) continue;
+    // A `--targets` result (it names its exposure) holds edges of one exposure, each compared with
+    // the virtual image in its own `resampling` block (ResamplingPerSubImageJson); taken here too,
+    // its sub-image would count twice beside the whole-mosaic result of the same sub-image.
+    if (a.contains("image_id")) continue;
     PerAxis& p = by_axis[a.at("axis").get<std::string>()];
     if (a.contains("direction")) p.direction = a["direction"];
     if (kind == "virtual") {

@@ -26,7 +26,9 @@ nlohmann::json DynamicResolutionJson(const std::vector<std::string>& paths);
 /// (the mean likewise when several virtual results are given), the loss m_r - m_v with
 /// u = sqrt(u(m_r)^2 + u(m_v)^2) and U = 2 u, and both relative to m_r in percent. The sub-images
 /// are taken as measured independently: their shared type-B part, which the difference partly
-/// cancels, is counted in full, so U is on the safe side. `axes` is the section's `axes` array.
+/// cancels, is counted in full, so U is on the safe side. `axes` is the section's `axes` array;
+/// the axes of `quality mtf --targets` results (those with an `image_id`: one exposure's edges,
+/// compared per edge in their `resampling` blocks) are left out.
 nlohmann::json ResamplingLossJson(const nlohmann::json& axes);
 
 /// Per raw sub-image and axis, over the section's edges measured with `quality mtf --targets

@@ -81,7 +81,34 @@ class FlightWorkflow : public ::testing::Test {
         dir_->File("data") + " --base III,IV --out " + dir_->File("report") +
         " --camera-format metashape --certificate --lab " + dir_->File("lab.yaml") + " --quality " +
         dir_->File("star.json") + *quality_options_));
+    MeasureTargetEdges();
   }
+  // As examples/flight_resolution.sh: the first patch of every sub-image and axis found from its
+  // target with this flight's adjusted camera, exposure and stitching (report/result.json),
+  // measured in the raw sub-image and in the virtual image: `target_options_`, the --quality
+  // options SplitFlight adds, whose report then shows the MTF50 map and the per-edge tables.
+  static void MeasureTargetEdges() {
+    target_options_ = new std::string;
+    ASSERT_EQ(run_->exit_code, 0) << run_->output;
+    const std::string patches = dir_->File("data/edge_targets/"), result = dir_->File("report/");
+    std::set<std::string> measured;  // sub-image and axis
+    for (const auto& f : PatchRows(patches + "patches.csv")) {
+      if (!measured.insert(f[2] + "/" + f[3]).second) continue;
+      const std::string out = dir_->File("map_" + f[0] + "_" + f[1] + ".json");
+      const auto r = testing::RunAerocal(
+          "quality mtf --targets " + patches + "targets.csv --camera " + result +
+          "camera_calibrated.yaml --orientation " + result + "result.json --mapping " + result +
+          "result.json --virtual-image " + patches + "virtual.tif --flight-axis x --image " +
+          patches + f[4] + " --sub-image " + f[2] + " --image-id " + f[1] + " --target " + f[0] +
+          " --image-origin " + MosaicOrigin(f[14], f[15], f[5], f[6]) + " --virtual-origin " +
+          MosaicOrigin(f[16], f[17], f[10], f[11]) + " --out " + out);
+      ASSERT_EQ(r.exit_code, 0) << f[0] << " in " << f[1] << "\n" << r.output;
+      *target_options_ += " --quality " + out;
+    }
+  }
+  // The --quality options of SplitFlight: the edge targets' and the targets found in the raw
+  // sub-images.
+  static std::string SplitQuality() { return *quality_options_ + *target_options_; }
   // simulate --edge-targets wrote mosaics of edge patches (raw_<SUB>.tif per sub-image and
   // virtual.tif) and patches.csv with the regions to measure: `quality mtf` on each mosaic,
   // quality_<mosaic>.json (named raw sub-image or virtual); all go into result.json (the report's
@@ -109,6 +136,7 @@ class FlightWorkflow : public ::testing::Test {
   }
   static void TearDownTestSuite() {
     delete quality_options_;
+    delete target_options_;
     delete run_;
     delete dir_;
   }
@@ -116,11 +144,13 @@ class FlightWorkflow : public ::testing::Test {
   static testing::CommandResult* run_;
   static int edge_patches_;
   static std::string* quality_options_;  // --quality of every edge targets' result
+  static std::string* target_options_;   // --quality of the raw sub-images' target edges
 };
 testing::TempDir* FlightWorkflow::dir_ = nullptr;
 testing::CommandResult* FlightWorkflow::run_ = nullptr;
 int FlightWorkflow::edge_patches_ = 0;
 std::string* FlightWorkflow::quality_options_ = nullptr;
+std::string* FlightWorkflow::target_options_ = nullptr;
 
 TEST_F(FlightWorkflow, FinishesAndWritesResultsWithTheFormatsKeys) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
@@ -597,7 +627,7 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
   // The second run (SplitFlight) writes its residual tables as CSV beside result.json
   // (--residuals-csv): read back, they must be the first run's inline arrays to the bit.
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto& r = SplitFlight(*dir_, *quality_options_);
+  const auto& r = SplitFlight(*dir_, SplitQuality());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   std::function<void(nlohmann::json&)> strip = [&](nlohmann::json& j) {
     if (j.is_object()) {
@@ -690,20 +720,32 @@ TEST_F(FlightWorkflow, TwiceGivesTheSameResult) {
 // the inline run's), and a table changed afterwards is refused by every reader, by name, exit 2.
 TEST_F(FlightWorkflow, CertificateAndReportReadTheResidualTables) {
   ASSERT_EQ(run_->exit_code, 0) << run_->output;
-  const auto& r = SplitFlight(*dir_, *quality_options_);
+  const auto& r = SplitFlight(*dir_, SplitQuality());
   ASSERT_EQ(r.exit_code, 0) << r.output;
   auto inline_cert = aerocal::testing::ReadJson(dir_->File("report/certificate/certificate.json"));
   auto split_cert = aerocal::testing::ReadJson(dir_->File("again/certificate/certificate.json"));
   ASSERT_GT(split_cert["residuals"].size(), 1000u);
   inline_cert.erase("source");
   split_cert.erase("source");
+  // The second run has the target edges' results too: their edges follow the first run's.
+  auto& inline_edges = inline_cert["dynamic_image_resolution"]["edges"];
+  auto& split_edges = split_cert["dynamic_image_resolution"]["edges"];
+  ASSERT_EQ(split_edges.size(), inline_edges.size() + 8);
+  for (size_t i = 0; i < inline_edges.size(); ++i) EXPECT_EQ(inline_edges[i], split_edges[i]) << i;
+  EXPECT_EQ(inline_cert["dynamic_image_resolution"]["resampling_loss"],
+            split_cert["dynamic_image_resolution"]["resampling_loss"]);
+  inline_cert.erase("dynamic_image_resolution");
+  split_cert.erase("dynamic_image_resolution");
   EXPECT_EQ(inline_cert, split_cert);
   // The report: its residual figures and tables from the inflated arrays, as the inline run's.
-  // (The row of the clock, "report written (UTC)", apart.)
+  // (The row of the clock, "report written (UTC)", apart, and section 10, which the target edges'
+  // results extend: TheExampleReportMapsMtf50AcrossTheFormat.)
   const auto without_clock = [](std::string html) {
     const size_t at = html.find("<tr><td>report written (UTC)</td>");
     if (at != std::string::npos) html.erase(at, html.find("</tr>", at) - at);
-    return html;
+    const size_t resolution = html.find("<h2 id=\"resolution\"");
+    EXPECT_NE(resolution, std::string::npos);
+    return html.substr(0, resolution);
   };
   const std::string html = ReadTextFile(dir_->File("again/report.html"));
   EXPECT_NE(html.find("<tr><td>report written (UTC)</td>"), std::string::npos);
@@ -836,7 +878,7 @@ TEST(FlightWorkflowInput, MissingProjectIsABadInput) {
 // the program's start); the second flight's result.json (SplitFlight, the same result with its
 // residuals in CSV tables) is read, 2 MB instead of 10 MB, twice a run.
 TEST_F(FlightWorkflow, RawSubImageEdgesFromTargetsStateTheResamplingLossPerEdge) {
-  ASSERT_EQ(SplitFlight(*dir_, *quality_options_).exit_code, 0);
+  ASSERT_EQ(SplitFlight(*dir_, SplitQuality()).exit_code, 0);
   const std::string patches = dir_->File("data/edge_targets/"), result = dir_->File("again/");
   const std::string common = "quality mtf --targets " + patches + "targets.csv --camera " + result +
                              "camera_calibrated.yaml --orientation " + result +
@@ -895,7 +937,7 @@ TEST_F(FlightWorkflow, RawSubImageEdgesFromTargetsStateTheResamplingLossPerEdge)
 // the file (exit 2, nothing written). A sub-image that does not see the edge skips it by name
 // (exit 3: nothing measured).
 TEST_F(FlightWorkflow, RawSubImageTargetsRefuseMappingsThatDoNotMatch) {
-  ASSERT_EQ(SplitFlight(*dir_, *quality_options_).exit_code, 0);
+  ASSERT_EQ(SplitFlight(*dir_, SplitQuality()).exit_code, 0);
   const std::string patches = dir_->File("data/edge_targets/"), result = dir_->File("again/");
   const auto f = PatchRows(patches + "patches.csv").front();
   const std::string out = dir_->File("raw_bad.json");
@@ -933,6 +975,46 @@ TEST_F(FlightWorkflow, RawSubImageTargetsRefuseMappingsThatDoNotMatch) {
                                                                                other),
             std::string::npos)
       << skipped.dump();
+}
+
+// The flight example's report (examples/flight_resolution.sh, issue 36): with the target edges
+// found in the raw sub-images (MeasureTargetEdges, one per sub-image and axis) among its --quality
+// results, report.html shows the MTF50 map across the format and the per-sub-image and per-edge
+// tables. Only edges with a place in the virtual image are mapped: the 8 target edges, not the
+// --roi edges of the patch mosaics (no --image-origin: a mosaic has no one place). The per-axis
+// resampling loss stays that of the mosaics' results (each sub-image counted once).
+TEST_F(FlightWorkflow, TheExampleReportMapsMtf50AcrossTheFormat) {
+  ASSERT_EQ(SplitFlight(*dir_, SplitQuality()).exit_code, 0);
+  const std::string html = ReadTextFile(dir_->File("again/report.html"));
+  for (const char* id : {"id=\"resolution-map\"",
+                         "id=\"resolution-subimages\"",
+                         "id=\"resolution-pairs\"",
+                         "id=\"resolution-loss\""})
+    EXPECT_NE(html.find(id), std::string::npos) << id;
+  const auto section =
+      aerocal::testing::ReadJson(dir_->File("again/result.json"))["dynamic_image_resolution"];
+  ASSERT_EQ(section["virtual_format_px"].size(), 2u);  // the camera's format, from a target result
+  const double width = section["virtual_format_px"][0], height = section["virtual_format_px"][1];
+  int mapped = 0;
+  for (const auto& e : section["edges"]) {
+    if (!e.contains("position_virtual_px")) {
+      EXPECT_FALSE(e.contains("target")) << e.dump();
+      continue;
+    }
+    ++mapped;
+    EXPECT_EQ(e["image_kind"], "raw");
+    EXPECT_TRUE(e["resampling"]["virtual_mtf50_cy_px"].is_number()) << e.dump();
+    const double col = e["position_virtual_px"][0], row = e["position_virtual_px"][1];
+    EXPECT_TRUE(col > 0 && col < width && row > 0 && row < height) << e.dump();
+  }
+  EXPECT_EQ(mapped, 8);
+  ASSERT_EQ(section["resampling_per_sub_image"].size(), 8u);  // 4 sub-images x 2 axes
+  for (const auto& r : section["resampling_per_sub_image"]) {
+    EXPECT_EQ(r["edges"], 1) << r.dump();
+    EXPECT_EQ(r["virtual_measured"], 1) << r.dump();
+  }
+  for (const auto& loss : section["resampling_loss"])
+    EXPECT_EQ(loss["sub_images"].size(), 4u) << loss.dump();
 }
 
 }  // namespace
