@@ -75,6 +75,25 @@ TEST(CliQuality, MtfOfEightAndSixteenBitEdgesWithGroundUnits) {
   }
 }
 
+// --virtual --roi: with --image-origin each region gets its place in the virtual image (the file's
+// origin plus the region's centre pixel, the report's MTF50 map); without it none (a file of
+// patches from several exposures has no one place).
+TEST(CliQuality, ImageOriginPlacesAVirtualRegionInTheFormat) {
+  testing::TempDir dir("aerocal_cli_quality_origin");
+  std::mt19937_64 rng(37);
+  stitch::WriteGrayImage(dir.File("window.png"), TwoEdges(1.0, 1.0, &rng), 8);
+  const std::string base =
+      "quality mtf --image " + dir.File("window.png") + " --virtual --roi 128,0,128,128";
+  auto run = RunAerocal(base + " --image-origin 1000,2000 --out " + dir.File("o.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  const nlohmann::json placed = testing::ReadJson(dir.File("o.json"))["edges"][0];
+  ASSERT_TRUE(placed.contains("position_virtual_px")) << placed.dump();
+  EXPECT_EQ(placed["position_virtual_px"], nlohmann::json({1000 + 128 + 63.5, 2000 + 63.5}));
+  run = RunAerocal(base + " --out " + dir.File("n.json"));
+  ASSERT_EQ(run.exit_code, 0) << run.output;
+  EXPECT_FALSE(testing::ReadJson(dir.File("n.json"))["edges"][0].contains("position_virtual_px"));
+}
+
 TEST(CliQuality, BadOptionsExitTwoNamingTheOption) {
   testing::TempDir dir("aerocal_cli_quality_bad");
   std::mt19937_64 rng(1);
