@@ -2,6 +2,7 @@
 
 #include "calib/core/error.h"
 #include "calib/core/progress.h"
+#include "calib/core/stopwatch.h"
 #include "calib/core/string_printf.h"
 
 #include <opencv2/calib3d.hpp>
@@ -9,7 +10,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
-#include <chrono>
 #include <filesystem>
 #include <glob.h>
 #include <map>
@@ -228,7 +228,7 @@ OpenCvCalibration CalibrateWithOpenCv(const DetectedBoards& boards) {
   std::vector<cv::Mat> rvecs, tvecs;
   OpenCvCalibration out;
   out.iterations_limit = kOpenCvIterations;
-  const auto t0 = std::chrono::steady_clock::now();
+  const Stopwatch calibration_time;
   out.rms_px = cv::calibrateCamera(
       object,
       image,
@@ -240,7 +240,7 @@ OpenCvCalibration CalibrateWithOpenCv(const DetectedBoards& boards) {
       0,
       cv::TermCriteria(
           cv::TermCriteria::COUNT + cv::TermCriteria::EPS, kOpenCvIterations, DBL_EPSILON));
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  out.seconds = calibration_time.Seconds();
   out.fx = k.at<double>(0, 0);
   out.fy = k.at<double>(1, 1);
   out.cx = k.at<double>(0, 2);
