@@ -4,9 +4,9 @@
 #include "calib/core/progress.h"
 #include "calib/core/stopwatch.h"
 #include "calib/core/string_printf.h"
+#include "stitch/image_io/image_codecs.h"
 
 #include <opencv2/calib3d.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
@@ -115,7 +115,7 @@ DetectedBoards DetectBoards(const std::string& glob,
   };
   for (const auto& path : files) {
     const Tick tick{progress};
-    const cv::Mat gray = cv::imread(path, cv::IMREAD_GRAYSCALE);
+    const cv::Mat gray = stitch::DecodeImageFile(path, cv::IMREAD_GRAYSCALE);
     if (gray.empty()) throw InputError(path + ": not an image OpenCV can read");
     if (out.width_px == 0) {
       out.width_px = gray.cols;

@@ -2,9 +2,9 @@
 
 #include "calib/core/error.h"
 #include "stitch/image_io/cv_view.h"
+#include "stitch/image_io/image_codecs.h"
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 
 #include <sys/stat.h>
 
@@ -16,8 +16,8 @@ GrayImage ReadGrayImage(const std::string& path) {
   if (!S_ISREG(info.st_mode)) ThrowInputError({path, 0}, "not a regular file");
   cv::Mat raw;
   try {
-    raw = cv::imread(path,
-                     cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH | cv::IMREAD_IGNORE_ORIENTATION);
+    raw = DecodeImageFile(
+        path, cv::IMREAD_GRAYSCALE | cv::IMREAD_ANYDEPTH | cv::IMREAD_IGNORE_ORIENTATION);
   } catch (const cv::Exception& e) {
     ThrowInputError({path, 0}, std::string("cannot decode image: ") + e.what());
   }
@@ -48,7 +48,7 @@ void WriteGrayImage(const std::string& path, const GrayImage& image, int bits) {
   view.convertTo(out, bits == 8 ? CV_8U : CV_16U);  // rounds and saturates
   bool ok = false;
   try {
-    ok = cv::imwrite(path, out);
+    ok = EncodeImageFile(path, out);
   } catch (const cv::Exception& e) {
     throw Error(path + ": cannot write image: " + e.what());
   }

@@ -1,4 +1,5 @@
-// Reading and writing grey-value images (TIFF, PNG, JPEG, ... as OpenCV's imgcodecs reads them).
+// Reading and writing grey-value images (TIFF, PNG, JPEG, ... as OpenCV's imgcodecs reads them,
+// through the module image_codecs.h loads on first use).
 // Colour images are converted to grey; 8- and 16-bit depths keep their digital numbers. EXIF
 // orientation is ignored: the stored pixel array is what the sensor wrote, and that is what the
 // camera file's sub-image formats describe.

@@ -2,9 +2,9 @@
 
 #include "calib/core/atomic_file.h"
 #include "calib/core/error.h"
+#include "stitch/image_io/image_codecs.h"
 
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <tiffio.h>
 
@@ -264,7 +264,7 @@ int TiffTileWidth(const std::string& path) {
 
 MemoryRaster ReadImageFile(const std::string& path, bool gray) {
   CheckInputFile(path);
-  cv::Mat image = cv::imread(path, cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
+  cv::Mat image = DecodeImageFile(path, cv::IMREAD_UNCHANGED | cv::IMREAD_IGNORE_ORIENTATION);
   if (image.empty()) throw InputError(path + ": cannot read the image");
   if (image.depth() != CV_8U && image.depth() != CV_16U)
     throw InputError(path + ": expected 8- or 16-bit unsigned samples");

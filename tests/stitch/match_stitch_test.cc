@@ -227,5 +227,28 @@ TEST_F(MatchStitch, BadImagesAreNamedAndNothingIsWritten) {
   EXPECT_FALSE(std::ifstream(out).good());
 }
 
+// OpenCV's imgcodecs (with GDAL, ~140 shared libraries) is no longer linked: the program starts
+// without it, and the first image read or written loads it through the module (image_codecs.h).
+TEST(ImageCodecs, TheProgramStartsWithoutThemAndTheFirstImageLoadsThem) {
+  const auto libraries = aerocal::testing::RunCommand("ldd " + aerocal::testing::AerocalBinary());
+  ASSERT_EQ(libraries.exit_code, 0) << libraries.output;
+  EXPECT_EQ(libraries.output.find("libopencv_imgcodecs"), std::string::npos) << libraries.output;
+  EXPECT_EQ(libraries.output.find("libgdal"), std::string::npos) << libraries.output;
+
+  TempDir dir("aerocal_codecs");
+  GrayImage image(3, 4);
+  for (int i = 0; i < image.size(); ++i) image.data()[i] = static_cast<float>(1000 * i + 7);
+  WriteGrayImage(dir.File("ramp.png"), image, 16);
+  const GrayImage back = ReadGrayImage(dir.File("ramp.png"));
+  ASSERT_EQ(back.rows(), 3);
+  ASSERT_EQ(back.cols(), 4);
+  for (int i = 0; i < image.size(); ++i) EXPECT_EQ(back.data()[i], image.data()[i]) << i;
+  std::ifstream maps("/proc/self/maps");
+  const std::string mapped((std::istreambuf_iterator<char>(maps)),
+                           std::istreambuf_iterator<char>());
+  EXPECT_NE(mapped.find("libaerocal_image_codecs.so"), std::string::npos);
+  EXPECT_NE(mapped.find("libopencv_imgcodecs"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace aerocal::stitch

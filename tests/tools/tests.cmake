@@ -12,7 +12,7 @@ aerocal_add_test(tools/cli_joint LIBS aerocal::calib LABELS cli TIMEOUT 600)
 aerocal_add_test(tools/cli_options LIBS aerocal::calib LABELS cli)
 # Camera files in other tools' formats (issue 15): the CLI, plus the OpenCV FileStorage format
 # (tools/camera_formats.cc) against cv::projectPoints and cv::undistortPoints.
-aerocal_add_test(tools/cli_camera LIBS aerocal::calib ${OpenCV_LIBS} LABELS cli)
+aerocal_add_test(tools/cli_camera LIBS aerocal::calib ${AEROCAL_OPENCV_LIBS} LABELS cli)
 target_sources(test_tools_cli_camera PRIVATE ${PROJECT_SOURCE_DIR}/tools/camera_formats.cc
   ${PROJECT_SOURCE_DIR}/tools/opencv_storage_scan.cc)
 target_include_directories(test_tools_cli_camera PRIVATE ${OpenCV_INCLUDE_DIRS})
