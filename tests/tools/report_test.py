@@ -562,6 +562,20 @@ class WhatPeopleRead(unittest.TestCase):
         self.assertIn("MTF50 across the format", text)
         self.assertIn("(14000 x 12000 px)", text)
         self.assertEqual(text.count(PNG_URI), 1)
+        # On the map, the edge found in raw sub-image I is placed twice at its place in the virtual
+        # image: its raw MTF50 among the raw sub-images, and, marked as the virtual image's, the MTF50
+        # measured in the virtual image resampled from it (its resampling block); the edge measured in
+        # the virtual image directly keeps its panel.
+        sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "report"))
+        try:
+            import report_resolution
+        finally:
+            sys.path.pop(0)
+        self.assertEqual(report_resolution.map_panels(section), {
+            "along track (MTF along x), raw sub-images": [(2100.5, 3300.5, 0.1806)],
+            "along track (MTF along x), virtual image": [(2100.5, 3300.5, 0.1652)],
+            "across track (MTF along y), virtual image": [(9000.0, 5000.0, 0.1690)]})
+        self.assertIn("the virtual image's panel holds the same edges measured in the virtual image", text)
         self.assertEqual(page.row("resolution-subimages", "I"),
                          ["I", "x", "along_track", "1", "0.1806", "1", "0.1652", "8.53", "8.31", "7.12"])
         self.assertEqual(page.row("resolution-pairs", "I"),
