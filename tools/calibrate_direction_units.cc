@@ -44,18 +44,40 @@ triangulation::BudgetQuantity OfUnit(const std::string& unit, triangulation::Bud
   return q;
 }
 
-// The budget of every head (see the header comment): its interior as a single camera's from its
-// adjustment (the marginal covariance of the joint solve, its sigma0 and redundancy, the head's
-// pixel pitch), "HEAD.c", ...; m_0 once (one solve); the mounts of the heads after the first,
-// "HEAD.mount_omega" ... in deg. `first` gets the first head's run (the certificate's
-// correlation table and radii).
-std::vector<triangulation::BudgetQuantity> UnitsBudget(const calib::Rig& rig,
-                                                       const triangulation::DirectionUnitsRun& run,
-                                                       const DirectionsArgs& args,
-                                                       const triangulation::BudgetOptions& options,
-                                                       triangulation::CalibrationRun* first) {
+// The heads' budgets: every head's interior quantities as "HEAD.c", ... (each from its own run:
+// its estimate, its marginal covariance of the joint solve, the joint sigma0 and redundancy, its
+// pixel pitch, its radii), m_0 once (one solve), the mounts of the heads after the first.
+struct HeadsBudget {
+  std::vector<triangulation::BudgetQuantity> quantities;
+  std::vector<std::vector<double>> radii_mm;  // per unit (the run's order)
+  triangulation::CalibrationRun first;  // the first head's run: the correlation table, stability
+};
+
+// The mount of unit k > 0 relative to the first unit, "HEAD.mount_omega" ... in deg.
+std::vector<triangulation::BudgetQuantity> MountBudget(const triangulation::DirectionUnitsRun& run,
+                                                       size_t k) {
   std::vector<triangulation::BudgetQuantity> out;
   const char* axes[3] = {"omega", "phi", "kappa"};
+  const triangulation::DirectionUnitsCalibration& c = run.calibration;
+  for (int i = 0; k > 0 && c.covariance_ok && i < 3; ++i)
+    out.push_back(triangulation::AdjustedQuantityBudget(
+        run.ids[k] + ".mount_" + axes[i],
+        "deg",
+        "mount of head " + run.ids[k] + " relative to head " + run.ids[0] + " (" + axes[i] + ")",
+        c.mount_opk_rad[k][i] / kDeg,
+        c.mount_sigma_rad[k][i] / kDeg,
+        run.all.solve.redundancy,
+        "the joint covariance of the two heads' rotations, propagated to the mount"));
+  return out;
+}
+
+// The budget of every head (HeadsBudget). The distortion radii are the given ones (--radii-mm,
+// the budget file) for every head, else each head's own format's (DefaultCertifiedRadiiMm): a head
+// of a smaller format is not certified beyond its corners.
+HeadsBudget UnitsBudget(const calib::Rig& rig,
+                        const triangulation::DirectionUnitsRun& run,
+                        const DirectionSetup& setup) {
+  HeadsBudget out;
   for (size_t k = 0; k < run.ids.size(); ++k) {
     const calib::Camera& camera = rig.heads[rig.HeadIndex(run.ids[k])].camera;
     triangulation::CalibrationRun unit;
@@ -63,27 +85,17 @@ std::vector<triangulation::BudgetQuantity> UnitsBudget(const calib::Rig& rig,
     unit.start_c_mm = camera.c_mm();
     unit.project.cameras[unit.camera] = camera;
     unit.all = run.adjustments[k];
-    triangulation::BudgetOptions of_unit = options;
-    if (args.radii_mm.empty() && options.radii_mm.empty())
-      of_unit.radii_mm = DefaultCertifiedRadiiMm(camera);
+    triangulation::BudgetOptions of_unit = setup.budget;
+    if (!setup.radii_given) of_unit.radii_mm = DefaultCertifiedRadiiMm(camera);
+    out.radii_mm.push_back(of_unit.radii_mm);
     for (const auto& q : triangulation::UncertaintyBudget(unit, unit.project, of_unit)) {
-      if (q.name.rfind("m_", 0) == 0) {
-        if (k == 0) out.push_back(q);
-        continue;
-      }
-      out.push_back(OfUnit(run.ids[k], q));
+      if (q.name.rfind("m_", 0) != 0)
+        out.quantities.push_back(OfUnit(run.ids[k], q));
+      else if (k == 0)
+        out.quantities.push_back(q);
     }
-    const triangulation::DirectionUnitsCalibration& c = run.calibration;
-    for (int i = 0; k > 0 && c.covariance_ok && i < 3; ++i)
-      out.push_back(triangulation::AdjustedQuantityBudget(
-          run.ids[k] + ".mount_" + axes[i],
-          "deg",
-          "mount of head " + run.ids[k] + " relative to head " + run.ids[0] + " (" + axes[i] + ")",
-          c.mount_opk_rad[k][i] / kDeg,
-          c.mount_sigma_rad[k][i] / kDeg,
-          run.all.solve.redundancy,
-          "the joint covariance of the two heads' rotations, propagated to the mount"));
-    if (k == 0) *first = unit;
+    for (auto& q : MountBudget(run, k)) out.quantities.push_back(std::move(q));
+    if (k == 0) out.first = unit;
   }
   return out;
 }
@@ -114,9 +126,11 @@ calib::Rig UpdatedRig(const calib::Rig& rig, const triangulation::DirectionUnits
 }
 
 // Per unit: its rotation to the instrument, its mount relative to the first unit, the start, its
-// format and pixel pitch and its interior's correlations (the certificate draws every head's
-// distortion and correlation map from these, not only the first head's).
-nlohmann::json UnitsJson(const triangulation::DirectionUnitsRun& run, const calib::Rig& written) {
+// format and pixel pitch, the radii of its certified distortion values and its interior's
+// correlations (the certificate draws and budgets every head from these, not only the first).
+nlohmann::json UnitsJson(const triangulation::DirectionUnitsRun& run,
+                         const calib::Rig& written,
+                         const std::vector<std::vector<double>>& radii_mm) {
   nlohmann::json units = nlohmann::json::array();
   const triangulation::DirectionUnitsCalibration& c = run.calibration;
   for (size_t k = 0; k < run.ids.size(); ++k) {
@@ -135,7 +149,8 @@ nlohmann::json UnitsJson(const triangulation::DirectionUnitsRun& run, const cali
          {"start_opk_deg", DegreesJson(run.start_opk_rad[k])},
          {"start_rotation", run.start_rotation[k]},
          {"pixel_size_mm", head.pixel_size_mm},
-         {"format_px", {head.width_px, head.height_px}}});
+         {"format_px", {head.width_px, head.height_px}},
+         {"radii_mm", radii_mm[k]}});
     if (!a.result.cameras.empty())
       units.back()["interior_covariance"] =
           triangulation::InteriorCovarianceToJson(a.interior_covariance, a.result.cameras[0]);
@@ -205,18 +220,15 @@ CalibrateOutcome CalibrateRigFromDirections(const DirectionsArgs& args) {
                                   triangulation::FormatSummary(r).c_str());
   const calib::Rig written = UpdatedRig(rig, run);
   nlohmann::json json = DirectionResultJson(r, setup);
-  triangulation::CalibrationRun first;
-  const auto budget = UnitsBudget(rig, run, args, setup.budget, &first);
-  for (const auto& q : budget) outcome.printed += StringPrintf("  %s\n", q.statement.c_str());
+  const HeadsBudget budget = UnitsBudget(rig, run, setup);
+  for (const auto& q : budget.quantities)
+    outcome.printed += StringPrintf("  %s\n", q.statement.c_str());
   // The first head's run gives the interior correlations, groups (none), stability and radii;
-  // the budget lists every head's quantities.
+  // the budget lists every head's quantities, `units` every head's radii and correlations.
   nlohmann::json cal = triangulation::CalibrationToJson(
-      first,
-      budget,
-      setup.budget.radii_mm.empty() ? DefaultCertifiedRadiiMm(reference) : setup.budget.radii_mm,
-      reference.c_mm());
+      budget.first, budget.quantities, budget.radii_mm.front(), reference.c_mm());
   cal["method"] = MethodJson(run, data, args.directions);
-  cal["units"] = UnitsJson(run, written);
+  cal["units"] = UnitsJson(run, written, budget.radii_mm);
   cal["data"] = DirectionDataJson(data, 0);
   cal["data"]["units"] = run.ids.size();
   // The first unit's id, pixel size and format: the certificate's distortion figure is its.

@@ -110,7 +110,8 @@ DirectionSetup ReadDirectionSetup(const DirectionsArgs& args, const calib::Camer
                       ": target_radius_mm is the eccentricity of test-field targets; a direction "
                       "calibration has none (--directions)");
   if (!args.radii_mm.empty()) setup.budget.radii_mm = args.radii_mm;
-  if (setup.budget.radii_mm.empty()) setup.budget.radii_mm = DefaultCertifiedRadiiMm(camera);
+  setup.radii_given = !setup.budget.radii_mm.empty();
+  if (!setup.radii_given) setup.budget.radii_mm = DefaultCertifiedRadiiMm(camera);
   return setup;
 }
 

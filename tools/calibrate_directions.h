@@ -31,6 +31,9 @@ struct DirectionsArgs {
 struct DirectionSetup {
   triangulation::DirectionRunOptions options;
   triangulation::BudgetOptions budget;
+  /// --radii-mm or the budget file named the radii; otherwise budget.radii_mm are the camera's
+  /// defaults (a rig's heads then take each its own format's: DefaultCertifiedRadiiMm).
+  bool radii_given = false;
 };
 /// Throws ConfigError naming the option on bad values; `camera` gives the model and the default
 /// radii.

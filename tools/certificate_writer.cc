@@ -386,11 +386,21 @@ nlohmann::json DistortionJson(const nlohmann::json& cert) {
       {"profile_kind", figure.profile_kind}, {"profile", figure.profile}, {"grid", figure.grid}};
 }
 
-// A rig's heads calibrated in one adjustment: per head its distortion samples (DistortionJson over
-// its own estimate, format and pitch) and its interior's correlations, in the units' order, so that
-// the renderer draws every head, not only the first (the certificate's `distortion`,
-// `correlation`).
-nlohmann::json UnitFigures(const nlohmann::json& result, const nlohmann::json& cert) {
+// The rows of `results` that are unit `id`'s quantities ("ID.name"), in their order.
+nlohmann::json RowsOfUnit(const nlohmann::json& results, const std::string& id) {
+  nlohmann::json out = nlohmann::json::array();
+  for (const auto& q : results)
+    if (q.value("quantity", "").rfind(id + ".", 0) == 0) out.push_back(q);
+  return out;
+}
+
+// A rig's heads calibrated in one adjustment, each certified on its own, in the units' order: its
+// uncertainty budget (its rows of `results`: computed by aerocal over the head's own estimate,
+// covariance, pitch and radii, tools/calibrate_direction_units.cc), the radii of its distortion
+// values, its distortion samples (DistortionJson over its own estimate, format and pitch) and its
+// interior's correlations; the renderer gives every head its budget table, distortion row and
+// correlation map.
+nlohmann::json HeadsJson(const nlohmann::json& result, const nlohmann::json& cert) {
   nlohmann::json out = nlohmann::json::array();
   const nlohmann::json& cameras = result.value("cameras", nlohmann::json::array());
   for (const auto& unit : cert["units"]) {
@@ -405,6 +415,8 @@ nlohmann::json UnitFigures(const nlohmann::json& result, const nlohmann::json& c
       of_unit["camera_file"] = nlohmann::json::object();
     const bool known = of_unit["interior"].is_object();
     out.push_back({{"id", id},
+                   {"results", RowsOfUnit(cert["results"], id)},
+                   {"radii_mm", unit.value("radii_mm", nlohmann::json::array())},
                    {"distortion", known ? DistortionJson(of_unit) : nlohmann::json()},
                    {"correlation", unit.value("interior_covariance", nlohmann::json())}});
   }
@@ -454,10 +466,11 @@ nlohmann::json CertificateData(const nlohmann::json& result,
       residuals.push_back({r.at("col"), r.at("row"), r.at("v_col_px"), r.at("v_row_px")});
   cert["residuals"] = residuals;
   // Several units from directions (a rig's heads, a multi-CCD camera's sub-images): each unit's
-  // values with U are rows "UNIT.quantity" of `results`; the units themselves listed here.
+  // values with U are rows "UNIT.quantity" of `results`; the units themselves listed here, a
+  // rig's heads each with its own budget and figures (`heads`).
   if (cal.contains("units")) {
     cert["units"] = cal["units"];
-    cert["unit_figures"] = UnitFigures(result, cert);
+    cert["heads"] = HeadsJson(result, cert);
   }
   if (cal.contains("subimages")) cert["units"] = cal["subimages"];
   if (cal.contains("gauge")) cert["gauge"] = cal["gauge"];

@@ -103,12 +103,13 @@ TEST(ResultFile, WrittenFileIsResultTextByteForByte) {
 }
 
 // Each kind carries its own schema_version (docs/schema/CHANGES.md): version 3 raised the kinds
-// whose keys changed (adjust, pushbroom, rig_stitch) and left the others at 2, so their files stay
-// readable. The writer stamps the kind's version; a reader refuses another by the kind's number.
+// whose keys changed (adjust, pushbroom, rig_stitch; later certificate) and left the others at 2,
+// so their files stay readable. The writer stamps the kind's version; a reader refuses another by
+// the kind's number.
 TEST(ResultKinds, EachKindHasItsOwnVersion) {
-  for (const char* kind : {"adjust", "pushbroom", "rig_stitch"})
+  for (const char* kind : {"adjust", "pushbroom", "rig_stitch", "certificate"})
     EXPECT_EQ(ResultSchemaVersion(kind), 3) << kind;
-  for (const char* kind : {"flight", "stitch", "certificate", "rig_error_analysis"})
+  for (const char* kind : {"flight", "stitch", "rig_error_analysis"})
     EXPECT_EQ(ResultSchemaVersion(kind), 2) << kind;
   EXPECT_THROW(ResultSchemaVersion("no_such_kind"), LogicError);
   ASSERT_EQ(kResultKinds.size(), kResultKindTable.size());

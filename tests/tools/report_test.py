@@ -562,6 +562,20 @@ class WhatPeopleRead(unittest.TestCase):
         self.assertIn("MTF50 across the format", text)
         self.assertIn("(14000 x 12000 px)", text)
         self.assertEqual(text.count(PNG_URI), 1)
+        # On the map, the edge found in raw sub-image I is placed twice at its place in the virtual
+        # image: its raw MTF50 among the raw sub-images, and, marked as the virtual image's, the MTF50
+        # measured in the virtual image resampled from it (its resampling block); the edge measured in
+        # the virtual image directly keeps its panel.
+        sys.path.insert(0, os.path.join(HERE, "..", "..", "tools", "report"))
+        try:
+            import report_resolution
+        finally:
+            sys.path.pop(0)
+        self.assertEqual(report_resolution.map_panels(section), {
+            "along track (MTF along x), raw sub-images": [(2100.5, 3300.5, 0.1806)],
+            "along track (MTF along x), virtual image": [(2100.5, 3300.5, 0.1652)],
+            "across track (MTF along y), virtual image": [(9000.0, 5000.0, 0.1690)]})
+        self.assertIn("the virtual image's panel holds the same edges measured in the virtual image", text)
         self.assertEqual(page.row("resolution-subimages", "I"),
                          ["I", "x", "along_track", "1", "0.1806", "1", "0.1652", "8.53", "8.31", "7.12"])
         self.assertEqual(page.row("resolution-pairs", "I"),
@@ -573,9 +587,9 @@ class WhatPeopleRead(unittest.TestCase):
 
 
 class CertificateHeads(unittest.TestCase):
-    """tools/certificate/aerocal_certificate.py draws every head of a rig's certificate (its
-    `unit_figures`, computed by aerocal), not only the first: one distortion row and one
-    correlation map per head, each from that head's own numbers."""
+    """tools/certificate/aerocal_certificate.py draws and budgets every head of a rig's certificate
+    (its `heads`, computed by aerocal), not only the first: one budget table, one distortion row and
+    one correlation map per head, each from that head's own numbers."""
 
     @classmethod
     def setUpClass(cls):
@@ -596,11 +610,20 @@ class CertificateHeads(unittest.TestCase):
                   "correlation": {"names": ["c", "x0"], "covariance": [[1e-6, 0], [0, 1e-6]],
                                   "correlation": [[1.0, 0.1 * k], [0.1 * k, 1.0]]}}
                  for k, h in enumerate(heads)]
+        rows = [{"quantity": "%s.dr@20" % h, "value": 2.0 * (k + 1), "U": 0.3 * (k + 1), "k": 2.0,
+                 "u_c": 0.15 * (k + 1), "dof_eff": 500.0 + k, "unit": "um",
+                 "components": [{"source": "image measurements", "type": "A", "distribution": "normal",
+                                 "u": 0.15 * (k + 1), "dof": 500.0 + k}]}
+                for k, h in enumerate(heads)]
+        for k, h in enumerate(heads):
+            units[k].update(results=[rows[k]], radii_mm=[20.0 - k])
+        m_0 = {"quantity": "m_0", "value": 0.3, "U": 0.02, "k": 2.0, "u_c": 0.01, "dof_eff": 900.0,
+               "unit": "um", "components": [{"source": "variance estimate", "type": "A",
+                                             "distribution": "normal", "u": 0.01, "dof": 900.0}]}
         return {"camera_file": {"format_px": [6000, 4000]}, "residuals": [[100, 100, 0.5, -0.2]],
-                "results": [{"quantity": "%s.dr@20" % h, "value": 2.0 * (k + 1), "U": 0.3}
-                            for k, h in enumerate(heads)],
+                "results": rows[:1] + [m_0] + rows[1:],
                 "distortion": units[0]["distortion"], "correlation": units[0]["correlation"],
-                "unit_figures": units}
+                "heads": units}
 
     def titles(self, fig):
         return [ax.get_title() for ax in fig.axes if ax.get_title()]
@@ -628,9 +651,27 @@ class CertificateHeads(unittest.TestCase):
             self.assertAlmostEqual(ax.images[0].get_array()[0][1], 0.1 * k)
         self.cert.plt.close(fig)
 
+    def test_every_head_gets_its_own_budget_table(self):
+        # One table per head from its own rows (its U, nu), at its own radii, then m_0 (one
+        # adjustment of all heads) apart; a single camera keeps one table of all its rows.
+        heads = ["A", "B", "C"]
+        tables = self.cert.budget_tables(self.certificate(heads))
+        self.assertEqual([t for t, _ in tables], ["head A (radii 20 mm)", "head B (radii 19 mm)",
+                                                  "head C (radii 18 mm)", "the adjustment of all heads"])
+        for k, h in enumerate(heads):
+            rows = tables[k][1]
+            self.assertEqual([r[0] for r in rows[1:]], ["%s.dr@20" % h] * 2)
+            self.assertEqual(rows[2][4], self.cert.fmt(0.15 * (k + 1), 3) + " / " + self.cert.fmt_u(0.3 * (k + 1)))
+            self.assertEqual(rows[1][5], self.cert.fmt(500.0 + k, 3))
+        self.assertEqual([r[0] for r in tables[3][1][1:]], ["m_0", "m_0"])
+        c = self.certificate(["A"])
+        del c["heads"]
+        self.assertEqual([t for t, _ in self.cert.budget_tables(c)], [""])
+        self.assertEqual(len(self.cert.budget_tables(c)[0][1]), 1 + 2 * len(c["results"]))
+
     def test_a_single_camera_keeps_one_row(self):
         c = self.certificate(["A"])
-        del c["unit_figures"]
+        del c["heads"]
         c["results"] = [{"quantity": "dr@20", "value": 2.0, "U": 0.3}]
         fig = self.cert.fig_distortion(c)
         self.assertEqual(self.titles(fig), ["distortion curves (bars: U, k as stated)",

@@ -91,15 +91,32 @@ def result_rows(c):
     return rows
 
 
-def budget_rows(c):
+def budget_rows(results):
+    """One budget table: every quantity's components and its combined / expanded uncertainty."""
     rows = [["quantity", "component", "type", "distribution", "u_i", "nu_i"]]
-    for q in c["results"]:
+    for q in results:
         for comp in q["components"]:
             rows.append([q["quantity"], comp["source"], comp["type"], comp["distribution"],
                          fmt(comp["u"], 3), fmt(comp["dof"], 3)])
         rows.append([q["quantity"], "combined u_c / expanded U", "", "k = %s" % fmt(q["k"], 3),
                      fmt(q["u_c"], 3) + " / " + fmt_u(q["U"]), fmt(q["dof_eff"], 3)])
     return rows
+
+
+def budget_tables(c):
+    """[(heading, rows)]: a rig's heads (certificate.json `heads`) one budget table each, from the
+    head's own rows as aerocal computed them, then the rows of no head (m_0: one adjustment); a
+    single camera one table of all its rows."""
+    heads = c.get("heads") or []
+    if not heads:
+        return [("", budget_rows(c["results"]))]
+    out = [("head %s (radii %s mm)" % (h.get("id", "?"), ", ".join(fmt(r, 4) for r in h.get("radii_mm") or [])),
+            budget_rows(h.get("results") or [])) for h in heads]
+    of_heads = {q["quantity"] for h in heads for q in h.get("results") or []}
+    rest = [q for q in c["results"] if q["quantity"] not in of_heads]
+    if rest:
+        out.append(("the adjustment of all heads", budget_rows(rest)))
+    return out
 
 
 def source_rows(c):
@@ -432,9 +449,9 @@ def is_independent(comp):
 
 def unit_panels(c):
     """[(title prefix, quantity prefix, distortion, correlation)]: one per rig head when the certificate
-    has `unit_figures` (every head's samples, computed by aerocal: tools/certificate_writer.cc
-    UnitFigures), else the certificate's own single camera."""
-    units = c.get("unit_figures") or []
+    has `heads` (every head's samples, computed by aerocal: tools/certificate_writer.cc HeadsJson),
+    else the certificate's own single camera."""
+    units = c.get("heads") or []
     if units:
         return [("head %s: " % u.get("id", "?"), "%s." % u.get("id", "?"), u.get("distortion"),
                  u.get("correlation")) for u in units]
@@ -490,7 +507,7 @@ def draw_distortion(ax1, ax2, d, c, title, prefix):
 def fig_distortion(c):
     """The camera's correction as aerocal computed it in its model (certificate.json `distortion`:
     triangulation/calibration/distortion_figure.h; a rig's heads: one row per head from
-    `unit_figures`); this script restates no camera model."""
+    `heads`); this script restates no camera model."""
     panels = unit_panels(c)
     fig, axes = plt.subplots(len(panels), 2, figsize=(8, 3.4 * len(panels)), squeeze=False)
     for (title, prefix, d, _), (ax1, ax2) in zip(panels, axes):
@@ -601,10 +618,12 @@ def page_html(c, figures):
               "coverage probability about 95 %; U with two significant digits.</p>",
               "<ul>" + "".join("<li>%s</li>" % html.escape(q["statement"]) for q in c["results"]) + "</ul>",
               html_table(result_rows(c)),
-              "<h2>3. Uncertainty budget</h2>", "<p>%s</p>" % html.escape(type_a_note(c)), html_table(budget_rows(c)),
-              "<h3>Sources of the components</h3>", html_table(source_rows(c)),
-             "<h2>4. Distortion</h2>", figures["distortion"],
-             "<h2>5. Residuals and correlations</h2>", figures["residuals"]]
+              "<h2>3. Uncertainty budget</h2>", "<p>%s</p>" % html.escape(type_a_note(c))]
+    for heading, rows in budget_tables(c):
+        parts += (["<h3>Budget of %s</h3>" % html.escape(heading)] if heading else []) + [html_table(rows)]
+    parts += ["<h3>Sources of the components</h3>", html_table(source_rows(c)),
+              "<h2>4. Distortion</h2>", figures["distortion"],
+              "<h2>5. Residuals and correlations</h2>", figures["residuals"]]
     st = stability_rows(c)
     parts.append("<h2>6. Stability over image groups</h2>")
     parts.append(html_table(st, flag_col=len(st[0]) - 1) if st else "<p>No image groups given.</p>")
@@ -721,9 +740,9 @@ def write_pdf_pages(c, tmp, title):
                   ("Camera model", wrapped), ("", model_rows(c)),
                   ("2. Results (U = k u_c, ISO GUM / JJF 1059.1)", statements),
                   ("", result_rows(c)),
-                  ("3. Uncertainty budget", [[line] for line in textwrap.wrap(type_a_note(c), 150)] or [[""]]),
-                  ("", budget_rows(c)),
-                  ("Sources of the components", [[r[0], r[1], r[2], line] for r in source_rows(c)
+                  ("3. Uncertainty budget", [[line] for line in textwrap.wrap(type_a_note(c), 150)] or [[""]])]
+        blocks += [("budget of " + heading if heading else "", rows) for heading, rows in budget_tables(c)]
+        blocks += [("Sources of the components", [[r[0], r[1], r[2], line] for r in source_rows(c)
                                                   for line in (textwrap.wrap(r[3], 90) or [""])])]
         if is_draft(c):
             blocks.insert(0, ("DRAFT: no laboratory file (--lab): not a calibration certificate", [[""]]))
@@ -775,7 +794,7 @@ def write_pdf_pages(c, tmp, title):
 
 
 # ResultSchemaVersion("certificate") of calib/core/result_file.h: the version this renderer reads.
-SCHEMA_VERSION = 2
+SCHEMA_VERSION = 3
 
 
 def main(argv):

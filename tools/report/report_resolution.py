@@ -69,28 +69,41 @@ def _loss(d):
                   "loss %", "U %"], rows)
 
 
-def _map(d):
-    """MTF50 across the format: a panel per direction (or axis) and image kind, the edges that carry their
-    position in the virtual image (`quality mtf --targets`, or `--virtual` with --roi)."""
-    fmt_px = [rd.number(v) for v in rd.listing(rd.get(d, "virtual_format_px"))]
+def map_panels(d):
+    """{title: [(col, row, mtf50_cy_px)]}: the edges that carry their position in the virtual image
+    (`quality mtf --targets`, or `--virtual` with --roi and --image-origin), a panel per direction (or
+    axis) and image kind. An edge found in a raw sub-image and measured again in the virtual image
+    resampled from it (`--targets --sub-image --virtual-image`: its `resampling` block) is placed
+    twice at its one place: its raw MTF50 in the raw sub-images' panel and its virtual MTF50 in the
+    virtual image's, so the two panels of a direction compare the same edges."""
     panels = {}
     for e in rd.listing(rd.get(d, "edges")):
         pos = [rd.number(v) for v in rd.listing(rd.get(e, "position_virtual_px"))]
-        mtf50 = rd.number(rd.get(e, "mtf50_cy_px"))
-        if len(pos) != 2 or None in pos or mtf50 is None:
+        if len(pos) != 2 or None in pos:
             continue
         direction, axis = rd.get(e, "direction"), rd.get(e, "axis")
-        which = "raw sub-images" if rd.get(e, "image_kind") == "raw" else "virtual image"
-        title = f"{direction.replace('_', ' ')} (MTF along {axis}), {which}" if direction else \
-            f"MTF along {axis}, {which}"
-        panels.setdefault(title, []).append((pos[0], pos[1], mtf50))
+        along = f"{direction.replace('_', ' ')} (MTF along {axis})" if direction else f"MTF along {axis}"
+        raw = rd.get(e, "image_kind") == "raw"
+        virtual = rd.number(rd.get(rd.get(e, "resampling"), "virtual_mtf50_cy_px")) if raw else None
+        for which, mtf50 in (("raw sub-images" if raw else "virtual image", rd.number(rd.get(e, "mtf50_cy_px"))),
+                             ("virtual image", virtual)):
+            if mtf50 is not None:
+                panels.setdefault(f"{along}, {which}", []).append((pos[0], pos[1], mtf50))
+    return panels
+
+
+def _map(d):
+    """MTF50 across the format (map_panels), one colour scale."""
+    fmt_px = [rd.number(v) for v in rd.listing(rd.get(d, "virtual_format_px"))]
+    panels = map_panels(d)
     if not panels or len(fmt_px) != 2 or None in fmt_px:
         return ""
     png, facts = plots.mtf_map(sorted(panels.items()), fmt_px[0], fmt_px[1])
     return figure("resolution-map", png, "MTF50 across the format",
                   f"MTF50 of each edge region at its place in the virtual image ({fmt_px[0]:.0f} x {fmt_px[1]:.0f} px), "
-                  f"a panel per direction and image (a raw sub-image's edge drawn where the virtual image shows it); "
-                  f"colour and size from "
+                  f"a panel per direction and image (a raw sub-image's edge drawn where the virtual image shows it; "
+                  f"the virtual image's panel holds the same edges measured in the virtual image resampled from "
+                  f"the sub-images); colour and size from "
                   f"{facts['lo']:.4f} to {facts['hi']:.4f} cycles/px.")
 
 
