@@ -503,13 +503,31 @@ nlohmann::json CertificateOfResult(const CertificateArgs& args,
   });
 }
 
+// A previous certificate of schema version 2 (before the per-head tables of version 3) still
+// compares: the comparison reads only its `results` rows, whose form version 3 kept
+// (docs/schema/CHANGES.md). A lab compares with last year's certificate as it was issued.
+constexpr int kOldestComparableCertificate = 2;
+
+// args.previous: a certificate (this version or an older comparable one) or a calibrate result.
+nlohmann::json ReadPrevious(const std::string& path) {
+  nlohmann::json document = ReadJsonFile(path);
+  if (document.is_object() && document.value("kind", nlohmann::json()) == "certificate" &&
+      document.contains("schema_version") && document["schema_version"].is_number_integer()) {
+    const long long version = document["schema_version"].get<long long>();
+    if (version >= kOldestComparableCertificate && version < ResultSchemaVersion("certificate"))
+      return document;
+  }
+  CheckResult(
+      document, path, {"certificate", "adjust"}, "`aerocal certificate` or `aerocal calibrate`");
+  return document;
+}
+
 // The comparison with args.previous (a certificate.json or calibrate result) against the
 // tolerances, into cert["comparison"]; whether it passes.
 bool CompareWithPrevious(const CertificateArgs& args,
                          const std::map<std::string, double>& tolerances,
                          nlohmann::json* cert) {
-  const nlohmann::json previous = ReadResult(
-      args.previous, {"certificate", "adjust"}, "`aerocal certificate` or `aerocal calibrate`");
+  const nlohmann::json previous = ReadPrevious(args.previous);
   return ReadTyped(args.previous, "--previous", [&] {
     const nlohmann::json* old = Uncertainty(previous);
     if (!old)

@@ -276,10 +276,11 @@ TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
   for (const auto& q : cert["results"])
     if (q["quantity"] == "c")
       for (const auto& comp : q["components"])
-        if (comp["source"] == "pixel pitch")
+        if (comp["source"] == "pixel pitch") {  // braces: EXPECT_NEAR is an if/else macro
           EXPECT_NEAR(comp["u"].get<double>(),
                       q["value"].get<double>() * 3.2e-6 / 0.0031911032863849768 / std::sqrt(3.0),
                       1e-9);
+        }
   // Deterministic: a second run writes the same bytes.
   const auto c2 = RunAerocal(args + " --out " + tmp_.File("cert2"));
   ASSERT_EQ(c2.exit_code, 0) << c2.output;
@@ -288,6 +289,26 @@ TEST_F(OlympusCalibration, CertificateJsonHtmlAndPdfDeterministic) {
     EXPECT_EQ(ReadTextFile(tmp_.File(std::string("cert1/") + f)),
               ReadTextFile(tmp_.File(std::string("cert2/") + f)));
   }
+  // Last year's certificate as it was issued (schema 2, before the per-head tables) still
+  // compares; an older version is refused by name.
+  nlohmann::json issued = cert;
+  issued["schema_version"] = 2;
+  issued.erase("heads");
+  issued.erase("comparison");
+  WriteText(tmp_.File("issued.json"), issued.dump(1));
+  const std::string against_issued = "certificate --no-render --result " + tmp_.File("oly.json") +
+                                     " --lab " + tmp_.File("lab.yaml") + " --previous " +
+                                     tmp_.File("issued.json") + " --tolerances " +
+                                     tmp_.File("tol.yaml");
+  const auto c3 = RunAerocal(against_issued + " --out " + tmp_.File("cert3"));
+  ASSERT_EQ(c3.exit_code, 0) << c3.output;
+  EXPECT_TRUE(ReadJson(tmp_.File("cert3/certificate.json"))["comparison"]["pass"].get<bool>());
+  issued["schema_version"] = 1;
+  WriteText(tmp_.File("issued.json"), issued.dump(1));
+  const auto c4 = RunAerocal(against_issued + " --out " + tmp_.File("cert4"));
+  EXPECT_EQ(c4.exit_code, 2) << c4.output;
+  EXPECT_NE(c4.output.find("issued.json: schema_version is 1, expected 3"), std::string::npos)
+      << c4.output;
   // Every PDF page rendered to PNG (poppler's pdftoppm).
   if (RunCommand("command -v pdftoppm").exit_code != 0)
     GTEST_SKIP()
