@@ -20,6 +20,11 @@ using ConstMap = Eigen::Map<const RowMatrix>;
 using Map = Eigen::Map<RowMatrix>;
 
 constexpr double kMinDiagonal = 1e-6, kMaxDiagonal = 1e32;  // Ceres' LM defaults
+// The cost of one small product in multiply-adds beyond its own (the call, the size dispatch, the
+// cell's address). With the multiply-adds alone the exposures' 3 x 3 products were undercounted
+// against the interior's 10-wide ones: a perf profile of two threads put 61 % of the assembly's
+// samples on one thread; with this weight 54 % (docs/measurements/triangulation.md).
+constexpr double kProductOverhead = 30.0;
 
 // Slot of free block `b` among the parameters of residual term `t`.
 int SlotOf(const ResidualTerm& t, int b) {
@@ -234,7 +239,8 @@ void ReducedSystem::IndexCells(const ResidualEvaluator& ev) {
     const int t = ev.block(points_[e]).tangent;
     for (size_t a = point_blk_start_[e]; a <= entry; ++a) {
       pair_cell_.push_back(CellIndex(row, point_blk_[a]));
-      cell_cost[pair_cell_.back()] += t * BlockSize(row) * BlockSize(point_blk_[a]);
+      cell_cost[pair_cell_.back()] +=
+          kProductOverhead + t * BlockSize(row) * BlockSize(point_blk_[a]);
     }
     pair_cell_start_.push_back(static_cast<long long>(pair_cell_.size()));
     row_cost[row] += 8.0;  // a piece's loop visits every point of its row
@@ -250,7 +256,8 @@ void ReducedSystem::IndexCells(const ResidualEvaluator& ev) {
         u_cell_.push_back(
             col < 0 || col > static_cast<int>(j) ? -1 : CellIndex(static_cast<int>(j), col));
         if (u_cell_.back() >= 0)
-          cell_cost[u_cell_.back()] += rows * BlockSize(static_cast<int>(j)) * BlockSize(col);
+          cell_cost[u_cell_.back()] +=
+              kProductOverhead + rows * BlockSize(static_cast<int>(j)) * BlockSize(col);
       }
       u_cell_start_.push_back(static_cast<long long>(u_cell_.size()));
       row_cost[j] += 8.0;
