@@ -20,6 +20,11 @@ using ConstMap = Eigen::Map<const RowMatrix>;
 using Map = Eigen::Map<RowMatrix>;
 
 constexpr double kMinDiagonal = 1e-6, kMaxDiagonal = 1e32;  // Ceres' LM defaults
+// The cost of one small product in multiply-adds beyond its own (the call, the size dispatch, the
+// cell's address). With the multiply-adds alone the exposures' 3 x 3 products were undercounted
+// against the interior's 10-wide ones: a perf profile of two threads put 61 % of the assembly's
+// samples on one thread; with this weight 54 % (docs/measurements/triangulation.md).
+constexpr double kProductOverhead = 30.0;
 
 // Slot of free block `b` among the parameters of residual term `t`.
 int SlotOf(const ResidualTerm& t, int b) {
@@ -223,28 +228,74 @@ int ReducedSystem::CellIndex(int row, int col_block) const {
 }
 
 void ReducedSystem::IndexCells(const ResidualEvaluator& ev) {
-  // The cell of every product AssembleRow adds, looked up once: per point entry (row block
-  // point_blk_[entry]) the cells of its pairs with the point's earlier blocks ...
+  // The cell of every product AssembleRow adds, looked up once, with its multiply-adds (the
+  // cost that splits the work between threads): per point entry (row block point_blk_[entry])
+  // the cells of its pairs with the point's earlier blocks ...
+  std::vector<double> cell_cost(row_cols_.size(), 0.0), row_cost(reduced_.size(), 0.0);
   pair_cell_start_ = {0};
   pair_cell_.clear();
   for (size_t entry = 0; entry < point_blk_.size(); ++entry) {
-    const int e = entry_point_[entry];
-    for (size_t a = point_blk_start_[e]; a <= entry; ++a)
-      pair_cell_.push_back(CellIndex(point_blk_[entry], point_blk_[a]));
+    const int e = entry_point_[entry], row = point_blk_[entry];
+    const int t = ev.block(points_[e]).tangent;
+    for (size_t a = point_blk_start_[e]; a <= entry; ++a) {
+      pair_cell_.push_back(CellIndex(row, point_blk_[a]));
+      cell_cost[pair_cell_.back()] +=
+          kProductOverhead + t * BlockSize(row) * BlockSize(point_blk_[a]);
+    }
     pair_cell_start_.push_back(static_cast<long long>(pair_cell_.size()));
+    row_cost[row] += 8.0;  // a piece's loop visits every point of its row
   }
   // ... and per residual of a block row, the cell of each of its parameters (-1: none).
   u_cell_start_ = {0};
   u_cell_.clear();
   for (size_t j = 0; j + 1 < red_res_start_.size(); ++j)
     for (int k = red_res_start_[j]; k < red_res_start_[j + 1]; ++k) {
+      const int rows = ev.residual_size(red_res_[k]);
       for (int b : ev.term(red_res_[k]).free) {
         const int col = b < 0 ? -1 : reduced_of_block_[b];
         u_cell_.push_back(
             col < 0 || col > static_cast<int>(j) ? -1 : CellIndex(static_cast<int>(j), col));
+        if (u_cell_.back() >= 0)
+          cell_cost[u_cell_.back()] +=
+              kProductOverhead + rows * BlockSize(static_cast<int>(j)) * BlockSize(col);
       }
       u_cell_start_.push_back(static_cast<long long>(u_cell_.size()));
+      row_cost[j] += 8.0;
     }
+  PartitionRows(cell_cost, row_cost);
+}
+
+void ReducedSystem::PartitionRows(const std::vector<double>& cell_cost,
+                                  const std::vector<double>& row_cost) {
+  double total = 0.0;
+  for (double c : cell_cost) total += c;
+  for (double c : row_cost) total += c;
+  const double max_piece = total / (2.0 * threads_);
+  row_parts_.clear();
+  std::vector<double> part_cost;
+  for (int i = 0; i < static_cast<int>(reduced_.size()); ++i) {
+    const int c0 = row_start_[i], c1 = row_start_[i + 1];
+    double cells = 0.0;
+    for (int c = c0; c < c1; ++c) cells += cell_cost[c];
+    // One thread: whole rows. Else a row above the piece size is cut where its cells' cost
+    // passes k / pieces of the row's.
+    const int pieces =
+        threads_ == 1 ? 1
+                      : std::max(1, static_cast<int>(std::ceil((row_cost[i] + cells) / max_piece)));
+    double sum = 0.0, piece = 0.0;
+    int begin = c0, cut = 1;
+    for (int c = c0; c < c1; ++c) {
+      sum += cell_cost[c];
+      piece += cell_cost[c];
+      if (c + 1 < c1 && sum < cells * cut / pieces) continue;
+      row_parts_.push_back({i, begin, c + 1});
+      part_cost.push_back(row_cost[i] + piece);
+      begin = c + 1;
+      piece = 0.0;
+      while (cut < pieces && sum >= cells * cut / pieces) ++cut;  // a heavy cell spans cuts
+    }
+  }
+  part_bounds_ = BalancedBounds(part_cost, threads_);
 }
 
 void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
@@ -300,51 +351,59 @@ void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
   });
 }
 
-void ReducedSystem::AssembleRow(const ResidualEvaluator& ev, int i) {
-  const int bi = reduced_[i], si = ev.block(bi).tangent, oi = reduced_offset_[i];
-  for (int c = row_start_[i]; c < row_start_[i + 1]; ++c)
-    std::fill_n(s_.data() + cell_offset_[c], si * ev.block(reduced_[row_cols_[c]]).tangent, 0.0);
-  // U = F^T F, the residuals by index.
+void ReducedSystem::AssembleRow(const ResidualEvaluator& ev, const RowPart& part) {
+  const int i = part.row, bi = reduced_[i], si = BlockSize(i), oi = reduced_offset_[i];
+  const int c0 = part.cell_begin, c1 = part.cell_end;
+  const bool last = c1 == row_start_[i + 1];  // the diagonal cell is the row's last
+  for (int c = c0; c < c1; ++c)
+    std::fill_n(s_.data() + cell_offset_[c], si * BlockSize(row_cols_[c]), 0.0);
+  // U = F^T F, the residuals by index (the cells and sizes from the index arrays read in order,
+  // not from the residual terms: those are scattered over the heap).
   for (int k = red_res_start_[i]; k < red_res_start_[i + 1]; ++k) {
     const int r = red_res_[k], rows = ev.residual_size(r);
-    const ResidualTerm& term = ev.term(r);
     const double* fi = ev.jacobian(r, red_res_slot_[k]);
     const int* cells = u_cell_.data() + u_cell_start_[k];
-    for (size_t q = 0; q < term.free.size(); ++q) {
-      if (cells[q] < 0) continue;
-      const int sj = ev.block(term.free[q]).tangent;
+    const int slots = static_cast<int>(u_cell_start_[k + 1] - u_cell_start_[k]);
+    for (int q = 0; q < slots; ++q) {
+      const int c = cells[q];  // -1 (no cell) is below c0 too
+      if (c < c0 || c >= c1) continue;
       AddTransposedProduct(fi,
-                           ev.jacobian(r, static_cast<int>(q)),
+                           ev.jacobian(r, q),
                            rows,
                            si,
-                           sj,
+                           BlockSize(row_cols_[c]),
                            1.0,
-                           s_.data() + cell_offset_[cells[q]]);
+                           s_.data() + cell_offset_[c]);
     }
   }
-  double* diagonal = s_.data() + cell_offset_[CellIndex(i, i)];
   const int ti = ev.tangent_offset(bi);
-  for (int a = 0; a < si; ++a) diagonal[a * si + a] += d2_(ti + a);
-  rhs_.segment(oi, si) = -g_.segment(ti, si);
-  // - W_e^T V_e^-1 W_e, the points by index.
+  if (last) {
+    double* diagonal = s_.data() + cell_offset_[CellIndex(i, i)];
+    for (int a = 0; a < si; ++a) diagonal[a * si + a] += d2_(ti + a);
+    rhs_.segment(oi, si) = -g_.segment(ti, si);
+  }
+  // - W_e^T V_e^-1 W_e, the points by index; a point's cells ascend with its blocks.
   for (int k = red_pt_start_[i]; k < red_pt_start_[i + 1]; ++k) {
     const int entry = red_pt_entry_[k];
-    const int e = entry_point_[entry];
+    const int e = entry_point_[entry], a0 = point_blk_start_[e];
     const int t = ev.block(points_[e]).tangent;
     const double* wi = w_.data() + point_w_[entry];
     const int* cells = pair_cell_.data() + pair_cell_start_[entry];
-    for (int a = point_blk_start_[e]; a <= entry; ++a) {
-      const int sj = reduced_offset_[point_blk_[a] + 1] - reduced_offset_[point_blk_[a]];
+    for (int a = a0; a <= entry; ++a) {
+      const int c = cells[a - a0];
+      if (c < c0) continue;
+      if (c >= c1) break;
       AddTransposedProduct(wi,
                            q_.data() + point_w_[a],
                            t,
                            si,
-                           sj,
+                           BlockSize(point_blk_[a]),
                            -1.0,
-                           s_.data() + cell_offset_[cells[a - point_blk_start_[e]]]);
+                           s_.data() + cell_offset_[c]);
     }
-    AddTransposedProduct(
-        wi, qg_.data() + ev.tangent_offset(points_[e]), t, si, 1, 1.0, rhs_.data() + oi);
+    if (last)
+      AddTransposedProduct(
+          wi, qg_.data() + ev.tangent_offset(points_[e]), t, si, 1, 1.0, rhs_.data() + oi);
   }
 }
 
@@ -404,8 +463,8 @@ bool ReducedSystem::Reduce(const ResidualEvaluator& ev, bool pseudo) {
   });
   if (!ok) return false;
   rhs_.resize(n_reduced_);
-  ParallelRanges(row_bounds_, [&](int begin, int end, int) {
-    for (int i = begin; i < end; ++i) AssembleRow(ev, i);
+  ParallelRanges(part_bounds_, [&](int begin, int end, int) {
+    for (int p = begin; p < end; ++p) AssembleRow(ev, row_parts_[p]);
   });
   return true;
 }

@@ -57,8 +57,22 @@ class ReducedSystem {
   void BuildStructure(const ResidualEvaluator& ev);
   /// Index (into row_cols_ / cell_offset_) of the cell (row, col_block), col_block <= row.
   int CellIndex(int row, int col_block) const;
+  /// Scalar size of reduced block j.
+  int BlockSize(int j) const { return reduced_offset_[j + 1] - reduced_offset_[j]; }
+  /// The cells of the products below (pair_cell_, u_cell_) and the assembly's pieces of work.
   void IndexCells(const ResidualEvaluator& ev);
-  void AssembleRow(const ResidualEvaluator& ev, int row);
+  /// A piece of a block row of S: the cells [cell_begin, cell_end) (indices into row_cols_), all
+  /// summed by one thread; the row's last piece owns the diagonal cell's damping and the row's
+  /// right-hand side. Every cell is summed in the same order whatever the pieces: the pieces only
+  /// decide which thread sums it.
+  struct RowPart {
+    int row, cell_begin, cell_end;
+  };
+  /// Cuts the rows into pieces of at most 1 / (2 threads) of the total cost (the interior's row
+  /// alone receives a product from every point: about half of the work) and the pieces into one
+  /// contiguous range per thread.
+  void PartitionRows(const std::vector<double>& cell_cost, const std::vector<double>& row_cost);
+  void AssembleRow(const ResidualEvaluator& ev, const RowPart& part);
   /// V_e^-1 (damped by d2_; pseudo-inverse with `pseudo`), Q_e, V_e^-1 g_e per point, then every
   /// row of S and the right-hand side. False when a point block is not finite.
   bool Reduce(const ResidualEvaluator& ev, bool pseudo);
@@ -90,6 +104,8 @@ class ReducedSystem {
   std::vector<int> pair_cell_, u_cell_;
   std::vector<double> s_;
   std::vector<int> row_bounds_, point_bounds_;
+  std::vector<RowPart> row_parts_;
+  std::vector<int> part_bounds_;  // per thread, a range of row_parts_
   // per point: V (undamped), V^-1 (damped), g_e; W, Q = V^-1 W
   std::vector<long long> v_offset_;
   std::vector<double> v_, vinv_, w_, q_, qg_;

@@ -58,7 +58,9 @@ class ResidualEvaluator {
   const ResidualTerm& term(int i) const { return residuals_[i]; }
   int tangent_offset(int b) const { return tangent_offset_[b]; }
   int num_tangent() const { return tangent_offset_.back(); }
-  int residual_size(int i) const { return residuals_[i].cost->num_residuals(); }
+  // From the offsets (one array read in order) rather than the cost function (a heap object per
+  // residual: a cache miss per call in the reduced system's loops over all residuals).
+  int residual_size(int i) const { return static_cast<int>(r_offset_[i + 1] - r_offset_[i]); }
   /// Corrected residual i and its tangent Jacobian on parameter k (rows x tangent, row-major) of
   /// the last Evaluate with jacobians; nullptr for a constant parameter.
   const double* residual(int i) const { return r_.data() + r_offset_[i]; }
