@@ -32,6 +32,11 @@ inline SimulatedFlight SimulateBlock(int exposures) {
   o.tie_points = 16 * exposures;
   o.ground_points = std::max(329, 2 * exposures);
   o.control_points = std::max(5, exposures / 20);
+  // The per-exposure stitching measurements are not adjusted here; above the simulator's bound
+  // (kMaxSimulatedStitchTies, reached at 2,223 exposures) they are left out. The 150 and 600
+  // blocks keep theirs, so their random draws and figures stay as measured.
+  if (exposures * static_cast<double>(o.stitching.ties_per_frame) > kMaxSimulatedStitchTies)
+    o.stitching.ties_per_frame = 0;
   return SimulateFlight(o);
 }
 
