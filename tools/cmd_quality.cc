@@ -533,21 +533,9 @@ CLI::App* AddStar(CLI::App& app, StarArgs* star) {
   return s;
 }
 
-CommandRun Setup(CLI::App& app) {
-  app.require_subcommand(1);
-  auto mtf = std::make_shared<MtfArgs>();
-  CLI::App* m = app.add_subcommand(
-      "mtf",
-      "Slanted-edge MTF (ISO 12233 e-SFR) of edge regions: MTF50, MTF at Nyquist, U (k = 2)");
-  m->option_defaults()->always_capture_default();
-  m->add_option(
-       "--image", mtf->image, "Grey-value image (8 or 16 bit; colour is converted to grey)")
-      ->required();
-  m->add_option(
-      "--roi",
-      mtf->rois,
-      "Edge region col,row,width,height (px, at least 16 x 16), one edge slanted by 1..35 "
-      "deg; repeat for more edges (or --targets)");
+// `quality mtf --targets`'s options: the edge targets projected into the image, from the virtual
+// image into a raw sub-image through a stitch result's mappings.
+void AddMtfTargetOptions(CLI::App* m, MtfArgs* mtf) {
   m->add_option(
       "--targets",
       mtf->targets,
@@ -587,6 +575,23 @@ CommandRun Setup(CLI::App& app) {
                 mtf->target_half_width_px,
                 "--targets: region width each side of the edge (px)")
       ->check(FiniteRange(8, 1e4));
+}
+
+// `quality mtf`'s options.
+CLI::App* AddMtf(CLI::App& app, MtfArgs* mtf) {
+  CLI::App* m = app.add_subcommand(
+      "mtf",
+      "Slanted-edge MTF (ISO 12233 e-SFR) of edge regions: MTF50, MTF at Nyquist, U (k = 2)");
+  m->option_defaults()->always_capture_default();
+  m->add_option(
+       "--image", mtf->image, "Grey-value image (8 or 16 bit; colour is converted to grey)")
+      ->required();
+  m->add_option(
+      "--roi",
+      mtf->rois,
+      "Edge region col,row,width,height (px, at least 16 x 16), one edge slanted by 1..35 "
+      "deg; repeat for more edges (or --targets)");
+  AddMtfTargetOptions(m, mtf);
   m->add_option(
        "--gamma", mtf->gamma, "Linearisation: value = DN^gamma (1: linear data), 0 < G <= 10")
       ->check(FiniteRange(1e-6, 10.0))
@@ -613,7 +618,11 @@ CommandRun Setup(CLI::App& app) {
   m->add_option(
        "--out", mtf->out, "Output file: the result JSON (kind quality_mtf, written atomically)")
       ->required();
-  auto bars = std::make_shared<BarsArgs>();
+  return m;
+}
+
+// `quality bars`'s options.
+CLI::App* AddBars(CLI::App& app, BarsArgs* bars) {
   CLI::App* b = app.add_subcommand(
       "bars",
       "Bar targets: contrast transfer per bar group and the limiting frequency at a threshold");
@@ -642,6 +651,15 @@ CommandRun Setup(CLI::App& app) {
   b->add_option(
        "--out", bars->out, "Output file: the result JSON (kind quality_bars, written atomically)")
       ->required();
+  return b;
+}
+
+CommandRun Setup(CLI::App& app) {
+  app.require_subcommand(1);
+  auto mtf = std::make_shared<MtfArgs>();
+  CLI::App* m = AddMtf(app, mtf.get());
+  auto bars = std::make_shared<BarsArgs>();
+  CLI::App* b = AddBars(app, bars.get());
   auto star = std::make_shared<StarArgs>();
   CLI::App* s = AddStar(app, star.get());
   return [mtf, m, bars, b, star, s] {

@@ -124,22 +124,21 @@ void PrepareFlight(FlightArgs* args) {
   }
 }
 
-int RunFlight(const FlightArgs& args) {
-  // The workflow's five steps, then the report (its figures take tens of seconds on a big flight).
-  Progress progress("flight", args.no_report ? 5 : 6);
-  const auto result = triangulation::RunFlightWorkflow(args.options, &progress);
-  namespace fs = std::filesystem;
-  for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
-  for (const auto& [step, reason] : result.failures)
-    std::fprintf(stderr, "flight: step %s failed: %s\n", step.c_str(), reason.c_str());
-  if (!result.valid) std::fprintf(stderr, "flight: no calibrated camera written\n");
-  // result.json, the calibrated camera(s), report.html and certificate/ are one set
-  // (tools/output_set.h): staged in OUT, moved into place only when every part was written, so
-  // a failing report or certificate replaces nothing of the previous flight in OUT.
-  OutputSet set(args.out);
+namespace {
+
+// The parts a flight writes into OUT, and those of an earlier run it removes.
+struct FlightParts {
+  std::vector<std::string> parts = {"result.json"}, obsolete;
+};
+
+// result.json (with the resolution results and, asked for, the residual tables beside it) and,
+// for a valid flight, the calibrated camera(s), staged in `set`; returns result.json's path.
+std::string StageResult(const FlightArgs& args,
+                        const triangulation::FlightWorkflowResult& result,
+                        OutputSet& set,
+                        FlightParts* out) {
   const std::string camera_name = "camera_calibrated.yaml";
   const std::string format_name = "camera_calibrated." + args.camera_format;
-  std::vector<std::string> parts = {"result.json"}, obsolete;
   const std::string json_path = set.Staged("result.json");
   nlohmann::json document = result.document;
   document["aerocal_version"] = AEROCAL_VERSION;
@@ -150,63 +149,100 @@ int RunFlight(const FlightArgs& args) {
   const std::vector<std::string> tables = args.residuals_csv
                                               ? SplitResidualTables(&document, set.staging())
                                               : std::vector<std::string>{};
-  parts.insert(parts.end(), tables.begin(), tables.end());
-  obsolete = ResidualTablesNotWritten(tables);
+  out->parts.insert(out->parts.end(), tables.begin(), tables.end());
+  out->obsolete = ResidualTablesNotWritten(tables);
   WriteResult(json_path, "flight", document);
   // A calibrated camera is written only for a valid flight: a file that exists is one the next
   // flight may use (an old one in the folder is removed, so it cannot pass for this run's).
-  (result.valid ? parts : obsolete).push_back(camera_name);
+  (result.valid ? out->parts : out->obsolete).push_back(camera_name);
   if (result.valid) calib::WriteCamera(set.Staged(camera_name), result.calibrated_camera);
   if (!args.camera_format.empty()) {
-    (result.valid ? parts : obsolete).push_back(format_name);
+    (result.valid ? out->parts : out->obsolete).push_back(format_name);
     if (result.valid)
       WriteCameraInFormat(set.Staged(format_name), result.calibrated_camera, args.camera_format);
   }
-  // A report or certificate of an earlier flight left beside this result.json would not
-  // describe it: parts this run does not write are removed with the commit.
-  if (args.no_report) obsolete.insert(obsolete.end(), {"report.html", "report.pdf"});
-  if (!args.no_report) {
-    const char* env = std::getenv("AEROCAL_REPORT_SCRIPT");
-    const std::string script = env ? env : AEROCAL_REPORT_SCRIPT;
-    const std::string html = set.Staged("report.html"), pdf = set.Staged("report.pdf");
-    progress.Stage("report");
-    if (!RunPythonScript(script, {json_path, html, pdf})) {
-      std::fprintf(stderr,
-                   "error: the report could not be written (%s); nothing written, the "
-                   "previous flight in %s is left as it was\n",
-                   PythonCommandLine(script, {json_path, html, pdf}).c_str(),
-                   args.out.c_str());
-      return kExitInternal;
-    }
-    progress.Advance();
-    parts.push_back("report.html");
-    // report.pdf: the same page typeset, where weasyprint is installed (tools/report/README.md).
-    (std::filesystem::exists(pdf) ? parts : obsolete).push_back("report.pdf");
+  return json_path;
+}
+
+// report.html (and report.pdf where weasyprint is installed) from result.json by the report
+// script; false (with the error printed) when the script fails.
+bool StageReport(const FlightArgs& args,
+                 const std::string& json_path,
+                 OutputSet& set,
+                 Progress& progress,
+                 FlightParts* out) {
+  const char* env = std::getenv("AEROCAL_REPORT_SCRIPT");
+  const std::string script = env ? env : AEROCAL_REPORT_SCRIPT;
+  const std::string html = set.Staged("report.html"), pdf = set.Staged("report.pdf");
+  progress.Stage("report");
+  if (!RunPythonScript(script, {json_path, html, pdf})) {
+    std::fprintf(stderr,
+                 "error: the report could not be written (%s); nothing written, the "
+                 "previous flight in %s is left as it was\n",
+                 PythonCommandLine(script, {json_path, html, pdf}).c_str(),
+                 args.out.c_str());
+    return false;
   }
-  int certificate_code = kExitOk;
-  if (args.certificate && result.valid) {
-    CertificateArgs certificate;
-    certificate.result = json_path;
-    certificate.lab = args.lab;
-    certificate.out = set.Staged("certificate");
-    certificate.result_name = set.Final("result.json");
-    certificate.out_name = set.Final("certificate");
-    certificate.no_render = args.no_report;
-    certificate.quality = args.quality;
-    certificate_code = WriteCertificate(certificate);
-    if (certificate_code == kExitInternal) {
-      std::fprintf(stderr,
-                   "error: nothing written, the previous flight in %s is left as it was\n",
-                   args.out.c_str());
-      return certificate_code;
-    }
-    parts.push_back("certificate");
-  } else {
+  progress.Advance();
+  out->parts.push_back("report.html");
+  // report.pdf: the same page typeset, where weasyprint is installed (tools/report/README.md).
+  (std::filesystem::exists(pdf) ? out->parts : out->obsolete).push_back("report.pdf");
+  return true;
+}
+
+// The certificate of a valid flight (--certificate); its exit code.
+int StageCertificate(const FlightArgs& args,
+                     const triangulation::FlightWorkflowResult& result,
+                     const std::string& json_path,
+                     OutputSet& set,
+                     FlightParts* out) {
+  if (!(args.certificate && result.valid)) {
     if (args.certificate)
       std::fprintf(stderr, "flight: no certificate written (the flight is not valid)\n");
-    obsolete.push_back("certificate");
+    out->obsolete.push_back("certificate");
+    return kExitOk;
   }
-  set.Commit(parts, obsolete);
+  CertificateArgs certificate;
+  certificate.result = json_path;
+  certificate.lab = args.lab;
+  certificate.out = set.Staged("certificate");
+  certificate.result_name = set.Final("result.json");
+  certificate.out_name = set.Final("certificate");
+  certificate.no_render = args.no_report;
+  certificate.quality = args.quality;
+  const int code = WriteCertificate(certificate);
+  if (code != kExitInternal) out->parts.push_back("certificate");
+  return code;
+}
+
+}  // namespace
+
+int RunFlight(const FlightArgs& args) {
+  // The workflow's five steps, then the report (its figures take tens of seconds on a big flight).
+  Progress progress("flight", args.no_report ? 5 : 6);
+  const auto result = triangulation::RunFlightWorkflow(args.options, &progress);
+  for (const auto& line : result.summary) std::printf("%s\n", line.c_str());
+  for (const auto& [step, reason] : result.failures)
+    std::fprintf(stderr, "flight: step %s failed: %s\n", step.c_str(), reason.c_str());
+  if (!result.valid) std::fprintf(stderr, "flight: no calibrated camera written\n");
+  // result.json, the calibrated camera(s), report.html and certificate/ are one set
+  // (tools/output_set.h): staged in OUT, moved into place only when every part was written, so
+  // a failing report or certificate replaces nothing of the previous flight in OUT.
+  OutputSet set(args.out);
+  FlightParts out;
+  const std::string json_path = StageResult(args, result, set, &out);
+  // A report or certificate of an earlier flight left beside this result.json would not
+  // describe it: parts this run does not write are removed with the commit.
+  if (args.no_report) out.obsolete.insert(out.obsolete.end(), {"report.html", "report.pdf"});
+  if (!args.no_report && !StageReport(args, json_path, set, progress, &out)) return kExitInternal;
+  const int certificate_code = StageCertificate(args, result, json_path, set, &out);
+  if (certificate_code == kExitInternal) {
+    std::fprintf(stderr,
+                 "error: nothing written, the previous flight in %s is left as it was\n",
+                 args.out.c_str());
+    return certificate_code;
+  }
+  set.Commit(out.parts, out.obsolete);
   if (!args.no_report) std::printf("report: %s\n", set.Final("report.html").c_str());
   if (certificate_code != kExitOk) return certificate_code;
   return result.converged && result.valid ? kExitOk : kExitNotConverged;

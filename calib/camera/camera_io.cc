@@ -102,6 +102,96 @@ ReferencePoint ReadReferencePoint(const YAML::Node& node,
   return r;
 }
 
+/// The file's camera model (default the 10-parameter one), refused where the command needs that.
+CameraModelId ReadCameraModel(const YAML::Node& root,
+                              const std::string& file,
+                              CameraModels models) {
+  const std::string model_name =
+      root["model"] ? YamlString(root["model"], file, "model") : std::string(Model::kName);
+  const std::optional<CameraModelId> id = CameraModelFromName(model_name);
+  if (!id)
+    ThrowInputError(
+        WhereIs(root["model"], file),
+        "unknown camera model '" + model_name + "' (expected one of " + CameraModelNames() + ")");
+  if (*id != Model::kId && models == CameraModels::kBrownFraser10Only)
+    ThrowInputError(WhereIs(root["model"], file),
+                    "camera model '" + model_name + "': this command needs " +
+                        std::string(Model::kName) +
+                        " (convert it first: aerocal camera convert "
+                        "--to aerocal --model " +
+                        std::string(Model::kName) + ")");
+  return *id;
+}
+
+/// The interior and its sigmas are keyed by the model's parameter table: a new model needs
+/// nothing here. A principal distance must be > 0 and at least kMinPrincipalDistancePx pixels.
+void ReadInterior(const YAML::Node& root, const std::string& file, Camera* camera) {
+  const std::vector<ParamInfo> table = camera->Params();
+  std::vector<std::string> keys;
+  for (const ParamInfo& info : table) keys.emplace_back(info.name);
+  if (!root["interior"])
+    ThrowInputError({file, 1}, "missing interior (at least " + keys.front() + ")");
+  const YAML::Node& interior = root["interior"];
+  RejectUnknownKeys(interior, keys, file);
+  for (size_t i = 0; i < table.size(); ++i) {
+    if (!interior[keys[i]]) continue;
+    const double bound = ModelParamBound(table[i]);
+    camera->interior[i] =
+        YamlBounded(interior[keys[i]], file, "interior." + keys[i], -bound, bound);
+  }
+  for (size_t i = 0; i < table.size(); ++i) {
+    if (table[i].group != ParamGroup::kPrincipalDistance) continue;
+    if (!(camera->interior[i] > 0))
+      ThrowInputError(WhereIs(interior, file),
+                      "interior." + keys[i] + " must be > 0 " + std::string(table[i].unit) +
+                          " (got " + FormatNumber(camera->interior[i]) + ")");
+    // At least kMinPrincipalDistancePx pixels: a principal distance of 1e-9 mm is no lens (every
+    // ray leaves the format at once) and passed as one.
+    const double c_px =
+        table[i].unit == "px" ? camera->interior[i] : camera->interior[i] / camera->pixel_size_mm;
+    if (table[i].unit != "1" && !(c_px >= kMinPrincipalDistancePx))
+      ThrowInputError(WhereIs(interior[keys[i]] ? interior[keys[i]] : interior, file),
+                      "interior." + keys[i] + " must be at least " +
+                          FormatNumber(kMinPrincipalDistancePx) + " pixels (got " +
+                          FormatNumber(camera->interior[i]) + " " + std::string(table[i].unit) +
+                          " = " + FormatNumber(c_px) + " px)");
+  }
+  if (root["interior_sigma"]) {
+    const YAML::Node& sig = root["interior_sigma"];
+    RejectUnknownKeys(sig, keys, file);
+    for (size_t i = 0; i < table.size(); ++i) {
+      const std::string& key = keys[i];
+      if (!sig[key]) continue;
+      const double s = YamlBounded(sig[key], file, "interior_sigma." + key, 0, 1e6);
+      if (!(s > 0))
+        ThrowInputError(WhereIs(sig[key], file),
+                        "interior_sigma." + key + " must be > 0 (got " + FormatNumber(s) + ")");
+      camera->interior_sigma[i] = s;
+    }
+  }
+}
+
+/// The sub-images (ids unique) and the reference points that name them.
+void ReadSubimagesAndReferences(const YAML::Node& root, const std::string& file, Camera* camera) {
+  if (root["subimages"]) {
+    if (!root["subimages"].IsSequence())
+      ThrowInputError(WhereIs(root["subimages"], file), "subimages must be a list");
+    std::set<std::string> ids;
+    for (const auto& node : root["subimages"]) {
+      camera->subimages.push_back(ReadSubimage(node, file));
+      if (!ids.insert(camera->subimages.back().id).second)
+        ThrowInputError(WhereIs(node, file),
+                        "duplicate sub-image id '" + camera->subimages.back().id + "'");
+    }
+  }
+  if (root["reference_points"]) {
+    if (!root["reference_points"].IsSequence())
+      ThrowInputError(WhereIs(root["reference_points"], file), "reference_points must be a list");
+    for (const auto& node : root["reference_points"])
+      camera->reference_points.push_back(ReadReferencePoint(node, file, *camera));
+  }
+}
+
 }  // namespace
 
 Camera ParseCamera(const YAML::Node& root,
@@ -120,21 +210,7 @@ Camera ParseCamera(const YAML::Node& root,
                                       "model"};
   allowed.insert(allowed.end(), record_keys.begin(), record_keys.end());
   RejectUnknownKeys(root, allowed, file);
-  const std::string model_name =
-      root["model"] ? YamlString(root["model"], file, "model") : std::string(Model::kName);
-  const std::optional<CameraModelId> id = CameraModelFromName(model_name);
-  if (!id)
-    ThrowInputError(
-        WhereIs(root["model"], file),
-        "unknown camera model '" + model_name + "' (expected one of " + CameraModelNames() + ")");
-  if (*id != Model::kId && models == CameraModels::kBrownFraser10Only)
-    ThrowInputError(WhereIs(root["model"], file),
-                    "camera model '" + model_name + "': this command needs " +
-                        std::string(Model::kName) +
-                        " (convert it first: aerocal camera convert "
-                        "--to aerocal --model " +
-                        std::string(Model::kName) + ")");
-  Camera camera = Camera::OfModel(*id);
+  Camera camera = Camera::OfModel(ReadCameraModel(root, file, models));
   camera.name = root["name"] ? YamlString(root["name"], file, "name") : "";
   if (!root["pixel_size_mm"]) ThrowInputError({file, 1}, "missing pixel_size_mm");
   camera.pixel_size_mm =
@@ -144,67 +220,8 @@ Camera ParseCamera(const YAML::Node& root,
         root["pixel_size_tolerance_mm"], file, "pixel_size_tolerance_mm", 0, camera.pixel_size_mm);
   if (!root["format_px"]) ThrowInputError({file, 1}, "missing format_px");
   std::tie(camera.width_px, camera.height_px) = ReadFormat(root["format_px"], file);
-  // The interior and its sigmas are keyed by the model's parameter table: a new model needs
-  // nothing here.
-  const std::vector<ParamInfo> table = camera.Params();
-  std::vector<std::string> keys;
-  for (const ParamInfo& info : table) keys.emplace_back(info.name);
-  if (!root["interior"])
-    ThrowInputError({file, 1}, "missing interior (at least " + keys.front() + ")");
-  const YAML::Node& interior = root["interior"];
-  RejectUnknownKeys(interior, keys, file);
-  for (size_t i = 0; i < table.size(); ++i) {
-    if (!interior[keys[i]]) continue;
-    const double bound = ModelParamBound(table[i]);
-    camera.interior[i] = YamlBounded(interior[keys[i]], file, "interior." + keys[i], -bound, bound);
-  }
-  for (size_t i = 0; i < table.size(); ++i) {
-    if (table[i].group != ParamGroup::kPrincipalDistance) continue;
-    if (!(camera.interior[i] > 0))
-      ThrowInputError(WhereIs(interior, file),
-                      "interior." + keys[i] + " must be > 0 " + std::string(table[i].unit) +
-                          " (got " + FormatNumber(camera.interior[i]) + ")");
-    // At least kMinPrincipalDistancePx pixels: a principal distance of 1e-9 mm is no lens (every
-    // ray leaves the format at once) and passed as one.
-    const double c_px =
-        table[i].unit == "px" ? camera.interior[i] : camera.interior[i] / camera.pixel_size_mm;
-    if (table[i].unit != "1" && !(c_px >= kMinPrincipalDistancePx))
-      ThrowInputError(WhereIs(interior[keys[i]] ? interior[keys[i]] : interior, file),
-                      "interior." + keys[i] + " must be at least " +
-                          FormatNumber(kMinPrincipalDistancePx) + " pixels (got " +
-                          FormatNumber(camera.interior[i]) + " " + std::string(table[i].unit) +
-                          " = " + FormatNumber(c_px) + " px)");
-  }
-  if (root["interior_sigma"]) {
-    const YAML::Node& sig = root["interior_sigma"];
-    RejectUnknownKeys(sig, keys, file);
-    for (size_t i = 0; i < table.size(); ++i) {
-      const std::string& key = keys[i];
-      if (!sig[key]) continue;
-      const double s = YamlBounded(sig[key], file, "interior_sigma." + key, 0, 1e6);
-      if (!(s > 0))
-        ThrowInputError(WhereIs(sig[key], file),
-                        "interior_sigma." + key + " must be > 0 (got " + FormatNumber(s) + ")");
-      camera.interior_sigma[i] = s;
-    }
-  }
-  if (root["subimages"]) {
-    if (!root["subimages"].IsSequence())
-      ThrowInputError(WhereIs(root["subimages"], file), "subimages must be a list");
-    std::set<std::string> ids;
-    for (const auto& node : root["subimages"]) {
-      camera.subimages.push_back(ReadSubimage(node, file));
-      if (!ids.insert(camera.subimages.back().id).second)
-        ThrowInputError(WhereIs(node, file),
-                        "duplicate sub-image id '" + camera.subimages.back().id + "'");
-    }
-  }
-  if (root["reference_points"]) {
-    if (!root["reference_points"].IsSequence())
-      ThrowInputError(WhereIs(root["reference_points"], file), "reference_points must be a list");
-    for (const auto& node : root["reference_points"])
-      camera.reference_points.push_back(ReadReferencePoint(node, file, camera));
-  }
+  ReadInterior(root, file, &camera);
+  ReadSubimagesAndReferences(root, file, &camera);
   return camera;
 }
 

@@ -110,28 +110,9 @@ class Snooper {
   Test Run(int round) {
     const Stopwatch round_time;
     Test t;
-    std::vector<ResidualId> ids;
     int components = 0;
-    for (ResidualId id : AllResiduals()) {
-      if (!b_.IsActive(id)) continue;
-      if (!o_.groups.empty() && !Contains(o_.groups, b_.ResidualGroup(id))) continue;
-      ids.push_back(id);
-      components += static_cast<int>(b_.EvaluateResidual(id).size());
-    }
-    if (round == 1 && !initialized_) {
-      initialized_ = true;
-      out_.n_tested_components = components;
-      out_.alpha = o_.alpha;
-      out_.alpha0 = o_.alpha / std::max(1, components);
-      out_.critical_value = o_.critical_value > 0
-                                ? o_.critical_value
-                                : std::max(3.29, NormalCriticalValue(out_.alpha0));
-      out_.power = o_.power;
-      out_.delta0 = NonCentrality(out_.critical_value, o_.power);
-      out_.delta0_joint = NonCentralityJoint(out_.critical_value, o_.power);
-      out_.min_redundancy = o_.min_redundancy;
-      out_.group_correlation = o_.group_correlation;
-    }
+    const std::vector<ResidualId> ids = TestedResiduals(&components);
+    if (round == 1 && !initialized_) InitializeOutcome(components);
     ObservationCofactors cof = b_.ComputeObservationCofactors(ids, true, o_.max_dense_parameters);
     t.method = cof.method;
     out_.cofactor_method = cof.method;
@@ -143,49 +124,11 @@ class Snooper {
       return t;
     }
     t.clusters = std::move(cof.clusters);
-    for (size_t c = 0; c < t.clusters.size(); ++c) {
-      int row = 0;
-      for (ResidualId id : t.clusters[c].residuals) {
-        t.row_of[id] = {c, row};
-        row += static_cast<int>(b_.EvaluateResidual(id).size());
-      }
-    }
+    IndexClusterRows(&t);
     const double s = std::max(out_.report.sigma0, 1.0);
     out_.reference_sigma = s;
     for (ResidualId id : ids) {
-      TestedObservation x;
-      x.id = id;
-      x.group = b_.ResidualGroup(id);
-      x.label = b_.ResidualLabel(id);
-      x.v = b_.EvaluateResidual(id);
-      x.redundancy = cof.redundancy.at(id);
-      x.point = PointOf(b_, id);
-      x.round = round;
-      for (size_t k = 0; k < x.v.size(); ++k) {
-        const double r = x.redundancy[k];
-        if (r < kUntestable) {
-          x.w.push_back(std::numeric_limits<double>::quiet_NaN());
-          x.mdb_sigma.push_back(std::numeric_limits<double>::infinity());
-          continue;
-        }
-        const double w = std::abs(x.v[k]) / (s * std::sqrt(r));
-        x.w.push_back(w);
-        x.mdb_sigma.push_back(out_.delta0 * s / std::sqrt(r));
-        if (r >= o_.min_redundancy && w > x.w_max) {
-          x.w_max = w;
-          x.component = static_cast<int>(k);
-        }
-        if (r < o_.min_redundancy) x.w_weak = std::max(x.w_weak, w);
-        x.w_full = std::max(x.w_full, w);
-      }
-      x.t_full = x.w_full * x.w_full;
-      x.t_joint = x.w_max * x.w_max;
-      // An observation of several correlated components (x, y of an image point) is tested as
-      // a whole: per-component w of another observation can exceed both of the blundered one's,
-      // the joint statistic cannot (its non-centrality is the largest at the blunder).
-      const auto at = t.row_of.find(id);
-      if (x.v.size() > 1 && at != t.row_of.end())
-        JointTest(t.clusters[at->second.first], at->second.second, s, &x);
+      TestedObservation x = TestOne(id, cof.redundancy.at(id), t, s, round);
       t.index[id] = t.observations.size();
       t.observations.push_back(std::move(x));
     }
@@ -199,6 +142,89 @@ class Snooper {
     out_.cofactor_method = t.method;
     out_.seconds_testing += round_time.Seconds();
     return t;
+  }
+
+  // The active residuals of the tested groups, and their number of scalar components.
+  std::vector<ResidualId> TestedResiduals(int* components) const {
+    std::vector<ResidualId> ids;
+    for (ResidualId id : AllResiduals()) {
+      if (!b_.IsActive(id)) continue;
+      if (!o_.groups.empty() && !Contains(o_.groups, b_.ResidualGroup(id))) continue;
+      ids.push_back(id);
+      *components += static_cast<int>(b_.EvaluateResidual(id).size());
+    }
+    return ids;
+  }
+
+  // The test's constants, fixed by the first test: alpha0 = alpha / components (Bonferroni),
+  // its critical value (at least 3.29) and the non-centralities at the chosen power.
+  void InitializeOutcome(int components) {
+    initialized_ = true;
+    out_.n_tested_components = components;
+    out_.alpha = o_.alpha;
+    out_.alpha0 = o_.alpha / std::max(1, components);
+    out_.critical_value = o_.critical_value > 0 ? o_.critical_value
+                                                : std::max(3.29, NormalCriticalValue(out_.alpha0));
+    out_.power = o_.power;
+    out_.delta0 = NonCentrality(out_.critical_value, o_.power);
+    out_.delta0_joint = NonCentralityJoint(out_.critical_value, o_.power);
+    out_.min_redundancy = o_.min_redundancy;
+    out_.group_correlation = o_.group_correlation;
+  }
+
+  // Where each clustered residual's rows start in its cluster's Q_vv.
+  void IndexClusterRows(Test* t) const {
+    for (size_t c = 0; c < t->clusters.size(); ++c) {
+      int row = 0;
+      for (ResidualId id : t->clusters[c].residuals) {
+        t->row_of[id] = {c, row};
+        row += static_cast<int>(b_.EvaluateResidual(id).size());
+      }
+    }
+  }
+
+  // One observation's test: per component w = |v| / (s sqrt(r)) and its MDB delta0 s / sqrt(r)
+  // (untestable below r = kUntestable), the largest w among the components controlled well
+  // enough (r >= min_redundancy), and the joint test where it has correlated components.
+  TestedObservation TestOne(ResidualId id,
+                            const std::vector<double>& redundancy,
+                            const Test& t,
+                            double s,
+                            int round) const {
+    TestedObservation x;
+    x.id = id;
+    x.group = b_.ResidualGroup(id);
+    x.label = b_.ResidualLabel(id);
+    x.v = b_.EvaluateResidual(id);
+    x.redundancy = redundancy;
+    x.point = PointOf(b_, id);
+    x.round = round;
+    for (size_t k = 0; k < x.v.size(); ++k) {
+      const double r = x.redundancy[k];
+      if (r < kUntestable) {
+        x.w.push_back(std::numeric_limits<double>::quiet_NaN());
+        x.mdb_sigma.push_back(std::numeric_limits<double>::infinity());
+        continue;
+      }
+      const double w = std::abs(x.v[k]) / (s * std::sqrt(r));
+      x.w.push_back(w);
+      x.mdb_sigma.push_back(out_.delta0 * s / std::sqrt(r));
+      if (r >= o_.min_redundancy && w > x.w_max) {
+        x.w_max = w;
+        x.component = static_cast<int>(k);
+      }
+      if (r < o_.min_redundancy) x.w_weak = std::max(x.w_weak, w);
+      x.w_full = std::max(x.w_full, w);
+    }
+    x.t_full = x.w_full * x.w_full;
+    x.t_joint = x.w_max * x.w_max;
+    // An observation of several correlated components (x, y of an image point) is tested as
+    // a whole: per-component w of another observation can exceed both of the blundered one's,
+    // the joint statistic cannot (its non-centrality is the largest at the blunder).
+    const auto at = t.row_of.find(id);
+    if (x.v.size() > 1 && at != t.row_of.end())
+      JointTest(t.clusters[at->second.first], at->second.second, s, &x);
+    return x;
   }
 
   // T = v^T Q_ii^+ v / s^2 over the eigen-directions of Q_ii with eigenvalue >= min_redundancy
@@ -404,23 +430,8 @@ class Snooper {
       if (x.w_max > out_.critical_value) candidates.push_back(&x);
     std::sort(
         candidates.begin(), candidates.end(), [](auto* a, auto* b) { return a->w_max > b->w_max; });
-    // The largest w of each point, over every tested observation and its weakly controlled
-    // components too (decided ones included: the rays of a point whose survey is suspected, or
-    // whose largest w sits on a weakly controlled component, stay), and of each image
-    // (undecided candidates only).
-    std::map<BlockId, std::pair<double, ResidualId>> point_max;
-    for (const auto& x : t.observations) {
-      if (x.point < 0) continue;
-      const double w = std::max(x.w_max, x.w_weak);
-      auto [it, added] = point_max.try_emplace(x.point, w, x.id);
-      if (!added && w > it->second.first) it->second = {w, x.id};
-    }
     std::map<BlockId, ResidualId> best_of_point, best_of_image;
-    for (const auto& [point, best] : point_max) best_of_point[point] = best.second;
-    for (auto* x : candidates) {
-      const BlockId image = ImageOf(b_, x->id);
-      if (image >= 0 && !decided_.count(x->id)) best_of_image.try_emplace(image, x->id);
-    }
+    BestOfPointAndImage(t, candidates, &best_of_point, &best_of_image);
     int removed = 0;
     for (auto* x : candidates) {
       if (x->point >= 0 && best_of_point.at(x->point) != x->id) continue;
@@ -446,53 +457,89 @@ class Snooper {
         x->reason = "rejection cap reached";
         continue;
       }
-      // The members its other components separate from it stay (see the header).
-      std::vector<ResidualId> acted;
-      const double margin = out_.critical_value * out_.critical_value;
-      for (ResidualId member : x->correlated)
-        if (member == x->id || x->t_joint - t.observations[t.index.at(member)].t_joint <= margin)
-          acted.push_back(member);
-      // Other candidates of its point the data cannot tell from it either (correlated below
-      // group_correlation, e.g. strip neighbours at 0.95): rejecting the larger alone names the
-      // good one in a share of runs and leaves the blunder on a point too weak to test it.
-      if (x->point >= 0)
-        for (const auto& y : t.observations)
-          if (y.point == x->point && y.id != x->id && y.w_max > out_.critical_value &&
-              x->t_joint - y.t_joint <= margin && !decided_.count(y.id) &&
-              !Contains(o_.report_only_groups, y.group) &&
-              std::find(acted.begin(), acted.end(), y.id) == acted.end())
-            acted.push_back(y.id);
+      const std::vector<ResidualId> acted = ActedGroup(t, *x);
       const std::string veto = o_.veto ? o_.veto(acted) : std::string();
       if (!veto.empty()) {
         Decide(x, SnoopingVerdict::kVetoed, veto);
         continue;
       }
-      std::string reason;
-      if (acted.size() > 1) {
-        reason = (x->point >= 0 ? b_.BlockName(x->point) : std::string("observation ")) + ": " +
-                 "one of these " + std::to_string(acted.size()) +
-                 " observations holds a gross error; they cannot be told apart (|rho| > " +
-                 Fixed(o_.group_correlation, 2) + "); all are rejected";
-        out_.findings.push_back(reason + " (w = " + Fixed(x->w_max, 1) + ")");
-      } else if (x->correlated.size() > 1) {
-        reason = "its correlated group of " + std::to_string(x->correlated.size()) +
-                 " is told apart by its other components (joint statistic larger by more than " +
-                 "k^2): rejected alone";
-      }
-      for (ResidualId member : acted) {
-        TestedObservation r = t.observations[t.index.at(member)];
-        r.correlated = acted;
-        r.group_size = static_cast<int>(acted.size());
-        r.verdict = SnoopingVerdict::kRejected;
-        r.round = round;
-        r.reason = reason;
-        out_.rejected.push_back(r);
-        b_.RemoveResidual(member);
-        ++removed;
-      }
+      removed += RejectGroup(t, *x, acted, round);
       x->verdict = SnoopingVerdict::kRejected;
     }
     return removed;
+  }
+
+  // The largest w of each point, over every tested observation and its weakly controlled
+  // components too (decided ones included: the rays of a point whose survey is suspected, or
+  // whose largest w sits on a weakly controlled component, stay), and of each image
+  // (undecided candidates only): only those are acted on in a round.
+  void BestOfPointAndImage(const Test& t,
+                           const std::vector<TestedObservation*>& candidates,
+                           std::map<BlockId, ResidualId>* best_of_point,
+                           std::map<BlockId, ResidualId>* best_of_image) const {
+    std::map<BlockId, std::pair<double, ResidualId>> point_max;
+    for (const auto& x : t.observations) {
+      if (x.point < 0) continue;
+      const double w = std::max(x.w_max, x.w_weak);
+      auto [it, added] = point_max.try_emplace(x.point, w, x.id);
+      if (!added && w > it->second.first) it->second = {w, x.id};
+    }
+    for (const auto& [point, best] : point_max) (*best_of_point)[point] = best.second;
+    for (auto* x : candidates) {
+      const BlockId image = ImageOf(b_, x->id);
+      if (image >= 0 && !decided_.count(x->id)) best_of_image->try_emplace(image, x->id);
+    }
+  }
+
+  // What is rejected with candidate x: the members of its correlated group its other components
+  // do not separate from it (joint statistic within k^2; see the header), and the other
+  // candidates of its point the data cannot tell from it either (correlated below
+  // group_correlation, e.g. strip neighbours at 0.95): rejecting the larger alone names the
+  // good one in a share of runs and leaves the blunder on a point too weak to test it.
+  std::vector<ResidualId> ActedGroup(const Test& t, const TestedObservation& x) const {
+    std::vector<ResidualId> acted;
+    const double margin = out_.critical_value * out_.critical_value;
+    for (ResidualId member : x.correlated)
+      if (member == x.id || x.t_joint - t.observations[t.index.at(member)].t_joint <= margin)
+        acted.push_back(member);
+    if (x.point >= 0)
+      for (const auto& y : t.observations)
+        if (y.point == x.point && y.id != x.id && y.w_max > out_.critical_value &&
+            x.t_joint - y.t_joint <= margin && !decided_.count(y.id) &&
+            !Contains(o_.report_only_groups, y.group) &&
+            std::find(acted.begin(), acted.end(), y.id) == acted.end())
+          acted.push_back(y.id);
+    return acted;
+  }
+
+  // Rejects `acted` (x's group) with the reason, removing its residuals; returns their number.
+  int RejectGroup(const Test& t,
+                  const TestedObservation& x,
+                  const std::vector<ResidualId>& acted,
+                  int round) {
+    std::string reason;
+    if (acted.size() > 1) {
+      reason = (x.point >= 0 ? b_.BlockName(x.point) : std::string("observation ")) + ": " +
+               "one of these " + std::to_string(acted.size()) +
+               " observations holds a gross error; they cannot be told apart (|rho| > " +
+               Fixed(o_.group_correlation, 2) + "); all are rejected";
+      out_.findings.push_back(reason + " (w = " + Fixed(x.w_max, 1) + ")");
+    } else if (x.correlated.size() > 1) {
+      reason = "its correlated group of " + std::to_string(x.correlated.size()) +
+               " is told apart by its other components (joint statistic larger by more than " +
+               "k^2): rejected alone";
+    }
+    for (ResidualId member : acted) {
+      TestedObservation r = t.observations[t.index.at(member)];
+      r.correlated = acted;
+      r.group_size = static_cast<int>(acted.size());
+      r.verdict = SnoopingVerdict::kRejected;
+      r.round = round;
+      r.reason = reason;
+      out_.rejected.push_back(r);
+      b_.RemoveResidual(member);
+    }
+    return static_cast<int>(acted.size());
   }
 
   // The smallest eigenvalue of Q_ii of `x` (its least redundant direction).
@@ -505,115 +552,56 @@ class Snooper {
     return Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(q).eigenvalues()(0);
   }
 
-  // Surveys first (see the header): leaves out the worst failing report-only observation while
-  // the data single it out and that is what makes the others pass; restores them all when not.
-  void TestSurveys(const SolverOptions& solver) {
-    int n_surveys = 0;
-    for (ResidualId id : AllResiduals())
-      n_surveys += b_.IsActive(id) && Contains(o_.report_only_groups, b_.ResidualGroup(id));
-    const int limit = o_.max_left_out > 0 ? o_.max_left_out : std::max(1, n_surveys / 3);
+  // The state of the survey test across its rounds.
+  struct SurveyRun {
+    int n_surveys = 0, limit = 0;  // active surveys; at most `limit` of them left out
     std::vector<TestedObservation> left;
     std::string stopped;  // why no (further) survey is left out although one fails
     std::vector<TestedObservation> suspects;  // failing, singled out, but not left out
     bool inseparable = false;                 // the suspects are a group the test cannot tell apart
     bool unsolvable = false;  // the block without the last one left out cannot be solved
+  };
+
+  // Surveys first (see the header): leaves out the worst failing report-only observation while
+  // the data single it out and that is what makes the others pass; restores them all when not.
+  void TestSurveys(const SolverOptions& solver) {
+    SurveyRun run;
+    for (ResidualId id : AllResiduals())
+      run.n_surveys += b_.IsActive(id) && Contains(o_.report_only_groups, b_.ResidualGroup(id));
+    run.limit = o_.max_left_out > 0 ? o_.max_left_out : std::max(1, run.n_surveys / 3);
     for (;;) {
       Test t = Run(1);
       if (!out_.cofactors_ok) return;
-      const double k = out_.critical_value, s = out_.reference_sigma;
       std::vector<const TestedObservation*> failing;  // worst first
       for (const auto& x : t.observations)
-        if (Contains(o_.report_only_groups, x.group) && x.w_full > k) failing.push_back(&x);
+        if (Contains(o_.report_only_groups, x.group) && x.w_full > out_.critical_value)
+          failing.push_back(&x);
       std::sort(
           failing.begin(), failing.end(), [](auto* a, auto* b) { return a->t_full > b->t_full; });
       if (failing.empty()) {  // every remaining survey passes; does the block fit its sigmas?
         const double band = 1 + kFitBand / std::sqrt(2.0 * std::max(1, out_.report.redundancy));
-        if (!left.empty() && out_.report.sigma0 > band)
-          stopped = "sigma0 " + Fixed(out_.report.sigma0, 3) + " without it is above " +
-                    Fixed(band, 3) + " = 1 + 3 / sqrt(2 r): a model error remains";
+        if (!run.left.empty() && out_.report.sigma0 > band)
+          run.stopped = "sigma0 " + Fixed(out_.report.sigma0, 3) + " without it is above " +
+                        Fixed(band, 3) + " = 1 + 3 / sqrt(2 r): a model error remains";
         break;
       }
       const TestedObservation& worst = *failing.front();
-      // Surveys the test cannot tell from the worst: chi-square within k^2 (the likelihood ratio
-      // of the two explanations above exp(-k^2 / 2), the test's own tail).
-      std::string group;
-      int together = 0;
-      for (const auto* x : failing)
-        if (worst.t_full - x->t_full <= k * k) {
-          group += (together++ ? ", " : "") + x->label + " (w = " + Fixed(x->w_full, 1) + ")";
-        }
-      double largest_v = 0.0;  // the survey's own residual, in sigmas
-      for (double v : worst.v) largest_v = std::max(largest_v, std::abs(v) / s);
-      const double holds = SmallestCofactor(t, worst);
-      if (together > 1) {
-        stopped = "the surveys " + group +
-                  " fail and the test cannot tell them apart (their chi-square statistics lie "
-                  "within k^2 = " +
-                  Fixed(k * k, 1) + "): one of them may be off";
-        for (const auto* x : failing)
-          if (worst.t_full - x->t_full <= k * k) suspects.push_back(*x);
-        inseparable = true;
-      } else if (largest_v <= k) {
-        stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
-                  " over all its components) but its residual is " + Fixed(largest_v, 1) +
-                  " sigma, within the critical value: the disagreement lies in a direction the "
-                  "block bends to fit (r < " +
-                  Fixed(o_.min_redundancy, 2) + "), where a model error looks the same";
-      } else if (holds < kHoldsTheBlock) {
-        stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
-                  ") but it alone holds the block in one direction (redundancy " + Fixed(holds, 6) +
-                  "): without it the block would be loose there";
-      } else if (static_cast<int>(left.size()) >= limit) {
-        stopped = worst.label + " still fails (w = " + Fixed(worst.w_full, 1) + "); at most " +
-                  std::to_string(limit) + " of the " + std::to_string(n_surveys) +
-                  " surveys are left out";
-      } else if (const std::string veto = o_.veto ? o_.veto({worst.id}) : std::string();
-                 !veto.empty()) {
-        stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) + "); " + veto;
-      }
-      if (!stopped.empty()) {
-        if (suspects.empty() && largest_v > k) suspects.push_back(worst);
-        break;
-      }
-      left.push_back(worst);
+      if (SurveyStays(t, failing, &run)) break;
+      run.left.push_back(worst);
       b_.RemoveResidual(worst.id);
       Resolve(b_, solver, &out_);
       if (!out_.report.usable) {
-        stopped = "the block without " + worst.label + " cannot be solved";
-        unsolvable = true;  // it is in `left`: a suspect with those left out before it
+        run.stopped = "the block without " + worst.label + " cannot be solved";
+        run.unsolvable = true;  // it is in `left`: a suspect with those left out before it
         break;
       }
     }
-    if (!suspects.empty() || unsolvable) {  // suspects it cannot leave out: not a fit
-      out_.unresolved_reason = stopped;
-      if (inseparable && !left.empty()) {
-        // Those singled out before a group the test cannot tell apart stay out (each failed
-        // alone, beyond k sigmas; putting it back would bend the block by its blunder too):
-        // both are named, and the caller's run is not a fit.
-        out_.findings.push_back("surveys tested first: " + stopped +
-                                ": these surveys are kept, named as unresolved");
-        stopped.clear();
-      } else {  // every survey is restored below: those left out before are suspects as well
-        suspects.insert(suspects.begin(), left.begin(), left.end());
-      }
-      out_.unresolved = std::move(suspects);
-    }
-    if (!stopped.empty()) {  // not a survey blunder the data single out: every survey stays
-      std::string names;
-      for (const auto& x : left) names += (names.empty() ? "" : ", ") + x.label;
-      if (!left.empty()) {
-        for (const auto& x : left) b_.RestoreResidual(x.id);
-        Resolve(b_, solver, &out_);
-      }
-      out_.findings.push_back("surveys tested first: " + stopped +
-                              (left.empty() ? std::string()
-                                            : "; leaving out " + names +
-                                                  " (w = " + Fixed(left.front().w_full, 1) +
-                                                  ") did not make the block fit") +
-                              ": every survey kept (a survey blunder, or a model error)");
+    if (!run.suspects.empty() || run.unsolvable) RecordUnresolvedSurveys(&run);
+    if (!run.stopped.empty()) {
+      RestoreSurveys(run, solver);
       return;
     }
-    for (auto& x : left) {
+    for (auto& x : run.left) {
       x.verdict = SnoopingVerdict::kLeftOut;
       x.reason = "suspected blunder in the " + x.group + " observation " + x.label +
                  " (w = " + Fixed(x.w_full, 1) +
@@ -624,6 +612,89 @@ class Snooper {
       out_.findings.push_back("left out: " + x.reason);
       out_.left_out.push_back(x);
     }
+  }
+
+  // Whether the worst failing survey (failing.front()) must stay: it cannot be told from others,
+  // its own residual is within k, it alone holds the block, the cap is reached, or the caller
+  // vetoes it. Then run->stopped says why, and the suspects are named.
+  bool SurveyStays(const Test& t,
+                   const std::vector<const TestedObservation*>& failing,
+                   SurveyRun* run) const {
+    const double k = out_.critical_value, s = out_.reference_sigma;
+    const TestedObservation& worst = *failing.front();
+    // Surveys the test cannot tell from the worst: chi-square within k^2 (the likelihood ratio
+    // of the two explanations above exp(-k^2 / 2), the test's own tail).
+    std::string group;
+    int together = 0;
+    for (const auto* x : failing)
+      if (worst.t_full - x->t_full <= k * k) {
+        group += (together++ ? ", " : "") + x->label + " (w = " + Fixed(x->w_full, 1) + ")";
+      }
+    double largest_v = 0.0;  // the survey's own residual, in sigmas
+    for (double v : worst.v) largest_v = std::max(largest_v, std::abs(v) / s);
+    const double holds = SmallestCofactor(t, worst);
+    std::string& stopped = run->stopped;
+    if (together > 1) {
+      stopped = "the surveys " + group +
+                " fail and the test cannot tell them apart (their chi-square statistics lie "
+                "within k^2 = " +
+                Fixed(k * k, 1) + "): one of them may be off";
+      for (const auto* x : failing)
+        if (worst.t_full - x->t_full <= k * k) run->suspects.push_back(*x);
+      run->inseparable = true;
+    } else if (largest_v <= k) {
+      stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
+                " over all its components) but its residual is " + Fixed(largest_v, 1) +
+                " sigma, within the critical value: the disagreement lies in a direction the "
+                "block bends to fit (r < " +
+                Fixed(o_.min_redundancy, 2) + "), where a model error looks the same";
+    } else if (holds < kHoldsTheBlock) {
+      stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) +
+                ") but it alone holds the block in one direction (redundancy " + Fixed(holds, 6) +
+                "): without it the block would be loose there";
+    } else if (static_cast<int>(run->left.size()) >= run->limit) {
+      stopped = worst.label + " still fails (w = " + Fixed(worst.w_full, 1) + "); at most " +
+                std::to_string(run->limit) + " of the " + std::to_string(run->n_surveys) +
+                " surveys are left out";
+    } else if (const std::string veto = o_.veto ? o_.veto({worst.id}) : std::string();
+               !veto.empty()) {
+      stopped = worst.label + " fails (w = " + Fixed(worst.w_full, 1) + "); " + veto;
+    }
+    if (stopped.empty()) return false;
+    if (run->suspects.empty() && largest_v > k) run->suspects.push_back(worst);
+    return true;
+  }
+
+  // Suspects it cannot leave out: not a fit, named as unresolved.
+  void RecordUnresolvedSurveys(SurveyRun* run) {
+    out_.unresolved_reason = run->stopped;
+    if (run->inseparable && !run->left.empty()) {
+      // Those singled out before a group the test cannot tell apart stay out (each failed
+      // alone, beyond k sigmas; putting it back would bend the block by its blunder too):
+      // both are named, and the caller's run is not a fit.
+      out_.findings.push_back("surveys tested first: " + run->stopped +
+                              ": these surveys are kept, named as unresolved");
+      run->stopped.clear();
+    } else {  // every survey is restored below: those left out before are suspects as well
+      run->suspects.insert(run->suspects.begin(), run->left.begin(), run->left.end());
+    }
+    out_.unresolved = std::move(run->suspects);
+  }
+
+  // Not a survey blunder the data single out: every survey stays (those left out restored).
+  void RestoreSurveys(const SurveyRun& run, const SolverOptions& solver) {
+    std::string names;
+    for (const auto& x : run.left) names += (names.empty() ? "" : ", ") + x.label;
+    if (!run.left.empty()) {
+      for (const auto& x : run.left) b_.RestoreResidual(x.id);
+      Resolve(b_, solver, &out_);
+    }
+    out_.findings.push_back("surveys tested first: " + run.stopped +
+                            (run.left.empty() ? std::string()
+                                              : "; leaving out " + names +
+                                                    " (w = " + Fixed(run.left.front().w_full, 1) +
+                                                    ") did not make the block fit") +
+                            ": every survey kept (a survey blunder, or a model error)");
   }
 
   void Decide(TestedObservation* x, SnoopingVerdict verdict, const std::string& reason) {

@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 #include <limits>
 #include <set>
 
@@ -874,6 +875,115 @@ std::unique_ptr<internal::SchurComplement> ProblemBuilder::BuildSchurComplement(
   return std::make_unique<internal::SchurComplement>(std::move(crs), columns);
 }
 
+namespace {
+
+/// Redundancy numbers and point clusters from the reduced system and its (selected) inverse,
+/// one group of residuals at a time: the residuals observing one point (the block index in the
+/// Schur system) together, the others one by one. H = J N^- J^T over a group's rows:
+///   h_ij = a_i A^+ a_j^T + d_i^T S^- d_j,  d_i = B^T A^+ a_i - f_i  (normal_equations.h),
+/// and Q_vv = I - H for the whitened residuals.
+class CofactorAssembly {
+ public:
+  CofactorAssembly(const internal::SchurComplement& schur,
+                   const internal::SelectedInverse& inverse,
+                   const std::vector<int>& first_row,
+                   const std::vector<BlockId>& free_blocks,
+                   std::function<int(ResidualId)> size_of,
+                   bool with_clusters,
+                   ObservationCofactors* out)
+      : schur_(schur),
+        inverse_(inverse),
+        first_row_(first_row),
+        free_blocks_(free_blocks),
+        size_of_(std::move(size_of)),
+        with_clusters_(with_clusters),
+        out_(out) {}
+
+  /// The residuals observing eliminated point `point`: a_i from the point's columns, f_i and
+  /// S^- on the reduced columns the point couples to.
+  void AddPointGroup(int point, const std::vector<ResidualId>& group) {
+    const internal::SchurComplement::PointTerms t = schur_.Point(point);
+    Eigen::MatrixXd f;
+    ReducedParts(group, t.cols, &f);
+    Eigen::MatrixXd a(t.a_pinv.rows(), f.cols());
+    int c = 0;
+    for (ResidualId id : group)
+      for (int k = 0; k < size_of_(id); ++k, ++c)
+        a.col(c) = schur_.RowPointPart(first_row_[id] + k);
+    const Eigen::MatrixXd ta = t.a_pinv * a;
+    Eigen::MatrixXd h = a.transpose() * ta;
+    if (!t.cols.empty()) {
+      const Eigen::MatrixXd d = t.b.transpose() * ta - f;
+      h.noalias() += d.transpose() * inverse_.Gather(t.cols, t.cols) * d;
+    }
+    Store(group, h, point);
+  }
+
+  /// A residual that observes no point: h = f^T S^- f over the reduced columns it touches.
+  void AddSingle(ResidualId id) {
+    std::vector<int> set_cols;
+    for (int k = 0; k < size_of_(id); ++k) {
+      schur_.RowReduced(first_row_[id] + k, &cols_, &vals_);
+      set_cols.insert(set_cols.end(), cols_.begin(), cols_.end());
+    }
+    std::sort(set_cols.begin(), set_cols.end());
+    set_cols.erase(std::unique(set_cols.begin(), set_cols.end()), set_cols.end());
+    Eigen::MatrixXd f;
+    ReducedParts({id}, set_cols, &f);
+    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(f.cols(), f.cols());
+    if (!set_cols.empty()) h = f.transpose() * inverse_.Gather(set_cols, set_cols) * f;
+    Store({id}, h, -1);
+  }
+
+ private:
+  /// f: the group's rows of the reduced Jacobian on `set_cols` (sorted), one column per row.
+  void ReducedParts(const std::vector<ResidualId>& group,
+                    const std::vector<int>& set_cols,
+                    Eigen::MatrixXd* f) {
+    int m = 0;
+    for (ResidualId id : group) m += size_of_(id);
+    *f = Eigen::MatrixXd::Zero(set_cols.size(), m);
+    int c = 0;
+    for (ResidualId id : group)
+      for (int k = 0; k < size_of_(id); ++k, ++c) {
+        schur_.RowReduced(first_row_[id] + k, &cols_, &vals_);
+        for (size_t q = 0; q < cols_.size(); ++q) {
+          const auto at = std::lower_bound(set_cols.begin(), set_cols.end(), cols_[q]);
+          (*f)(at - set_cols.begin(), c) = vals_[q];
+        }
+      }
+  }
+
+  /// r_ii = (Q_vv)_ii clamped to [0, 1]; with clusters, the symmetrised Q_vv of a point group.
+  void Store(const std::vector<ResidualId>& group, const Eigen::MatrixXd& h, int point) {
+    const Eigen::MatrixXd qvv = Eigen::MatrixXd::Identity(h.rows(), h.cols()) - h;
+    int c = 0;
+    for (ResidualId id : group) {
+      std::vector<double>& r = out_->redundancy[id];
+      for (int k = 0; k < size_of_(id); ++k, ++c) r.push_back(std::clamp(qvv(c, c), 0.0, 1.0));
+    }
+    if (with_clusters_ && point >= 0) {
+      ResidualCluster cluster;
+      cluster.point = free_blocks_[point];
+      cluster.residuals = group;
+      cluster.qvv = 0.5 * (qvv + qvv.transpose());
+      out_->clusters.push_back(std::move(cluster));
+    }
+  }
+
+  const internal::SchurComplement& schur_;
+  const internal::SelectedInverse& inverse_;
+  const std::vector<int>& first_row_;
+  const std::vector<BlockId>& free_blocks_;
+  const std::function<int(ResidualId)> size_of_;
+  const bool with_clusters_;
+  ObservationCofactors* out_;
+  std::vector<int> cols_;  // scratch of RowReduced
+  std::vector<double> vals_;
+};
+
+}  // namespace
+
 ObservationCofactors ProblemBuilder::ComputeObservationCofactors(const std::vector<ResidualId>& ids,
                                                                  bool with_clusters,
                                                                  int max_dense_parameters) const {
@@ -915,9 +1025,7 @@ ObservationCofactors ProblemBuilder::ComputeObservationCofactors(const std::vect
   if (inverse.singular())
     out.message = "the normal matrix is singular (datum defect); Q_vv from its pseudo-inverse";
 
-  // Residuals grouped by the point they observe (the block index in the Schur system); the
-  // others one by one. H = J N^- J^T over a group's rows:
-  //   h_ij = a_i A^+ a_j^T + d_i^T S^- d_j,  d_i = B^T A^+ a_i - f_i  (normal_equations.h).
+  // Residuals grouped by the point they observe; the others one by one.
   std::map<int, std::vector<ResidualId>> by_point;
   std::vector<ResidualId> pointless;
   for (ResidualId id : ids) {
@@ -928,71 +1036,16 @@ ObservationCofactors ProblemBuilder::ComputeObservationCofactors(const std::vect
     else
       pointless.push_back(id);
   }
-  std::vector<int> cols;
-  std::vector<double> vals;
-  auto reduced_parts = [&](const std::vector<ResidualId>& group,
-                           const std::vector<int>& set_cols,
-                           Eigen::MatrixXd* f) {
-    int m = 0;
-    for (ResidualId id : group) m += residuals_[id].size;
-    *f = Eigen::MatrixXd::Zero(set_cols.size(), m);
-    int c = 0;
-    for (ResidualId id : group)
-      for (int k = 0; k < residuals_[id].size; ++k, ++c) {
-        schur->RowReduced(first_row[id] + k, &cols, &vals);
-        for (size_t q = 0; q < cols.size(); ++q) {
-          const auto at = std::lower_bound(set_cols.begin(), set_cols.end(), cols[q]);
-          (*f)(at - set_cols.begin(), c) = vals[q];
-        }
-      }
-  };
-  auto store = [&](const std::vector<ResidualId>& group, const Eigen::MatrixXd& h, int point) {
-    const Eigen::MatrixXd qvv = Eigen::MatrixXd::Identity(h.rows(), h.cols()) - h;
-    int c = 0;
-    for (ResidualId id : group) {
-      std::vector<double>& r = out.redundancy[id];
-      for (int k = 0; k < residuals_[id].size; ++k, ++c)
-        r.push_back(std::clamp(qvv(c, c), 0.0, 1.0));
-    }
-    if (with_clusters && point >= 0) {
-      ResidualCluster cluster;
-      cluster.point = free_blocks[point];
-      cluster.residuals = group;
-      cluster.qvv = 0.5 * (qvv + qvv.transpose());
-      out.clusters.push_back(std::move(cluster));
-    }
-  };
-  for (const auto& [point, group] : by_point) {
-    const internal::SchurComplement::PointTerms t = schur->Point(point);
-    Eigen::MatrixXd f;
-    reduced_parts(group, t.cols, &f);
-    Eigen::MatrixXd a(t.a_pinv.rows(), f.cols());
-    int c = 0;
-    for (ResidualId id : group)
-      for (int k = 0; k < residuals_[id].size; ++k, ++c)
-        a.col(c) = schur->RowPointPart(first_row[id] + k);
-    const Eigen::MatrixXd ta = t.a_pinv * a;
-    Eigen::MatrixXd h = a.transpose() * ta;
-    if (!t.cols.empty()) {
-      const Eigen::MatrixXd d = t.b.transpose() * ta - f;
-      h.noalias() += d.transpose() * inverse.Gather(t.cols, t.cols) * d;
-    }
-    store(group, h, point);
-  }
-  for (ResidualId id : pointless) {
-    std::vector<int> set_cols;
-    for (int k = 0; k < residuals_[id].size; ++k) {
-      schur->RowReduced(first_row[id] + k, &cols, &vals);
-      set_cols.insert(set_cols.end(), cols.begin(), cols.end());
-    }
-    std::sort(set_cols.begin(), set_cols.end());
-    set_cols.erase(std::unique(set_cols.begin(), set_cols.end()), set_cols.end());
-    Eigen::MatrixXd f;
-    reduced_parts({id}, set_cols, &f);
-    Eigen::MatrixXd h = Eigen::MatrixXd::Zero(f.cols(), f.cols());
-    if (!set_cols.empty()) h = f.transpose() * inverse.Gather(set_cols, set_cols) * f;
-    store({id}, h, -1);
-  }
+  CofactorAssembly assembly(
+      *schur,
+      inverse,
+      first_row,
+      free_blocks,
+      [&](ResidualId id) { return residuals_[id].size; },
+      with_clusters,
+      &out);
+  for (const auto& [point, group] : by_point) assembly.AddPointGroup(point, group);
+  for (ResidualId id : pointless) assembly.AddSingle(id);
   return out;
 }
 
@@ -1120,6 +1173,190 @@ NullSpaceReport ProblemBuilder::NullSpace(double relative_threshold, int max_par
   return report;
 }
 
+namespace {
+
+using BlockPairs = std::vector<std::pair<BlockId, BlockId>>;
+
+/// Pairs: every block with itself, interior x interior, and, with cross_blocks, the pairs with
+/// one of those; without cross_blocks every pair.
+BlockPairs CovariancePairs(const std::vector<BlockId>& free_requested,
+                           const std::vector<BlockId>& cross_blocks,
+                           const std::function<bool(BlockId)>& is_interior) {
+  const std::set<BlockId> cross(cross_blocks.begin(), cross_blocks.end());
+  BlockPairs pairs;
+  for (size_t i = 0; i < free_requested.size(); ++i)
+    for (size_t k = i; k < free_requested.size(); ++k) {
+      const BlockId a = free_requested[i], b = free_requested[k];
+      const bool interior_pair = is_interior(a) && is_interior(b);
+      if (cross.empty() || i == k || interior_pair || cross.count(a) || cross.count(b))
+        pairs.emplace_back(std::min(a, b), std::max(a, b));
+    }
+  return pairs;
+}
+
+/// `why`, followed by up to 20 of the undetermined parameters in parentheses.
+std::string WithUndetermined(const std::string& why, const std::vector<std::string>& undetermined) {
+  std::string message = why;
+  if (!undetermined.empty()) {
+    message += " (";
+    for (size_t i = 0; i < undetermined.size() && i < 20; ++i)
+      message += (i ? ", " : "") + undetermined[i];
+    if (undetermined.size() > 20) message += ", ...";
+    message += ")";
+  }
+  return message;
+}
+
+/// Small problems: Ceres' covariance (dense SVD; its rank test is the reference), computed on
+/// `mirror`, the problem copied in BlockId order (`in_order[id]`: where block id lives in the
+/// copy), since Ceres orders the Jacobian's columns by block address. False when singular.
+bool CeresCovarianceBlocks(ceres::Problem* mirror,
+                           const std::vector<double*>& in_order,
+                           const BlockPairs& pairs,
+                           const std::function<int(BlockId)>& size_of,
+                           double s2,
+                           CovarianceReport* report) {
+  ceres::Covariance::Options options;
+  options.algorithm_type = ceres::DENSE_SVD;
+  options.min_reciprocal_condition_number = 1e-14;
+  options.num_threads = 1;
+  options.apply_loss_function = true;
+  ceres::Covariance covariance(options);
+  std::vector<std::pair<const double*, const double*>> ceres_pairs;
+  for (const auto& [a, b] : pairs) ceres_pairs.emplace_back(in_order[a], in_order[b]);
+  if (!ceres_pairs.empty() && !covariance.Compute(ceres_pairs, mirror)) return false;
+  for (const auto& [a, b] : pairs) {
+    Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(size_of(a),
+                                                                             size_of(b));
+    covariance.GetCovarianceBlock(in_order[a], in_order[b], m.data());
+    report->blocks[{a, b}] = s2 * Eigen::MatrixXd(m);
+  }
+  return true;
+}
+
+/// A requested block as a linear function of the reduced parameters s: x = G s (+ an own term
+/// A^+ for a point: p = -A^+ B s + ...), and d(ambient)/d(tangent) of the block.
+struct Lift {
+  std::vector<int> cols;
+  Eigen::MatrixXd g, own, plus;
+};
+
+/// Points eliminated, S factorised, S^-1 on the pattern of its factor (normal_equations.h):
+/// Q(a, b) = G_a S^-1(cols_a, cols_b) G_b^T (+ A^+ on a point's own diagonal block), in ambient
+/// entries through each block's plus Jacobian. False when a requested point is singular.
+bool SchurCovarianceBlocks(const std::vector<BlockId>& order,
+                           const internal::SchurComplement& schur,
+                           const internal::SelectedInverse& inverse,
+                           const std::vector<BlockId>& free_requested,
+                           const BlockPairs& pairs,
+                           const std::function<Eigen::MatrixXd(BlockId)>& plus_jacobian,
+                           double s2,
+                           CovarianceReport* report) {
+  std::map<BlockId, int> index;  // block -> index in the Schur system
+  for (size_t b = 0; b < order.size(); ++b) index[order[b]] = static_cast<int>(b);
+  bool any_point = false;
+  for (size_t b = 0; b < order.size(); ++b) any_point |= schur.is_point(static_cast<int>(b));
+  report->method = std::string(any_point ? "schur_" : "normal_") +
+                   (inverse.dense() ? "dense_inverse" : "selected_inverse");
+  std::map<BlockId, Lift> lifts;
+  for (BlockId id : free_requested) {
+    Lift lift;
+    const int b = index.at(id);
+    if (schur.is_point(b)) {
+      const auto t = schur.Point(b);
+      if (t.singular) return false;
+      lift.cols = t.cols;
+      lift.g = -t.a_pinv * t.b;
+      lift.own = t.a_pinv;
+    } else {
+      lift.cols = schur.ReducedColumns({b});
+      lift.g = Eigen::MatrixXd::Identity(lift.cols.size(), lift.cols.size());
+    }
+    lift.plus = plus_jacobian(id);
+    lifts[id] = std::move(lift);
+  }
+  for (const auto& [a, b] : pairs) {
+    const Lift& la = lifts.at(a);
+    const Lift& lb = lifts.at(b);
+    Eigen::MatrixXd q = Eigen::MatrixXd::Zero(la.g.rows(), lb.g.rows());
+    if (!la.cols.empty() && !lb.cols.empty())
+      q = la.g * inverse.Gather(la.cols, lb.cols) * lb.g.transpose();
+    if (a == b && la.own.size() > 0) q += la.own;
+    report->blocks[{a, b}] = s2 * la.plus * q * lb.plus.transpose();
+  }
+  return true;
+}
+
+/// Rotation blocks are reported in omega, phi, kappa: C_opk = J C_q J^T with J the conversion's
+/// Jacobian (calib/camera/rotation.h OpkJacobianOfQuaternion; NaN rows for omega and kappa at
+/// phi = +-90 deg, whose sigmas are then unknown). `quaternion_of`: a rotation block's values,
+/// nullptr for any other block.
+void ReportRotationsInOpk(const std::function<const double*(BlockId)>& quaternion_of,
+                          CovarianceReport* report) {
+  const auto report_jacobian = [&](BlockId id, int size) -> Eigen::MatrixXd {
+    const double* q = quaternion_of(id);
+    if (!q) return Eigen::MatrixXd::Identity(size, size);
+    return OpkJacobianOfQuaternion(Eigen::Map<const Eigen::Vector4d>(q));
+  };
+  for (auto& [ab, c] : report->blocks) {
+    if (!quaternion_of(ab.first) && !quaternion_of(ab.second)) continue;
+    c = report_jacobian(ab.first, c.rows()) * c * report_jacobian(ab.second, c.cols()).transpose();
+  }
+}
+
+/// sqrt of each requested block's diagonal (NaN, not separable, stays NaN).
+void FillSigmas(const std::vector<BlockId>& free_requested, CovarianceReport* report) {
+  for (BlockId id : free_requested) {
+    const Eigen::MatrixXd& c = report->blocks.at({id, id});
+    for (int e = 0; e < c.rows(); ++e)
+      report->sigma(report->offsets[id] + e) =
+          std::isnan(c(e, e)) ? c(e, e) : std::sqrt(std::max(0.0, c(e, e)));
+  }
+}
+
+/// Correlations above the threshold, in the order of the requested entries.
+void FindHighCorrelations(double correlation_threshold, CovarianceReport* report) {
+  struct Pair {
+    int i, k;
+    double rho;
+  };
+  std::vector<Pair> high;
+  for (const auto& [ab, c] : report->blocks) {
+    const int oa = report->offsets.at(ab.first), ob = report->offsets.at(ab.second);
+    for (int r = 0; r < c.rows(); ++r)
+      for (int q = ab.first == ab.second ? r + 1 : 0; q < c.cols(); ++q) {
+        const int i = std::min(oa + r, ob + q), k = std::max(oa + r, ob + q);
+        if (!report->free[i] || !report->free[k]) continue;
+        const double rho = report->Correlation(i, k);
+        if (std::abs(rho) > correlation_threshold) high.push_back({i, k, rho});
+      }
+  }
+  std::sort(high.begin(), high.end(), [](const Pair& x, const Pair& y) {
+    return x.i != y.i ? x.i < y.i : x.k < y.k;
+  });
+  for (const Pair& h : high)
+    report->high_correlations.push_back({report->names[h.i], report->names[h.k], h.rho});
+}
+
+/// The full correlation matrix of the interior entries.
+void FillInteriorCorrelation(const std::function<bool(BlockId)>& is_interior,
+                             CovarianceReport* report) {
+  std::vector<int> interior_rows;
+  for (int i = 0; i < static_cast<int>(report->names.size()); ++i)
+    if (is_interior(report->entry_block[i])) interior_rows.push_back(i);
+  report->interior_correlation =
+      Eigen::MatrixXd::Identity(interior_rows.size(), interior_rows.size());
+  for (size_t r = 0; r < interior_rows.size(); ++r) {
+    report->interior_names.push_back(report->names[interior_rows[r]]);
+    for (size_t q = 0; q < interior_rows.size(); ++q)
+      if (r != q)
+        report->interior_correlation(r, q) =
+            report->Correlation(interior_rows[r], interior_rows[q]);
+  }
+}
+
+}  // namespace
+
 CovarianceReport ProblemBuilder::EstimateCovariance(
     const std::vector<BlockId>& blocks,
     double sigma0,
@@ -1143,165 +1380,53 @@ CovarianceReport ProblemBuilder::EstimateCovariance(
   std::vector<BlockId> free_requested;
   for (BlockId id : blocks)
     if (!blocks_[id].constant && blocks_[id].num_residuals > 0) free_requested.push_back(id);
-  // Pairs: every block with itself, interior x interior, and, with cross_blocks, the pairs with
-  // one of those; without cross_blocks every pair.
-  const std::set<BlockId> cross(cross_blocks.begin(), cross_blocks.end());
-  std::vector<std::pair<BlockId, BlockId>> pairs;
-  for (size_t i = 0; i < free_requested.size(); ++i)
-    for (size_t k = i; k < free_requested.size(); ++k) {
-      const BlockId a = free_requested[i], b = free_requested[k];
-      const bool interior_pair =
-          blocks_[a].kind == BlockKind::kInterior && blocks_[b].kind == BlockKind::kInterior;
-      if (cross.empty() || i == k || interior_pair || cross.count(a) || cross.count(b))
-        pairs.emplace_back(std::min(a, b), std::max(a, b));
-    }
+  const auto is_interior = [&](BlockId id) { return blocks_[id].kind == BlockKind::kInterior; };
+  const BlockPairs pairs = CovariancePairs(free_requested, cross_blocks, is_interior);
   auto fail = [&](const std::string& why) {
     ReleaseFactorized();
     report.ok = false;
     report.undetermined = NullSpaceParameters(3000);
-    report.message = why;
-    if (!report.undetermined.empty()) {
-      report.message += " (";
-      for (size_t i = 0; i < report.undetermined.size() && i < 20; ++i)
-        report.message += (i ? ", " : "") + report.undetermined[i];
-      if (report.undetermined.size() > 20) report.message += ", ...";
-      report.message += ")";
-    }
+    report.message = WithUndetermined(why, report.undetermined);
     report.blocks.clear();
     return report;
   };
   const std::string singular_message =
       "the normal matrix is singular or badly conditioned: the problem has a datum defect or "
       "parameters the observations cannot determine";
-  auto plus_jacobian = [&](BlockId id) { return PlusJacobianOf(id); };
   const double s2 = sigma0 * sigma0;
-  const int n_free = NumFreeParameters();
-  if (n_free <= kCeresCovarianceLimit) {
-    // Small problems: Ceres' covariance (dense SVD; its rank test is the reference).
+  if (NumFreeParameters() <= kCeresCovarianceLimit) {
     report.method = "ceres_dense_svd";
-    ceres::Covariance::Options options;
-    options.algorithm_type = ceres::DENSE_SVD;
-    options.min_reciprocal_condition_number = 1e-14;
-    options.num_threads = 1;
-    options.apply_loss_function = true;
-    ceres::Covariance covariance(options);
     // On a copy in BlockId order: Ceres orders the Jacobian's columns by block address.
     std::vector<double> buffer;
     std::vector<double*> in_order;
     const std::unique_ptr<ceres::Problem> mirror = CopyInBlockOrder(&buffer, &in_order, true);
-    std::vector<std::pair<const double*, const double*>> ceres_pairs;
-    for (const auto& [a, b] : pairs) ceres_pairs.emplace_back(in_order[a], in_order[b]);
-    if (!ceres_pairs.empty() && !covariance.Compute(ceres_pairs, mirror.get()))
+    const auto size_of = [&](BlockId id) { return blocks_[id].size; };
+    if (!CeresCovarianceBlocks(mirror.get(), in_order, pairs, size_of, s2, &report))
       return fail(singular_message);
-    for (const auto& [a, b] : pairs) {
-      Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> m(blocks_[a].size,
-                                                                               blocks_[b].size);
-      covariance.GetCovarianceBlock(in_order[a], in_order[b], m.data());
-      report.blocks[{a, b}] = s2 * Eigen::MatrixXd(m);
-    }
   } else {
-    // Points eliminated, S factorised, S^-1 on the pattern of its factor (normal_equations.h).
     // The factorisation of the last redundancy numbers when nothing changed since (snooping's
     // final test): one factorisation and selected inversion for both. Released at the end.
     const Factorized* factorized = Factorize(true, 0);
     if (!factorized) return fail("the residuals cannot be evaluated at the current values");
-    const std::vector<BlockId>& order = factorized->free_blocks;
-    const internal::SchurComplement* schur = factorized->schur.get();
-    const internal::SelectedInverse& inverse = factorized->inverse;
-    if (!factorized->inverse_ok || inverse.singular()) return fail(singular_message);
-    std::map<BlockId, int> index;  // block -> index in the Schur system
-    for (size_t b = 0; b < order.size(); ++b) index[order[b]] = static_cast<int>(b);
-    bool any_point = false;
-    for (size_t b = 0; b < order.size(); ++b) any_point |= schur->is_point(static_cast<int>(b));
-    report.method = std::string(any_point ? "schur_" : "normal_") +
-                    (inverse.dense() ? "dense_inverse" : "selected_inverse");
-    // Every requested block as a linear function of the reduced parameters s:
-    // x = G s (+ an own term A^+ for a point: p = -A^+ B s + ...).
-    struct Lift {
-      std::vector<int> cols;
-      Eigen::MatrixXd g, own, plus;
-    };
-    std::map<BlockId, Lift> lifts;
-    for (BlockId id : free_requested) {
-      Lift lift;
-      const int b = index.at(id);
-      if (schur->is_point(b)) {
-        const auto t = schur->Point(b);
-        if (t.singular) return fail(singular_message);
-        lift.cols = t.cols;
-        lift.g = -t.a_pinv * t.b;
-        lift.own = t.a_pinv;
-      } else {
-        lift.cols = schur->ReducedColumns({b});
-        lift.g = Eigen::MatrixXd::Identity(lift.cols.size(), lift.cols.size());
-      }
-      lift.plus = plus_jacobian(id);
-      lifts[id] = std::move(lift);
-    }
-    for (const auto& [a, b] : pairs) {
-      const Lift& la = lifts.at(a);
-      const Lift& lb = lifts.at(b);
-      Eigen::MatrixXd q = Eigen::MatrixXd::Zero(la.g.rows(), lb.g.rows());
-      if (!la.cols.empty() && !lb.cols.empty())
-        q = la.g * inverse.Gather(la.cols, lb.cols) * lb.g.transpose();
-      if (a == b && la.own.size() > 0) q += la.own;
-      report.blocks[{a, b}] = s2 * la.plus * q * lb.plus.transpose();
-    }
+    if (!factorized->inverse_ok || factorized->inverse.singular()) return fail(singular_message);
+    const auto plus_jacobian = [&](BlockId id) { return PlusJacobianOf(id); };
+    if (!SchurCovarianceBlocks(factorized->free_blocks,
+                               *factorized->schur,
+                               factorized->inverse,
+                               free_requested,
+                               pairs,
+                               plus_jacobian,
+                               s2,
+                               &report))
+      return fail(singular_message);
     ReleaseFactorized();
   }
-  // Rotation blocks are reported in omega, phi, kappa: C_opk = J C_q J^T with J the conversion's
-  // Jacobian (calib/camera/rotation.h OpkJacobianOfQuaternion; NaN rows for omega and kappa at
-  // phi = +-90 deg, whose sigmas are then unknown).
-  for (auto& [ab, c] : report.blocks) {
-    const Block& a = blocks_[ab.first];
-    const Block& b = blocks_[ab.second];
-    if (!a.rotation && !b.rotation) continue;
-    const auto report_jacobian = [](const Block& block) -> Eigen::MatrixXd {
-      if (!block.rotation) return Eigen::MatrixXd::Identity(block.size, block.size);
-      return OpkJacobianOfQuaternion(Eigen::Map<const Eigen::Vector4d>(block.values));
-    };
-    c = report_jacobian(a) * c * report_jacobian(b).transpose();
-  }
+  ReportRotationsInOpk(
+      [&](BlockId id) { return blocks_[id].rotation ? blocks_[id].values : nullptr; }, &report);
   report.ok = true;
-  for (BlockId id : free_requested) {
-    const Eigen::MatrixXd& c = report.blocks.at({id, id});
-    for (int e = 0; e < c.rows(); ++e)  // NaN (not separable) stays NaN
-      report.sigma(report.offsets[id] + e) =
-          std::isnan(c(e, e)) ? c(e, e) : std::sqrt(std::max(0.0, c(e, e)));
-  }
-  // Correlations above the threshold, in the order of the requested entries.
-  struct Pair {
-    int i, k;
-    double rho;
-  };
-  std::vector<Pair> high;
-  for (const auto& [ab, c] : report.blocks) {
-    const int oa = report.offsets.at(ab.first), ob = report.offsets.at(ab.second);
-    for (int r = 0; r < c.rows(); ++r)
-      for (int q = ab.first == ab.second ? r + 1 : 0; q < c.cols(); ++q) {
-        const int i = std::min(oa + r, ob + q), k = std::max(oa + r, ob + q);
-        if (!report.free[i] || !report.free[k]) continue;
-        const double rho = report.Correlation(i, k);
-        if (std::abs(rho) > correlation_threshold) high.push_back({i, k, rho});
-      }
-  }
-  std::sort(high.begin(), high.end(), [](const Pair& x, const Pair& y) {
-    return x.i != y.i ? x.i < y.i : x.k < y.k;
-  });
-  for (const Pair& h : high)
-    report.high_correlations.push_back({report.names[h.i], report.names[h.k], h.rho});
-  // The full correlation matrix of the interior entries.
-  std::vector<int> interior_rows;
-  for (int i = 0; i < total; ++i)
-    if (blocks_[report.entry_block[i]].kind == BlockKind::kInterior) interior_rows.push_back(i);
-  report.interior_correlation =
-      Eigen::MatrixXd::Identity(interior_rows.size(), interior_rows.size());
-  for (size_t r = 0; r < interior_rows.size(); ++r) {
-    report.interior_names.push_back(report.names[interior_rows[r]]);
-    for (size_t q = 0; q < interior_rows.size(); ++q)
-      if (r != q)
-        report.interior_correlation(r, q) = report.Correlation(interior_rows[r], interior_rows[q]);
-  }
+  FillSigmas(free_requested, &report);
+  FindHighCorrelations(correlation_threshold, &report);
+  FillInteriorCorrelation(is_interior, &report);
   return report;
 }
 

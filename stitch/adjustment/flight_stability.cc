@@ -36,6 +36,148 @@ Spread SpreadOf(const std::vector<double>& x) {
   return s;
 }
 
+/// One parameter of one free sub-image over the frames.
+struct Series {
+  std::string subimage, name;
+  size_t k, i;  // sub-image and parameter index
+  std::vector<double> values, sigmas;
+};
+
+/// Parameter series of the free sub-images (sub-image order of the first frame).
+std::vector<Series> ParameterSeries(const std::vector<const FrameAdjustment*>& frames) {
+  std::vector<Series> series;
+  const FrameAdjustment& first = *frames.front();
+  for (size_t k = 0; k < first.subimages.size(); ++k) {
+    const SubimageEstimate& e = first.subimages[k];
+    if (e.base) continue;
+    const auto names = MappingParamNames(e.model);
+    for (size_t i = 0; i < e.params.size(); ++i) series.push_back({e.id, names[i], k, i, {}, {}});
+  }
+  for (const FrameAdjustment* f : frames)
+    for (Series& s : series) {
+      s.values.push_back(f->subimages.at(s.k).params.at(s.i));
+      s.sigmas.push_back(f->subimages.at(s.k).sigma.at(s.i));
+    }
+  return series;
+}
+
+/// sigma0 against the pooled sigma0 of the flight: F = sigma0^2 / (sum vtpv / sum redundancy)
+/// above the F quantile at alpha / n_frames (Bonferroni over the frames).
+void FlagSigma0(const std::vector<const FrameAdjustment*>& frames,
+                const std::vector<double>& s0px,
+                double alpha,
+                std::vector<FlaggedFrame>& flags) {
+  const size_t n_frames = frames.size();
+  double vtpv = 0, redundancy = 0;
+  for (const FrameAdjustment* f : frames) {
+    vtpv += f->vtpv;
+    redundancy += f->redundancy;
+  }
+  if (!(redundancy > 0 && vtpv > 0)) return;
+  const double pooled = vtpv / redundancy;
+  char text[240];
+  for (size_t f = 0; f < n_frames; ++f) {
+    if (frames[f]->redundancy <= 0) continue;
+    const double ratio = frames[f]->sigma0 * frames[f]->sigma0 / pooled;
+    const double critical =
+        FDistributionQuantile(1.0 - alpha / n_frames, frames[f]->redundancy, redundancy);
+    if (ratio <= critical) continue;
+    std::snprintf(text,
+                  sizeof(text),
+                  "sigma0_px = %.4g: F = sigma0^2 / pooled sigma0^2 = %.3g > %.3g",
+                  s0px[f],
+                  ratio,
+                  critical);
+    flags[f].reasons.push_back(text);
+  }
+}
+
+/// The parameter table: mean and spread of each series and its mean a-posteriori sigma.
+std::vector<ParameterStability> ParameterTable(const std::vector<Series>& series) {
+  std::vector<ParameterStability> table;
+  for (const Series& s : series) {
+    const Spread spread = SpreadOf(s.values);
+    ParameterStability p;
+    p.subimage = s.subimage;
+    p.name = s.name;
+    p.mean = spread.mean;
+    p.std = spread.std;
+    for (double v : s.sigmas) p.mean_sigma += v / s.sigmas.size();
+    table.push_back(p);
+  }
+  return table;
+}
+
+/// d^2 of every frame's mapping of sub-image k (n parameters) against the mean of the other
+/// frames in `use`: d^2 = dp^T ((1 + 1/others) C)^-1 dp, C the frame's covariance (the mean of
+/// the others adds its share); 0 where it cannot be formed.
+std::vector<double> MappingDistances(const std::vector<const FrameAdjustment*>& frames,
+                                     size_t k,
+                                     int n,
+                                     const std::vector<bool>& use) {
+  const size_t n_frames = frames.size();
+  Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
+  int count = 0;
+  for (size_t f = 0; f < n_frames; ++f)
+    if (use[f]) {
+      sum += Eigen::Map<const Eigen::VectorXd>(frames[f]->subimages[k].params.data(), n);
+      ++count;
+    }
+  std::vector<double> d2(n_frames, 0.0);
+  for (size_t f = 0; f < n_frames; ++f) {
+    const SubimageEstimate& e = frames[f]->subimages[k];
+    const Eigen::Map<const Eigen::VectorXd> p(e.params.data(), n);
+    const int others = count - (use[f] ? 1 : 0);
+    if (others < 2 || e.covariance.rows() != n || e.covariance.isZero(0.0)) continue;
+    Eigen::VectorXd centre = sum;
+    if (use[f]) centre -= p;
+    centre /= others;
+    // Equilibrated (unit diagonal): plain parameters span 1e-9 (c1, c2) to 1e3 px (a0, b0).
+    const Eigen::VectorXd scale = e.covariance.diagonal().cwiseMax(1e-300).cwiseSqrt();
+    const Eigen::VectorXd dp = (p - centre).cwiseQuotient(scale);
+    const Eigen::MatrixXd correlation =
+        scale.cwiseInverse().asDiagonal() * e.covariance * scale.cwiseInverse().asDiagonal();
+    const Eigen::LDLT<Eigen::MatrixXd> ldlt((1.0 + 1.0 / others) * correlation);
+    if (ldlt.info() == Eigen::Success) d2[f] = dp.dot(ldlt.solve(dp));
+  }
+  return d2;
+}
+
+/// The joint test per free sub-image: d^2 against n F(n, inf) at alpha / (n_frames n_free),
+/// tested twice, the second time without the frames out of line in the reference.
+void FlagMappings(const std::vector<const FrameAdjustment*>& frames,
+                  double alpha,
+                  std::vector<FlaggedFrame>& flags) {
+  const size_t n_frames = frames.size();
+  const FrameAdjustment& first = *frames.front();
+  int n_free = 0;
+  for (const SubimageEstimate& e : first.subimages) n_free += !e.base;
+  char text[240];
+  for (size_t k = 0; k < first.subimages.size(); ++k) {
+    const SubimageEstimate& e0 = first.subimages[k];
+    if (e0.base) continue;
+    const int n = static_cast<int>(e0.params.size());
+    const double critical =
+        n * FDistributionQuantile(1.0 - alpha / (n_frames * std::max(1, n_free)), n, 1e7);
+    std::vector<bool> use(n_frames, true);
+    std::vector<double> d2 = MappingDistances(frames, k, n, use);
+    for (size_t f = 0; f < n_frames; ++f) use[f] = d2[f] <= critical;
+    d2 = MappingDistances(frames, k, n, use);
+    for (size_t f = 0; f < n_frames; ++f) {
+      if (d2[f] <= critical) continue;
+      std::snprintf(text,
+                    sizeof(text),
+                    "sub-image %s: mapping differs from the other frames' mean by chi2 = %.3g > "
+                    "%.3g (%d parameters)",
+                    e0.id.c_str(),
+                    d2[f],
+                    critical,
+                    n);
+      flags[f].reasons.push_back(text);
+    }
+  }
+}
+
 }  // namespace
 
 ModelStability ComputeStability(calib::MappingModel model,
@@ -56,115 +198,11 @@ ModelStability ComputeStability(calib::MappingModel model,
   out.mean_sigma0_px = sigma0_px.mean;
   out.std_sigma0_px = sigma0_px.std;
 
-  // Parameter series of the free sub-images (sub-image order of the first frame).
-  struct Series {
-    std::string subimage, name;
-    size_t k, i;
-    std::vector<double> values, sigmas;
-  };
-  std::vector<Series> series;
-  const FrameAdjustment& first = *frames.front();
-  for (size_t k = 0; k < first.subimages.size(); ++k) {
-    const SubimageEstimate& e = first.subimages[k];
-    if (e.base) continue;
-    const auto names = MappingParamNames(e.model);
-    for (size_t i = 0; i < e.params.size(); ++i) series.push_back({e.id, names[i], k, i, {}, {}});
-  }
-  for (const FrameAdjustment* f : frames)
-    for (Series& s : series) {
-      s.values.push_back(f->subimages.at(s.k).params.at(s.i));
-      s.sigmas.push_back(f->subimages.at(s.k).sigma.at(s.i));
-    }
-  const size_t n_frames = frames.size();
-  std::vector<FlaggedFrame> flags(n_frames);
-  char text[240];
-  // sigma0 against the pooled sigma0 of the flight.
-  double vtpv = 0, redundancy = 0;
-  for (const FrameAdjustment* f : frames) {
-    vtpv += f->vtpv;
-    redundancy += f->redundancy;
-  }
-  if (redundancy > 0 && vtpv > 0) {
-    const double pooled = vtpv / redundancy;
-    for (size_t f = 0; f < n_frames; ++f) {
-      if (frames[f]->redundancy <= 0) continue;
-      const double ratio = frames[f]->sigma0 * frames[f]->sigma0 / pooled;
-      const double critical =
-          FDistributionQuantile(1.0 - alpha / n_frames, frames[f]->redundancy, redundancy);
-      if (ratio <= critical) continue;
-      std::snprintf(text,
-                    sizeof(text),
-                    "sigma0_px = %.4g: F = sigma0^2 / pooled sigma0^2 = %.3g > %.3g",
-                    s0px[f],
-                    ratio,
-                    critical);
-      flags[f].reasons.push_back(text);
-    }
-  }
-  // Parameter table and the joint test per free sub-image.
-  for (Series& s : series) {
-    const Spread spread = SpreadOf(s.values);
-    ParameterStability p;
-    p.subimage = s.subimage;
-    p.name = s.name;
-    p.mean = spread.mean;
-    p.std = spread.std;
-    for (double v : s.sigmas) p.mean_sigma += v / s.sigmas.size();
-    out.parameters.push_back(p);
-  }
-  int n_free = 0;
-  for (const SubimageEstimate& e : first.subimages) n_free += !e.base;
-  for (size_t k = 0; k < first.subimages.size(); ++k) {
-    const SubimageEstimate& e0 = first.subimages[k];
-    if (e0.base) continue;
-    const int n = static_cast<int>(e0.params.size());
-    const double critical =
-        n * FDistributionQuantile(1.0 - alpha / (n_frames * std::max(1, n_free)), n, 1e7);
-    // d^2 of every frame against the mean of the other frames that are not out of line.
-    auto test = [&](const std::vector<bool>& use, std::vector<double>* d2) {
-      Eigen::VectorXd sum = Eigen::VectorXd::Zero(n);
-      int count = 0;
-      for (size_t f = 0; f < n_frames; ++f)
-        if (use[f]) {
-          sum += Eigen::Map<const Eigen::VectorXd>(frames[f]->subimages[k].params.data(), n);
-          ++count;
-        }
-      d2->assign(n_frames, 0.0);
-      for (size_t f = 0; f < n_frames; ++f) {
-        const SubimageEstimate& e = frames[f]->subimages[k];
-        const Eigen::Map<const Eigen::VectorXd> p(e.params.data(), n);
-        const int others = count - (use[f] ? 1 : 0);
-        if (others < 2 || e.covariance.rows() != n || e.covariance.isZero(0.0)) continue;
-        Eigen::VectorXd centre = sum;
-        if (use[f]) centre -= p;
-        centre /= others;
-        // Equilibrated (unit diagonal): plain parameters span 1e-9 (c1, c2) to 1e3 px (a0, b0).
-        const Eigen::VectorXd scale = e.covariance.diagonal().cwiseMax(1e-300).cwiseSqrt();
-        const Eigen::VectorXd dp = (p - centre).cwiseQuotient(scale);
-        const Eigen::MatrixXd correlation =
-            scale.cwiseInverse().asDiagonal() * e.covariance * scale.cwiseInverse().asDiagonal();
-        const Eigen::LDLT<Eigen::MatrixXd> ldlt((1.0 + 1.0 / others) * correlation);
-        if (ldlt.info() == Eigen::Success) (*d2)[f] = dp.dot(ldlt.solve(dp));
-      }
-    };
-    std::vector<bool> use(n_frames, true);
-    std::vector<double> d2;
-    test(use, &d2);
-    for (size_t f = 0; f < n_frames; ++f) use[f] = d2[f] <= critical;
-    test(use, &d2);  // again without the frames out of line in the reference
-    for (size_t f = 0; f < n_frames; ++f) {
-      if (d2[f] <= critical) continue;
-      std::snprintf(text,
-                    sizeof(text),
-                    "sub-image %s: mapping differs from the other frames' mean by chi2 = %.3g > "
-                    "%.3g (%d parameters)",
-                    e0.id.c_str(),
-                    d2[f],
-                    critical,
-                    n);
-      flags[f].reasons.push_back(text);
-    }
-  }
+  const std::vector<Series> series = ParameterSeries(frames);
+  std::vector<FlaggedFrame> flags(frames.size());
+  FlagSigma0(frames, s0px, alpha, flags);
+  out.parameters = ParameterTable(series);
+  FlagMappings(frames, alpha, flags);
   for (size_t f = 0; f < frames.size(); ++f)
     if (!flags[f].reasons.empty()) {
       flags[f].frame = frames[f]->frame;

@@ -155,6 +155,276 @@ std::vector<RejectedObservation> RobustOutliers(const calib::Camera& camera,
   return out;
 }
 
+/// What the robust start leaves out before the adjustment proper.
+struct RobustStart {
+  std::set<ObservationKey> excluded;          // the caller's plus the robust start's
+  std::vector<RejectedObservation> rejected;  // the robust start's gross errors
+  std::string note;                           // why they were kept after all, if they were
+};
+
+RobustStart ApplyRobustStart(const calib::Camera& camera,
+                             const FrameMeasurements& frame,
+                             MappingModel model,
+                             const StitchOptions& options,
+                             const std::set<ObservationKey>& excluded_in) {
+  RobustStart out{excluded_in, {}, ""};
+  if (!(options.robust_start && options.data_snooping)) return out;
+  out.rejected = RobustOutliers(camera, frame, model, options, out.excluded);
+  std::set<ObservationKey> more = out.excluded;
+  for (const auto& r : out.rejected) more.insert({r.point, r.subimage});
+  if (!out.rejected.empty() && !FindUnderdetermined(camera, frame, model, options, more).empty()) {
+    out.note = "frame " + frame.frame + ": the robust start found " +
+               std::to_string(out.rejected.size()) +
+               " gross error(s) but leaving them out would under-determine the " +
+               std::string(calib::MappingModelName(model)) + " model: kept for data snooping";
+    out.rejected.clear();
+  } else {
+    out.excluded = std::move(more);
+  }
+  return out;
+}
+
+/// Residual bookkeeping: what each residual observes.
+struct Observed {
+  std::string point;
+  int subimage;
+  bool reference;
+  double sigma_px;
+};
+
+/// One frame's problem: a mapping block per sub-image and a 2D point per tie. The parameter
+/// memory lives here; `builder` (declared last, destroyed first) points into it.
+struct FrameProblem {
+  std::vector<MappingModel> models;
+  std::vector<calib::MappingConditioning> conditioning;
+  std::vector<std::vector<double>> values;  // conditioned parameters, solver memory
+  std::vector<bool> base;
+  std::vector<calib::BlockId> blocks;
+  std::vector<Eigen::Vector2d> tie_positions;
+  std::map<calib::ResidualId, Observed> observed;
+  int n_ties = 0;
+  calib::ProblemBuilder builder;
+};
+
+void AddMappingBlocks(const calib::Camera& camera,
+                      MappingModel model,
+                      const StitchOptions& options,
+                      FrameProblem& p) {
+  const size_t n_sub = camera.subimages.size();
+  p.models.resize(n_sub);
+  p.conditioning.resize(n_sub);
+  p.values.resize(n_sub);
+  p.base.resize(n_sub);
+  p.blocks.resize(n_sub);
+  for (size_t k = 0; k < n_sub; ++k) {
+    const auto& s = camera.subimages[k];
+    p.base[k] = IsBase(options, s.id);
+    p.models[k] = ModelOf(s, model, p.base[k]);
+    p.conditioning[k] =
+        calib::MappingConditioning::ForSubimage(p.models[k], s.width_px, s.height_px);
+    // Start (and, for a base, hold) at the camera file's mapping expressed in the model.
+    const std::vector<double> plain = calib::ParamsFromHomography(
+        p.models[k], calib::HomographyFromParams(s.model, s.params.data()));
+    p.values[k] = calib::ConditionedFromPlain(p.models[k], p.conditioning[k], plain);
+    p.blocks[k] = p.builder.AddBlock("mapping " + s.id,
+                                     p.values[k].data(),
+                                     static_cast<int>(p.values[k].size()),
+                                     calib::BlockKind::kMapping);
+    if (p.base[k]) p.builder.FixBlock(p.blocks[k]);
+  }
+}
+
+void AddReferences(const calib::Camera& camera,
+                   const FrameMeasurements& frame,
+                   const std::set<ObservationKey>& excluded,
+                   FrameProblem& p) {
+  for (const auto& ref : frame.references) {
+    const auto& s = camera.subimages[ref.subimage];
+    if (excluded.count({ref.point, s.id})) continue;
+    const int k = ref.subimage;
+    auto cost = calib::VisitMappingModel(p.models[k], [&](auto m) {
+      return calib::StitchReferenceResidual<decltype(m)>::Create(
+          p.conditioning[k], ref.uv, ref.virtual_px, ref.sigma_px);
+    });
+    const auto id = p.builder.AddResidual(
+        calib::kGroupStitchReference,
+        std::move(cost),
+        {p.blocks[k]},
+        "frame " + frame.frame + " reference " + ref.point + " sub-image " + s.id);
+    p.observed[id] = {ref.point, k, true, ref.sigma_px};
+  }
+}
+
+/// A 2D point per tie with two or more active rays, started at the mean of its rays' virtual
+/// positions, and one residual per ray.
+void AddTies(const calib::Camera& camera,
+             const FrameMeasurements& frame,
+             const std::set<ObservationKey>& excluded,
+             const StitchOptions& options,
+             FrameProblem& p) {
+  p.tie_positions.reserve(frame.ties.size());  // block memory must not move
+  for (const auto& tie : frame.ties) {
+    const auto rays = ActiveRays(camera, tie, excluded);
+    if (rays.size() < 2) continue;
+    Eigen::Vector2d start = Eigen::Vector2d::Zero();
+    for (const TieRay& ray : rays) start += camera.subimages[ray.subimage].VirtualFromSub(ray.uv);
+    p.tie_positions.push_back(start / static_cast<double>(rays.size()));
+    const auto point_block = p.builder.AddBlock("tie " + tie.point,
+                                                p.tie_positions.back().data(),
+                                                2,
+                                                calib::BlockKind::kTiePoint2d,
+                                                {"U", "V"});
+    ++p.n_ties;
+    for (const TieRay& ray : rays) {
+      const int k = ray.subimage;
+      auto cost = calib::VisitMappingModel(p.models[k], [&](auto m) {
+        return calib::StitchTieResidual<decltype(m)>::Create(
+            p.conditioning[k], ray.uv, ray.sigma_px);
+      });
+      const auto id = p.builder.AddResidual(
+          calib::kGroupStitchTie,
+          std::move(cost),
+          {p.blocks[k], point_block},
+          "frame " + frame.frame + " tie " + tie.point + " sub-image " + camera.subimages[k].id,
+          options.loss);
+      p.observed[id] = {tie.point, k, false, ray.sigma_px};
+    }
+  }
+}
+
+/// Solves, with data snooping when asked (its rejections appended to `rejected`).
+calib::SolveReport SolveFrame(const calib::Camera& camera,
+                              const StitchOptions& options,
+                              FrameProblem& p,
+                              std::vector<RejectedObservation>& rejected) {
+  if (!options.data_snooping) return p.builder.Solve(options.solver);
+  calib::SnoopingOptions snooping;
+  snooping.groups = {calib::kGroupStitchReference, calib::kGroupStitchTie};
+  snooping.critical_value =
+      std::max(3.29,
+               calib::NormalCriticalValue(options.snooping_alpha /
+                                          std::max(1, p.builder.NumObservations())));
+  snooping.max_rejections = 200;
+  const calib::SnoopingOutcome snooped =
+      calib::SolveWithDataSnooping(p.builder, options.solver, snooping);
+  for (const auto& r : snooped.rejected) {
+    const Observed& o = p.observed.at(r.id);
+    rejected.push_back({o.point,
+                        camera.subimages[o.subimage].id,
+                        o.reference,
+                        r.w_max,
+                        Eigen::Vector2d(r.v[0], r.v[1]) * o.sigma_px});
+  }
+  return snooped.report;
+}
+
+void CopySolveStatistics(const calib::SolveReport& report, FrameAdjustment& out) {
+  out.converged = report.converged;
+  out.iterations = report.iterations;
+  out.sigma0 = report.sigma0;
+  out.vtpv = report.vtpv;
+  out.redundancy = report.redundancy;
+  out.n_observations = report.n_observations;
+  out.n_unknowns = report.n_unknowns;
+  out.diagnostics = report.diagnostics;
+}
+
+/// sigma0 in px: sigma0 times the median a-priori sigma of the observations still active.
+double Sigma0Px(double sigma0, const FrameProblem& p) {
+  std::vector<double> active_sigmas;
+  for (const auto& [id, o] : p.observed)
+    if (p.builder.IsActive(id)) active_sigmas.push_back(o.sigma_px);
+  return sigma0 * Median(active_sigmas);
+}
+
+/// Residuals of the clean adjustment, in px: estimated minus observed.
+std::vector<PointResidual> ActiveResiduals(const calib::Camera& camera, const FrameProblem& p) {
+  std::vector<PointResidual> out;
+  for (const auto& [id, o] : p.observed) {
+    if (!p.builder.IsActive(id)) continue;
+    const std::vector<double> r = p.builder.EvaluateResidual(id);
+    out.push_back({o.point,
+                   camera.subimages[o.subimage].id,
+                   o.reference,
+                   Eigen::Vector2d(r[0], r[1]) * o.sigma_px,
+                   o.sigma_px});
+  }
+  return out;
+}
+
+/// Covariance of the free mappings (scaled by sigma0^2). A solution that overflowed (absurd
+/// input that passed the readers' bounds) must not reach the covariance's SVD, which does not
+/// survive non-finite or overflowing entries: a named failure (not converged, exit 3) instead.
+calib::CovarianceReport FreeMappingCovariance(const std::string& frame_id,
+                                              const calib::SolveReport& report,
+                                              FrameProblem& p,
+                                              FrameAdjustment& out) {
+  std::vector<calib::BlockId> free_blocks;
+  for (size_t k = 0; k < p.blocks.size(); ++k)
+    if (!p.base[k]) free_blocks.push_back(p.blocks[k]);
+  bool finite = std::isfinite(report.sigma0) && std::abs(report.sigma0) < 1e150;
+  for (const auto& v : p.values)
+    for (double x : v) finite = finite && std::isfinite(x) && std::abs(x) < 1e150;
+  for (const auto& t : p.tie_positions)
+    finite = finite && t.allFinite() && t.cwiseAbs().maxCoeff() < 1e150;
+  calib::CovarianceReport covariance;
+  if (finite) {
+    covariance = p.builder.EstimateCovariance(free_blocks, std::max(report.sigma0, 0.0));
+  } else {
+    out.converged = false;
+    covariance.ok = false;
+    covariance.message = "frame " + frame_id +
+                         ": numerical failure in the adjustment (non-finite or overflowing "
+                         "values): no covariance, results not usable";
+  }
+  return covariance;
+}
+
+/// Sub-image k's estimate in plain form, its covariance propagated from the conditioned
+/// parameters (C_plain = J C J^T) and to the four corners' virtual positions (G C G^T).
+SubimageEstimate EstimateSubimage(const calib::SubimageMapping& s,
+                                  size_t k,
+                                  const FrameProblem& p,
+                                  const calib::CovarianceReport& covariance) {
+  const int n = static_cast<int>(p.values[k].size());
+  const MappingModel model = p.models[k];
+  const calib::MappingConditioning& conditioning = p.conditioning[k];
+  SubimageEstimate e;
+  e.id = s.id;
+  e.model = model;
+  e.base = p.base[k];
+  e.params = calib::PlainFromConditioned(model, conditioning, p.values[k]);
+  Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, n);
+  if (!p.base[k] && covariance.ok) c = covariance.BlockCovariance(p.blocks[k], n);
+  const Eigen::MatrixXd j = calib::PlainFromConditionedJacobian(model, conditioning, p.values[k]);
+  e.covariance = j * c * j.transpose();
+  for (int i = 0; i < n; ++i) e.sigma.push_back(std::sqrt(std::max(0.0, e.covariance(i, i))));
+  const double corner_u[4] = {0.0, s.width_px - 1.0, 0.0, s.width_px - 1.0};
+  const double corner_v[4] = {0.0, 0.0, s.height_px - 1.0, s.height_px - 1.0};
+  calib::SubimageMapping estimated = s;
+  estimated.model = model;
+  estimated.params = e.params;
+  for (int i = 0; i < 4; ++i) {
+    CornerPrecision& corner = e.corners[i];
+    corner.uv = {corner_u[i], corner_v[i]};
+    corner.virtual_px = estimated.VirtualFromSub(corner.uv);
+    const Eigen::Vector2d uvc((corner_u[i] - conditioning.cu) / conditioning.scale,
+                              (corner_v[i] - conditioning.cv) / conditioning.scale);
+    const Eigen::MatrixXd g = VirtualJacobian(model, p.values[k], uvc);
+    const Eigen::Matrix2d cov_uv = g * c * g.transpose();
+    corner.sigma_U_px = std::sqrt(std::max(0.0, cov_uv(0, 0)));
+    corner.sigma_V_px = std::sqrt(std::max(0.0, cov_uv(1, 1)));
+    e.max_corner_sigma_px = std::max(e.max_corner_sigma_px, corner.sigma_px());
+  }
+  if (!p.base[k] && !covariance.ok) {
+    // No precision could be computed: say so (null in JSON), never report zero sigmas.
+    std::fill(e.sigma.begin(), e.sigma.end(), kUnknown);
+    for (CornerPrecision& corner : e.corners) corner.sigma_U_px = corner.sigma_V_px = kUnknown;
+    e.max_corner_sigma_px = kUnknown;
+  }
+  return e;
+}
+
 }  // namespace
 
 FrameAdjustment AdjustFrame(const calib::Camera& camera,
@@ -164,222 +434,33 @@ FrameAdjustment AdjustFrame(const calib::Camera& camera,
                             const std::set<ObservationKey>& excluded_in) {
   const std::string refusal = FindUnderdetermined(camera, frame, model, options, excluded_in);
   if (!refusal.empty()) throw InputError(refusal);
-  std::set<ObservationKey> excluded = excluded_in;
-  std::vector<RejectedObservation> robust_rejected;
-  std::string robust_note;
-  if (options.robust_start && options.data_snooping) {
-    robust_rejected = RobustOutliers(camera, frame, model, options, excluded);
-    std::set<ObservationKey> more = excluded;
-    for (const auto& r : robust_rejected) more.insert({r.point, r.subimage});
-    if (!robust_rejected.empty() &&
-        !FindUnderdetermined(camera, frame, model, options, more).empty()) {
-      robust_note = "frame " + frame.frame + ": the robust start found " +
-                    std::to_string(robust_rejected.size()) +
-                    " gross error(s) but leaving them out would under-determine the " +
-                    std::string(calib::MappingModelName(model)) + " model: kept for data snooping";
-      robust_rejected.clear();
-    } else {
-      excluded = std::move(more);
-    }
-  }
+  RobustStart robust = ApplyRobustStart(camera, frame, model, options, excluded_in);
 
-  const size_t n_sub = camera.subimages.size();
-  std::vector<MappingModel> models(n_sub);
-  std::vector<calib::MappingConditioning> conditioning(n_sub);
-  std::vector<std::vector<double>> values(n_sub);  // conditioned parameters, solver memory
-  std::vector<bool> base(n_sub);
-  calib::ProblemBuilder builder;
-  std::vector<calib::BlockId> blocks(n_sub);
-  for (size_t k = 0; k < n_sub; ++k) {
-    const auto& s = camera.subimages[k];
-    base[k] = IsBase(options, s.id);
-    models[k] = ModelOf(s, model, base[k]);
-    conditioning[k] = calib::MappingConditioning::ForSubimage(models[k], s.width_px, s.height_px);
-    // Start (and, for a base, hold) at the camera file's mapping expressed in the model.
-    const std::vector<double> plain = calib::ParamsFromHomography(
-        models[k], calib::HomographyFromParams(s.model, s.params.data()));
-    values[k] = calib::ConditionedFromPlain(models[k], conditioning[k], plain);
-    blocks[k] = builder.AddBlock("mapping " + s.id,
-                                 values[k].data(),
-                                 static_cast<int>(values[k].size()),
-                                 calib::BlockKind::kMapping);
-    if (base[k]) builder.FixBlock(blocks[k]);
-  }
-
-  // Residual bookkeeping: what each residual observes.
-  struct Observed {
-    std::string point;
-    int subimage;
-    bool reference;
-    double sigma_px;
-  };
-  std::map<calib::ResidualId, Observed> observed;
-  std::vector<double> sigmas;
-  for (const auto& ref : frame.references) {
-    const auto& s = camera.subimages[ref.subimage];
-    if (excluded.count({ref.point, s.id})) continue;
-    const int k = ref.subimage;
-    auto cost = calib::VisitMappingModel(models[k], [&](auto m) {
-      return calib::StitchReferenceResidual<decltype(m)>::Create(
-          conditioning[k], ref.uv, ref.virtual_px, ref.sigma_px);
-    });
-    const auto id = builder.AddResidual(
-        calib::kGroupStitchReference,
-        std::move(cost),
-        {blocks[k]},
-        "frame " + frame.frame + " reference " + ref.point + " sub-image " + s.id);
-    observed[id] = {ref.point, k, true, ref.sigma_px};
-    sigmas.push_back(ref.sigma_px);
-  }
-  std::vector<Eigen::Vector2d> tie_positions;
-  tie_positions.reserve(frame.ties.size());  // block memory must not move
-  int n_ties = 0;
-  for (const auto& tie : frame.ties) {
-    const auto rays = ActiveRays(camera, tie, excluded);
-    if (rays.size() < 2) continue;
-    Eigen::Vector2d start = Eigen::Vector2d::Zero();
-    for (const TieRay& ray : rays) start += camera.subimages[ray.subimage].VirtualFromSub(ray.uv);
-    tie_positions.push_back(start / static_cast<double>(rays.size()));
-    const auto point_block = builder.AddBlock("tie " + tie.point,
-                                              tie_positions.back().data(),
-                                              2,
-                                              calib::BlockKind::kTiePoint2d,
-                                              {"U", "V"});
-    ++n_ties;
-    for (const TieRay& ray : rays) {
-      const int k = ray.subimage;
-      auto cost = calib::VisitMappingModel(models[k], [&](auto m) {
-        return calib::StitchTieResidual<decltype(m)>::Create(conditioning[k], ray.uv, ray.sigma_px);
-      });
-      const auto id = builder.AddResidual(
-          calib::kGroupStitchTie,
-          std::move(cost),
-          {blocks[k], point_block},
-          "frame " + frame.frame + " tie " + tie.point + " sub-image " + camera.subimages[k].id,
-          options.loss);
-      observed[id] = {tie.point, k, false, ray.sigma_px};
-      sigmas.push_back(ray.sigma_px);
-    }
-  }
+  FrameProblem p;
+  AddMappingBlocks(camera, model, options, p);
+  AddReferences(camera, frame, robust.excluded, p);
+  AddTies(camera, frame, robust.excluded, options, p);
 
   FrameAdjustment out;
   out.frame = frame.frame;
   out.model = model;
-  out.n_ties = n_ties;
+  out.n_ties = p.n_ties;
   out.n_references = static_cast<int>(frame.references.size());
   out.n_single_ray_points = frame.single_ray_points;
 
-  calib::SolveReport report;
-  if (options.data_snooping) {
-    calib::SnoopingOptions snooping;
-    snooping.groups = {calib::kGroupStitchReference, calib::kGroupStitchTie};
-    snooping.critical_value =
-        std::max(3.29,
-                 calib::NormalCriticalValue(options.snooping_alpha /
-                                            std::max(1, builder.NumObservations())));
-    snooping.max_rejections = 200;
-    const calib::SnoopingOutcome snooped =
-        calib::SolveWithDataSnooping(builder, options.solver, snooping);
-    report = snooped.report;
-    for (const auto& r : snooped.rejected) {
-      const Observed& o = observed.at(r.id);
-      out.rejected.push_back({o.point,
-                              camera.subimages[o.subimage].id,
-                              o.reference,
-                              r.w_max,
-                              Eigen::Vector2d(r.v[0], r.v[1]) * o.sigma_px});
-    }
-  } else {
-    report = builder.Solve(options.solver);
-  }
+  const calib::SolveReport report = SolveFrame(camera, options, p, out.rejected);
   // Gross errors of the robust start first (found before any model was compared).
-  out.rejected.insert(out.rejected.begin(), robust_rejected.begin(), robust_rejected.end());
-  out.converged = report.converged;
-  out.iterations = report.iterations;
-  out.sigma0 = report.sigma0;
-  out.vtpv = report.vtpv;
-  out.redundancy = report.redundancy;
-  out.n_observations = report.n_observations;
-  out.n_unknowns = report.n_unknowns;
-  out.diagnostics = report.diagnostics;
-  if (!robust_note.empty()) out.diagnostics.push_back(robust_note);
-  std::vector<double> active_sigmas;
-  for (const auto& [id, o] : observed)
-    if (builder.IsActive(id)) active_sigmas.push_back(o.sigma_px);
-  out.sigma0_px = out.sigma0 * Median(active_sigmas);
+  out.rejected.insert(out.rejected.begin(), robust.rejected.begin(), robust.rejected.end());
+  CopySolveStatistics(report, out);
+  if (!robust.note.empty()) out.diagnostics.push_back(robust.note);
+  out.sigma0_px = Sigma0Px(out.sigma0, p);
+  out.residuals = ActiveResiduals(camera, p);
 
-  // Residuals of the clean adjustment, in px: estimated minus observed.
-  for (const auto& [id, o] : observed) {
-    if (!builder.IsActive(id)) continue;
-    const std::vector<double> r = builder.EvaluateResidual(id);
-    out.residuals.push_back({o.point,
-                             camera.subimages[o.subimage].id,
-                             o.reference,
-                             Eigen::Vector2d(r[0], r[1]) * o.sigma_px,
-                             o.sigma_px});
-  }
-
-  // Covariance of the free mappings (scaled by sigma0^2), then plain form and corners.
-  std::vector<calib::BlockId> free_blocks;
-  for (size_t k = 0; k < n_sub; ++k)
-    if (!base[k]) free_blocks.push_back(blocks[k]);
-  // A solution that overflowed (absurd input that passed the readers' bounds) must not reach the
-  // covariance's SVD, which does not survive non-finite or overflowing entries: a named failure
-  // (not converged, exit 3) instead.
-  bool finite = std::isfinite(report.sigma0) && std::abs(report.sigma0) < 1e150;
-  for (const auto& v : values)
-    for (double x : v) finite = finite && std::isfinite(x) && std::abs(x) < 1e150;
-  for (const auto& p : tie_positions)
-    finite = finite && p.allFinite() && p.cwiseAbs().maxCoeff() < 1e150;
-  calib::CovarianceReport covariance;
-  if (finite) {
-    covariance = builder.EstimateCovariance(free_blocks, std::max(report.sigma0, 0.0));
-  } else {
-    out.converged = false;
-    covariance.ok = false;
-    covariance.message = "frame " + frame.frame +
-                         ": numerical failure in the adjustment (non-finite or overflowing "
-                         "values): no covariance, results not usable";
-  }
+  const calib::CovarianceReport covariance = FreeMappingCovariance(frame.frame, report, p, out);
   out.covariance_ok = covariance.ok;
   if (!covariance.ok) out.diagnostics.push_back(covariance.message);
-  for (size_t k = 0; k < n_sub; ++k) {
-    const auto& s = camera.subimages[k];
-    const int n = static_cast<int>(values[k].size());
-    SubimageEstimate e;
-    e.id = s.id;
-    e.model = models[k];
-    e.base = base[k];
-    e.params = calib::PlainFromConditioned(models[k], conditioning[k], values[k]);
-    Eigen::MatrixXd c = Eigen::MatrixXd::Zero(n, n);
-    if (!base[k] && covariance.ok) c = covariance.BlockCovariance(blocks[k], n);
-    const Eigen::MatrixXd j =
-        calib::PlainFromConditionedJacobian(models[k], conditioning[k], values[k]);
-    e.covariance = j * c * j.transpose();
-    for (int i = 0; i < n; ++i) e.sigma.push_back(std::sqrt(std::max(0.0, e.covariance(i, i))));
-    const double corner_u[4] = {0.0, s.width_px - 1.0, 0.0, s.width_px - 1.0};
-    const double corner_v[4] = {0.0, 0.0, s.height_px - 1.0, s.height_px - 1.0};
-    calib::SubimageMapping estimated = s;
-    estimated.model = models[k];
-    estimated.params = e.params;
-    for (int i = 0; i < 4; ++i) {
-      CornerPrecision& corner = e.corners[i];
-      corner.uv = {corner_u[i], corner_v[i]};
-      corner.virtual_px = estimated.VirtualFromSub(corner.uv);
-      const Eigen::Vector2d uvc((corner_u[i] - conditioning[k].cu) / conditioning[k].scale,
-                                (corner_v[i] - conditioning[k].cv) / conditioning[k].scale);
-      const Eigen::MatrixXd g = VirtualJacobian(models[k], values[k], uvc);
-      const Eigen::Matrix2d cov_uv = g * c * g.transpose();
-      corner.sigma_U_px = std::sqrt(std::max(0.0, cov_uv(0, 0)));
-      corner.sigma_V_px = std::sqrt(std::max(0.0, cov_uv(1, 1)));
-      e.max_corner_sigma_px = std::max(e.max_corner_sigma_px, corner.sigma_px());
-    }
-    if (!base[k] && !covariance.ok) {
-      // No precision could be computed: say so (null in JSON), never report zero sigmas.
-      std::fill(e.sigma.begin(), e.sigma.end(), kUnknown);
-      for (CornerPrecision& corner : e.corners) corner.sigma_U_px = corner.sigma_V_px = kUnknown;
-      e.max_corner_sigma_px = kUnknown;
-    }
+  for (size_t k = 0; k < camera.subimages.size(); ++k) {
+    SubimageEstimate e = EstimateSubimage(camera.subimages[k], k, p, covariance);
     out.max_corner_sigma_px = std::max(out.max_corner_sigma_px, e.max_corner_sigma_px);
     out.subimages.push_back(std::move(e));
   }

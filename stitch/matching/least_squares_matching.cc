@@ -50,6 +50,74 @@ bool Sample(const GrayImage& b, double col, double row, double* value, double* g
   return true;
 }
 
+using Vector8d = Eigen::Matrix<double, 8, 1>;
+using Matrix8d = Eigen::Matrix<double, 8, 8>;
+
+// The template: the (2h + 1)^2 grey values of a round p_a, row by row.
+std::vector<double> TemplateAround(const GrayImage& a, const Eigen::Vector2i& p_a, int h) {
+  const int side = 2 * h + 1;
+  std::vector<double> tmpl(side * side);
+  for (int i = 0; i < side; ++i)
+    for (int j = 0; j < side; ++j) tmpl[i * side + j] = a(p_a.y() - h + i, p_a.x() - h + j);
+  return tmpl;
+}
+
+// One linearisation of the model a(x, y) = r0 + r1 b(t + A (x, y)) over the template: the normal
+// equations (lower triangle mirrored), v^T v and the resampled patch; false when a pixel's
+// bicubic support leaves b. Parameters: t_col, t_row, A00, A01, A10, A11, r0, r1.
+bool Linearise(const GrayImage& b,
+               const std::vector<double>& tmpl,
+               int h,
+               const Eigen::Vector2d& t,
+               const Eigen::Matrix2d& affine,
+               double r0,
+               double r1,
+               Matrix8d* normal,
+               Vector8d* rhs,
+               double* vtv,
+               std::vector<double>* fitted) {
+  const int side = 2 * h + 1;
+  normal->setZero();
+  *rhs = Vector8d::Zero();
+  *vtv = 0;
+  for (int i = 0; i < side; ++i) {
+    for (int j = 0; j < side; ++j) {
+      const double x = j - h, y = i - h;
+      const Eigen::Vector2d q = t + affine * Eigen::Vector2d(x, y);
+      double g, gc, gr;
+      if (!Sample(b, q.x(), q.y(), &g, &gc, &gr)) return false;
+      Vector8d jac;
+      jac << r1 * gc, r1 * gr, r1 * gc * x, r1 * gc * y, r1 * gr * x, r1 * gr * y, 1.0, g;
+      const double v = tmpl[i * side + j] - (r0 + r1 * g);
+      normal->selfadjointView<Eigen::Lower>().rankUpdate(jac);
+      *rhs += jac * v;
+      *vtv += v * v;
+      (*fitted)[i * side + j] = g;
+    }
+  }
+  normal->triangularView<Eigen::StrictlyUpper>() = normal->transpose();
+  return true;
+}
+
+// Correlation coefficient of the template with the resampled patch (0 where one is flat).
+double PatchCorrelation(const std::vector<double>& tmpl, const std::vector<double>& fitted) {
+  const int n = static_cast<int>(tmpl.size());
+  double ma = 0, mb = 0;
+  for (int k = 0; k < n; ++k) {
+    ma += tmpl[k];
+    mb += fitted[k];
+  }
+  ma /= n;
+  mb /= n;
+  double sab = 0, saa = 0, sbb = 0;
+  for (int k = 0; k < n; ++k) {
+    sab += (tmpl[k] - ma) * (fitted[k] - mb);
+    saa += (tmpl[k] - ma) * (tmpl[k] - ma);
+    sbb += (fitted[k] - mb) * (fitted[k] - mb);
+  }
+  return saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
+}
+
 }  // namespace
 
 void LsmOptions::Validate() const {
@@ -77,12 +145,8 @@ LsmResult MatchLeastSquares(const GrayImage& a,
   AEROCAL_CHECK(p_a.x() - h >= 0 && p_a.y() - h >= 0 && p_a.x() + h < a.cols() &&
                 p_a.y() + h < a.rows())
       << "template leaves image a at " << p_a.transpose();
-  using Vector8d = Eigen::Matrix<double, 8, 1>;
-  using Matrix8d = Eigen::Matrix<double, 8, 8>;
-  const int side = 2 * h + 1, n = side * side;
-  std::vector<double> tmpl(n);
-  for (int i = 0; i < side; ++i)
-    for (int j = 0; j < side; ++j) tmpl[i * side + j] = a(p_a.y() - h + i, p_a.x() - h + j);
+  const std::vector<double> tmpl = TemplateAround(a, p_a, h);
+  const int n = static_cast<int>(tmpl.size());
 
   // Parameters: t_col, t_row, A00, A01, A10, A11, r0, r1.
   Eigen::Vector2d t = t0;
@@ -90,32 +154,15 @@ LsmResult MatchLeastSquares(const GrayImage& a,
   double r0 = 0, r1 = 1;
   LsmResult result;
   Matrix8d normal;
+  Vector8d rhs;
   double vtv = 0;
   std::vector<double> fitted(n);
   bool converged = false;
   for (int iteration = 1; iteration <= options.max_iterations && !converged; ++iteration) {
-    normal.setZero();
-    Vector8d rhs = Vector8d::Zero();
-    vtv = 0;
-    for (int i = 0; i < side; ++i) {
-      for (int j = 0; j < side; ++j) {
-        const double x = j - h, y = i - h;
-        const Eigen::Vector2d q = t + affine * Eigen::Vector2d(x, y);
-        double g, gc, gr;
-        if (!Sample(b, q.x(), q.y(), &g, &gc, &gr)) {
-          result.status = LsmStatus::kOutside;
-          return result;
-        }
-        Vector8d jac;
-        jac << r1 * gc, r1 * gr, r1 * gc * x, r1 * gc * y, r1 * gr * x, r1 * gr * y, 1.0, g;
-        const double v = tmpl[i * side + j] - (r0 + r1 * g);
-        normal.selfadjointView<Eigen::Lower>().rankUpdate(jac);
-        rhs += jac * v;
-        vtv += v * v;
-        fitted[i * side + j] = g;
-      }
+    if (!Linearise(b, tmpl, h, t, affine, r0, r1, &normal, &rhs, &vtv, &fitted)) {
+      result.status = LsmStatus::kOutside;
+      return result;
     }
-    normal.triangularView<Eigen::StrictlyUpper>() = normal.transpose();
     const Eigen::LDLT<Matrix8d> ldlt(normal);
     if (ldlt.info() != Eigen::Success || !ldlt.isPositive()) return result;  // flat patch
     const Vector8d step = ldlt.solve(rhs);
@@ -143,20 +190,7 @@ LsmResult MatchLeastSquares(const GrayImage& a,
   result.offset = r0;
   if (!converged) return result;
   // Correlation of the template with the resampled patch at the solution's last linearisation.
-  double ma = 0, mb = 0;
-  for (int k = 0; k < n; ++k) {
-    ma += tmpl[k];
-    mb += fitted[k];
-  }
-  ma /= n;
-  mb /= n;
-  double sab = 0, saa = 0, sbb = 0;
-  for (int k = 0; k < n; ++k) {
-    sab += (tmpl[k] - ma) * (fitted[k] - mb);
-    saa += (tmpl[k] - ma) * (tmpl[k] - ma);
-    sbb += (fitted[k] - mb) * (fitted[k] - mb);
-  }
-  result.correlation = saa > 0 && sbb > 0 ? sab / std::sqrt(saa * sbb) : 0.0;
+  result.correlation = PatchCorrelation(tmpl, fitted);
   if (result.correlation < options.min_correlation) {
     result.status = LsmStatus::kLowCorrelation;
   } else if (result.SigmaMaxPx() > options.max_sigma_px) {

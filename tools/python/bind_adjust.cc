@@ -518,9 +518,8 @@ Eigen::MatrixXd Covariance(const Result& r, const std::vector<std::string>& name
   return triangulation::CovarianceOfNamed(*r.kept->adjustment.adjustment, r.result, names).matrix;
 }
 
-}  // namespace
-
-void BindAdjust(py::module_& m) {
+// Block: a project read from files or built from arrays, and its tables.
+void BindBlock(py::module_& m) {
   py::class_<Block>(m, "Block", R"doc(
 A block for aerial triangulation: cameras, exposures, ground points, image observations.
 
@@ -559,7 +558,9 @@ arrays (exposures, points, observations).)doc")
         for (const auto& [id, c] : b.project.cameras) ids.push_back(id);
         return ids;
       });
+}
 
+void BindCameraEstimate(py::module_& m) {
   py::class_<triangulation::CameraEstimate>(m, "CameraEstimate")
       .def_readonly("id", &triangulation::CameraEstimate::id)
       .def_property_readonly("model",
@@ -576,9 +577,12 @@ arrays (exposures, points, observations).)doc")
           "sigma",
           [](const triangulation::CameraEstimate& c) { return ParamDict(c, c.sigma, true); },
           "Standard deviations; None for fixed or unknown (never 0)");
+}
 
-  py::class_<Result>(m, "AdjustmentResult", "The result of adjust(): as `aerocal adjust` writes it")
-      .def_property_readonly("sigma0", [](const Result& r) { return r.result.sigma0; })
+// AdjustmentResult's statistics: sigma0, validity, findings, cameras, rig heads, RMSEs and the
+// interior correlation.
+void BindResultStatistics(py::class_<Result>& result) {
+  result.def_property_readonly("sigma0", [](const Result& r) { return r.result.sigma0; })
       .def_property_readonly("sigma0_px", [](const Result& r) { return r.result.sigma0_px; })
       .def_property_readonly("converged", [](const Result& r) { return r.result.converged(); })
       .def_property_readonly("valid", [](const Result& r) { return r.result.valid; })
@@ -616,7 +620,12 @@ arrays (exposures, points, observations).)doc")
           [](const Result& r) { return Eigen::MatrixXd(r.result.interior_correlation); },
           "Correlation matrix of the interior parameters (rows: correlation_names)")
       .def_property_readonly("correlation_names",
-                             [](const Result& r) { return r.result.interior_correlation_names; })
+                             [](const Result& r) { return r.result.interior_correlation_names; });
+}
+
+// AdjustmentResult's joint covariance, its point, exposure and residual tables and its JSON.
+void BindResultTables(py::class_<Result>& result) {
+  result
       .def("covariance",
            &Covariance,
            py::arg("names"),
@@ -652,6 +661,17 @@ arrays (exposures, points, observations).)doc")
           "to_json",
           [](const Result& r) { return r.json; },
           "The result file's text, identical to `aerocal adjust --out`");
+}
+
+}  // namespace
+
+void BindAdjust(py::module_& m) {
+  BindBlock(m);
+  BindCameraEstimate(m);
+  py::class_<Result> result(
+      m, "AdjustmentResult", "The result of adjust(): as `aerocal adjust` writes it");
+  BindResultStatistics(result);
+  BindResultTables(result);
 
   m.def("adjust",
         &Adjust,

@@ -163,17 +163,9 @@ py::tuple ConvertCamera(const CameraFile& c,
   return py::make_tuple(converted.file, ResidualDict(converted.result));
 }
 
-}  // namespace
-
-void BindCamera(py::module_& m) {
-  py::class_<CameraFile>(m, "Camera", R"doc(
-A camera in any registered model, as a camera file holds it.
-
-Read one with Camera.read(path, format="auto"); `format` is any name of formats() ("auto" detects
-it from the content). Parameters are a dict by the model's names in its units (camera.units);
-camera.sigma holds the file's standard deviations (None where it gives none). Pixels are
-(col, row) with the top-left pixel centre at (0, 0); rays are normalised (x / c, y / c) in the
-photo frame (x right, y up), the camera looking along -z.)doc")
+// Camera: reading and writing, the parameters and the frame.
+void BindCameraFile(py::class_<CameraFile>& camera) {
+  camera
       .def_static(
           "read",
           &ReadCamera,
@@ -219,7 +211,12 @@ photo frame (x right, y up), the camera looking along -z.)doc")
           "notes",
           [](const CameraFile& c) { return c.notes; },
           "What the reader assumed or left out")
-      .def("set_param", &SetParam, py::arg("name"), py::arg("value"))
+      .def("set_param", &SetParam, py::arg("name"), py::arg("value"));
+}
+
+// Camera: pixels to rays and back.
+void BindCameraProjection(py::class_<CameraFile>& camera) {
+  camera
       .def("image_to_ray",
            &ImageToRay,
            py::arg("pixels"),
@@ -235,6 +232,10 @@ photo frame (x right, y up), the camera looking along -z.)doc")
                std::to_string(c.camera.frame.width_px) + "x" +
                std::to_string(c.camera.frame.height_px) + ">";
       });
+}
+
+// The registries: conversion between models, the file formats and the models.
+void BindCameraRegistry(py::module_& m) {
   m.def("convert_camera",
         &ConvertCamera,
         py::arg("camera"),
@@ -261,6 +262,22 @@ photo frame (x right, y up), the camera looking along -z.)doc")
         return names;
       },
       "Names of the registered camera models");
+}
+
+}  // namespace
+
+void BindCamera(py::module_& m) {
+  py::class_<CameraFile> camera(m, "Camera", R"doc(
+A camera in any registered model, as a camera file holds it.
+
+Read one with Camera.read(path, format="auto"); `format` is any name of formats() ("auto" detects
+it from the content). Parameters are a dict by the model's names in its units (camera.units);
+camera.sigma holds the file's standard deviations (None where it gives none). Pixels are
+(col, row) with the top-left pixel centre at (0, 0); rays are normalised (x / c, y / c) in the
+photo frame (x right, y up), the camera looking along -z.)doc");
+  BindCameraFile(camera);
+  BindCameraProjection(camera);
+  BindCameraRegistry(m);
 }
 
 }  // namespace aerocal::python

@@ -135,9 +135,32 @@ py::object RigErrorAnalysis(const tools::RigErrorAnalysisRequest& request) {
   return JsonToPython(text);
 }
 
-}  // namespace
+// rig_error_analysis(...): the keywords as the command's request.
+py::object RigErrorAnalysisOf(const std::string& camera,
+                              const std::string& limits,
+                              const std::string& target,
+                              const std::string& virtual_px,
+                              int grid,
+                              double height_m,
+                              int samples,
+                              std::uint64_t seed,
+                              double relief_m) {
+  tools::RigErrorAnalysisRequest request;
+  request.camera = camera;
+  request.limits = limits;
+  request.target = target;
+  request.virtual_px = virtual_px;
+  request.grid = grid;
+  request.height_m = height_m;
+  request.samples = samples;
+  request.seed = seed;
+  request.relief_m = relief_m;
+  return RigErrorAnalysis(request);
+}
 
-void BindRig(py::module_& m) {
+// RigStitchResult: validity, findings, sigma0, the per-exposure and snooping sections, the
+// printed text, the JSON and the stitched images.
+void BindRigStitchResult(py::module_& m) {
   py::class_<RigStitchResult>(
       m, "RigStitchResult", "The result of rig_stitch(): as `aerocal rig stitch` writes it")
       .def_property_readonly(
@@ -182,6 +205,12 @@ void BindRig(py::module_& m) {
            "valid_pixels, warnings). images: the folder of the head images <image>_<head>.tif "
            "(default: the one given to rig_stitch); balance False is --no-balance. The GIL is "
            "released while stitching.");
+}
+
+}  // namespace
+
+void BindRig(py::module_& m) {
+  BindRigStitchResult(m);
   m.def("rig_design",
         &RigDesign,
         py::arg("camera"),
@@ -191,43 +220,22 @@ void BindRig(py::module_& m) {
         "writes them, as a dict: GSD change ratios of each head against the closed form, the "
         "virtual format needed, covered area, effective format, overlap zones, standard tie "
         "positions (height_m 0: the rig file's virtual.height_m).");
-  m.def(
-      "rig_error_analysis",
-      [](const std::string& camera,
-         const std::string& limits,
-         const std::string& target,
-         const std::string& virtual_px,
-         int grid,
-         double height_m,
-         int samples,
-         std::uint64_t seed,
-         double relief_m) {
-        tools::RigErrorAnalysisRequest request;
-        request.camera = camera;
-        request.limits = limits;
-        request.target = target;
-        request.virtual_px = virtual_px;
-        request.grid = grid;
-        request.height_m = height_m;
-        request.samples = samples;
-        request.seed = seed;
-        request.relief_m = relief_m;
-        return RigErrorAnalysis(request);
-      },
-      py::arg("camera"),
-      py::arg("limits"),
-      py::arg("target") = "",
-      py::arg("virtual") = "",
-      py::arg("grid") = 0,
-      py::arg("height_m") = 0.0,
-      py::arg("samples") = 100000,
-      py::arg("seed") = 1,
-      py::arg("relief_m") = 100.0,
-      "The conversion error analysis of a rig's virtual image as `aerocal rig error-analysis "
-      "--camera CAMERA --limits LIMITS --out F` writes it, as a dict (without the names of the "
-      "command's CSV and PNG files): target 'HEAD:COL,ROW', virtual 'COL,ROW' or an N x N grid; "
-      "maximum error, linear propagation and Monte-Carlo (samples, seed). The GIL is released "
-      "while it runs.");
+  m.def("rig_error_analysis",
+        &RigErrorAnalysisOf,
+        py::arg("camera"),
+        py::arg("limits"),
+        py::arg("target") = "",
+        py::arg("virtual") = "",
+        py::arg("grid") = 0,
+        py::arg("height_m") = 0.0,
+        py::arg("samples") = 100000,
+        py::arg("seed") = 1,
+        py::arg("relief_m") = 100.0,
+        "The conversion error analysis of a rig's virtual image as `aerocal rig error-analysis "
+        "--camera CAMERA --limits LIMITS --out F` writes it, as a dict (without the names of the "
+        "command's CSV and PNG files): target 'HEAD:COL,ROW', virtual 'COL,ROW' or an N x N grid; "
+        "maximum error, linear propagation and Monte-Carlo (samples, seed). The GIL is released "
+        "while it runs.");
   m.def("rig_stitch",
         &RigStitch,
         py::arg("camera"),

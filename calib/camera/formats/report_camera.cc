@@ -104,21 +104,24 @@ double AspectAsB1ResidualPx(const ModelCamera& ours, double s) {
   return worst;
 }
 
-CameraFile ReadReportCamera(const std::string& path,
-                            const std::vector<std::string>& lines,
-                            const CameraReadOptions& options,
-                            const std::string& tool) {
-  const auto cameras = ReportCameras(path, lines);
+namespace {
+
+/// The camera block named by options.camera_id, or the only one with values; its name in *name.
+const ReportBlock& ChooseReportCamera(
+    const std::string& path,
+    const std::vector<std::pair<std::string, ReportBlock>>& cameras,
+    const CameraReadOptions& options,
+    const std::string& tool,
+    std::string* name) {
   std::string ids;
   const ReportBlock* found = nullptr;
-  std::string name;
   int with_values = 0;
   for (const auto& c : cameras) {
     if (c.second.empty()) continue;  // a camera listed without parameters
     ++with_values;
     ids += (ids.empty() ? "" : ", ") + c.first;
     if (c.first == options.camera_id || options.camera_id.empty())
-      found = &c.second, name = c.first;
+      found = &c.second, *name = c.first;
   }
   if (!found || (options.camera_id.empty() && with_values > 1))
     ThrowInputError(
@@ -128,36 +131,118 @@ CameraFile ReadReportCamera(const std::string& path,
         : options.camera_id.empty() ? "holds " + std::to_string(with_values) +
                                           " cameras: name one with --camera (" + ids + ")"
                                     : "no camera " + options.camera_id + " (cameras: " + ids + ")");
-  // The entry under either tool's name; `required` false: absent is 0 (a term the report's model
-  // does not have).
+  return *found;
+}
+
+/// The entry under either tool's name; `required` false: absent is 0 (a term the report's model
+/// does not have).
+ReportEntry ReportValue(const std::string& path,
+                        const std::string& name,
+                        const ReportBlock& block,
+                        std::initializer_list<const char*> titles,
+                        bool required) {
+  for (const char* t : titles)
+    if (const auto it = block.find(t); it != block.end() && it->second.line != 0) return it->second;
+  if (required)
+    ThrowInputError({path, 1}, name + ": the report has no '" + *titles.begin() + "' value");
+  return ReportEntry{};
+}
+
+/// Image width / height as printed; 0 when not printed (then --width / --height).
+int ReportInteger(const std::string& path, const ReportEntry& e, const char* what) {
+  if (e.line == 0) return 0;
+  if (!(e.value >= 1 && e.value <= 1e6) || e.value != std::floor(e.value))
+    ThrowInputError({path, e.line}, std::string(what) + " must be a positive integer");
+  return static_cast<int>(e.value);
+}
+
+/// The report's terms other than the distortion, under either tool's name.
+struct ReportTerms {
+  ReportEntry c, px, py, fh, iw, ih, as;
+};
+
+/// Reads the terms (the first missing required one is the error) and refuses the terms that are
+/// not modelled: skew and the aspect-ratio form (sk, B1, B2) must be 0.
+ReportTerms ReadReportTerms(const std::string& path,
+                            const std::string& name,
+                            const ReportBlock& block,
+                            const std::string& tool) {
   const auto get = [&](std::initializer_list<const char*> titles, bool required) {
-    for (const char* t : titles)
-      if (const auto it = found->find(t); it != found->end() && it->second.line != 0)
-        return it->second;
-    if (required)
-      ThrowInputError({path, 1}, name + ": the report has no '" + *titles.begin() + "' value");
-    return ReportEntry{};
+    return ReportValue(path, name, block, titles, required);
   };
-  const ReportEntry c = get({"Camera Constant", "Focal Length"}, true),
-                    px = get({"px", "Xp"}, true), py = get({"py", "Yp"}, true),
-                    fh = get({"Format height", "Fh"}, true), iw = get({"Image width", "Iw"}, false),
-                    ih = get({"Image height", "Ih"}, false), as = get({"as"}, false),
-                    sk = get({"sk"}, false), b1 = get({"B1"}, false), b2 = get({"B2"}, false);
+  ReportTerms t;
+  t.c = get({"Camera Constant", "Focal Length"}, true);
+  t.px = get({"px", "Xp"}, true);
+  t.py = get({"py", "Yp"}, true);
+  t.fh = get({"Format height", "Fh"}, true);
+  t.iw = get({"Image width", "Iw"}, false);
+  t.ih = get({"Image height", "Ih"}, false);
+  t.as = get({"as"}, false);
+  const ReportEntry sk = get({"sk"}, false), b1 = get({"B1"}, false), b2 = get({"B2"}, false);
   for (const ReportEntry* e : {&sk, &b1, &b2})
     if (e->value != 0)
       ThrowInputError({path, e->line},
                       tool + " term = " + FormatNumber(e->value) +
                           " (skew / aspect-ratio form) is not modelled");
+  return t;
+}
+
+/// The report's interior values in the 10-parameter model: c, the principal point (mm from the
+/// upper-left corner, y down, to the centre-based photo frame; x over `x_scale`), B1 = s - 1 and
+/// K1-K3, P1, P2; the deviations as a diagonal covariance.
+void SetReportParameters(const std::string& path,
+                         const std::string& name,
+                         const ReportBlock& block,
+                         const ReportTerms& t,
+                         double pixel,
+                         double x_scale,
+                         double s,
+                         CameraFile* file) {
+  const ReportEntry &c = t.c, &px = t.px, &py = t.py, &as = t.as;
+  const int width = file->camera.frame.width_px, height = file->camera.frame.height_px;
+  std::vector<double>& q = file->camera.params;
+  q.assign(Model::kNumParams, 0.0);
+  file->camera.model = Model::kId;
+  q[Model::kC] = c.value;
+  q[Model::kX0] = px.value / x_scale - width * pixel / 2;
+  q[Model::kY0] = height * pixel / 2 - py.value;
+  q[Model::kB1] = s - 1.0;
+  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(Model::kNumParams, Model::kNumParams);
+  const char* terms[] = {"K1", "K2", "K3", "P1", "P2"};
+  const int index[] = {Model::kK1, Model::kK2, Model::kK3, Model::kP1, Model::kP2};
+  for (int k = 0; k < 5; ++k) {
+    const ReportEntry e = ReportValue(path, name, block, {terms[k]}, k < 2);
+    q[index[k]] = e.value;
+    covariance(index[k], index[k]) = e.deviation * e.deviation;
+  }
+  covariance(Model::kC, Model::kC) = c.deviation * c.deviation;
+  covariance(Model::kX0, Model::kX0) = px.deviation * px.deviation / (s * s);
+  covariance(Model::kY0, Model::kY0) = py.deviation * py.deviation;
+  covariance(Model::kB1, Model::kB1) = as.deviation * as.deviation;
+  if (covariance.diagonal().maxCoeff() > 0) {
+    file->covariance = covariance;
+    file->notes.push_back(
+        "the report's deviations as a diagonal covariance (correlations are "
+        "printed only over 95 %: not read)");
+  }
+}
+
+}  // namespace
+
+CameraFile ReadReportCamera(const std::string& path,
+                            const std::vector<std::string>& lines,
+                            const CameraReadOptions& options,
+                            const std::string& tool) {
+  const auto cameras = ReportCameras(path, lines);
+  std::string name;
+  const ReportBlock& found = ChooseReportCamera(path, cameras, options, tool, &name);
+  const ReportTerms t = ReadReportTerms(path, name, found, tool);
+  const ReportEntry &fh = t.fh, &as = t.as;
   CameraFile file;
   file.name = name;
   file.chosen_by_camera_id = !options.camera_id.empty();
-  const auto integer = [&](const ReportEntry& e, const char* what) {
-    if (e.line == 0) return 0;  // not printed: --width / --height
-    if (!(e.value >= 1 && e.value <= 1e6) || e.value != std::floor(e.value))
-      ThrowInputError({path, e.line}, std::string(what) + " must be a positive integer");
-    return static_cast<int>(e.value);
-  };
-  const int file_width = integer(iw, "Image width"), file_height = integer(ih, "Image height");
+  const int file_width = ReportInteger(path, t.iw, "Image width"),
+            file_height = ReportInteger(path, t.ih, "Image height");
   if (!(fh.value > 0)) ThrowInputError({path, fh.line}, "Format height must be > 0 mm");
   ResolveFormat(&file, options, {path, fh.line}, file_width, file_height, 0.0);
   const int width = file.camera.frame.width_px, height = file.camera.frame.height_px;
@@ -167,7 +252,7 @@ CameraFile ReadReportCamera(const std::string& path,
   // (format width against the square pixel) is not modelled, as its Bundle Soln reader does: the
   // principal point is kept in pixels (ppx over PhotoModeler's mm per pixel along x).
   const double s = 1.0 + as.value;
-  const ReportEntry fw = get({"Format width", "Fw"}, false);
+  const ReportEntry fw = ReportValue(path, name, found, {"Format width", "Fw"}, false);
   const double x_scale = as.line == 0 && fw.line != 0 ? fw.value / (width * pixel) : s;
   if (!(x_scale > 0)) ThrowInputError({path, fw.line}, "Format width must be > 0 mm");
   if (as.line == 0 && std::abs(x_scale - 1.0) > 1e-6)
@@ -176,31 +261,7 @@ CameraFile ReadReportCamera(const std::string& path,
         " mm at the square pixel of the format "
         "height: x scale " +
         FormatNumber(x_scale - 1.0) + " not modelled (the principal point is kept in pixels)");
-  std::vector<double>& q = file.camera.params;
-  q.assign(Model::kNumParams, 0.0);
-  file.camera.model = Model::kId;
-  q[Model::kC] = c.value;
-  q[Model::kX0] = px.value / x_scale - width * pixel / 2;
-  q[Model::kY0] = height * pixel / 2 - py.value;
-  q[Model::kB1] = s - 1.0;
-  Eigen::MatrixXd covariance = Eigen::MatrixXd::Zero(Model::kNumParams, Model::kNumParams);
-  const char* terms[] = {"K1", "K2", "K3", "P1", "P2"};
-  const int index[] = {Model::kK1, Model::kK2, Model::kK3, Model::kP1, Model::kP2};
-  for (int k = 0; k < 5; ++k) {
-    const ReportEntry e = get({terms[k]}, k < 2);
-    q[index[k]] = e.value;
-    covariance(index[k], index[k]) = e.deviation * e.deviation;
-  }
-  covariance(Model::kC, Model::kC) = c.deviation * c.deviation;
-  covariance(Model::kX0, Model::kX0) = px.deviation * px.deviation / (s * s);
-  covariance(Model::kY0, Model::kY0) = py.deviation * py.deviation;
-  covariance(Model::kB1, Model::kB1) = as.deviation * as.deviation;
-  if (covariance.diagonal().maxCoeff() > 0) {
-    file.covariance = covariance;
-    file.notes.push_back(
-        "the report's deviations as a diagonal covariance (correlations are "
-        "printed only over 95 %: not read)");
-  }
+  SetReportParameters(path, name, found, t, pixel, x_scale, s, &file);
   if (s != 1.0)
     file.notes.push_back(tool + " as = " + FormatNumber(as.value) + " read as B1: not exact, " +
                          FormatNumber(AspectAsB1ResidualPx(file.camera, s), 3) +
