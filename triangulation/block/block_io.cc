@@ -304,6 +304,158 @@ std::vector<std::pair<std::string, std::string>> ProjectFiles(const Project& pro
   return files;
 }
 
+namespace {
+
+// The `cameras:` map (id: file): a camera file, or a rig file whose reference head is the camera.
+void ReadProjectCameras(const YAML::Node& cameras,
+                        const std::string& path,
+                        const std::string& dir,
+                        Project* project) {
+  if (!cameras.IsMap()) ThrowInputError(WhereIs(cameras, path), "cameras must be a map id: file");
+  if (cameras.size() == 0) ThrowInputError(WhereIs(cameras, path), "no cameras");
+  for (const auto& entry : cameras) {
+    const std::string id = entry.first.Scalar();
+    const std::string file = ResolvePath(dir, YamlString(entry.second, path, "camera file"));
+    project->camera_files[id] = file;
+    try {
+      const YAML::Node camera = LoadYamlFile(file);
+      if (camera.IsMap() && camera["rig"]) {
+        // A rig camera file: the rig, and its reference head as the camera of that id.
+        const calib::Rig rig = calib::ParseRig(camera, file);
+        project->cameras[id] = rig.heads[rig.ReferenceIndex()].camera;
+        project->rigs[id] = rig;
+      } else {
+        project->cameras[id] = calib::ParseCamera(camera, file, calib::CameraModels::kAny);
+      }
+    } catch (const InputError& e) {
+      throw InputError(e.what() + calib::ForeignCameraHint(file));  // another tool's file
+    }
+  }
+}
+
+// `frame: {crs: ...}`: a CRS through PROJ (triangulation/georef/crs.h), optionally per file,
+// with heights.
+void ReadCrsFrame(const YAML::Node& f,
+                  const std::string& path,
+                  const std::string& dir,
+                  FrameSpec* frame) {
+  RejectUnknownKeys(
+      f, {"crs", "vertical", "geoid_grid", "points_crs", "exposures_crs", "origin"}, path);
+  FrameSpec& s = *frame;
+  s.kind = FrameSpec::Kind::kCrs;
+  s.crs = YamlString(f["crs"], path, "frame: crs");
+  if (f["vertical"]) s.vertical = YamlString(f["vertical"], path, "frame: vertical");
+  if (f["geoid_grid"])
+    s.geoid_grid = ResolvePath(dir, YamlString(f["geoid_grid"], path, "frame: geoid_grid"));
+  if (f["points_crs"]) s.points_crs = YamlString(f["points_crs"], path, "frame: points_crs");
+  if (f["exposures_crs"])
+    s.exposures_crs = YamlString(f["exposures_crs"], path, "frame: exposures_crs");
+  if (f["origin"]) {
+    const YAML::Node& origin = f["origin"];
+    if (!origin.IsMap() || !origin["lat"] || !origin["lon"])
+      ThrowInputError(WhereIs(origin, path), "frame: origin needs {lat: DEG, lon: DEG[, h: M]}");
+    RejectUnknownKeys(origin, {"lat", "lon", "h"}, path);
+    s.lat_deg = YamlBounded(origin["lat"], path, "frame: origin lat", -90, 90);
+    s.lon_deg = YamlBounded(origin["lon"], path, "frame: origin lon", -180, 360);
+    s.h_m = origin["h"] ? YamlBounded(origin["h"], path, "frame: origin h", -1e5, 1e5) : 0.0;
+    s.has_origin = true;
+  }
+  s.description = "crs " + s.crs;
+}
+
+// `frame: {local: {lat, lon, h}}`: the local tangent plane at that origin.
+void ReadLocalFrame(const YAML::Node& local, const std::string& path, FrameSpec* frame) {
+  if (!local.IsMap())
+    ThrowInputError(WhereIs(local, path), "frame: local needs {lat: DEG, lon: DEG[, h: M]}");
+  RejectUnknownKeys(local, {"lat", "lon", "h"}, path);
+  for (const char* key : {"lat", "lon"})
+    if (!local[key])
+      ThrowInputError(WhereIs(local, path), std::string("frame: local needs '") + key + "' (deg)");
+  frame->kind = FrameSpec::Kind::kLocal;
+  frame->lat_deg = YamlBounded(local["lat"], path, "frame: local lat", -90, 90);
+  frame->lon_deg = YamlBounded(local["lon"], path, "frame: local lon", -180, 360);
+  frame->h_m = local["h"] ? YamlBounded(local["h"], path, "frame: local h", -1e5, 1e5) : 0.0;
+  frame->description = "local tangent plane";
+}
+
+// Geodetic input without a stated origin: the local tangent plane about the block's centre
+// (mean of the surveyed points, else of the exposure centres), so that no curvature is lost.
+void SetGeodeticFrameOrigin(const SourceRef& where, Project* project) {
+  FrameSpec& frame = project->frame;
+  frame.kind = FrameSpec::Kind::kGeodeticToLocal;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (const auto& p : project->points)
+    if (p.xyz_m && p.role != PointRole::kTie) {
+      sum += *p.xyz_m;
+      ++n;
+    }
+  if (n == 0)
+    for (const auto& e : project->exposures) {
+      sum += e.center_m;
+      ++n;
+    }
+  if (n == 0) ThrowInputError(where, "frame: geodetic needs surveyed points or exposures");
+  const Eigen::Vector3d origin = sum / n;  // X = longitude, Y = latitude (deg), Z = height (m)
+  if (!(std::abs(origin.y()) <= 90 && std::abs(origin.x()) <= 540 && std::abs(origin.z()) <= 1e5))
+    ThrowInputError(where,
+                    "frame: geodetic, but the block's mean X, Y, Z (" + FormatNumber(origin.x()) +
+                        ", " + FormatNumber(origin.y()) + ", " + FormatNumber(origin.z()) +
+                        ") is no longitude/latitude/height: metre coordinates need "
+                        "frame: {projected: ...}");
+  frame.lon_deg = origin.x();
+  frame.lat_deg = origin.y();
+  frame.h_m = origin.z();
+  frame.description = "local tangent plane about the block centre";
+}
+
+// The `frame:` entry (after the points and exposures: a geodetic frame is centred on them).
+void ReadProjectFrame(const YAML::Node& f,
+                      const std::string& path,
+                      const std::string& dir,
+                      Project* project) {
+  const SourceRef where = WhereIs(f, path);
+  project->frame.source = where.ToString();
+  if (f.IsMap() && f["crs"]) {
+    ReadCrsFrame(f, path, dir, &project->frame);
+  } else {
+    if (!f.IsMap() || f.size() != 1)
+      ThrowInputError(where,
+                      "frame must be one of {crs: CRS, ...}, {local: {lat, lon, h}}, "
+                      "{utm: ZONE}, {projected: TEXT}, {geodetic: ...}");
+    RejectUnknownKeys(f, {"local", "utm", "projected", "geodetic"}, path);
+  }
+  if (f["local"]) {
+    ReadLocalFrame(f["local"], path, &project->frame);
+  } else if (f["utm"]) {
+    project->frame.kind = FrameSpec::Kind::kUtm;
+    project->frame.utm_zone = YamlString(f["utm"], path, "frame: utm zone");
+    project->frame.description = "UTM " + project->frame.utm_zone;
+  } else if (f["projected"]) {
+    project->frame.description = YamlString(f["projected"], path, "frame: projected");
+  } else if (f["geodetic"]) {
+    SetGeodeticFrameOrigin(where, project);
+  }
+}
+
+// What was read (--verbose): a wrong file named in the project shows here first.
+void LogProjectRead(const Project& project) {
+  LogInfo(
+      StringPrintf("read %s: %zu camera(s), %zu exposures (%s), %zu points (%s), "
+                   "%zu image observations (%s), frame: %s",
+                   project.path.c_str(),
+                   project.cameras.size(),
+                   project.exposures.size(),
+                   project.exposures_file.c_str(),
+                   project.points.size(),
+                   project.points_file.c_str(),
+                   project.observations.size(),
+                   project.observations_file.c_str(),
+                   project.frame.description.c_str()));
+}
+
+}  // namespace
+
 Project ReadProject(const std::string& path_in, double default_sigma_px) {
   std::string path = path_in;
   std::error_code ec;  // the error_code form: a symbolic-link loop is then reported by the reader
@@ -319,27 +471,7 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
   project.path = path;
   for (const char* key : {"cameras", "exposures", "observations", "points"})
     if (!root[key]) ThrowInputError({path, 0}, std::string("missing '") + key + "'");
-  if (!root["cameras"].IsMap())
-    ThrowInputError(WhereIs(root["cameras"], path), "cameras must be a map id: file");
-  if (root["cameras"].size() == 0) ThrowInputError(WhereIs(root["cameras"], path), "no cameras");
-  for (const auto& entry : root["cameras"]) {
-    const std::string id = entry.first.Scalar();
-    const std::string file = ResolvePath(dir, YamlString(entry.second, path, "camera file"));
-    project.camera_files[id] = file;
-    try {
-      const YAML::Node camera = LoadYamlFile(file);
-      if (camera.IsMap() && camera["rig"]) {
-        // A rig camera file: the rig, and its reference head as the camera of that id.
-        const calib::Rig rig = calib::ParseRig(camera, file);
-        project.cameras[id] = rig.heads[rig.ReferenceIndex()].camera;
-        project.rigs[id] = rig;
-      } else {
-        project.cameras[id] = calib::ParseCamera(camera, file, calib::CameraModels::kAny);
-      }
-    } catch (const InputError& e) {
-      throw InputError(e.what() + calib::ForeignCameraHint(file));  // another tool's file
-    }
-  }
+  ReadProjectCameras(root["cameras"], path, dir, &project);
   project.exposures_file = ResolvePath(dir, YamlString(root["exposures"], path, "exposures"));
   project.observations_file =
       ResolvePath(dir, YamlString(root["observations"], path, "observations"));
@@ -352,110 +484,10 @@ Project ReadProject(const std::string& path_in, double default_sigma_px) {
     if (e.camera.empty() && project.cameras.size() == 1) e.camera = project.cameras.begin()->first;
   project.observations = ReadObservations(project.observations_file, default_sigma_px);
   project.points = ReadPoints(project.points_file);
-  if (root["frame"]) {
-    const YAML::Node& f = root["frame"];
-    const SourceRef where = WhereIs(f, path);
-    project.frame.source = where.ToString();
-    if (f.IsMap() && f["crs"]) {
-      // A CRS through PROJ (triangulation/georef/crs.h), optionally per file, with heights.
-      RejectUnknownKeys(
-          f, {"crs", "vertical", "geoid_grid", "points_crs", "exposures_crs", "origin"}, path);
-      FrameSpec& s = project.frame;
-      s.kind = FrameSpec::Kind::kCrs;
-      s.crs = YamlString(f["crs"], path, "frame: crs");
-      if (f["vertical"]) s.vertical = YamlString(f["vertical"], path, "frame: vertical");
-      if (f["geoid_grid"])
-        s.geoid_grid = ResolvePath(dir, YamlString(f["geoid_grid"], path, "frame: geoid_grid"));
-      if (f["points_crs"]) s.points_crs = YamlString(f["points_crs"], path, "frame: points_crs");
-      if (f["exposures_crs"])
-        s.exposures_crs = YamlString(f["exposures_crs"], path, "frame: exposures_crs");
-      if (f["origin"]) {
-        const YAML::Node& origin = f["origin"];
-        if (!origin.IsMap() || !origin["lat"] || !origin["lon"])
-          ThrowInputError(WhereIs(origin, path),
-                          "frame: origin needs {lat: DEG, lon: DEG[, h: M]}");
-        RejectUnknownKeys(origin, {"lat", "lon", "h"}, path);
-        s.lat_deg = YamlBounded(origin["lat"], path, "frame: origin lat", -90, 90);
-        s.lon_deg = YamlBounded(origin["lon"], path, "frame: origin lon", -180, 360);
-        s.h_m = origin["h"] ? YamlBounded(origin["h"], path, "frame: origin h", -1e5, 1e5) : 0.0;
-        s.has_origin = true;
-      }
-      s.description = "crs " + s.crs;
-    } else {
-      if (!f.IsMap() || f.size() != 1)
-        ThrowInputError(where,
-                        "frame must be one of {crs: CRS, ...}, {local: {lat, lon, h}}, "
-                        "{utm: ZONE}, {projected: TEXT}, {geodetic: ...}");
-      RejectUnknownKeys(f, {"local", "utm", "projected", "geodetic"}, path);
-    }
-    if (f["local"]) {
-      const YAML::Node& local = f["local"];
-      if (!local.IsMap())
-        ThrowInputError(WhereIs(local, path), "frame: local needs {lat: DEG, lon: DEG[, h: M]}");
-      RejectUnknownKeys(local, {"lat", "lon", "h"}, path);
-      for (const char* key : {"lat", "lon"})
-        if (!local[key])
-          ThrowInputError(WhereIs(local, path),
-                          std::string("frame: local needs '") + key + "' (deg)");
-      project.frame.kind = FrameSpec::Kind::kLocal;
-      project.frame.lat_deg = YamlBounded(local["lat"], path, "frame: local lat", -90, 90);
-      project.frame.lon_deg = YamlBounded(local["lon"], path, "frame: local lon", -180, 360);
-      project.frame.h_m =
-          local["h"] ? YamlBounded(local["h"], path, "frame: local h", -1e5, 1e5) : 0.0;
-      project.frame.description = "local tangent plane";
-    } else if (f["utm"]) {
-      project.frame.kind = FrameSpec::Kind::kUtm;
-      project.frame.utm_zone = YamlString(f["utm"], path, "frame: utm zone");
-      project.frame.description = "UTM " + project.frame.utm_zone;
-    } else if (f["projected"]) {
-      project.frame.description = YamlString(f["projected"], path, "frame: projected");
-    } else if (f["geodetic"]) {
-      // Geodetic input without a stated origin: the local tangent plane about the block's centre
-      // (mean of the surveyed points, else of the exposure centres), so that no curvature is lost.
-      project.frame.kind = FrameSpec::Kind::kGeodeticToLocal;
-      Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-      int n = 0;
-      for (const auto& p : project.points)
-        if (p.xyz_m && p.role != PointRole::kTie) {
-          sum += *p.xyz_m;
-          ++n;
-        }
-      if (n == 0)
-        for (const auto& e : project.exposures) {
-          sum += e.center_m;
-          ++n;
-        }
-      if (n == 0) ThrowInputError(where, "frame: geodetic needs surveyed points or exposures");
-      const Eigen::Vector3d origin = sum / n;  // X = longitude, Y = latitude (deg), Z = height (m)
-      if (!(std::abs(origin.y()) <= 90 && std::abs(origin.x()) <= 540 &&
-            std::abs(origin.z()) <= 1e5))
-        ThrowInputError(where,
-                        "frame: geodetic, but the block's mean X, Y, Z (" +
-                            FormatNumber(origin.x()) + ", " + FormatNumber(origin.y()) + ", " +
-                            FormatNumber(origin.z()) +
-                            ") is no longitude/latitude/height: metre coordinates need "
-                            "frame: {projected: ...}");
-      project.frame.lon_deg = origin.x();
-      project.frame.lat_deg = origin.y();
-      project.frame.h_m = origin.z();
-      project.frame.description = "local tangent plane about the block centre";
-    }
-  }
+  if (root["frame"]) ReadProjectFrame(root["frame"], path, dir, &project);
   if (root["platform"]) project.platform = ReadPlatform(root["platform"], path);
   ValidateProject(project);
-  // What was read (--verbose): a wrong file named in the project shows here first.
-  LogInfo(
-      StringPrintf("read %s: %zu camera(s), %zu exposures (%s), %zu points (%s), "
-                   "%zu image observations (%s), frame: %s",
-                   path.c_str(),
-                   project.cameras.size(),
-                   project.exposures.size(),
-                   project.exposures_file.c_str(),
-                   project.points.size(),
-                   project.points_file.c_str(),
-                   project.observations.size(),
-                   project.observations_file.c_str(),
-                   project.frame.description.c_str()));
+  LogProjectRead(project);
   return project;
 }
 

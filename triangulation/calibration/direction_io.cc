@@ -52,10 +52,7 @@ std::pair<std::string, Eigen::Vector2d> RowSetting(const CsvTable& table,
 using CameraOfRow =
     std::function<const calib::Camera&(const CsvTable&, const CsvTable::Row&, std::string* unit)>;
 
-DirectionData ReadRows(const CsvTable& table,
-                       const std::string& path,
-                       const CameraOfRow& camera_of_row,
-                       double default_sigma_px) {
+void CheckDirectionColumns(const CsvTable& table, const std::string& path) {
   table.RequireColumns({"target", "col", "row"});
   table.RejectUnknownColumns({"target",
                               "col",
@@ -73,6 +70,81 @@ DirectionData ReadRows(const CsvTable& table,
     ThrowInputError({path, 0}, "azimuth_deg and elevation_deg go together (one column is missing)");
   if (table.rows().empty())
     ThrowInputError({path, 0}, "no rows (a directions file needs observations)");
+}
+
+// One row's observation: target, pixel in `camera`'s frame, sigmas and the instrument setting.
+DirectionObservation ReadDirectionObservation(const CsvTable& table,
+                                              const CsvTable::Row& row,
+                                              const calib::Camera& camera,
+                                              double default_sigma_px,
+                                              Eigen::Vector2d* turn_tilt_deg) {
+  const SourceRef where = table.Where(row);
+  DirectionObservation o;
+  o.where = where.ToString();
+  o.target = table.String(row, "target");
+  if (o.target.empty()) ThrowInputError(where, "target must not be empty");
+  o.pixel = Eigen::Vector2d(table.Bounded(row, "col", -0.5, camera.width_px - 0.5),
+                            table.Bounded(row, "row", -0.5, camera.height_px - 0.5));
+  o.sigma_px = table.OptionalBounded(row, "sigma_px", 0.0, 100.0).value_or(default_sigma_px);
+  if (!(o.sigma_px > 0)) ThrowInputError(where, "sigma_px must be > 0 (got 0)");
+  o.sigma_rad =
+      table.OptionalBounded(row, "sigma_arcsec", 0.0, kMaxSigmaArcsec).value_or(0.0) * kArcSecond;
+  const auto [setting, turn_tilt] = RowSetting(table, row);
+  o.setting = setting;
+  o.instrument_rotation =
+      calib::RotationFromOpk(Eigen::Vector3d(turn_tilt.y() * kDeg, turn_tilt.x() * kDeg, 0.0));
+  *turn_tilt_deg = turn_tilt;
+  return o;
+}
+
+// A named setting has the same turn and tilt on every row.
+void CheckSettingAngles(const std::string& setting,
+                        const Eigen::Vector2d& turn_tilt,
+                        int line,
+                        const SourceRef& where,
+                        std::map<std::string, std::pair<Eigen::Vector2d, int>>* settings) {
+  if (setting.empty()) return;
+  const auto [at, added] = settings->emplace(setting, std::make_pair(turn_tilt, line));
+  if (!added && !SameAngles(at->second.first, turn_tilt))
+    ThrowInputError(
+        where,
+        StringPrintf("setting %s has turn %.9g, tilt %.9g deg here and %.9g, %.9g at line %d",
+                     setting.c_str(),
+                     turn_tilt.x(),
+                     turn_tilt.y(),
+                     at->second.first.x(),
+                     at->second.first.y(),
+                     at->second.second));
+}
+
+// The row's target direction: a new target is added to `out`, a known one must agree.
+void AddTargetDirection(
+    const std::string& target,
+    const std::optional<Eigen::Vector2d>& angles,
+    int line,
+    const SourceRef& where,
+    std::map<std::string, std::pair<std::optional<Eigen::Vector2d>, int>>* target_angles,
+    DirectionData* out) {
+  const auto [at, added] = target_angles->emplace(target, std::make_pair(angles, line));
+  if (added) {
+    const Eigen::Vector2d start_rad =
+        angles ? Eigen::Vector2d(*angles * kDeg) : Eigen::Vector2d(0.0, 0.0);
+    out->targets.push_back({target, start_rad, angles.has_value()});
+  } else if (at->second.first.has_value() != angles.has_value() ||
+             (angles && !SameAngles(*angles, *at->second.first))) {
+    ThrowInputError(
+        where,
+        "target " + target + ": its azimuth_deg, elevation_deg differ from line " +
+            std::to_string(at->second.second) +
+            " (a known target gives the same direction on every row; an estimated one none)");
+  }
+}
+
+DirectionData ReadRows(const CsvTable& table,
+                       const std::string& path,
+                       const CameraOfRow& camera_of_row,
+                       double default_sigma_px) {
+  CheckDirectionColumns(table, path);
   DirectionData out;
   std::map<std::string, std::pair<std::optional<Eigen::Vector2d>, int>>
       target_angles;                                                // -> (angles, line)
@@ -83,47 +155,11 @@ DirectionData ReadRows(const CsvTable& table,
     const SourceRef where = table.Where(row);
     std::string unit;
     const calib::Camera& camera = camera_of_row(table, row, &unit);
-    DirectionObservation o;
-    o.where = where.ToString();
-    o.target = table.String(row, "target");
-    if (o.target.empty()) ThrowInputError(where, "target must not be empty");
-    o.pixel = Eigen::Vector2d(table.Bounded(row, "col", -0.5, camera.width_px - 0.5),
-                              table.Bounded(row, "row", -0.5, camera.height_px - 0.5));
-    o.sigma_px = table.OptionalBounded(row, "sigma_px", 0.0, 100.0).value_or(default_sigma_px);
-    if (!(o.sigma_px > 0)) ThrowInputError(where, "sigma_px must be > 0 (got 0)");
-    o.sigma_rad =
-        table.OptionalBounded(row, "sigma_arcsec", 0.0, kMaxSigmaArcsec).value_or(0.0) * kArcSecond;
-    const auto [setting, turn_tilt] = RowSetting(table, row);
-    o.setting = setting;
-    o.instrument_rotation =
-        calib::RotationFromOpk(Eigen::Vector3d(turn_tilt.y() * kDeg, turn_tilt.x() * kDeg, 0.0));
-    if (!setting.empty()) {
-      const auto [at, added] = settings.emplace(setting, std::make_pair(turn_tilt, row.line));
-      if (!added && !SameAngles(at->second.first, turn_tilt))
-        ThrowInputError(
-            where,
-            StringPrintf("setting %s has turn %.9g, tilt %.9g deg here and %.9g, %.9g at line %d",
-                         setting.c_str(),
-                         turn_tilt.x(),
-                         turn_tilt.y(),
-                         at->second.first.x(),
-                         at->second.first.y(),
-                         at->second.second));
-    }
-    const std::optional<Eigen::Vector2d> angles = RowAngles(table, row);
-    const auto [at, added] = target_angles.emplace(o.target, std::make_pair(angles, row.line));
-    if (added) {
-      const Eigen::Vector2d start_rad =
-          angles ? Eigen::Vector2d(*angles * kDeg) : Eigen::Vector2d(0.0, 0.0);
-      out.targets.push_back({o.target, start_rad, angles.has_value()});
-    } else if (at->second.first.has_value() != angles.has_value() ||
-               (angles && !SameAngles(*angles, *at->second.first))) {
-      ThrowInputError(
-          where,
-          "target " + o.target + ": its azimuth_deg, elevation_deg differ from line " +
-              std::to_string(at->second.second) +
-              " (a known target gives the same direction on every row; an estimated one none)");
-    }
+    Eigen::Vector2d turn_tilt;
+    const DirectionObservation o =
+        ReadDirectionObservation(table, row, camera, default_sigma_px, &turn_tilt);
+    CheckSettingAngles(o.setting, turn_tilt, row.line, where, &settings);
+    AddTargetDirection(o.target, RowAngles(table, row), row.line, where, &target_angles, &out);
     const std::string group = table.String(row, "group");
     if (!seen.emplace(o.target, o.setting, group, unit).second)
       ThrowInputError(where,

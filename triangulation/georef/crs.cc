@@ -8,6 +8,7 @@
 #include <proj.h>
 #include <proj_experimental.h>  // compound / 3D CRS construction (stable since PROJ 6)
 #include <set>
+#include <utility>
 #include <vector>
 
 namespace aerocal::triangulation {
@@ -28,6 +29,208 @@ std::string Lower(std::string s) {
   return s;
 }
 
+std::string ContextError(PJ_CONTEXT* ctx) {
+  return proj_context_errno_string(ctx, proj_context_errno(ctx));
+}
+
+// Every error of the set-up: `where: what` (the option or the project file's frame entry).
+[[noreturn]] void Fail(const std::string& where, const std::string& what) {
+  throw InputError(where + ": " + what);
+}
+
+// The file's CRS (with the vertical CRS when one is given apart); `definition` gets its name.
+PjPtr ReadSourceCrs(PJ_CONTEXT* ctx,
+                    const CrsOptions& o,
+                    const std::string& where,
+                    std::string* definition_name) {
+  if (o.definition.empty()) Fail(where, "no CRS given (an EPSG code, WKT or PROJ string)");
+  // A PROJ string as ODM's gcp_list.txt writes it ("+proj=utm +zone=22 +south ...") is a CRS
+  // only with +type=crs.
+  std::string definition = o.definition;
+  if (definition.rfind("+proj=", 0) == 0 && definition.find("+type=crs") == std::string::npos)
+    definition += " +type=crs";
+  PjPtr source(proj_create(ctx, definition.c_str()));
+  if (!source || !proj_is_crs(source.get()))
+    Fail(where, "PROJ cannot read '" + o.definition + "' as a CRS (" + ContextError(ctx) + ")");
+  if (o.vertical.empty()) return source;
+  if (!o.geoid_grid.empty()) Fail(where, "give a vertical CRS or a geoid grid, not both");
+  PjPtr vertical(proj_create(ctx, o.vertical.c_str()));
+  if (!vertical || proj_get_type(vertical.get()) != PJ_TYPE_VERTICAL_CRS)
+    Fail(where, "PROJ cannot read '" + o.vertical + "' as a vertical CRS");
+  const PJ_TYPE t = proj_get_type(source.get());
+  if (!(t == PJ_TYPE_PROJECTED_CRS || t == PJ_TYPE_GEOGRAPHIC_2D_CRS))
+    Fail(where,
+         "a separate vertical CRS needs a 2D horizontal CRS ('" + o.definition +
+             "' is not one; use a compound CRS instead)");
+  source.reset(proj_create_compound_crs(
+      ctx, (o.definition + " + " + o.vertical).c_str(), source.get(), vertical.get()));
+  if (!source) Fail(where, "PROJ cannot combine '" + o.definition + "' and '" + o.vertical + "'");
+  *definition_name += " + " + o.vertical;
+  return source;
+}
+
+// The horizontal (or geocentric) part decides the axes of the file's coordinates.
+CrsConverter::Axes AxesOf(PJ_CONTEXT* ctx,
+                          PJ* source,
+                          const CrsOptions& o,
+                          const std::string& where) {
+  PjPtr horizontal(proj_get_type(source) == PJ_TYPE_COMPOUND_CRS
+                       ? proj_crs_get_sub_crs(ctx, source, 0)
+                       : proj_clone(ctx, source));
+  if (horizontal && proj_get_type(horizontal.get()) == PJ_TYPE_BOUND_CRS)
+    horizontal.reset(proj_get_source_crs(ctx, horizontal.get()));
+  if (!horizontal) Fail(where, "'" + o.definition + "' has no horizontal CRS");
+  const PJ_TYPE ht = proj_get_type(horizontal.get());
+  if (IsGeographic(ht)) return CrsConverter::Axes::kGeographic;
+  if (ht == PJ_TYPE_PROJECTED_CRS) return CrsConverter::Axes::kProjected;
+  if (ht == PJ_TYPE_GEOCENTRIC_CRS) return CrsConverter::Axes::kGeocentric;
+  Fail(where, "'" + o.definition + "' is no geographic, projected or geocentric CRS");
+}
+
+// The pivot: the geographic 3D CRS of the file's own datum unless one is given.
+PjPtr PivotCrs(PJ_CONTEXT* ctx,
+               PJ* source,
+               const std::string& pivot_definition,
+               const CrsOptions& o,
+               const std::string& where) {
+  PjPtr pivot;
+  if (pivot_definition.empty()) {
+    PjPtr geodetic(proj_crs_get_geodetic_crs(ctx, source));
+    if (!geodetic) Fail(where, "'" + o.definition + "' has no geodetic datum");
+    if (proj_get_type(geodetic.get()) == PJ_TYPE_GEOCENTRIC_CRS) {
+      PjPtr datum(proj_crs_get_datum_forced(ctx, geodetic.get()));
+      PjPtr cs(proj_create_ellipsoidal_3D_cs(
+          ctx, PJ_ELLPS3D_LONGITUDE_LATITUDE_HEIGHT, nullptr, 0, nullptr, 0));
+      pivot.reset(proj_create_geographic_crs_from_datum(
+          ctx,
+          (std::string(proj_get_name(geodetic.get())) + " (geographic 3D)").c_str(),
+          datum.get(),
+          cs.get()));
+    } else {
+      pivot.reset(proj_crs_promote_to_3D(ctx, nullptr, geodetic.get()));
+    }
+  } else {
+    pivot.reset(proj_create(ctx, pivot_definition.c_str()));
+  }
+  if (!pivot)
+    Fail(where, "no geographic 3D CRS for '" + o.definition + "' (" + ContextError(ctx) + ")");
+  return pivot;
+}
+
+// Semi-major axis a (m) and flattening f of the pivot's ellipsoid.
+void EllipsoidOf(PJ_CONTEXT* ctx,
+                 PJ* pivot,
+                 const CrsOptions& o,
+                 const std::string& where,
+                 double* a,
+                 double* f) {
+  PjPtr ellipsoid(proj_get_ellipsoid(ctx, pivot));
+  double b = 0, inv_f = 0;
+  int computed = 0;
+  if (!ellipsoid || !proj_ellipsoid_get_parameters(ctx, ellipsoid.get(), a, &b, &computed, &inv_f))
+    Fail(where, "no ellipsoid for '" + o.definition + "'");
+  *f = inv_f > 0 ? 1.0 / inv_f : 0.0;
+}
+
+// The operations from source to pivot that PROJ knows, best first.
+std::vector<PjPtr> Operations(PJ_CONTEXT* ctx,
+                              PJ* source,
+                              PJ* pivot,
+                              PROJ_GRID_AVAILABILITY_USE use) {
+  PJ_OPERATION_FACTORY_CONTEXT* factory = proj_create_operation_factory_context(ctx, nullptr);
+  proj_operation_factory_context_set_grid_availability_use(ctx, factory, use);
+  proj_operation_factory_context_set_spatial_criterion(
+      ctx, factory, PROJ_SPATIAL_CRITERION_PARTIAL_INTERSECTION);
+  PJ_OBJ_LIST* list = proj_create_operations(ctx, source, pivot, factory);
+  proj_operation_factory_context_destroy(factory);
+  std::vector<PjPtr> out;
+  for (int i = 0; list && i < proj_list_get_count(list); ++i)
+    out.emplace_back(proj_list_get(ctx, list, i));
+  if (list) proj_list_destroy(list);
+  return out;
+}
+
+bool VerticalBallpark(PJ* op) {
+  return Lower(proj_get_name(op)).find("ballpark vertical") != std::string::npos;
+}
+
+// The grids an operation uses: short name (may be null) and whether it is installed.
+std::vector<std::pair<const char*, bool>> GridsUsed(PJ_CONTEXT* ctx, PJ* op) {
+  std::vector<std::pair<const char*, bool>> grids;
+  for (int g = 0; g < proj_coordoperation_get_grid_used_count(ctx, op); ++g) {
+    const char *short_name = nullptr, *full_name = nullptr, *package = nullptr, *url = nullptr;
+    int direct = 0, open = 0, available = 0;
+    proj_coordoperation_get_grid_used(
+        ctx, op, g, &short_name, &full_name, &package, &url, &direct, &open, &available);
+    grids.emplace_back(short_name, available != 0);
+  }
+  return grids;
+}
+
+std::vector<std::string> MissingGrids(PJ_CONTEXT* ctx, PJ* op) {
+  std::vector<std::string> names;
+  for (const auto& [name, available] : GridsUsed(ctx, op))
+    if (!available && name) names.emplace_back(name);
+  return names;
+}
+
+// The operation: the best one whose grids are installed. With orthometric heights the geoid
+// grid is required; a ballpark vertical transformation (heights unchanged) is refused.
+PjPtr ChooseOperation(PJ_CONTEXT* ctx,
+                      PJ* source,
+                      PJ* pivot,
+                      bool orthometric,
+                      const CrsOptions& o,
+                      const std::string& where,
+                      const std::string& definition_name) {
+  for (auto& op :
+       Operations(ctx, source, pivot, PROJ_GRID_AVAILABILITY_DISCARD_OPERATION_IF_MISSING_GRID)) {
+    if (!proj_coordoperation_is_instantiable(ctx, op.get())) continue;
+    if (orthometric && o.geoid_grid.empty() && VerticalBallpark(op.get())) continue;
+    if (!MissingGrids(ctx, op.get()).empty()) continue;
+    return std::move(op);
+  }
+  std::set<std::string> missing;
+  for (auto& op : Operations(ctx, source, pivot, PROJ_GRID_AVAILABILITY_IGNORED))
+    for (const auto& g : MissingGrids(ctx, op.get())) missing.insert(g);
+  std::string names;
+  for (const auto& g : missing) names += (names.empty() ? "" : ", ") + g;
+  Fail(where,
+       "no conversion of '" + definition_name + "' to ellipsoidal heights: " +
+           (names.empty() ? std::string("PROJ knows no operation")
+                          : "the geoid grid " + names + " is not installed") +
+           " (PROJ searches " + proj_info().searchpath +
+           "; install it there, or name a grid file with geoid_grid:)");
+}
+
+// The operation's name with the grids it uses.
+std::string OperationName(PJ_CONTEXT* ctx, PJ* op) {
+  std::string name = proj_get_name(op);
+  bool first = true;
+  for (const auto& [grid, available] : GridsUsed(ctx, op)) {
+    name += std::string(first ? "; grids: " : ", ") + (grid ? grid : "?");
+    first = false;
+  }
+  return name;
+}
+
+// The pipeline adding the undulation of a user's geoid grid to orthometric heights.
+PjPtr GeoidPipeline(PJ_CONTEXT* ctx, const CrsOptions& o, const std::string& where) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(o.geoid_grid, ec))
+    Fail(where, "geoid grid '" + o.geoid_grid + "' not found");
+  const std::string path = std::filesystem::absolute(o.geoid_grid).string();
+  const std::string pipeline =
+      "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad +step +proj=vgridshift "
+      "+grids=" +
+      path + " +multiplier=1 +step +proj=unitconvert +xy_in=rad +xy_out=deg";
+  PjPtr geoid(proj_create(ctx, pipeline.c_str()));
+  if (!geoid)
+    Fail(where,
+         "PROJ cannot read the geoid grid '" + o.geoid_grid + "' (" + ContextError(ctx) + ")");
+  return geoid;
+}
+
 }  // namespace
 
 struct CrsConverter::Impl {
@@ -45,171 +248,31 @@ struct CrsConverter::Impl {
     source.reset();
     if (ctx) proj_context_destroy(ctx);
   }
-  std::string LastError() const { return proj_context_errno_string(ctx, proj_context_errno(ctx)); }
+  std::string LastError() const { return ContextError(ctx); }
 };
 
 CrsConverter::CrsConverter(const CrsOptions& o, const std::string& pivot_definition)
     : impl_(std::make_unique<Impl>()) {
   Impl& m = *impl_;
   const std::string where = o.where.empty() ? std::string("crs") : o.where;
-  const auto fail = [&](const std::string& what) { throw InputError(where + ": " + what); };
   m.ctx = proj_context_create();
   proj_context_set_enable_network(m.ctx, 0);  // never download grids (PROJ_NETWORK=OFF)
   proj_log_level(m.ctx, PJ_LOG_NONE);
   m.definition = o.definition;
-  if (o.definition.empty()) fail("no CRS given (an EPSG code, WKT or PROJ string)");
-  // A PROJ string as ODM's gcp_list.txt writes it ("+proj=utm +zone=22 +south ...") is a CRS
-  // only with +type=crs.
-  std::string definition = o.definition;
-  if (definition.rfind("+proj=", 0) == 0 && definition.find("+type=crs") == std::string::npos)
-    definition += " +type=crs";
-  m.source.reset(proj_create(m.ctx, definition.c_str()));
-  if (!m.source || !proj_is_crs(m.source.get()))
-    fail("PROJ cannot read '" + o.definition + "' as a CRS (" + m.LastError() + ")");
-  if (!o.vertical.empty()) {
-    if (!o.geoid_grid.empty()) fail("give a vertical CRS or a geoid grid, not both");
-    PjPtr vertical(proj_create(m.ctx, o.vertical.c_str()));
-    if (!vertical || proj_get_type(vertical.get()) != PJ_TYPE_VERTICAL_CRS)
-      fail("PROJ cannot read '" + o.vertical + "' as a vertical CRS");
-    const PJ_TYPE t = proj_get_type(m.source.get());
-    if (!(t == PJ_TYPE_PROJECTED_CRS || t == PJ_TYPE_GEOGRAPHIC_2D_CRS))
-      fail("a separate vertical CRS needs a 2D horizontal CRS ('" + o.definition +
-           "' is not one; use a compound CRS instead)");
-    m.source.reset(proj_create_compound_crs(
-        m.ctx, (o.definition + " + " + o.vertical).c_str(), m.source.get(), vertical.get()));
-    if (!m.source) fail("PROJ cannot combine '" + o.definition + "' and '" + o.vertical + "'");
-    m.definition += " + " + o.vertical;
-  }
-  // The horizontal (or geocentric) part decides the axes of the file's coordinates.
-  PjPtr horizontal(proj_get_type(m.source.get()) == PJ_TYPE_COMPOUND_CRS
-                       ? proj_crs_get_sub_crs(m.ctx, m.source.get(), 0)
-                       : proj_clone(m.ctx, m.source.get()));
-  if (horizontal && proj_get_type(horizontal.get()) == PJ_TYPE_BOUND_CRS)
-    horizontal.reset(proj_get_source_crs(m.ctx, horizontal.get()));
-  if (!horizontal) fail("'" + o.definition + "' has no horizontal CRS");
-  const PJ_TYPE ht = proj_get_type(horizontal.get());
-  if (IsGeographic(ht))
-    m.axes = Axes::kGeographic;
-  else if (ht == PJ_TYPE_PROJECTED_CRS)
-    m.axes = Axes::kProjected;
-  else if (ht == PJ_TYPE_GEOCENTRIC_CRS)
-    m.axes = Axes::kGeocentric;
-  else
-    fail("'" + o.definition + "' is no geographic, projected or geocentric CRS");
+  m.source = ReadSourceCrs(m.ctx, o, where, &m.definition);
+  m.axes = AxesOf(m.ctx, m.source.get(), o, where);
   m.orthometric = proj_get_type(m.source.get()) == PJ_TYPE_COMPOUND_CRS || !o.geoid_grid.empty();
-
-  // The pivot: the geographic 3D CRS of the file's own datum unless one is given.
-  if (pivot_definition.empty()) {
-    PjPtr geodetic(proj_crs_get_geodetic_crs(m.ctx, m.source.get()));
-    if (!geodetic) fail("'" + o.definition + "' has no geodetic datum");
-    if (proj_get_type(geodetic.get()) == PJ_TYPE_GEOCENTRIC_CRS) {
-      PjPtr datum(proj_crs_get_datum_forced(m.ctx, geodetic.get()));
-      PjPtr cs(proj_create_ellipsoidal_3D_cs(
-          m.ctx, PJ_ELLPS3D_LONGITUDE_LATITUDE_HEIGHT, nullptr, 0, nullptr, 0));
-      m.pivot.reset(proj_create_geographic_crs_from_datum(
-          m.ctx,
-          (std::string(proj_get_name(geodetic.get())) + " (geographic 3D)").c_str(),
-          datum.get(),
-          cs.get()));
-    } else {
-      m.pivot.reset(proj_crs_promote_to_3D(m.ctx, nullptr, geodetic.get()));
-    }
-  } else {
-    m.pivot.reset(proj_create(m.ctx, pivot_definition.c_str()));
-  }
-  if (!m.pivot) fail("no geographic 3D CRS for '" + o.definition + "' (" + m.LastError() + ")");
+  m.pivot = PivotCrs(m.ctx, m.source.get(), pivot_definition, o, where);
   const char* wkt = proj_as_wkt(m.ctx, m.pivot.get(), PJ_WKT2_2019, nullptr);
   m.pivot_wkt = wkt ? wkt : "";
-  {
-    PjPtr ellipsoid(proj_get_ellipsoid(m.ctx, m.pivot.get()));
-    double b = 0, inv_f = 0;
-    int computed = 0;
-    if (!ellipsoid ||
-        !proj_ellipsoid_get_parameters(m.ctx, ellipsoid.get(), &m.a, &b, &computed, &inv_f))
-      fail("no ellipsoid for '" + o.definition + "'");
-    m.f = inv_f > 0 ? 1.0 / inv_f : 0.0;
-  }
-
-  // The operation: the best one whose grids are installed. With orthometric heights the geoid
-  // grid is required; a ballpark vertical transformation (heights unchanged) is refused.
-  const auto operations = [&](PROJ_GRID_AVAILABILITY_USE use) {
-    PJ_OPERATION_FACTORY_CONTEXT* factory = proj_create_operation_factory_context(m.ctx, nullptr);
-    proj_operation_factory_context_set_grid_availability_use(m.ctx, factory, use);
-    proj_operation_factory_context_set_spatial_criterion(
-        m.ctx, factory, PROJ_SPATIAL_CRITERION_PARTIAL_INTERSECTION);
-    PJ_OBJ_LIST* list = proj_create_operations(m.ctx, m.source.get(), m.pivot.get(), factory);
-    proj_operation_factory_context_destroy(factory);
-    std::vector<PjPtr> out;
-    for (int i = 0; list && i < proj_list_get_count(list); ++i)
-      out.emplace_back(proj_list_get(m.ctx, list, i));
-    if (list) proj_list_destroy(list);
-    return out;
-  };
-  const auto vertical_ballpark = [&](PJ* op) {
-    return Lower(proj_get_name(op)).find("ballpark vertical") != std::string::npos;
-  };
-  const auto grids_missing = [&](PJ* op) {
-    std::vector<std::string> names;
-    for (int g = 0; g < proj_coordoperation_get_grid_used_count(m.ctx, op); ++g) {
-      const char *short_name = nullptr, *full_name = nullptr, *package = nullptr, *url = nullptr;
-      int direct = 0, open = 0, available = 0;
-      proj_coordoperation_get_grid_used(
-          m.ctx, op, g, &short_name, &full_name, &package, &url, &direct, &open, &available);
-      if (!available && short_name) names.emplace_back(short_name);
-    }
-    return names;
-  };
-  PjPtr chosen;
-  for (auto& op : operations(PROJ_GRID_AVAILABILITY_DISCARD_OPERATION_IF_MISSING_GRID)) {
-    if (!proj_coordoperation_is_instantiable(m.ctx, op.get())) continue;
-    if (m.orthometric && o.geoid_grid.empty() && vertical_ballpark(op.get())) continue;
-    if (!grids_missing(op.get()).empty()) continue;
-    chosen = std::move(op);
-    break;
-  }
-  if (!chosen) {
-    std::set<std::string> missing;
-    for (auto& op : operations(PROJ_GRID_AVAILABILITY_IGNORED))
-      for (const auto& g : grids_missing(op.get())) missing.insert(g);
-    std::string names;
-    for (const auto& g : missing) names += (names.empty() ? "" : ", ") + g;
-    fail("no conversion of '" + m.definition + "' to ellipsoidal heights: " +
-         (names.empty() ? std::string("PROJ knows no operation")
-                        : "the geoid grid " + names + " is not installed") +
-         " (PROJ searches " + proj_info().searchpath +
-         "; install it there, or name a grid file with geoid_grid:)");
-  }
-  m.operation_name = proj_get_name(chosen.get());
-  for (int g = 0; g < proj_coordoperation_get_grid_used_count(m.ctx, chosen.get()); ++g) {
-    const char *short_name = nullptr, *full_name = nullptr, *package = nullptr, *url = nullptr;
-    int direct = 0, open = 0, available = 0;
-    proj_coordoperation_get_grid_used(m.ctx,
-                                      chosen.get(),
-                                      g,
-                                      &short_name,
-                                      &full_name,
-                                      &package,
-                                      &url,
-                                      &direct,
-                                      &open,
-                                      &available);
-    m.operation_name += std::string(g == 0 ? "; grids: " : ", ") + (short_name ? short_name : "?");
-  }
+  EllipsoidOf(m.ctx, m.pivot.get(), o, where, &m.a, &m.f);
+  const PjPtr chosen =
+      ChooseOperation(m.ctx, m.source.get(), m.pivot.get(), m.orthometric, o, where, m.definition);
+  m.operation_name = OperationName(m.ctx, chosen.get());
   m.operation.reset(proj_normalize_for_visualization(m.ctx, chosen.get()));
-  if (!m.operation) fail("PROJ cannot normalise the axis order (" + m.LastError() + ")");
-
+  if (!m.operation) Fail(where, "PROJ cannot normalise the axis order (" + m.LastError() + ")");
   if (!o.geoid_grid.empty()) {
-    std::error_code ec;
-    if (!std::filesystem::is_regular_file(o.geoid_grid, ec))
-      fail("geoid grid '" + o.geoid_grid + "' not found");
-    const std::string path = std::filesystem::absolute(o.geoid_grid).string();
-    const std::string pipeline =
-        "+proj=pipeline +step +proj=unitconvert +xy_in=deg +xy_out=rad +step +proj=vgridshift "
-        "+grids=" +
-        path + " +multiplier=1 +step +proj=unitconvert +xy_in=rad +xy_out=deg";
-    m.geoid.reset(proj_create(m.ctx, pipeline.c_str()));
-    if (!m.geoid)
-      fail("PROJ cannot read the geoid grid '" + o.geoid_grid + "' (" + m.LastError() + ")");
+    m.geoid = GeoidPipeline(m.ctx, o, where);
     m.operation_name += "; heights + undulation of " + o.geoid_grid;
   }
 }

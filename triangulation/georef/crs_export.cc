@@ -45,31 +45,28 @@ FrameSpec TargetSpec(const FrameSpec& spec, const ObjectFrame& from, const std::
 
 std::string Number(double v, int digits = 12) { return FormatNumber(v, digits); }
 
-}  // namespace
+using File = ObjectFrame::File;
 
-void ExportResultInCrs(const Project& project,
-                       const nlohmann::json& result,
-                       const std::string& write_crs,
-                       const std::string& folder) {
-  using File = ObjectFrame::File;
-  if (project.frame.kind != FrameSpec::Kind::kCrs)
-    throw InputError(project.path +
-                     ": --write-crs needs a project with frame: {crs: ...} (the "
-                     "CRS its numbers are in)");
-  const ObjectFrame from(project.frame);
-  from.FixOrigin(project);
-  const ObjectFrame to(TargetSpec(project.frame, from, write_crs));
-  const ObjectFrame wgs84(TargetSpec(project.frame, from, "EPSG:4979"));
-  const CrsConverter target(CrsOptions{write_crs, "", "", "--write-crs"});
-  const auto convert =
-      [&](const Eigen::Vector3d& in, File file, const ObjectFrame& out, const std::string& what) {
-        const Eigen::Vector3d x = out.ToInput(from.ToAdjustment(in, file));
-        if (!x.allFinite())
-          throw InputError("result: " + what + " cannot be converted to " + write_crs);
-        return x;
-      };
-  std::filesystem::create_directories(folder);
-  // Exposures: centres and attitudes.
+// Converts a result's coordinates (in the project's CRS) into the output frames' CRS.
+struct CrsExport {
+  const ObjectFrame& from;
+  const std::string& write_crs;
+  Eigen::Vector3d Convert(const Eigen::Vector3d& in,
+                          File file,
+                          const ObjectFrame& out,
+                          const std::string& what) const {
+    const Eigen::Vector3d x = out.ToInput(from.ToAdjustment(in, file));
+    if (!x.allFinite())
+      throw InputError("result: " + what + " cannot be converted to " + write_crs);
+    return x;
+  }
+};
+
+// Exposures: centres and attitudes (relative to the CRS's axes at the exposure).
+void WriteExposuresInCrs(const CrsExport& x,
+                         const ObjectFrame& to,
+                         const nlohmann::json& result,
+                         const std::string& folder) {
   WriteFileAtomically(folder + "/exposures.csv", [&](std::ostream& out) {
     out << "image,X,Y,Z,omega,phi,kappa\n";
     for (const auto& e : result.at("exposures")) {
@@ -79,9 +76,10 @@ void ExportResultInCrs(const Project& project,
       const Eigen::Vector3d opk_in(e.at("omega").get<double>() * kDegToRad,
                                    e.at("phi").get<double>() * kDegToRad,
                                    e.at("kappa").get<double>() * kDegToRad);
-      const Eigen::Vector3d c_out = convert(c_in, File::kExposures, to, "exposure " + image);
-      const Eigen::Matrix3d r_local = NearestRotation(from.MetricJacobian(c_in, File::kExposures)) *
-                                      calib::RotationFromOpk(opk_in);
+      const Eigen::Vector3d c_out = x.Convert(c_in, File::kExposures, to, "exposure " + image);
+      const Eigen::Matrix3d r_local =
+          NearestRotation(x.from.MetricJacobian(c_in, File::kExposures)) *
+          calib::RotationFromOpk(opk_in);
       const Eigen::Vector3d opk_out = calib::OpkFromRotation(
           NearestRotation(to.MetricJacobian(c_out, File::kExposures)).transpose() * r_local);
       out << image << "," << Number(c_out.x()) << "," << Number(c_out.y()) << ","
@@ -90,25 +88,37 @@ void ExportResultInCrs(const Project& project,
           << "\n";
     }
   });
-  // Points: every adjusted point with its role.
+}
+
+// Points: every adjusted point with its role.
+void WritePointsInCrs(const CrsExport& x,
+                      const ObjectFrame& to,
+                      const nlohmann::json& result,
+                      const std::string& folder) {
   WriteFileAtomically(folder + "/points.csv", [&](std::ostream& out) {
     out << "point,X,Y,Z,role\n";
     for (const auto& [table, role] :
          {std::pair<const char*, const char*>{"control", "control"}, {"check", "check"}})
       for (const auto& p : result.at(table).at("points")) {
         const std::string id = p.at("point").get<std::string>();
-        const Eigen::Vector3d x =
-            convert(Vec(p.at("adjusted"), id), File::kPoints, to, std::string(role) + " " + id);
-        out << id << "," << Number(x.x()) << "," << Number(x.y()) << "," << Number(x.z()) << ","
+        const Eigen::Vector3d c =
+            x.Convert(Vec(p.at("adjusted"), id), File::kPoints, to, std::string(role) + " " + id);
+        out << id << "," << Number(c.x()) << "," << Number(c.y()) << "," << Number(c.z()) << ","
             << role << "\n";
       }
   });
-  // Check-point errors for QGIS (RFC 7946 GeoJSON: WGS84 longitude, latitude).
+}
+
+// Check-point errors for QGIS (RFC 7946 GeoJSON: WGS84 longitude, latitude).
+void WriteCheckErrorsGeoJson(const CrsExport& x,
+                             const ObjectFrame& wgs84,
+                             const nlohmann::json& result,
+                             const std::string& folder) {
   nlohmann::json features = nlohmann::json::array();
   for (const auto& p : result.at("check").at("points")) {
     const std::string id = p.at("point").get<std::string>();
     const Eigen::Vector3d g =
-        convert(Vec(p.at("adjusted"), id), File::kPoints, wgs84, "check " + id);
+        x.Convert(Vec(p.at("adjusted"), id), File::kPoints, wgs84, "check " + id);
     const Eigen::Vector3d d = Vec(p.at("difference_m"), id);
     features.push_back({{"type", "Feature"},
                         {"geometry", {{"type", "Point"}, {"coordinates", {g.x(), g.y(), g.z()}}}},
@@ -124,6 +134,13 @@ void ExportResultInCrs(const Project& project,
   const nlohmann::json geojson = {
       {"type", "FeatureCollection"}, {"name", "check_errors"}, {"features", features}};
   WriteFileAtomically(folder + "/check_errors.geojson", geojson.dump(1) + "\n");
+}
+
+// crs.txt: what the files' numbers are.
+void WriteCrsNote(const CrsConverter& target,
+                  const std::string& write_crs,
+                  const ObjectFrame& from,
+                  const std::string& folder) {
   std::ostringstream crs;
   crs << "exposures.csv, points.csv: " << target.Name() << " (" << write_crs << "; "
       << (target.axes() == CrsConverter::Axes::kGeographic  ? "X = longitude, Y = latitude (deg)"
@@ -138,6 +155,29 @@ void ExportResultInCrs(const Project& project,
          "tangent plane\n"
       << "converted from: " << from.Description() << "\n";
   WriteFileAtomically(folder + "/crs.txt", crs.str());
+}
+
+}  // namespace
+
+void ExportResultInCrs(const Project& project,
+                       const nlohmann::json& result,
+                       const std::string& write_crs,
+                       const std::string& folder) {
+  if (project.frame.kind != FrameSpec::Kind::kCrs)
+    throw InputError(project.path +
+                     ": --write-crs needs a project with frame: {crs: ...} (the "
+                     "CRS its numbers are in)");
+  const ObjectFrame from(project.frame);
+  from.FixOrigin(project);
+  const ObjectFrame to(TargetSpec(project.frame, from, write_crs));
+  const ObjectFrame wgs84(TargetSpec(project.frame, from, "EPSG:4979"));
+  const CrsConverter target(CrsOptions{write_crs, "", "", "--write-crs"});
+  const CrsExport x{from, write_crs};
+  std::filesystem::create_directories(folder);
+  WriteExposuresInCrs(x, to, result, folder);
+  WritePointsInCrs(x, to, result, folder);
+  WriteCheckErrorsGeoJson(x, wgs84, result, folder);
+  WriteCrsNote(target, write_crs, from, folder);
 }
 
 }  // namespace aerocal::triangulation

@@ -12,6 +12,7 @@
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <random>
 
 namespace aerocal::triangulation {
@@ -68,6 +69,136 @@ stitch::GrayImage IntegrateOverPixels(const TexturedGround& texture,
   return image;
 }
 
+using Terrain = std::function<double(double, double)>;
+using GreyNoise = std::function<double()>;
+
+// Scene extent: the footprint of the first and last lines and of the outer detectors (`lo`,
+// `hi`, m); returns the mean terrain height there.
+double SceneExtent(const calib::LineCamera& cam,
+                   const PosTrajectory& truth,
+                   int lines,
+                   const Terrain& terrain,
+                   Eigen::Vector2d* lo,
+                   Eigen::Vector2d* hi) {
+  *lo = Eigen::Vector2d::Constant(1e300);
+  *hi = -*lo;
+  double height_sum = 0;
+  int height_n = 0;
+  for (int k = 0; k <= 32; ++k) {
+    const double line = (lines - 1) * k / 32.0;
+    for (double i : {0.0, 0.5 * (cam.detectors - 1), cam.detectors - 1.0}) {
+      const auto g = GroundOfDetector(cam, truth, i, line, terrain);
+      if (!g) throw Error("image mode: a detector ray misses the terrain");
+      *lo = lo->cwiseMin(g->head<2>());
+      *hi = hi->cwiseMax(g->head<2>());
+      height_sum += g->z(), ++height_n;
+    }
+  }
+  return height_sum / height_n;
+}
+
+// The line image through the true camera and poses: the ground point of every pixel, then the
+// texture integrated over each pixel's footprint (one line period along track).
+stitch::GrayImage RenderLineImage(const calib::LineCamera& cam,
+                                  const PosTrajectory& truth,
+                                  int lines,
+                                  const Terrain& terrain,
+                                  const TexturedGround& texture,
+                                  const GreyNoise& grey_noise) {
+  Eigen::MatrixXd ground_x(lines, cam.detectors), ground_y(lines, cam.detectors);
+  std::vector<Eigen::Vector3d> in_camera(cam.detectors);
+  const Eigen::Matrix3d mount = calib::RotationFromOpk(cam.mount_rad);
+  for (int i = 0; i < cam.detectors; ++i) {
+    const Eigen::Vector2d xy = cam.DetectorPosition(i);
+    in_camera[i] = mount * Eigen::Vector3d(xy.x(), xy.y(), -cam.c_mm);
+  }
+  for (int l = 0; l < lines; ++l) {
+    Eigen::Vector3d center, opk;
+    truth.PoseAtLine(l, &center, &opk);
+    const Eigen::Matrix3d body = calib::RotationFromOpk(opk);
+    const Eigen::Vector3d origin = center + body * cam.lever_arm_m;
+    for (int i = 0; i < cam.detectors; ++i) {
+      const auto g = IntersectSurface(origin, body * in_camera[i], terrain);
+      if (!g) throw Error("image mode: a detector ray misses the terrain");
+      ground_x(l, i) = g->x();
+      ground_y(l, i) = g->y();
+    }
+  }
+  return IntegrateOverPixels(texture, ground_x, ground_y, grey_noise);
+}
+
+// The reference frame camera: distortion-free, c for the reference GSD at the flying height.
+calib::Camera ReferenceCamera(const LineSimulationOptions& o,
+                              const LineImageOptions& io,
+                              double reference_gsd) {
+  calib::Camera ref;
+  ref.name = "pushbroom-sim reference frame camera";
+  ref.pixel_size_mm = io.reference_pixel_mm;
+  ref.width_px = io.reference_width_px;
+  ref.height_px = io.reference_height_px;
+  std::fill(ref.interior.begin(), ref.interior.end(), 0.0);
+  ref.interior[calib::Camera::Model::kC] = io.reference_pixel_mm * o.height_m / reference_gsd;
+  return ref;
+}
+
+// Reference exposure k at along-track position y near the mean track (x_mean, z_mean), with
+// small smooth position and attitude wobbles.
+Exposure ReferenceExposure(int k, double x_mean, double y, double z_mean) {
+  Exposure e;
+  e.image = "ref" + std::to_string(k + 1);
+  e.camera = "reference";
+  e.center_m =
+      Eigen::Vector3d(x_mean + 2.0 * std::sin(0.7 * k), y, z_mean + 1.5 * std::cos(0.9 * k));
+  e.opk_rad =
+      Eigen::Vector3d(0.3 * std::sin(1.3 * k), -0.2 * std::cos(0.8 * k), 0.4 * std::sin(0.5 * k)) *
+      (M_PI / 180.0);
+  e.line = k + 2;
+  return e;
+}
+
+// The image of reference exposure e: the ground point of every pixel, then the texture.
+stitch::GrayImage RenderReferenceFrame(const calib::Camera& ref,
+                                       const Exposure& e,
+                                       const Terrain& terrain,
+                                       const TexturedGround& texture,
+                                       const GreyNoise& grey_noise) {
+  Eigen::MatrixXd frame_x(ref.height_px, ref.width_px), frame_y(ref.height_px, ref.width_px);
+  for (int r = 0; r < ref.height_px; ++r)
+    for (int c = 0; c < ref.width_px; ++c) {
+      const ImageRay ray = RayFromPixel(ref, e.opk_rad, e.center_m, Eigen::Vector2d(c, r));
+      const auto g = IntersectSurface(ray.center_m, ray.direction, terrain);
+      frame_x(r, c) = g ? g->x() : std::nan("");
+      frame_y(r, c) = g ? g->y() : std::nan("");
+    }
+  return IntegrateOverPixels(texture, frame_x, frame_y, grey_noise);
+}
+
+// The reference strip: nadir frames along the flight's mean track at the flying height, covering
+// the scene (lo.y .. hi.y) with a quarter frame beyond each end.
+void RenderReferenceStrip(const LineSimulation& sim,
+                          const LineImageOptions& io,
+                          double reference_gsd,
+                          const Eigen::Vector2d& lo,
+                          const Eigen::Vector2d& hi,
+                          const Terrain& terrain,
+                          const TexturedGround& texture,
+                          const GreyNoise& grey_noise,
+                          LineImageSimulation* out) {
+  const int lines = int(sim.pos_truth.size());
+  double x_mean = 0, z_mean = 0;
+  for (const auto& r : sim.pos_truth) x_mean += r.center_m.x(), z_mean += r.center_m.z();
+  x_mean /= lines, z_mean /= lines;
+  const double along_m = io.reference_height_px * reference_gsd;  // image rows along Y
+  const double base_m = (1 - io.forward_overlap) * along_m;
+  int k = 0;
+  for (double y = lo.y() - 0.25 * along_m; y <= hi.y() + 0.25 * along_m + base_m;
+       y += base_m, ++k) {
+    out->reference_exposures.push_back(ReferenceExposure(k, x_mean, y, z_mean));
+    out->reference_images.push_back(RenderReferenceFrame(
+        out->reference_camera, out->reference_exposures.back(), terrain, texture, grey_noise));
+  }
+}
+
 }  // namespace
 
 void LineImageOptions::Validate() const {
@@ -95,29 +226,15 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim,
                                      const LineSimulationOptions& o,
                                      const LineImageOptions& io) {
   io.Validate();
-  const auto terrain = [&o](double x, double y) { return SimulatedTerrainHeight(o, x, y); };
+  const Terrain terrain = [&o](double x, double y) { return SimulatedTerrainHeight(o, x, y); };
   const PosTrajectory truth = PosTrajectory::FromRecords(sim.pos_truth, "pos_truth.csv");
   const calib::LineCamera& cam = sim.truth;
   const int lines = int(sim.pos_truth.size());
   std::mt19937_64 rng(io.seed * 7919 + 13);
   std::normal_distribution<double> noise(0.0, 1.0);
   LineImageSimulation out;
-
-  // Scene extent: the footprint of the first and last lines and of the outer detectors.
-  Eigen::Vector2d lo = Eigen::Vector2d::Constant(1e300), hi = -lo;
-  double height_sum = 0;
-  int height_n = 0;
-  for (int k = 0; k <= 32; ++k) {
-    const double line = (lines - 1) * k / 32.0;
-    for (double i : {0.0, 0.5 * (cam.detectors - 1), cam.detectors - 1.0}) {
-      const auto g = GroundOfDetector(cam, truth, i, line, terrain);
-      if (!g) throw Error("image mode: a detector ray misses the terrain");
-      lo = lo.cwiseMin(g->head<2>());
-      hi = hi.cwiseMax(g->head<2>());
-      height_sum += g->z(), ++height_n;
-    }
-  }
-  out.mean_height_m = height_sum / height_n;
+  Eigen::Vector2d lo, hi;
+  out.mean_height_m = SceneExtent(cam, truth, lines, terrain, &lo, &hi);
   const double line_spacing_m =
       (sim.pos_truth.back().center_m - sim.pos_truth.front().center_m).head<2>().norm() /
       std::max(1, lines - 1);
@@ -130,67 +247,10 @@ LineImageSimulation RenderLineImages(const LineSimulation& sim,
   texture.x_c = 0.5 * (lo.x() + hi.x());
   texture.y_c = 0.5 * (lo.y() + hi.y());
   out.texture_gsd_m = texture.gsd_m;
-  auto grey_noise = [&]() { return io.grey_noise_dn * noise(rng); };
-
-  // The line image through the true camera and poses: the ground point of every pixel, then the
-  // texture integrated over each pixel's footprint (one line period along track).
-  Eigen::MatrixXd ground_x(lines, cam.detectors), ground_y(lines, cam.detectors);
-  std::vector<Eigen::Vector3d> in_camera(cam.detectors);
-  const Eigen::Matrix3d mount = calib::RotationFromOpk(cam.mount_rad);
-  for (int i = 0; i < cam.detectors; ++i) {
-    const Eigen::Vector2d xy = cam.DetectorPosition(i);
-    in_camera[i] = mount * Eigen::Vector3d(xy.x(), xy.y(), -cam.c_mm);
-  }
-  for (int l = 0; l < lines; ++l) {
-    Eigen::Vector3d center, opk;
-    truth.PoseAtLine(l, &center, &opk);
-    const Eigen::Matrix3d body = calib::RotationFromOpk(opk);
-    const Eigen::Vector3d origin = center + body * cam.lever_arm_m;
-    for (int i = 0; i < cam.detectors; ++i) {
-      const auto g = IntersectSurface(origin, body * in_camera[i], terrain);
-      if (!g) throw Error("image mode: a detector ray misses the terrain");
-      ground_x(l, i) = g->x();
-      ground_y(l, i) = g->y();
-    }
-  }
-  out.line_image = IntegrateOverPixels(texture, ground_x, ground_y, grey_noise);
-
-  // The reference strip: nadir frames along the flight's mean track at the flying height.
-  calib::Camera& ref = out.reference_camera;
-  ref.name = "pushbroom-sim reference frame camera";
-  ref.pixel_size_mm = io.reference_pixel_mm;
-  ref.width_px = io.reference_width_px;
-  ref.height_px = io.reference_height_px;
-  std::fill(ref.interior.begin(), ref.interior.end(), 0.0);
-  ref.interior[calib::Camera::Model::kC] = io.reference_pixel_mm * o.height_m / reference_gsd;
-  double x_mean = 0, z_mean = 0;
-  for (const auto& r : sim.pos_truth) x_mean += r.center_m.x(), z_mean += r.center_m.z();
-  x_mean /= lines, z_mean /= lines;
-  const double along_m = io.reference_height_px * reference_gsd;  // image rows along Y
-  const double base_m = (1 - io.forward_overlap) * along_m;
-  int k = 0;
-  for (double y = lo.y() - 0.25 * along_m; y <= hi.y() + 0.25 * along_m + base_m;
-       y += base_m, ++k) {
-    Exposure e;
-    e.image = "ref" + std::to_string(k + 1);
-    e.camera = "reference";
-    e.center_m =
-        Eigen::Vector3d(x_mean + 2.0 * std::sin(0.7 * k), y, z_mean + 1.5 * std::cos(0.9 * k));
-    e.opk_rad = Eigen::Vector3d(
-                    0.3 * std::sin(1.3 * k), -0.2 * std::cos(0.8 * k), 0.4 * std::sin(0.5 * k)) *
-                (M_PI / 180.0);
-    e.line = k + 2;
-    out.reference_exposures.push_back(e);
-    Eigen::MatrixXd frame_x(ref.height_px, ref.width_px), frame_y(ref.height_px, ref.width_px);
-    for (int r = 0; r < ref.height_px; ++r)
-      for (int c = 0; c < ref.width_px; ++c) {
-        const ImageRay ray = RayFromPixel(ref, e.opk_rad, e.center_m, Eigen::Vector2d(c, r));
-        const auto g = IntersectSurface(ray.center_m, ray.direction, terrain);
-        frame_x(r, c) = g ? g->x() : std::nan("");
-        frame_y(r, c) = g ? g->y() : std::nan("");
-      }
-    out.reference_images.push_back(IntegrateOverPixels(texture, frame_x, frame_y, grey_noise));
-  }
+  const GreyNoise grey_noise = [&]() { return io.grey_noise_dn * noise(rng); };
+  out.line_image = RenderLineImage(cam, truth, lines, terrain, texture, grey_noise);
+  out.reference_camera = ReferenceCamera(o, io, reference_gsd);
+  RenderReferenceStrip(sim, io, reference_gsd, lo, hi, terrain, texture, grey_noise, &out);
   return out;
 }
 

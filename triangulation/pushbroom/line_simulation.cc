@@ -10,6 +10,7 @@
 #include "triangulation/sensor/line_scan_camera.h"
 
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <random>
 #include <sstream>
@@ -52,16 +53,20 @@ void LineSimulationOptions::Validate() const {
           "--pos-bias-m, --pos-bias-deg, --pos-drift-m and --pos-drift-deg must be >= 0");
 }
 
-LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
-  o.Validate();
-  std::mt19937_64 rng(o.seed);
-  std::normal_distribution<double> normal(0.0, 1.0);
-  std::uniform_real_distribution<double> uniform(0.0, 1.0);
-  LineSimulation sim;
+namespace {
 
-  // The camera: three sub-cameras, c so that each covers tilt (1 + overlap) across.
+// The simulation's random numbers, one generator and one distribution each, shared by the steps
+// in their order (the same seed gives the same files).
+struct SimulationRandom {
+  explicit SimulationRandom(std::uint64_t seed) : rng(seed) {}
+  std::mt19937_64 rng;
+  std::normal_distribution<double> normal{0.0, 1.0};
+  std::uniform_real_distribution<double> uniform{0.0, 1.0};
+};
+
+// The nominal camera: three sub-cameras, c so that each covers tilt (1 + overlap) across.
+calib::LineCamera NominalLineCamera(const LineSimulationOptions& o, double half_field_rad) {
   const int n = o.detectors_per_camera;
-  const double half_field_rad = std::max(0.5 * o.tilt_deg * (1 + o.overlap), 5.0) * kDeg;
   const double c = 0.5 * n * o.pitch_mm / std::tan(half_field_rad);
   std::vector<calib::LineSubcamera> subs(3);
   const char* ids[] = {"L", "N", "R"};
@@ -81,10 +86,15 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
   }
   cam.mount_rad = Eigen::Vector3d(0.1, -0.05, 0.2) * kDeg;  // a known boresight
   cam.lever_arm_m = Eigen::Vector3d(0.2, 0.1, -0.3);
-  sim.nominal = cam;
-  sim.nominal.name = "pushbroom-sim nominal";
-  sim.reference_subcamera = 1;
-  // Smooth per-detector errors: a cubic in u per sub-camera and axis.
+  return cam;
+}
+
+// Smooth per-detector errors: a cubic in u per sub-camera and axis.
+std::vector<calib::LinePolynomial> TruthPolynomials(const LineSimulationOptions& o,
+                                                    int reference_subcamera,
+                                                    SimulationRandom* random) {
+  auto& [rng, normal, uniform] = *random;
+  const int n = o.detectors_per_camera;
   const double amp = o.detector_error_px * o.pitch_mm;
   const double sub_amp = o.subcamera_error_px * o.pitch_mm;
   std::vector<calib::LinePolynomial> truth_polynomials;
@@ -92,7 +102,7 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     calib::LinePolynomial p;
     p.first = k * n;
     p.last = k * n + n - 1;
-    const bool reference = k == sim.reference_subcamera && sub_amp == 0;
+    const bool reference = k == reference_subcamera && sub_amp == 0;
     for (auto* axis : {&p.dx, &p.dy}) {
       *axis = {reference ? 0.0 : amp * normal(rng),
                reference ? 0.0 : amp * normal(rng),
@@ -116,14 +126,17 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     }
     truth_polynomials.push_back(p);
   }
-  cam.calibration = truth_polynomials;
-  sim.truth = cam;
-  sim.truth.name = "pushbroom-sim truth";
+  return truth_polynomials;
+}
 
-  // The flight: along +Y, kappa 0 (the line along X, across track).
-  const double spacing_m = o.pitch_mm / c * o.height_m;  // along-track ground spacing of a line
-  const double dt = spacing_m / o.speed_m_s;
-  const double length = o.lines * spacing_m;
+// The true poses (sim->pos_truth) and the error-free POS rows (returned) of every line: along +Y,
+// kappa 0 (the line along X, across track).
+std::vector<PosRecord> SimulateTrajectory(const LineSimulationOptions& o,
+                                          double spacing_m,
+                                          double dt,
+                                          SimulationRandom* random,
+                                          LineSimulation* sim) {
+  auto& [rng, normal, uniform] = *random;
   const double ph[6] = {uniform(rng) * 6.28,
                         uniform(rng) * 6.28,
                         uniform(rng) * 6.28,
@@ -150,11 +163,16 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     r.source_line = l + 2;
     r.time_s = 1000.0 + l * dt;
     trajectory(l + o.time_offset_s / dt, &r);
-    sim.pos_truth.push_back(r);
+    sim->pos_truth.push_back(r);
     trajectory(l, &r);
     pos_rows.push_back(r);
   }
-  // POS error: a cubic B-spline with random node values.
+  return pos_rows;
+}
+
+// POS error: a cubic B-spline with random node values, plus bias and drift.
+std::vector<Vector6d> PosErrorNodes(const LineSimulationOptions& o, SimulationRandom* random) {
+  auto& [rng, normal, uniform] = *random;
   const int nodes = calib::SplineNodeCount(o.lines - 1, o.node_spacing_lines);
   std::vector<Vector6d> error_nodes(nodes);
   for (auto& e : error_nodes)
@@ -171,6 +189,15 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     for (int j = 0; j < nodes; ++j)
       error_nodes[j] += bias + drift * ((j - 1) * double(o.node_spacing_lines) / (o.lines - 1));
   }
+  return error_nodes;
+}
+
+// The POS (rows plus the spline's error, with sigmas) and the corrections that undo the error.
+void AddPosErrors(const LineSimulationOptions& o,
+                  const std::vector<PosRecord>& pos_rows,
+                  const std::vector<Vector6d>& error_nodes,
+                  LineSimulation* sim) {
+  const int nodes = int(error_nodes.size());
   for (int l = 0; l < o.lines; ++l) {
     const calib::SplineSpan span = calib::CubicBSplineWeights(l, o.node_spacing_lines);
     const int j = std::min(span.first_node, nodes - 4);
@@ -182,12 +209,51 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     if (o.pos_error_m > 0) r.center_sigma_m = Eigen::Vector3d::Constant(o.pos_error_m);
     if (o.pos_error_deg > 0) r.opk_sigma_rad = Eigen::Vector3d::Constant(o.pos_error_deg * kDeg);
     if (!r.center_sigma_m || !r.opk_sigma_rad) r.center_sigma_m.reset(), r.opk_sigma_rad.reset();
-    sim.pos.push_back(r);
-    sim.true_corrections.push_back(-e);
+    sim->pos.push_back(r);
+    sim->true_corrections.push_back(-e);
   }
-  const PosTrajectory truth = PosTrajectory::FromRecords(sim.pos_truth, "pos_truth.csv");
+}
 
-  // Terrain and cloud control points in the swath.
+// The noisy observations of `ground` by the sub-cameras that see it (near line t0).
+std::vector<LineObservation> ObserveControlPoint(const LineSimulationOptions& o,
+                                                 const LineSimulation& sim,
+                                                 const PosTrajectory& truth,
+                                                 const Eigen::Vector3d& ground,
+                                                 double t0,
+                                                 SimulationRandom* random) {
+  auto& [rng, normal, uniform] = *random;
+  const int n = o.detectors_per_camera;
+  std::vector<LineObservation> seen;
+  for (int s = 0; s < 3; ++s) {
+    double i = 0, t = 0;
+    const int first = s * n, last = s * n + n - 1;
+    if (!SubcameraPixelOfPoint(sim.truth, truth, s, t0, ground, &i, &t)) continue;
+    if (!(i >= first - 0.5 && i <= last + 0.5)) continue;
+    if (!(t >= 1 && t <= o.lines - 2)) continue;
+    LineObservation obs;
+    obs.detector = i + o.image_noise_px * normal(rng);
+    obs.line = t + o.image_noise_px * normal(rng);
+    obs.sigma_px = o.image_sigma_px;
+    // A measurement lies on one of its sub-camera's detectors (a column of the line image
+    // belongs to one sub-camera): a point that noise carries past the sub-camera's edge would
+    // be read as the neighbour's detector, so it is not measured (and, at the outer edges,
+    // beyond the line).
+    const long column = std::lround(obs.detector);
+    if (!(obs.detector >= -0.5 && column >= first && column <= last)) continue;
+    seen.push_back(obs);
+  }
+  return seen;
+}
+
+// Terrain and cloud control points in the swath, each with its observations.
+void PlaceControlPoints(const LineSimulationOptions& o,
+                        double spacing_m,
+                        double half_field_rad,
+                        SimulationRandom* random,
+                        LineSimulation* sim) {
+  auto& [rng, normal, uniform] = *random;
+  const PosTrajectory truth = PosTrajectory::FromRecords(sim->pos_truth, "pos_truth.csv");
+  const double length = o.lines * spacing_m;
   const double half_swath = o.height_m * std::tan(1.5 * o.tilt_deg * kDeg + half_field_rad * 0.3);
   auto terrain = [&](double x, double y) { return SimulatedTerrainHeight(o, x, y); };
   int placed = 0;
@@ -196,42 +262,47 @@ LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
     const double y = (0.02 + 0.96 * uniform(rng)) * length;
     const double x = (2 * uniform(rng) - 1) * half_swath;
     const Eigen::Vector3d ground(x, y, terrain(x, y));
-    const double t0 = y / spacing_m;
-    std::vector<LineObservation> seen;
-    for (int s = 0; s < 3; ++s) {
-      double i = 0, t = 0;
-      const int first = s * n, last = s * n + n - 1;
-      if (!SubcameraPixelOfPoint(sim.truth, truth, s, t0, ground, &i, &t)) continue;
-      if (!(i >= first - 0.5 && i <= last + 0.5)) continue;
-      if (!(t >= 1 && t <= o.lines - 2)) continue;
-      LineObservation obs;
-      obs.detector = i + o.image_noise_px * normal(rng);
-      obs.line = t + o.image_noise_px * normal(rng);
-      obs.sigma_px = o.image_sigma_px;
-      // A measurement lies on one of its sub-camera's detectors (a column of the line image
-      // belongs to one sub-camera): a point that noise carries past the sub-camera's edge would
-      // be read as the neighbour's detector, so it is not measured (and, at the outer edges,
-      // beyond the line).
-      const long column = std::lround(obs.detector);
-      if (!(obs.detector >= -0.5 && column >= first && column <= last)) continue;
-      seen.push_back(obs);
-    }
+    std::vector<LineObservation> seen =
+        ObserveControlPoint(o, *sim, truth, ground, y / spacing_m, random);
     if (seen.empty()) continue;
     GroundPoint g;
     g.id = "c" + std::to_string(placed + 1);
     g.role = PointRole::kControl;
     g.sigma_m = Eigen::Vector3d::Constant(o.control_sigma_m);
     g.xyz_m = ground;
-    sim.points_truth.push_back(g);
+    sim->points_truth.push_back(g);
     g.xyz_m = ground + o.control_noise_m * Eigen::Vector3d(normal(rng), normal(rng), normal(rng));
-    sim.points.push_back(g);
+    sim->points.push_back(g);
     for (auto& obs : seen) {
       obs.point = g.id;
-      obs.source_line = int(sim.observations.size()) + 2;
-      sim.observations.push_back(obs);
+      obs.source_line = int(sim->observations.size()) + 2;
+      sim->observations.push_back(obs);
     }
     ++placed;
   }
+}
+
+}  // namespace
+
+LineSimulation SimulateLineFlight(const LineSimulationOptions& o) {
+  o.Validate();
+  SimulationRandom random(o.seed);
+  LineSimulation sim;
+  const double half_field_rad = std::max(0.5 * o.tilt_deg * (1 + o.overlap), 5.0) * kDeg;
+  calib::LineCamera cam = NominalLineCamera(o, half_field_rad);
+  const double c = cam.c_mm;
+  sim.nominal = cam;
+  sim.nominal.name = "pushbroom-sim nominal";
+  sim.reference_subcamera = 1;
+  cam.calibration = TruthPolynomials(o, sim.reference_subcamera, &random);
+  sim.truth = cam;
+  sim.truth.name = "pushbroom-sim truth";
+
+  const double spacing_m = o.pitch_mm / c * o.height_m;  // along-track ground spacing of a line
+  const double dt = spacing_m / o.speed_m_s;
+  const std::vector<PosRecord> pos_rows = SimulateTrajectory(o, spacing_m, dt, &random, &sim);
+  AddPosErrors(o, pos_rows, PosErrorNodes(o, &random), &sim);
+  PlaceControlPoints(o, spacing_m, half_field_rad, &random, &sim);
   return sim;
 }
 

@@ -126,85 +126,132 @@ ImageRay LineScanCamera::StartingRay(const SensorContext& context,
   return ray;
 }
 
+namespace {
+
+void CheckLineObservation(const calib::LineCamera& camera,
+                          const PosTrajectory& pos,
+                          const SourceRef& where,
+                          double detector,
+                          double line) {
+  if (!(detector >= -0.5 && detector <= camera.detectors - 0.5))
+    ThrowInputError(where,
+                    "col (detector) must be within -0.5 .. " +
+                        FormatNumber(camera.detectors - 0.5) + " (got " + FormatNumber(detector) +
+                        ")");
+  if (!pos.CoversLine(line))
+    ThrowInputError(where,
+                    "row (scan line) " + FormatNumber(line) +
+                        " is outside the POS trajectory (lines " + FormatNumber(pos.first_line()) +
+                        " .. " + FormatNumber(pos.last_line()) + ")");
+}
+
+// The detector index where the slope of sub-camera `range` is taken by central differences of
+// +- kSlopeStep (inside the range).
+constexpr double kSlopeStep = 0.01;
+double SlopeSite(const std::pair<int, int>& range, double detector) {
+  return std::max(range.first + kSlopeStep, std::min(range.second - kSlopeStep, detector));
+}
+
+// Whitening in detectors and lines: the local detector spacing in the virtual focal plane and
+// the image motion of one line (at the POS pose, the file's camera and the point's current
+// values); the observation's sigma in mm, x and y.
+Eigen::Vector2d LineSigmaMm(const calib::LineCamera& camera,
+                            const PosTrajectory& pos,
+                            const std::pair<int, int>& range,
+                            double detector,
+                            double line,
+                            const Eigen::Vector3d& xyz,
+                            double sigma_px) {
+  const double h = kSlopeStep;
+  const double ic = SlopeSite(range, detector);
+  const double dx_di =
+      range.second > range.first
+          ? std::abs(camera.DesignPosition(ic + h).x() - camera.DesignPosition(ic - h).x()) /
+                (2 * h)
+          : camera.pitch_mm;
+  double dy_dt = 0;
+  {
+    const double t0 = pos.CoversLine(line - 0.5) ? line - 0.5 : line;
+    const double t1 = pos.CoversLine(line + 0.5) ? line + 0.5 : line;
+    Eigen::Vector2d y0, y1;
+    if (t1 > t0 && ProjectAtLine(camera, pos, t0, xyz, &y0) &&
+        ProjectAtLine(camera, pos, t1, xyz, &y1))
+      dy_dt = std::abs(y1.y() - y0.y()) / (t1 - t0);
+  }
+  if (!(dy_dt > 1e-3 * camera.pitch_mm)) dy_dt = camera.pitch_mm;
+  return Eigen::Vector2d(sigma_px * std::max(dx_di, 1e-3 * camera.pitch_mm), sigma_px * dy_dt);
+}
+
+// The POS velocity and attitude rate at the line (the time offset's lever): central
+// differences of the interpolated POS over +- 1 ms.
+void PosRatesAtLine(const PosTrajectory& pos,
+                    double line,
+                    Eigen::Vector3d* velocity,
+                    Eigen::Vector3d* opk_rate) {
+  const double time = pos.LineTime(line);
+  const double t0 = std::max(pos.records().front().time_s, time - 1e-3);
+  const double t1 = std::min(pos.records().back().time_s, time + 1e-3);
+  Eigen::Vector3d c0, c1, o0, o1;
+  pos.PoseAtTime(t0, &c0, &o0);
+  pos.PoseAtTime(t1, &c1, &o1);
+  *velocity = Eigen::Vector3d((c1 - c0) / (t1 - t0));
+  *opk_rate = Eigen::Vector3d((o1 - o0) / (t1 - t0));
+}
+
+// The table at its start values: the measured position, the line direction there (the ray
+// angle's frame) and c, at which the angle is weighted (line_ray_angle.h).
+calib::LineDetectorGeometry DetectorGeometry(const calib::LineCamera& camera,
+                                             const std::pair<int, int>& range,
+                                             double detector,
+                                             double u,
+                                             const Eigen::Vector3d& range_m) {
+  const double h = kSlopeStep;
+  const double ic = SlopeSite(range, detector);
+  calib::LineDetectorGeometry geometry;
+  geometry.xy_mm = camera.DetectorPosition(detector);
+  geometry.slope_mm =
+      range.second > range.first
+          ? Eigen::Vector2d((camera.DetectorPosition(ic + h) - camera.DetectorPosition(ic - h)) /
+                            (2 * h))
+          : Eigen::Vector2d(camera.pitch_mm, 0.0);
+  geometry.u = u;
+  geometry.du_di = range.second > range.first ? 2.0 / double(range.second - range.first) : 0;
+  geometry.nominal_c_mm = camera.c_mm;
+  geometry.nominal_range_m = range_m.norm();
+  return geometry;
+}
+
+}  // namespace
+
 ObservationTerm LineScanCamera::Observe(const SensorContext& context,
                                         const ImageObservation& observation,
                                         calib::BlockId point) {
   const SourceRef where{context.project.observations_file, observation.line};
   const double detector = observation.pixel.x(), line = observation.pixel.y();
-  const double first_line = pos_.first_line(), last_line = pos_.last_line();
-  if (!(detector >= -0.5 && detector <= camera_.detectors - 0.5))
-    ThrowInputError(where,
-                    "col (detector) must be within -0.5 .. " +
-                        FormatNumber(camera_.detectors - 0.5) + " (got " + FormatNumber(detector) +
-                        ")");
-  if (!pos_.CoversLine(line))
-    ThrowInputError(where,
-                    "row (scan line) " + FormatNumber(line) +
-                        " is outside the POS trajectory (lines " + FormatNumber(first_line) +
-                        " .. " + FormatNumber(last_line) + ")");
+  CheckLineObservation(camera_, pos_, where, detector, line);
   const LineDetectorSite site = DetectorSite(detector);
   const int s = site.subcamera;
   Eigen::Vector3d pos_center, pos_opk;
   pos_.PoseAtLine(line, &pos_center, &pos_opk);
-  // Whitening in detectors and lines: the local detector spacing in the virtual focal plane and
-  // the image motion of one line (at the POS pose, the file's camera and the point's current
-  // values).
-  const double h = 0.01;
-  const double ic = std::max(ranges_[s].first + h, std::min(ranges_[s].second - h, detector));
-  const double dx_di =
-      ranges_[s].second > ranges_[s].first
-          ? std::abs(camera_.DesignPosition(ic + h).x() - camera_.DesignPosition(ic - h).x()) /
-                (2 * h)
-          : camera_.pitch_mm;
   const Eigen::Vector3d xyz = Eigen::Map<const Eigen::Vector3d>(context.builder.BlockValues(point));
-  double dy_dt = 0;
-  {
-    const double t0 = pos_.CoversLine(line - 0.5) ? line - 0.5 : line;
-    const double t1 = pos_.CoversLine(line + 0.5) ? line + 0.5 : line;
-    Eigen::Vector2d y0, y1;
-    if (t1 > t0 && ProjectAtLine(camera_, pos_, t0, xyz, &y0) &&
-        ProjectAtLine(camera_, pos_, t1, xyz, &y1))
-      dy_dt = std::abs(y1.y() - y0.y()) / (t1 - t0);
-  }
-  if (!(dy_dt > 1e-3 * camera_.pitch_mm)) dy_dt = camera_.pitch_mm;
-  const Eigen::Vector2d sigma_xy_mm(observation.sigma_px * std::max(dx_di, 1e-3 * camera_.pitch_mm),
-                                    observation.sigma_px * dy_dt);
-  const double t = std::max(0.0, line - first_line);
+  const Eigen::Vector2d sigma_xy_mm =
+      LineSigmaMm(camera_, pos_, ranges_[s], detector, line, xyz, observation.sigma_px);
+  const double t = std::max(0.0, line - pos_.first_line());
   const calib::SplineSpan span = calib::CubicBSplineWeights(t, options_.node_spacing_lines);
   const int j = std::min(span.first_node, NumNodes() - 4);
   terms_.push_back({s, detector, site.u, sigma_xy_mm, j});
   ObservationTerm term;
   term.group = kGroupLineImage;
-  // The POS velocity and attitude rate at the line (the time offset's lever): central
-  // differences of the interpolated POS over +- 1 ms.
-  const double time = pos_.LineTime(line);
-  const double t0 = std::max(pos_.records().front().time_s, time - 1e-3);
-  const double t1 = std::min(pos_.records().back().time_s, time + 1e-3);
-  Eigen::Vector3d c0, c1, o0, o1;
-  pos_.PoseAtTime(t0, &c0, &o0);
-  pos_.PoseAtTime(t1, &c1, &o1);
-  // The table at its start values: the measured position, the line direction there (the ray
-  // angle's frame) and c, at which the angle is weighted (line_ray_angle.h).
-  calib::LineDetectorGeometry geometry;
-  geometry.xy_mm = camera_.DetectorPosition(detector);
-  geometry.slope_mm =
-      ranges_[s].second > ranges_[s].first
-          ? Eigen::Vector2d((camera_.DetectorPosition(ic + h) - camera_.DetectorPosition(ic - h)) /
-                            (2 * h))
-          : Eigen::Vector2d(camera_.pitch_mm, 0.0);
-  geometry.u = site.u;
-  geometry.du_di =
-      ranges_[s].second > ranges_[s].first ? 2.0 / double(ranges_[s].second - ranges_[s].first) : 0;
-  geometry.nominal_c_mm = camera_.c_mm;
-  geometry.nominal_range_m =
-      (xyz - pos_center - calib::RotationFromOpk(pos_opk) * camera_.lever_arm_m).norm();
-  term.cost = calib::LineCollinearityResidual::Create(geometry,
-                                                      span,
-                                                      pos_opk,
-                                                      pos_center,
-                                                      sigma_xy_mm,
-                                                      Eigen::Vector3d((c1 - c0) / (t1 - t0)),
-                                                      Eigen::Vector3d((o1 - o0) / (t1 - t0)));
+  Eigen::Vector3d velocity, opk_rate;
+  PosRatesAtLine(pos_, line, &velocity, &opk_rate);
+  const calib::LineDetectorGeometry geometry = DetectorGeometry(
+      camera_,
+      ranges_[s],
+      detector,
+      site.u,
+      Eigen::Vector3d(xyz - pos_center - calib::RotationFromOpk(pos_opk) * camera_.lever_arm_m));
+  term.cost = calib::LineCollinearityResidual::Create(
+      geometry, span, pos_opk, pos_center, sigma_xy_mm, velocity, opk_rate);
   term.blocks = {node_blocks_[j],
                  node_blocks_[j + 1],
                  node_blocks_[j + 2],
