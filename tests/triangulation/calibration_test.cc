@@ -318,7 +318,7 @@ TEST(Calibrate, SimulatedTestFieldRecoversTheTruthAndItsGroupsAgree) {
       << (run.stability.flagged.empty() ? "" : run.stability.flagged[0]);
   ASSERT_GT(run.all.control_cofactor.size(), 0);
   // The budget: c with its components, U = k u_c, and the check points' accuracy.
-  const auto budget = UncertaintyBudget(run, run.project, {{10.0}, 5.0, {}});
+  const auto budget = UncertaintyBudget(run, run.project, {{10.0}, 5.0, {}, {}});
   const auto q =
       std::find_if(budget.begin(), budget.end(), [](const auto& b) { return b.name == "c"; });
   ASSERT_NE(q, budget.end());

@@ -134,7 +134,7 @@ TEST(TestFieldStudy, ExpandedUncertaintyCoversTheTruth) {
     const CalibrationRun run = CalibrateField(f);
     if (!run.all.result.valid) continue;
     ++valid;
-    const auto budget = UncertaintyBudget(run, run.project, {{5.0, 10.0}, 0.0, {}});
+    const auto budget = UncertaintyBudget(run, run.project, {{5.0, 10.0}, 0.0, {}, {}});
     for (int k = 0; k < 3; ++k) {
       const auto q = std::find_if(budget.begin(), budget.end(), [&](const BudgetQuantity& b) {
         return b.name == names[k];
