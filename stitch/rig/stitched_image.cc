@@ -1,10 +1,10 @@
 #include "stitch/rig/stitched_image.h"
 
 #include "calib/core/error.h"
+#include "stitch/rig/feather_weights.h"
 #include "stitch/rig/rig_convert.h"
 
 #include <Eigen/Dense>
-#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -103,23 +103,10 @@ std::vector<HeadOnVirtual> ProjectHeads(const RigConverter& converter,
         ProjectHeadFootprint(converter, static_cast<int>(k), grids.grids[k], &source, resample);
     const VirtualRegion& box = projection.region;
     const size_t pixels = static_cast<size_t>(box.width) * box.height;
-    cv::Mat inside(
-        box.height, box.width, CV_8UC1, const_cast<std::uint8_t*>(projection.covered.data()));
-    cv::Mat distance;
-    cv::distanceTransform(inside, distance, cv::DIST_L2, 3);
     on[k].region = box;
     on[k].value.resize(pixels);
     std::memcpy(on[k].value.data(), projection.values.bytes().data(), 2 * pixels);
-    on[k].weight.resize(pixels);
-    for (int r = 0; r < box.height; ++r) {
-      const float* d = distance.ptr<float>(r);
-      const std::uint8_t* in = inside.ptr<std::uint8_t>(r);
-      std::uint8_t* w = on[k].weight.data() + static_cast<size_t>(r) * box.width;
-      for (int c = 0; c < box.width; ++c)
-        w[c] = in[c] == 0 ? 0
-                          : static_cast<std::uint8_t>(
-                                std::clamp(std::lround(d[c]), 1L, static_cast<long>(feather_px)));
-    }
+    on[k].weight = FeatherWeights(projection.covered.data(), box.width, box.height, feather_px);
   }
   return on;
 }

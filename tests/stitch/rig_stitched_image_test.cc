@@ -13,6 +13,7 @@
 // The scene: the uav4 line at 0.2 x its formats (same geometry, 582 x 874 px heads), textured
 // with a real photograph (../shared/data/odm_boruszyn_kap_frames).
 #include "stitch/resample/raster.h"
+#include "stitch/rig/feather_weights.h"
 #include "stitch/rig/head_window.h"
 #include "stitch/rig/rig_conversion.h"
 #include "stitch/rig/rig_convert.h"
@@ -506,6 +507,51 @@ TEST(RigStitchedImage, FootprintBoxHoldsTheWholeFormatsPixelsBitForBit) {
     EXPECT_GT(covered_whole, 100000) << f.truth.heads[k].id;
     EXPECT_EQ(covered_box, covered_whole) << f.truth.heads[k].id;
     EXPECT_EQ(differ, 0) << f.truth.heads[k].id;
+  }
+}
+
+// The banded feather weights (feather_weights.h) against OpenCV's distance transform over the
+// whole raster, bit for bit: a tilted quadrilateral touching two raster edges, with holes of 1 to
+// 40 px and isolated uncovered pixels, for ramps from 1 to 255 px (the band wider than the
+// raster), and each head's real footprint coverage of the simulated line.
+TEST(RigStitchedImage, BandedFeatherWeightsEqualTheWholeDistanceTransform) {
+  const int width = 701, height = 523;
+  std::vector<std::uint8_t> covered(static_cast<size_t>(width) * height, 0);
+  const auto side = [](double ax, double ay, double bx, double by, double x, double y) {
+    return (bx - ax) * (y - ay) - (by - ay) * (x - ax);
+  };
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x)
+      covered[static_cast<size_t>(y) * width + x] =
+          side(-30, 60, 640, -20, x, y) >= 0 && side(640, -20, 760, 480, x, y) >= 0 &&
+                  side(760, 480, 90, 560, x, y) >= 0 && side(90, 560, -30, 60, x, y) >= 0
+              ? 255
+              : 0;
+  std::mt19937 rng(5);
+  for (int hole = 0; hole < 30; ++hole) {
+    const int cx = rng() % width, cy = rng() % height, r = hole < 20 ? 0 : 1 + rng() % 20;
+    for (int y = std::max(0, cy - r); y <= std::min(height - 1, cy + r); ++y)
+      for (int x = std::max(0, cx - r); x <= std::min(width - 1, cx + r); ++x)
+        covered[static_cast<size_t>(y) * width + x] = 0;
+  }
+  for (const int feather : {1, 2, 7, 64, 200, 255})
+    EXPECT_EQ(FeatherWeights(covered.data(), width, height, feather),
+              FeatherWeightsWhole(covered.data(), width, height, feather))
+        << "feather " << feather;
+  const std::vector<std::uint8_t> all(static_cast<size_t>(width) * height, 255);
+  EXPECT_EQ(FeatherWeights(all.data(), width, height, 64),
+            FeatherWeightsWhole(all.data(), width, height, 64));
+
+  const SimulatedRigFlight f = triangulation::SimulateRigFlight(SmallLine(0.0));
+  const RigConverter converter = FirstExposureAtGroundCalibration(f);
+  const HeadMapCorrections grids = MakeHeadMapCorrections(converter, 0.01);
+  for (int k = 0; k < static_cast<int>(f.truth.heads.size()); ++k) {
+    const calib::Camera& head = f.truth.heads[k].camera;
+    MemoryRaster source({head.width_px, head.height_px, 1, 16});
+    const HeadProjection p = ProjectHeadFootprint(converter, k, grids.grids[k], &source);
+    EXPECT_EQ(FeatherWeights(p.covered.data(), p.region.width, p.region.height, 64),
+              FeatherWeightsWhole(p.covered.data(), p.region.width, p.region.height, 64))
+        << f.truth.heads[k].id;
   }
 }
 
