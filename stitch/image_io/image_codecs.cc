@@ -5,17 +5,16 @@
 
 #include <cstdlib>
 #include <dlfcn.h>
-#include <limits.h>
-#include <stdlib.h>
+#include <filesystem>
 #include <string>
 #include <vector>
 
 namespace aerocal::stitch {
 namespace {
 
-std::string FolderOf(const std::string& file) {
-  const size_t slash = file.rfind('/');
-  return slash == std::string::npos ? std::string() : file.substr(0, slash + 1);
+/// The module's path in the folder that holds `file`.
+std::string BesideFile(const std::filesystem::path& file) {
+  return (file.parent_path() / kImageCodecsFile).string();
 }
 
 /// The places image_codecs.h lists, in its order (duplicates are harmless: tried twice).
@@ -25,9 +24,10 @@ std::vector<std::string> Candidates() {
   Dl_info info{};
   if (dladdr(reinterpret_cast<void*>(&DecodeImageFile), &info) && info.dli_fname &&
       info.dli_fname[0] == '/')
-    places.push_back(FolderOf(info.dli_fname) + kImageCodecsFile);
-  char exe[PATH_MAX];
-  if (realpath("/proc/self/exe", exe)) places.push_back(FolderOf(exe) + kImageCodecsFile);
+    places.push_back(BesideFile(info.dli_fname));
+  std::error_code error;
+  const std::filesystem::path exe = std::filesystem::canonical("/proc/self/exe", error);
+  if (!error) places.push_back(BesideFile(exe));
 #ifdef AEROCAL_IMAGE_CODECS_BUILD_PATH
   places.emplace_back(AEROCAL_IMAGE_CODECS_BUILD_PATH);
 #endif
