@@ -29,18 +29,22 @@ namespace {
 // nothing): its interpolated value (16 bit: DN x scale) and its blending weight (0: not covered).
 struct HeadOnVirtual {
   VirtualRegion region;
-  std::vector<std::uint16_t> value;
+  std::vector<std::uint8_t> value;  // 16-bit samples, native byte order (the projection's bytes)
   std::vector<std::uint8_t> weight;
 };
 
 // Head k's samples along one virtual row: value[c - first], weight[c - first] for columns
 // first..last (none when the row misses the head's box).
 struct HeadRow {
-  const std::uint16_t* value = nullptr;
+  const std::uint8_t* value = nullptr;  // 2 bytes per sample
   const std::uint8_t* weight = nullptr;
   int first = 0, last = -1;
   std::uint8_t Weight(int c) const { return c < first || c > last ? 0 : weight[c - first]; }
-  std::uint16_t Value(int c) const { return value[c - first]; }  // where Weight(c) > 0
+  std::uint16_t Value(int c) const {  // where Weight(c) > 0
+    std::uint16_t v;
+    std::memcpy(&v, value + 2 * static_cast<size_t>(c - first), 2);
+    return v;
+  }
 };
 
 HeadRow RowOf(const HeadOnVirtual& h, int r) {
@@ -48,26 +52,35 @@ HeadRow RowOf(const HeadOnVirtual& h, int r) {
   const VirtualRegion& b = h.region;
   if (r < b.y0 || r >= b.y0 + b.height) return row;
   const size_t at = static_cast<size_t>(r - b.y0) * b.width;
-  return {h.value.data() + at, h.weight.data() + at, b.x0, b.x0 + b.width - 1};
+  return {h.value.data() + 2 * at, h.weight.data() + at, b.x0, b.x0 + b.width - 1};
 }
 
-// The head's raw pixels as a 16-bit raster (8-bit values x 256: the interpolation keeps 1/256 DN).
-MemoryRaster AsSixteenBit(RasterSource* source, double scale) {
+// std::clamp(std::round(x), 0.0, top) for a finite x and an integer top, without the library
+// call: round half away from zero is trunc(x) + 1 when x - trunc(x) >= 0.5 (x >= 0; the fraction
+// is exact in double); x <= 0 clamps to 0 (round gives 0, -0 or less) and x >= top - 0.5 to top.
+double RoundClamped(double x, double top) {
+  if (!(x > 0)) return 0.0;
+  if (x >= top) return top;
+  const double whole = static_cast<double>(static_cast<std::int64_t>(x));
+  return x - whole >= 0.5 ? whole + 1.0 : whole;
+}
+
+// The head's raw pixels as a 16-bit raster (8-bit values x 256: the interpolation keeps 1/256 DN;
+// 16-bit values as they are).
+MemoryRaster AsSixteenBit(RasterSource* source) {
   const RasterInfo in = source->Info();
   MemoryRaster out({in.width, in.height, 1, 16});
+  std::uint8_t* to = out.bytes().data();
   std::vector<std::uint8_t> row(in.RowBytes());
-  for (int r = 0; r < in.height; ++r) {
+  for (int r = 0; r < in.height; ++r, to += 2 * static_cast<size_t>(in.width)) {
+    if (in.bits == 16) {
+      source->ReadWindow(0, r, in.width, 1, to);
+      continue;
+    }
     source->ReadWindow(0, r, in.width, 1, row.data());
     for (int c = 0; c < in.width; ++c) {
-      double v;
-      if (in.bits == 8) {
-        v = row[c];
-      } else {
-        std::uint16_t s;
-        std::memcpy(&s, &row[2 * c], 2);
-        v = s;
-      }
-      out.Set(c, r, 0, v * scale);
+      const std::uint16_t s = static_cast<std::uint16_t>(row[c] << 8);
+      std::memcpy(to + 2 * c, &s, 2);
     }
   }
   return out;
@@ -94,18 +107,15 @@ std::vector<HeadOnVirtual> ProjectHeads(const RigConverter& converter,
                                         const std::vector<RasterSource*>& sources,
                                         const HeadMapCorrections& grids,
                                         const ResampleOptions& resample,
-                                        double scale,
                                         int feather_px) {
   std::vector<HeadOnVirtual> on(sources.size());
   for (size_t k = 0; k < sources.size(); ++k) {
-    MemoryRaster source = AsSixteenBit(sources[k], scale);
-    const HeadProjection projection =
+    MemoryRaster source = AsSixteenBit(sources[k]);
+    HeadProjection projection =
         ProjectHeadFootprint(converter, static_cast<int>(k), grids.grids[k], &source, resample);
     const VirtualRegion& box = projection.region;
-    const size_t pixels = static_cast<size_t>(box.width) * box.height;
     on[k].region = box;
-    on[k].value.resize(pixels);
-    std::memcpy(on[k].value.data(), projection.values.bytes().data(), 2 * pixels);
+    on[k].value = std::move(projection.values.bytes());
     on[k].weight = FeatherWeights(projection.covered.data(), box.width, box.height, feather_px);
   }
   return on;
@@ -237,7 +247,7 @@ void BlendAndWrite(const std::vector<HeadOnVirtual>& on,
           }
         }
         const size_t o = static_cast<size_t>(r - r0) * width + c;
-        const double v = weights > 0 ? std::clamp(std::round(weighted / weights), 0.0, top) : 0.0;
+        const double v = weights > 0 ? RoundClamped(weighted / weights, top) : 0.0;
         if (bytes == 1) {
           out_rows[o] = static_cast<std::uint8_t>(v);
         } else {
@@ -372,7 +382,7 @@ StitchedImageReport MakeStitchedImage(const RigConverter& converter,
   resample.fill = 0.0;
   resample.strip_rows = options.strip_rows;
   const std::vector<HeadOnVirtual> on =
-      ProjectHeads(converter, sources, grids, resample, scale, options.feather_px);
+      ProjectHeads(converter, sources, grids, resample, options.feather_px);
 
   StitchedImageReport report;
   report.width_px = width;
