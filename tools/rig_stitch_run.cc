@@ -184,17 +184,20 @@ nlohmann::json TieMatchingJson(const StitchInputs& in,
     zones.push_back({{"image", z.image},
                      {"zone", z.zone},
                      {"pixels", z.pixels},
+                     {"cell_px", z.cell_px},
                      {"cells", z.cells},
                      {"lsm_tried", z.lsm_tried},
                      {"lsm_failed", z.lsm_failed},
                      {"ties", z.ties}});
-    *printed += StringPrintf("matched %s zone %s: %d ties (%d cells, LSM %d tried, %d failed)\n",
-                             z.image.c_str(),
-                             z.zone.c_str(),
-                             z.ties,
-                             z.cells,
-                             z.lsm_tried,
-                             z.lsm_failed);
+    *printed +=
+        StringPrintf("matched %s zone %s: %d ties (%d cells of %.0f px, LSM %d tried, %d failed)\n",
+                     z.image.c_str(),
+                     z.zone.c_str(),
+                     z.ties,
+                     z.cells,
+                     z.cell_px,
+                     z.lsm_tried,
+                     z.lsm_failed);
   }
   // The LSM sigmas take the template's residuals as independent; sigma0 says by how much they
   // are too small here, and the increments' sigmas are scaled by it (a-posteriori).

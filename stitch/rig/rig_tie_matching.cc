@@ -18,6 +18,9 @@ namespace aerocal::stitch {
 void RigTieMatchOptions::Validate() const {
   if (!(cell_px >= 8))
     throw ConfigError("tie matching: cell_px must be >= 8 (got " + std::to_string(cell_px) + ")");
+  if (!(target_ties >= 0 && target_ties <= 1e7))
+    throw ConfigError("tie matching: target_ties must be within 0..1e7 (got " +
+                      std::to_string(target_ties) + ")");
   if (!(min_sigma_px > 0)) throw ConfigError("tie matching: min_sigma_px must be > 0");
   if (!(prefilter_sigma_px == 0 || (prefilter_sigma_px >= 0.3 && prefilter_sigma_px <= 5)))
     throw ConfigError("tie matching: prefilter_sigma_px must be 0 or within 0.3..5 (got " +
@@ -25,6 +28,12 @@ void RigTieMatchOptions::Validate() const {
   lsm.Validate();
   wallis.Validate();
   foerstner.Validate();
+}
+
+double TieCellPx(const RigTieMatchOptions& options, double zone_pixels) {
+  if (!(options.target_ties > 0) || !(zone_pixels > 0)) return options.cell_px;
+  const double side = std::sqrt(zone_pixels / options.target_ties);
+  return std::max(options.cell_px, 8.0 * std::ceil(side / 8.0));
 }
 
 namespace {
@@ -187,11 +196,15 @@ void MatchOnWholeProjections(const ExposureToMatch& in,
       box = box.area() == 0 ? cv::Rect(c, r, 1, 1) : (box | cv::Rect(c, r, 1, 1));
       ++zone_pixels[m];
     }
+  double all_zone_pixels = 0;
+  for (const auto& zone : zone_pixels) all_zone_pixels += zone.second;
+  const double cell_px = TieCellPx(options, all_zone_pixels);
   for (const auto& [mask, box] : zone_box) {
     RigZoneMatchReport report;
     report.image = exposure.image;
     report.zone = ZoneName(rig, mask);
     report.pixels = zone_pixels[mask];
+    report.cell_px = cell_px;
     const std::vector<int> members = Members(mask, n_heads);
     const int first = members.front();
     const GrayImage crop = projected[first].block(box.y, box.x, box.height, box.width);
@@ -207,9 +220,8 @@ void MatchOnWholeProjections(const ExposureToMatch& in,
       if (at.x() < 0 || at.y() < 0 || at.x() >= width || at.y() >= height ||
           zone_mask.at<std::uint8_t>(at.y(), at.x()) != mask)
         continue;
-      best.try_emplace(
-          {static_cast<int>(at.y() / options.cell_px), static_cast<int>(at.x() / options.cell_px)},
-          at);
+      best.try_emplace({static_cast<int>(at.y() / cell_px), static_cast<int>(at.x() / cell_px)},
+                       at);
     }
     report.cells = static_cast<int>(best.size());
     for (const auto& cell_point : best) {
@@ -233,13 +245,14 @@ void MatchOnWholeProjections(const ExposureToMatch& in,
 }
 
 // Zones on a coarse grid (every kCoarseStep virtual px): per head the coverage, its distance
-// transform, and per zone the sample count above the margin (the zone's pixels, estimated) and
-// the cells with a sample within the margin relaxed by two steps (candidates: the exact zone of
-// a point is decided at the point).
+// transform, and per zone the sample count above the margin (the zone's pixels, estimated), the
+// exposure's tie cell from them, and the cells with a sample within the margin relaxed by two
+// steps (candidates: the exact zone of a point is decided at the point).
 constexpr int kCoarseStep = 4;
 
 struct CoarseZones {
   std::map<unsigned, long> pixels;                     // zone -> estimated pixels
+  double cell_px = 0;                                  // TieCellPx of the zones' pixels
   std::map<std::pair<int, int>, unsigned> cell_heads;  // (row, col) cell -> union of heads
 };
 
@@ -247,7 +260,7 @@ CoarseZones FindCoarseZones(const std::vector<HeadWindowSampler>& samplers,
                             int width,
                             int height,
                             double margin,
-                            double cell_px) {
+                            const RigTieMatchOptions& options) {
   const int cols = (width + kCoarseStep - 1) / kCoarseStep;
   const int rows = (height + kCoarseStep - 1) / kCoarseStep;
   cv::Mat exact(rows, cols, CV_8UC1, cv::Scalar(0)), relaxed(rows, cols, CV_8UC1, cv::Scalar(0));
@@ -267,13 +280,20 @@ CoarseZones FindCoarseZones(const std::vector<HeadWindowSampler>& samplers,
       }
   }
   CoarseZones out;
+  double all_zone_pixels = 0;
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) {
-      const unsigned m = exact.at<std::uint8_t>(r, c), m_relaxed = relaxed.at<std::uint8_t>(r, c);
+      const unsigned m = exact.at<std::uint8_t>(r, c);
       if (m & (m - 1)) out.pixels[m] += kCoarseStep * kCoarseStep;
+    }
+  for (const auto& zone : out.pixels) all_zone_pixels += zone.second;
+  out.cell_px = TieCellPx(options, all_zone_pixels);
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) {
+      const unsigned m_relaxed = relaxed.at<std::uint8_t>(r, c);
       if ((m_relaxed & (m_relaxed - 1)) == 0) continue;
-      const std::pair<int, int> cell(static_cast<int>(r * kCoarseStep / cell_px),
-                                     static_cast<int>(c * kCoarseStep / cell_px));
+      const std::pair<int, int> cell(static_cast<int>(r * kCoarseStep / out.cell_px),
+                                     static_cast<int>(c * kCoarseStep / out.cell_px));
       out.cell_heads[cell] |= m_relaxed;
     }
   return out;
@@ -312,12 +332,10 @@ std::map<unsigned, std::map<std::pair<int, int>, Eigen::Vector2i>> BestPointsPer
   foerstner.max_points = std::max(foerstner.max_points, 100000);
   std::map<unsigned, std::map<std::pair<int, int>, Eigen::Vector2i>> best;
   for (const auto& [cell, heads] : zones.cell_heads) {
-    const int x0 = static_cast<int>(std::ceil(cell.second * options.cell_px));
-    const int y0 = static_cast<int>(std::ceil(cell.first * options.cell_px));
-    const int x1 =
-        std::min(width, static_cast<int>(std::ceil((cell.second + 1) * options.cell_px)));
-    const int y1 =
-        std::min(height, static_cast<int>(std::ceil((cell.first + 1) * options.cell_px)));
+    const int x0 = static_cast<int>(std::ceil(cell.second * zones.cell_px));
+    const int y0 = static_cast<int>(std::ceil(cell.first * zones.cell_px));
+    const int x1 = std::min(width, static_cast<int>(std::ceil((cell.second + 1) * zones.cell_px)));
+    const int y1 = std::min(height, static_cast<int>(std::ceil((cell.first + 1) * zones.cell_px)));
     const cv::Rect box = Grown(x0, y0, x1, y1, border, width, height);
     for (size_t first = 0; first < samplers.size(); ++first) {
       // a first head: in the cell's union with a higher head after it
@@ -331,8 +349,8 @@ std::map<unsigned, std::map<std::pair<int, int>, Eigen::Vector2i>> BestPointsPer
         const unsigned mask = ZoneAt(samplers, at, margin);
         if ((mask & (mask - 1)) == 0 || !(mask & (1u << first)) || (mask & ((1u << first) - 1)))
           continue;  // not a zone, or first is not its first head
-        const std::pair<int, int> key(static_cast<int>(at.y() / options.cell_px),
-                                      static_cast<int>(at.x() / options.cell_px));
+        const std::pair<int, int> key(static_cast<int>(at.y() / zones.cell_px),
+                                      static_cast<int>(at.x() / zones.cell_px));
         best[mask].try_emplace(key, at);
       }
     }
@@ -355,7 +373,7 @@ void MatchInWindows(const ExposureToMatch& in,
   const int width = rig.virtual_camera.camera.width_px;
   const int height = rig.virtual_camera.camera.height_px;
   const int margin = ZoneMarginPx(options);
-  const CoarseZones zones = FindCoarseZones(samplers, width, height, margin, options.cell_px);
+  const CoarseZones zones = FindCoarseZones(samplers, width, height, margin, options);
   const auto best = BestPointsPerCell(samplers, zones, width, height, margin, options);
   // Window half sides: the template plus the prefilter's border; the search adds the shift bound,
   // an affine slack and the bicubic support.
@@ -369,6 +387,7 @@ void MatchInWindows(const ExposureToMatch& in,
     report.zone = ZoneName(rig, mask);
     const auto pixels = zones.pixels.find(mask);
     report.pixels = pixels == zones.pixels.end() ? 0 : pixels->second;
+    report.cell_px = zones.cell_px;
     report.cells = static_cast<int>(cells.size());
     const std::vector<int> members = Members(mask, n_heads);
     const int first = members.front();

@@ -13,7 +13,10 @@
 // mean-weight threshold then over the whole box instead of the cell). The matcher of
 // `aerocal match` (stitch/matching) then works per zone:
 //  1. Foerstner points (interest_operators.h) on the Wallis-filtered projection of the zone's
-//     first head (rig order), the strongest one per square cell of `cell_px` virtual px;
+//     first head (rig order), the strongest one per square cell of the exposure's tie cell
+//     (`TieCellPx`: `cell_px`, grown at large formats so the zones hold about `target_ties`
+//     cells: the self-calibration's error against the truth does not improve beyond a few
+//     hundred ties per exposure, its cost grows with them; stitch/README.md "Tie density");
 //  2. least-squares matching (least_squares_matching.h) of its template into the projection of
 //     each other head of the zone, starting at the same virtual pixel (the ground calibration
 //     leaves ~2 px; LSM's shift bound `lsm.max_shift_px`), both projections low-passed by a
@@ -45,7 +48,10 @@
 namespace aerocal::stitch {
 
 struct RigTieMatchOptions {
-  double cell_px = 40.0;            // one tie per cell of this side per zone, virtual px, >= 8
+  double cell_px = 40.0;            // one tie per cell of this side per zone, virtual px, >= 8:
+                                    // the smallest cell (TieCellPx)
+  double target_ties = 2000;        // cells the zones of an exposure hold at most (about; the
+                                    // cell grows beyond cell_px); 0: cell_px always
   double min_sigma_px = 0.02;       // floor of the LSM sigma written, virtual px, > 0
   double prefilter_sigma_px = 1.5;  // Gaussian low-pass of the projected heads for LSM (header
                                     // comment), virtual px; 0: none, else 0.3..5
@@ -61,6 +67,7 @@ struct RigTieMatchOptions {
 struct RigZoneMatchReport {
   std::string image, zone;  // "AB", "ABC"
   long pixels = 0;          // zone pixels (after the margin)
+  double cell_px = 0;       // the exposure's tie cell, virtual px (TieCellPx)
   int cells = 0;            // cells with a Foerstner point in the zone
   int lsm_tried = 0, lsm_failed = 0;
   int ties = 0;  // ties written (two or more heads)
@@ -73,6 +80,12 @@ struct RigTieMatches {
                                      // virtual px: the matching noise of the tie's differences
   std::vector<RigZoneMatchReport> zones;
 };
+
+/// The tie cell of an exposure whose overlap zones (two or more heads, after the margin) hold
+/// `zone_pixels` virtual px: `cell_px`, or the side of `target_ties` square cells covering them,
+/// rounded up to a multiple of 8 px (both matching paths estimate the pixels differently; the
+/// rounding makes them choose the same cell), whichever is larger.
+double TieCellPx(const RigTieMatchOptions& options, double zone_pixels);
 
 /// Matches the ties of exposure `exposure_index` (`exposure`: its POS and z_ref) on `heads` (one
 /// image per head of `rig`, rig order, each of its head's format; LogicError otherwise) and

@@ -394,7 +394,7 @@ double SeamMisregistrationPx(const StitchedScene& s, const RigExposure& refined)
 }
 
 // Tie density against what the self-calibration gives (issue 35): the matcher's cell (arg,
-// virtual px; one tie per cell and zone) against the ties, the CPU seconds of matching and
+// virtual px; one tie per cell and zone; no target count) against the ties, the CPU seconds of matching and
 // self-calibration, the RMS of the increments' sigmas and of their errors against the
 // simulator's truth (arcsec), and the seam misregistration the result leaves in the stitched
 // image (SeamMisregistrationPx). Run with AEROCAL_BENCH_RIG_SCALE=1 for the full formats.
@@ -403,6 +403,7 @@ void BM_TieDensity(benchmark::State& state) {
   if (SkipWithoutScene(s, state)) return;
   RigTieMatchOptions match;
   match.cell_px = static_cast<double>(state.range(0));
+  match.target_ties = 0;  // the arg is the cell at every format
   RigStitchOptions options;
   options.standard_radius_px *= SceneFormatScale();
   constexpr double kArcsec = 180.0 * 3600.0 / M_PI;

@@ -617,6 +617,35 @@ TEST(RigTieMatching, WindowsMatchAsTheWholeProjections) {
       beyond);
   EXPECT_GT(same, static_cast<int>(windows.observations.size()) / 2);
   EXPECT_LT(rms, 0.03);
+
+  // The tie cell: 40 px at this small format (the default target of 2000 cells is far above the
+  // zones' area / 40^2); a target of a quarter of the ties grows it to the side of that many
+  // square cells over the zones' pixels, rounded up to 8 px, in both paths, and the ties thin
+  // by about the ratio of the cells' areas (cells at the zones' borders hold a tie too: at most
+  // twice the target).
+  double zone_pixels = 0;
+  for (const RigZoneMatchReport& z : windows.zones) {
+    EXPECT_EQ(z.cell_px, 40.0) << z.zone;
+    zone_pixels += z.pixels;
+  }
+  RigTieMatchOptions thin;
+  thin.target_ties = std::floor(windows.ties.size() / 4.0);
+  const double cell = 8.0 * std::ceil(std::sqrt(zone_pixels / thin.target_ties) / 8.0);
+  EXPECT_EQ(TieCellPx(thin, zone_pixels), cell);
+  EXPECT_GT(cell, 40.0);
+  RigTieMatches thinned, thinned_whole;
+  MatchRigExposureTies(f.truth, in.exposures[0], 0, heads, thin, &thinned);
+  thin.whole_projections = true;
+  MatchRigExposureTies(f.truth, in.exposures[0], 0, heads, thin, &thinned_whole);
+  for (const RigZoneMatchReport& z : thinned.zones) EXPECT_EQ(z.cell_px, cell) << z.zone;
+  for (const RigZoneMatchReport& z : thinned_whole.zones) EXPECT_EQ(z.cell_px, cell) << z.zone;
+  std::printf("target %.0f ties: cell %.0f px, %zu ties (whole projections %zu)\n",
+              thin.target_ties,
+              cell,
+              thinned.ties.size(),
+              thinned_whole.ties.size());
+  EXPECT_GT(thinned.ties.size(), thin.target_ties / 2);
+  EXPECT_LT(thinned.ties.size(), 2 * thin.target_ties);
 }
 
 // The diagnosis behind the prefilter and the area-integrating renderer (stitch/README.md "Ties
