@@ -238,6 +238,171 @@ void ResampleStrip(std::vector<Window>& windows,
   });
 }
 
+// One window per sub-image: its format, the inverse mapping (virtual -> sub-image) and its
+// correction grid; InputError when a source does not match its sub-image or the first source.
+std::vector<Window> MakeWindows(const calib::Camera& camera,
+                                const std::vector<RasterSource*>& sources,
+                                const std::vector<MapCorrectionGrid>& corrections) {
+  const RasterInfo first = sources.front()->Info();
+  std::vector<Window> windows(sources.size());
+  for (size_t k = 0; k < sources.size(); ++k) {
+    const auto& s = camera.subimages[k];
+    const RasterInfo info = sources[k]->Info();
+    if (info.width != s.width_px || info.height != s.height_px)
+      throw InputError("sub-image " + s.id + ": image is " + std::to_string(info.width) + " x " +
+                       std::to_string(info.height) + " px, the camera file says " +
+                       std::to_string(s.width_px) + " x " + std::to_string(s.height_px));
+    if (info.bits != first.bits || info.bands != first.bands)
+      throw InputError("sub-image " + s.id + ": " + std::to_string(info.bits) + " bit, " +
+                       std::to_string(info.bands) + " band(s), unlike sub-image " +
+                       camera.subimages[0].id);
+    windows[k].width_px = s.width_px;
+    windows[k].height_px = s.height_px;
+    windows[k].sub_from_virtual = calib::HomographyFromParams(s.model, s.params.data()).inverse();
+    // Scaled so that w > 0 where the virtual ray lies in front of the sub-image (its pixel (0, 0)
+    // maps to w = 1 through the inverse); CoveredColumns relies on it. A negative (2, 2) (virtual
+    // pixel (0, 0) behind the sub-image's camera, e.g. a head tilted away from that corner) must
+    // not flip the sign. Affine: the last row stays 0 0 1.
+    windows[k].sub_from_virtual /= std::abs(windows[k].sub_from_virtual(2, 2));
+    if (!corrections.empty() && corrections[k].step_px > 0) {
+      const MapCorrectionGrid& g = corrections[k];
+      AEROCAL_CHECK(g.cols >= 2 && g.rows >= 2 && (g.cols - 1) * g.step_px >= camera.width_px - 1 &&
+                    (g.rows - 1) * g.step_px >= camera.height_px - 1 &&
+                    g.duv.size() == 2 * static_cast<size_t>(g.cols) * g.rows)
+          << "correction grid of sub-image " << s.id << " does not cover the virtual format";
+      windows[k].correction = &g;
+    }
+  }
+  return windows;
+}
+
+// The strip's rows [y0, y0 + rows) of a virtual image `width` wide, and how its windows are read.
+struct StripGeometry {
+  int width, y0, rows;
+  int margin;  // interpolation support, px
+  bool fast;   // the fast path (fast_strip.h) reads the windows
+  RasterInfo source;
+};
+
+// The window of sub-image `win` for a strip: the bounding box of the strip's corners mapped into
+// it, plus the interpolation margin and the correction's reach; read from `source` (or, on the
+// fast path, pointed at in place).
+void PrepareWindow(const StripGeometry& g, RasterSource* source, Window* win_out) {
+  Window& win = *win_out;
+  // A projectivity maps the strip's rectangle onto the quadrilateral of its corners when w > 0
+  // at all four (w is affine in (U, V), so then positive over the whole strip, and straight
+  // lines stay straight): the corners' bounding box is exact. A corner at or behind the
+  // sub-image's horizon (w <= 0, a tilted head under a wide virtual image) makes the image
+  // of the strip unbounded and the corners' box meaningless: then the whole format. A
+  // correction moves (u, v) by up to max_abs_px.
+  double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
+  for (double U : {0.0, g.width - 1.0})
+    for (double V : {static_cast<double>(g.y0), g.y0 + g.rows - 1.0}) {
+      const Eigen::Vector3d p = win.sub_from_virtual * Eigen::Vector3d(U, V, 1.0);
+      if (!(p.z() > 0)) {
+        u0 = v0 = -1e300;
+        u1 = v1 = 1e300;
+        break;
+      }
+      u0 = std::min(u0, p.x() / p.z());
+      u1 = std::max(u1, p.x() / p.z());
+      v0 = std::min(v0, p.y() / p.z());
+      v1 = std::max(v1, p.y() / p.z());
+    }
+  u0 = std::max(u0, -1e9), v0 = std::max(v0, -1e9), u1 = std::min(u1, 1e9), v1 = std::min(v1, 1e9);
+  const int extra =
+      win.correction ? static_cast<int>(std::ceil(win.correction->max_abs_px)) + 1 : 0;
+  const int x0 = std::max(0, static_cast<int>(std::floor(u0)) - g.margin - extra);
+  const int x1 = std::min(win.width_px - 1, static_cast<int>(std::ceil(u1)) + g.margin + extra);
+  const int wy0 = std::max(0, static_cast<int>(std::floor(v0)) - g.margin - extra);
+  const int wy1 = std::min(win.height_px - 1, static_cast<int>(std::ceil(v1)) + g.margin + extra);
+  win.used = x0 <= x1 && wy0 <= wy1;
+  if (!win.used) return;
+  win.x0 = x0;
+  win.y0 = wy0;
+  win.w = x1 - x0 + 1;
+  win.h = wy1 - wy0 + 1;
+  // Plus a row and two samples of padding: the fast path reads the last column's and row's
+  // right and lower neighbours with weight 0.
+  const int sample_bytes = g.source.bands * g.source.BytesPerSample();
+  if (g.fast && source->Samples() && wy1 + 2 < win.height_px) {
+    // In place: the padding the fast path reads (the next row and its next sample) exists.
+    win.samples = source->Samples() + (static_cast<size_t>(wy0) * win.width_px + x0) * sample_bytes;
+    win.stride = win.width_px;
+    return;
+  }
+  win.bytes.resize(static_cast<size_t>(win.w) * (win.h + 1) * sample_bytes + 2 * sample_bytes);
+  source->ReadWindow(win.x0, win.y0, win.w, win.h, win.bytes.data());
+  win.samples = win.bytes.data();
+  win.stride = win.w;
+}
+
+// Where a strip's output goes: its samples, its coverage bytes (none: nullptr) and the counts.
+struct StripOutput {
+  std::vector<std::uint8_t>* strip;
+  std::uint8_t* coverage_rows;
+  std::atomic<long>* covered;
+  std::atomic<long>* overlap;
+};
+
+// Rows [r0, r0 + n) of the strip, `columns` of each, by the path and sample type of `g`.
+void ResampleRows(std::vector<Window>& windows,
+                  const ResampleOptions& options,
+                  const StripGeometry& g,
+                  float fill,
+                  const ColumnSpan& columns,
+                  int r0,
+                  int n,
+                  const StripOutput& o) {
+  const int width = g.width;
+  const bool eight = g.source.bits == 8, one_band = g.source.bands == 1;
+  if (g.fast && eight)
+    internal::ResampleStripFast<std::uint8_t>(windows,
+                                              fill,
+                                              width,
+                                              columns,
+                                              r0,
+                                              n,
+                                              o.strip->data(),
+                                              o.coverage_rows,
+                                              o.covered,
+                                              o.overlap);
+  else if (g.fast)
+    internal::ResampleStripFast<std::uint16_t>(windows,
+                                               fill,
+                                               width,
+                                               columns,
+                                               r0,
+                                               n,
+                                               o.strip->data(),
+                                               o.coverage_rows,
+                                               o.covered,
+                                               o.overlap);
+  else if (eight && one_band)
+    ResampleStrip<std::uint8_t, 1>(
+        windows, options, width, columns, r0, n, o.strip, o.coverage_rows, o.covered, o.overlap);
+  else if (eight)
+    ResampleStrip<std::uint8_t, 3>(
+        windows, options, width, columns, r0, n, o.strip, o.coverage_rows, o.covered, o.overlap);
+  else if (one_band)
+    ResampleStrip<std::uint16_t, 1>(
+        windows, options, width, columns, r0, n, o.strip, o.coverage_rows, o.covered, o.overlap);
+  else
+    ResampleStrip<std::uint16_t, 3>(
+        windows, options, width, columns, r0, n, o.strip, o.coverage_rows, o.covered, o.overlap);
+}
+
+// The options' region, or the whole format; LogicError when it leaves the format.
+VirtualRegion CheckedRegion(const ResampleOptions& options, int width, int height) {
+  const VirtualRegion region =
+      options.region.Empty() ? VirtualRegion{0, 0, width, height} : options.region;
+  AEROCAL_CHECK(region.x0 >= 0 && region.y0 >= 0 && region.height > 0 &&
+                region.x0 + region.width <= width && region.y0 + region.height <= height)
+      << "region " << region.x0 << " " << region.y0 << " " << region.width << " x " << region.height
+      << " outside the virtual format " << width << " x " << height;
+  return region;
+}
+
 }  // namespace
 
 Interpolation ParseInterpolation(const std::string& name) {
@@ -276,139 +441,38 @@ ResampleReport ResampleVirtualImage(const calib::Camera& camera,
       << sources.size() << " sources for " << camera.subimages.size() << " sub-images";
   AEROCAL_CHECK(options.strip_rows > 0) << options.strip_rows;
   const RasterInfo first = sources.front()->Info();
-  std::vector<Window> windows(sources.size());
-  for (size_t k = 0; k < sources.size(); ++k) {
-    const auto& s = camera.subimages[k];
-    const RasterInfo info = sources[k]->Info();
-    if (info.width != s.width_px || info.height != s.height_px)
-      throw InputError("sub-image " + s.id + ": image is " + std::to_string(info.width) + " x " +
-                       std::to_string(info.height) + " px, the camera file says " +
-                       std::to_string(s.width_px) + " x " + std::to_string(s.height_px));
-    if (info.bits != first.bits || info.bands != first.bands)
-      throw InputError("sub-image " + s.id + ": " + std::to_string(info.bits) + " bit, " +
-                       std::to_string(info.bands) + " band(s), unlike sub-image " +
-                       camera.subimages[0].id);
-    windows[k].width_px = s.width_px;
-    windows[k].height_px = s.height_px;
-    windows[k].sub_from_virtual = calib::HomographyFromParams(s.model, s.params.data()).inverse();
-    // Scaled so that w > 0 where the virtual ray lies in front of the sub-image (its pixel (0, 0)
-    // maps to w = 1 through the inverse); CoveredColumns relies on it. A negative (2, 2) (virtual
-    // pixel (0, 0) behind the sub-image's camera, e.g. a head tilted away from that corner) must
-    // not flip the sign. Affine: the last row stays 0 0 1.
-    windows[k].sub_from_virtual /= std::abs(windows[k].sub_from_virtual(2, 2));
-    if (!corrections.empty() && corrections[k].step_px > 0) {
-      const MapCorrectionGrid& g = corrections[k];
-      AEROCAL_CHECK(g.cols >= 2 && g.rows >= 2 && (g.cols - 1) * g.step_px >= camera.width_px - 1 &&
-                    (g.rows - 1) * g.step_px >= camera.height_px - 1 &&
-                    g.duv.size() == 2 * static_cast<size_t>(g.cols) * g.rows)
-          << "correction grid of sub-image " << s.id << " does not cover the virtual format";
-      windows[k].correction = &g;
-    }
-  }
+  std::vector<Window> windows = MakeWindows(camera, sources, corrections);
   const int width = camera.width_px, height = camera.height_px;
-  const VirtualRegion region =
-      options.region.Empty() ? VirtualRegion{0, 0, width, height} : options.region;
-  AEROCAL_CHECK(region.x0 >= 0 && region.y0 >= 0 && region.height > 0 &&
-                region.x0 + region.width <= width && region.y0 + region.height <= height)
-      << "region " << region.x0 << " " << region.y0 << " " << region.width << " x " << region.height
-      << " outside the virtual format " << width << " x " << height;
+  const VirtualRegion region = CheckedRegion(options, width, height);
   const ColumnSpan columns{region.x0, region.x0 + region.width - 1};
   const int region_end = region.y0 + region.height;
   const RasterInfo out_info{region.width, region.height, first.bands, first.bits};
   std::vector<std::uint8_t> strip(out_info.RowBytes() * options.strip_rows);
   std::vector<std::uint8_t> coverage_strip(coverage ? region.width * options.strip_rows : 0);
-  std::uint8_t* const coverage_rows = coverage ? coverage_strip.data() : nullptr;
   std::atomic<long> covered{0}, overlap{0};
+  const StripOutput output{&strip, coverage ? coverage_strip.data() : nullptr, &covered, &overlap};
   tbb::task_arena arena(options.threads > 0 ? options.threads : tbb::task_arena::automatic);
-  const int margin = options.interpolation == Interpolation::kBicubic ? 3 : 2;
+  StripGeometry g{
+      width, 0, 0, options.interpolation == Interpolation::kBicubic ? 3 : 2, false, first};
   // The fast path (fast_strip.h): bilinear, one band, no correction grid.
-  const bool fast =
+  g.fast =
       !options.reference && options.interpolation == Interpolation::kBilinear && first.bands == 1 &&
       std::none_of(windows.begin(), windows.end(), [](const Window& w) { return w.correction; });
   const float fill =
       std::clamp(static_cast<float>(options.fill), 0.0f, first.bits == 8 ? 255.0f : 65535.0f);
   // The whole format's strips (from row 0), so that a region gets the same windows.
-  for (int y0 = region.y0 / options.strip_rows * options.strip_rows; y0 < region_end;
-       y0 += options.strip_rows) {
-    const int rows = std::min(options.strip_rows, height - y0);
-    // Window of each sub-image: bounding box of the strip's corners mapped into it, plus margin.
-    auto prepare = [&](size_t k) {
-      Window& win = windows[k];
-      // A projectivity maps the strip's rectangle onto the quadrilateral of its corners when w > 0
-      // at all four (w is affine in (U, V), so then positive over the whole strip, and straight
-      // lines stay straight): the corners' bounding box is exact. A corner at or behind the
-      // sub-image's horizon (w <= 0, a tilted head under a wide virtual image) makes the image
-      // of the strip unbounded and the corners' box meaningless: then the whole format. A
-      // correction moves (u, v) by up to max_abs_px.
-      double u0 = 1e300, v0 = 1e300, u1 = -1e300, v1 = -1e300;
-      for (double U : {0.0, width - 1.0})
-        for (double V : {static_cast<double>(y0), y0 + rows - 1.0}) {
-          const Eigen::Vector3d p = win.sub_from_virtual * Eigen::Vector3d(U, V, 1.0);
-          if (!(p.z() > 0)) {
-            u0 = v0 = -1e300;
-            u1 = v1 = 1e300;
-            break;
-          }
-          u0 = std::min(u0, p.x() / p.z());
-          u1 = std::max(u1, p.x() / p.z());
-          v0 = std::min(v0, p.y() / p.z());
-          v1 = std::max(v1, p.y() / p.z());
-        }
-      u0 = std::max(u0, -1e9), v0 = std::max(v0, -1e9), u1 = std::min(u1, 1e9),
-      v1 = std::min(v1, 1e9);
-      const int extra =
-          win.correction ? static_cast<int>(std::ceil(win.correction->max_abs_px)) + 1 : 0;
-      const int x0 = std::max(0, static_cast<int>(std::floor(u0)) - margin - extra);
-      const int x1 = std::min(win.width_px - 1, static_cast<int>(std::ceil(u1)) + margin + extra);
-      const int wy0 = std::max(0, static_cast<int>(std::floor(v0)) - margin - extra);
-      const int wy1 = std::min(win.height_px - 1, static_cast<int>(std::ceil(v1)) + margin + extra);
-      win.used = x0 <= x1 && wy0 <= wy1;
-      if (!win.used) return;
-      win.x0 = x0;
-      win.y0 = wy0;
-      win.w = x1 - x0 + 1;
-      win.h = wy1 - wy0 + 1;
-      // Plus a row and two samples of padding: the fast path reads the last column's and row's
-      // right and lower neighbours with weight 0.
-      const int sample_bytes = first.bands * first.BytesPerSample();
-      if (fast && sources[k]->Samples() && wy1 + 2 < win.height_px) {
-        // In place: the padding the fast path reads (the next row and its next sample) exists.
-        win.samples =
-            sources[k]->Samples() + (static_cast<size_t>(wy0) * win.width_px + x0) * sample_bytes;
-        win.stride = win.width_px;
-        return;
-      }
-      win.bytes.resize(static_cast<size_t>(win.w) * (win.h + 1) * sample_bytes + 2 * sample_bytes);
-      sources[k]->ReadWindow(win.x0, win.y0, win.w, win.h, win.bytes.data());
-      win.samples = win.bytes.data();
-      win.stride = win.w;
-    };
+  for (g.y0 = region.y0 / options.strip_rows * options.strip_rows; g.y0 < region_end;
+       g.y0 += options.strip_rows) {
+    g.rows = std::min(options.strip_rows, height - g.y0);
     // Sources are distinct objects: their windows are read in parallel.
-    arena.execute(
-        [&] { tbb::parallel_for(size_t{0}, windows.size(), [&](size_t k) { prepare(k); }); });
-    const int r0 = std::max(y0, region.y0), n = std::min(y0 + rows, region_end) - r0;
     arena.execute([&] {
-      if (fast && first.bits == 8)
-        internal::ResampleStripFast<std::uint8_t>(
-            windows, fill, width, columns, r0, n, strip.data(), coverage_rows, &covered, &overlap);
-      else if (fast)
-        internal::ResampleStripFast<std::uint16_t>(
-            windows, fill, width, columns, r0, n, strip.data(), coverage_rows, &covered, &overlap);
-      else if (first.bits == 8 && first.bands == 1)
-        ResampleStrip<std::uint8_t, 1>(
-            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
-      else if (first.bits == 8)
-        ResampleStrip<std::uint8_t, 3>(
-            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
-      else if (first.bands == 1)
-        ResampleStrip<std::uint16_t, 1>(
-            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
-      else
-        ResampleStrip<std::uint16_t, 3>(
-            windows, options, width, columns, r0, n, &strip, coverage_rows, &covered, &overlap);
+      tbb::parallel_for(
+          size_t{0}, windows.size(), [&](size_t k) { PrepareWindow(g, sources[k], &windows[k]); });
     });
+    const int r0 = std::max(g.y0, region.y0), n = std::min(g.y0 + g.rows, region_end) - r0;
+    arena.execute([&] { ResampleRows(windows, options, g, fill, columns, r0, n, output); });
     sink->WriteRows(r0 - region.y0, n, strip.data());
-    if (coverage) coverage->WriteRows(r0 - region.y0, n, coverage_rows);
+    if (coverage) coverage->WriteRows(r0 - region.y0, n, output.coverage_rows);
   }
   ResampleReport report;
   report.covered = covered;
