@@ -128,69 +128,88 @@ std::vector<int> Members(unsigned mask, int n_heads) {
   return members;
 }
 
-// The former path (RigTieMatchOptions::whole_projections): every head projected onto the whole
-// virtual format, zones from distance transforms, Foerstner over each zone's bounding box.
+// The former path's heads (RigTieMatchOptions::whole_projections): every head once on the whole
+// virtual grid (float grey values), its low-passed copy for LSM, and per virtual pixel the bits
+// of the heads whose coverage, shrunk by the zone margin, holds it.
+struct WholeProjections {
+  std::vector<GrayImage> projected, smoothed;
+  cv::Mat zone_mask;  // CV_8UC1, bit k: head k
+};
+
+// The low-pass copy for LSM: a normalised convolution over the head's coverage (blur of the
+// covered values / blur of the coverage), so the fill outside does not leak in at the border.
+GrayImage SmoothedOverCoverage(const GrayImage& projected, const cv::Mat& inside, double sigma) {
+  GrayImage smoothed = projected;
+  if (!(sigma > 0)) return smoothed;
+  const int height = static_cast<int>(projected.rows()), width = static_cast<int>(projected.cols());
+  cv::Mat weight;
+  inside.convertTo(weight, CV_32F, 1.0 / 255.0);
+  cv::Mat values = cv::Mat(height, width, CV_32F, const_cast<float*>(projected.data())).mul(weight);
+  cv::GaussianBlur(values, values, cv::Size(0, 0), sigma);
+  cv::GaussianBlur(weight, weight, cv::Size(0, 0), sigma);
+  cv::Mat out(height, width, CV_32F, smoothed.data());
+  for (int r = 0; r < height; ++r)
+    for (int c = 0; c < width; ++c) {
+      const float w = weight.at<float>(r, c);
+      out.at<float>(r, c) = w > 1e-3f ? values.at<float>(r, c) / w : 0.0f;
+    }
+  return smoothed;
+}
+
+WholeProjections ProjectWholeHeads(const ExposureToMatch& in, const RigTieMatchOptions& options) {
+  const calib::Rig& rig = in.converter.rig();
+  const int n_heads = static_cast<int>(rig.heads.size());
+  const int width = rig.virtual_camera.camera.width_px,
+            height = rig.virtual_camera.camera.height_px;
+  // The coverage shrunk by the template half size plus the LSM shift bound and 2 px (the
+  // interpolation support).
+  const int margin = ZoneMarginPx(options);
+  WholeProjections out{
+      std::vector<GrayImage>(n_heads), {}, cv::Mat(height, width, CV_8UC1, cv::Scalar(0))};
+  for (int k = 0; k < n_heads; ++k) {
+    const GrayImage& head = in.heads[k];
+    float top = 0.0f;
+    for (int r = 0; r < head.rows(); ++r)
+      for (int c = 0; c < head.cols(); ++c) top = std::max(top, head(r, c));
+    const double scale = top <= 255.0f ? 256.0 : 1.0;
+    MemoryRaster source({static_cast<int>(head.cols()), static_cast<int>(head.rows()), 1, 16});
+    for (int r = 0; r < head.rows(); ++r)
+      for (int c = 0; c < head.cols(); ++c)
+        source.Set(c, r, 0, std::clamp(head(r, c) * scale, 0.0, 65535.0));
+    const HeadProjection p = ProjectHeadOntoVirtual(in.converter, k, in.grids.grids[k], &source);
+    GrayImage& projected = out.projected[k];
+    projected.resize(height, width);
+    cv::Mat inside(height, width, CV_8UC1);
+    for (int r = 0; r < height; ++r)
+      for (int c = 0; c < width; ++c) {
+        projected(r, c) = static_cast<float>(p.values.At(c, r) / scale);
+        inside.at<std::uint8_t>(r, c) = p.covered[static_cast<size_t>(r) * width + c];
+      }
+    out.smoothed.push_back(SmoothedOverCoverage(projected, inside, options.prefilter_sigma_px));
+    cv::Mat distance;
+    cv::distanceTransform(inside, distance, cv::DIST_L2, 3);
+    for (int r = 0; r < height; ++r)
+      for (int c = 0; c < width; ++c)
+        if (distance.at<float>(r, c) > margin) out.zone_mask.at<std::uint8_t>(r, c) |= 1u << k;
+  }
+  return out;
+}
+
+// The former path: zones (the sets of two or more heads) from the whole projections; per zone
+// and cell the strongest Foerstner point of the zone's first head over the zone's bounding box.
 void MatchOnWholeProjections(const ExposureToMatch& in,
                              const RigTieMatchOptions& options,
                              RigTieMatches* out) {
   const auto& [converter, grids, exposure, exposure_index, heads] = in;
   const calib::Rig& rig = converter.rig();
   const int n_heads = static_cast<int>(rig.heads.size());
-  const calib::Camera& v = rig.virtual_camera.camera;
-  const int width = v.width_px, height = v.height_px;
-  // Every head once on the virtual grid (float grey values) with its coverage shrunk by the
-  // template half size plus the LSM shift bound and 2 px (the interpolation support).
-  const int margin = ZoneMarginPx(options);
-  std::vector<GrayImage> projected(n_heads), smoothed(n_heads);
-  cv::Mat zone_mask(height, width, CV_8UC1, cv::Scalar(0));
-  for (int k = 0; k < n_heads; ++k) {
-    float top = 0.0f;
-    for (int r = 0; r < heads[k].rows(); ++r)
-      for (int c = 0; c < heads[k].cols(); ++c) top = std::max(top, heads[k](r, c));
-    const double scale = top <= 255.0f ? 256.0 : 1.0;
-    MemoryRaster source(
-        {static_cast<int>(heads[k].cols()), static_cast<int>(heads[k].rows()), 1, 16});
-    for (int r = 0; r < heads[k].rows(); ++r)
-      for (int c = 0; c < heads[k].cols(); ++c)
-        source.Set(c, r, 0, std::clamp(heads[k](r, c) * scale, 0.0, 65535.0));
-    const HeadProjection p = ProjectHeadOntoVirtual(converter, k, grids.grids[k], &source);
-    projected[k].resize(height, width);
-    cv::Mat inside(height, width, CV_8UC1);
-    for (int r = 0; r < height; ++r)
-      for (int c = 0; c < width; ++c) {
-        projected[k](r, c) = static_cast<float>(p.values.At(c, r) / scale);
-        inside.at<std::uint8_t>(r, c) = p.covered[static_cast<size_t>(r) * width + c];
-      }
-    // The low-pass copy for LSM: a normalised convolution over the head's coverage (blur of the
-    // covered values / blur of the coverage), so the fill outside does not leak in at the border.
-    smoothed[k] = projected[k];
-    if (options.prefilter_sigma_px > 0) {
-      cv::Mat weight;
-      inside.convertTo(weight, CV_32F, 1.0 / 255.0);
-      cv::Mat values = cv::Mat(height, width, CV_32F, projected[k].data()).mul(weight);
-      cv::GaussianBlur(values, values, cv::Size(0, 0), options.prefilter_sigma_px);
-      cv::GaussianBlur(weight, weight, cv::Size(0, 0), options.prefilter_sigma_px);
-      cv::Mat out(height, width, CV_32F, smoothed[k].data());
-      for (int r = 0; r < height; ++r)
-        for (int c = 0; c < width; ++c) {
-          const float w = weight.at<float>(r, c);
-          out.at<float>(r, c) = w > 1e-3f ? values.at<float>(r, c) / w : 0.0f;
-        }
-    }
-    cv::Mat distance;
-    cv::distanceTransform(inside, distance, cv::DIST_L2, 3);
-    for (int r = 0; r < height; ++r)
-      for (int c = 0; c < width; ++c)
-        if (distance.at<float>(r, c) > margin) zone_mask.at<std::uint8_t>(r, c) |= 1u << k;
-  }
-
-  // Zones: the sets of two or more heads; per zone and cell the strongest Foerstner point of the
-  // zone's first head.
+  const WholeProjections w = ProjectWholeHeads(in, options);
+  const int width = w.zone_mask.cols, height = w.zone_mask.rows;
   std::map<unsigned, cv::Rect> zone_box;
   std::map<unsigned, long> zone_pixels;
   for (int r = 0; r < height; ++r)
     for (int c = 0; c < width; ++c) {
-      const unsigned m = zone_mask.at<std::uint8_t>(r, c);
+      const unsigned m = w.zone_mask.at<std::uint8_t>(r, c);
       if (m == 0 || (m & (m - 1)) == 0) continue;
       cv::Rect& box = zone_box[m];
       box = box.area() == 0 ? cv::Rect(c, r, 1, 1) : (box | cv::Rect(c, r, 1, 1));
@@ -207,7 +226,7 @@ void MatchOnWholeProjections(const ExposureToMatch& in,
     report.cell_px = cell_px;
     const std::vector<int> members = Members(mask, n_heads);
     const int first = members.front();
-    const GrayImage crop = projected[first].block(box.y, box.x, box.height, box.width);
+    const GrayImage crop = w.projected[first].block(box.y, box.x, box.height, box.width);
     FoerstnerOptions foerstner = options.foerstner;
     foerstner.max_points = std::max(foerstner.max_points, 100000);
     const std::vector<InterestPoint> points =
@@ -218,7 +237,7 @@ void MatchOnWholeProjections(const ExposureToMatch& in,
       const Eigen::Vector2i at(box.x + static_cast<int>(std::lround(p.position.x())),
                                box.y + static_cast<int>(std::lround(p.position.y())));
       if (at.x() < 0 || at.y() < 0 || at.x() >= width || at.y() >= height ||
-          zone_mask.at<std::uint8_t>(at.y(), at.x()) != mask)
+          w.zone_mask.at<std::uint8_t>(at.y(), at.x()) != mask)
         continue;
       best.try_emplace({static_cast<int>(at.y() / cell_px), static_cast<int>(at.x() / cell_px)},
                        at);
@@ -227,18 +246,11 @@ void MatchOnWholeProjections(const ExposureToMatch& in,
     for (const auto& cell_point : best) {
       const Eigen::Vector2i at = cell_point.second;  // a copy: lambdas capture it
       const Eigen::Vector2d p(at.x(), at.y());
-      AppendTie(
-          converter,
-          options,
-          members,
-          p,
-          exposure_index,
-          [&](int k) {
-            return MatchLeastSquares(
-                smoothed[first], at, smoothed[k], p, Eigen::Matrix2d::Identity(), options.lsm);
-          },
-          &report,
-          out);
+      const auto match = [&](int k) {
+        return MatchLeastSquares(
+            w.smoothed[first], at, w.smoothed[k], p, Eigen::Matrix2d::Identity(), options.lsm);
+      };
+      AppendTie(converter, options, members, p, exposure_index, match, &report, out);
     }
     out->zones.push_back(report);
   }
