@@ -500,17 +500,16 @@ BudgetQuantity AdjustedQuantityBudget(const std::string& name,
   return q;
 }
 
-std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
-                                              const Project& project,
-                                              const BudgetOptions& options) {
-  const AdjustmentResult& all = run.all.result;
-  if (all.cameras.empty()) return {};
-  const CameraEstimate& camera = all.cameras[0];
-  const BudgetInputs inputs = MakeBudgetInputs(run, project, options);
-  const double dof_adjustment = inputs.dof_adjustment;
+namespace {
 
+// The certified functions of the interior: every free parameter, and the distortion values at the
+// radii. Those are the model's own terms (calib::ModelDistortionAtRadius: brown_fraser_10's,
+// header), there when a term of their group is free; a camera in a model without such a profile
+// certifies its parameters.
+std::vector<InteriorFunction> InteriorFunctions(const CameraEstimate& camera,
+                                                const std::vector<calib::ParamInfo>& table,
+                                                const std::vector<double>& radii_mm) {
   std::vector<InteriorFunction> functions;
-  const std::vector<calib::ParamInfo>& table = inputs.table;
   for (int k = 0; k < static_cast<int>(table.size()); ++k) {
     if (!camera.free[k]) continue;
     functions.push_back({std::string(table[k].name),
@@ -518,9 +517,6 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
                          "interior parameter",
                          [k](const calib::InteriorParams& p) { return p[k]; }});
   }
-  // The distortion values at radii are the model's own terms (calib::ModelDistortionAtRadius:
-  // brown_fraser_10's, header), there when a term of their group is free; a camera in a model
-  // without such a profile certifies its parameters.
   const bool own = calib::HasDistortionAtRadius(camera.model);
   const auto any_free = [&](calib::ParamGroup group) {
     for (int k = 0; k < static_cast<int>(table.size()); ++k)
@@ -529,7 +525,7 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
   };
   const bool radial = own && any_free(calib::ParamGroup::kRadial);
   const bool decentring = own && any_free(calib::ParamGroup::kDecentering);
-  for (double r : options.radii_mm) {
+  for (double r : radii_mm) {
     if (radial)
       functions.push_back({StringPrintf("dr@%g", r),
                            "um",
@@ -546,87 +542,102 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
              return calib::ModelDistortionAtRadius(model, p.data(), r)->decentring_um;
            }});
   }
+  return functions;
+}
 
-  std::vector<BudgetQuantity> out;
-  for (const auto& f : functions) out.push_back(InteriorQuantity(f, inputs));
-  // Check-point accuracy and m_0.
-  if (all.check.n > 0) {
-    const double n = all.check.n;
-    const char* axes[] = {"m_X", "m_Y", "m_Z"};
-    Eigen::Vector3d survey = Eigen::Vector3d::Zero();
-    int n_survey = 0;
-    for (const auto& d : all.check_points)
-      if (const GroundPoint* p = project.FindPoint(d.point)) {
-        survey += p->sigma_m.cwiseAbs2();
-        ++n_survey;
-      }
-    if (n_survey > 0) survey = (survey / n_survey).cwiseSqrt();
-    for (int a = 0; a < 3; ++a) {
-      BudgetQuantity q;
-      q.name = axes[a];
-      q.unit = "mm";
-      q.description = "check-point RMSE";
-      q.value = 1e3 * all.check.rmse_m(a);
-      q.components.push_back(Component(
-          "check-point sampling", "A", q.value / std::sqrt(2 * n), std::max(1.0, n - 1), "mm"));
-      q.components.back().origin =
-          StringPrintf("%d check points: the RMSE's standard deviation m / sqrt(2 n)", all.check.n);
-      q.components.push_back(Component("check-point survey", "B", 1e3 * survey(a), kInf, "mm"));
-      q.components.back().origin = "RMS of the check points' survey sigmas (points file)";
-      out.push_back(q);
+// The check-point RMSE per axis: its sampling (m / sqrt(2 n), type A) and the RMS of the check
+// points' survey sigmas (type B).
+void AddCheckPointQuantities(const AdjustmentResult& all,
+                             const Project& project,
+                             std::vector<BudgetQuantity>* out) {
+  if (all.check.n <= 0) return;
+  const double n = all.check.n;
+  const char* axes[] = {"m_X", "m_Y", "m_Z"};
+  Eigen::Vector3d survey = Eigen::Vector3d::Zero();
+  int n_survey = 0;
+  for (const auto& d : all.check_points)
+    if (const GroundPoint* p = project.FindPoint(d.point)) {
+      survey += p->sigma_m.cwiseAbs2();
+      ++n_survey;
     }
-  }
-  {
+  if (n_survey > 0) survey = (survey / n_survey).cwiseSqrt();
+  for (int a = 0; a < 3; ++a) {
     BudgetQuantity q;
-    q.name = "m_0";
-    q.unit = "um";
-    q.description = "sigma0 of the image measurements";
-    q.value = all.sigma0_um;
-    q.components.push_back(Component("variance estimate",
-                                     "A",
-                                     all.sigma0_um / std::sqrt(2.0 * dof_adjustment),
-                                     dof_adjustment,
-                                     "um"));
+    q.name = axes[a];
+    q.unit = "mm";
+    q.description = "check-point RMSE";
+    q.value = 1e3 * all.check.rmse_m(a);
+    q.components.push_back(Component(
+        "check-point sampling", "A", q.value / std::sqrt(2 * n), std::max(1.0, n - 1), "mm"));
     q.components.back().origin =
-        "sigma0 / sqrt(2 r), redundancy r = " + std::to_string(all.solve.redundancy);
-    out.push_back(q);
+        StringPrintf("%d check points: the RMSE's standard deviation m / sqrt(2 n)", all.check.n);
+    q.components.push_back(Component("check-point survey", "B", 1e3 * survey(a), kInf, "mm"));
+    q.components.back().origin = "RMS of the check points' survey sigmas (points file)";
+    out->push_back(q);
   }
+}
+
+// m_0: sigma0 of the image measurements, its variance estimate sigma0 / sqrt(2 r).
+BudgetQuantity SigmaZeroQuantity(const AdjustmentResult& all, double dof_adjustment) {
+  BudgetQuantity q;
+  q.name = "m_0";
+  q.unit = "um";
+  q.description = "sigma0 of the image measurements";
+  q.value = all.sigma0_um;
+  q.components.push_back(Component("variance estimate",
+                                   "A",
+                                   all.sigma0_um / std::sqrt(2.0 * dof_adjustment),
+                                   dof_adjustment,
+                                   "um"));
+  q.components.back().origin =
+      "sigma0 / sqrt(2 r), redundancy r = " + std::to_string(all.solve.redundancy);
+  return q;
+}
+
+// A component of the budget file as a type B component of `q`, its value converted to the
+// quantity's unit (0.002 um for a quantity in mm is 2e-6 mm; another kind needs the sensitivity
+// that converts it). ConfigError naming the budget file's line.
+UncertaintyComponent FromBudgetFile(const UserComponent& u, const BudgetQuantity& q) {
+  UncertaintyComponent c;
+  c.source = u.source;
+  c.type = "B";
+  c.distribution = u.distribution;
+  c.value = u.value;
+  c.value_unit = u.unit;
+  c.divisor = Divisor(u.distribution, "budget component " + u.source);
+  const std::string who = u.where + ": budget component '" + u.source + "' of " + u.quantity;
+  const BudgetUnit* from = u.unit.empty() ? nullptr : FindBudgetUnit(u.unit);
+  const BudgetUnit* to = FindBudgetUnit(q.unit);
+  double factor = 1.0;
+  if (from && u.unit != q.unit) {
+    if (to && std::string(to->kind) == from->kind)
+      factor = from->scale / to->scale;
+    else if (!u.sensitivity_given)
+      throw ConfigError(who + ": unit " + u.unit + " is no " + (to ? to->kind : q.unit) +
+                        "; give its sensitivity (" + q.unit + " per " + u.unit + ")");
+  }
+  c.sensitivity = u.sensitivity * factor;
+  c.u = std::abs(c.sensitivity) * u.value / c.divisor;
+  if (!std::isfinite(c.u))
+    throw ConfigError(who + ": the standard uncertainty is not finite (value " +
+                      FormatNumber(u.value) + " " + u.unit + ", sensitivity " +
+                      FormatNumber(u.sensitivity) + ")");
+  c.dof = u.dof;
+  c.origin = "budget file " + u.where;
+  return c;
+}
+
+// The budget file's components added to their quantities; one of the same name (case aside)
+// replaces the default one: the budget file overrides what aerocal derived (a pitch tolerance
+// from a better datasheet, ...).
+void AddUserComponents(const BudgetOptions& options, std::vector<BudgetQuantity>* out) {
   for (const auto& u : options.user) {
     auto q = std::find_if(
-        out.begin(), out.end(), [&](const BudgetQuantity& b) { return b.name == u.quantity; });
-    if (q == out.end())
+        out->begin(), out->end(), [&](const BudgetQuantity& b) { return b.name == u.quantity; });
+    if (q == out->end())
       throw ConfigError(u.where + ": budget component '" + u.source + "': unknown quantity " +
                         u.quantity + " (not certified by this calibration)");
-    UncertaintyComponent c;
-    c.source = u.source;
-    c.type = "B";
-    c.distribution = u.distribution;
-    c.value = u.value;
-    c.value_unit = u.unit;
-    c.divisor = Divisor(u.distribution, "budget component " + u.source);
-    // Units: a value in the quantity's own kind is converted to the quantity's unit (0.002 um for
-    // a quantity in mm is 2e-6 mm); another kind needs the sensitivity that converts it.
-    const std::string who = u.where + ": budget component '" + u.source + "' of " + u.quantity;
-    const BudgetUnit* from = u.unit.empty() ? nullptr : FindBudgetUnit(u.unit);
-    const BudgetUnit* to = FindBudgetUnit(q->unit);
-    double factor = 1.0;
-    if (from && u.unit != q->unit) {
-      if (to && std::string(to->kind) == from->kind)
-        factor = from->scale / to->scale;
-      else if (!u.sensitivity_given)
-        throw ConfigError(who + ": unit " + u.unit + " is no " + (to ? to->kind : q->unit) +
-                          "; give its sensitivity (" + q->unit + " per " + u.unit + ")");
-    }
-    c.sensitivity = u.sensitivity * factor;
-    c.u = std::abs(c.sensitivity) * u.value / c.divisor;
-    if (!std::isfinite(c.u))
-      throw ConfigError(who + ": the standard uncertainty is not finite (value " +
-                        FormatNumber(u.value) + " " + u.unit + ", sensitivity " +
-                        FormatNumber(u.sensitivity) + ")");
-    c.dof = u.dof;
-    c.origin = "budget file " + u.where;
-    // A component of the same name (case aside) replaces the default one: the budget file
-    // overrides what aerocal derived (a pitch tolerance from a better datasheet, ...).
+    UncertaintyComponent c = FromBudgetFile(u, *q);
     const auto same = std::find_if(
         q->components.begin(), q->components.end(), [&](const UncertaintyComponent& d) {
           return SameName(d.source, u.source);
@@ -638,6 +649,22 @@ std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
       q->components.push_back(c);
     }
   }
+}
+
+}  // namespace
+
+std::vector<BudgetQuantity> UncertaintyBudget(const CalibrationRun& run,
+                                              const Project& project,
+                                              const BudgetOptions& options) {
+  const AdjustmentResult& all = run.all.result;
+  if (all.cameras.empty()) return {};
+  const BudgetInputs inputs = MakeBudgetInputs(run, project, options);
+  std::vector<BudgetQuantity> out;
+  for (const auto& f : InteriorFunctions(all.cameras[0], inputs.table, options.radii_mm))
+    out.push_back(InteriorQuantity(f, inputs));
+  AddCheckPointQuantities(all, project, &out);
+  out.push_back(SigmaZeroQuantity(all, inputs.dof_adjustment));
+  AddUserComponents(options, &out);
   for (auto& q : out) {
     Finish(&q);
     // A non-finite intermediate (a distortion at an absurd radius, an overflowing component) is
