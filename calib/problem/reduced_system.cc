@@ -109,6 +109,7 @@ std::unique_ptr<ReducedSystem> ReducedSystem::Create(const ResidualEvaluator& ev
       s.residual_point_[i] = s.point_of_block_[b];
     }
   s.BuildStructure(ev);
+  s.IndexPointTerms(ev);
   s.dense_ = s.n_reduced_ <= max_dense;
   if (s.dense_) {
     s.dense_s_.setZero(s.n_reduced_, s.n_reduced_);  // cells outside the pattern stay 0
@@ -219,7 +220,6 @@ void ReducedSystem::BuildStructure(const ResidualEvaluator& ev) {
   row_bounds_ = BalancedBounds(row_cost, threads_);
   point_bounds_ = BalancedBounds(point_cost, threads_);
   IndexCells(ev);
-  IndexPointTerms(ev);
 }
 
 int ReducedSystem::CellIndex(int row, int col_block) const {
