@@ -69,6 +69,16 @@ inline void AddTransposedProduct(
   }
 }
 
+/// AddTransposedProduct with the shared dimension and the column count of a fixed at compile time
+/// (kRows, kM > 0; 0 takes the runtime value), for a caller that runs many products of one shape
+/// (a row of S, a point's pairs): one switch on n per product instead of three size switches and
+/// two calls. The same operations in the same order: the same bits.
+template <int kRows, int kM>
+inline void AddTransposedProductOf(
+    const double* a, const double* b, int rows, int m, int n, double sign, double* out) {
+  kernel_detail::DispatchColumns<kRows, kM>(a, b, rows, m, n, sign, out);
+}
+
 /// out (m x n) = a b, with a (m x k) and b (k x n); all row-major.
 inline void MultiplyInto(const double* a, const double* b, int m, int k, int n, double* out) {
   for (int i = 0; i < m; ++i)

@@ -109,6 +109,7 @@ std::unique_ptr<ReducedSystem> ReducedSystem::Create(const ResidualEvaluator& ev
       s.residual_point_[i] = s.point_of_block_[b];
     }
   s.BuildStructure(ev);
+  s.IndexPointTerms(ev);
   s.dense_ = s.n_reduced_ <= max_dense;
   if (s.dense_) {
     s.dense_s_.setZero(s.n_reduced_, s.n_reduced_);  // cells outside the pattern stay 0
@@ -265,6 +266,49 @@ void ReducedSystem::IndexCells(const ResidualEvaluator& ev) {
   PartitionRows(cell_cost, row_cost);
 }
 
+void ReducedSystem::IndexPointTerms(const ResidualEvaluator& ev) {
+  point_res_slot_.resize(point_res_.size());
+  point_res_w_start_ = {0};
+  point_res_w_slot_.clear();
+  point_res_w_entry_.clear();
+  for (size_t e = 0; e < points_.size(); ++e) {
+    const int b0 = point_blk_start_[e], b1 = point_blk_start_[e + 1];
+    for (int k = point_res_start_[e]; k < point_res_start_[e + 1]; ++k) {
+      const ResidualTerm& term = ev.term(point_res_[k]);
+      point_res_slot_[k] = SlotOf(term, points_[e]);
+      for (size_t q = 0; q < term.free.size(); ++q) {
+        const int b = term.free[q];
+        if (b < 0 || reduced_of_block_[b] < 0) continue;
+        point_res_w_slot_.push_back(static_cast<int>(q));
+        point_res_w_entry_.push_back(static_cast<int>(std::lower_bound(point_blk_.begin() + b0,
+                                                                       point_blk_.begin() + b1,
+                                                                       reduced_of_block_[b]) -
+                                                      point_blk_.begin()));
+      }
+      point_res_w_start_.push_back(static_cast<long long>(point_res_w_slot_.size()));
+    }
+  }
+}
+
+template <int kRows, int kT>
+void ReducedSystem::AddPointResidual(
+    const ResidualEvaluator& ev, int k, int t, double* v, double* g) {
+  const int i = point_res_[k], rows = ev.residual_size(i);
+  const double* ej = ev.jacobian(i, point_res_slot_[k]);
+  AddTransposedProductOf<kRows, kT>(ej, ej, rows, t, t, 1.0, v);
+  AddTransposedProductOf<kRows, kT>(ej, ev.residual(i), rows, t, 1, 1.0, g);
+  for (long long p = point_res_w_start_[k]; p < point_res_w_start_[k + 1]; ++p) {
+    const int a = point_res_w_entry_[p];
+    AddTransposedProductOf<kRows, kT>(ej,
+                                      ev.jacobian(i, point_res_w_slot_[p]),
+                                      rows,
+                                      t,
+                                      BlockSize(point_blk_[a]),
+                                      1.0,
+                                      w_.data() + point_w_[a]);
+  }
+}
+
 void ReducedSystem::PartitionRows(const std::vector<double>& cell_cost,
                                   const std::vector<double>& row_cost) {
   double total = 0.0;
@@ -314,21 +358,10 @@ void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
                                                          : w_.data() + w_.size(),
                   0.0);
       for (int k = point_res_start_[e]; k < point_res_start_[e + 1]; ++k) {
-        const int i = point_res_[k], rows = ev.residual_size(i);
-        const ResidualTerm& term = ev.term(i);
-        const double* ej = ev.jacobian(i, SlotOf(term, pb));
-        AddTransposedProduct(ej, ej, rows, t, t, 1.0, v);
-        AddTransposedProduct(ej, ev.residual(i), rows, t, 1, 1.0, g_.data() + to);
-        for (size_t q = 0; q < term.free.size(); ++q) {
-          const int b = term.free[q];
-          if (b < 0 || reduced_of_block_[b] < 0) continue;
-          const int j = reduced_of_block_[b], sj = ev.block(b).tangent;
-          const int a = static_cast<int>(
-              std::lower_bound(point_blk_.begin() + b0, point_blk_.begin() + b1, j) -
-              point_blk_.begin());
-          AddTransposedProduct(
-              ej, ev.jacobian(i, static_cast<int>(q)), rows, t, sj, 1.0, w_.data() + point_w_[a]);
-        }
+        if (t == 3 && ev.residual_size(point_res_[k]) == 2)  // a ray of a ground point
+          AddPointResidual<2, 3>(ev, k, t, v, g_.data() + to);
+        else
+          AddPointResidual<0, 0>(ev, k, t, v, g_.data() + to);
       }
       for (int a = 0; a < t; ++a) diag_(to + a) = v[a * t + a];
     }
@@ -352,7 +385,23 @@ void ReducedSystem::Linearize(const ResidualEvaluator& ev) {
 }
 
 void ReducedSystem::AssembleRow(const ResidualEvaluator& ev, const RowPart& part) {
-  const int i = part.row, bi = reduced_[i], si = BlockSize(i), oi = reduced_offset_[i];
+  switch (BlockSize(part.row)) {  // an exposure's rotation or centre, the interior
+    case 3:
+      return AssembleRowSized<3>(ev, part);
+    case 10:
+      return AssembleRowSized<10>(ev, part);
+    default:
+      return AssembleRowSized<0>(ev, part);
+  }
+}
+
+// The row's products by the kernel of their shape (block_kernels.h): the residual's rows 2 (a ray)
+// and the point's tangent 3 with the row's size kSi are fixed once for the row piece; any other
+// shape takes the generic dispatch. The same operations in the same order either way.
+template <int kSi>
+void ReducedSystem::AssembleRowSized(const ResidualEvaluator& ev, const RowPart& part) {
+  const int i = part.row, bi = reduced_[i], oi = reduced_offset_[i];
+  const int si = kSi > 0 ? kSi : BlockSize(i);
   const int c0 = part.cell_begin, c1 = part.cell_end;
   const bool last = c1 == row_start_[i + 1];  // the diagonal cell is the row's last
   for (int c = c0; c < c1; ++c)
@@ -367,13 +416,12 @@ void ReducedSystem::AssembleRow(const ResidualEvaluator& ev, const RowPart& part
     for (int q = 0; q < slots; ++q) {
       const int c = cells[q];  // -1 (no cell) is below c0 too
       if (c < c0 || c >= c1) continue;
-      AddTransposedProduct(fi,
-                           ev.jacobian(r, q),
-                           rows,
-                           si,
-                           BlockSize(row_cols_[c]),
-                           1.0,
-                           s_.data() + cell_offset_[c]);
+      const int sj = BlockSize(row_cols_[c]);
+      double* cell = s_.data() + cell_offset_[c];
+      if (rows == 2)
+        AddTransposedProductOf<2, kSi>(fi, ev.jacobian(r, q), rows, si, sj, 1.0, cell);
+      else
+        AddTransposedProduct(fi, ev.jacobian(r, q), rows, si, sj, 1.0, cell);
     }
   }
   const int ti = ev.tangent_offset(bi);
@@ -388,22 +436,39 @@ void ReducedSystem::AssembleRow(const ResidualEvaluator& ev, const RowPart& part
     const int e = entry_point_[entry], a0 = point_blk_start_[e];
     const int t = ev.block(points_[e]).tangent;
     const double* wi = w_.data() + point_w_[entry];
+    const double* qg = qg_.data() + ev.tangent_offset(points_[e]);
     const int* cells = pair_cell_.data() + pair_cell_start_[entry];
-    for (int a = a0; a <= entry; ++a) {
-      const int c = cells[a - a0];
-      if (c < c0) continue;
-      if (c >= c1) break;
-      AddTransposedProduct(wi,
-                           q_.data() + point_w_[a],
-                           t,
-                           si,
-                           BlockSize(point_blk_[a]),
-                           -1.0,
-                           s_.data() + cell_offset_[c]);
+    if (t == 3) {
+      AddPointPairs<3, kSi>(wi, cells, a0, entry, t, si, c0, c1, -1.0);
+      if (last) AddTransposedProductOf<3, kSi>(wi, qg, t, si, 1, 1.0, rhs_.data() + oi);
+    } else {
+      AddPointPairs<0, kSi>(wi, cells, a0, entry, t, si, c0, c1, -1.0);
+      if (last) AddTransposedProduct(wi, qg, t, si, 1, 1.0, rhs_.data() + oi);
     }
-    if (last)
-      AddTransposedProduct(
-          wi, qg_.data() + ev.tangent_offset(points_[e]), t, si, 1, 1.0, rhs_.data() + oi);
+  }
+}
+
+template <int kT, int kSi>
+void ReducedSystem::AddPointPairs(const double* wi,
+                                  const int* cells,
+                                  int a0,
+                                  int entry,
+                                  int t,
+                                  int si,
+                                  int c0,
+                                  int c1,
+                                  double sign) {
+  for (int a = a0; a <= entry; ++a) {
+    const int c = cells[a - a0];
+    if (c < c0) continue;
+    if (c >= c1) break;
+    AddTransposedProductOf<kT, kSi>(wi,
+                                    q_.data() + point_w_[a],
+                                    t,
+                                    si,
+                                    BlockSize(point_blk_[a]),
+                                    sign,
+                                    s_.data() + cell_offset_[c]);
   }
 }
 

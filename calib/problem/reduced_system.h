@@ -72,7 +72,30 @@ class ReducedSystem {
   /// alone receives a product from every point: about half of the work) and the pieces into one
   /// contiguous range per thread.
   void PartitionRows(const std::vector<double>& cell_cost, const std::vector<double>& row_cost);
+  /// Per entry of point_res_: the point's slot in the residual and, per reduced parameter of the
+  /// residual, its slot and its point entry (index into point_blk_): Linearize reads these in order
+  /// instead of the residual terms scattered over the heap.
+  void IndexPointTerms(const ResidualEvaluator& ev);
+  /// V_e, g_e and W_e += the terms of residual point_res_[k] (kRows x kT fixed at compile time,
+  /// 0: the runtime sizes).
+  template <int kRows, int kT>
+  void AddPointResidual(const ResidualEvaluator& ev, int k, int t, double* v, double* g);
   void AssembleRow(const ResidualEvaluator& ev, const RowPart& part);
+  /// AssembleRow with the row's block size kSi fixed at compile time (3, 10; 0: BlockSize(row)).
+  template <int kSi>
+  void AssembleRowSized(const ResidualEvaluator& ev, const RowPart& part);
+  /// sign W_e^T Q_a into the cells of a point's pairs (a0..entry) that lie in [c0, c1), with the
+  /// point's tangent kT and the row's size kSi fixed at compile time (0: t, si).
+  template <int kT, int kSi>
+  void AddPointPairs(const double* wi,
+                     const int* cells,
+                     int a0,
+                     int entry,
+                     int t,
+                     int si,
+                     int c0,
+                     int c1,
+                     double sign);
   /// V_e^-1 (damped by d2_; pseudo-inverse with `pseudo`), Q_e, V_e^-1 g_e per point, then every
   /// row of S and the right-hand side. False when a point block is not finite.
   bool Reduce(const ResidualEvaluator& ev, bool pseudo);
@@ -100,6 +123,8 @@ class ReducedSystem {
   // The cells AssembleRow adds into, looked up once (IndexCells): per point entry, the cells of
   // its pairs with the point's blocks up to it; per entry of red_res_, the cell of each parameter
   // of the residual (-1: a point, constant, or a column block above the row).
+  std::vector<int> point_res_slot_, point_res_w_slot_, point_res_w_entry_;
+  std::vector<long long> point_res_w_start_;
   std::vector<long long> pair_cell_start_, u_cell_start_;
   std::vector<int> pair_cell_, u_cell_;
   std::vector<double> s_;
