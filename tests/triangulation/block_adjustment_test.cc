@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -259,6 +260,42 @@ TEST(BlockAdjustment, PlantedGrossErrorIsFoundListedAndRemoved) {
   EXPECT_EQ(a.check.n, b.check.n);
   EXPECT_NEAR(b.check.spatial_rmse_m, a.check.spatial_rmse_m, 1e-3 * a.check.spatial_rmse_m);
   EXPECT_NEAR(b.sigma0, a.sigma0, 1e-6);
+}
+
+// An exposure that sees two points cannot be oriented: it is left out with its observations
+// (DropUndeterminedExposures, which no other test checks), and the result is the one of the
+// block that never observed it: the same residuals, in the same order, and the same sigma0.
+TEST(BlockAdjustment, ExposureSeeingTwoPointsIsLeftOutAsIfNeverObserved) {
+  const Project clean = ProjectFromFlight(SimulateFlight(FlightSimulationOptions{}));
+  const std::string image = clean.exposures[clean.exposures.size() / 2].image;
+  Project two = clean, none = clean;
+  two.observations.clear();
+  none.observations.clear();
+  int kept_of_image = 0;
+  for (const auto& o : clean.observations) {
+    if (o.image != image) {
+      two.observations.push_back(o);
+      none.observations.push_back(o);
+    } else if (kept_of_image < 2) {
+      two.observations.push_back(o);
+      ++kept_of_image;
+    }
+  }
+  ASSERT_EQ(kept_of_image, 2);
+  const AdjustmentResult a = Adjust(two, AdjustOptions{});
+  const AdjustmentResult b = Adjust(none, AdjustOptions{});
+  EXPECT_NE(std::find(a.notes.begin(),
+                      a.notes.end(),
+                      "image " + image +
+                          " sees 2 point(s) only: its orientation cannot be determined; left out"),
+            a.notes.end());
+  ASSERT_EQ(a.residuals.size(), b.residuals.size());
+  EXPECT_NEAR(a.sigma0, b.sigma0, 1e-9 * b.sigma0);
+  for (size_t i = 0; i < a.residuals.size(); ++i) {
+    ASSERT_EQ(a.residuals[i].image, b.residuals[i].image);
+    ASSERT_EQ(a.residuals[i].point, b.residuals[i].point);
+    EXPECT_NEAR((a.residuals[i].residual_px - b.residuals[i].residual_px).norm(), 0.0, 1e-9);
+  }
 }
 
 }  // namespace
