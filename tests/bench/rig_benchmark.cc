@@ -394,8 +394,8 @@ double SeamMisregistrationPx(const StitchedScene& s, const RigExposure& refined)
 }
 
 // Tie density against what the self-calibration gives (issue 35): the matcher's cell (arg,
-// virtual px; one tie per cell and zone; no target count) against the ties, the CPU seconds of matching and
-// self-calibration, the RMS of the increments' sigmas and of their errors against the
+// virtual px; one tie per cell and zone; no target count) against the ties, the CPU seconds of
+// matching and self-calibration, the RMS of the increments' sigmas and of their errors against the
 // simulator's truth (arcsec), and the seam misregistration the result leaves in the stitched
 // image (SeamMisregistrationPx). Run with AEROCAL_BENCH_RIG_SCALE=1 for the full formats.
 void BM_TieDensity(benchmark::State& state) {
