@@ -50,8 +50,9 @@ namespace aerocal::stitch {
 struct RigTieMatchOptions {
   double cell_px = 40.0;            // one tie per cell of this side per zone, virtual px, >= 8:
                                     // the smallest cell (TieCellPx)
-  double target_ties = 2000;        // cells the zones of an exposure hold at most (about; the
-                                    // cell grows beyond cell_px); 0: cell_px always
+  double target_ties = 2000;        // about this many cells over an exposure's zones (the
+                                    // cell grows beyond cell_px to keep to it; cells at the
+                                    // zones' borders add some); 0: cell_px always
   double min_sigma_px = 0.02;       // floor of the LSM sigma written, virtual px, > 0
   double prefilter_sigma_px = 1.5;  // Gaussian low-pass of the projected heads for LSM (header
                                     // comment), virtual px; 0: none, else 0.3..5
