@@ -106,6 +106,13 @@ void AppendTie(const RigConverter& converter,
   ++report->ties;
 }
 
+// The exposure's tie cell from its zones' pixels (zone -> pixels), in either path.
+double CellOfZones(const RigTieMatchOptions& options, const std::map<unsigned, long>& pixels) {
+  double all = 0;
+  for (const auto& zone : pixels) all += zone.second;
+  return TieCellPx(options, all);
+}
+
 // One exposure's inputs to either path.
 struct ExposureToMatch {
   const RigConverter& converter;
@@ -215,9 +222,7 @@ void MatchOnWholeProjections(const ExposureToMatch& in,
       box = box.area() == 0 ? cv::Rect(c, r, 1, 1) : (box | cv::Rect(c, r, 1, 1));
       ++zone_pixels[m];
     }
-  double all_zone_pixels = 0;
-  for (const auto& zone : zone_pixels) all_zone_pixels += zone.second;
-  const double cell_px = TieCellPx(options, all_zone_pixels);
+  const double cell_px = CellOfZones(options, zone_pixels);
   for (const auto& [mask, box] : zone_box) {
     RigZoneMatchReport report;
     report.image = exposure.image;
@@ -292,14 +297,12 @@ CoarseZones FindCoarseZones(const std::vector<HeadWindowSampler>& samplers,
       }
   }
   CoarseZones out;
-  double all_zone_pixels = 0;
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) {
       const unsigned m = exact.at<std::uint8_t>(r, c);
       if (m & (m - 1)) out.pixels[m] += kCoarseStep * kCoarseStep;
     }
-  for (const auto& zone : out.pixels) all_zone_pixels += zone.second;
-  out.cell_px = TieCellPx(options, all_zone_pixels);
+  out.cell_px = CellOfZones(options, out.pixels);
   for (int r = 0; r < rows; ++r)
     for (int c = 0; c < cols; ++c) {
       const unsigned m_relaxed = relaxed.at<std::uint8_t>(r, c);
